@@ -1,0 +1,15 @@
+"""TopStoc's plain-Python API on numpy arrays (no Blender needed).
+
+>>> import numpy as np, topstoc
+>>> mesh = topstoc.Mesh(vertices, triangles)
+>>> result = mesh.decimate(ratio=0.1, seed=1)
+"""
+
+from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
+                       sampling_probabilities)
+from .mesh import Mesh, MeshReport
+
+__all__ = [
+    "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
+    "decimate_with_samples", "sampling_probabilities",
+]

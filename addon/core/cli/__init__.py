@@ -1,0 +1,55 @@
+"""Command line: ``python3 -m topstoc SUBCOMMAND ...`` (SPEC section 6).
+
+Each subcommand lives in its own module here and provides ``add_parser(subparsers)`` and
+``run(args) -> int``. Errors print one clear line on standard error and exit non-zero.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+
+# Subcommand modules, in the order --help lists them.
+SUBCOMMANDS = ("decimate", "measure", "topology", "loops", "edit")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python3 -m topstoc",
+                                     description="TopStoc: guided decimation with topology control.")
+    subparsers = parser.add_subparsers(dest="command", metavar="SUBCOMMAND")
+    subparsers.required = True
+    for name in SUBCOMMANDS:
+        try:
+            module = importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as error:
+            if error.name == f"{__name__}.{name}":
+                continue  # not part of this build
+            raise
+        module.add_parser(subparsers)
+    return parser
+
+
+def print_json(data) -> None:
+    """Prints a JSON document (numpy scalars and arrays converted)."""
+    def convert(value):
+        if hasattr(value, "tolist"):
+            return value.tolist()
+        raise TypeError(f"cannot write {type(value).__name__} as JSON")
+    json.dump(data, sys.stdout, indent=2, default=convert)
+    sys.stdout.write("\n")
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.run(args) or 0)
+    except (ValueError, OSError, RuntimeError) as error:
+        message = str(error).splitlines()[0] if str(error) else type(error).__name__
+        print(f"topstoc {args.command}: error: {message}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"topstoc {args.command}: interrupted", file=sys.stderr)
+        return 130

@@ -1,0 +1,177 @@
+"""The prepared mesh: validated once, reused by every decimation and analysis."""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from .native import engine
+
+
+@dataclass(frozen=True)
+class MeshReport:
+    """What validation found in the caller's arrays and what it repaired.
+
+    Degenerate triangles (a repeated vertex) and exact duplicates are dropped; everything
+    else is kept and counted. Counts refer to the caller's arrays.
+    """
+
+    input_vertices: int
+    input_triangles: int
+    degenerate_triangles: int
+    duplicate_triangles: int
+    zero_area_triangles: int
+    isolated_vertices: int
+    boundary_edges: int
+    nonmanifold_edges: int
+    nonmanifold_vertices: int
+    inconsistent_edges: int
+    components: int
+    dropped_triangles: np.ndarray
+
+    @property
+    def manifold(self) -> bool:
+        return self.nonmanifold_edges == 0 and self.nonmanifold_vertices == 0
+
+    @property
+    def closed(self) -> bool:
+        return self.boundary_edges == 0
+
+    def summary(self) -> str:
+        """One line for a status bar or a log."""
+        parts = [f"{self.input_vertices} vertices", f"{self.input_triangles} triangles",
+                 f"{self.components} component{'s' if self.components != 1 else ''}"]
+        for name, count in (("degenerate dropped", self.degenerate_triangles),
+                            ("duplicates dropped", self.duplicate_triangles),
+                            ("zero-area", self.zero_area_triangles),
+                            ("isolated vertices", self.isolated_vertices),
+                            ("boundary edges", self.boundary_edges),
+                            ("non-manifold edges", self.nonmanifold_edges),
+                            ("non-manifold vertices", self.nonmanifold_vertices),
+                            ("inconsistently oriented edges", self.inconsistent_edges)):
+            if count:
+                parts.append(f"{count} {name}")
+        return ", ".join(parts)
+
+
+def _as_vertices(vertices) -> np.ndarray:
+    array = np.asarray(vertices)
+    if array.ndim != 2 or array.shape[1] != 3 or array.dtype.kind != "f":
+        raise ValueError(f"vertices must be a float32 or float64 array of shape (n, 3), "
+                         f"got {array.dtype} array of shape {array.shape}")
+    return array
+
+
+def _as_triangles(triangles) -> np.ndarray:
+    array = np.asarray(triangles)
+    if array.ndim != 2 or array.shape[1] != 3 or array.dtype.kind not in "iu":
+        raise ValueError(f"triangles must be an int32 or int64 array of shape (m, 3), "
+                         f"got {array.dtype} array of shape {array.shape}")
+    return array
+
+
+def _digest(array) -> bytes | None:
+    if array is None:
+        return None
+    data = np.ascontiguousarray(array)
+    return hashlib.blake2b(data.tobytes() + str(data.dtype).encode() + str(data.shape).encode(),
+                           digest_size=16).digest()
+
+
+class Mesh:
+    """A triangle mesh prepared for TopStoc: adjacency, normals and importance weights.
+
+    Build it once per mesh state; every decimation, measurement and analysis reuses it, so a
+    re-decimation costs milliseconds. The caller's arrays are copied and never modified.
+
+    >>> mesh = Mesh(vertices, triangles)          # (n, 3) floats, (m, 3) ints
+    >>> result = mesh.decimate(ratio=0.1, seed=1)
+    >>> result.vertices, result.triangles
+    """
+
+    def __init__(self, vertices, triangles):
+        vertices = _as_vertices(vertices)
+        triangles = _as_triangles(triangles)
+        self._native = engine.Mesh(vertices, triangles)
+        self._vertices = np.array(vertices, dtype=np.float64)
+        self._vertices.setflags(write=False)
+        self._triangles = np.array(triangles, dtype=np.int64).astype(np.int32)
+        self._triangles.setflags(write=False)
+        self._layouts: dict = {}
+
+    # -- the caller's data, read-only --------------------------------------------------------
+    @property
+    def vertices(self) -> np.ndarray:
+        """(n, 3) float64 positions as given (read-only copy)."""
+        return self._vertices
+
+    @property
+    def triangles(self) -> np.ndarray:
+        """(m, 3) int32 triangles as given, including any the validation dropped (read-only)."""
+        return self._triangles
+
+    @property
+    def num_vertices(self) -> int:
+        return self._native.num_vertices
+
+    @property
+    def num_triangles(self) -> int:
+        """Triangles after dropping degenerate and duplicate ones."""
+        return self._native.num_faces
+
+    @property
+    def diagonal(self) -> float:
+        """Length of the bounding-box diagonal."""
+        return self._native.diagonal
+
+    @property
+    def weights(self) -> np.ndarray:
+        """Importance weight x(v) of thesis eq. 4.1 per vertex, in [0, 1]."""
+        return self._native.weights
+
+    @property
+    def normals(self) -> np.ndarray:
+        """Unit area-weighted vertex normals (zero where a vertex has no area)."""
+        return self._native.normals
+
+    @property
+    def native(self):
+        """The engine's prepared mesh (for the other topstoc.core modules)."""
+        return self._native
+
+    def report(self) -> MeshReport:
+        """What validation found and repaired."""
+        return MeshReport(**self._native.report)
+
+    def feature_layout(self, regions=None, borders=None):
+        """Feature layout for per-triangle region ids and flagged edges, cached per content.
+
+        regions: one integer per triangle of the caller's array (material slot, UV island...);
+        clusters never cross a change of region. borders: (k, 2) vertex pairs that clusters
+        never cross (UV seams, sharp edges); each must be an edge of the mesh.
+        """
+        key = (_digest(regions), _digest(borders))
+        layout = self._layouts.get(key)
+        if layout is None:
+            layout = engine.build_feature_layout(self._native, regions, borders)
+            if len(self._layouts) >= 8:
+                self._layouts.pop(next(iter(self._layouts)))
+            self._layouts[key] = layout
+        return layout
+
+    def decimate(self, ratio=None, vertices=None, triangles=None, **options):
+        """TopStoc decimation; see topstoc.core.decimate.decimate for every option."""
+        from .decimate import decimate
+
+        return decimate(self, ratio=ratio, vertices=vertices, triangles=triangles, **options)
+
+    def decimate_with_samples(self, samples, **options):
+        """Re-creates a decimation from its saved sample list (thesis 4.1.3)."""
+        from .decimate import decimate_with_samples
+
+        return decimate_with_samples(self, samples, **options)
+
+    def __repr__(self) -> str:
+        return f"<topstoc.Mesh {self.num_vertices} vertices, {self.num_triangles} triangles>"

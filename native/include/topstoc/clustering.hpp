@@ -1,0 +1,35 @@
+// Topological clustering by multi-source breadth-first flood fill (thesis 4.1, algorithm 4.1).
+//
+// Each vertex joins the sample that minimises (hop distance, rank in the sample list). That
+// definition does not depend on the order in which the fill visits vertices, so the result is
+// reproducible from the sample list alone and can be updated exactly when samples are added.
+// Feature vertices are entered only along feature edges: borders are partitioned as curves of
+// their own and no cluster crosses them.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "topstoc/features.hpp"
+#include "topstoc/mesh.hpp"
+
+namespace topstoc {
+
+struct Clustering {
+  std::vector<int32_t> label;   ///< rank of the vertex's sample, -1 if unreached
+  std::vector<int32_t> dist;    ///< hop distance to that sample (INT32_MAX if unreached)
+  std::vector<int32_t> parent;  ///< neighbour the vertex was reached from, -1 for samples
+};
+
+/// Floods from `samples` (distinct vertex ids; rank = position). If cross_faces is given it
+/// receives, per face, 1 where the face touches an edge between two clusters: the candidate
+/// list of the fast path (thesis 4.1.1), collected during the fill instead of by a later scan.
+void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples, Clustering& out,
+           std::vector<uint8_t>* cross_faces = nullptr);
+
+/// Adds samples[first_new..) to an existing clustering of samples[0..first_new) and updates
+/// only the vertices whose (distance, rank) improves. Gives exactly what flood() would.
+void flood_add(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
+               int32_t first_new, Clustering& clustering);
+
+}  // namespace topstoc

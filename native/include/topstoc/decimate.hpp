@@ -1,0 +1,72 @@
+// TopStoc decimation (thesis 4.1; SPEC §1): sample, flood, check, repair, emit.
+//
+// The output's vertices are input vertices (or, in filtered mode, points near them); every
+// output triangle comes from one input triangle whose corners lie in three different clusters,
+// and keeps its orientation. When the clustering would break the topology the decimation adds
+// samples to the offending clusters and re-floods incrementally until every check passes;
+// the result reports how many samples that took. The final sample list, fed back through
+// decimate_with_samples, reproduces the identical output.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "topstoc/features.hpp"
+#include "topstoc/mesh.hpp"
+#include "topstoc/partition.hpp"
+#include "topstoc/sampling.hpp"
+
+namespace topstoc {
+
+enum class Placement { Subsample, Filtered };
+
+struct DecimateParams {
+  int32_t target_vertices = 0;  ///< wanted output vertices (exact without guidance, before repairs)
+  SamplingParams sampling;
+  Placement placement = Placement::Subsample;
+  int32_t max_repair_rounds = 200;
+  int fast_path = -1;           ///< collect candidate faces during the flood: -1 below 5 %, 0 never, 1 always
+  int budget_passes = 3;        ///< extra draws to land within 0.5 % of the target (unguided only)
+};
+
+struct RepairStats {
+  int32_t rounds = 0;          ///< re-flood rounds after the first check
+  int32_t samples_added = 0;   ///< samples added to restore topology or shape
+  PartitionIssues found;       ///< issues found over all rounds
+  PartitionIssues remaining;   ///< issues left when the round limit was hit (normally none)
+};
+
+struct DecimateResult {
+  // All vertex ids below are the caller's (see Mesh::vertex_source).
+  std::vector<int32_t> samples;        ///< the full sample list: feed it back to reproduce this result
+  std::vector<int32_t> kept;           ///< input vertex of each output vertex (samples with triangles)
+  std::vector<double> positions;       ///< 3 per output vertex
+  std::vector<int32_t> triangles;      ///< 3 per output triangle, indices into kept
+  std::vector<int32_t> face_source;    ///< caller's triangle each output triangle comes from
+  std::vector<int32_t> corner_source;  ///< 3 per output triangle: caller's corner 3 * triangle + slot
+  std::vector<int32_t> labels;         ///< per input vertex: output vertex of its cluster, -1 if none
+  int32_t target_vertices = 0;
+  int32_t selected = 0;                ///< samples drawn before repairs
+  int32_t forced = 0;                  ///< corners and control points among them
+  int32_t density_rejected = 0;
+  bool guided = false;
+  double expected_vertices = 0.0;      ///< sum of the sampling probabilities
+  double rate = 0.0;                   ///< base rate k used for the probabilities
+  bool fast_path = false;
+  RepairStats repairs;
+  double seconds_sampling = 0, seconds_clustering = 0, seconds_checking = 0, seconds_output = 0;
+};
+
+/// Decimates to params.target_vertices (1 <= target). Throws std::invalid_argument on bad params.
+DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params);
+
+/// Re-creates a decimation from a saved sample list (thesis 4.1.3).
+DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
+                                     Placement placement, int32_t max_repair_rounds = 200);
+
+/// Decimates to about `target_triangles` output triangles (within 1 % where the mesh allows),
+/// re-decimating with a corrected vertex target up to `max_iterations` times.
+DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layout, DecimateParams params,
+                                     int32_t target_triangles, int max_iterations = 6);
+
+}  // namespace topstoc

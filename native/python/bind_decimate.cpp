@@ -1,0 +1,220 @@
+// Bindings for decimation, sampling probabilities and triangle quality.
+#include <pybind11/stl.h>
+
+#include <cmath>
+
+#include "convert.hpp"
+#include "topstoc/decimate.hpp"
+#include "topstoc/quality.hpp"
+
+namespace topstoc::python {
+
+namespace {
+
+DensityMode density_from(const std::string& name) {
+  if (name == "off") return DensityMode::Off;
+  if (name == "uniform") return DensityMode::Uniform;
+  if (name == "adaptive") return DensityMode::Adaptive;
+  if (name == "euclidean") return DensityMode::Euclidean;
+  throw py::value_error("density must be 'off', 'uniform', 'adaptive' or 'euclidean', got '" + name + "'");
+}
+
+Placement placement_from(const std::string& name) {
+  if (name == "subsample") return Placement::Subsample;
+  if (name == "filtered") return Placement::Filtered;
+  throw py::value_error("placement must be 'subsample' or 'filtered', got '" + name + "'");
+}
+
+template <size_t N>
+void fill(const py::handle& object, double (&out)[N], const char* what) {
+  auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(object);
+  if (!values || size_t(values.size()) != N)
+    throw py::value_error(std::string(what) + " must hold " + std::to_string(N) + " numbers");
+  for (size_t i = 0; i < N; ++i) out[i] = values.data()[i];
+}
+
+ViewGuidance view_from(const py::handle& object) {
+  ViewGuidance view;
+  if (object.is_none()) return view;
+  py::dict d = py::cast<py::dict>(object);
+  view.enabled = true;
+  view.perspective = d.contains("perspective") ? py::cast<bool>(d["perspective"]) : true;
+  if (d.contains("eye")) fill(d["eye"], view.eye, "view eye");
+  if (d.contains("direction")) fill(d["direction"], view.direction, "view direction");
+  if (d.contains("back_ratio")) view.back_ratio = py::cast<double>(d["back_ratio"]);
+  if (d.contains("silhouette_angle")) view.silhouette_angle = py::cast<double>(d["silhouette_angle"]);
+  if (d.contains("silhouette_falloff")) view.silhouette_falloff = py::cast<double>(d["silhouette_falloff"]);
+  if (d.contains("view_projection") && !d["view_projection"].is_none()) {
+    fill(d["view_projection"], view.view_projection, "view_projection");
+    view.frustum = true;
+  }
+  if (d.contains("outside_probability")) view.outside_probability = py::cast<double>(d["outside_probability"]);
+  return view;
+}
+
+std::vector<BoxGuidance> boxes_from(const py::handle& object) {
+  std::vector<BoxGuidance> boxes;
+  if (object.is_none()) return boxes;
+  for (const auto& item : object) {
+    auto pair = py::cast<py::tuple>(item);
+    if (pair.size() != 2) throw py::value_error("each box must be (world_to_box 4x4 matrix, value)");
+    BoxGuidance box{};
+    fill(pair[0], box.world_to_box, "box matrix");
+    box.value = py::cast<double>(pair[1]);
+    boxes.push_back(box);
+  }
+  return boxes;
+}
+
+py::dict issues_dict(const PartitionIssues& i) {
+  py::dict d;
+  d["unreached"] = i.unreached;
+  d["non_disk"] = i.non_disk;
+  d["bad_edge"] = i.bad_edge;
+  d["duplicate"] = i.duplicate;
+  d["bad_link"] = i.bad_link;
+  d["short_loop"] = i.short_loop;
+  d["isolated"] = i.isolated;
+  d["sliver"] = i.sliver;
+  d["absorbed"] = i.absorbed;
+  d["bad_component"] = i.bad_component;
+  d["pillows"] = i.pillows;
+  return d;
+}
+
+py::dict result_dict(DecimateResult&& r) {
+  py::dict d;
+  d["samples"] = to_array(std::move(r.samples));
+  d["kept"] = to_array(std::move(r.kept));
+  d["positions"] = to_array(std::move(r.positions), 3);
+  d["triangles"] = to_array(std::move(r.triangles), 3);
+  d["face_source"] = to_array(std::move(r.face_source));
+  d["corner_source"] = to_array(std::move(r.corner_source), 3);
+  d["labels"] = to_array(std::move(r.labels));
+  d["target_vertices"] = r.target_vertices;
+  d["selected"] = r.selected;
+  d["forced"] = r.forced;
+  d["density_rejected"] = r.density_rejected;
+  d["guided"] = r.guided;
+  d["expected_vertices"] = r.expected_vertices;
+  d["rate"] = r.rate;
+  d["fast_path"] = r.fast_path;
+  py::dict repairs;
+  repairs["rounds"] = r.repairs.rounds;
+  repairs["samples_added"] = r.repairs.samples_added;
+  repairs["found"] = issues_dict(r.repairs.found);
+  repairs["remaining"] = issues_dict(r.repairs.remaining);
+  d["repairs"] = repairs;
+  py::dict seconds;
+  seconds["sampling"] = r.seconds_sampling;
+  seconds["clustering"] = r.seconds_clustering;
+  seconds["checking"] = r.seconds_checking;
+  seconds["output"] = r.seconds_output;
+  d["seconds"] = seconds;
+  return d;
+}
+
+SamplingParams sampling_from(const Mesh& mesh, uint64_t seed, double adaptivity, double flat_floor,
+                             const std::vector<double>& guidance, const std::string& density, int32_t density_rings,
+                             double density_ratio, double density_epsilon, const py::handle& view,
+                             const py::handle& boxes) {
+  SamplingParams s;
+  s.seed = seed;
+  s.adaptivity = adaptivity;
+  s.flat_floor = flat_floor;
+  s.guidance = guidance.empty() ? nullptr : guidance.data();
+  s.density = density_from(density);
+  s.density_rings = density_rings;
+  s.density_ratio = density_ratio;
+  s.density_epsilon = density_epsilon;
+  s.view = view_from(view);
+  s.boxes = boxes_from(boxes);
+  validate_sampling_params(mesh, s);
+  return s;
+}
+
+}  // namespace
+
+void bind_decimate(py::module_& m) {
+  m.def(
+      "decimate",
+      [](const Mesh& mesh, const FeatureLayout& layout, int32_t target_vertices, int32_t target_triangles,
+         uint64_t seed, double adaptivity, double flat_floor, const py::handle& guidance, const std::string& density,
+         int32_t density_rings, double density_ratio, double density_epsilon, const py::handle& view,
+         const py::handle& boxes, const std::string& placement, int fast_path, int32_t max_repair_rounds) {
+        const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
+        DecimateParams params;
+        params.sampling = sampling_from(mesh, seed, adaptivity, flat_floor, u, density, density_rings, density_ratio,
+                                        density_epsilon, view, boxes);
+        params.placement = placement_from(placement);
+        params.fast_path = fast_path;
+        params.max_repair_rounds = max_repair_rounds;
+        params.target_vertices = target_vertices;
+        DecimateResult r;
+        {
+          py::gil_scoped_release release;
+          r = target_triangles > 0 ? decimate_to_triangles(mesh, layout, params, target_triangles)
+                                   : decimate(mesh, layout, params);
+        }
+        return result_dict(std::move(r));
+      },
+      py::arg("mesh"), py::arg("layout"), py::arg("target_vertices") = 0, py::arg("target_triangles") = 0,
+      py::arg("seed") = 0, py::arg("adaptivity") = 0.5, py::arg("flat_floor") = 0.25, py::arg("guidance") = py::none(),
+      py::arg("density") = "off", py::arg("density_rings") = 0, py::arg("density_ratio") = 2.0,
+      py::arg("density_epsilon") = 0.0, py::arg("view") = py::none(), py::arg("boxes") = py::none(),
+      py::arg("placement") = "subsample", py::arg("fast_path") = -1, py::arg("max_repair_rounds") = 200,
+      "TopStoc decimation to a vertex target (or a triangle target when target_triangles > 0).");
+
+  m.def(
+      "decimate_with_samples",
+      [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& samples, const std::string& placement,
+         int32_t max_repair_rounds) {
+        auto ids = ids_from(samples, -1, "samples");
+        DecimateResult r;
+        {
+          py::gil_scoped_release release;
+          r = decimate_with_samples(mesh, layout, std::move(ids), placement_from(placement), max_repair_rounds);
+        }
+        return result_dict(std::move(r));
+      },
+      py::arg("mesh"), py::arg("layout"), py::arg("samples"), py::arg("placement") = "subsample",
+      py::arg("max_repair_rounds") = 200, "Re-creates a decimation from its saved sample list.");
+
+  m.def(
+      "sampling_probabilities",
+      [](const Mesh& mesh, const FeatureLayout& layout, double rate, uint64_t seed, double adaptivity,
+         double flat_floor, const py::handle& guidance, const py::handle& view, const py::handle& boxes) {
+        const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
+        auto s = sampling_from(mesh, seed, adaptivity, flat_floor, u, "off", 0, 2.0, 0.0, view, boxes);
+        std::vector<double> p;
+        {
+          py::gil_scoped_release release;
+          p = sampling_probabilities(mesh, layout, s, rate);
+        }
+        return to_array(std::move(p));
+      },
+      py::arg("mesh"), py::arg("layout"), py::arg("rate"), py::arg("seed") = 0, py::arg("adaptivity") = 0.5,
+      py::arg("flat_floor") = 0.25, py::arg("guidance") = py::none(), py::arg("view") = py::none(),
+      py::arg("boxes") = py::none(), "Per-vertex sampling probability p(v) for base rate k (SPEC 1.2).");
+
+  m.def(
+      "aspect_ratio_stats",
+      [](const py::handle& vertices, const py::handle& triangles) {
+        auto p = positions_from(vertices, "vertices");
+        auto t = indices_from(triangles, 3, "triangles");
+        const int64_t n = int64_t(p.size() / 3);
+        for (size_t i = 0; i < t.size(); ++i)
+          if (t[i] < 0 || t[i] >= n)
+            throw py::value_error("triangle " + std::to_string(i / 3) + " refers to vertex " + std::to_string(t[i]) +
+                                  " outside [0, " + std::to_string(n) + ")");
+        AspectStats s = aspect_ratio_stats(p.data(), t.data(), int64_t(t.size() / 3));
+        py::dict d;
+        d["mean"] = s.mean;
+        d["max"] = s.max;
+        d["degenerate"] = s.degenerate;
+        return d;
+      },
+      py::arg("vertices"), py::arg("triangles"), "Aspect ratio (thesis eq. 4.2): mean, max, degenerate count.");
+}
+
+}  // namespace topstoc::python

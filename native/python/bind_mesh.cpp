@@ -1,0 +1,107 @@
+// Bindings for the prepared mesh and its feature layout.
+#include <pybind11/stl.h>
+
+#include "convert.hpp"
+#include "topstoc/features.hpp"
+#include "topstoc/mesh.hpp"
+
+namespace topstoc::python {
+
+namespace {
+
+// Per-vertex values (width per vertex) reordered from internal to caller order.
+template <class T>
+std::vector<T> by_caller(const Mesh& mesh, const std::vector<T>& values, size_t width) {
+  std::vector<T> out(values.size());
+  const auto& source = mesh.vertex_source();
+  for (size_t v = 0; v < source.size(); ++v)
+    for (size_t k = 0; k < width; ++k) out[width * size_t(source[v]) + k] = values[width * v + k];
+  return out;
+}
+
+// Internal vertex ids replaced by the caller's.
+std::vector<int32_t> caller_ids(const Mesh& mesh, const std::vector<int32_t>& ids) {
+  std::vector<int32_t> out(ids.size());
+  for (size_t i = 0; i < ids.size(); ++i) out[i] = mesh.vertex_source()[ids[i]];
+  return out;
+}
+
+py::dict report_dict(const MeshReport& r) {
+  py::dict d;
+  d["input_vertices"] = r.input_vertices;
+  d["input_triangles"] = r.input_triangles;
+  d["degenerate_triangles"] = r.degenerate_triangles;
+  d["duplicate_triangles"] = r.duplicate_triangles;
+  d["zero_area_triangles"] = r.zero_area_triangles;
+  d["isolated_vertices"] = r.isolated_vertices;
+  d["boundary_edges"] = r.boundary_edges;
+  d["nonmanifold_edges"] = r.nonmanifold_edges;
+  d["nonmanifold_vertices"] = r.nonmanifold_vertices;
+  d["inconsistent_edges"] = r.inconsistent_edges;
+  d["components"] = r.components;
+  d["dropped_triangles"] = copy_array(r.dropped_triangles);
+  return d;
+}
+
+}  // namespace
+
+void bind_mesh(py::module_& m) {
+  py::class_<Mesh, std::shared_ptr<Mesh>>(m, "Mesh", "Prepared triangle mesh (validated, with adjacency and weights).")
+      .def(py::init([](const py::handle& vertices, const py::handle& triangles) {
+             auto positions = positions_from(vertices, "vertices");
+             auto tris = indices_from(triangles, 3, "triangles");
+             py::gil_scoped_release release;
+             return std::make_shared<Mesh>(std::move(positions), tris.data(), int64_t(tris.size() / 3));
+           }),
+           py::arg("vertices"), py::arg("triangles"))
+      .def_property_readonly("num_vertices", &Mesh::num_vertices)
+      .def_property_readonly("num_faces", &Mesh::num_faces)
+      .def_property_readonly("num_edges", &Mesh::num_edges)
+      .def_property_readonly("diagonal", &Mesh::diagonal)
+      .def_property_readonly("mean_weight", &Mesh::mean_weight)
+      // Everything below is in the caller's vertex ids and order.
+      .def_property_readonly("weights", [](const Mesh& mesh) { return to_array(by_caller(mesh, mesh.weights(), 1)); })
+      .def_property_readonly("normals", [](const Mesh& mesh) { return to_array(by_caller(mesh, mesh.normals(), 3), 3); })
+      .def_property_readonly("component", [](const Mesh& mesh) { return to_array(by_caller(mesh, mesh.component(), 1)); })
+      .def_property_readonly("faces", [](const Mesh& mesh) { return to_array(caller_ids(mesh, mesh.faces()), 3); })
+      .def_property_readonly("face_source", [](const Mesh& mesh) { return copy_array(mesh.face_source()); })
+      .def_property_readonly("edges", [](const Mesh& mesh) { return to_array(caller_ids(mesh, mesh.edge_vertices()), 2); })
+      .def_property_readonly("report", [](const Mesh& mesh) { return report_dict(mesh.report()); });
+
+  py::class_<FeatureLayout, std::shared_ptr<FeatureLayout>>(
+      m, "FeatureLayout", "Edges no cluster may cross (boundaries, region borders, flagged edges) and their curves.")
+      .def_property_readonly("feature_edges",
+                             [](const FeatureLayout& l) {
+                               int32_t count = 0;
+                               for (auto x : l.edge_feature) count += x;
+                               return count;
+                             })
+      .def_property_readonly("region_border_edges", [](const FeatureLayout& l) { return l.region_border_edges; })
+      .def_property_readonly("flagged_edges", [](const FeatureLayout& l) { return l.flagged_edges; })
+      .def_property_readonly("corners",
+                             [](const FeatureLayout& l) {
+                               int32_t count = 0;
+                               for (auto x : l.vertex_corner) count += x;
+                               return count;
+                             })
+      .def_property_readonly("num_curves", &FeatureLayout::num_curves)
+      .def_property_readonly("edge_feature", [](const FeatureLayout& l) { return copy_array(l.edge_feature); })
+      .def_property_readonly("vertex_feature", [](const FeatureLayout& l) { return copy_array(l.vertex_feature); });
+
+  m.def(
+      "build_feature_layout",
+      [](const Mesh& mesh, const py::handle& regions, const py::handle& borders) {
+        auto region_ids = ids_from(regions, mesh.report().input_triangles, "regions");
+        std::vector<int32_t> edges;
+        if (!borders.is_none()) edges = indices_from(borders, 2, "borders");
+        py::gil_scoped_release release;
+        // pybind11 holders cannot be shared_ptr<const T>; Python never mutates the layout.
+        return std::const_pointer_cast<FeatureLayout>(
+            build_feature_layout(mesh, region_ids.empty() ? nullptr : region_ids.data(), int64_t(region_ids.size()),
+                                 edges.data(), int64_t(edges.size() / 2)));
+      },
+      py::arg("mesh"), py::arg("regions") = py::none(), py::arg("borders") = py::none(),
+      "Feature layout from per-triangle region ids (caller's order) and flagged edges (vertex pairs).");
+}
+
+}  // namespace topstoc::python

@@ -1,0 +1,372 @@
+#include "topstoc/sampling.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "topstoc/random.hpp"
+
+namespace topstoc {
+
+namespace {
+
+constexpr uint64_t kStreamSelection = 1;
+
+enum VertexClass : uint8_t { kIsolated = 0, kSurface = 1, kCurve = 2, kCorner = 3 };
+
+std::vector<uint8_t> classify(const Mesh& mesh, const FeatureLayout& layout) {
+  const int32_t n = mesh.num_vertices();
+  const auto& vfo = mesh.vertex_face_offsets();
+  std::vector<uint8_t> cls(n);
+  for (int32_t v = 0; v < n; ++v)
+    cls[v] = vfo[v] == vfo[v + 1] ? kIsolated
+             : layout.vertex_corner[v] ? kCorner
+             : layout.vertex_feature[v] ? kCurve
+                                        : kSurface;
+  return cls;
+}
+
+// Importance factor q(v) = 1 + α (x / x̄ - 1), floored so flat regions are not starved.
+inline double importance(const Mesh& mesh, const SamplingParams& params, int32_t v) {
+  const double mean = mesh.mean_weight();
+  const double q = mean > 0 ? 1.0 + params.adaptivity * (mesh.weights()[v] / mean - 1.0) : 1.0;
+  return std::max(q, params.flat_floor);
+}
+
+bool inside_box(const BoxGuidance& box, const double* p) {
+  const double* m = box.world_to_box;
+  for (int r = 0; r < 3; ++r) {
+    const double c = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
+    if (std::abs(c) > 1.0) return false;
+  }
+  return true;
+}
+
+bool inside_frustum(const ViewGuidance& view, const double* p) {
+  const double* m = view.view_projection;
+  double clip[4];
+  for (int r = 0; r < 4; ++r) clip[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
+  if (clip[3] <= 0) return false;
+  for (int r = 0; r < 3; ++r)
+    if (std::abs(clip[r]) > clip[3]) return false;
+  return true;
+}
+
+// Silhouette band, back faces and frustum (thesis 4.4) applied to p for one vertex.
+double apply_view(const ViewGuidance& view, const double* position, const double* normal, double p) {
+  double to_eye[3];
+  if (view.perspective) {
+    for (int k = 0; k < 3; ++k) to_eye[k] = view.eye[k] - position[k];
+  } else {
+    for (int k = 0; k < 3; ++k) to_eye[k] = -view.direction[k];
+  }
+  const double len = std::sqrt(to_eye[0] * to_eye[0] + to_eye[1] * to_eye[1] + to_eye[2] * to_eye[2]);
+  const double facing = len > 0 ? (normal[0] * to_eye[0] + normal[1] * to_eye[1] + normal[2] * to_eye[2]) / len : 1.0;
+  const double band = (1.0 - std::cos(view.silhouette_angle)) / 2.0;
+  const double away = std::abs(facing);
+  if (facing < 0) p *= view.back_ratio;
+  if (away <= band) {
+    p = 1.0;
+  } else if (view.silhouette_falloff > 0 && away < band + view.silhouette_falloff) {
+    const double t = (away - band) / view.silhouette_falloff;  // 0 at the band, 1 outside
+    p = (1.0 - t) * 1.0 + t * p;
+  }
+  if (view.frustum && !inside_frustum(view, position)) p = std::min(p, view.outside_probability);
+  return p;
+}
+
+double surface_probability(const Mesh& mesh, const SamplingParams& params, int32_t v, double k) {
+  const double* position = mesh.position(v);
+  double u = params.guidance ? params.guidance[mesh.vertex_source()[v]] : 0.0;
+  for (const auto& box : params.boxes)
+    if (inside_box(box, position)) u = box.value;
+  if (u >= 1.0) return 1.0;   // a control point
+  if (u <= -1.0) return 0.0;  // never sampled (topology may still need it)
+  const double p0 = std::min(1.0, k * importance(mesh, params, v));
+  double p = u > 0 ? p0 + (1.0 - p0) * u : p0 * (1.0 + u);
+  if (params.view.enabled) p = apply_view(params.view, position, &mesh.normals()[3 * size_t(v)], p);
+  return std::clamp(p, 0.0, 1.0);
+}
+
+std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& cls, const SamplingParams& params,
+                                  double k) {
+  const int32_t n = mesh.num_vertices();
+  std::vector<double> p(n);
+#pragma omp parallel for schedule(static)
+  for (int32_t v = 0; v < n; ++v) {
+    switch (cls[v]) {
+      case kIsolated: p[v] = 0.0; break;
+      case kCorner: p[v] = 1.0; break;
+      case kCurve: p[v] = std::sqrt(surface_probability(mesh, params, v, k)); break;
+      default: p[v] = surface_probability(mesh, params, v, k);
+    }
+  }
+  return p;
+}
+
+// Without guidance: the base rate k whose probabilities sum to the target (Illinois regula falsi
+// on the monotone sum; the draw fixes the count, so k need only be close).
+double solve_rate(const Mesh& mesh, const std::vector<uint8_t>& cls, const SamplingParams& params, double target) {
+  const int32_t n = mesh.num_vertices();
+  std::vector<double> q(n, 0.0);
+  double min_q = 1e300;
+  for (int32_t v = 0; v < n; ++v)
+    if (cls[v] == kSurface || cls[v] == kCurve) {
+      q[v] = importance(mesh, params, v);
+      min_q = std::min(min_q, q[v]);
+    }
+  auto sum = [&](double k) {
+    double s = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : s)
+    for (int32_t v = 0; v < n; ++v) {
+      if (cls[v] == kSurface) s += std::min(1.0, k * q[v]);
+      else if (cls[v] == kCurve) s += std::min(1.0, std::sqrt(k * q[v]));
+      else if (cls[v] == kCorner) s += 1.0;
+    }
+    return s;
+  };
+  double lo = 0.0, hi = min_q < 1e300 ? 1.0 / min_q : 1.0;
+  double f_lo = sum(lo) - target, f_hi = sum(hi) - target;
+  if (f_lo >= 0) return 0.0;
+  if (f_hi <= 0) return hi;
+  int side = 0;
+  double k = lo;
+  for (int it = 0; it < 60; ++it) {
+    k = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+    const double f = sum(k) - target;
+    if (std::abs(f) <= std::max(0.5, 1e-4 * target)) break;
+    if (f < 0) {
+      lo = k, f_lo = f;
+      if (side == -1) f_hi /= 2;
+      side = -1;
+    } else {
+      hi = k, f_hi = f;
+      if (side == 1) f_lo /= 2;
+      side = 1;
+    }
+  }
+  return k;
+}
+
+struct Candidate {
+  double key;
+  int32_t vertex;
+  bool operator<(const Candidate& o) const { return key < o.key || (key == o.key && vertex < o.vertex); }
+};
+
+// Breadth-first ball of `rings` hops around `center`, restricted by `follow(slot)`; calls
+// visit(v) for each vertex reached (center included).
+template <class Follow, class Visit>
+void ring_ball(const Mesh& mesh, int32_t center, int32_t rings, std::vector<int32_t>& stamp, int32_t stamp_id,
+               std::vector<int32_t>& queue, Follow follow, Visit visit) {
+  const auto& ao = mesh.adjacency_offsets();
+  const auto& adj = mesh.adjacency();
+  queue.clear();
+  queue.push_back(center);
+  stamp[center] = stamp_id;
+  size_t head = 0;
+  for (int32_t ring = 0; ring <= rings && head < queue.size(); ++ring) {
+    const size_t end = queue.size();
+    for (; head < end; ++head) {
+      const int32_t v = queue[head];
+      visit(v);
+      if (ring == rings) continue;
+      for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
+        const int32_t u = adj[i];
+        if (stamp[u] != stamp_id && follow(v, i, u)) {
+          stamp[u] = stamp_id;
+          queue.push_back(u);
+        }
+      }
+    }
+  }
+}
+
+double mean_edge_length(const Mesh& mesh) {
+  const auto& ev = mesh.edge_vertices();
+  double total = 0.0;
+  const int32_t m = mesh.num_edges();
+#pragma omp parallel for schedule(static) reduction(+ : total)
+  for (int32_t e = 0; e < m; ++e) {
+    const double* a = mesh.position(ev[2 * e]);
+    const double* b = mesh.position(ev[2 * e + 1]);
+    total += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+  }
+  return m ? total / m : 0.0;
+}
+
+// Poisson-disk rejection (thesis 4.1.2): candidates in key order, each accepted sample blocks
+// its neighbourhood. Surface samples block surface vertices; curve samples and corners block
+// both, so borders keep their own spacing. Stops at `count` samples; if rejection leaves too
+// few, the rejected candidates are taken back in key order.
+std::vector<int32_t> select_with_density(const Mesh& mesh, const FeatureLayout& layout,
+                                         const std::vector<uint8_t>& cls, const SamplingParams& params,
+                                         std::vector<int32_t> forced, std::vector<Candidate> candidates,
+                                         int32_t count, int32_t& rejected_out) {
+  const int32_t n = mesh.num_vertices();
+  const double r = std::sqrt(double(std::max<int32_t>(1, n)) / (3.0 * std::max<int32_t>(1, count)));
+  const int32_t eps_uniform = params.density_rings > 0 ? params.density_rings : std::max(1, int32_t(std::lround(r)));
+  const int32_t eps_big = params.density_rings > 0 ? params.density_rings : std::max(2, int32_t(std::lround(1.25 * r)));
+  const int32_t eps_small = std::max(1, int32_t(eps_big / std::max(1.0, params.density_ratio)));
+  const double eps_euclid = params.density_epsilon > 0 ? params.density_epsilon : r * mean_edge_length(mesh);
+  const auto& feature = layout.vertex_feature;
+  const auto& ae = mesh.adjacency_edge();
+
+  std::vector<uint8_t> blocked(n, 0);
+  std::vector<int32_t> stamp(n, -1), queue;
+  int32_t stamp_id = 0;
+  auto block_around = [&](int32_t s) {
+    const bool surface = cls[s] == kSurface;
+    int32_t rings = eps_uniform;
+    if (params.density == DensityMode::Adaptive)
+      rings = mesh.weights()[s] > mesh.mean_weight() ? eps_small : eps_big;
+    const double* ps = mesh.position(s);
+    const bool euclid = params.density == DensityMode::Euclidean;
+    const int32_t max_rings = euclid ? n : rings;
+    ++stamp_id;
+    // Surface samples spread over surface vertices only; border samples along borders and into the surface.
+    ring_ball(
+        mesh, s, max_rings, stamp, stamp_id, queue,
+        [&](int32_t, int32_t slot, int32_t u) {
+          if (euclid) {
+            const double* pu = mesh.position(u);
+            const double d2 = (pu[0] - ps[0]) * (pu[0] - ps[0]) + (pu[1] - ps[1]) * (pu[1] - ps[1]) +
+                              (pu[2] - ps[2]) * (pu[2] - ps[2]);
+            if (d2 > eps_euclid * eps_euclid) return false;
+          }
+          if (surface) return !feature[u];
+          return feature[u] ? layout.edge_feature[ae[slot]] != 0 : true;
+        },
+        [&](int32_t v) { blocked[v] = 1; });
+  };
+  std::vector<int32_t> chosen = std::move(forced);
+  for (int32_t s : chosen) block_around(s);
+  std::vector<Candidate> skipped;
+  // Sort candidates lazily in chunks: usually only the first ~2 count are ever looked at.
+  size_t sorted_end = 0;
+  auto ensure_sorted = [&](size_t i) {
+    if (i < sorted_end) return;
+    const size_t chunk = std::max<size_t>(2 * size_t(count) + 64, sorted_end);
+    const size_t end = std::min(candidates.size(), sorted_end + chunk);
+    std::nth_element(candidates.begin() + sorted_end, candidates.begin() + (end - 1), candidates.end());
+    std::sort(candidates.begin() + sorted_end, candidates.begin() + end);
+    sorted_end = end;
+  };
+  int32_t rejected = 0;
+  for (size_t i = 0; i < candidates.size() && int32_t(chosen.size()) < count; ++i) {
+    ensure_sorted(i);
+    const int32_t v = candidates[i].vertex;
+    if (blocked[v]) {
+      ++rejected;
+      skipped.push_back(candidates[i]);
+      continue;
+    }
+    chosen.push_back(v);
+    block_around(v);
+  }
+  for (size_t i = 0; i < skipped.size() && int32_t(chosen.size()) < count; ++i) {
+    chosen.push_back(skipped[i].vertex);
+    --rejected;
+  }
+  rejected_out = rejected;
+  return chosen;
+}
+
+}  // namespace
+
+bool is_guided(const Mesh& mesh, const SamplingParams& params) {
+  if (params.view.enabled || !params.boxes.empty()) return true;
+  if (params.guidance)
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+      if (params.guidance[v] != 0.0) return true;  // indexed by caller id; any order will do
+  return false;
+}
+
+void validate_sampling_params(const Mesh& mesh, const SamplingParams& params) {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok) throw std::invalid_argument(message);
+  };
+  require(params.adaptivity >= 0.0 && params.adaptivity <= 1.0, "adaptivity must lie in [0, 1]");
+  require(params.flat_floor >= 0.0 && params.flat_floor <= 1.0, "flat_floor must lie in [0, 1]");
+  require(params.density_rings >= 0, "density_rings must be >= 0");
+  require(params.density_ratio >= 1.0, "density_ratio must be >= 1");
+  require(params.density_epsilon >= 0.0 && std::isfinite(params.density_epsilon), "density_epsilon must be >= 0");
+  if (params.guidance)
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+      const double u = params.guidance[v];
+      if (!(u >= -1.0 && u <= 1.0))
+        throw std::invalid_argument("guidance of vertex " + std::to_string(v) + " is " + std::to_string(u) +
+                                    "; it must lie in [-1, 1]");
+    }
+  for (size_t b = 0; b < params.boxes.size(); ++b) {
+    const auto& box = params.boxes[b];
+    require(box.value >= -1.0 && box.value <= 1.0, "box " + std::to_string(b) + " guidance must lie in [-1, 1]");
+    for (double x : box.world_to_box) require(std::isfinite(x), "box " + std::to_string(b) + " matrix is not finite");
+  }
+  if (params.view.enabled) {
+    const auto& view = params.view;
+    require(view.back_ratio >= 0.0 && view.back_ratio <= 1.0, "view back_ratio must lie in [0, 1]");
+    require(view.silhouette_angle >= 0.0 && view.silhouette_angle <= M_PI, "silhouette angle must lie in [0, pi]");
+    require(view.silhouette_falloff >= 0.0, "silhouette falloff must be >= 0");
+    require(view.outside_probability >= 0.0 && view.outside_probability <= 1.0,
+            "outside-frustum probability must lie in [0, 1]");
+    double d2 = 0;
+    for (double x : view.direction) d2 += x * x;
+    require(view.perspective || d2 > 0, "view direction must not be zero");
+    for (double x : view.eye) require(std::isfinite(x), "view eye position is not finite");
+    for (double x : view.view_projection) require(std::isfinite(x), "view-projection matrix is not finite");
+  }
+}
+
+std::vector<double> sampling_probabilities(const Mesh& mesh, const FeatureLayout& layout,
+                                           const SamplingParams& params, double k) {
+  return probabilities(mesh, classify(mesh, layout), params, k);
+}
+
+SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const SamplingParams& params,
+                         int32_t target_vertices) {
+  validate_sampling_params(mesh, params);
+  const int32_t n = mesh.num_vertices();
+  const auto cls = classify(mesh, layout);
+  int32_t active = 0;
+  for (int32_t v = 0; v < n; ++v) active += cls[v] != kIsolated;
+  SampleSet out;
+  out.guided = is_guided(mesh, params);
+  const int32_t target = std::clamp(target_vertices, 0, active);
+  out.rate = out.guided ? double(target) / double(std::max(1, active)) : solve_rate(mesh, cls, params, target);
+  const auto p = probabilities(mesh, cls, params, out.rate);
+  double expected = 0.0;
+  for (double x : p) expected += x;
+  out.expected = expected;
+  const int32_t count = out.guided ? int32_t(std::lround(expected)) : target;
+
+  std::vector<int32_t> forced;
+  std::vector<Candidate> candidates;
+  for (int32_t v = 0; v < n; ++v) {
+    if (p[v] >= 1.0) {
+      forced.push_back(v);
+    } else if (p[v] > 0.0) {
+      // Keyed by the caller's vertex id: the draw does not depend on the internal order.
+      const double u = uniform01(params.seed, kStreamSelection, uint64_t(mesh.vertex_source()[v]));
+      candidates.push_back({(u / (1.0 - u)) * ((1.0 - p[v]) / p[v]), v});
+    }
+  }
+  out.forced = static_cast<int32_t>(forced.size());
+  const int32_t free_count = std::max<int32_t>(0, count - out.forced);
+  if (params.density == DensityMode::Off) {
+    out.samples = std::move(forced);
+    const size_t take = std::min<size_t>(free_count, candidates.size());
+    if (take > 0) {
+      std::nth_element(candidates.begin(), candidates.begin() + (take - 1), candidates.end());
+      for (size_t i = 0; i < take; ++i) out.samples.push_back(candidates[i].vertex);
+    }
+  } else {
+    out.samples = select_with_density(mesh, layout, cls, params, std::move(forced), std::move(candidates),
+                                      std::max(count, out.forced), out.density_rejected);
+  }
+  std::sort(out.samples.begin(), out.samples.end());
+  return out;
+}
+
+}  // namespace topstoc

@@ -1,0 +1,29 @@
+"""Shared test setup: finds the staged package (build/python) and the test meshes."""
+
+import os
+import pathlib
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+BUILD = pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build"))
+DATA = ROOT / "tests" / "data"
+SHARED_MESHES = ROOT.parent / "shared" / "meshes"
+
+for path in (str(BUILD / "python"), str(ROOT / "tests")):
+    if path not in sys.path:
+        sys.path.insert(0, path)
+
+
+@pytest.fixture(scope="session")
+def data_dir() -> pathlib.Path:
+    return DATA
+
+
+@pytest.fixture(scope="session")
+def shared_meshes() -> pathlib.Path:
+    """../shared/meshes when present (benchmarks and extra checks); skips otherwise."""
+    if not SHARED_MESHES.is_dir():
+        pytest.skip("../shared/meshes is not available")
+    return SHARED_MESHES

@@ -1,0 +1,114 @@
+"""Synthetic test meshes with known topology (numpy only, no topstoc code)."""
+
+import numpy as np
+
+
+def icosphere(subdivisions: int = 3):
+    """Unit sphere: 10 * 4^k + 2 vertices, genus 0."""
+    t = (1 + 5 ** 0.5) / 2
+    vertices = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t),
+                (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
+             (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
+             (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    vertices = [np.array(v, dtype=float) / np.linalg.norm(v) for v in vertices]
+    for _ in range(subdivisions):
+        midpoint = {}
+
+        def mid(a, b):
+            key = (min(a, b), max(a, b))
+            if key not in midpoint:
+                m = vertices[a] + vertices[b]
+                vertices.append(m / np.linalg.norm(m))
+                midpoint[key] = len(vertices) - 1
+            return midpoint[key]
+
+        refined = []
+        for a, b, c in faces:
+            ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+            refined += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+        faces = refined
+    return np.array(vertices), np.array(faces, dtype=np.int32)
+
+
+def torus(nu: int = 32, nv: int = 16, major: float = 1.0, minor: float = 0.35):
+    """Torus as an nu x nv grid, genus 1, outward normals."""
+    u = np.arange(nu) * 2 * np.pi / nu
+    v = np.arange(nv) * 2 * np.pi / nv
+    uu, vv = np.meshgrid(u, v, indexing="ij")
+    x = (major + minor * np.cos(vv)) * np.cos(uu)
+    y = (major + minor * np.cos(vv)) * np.sin(uu)
+    z = minor * np.sin(vv)
+    vertices = np.stack([x, y, z], -1).reshape(-1, 3)
+    idx = lambda i, j: (i % nu) * nv + (j % nv)  # noqa: E731
+    faces = []
+    for i in range(nu):
+        for j in range(nv):
+            a, b, c, d = idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)
+            faces += [(a, b, c), (a, c, d)]
+    return vertices, np.array(faces, dtype=np.int32)
+
+
+def grid(n: int = 10, m: int = 10):
+    """Flat n x m quad grid in the xy plane, triangulated: a disk with one boundary loop."""
+    xs, ys = np.meshgrid(np.arange(n + 1, dtype=float), np.arange(m + 1, dtype=float), indexing="ij")
+    vertices = np.stack([xs, ys, np.zeros_like(xs)], -1).reshape(-1, 3)
+    idx = lambda i, j: i * (m + 1) + j  # noqa: E731
+    faces = []
+    for i in range(n):
+        for j in range(m):
+            a, b, c, d = idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)
+            faces += [(a, b, c), (a, c, d)]
+    return vertices, np.array(faces, dtype=np.int32)
+
+
+def voxel_surface(filled: np.ndarray):
+    """Boundary surface of a set of unit voxels, outward oriented, vertices welded.
+
+    Manifold as long as no two filled voxels touch only along an edge or at a corner.
+    """
+    filled = np.pad(np.asarray(filled, dtype=bool), 1)
+    quads = []
+    offsets = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]])
+    # (axis direction, the 4 cube corners of that face in outward counter-clockwise order)
+    sides = [((-1, 0, 0), (0, 4, 7, 3)), ((1, 0, 0), (1, 2, 6, 5)), ((0, -1, 0), (0, 1, 5, 4)),
+             ((0, 1, 0), (3, 7, 6, 2)), ((0, 0, -1), (0, 3, 2, 1)), ((0, 0, 1), (4, 5, 6, 7))]
+    for cell in np.argwhere(filled):
+        for direction, corners in sides:
+            neighbour = cell + direction
+            if not filled[tuple(neighbour)]:
+                quads.append([tuple(cell + offsets[c]) for c in corners])
+    index = {}
+    vertices = []
+    faces = []
+    for quad in quads:
+        ids = []
+        for corner in quad:
+            if corner not in index:
+                index[corner] = len(vertices)
+                vertices.append(corner)
+            ids.append(index[corner])
+        faces += [(ids[0], ids[1], ids[2]), (ids[0], ids[2], ids[3])]
+    return np.array(vertices, dtype=float), np.array(faces, dtype=np.int32)
+
+
+def genus_slab(genus: int, scale: int = 2):
+    """A slab with `genus` square holes in a row (closed, orientable, genus g)."""
+    cells = np.ones((2 * genus + 1, 3, 1), dtype=bool)
+    for i in range(genus):
+        cells[2 * i + 1, 1, 0] = False
+    filled = np.kron(cells, np.ones((scale, scale, scale), dtype=bool))
+    return voxel_surface(filled)
+
+
+def disjoint(*meshes):
+    """Several meshes side by side as one mesh (vertex ids offset, positions shifted apart)."""
+    vertices, faces, offset, shift = [], [], 0, 0.0
+    for v, f in meshes:
+        v = np.asarray(v, dtype=float).copy()
+        v[:, 0] += shift - v[:, 0].min()
+        shift = v[:, 0].max() + 1.0
+        vertices.append(v)
+        faces.append(np.asarray(f) + offset)
+        offset += len(v)
+    return np.concatenate(vertices), np.concatenate(faces).astype(np.int32)
