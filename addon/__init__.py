@@ -18,7 +18,13 @@ bl_info = {
 
 
 def __getattr__(name):
-    """``topstoc.Mesh`` etc.: the core API, loaded on first use (PEP 562)."""
+    """``topstoc.Mesh`` etc.: the core API, loaded on first use (PEP 562).
+
+    Only public names are looked up in topstoc.core: private names and submodules must fall
+    through, because ``from topstoc import _topstoc`` probes the attribute before importing.
+    """
+    if name.startswith("_") or name in ("core", "blender", "batch"):
+        raise AttributeError(f"module 'topstoc' has no attribute {name!r}")
     from . import core
 
     try:
