@@ -66,14 +66,15 @@ Role vertex_role(std::string_view name) {
   return Role::Other;
 }
 
-// Scale that maps a stored colour value to [0, 1].
-double color_scale(PlyType t) {
+// Divisor that maps a stored colour value to [0, 1] (a division, so that byte k reads as
+// exactly k / 255.0, which the writer tests for).
+double color_divisor(PlyType t) {
   switch (t) {
     case PlyType::Float32:
     case PlyType::Float64: return 1.0;
     case PlyType::Int16:
-    case PlyType::UInt16: return 1.0 / 65535.0;
-    default: return 1.0 / 255.0;
+    case PlyType::UInt16: return 65535.0;
+    default: return 255.0;
   }
 }
 
@@ -313,7 +314,7 @@ MeshFile read_body(const PlyHeader& header, Source& source) {
             case Role::Blue:
             case Role::Alpha:
               if (colors)
-                mesh.vertex_colors[mesh.color_channels * row + (int(p.role) - int(Role::Red))] = value * color_scale(p.type);
+                mesh.vertex_colors[mesh.color_channels * row + (int(p.role) - int(Role::Red))] = value / color_divisor(p.type);
               break;
             case Role::U: if (uv) vertex_uvs[2 * row] = value; break;
             case Role::V: if (uv) vertex_uvs[2 * row + 1] = value; break;
