@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cctype>
 #include <fstream>
-#include <iterator>
 #include <stdexcept>
 
 #include "io_detail.hpp"
@@ -48,10 +47,9 @@ std::vector<PolygonGroup> polygon_groups(const MeshFile& mesh) {
   return groups;
 }
 
-std::vector<int64_t> group_corners(const PolygonGroup& group) {
-  std::vector<int64_t> corners = {3 * group.begin, 3 * group.begin + 1, 3 * group.begin + 2};
+void group_corners(const PolygonGroup& group, std::vector<int64_t>& corners) {
+  corners.assign({3 * group.begin, 3 * group.begin + 1, 3 * group.begin + 2});
   for (int64_t t = group.begin + 1; t < group.end; ++t) corners.push_back(3 * t + 2);
-  return corners;
 }
 
 void validate_for_writing(const MeshFile& mesh) {
@@ -139,9 +137,11 @@ MeshFile read_mesh_path(const std::string& path) {
     if (path.size() > s.size() && path.compare(path.size() - s.size(), s.size(), s) == 0)
       throw std::invalid_argument(path + ": compressed files are read through topstoc.core.io (Python)");
   }
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw std::runtime_error(path + ": cannot open the file");
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string data(size_t(in.tellg()), '\0');
+  in.seekg(0);
+  if (!in.read(data.data(), std::streamsize(data.size()))) throw std::runtime_error(path + ": cannot read the file");
   try {
     return read_mesh_file(data.data(), data.size(), format);
   } catch (const std::invalid_argument& error) {

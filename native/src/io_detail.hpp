@@ -156,8 +156,9 @@ struct PolygonGroup {
 };
 std::vector<PolygonGroup> polygon_groups(const MeshFile& mesh);
 
-/// Corners of a polygon group, in order (v0, v1, ..., vk-1), as corner indices 3 t + slot.
-std::vector<int64_t> group_corners(const PolygonGroup& group);
+/// Corners of a polygon group, in order (v0, v1, ..., vk-1), as corner indices 3 t + slot
+/// (into a reused vector: writers call this once per face).
+void group_corners(const PolygonGroup& group, std::vector<int64_t>& corners);
 
 /// Checks array sizes and index ranges of a mesh about to be written.
 void validate_for_writing(const MeshFile& mesh);

@@ -168,6 +168,7 @@ MeshFile read_obj(const char* data, size_t size) {
 
 std::string write_obj(const MeshFile& mesh) {
   std::string out = "# written by TopStoc\n";
+  out.reserve(size_t(mesh.num_vertices()) * 64 + mesh.triangles.size() * (mesh.corner_uvs.empty() ? 9 : 24));
   for (const auto& library : mesh.material_libraries) out += "mtllib " + library + "\n";
   const int64_t n = mesh.num_vertices();
   for (int64_t v = 0; v < n; ++v) {
@@ -205,6 +206,7 @@ std::string write_obj(const MeshFile& mesh) {
   }
 
   int32_t material = -1;
+  std::vector<int64_t> corners;
   for (const auto& group : polygon_groups(mesh)) {
     if (!mesh.triangle_material.empty() && mesh.triangle_material[group.begin] != material) {
       material = mesh.triangle_material[group.begin];
@@ -215,7 +217,7 @@ std::string write_obj(const MeshFile& mesh) {
                                                  : mesh.material_names[material];
       out += '\n';
     }
-    const auto corners = group_corners(group);
+    group_corners(group, corners);
     bool uv_complete = with_uvs;
     for (int64_t c : corners) uv_complete = uv_complete && corner_vt[c] >= 0;
     out += 'f';

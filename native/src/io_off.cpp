@@ -149,6 +149,7 @@ std::string write_off(const MeshFile& mesh) {
   }
   const auto groups = polygon_groups(mesh);
   std::string out = colors ? "COFF\n" : "OFF\n";
+  out.reserve(size_t(mesh.num_vertices()) * 64 + mesh.triangles.size() * 9);
   out += std::to_string(mesh.num_vertices()) + " " + std::to_string(groups.size()) + " 0\n";
   for (int64_t v = 0; v < mesh.num_vertices(); ++v) {
     for (int k = 0; k < 3; ++k) {
@@ -169,8 +170,9 @@ std::string write_off(const MeshFile& mesh) {
     }
     out += '\n';
   }
+  std::vector<int64_t> corners;
   for (const auto& group : groups) {
-    const auto corners = group_corners(group);
+    group_corners(group, corners);
     append_number(out, int64_t(corners.size()));
     for (int64_t c : corners) out += ' ', append_number(out, int64_t(mesh.triangles[c]));
     out += '\n';

@@ -441,6 +441,7 @@ std::string write_ply(const MeshFile& mesh) {
   if (face_uvs) out += std::string("property list ") + (byte_counts ? "uchar " : "int ") + uv_type + " texcoord\n";
   out += "end_header\n";
 
+  out.reserve(out.size() + size_t(n) * (3 * 8 + 4 * 8 + 2 * 8) + groups.size() * 16 + mesh.triangles.size() * 4);
   BinaryWriter writer(out);
   for (int64_t v = 0; v < n; ++v) {
     for (int k = 0; k < 3; ++k) writer.put_real(mesh.positions[3 * v + k], float_positions);
@@ -452,8 +453,9 @@ std::string write_ply(const MeshFile& mesh) {
     if (!vertex_uvs.empty())
       for (int k = 0; k < 2; ++k) writer.put_real(vertex_uvs[2 * v + k], float_uvs);
   }
+  std::vector<int64_t> corners;
   for (const auto& group : groups) {
-    const auto corners = group_corners(group);
+    group_corners(group, corners);
     const auto put_count = [&](size_t count) { byte_counts ? writer.put(uint8_t(count)) : writer.put(int32_t(count)); };
     put_count(corners.size());
     for (int64_t c : corners) writer.put(mesh.triangles[c]);
