@@ -31,6 +31,9 @@ from .native import engine
 
 FORMATS = ("obj", "ply", "off", "stl")
 COMPRESSIONS = ("gz", "bz2")
+#: Optional MeshData attributes each format stores (besides positions and faces).
+CARRIES = {"obj": ("corner_uvs", "vertex_colors", "triangle_material"),
+           "ply": ("corner_uvs", "vertex_colors"), "off": ("vertex_colors",), "stl": ()}
 
 
 @dataclass
@@ -80,6 +83,11 @@ class MeshData:
     @property
     def num_vertices(self) -> int:
         return len(self.vertices)
+
+    def attributes(self) -> List[str]:
+        """Names of the optional attributes this mesh carries."""
+        return [name for name in ("corner_uvs", "vertex_colors", "triangle_material")
+                if getattr(self, name) is not None]
 
     @property
     def num_triangles(self) -> int:
@@ -172,10 +180,16 @@ def encode_mesh(data: MeshData, kind: str) -> bytes:
                              material_libraries=[str(n) for n in data.material_libraries])
 
 
+def dropped_attributes(data: MeshData, path) -> List[str]:
+    """The attributes of ``data`` that writing it to ``path`` would lose (see CARRIES)."""
+    kind, _ = mesh_format(path)
+    return [name for name in data.attributes() if name not in CARRIES[kind]]
+
+
 def write_mesh(path, data: MeshData) -> None:
     """Writes ``data`` in the format the extension names; .gz (or .bz2) compresses.
 
-    Formats carry what they can (module docs); PLY is written binary little-endian, STL
+    Formats carry what they can (CARRIES, dropped_attributes); PLY is written binary little-endian, STL
     binary. The file is written to a temporary name first and then renamed, so a failed write
     never leaves a half-written file at ``path``.
     """
@@ -194,6 +208,8 @@ def write_mesh(path, data: MeshData) -> None:
         with open(temporary, "wb") as stream:
             stream.write(payload)
         os.replace(temporary, name)
+    except OSError as error:
+        raise OSError(error.errno, f"{name}: cannot write the file ({error.strerror})") from None
     finally:
         if os.path.exists(temporary):
             os.remove(temporary)

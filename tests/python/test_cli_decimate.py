@@ -83,6 +83,9 @@ def test_uvs_and_materials_survive(tmp_path):
     report = run_json(source, tmp_path / "spider.obj", "--ratio", 0.4)
     original, written = read_mesh(source), read_mesh(tmp_path / "spider.obj")
     assert report["input"]["uv_seam_edges"] > 0
+    assert report["output"]["dropped_attributes"] == []
+    to_ply = run_json(source, tmp_path / "spider.ply", "--ratio", 0.4)
+    assert to_ply["output"]["dropped_attributes"] == ["triangle_material"]
     assert written.corner_uvs is not None and written.triangle_material is not None
     assert set(written.material_names) <= set(original.material_names)
     # Every output corner is an input corner: same position, same UV, same material.

@@ -566,6 +566,19 @@ def test_corrupt_compression(tmp_path):
     assert read_mesh(tmp_path / "y.off.bz2").num_triangles == 1
 
 
+def test_dropped_attributes_follow_what_formats_carry():
+    mesh = attributed_mesh()
+    assert io.dropped_attributes(mesh, "a.obj.gz") == []
+    assert io.dropped_attributes(mesh, "a.ply") == ["triangle_material"]
+    assert io.dropped_attributes(mesh, "a.off") == ["corner_uvs", "triangle_material"]
+    assert io.dropped_attributes(mesh, "a.stl") == ["corner_uvs", "vertex_colors", "triangle_material"]
+
+
+def test_unwritable_destination_names_the_file(tmp_path):
+    with pytest.raises(OSError, match=r"out\.obj: cannot write the file"):
+        write_mesh(tmp_path / "no" / "such" / "out.obj", attributed_mesh())
+
+
 def test_writing_bad_data_is_refused_and_leaves_no_file(tmp_path):
     bad = MeshData(vertices=np.zeros((3, 3)), triangles=[[0, 1, 3]])
     with pytest.raises(ValueError, match=r"bad\.obj: triangle 0 refers to vertex 3, outside \[0, 3\)"):

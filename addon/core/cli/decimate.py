@@ -16,7 +16,7 @@ import numpy as np
 
 from ..attributes import material_regions, transfer_attributes, uv_seam_edges
 from ..decimate import decimate as core_decimate
-from ..io import mesh_format, read_mesh, write_mesh
+from ..io import dropped_attributes, mesh_format, read_mesh, write_mesh
 from ..mesh import Mesh
 from . import print_json
 
@@ -112,6 +112,7 @@ def run(args) -> int:
     output = transfer_attributes(data, result)
     output.material_libraries = [_relative_library(lib, args.input, args.output) for lib in output.material_libraries]
     write_mesh(args.output, output)
+    dropped = dropped_attributes(output, args.output)
 
     stats = result.stats
     if args.json:
@@ -122,7 +123,8 @@ def run(args) -> int:
                       "materials": len(data.material_names), "uv_seam_edges": 0 if seams is None else len(seams),
                       "dropped_triangles": report.degenerate_triangles + report.duplicate_triangles,
                       "components": report.components, "manifold": report.manifold, "closed": report.closed},
-            "output": {"path": args.output, "vertices": result.num_vertices, "triangles": result.num_triangles},
+            "output": {"path": args.output, "vertices": result.num_vertices, "triangles": result.num_triangles,
+                       "dropped_attributes": dropped},
             "target": {key: value for key, value in (("ratio", args.ratio), ("vertices", args.vertices),
                                                     ("triangles", args.triangles), ("max_error", args.max_error))
                        if value is not None},
@@ -141,5 +143,5 @@ def run(args) -> int:
     else:
         print(f"{args.input}: {data.num_vertices} vertices, {data.num_triangles} triangles -> {args.output}: "
               f"{result.num_vertices} vertices, {result.num_triangles} triangles in {seconds:.3f} s "
-              f"({stats.repairs} repair samples)")
+              f"({stats.repairs} repair samples)" + (f"; {args.output} cannot store {', '.join(dropped)}" if dropped else ""))
     return 0
