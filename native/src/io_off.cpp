@@ -71,7 +71,7 @@ MeshFile read_off(const char* data, size_t size) {
   if (n > INT32_MAX || faces > INT32_MAX) fail_at_line(lines.number(), "too many vertices or faces");
 
   MeshFile mesh;
-  mesh.positions.reserve(3 * size_t(n));
+  mesh.positions.reserve(std::min(3 * size_t(n), size));  // counts may lie: the file's size bounds them
   std::vector<double> colors;
   int color_channels = 0;
   bool integer_colors = true;
@@ -115,7 +115,7 @@ MeshFile read_off(const char* data, size_t size) {
   }
 
   std::vector<int32_t> corners;
-  mesh.triangles.reserve(3 * size_t(faces));
+  mesh.triangles.reserve(std::min(3 * size_t(faces), size));
   for (int64_t f = 0; f < faces; ++f) {
     if (!next_content(lines, line))
       throw std::invalid_argument("the file ends after " + std::to_string(f) + " of " + std::to_string(faces) + " faces");

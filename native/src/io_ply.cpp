@@ -185,8 +185,26 @@ class BinarySource {
   }
 
   std::string where() const { return ""; }
+  size_t remaining() const { return size_t(end_ - cursor_); }
+  /// Fewest bytes a value of this property takes (an empty list: just its count).
+  static size_t min_bytes(const PlyProperty& p) {
+    return type_size(p.count_type != PlyType::None ? p.count_type : p.type);
+  }
 
  private:
+  static size_t type_size(PlyType t) {
+    switch (t) {
+      case PlyType::Int8:
+      case PlyType::UInt8: return 1;
+      case PlyType::Int16:
+      case PlyType::UInt16: return 2;
+      case PlyType::Int32:
+      case PlyType::UInt32:
+      case PlyType::Float32: return 4;
+      default: return 8;
+    }
+  }
+
   template <class T>
   T load() {
     if (size_t(end_ - cursor_) < sizeof(T)) throw std::invalid_argument("the file ends in the middle of the data");
@@ -229,6 +247,9 @@ class AsciiSource {
   }
 
   std::string where() const { return "line " + std::to_string(line_) + ", "; }
+  size_t remaining() const { return size_t(end_ - cursor_); }
+  /// Fewest bytes a value takes: one character and a separator.
+  static size_t min_bytes(const PlyProperty&) { return 2; }
 
  private:
   std::string_view next() {
@@ -266,6 +287,18 @@ MeshFile read_body(const PlyHeader& header, Source& source) {
     for (const auto& p : element.properties) has[int(p.role)] = true;
     const bool colors = is_vertex && has[int(Role::Red)] && has[int(Role::Green)] && has[int(Role::Blue)];
     const bool uv = is_vertex && has[int(Role::U)] && has[int(Role::V)];
+    if (is_face && !has[int(Role::Indices)] && element.count > 0)
+      throw std::invalid_argument("the face element has no vertex_indices list");
+    if (is_vertex && !(has[int(Role::X)] && has[int(Role::Y)] && has[int(Role::Z)]) && element.count > 0)
+      throw std::invalid_argument("the vertex element has no x, y and z properties");
+    if (element.properties.empty()) continue;  // nothing to read, however many rows
+    // Refuse counts the rest of the file cannot hold before allocating for them.
+    size_t row_bytes = 0;
+    for (const auto& p : element.properties) row_bytes += source.min_bytes(p);
+    if (size_t(element.count) > source.remaining() / row_bytes + 1)
+      throw std::invalid_argument("element '" + element.name + "' announces " + std::to_string(element.count) +
+                                  " rows, more than the " + std::to_string(source.remaining()) +
+                                  " bytes left in the file can hold");
     if (is_vertex) {
       mesh.positions.assign(3 * size_t(element.count), 0.0);
       if (colors) {
@@ -274,8 +307,6 @@ MeshFile read_body(const PlyHeader& header, Source& source) {
       }
       if (uv) vertex_uvs.assign(2 * size_t(element.count), 0.0);
     }
-    if (is_face && !has[int(Role::Indices)] && element.count > 0)
-      throw std::invalid_argument("the face element has no vertex_indices list");
     if (is_face) {  // most files hold triangles
       mesh.triangles.reserve(3 * size_t(element.count));
       mesh.triangle_polygon.reserve(size_t(element.count));

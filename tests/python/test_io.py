@@ -517,6 +517,10 @@ def test_unparseable_stl_names_file_and_line():
         read_mesh(path)
 
 
+XYZ_HEADER = ("ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n"
+              "end_header\n")
+
+
 @pytest.mark.parametrize("name,content,message", [
     ("a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", r"line 4: face refers to vertex 4, but the file has 3"),
     ("b.obj", "v 0 0 0\nf 1 -2 1\n", r"line 2: vertex index -2 points before the first vertex"),
@@ -529,10 +533,14 @@ def test_unparseable_stl_names_file_and_line():
     ("i.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
               "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n3 0 0 1\n",
      r"face 0 refers to vertex 1, but the file has 1 vertices"),
-    ("j.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nend_header\n0\n",
-     r"line 7, element 'vertex' row 1: the file ends in the middle of the data"),
-    ("k.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1,5\n",
-     r"line 6, element 'vertex' row 0: expected a number, got '1,5'"),
+    ("j.ply", XYZ_HEADER.format(2) + "0 0 0\n0 0\n",
+     r"line 10, element 'vertex' row 1: the file ends in the middle of the data"),
+    ("k.ply", XYZ_HEADER.format(1) + "0 1,5 0\n",
+     r"line 8, element 'vertex' row 0: expected a number, got '1,5'"),
+    ("q.ply", XYZ_HEADER.format(10 ** 12) + "0 0 0\n", r"element 'vertex' announces 1000000000000 rows, more than"),
+    ("r.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n",
+     r"the vertex element has no x, y and z properties"),
+    ("s.off", "OFF\n999999999 1 0\n0 0 0\n", r"the file ends after 1 of 999999999 vertices"),
     ("l.ply", "solid\n", r"not a PLY file"),
     ("m.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n", r"line 2: unknown PLY format"),
     ("n.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n",
