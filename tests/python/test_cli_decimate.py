@@ -135,6 +135,12 @@ def test_guidance_of_the_wrong_length(tmp_path):
     done = topstoc(DATA / "genus_positive" / "cgal_eight.off", tmp_path / "out.off", "--ratio", 0.1,
                    "--guidance", tmp_path / "bad.npy")
     assert_one_error_line(done, "bad.npy", "not a readable .npy file")
+    u = np.zeros(315)
+    u[17] = np.nan
+    np.save(tmp_path / "nan.npy", u)
+    done = topstoc(DATA / "genus_positive" / "cgal_eight.off", tmp_path / "out.off", "--ratio", 0.1,
+                   "--guidance", tmp_path / "nan.npy")
+    assert_one_error_line(done, "nan.npy", "guidance of vertex 17 is nan")
 
 
 def test_stl_vertex_ids_follow_the_welded_order(tmp_path):

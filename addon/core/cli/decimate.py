@@ -73,7 +73,11 @@ def load_guidance(path: str, num_vertices: int) -> np.ndarray:
     if u.shape != (num_vertices,):
         raise ValueError(f"{path}: guidance must hold one value per input vertex ({num_vertices}), "
                          f"got shape {u.shape}")
-    return u.astype(np.float64)
+    u = u.astype(np.float64)
+    bad = np.flatnonzero(~(np.abs(u) <= 1))  # also catches NaN
+    if len(bad):
+        raise ValueError(f"{path}: guidance of vertex {bad[0]} is {u[bad[0]]}; values must lie in [-1, 1]")
+    return u
 
 
 def _supports_max_error() -> bool:
