@@ -180,6 +180,11 @@ def test_max_error(tmp_path):
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     assert report["target"] == {"max_error": "1%"}
+    original = read_mesh(source)
     assert read_mesh(tmp_path / "out.off").num_vertices == report["output"]["vertices"] < 2775
+    diagonal = np.linalg.norm(original.vertices.max(0) - original.vertices.min(0))
+    bound = report["error_bound"]
+    assert bound["max_error"] == pytest.approx(0.01 * diagonal)
+    assert 0 < bound["achieved_error"] <= bound["max_error"]
     bad = topstoc(source, tmp_path / "bad.off", "--max-error", "-1")
     assert_one_error_line(bad, "--max-error must be positive")

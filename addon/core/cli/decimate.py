@@ -48,8 +48,9 @@ def add_parser(subparsers) -> None:
     parser.set_defaults(run=run)
 
 
-def parse_max_error(text: str, diagonal: float) -> float:
-    """'0.01' -> 0.01; '0.5%' -> 0.5 % of the diagonal. Raises ValueError."""
+def parse_max_error(text: str) -> tuple:
+    """'0.01' -> (0.01, False): absolute; '0.5%' -> (0.005, True): a fraction of the
+    bounding-box diagonal. Raises ValueError."""
     relative = text.strip().endswith("%")
     try:
         value = float(text.strip().rstrip("%"))
@@ -57,7 +58,7 @@ def parse_max_error(text: str, diagonal: float) -> float:
         raise ValueError(f"--max-error must be a number, optionally followed by %, got {text!r}") from None
     if not np.isfinite(value) or value <= 0:
         raise ValueError(f"--max-error must be positive, got {text!r}")
-    return value * diagonal / 100.0 if relative else value
+    return (value / 100.0, True) if relative else (value, False)
 
 
 def load_guidance(path: str, num_vertices: int) -> np.ndarray:
@@ -81,7 +82,8 @@ def load_guidance(path: str, num_vertices: int) -> np.ndarray:
 
 
 def _supports_max_error() -> bool:
-    return "max_error" in inspect.signature(core_decimate).parameters
+    parameters = inspect.signature(core_decimate).parameters
+    return "max_error" in parameters and "relative" in parameters
 
 
 def _relative_library(library: str, source: str, destination: str) -> str:
@@ -90,6 +92,16 @@ def _relative_library(library: str, source: str, destination: str) -> str:
     if os.path.isabs(library) or not os.path.exists(here):
         return library
     return os.path.relpath(here, os.path.dirname(os.path.abspath(destination)))
+
+
+def _error_bound_report(result) -> dict:
+    """How an error-bounded search went (absolute errors), when --max-error was used."""
+    report = getattr(result, "error_bound", None)
+    if report is None:
+        return {}
+    return {"error_bound": {"max_error": report.max_error, "achieved_error": report.achieved_error,
+                            "target_vertices": report.target_vertices, "failed_target": report.failed_target,
+                            "probes": len(report.probes), "seconds": report.seconds}}
 
 
 def run(args) -> int:
@@ -108,7 +120,8 @@ def run(args) -> int:
     options = dict(seed=args.seed, adaptivity=args.adaptivity, density=args.density, guidance=guidance,
                    regions=material_regions(data), borders=seams if seams is not None and len(seams) else None)
     if args.max_error is not None:
-        result = mesh.decimate(max_error=parse_max_error(args.max_error, mesh.diagonal), **options)
+        bound, relative = parse_max_error(args.max_error)
+        result = mesh.decimate(max_error=bound, relative=relative, **options)
     else:
         result = mesh.decimate(ratio=args.ratio, vertices=args.vertices, triangles=args.triangles, **options)
     seconds = time.perf_counter() - start
@@ -143,6 +156,7 @@ def run(args) -> int:
             "samples_selected": stats.selected,
             "density_rejected": stats.density_rejected,
             "aspect_ratio": result.aspect_ratio(),
+            **_error_bound_report(result),
         })
     else:
         print(f"{args.input}: {data.num_vertices} vertices, {data.num_triangles} triangles -> {args.output}: "
