@@ -11,6 +11,8 @@ from .io import MeshData, read_mesh, write_mesh
 from .mesh import Mesh, MeshReport
 
 __all__ = [
-    "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshData", "MeshReport", "View", "decimate",
-    "decimate_with_samples", "read_mesh", "sampling_probabilities", "write_mesh",
+    "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
+    "decimate_with_samples", "sampling_probabilities",
+    # mesh files (io.py)
+    "MeshData", "read_mesh", "write_mesh",
 ]
