@@ -21,7 +21,7 @@ from typing import Callable
 from .hausdorff import as_surface
 from .native import engine
 
-DEFAULT_SEARCH_SAMPLES = 100_000
+DEFAULT_SEARCH_SAMPLES = 50_000
 
 
 @dataclass(frozen=True)
