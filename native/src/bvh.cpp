@@ -109,7 +109,7 @@ TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int6
   corners_.resize(9 * size_t(m));
   std::vector<double> centroids(3 * size_t(m));
   std::vector<double> unordered(9 * size_t(m));
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(m >= 100000)
   for (int32_t f = 0; f < m; ++f)
     for (int c = 0; c < 3; ++c)
       for (int k = 0; k < 3; ++k) {
@@ -123,7 +123,7 @@ TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int6
   build(0, m, unordered, centroids, order);
   // Store the corners in leaf order so that a leaf's triangles sit together in memory.
   triangle_ids_ = order;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(m >= 100000)
   for (int32_t s = 0; s < m; ++s)
     std::copy_n(&unordered[9 * size_t(order[s])], 9, &corners_[9 * size_t(s)]);
 }

@@ -16,6 +16,9 @@ constexpr int64_t kMaxSamples = 100000000;
 // Samples handled by one task; within a task each query starts from the previous answer.
 constexpr int64_t kBlock = 256;
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Loops shorter than this run serially: starting threads costs more than it saves, and far more
+// when other processes hold the cores.
+constexpr int64_t kParallelMin = 100000;
 
 double length(const double* a, const double* b) {
   const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
@@ -45,9 +48,9 @@ Lengths surface_lengths(const Surface& s) {
   const int64_t num_edges = int64_t(e.size() / 2), m = s.num_triangles();
   l.edge.resize(num_edges);
   l.longest.resize(m);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(num_edges >= kParallelMin)
   for (int64_t i = 0; i < num_edges; ++i) l.edge[i] = length(&p[3 * size_t(e[2 * i])], &p[3 * size_t(e[2 * i + 1])]);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(m >= kParallelMin)
   for (int64_t f = 0; f < m; ++f) {
     const double* a = &p[3 * size_t(t[3 * f])];
     const double* b = &p[3 * size_t(t[3 * f + 1])];
@@ -67,9 +70,9 @@ int64_t used_vertex_count(const Surface& s) {
 double sample_count(const Lengths& l, int64_t vertices, double step) {
   double edge_samples = 0.0, face_samples = 0.0;
   const int64_t num_edges = int64_t(l.edge.size()), m = int64_t(l.longest.size());
-#pragma omp parallel for schedule(static) reduction(+ : edge_samples)
+#pragma omp parallel for schedule(static) reduction(+ : edge_samples) if(num_edges >= kParallelMin)
   for (int64_t i = 0; i < num_edges; ++i) edge_samples += divisions(l.edge[i], step) - 1.0;
-#pragma omp parallel for schedule(static) reduction(+ : face_samples)
+#pragma omp parallel for schedule(static) reduction(+ : face_samples) if(m >= kParallelMin)
   for (int64_t f = 0; f < m; ++f) {
     const double n = divisions(l.longest[f], step);
     face_samples += n * n;
@@ -205,7 +208,7 @@ SurfaceSamples sample_surface(const Surface& surface, double step) {
       std::copy_n(&p[3 * size_t(v)], 3, &s.points[3 * size_t(next)]);
       s.element[next++] = v;
     }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(num_edges >= kParallelMin)
   for (int64_t i = 0; i < num_edges; ++i) {
     const double* a = &p[3 * size_t(e[2 * i])];
     const double* b = &p[3 * size_t(e[2 * i + 1])];
@@ -217,7 +220,7 @@ SurfaceSamples sample_surface(const Surface& surface, double step) {
       s.element[out] = int32_t(i);
     }
   }
-#pragma omp parallel for schedule(dynamic, 1024)
+#pragma omp parallel for schedule(dynamic, 1024) if(total >= kParallelMin)
   for (int64_t f = 0; f < m; ++f) {
     const double* a = &p[3 * size_t(t[3 * f])];
     const double* b = &p[3 * size_t(t[3 * f + 1])];
@@ -268,7 +271,7 @@ std::vector<ClosestHit> closest_points(const Surface& surface, const double* poi
   const TriangleBvh& bvh = surface.bvh();
   std::vector<ClosestHit> hits(count);
   const int64_t blocks = (count + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(dynamic, 4)
+#pragma omp parallel for schedule(dynamic, 4) if(count >= 4 * kBlock)
   for (int64_t block = 0; block < blocks; ++block) {
     int32_t hint = -1;
     for (int64_t i = block * kBlock; i < std::min(count, (block + 1) * kBlock); ++i) {
@@ -293,7 +296,7 @@ OneSidedDistance one_sided_distance(const Surface& from, const SurfaceSamples& s
   {
     const TriangleBvh& bvh = to.bvh();
     const int64_t blocks = (count + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(dynamic, 4)
+#pragma omp parallel for schedule(dynamic, 4) if(count >= 4 * kBlock)
     for (int64_t block = 0; block < blocks; ++block) {
       int32_t hint = -1;
       for (int64_t i = block * kBlock; i < std::min(count, (block + 1) * kBlock); ++i) {
@@ -367,7 +370,7 @@ OneSidedDistance one_sided_distance(const Surface& from, const SurfaceSamples& s
   for (int64_t i = samples.num_vertex_samples; i < samples.num_vertex_samples + samples.num_edge_samples; ++i)
     edge_max[samples.element[i]] = std::max(edge_max[samples.element[i]], distance[i]);
   r.face_max.assign(m, 0.0);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if(m >= kParallelMin)
   for (int64_t f = 0; f < m; ++f) {
     double x = 0.0;
     for (int64_t i = samples.face_offsets[f]; i < samples.face_offsets[f + 1]; ++i) x = std::max(x, distance[i]);
