@@ -18,7 +18,10 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/IO/polygon_mesh_io.h>
 #include <CGAL/Polygon_mesh_processing/bbox.h>
+#include <CGAL/IO/polygon_soup_io.h>
 #include <CGAL/Polygon_mesh_processing/distance.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
 #include <CGAL/Surface_mesh.h>
 
@@ -43,8 +46,15 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// Reads a polygon soup and makes a mesh of it; non-manifold vertices are duplicated (orienting
+// the soup), which changes no point of the surface and so no distance.
 bool load(const char* path, SurfaceMesh& mesh) {
-  if (!CGAL::IO::read_polygon_mesh(path, mesh) || mesh.is_empty()) return false;
+  std::vector<Point> points;
+  std::vector<std::vector<std::size_t>> polygons;
+  if (!CGAL::IO::read_polygon_soup(path, points, polygons) || polygons.empty()) return false;
+  PMP::orient_polygon_soup(points, polygons);
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  if (mesh.is_empty()) return false;
   if (!CGAL::is_triangle_mesh(mesh)) PMP::triangulate_faces(mesh);
   return true;
 }
