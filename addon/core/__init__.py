@@ -9,6 +9,7 @@ from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decim
                        sampling_probabilities)
 from .error_bound import ErrorBoundReport
 from .hausdorff import Distance, HausdorffResult, OneSidedDistance, closest_points, hausdorff
+from .io import MeshData, read_mesh, write_mesh
 from .mesh import Mesh, MeshReport
 
 __all__ = [
@@ -16,4 +17,6 @@ __all__ = [
     "decimate_with_samples", "sampling_probabilities",
     # measurement (hausdorff.py) and error-bounded decimation (error_bound.py)
     "Distance", "ErrorBoundReport", "HausdorffResult", "OneSidedDistance", "closest_points", "hausdorff",
+    # mesh files (io.py)
+    "MeshData", "read_mesh", "write_mesh",
 ]
