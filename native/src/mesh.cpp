@@ -328,15 +328,20 @@ void Mesh::compute_normals_and_weights() {
   }
   normals_.assign(3 * size_t(n), 0.0);
   weights_.assign(n, 0.0);
-#pragma omp parallel for schedule(static)
+  vertex_areas_.assign(n, 0.0);
+  double total_area = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : total_area)
   for (int32_t v = 0; v < n; ++v) {
-    double sum[3] = {0, 0, 0};
+    double sum[3] = {0, 0, 0}, area = 0.0;
     for (int32_t i = vertex_face_offsets_[v]; i < vertex_face_offsets_[v + 1]; ++i) {
       const double* fn = &face_normals[3 * size_t(vertex_faces_[i])];
       sum[0] += fn[0];
       sum[1] += fn[1];
       sum[2] += fn[2];
+      area += std::sqrt(fn[0] * fn[0] + fn[1] * fn[1] + fn[2] * fn[2]) / 6.0;  // a third of half the cross
     }
+    vertex_areas_[v] = area;
+    total_area += area;
     const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
     if (len > 0)
       for (int k = 0; k < 3; ++k) normals_[3 * size_t(v) + k] = sum[k] / len;
@@ -360,6 +365,7 @@ void Mesh::compute_normals_and_weights() {
     ++counted;
   }
   mean_weight_ = counted ? total / double(counted) : 0.0;
+  mean_vertex_area_ = counted ? total_area / double(counted) : 0.0;
 }
 
 void Mesh::compute_components_and_manifoldness() {

@@ -31,10 +31,14 @@ std::vector<uint8_t> classify(const Mesh& mesh, const FeatureLayout& layout) {
 }
 
 // Importance factor q(v) = 1 + α (x / x̄ - 1), floored so flat regions are not starved.
+// With area weighting, q is also scaled by the vertex's area over the mean, so that samples
+// per unit area, not per vertex, follow the weights on irregularly tessellated meshes.
 inline double importance(const Mesh& mesh, const SamplingParams& params, int32_t v) {
   const double mean = mesh.mean_weight();
-  const double q = mean > 0 ? 1.0 + params.adaptivity * (mesh.weights()[v] / mean - 1.0) : 1.0;
-  return std::max(q, params.flat_floor);
+  const double q = std::max(mean > 0 ? 1.0 + params.adaptivity * (mesh.weights()[v] / mean - 1.0) : 1.0,
+                            params.flat_floor);
+  if (!params.area_weighted || mesh.mean_vertex_area() <= 0) return q;
+  return q * mesh.vertex_areas()[v] / mesh.mean_vertex_area();
 }
 
 bool inside_box(const BoxGuidance& box, const double* p) {
