@@ -19,12 +19,17 @@ bl_info = {
 
 def __getattr__(name):
     """``topstoc.Mesh`` etc.: the core API, loaded on first use (PEP 562)."""
-    from . import core
+    # Submodules and private names are not core attributes: answering them here would recurse
+    # while the import system is still loading them (``from .. import _topstoc``).
+    if name.startswith("_") or name in ("core", "blender", "batch"):
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
 
+    core = importlib.import_module(__name__ + ".core")
     try:
         return getattr(core, name)
     except AttributeError:
-        raise AttributeError(f"module 'topstoc' has no attribute {name!r}") from None
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
 
 
 def register():
