@@ -41,7 +41,7 @@ def kept_ids(source_mesh, output_mesh):
 
 def snapshot(mesh):
     """Everything a test needs to prove a mesh unchanged."""
-    data = {"co": positions(mesh).copy(), "polygons": polygons(mesh),
+    data = {"co": positions(mesh).tolist(), "polygons": polygons(mesh),
             "materials": [p.material_index for p in mesh.polygons],
             "uv": {uv.name: [tuple(d.uv) for d in uv.data] for uv in mesh.uv_layers},
             "attributes": sorted((a.name, a.domain, a.data_type) for a in mesh.attributes)}
