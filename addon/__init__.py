@@ -18,18 +18,19 @@ bl_info = {
 
 
 def __getattr__(name):
-    """``topstoc.Mesh`` etc.: the core API, loaded on first use (PEP 562)."""
-    # Submodules and private names are not core attributes: answering them here would recurse
-    # while the import system is still loading them (``from .. import _topstoc``).
-    if name.startswith("_") or name in ("core", "blender", "batch"):
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    import importlib
+    """``topstoc.Mesh`` etc.: the core API, loaded on first use (PEP 562).
 
-    core = importlib.import_module(__name__ + ".core")
+    Only public names are looked up in topstoc.core: private names and submodules must fall
+    through, because ``from topstoc import _topstoc`` probes the attribute before importing.
+    """
+    if name.startswith("_") or name in ("core", "blender", "batch"):
+        raise AttributeError(f"module 'topstoc' has no attribute {name!r}")
+    from . import core
+
     try:
         return getattr(core, name)
     except AttributeError:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+        raise AttributeError(f"module 'topstoc' has no attribute {name!r}") from None
 
 
 def register():

@@ -195,8 +195,8 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
                                 DecimateResult result) {
   auto start = Clock::now();
   Clustering clustering;
-  std::vector<uint8_t> cross_faces;
-  flood(mesh, layout, samples, clustering, fast_path ? &cross_faces : nullptr);
+  std::vector<int32_t> cross_edges;
+  flood(mesh, layout, samples, clustering, fast_path ? &cross_edges : nullptr);
   result.seconds_clustering = seconds_since(start);
   result.fast_path = fast_path;
   start = Clock::now();
@@ -204,9 +204,15 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
   for (int32_t round = 0;; ++round) {
     const bool slivers = repair_slivers && round < kSliverRounds;
     if (round == 0 && fast_path) {
+      // Only faces around cluster borders can hold three clusters; keep them in face order.
+      std::vector<uint8_t> near_border(mesh.num_faces(), 0);
+      const auto& efo = mesh.edge_face_offsets();
+      const auto& ef = mesh.edge_faces();
+      for (int32_t e : cross_edges)
+        for (int32_t j = efo[e]; j < efo[e + 1]; ++j) near_border[ef[j]] = 1;
       std::vector<int32_t> candidates;
       for (int32_t f = 0; f < mesh.num_faces(); ++f)
-        if (cross_faces[f]) candidates.push_back(f);
+        if (near_border[f]) candidates.push_back(f);
       partition = check_partition(mesh, layout, samples, clustering, required, slivers, &candidates);
     } else {
       partition = check_partition(mesh, layout, samples, clustering, required, slivers);

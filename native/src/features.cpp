@@ -48,6 +48,8 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
     if (!layout.edge_feature[e]) ++layout.flagged_edges;
     layout.edge_feature[e] = 1;
   }
+  for (int32_t e = 0; e < num_edges; ++e)
+    if (layout.edge_feature[e]) layout.feature_edges.push_back(e);
 }
 
 void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
