@@ -151,7 +151,8 @@ def discontinuous_edges(triangles: np.ndarray, corner_values: np.ndarray) -> np.
     m = len(triangles)
     if m == 0:
         return np.zeros((0, 2), dtype=np.int32)
-    values = np.asarray(corner_values).reshape(m, 3, -1)
+    # NaN (a corner without a value) compares equal to NaN here, unlike in IEEE arithmetic.
+    values = np.nan_to_num(np.asarray(corner_values, dtype=np.float64).reshape(m, 3, -1), nan=np.inf)
     nxt = [1, 2, 0]
     a, b = triangles.ravel(), triangles[:, nxt].ravel()
     va, vb = values.reshape(3 * m, -1), values[:, nxt].reshape(3 * m, -1)
