@@ -68,7 +68,7 @@ def read_color_guidance(mesh, name: str) -> np.ndarray:
     if key == "color":
         rgb = rules.linear_to_srgb(rgb)
     if attribute.domain == "CORNER":
-        corner_vertex = mesh_io._get(mesh.loops, "vertex_index", len(mesh.loops), 1, np.int32)
+        corner_vertex = mesh_io.loop_vertices(mesh)
         rgb = rules.corner_to_vertex_mean(len(mesh.vertices), corner_vertex, rgb)
     return rules.color_to_guidance(rgb)
 

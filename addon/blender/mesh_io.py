@@ -65,17 +65,45 @@ def _get(collection, key: str, count: int, width: int, dtype) -> np.ndarray:
     return buffer.reshape(count, width) if width > 1 else buffer
 
 
+def _indices(collection, key: str, count: int, width: int = 1) -> np.ndarray:
+    """An index property as int32. Blender keeps many index fields as unsigned ints: a uint32
+    buffer takes foreach_get's raw-copy path there (about 10x faster than int32 on 3.4)."""
+    return _get(collection, key, count, width, np.uint32).view(np.int32)
+
+
+def loop_vertices(mesh) -> np.ndarray:
+    """Vertex of every loop (face corner)."""
+    corner_vert = mesh.attributes.get(".corner_vert")  # Blender 3.6+: a plain int attribute
+    if corner_vert is not None:
+        return _get(corner_vert.data, "value", len(mesh.loops), 1, np.int32)
+    return _indices(mesh.loops, "vertex_index", len(mesh.loops))
+
+
+def _triangle_polygons(mesh, count: int) -> np.ndarray:
+    if hasattr(mesh, "loop_triangle_polygons"):  # Blender 4.0+
+        return _get(mesh.loop_triangle_polygons, "value", count, 1, np.int32)
+    return _indices(mesh.loop_triangles, "polygon_index", count)
+
+
+def _polygon_materials(mesh) -> np.ndarray:
+    p = len(mesh.polygons)
+    attribute = mesh.attributes.get("material_index")
+    if attribute is not None and attribute.domain == "FACE":
+        return _get(attribute.data, "value", p, 1, np.int32)
+    if len(mesh.materials) <= 1:
+        return np.zeros(p, dtype=np.int32)
+    return _get(mesh.polygons, "material_index", p, 1, np.int32)
+
+
 def read_mesh(mesh: bpy.types.Mesh) -> MeshArrays:
     """Reads positions and the loop triangulation of ``mesh`` (object mode data)."""
     mesh.calc_loop_triangles()
-    n, m, p = len(mesh.vertices), len(mesh.loop_triangles), len(mesh.polygons)
+    n, m = len(mesh.vertices), len(mesh.loop_triangles)
     vertices = _get(mesh.vertices, "co", n, 3, np.float32).astype(np.float64)
-    triangles = _get(mesh.loop_triangles, "vertices", m, 3, np.int32)
-    triangle_loops = _get(mesh.loop_triangles, "loops", m, 3, np.int32)
-    triangle_polygon = _get(mesh.loop_triangles, "polygon_index", m, 1, np.int32)
-    polygon_material = _get(mesh.polygons, "material_index", p, 1, np.int32)
-    return MeshArrays(vertices, triangles, triangle_polygon, triangle_loops, polygon_material,
-                      num_edges=len(mesh.edges), num_loops=len(mesh.loops))
+    triangle_loops = _indices(mesh.loop_triangles, "loops", m, 3)
+    triangles = loop_vertices(mesh)[triangle_loops]
+    return MeshArrays(vertices, triangles, _triangle_polygons(mesh, m), triangle_loops,
+                      _polygon_materials(mesh), num_edges=len(mesh.edges), num_loops=len(mesh.loops))
 
 
 def read_edges(mesh: bpy.types.Mesh, flag: str) -> np.ndarray:
@@ -138,10 +166,15 @@ def fill_geometry(mesh: bpy.types.Mesh, vertices: np.ndarray, triangles: np.ndar
     if n:
         mesh.vertices.foreach_set("co", np.ascontiguousarray(vertices, dtype=np.float32).ravel())
     if m:
-        mesh.loops.foreach_set("vertex_index", np.ascontiguousarray(triangles, dtype=np.int32).ravel())
-        mesh.polygons.foreach_set("loop_start", np.arange(0, 3 * m, 3, dtype=np.int32))
+        corners = np.ascontiguousarray(triangles, dtype=np.int32).ravel()
+        corner_vert = mesh.attributes.get(".corner_vert")
+        if corner_vert is not None:  # Blender 3.6+
+            corner_vert.data.foreach_set("value", corners)
+        else:
+            mesh.loops.foreach_set("vertex_index", corners.view(np.uint32))
+        mesh.polygons.foreach_set("loop_start", np.arange(0, 3 * m, 3, dtype=np.uint32))
         if bpy.app.version < (4, 0, 0):  # loop_total became derived from loop_start in 4.0
-            mesh.polygons.foreach_set("loop_total", np.full(m, 3, dtype=np.int32))
+            mesh.polygons.foreach_set("loop_total", np.full(m, 3, dtype=np.uint32))
     mesh.update(calc_edges=True)
 
 
@@ -203,8 +236,11 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
         out.materials.append(material)
     if m:
         out.polygons.foreach_set("material_index", arrays.polygon_material[face_polygon])
-        smooth = _get(source.polygons, "use_smooth", len(source.polygons), 1, bool)
-        out.polygons.foreach_set("use_smooth", smooth[face_polygon])
+        sharp = source.attributes.get("sharp_face")  # Blender 4.0+: absent means all smooth
+        if sharp is not None or bpy.app.version < (4, 0, 0):
+            smooth = (~_get(sharp.data, "value", len(source.polygons), 1, bool) if sharp is not None
+                      else _get(source.polygons, "use_smooth", len(source.polygons), 1, bool))
+            out.polygons.foreach_set("use_smooth", smooth[face_polygon])
 
     uv_names = set()
     for uv in source.uv_layers:

@@ -39,10 +39,10 @@ def write_guidance(obj, vertex_mask: np.ndarray, polygon_mask: np.ndarray, u: fl
         count, mask = len(mesh.vertices), vertex_mask
     else:
         count = len(mesh.loops)
-        loop_vertex = mesh_io._get(mesh.loops, "vertex_index", count, 1, np.int32)
+        loop_vertex = mesh_io.loop_vertices(mesh)
         if polygon_mask is not None:
             loop_polygon = np.repeat(np.arange(len(mesh.polygons)),
-                                     mesh_io._get(mesh.polygons, "loop_total", len(mesh.polygons), 1, np.int32))
+                                     mesh_io._indices(mesh.polygons, "loop_total", len(mesh.polygons)))
             mask = polygon_mask[loop_polygon]
         else:
             mask = vertex_mask[loop_vertex]
