@@ -158,6 +158,7 @@ def decimate_blend_file(path: str, out_dir: str, args) -> dict:
                         "triangles_out": run.result.num_triangles, "seconds": run.seconds,
                         "repairs": run.result.stats.repairs})
     target = os.path.join(out_dir, os.path.basename(path))
+    bpy.context.preferences.filepaths.save_version = 0  # no .blend1 backups next to the outputs
     bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(target), copy=True)
     return {"input": path, "output": target, "vertices_in": vertices_in, "vertices_out": vertices_out,
             "triangles_out": triangles_out, "seconds": seconds, "error": None, "objects": entries}
