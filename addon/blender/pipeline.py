@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from ..core import decimate as core_decimate
+from ..core.decimate import decimate as decimate_function
 from . import mesh_io
 from .cache import Prepared, prepared_meshes
 from .guidance import EngineGuidance, gather
@@ -39,7 +39,7 @@ class Run:
 
 def has_max_error() -> bool:
     """True when the engine offers the max-deviation target (Hausdorff issue)."""
-    return "max_error" in inspect.signature(core_decimate.decimate).parameters
+    return "max_error" in inspect.signature(decimate_function).parameters
 
 
 def target_kwargs(params, prepared: Prepared) -> dict:

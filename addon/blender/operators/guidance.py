@@ -112,6 +112,32 @@ class TOPSTOC_OT_set_guidance(bpy.types.Operator):
         return {"FINISHED"}
 
 
+class TOPSTOC_OT_show_guidance(bpy.types.Operator):
+    """Show the painted guidance in the viewport (solid shading coloured by the guidance layer)"""
+
+    bl_idname = "topstoc.show_guidance"
+    bl_label = "Show Guidance"
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.object
+        return (obj is not None and obj.type == "MESH" and context.space_data is not None
+                and context.space_data.type == "VIEW_3D")
+
+    def execute(self, context):
+        obj = context.object
+        attribute = obj.data.color_attributes.get(obj.topstoc.color_attribute)
+        if attribute is None:
+            self.report({"ERROR"}, f"'{obj.name}' has no guidance layer '{obj.topstoc.color_attribute}'")
+            return {"CANCELLED"}
+        obj.data.color_attributes.active_color = attribute
+        shading = context.space_data.shading
+        if shading.type not in {"SOLID"}:
+            shading.type = "SOLID"
+        shading.color_type = "VERTEX"  # "Attribute": the active colour attribute
+        return {"FINISHED"}
+
+
 class TOPSTOC_OT_add_box(bpy.types.Operator):
     """Add a cube empty whose inside takes the given guidance"""
 
@@ -139,4 +165,4 @@ class TOPSTOC_OT_add_box(bpy.types.Operator):
         return {"FINISHED"}
 
 
-CLASSES = (TOPSTOC_OT_add_guidance_layer, TOPSTOC_OT_set_guidance, TOPSTOC_OT_add_box)
+CLASSES = (TOPSTOC_OT_add_guidance_layer, TOPSTOC_OT_set_guidance, TOPSTOC_OT_show_guidance, TOPSTOC_OT_add_box)

@@ -71,6 +71,7 @@ class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
             box.prop(s, "color_strength")
             row = box.row(align=True)
             row.operator("topstoc.add_guidance_layer", icon="BRUSH_DATA")
+            row.operator("topstoc.show_guidance", icon="SHADING_SOLID")
         if context.mode == "EDIT_MESH":
             row = box.row(align=True)
             for level, label in (("KEEP", "Keep"), ("MORE", "More"), ("NEUTRAL", "Neutral"), ("LESS", "Less"),
