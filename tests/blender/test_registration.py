@@ -2,6 +2,7 @@
 
 import importlib
 import importlib.util
+import sys
 
 import addon_utils
 import bpy
@@ -80,3 +81,24 @@ def test_panels_draw(ts, scene, kind):
             cls.draw(fake, bpy.context)
     assert "topstoc.guided_decimate" in seen
     assert ("use_color" in seen) == (kind == "mesh") and ("box_weight" in seen) == (kind == "empty")
+
+
+def _extension_cli():
+    import pathlib
+
+    root = pathlib.Path(bpy.utils.resource_path("LOCAL")) / "scripts" / "addons_core" / "bl_pkg" / "cli"
+    script = root / "blender_ext.py"
+    return script if script.exists() else None
+
+
+@pytest.mark.skipif(bpy.app.version < (4, 2, 0), reason="extensions exist from Blender 4.2")
+def test_manifest_validates_as_an_extension(ts):
+    import subprocess
+
+    from conftest import PACKAGE
+
+    script = _extension_cli()
+    if script is None:
+        pytest.skip("Blender's extension command line (bl_pkg) is not available")
+    done = subprocess.run([sys.executable, str(script), "validate", str(PACKAGE)], capture_output=True, text=True)
+    assert done.returncode == 0 and "Success" in done.stdout, done.stdout + done.stderr
