@@ -234,13 +234,15 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
 
     for material in source.materials:
         out.materials.append(material)
-    if m:
+    if m and np.any(arrays.polygon_material):  # all zero is Blender's default: skip the slow write
         out.polygons.foreach_set("material_index", arrays.polygon_material[face_polygon])
+    if m:
         sharp = source.attributes.get("sharp_face")  # Blender 4.0+: absent means all smooth
         if sharp is not None or bpy.app.version < (4, 0, 0):
             smooth = (~_get(sharp.data, "value", len(source.polygons), 1, bool) if sharp is not None
                       else _get(source.polygons, "use_smooth", len(source.polygons), 1, bool))
-            out.polygons.foreach_set("use_smooth", smooth[face_polygon])
+            if smooth.any():  # flat is the default
+                out.polygons.foreach_set("use_smooth", smooth[face_polygon])
 
     uv_names = set()
     for uv in source.uv_layers:

@@ -89,7 +89,7 @@ def decimate(context, obj, params, *, seed_offset: int = 0, target: dict = None,
     """Decimates ``obj`` with the scene's guidance settings and ``params`` (nothing written)."""
     start = time.perf_counter()
     prepared = prepare(obj)
-    guidance = gather(obj, prepared.arrays, context.scene, context.evaluated_depsgraph_get(), region_3d)
+    guidance = gather(obj, prepared.arrays, context.scene, None, region_3d)
     target = target if target is not None else target_kwargs(params, prepared)
     options = options_kwargs(params)
     options["seed"] += seed_offset
@@ -166,7 +166,7 @@ def restore(context, obj, name: str) -> Run:
     prepared = prepare(obj)
     if prepared.digest != entry.mesh_digest:
         raise DecimationError(f"'{obj.name}' changed since the samples '{name}' were saved")
-    guidance = gather(obj, prepared.arrays, context.scene, context.evaluated_depsgraph_get())
+    guidance = gather(obj, prepared.arrays, context.scene)
     if guidance.layout_digest() != entry.layout_digest:
         raise DecimationError(f"the seams, sharp edges or materials of '{obj.name}' changed since "
                               f"the samples '{name}' were saved")
@@ -195,7 +195,7 @@ def decimate_many(context, obj, params, variants) -> list:
     """
     start = time.perf_counter()
     prepared = prepare(obj)
-    guidance = gather(obj, prepared.arrays, context.scene, context.evaluated_depsgraph_get())
+    guidance = gather(obj, prepared.arrays, context.scene)
     prepared.mesh.feature_layout(guidance.regions, guidance.borders)  # built once, shared by the threads
     options = options_kwargs(params)
 

@@ -15,6 +15,7 @@ from typing import Optional
 import bpy
 
 from . import mesh_io, pipeline
+from .guidance import gather
 
 PREVIEW_SUFFIX = "_TopStocPreview"
 
@@ -25,8 +26,7 @@ class PreviewSession:
     def __init__(self, context, obj, params, region_3d=None):
         self.obj = obj
         self.prepared = pipeline.prepare(obj)
-        self.guidance = pipeline.gather(obj, self.prepared.arrays, context.scene,
-                                        context.evaluated_depsgraph_get(), region_3d)
+        self.guidance = gather(obj, self.prepared.arrays, context.scene, None, region_3d)
         self.prepared.mesh.feature_layout(self.guidance.regions, self.guidance.borders)
         self.options = pipeline.options_kwargs(params)
         self.mesh = bpy.data.meshes.new(obj.name + PREVIEW_SUFFIX)
