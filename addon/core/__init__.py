@@ -7,9 +7,12 @@
 
 from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
                        sampling_probabilities)
+from .io import MeshData, read_mesh, write_mesh
 from .mesh import Mesh, MeshReport
 
 __all__ = [
     "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
     "decimate_with_samples", "sampling_probabilities",
+    # mesh files (io.py)
+    "MeshData", "read_mesh", "write_mesh",
 ]
