@@ -17,9 +17,7 @@ import sys
 import time
 import traceback
 
-import numpy as np
 
-from ..core import guidance as rules
 from ..core.mesh import Mesh
 
 BLEND = ".blend"
@@ -73,7 +71,7 @@ def _options(args) -> dict:
 
 def decimate_mesh_file(path: str, out_dir: str, args) -> dict:
     """Decimates one mesh file; returns its report entry."""
-    from ..core import io
+    from ..core import attributes, io
 
     data = io.read_mesh(path)
     if data.num_triangles == 0:
@@ -82,20 +80,12 @@ def decimate_mesh_file(path: str, out_dir: str, args) -> dict:
     mesh = Mesh(data.vertices, data.triangles)
     borders = None
     if data.corner_uvs is not None:
-        seams = rules.discontinuous_edges(data.triangles, data.corner_uvs)
+        seams = attributes.uv_seam_edges(data.triangles, data.corner_uvs)
         borders = seams if len(seams) else None
-    regions = None
-    if data.triangle_material is not None and len(np.unique(data.triangle_material)) > 1:
-        regions = rules.compact_regions(data.triangle_material)
-    result = mesh.decimate(**_target(args, mesh.diagonal), **_options(args), regions=regions, borders=borders)
+    result = mesh.decimate(**_target(args, mesh.diagonal), **_options(args), borders=borders,
+                           regions=attributes.material_regions(data))
     seconds = time.perf_counter() - start
-    corner = np.asarray(result.corner_source, dtype=np.int64)
-    out = io.MeshData(
-        vertices=result.vertices, triangles=result.triangles,
-        corner_uvs=None if data.corner_uvs is None else data.corner_uvs.reshape(-1, 2)[corner.ravel()],
-        vertex_colors=None if data.vertex_colors is None else data.vertex_colors[result.kept],
-        triangle_material=None if data.triangle_material is None else data.triangle_material[result.face_source],
-        material_names=data.material_names, material_libraries=data.material_libraries)
+    out = attributes.transfer_attributes(data, result)
     target = os.path.join(out_dir, os.path.basename(path))
     io.write_mesh(target, out)
     return {"input": path, "output": target, "vertices_in": data.num_vertices,

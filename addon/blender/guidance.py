@@ -17,6 +17,7 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 from ..core import guidance as rules
+from ..core.attributes import uv_seam_edges
 from ..core.decimate import Box, View
 from . import mesh_io
 from .props import DEFAULT_COLOR_LAYER
@@ -79,7 +80,7 @@ def _borders(obj, settings, arrays: mesh_io.MeshArrays, sources: list) -> Option
     if settings.use_uv_seams:
         for name, uv in mesh_io.read_uv_maps(mesh).items():
             corner_uv = uv[arrays.triangle_loops]
-            seams = rules.discontinuous_edges(arrays.triangles, corner_uv)
+            seams = uv_seam_edges(arrays.triangles, corner_uv)
             if len(seams):
                 parts.append(seams)
                 sources.append(f"UV seams of '{name}' ({len(seams)} edges)")

@@ -31,7 +31,8 @@ Combining enabled sources (``combine``), each with a strength ``s`` in [0, 1]:
 Applied afterwards by the engine: box empties (a vertex inside a box takes that box's
 weight, the last box wins where boxes overlap) and the view (back faces ``p *= back_ratio``,
 silhouette band ``p = 1``, outside the frustum at most ``outside_probability``). UV seams,
-sharp edges and material borders are not guidance but borders: no cluster crosses them.
+sharp edges and material borders are not guidance but borders: no cluster crosses them
+(UV seams are found by topstoc.core.attributes.uv_seam_edges).
 """
 
 from __future__ import annotations
@@ -138,37 +139,6 @@ def combine(sources: Iterable[Tuple[np.ndarray, float]], num_vertices: int) -> O
     u[drop] = -1.0
     u[keep] = 1.0
     return u
-
-
-def discontinuous_edges(triangles: np.ndarray, corner_values: np.ndarray) -> np.ndarray:
-    """Edges (k, 2) across which per-corner values differ (UV seams of one UV map, say).
-
-    corner_values: (m, 3, c) values at each triangle corner. An edge is discontinuous when the
-    faces that share it disagree on the value at either of its ends (exact comparison). Edges
-    with one face are never reported (a mesh boundary is a border anyway).
-    """
-    triangles = np.asarray(triangles, dtype=np.int64)
-    m = len(triangles)
-    if m == 0:
-        return np.zeros((0, 2), dtype=np.int32)
-    # NaN (a corner without a value) compares equal to NaN here, unlike in IEEE arithmetic.
-    values = np.nan_to_num(np.asarray(corner_values, dtype=np.float64).reshape(m, 3, -1), nan=np.inf)
-    nxt = [1, 2, 0]
-    a, b = triangles.ravel(), triangles[:, nxt].ravel()
-    va, vb = values.reshape(3 * m, -1), values[:, nxt].reshape(3 * m, -1)
-    swap = (a > b)[:, None]
-    low_value, high_value = np.where(swap, vb, va), np.where(swap, va, vb)
-    low, high = np.minimum(a, b), np.maximum(a, b)
-    key = low * (int(triangles.max()) + 1) + high
-    order = np.argsort(key, kind="stable")
-    key = key[order]
-    start = np.r_[True, key[1:] != key[:-1]]
-    first = np.maximum.accumulate(np.where(start, np.arange(len(key)), 0))
-    lv, hv = low_value[order], high_value[order]
-    differs = np.any(lv != lv[first], axis=1) | np.any(hv != hv[first], axis=1)
-    seam_keys = np.unique(key[differs])
-    n1 = int(triangles.max()) + 1
-    return np.stack([seam_keys // n1, seam_keys % n1], axis=1).astype(np.int32)
 
 
 def mesh_edges(triangles: np.ndarray) -> np.ndarray:

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import meshgen
-from helpers import Params, make_object, select_only, vertex_areas
+from helpers import Params, make_object, vertex_areas
 
 
 def sphere(name="Sphere", subdivisions=4):

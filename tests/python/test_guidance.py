@@ -55,32 +55,6 @@ def test_material_guidance_takes_the_largest_slot_weight():
         assert u[vertex] == max({0: -1.0, 1: 0.5}[s] for s in slots)
 
 
-def brute_seams(triangles, corner_values):
-    by_edge = {}
-    for t, tri in enumerate(triangles):
-        for c in range(3):
-            a, b = int(tri[c]), int(tri[(c + 1) % 3])
-            values = {a: tuple(corner_values[t][c]), b: tuple(corner_values[t][(c + 1) % 3])}
-            by_edge.setdefault((min(a, b), max(a, b)), []).append(values)
-    return sorted(edge for edge, sides in by_edge.items()
-                  if any(s != sides[0] for s in sides[1:]))
-
-
-def test_discontinuous_edges_matches_brute_force():
-    v, f = meshgen.torus(12, 8)
-    rng = np.random.default_rng(3)
-    # UVs per vertex, then cut: corners of faces with i < 6 get shifted values (an island).
-    uv = rng.random((len(v), 2))
-    corner = uv[f].copy()
-    island = np.arange(len(f)) < 6 * 8 * 2
-    corner[island] += 10.0
-    corner[5, 1] = [np.nan, np.nan]
-    got = rules.discontinuous_edges(f, corner)
-    want = brute_seams(f, np.nan_to_num(corner, nan=np.inf))
-    assert [tuple(e) for e in got.tolist()] == want
-    assert len(want) > 0
-
-
 def test_mesh_edges_and_edges_in():
     v, f = meshgen.grid(3, 2)
     edges = rules.mesh_edges(f)
