@@ -133,7 +133,8 @@ def main(argv):
         return 0
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")),
                platform.processor())
-    print(f"machine: {os.cpu_count()} cores, {cpu}; Blender {bpy.app.version_string}")
+    print(f"machine: {os.cpu_count()} cores, {cpu}; Blender {bpy.app.version_string}; "
+          f"load average {os.getloadavg()[0]:.1f}; OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY', 'default')}")
     vertices, triangles = read_binary_ply(args.mesh)
     obj = make_object("Horse", vertices, triangles)
     print(f"mesh: {args.mesh} ({len(vertices):,} vertices, {len(triangles):,} triangles)")
@@ -145,7 +146,6 @@ def main(argv):
             stages.append(split)
         updates, _ = preview_updates(obj, ratio, args.updates)
         modifier = [modifier_apply(obj, ratio) for _ in range(args.modifier_repeat)]
-        mod_seconds = statistics.median(s for s, _ in modifier)
         first = statistics.median(firsts)
         update = statistics.median(updates)
         split = {k: statistics.median(s[k] for s in stages) for k in stages[0]}
@@ -155,10 +155,13 @@ def main(argv):
         print(f"  TopStoc slider update {update * 1000:8.1f} ms (median of {len(updates)} ratios in "
               f"[{ratio / 2:g}, {min(1, 2 * ratio):g}]; max {max(updates) * 1000:.1f} ms) "
               f"= {1 / update:.1f} updates/s")
-        print(f"  Blender Decimate modifier (Collapse) apply {mod_seconds:8.3f} s (median of "
-              f"{len(modifier)}) -> {modifier[0][1][0]:,} v, {modifier[0][1][1]:,} t")
-        print(f"  ratio modifier / TopStoc first result: {mod_seconds / first:.1f}x; "
-              f"modifier / slider update: {mod_seconds / update:.0f}x")
+        if modifier:
+            mod_seconds = statistics.median(s for s, _ in modifier)
+            print(f"  Blender Decimate modifier (Collapse) apply {mod_seconds:8.3f} s (median of "
+                  f"{len(modifier)}) -> {modifier[0][1][0]:,} v, {modifier[0][1][1]:,} t")
+            print(f"  ratio modifier / TopStoc first result: {mod_seconds / first:.1f}x; "
+                  f"modifier / slider update: {mod_seconds / update:.0f}x")
+    print(f"load average after the run: {os.getloadavg()[0]:.1f} (on {os.cpu_count()} cores)")
     return 0
 
 

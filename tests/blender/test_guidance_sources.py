@@ -233,3 +233,16 @@ def test_missing_sources_are_reported_and_nothing_changes(ts, scene):
         run(ts, obj)
     assert [o.name for o in bpy.data.objects] == ["Sphere"]
     assert len(obj.data.vertices) == len(v)
+
+
+def test_guidance_layer_and_palette(ts, scene):
+    obj, v, f = sphere(subdivisions=1)
+    assert bpy.ops.topstoc.add_guidance_layer() == {"FINISHED"}
+    layer = obj.data.color_attributes[obj.topstoc.color_attribute]
+    assert obj.data.color_attributes.active_color.name == layer.name
+    u = ts.blender.guidance.read_color_guidance(obj.data, layer.name)
+    np.testing.assert_allclose(u, 0.0, atol=1e-6)                       # created neutral grey
+    palette = bpy.data.palettes["TopStoc Guidance"]
+    rules = ts.core.guidance
+    decoded = [rules.color_to_guidance(np.array(c.color)[None])[0] for c in palette.colors]
+    np.testing.assert_allclose(decoded, [1.0, 0.5, 0.0, -0.5, -1.0], atol=1e-6)
