@@ -81,6 +81,7 @@ def main(argv=None) -> int:
     parser.add_argument("--ratio", type=float, default=0.1)
     parser.add_argument("--output", default="topstoc-demo")
     parser.add_argument("--samples", type=int, default=16, help="Cycles samples for the render")
+    parser.add_argument("--resolution", type=int, default=100, help="render size in %% of 1200 x 560")
     args = parser.parse_args(argv)
     if not args.input or not os.path.exists(args.input):
         print(f"topstoc demo: error: input mesh '{args.input}' not found", file=sys.stderr)
@@ -134,6 +135,7 @@ def main(argv=None) -> int:
     scene.cycles.device = "CPU"
     scene.cycles.use_denoising = False  # Debian's Blender is built without OpenImageDenoise
     scene.render.resolution_x, scene.render.resolution_y = 1200, 560
+    scene.render.resolution_percentage = args.resolution
     scene.render.filepath = os.path.abspath(stem + ".png")
     bpy.ops.render.render(write_still=True)
     print(f"topstoc demo: wrote {stem}.blend, {stem}.obj and {stem}.png")
