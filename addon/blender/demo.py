@@ -1,6 +1,7 @@
-"""The demo behind the README's main command.
+"""The demo behind the README's main command (scripts/demo.sh).
 
-Imports a mesh (by default the COLLADA duck bundled in tests/data, which has UV seams), paints
+Imports a mesh (OBJ through Blender, other formats through topstoc.core.io; by default the
+COLLADA duck bundled in tests/data, which has UV seams), paints
 guidance on it the way an artist would (head: more detail, bottom: less), decimates it with
 the Guided Decimate pipeline, and writes the scene (.blend), the result (.obj) and a Cycles
 render with wireframe lines of the original next to the result (.png).
@@ -27,6 +28,25 @@ def _default_input() -> str:
         if candidate.exists():
             return str(candidate)
     return ""
+
+
+def _load(path: str, scene) -> bpy.types.Object:
+    """OBJ through Blender's importer (materials, UVs); other formats through topstoc.core.io."""
+    if path.lower().endswith(".obj"):
+        bpy.ops.wm.obj_import(filepath=path)
+        obj = bpy.context.selected_objects[0]
+    else:
+        from ..core import io
+        from . import mesh_io
+
+        data = io.read_mesh(path)
+        mesh = bpy.data.meshes.new(pathlib.Path(path).name.split(".")[0])
+        mesh_io.fill_geometry(mesh, data.vertices, data.triangles)
+        obj = bpy.data.objects.new(mesh.name, mesh)
+        scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    return obj
 
 
 def _wire_material(name: str, colour) -> bpy.types.Material:
@@ -57,9 +77,15 @@ def _frame(objects, scene) -> None:
     camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     scene.collection.objects.link(camera)
     camera.data.type = "ORTHO"
-    camera.data.ortho_scale = 1.1 * max(size.x, size.z * 2.2)
-    camera.location = centre + Vector((0.0, -3.0 * max(size), 0.0))
-    camera.rotation_euler = (np.pi / 2, 0.0, 0.0)
+    if size.y <= size.z:  # look along the thinner of y and z: the larger silhouette faces the camera
+        camera.data.ortho_scale = 1.1 * max(size.x, size.z * 2.2)
+        camera.location = centre + Vector((0.0, -3.0 * max(size), 0.0))
+        camera.rotation_euler = (np.pi / 2, 0.0, 0.0)
+    else:
+        camera.data.ortho_scale = 1.1 * max(size.x, size.y * 2.2)
+        camera.location = centre + Vector((0.0, 0.0, 3.0 * max(size)))
+        camera.rotation_euler = (0.0, 0.0, 0.0)
+    camera.data.clip_end = 10.0 * max(size)
     scene.camera = camera
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     sun.rotation_euler = (0.9, 0.2, -0.5)
@@ -84,7 +110,7 @@ def main(argv=None) -> int:
     parser.add_argument("--resolution", type=int, default=100, help="render size in %% of 1200 x 560")
     args = parser.parse_args(argv)
     if not args.input or not os.path.exists(args.input):
-        print(f"topstoc demo: error: input mesh '{args.input}' not found", file=sys.stderr)
+        print(f"TopStoc demo: error: input mesh '{args.input}' not found", file=sys.stderr)
         return 1
     os.makedirs(args.output, exist_ok=True)
     if not hasattr(bpy.types.Object, "topstoc"):
@@ -93,14 +119,14 @@ def main(argv=None) -> int:
     if not hasattr(bpy.types.Object, "topstoc"):
         register()
     scene = bpy.context.scene
-    bpy.ops.wm.obj_import(filepath=args.input)
-    obj = bpy.context.selected_objects[0]
-    bpy.context.view_layer.objects.active = obj
+    obj = _load(args.input, scene)
     # Guidance as an artist would paint it: the top fifth keeps more, the bottom fifth less.
     co = np.empty(3 * len(obj.data.vertices), dtype=np.float32)
     obj.data.vertices.foreach_get("co", co)
     world = np.array(obj.matrix_world)
-    z = (co.reshape(-1, 3) @ world[:3, :3].T + world[:3, 3])[:, 2]
+    points = co.reshape(-1, 3) @ world[:3, :3].T + world[:3, 3]
+    extent = points.max(axis=0) - points.min(axis=0)
+    z = points[:, 2] if extent[1] <= extent[2] else points[:, 1]  # "up" as the render shows it
     low, high = np.quantile(z, [0.2, 0.8])
     write_guidance(obj, z >= high, None, 0.5)
     write_guidance(obj, z <= low, None, -0.5)
@@ -114,7 +140,8 @@ def main(argv=None) -> int:
     result = pipeline.write_output(run, "NEW_OBJECT")
     width = max(c[0] for c in obj.bound_box) - min(c[0] for c in obj.bound_box)
     result.location.x += 1.15 * width * obj.matrix_world.to_scale().x
-    print(f"topstoc demo: {pipeline.summary(run)} (sources: {', '.join(run.parameters['sources']) or 'none'})")
+    summary = f"TopStoc demo: {pipeline.summary(run)} (guidance: {', '.join(run.parameters['sources']) or 'none'})"
+    print(summary, flush=True)
 
     stem = os.path.join(args.output, pathlib.Path(args.input).name.split(".")[0] + "_topstoc")
     for other in scene.objects:
@@ -138,5 +165,8 @@ def main(argv=None) -> int:
     scene.render.resolution_percentage = args.resolution
     scene.render.filepath = os.path.abspath(stem + ".png")
     bpy.ops.render.render(write_still=True)
-    print(f"topstoc demo: wrote {stem}.blend, {stem}.obj and {stem}.png")
+    written = f"TopStoc demo: wrote {stem}.blend, {stem}.obj and {stem}.png"
+    print(written, flush=True)
+    with open(os.path.join(args.output, "summary.txt"), "w") as stream:
+        stream.write(summary + "\n" + written + "\n")
     return 0

@@ -27,4 +27,5 @@ def test_demo_writes_blend_obj_png(ts, tmp_path):
     faces = sum(line.startswith("f ") for line in obj)
     assert 0 < vertices < 2108 and faces > 0           # decimated from the duck's 2108 vertices
     assert stem.with_suffix(".blend").stat().st_size > 0
-    assert "topstoc demo:" in done.stdout and "painted 'TopStoc Guidance'" in done.stdout
+    assert "TopStoc demo:" in done.stdout and "painted 'TopStoc Guidance'" in done.stdout
+    assert "TopStoc demo:" in (tmp_path / "summary.txt").read_text()
