@@ -59,10 +59,11 @@ def _target(args, diagonal: float) -> dict:
         raise ValueError("--max-error needs the Hausdorff engine, which this build lacks")
     text = args.max_error.strip()
     try:
-        value = float(text[:-1]) / 100.0 * diagonal if text.endswith("%") else float(text)
+        if text.endswith("%"):
+            return {"max_error": float(text[:-1]) / 100.0, "relative": True}
+        return {"max_error": float(text)}
     except ValueError:
         raise ValueError(f"--max-error must be a number or a percentage, got '{args.max_error}'") from None
-    return {"max_error": value}
 
 
 def _options(args) -> dict:
@@ -90,7 +91,13 @@ def decimate_mesh_file(path: str, out_dir: str, args) -> dict:
     io.write_mesh(target, out)
     return {"input": path, "output": target, "vertices_in": data.num_vertices,
             "vertices_out": result.num_vertices, "triangles_out": result.num_triangles,
-            "seconds": seconds, "repairs": result.stats.repairs, "error": None}
+            "seconds": seconds, "repairs": result.stats.repairs, "error": _achieved_error(result)}
+
+
+def _achieved_error(result):
+    """The measured symmetric Hausdorff error for --max-error runs, else None."""
+    bound = getattr(result, "error_bound", None)
+    return None if bound is None else float(bound.achieved_error)
 
 
 class _Params:
@@ -102,8 +109,8 @@ class _Params:
         self.ratio = args.ratio or 0.1
         self.vertices = args.vertices or 1
         self.triangles = args.triangles or 1
-        self.max_error = target.get("max_error", 0.0)
-        self.max_error_relative = False
+        self.max_error = target.get("max_error", 0.0) * (100.0 if target.get("relative") else 1.0)
+        self.max_error_relative = bool(target.get("relative"))
         self.seed, self.adaptivity, self.density = args.seed, args.adaptivity, args.density
         self.placement = "subsample"
 
@@ -146,7 +153,7 @@ def decimate_blend_file(path: str, out_dir: str, args) -> dict:
         triangles_out += run.result.num_triangles
         entries.append({"object": obj.name, "vertices_in": n, "vertices_out": run.result.num_vertices,
                         "triangles_out": run.result.num_triangles, "seconds": run.seconds,
-                        "repairs": run.result.stats.repairs})
+                        "repairs": run.result.stats.repairs, "error": _achieved_error(run.result)})
     target = os.path.join(out_dir, os.path.basename(path))
     bpy.context.preferences.filepaths.save_version = 0  # no .blend1 backups next to the outputs
     bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(target), copy=True)

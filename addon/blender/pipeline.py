@@ -53,10 +53,9 @@ def target_kwargs(params, prepared: Prepared) -> dict:
         return {"triangles": int(params.triangles)}
     if not has_max_error():
         raise DecimationError("the max-deviation target needs the Hausdorff engine, which this build lacks")
-    error = float(params.max_error)
-    if params.max_error_relative:
-        error = error / 100.0 * prepared.mesh.diagonal
-    return {"max_error": error}
+    if params.max_error_relative:  # the panel says percent; the engine takes a fraction of the diagonal
+        return {"max_error": float(params.max_error) / 100.0, "relative": True}
+    return {"max_error": float(params.max_error)}
 
 
 def options_kwargs(params) -> dict:
@@ -183,6 +182,9 @@ def summary(run: Run, seconds: float = None) -> str:
     seconds = run.seconds if seconds is None else seconds
     text = (f"{run.obj.name}: {report.input_vertices:,} -> {run.result.num_vertices:,} vertices, "
             f"{run.result.num_triangles:,} triangles in {seconds:.3f} s")
+    bound = getattr(run.result, "error_bound", None)
+    if bound is not None:
+        text += f", deviation {bound.achieved_error:.4g} <= {bound.max_error:.4g}"
     if run.result.stats.repairs:
         text += f" ({run.result.stats.repairs} topology repairs)"
     return text

@@ -8,6 +8,7 @@ import shutil
 import subprocess
 
 import bpy
+import numpy as np
 import pytest
 
 from conftest import DATA, PACKAGE
@@ -116,3 +117,20 @@ def test_mesh_files(ts, tmp_path):
     spider = io.read_mesh(out / "spider.obj")
     assert spider.corner_uvs is not None and spider.triangle_material is not None
 
+
+
+def test_max_error_target(ts, tmp_path):
+    if not has_io(ts) or not ts.blender.pipeline.has_max_error():
+        pytest.skip("needs topstoc.core.io and the max-error target")
+    source = DATA / "genus0" / "cgal_fandisk.off"
+    report = tmp_path / "r.json"
+    done = batch("--input", source, "--max-error", "0.5%", "--output", tmp_path / "o", "--json", report)
+    assert done.returncode == 0, done.stdout + done.stderr
+    [entry] = json.loads(report.read_text())["results"]
+    io = importlib.import_module(ts.__name__ + ".core.io")
+    original = io.read_mesh(source)
+    diagonal = float(np.linalg.norm(original.vertices.max(axis=0) - original.vertices.min(axis=0)))
+    assert entry["error"] is not None and entry["error"] <= 0.005 * diagonal
+    assert entry["vertices_out"] < entry["vertices_in"]
+    done = batch("--input", source, "--max-error", "abc", "--output", tmp_path / "p")
+    assert done.returncode == 1 and "--max-error must be a number" in done.stderr
