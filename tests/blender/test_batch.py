@@ -100,7 +100,7 @@ def test_mesh_files(ts, tmp_path):
     if not has_io(ts):
         pytest.skip("topstoc.core.io is not in this build")
     inputs = [DATA / "genus0" / "cgal_fandisk.off", DATA / "uv_materials" / "spider" / "spider.obj",
-              DATA / "nonmanifold_degenerate" / "dragon_vrip_res4.ply.gz",
+              DATA / "open_boundary" / "kivy_suzanne_monkey.obj",
               DATA / "nonmanifold_degenerate" / "openscad_unparseable.stl"]
     out = tmp_path / "out"
     report = tmp_path / "r.json"
