@@ -1,4 +1,5 @@
 #include "topstoc/clustering.hpp"
+#include "topstoc/parallel.hpp"
 
 #include <omp.h>
 
@@ -16,8 +17,6 @@ inline int32_t dist_of(uint64_t key) { return int32_t(key >> 32); }
 inline int32_t rank_of(uint64_t key) { return int32_t(key & 0xffffffffu); }
 constexpr uint64_t kUnreached = ~uint64_t(0);
 
-// Frontiers smaller than this are relaxed by one thread (a parallel region costs more).
-constexpr size_t kParallelFrontier = 4096;
 
 // Level-synchronous relaxation from `frontier` (all at distance `level`): a neighbour improves
 // when (level + 1, rank) beats what it holds. Keys are lowered with an atomic minimum, so the
@@ -40,7 +39,7 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   while (!frontier.empty()) {
     const uint64_t d = uint64_t(level) + 1;
     const int64_t count = int64_t(frontier.size());
-#pragma omp parallel if (frontier.size() >= kParallelFrontier)
+#pragma omp parallel if (int64_t(frontier.size()) >= kParallelMin / 16)
     {
       const int me = omp_get_thread_num();
       auto& mine = next[me];
@@ -92,7 +91,7 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
                     int32_t first_new, Clustering& c, std::vector<int32_t>* cross_edges) {
   const int32_t n = mesh.num_vertices();
   std::vector<uint64_t> key(n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) key[v] = c.label[v] < 0 ? kUnreached : pack(c.dist[v], c.label[v]);
   std::vector<int32_t> frontier;
   for (size_t r = size_t(first_new); r < samples.size(); ++r) {
@@ -106,7 +105,7 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
     frontier.push_back(s);
   }
   relax_levels(mesh, layout, std::move(frontier), 0, key, cross_edges);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     c.label[v] = key[v] == kUnreached ? -1 : rank_of(key[v]);
     c.dist[v] = key[v] == kUnreached ? INT_MAX : dist_of(key[v]);

@@ -1,4 +1,5 @@
 #include "topstoc/decimate.hpp"
+#include "topstoc/parallel.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -170,7 +171,7 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   result.triangles.resize(3 * t);
   result.face_source.resize(t);
   result.corner_source.resize(3 * t);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (t >= kParallelMin)
   for (size_t i = 0; i < t; ++i) {
     const int32_t f = partition.source_face[i];
     result.face_source[i] = mesh.face_source()[f];

@@ -1,4 +1,5 @@
 #include "topstoc/features.hpp"
+#include "topstoc/parallel.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -89,7 +90,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   layout.vertex_feature.assign(n, 0);
   layout.vertex_corner.assign(n, 0);
   layout.chi_constant.assign(n, 0);
-#pragma omp parallel
+#pragma omp parallel if (n >= kParallelMin)
   {
     std::vector<int32_t> fan_of_slot;
 #pragma omp for schedule(static)

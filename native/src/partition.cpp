@@ -1,4 +1,5 @@
 #include "topstoc/partition.hpp"
+#include "topstoc/parallel.hpp"
 
 #include <omp.h>
 
@@ -159,7 +160,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   {
     const int64_t count = candidate_faces ? int64_t(candidate_faces->size()) : int64_t(mesh.num_faces());
     std::vector<std::vector<int32_t>> found(threads);
-#pragma omp parallel
+#pragma omp parallel if (count >= kParallelMin)
     {
       auto& mine = found[omp_get_thread_num()];
 #pragma omp for schedule(static)
@@ -203,7 +204,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // small cluster joined its neighbours, so no sample is needed. Any other repeat is an issue.
   std::vector<uint8_t> drop(emitted, 0);
   int32_t duplicates = 0, pillows = 0;
-#pragma omp parallel for schedule(dynamic, 256) reduction(+ : duplicates, pillows)
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : duplicates, pillows) if (k >= kParallelMin)
   for (int32_t s = 0; s < k; ++s) {
     for (int32_t a = around_offsets[s]; a < around_offsets[s + 1]; ++a) {
       const int32_t* ta = &out.triangles[3 * size_t(around[a])];
@@ -240,7 +241,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   out.absorbed.assign(k, 0);
   std::vector<std::vector<uint64_t>> seen_pairs(threads);
   int32_t bad_link = 0, bad_edge = 0, isolated = 0, absorbed = 0;
-#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed)
+#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed) if (k >= kParallelMin)
   {
     std::vector<std::pair<int32_t, int32_t>> neighbour_count;
     std::vector<std::array<int32_t, 2>> link;
