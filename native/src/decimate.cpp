@@ -271,7 +271,11 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       } else {
         snapshot = Snapshot();
       }
-      const int32_t need = top_up_to - (int32_t(samples.size()) - partition.issues.absorbed);
+      int32_t need = top_up_to - (int32_t(samples.size()) - partition.issues.absorbed);
+      // Some new samples get absorbed in turn: ask for that many more, so that one round
+      // usually lands on the target (a small overshoot stays within the budget tolerance).
+      if (need > kSmallTopUp)
+        need += int32_t(std::ceil(1.5 * need * double(partition.issues.absorbed) / double(samples.size())));
       if (need <= kSmallTopUp && !snapshot.active) {
         snapshot.active = true;
         snapshot.samples = samples.size();
