@@ -8,8 +8,11 @@
 from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
                        sampling_probabilities)
 from .mesh import Mesh, MeshReport
+from .topology import ComponentGenerators, ComponentTopology, Topology, generators, topology
 
 __all__ = [
     "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
     "decimate_with_samples", "sampling_probabilities",
+    # topology
+    "ComponentGenerators", "ComponentTopology", "Topology", "generators", "topology",
 ]
