@@ -53,16 +53,22 @@ std::vector<ComponentGenerators> compute_generators(const SimplicialComplex& k, 
   };
 
   // The other edges, bucketed by the length of the loop they close through T (counting sort).
+  // Each edge is represented by its first side (the one whose twin comes later).
+  const int32_t num_sides = 3 * k.num_triangles();
   std::vector<int32_t> bucket_offsets(2 * size_t(max_depth) + 2, 0), by_length;
   auto loop_key = [&](int32_t e) { return depth[k.edges[2 * size_t(e)]] + depth[k.edges[2 * size_t(e) + 1]]; };
-  for (int32_t e = 0; e < num_edges; ++e)
-    if (!in_tree[e] && selected(k.edges[2 * size_t(e)])) ++bucket_offsets[loop_key(e) + 1];
+  auto non_tree_side = [&](int32_t s) {
+    const int32_t code = k.side_twin[s];
+    return code >= 0 && (code >> 1) > s && !in_tree[k.triangle_edges[s]] && selected(k.triangles[s]);
+  };
+  for (int32_t s = 0; s < num_sides; ++s)
+    if (non_tree_side(s)) ++bucket_offsets[loop_key(k.triangle_edges[s]) + 1];
   for (size_t i = 1; i < bucket_offsets.size(); ++i) bucket_offsets[i] += bucket_offsets[i - 1];
   by_length.resize(bucket_offsets.back());
   {
     std::vector<int32_t> fill(bucket_offsets.begin(), bucket_offsets.end() - 1);
-    for (int32_t e = 0; e < num_edges; ++e)
-      if (!in_tree[e] && selected(k.edges[2 * size_t(e)])) by_length[fill[loop_key(e)]++] = e;
+    for (int32_t s = 0; s < num_sides; ++s)
+      if (non_tree_side(s)) by_length[fill[loop_key(k.triangle_edges[s])]++] = s;
   }
 
   // Cotree: triangles joined across those edges, longest loop first. What joins nothing is a
@@ -70,9 +76,9 @@ std::vector<ComponentGenerators> compute_generators(const SimplicialComplex& k, 
   UnionFind triangles(k.num_triangles());
   std::vector<std::vector<int32_t>> found(out.size());
   for (auto it = by_length.rbegin(); it != by_length.rend(); ++it) {
-    const int32_t e = *it;
-    const int32_t t0 = k.edge_sides[k.edge_side_offsets[e]] / 3, t1 = k.edge_sides[k.edge_side_offsets[e] + 1] / 3;
-    if (!triangles.unite(t0, t1)) found[slot[report.vertex_component[k.edges[2 * size_t(e)]]]].push_back(e);
+    const int32_t s = *it;
+    if (!triangles.unite(s / 3, (k.side_twin[s] >> 1) / 3))
+      found[slot[report.vertex_component[k.triangles[s]]]].push_back(k.triangle_edges[s]);
   }
 
   std::vector<uint8_t> reached(n, 0), in_cut(num_edges, 0);

@@ -15,62 +15,40 @@ namespace topstoc {
 
 namespace {
 
-// Walking around a vertex: a triangle's two edges at a vertex, and the triangle across an edge
-// shared by exactly two triangles. Orientation-free, so they work on non-orientable surfaces.
+// Walks around a vertex through the twins of its sides (FanCursor), orientation-free.
 struct Walker {
   const SimplicialComplex& k;
 
-  int corner_of(int32_t t, int32_t v) const {
-    const int32_t* tri = &k.triangles[3 * size_t(t)];
-    return tri[0] == v ? 0 : (tri[1] == v ? 1 : 2);
-  }
-  // The edge of triangle t at vertex v other than e.
-  int32_t other_edge_at(int32_t t, int32_t v, int32_t e) const {
-    const int c = corner_of(t, v);
-    const int32_t leaving = k.triangle_edges[3 * size_t(t) + c];
-    const int32_t arriving = k.triangle_edges[3 * size_t(t) + (c + 2) % 3];
-    return leaving == e ? arriving : leaving;
-  }
-  // The other triangle on edge e (which has exactly two).
-  int32_t across(int32_t e, int32_t t) const {
-    const int32_t s0 = k.edge_sides[k.edge_side_offsets[e]], s1 = k.edge_sides[k.edge_side_offsets[e] + 1];
-    return s0 / 3 == t ? s1 / 3 : s0 / 3;
-  }
-  int32_t other_end(int32_t e, int32_t v) const {
-    return k.edges[2 * size_t(e)] == v ? k.edges[2 * size_t(e) + 1] : k.edges[2 * size_t(e)];
-  }
-  int32_t count(int32_t e) const { return k.edge_triangle_count(e); }
-
-  // Number of triangles in the fan of v that contains t0 (triangles joined across edges at v
-  // with exactly two triangles). `limit` (v's triangle count) guards the walk.
-  int32_t fan_size(int32_t v, int32_t t0, int32_t limit) const {
-    const int c = corner_of(t0, v);
-    const int32_t ends[2] = {k.triangle_edges[3 * size_t(t0) + c], k.triangle_edges[3 * size_t(t0) + (c + 2) % 3]};
+  // Number of triangles in the fan of v that contains side x0 (starting at v): triangles joined
+  // across edges at v with exactly two triangles. `limit` (v's triangle count) guards the walk.
+  int32_t fan_size(int32_t x0, int32_t limit) const {
+    const int32_t t0 = x0 / 3;
     int32_t size = 1;
-    for (int32_t e : ends) {
-      int32_t t = t0;
-      while (size <= limit && count(e) == 2) {
-        const int32_t next = across(e, t);
-        if (next == t0) return size;  // the fan is a full cycle around v
+    for (int direction = 0; direction < 2; ++direction) {
+      FanCursor at{x0, true};
+      if (direction == 1) at.turn();
+      while (size <= limit && at.cross(k)) {
+        if (at.side / 3 == t0) return size;  // the fan is a full cycle around v
         ++size;
-        t = next;
-        e = other_edge_at(t, v, e);
+        at.turn();
       }
     }
     return size;
   }
 
-  // Arriving at v along boundary edge e of triangle t: the next boundary edge around v's fan, or
-  // -1 when the fan ends at an edge with three or more triangles.
-  int32_t next_boundary_edge(int32_t v, int32_t t, int32_t e, int32_t limit) const {
+  // From boundary side `at` (at.side has no twin) turn around the vertex to the next side with
+  // no twin: returns true with `at` on it, or false when the fan ends at an edge of three or
+  // more triangles.
+  bool next_boundary_side(FanCursor& at, int32_t limit) const {
+    at.turn();
     for (int32_t steps = 0; steps <= limit; ++steps) {
-      const int32_t o = other_edge_at(t, v, e);
-      if (count(o) == 1) return o;
-      if (count(o) != 2) return -1;
-      t = across(o, t);
-      e = o;
+      const int32_t code = k.side_twin[at.side];
+      if (code == SimplicialComplex::kOpenSide) return true;
+      if (code == SimplicialComplex::kFinSide) return false;
+      at.cross(k);
+      at.turn();
     }
-    return -1;
+    return false;
   }
 };
 
@@ -133,53 +111,66 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
     c.kind = c.triangles > 0 ? ComponentKind::surface : (c.edges > 0 ? ComponentKind::graph : ComponentKind::vertex);
   }
 
-  // Sheets and orientation: triangles joined across edges with exactly two triangles; the parity
-  // says whether two triangles must be flipped relative to each other to agree.
-  ParityUnionFind sheets(num_triangles);
-  std::vector<uint8_t> component_conflict(num_components, 0), component_flipped(num_components, 0);
+  // Edge classes per component.
   std::vector<uint8_t> component_fins(num_components, 0);
   for (int32_t e = 0; e < num_edges; ++e) {
-    const int32_t count = k.edge_triangle_count(e);
+    const int32_t count = k.edge_triangles[e];
     const int32_t c = component_of[k.edges[2 * size_t(e)]];
     if (count == 1) ++comps[c].boundary_edges;
     if (count >= 3) component_fins[c] = 1;
-    if (count != 2) continue;
-    const int32_t s0 = k.edge_sides[k.edge_side_offsets[e]], s1 = k.edge_sides[k.edge_side_offsets[e] + 1];
-    // Two triangles agree when they traverse their shared edge in opposite directions.
-    const bool same_direction = (k.triangles[s0] == k.edges[2 * size_t(e)]) == (k.triangles[s1] == k.edges[2 * size_t(e)]);
-    if (same_direction) component_flipped[c] = 1;
-    if (sheets.unite(s0 / 3, s1 / 3, same_direction ? 1 : 0) == ParityUnionFind::Join::conflict)
-      component_conflict[c] = 1;
   }
+
+  // Sheets and orientation: triangles joined across edges with exactly two triangles; the parity
+  // says whether two triangles must be flipped relative to each other to agree. Conflicts and
+  // flips are rare: remember a triangle of each and find its component afterwards.
+  ParityUnionFind sheets(num_triangles);
+  std::vector<int32_t> conflict_triangles, flipped_triangles;
+  for (int32_t s = 0; s < 3 * num_triangles; ++s) {
+    const int32_t code = k.side_twin[s];
+    if (code < 0 || (code >> 1) < s) continue;  // each shared edge once
+    const uint8_t same_direction = code & 1;
+    if (same_direction) flipped_triangles.push_back(s / 3);
+    if (sheets.unite(s / 3, (code >> 1) / 3, same_direction) == ParityUnionFind::Join::conflict)
+      conflict_triangles.push_back(s / 3);
+  }
+  auto component_of_triangle = [&](int32_t t) { return component_of[k.triangles[3 * size_t(t)]]; };
+  std::vector<uint8_t> component_conflict(num_components, 0), component_flipped(num_components, 0);
+  for (int32_t t : conflict_triangles) component_conflict[component_of_triangle(t)] = 1;
+  for (int32_t t : flipped_triangles) component_flipped[component_of_triangle(t)] = 1;
   // A sheet with a boundary edge can never be part of a 2-cycle.
   std::vector<uint8_t> sheet_open(num_triangles, 0);
-  for (int32_t e = 0; e < num_edges; ++e)
-    if (k.edge_triangle_count(e) == 1) sheet_open[sheets.find(k.edge_sides[k.edge_side_offsets[e]] / 3)] = 1;
+  for (int32_t s = 0; s < 3 * num_triangles; ++s)
+    if (k.side_twin[s] == SimplicialComplex::kOpenSide) sheet_open[sheets.find(s / 3)] = 1;
 
   // beta2: closed sheets, minus the rank of the parity constraints at edges of 3+ triangles.
   std::vector<int32_t> closed_sheets(num_components, 0);
   std::vector<int32_t> sheet_column(num_triangles, -1);
-  int32_t free_fin_sheets = 0;
+  std::vector<int32_t> column_component;
   for (int32_t t = 0; t < num_triangles; ++t) {
     if (sheets.find(t) != t || sheet_open[t]) continue;
-    const int32_t c = component_of[k.triangles[3 * size_t(t)]];
+    const int32_t c = component_of_triangle(t);
     ++closed_sheets[c];
-    if (component_fins[c]) sheet_column[t] = free_fin_sheets++;
+    if (component_fins[c]) {
+      sheet_column[t] = static_cast<int32_t>(column_component.size());
+      column_component.push_back(c);
+    }
   }
-  if (free_fin_sheets > 0) {
-    std::vector<std::vector<phat::index>> columns(free_fin_sheets);
-    std::vector<int32_t> column_component(free_fin_sheets);
+  if (!column_component.empty()) {
+    // Sides on edges of three or more triangles, grouped by edge: one row per edge.
+    std::vector<std::pair<int32_t, int32_t>> fins;  // (edge, side)
+    for (int32_t s = 0; s < 3 * num_triangles; ++s)
+      if (k.side_twin[s] == SimplicialComplex::kFinSide) fins.emplace_back(k.triangle_edges[s], s);
+    std::sort(fins.begin(), fins.end());
+    std::vector<std::vector<phat::index>> columns(column_component.size());
     int64_t rows = 0;
-    for (int32_t e = 0; e < num_edges; ++e) {
-      if (k.edge_triangle_count(e) < 3) continue;
-      for (int32_t i = k.edge_side_offsets[e]; i < k.edge_side_offsets[e + 1]; ++i) {
-        const int32_t col = sheet_column[sheets.find(k.edge_sides[i] / 3)];
+    for (size_t i = 0; i < fins.size(); ++rows) {
+      size_t j = i;
+      for (; j < fins.size() && fins[j].first == fins[i].first; ++j) {
+        const int32_t col = sheet_column[sheets.find(fins[j].second / 3)];
         if (col >= 0) columns[col].push_back(rows);
       }
-      ++rows;
+      i = j;
     }
-    for (int32_t t = 0; t < num_triangles; ++t)
-      if (sheet_column[t] >= 0) column_component[sheet_column[t]] = component_of[k.triangles[3 * size_t(t)]];
     // A sheet that meets an edge an even number of times adds nothing to its constraint.
     for (auto& col : columns) {
       std::vector<phat::index> odd;
@@ -192,32 +183,26 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
       col.swap(odd);
     }
     const auto pivot = z2_pivot_columns(rows, columns);
-    for (int32_t col = 0; col < free_fin_sheets; ++col)
+    for (size_t col = 0; col < columns.size(); ++col)
       if (pivot[col]) --closed_sheets[column_component[col]];
   }
 
   // Non-manifold edges (no triangle, or three and more) and vertices, in surface components.
-  std::vector<int32_t> vertex_triangles(n, 0), vertex_some_triangle(n, -1);
-  for (int32_t t = 0; t < num_triangles; ++t)
-    for (int c = 0; c < 3; ++c) {
-      const int32_t v = k.triangles[3 * size_t(t) + c];
-      if (vertex_triangles[v]++ == 0) vertex_some_triangle[v] = t;
-    }
   std::vector<uint8_t> bad_vertex(n, 0);
   for (int32_t e = 0; e < num_edges; ++e) {
-    const int32_t count = k.edge_triangle_count(e);
+    const int32_t count = k.edge_triangles[e];
     const int32_t a = k.edges[2 * size_t(e)], b = k.edges[2 * size_t(e) + 1];
-    if (comps[component_of[a]].kind != ComponentKind::surface || count == 1 || count == 2) continue;
+    if (count == 1 || count == 2 || comps[component_of[a]].kind != ComponentKind::surface) continue;
     out.nonmanifold_edges.push_back(a);
     out.nonmanifold_edges.push_back(b);
     out.nonmanifold_edge_triangles.push_back(count);
     ++comps[component_of[a]].nonmanifold_edges;
     bad_vertex[a] = bad_vertex[b] = 1;
   }
-#pragma omp parallel for schedule(dynamic, 4096)
+#pragma omp parallel for schedule(dynamic, 8192)
   for (int32_t v = 0; v < n; ++v) {
-    if (bad_vertex[v] || vertex_triangles[v] == 0) continue;
-    if (walk.fan_size(v, vertex_some_triangle[v], vertex_triangles[v]) != vertex_triangles[v]) bad_vertex[v] = 1;
+    if (bad_vertex[v] || k.vertex_triangles[v] == 0) continue;
+    if (walk.fan_size(k.vertex_side[v], k.vertex_triangles[v]) != k.vertex_triangles[v]) bad_vertex[v] = 1;
   }
   for (int32_t v = 0; v < n; ++v)
     if (bad_vertex[v]) {
@@ -225,47 +210,48 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
       ++comps[component_of[v]].nonmanifold_vertices;
     }
 
-  // Boundary curves: from each unvisited boundary edge, walk around the fans at its ends.
-  std::vector<uint8_t> visited(num_edges, 0);
+  // Boundary curves: from each unvisited boundary side, turn around the fans at its ends.
+  std::vector<uint8_t> visited;
   std::vector<int32_t> backward;
-  for (int32_t e0 = 0; e0 < num_edges; ++e0) {
-    if (k.edge_triangle_count(e0) != 1 || visited[e0]) continue;
-    visited[e0] = 1;
-    const int32_t s0 = k.edge_sides[k.edge_side_offsets[e0]], t0 = s0 / 3;
-    const int32_t a = k.triangles[s0], b = k.triangles[3 * size_t(t0) + (s0 % 3 + 1) % 3];
+  for (int32_t s0 = 0; s0 < 3 * num_triangles; ++s0) {
+    if (k.side_twin[s0] != SimplicialComplex::kOpenSide) continue;
+    if (visited.empty()) visited.assign(3 * size_t(num_triangles), 0);
+    if (visited[s0]) continue;
+    visited[s0] = 1;
     const size_t start = out.boundary_vertices.size();
-    out.boundary_vertices.push_back(a);
-    int32_t e = e0, t = t0, at = b;
+    out.boundary_vertices.push_back(k.side_start(s0));
+    // Forward from the end of s0. `at` stands on the boundary side just followed, at its far end.
+    FanCursor at{s0, false};
     bool closed = false;
     while (true) {
-      const int32_t next = walk.next_boundary_edge(at, t, e, vertex_triangles[at]);
-      if (next == e0) {
+      const int32_t vertex = at.starts_at_vertex ? k.side_start(at.side) : k.side_end(at.side);
+      if (!walk.next_boundary_side(at, k.vertex_triangles[vertex])) {
+        out.boundary_vertices.push_back(vertex);
+        break;
+      }
+      if (at.side == s0) {
         closed = true;
         break;
       }
-      out.boundary_vertices.push_back(at);
-      if (next < 0 || visited[next]) break;
-      visited[next] = 1;
-      e = next;
-      t = k.edge_sides[k.edge_side_offsets[next]] / 3;
-      at = walk.other_end(next, at);
+      out.boundary_vertices.push_back(vertex);
+      if (visited[at.side]) break;
+      visited[at.side] = 1;
+      at.starts_at_vertex = !at.starts_at_vertex;  // move to the side's other end
     }
     if (!closed) {
-      // An open curve: extend it backwards from a as well, then put that part in front.
+      // An open curve: extend it backwards from the start of s0 as well, then put that part first.
       backward.clear();
-      e = e0, t = t0, at = a;
+      at = FanCursor{s0, true};
       while (true) {
-        const int32_t next = walk.next_boundary_edge(at, t, e, vertex_triangles[at]);
-        if (next < 0 || visited[next]) break;
-        visited[next] = 1;
-        at = walk.other_end(next, at);
-        backward.push_back(at);
-        e = next;
-        t = k.edge_sides[k.edge_side_offsets[next]] / 3;
+        const int32_t vertex = at.starts_at_vertex ? k.side_start(at.side) : k.side_end(at.side);
+        if (!walk.next_boundary_side(at, k.vertex_triangles[vertex]) || visited[at.side]) break;
+        visited[at.side] = 1;
+        at.starts_at_vertex = !at.starts_at_vertex;
+        backward.push_back(at.starts_at_vertex ? k.side_start(at.side) : k.side_end(at.side));
       }
       out.boundary_vertices.insert(out.boundary_vertices.begin() + start, backward.rbegin(), backward.rend());
     }
-    const int32_t c = component_of[a];
+    const int32_t c = component_of[k.side_start(s0)];
     out.boundary_offsets.push_back(static_cast<int32_t>(out.boundary_vertices.size()));
     out.boundary_component.push_back(c);
     out.boundary_closed.push_back(closed ? 1 : 0);

@@ -13,6 +13,10 @@
 //    vertex a.
 // Out-of-range indices and non-finite coordinates raise std::invalid_argument naming the element.
 // The caller's arrays are only read.
+//
+// Sides: side s = 3t + c of triangle t runs from corner c to corner c+1. Walking around a
+// vertex only needs, per side, the side across its edge (side_twin), so the walks touch one
+// array: that is what keeps them fast on meshes whose vertex order has no locality.
 #pragma once
 
 #include <cstdint>
@@ -28,12 +32,19 @@ struct SimplicialComplex {
   std::vector<int32_t> triangle_source;
   /// Distinct 1-simplices as (lower, higher) vertex pairs, sorted lexicographically.
   std::vector<int32_t> edges;
-  /// triangle_edges[3t + c] is the edge from corner c to corner c+1 of triangle t.
+  /// Number of triangles on each edge (0 for a wire edge, 1 on a boundary, 2 inside a surface).
+  std::vector<int32_t> edge_triangles;
+  /// triangle_edges[s]: the edge of side s.
   std::vector<int32_t> triangle_edges;
-  /// Triangle sides on each edge (CSR): edge_sides[edge_side_offsets[e] .. edge_side_offsets[e+1])
-  /// lists sides 3t + c, in increasing order, whose edge is e.
-  std::vector<int32_t> edge_side_offsets;
-  std::vector<int32_t> edge_sides;
+  /// side_twin[s]: when the edge of s has exactly two triangles, 2 * (the other side) + 1 if both
+  /// sides run along the edge in the same direction (inconsistent orientation), + 0 otherwise;
+  /// kOpenSide when s is the edge's only side, kFinSide when the edge has three or more.
+  std::vector<int32_t> side_twin;
+  static constexpr int32_t kOpenSide = -1;
+  static constexpr int32_t kFinSide = -2;
+  /// Triangles at each vertex, and one side starting at it (-1 for none).
+  std::vector<int32_t> vertex_triangles;
+  std::vector<int32_t> vertex_side;
 
   int32_t input_triangles = 0;
   int32_t input_edges = 0;
@@ -44,21 +55,45 @@ struct SimplicialComplex {
 
   int32_t num_triangles() const { return static_cast<int32_t>(triangles.size() / 3); }
   int32_t num_edges() const { return static_cast<int32_t>(edges.size() / 2); }
-  /// Number of triangles on edge e (0 for a wire edge, 1 on a boundary, 2 inside a surface).
-  int32_t edge_triangle_count(int32_t e) const { return edge_side_offsets[e + 1] - edge_side_offsets[e]; }
-  /// The vertex opposite side s (the third corner of its triangle).
-  int32_t opposite(int32_t side) const { return triangles[3 * (side / 3) + (side % 3 + 2) % 3]; }
+  /// Vertex where side s starts, and where it ends.
+  int32_t side_start(int32_t s) const { return triangles[s]; }
+  int32_t side_end(int32_t s) const { return triangles[next_side(s)]; }
+  static int32_t next_side(int32_t s) { return s - s % 3 + (s % 3 + 1) % 3; }
+  static int32_t previous_side(int32_t s) { return s - s % 3 + (s % 3 + 2) % 3; }
 };
 
 /// Builds the complex. positions: 3 * num_vertices coordinates, checked to be finite (may be
 /// null to skip the check); triangles: 3 * num_triangles vertex ids; edges: 2 * num_edges vertex
-/// ids (may be null when num_edges is 0). Throws std::invalid_argument naming the first
-/// offending vertex, triangle or edge.
+/// ids (may be null when num_edges is 0). At most 2^30 / 3 (about 357 million) triangles.
+/// Throws std::invalid_argument naming the first offending vertex, triangle or edge.
 SimplicialComplex build_complex(const double* positions, int32_t num_vertices, const int32_t* triangles,
                                 int64_t num_triangles, const int32_t* edges, int64_t num_edges);
 
 /// Vertex-to-edge incidence (CSR): the edges of vertex v are
 /// incident_edges[offsets[v] .. offsets[v+1]), in increasing edge order.
 void vertex_edges(const SimplicialComplex& complex, std::vector<int32_t>& offsets, std::vector<int32_t>& incident_edges);
+
+/// Turning around a vertex v through the triangle sides that touch it. A position is a side x
+/// of a triangle at v and whether v is where x starts. Orientation-free: works on
+/// inconsistently oriented and non-orientable surfaces.
+struct FanCursor {
+  int32_t side;
+  bool starts_at_vertex;
+
+  /// The other side of the same triangle at v.
+  void turn() {
+    side = starts_at_vertex ? SimplicialComplex::previous_side(side) : SimplicialComplex::next_side(side);
+    starts_at_vertex = !starts_at_vertex;
+  }
+  /// Steps across the edge of the current side into the neighbouring triangle. Returns false
+  /// (and stays) when the edge does not have exactly two triangles.
+  bool cross(const SimplicialComplex& complex) {
+    const int32_t code = complex.side_twin[side];
+    if (code < 0) return false;
+    side = code >> 1;
+    if (!(code & 1)) starts_at_vertex = !starts_at_vertex;  // opposite directions: roles swap
+    return true;
+  }
+};
 
 }  // namespace topstoc
