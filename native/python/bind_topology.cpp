@@ -78,7 +78,7 @@ void bind_topology(py::module_& m) {
       "topology",
       [](const py::handle& vertices, const py::handle& triangles, const py::handle& edges, bool with_generators) {
         const auto positions = positions_from(vertices, "vertices");
-        const auto tris = indices_from(triangles, 3, "triangles");
+        auto tris = indices_from(triangles, 3, "triangles");
         std::vector<int32_t> wires;
         if (!edges.is_none()) wires = indices_from(edges, 2, "edges");
         if (positions.size() / 3 > size_t(INT32_MAX)) throw py::value_error("more than 2^31 vertices");
@@ -86,8 +86,8 @@ void bind_topology(py::module_& m) {
         std::vector<ComponentGenerators> generators;
         {
           py::gil_scoped_release release;
-          const auto complex = build_complex(positions.data(), static_cast<int32_t>(positions.size() / 3), tris.data(),
-                                             int64_t(tris.size() / 3), wires.data(), int64_t(wires.size() / 2));
+          const auto complex = build_complex(positions.data(), static_cast<int32_t>(positions.size() / 3),
+                                             std::move(tris), wires.data(), int64_t(wires.size() / 2));
           report = analyze_topology(complex);
           if (with_generators) generators = compute_generators(complex, report);
         }

@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+
+#include <omp.h>
 
 namespace topstoc {
 
@@ -72,11 +75,87 @@ void check_input(const double* positions, int32_t n, const int32_t* triangles, i
     }
 }
 
-// Fills edges, incidences and twins of `out`, whose triangles (three distinct vertices each) and
-// num_vertices are set; wires are extra vertex pairs (lower first).
-void build_edges(SimplicialComplex& out, const std::vector<int32_t>& wires) {
+// Spreads the low 10 bits of x so that they occupy every third bit.
+uint32_t spread_bits(uint32_t x) {
+  x &= 0x3ff;
+  x = (x | x << 16) & 0x30000ff;
+  x = (x | x << 8) & 0x300f00f;
+  x = (x | x << 4) & 0x30c30c3;
+  x = (x | x << 2) & 0x9249249;
+  return x;
+}
+
+// Internal vertex order: along a Z-order curve of the positions (10 bits per axis; ties keep
+// the caller's order), by a radix sort of (key, id) pairs.
+std::vector<int32_t> morton_order(const double* positions, int32_t n) {
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  for (int32_t v = 0; v < n; ++v)
+    for (int k = 0; k < 3; ++k) {
+      const double x = positions[3 * size_t(v) + k];
+      lo[k] = v ? std::min(lo[k], x) : x;
+      hi[k] = v ? std::max(hi[k], x) : x;
+    }
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
+  std::vector<uint64_t> keyed(n), scratch(n);
+#pragma omp parallel for schedule(static)
+  for (int32_t v = 0; v < n; ++v) {
+    uint32_t key = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double t = (positions[3 * size_t(v) + k] - lo[k]) / extent;
+      key |= spread_bits(uint32_t(std::clamp(t, 0.0, 1.0) * 1023.0)) << k;
+    }
+    keyed[v] = (uint64_t(key) << 32) | uint32_t(v);
+  }
+  // Least significant digit first, 3 passes of 10 bits over the 30-bit key (stable).
+  for (int shift = 32; shift < 62; shift += 10) {
+    std::vector<int32_t> count(1025, 0);
+    for (uint64_t x : keyed) ++count[((x >> shift) & 1023) + 1];
+    for (int i = 0; i < 1024; ++i) count[i + 1] += count[i];
+    for (uint64_t x : keyed) scratch[count[(x >> shift) & 1023]++] = x;
+    keyed.swap(scratch);
+  }
+  std::vector<int32_t> order(n);
+  for (int32_t i = 0; i < n; ++i) order[i] = int32_t(uint32_t(keyed[i]));
+  return order;
+}
+
+// Renumbers the vertices of `out` (and the wires) by `order` and sorts the triangles by their
+// lowest vertex (stable: ties keep the caller's order).
+void renumber(SimplicialComplex& out, std::vector<int32_t> order, std::vector<int32_t>& wires) {
+  const int32_t n = out.num_vertices, m = out.num_triangles();
+  out.vertex_index.resize(n);
+  for (int32_t i = 0; i < n; ++i) out.vertex_index[order[i]] = i;
+  out.vertex_source = std::move(order);
+  const auto& index = out.vertex_index;
+  for (size_t i = 0; i < wires.size(); i += 2) {
+    const int32_t a = index[wires[i]], b = index[wires[i + 1]];
+    wires[i] = std::min(a, b);
+    wires[i + 1] = std::max(a, b);
+  }
+  std::vector<int32_t> offsets(size_t(n) + 1, 0);
+#pragma omp parallel for schedule(static)
+  for (size_t i = 0; i < out.triangles.size(); ++i) out.triangles[i] = index[out.triangles[i]];
+  auto lowest = [&](int32_t t) {
+    const int32_t* x = &out.triangles[3 * size_t(t)];
+    return std::min({x[0], x[1], x[2]});
+  };
+  for (int32_t t = 0; t < m; ++t) ++offsets[lowest(t) + 1];
+  for (int32_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
+  std::vector<int32_t> triangles(out.triangles.size()), source(m);
+  for (int32_t t = 0; t < m; ++t) {
+    const int32_t at = offsets[lowest(t)]++;
+    for (int c = 0; c < 3; ++c) triangles[3 * size_t(at) + c] = out.triangles[3 * size_t(t) + c];
+    source[at] = out.triangle_source[t];
+  }
+  out.triangles.swap(triangles);
+  out.triangle_source.swap(source);
+}
+
+// Fills the twins, fins, wires and vertex incidences of `out`, whose triangles (three distinct
+// vertices each) and num_vertices are set; wires are extra vertex pairs (lower first).
+void link_sides(SimplicialComplex& out, const std::vector<int32_t>& wires) {
   const int32_t n = out.num_vertices;
-  const int32_t num_sides = static_cast<int32_t>(out.triangles.size());
+  const int32_t num_sides = out.num_sides();
   const int32_t* tri = out.triangles.data();
 
   // Each side and wire becomes an entry in the bucket of its lower vertex: the higher vertex in
@@ -103,56 +182,77 @@ void build_edges(SimplicialComplex& out, const std::vector<int32_t>& wires) {
     for (size_t i = 0; i < wires.size(); i += 2) entries[fill[wires[i]]++] = uint64_t(uint32_t(wires[i + 1])) << 32;
   }
 
-  // Per vertex: sort its bucket and count distinct edges.
-  std::vector<int32_t> edge_base(size_t(n) + 1, 0);
-#pragma omp parallel for schedule(dynamic, 8192)
-  for (int32_t v = 0; v < n; ++v) {
-    uint64_t* begin = entries.data() + offsets[v];
-    uint64_t* end = entries.data() + offsets[v + 1];
-    sort_bucket(begin, end);
-    int32_t distinct = 0;
-    for (uint64_t* i = begin; i < end; ++i)
-      if (i == begin || (*i >> 32) != (*(i - 1) >> 32)) ++distinct;
-    edge_base[v] = distinct;
-  }
-  exclusive_scan(edge_base, "edges");
-  const int32_t num_edges = edge_base[n];
-  out.edges.resize(2 * size_t(num_edges));
-  out.edge_triangles.assign(num_edges, 0);
-  out.triangle_edges.resize(num_sides);
+  // Per vertex: sort its bucket and link the sides of each edge. Fins and wires are rare:
+  // collected per thread, sorted afterwards so the result does not depend on the threads.
   out.side_twin.resize(num_sides);
-
-  // Number the edges (lower vertex, then higher) and link each edge's sides.
-#pragma omp parallel for schedule(dynamic, 8192)
-  for (int32_t v = 0; v < n; ++v) {
-    int32_t edge = edge_base[v];
-    for (int32_t i = offsets[v]; i < offsets[v + 1]; ++edge) {
-      const uint32_t hi = uint32_t(entries[i] >> 32);
-      int32_t j = i;
-      while (j < offsets[v + 1] && uint32_t(entries[j] >> 32) == hi) ++j;
-      out.edges[2 * size_t(edge)] = v;
-      out.edges[2 * size_t(edge) + 1] = int32_t(hi);
-      // Wires (low word 0) sort first; the rest are sides.
-      int32_t first_side = i;
-      while (first_side < j && uint32_t(entries[first_side]) == 0) ++first_side;
-      const int32_t count = j - first_side;
-      out.edge_triangles[edge] = count;
-      for (int32_t k = first_side; k < j; ++k) {
-        const uint32_t low = uint32_t(entries[k]);
-        const int32_t s = int32_t(low >> 1) - 1;
-        out.triangle_edges[s] = edge;
-        if (count == 1) {
-          out.side_twin[s] = SimplicialComplex::kOpenSide;
+  std::vector<std::vector<int32_t>> fin_parts(omp_get_max_threads()), wire_parts(omp_get_max_threads());
+  int64_t num_edges = 0;
+#pragma omp parallel reduction(+ : num_edges)
+  {
+    auto& fins = fin_parts[omp_get_thread_num()];  // (lower, higher, side) triples
+    auto& lone_wires = wire_parts[omp_get_thread_num()];
+#pragma omp for schedule(dynamic, 8192)
+    for (int32_t v = 0; v < n; ++v) {
+      uint64_t* begin = entries.data() + offsets[v];
+      uint64_t* end = entries.data() + offsets[v + 1];
+      sort_bucket(begin, end);
+      for (uint64_t* i = begin; i < end;) {
+        const uint32_t hi = uint32_t(*i >> 32);
+        uint64_t* j = i;
+        while (j < end && uint32_t(*j >> 32) == hi) ++j;
+        ++num_edges;
+        uint64_t* first_side = i;  // wires (low word 0) sort first
+        while (first_side < j && uint32_t(*first_side) == 0) ++first_side;
+        const int64_t count = j - first_side;
+        if (count == 0) {
+          lone_wires.push_back(v);
+          lone_wires.push_back(int32_t(hi));
+        } else if (count == 1) {
+          out.side_twin[int32_t(uint32_t(*first_side) >> 1) - 1] = SimplicialComplex::kOpenSide;
         } else if (count == 2) {
-          const uint32_t other = uint32_t(entries[k == first_side ? k + 1 : first_side]);
-          const int32_t same_direction = ((other ^ low) & 1u) ? 0 : 1;
-          out.side_twin[s] = 2 * (int32_t(other >> 1) - 1) + same_direction;
+          const uint32_t x = uint32_t(first_side[0]), y = uint32_t(first_side[1]);
+          const int32_t same_direction = ((x ^ y) & 1u) ? 0 : 1;
+          out.side_twin[int32_t(x >> 1) - 1] = 2 * (int32_t(y >> 1) - 1) + same_direction;
+          out.side_twin[int32_t(y >> 1) - 1] = 2 * (int32_t(x >> 1) - 1) + same_direction;
         } else {
-          out.side_twin[s] = SimplicialComplex::kFinSide;
+          for (uint64_t* k = first_side; k < j; ++k) {
+            const int32_t s = int32_t(uint32_t(*k) >> 1) - 1;
+            out.side_twin[s] = SimplicialComplex::kFinSide;
+            fins.insert(fins.end(), {v, int32_t(hi), s});
+          }
         }
+        i = j;
       }
-      i = j;
     }
+  }
+  if (num_edges > INT32_MAX) throw std::invalid_argument("complex is too large: more than 2^31 edges");
+  out.num_edges = static_cast<int32_t>(num_edges);
+
+  std::vector<std::array<int32_t, 3>> fins;
+  for (const auto& part : fin_parts)
+    for (size_t i = 0; i < part.size(); i += 3) fins.push_back({part[i], part[i + 1], part[i + 2]});
+  std::sort(fins.begin(), fins.end());
+  out.fin_edges.clear();
+  out.fin_offsets.assign(1, 0);
+  out.fin_sides.clear();
+  for (size_t i = 0; i < fins.size(); ++i) {
+    if (i == 0 || fins[i][0] != fins[i - 1][0] || fins[i][1] != fins[i - 1][1]) {
+      if (i > 0) out.fin_offsets.push_back(static_cast<int32_t>(i));
+      out.fin_edges.push_back(fins[i][0]);
+      out.fin_edges.push_back(fins[i][1]);
+    }
+    out.fin_sides.push_back(fins[i][2]);
+  }
+  if (!fins.empty()) out.fin_offsets.push_back(static_cast<int32_t>(fins.size()));
+
+  std::vector<std::pair<int32_t, int32_t>> lone;
+  for (const auto& part : wire_parts)
+    for (size_t i = 0; i < part.size(); i += 2) lone.emplace_back(part[i], part[i + 1]);
+  std::sort(lone.begin(), lone.end());
+  out.wire_edges.clear();
+  for (const auto& [a, b] : lone) {
+    out.wire_edges.push_back(a);
+    out.wire_edges.push_back(b);
   }
 }
 
@@ -164,36 +264,29 @@ std::vector<uint8_t> find_duplicates(const SimplicialComplex& k, int32_t& count)
   std::vector<uint8_t> duplicate(m, 0);
   count = 0;
   for (int32_t t = 0; t < m; ++t) {
-    const int32_t a = k.side_twin[3 * t], b = k.side_twin[3 * t + 1], c = k.side_twin[3 * t + 2];
+    const int32_t a = k.side_twin[3 * size_t(t)], b = k.side_twin[3 * size_t(t) + 1], c = k.side_twin[3 * size_t(t) + 2];
     if (a < 0 || b < 0 || c < 0) continue;
     const int32_t u = (a >> 1) / 3;
     if (u < t && u == (b >> 1) / 3 && u == (c >> 1) / 3) duplicate[t] = 1;
   }
-  // Edges of three or more triangles: compare opposite vertices within each edge.
-  std::vector<std::pair<int32_t, int32_t>> fins;  // (edge, side)
-  for (int32_t s = 0; s < 3 * m; ++s)
-    if (k.side_twin[s] == SimplicialComplex::kFinSide) fins.emplace_back(k.triangle_edges[s], s);
-  std::sort(fins.begin(), fins.end());
-  for (size_t i = 0; i < fins.size();) {
-    size_t j = i;
-    while (j < fins.size() && fins[j].first == fins[i].first) ++j;
-    for (size_t x = i; x < j; ++x)
-      for (size_t y = i; y < x; ++y) {
-        const int32_t sx = fins[x].second, sy = fins[y].second;  // sy < sx
+  for (size_t f = 0; f + 1 < k.fin_offsets.size(); ++f)
+    for (int32_t x = k.fin_offsets[f]; x < k.fin_offsets[f + 1]; ++x)
+      for (int32_t y = k.fin_offsets[f]; y < x; ++y) {
+        const int32_t sx = k.fin_sides[x], sy = k.fin_sides[y];  // sy < sx
         if (k.triangles[SimplicialComplex::previous_side(sx)] == k.triangles[SimplicialComplex::previous_side(sy)])
           duplicate[sx / 3] = 1;
       }
-    i = j;
-  }
   for (auto d : duplicate) count += d;
   return duplicate;
 }
 
 }  // namespace
 
-SimplicialComplex build_complex(const double* positions, int32_t num_vertices, const int32_t* triangles,
-                                int64_t num_triangles, const int32_t* edges, int64_t num_edges) {
-  check_input(positions, num_vertices, triangles, num_triangles, edges, num_edges);
+SimplicialComplex build_complex(const double* positions, int32_t num_vertices, std::vector<int32_t> triangles,
+                                const int32_t* edges, int64_t num_edges) {
+  if (triangles.size() % 3 != 0) throw std::invalid_argument("triangles must hold 3 vertex ids each");
+  const int64_t num_triangles = static_cast<int64_t>(triangles.size() / 3);
+  check_input(positions, num_vertices, triangles.data(), num_triangles, edges, num_edges);
   const int32_t m = static_cast<int32_t>(num_triangles);
   SimplicialComplex out;
   out.num_vertices = num_vertices;
@@ -201,15 +294,15 @@ SimplicialComplex build_complex(const double* positions, int32_t num_vertices, c
   out.input_edges = static_cast<int32_t>(num_edges);
 
   // Collapsed triangles become wire edges (or nothing beyond their vertex); the others are
-  // 2-simplex candidates, kept in the caller's order.
+  // 2-simplex candidates, kept in the caller's order (compacted in place).
   std::vector<int32_t> wires;  // vertex pairs, lower first
-  out.triangles.reserve(3 * size_t(m));
-  out.triangle_source.reserve(m);
+  out.triangle_source.resize(m);
+  int32_t kept = 0;
   for (int32_t t = 0; t < m; ++t) {
-    const int32_t* x = triangles + 3 * size_t(t);
+    const int32_t x[3] = {triangles[3 * size_t(t)], triangles[3 * size_t(t) + 1], triangles[3 * size_t(t) + 2]};
     if (x[0] != x[1] && x[1] != x[2] && x[2] != x[0]) {
-      out.triangles.insert(out.triangles.end(), x, x + 3);
-      out.triangle_source.push_back(t);
+      for (int c = 0; c < 3; ++c) triangles[3 * size_t(kept) + c] = x[c];
+      out.triangle_source[kept++] = t;
       continue;
     }
     ++out.collapsed_triangles;
@@ -220,44 +313,40 @@ SimplicialComplex build_complex(const double* positions, int32_t num_vertices, c
       wires.push_back(s[0] == s[1] ? s[2] : s[1]);
     }
   }
+  triangles.resize(3 * size_t(kept));
+  out.triangles = std::move(triangles);
+  out.triangle_source.resize(kept);
   for (int64_t e = 0; e < num_edges; ++e) {
     const int32_t a = edges[2 * e], b = edges[2 * e + 1];
     if (a == b) continue;  // a vertex, already in the complex
     wires.push_back(std::min(a, b));
     wires.push_back(std::max(a, b));
   }
-  build_edges(out, wires);
+  if (positions) {
+    renumber(out, morton_order(positions, num_vertices), wires);
+  } else {
+    out.vertex_source.resize(num_vertices);
+    std::iota(out.vertex_source.begin(), out.vertex_source.end(), 0);
+    out.vertex_index = out.vertex_source;
+  }
+  link_sides(out, wires);
 
-  // Duplicates are rare: when there are any, drop them and build again.
+  // Duplicates are rare: when there are any, drop them and link again.
   int32_t duplicates = 0;
   const auto duplicate = find_duplicates(out, duplicates);
   if (duplicates > 0) {
-    std::vector<int32_t> kept, source;
-    kept.reserve(out.triangles.size());
+    int32_t at = 0;
     for (int32_t t = 0; t < out.num_triangles(); ++t) {
       if (duplicate[t]) continue;
-      kept.insert(kept.end(), out.triangles.begin() + 3 * size_t(t), out.triangles.begin() + 3 * size_t(t) + 3);
-      source.push_back(out.triangle_source[t]);
+      for (int c = 0; c < 3; ++c) out.triangles[3 * size_t(at) + c] = out.triangles[3 * size_t(t) + c];
+      out.triangle_source[at++] = out.triangle_source[t];
     }
-    out.triangles.swap(kept);
-    out.triangle_source.swap(source);
+    out.triangles.resize(3 * size_t(at));
+    out.triangle_source.resize(at);
     out.duplicate_triangles = duplicates;
-    build_edges(out, wires);
+    link_sides(out, wires);
   }
   return out;
-}
-
-void vertex_edges(const SimplicialComplex& complex, std::vector<int32_t>& offsets, std::vector<int32_t>& incident) {
-  const int32_t n = complex.num_vertices, num_edges = complex.num_edges();
-  offsets.assign(size_t(n) + 1, 0);
-  for (int32_t v : complex.edges) ++offsets[v];
-  exclusive_scan(offsets, "edge incidences");
-  incident.resize(complex.edges.size());
-  std::vector<int32_t> fill(offsets.begin(), offsets.end() - 1);
-  for (int32_t e = 0; e < num_edges; ++e) {
-    incident[fill[complex.edges[2 * size_t(e)]]++] = e;
-    incident[fill[complex.edges[2 * size_t(e) + 1]]++] = e;
-  }
 }
 
 }  // namespace topstoc

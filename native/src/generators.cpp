@@ -3,14 +3,33 @@
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "topstoc/union_find.hpp"
 
 namespace topstoc {
 
+namespace {
+
+// Calls visit(cursor) once for every edge at v, going once around v's fan. Only for vertices
+// of closed manifold components, where the fan is a full cycle.
+template <class Visit>
+void for_each_edge_around(const SimplicialComplex& k, int32_t v, Visit visit) {
+  const int32_t first = k.vertex_side[v];
+  FanCursor at{first, true};
+  do {
+    visit(at);
+    at.turn();
+    if (!at.cross(k)) break;  // cannot happen on a closed manifold; guards the loop
+  } while (at.side != first);
+}
+
+}  // namespace
+
 std::vector<ComponentGenerators> compute_generators(const SimplicialComplex& k, const TopologyReport& report) {
-  const int32_t n = k.num_vertices, num_edges = k.num_edges();
+  const int32_t n = k.num_vertices, num_sides = k.num_sides();
   std::vector<ComponentGenerators> out;
+  const auto& caller = k.vertex_source;
   std::vector<int32_t> slot(report.components.size(), -1);  // component -> index in out
   for (size_t c = 0; c < report.components.size(); ++c) {
     const auto& comp = report.components[c];
@@ -19,69 +38,67 @@ std::vector<ComponentGenerators> compute_generators(const SimplicialComplex& k, 
     out.emplace_back();
     out.back().component = static_cast<int32_t>(c);
     out.back().genus = comp.genus;
-    out.back().root = comp.first_vertex;
+    out.back().root = k.vertex_index[comp.first_vertex];  // internal until the end
   }
   if (out.empty()) return out;
-  auto selected = [&](int32_t v) { return slot[report.vertex_component[v]] >= 0; };
+  std::vector<int32_t> vertex_slot(n);  // per internal vertex: index in out, or -1
+  for (int32_t v = 0; v < n; ++v) vertex_slot[v] = slot[report.vertex_component[caller[v]]];
+  auto slot_of_vertex = [&](int32_t v) { return vertex_slot[v]; };
 
-  // Breadth-first search tree T from each component's root.
-  std::vector<int32_t> offsets, incident;
-  vertex_edges(k, offsets, incident);
-  std::vector<int32_t> depth(n, -1), parent_edge(n, -1), queue;
-  std::vector<uint8_t> in_tree(num_edges, 0);
+  // Breadth-first search tree T from each component's root, walking the fans. parent_side[u]
+  // is a side on the tree edge from u's parent to u; in_tree marks both sides of tree edges.
+  std::vector<int32_t> depth(n, -1), parent_side(n, -1), queue;
+  std::vector<uint8_t> in_tree(num_sides, 0);
   int32_t max_depth = 0;
   for (const auto& g : out) {
     queue.assign(1, g.root);
     depth[g.root] = 0;
     for (size_t head = 0; head < queue.size(); ++head) {
       const int32_t v = queue[head];
-      for (int32_t i = offsets[v]; i < offsets[v + 1]; ++i) {
-        const int32_t e = incident[i];
-        const int32_t u = k.edges[2 * size_t(e)] == v ? k.edges[2 * size_t(e) + 1] : k.edges[2 * size_t(e)];
-        if (depth[u] >= 0) continue;
+      for_each_edge_around(k, v, [&](const FanCursor& at) {
+        const int32_t u = at.neighbour(k);
+        if (depth[u] >= 0) return;
         depth[u] = depth[v] + 1;
         max_depth = std::max(max_depth, depth[u]);
-        parent_edge[u] = e;
-        in_tree[e] = 1;
+        parent_side[u] = at.side;
+        in_tree[at.side] = 1;
+        in_tree[k.side_twin[at.side] >> 1] = 1;
         queue.push_back(u);
-      }
+      });
     }
   }
   auto parent = [&](int32_t v) {
-    const int32_t e = parent_edge[v];
-    return k.edges[2 * size_t(e)] == v ? k.edges[2 * size_t(e) + 1] : k.edges[2 * size_t(e)];
+    const int32_t s = parent_side[v];
+    return k.side_start(s) == v ? k.side_end(s) : k.side_start(s);
   };
 
-  // The other edges, bucketed by the length of the loop they close through T (counting sort).
-  // Each edge is represented by its first side (the one whose twin comes later).
-  const int32_t num_sides = 3 * k.num_triangles();
-  std::vector<int32_t> bucket_offsets(2 * size_t(max_depth) + 2, 0), by_length;
-  auto loop_key = [&](int32_t e) { return depth[k.edges[2 * size_t(e)]] + depth[k.edges[2 * size_t(e) + 1]]; };
-  auto non_tree_side = [&](int32_t s) {
+  // The other edges (each by its lower side), bucketed by the length of the loop they close
+  // through T (counting sort; ties by side).
+  std::vector<int32_t> key(num_sides, -1);
+  std::vector<int32_t> bucket_offsets(2 * size_t(max_depth) + 2, 0);
+  for (int32_t s = 0; s < num_sides; ++s) {
     const int32_t code = k.side_twin[s];
-    return code >= 0 && (code >> 1) > s && !in_tree[k.triangle_edges[s]] && selected(k.triangles[s]);
-  };
-  for (int32_t s = 0; s < num_sides; ++s)
-    if (non_tree_side(s)) ++bucket_offsets[loop_key(k.triangle_edges[s]) + 1];
-  for (size_t i = 1; i < bucket_offsets.size(); ++i) bucket_offsets[i] += bucket_offsets[i - 1];
-  by_length.resize(bucket_offsets.back());
-  {
-    std::vector<int32_t> fill(bucket_offsets.begin(), bucket_offsets.end() - 1);
-    for (int32_t s = 0; s < num_sides; ++s)
-      if (non_tree_side(s)) by_length[fill[loop_key(k.triangle_edges[s])]++] = s;
+    if (code < 0 || (code >> 1) < s || in_tree[s] || slot_of_vertex(k.side_start(s)) < 0) continue;
+    key[s] = depth[k.side_start(s)] + depth[k.side_end(s)];
+    ++bucket_offsets[key[s] + 1];
   }
+  for (size_t i = 1; i < bucket_offsets.size(); ++i) bucket_offsets[i] += bucket_offsets[i - 1];
+  std::vector<int32_t> by_length(bucket_offsets.back());
+  for (int32_t s = 0; s < num_sides; ++s)
+    if (key[s] >= 0) by_length[bucket_offsets[key[s]]++] = s;
 
   // Cotree: triangles joined across those edges, longest loop first. What joins nothing is a
   // generator; collected longest first, so reversed below.
   UnionFind triangles(k.num_triangles());
-  std::vector<std::vector<int32_t>> found(out.size());
+  std::vector<std::vector<int32_t>> found(out.size());  // generator sides
   for (auto it = by_length.rbegin(); it != by_length.rend(); ++it) {
     const int32_t s = *it;
-    if (!triangles.unite(s / 3, (k.side_twin[s] >> 1) / 3))
-      found[slot[report.vertex_component[k.triangles[s]]]].push_back(k.triangle_edges[s]);
+    if (!triangles.unite(s / 3, (k.side_twin[s] >> 1) / 3)) found[slot_of_vertex(k.side_start(s))].push_back(s);
   }
 
-  std::vector<uint8_t> reached(n, 0), in_cut(num_edges, 0);
+  // Loops and the cut graph (marked on sides, both sides of an edge).
+  std::vector<uint8_t> reached(n, 0), in_cut(num_sides, 0);
+  auto mark_cut = [&](int32_t s, uint8_t value) { in_cut[s] = in_cut[k.side_twin[s] >> 1] = value; };
   std::vector<int32_t> from_a, from_b;
   for (size_t i = 0; i < out.size(); ++i) {
     auto& g = out[i];
@@ -91,11 +108,13 @@ std::vector<ComponentGenerators> compute_generators(const SimplicialComplex& k, 
                              std::to_string(g.genus) + " left " + std::to_string(found[i].size()) +
                              " unpaired edges");
     reached[g.root] = 1;
-    for (int32_t e : found[i]) {
-      const int32_t a = k.edges[2 * size_t(e)], b = k.edges[2 * size_t(e) + 1];
-      g.edges.push_back(a);
-      g.edges.push_back(b);
-      in_cut[e] = 1;
+    for (int32_t s : found[i]) {
+      // Internal ids until the end of the loop below; a is the end with the lower caller id.
+      int32_t a = k.side_start(s), b = k.side_end(s);
+      if (caller[a] > caller[b]) std::swap(a, b);
+      g.edges.push_back(caller[a]);
+      g.edges.push_back(caller[b]);
+      mark_cut(s, 1);
       // Loop: a, b, up from b to the lowest common ancestor, down to a's parent.
       from_a.clear();
       from_b.clear();
@@ -113,12 +132,13 @@ std::vector<ComponentGenerators> compute_generators(const SimplicialComplex& k, 
       g.loop_vertices.insert(g.loop_vertices.end(), from_b.begin(), from_b.end());
       if (x != a) g.loop_vertices.push_back(x);
       if (!from_a.empty()) g.loop_vertices.insert(g.loop_vertices.end(), from_a.rbegin(), from_a.rend() - 1);
+      for (size_t j = g.loop_offsets.back(); j < g.loop_vertices.size(); ++j) g.loop_vertices[j] = caller[g.loop_vertices[j]];
       g.loop_offsets.push_back(static_cast<int32_t>(g.loop_vertices.size()));
       // Cut graph: the tree paths from both ends towards the root, until they meet earlier ones.
       for (int32_t w : {a, b})
         for (; !reached[w]; w = parent(w)) {
           reached[w] = 1;
-          in_cut[parent_edge[w]] = 1;
+          mark_cut(parent_side[w], 1);
         }
     }
     // The path from the root to the first branching carries no loop: strip it.
@@ -126,24 +146,33 @@ std::vector<ComponentGenerators> compute_generators(const SimplicialComplex& k, 
       int32_t r = g.root;
       while (true) {
         int32_t degree = 0, only = -1;
-        for (int32_t j = offsets[r]; j < offsets[r + 1]; ++j)
-          if (in_cut[incident[j]]) {
+        for_each_edge_around(k, r, [&](const FanCursor& at) {
+          if (in_cut[at.side]) {
             ++degree;
-            only = incident[j];
+            only = at.side;
           }
+        });
         if (degree != 1 || !in_tree[only]) break;
-        in_cut[only] = 0;
-        r = k.edges[2 * size_t(only)] == r ? k.edges[2 * size_t(only) + 1] : k.edges[2 * size_t(only)];
+        const int32_t next = k.side_start(only) == r ? k.side_end(only) : k.side_start(only);
+        mark_cut(only, 0);
+        r = next;
       }
       g.root = r;
     }
+    g.root = caller[g.root];
   }
-  for (int32_t e = 0; e < num_edges; ++e)
-    if (in_cut[e]) {
-      auto& g = out[slot[report.vertex_component[k.edges[2 * size_t(e)]]]];
-      g.cut_edges.push_back(k.edges[2 * size_t(e)]);
-      g.cut_edges.push_back(k.edges[2 * size_t(e) + 1]);
+  std::vector<std::pair<int32_t, int32_t>> cut;
+  for (int32_t s = 0; s < num_sides; ++s)
+    if (in_cut[s] && (k.side_twin[s] >> 1) > s) {
+      const int32_t a = caller[k.side_start(s)], b = caller[k.side_end(s)];
+      cut.emplace_back(std::min(a, b), std::max(a, b));
     }
+  std::sort(cut.begin(), cut.end());
+  for (const auto& [a, b] : cut) {
+    auto& g = out[slot_of_vertex(k.vertex_index[a])];
+    g.cut_edges.push_back(a);
+    g.cut_edges.push_back(b);
+  }
   return out;
 }
 

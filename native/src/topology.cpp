@@ -6,8 +6,10 @@
 #include <phat/representations/default_representations.h>
 
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "topstoc/union_find.hpp"
 
@@ -75,103 +77,106 @@ std::vector<uint8_t> z2_pivot_columns(int64_t num_rows, const std::vector<std::v
 }  // namespace
 
 TopologyReport analyze_topology(const SimplicialComplex& k) {
-  const int32_t n = k.num_vertices, num_edges = k.num_edges(), num_triangles = k.num_triangles();
+  const int32_t n = k.num_vertices, num_triangles = k.num_triangles(), num_sides = k.num_sides();
   const Walker walk{k};
   TopologyReport out;
   out.num_vertices = n;
-  out.num_edges = num_edges;
+  out.num_edges = k.num_edges;
   out.num_triangles = num_triangles;
   out.collapsed_triangles = k.collapsed_triangles;
   out.duplicate_triangles = k.duplicate_triangles;
 
-  // Components: union-find over edges, numbered by their smallest vertex.
+  std::vector<int32_t> component_of;  // per internal vertex
+  const auto& caller = k.vertex_source;
+
+  // Components: union-find over the edges (each represented by a side, plus fins and wires),
+  // numbered by their smallest vertex.
   {
     UnionFind vertices(n);
-    for (int32_t e = 0; e < num_edges; ++e) vertices.unite(k.edges[2 * size_t(e)], k.edges[2 * size_t(e) + 1]);
+    for (int32_t s = 0; s < num_sides; ++s)
+      if (k.represents_edge(s)) vertices.unite(k.side_start(s), k.side_end(s));
+    for (size_t i = 0; i < k.fin_edges.size(); i += 2) vertices.unite(k.fin_edges[i], k.fin_edges[i + 1]);
+    for (size_t i = 0; i < k.wire_edges.size(); i += 2) vertices.unite(k.wire_edges[i], k.wire_edges[i + 1]);
+    // Walk the caller's ids in order so that components are numbered by their smallest one.
     out.vertex_component.assign(n, -1);
+    component_of.assign(n, -1);
     std::vector<int32_t> label(n, -1);
-    for (int32_t v = 0; v < n; ++v) {
+    for (int32_t caller = 0; caller < n; ++caller) {
+      const int32_t v = k.vertex_index[caller];
       const int32_t r = vertices.find(v);
       if (label[r] < 0) {
         label[r] = static_cast<int32_t>(out.components.size());
         out.components.emplace_back();
-        out.components.back().first_vertex = v;
+        out.components.back().first_vertex = caller;
       }
-      out.vertex_component[v] = label[r];
+      out.vertex_component[caller] = component_of[v] = label[r];
     }
   }
-  const auto& component_of = out.vertex_component;
   auto& comps = out.components;
   const int32_t num_components = static_cast<int32_t>(comps.size());
+  std::vector<int32_t> triangle_component(num_triangles);
   for (int32_t v = 0; v < n; ++v) ++comps[component_of[v]].vertices;
-  for (int32_t e = 0; e < num_edges; ++e) ++comps[component_of[k.edges[2 * size_t(e)]]].edges;
-  for (int32_t t = 0; t < num_triangles; ++t) ++comps[component_of[k.triangles[3 * size_t(t)]]].triangles;
+  for (int32_t t = 0; t < num_triangles; ++t) {
+    auto& c = comps[triangle_component[t] = component_of[k.triangles[3 * size_t(t)]]];
+    ++c.triangles;
+    for (int32_t s = 3 * t; s < 3 * t + 3; ++s) {
+      if (k.side_twin[s] == SimplicialComplex::kOpenSide) ++c.boundary_edges;
+      if (k.represents_edge(s)) ++c.edges;
+    }
+  }
+  std::vector<uint8_t> component_fins(num_components, 0);
+  for (size_t i = 0; i < k.fin_edges.size(); i += 2) {
+    ++comps[component_of[k.fin_edges[i]]].edges;
+    component_fins[component_of[k.fin_edges[i]]] = 1;
+  }
+  for (size_t i = 0; i < k.wire_edges.size(); i += 2) ++comps[component_of[k.wire_edges[i]]].edges;
   for (auto& c : comps) {
     c.euler = int64_t(c.vertices) - c.edges + c.triangles;
     c.kind = c.triangles > 0 ? ComponentKind::surface : (c.edges > 0 ? ComponentKind::graph : ComponentKind::vertex);
-  }
-
-  // Edge classes per component.
-  std::vector<uint8_t> component_fins(num_components, 0);
-  for (int32_t e = 0; e < num_edges; ++e) {
-    const int32_t count = k.edge_triangles[e];
-    const int32_t c = component_of[k.edges[2 * size_t(e)]];
-    if (count == 1) ++comps[c].boundary_edges;
-    if (count >= 3) component_fins[c] = 1;
   }
 
   // Sheets and orientation: triangles joined across edges with exactly two triangles; the parity
   // says whether two triangles must be flipped relative to each other to agree. Conflicts and
   // flips are rare: remember a triangle of each and find its component afterwards.
   ParityUnionFind sheets(num_triangles);
-  std::vector<int32_t> conflict_triangles, flipped_triangles;
-  for (int32_t s = 0; s < 3 * num_triangles; ++s) {
+  std::vector<uint8_t> component_conflict(num_components, 0), component_flipped(num_components, 0);
+  for (int32_t s = 0; s < num_sides; ++s) {
     const int32_t code = k.side_twin[s];
     if (code < 0 || (code >> 1) < s) continue;  // each shared edge once
     const uint8_t same_direction = code & 1;
-    if (same_direction) flipped_triangles.push_back(s / 3);
+    if (same_direction) component_flipped[triangle_component[s / 3]] = 1;
     if (sheets.unite(s / 3, (code >> 1) / 3, same_direction) == ParityUnionFind::Join::conflict)
-      conflict_triangles.push_back(s / 3);
+      component_conflict[triangle_component[s / 3]] = 1;
   }
-  auto component_of_triangle = [&](int32_t t) { return component_of[k.triangles[3 * size_t(t)]]; };
-  std::vector<uint8_t> component_conflict(num_components, 0), component_flipped(num_components, 0);
-  for (int32_t t : conflict_triangles) component_conflict[component_of_triangle(t)] = 1;
-  for (int32_t t : flipped_triangles) component_flipped[component_of_triangle(t)] = 1;
   // A sheet with a boundary edge can never be part of a 2-cycle.
   std::vector<uint8_t> sheet_open(num_triangles, 0);
-  for (int32_t s = 0; s < 3 * num_triangles; ++s)
+  for (int32_t s = 0; s < num_sides; ++s)
     if (k.side_twin[s] == SimplicialComplex::kOpenSide) sheet_open[sheets.find(s / 3)] = 1;
 
   // beta2: closed sheets, minus the rank of the parity constraints at edges of 3+ triangles.
   std::vector<int32_t> closed_sheets(num_components, 0);
-  std::vector<int32_t> sheet_column(num_triangles, -1);
+  std::vector<int32_t> sheet_column;
   std::vector<int32_t> column_component;
   for (int32_t t = 0; t < num_triangles; ++t) {
     if (sheets.find(t) != t || sheet_open[t]) continue;
-    const int32_t c = component_of_triangle(t);
+    const int32_t c = triangle_component[t];
     ++closed_sheets[c];
     if (component_fins[c]) {
+      if (sheet_column.empty()) sheet_column.assign(num_triangles, -1);
       sheet_column[t] = static_cast<int32_t>(column_component.size());
       column_component.push_back(c);
     }
   }
   if (!column_component.empty()) {
-    // Sides on edges of three or more triangles, grouped by edge: one row per edge.
-    std::vector<std::pair<int32_t, int32_t>> fins;  // (edge, side)
-    for (int32_t s = 0; s < 3 * num_triangles; ++s)
-      if (k.side_twin[s] == SimplicialComplex::kFinSide) fins.emplace_back(k.triangle_edges[s], s);
-    std::sort(fins.begin(), fins.end());
+    // One row per edge of three or more triangles; a sheet meeting it an odd number of times
+    // has a 1 there.
     std::vector<std::vector<phat::index>> columns(column_component.size());
-    int64_t rows = 0;
-    for (size_t i = 0; i < fins.size(); ++rows) {
-      size_t j = i;
-      for (; j < fins.size() && fins[j].first == fins[i].first; ++j) {
-        const int32_t col = sheet_column[sheets.find(fins[j].second / 3)];
-        if (col >= 0) columns[col].push_back(rows);
+    const int64_t rows = static_cast<int64_t>(k.fin_offsets.size()) - 1;
+    for (int64_t row = 0; row < rows; ++row)
+      for (int32_t i = k.fin_offsets[row]; i < k.fin_offsets[row + 1]; ++i) {
+        const int32_t col = sheet_column[sheets.find(k.fin_sides[i] / 3)];
+        if (col >= 0) columns[col].push_back(row);
       }
-      i = j;
-    }
-    // A sheet that meets an edge an even number of times adds nothing to its constraint.
     for (auto& col : columns) {
       std::vector<phat::index> odd;
       for (size_t i = 0; i < col.size();) {
@@ -189,15 +194,26 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
 
   // Non-manifold edges (no triangle, or three and more) and vertices, in surface components.
   std::vector<uint8_t> bad_vertex(n, 0);
-  for (int32_t e = 0; e < num_edges; ++e) {
-    const int32_t count = k.edge_triangles[e];
-    const int32_t a = k.edges[2 * size_t(e)], b = k.edges[2 * size_t(e) + 1];
-    if (count == 1 || count == 2 || comps[component_of[a]].kind != ComponentKind::surface) continue;
-    out.nonmanifold_edges.push_back(a);
-    out.nonmanifold_edges.push_back(b);
-    out.nonmanifold_edge_triangles.push_back(count);
-    ++comps[component_of[a]].nonmanifold_edges;
-    bad_vertex[a] = bad_vertex[b] = 1;
+  {
+    std::vector<std::array<int32_t, 3>> bad_edges;  // (lower, higher, triangles)
+    for (size_t i = 0; i < k.fin_edges.size(); i += 2)
+      bad_edges.push_back({k.fin_edges[i], k.fin_edges[i + 1], k.fin_offsets[i / 2 + 1] - k.fin_offsets[i / 2]});
+    for (size_t i = 0; i < k.wire_edges.size(); i += 2)
+      if (comps[component_of[k.wire_edges[i]]].kind == ComponentKind::surface)
+        bad_edges.push_back({k.wire_edges[i], k.wire_edges[i + 1], 0});
+    for (auto& [a, b, count] : bad_edges) {
+      bad_vertex[a] = bad_vertex[b] = 1;
+      ++comps[component_of[a]].nonmanifold_edges;
+      a = caller[a];
+      b = caller[b];
+      if (a > b) std::swap(a, b);
+    }
+    std::sort(bad_edges.begin(), bad_edges.end());
+    for (const auto& [a, b, count] : bad_edges) {
+      out.nonmanifold_edges.push_back(a);
+      out.nonmanifold_edges.push_back(b);
+      out.nonmanifold_edge_triangles.push_back(count);
+    }
   }
 #pragma omp parallel for schedule(dynamic, 8192)
   for (int32_t v = 0; v < n; ++v) {
@@ -206,21 +222,22 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
   }
   for (int32_t v = 0; v < n; ++v)
     if (bad_vertex[v]) {
-      out.nonmanifold_vertices.push_back(v);
+      out.nonmanifold_vertices.push_back(caller[v]);
       ++comps[component_of[v]].nonmanifold_vertices;
     }
+  std::sort(out.nonmanifold_vertices.begin(), out.nonmanifold_vertices.end());
 
   // Boundary curves: from each unvisited boundary side, turn around the fans at its ends.
   std::vector<uint8_t> visited;
   std::vector<int32_t> backward;
-  for (int32_t s0 = 0; s0 < 3 * num_triangles; ++s0) {
+  for (int32_t s0 = 0; s0 < num_sides; ++s0) {
     if (k.side_twin[s0] != SimplicialComplex::kOpenSide) continue;
-    if (visited.empty()) visited.assign(3 * size_t(num_triangles), 0);
+    if (visited.empty()) visited.assign(num_sides, 0);
     if (visited[s0]) continue;
     visited[s0] = 1;
     const size_t start = out.boundary_vertices.size();
     out.boundary_vertices.push_back(k.side_start(s0));
-    // Forward from the end of s0. `at` stands on the boundary side just followed, at its far end.
+    // Forward from the end of s0; `at` stands on the boundary side just followed, at its far end.
     FanCursor at{s0, false};
     bool closed = false;
     while (true) {
@@ -251,6 +268,8 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
       }
       out.boundary_vertices.insert(out.boundary_vertices.begin() + start, backward.rbegin(), backward.rend());
     }
+    for (size_t i = start; i < out.boundary_vertices.size(); ++i)
+      out.boundary_vertices[i] = caller[out.boundary_vertices[i]];
     const int32_t c = component_of[k.side_start(s0)];
     out.boundary_offsets.push_back(static_cast<int32_t>(out.boundary_vertices.size()));
     out.boundary_component.push_back(c);
@@ -290,7 +309,9 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
 
 TopologyReport analyze_topology(const double* positions, int32_t num_vertices, const int32_t* triangles,
                                 int64_t num_triangles, const int32_t* edges, int64_t num_edges) {
-  return analyze_topology(build_complex(positions, num_vertices, triangles, num_triangles, edges, num_edges));
+  return analyze_topology(build_complex(positions, num_vertices,
+                                        std::vector<int32_t>(triangles, triangles + 3 * num_triangles), edges,
+                                        num_edges));
 }
 
 }  // namespace topstoc

@@ -14,9 +14,18 @@
 // Out-of-range indices and non-finite coordinates raise std::invalid_argument naming the element.
 // The caller's arrays are only read.
 //
-// Sides: side s = 3t + c of triangle t runs from corner c to corner c+1. Walking around a
-// vertex only needs, per side, the side across its edge (side_twin), so the walks touch one
-// array: that is what keeps them fast on meshes whose vertex order has no locality.
+// Internal numbering: vertices are renumbered along a Z-order (Morton) curve of their positions
+// and triangles ordered by their lowest vertex, so that neighbours sit close in memory (on a
+// Loop-subdivided mesh, whose file order has no locality, this halves the analysis time).
+// Every vertex id inside the struct is internal; vertex_source maps back to the caller's ids,
+// vertex_index maps the caller's ids in. Results handed to callers use the caller's ids.
+//
+// Sides instead of an edge table: side s = 3t + c of triangle t runs from corner c to corner
+// c+1. Each side records the side across its edge (side_twin), which is all that walking around
+// vertices, grouping triangles and building trees needs; edges with no triangle or with three
+// or more are listed apart (they are rare). Keeping one int per side and no edge ids halves the
+// memory the analysis touches, which is what its time depends on for large meshes whose vertex
+// order has no locality.
 #pragma once
 
 #include <cstdint>
@@ -25,26 +34,34 @@
 namespace topstoc {
 
 struct SimplicialComplex {
+  static constexpr int32_t kOpenSide = -1;  ///< the edge has this triangle only (a boundary edge)
+  static constexpr int32_t kFinSide = -2;   ///< the edge has three or more triangles
+
   int32_t num_vertices = 0;
-  /// Distinct 2-simplices: three corners each, in the caller's corner order (orientation of the
-  /// first occurrence), and the index of that occurrence in the caller's triangle array.
+  /// Caller's id of each internal vertex, and internal id of each caller vertex.
+  std::vector<int32_t> vertex_source;
+  std::vector<int32_t> vertex_index;
+  /// Distinct 2-simplices (internal vertex ids): three corners each, in the caller's corner
+  /// order (orientation of the first occurrence), and the index of that occurrence in the
+  /// caller's triangle array.
   std::vector<int32_t> triangles;
   std::vector<int32_t> triangle_source;
-  /// Distinct 1-simplices as (lower, higher) vertex pairs, sorted lexicographically.
-  std::vector<int32_t> edges;
-  /// Number of triangles on each edge (0 for a wire edge, 1 on a boundary, 2 inside a surface).
-  std::vector<int32_t> edge_triangles;
-  /// triangle_edges[s]: the edge of side s.
-  std::vector<int32_t> triangle_edges;
   /// side_twin[s]: when the edge of s has exactly two triangles, 2 * (the other side) + 1 if both
   /// sides run along the edge in the same direction (inconsistent orientation), + 0 otherwise;
-  /// kOpenSide when s is the edge's only side, kFinSide when the edge has three or more.
+  /// kOpenSide or kFinSide otherwise.
   std::vector<int32_t> side_twin;
-  static constexpr int32_t kOpenSide = -1;
-  static constexpr int32_t kFinSide = -2;
   /// Triangles at each vertex, and one side starting at it (-1 for none).
   std::vector<int32_t> vertex_triangles;
   std::vector<int32_t> vertex_side;
+  /// Edges with three or more triangles (internal vertex pairs, lower first, sorted) and their sides
+  /// (CSR: fin_sides[fin_offsets[i] .. fin_offsets[i+1]), increasing).
+  std::vector<int32_t> fin_edges;
+  std::vector<int32_t> fin_offsets = {0};
+  std::vector<int32_t> fin_sides;
+  /// Edges in no triangle (internal vertex pairs, lower first, sorted).
+  std::vector<int32_t> wire_edges;
+  /// Number of distinct edges (1-simplices) of the complex.
+  int32_t num_edges = 0;
 
   int32_t input_triangles = 0;
   int32_t input_edges = 0;
@@ -54,32 +71,36 @@ struct SimplicialComplex {
   int32_t duplicate_triangles = 0;
 
   int32_t num_triangles() const { return static_cast<int32_t>(triangles.size() / 3); }
-  int32_t num_edges() const { return static_cast<int32_t>(edges.size() / 2); }
+  int32_t num_sides() const { return static_cast<int32_t>(triangles.size()); }
   /// Vertex where side s starts, and where it ends.
   int32_t side_start(int32_t s) const { return triangles[s]; }
   int32_t side_end(int32_t s) const { return triangles[next_side(s)]; }
   static int32_t next_side(int32_t s) { return s - s % 3 + (s % 3 + 1) % 3; }
   static int32_t previous_side(int32_t s) { return s - s % 3 + (s % 3 + 2) % 3; }
+  /// True for exactly one side of every edge with one or two triangles (the edge's
+  /// representative side): open sides, and the lower side of each twin pair.
+  bool represents_edge(int32_t s) const { return side_twin[s] == kOpenSide || (side_twin[s] >> 1) > s; }
 };
 
-/// Builds the complex. positions: 3 * num_vertices coordinates, checked to be finite (may be
-/// null to skip the check); triangles: 3 * num_triangles vertex ids; edges: 2 * num_edges vertex
-/// ids (may be null when num_edges is 0). At most 2^30 / 3 (about 357 million) triangles.
-/// Throws std::invalid_argument naming the first offending vertex, triangle or edge.
-SimplicialComplex build_complex(const double* positions, int32_t num_vertices, const int32_t* triangles,
-                                int64_t num_triangles, const int32_t* edges, int64_t num_edges);
+/// Builds the complex. positions: 3 * num_vertices coordinates, checked to be finite and used
+/// for the internal order (may be null: no check, caller's order kept); triangles: 3 * num_triangles vertex ids (taken over to avoid a copy);
+/// edges: 2 * num_edges vertex ids (may be null when num_edges is 0). At most 2^30 / 3 (about
+/// 357 million) triangles. Throws std::invalid_argument naming the first offending vertex,
+/// triangle or edge.
+SimplicialComplex build_complex(const double* positions, int32_t num_vertices, std::vector<int32_t> triangles,
+                                const int32_t* edges, int64_t num_edges);
 
-/// Vertex-to-edge incidence (CSR): the edges of vertex v are
-/// incident_edges[offsets[v] .. offsets[v+1]), in increasing edge order.
-void vertex_edges(const SimplicialComplex& complex, std::vector<int32_t>& offsets, std::vector<int32_t>& incident_edges);
-
-/// Turning around a vertex v through the triangle sides that touch it. A position is a side x
-/// of a triangle at v and whether v is where x starts. Orientation-free: works on
+/// Turning around a vertex v through the triangle sides that touch it. A position is a side of
+/// a triangle at v and whether v is where that side starts. Orientation-free: works on
 /// inconsistently oriented and non-orientable surfaces.
 struct FanCursor {
   int32_t side;
   bool starts_at_vertex;
 
+  /// The vertex at the other end of the current side.
+  int32_t neighbour(const SimplicialComplex& k) const {
+    return starts_at_vertex ? k.side_end(side) : k.side_start(side);
+  }
   /// The other side of the same triangle at v.
   void turn() {
     side = starts_at_vertex ? SimplicialComplex::previous_side(side) : SimplicialComplex::next_side(side);
@@ -87,8 +108,8 @@ struct FanCursor {
   }
   /// Steps across the edge of the current side into the neighbouring triangle. Returns false
   /// (and stays) when the edge does not have exactly two triangles.
-  bool cross(const SimplicialComplex& complex) {
-    const int32_t code = complex.side_twin[side];
+  bool cross(const SimplicialComplex& k) {
+    const int32_t code = k.side_twin[side];
     if (code < 0) return false;
     side = code >> 1;
     if (!(code & 1)) starts_at_vertex = !starts_at_vertex;  // opposite directions: roles swap
