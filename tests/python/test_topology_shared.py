@@ -2,6 +2,7 @@
 genus of each component equals ../shared/tools/meshstat.py. Skips without ../shared."""
 
 import importlib.util
+import os
 
 import numpy as np
 import pytest
@@ -16,6 +17,14 @@ from topology_checks import check_generators, gudhi_betti  # noqa: E402
 MESH_SUFFIXES = (".off", ".obj", ".ply", ".stl", ".gz", ".bz2")
 FILES = sorted(str(p.relative_to(SHARED_MESHES)) for p in SHARED_MESHES.rglob("*")
                if p.is_file() and p.name.endswith(MESH_SUFFIXES)) if SHARED_MESHES.is_dir() else []
+# The references need 10-40 s each on the million-triangle meshes under big/ (GUDHI, meshstat):
+# run them with TOPSTOC_BIG_TESTS=1 (the topology benchmark compares Betti numbers there too).
+BIG = os.environ.get("TOPSTOC_BIG_TESTS") == "1"
+
+
+def skip_big(name):
+    if name.startswith("big/") and not BIG:
+        pytest.skip("million-triangle mesh: set TOPSTOC_BIG_TESTS=1 to compare it with GUDHI and meshstat")
 
 
 def load_meshstat():
@@ -37,6 +46,7 @@ def read_or_skip(path):
 
 @pytest.mark.parametrize("name", FILES)
 def test_betti_numbers_equal_gudhi(shared_meshes, name):
+    skip_big(name)
     data = read_or_skip(shared_meshes / name)
     info = topology(data.vertices, data.triangles)
     assert info.betti == gudhi_betti(len(data.vertices), data.triangles)
@@ -44,6 +54,7 @@ def test_betti_numbers_equal_gudhi(shared_meshes, name):
 
 @pytest.mark.parametrize("name", FILES)
 def test_genus_per_component_equals_meshstat(shared_meshes, name):
+    skip_big(name)
     meshstat = load_meshstat()
     data = read_or_skip(shared_meshes / name)
     raw = meshstat.load(str(shared_meshes / name))
@@ -56,6 +67,11 @@ def test_genus_per_component_equals_meshstat(shared_meshes, name):
     ours = sorted(((c.faces, c.euler, len(c.boundary_loops), c.manifold, undefined(c.genus)) for c in surfaces),
                   reverse=True)
     theirs = [(f, chi, loops, manifold, undefined(genus)) for f, chi, loops, manifold, genus in stats["comp_summary"]]
+    if stats["duplicate_faces"] or stats["degenerate_faces_topo"]:
+        # meshstat counts a repeated triangle twice (its edges then look interior) where the
+        # simplicial complex has it once: euler and boundaries differ, genus must not.
+        ours = [(x[0], None, None) + x[3:] for x in ours]
+        theirs = [(x[0], None, None) + x[3:] for x in theirs]
     if len(surfaces) <= 12 or stats["polys"].keys() == {3}:
         assert sorted(x[1:] for x in ours[:len(theirs)]) == sorted(x[1:] for x in theirs)
     genus_sum = sum(c.genus for c in surfaces) if all(c.genus is not None for c in surfaces) else None
