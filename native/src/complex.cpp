@@ -16,15 +16,34 @@ namespace {
 
 constexpr int64_t kMaxSides = (int64_t(1) << 30) - 1;  // side_twin stores 2 * side in an int32
 
-// Prefix sums in place: counts[i] becomes the sum of counts[0..i); counts.back() the total.
-void exclusive_scan(std::vector<int32_t>& counts, const char* what) {
-  int64_t sum = 0;
-  for (auto& c : counts) {
-    const int64_t x = c;
-    c = static_cast<int32_t>(sum);
-    sum += x;
+int32_t pass_threads(int64_t items) { return items >= kParallelMinimum ? std::max(1, omp_get_max_threads()) : 1; }
+
+// Stable counting sort of items 0..count-1 into buckets 0..num_buckets-1: count_item(i, hist)
+// increments hist[bucket of i]; place(i, hist) writes item i at hist[bucket of i]++. Runs on
+// contiguous chunks, one histogram per chunk, so the result is the serial one. `offsets`
+// receives the bucket starts (num_buckets + 1 entries).
+template <class CountItem, class Place>
+void counting_sort(int64_t count, int32_t num_buckets, CountItem count_item, Place place, std::vector<int32_t>& offsets) {
+  const int32_t chunks = pass_threads(count);
+  std::vector<std::vector<int32_t>> hist(chunks, std::vector<int32_t>(num_buckets, 0));
+#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
+  for (int32_t c = 0; c < chunks; ++c)
+    for (int64_t i = count * c / chunks; i < count * (c + 1) / chunks; ++i) count_item(i, hist[c].data());
+  offsets.assign(size_t(num_buckets) + 1, 0);
+  int64_t running = 0;
+  for (int32_t b = 0; b < num_buckets; ++b) {
+    offsets[b] = static_cast<int32_t>(running);
+    for (int32_t c = 0; c < chunks; ++c) {
+      const int32_t x = hist[c][b];
+      hist[c][b] = static_cast<int32_t>(running);
+      running += x;
+    }
   }
-  if (sum > INT32_MAX) throw std::invalid_argument(std::string("complex is too large: more than 2^31 ") + what);
+  if (running > INT32_MAX) throw std::invalid_argument("complex is too large: more than 2^31 incidences");
+  offsets[num_buckets] = static_cast<int32_t>(running);
+#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
+  for (int32_t c = 0; c < chunks; ++c)
+    for (int64_t i = count * c / chunks; i < count * (c + 1) / chunks; ++i) place(i, hist[c].data());
 }
 
 // Sorts a small range in place (insertion sort; buckets here hold a handful of entries), falling
@@ -97,7 +116,7 @@ std::vector<int32_t> morton_order(const double* positions, int32_t n) {
     }
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
   std::vector<uint64_t> keyed(n), scratch(n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
   for (int32_t v = 0; v < n; ++v) {
     uint32_t key = 0;
     for (int k = 0; k < 3; ++k) {
@@ -132,21 +151,21 @@ void renumber(SimplicialComplex& out, std::vector<int32_t> order, std::vector<in
     wires[i] = std::min(a, b);
     wires[i + 1] = std::max(a, b);
   }
-  std::vector<int32_t> offsets(size_t(n) + 1, 0);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (out.triangles.size() >= size_t(kParallelMinimum))
   for (size_t i = 0; i < out.triangles.size(); ++i) out.triangles[i] = index[out.triangles[i]];
-  auto lowest = [&](int32_t t) {
+  auto lowest = [&](int64_t t) {
     const int32_t* x = &out.triangles[3 * size_t(t)];
     return std::min({x[0], x[1], x[2]});
   };
-  for (int32_t t = 0; t < m; ++t) ++offsets[lowest(t) + 1];
-  for (int32_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
-  std::vector<int32_t> triangles(out.triangles.size()), source(m);
-  for (int32_t t = 0; t < m; ++t) {
-    const int32_t at = offsets[lowest(t)]++;
-    for (int c = 0; c < 3; ++c) triangles[3 * size_t(at) + c] = out.triangles[3 * size_t(t) + c];
-    source[at] = out.triangle_source[t];
-  }
+  std::vector<int32_t> triangles(out.triangles.size()), source(m), offsets;
+  counting_sort(
+      m, n, [&](int64_t t, int32_t* hist) { ++hist[lowest(t)]; },
+      [&](int64_t t, int32_t* hist) {
+        const int32_t at = hist[lowest(t)]++;
+        for (int c = 0; c < 3; ++c) triangles[3 * size_t(at) + c] = out.triangles[3 * size_t(t) + c];
+        source[at] = out.triangle_source[t];
+      },
+      offsets);
   out.triangles.swap(triangles);
   out.triangle_source.swap(source);
 }
@@ -160,34 +179,40 @@ void link_sides(SimplicialComplex& out, const std::vector<int32_t>& wires) {
 
   // Each side and wire becomes an entry in the bucket of its lower vertex: the higher vertex in
   // the top 32 bits, then (side + 1) and whether the side runs from lower to higher (wires: 0).
-  // Sorting a bucket groups each edge's entries.
-  std::vector<int32_t> offsets(size_t(n) + 1, 0);
+  // Sorting a bucket groups each edge's entries. Items 0..num_sides-1 are sides, the rest wires.
+  const int64_t num_wires = static_cast<int64_t>(wires.size() / 2);
+  auto lower = [&](int64_t i) {
+    if (i >= num_sides) return wires[2 * size_t(i - num_sides)];
+    const int32_t a = tri[i], b = tri[SimplicialComplex::next_side(int32_t(i))];
+    return a < b ? a : b;
+  };
+  std::vector<int32_t> offsets;
+  std::vector<uint64_t> entries(size_t(num_sides) + size_t(num_wires));
+  counting_sort(
+      num_sides + num_wires, n, [&](int64_t i, int32_t* hist) { ++hist[lower(i)]; },
+      [&](int64_t i, int32_t* hist) {
+        if (i >= num_sides) {
+          const size_t w = 2 * size_t(i - num_sides);
+          entries[hist[wires[w]]++] = uint64_t(uint32_t(wires[w + 1])) << 32;
+          return;
+        }
+        const int32_t a = tri[i], b = tri[SimplicialComplex::next_side(int32_t(i))];
+        const uint32_t low = (uint32_t(i + 1) << 1) | (a < b ? 1u : 0u);
+        entries[hist[a < b ? a : b]++] = (uint64_t(uint32_t(a < b ? b : a)) << 32) | low;
+      },
+      offsets);
+  // Triangles at each vertex, and the first side starting there.
   out.vertex_triangles.assign(n, 0);
   out.vertex_side.assign(n, -1);
-  for (int32_t s = 0; s < num_sides; ++s) {
-    const int32_t a = tri[s], b = tri[SimplicialComplex::next_side(s)];
-    ++offsets[a < b ? a : b];
-    if (out.vertex_triangles[a]++ == 0) out.vertex_side[a] = s;
-  }
-  for (size_t i = 0; i < wires.size(); i += 2) ++offsets[wires[i]];
-  exclusive_scan(offsets, "edge incidences");
-  std::vector<uint64_t> entries(offsets[n]);
-  {
-    std::vector<int32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (int32_t s = 0; s < num_sides; ++s) {
-      const int32_t a = tri[s], b = tri[SimplicialComplex::next_side(s)];
-      const uint32_t low = (uint32_t(s + 1) << 1) | (a < b ? 1u : 0u);
-      entries[fill[a < b ? a : b]++] = (uint64_t(uint32_t(a < b ? b : a)) << 32) | low;
-    }
-    for (size_t i = 0; i < wires.size(); i += 2) entries[fill[wires[i]]++] = uint64_t(uint32_t(wires[i + 1])) << 32;
-  }
+  for (int32_t s = 0; s < num_sides; ++s)
+    if (out.vertex_triangles[tri[s]]++ == 0) out.vertex_side[tri[s]] = s;
 
   // Per vertex: sort its bucket and link the sides of each edge. Fins and wires are rare:
   // collected per thread, sorted afterwards so the result does not depend on the threads.
   out.side_twin.resize(num_sides);
-  std::vector<std::vector<int32_t>> fin_parts(omp_get_max_threads()), wire_parts(omp_get_max_threads());
+  std::vector<std::vector<int32_t>> fin_parts(pass_threads(num_sides)), wire_parts(pass_threads(num_sides));
   int64_t num_edges = 0;
-#pragma omp parallel reduction(+ : num_edges)
+#pragma omp parallel reduction(+ : num_edges) num_threads(pass_threads(num_sides))
   {
     auto& fins = fin_parts[omp_get_thread_num()];  // (lower, higher, side) triples
     auto& lone_wires = wire_parts[omp_get_thread_num()];

@@ -215,7 +215,7 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
       out.nonmanifold_edge_triangles.push_back(count);
     }
   }
-#pragma omp parallel for schedule(dynamic, 8192)
+#pragma omp parallel for schedule(dynamic, 8192) if (n >= kParallelMinimum)
   for (int32_t v = 0; v < n; ++v) {
     if (bad_vertex[v] || k.vertex_triangles[v] == 0) continue;
     if (walk.fan_size(k.vertex_side[v], k.vertex_triangles[v]) != k.vertex_triangles[v]) bad_vertex[v] = 1;

@@ -33,6 +33,10 @@
 
 namespace topstoc {
 
+/// Passes over fewer items than this stay serial: starting threads costs more than it saves
+/// (and much more when the machine is busy and a thread waits to be scheduled).
+inline constexpr int64_t kParallelMinimum = 1 << 17;
+
 struct SimplicialComplex {
   static constexpr int32_t kOpenSide = -1;  ///< the edge has this triangle only (a boundary edge)
   static constexpr int32_t kFinSide = -2;   ///< the edge has three or more triangles
