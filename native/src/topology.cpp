@@ -89,84 +89,95 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
   std::vector<int32_t> component_of;  // per internal vertex
   const auto& caller = k.vertex_source;
 
-  // Components: union-find over the edges (each represented by a side, plus fins and wires),
-  // numbered by their smallest vertex.
+  // Two independent union-finds, run side by side: vertices joined by edges (each edge
+  // represented by a side, plus fins and wires) give the components; triangles joined across
+  // edges with exactly two triangles give the sheets, with a parity that says whether two
+  // triangles must be flipped relative to each other to agree. Flips and conflicts are rare:
+  // a triangle of each is remembered and its component found afterwards.
+  UnionFind vertices(n);
+  ParityUnionFind sheets(num_triangles);
+  std::vector<uint8_t> sheet_open(num_triangles, 0);  // a sheet with a boundary edge
+  std::vector<int32_t> flipped_triangles, conflict_triangles;
+#pragma omp parallel sections num_threads(2) if (num_sides >= kParallelMinimum)
   {
-    UnionFind vertices(n);
-    for (int32_t s = 0; s < num_sides; ++s)
-      if (k.represents_edge(s)) vertices.unite(k.side_start(s), k.side_end(s));
-    for (size_t i = 0; i < k.fin_edges.size(); i += 2) vertices.unite(k.fin_edges[i], k.fin_edges[i + 1]);
-    for (size_t i = 0; i < k.wire_edges.size(); i += 2) vertices.unite(k.wire_edges[i], k.wire_edges[i + 1]);
-    // Walk the caller's ids in order so that components are numbered by their smallest one.
-    out.vertex_component.assign(n, -1);
-    component_of.assign(n, -1);
+#pragma omp section
+    {
+      for (int32_t s = 0; s < num_sides; ++s)
+        if (k.represents_edge(s)) vertices.unite(k.side_start(s), k.side_end(s));
+      for (size_t i = 0; i < k.fin_edges.size(); i += 2) vertices.unite(k.fin_edges[i], k.fin_edges[i + 1]);
+      for (size_t i = 0; i < k.wire_edges.size(); i += 2) vertices.unite(k.wire_edges[i], k.wire_edges[i + 1]);
+    }
+#pragma omp section
+    {
+      for (int32_t s = 0; s < num_sides; ++s) {
+        const int32_t code = k.side_twin[s];
+        if (code < 0 || (code >> 1) < s) continue;  // each shared edge once
+        const uint8_t same_direction = code & 1;
+        if (same_direction) flipped_triangles.push_back(s / 3);
+        if (sheets.unite(s / 3, (code >> 1) / 3, same_direction) == ParityUnionFind::Join::conflict)
+          conflict_triangles.push_back(s / 3);
+      }
+      for (int32_t s = 0; s < num_sides; ++s)
+        if (k.side_twin[s] == SimplicialComplex::kOpenSide) sheet_open[sheets.find(s / 3)] = 1;
+    }
+  }
+
+  // Components numbered by their smallest caller id: walk the caller's ids in order.
+  out.vertex_component.assign(n, -1);
+  component_of.assign(n, -1);
+  {
     std::vector<int32_t> label(n, -1);
-    for (int32_t caller = 0; caller < n; ++caller) {
-      const int32_t v = k.vertex_index[caller];
+    for (int32_t id = 0; id < n; ++id) {
+      const int32_t v = k.vertex_index[id];
       const int32_t r = vertices.find(v);
       if (label[r] < 0) {
         label[r] = static_cast<int32_t>(out.components.size());
         out.components.emplace_back();
-        out.components.back().first_vertex = caller;
+        out.components.back().first_vertex = id;
       }
-      out.vertex_component[caller] = component_of[v] = label[r];
+      out.vertex_component[id] = component_of[v] = label[r];
     }
   }
   auto& comps = out.components;
   const int32_t num_components = static_cast<int32_t>(comps.size());
-  std::vector<int32_t> triangle_component(num_triangles);
-  for (int32_t v = 0; v < n; ++v) ++comps[component_of[v]].vertices;
-  for (int32_t t = 0; t < num_triangles; ++t) {
-    auto& c = comps[triangle_component[t] = component_of[k.triangles[3 * size_t(t)]]];
-    ++c.triangles;
-    for (int32_t s = 3 * t; s < 3 * t + 3; ++s) {
-      if (k.side_twin[s] == SimplicialComplex::kOpenSide) ++c.boundary_edges;
-      if (k.represents_edge(s)) ++c.edges;
-    }
-  }
   std::vector<uint8_t> component_fins(num_components, 0);
   for (size_t i = 0; i < k.fin_edges.size(); i += 2) {
     ++comps[component_of[k.fin_edges[i]]].edges;
     component_fins[component_of[k.fin_edges[i]]] = 1;
   }
   for (size_t i = 0; i < k.wire_edges.size(); i += 2) ++comps[component_of[k.wire_edges[i]]].edges;
-  for (auto& c : comps) {
-    c.euler = int64_t(c.vertices) - c.edges + c.triangles;
-    c.kind = c.triangles > 0 ? ComponentKind::surface : (c.edges > 0 ? ComponentKind::graph : ComponentKind::vertex);
-  }
+  for (int32_t v = 0; v < n; ++v) ++comps[component_of[v]].vertices;
 
-  // Sheets and orientation: triangles joined across edges with exactly two triangles; the parity
-  // says whether two triangles must be flipped relative to each other to agree. Conflicts and
-  // flips are rare: remember a triangle of each and find its component afterwards.
-  ParityUnionFind sheets(num_triangles);
-  std::vector<uint8_t> component_conflict(num_components, 0), component_flipped(num_components, 0);
-  for (int32_t s = 0; s < num_sides; ++s) {
-    const int32_t code = k.side_twin[s];
-    if (code < 0 || (code >> 1) < s) continue;  // each shared edge once
-    const uint8_t same_direction = code & 1;
-    if (same_direction) component_flipped[triangle_component[s / 3]] = 1;
-    if (sheets.unite(s / 3, (code >> 1) / 3, same_direction) == ParityUnionFind::Join::conflict)
-      component_conflict[triangle_component[s / 3]] = 1;
-  }
-  // A sheet with a boundary edge can never be part of a 2-cycle.
-  std::vector<uint8_t> sheet_open(num_triangles, 0);
-  for (int32_t s = 0; s < num_sides; ++s)
-    if (k.side_twin[s] == SimplicialComplex::kOpenSide) sheet_open[sheets.find(s / 3)] = 1;
-
-  // beta2: closed sheets, minus the rank of the parity constraints at edges of 3+ triangles.
+  // Per triangle: counts, and the closed sheets (beta2 before the constraints at fins). Sheets
+  // of components with fins become columns of the Z2 system below.
+  std::vector<int32_t> triangle_component(num_triangles);
   std::vector<int32_t> closed_sheets(num_components, 0);
   std::vector<int32_t> sheet_column;
   std::vector<int32_t> column_component;
   for (int32_t t = 0; t < num_triangles; ++t) {
+    const int32_t ci = triangle_component[t] = component_of[k.triangles[3 * size_t(t)]];
+    auto& c = comps[ci];
+    ++c.triangles;
+    for (int32_t s = 3 * t; s < 3 * t + 3; ++s) {
+      if (k.side_twin[s] == SimplicialComplex::kOpenSide) ++c.boundary_edges;
+      if (k.represents_edge(s)) ++c.edges;
+    }
     if (sheets.find(t) != t || sheet_open[t]) continue;
-    const int32_t c = triangle_component[t];
-    ++closed_sheets[c];
-    if (component_fins[c]) {
+    ++closed_sheets[ci];
+    if (component_fins[ci]) {
       if (sheet_column.empty()) sheet_column.assign(num_triangles, -1);
       sheet_column[t] = static_cast<int32_t>(column_component.size());
-      column_component.push_back(c);
+      column_component.push_back(ci);
     }
   }
+  for (auto& c : comps) {
+    c.euler = int64_t(c.vertices) - c.edges + c.triangles;
+    c.kind = c.triangles > 0 ? ComponentKind::surface : (c.edges > 0 ? ComponentKind::graph : ComponentKind::vertex);
+  }
+  std::vector<uint8_t> component_conflict(num_components, 0), component_flipped(num_components, 0);
+  for (int32_t t : flipped_triangles) component_flipped[triangle_component[t]] = 1;
+  for (int32_t t : conflict_triangles) component_conflict[triangle_component[t]] = 1;
+
   if (!column_component.empty()) {
     // One row per edge of three or more triangles; a sheet meeting it an odd number of times
     // has a 1 there.
