@@ -3,7 +3,9 @@
 SPEC section 3, thesis chapter 3 and 4.2.1. Works on any triangle mesh read as a simplicial
 complex over Z2, in the caller's vertex ids:
 
-* every vertex is a 0-simplex, also an unused one (an isolated vertex is a component);
+* every vertex is a 0-simplex, also an unused one: an isolated vertex is a component of its
+  own, counted in betti[0] and listed in ``Topology.isolated_vertices`` (not in
+  ``Topology.components``, which would otherwise hold one object per point of a point cloud);
 * a triangle with three distinct vertices is a 2-simplex; repeated copies (same vertex set,
   any order) count once (``duplicate_triangles``);
 * a triangle with a repeated vertex is read as the edge (or vertex) it spans
@@ -25,29 +27,30 @@ import numpy as np
 
 from .native import engine
 
-_KINDS = ("vertex", "graph", "surface")
+_KINDS = ("vertex", "graph", "surface")  # native kind codes 0, 1, 2
 
 
-def _flag(value) -> bool | None:
-    return None if int(value) < 0 else bool(value)
+def _flag(value: int) -> bool | None:
+    return None if value < 0 else bool(value)
 
 
-def _count(value) -> int | None:
-    return None if int(value) < 0 else int(value)
+def _count(value: int) -> int | None:
+    return None if value < 0 else value
 
 
 def _plural(count: int, word: str, plural: str | None = None) -> str:
     return f"{count} {word if count == 1 else (plural or word + 's')}"
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class ComponentTopology:
     """Invariants of one connected component.
 
-    ``kind`` is ``"surface"`` (at least one triangle), ``"graph"`` (edges only) or ``"vertex"``
-    (an isolated vertex). The surface properties (closed, manifold, orientable, genus...) are
-    ``None`` where they are not defined: for graphs and vertices, orientability next to an edge
-    of three or more triangles, genus on a non-manifold or non-orientable component.
+    ``kind`` is ``"surface"`` (at least one triangle) or ``"graph"`` (edges only; isolated
+    vertices are listed apart, see :class:`Topology`). The surface properties (closed,
+    manifold, orientable, genus...) are ``None`` where they are not defined: for graphs,
+    orientability next to an edge of three or more triangles, genus on a non-manifold or
+    non-orientable component.
     """
 
     index: int
@@ -74,8 +77,6 @@ class ComponentTopology:
     @property
     def summary(self) -> str:
         """One line for a panel or a log, e.g. ``"genus 3, closed, orientable"``."""
-        if self.kind == "vertex":
-            return "isolated vertex"
         b0, b1, b2 = self.betti
         if self.kind == "graph":
             return "edge graph, tree" if b1 == 0 else f"edge graph, {_plural(b1, 'independent cycle')}"
@@ -143,14 +144,17 @@ class ComponentGenerators:
 
 @dataclass(frozen=True)
 class Topology:
-    """Invariants of a whole mesh: totals, Betti numbers and one :class:`ComponentTopology` each."""
+    """Invariants of a whole mesh: totals, Betti numbers, one :class:`ComponentTopology` per
+    connected component with at least one edge, and the isolated vertices (each a component
+    too: betti[0] = len(components) + len(isolated_vertices))."""
 
     betti: tuple[int, int, int]
     vertices: int
     edges: int
     faces: int
     components: list[ComponentTopology]
-    vertex_component: np.ndarray = field(repr=False)  #: (n,) component index of each vertex
+    isolated_vertices: np.ndarray = field(repr=False)  #: (k,) ids of vertices in no edge or triangle
+    vertex_component: np.ndarray = field(repr=False)  #: (n,) index into components, -1 if isolated
     collapsed_triangles: int  #: triangles with a repeated vertex, read as an edge or a vertex
     duplicate_triangles: int  #: repeats of an earlier triangle's vertex set, counted once
     generators: list[ComponentGenerators] = field(default_factory=list, repr=False)  #: when asked for
@@ -166,18 +170,18 @@ class Topology:
     def summary(self) -> str:
         """One line: ``"1 component: genus 3, closed, orientable"``, or counts for many."""
         count = len(self.components)
+        isolated = len(self.isolated_vertices)
+        extra = f", {_plural(isolated, 'isolated vertex', 'isolated vertices')}" if isolated else ""
         if count == 0:
-            return "empty"
+            return _plural(isolated, "isolated vertex", "isolated vertices") if isolated else "empty"
         if count == 1:
-            return f"1 component: {self.components[0].summary}"
-        kinds = {kind: sum(c.kind == kind for c in self.components) for kind in _KINDS}
-        parts = [_plural(kinds["surface"], "surface")] if kinds["surface"] else []
-        if kinds["graph"]:
-            parts.append(_plural(kinds["graph"], "edge graph"))
-        if kinds["vertex"]:
-            parts.append(_plural(kinds["vertex"], "isolated vertex", "isolated vertices"))
+            return f"1 component: {self.components[0].summary}{extra}"
+        surfaces = sum(c.kind == "surface" for c in self.components)
+        parts = [_plural(surfaces, "surface")] if surfaces else []
+        if count > surfaces:
+            parts.append(_plural(count - surfaces, "edge graph"))
         b0, b1, b2 = self.betti
-        return f"{count} components ({', '.join(parts)}), betti {b0}/{b1}/{b2}"
+        return f"{count} components ({', '.join(parts)}){extra}, betti {b0}/{b1}/{b2}"
 
     def to_dict(self) -> dict:
         """JSON-ready (SPEC section 6: ``betti`` and ``components``; plus totals and generators)."""
@@ -185,7 +189,8 @@ class Topology:
                "faces": self.faces, "euler": self.euler, "summary": self.summary(),
                "collapsed_triangles": self.collapsed_triangles,
                "duplicate_triangles": self.duplicate_triangles,
-               "components": [c.to_dict() for c in self.components]}
+               "components": [c.to_dict() for c in self.components],
+               "isolated_vertices": self.isolated_vertices.tolist()}
         if self.generators:
             out["generators"] = [g.to_dict() for g in self.generators]
         return out
@@ -211,28 +216,37 @@ def topology(vertices, triangles, edges=None, generators: bool = False) -> Topol
     components and Betti numbers (0, 0, 0).
     """
     raw = engine.topology(vertices, triangles, edges, generators)
-    cols = raw["components"]
+    # Native components include isolated vertices; here they are listed apart and the others
+    # renumbered (same order: by smallest vertex id).
+    native = raw["components"]
+    kinds = native["kind"]
+    kept = kinds != 0
+    renumber = np.full(len(kinds) + 1, -1, dtype=np.int32)  # last slot: -1 stays -1
+    renumber[:-1][kept] = np.arange(int(kept.sum()), dtype=np.int32)
+    # Plain lists: indexing them is much cheaper than numpy scalars.
+    cols = {key: value[kept].tolist() for key, value in native.items()}
+    component_of = renumber[raw["vertex_component"]]
     curves = _split(raw["boundary_offsets"], raw["boundary_vertices"])
     loops_of: dict[int, list] = {}
     paths_of: dict[int, list] = {}
-    for curve, comp, closed in zip(curves, raw["boundary_component"], raw["boundary_closed"]):
-        (loops_of if closed else paths_of).setdefault(int(comp), []).append(curve)
+    for curve, comp, closed in zip(curves, renumber[raw["boundary_component"]].tolist(),
+                                   raw["boundary_closed"].tolist()):
+        (loops_of if closed else paths_of).setdefault(comp, []).append(curve)
     nm_edges = raw["nonmanifold_edges"]
     nm_faces = raw["nonmanifold_edge_triangles"]
     nm_vertices = raw["nonmanifold_vertices"]
-    component_of = raw["vertex_component"]
     nm_edge_comp = component_of[nm_edges[:, 0]] if len(nm_edges) else np.zeros(0, np.int32)
     nm_vertex_comp = component_of[nm_vertices] if len(nm_vertices) else np.zeros(0, np.int32)
     empty_pairs = np.zeros((0, 2), np.int32)
     empty = np.zeros(0, np.int32)
     components = []
-    for i in range(len(cols["kind"])):
+    for i, kind in enumerate(cols["kind"]):
         has_nm = cols["nonmanifold_edges"][i] > 0 or cols["nonmanifold_vertices"][i] > 0
         components.append(ComponentTopology(
-            index=i, kind=_KINDS[cols["kind"][i]], first_vertex=int(cols["first_vertex"][i]),
-            vertices=int(cols["vertices"][i]), edges=int(cols["edges"][i]), faces=int(cols["triangles"][i]),
-            euler=int(cols["euler"][i]), betti=tuple(int(b) for b in cols["betti"][i]),
-            boundary_edges=int(cols["boundary_edges"][i]), closed=_flag(cols["closed"][i]),
+            index=i, kind=_KINDS[kind], first_vertex=cols["first_vertex"][i],
+            vertices=cols["vertices"][i], edges=cols["edges"][i], faces=cols["triangles"][i],
+            euler=cols["euler"][i], betti=tuple(cols["betti"][i]),
+            boundary_edges=cols["boundary_edges"][i], closed=_flag(cols["closed"][i]),
             manifold=_flag(cols["manifold"][i]), orientable=_flag(cols["orientable"][i]),
             consistently_oriented=_flag(cols["consistently_oriented"][i]),
             genus=_count(cols["genus"][i]), crosscaps=_count(cols["crosscaps"][i]),
@@ -240,13 +254,16 @@ def topology(vertices, triangles, edges=None, generators: bool = False) -> Topol
             nonmanifold_edges=nm_edges[nm_edge_comp == i] if has_nm else empty_pairs,
             nonmanifold_edge_faces=nm_faces[nm_edge_comp == i] if has_nm else empty,
             nonmanifold_vertices=nm_vertices[nm_vertex_comp == i] if has_nm else empty))
+    gens = []
+    for g in raw["generators"]:
+        g["component"] = int(renumber[g["component"]])
+        gens.append(_generators_from(g))
     return Topology(
         betti=tuple(int(b) for b in raw["betti"]), vertices=int(raw["num_vertices"]),
         edges=int(raw["num_edges"]), faces=int(raw["num_triangles"]), components=components,
-        vertex_component=component_of, collapsed_triangles=int(raw["collapsed_triangles"]),
-        duplicate_triangles=int(raw["duplicate_triangles"]),
-        generators=[_generators_from(g) for g in raw["generators"]])
-
+        isolated_vertices=native["first_vertex"][~kept], vertex_component=component_of,
+        collapsed_triangles=int(raw["collapsed_triangles"]),
+        duplicate_triangles=int(raw["duplicate_triangles"]), generators=gens)
 
 def generators(vertices, triangles, edges=None) -> list[ComponentGenerators]:
     """Generator edges and loops of every closed orientable manifold component (genus-0

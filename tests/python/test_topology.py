@@ -54,11 +54,13 @@ def test_betti_numbers_equal_gudhi(name):
     vertices, triangles, edges = SYNTHETIC[name]
     info = topology(vertices, triangles, edges)
     assert info.betti == gudhi_betti(len(vertices), triangles, edges)
-    assert info.betti == tuple(np.sum([c.betti for c in info.components], axis=0)) if info.components else True
+    isolated = len(info.isolated_vertices)
+    assert info.betti == tuple(np.sum([c.betti for c in info.components] + [(isolated, 0, 0)], axis=0))
     # Euler-Poincare per component, and totals
     for c in info.components:
         assert c.euler == c.vertices - c.edges + c.faces == c.betti[0] - c.betti[1] + c.betti[2]
-    assert sum(c.vertices for c in info.components) == len(vertices)
+    assert sum(c.vertices for c in info.components) + isolated == len(vertices)
+    assert np.array_equal(np.flatnonzero(info.vertex_component < 0), info.isolated_vertices)
 
 
 EXPECTED = {  # name: per component (kind, betti, closed, orientable, manifold, genus, crosscaps, loops)
@@ -77,8 +79,7 @@ EXPECTED = {  # name: per component (kind, betti, closed, orientable, manifold, 
     "mixed": [("surface", (1, 2, 1), True, True, True, 1, None, 0),
               ("surface", (1, 1, 0), False, False, True, None, 1, 1),
               ("surface", (1, 0, 1), True, True, False, None, None, 0),  # sphere with a wire edge
-              ("graph", (1, 3, 0), None, None, None, None, None, 0),
-              ("vertex", (1, 0, 0), None, None, None, None, None, 0)],
+              ("graph", (1, 3, 0), None, None, None, None, None, 0)],
 }
 
 
@@ -102,7 +103,10 @@ def test_summaries():
     vertices, _, edges = meshgen.complete_graph(4)
     assert summary((vertices, np.zeros((0, 3), int)), edges) == ["edge graph, 3 independent cycles"]
     assert topology(*with_isolated(meshgen.torus(8, 6), 2)).summary() == \
-        "3 components (1 surface, 2 isolated vertices), betti 3/2/1"
+        "1 component: genus 1, closed, orientable, 2 isolated vertices"
+    assert topology(*with_isolated(meshgen.disjoint(meshgen.torus(8, 6), meshgen.grid(2, 2)), 1)).summary() == \
+        "2 components (2 surfaces), 1 isolated vertex, betti 3/2/1"
+    assert topology(np.zeros((3, 3)), np.zeros((0, 3), int)).summary() == "3 isolated vertices"
 
 
 @pytest.mark.parametrize("name", ["sphere", "torus", "genus 2", "two tori", "disk", "moebius", "klein bottle",
@@ -224,6 +228,18 @@ def test_invariant_under_relabeling():
     assert key(topology(vertices[perm], relabeled)) == key(topology(vertices, triangles))
 
 
+def test_isolated_vertices_listed_apart():
+    vertices, triangles = with_isolated(meshgen.torus(8, 6), 3)
+    vertices = np.concatenate([np.full((2, 3), 5.0), vertices])  # two more, before the torus
+    info = topology(vertices, triangles + 2)
+    assert info.isolated_vertices.tolist() == [0, 1, 50, 51, 52]
+    assert info.betti == (6, 2, 1) and [c.first_vertex for c in info.components] == [2]
+    assert info.vertex_component.tolist() == [-1, -1] + [0] * 48 + [-1] * 3
+    assert info.to_dict()["isolated_vertices"] == [0, 1, 50, 51, 52]
+    cloud = topology(np.random.default_rng(1).random((200000, 3)), np.zeros((0, 3), np.int32))
+    assert cloud.betti == (200000, 0, 0) and cloud.components == [] and len(cloud.isolated_vertices) == 200000
+
+
 def test_components_numbered_by_smallest_vertex():
     vertices, triangles = meshgen.disjoint(meshgen.torus(8, 6), meshgen.icosphere(1))
     shifted = np.concatenate([vertices[48:], vertices[:48]])
@@ -250,6 +266,7 @@ def test_to_dict_has_the_cli_keys():
 def test_empty_mesh():
     info = topology(np.zeros((0, 3)), np.zeros((0, 3), np.int32))
     assert info.betti == (0, 0, 0) and info.components == [] and info.summary() == "empty"
+    assert info.isolated_vertices.shape == (0,)
     assert generators(np.zeros((0, 3)), np.zeros((0, 3), np.int32)) == []
 
 
