@@ -7,6 +7,7 @@
 
 from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
                        sampling_probabilities)
+from .io import MeshData, read_mesh, write_mesh
 from .mesh import Mesh, MeshReport
 from .topology import ComponentGenerators, ComponentTopology, Topology, generators, topology
 
@@ -15,4 +16,6 @@ __all__ = [
     "decimate_with_samples", "sampling_probabilities",
     # topology
     "ComponentGenerators", "ComponentTopology", "Topology", "generators", "topology",
+    # mesh files (io.py)
+    "MeshData", "read_mesh", "write_mesh",
 ]

@@ -21,11 +21,11 @@ struct Clustering {
   std::vector<int32_t> parent;  ///< neighbour the vertex was reached from, -1 for samples
 };
 
-/// Floods from `samples` (distinct vertex ids; rank = position). If cross_faces is given it
-/// receives, per face, 1 where the face touches an edge between two clusters: the candidate
-/// list of the fast path (thesis 4.1.1), collected during the fill instead of by a later scan.
+/// Floods from `samples` (distinct vertex ids; rank = position). If cross_edges is given it
+/// receives every edge between two clusters, once: the faces around them are the candidates
+/// of the fast path (thesis 4.1.1), collected during the fill instead of by a later scan.
 void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples, Clustering& out,
-           std::vector<uint8_t>* cross_faces = nullptr);
+           std::vector<int32_t>* cross_edges = nullptr);
 
 /// Adds samples[first_new..) to an existing clustering of samples[0..first_new) and updates
 /// only the vertices whose (distance, rank) improves. Gives exactly what flood() would.
