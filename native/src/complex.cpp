@@ -138,9 +138,48 @@ std::vector<int32_t> morton_order(const double* positions, int32_t n) {
   return order;
 }
 
-// Renumbers the vertices of `out` (and the wires) by `order` and sorts the triangles by their
-// lowest vertex (stable: ties keep the caller's order).
-void renumber(SimplicialComplex& out, std::vector<int32_t> order, std::vector<int32_t>& wires) {
+// Whether the caller's numbering already has locality: consecutive triangles mostly have
+// nearby lowest vertices (then renumbering costs more than it saves).
+bool local_order(const std::vector<int32_t>& tri) {
+  const size_t m = tri.size() / 3;
+  auto lowest = [&](size_t t) { return std::min({tri[3 * t], tri[3 * t + 1], tri[3 * t + 2]}); };
+  size_t near = 0;
+  for (size_t t = 1; t < m; ++t) near += std::abs(int64_t(lowest(t)) - lowest(t - 1)) <= 256;
+  return 2 * near >= m;
+}
+
+// Whether consecutive triangles mostly share a vertex: the order of meshes written face by face
+// (modellers, scanners' meshers, subdivision), as opposed to shuffled ones.
+bool coherent_triangle_order(const std::vector<int32_t>& tri) {
+  const size_t m = tri.size() / 3;
+  size_t sharing = 0;
+  for (size_t t = 1; t < m; ++t) {
+    const int32_t* a = &tri[3 * t - 3];
+    const int32_t* b = &tri[3 * t];
+    sharing += (a[0] == b[0] || a[0] == b[1] || a[0] == b[2] || a[1] == b[0] || a[1] == b[1] || a[1] == b[2] ||
+                a[2] == b[0] || a[2] == b[1] || a[2] == b[2]);
+  }
+  return 4 * sharing >= m;
+}
+
+// Vertices in order of first appearance in the triangles, then the unused ones.
+std::vector<int32_t> first_appearance_order(const std::vector<int32_t>& tri, int32_t n) {
+  std::vector<uint8_t> seen(n, 0);
+  std::vector<int32_t> order;
+  order.reserve(n);
+  for (int32_t v : tri)
+    if (!seen[v]) {
+      seen[v] = 1;
+      order.push_back(v);
+    }
+  for (int32_t v = 0; v < n; ++v)
+    if (!seen[v]) order.push_back(v);
+  return order;
+}
+
+// Renumbers the vertices of `out` (and the wires) by `order`; with sort_triangles, also sorts
+// the triangles by their lowest vertex (stable: ties keep the caller's order).
+void renumber(SimplicialComplex& out, std::vector<int32_t> order, std::vector<int32_t>& wires, bool sort_triangles) {
   const int32_t n = out.num_vertices, m = out.num_triangles();
   out.vertex_index.resize(n);
   for (int32_t i = 0; i < n; ++i) out.vertex_index[order[i]] = i;
@@ -153,6 +192,7 @@ void renumber(SimplicialComplex& out, std::vector<int32_t> order, std::vector<in
   }
 #pragma omp parallel for schedule(static) if (out.triangles.size() >= size_t(kParallelMinimum))
   for (size_t i = 0; i < out.triangles.size(); ++i) out.triangles[i] = index[out.triangles[i]];
+  if (!sort_triangles) return;
   auto lowest = [&](int64_t t) {
     const int32_t* x = &out.triangles[3 * size_t(t)];
     return std::min({x[0], x[1], x[2]});
@@ -347,8 +387,16 @@ SimplicialComplex build_complex(const double* positions, int32_t num_vertices, s
     wires.push_back(std::min(a, b));
     wires.push_back(std::max(a, b));
   }
-  if (positions) {
-    renumber(out, morton_order(positions, num_vertices), wires);
+  // Locality: keep an order that has it; keep a coherent triangle order and number vertices as
+  // they appear in it; otherwise number vertices along a Z-order curve and sort the triangles.
+  if (local_order(out.triangles)) {
+    out.vertex_source.resize(num_vertices);
+    std::iota(out.vertex_source.begin(), out.vertex_source.end(), 0);
+    out.vertex_index = out.vertex_source;
+  } else if (coherent_triangle_order(out.triangles)) {
+    renumber(out, first_appearance_order(out.triangles, num_vertices), wires, false);
+  } else if (positions) {
+    renumber(out, morton_order(positions, num_vertices), wires, true);
   } else {
     out.vertex_source.resize(num_vertices);
     std::iota(out.vertex_source.begin(), out.vertex_source.end(), 0);
