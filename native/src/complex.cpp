@@ -247,77 +247,69 @@ void link_sides(SimplicialComplex& out, const std::vector<int32_t>& wires) {
   for (int32_t s = 0; s < num_sides; ++s)
     if (out.vertex_triangles[tri[s]]++ == 0) out.vertex_side[tri[s]] = s;
 
-  // Per vertex: sort its bucket and link the sides of each edge. Fins and wires are rare:
-  // collected per thread, sorted afterwards so the result does not depend on the threads.
+  // Per vertex: sort its bucket and link the sides of each edge. Buckets holding an edge with
+  // no triangle or with three and more (rare) are flagged and read again serially below, so the
+  // parallel loop allocates nothing (an exception must not escape an OpenMP region).
   out.side_twin.resize(num_sides);
-  std::vector<std::vector<int32_t>> fin_parts(pass_threads(num_sides)), wire_parts(pass_threads(num_sides));
+  std::vector<uint8_t> special(n, 0);
   int64_t num_edges = 0;
-#pragma omp parallel reduction(+ : num_edges) num_threads(pass_threads(num_sides))
-  {
-    auto& fins = fin_parts[omp_get_thread_num()];  // (lower, higher, side) triples
-    auto& lone_wires = wire_parts[omp_get_thread_num()];
-#pragma omp for schedule(dynamic, 8192)
-    for (int32_t v = 0; v < n; ++v) {
-      uint64_t* begin = entries.data() + offsets[v];
-      uint64_t* end = entries.data() + offsets[v + 1];
-      sort_bucket(begin, end);
-      for (uint64_t* i = begin; i < end;) {
-        const uint32_t hi = uint32_t(*i >> 32);
-        uint64_t* j = i;
-        while (j < end && uint32_t(*j >> 32) == hi) ++j;
-        ++num_edges;
-        uint64_t* first_side = i;  // wires (low word 0) sort first
-        while (first_side < j && uint32_t(*first_side) == 0) ++first_side;
-        const int64_t count = j - first_side;
-        if (count == 0) {
-          lone_wires.push_back(v);
-          lone_wires.push_back(int32_t(hi));
-        } else if (count == 1) {
-          out.side_twin[int32_t(uint32_t(*first_side) >> 1) - 1] = SimplicialComplex::kOpenSide;
-        } else if (count == 2) {
-          const uint32_t x = uint32_t(first_side[0]), y = uint32_t(first_side[1]);
-          const int32_t same_direction = ((x ^ y) & 1u) ? 0 : 1;
-          out.side_twin[int32_t(x >> 1) - 1] = 2 * (int32_t(y >> 1) - 1) + same_direction;
-          out.side_twin[int32_t(y >> 1) - 1] = 2 * (int32_t(x >> 1) - 1) + same_direction;
-        } else {
-          for (uint64_t* k = first_side; k < j; ++k) {
-            const int32_t s = int32_t(uint32_t(*k) >> 1) - 1;
-            out.side_twin[s] = SimplicialComplex::kFinSide;
-            fins.insert(fins.end(), {v, int32_t(hi), s});
-          }
-        }
-        i = j;
+#pragma omp parallel for schedule(dynamic, 8192) reduction(+ : num_edges) num_threads(pass_threads(num_sides))
+  for (int32_t v = 0; v < n; ++v) {
+    uint64_t* begin = entries.data() + offsets[v];
+    uint64_t* end = entries.data() + offsets[v + 1];
+    sort_bucket(begin, end);
+    for (uint64_t* i = begin; i < end;) {
+      const uint32_t hi = uint32_t(*i >> 32);
+      uint64_t* j = i;
+      while (j < end && uint32_t(*j >> 32) == hi) ++j;
+      ++num_edges;
+      uint64_t* first_side = i;  // wires (low word 0) sort first
+      while (first_side < j && uint32_t(*first_side) == 0) ++first_side;
+      const int64_t count = j - first_side;
+      if (count == 1) {
+        out.side_twin[int32_t(uint32_t(*first_side) >> 1) - 1] = SimplicialComplex::kOpenSide;
+      } else if (count == 2) {
+        const uint32_t x = uint32_t(first_side[0]), y = uint32_t(first_side[1]);
+        const int32_t same_direction = ((x ^ y) & 1u) ? 0 : 1;
+        out.side_twin[int32_t(x >> 1) - 1] = 2 * (int32_t(y >> 1) - 1) + same_direction;
+        out.side_twin[int32_t(y >> 1) - 1] = 2 * (int32_t(x >> 1) - 1) + same_direction;
+      } else {
+        special[v] = 1;
+        for (uint64_t* k = first_side; k < j; ++k)
+          out.side_twin[int32_t(uint32_t(*k) >> 1) - 1] = SimplicialComplex::kFinSide;
       }
+      i = j;
     }
   }
   if (num_edges > INT32_MAX) throw std::invalid_argument("complex is too large: more than 2^31 edges");
   out.num_edges = static_cast<int32_t>(num_edges);
 
-  std::vector<std::array<int32_t, 3>> fins;
-  for (const auto& part : fin_parts)
-    for (size_t i = 0; i < part.size(); i += 3) fins.push_back({part[i], part[i + 1], part[i + 2]});
-  std::sort(fins.begin(), fins.end());
+  // Fins (edges of 3+ triangles, with their sides) and lone wires, in edge order.
   out.fin_edges.clear();
   out.fin_offsets.assign(1, 0);
   out.fin_sides.clear();
-  for (size_t i = 0; i < fins.size(); ++i) {
-    if (i == 0 || fins[i][0] != fins[i - 1][0] || fins[i][1] != fins[i - 1][1]) {
-      if (i > 0) out.fin_offsets.push_back(static_cast<int32_t>(i));
-      out.fin_edges.push_back(fins[i][0]);
-      out.fin_edges.push_back(fins[i][1]);
-    }
-    out.fin_sides.push_back(fins[i][2]);
-  }
-  if (!fins.empty()) out.fin_offsets.push_back(static_cast<int32_t>(fins.size()));
-
-  std::vector<std::pair<int32_t, int32_t>> lone;
-  for (const auto& part : wire_parts)
-    for (size_t i = 0; i < part.size(); i += 2) lone.emplace_back(part[i], part[i + 1]);
-  std::sort(lone.begin(), lone.end());
   out.wire_edges.clear();
-  for (const auto& [a, b] : lone) {
-    out.wire_edges.push_back(a);
-    out.wire_edges.push_back(b);
+  for (int32_t v = 0; v < n; ++v) {
+    if (!special[v]) continue;
+    const uint64_t* end = entries.data() + offsets[v + 1];
+    for (const uint64_t* i = entries.data() + offsets[v]; i < end;) {
+      const uint32_t hi = uint32_t(*i >> 32);
+      const uint64_t* j = i;
+      while (j < end && uint32_t(*j >> 32) == hi) ++j;
+      const uint64_t* first_side = i;
+      while (first_side < j && uint32_t(*first_side) == 0) ++first_side;
+      if (first_side == j) {
+        out.wire_edges.push_back(v);
+        out.wire_edges.push_back(int32_t(hi));
+      } else if (j - first_side >= 3) {
+        out.fin_edges.push_back(v);
+        out.fin_edges.push_back(int32_t(hi));
+        for (const uint64_t* k = first_side; k < j; ++k) out.fin_sides.push_back(int32_t(uint32_t(*k) >> 1) - 1);
+        std::sort(out.fin_sides.end() - (j - first_side), out.fin_sides.end());
+        out.fin_offsets.push_back(static_cast<int32_t>(out.fin_sides.size()));
+      }
+      i = j;
+    }
   }
 }
 

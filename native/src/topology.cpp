@@ -92,12 +92,13 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
   // Two independent union-finds, run side by side: vertices joined by edges (each edge
   // represented by a side, plus fins and wires) give the components; triangles joined across
   // edges with exactly two triangles give the sheets, with a parity that says whether two
-  // triangles must be flipped relative to each other to agree. Flips and conflicts are rare:
-  // a triangle of each is remembered and its component found afterwards.
+  // triangles must be flipped relative to each other to agree. A triangle on a flipped edge or
+  // on a parity conflict is flagged; its component is found afterwards.
   UnionFind vertices(n);
   ParityUnionFind sheets(num_triangles);
   std::vector<uint8_t> sheet_open(num_triangles, 0);  // a sheet with a boundary edge
-  std::vector<int32_t> flipped_triangles, conflict_triangles;
+  std::vector<uint8_t> triangle_flags(num_triangles, 0);  // kFlipped, kConflict (no allocation below)
+  constexpr uint8_t kFlipped = 1, kConflict = 2;
 #pragma omp parallel sections num_threads(2) if (num_sides >= kParallelMinimum)
   {
 #pragma omp section
@@ -113,9 +114,9 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
         const int32_t code = k.side_twin[s];
         if (code < 0 || (code >> 1) < s) continue;  // each shared edge once
         const uint8_t same_direction = code & 1;
-        if (same_direction) flipped_triangles.push_back(s / 3);
+        if (same_direction) triangle_flags[s / 3] |= kFlipped;
         if (sheets.unite(s / 3, (code >> 1) / 3, same_direction) == ParityUnionFind::Join::conflict)
-          conflict_triangles.push_back(s / 3);
+          triangle_flags[s / 3] |= kConflict;
       }
       for (int32_t s = 0; s < num_sides; ++s)
         if (k.side_twin[s] == SimplicialComplex::kOpenSide) sheet_open[sheets.find(s / 3)] = 1;
@@ -152,12 +153,15 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
   // of components with fins become columns of the Z2 system below.
   std::vector<int32_t> triangle_component(num_triangles);
   std::vector<int32_t> closed_sheets(num_components, 0);
+  std::vector<uint8_t> component_conflict(num_components, 0), component_flipped(num_components, 0);
   std::vector<int32_t> sheet_column;
   std::vector<int32_t> column_component;
   for (int32_t t = 0; t < num_triangles; ++t) {
     const int32_t ci = triangle_component[t] = component_of[k.triangles[3 * size_t(t)]];
     auto& c = comps[ci];
     ++c.triangles;
+    if (triangle_flags[t] & kFlipped) component_flipped[ci] = 1;
+    if (triangle_flags[t] & kConflict) component_conflict[ci] = 1;
     for (int32_t s = 3 * t; s < 3 * t + 3; ++s) {
       if (k.side_twin[s] == SimplicialComplex::kOpenSide) ++c.boundary_edges;
       if (k.represents_edge(s)) ++c.edges;
@@ -174,9 +178,6 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
     c.euler = int64_t(c.vertices) - c.edges + c.triangles;
     c.kind = c.triangles > 0 ? ComponentKind::surface : (c.edges > 0 ? ComponentKind::graph : ComponentKind::vertex);
   }
-  std::vector<uint8_t> component_conflict(num_components, 0), component_flipped(num_components, 0);
-  for (int32_t t : flipped_triangles) component_flipped[triangle_component[t]] = 1;
-  for (int32_t t : conflict_triangles) component_conflict[triangle_component[t]] = 1;
 
   if (!column_component.empty()) {
     // One row per edge of three or more triangles; a sheet meeting it an odd number of times

@@ -14,11 +14,13 @@
 // Out-of-range indices and non-finite coordinates raise std::invalid_argument naming the element.
 // The caller's arrays are only read.
 //
-// Internal numbering: vertices are renumbered along a Z-order (Morton) curve of their positions
-// and triangles ordered by their lowest vertex, so that neighbours sit close in memory (on a
-// Loop-subdivided mesh, whose file order has no locality, this halves the analysis time).
-// Every vertex id inside the struct is internal; vertex_source maps back to the caller's ids,
-// vertex_index maps the caller's ids in. Results handed to callers use the caller's ids.
+// Internal numbering, for memory locality: the caller's numbering is kept when consecutive
+// triangles already have nearby vertices (most files); when consecutive triangles share
+// vertices but the ids are scattered, vertices are numbered by first appearance; otherwise
+// (shuffled meshes such as horse_loop2_1.55M.ply) vertices follow a Z-order (Morton) curve of
+// their positions and triangles are sorted by lowest vertex, which halves the analysis time
+// there. Every vertex id inside the struct is internal; vertex_source maps back to the caller's
+// ids, vertex_index maps the caller's ids in. Results handed to callers use the caller's ids.
 //
 // Sides instead of an edge table: side s = 3t + c of triangle t runs from corner c to corner
 // c+1. Each side records the side across its edge (side_twin), which is all that walking around
@@ -87,7 +89,7 @@ struct SimplicialComplex {
 };
 
 /// Builds the complex. positions: 3 * num_vertices coordinates, checked to be finite and used
-/// for the internal order (may be null: no check, caller's order kept); triangles: 3 * num_triangles vertex ids (taken over to avoid a copy);
+/// for the internal order (may be null: no check, no Z-order); triangles: 3 * num_triangles vertex ids (taken over to avoid a copy);
 /// edges: 2 * num_edges vertex ids (may be null when num_edges is 0). At most 2^30 / 3 (about
 /// 357 million) triangles. Throws std::invalid_argument naming the first offending vertex,
 /// triangle or edge.
