@@ -36,6 +36,7 @@ def check_generators(vertices, triangles, gens, component_genus):
     for g in gens:
         edges = [tuple(sorted(e)) for e in g.edges.tolist()]
         assert len(edges) == 2 * g.genus == len(set(edges)) == len(g.loops)
+        assert [len(loop) for loop in g.loops] == sorted(len(loop) for loop in g.loops)  # shortest first
         assert set(edges) <= mesh_edges
         cut = {tuple(e) for e in g.cut_edges.tolist()}
         assert all(a < b for a, b in cut) and cut <= mesh_edges and set(edges) <= cut

@@ -24,6 +24,26 @@ void for_each_edge_around(const SimplicialComplex& k, int32_t v, Visit visit) {
   } while (at.side != first);
 }
 
+// Reorders a component's generators by the length of their loops, shortest first (stable).
+void sort_by_loop_length(ComponentGenerators& g) {
+  const size_t count = g.loop_offsets.size() - 1;
+  std::vector<size_t> order(count);
+  for (size_t i = 0; i < count; ++i) order[i] = i;
+  auto length = [&](size_t i) { return g.loop_offsets[i + 1] - g.loop_offsets[i]; };
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return length(a) < length(b); });
+  std::vector<int32_t> edges, offsets = {0}, vertices;
+  for (size_t i : order) {
+    edges.push_back(g.edges[2 * i]);
+    edges.push_back(g.edges[2 * i + 1]);
+    vertices.insert(vertices.end(), g.loop_vertices.begin() + g.loop_offsets[i],
+                    g.loop_vertices.begin() + g.loop_offsets[i + 1]);
+    offsets.push_back(static_cast<int32_t>(vertices.size()));
+  }
+  g.edges.swap(edges);
+  g.loop_offsets.swap(offsets);
+  g.loop_vertices.swap(vertices);
+}
+
 }  // namespace
 
 std::vector<ComponentGenerators> compute_generators(const SimplicialComplex& k, const TopologyReport& report) {
@@ -160,6 +180,7 @@ std::vector<ComponentGenerators> compute_generators(const SimplicialComplex& k, 
       g.root = r;
     }
     g.root = caller[g.root];
+    sort_by_loop_length(g);
   }
   std::vector<std::pair<int32_t, int32_t>> cut;
   for (int32_t s = 0; s < num_sides; ++s)

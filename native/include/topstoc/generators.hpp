@@ -31,7 +31,8 @@ struct ComponentGenerators {
   int32_t component = 0;  ///< index in TopologyReport::components
   int32_t genus = 0;
   int32_t root = 0;       ///< search-tree root (where the cut graph's trees meet)
-  /// 2g generator edges (vertex pairs as they start their loop), shortest loop first.
+  /// 2g generator edges (vertex pairs, lower id first), ordered by the length of their loop,
+  /// shortest first.
   std::vector<int32_t> edges;
   /// Loop i (CSR) visits loop_vertices[loop_offsets[i] .. loop_offsets[i+1]): it starts with
   /// generator edge i (its first two vertices) and closes back to its first vertex.
