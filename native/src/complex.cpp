@@ -138,28 +138,32 @@ std::vector<int32_t> morton_order(const double* positions, int32_t n) {
   return order;
 }
 
-// Whether the caller's numbering already has locality: consecutive triangles mostly have
-// nearby lowest vertices (then renumbering costs more than it saves).
-bool local_order(const std::vector<int32_t>& tri) {
+// Whether the caller's numbering already has locality: most triangles span nearby vertex ids.
+bool local_numbering(const std::vector<int32_t>& tri) {
   const size_t m = tri.size() / 3;
-  auto lowest = [&](size_t t) { return std::min({tri[3 * t], tri[3 * t + 1], tri[3 * t + 2]}); };
   size_t near = 0;
-  for (size_t t = 1; t < m; ++t) near += std::abs(int64_t(lowest(t)) - lowest(t - 1)) <= 256;
+  for (size_t t = 0; t < m; ++t) {
+    const int32_t* x = &tri[3 * t];
+    near += int64_t(std::max({x[0], x[1], x[2]})) - std::min({x[0], x[1], x[2]}) <= 1024;
+  }
   return 2 * near >= m;
 }
 
-// Whether consecutive triangles mostly share a vertex: the order of meshes written face by face
-// (modellers, scanners' meshers, subdivision), as opposed to shuffled ones.
+// Whether consecutive triangles mostly lie close together: they share a vertex or have nearby
+// lowest vertices (meshes written face by face by modellers, scanners' meshers, subdivision),
+// as opposed to shuffled ones.
 bool coherent_triangle_order(const std::vector<int32_t>& tri) {
   const size_t m = tri.size() / 3;
-  size_t sharing = 0;
+  size_t near = 0;
   for (size_t t = 1; t < m; ++t) {
     const int32_t* a = &tri[3 * t - 3];
     const int32_t* b = &tri[3 * t];
-    sharing += (a[0] == b[0] || a[0] == b[1] || a[0] == b[2] || a[1] == b[0] || a[1] == b[1] || a[1] == b[2] ||
-                a[2] == b[0] || a[2] == b[1] || a[2] == b[2]);
+    const bool share = a[0] == b[0] || a[0] == b[1] || a[0] == b[2] || a[1] == b[0] || a[1] == b[1] ||
+                       a[1] == b[2] || a[2] == b[0] || a[2] == b[1] || a[2] == b[2];
+    const int64_t jump = int64_t(std::min({a[0], a[1], a[2]})) - std::min({b[0], b[1], b[2]});
+    near += share || (jump >= -256 && jump <= 256);
   }
-  return 4 * sharing >= m;
+  return 2 * near >= m;
 }
 
 // Vertices in order of first appearance in the triangles, then the unused ones.
@@ -379,9 +383,9 @@ SimplicialComplex build_complex(const double* positions, int32_t num_vertices, s
     wires.push_back(std::min(a, b));
     wires.push_back(std::max(a, b));
   }
-  // Locality: keep an order that has it; keep a coherent triangle order and number vertices as
-  // they appear in it; otherwise number vertices along a Z-order curve and sort the triangles.
-  if (local_order(out.triangles)) {
+  // Locality: keep a numbering that has it; keep a coherent triangle order and number vertices
+  // as they appear in it; otherwise number vertices along a Z-order curve and sort the triangles.
+  if (local_numbering(out.triangles)) {
     out.vertex_source.resize(num_vertices);
     std::iota(out.vertex_source.begin(), out.vertex_source.end(), 0);
     out.vertex_index = out.vertex_source;

@@ -14,9 +14,10 @@
 // Out-of-range indices and non-finite coordinates raise std::invalid_argument naming the element.
 // The caller's arrays are only read.
 //
-// Internal numbering, for memory locality: the caller's numbering is kept when consecutive
-// triangles already have nearby vertices (most files); when consecutive triangles share
-// vertices but the ids are scattered, vertices are numbered by first appearance; otherwise
+// Internal numbering, for memory locality: the caller's numbering is kept when triangles
+// already span nearby vertex ids; when the triangle order is coherent (consecutive triangles
+// close together) but the ids are scattered, vertices are numbered by first appearance in it
+// (Loop-subdivided meshes such as turbine x3); otherwise
 // (shuffled meshes such as horse_loop2_1.55M.ply) vertices follow a Z-order (Morton) curve of
 // their positions and triangles are sorted by lowest vertex, which halves the analysis time
 // there. Every vertex id inside the struct is internal; vertex_source maps back to the caller's
