@@ -63,6 +63,22 @@ def test_betti_numbers_equal_gudhi(name):
     assert np.array_equal(np.flatnonzero(info.vertex_component < 0), info.isolated_vertices)
 
 
+@pytest.mark.parametrize("seed", range(25))
+def test_random_complexes_equal_gudhi(seed):
+    """Random triangles on few vertices: many edges of 3+ triangles, pinched vertices, wires,
+    repeats and collapsed triangles, all at once (the Z2 system for beta2 gets exercised)."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(5, 14))
+    triangles = rng.integers(0, n, size=(int(rng.integers(1, 40)), 3))
+    edges = rng.integers(0, n, size=(int(rng.integers(0, 6)), 2))
+    vertices = rng.random((n + int(rng.integers(0, 3)), 3))
+    info = topology(vertices, triangles, edges)
+    assert info.betti == gudhi_betti(len(vertices), triangles, edges)
+    assert sum(c.edges for c in info.components) == info.edges
+    for c in info.components:
+        assert c.euler == c.betti[0] - c.betti[1] + c.betti[2]
+
+
 EXPECTED = {  # name: per component (kind, betti, closed, orientable, manifold, genus, crosscaps, loops)
     "sphere": [("surface", (1, 0, 1), True, True, True, 0, None, 0)],
     "torus": [("surface", (1, 2, 1), True, True, True, 1, None, 0)],
