@@ -77,17 +77,19 @@ void bind_topology(py::module_& m) {
   m.def(
       "topology",
       [](const py::handle& vertices, const py::handle& triangles, const py::handle& edges, bool with_generators) {
-        const auto positions = positions_from(vertices, "vertices");
+        const auto positions = positions_array(vertices, "vertices");  // read only: no copy
         auto tris = indices_from(triangles, 3, "triangles");
         std::vector<int32_t> wires;
         if (!edges.is_none()) wires = indices_from(edges, 2, "edges");
-        if (positions.size() / 3 > size_t(INT32_MAX)) throw py::value_error("more than 2^31 vertices");
+        if (positions.shape(0) > INT32_MAX) throw py::value_error("more than 2^31 vertices");
+        const double* coordinates = positions.data();
+        const auto num_vertices = static_cast<int32_t>(positions.shape(0));
         TopologyReport report;
         std::vector<ComponentGenerators> generators;
         {
           py::gil_scoped_release release;
-          const auto complex = build_complex(positions.data(), static_cast<int32_t>(positions.size() / 3),
-                                             std::move(tris), wires.data(), int64_t(wires.size() / 2));
+          const auto complex =
+              build_complex(coordinates, num_vertices, std::move(tris), wires.data(), int64_t(wires.size() / 2));
           report = analyze_topology(complex);
           if (with_generators) generators = compute_generators(complex, report);
         }

@@ -151,13 +151,12 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
 
   // Per triangle: counts, and the closed sheets (beta2 before the constraints at fins). Sheets
   // of components with fins become columns of the Z2 system below.
-  std::vector<int32_t> triangle_component(num_triangles);
   std::vector<int32_t> closed_sheets(num_components, 0);
   std::vector<uint8_t> component_conflict(num_components, 0), component_flipped(num_components, 0);
   std::vector<int32_t> sheet_column;
   std::vector<int32_t> column_component;
   for (int32_t t = 0; t < num_triangles; ++t) {
-    const int32_t ci = triangle_component[t] = component_of[k.triangles[3 * size_t(t)]];
+    const int32_t ci = component_of[k.triangles[3 * size_t(t)]];
     auto& c = comps[ci];
     ++c.triangles;
     if (triangle_flags[t] & kFlipped) component_flipped[ci] = 1;
