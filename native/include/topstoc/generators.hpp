@@ -4,8 +4,9 @@
 // through it. Together the loops form a basis of the component's first homology over Z2.
 //
 // The pairing is computed as a tree-cotree decomposition in linear time:
-//  - edges are ordered by a breadth-first search from a root vertex: first the edges of the
-//    search tree T, then the others by the length of the loop they close through T;
+//  - edges are ordered by a breadth-first search from the component's smallest vertex id: first
+//    the edges of the search tree T, then the others by the length of the loop they close
+//    through T;
 //  - vertex-edge pairs: union-find on vertices in that order keeps exactly T (the negative edges);
 //  - edge-triangle pairs: union-find on triangles across the remaining edges in reverse order;
 //    an edge that joins two groups of triangles belongs to the cotree C (it is paired with a
@@ -15,8 +16,9 @@
 //    so the basis is the greedy (shortest) system of loops through the root
 //    (Erickson and Whittlesey 2005), measured in edges.
 // The loop of generator edge (u, v) is that edge plus the tree paths from u and v to their
-// lowest common ancestor: a simple closed cycle. The tree paths joining all loops to each other
-// plus the generator edges form a cut graph: cutting the surface along it leaves one disk.
+// lowest common ancestor: a simple closed cycle (the loop through the root minus the shared
+// stem). The tree paths joining all loops to each other plus the generator edges form a cut
+// graph: cutting the surface along it leaves one disk. All ids are the caller's.
 #pragma once
 
 #include <cstdint>
