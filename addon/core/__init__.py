@@ -7,9 +7,12 @@
 
 from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
                        sampling_probabilities)
+from .loops import (Cancelled, ComponentLoops, Loop, LoopsResult, handle_tunnel_loops,
+                    self_intersections, tetrahedralize_surface)
 from .mesh import Mesh, MeshReport
 
 __all__ = [
-    "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
-    "decimate_with_samples", "sampling_probabilities",
+    "Box", "Cancelled", "ComponentLoops", "DecimateResult", "DecimateStats", "Loop", "LoopsResult",
+    "Mesh", "MeshReport", "View", "decimate", "decimate_with_samples", "handle_tunnel_loops",
+    "sampling_probabilities", "self_intersections", "tetrahedralize_surface",
 ]

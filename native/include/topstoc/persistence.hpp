@@ -1,0 +1,32 @@
+// Handle and tunnel cycles by persistent homology (thesis 3.2.4; Dey, Li, Sun 2007).
+//
+// The filtration adds the surface's simplices first, then the inside's (vertices, edges,
+// triangles, tetrahedra), then the outside's. After the surface, 2g edges remain unpaired;
+// an inside triangle that pairs one of them kills a surface cycle that bounds inside: a
+// handle cycle. The outside's triangles kill the other g: tunnel cycles. Each cycle is the
+// reduced column of its killing triangle; as everything older than the generator edge is on
+// the surface, so is the cycle. Pairing uses PHAT's twist reduction with bit-tree pivot
+// columns (the column type makes a 70x difference), restricted to the triangle and
+// tetrahedron columns that decide it.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "topstoc/progress.hpp"
+#include "topstoc/surface.hpp"
+#include "topstoc/tetrahedralize.hpp"
+
+namespace topstoc {
+
+struct PersistentCycle {
+  bool handle = false;          ///< killed inside (handle) or outside (tunnel)
+  int32_t generator_edge = -1;  ///< the unpaired surface edge the killing triangle pairs (surface edge id)
+  std::vector<int32_t> edges;   ///< the cycle: surface edge ids, each once (a Z2 cycle, not always simple)
+};
+
+/// Pairs the filtration surface < inside < outside of `tets` (made from `surface`) and returns
+/// its 2g cycles, handles first. Throws std::logic_error if the counts are not g and g.
+std::vector<PersistentCycle> handle_tunnel_cycles(const Surface& surface, const TetMesh& tets, Progress* progress = nullptr);
+
+}  // namespace topstoc
