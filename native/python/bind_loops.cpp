@@ -102,6 +102,22 @@ void bind_loops(py::module_& m) {
       "Handle and tunnel loops of every closed orientable component (see topstoc.core.loops).");
 
   m.def(
+      "shorten_loop",
+      [](const Mesh& mesh, const py::handle& loop, bool count_edges, int32_t max_window) {
+        auto ids = ids_from(loop, -1, "loop");
+        LoopParams params;
+        params.count_edges = count_edges;
+        std::vector<int32_t> out;
+        {
+          py::gil_scoped_release release;
+          out = shorten_loop(mesh, ids, params, max_window);
+        }
+        return to_array(std::move(out));
+      },
+      py::arg("mesh"), py::arg("loop"), py::arg("count_edges") = false, py::arg("max_window") = 192,
+      "Shortens a simple closed edge loop on a closed manifold component, keeping its homotopy class.");
+
+  m.def(
       "self_intersections",
       [](const py::handle& vertices, const py::handle& triangles) {
         auto p = positions_from(vertices, "vertices");

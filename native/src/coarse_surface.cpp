@@ -71,10 +71,12 @@ std::unique_ptr<CoarseMesh> make_coarse_mesh(const Mesh& mesh, int32_t target, u
     for (size_t i = 0; i < flagged.size(); ++i) slot[flagged[i]] = int32_t(i);
     std::vector<int32_t> farthest(flagged.size(), -1);
     std::vector<double> reach(flagged.size(), -1.0);
+    std::vector<uint8_t> is_sample(mesh.num_vertices(), 0);  // by caller id
+    for (int32_t s : d.samples) is_sample[s] = 1;
     for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
       const int32_t caller = source[v];
       const int32_t c = d.labels[caller];
-      if (c < 0 || slot[c] < 0) continue;
+      if (c < 0 || slot[c] < 0 || is_sample[caller]) continue;
       const double* p = mesh.position(v);
       const double* q = mesh.position(mesh.vertex_index()[d.kept[c]]);
       const double r = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);

@@ -82,27 +82,86 @@ SurfaceHomology::SurfaceHomology(const Surface& s) {
   if (int64_t(generators_.size()) != 2 - s.euler())
     throw std::logic_error("tree-cotree left " + std::to_string(generators_.size()) + " edges, expected 2 - chi = " +
                            std::to_string(2 - s.euler()));
-  // Dual loop of each generator: the cotree path between its two faces, plus the generator.
-  std::vector<std::pair<int32_t, int32_t>> crossings;  // (edge, generator index)
+  // Orient the faces consistently (the surface is orientable): the left face of an edge is the
+  // one that runs along it from its lower to its higher vertex.
+  std::vector<int8_t> flip(nf, -1);
+  queue.clear();
+  if (nf) {
+    flip[0] = 0;
+    queue.push_back(0);
+  }
+  auto runs_forward = [&](int32_t f, int32_t e) {  // face f, as stored, runs along e low -> high
+    for (int c = 0; c < 3; ++c)
+      if (s.face_edges[3 * size_t(f) + c] == e) return s.triangles[3 * size_t(f) + c] == s.edge_vertices[2 * size_t(e)];
+    return false;
+  };
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const int32_t f = queue[head];
+    for (int c = 0; c < 3; ++c) {
+      const int32_t e = s.face_edges[3 * size_t(f) + c];
+      const int32_t g = s.edge_faces[2 * size_t(e)] == f ? s.edge_faces[2 * size_t(e) + 1] : s.edge_faces[2 * size_t(e)];
+      if (flip[g] >= 0) continue;
+      flip[g] = int8_t(flip[f] ^ (runs_forward(f, e) == runs_forward(g, e)));
+      queue.push_back(g);
+    }
+  }
+  auto left_face = [&](int32_t e) {
+    const int32_t f = s.edge_faces[2 * size_t(e)];
+    return (runs_forward(f, e) != bool(flip[f])) ? f : s.edge_faces[2 * size_t(e) + 1];
+  };
+  // Dual loop of each generator: across the generator, then back through the cotree. Each step
+  // from face a across edge e counts +1 when a is e's left face.
+  struct Crossing {
+    int32_t edge, loop;
+    int8_t sign;
+  };
+  std::vector<Crossing> crossings;
   auto face_across = [&](int32_t f, int32_t e) {
     return s.edge_faces[2 * size_t(e)] == f ? s.edge_faces[2 * size_t(e) + 1] : s.edge_faces[2 * size_t(e)];
   };
+  auto step = [&](int32_t from, int32_t e, int32_t j) {
+    crossings.push_back({e, j, int8_t(left_face(e) == from ? 1 : -1)});
+  };
+  std::vector<int32_t> down;
   for (int32_t j = 0; j < dimension(); ++j) {
     const int32_t e = generators_[j];
-    crossings.emplace_back(e, j);
-    int32_t a = s.edge_faces[2 * size_t(e)], b = s.edge_faces[2 * size_t(e) + 1];
+    const int32_t p = s.edge_faces[2 * size_t(e)], q = s.edge_faces[2 * size_t(e) + 1];
+    step(p, e, j);
+    // Up from q and from p to their lowest common ancestor; the part from p is walked downwards.
+    int32_t a = q, b = p;
+    down.clear();
     while (a != b) {
-      if (depth[a] < depth[b]) std::swap(a, b);
-      crossings.emplace_back(parent_edge[a], j);
-      a = face_across(a, parent_edge[a]);
+      if (depth[a] >= depth[b]) {
+        step(a, parent_edge[a], j);
+        a = face_across(a, parent_edge[a]);
+      } else {
+        down.push_back(b);
+        b = face_across(b, parent_edge[b]);
+      }
     }
+    for (size_t i = down.size(); i-- > 0;) step(face_across(down[i], parent_edge[down[i]]), parent_edge[down[i]], j);
   }
   crossing_offsets_.assign(size_t(m) + 1, 0);
-  for (const auto& c : crossings) ++crossing_offsets_[c.first + 1];
+  for (const auto& c : crossings) ++crossing_offsets_[c.edge + 1];
   for (int32_t e = 0; e < m; ++e) crossing_offsets_[e + 1] += crossing_offsets_[e];
   crossing_.resize(crossings.size());
+  crossing_sign_.resize(crossings.size());
   std::vector<int32_t> fill(crossing_offsets_.begin(), crossing_offsets_.end() - 1);
-  for (const auto& c : crossings) crossing_[fill[c.first]++] = c.second;
+  for (const auto& c : crossings) {
+    crossing_sign_[fill[c.edge]] = c.sign;
+    crossing_[fill[c.edge]++] = c.loop;
+  }
+}
+
+std::vector<int64_t> SurfaceHomology::integer_class_of_loop(const Surface& s, const std::vector<int32_t>& loop) const {
+  std::vector<int64_t> x(dimension(), 0);
+  for (size_t i = 0; i < loop.size(); ++i) {
+    const int32_t a = loop[i], b = loop[(i + 1) % loop.size()];
+    const int32_t e = s.find_edge(a, b);
+    if (e < 0) throw std::logic_error("loop step " + std::to_string(i) + " is not an edge");
+    add_edge_signed(x, e, s.edge_vertices[2 * size_t(e)] == a);
+  }
+  return x;
 }
 
 Bits SurfaceHomology::class_of_edges(const std::vector<int32_t>& edges) const {

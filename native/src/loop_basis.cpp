@@ -157,7 +157,7 @@ std::vector<SelectedLoop> select_loops(const Surface& s, const SurfaceHomology& 
     const size_t k = c->edges.size();
     for (size_t i = 1; i <= 3 && k; ++i) add_root(s.edge_vertices[2 * size_t(c->edges[(i * k) / 4 % k])]);
   }
-  if (max_roots <= 0) max_roots = 16 + 6 * dim;
+  if (max_roots <= 0) max_roots = 12 + 4 * dim;
   max_roots = std::min(max_roots, n);
 
   ShortestPaths sp(s, weight);

@@ -185,10 +185,14 @@ LoopsResult compute_loops(const Mesh& mesh, const LoopParams& params) {
   result.seconds_prepare = seconds_since(start);
 
   // Which components take the coarse route (thesis 5.2.2).
+  // The automatic target is small: TetGen's time grows with it, and the refinement against
+  // self-intersections adds samples where the shape needs them.
   const int32_t active = mesh.num_vertices() - mesh.report().isolated_vertices;
+  int64_t total_genus = 0;
+  for (int32_t k : work) total_genus += result.components[k].genus;
   const int32_t base_target = params.coarse_vertices > 0
                                   ? params.coarse_vertices
-                                  : std::clamp(active / 48, std::min(active, 3000), 12000);
+                                  : int32_t(std::min<int64_t>(active, std::min<int64_t>(20000, 3000 + 100 * total_genus)));
   std::vector<uint8_t> coarse_wanted(components.size(), 0);
   for (int32_t k : work) {
     const ComponentLoops& c = result.components[k];
@@ -253,6 +257,16 @@ LoopsResult compute_loops(const Mesh& mesh, const LoopParams& params) {
           refusal += " (on a coarse version)";
           continue;
         }
+        // Big moves are cheap on the coarse surface: tighten there first, then only locally.
+        start = Clock::now();
+        if (params.shorten) {
+          progress.stage("shorten (coarse)", at(0.55), at(0.6));
+          const auto coarse_weight = edge_weights(view.surface, params.count_edges);
+          const SurfaceHomology coarse_homology(view.surface);
+          LoopTightener coarse_tightener(view.surface, coarse_weight, &coarse_homology);
+          for (auto& loop : analysis.loops) loop.vertices = coarse_tightener.tighten(loop.vertices, TightenParams{}, &progress);
+        }
+        result.seconds_shorten += seconds_since(start);
         start = Clock::now();
         progress.stage("map to full mesh", at(0.6), at(0.65));
         ClusterMap map(fine, fine_weight, std::move(view.cluster_of), std::move(view.representative));
@@ -324,7 +338,9 @@ LoopsResult compute_loops(const Mesh& mesh, const LoopParams& params) {
     start = Clock::now();
     progress.stage("shorten", at(0.7), at(1.0));
     double checking = 0.0;  // spent verifying inside the shortening loop
-    LoopTightener tightener(fine, fine_weight);
+    TightenParams local_moves;  // loops carried back from a tightened coarse loop need small moves only
+    local_moves.max_window = 64;
+    LoopTightener tightener(fine, fine_weight, &homology);
     const std::vector<double> euclidean = params.count_edges ? edge_weights(fine, false) : fine_weight;
     for (size_t i = 0; i < loops.size(); ++i) {
       HandleTunnelLoop loop;
@@ -334,10 +350,11 @@ LoopsResult compute_loops(const Mesh& mesh, const LoopParams& params) {
       std::vector<int32_t> shortened = loops[i];
       if (params.shorten) {
         progress.update(double(i) / double(loops.size()));
-        shortened = tightener.tighten(loops[i], TightenParams{}, &progress);
+        shortened = tightener.tighten(loops[i], out.route == "coarse" ? local_moves : TightenParams{}, &progress);
         const auto verify_start = Clock::now();
         check_simple(fine, shortened, seen);
-        if (!(homology.class_of_loop(fine, shortened) == classes[i]))
+        if (!(homology.class_of_loop(fine, shortened) == classes[i]) ||
+            homology.integer_class_of_loop(fine, shortened) != homology.integer_class_of_loop(fine, loops[i]))
           throw std::logic_error(component_name(k, check) + ": shortening changed a loop's class");
         if (loop_length(fine, shortened, fine_weight) > loop_length(fine, loops[i], fine_weight) * (1 + 1e-12))
           throw std::logic_error(component_name(k, check) + ": shortening made a loop longer");
@@ -356,6 +373,51 @@ LoopsResult compute_loops(const Mesh& mesh, const LoopParams& params) {
   }
   progress.stage("done", 1.0, 1.0);
   return result;
+}
+
+std::vector<int32_t> shorten_loop(const Mesh& mesh, const std::vector<int32_t>& loop, const LoopParams& params,
+                                  int32_t max_window) {
+  if (loop.size() < 3) throw std::invalid_argument("a loop needs at least three vertices");
+  std::vector<int32_t> internal;
+  for (size_t i = 0; i < loop.size(); ++i) {
+    if (loop[i] < 0 || loop[i] >= int32_t(mesh.vertex_index().size()))
+      throw std::invalid_argument("loop vertex " + std::to_string(i) + " is " + std::to_string(loop[i]) +
+                                  ", outside [0, " + std::to_string(mesh.vertex_index().size()) + ")");
+    internal.push_back(mesh.vertex_index()[loop[i]]);
+  }
+  const int32_t component = mesh.component()[internal[0]];
+  if (component < 0) throw std::invalid_argument("loop vertex 0 is in no triangle");
+  const auto components = component_vertices(mesh);
+  const auto checks = check_closed_surfaces(mesh, components);
+  if (!checks[component].problem.empty())
+    throw std::invalid_argument("the loop lies on a component that is " + checks[component].problem + " (" +
+                                checks[component].detail + "); loops are shortened on closed manifold surfaces");
+  const Surface s = extract_surface(mesh, components[component]);
+  std::vector<int32_t> local;
+  for (size_t i = 0; i < internal.size(); ++i) {
+    local.push_back(local_id(components[component], internal[i]));
+    if (local.back() < 0) throw std::invalid_argument("the loop leaves the component of its first vertex");
+  }
+  std::vector<uint8_t> seen(s.num_vertices(), 0);
+  for (size_t i = 0; i < local.size(); ++i) {
+    if (seen[local[i]]) throw std::invalid_argument("the loop visits vertex " + std::to_string(loop[i]) + " twice");
+    seen[local[i]] = 1;
+    if (s.find_edge(local[i], local[(i + 1) % local.size()]) < 0)
+      throw std::invalid_argument("loop vertices " + std::to_string(loop[i]) + " and " +
+                                  std::to_string(loop[(i + 1) % loop.size()]) + " are not joined by an edge");
+  }
+  const auto weight = edge_weights(s, params.count_edges);
+  const SurfaceHomology homology(s);
+  LoopTightener tightener(s, weight, &homology);
+  TightenParams tighten;
+  tighten.max_window = max_window;
+  Progress progress(params.progress);
+  const auto shortened = tightener.tighten(local, tighten, &progress);
+  if (homology.integer_class_of_loop(s, shortened) != homology.integer_class_of_loop(s, local))
+    throw std::logic_error("shortening changed the loop's class");
+  std::vector<int32_t> out;
+  for (int32_t v : shortened) out.push_back(mesh.vertex_source()[s.mesh_vertex[v]]);
+  return out;
 }
 
 }  // namespace topstoc

@@ -97,15 +97,16 @@ std::vector<SurfaceCheck> check_closed_surfaces(const Mesh& mesh, const std::vec
   for (size_t c = 0; c < components.size(); ++c) {
     if (checks[c].nonmanifold_edges) continue;
     for (int32_t v : components[c])
-      if (vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot) > 1) {
+      if (!mesh.manifold_vertex()[v] && vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot) > 1) {
         ++checks[c].pinched_vertices;
         if (first_pinched[c] < 0 || source[v] < source[first_pinched[c]]) first_pinched[c] = v;
       }
   }
-  // Orientability: propagate a flip bit across edges; a contradiction means no consistent orientation.
-  std::vector<int8_t> flip(mesh.num_faces(), -1);
+  // Orientability: propagate a flip bit across edges; a contradiction means no consistent
+  // orientation. Consistently oriented input (the usual case) needs no search.
+  std::vector<int8_t> flip(mesh.report().inconsistent_edges ? mesh.num_faces() : 0, -1);
   std::vector<int32_t> stack;
-  for (int32_t start = 0; start < mesh.num_faces(); ++start) {
+  for (int32_t start = 0; start < int32_t(flip.size()); ++start) {
     const int32_t c = component[mesh.faces()[3 * size_t(start)]];
     SurfaceCheck& check = checks[c];
     if (flip[start] >= 0 || check.nonmanifold_edges || check.pinched_vertices || !check.problem.empty()) continue;

@@ -133,9 +133,13 @@ def test_genus_positive_meshes(data_dir, name, genus):
     check_component(vertices, triangles, result.components[0])
 
 
-def test_every_shared_genus_positive_mesh_has_g_loops_of_each_kind(shared_meshes):
-    """The shared collection may hold more meshes than tests/data: count loops on all of them."""
+def test_every_shared_genus_positive_mesh_has_g_loops_of_each_kind(shared_meshes, data_dir):
+    """The shared collection may hold more meshes than tests/data (whose copies are checked in
+    full above): count and check the loops of the others."""
     for path in sorted((shared_meshes / "genus_positive").glob("*.off")):
+        copy = data_dir / "genus_positive" / path.name
+        if copy.exists() and copy.read_bytes() == path.read_bytes():
+            continue
         vertices, triangles = read_off(path)
         result = topstoc.handle_tunnel_loops(vertices, triangles)
         for component in result.components:
@@ -316,7 +320,7 @@ def test_self_intersecting_surface_is_refused_with_the_triangles():
 
 
 def test_self_intersections_agree_with_brute_force():
-    vertices, triangles = meshgen.torus(12, 6, major=0.3, minor=0.5)
+    vertices, triangles = meshgen.torus(10, 5, major=0.3, minor=0.5)
     # Generic positions: the floating-point reference below is unreliable on exact coincidences.
     vertices = vertices + np.random.default_rng(1).normal(scale=1e-4, size=vertices.shape)
     pairs = {tuple(p) for p in topstoc.self_intersections(vertices, triangles).tolist()}

@@ -6,7 +6,9 @@
 // edge j and crosses a set of edges; a cycle's coordinate j is the parity of its edges in that
 // set (its intersection number with the dual loop). The coordinates of the fundamental cycle
 // of generator j are the unit vector j, so two cycles are homologous exactly when their
-// coordinates agree, and a set of cycles spans H1 exactly when their coordinates do.
+// coordinates agree, and a set of cycles spans H1 exactly when their coordinates do. Counted
+// with signs on the consistently oriented surface, the same crossings give integer
+// coordinates: homology over Z.
 #pragma once
 
 #include <cstdint>
@@ -77,6 +79,21 @@ class SurfaceHomology {
     for (int32_t i = crossing_offsets_[e]; i < crossing_offsets_[e + 1]; ++i)
       words[crossing_[i] >> 6] ^= uint64_t(1) << (crossing_[i] & 63);
   }
+  /// Adds the integer coordinates of edge e traversed forward (lower to higher vertex) or
+  /// backward to x: signed intersection numbers with the dual loops on the oriented surface.
+  void add_edge_signed(std::vector<int64_t>& x, int32_t e, bool forward) const {
+    for (int32_t i = crossing_offsets_[e]; i < crossing_offsets_[e + 1]; ++i)
+      x[crossing_[i]] += forward ? crossing_sign_[i] : -crossing_sign_[i];
+  }
+  /// Calls f(j, sign) for each dual loop j crossing edge e (sign +1 when it crosses from the
+  /// edge's left face).
+  template <class F>
+  void for_each_crossing(int32_t e, F f) const {
+    for (int32_t i = crossing_offsets_[e]; i < crossing_offsets_[e + 1]; ++i) f(crossing_[i], int(crossing_sign_[i]));
+  }
+  /// Integer coordinates of a closed vertex loop: equal exactly when two loops are homologous
+  /// over Z (with their orientations).
+  std::vector<int64_t> integer_class_of_loop(const Surface& surface, const std::vector<int32_t>& loop) const;
   /// Coordinates of a cycle given as edges (each once), or as a closed vertex sequence.
   Bits class_of_edges(const std::vector<int32_t>& edges) const;
   Bits class_of_loop(const Surface& surface, const std::vector<int32_t>& loop) const;
@@ -86,6 +103,7 @@ class SurfaceHomology {
  private:
   std::vector<int32_t> generators_;
   std::vector<int32_t> crossing_offsets_, crossing_;  // per edge: the dual loops crossing it
+  std::vector<int8_t> crossing_sign_;                 // and in which direction
 };
 
 }  // namespace topstoc

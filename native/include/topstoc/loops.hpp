@@ -82,6 +82,13 @@ struct LoopsResult {
          seconds_select = 0, seconds_map = 0, seconds_shorten = 0, seconds_verify = 0;
 };
 
+/// Shortens a simple closed loop of mesh edges (caller's vertex ids, last joins first) on a closed
+/// manifold component without changing its homotopy class (the tightening of step 5; for loops
+/// the user edited). Throws std::invalid_argument when the loop is not a simple edge cycle of
+/// such a component. params.count_edges picks the metric; the other fields are ignored.
+std::vector<int32_t> shorten_loop(const Mesh& mesh, const std::vector<int32_t>& loop, const LoopParams& params = {},
+                                  int32_t max_window = 192);
+
 /// Handle and tunnel loops of every component of `mesh`. Throws std::invalid_argument (bad
 /// component, TetGen refusal), Cancelled (progress callback said stop), std::logic_error (a
 /// self-check failed).

@@ -26,9 +26,10 @@ class ShortestPaths {
     run(sources, allowed, [](int32_t) { return true; }, target);
   }
 
-  /// Same, also skipping edges with !allowed_edge(e).
+  /// Same, also skipping edges with !allowed_edge(e), and stopping at distance `limit`.
   template <class Allowed, class AllowedEdge>
-  void run(const std::vector<int32_t>& sources, Allowed allowed, AllowedEdge allowed_edge, int32_t target) {
+  void run(const std::vector<int32_t>& sources, Allowed allowed, AllowedEdge allowed_edge, int32_t target,
+           double limit = kInfinity) {
     ++run_;
     settled_.clear();
     using Item = std::pair<double, int32_t>;
@@ -42,6 +43,7 @@ class ShortestPaths {
       const auto [d, v] = heap.top();
       heap.pop();
       if (settled_flag_[v] == run_ || d > distance_[v]) continue;
+      if (d > limit) return;
       settled_flag_[v] = run_;
       settled_.push_back(v);
       if (v == target) return;
