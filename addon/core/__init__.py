@@ -7,12 +7,21 @@
 
 from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
                        sampling_probabilities)
-from .loops import (Cancelled, ComponentLoops, Loop, LoopsResult, handle_tunnel_loops,
-                    self_intersections, tetrahedralize_surface)
+from .error_bound import ErrorBoundReport
+from .hausdorff import Distance, HausdorffResult, OneSidedDistance, closest_points, hausdorff
+from .io import MeshData, read_mesh, write_mesh
+from .loops import (Cancelled, ComponentLoops, Loop, LoopsResult, handle_tunnel_loops, self_intersections,
+                    shorten_loop, tetrahedralize_surface)
 from .mesh import Mesh, MeshReport
 
 __all__ = [
-    "Box", "Cancelled", "ComponentLoops", "DecimateResult", "DecimateStats", "Loop", "LoopsResult",
-    "Mesh", "MeshReport", "View", "decimate", "decimate_with_samples", "handle_tunnel_loops",
-    "sampling_probabilities", "self_intersections", "tetrahedralize_surface",
+    "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
+    "decimate_with_samples", "sampling_probabilities",
+    # measurement (hausdorff.py) and error-bounded decimation (error_bound.py)
+    "Distance", "ErrorBoundReport", "HausdorffResult", "OneSidedDistance", "closest_points", "hausdorff",
+    # mesh files (io.py)
+    "MeshData", "read_mesh", "write_mesh",
+    # handle and tunnel loops (loops.py)
+    "Cancelled", "ComponentLoops", "Loop", "LoopsResult", "handle_tunnel_loops", "self_intersections",
+    "shorten_loop", "tetrahedralize_surface",
 ]

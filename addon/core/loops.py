@@ -137,6 +137,18 @@ class LoopsResult:
         }
 
 
+def _as_mesh(mesh, triangles) -> Mesh:
+    if isinstance(mesh, Mesh):
+        if triangles is not None:
+            raise ValueError("triangles are given by the Mesh already")
+        return mesh
+    if triangles is None:
+        if hasattr(mesh, "vertices") and hasattr(mesh, "triangles"):  # MeshData
+            return Mesh(mesh.vertices, mesh.triangles)
+        raise ValueError("give a topstoc.Mesh, a MeshData, or vertices and triangles")
+    return Mesh(mesh, triangles)
+
+
 def _loop(raw: dict) -> Loop:
     return Loop(kind=raw["kind"], vertices=raw["vertices"], generator=tuple(raw["generator"]),
                 length=raw["length"], initial_length=raw["initial_length"],
@@ -160,7 +172,8 @@ def handle_tunnel_loops(mesh, triangles=None, *, coarse_vertices: Optional[int] 
                         ) -> LoopsResult:
     """Handle and tunnel loops of every closed orientable component.
 
-    mesh: a ``topstoc.Mesh``, or the vertices ((n, 3) floats) with ``triangles`` ((m, 3) ints).
+    mesh: a ``topstoc.Mesh``, a ``MeshData`` from ``read_mesh``, or the vertices ((n, 3)
+    floats) with ``triangles`` ((m, 3) ints). Vertex ids in the result are the input's.
     coarse_vertices: None decides per component (components above ``full_route_faces``
     triangles go through a coarse decimation of about max(3000, n/48) vertices); 0 always
     tetrahedralizes the full component; a positive count forces the coarse route with that
@@ -173,12 +186,7 @@ def handle_tunnel_loops(mesh, triangles=None, *, coarse_vertices: Optional[int] 
     Raises ValueError for a component that is not manifold or not orientable, or that TetGen
     refuses (self-intersections), naming it and an offending element.
     """
-    if not isinstance(mesh, Mesh):
-        if triangles is None:
-            raise ValueError("give a topstoc.Mesh, or vertices and triangles")
-        mesh = Mesh(mesh, triangles)
-    elif triangles is not None:
-        raise ValueError("triangles are given by the Mesh already")
+    mesh = _as_mesh(mesh, triangles)
     if metric not in METRICS:
         raise ValueError(f"metric must be one of {METRICS}, got {metric!r}")
     if coarse_vertices is None:
@@ -204,6 +212,21 @@ def handle_tunnel_loops(mesh, triangles=None, *, coarse_vertices: Optional[int] 
                        coarse_samples_added=raw["coarse_samples_added"])
 
 
+def shorten_loop(mesh, loop, triangles=None, *, metric: str = "length") -> np.ndarray:
+    """Shortens a simple closed loop of mesh edges without changing its homotopy class.
+
+    For loops the user edited (thesis 4.2.1): ``loop`` lists vertex ids in order (the last
+    joins the first) on a closed manifold component. Returns the shortened loop, never longer,
+    with the same homology class over the integers (checked). ``mesh`` as in
+    handle_tunnel_loops. Raises ValueError when the loop is not a simple edge cycle of such a
+    component.
+    """
+    mesh = _as_mesh(mesh, triangles)
+    if metric not in METRICS:
+        raise ValueError(f"metric must be one of {METRICS}, got {metric!r}")
+    return engine.shorten_loop(mesh.native, np.asarray(loop), count_edges=metric == "edges")
+
+
 def self_intersections(vertices, triangles) -> np.ndarray:
     """Pairs (i, j), i <= j, of triangles that intersect other than in shared vertices or a
     shared edge; (i, i) marks a zero-area triangle. Exact orientation tests."""
@@ -221,4 +244,4 @@ def tetrahedralize_surface(vertices, triangles) -> dict:
 
 
 __all__ = ["Cancelled", "ComponentLoops", "Loop", "LoopsResult", "handle_tunnel_loops",
-           "self_intersections", "tetrahedralize_surface"]
+           "self_intersections", "shorten_loop", "tetrahedralize_surface"]

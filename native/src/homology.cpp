@@ -4,19 +4,19 @@
 
 namespace topstoc {
 
-int32_t Bits::top() const {
+int32_t Z2Vector::top() const {
   for (size_t k = words.size(); k-- > 0;)
     if (words[k]) return int32_t(64 * k + 63 - __builtin_clzll(words[k]));
   return -1;
 }
 
-Bits Z2Basis::reduce(Bits x) const {
-  Bits unused(size_);
+Z2Vector Z2Basis::reduce(Z2Vector x) const {
+  Z2Vector unused(size_);
   return reduce(std::move(x), unused);
 }
 
-Bits Z2Basis::reduce(Bits x, Bits& used) const {
-  used = Bits(size_);
+Z2Vector Z2Basis::reduce(Z2Vector x, Z2Vector& used) const {
+  used = Z2Vector(size_);
   for (int32_t t = x.top(); t >= 0 && pivot_[t] >= 0; t = x.top()) {
     x.add(rows_[pivot_[t]]);
     used.add(combos_[pivot_[t]]);
@@ -24,9 +24,9 @@ Bits Z2Basis::reduce(Bits x, Bits& used) const {
   return x;
 }
 
-bool Z2Basis::insert(const Bits& x) {
-  Bits used;
-  Bits r = reduce(x, used);
+bool Z2Basis::insert(const Z2Vector& x) {
+  Z2Vector used;
+  Z2Vector r = reduce(x, used);
   const int32_t t = r.top();
   if (t < 0) return false;
   used.flip(int32_t(sources_.size()));
@@ -37,7 +37,7 @@ bool Z2Basis::insert(const Bits& x) {
   return true;
 }
 
-SurfaceHomology::SurfaceHomology(const Surface& s) {
+SurfaceHomology::SurfaceHomology(const ClosedSurface& s) {
   const int32_t n = s.num_vertices(), m = s.num_edges(), nf = s.num_faces();
   // Spanning tree of the vertices (breadth first: short tree paths).
   std::vector<uint8_t> in_tree(m, 0), seen(n, 0);
@@ -153,7 +153,7 @@ SurfaceHomology::SurfaceHomology(const Surface& s) {
   }
 }
 
-std::vector<int64_t> SurfaceHomology::integer_class_of_loop(const Surface& s, const std::vector<int32_t>& loop) const {
+std::vector<int64_t> SurfaceHomology::integer_class_of_loop(const ClosedSurface& s, const std::vector<int32_t>& loop) const {
   std::vector<int64_t> x(dimension(), 0);
   for (size_t i = 0; i < loop.size(); ++i) {
     const int32_t a = loop[i], b = loop[(i + 1) % loop.size()];
@@ -164,14 +164,14 @@ std::vector<int64_t> SurfaceHomology::integer_class_of_loop(const Surface& s, co
   return x;
 }
 
-Bits SurfaceHomology::class_of_edges(const std::vector<int32_t>& edges) const {
-  Bits x(dimension());
+Z2Vector SurfaceHomology::class_of_edges(const std::vector<int32_t>& edges) const {
+  Z2Vector x(dimension());
   for (int32_t e : edges) add_edge(x, e);
   return x;
 }
 
-Bits SurfaceHomology::class_of_loop(const Surface& s, const std::vector<int32_t>& loop) const {
-  Bits x(dimension());
+Z2Vector SurfaceHomology::class_of_loop(const ClosedSurface& s, const std::vector<int32_t>& loop) const {
+  Z2Vector x(dimension());
   for (size_t i = 0; i < loop.size(); ++i) {
     const int32_t e = s.find_edge(loop[i], loop[(i + 1) % loop.size()]);
     if (e < 0) throw std::logic_error("loop step " + std::to_string(i) + " is not an edge");
@@ -180,7 +180,7 @@ Bits SurfaceHomology::class_of_loop(const Surface& s, const std::vector<int32_t>
   return x;
 }
 
-bool SurfaceHomology::is_cycle(const Surface& s, const std::vector<int32_t>& edges) {
+bool SurfaceHomology::is_cycle(const ClosedSurface& s, const std::vector<int32_t>& edges) {
   std::vector<uint8_t> parity(s.num_vertices(), 0);
   for (int32_t e : edges) {
     parity[s.edge_vertices[2 * size_t(e)]] ^= 1;

@@ -9,7 +9,7 @@
 
 namespace topstoc {
 
-std::vector<std::vector<int32_t>> simple_cycles(const Surface& s, const std::vector<int32_t>& edges) {
+std::vector<std::vector<int32_t>> simple_cycles(const ClosedSurface& s, const std::vector<int32_t>& edges) {
   // Remaining cycle edges around each vertex (small lists: a cycle has few edges per vertex).
   std::vector<std::pair<int32_t, int32_t>> incidences;  // (vertex, edge)
   for (int32_t e : edges) {
@@ -64,7 +64,7 @@ std::vector<std::vector<int32_t>> simple_cycles(const Surface& s, const std::vec
   return cycles;
 }
 
-double loop_length(const Surface& s, const std::vector<int32_t>& loop, const std::vector<double>& weight) {
+double loop_length(const ClosedSurface& s, const std::vector<int32_t>& loop, const std::vector<double>& weight) {
   double total = 0.0;
   for (size_t i = 0; i < loop.size(); ++i) total += weight[s.find_edge(loop[i], loop[(i + 1) % loop.size()])];
   return total;
@@ -79,7 +79,7 @@ struct Candidate {
   int32_t kind;
   int64_t order;  // tie-break: creation order (deterministic)
   std::vector<int32_t> vertices;
-  Bits cls;
+  Z2Vector cls;
 };
 
 // Pairs each of the k loops with one of the k cycles whose coefficient is 1 (Kuhn's matching;
@@ -108,7 +108,7 @@ std::vector<int32_t> match(const std::vector<std::vector<uint8_t>>& coefficient)
 
 }  // namespace
 
-std::vector<SelectedLoop> select_loops(const Surface& s, const SurfaceHomology& h, const std::vector<PersistentCycle>& cycles,
+std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomology& h, const std::vector<PersistentCycle>& cycles,
                                        const std::vector<double>& weight, int32_t max_roots, Progress* progress) {
   const int32_t dim = h.dimension(), g = dim / 2, n = s.num_vertices();
   std::vector<SelectedLoop> out;
@@ -121,8 +121,8 @@ std::vector<SelectedLoop> select_loops(const Surface& s, const SurfaceHomology& 
   for (const auto* c : ordered)
     if (!split.insert(h.class_of_edges(c->edges)))
       throw std::logic_error("the handle and tunnel cycles are not independent in H1");
-  auto kind_of = [&](const Bits& x, Bits* coefficients = nullptr) {
-    Bits used;
+  auto kind_of = [&](const Z2Vector& x, Z2Vector* coefficients = nullptr) {
+    Z2Vector used;
     if (!split.reduce(x, used).zero() || used.zero()) return int32_t(kNeither);
     if (coefficients) *coefficients = used;
     bool handle_part = false, tunnel_part = false;
@@ -136,7 +136,7 @@ std::vector<SelectedLoop> select_loops(const Surface& s, const SurfaceHomology& 
   // The simple pieces of the persistence cycles.
   for (const auto* c : ordered)
     for (auto& loop : simple_cycles(s, c->edges)) {
-      Bits cls = h.class_of_loop(s, loop);
+      Z2Vector cls = h.class_of_loop(s, loop);
       const int32_t kind = kind_of(cls);
       if (kind == kNeither) continue;
       const double length = loop_length(s, loop, weight);
@@ -189,7 +189,7 @@ std::vector<SelectedLoop> select_loops(const Surface& s, const SurfaceHomology& 
     }
     // Fundamental cycles of the non-tree edges, shortest (through the root) first.
     local.clear();
-    Bits cls(dim);
+    Z2Vector cls(dim);
     for (int32_t e = 0; e < s.num_edges(); ++e) {
       const int32_t a = s.edge_vertices[2 * size_t(e)], b = s.edge_vertices[2 * size_t(e) + 1];
       if (sp.parent_edge(a) == e || sp.parent_edge(b) == e) continue;
@@ -252,7 +252,7 @@ std::vector<SelectedLoop> select_loops(const Surface& s, const SurfaceHomology& 
   for (int32_t kind : {int32_t(kHandle), int32_t(kTunnel)}) {
     std::vector<std::vector<uint8_t>> coefficient(g, std::vector<uint8_t>(g, 0));
     for (int32_t k = 0; k < g; ++k) {
-      Bits used;
+      Z2Vector used;
       kind_of(picked[kind][k]->cls, &used);
       for (int32_t i = 0; i < g; ++i) coefficient[k][i] = used.get(kind == kHandle ? i : g + i);
     }

@@ -5,7 +5,7 @@
 
 namespace topstoc {
 
-ClusterMap::ClusterMap(const Surface& full, const std::vector<double>& edge_weight, std::vector<int32_t> cluster_of,
+ClusterMap::ClusterMap(const ClosedSurface& full, const std::vector<double>& edge_weight, std::vector<int32_t> cluster_of,
                        std::vector<int32_t> representative)
     : full_(full), paths_(full, edge_weight), cluster_of_(std::move(cluster_of)), representative_(std::move(representative)) {
   const int32_t clusters = int32_t(representative_.size());

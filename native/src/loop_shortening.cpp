@@ -4,7 +4,7 @@
 
 namespace topstoc {
 
-LoopTightener::LoopTightener(const Surface& s, const std::vector<double>& weight, const SurfaceHomology* homology)
+LoopTightener::LoopTightener(const ClosedSurface& s, const std::vector<double>& weight, const SurfaceHomology* homology)
     : surface_(s),
       weight_(weight),
       homology_(homology),
@@ -40,7 +40,7 @@ uint64_t LoopTightener::edge_hash(int32_t e, bool forward) const {
 }
 
 void LoopTightener::grow_disk(const std::vector<int32_t>& around, int32_t seed, int32_t rings, int32_t max_region) {
-  const Surface& s = surface_;
+  const ClosedSurface& s = surface_;
   ++stamp_;
   disk_vertices_.clear();
   // Vertices within `rings` hops of `around` may carry disk faces.
@@ -117,7 +117,7 @@ void LoopTightener::grow_disk(const std::vector<int32_t>& around, int32_t seed, 
 }
 
 bool LoopTightener::improve_window(std::vector<int32_t>& loop, size_t start, int32_t w, const TightenParams& params) {
-  const Surface& s = surface_;
+  const ClosedSurface& s = surface_;
   const size_t n = loop.size();
   std::vector<int32_t> window(size_t(w) + 1);
   double old_length = 0.0;
@@ -147,7 +147,7 @@ bool LoopTightener::improve_window(std::vector<int32_t>& loop, size_t start, int
 }
 
 bool LoopTightener::improve_band(std::vector<int32_t>& loop, int32_t rings, const TightenParams& params) {
-  const Surface& s = surface_;
+  const ClosedSurface& s = surface_;
   const size_t n = loop.size();
   double old_length = 0.0;
   uint64_t loop_hash = 0;

@@ -12,7 +12,7 @@
 #include "topstoc/loop_mapping.hpp"
 #include "topstoc/loop_shortening.hpp"
 #include "topstoc/persistence.hpp"
-#include "topstoc/surface.hpp"
+#include "topstoc/closed_surface.hpp"
 #include "topstoc/tetrahedralize.hpp"
 
 namespace topstoc {
@@ -23,7 +23,7 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-std::vector<double> edge_weights(const Surface& s, bool count_edges) {
+std::vector<double> edge_weights(const ClosedSurface& s, bool count_edges) {
   std::vector<double> w(s.num_edges(), 1.0);
   if (!count_edges)
     for (int32_t e = 0; e < s.num_edges(); ++e) w[e] = s.edge_length(e);
@@ -38,12 +38,12 @@ int32_t local_id(const std::vector<int32_t>& sorted, int32_t id) {
 // The coarse surface standing for one full component, with the cluster of every full vertex
 // and the full vertex behind every coarse one. Empty `why` on success.
 struct CoarseView {
-  Surface surface;
+  ClosedSurface surface;
   std::vector<int32_t> cluster_of, representative;
   std::string why;
 };
 
-CoarseView coarse_view(const Mesh& mesh, const std::vector<int32_t>& fine_vertices, const Surface& fine,
+CoarseView coarse_view(const Mesh& mesh, const std::vector<int32_t>& fine_vertices, const ClosedSurface& fine,
                        int32_t fine_component, int32_t genus, const CoarseMesh& coarse) {
   CoarseView view;
   int32_t found = -1, count = 0;
@@ -93,7 +93,7 @@ struct Analysis {
 };
 
 // Steps 1-3 on one surface; `begin`..`end` is its share of the progress bar.
-Analysis analyse(const Surface& s, const std::vector<double>& weight, const LoopParams& params, Progress& progress,
+Analysis analyse(const ClosedSurface& s, const std::vector<double>& weight, const LoopParams& params, Progress& progress,
                  LoopsResult& r, double begin, double end) {
   auto at = [&](double f) { return begin + (end - begin) * f; };
   Analysis a;
@@ -115,7 +115,7 @@ Analysis analyse(const Surface& s, const std::vector<double>& weight, const Loop
   return a;
 }
 
-void check_simple(const Surface& s, const std::vector<int32_t>& loop, std::vector<uint8_t>& seen) {
+void check_simple(const ClosedSurface& s, const std::vector<int32_t>& loop, std::vector<uint8_t>& seen) {
   if (loop.size() < 3) throw std::logic_error("a loop has fewer than three edges");
   for (size_t i = 0; i < loop.size(); ++i) {
     if (seen[loop[i]]) throw std::logic_error("a loop visits a vertex twice");
@@ -226,7 +226,7 @@ LoopsResult compute_loops(const Mesh& mesh, const LoopParams& params) {
     faces_done += out.faces;
 
     start = Clock::now();
-    const Surface fine = extract_surface(mesh, components[fine_component]);
+    const ClosedSurface fine = extract_surface(mesh, components[fine_component]);
     const auto fine_weight = edge_weights(fine, params.count_edges);
     result.seconds_prepare += seconds_since(start);
 
@@ -325,7 +325,7 @@ LoopsResult compute_loops(const Mesh& mesh, const LoopParams& params) {
     const SurfaceHomology homology(fine);
     std::vector<uint8_t> seen(fine.num_vertices(), 0);
     Z2Basis span(homology.dimension());
-    std::vector<Bits> classes;
+    std::vector<Z2Vector> classes;
     for (const auto& loop : loops) {
       check_simple(fine, loop, seen);
       classes.push_back(homology.class_of_loop(fine, loop));
@@ -392,7 +392,7 @@ std::vector<int32_t> shorten_loop(const Mesh& mesh, const std::vector<int32_t>& 
   if (!checks[component].problem.empty())
     throw std::invalid_argument("the loop lies on a component that is " + checks[component].problem + " (" +
                                 checks[component].detail + "); loops are shortened on closed manifold surfaces");
-  const Surface s = extract_surface(mesh, components[component]);
+  const ClosedSurface s = extract_surface(mesh, components[component]);
   std::vector<int32_t> local;
   for (size_t i = 0; i < internal.size(); ++i) {
     local.push_back(local_id(components[component], internal[i]));

@@ -1,5 +1,7 @@
 #include "topstoc/partition.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <climits>
@@ -43,22 +45,30 @@ void seed_unreached(const Mesh& mesh, const Clustering& c, Partition& out) {
   }
 }
 
-// Does the set of oriented link arcs a -> b around one sample form a single path or cycle?
+// Do the oriented link arcs a -> b around one sample form a single path or cycle? Each
+// neighbour may start and end at most one arc: that is also what consistent orientation of
+// the triangles around the sample means.
 bool single_fan(std::vector<std::array<int32_t, 2>>& arcs) {
   if (arcs.empty()) return false;
   std::sort(arcs.begin(), arcs.end());
   for (size_t i = 1; i < arcs.size(); ++i)
-    if (arcs[i][0] == arcs[i - 1][0]) return false;  // two arcs leave the same neighbour
-  std::vector<int32_t> targets;
-  for (const auto& a : arcs) targets.push_back(a[1]);
-  std::sort(targets.begin(), targets.end());
-  for (size_t i = 1; i < targets.size(); ++i)
-    if (targets[i] == targets[i - 1]) return false;  // two arcs enter the same neighbour
+    if (arcs[i][0] == arcs[i - 1][0]) return false;
+  std::array<int32_t, 64> small;
+  std::vector<int32_t> large;
+  int32_t* targets = small.data();
+  if (arcs.size() > small.size()) {
+    large.resize(arcs.size());
+    targets = large.data();
+  }
+  for (size_t i = 0; i < arcs.size(); ++i) targets[i] = arcs[i][1];
+  std::sort(targets, targets + arcs.size());
+  for (size_t i = 1; i < arcs.size(); ++i)
+    if (targets[i] == targets[i - 1]) return false;
   // Start at the one source that is nobody's target (a path), or anywhere (a cycle).
   int32_t start = arcs[0][0];
   int32_t starts = 0;
   for (const auto& a : arcs)
-    if (!std::binary_search(targets.begin(), targets.end(), a[0])) {
+    if (!std::binary_search(targets, targets + arcs.size(), a[0])) {
       start = a[0];
       ++starts;
     }
@@ -78,7 +88,55 @@ bool single_fan(std::vector<std::array<int32_t, 2>>& arcs) {
   return walked == arcs.size();
 }
 
+// Triangle i as seen from its lowest rank s: (b, c) such that (s, b, c) is a rotation of it.
+inline std::array<int32_t, 2> rotated_from_lowest(const int32_t* t) {
+  const int j = (t[0] < t[1] && t[0] < t[2]) ? 0 : (t[1] < t[2] ? 1 : 2);
+  return {t[(j + 1) % 3], t[(j + 2) % 3]};
+}
+
+// Collects per-thread lists of marked clusters into one sorted, unique list.
+struct Marks {
+  std::vector<std::vector<int32_t>> per_thread;
+  explicit Marks(int threads) : per_thread(threads) {}
+  void add(int32_t s) { per_thread[omp_get_thread_num()].push_back(s); }
+  void merge_into(std::vector<int32_t>& out) const {
+    for (const auto& list : per_thread) out.insert(out.end(), list.begin(), list.end());
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+};
+
 }  // namespace
+
+std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layout, int32_t num_samples,
+                                    const Clustering& c) {
+  // 6 chi = sum over the cluster's vertices of the layout's per-vertex constant, corrected by
+  // the edges and faces the cluster shares with others (see FeatureLayout::chi_constant).
+  std::vector<int64_t> chi6(num_samples, 0);
+  const auto& label = c.label;
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+    if (label[v] >= 0) chi6[label[v]] += layout.chi_constant[v];
+  const auto& faces = mesh.faces();
+  const auto& fe = mesh.face_edges();
+  const auto& efo = mesh.edge_face_offsets();
+  const auto& ef = mesh.edge_faces();
+  const auto& ev = mesh.edge_vertices();
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+    const int32_t la = label[faces[3 * size_t(f)]], lb = label[faces[3 * size_t(f) + 1]],
+                  lc = label[faces[3 * size_t(f) + 2]];
+    if (la == lb && lb == lc) continue;
+    chi6[la] -= 2, chi6[lb] -= 2, chi6[lc] -= 2;
+    for (int s = 0; s < 3; ++s) {
+      const int32_t e = fe[3 * size_t(f) + s];
+      if (ef[efo[e]] != f) continue;  // each edge once, from its first face
+      const int32_t lx = label[ev[2 * size_t(e)]], ly = label[ev[2 * size_t(e) + 1]];
+      if (lx == ly) continue;
+      const int32_t copies = layout.edge_copies(mesh, e);
+      chi6[lx] += 3 * copies, chi6[ly] += 3 * copies;
+    }
+  }
+  return chi6;
+}
 
 Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
                           const Clustering& c, const std::vector<uint8_t>& required, bool check_slivers,
@@ -87,108 +145,172 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   const int32_t n = mesh.num_vertices();
   const int32_t k = static_cast<int32_t>(samples.size());
   const auto& label = c.label;
+  const auto& vfo = mesh.vertex_face_offsets();
   for (int32_t v = 0; v < n; ++v)
-    if (label[v] < 0 && mesh.vertex_face_offsets()[v] != mesh.vertex_face_offsets()[v + 1]) {
+    if (label[v] < 0 && vfo[v] != vfo[v + 1]) {
       seed_unreached(mesh, c, out);
       return out;  // the other checks need every vertex in a cluster
     }
+  const int threads = omp_get_max_threads();
+  Marks marks(threads);
 
-  std::vector<uint8_t> split(k, 0);
-  auto mark = [&](int32_t s) { split[s] = 1; };
-
-  // --- one pass over vertices and over faces with more than one cluster -----------------------
-  std::vector<int64_t> chi6(k, 0);
-  for (int32_t v = 0; v < n; ++v)
-    if (label[v] >= 0) chi6[label[v]] += layout.chi_constant[v];
+  // --- emit: faces whose corners lie in three clusters (static chunks keep the serial order) ---
   const auto& faces = mesh.faces();
-  const auto& fe = mesh.face_edges();
-  const auto& efo = mesh.edge_face_offsets();
-  const auto& ef = mesh.edge_faces();
-  const auto& ev = mesh.edge_vertices();
-  struct FeaturePair {
-    int32_t copies = 0;
-    bool seen = false;
-  };
-  std::unordered_map<uint64_t, FeaturePair> feature_pairs;
-  auto visit_face = [&](int32_t f) {
-    const int32_t la = label[faces[3 * f]], lb = label[faces[3 * f + 1]], lc = label[faces[3 * f + 2]];
-    if (la == lb && lb == lc) return;
-    chi6[la] -= 2, chi6[lb] -= 2, chi6[lc] -= 2;
-    if (la != lb && lb != lc && lc != la) {
-      out.triangles.insert(out.triangles.end(), {la, lb, lc});
-      out.source_face.push_back(f);
-    }
-    for (int s = 0; s < 3; ++s) {
-      const int32_t e = fe[3 * f + s];
-      if (ef[efo[e]] != f) continue;  // each edge once, from its first face
-      const int32_t lx = label[ev[2 * e]], ly = label[ev[2 * e + 1]];
-      if (lx == ly) continue;
-      const int32_t copies = layout.edge_copies(mesh, e);
-      chi6[lx] += 3 * copies, chi6[ly] += 3 * copies;
-      if (layout.edge_feature[e]) feature_pairs[pair_key(lx, ly)].copies += copies;
-    }
-  };
-  if (candidate_faces) {
-    for (int32_t f : *candidate_faces) visit_face(f);
-  } else {
-    for (int32_t f = 0; f < mesh.num_faces(); ++f) visit_face(f);
-  }
-  for (int32_t s = 0; s < k; ++s)
-    if (chi6[s] != 6 * int64_t(layout.sectors[samples[s]])) {
-      ++out.issues.non_disk;
-      mark(s);
-    }
-
-  // --- pillows and duplicates ---------------------------------------------------------------
-  // Three clusters can meet at two faces: a small cluster sits between two others that wrap
-  // around it, touching it along its whole border. The nerve then holds their triangle twice,
-  // facing opposite ways, and the small cluster has no other triangle. Dropping both copies
-  // gives the nerve of the partition in which the small cluster joined its neighbours, so no
-  // sample is needed. Any other repetition is a real violation.
   {
-    const int32_t emitted = static_cast<int32_t>(out.source_face.size());
-    std::vector<int32_t> bucket_offsets(k + 1, 0), bucket(emitted);
-    auto lowest = [&](int32_t i) {
-      return std::min({out.triangles[3 * i], out.triangles[3 * i + 1], out.triangles[3 * i + 2]});
-    };
-    for (int32_t i = 0; i < emitted; ++i) ++bucket_offsets[lowest(i) + 1];
-    for (int32_t s = 0; s < k; ++s) bucket_offsets[s + 1] += bucket_offsets[s];
+    const int64_t count = candidate_faces ? int64_t(candidate_faces->size()) : int64_t(mesh.num_faces());
+    std::vector<std::vector<int32_t>> found(threads);
+#pragma omp parallel
     {
-      std::vector<int32_t> fill(bucket_offsets.begin(), bucket_offsets.end() - 1);
-      for (int32_t i = 0; i < emitted; ++i) bucket[fill[lowest(i)]++] = i;
+      auto& mine = found[omp_get_thread_num()];
+#pragma omp for schedule(static)
+      for (int64_t i = 0; i < count; ++i) {
+        const int32_t f = candidate_faces ? (*candidate_faces)[i] : int32_t(i);
+        const int32_t la = label[faces[3 * size_t(f)]], lb = label[faces[3 * size_t(f) + 1]],
+                      lc = label[faces[3 * size_t(f) + 2]];
+        if (la != lb && lb != lc && lc != la) mine.push_back(f);
+      }
     }
-    // Rotate so the lowest rank comes first; then same orientation <=> same (b, c).
-    auto rotated = [&](int32_t i) {
-      const int32_t* t = &out.triangles[3 * size_t(i)];
-      const int j = t[0] == lowest(i) ? 0 : t[1] == lowest(i) ? 1 : 2;
-      return std::array<int32_t, 2>{t[(j + 1) % 3], t[(j + 2) % 3]};
-    };
-    std::vector<uint8_t> drop(emitted, 0);
-    // Triangles per cluster before dropping: a pillow is the artifact only when one of its
-    // clusters has nothing else (that cluster is then absorbed by its neighbours).
-    std::vector<int32_t> incident(k, 0);
-    for (int32_t x : out.triangles) ++incident[x];
-    for (int32_t s = 0; s < k; ++s)
-      for (int32_t a = bucket_offsets[s]; a < bucket_offsets[s + 1]; ++a) {
-        const auto ra = rotated(bucket[a]);
-        int32_t same = 0, opposite = -1, repeats = 0;
-        for (int32_t b = bucket_offsets[s]; b < bucket_offsets[s + 1]; ++b) {
-          if (a == b) continue;
-          const auto rb = rotated(bucket[b]);
-          if (rb == ra) ++same, ++repeats;
-          if (rb[0] == ra[1] && rb[1] == ra[0]) opposite = bucket[b], ++repeats;
-        }
-        if (repeats == 0) continue;
-        const int32_t* tri = &out.triangles[3 * size_t(bucket[a])];
-        const bool absorbs = incident[tri[0]] == 2 || incident[tri[1]] == 2 || incident[tri[2]] == 2;
-        if (repeats == 1 && same == 0 && absorbs) {
-          if (!drop[bucket[a]]) ++out.issues.pillows;
-          drop[bucket[a]] = drop[opposite] = 1;
-        } else if (!drop[bucket[a]]) {
-          ++out.issues.duplicate;
-          for (int j = 0; j < 3; ++j) mark(out.triangles[3 * size_t(bucket[a]) + j]);
+    for (const auto& list : found)
+      for (int32_t f : list) {
+        out.source_face.push_back(f);
+        for (int j = 0; j < 3; ++j) out.triangles.push_back(label[faces[3 * size_t(f) + j]]);
+      }
+  }
+  const int32_t emitted = static_cast<int32_t>(out.source_face.size());
+
+  // --- feature pairs: clusters adjacent along a feature curve, with the copies of their edge ---
+  std::unordered_map<uint64_t, int32_t> feature_copies;
+  for (int32_t e : layout.feature_edges) {
+    const int32_t lx = label[mesh.edge_vertices()[2 * size_t(e)]], ly = label[mesh.edge_vertices()[2 * size_t(e) + 1]];
+    if (lx != ly) feature_copies[pair_key(lx, ly)] += layout.edge_copies(mesh, e);
+  }
+
+  // --- triangles around each sample -----------------------------------------------------------
+  std::vector<int32_t> around_offsets(k + 1, 0), around(out.triangles.size());
+  for (int32_t x : out.triangles) ++around_offsets[x + 1];
+  for (int32_t s = 0; s < k; ++s) around_offsets[s + 1] += around_offsets[s];
+  {
+    std::vector<int32_t> fill(around_offsets.begin(), around_offsets.end() - 1);
+    for (int32_t i = 0; i < emitted; ++i)
+      for (int j = 0; j < 3; ++j) around[fill[out.triangles[3 * size_t(i) + j]]++] = i;
+  }
+  auto incident = [&](int32_t s) { return around_offsets[s + 1] - around_offsets[s]; };
+
+  // --- duplicates and pillows, decided by each triangle's lowest rank ---------------------------
+  // A small cluster can sit between two others that wrap around it, touching it along its whole
+  // border: their triangle is emitted twice, facing opposite ways, and the small cluster has
+  // no other triangle. Dropping both copies gives the nerve of the partition in which the
+  // small cluster joined its neighbours, so no sample is needed. Any other repeat is an issue.
+  std::vector<uint8_t> drop(emitted, 0);
+  int32_t duplicates = 0, pillows = 0;
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : duplicates, pillows)
+  for (int32_t s = 0; s < k; ++s) {
+    for (int32_t a = around_offsets[s]; a < around_offsets[s + 1]; ++a) {
+      const int32_t* ta = &out.triangles[3 * size_t(around[a])];
+      if (std::min({ta[0], ta[1], ta[2]}) != s) continue;
+      const auto ra = rotated_from_lowest(ta);
+      int32_t same = 0, opposite = -1, repeats = 0;
+      for (int32_t b = around_offsets[s]; b < around_offsets[s + 1]; ++b) {
+        if (a == b) continue;
+        const int32_t* tb = &out.triangles[3 * size_t(around[b])];
+        if (std::min({tb[0], tb[1], tb[2]}) != s) continue;
+        const auto rb = rotated_from_lowest(tb);
+        if (rb == ra) ++same, ++repeats;
+        if (rb[0] == ra[1] && rb[1] == ra[0]) opposite = around[b], ++repeats;
+      }
+      if (repeats == 0) continue;
+      const bool absorbs = incident(ta[0]) == 2 || incident(ta[1]) == 2 || incident(ta[2]) == 2;
+      if (repeats == 1 && same == 0 && absorbs) {
+        if (around[a] < opposite) ++pillows;  // count each pair once
+        drop[around[a]] = 1;                  // the opposite copy is dropped from its own turn
+      } else {
+        ++duplicates;
+        for (int j = 0; j < 3; ++j) marks.add(ta[j]);
+      }
+    }
+  }
+  out.issues.duplicate = duplicates;
+  out.issues.pillows = pillows;
+
+  // --- per sample: one oriented fan, expected edge multiplicities, Euler contributions ----------
+  // Six times a component's Euler characteristic is the sum over its samples of
+  // 6 - 3 (neighbours) + 2 (triangles), counting only samples that keep a triangle.
+  const int32_t num_components = mesh.num_components();
+  std::vector<int64_t> chi6_out(k, 0);
+  out.absorbed.assign(k, 0);
+  std::vector<std::vector<uint64_t>> seen_pairs(threads);
+  int32_t bad_link = 0, bad_edge = 0, isolated = 0, absorbed = 0;
+#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed)
+  {
+    std::vector<std::pair<int32_t, int32_t>> neighbour_count;
+    std::vector<std::array<int32_t, 2>> link;
+    auto& seen = seen_pairs[omp_get_thread_num()];
+#pragma omp for schedule(dynamic, 256)
+    for (int32_t s = 0; s < k; ++s) {
+      neighbour_count.clear();
+      link.clear();
+      for (int32_t i = around_offsets[s]; i < around_offsets[s + 1]; ++i) {
+        if (drop[around[i]]) continue;
+        const int32_t* tri = &out.triangles[3 * size_t(around[i])];
+        const int j = tri[0] == s ? 0 : tri[1] == s ? 1 : 2;
+        const int32_t next = tri[(j + 1) % 3], prev = tri[(j + 2) % 3];
+        link.push_back({next, prev});
+        for (int32_t other : {next, prev}) {
+          auto it = std::find_if(neighbour_count.begin(), neighbour_count.end(),
+                                 [&](const auto& p) { return p.first == other; });
+          if (it == neighbour_count.end()) neighbour_count.push_back({other, 1});
+          else ++it->second;
         }
       }
+      if (link.empty()) {
+        // No triangle: the neighbours absorbed this cluster (the pillow case) unless the sample
+        // must stay. The Euler characteristic check confirms the topology either way.
+        if (required[samples[s]] || layout.vertex_corner[samples[s]]) {
+          ++isolated;
+          marks.add(s);
+        } else {
+          ++absorbed;
+          out.absorbed[s] = 1;
+        }
+        continue;
+      }
+      chi6_out[s] = 6 - 3 * int64_t(neighbour_count.size()) + 2 * int64_t(link.size());
+      for (const auto& [other, count] : neighbour_count) {
+        if (other < s) continue;  // each pair once
+        int32_t expected = 2;
+        auto it = feature_copies.find(pair_key(s, other));
+        if (it != feature_copies.end()) {
+          expected = it->second;
+          seen.push_back(it->first);
+        }
+        if (count != expected) {
+          ++bad_edge;
+          marks.add(s), marks.add(other);
+        }
+      }
+      if (mesh.manifold_vertex()[samples[s]] && !single_fan(link)) {
+        ++bad_link;
+        marks.add(s);
+      }
+    }
+  }
+  out.issues.bad_link = bad_link;
+  out.issues.bad_edge = bad_edge;
+  out.issues.isolated = isolated;
+  out.issues.absorbed = absorbed;
+  {
+    // Feature pairs without a triangle between them: the border between them collapsed.
+    std::vector<uint64_t> seen;
+    for (const auto& list : seen_pairs) seen.insert(seen.end(), list.begin(), list.end());
+    std::sort(seen.begin(), seen.end());
+    for (const auto& [key, copies] : feature_copies)
+      if (!std::binary_search(seen.begin(), seen.end(), key)) {
+        ++out.issues.bad_edge;
+        marks.add(int32_t(key >> 32)), marks.add(int32_t(key & 0xffffffffu));
+      }
+  }
+  {
+    // Dropped pillows leave the output.
     int32_t kept = 0;
     for (int32_t i = 0; i < emitted; ++i) {
       if (drop[i]) continue;
@@ -199,95 +321,41 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     out.source_face.resize(kept);
   }
 
-  // --- decimated triangles around each sample ----------------------------------------------
-  const int32_t t = static_cast<int32_t>(out.source_face.size());
-  std::vector<int32_t> around_offsets(k + 1, 0), around;
-  for (int32_t x : out.triangles) ++around_offsets[x + 1];
-  for (int32_t s = 0; s < k; ++s) around_offsets[s + 1] += around_offsets[s];
-  around.resize(out.triangles.size());
-  {
-    std::vector<int32_t> fill(around_offsets.begin(), around_offsets.end() - 1);
-    for (int32_t i = 0; i < t; ++i)
-      for (int j = 0; j < 3; ++j) around[fill[out.triangles[3 * i + j]]++] = i;
-  }
-  // Euler characteristic of the output per input component, to compare with the input's.
-  const int32_t num_components = mesh.num_components();
-  std::vector<int64_t> component_chi(num_components, 0);
-  out.absorbed.assign(k, 0);
-  for (int32_t s = 0; s < k; ++s)
-    if (around_offsets[s] < around_offsets[s + 1]) ++component_chi[mesh.component()[samples[s]]];
-  for (int32_t i = 0; i < t; ++i) ++component_chi[mesh.component()[samples[out.triangles[3 * i]]]];
-  std::vector<std::pair<int32_t, int32_t>> neighbour_count;
-  std::vector<std::array<int32_t, 2>> link;
-  for (int32_t s = 0; s < k; ++s) {
-    const int32_t b = around_offsets[s], e = around_offsets[s + 1];
-    if (b == e) {
-      // No triangle: the neighbours absorbed this cluster (the pillow case), unless the sample
-      // must stay. The Euler characteristic check below confirms the topology either way.
-      if (required[samples[s]] || layout.vertex_corner[samples[s]]) {
-        ++out.issues.isolated;
-        mark(s);
-      } else {
-        ++out.issues.absorbed;
-        out.absorbed[s] = 1;
-      }
-      continue;
-    }
-    neighbour_count.clear();
-    link.clear();
-    for (int32_t i = b; i < e; ++i) {
-      const int32_t* tri = &out.triangles[3 * size_t(around[i])];
-      const int j = tri[0] == s ? 0 : tri[1] == s ? 1 : 2;
-      const int32_t next = tri[(j + 1) % 3], prev = tri[(j + 2) % 3];
-      link.push_back({next, prev});
-      for (int32_t other : {next, prev}) {
-        auto it = std::find_if(neighbour_count.begin(), neighbour_count.end(),
-                               [&](const auto& p) { return p.first == other; });
-        if (it == neighbour_count.end()) neighbour_count.push_back({other, 1});
-        else ++it->second;
-      }
-    }
-    for (const auto& [other, count] : neighbour_count)
-      if (other > s) --component_chi[mesh.component()[samples[s]]];  // each edge once
-    for (const auto& [other, count] : neighbour_count) {
-      if (other < s) continue;  // each pair once
-      int32_t expected = 2;
-      auto it = feature_pairs.find(pair_key(s, other));
-      if (it != feature_pairs.end()) {
-        expected = it->second.copies;
-        it->second.seen = true;
-      }
-      if (count != expected) {
-        ++out.issues.bad_edge;
-        mark(s), mark(other);
-      }
-    }
-    if (mesh.manifold_vertex()[samples[s]] && !single_fan(link)) {
-      ++out.issues.bad_link;
-      mark(s);
-    }
-  }
-  for (const auto& [key, pair] : feature_pairs)
-    if (!pair.seen) {
-      ++out.issues.bad_edge;
-      mark(int32_t(key >> 32)), mark(int32_t(key & 0xffffffffu));
-    }
-
+  // --- Euler characteristic per component -------------------------------------------------------
+  // A component that lost all its triangles fails too (a torus has chi = 0 with or without).
+  std::vector<int64_t> component_chi6(num_components, 0);
+  std::vector<int32_t> component_triangles(num_components, 0);
+  for (int32_t s = 0; s < k; ++s) component_chi6[mesh.component()[samples[s]]] += chi6_out[s];
+  for (int32_t f : out.source_face) ++component_triangles[mesh.component()[faces[3 * size_t(f)]]];
+  std::vector<uint8_t> failing(num_components, 0);
   for (int32_t comp = 0; comp < num_components; ++comp)
-    if (component_chi[comp] != mesh.component_euler()[comp]) ++out.issues.bad_component;
-  if (out.issues.bad_component > 0 && out.issues.topological() == out.issues.bad_component) {
-    // No local check names a culprit: split the widest cluster of each failing component.
-    std::vector<int32_t> widest(num_components, -1);
-    for (int32_t v = 0; v < n; ++v) {
-      const int32_t comp = mesh.component()[v];
-      if (label[v] < 0 || component_chi[comp] == mesh.component_euler()[comp]) continue;
-      if (widest[comp] < 0 || c.dist[v] > c.dist[widest[comp]]) widest[comp] = v;
+    if (component_chi6[comp] != 6 * mesh.component_euler()[comp] || component_triangles[comp] == 0) {
+      failing[comp] = 1;
+      ++out.issues.bad_component;
     }
-    for (int32_t v : widest)
-      if (v >= 0) out.new_samples.push_back(v);
+  marks.merge_into(out.split_clusters);
+  if (out.issues.bad_component > 0 && out.issues.topological() == out.issues.bad_component) {
+    // Only the Euler characteristic names a problem: find the clusters that are not disks.
+    const auto chi6 = cluster_euler6(mesh, layout, k, c);
+    for (int32_t s = 0; s < k; ++s)
+      if (failing[mesh.component()[samples[s]]] && chi6[s] != 6 * int64_t(layout.sectors[samples[s]])) {
+        ++out.issues.non_disk;
+        out.split_clusters.push_back(s);
+      }
+    if (out.issues.non_disk == 0) {
+      // Nothing local to blame: split the widest cluster of each failing component.
+      std::vector<int32_t> widest(num_components, -1);
+      for (int32_t v = 0; v < n; ++v) {
+        const int32_t comp = mesh.component()[v];
+        if (label[v] < 0 || !failing[comp]) continue;
+        if (widest[comp] < 0 || c.dist[v] > c.dist[widest[comp]]) widest[comp] = v;
+      }
+      for (int32_t v : widest)
+        if (v >= 0) out.new_samples.push_back(v);
+    }
   }
 
-  // --- closed feature curves need three clusters to stay loops -----------------------------
+  // --- closed feature curves need three clusters to stay loops ---------------------------------
   for (int32_t curve = 0; curve < layout.num_curves(); ++curve) {
     if (!layout.curve_closed[curve]) continue;
     const int32_t b = layout.curve_offsets[curve], e = layout.curve_offsets[curve + 1];
@@ -304,16 +372,15 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     }
   }
 
-  // --- triangles of zero area (collinear samples) ------------------------------------------
+  // --- triangles of zero area (collinear samples) ------------------------------------------------
   if (check_slivers) {
+    const int32_t t = static_cast<int32_t>(out.source_face.size());
+    std::vector<int32_t> slivers;
     for (int32_t i = 0; i < t; ++i) {
       const double* p[3];
-      for (int j = 0; j < 3; ++j) p[j] = mesh.position(samples[out.triangles[3 * i + j]]);
+      for (int j = 0; j < 3; ++j) p[j] = mesh.position(samples[out.triangles[3 * size_t(i) + j]]);
       double u[3], w[3], longest = 0;
-      for (int a = 0; a < 3; ++a) {
-        u[a] = p[1][a] - p[0][a];
-        w[a] = p[2][a] - p[0][a];
-      }
+      for (int a = 0; a < 3; ++a) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
       for (int j = 0; j < 3; ++j) {
         const double* q0 = p[j];
         const double* q1 = p[(j + 1) % 3];
@@ -321,16 +388,16 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
                                         (q1[2] - q0[2]) * (q1[2] - q0[2]));
       }
       const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
-      const double area2 = std::sqrt(cx * cx + cy * cy + cz * cz);
-      if (area2 <= 1e-9 * longest) {
+      if (std::sqrt(cx * cx + cy * cy + cz * cz) <= 1e-9 * longest) {
         ++out.issues.sliver;
-        for (int j = 0; j < 3; ++j) mark(out.triangles[3 * i + j]);
+        for (int j = 0; j < 3; ++j) slivers.push_back(out.triangles[3 * size_t(i) + j]);
       }
     }
+    out.split_clusters.insert(out.split_clusters.end(), slivers.begin(), slivers.end());
   }
-
-  for (int32_t s = 0; s < k; ++s)
-    if (split[s]) out.split_clusters.push_back(s);
+  std::sort(out.split_clusters.begin(), out.split_clusters.end());
+  out.split_clusters.erase(std::unique(out.split_clusters.begin(), out.split_clusters.end()),
+                           out.split_clusters.end());
   return out;
 }
 

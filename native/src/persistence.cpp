@@ -32,7 +32,7 @@ struct Filtration {
 
 }  // namespace
 
-std::vector<PersistentCycle> handle_tunnel_cycles(const Surface& s, const TetMesh& t, Progress* progress) {
+std::vector<PersistentCycle> handle_tunnel_cycles(const ClosedSurface& s, const TetMesh& t, Progress* progress) {
   const int32_t num_points = t.num_points(), num_tets = t.num_tets(), num_faces = t.num_faces();
   const int32_t nv = s.num_vertices();
   if (t.num_surface_points != nv) throw std::logic_error("tetrahedralization does not match the surface");

@@ -16,7 +16,7 @@
 #include "topstoc/decimate.hpp"
 #include "topstoc/mesh.hpp"
 #include "topstoc/progress.hpp"
-#include "topstoc/surface.hpp"
+#include "topstoc/closed_surface.hpp"
 
 namespace topstoc {
 

@@ -19,6 +19,7 @@ namespace topstoc {
 
 struct FeatureLayout {
   std::vector<uint8_t> edge_feature;    ///< per edge: 1 if no cluster may cross it
+  std::vector<int32_t> feature_edges;   ///< ids of the feature edges
   std::vector<int32_t> feature_degree;  ///< per vertex: number of feature edges
   std::vector<int32_t> sectors;         ///< per vertex: fans once feature edges are cut
   std::vector<int32_t> sector_of_slot;  ///< per slot of mesh.vertex_faces(): sector of that face

@@ -14,19 +14,19 @@
 #include <cstdint>
 #include <vector>
 
-#include "topstoc/surface.hpp"
+#include "topstoc/closed_surface.hpp"
 
 namespace topstoc {
 
 /// A vector over Z2, packed in 64-bit words.
-struct Bits {
+struct Z2Vector {
   std::vector<uint64_t> words;
 
-  Bits() = default;
-  explicit Bits(int32_t size) : words((size + 63) / 64, 0) {}
+  Z2Vector() = default;
+  explicit Z2Vector(int32_t size) : words((size + 63) / 64, 0) {}
   bool get(int32_t i) const { return (words[i >> 6] >> (i & 63)) & 1; }
   void flip(int32_t i) { words[i >> 6] ^= uint64_t(1) << (i & 63); }
-  void add(const Bits& o) {
+  void add(const Z2Vector& o) {
     for (size_t k = 0; k < words.size(); ++k) words[k] ^= o.words[k];
   }
   bool zero() const {
@@ -36,7 +36,7 @@ struct Bits {
   }
   /// Highest set bit, or -1.
   int32_t top() const;
-  bool operator==(const Bits& o) const { return words == o.words; }
+  bool operator==(const Z2Vector& o) const { return words == o.words; }
 };
 
 /// Incrementally built basis of a subspace of Z2^n (Gaussian elimination on the highest bit).
@@ -45,20 +45,20 @@ class Z2Basis {
   explicit Z2Basis(int32_t size) : pivot_(size, -1), size_(size) {}
   int32_t rank() const { return int32_t(rows_.size()); }
   /// `x` reduced by the basis: zero exactly when x lies in the span.
-  Bits reduce(Bits x) const;
+  Z2Vector reduce(Z2Vector x) const;
   /// Same, also recording which basis rows were added (bit k = row k).
-  Bits reduce(Bits x, Bits& used) const;
-  bool contains(const Bits& x) const { return reduce(x).zero(); }
+  Z2Vector reduce(Z2Vector x, Z2Vector& used) const;
+  bool contains(const Z2Vector& x) const { return reduce(x).zero(); }
   /// Adds x when independent; returns whether it was.
-  bool insert(const Bits& x);
+  bool insert(const Z2Vector& x);
   /// Row k as inserted after reduction (its top bit is its pivot).
-  const Bits& row(int32_t k) const { return rows_[k]; }
+  const Z2Vector& row(int32_t k) const { return rows_[k]; }
   /// Rows inserted as given, before reduction: row_source(k) = the k-th inserted vector.
-  const Bits& source(int32_t k) const { return sources_[k]; }
+  const Z2Vector& source(int32_t k) const { return sources_[k]; }
 
  private:
-  std::vector<Bits> rows_, sources_;
-  std::vector<Bits> combos_;   // row k = sum of sources marked in combos_[k]
+  std::vector<Z2Vector> rows_, sources_;
+  std::vector<Z2Vector> combos_;   // row k = sum of sources marked in combos_[k]
   std::vector<int32_t> pivot_;  // bit -> row with that top bit
   int32_t size_;
 };
@@ -66,14 +66,14 @@ class Z2Basis {
 class SurfaceHomology {
  public:
   /// Builds the decomposition of a closed orientable surface (BFS tree from vertex 0).
-  explicit SurfaceHomology(const Surface& surface);
+  explicit SurfaceHomology(const ClosedSurface& surface);
 
   /// 2g.
   int32_t dimension() const { return int32_t(generators_.size()); }
   /// The 2g edges in neither tree: their fundamental cycles form a basis of H1.
   const std::vector<int32_t>& generator_edges() const { return generators_; }
   /// Adds edge e's coordinates to x (x has dimension() bits).
-  void add_edge(Bits& x, int32_t e) const { add_edge(x.words.data(), e); }
+  void add_edge(Z2Vector& x, int32_t e) const { add_edge(x.words.data(), e); }
   /// Same on raw words (dimension() bits).
   void add_edge(uint64_t* words, int32_t e) const {
     for (int32_t i = crossing_offsets_[e]; i < crossing_offsets_[e + 1]; ++i)
@@ -93,12 +93,12 @@ class SurfaceHomology {
   }
   /// Integer coordinates of a closed vertex loop: equal exactly when two loops are homologous
   /// over Z (with their orientations).
-  std::vector<int64_t> integer_class_of_loop(const Surface& surface, const std::vector<int32_t>& loop) const;
+  std::vector<int64_t> integer_class_of_loop(const ClosedSurface& surface, const std::vector<int32_t>& loop) const;
   /// Coordinates of a cycle given as edges (each once), or as a closed vertex sequence.
-  Bits class_of_edges(const std::vector<int32_t>& edges) const;
-  Bits class_of_loop(const Surface& surface, const std::vector<int32_t>& loop) const;
+  Z2Vector class_of_edges(const std::vector<int32_t>& edges) const;
+  Z2Vector class_of_loop(const ClosedSurface& surface, const std::vector<int32_t>& loop) const;
   /// True when `edges` is a cycle (every vertex of even degree).
-  static bool is_cycle(const Surface& surface, const std::vector<int32_t>& edges);
+  static bool is_cycle(const ClosedSurface& surface, const std::vector<int32_t>& edges);
 
  private:
   std::vector<int32_t> generators_;

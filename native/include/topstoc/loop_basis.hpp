@@ -21,7 +21,7 @@
 #include "topstoc/homology.hpp"
 #include "topstoc/persistence.hpp"
 #include "topstoc/progress.hpp"
-#include "topstoc/surface.hpp"
+#include "topstoc/closed_surface.hpp"
 
 namespace topstoc {
 
@@ -35,15 +35,15 @@ struct SelectedLoop {
 /// g handle loops then g tunnel loops. edge_weight: per surface edge (length or 1).
 /// max_roots: shortest-path trees to grow (0: automatic). Throws std::logic_error if no
 /// basis of simple loops is found (not seen in practice; reported rather than guessed).
-std::vector<SelectedLoop> select_loops(const Surface& surface, const SurfaceHomology& homology,
+std::vector<SelectedLoop> select_loops(const ClosedSurface& surface, const SurfaceHomology& homology,
                                        const std::vector<PersistentCycle>& cycles, const std::vector<double>& edge_weight,
                                        int32_t max_roots = 0, Progress* progress = nullptr);
 
 /// Splits a Z2 cycle (edges, each vertex of even degree) into edge-disjoint simple cycles,
 /// each a closed vertex sequence.
-std::vector<std::vector<int32_t>> simple_cycles(const Surface& surface, const std::vector<int32_t>& edges);
+std::vector<std::vector<int32_t>> simple_cycles(const ClosedSurface& surface, const std::vector<int32_t>& edges);
 
 /// Length of a closed vertex loop in the given edge weights.
-double loop_length(const Surface& surface, const std::vector<int32_t>& loop, const std::vector<double>& edge_weight);
+double loop_length(const ClosedSurface& surface, const std::vector<int32_t>& loop, const std::vector<double>& edge_weight);
 
 }  // namespace topstoc

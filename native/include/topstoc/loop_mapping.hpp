@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "topstoc/shortest_paths.hpp"
-#include "topstoc/surface.hpp"
+#include "topstoc/closed_surface.hpp"
 
 namespace topstoc {
 
@@ -23,7 +23,7 @@ class ClusterMap {
  public:
   /// cluster_of: per full-surface vertex, its coarse vertex (0 .. num_clusters-1);
   /// representative: per coarse vertex, the full-surface vertex it was made from.
-  ClusterMap(const Surface& full, const std::vector<double>& edge_weight, std::vector<int32_t> cluster_of,
+  ClusterMap(const ClosedSurface& full, const std::vector<double>& edge_weight, std::vector<int32_t> cluster_of,
              std::vector<int32_t> representative);
 
   /// The full-surface loop for a simple closed loop of coarse vertices. Throws
@@ -35,7 +35,7 @@ class ClusterMap {
   std::pair<int32_t, int32_t> crossing_edge(int32_t a, int32_t b) const;
 
  private:
-  const Surface& full_;
+  const ClosedSurface& full_;
   ShortestPaths paths_;
   std::vector<int32_t> cluster_of_, representative_;
   std::vector<int32_t> member_offsets_, members_;  // full vertices of each cluster, CSR

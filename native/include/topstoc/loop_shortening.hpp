@@ -24,7 +24,7 @@
 #include "topstoc/homology.hpp"
 #include "topstoc/progress.hpp"
 #include "topstoc/shortest_paths.hpp"
-#include "topstoc/surface.hpp"
+#include "topstoc/closed_surface.hpp"
 
 namespace topstoc {
 
@@ -39,7 +39,7 @@ class LoopTightener {
  public:
   /// edge_weight: per surface edge (length, or 1 to count edges). Band moves need `homology`
   /// (without it only local moves are made).
-  LoopTightener(const Surface& surface, const std::vector<double>& edge_weight,
+  LoopTightener(const ClosedSurface& surface, const std::vector<double>& edge_weight,
                 const SurfaceHomology* homology = nullptr);
 
   /// Returns the tightened loop (never longer; the input when nothing shortens it).
@@ -51,7 +51,7 @@ class LoopTightener {
   void grow_disk(const std::vector<int32_t>& around, int32_t seed_face, int32_t rings, int32_t max_region);
   uint64_t edge_hash(int32_t e, bool forward) const;
 
-  const Surface& surface_;
+  const ClosedSurface& surface_;
   const std::vector<double>& weight_;
   const SurfaceHomology* homology_;
   std::vector<uint64_t> coefficient_;  // random weights of the homology coordinates (class hashes)

@@ -1,20 +1,22 @@
-// Emission of the decimated triangles from a clustering, and the check that the clustering
-// yields a mesh homeomorphic to the input (closed ball property, Edelsbrunner & Shah 1997).
+// Emission of the decimated triangles from a clustering, and the checks that the result is
+// homeomorphic to the input.
 //
-// Work happens on the mesh cut along the feature edges, where each side of a border is a
-// surface with boundary of its own. The clustering passes when
-//   - every vertex is reached;
-//   - every cluster is one closed disk per side it touches: six times its Euler characteristic
-//     (sum of per-vertex constants, corrected along cluster borders) equals six times the
-//     number of sectors at its sample;
-//   - every two clusters meet in one arc per side: the decimated edge between them has exactly
-//     the triangles expected (two inside a surface, one per side along a feature curve);
-//   - every three clusters meet at most once: no duplicate triangle (a triangle emitted twice
-//     with opposite orientations is dropped instead, see partition.cpp);
-//   - the triangles around every manifold sample form a single fan;
+// Each input face whose corners lie in three clusters emits the triangle of those clusters'
+// samples. The result is accepted when, per component of the input,
+//   - every vertex is reached by some sample;
+//   - the triangles around every manifold sample form one consistently oriented fan;
+//   - every decimated edge has the triangles expected: two inside a surface, one per side
+//     along a feature curve (boundary: one, border between two regions: two, ...);
+//   - no triangle appears twice (a triangle emitted twice with opposite orientations, around a
+//     cluster that has no other triangle, is dropped instead: see partition.cpp);
 //   - every closed feature curve is split among at least three clusters;
-//   - every component keeps its Euler characteristic (the final safety net).
-// Each failure names the clusters to split; the decimation adds samples there and re-floods.
+//   - the Euler characteristic is unchanged.
+// A manifold, consistently oriented result with the same Euler characteristic and the same
+// boundary loops as the input component is homeomorphic to it (classification of surfaces),
+// so these output checks are the guarantee. When only the Euler characteristic fails, the
+// clusters that are not disks (closed ball property, Edelsbrunner & Shah 1997) are located on
+// the mesh cut along the features and split. Each failure names the clusters to split; the
+// decimation adds samples there and re-floods.
 #pragma once
 
 #include <cstdint>
@@ -27,17 +29,17 @@
 namespace topstoc {
 
 struct PartitionIssues {
-  int32_t unreached = 0;   ///< vertices no sample reaches
-  int32_t non_disk = 0;    ///< clusters that are not one disk per side
-  int32_t bad_edge = 0;    ///< cluster pairs meeting in more or fewer arcs than expected
-  int32_t duplicate = 0;   ///< decimated triangles emitted twice
-  int32_t bad_link = 0;    ///< samples whose triangles do not form one fan
-  int32_t short_loop = 0;  ///< closed feature curves with fewer than three clusters
-  int32_t isolated = 0;    ///< required samples (corners, control points) without a triangle
-  int32_t sliver = 0;      ///< decimated triangles of (numerically) zero area
+  int32_t unreached = 0;      ///< vertices no sample reaches
+  int32_t non_disk = 0;       ///< clusters that are not one disk per side (diagnosis only)
+  int32_t bad_edge = 0;       ///< cluster pairs with more or fewer triangles than expected
+  int32_t duplicate = 0;      ///< decimated triangles emitted twice
+  int32_t bad_link = 0;       ///< samples whose triangles do not form one oriented fan
+  int32_t short_loop = 0;     ///< closed feature curves with fewer than three clusters
+  int32_t isolated = 0;       ///< required samples (corners, control points) without a triangle
   int32_t bad_component = 0;  ///< components whose Euler characteristic changed
-  int32_t pillows = 0;     ///< opposite triangle pairs dropped (not an issue: see partition.cpp)
-  int32_t absorbed = 0;    ///< samples left without triangles, absorbed by a neighbour (not an issue)
+  int32_t sliver = 0;         ///< decimated triangles of (numerically) zero area
+  int32_t pillows = 0;        ///< opposite triangle pairs dropped (not an issue)
+  int32_t absorbed = 0;       ///< samples left without triangles, absorbed by a neighbour (not an issue)
   int32_t topological() const {
     return unreached + non_disk + bad_edge + duplicate + bad_link + short_loop + isolated + bad_component;
   }
@@ -52,13 +54,19 @@ struct Partition {
   std::vector<uint8_t> absorbed;        ///< per rank: 1 if the sample has no triangle (not in the output)
 };
 
-/// Emits triangles and checks the partition. `required` marks vertices whose samples must
-/// appear in the output (corners, control points); other samples left without a triangle are
-/// absorbed by their neighbours. candidate_faces, if given, lists (in increasing order) a
-/// superset of the faces whose corners lie in more than one cluster (the fast path);
-/// otherwise every face is scanned.
+/// Emits triangles and checks them. `required` marks vertices whose samples must appear in the
+/// output (control points); corners are always required. Other samples left without a
+/// triangle are absorbed by their neighbours. candidate_faces, if given, lists (in increasing
+/// order) a superset of the faces whose corners lie in three clusters (the fast path, thesis
+/// 4.1.1); otherwise every face is scanned.
 Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
                           const Clustering& clustering, const std::vector<uint8_t>& required, bool check_slivers,
                           const std::vector<int32_t>* candidate_faces = nullptr);
+
+/// Six times the Euler characteristic of every cluster on the mesh cut along the feature
+/// edges (one pass over all faces). A cluster is one disk per side exactly when the value is
+/// six times the number of sectors at its sample.
+std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layout, int32_t num_samples,
+                                    const Clustering& clustering);
 
 }  // namespace topstoc

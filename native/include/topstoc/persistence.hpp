@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "topstoc/progress.hpp"
-#include "topstoc/surface.hpp"
+#include "topstoc/closed_surface.hpp"
 #include "topstoc/tetrahedralize.hpp"
 
 namespace topstoc {
@@ -27,6 +27,6 @@ struct PersistentCycle {
 
 /// Pairs the filtration surface < inside < outside of `tets` (made from `surface`) and returns
 /// its 2g cycles, handles first. Throws std::logic_error if the counts are not g and g.
-std::vector<PersistentCycle> handle_tunnel_cycles(const Surface& surface, const TetMesh& tets, Progress* progress = nullptr);
+std::vector<PersistentCycle> handle_tunnel_cycles(const ClosedSurface& surface, const TetMesh& tets, Progress* progress = nullptr);
 
 }  // namespace topstoc

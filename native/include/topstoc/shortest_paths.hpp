@@ -1,4 +1,4 @@
-// Dijkstra on the edge graph of a Surface, restricted to an allowed set of vertices, with
+// Dijkstra on the edge graph of a ClosedSurface, restricted to an allowed set of vertices, with
 // scratch arrays that are reset lazily (a run costs what it visits, not the surface's size).
 // Used to pick, map and tighten loops.
 #pragma once
@@ -8,14 +8,14 @@
 #include <queue>
 #include <vector>
 
-#include "topstoc/surface.hpp"
+#include "topstoc/closed_surface.hpp"
 
 namespace topstoc {
 
 class ShortestPaths {
  public:
   /// edge_weight: one non-negative weight per surface edge (length, or 1 to count edges).
-  ShortestPaths(const Surface& surface, const std::vector<double>& edge_weight)
+  ShortestPaths(const ClosedSurface& surface, const std::vector<double>& edge_weight)
       : surface_(surface), weight_(edge_weight), stamp_(surface.num_vertices(), 0), distance_(surface.num_vertices()),
         parent_edge_(surface.num_vertices()), settled_flag_(surface.num_vertices(), 0) {}
 
@@ -91,7 +91,7 @@ class ShortestPaths {
     }
   }
 
-  const Surface& surface_;
+  const ClosedSurface& surface_;
   const std::vector<double>& weight_;
   uint32_t run_ = 0;
   std::vector<uint32_t> stamp_;

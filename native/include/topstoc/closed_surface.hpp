@@ -15,7 +15,7 @@
 
 namespace topstoc {
 
-struct Surface {
+struct ClosedSurface {
   std::vector<double> positions;          ///< 3 per local vertex
   std::vector<int32_t> triangles;         ///< 3 local vertex ids per face, as oriented in the mesh
   std::vector<int32_t> edge_vertices;     ///< 2 local vertex ids per edge, lower first
@@ -64,6 +64,6 @@ std::vector<std::vector<int32_t>> component_vertices(const Mesh& mesh);
 std::vector<SurfaceCheck> check_closed_surfaces(const Mesh& mesh, const std::vector<std::vector<int32_t>>& components);
 
 /// Extracts the component made of `vertices` (internal ids; it must pass the check).
-Surface extract_surface(const Mesh& mesh, const std::vector<int32_t>& vertices);
+ClosedSurface extract_surface(const Mesh& mesh, const std::vector<int32_t>& vertices);
 
 }  // namespace topstoc

@@ -1,4 +1,4 @@
-#include "topstoc/surface.hpp"
+#include "topstoc/closed_surface.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,13 +7,13 @@
 
 namespace topstoc {
 
-double Surface::edge_length(int32_t e) const {
+double ClosedSurface::edge_length(int32_t e) const {
   const double* a = position(edge_vertices[2 * size_t(e)]);
   const double* b = position(edge_vertices[2 * size_t(e) + 1]);
   return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
 }
 
-int32_t Surface::find_edge(int32_t a, int32_t b) const {
+int32_t ClosedSurface::find_edge(int32_t a, int32_t b) const {
   for (int32_t i = adjacency_offsets[a]; i < adjacency_offsets[a + 1]; ++i)
     if (adjacency[i] == b) return adjacency_edge[i];
   return -1;
@@ -172,8 +172,8 @@ std::vector<SurfaceCheck> check_closed_surfaces(const Mesh& mesh, const std::vec
   return checks;
 }
 
-Surface extract_surface(const Mesh& mesh, const std::vector<int32_t>& vertices) {
-  Surface s;
+ClosedSurface extract_surface(const Mesh& mesh, const std::vector<int32_t>& vertices) {
+  ClosedSurface s;
   const int32_t n = int32_t(vertices.size());
   s.mesh_vertex = vertices;
   const LocalIds local(vertices, mesh.num_vertices());
