@@ -75,86 +75,95 @@ std::vector<PersistentCycle> handle_tunnel_cycles(const ClosedSurface& s, const 
       }
   }
 
-  // Filtration order: surface, inside, outside; by dimension within each part.
-  Filtration fl;
-  fl.point_column.assign(num_points, -1);
-  fl.edge_column.assign(num_edges, -1);
-  fl.face_column.assign(num_faces, -1);
-  fl.tet_column.assign(num_tets, -1);
-  for (int32_t v = 0; v < nv; ++v) fl.point_column[v] = fl.columns++;
-  fl.surface_edges_begin = fl.columns;
-  for (int32_t e = 0; e < s.num_edges(); ++e)
-    fl.edge_column[edge_id(s.edge_vertices[2 * size_t(e)], s.edge_vertices[2 * size_t(e) + 1])] = fl.columns++;
-  fl.surface_edges_end = fl.columns;
-  for (int32_t f : t.surface_face) fl.face_column[f] = fl.columns++;
+  std::vector<int32_t> edge_of_column;
+  std::vector<PersistentCycle> cycles;
+  std::vector<phat::index> column;
+  // Two filtrations: the surface then the inside (its dying cycles bound inside: handles), and
+  // the surface then the outside (tunnels). A single filtration surface < inside < outside
+  // would pair the right generator edges, but a tunnel cycle could then bound a chain that
+  // also uses inside triangles, i.e. carry a handle component.
   for (uint8_t part : {kInside, kOutside}) {
-    for (int32_t p = 0; p < num_points; ++p)
-      if (point_part[p] == part) fl.point_column[p] = fl.columns++;
+    if (progress) progress->update(part == kInside ? 0.0 : 0.5);
+    // Filtration order: the surface, then the part, by dimension.
+    Filtration fl;
+    fl.point_column.assign(num_points, -1);
+    fl.edge_column.assign(num_edges, -1);
+    fl.face_column.assign(num_faces, -1);
+    fl.tet_column.assign(num_tets, -1);
+    for (int32_t v = 0; v < nv; ++v) fl.point_column[v] = fl.columns++;
+    fl.surface_edges_begin = fl.columns;
+    for (int32_t e = 0; e < s.num_edges(); ++e)
+      fl.edge_column[edge_id(s.edge_vertices[2 * size_t(e)], s.edge_vertices[2 * size_t(e) + 1])] = fl.columns++;
+    fl.surface_edges_end = fl.columns;
+    for (int32_t f : t.surface_face) fl.face_column[f] = fl.columns++;
+    for (int32_t q = 0; q < num_points; ++q)
+      if (point_part[q] == part) fl.point_column[q] = fl.columns++;
     for (int32_t e = 0; e < num_edges; ++e)
       if (edge_part[e] == part) fl.edge_column[e] = fl.columns++;
     for (int32_t f = 0; f < num_faces; ++f)
       if (face_part[f] == part) fl.face_column[f] = fl.columns++;
     for (int32_t k = 0; k < num_tets; ++k)
       if ((t.inside[k] ? kInside : kOutside) == part) fl.tet_column[k] = fl.columns++;
-  }
-  for (int32_t p = 0; p < num_points; ++p)
-    if (fl.point_column[p] < 0) throw std::logic_error("a tetrahedralization point is in no tetrahedron");
 
-  // Boundary matrix: only triangles and tetrahedra matter for which surface cycles die, so
-  // vertex and edge columns stay empty (edges are never reduced).
-  phat::boundary_matrix<phat::bit_tree_pivot_column> matrix;
-  matrix.set_num_cols(fl.columns);
-  std::vector<int8_t> dim(fl.columns, 0);
-  std::vector<int64_t> column_face(fl.columns, -1), column_tet(fl.columns, -1);
-  for (int32_t e = 0; e < num_edges; ++e) dim[fl.edge_column[e]] = 1;
-  for (int32_t f = 0; f < num_faces; ++f) {
-    dim[fl.face_column[f]] = 2;
-    column_face[fl.face_column[f]] = f;
-  }
-  for (int32_t k = 0; k < num_tets; ++k) {
-    dim[fl.tet_column[k]] = 3;
-    column_tet[fl.tet_column[k]] = k;
-  }
-  std::vector<phat::index> column;
-  for (int64_t c = 0; c < fl.columns; ++c) {
-    matrix.set_dim(c, dim[c]);
-    column.clear();
-    if (dim[c] == 2) {
-      const int32_t* v = &t.faces[3 * size_t(column_face[c])];
-      column = {fl.edge_column[edge_id(v[0], v[1])], fl.edge_column[edge_id(v[0], v[2])], fl.edge_column[edge_id(v[1], v[2])]};
-    } else if (dim[c] == 3) {
-      for (int i = 0; i < 4; ++i) column.push_back(fl.face_column[t.tet_faces[4 * size_t(column_tet[c]) + i]]);
-    }
-    std::sort(column.begin(), column.end());
-    if (!column.empty()) matrix.set_col(c, column);
-  }
-
-  // Twist reduction (Chen & Kerber 2011) of the tetrahedra, then the triangles: a column
-  // whose pivot is taken gets cleared, as it is positive.
-  std::vector<int64_t> owner_of_low(fl.columns, -1);
-  for (int8_t d : {int8_t(3), int8_t(2)}) {
+    // Boundary matrix: only triangles and tetrahedra matter for which surface cycles die, so
+    // vertex and edge columns stay empty (edges are never reduced).
+    phat::boundary_matrix<phat::bit_tree_pivot_column> matrix;
+    matrix.set_num_cols(fl.columns);
+    std::vector<int8_t> dim(fl.columns, 0);
+    std::vector<int64_t> column_face(fl.columns, -1), column_tet(fl.columns, -1);
+    for (int32_t e = 0; e < num_edges; ++e)
+      if (fl.edge_column[e] >= 0) dim[fl.edge_column[e]] = 1;
+    for (int32_t f = 0; f < num_faces; ++f)
+      if (fl.face_column[f] >= 0) {
+        dim[fl.face_column[f]] = 2;
+        column_face[fl.face_column[f]] = f;
+      }
+    for (int32_t k = 0; k < num_tets; ++k)
+      if (fl.tet_column[k] >= 0) {
+        dim[fl.tet_column[k]] = 3;
+        column_tet[fl.tet_column[k]] = k;
+      }
     for (int64_t c = 0; c < fl.columns; ++c) {
-      if (dim[c] != d) continue;
-      if (progress && (c & 1023) == 0) progress->update((d == 3 ? 0.0 : 0.5) + 0.5 * double(c) / double(fl.columns));
-      phat::index low = matrix.get_max_index(c);
-      while (low != -1 && owner_of_low[low] != -1) {
-        matrix.add_to(owner_of_low[low], c);
-        low = matrix.get_max_index(c);
+      matrix.set_dim(c, dim[c]);
+      column.clear();
+      if (dim[c] == 2) {
+        const int32_t* v = &t.faces[3 * size_t(column_face[c])];
+        column = {fl.edge_column[edge_id(v[0], v[1])], fl.edge_column[edge_id(v[0], v[2])],
+                  fl.edge_column[edge_id(v[1], v[2])]};
+      } else if (dim[c] == 3) {
+        for (int i = 0; i < 4; ++i) column.push_back(fl.face_column[t.tet_faces[4 * size_t(column_tet[c]) + i]]);
       }
-      if (low != -1) {
-        owner_of_low[low] = c;
-        matrix.clear(low);
-      }
-      matrix.finalize(c);
+      for (phat::index row : column)
+        if (row < 0) throw std::logic_error("a simplex's face is missing from the filtration");
+      std::sort(column.begin(), column.end());
+      if (!column.empty()) matrix.set_col(c, column);
     }
-  }
 
-  // Triangles of the inside or outside whose pivot is a surface edge kill a surface cycle.
-  std::vector<int32_t> edge_of_column(fl.surface_edges_end - fl.surface_edges_begin);
-  for (int32_t e = 0; e < num_edges; ++e)
-    if (surface_edge_of[e] >= 0) edge_of_column[fl.edge_column[e] - fl.surface_edges_begin] = surface_edge_of[e];
-  std::vector<PersistentCycle> cycles;
-  for (uint8_t part : {kInside, kOutside})
+    // Twist reduction (Chen & Kerber 2011) of the tetrahedra, then the triangles: a column
+    // whose pivot is taken gets cleared, as it is positive.
+    std::vector<int64_t> owner_of_low(fl.columns, -1);
+    for (int8_t d : {int8_t(3), int8_t(2)}) {
+      for (int64_t c = 0; c < fl.columns; ++c) {
+        if (dim[c] != d) continue;
+        if (progress && (c & 1023) == 0)
+          progress->update((part == kInside ? 0.0 : 0.5) + (d == 3 ? 0.0 : 0.25) + 0.25 * double(c) / double(fl.columns));
+        phat::index low = matrix.get_max_index(c);
+        while (low != -1 && owner_of_low[low] != -1) {
+          matrix.add_to(owner_of_low[low], c);
+          low = matrix.get_max_index(c);
+        }
+        if (low != -1) {
+          owner_of_low[low] = c;
+          matrix.clear(low);
+        }
+        matrix.finalize(c);
+      }
+    }
+
+    // Triangles of the part whose pivot is a surface edge kill a surface cycle.
+    edge_of_column.assign(fl.surface_edges_end - fl.surface_edges_begin, -1);
+    for (int32_t e = 0; e < num_edges; ++e)
+      if (surface_edge_of[e] >= 0) edge_of_column[fl.edge_column[e] - fl.surface_edges_begin] = surface_edge_of[e];
     for (int64_t c = 0; c < fl.columns; ++c) {
       if (dim[c] != 2 || face_part[column_face[c]] != part) continue;
       const phat::index low = matrix.get_max_index(c);
@@ -162,6 +171,7 @@ std::vector<PersistentCycle> handle_tunnel_cycles(const ClosedSurface& s, const 
       PersistentCycle cycle;
       cycle.handle = part == kInside;
       cycle.generator_edge = edge_of_column[low - fl.surface_edges_begin];
+      column.clear();  // PHAT appends the pivot column to what `column` holds
       matrix.get_col(c, column);
       for (phat::index row : column) {
         if (row < fl.surface_edges_begin || row >= fl.surface_edges_end)
@@ -170,6 +180,7 @@ std::vector<PersistentCycle> handle_tunnel_cycles(const ClosedSurface& s, const 
       }
       cycles.push_back(std::move(cycle));
     }
+  }
   const int32_t g = s.genus();
   int32_t handles = 0;
   for (const auto& c : cycles) handles += c.handle;

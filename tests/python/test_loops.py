@@ -162,8 +162,9 @@ def test_synthetic_slabs(genus):
     assert sorted(round(loop.length, 6) for loop in component.handles) == [8.0] * genus
 
 
-def test_torus_loops_are_meridian_and_inner_equator():
-    nu, nv, major, minor = 48, 24, 1.0, 0.3
+@pytest.mark.parametrize("nu,nv,major,minor", [(48, 24, 1.0, 0.3), (24, 12, 1.0, 0.35), (12, 6, 1.0, 0.35),
+                                                 (40, 8, 1.0, 0.4), (16, 16, 1.0, 0.6)])
+def test_torus_loops_are_meridian_and_inner_equator(nu, nv, major, minor):
     vertices, triangles = meshgen.torus(nu, nv, major, minor)
     (component,) = topstoc.handle_tunnel_loops(vertices, triangles).components
     check_component(vertices, triangles, component)
