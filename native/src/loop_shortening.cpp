@@ -1,6 +1,9 @@
 #include "topstoc/loop_shortening.hpp"
 
 #include <algorithm>
+#include <queue>
+#include <tuple>
+#include <cstdlib>
 
 namespace topstoc {
 
@@ -16,6 +19,7 @@ LoopTightener::LoopTightener(const ClosedSurface& s, const std::vector<double>& 
       vertex_faces_(s.num_vertices(), 0),
       edge_faces_(s.num_edges(), 0),
       ring_(s.num_vertices(), 0),
+      source_(s.num_vertices(), 0),
       on_loop_(s.num_vertices(), -1) {
   if (homology_) {
     // Class hashes: a fixed random linear form of the integer homology coordinates.
@@ -39,18 +43,23 @@ uint64_t LoopTightener::edge_hash(int32_t e, bool forward) const {
   return h;
 }
 
-void LoopTightener::grow_disk(const std::vector<int32_t>& around, int32_t seed, int32_t rings, int32_t max_region) {
+void LoopTightener::grow_disk(const std::vector<int32_t>& around, int32_t seed, int32_t rings, int32_t max_region,
+                              bool along) {
   const ClosedSurface& s = surface_;
   ++stamp_;
   disk_vertices_.clear();
-  // Vertices within `rings` hops of `around` may carry disk faces.
+  // Vertices within `rings` hops of `around` may carry disk faces; each remembers which vertex
+  // of `around` it is closest to.
   queue_.clear();
-  for (int32_t v : around)
+  for (size_t i = 0; i < around.size(); ++i) {
+    const int32_t v = around[i];
     if (ring_stamp_[v] != stamp_) {
       ring_stamp_[v] = stamp_;
       ring_[v] = 0;
+      source_[v] = int32_t(i);
       queue_.push_back(v);
     }
+  }
   for (size_t head = 0; head < queue_.size(); ++head) {
     const int32_t v = queue_[head];
     if (ring_[v] == rings) continue;
@@ -59,6 +68,7 @@ void LoopTightener::grow_disk(const std::vector<int32_t>& around, int32_t seed, 
       if (ring_stamp_[u] == stamp_) continue;
       ring_stamp_[u] = stamp_;
       ring_[u] = ring_[v] + 1;
+      source_[u] = source_[v];
       queue_.push_back(u);
     }
   }
@@ -99,20 +109,47 @@ void LoopTightener::grow_disk(const std::vector<int32_t>& around, int32_t seed, 
       bump(edge_stamp_, edge_faces_, s.face_edges[3 * size_t(f) + c]);
     }
   };
+  auto across = [&](int32_t f, int c) {
+    const int32_t e = s.face_edges[3 * size_t(f) + c];
+    return s.edge_faces[2 * size_t(e)] == f ? s.edge_faces[2 * size_t(e) + 1] : s.edge_faces[2 * size_t(e)];
+  };
   join(seed);
   int32_t size = 1;
-  queue_.assign(1, seed);
-  for (size_t head = 0; head < queue_.size() && size < max_region; ++head) {
-    const int32_t f = queue_[head];
-    for (int c = 0; c < 3; ++c) {
-      const int32_t e = s.face_edges[3 * size_t(f) + c];
-      const int32_t g = s.edge_faces[2 * size_t(e)] == f ? s.edge_faces[2 * size_t(e) + 1] : s.edge_faces[2 * size_t(e)];
-      if (can_join(g)) {
-        join(g);
-        ++size;
-        queue_.push_back(g);
+  if (!along) {  // breadth first from the seed
+    queue_.assign(1, seed);
+    for (size_t head = 0; head < queue_.size() && size < max_region; ++head)
+      for (int c = 0; c < 3; ++c) {
+        const int32_t g = across(queue_[head], c);
+        if (can_join(g)) {
+          join(g);
+          ++size;
+          queue_.push_back(g);
+        }
       }
+    return;
+  }
+  // Along `around` in its order: the disk follows the loop and meets itself only where the
+  // loop closes, so the cut it leaves there crosses the band once.
+  using Key = std::tuple<int32_t, int32_t, int32_t>;  // (farthest source along the loop, ring, face)
+  std::priority_queue<Key, std::vector<Key>, std::greater<Key>> heap;
+  auto push_neighbours = [&](int32_t f) {
+    for (int c = 0; c < 3; ++c) {
+      const int32_t g = across(f, c);
+      if (face_stamp_[g] == stamp_) continue;
+      const int32_t* t = &s.triangles[3 * size_t(g)];
+      if (ring_stamp_[t[0]] != stamp_ || ring_stamp_[t[1]] != stamp_ || ring_stamp_[t[2]] != stamp_) continue;
+      heap.emplace(std::max({source_[t[0]], source_[t[1]], source_[t[2]]}),
+                   std::max({ring_[t[0]], ring_[t[1]], ring_[t[2]]}), g);
     }
+  };
+  push_neighbours(seed);
+  while (!heap.empty() && size < max_region) {
+    const int32_t g = std::get<2>(heap.top());
+    heap.pop();
+    if (!can_join(g)) continue;  // pushed again if a neighbour joins later
+    join(g);
+    ++size;
+    push_neighbours(g);
   }
 }
 
@@ -124,7 +161,7 @@ bool LoopTightener::improve_window(std::vector<int32_t>& loop, size_t start, int
   for (int32_t i = 0; i <= w; ++i) window[i] = loop[(start + i) % n];
   for (int32_t i = 0; i < w; ++i) old_length += weight_[s.find_edge(window[i], window[i + 1])];
   // A shorter path between the ends stays within half the window's length of it.
-  grow_disk(window, s.edge_faces[2 * size_t(s.find_edge(window[0], window[1]))], w / 2 + 2, params.max_region);
+  grow_disk(window, s.edge_faces[2 * size_t(s.find_edge(window[0], window[1]))], w / 2 + 2, params.max_region, false);
   auto in_disk = [&](int32_t v) { return vertex_stamp_[v] == stamp_ && vertex_faces_[v] > 0; };
   auto edge_in_disk = [&](int32_t e) { return edge_stamp_[e] == stamp_ && edge_faces_[e] > 0; };
   for (int32_t i = 0; i < w; ++i)
@@ -156,7 +193,7 @@ bool LoopTightener::improve_band(std::vector<int32_t>& loop, int32_t rings, cons
     old_length += weight_[e];
     loop_hash += edge_hash(e, s.edge_vertices[2 * size_t(e)] == loop[i]);
   }
-  grow_disk(loop, s.edge_faces[2 * size_t(s.find_edge(loop[0], loop[1]))], rings, 4 * params.max_region);
+  grow_disk(loop, s.edge_faces[2 * size_t(s.find_edge(loop[0], loop[1]))], rings, 4 * params.max_region, true);
   auto in_disk = [&](int32_t v) { return vertex_stamp_[v] == stamp_ && vertex_faces_[v] > 0; };
   auto edge_in_disk = [&](int32_t e) { return edge_stamp_[e] == stamp_ && edge_faces_[e] > 0; };
   // Class hash of the tree path from the root to every disk vertex. In a disk every path between

@@ -48,7 +48,7 @@ class LoopTightener {
  private:
   bool improve_window(std::vector<int32_t>& loop, size_t start, int32_t window, const TightenParams& params);
   bool improve_band(std::vector<int32_t>& loop, int32_t rings, const TightenParams& params);
-  void grow_disk(const std::vector<int32_t>& around, int32_t seed_face, int32_t rings, int32_t max_region);
+  void grow_disk(const std::vector<int32_t>& around, int32_t seed_face, int32_t rings, int32_t max_region, bool along);
   uint64_t edge_hash(int32_t e, bool forward) const;
 
   const ClosedSurface& surface_;
@@ -59,6 +59,7 @@ class LoopTightener {
   uint32_t stamp_ = 0;
   std::vector<uint32_t> vertex_stamp_, face_stamp_, edge_stamp_, ring_stamp_;
   std::vector<int32_t> vertex_faces_, edge_faces_, ring_;  // faces of the disk at each vertex / edge; hop distance
+  std::vector<int32_t> source_;   // index of the nearest vertex of `around`
   std::vector<int32_t> on_loop_;  // position on the loop, or -1
   std::vector<int32_t> queue_, disk_vertices_;
   std::vector<uint64_t> hash_;    // class hash of the disk tree path to each vertex
