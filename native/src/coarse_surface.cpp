@@ -23,20 +23,21 @@ void describe(const Mesh& mesh, CoarseMesh& coarse) {
   }
 }
 
-// Coarse vertices (output ids) of the triangles that intersect within a wanted component.
-std::vector<int32_t> intersecting_vertices(const CoarseMesh& coarse, const std::vector<uint8_t>& wanted, int32_t& pairs) {
-  const auto& d = coarse.decimation;
+// Coarse vertices (output ids) of the triangles that intersect within a wanted component. A
+// coarse vertex belongs to the component of the input vertex it was made from, so this needs
+// no prepared coarse mesh.
+std::vector<int32_t> intersecting_vertices(const Mesh& mesh, const DecimateResult& d, const std::vector<uint8_t>& wanted,
+                                           int32_t& pairs) {
   const int32_t num_triangles = int32_t(d.triangles.size() / 3);
   const int32_t num_vertices = int32_t(d.positions.size() / 3);
-  const Mesh& cm = *coarse.mesh;
   auto component_of_triangle = [&](int32_t t) {
-    return cm.component()[cm.vertex_index()[d.triangles[3 * size_t(t)]]];
+    return mesh.component()[mesh.vertex_index()[d.kept[d.triangles[3 * size_t(t)]]]];
   };
   std::vector<uint8_t> flagged(num_vertices, 0);
   pairs = 0;
   for (const auto& [s, t] : self_intersections(d.positions.data(), num_vertices, d.triangles.data(), num_triangles)) {
     const int32_t c = component_of_triangle(s);
-    if (c != component_of_triangle(t) || !wanted[coarse.fine_component[c]]) continue;
+    if (c != component_of_triangle(t) || !wanted[c]) continue;
     ++pairs;
     for (int32_t k = 0; k < 3; ++k) {
       flagged[d.triangles[3 * size_t(s) + k]] = 1;
@@ -59,44 +60,53 @@ std::unique_ptr<CoarseMesh> make_coarse_mesh(const Mesh& mesh, int32_t target, u
   params.target_vertices = target;
   params.sampling.seed = seed;
   coarse->decimation = decimate(mesh, *layout, params);
-  describe(mesh, *coarse);
   const auto& source = mesh.vertex_source();
   for (;;) {
-    const auto flagged = intersecting_vertices(*coarse, wanted, coarse->intersecting);
+    const auto flagged = intersecting_vertices(mesh, coarse->decimation, wanted, coarse->intersecting);
     if (flagged.empty() || coarse->rounds >= max_rounds) break;
     if (progress) progress->update(double(coarse->rounds + 1) / double(max_rounds + 1));
-    // Split each flagged cluster at the member farthest from its sample.
+    // Split each flagged cluster in three: add the member farthest from its sample, then the
+    // member farthest from both (one new sample per cluster leaves a long tail of rounds).
     const auto& d = coarse->decimation;
     std::vector<int32_t> slot(d.kept.size(), -1);
     for (size_t i = 0; i < flagged.size(); ++i) slot[flagged[i]] = int32_t(i);
-    std::vector<int32_t> farthest(flagged.size(), -1);
-    std::vector<double> reach(flagged.size(), -1.0);
     std::vector<uint8_t> is_sample(mesh.num_vertices(), 0);  // by caller id
     for (int32_t s : d.samples) is_sample[s] = 1;
-    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-      const int32_t caller = source[v];
-      const int32_t c = d.labels[caller];
-      if (c < 0 || slot[c] < 0 || is_sample[caller]) continue;
-      const double* p = mesh.position(v);
-      const double* q = mesh.position(mesh.vertex_index()[d.kept[c]]);
-      const double r = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
-      if (r > reach[slot[c]]) {
-        reach[slot[c]] = r;
-        farthest[slot[c]] = caller;
+    auto squared = [](const double* p, const double* q) {
+      return (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
+    };
+    std::vector<int32_t> first(flagged.size(), -1), second(flagged.size(), -1);
+    for (std::vector<int32_t>* pick : {&first, &second}) {
+      std::vector<double> reach(flagged.size(), 0.0);
+      for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+        const int32_t caller = source[v];
+        const int32_t c = d.labels[caller];
+        if (c < 0 || slot[c] < 0 || is_sample[caller]) continue;
+        const int32_t i = slot[c];
+        double r = squared(mesh.position(v), mesh.position(mesh.vertex_index()[d.kept[c]]));
+        if (pick == &second) {
+          if (first[i] < 0 || caller == first[i]) continue;
+          r = std::min(r, squared(mesh.position(v), mesh.position(mesh.vertex_index()[first[i]])));
+        }
+        if (r > reach[i]) {
+          reach[i] = r;
+          (*pick)[i] = caller;
+        }
       }
     }
     std::vector<int32_t> samples = d.samples;
     const size_t before = samples.size();
     for (size_t i = 0; i < flagged.size(); ++i)
-      if (reach[i] > 0) samples.push_back(farthest[i]);
+      for (int32_t v : {first[i], second[i]})
+        if (v >= 0) samples.push_back(v);
     std::sort(samples.begin() + before, samples.end());
     samples.erase(std::unique(samples.begin() + before, samples.end()), samples.end());
     coarse->samples_added += int32_t(samples.size() - before);
     if (samples.size() == before) break;
     coarse->decimation = decimate_with_samples(mesh, *layout, std::move(samples), Placement::Subsample);
-    describe(mesh, *coarse);
     ++coarse->rounds;
   }
+  describe(mesh, *coarse);
   return coarse;
 }
 

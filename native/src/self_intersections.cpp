@@ -182,7 +182,8 @@ std::vector<std::pair<int32_t, int32_t>> self_intersections(const double* positi
       pairs.emplace_back(t, t);
   }
   const int64_t cells = int64_t(starts.size()) - 1;
-#pragma omp parallel
+  // Threads pay off on large meshes only (and a parallel region costs a time slice on a busy machine).
+#pragma omp parallel if (num_triangles > 50000)
   {
     std::vector<std::pair<int32_t, int32_t>> found;
 #pragma omp for schedule(dynamic, 64)

@@ -4,9 +4,10 @@
 //
 // Decimation keeps topology but not embedding: where a shape is thin (turbine blades, the
 // two sides of a fin), coarse triangles cut through the opposite side. Every round finds the
-// intersecting triangles exactly and splits the clusters of their corners by adding, in each,
-// the vertex farthest from its sample; the decimation is then redone from the enlarged sample
-// list. Only thin places get finer, so the coarse mesh stays small.
+// intersecting triangles exactly and splits the clusters of their corners in three by adding,
+// in each, the vertex farthest from its sample and the vertex farthest from both; the
+// decimation is then redone from the enlarged sample list. Only thin places get finer, so the
+// coarse mesh stays small.
 #pragma once
 
 #include <cstdint>
