@@ -6,6 +6,7 @@
 // stage change), so inner loops may report as often as they like.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <functional>
 #include <stdexcept>
@@ -45,13 +46,14 @@ class Progress {
     const auto now = std::chrono::steady_clock::now();
     if (!force && now - last_ < std::chrono::milliseconds(50)) return;
     last_ = now;
-    const double overall = begin_ + (end_ - begin_) * (fraction < 0 ? 0 : fraction > 1 ? 1 : fraction);
+    double overall = begin_ + (end_ - begin_) * (fraction < 0 ? 0 : fraction > 1 ? 1 : fraction);
+    overall = reported_ = std::max(reported_, overall);  // a retried stage never moves the bar back
     if (!callback_(overall, name_)) throw Cancelled(name_);
   }
 
   ProgressCallback callback_;
   const char* name_ = "";
-  double begin_ = 0.0, end_ = 1.0;
+  double begin_ = 0.0, end_ = 1.0, reported_ = 0.0;
   std::chrono::steady_clock::time_point last_{};
 };
 
