@@ -13,12 +13,15 @@ from .io import MeshData, read_mesh, write_mesh
 from .loops import (Cancelled, ComponentLoops, Loop, LoopsResult, handle_tunnel_loops, self_intersections,
                     shorten_loop, tetrahedralize_surface)
 from .mesh import Mesh, MeshReport
+from .topology import ComponentGenerators, ComponentTopology, Topology, generators, topology
 
 __all__ = [
     "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
     "decimate_with_samples", "sampling_probabilities",
     # measurement (hausdorff.py) and error-bounded decimation (error_bound.py)
     "Distance", "ErrorBoundReport", "HausdorffResult", "OneSidedDistance", "closest_points", "hausdorff",
+    # topology
+    "ComponentGenerators", "ComponentTopology", "Topology", "generators", "topology",
     # mesh files (io.py)
     "MeshData", "read_mesh", "write_mesh",
     # handle and tunnel loops (loops.py)

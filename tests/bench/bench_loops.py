@@ -22,7 +22,6 @@ span the outside, tunnels the reverse, all span the surface).
 import argparse
 import os
 import pathlib
-import platform
 import statistics
 import subprocess
 import sys
@@ -33,7 +32,9 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "build" / "python"))
 sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT / "tests" / "bench"))
 
+from machine import machine  # noqa: E402
 from topstoc.core import Mesh, handle_tunnel_loops, read_mesh, tetrahedralize_surface, write_mesh  # noqa: E402
 from topstoc.core.io import MeshData  # noqa: E402
 
@@ -41,18 +42,6 @@ SHARED = ROOT.parent / "shared"
 OUT = ROOT / "build" / "bench_meshes"
 CASES = [("turbine_l1", "turbine", 1), ("slab12_l3", "slab12", 3), ("turbine_l3", "turbine", 3),
          ("slab12_l5", "slab12", 5)]
-
-
-def machine() -> str:
-    model = "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{os.cpu_count()} cores, {model}, {platform.system()} {platform.release()}"
 
 
 def base_mesh(name: str) -> pathlib.Path:
@@ -116,7 +105,7 @@ def main() -> int:
     if not (SHARED / "tools" / "loop_subdiv.py").exists():
         print(f"skipped: {SHARED / 'tools'} not found (the benchmark meshes are made from ../shared)")
         return 0
-    print(f"machine: {machine()}, load average {os.getloadavg()[0]:.2f} at start")
+    print(f"machine: {machine()}")
     stage_names = ["prepare", "decimate", "self_intersections", "tetrahedralize", "persistence", "select", "map",
                    "shorten", "verify"]
     for name, base, levels in CASES:

@@ -6,7 +6,6 @@ inside/outside labels of the tetrahedra are checked against winding numbers comp
 """
 
 import dataclasses
-import pathlib
 
 import numpy as np
 import pytest
@@ -15,6 +14,7 @@ import homology_check as hc
 import meshgen
 import reference
 import topstoc
+from reference import read_off
 
 pytestmark = pytest.mark.skipif(hc.gudhi is None, reason="python3-gudhi is not installed")
 
@@ -24,23 +24,6 @@ GENUS_POSITIVE = [
     ("cgal_eight.off", 2), ("cgal_knot1.off", 1), ("cgal_elephant.off", 3),
     ("cgal_anchor_dense.off", 4), ("cgal_couplingdown.off", 9), ("cgal_turbine.off", 11),
 ]
-
-
-def read_off(path):
-    """Vertices and fan-triangulated faces of an OFF file."""
-    tokens = pathlib.Path(path).read_text().split()
-    assert tokens[0] == "OFF"
-    nv, nf = int(tokens[1]), int(tokens[2])
-    values = tokens[4:]
-    vertices = np.array(values[:3 * nv], dtype=np.float64).reshape(nv, 3)
-    rest, triangles = values[3 * nv:], []
-    i = 0
-    for _ in range(nf):
-        k = int(rest[i])
-        poly = [int(x) for x in rest[i + 1:i + 1 + k]]
-        triangles += [(poly[0], poly[j], poly[j + 1]) for j in range(1, k - 1)]
-        i += 1 + k
-    return vertices, np.array(triangles, dtype=np.int32)
 
 
 def check_component(vertices, triangles, component, field=2):
@@ -305,7 +288,7 @@ def test_non_manifold_mesh_is_refused_with_the_reason(data_dir):
 
 
 def test_non_orientable_surface_is_refused():
-    vertices, triangles = klein_bottle()
+    vertices, triangles = meshgen.klein_bottle()
     with pytest.raises(ValueError, match="non-orientable"):
         topstoc.handle_tunnel_loops(vertices, triangles)
 
@@ -410,28 +393,3 @@ def test_json_document(data_dir):
     assert component["genus"] == 2
     assert len(component["handles"]) == len(component["tunnels"]) == 2
     assert all(isinstance(v, int) for loop in component["handles"] for v in loop)
-
-
-def klein_bottle(nu=12, nv=8):
-    """A Klein bottle as a grid with one side glued flipped (combinatorially non-orientable)."""
-    u = np.arange(nu) * 2 * np.pi / nu
-    v = np.arange(nv) * 2 * np.pi / nv
-    uu, vv = np.meshgrid(u, v, indexing="ij")
-    # Figure-8 immersion: positions only need to be finite.
-    r = 2.0
-    x = (r + np.cos(uu / 2) * np.sin(vv) - np.sin(uu / 2) * np.sin(2 * vv)) * np.cos(uu)
-    y = (r + np.cos(uu / 2) * np.sin(vv) - np.sin(uu / 2) * np.sin(2 * vv)) * np.sin(uu)
-    z = np.sin(uu / 2) * np.sin(vv) + np.cos(uu / 2) * np.sin(2 * vv)
-    vertices = np.stack([x, y, z], -1).reshape(-1, 3)
-
-    def idx(i, j):
-        if i == nu:  # crossing the seam flips the v direction
-            return 0 * nv + (-j) % nv
-        return i * nv + j % nv
-
-    faces = []
-    for i in range(nu):
-        for j in range(nv):
-            a, b, c, d = idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)
-            faces += [(a, b, c), (a, c, d)]
-    return vertices, np.array(faces, dtype=np.int32)
