@@ -7,9 +7,12 @@
 
 from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
                        sampling_probabilities)
+from .edit import EditResult, cut_along_loop, delete_faces, fill_holes, fill_loops, remove_handle
 from .mesh import Mesh, MeshReport
 
 __all__ = [
     "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
     "decimate_with_samples", "sampling_probabilities",
+    # editing (topstoc.core.edit also has boundary_loops and the result's parts)
+    "EditResult", "cut_along_loop", "delete_faces", "fill_holes", "fill_loops", "remove_handle",
 ]
