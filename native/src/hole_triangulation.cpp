@@ -218,48 +218,51 @@ class Filler {
     return true;
   }
 
-  // Liepa's dynamic programme: weight(i, j) = (largest dihedral angle, area) of the best
-  // triangulation of corners i..j closed by the chord (i, j), compared lexicographically.
+  // Liepa's dynamic programme: the best triangulation of corners i..j closed by the chord (i, j)
+  // has the largest smallest-cosine of its dihedral angles (between neighbouring patch
+  // triangles and against the surface beyond the hole's sides), then the least area.
   bool minimum_weight(const std::vector<int32_t>& c) {
     const int32_t n = static_cast<int32_t>(c.size());
     constexpr double kInf = std::numeric_limits<double>::infinity();
     const size_t cells = size_t(n) * size_t(n);
-    std::vector<double> angle(cells, kInf), area(cells, kInf);
+    std::vector<double> cosine(cells, -kInf), area(cells, kInf);
     std::vector<int32_t> apex(cells, -1);
     std::vector<Vec> normal(cells, Vec{0, 0, 0});
     auto at = [n](int32_t i, int32_t j) { return size_t(i) * size_t(n) + size_t(j); };
-    for (int32_t i = 0; i + 1 < n; ++i) angle[at(i, i + 1)] = area[at(i, i + 1)] = 0.0;
-    auto dihedral = [](const Vec& a, const Vec& b) {
-      if (norm(b) == 0.0) return 0.0;
-      return std::acos(std::max(-1.0, std::min(1.0, dot(a, b))));
-    };
-    // Normal of the triangle beyond the side or chord (i, j) inside the sub-solution, or of the
+    for (int32_t i = 0; i + 1 < n; ++i) cosine[at(i, i + 1)] = 1.0, area[at(i, i + 1)] = 0.0;
+    // Cosine of the dihedral angle against a neighbour's unit normal (1 when unknown).
+    auto fold = [](const Vec& a, const Vec& b) { return norm(b) == 0.0 ? 1.0 : dot(a, b); };
+    // Normal of the triangle beyond the side or chord (i, j) in the sub-solution, or of the
     // surface beyond a hole side.
     auto beyond = [&](int32_t i, int32_t j) { return j == i + 1 ? side_normal(c[i], c[j]) : normal[at(i, j)]; };
+    std::vector<Vec> points(n);
+    for (int32_t i = 0; i < n; ++i) points[i] = point(c[i]);
     for (int32_t span = 2; span < n; ++span)
       for (int32_t i = 0; i + span < n; ++i) {
         const int32_t j = i + span;
         const bool closing = i == 0 && j == n - 1;  // the chord (0, n - 1) is the piece's last side
         if (!closing && forbidden(c[i], c[j])) continue;
-        double best_angle = kInf, best_area = kInf;
+        double best_cosine = -kInf, best_area = kInf;
         for (int32_t m = i + 1; m < j; ++m) {
           if (!std::isfinite(area[at(i, m)]) || !std::isfinite(area[at(m, j)])) continue;
-          const Vec pi = point(c[i]), pm = point(c[m]), pj = point(c[j]);
-          const Vec twice = cross(pm - pi, pj - pi);
-          if (degenerate(c[i], c[m], c[j])) continue;
-          const Vec nt = unit(twice);
-          double worst = std::max({angle[at(i, m)], angle[at(m, j)], dihedral(nt, beyond(i, m)), dihedral(nt, beyond(m, j))});
-          if (closing) worst = std::max(worst, dihedral(nt, side_normal(c[j], c[i])));
-          const double total = area[at(i, m)] + area[at(m, j)] + 0.5 * norm(twice);
-          const bool better = worst < best_angle - 1e-9 || (worst <= best_angle + 1e-9 && total < best_area);
-          if (better) {
-            best_angle = worst;
+          const Vec twice = cross(points[m] - points[i], points[j] - points[i]);
+          const double scale = std::max({dot(points[m] - points[i], points[m] - points[i]),
+                                         dot(points[j] - points[i], points[j] - points[i]),
+                                         dot(points[j] - points[m], points[j] - points[m])});
+          const double length = norm(twice);
+          if (!(length > 1e-12 * scale)) continue;  // degenerate
+          const Vec nt = (1.0 / length) * twice;
+          double worst = std::min({cosine[at(i, m)], cosine[at(m, j)], fold(nt, beyond(i, m)), fold(nt, beyond(m, j))});
+          if (closing) worst = std::min(worst, fold(nt, side_normal(c[j], c[i])));
+          const double total = area[at(i, m)] + area[at(m, j)] + 0.5 * length;
+          if (worst > best_cosine + 1e-12 || (worst >= best_cosine - 1e-12 && total < best_area)) {
+            best_cosine = worst;
             best_area = total;
             apex[at(i, j)] = m;
             normal[at(i, j)] = nt;
           }
         }
-        angle[at(i, j)] = best_angle;
+        cosine[at(i, j)] = best_cosine;
         area[at(i, j)] = best_area;
       }
     if (!std::isfinite(area[at(0, n - 1)])) return false;
