@@ -32,16 +32,17 @@ class BoundaryLoop:
     """A boundary loop (hole): its vertices in order, the surface on their left.
 
     ``nonmanifold_vertex`` is a vertex of the loop where the boundary is not manifold (it
-    touches another loop, or its triangles form several fans), or None; such a loop cannot
-    be filled.
+    touches another loop, or its triangles form several fans), or None. ``lone_triangle``:
+    the loop borders a component of one triangle. Either way the loop cannot be filled.
     """
 
     vertices: np.ndarray
     nonmanifold_vertex: Optional[int] = None
+    lone_triangle: bool = False
 
     @property
     def fillable(self) -> bool:
-        return self.nonmanifold_vertex is None
+        return self.nonmanifold_vertex is None and not self.lone_triangle
 
     def __len__(self) -> int:
         return len(self.vertices)
@@ -220,8 +221,8 @@ def boundary_loops(vertices, triangles) -> List[BoundaryLoop]:
     The index of a loop in this list is what ``fill_holes(holes=...)`` takes.
     """
     vertices = _vertices(vertices)
-    return [BoundaryLoop(vertices=ids, nonmanifold_vertex=None if bad < 0 else int(bad))
-            for ids, bad in engine.boundary_loops(triangles, len(vertices))]
+    return [BoundaryLoop(vertices=ids, nonmanifold_vertex=None if bad < 0 else int(bad), lone_triangle=bool(lone))
+            for ids, bad, lone in engine.boundary_loops(triangles, len(vertices))]
 
 
 def delete_faces(vertices, triangles, faces) -> EditResult:
@@ -253,12 +254,13 @@ def cut_along_loop(vertices, triangles, loop: Sequence[int]) -> EditResult:
 
 
 def fill_holes(vertices, triangles, holes: Optional[Sequence[int]] = None, *, max_edges: Optional[int] = None,
-               skip_nonmanifold: bool = False, weld_pinches: bool = True, planar: bool = True,
+               skip_unfillable: bool = False, weld_pinches: bool = True, planar: bool = True,
                max_dp_corners: int = 160, refine: bool = False, fair: bool = False) -> EditResult:
     """Fills holes: the ones listed (indices into :func:`boundary_loops`) or all of them.
 
     With ``holes=None``, every hole with at most ``max_edges`` edges (any size if None);
-    ``skip_nonmanifold`` leaves holes touching a non-manifold vertex open instead of raising.
+    ``skip_unfillable`` leaves holes that are not :attr:`BoundaryLoop.fillable` open instead of
+    raising.
     A hole whose border passes twice through one point (two vertices at exactly the same
     position) cannot be filled without degenerate or overlapping triangles; ``weld_pinches``
     merges such vertices and fills each lobe on its own (one patch per lobe, the duplicate
@@ -278,7 +280,7 @@ def fill_holes(vertices, triangles, holes: Optional[Sequence[int]] = None, *, ma
     if max_edges is not None and max_edges < 3:
         raise ValueError(f"max_edges must be at least 3, got {max_edges}")
     vertices = _vertices(vertices)
-    raw = engine.fill_holes(vertices, triangles, holes, max_edges=max_edges or 0, skip_nonmanifold=skip_nonmanifold,
+    raw = engine.fill_holes(vertices, triangles, holes, max_edges=max_edges or 0, skip_unfillable=skip_unfillable,
                             weld_pinches=weld_pinches, **_fill_options(planar, max_dp_corners, refine, fair))
     return _result(raw, vertices, triangles)
 

@@ -111,23 +111,23 @@ void bind_edit(py::module_& m) {
           loops = boundary_loops(t.data(), int64_t(t.size() / 3), num_vertices);
         }
         py::list out;
-        for (BoundaryLoop& loop : loops) out.append(py::make_tuple(to_array(std::move(loop.vertices)), loop.nonmanifold_vertex));
+        for (BoundaryLoop& loop : loops) out.append(py::make_tuple(to_array(std::move(loop.vertices)), loop.nonmanifold_vertex, loop.lone_triangle));
         return out;
       },
       py::arg("triangles"), py::arg("num_vertices"),
-      "Boundary loops as (vertex ids, first non-manifold vertex or -1), ordered by lowest vertex.");
+      "Boundary loops as (vertex ids, first non-manifold vertex or -1, lone triangle), by lowest vertex.");
 
   m.def(
       "fill_holes",
       [](const py::handle& vertices, const py::handle& triangles, const py::handle& holes, int32_t max_edges,
-         bool skip_nonmanifold, bool weld_pinches, bool planar, int32_t max_dp_corners, bool refine, bool fair) {
+         bool skip_unfillable, bool weld_pinches, bool planar, int32_t max_dp_corners, bool refine, bool fair) {
         Arrays a = arrays_from(vertices, triangles);
         HoleSelection selection;
         selection.holes = ids_from(holes, -1, "holes");
         if (!holes.is_none() && selection.holes.empty())
           throw py::value_error("holes is empty: pass None to fill every hole");
         selection.max_edges = max_edges;
-        selection.skip_nonmanifold = skip_nonmanifold;
+        selection.skip_unfillable = skip_unfillable;
         selection.weld_pinches = weld_pinches;
         const FillOptions options = fill_options(planar, max_dp_corners, refine, fair);
         EditResult r;
@@ -139,7 +139,7 @@ void bind_edit(py::module_& m) {
         return result_dict(std::move(r));
       },
       py::arg("vertices"), py::arg("triangles"), py::arg("holes") = py::none(), py::arg("max_edges") = 0,
-      py::arg("skip_nonmanifold") = false, py::arg("weld_pinches") = true, py::arg("planar") = true,
+      py::arg("skip_unfillable") = false, py::arg("weld_pinches") = true, py::arg("planar") = true,
       py::arg("max_dp_corners") = 160, py::arg("refine") = false, py::arg("fair") = false,
       "Fills boundary loops chosen by index into boundary_loops() (None: all, up to max_edges edges).");
 

@@ -132,6 +132,16 @@ std::vector<BoundaryLoop> boundary_loops(const int32_t* triangles, int64_t num_t
       }
       // Walked against the triangles: turn round, keeping the lowest vertex first.
       if (votes < 0) std::reverse(loop.vertices.begin() + 1, loop.vertices.end());
+      if (loop.vertices.size() == 3) {  // three boundary sides of one triangle?
+        const int32_t v = loop.vertices[0];
+        for (int32_t i = around.begin(v); i < around.end(v) && !loop.lone_triangle; ++i) {
+          const int32_t* x = triangles + 3 * size_t(around.list[i]);
+          int32_t on_loop = 0;
+          for (int c = 0; c < 3; ++c) on_loop += x[c] == loop.vertices[1] || x[c] == loop.vertices[2];
+          const int64_t t = around.list[i];
+          loop.lone_triangle = on_loop == 2 && boundary_side[3 * t] && boundary_side[3 * t + 1] && boundary_side[3 * t + 2];
+        }
+      }
       loops.push_back(std::move(loop));
     }
   return loops;
@@ -430,8 +440,12 @@ EditResult fill_holes(const double* positions, int32_t num_vertices, const int32
   std::vector<int32_t> index;
   for (int32_t i : chosen) {
     const BoundaryLoop& loop = loops[i];
-    if (loop.nonmanifold_vertex >= 0) {
-      if (selection.skip_nonmanifold) continue;
+    if (!loop.fillable()) {
+      if (selection.skip_unfillable) continue;
+      if (loop.lone_triangle)
+        throw std::invalid_argument("boundary loop " + std::to_string(i) +
+                                    " is the border of a lone triangle: filling it would duplicate that triangle "
+                                    "(delete the triangle or skip such loops)");
       throw std::invalid_argument("boundary loop " + std::to_string(i) + " touches non-manifold vertex " +
                                   std::to_string(loop.nonmanifold_vertex) +
                                   ": it cannot be filled (repair the vertex or skip such loops)");

@@ -508,11 +508,17 @@ def test_fill_rejects_bad_holes():
     assert all(loop.nonmanifold_vertex == 2 for loop in loops)
     with pytest.raises(ValueError, match="non-manifold vertex 2"):
         edit.fill_holes(vertices, triangles)
-    assert edit.fill_holes(vertices, triangles, skip_nonmanifold=True).patches == []
+    assert edit.fill_holes(vertices, triangles, skip_unfillable=True).patches == []
     with pytest.raises(ValueError, match="non-manifold vertex 2"):
         edit.fill_loops(vertices, triangles, [[0, 1, 2, 3]])
     with pytest.raises(ValueError, match="lone triangle"):
         edit.fill_holes(vertices[:3], triangles[:1])
+    with pytest.raises(ValueError, match="lone triangle"):
+        edit.fill_loops(vertices[:3], triangles[:1], [[0, 1, 2]])
+    lone = edit.boundary_loops(*meshgen.disjoint(meshgen.grid(1, 1), (vertices[:3], triangles[:1])))
+    assert [loop.lone_triangle for loop in lone] == [False, True] and not lone[1].fillable
+    assert len(edit.fill_holes(*meshgen.disjoint(meshgen.grid(1, 1), (vertices[:3], triangles[:1])),
+                               skip_unfillable=True).patches) == 1
     grid_v, grid_t = meshgen.grid(3, 3)
     with pytest.raises(ValueError, match="not joined by a boundary edge"):
         edit.fill_loops(grid_v, grid_t, [[5, 6, 10, 9]])  # an interior cycle
@@ -666,3 +672,34 @@ def test_fill_is_deterministic():
     assert len(first.patches) > 16  # enough holes for the parallel path
     again = edit.fill_holes(holed.vertices, holed.triangles)
     assert np.array_equal(first.triangles, again.triangles)
+
+
+def test_fill_random_holes_always_closes_the_surface():
+    """Property test: random face regions deleted from a sphere, a torus and a genus-2 slab
+    (jittered), then every hole filled: always closed, manifold, consistently oriented and
+    without a degenerate triangle (lone-triangle pieces left by the deletion are skipped)."""
+    rng = np.random.default_rng(7)
+    meshes = [meshgen.icosphere(3), meshgen.torus(24, 12), meshgen.genus_slab(2)]
+    for trial in range(60):
+        vertices, triangles = meshes[trial % 3]
+        vertices = vertices + rng.normal(0, 0.01, vertices.shape)
+        neighbours = {}
+        for f, t in enumerate(triangles):
+            for i in range(3):
+                neighbours.setdefault(frozenset((t[i], t[(i + 1) % 3])), []).append(f)
+        region = set(rng.choice(len(triangles), rng.integers(1, 4), replace=False).tolist())
+        frontier, size = list(region), rng.integers(1, 60)
+        while len(region) < size and frontier:
+            t = triangles[frontier.pop(rng.integers(len(frontier)))]
+            for i in range(3):
+                for g in neighbours[frozenset((t[i], t[(i + 1) % 3]))]:
+                    if g not in region and rng.random() < 0.7:
+                        region.add(g)
+                        frontier.append(g)
+        holed = edit.delete_faces(vertices, triangles, sorted(region))
+        loops = edit.boundary_loops(holed.vertices, holed.triangles)
+        result = edit.fill_holes(holed.vertices, holed.triangles, skip_unfillable=True)
+        assert len(result.patches) >= sum(loop.fillable for loop in loops)
+        if all(loop.fillable for loop in loops):
+            closed_surface_summary(result.triangles)  # asserts closed, manifold, oriented
+        assert np.all(areas(result.vertices, result.triangles) > 0), trial

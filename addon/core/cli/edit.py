@@ -26,8 +26,9 @@ def add_parser(subparsers) -> None:
     fill.add_argument("output", metavar="OUT", help="output mesh file")
     fill.add_argument("--holes", metavar="I,J,...", help="fill only these holes (indices, comma-separated)")
     fill.add_argument("--max-edges", type=int, metavar="N", help="fill only holes with at most N edges")
-    fill.add_argument("--skip-nonmanifold", action="store_true",
-                      help="leave holes touching a non-manifold vertex open instead of failing")
+    fill.add_argument("--skip-unfillable", action="store_true",
+                      help="leave holes touching a non-manifold vertex or bordering a lone triangle open "
+                           "instead of failing")
     fill.add_argument("--no-weld", action="store_true",
                       help="do not weld a hole's duplicate vertices (same position) into separate lobes")
     _patch_options(fill)
@@ -76,7 +77,7 @@ def run_fill(args) -> int:
         raise ValueError(f"--max-edges must be at least 3, got {args.max_edges}")
     start = time.perf_counter()
     result = fill_holes(data.vertices, data.triangles, holes=holes, max_edges=args.max_edges,
-                        skip_nonmanifold=args.skip_nonmanifold, weld_pinches=not args.no_weld, fair=args.fair)
+                        skip_unfillable=args.skip_unfillable, weld_pinches=not args.no_weld, fair=args.fair)
     seconds = time.perf_counter() - start
     methods = {}
     for patch in result.patches:

@@ -23,8 +23,12 @@ struct BoundaryLoop {
   std::vector<int32_t> vertices;
   /// A vertex of the loop where the boundary is not manifold (it lies on another boundary loop,
   /// its triangles form several fans, or an edge at it has more than two triangles), or -1.
-  /// Such a loop cannot be filled.
   int32_t nonmanifold_vertex = -1;
+  /// The loop is the border of a lone triangle (a component of one triangle): its patch would
+  /// duplicate that triangle.
+  bool lone_triangle = false;
+  /// Loops that touch a non-manifold vertex or border a lone triangle cannot be filled.
+  bool fillable() const { return nonmanifold_vertex < 0 && !lone_triangle; }
 };
 
 /// Every boundary loop, ordered by their first (lowest) vertex. Triangles with a repeated vertex
@@ -56,7 +60,7 @@ void fill_loops_into(EditResult& mesh, const std::vector<std::vector<int32_t>>& 
 struct HoleSelection {
   std::vector<int32_t> holes;     ///< indices into boundary_loops(); empty: every loop
   int32_t max_edges = 0;          ///< with `holes` empty: only loops with at most this many edges (0: any)
-  bool skip_nonmanifold = false;  ///< leave loops touching a non-manifold vertex open instead of raising
+  bool skip_unfillable = false;   ///< leave loops that are not fillable() open instead of raising
   /// A loop that passes twice through the same point (two of its vertices at exactly the same
   /// position, as left by tools that split non-manifold vertices) cannot be filled without
   /// degenerate or overlapping triangles. Weld such vertices and fill each lobe of the loop on
