@@ -8,6 +8,7 @@
 from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
                        sampling_probabilities)
 from .edit import EditResult, cut_along_loop, delete_faces, fill_holes, fill_loops, remove_handle
+from .io import MeshData, read_mesh, write_mesh
 from .mesh import Mesh, MeshReport
 
 __all__ = [
@@ -15,4 +16,6 @@ __all__ = [
     "decimate_with_samples", "sampling_probabilities",
     # editing (topstoc.core.edit also has boundary_loops and the result's parts)
     "EditResult", "cut_along_loop", "delete_faces", "fill_holes", "fill_loops", "remove_handle",
+    # mesh files (io.py)
+    "MeshData", "read_mesh", "write_mesh",
 ]

@@ -107,6 +107,7 @@ class DecimateStats:
     fast_path: bool             #: candidate faces collected during the flood
     repair_rounds: int          #: re-flood rounds needed to keep the topology
     repairs: int                #: samples added to keep the topology
+    top_up: int                 #: samples added to make up for clusters absorbed by neighbours
     issues_found: dict          #: what the checks found over all rounds
     issues_remaining: dict      #: what was left (all zero unless the round limit was hit)
     seconds: dict               #: per stage: sampling, clustering, checking, output
@@ -159,7 +160,7 @@ def _result(raw: dict, parameters: dict) -> DecimateResult:
         target_vertices=raw["target_vertices"], selected=raw["selected"], forced=raw["forced"],
         density_rejected=raw["density_rejected"], guided=raw["guided"],
         expected_vertices=raw["expected_vertices"], rate=raw["rate"], fast_path=raw["fast_path"],
-        repair_rounds=repairs["rounds"], repairs=repairs["samples_added"],
+        repair_rounds=repairs["rounds"], repairs=repairs["samples_added"], top_up=raw["top_up_samples"],
         issues_found=dict(repairs["found"]), issues_remaining=dict(repairs["remaining"]),
         seconds=dict(raw["seconds"]))
     return DecimateResult(vertices=raw["positions"], triangles=raw["triangles"], kept=raw["kept"],

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "caller_order.hpp"
 #include "convert.hpp"
 #include "topstoc/decimate.hpp"
 #include "topstoc/quality.hpp"
@@ -99,6 +100,7 @@ py::dict result_dict(DecimateResult&& r) {
   d["expected_vertices"] = r.expected_vertices;
   d["rate"] = r.rate;
   d["fast_path"] = r.fast_path;
+  d["top_up_samples"] = r.top_up_samples;
   py::dict repairs;
   repairs["rounds"] = r.repairs.rounds;
   repairs["samples_added"] = r.repairs.samples_added;
@@ -189,7 +191,7 @@ void bind_decimate(py::module_& m) {
         std::vector<double> p;
         {
           py::gil_scoped_release release;
-          p = sampling_probabilities(mesh, layout, s, rate);
+          p = by_caller(mesh, sampling_probabilities(mesh, layout, s, rate));
         }
         return to_array(std::move(p));
       },

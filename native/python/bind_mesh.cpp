@@ -1,6 +1,7 @@
 // Bindings for the prepared mesh and its feature layout.
 #include <pybind11/stl.h>
 
+#include "caller_order.hpp"
 #include "convert.hpp"
 #include "topstoc/features.hpp"
 #include "topstoc/mesh.hpp"
@@ -8,23 +9,6 @@
 namespace topstoc::python {
 
 namespace {
-
-// Per-vertex values (width per vertex) reordered from internal to caller order.
-template <class T>
-std::vector<T> by_caller(const Mesh& mesh, const std::vector<T>& values, size_t width) {
-  std::vector<T> out(values.size());
-  const auto& source = mesh.vertex_source();
-  for (size_t v = 0; v < source.size(); ++v)
-    for (size_t k = 0; k < width; ++k) out[width * size_t(source[v]) + k] = values[width * v + k];
-  return out;
-}
-
-// Internal vertex ids replaced by the caller's.
-std::vector<int32_t> caller_ids(const Mesh& mesh, const std::vector<int32_t>& ids) {
-  std::vector<int32_t> out(ids.size());
-  for (size_t i = 0; i < ids.size(); ++i) out[i] = mesh.vertex_source()[ids[i]];
-  return out;
-}
 
 py::dict report_dict(const MeshReport& r) {
   py::dict d;

@@ -21,6 +21,10 @@ double seconds_since(Clock::time_point start) {
 // Rounds in which zero-area triangles are still repaired; after that they are only counted
 // (an input with collinear vertices may not allow removing them all).
 constexpr int32_t kSliverRounds = 8;
+// Rounds of splitting the widest clusters to make up for absorbed ones (see cluster_and_emit).
+constexpr int32_t kMaxTopUpRounds = 12;
+constexpr int32_t kSmallTopUp = 3;       // top-ups this small may be undone and retried
+constexpr size_t kMaxTopUpRetries = 12;  // clusters tried for them
 
 void accumulate(PartitionIssues& into, const PartitionIssues& add) {
   into.unreached += add.unreached;
@@ -189,10 +193,28 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
 }
 
 // Floods, checks and repairs until the partition passes (see partition.hpp).
+// The `count` widest clusters (largest flood distance, then lowest rank) that can split.
+std::vector<int32_t> widest_clusters(const Clustering& c, const std::vector<uint8_t>& absorbed, int32_t count,
+                                     const std::vector<int32_t>& excluded) {
+  std::vector<int32_t> radius(absorbed.size(), 0);
+  for (size_t v = 0; v < c.label.size(); ++v)
+    if (c.label[v] >= 0) radius[c.label[v]] = std::max(radius[c.label[v]], c.dist[v]);
+  for (int32_t s : excluded) radius[s] = 0;
+  std::vector<int32_t> ranks;
+  for (int32_t s = 0; s < int32_t(absorbed.size()); ++s)
+    if (!absorbed[s] && radius[s] > 0) ranks.push_back(s);
+  const size_t take = std::min<size_t>(ranks.size(), size_t(std::max(0, count)));
+  std::partial_sort(ranks.begin(), ranks.begin() + take, ranks.end(), [&](int32_t a, int32_t b) {
+    return radius[a] > radius[b] || (radius[a] == radius[b] && a < b);
+  });
+  ranks.resize(take);
+  return ranks;
+}
+
 DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                 Placement placement, int32_t max_rounds, bool repair_slivers, bool fast_path,
                                 const std::vector<uint8_t>& avoid, const std::vector<uint8_t>& required,
-                                DecimateResult result) {
+                                int32_t top_up_to, DecimateResult result) {
   auto start = Clock::now();
   Clustering clustering;
   std::vector<int32_t> cross_edges;
@@ -201,6 +223,16 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
   result.fast_path = fast_path;
   start = Clock::now();
   Partition partition;
+  // The last few top-up samples can overshoot (a split may revive an absorbed neighbour): then
+  // the state before them is restored and the next widest clusters are tried instead.
+  struct Snapshot {
+    size_t samples = 0;
+    Clustering clustering;
+    RepairStats repairs;
+    int32_t top_up_samples = 0;
+    std::vector<int32_t> tried;
+    bool active = false;
+  } snapshot;
   for (int32_t round = 0;; ++round) {
     const bool slivers = repair_slivers && round < kSliverRounds;
     if (round == 0 && fast_path) {
@@ -219,9 +251,38 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     }
     accumulate(result.repairs.found, partition.issues);
     const bool clean = partition.issues.topological() == 0 && (!slivers || partition.issues.sliver == 0);
-    if (clean) break;
-    std::vector<int32_t> added = partition.new_samples;
-    const auto split = splitting_vertices(mesh, clustering, samples, partition.split_clusters, avoid);
+    std::vector<int32_t> to_split = partition.split_clusters;
+    if (clean) {
+      // Exact budget: absorbed clusters leave the output, so a clean result can fall short of
+      // the target. Split the widest clusters at their farthest vertex until it is met.
+      const int32_t kept = int32_t(samples.size()) - partition.issues.absorbed;
+      if (snapshot.active && kept > top_up_to && snapshot.tried.size() < kMaxTopUpRetries) {
+        samples.resize(snapshot.samples);
+        clustering = snapshot.clustering;
+        result.repairs.rounds = snapshot.repairs.rounds;
+        result.repairs.samples_added = snapshot.repairs.samples_added;
+        result.top_up_samples = snapshot.top_up_samples;
+        partition = check_partition(mesh, layout, samples, clustering, required, false);
+      } else if (top_up_to <= 0 || kept >= top_up_to || result.top_up_rounds >= kMaxTopUpRounds) {
+        break;
+      } else {
+        snapshot = Snapshot();
+      }
+      const int32_t need = top_up_to - (int32_t(samples.size()) - partition.issues.absorbed);
+      if (need <= kSmallTopUp && !snapshot.active) {
+        snapshot.active = true;
+        snapshot.samples = samples.size();
+        snapshot.clustering = clustering;
+        snapshot.repairs = result.repairs;
+        snapshot.top_up_samples = result.top_up_samples;
+      }
+      to_split = widest_clusters(clustering, partition.absorbed, need, snapshot.tried);
+      if (snapshot.active) snapshot.tried.insert(snapshot.tried.end(), to_split.begin(), to_split.end());
+      if (to_split.empty()) break;
+      ++result.top_up_rounds;
+    }
+    std::vector<int32_t> added = clean ? std::vector<int32_t>() : partition.new_samples;
+    const auto split = splitting_vertices(mesh, clustering, samples, to_split, avoid);
     added.insert(added.end(), split.begin(), split.end());
     std::sort(added.begin(), added.end());
     added.erase(std::unique(added.begin(), added.end()), added.end());
@@ -235,8 +296,12 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     const int32_t first_new = static_cast<int32_t>(samples.size());
     samples.insert(samples.end(), added.begin(), added.end());
     flood_add(mesh, layout, samples, first_new, clustering);
-    result.repairs.rounds = round + 1;
-    result.repairs.samples_added += static_cast<int32_t>(added.size());
+    if (clean) {
+      result.top_up_samples += static_cast<int32_t>(added.size());
+    } else {
+      result.repairs.rounds += 1;
+      result.repairs.samples_added += static_cast<int32_t>(added.size());
+    }
   }
   // Zero-area triangles left after the repair rounds are reported, not hidden.
   if (partition.issues.sliver > 0 && partition.issues.topological() == 0)
@@ -255,7 +320,7 @@ namespace {
 
 // One pass: draw samples for `target`, then flood, check, repair, emit.
 DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
-                             int32_t target) {
+                             int32_t target, int32_t top_up_to) {
   const int32_t active = active_vertices(mesh);
   const auto start = Clock::now();
   SampleSet set = select_samples(mesh, layout, params.sampling, target);
@@ -281,7 +346,7 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
   }
   const bool fast = params.fast_path == 1 || (params.fast_path < 0 && target < 0.05 * active);
   return cluster_and_emit(mesh, layout, std::move(set.samples), params.placement, params.max_repair_rounds, true,
-                          fast, avoid, required, std::move(result));
+                          fast, avoid, required, set.guided ? 0 : top_up_to, std::move(result));
 }
 
 }  // namespace
@@ -295,19 +360,18 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
                                 " vertices exceeds the mesh's " + std::to_string(active) + " vertices in triangles");
   if (params.max_repair_rounds < 0) throw std::invalid_argument("max_repair_rounds must be >= 0");
   const int32_t target = params.target_vertices;
-  DecimateResult best = decimate_once(mesh, layout, params, target);
-  // Repairs add samples and absorbed clusters remove some. Without guidance the budget is
-  // exact: re-draw with the target shifted by the miss until the output is within 0.5 %
-  // (or as close as the topology allows). Guided decimations keep the user's count.
-  const auto miss = [&](const DecimateResult& r) { return int32_t(r.kept.size()) - target; };
-  const int32_t tolerance = std::max<int32_t>(0, int32_t(0.005 * target));
+  // Without guidance the budget is exact. Repairs add samples and absorbed clusters remove
+  // some; a shortfall is topped up inside the pass (widest clusters split), an excess (the
+  // topology needed more than drawn) is drawn again lower and topped up. Guided decimations
+  // keep the count the probabilities give (user input wins, thesis 4.3).
+  DecimateResult best = decimate_once(mesh, layout, params, target, target);
+  const auto excess = [&](const DecimateResult& r) { return int32_t(r.kept.size()) - target; };
+  const int32_t tolerance = int32_t(0.005 * target);
   int32_t drawn = target;
-  for (int pass = 0; pass < params.budget_passes && !best.guided && std::abs(miss(best)) > tolerance; ++pass) {
-    const int32_t next = std::clamp(drawn - miss(best), 1, active);
-    if (next == drawn) break;
-    drawn = next;
-    DecimateResult r = decimate_once(mesh, layout, params, drawn);
-    if (std::abs(miss(r)) < std::abs(miss(best))) best = std::move(r);
+  for (int pass = 0; pass < params.budget_passes && !best.guided && excess(best) > tolerance; ++pass) {
+    drawn = std::max(1, drawn - excess(best) - tolerance);
+    DecimateResult r = decimate_once(mesh, layout, params, drawn, target);
+    if (std::abs(excess(r)) < std::abs(excess(best))) best = std::move(r);
   }
   return best;
 }
@@ -332,7 +396,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
   // Saved lists come from a finished decimation; only topology is re-checked, so the same
   // list always gives the same mesh.
   return cluster_and_emit(mesh, layout, std::move(samples), placement, max_repair_rounds, false, false, {},
-                          std::vector<uint8_t>(mesh.num_vertices(), 0), std::move(result));
+                          std::vector<uint8_t>(mesh.num_vertices(), 0), 0, std::move(result));
 }
 
 DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layout, DecimateParams params,

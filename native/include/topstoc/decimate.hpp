@@ -26,7 +26,7 @@ struct DecimateParams {
   Placement placement = Placement::Subsample;
   int32_t max_repair_rounds = 200;
   int fast_path = -1;           ///< collect candidate faces during the flood: -1 below 5 %, 0 never, 1 always
-  int budget_passes = 3;        ///< extra draws to land within 0.5 % of the target (unguided only)
+  int budget_passes = 2;        ///< extra draws when repairs overshoot the target (unguided only)
 };
 
 struct RepairStats {
@@ -54,6 +54,8 @@ struct DecimateResult {
   double rate = 0.0;                   ///< base rate k used for the probabilities
   bool fast_path = false;
   RepairStats repairs;
+  int32_t top_up_samples = 0;          ///< samples added to make up for absorbed clusters
+  int32_t top_up_rounds = 0;
   double seconds_sampling = 0, seconds_clustering = 0, seconds_checking = 0, seconds_output = 0;
 };
 

@@ -1,0 +1,215 @@
+"""Mesh files: OBJ, PLY, OFF and STL, plain or gzip-compressed (reading also bzip2).
+
+>>> data = read_mesh("bunny.ply.gz")
+>>> data.vertices.shape, data.triangles.shape
+>>> write_mesh("bunny.obj", data)
+
+Reading keeps the file's raw complex: the file's vertices in the file's order, every face
+(polygons fan-triangulated, degenerate and non-manifold faces included). STL files, which
+store three positions per facet, are welded by exact position first (vertex ids then follow
+the order of first appearance). The parsers are native (topstoc._topstoc); compressed files
+are decompressed here and parsed from memory.
+
+What each format carries, reading and writing: OBJ positions, polygons, UVs (vt), materials
+(usemtl names, mtllib) and vertex colours (``v x y z r g b``); PLY positions, polygons, vertex
+colours and UVs (per vertex, or MeshLab's per-face ``texcoord`` list); OFF positions, polygons
+and vertex colours (COFF); STL positions and triangles.
+"""
+
+from __future__ import annotations
+
+import bz2
+import gzip
+import os
+import zlib
+from dataclasses import dataclass, field
+from typing import List, Optional
+
+import numpy as np
+
+from .native import engine
+
+FORMATS = ("obj", "ply", "off", "stl")
+COMPRESSIONS = ("gz", "bz2")
+#: Optional MeshData attributes each format stores (besides positions and faces).
+CARRIES = {"obj": ("corner_uvs", "vertex_colors", "triangle_material"),
+           "ply": ("corner_uvs", "vertex_colors"), "off": ("vertex_colors",), "stl": ()}
+
+
+@dataclass
+class MeshData:
+    """A mesh as stored in a file, in the file's vertex and face order.
+
+    vertices: (n, 3) float64. triangles: (m, 3) int32, polygons fan-triangulated as
+    (v0, vi, vi+1). triangle_polygon: (m,) int32, the index of each triangle's face in the file
+    (faces with fewer than three corners produce no triangle but keep their index).
+    corner_uvs: (m, 3, 2) float64 per triangle corner, NaN where a corner has none.
+    vertex_colors: (n, 3) or (n, 4) float64, in [0, 1] when the file stores bytes.
+    triangle_material: (m,) int32 index into material_names, -1 for faces without one.
+    material_libraries: OBJ mtllib arguments as written (the .mtl files are not read).
+    skipped_faces: faces with fewer than three corners (points, lines) in the file.
+    """
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    triangle_polygon: Optional[np.ndarray] = None
+    corner_uvs: Optional[np.ndarray] = None
+    vertex_colors: Optional[np.ndarray] = None
+    triangle_material: Optional[np.ndarray] = None
+    material_names: List[str] = field(default_factory=list)
+    material_libraries: List[str] = field(default_factory=list)
+    skipped_faces: int = 0
+
+    def __post_init__(self):
+        self.vertices = np.asarray(self.vertices, dtype=np.float64).reshape(-1, 3)
+        triangles = np.asarray(self.triangles, dtype=np.int64).reshape(-1, 3)
+        if triangles.size and (triangles.min() < 0 or triangles.max() > np.iinfo(np.int32).max):
+            raise ValueError(f"triangle indices must lie in [0, 2**31), got "
+                             f"[{triangles.min()}, {triangles.max()}]")
+        self.triangles = triangles.astype(np.int32)
+        m = len(self.triangles)
+        if self.triangle_polygon is None:
+            self.triangle_polygon = np.arange(m, dtype=np.int32)
+        self.triangle_polygon = np.asarray(self.triangle_polygon, dtype=np.int32)
+        if self.corner_uvs is not None:
+            self.corner_uvs = np.asarray(self.corner_uvs, dtype=np.float64).reshape(m, 3, 2)
+        if self.vertex_colors is not None:
+            self.vertex_colors = np.asarray(self.vertex_colors, dtype=np.float64)
+        if self.triangle_material is not None:
+            self.triangle_material = np.asarray(self.triangle_material, dtype=np.int32)
+        self.material_names = list(self.material_names)
+        self.material_libraries = list(self.material_libraries)
+
+    @property
+    def num_vertices(self) -> int:
+        return len(self.vertices)
+
+    def attributes(self) -> List[str]:
+        """Names of the optional attributes this mesh carries."""
+        return [name for name in ("corner_uvs", "vertex_colors", "triangle_material")
+                if getattr(self, name) is not None]
+
+    @property
+    def num_triangles(self) -> int:
+        return len(self.triangles)
+
+    def summary(self) -> str:
+        """One line: counts and which attributes the mesh carries."""
+        parts = [f"{self.num_vertices} vertices", f"{self.num_triangles} triangles"]
+        if self.corner_uvs is not None:
+            parts.append("UVs")
+        if self.vertex_colors is not None:
+            parts.append(f"{self.vertex_colors.shape[1]}-channel vertex colours")
+        if self.triangle_material is not None:
+            parts.append(f"{len(self.material_names)} materials")
+        if self.skipped_faces:
+            parts.append(f"{self.skipped_faces} faces with fewer than 3 corners skipped")
+        return ", ".join(parts)
+
+
+def mesh_format(path) -> tuple:
+    """(format, compression) from a file name: e.g. ("ply", "gz"), ("obj", None).
+
+    Raises ValueError for extensions other than .obj .ply .off .stl (optionally + .gz/.bz2).
+    """
+    name = os.fspath(path)
+    stem, ext = os.path.splitext(name.lower())
+    compression = None
+    if ext[1:] in COMPRESSIONS:
+        compression = ext[1:]
+        stem, ext = os.path.splitext(stem)
+    if ext[1:] not in FORMATS:
+        raise ValueError(f"{name}: unknown mesh file extension {ext or '(none)'!r}; expected one of "
+                         f"{', '.join('.' + f for f in FORMATS)} (optionally followed by .gz or .bz2)")
+    return ext[1:], compression
+
+
+def _decompress(name: str, raw: bytes, compression: Optional[str]) -> bytes:
+    try:
+        if compression == "gz":
+            return gzip.decompress(raw)
+        if compression == "bz2":
+            return bz2.decompress(raw)
+    except (OSError, EOFError, ValueError, zlib.error) as error:
+        raise ValueError(f"{name}: cannot decompress ({compression}): {error}") from None
+    return raw
+
+
+def read_mesh(path) -> MeshData:
+    """Reads a mesh file (see the module docs for formats and conventions).
+
+    Raises FileNotFoundError / OSError when the file cannot be read, ValueError (naming the
+    file, and the line or element) for an unknown extension, an empty PLY or OFF, unparseable
+    content or indices out of range. An empty OBJ or STL reads as an empty mesh.
+    """
+    name = os.fspath(path)
+    kind, compression = mesh_format(name)
+    with open(name, "rb") as stream:
+        raw = stream.read()
+    data = _decompress(name, raw, compression)
+    try:
+        parsed = engine.read_mesh(data, kind)
+    except ValueError as error:
+        raise ValueError(f"{name}: {error}") from None
+    m = len(parsed["triangles"])
+    uvs = parsed["corner_uvs"]
+    return MeshData(vertices=parsed["vertices"], triangles=parsed["triangles"],
+                    triangle_polygon=parsed["triangle_polygon"],
+                    corner_uvs=None if uvs is None else uvs.reshape(m, 3, 2),
+                    vertex_colors=parsed["vertex_colors"],
+                    triangle_material=parsed["triangle_material"],
+                    material_names=parsed["material_names"],
+                    material_libraries=parsed["material_libraries"],
+                    skipped_faces=int(parsed["skipped_faces"]))
+
+
+def encode_mesh(data: MeshData, kind: str) -> bytes:
+    """The bytes of ``data`` written as ``kind`` ("obj", "ply", "off" or "stl"), uncompressed."""
+    if kind not in FORMATS:
+        raise ValueError(f"format must be one of {FORMATS}, got {kind!r}")
+    m = data.num_triangles
+    uvs = None if data.corner_uvs is None else np.asarray(data.corner_uvs, dtype=np.float64)
+    if uvs is not None and uvs.shape != (m, 3, 2):
+        raise ValueError(f"corner_uvs must have shape ({m}, 3, 2), got {uvs.shape}")
+    return engine.write_mesh(kind, data.vertices, data.triangles,
+                             triangle_polygon=data.triangle_polygon,
+                             corner_uvs=None if uvs is None else uvs.reshape(m, 6),
+                             vertex_colors=data.vertex_colors,
+                             triangle_material=data.triangle_material,
+                             material_names=[str(n) for n in data.material_names],
+                             material_libraries=[str(n) for n in data.material_libraries])
+
+
+def dropped_attributes(data: MeshData, path) -> List[str]:
+    """The attributes of ``data`` that writing it to ``path`` would lose (see CARRIES)."""
+    kind, _ = mesh_format(path)
+    return [name for name in data.attributes() if name not in CARRIES[kind]]
+
+
+def write_mesh(path, data: MeshData) -> None:
+    """Writes ``data`` in the format the extension names; .gz (or .bz2) compresses.
+
+    Formats carry what they can (CARRIES, dropped_attributes); PLY is written binary little-endian, STL
+    binary. The file is written to a temporary name first and then renamed, so a failed write
+    never leaves a half-written file at ``path``.
+    """
+    name = os.fspath(path)
+    kind, compression = mesh_format(name)
+    try:
+        payload = encode_mesh(data, kind)
+    except ValueError as error:
+        raise ValueError(f"{name}: {error}") from None
+    if compression == "gz":
+        payload = gzip.compress(payload, compresslevel=6, mtime=0)
+    elif compression == "bz2":
+        payload = bz2.compress(payload)
+    temporary = f"{name}.tmp{os.getpid()}"
+    try:
+        with open(temporary, "wb") as stream:
+            stream.write(payload)
+        os.replace(temporary, name)
+    except OSError as error:
+        raise OSError(error.errno, f"{name}: cannot write the file ({error.strerror})") from None
+    finally:
+        if os.path.exists(temporary):
+            os.remove(temporary)

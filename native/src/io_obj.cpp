@@ -1,0 +1,234 @@
+// Wavefront OBJ: v (with optional r g b [a]), vt, f (any polygon, v, v/vt, v//vn, v/vt/vn,
+// negative = relative indices), usemtl, mtllib. Other statements (vn, g, o, s, l, p, ...) are
+// skipped. Materials are named by usemtl in order of first use; the .mtl file is not read.
+#include <string>
+#include <unordered_map>
+
+#include "io_detail.hpp"
+
+namespace topstoc::io_detail {
+
+namespace {
+
+std::string_view trim(std::string_view text) {
+  while (!text.empty() && is_space(text.front())) text.remove_prefix(1);
+  while (!text.empty() && is_space(text.back())) text.remove_suffix(1);
+  return text;
+}
+
+// An index as written (1-based, or negative = counted back from the last one defined so
+// far) resolved to 0-based. Forward references are allowed and checked at the end.
+int64_t resolve(std::string_view token, int64_t defined, size_t line, const char* what) {
+  int64_t index = 0;
+  if (!parse_int(token, index) || index == 0)
+    fail_at_line(line, std::string("bad ") + what + " index " + quote(token));
+  const int64_t resolved = index > 0 ? index - 1 : defined + index;
+  if (resolved < 0)
+    fail_at_line(line, std::string(what) + " index " + std::to_string(index) + " points before the first " + what);
+  if (resolved > INT32_MAX) fail_at_line(line, std::string(what) + " index " + std::to_string(index) + " is too large");
+  return resolved;
+}
+
+// Faces as read, before we know whether any corner has a UV or any face a material.
+struct ObjFaces {
+  std::vector<int32_t> corner_vertex, corner_uv;  // uv: -1 = none
+  std::vector<int64_t> offsets{0};
+  std::vector<int32_t> material;
+  int64_t max_vertex = -1, max_uv = -1;
+  size_t max_vertex_line = 0, max_uv_line = 0;
+};
+
+}  // namespace
+
+MeshFile read_obj(const char* data, size_t size) {
+  MeshFile mesh;
+  std::vector<double> uv_table;
+  std::vector<double> colors;  // 4 per coloured vertex, alpha 1 unless given; kept if all are
+  int64_t colored = 0, channels = 3;
+  ObjFaces faces;
+  std::unordered_map<std::string, int32_t> material_ids;
+  int32_t material = -1;
+  bool any_material = false;
+
+  TextLines lines(data, data + size);
+  std::string_view line;
+  std::string joined;  // a statement continued over several lines with '\'
+  while (lines.next(line)) {
+    if (!line.empty() && line.back() == '\\') {
+      joined.assign(line.substr(0, line.size() - 1));
+      joined += ' ';
+      while (lines.next(line)) {
+        const bool more = !line.empty() && line.back() == '\\';
+        joined.append(line.substr(0, line.size() - (more ? 1 : 0)));
+        if (!more) break;
+        joined += ' ';
+      }
+      line = joined;
+    }
+    const size_t number = lines.number();
+    if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    std::string_view rest = line, keyword, token;
+    if (!next_token(rest, keyword)) continue;
+
+    if (keyword == "v") {
+      double values[7];
+      int count = 0;
+      while (next_token(rest, token)) {
+        if (count == 7) fail_at_line(number, "vertex has more than 7 numbers");
+        if (!parse_double(token, values[count])) fail_at_line(number, "vertex coordinate " + quote(token) + " is not a number");
+        ++count;
+      }
+      if (count < 3) fail_at_line(number, "vertex needs 3 coordinates, got " + std::to_string(count));
+      mesh.positions.insert(mesh.positions.end(), values, values + 3);
+      // "v x y z r g b [a]" is the common colour extension; "v x y z w" has no colour.
+      const bool has_color = count >= 6;
+      if (has_color) {
+        colors.insert(colors.end(), {values[3], values[4], values[5], count == 7 ? values[6] : 1.0});
+        if (count == 7) channels = 4;
+        ++colored;
+      }
+    } else if (keyword == "vt") {
+      double uv[2] = {0.0, 0.0};
+      int count = 0;
+      while (next_token(rest, token)) {
+        double value;
+        if (!parse_double(token, value)) fail_at_line(number, "texture coordinate " + quote(token) + " is not a number");
+        if (count < 2) uv[count] = value;
+        ++count;
+      }
+      if (count < 1) fail_at_line(number, "vt needs at least one coordinate");
+      uv_table.insert(uv_table.end(), uv, uv + 2);
+    } else if (keyword == "f" || keyword == "fo") {
+      while (next_token(rest, token)) {
+        const size_t slash = token.find('/');
+        const int64_t v = resolve(token.substr(0, slash), mesh.num_vertices(), number, "vertex");
+        if (v > faces.max_vertex) faces.max_vertex = v, faces.max_vertex_line = number;
+        int64_t t = -1;
+        if (slash != std::string_view::npos) {
+          std::string_view uv_token = token.substr(slash + 1);
+          uv_token = uv_token.substr(0, uv_token.find('/'));
+          if (!uv_token.empty()) {
+            t = resolve(uv_token, int64_t(uv_table.size() / 2), number, "texture coordinate");
+            if (t > faces.max_uv) faces.max_uv = t, faces.max_uv_line = number;
+          }
+        }
+        faces.corner_vertex.push_back(int32_t(v));
+        faces.corner_uv.push_back(int32_t(t));
+      }
+      faces.offsets.push_back(int64_t(faces.corner_vertex.size()));
+      faces.material.push_back(material);
+    } else if (keyword == "usemtl") {
+      const std::string name(trim(rest));
+      if (name.empty()) fail_at_line(number, "usemtl without a material name");
+      any_material = true;
+      if (name == "(null)") {  // how the writer spells "no material" after a named one
+        material = -1;
+        continue;
+      }
+      material = material_ids.emplace(name, int32_t(mesh.material_names.size())).first->second;
+      if (material == int32_t(mesh.material_names.size())) mesh.material_names.push_back(name);
+    } else if (keyword == "mtllib") {
+      const std::string name(trim(rest));
+      if (!name.empty()) mesh.material_libraries.push_back(name);
+    }
+  }
+
+  const int64_t n = mesh.num_vertices();
+  if (faces.max_vertex >= n)
+    fail_at_line(faces.max_vertex_line, "face refers to vertex " + std::to_string(faces.max_vertex + 1) +
+                                            ", but the file has " + std::to_string(n) + " vertices");
+  if (faces.max_uv >= int64_t(uv_table.size() / 2))
+    fail_at_line(faces.max_uv_line, "face refers to texture coordinate " + std::to_string(faces.max_uv + 1) +
+                                        ", but the file has " + std::to_string(uv_table.size() / 2));
+  if (colored == n && n > 0) {
+    mesh.color_channels = int32_t(channels);
+    mesh.vertex_colors.reserve(size_t(channels * n));
+    for (int64_t v = 0; v < n; ++v)
+      for (int64_t k = 0; k < channels; ++k) mesh.vertex_colors.push_back(colors[4 * size_t(v) + k]);
+  }
+
+  const bool with_uvs = faces.max_uv >= 0;
+  std::vector<double> uvs;
+  const int64_t count = int64_t(faces.offsets.size()) - 1;
+  for (int64_t f = 0; f < count; ++f) {
+    const int64_t begin = faces.offsets[f], end = faces.offsets[f + 1];
+    if (with_uvs) {
+      uvs.clear();
+      for (int64_t c = begin; c < end; ++c) {
+        const int32_t t = faces.corner_uv[c];
+        uvs.push_back(t >= 0 ? uv_table[2 * size_t(t)] : kNaN);
+        uvs.push_back(t >= 0 ? uv_table[2 * size_t(t) + 1] : kNaN);
+      }
+    }
+    add_polygon(mesh, faces.corner_vertex.data() + begin, size_t(end - begin), with_uvs ? uvs.data() : nullptr,
+                faces.material[f], with_uvs, any_material);
+  }
+  return mesh;
+}
+
+std::string write_obj(const MeshFile& mesh) {
+  std::string out = "# written by TopStoc\n";
+  out.reserve(size_t(mesh.num_vertices()) * 64 + mesh.triangles.size() * (mesh.corner_uvs.empty() ? 9 : 24));
+  for (const auto& library : mesh.material_libraries) out += "mtllib " + library + "\n";
+  const int64_t n = mesh.num_vertices();
+  for (int64_t v = 0; v < n; ++v) {
+    out += "v";
+    for (int k = 0; k < 3; ++k) out += ' ', append_number(out, mesh.positions[3 * v + k]);
+    for (int k = 0; k < mesh.color_channels; ++k) out += ' ', append_number(out, mesh.vertex_colors[mesh.color_channels * v + k]);
+    out += '\n';
+  }
+
+  // One vt per distinct UV (bit pattern), in order of first use.
+  const bool with_uvs = !mesh.corner_uvs.empty();
+  std::vector<int64_t> corner_vt;
+  if (with_uvs) {
+    struct PairHash {
+      size_t operator()(const std::pair<uint64_t, uint64_t>& p) const { return p.first * 0x9E3779B97F4A7C15ull ^ p.second; }
+    };
+    std::unordered_map<std::pair<uint64_t, uint64_t>, int64_t, PairHash> ids;
+    corner_vt.assign(mesh.triangles.size(), -1);
+    for (size_t c = 0; c < mesh.triangles.size(); ++c) {
+      const double u = mesh.corner_uvs[2 * c], w = mesh.corner_uvs[2 * c + 1];
+      if (std::isnan(u) || std::isnan(w)) continue;
+      std::pair<uint64_t, uint64_t> key;
+      std::memcpy(&key.first, &u, 8);
+      std::memcpy(&key.second, &w, 8);
+      const auto [it, added] = ids.emplace(key, int64_t(ids.size()));
+      if (added) {
+        out += "vt ";
+        append_number(out, u);
+        out += ' ';
+        append_number(out, w);
+        out += '\n';
+      }
+      corner_vt[c] = it->second;
+    }
+  }
+
+  int32_t material = -1;
+  std::vector<int64_t> corners;
+  for (const auto& group : polygon_groups(mesh)) {
+    if (!mesh.triangle_material.empty() && mesh.triangle_material[group.begin] != material) {
+      material = mesh.triangle_material[group.begin];
+      // OBJ cannot go back to "no material"; "(null)" reads back as -1 (see read_obj).
+      out += "usemtl ";
+      out += material < 0                        ? std::string("(null)")
+             : mesh.material_names.empty() ? "material_" + std::to_string(material)
+                                                 : mesh.material_names[material];
+      out += '\n';
+    }
+    group_corners(group, corners);
+    bool uv_complete = with_uvs;
+    for (int64_t c : corners) uv_complete = uv_complete && corner_vt[c] >= 0;
+    out += 'f';
+    for (int64_t c : corners) {
+      out += ' ';
+      append_number(out, int64_t(mesh.triangles[c]) + 1);
+      if (uv_complete) out += '/', append_number(out, corner_vt[c] + 1);
+    }
+    out += '\n';
+  }
+  return out;
+}
+
+}  // namespace topstoc::io_detail

@@ -1,0 +1,76 @@
+"""UV seams and attribute transfer (topstoc.core.attributes) against brute force."""
+
+import pathlib
+
+import numpy as np
+
+from meshgen import torus
+from topstoc.core import Mesh
+from topstoc.core.attributes import material_regions, transfer_attributes, uv_seam_edges
+from topstoc.core.io import MeshData, read_mesh
+
+DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
+
+
+def brute_force_seams(triangles, corner_uvs):
+    sides = {}
+    for t, tri in enumerate(triangles):
+        if len(set(tri.tolist())) < 3:
+            continue
+        for c in range(3):
+            a, b = int(tri[c]), int(tri[(c + 1) % 3])
+            ua, ub = tuple(corner_uvs[t, c]), tuple(corner_uvs[t, (c + 1) % 3])
+            key, value = ((a, b), (ua, ub)) if a < b else ((b, a), (ub, ua))
+            sides.setdefault(key, set()).add(value)
+    return {key for key, values in sides.items() if len(values) > 1}
+
+
+def test_seams_of_the_test_files_match_brute_force():
+    for name in ("uv_materials/spider/spider.obj", "uv_materials/duck/duck_via_assimp.obj"):
+        data = read_mesh(DATA / name)
+        seams = uv_seam_edges(data.triangles, data.corner_uvs)
+        assert seams.dtype == np.int32 and (seams[:, 0] < seams[:, 1]).all()
+        assert {tuple(e) for e in seams.tolist()} == brute_force_seams(data.triangles, data.corner_uvs), name
+
+
+def test_torus_cut_open_by_its_uvs_has_exactly_those_seams():
+    nu, nv = 12, 6
+    vertices, triangles = torus(nu, nv)
+    # meshgen's grid: face pair f // 2 = i * nv + j, triangles (i,j)(i+1,j)(i+1,j+1) and
+    # (i,j)(i+1,j+1)(i,j+1). UVs from the unwrapped grid cut the torus along i = 0 and j = 0.
+    f = np.arange(len(triangles))
+    i, j = (f // 2) // nv, (f // 2) % nv
+    offsets = np.where((f % 2 == 0)[:, None, None], [[0, 0], [1, 0], [1, 1]], [[0, 0], [1, 1], [0, 1]])
+    grid = np.stack([i, j], axis=-1)[:, None, :] + offsets
+    uvs = grid / [nu, nv]
+    seams = {tuple(e) for e in uv_seam_edges(triangles, uvs).tolist()}
+    assert seams == brute_force_seams(triangles, uvs)
+    assert len(seams) == nu + nv  # one meridian and one parallel loop
+
+
+def test_no_uv_differences_no_seams():
+    vertices, triangles = torus(8, 4)
+    uvs = vertices[triangles][..., :2]  # a function of the vertex: continuous everywhere
+    assert len(uv_seam_edges(triangles, uvs)) == 0
+    nan = np.full((len(triangles), 3, 2), np.nan)
+    assert len(uv_seam_edges(triangles, nan)) == 0
+
+
+def test_transfer_copies_through_the_source_maps():
+    data = read_mesh(DATA / "uv_materials" / "spider" / "spider.obj")
+    mesh = Mesh(data.vertices, data.triangles)
+    result = mesh.decimate(ratio=0.5, regions=material_regions(data),
+                           borders=uv_seam_edges(data.triangles, data.corner_uvs))
+    out = transfer_attributes(data, result)
+    np.testing.assert_array_equal(out.triangle_material, data.triangle_material[result.face_source])
+    flat = data.corner_uvs.reshape(-1, 2)
+    np.testing.assert_array_equal(out.corner_uvs, flat[result.corner_source.ravel()].reshape(-1, 3, 2))
+    # The source corner belongs to the kept vertex.
+    np.testing.assert_array_equal(data.triangles.ravel()[result.corner_source.ravel()],
+                                  result.kept[result.triangles.ravel()])
+    assert out.material_names == data.material_names
+
+
+def test_single_material_is_no_region():
+    assert material_regions(MeshData(vertices=np.zeros((3, 3)), triangles=[[0, 1, 2]],
+                                     triangle_material=[0], material_names=["a"])) is None

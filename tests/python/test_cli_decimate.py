@@ -1,0 +1,190 @@
+"""The ``decimate`` command line (SPEC section 6), run as a subprocess like a user would."""
+
+import inspect
+import json
+import os
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from meshgen import torus
+from topstoc.core.decimate import decimate as core_decimate
+from topstoc.core.io import MeshData, read_mesh, write_mesh
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+BUILD_PYTHON = pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build")) / "python"
+DATA = ROOT / "tests" / "data"
+
+
+def topstoc(*args):
+    env = dict(os.environ, PYTHONPATH=str(BUILD_PYTHON))
+    return subprocess.run([sys.executable, "-m", "topstoc", "decimate", *map(str, args)],
+                          capture_output=True, text=True, env=env, timeout=120)
+
+
+def run_json(*args):
+    done = topstoc(*args, "--json")
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == ""
+    return json.loads(done.stdout)
+
+
+def assert_one_error_line(done, *fragments):
+    assert done.returncode == 1
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("topstoc decimate: error: ")
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+    assert done.stdout == ""
+
+
+def test_json_report_matches_the_files(tmp_path):
+    source = DATA / "genus_positive" / "cgal_elephant.off"
+    out = tmp_path / "elephant.ply"
+    report = run_json(source, out, "--vertices", 500, "--seed", 3)
+    original, written = read_mesh(source), read_mesh(out)
+    assert report["input"]["vertices"] == original.num_vertices == 2775
+    assert report["input"]["triangles"] == original.num_triangles == 5558
+    assert report["output"]["vertices"] == written.num_vertices
+    assert report["output"]["triangles"] == written.num_triangles
+    assert abs(written.num_vertices - 500) <= 5 + report["repairs"]
+    assert report["seconds"] > 0 and isinstance(report["repairs"], int)
+    assert report["topology_kept"] is True
+    # Output vertices are input vertices; a closed genus-3 surface keeps chi = -4.
+    original_rows = {tuple(v) for v in original.vertices}
+    assert all(tuple(v) in original_rows for v in written.vertices)
+    edges = np.unique(np.sort(written.triangles[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)
+    assert written.num_vertices - len(edges) + written.num_triangles == -4
+
+
+def test_triangle_and_ratio_targets(tmp_path):
+    source = DATA / "genus0" / "cgal_fandisk.off"
+    by_triangles = run_json(source, tmp_path / "a.obj", "--triangles", 2000)
+    assert abs(by_triangles["output"]["triangles"] - 2000) <= 0.05 * 2000
+    by_ratio = run_json(source, tmp_path / "b.off.gz", "--ratio", 0.1, "--density", "adaptive", "--adaptivity", 0.8)
+    assert read_mesh(tmp_path / "b.off.gz").num_vertices == by_ratio["output"]["vertices"]
+    assert abs(by_ratio["output"]["vertices"] - 648) <= 0.1 * 648
+
+
+def test_same_seed_same_file_other_seed_other_file(tmp_path):
+    source = DATA / "genus_positive" / "cgal_knot1.off"
+    for name, seed in (("a.ply", 7), ("b.ply", 7), ("c.ply", 8)):
+        run_json(source, tmp_path / name, "--ratio", 0.2, "--seed", seed)
+    assert (tmp_path / "a.ply").read_bytes() == (tmp_path / "b.ply").read_bytes()
+    assert (tmp_path / "a.ply").read_bytes() != (tmp_path / "c.ply").read_bytes()
+
+
+def test_uvs_and_materials_survive(tmp_path):
+    source = DATA / "uv_materials" / "spider" / "spider.obj"
+    report = run_json(source, tmp_path / "spider.obj", "--ratio", 0.4)
+    original, written = read_mesh(source), read_mesh(tmp_path / "spider.obj")
+    assert report["input"]["uv_seam_edges"] > 0
+    assert report["output"]["dropped_attributes"] == []
+    to_ply = run_json(source, tmp_path / "spider.ply", "--ratio", 0.4)
+    assert to_ply["output"]["dropped_attributes"] == ["triangle_material"]
+    assert written.corner_uvs is not None and written.triangle_material is not None
+    assert set(written.material_names) <= set(original.material_names)
+    # Every output corner is an input corner: same position, same UV, same material.
+    corners = {(tuple(original.vertices[v]), tuple(original.corner_uvs[t, c]),
+                original.material_names[original.triangle_material[t]])
+               for t, tri in enumerate(original.triangles) for c, v in enumerate(tri)}
+    for t, tri in enumerate(written.triangles):
+        for c, v in enumerate(tri):
+            key = (tuple(written.vertices[v]), tuple(written.corner_uvs[t, c]),
+                   written.material_names[written.triangle_material[t]])
+            assert key in corners, (t, c)
+    # mtllib still finds the input's .mtl from the output's folder.
+    assert (tmp_path / written.material_libraries[0]).resolve() == (source.parent / "spider.mtl").resolve()
+
+
+def test_vertex_colours_survive(tmp_path):
+    vertices, triangles = torus(40, 20)
+    colors = np.round(np.random.default_rng(1).random((len(vertices), 3)) * 255) / 255
+    write_mesh(tmp_path / "torus.ply", MeshData(vertices=vertices, triangles=triangles, vertex_colors=colors))
+    run_json(tmp_path / "torus.ply", tmp_path / "small.ply", "--ratio", 0.25)
+    written = read_mesh(tmp_path / "small.ply")
+    index = {tuple(v): i for i, v in enumerate(vertices)}
+    source = np.array([index[tuple(v)] for v in written.vertices])
+    np.testing.assert_array_equal(written.vertex_colors, colors[source])
+
+
+def test_guidance_keeps_control_points(tmp_path):
+    source = DATA / "genus_positive" / "cgal_eight.off"
+    u = np.zeros(315)
+    control = np.arange(0, 315, 10)
+    u[control] = 1.0
+    np.save(tmp_path / "u.npy", u)
+    report = run_json(source, tmp_path / "out.off", "--ratio", 0.1, "--guidance", tmp_path / "u.npy")
+    assert report["guided"] is True
+    original, written = read_mesh(source), read_mesh(tmp_path / "out.off")
+    kept = {tuple(v) for v in written.vertices}
+    assert all(tuple(original.vertices[v]) in kept for v in control)
+
+
+def test_guidance_of_the_wrong_length(tmp_path):
+    np.save(tmp_path / "u.npy", np.zeros(100))
+    done = topstoc(DATA / "genus_positive" / "cgal_eight.off", tmp_path / "out.off", "--ratio", 0.1,
+                   "--guidance", tmp_path / "u.npy")
+    assert_one_error_line(done, "u.npy", "one value per input vertex (315)", "(100,)")
+    assert not (tmp_path / "out.off").exists()
+    (tmp_path / "bad.npy").write_text("not numpy")
+    done = topstoc(DATA / "genus_positive" / "cgal_eight.off", tmp_path / "out.off", "--ratio", 0.1,
+                   "--guidance", tmp_path / "bad.npy")
+    assert_one_error_line(done, "bad.npy", "not a readable .npy file")
+    u = np.zeros(315)
+    u[17] = np.nan
+    np.save(tmp_path / "nan.npy", u)
+    done = topstoc(DATA / "genus_positive" / "cgal_eight.off", tmp_path / "out.off", "--ratio", 0.1,
+                   "--guidance", tmp_path / "nan.npy")
+    assert_one_error_line(done, "nan.npy", "guidance of vertex 17 is nan")
+
+
+def test_stl_vertex_ids_follow_the_welded_order(tmp_path):
+    source = DATA / "nonmanifold_degenerate" / "openscad_issue1580-back-to-back.stl"
+    report = run_json(source, tmp_path / "out.stl", "--ratio", 1.0)
+    assert report["input"]["vertices"] == 6 and report["input"]["triangles"] == 10
+
+
+@pytest.mark.parametrize("args,fragments", [
+    (["missing.obj", "out.obj", "--ratio", "0.5"], ["missing.obj"]),
+    ([DATA / "nonmanifold_degenerate" / "openscad_unparseable.stl", "out.stl", "--ratio", "0.5"],
+     ["openscad_unparseable.stl: line 4:", "is not a number"]),
+    ([DATA / "nonmanifold_degenerate" / "openscad_empty.stl", "out.stl", "--ratio", "0.5"],
+     ["openscad_empty.stl: the mesh has no triangles"]),
+    ([DATA / "genus_positive" / "cgal_eight.off", "out.fbx", "--ratio", "0.5"], ["unknown mesh file extension"]),
+    ([DATA / "genus_positive" / "cgal_eight.off", "out.off", "--ratio", "0"], ["ratio must lie in (0, 1]"]),
+    ([DATA / "genus_positive" / "cgal_eight.off", "out.off", "--vertices", "100000"], ["vertex target 100000"]),
+])
+def test_bad_input_is_one_error_line(tmp_path, args, fragments):
+    args = [tmp_path / a if isinstance(a, str) and a.startswith(("missing", "out")) else a for a in args]
+    done = topstoc(*args)
+    assert_one_error_line(done, *fragments)
+    assert not list(tmp_path.glob("out*"))
+
+
+def test_a_target_is_required(tmp_path):
+    done = topstoc(DATA / "genus_positive" / "cgal_eight.off", tmp_path / "out.off")
+    assert done.returncode == 2 and "one of the arguments" in done.stderr
+
+
+def test_max_error(tmp_path):
+    source = DATA / "genus_positive" / "cgal_elephant.off"
+    done = topstoc(source, tmp_path / "out.off", "--max-error", "1%", "--json")
+    if "max_error" not in inspect.signature(core_decimate).parameters:
+        assert_one_error_line(done, "--max-error needs the error-bounded decimation")
+        return
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert report["target"] == {"max_error": "1%"}
+    original = read_mesh(source)
+    assert read_mesh(tmp_path / "out.off").num_vertices == report["output"]["vertices"] < 2775
+    diagonal = np.linalg.norm(original.vertices.max(0) - original.vertices.min(0))
+    bound = report["error_bound"]
+    assert bound["max_error"] == pytest.approx(0.01 * diagonal)
+    assert 0 < bound["achieved_error"] <= bound["max_error"]
+    bad = topstoc(source, tmp_path / "bad.off", "--max-error", "-1")
+    assert_one_error_line(bad, "--max-error must be positive")

@@ -1,0 +1,288 @@
+"""TopStoc decimation: topology, budget, guidance, borders, determinism and bad input.
+
+Topology is checked with tests/reference.py (scipy connected components), never with the
+engine's own checks.
+"""
+
+import os
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import meshgen
+import reference
+from topstoc.core import Mesh
+
+DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
+SURFACES = sorted(DATA.glob("genus0/*.off")) + sorted(DATA.glob("genus_positive/*.off")) + [
+    DATA / "open_boundary/cgal_elephant-with-holes.off", DATA / "open_boundary/cgal_mushroom.off"]
+SEEDS = range(20)
+RATIOS = (0.2, 0.05, 0.01)
+
+
+def load(path):
+    return Mesh(*reference.read_off(path))
+
+
+def check_output(mesh, result, expected_invariants):
+    """The decimated mesh is clean and keeps every component's topology."""
+    tri = result.triangles
+    degenerate, duplicates = reference.degenerate_or_duplicate(tri)
+    assert degenerate == 0 and duplicates == 0
+    # orientation kept: no directed edge twice (so every manifold edge is used once each way)
+    directed = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    assert len(np.unique(directed, axis=0)) == len(directed)
+    assert reference.invariants(result.num_vertices, tri) == expected_invariants
+    # every output vertex is the input vertex it stands for, and each triangle's corners are
+    # the samples of its source triangle's clusters
+    np.testing.assert_array_equal(result.vertices, mesh.vertices[result.kept])
+    source = mesh.triangles[result.face_source]
+    np.testing.assert_array_equal(result.labels[source], tri)
+
+
+@pytest.mark.parametrize("path", SURFACES, ids=lambda p: p.name)
+def test_topology_kept_for_every_seed_and_ratio(path):
+    mesh = load(path)
+    expected = reference.invariants(mesh.num_vertices, mesh.triangles)
+    assert all(manifold and orientable for _, _, manifold, orientable in expected)
+    for ratio in RATIOS:
+        for seed in SEEDS:
+            result = mesh.decimate(ratio=ratio, seed=seed)
+            check_output(mesh, result, expected)
+            assert result.stats.topology_kept
+            target = result.stats.target_vertices
+            miss = result.num_vertices - target
+            if mesh.num_vertices >= 1000:
+                # the budget holds within 1 %, unless the topology needs more samples than the
+                # target allows: then the excess is the repairs the result reports
+                assert abs(miss) <= 0.01 * target or 0 < miss <= result.stats.repairs, (ratio, seed, miss)
+
+
+def test_big_shared_meshes_keep_topology(shared_meshes):
+    for name in ("genus0/cgal_bunny00.off", "genus0/cgal_armadillo.off"):
+        mesh = load(shared_meshes / name)
+        expected = reference.invariants(mesh.num_vertices, mesh.triangles)
+        for ratio in RATIOS:
+            for seed in range(3):
+                result = mesh.decimate(ratio=ratio, seed=seed)
+                check_output(mesh, result, expected)
+                assert abs(result.num_vertices - result.stats.target_vertices) <= 0.01 * result.stats.target_vertices
+
+
+def test_several_components_and_tiny_targets():
+    v, t = meshgen.disjoint(meshgen.torus(24, 12), meshgen.icosphere(3), meshgen.genus_slab(3, 2))
+    mesh = Mesh(v, t)
+    expected = reference.invariants(mesh.num_vertices, mesh.triangles)
+    for target in (3, 30, 300):
+        result = mesh.decimate(vertices=target, seed=target)
+        check_output(mesh, result, expected)
+        # far too small for three components with genus 1 and 3: the engine adds what they need
+        if target == 3:
+            assert result.num_vertices > 3 and result.stats.repairs > 0
+
+
+def region_invariants(num_vertices, triangles, regions):
+    return {r: reference.invariants(num_vertices, triangles[regions == r]) for r in np.unique(regions)}
+
+
+def sphere_with_regions():
+    v, t = meshgen.icosphere(4)
+    centroid = v[t].mean(axis=1)
+    regions = (centroid[:, 0] > 0.2).astype(np.int32) + 2 * (centroid[:, 1] > -0.3)
+    return v, t, regions
+
+
+def test_regions_are_never_crossed_and_survive():
+    v, t, regions = sphere_with_regions()
+    mesh = Mesh(v, t)
+    expected = region_invariants(len(v), t, regions)
+    regions_of_vertex = [set() for _ in range(len(v))]
+    for f, (a, b, c) in enumerate(t):
+        for x in (a, b, c):
+            regions_of_vertex[x].add(int(regions[f]))
+    for ratio in RATIOS:
+        for seed in range(5):
+            r = mesh.decimate(ratio=ratio, seed=seed, regions=regions)
+            out_regions = regions[r.face_source]
+            # each region decimates to a surface of the same topology, with the same borders
+            got = region_invariants(r.num_vertices, r.triangles, out_regions)
+            assert got == expected
+            # no cluster crosses a border: a vertex's sample touches every region the vertex touches
+            for vertex, output in enumerate(r.labels):
+                assert regions_of_vertex[vertex] <= regions_of_vertex[r.kept[output]]
+            # attributes come from a corner of the kept vertex in the output triangle's region
+            corner_face, corner_slot = np.divmod(r.corner_source, 3)
+            np.testing.assert_array_equal(t[corner_face, corner_slot], r.kept[r.triangles])
+            np.testing.assert_array_equal(regions[corner_face], out_regions[:, None].repeat(3, 1))
+
+
+def test_flagged_border_edges_act_like_region_borders():
+    v, t, regions = sphere_with_regions()
+    mesh = Mesh(v, t)
+    edges = reference.undirected_edges(t)
+    face_of_side = np.concatenate([np.arange(len(t))] * 3)
+    order = np.lexsort((edges[:, 1], edges[:, 0]))
+    e, f = edges[order], face_of_side[order]
+    same = np.all(e[0::2] == e[1::2], axis=1)
+    assert same.all()  # closed manifold: every edge has exactly two sides
+    border = e[0::2][regions[f[0::2]] != regions[f[1::2]]]
+    a = mesh.decimate(ratio=0.05, seed=4, regions=regions)
+    b = mesh.decimate(ratio=0.05, seed=4, borders=border)
+    np.testing.assert_array_equal(a.triangles, b.triangles)
+    np.testing.assert_array_equal(a.kept, b.kept)
+
+
+def test_control_points_kept_and_excluded_vertices_absent():
+    v, t = meshgen.icosphere(4)
+    mesh = Mesh(v, t)
+    rng = np.random.default_rng(5)
+    u = np.zeros(len(v))
+    keep = rng.choice(np.flatnonzero(v[:, 2] < 0.5), 25, replace=False)
+    u[keep] = 1.0
+    drop = np.flatnonzero(v[:, 2] > 0.7)
+    u[drop] = -1.0
+    for seed in range(5):
+        r = mesh.decimate(ratio=0.02, seed=seed, guidance=u)
+        assert set(keep) <= set(r.kept)
+        assert not set(drop) & set(r.kept)
+        check_output(mesh, r, reference.invariants(len(v), t))
+
+
+def test_painted_region_keeps_more_vertices():
+    v, t = meshgen.icosphere(5)
+    mesh = Mesh(v, t)
+    painted = v[:, 0] > 0
+    u = np.where(painted, 0.5, 0.0)
+    r = mesh.decimate(ratio=0.02, seed=1, guidance=u)
+    inside = painted[r.kept].sum()
+    outside = (~painted[r.kept]).sum()
+    # p = k + (1 - k) 0.5 ~ 0.51 vs k = 0.02 per vertex: far more than 5x denser
+    assert inside > 5 * outside
+
+
+def test_view_dependent_keeps_the_front():
+    from topstoc.core import View
+    v, t = meshgen.icosphere(5)
+    mesh = Mesh(v, t)
+    r = mesh.decimate(ratio=0.05, seed=2, view=View(eye=[0, 0, 10], back_ratio=0.1))
+    front = v[r.kept][:, 2] > 0.3
+    back = v[r.kept][:, 2] < -0.3
+    assert front.sum() > 5 * back.sum()
+    check_output(mesh, r, reference.invariants(len(v), t))
+
+
+def test_same_seed_identical_arrays_and_samples_restore():
+    v, t, regions = sphere_with_regions()
+    mesh = Mesh(v, t)
+    for placement in ("subsample", "filtered"):
+        a = mesh.decimate(ratio=0.03, seed=11, regions=regions, placement=placement)
+        b = mesh.decimate(ratio=0.03, seed=11, regions=regions, placement=placement)
+        c = mesh.decimate_with_samples(a.samples, regions=regions, placement=placement)
+        for other in (b, c):
+            for name in ("vertices", "triangles", "kept", "face_source", "corner_source", "labels", "samples"):
+                np.testing.assert_array_equal(getattr(a, name), getattr(other, name), err_msg=name)
+    assert not np.array_equal(mesh.decimate(ratio=0.03, seed=12).kept, a.kept)
+
+
+SERIAL_PARALLEL_SCRIPT = """
+import hashlib, sys
+sys.path[:0] = [{build!r}, {tests!r}]
+import meshgen
+from topstoc.core import Mesh
+mesh = Mesh(*meshgen.icosphere(5))
+digest = hashlib.sha256()
+for ratio in (0.2, 0.02):
+    r = mesh.decimate(ratio=ratio, seed=3, density="adaptive")
+    for a in (r.vertices, r.triangles, r.kept, r.corner_source, r.labels, r.samples):
+        digest.update(a.tobytes())
+print(digest.hexdigest())
+"""
+
+
+def test_serial_and_parallel_runs_agree():
+    build = str(pathlib.Path(sys.modules["topstoc"].__file__).parents[1])
+    tests = str(pathlib.Path(__file__).resolve().parents[1])
+    script = SERIAL_PARALLEL_SCRIPT.format(build=build, tests=tests)
+    digests = set()
+    for threads in ("1", "2", "3"):
+        env = dict(os.environ, OMP_NUM_THREADS=threads)
+        out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
+        digests.add(out.stdout.strip())
+    assert len(digests) == 1
+
+
+def test_triangle_target_within_one_percent():
+    mesh = load(DATA / "genus0/cgal_fandisk.off")
+    for target in (500, 2000, 6000):
+        r = mesh.decimate(triangles=target, seed=1)
+        assert abs(r.num_triangles - target) <= 0.01 * target
+
+
+def test_filtered_placement_moves_surface_samples_only():
+    v, t = meshgen.grid(30, 30)
+    v[:, 2] = np.sin(v[:, 0] / 4) * np.cos(v[:, 1] / 5) * 3
+    mesh = Mesh(v, t)
+    plain = mesh.decimate(ratio=0.05, seed=2)
+    filtered = mesh.decimate(ratio=0.05, seed=2, placement="filtered")
+    np.testing.assert_array_equal(plain.triangles, filtered.triangles)
+    moved = np.linalg.norm(filtered.vertices - plain.vertices, axis=1)
+    border = (v[plain.kept, 0] % 30 == 0) | (v[plain.kept, 1] % 30 == 0)
+    assert np.all(moved[border] == 0)       # boundary samples stay (borders keep their positions)
+    assert np.count_nonzero(moved[~border]) > 0.5 * (~border).sum()
+    # and no sample leaves its cluster's radius
+    for i, s in enumerate(plain.kept):
+        members = v[plain.labels == i]
+        radius = np.linalg.norm(members - v[s], axis=1).max()
+        assert moved[i] <= radius + 1e-9
+
+
+def test_nonmanifold_input_is_decimated_without_damage():
+    # two tetrahedra sharing one edge (the edge has four triangles), plus a fin
+    v = np.array([[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, 0.5, 1], [0.5, -1, 0], [0.5, -0.5, 1],
+                  [0.5, 0.2, -1]], dtype=float)
+    t = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2],
+                  [0, 1, 4], [0, 5, 1], [1, 5, 4], [0, 4, 5], [0, 1, 6]])
+    mesh = Mesh(v, t)
+    assert mesh.report().nonmanifold_edges == 1
+    r = mesh.decimate(vertices=4, seed=0)
+    degenerate, duplicates = reference.degenerate_or_duplicate(r.triangles)
+    assert degenerate == 0 and duplicates == 0
+    # the non-manifold edge is a corner-to-corner feature: both ends stay
+    assert {0, 1} <= set(r.kept)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(ratio=0), r"ratio must lie in \(0, 1\]"),
+    (dict(ratio=1.5), r"ratio must lie in \(0, 1\]"),
+    (dict(ratio=float("nan")), r"ratio must lie in \(0, 1\]"),
+    (dict(vertices=0), r"outside \[1, 642\]"),
+    (dict(vertices=10**6), r"outside \[1, 642\]"),
+    (dict(vertices=2.5), "must be an integer"),
+    (dict(triangles=0), r"outside \[1, 1280\]"),
+    (dict(ratio=0.1, vertices=10), "exactly one target"),
+    (dict(), "exactly one target"),
+    (dict(ratio=0.1, seed=-1), "seed"),
+    (dict(ratio=0.1, placement="moved"), "placement"),
+    (dict(ratio=0.1, regions=np.zeros(7, dtype=np.int32)), "regions has 7 entries"),
+    (dict(ratio=0.1, borders=np.array([[0, 600]])), r"border edge 0 \(0, 600\) is not an edge"),
+    (dict(ratio=0.1, borders=np.array([[0, 10**6]])), "is not an edge"),
+])
+def test_bad_decimation_arguments(kwargs, message):
+    mesh = Mesh(*meshgen.icosphere(3))
+    with pytest.raises(ValueError, match=message):
+        mesh.decimate(**kwargs)
+
+
+@pytest.mark.parametrize("samples, message", [
+    (np.array([], dtype=np.int64), "empty"),
+    (np.array([0, 1, 700]), "outside"),
+    (np.array([0, 5, 5]), "sampled twice"),
+    (np.array([0.5]), "integer"),
+])
+def test_bad_sample_lists(samples, message):
+    mesh = Mesh(*meshgen.icosphere(3))
+    with pytest.raises(ValueError, match=message):
+        mesh.decimate_with_samples(samples)

@@ -1,0 +1,108 @@
+"""The prepared mesh: validation, repairs, weights, and what it must never do."""
+
+import numpy as np
+import pytest
+
+import meshgen
+import reference
+from topstoc.core import Mesh
+
+
+def tetrahedron():
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
+    triangles = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]])
+    return vertices, triangles
+
+
+def test_accepts_float32_and_int64_with_identical_results():
+    v, t = meshgen.icosphere(2)
+    a = Mesh(v.astype(np.float64), t.astype(np.int32))
+    b = Mesh(v.astype(np.float32).astype(np.float64), t.astype(np.int64))
+    c = Mesh(v.astype(np.float32), t.astype(np.int64))
+    assert a.num_vertices == b.num_vertices == c.num_vertices == len(v)
+    np.testing.assert_array_equal(b.weights, c.weights)
+    assert a.report().closed and a.report().manifold
+
+
+def test_weights_follow_eq_4_1_against_independent_formula():
+    v, t = meshgen.genus_slab(2, scale=2)
+    mesh = Mesh(v, t)
+    np.testing.assert_allclose(mesh.weights, reference.importance_weights(v, t), atol=1e-12)
+    np.testing.assert_allclose(mesh.normals, reference.area_weighted_normals(v, t), atol=1e-12)
+    # a flat grid has zero weight everywhere; the slab's convex edges are the heavy vertices
+    flat_v, flat_t = meshgen.grid(6, 6)
+    assert np.all(Mesh(flat_v, flat_t).weights < 1e-12)
+    assert mesh.weights.max() > 0.1
+
+
+def test_report_counts_repairs_and_defects():
+    v, t = tetrahedron()
+    extra_vertices = np.vstack([v, [[5, 5, 5], [6, 6, 6]]])  # two isolated vertices
+    triangles = np.vstack([t,
+                           [[0, 0, 1]],        # degenerate: dropped
+                           [[2, 0, 1]],        # duplicate of [0, 2, 1] (rotation): dropped
+                           [[0, 1, 2]]])       # duplicate, opposite orientation: dropped
+    mesh = Mesh(extra_vertices, triangles)
+    report = mesh.report()
+    assert report.degenerate_triangles == 1
+    assert report.duplicate_triangles == 2
+    assert list(report.dropped_triangles) == [4, 5, 6]
+    assert report.isolated_vertices == 2
+    assert mesh.num_triangles == 4
+    assert report.components == 1 and report.closed and report.manifold
+
+
+def test_report_finds_nonmanifold_edges_pinched_vertices_and_flips():
+    # three triangles on one edge
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]], dtype=float)
+    fin = Mesh(v, np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4]]))
+    assert fin.report().nonmanifold_edges == 1
+    assert fin.report().boundary_edges == 6
+    # two triangles touching at one vertex (a bow tie)
+    v = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [-1, 0, 0], [-1, -1, 0]], dtype=float)
+    bowtie = Mesh(v, np.array([[0, 1, 2], [0, 3, 4]]))
+    assert bowtie.report().nonmanifold_vertices == 1 and bowtie.report().components == 1
+    # two triangles sharing an edge in the same direction
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], dtype=float)
+    consistent = Mesh(v, np.array([[0, 1, 2], [2, 1, 3]]))
+    assert consistent.report().inconsistent_edges == 0
+    flipped = Mesh(v, np.array([[0, 1, 2], [1, 2, 3]]))
+    assert flipped.report().inconsistent_edges == 1
+
+
+@pytest.mark.parametrize("bad, message", [
+    (lambda v, t: (np.where(np.arange(len(v))[:, None] == 3, np.nan, v), t), "vertex 3 has a non-finite"),
+    (lambda v, t: (np.where(np.arange(len(v))[:, None] == 2, np.inf, v), t), "vertex 2 has a non-finite"),
+    (lambda v, t: (v, np.vstack([t, [[0, 1, 99]]])), "triangle 4 refers to vertex 99"),
+    (lambda v, t: (v, np.vstack([t, [[0, -1, 2]]])), "triangle 4 refers to vertex -1"),
+    (lambda v, t: (v[:, :2], t), "shape (n, 3)"),
+    (lambda v, t: (v.astype(np.int64), t), "float32 or float64"),
+    (lambda v, t: (v, t.astype(float)), "int32 or int64"),
+    (lambda v, t: (v, t[:, :2]), "shape (m, 3)"),
+    (lambda v, t: (np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int32)), "no vertices"),
+    (lambda v, t: (v, np.zeros((0, 3), dtype=np.int32)), "no triangles"),
+    (lambda v, t: (v, np.array([[0, 0, 1], [2, 2, 2]])), "no valid triangles"),
+    (lambda v, t: (v, np.array([[0, 1, 2**33]])), "outside the 32-bit index range"),
+])
+def test_bad_input_raises_a_clear_error(bad, message):
+    v, t = tetrahedron()
+    vertices, triangles = bad(v, t)
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        Mesh(vertices, triangles)
+
+
+def test_callers_arrays_are_never_modified():
+    v, t = meshgen.torus(12, 8)
+    v0, t0 = v.copy(), t.copy()
+    mesh = Mesh(v, t)
+    mesh.decimate(ratio=0.3, seed=1)
+    np.testing.assert_array_equal(v, v0)
+    np.testing.assert_array_equal(t, t0)
+    assert not mesh.vertices.flags.writeable and not mesh.triangles.flags.writeable
+
+
+def test_components_and_diagonal():
+    mesh = Mesh(*meshgen.disjoint(meshgen.torus(8, 6), meshgen.icosphere(1), meshgen.torus(8, 6)))
+    assert mesh.report().components == 3
+    lo, hi = mesh.vertices.min(0), mesh.vertices.max(0)
+    assert mesh.diagonal == pytest.approx(np.linalg.norm(hi - lo))
