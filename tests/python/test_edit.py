@@ -592,6 +592,26 @@ def test_remove_every_handle_until_genus_zero(path):
     assert np.array_equal(current_v, vertices[source])
 
 
+@pytest.mark.parametrize("path", genus_meshes(), ids=lambda p: p.stem)
+def test_remove_handle_loops_from_the_loops_module_until_genus_zero(path):
+    """The same with the handle loops of topstoc.core.loops (Dey et al.: persistence inside the
+    volume, then shortened), recomputed after each removal."""
+    loops = pytest.importorskip("topstoc.core.loops", reason="topstoc.core.loops is not in this build")
+    vertices, triangles = read_off(path)
+    genus = (2 - closed_surface_summary(triangles)[1]) // 2
+    current_v, current_t = vertices, triangles
+    source = np.arange(len(vertices))
+    for step in range(genus):
+        handles = loops.handle_tunnel_loops(current_v, current_t).handles
+        assert len(handles) == genus - step
+        result = edit.remove_handle(current_v, current_t, handles[0].vertices)
+        source = source[result.vertex_source]
+        current_v, current_t = result.vertices, result.triangles
+        assert closed_surface_summary(current_t) == (1, 2 - 2 * (genus - step - 1)), (path.stem, step)
+        assert np.all(areas(current_v, current_t) > 0)
+    assert np.array_equal(current_v, vertices[source])
+
+
 def test_remove_handle_refuses_separating_and_boundary_loops():
     vertices, triangles = meshgen.torus(16, 8)
     ring = [1, 9, 10, 17 + 1, 17, 8]  # the one-ring of vertex 9 bounds a disk
