@@ -255,7 +255,7 @@ def cut_along_loop(vertices, triangles, loop: Sequence[int]) -> EditResult:
 
 def fill_holes(vertices, triangles, holes: Optional[Sequence[int]] = None, *, max_edges: Optional[int] = None,
                skip_unfillable: bool = False, weld_pinches: bool = True, planar: bool = True,
-               max_dp_corners: int = 160, refine: bool = False, fair: bool = False) -> EditResult:
+               max_dp_corners: int = 300, refine: bool = False, fair: bool = False) -> EditResult:
     """Fills holes: the ones listed (indices into :func:`boundary_loops`) or all of them.
 
     With ``holes=None``, every hole with at most ``max_edges`` edges (any size if None);
@@ -286,7 +286,7 @@ def fill_holes(vertices, triangles, holes: Optional[Sequence[int]] = None, *, ma
 
 
 def fill_loops(vertices, triangles, loops: Sequence[Sequence[int]], *, planar: bool = True,
-               max_dp_corners: int = 160, refine: bool = False, fair: bool = False) -> EditResult:
+               max_dp_corners: int = 300, refine: bool = False, fair: bool = False) -> EditResult:
     """Fills holes given as boundary cycles of vertex ids (either direction)."""
     vertices = _vertices(vertices)
     raw = engine.fill_loops(vertices, triangles, [_loop(loop) for loop in loops],
@@ -295,7 +295,7 @@ def fill_loops(vertices, triangles, loops: Sequence[Sequence[int]], *, planar: b
 
 
 def remove_handle(vertices, triangles, loop: Sequence[int], *, allow_separating: bool = False,
-                  planar: bool = True, max_dp_corners: int = 160, refine: bool = False,
+                  planar: bool = True, max_dp_corners: int = 300, refine: bool = False,
                   fair: bool = False) -> EditResult:
     """Removes the handle or tunnel that ``loop`` goes around: cut along it, fill both holes.
 

@@ -140,7 +140,7 @@ void bind_edit(py::module_& m) {
       },
       py::arg("vertices"), py::arg("triangles"), py::arg("holes") = py::none(), py::arg("max_edges") = 0,
       py::arg("skip_unfillable") = false, py::arg("weld_pinches") = true, py::arg("planar") = true,
-      py::arg("max_dp_corners") = 160, py::arg("refine") = false, py::arg("fair") = false,
+      py::arg("max_dp_corners") = 300, py::arg("refine") = false, py::arg("fair") = false,
       "Fills boundary loops chosen by index into boundary_loops() (None: all, up to max_edges edges).");
 
   m.def(
@@ -159,7 +159,7 @@ void bind_edit(py::module_& m) {
         return result_dict(std::move(r));
       },
       py::arg("vertices"), py::arg("triangles"), py::arg("loops"), py::arg("planar") = true,
-      py::arg("max_dp_corners") = 160, py::arg("refine") = false, py::arg("fair") = false,
+      py::arg("max_dp_corners") = 300, py::arg("refine") = false, py::arg("fair") = false,
       "Fills holes given as boundary cycles of vertex ids.");
 
   m.def(
@@ -180,7 +180,7 @@ void bind_edit(py::module_& m) {
         return result_dict(std::move(r));
       },
       py::arg("vertices"), py::arg("triangles"), py::arg("loop"), py::arg("allow_separating") = false,
-      py::arg("planar") = true, py::arg("max_dp_corners") = 160, py::arg("refine") = false, py::arg("fair") = false,
+      py::arg("planar") = true, py::arg("max_dp_corners") = 300, py::arg("refine") = false, py::arg("fair") = false,
       "Cuts along a handle or tunnel loop and fills both holes: the genus drops by one.");
 }
 

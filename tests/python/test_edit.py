@@ -462,7 +462,7 @@ def test_fill_3d_fallback_on_a_wrapping_window(tmp_path):
     holed = edit.delete_faces(vertices, triangles, doomed)
     (hole,) = edit.boundary_loops(holed.vertices, holed.triangles)
     assert len(hole) == 48
-    for max_dp_corners, method, clean in ((160, "minimum_weight", True), (30, "split", True), (12, "split", False)):
+    for max_dp_corners, method, clean in ((300, "minimum_weight", True), (30, "split", True), (12, "split", False)):
         result = edit.fill_holes(holed.vertices, holed.triangles, planar=False, max_dp_corners=max_dp_corners)
         (patch,) = result.patches
         assert patch.method == method

@@ -29,7 +29,7 @@ const char* fill_method_name(FillMethod method);
 
 struct HoleTriangulationOptions {
   bool planar = true;             ///< try the planar projection first (false: go straight to 3D)
-  int32_t max_dp_corners = 160;   ///< minimum-weight triangulation up to this many corners
+  int32_t max_dp_corners = 300;   ///< minimum-weight triangulation up to this many corners (O(k^3): ~0.1 s at 300)
 };
 
 /// One hole: corners in patch order (the patch's triangles turn the same way), and for each
