@@ -295,16 +295,21 @@ def fill_loops(vertices, triangles, loops: Sequence[Sequence[int]], *, planar: b
 
 
 def remove_handle(vertices, triangles, loop: Sequence[int], *, allow_separating: bool = False,
-                  planar: bool = True, max_dp_corners: int = 300, refine: bool = False,
+                  separation: float = 0.25, planar: bool = True, max_dp_corners: int = 300, refine: bool = False,
                   fair: bool = False) -> EditResult:
     """Removes the handle or tunnel that ``loop`` goes around: cut along it, fill both holes.
 
     The genus of that component drops by one; components and boundary loops stay. A loop that
     goes around nothing (it splits its component) raises ValueError unless
     ``allow_separating``; so does a loop touching the mesh boundary.
+
+    Only the loop's vertices move: each copy goes ``separation`` of the way towards its
+    neighbours on its own side (less where a triangle would turn over), so the two patches do
+    not lie on top of each other; 0 leaves them in place, coinciding.
     """
     vertices = _vertices(vertices)
     raw = engine.remove_handle(vertices, triangles, _loop(loop), allow_separating=allow_separating,
+                               separation=float(separation),
                                **_fill_options(planar, max_dp_corners, refine, fair))
     return _result(raw, vertices, triangles)
 

@@ -165,12 +165,15 @@ void bind_edit(py::module_& m) {
   m.def(
       "remove_handle",
       [](const py::handle& vertices, const py::handle& triangles, const py::handle& loop, bool allow_separating,
-         bool planar, int32_t max_dp_corners, bool refine, bool fair) {
+         double separation, bool planar, int32_t max_dp_corners, bool refine, bool fair) {
+        if (!(separation >= 0.0 && separation < 1.0))
+          throw py::value_error("separation must lie in [0, 1), got " + std::to_string(separation));
         Arrays a = arrays_from(vertices, triangles);
         const auto ids = ids_from(loop, -1, "loop");
         RemoveHandleOptions options;
         options.fill = fill_options(planar, max_dp_corners, refine, fair);
         options.allow_separating = allow_separating;
+        options.separation = separation;
         EditResult r;
         {
           py::gil_scoped_release release;
@@ -180,7 +183,7 @@ void bind_edit(py::module_& m) {
         return result_dict(std::move(r));
       },
       py::arg("vertices"), py::arg("triangles"), py::arg("loop"), py::arg("allow_separating") = false,
-      py::arg("planar") = true, py::arg("max_dp_corners") = 300, py::arg("refine") = false, py::arg("fair") = false,
+      py::arg("separation") = 0.25, py::arg("planar") = true, py::arg("max_dp_corners") = 300, py::arg("refine") = false, py::arg("fair") = false,
       "Cuts along a handle or tunnel loop and fills both holes: the genus drops by one.");
 }
 
