@@ -8,6 +8,8 @@
 from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
                        sampling_probabilities)
 from .edit import EditResult, cut_along_loop, delete_faces, fill_holes, fill_loops, remove_handle
+from .error_bound import ErrorBoundReport
+from .hausdorff import Distance, HausdorffResult, OneSidedDistance, closest_points, hausdorff
 from .io import MeshData, read_mesh, write_mesh
 from .mesh import Mesh, MeshReport
 
@@ -16,6 +18,8 @@ __all__ = [
     "decimate_with_samples", "sampling_probabilities",
     # editing (topstoc.core.edit also has boundary_loops and the result's parts)
     "EditResult", "cut_along_loop", "delete_faces", "fill_holes", "fill_loops", "remove_handle",
+    # measurement (hausdorff.py) and error-bounded decimation (error_bound.py)
+    "Distance", "ErrorBoundReport", "HausdorffResult", "OneSidedDistance", "closest_points", "hausdorff",
     # mesh files (io.py)
     "MeshData", "read_mesh", "write_mesh",
 ]

@@ -14,6 +14,7 @@ over the target, thesis 4.3); without, the target is met within 0.5 %.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Optional, Sequence
@@ -140,6 +141,8 @@ class DecimateResult:
     samples: np.ndarray
     stats: DecimateStats
     parameters: dict = field(default_factory=dict)
+    #: with ``max_error``: how the error-bounded search went (see topstoc.core.error_bound)
+    error_bound: Optional[object] = None
 
     @property
     def num_vertices(self) -> int:
@@ -207,7 +210,8 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
              density_ratio: float = 2.0, density_epsilon: float = 0.0, guidance=None,
              regions=None, borders=None, view: Optional[View] = None,
              boxes: Sequence[Box] = (), placement: str = "subsample",
-             fast_path: Optional[bool] = None, max_repair_rounds: int = 200) -> DecimateResult:
+             fast_path: Optional[bool] = None, max_repair_rounds: int = 200,
+             max_error: Optional[float] = None, relative: bool = False) -> DecimateResult:
     """Decimates ``mesh`` with TopStoc. Give exactly one target.
 
     ratio: fraction of the vertices to keep, in (0, 1]. vertices / triangles: counts.
@@ -220,11 +224,27 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
     no cluster crosses either, and both survive exactly. view, boxes: see View and Box.
     placement: "subsample" keeps input positions, "filtered" moves surface vertices to the
     quadric-optimal point of their cluster (borders stay).
+    max_error: the fewest vertices whose symmetric Hausdorff error stays within this bound
+    (absolute, or a fraction of the bounding-box diagonal with ``relative=True``), found by a
+    search over re-decimations with the same seed; ``result.error_bound`` tells how it went.
     """
-    given = [name for name, value in (("ratio", ratio), ("vertices", vertices), ("triangles", triangles))
-             if value is not None]
+    given = [name for name, value in (("ratio", ratio), ("vertices", vertices), ("triangles", triangles),
+                                      ("max_error", max_error)) if value is not None]
     if len(given) != 1:
-        raise ValueError(f"give exactly one target (ratio, vertices or triangles), got {given or 'none'}")
+        raise ValueError(f"give exactly one target (ratio, vertices, triangles or max_error), got {given or 'none'}")
+    if max_error is not None:  # error-bounded: a search over vertex targets (error_bound.py)
+        from .error_bound import search_vertex_count
+
+        def decimate_at(count: int) -> DecimateResult:
+            return decimate(mesh, vertices=count, seed=seed, adaptivity=adaptivity, flat_floor=flat_floor,
+                            density=density, density_rings=density_rings, density_ratio=density_ratio,
+                            density_epsilon=density_epsilon, guidance=guidance, regions=regions,
+                            borders=borders, view=view, boxes=boxes, placement=placement,
+                            fast_path=fast_path, max_repair_rounds=max_repair_rounds)
+
+        result, report = search_vertex_count(mesh, max_error, decimate_at, relative=relative)
+        return dataclasses.replace(result, error_bound=report,
+                                   parameters={**result.parameters, "max_error": max_error, "relative": relative})
     if density not in DENSITY_MODES:
         raise ValueError(f"density must be one of {DENSITY_MODES}, got {density!r}")
     if placement not in PLACEMENTS:

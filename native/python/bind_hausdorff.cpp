@@ -1,8 +1,145 @@
-// Bindings for hausdorff (filled in by the hausdorff work; empty until then).
+// Bindings for the Hausdorff measurement: surfaces, their samples, closest points, distances.
+#include <cmath>
+
 #include "convert.hpp"
+#include "topstoc/hausdorff.hpp"
 
 namespace topstoc::python {
 
-void bind_hausdorff(py::module_&) {}
+namespace {
+
+std::shared_ptr<Surface> make_surface(const py::handle& vertices, const py::handle& triangles) {
+  auto positions = positions_from(vertices, "vertices");
+  auto tris = indices_from(triangles, 3, "triangles");
+  py::gil_scoped_release release;
+  return std::make_shared<Surface>(std::move(positions), std::move(tris));
+}
+
+py::dict one_sided_dict(OneSidedDistance&& d) {
+  py::dict out;
+  out["max"] = d.max;
+  out["mean"] = d.mean;
+  out["rms"] = d.rms;
+  out["percentile"] = d.percentile;
+  out["max_point"] = copy_array(std::vector<double>(d.max_point, d.max_point + 3));
+  out["samples"] = d.samples;
+  out["vertex_distance"] = to_array(std::move(d.vertex_distance));
+  out["face_max"] = to_array(std::move(d.face_max));
+  return out;
+}
+
+py::dict result_dict(HausdorffResult&& r) {
+  py::dict out;
+  out["forward"] = one_sided_dict(std::move(r.forward));
+  out["backward"] = one_sided_dict(std::move(r.backward));
+  py::dict symmetric;
+  symmetric["max"] = r.symmetric_max;
+  symmetric["mean"] = r.symmetric_mean;
+  symmetric["rms"] = r.symmetric_rms;
+  symmetric["percentile"] = r.symmetric_percentile;
+  out["symmetric"] = symmetric;
+  out["diagonal"] = r.diagonal;
+  out["step"] = r.step;
+  return out;
+}
+
+}  // namespace
+
+void bind_hausdorff(py::module_& m) {
+  py::class_<Surface, std::shared_ptr<Surface>>(
+      m, "Surface", "Triangle mesh validated for measurement (caller's arrays as given), with a closest-point index.")
+      .def(py::init(&make_surface), py::arg("vertices"), py::arg("triangles"))
+      .def_property_readonly("num_vertices", &Surface::num_vertices)
+      .def_property_readonly("num_triangles", &Surface::num_triangles)
+      .def_property_readonly("diagonal", &Surface::diagonal)
+      .def_property_readonly("area", &Surface::area)
+      .def_property_readonly("edges", [](const Surface& s) { return copy_array(s.edges(), 2); });
+
+  py::class_<SurfaceSamples, std::shared_ptr<SurfaceSamples>>(
+      m, "SurfaceSamples", "Sample points of a surface: vertices, then edge points, then face points.")
+      .def_property_readonly("step", [](const SurfaceSamples& s) { return s.step; })
+      .def_property_readonly("size", &SurfaceSamples::size)
+      .def_property_readonly("num_vertex_samples", [](const SurfaceSamples& s) { return s.num_vertex_samples; })
+      .def_property_readonly("num_edge_samples", [](const SurfaceSamples& s) { return s.num_edge_samples; })
+      .def_property_readonly("num_face_samples", [](const SurfaceSamples& s) { return s.num_face_samples; })
+      .def_property_readonly("points", [](const SurfaceSamples& s) { return copy_array(s.points, 3); })
+      .def_property_readonly("element", [](const SurfaceSamples& s) { return copy_array(s.element); })
+      .def_property_readonly("face_offsets", [](const SurfaceSamples& s) { return copy_array(s.face_offsets); })
+      .def_property_readonly("face_weight", [](const SurfaceSamples& s) { return copy_array(s.face_weight); });
+
+  m.def(
+      "sample_surface",
+      [](const Surface& surface, double step) {
+        py::gil_scoped_release release;
+        return std::make_shared<SurfaceSamples>(sample_surface(surface, step));
+      },
+      py::arg("surface"), py::arg("step"), "Samples a surface with spacing `step` (Aspert et al. 2002).");
+
+  m.def(
+      "step_for_sample_count",
+      [](const Surface& surface, int64_t samples) {
+        py::gil_scoped_release release;
+        return step_for_sample_count(surface, samples);
+      },
+      py::arg("surface"), py::arg("samples"), "Sample spacing that gives about `samples` samples.");
+
+  m.def(
+      "closest_points",
+      [](const Surface& surface, const py::handle& points) {
+        const auto p = positions_from(points, "points");
+        const int64_t n = int64_t(p.size() / 3);
+        for (int64_t i = 0; i < n; ++i)
+          if (!std::isfinite(p[3 * i]) || !std::isfinite(p[3 * i + 1]) || !std::isfinite(p[3 * i + 2]))
+            throw py::value_error("point " + std::to_string(i) + " has a non-finite coordinate");
+        std::vector<ClosestHit> hits;
+        {
+          py::gil_scoped_release release;
+          hits = closest_points(surface, p.data(), n);
+        }
+        std::vector<double> distance(n), closest(3 * n);
+        std::vector<int32_t> triangle(n);
+        for (int64_t i = 0; i < n; ++i) {
+          distance[i] = std::sqrt(hits[i].distance2);
+          triangle[i] = hits[i].triangle;
+          for (int k = 0; k < 3; ++k) closest[3 * i + k] = hits[i].point[k];
+        }
+        py::dict out;
+        out["distance"] = to_array(std::move(distance));
+        out["triangle"] = to_array(std::move(triangle));
+        out["point"] = to_array(std::move(closest), 3);
+        return out;
+      },
+      py::arg("surface"), py::arg("points"), "Nearest point on the surface of each point: distance, triangle, point.");
+
+  m.def(
+      "hausdorff",
+      [](const Surface& a, const Surface& b, int64_t samples, double step, double percentile) {
+        HausdorffParams params;
+        params.samples = samples;
+        params.step = step;
+        params.percentile = percentile;
+        HausdorffResult r;
+        {
+          py::gil_scoped_release release;
+          r = hausdorff(a, b, params);
+        }
+        return result_dict(std::move(r));
+      },
+      py::arg("a"), py::arg("b"), py::arg("samples") = 1000000, py::arg("step") = 0.0, py::arg("percentile") = 0.95,
+      "Forward (A to B), backward (B to A) and symmetric Hausdorff distance.");
+
+  m.def(
+      "hausdorff_with_samples",
+      [](const Surface& a, const SurfaceSamples& a_samples, const Surface& b, double percentile) {
+        HausdorffResult r;
+        {
+          py::gil_scoped_release release;
+          r = hausdorff(a, a_samples, b, percentile);
+        }
+        return result_dict(std::move(r));
+      },
+      py::arg("a"), py::arg("a_samples"), py::arg("b"), py::arg("percentile") = 0.95,
+      "Hausdorff distance reusing samples of A taken earlier (B is sampled with their step).");
+}
 
 }  // namespace topstoc::python

@@ -1,5 +1,7 @@
 #include "topstoc/clustering.hpp"
 
+#include <omp.h>
+
 #include <climits>
 #include <stdexcept>
 #include <string>
@@ -14,53 +16,74 @@ inline int32_t dist_of(uint64_t key) { return int32_t(key >> 32); }
 inline int32_t rank_of(uint64_t key) { return int32_t(key & 0xffffffffu); }
 constexpr uint64_t kUnreached = ~uint64_t(0);
 
+// Frontiers smaller than this are relaxed by one thread (a parallel region costs more).
+constexpr size_t kParallelFrontier = 4096;
+
 // Level-synchronous relaxation from `frontier` (all at distance `level`): a neighbour improves
-// when (level + 1, rank) beats what it holds. Serves the full fill (everything starts
-// unreached) and incremental additions (only improvements propagate). With cross_edges, every
-// edge between two clusters is recorded once, from its farther end, when both ends are final.
+// when (level + 1, rank) beats what it holds. Keys are lowered with an atomic minimum, so the
+// result does not depend on how threads interleave: it is the same for any thread count.
+// Serves the full fill and incremental additions alike (only improvements propagate). With
+// cross_edges, every edge between two clusters is recorded once, from its farther end, when
+// both ends are final (only for a full fill).
 void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> frontier, int32_t level,
-                  std::vector<uint64_t>& key, std::vector<int32_t>& parent, bool incremental,
-                  std::vector<int32_t>* cross_edges) {
+                  std::vector<uint64_t>& key, std::vector<int32_t>* cross_edges) {
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
   const auto& ae = mesh.adjacency_edge();
   const auto& edge_feature = layout.edge_feature;
   const auto& vertex_feature = layout.vertex_feature;
-  std::vector<int32_t> next;
-  // A full fill pushes a vertex only when it is first reached; an incremental one may lower the
-  // rank of a vertex reached in an earlier fill, which must then be queued exactly once.
-  std::vector<uint8_t> in_next(incremental ? mesh.num_vertices() : 0, 0);
+  std::vector<uint8_t> queued(mesh.num_vertices(), 0);
+  const int threads = omp_get_max_threads();
+  std::vector<std::vector<int32_t>> next(threads), cross(threads);
+  uint64_t* keys = key.data();
+  uint8_t* in_next = queued.data();
   while (!frontier.empty()) {
-    next.clear();
-    const int32_t d = level + 1;
-    for (int32_t v : frontier) {
-      const int32_t rank = rank_of(key[v]);
-      const uint64_t candidate = pack(d, rank);
-      for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
-        const int32_t u = adj[i];
-        const uint64_t held = key[u];
-        if (cross_edges && held != kUnreached && dist_of(held) <= level && rank_of(held) != rank &&
-            (dist_of(held) < level || u > v))
-          cross_edges->push_back(ae[i]);
-        if (candidate >= held) continue;
-        // Feature vertices are entered only along feature edges.
-        if (vertex_feature[u] && !edge_feature[ae[i]]) continue;
-        const bool first_reach = dist_of(held) > d || held == kUnreached;
-        key[u] = candidate;
-        parent[u] = v;
-        if (incremental) {
-          if (!in_next[u]) {
-            in_next[u] = 1;
-            next.push_back(u);
+    const uint64_t d = uint64_t(level) + 1;
+    const int64_t count = int64_t(frontier.size());
+#pragma omp parallel if (frontier.size() >= kParallelFrontier)
+    {
+      const int me = omp_get_thread_num();
+      auto& mine = next[me];
+      auto& my_cross = cross[me];
+#pragma omp for schedule(dynamic, 256)
+      for (int64_t i = 0; i < count; ++i) {
+        const int32_t v = frontier[i];
+        const int32_t rank = rank_of(__atomic_load_n(&keys[v], __ATOMIC_RELAXED));
+        const uint64_t candidate = (d << 32) | uint32_t(rank);
+        for (int32_t j = ao[v]; j < ao[v + 1]; ++j) {
+          const int32_t u = adj[j];
+          uint64_t held = __atomic_load_n(&keys[u], __ATOMIC_RELAXED);
+          // Keys at distance <= level are final during this pass.
+          if (cross_edges && held != kUnreached && dist_of(held) <= level && rank_of(held) != rank &&
+              (dist_of(held) < level || u > v))
+            my_cross.push_back(ae[j]);
+          if (candidate >= held) continue;
+          // Feature vertices are entered only along feature edges.
+          if (vertex_feature[u] && !edge_feature[ae[j]]) continue;
+          // Atomic minimum: retry while ours is still smaller than what another thread wrote.
+          bool lowered = false;
+          while (candidate < held) {
+            if (__atomic_compare_exchange_n(&keys[u], &held, candidate, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+              lowered = true;
+              break;
+            }
           }
-        } else if (first_reach) {
-          next.push_back(u);
+          // Queue each lowered vertex once for the next level, whichever thread lowered it.
+          if (lowered && !__atomic_exchange_n(&in_next[u], uint8_t(1), __ATOMIC_RELAXED)) mine.push_back(u);
         }
       }
     }
-    if (incremental)
-      for (int32_t u : next) in_next[u] = 0;
-    frontier.swap(next);
+    frontier.clear();
+    for (auto& list : next) {
+      for (int32_t u : list) in_next[u] = 0;
+      frontier.insert(frontier.end(), list.begin(), list.end());
+      list.clear();
+    }
+    if (cross_edges)
+      for (auto& list : cross) {
+        cross_edges->insert(cross_edges->end(), list.begin(), list.end());
+        list.clear();
+      }
     ++level;
   }
 }
@@ -68,8 +91,8 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
 void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
                     int32_t first_new, Clustering& c, std::vector<int32_t>* cross_edges) {
   const int32_t n = mesh.num_vertices();
-  const bool incremental = first_new > 0;
   std::vector<uint64_t> key(n);
+#pragma omp parallel for schedule(static)
   for (int32_t v = 0; v < n; ++v) key[v] = c.label[v] < 0 ? kUnreached : pack(c.dist[v], c.label[v]);
   std::vector<int32_t> frontier;
   for (size_t r = size_t(first_new); r < samples.size(); ++r) {
@@ -80,10 +103,10 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
     if (key[s] != kUnreached && dist_of(key[s]) == 0)
       throw std::invalid_argument("vertex " + std::to_string(s) + " is sampled twice");
     key[s] = pack(0, static_cast<int32_t>(r));
-    c.parent[s] = -1;
     frontier.push_back(s);
   }
-  relax_levels(mesh, layout, std::move(frontier), 0, key, c.parent, incremental, cross_edges);
+  relax_levels(mesh, layout, std::move(frontier), 0, key, cross_edges);
+#pragma omp parallel for schedule(static)
   for (int32_t v = 0; v < n; ++v) {
     c.label[v] = key[v] == kUnreached ? -1 : rank_of(key[v]);
     c.dist[v] = key[v] == kUnreached ? INT_MAX : dist_of(key[v]);
@@ -97,7 +120,6 @@ void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int3
   const int32_t n = mesh.num_vertices();
   out.label.assign(n, -1);
   out.dist.assign(n, INT_MAX);
-  out.parent.assign(n, -1);
   if (cross_edges) cross_edges->clear();
   seed_and_relax(mesh, layout, samples, 0, out, cross_edges);
 }
@@ -105,6 +127,20 @@ void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int3
 void flood_add(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
                int32_t first_new, Clustering& c) {
   seed_and_relax(mesh, layout, samples, first_new, c, nullptr);
+}
+
+int32_t step_towards_sample(const Mesh& mesh, const FeatureLayout& layout, const Clustering& c, int32_t x) {
+  const auto& ao = mesh.adjacency_offsets();
+  const auto& adj = mesh.adjacency();
+  const auto& ae = mesh.adjacency_edge();
+  int32_t best = -1;
+  for (int32_t j = ao[x]; j < ao[x + 1]; ++j) {
+    const int32_t p = adj[j];
+    if (c.label[p] != c.label[x] || c.dist[p] != c.dist[x] - 1) continue;
+    if (layout.vertex_feature[x] && !layout.edge_feature[ae[j]]) continue;  // the fill could not come this way
+    if (best < 0 || p < best) best = p;
+  }
+  return best;
 }
 
 }  // namespace topstoc

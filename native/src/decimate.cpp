@@ -90,7 +90,7 @@ std::vector<int32_t> splitting_vertices(const Mesh& mesh, const Clustering& c, c
 
 // Corner of the caller's mesh that carries the attributes (UV, colour) an output corner needs:
 // a corner of the sample vertex on the same side of every border as the input face the output
-// triangle came from. Walks the flood's parent links from the face's corner to the sample,
+// triangle came from. Walks the flood's steps back from the face's corner to the sample,
 // carrying the current face across edges so the side is kept.
 int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Clustering& c, int32_t face,
                          int32_t slot, int32_t sample_vertex) {
@@ -109,7 +109,7 @@ int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Cl
   int32_t current = face;
   int32_t x = faces[3 * size_t(face) + slot];
   for (int32_t guard = 0; x != sample_vertex && guard <= mesh.num_vertices(); ++guard) {
-    const int32_t p = c.parent[x];
+    const int32_t p = step_towards_sample(mesh, layout, c, x);
     if (p < 0) break;
     const int32_t e = mesh.find_edge(x, p);
     const int32_t side = layout.sector_of(mesh, x, current);

@@ -81,8 +81,12 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
           same_copies = same_copies && c == first_copies;
         }
       }
-      const int32_t sectors = vertex_fans(mesh, v, [&](int32_t e) { return layout.edge_feature[e] != 0; }, fan_of_slot);
-      std::copy(fan_of_slot.begin(), fan_of_slot.end(), layout.sector_of_slot.begin() + vfo[v]);
+      // A manifold vertex without feature edges is one sector (slots stay 0); others need the fans.
+      int32_t sectors = 1;
+      if (degree > 0 || !mesh.manifold_vertex()[v]) {
+        sectors = vertex_fans(mesh, v, [&](int32_t e) { return layout.edge_feature[e] != 0; }, fan_of_slot);
+        std::copy(fan_of_slot.begin(), fan_of_slot.end(), layout.sector_of_slot.begin() + vfo[v]);
+      }
       layout.feature_degree[v] = degree;
       layout.sectors[v] = sectors;
       layout.vertex_feature[v] = degree > 0 || sectors > 1;

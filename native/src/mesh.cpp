@@ -97,32 +97,33 @@ void Mesh::validate_and_copy_faces(const int32_t* triangles, int64_t num_triangl
   }
   // Drop exact duplicates (same vertex set, either orientation): bucket by smallest vertex, then
   // compare the sorted triples inside each small bucket. The first occurrence is kept.
+  std::vector<std::array<int32_t, 3>> sorted(candidates.size());
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    const int32_t* t = triangles + 3 * size_t(candidates[i]);
+    sorted[i] = {t[0], t[1], t[2]};
+    std::sort(sorted[i].begin(), sorted[i].end());
+  }
   std::vector<int32_t> bucket_offsets(num_vertices_ + 1, 0);
-  auto sorted_triple = [&](int32_t f) {
-    std::array<int32_t, 3> t = {triangles[3 * f], triangles[3 * f + 1], triangles[3 * f + 2]};
-    std::sort(t.begin(), t.end());
-    return t;
-  };
-  for (int32_t f : candidates) ++bucket_offsets[sorted_triple(f)[0]];
+  for (const auto& t : sorted) ++bucket_offsets[t[0]];
   exclusive_scan(bucket_offsets);
   std::vector<int32_t> bucket(candidates.size());
   {
     std::vector<int32_t> fill(bucket_offsets.begin(), bucket_offsets.end() - 1);
-    for (int32_t f : candidates) bucket[fill[sorted_triple(f)[0]]++] = f;
+    for (size_t i = 0; i < sorted.size(); ++i) bucket[fill[sorted[i][0]]++] = int32_t(i);
   }
-  std::vector<uint8_t> duplicate(num_triangles, 0);
+  std::vector<uint8_t> duplicate(candidates.size(), 0);
   for (int32_t v = 0; v < num_vertices_; ++v) {
     const int32_t b = bucket_offsets[v], e = bucket_offsets[v + 1];
     for (int32_t i = b; i < e; ++i) {
       if (duplicate[bucket[i]]) continue;
-      const auto ti = sorted_triple(bucket[i]);
       for (int32_t j = i + 1; j < e; ++j)
-        if (!duplicate[bucket[j]] && sorted_triple(bucket[j]) == ti) duplicate[bucket[j]] = 1;
+        if (!duplicate[bucket[j]] && sorted[bucket[j]] == sorted[bucket[i]]) duplicate[bucket[j]] = 1;
     }
   }
   faces_.reserve(3 * candidates.size());
-  for (int32_t f : candidates) {
-    if (duplicate[f]) {
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    const int32_t f = candidates[i];
+    if (duplicate[i]) {
       ++report_.duplicate_triangles;
       report_.dropped_triangles.push_back(f);
       continue;
@@ -317,15 +318,21 @@ void Mesh::build_edge_faces() {
 
 void Mesh::compute_normals_and_weights() {
   const int32_t n = num_vertices_;
+  const int32_t m = num_faces();
+  // Area-weighted: the unnormalised face normal (twice the area) summed at each corner.
+  std::vector<double> face_normals(3 * size_t(m));
+#pragma omp parallel for schedule(static)
+  for (int32_t f = 0; f < m; ++f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
+    cross(position(t[0]), position(t[1]), position(t[2]), &face_normals[3 * size_t(f)]);
+  }
   normals_.assign(3 * size_t(n), 0.0);
   weights_.assign(n, 0.0);
 #pragma omp parallel for schedule(static)
   for (int32_t v = 0; v < n; ++v) {
     double sum[3] = {0, 0, 0};
     for (int32_t i = vertex_face_offsets_[v]; i < vertex_face_offsets_[v + 1]; ++i) {
-      const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
-      double fn[3];
-      cross(position(t[0]), position(t[1]), position(t[2]), fn);
+      const double* fn = &face_normals[3 * size_t(vertex_faces_[i])];
       sum[0] += fn[0];
       sum[1] += fn[1];
       sum[2] += fn[2];

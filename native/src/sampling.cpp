@@ -5,6 +5,9 @@
 #include <stdexcept>
 #include <string>
 
+#include <limits>
+#include <omp.h>
+
 #include "topstoc/random.hpp"
 
 namespace topstoc {
@@ -105,46 +108,64 @@ std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& 
   return p;
 }
 
-// Without guidance: the base rate k whose probabilities sum to the target (Illinois regula falsi
-// on the monotone sum; the draw fixes the count, so k need only be close).
+// Without guidance: the base rate k whose probabilities sum to the target. The sum is
+// increasing and concave in k (min(1, k q) and sqrt are), so Newton steps taken from below stay
+// below the root and converge monotonically; a bracket guards against round-off. The draw
+// fixes the count anyway, so k need only be close.
 double solve_rate(const Mesh& mesh, const std::vector<uint8_t>& cls, const SamplingParams& params, double target) {
   const int32_t n = mesh.num_vertices();
   std::vector<double> q(n, 0.0);
-  double min_q = 1e300;
-  for (int32_t v = 0; v < n; ++v)
+  double min_q = 1e300, total_q = 0.0, corners = 0.0;
+  for (int32_t v = 0; v < n; ++v) {
     if (cls[v] == kSurface || cls[v] == kCurve) {
       q[v] = importance(mesh, params, v);
       min_q = std::min(min_q, q[v]);
+      total_q += q[v];
+    } else if (cls[v] == kCorner) {
+      corners += 1.0;
     }
-  auto sum = [&](double k) {
-    double s = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : s)
+  }
+  // Sum of the probabilities at k and its derivative.
+  auto evaluate = [&](double k, double& slope) {
+    double sum = 0.0, d = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : sum, d)
     for (int32_t v = 0; v < n; ++v) {
-      if (cls[v] == kSurface) s += std::min(1.0, k * q[v]);
-      else if (cls[v] == kCurve) s += std::min(1.0, std::sqrt(k * q[v]));
-      else if (cls[v] == kCorner) s += 1.0;
+      if (cls[v] == kSurface) {
+        const double p = k * q[v];
+        if (p < 1.0) sum += p, d += q[v];
+        else sum += 1.0;
+      } else if (cls[v] == kCurve) {
+        const double p = k * q[v];
+        if (p < 1.0) {
+          const double r = std::sqrt(p);
+          sum += r;
+          d += k > 0 ? 0.5 * r / k : 0.0;
+        } else {
+          sum += 1.0;
+        }
+      } else if (cls[v] == kCorner) {
+        sum += 1.0;
+      }
     }
-    return s;
+    slope = d;
+    return sum;
   };
+  if (total_q <= 0 || target <= corners) return 0.0;
   double lo = 0.0, hi = min_q < 1e300 ? 1.0 / min_q : 1.0;
-  double f_lo = sum(lo) - target, f_hi = sum(hi) - target;
-  if (f_lo >= 0) return 0.0;
-  if (f_hi <= 0) return hi;
-  int side = 0;
-  double k = lo;
-  for (int it = 0; it < 60; ++it) {
-    k = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
-    const double f = sum(k) - target;
+  double slope = 0.0;
+  if (evaluate(hi, slope) <= target) return hi;
+  // Start from the rate that would be exact if nothing clamped and there were no curves; the
+  // curves' sqrt makes the true sum larger, so this start is at or below the root... unless
+  // clamping dominates, which the bracket handles.
+  double k = std::min(hi, (target - corners) / total_q);
+  for (int it = 0; it < 50; ++it) {
+    const double f = evaluate(k, slope) - target;
     if (std::abs(f) <= std::max(0.5, 1e-4 * target)) break;
-    if (f < 0) {
-      lo = k, f_lo = f;
-      if (side == -1) f_hi /= 2;
-      side = -1;
-    } else {
-      hi = k, f_hi = f;
-      if (side == 1) f_lo /= 2;
-      side = 1;
-    }
+    if (f < 0) lo = k;
+    else hi = k;
+    double next = slope > 0 ? k - f / slope : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    k = next;
   }
   return k;
 }
@@ -154,6 +175,29 @@ struct Candidate {
   int32_t vertex;
   bool operator<(const Candidate& o) const { return key < o.key || (key == o.key && vertex < o.vertex); }
 };
+
+// Candidates with Pareto key (U / (1 - U)) ((1 - p) / p) below `threshold`, in vertex order.
+// The uniform U of a vertex depends on the seed and its caller id only.
+std::vector<Candidate> pareto_candidates(const Mesh& mesh, uint64_t seed, const std::vector<double>& p,
+                                         double threshold) {
+  const int32_t n = mesh.num_vertices();
+  const int threads = omp_get_max_threads();
+  std::vector<std::vector<Candidate>> found(threads);
+#pragma omp parallel
+  {
+    auto& mine = found[omp_get_thread_num()];
+#pragma omp for schedule(static)
+    for (int32_t v = 0; v < n; ++v) {
+      if (!(p[v] > 0.0 && p[v] < 1.0)) continue;
+      const double u = uniform01(seed, kStreamSelection, uint64_t(mesh.vertex_source()[v]));
+      const double key = (u / (1.0 - u)) * ((1.0 - p[v]) / p[v]);
+      if (key < threshold) mine.push_back({key, v});
+    }
+  }
+  std::vector<Candidate> out;
+  for (auto& list : found) out.insert(out.end(), list.begin(), list.end());
+  return out;
+}
 
 // Breadth-first ball of `rings` hops around `center`, restricted by `follow(slot)`; calls
 // visit(v) for each vertex reached (center included).
@@ -200,10 +244,11 @@ double mean_edge_length(const Mesh& mesh) {
 // its neighbourhood. Surface samples block surface vertices; curve samples and corners block
 // both, so borders keep their own spacing. Stops at `count` samples; if rejection leaves too
 // few, the rejected candidates are taken back in key order.
+template <class AllCandidates>
 std::vector<int32_t> select_with_density(const Mesh& mesh, const FeatureLayout& layout,
                                          const std::vector<uint8_t>& cls, const SamplingParams& params,
                                          std::vector<int32_t> forced, std::vector<Candidate> candidates,
-                                         int32_t count, int32_t& rejected_out) {
+                                         AllCandidates all_candidates, int32_t count, int32_t& rejected_out) {
   const int32_t n = mesh.num_vertices();
   const double r = std::sqrt(double(std::max<int32_t>(1, n)) / (3.0 * std::max<int32_t>(1, count)));
   const int32_t eps_uniform = params.density_rings > 0 ? params.density_rings : std::max(1, int32_t(std::lround(r)));
@@ -254,7 +299,23 @@ std::vector<int32_t> select_with_density(const Mesh& mesh, const FeatureLayout& 
     sorted_end = end;
   };
   int32_t rejected = 0;
-  for (size_t i = 0; i < candidates.size() && int32_t(chosen.size()) < count; ++i) {
+  bool complete = false;  // candidates holds every vertex with 0 < p < 1
+  for (size_t i = 0; int32_t(chosen.size()) < count; ++i) {
+    if (i == candidates.size()) {
+      if (complete) break;
+      // The kept superset ran out: continue with the candidates it did not hold, in key order.
+      std::vector<Candidate> everything = all_candidates();
+      std::sort(everything.begin(), everything.end());
+      const Candidate last = i > 0 ? candidates[i - 1] : Candidate{-1.0, -1};
+      std::vector<Candidate> rest;
+      for (const auto& c : everything)
+        if (last < c) rest.push_back(c);
+      candidates.resize(i);
+      candidates.insert(candidates.end(), rest.begin(), rest.end());
+      sorted_end = candidates.size();
+      complete = true;
+      if (i == candidates.size()) break;
+    }
     ensure_sorted(i);
     const int32_t v = candidates[i].vertex;
     if (blocked[v]) {
@@ -341,20 +402,22 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
   out.expected = expected;
   const int32_t count = out.guided ? int32_t(std::lround(expected)) : target;
 
+  // Pareto keys: with threshold 1 the expected number of keys below it is exactly the sum of
+  // the probabilities, so a slightly larger threshold keeps a small superset of what the draw
+  // needs; if it falls short (tiny targets), the threshold grows.
   std::vector<int32_t> forced;
-  std::vector<Candidate> candidates;
-  for (int32_t v = 0; v < n; ++v) {
-    if (p[v] >= 1.0) {
-      forced.push_back(v);
-    } else if (p[v] > 0.0) {
-      // Keyed by the caller's vertex id: the draw does not depend on the internal order.
-      const double u = uniform01(params.seed, kStreamSelection, uint64_t(mesh.vertex_source()[v]));
-      candidates.push_back({(u / (1.0 - u)) * ((1.0 - p[v]) / p[v]), v});
-    }
-  }
+  for (int32_t v = 0; v < n; ++v)
+    if (p[v] >= 1.0) forced.push_back(v);
   out.forced = static_cast<int32_t>(forced.size());
   const int32_t free_count = std::max<int32_t>(0, count - out.forced);
-  if (params.density == DensityMode::Off) {
+  const bool density = params.density != DensityMode::Off;
+  std::vector<Candidate> candidates;
+  for (double threshold = density ? 3.0 : 1.25;; threshold *= 4) {
+    candidates = pareto_candidates(mesh, params.seed, p, threshold);
+    const bool everything = threshold > 1e6;
+    if (everything || int64_t(candidates.size()) >= int64_t(density ? 2 : 1) * free_count + 16) break;
+  }
+  if (!density) {
     out.samples = std::move(forced);
     const size_t take = std::min<size_t>(free_count, candidates.size());
     if (take > 0) {
@@ -362,7 +425,9 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
       for (size_t i = 0; i < take; ++i) out.samples.push_back(candidates[i].vertex);
     }
   } else {
-    out.samples = select_with_density(mesh, layout, cls, params, std::move(forced), std::move(candidates),
+    // Density control may reject many candidates: if the kept superset runs out, take all.
+    auto all = [&]() { return pareto_candidates(mesh, params.seed, p, std::numeric_limits<double>::infinity()); };
+    out.samples = select_with_density(mesh, layout, cls, params, std::move(forced), std::move(candidates), all,
                                       std::max(count, out.forced), out.density_rejected);
   }
   std::sort(out.samples.begin(), out.samples.end());

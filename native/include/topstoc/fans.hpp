@@ -4,6 +4,7 @@
 // decimation treats as separate sides of a border.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -24,9 +25,15 @@ int32_t vertex_fans(const Mesh& mesh, int32_t v, Blocked blocked, std::vector<in
   const auto& efo = mesh.edge_face_offsets();
   const auto& ef = mesh.edge_faces();
   const int32_t begin = vfo[v], count = vfo[v + 1] - vfo[v];
-  // Small union-find over the slots of v.
-  fan_of_slot.assign(count, 0);
-  std::vector<int32_t>& parent = fan_of_slot;
+  fan_of_slot.resize(count);
+  // Union-find over the slots of v; valences are small, so the work stays in fixed buffers.
+  std::array<int32_t, 64> small_parent;
+  std::vector<int32_t> large_parent;
+  int32_t* parent = small_parent.data();
+  if (count > int32_t(small_parent.size())) {
+    large_parent.resize(count);
+    parent = large_parent.data();
+  }
   for (int32_t i = 0; i < count; ++i) parent[i] = i;
   auto find = [&](int32_t i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
@@ -39,27 +46,27 @@ int32_t vertex_fans(const Mesh& mesh, int32_t v, Blocked blocked, std::vector<in
   };
   for (int32_t i = 0; i < count; ++i) {
     const int32_t f = vf[begin + i];
-    for (int32_t c = 0; c < 3; ++c) {
-      // The two sides of f that touch v: the side starting at v and the one ending at v.
-      const bool touches = faces[3 * f + c] == v || faces[3 * f + (c + 1) % 3] == v;
-      if (!touches) continue;
-      const int32_t e = fe[3 * f + c];
+    const int32_t* t = &faces[3 * size_t(f)];
+    const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+    // The two sides of f at v: leaving v (c -> c+1) and arriving at v (c+2 -> c).
+    for (int side : {c, (c + 2) % 3}) {
+      const int32_t e = fe[3 * size_t(f) + side];
       if (efo[e + 1] - efo[e] != 2 || blocked(e)) continue;
       const int32_t g = ef[efo[e]] == f ? ef[efo[e] + 1] : ef[efo[e]];
+      if (g < f) continue;  // each pair once, from its lower face
       const int32_t j = slot_of_face(g);
       if (j < 0) continue;
       const int32_t a = find(i), b = find(j);
       if (a != b) parent[a < b ? b : a] = a < b ? a : b;
     }
   }
-  // Relabel roots to 0, 1, ... in order of first appearance.
-  std::vector<int32_t> root(count);
-  for (int32_t i = 0; i < count; ++i) root[i] = find(i);
-  std::vector<int32_t> index(count, -1);
+  // Roots are the lowest slot of each fan, so numbering roots in slot order numbers fans in
+  // order of first appearance.
   int32_t fans = 0;
   for (int32_t i = 0; i < count; ++i) {
-    if (index[root[i]] < 0) index[root[i]] = fans++;
-    fan_of_slot[i] = index[root[i]];
+    const int32_t root = find(i);
+    if (root == i) fan_of_slot[i] = fans++;
+    else fan_of_slot[i] = fan_of_slot[root];
   }
   return fans;
 }

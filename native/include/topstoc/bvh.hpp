@@ -1,0 +1,56 @@
+// Closest points on a triangle mesh: a bounding volume hierarchy over its triangles.
+//
+// Used by the Hausdorff measurement (hausdorff.hpp) to find, for millions of sample points, the
+// nearest point of the other surface. The query is exact: it returns the triangle of smallest
+// distance (ties broken by the lower triangle id), whatever hint it is given, so parallel and
+// serial callers get the same answer. Degenerate (zero-area) triangles are handled as the
+// segments or points they are.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace topstoc {
+
+/// Closest point of triangle (a, b, c) to p: writes it to `closest` and returns the squared
+/// distance. Works for degenerate triangles (collinear corners, repeated points).
+double closest_point_on_triangle(const double* p, const double* a, const double* b, const double* c,
+                                 double* closest);
+
+/// Result of a closest-point query.
+struct ClosestHit {
+  double distance2 = 0.0;   ///< squared distance to the closest point
+  double point[3] = {0, 0, 0};
+  int32_t triangle = -1;    ///< caller's triangle id
+  int32_t slot = -1;        ///< internal position of that triangle: pass it back as a hint
+};
+
+class TriangleBvh {
+ public:
+  /// positions: 3 per vertex; triangles: 3 vertex ids per triangle, all in [0, num_vertices).
+  /// The caller validates the input (see hausdorff.hpp's Surface); num_triangles >= 1.
+  TriangleBvh(const double* positions, const int32_t* triangles, int64_t num_triangles);
+
+  /// Closest point of the mesh to p. `hint_slot` (a previous hit's slot, or -1) only speeds the
+  /// search up: nearby queries usually have nearby answers.
+  ClosestHit closest(const double* p, int32_t hint_slot = -1) const;
+
+  int64_t num_triangles() const { return int64_t(triangle_ids_.size()); }
+  int64_t num_nodes() const { return int64_t(nodes_.size()); }
+
+ private:
+  struct Node {
+    double lo[3], hi[3];
+    int32_t first;  ///< leaf: first slot; inner: index of the second child (the first follows the node)
+    int32_t count;  ///< leaf: number of triangles (> 0); inner: 0
+  };
+  int32_t build(int32_t begin, int32_t end, const std::vector<double>& corners, const std::vector<double>& centroids,
+                std::vector<int32_t>& order);
+  double slot_distance2(const double* p, int32_t slot, double* closest) const;
+
+  std::vector<Node> nodes_;
+  std::vector<double> corners_;          ///< 9 coordinates per slot, in leaf order
+  std::vector<int32_t> triangle_ids_;    ///< caller's triangle id per slot
+};
+
+}  // namespace topstoc

@@ -1,0 +1,40 @@
+# Shared by scripts/demo.sh and scripts/test.sh: install what is missing, build, find tools.
+# Sourced, not run. Works as root or with sudo on Debian 12.
+
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$ROOT"
+
+# Debian packages: the build and runtime, then peers and tools used by tests and benchmarks.
+RUNTIME_PACKAGES="blender cmake g++ make pybind11-dev libopenmesh-dev libtet1.5-dev libphat-dev
+  python3 python3-numpy python3-pytest"
+TEST_PACKAGES="libmeshoptimizer-dev libcgal-dev python3-gudhi python3-scipy python3-venv xvfb
+  xauth git ca-certificates"
+
+as_root() {
+  if [ "$(id -u)" = 0 ]; then "$@";
+  elif command -v sudo >/dev/null; then sudo "$@";
+  else echo "error: need root or sudo to run: $*" >&2; return 1; fi
+}
+
+# Installs the given Debian packages that are not installed yet.
+ensure_packages() {
+  local missing=()
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "== installing Debian packages: ${missing[*]}"
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get update -q >/dev/null &&
+    as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+# Builds the module against /usr/bin/python3 and stages build/python/topstoc.
+build() {
+  echo "== building (cmake -S . -B build && cmake --build build)"
+  mkdir -p build
+  /usr/bin/cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >build/configure.log 2>&1 ||
+    { cat build/configure.log; return 1; }
+  /usr/bin/cmake --build build -j"$(nproc)" >build/build.log 2>&1 ||
+    { grep -E -B2 -A6 "error" build/build.log | head -60; return 1; }
+  test -f build/python/topstoc/__init__.py && ls build/python/topstoc/_topstoc*.so >/dev/null
+}

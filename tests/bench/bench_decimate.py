@@ -1,0 +1,118 @@
+#!/usr/bin/python3
+"""Decimation speed next to meshoptimizer, measured in the same run (issue 2 benchmark).
+
+    /usr/bin/python3 tests/bench/bench_decimate.py [MESH] [--ratios 0.1,0.01] [--repeats 7]
+
+Default mesh: ../shared/meshes/big/horse_loop2_1.55M.ply (skips cleanly when absent). Times:
+  - first decimation: topstoc.Mesh (validation, adjacency, weights) + decimate, file read excluded;
+  - re-decimation: decimate on the prepared mesh (what a slider drag costs), seeds 0..R-1;
+  - meshopt_simplify (QEM edge collapse) and meshopt_simplifySloppy (grid clustering), via
+    build/peers/meshopt_bench on the same file and the same vertex fraction of the index count.
+Prints medians, the ratios and the machine. Speed is never asserted in tests; it lives here.
+"""
+
+import argparse
+import json
+import os
+import pathlib
+import platform
+import statistics
+import subprocess
+import sys
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "build" / "python"))
+
+from topstoc.core import Mesh, read_mesh  # noqa: E402
+
+DEFAULT_MESH = ROOT.parent / "shared" / "meshes" / "big" / "horse_loop2_1.55M.ply"
+PEER = ROOT / "build" / "peers" / "meshopt_bench"
+
+
+def machine() -> str:
+    model = "unknown CPU"
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    load = os.getloadavg()[0]
+    return f"{os.cpu_count()} cores, {model}, {platform.system()} {platform.release()}, load average {load:.2f}"
+
+
+def median_ms(values):
+    return 1000 * statistics.median(values)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("mesh", nargs="?", default=str(DEFAULT_MESH))
+    parser.add_argument("--ratios", default="0.1,0.01")
+    parser.add_argument("--repeats", type=int, default=7)
+    args = parser.parse_args()
+    path = pathlib.Path(args.mesh)
+    if not path.exists():
+        print(f"skipped: {path} not found (the benchmark mesh lives in ../shared/meshes)")
+        return 0
+    ratios = [float(r) for r in args.ratios.split(",")]
+    data = read_mesh(path)
+    print(f"mesh: {path.name}, {len(data.vertices)} vertices, {len(data.triangles)} triangles")
+    print(f"machine: {machine()}")
+    if os.getloadavg()[0] > 1.0:
+        print("note: the machine is busy; medians are inflated (ratios less so, both sides are measured alike)")
+
+    first = []
+    for _ in range(3):
+        start = time.perf_counter()
+        mesh = Mesh(data.vertices, data.triangles)
+        result = mesh.decimate(ratio=ratios[0], seed=0)
+        first.append(time.perf_counter() - start)
+    prepare = []
+    for _ in range(3):
+        start = time.perf_counter()
+        mesh = Mesh(data.vertices, data.triangles)
+        prepare.append(time.perf_counter() - start)
+
+    rows = []
+    for ratio in ratios:
+        seconds, stages = [], {}
+        for seed in range(args.repeats):
+            start = time.perf_counter()
+            result = mesh.decimate(ratio=ratio, seed=seed)
+            seconds.append(time.perf_counter() - start)
+            for name, value in result.stats.seconds.items():
+                stages.setdefault(name, []).append(value)
+        peer = None
+        if PEER.exists():
+            out = subprocess.run([str(PEER), str(path), str(ratio), str(args.repeats)], capture_output=True,
+                                 text=True, check=True)
+            peer = json.loads(out.stdout)
+        rows.append((ratio, seconds, stages, result, peer))
+
+    print(f"\nprepare (validation, Morton order, adjacency, normals, weights): median {median_ms(prepare):.0f} ms")
+    print(f"first decimation at {ratios[0]:.0%} (prepare + decimate): median {median_ms(first):.0f} ms")
+    print("\n| target | ours: re-decimation | stages (sampling / clustering / checking / output) | "
+          "meshopt_simplify | meshopt_simplifySloppy | simplify / ours | sloppy / ours |")
+    print("|---|---|---|---|---|---|---|")
+    for ratio, seconds, stages, result, peer in rows:
+        ours = median_ms(seconds)
+        stage_text = " / ".join(f"{median_ms(stages[k]):.0f}" for k in ("sampling", "clustering", "checking", "output"))
+        if peer:
+            simplify = 1000 * peer["simplify"]["median_seconds"]
+            sloppy = 1000 * peer["simplify_sloppy"]["median_seconds"]
+            print(f"| {ratio:.0%} ({result.num_vertices} v, {result.num_triangles} t) | {ours:.0f} ms | {stage_text} ms | "
+                  f"{simplify:.0f} ms ({peer['simplify']['vertices']} v) | {sloppy:.0f} ms ({peer['simplify_sloppy']['vertices']} v) | "
+                  f"{simplify / ours:.1f}x | {sloppy / ours:.2f}x |")
+        else:
+            print(f"| {ratio:.0%} | {ours:.0f} ms | {stage_text} ms | (build/peers/meshopt_bench missing) | | | |")
+    if rows[0][4]:
+        simplify = rows[0][4]["simplify"]["median_seconds"]
+        print(f"\nfirst decimation vs meshopt_simplify at {ratios[0]:.0%}: {simplify / statistics.median(first):.1f}x faster")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
