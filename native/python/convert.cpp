@@ -39,16 +39,15 @@ std::vector<int32_t> indices_from(const py::handle& object, int64_t columns, con
   if (!a || a.ndim() != 2 || a.shape(1) != columns || (a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
     throw py::value_error(std::string(what) + " must be an int32 or int64 array of shape (m, " +
                           std::to_string(columns) + "), got " + (a ? describe(a) : std::string("something else")));
-  if (py::isinstance<py::array_t<int32_t>>(a)) {  // already int32: one copy, no range check needed
-    auto d = py::array_t<int32_t, py::array::c_style | py::array::forcecast>::ensure(a);
+  // int32 in C order (what io and Blender hand over) is copied as is: no int64 detour.
+  if (py::isinstance<py::array_t<int32_t, py::array::c_style>>(a)) {
+    auto d = py::array_t<int32_t, py::array::c_style>::ensure(a);
     return std::vector<int32_t>(d.data(), d.data() + d.size());
   }
   auto d = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
-  const int64_t* data = d.data();
-  const py::ssize_t size = d.size();
-  std::vector<int32_t> out(size);
-  for (py::ssize_t i = 0; i < size; ++i) {
-    const int64_t x = data[i];
+  std::vector<int32_t> out(d.size());
+  for (py::ssize_t i = 0; i < d.size(); ++i) {
+    const int64_t x = d.data()[i];
     if (x < INT32_MIN || x > INT32_MAX)
       throw py::value_error(std::string(what) + " row " + std::to_string(i / columns) + " holds " + std::to_string(x) +
                             ", outside the 32-bit index range");
