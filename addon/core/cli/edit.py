@@ -20,8 +20,8 @@ def add_parser(subparsers) -> None:
         "fill-holes", help="fill holes (boundary loops)",
         description="Fill every hole of IN (or the ones chosen) and write OUT. Each hole is triangulated on its "
                     "best-fit plane when its border projects there without overlap, else in 3D (minimum-weight "
-                    "triangulation); holes are numbered as in the topology subcommand's boundary loops, by their "
-                    "lowest vertex id.")
+                    "triangulation). Holes are numbered over the whole mesh in the order of their lowest vertex id; "
+                    "the --json report lists each filled one with its first (lowest) vertex.")
     fill.add_argument("input", metavar="IN", help="input mesh file")
     fill.add_argument("output", metavar="OUT", help="output mesh file")
     fill.add_argument("--holes", metavar="I,J,...", help="fill only these holes (indices, comma-separated)")
@@ -82,7 +82,10 @@ def run_fill(args) -> int:
     methods = {}
     for patch in result.patches:
         methods[patch.method] = methods.get(patch.method, 0) + 1
+    filled = [{"hole": p.hole, "first_vertex": int(result.vertex_source[p.boundary].min()),
+               "edges": int(len(p.boundary)), "method": p.method} for p in result.patches]
     details = {"operation": "fill-holes", "holes_filled": len({p.hole for p in result.patches}),
+               "filled": filled,
                "patches": len(result.patches), "methods": methods,
                "triangles_added": int(result.num_triangles - len(data.triangles)),
                "vertices_added": int(np.count_nonzero(result.vertex_source < 0)),
@@ -139,7 +142,7 @@ def _finish(args, data, result, seconds: float, details: dict) -> int:
           f"({added:+d}), {info.summary()}")
     if details["operation"] == "fill-holes":
         methods = ", ".join(f"{count} {name}" for name, count in sorted(details["methods"].items()))
-        print(f"  {details['holes_filled']} holes filled ({methods or 'none'})")
+        print(f"  {details['holes_filled']} holes filled with {details['patches']} patches ({methods or 'none'})")
     else:
         print(f"  cut along a {len(details['loop'])}-vertex {details['loop_kind']} loop, "
               f"filled with {' and '.join(details['methods'])} patches")
