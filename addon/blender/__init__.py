@@ -1,9 +1,32 @@
-"""Blender-facing part of the add-on (needs bpy). Filled in by the add-on work."""
+"""Blender-facing part of the add-on (needs bpy): settings, operators, panels.
+
+Sub-packages register in order and unregister in reverse; the prepared-mesh cache is emptied
+when a file is loaded and on unregister.
+"""
+
+import bpy
+from bpy.app.handlers import persistent
+
+from . import operators, props, ui
+from .cache import prepared_meshes
+
+MODULES = (props, operators, ui)
+
+
+@persistent
+def _clear_cache(*_args):
+    prepared_meshes.clear()
 
 
 def register():
-    pass
+    for module in MODULES:
+        module.register()
+    bpy.app.handlers.load_post.append(_clear_cache)
 
 
 def unregister():
-    pass
+    if _clear_cache in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.remove(_clear_cache)
+    for module in reversed(MODULES):
+        module.unregister()
+    prepared_meshes.clear()

@@ -12,6 +12,7 @@ from .error_bound import ErrorBoundReport
 from .hausdorff import Distance, HausdorffResult, OneSidedDistance, closest_points, hausdorff
 from .io import MeshData, read_mesh, write_mesh
 from .mesh import Mesh, MeshReport
+from .topology import ComponentGenerators, ComponentTopology, Topology, generators, topology
 
 __all__ = [
     "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
@@ -20,6 +21,8 @@ __all__ = [
     "EditResult", "cut_along_loop", "delete_faces", "fill_holes", "fill_loops", "remove_handle",
     # measurement (hausdorff.py) and error-bounded decimation (error_bound.py)
     "Distance", "ErrorBoundReport", "HausdorffResult", "OneSidedDistance", "closest_points", "hausdorff",
+    # topology
+    "ComponentGenerators", "ComponentTopology", "Topology", "generators", "topology",
     # mesh files (io.py)
     "MeshData", "read_mesh", "write_mesh",
 ]

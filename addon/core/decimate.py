@@ -206,7 +206,8 @@ def target_vertex_count(mesh: Mesh, ratio=None, vertices=None) -> int:
 
 def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] = None,
              triangles: Optional[int] = None, *, seed: int = 0, adaptivity: float = 0.5,
-             flat_floor: float = 0.25, density: str = "off", density_rings: int = 0,
+             flat_floor: float = 0.25, area_weighted: bool = False, feature_angle: float = 0.0,
+             density: str = "off", density_rings: int = 0,
              density_ratio: float = 2.0, density_epsilon: float = 0.0, guidance=None,
              regions=None, borders=None, view: Optional[View] = None,
              boxes: Sequence[Box] = (), placement: str = "subsample",
@@ -217,7 +218,11 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
     ratio: fraction of the vertices to keep, in (0, 1]. vertices / triangles: counts.
     seed: the same seed gives the same mesh. adaptivity: 0 samples uniformly, 1 follows the
     normal-deviation weights fully. flat_floor: flat regions keep at least this fraction of the
-    base rate (the thesis' tweak against slivers). density: Poisson-disk rejection of samples,
+    base rate (the thesis' tweak against slivers). area_weighted: probabilities per unit area
+    instead of per vertex (for irregularly tessellated meshes, e.g. CAD exports).
+    feature_angle: creases sharper than this many radians are kept as borders (sampled as curves,
+    never crossed; good for hard-surface models, costly on noisy scans; 0 = off).
+    density: Poisson-disk rejection of samples,
     "off", "uniform" (rings), "adaptive" (thesis 4.1.2: density_ratio = eps_big / eps_small)
     or "euclidean" (density_epsilon, 0 = automatic). guidance: u per vertex (module docs).
     regions: an id per input triangle (materials, UV islands), borders: (k, 2) vertex pairs;
@@ -237,7 +242,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
 
         def decimate_at(count: int) -> DecimateResult:
             return decimate(mesh, vertices=count, seed=seed, adaptivity=adaptivity, flat_floor=flat_floor,
-                            density=density, density_rings=density_rings, density_ratio=density_ratio,
+                            area_weighted=area_weighted, feature_angle=feature_angle, density=density, density_rings=density_rings, density_ratio=density_ratio,
                             density_epsilon=density_epsilon, guidance=guidance, regions=regions,
                             borders=borders, view=view, boxes=boxes, placement=placement,
                             fast_path=fast_path, max_repair_rounds=max_repair_rounds)
@@ -262,14 +267,18 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
     else:
         target = target_vertex_count(mesh, ratio, vertices)
     u = _guidance(mesh, guidance)
-    layout = mesh.feature_layout(regions, borders)
+    if not 0 <= feature_angle <= math.pi:
+        raise ValueError(f"feature_angle must lie in [0, pi] radians, got {feature_angle!r}")
+    layout = mesh.feature_layout(regions, borders, feature_angle)
     parameters = dict(ratio=ratio, vertices=vertices, triangles=triangles, seed=int(seed),
-                      adaptivity=adaptivity, flat_floor=flat_floor, density=density,
+                      adaptivity=adaptivity, flat_floor=flat_floor, area_weighted=bool(area_weighted),
+                      feature_angle=float(feature_angle), density=density,
                       density_rings=density_rings, density_ratio=density_ratio,
                       density_epsilon=density_epsilon, placement=placement)
     raw = engine.decimate(
         mesh.native, layout, target_vertices=target, target_triangles=target_triangles,
-        seed=int(seed), adaptivity=float(adaptivity), flat_floor=float(flat_floor), guidance=u,
+        seed=int(seed), adaptivity=float(adaptivity), flat_floor=float(flat_floor),
+        area_weighted=bool(area_weighted), guidance=u,
         density=density, density_rings=int(density_rings), density_ratio=float(density_ratio),
         density_epsilon=float(density_epsilon),
         view=view.as_engine() if view is not None else None,
@@ -279,20 +288,20 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
     return _result(raw, parameters)
 
 
-def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None,
+def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, feature_angle: float = 0.0,
                           placement: str = "subsample") -> DecimateResult:
     """Re-creates a decimation from ``DecimateResult.samples`` (thesis 4.1.3).
 
-    With the same mesh, regions, borders and placement the output is identical.
+    With the same mesh, regions, borders, feature angle and placement the output is identical.
     """
     if placement not in PLACEMENTS:
         raise ValueError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
     samples = np.asarray(samples)
     if samples.ndim != 1 or samples.dtype.kind not in "iu":
         raise ValueError(f"samples must be a 1-D integer array, got {samples.dtype} {samples.shape}")
-    layout = mesh.feature_layout(regions, borders)
+    layout = mesh.feature_layout(regions, borders, feature_angle)
     raw = engine.decimate_with_samples(mesh.native, layout, samples, placement=placement)
-    return _result(raw, dict(samples=len(samples), placement=placement))
+    return _result(raw, dict(samples=len(samples), placement=placement, feature_angle=feature_angle))
 
 
 def sampling_probabilities(mesh: Mesh, rate: float, *, adaptivity: float = 0.5,

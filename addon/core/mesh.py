@@ -145,17 +145,18 @@ class Mesh:
         """What validation found and repaired."""
         return MeshReport(**self._native.report)
 
-    def feature_layout(self, regions=None, borders=None):
+    def feature_layout(self, regions=None, borders=None, feature_angle: float = 0.0):
         """Feature layout for per-triangle region ids and flagged edges, cached per content.
 
         regions: one integer per triangle of the caller's array (material slot, UV island...);
         clusters never cross a change of region. borders: (k, 2) vertex pairs that clusters
-        never cross (UV seams, sharp edges); each must be an edge of the mesh.
+        never cross (UV seams, sharp edges); each must be an edge of the mesh. feature_angle
+        (radians, 0 = off): creases sharper than this become borders too.
         """
-        key = (_digest(regions), _digest(borders))
+        key = (_digest(regions), _digest(borders), float(feature_angle))
         layout = self._layouts.get(key)
         if layout is None:
-            layout = engine.build_feature_layout(self._native, regions, borders)
+            layout = engine.build_feature_layout(self._native, regions, borders, float(feature_angle))
             if len(self._layouts) >= 8:
                 self._layouts.pop(next(iter(self._layouts)))
             self._layouts[key] = layout

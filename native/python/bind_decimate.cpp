@@ -116,7 +116,7 @@ py::dict result_dict(DecimateResult&& r) {
   return d;
 }
 
-SamplingParams sampling_from(const Mesh& mesh, uint64_t seed, double adaptivity, double flat_floor,
+SamplingParams sampling_from(const Mesh& mesh, uint64_t seed, double adaptivity, double flat_floor, bool area_weighted,
                              const std::vector<double>& guidance, const std::string& density, int32_t density_rings,
                              double density_ratio, double density_epsilon, const py::handle& view,
                              const py::handle& boxes) {
@@ -124,6 +124,7 @@ SamplingParams sampling_from(const Mesh& mesh, uint64_t seed, double adaptivity,
   s.seed = seed;
   s.adaptivity = adaptivity;
   s.flat_floor = flat_floor;
+  s.area_weighted = area_weighted;
   s.guidance = guidance.empty() ? nullptr : guidance.data();
   s.density = density_from(density);
   s.density_rings = density_rings;
@@ -141,12 +142,14 @@ void bind_decimate(py::module_& m) {
   m.def(
       "decimate",
       [](const Mesh& mesh, const FeatureLayout& layout, int32_t target_vertices, int32_t target_triangles,
-         uint64_t seed, double adaptivity, double flat_floor, const py::handle& guidance, const std::string& density,
+         uint64_t seed, double adaptivity, double flat_floor, bool area_weighted, const py::handle& guidance,
+         const std::string& density,
          int32_t density_rings, double density_ratio, double density_epsilon, const py::handle& view,
          const py::handle& boxes, const std::string& placement, int fast_path, int32_t max_repair_rounds) {
         const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
         DecimateParams params;
-        params.sampling = sampling_from(mesh, seed, adaptivity, flat_floor, u, density, density_rings, density_ratio,
+        params.sampling = sampling_from(mesh, seed, adaptivity, flat_floor, area_weighted, u, density, density_rings,
+                                        density_ratio,
                                         density_epsilon, view, boxes);
         params.placement = placement_from(placement);
         params.fast_path = fast_path;
@@ -161,8 +164,8 @@ void bind_decimate(py::module_& m) {
         return result_dict(std::move(r));
       },
       py::arg("mesh"), py::arg("layout"), py::arg("target_vertices") = 0, py::arg("target_triangles") = 0,
-      py::arg("seed") = 0, py::arg("adaptivity") = 0.5, py::arg("flat_floor") = 0.25, py::arg("guidance") = py::none(),
-      py::arg("density") = "off", py::arg("density_rings") = 0, py::arg("density_ratio") = 2.0,
+      py::arg("seed") = 0, py::arg("adaptivity") = 0.5, py::arg("flat_floor") = 0.25, py::arg("area_weighted") = false,
+      py::arg("guidance") = py::none(), py::arg("density") = "off", py::arg("density_rings") = 0, py::arg("density_ratio") = 2.0,
       py::arg("density_epsilon") = 0.0, py::arg("view") = py::none(), py::arg("boxes") = py::none(),
       py::arg("placement") = "subsample", py::arg("fast_path") = -1, py::arg("max_repair_rounds") = 200,
       "TopStoc decimation to a vertex target (or a triangle target when target_triangles > 0).");
@@ -185,9 +188,10 @@ void bind_decimate(py::module_& m) {
   m.def(
       "sampling_probabilities",
       [](const Mesh& mesh, const FeatureLayout& layout, double rate, uint64_t seed, double adaptivity,
-         double flat_floor, const py::handle& guidance, const py::handle& view, const py::handle& boxes) {
+         double flat_floor, bool area_weighted, const py::handle& guidance, const py::handle& view,
+         const py::handle& boxes) {
         const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
-        auto s = sampling_from(mesh, seed, adaptivity, flat_floor, u, "off", 0, 2.0, 0.0, view, boxes);
+        auto s = sampling_from(mesh, seed, adaptivity, flat_floor, area_weighted, u, "off", 0, 2.0, 0.0, view, boxes);
         std::vector<double> p;
         {
           py::gil_scoped_release release;
@@ -196,7 +200,7 @@ void bind_decimate(py::module_& m) {
         return to_array(std::move(p));
       },
       py::arg("mesh"), py::arg("layout"), py::arg("rate"), py::arg("seed") = 0, py::arg("adaptivity") = 0.5,
-      py::arg("flat_floor") = 0.25, py::arg("guidance") = py::none(), py::arg("view") = py::none(),
+      py::arg("flat_floor") = 0.25, py::arg("area_weighted") = false, py::arg("guidance") = py::none(), py::arg("view") = py::none(),
       py::arg("boxes") = py::none(), "Per-vertex sampling probability p(v) for base rate k (SPEC 1.2).");
 
   m.def(

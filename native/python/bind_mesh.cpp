@@ -62,6 +62,7 @@ void bind_mesh(py::module_& m) {
                              })
       .def_property_readonly("region_border_edges", [](const FeatureLayout& l) { return l.region_border_edges; })
       .def_property_readonly("flagged_edges", [](const FeatureLayout& l) { return l.flagged_edges; })
+      .def_property_readonly("crease_edges", [](const FeatureLayout& l) { return l.crease_edges; })
       .def_property_readonly("corners",
                              [](const FeatureLayout& l) {
                                int32_t count = 0;
@@ -74,7 +75,7 @@ void bind_mesh(py::module_& m) {
 
   m.def(
       "build_feature_layout",
-      [](const Mesh& mesh, const py::handle& regions, const py::handle& borders) {
+      [](const Mesh& mesh, const py::handle& regions, const py::handle& borders, double feature_angle) {
         auto region_ids = ids_from(regions, mesh.report().input_triangles, "regions");
         std::vector<int32_t> edges;
         if (!borders.is_none()) edges = indices_from(borders, 2, "borders");
@@ -82,10 +83,12 @@ void bind_mesh(py::module_& m) {
         // pybind11 holders cannot be shared_ptr<const T>; Python never mutates the layout.
         return std::const_pointer_cast<FeatureLayout>(
             build_feature_layout(mesh, region_ids.empty() ? nullptr : region_ids.data(), int64_t(region_ids.size()),
-                                 edges.data(), int64_t(edges.size() / 2)));
+                                 edges.data(), int64_t(edges.size() / 2), feature_angle));
       },
       py::arg("mesh"), py::arg("regions") = py::none(), py::arg("borders") = py::none(),
-      "Feature layout from per-triangle region ids (caller's order) and flagged edges (vertex pairs).");
+      py::arg("feature_angle") = 0.0,
+      "Feature layout from per-triangle region ids (caller's order), flagged edges (vertex pairs) and a crease "
+      "angle in radians (0 = off).");
 }
 
 }  // namespace topstoc::python

@@ -25,12 +25,16 @@ py::array as_array(const py::handle& object, const char* what) {
 
 }  // namespace
 
-std::vector<double> positions_from(const py::handle& object, const char* what) {
+py::array_t<double, py::array::c_style> positions_array(const py::handle& object, const char* what) {
   py::array a = as_array(object, what);
   if (!a || a.ndim() != 2 || a.shape(1) != 3 || (a.dtype().kind() != 'f'))
     throw py::value_error(std::string(what) + " must be a float32 or float64 array of shape (n, 3), got " +
                           (a ? describe(a) : std::string("something else")));
-  auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+  return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+}
+
+std::vector<double> positions_from(const py::handle& object, const char* what) {
+  const auto d = positions_array(object, what);
   return std::vector<double>(d.data(), d.data() + d.size());
 }
 

@@ -1,4 +1,5 @@
 #include "topstoc/clustering.hpp"
+#include "topstoc/parallel.hpp"
 
 #include <omp.h>
 
@@ -16,8 +17,6 @@ inline int32_t dist_of(uint64_t key) { return int32_t(key >> 32); }
 inline int32_t rank_of(uint64_t key) { return int32_t(key & 0xffffffffu); }
 constexpr uint64_t kUnreached = ~uint64_t(0);
 
-// Frontiers smaller than this are relaxed by one thread (a parallel region costs more).
-constexpr size_t kParallelFrontier = 4096;
 
 // Level-synchronous relaxation from `frontier` (all at distance `level`): a neighbour improves
 // when (level + 1, rank) beats what it holds. Keys are lowered with an atomic minimum, so the
@@ -26,7 +25,7 @@ constexpr size_t kParallelFrontier = 4096;
 // cross_edges, every edge between two clusters is recorded once, from its farther end, when
 // both ends are final (only for a full fill).
 void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> frontier, int32_t level,
-                  std::vector<uint64_t>& key, std::vector<int32_t>* cross_edges) {
+                  std::vector<uint64_t>& key, std::vector<int32_t>* cross_edges, std::vector<int32_t>* changed) {
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
   const auto& ae = mesh.adjacency_edge();
@@ -38,9 +37,11 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   uint64_t* keys = key.data();
   uint8_t* in_next = queued.data();
   while (!frontier.empty()) {
+    // Every vertex is lowered at one level at most, so the frontiers list each change once.
+    if (changed) changed->insert(changed->end(), frontier.begin(), frontier.end());
     const uint64_t d = uint64_t(level) + 1;
     const int64_t count = int64_t(frontier.size());
-#pragma omp parallel if (frontier.size() >= kParallelFrontier)
+#pragma omp parallel if (int64_t(frontier.size()) >= kParallelMin / 16)
     {
       const int me = omp_get_thread_num();
       auto& mine = next[me];
@@ -89,10 +90,11 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
 }
 
 void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
-                    int32_t first_new, Clustering& c, std::vector<int32_t>* cross_edges) {
+                    int32_t first_new, Clustering& c, std::vector<int32_t>* cross_edges,
+                    std::vector<int32_t>* changed) {
   const int32_t n = mesh.num_vertices();
   std::vector<uint64_t> key(n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) key[v] = c.label[v] < 0 ? kUnreached : pack(c.dist[v], c.label[v]);
   std::vector<int32_t> frontier;
   for (size_t r = size_t(first_new); r < samples.size(); ++r) {
@@ -105,8 +107,8 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
     key[s] = pack(0, static_cast<int32_t>(r));
     frontier.push_back(s);
   }
-  relax_levels(mesh, layout, std::move(frontier), 0, key, cross_edges);
-#pragma omp parallel for schedule(static)
+  relax_levels(mesh, layout, std::move(frontier), 0, key, cross_edges, changed);
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     c.label[v] = key[v] == kUnreached ? -1 : rank_of(key[v]);
     c.dist[v] = key[v] == kUnreached ? INT_MAX : dist_of(key[v]);
@@ -121,12 +123,12 @@ void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int3
   out.label.assign(n, -1);
   out.dist.assign(n, INT_MAX);
   if (cross_edges) cross_edges->clear();
-  seed_and_relax(mesh, layout, samples, 0, out, cross_edges);
+  seed_and_relax(mesh, layout, samples, 0, out, cross_edges, nullptr);
 }
 
 void flood_add(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
-               int32_t first_new, Clustering& c) {
-  seed_and_relax(mesh, layout, samples, first_new, c, nullptr);
+               int32_t first_new, Clustering& c, std::vector<int32_t>* changed) {
+  seed_and_relax(mesh, layout, samples, first_new, c, nullptr, changed);
 }
 
 int32_t step_towards_sample(const Mesh& mesh, const FeatureLayout& layout, const Clustering& c, int32_t x) {

@@ -1,5 +1,7 @@
 #include "topstoc/features.hpp"
+#include "topstoc/parallel.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -18,7 +20,7 @@ int32_t FeatureLayout::sector_of(const Mesh& mesh, int32_t v, int32_t f) const {
 namespace {
 
 void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t face_region_count,
-                        const int32_t* flagged, int64_t num_flagged, FeatureLayout& layout) {
+                        const int32_t* flagged, int64_t num_flagged, double feature_angle, FeatureLayout& layout) {
   const int32_t num_edges = mesh.num_edges();
   layout.edge_feature.assign(num_edges, 0);
   const auto& efo = mesh.edge_face_offsets();
@@ -48,6 +50,31 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
     if (!layout.edge_feature[e]) ++layout.flagged_edges;
     layout.edge_feature[e] = 1;
   }
+  if (feature_angle > 0) {
+    // Creases: the angle between the two triangles' normals exceeds the feature angle.
+    const double threshold = std::cos(feature_angle);
+    const auto& faces = mesh.faces();
+    auto unit_normal = [&](int32_t f, double* n) {
+      const double* a = mesh.position(faces[3 * size_t(f)]);
+      const double* b = mesh.position(faces[3 * size_t(f) + 1]);
+      const double* c = mesh.position(faces[3 * size_t(f) + 2]);
+      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
+      const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      if (len == 0) return false;
+      n[0] /= len, n[1] /= len, n[2] /= len;
+      return true;
+    };
+    for (int32_t e = 0; e < num_edges; ++e) {
+      if (layout.edge_feature[e] || efo[e + 1] - efo[e] != 2) continue;
+      double n0[3], n1[3];
+      if (!unit_normal(ef[efo[e]], n0) || !unit_normal(ef[efo[e] + 1], n1)) continue;
+      if (n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] < threshold) {
+        layout.edge_feature[e] = 1;
+        ++layout.crease_edges;
+      }
+    }
+  }
   for (int32_t e = 0; e < num_edges; ++e)
     if (layout.edge_feature[e]) layout.feature_edges.push_back(e);
 }
@@ -63,7 +90,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   layout.vertex_feature.assign(n, 0);
   layout.vertex_corner.assign(n, 0);
   layout.chi_constant.assign(n, 0);
-#pragma omp parallel
+#pragma omp parallel if (n >= kParallelMin)
   {
     std::vector<int32_t> fan_of_slot;
 #pragma omp for schedule(static)
@@ -157,9 +184,11 @@ void trace_curves(const Mesh& mesh, FeatureLayout& layout) {
 
 std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, const int32_t* face_region,
                                                           int64_t face_region_count, const int32_t* flagged_edges,
-                                                          int64_t num_flagged_edges) {
+                                                          int64_t num_flagged_edges, double feature_angle) {
+  if (!(feature_angle >= 0.0 && feature_angle <= M_PI))
+    throw std::invalid_argument("feature angle must lie in [0, pi] radians");
   auto layout = std::make_shared<FeatureLayout>();
-  mark_feature_edges(mesh, face_region, face_region_count, flagged_edges, num_flagged_edges, *layout);
+  mark_feature_edges(mesh, face_region, face_region_count, flagged_edges, num_flagged_edges, feature_angle, *layout);
   compute_sectors_and_corners(mesh, *layout);
   trace_curves(mesh, *layout);
   return layout;

@@ -1,4 +1,5 @@
 #include "topstoc/hausdorff.hpp"
+#include "topstoc/parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +19,6 @@ constexpr int64_t kBlock = 256;
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Loops shorter than this run serially: starting threads costs more than it saves, and far more
 // when other processes hold the cores.
-constexpr int64_t kParallelMin = 100000;
 
 double length(const double* a, const double* b) {
   const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};

@@ -1,4 +1,5 @@
 #include "topstoc/mesh.hpp"
+#include "topstoc/parallel.hpp"
 
 #include <algorithm>
 #include <array>
@@ -164,7 +165,7 @@ void Mesh::reorder_for_locality() {
     }
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
   std::vector<std::pair<uint64_t, int32_t>> keyed(n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     uint64_t key = 0;
     for (int k = 0; k < 3; ++k) {
@@ -220,7 +221,7 @@ void Mesh::build_adjacency_and_edges() {
   // Each vertex sees at most two neighbours per incident face: gather, sort, unique in place.
   std::vector<int32_t> scratch(2 * vertex_faces_.size());
   std::vector<int32_t> degree(n + 1, 0);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     int32_t* out = scratch.data() + 2 * size_t(vertex_face_offsets_[v]);
     int32_t k = 0;
@@ -238,7 +239,7 @@ void Mesh::build_adjacency_and_edges() {
   adjacency_edge_.resize(adjacency_offsets_[n]);
   // Edge ids: edges are numbered by their lower endpoint, then by the higher one.
   std::vector<int32_t> greater(n + 1, 0);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     const int32_t* src = scratch.data() + 2 * size_t(vertex_face_offsets_[v]);
     std::copy(src, src + degree[v], adjacency_.begin() + adjacency_offsets_[v]);
@@ -248,7 +249,7 @@ void Mesh::build_adjacency_and_edges() {
   exclusive_scan(edge_base);
   const int32_t num_edges = edge_base[n];
   edge_vertices_.resize(2 * size_t(num_edges));
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     const int32_t b = adjacency_offsets_[v], e = adjacency_offsets_[v + 1];
     const int32_t first_greater = e - greater[v];
@@ -262,7 +263,7 @@ void Mesh::build_adjacency_and_edges() {
       }
     }
   }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v)
     for (int32_t i = adjacency_offsets_[v]; i < adjacency_offsets_[v + 1]; ++i) {
       const int32_t u = adjacency_[i];
@@ -285,7 +286,7 @@ int32_t Mesh::find_edge(int32_t a, int32_t b) const {
 void Mesh::build_edge_faces() {
   const int32_t m = num_faces();
   face_edges_.resize(faces_.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (m >= kParallelMin)
   for (int32_t f = 0; f < m; ++f)
     for (int c = 0; c < 3; ++c) face_edges_[3 * f + c] = find_edge(faces_[3 * f + c], faces_[3 * f + (c + 1) % 3]);
   edge_face_offsets_.assign(num_edges() + 1, 0);
@@ -321,22 +322,27 @@ void Mesh::compute_normals_and_weights() {
   const int32_t m = num_faces();
   // Area-weighted: the unnormalised face normal (twice the area) summed at each corner.
   std::vector<double> face_normals(3 * size_t(m));
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (m >= kParallelMin)
   for (int32_t f = 0; f < m; ++f) {
     const int32_t* t = &faces_[3 * size_t(f)];
     cross(position(t[0]), position(t[1]), position(t[2]), &face_normals[3 * size_t(f)]);
   }
   normals_.assign(3 * size_t(n), 0.0);
   weights_.assign(n, 0.0);
-#pragma omp parallel for schedule(static)
+  vertex_areas_.assign(n, 0.0);
+  double total_area = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : total_area) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
-    double sum[3] = {0, 0, 0};
+    double sum[3] = {0, 0, 0}, area = 0.0;
     for (int32_t i = vertex_face_offsets_[v]; i < vertex_face_offsets_[v + 1]; ++i) {
       const double* fn = &face_normals[3 * size_t(vertex_faces_[i])];
       sum[0] += fn[0];
       sum[1] += fn[1];
       sum[2] += fn[2];
+      area += std::sqrt(fn[0] * fn[0] + fn[1] * fn[1] + fn[2] * fn[2]) / 6.0;  // a third of half the cross
     }
+    vertex_areas_[v] = area;
+    total_area += area;
     const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
     if (len > 0)
       for (int k = 0; k < 3; ++k) normals_[3 * size_t(v) + k] = sum[k] / len;
@@ -344,7 +350,7 @@ void Mesh::compute_normals_and_weights() {
   // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
   double total = 0.0;
   int64_t counted = 0;
-#pragma omp parallel for schedule(static) reduction(+ : total, counted)
+#pragma omp parallel for schedule(static) reduction(+ : total, counted) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     const int32_t b = adjacency_offsets_[v], e = adjacency_offsets_[v + 1];
     if (b == e) continue;
@@ -360,6 +366,7 @@ void Mesh::compute_normals_and_weights() {
     ++counted;
   }
   mean_weight_ = counted ? total / double(counted) : 0.0;
+  mean_vertex_area_ = counted ? total_area / double(counted) : 0.0;
 }
 
 void Mesh::compute_components_and_manifoldness() {
@@ -391,7 +398,7 @@ void Mesh::compute_components_and_manifoldness() {
 
   manifold_vertex_.assign(n, 1);
   int32_t pinched = 0;
-#pragma omp parallel reduction(+ : pinched)
+#pragma omp parallel reduction(+ : pinched) if (n >= kParallelMin)
   {
     std::vector<int32_t> fan_of_slot;
 #pragma omp for schedule(static)

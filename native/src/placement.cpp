@@ -1,4 +1,5 @@
 #include "topstoc/placement.hpp"
+#include "topstoc/parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -86,7 +87,7 @@ std::vector<double> filtered_positions(const Mesh& mesh, const FeatureLayout& la
     radius2[label[v]] = std::max(radius2[label[v]], d2);
   }
   std::vector<double> out(3 * size_t(k));
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (k >= kParallelMin)
   for (int32_t s = 0; s < k; ++s) {
     const double* p = mesh.position(samples[s]);
     double* x = &out[3 * size_t(s)];

@@ -1,4 +1,5 @@
 #include "topstoc/quality.hpp"
+#include "topstoc/parallel.hpp"
 
 #include <cmath>
 #include <limits>
@@ -24,7 +25,7 @@ AspectStats aspect_ratio_stats(const double* positions, const int32_t* triangles
   AspectStats stats;
   double sum = 0.0, max = 0.0;
   int64_t counted = 0, degenerate = 0;
-#pragma omp parallel for schedule(static) reduction(+ : sum, counted, degenerate) reduction(max : max)
+#pragma omp parallel for schedule(static) reduction(+ : sum, counted, degenerate) reduction(max : max) if (num_triangles >= kParallelMin)
   for (int64_t t = 0; t < num_triangles; ++t) {
     const int32_t* tri = triangles + 3 * t;
     const double ar = aspect_ratio(positions + 3 * size_t(tri[0]), positions + 3 * size_t(tri[1]),

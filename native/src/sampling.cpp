@@ -1,4 +1,5 @@
 #include "topstoc/sampling.hpp"
+#include "topstoc/parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -31,10 +32,14 @@ std::vector<uint8_t> classify(const Mesh& mesh, const FeatureLayout& layout) {
 }
 
 // Importance factor q(v) = 1 + α (x / x̄ - 1), floored so flat regions are not starved.
+// With area weighting, q is also scaled by the vertex's area over the mean, so that samples
+// per unit area, not per vertex, follow the weights on irregularly tessellated meshes.
 inline double importance(const Mesh& mesh, const SamplingParams& params, int32_t v) {
   const double mean = mesh.mean_weight();
-  const double q = mean > 0 ? 1.0 + params.adaptivity * (mesh.weights()[v] / mean - 1.0) : 1.0;
-  return std::max(q, params.flat_floor);
+  const double q = std::max(mean > 0 ? 1.0 + params.adaptivity * (mesh.weights()[v] / mean - 1.0) : 1.0,
+                            params.flat_floor);
+  if (!params.area_weighted || mesh.mean_vertex_area() <= 0) return q;
+  return q * mesh.vertex_areas()[v] / mesh.mean_vertex_area();
 }
 
 bool inside_box(const BoxGuidance& box, const double* p) {
@@ -96,7 +101,7 @@ std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& 
                                   double k) {
   const int32_t n = mesh.num_vertices();
   std::vector<double> p(n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     switch (cls[v]) {
       case kIsolated: p[v] = 0.0; break;
@@ -128,7 +133,7 @@ double solve_rate(const Mesh& mesh, const std::vector<uint8_t>& cls, const Sampl
   // Sum of the probabilities at k and its derivative.
   auto evaluate = [&](double k, double& slope) {
     double sum = 0.0, d = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : sum, d)
+#pragma omp parallel for schedule(static) reduction(+ : sum, d) if (n >= kParallelMin)
     for (int32_t v = 0; v < n; ++v) {
       if (cls[v] == kSurface) {
         const double p = k * q[v];
@@ -183,7 +188,7 @@ std::vector<Candidate> pareto_candidates(const Mesh& mesh, uint64_t seed, const 
   const int32_t n = mesh.num_vertices();
   const int threads = omp_get_max_threads();
   std::vector<std::vector<Candidate>> found(threads);
-#pragma omp parallel
+#pragma omp parallel if (n >= kParallelMin)
   {
     auto& mine = found[omp_get_thread_num()];
 #pragma omp for schedule(static)
@@ -231,7 +236,7 @@ double mean_edge_length(const Mesh& mesh) {
   const auto& ev = mesh.edge_vertices();
   double total = 0.0;
   const int32_t m = mesh.num_edges();
-#pragma omp parallel for schedule(static) reduction(+ : total)
+#pragma omp parallel for schedule(static) reduction(+ : total) if (m >= kParallelMin)
   for (int32_t e = 0; e < m; ++e) {
     const double* a = mesh.position(ev[2 * e]);
     const double* b = mesh.position(ev[2 * e + 1]);

@@ -286,3 +286,37 @@ def test_bad_sample_lists(samples, message):
     mesh = Mesh(*meshgen.icosphere(3))
     with pytest.raises(ValueError, match=message):
         mesh.decimate_with_samples(samples)
+
+
+def test_creases_become_borders_on_hard_surface_models():
+    mesh = load(DATA / "genus0/cgal_fandisk.off")
+    import math
+    layout = mesh.feature_layout(feature_angle=math.radians(40))
+    assert layout.crease_edges > 500 and layout.corners > 0
+    plain = mesh.decimate(ratio=0.05, seed=1)
+    creased = mesh.decimate(ratio=0.05, seed=1, feature_angle=math.radians(40))
+    assert creased.num_vertices == plain.num_vertices  # still the exact budget
+    # creases are sampled as curves: a large share of the kept vertices lie on them
+    crease_vertices = np.unique(mesh.native.edges[layout.edge_feature.astype(bool)])
+    assert np.isin(creased.kept, crease_vertices).sum() > 0.3 * creased.num_vertices
+    check_output(mesh, creased, reference.invariants(mesh.num_vertices, mesh.triangles))
+    # and the result stays closer to the original (mean symmetric Hausdorff distance)
+    from topstoc.core.hausdorff import hausdorff
+    plain_error = hausdorff(mesh, plain, samples=50000).symmetric.mean
+    creased_error = hausdorff(mesh, creased, samples=50000).symmetric.mean
+    assert creased_error < 0.8 * plain_error
+
+
+def test_fast_path_gives_the_same_mesh():
+    # thesis 4.1.1: candidate faces collected during the flood instead of a scan of all faces
+    v, t, regions = sphere_with_regions()
+    mesh = Mesh(v, t)
+    for ratio in (0.2, 0.03, 0.005):
+        fast = mesh.decimate(ratio=ratio, seed=5, regions=regions, fast_path=True)
+        full = mesh.decimate(ratio=ratio, seed=5, regions=regions, fast_path=False)
+        assert fast.stats.fast_path and not full.stats.fast_path
+        for name in ("triangles", "kept", "face_source", "corner_source", "labels", "samples"):
+            np.testing.assert_array_equal(getattr(fast, name), getattr(full, name), err_msg=name)
+    # automatic below 5 % of the vertices
+    assert mesh.decimate(ratio=0.03, seed=5).stats.fast_path
+    assert not mesh.decimate(ratio=0.2, seed=5).stats.fast_path

@@ -1,8 +1,8 @@
 // Feature layout: the edges that no cluster may cross, and what follows from them.
 //
 // Feature edges are mesh boundary edges, non-manifold edges, borders between faces with
-// different region ids (materials, UV islands) and edges the caller flags (UV seams, sharp
-// edges). Cutting the mesh along them splits each vertex into sectors (fans of triangles);
+// different region ids (materials, UV islands), edges the caller flags (UV seams, sharp
+// edges) and, on request, creases sharper than a feature angle. Cutting the mesh along them splits each vertex into sectors (fans of triangles);
 // the decimation treats every sector as its own side of a border. Feature vertices are
 // reached by the flood fill only along feature edges, so each border is sampled and
 // partitioned as a curve of its own and survives into the output; corners (where curves
@@ -37,6 +37,7 @@ struct FeatureLayout {
   std::vector<int32_t> chi_constant;
   int32_t region_border_edges = 0;
   int32_t flagged_edges = 0;
+  int32_t crease_edges = 0;
 
   int32_t num_curves() const { return static_cast<int32_t>(curve_closed.size()); }
   /// Copies of edge e in the mesh cut along the feature edges.
@@ -47,9 +48,10 @@ struct FeatureLayout {
 
 /// face_region: one id per caller triangle (indexed like the caller's triangle array), or null.
 /// flagged_edges: pairs of caller vertex ids; each must be an edge of the mesh (else
-/// std::invalid_argument).
+/// std::invalid_argument). feature_angle (radians, 0 = off): edges whose two triangles meet at a
+/// dihedral angle above it (creases) become features too, so sharp edges are sampled as curves.
 std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, const int32_t* face_region,
                                                           int64_t face_region_count, const int32_t* flagged_edges,
-                                                          int64_t num_flagged_edges);
+                                                          int64_t num_flagged_edges, double feature_angle = 0.0);
 
 }  // namespace topstoc

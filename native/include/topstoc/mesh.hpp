@@ -74,6 +74,9 @@ class Mesh {
 
   /// Unit area-weighted vertex normals (zero for vertices without area).
   const std::vector<double>& normals() const { return normals_; }
+  /// A third of the area of the triangles around each vertex, and its mean over vertices in faces.
+  const std::vector<double>& vertex_areas() const { return vertex_areas_; }
+  double mean_vertex_area() const { return mean_vertex_area_; }
   /// Importance weight x(v) of thesis eq. 4.1, in [0, 1]; mean over vertices in faces.
   const std::vector<double>& weights() const { return weights_; }
   double mean_weight() const { return mean_weight_; }
@@ -105,8 +108,8 @@ class Mesh {
   std::vector<int32_t> vertex_face_offsets_, vertex_faces_;
   std::vector<int32_t> adjacency_offsets_, adjacency_, adjacency_edge_;
   std::vector<int32_t> edge_vertices_, edge_face_offsets_, edge_faces_, face_edges_;
-  std::vector<double> normals_, weights_;
-  double mean_weight_ = 0.0, diagonal_ = 0.0;
+  std::vector<double> normals_, weights_, vertex_areas_;
+  double mean_weight_ = 0.0, diagonal_ = 0.0, mean_vertex_area_ = 0.0;
   std::vector<int32_t> component_;
   std::vector<int64_t> component_euler_;
   std::vector<uint8_t> manifold_vertex_, inconsistent_edge_;

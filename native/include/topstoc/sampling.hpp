@@ -40,6 +40,7 @@ struct BoxGuidance {
 struct SamplingParams {
   double adaptivity = 0.5;              ///< α in [0, 1]: 0 uniform, 1 fully weight-driven
   double flat_floor = 0.25;             ///< p never drops below flat_floor * k for u = 0 (the thesis' tweak)
+  bool area_weighted = false;           ///< scale p by the vertex's share of the area (irregular meshes)
   const double* guidance = nullptr;     ///< u per caller vertex in [-1, 1], or null
   ViewGuidance view;
   std::vector<BoxGuidance> boxes;

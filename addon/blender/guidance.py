@@ -1,0 +1,200 @@
+"""Guidance sources of a Blender object -> engine arguments (u, regions, borders, view, boxes).
+
+The rules that turn each source into ``u`` and combine them are in topstoc.core.guidance;
+this module only reads Blender data. Problems with the user's settings (a vertex group or
+colour attribute that does not exist, no camera) raise GuidanceError with a message for the
+status bar; nothing is modified.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+from typing import List, Optional
+
+import bpy
+import numpy as np
+from mathutils import Matrix, Vector
+
+from ..core import guidance as rules
+from ..core.attributes import uv_seam_edges
+from ..core.decimate import Box, View
+from . import mesh_io
+from .props import DEFAULT_COLOR_LAYER
+
+
+class GuidanceError(ValueError):
+    """A guidance setting that cannot be honoured (message names the setting)."""
+
+
+@dataclass
+class EngineGuidance:
+    """What the engine receives besides the target; ``sources`` says what was used."""
+
+    guidance: Optional[np.ndarray] = None
+    regions: Optional[np.ndarray] = None
+    borders: Optional[np.ndarray] = None
+    view: Optional[View] = None
+    boxes: List[Box] = field(default_factory=list)
+    sources: List[str] = field(default_factory=list)
+
+    def decimate_kwargs(self) -> dict:
+        return dict(guidance=self.guidance, regions=self.regions, borders=self.borders, view=self.view,
+                    boxes=self.boxes)
+
+    def layout_kwargs(self) -> dict:
+        """The part that restoring from samples needs (the feature layout)."""
+        return dict(regions=self.regions, borders=self.borders)
+
+    def layout_digest(self) -> str:
+        h = hashlib.blake2b(digest_size=16)
+        for array in (self.regions, self.borders):
+            h.update(b"-" if array is None else np.ascontiguousarray(array).tobytes())
+        return h.hexdigest()
+
+
+def _matrix(m: Matrix) -> np.ndarray:
+    return np.array([list(row) for row in m], dtype=np.float64)
+
+
+def read_color_guidance(mesh, name: str) -> np.ndarray:
+    """u per vertex from a colour attribute (rules in topstoc.core.guidance)."""
+    attribute = mesh.color_attributes.get(name)
+    if attribute is None:
+        raise GuidanceError(f"colour attribute '{name}' not found on mesh '{mesh.name}' "
+                            "(paint it in Vertex Paint mode or use 'Add Guidance Layer')")
+    count = len(mesh.vertices) if attribute.domain == "POINT" else len(mesh.loops)
+    values, key = mesh_io.read_attribute(attribute, count)
+    rgb = values[:, :3].astype(np.float64)
+    if key == "color":
+        rgb = rules.linear_to_srgb(rgb)
+    if attribute.domain == "CORNER":
+        corner_vertex = mesh_io.loop_vertices(mesh)
+        rgb = rules.corner_to_vertex_mean(len(mesh.vertices), corner_vertex, rgb)
+    return rules.color_to_guidance(rgb)
+
+
+def _borders(obj, settings, arrays: mesh_io.MeshArrays, sources: list) -> Optional[np.ndarray]:
+    mesh = obj.data
+    parts = []
+    if settings.use_uv_seams:
+        for name, uv in mesh_io.read_uv_maps(mesh).items():
+            corner_uv = uv[arrays.triangle_loops]
+            seams = uv_seam_edges(arrays.triangles, corner_uv)
+            if len(seams):
+                parts.append(seams)
+                sources.append(f"UV seams of '{name}' ({len(seams)} edges)")
+        marked = mesh_io.read_edges(mesh, "use_seam")
+        if len(marked):
+            parts.append(marked)
+            sources.append(f"marked seams ({len(marked)} edges)")
+    if settings.use_sharp:
+        sharp = mesh_io.read_edges(mesh, "use_edge_sharp")
+        if len(sharp):
+            parts.append(sharp)
+            sources.append(f"sharp edges ({len(sharp)})")
+    if not parts:
+        return None
+    # Only edges of triangles can be borders (loose edges carry no faces to separate).
+    edges = rules.mesh_edges(arrays.triangles)
+    borders = rules.edges_in(edges, np.concatenate(parts))
+    return borders if len(borders) else None
+
+
+def _boxes(obj, scene) -> List[Box]:
+    world = obj.matrix_world
+    boxes = []
+    for box in sorted(scene.objects, key=lambda o: o.name):
+        if box.type != "EMPTY" or box.empty_display_type != "CUBE" or not box.topstoc.box_enabled:
+            continue
+        if abs(box.matrix_world.determinant()) < 1e-30 or box.empty_display_size <= 0:
+            raise GuidanceError(f"guidance box '{box.name}' has zero size")
+        scale = Matrix.Scale(1.0 / box.empty_display_size, 4)
+        world_to_box = scale @ box.matrix_world.inverted() @ world
+        value = float(np.clip(box.topstoc.box_weight * scene.topstoc.box_strength, -1, 1))
+        boxes.append(Box(_matrix(world_to_box), value))
+    return boxes
+
+
+def _camera_view(obj, scene, depsgraph) -> View:
+    camera = scene.camera
+    if camera is None:
+        raise GuidanceError("view-dependent decimation needs a scene camera")
+    render = scene.render
+    to_local = obj.matrix_world.inverted()
+    projection = camera.calc_matrix_camera(depsgraph, x=render.resolution_x, y=render.resolution_y,
+                                           scale_x=render.pixel_aspect_x, scale_y=render.pixel_aspect_y)
+    clip = projection @ camera.matrix_world.inverted() @ obj.matrix_world
+    if camera.data.type == "ORTHO":
+        direction = to_local.to_3x3() @ (camera.matrix_world.to_3x3() @ Vector((0.0, 0.0, -1.0)))
+        return View(direction=list(direction), view_projection=_matrix(clip))
+    eye = to_local @ camera.matrix_world.translation
+    return View(eye=list(eye), view_projection=_matrix(clip))
+
+
+def _viewport_view(obj, region_3d) -> View:
+    if region_3d is None:
+        raise GuidanceError("no 3D viewport to take the view from; use the scene camera")
+    to_local = obj.matrix_world.inverted()
+    clip = region_3d.perspective_matrix @ obj.matrix_world
+    view_to_world = region_3d.view_matrix.inverted()
+    if region_3d.is_perspective:
+        return View(eye=list(to_local @ view_to_world.translation), view_projection=_matrix(clip))
+    direction = to_local.to_3x3() @ (view_to_world.to_3x3() @ Vector((0.0, 0.0, -1.0)))
+    return View(direction=list(direction), view_projection=_matrix(clip))
+
+
+def gather(obj, arrays: mesh_io.MeshArrays, scene, depsgraph=None, region_3d=None) -> EngineGuidance:
+    """Reads every enabled guidance source of ``obj`` into engine arguments."""
+    settings = obj.topstoc
+    scene_settings = scene.topstoc
+    n = len(arrays.vertices)
+    out = EngineGuidance()
+    sources = []
+
+    if settings.use_vertex_group:
+        group = obj.vertex_groups.get(settings.vertex_group)
+        if group is None:
+            raise GuidanceError(f"vertex group '{settings.vertex_group}' not found on '{obj.name}'")
+        weights, assigned = mesh_io.read_vertex_group(obj, group.index)
+        u = rules.vertex_group_guidance(weights, assigned, settings.vertex_group_mapping)
+        sources.append((u, settings.vertex_group_strength))
+        out.sources.append(f"vertex group '{group.name}'")
+    if settings.use_color and settings.color_attribute:
+        mesh = obj.data
+        if mesh.color_attributes.get(settings.color_attribute) is not None:
+            sources.append((read_color_guidance(mesh, settings.color_attribute), settings.color_strength))
+            out.sources.append(f"painted '{settings.color_attribute}'")
+        elif settings.color_attribute != DEFAULT_COLOR_LAYER:  # the default layer may not exist yet
+            raise GuidanceError(f"colour attribute '{settings.color_attribute}' not found on '{obj.name}'")
+    if settings.use_materials and len(arrays.polygon_material):
+        weights = list(settings.material_weights)[:max(len(obj.material_slots), 1)]
+        if any(w != 0.0 for w in weights):
+            u = rules.material_guidance(n, arrays.triangles, arrays.triangle_material, weights)
+            sources.append((u, settings.material_strength))
+            out.sources.append("material slot weights")
+        if len(np.unique(arrays.polygon_material)) > 1:
+            out.regions = rules.compact_regions(arrays.triangle_material)
+            out.sources.append("material borders")
+    out.guidance = rules.combine(sources, n)
+    detail = []
+    out.borders = _borders(obj, settings, arrays, detail)
+    out.sources.extend(detail)
+    if scene_settings.use_boxes:
+        out.boxes = _boxes(obj, scene)
+        if out.boxes:
+            out.sources.append(f"{len(out.boxes)} box{'es' if len(out.boxes) > 1 else ''}")
+    if scene_settings.use_view:
+        if scene_settings.view_source == "CAMERA":
+            view = _camera_view(obj, scene, depsgraph or bpy.context.evaluated_depsgraph_get())
+        else:
+            view = _viewport_view(obj, region_3d)
+        view.back_ratio = scene_settings.back_ratio
+        view.silhouette_angle = scene_settings.silhouette_angle
+        view.silhouette_falloff = scene_settings.silhouette_falloff
+        if not scene_settings.use_frustum:
+            view.view_projection = None
+        view.outside_probability = scene_settings.outside_probability
+        out.view = view
+        out.sources.append("camera view" if scene_settings.view_source == "CAMERA" else "viewport view")
+    return out

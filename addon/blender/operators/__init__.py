@@ -1,0 +1,19 @@
+"""Operators, one module per concern; each module lists its classes in CLASSES."""
+
+import bpy
+
+from . import decimate, guidance, preview, samples, variants
+
+MODULES = (decimate, guidance, preview, samples, variants)
+
+
+def register():
+    for module in MODULES:
+        for cls in module.CLASSES:
+            bpy.utils.register_class(cls)
+
+
+def unregister():
+    for module in reversed(MODULES):
+        for cls in reversed(module.CLASSES):
+            bpy.utils.unregister_class(cls)

@@ -1,0 +1,74 @@
+"""The one-click "Guided Decimate" operator (object mode, every selected mesh)."""
+
+from __future__ import annotations
+
+import time
+
+import bpy
+
+from .. import pipeline
+from ..guidance import GuidanceError
+from ..props import DecimationParameters, copy_parameters
+
+
+def selected_meshes(context):
+    return [obj for obj in context.selected_objects if obj.type == "MESH"]
+
+
+class TOPSTOC_OT_guided_decimate(DecimationParameters, bpy.types.Operator):
+    """Decimate the selected meshes with TopStoc, honouring their guidance"""
+
+    bl_idname = "topstoc.guided_decimate"
+    bl_label = "Guided Decimate"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.mode == "OBJECT" and bool(selected_meshes(context))
+
+    def invoke(self, context, event):
+        copy_parameters(context.scene.topstoc, self)  # the panel's settings; the redo panel tweaks them
+        return self.execute(context)
+
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "target_mode")
+        field = {"RATIO": "ratio", "VERTICES": "vertices", "TRIANGLES": "triangles",
+                 "MAX_ERROR": "max_error"}[self.target_mode]
+        layout.prop(self, field)
+        if self.target_mode == "MAX_ERROR":
+            layout.prop(self, "max_error_relative")
+        for name in ("seed", "adaptivity", "density", "placement", "output"):
+            layout.prop(self, name)
+
+    def execute(self, context):
+        start = time.perf_counter()
+        outputs, lines, failures = [], [], []
+        for obj in selected_meshes(context):
+            try:
+                run = pipeline.decimate(context, obj, self, region_3d=context.region_data)
+                if self.output == "NEW_OBJECT":
+                    pipeline.store_samples(run)
+                outputs.append(pipeline.write_output(run, self.output))
+                lines.append(pipeline.summary(run))
+            except (pipeline.DecimationError, GuidanceError) as error:
+                failures.append(str(error))
+        for message in failures:
+            self.report({"ERROR"}, message)
+        if not outputs:
+            return {"CANCELLED"}
+        if self.output == "NEW_OBJECT":
+            for obj in context.selected_objects:
+                obj.select_set(False)
+            for obj in outputs:
+                obj.select_set(True)
+            context.view_layer.objects.active = outputs[0]
+        seconds = time.perf_counter() - start
+        if len(lines) == 1:
+            self.report({"INFO"}, f"TopStoc: {lines[0]}; {seconds:.3f} s with output")
+        else:
+            self.report({"INFO"}, f"TopStoc: {len(lines)} objects decimated in {seconds:.3f} s")
+        return {"FINISHED"}
+
+
+CLASSES = (TOPSTOC_OT_guided_decimate,)

@@ -1,0 +1,133 @@
+"""Multiview (thesis 4.7.2) and LOD chains: several decimations laid out side by side."""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+from mathutils import Vector
+
+from .. import pipeline
+from ..guidance import GuidanceError
+from ..props import DecimationParameters, copy_parameters
+
+
+def parse_ratios(text: str) -> list:
+    """'1, 0.5, 0.25' -> [1.0, 0.5, 0.25]; every ratio must lie in (0, 1]."""
+    try:
+        ratios = [float(part) for part in text.replace(";", ",").split(",") if part.strip()]
+    except ValueError:
+        raise pipeline.DecimationError(f"LOD ratios must be numbers separated by commas, got '{text}'") from None
+    if not ratios or any(not 0 < r <= 1 for r in ratios):
+        raise pipeline.DecimationError(f"LOD ratios must lie in (0, 1], got '{text}'")
+    return ratios
+
+
+def variant_ratios(ratio: float, count: int, variance: float) -> list:
+    """``count`` ratios spread evenly over ratio * [1 - variance, 1 + variance] (capped at 1)."""
+    spread = np.linspace(-1.0, 1.0, count) if count > 1 else np.zeros(1)
+    return [float(min(1.0, max(1e-6, ratio * (1.0 + variance * t)))) for t in spread]
+
+
+def _collection(context, name: str) -> bpy.types.Collection:
+    collection = bpy.data.collections.get(name)
+    if collection is None:
+        collection = bpy.data.collections.new(name)
+        context.scene.collection.children.link(collection)
+    return collection
+
+
+def _lay_out(source, objects, collection) -> None:
+    """Moves the objects into ``collection``, side by side along X after the source."""
+    corners = [source.matrix_world @ Vector(c) for c in source.bound_box]
+    width = max(c.x for c in corners) - min(c.x for c in corners)
+    step = 1.2 * width if width > 0 else 1.0
+    for i, obj in enumerate(objects):
+        for old in list(obj.users_collection):
+            old.objects.unlink(obj)
+        collection.objects.link(obj)
+        obj.matrix_world = source.matrix_world.copy()
+        obj.location.x += step * (i + 1)
+
+
+class _VariantsBase(DecimationParameters):
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.object
+        return context.mode == "OBJECT" and obj is not None and obj.type == "MESH"
+
+    def invoke(self, context, event):
+        copy_parameters(context.scene.topstoc, self)
+        return self.execute(context)
+
+    def variants(self, context) -> list:
+        raise NotImplementedError
+
+    def names(self, obj, runs) -> list:
+        raise NotImplementedError
+
+    def execute(self, context):
+        obj = context.object
+        try:
+            runs = pipeline.decimate_many(context, obj, self, self.variants(context))
+        except (pipeline.DecimationError, GuidanceError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        names = self.names(obj, runs)
+        outputs = [pipeline.write_output(run, "NEW_OBJECT", name=name) for run, name in zip(runs, names)]
+        _lay_out(obj, outputs, _collection(context, self.collection_name(obj)))
+        counts = ", ".join(f"{run.result.num_vertices:,}" for run in runs)
+        self.report({"INFO"}, f"TopStoc: {len(runs)} variants of {obj.name} ({counts} vertices) "
+                              f"in {runs[0].seconds:.3f} s")
+        return {"FINISHED"}
+
+
+class TOPSTOC_OT_multiview(_VariantsBase, bpy.types.Operator):
+    """Several decimations with different seeds and ±variance on the ratio, side by side"""
+
+    bl_idname = "topstoc.multiview"
+    bl_label = "Multiview"
+
+    count: bpy.props.IntProperty(name="Variants", default=4, min=1, max=32)
+    variance: bpy.props.FloatProperty(name="Variance", default=0.25, min=0.0, max=0.95, subtype="FACTOR")
+
+    def invoke(self, context, event):
+        self.count = context.scene.topstoc.variants
+        self.variance = context.scene.topstoc.variance
+        return super().invoke(context, event)
+
+    def variants(self, context):
+        return [({"ratio": r}, self.seed + i) for i, r in enumerate(variant_ratios(self.ratio, self.count,
+                                                                                     self.variance))]
+
+    def names(self, obj, runs):
+        return [f"{obj.name}_MV{i + 1}" for i in range(len(runs))]
+
+    def collection_name(self, obj):
+        return f"{obj.name} Multiview"
+
+
+class TOPSTOC_OT_lod_chain(_VariantsBase, bpy.types.Operator):
+    """LOD0 ... LODn at the given ratios, named and collected"""
+
+    bl_idname = "topstoc.lod_chain"
+    bl_label = "LOD Chain"
+
+    ratios: bpy.props.StringProperty(name="Ratios", default="1.0, 0.5, 0.25, 0.1")
+
+    def invoke(self, context, event):
+        self.ratios = context.scene.topstoc.lod_ratios
+        return super().invoke(context, event)
+
+    def variants(self, context):
+        return [({"ratio": r}, self.seed) for r in parse_ratios(self.ratios)]
+
+    def names(self, obj, runs):
+        return [f"{obj.name}_LOD{i}" for i in range(len(runs))]
+
+    def collection_name(self, obj):
+        return f"{obj.name} LODs"
+
+
+CLASSES = (TOPSTOC_OT_multiview, TOPSTOC_OT_lod_chain)

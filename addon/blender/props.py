@@ -1,0 +1,152 @@
+"""Settings stored in .blend files: guidance sources per object, decimation defaults per scene."""
+
+from __future__ import annotations
+
+import math
+
+import bpy
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
+                       FloatVectorProperty, IntProperty, PointerProperty, StringProperty)
+
+#: Material slots that can carry a guidance weight (later slots count as 0).
+MAX_MATERIAL_SLOTS = 32
+DEFAULT_COLOR_LAYER = "TopStoc Guidance"
+
+TARGET_MODES = [
+    ("RATIO", "Ratio", "Fraction of the vertices to keep"),
+    ("VERTICES", "Vertices", "Number of output vertices"),
+    ("TRIANGLES", "Triangles", "Number of output triangles"),
+    ("MAX_ERROR", "Max Deviation", "Largest allowed Hausdorff deviation from the original"),
+]
+DENSITY_MODES = [
+    ("off", "Off", "No density control"),
+    ("uniform", "Uniform", "Reject samples closer than a ring distance to another sample"),
+    ("adaptive", "Adaptive", "Larger spacing where the surface is flat (thesis 4.1.2)"),
+]
+OUTPUT_MODES = [
+    ("NEW_OBJECT", "New Object", "Put the result in a new object next to the original"),
+    ("IN_PLACE", "In Place", "Replace the object's mesh (undo restores it)"),
+]
+PLACEMENTS = [
+    ("subsample", "Subsample", "Output vertices are input vertices (attributes copy exactly)"),
+    ("filtered", "Filtered", "Move vertices to the quadric-optimal point of their cluster"),
+]
+
+
+class DecimationParameters:
+    """Decimation parameters shared by the operators and the scene defaults (a mixin)."""
+
+    target_mode: EnumProperty(name="Target", items=TARGET_MODES, default="RATIO")
+    ratio: FloatProperty(name="Ratio", description="Fraction of the vertices to keep",
+                         default=0.1, min=1e-6, max=1.0, soft_min=0.001, precision=4,
+                         subtype="FACTOR")
+    vertices: IntProperty(name="Vertices", description="Number of output vertices", default=1000, min=1)
+    triangles: IntProperty(name="Triangles", description="Number of output triangles", default=2000, min=1)
+    max_error: FloatProperty(name="Max Deviation", description="Largest allowed deviation", default=1.0,
+                             min=0.0, precision=4)
+    max_error_relative: BoolProperty(name="Percent of Diagonal",
+                                     description="Max deviation in % of the bounding-box diagonal",
+                                     default=True)
+    seed: IntProperty(name="Seed", description="The same seed gives the same result", default=0, min=0)
+    adaptivity: FloatProperty(name="Adaptivity", description="0 samples uniformly, 1 follows curvature fully",
+                              default=0.5, min=0.0, max=1.0, subtype="FACTOR")
+    density: EnumProperty(name="Density Control", items=DENSITY_MODES, default="off")
+    placement: EnumProperty(name="Placement", items=PLACEMENTS, default="subsample")
+    output: EnumProperty(name="Output", items=OUTPUT_MODES, default="NEW_OBJECT")
+
+
+def copy_parameters(source, target) -> None:
+    """Copies every DecimationParameters property from one holder to another."""
+    for name in DecimationParameters.__annotations__:
+        setattr(target, name, getattr(source, name))
+
+
+class TOPSTOC_PG_sample_set(bpy.types.PropertyGroup):
+    """A saved decimation: parameters, fingerprints and the sample ids (custom property)."""
+
+    parameters: StringProperty(name="Parameters", description="JSON")
+    mesh_digest: StringProperty(name="Mesh Fingerprint")
+    layout_digest: StringProperty(name="Border Fingerprint")
+    vertices_out: IntProperty(name="Vertices")
+    triangles_out: IntProperty(name="Triangles")
+
+
+class TOPSTOC_PG_object(bpy.types.PropertyGroup):
+    """Guidance sources of a mesh object, and box settings of an empty."""
+
+    use_vertex_group: BoolProperty(name="Vertex Group", description="Guidance from a vertex group")
+    vertex_group: StringProperty(name="Group", description="Vertex group giving guidance")
+    vertex_group_mapping: EnumProperty(
+        name="Mapping", default="DETAIL",
+        items=[("DETAIL", "Weight = Detail", "u = w: weight 1 keeps every vertex, 0 is neutral"),
+               ("SIGNED", "Signed", "u = 2w - 1: 1 keeps, 0.5 neutral, 0 drops"),
+               ("DECIMATE", "Blender Decimate", "u = 1 - w: weight 0 locks (as Blender's Decimate), 1 neutral")])
+    vertex_group_strength: FloatProperty(name="Strength", default=1.0, min=0.0, max=1.0, subtype="FACTOR")
+
+    use_color: BoolProperty(name="Painted Guidance",
+                            description="Guidance painted in Vertex Paint mode or set on a selection "
+                                        "(orange = more detail, grey = neutral, blue = less)",
+                            default=True)
+    color_attribute: StringProperty(name="Color Attribute", default=DEFAULT_COLOR_LAYER)
+    color_strength: FloatProperty(name="Strength", default=1.0, min=0.0, max=1.0, subtype="FACTOR")
+
+    use_uv_seams: BoolProperty(name="Keep UV Seams", description="No cluster crosses a UV seam", default=True)
+    use_materials: BoolProperty(name="Keep Material Borders",
+                                description="No cluster crosses a border between material slots",
+                                default=True)
+    material_weights: FloatVectorProperty(name="Slot Weights", size=MAX_MATERIAL_SLOTS, min=-1.0, max=1.0,
+                                          description="Guidance per material slot (-1 less ... 1 keep)")
+    material_strength: FloatProperty(name="Strength", default=1.0, min=0.0, max=1.0, subtype="FACTOR")
+    use_sharp: BoolProperty(name="Keep Sharp Edges", description="No cluster crosses an edge marked sharp",
+                            default=False)
+
+    box_enabled: BoolProperty(name="Guidance Box",
+                              description="This cube empty sets the guidance of the vertices inside it")
+    box_weight: FloatProperty(name="Box Weight", default=1.0, min=-1.0, max=1.0,
+                              description="Guidance inside the box (-1 drop ... 1 keep)")
+
+    sample_sets: CollectionProperty(type=TOPSTOC_PG_sample_set)
+    sample_set_index: IntProperty(name="Sample Set")
+
+
+class TOPSTOC_PG_scene(DecimationParameters, bpy.types.PropertyGroup):
+    """Scene-wide defaults: decimation parameters, boxes, view, multiview and LODs."""
+
+    use_boxes: BoolProperty(name="Guidance Boxes", description="Use cube empties marked as guidance boxes",
+                            default=True)
+    box_strength: FloatProperty(name="Strength", default=1.0, min=0.0, max=1.0, subtype="FACTOR")
+
+    use_view: BoolProperty(name="View-Dependent", description="Fewer vertices on back faces, keep silhouettes")
+    view_source: EnumProperty(name="View", default="CAMERA",
+                              items=[("CAMERA", "Scene Camera", "The scene's active camera"),
+                                     ("VIEWPORT", "Viewport", "The current 3D viewport view")])
+    back_ratio: FloatProperty(name="Back-Face Ratio", default=0.25, min=0.0, max=1.0, subtype="FACTOR")
+    silhouette_angle: FloatProperty(name="Silhouette Band", default=math.radians(20.0), min=0.0,
+                                    max=math.radians(90.0), subtype="ANGLE")
+    silhouette_falloff: FloatProperty(name="Fall-Off", default=0.1, min=0.0, max=1.0)
+    use_frustum: BoolProperty(name="Cull Outside View", default=False)
+    outside_probability: FloatProperty(name="Outside Probability", default=0.0, min=0.0, max=1.0,
+                                       subtype="FACTOR")
+
+    variants: IntProperty(name="Variants", default=4, min=1, max=32)
+    variance: FloatProperty(name="Variance", description="± change of the target across the variants",
+                            default=0.25, min=0.0, max=0.95, subtype="FACTOR")
+    lod_ratios: StringProperty(name="LOD Ratios", default="1.0, 0.5, 0.25, 0.1",
+                               description="Comma-separated ratios, LOD0 first")
+
+
+CLASSES = (TOPSTOC_PG_sample_set, TOPSTOC_PG_object, TOPSTOC_PG_scene)
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    bpy.types.Object.topstoc = PointerProperty(type=TOPSTOC_PG_object)
+    bpy.types.Scene.topstoc = PointerProperty(type=TOPSTOC_PG_scene)
+
+
+def unregister():
+    del bpy.types.Scene.topstoc
+    del bpy.types.Object.topstoc
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,148 @@
+"""Decimation panels: target and options, guidance sources, preview/multiview/LODs, samples."""
+
+from __future__ import annotations
+
+import bpy
+
+from ..pipeline import has_max_error
+
+CATEGORY = "TopStoc"
+
+
+class _Panel:
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = CATEGORY
+
+
+class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
+    bl_label = "Guided Decimation"
+    bl_idname = "TOPSTOC_PT_decimate"
+
+    def draw(self, context):
+        layout = self.layout
+        settings = context.scene.topstoc
+        layout.prop(settings, "target_mode")
+        if settings.target_mode == "RATIO":
+            layout.prop(settings, "ratio")
+        elif settings.target_mode == "VERTICES":
+            layout.prop(settings, "vertices")
+        elif settings.target_mode == "TRIANGLES":
+            layout.prop(settings, "triangles")
+        else:
+            row = layout.row(align=True)
+            row.prop(settings, "max_error")
+            row.prop(settings, "max_error_relative", text="%")
+            if not has_max_error():
+                layout.label(text="Needs the Hausdorff engine (not in this build)", icon="ERROR")
+        col = layout.column(align=True)
+        col.prop(settings, "seed")
+        col.prop(settings, "adaptivity")
+        layout.prop(settings, "density")
+        layout.prop(settings, "placement")
+        layout.prop(settings, "output", expand=True)
+        layout.operator("topstoc.guided_decimate", icon="MOD_DECIM")
+        layout.operator("topstoc.preview", icon="HIDE_OFF")
+
+
+class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
+    bl_label = "Guidance"
+    bl_idname = "TOPSTOC_PT_guidance"
+    bl_parent_id = "TOPSTOC_PT_decimate"
+
+    def draw(self, context):
+        layout = self.layout
+        obj = context.object
+        scene = context.scene.topstoc
+        if obj is not None and obj.type == "EMPTY":
+            layout.prop(obj.topstoc, "box_enabled")
+            if obj.empty_display_type != "CUBE":
+                layout.label(text="Only cube empties act as boxes", icon="INFO")
+            layout.prop(obj.topstoc, "box_weight")
+            return
+        if obj is None or obj.type != "MESH":
+            layout.label(text="Select a mesh")
+            return
+        s = obj.topstoc
+        box = layout.box()
+        box.prop(s, "use_color")
+        if s.use_color:
+            box.prop_search(s, "color_attribute", obj.data, "color_attributes")
+            box.prop(s, "color_strength")
+            row = box.row(align=True)
+            row.operator("topstoc.add_guidance_layer", icon="BRUSH_DATA")
+            row.operator("topstoc.show_guidance", icon="SHADING_SOLID")
+        if context.mode == "EDIT_MESH":
+            row = box.row(align=True)
+            for level, label in (("KEEP", "Keep"), ("MORE", "More"), ("NEUTRAL", "Neutral"), ("LESS", "Less"),
+                                 ("DROP", "Drop")):
+                row.operator("topstoc.set_guidance", text=label).level = level
+        box = layout.box()
+        box.prop(s, "use_vertex_group")
+        if s.use_vertex_group:
+            box.prop_search(s, "vertex_group", obj, "vertex_groups")
+            box.prop(s, "vertex_group_mapping")
+            box.prop(s, "vertex_group_strength")
+        box = layout.box()
+        box.prop(s, "use_materials")
+        if s.use_materials and obj.material_slots:
+            col = box.column(align=True)
+            for index, slot in enumerate(obj.material_slots[:len(s.material_weights)]):
+                col.prop(s, "material_weights", index=index, text=slot.name or f"Slot {index}")
+            box.prop(s, "material_strength")
+        layout.prop(s, "use_uv_seams")
+        layout.prop(s, "use_sharp")
+        box = layout.box()
+        box.prop(scene, "use_boxes")
+        if scene.use_boxes:
+            box.prop(scene, "box_strength")
+            box.operator("topstoc.add_box", icon="CUBE")
+        box = layout.box()
+        box.prop(scene, "use_view")
+        if scene.use_view:
+            box.prop(scene, "view_source")
+            box.prop(scene, "back_ratio")
+            box.prop(scene, "silhouette_angle")
+            box.prop(scene, "silhouette_falloff")
+            box.prop(scene, "use_frustum")
+            if scene.use_frustum:
+                box.prop(scene, "outside_probability")
+
+
+class TOPSTOC_PT_variants(_Panel, bpy.types.Panel):
+    bl_label = "Multiview & LODs"
+    bl_idname = "TOPSTOC_PT_variants"
+    bl_parent_id = "TOPSTOC_PT_decimate"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        settings = context.scene.topstoc
+        row = layout.row(align=True)
+        row.prop(settings, "variants")
+        row.prop(settings, "variance")
+        layout.operator("topstoc.multiview", icon="MOD_ARRAY")
+        layout.prop(settings, "lod_ratios")
+        layout.operator("topstoc.lod_chain", icon="MOD_DECIM")
+
+
+class TOPSTOC_PT_samples(_Panel, bpy.types.Panel):
+    bl_label = "Samples"
+    bl_idname = "TOPSTOC_PT_samples"
+    bl_parent_id = "TOPSTOC_PT_decimate"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        obj = context.object
+        if obj is None or obj.type != "MESH":
+            return
+        layout.operator("topstoc.save_samples", icon="FILE_TICK")
+        for entry in obj.topstoc.sample_sets:
+            row = layout.row(align=True)
+            row.label(text=f"{entry.name}: {entry.vertices_out:,} v, {entry.triangles_out:,} t")
+            row.operator("topstoc.restore_samples", text="", icon="RECOVER_LAST").name = entry.name
+            row.operator("topstoc.remove_samples", text="", icon="X").name = entry.name
+
+
+CLASSES = (TOPSTOC_PT_decimate, TOPSTOC_PT_guidance, TOPSTOC_PT_variants, TOPSTOC_PT_samples)

@@ -1,0 +1,196 @@
+"""In-Blender benchmark: TopStoc Guided Decimate vs Blender's Decimate modifier (Collapse).
+
+    blender -b --factory-startup --python tests/bench/bench_blender_decimate.py -- [--ratios 0.01 0.1]
+        [--mesh PATH] [--repeat 3] [--updates 20]
+
+On the 1.55M-triangle horse (../shared/meshes/big, skipped when absent): time to first result
+(read the Blender mesh + prepare + decimate + write the new object with attributes) and the time
+of one live-preview update (re-decimate the cached mesh + write the preview mesh), next to the
+Decimate modifier applied at the same ratio in the same run. Prints medians and ratios.
+"""
+
+import argparse
+import os
+import pathlib
+import platform
+import statistics
+import sys
+import time
+
+import addon_utils
+import bpy
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+HORSE = ROOT.parent / "shared" / "meshes" / "big" / "horse_loop2_1.55M.ply"
+
+
+def read_binary_ply(path):
+    """Vertices and triangles of a binary little-endian PLY with float xyz and uchar/int lists."""
+    with open(path, "rb") as stream:
+        header = []
+        while True:
+            line = stream.readline().decode("ascii").strip()
+            header.append(line)
+            if line == "end_header":
+                break
+        body = stream.read()
+    counts = {l.split()[1]: int(l.split()[2]) for l in header if l.startswith("element")}
+    if "format binary_little_endian 1.0" not in header or "property list uchar int vertex_indices" not in header:
+        raise ValueError(f"{path}: only the plain binary layout of the benchmark mesh is supported")
+    n, m = counts["vertex"], counts["face"]
+    vertices = np.frombuffer(body, dtype="<f4", count=3 * n).reshape(n, 3)
+    faces = np.frombuffer(body, dtype=np.dtype([("k", "u1"), ("v", "<i4", 3)]), count=m, offset=12 * n)
+    if np.any(faces["k"] != 3):
+        raise ValueError(f"{path}: not a triangle mesh")
+    return vertices.astype(np.float64), faces["v"].astype(np.int32)
+
+
+def make_object(name, vertices, triangles):
+    mesh = bpy.data.meshes.new(name)
+    ts.blender.mesh_io.fill_geometry(mesh, vertices, triangles)
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
+class Params:
+    def __init__(self, ratio):
+        self.target_mode, self.ratio, self.seed, self.adaptivity = "RATIO", ratio, 1, 0.5
+        self.density, self.placement, self.output = "off", "subsample", "NEW_OBJECT"
+        self.vertices = self.triangles = 1
+        self.max_error, self.max_error_relative = 0.0, False
+
+
+def remove(obj):
+    mesh = obj.data
+    bpy.data.objects.remove(obj)
+    bpy.data.meshes.remove(mesh)
+
+
+def topstoc_first_result(obj, ratio):
+    """Seconds of one cold Guided Decimate (cache emptied): read + prepare + decimate + write."""
+    pipeline = ts.blender.pipeline
+    ts.blender.cache.prepared_meshes.clear()
+    start = time.perf_counter()
+    run = pipeline.decimate(bpy.context, obj, Params(ratio))
+    out = pipeline.write_output(run)
+    seconds = time.perf_counter() - start
+    counts = (len(out.data.vertices), len(out.data.polygons))
+    remove(out)
+    return seconds, counts
+
+
+def stages(obj, ratio):
+    """The same work stage by stage (one run): where the first result's time goes."""
+    mesh_io, t = ts.blender.mesh_io, {}
+    clock = time.perf_counter()
+    arrays = mesh_io.read_mesh(obj.data)
+    t["read"], clock = time.perf_counter() - clock, time.perf_counter()
+    arrays.digest()
+    t["fingerprint"], clock = time.perf_counter() - clock, time.perf_counter()
+    mesh = ts.core.Mesh(arrays.vertices, arrays.triangles)
+    t["prepare"], clock = time.perf_counter() - clock, time.perf_counter()
+    mesh.feature_layout(None, None)
+    t["layout"], clock = time.perf_counter() - clock, time.perf_counter()
+    result = mesh.decimate(ratio=ratio, seed=1)
+    t["decimate"], clock = time.perf_counter() - clock, time.perf_counter()
+    written = bpy.data.meshes.new("stage")
+    mesh_io.fill_geometry(written, result.vertices, result.triangles)
+    t["write geometry"] = time.perf_counter() - clock
+    bpy.data.meshes.remove(written)
+    return t
+
+
+def preview_updates(obj, ratio, count):
+    session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(ratio))
+    session.update(ratio)  # warm
+    times = []
+    for r in np.geomspace(ratio / 2, min(1.0, ratio * 2), count):
+        start = time.perf_counter()
+        session.update(float(r))
+        times.append(time.perf_counter() - start)
+    decimate_part = session.seconds_decimate
+    session.close()
+    return times, decimate_part
+
+
+def modifier_apply(obj, ratio):
+    copy = obj.copy()
+    copy.data = obj.data.copy()
+    bpy.context.scene.collection.objects.link(copy)
+    modifier = copy.modifiers.new("Decimate", "DECIMATE")
+    modifier.decimate_type = "COLLAPSE"
+    modifier.ratio = ratio
+    for other in bpy.context.scene.objects:
+        other.select_set(False)
+    copy.select_set(True)
+    bpy.context.view_layer.objects.active = copy
+    start = time.perf_counter()
+    bpy.ops.object.modifier_apply(modifier="Decimate")
+    seconds = time.perf_counter() - start
+    counts = (len(copy.data.vertices), len(copy.data.polygons))
+    remove(copy)
+    return seconds, counts
+
+
+def main(argv):
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--mesh", default=str(HORSE))
+    parser.add_argument("--ratios", type=float, nargs="+", default=[0.01, 0.1])
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--updates", type=int, default=20)
+    parser.add_argument("--modifier-repeat", type=int, default=1)
+    args = parser.parse_args(argv)
+    if not os.path.exists(args.mesh):
+        print(f"skipped: {args.mesh} is not available")
+        return 0
+    cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")),
+               platform.processor())
+    print(f"machine: {os.cpu_count()} cores, {cpu}; Blender {bpy.app.version_string}; "
+          f"load average {os.getloadavg()[0]:.1f}; OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY', 'default')}")
+    try:
+        from topstoc.core.io import read_mesh  # any format when the io module is built
+        data = read_mesh(args.mesh)
+        vertices, triangles = data.vertices, data.triangles
+    except ImportError:
+        vertices, triangles = read_binary_ply(args.mesh)
+    obj = make_object("Horse", vertices, triangles)
+    print(f"mesh: {args.mesh} ({len(vertices):,} vertices, {len(triangles):,} triangles)")
+    for ratio in args.ratios:
+        firsts = []
+        for _ in range(args.repeat):
+            seconds, ours = topstoc_first_result(obj, ratio)
+            firsts.append(seconds)
+        split = stages(obj, ratio)
+        updates, _ = preview_updates(obj, ratio, args.updates)
+        modifier = [modifier_apply(obj, ratio) for _ in range(args.modifier_repeat)]
+        first = statistics.median(firsts)
+        update = statistics.median(updates)
+        print(f"target ratio {ratio}:")
+        print(f"  TopStoc first result  {first:8.3f} s  (median of {args.repeat})  -> {ours[0]:,} v, {ours[1]:,} t")
+        print("    stages of one run: " + ", ".join(f"{k} {v:.3f} s" for k, v in split.items()))
+        print(f"  TopStoc slider update {update * 1000:8.1f} ms (median of {len(updates)} ratios in "
+              f"[{ratio / 2:g}, {min(1, 2 * ratio):g}]; max {max(updates) * 1000:.1f} ms) "
+              f"= {1 / update:.1f} updates/s")
+        if modifier:
+            mod_seconds = statistics.median(s for s, _ in modifier)
+            print(f"  Blender Decimate modifier (Collapse) apply {mod_seconds:8.3f} s (median of "
+                  f"{len(modifier)}) -> {modifier[0][1][0]:,} v, {modifier[0][1][1]:,} t")
+            print(f"  ratio modifier / TopStoc first result: {mod_seconds / first:.1f}x; "
+                  f"modifier / slider update: {mod_seconds / update:.0f}x")
+    print(f"load average after the run: {os.getloadavg()[0]:.1f} (on {os.cpu_count()} cores)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build")) / "python"))
+    addon_utils.enable("topstoc", default_set=True)
+    import topstoc as ts  # noqa: E402
+    import topstoc.blender.pipeline  # noqa: E402,F401
+    import topstoc.blender.preview  # noqa: E402,F401
+
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    code = main(argv)
+    sys.stdout.flush()
+    os._exit(code)

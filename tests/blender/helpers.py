@@ -1,0 +1,77 @@
+"""Helpers for the Blender tests: build objects from numpy arrays, read them back."""
+
+import bpy
+import numpy as np
+
+
+def make_object(name, vertices, faces, collection=None):
+    """A mesh object from vertices (n, 3) and faces (list of vertex-id sequences), selected and active."""
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([tuple(map(float, v)) for v in vertices], [], [tuple(map(int, f)) for f in faces])
+    mesh.update()
+    obj = bpy.data.objects.new(name, mesh)
+    (collection or bpy.context.scene.collection).objects.link(obj)
+    select_only(obj)
+    return obj
+
+
+def select_only(obj):
+    for other in bpy.context.scene.objects:
+        other.select_set(False)
+    obj.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+
+
+def positions(mesh):
+    co = np.empty(3 * len(mesh.vertices), dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
+def polygons(mesh):
+    """List of vertex-id tuples per polygon."""
+    return [tuple(p.vertices) for p in mesh.polygons]
+
+
+def kept_ids(source_mesh, output_mesh):
+    """Input vertex id of every output vertex, matched by exact position (subsample placement)."""
+    lookup = {tuple(p): i for i, p in enumerate(positions(source_mesh).tolist())}
+    return np.array([lookup[tuple(p)] for p in positions(output_mesh).tolist()])
+
+
+def snapshot(mesh):
+    """Everything a test needs to prove a mesh unchanged."""
+    data = {"co": positions(mesh).tolist(), "polygons": polygons(mesh),
+            "materials": [p.material_index for p in mesh.polygons],
+            "uv": {uv.name: [tuple(d.uv) for d in uv.data] for uv in mesh.uv_layers},
+            "attributes": sorted((a.name, a.domain, a.data_type) for a in mesh.attributes)}
+    return data
+
+
+def vertex_areas(vertices, triangles):
+    """One third of the incident triangle areas per vertex."""
+    v = np.asarray(vertices, dtype=float)
+    t = np.asarray(triangles)
+    area = 0.5 * np.linalg.norm(np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]]), axis=1)
+    out = np.zeros(len(v))
+    np.add.at(out, t.ravel(), np.repeat(area / 3, 3))
+    return out
+
+
+class Params:
+    """A DecimationParameters holder for calling the pipeline directly."""
+
+    def __init__(self, **kw):
+        self.target_mode = "RATIO"
+        self.ratio = 0.1
+        self.vertices = 100
+        self.triangles = 200
+        self.max_error = 1.0
+        self.max_error_relative = True
+        self.seed = 0
+        self.adaptivity = 0.5
+        self.density = "off"
+        self.placement = "subsample"
+        self.output = "NEW_OBJECT"
+        for key, value in kw.items():
+            setattr(self, key, value)

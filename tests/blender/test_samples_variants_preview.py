@@ -1,0 +1,97 @@
+"""Samples restore identically; multiview and LOD chains; the live-preview update path."""
+
+import bpy
+import numpy as np
+import pytest
+
+import meshgen
+from helpers import make_object, polygons, positions, select_only
+
+
+def output_geometry(obj):
+    return positions(obj.data).tolist(), polygons(obj.data)
+
+
+def test_samples_restore_identically(ts, scene):
+    obj = make_object("Knot", *meshgen.torus(48, 16))
+    obj.topstoc.use_sharp = True
+    bpy.ops.topstoc.guided_decimate(ratio=0.15, seed=7, adaptivity=0.8, density="adaptive")
+    first = bpy.data.objects["Knot_TopStoc"]
+    select_only(obj)
+    assert bpy.ops.topstoc.save_samples(name="Keep") == {"FINISHED"}
+    bpy.ops.topstoc.guided_decimate(ratio=0.3, seed=1)            # another run replaces "Last"
+    select_only(obj)
+    assert bpy.ops.topstoc.restore_samples(name="Keep") == {"FINISHED"}
+    restored = bpy.data.objects["Knot_Keep"]
+    assert output_geometry(restored) == output_geometry(first)
+    saved = obj.topstoc.sample_sets["Keep"]
+    assert saved.vertices_out == len(first.data.vertices)
+    assert '"seed": 7' in saved.parameters
+
+
+def test_restore_refuses_a_changed_mesh(ts, scene):
+    obj = make_object("Ball", *meshgen.icosphere(3))
+    bpy.ops.topstoc.guided_decimate(ratio=0.2)
+    select_only(obj)
+    co = positions(obj.data)
+    co[5] += 0.01
+    obj.data.vertices.foreach_set("co", co.ravel())
+    obj.data.update()
+    with pytest.raises(RuntimeError, match="changed since the samples"):
+        bpy.ops.topstoc.restore_samples(name="Last")
+
+
+def test_multiview_variants(ts, scene):
+    obj = make_object("Ball", *meshgen.icosphere(4))
+    assert bpy.ops.topstoc.multiview(ratio=0.1, count=5, variance=0.5, seed=2) == {"FINISHED"}
+    collection = bpy.data.collections["Ball Multiview"]
+    names = sorted(o.name for o in collection.objects)
+    assert names == [f"Ball_MV{i}" for i in range(1, 6)]
+    counts = [len(bpy.data.objects[n].data.vertices) for n in names]
+    n = len(obj.data.vertices)
+    expected = [round(n * 0.1 * (1 + 0.5 * t)) for t in np.linspace(-1, 1, 5)]
+    for got, want in zip(counts, expected):
+        assert abs(got - want) <= max(2, 0.01 * want)
+    xs = [bpy.data.objects[name].location.x for name in names]
+    assert all(b > a for a, b in zip(xs, xs[1:])) and xs[0] > obj.location.x
+
+
+def test_lod_chain(ts, scene):
+    obj = make_object("Ball", *meshgen.icosphere(4))
+    assert bpy.ops.topstoc.lod_chain(ratios="1.0, 0.5, 0.2, 0.05") == {"FINISHED"}
+    lods = [bpy.data.objects[f"Ball_LOD{i}"] for i in range(4)]
+    assert {o.name for o in bpy.data.collections["Ball LODs"].objects} == {o.name for o in lods}
+    counts = [len(o.data.vertices) for o in lods]
+    assert counts[0] == len(obj.data.vertices)
+    assert counts == sorted(counts, reverse=True)
+    assert abs(counts[2] - 0.2 * counts[0]) <= 0.01 * counts[0]
+    with pytest.raises(RuntimeError, match="LOD ratios"):
+        bpy.ops.topstoc.lod_chain(ratios="1, 2")
+
+
+def test_preview_session(ts, scene):
+    obj = make_object("Donut", *meshgen.torus(64, 32))
+    from helpers import Params
+
+    session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(seed=4))
+    assert obj.hide_get()
+    for ratio in (0.5, 0.1, 0.02):
+        session.update(ratio)
+        expected = session.prepared.mesh.decimate(ratio=ratio, seed=4)
+        assert len(session.mesh.vertices) == expected.num_vertices
+        assert len(session.mesh.polygons) == expected.num_triangles
+    # Asynchronous path: only the latest request is computed.
+    session.request(0.3)
+    session.request(0.05)
+    import time
+
+    for _ in range(2000):  # at most 10 s
+        session.poll()
+        time.sleep(0.005)
+        if not session.busy and session.ratio == 0.05:
+            break
+    assert session.ratio == 0.05
+    name = session.preview.name
+    session.close()
+    assert not obj.hide_get()
+    assert name not in bpy.data.objects
