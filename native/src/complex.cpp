@@ -1,10 +1,10 @@
 #include "topstoc/complex.hpp"
+#include "topstoc/validate.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <numeric>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -68,30 +68,9 @@ void check_input(const double* positions, int32_t n, const int32_t* triangles, i
   if (m < 0 || k < 0) throw std::invalid_argument("number of triangles or edges is negative");
   if (3 * m > kMaxSides) throw std::invalid_argument("complex is too large: more than 2^30 / 3 triangles");
   if (k > INT32_MAX / 2) throw std::invalid_argument("complex is too large: more than 2^31 / 2 edges");
-  if (positions) {
-    for (int32_t v = 0; v < n; ++v) {
-      const double* p = positions + 3 * size_t(v);
-      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-        std::ostringstream s;
-        s << "vertex " << v << " has a non-finite coordinate (" << p[0] << ", " << p[1] << ", " << p[2] << ")";
-        throw std::invalid_argument(s.str());
-      }
-    }
-  }
-  for (int64_t t = 0; t < m; ++t)
-    for (int c = 0; c < 3; ++c) {
-      const int32_t v = triangles[3 * t + c];
-      if (v < 0 || v >= n)
-        throw std::invalid_argument("triangle " + std::to_string(t) + " refers to vertex " + std::to_string(v) +
-                                    ", but vertex indices must lie in [0, " + std::to_string(n) + ")");
-    }
-  for (int64_t e = 0; e < k; ++e)
-    for (int c = 0; c < 2; ++c) {
-      const int32_t v = edges[2 * e + c];
-      if (v < 0 || v >= n)
-        throw std::invalid_argument("edge " + std::to_string(e) + " refers to vertex " + std::to_string(v) +
-                                    ", but vertex indices must lie in [0, " + std::to_string(n) + ")");
-    }
+  if (positions) require_finite_positions(positions, n);
+  require_indices_in_range(triangles, m, 3, n, "triangle");
+  require_indices_in_range(edges, k, 2, n, "edge");
 }
 
 // Spreads the low 10 bits of x so that they occupy every third bit.

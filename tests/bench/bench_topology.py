@@ -15,7 +15,6 @@ Skips cleanly without ../shared or a build.
 
 import os
 import pathlib
-import platform
 import statistics
 import subprocess
 import sys
@@ -29,19 +28,8 @@ HORSE = SHARED / "meshes" / "big" / "horse_loop2_1.55M.ply"
 SUBDIVIDED = BUILD / "bench" / "turbine_loop3.ply"
 
 sys.path.insert(0, str(BUILD / "python"))
-
-
-def machine() -> str:
-    model = "unknown CPU"
-    try:
-        for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    threads = os.environ.get("OMP_NUM_THREADS", str(os.cpu_count()))
-    return f"{os.cpu_count()} cores ({threads} OpenMP threads), {model}, {platform.system()} {platform.release()}"
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from machine import machine  # noqa: E402
 
 
 def load() -> str:
@@ -126,7 +114,7 @@ def main() -> int:
         print(f"making {SUBDIVIDED} (Loop subdivision x3 of {TURBINE.name}) ...")
         subprocess.run([sys.executable, str(SHARED / "tools" / "loop_subdiv.py"), str(TURBINE), str(SUBDIVIDED), "3"],
                        check=True, stdout=subprocess.DEVNULL)
-    print(f"machine: {machine()}; {load()}")
+    print(f"machine: {machine()}")
     bench("turbine, Loop subdivision x3 (genus 11)", *read(SUBDIVIDED), runs, gudhi_runs=min(runs, 3))
     if HORSE.exists():
         bench("horse, Loop subdivision x2 (genus 0)", *read(HORSE), runs, gudhi_runs=1, generators=False)
