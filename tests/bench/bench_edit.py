@@ -21,9 +21,7 @@ the steadier figure), the ratio to the peer, the meshes and the machine. Skips w
 from __future__ import annotations
 
 import argparse
-import os
 import pathlib
-import platform
 import subprocess
 import sys
 import tempfile
@@ -33,26 +31,15 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SHARED = ROOT.parent / "shared"
-sys.path[:0] = [str(ROOT / "build" / "python"), str(ROOT / "tests"), str(ROOT / "tests" / "python")]
+sys.path[:0] = [str(ROOT / "build" / "python"), str(ROOT / "tests"), str(ROOT / "tests" / "python"),
+                str(ROOT / "tests" / "bench")]
 
 import meshgen  # noqa: E402
+from machine import machine  # noqa: E402
 from test_edit import generator_loop, read_off, write_off  # noqa: E402
 from topstoc.core import edit  # noqa: E402
 
 CGAL_EDIT = ROOT / "build" / "peers" / "cgal_edit"
-
-
-def machine() -> str:
-    model = "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    threads = os.environ.get("OMP_NUM_THREADS", "default")
-    return f"{os.cpu_count()} cores ({model}), {platform.system()}, OMP_NUM_THREADS={threads}"
 
 
 def timed(function, repeats: int):
