@@ -1,36 +1,26 @@
 #include "topstoc/incidence.hpp"
 
+#include "topstoc/validate.hpp"
+
 #include <algorithm>
-#include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 
 namespace topstoc {
 
 void check_positions(const double* positions, int32_t num_vertices, const std::vector<int32_t>* vertices) {
-  auto check = [&](int32_t v) {
-    const double* p = positions + 3 * size_t(v);
-    if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) return;
-    std::ostringstream s;
-    s << "vertex " << v << " has a non-finite coordinate (" << p[0] << ", " << p[1] << ", " << p[2] << ")";
-    throw std::invalid_argument(s.str());
-  };
   if (vertices) {
-    for (int32_t v : *vertices) check(v);
+    for (int32_t v : *vertices) require_finite_position(positions, v);
   } else {
-    for (int32_t v = 0; v < num_vertices; ++v) check(v);
+    require_finite_positions(positions, num_vertices);
   }
 }
 
 void check_triangles(const int32_t* triangles, int64_t num_triangles, int32_t num_vertices, bool allow_repeated) {
   if (num_triangles > INT32_MAX / 3) throw std::invalid_argument("mesh is too large: more than 2^31 / 3 triangles");
+  require_indices_in_range(triangles, num_triangles, 3, num_vertices, "triangle");
   for (int64_t t = 0; t < num_triangles; ++t) {
     const int32_t* c = triangles + 3 * t;
-    for (int k = 0; k < 3; ++k)
-      if (c[k] < 0 || c[k] >= num_vertices)
-        throw std::invalid_argument("triangle " + std::to_string(t) + " refers to vertex " + std::to_string(c[k]) +
-                                    " outside [0, " + std::to_string(num_vertices) + ")");
     if (!allow_repeated && (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]))
       throw std::invalid_argument("triangle " + std::to_string(t) + " (" + std::to_string(c[0]) + ", " +
                                   std::to_string(c[1]) + ", " + std::to_string(c[2]) +

@@ -7,14 +7,16 @@
 
 namespace topstoc {
 
+void require_finite_position(const double* positions, int64_t v) {
+  const double* p = positions + 3 * v;
+  if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) return;
+  std::ostringstream s;
+  s << "vertex " << v << " has a non-finite coordinate (" << p[0] << ", " << p[1] << ", " << p[2] << ")";
+  throw std::invalid_argument(s.str());
+}
+
 void require_finite_positions(const double* positions, int64_t num_vertices) {
-  for (int64_t v = 0; v < num_vertices; ++v) {
-    const double* p = positions + 3 * v;
-    if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) continue;
-    std::ostringstream s;
-    s << "vertex " << v << " has a non-finite coordinate (" << p[0] << ", " << p[1] << ", " << p[2] << ")";
-    throw std::invalid_argument(s.str());
-  }
+  for (int64_t v = 0; v < num_vertices; ++v) require_finite_position(positions, v);
 }
 
 void require_indices_in_range(const int32_t* indices, int64_t rows, int columns, int64_t num_vertices,

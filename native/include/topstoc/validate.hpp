@@ -5,6 +5,9 @@
 
 namespace topstoc {
 
+/// Throws std::invalid_argument naming vertex v if a coordinate is NaN or infinite.
+void require_finite_position(const double* positions, int64_t v);
+
 /// Throws std::invalid_argument naming the first vertex with a NaN or infinite coordinate.
 void require_finite_positions(const double* positions, int64_t num_vertices);
 
