@@ -1,10 +1,10 @@
 #include "topstoc/incidence.hpp"
 
-#include "topstoc/validate.hpp"
-
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+
+#include "topstoc/validate.hpp"
 
 namespace topstoc {
 
