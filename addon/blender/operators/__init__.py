@@ -2,9 +2,9 @@
 
 import bpy
 
-from . import decimate, guidance, preview, samples, variants
+from . import decimate, guidance, metrics, preview, samples, variants
 
-MODULES = (decimate, guidance, preview, samples, variants)
+MODULES = (decimate, guidance, preview, samples, variants, metrics)
 
 
 def register():
