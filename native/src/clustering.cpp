@@ -25,7 +25,7 @@ constexpr uint64_t kUnreached = ~uint64_t(0);
 // cross_edges, every edge between two clusters is recorded once, from its farther end, when
 // both ends are final (only for a full fill).
 void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> frontier, int32_t level,
-                  std::vector<uint64_t>& key, std::vector<int32_t>* cross_edges) {
+                  std::vector<uint64_t>& key, std::vector<int32_t>* cross_edges, std::vector<int32_t>* changed) {
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
   const auto& ae = mesh.adjacency_edge();
@@ -37,6 +37,8 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   uint64_t* keys = key.data();
   uint8_t* in_next = queued.data();
   while (!frontier.empty()) {
+    // Every vertex is lowered at one level at most, so the frontiers list each change once.
+    if (changed) changed->insert(changed->end(), frontier.begin(), frontier.end());
     const uint64_t d = uint64_t(level) + 1;
     const int64_t count = int64_t(frontier.size());
 #pragma omp parallel if (int64_t(frontier.size()) >= kParallelMin / 16)
@@ -88,7 +90,8 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
 }
 
 void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
-                    int32_t first_new, Clustering& c, std::vector<int32_t>* cross_edges) {
+                    int32_t first_new, Clustering& c, std::vector<int32_t>* cross_edges,
+                    std::vector<int32_t>* changed) {
   const int32_t n = mesh.num_vertices();
   std::vector<uint64_t> key(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
@@ -104,7 +107,7 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
     key[s] = pack(0, static_cast<int32_t>(r));
     frontier.push_back(s);
   }
-  relax_levels(mesh, layout, std::move(frontier), 0, key, cross_edges);
+  relax_levels(mesh, layout, std::move(frontier), 0, key, cross_edges, changed);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     c.label[v] = key[v] == kUnreached ? -1 : rank_of(key[v]);
@@ -120,12 +123,12 @@ void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int3
   out.label.assign(n, -1);
   out.dist.assign(n, INT_MAX);
   if (cross_edges) cross_edges->clear();
-  seed_and_relax(mesh, layout, samples, 0, out, cross_edges);
+  seed_and_relax(mesh, layout, samples, 0, out, cross_edges, nullptr);
 }
 
 void flood_add(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
-               int32_t first_new, Clustering& c) {
-  seed_and_relax(mesh, layout, samples, first_new, c, nullptr);
+               int32_t first_new, Clustering& c, std::vector<int32_t>* changed) {
+  seed_and_relax(mesh, layout, samples, first_new, c, nullptr, changed);
 }
 
 int32_t step_towards_sample(const Mesh& mesh, const FeatureLayout& layout, const Clustering& c, int32_t x) {

@@ -224,6 +224,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
   result.fast_path = fast_path;
   start = Clock::now();
   Partition partition;
+  EmitState emit;  // later rounds re-evaluate only the faces around relabelled vertices
   // The last few top-up samples can overshoot (a split may revive an absorbed neighbour): then
   // the state before them is restored and the next widest clusters are tried instead.
   struct Snapshot {
@@ -246,9 +247,9 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       std::vector<int32_t> candidates;
       for (int32_t f = 0; f < mesh.num_faces(); ++f)
         if (near_border[f]) candidates.push_back(f);
-      partition = check_partition(mesh, layout, samples, clustering, required, slivers, &candidates);
+      partition = check_partition(mesh, layout, samples, clustering, required, slivers, &candidates, &emit);
     } else {
-      partition = check_partition(mesh, layout, samples, clustering, required, slivers);
+      partition = check_partition(mesh, layout, samples, clustering, required, slivers, nullptr, &emit);
     }
     accumulate(result.repairs.found, partition.issues);
     const bool clean = partition.issues.topological() == 0 && (!slivers || partition.issues.sliver == 0);
@@ -260,16 +261,21 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       if (snapshot.active && kept > top_up_to && snapshot.tried.size() < kMaxTopUpRetries) {
         samples.resize(snapshot.samples);
         clustering = snapshot.clustering;
+        emit = EmitState();
         result.repairs.rounds = snapshot.repairs.rounds;
         result.repairs.samples_added = snapshot.repairs.samples_added;
         result.top_up_samples = snapshot.top_up_samples;
-        partition = check_partition(mesh, layout, samples, clustering, required, false);
+        partition = check_partition(mesh, layout, samples, clustering, required, false, nullptr, &emit);
       } else if (top_up_to <= 0 || kept >= top_up_to || result.top_up_rounds >= kMaxTopUpRounds) {
         break;
       } else {
         snapshot = Snapshot();
       }
-      const int32_t need = top_up_to - (int32_t(samples.size()) - partition.issues.absorbed);
+      int32_t need = top_up_to - (int32_t(samples.size()) - partition.issues.absorbed);
+      // Some new samples get absorbed in turn: ask for that many more, so that one round
+      // usually lands on the target (a small overshoot stays within the budget tolerance).
+      if (need > kSmallTopUp)
+        need += int32_t(std::ceil(1.5 * need * double(partition.issues.absorbed) / double(samples.size())));
       if (need <= kSmallTopUp && !snapshot.active) {
         snapshot.active = true;
         snapshot.samples = samples.size();
@@ -296,7 +302,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     }
     const int32_t first_new = static_cast<int32_t>(samples.size());
     samples.insert(samples.end(), added.begin(), added.end());
-    flood_add(mesh, layout, samples, first_new, clustering);
+    flood_add(mesh, layout, samples, first_new, clustering, &emit.changed);
     if (clean) {
       result.top_up_samples += static_cast<int32_t>(added.size());
     } else {

@@ -141,7 +141,7 @@ std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layou
 
 Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
                           const Clustering& c, const std::vector<uint8_t>& required, bool check_slivers,
-                          const std::vector<int32_t>* candidate_faces) {
+                          const std::vector<int32_t>* candidate_faces, EmitState* state) {
   Partition out;
   const int32_t n = mesh.num_vertices();
   const int32_t k = static_cast<int32_t>(samples.size());
@@ -155,21 +155,42 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   const int threads = omp_get_max_threads();
   Marks marks(threads);
 
-  // --- emit: faces whose corners lie in three clusters (static chunks keep the serial order) ---
+  // --- emit: faces whose corners lie in three clusters ------------------------------------------
   const auto& faces = mesh.faces();
+  const int32_t m = mesh.num_faces();
+  EmitState local;
+  EmitState& emit = state ? *state : local;
+  auto three_clusters = [&](int32_t f) {
+    const int32_t la = label[faces[3 * size_t(f)]], lb = label[faces[3 * size_t(f) + 1]],
+                  lc = label[faces[3 * size_t(f) + 2]];
+    return uint8_t(la != lb && lb != lc && lc != la);
+  };
+  if (emit.valid) {
+    // Only faces around relabelled vertices can have changed.
+    const auto& vfo = mesh.vertex_face_offsets();
+    const auto& vf = mesh.vertex_faces();
+    for (int32_t v : emit.changed)
+      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) emit.emits[vf[i]] = three_clusters(vf[i]);
+  } else {
+    emit.emits.assign(m, 0);
+    const int64_t count = candidate_faces ? int64_t(candidate_faces->size()) : int64_t(m);
+#pragma omp parallel for schedule(static) if (count >= kParallelMin)
+    for (int64_t i = 0; i < count; ++i) {
+      const int32_t f = candidate_faces ? (*candidate_faces)[i] : int32_t(i);
+      emit.emits[f] = three_clusters(f);
+    }
+    emit.valid = true;
+  }
+  emit.changed.clear();
   {
-    const int64_t count = candidate_faces ? int64_t(candidate_faces->size()) : int64_t(mesh.num_faces());
+    // Collect in face order (static chunks keep the serial order).
     std::vector<std::vector<int32_t>> found(threads);
-#pragma omp parallel if (count >= kParallelMin)
+#pragma omp parallel if (m >= kParallelMin)
     {
       auto& mine = found[omp_get_thread_num()];
 #pragma omp for schedule(static)
-      for (int64_t i = 0; i < count; ++i) {
-        const int32_t f = candidate_faces ? (*candidate_faces)[i] : int32_t(i);
-        const int32_t la = label[faces[3 * size_t(f)]], lb = label[faces[3 * size_t(f) + 1]],
-                      lc = label[faces[3 * size_t(f) + 2]];
-        if (la != lb && lb != lc && lc != la) mine.push_back(f);
-      }
+      for (int32_t f = 0; f < m; ++f)
+        if (emit.emits[f]) mine.push_back(f);
     }
     for (const auto& list : found)
       for (int32_t f : list) {

@@ -305,3 +305,18 @@ def test_creases_become_borders_on_hard_surface_models():
     plain_error = hausdorff(mesh, plain, samples=50000).symmetric.mean
     creased_error = hausdorff(mesh, creased, samples=50000).symmetric.mean
     assert creased_error < 0.8 * plain_error
+
+
+def test_fast_path_gives_the_same_mesh():
+    # thesis 4.1.1: candidate faces collected during the flood instead of a scan of all faces
+    v, t, regions = sphere_with_regions()
+    mesh = Mesh(v, t)
+    for ratio in (0.2, 0.03, 0.005):
+        fast = mesh.decimate(ratio=ratio, seed=5, regions=regions, fast_path=True)
+        full = mesh.decimate(ratio=ratio, seed=5, regions=regions, fast_path=False)
+        assert fast.stats.fast_path and not full.stats.fast_path
+        for name in ("triangles", "kept", "face_source", "corner_source", "labels", "samples"):
+            np.testing.assert_array_equal(getattr(fast, name), getattr(full, name), err_msg=name)
+    # automatic below 5 % of the vertices
+    assert mesh.decimate(ratio=0.03, seed=5).stats.fast_path
+    assert not mesh.decimate(ratio=0.2, seed=5).stats.fast_path

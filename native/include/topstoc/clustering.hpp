@@ -33,7 +33,8 @@ int32_t step_towards_sample(const Mesh& mesh, const FeatureLayout& layout, const
 
 /// Adds samples[first_new..) to an existing clustering of samples[0..first_new) and updates
 /// only the vertices whose (distance, rank) improves. Gives exactly what flood() would.
+/// changed, if given, receives every vertex whose label or distance changed.
 void flood_add(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
-               int32_t first_new, Clustering& clustering);
+               int32_t first_new, Clustering& clustering, std::vector<int32_t>* changed = nullptr);
 
 }  // namespace topstoc

@@ -54,14 +54,23 @@ struct Partition {
   std::vector<uint8_t> absorbed;        ///< per rank: 1 if the sample has no triangle (not in the output)
 };
 
+/// Which faces emit a triangle, kept between the rounds of one decimation: after flood_add,
+/// only the faces around the vertices that changed are evaluated again.
+struct EmitState {
+  std::vector<uint8_t> emits;    ///< per face: corners in three clusters
+  std::vector<int32_t> changed;  ///< vertices relabelled since the last check (flood_add fills it)
+  bool valid = false;            ///< emits matches the clustering as of the last check
+};
+
 /// Emits triangles and checks them. `required` marks vertices whose samples must appear in the
 /// output (control points); corners are always required. Other samples left without a
 /// triangle are absorbed by their neighbours. candidate_faces, if given, lists (in increasing
 /// order) a superset of the faces whose corners lie in three clusters (the fast path, thesis
 /// 4.1.1); otherwise every face is scanned.
+/// With an EmitState that is valid, only the faces around state->changed are evaluated.
 Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
                           const Clustering& clustering, const std::vector<uint8_t>& required, bool check_slivers,
-                          const std::vector<int32_t>* candidate_faces = nullptr);
+                          const std::vector<int32_t>* candidate_faces = nullptr, EmitState* state = nullptr);
 
 /// Six times the Euler characteristic of every cluster on the mesh cut along the feature
 /// edges (one pass over all faces). A cluster is one disk per side exactly when the value is
