@@ -112,3 +112,105 @@ def disjoint(*meshes):
         faces.append(np.asarray(f) + offset)
         offset += len(v)
     return np.concatenate(vertices), np.concatenate(faces).astype(np.int32)
+
+
+# --- Surfaces and complexes for topology tests (abstract where no embedding exists) -----------
+
+def _strip_positions(count: int) -> np.ndarray:
+    """Placeholder positions for abstract complexes (topology ignores them; they must be finite)."""
+    return np.stack([np.arange(count, dtype=float), np.zeros(count), np.zeros(count)], -1)
+
+
+def mobius(n: int = 12, width: int = 2):
+    """Moebius strip: n columns of width + 1 vertices, the last column glued to the first flipped.
+
+    Non-orientable, one boundary loop, euler characteristic 0.
+    """
+    rows = width + 1
+    idx = lambda i, j: i * rows + j  # noqa: E731
+    u = np.repeat(np.arange(n) * 2 * np.pi / n, rows)
+    w = np.tile(np.linspace(-0.3, 0.3, rows), n)
+    vertices = np.stack([(1 + w * np.cos(u / 2)) * np.cos(u), (1 + w * np.cos(u / 2)) * np.sin(u),
+                         w * np.sin(u / 2)], -1)
+    faces = []
+    for i in range(n):
+        for j in range(width):
+            a, b = idx(i, j), idx(i, j + 1)
+            if i < n - 1:
+                c, d = idx(i + 1, j), idx(i + 1, j + 1)
+            else:  # the half twist: row j meets row width - j
+                c, d = idx(0, width - j), idx(0, width - j - 1)
+            faces += [(a, c, d), (a, d, b)]
+    return vertices, np.array(faces, dtype=np.int32)
+
+
+def klein_bottle(nu: int = 8, nv: int = 6):
+    """Klein bottle as an abstract complex: a torus grid whose last column is glued back flipped.
+
+    Closed, non-orientable, euler 0: over Z2, betti (1, 2, 1) and 2 cross-caps.
+    """
+    idx = lambda i, j: i * nv + (j % nv)  # noqa: E731
+    faces = []
+    for i in range(nu):
+        for j in range(nv):
+            a, b = idx(i, j), idx(i, j + 1)
+            if i < nu - 1:
+                c, d = idx(i + 1, j), idx(i + 1, j + 1)
+            else:
+                c, d = idx(0, -j), idx(0, -(j + 1))
+            faces += [(a, c, d), (a, d, b)]
+    return _strip_positions(nu * nv), np.array(faces, dtype=np.int32)
+
+
+def projective_plane():
+    """The 6-vertex real projective plane (hemi-icosahedron): over Z2 betti (1, 1, 1), 1 cross-cap."""
+    faces = [(0, 1, 2), (0, 2, 3), (0, 3, 4), (0, 4, 5), (0, 5, 1), (1, 2, 4), (2, 3, 5), (3, 4, 1),
+             (4, 5, 2), (5, 1, 3)]
+    return _strip_positions(6), np.array(faces, dtype=np.int32)
+
+
+def pinched_sphere(subdivisions: int = 1):
+    """Sphere with two antipodal vertices identified (a pinched torus): one non-manifold vertex,
+    all edges manifold, betti (1, 1, 1)."""
+    vertices, faces = icosphere(subdivisions)
+    faces = np.where(faces == 3, 0, faces)  # icosphere vertices 0 and 3 are antipodal
+    keep = np.arange(len(vertices)) != 3
+    remap = np.cumsum(keep) - 1
+    return vertices[keep], remap[faces].astype(np.int32)
+
+
+def theta_surface(ring: int = 8):
+    """Three disks (cones) sharing their boundary circle: every ring edge has three triangles.
+
+    Betti (1, 0, 2): two independent 2-cycles, the third disk pair being their sum.
+    """
+    angles = np.arange(ring) * 2 * np.pi / ring
+    circle = np.stack([np.cos(angles), np.sin(angles), np.zeros(ring)], -1)
+    apexes = np.array([[0, 0, 1.0], [0, 0, -1.0], [0.3, 0.3, 0.0]])
+    faces = [(j, (j + 1) % ring, ring + k) for k in range(3) for j in range(ring)]
+    return np.concatenate([circle, apexes]), np.array(faces, dtype=np.int32)
+
+
+def book(pages: int = 3):
+    """Triangles sharing one edge (0, 1), like the pages of a book: contractible, non-manifold."""
+    vertices = np.concatenate([[[0, 0, 0], [0, 0, 1.0]],
+                               [[np.cos(a), np.sin(a), 0.5] for a in np.arange(pages) * 2 * np.pi / pages]])
+    faces = [(0, 1, 2 + k) for k in range(pages)]
+    return vertices, np.array(faces, dtype=np.int32)
+
+
+def tetrahedra_sharing_edge():
+    """Boundaries of two tetrahedra glued along one edge (4 triangles on it): betti (1, 0, 2)."""
+    vertices = np.array([[0, 0, 0], [0, 0, 1], [1, 0, 0.5], [0, 1, 0.5], [-1, 0, 0.5], [0, -1, 0.5]], dtype=float)
+    faces = []
+    for tet in ((0, 1, 2, 3), (0, 1, 4, 5)):
+        a, b, c, d = tet
+        faces += [(a, b, c), (a, c, d), (a, d, b), (b, d, c)]
+    return vertices, np.array(faces, dtype=np.int32)
+
+
+def complete_graph(k: int = 4):
+    """Edges of the complete graph K_k with no triangle: betti (1, (k-1)(k-2)/2, 0)."""
+    vertices = _strip_positions(k)
+    edges = np.array([(a, b) for a in range(k) for b in range(a + 1, k)], dtype=np.int32)
+    return vertices, np.zeros((0, 3), dtype=np.int32), edges

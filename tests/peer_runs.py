@@ -13,29 +13,10 @@ import subprocess
 
 import numpy as np
 
+from reference import read_off  # noqa: F401  (re-exported for the benchmarks)
+
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PEERS = pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build")) / "peers"
-
-
-def read_off(path):
-    """OFF reader for the test meshes (polygons fan-triangulated, comments skipped)."""
-    tokens = []
-    with open(path) as handle:
-        for line in handle:
-            tokens += line.split("#")[0].split()
-    if not tokens or tokens[0] != "OFF":
-        raise ValueError(f"{path}: not an OFF file")
-    nv, nf = int(tokens[1]), int(tokens[2])
-    at = 4
-    vertices = np.array(tokens[at:at + 3 * nv], dtype=float).reshape(nv, 3)
-    at += 3 * nv
-    triangles = []
-    for _ in range(nf):
-        k = int(tokens[at])
-        polygon = [int(x) for x in tokens[at + 1:at + 1 + k]]
-        at += 1 + k
-        triangles += [(polygon[0], polygon[i], polygon[i + 1]) for i in range(1, k - 1)]
-    return vertices, np.array(triangles, dtype=np.int32)
 
 
 def write_off(path, vertices, triangles) -> None:

@@ -153,6 +153,78 @@ def euler_genus(chi, boundary_loops):
     return (2 - chi - boundary_loops) // 2
 
 
+def cut_along(triangles, cut_edges):
+    """Cuts a surface along edges: each vertex is split into one copy per group of its corners
+    that stay joined across uncut edges shared by exactly two triangles. Returns (number of
+    vertices, triangles) of the cut surface."""
+    tri = np.asarray(triangles, dtype=np.int64)
+    cut = {(min(a, b), max(a, b)) for a, b in np.asarray(cut_edges).tolist()}
+    parent = list(range(3 * len(tri)))
+
+    def find(x):
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    sides = {}
+    for f, t in enumerate(tri.tolist()):
+        for k in range(3):
+            a, b = t[k], t[(k + 1) % 3]
+            sides.setdefault((min(a, b), max(a, b)), []).append(f)
+    for edge, faces in sides.items():
+        if edge in cut or len(faces) != 2:
+            continue
+        f, g = faces
+        for v in edge:  # the corners of v in f and g are one vertex of the cut surface
+            cf = 3 * f + tri[f].tolist().index(v)
+            cg = 3 * g + tri[g].tolist().index(v)
+            parent[find(cf)] = find(cg)
+    ids = {}
+    out = np.empty_like(tri)
+    for f in range(len(tri)):
+        for k in range(3):
+            out[f, k] = ids.setdefault(find(3 * f + k), len(ids))
+    return len(ids), out
+
+
+def gf2_rank(vectors):
+    """Rank over Z2 of bit vectors given as Python ints."""
+    pivots = {}
+    rank = 0
+    for v in vectors:
+        while v:
+            top = v.bit_length() - 1
+            if top in pivots:
+                v ^= pivots[top]
+            else:
+                pivots[top] = v
+                rank += 1
+                break
+    return rank
+
+
+def homology_rank(triangles, cycles):
+    """Number of independent classes the cycles (closed vertex sequences) span in H1 over Z2:
+    rank(boundaries + cycles) - rank(boundaries)."""
+    tri = np.asarray(triangles, dtype=np.int64)
+    index = {}
+
+    def bit(a, b):
+        return 1 << index.setdefault((min(a, b), max(a, b)), len(index))
+
+    boundaries = [bit(a, b) ^ bit(b, c) ^ bit(c, a) for a, b, c in tri.tolist()]
+    chains = []
+    for cycle in cycles:
+        cycle = list(cycle)
+        chain = 0
+        for i in range(len(cycle)):
+            chain ^= bit(cycle[i], cycle[(i + 1) % len(cycle)])
+        chains.append(chain)
+    base = gf2_rank(boundaries)
+    return gf2_rank(boundaries + chains) - base
+
+
 def degenerate_or_duplicate(triangles):
     """(number of triangles with a repeated vertex, number of repeated vertex sets)."""
     t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)

@@ -11,12 +11,15 @@ from .error_bound import ErrorBoundReport
 from .hausdorff import Distance, HausdorffResult, OneSidedDistance, closest_points, hausdorff
 from .io import MeshData, read_mesh, write_mesh
 from .mesh import Mesh, MeshReport
+from .topology import ComponentGenerators, ComponentTopology, Topology, generators, topology
 
 __all__ = [
     "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
     "decimate_with_samples", "sampling_probabilities",
     # measurement (hausdorff.py) and error-bounded decimation (error_bound.py)
     "Distance", "ErrorBoundReport", "HausdorffResult", "OneSidedDistance", "closest_points", "hausdorff",
+    # topology
+    "ComponentGenerators", "ComponentTopology", "Topology", "generators", "topology",
     # mesh files (io.py)
     "MeshData", "read_mesh", "write_mesh",
 ]

@@ -25,12 +25,16 @@ py::array as_array(const py::handle& object, const char* what) {
 
 }  // namespace
 
-std::vector<double> positions_from(const py::handle& object, const char* what) {
+py::array_t<double, py::array::c_style> positions_array(const py::handle& object, const char* what) {
   py::array a = as_array(object, what);
   if (!a || a.ndim() != 2 || a.shape(1) != 3 || (a.dtype().kind() != 'f'))
     throw py::value_error(std::string(what) + " must be a float32 or float64 array of shape (n, 3), got " +
                           (a ? describe(a) : std::string("something else")));
-  auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+  return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+}
+
+std::vector<double> positions_from(const py::handle& object, const char* what) {
+  const auto d = positions_array(object, what);
   return std::vector<double>(d.data(), d.data() + d.size());
 }
 
@@ -39,6 +43,11 @@ std::vector<int32_t> indices_from(const py::handle& object, int64_t columns, con
   if (!a || a.ndim() != 2 || a.shape(1) != columns || (a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
     throw py::value_error(std::string(what) + " must be an int32 or int64 array of shape (m, " +
                           std::to_string(columns) + "), got " + (a ? describe(a) : std::string("something else")));
+  // int32 in C order (what io and Blender hand over) is copied as is: no int64 detour.
+  if (py::isinstance<py::array_t<int32_t, py::array::c_style>>(a)) {
+    auto d = py::array_t<int32_t, py::array::c_style>::ensure(a);
+    return std::vector<int32_t>(d.data(), d.data() + d.size());
+  }
   auto d = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
   std::vector<int32_t> out(d.size());
   for (py::ssize_t i = 0; i < d.size(); ++i) {

@@ -17,6 +17,10 @@ namespace py = pybind11;
 /// (n, 3) float32/float64 -> 3n doubles. `what` names the argument in errors.
 std::vector<double> positions_from(const py::handle& array, const char* what = "vertices");
 
+/// Same checks, without the copy: the caller's array when it already is C-ordered float64 (a
+/// converted copy otherwise). Keep the returned array alive while reading its data().
+py::array_t<double, py::array::c_style> positions_array(const py::handle& array, const char* what = "vertices");
+
 /// (m, k) integer array -> k*m int32 values (k = columns, e.g. 3 for triangles, 2 for edges).
 /// Values outside int32 raise ValueError naming the row.
 std::vector<int32_t> indices_from(const py::handle& array, int64_t columns, const char* what);

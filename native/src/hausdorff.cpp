@@ -1,10 +1,10 @@
 #include "topstoc/hausdorff.hpp"
+#include "topstoc/validate.hpp"
 #include "topstoc/parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -80,11 +80,6 @@ double sample_count(const Lengths& l, int64_t vertices, double step) {
   return double(vertices) + edge_samples + face_samples;
 }
 
-std::string format_point(const double* p) {
-  std::ostringstream s;
-  s << "(" << p[0] << ", " << p[1] << ", " << p[2] << ")";
-  return s.str();
-}
 
 }  // namespace
 
@@ -99,20 +94,10 @@ Surface::Surface(std::vector<double> positions, std::vector<int32_t> triangles)
   if (positions_.size() / 3 > size_t(INT32_MAX) || triangles_.size() / 3 > size_t(INT32_MAX / 3))
     throw std::invalid_argument("mesh is too large for 32-bit indices");
   const int32_t n = num_vertices(), m = num_triangles();
-  for (int32_t v = 0; v < n; ++v) {
-    const double* p = &positions_[3 * size_t(v)];
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-      throw std::invalid_argument("vertex " + std::to_string(v) + " has a non-finite coordinate " + format_point(p));
-  }
+  require_finite_positions(positions_.data(), n);
+  require_indices_in_range(triangles_.data(), m, 3, n, "triangle");
   used_.assign(n, 0);
-  for (int32_t f = 0; f < m; ++f)
-    for (int c = 0; c < 3; ++c) {
-      const int32_t v = triangles_[3 * size_t(f) + c];
-      if (v < 0 || v >= n)
-        throw std::invalid_argument("triangle " + std::to_string(f) + " refers to vertex " + std::to_string(v) +
-                                    ", but vertex indices must lie in [0, " + std::to_string(n) + ")");
-      used_[v] = 1;
-    }
+  for (int32_t v : triangles_) used_[v] = 1;
 
   double lo[3], hi[3];
   for (int k = 0; k < 3; ++k) {

@@ -5,20 +5,14 @@
 #include <array>
 #include <cmath>
 #include <numeric>
-#include <sstream>
 #include <stdexcept>
 
 #include "topstoc/fans.hpp"
+#include "topstoc/validate.hpp"
 
 namespace topstoc {
 
 namespace {
-
-std::string format_point(const double* p) {
-  std::ostringstream s;
-  s << "(" << p[0] << ", " << p[1] << ", " << p[2] << ")";
-  return s.str();
-}
 
 void cross(const double* a, const double* b, const double* c, double* out) {
   const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
@@ -52,11 +46,7 @@ Mesh::Mesh(std::vector<double> positions, const int32_t* triangles, int64_t num_
   if (num_vertices_ == 0) throw std::invalid_argument("mesh has no vertices");
   if (num_triangles <= 0) throw std::invalid_argument("mesh has no triangles");
   if (num_triangles > INT32_MAX / 3) throw std::invalid_argument("mesh is too large: more than 2^31 / 3 triangles");
-  for (int32_t v = 0; v < num_vertices_; ++v) {
-    const double* p = position(v);
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-      throw std::invalid_argument("vertex " + std::to_string(v) + " has a non-finite coordinate " + format_point(p));
-  }
+  require_finite_positions(positions_.data(), num_vertices_);
   double lo[3] = {positions_[0], positions_[1], positions_[2]}, hi[3] = {lo[0], lo[1], lo[2]};
   for (int32_t v = 0; v < num_vertices_; ++v)
     for (int k = 0; k < 3; ++k) {
@@ -77,13 +67,7 @@ Mesh::Mesh(std::vector<double> positions, const int32_t* triangles, int64_t num_
 
 void Mesh::validate_and_copy_faces(const int32_t* triangles, int64_t num_triangles) {
   // Range check first: an out-of-range index is an error, not something to repair.
-  for (int64_t f = 0; f < num_triangles; ++f)
-    for (int c = 0; c < 3; ++c) {
-      const int32_t v = triangles[3 * f + c];
-      if (v < 0 || v >= num_vertices_)
-        throw std::invalid_argument("triangle " + std::to_string(f) + " refers to vertex " + std::to_string(v) +
-                                    ", but vertex indices must lie in [0, " + std::to_string(num_vertices_) + ")");
-    }
+  require_indices_in_range(triangles, num_triangles, 3, num_vertices_, "triangle");
   // Drop triangles with a repeated vertex.
   std::vector<int32_t> candidates;
   candidates.reserve(num_triangles);

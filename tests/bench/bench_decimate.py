@@ -15,7 +15,6 @@ import argparse
 import json
 import os
 import pathlib
-import platform
 import statistics
 import subprocess
 import sys
@@ -25,22 +24,11 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "build" / "python"))
 
 from topstoc.core import Mesh, read_mesh  # noqa: E402
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from machine import machine  # noqa: E402
 
 DEFAULT_MESH = ROOT.parent / "shared" / "meshes" / "big" / "horse_loop2_1.55M.ply"
 PEER = ROOT / "build" / "peers" / "meshopt_bench"
-
-
-def machine() -> str:
-    model = "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    load = os.getloadavg()[0]
-    return f"{os.cpu_count()} cores, {model}, {platform.system()} {platform.release()}, load average {load:.2f}"
 
 
 def median_ms(values):

@@ -20,7 +20,6 @@ from __future__ import annotations
 import json
 import os
 import pathlib
-import platform
 import statistics
 import subprocess
 import sys
@@ -36,21 +35,11 @@ import topstoc  # noqa: E402
 from peer_runs import (cgal_hausdorff, meshlab_hausdorff, meshopt_simplify, peer, read_off,  # noqa: E402
                        write_off)
 from topstoc.core.native import engine  # noqa: E402
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from machine import machine  # noqa: E402
 
 DATA = ROOT / "tests" / "data"
 SHARED = ROOT.parent / "shared" / "meshes"
-
-
-def machine() -> str:
-    model = "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{os.cpu_count()} cores ({model}), {platform.system()} {platform.release()}"
 
 
 def timed_queries(original: pathlib.Path, points_file: pathlib.Path, repeats: int = 3) -> float:

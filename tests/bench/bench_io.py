@@ -11,7 +11,6 @@ Needs ../shared/meshes (skips otherwise) and a build (cmake --build build).
 import json
 import os
 import pathlib
-import platform
 import statistics
 import subprocess
 import sys
@@ -24,18 +23,8 @@ SHARED = ROOT.parent / "shared" / "meshes"
 MESHES = ["big/horse_loop2_1.55M.ply", "genus0/petsc_horse.ply.bz2", "big/dragon_vrip.ply.gz"]
 
 sys.path.insert(0, str(BUILD / "python"))
-
-
-def machine() -> str:
-    model = "unknown CPU"
-    try:
-        for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{os.cpu_count()} cores, {model}, {platform.system()} {platform.release()}"
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from machine import machine  # noqa: E402
 
 
 def median_seconds(function, runs: int) -> float:

@@ -10,30 +10,11 @@ import numpy as np
 import pytest
 
 import meshgen
+from reference import read_off
 import topstoc
 from topstoc.core.native import engine
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-
-def read_off(path):
-    """Minimal OFF reader for the test meshes (polygons fan-triangulated)."""
-    tokens = []
-    with open(path) as handle:
-        for line in handle:
-            tokens += line.split("#")[0].split()
-    assert tokens[0] == "OFF"
-    nv, nf = int(tokens[1]), int(tokens[2])
-    at = 4
-    vertices = np.array(tokens[at:at + 3 * nv], dtype=float).reshape(nv, 3)
-    at += 3 * nv
-    triangles = []
-    for _ in range(nf):
-        k = int(tokens[at])
-        polygon = [int(x) for x in tokens[at + 1:at + 1 + k]]
-        at += 1 + k
-        triangles += [(polygon[0], polygon[i], polygon[i + 1]) for i in range(1, k - 1)]
-    return vertices, np.array(triangles, dtype=np.int32)
 
 
 # --- independent reference: point-to-triangle distance by plane projection -------------------

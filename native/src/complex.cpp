@@ -1,0 +1,400 @@
+#include "topstoc/complex.hpp"
+#include "topstoc/validate.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+#include <omp.h>
+
+namespace topstoc {
+
+namespace {
+
+constexpr int64_t kMaxSides = (int64_t(1) << 30) - 1;  // side_twin stores 2 * side in an int32
+
+int32_t pass_threads(int64_t items) { return items >= kParallelMinimum ? std::max(1, omp_get_max_threads()) : 1; }
+
+// Stable counting sort of items 0..count-1 into buckets 0..num_buckets-1: count_item(i, hist)
+// increments hist[bucket of i]; place(i, hist) writes item i at hist[bucket of i]++. Runs on
+// contiguous chunks, one histogram per chunk, so the result is the serial one. `offsets`
+// receives the bucket starts (num_buckets + 1 entries).
+template <class CountItem, class Place>
+void counting_sort(int64_t count, int32_t num_buckets, CountItem count_item, Place place, std::vector<int32_t>& offsets) {
+  const int32_t chunks = pass_threads(count);
+  std::vector<std::vector<int32_t>> hist(chunks, std::vector<int32_t>(num_buckets, 0));
+#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
+  for (int32_t c = 0; c < chunks; ++c)
+    for (int64_t i = count * c / chunks; i < count * (c + 1) / chunks; ++i) count_item(i, hist[c].data());
+  offsets.assign(size_t(num_buckets) + 1, 0);
+  int64_t running = 0;
+  for (int32_t b = 0; b < num_buckets; ++b) {
+    offsets[b] = static_cast<int32_t>(running);
+    for (int32_t c = 0; c < chunks; ++c) {
+      const int32_t x = hist[c][b];
+      hist[c][b] = static_cast<int32_t>(running);
+      running += x;
+    }
+  }
+  if (running > INT32_MAX) throw std::invalid_argument("complex is too large: more than 2^31 incidences");
+  offsets[num_buckets] = static_cast<int32_t>(running);
+#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
+  for (int32_t c = 0; c < chunks; ++c)
+    for (int64_t i = count * c / chunks; i < count * (c + 1) / chunks; ++i) place(i, hist[c].data());
+}
+
+// Sorts a small range in place (insertion sort; buckets here hold a handful of entries), falling
+// back to std::sort for the rare large bucket (a vertex shared by many triangles).
+template <class T>
+void sort_bucket(T* begin, T* end) {
+  if (end - begin > 24) {
+    std::sort(begin, end);
+    return;
+  }
+  for (T* i = begin + 1; i < end; ++i) {
+    T x = *i;
+    T* j = i;
+    for (; j > begin && x < *(j - 1); --j) *j = *(j - 1);
+    *j = x;
+  }
+}
+
+void check_input(const double* positions, int32_t n, const int32_t* triangles, int64_t m, const int32_t* edges,
+                 int64_t k) {
+  if (n < 0) throw std::invalid_argument("number of vertices is negative");
+  if (m < 0 || k < 0) throw std::invalid_argument("number of triangles or edges is negative");
+  if (3 * m > kMaxSides) throw std::invalid_argument("complex is too large: more than 2^30 / 3 triangles");
+  if (k > INT32_MAX / 2) throw std::invalid_argument("complex is too large: more than 2^31 / 2 edges");
+  if (positions) require_finite_positions(positions, n);
+  require_indices_in_range(triangles, m, 3, n, "triangle");
+  require_indices_in_range(edges, k, 2, n, "edge");
+}
+
+// Spreads the low 10 bits of x so that they occupy every third bit.
+uint32_t spread_bits(uint32_t x) {
+  x &= 0x3ff;
+  x = (x | x << 16) & 0x30000ff;
+  x = (x | x << 8) & 0x300f00f;
+  x = (x | x << 4) & 0x30c30c3;
+  x = (x | x << 2) & 0x9249249;
+  return x;
+}
+
+// Internal vertex order: along a Z-order curve of the positions (10 bits per axis; ties keep
+// the caller's order), by a radix sort of (key, id) pairs.
+std::vector<int32_t> morton_order(const double* positions, int32_t n) {
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  for (int32_t v = 0; v < n; ++v)
+    for (int k = 0; k < 3; ++k) {
+      const double x = positions[3 * size_t(v) + k];
+      lo[k] = v ? std::min(lo[k], x) : x;
+      hi[k] = v ? std::max(hi[k], x) : x;
+    }
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
+  std::vector<uint64_t> keyed(n), scratch(n);
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+  for (int32_t v = 0; v < n; ++v) {
+    uint32_t key = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double t = (positions[3 * size_t(v) + k] - lo[k]) / extent;
+      key |= spread_bits(uint32_t(std::clamp(t, 0.0, 1.0) * 1023.0)) << k;
+    }
+    keyed[v] = (uint64_t(key) << 32) | uint32_t(v);
+  }
+  // Least significant digit first, 3 passes of 10 bits over the 30-bit key (stable).
+  for (int shift = 32; shift < 62; shift += 10) {
+    std::vector<int32_t> count(1025, 0);
+    for (uint64_t x : keyed) ++count[((x >> shift) & 1023) + 1];
+    for (int i = 0; i < 1024; ++i) count[i + 1] += count[i];
+    for (uint64_t x : keyed) scratch[count[(x >> shift) & 1023]++] = x;
+    keyed.swap(scratch);
+  }
+  std::vector<int32_t> order(n);
+  for (int32_t i = 0; i < n; ++i) order[i] = int32_t(uint32_t(keyed[i]));
+  return order;
+}
+
+// Whether the caller's numbering already has locality: most triangles span nearby vertex ids.
+bool local_numbering(const std::vector<int32_t>& tri) {
+  const size_t m = tri.size() / 3;
+  size_t near = 0;
+  for (size_t t = 0; t < m; ++t) {
+    const int32_t* x = &tri[3 * t];
+    near += int64_t(std::max({x[0], x[1], x[2]})) - std::min({x[0], x[1], x[2]}) <= 1024;
+  }
+  return 2 * near >= m;
+}
+
+// Whether consecutive triangles mostly lie close together: they share a vertex or have nearby
+// lowest vertices (meshes written face by face by modellers, scanners' meshers, subdivision),
+// as opposed to shuffled ones.
+bool coherent_triangle_order(const std::vector<int32_t>& tri) {
+  const size_t m = tri.size() / 3;
+  size_t near = 0;
+  for (size_t t = 1; t < m; ++t) {
+    const int32_t* a = &tri[3 * t - 3];
+    const int32_t* b = &tri[3 * t];
+    const bool share = a[0] == b[0] || a[0] == b[1] || a[0] == b[2] || a[1] == b[0] || a[1] == b[1] ||
+                       a[1] == b[2] || a[2] == b[0] || a[2] == b[1] || a[2] == b[2];
+    const int64_t jump = int64_t(std::min({a[0], a[1], a[2]})) - std::min({b[0], b[1], b[2]});
+    near += share || (jump >= -256 && jump <= 256);
+  }
+  return 2 * near >= m;
+}
+
+// Vertices in order of first appearance in the triangles, then the unused ones.
+std::vector<int32_t> first_appearance_order(const std::vector<int32_t>& tri, int32_t n) {
+  std::vector<uint8_t> seen(n, 0);
+  std::vector<int32_t> order;
+  order.reserve(n);
+  for (int32_t v : tri)
+    if (!seen[v]) {
+      seen[v] = 1;
+      order.push_back(v);
+    }
+  for (int32_t v = 0; v < n; ++v)
+    if (!seen[v]) order.push_back(v);
+  return order;
+}
+
+// Renumbers the vertices of `out` (and the wires) by `order`; with sort_triangles, also sorts
+// the triangles by their lowest vertex (stable: ties keep the caller's order).
+void renumber(SimplicialComplex& out, std::vector<int32_t> order, std::vector<int32_t>& wires, bool sort_triangles) {
+  const int32_t n = out.num_vertices, m = out.num_triangles();
+  out.vertex_index.resize(n);
+  for (int32_t i = 0; i < n; ++i) out.vertex_index[order[i]] = i;
+  out.vertex_source = std::move(order);
+  const auto& index = out.vertex_index;
+  for (size_t i = 0; i < wires.size(); i += 2) {
+    const int32_t a = index[wires[i]], b = index[wires[i + 1]];
+    wires[i] = std::min(a, b);
+    wires[i + 1] = std::max(a, b);
+  }
+#pragma omp parallel for schedule(static) if (out.triangles.size() >= size_t(kParallelMinimum))
+  for (size_t i = 0; i < out.triangles.size(); ++i) out.triangles[i] = index[out.triangles[i]];
+  if (!sort_triangles) return;
+  auto lowest = [&](int64_t t) {
+    const int32_t* x = &out.triangles[3 * size_t(t)];
+    return std::min({x[0], x[1], x[2]});
+  };
+  std::vector<int32_t> triangles(out.triangles.size()), source(m), offsets;
+  counting_sort(
+      m, n, [&](int64_t t, int32_t* hist) { ++hist[lowest(t)]; },
+      [&](int64_t t, int32_t* hist) {
+        const int32_t at = hist[lowest(t)]++;
+        for (int c = 0; c < 3; ++c) triangles[3 * size_t(at) + c] = out.triangles[3 * size_t(t) + c];
+        source[at] = out.triangle_source[t];
+      },
+      offsets);
+  out.triangles.swap(triangles);
+  out.triangle_source.swap(source);
+}
+
+// Fills the twins, fins, wires and vertex incidences of `out`, whose triangles (three distinct
+// vertices each) and num_vertices are set; wires are extra vertex pairs (lower first).
+void link_sides(SimplicialComplex& out, const std::vector<int32_t>& wires) {
+  const int32_t n = out.num_vertices;
+  const int32_t num_sides = out.num_sides();
+  const int32_t* tri = out.triangles.data();
+
+  // Each side and wire becomes an entry in the bucket of its lower vertex: the higher vertex in
+  // the top 32 bits, then (side + 1) and whether the side runs from lower to higher (wires: 0).
+  // Sorting a bucket groups each edge's entries. Items 0..num_sides-1 are sides, the rest wires.
+  const int64_t num_wires = static_cast<int64_t>(wires.size() / 2);
+  auto lower = [&](int64_t i) {
+    if (i >= num_sides) return wires[2 * size_t(i - num_sides)];
+    const int32_t a = tri[i], b = tri[SimplicialComplex::next_side(int32_t(i))];
+    return a < b ? a : b;
+  };
+  std::vector<int32_t> offsets;
+  std::vector<uint64_t> entries(size_t(num_sides) + size_t(num_wires));
+  counting_sort(
+      num_sides + num_wires, n, [&](int64_t i, int32_t* hist) { ++hist[lower(i)]; },
+      [&](int64_t i, int32_t* hist) {
+        if (i >= num_sides) {
+          const size_t w = 2 * size_t(i - num_sides);
+          entries[hist[wires[w]]++] = uint64_t(uint32_t(wires[w + 1])) << 32;
+          return;
+        }
+        const int32_t a = tri[i], b = tri[SimplicialComplex::next_side(int32_t(i))];
+        const uint32_t low = (uint32_t(i + 1) << 1) | (a < b ? 1u : 0u);
+        entries[hist[a < b ? a : b]++] = (uint64_t(uint32_t(a < b ? b : a)) << 32) | low;
+      },
+      offsets);
+  // Triangles at each vertex, and the first side starting there.
+  out.vertex_triangles.assign(n, 0);
+  out.vertex_side.assign(n, -1);
+  for (int32_t s = 0; s < num_sides; ++s)
+    if (out.vertex_triangles[tri[s]]++ == 0) out.vertex_side[tri[s]] = s;
+
+  // Per vertex: sort its bucket and link the sides of each edge. Buckets holding an edge with
+  // no triangle or with three and more (rare) are flagged and read again serially below, so the
+  // parallel loop allocates nothing (an exception must not escape an OpenMP region).
+  out.side_twin.resize(num_sides);
+  std::vector<uint8_t> special(n, 0);
+  int64_t num_edges = 0;
+#pragma omp parallel for schedule(dynamic, 8192) reduction(+ : num_edges) num_threads(pass_threads(num_sides))
+  for (int32_t v = 0; v < n; ++v) {
+    uint64_t* begin = entries.data() + offsets[v];
+    uint64_t* end = entries.data() + offsets[v + 1];
+    sort_bucket(begin, end);
+    for (uint64_t* i = begin; i < end;) {
+      const uint32_t hi = uint32_t(*i >> 32);
+      uint64_t* j = i;
+      while (j < end && uint32_t(*j >> 32) == hi) ++j;
+      ++num_edges;
+      uint64_t* first_side = i;  // wires (low word 0) sort first
+      while (first_side < j && uint32_t(*first_side) == 0) ++first_side;
+      const int64_t count = j - first_side;
+      if (count == 1) {
+        out.side_twin[int32_t(uint32_t(*first_side) >> 1) - 1] = SimplicialComplex::kOpenSide;
+      } else if (count == 2) {
+        const uint32_t x = uint32_t(first_side[0]), y = uint32_t(first_side[1]);
+        const int32_t same_direction = ((x ^ y) & 1u) ? 0 : 1;
+        out.side_twin[int32_t(x >> 1) - 1] = 2 * (int32_t(y >> 1) - 1) + same_direction;
+        out.side_twin[int32_t(y >> 1) - 1] = 2 * (int32_t(x >> 1) - 1) + same_direction;
+      } else {
+        special[v] = 1;
+        for (uint64_t* k = first_side; k < j; ++k)
+          out.side_twin[int32_t(uint32_t(*k) >> 1) - 1] = SimplicialComplex::kFinSide;
+      }
+      i = j;
+    }
+  }
+  if (num_edges > INT32_MAX) throw std::invalid_argument("complex is too large: more than 2^31 edges");
+  out.num_edges = static_cast<int32_t>(num_edges);
+
+  // Fins (edges of 3+ triangles, with their sides) and lone wires, in edge order.
+  out.fin_edges.clear();
+  out.fin_offsets.assign(1, 0);
+  out.fin_sides.clear();
+  out.wire_edges.clear();
+  for (int32_t v = 0; v < n; ++v) {
+    if (!special[v]) continue;
+    const uint64_t* end = entries.data() + offsets[v + 1];
+    for (const uint64_t* i = entries.data() + offsets[v]; i < end;) {
+      const uint32_t hi = uint32_t(*i >> 32);
+      const uint64_t* j = i;
+      while (j < end && uint32_t(*j >> 32) == hi) ++j;
+      const uint64_t* first_side = i;
+      while (first_side < j && uint32_t(*first_side) == 0) ++first_side;
+      if (first_side == j) {
+        out.wire_edges.push_back(v);
+        out.wire_edges.push_back(int32_t(hi));
+      } else if (j - first_side >= 3) {
+        out.fin_edges.push_back(v);
+        out.fin_edges.push_back(int32_t(hi));
+        for (const uint64_t* k = first_side; k < j; ++k) out.fin_sides.push_back(int32_t(uint32_t(*k) >> 1) - 1);
+        std::sort(out.fin_sides.end() - (j - first_side), out.fin_sides.end());
+        out.fin_offsets.push_back(static_cast<int32_t>(out.fin_sides.size()));
+      }
+      i = j;
+    }
+  }
+}
+
+// Triangles whose vertex set repeats an earlier triangle's: either all three sides are twinned
+// with one and the same triangle, or they meet it at an edge of three or more triangles with the
+// same opposite vertex. Returns the later triangle of each such pair.
+std::vector<uint8_t> find_duplicates(const SimplicialComplex& k, int32_t& count) {
+  const int32_t m = k.num_triangles();
+  std::vector<uint8_t> duplicate(m, 0);
+  count = 0;
+  for (int32_t t = 0; t < m; ++t) {
+    const int32_t a = k.side_twin[3 * size_t(t)], b = k.side_twin[3 * size_t(t) + 1], c = k.side_twin[3 * size_t(t) + 2];
+    if (a < 0 || b < 0 || c < 0) continue;
+    const int32_t u = (a >> 1) / 3;
+    if (u < t && u == (b >> 1) / 3 && u == (c >> 1) / 3) duplicate[t] = 1;
+  }
+  for (size_t f = 0; f + 1 < k.fin_offsets.size(); ++f)
+    for (int32_t x = k.fin_offsets[f]; x < k.fin_offsets[f + 1]; ++x)
+      for (int32_t y = k.fin_offsets[f]; y < x; ++y) {
+        const int32_t sx = k.fin_sides[x], sy = k.fin_sides[y];  // sy < sx
+        if (k.triangles[SimplicialComplex::previous_side(sx)] == k.triangles[SimplicialComplex::previous_side(sy)])
+          duplicate[sx / 3] = 1;
+      }
+  for (auto d : duplicate) count += d;
+  return duplicate;
+}
+
+}  // namespace
+
+SimplicialComplex build_complex(const double* positions, int32_t num_vertices, std::vector<int32_t> triangles,
+                                const int32_t* edges, int64_t num_edges) {
+  if (triangles.size() % 3 != 0) throw std::invalid_argument("triangles must hold 3 vertex ids each");
+  const int64_t num_triangles = static_cast<int64_t>(triangles.size() / 3);
+  check_input(positions, num_vertices, triangles.data(), num_triangles, edges, num_edges);
+  const int32_t m = static_cast<int32_t>(num_triangles);
+  SimplicialComplex out;
+  out.num_vertices = num_vertices;
+  out.input_triangles = m;
+  out.input_edges = static_cast<int32_t>(num_edges);
+
+  // Collapsed triangles become wire edges (or nothing beyond their vertex); the others are
+  // 2-simplex candidates, kept in the caller's order (compacted in place).
+  std::vector<int32_t> wires;  // vertex pairs, lower first
+  out.triangle_source.resize(m);
+  int32_t kept = 0;
+  for (int32_t t = 0; t < m; ++t) {
+    const int32_t x[3] = {triangles[3 * size_t(t)], triangles[3 * size_t(t) + 1], triangles[3 * size_t(t) + 2]};
+    if (x[0] != x[1] && x[1] != x[2] && x[2] != x[0]) {
+      for (int c = 0; c < 3; ++c) triangles[3 * size_t(kept) + c] = x[c];
+      out.triangle_source[kept++] = t;
+      continue;
+    }
+    ++out.collapsed_triangles;
+    std::array<int32_t, 3> s = {x[0], x[1], x[2]};
+    std::sort(s.begin(), s.end());
+    if (s[0] != s[2]) {  // two distinct vertices: the edge between them
+      wires.push_back(s[0]);
+      wires.push_back(s[0] == s[1] ? s[2] : s[1]);
+    }
+  }
+  triangles.resize(3 * size_t(kept));
+  out.triangles = std::move(triangles);
+  out.triangle_source.resize(kept);
+  for (int64_t e = 0; e < num_edges; ++e) {
+    const int32_t a = edges[2 * e], b = edges[2 * e + 1];
+    if (a == b) continue;  // a vertex, already in the complex
+    wires.push_back(std::min(a, b));
+    wires.push_back(std::max(a, b));
+  }
+  // Locality: keep a numbering that has it; keep a coherent triangle order and number vertices
+  // as they appear in it; otherwise number vertices along a Z-order curve and sort the triangles.
+  if (local_numbering(out.triangles)) {
+    out.vertex_source.resize(num_vertices);
+    std::iota(out.vertex_source.begin(), out.vertex_source.end(), 0);
+    out.vertex_index = out.vertex_source;
+  } else if (coherent_triangle_order(out.triangles)) {
+    renumber(out, first_appearance_order(out.triangles, num_vertices), wires, false);
+  } else if (positions) {
+    renumber(out, morton_order(positions, num_vertices), wires, true);
+  } else {
+    out.vertex_source.resize(num_vertices);
+    std::iota(out.vertex_source.begin(), out.vertex_source.end(), 0);
+    out.vertex_index = out.vertex_source;
+  }
+  link_sides(out, wires);
+
+  // Duplicates are rare: when there are any, drop them and link again.
+  int32_t duplicates = 0;
+  const auto duplicate = find_duplicates(out, duplicates);
+  if (duplicates > 0) {
+    int32_t at = 0;
+    for (int32_t t = 0; t < out.num_triangles(); ++t) {
+      if (duplicate[t]) continue;
+      for (int c = 0; c < 3; ++c) out.triangles[3 * size_t(at) + c] = out.triangles[3 * size_t(t) + c];
+      out.triangle_source[at++] = out.triangle_source[t];
+    }
+    out.triangles.resize(3 * size_t(at));
+    out.triangle_source.resize(at);
+    out.duplicate_triangles = duplicates;
+    link_sides(out, wires);
+  }
+  return out;
+}
+
+}  // namespace topstoc

@@ -1,0 +1,32 @@
+#include "topstoc/validate.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace topstoc {
+
+void require_finite_positions(const double* positions, int64_t num_vertices) {
+  for (int64_t v = 0; v < num_vertices; ++v) {
+    const double* p = positions + 3 * v;
+    if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) continue;
+    std::ostringstream s;
+    s << "vertex " << v << " has a non-finite coordinate (" << p[0] << ", " << p[1] << ", " << p[2] << ")";
+    throw std::invalid_argument(s.str());
+  }
+}
+
+void require_indices_in_range(const int32_t* indices, int64_t rows, int columns, int64_t num_vertices,
+                              const char* what) {
+  for (int64_t r = 0; r < rows; ++r)
+    for (int c = 0; c < columns; ++c) {
+      const int32_t v = indices[columns * r + c];
+      if (v < 0 || v >= num_vertices)
+        throw std::invalid_argument(std::string(what) + " " + std::to_string(r) + " refers to vertex " +
+                                    std::to_string(v) + ", but vertex indices must lie in [0, " +
+                                    std::to_string(num_vertices) + ")");
+    }
+}
+
+}  // namespace topstoc
