@@ -94,10 +94,10 @@ def topology_primitives(obj, show) -> list:
         if len(ids) and _valid(ids, n):
             out.append(Primitive("boundary", POINTS, co[ids], colors.BOUNDARY, size="point"))
     if show.show_nonmanifold:
-        edges = _id_array(topology, "nonmanifold_edges")
+        edges = _id_array(topology, "nonmanifold_edge_ids")
         if len(edges) and _valid(edges, n):
             out.append(Primitive("nonmanifold_edges", LINES, co[edges], colors.NONMANIFOLD))
-        ids = _id_array(topology, "nonmanifold_vertices")
+        ids = _id_array(topology, "nonmanifold_vertex_ids")
         if len(ids) and _valid(ids, n):
             out.append(Primitive("nonmanifold_vertices", POINTS, co[ids], colors.NONMANIFOLD, size="point"))
     return out

@@ -186,7 +186,7 @@ def _draw_legend():
         blf.position(font, x0 + LEGEND_WIDTH + 6, y0 + t * LEGEND_HEIGHT - 4, 0)
         blf.draw(font, text)
     blf.position(font, x0, y0 + LEGEND_HEIGHT + 10, 0)
-    blf.draw(font, f"Hausdorff error per face: {obj.name}")
+    blf.draw(font, f"Error per face (to the original): {obj.name}")
 
 
 def _font_size(blf, font: int, size: int) -> None:

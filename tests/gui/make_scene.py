@@ -1,11 +1,13 @@
 """Builds a saved scene for the GUI tests (run in `blender -b --factory-startup`).
 
     blender -b --factory-startup --python make_scene.py -- --mesh FILE --output SCENE.blend
-        [--name NAME] [--transform] [--decimate RATIO] [--measure] [--analyse] [--loops]
+        [--name NAME] [--subdivide LEVELS] [--transform] [--decimate RATIO] [--measure]
+        [--analyse] [--loops]
 
-Reads any mesh format through topstoc.core.io; --transform moves, rotates and scales the object
-non-uniformly (overlays must follow); --decimate adds "<name>_TopStoc" next to it (hidden
-original stays); --measure stores the Hausdorff figures on the decimated object; --analyse and
+Reads any mesh format through topstoc.core.io; --subdivide splits every triangle into four
+(midpoint subdivision: same shape and topology, more triangles); --transform moves, rotates and
+scales the object non-uniformly (overlays must follow); --decimate adds "<name>_TopStoc" at the
+same place; --measure stores the Hausdorff figures on the decimated object; --analyse and
 --loops store the topology and the handle/tunnel loops on the mesh. The default scene's cube
 is removed. Exits non-zero on any failure.
 """
@@ -24,6 +26,7 @@ def parse(argv):
     parser.add_argument("--mesh", required=True)
     parser.add_argument("--output", required=True)
     parser.add_argument("--name", default="Mesh")
+    parser.add_argument("--subdivide", type=int, default=0)
     parser.add_argument("--transform", action="store_true")
     parser.add_argument("--decimate", type=float)
     parser.add_argument("--measure", action="store_true")
@@ -44,8 +47,14 @@ def main():
     if cube is not None:
         bpy.data.objects.remove(cube)
     data = io.read_mesh(args.mesh)
+    vertices, triangles = data.vertices, data.triangles
+    if args.subdivide:
+        sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+        import meshgen
+
+        vertices, triangles = meshgen.subdivide(vertices, triangles, args.subdivide)
     mesh = bpy.data.meshes.new(args.name)
-    mesh_io.fill_geometry(mesh, data.vertices, data.triangles)
+    mesh_io.fill_geometry(mesh, vertices, triangles)
     obj = bpy.data.objects.new(args.name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     if args.transform:

@@ -13,6 +13,7 @@ import session  # noqa: E402
 def steps():
     session.enable_addon()
     yield from session.show_topstoc_tab("TOPSTOC_PT_metrics")
+    yield from session.collapse_first_panel()
     scene = bpy.context.scene
     show = scene.topstoc.overlays
     original = bpy.data.objects["Dragon"]

@@ -82,22 +82,50 @@ def show_topstoc_tab(panel_class="TOPSTOC_PT_decimate"):
         cls.draw = original_draw
 
 
-def frame(objects, rotation=(1.1, 0.0, 0.6), distance_factor=2.6):
-    """Points the 3D view at ``objects`` from a fixed angle (Euler XYZ, radians)."""
-    from mathutils import Euler
+def frame(objects, tilt=0.45, turn=0.35, distance_factor=2.4):
+    """Points the 3D view at ``objects`` along the first object's thinnest local axis (where a
+    flat part shows its holes), tilted by ``tilt`` and turned by ``turn`` radians."""
+    from mathutils import Matrix, Quaternion
 
     _w, _a, _r, space = view3d()
     corners = [o.matrix_world @ Vector(c) for o in objects for c in o.bound_box]
     center = sum(corners, Vector()) / len(corners)
     radius = max((c - center).length for c in corners)
+    first = objects[0]
+    local = [Vector(c) for c in first.bound_box]
+    extent = [max(c[i] for c in local) - min(c[i] for c in local) for i in range(3)]
+    thin = extent.index(min(extent))
+    world = first.matrix_world.to_3x3()
+    axis = (world @ Vector([1.0 if i == thin else 0.0 for i in range(3)])).normalized()
+    up = (world @ Vector([1.0 if i == (thin + 2) % 3 else 0.0 for i in range(3)])).normalized()
+    side = up.cross(axis).normalized()
+    up = axis.cross(side).normalized()
+    rotation = Matrix((side, up, axis)).transposed().to_quaternion()  # view z axis = towards the viewer
+    rotation = rotation @ Quaternion((0, 1, 0), turn) @ Quaternion((1, 0, 0), -tilt)
     view = space.region_3d
     view.view_perspective = "PERSP"
     view.view_location = center
-    view.view_rotation = Euler(rotation, "XYZ").to_quaternion()
+    view.view_rotation = rotation
     view.view_distance = radius * distance_factor
     space.shading.type = "SOLID"
     space.overlay.show_floor = False
     space.overlay.show_axis_x = space.overlay.show_axis_y = False
+    space.overlay.show_cursor = False  # its red ring would count as boundary red
+    space.show_gizmo_navigate = False
+
+
+def collapse_first_panel():
+    """Steps: a simulated click on the sidebar's first panel header (Guided Decimation) folds it,
+    so the panels below it show in the screenshot."""
+    _window, area, _region, _space = view3d()
+    window = bpy.context.window_manager.windows[0]
+    sidebar = next(r for r in area.regions if r.type == "UI")
+    x, y = sidebar.x + sidebar.width // 3, sidebar.y + sidebar.height - 14
+    window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
+    window.event_simulate(type="LEFTMOUSE", value="PRESS", x=x, y=y)
+    window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x, y=y)
+    area.tag_redraw()
+    yield 0.3
 
 
 def screen_rect(obj):

@@ -74,7 +74,8 @@ class TOPSTOC_PT_metrics(_Panel, bpy.types.Panel):
         grid.label(text=f"{settings.aspect_max:.3f}")
         if settings.degenerate:
             box.label(text=f"{settings.degenerate} zero-area triangles", icon="ERROR")
-        layout.label(text=f"Diagonal {settings.diagonal:.4g}; measured in {settings.seconds:.2f} s")
+        layout.label(text=f"Original's diagonal: {settings.diagonal:.4g}")
+        layout.label(text=f"Measured in {settings.seconds:.2f} s")
 
 
 class TOPSTOC_PT_metrics_colors(_Panel, bpy.types.Panel):
