@@ -214,3 +214,21 @@ def complete_graph(k: int = 4):
     vertices = _strip_positions(k)
     edges = np.array([(a, b) for a in range(k) for b in range(a + 1, k)], dtype=np.int32)
     return vertices, np.zeros((0, 3), dtype=np.int32), edges
+
+
+def subdivide(vertices, triangles, levels: int = 1):
+    """Midpoint subdivision (each triangle into four, positions unchanged): same surface, same
+    topology, four times the triangles per level."""
+    v = np.asarray(vertices, dtype=float)
+    t = np.asarray(triangles, dtype=np.int64)
+    for _ in range(levels):
+        edges = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+        unique, index = np.unique(edges, axis=0, return_inverse=True)
+        index = index.reshape(-1) if index.ndim > 1 else index
+        mid = len(v) + index.reshape(3, -1)  # midpoint ids of edges 01, 12, 20 per triangle
+        v = np.concatenate([v, 0.5 * (v[unique[:, 0]] + v[unique[:, 1]])])
+        a, b, c = t[:, 0], t[:, 1], t[:, 2]
+        ab, bc, ca = mid
+        t = np.concatenate([np.stack([a, ab, ca], 1), np.stack([b, bc, ab], 1), np.stack([c, ca, bc], 1),
+                            np.stack([ab, bc, ca], 1)])
+    return v, t.astype(np.int32)

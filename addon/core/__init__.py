@@ -10,6 +10,8 @@ from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decim
 from .error_bound import ErrorBoundReport
 from .hausdorff import Distance, HausdorffResult, OneSidedDistance, closest_points, hausdorff
 from .io import MeshData, read_mesh, write_mesh
+from .loops import (Cancelled, ComponentLoops, Loop, LoopsResult, handle_tunnel_loops, self_intersections,
+                    shorten_loop, tetrahedralize_surface)
 from .mesh import Mesh, MeshReport
 from .topology import ComponentGenerators, ComponentTopology, Topology, generators, topology
 
@@ -22,4 +24,7 @@ __all__ = [
     "ComponentGenerators", "ComponentTopology", "Topology", "generators", "topology",
     # mesh files (io.py)
     "MeshData", "read_mesh", "write_mesh",
+    # handle and tunnel loops (loops.py)
+    "Cancelled", "ComponentLoops", "Loop", "LoopsResult", "handle_tunnel_loops", "self_intersections",
+    "shorten_loop", "tetrahedralize_surface",
 ]

@@ -46,48 +46,61 @@ void seed_unreached(const Mesh& mesh, const Clustering& c, Partition& out) {
   }
 }
 
-// Do the oriented link arcs a -> b around one sample form a single path or cycle? Each
-// neighbour may start and end at most one arc: that is also what consistent orientation of
-// the triangles around the sample means.
-bool single_fan(std::vector<std::array<int32_t, 2>>& arcs) {
-  if (arcs.empty()) return false;
-  std::sort(arcs.begin(), arcs.end());
-  for (size_t i = 1; i < arcs.size(); ++i)
-    if (arcs[i][0] == arcs[i - 1][0]) return false;
-  std::array<int32_t, 64> small;
-  std::vector<int32_t> large;
-  int32_t* targets = small.data();
-  if (arcs.size() > small.size()) {
-    large.resize(arcs.size());
-    targets = large.data();
-  }
-  for (size_t i = 0; i < arcs.size(); ++i) targets[i] = arcs[i][1];
-  std::sort(targets, targets + arcs.size());
-  for (size_t i = 1; i < arcs.size(); ++i)
-    if (targets[i] == targets[i - 1]) return false;
-  // Start at the one source that is nobody's target (a path), or anywhere (a cycle).
-  int32_t start = arcs[0][0];
-  int32_t starts = 0;
-  for (const auto& a : arcs)
-    if (!std::binary_search(targets, targets + arcs.size(), a[0])) {
-      start = a[0];
-      ++starts;
-    }
-  if (starts > 1) return false;
-  auto next = [&](int32_t v) {
-    auto it = std::lower_bound(arcs.begin(), arcs.end(), std::array<int32_t, 2>{v, INT32_MIN});
-    return (it != arcs.end() && (*it)[0] == v) ? (*it)[1] : INT32_MIN;
+// The link of one sample: its neighbours in the decimated mesh and, for each triangle (s, a,
+// b) around it, the arc a -> b. Valences are small, so lookups are linear scans.
+struct Link {
+  struct Neighbour {
+    int32_t id;
+    int32_t out = 0, in = 0;  // arcs leaving / entering this neighbour
+    int32_t next = -1;        // index of the neighbour the arc leaving it goes to
   };
-  size_t walked = 0;
-  for (int32_t v = start; walked <= arcs.size();) {
-    const int32_t w = next(v);
-    if (w == INT32_MIN) break;  // end of a path
-    ++walked;
-    if (w == start) break;  // closed the cycle
-    v = w;
+  std::vector<Neighbour> neighbours;
+  int32_t arcs = 0;
+  bool reversed = false;  // some arc a -> b has its reverse b -> a too
+
+  void clear() {
+    neighbours.clear();
+    arcs = 0;
+    reversed = false;
   }
-  return walked == arcs.size();
-}
+  int32_t index(int32_t id) {
+    for (size_t i = 0; i < neighbours.size(); ++i)
+      if (neighbours[i].id == id) return int32_t(i);
+    neighbours.push_back({id});
+    return int32_t(neighbours.size() - 1);
+  }
+  void add(int32_t from, int32_t to) {
+    const int32_t a = index(from), b = index(to);
+    if (neighbours[b].next == a) reversed = true;
+    ++neighbours[a].out, ++neighbours[b].in;
+    neighbours[a].next = b;
+    ++arcs;
+  }
+  /// A triangle appears twice: once more in the same orientation, or in both.
+  bool repeated() const {
+    if (reversed) return true;
+    for (const auto& n : neighbours)
+      if (n.out > 1 || n.in > 1) return true;
+    return false;
+  }
+  /// The arcs form one path or one cycle: the triangles around the sample are one consistently
+  /// oriented fan. (Call only when !repeated(): every neighbour then has out, in <= 1.)
+  bool single_fan() const {
+    int32_t start = 0, starts = 0;
+    for (size_t i = 0; i < neighbours.size(); ++i)
+      if (neighbours[i].in == 0) start = int32_t(i), ++starts;
+    if (starts > 1) return false;
+    int32_t walked = 0;
+    for (int32_t v = start; walked <= arcs;) {
+      const int32_t w = neighbours[v].next;
+      if (w < 0) break;  // end of a path
+      ++walked;
+      if (w == start) break;  // closed the cycle
+      v = w;
+    }
+    return walked == arcs;
+  }
+};
 
 // Triangle i as seen from its lowest rank s: (b, c) such that (s, b, c) is a rotation of it.
 inline std::array<int32_t, 2> rotated_from_lowest(const int32_t* t) {
@@ -218,103 +231,113 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   }
   auto incident = [&](int32_t s) { return around_offsets[s + 1] - around_offsets[s]; };
 
-  // --- duplicates and pillows, decided by each triangle's lowest rank ---------------------------
-  // A small cluster can sit between two others that wrap around it, touching it along its whole
-  // border: their triangle is emitted twice, facing opposite ways, and the small cluster has
-  // no other triangle. Dropping both copies gives the nerve of the partition in which the
-  // small cluster joined its neighbours, so no sample is needed. Any other repeat is an issue.
-  std::vector<uint8_t> drop(emitted, 0);
-  int32_t duplicates = 0, pillows = 0;
-#pragma omp parallel for schedule(dynamic, 256) reduction(+ : duplicates, pillows) if (k >= kParallelMin)
-  for (int32_t s = 0; s < k; ++s) {
-    for (int32_t a = around_offsets[s]; a < around_offsets[s + 1]; ++a) {
-      const int32_t* ta = &out.triangles[3 * size_t(around[a])];
-      if (std::min({ta[0], ta[1], ta[2]}) != s) continue;
-      const auto ra = rotated_from_lowest(ta);
-      int32_t same = 0, opposite = -1, repeats = 0;
-      for (int32_t b = around_offsets[s]; b < around_offsets[s + 1]; ++b) {
-        if (a == b) continue;
-        const int32_t* tb = &out.triangles[3 * size_t(around[b])];
-        if (std::min({tb[0], tb[1], tb[2]}) != s) continue;
-        const auto rb = rotated_from_lowest(tb);
-        if (rb == ra) ++same, ++repeats;
-        if (rb[0] == ra[1] && rb[1] == ra[0]) opposite = around[b], ++repeats;
-      }
-      if (repeats == 0) continue;
-      const bool absorbs = incident(ta[0]) == 2 || incident(ta[1]) == 2 || incident(ta[2]) == 2;
-      if (repeats == 1 && same == 0 && absorbs) {
-        if (around[a] < opposite) ++pillows;  // count each pair once
-        drop[around[a]] = 1;                  // the opposite copy is dropped from its own turn
-      } else {
-        ++duplicates;
-        for (int j = 0; j < 3; ++j) marks.add(ta[j]);
-      }
-    }
-  }
-  out.issues.duplicate = duplicates;
-  out.issues.pillows = pillows;
-
   // --- per sample: one oriented fan, expected edge multiplicities, Euler contributions ----------
-  // Six times a component's Euler characteristic is the sum over its samples of
-  // 6 - 3 (neighbours) + 2 (triangles), counting only samples that keep a triangle.
+  // Each triangle (s, a, b) around sample s is an arc a -> b of s's link. Six times a component's
+  // Euler characteristic is the sum over its samples of 6 - 3 (neighbours) + 2 (triangles),
+  // counting only samples that keep a triangle. A triangle emitted twice shows up as a repeated
+  // or reversed arc; such samples are set aside and settled after the pass (see below).
   const int32_t num_components = mesh.num_components();
   std::vector<int64_t> chi6_out(k, 0);
   out.absorbed.assign(k, 0);
+  std::vector<uint8_t> drop(emitted, 0);
   std::vector<std::vector<uint64_t>> seen_pairs(threads);
+  std::vector<std::vector<int32_t>> repeated_lists(threads);
   int32_t bad_link = 0, bad_edge = 0, isolated = 0, absorbed = 0;
-#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed) if (k >= kParallelMin)
-  {
-    std::vector<std::pair<int32_t, int32_t>> neighbour_count;
-    std::vector<std::array<int32_t, 2>> link;
-    auto& seen = seen_pairs[omp_get_thread_num()];
-#pragma omp for schedule(dynamic, 256)
-    for (int32_t s = 0; s < k; ++s) {
-      neighbour_count.clear();
-      link.clear();
-      for (int32_t i = around_offsets[s]; i < around_offsets[s + 1]; ++i) {
-        if (drop[around[i]]) continue;
-        const int32_t* tri = &out.triangles[3 * size_t(around[i])];
-        const int j = tri[0] == s ? 0 : tri[1] == s ? 1 : 2;
-        const int32_t next = tri[(j + 1) % 3], prev = tri[(j + 2) % 3];
-        link.push_back({next, prev});
-        for (int32_t other : {next, prev}) {
-          auto it = std::find_if(neighbour_count.begin(), neighbour_count.end(),
-                                 [&](const auto& p) { return p.first == other; });
-          if (it == neighbour_count.end()) neighbour_count.push_back({other, 1});
-          else ++it->second;
-        }
-      }
-      if (link.empty()) {
-        // No triangle: the neighbours absorbed this cluster (the pillow case) unless the sample
-        // must stay. The Euler characteristic check confirms the topology either way.
-        if (required[samples[s]] || layout.vertex_corner[samples[s]]) {
-          ++isolated;
-          marks.add(s);
-        } else {
-          ++absorbed;
-          out.absorbed[s] = 1;
-        }
-        continue;
-      }
-      chi6_out[s] = 6 - 3 * int64_t(neighbour_count.size()) + 2 * int64_t(link.size());
-      for (const auto& [other, count] : neighbour_count) {
-        if (other < s) continue;  // each pair once
-        int32_t expected = 2;
-        auto it = feature_copies.find(pair_key(s, other));
-        if (it != feature_copies.end()) {
-          expected = it->second;
-          seen.push_back(it->first);
-        }
-        if (count != expected) {
-          ++bad_edge;
-          marks.add(s), marks.add(other);
-        }
-      }
-      if (mesh.manifold_vertex()[samples[s]] && !single_fan(link)) {
-        ++bad_link;
+  // Returns false (and changes nothing) when the link repeats a triangle.
+  auto evaluate = [&](int32_t s, Link& link, std::vector<uint64_t>& seen, int32_t& links, int32_t& edges,
+                      int32_t& lonely, int32_t& eaten) {
+    link.clear();
+    for (int32_t i = around_offsets[s]; i < around_offsets[s + 1]; ++i) {
+      if (drop[around[i]]) continue;
+      const int32_t* tri = &out.triangles[3 * size_t(around[i])];
+      const int j = tri[0] == s ? 0 : tri[1] == s ? 1 : 2;
+      link.add(tri[(j + 1) % 3], tri[(j + 2) % 3]);
+    }
+    if (link.repeated()) return false;
+    if (link.arcs == 0) {
+      // No triangle: the neighbours absorbed this cluster (the pillow case) unless the sample
+      // must stay. The Euler characteristic check confirms the topology either way.
+      if (required[samples[s]] || layout.vertex_corner[samples[s]]) {
+        ++lonely;
         marks.add(s);
+      } else {
+        ++eaten;
+        out.absorbed[s] = 1;
+      }
+      return true;
+    }
+    chi6_out[s] = 6 - 3 * int64_t(link.neighbours.size()) + 2 * int64_t(link.arcs);
+    for (const auto& nb : link.neighbours) {
+      if (nb.id < s) continue;  // each pair once
+      int32_t expected = 2;
+      auto it = feature_copies.find(pair_key(s, nb.id));
+      if (it != feature_copies.end()) {
+        expected = it->second;
+        seen.push_back(it->first);
+      }
+      if (nb.in + nb.out != expected) {
+        ++edges;
+        marks.add(s), marks.add(nb.id);
       }
     }
+    if (mesh.manifold_vertex()[samples[s]] && !link.single_fan()) {
+      ++links;
+      marks.add(s);
+    }
+    return true;
+  };
+#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed) if (k >= kParallelMin)
+  {
+    Link link;
+    auto& seen = seen_pairs[omp_get_thread_num()];
+    auto& repeated = repeated_lists[omp_get_thread_num()];
+#pragma omp for schedule(dynamic, 256)
+    for (int32_t s = 0; s < k; ++s)
+      if (!evaluate(s, link, seen, bad_link, bad_edge, isolated, absorbed)) repeated.push_back(s);
+  }
+
+  // --- repeated triangles: pillows and duplicates ------------------------------------------------
+  // A small cluster can sit between two others that wrap around it, touching it along its whole
+  // border: their triangle is emitted twice, facing opposite ways, and the small cluster has no
+  // other triangle. Dropping both copies gives the nerve of the partition in which the small
+  // cluster joined its neighbours, so no sample is needed. Any other repeat is an issue. Every
+  // sample of a repeated triangle sees the repeat in its link, so the set-aside samples hold
+  // all of them; they are evaluated again once the pillows are gone.
+  std::vector<int32_t> repeated;
+  for (const auto& list : repeated_lists) repeated.insert(repeated.end(), list.begin(), list.end());
+  std::sort(repeated.begin(), repeated.end());
+  if (!repeated.empty()) {
+    std::vector<std::pair<std::array<int32_t, 3>, int32_t>> keyed;  // sorted triple, triangle
+    for (int32_t s : repeated)
+      for (int32_t i = around_offsets[s]; i < around_offsets[s + 1]; ++i) {
+        const int32_t* t = &out.triangles[3 * size_t(around[i])];
+        if (std::min({t[0], t[1], t[2]}) != s) continue;  // each triangle from its lowest sample
+        std::array<int32_t, 3> key = {t[0], t[1], t[2]};
+        std::sort(key.begin(), key.end());
+        keyed.push_back({key, around[i]});
+      }
+    std::sort(keyed.begin(), keyed.end());
+    for (size_t a = 0; a < keyed.size();) {
+      size_t b = a;
+      while (b < keyed.size() && keyed[b].first == keyed[a].first) ++b;
+      if (b - a >= 2) {
+        const int32_t* t0 = &out.triangles[3 * size_t(keyed[a].second)];
+        const int32_t* t1 = &out.triangles[3 * size_t(keyed[a + 1].second)];
+        const bool opposite = b - a == 2 && rotated_from_lowest(t0)[0] == rotated_from_lowest(t1)[1];
+        const bool absorbs = incident(t0[0]) == 2 || incident(t0[1]) == 2 || incident(t0[2]) == 2;
+        if (opposite && absorbs) {
+          ++out.issues.pillows;
+          drop[keyed[a].second] = drop[keyed[a + 1].second] = 1;
+        } else {
+          ++out.issues.duplicate;
+          for (int j = 0; j < 3; ++j) marks.add(t0[j]);
+        }
+      }
+      a = b;
+    }
+    Link link;
+    for (int32_t s : repeated)
+      if (!evaluate(s, link, seen_pairs[0], bad_link, bad_edge, isolated, absorbed)) marks.add(s);
   }
   out.issues.bad_link = bad_link;
   out.issues.bad_edge = bad_edge;

@@ -84,30 +84,48 @@ double apply_view(const ViewGuidance& view, const double* position, const double
   return p;
 }
 
-double surface_probability(const Mesh& mesh, const SamplingParams& params, int32_t v, double k) {
+// q for every vertex that is sampled stochastically (0 elsewhere), computed once per draw.
+std::vector<double> importance_factors(const Mesh& mesh, const std::vector<uint8_t>& cls,
+                                       const SamplingParams& params) {
+  const int32_t n = mesh.num_vertices();
+  std::vector<double> q(n, 0.0);
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v)
+    if (cls[v] == kSurface || cls[v] == kCurve) q[v] = importance(mesh, params, v);
+  return q;
+}
+
+bool has_per_vertex_guidance(const SamplingParams& params) {
+  return params.guidance || !params.boxes.empty() || params.view.enabled;
+}
+
+double surface_probability(const Mesh& mesh, const SamplingParams& params, int32_t v, double k, double q) {
   const double* position = mesh.position(v);
   double u = params.guidance ? params.guidance[mesh.vertex_source()[v]] : 0.0;
   for (const auto& box : params.boxes)
     if (inside_box(box, position)) u = box.value;
   if (u >= 1.0) return 1.0;   // a control point
   if (u <= -1.0) return 0.0;  // never sampled (topology may still need it)
-  const double p0 = std::min(1.0, k * importance(mesh, params, v));
+  const double p0 = std::min(1.0, k * q);
   double p = u > 0 ? p0 + (1.0 - p0) * u : p0 * (1.0 + u);
   if (params.view.enabled) p = apply_view(params.view, position, &mesh.normals()[3 * size_t(v)], p);
   return std::clamp(p, 0.0, 1.0);
 }
 
-std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& cls, const SamplingParams& params,
-                                  double k) {
+std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& cls, const std::vector<double>& q,
+                                  const SamplingParams& params, double k) {
   const int32_t n = mesh.num_vertices();
   std::vector<double> p(n);
+  const bool guided = has_per_vertex_guidance(params);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     switch (cls[v]) {
       case kIsolated: p[v] = 0.0; break;
       case kCorner: p[v] = 1.0; break;
-      case kCurve: p[v] = std::sqrt(surface_probability(mesh, params, v, k)); break;
-      default: p[v] = surface_probability(mesh, params, v, k);
+      default: {
+        const double surface = guided ? surface_probability(mesh, params, v, k, q[v]) : std::min(1.0, k * q[v]);
+        p[v] = cls[v] == kCurve ? std::sqrt(surface) : surface;
+      }
     }
   }
   return p;
@@ -117,13 +135,11 @@ std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& 
 // increasing and concave in k (min(1, k q) and sqrt are), so Newton steps taken from below stay
 // below the root and converge monotonically; a bracket guards against round-off. The draw
 // fixes the count anyway, so k need only be close.
-double solve_rate(const Mesh& mesh, const std::vector<uint8_t>& cls, const SamplingParams& params, double target) {
-  const int32_t n = mesh.num_vertices();
-  std::vector<double> q(n, 0.0);
+double solve_rate(const std::vector<uint8_t>& cls, const std::vector<double>& q, double target) {
+  const int32_t n = int32_t(cls.size());
   double min_q = 1e300, total_q = 0.0, corners = 0.0;
   for (int32_t v = 0; v < n; ++v) {
     if (cls[v] == kSurface || cls[v] == kCurve) {
-      q[v] = importance(mesh, params, v);
       min_q = std::min(min_q, q[v]);
       total_q += q[v];
     } else if (cls[v] == kCorner) {
@@ -387,7 +403,8 @@ void validate_sampling_params(const Mesh& mesh, const SamplingParams& params) {
 
 std::vector<double> sampling_probabilities(const Mesh& mesh, const FeatureLayout& layout,
                                            const SamplingParams& params, double k) {
-  return probabilities(mesh, classify(mesh, layout), params, k);
+  const auto cls = classify(mesh, layout);
+  return probabilities(mesh, cls, importance_factors(mesh, cls, params), params, k);
 }
 
 SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const SamplingParams& params,
@@ -400,8 +417,9 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
   SampleSet out;
   out.guided = is_guided(mesh, params);
   const int32_t target = std::clamp(target_vertices, 0, active);
-  out.rate = out.guided ? double(target) / double(std::max(1, active)) : solve_rate(mesh, cls, params, target);
-  const auto p = probabilities(mesh, cls, params, out.rate);
+  const auto q = importance_factors(mesh, cls, params);
+  out.rate = out.guided ? double(target) / double(std::max(1, active)) : solve_rate(cls, q, target);
+  const auto p = probabilities(mesh, cls, q, params, out.rate);
   double expected = 0.0;
   for (double x : p) expected += x;
   out.expected = expected;
