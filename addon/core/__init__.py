@@ -7,6 +7,7 @@
 
 from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
                        sampling_probabilities)
+from .edit import EditResult, cut_along_loop, delete_faces, fill_holes, fill_loops, remove_handle
 from .error_bound import ErrorBoundReport
 from .hausdorff import Distance, HausdorffResult, OneSidedDistance, closest_points, hausdorff
 from .io import MeshData, read_mesh, write_mesh
@@ -18,6 +19,8 @@ from .topology import ComponentGenerators, ComponentTopology, Topology, generato
 __all__ = [
     "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
     "decimate_with_samples", "sampling_probabilities",
+    # editing (topstoc.core.edit also has boundary_loops and the result's parts)
+    "EditResult", "cut_along_loop", "delete_faces", "fill_holes", "fill_loops", "remove_handle",
     # measurement (hausdorff.py) and error-bounded decimation (error_bound.py)
     "Distance", "ErrorBoundReport", "HausdorffResult", "OneSidedDistance", "closest_points", "hausdorff",
     # topology

@@ -283,7 +283,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
         density_epsilon=float(density_epsilon),
         view=view.as_engine() if view is not None else None,
         boxes=[box.as_engine() for box in boxes] or None, placement=placement,
-        fast_path=-1 if fast_path is None else int(bool(fast_path)),
+        fast_path=0 if fast_path is None else int(bool(fast_path)),
         max_repair_rounds=int(max_repair_rounds))
     return _result(raw, parameters)
 

@@ -167,7 +167,7 @@ void bind_decimate(py::module_& m) {
       py::arg("seed") = 0, py::arg("adaptivity") = 0.5, py::arg("flat_floor") = 0.25, py::arg("area_weighted") = false,
       py::arg("guidance") = py::none(), py::arg("density") = "off", py::arg("density_rings") = 0, py::arg("density_ratio") = 2.0,
       py::arg("density_epsilon") = 0.0, py::arg("view") = py::none(), py::arg("boxes") = py::none(),
-      py::arg("placement") = "subsample", py::arg("fast_path") = -1, py::arg("max_repair_rounds") = 200,
+      py::arg("placement") = "subsample", py::arg("fast_path") = 0, py::arg("max_repair_rounds") = 200,
       "TopStoc decimation to a vertex target (or a triangle target when target_triangles > 0).");
 
   m.def(

@@ -319,6 +319,5 @@ def test_fast_path_gives_the_same_mesh():
         assert fast.stats.fast_path and not full.stats.fast_path
         for name in ("triangles", "kept", "face_source", "corner_source", "labels", "samples"):
             np.testing.assert_array_equal(getattr(fast, name), getattr(full, name), err_msg=name)
-    # automatic below 5 % of the vertices
-    assert mesh.decimate(ratio=0.03, seed=5).stats.fast_path
-    assert not mesh.decimate(ratio=0.2, seed=5).stats.fast_path
+    # off unless asked for: the full scan is the faster one in this engine (see decimate.hpp)
+    assert not mesh.decimate(ratio=0.03, seed=5).stats.fast_path

@@ -25,7 +25,12 @@ struct DecimateParams {
   SamplingParams sampling;
   Placement placement = Placement::Subsample;
   int32_t max_repair_rounds = 200;
-  int fast_path = -1;           ///< collect candidate faces during the flood: -1 below 5 %, 0 never, 1 always
+  /// Collect candidate faces during the flood (thesis 4.1.1) instead of scanning all faces:
+  /// -1 below 5 % of the vertices, 0 never (default), 1 always. Measured on the 1.55M-triangle
+  /// horse, the scan of all faces' labels (parallel, streaming) is the faster one here: at 1 %
+  /// 104 ms per decimation without, 138 ms with (the border edges recorded during the flood
+  /// and the scattered face marks cost more than the labels they save reading).
+  int fast_path = 0;
   int budget_passes = 2;        ///< extra draws when repairs overshoot the target (unguided only)
 };
 
