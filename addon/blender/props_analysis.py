@@ -97,6 +97,8 @@ class TOPSTOC_PG_topology(bpy.types.PropertyGroup):
     loops_message: StringProperty(name="Loop Search Result")
     loops_stamp: StringProperty(name="Fingerprint of the Searched Mesh")
     loops_seconds: FloatProperty(name="Loop Search Time", subtype="TIME_ABSOLUTE", unit="TIME_ABSOLUTE")
+    edit_state: EnumProperty(name="Last Edit", items=STATES, default="NONE")
+    edit_message: StringProperty(name="Last Edit Result")
 
 
 class TOPSTOC_PG_metrics(bpy.types.PropertyGroup):
@@ -153,7 +155,7 @@ class TOPSTOC_PG_overlays(bpy.types.PropertyGroup):
                                            "error measured")
     line_width: FloatProperty(name="Line Width", default=3.0, min=1.0, max=20.0, update=_redraw)
     active_width: FloatProperty(name="Active Loop Width", default=7.0, min=1.0, max=30.0, update=_redraw)
-    point_size: FloatProperty(name="Point Size", default=7.0, min=1.0, max=30.0, update=_redraw)
+    point_size: FloatProperty(name="Point Size", default=5.0, min=1.0, max=30.0, update=_redraw)
 
 
 CLASSES = (TOPSTOC_PG_component, TOPSTOC_PG_loop, TOPSTOC_PG_topology, TOPSTOC_PG_metrics, TOPSTOC_PG_overlays)

@@ -1,10 +1,10 @@
-"""Panels in the 3D view's sidebar, tab "TopStoc": decimation, metrics (and their sub-panels)."""
+"""Panels in the 3D view's sidebar, tab "TopStoc": decimation, topology, metrics (and their sub-panels)."""
 
 import bpy
 
-from . import metrics, panels
+from . import metrics, panels, topology
 
-MODULES = (panels, metrics)
+MODULES = (panels, topology, metrics)
 
 
 def register():

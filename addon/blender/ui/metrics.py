@@ -48,6 +48,10 @@ class TOPSTOC_PT_metrics(_Panel, bpy.types.Panel):
             col.label(text=f"Compares with '{implied.name}'" if implied else "Pick the original to compare with",
                       icon="INFO")
         col.prop(settings, "samples")
+        reference = settings.reference or metrics.reference_of(obj)
+        if reference is not None:  # the basic information (thesis 4.7): vertex counts of both meshes
+            col.label(text=f"{len(reference.data.vertices):,} → {len(obj.data.vertices):,} vertices "
+                           f"({100.0 * len(obj.data.vertices) / max(1, len(reference.data.vertices)):.3g} %)")
         layout.operator("topstoc.measure", icon="DRIVER_DISTANCE")
         if settings.state == "ERROR":
             layout.label(text=settings.message, icon="ERROR")
