@@ -30,6 +30,7 @@ def steps():
     show.show_error = True
     yield 0.5
     session.shot("error_on", [decimated])
+    session.keep_for_docs("error_on", "hausdorff-colours.png")
     from topstoc.blender import overlays  # the add-on's modules, as registered
 
     session.report["values"]["drawn_error"] = overlays.drawn_primitives(decimated)
@@ -59,6 +60,7 @@ def steps():
     show.show_clusters = True
     yield 0.8
     session.shot("clusters_on", [original])
+    session.keep_for_docs("clusters_on", "samples-clusters.png")
     session.report["values"]["drawn_clusters"] = overlays.drawn_primitives(original)
     show.show_clusters = False
     yield 0.5

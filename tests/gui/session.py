@@ -160,6 +160,23 @@ def shot(name, objects=()):
     report["regions"][name] = {"view": view_rect(), **{o.name: screen_rect(o) for o in objects}}
 
 
+def keep_for_docs(shot_name, file_name):
+    """With TOPSTOC_DOC_SHOTS=DIR, saves the 3D view area (with its sidebar) of a screenshot as
+    DIR/file_name: how docs/images/*.png are made (see docs/blender-addon.md)."""
+    folder = os.environ.get("TOPSTOC_DOC_SHOTS")
+    if not folder:
+        return
+    _window, area, _region, _space = view3d()
+    pixels = np.load(os.path.join(OUT, shot_name + ".npy"))
+    crop = np.ascontiguousarray(pixels[area.y:area.y + area.height, area.x:area.x + area.width])
+    image = bpy.data.images.new(file_name, crop.shape[1], crop.shape[0], alpha=False)
+    image.pixels.foreach_set(crop.ravel())
+    image.filepath_raw = os.path.join(os.path.abspath(folder), file_name)
+    image.file_format = "PNG"
+    image.save()
+    bpy.data.images.remove(image)
+
+
 def check(name, ok, detail=""):
     report["checks"][name] = bool(ok)
     print(f"gui check {name}: {'ok' if ok else 'FAILED'} {detail}", flush=True)

@@ -23,7 +23,7 @@ def ramp():
 def report(gui, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("metrics_gui")
     scene = gui.scene(tmp / "dragon.blend", "--mesh", DATA / "genus0" / "cgal_ChineseDragon-10kv.off",
-                      "--name", "Dragon", "--transform", "--decimate", 0.05, "--measure")
+                      "--name", "Dragon", "--transform", "--decimate", 0.03, "--measure")
     return gui.run("metrics_script.py", scene, tmp / "out")
 
 
