@@ -1,21 +1,19 @@
 """Hausdorff error colours, legend, colour attribute, samples and clusters, turntable: real
 Blender 3.4 GUI under Xvfb, screenshots checked pixel by pixel (one launch)."""
 
+import sys
+
 import numpy as np
 import pytest
 
-from conftest import DATA
+from conftest import BUILD, DATA
 from pixels import count_near, count_on_ramp, crop, outside
 
-import sys
-import pathlib
-
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "build" / "python"))
+sys.path.insert(0, str(BUILD / "python"))
+from topstoc.core import colors  # noqa: E402  (bpy-free)
 
 
 def ramp():
-    from topstoc.core import colors
-
     return colors.error_colors(np.linspace(0, 1, 64), 1.0)
 
 
@@ -70,8 +68,6 @@ def test_colour_attribute_shows_errors_without_the_overlay(report):
 
 
 def test_clusters_and_samples_on_the_original(report):
-    from topstoc.core import colors
-
     on, off, samples = (image(report, n) for n in ("clusters_on", "clusters_off", "samples_only"))
     rect = report["regions"]["clusters_on"]["Dragon"]
     red_on = count_near(crop(on, rect), colors.CLUSTER_CORNER)

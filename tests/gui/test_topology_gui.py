@@ -3,13 +3,13 @@ tunnel loops turquoise, generator edges pink, boundary vertices red, the active 
 depth-tested, following the object's transform, each with a toggle, gone when the add-on is
 disabled; editing and undo from the panel; the background search's Esc."""
 
+import sys
+
 import numpy as np
 import pytest
 
 from conftest import BUILD, DATA
 from pixels import count_near, crop, outside
-
-import sys
 
 sys.path.insert(0, str(BUILD / "python"))
 from topstoc.core import colors  # noqa: E402  (bpy-free)
