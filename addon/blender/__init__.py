@@ -1,16 +1,17 @@
-"""Blender-facing part of the add-on (needs bpy): settings, operators, panels.
+"""Blender-facing part of the add-on (needs bpy): settings, operators, panels, overlays.
 
 Sub-packages register in order and unregister in reverse; the prepared-mesh cache is emptied
-when a file is loaded and on unregister.
+when a file is loaded and on unregister. Overlays add their draw handlers only outside
+background mode.
 """
 
 import bpy
 from bpy.app.handlers import persistent
 
-from . import operators, props, ui
+from . import operators, overlays, props, ui, watch
 from .cache import prepared_meshes
 
-MODULES = (props, operators, ui)
+MODULES = (props, operators, ui, watch, overlays)
 
 
 @persistent

@@ -8,6 +8,9 @@ import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
                        FloatVectorProperty, IntProperty, PointerProperty, StringProperty)
 
+from . import props_analysis
+from .props_analysis import TOPSTOC_PG_metrics, TOPSTOC_PG_overlays, TOPSTOC_PG_topology
+
 #: Material slots that can carry a guidance weight (later slots count as 0).
 MAX_MATERIAL_SLOTS = 32
 DEFAULT_COLOR_LAYER = "TopStoc Guidance"
@@ -108,6 +111,9 @@ class TOPSTOC_PG_object(bpy.types.PropertyGroup):
     sample_sets: CollectionProperty(type=TOPSTOC_PG_sample_set)
     sample_set_index: IntProperty(name="Sample Set")
 
+    topology: PointerProperty(type=TOPSTOC_PG_topology)   #: the Topology panel's results
+    metrics: PointerProperty(type=TOPSTOC_PG_metrics)     #: the Metrics panel's results
+
 
 class TOPSTOC_PG_scene(DecimationParameters, bpy.types.PropertyGroup):
     """Scene-wide defaults: decimation parameters, boxes, view, multiview and LODs."""
@@ -134,8 +140,10 @@ class TOPSTOC_PG_scene(DecimationParameters, bpy.types.PropertyGroup):
     lod_ratios: StringProperty(name="LOD Ratios", default="1.0, 0.5, 0.25, 0.1",
                                description="Comma-separated ratios, LOD0 first")
 
+    overlays: PointerProperty(type=TOPSTOC_PG_overlays)
 
-CLASSES = (TOPSTOC_PG_sample_set, TOPSTOC_PG_object, TOPSTOC_PG_scene)
+
+CLASSES = props_analysis.CLASSES + (TOPSTOC_PG_sample_set, TOPSTOC_PG_object, TOPSTOC_PG_scene)
 
 
 def register():

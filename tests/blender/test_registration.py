@@ -12,7 +12,10 @@ import meshgen
 from helpers import make_object
 
 OPERATORS = ("guided_decimate", "preview", "set_guidance", "add_guidance_layer", "show_guidance", "add_box",
-             "multiview", "lod_chain", "save_samples", "restore_samples", "remove_samples")
+             "multiview", "lod_chain", "save_samples", "restore_samples", "remove_samples",
+             "measure", "write_error_colors", "turntable", "analyse", "find_loops", "loop_step", "select_loop",
+             "cut_loop", "remove_loop", "fill_holes", "delete_faces")
+PANEL_MODULES = ("panels", "topology", "metrics")
 
 
 def test_unregister_and_register_again(ts, addon_module):
@@ -72,13 +75,18 @@ def test_panels_draw(ts, scene, kind):
         obj = bpy.data.objects.new("Box", None)
         scene.collection.objects.link(obj)
         bpy.context.view_layer.objects.active = obj
-    panels = importlib.import_module(ts.__name__ + ".blender.ui.panels")
     seen = set()
-    for cls in panels.CLASSES:
-        fake = type("P", (), {"layout": RecordingLayout(seen)})()
-        for mode in ("RATIO", "VERTICES", "TRIANGLES", "MAX_ERROR"):
-            scene.topstoc.target_mode = mode
-            cls.draw(fake, bpy.context)
+    for name in PANEL_MODULES:
+        module = importlib.import_module(f"{ts.__name__}.blender.ui.{name}")
+        for cls in module.CLASSES:
+            if issubclass(cls, bpy.types.UIList):
+                continue
+            fake = type("P", (), {"layout": RecordingLayout(seen)})()
+            for mode in ("RATIO", "VERTICES", "TRIANGLES", "MAX_ERROR"):
+                scene.topstoc.target_mode = mode
+                if hasattr(cls, "draw_header"):
+                    cls.draw_header(fake, bpy.context)
+                cls.draw(fake, bpy.context)
     assert "topstoc.guided_decimate" in seen
     assert ("use_color" in seen) == (kind == "mesh") and ("box_weight" in seen) == (kind == "empty")
 

@@ -2,9 +2,9 @@
 
 import bpy
 
-from . import decimate, guidance, preview, samples, variants
+from . import decimate, guidance, metrics, preview, samples, topology, variants
 
-MODULES = (decimate, guidance, preview, samples, variants)
+MODULES = (decimate, guidance, preview, samples, variants, topology, metrics)
 
 
 def register():
@@ -14,6 +14,7 @@ def register():
 
 
 def unregister():
+    topology.cancel_all()
     for module in reversed(MODULES):
         for cls in reversed(module.CLASSES):
             bpy.utils.unregister_class(cls)

@@ -1,10 +1,10 @@
-"""Panels in the 3D view's sidebar, tab "TopStoc" (more panels slot in here: topology, metrics)."""
+"""Panels in the 3D view's sidebar, tab "TopStoc": decimation, topology, metrics (and their sub-panels)."""
 
 import bpy
 
-from . import panels
+from . import metrics, panels, topology
 
-MODULES = (panels,)
+MODULES = (panels, topology, metrics)
 
 
 def register():

@@ -1,4 +1,5 @@
 """Decimation panels: target and options, guidance sources, preview/multiview/LODs, samples."""
+# Shared by every panel of the tab: ui/topology.py and ui/metrics.py use _Panel and CATEGORY.
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ class _Panel:
 class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
     bl_label = "Guided Decimation"
     bl_idname = "TOPSTOC_PT_decimate"
+    bl_order = 0
 
     def draw(self, context):
         layout = self.layout
@@ -137,6 +139,10 @@ class TOPSTOC_PT_samples(_Panel, bpy.types.Panel):
         obj = context.object
         if obj is None or obj.type != "MESH":
             return
+        show = context.scene.topstoc.overlays
+        row = layout.row(align=True)  # the last decimation's samples and clusters (thesis fig. 4.1)
+        row.prop(show, "show_samples", toggle=True, icon="DOT")
+        row.prop(show, "show_clusters", toggle=True, icon="MOD_EXPLODE")
         layout.operator("topstoc.save_samples", icon="FILE_TICK")
         for entry in obj.topstoc.sample_sets:
             row = layout.row(align=True)

@@ -1,0 +1,181 @@
+"""What the viewport overlays draw, as plain arrays (no ``gpu`` here; see overlays.py).
+
+Each builder turns results stored on an object into primitives in the object's local
+coordinates: lines (pairs of points), points, or triangles with one colour per corner.
+Results that no longer describe the mesh (it changed since) give no primitive. The arrays
+are what the GUI tests and the background tests check; overlays.py only uploads them.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+from typing import Optional
+
+import bpy
+import numpy as np
+
+from ..core import colors
+from . import mesh_io, metrics, watch
+
+LINES, POINTS, TRIS = "LINES", "POINTS", "TRIS"
+
+
+@dataclass
+class Primitive:
+    """One draw call: ``positions`` (k, 3) float32 in object space; LINES take them in pairs,
+    TRIS in triples. ``color`` is uniform unless ``colors`` (k, 4) gives one per point."""
+
+    name: str
+    kind: str
+    positions: np.ndarray
+    color: tuple = (1.0, 1.0, 1.0, 1.0)
+    colors: Optional[np.ndarray] = None
+    size: str = "line"  # which overlay setting gives its width: line, active, point
+
+    def __len__(self) -> int:
+        return len(self.positions)
+
+
+def positions(mesh) -> np.ndarray:
+    return mesh_io._get(mesh.vertices, "co", len(mesh.vertices), 3, np.float32)
+
+
+def _id_array(group, key: str, dtype=np.int32) -> np.ndarray:
+    value = group.get(key)
+    if value is None:
+        return np.zeros(0, dtype=dtype)
+    return np.asarray(value.to_list() if hasattr(value, "to_list") else value, dtype=dtype)
+
+
+def _valid(ids: np.ndarray, n: int) -> bool:
+    return len(ids) == 0 or (ids.min() >= 0 and ids.max() < n)
+
+
+def loop_segments(vertex_ids: np.ndarray) -> np.ndarray:
+    """(2k,) vertex ids of the k edges of a closed loop, in pairs."""
+    return np.stack([vertex_ids, np.roll(vertex_ids, -1)], axis=1).reshape(-1)
+
+
+def topology_current(obj) -> bool:
+    """True when the stored topology was computed on the mesh as it is now."""
+    topology = obj.topstoc.topology
+    return topology.state == "OK" and topology.stamp == watch.current_stamp(obj)
+
+
+def topology_primitives(obj, show) -> list:
+    """Loops, generator edges, boundary and non-manifold elements (``show``: overlay settings)."""
+    if obj.type != "MESH" or not topology_current(obj):
+        return []
+    topology = obj.topstoc.topology
+    co = positions(obj.data)
+    n = len(co)
+    out = []
+    wanted = {"HANDLE": show.show_handles, "TUNNEL": show.show_tunnels, "BOUNDARY": show.show_boundary}
+    color = {"HANDLE": colors.HANDLE, "TUNNEL": colors.TUNNEL, "BOUNDARY": colors.BOUNDARY}
+    segments = {"HANDLE": [], "TUNNEL": []}
+    for index, loop in enumerate(topology.loops):
+        ids = _id_array(loop, "vertices")
+        if len(ids) < 2 or not _valid(ids, n) or not wanted[loop.kind]:
+            continue
+        if index == topology.loop_index:
+            out.append(Primitive("active_loop", LINES, co[loop_segments(ids)], color[loop.kind], size="active"))
+        elif loop.kind in segments:
+            segments[loop.kind].append(loop_segments(ids))
+    for kind, name in (("HANDLE", "handles"), ("TUNNEL", "tunnels")):
+        if segments[kind]:
+            out.append(Primitive(name, LINES, co[np.concatenate(segments[kind])], color[kind]))
+    if show.show_generators:
+        edges = _id_array(topology, "generator_edges")
+        if len(edges) and _valid(edges, n):
+            out.append(Primitive("generators", LINES, co[edges], colors.GENERATOR))
+    if show.show_boundary:
+        ids = _id_array(topology, "boundary_vertices")
+        if len(ids) and _valid(ids, n):
+            out.append(Primitive("boundary", POINTS, co[ids], colors.BOUNDARY, size="point"))
+    if show.show_nonmanifold:
+        edges = _id_array(topology, "nonmanifold_edge_ids")
+        if len(edges) and _valid(edges, n):
+            out.append(Primitive("nonmanifold_edges", LINES, co[edges], colors.NONMANIFOLD))
+        ids = _id_array(topology, "nonmanifold_vertex_ids")
+        if len(ids) and _valid(ids, n):
+            out.append(Primitive("nonmanifold_vertices", POINTS, co[ids], colors.NONMANIFOLD, size="point"))
+    return out
+
+
+def _corner_positions(obj):
+    arrays = mesh_io.read_mesh(obj.data)
+    return arrays, arrays.vertices.astype(np.float32)[arrays.triangles.reshape(-1)]
+
+
+def error_primitives(obj, show) -> list:
+    """Per-face Hausdorff error colours with the overlay's scale (decimated objects)."""
+    if obj.type != "MESH" or not show.show_error or not metrics.is_current(obj):
+        return []
+    errors = metrics.face_errors(obj)
+    if errors is None:
+        return []
+    arrays, corners = _corner_positions(obj)
+    face_colors = colors.error_colors(errors, metrics.error_scale(obj, show.error_scale))
+    return [Primitive("error", TRIS, corners, colors=np.repeat(face_colors, 3, axis=0))]
+
+
+# Labels of the last decimation per object: (geometry epoch, samples digest) -> labels or None.
+_labels: dict = {}
+
+
+def _samples_entry(obj):
+    from .pipeline import LAST_SAMPLES
+
+    entry = obj.topstoc.sample_sets.get(LAST_SAMPLES)
+    return entry if entry is not None and "samples" in entry else None
+
+
+def last_decimation(obj, context=None):
+    """(samples, labels) of the object's last decimation, re-created from its saved samples
+    (thesis 4.1.3); None when there is none or the mesh changed since."""
+    entry = _samples_entry(obj)
+    if entry is None:
+        return None
+    samples = _id_array(entry, "samples")
+    key = (watch.epoch(obj), hashlib.blake2b(samples.data, digest_size=8).hexdigest(), entry.parameters)
+    memo = _labels.get(obj.name_full)
+    if memo is not None and memo[0] == key:
+        return memo[1]
+    from . import pipeline
+
+    value = None
+    try:
+        run = pipeline.restore(context or bpy.context, obj, entry.name)
+        value = (np.asarray(run.result.samples), np.asarray(run.result.labels))
+    except (ValueError, KeyError):  # the mesh or its borders changed: nothing to show
+        value = None
+    _labels[obj.name_full] = (key, value)
+    return value
+
+
+def decimation_primitives(obj, show, context=None) -> list:
+    """Sampled vertices and cluster regions of the last decimation (thesis fig. 4.1)."""
+    if obj.type != "MESH" or not (show.show_samples or show.show_clusters) or obj.mode == "EDIT":
+        return []
+    found = last_decimation(obj, context)
+    if found is None:
+        return []
+    samples, labels = found
+    out = []
+    if show.show_clusters:
+        arrays, corners = _corner_positions(obj)
+        if len(labels) == len(arrays.vertices):
+            face_colors = colors.cluster_face_colors(arrays.triangles, labels)
+            out.append(Primitive("clusters", TRIS, corners, colors=np.repeat(face_colors, 3, axis=0)))
+    if show.show_samples:
+        co = positions(obj.data)
+        if _valid(samples, len(co)):
+            out.append(Primitive("samples", POINTS, co[samples], colors.SAMPLE, size="point"))
+    return out
+
+
+def object_primitives(obj, show, context=None) -> list:
+    """Everything the overlays draw for one object, in draw order (faces first)."""
+    return (decimation_primitives(obj, show, context) + error_primitives(obj, show)
+            + topology_primitives(obj, show))

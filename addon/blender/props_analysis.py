@@ -1,0 +1,161 @@
+"""Analysis results and overlay settings stored in .blend files.
+
+Results live on the object (``obj.topstoc.topology``, ``obj.topstoc.metrics``), so undo and
+redo restore them together with the mesh they describe, and they survive saving. Vertex-id
+lists (loops, boundary and generator edges, per-face errors) are ID-property arrays on the
+same property groups; topstoc.blender.analysis and .metrics read and write them. Their keys
+must differ from the RNA property names (RNA properties are stored under their own names):
+"generator_edges", "boundary_vertices", "nonmanifold_edge_ids", "nonmanifold_vertex_ids",
+"face_error", and "vertices" on each loop.
+"""
+
+from __future__ import annotations
+
+import bpy
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, IntProperty,
+                       PointerProperty, StringProperty)
+
+LOOP_KINDS = [
+    ("HANDLE", "Handle", "Goes around a handle: bounds a disk inside the solid (yellow)"),
+    ("TUNNEL", "Tunnel", "Goes through a hole: bounds a disk outside the solid (turquoise)"),
+    ("BOUNDARY", "Boundary", "A boundary loop (hole) of the surface (red vertices)"),
+]
+STATES = [
+    ("NONE", "None", "Not analysed yet"),
+    ("OK", "OK", "Up to date"),
+    ("ERROR", "Error", "The last run failed; the message says why"),
+]
+
+
+def _redraw(_self, context):
+    """Property update: redraw every 3D view (overlays and panels follow the settings)."""
+    for window in context.window_manager.windows:
+        for area in window.screen.areas:
+            if area.type == "VIEW_3D":
+                area.tag_redraw()
+
+
+class TOPSTOC_PG_component(bpy.types.PropertyGroup):
+    """Invariants of one connected component (counts in Blender's terms: polygons, edges)."""
+
+    vertices: IntProperty(name="Vertices")
+    edges: IntProperty(name="Edges")
+    faces: IntProperty(name="Faces")
+    triangles: IntProperty(name="Triangles")
+    euler: IntProperty(name="Euler Characteristic")
+    betti0: IntProperty(name="β0")
+    betti1: IntProperty(name="β1")
+    betti2: IntProperty(name="β2")
+    genus: IntProperty(name="Genus", description="-1 where undefined (non-manifold, non-orientable)")
+    boundary_loops: IntProperty(name="Boundary Loops")
+    closed: BoolProperty(name="Closed")
+    manifold: BoolProperty(name="Manifold")
+    orientable: BoolProperty(name="Orientable")
+    summary: StringProperty(name="Summary")
+
+
+class TOPSTOC_PG_loop(bpy.types.PropertyGroup):
+    """A handle, tunnel or boundary loop; its vertex ids are the ID property ``"vertices"``."""
+
+    kind: EnumProperty(name="Kind", items=LOOP_KINDS)
+    component: IntProperty(name="Component")
+    length: FloatProperty(name="Length", subtype="DISTANCE")
+    num_edges: IntProperty(name="Edges")
+    fillable: BoolProperty(name="Fillable", default=True)
+
+
+class TOPSTOC_PG_topology(bpy.types.PropertyGroup):
+    """Topology of an object's mesh (the Topology panel's data)."""
+
+    state: EnumProperty(name="State", items=STATES, default="NONE")
+    message: StringProperty(name="Message", description="Why the last analysis failed")
+    stamp: StringProperty(name="Connectivity Fingerprint")
+    seconds: FloatProperty(name="Analysis Time", subtype="TIME_ABSOLUTE", unit="TIME_ABSOLUTE")
+    revision: IntProperty(name="Revision", description="Changes whenever the results change")
+
+    vertices: IntProperty(name="Vertices")
+    edges: IntProperty(name="Edges")
+    faces: IntProperty(name="Faces")
+    triangles: IntProperty(name="Triangles")
+    euler: IntProperty(name="χ")
+    betti0: IntProperty(name="β0")
+    betti1: IntProperty(name="β1")
+    betti2: IntProperty(name="β2")
+    genus: IntProperty(name="Genus", description="Sum over the components; -1 if any is undefined")
+    boundary_loops: IntProperty(name="Boundary Loops")
+    nonmanifold_edges: IntProperty(name="Non-Manifold Edges")
+    nonmanifold_vertices: IntProperty(name="Non-Manifold Vertices")
+    isolated_vertices: IntProperty(name="Isolated Vertices")
+    duplicate_triangles: IntProperty(name="Duplicate Triangles")
+    summary: StringProperty(name="Summary")
+    components: CollectionProperty(type=TOPSTOC_PG_component)
+    component_index: IntProperty(name="Component")
+
+    loops: CollectionProperty(type=TOPSTOC_PG_loop)
+    loop_index: IntProperty(name="Active Loop", update=_redraw)
+    loops_state: EnumProperty(name="Loop Search", items=STATES, default="NONE")
+    loops_message: StringProperty(name="Loop Search Result")
+    loops_stamp: StringProperty(name="Fingerprint of the Searched Mesh")
+    loops_seconds: FloatProperty(name="Loop Search Time", subtype="TIME_ABSOLUTE", unit="TIME_ABSOLUTE")
+    edit_state: EnumProperty(name="Last Edit", items=STATES, default="NONE")
+    edit_message: StringProperty(name="Last Edit Result")
+
+
+class TOPSTOC_PG_metrics(bpy.types.PropertyGroup):
+    """Hausdorff distance to a reference (usually the original) and triangle quality."""
+
+    state: EnumProperty(name="State", items=STATES, default="NONE")
+    message: StringProperty(name="Message")
+    reference: PointerProperty(name="Original", type=bpy.types.Object,
+                               poll=lambda self, obj: obj.type == "MESH",
+                               description="The mesh this one is compared with (default: the object it was "
+                                           "decimated from)")
+    samples: IntProperty(name="Samples", default=200_000, min=1000, soft_max=5_000_000,
+                         description="About how many points to sample on the original")
+    stamp: StringProperty(name="Fingerprint of Both Meshes")
+    seconds: FloatProperty(name="Measuring Time", subtype="TIME_ABSOLUTE", unit="TIME_ABSOLUTE")
+    revision: IntProperty(name="Revision")
+    diagonal: FloatProperty(name="Diagonal", subtype="DISTANCE")
+    symmetric_max: FloatProperty(name="Max", subtype="DISTANCE")
+    symmetric_mean: FloatProperty(name="Mean", subtype="DISTANCE")
+    symmetric_rms: FloatProperty(name="RMS", subtype="DISTANCE")
+    forward_max: FloatProperty(name="Max", subtype="DISTANCE")
+    forward_mean: FloatProperty(name="Mean", subtype="DISTANCE")
+    forward_rms: FloatProperty(name="RMS", subtype="DISTANCE")
+    backward_max: FloatProperty(name="Max", subtype="DISTANCE")
+    backward_mean: FloatProperty(name="Mean", subtype="DISTANCE")
+    backward_rms: FloatProperty(name="RMS", subtype="DISTANCE")
+    aspect_mean: FloatProperty(name="Aspect Ratio Mean")
+    aspect_max: FloatProperty(name="Aspect Ratio Max")
+    degenerate: IntProperty(name="Degenerate Triangles")
+
+
+class TOPSTOC_PG_overlays(bpy.types.PropertyGroup):
+    """Which overlays the 3D views draw (scene-wide), and how."""
+
+    show_handles: BoolProperty(name="Handle Loops", default=True, update=_redraw,
+                               description="Draw handle loops (yellow)")
+    show_tunnels: BoolProperty(name="Tunnel Loops", default=True, update=_redraw,
+                               description="Draw tunnel loops (turquoise)")
+    show_generators: BoolProperty(name="Generator Edges", default=True, update=_redraw,
+                                  description="Draw the 2g unpaired (generator) edges (pink)")
+    show_boundary: BoolProperty(name="Boundary Vertices", default=True, update=_redraw,
+                                description="Draw the vertices on boundary loops (red)")
+    show_nonmanifold: BoolProperty(name="Non-Manifold", default=True, update=_redraw,
+                                   description="Draw non-manifold edges and vertices (orange)")
+    show_samples: BoolProperty(name="Samples", default=False, update=_redraw,
+                               description="Draw the sampled vertices of the last decimation (blue)")
+    show_clusters: BoolProperty(name="Cluster Regions", default=False, update=_redraw,
+                                description="Colour the original by the clusters of the last decimation "
+                                            "(red: faces that became output triangles)")
+    show_error: BoolProperty(name="Error Colours", default=False, update=_redraw,
+                             description="Colour the decimated mesh by its Hausdorff error per face")
+    error_scale: FloatProperty(name="Scale", default=0.0, min=0.0, soft_max=5.0, precision=3, update=_redraw,
+                               description="Error (in % of the original's diagonal) shown red; 0 = the largest "
+                                           "error measured")
+    line_width: FloatProperty(name="Line Width", default=3.0, min=1.0, max=20.0, update=_redraw)
+    active_width: FloatProperty(name="Active Loop Width", default=7.0, min=1.0, max=30.0, update=_redraw)
+    point_size: FloatProperty(name="Point Size", default=5.0, min=1.0, max=30.0, update=_redraw)
+
+
+CLASSES = (TOPSTOC_PG_component, TOPSTOC_PG_loop, TOPSTOC_PG_topology, TOPSTOC_PG_metrics, TOPSTOC_PG_overlays)

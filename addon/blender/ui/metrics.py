@@ -1,0 +1,112 @@
+"""Metrics panel: Hausdorff distance to the original, triangle quality, error colours, turntable."""
+
+from __future__ import annotations
+
+import bpy
+
+from .. import metrics
+from .panels import _Panel
+
+SIDES = (("symmetric", "Symmetric"), ("forward", "Forward (original → this)"),
+         ("backward", "Backward (this → original)"))
+
+
+def _mesh(context):
+    obj = context.active_object
+    return obj if obj is not None and obj.type == "MESH" else None
+
+
+def distance_rows(obj) -> list:
+    """(side label, [(figure label, absolute text, percent text)]) as the panel shows them."""
+    figures = metrics.figures(obj)
+    rows = []
+    for side, label in SIDES:
+        values, percent = figures[side], figures[side + "_percent"]
+        rows.append((label, [(name.upper() if name == "rms" else name.capitalize(), f"{values[name]:.4g}",
+                              f"{percent[name]:.3g} %") for name in ("max", "mean", "rms")]))
+    return rows
+
+
+class TOPSTOC_PT_metrics(_Panel, bpy.types.Panel):
+    bl_label = "Metrics"
+    bl_idname = "TOPSTOC_PT_metrics"
+    bl_order = 20
+
+    def draw(self, context):
+        layout = self.layout
+        obj = _mesh(context)
+        if obj is None:
+            layout.label(text="Select a mesh")
+            return
+        settings = obj.topstoc.metrics
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        col = layout.column()
+        col.prop(settings, "reference")
+        if settings.reference is None:
+            implied = metrics.reference_of(obj)
+            col.label(text=f"Compares with '{implied.name}'" if implied else "Pick the original to compare with",
+                      icon="INFO")
+        col.prop(settings, "samples")
+        reference = settings.reference or metrics.reference_of(obj)
+        if reference is not None:  # the basic information (thesis 4.7): vertex counts of both meshes
+            col.label(text=f"{len(reference.data.vertices):,} → {len(obj.data.vertices):,} vertices "
+                           f"({100.0 * len(obj.data.vertices) / max(1, len(reference.data.vertices)):.3g} %)")
+        layout.operator("topstoc.measure", icon="DRIVER_DISTANCE")
+        if settings.state == "ERROR":
+            layout.label(text=settings.message, icon="ERROR")
+            return
+        if settings.state != "OK":
+            return
+        if not metrics.is_current(obj):
+            layout.label(text="A mesh changed since: measure again", icon="ERROR")
+        layout.use_property_split = False
+        for label, figures in distance_rows(obj):
+            box = layout.box()
+            box.label(text=label)
+            grid = box.grid_flow(row_major=True, columns=3, even_columns=True, align=True)
+            for name, absolute, percent in figures:
+                grid.label(text=name)
+                grid.label(text=absolute)
+                grid.label(text=percent)
+        box = layout.box()
+        box.label(text="Triangle Quality (aspect ratio)")
+        grid = box.grid_flow(row_major=True, columns=2, even_columns=True, align=True)
+        grid.label(text="Mean")
+        grid.label(text=f"{settings.aspect_mean:.3f}")
+        grid.label(text="Max")
+        grid.label(text=f"{settings.aspect_max:.3f}")
+        if settings.degenerate:
+            box.label(text=f"{settings.degenerate} zero-area triangles", icon="ERROR")
+        layout.label(text=f"Original's diagonal: {settings.diagonal:.4g}")
+        layout.label(text=f"Measured in {settings.seconds:.2f} s")
+
+
+class TOPSTOC_PT_metrics_colors(_Panel, bpy.types.Panel):
+    bl_label = "Colour by Error"
+    bl_idname = "TOPSTOC_PT_metrics_colors"
+    bl_parent_id = "TOPSTOC_PT_metrics"
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.topstoc.overlays, "show_error", text="")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        show = context.scene.topstoc.overlays
+        layout.active = show.show_error
+        layout.prop(show, "error_scale", text="Red at (% diagonal)")
+        layout.operator("topstoc.write_error_colors", icon="GROUP_VCOL")
+
+
+class TOPSTOC_PT_metrics_view(_Panel, bpy.types.Panel):
+    bl_label = "View"
+    bl_idname = "TOPSTOC_PT_metrics_view"
+    bl_parent_id = "TOPSTOC_PT_metrics"
+
+    def draw(self, context):
+        self.layout.operator("topstoc.turntable", icon="CON_ROTLIKE")
+
+
+CLASSES = (TOPSTOC_PT_metrics, TOPSTOC_PT_metrics_colors, TOPSTOC_PT_metrics_view)

@@ -1,0 +1,205 @@
+"""Topology panel (thesis 4.2.1): invariants, components, loop list, editing tools, overlays."""
+
+from __future__ import annotations
+
+import textwrap
+
+import bpy
+
+from .. import analysis
+from ..operators.topology import running
+from .panels import _Panel
+
+KIND_ICONS = {"HANDLE": "MOD_CURVE", "TUNNEL": "MOD_SCREW", "BOUNDARY": "MOD_EDGESPLIT"}
+
+
+def _mesh(context):
+    obj = context.active_object
+    return obj if obj is not None and obj.type == "MESH" else None
+
+
+def wrapped(layout, context, text: str, icon: str = "NONE") -> None:
+    """A long message as several labels, wrapped to the sidebar's width."""
+    scale = (context.preferences.system.ui_scale if context.preferences else 0.0) or 1.0  # 0 in background
+    pixels = context.region.width if context.region else 300
+    width = max(16, int((pixels - 50 * scale) / (7 * scale)))
+    for i, line in enumerate(textwrap.wrap(text, width) or [""]):
+        layout.label(text=line, icon=icon if i == 0 else "BLANK1")
+
+
+def invariant_rows(topology) -> list:
+    """(label, value) pairs of the panel's table, in Blender's counts (polygons, edges)."""
+    genus = "undefined" if topology.genus < 0 else str(topology.genus)
+    return [("Vertices", f"{topology.vertices:,}"), ("Edges", f"{topology.edges:,}"),
+            ("Faces", f"{topology.faces:,}"), ("Triangles", f"{topology.triangles:,}"),
+            ("β0 / β1 / β2", f"{topology.betti0} / {topology.betti1} / {topology.betti2}"),
+            ("χ", str(topology.euler)), ("Genus", genus), ("Components", str(len(topology.components))),
+            ("Boundary Loops", str(topology.boundary_loops)),
+            ("Non-Manifold Edges", str(topology.nonmanifold_edges)),
+            ("Non-Manifold Verts", str(topology.nonmanifold_vertices)),
+            ("Isolated Vertices", str(topology.isolated_vertices))] + \
+        ([("Repeated Faces (counted once)", str(topology.duplicate_triangles))] if topology.duplicate_triangles else [])
+
+
+def _table(layout, rows, factor: float = 0.68) -> None:
+    col = layout.column(align=True)
+    for label, value in rows:
+        split = col.split(factor=factor, align=True)
+        split.label(text=label)
+        split.label(text=value)
+
+
+class TOPSTOC_UL_components(bpy.types.UIList):
+    def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
+        layout.label(text=f"{index}: {item.summary}", icon="MESH_DATA" if item.manifold else "ERROR")
+
+
+class TOPSTOC_UL_loops(bpy.types.UIList):
+    def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
+        split = layout.split(factor=0.55, align=True)
+        split.label(text=item.name, icon=KIND_ICONS.get(item.kind, "DOT"))
+        warning = item.kind == "BOUNDARY" and not item.fillable
+        split.label(text=f"{item.num_edges} edges", icon="ERROR" if warning else "NONE")
+
+
+class TOPSTOC_PT_topology(_Panel, bpy.types.Panel):
+    bl_label = "Topology"
+    bl_idname = "TOPSTOC_PT_topology"
+    bl_order = 10
+
+    def draw(self, context):
+        layout = self.layout
+        obj = _mesh(context)
+        if obj is None:
+            layout.label(text="Select a mesh")
+            return
+        topology = obj.topstoc.topology
+        row = layout.row(align=True)
+        row.operator("topstoc.analyse", icon="VIEWZOOM")
+        row.operator("topstoc.find_loops", icon="MOD_SCREW")
+        search = running.get(obj.name)
+        if search is not None:
+            layout.label(text=f"{search.stage}: {100 * search.fraction:.0f} %"
+                              f"{' (cancelling)' if search.cancelled else ' (Esc cancels)'}", icon="TIME")
+        if topology.state == "ERROR":
+            wrapped(layout, context, topology.message, "ERROR")
+            return
+        if topology.state != "OK":
+            layout.label(text="Not analysed yet", icon="INFO")
+            return
+        if context.mode == "EDIT_MESH":
+            layout.label(text="Figures as of the last mode switch", icon="EDITMODE_HLT")
+        elif not analysis.is_current(obj):
+            layout.label(text="The mesh changed: Analyse again", icon="ERROR")
+        wrapped(layout, context, topology.summary)
+        _table(layout.box(), invariant_rows(topology))
+        layout.label(text=f"Analysed in {1000 * topology.seconds:.0f} ms")
+
+
+class TOPSTOC_PT_topology_components(_Panel, bpy.types.Panel):
+    bl_label = "Components"
+    bl_idname = "TOPSTOC_PT_topology_components"
+    bl_parent_id = "TOPSTOC_PT_topology"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    @classmethod
+    def poll(cls, context):
+        obj = _mesh(context)
+        return obj is not None and obj.topstoc.topology.state == "OK"
+
+    def draw(self, context):
+        layout = self.layout
+        obj = _mesh(context)
+        if obj is None:
+            return
+        topology = obj.topstoc.topology
+        layout.template_list("TOPSTOC_UL_components", "", topology, "components", topology, "component_index",
+                             rows=3)
+        if 0 <= topology.component_index < len(topology.components):
+            c = topology.components[topology.component_index]
+            _table(layout.box(), [
+                ("Vertices", f"{c.vertices:,}"), ("Edges", f"{c.edges:,}"), ("Faces", f"{c.faces:,}"),
+                ("β0 / β1 / β2", f"{c.betti0} / {c.betti1} / {c.betti2}"), ("χ", str(c.euler)),
+                ("Genus", "undefined" if c.genus < 0 else str(c.genus)), ("Boundary Loops", str(c.boundary_loops)),
+                ("Closed", "yes" if c.closed else "no"), ("Manifold", "yes" if c.manifold else "no"),
+                ("Orientable", "yes" if c.orientable else "no")])
+
+
+class TOPSTOC_PT_topology_loops(_Panel, bpy.types.Panel):
+    bl_label = "Loops"
+    bl_idname = "TOPSTOC_PT_topology_loops"
+    bl_parent_id = "TOPSTOC_PT_topology"
+
+    @classmethod
+    def poll(cls, context):
+        obj = _mesh(context)
+        return obj is not None and obj.topstoc.topology.state == "OK"
+
+    def draw(self, context):
+        layout = self.layout
+        obj = _mesh(context)
+        if obj is None:
+            return
+        topology = obj.topstoc.topology
+        if topology.loops_message:
+            wrapped(layout, context, topology.loops_message,
+                    "ERROR" if topology.loops_state == "ERROR" else "INFO")
+        if not topology.loops:
+            layout.label(text="No loops: Find Handles & Tunnels (closed surfaces)")
+            return
+        layout.template_list("TOPSTOC_UL_loops", "", topology, "loops", topology, "loop_index", rows=4)
+        active = analysis.active_loop(obj)
+        row = layout.row(align=True)
+        row.operator("topstoc.loop_step", text="", icon="TRIA_LEFT").direction = "PREVIOUS"
+        row.operator("topstoc.loop_step", text="", icon="TRIA_RIGHT").direction = "NEXT"
+        if active is None:
+            return
+        row.separator()
+        row.operator("topstoc.select_loop", text="Select")
+        if active.kind == "BOUNDARY":
+            row.operator("topstoc.fill_holes", text="Fill").mode = "ACTIVE"
+        else:
+            row.operator("topstoc.cut_loop", text="Cut")
+            row.operator("topstoc.remove_loop", text="Remove")
+        layout.label(text=f"{active.name}: {active.num_edges} edges, length {active.length:.4g}")
+
+
+class TOPSTOC_PT_topology_edit(_Panel, bpy.types.Panel):
+    bl_label = "Edit"
+    bl_idname = "TOPSTOC_PT_topology_edit"
+    bl_parent_id = "TOPSTOC_PT_topology"
+
+    def draw(self, context):
+        layout = self.layout
+        obj = _mesh(context)
+        if obj is not None and obj.topstoc.topology.edit_message:
+            topology = obj.topstoc.topology
+            wrapped(layout, context, topology.edit_message, "ERROR" if topology.edit_state == "ERROR" else "CHECKMARK")
+        col = layout.column(align=True)
+        col.operator("topstoc.fill_holes", text="Fill Selected Holes", icon="MOD_SOLIDIFY").mode = "SELECTED"
+        col.operator("topstoc.fill_holes", text="Fill All Holes", icon="MOD_SOLIDIFY").mode = "ALL"
+        col.operator("topstoc.delete_faces", icon="TRASH")
+
+
+class TOPSTOC_PT_topology_overlays(_Panel, bpy.types.Panel):
+    bl_label = "Overlays"
+    bl_idname = "TOPSTOC_PT_topology_overlays"
+    bl_parent_id = "TOPSTOC_PT_topology"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        show = context.scene.topstoc.overlays
+        col = layout.column(align=True)
+        for name in ("show_handles", "show_tunnels", "show_generators", "show_boundary", "show_nonmanifold"):
+            col.prop(show, name)
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        col = layout.column(align=True)
+        col.prop(show, "line_width")
+        col.prop(show, "active_width")
+        col.prop(show, "point_size")
+
+
+CLASSES = (TOPSTOC_UL_components, TOPSTOC_UL_loops, TOPSTOC_PT_topology, TOPSTOC_PT_topology_components,
+           TOPSTOC_PT_topology_loops, TOPSTOC_PT_topology_edit, TOPSTOC_PT_topology_overlays)

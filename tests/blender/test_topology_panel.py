@@ -1,0 +1,436 @@
+"""Topology panel data and operators inside Blender: invariants against an independent
+implementation (tests/reference.py), loops found and stepped through, select / cut / remove /
+fill / delete with the invariants updated and attributes kept, undo restoring the mesh and its
+analysis, bad input reported without a trace, and the overlays' arrays."""
+
+import importlib
+
+import bpy
+import numpy as np
+import pytest
+
+import meshgen
+import reference
+from conftest import DATA
+from helpers import make_object, positions, select_only
+
+
+@pytest.fixture
+def mods(ts):
+    names = {"analysis": "blender.analysis", "overlay_data": "blender.overlay_data", "panel": "blender.ui.topology",
+             "colors": "core.colors", "watch": "blender.watch", "mesh_edit": "blender.mesh_edit"}
+    return type("Mods", (), {key: importlib.import_module(f"{ts.__name__}.{name}") for key, name in names.items()})
+
+
+def load(name, path):
+    vertices, faces = reference.read_off(DATA / path)
+    return make_object(name, vertices, faces)
+
+
+def triangles_of(mesh):
+    mesh.calc_loop_triangles()
+    return np.array([t.vertices[:] for t in mesh.loop_triangles], dtype=np.int64).reshape(-1, 3)
+
+
+def expected(mesh):
+    """(V, E, F, duplicate triangles, per-component (chi, boundary loops, manifold, orientable)),
+    computed independently on the complex (a repeated triangle is one simplex)."""
+    triangles = triangles_of(mesh)
+    unique = np.unique(np.sort(triangles, axis=1), axis=0)
+    return (len(mesh.vertices), len(mesh.edges), len(mesh.polygons), len(triangles) - len(unique),
+            reference.invariants(len(mesh.vertices), unique))
+
+
+def panel_invariants(topology):
+    return sorted((c.euler, c.boundary_loops if c.manifold else None, c.manifold,
+                   c.orientable if c.manifold else None) for c in topology.components)
+
+
+def reference_invariants(components):
+    """Boundary loops compared on manifold components only: where boundary edges meet at a
+    non-manifold edge the engine reports open chains, the reference one edge component."""
+    return sorted(((chi, loops if manifold else None, manifold, orientable)
+                   for chi, loops, manifold, orientable in components), key=order)
+
+
+def order(row):
+    return row[0], row[2], -1 if row[1] is None else row[1]
+
+
+def assert_matches_reference(obj):
+    topology = obj.topstoc.topology
+    v, e, f, duplicates, components = expected(obj.data)
+    assert (topology.vertices, topology.edges, topology.faces) == (v, e, f)
+    assert topology.duplicate_triangles == duplicates
+    assert sorted(panel_invariants(topology), key=order) == reference_invariants(components)
+    assert topology.euler == v - e + f - duplicates
+    assert topology.betti0 == len(components)
+    if all(c[2] and c[3] for c in components):
+        assert topology.genus == sum(reference.euler_genus(c[0], c[1]) for c in components)
+    assert topology.boundary_loops == sum(c[1] for c in components if c[2])
+
+
+def is_edge_cycle(mesh, ids):
+    t = triangles_of(mesh)
+    edges = {tuple(sorted(p)) for tri in t for p in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0]))}
+    return len(set(ids)) == len(ids) >= 3 and all(tuple(sorted((a, b))) in edges
+                                                  for a, b in zip(ids, np.roll(ids, -1)))
+
+
+@pytest.mark.parametrize("path", ["genus_positive/cgal_eight.off", "genus_positive/cgal_elephant.off",
+                                  "open_boundary/cgal_mushroom.off", "open_boundary/kivy_suzanne_monkey.obj"])
+def test_analyse_matches_an_independent_count(mods, scene, path):
+    if path.endswith(".obj"):
+        bpy.ops.wm.obj_import(filepath=str(DATA / path))
+        obj = bpy.context.selected_objects[0]
+        select_only(obj)  # Suzanne has quads: V, E, F are Blender's counts
+    else:
+        obj = load("Mesh", path)
+    assert bpy.ops.topstoc.analyse() == {"FINISHED"}
+    assert obj.topstoc.topology.state == "OK"
+    assert_matches_reference(obj)
+    assert mods.analysis.is_current(obj)
+
+
+def test_quad_torus_and_loose_edges(mods, scene):
+    bpy.ops.mesh.primitive_torus_add(major_segments=24, minor_segments=12)
+    obj = bpy.context.active_object
+    mesh = obj.data
+    mesh.vertices.add(2)
+    mesh.edges.add(1)
+    mesh.edges[-1].vertices = (len(mesh.vertices) - 2, len(mesh.vertices) - 1)
+    mesh.update()
+    assert bpy.ops.topstoc.analyse() == {"FINISHED"}
+    t = obj.topstoc.topology
+    assert (t.vertices, t.edges, t.faces) == (24 * 12 + 2, 2 * 24 * 12 + 1, 24 * 12)
+    assert (t.betti0, t.betti1, t.betti2, t.euler) == (2, 2, 1, 1)  # torus + a wire edge
+    surface = [c for c in t.components if c.faces]
+    assert len(surface) == 1 and surface[0].genus == 1 and surface[0].faces == 24 * 12
+    assert len(t["generator_edges"]) == 2 * 2
+
+
+def test_find_loops_step_and_select(mods, scene):
+    obj = load("Eight", "genus_positive/cgal_eight.off")
+    assert bpy.ops.topstoc.analyse() == {"FINISHED"}
+    assert bpy.ops.topstoc.find_loops() == {"FINISHED"}
+    t = obj.topstoc.topology
+    kinds = [loop.kind for loop in t.loops]
+    assert kinds.count("HANDLE") == 2 and kinds.count("TUNNEL") == 2 and t.loops_state == "OK"
+    for loop in t.loops:
+        ids = mods.analysis.loop_vertices(loop)
+        assert is_edge_cycle(obj.data, ids) and loop.num_edges == len(ids)
+        co = positions(obj.data).astype(float)
+        assert loop.length == pytest.approx(np.linalg.norm(co[ids] - co[np.roll(ids, -1)], axis=1).sum(), rel=1e-5)
+    t.loop_index = 0
+    assert bpy.ops.topstoc.loop_step(direction="PREVIOUS") == {"FINISHED"} and t.loop_index == 3
+    assert bpy.ops.topstoc.loop_step(direction="NEXT") == {"FINISHED"} and t.loop_index == 0
+    bpy.ops.topstoc.loop_step(direction="NEXT")
+    ids = mods.analysis.loop_vertices(t.loops[1])
+    assert bpy.ops.topstoc.select_loop() == {"FINISHED"} and obj.mode == "EDIT"
+    bpy.ops.object.mode_set(mode="OBJECT")
+    selected = {tuple(sorted(e.vertices)) for e in obj.data.edges if e.select}
+    assert selected == {tuple(sorted((int(a), int(b)))) for a, b in zip(ids, np.roll(ids, -1))}
+    assert not any(p.select for p in obj.data.polygons)
+
+
+def add_attributes(obj):
+    mesh = obj.data
+    uv = mesh.uv_layers.new(name="UVMap")
+    values = np.random.default_rng(0).random(2 * len(mesh.loops)).astype(np.float32)
+    uv.data.foreach_set("uv", values)
+    ids = mesh.attributes.new("vertex_id", "INT", "POINT")
+    ids.data.foreach_set("value", np.arange(len(mesh.vertices), dtype=np.int32))
+    group = obj.vertex_groups.new(name="Group")
+    group.add(list(range(0, len(mesh.vertices), 3)), 0.5, "REPLACE")
+    mesh.edges[0].use_seam = True
+    return values.reshape(-1, 2)
+
+
+def test_remove_and_cut_update_invariants_and_keep_attributes(mods, scene):
+    obj = load("Eight", "genus_positive/cgal_eight.off")
+    uvs = add_attributes(obj)
+    loop_vertex = np.array([loop.vertex_index for loop in obj.data.loops])
+    seam = tuple(sorted(obj.data.edges[0].vertices))
+    assert bpy.ops.topstoc.find_loops() == {"FINISHED"}
+    t = obj.topstoc.topology
+    t.loop_index = [loop.kind for loop in t.loops].index("HANDLE")
+    handle = mods.analysis.loop_vertices(t.loops[t.loop_index])
+    assert bpy.ops.topstoc.remove_loop() == {"FINISHED"}
+    assert_matches_reference(obj)
+    assert t.genus == 1 and t.boundary_loops == 0 and t.betti1 == 2
+    mesh = obj.data
+    # every vertex keeps its attribute: copies carry their source id, patch vertices none here
+    ids = np.empty(len(mesh.vertices), dtype=np.int32)
+    mesh.attributes["vertex_id"].data.foreach_get("value", ids)
+    co_new = positions(mesh)
+    untouched = ~np.isin(ids, handle)
+    reference_co = np.array(reference.read_off(DATA / "genus_positive/cgal_eight.off")[0], dtype=np.float32)
+    np.testing.assert_allclose(co_new[untouched], reference_co[ids[untouched]], atol=1e-6)
+    # corners away from the loop keep their UVs exactly
+    new_uv = np.empty(2 * len(mesh.loops), dtype=np.float32)
+    mesh.uv_layers["UVMap"].data.foreach_get("uv", new_uv)
+    new_uv = new_uv.reshape(-1, 2)
+    old_corner = {(int(loop_vertex[i]), tuple(uvs[i])) for i in range(len(loop_vertex))}
+    kept = [(int(ids[mesh.loops[i].vertex_index]), tuple(new_uv[i])) for i in range(len(mesh.loops))]
+    assert sum(k in old_corner for k in kept) >= 0.9 * len(kept)
+    assert all(len(v.groups) == (1 if ids[v.index] % 3 == 0 else 0) for v in mesh.vertices)
+    assert any(e.use_seam and tuple(sorted(ids[list(e.vertices)])) == seam for e in mesh.edges)
+    # the other handle and tunnel loops were carried over as edge cycles of the new mesh
+    kinds = [loop.kind for loop in t.loops]
+    assert kinds.count("HANDLE") == 1
+    for loop in t.loops:
+        assert is_edge_cycle(mesh, mods.analysis.loop_vertices(loop))
+    t.loop_index = kinds.index("HANDLE")
+    assert bpy.ops.topstoc.cut_loop() == {"FINISHED"}
+    assert_matches_reference(obj)
+    assert t.genus == 0 and t.boundary_loops == 2
+    boundaries = [loop for loop in t.loops if loop.kind == "BOUNDARY"]
+    assert len(boundaries) == 2 and all(loop.fillable for loop in boundaries)
+    t.loop_index = list(t.loops).index(boundaries[0])
+    assert bpy.ops.topstoc.fill_holes(mode="ACTIVE") == {"FINISHED"}
+    assert t.boundary_loops == 1
+    assert_matches_reference(obj)
+
+
+def test_fill_selected_all_and_delete_faces(mods, scene):
+    obj = load("Elephant", "open_boundary/cgal_elephant-with-holes.off")
+    assert bpy.ops.topstoc.analyse() == {"FINISHED"}
+    t = obj.topstoc.topology
+    holes = t.boundary_loops
+    assert holes >= 2
+    mesh = obj.data
+    before = len(mesh.polygons)
+    mesh.vertices.foreach_set("select", np.zeros(len(mesh.vertices), dtype=bool))
+    with pytest.raises(RuntimeError, match="no hole has a selected boundary edge"):
+        bpy.ops.topstoc.fill_holes(mode="SELECTED")
+    assert len(obj.data.polygons) == before and t.boundary_loops == holes       # nothing lost
+    assert t.edit_state == "ERROR" and "no hole has a selected boundary edge" in t.edit_message  # in the panel
+    first = mods.analysis.loop_vertices([loop for loop in t.loops if loop.kind == "BOUNDARY"][0])
+    mesh = obj.data
+    mesh.vertices.foreach_set("select", np.isin(np.arange(len(mesh.vertices)), first[:2]))
+    assert bpy.ops.topstoc.fill_holes(mode="SELECTED") == {"FINISHED"}
+    assert t.boundary_loops == holes - 1
+    assert_matches_reference(obj)
+    assert bpy.ops.topstoc.fill_holes(mode="ALL") == {"FINISHED"}
+    assert t.boundary_loops == 0 and all(c.closed for c in t.components)
+    assert_matches_reference(obj)
+    mesh = obj.data
+    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), dtype=bool))
+    with pytest.raises(RuntimeError, match="no faces are selected"):
+        bpy.ops.topstoc.delete_faces()
+    count = len(obj.data.polygons)
+    mesh.polygons[10].select = True
+    assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
+    assert len(obj.data.polygons) == count - 1 and t.boundary_loops == 1
+    assert_matches_reference(obj)
+    assert t.genus == 3
+
+
+def test_edit_mode_operators_and_quads(mods, scene):
+    bpy.ops.mesh.primitive_torus_add(major_segments=16, minor_segments=8)
+    obj = bpy.context.active_object
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.select_all(action="DESELECT")
+    bpy.ops.object.mode_set(mode="OBJECT")
+    obj.data.polygons[0].select = True
+    bpy.ops.object.mode_set(mode="EDIT")
+    assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
+    assert obj.mode == "EDIT"                                     # back where the user was
+    bpy.ops.object.mode_set(mode="OBJECT")
+    t = obj.topstoc.topology
+    assert len(obj.data.polygons) == 16 * 8 - 1 and t.boundary_loops == 1
+    assert all(len(p.vertices) == 4 for p in obj.data.polygons)   # quads stay quads
+    assert bpy.ops.topstoc.fill_holes(mode="ALL") == {"FINISHED"}
+    assert t.boundary_loops == 0 and t.genus == 1
+    assert sum(len(p.vertices) == 4 for p in obj.data.polygons) == 16 * 8 - 1
+
+
+def state(obj):
+    t = obj.topstoc.topology
+    if obj.mode == "EDIT":  # Edit Mode selection lives in the edit mesh (left as the user would)
+        import bmesh
+
+        selected = sum(e.select for e in bmesh.from_edit_mesh(obj.data).edges)
+    else:
+        selected = sum(e.select for e in obj.data.edges)
+    return (len(obj.data.vertices), len(obj.data.polygons), t.genus, t.boundary_loops, len(t.loops), selected)
+
+
+def prepare_for(operator, obj, mods):
+    """Makes the active loop / the selection what ``operator`` needs; returns its kwargs."""
+    t = obj.topstoc.topology
+    mesh = obj.data
+    mesh.vertices.foreach_set("select", np.zeros(len(mesh.vertices), dtype=bool))
+    mesh.edges.foreach_set("select", np.zeros(len(mesh.edges), dtype=bool))
+    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), dtype=bool))
+    if operator in ("select_loop", "cut_loop", "remove_loop"):
+        t.loop_index = [loop.kind for loop in t.loops].index("HANDLE")
+        return {}
+    if operator == "delete_faces":
+        mesh.polygons[7].select = True
+        return {}
+    # fill_holes: cut first (so there are holes), then select one of them
+    t.loop_index = [loop.kind for loop in t.loops].index("HANDLE")
+    assert bpy.ops.topstoc.cut_loop() == {"FINISHED"}
+    hole = mods.analysis.loop_vertices([loop for loop in t.loops if loop.kind == "BOUNDARY"][0])
+    obj.data.vertices.foreach_set("select", np.isin(np.arange(len(obj.data.vertices)), hole))
+    return {"mode": "SELECTED"}
+
+
+@pytest.mark.parametrize("operator", ["select_loop", "cut_loop", "remove_loop", "fill_holes", "delete_faces"])
+def test_every_operator_updates_the_invariants_and_undo_restores(mods, scene, operator):
+    obj = load("Eight", "genus_positive/cgal_eight.off")
+    name = obj.name
+    assert bpy.ops.topstoc.find_loops() == {"FINISHED"}
+    kwargs = prepare_for(operator, obj, mods)
+    bpy.ops.ed.undo_push(message="before")
+    before = state(obj)
+    assert getattr(bpy.ops.topstoc, operator)("EXEC_DEFAULT", True, **kwargs) == {"FINISHED"}  # True: push undo
+    obj = bpy.data.objects[name]
+    after = state(obj)
+    assert after != before
+    if operator != "select_loop":
+        assert_matches_reference(obj)  # re-analysed automatically
+        assert mods.analysis.is_current(obj, fresh=True)
+    bpy.ops.ed.undo()
+    obj = bpy.data.objects[name]                                  # undo replaces Python references
+    assert obj.mode == "OBJECT" and state(obj) == before
+    assert mods.analysis.is_current(obj, fresh=True)              # the analysis came back with the mesh
+    assert_matches_reference(obj)
+
+
+def test_self_intersecting_mesh_reports_the_tetgen_refusal(mods, scene):
+    v, f = meshgen.torus(24, 12, major=0.3, minor=0.35)  # a spindle torus: the tube passes through itself
+    obj = make_object("Spindle", v, f)
+    assert bpy.ops.topstoc.analyse() == {"FINISHED"} and obj.topstoc.topology.genus == 1
+    with pytest.raises(RuntimeError, match="intersects itself") as error:
+        bpy.ops.topstoc.find_loops()
+    t = obj.topstoc.topology
+    assert t.loops_state == "ERROR" and "intersects itself" in t.loops_message
+    assert "Spindle" in str(error.value) and "Traceback" not in t.loops_message
+    assert len(obj.data.vertices) == len(v) and t.state == "OK"   # nothing lost, invariants kept
+
+
+def test_nonmanifold_mesh_loop_search_reports_in_the_panel(mods, ts, scene):
+    data = importlib.import_module(ts.__name__ + ".core.io").read_mesh(
+        str(DATA / "nonmanifold_degenerate/openscad_issue1580-back-to-back.stl"))
+    obj = make_object("Scan", data.vertices, data.triangles)
+    assert bpy.ops.topstoc.analyse() == {"FINISHED"}
+    t = obj.topstoc.topology
+    assert t.nonmanifold_edges == 2 and t.nonmanifold_vertices == 3 and t.genus == -1
+    assert t.duplicate_triangles == 1                   # the shared face, counted once (and shown)
+    assert_matches_reference(obj)
+    count = len(obj.data.polygons)
+    with pytest.raises(RuntimeError, match="manifold"):
+        bpy.ops.topstoc.find_loops()
+    assert t.loops_state == "ERROR" and "manifold" in t.loops_message and "Traceback" not in t.loops_message
+    assert len(obj.data.polygons) == count
+    shown = mods.overlay_data.topology_primitives(obj, bpy.context.scene.topstoc.overlays)
+    assert {p.name for p in shown} >= {"nonmanifold_edges"}
+
+
+def test_overlay_arrays_follow_the_analysis(mods, scene):
+    obj = load("Eight", "genus_positive/cgal_eight.off")
+    bpy.ops.topstoc.find_loops()
+    t = obj.topstoc.topology
+    show = bpy.context.scene.topstoc.overlays
+    t.loop_index = 1
+    prims = {p.name: p for p in mods.overlay_data.topology_primitives(obj, show)}
+    co = positions(obj.data)
+    active = mods.analysis.loop_vertices(t.loops[1])
+    np.testing.assert_allclose(prims["active_loop"].positions.reshape(-1, 2, 3)[:, 0], co[active])
+    assert prims["active_loop"].size == "active" and prims["active_loop"].color == mods.colors.HANDLE
+    handle_edges = sum(loop.num_edges for i, loop in enumerate(t.loops) if loop.kind == "HANDLE" and i != 1)
+    assert len(prims["handles"]) == 2 * handle_edges and prims["tunnels"].color == mods.colors.TUNNEL
+    assert len(prims["generators"]) == 2 * 4 and prims["generators"].color == mods.colors.GENERATOR
+    show.show_handles = False
+    names = {p.name for p in mods.overlay_data.topology_primitives(obj, show)}
+    assert "handles" not in names and "active_loop" not in names and "tunnels" in names
+    # a changed mesh draws nothing rather than loops at wrong places
+    bpy.ops.mesh.primitive_cube_add()
+    obj.data = bpy.context.active_object.data
+    assert mods.overlay_data.topology_primitives(obj, show) == []
+
+
+def test_topology_panels_draw_in_every_state(mods, scene):
+    from test_registration import RecordingLayout
+
+    obj = load("Eight", "genus_positive/cgal_eight.off")
+    seen = set()
+    for step in ("none", "analysed", "loops", "error"):
+        if step == "analysed":
+            bpy.ops.topstoc.analyse()
+        elif step == "loops":
+            bpy.ops.topstoc.find_loops()
+        elif step == "error":
+            obj.topstoc.topology.state, obj.topstoc.topology.message = "ERROR", "a clear message " * 8
+        for cls in mods.panel.CLASSES:
+            if not hasattr(cls, "draw") or issubclass(cls, bpy.types.UIList):
+                continue
+            if hasattr(cls, "poll") and not cls.poll(bpy.context):
+                continue
+            fake = type("P", (), {"layout": RecordingLayout(seen)})()
+            cls.draw(fake, bpy.context)
+    assert {"topstoc.analyse", "topstoc.find_loops", "topstoc.loop_step", "topstoc.select_loop",
+            "topstoc.cut_loop", "topstoc.remove_loop", "topstoc.fill_holes", "topstoc.delete_faces",
+            "show_handles", "show_generators", "line_width"} <= seen
+    rows = dict(mods.panel.invariant_rows(obj.topstoc.topology))
+    assert rows["Genus"] == "2" and rows["β0 / β1 / β2"] == "1 / 4 / 1" and rows["χ"] == "-2"
+
+
+def test_edit_mode_delete_undo_gives_the_faces_back(mods, scene):
+    import bmesh
+
+    obj = load("Eight", "genus_positive/cgal_eight.off")
+    name = obj.name
+    bpy.ops.topstoc.analyse()
+    mesh = obj.data
+    mesh.vertices.foreach_set("select", np.zeros(len(mesh.vertices), dtype=bool))
+    mesh.edges.foreach_set("select", np.zeros(len(mesh.edges), dtype=bool))
+    mesh.polygons.foreach_set("select", np.arange(len(mesh.polygons)) < 5)
+    bpy.context.tool_settings.mesh_select_mode = (False, False, True)
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.ed.undo_push(message="selected")
+    assert bpy.ops.topstoc.delete_faces("EXEC_DEFAULT", True) == {"FINISHED"}
+    obj = bpy.data.objects[name]
+    assert obj.mode == "EDIT" and len(bmesh.from_edit_mesh(obj.data).faces) == 634 - 5
+    assert obj.topstoc.topology.boundary_loops >= 1
+    bpy.ops.ed.undo()
+    obj = bpy.data.objects[name]
+    assert obj.mode == "EDIT" and len(bmesh.from_edit_mesh(obj.data).faces) == 634
+    bpy.ops.object.mode_set(mode="OBJECT")
+    # The panel never shows figures of another mesh: either the analysis came back with the
+    # mesh, or it knows it no longer fits (and the overlays show nothing).
+    if mods.analysis.is_current(obj, fresh=True):
+        assert_matches_reference(obj)
+    else:
+        assert mods.overlay_data.topology_primitives(obj, bpy.context.scene.topstoc.overlays) == []
+    assert bpy.ops.topstoc.analyse() == {"FINISHED"} and obj.topstoc.topology.genus == 2
+
+
+def test_loops_through_quad_diagonals_cut_and_remove(mods, scene):
+    bpy.ops.mesh.primitive_torus_add(major_segments=20, minor_segments=10)
+    obj = bpy.context.active_object
+    uv_before = {}
+    mesh = obj.data
+    uv = mesh.uv_layers.active.data
+    for poly in mesh.polygons:
+        uv_before[tuple(sorted(poly.vertices))] = sorted(tuple(uv[i].uv) for i in poly.loop_indices)
+    assert bpy.ops.topstoc.find_loops() == {"FINISHED"}
+    t = obj.topstoc.topology
+    assert [loop.kind for loop in t.loops].count("HANDLE") == 1
+    t.loop_index = [loop.kind for loop in t.loops].index("TUNNEL")
+    assert bpy.ops.topstoc.remove_loop() == {"FINISHED"}
+    assert t.genus == 0 and t.boundary_loops == 0
+    assert_matches_reference(obj)
+    mesh = obj.data
+    sizes = [len(p.vertices) for p in mesh.polygons]
+    assert sizes.count(4) >= 20 * 10 - 2 * 20  # quads away from the loop stay quads
+    uv = mesh.uv_layers.active.data
+    kept = 0
+    for poly in mesh.polygons:                 # untouched quads keep their UVs exactly
+        key = tuple(sorted(poly.vertices))
+        if len(poly.vertices) == 4 and key in uv_before:
+            assert sorted(tuple(uv[i].uv) for i in poly.loop_indices) == uv_before[key]
+            kept += 1
+    assert kept >= 20 * 10 - 2 * 20 - 2

@@ -1,0 +1,62 @@
+"""Real-GUI tests: each test builds a scene with `blender -b`, then opens it in a windowed
+Blender under `xvfb-run -a` that runs one script (several checks and screenshots per launch).
+The tests themselves run in plain Python (no bpy): they read the script's report.json and the
+screenshots' pixels (.npy) and check colours in the objects' screen regions.
+
+    python -m pytest tests/gui        # needs xvfb-run, blender and a build (skips otherwise)
+"""
+
+import json
+import os
+import pathlib
+import shutil
+import subprocess
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+BUILD = pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build"))
+DATA = ROOT / "tests" / "data"
+HERE = pathlib.Path(__file__).resolve().parent
+XVFB = shutil.which("xvfb-run")
+BLENDER = shutil.which("blender")
+
+
+def _environment():
+    return dict(os.environ, TOPSTOC_BUILD_PYTHON=str(BUILD / "python"), PYTHONPATH="")
+
+
+@pytest.fixture(scope="session")
+def gui():
+    """Skips unless a windowed Blender can run here."""
+    if XVFB is None or BLENDER is None:
+        pytest.skip("needs xvfb-run and a blender executable")
+    if not (BUILD / "python" / "topstoc" / "__init__.py").exists():
+        pytest.skip(f"no staged package under {BUILD}; build first")
+    return GuiRunner()
+
+
+class GuiRunner:
+    def scene(self, path: pathlib.Path, *args, timeout: int = 300) -> pathlib.Path:
+        """Makes a saved scene with tests/gui/make_scene.py (background Blender)."""
+        command = [BLENDER, "-b", "--factory-startup", "--python-exit-code", "1",
+                   "--python", str(HERE / "make_scene.py"), "--", "--output", str(path), *map(str, args)]
+        done = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=_environment())
+        assert done.returncode == 0 and path.exists(), done.stdout[-3000:] + done.stderr[-3000:]
+        return path
+
+    def run(self, script: str, scene: pathlib.Path, out: pathlib.Path, *args, timeout: int = 300) -> dict:
+        """Opens ``scene`` in a windowed Blender running tests/gui/<script>; returns its report."""
+        out.mkdir(parents=True, exist_ok=True)
+        command = [XVFB, "-a", "-s", "-screen 0 1280x1024x24", BLENDER, "--factory-startup",
+                   "--enable-event-simulate", str(scene),
+                   "--python-exit-code", "1", "--python", str(HERE / script), "--", str(out), *map(str, args)]
+        done = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=_environment(),
+                              cwd=str(HERE))
+        report_path = out / "report.json"
+        assert report_path.exists(), done.stdout[-4000:] + done.stderr[-4000:]
+        report = json.loads(report_path.read_text())
+        assert report["error"] is None, report["error"]
+        assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-4000:]
+        report["log"] = done.stdout
+        return report
