@@ -167,6 +167,13 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
       result.positions[3 * size_t(output_index[s]) + j] =
           filtered.empty() ? mesh.position(samples[s])[j] : filtered[3 * size_t(s) + j];
   }
+  // A sample with one sector has one corner to copy attributes from, whatever the triangle:
+  // find it once per sample (others walk per output corner, see attribute_corner).
+  std::vector<int32_t> single_corner(k, -1);
+#pragma omp parallel for schedule(static) if (k >= kParallelMin)
+  for (int32_t s = 0; s < k; ++s)
+    if (output_index[s] >= 0 && layout.sectors[samples[s]] <= 1)
+      single_corner[s] = attribute_corner(mesh, layout, clustering, -1, -1, samples[s]);
   const size_t t = partition.source_face.size();
   result.triangles.resize(3 * t);
   result.face_source.resize(t);
@@ -178,7 +185,9 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
     for (int j = 0; j < 3; ++j) {
       const int32_t rank = partition.triangles[3 * i + j];
       result.triangles[3 * i + j] = output_index[rank];
-      result.corner_source[3 * i + j] = attribute_corner(mesh, layout, clustering, f, j, samples[rank]);
+      result.corner_source[3 * i + j] = single_corner[rank] >= 0
+                                            ? single_corner[rank]
+                                            : attribute_corner(mesh, layout, clustering, f, j, samples[rank]);
     }
   }
   // Public ids are the caller's.
