@@ -9,13 +9,23 @@ build || exit 1
 
 # A venv on top of the system site packages (numpy, scipy, gudhi, pytest from Debian) that adds
 # the peers only PyPI has: bpy 4.2 (Blender 4.2 LTS as a module, CPython 3.11) and pymeshlab.
-# numpy stays below 2 (pybind11 2.10 predates numpy 2; Blender 4.2 ships numpy 1.26).
+# numpy stays below 2 there (Blender 4.2 ships numpy 1.26); NumPy 2 gets its own venv below.
 VENV=.venv
 if [ ! -x $VENV/bin/python ] || ! $VENV/bin/python -c "import bpy, pymeshlab" 2>/dev/null; then
   echo "== preparing $VENV (bpy 4.2, pymeshlab from PyPI; first run downloads ~600 MB)"
   /usr/bin/python3 -m venv --system-site-packages $VENV &&
     $VENV/bin/pip install -q --disable-pip-version-check "bpy==4.2.*" "pymeshlab==2023.12.post3" "numpy<2" ||
     echo "warning: could not prepare $VENV; suites that need bpy 4.x or pymeshlab will fail" >&2
+fi
+
+# A plain venv with NumPy 2 from PyPI (and a scipy built for it): pip users get NumPy 2 by default,
+# and the module is built with Debian's pybind11 2.10, which predates it.
+VENV2=.venv-numpy2
+if [ ! -x $VENV2/bin/python ] || ! $VENV2/bin/python -c "import numpy, scipy, gudhi, pytest; assert numpy.__version__ >= '2'" 2>/dev/null; then
+  echo "== preparing $VENV2 (numpy 2, scipy, gudhi, pytest from PyPI)"
+  /usr/bin/python3 -m venv $VENV2 &&
+    $VENV2/bin/pip install -q --disable-pip-version-check "numpy>=2,<3" scipy gudhi pytest ||
+    echo "warning: could not prepare $VENV2; the NumPy 2 suite will fail" >&2
 fi
 
 failed=()
@@ -26,6 +36,7 @@ run() {  # run NAME COMMAND...
 }
 PYTEST_ARGS=(-q -p no:cacheprovider)
 run "engine and Python API (python3 + pymeshlab)" $VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/python
+run "Python API with NumPy 2 (PyPI)" $VENV2/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/python
 if [ -d tests/blender ]; then
   run "add-on in Blender $(blender -v 2>/dev/null | head -1 | awk '{print $2}')" \
     blender -b --factory-startup --python-exit-code 1 --python-expr \

@@ -32,13 +32,15 @@ std::vector<double> scalars_from(const py::handle& array, int64_t n, const char*
 std::vector<int32_t> ids_from(const py::handle& array, int64_t n, const char* what);
 
 /// Moves a vector into a numpy array without copying; shape given by `rows` x `columns`
-/// (columns == 0 gives a 1-D array).
+/// (columns == 0 gives a 1-D array). Strides are given explicitly: pybind11 2.10 derives them
+/// from the dtype's item size with NumPy 1's struct layout, which reads 0 under NumPy 2.
 template <class T>
 py::array_t<T> to_array(std::vector<T>&& data, int64_t columns = 0) {
   auto* owned = new std::vector<T>(std::move(data));
   py::capsule release(owned, [](void* p) { delete static_cast<std::vector<T>*>(p); });
-  if (columns == 0) return py::array_t<T>({int64_t(owned->size())}, owned->data(), release);
-  return py::array_t<T>({int64_t(owned->size()) / columns, columns}, owned->data(), release);
+  const int64_t item = sizeof(T);
+  if (columns == 0) return py::array_t<T>({int64_t(owned->size())}, {item}, owned->data(), release);
+  return py::array_t<T>({int64_t(owned->size()) / columns, columns}, {columns * item, item}, owned->data(), release);
 }
 
 template <class T>
