@@ -157,7 +157,7 @@ void bind_decimate(py::module_& m) {
         params.target_vertices = target_vertices;
         DecimateResult r;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           r = target_triangles > 0 ? decimate_to_triangles(mesh, layout, params, target_triangles)
                                    : decimate(mesh, layout, params);
         }
@@ -177,7 +177,7 @@ void bind_decimate(py::module_& m) {
         auto ids = ids_from(samples, -1, "samples");
         DecimateResult r;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           r = decimate_with_samples(mesh, layout, std::move(ids), placement_from(placement), max_repair_rounds);
         }
         return result_dict(std::move(r));
@@ -194,7 +194,7 @@ void bind_decimate(py::module_& m) {
         auto s = sampling_from(mesh, seed, adaptivity, flat_floor, area_weighted, u, "off", 0, 2.0, 0.0, view, boxes);
         std::vector<double> p;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           p = by_caller(mesh, sampling_probabilities(mesh, layout, s, rate));
         }
         return to_array(std::move(p));

@@ -76,7 +76,7 @@ void bind_edit(py::module_& m) {
         const auto ids = ids_from(faces, -1, "faces");
         EditResult r;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           r = delete_faces(a.positions.data(), a.num_vertices(), a.triangles.data(), a.num_triangles(), ids.data(),
                            int64_t(ids.size()));
         }
@@ -92,7 +92,7 @@ void bind_edit(py::module_& m) {
         const auto ids = ids_from(loop, -1, "loop");
         EditResult r;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           r = cut_along_loop(a.positions.data(), a.num_vertices(), a.triangles.data(), a.num_triangles(), ids.data(),
                              static_cast<int32_t>(ids.size()));
         }
@@ -107,7 +107,7 @@ void bind_edit(py::module_& m) {
         const auto t = indices_from(triangles, 3, "triangles");
         std::vector<BoundaryLoop> loops;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           loops = boundary_loops(t.data(), int64_t(t.size() / 3), num_vertices);
         }
         py::list out;
@@ -132,7 +132,7 @@ void bind_edit(py::module_& m) {
         const FillOptions options = fill_options(planar, max_dp_corners, refine, fair);
         EditResult r;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           r = fill_holes(a.positions.data(), a.num_vertices(), a.triangles.data(), a.num_triangles(), selection,
                          options);
         }
@@ -153,7 +153,7 @@ void bind_edit(py::module_& m) {
         const FillOptions options = fill_options(planar, max_dp_corners, refine, fair);
         EditResult r;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           r = fill_loops(a.positions.data(), a.num_vertices(), a.triangles.data(), a.num_triangles(), holes, options);
         }
         return result_dict(std::move(r));
@@ -176,7 +176,7 @@ void bind_edit(py::module_& m) {
         options.separation = separation;
         EditResult r;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           r = remove_handle(a.positions.data(), a.num_vertices(), a.triangles.data(), a.num_triangles(), ids.data(),
                             static_cast<int32_t>(ids.size()), options);
         }

@@ -11,7 +11,7 @@ namespace {
 std::shared_ptr<Surface> make_surface(const py::handle& vertices, const py::handle& triangles) {
   auto positions = positions_from(vertices, "vertices");
   auto tris = indices_from(triangles, 3, "triangles");
-  py::gil_scoped_release release;
+  EngineCall call;
   return std::make_shared<Surface>(std::move(positions), std::move(tris));
 }
 
@@ -70,7 +70,7 @@ void bind_hausdorff(py::module_& m) {
   m.def(
       "sample_surface",
       [](const Surface& surface, double step) {
-        py::gil_scoped_release release;
+        EngineCall call;
         return std::make_shared<SurfaceSamples>(sample_surface(surface, step));
       },
       py::arg("surface"), py::arg("step"), "Samples a surface with spacing `step` (Aspert et al. 2002).");
@@ -78,7 +78,7 @@ void bind_hausdorff(py::module_& m) {
   m.def(
       "step_for_sample_count",
       [](const Surface& surface, int64_t samples) {
-        py::gil_scoped_release release;
+        EngineCall call;
         return step_for_sample_count(surface, samples);
       },
       py::arg("surface"), py::arg("samples"), "Sample spacing that gives about `samples` samples.");
@@ -93,7 +93,7 @@ void bind_hausdorff(py::module_& m) {
             throw py::value_error("point " + std::to_string(i) + " has a non-finite coordinate");
         std::vector<ClosestHit> hits;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           hits = closest_points(surface, p.data(), n);
         }
         std::vector<double> distance(n), closest(3 * n);
@@ -120,7 +120,7 @@ void bind_hausdorff(py::module_& m) {
         params.percentile = percentile;
         HausdorffResult r;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           r = hausdorff(a, b, params);
         }
         return result_dict(std::move(r));
@@ -133,7 +133,7 @@ void bind_hausdorff(py::module_& m) {
       [](const Surface& a, const SurfaceSamples& a_samples, const Surface& b, double percentile) {
         HausdorffResult r;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           r = hausdorff(a, a_samples, b, percentile);
         }
         return result_dict(std::move(r));

@@ -43,7 +43,7 @@ void bind_io(py::module_& m) {
         if (info.itemsize != 1 || info.ndim != 1) throw py::value_error("data must be a bytes-like object");
         MeshFile file;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           file = read_mesh_file(static_cast<const char*>(info.ptr), size_t(info.size), kind);
         }
         py::dict d;
@@ -89,7 +89,7 @@ void bind_io(py::module_& m) {
         file.material_libraries = material_libraries;
         std::string out;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           out = write_mesh_file(file, kind);
         }
         return py::bytes(out);

@@ -91,7 +91,7 @@ void bind_loops(py::module_& m) {
         }
         LoopsResult r;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           r = compute_loops(mesh, params);
         }
         return result_dict(r);
@@ -109,7 +109,7 @@ void bind_loops(py::module_& m) {
         params.count_edges = count_edges;
         std::vector<int32_t> out;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           out = shorten_loop(mesh, ids, params, max_window);
         }
         return to_array(std::move(out));
@@ -129,7 +129,7 @@ void bind_loops(py::module_& m) {
                                   " outside [0, " + std::to_string(n) + ")");
         std::vector<std::pair<int32_t, int32_t>> pairs;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           pairs = self_intersections(p.data(), int32_t(n), t.data(), int32_t(t.size() / 3));
         }
         std::vector<int32_t> flat;
@@ -157,7 +157,7 @@ void bind_loops(py::module_& m) {
           if (!used[v]) throw py::value_error("vertex " + std::to_string(v) + " is in no triangle");
         TetMesh tets;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           tets = tetrahedralize_surface(p.data(), int32_t(n), t.data(), int32_t(t.size() / 3));
         }
         py::dict d;

@@ -34,7 +34,7 @@ void bind_mesh(py::module_& m) {
       .def(py::init([](const py::handle& vertices, const py::handle& triangles) {
              auto positions = positions_from(vertices, "vertices");
              auto tris = indices_from(triangles, 3, "triangles");
-             py::gil_scoped_release release;
+             EngineCall call;
              return std::make_shared<Mesh>(std::move(positions), tris.data(), int64_t(tris.size() / 3));
            }),
            py::arg("vertices"), py::arg("triangles"))
@@ -79,7 +79,7 @@ void bind_mesh(py::module_& m) {
         auto region_ids = ids_from(regions, mesh.report().input_triangles, "regions");
         std::vector<int32_t> edges;
         if (!borders.is_none()) edges = indices_from(borders, 2, "borders");
-        py::gil_scoped_release release;
+        EngineCall call;
         // pybind11 holders cannot be shared_ptr<const T>; Python never mutates the layout.
         return std::const_pointer_cast<FeatureLayout>(
             build_feature_layout(mesh, region_ids.empty() ? nullptr : region_ids.data(), int64_t(region_ids.size()),

@@ -87,7 +87,7 @@ void bind_topology(py::module_& m) {
         TopologyReport report;
         std::vector<ComponentGenerators> generators;
         {
-          py::gil_scoped_release release;
+          EngineCall call;
           const auto complex =
               build_complex(coordinates, num_vertices, std::move(tris), wires.data(), int64_t(wires.size() / 2));
           report = analyze_topology(complex);

@@ -6,6 +6,8 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include "topstoc/parallel.hpp"
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -30,6 +32,12 @@ std::vector<double> scalars_from(const py::handle& array, int64_t n, const char*
 
 /// 1-D integer array of length n (or None -> empty).
 std::vector<int32_t> ids_from(const py::handle& array, int64_t n, const char* what);
+
+/// Scope of one engine call: releases the GIL and sizes OpenMP teams to the cores free now.
+struct EngineCall {
+  EngineCall() { use_free_cores(); }
+  py::gil_scoped_release release;
+};
 
 /// Moves a vector into a numpy array without copying; shape given by `rows` x `columns`
 /// (columns == 0 gives a 1-D array). Strides are given explicitly: pybind11 2.10 derives them

@@ -1,11 +1,9 @@
 // The `_topstoc` extension module: registers each concept's bindings. Bindings only convert
 // arrays, release the GIL and map errors; every algorithm lives in native/src.
 #include "convert.hpp"
-#include "topstoc/parallel.hpp"
 
 PYBIND11_MODULE(_topstoc, m) {
   m.doc() = "TopStoc native engine: decimation, measurement, topology (see topstoc.core for the Python API)";
-  topstoc::adapt_threads_to_load();
   namespace tp = topstoc::python;
   tp::bind_mesh(m);
   tp::bind_decimate(m);

@@ -1,4 +1,4 @@
-// When threads pay off: only on long loops, and only when cores are free.
+// When threads pay off: only on long loops, and only on cores that are free.
 #pragma once
 
 #include <cstdint>
@@ -10,9 +10,14 @@ namespace topstoc {
 /// 500-vertex decimation took 1.3 s with spinning threads and 8 ms without).
 constexpr int64_t kParallelMin = 100000;
 
-/// Lets OpenMP use fewer threads while the machine is busy (libgomp then sizes teams by the
-/// load average). Called once when the Python module loads. Results never depend on the
-/// number of threads.
-void adapt_threads_to_load();
+/// Cores not busy right now: the online cores (capped by OMP_NUM_THREADS) minus the other
+/// runnable threads the kernel counts at this instant (/proc/loadavg), at least 1. An
+/// instantaneous count, unlike libgomp's dynamic mode, which follows the 15-minute load
+/// average and so throttles a program for work it did itself minutes ago.
+int free_cores();
+
+/// Sizes the calling thread's OpenMP teams to free_cores(); each engine entry point calls it.
+/// Results never depend on the number of threads.
+void use_free_cores();
 
 }  // namespace topstoc
