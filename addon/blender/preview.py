@@ -68,16 +68,20 @@ class PreviewSession:
         self._pending = ratio
 
     def poll(self) -> bool:
-        """Shows a finished result and starts the next request; True when the view changed."""
-        changed = False
+        """Starts the next request, then shows a finished result; True when the view changed.
+
+        The next decimation starts before the finished one is written, so that the worker
+        computes while the main thread fills the preview mesh."""
+        finished = None
         if self._future is not None and self._future.done():
-            future, self._future = self._future, None
-            self.show(*future.result())  # re-raises engine errors in the main thread
-            changed = True
-        if self._future is None and self._pending is not None and self._pending != self.ratio:
+            finished, self._future = self._future.result(), None  # re-raises engine errors here
+        latest = finished[0] if finished else self.ratio
+        if self._future is None and self._pending is not None and self._pending != latest:
             self._future = self._pool.submit(self.compute, self._pending)
             self._pending = None
-        return changed
+        if finished:
+            self.show(*finished)
+        return finished is not None
 
     @property
     def busy(self) -> bool:

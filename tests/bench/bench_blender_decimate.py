@@ -6,7 +6,8 @@
 On the 1.55M-triangle horse (../shared/meshes/big, skipped when absent): time to first result
 (read the Blender mesh + prepare + decimate + write the new object with attributes) and the time
 of one live-preview update (re-decimate the cached mesh + write the preview mesh), next to the
-Decimate modifier applied at the same ratio in the same run. Prints medians and ratios.
+Decimate modifier applied at the same ratio in the same run, and the rate of updates shown
+during a simulated drag of the modal slider. Prints medians and ratios.
 """
 
 import argparse
@@ -115,6 +116,25 @@ def preview_updates(obj, ratio, count):
     return times, decimate_part
 
 
+def preview_drag(obj, ratio, seconds=4.0, event_interval=0.01):
+    """Updates shown per second during a drag, the way the modal slider runs: a new ratio is
+    requested every ``event_interval`` (mouse events), the worker thread decimates the latest
+    request while the main thread writes the previous result into the preview object."""
+    session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(ratio))
+    session.update(ratio)  # warm
+    sweep = np.geomspace(ratio / 2, min(1.0, ratio * 2), 50)
+    shown, start, i = 0, time.perf_counter(), 0
+    while time.perf_counter() - start < seconds:
+        session.request(float(sweep[i % len(sweep)] if (i // len(sweep)) % 2 == 0 else sweep[-1 - i % len(sweep)]))
+        i += 1
+        if session.poll():
+            shown += 1
+        time.sleep(event_interval)
+    elapsed = time.perf_counter() - start
+    session.close()
+    return shown / elapsed
+
+
 def modifier_apply(obj, ratio):
     copy = obj.copy()
     copy.data = obj.data.copy()
@@ -164,6 +184,7 @@ def main(argv):
             firsts.append(seconds)
         split = stages(obj, ratio)
         updates, _ = preview_updates(obj, ratio, args.updates)
+        drag_rate = preview_drag(obj, ratio)
         modifier = [modifier_apply(obj, ratio) for _ in range(args.modifier_repeat)]
         first = statistics.median(firsts)
         update = statistics.median(updates)
@@ -172,7 +193,9 @@ def main(argv):
         print("    stages of one run: " + ", ".join(f"{k} {v:.3f} s" for k, v in split.items()))
         print(f"  TopStoc slider update {update * 1000:8.1f} ms (median of {len(updates)} ratios in "
               f"[{ratio / 2:g}, {min(1, 2 * ratio):g}]; max {max(updates) * 1000:.1f} ms) "
-              f"= {1 / update:.1f} updates/s")
+              f"= {1 / update:.1f} updates/s one after another")
+        print(f"  TopStoc slider drag    {drag_rate:8.1f} updates shown per second (modal path: a ratio "
+              f"requested every 10 ms, decimation on a worker thread while the main thread writes)")
         if modifier:
             mod_seconds = statistics.median(s for s, _ in modifier)
             print(f"  Blender Decimate modifier (Collapse) apply {mod_seconds:8.3f} s (median of "
