@@ -196,6 +196,14 @@ class _LoopOperator:
     def kinds_ok(kind) -> bool:
         return True
 
+    def edit_active_loop(self, context, edit_function, verb: str) -> set:
+        """Runs ``edit_function(vertices, triangles, loop_ids)`` on the active loop."""
+        obj = _mesh_object(context)
+        index = obj.topstoc.topology.loop_index
+        ids = _loop_ids(obj)
+        return run_edit(self, context, lambda o, a: edit_function(a.vertices, a.triangles, ids),
+                        dropped=index, verb=f"{verb} {analysis.active_loop(obj).name}", uses_loop=True)
+
 
 def run_edit(operator, context, compute, dropped: int = -1, verb: str = "edited", uses_loop: bool = False) -> set:
     """Runs ``compute(obj, arrays) -> EditResult`` on the active mesh, writes it, re-analyses.
@@ -301,11 +309,7 @@ class TOPSTOC_OT_cut_loop(_LoopOperator, bpy.types.Operator):
         return kind != "BOUNDARY"
 
     def execute(self, context):
-        obj = _mesh_object(context)
-        index = obj.topstoc.topology.loop_index
-        ids = _loop_ids(obj)
-        return run_edit(self, context, lambda o, a: edit.cut_along_loop(a.vertices, a.triangles, ids),
-                        dropped=index, verb=f"cut along {analysis.active_loop(obj).name}", uses_loop=True)
+        return self.edit_active_loop(context, edit.cut_along_loop, "cut along")
 
 
 class TOPSTOC_OT_remove_loop(_LoopOperator, bpy.types.Operator):
@@ -321,11 +325,7 @@ holes (the genus drops by one)"""
         return kind != "BOUNDARY"
 
     def execute(self, context):
-        obj = _mesh_object(context)
-        index = obj.topstoc.topology.loop_index
-        ids = _loop_ids(obj)
-        return run_edit(self, context, lambda o, a: edit.remove_handle(a.vertices, a.triangles, ids),
-                        dropped=index, verb=f"removed {analysis.active_loop(obj).name}", uses_loop=True)
+        return self.edit_active_loop(context, edit.remove_handle, "removed")
 
 
 FILL_MODES = [("ACTIVE", "Active Loop", "Fill the active boundary loop"),
