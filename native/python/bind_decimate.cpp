@@ -5,6 +5,7 @@
 
 #include "caller_order.hpp"
 #include "convert.hpp"
+#include "topstoc/validate.hpp"
 #include "topstoc/decimate.hpp"
 #include "topstoc/quality.hpp"
 
@@ -209,10 +210,7 @@ void bind_decimate(py::module_& m) {
         auto p = positions_from(vertices, "vertices");
         auto t = indices_from(triangles, 3, "triangles");
         const int64_t n = int64_t(p.size() / 3);
-        for (size_t i = 0; i < t.size(); ++i)
-          if (t[i] < 0 || t[i] >= n)
-            throw py::value_error("triangle " + std::to_string(i / 3) + " refers to vertex " + std::to_string(t[i]) +
-                                  " outside [0, " + std::to_string(n) + ")");
+        require_indices_in_range(t.data(), int64_t(t.size() / 3), 3, n, "triangle");
         AspectStats s = aspect_ratio_stats(p.data(), t.data(), int64_t(t.size() / 3));
         py::dict d;
         d["mean"] = s.mean;

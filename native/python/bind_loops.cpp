@@ -3,6 +3,7 @@
 #include <pybind11/stl.h>
 
 #include "convert.hpp"
+#include "topstoc/validate.hpp"
 #include "topstoc/loops.hpp"
 #include "topstoc/mesh.hpp"
 #include "topstoc/self_intersections.hpp"
@@ -123,10 +124,7 @@ void bind_loops(py::module_& m) {
         auto p = positions_from(vertices, "vertices");
         auto t = indices_from(triangles, 3, "triangles");
         const int64_t n = int64_t(p.size() / 3);
-        for (size_t i = 0; i < t.size(); ++i)
-          if (t[i] < 0 || t[i] >= n)
-            throw py::value_error("triangle " + std::to_string(i / 3) + " refers to vertex " + std::to_string(t[i]) +
-                                  " outside [0, " + std::to_string(n) + ")");
+        require_indices_in_range(t.data(), int64_t(t.size() / 3), 3, n, "triangle");
         std::vector<std::pair<int32_t, int32_t>> pairs;
         {
           EngineCall call;
@@ -146,13 +144,9 @@ void bind_loops(py::module_& m) {
         auto p = positions_from(vertices, "vertices");
         auto t = indices_from(triangles, 3, "triangles");
         const int64_t n = int64_t(p.size() / 3);
+        require_indices_in_range(t.data(), int64_t(t.size() / 3), 3, n, "triangle");
         std::vector<uint8_t> used(n, 0);
-        for (size_t i = 0; i < t.size(); ++i) {
-          if (t[i] < 0 || t[i] >= n)
-            throw py::value_error("triangle " + std::to_string(i / 3) + " refers to vertex " + std::to_string(t[i]) +
-                                  " outside [0, " + std::to_string(n) + ")");
-          used[t[i]] = 1;
-        }
+        for (int32_t v : t) used[v] = 1;
         for (int64_t v = 0; v < n; ++v)
           if (!used[v]) throw py::value_error("vertex " + std::to_string(v) + " is in no triangle");
         TetMesh tets;
