@@ -1,5 +1,6 @@
 #include "topstoc/placement.hpp"
 #include "topstoc/parallel.hpp"
+#include "topstoc/quadric.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -42,11 +43,6 @@ void symmetric_eigen(double a[9], double values[3], double vectors[9]) {
   for (int i = 0; i < 3; ++i) values[i] = a[4 * i];
 }
 
-struct Quadric {
-  double a[6] = {0, 0, 0, 0, 0, 0};  // xx xy xz yy yz zz
-  double b[3] = {0, 0, 0};
-};
-
 }  // namespace
 
 std::vector<double> filtered_positions(const Mesh& mesh, const FeatureLayout& layout,
@@ -57,25 +53,11 @@ std::vector<double> filtered_positions(const Mesh& mesh, const FeatureLayout& la
   std::vector<Quadric> quadrics(k);
   for (int32_t f = 0; f < mesh.num_faces(); ++f) {
     const int32_t* t = &faces[3 * size_t(f)];
-    const double* p0 = mesh.position(t[0]);
-    const double* p1 = mesh.position(t[1]);
-    const double* p2 = mesh.position(t[2]);
-    double u[3], w[3];
-    for (int i = 0; i < 3; ++i) u[i] = p1[i] - p0[i], w[i] = p2[i] - p0[i];
-    double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (len == 0) continue;
-    const double area = 0.5 * len;
-    for (double& x : n) x /= len;
-    const double d = -(n[0] * p0[0] + n[1] * p0[1] + n[2] * p0[2]);
+    Quadric plane;
+    plane.add_triangle(mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
     const int32_t l[3] = {label[t[0]], label[t[1]], label[t[2]]};
-    for (int j = 0; j < 3; ++j) {
-      if ((j > 0 && l[j] == l[0]) || (j > 1 && l[j] == l[1])) continue;  // each cluster once
-      Quadric& q = quadrics[l[j]];
-      q.a[0] += area * n[0] * n[0], q.a[1] += area * n[0] * n[1], q.a[2] += area * n[0] * n[2];
-      q.a[3] += area * n[1] * n[1], q.a[4] += area * n[1] * n[2], q.a[5] += area * n[2] * n[2];
-      for (int i = 0; i < 3; ++i) q.b[i] -= area * d * n[i];
-    }
+    for (int j = 0; j < 3; ++j)
+      if (!((j > 0 && l[j] == l[0]) || (j > 1 && l[j] == l[1]))) quadrics[l[j]].add(plane);  // each cluster once
   }
   // Radius of each cluster around its sample: the bound on how far the sample may move.
   std::vector<double> radius2(k, 0.0);
@@ -100,10 +82,11 @@ std::vector<double> filtered_positions(const Mesh& mesh, const FeatureLayout& la
     symmetric_eigen(a, values, vectors);
     const double largest = std::max({std::abs(values[0]), std::abs(values[1]), std::abs(values[2])});
     if (largest <= 0) continue;
-    // x = p + A^+ (b - A p), the pseudo-inverse keeping directions with eigenvalue > 1e-3 max.
+    // The minimiser solves A x = -b: x = p + A^+ (-b - A p), the pseudo-inverse keeping
+    // directions with eigenvalue > 1e-3 max.
     double r[3];
     for (int i = 0; i < 3; ++i)
-      r[i] = q.b[i] - (a_copy[3 * i] * p[0] + a_copy[3 * i + 1] * p[1] + a_copy[3 * i + 2] * p[2]);
+      r[i] = -q.b[i] - (a_copy[3 * i] * p[0] + a_copy[3 * i + 1] * p[1] + a_copy[3 * i + 2] * p[2]);
     double move[3] = {0, 0, 0};
     for (int e = 0; e < 3; ++e) {
       if (std::abs(values[e]) < 1e-3 * largest) continue;

@@ -1,0 +1,46 @@
+// Quadric error (Garland & Heckbert 1997): the area-weighted sum of squared distances from a
+// point to a set of planes, E(x) = xᵀAx + 2bᵀx + c. Summing two quadrics sums their planes, so
+// a cluster's quadric measures how far a point is from all the input triangles it stands for.
+#pragma once
+
+#include <cmath>
+
+namespace topstoc {
+
+struct Quadric {
+  double a[6] = {0, 0, 0, 0, 0, 0};  ///< symmetric A: xx xy xz yy yz zz
+  double b[3] = {0, 0, 0};
+  double c = 0;
+
+  /// Adds the plane through p0, p1, p2, weighted by the triangle's area; no-op for zero area.
+  void add_triangle(const double* p0, const double* p1, const double* p2) {
+    double u[3], w[3];
+    for (int i = 0; i < 3; ++i) u[i] = p1[i] - p0[i], w[i] = p2[i] - p0[i];
+    double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (len == 0) return;
+    const double area = 0.5 * len;
+    for (double& x : n) x /= len;
+    const double d = -(n[0] * p0[0] + n[1] * p0[1] + n[2] * p0[2]);
+    a[0] += area * n[0] * n[0], a[1] += area * n[0] * n[1], a[2] += area * n[0] * n[2];
+    a[3] += area * n[1] * n[1], a[4] += area * n[1] * n[2], a[5] += area * n[2] * n[2];
+    for (int i = 0; i < 3; ++i) b[i] += area * d * n[i];
+    c += area * d * d;
+  }
+
+  void add(const Quadric& q) {
+    for (int i = 0; i < 6; ++i) a[i] += q.a[i];
+    for (int i = 0; i < 3; ++i) b[i] += q.b[i];
+    c += q.c;
+  }
+
+  /// Summed squared distance of x to the planes (area-weighted); >= 0 up to rounding.
+  double error(const double* x) const {
+    const double ax0 = a[0] * x[0] + a[1] * x[1] + a[2] * x[2];
+    const double ax1 = a[1] * x[0] + a[3] * x[1] + a[4] * x[2];
+    const double ax2 = a[2] * x[0] + a[4] * x[1] + a[5] * x[2];
+    return x[0] * ax0 + x[1] * ax1 + x[2] * ax2 + 2.0 * (b[0] * x[0] + b[1] * x[1] + b[2] * x[2]) + c;
+  }
+};
+
+}  // namespace topstoc
