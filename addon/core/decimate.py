@@ -111,7 +111,9 @@ class DecimateStats:
     top_up: int                 #: samples added to make up for clusters absorbed by neighbours
     issues_found: dict          #: what the checks found over all rounds
     issues_remaining: dict      #: what was left (all zero unless the round limit was hit)
-    seconds: dict               #: per stage: sampling, clustering, checking, output
+    seconds: dict               #: per stage: sampling, clustering, checking, output, refine
+    refine_vertices: int = 0    #: target of the quadric refinement (0: not refined)
+    refine_collapses: int = 0   #: collapses the refinement made
 
     @property
     def topology_kept(self) -> bool:
@@ -128,8 +130,9 @@ class DecimateResult:
     (``3 * triangle + slot``) whose attributes (UVs, colours, split normals) output corner
     ``(j, c)`` should take: a corner of the kept vertex on the same side of every border.
     ``labels[v]`` is the output vertex whose cluster holds input vertex ``v`` (-1 for vertices
-    in no triangle). ``samples`` (with the same mesh, borders and placement) reproduces the
-    result exactly through ``Mesh.decimate_with_samples``.
+    in no triangle). ``samples`` (with the same mesh, borders and placement; for a refined
+    result also ``stats.refine_vertices`` and the guidance) reproduces the result exactly
+    through ``Mesh.decimate_with_samples``.
     """
 
     vertices: np.ndarray
@@ -165,7 +168,8 @@ def _result(raw: dict, parameters: dict) -> DecimateResult:
         expected_vertices=raw["expected_vertices"], rate=raw["rate"], fast_path=raw["fast_path"],
         repair_rounds=repairs["rounds"], repairs=repairs["samples_added"], top_up=raw["top_up_samples"],
         issues_found=dict(repairs["found"]), issues_remaining=dict(repairs["remaining"]),
-        seconds=dict(raw["seconds"]))
+        seconds=dict(raw["seconds"]), refine_vertices=raw["refine_vertices"],
+        refine_collapses=raw["refine_collapses"])
     return DecimateResult(vertices=raw["positions"], triangles=raw["triangles"], kept=raw["kept"],
                           face_source=raw["face_source"], corner_source=raw["corner_source"],
                           labels=raw["labels"], samples=raw["samples"], stats=stats,
@@ -211,7 +215,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
              density_ratio: float = 2.0, density_epsilon: float = 0.0, guidance=None,
              regions=None, borders=None, view: Optional[View] = None,
              boxes: Sequence[Box] = (), placement: str = "subsample",
-             fast_path: Optional[bool] = None, max_repair_rounds: int = 200,
+             fast_path: Optional[bool] = None, max_repair_rounds: int = 200, refine: float = 0.0,
              max_error: Optional[float] = None, relative: bool = False) -> DecimateResult:
     """Decimates ``mesh`` with TopStoc. Give exactly one target.
 
@@ -229,6 +233,10 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
     no cluster crosses either, and both survive exactly. view, boxes: see View and Box.
     placement: "subsample" keeps input positions, "filtered" moves surface vertices to the
     quadric-optimal point of their cluster (borders stay).
+    refine: 0 = off (fastest). f >= 1: TopStoc keeps f times the target, then half-edge
+    collapses ordered by quadric error against the input thin it to the target (every output
+    vertex still an input vertex, topology and borders kept, guidance weighting the costs).
+    Lower error at a higher cost; 3 is a good start.
     max_error: the fewest vertices whose symmetric Hausdorff error stays within this bound
     (absolute, or a fraction of the bounding-box diagonal with ``relative=True``), found by a
     search over re-decimations with the same seed; ``result.error_bound`` tells how it went.
@@ -245,7 +253,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
                             area_weighted=area_weighted, feature_angle=feature_angle, density=density, density_rings=density_rings, density_ratio=density_ratio,
                             density_epsilon=density_epsilon, guidance=guidance, regions=regions,
                             borders=borders, view=view, boxes=boxes, placement=placement,
-                            fast_path=fast_path, max_repair_rounds=max_repair_rounds)
+                            fast_path=fast_path, max_repair_rounds=max_repair_rounds, refine=refine)
 
         result, report = search_vertex_count(mesh, max_error, decimate_at, relative=relative)
         return dataclasses.replace(result, error_bound=report,
@@ -256,6 +264,9 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
         raise ValueError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+    if isinstance(refine, bool) or not isinstance(refine, (int, float, np.integer, np.floating)) \
+            or not (refine == 0 or 1 <= refine < math.inf):
+        raise ValueError(f"refine must be 0 (off) or a factor of at least 1, got {refine!r}")
     target_triangles = 0
     if triangles is not None:
         if isinstance(triangles, bool) or not isinstance(triangles, (int, np.integer)):
@@ -274,7 +285,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
                       adaptivity=adaptivity, flat_floor=flat_floor, area_weighted=bool(area_weighted),
                       feature_angle=float(feature_angle), density=density,
                       density_rings=density_rings, density_ratio=density_ratio,
-                      density_epsilon=density_epsilon, placement=placement)
+                      density_epsilon=density_epsilon, placement=placement, refine=float(refine))
     raw = engine.decimate(
         mesh.native, layout, target_vertices=target, target_triangles=target_triangles,
         seed=int(seed), adaptivity=float(adaptivity), flat_floor=float(flat_floor),
@@ -284,24 +295,32 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
         view=view.as_engine() if view is not None else None,
         boxes=[box.as_engine() for box in boxes] or None, placement=placement,
         fast_path=0 if fast_path is None else int(bool(fast_path)),
-        max_repair_rounds=int(max_repair_rounds))
+        max_repair_rounds=int(max_repair_rounds), refine=float(refine))
     return _result(raw, parameters)
 
 
 def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, feature_angle: float = 0.0,
-                          placement: str = "subsample") -> DecimateResult:
+                          placement: str = "subsample", refine_vertices: int = 0,
+                          guidance=None) -> DecimateResult:
     """Re-creates a decimation from ``DecimateResult.samples`` (thesis 4.1.3).
 
     With the same mesh, regions, borders, feature angle and placement the output is identical.
+    A refined result (``refine`` > 0) also needs ``refine_vertices=result.stats.refine_vertices``
+    and the same ``guidance``.
     """
     if placement not in PLACEMENTS:
         raise ValueError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
     samples = np.asarray(samples)
     if samples.ndim != 1 or samples.dtype.kind not in "iu":
         raise ValueError(f"samples must be a 1-D integer array, got {samples.dtype} {samples.shape}")
+    if isinstance(refine_vertices, bool) or not isinstance(refine_vertices, (int, np.integer)) \
+            or refine_vertices < 0:
+        raise ValueError(f"refine_vertices must be a non-negative integer, got {refine_vertices!r}")
     layout = mesh.feature_layout(regions, borders, feature_angle)
-    raw = engine.decimate_with_samples(mesh.native, layout, samples, placement=placement)
-    return _result(raw, dict(samples=len(samples), placement=placement, feature_angle=feature_angle))
+    raw = engine.decimate_with_samples(mesh.native, layout, samples, placement=placement,
+                                       refine_vertices=int(refine_vertices), guidance=_guidance(mesh, guidance))
+    return _result(raw, dict(samples=len(samples), placement=placement, feature_angle=feature_angle,
+                             refine_vertices=int(refine_vertices)))
 
 
 def sampling_probabilities(mesh: Mesh, rate: float, *, adaptivity: float = 0.5,

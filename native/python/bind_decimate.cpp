@@ -102,6 +102,8 @@ py::dict result_dict(DecimateResult&& r) {
   d["rate"] = r.rate;
   d["fast_path"] = r.fast_path;
   d["top_up_samples"] = r.top_up_samples;
+  d["refine_vertices"] = r.refine_vertices;
+  d["refine_collapses"] = r.refine_collapses;
   py::dict repairs;
   repairs["rounds"] = r.repairs.rounds;
   repairs["samples_added"] = r.repairs.samples_added;
@@ -113,6 +115,7 @@ py::dict result_dict(DecimateResult&& r) {
   seconds["clustering"] = r.seconds_clustering;
   seconds["checking"] = r.seconds_checking;
   seconds["output"] = r.seconds_output;
+  seconds["refine"] = r.seconds_refine;
   d["seconds"] = seconds;
   return d;
 }
@@ -146,7 +149,8 @@ void bind_decimate(py::module_& m) {
          uint64_t seed, double adaptivity, double flat_floor, bool area_weighted, const py::handle& guidance,
          const std::string& density,
          int32_t density_rings, double density_ratio, double density_epsilon, const py::handle& view,
-         const py::handle& boxes, const std::string& placement, int fast_path, int32_t max_repair_rounds) {
+         const py::handle& boxes, const std::string& placement, int fast_path, int32_t max_repair_rounds,
+         double refine) {
         const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
         DecimateParams params;
         params.sampling = sampling_from(mesh, seed, adaptivity, flat_floor, area_weighted, u, density, density_rings,
@@ -156,6 +160,7 @@ void bind_decimate(py::module_& m) {
         params.fast_path = fast_path;
         params.max_repair_rounds = max_repair_rounds;
         params.target_vertices = target_vertices;
+        params.refine = refine;
         DecimateResult r;
         {
           EngineCall call;
@@ -169,22 +174,27 @@ void bind_decimate(py::module_& m) {
       py::arg("guidance") = py::none(), py::arg("density") = "off", py::arg("density_rings") = 0, py::arg("density_ratio") = 2.0,
       py::arg("density_epsilon") = 0.0, py::arg("view") = py::none(), py::arg("boxes") = py::none(),
       py::arg("placement") = "subsample", py::arg("fast_path") = 0, py::arg("max_repair_rounds") = 200,
+      py::arg("refine") = 0.0,
       "TopStoc decimation to a vertex target (or a triangle target when target_triangles > 0).");
 
   m.def(
       "decimate_with_samples",
       [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& samples, const std::string& placement,
-         int32_t max_repair_rounds) {
+         int32_t max_repair_rounds, int32_t refine_vertices, const py::handle& guidance) {
         auto ids = ids_from(samples, -1, "samples");
+        const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
+        if (refine_vertices < 0) throw py::value_error("refine_vertices must be >= 0");
         DecimateResult r;
         {
           EngineCall call;
-          r = decimate_with_samples(mesh, layout, std::move(ids), placement_from(placement), max_repair_rounds);
+          r = decimate_with_samples(mesh, layout, std::move(ids), placement_from(placement), max_repair_rounds,
+                                    refine_vertices, u.empty() ? nullptr : u.data());
         }
         return result_dict(std::move(r));
       },
       py::arg("mesh"), py::arg("layout"), py::arg("samples"), py::arg("placement") = "subsample",
-      py::arg("max_repair_rounds") = 200, "Re-creates a decimation from its saved sample list.");
+      py::arg("max_repair_rounds") = 200, py::arg("refine_vertices") = 0, py::arg("guidance") = py::none(),
+      "Re-creates a decimation from its saved sample list.");
 
   m.def(
       "sampling_probabilities",

@@ -9,6 +9,7 @@
 
 #include "topstoc/clustering.hpp"
 #include "topstoc/placement.hpp"
+#include "topstoc/refine.hpp"
 
 namespace topstoc {
 
@@ -374,6 +375,24 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
 
 DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params) {
   const int32_t active = active_vertices(mesh);
+  if (!(params.refine == 0.0 || params.refine >= 1.0))
+    throw std::invalid_argument("refine must be 0 (off) or at least 1, got " + std::to_string(params.refine));
+  if (params.refine >= 1.0 && params.target_vertices >= 1 && params.target_vertices <= active) {
+    // Refined: TopStoc to `refine` times the target, then collapses down to it. A guided
+    // first pass keeps the count its probabilities give; the collapses keep that proportion.
+    DecimateParams first = params;
+    first.refine = 0.0;
+    first.target_vertices = int32_t(std::min<double>(active, std::ceil(params.refine * params.target_vertices)));
+    DecimateResult result = decimate(mesh, layout, first);
+    RefineParams refine;
+    refine.target_vertices = result.guided
+        ? std::max(1, int32_t(std::lround(double(result.kept.size()) * params.target_vertices / first.target_vertices)))
+        : params.target_vertices;
+    refine.guidance = params.sampling.guidance;
+    refine_by_collapses(mesh, layout, refine, result);
+    result.target_vertices = params.target_vertices;
+    return result;
+  }
   if (params.target_vertices < 1)
     throw std::invalid_argument("target must be at least 1 vertex, got " + std::to_string(params.target_vertices));
   if (params.target_vertices > active)
@@ -398,7 +417,8 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
 }
 
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
-                                     Placement placement, int32_t max_repair_rounds) {
+                                     Placement placement, int32_t max_repair_rounds, int32_t refine_vertices,
+                                     const double* guidance) {
   if (samples.empty()) throw std::invalid_argument("the sample list is empty");
   const auto& vfo = mesh.vertex_face_offsets();
   for (size_t i = 0; i < samples.size(); ++i) {
@@ -416,8 +436,15 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
   result.selected = result.target_vertices;
   // Saved lists come from a finished decimation; only topology is re-checked, so the same
   // list always gives the same mesh.
-  return cluster_and_emit(mesh, layout, std::move(samples), placement, max_repair_rounds, false, false, {},
-                          std::vector<uint8_t>(mesh.num_vertices(), 0), 0, std::move(result));
+  result = cluster_and_emit(mesh, layout, std::move(samples), placement, max_repair_rounds, false, false, {},
+                            std::vector<uint8_t>(mesh.num_vertices(), 0), 0, std::move(result));
+  if (refine_vertices > 0) {
+    RefineParams refine;
+    refine.target_vertices = refine_vertices;
+    refine.guidance = guidance;
+    refine_by_collapses(mesh, layout, refine, result);
+  }
+  return result;
 }
 
 DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layout, DecimateParams params,

@@ -32,6 +32,9 @@ struct DecimateParams {
   /// and the scattered face marks cost more than the labels they save reading).
   int fast_path = 0;
   int budget_passes = 2;        ///< extra draws when repairs overshoot the target (unguided only)
+  /// Quadric refinement (refine.hpp): 0 = off; f > 1 keeps f times the target with TopStoc,
+  /// then quadric-ordered collapses thin the result to the target (better error, slower).
+  double refine = 0.0;
 };
 
 struct RepairStats {
@@ -61,15 +64,20 @@ struct DecimateResult {
   RepairStats repairs;
   int32_t top_up_samples = 0;          ///< samples added to make up for absorbed clusters
   int32_t top_up_rounds = 0;
+  int32_t refine_vertices = 0;         ///< target of the quadric refinement (0: none)
+  int32_t refine_collapses = 0;        ///< collapses it made
   double seconds_sampling = 0, seconds_clustering = 0, seconds_checking = 0, seconds_output = 0;
+  double seconds_refine = 0;
 };
 
 /// Decimates to params.target_vertices (1 <= target). Throws std::invalid_argument on bad params.
 DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params);
 
-/// Re-creates a decimation from a saved sample list (thesis 4.1.3).
+/// Re-creates a decimation from a saved sample list (thesis 4.1.3). A refined result also
+/// needs its refine_vertices and the guidance it was made with.
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
-                                     Placement placement, int32_t max_repair_rounds = 200);
+                                     Placement placement, int32_t max_repair_rounds = 200,
+                                     int32_t refine_vertices = 0, const double* guidance = nullptr);
 
 /// Decimates to about `target_triangles` output triangles (within 1 % where the mesh allows),
 /// re-decimating with a corrected vertex target up to `max_iterations` times.
