@@ -134,6 +134,7 @@ def main(argv=None) -> int:
     class Params:
         target_mode, ratio, seed, adaptivity = "RATIO", args.ratio, 1, 0.5
         density, placement, vertices, triangles, max_error, max_error_relative = "off", "subsample", 1, 1, 0, False
+        refine = 0
 
     run = pipeline.decimate(bpy.context, obj, Params())
     pipeline.store_samples(run)

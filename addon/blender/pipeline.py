@@ -3,6 +3,7 @@ write the output, remember the samples. Shared by the operators, the preview and
 
 from __future__ import annotations
 
+import hashlib
 import inspect
 import json
 import os
@@ -60,7 +61,7 @@ def target_kwargs(params, prepared: Prepared) -> dict:
 
 def options_kwargs(params) -> dict:
     return dict(seed=int(params.seed), adaptivity=float(params.adaptivity), density=params.density,
-                placement=params.placement)
+                placement=params.placement, refine=int(params.refine))
 
 
 def check_mesh(obj) -> None:
@@ -141,6 +142,13 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None) -> bpy.ty
     return target
 
 
+def guidance_digest(guidance) -> str:
+    """Fingerprint of a per-vertex guidance array (None: no guidance)."""
+    if guidance is None:
+        return "-"
+    return hashlib.blake2b(np.ascontiguousarray(guidance, dtype=np.float64).tobytes(), digest_size=16).hexdigest()
+
+
 def store_samples(run: Run, name: str = LAST_SAMPLES) -> None:
     """Remembers the run's samples on its object (replacing a set of the same name)."""
     sets = run.obj.topstoc.sample_sets
@@ -148,7 +156,9 @@ def store_samples(run: Run, name: str = LAST_SAMPLES) -> None:
     if entry is None:
         entry = sets.add()
         entry.name = name
-    entry.parameters = json.dumps(run.parameters)
+    # A refined result replays with its refinement target and the same per-vertex guidance.
+    entry.parameters = json.dumps(dict(run.parameters, refine_vertices=int(run.result.stats.refine_vertices),
+                                       guidance_digest=guidance_digest(run.guidance.guidance)))
     entry.mesh_digest = run.prepared.digest
     entry.layout_digest = run.guidance.layout_digest()
     entry.vertices_out = run.result.num_vertices
@@ -170,8 +180,14 @@ def restore(context, obj, name: str) -> Run:
         raise DecimationError(f"the seams, sharp edges or materials of '{obj.name}' changed since "
                               f"the samples '{name}' were saved")
     parameters = json.loads(entry.parameters)
+    refine_vertices = int(parameters.get("refine_vertices", 0))
+    if refine_vertices and parameters.get("guidance_digest") != guidance_digest(guidance.guidance):
+        raise DecimationError(f"the painted guidance of '{obj.name}' changed since the refined samples "
+                              f"'{name}' were saved")
     samples = np.asarray(entry["samples"], dtype=np.int32)
     result = prepared.mesh.decimate_with_samples(samples, placement=parameters.get("placement", "subsample"),
+                                                 refine_vertices=refine_vertices,
+                                                 guidance=guidance.guidance if refine_vertices else None,
                                                  **guidance.layout_kwargs())
     return Run(obj, prepared, guidance, result, parameters, time.perf_counter() - start)
 

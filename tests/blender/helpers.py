@@ -71,7 +71,7 @@ class Params:
         self.seed = 0
         self.adaptivity = 0.5
         self.density = "off"
-        self.placement = "subsample"
+        self.placement, self.refine = "subsample", 0
         self.output = "NEW_OBJECT"
         for key, value in kw.items():
             setattr(self, key, value)

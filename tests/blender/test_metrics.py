@@ -145,7 +145,7 @@ def test_error_overlay_and_colour_attribute(mods, decimated):
 def test_clusters_and_samples_of_the_last_decimation(mods, ts, scene):
     obj = make_object("Ball", *meshgen.icosphere(3))
     run = ts.blender.pipeline.decimate(bpy.context, obj, type("P", (), dict(
-        target_mode="RATIO", ratio=0.1, seed=5, adaptivity=0.5, density="off", placement="subsample"))())
+        target_mode="RATIO", ratio=0.1, seed=5, adaptivity=0.5, density="off", placement="subsample", refine=0))())
     ts.blender.pipeline.store_samples(run)
     show = bpy.context.scene.topstoc.overlays
     show.show_samples = show.show_clusters = True

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import meshgen
-from helpers import make_object, polygons, positions, select_only
+from helpers import Params, make_object, polygons, positions, select_only
 
 
 def output_geometry(obj):
@@ -95,3 +95,29 @@ def test_preview_session(ts, scene):
     session.close()
     assert not obj.hide_get()
     assert name not in bpy.data.objects
+
+
+def test_refined_decimation_keeps_uvs_and_restores(ts, scene):
+    obj = make_object("Knot", *meshgen.torus(48, 16))
+    obj.data.uv_layers.new(name="UVMap")
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.select_all(action="SELECT")
+    bpy.ops.uv.smart_project(island_margin=0.02)  # several islands: seams the refinement must keep
+    bpy.ops.object.mode_set(mode="OBJECT")
+    obj.topstoc.use_uv_seams = True
+    plain_run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.1, seed=3))
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.1, seed=3, refine=6, placement="subsample") == {"FINISHED"}
+    first = bpy.data.objects["Knot_TopStoc"]
+    assert len(first.data.vertices) <= max(plain_run.result.num_vertices, plain_run.result.stats.target_vertices)
+    # every output corner carries exactly the UV its input corner had (no island crossed)
+    source_uv = np.empty(2 * len(obj.data.loops))
+    obj.data.uv_layers["UVMap"].data.foreach_get("uv", source_uv)
+    out_uv = np.empty(2 * len(first.data.loops))
+    first.data.uv_layers["UVMap"].data.foreach_get("uv", out_uv)
+    source_pairs = {tuple(np.round(p, 6)) for p in source_uv.reshape(-1, 2)}
+    assert {tuple(np.round(p, 6)) for p in out_uv.reshape(-1, 2)} <= source_pairs
+    saved = obj.topstoc.sample_sets["Last"]
+    assert '"refine": 6' in saved.parameters and '"refine_vertices": 0' not in saved.parameters
+    select_only(obj)
+    assert bpy.ops.topstoc.restore_samples(name="Last") == {"FINISHED"}
+    assert output_geometry(bpy.data.objects["Knot_Last"]) == output_geometry(first)

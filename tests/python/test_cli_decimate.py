@@ -78,13 +78,15 @@ def test_same_seed_same_file_other_seed_other_file(tmp_path):
     assert (tmp_path / "a.ply").read_bytes() != (tmp_path / "c.ply").read_bytes()
 
 
-def test_uvs_and_materials_survive(tmp_path):
+@pytest.mark.parametrize("extra", [(), ("--refine", 6)], ids=["plain", "refined"])
+def test_uvs_and_materials_survive(tmp_path, extra):
     source = DATA / "uv_materials" / "spider" / "spider.obj"
-    report = run_json(source, tmp_path / "spider.obj", "--ratio", 0.4)
+    report = run_json(source, tmp_path / "spider.obj", "--ratio", 0.4, *extra)
     original, written = read_mesh(source), read_mesh(tmp_path / "spider.obj")
     assert report["input"]["uv_seam_edges"] > 0
     assert report["output"]["dropped_attributes"] == []
-    to_ply = run_json(source, tmp_path / "spider.ply", "--ratio", 0.4)
+    assert (report["refine"]["collapses"] > 0) == bool(extra)
+    to_ply = run_json(source, tmp_path / "spider.ply", "--ratio", 0.4, *extra)
     assert to_ply["output"]["dropped_attributes"] == ["triangle_material"]
     assert written.corner_uvs is not None and written.triangle_material is not None
     assert set(written.material_names) <= set(original.material_names)

@@ -38,7 +38,7 @@ class TOPSTOC_OT_guided_decimate(DecimationParameters, bpy.types.Operator):
         layout.prop(self, field)
         if self.target_mode == "MAX_ERROR":
             layout.prop(self, "max_error_relative")
-        for name in ("seed", "adaptivity", "density", "placement", "output"):
+        for name in ("seed", "adaptivity", "density", "placement", "refine", "output"):
             layout.prop(self, name)
 
     def execute(self, context):

@@ -42,6 +42,7 @@ class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
         col.prop(settings, "adaptivity")
         layout.prop(settings, "density")
         layout.prop(settings, "placement")
+        layout.prop(settings, "refine")
         layout.prop(settings, "output", expand=True)
         layout.operator("topstoc.guided_decimate", icon="MOD_DECIM")
         layout.operator("topstoc.preview", icon="HIDE_OFF")
