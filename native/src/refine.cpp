@@ -3,27 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <queue>
 #include <stdexcept>
 #include <string>
 
+#include "topstoc/indexed_heap.hpp"
 #include "topstoc/quadric.hpp"
 
 namespace topstoc {
 
 namespace {
-
-// The cheapest allowed collapse of one vertex, as it stood when `version` was current.
-struct Candidate {
-  double cost;
-  int32_t from;
-  uint32_t version;
-  // Min-heap on cost; ties by vertex id so the order never depends on the platform.
-  bool operator<(const Candidate& o) const {
-    if (cost != o.cost) return cost > o.cost;
-    return from > o.from;
-  }
-};
 
 class Collapser {
  public:
@@ -34,7 +22,7 @@ class Collapser {
             std::vector<uint8_t> curve_closed, std::vector<int32_t> corner_sector)
       : r_(result), quadric_(std::move(quadrics)), weight_(std::move(weight)), locked_(std::move(locked)),
         curve_(std::move(curve)), curve_size_(std::move(curve_size)), curve_closed_(std::move(curve_closed)),
-        corner_sector_(std::move(corner_sector)) {
+        corner_sector_(std::move(corner_sector)), heap_(static_cast<int32_t>(result.kept.size())) {
     const size_t n = r_.kept.size(), m = r_.face_source.size();
     vertex_faces_.resize(n);
     for (size_t t = 0; t < m; ++t)
@@ -42,8 +30,6 @@ class Collapser {
     alive_face_.assign(m, 1);
     merged_into_.assign(n, -1);
     target_.assign(n, -1);
-    best_cost_.assign(n, 0.0);
-    version_.assign(n, 0);
     for (int32_t u = 0; u < int32_t(n); ++u) update(u);
   }
 
@@ -52,12 +38,9 @@ class Collapser {
     int32_t alive = static_cast<int32_t>(r_.kept.size());
     int32_t collapses = 0;
     while (alive > target && !heap_.empty()) {
-      const Candidate c = heap_.top();
-      heap_.pop();
-      const int32_t u = c.from, v = target_[u];
-      if (c.version != version_[u] || merged_into_[u] >= 0) continue;  // superseded
+      const int32_t u = heap_.top(), v = target_[u];
       // Collapses next to `v` may have changed its cost or ruled it out: look again.
-      if (v < 0 || merged_into_[v] >= 0 || c.cost != cost(u, v)) {
+      if (merged_into_[v] >= 0 || heap_.top_key() != cost(u, v)) {
         update(u);
         continue;
       }
@@ -106,24 +89,33 @@ class Collapser {
 
  private:
   double cost(int32_t from, int32_t to) const {
-    Quadric q = quadric_[from];
-    q.add(quadric_[to]);
-    return weight_[from] * std::max(0.0, q.error(&r_.positions[3 * size_t(to)]));
+    const double* x = &r_.positions[3 * size_t(to)];
+    return weight_[from] * std::max(0.0, quadric_[from].error(x) + quadric_[to].error(x));
   }
 
   // Queues u's cheapest collapse. Checks wait until it is popped (most queued collapses are
   // superseded before that); with `checked`, the cheapest one that passes them. None: u
   // waits until a collapse next to it calls update again.
   void update(int32_t u, bool checked = false) {
-    ++version_[u];
     target_[u] = -1;
+    heap_.remove(u);
     if (locked_[u]) return;
     neighbours(u, options_);
+    if (!checked) {  // the cheapest, lowest id on ties
+      int32_t best = -1;
+      double best_cost = 0;
+      for (int32_t v : options_) {
+        const double c = cost(u, v);
+        if (best < 0 || c < best_cost) best = v, best_cost = c;
+      }
+      if (best >= 0) queue(u, best, best_cost);
+      return;
+    }
     costs_.clear();
     for (int32_t v : options_) costs_.push_back({cost(u, v), v});
     std::sort(costs_.begin(), costs_.end());
     for (const auto& [c, v] : costs_)
-      if (!checked || allowed(u, v)) {
+      if (allowed(u, v)) {
         queue(u, v, c);
         return;
       }
@@ -131,8 +123,7 @@ class Collapser {
 
   void queue(int32_t u, int32_t v, double c) {
     target_[u] = v;
-    best_cost_[u] = c;
-    heap_.push({c, u, version_[u]});
+    heap_.set(u, c);
   }
 
   int32_t survivor(int32_t v) {
@@ -264,7 +255,7 @@ class Collapser {
     vertex_faces_[u].clear();
     merged_into_[u] = v;
     quadric_[v].add(quadric_[u]);
-    ++version_[u];
+    heap_.remove(u);
     // v's costs all change (its quadric grew); around it only collapses onto v or u change,
     // or a new edge to v may be cheaper than what a vertex had queued. Checks that failed
     // may pass now: a vertex without a queued collapse looks again.
@@ -276,10 +267,7 @@ class Collapser {
         update(x);
       } else {
         const double c = cost(x, v);
-        if (c < best_cost_[x]) {
-          ++version_[x];
-          queue(x, v, c);
-        }
+        if (c < heap_.key_of(x)) queue(x, v, c);
       }
     }
   }
@@ -294,9 +282,7 @@ class Collapser {
   std::vector<std::vector<int32_t>> vertex_faces_;
   std::vector<uint8_t> alive_face_;
   std::vector<int32_t> merged_into_, target_;
-  std::vector<double> best_cost_;
-  std::vector<uint32_t> version_;
-  std::priority_queue<Candidate> heap_;
+  IndexedHeap heap_;
   std::vector<int32_t> scratch_, scratch_other_, options_, star_;
   std::vector<std::pair<double, int32_t>> costs_;
 };
