@@ -14,6 +14,7 @@ from typing import Optional
 
 import bpy
 
+from ..core.mesh_edges import mesh_edges
 from . import mesh_io, pipeline
 from .guidance import gather
 
@@ -47,15 +48,17 @@ class PreviewSession:
         self.seconds_write = 0.0
 
     def compute(self, ratio: float):
-        """Decimates at ``ratio`` (any thread)."""
+        """Decimates at ``ratio`` and derives the result's edges (any thread: the main thread
+        then only copies arrays into the preview mesh)."""
         start = time.perf_counter()
         result = self.prepared.mesh.decimate(ratio=ratio, **self.options, **self.guidance.decimate_kwargs())
-        return ratio, result, time.perf_counter() - start
+        edges = mesh_edges(result.triangles, len(result.vertices))
+        return ratio, result, edges, time.perf_counter() - start
 
-    def show(self, ratio: float, result, seconds: float) -> None:
+    def show(self, ratio: float, result, edges, seconds: float) -> None:
         """Puts a result into the preview object (main thread)."""
         start = time.perf_counter()
-        mesh_io.fill_geometry(self.mesh, result.vertices, result.triangles)
+        mesh_io.fill_geometry(self.mesh, result.vertices, result.triangles, edges)
         self.ratio, self.result, self.seconds_decimate = ratio, result, seconds
         self.seconds_write = time.perf_counter() - start
 
