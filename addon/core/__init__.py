@@ -14,6 +14,7 @@ from .io import MeshData, read_mesh, write_mesh
 from .loops import (Cancelled, ComponentLoops, Loop, LoopsResult, handle_tunnel_loops, self_intersections,
                     shorten_loop, tetrahedralize_surface)
 from .mesh import Mesh, MeshReport
+from .mesh_edges import MeshEdges, mesh_edges
 from .topology import ComponentGenerators, ComponentTopology, Topology, generators, topology
 
 __all__ = [
@@ -25,6 +26,8 @@ __all__ = [
     "Distance", "ErrorBoundReport", "HausdorffResult", "OneSidedDistance", "closest_points", "hausdorff",
     # topology
     "ComponentGenerators", "ComponentTopology", "Topology", "generators", "topology",
+    # edges of a triangle list, for hosts that store them (mesh_edges.py)
+    "MeshEdges", "mesh_edges",
     # mesh files (io.py)
     "MeshData", "read_mesh", "write_mesh",
     # handle and tunnel loops (loops.py)

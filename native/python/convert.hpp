@@ -58,6 +58,7 @@ py::array_t<T> copy_array(const std::vector<T>& data, int64_t columns = 0) {
 
 // One binding function per concept; each lives in its own bind_*.cpp.
 void bind_mesh(py::module_& m);
+void bind_mesh_edges(py::module_& m);
 void bind_decimate(py::module_& m);
 void bind_io(py::module_& m);
 void bind_hausdorff(py::module_& m);

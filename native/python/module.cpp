@@ -6,6 +6,7 @@ PYBIND11_MODULE(_topstoc, m) {
   m.doc() = "TopStoc native engine: decimation, measurement, topology (see topstoc.core for the Python API)";
   namespace tp = topstoc::python;
   tp::bind_mesh(m);
+  tp::bind_mesh_edges(m);
   tp::bind_decimate(m);
   tp::bind_io(m);
   tp::bind_hausdorff(m);

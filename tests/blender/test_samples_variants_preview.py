@@ -91,6 +91,16 @@ def test_preview_session(ts, scene):
         if not session.busy and session.ratio == 0.05:
             break
     assert session.ratio == 0.05
+    # the worker went from 0.3 to 0.05 on its own: nothing is left to show
+    assert not session.busy and not session.poll()
+    # an engine error in the worker surfaces on the main thread, at the next poll
+    session.options = dict(session.options, placement="no such placement")
+    session.request(0.2)
+    with pytest.raises(ValueError, match="placement"):
+        for _ in range(2000):
+            session.poll()
+            time.sleep(0.005)
+    assert session.ratio == 0.05
     name = session.preview.name
     session.close()
     assert not obj.hide_get()
