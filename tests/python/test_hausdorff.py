@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import meshgen
+from threads import outputs_by_thread_count
 from reference import read_off
 import topstoc
 from topstoc.core.native import engine
@@ -214,18 +215,12 @@ def test_parallel_result_equals_serial(data_dir, tmp_path):
     script = (
         "import json, sys; sys.path.insert(0, sys.argv[1])\n"
         "import numpy as np, topstoc\n"
-        "d = np.load(sys.argv[2])\n"
+        "d = np.load(sys.argv[3])\n"
         "r = topstoc.hausdorff((d['va'], d['ta']), (d['vb'], d['tb']), samples=200000, percentile=99)\n"
         "print(json.dumps([r.forward.as_dict(), r.backward.as_dict(), float(np.sum(r.face_error)),"
         " float(np.nansum(r.vertex_error)), r.forward.max_point.tolist()]))\n")
-    build = os.path.dirname(os.path.dirname(topstoc.__file__))
-    outputs = []
-    for threads in ("1", "2"):
-        env = dict(os.environ, OMP_NUM_THREADS=threads)
-        done = subprocess.run([sys.executable, "-c", script, build, str(tmp_path / "pair.npz")],
-                              env=env, capture_output=True, text=True, check=True)
-        outputs.append(done.stdout)
-    assert outputs[0] == outputs[1]
+    outputs = outputs_by_thread_count(script, tmp_path / "pair.npz", counts=("1", "2"))
+    assert outputs["1"] == outputs["2"]
 
 
 # --- bad input ---------------------------------------------------------------------------------

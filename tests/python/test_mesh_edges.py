@@ -1,14 +1,10 @@
 """Edges of a triangle list and each corner's edge, against a plain numpy reference."""
 
-import os
-import pathlib
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
 import meshgen
+from threads import outputs_by_thread_count
 from topstoc.core import mesh_edges
 
 
@@ -74,7 +70,7 @@ def test_empty_and_invalid_input():
 
 THREADS_SCRIPT = """
 import sys, hashlib, numpy as np
-sys.path[:0] = [{build!r}, {tests!r}]
+sys.path[:0] = sys.argv[1:3]
 import meshgen
 from topstoc.core import mesh_edges
 vertices, triangles = meshgen.grid(400, 260)  # 105k vertices: above the parallel threshold
@@ -85,12 +81,4 @@ print(hashlib.sha256(edges.vertices.tobytes() + edges.corner_edge.tobytes()).hex
 
 
 def test_serial_and_parallel_runs_agree():
-    build = str(pathlib.Path(sys.modules["topstoc"].__file__).parents[1])
-    tests = str(pathlib.Path(__file__).resolve().parents[1])
-    script = THREADS_SCRIPT.format(build=build, tests=tests)
-    digests = set()
-    for threads in ("1", "2", "3"):
-        env = dict(os.environ, OMP_NUM_THREADS=threads)
-        out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
-        digests.add(out.stdout.strip())
-    assert len(digests) == 1
+    assert len(set(outputs_by_thread_count(THREADS_SCRIPT).values())) == 1
