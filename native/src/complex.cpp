@@ -193,54 +193,82 @@ void renumber(SimplicialComplex& out, std::vector<int32_t> order, std::vector<in
   out.triangle_source.swap(source);
 }
 
+// The sides and wires of the edges whose lower vertex is v, as sorted entries: the higher
+// vertex in the top 32 bits, then (side + 1) and whether the side runs from lower to higher
+// (wires: low word 0, so they sort first in their edge). Read from v's star: each side s
+// starting at v gives the edge to its end (s itself) and the edge to its triangle's third vertex
+// (the side before s, which ends at v). `entries` must hold 2 * (triangles at v) + (wires at v).
+// Returns the number of entries.
+int32_t edges_at(const SimplicialComplex& k, int32_t v, const int32_t* star, const int32_t* star_offsets,
+                 const int32_t* wire_ends, const int32_t* wire_offsets, uint64_t* entries) {
+  const int32_t* tri = k.triangles.data();
+  int32_t count = 0;
+  if (wire_offsets)
+    for (int32_t i = wire_offsets[v]; i < wire_offsets[v + 1]; ++i) entries[count++] = uint64_t(uint32_t(wire_ends[i])) << 32;
+  for (int32_t i = star_offsets[v]; i < star_offsets[v + 1]; ++i) {
+    const int32_t s = star[i];
+    const int32_t corner = s % 3, first = s - corner;
+    const int32_t end = tri[first + (corner == 2 ? 0 : corner + 1)];
+    const int32_t before = first + (corner == 0 ? 2 : corner - 1);  // runs from the third vertex to v
+    const int32_t third = tri[before];
+    if (end > v) entries[count++] = (uint64_t(uint32_t(end)) << 32) | (uint32_t(s + 1) << 1) | 1u;
+    if (third > v) entries[count++] = (uint64_t(uint32_t(third)) << 32) | (uint32_t(before + 1) << 1);
+  }
+  sort_bucket(entries, entries + count);
+  return count;
+}
+
 // Fills the twins, fins, wires and vertex incidences of `out`, whose triangles (three distinct
 // vertices each) and num_vertices are set; wires are extra vertex pairs (lower first).
+//
+// Edges are found around vertices rather than by bucketing every side by its lower vertex: the
+// star of each vertex (the sides starting there) is one counting sort of 4-byte side ids, and
+// it also gives the triangle count and first side of every vertex. Each vertex then lists the
+// edges to its higher neighbours from its star (edges_at) and links their sides.
 void link_sides(SimplicialComplex& out, const std::vector<int32_t>& wires) {
   const int32_t n = out.num_vertices;
   const int32_t num_sides = out.num_sides();
   const int32_t* tri = out.triangles.data();
 
-  // Each side and wire becomes an entry in the bucket of its lower vertex: the higher vertex in
-  // the top 32 bits, then (side + 1) and whether the side runs from lower to higher (wires: 0).
-  // Sorting a bucket groups each edge's entries. Items 0..num_sides-1 are sides, the rest wires.
-  const int64_t num_wires = static_cast<int64_t>(wires.size() / 2);
-  auto lower = [&](int64_t i) {
-    if (i >= num_sides) return wires[2 * size_t(i - num_sides)];
-    const int32_t a = tri[i], b = tri[SimplicialComplex::next_side(int32_t(i))];
-    return a < b ? a : b;
-  };
-  std::vector<int32_t> offsets;
-  std::vector<uint64_t> entries(size_t(num_sides) + size_t(num_wires));
+  std::vector<int32_t> star(num_sides), star_offsets;
   counting_sort(
-      num_sides + num_wires, n, [&](int64_t i, int32_t* hist) { ++hist[lower(i)]; },
-      [&](int64_t i, int32_t* hist) {
-        if (i >= num_sides) {
-          const size_t w = 2 * size_t(i - num_sides);
-          entries[hist[wires[w]]++] = uint64_t(uint32_t(wires[w + 1])) << 32;
-          return;
-        }
-        const int32_t a = tri[i], b = tri[SimplicialComplex::next_side(int32_t(i))];
-        const uint32_t low = (uint32_t(i + 1) << 1) | (a < b ? 1u : 0u);
-        entries[hist[a < b ? a : b]++] = (uint64_t(uint32_t(a < b ? b : a)) << 32) | low;
-      },
-      offsets);
-  // Triangles at each vertex, and the first side starting there.
-  out.vertex_triangles.assign(n, 0);
-  out.vertex_side.assign(n, -1);
-  for (int32_t s = 0; s < num_sides; ++s)
-    if (out.vertex_triangles[tri[s]]++ == 0) out.vertex_side[tri[s]] = s;
+      num_sides, n, [&](int64_t s, int32_t* hist) { ++hist[tri[s]]; },
+      [&](int64_t s, int32_t* hist) { star[hist[tri[s]]++] = int32_t(s); }, star_offsets);
+  // Wires by lower vertex (rare; serial).
+  const int64_t num_wires = static_cast<int64_t>(wires.size() / 2);
+  std::vector<int32_t> wire_ends, wire_offsets;
+  if (num_wires > 0) {
+    wire_ends.resize(num_wires);
+    counting_sort(
+        num_wires, n, [&](int64_t w, int32_t* hist) { ++hist[wires[2 * w]]; },
+        [&](int64_t w, int32_t* hist) { wire_ends[hist[wires[2 * w]]++] = wires[2 * w + 1]; }, wire_offsets);
+  }
+  const int32_t* wire_at = num_wires > 0 ? wire_offsets.data() : nullptr;
 
-  // Per vertex: sort its bucket and link the sides of each edge. Buckets holding an edge with
-  // no triangle or with three and more (rare) are flagged and read again serially below, so the
+  // Triangles at each vertex, the first side starting there, and the largest entry list.
+  out.vertex_triangles.resize(n);
+  out.vertex_side.resize(n);
+  int32_t most_entries = 0;
+  for (int32_t v = 0; v < n; ++v) {
+    const int32_t triangles = star_offsets[v + 1] - star_offsets[v];
+    out.vertex_triangles[v] = triangles;
+    out.vertex_side[v] = triangles ? star[star_offsets[v]] : -1;
+    most_entries = std::max(most_entries, 2 * triangles + (wire_at ? wire_at[v + 1] - wire_at[v] : 0));
+  }
+
+  // Per vertex: list its edges and link the sides of each. Vertices holding an edge with no
+  // triangle or with three and more (rare) are flagged and read again serially below, so the
   // parallel loop allocates nothing (an exception must not escape an OpenMP region).
   out.side_twin.resize(num_sides);
   std::vector<uint8_t> special(n, 0);
+  const int32_t threads = pass_threads(num_sides);
+  std::vector<uint64_t> scratch(size_t(threads) * size_t(most_entries));
   int64_t num_edges = 0;
-#pragma omp parallel for schedule(dynamic, 8192) reduction(+ : num_edges) num_threads(pass_threads(num_sides))
+#pragma omp parallel for schedule(dynamic, 8192) reduction(+ : num_edges) num_threads(threads)
   for (int32_t v = 0; v < n; ++v) {
-    uint64_t* begin = entries.data() + offsets[v];
-    uint64_t* end = entries.data() + offsets[v + 1];
-    sort_bucket(begin, end);
+    uint64_t* begin = scratch.data() + size_t(omp_get_thread_num()) * size_t(most_entries);
+    uint64_t* end =
+        begin + edges_at(out, v, star.data(), star_offsets.data(), wire_ends.data(), wire_at, begin);
     for (uint64_t* i = begin; i < end;) {
       const uint32_t hi = uint32_t(*i >> 32);
       uint64_t* j = i;
@@ -274,8 +302,9 @@ void link_sides(SimplicialComplex& out, const std::vector<int32_t>& wires) {
   out.wire_edges.clear();
   for (int32_t v = 0; v < n; ++v) {
     if (!special[v]) continue;
-    const uint64_t* end = entries.data() + offsets[v + 1];
-    for (const uint64_t* i = entries.data() + offsets[v]; i < end;) {
+    const uint64_t* begin = scratch.data();
+    const uint64_t* end = begin + edges_at(out, v, star.data(), star_offsets.data(), wire_ends.data(), wire_at, scratch.data());
+    for (const uint64_t* i = begin; i < end;) {
       const uint32_t hi = uint32_t(*i >> 32);
       const uint64_t* j = i;
       while (j < end && uint32_t(*j >> 32) == hi) ++j;
