@@ -117,52 +117,63 @@ std::vector<int32_t> morton_order(const double* positions, int32_t n) {
   return order;
 }
 
-// Whether the caller's numbering already has locality: most triangles span nearby vertex ids.
-bool local_numbering(const std::vector<int32_t>& tri) {
-  const size_t m = tri.size() / 3;
-  size_t near = 0;
-  for (size_t t = 0; t < m; ++t) {
-    const int32_t* x = &tri[3 * t];
-    near += int64_t(std::max({x[0], x[1], x[2]})) - std::min({x[0], x[1], x[2]}) <= 1024;
-  }
-  return 2 * near >= m;
-}
-
-// Whether consecutive triangles mostly lie close together: they share a vertex or have nearby
+// Locality of the caller's arrays, counted while the triangles are copied (one pass): the
+// caller's numbering has it when most triangles span nearby vertex ids; the triangle order has
+// it when consecutive triangles mostly lie close together: they share a vertex or have nearby
 // lowest vertices (meshes written face by face by modellers, scanners' meshers, subdivision),
 // as opposed to shuffled ones.
-bool coherent_triangle_order(const std::vector<int32_t>& tri) {
-  const size_t m = tri.size() / 3;
-  size_t near = 0;
-  for (size_t t = 1; t < m; ++t) {
-    const int32_t* a = &tri[3 * t - 3];
-    const int32_t* b = &tri[3 * t];
-    const bool share = a[0] == b[0] || a[0] == b[1] || a[0] == b[2] || a[1] == b[0] || a[1] == b[1] ||
-                       a[1] == b[2] || a[2] == b[0] || a[2] == b[1] || a[2] == b[2];
-    const int64_t jump = int64_t(std::min({a[0], a[1], a[2]})) - std::min({b[0], b[1], b[2]});
-    near += share || (jump >= -256 && jump <= 256);
-  }
-  return 2 * near >= m;
-}
+struct LocalityCount {
+  int64_t triangles = 0, spanning_nearby_ids = 0, close_to_previous = 0;
+  const int32_t* previous = nullptr;
 
-// Vertices in order of first appearance in the triangles, then the unused ones.
-std::vector<int32_t> first_appearance_order(const std::vector<int32_t>& tri, int32_t n) {
-  std::vector<uint8_t> seen(n, 0);
-  std::vector<int32_t> order;
-  order.reserve(n);
-  for (int32_t v : tri)
-    if (!seen[v]) {
-      seen[v] = 1;
-      order.push_back(v);
+  void add(const int32_t* b) {
+    spanning_nearby_ids += int64_t(std::max({b[0], b[1], b[2]})) - std::min({b[0], b[1], b[2]}) <= 1024;
+    if (const int32_t* a = previous) {
+      const bool share = a[0] == b[0] || a[0] == b[1] || a[0] == b[2] || a[1] == b[0] || a[1] == b[1] ||
+                         a[1] == b[2] || a[2] == b[0] || a[2] == b[1] || a[2] == b[2];
+      const int64_t jump = int64_t(std::min({a[0], a[1], a[2]})) - std::min({b[0], b[1], b[2]});
+      close_to_previous += share || (jump >= -256 && jump <= 256);
     }
+    previous = b;
+    ++triangles;
+  }
+  bool local_numbering() const { return 2 * spanning_nearby_ids >= triangles; }
+  bool coherent_triangle_order() const { return 2 * close_to_previous >= triangles; }
+};
+
+// Renumbers the vertices of `out` (and the wires) in order of first appearance in its
+// triangles, then the unused ones: one pass that numbers each vertex when it is first met and
+// rewrites the corners as it goes (the triangle order is kept).
+void renumber_by_first_appearance(SimplicialComplex& out, std::vector<int32_t>& wires) {
+  const int32_t n = out.num_vertices;
+  auto& index = out.vertex_index;
+  auto& source = out.vertex_source;
+  index.assign(n, -1);
+  source.resize(n);
+  int32_t next = 0;
+  for (int32_t& v : out.triangles) {
+    int32_t& i = index[v];
+    if (i < 0) {
+      i = next++;
+      source[i] = v;
+    }
+    v = i;
+  }
   for (int32_t v = 0; v < n; ++v)
-    if (!seen[v]) order.push_back(v);
-  return order;
+    if (index[v] < 0) {
+      index[v] = next++;
+      source[index[v]] = v;
+    }
+  for (size_t i = 0; i < wires.size(); i += 2) {
+    const int32_t a = index[wires[i]], b = index[wires[i + 1]];
+    wires[i] = std::min(a, b);
+    wires[i + 1] = std::max(a, b);
+  }
 }
 
-// Renumbers the vertices of `out` (and the wires) by `order`; with sort_triangles, also sorts
-// the triangles by their lowest vertex (stable: ties keep the caller's order).
-void renumber(SimplicialComplex& out, std::vector<int32_t> order, std::vector<int32_t>& wires, bool sort_triangles) {
+// Renumbers the vertices of `out` (and the wires) by `order` and sorts the triangles by their
+// lowest vertex (stable: ties keep the caller's order).
+void renumber_and_sort(SimplicialComplex& out, std::vector<int32_t> order, std::vector<int32_t>& wires) {
   const int32_t n = out.num_vertices, m = out.num_triangles();
   out.vertex_index.resize(n);
   for (int32_t i = 0; i < n; ++i) out.vertex_index[order[i]] = i;
@@ -175,7 +186,6 @@ void renumber(SimplicialComplex& out, std::vector<int32_t> order, std::vector<in
   }
 #pragma omp parallel for schedule(static) if (out.triangles.size() >= size_t(kParallelMinimum))
   for (size_t i = 0; i < out.triangles.size(); ++i) out.triangles[i] = index[out.triangles[i]];
-  if (!sort_triangles) return;
   auto lowest = [&](int64_t t) {
     const int32_t* x = &out.triangles[3 * size_t(t)];
     return std::min({x[0], x[1], x[2]});
@@ -351,11 +361,9 @@ std::vector<uint8_t> find_duplicates(const SimplicialComplex& k, int32_t& count)
 
 }  // namespace
 
-SimplicialComplex build_complex(const double* positions, int32_t num_vertices, std::vector<int32_t> triangles,
-                                const int32_t* edges, int64_t num_edges) {
-  if (triangles.size() % 3 != 0) throw std::invalid_argument("triangles must hold 3 vertex ids each");
-  const int64_t num_triangles = static_cast<int64_t>(triangles.size() / 3);
-  check_input(positions, num_vertices, triangles.data(), num_triangles, edges, num_edges);
+SimplicialComplex build_complex(const double* positions, int32_t num_vertices, const int32_t* triangles,
+                                int64_t num_triangles, const int32_t* edges, int64_t num_edges) {
+  check_input(positions, num_vertices, triangles, num_triangles, edges, num_edges);
   const int32_t m = static_cast<int32_t>(num_triangles);
   SimplicialComplex out;
   out.num_vertices = num_vertices;
@@ -363,14 +371,18 @@ SimplicialComplex build_complex(const double* positions, int32_t num_vertices, s
   out.input_edges = static_cast<int32_t>(num_edges);
 
   // Collapsed triangles become wire edges (or nothing beyond their vertex); the others are
-  // 2-simplex candidates, kept in the caller's order (compacted in place).
+  // 2-simplex candidates, copied in the caller's order.
   std::vector<int32_t> wires;  // vertex pairs, lower first
+  out.triangles.resize(3 * size_t(m));
   out.triangle_source.resize(m);
+  LocalityCount locality;
   int32_t kept = 0;
   for (int32_t t = 0; t < m; ++t) {
     const int32_t x[3] = {triangles[3 * size_t(t)], triangles[3 * size_t(t) + 1], triangles[3 * size_t(t) + 2]};
     if (x[0] != x[1] && x[1] != x[2] && x[2] != x[0]) {
-      for (int c = 0; c < 3; ++c) triangles[3 * size_t(kept) + c] = x[c];
+      int32_t* copy = &out.triangles[3 * size_t(kept)];
+      for (int c = 0; c < 3; ++c) copy[c] = x[c];
+      locality.add(copy);
       out.triangle_source[kept++] = t;
       continue;
     }
@@ -382,8 +394,7 @@ SimplicialComplex build_complex(const double* positions, int32_t num_vertices, s
       wires.push_back(s[0] == s[1] ? s[2] : s[1]);
     }
   }
-  triangles.resize(3 * size_t(kept));
-  out.triangles = std::move(triangles);
+  out.triangles.resize(3 * size_t(kept));
   out.triangle_source.resize(kept);
   for (int64_t e = 0; e < num_edges; ++e) {
     const int32_t a = edges[2 * e], b = edges[2 * e + 1];
@@ -393,14 +404,14 @@ SimplicialComplex build_complex(const double* positions, int32_t num_vertices, s
   }
   // Locality: keep a numbering that has it; keep a coherent triangle order and number vertices
   // as they appear in it; otherwise number vertices along a Z-order curve and sort the triangles.
-  if (local_numbering(out.triangles)) {
+  if (locality.local_numbering()) {
     out.vertex_source.resize(num_vertices);
     std::iota(out.vertex_source.begin(), out.vertex_source.end(), 0);
     out.vertex_index = out.vertex_source;
-  } else if (coherent_triangle_order(out.triangles)) {
-    renumber(out, first_appearance_order(out.triangles, num_vertices), wires, false);
+  } else if (locality.coherent_triangle_order()) {
+    renumber_by_first_appearance(out, wires);
   } else if (positions) {
-    renumber(out, morton_order(positions, num_vertices), wires, true);
+    renumber_and_sort(out, morton_order(positions, num_vertices), wires);
   } else {
     out.vertex_source.resize(num_vertices);
     std::iota(out.vertex_source.begin(), out.vertex_source.end(), 0);

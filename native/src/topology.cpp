@@ -320,9 +320,7 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
 
 TopologyReport analyze_topology(const double* positions, int32_t num_vertices, const int32_t* triangles,
                                 int64_t num_triangles, const int32_t* edges, int64_t num_edges) {
-  return analyze_topology(build_complex(positions, num_vertices,
-                                        std::vector<int32_t>(triangles, triangles + 3 * num_triangles), edges,
-                                        num_edges));
+  return analyze_topology(build_complex(positions, num_vertices, triangles, num_triangles, edges, num_edges));
 }
 
 }  // namespace topstoc

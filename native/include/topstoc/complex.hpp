@@ -90,12 +90,12 @@ struct SimplicialComplex {
 };
 
 /// Builds the complex. positions: 3 * num_vertices coordinates, checked to be finite and used
-/// for the internal order (may be null: no check, no Z-order); triangles: 3 * num_triangles vertex ids (taken over to avoid a copy);
-/// edges: 2 * num_edges vertex ids (may be null when num_edges is 0). At most 2^30 / 3 (about
-/// 357 million) triangles. Throws std::invalid_argument naming the first offending vertex,
-/// triangle or edge.
-SimplicialComplex build_complex(const double* positions, int32_t num_vertices, std::vector<int32_t> triangles,
-                                const int32_t* edges, int64_t num_edges);
+/// for the internal order (may be null: no check, no Z-order); triangles: 3 * num_triangles
+/// vertex ids; edges: 2 * num_edges vertex ids (may be null when num_edges is 0). The arrays
+/// are only read. At most 2^30 / 3 (about 357 million) triangles. Throws
+/// std::invalid_argument naming the first offending vertex, triangle or edge.
+SimplicialComplex build_complex(const double* positions, int32_t num_vertices, const int32_t* triangles,
+                                int64_t num_triangles, const int32_t* edges, int64_t num_edges);
 
 /// Turning around a vertex v through the triangle sides that touch it. A position is a side of
 /// a triangle at v and whether v is where that side starts. Orientation-free: works on
