@@ -241,7 +241,9 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
   // Boundary curves: from each unvisited boundary side, turn around the fans at its ends.
   std::vector<uint8_t> visited;
   std::vector<int32_t> backward;
-  for (int32_t s0 = 0; s0 < num_sides; ++s0) {
+  int64_t boundary_edges = 0;  // closed surfaces (the common case) skip the scan
+  for (const auto& c : comps) boundary_edges += c.boundary_edges;
+  for (int32_t s0 = 0; s0 < (boundary_edges ? num_sides : 0); ++s0) {
     if (k.side_twin[s0] != SimplicialComplex::kOpenSide) continue;
     if (visited.empty()) visited.assign(num_sides, 0);
     if (visited[s0]) continue;
