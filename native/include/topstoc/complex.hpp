@@ -82,8 +82,8 @@ struct SimplicialComplex {
   /// Vertex where side s starts, and where it ends.
   int32_t side_start(int32_t s) const { return triangles[s]; }
   int32_t side_end(int32_t s) const { return triangles[next_side(s)]; }
-  static int32_t next_side(int32_t s) { return s - s % 3 + (s % 3 + 1) % 3; }
-  static int32_t previous_side(int32_t s) { return s - s % 3 + (s % 3 + 2) % 3; }
+  static int32_t next_side(int32_t s) { return s % 3 == 2 ? s - 2 : s + 1; }
+  static int32_t previous_side(int32_t s) { return s % 3 == 0 ? s + 2 : s - 1; }
   /// True for exactly one side of every edge with one or two triangles (the edge's
   /// representative side): open sides, and the lower side of each twin pair.
   bool represents_edge(int32_t s) const { return side_twin[s] == kOpenSide || (side_twin[s] >> 1) > s; }
