@@ -189,7 +189,7 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
       if (k.side_twin[s] == SimplicialComplex::kOpenSide) ++c.boundary_edges;
       if (k.represents_edge(s)) ++c.edges;
     }
-    if (sheets.find(t) != t || sheet_open[t]) continue;
+    if (!sheets.is_root(t) || sheet_open[t]) continue;
     ++closed_sheets[ci];
     if (component_fins[ci]) {
       if (sheet_column.empty()) sheet_column.assign(num_triangles, -1);
