@@ -62,15 +62,14 @@ void sort_bucket(T* begin, T* end) {
   }
 }
 
-void check_input(const double* positions, int32_t n, const int32_t* triangles, int64_t m, const int32_t* edges,
-                 int64_t k) {
+// Sizes and coordinates; the triangles' indices are checked while they are copied, then the
+// edges' (build_complex), so that the first problem in this order is the one reported.
+void check_sizes_and_positions(const double* positions, int32_t n, int64_t m, int64_t k) {
   if (n < 0) throw std::invalid_argument("number of vertices is negative");
   if (m < 0 || k < 0) throw std::invalid_argument("number of triangles or edges is negative");
   if (3 * m > kMaxSides) throw std::invalid_argument("complex is too large: more than 2^30 / 3 triangles");
   if (k > INT32_MAX / 2) throw std::invalid_argument("complex is too large: more than 2^31 / 2 edges");
   if (positions) require_finite_positions(positions, n);
-  require_indices_in_range(triangles, m, 3, n, "triangle");
-  require_indices_in_range(edges, k, 2, n, "edge");
 }
 
 // Spreads the low 10 bits of x so that they occupy every third bit.
@@ -363,7 +362,7 @@ std::vector<uint8_t> find_duplicates(const SimplicialComplex& k, int32_t& count)
 
 SimplicialComplex build_complex(const double* positions, int32_t num_vertices, const int32_t* triangles,
                                 int64_t num_triangles, const int32_t* edges, int64_t num_edges) {
-  check_input(positions, num_vertices, triangles, num_triangles, edges, num_edges);
+  check_sizes_and_positions(positions, num_vertices, num_triangles, num_edges);
   const int32_t m = static_cast<int32_t>(num_triangles);
   SimplicialComplex out;
   out.num_vertices = num_vertices;
@@ -377,8 +376,11 @@ SimplicialComplex build_complex(const double* positions, int32_t num_vertices, c
   out.triangle_source.resize(m);
   LocalityCount locality;
   int32_t kept = 0;
+  bool indices_in_range = true;  // unsigned: negative ids compare as huge
+  const uint32_t n = uint32_t(num_vertices);
   for (int32_t t = 0; t < m; ++t) {
     const int32_t x[3] = {triangles[3 * size_t(t)], triangles[3 * size_t(t) + 1], triangles[3 * size_t(t) + 2]};
+    indices_in_range &= (uint32_t(x[0]) < n) & (uint32_t(x[1]) < n) & (uint32_t(x[2]) < n);
     if (x[0] != x[1] && x[1] != x[2] && x[2] != x[0]) {
       int32_t* copy = &out.triangles[3 * size_t(kept)];
       for (int c = 0; c < 3; ++c) copy[c] = x[c];
@@ -396,6 +398,8 @@ SimplicialComplex build_complex(const double* positions, int32_t num_vertices, c
   }
   out.triangles.resize(3 * size_t(kept));
   out.triangle_source.resize(kept);
+  if (!indices_in_range) require_indices_in_range(triangles, num_triangles, 3, num_vertices, "triangle");  // throws
+  require_indices_in_range(edges, num_edges, 2, num_vertices, "edge");
   for (int64_t e = 0; e < num_edges; ++e) {
     const int32_t a = edges[2 * e], b = edges[2 * e + 1];
     if (a == b) continue;  // a vertex, already in the complex
