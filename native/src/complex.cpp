@@ -124,20 +124,32 @@ std::vector<int32_t> morton_order(const double* positions, int32_t n) {
 struct LocalityCount {
   int64_t triangles = 0, spanning_nearby_ids = 0, close_to_previous = 0;
   const int32_t* previous = nullptr;
+  // Each answer is settled once its count or its complement passes half of `at_most` (the
+  // caller's triangle count bounds the final one): later triangles are then not examined.
+  int64_t at_most = 0;
+  bool numbering_settled = false, order_settled = false;
+
+  explicit LocalityCount(int64_t at_most) : at_most(at_most) {}
 
   void add(const int32_t* b) {
-    spanning_nearby_ids += int64_t(std::max({b[0], b[1], b[2]})) - std::min({b[0], b[1], b[2]}) <= 1024;
+    ++triangles;
+    if (!numbering_settled) {
+      spanning_nearby_ids += int64_t(std::max({b[0], b[1], b[2]})) - std::min({b[0], b[1], b[2]}) <= 1024;
+      numbering_settled = 2 * spanning_nearby_ids >= at_most || 2 * (triangles - spanning_nearby_ids) > at_most;
+    }
+    if (order_settled) return;
     if (const int32_t* a = previous) {
       const bool share = a[0] == b[0] || a[0] == b[1] || a[0] == b[2] || a[1] == b[0] || a[1] == b[1] ||
                          a[1] == b[2] || a[2] == b[0] || a[2] == b[1] || a[2] == b[2];
       const int64_t jump = int64_t(std::min({a[0], a[1], a[2]})) - std::min({b[0], b[1], b[2]});
       close_to_previous += share || (jump >= -256 && jump <= 256);
+      order_settled = 2 * close_to_previous >= at_most || 2 * (triangles - 1 - close_to_previous) > at_most;
     }
     previous = b;
-    ++triangles;
   }
-  bool local_numbering() const { return 2 * spanning_nearby_ids >= triangles; }
-  bool coherent_triangle_order() const { return 2 * close_to_previous >= triangles; }
+  // Once settled, the count stands on the side of the answer it settled on for any final count.
+  bool local_numbering() const { return 2 * spanning_nearby_ids >= (numbering_settled ? at_most : triangles); }
+  bool coherent_triangle_order() const { return 2 * close_to_previous >= (order_settled ? at_most : triangles); }
 };
 
 // Renumbers the vertices of `out` (and the wires) in order of first appearance in its
@@ -374,7 +386,7 @@ SimplicialComplex build_complex(const double* positions, int32_t num_vertices, c
   std::vector<int32_t> wires;  // vertex pairs, lower first
   out.triangles.resize(3 * size_t(m));
   out.triangle_source.resize(m);
-  LocalityCount locality;
+  LocalityCount locality(m);
   int32_t kept = 0;
   bool indices_in_range = true;  // unsigned: negative ids compare as huge
   const uint32_t n = uint32_t(num_vertices);
