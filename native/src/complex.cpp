@@ -20,22 +20,24 @@ int32_t pass_threads(int64_t items) { return items >= kParallelMinimum ? std::ma
 
 // Stable counting sort of items 0..count-1 into buckets 0..num_buckets-1: count_item(i, hist)
 // increments hist[bucket of i]; place(i, hist) writes item i at hist[bucket of i]++. Runs on
-// contiguous chunks, one histogram per chunk, so the result is the serial one. `offsets`
-// receives the bucket starts (num_buckets + 1 entries).
+// contiguous chunks, one histogram per chunk (in `histograms`, reused memory), so the result is
+// the serial one. `offsets` receives the bucket starts (num_buckets + 1 entries).
 template <class CountItem, class Place>
-void counting_sort(int64_t count, int32_t num_buckets, CountItem count_item, Place place, std::vector<int32_t>& offsets) {
+void counting_sort(int64_t count, int32_t num_buckets, CountItem count_item, Place place, std::vector<int32_t>& offsets,
+                   std::vector<int32_t>& histograms) {
   const int32_t chunks = pass_threads(count);
-  std::vector<std::vector<int32_t>> hist(chunks, std::vector<int32_t>(num_buckets, 0));
+  histograms.assign(size_t(chunks) * size_t(num_buckets), 0);
+  auto hist = [&](int32_t c) { return histograms.data() + size_t(c) * size_t(num_buckets); };
 #pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
   for (int32_t c = 0; c < chunks; ++c)
-    for (int64_t i = count * c / chunks; i < count * (c + 1) / chunks; ++i) count_item(i, hist[c].data());
+    for (int64_t i = count * c / chunks; i < count * (c + 1) / chunks; ++i) count_item(i, hist(c));
   offsets.assign(size_t(num_buckets) + 1, 0);
   int64_t running = 0;
   for (int32_t b = 0; b < num_buckets; ++b) {
     offsets[b] = static_cast<int32_t>(running);
     for (int32_t c = 0; c < chunks; ++c) {
-      const int32_t x = hist[c][b];
-      hist[c][b] = static_cast<int32_t>(running);
+      const int32_t x = hist(c)[b];
+      hist(c)[b] = static_cast<int32_t>(running);
       running += x;
     }
   }
@@ -43,7 +45,7 @@ void counting_sort(int64_t count, int32_t num_buckets, CountItem count_item, Pla
   offsets[num_buckets] = static_cast<int32_t>(running);
 #pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
   for (int32_t c = 0; c < chunks; ++c)
-    for (int64_t i = count * c / chunks; i < count * (c + 1) / chunks; ++i) place(i, hist[c].data());
+    for (int64_t i = count * c / chunks; i < count * (c + 1) / chunks; ++i) place(i, hist(c));
 }
 
 // Sorts a small range in place (insertion sort; buckets here hold a handful of entries), falling
@@ -209,7 +211,7 @@ void renumber_and_sort(SimplicialComplex& out, std::vector<int32_t> order, std::
         for (int c = 0; c < 3; ++c) triangles[3 * size_t(at) + c] = out.triangles[3 * size_t(t) + c];
         source[at] = out.triangle_source[t];
       },
-      offsets);
+      offsets, out.scratch.histograms);
   out.triangles.swap(triangles);
   out.triangle_source.swap(source);
 }
@@ -251,10 +253,12 @@ void link_sides(SimplicialComplex& out, const std::vector<int32_t>& wires) {
   const int32_t num_sides = out.num_sides();
   const int32_t* tri = out.triangles.data();
 
-  std::vector<int32_t> star(num_sides), star_offsets;
+  auto& star = out.scratch.star;
+  auto& star_offsets = out.scratch.star_offsets;
+  star.resize(num_sides);
   counting_sort(
       num_sides, n, [&](int64_t s, int32_t* hist) { ++hist[tri[s]]; },
-      [&](int64_t s, int32_t* hist) { star[hist[tri[s]]++] = int32_t(s); }, star_offsets);
+      [&](int64_t s, int32_t* hist) { star[hist[tri[s]]++] = int32_t(s); }, star_offsets, out.scratch.histograms);
   // Wires by lower vertex (rare; serial).
   const int64_t num_wires = static_cast<int64_t>(wires.size() / 2);
   std::vector<int32_t> wire_ends, wire_offsets;
@@ -262,7 +266,8 @@ void link_sides(SimplicialComplex& out, const std::vector<int32_t>& wires) {
     wire_ends.resize(num_wires);
     counting_sort(
         num_wires, n, [&](int64_t w, int32_t* hist) { ++hist[wires[2 * w]]; },
-        [&](int64_t w, int32_t* hist) { wire_ends[hist[wires[2 * w]]++] = wires[2 * w + 1]; }, wire_offsets);
+        [&](int64_t w, int32_t* hist) { wire_ends[hist[wires[2 * w]]++] = wires[2 * w + 1]; }, wire_offsets,
+        out.scratch.histograms);
   }
   const int32_t* wire_at = num_wires > 0 ? wire_offsets.data() : nullptr;
 
@@ -374,12 +379,21 @@ std::vector<uint8_t> find_duplicates(const SimplicialComplex& k, int32_t& count)
 
 SimplicialComplex build_complex(const double* positions, int32_t num_vertices, const int32_t* triangles,
                                 int64_t num_triangles, const int32_t* edges, int64_t num_edges) {
+  SimplicialComplex out;
+  build_complex(out, positions, num_vertices, triangles, num_triangles, edges, num_edges);
+  return out;
+}
+
+void build_complex(SimplicialComplex& out, const double* positions, int32_t num_vertices, const int32_t* triangles,
+                   int64_t num_triangles, const int32_t* edges, int64_t num_edges) {
   check_sizes_and_positions(positions, num_vertices, num_triangles, num_edges);
   const int32_t m = static_cast<int32_t>(num_triangles);
-  SimplicialComplex out;
+  // Every field is set below; vectors are resized or assigned, keeping the memory they hold.
   out.num_vertices = num_vertices;
   out.input_triangles = m;
   out.input_edges = static_cast<int32_t>(num_edges);
+  out.collapsed_triangles = 0;
+  out.duplicate_triangles = 0;
 
   // Collapsed triangles become wire edges (or nothing beyond their vertex); the others are
   // 2-simplex candidates, copied in the caller's order.
@@ -450,7 +464,6 @@ SimplicialComplex build_complex(const double* positions, int32_t num_vertices, c
     out.duplicate_triangles = duplicates;
     link_sides(out, wires);
   }
-  return out;
 }
 
 }  // namespace topstoc
