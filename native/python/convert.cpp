@@ -60,6 +60,13 @@ std::vector<int32_t> indices_from(const py::handle& object, int64_t columns, con
   return out;
 }
 
+py::array_t<int32_t, py::array::c_style> indices_array(const py::handle& object, int64_t columns, const char* what) {
+  py::array a = as_array(object, what);
+  if (a && py::isinstance<py::array_t<int32_t, py::array::c_style>>(a) && a.ndim() == 2 && a.shape(1) == columns)
+    return py::array_t<int32_t, py::array::c_style>::ensure(a);
+  return py::array_t<int32_t, py::array::c_style>::ensure(to_array(indices_from(object, columns, what), columns));
+}
+
 std::vector<double> scalars_from(const py::handle& object, int64_t n, const char* what) {
   if (object.is_none()) return {};
   py::array a = as_array(object, what);

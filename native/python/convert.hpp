@@ -27,6 +27,10 @@ py::array_t<double, py::array::c_style> positions_array(const py::handle& array,
 /// Values outside int32 raise ValueError naming the row.
 std::vector<int32_t> indices_from(const py::handle& array, int64_t columns, const char* what);
 
+/// Same checks, without the copy: the caller's array when it already is C-ordered int32 (a
+/// checked, converted copy otherwise). Keep the returned array alive while reading its data().
+py::array_t<int32_t, py::array::c_style> indices_array(const py::handle& array, int64_t columns, const char* what);
+
 /// 1-D float array of length n (or None -> empty). NaN raises ValueError naming the entry.
 std::vector<double> scalars_from(const py::handle& array, int64_t n, const char* what);
 

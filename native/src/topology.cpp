@@ -89,38 +89,62 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
   std::vector<int32_t> component_of;  // per internal vertex
   const auto& caller = k.vertex_source;
 
-  // Two independent union-finds, run side by side: vertices joined by edges (each edge
-  // represented by a side, plus fins and wires) give the components; triangles joined across
-  // edges with exactly two triangles give the sheets, with a parity that says whether two
-  // triangles must be flipped relative to each other to agree. A triangle on a flipped edge or
-  // on a parity conflict is flagged; its component is found afterwards.
-  UnionFind vertices(n);
+  // Two independent passes, run side by side. Sheets: triangles joined across edges with
+  // exactly two triangles, with a parity that says whether two triangles must be flipped
+  // relative to each other to agree (a triangle on a flipped edge or on a parity conflict is
+  // flagged; its component is found afterwards). Fans: whether the triangles at each vertex
+  // are one fan, walking around it.
   ParityUnionFind sheets(num_triangles);
   std::vector<uint8_t> sheet_open(num_triangles, 0);  // a sheet with a boundary edge
   std::vector<uint8_t> triangle_flags(num_triangles, 0);  // kFlipped, kConflict (no allocation below)
+  std::vector<uint8_t> split_fan(n, 0);  // a vertex with triangles that are not one fan
   constexpr uint8_t kFlipped = 1, kConflict = 2;
+  bool any_open_side = false;
 #pragma omp parallel sections num_threads(2) if (num_sides >= kParallelMinimum)
   {
 #pragma omp section
     {
-      for (int32_t s = 0; s < num_sides; ++s)
-        if (k.represents_edge(s)) vertices.unite(k.side_start(s), k.side_end(s));
-      for (size_t i = 0; i < k.fin_edges.size(); i += 2) vertices.unite(k.fin_edges[i], k.fin_edges[i + 1]);
-      for (size_t i = 0; i < k.wire_edges.size(); i += 2) vertices.unite(k.wire_edges[i], k.wire_edges[i + 1]);
-    }
-#pragma omp section
-    {
       for (int32_t s = 0; s < num_sides; ++s) {
         const int32_t code = k.side_twin[s];
-        if (code < 0 || (code >> 1) < s) continue;  // each shared edge once
+        if (code < 0) {
+          any_open_side |= code == SimplicialComplex::kOpenSide;
+          continue;
+        }
+        if ((code >> 1) < s) continue;  // each shared edge once
         const uint8_t same_direction = code & 1;
         if (same_direction) triangle_flags[s / 3] |= kFlipped;
         if (sheets.unite(s / 3, (code >> 1) / 3, same_direction) == ParityUnionFind::Join::conflict)
           triangle_flags[s / 3] |= kConflict;
       }
-      for (int32_t s = 0; s < num_sides; ++s)
-        if (k.side_twin[s] == SimplicialComplex::kOpenSide) sheet_open[sheets.find(s / 3)] = 1;
+      if (any_open_side)
+        for (int32_t s = 0; s < num_sides; ++s)
+          if (k.side_twin[s] == SimplicialComplex::kOpenSide) sheet_open[sheets.find(s / 3)] = 1;
     }
+#pragma omp section
+    for (int32_t v = 0; v < n; ++v) {
+      const int32_t triangles = k.vertex_triangles[v];
+      split_fan[v] = triangles > 0 && walk.fan_size(k.vertex_side[v], triangles) != triangles;
+    }
+  }
+
+  // Components, from the sheets rather than a union-find over every edge: a sheet is
+  // connected, and the triangles of a vertex that are one fan lie in one sheet, so a vertex
+  // belongs with the sheet of any of its triangles, named here by a corner of the sheet's root
+  // triangle (two sheets named alike share that vertex, so they are connected). Sheets meet at
+  // vertices with split fans (every vertex of an edge with three or more triangles is one) and
+  // through lone wires; only then are names joined, in a union-find over vertices.
+  auto sheet_name = [&](int32_t t) { return k.triangles[3 * size_t(sheets.find(t))]; };
+  std::vector<int32_t> component_name(n);  // in internal order: the finds walk the sheets in memory order
+  for (int32_t v = 0; v < n; ++v) component_name[v] = k.vertex_triangles[v] ? sheet_name(k.vertex_side[v] / 3) : v;
+  const bool any_split_fan = std::find(split_fan.begin(), split_fan.end(), 1) != split_fan.end();
+  if (any_split_fan || !k.wire_edges.empty()) {
+    UnionFind joined(n);
+    for (size_t i = 0; i < k.wire_edges.size(); i += 2)
+      joined.unite(component_name[k.wire_edges[i]], component_name[k.wire_edges[i + 1]]);
+    if (any_split_fan)
+      for (int32_t s = 0; s < num_sides; ++s)
+        if (split_fan[k.side_start(s)]) joined.unite(component_name[k.side_start(s)], sheet_name(s / 3));
+    for (int32_t v = 0; v < n; ++v) component_name[v] = joined.find(component_name[v]);
   }
 
   // Components numbered by their smallest caller id: walk the caller's ids in order.
@@ -130,7 +154,7 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
     std::vector<int32_t> label(n, -1);
     for (int32_t id = 0; id < n; ++id) {
       const int32_t v = k.vertex_index[id];
-      const int32_t r = vertices.find(v);
+      const int32_t r = component_name[v];
       if (label[r] < 0) {
         label[r] = static_cast<int32_t>(out.components.size());
         out.components.emplace_back();
@@ -165,7 +189,7 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
       if (k.side_twin[s] == SimplicialComplex::kOpenSide) ++c.boundary_edges;
       if (k.represents_edge(s)) ++c.edges;
     }
-    if (sheets.find(t) != t || sheet_open[t]) continue;
+    if (!sheets.is_root(t) || sheet_open[t]) continue;
     ++closed_sheets[ci];
     if (component_fins[ci]) {
       if (sheet_column.empty()) sheet_column.assign(num_triangles, -1);
@@ -226,13 +250,8 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
       out.nonmanifold_edge_triangles.push_back(count);
     }
   }
-#pragma omp parallel for schedule(dynamic, 8192) if (n >= kParallelMinimum)
-  for (int32_t v = 0; v < n; ++v) {
-    if (bad_vertex[v] || k.vertex_triangles[v] == 0) continue;
-    if (walk.fan_size(k.vertex_side[v], k.vertex_triangles[v]) != k.vertex_triangles[v]) bad_vertex[v] = 1;
-  }
   for (int32_t v = 0; v < n; ++v)
-    if (bad_vertex[v]) {
+    if (bad_vertex[v] || split_fan[v]) {
       out.nonmanifold_vertices.push_back(caller[v]);
       ++comps[component_of[v]].nonmanifold_vertices;
     }
@@ -241,7 +260,9 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
   // Boundary curves: from each unvisited boundary side, turn around the fans at its ends.
   std::vector<uint8_t> visited;
   std::vector<int32_t> backward;
-  for (int32_t s0 = 0; s0 < num_sides; ++s0) {
+  int64_t boundary_edges = 0;  // closed surfaces (the common case) skip the scan
+  for (const auto& c : comps) boundary_edges += c.boundary_edges;
+  for (int32_t s0 = 0; s0 < (boundary_edges ? num_sides : 0); ++s0) {
     if (k.side_twin[s0] != SimplicialComplex::kOpenSide) continue;
     if (visited.empty()) visited.assign(num_sides, 0);
     if (visited[s0]) continue;
@@ -320,9 +341,7 @@ TopologyReport analyze_topology(const SimplicialComplex& k) {
 
 TopologyReport analyze_topology(const double* positions, int32_t num_vertices, const int32_t* triangles,
                                 int64_t num_triangles, const int32_t* edges, int64_t num_edges) {
-  return analyze_topology(build_complex(positions, num_vertices,
-                                        std::vector<int32_t>(triangles, triangles + 3 * num_triangles), edges,
-                                        num_edges));
+  return analyze_topology(build_complex(positions, num_vertices, triangles, num_triangles, edges, num_edges));
 }
 
 }  // namespace topstoc

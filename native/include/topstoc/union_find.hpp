@@ -80,6 +80,9 @@ class ParityUnionFind {
     return find(x, ignored);
   }
 
+  /// Whether x is the root of its set (a read, unlike find, which shortens paths).
+  bool is_root(int32_t x) const { return parent_[x] == x; }
+
   enum class Join { merged, consistent, conflict };
 
   /// Asserts parity(a) xor parity(b) == p. Returns merged when two sets became one, consistent
