@@ -58,7 +58,7 @@ def make_object(name, vertices, triangles):
 class Params:
     def __init__(self, ratio):
         self.target_mode, self.ratio, self.seed, self.adaptivity = "RATIO", ratio, 1, 0.5
-        self.density, self.placement, self.output = "off", "subsample", "NEW_OBJECT"
+        self.density, self.placement, self.refine, self.output = "off", "subsample", 0, "NEW_OBJECT"
         self.vertices = self.triangles = 1
         self.max_error, self.max_error_relative = 0.0, False
 
