@@ -253,8 +253,8 @@ void link_sides(SimplicialComplex& out, const std::vector<int32_t>& wires) {
   const int32_t num_sides = out.num_sides();
   const int32_t* tri = out.triangles.data();
 
-  auto& star = out.scratch.star;
-  auto& star_offsets = out.scratch.star_offsets;
+  auto& star = out.vertex_star;
+  auto& star_offsets = out.vertex_star_offsets;
   star.resize(num_sides);
   counting_sort(
       num_sides, n, [&](int64_t s, int32_t* hist) { ++hist[tri[s]]; },

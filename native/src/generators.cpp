@@ -65,8 +65,10 @@ std::vector<ComponentGenerators> compute_generators(const SimplicialComplex& k, 
   for (int32_t v = 0; v < n; ++v) vertex_slot[v] = slot[report.vertex_component[caller[v]]];
   auto slot_of_vertex = [&](int32_t v) { return vertex_slot[v]; };
 
-  // Breadth-first search tree T from each component's root, walking the fans. parent_side[u]
-  // is a side on the tree edge from u's parent to u; in_tree marks both sides of tree edges.
+  // Breadth-first search tree T from each component's root. On a closed manifold the sides
+  // starting at v (its star, contiguous) end at its neighbours, once each: cheaper to read than
+  // walking the fan. parent_side[u] is a side on the tree edge from u's parent to u; in_tree
+  // marks both sides of tree edges.
   std::vector<int32_t> depth(n, -1), parent_side(n, -1), queue;
   std::vector<uint8_t> in_tree(num_sides, 0);
   int32_t max_depth = 0;
@@ -75,16 +77,17 @@ std::vector<ComponentGenerators> compute_generators(const SimplicialComplex& k, 
     depth[g.root] = 0;
     for (size_t head = 0; head < queue.size(); ++head) {
       const int32_t v = queue[head];
-      for_each_edge_around(k, v, [&](const FanCursor& at) {
-        const int32_t u = at.neighbour(k);
-        if (depth[u] >= 0) return;
+      for (int32_t i = k.vertex_star_offsets[v]; i < k.vertex_star_offsets[v + 1]; ++i) {
+        const int32_t s = k.vertex_star[i];
+        const int32_t u = k.side_end(s);
+        if (depth[u] >= 0) continue;
         depth[u] = depth[v] + 1;
         max_depth = std::max(max_depth, depth[u]);
-        parent_side[u] = at.side;
-        in_tree[at.side] = 1;
-        in_tree[k.side_twin[at.side] >> 1] = 1;
+        parent_side[u] = s;
+        in_tree[s] = 1;
+        in_tree[k.side_twin[s] >> 1] = 1;
         queue.push_back(u);
-      });
+      }
     }
   }
   auto parent = [&](int32_t v) {

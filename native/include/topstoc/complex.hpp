@@ -60,6 +60,10 @@ struct SimplicialComplex {
   /// Triangles at each vertex, and one side starting at it (-1 for none).
   std::vector<int32_t> vertex_triangles;
   std::vector<int32_t> vertex_side;
+  /// The sides starting at each vertex, in side order (CSR: vertex_star[vertex_star_offsets[v]
+  /// .. vertex_star_offsets[v+1])). On a closed manifold their ends are v's neighbours, once each.
+  std::vector<int32_t> vertex_star;
+  std::vector<int32_t> vertex_star_offsets;
   /// Edges with three or more triangles (internal vertex pairs, lower first, sorted) and their sides
   /// (CSR: fin_sides[fin_offsets[i] .. fin_offsets[i+1]), increasing).
   std::vector<int32_t> fin_edges;
@@ -80,7 +84,7 @@ struct SimplicialComplex {
   /// Working memory of build_complex, kept here so that building into the same object again
   /// reuses it (see build_complex).
   struct Scratch {
-    std::vector<int32_t> star, star_offsets, histograms;
+    std::vector<int32_t> histograms;
   } scratch;
 
   int32_t num_triangles() const { return static_cast<int32_t>(triangles.size() / 3); }
