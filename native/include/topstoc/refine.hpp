@@ -7,9 +7,11 @@
 // A collapse moves vertex u onto its neighbour v, so every output vertex is still an input
 // vertex (or its filtered position) and positions never move. A collapse is done only if it
 // keeps every guarantee of the decimation: the link condition holds (so the surface stays a
-// manifold of the same topology), no triangle flips or loses all area, and u lies on no border
-// (feature vertices, boundaries, UV seams and material borders never move, so attributes keep
-// carrying over exactly). User guidance scales the costs; control points are never removed.
+// manifold of the same topology), no triangle flips or loses all area, and a vertex on a
+// border curve (boundary, UV seam, material border, flagged edge) moves only along its curve,
+// onto the next vertex of the same curve or a corner, so borders keep their course and their
+// sides and attributes keep carrying over exactly. Corners never move, closed curves keep three
+// vertices. User guidance scales the costs; control points are never removed.
 #pragma once
 
 #include <cstdint>
