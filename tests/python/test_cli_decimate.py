@@ -1,45 +1,24 @@
 """The ``decimate`` command line (SPEC section 6), run as a subprocess like a user would."""
 
+import functools
 import inspect
 import json
-import os
 import pathlib
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
+import cli
 from meshgen import torus
 from topstoc.core.decimate import decimate as core_decimate
 from topstoc.core.io import MeshData, read_mesh, write_mesh
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-BUILD_PYTHON = pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build")) / "python"
 DATA = ROOT / "tests" / "data"
 
-
-def topstoc(*args):
-    env = dict(os.environ, PYTHONPATH=str(BUILD_PYTHON))
-    return subprocess.run([sys.executable, "-m", "topstoc", "decimate", *map(str, args)],
-                          capture_output=True, text=True, env=env, timeout=120)
-
-
-def run_json(*args):
-    done = topstoc(*args, "--json")
-    assert done.returncode == 0, done.stderr
-    assert done.stderr == ""
-    return json.loads(done.stdout)
-
-
-def assert_one_error_line(done, *fragments):
-    assert done.returncode == 1
-    lines = done.stderr.strip().splitlines()
-    assert len(lines) == 1, done.stderr
-    assert lines[0].startswith("topstoc decimate: error: ")
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
-    assert done.stdout == ""
+topstoc = functools.partial(cli.run, "decimate", timeout=120)
+run_json = functools.partial(cli.run_json, "decimate")
+assert_one_error_line = functools.partial(cli.assert_one_error_line, "decimate")
 
 
 def test_json_report_matches_the_files(tmp_path):

@@ -1,27 +1,16 @@
 """``python3 -m topstoc fill-holes`` and ``remove-handle`` (SPEC section 6)."""
 
 import json
-import os
-import pathlib
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import meshgen
 import reference as ref
-
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-BUILD = pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build"))
+from cli import run as topstoc
 
 io = pytest.importorskip("topstoc.core.io", reason="file I/O (topstoc.core.io) is not in this build")
 pytest.importorskip("topstoc.core.topology", reason="topstoc.core.topology is not in this build")
-
-
-def topstoc(*args):
-    env = dict(os.environ, PYTHONPATH=str(BUILD / "python"))
-    return subprocess.run([sys.executable, "-m", "topstoc", *map(str, args)], capture_output=True, text=True, env=env)
 
 
 def genus_of(vertices, triangles):

@@ -1,34 +1,22 @@
 """The ``loops`` command line (SPEC section 6), run as a subprocess like a user would."""
 
+import functools
 import gzip
-import json
-import os
 import pathlib
-import subprocess
-import sys
 
 import numpy as np
 
+import cli
 import homology_check as hc
 from meshgen import genus_slab, torus
 from topstoc.core.io import MeshData, read_mesh, write_mesh
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-BUILD_PYTHON = pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build")) / "python"
 DATA = ROOT / "tests" / "data"
 
-
-def topstoc(*args):
-    env = dict(os.environ, PYTHONPATH=str(BUILD_PYTHON))
-    return subprocess.run([sys.executable, "-m", "topstoc", "loops", *map(str, args)],
-                          capture_output=True, text=True, env=env, timeout=300)
-
-
-def run_json(*args):
-    done = topstoc(*args, "--json")
-    assert done.returncode == 0, done.stderr
-    assert done.stderr == ""
-    return json.loads(done.stdout)
+topstoc = functools.partial(cli.run, "loops")
+run_json = functools.partial(cli.run_json, "loops")
+assert_one_error_line = functools.partial(cli.assert_one_error_line, "loops")
 
 
 def test_json_lists_genus_handles_and_tunnels_in_file_ids():
@@ -89,16 +77,6 @@ def test_open_components_are_reported():
     doc = run_json(DATA / "open_boundary" / "cgal_mushroom.off")
     assert [c["status"] for c in doc["components"]] == ["open"]
     assert doc["components"][0]["handles"] == []
-
-
-def assert_one_error_line(done, *fragments):
-    assert done.returncode == 1
-    lines = done.stderr.strip().splitlines()
-    assert len(lines) == 1, done.stderr
-    assert lines[0].startswith("topstoc loops: error: ")
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
-    assert done.stdout == ""
 
 
 def test_errors_are_one_line(tmp_path):

@@ -1,23 +1,17 @@
 """``python3 -m topstoc topology IN`` (SPEC section 6): JSON keys and values, text report, errors."""
 
+import functools
 import json
-import os
-import subprocess
-import sys
 
 import pytest
 
-from conftest import BUILD
+import cli
 
 pytest.importorskip("topstoc.core.io")
 from topstoc.core.io import read_mesh  # noqa: E402
 from topstoc.core.topology import topology  # noqa: E402
 
-
-def run_cli(*args):
-    env = dict(os.environ, PYTHONPATH=str(BUILD / "python"))
-    return subprocess.run([sys.executable, "-m", "topstoc", "topology", *map(str, args)],
-                          capture_output=True, text=True, env=env, timeout=120)
+run_cli = functools.partial(cli.run, "topology", timeout=120)
 
 
 def test_json_report_matches_the_api(data_dir):
