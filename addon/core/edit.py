@@ -21,6 +21,7 @@ from typing import List, Optional, Sequence
 
 import numpy as np
 
+from .mesh import as_vertices
 from .native import engine
 
 #: Patch methods, from the thesis' planar projection to the last resort (hole_triangulation.hpp).
@@ -196,14 +197,6 @@ def _result(raw: dict, vertices: np.ndarray, triangles) -> EditResult:
                       input_triangles=len(triangles), cut_sides=sides, patches=patches)
 
 
-def _vertices(vertices) -> np.ndarray:
-    array = np.asarray(vertices)
-    if array.ndim != 2 or array.shape[1] != 3 or array.dtype.kind != "f":
-        raise ValueError(f"vertices must be a float32 or float64 array of shape (n, 3), "
-                         f"got {array.dtype} array of shape {array.shape}")
-    return array
-
-
 def _loop(loop) -> np.ndarray:
     array = np.asarray(loop)
     if array.ndim != 1 or (array.size and array.dtype.kind not in "iu"):
@@ -220,7 +213,7 @@ def boundary_loops(vertices, triangles) -> List[BoundaryLoop]:
 
     The index of a loop in this list is what ``fill_holes(holes=...)`` takes.
     """
-    vertices = _vertices(vertices)
+    vertices = as_vertices(vertices)
     return [BoundaryLoop(vertices=ids, nonmanifold_vertex=None if bad < 0 else int(bad), lone_triangle=bool(lone))
             for ids, bad, lone in engine.boundary_loops(triangles, len(vertices))]
 
@@ -239,7 +232,7 @@ def delete_faces(vertices, triangles, faces) -> EditResult:
     elif faces.ndim != 1 or (faces.size and faces.dtype.kind not in "iu"):
         raise ValueError(f"faces must be triangle indices or a boolean mask, got {faces.dtype} array "
                          f"of shape {faces.shape}")
-    vertices = _vertices(vertices)
+    vertices = as_vertices(vertices)
     return _result(engine.delete_faces(vertices, triangles, faces.astype(np.int64)), vertices, triangles)
 
 
@@ -249,7 +242,7 @@ def cut_along_loop(vertices, triangles, loop: Sequence[int]) -> EditResult:
     Each loop vertex is split into one copy per side; ``cut_sides`` lists the two new
     boundary loops (one for a one-sided loop). Positions and ids of existing vertices are kept.
     """
-    vertices = _vertices(vertices)
+    vertices = as_vertices(vertices)
     return _result(engine.cut_along_loop(vertices, triangles, _loop(loop)), vertices, triangles)
 
 
@@ -279,7 +272,7 @@ def fill_holes(vertices, triangles, holes: Optional[Sequence[int]] = None, *, ma
         holes = holes.astype(np.int64)
     if max_edges is not None and max_edges < 3:
         raise ValueError(f"max_edges must be at least 3, got {max_edges}")
-    vertices = _vertices(vertices)
+    vertices = as_vertices(vertices)
     raw = engine.fill_holes(vertices, triangles, holes, max_edges=max_edges or 0, skip_unfillable=skip_unfillable,
                             weld_pinches=weld_pinches, **_fill_options(planar, max_dp_corners, refine, fair))
     return _result(raw, vertices, triangles)
@@ -288,7 +281,7 @@ def fill_holes(vertices, triangles, holes: Optional[Sequence[int]] = None, *, ma
 def fill_loops(vertices, triangles, loops: Sequence[Sequence[int]], *, planar: bool = True,
                max_dp_corners: int = 300, refine: bool = False, fair: bool = False) -> EditResult:
     """Fills holes given as boundary cycles of vertex ids (either direction)."""
-    vertices = _vertices(vertices)
+    vertices = as_vertices(vertices)
     raw = engine.fill_loops(vertices, triangles, [_loop(loop) for loop in loops],
                             **_fill_options(planar, max_dp_corners, refine, fair))
     return _result(raw, vertices, triangles)
@@ -307,7 +300,7 @@ def remove_handle(vertices, triangles, loop: Sequence[int], *, allow_separating:
     neighbours on its own side (less where a triangle would turn over), so the two patches do
     not lie on top of each other; 0 leaves them in place, coinciding.
     """
-    vertices = _vertices(vertices)
+    vertices = as_vertices(vertices)
     raw = engine.remove_handle(vertices, triangles, _loop(loop), allow_separating=allow_separating,
                                separation=float(separation),
                                **_fill_options(planar, max_dp_corners, refine, fair))

@@ -56,7 +56,8 @@ class MeshReport:
         return ", ".join(parts)
 
 
-def _as_vertices(vertices) -> np.ndarray:
+def as_vertices(vertices) -> np.ndarray:
+    """The caller's vertex array as numpy, checked to be floats of shape (n, 3) (ValueError)."""
     array = np.asarray(vertices)
     if array.ndim != 2 or array.shape[1] != 3 or array.dtype.kind != "f":
         raise ValueError(f"vertices must be a float32 or float64 array of shape (n, 3), "
@@ -92,7 +93,7 @@ class Mesh:
     """
 
     def __init__(self, vertices, triangles):
-        vertices = _as_vertices(vertices)
+        vertices = as_vertices(vertices)
         triangles = _as_triangles(triangles)
         self._native = engine.Mesh(vertices, triangles)
         self._vertices = np.array(vertices, dtype=np.float64)
