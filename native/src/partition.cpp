@@ -205,11 +205,21 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
       for (int32_t f = 0; f < m; ++f)
         if (emit.emits[f]) mine.push_back(f);
     }
-    for (const auto& list : found)
-      for (int32_t f : list) {
-        out.source_face.push_back(f);
-        for (int j = 0; j < 3; ++j) out.triangles.push_back(label[faces[3 * size_t(f) + j]]);
-      }
+    std::vector<size_t> start(threads + 1, 0);
+    for (int i = 0; i < threads; ++i) start[i + 1] = start[i] + found[i].size();
+    out.source_face.resize(start[threads]);
+    out.triangles.resize(3 * start[threads]);
+#pragma omp parallel if (m >= kParallelMin)
+    {
+      const int me = omp_get_thread_num();
+      for (int list = me; list < threads; list += omp_get_num_threads())
+        for (size_t i = 0; i < found[list].size(); ++i) {
+          const int32_t f = found[list][i];
+          const size_t at = start[list] + i;
+          out.source_face[at] = f;
+          for (int j = 0; j < 3; ++j) out.triangles[3 * at + j] = label[faces[3 * size_t(f) + j]];
+        }
+    }
   }
   const int32_t emitted = static_cast<int32_t>(out.source_face.size());
 
@@ -220,16 +230,26 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     if (lx != ly) feature_copies[pair_key(lx, ly)] += layout.edge_copies(mesh, e);
   }
 
-  // --- triangles around each sample -----------------------------------------------------------
-  std::vector<int32_t> around_offsets(k + 1, 0), around(out.triangles.size());
-  for (int32_t x : out.triangles) ++around_offsets[x + 1];
-  for (int32_t s = 0; s < k; ++s) around_offsets[s + 1] += around_offsets[s];
+  // --- the arcs of each sample's link ---------------------------------------------------------
+  // Triangle (a, b, c) gives a the arc b -> c, b the arc c -> a and c the arc a -> b. Stored per
+  // sample in one array, so that evaluating a sample reads one short contiguous run.
+  struct Arc {
+    int32_t from, to, triangle;
+  };
+  std::vector<int32_t> arc_offsets(k + 1, 0);
+  for (int32_t x : out.triangles) ++arc_offsets[x + 1];
+  for (int32_t s = 0; s < k; ++s) arc_offsets[s + 1] += arc_offsets[s];
+  std::vector<Arc> arcs(out.triangles.size());
   {
-    std::vector<int32_t> fill(around_offsets.begin(), around_offsets.end() - 1);
-    for (int32_t i = 0; i < emitted; ++i)
-      for (int j = 0; j < 3; ++j) around[fill[out.triangles[3 * size_t(i) + j]]++] = i;
+    std::vector<int32_t> fill(arc_offsets.begin(), arc_offsets.end() - 1);
+    for (int32_t i = 0; i < emitted; ++i) {
+      const int32_t* t = &out.triangles[3 * size_t(i)];
+      arcs[fill[t[0]]++] = {t[1], t[2], i};
+      arcs[fill[t[1]]++] = {t[2], t[0], i};
+      arcs[fill[t[2]]++] = {t[0], t[1], i};
+    }
   }
-  auto incident = [&](int32_t s) { return around_offsets[s + 1] - around_offsets[s]; };
+  auto incident = [&](int32_t s) { return arc_offsets[s + 1] - arc_offsets[s]; };
 
   // --- per sample: one oriented fan, expected edge multiplicities, Euler contributions ----------
   // Each triangle (s, a, b) around sample s is an arc a -> b of s's link. Six times a component's
@@ -240,6 +260,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   std::vector<int64_t> chi6_out(k, 0);
   out.absorbed.assign(k, 0);
   std::vector<uint8_t> drop(emitted, 0);
+  bool any_dropped = false;  // drop is read only once pillows are dropped
   std::vector<std::vector<uint64_t>> seen_pairs(threads);
   std::vector<std::vector<int32_t>> repeated_lists(threads);
   int32_t bad_link = 0, bad_edge = 0, isolated = 0, absorbed = 0;
@@ -247,12 +268,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   auto evaluate = [&](int32_t s, Link& link, std::vector<uint64_t>& seen, int32_t& links, int32_t& edges,
                       int32_t& lonely, int32_t& eaten) {
     link.clear();
-    for (int32_t i = around_offsets[s]; i < around_offsets[s + 1]; ++i) {
-      if (drop[around[i]]) continue;
-      const int32_t* tri = &out.triangles[3 * size_t(around[i])];
-      const int j = tri[0] == s ? 0 : tri[1] == s ? 1 : 2;
-      link.add(tri[(j + 1) % 3], tri[(j + 2) % 3]);
-    }
+    for (int32_t i = arc_offsets[s]; i < arc_offsets[s + 1]; ++i)
+      if (!any_dropped || !drop[arcs[i].triangle]) link.add(arcs[i].from, arcs[i].to);
     if (link.repeated()) return false;
     if (link.arcs == 0) {
       // No triangle: the neighbours absorbed this cluster (the pillow case) unless the sample
@@ -270,7 +287,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     for (const auto& nb : link.neighbours) {
       if (nb.id < s) continue;  // each pair once
       int32_t expected = 2;
-      auto it = feature_copies.find(pair_key(s, nb.id));
+      auto it = feature_copies.empty() ? feature_copies.end() : feature_copies.find(pair_key(s, nb.id));
       if (it != feature_copies.end()) {
         expected = it->second;
         seen.push_back(it->first);
@@ -309,12 +326,12 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   if (!repeated.empty()) {
     std::vector<std::pair<std::array<int32_t, 3>, int32_t>> keyed;  // sorted triple, triangle
     for (int32_t s : repeated)
-      for (int32_t i = around_offsets[s]; i < around_offsets[s + 1]; ++i) {
-        const int32_t* t = &out.triangles[3 * size_t(around[i])];
+      for (int32_t i = arc_offsets[s]; i < arc_offsets[s + 1]; ++i) {
+        const int32_t* t = &out.triangles[3 * size_t(arcs[i].triangle)];
         if (std::min({t[0], t[1], t[2]}) != s) continue;  // each triangle from its lowest sample
         std::array<int32_t, 3> key = {t[0], t[1], t[2]};
         std::sort(key.begin(), key.end());
-        keyed.push_back({key, around[i]});
+        keyed.push_back({key, arcs[i].triangle});
       }
     std::sort(keyed.begin(), keyed.end());
     for (size_t a = 0; a < keyed.size();) {
@@ -328,6 +345,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
         if (opposite && absorbs) {
           ++out.issues.pillows;
           drop[keyed[a].second] = drop[keyed[a + 1].second] = 1;
+          any_dropped = true;
         } else {
           ++out.issues.duplicate;
           for (int j = 0; j < 3; ++j) marks.add(t0[j]);
@@ -420,10 +438,18 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // --- triangles of zero area (collinear samples) ------------------------------------------------
   if (check_slivers) {
     const int32_t t = static_cast<int32_t>(out.source_face.size());
-    std::vector<int32_t> slivers;
+    // The samples' positions gathered once, in rank order: the triangles then read a compact
+    // array instead of the whole mesh's.
+    std::vector<double> at(3 * size_t(k));
+#pragma omp parallel for schedule(static) if (k >= kParallelMin)
+    for (int32_t s = 0; s < k; ++s)
+      for (int j = 0; j < 3; ++j) at[3 * size_t(s) + j] = mesh.position(samples[s])[j];
+    std::vector<uint8_t> sliver(t, 0);
+    int32_t slivers = 0;
+#pragma omp parallel for schedule(static) reduction(+ : slivers) if (t >= kParallelMin)
     for (int32_t i = 0; i < t; ++i) {
       const double* p[3];
-      for (int j = 0; j < 3; ++j) p[j] = mesh.position(samples[out.triangles[3 * size_t(i) + j]]);
+      for (int j = 0; j < 3; ++j) p[j] = &at[3 * size_t(out.triangles[3 * size_t(i) + j])];
       double u[3], w[3], longest = 0;
       for (int a = 0; a < 3; ++a) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
       for (int j = 0; j < 3; ++j) {
@@ -434,11 +460,14 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
       }
       const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
       if (std::sqrt(cx * cx + cy * cy + cz * cz) <= 1e-9 * longest) {
-        ++out.issues.sliver;
-        for (int j = 0; j < 3; ++j) slivers.push_back(out.triangles[3 * size_t(i) + j]);
+        sliver[i] = 1;
+        ++slivers;
       }
     }
-    out.split_clusters.insert(out.split_clusters.end(), slivers.begin(), slivers.end());
+    out.issues.sliver += slivers;
+    for (int32_t i = 0; i < t && slivers > 0; ++i)
+      if (sliver[i])
+        for (int j = 0; j < 3; ++j) out.split_clusters.push_back(out.triangles[3 * size_t(i) + j]);
   }
   std::sort(out.split_clusters.begin(), out.split_clusters.end());
   out.split_clusters.erase(std::unique(out.split_clusters.begin(), out.split_clusters.end()),
