@@ -7,6 +7,7 @@
 #include <string>
 
 #include <limits>
+#include <memory>
 #include <omp.h>
 
 #include "topstoc/random.hpp"
@@ -84,15 +85,53 @@ double apply_view(const ViewGuidance& view, const double* position, const double
   return p;
 }
 
-// q for every vertex that is sampled stochastically (0 elsewhere), computed once per draw.
-std::vector<double> importance_factors(const Mesh& mesh, const std::vector<uint8_t>& cls,
-                                       const SamplingParams& params) {
+// Per-vertex class and importance q (0 where not sampled stochastically), with q sorted per
+// class for solving the rate. Depends on the mesh, the layout and three parameters only, so it
+// is kept on the layout and reused while they stay the same (a slider changes only the target).
+struct ImportanceTable {
+  double adaptivity = 0.0, flat_floor = 0.0;
+  bool area_weighted = false;
+  std::vector<uint8_t> cls;
+  std::vector<double> q;
+  std::vector<double> surface_q, surface_sum;    // sorted ascending; prefix sums of q
+  std::vector<double> curve_q, curve_sqrt_sum;   // sorted ascending; prefix sums of sqrt(q)
+  double corners = 0.0;
+  double total_q = 0.0;  // over surface and curve vertices
+  int32_t active = 0;    // vertices in triangles
+};
+
+std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const FeatureLayout& layout,
+                                                        const SamplingParams& params) {
+  auto cached = std::static_pointer_cast<const ImportanceTable>(layout.sampling_table.get());
+  if (cached && cached->adaptivity == params.adaptivity && cached->flat_floor == params.flat_floor &&
+      cached->area_weighted == params.area_weighted && int32_t(cached->cls.size()) == mesh.num_vertices())
+    return cached;
+  auto table = std::make_shared<ImportanceTable>();
+  table->adaptivity = params.adaptivity;
+  table->flat_floor = params.flat_floor;
+  table->area_weighted = params.area_weighted;
+  table->cls = classify(mesh, layout);
+  const auto& cls = table->cls;
   const int32_t n = mesh.num_vertices();
-  std::vector<double> q(n, 0.0);
+  table->q.assign(n, 0.0);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v)
-    if (cls[v] == kSurface || cls[v] == kCurve) q[v] = importance(mesh, params, v);
-  return q;
+    if (cls[v] == kSurface || cls[v] == kCurve) table->q[v] = importance(mesh, params, v);
+  for (int32_t v = 0; v < n; ++v) {
+    if (cls[v] == kSurface) table->surface_q.push_back(table->q[v]);
+    else if (cls[v] == kCurve) table->curve_q.push_back(table->q[v]);
+    else if (cls[v] == kCorner) table->corners += 1.0;
+    table->active += cls[v] != kIsolated;
+    table->total_q += table->q[v];
+  }
+  std::sort(table->surface_q.begin(), table->surface_q.end());
+  std::sort(table->curve_q.begin(), table->curve_q.end());
+  table->surface_sum.assign(1, 0.0);
+  for (double q : table->surface_q) table->surface_sum.push_back(table->surface_sum.back() + q);
+  table->curve_sqrt_sum.assign(1, 0.0);
+  for (double q : table->curve_q) table->curve_sqrt_sum.push_back(table->curve_sqrt_sum.back() + std::sqrt(q));
+  layout.sampling_table.set(table);
+  return table;
 }
 
 bool has_per_vertex_guidance(const SamplingParams& params) {
@@ -134,52 +173,32 @@ std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& 
 // Without guidance: the base rate k whose probabilities sum to the target. The sum is
 // increasing and concave in k (min(1, k q) and sqrt are), so Newton steps taken from below stay
 // below the root and converge monotonically; a bracket guards against round-off. The draw
-// fixes the count anyway, so k need only be close.
-double solve_rate(const std::vector<uint8_t>& cls, const std::vector<double>& q, double target) {
-  const int32_t n = int32_t(cls.size());
-  double min_q = 1e300, total_q = 0.0, corners = 0.0;
-  for (int32_t v = 0; v < n; ++v) {
-    if (cls[v] == kSurface || cls[v] == kCurve) {
-      min_q = std::min(min_q, q[v]);
-      total_q += q[v];
-    } else if (cls[v] == kCorner) {
-      corners += 1.0;
-    }
-  }
+// fixes the count anyway, so k need only be close. Each evaluation reads the sorted q and
+// their prefix sums: the vertices with k q < 1 are a prefix, the rest count 1 each.
+double solve_rate(const ImportanceTable& table, double target) {
+  const size_t surfaces = table.surface_q.size(), curves = table.curve_q.size();
+  double min_q = 1e300;
+  if (surfaces) min_q = std::min(min_q, table.surface_q.front());
+  if (curves) min_q = std::min(min_q, table.curve_q.front());
   // Sum of the probabilities at k and its derivative.
   auto evaluate = [&](double k, double& slope) {
-    double sum = 0.0, d = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : sum, d) if (n >= kParallelMin)
-    for (int32_t v = 0; v < n; ++v) {
-      if (cls[v] == kSurface) {
-        const double p = k * q[v];
-        if (p < 1.0) sum += p, d += q[v];
-        else sum += 1.0;
-      } else if (cls[v] == kCurve) {
-        const double p = k * q[v];
-        if (p < 1.0) {
-          const double r = std::sqrt(p);
-          sum += r;
-          d += k > 0 ? 0.5 * r / k : 0.0;
-        } else {
-          sum += 1.0;
-        }
-      } else if (cls[v] == kCorner) {
-        sum += 1.0;
-      }
-    }
-    slope = d;
-    return sum;
+    const double limit = k > 0 ? 1.0 / k : std::numeric_limits<double>::infinity();
+    const size_t s = std::lower_bound(table.surface_q.begin(), table.surface_q.end(), limit) - table.surface_q.begin();
+    const size_t c = std::lower_bound(table.curve_q.begin(), table.curve_q.end(), limit) - table.curve_q.begin();
+    const double root = std::sqrt(k);
+    slope = table.surface_sum[s] + (k > 0 ? 0.5 * table.curve_sqrt_sum[c] / root : 0.0);
+    return table.corners + k * table.surface_sum[s] + double(surfaces - s) + root * table.curve_sqrt_sum[c] +
+           double(curves - c);
   };
-  if (total_q <= 0 || target <= corners) return 0.0;
+  if (table.total_q <= 0 || target <= table.corners) return 0.0;
   double lo = 0.0, hi = min_q < 1e300 ? 1.0 / min_q : 1.0;
   double slope = 0.0;
   if (evaluate(hi, slope) <= target) return hi;
   // Start from the rate that would be exact if nothing clamped and there were no curves; the
   // curves' sqrt makes the true sum larger, so this start is at or below the root... unless
   // clamping dominates, which the bracket handles.
-  double k = std::min(hi, (target - corners) / total_q);
-  for (int it = 0; it < 50; ++it) {
+  double k = std::min(hi, (target - table.corners) / table.total_q);
+  for (int it = 0; it < 100; ++it) {
     const double f = evaluate(k, slope) - target;
     if (std::abs(f) <= std::max(0.5, 1e-4 * target)) break;
     if (f < 0) lo = k;
@@ -403,23 +422,22 @@ void validate_sampling_params(const Mesh& mesh, const SamplingParams& params) {
 
 std::vector<double> sampling_probabilities(const Mesh& mesh, const FeatureLayout& layout,
                                            const SamplingParams& params, double k) {
-  const auto cls = classify(mesh, layout);
-  return probabilities(mesh, cls, importance_factors(mesh, cls, params), params, k);
+  const auto table = importance_table(mesh, layout, params);
+  return probabilities(mesh, table->cls, table->q, params, k);
 }
 
 SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const SamplingParams& params,
                          int32_t target_vertices) {
   validate_sampling_params(mesh, params);
   const int32_t n = mesh.num_vertices();
-  const auto cls = classify(mesh, layout);
-  int32_t active = 0;
-  for (int32_t v = 0; v < n; ++v) active += cls[v] != kIsolated;
+  const auto table = importance_table(mesh, layout, params);
+  const auto& cls = table->cls;
+  const int32_t active = table->active;
   SampleSet out;
   out.guided = is_guided(mesh, params);
   const int32_t target = std::clamp(target_vertices, 0, active);
-  const auto q = importance_factors(mesh, cls, params);
-  out.rate = out.guided ? double(target) / double(std::max(1, active)) : solve_rate(cls, q, target);
-  const auto p = probabilities(mesh, cls, q, params, out.rate);
+  out.rate = out.guided ? double(target) / double(std::max(1, active)) : solve_rate(*table, target);
+  const auto p = probabilities(mesh, cls, table->q, params, out.rate);
   double expected = 0.0;
   for (double x : p) expected += x;
   out.expected = expected;

@@ -11,11 +11,34 @@
 
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "topstoc/mesh.hpp"
 
 namespace topstoc {
+
+/// One table another module derives from a layout and its mesh and keeps between calls
+/// (sampling keeps its per-vertex importance there: a slider re-decimating with the same
+/// parameters then skips recomputing it). Copies start empty; safe to use from many threads.
+class DerivedTable {
+ public:
+  DerivedTable() = default;
+  DerivedTable(const DerivedTable&) {}
+  DerivedTable& operator=(const DerivedTable&) { return *this; }
+  std::shared_ptr<const void> get() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return table_;
+  }
+  void set(std::shared_ptr<const void> table) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    table_ = std::move(table);
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  mutable std::shared_ptr<const void> table_;
+};
 
 struct FeatureLayout {
   std::vector<uint8_t> edge_feature;    ///< per edge: 1 if no cluster may cross it
@@ -35,6 +58,7 @@ struct FeatureLayout {
   /// cluster's vertices it gives six times the cluster's Euler characteristic up to the terms
   /// of edges and faces shared with other clusters (see partition.cpp).
   std::vector<int32_t> chi_constant;
+  DerivedTable sampling_table;  ///< sampling.cpp's importance table for its last parameters
   int32_t region_border_edges = 0;
   int32_t flagged_edges = 0;
   int32_t crease_edges = 0;
