@@ -37,8 +37,10 @@ std::vector<double> scalars_from(const py::handle& array, int64_t n, const char*
 /// 1-D integer array of length n (or None -> empty).
 std::vector<int32_t> ids_from(const py::handle& array, int64_t n, const char* what);
 
-/// Scope of one engine call: releases the GIL and sizes OpenMP teams to the cores free now.
+/// Scope of one engine call: releases the GIL and sizes OpenMP teams to this call's share of
+/// the cores free now.
 struct EngineCall {
+  RunningCall running;
   EngineCall() { use_free_cores(); }
   py::gil_scoped_release release;
 };

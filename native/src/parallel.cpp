@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -60,6 +61,17 @@ int free_cores() {
   return std::clamp(omp_get_num_procs() - others, 1, ceiling);
 }
 
-void use_free_cores() { omp_set_num_threads(free_cores()); }
+namespace {
+std::atomic<int> running_calls{0};
+}  // namespace
+
+RunningCall::RunningCall() { running_calls.fetch_add(1); }
+RunningCall::~RunningCall() { running_calls.fetch_sub(1); }
+
+void use_free_cores() {
+  // Our own running calls count as busy in free_cores() only while their threads are on a core
+  // at this instant; dividing by the calls in flight gives each its share either way.
+  omp_set_num_threads(std::max(1, free_cores() / std::max(1, running_calls.load())));
+}
 
 }  // namespace topstoc

@@ -16,8 +16,19 @@ constexpr int64_t kParallelMin = 100000;
 /// average and so throttles a program for work it did itself minutes ago.
 int free_cores();
 
-/// Sizes the calling thread's OpenMP teams to free_cores(); each engine entry point calls it.
-/// Results never depend on the number of threads.
+/// Sizes the calling thread's OpenMP teams to its share of free_cores(): engine calls running
+/// at the same time (say two preview updates on two threads) split the free cores between them
+/// instead of each taking them all. Results never depend on the number of threads.
 void use_free_cores();
+
+/// Marks one engine call as running for its lifetime (counted by use_free_cores); each engine
+/// entry point holds one, then calls use_free_cores.
+class RunningCall {
+ public:
+  RunningCall();
+  ~RunningCall();
+  RunningCall(const RunningCall&) = delete;
+  RunningCall& operator=(const RunningCall&) = delete;
+};
 
 }  // namespace topstoc
