@@ -3,17 +3,24 @@
 A PreviewSession owns a temporary object that shows the current result (geometry only, no
 attributes: the final result is written with every attribute when the user applies). Engine
 calls release the GIL, so the interface stays responsive even when one update is slow; the
-session always computes the most recent request and drops the ones in between. The worker
-goes on to the latest request as soon as it finishes one, without waiting for the main thread
-to notice (the modal timer) or to write the result: the rate a user sees is then set by the
-decimation alone whenever the write is the shorter of the two.
+session always computes the most recent request and drops the ones in between. A worker goes
+on to the latest request as soon as it finishes one, without waiting for the main thread to
+notice (the modal timer) or to write the result.
+
+Two workers run when the machine has two cores or more: while one decimates, the next request
+starts on the other, and the engine gives each call its share of the free cores. A decimation
+is bound by memory latency more than by arithmetic, so two running side by side on one thread
+each show nearly twice as many updates per second as one using both threads (horse, 1.55M
+triangles, ratios 5-20 %: 14.7 vs 8.8 per second outside Blender). Results are shown in the
+order they were requested: one that finishes after a newer one was shown is dropped.
 """
 
 from __future__ import annotations
 
+import os
 import threading
 import time
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from typing import Optional
 
 import bpy
@@ -23,6 +30,7 @@ from . import mesh_io, pipeline
 from .guidance import gather
 
 PREVIEW_SUFFIX = "_TopStocPreview"
+WORKERS = 2 if (os.cpu_count() or 1) >= 2 else 1
 
 
 class PreviewSession:
@@ -43,13 +51,17 @@ class PreviewSession:
         self.preview.matrix_world = obj.matrix_world.copy()
         self.was_hidden = obj.hide_get()
         obj.hide_set(True)
-        self._pool = ThreadPoolExecutor(max_workers=1)
+        self._pool = ThreadPoolExecutor(max_workers=WORKERS)
         self._lock = threading.Lock()
-        self._future: Optional[Future] = None  # the worker loop, while it runs
+        self._workers = 0                      # worker loops running
         self._pending: Optional[float] = None  # latest ratio asked for and not yet started
         self._started: Optional[float] = None  # ratio of the newest computation started
-        self._finished = None                  # newest computed result not shown yet
-        self._error: Optional[BaseException] = None  # raised by the worker, re-raised by poll
+        self._started_count = 0                # computations started (their order numbers)
+        self._shown_order = 0                  # order number of the result shown last
+        self._finished = None                  # (order, result) newest computed, not shown yet
+        self._error: Optional[BaseException] = None  # raised by a worker, re-raised by poll
+        self._last_start = 0.0                 # when the newest computation started
+        self._typical = 0.0                    # running average of a computation's seconds
         self.ratio: Optional[float] = None
         self.result = None
         self.seconds_decimate = 0.0
@@ -84,45 +96,67 @@ class PreviewSession:
 
     def _start_worker(self) -> None:
         with self._lock:
-            if self._future is None and self._pending is not None and self._pending != self._started:
-                self._future = self._pool.submit(self._work)
+            if self._workers < WORKERS and self._pending is not None and self._pending != self._started:
+                self._workers += 1
+                self._pool.submit(self._work)
 
     def _work(self) -> None:
         """Worker loop: computes the latest pending request until none is new."""
         while True:
+            self._stagger()
             with self._lock:
                 ratio, self._pending = self._pending, None
                 if ratio is None or ratio == self._started:
-                    self._future = None
+                    self._workers -= 1
                     return
                 self._started = ratio
+                self._started_count += 1
+                self._last_start = time.perf_counter()
+                order = self._started_count
             try:
                 finished = self.compute(ratio)
+                self._typical = 0.7 * self._typical + 0.3 * finished[3] if self._typical else finished[3]
             except Exception as error:  # noqa: BLE001 - handed to the main thread
                 with self._lock:
-                    self._error, self._future, self._started = error, None, None
+                    self._error, self._started = error, None
+                    self._workers -= 1
                 return
             with self._lock:
-                self._finished = finished  # a newer result replaces one not shown yet
+                # A newer result replaces one not shown yet; an older one than shown is dropped.
+                newest = self._finished[0] if self._finished else self._shown_order
+                if order > newest:
+                    self._finished = (order, finished)
+
+    def _stagger(self) -> None:
+        """Spreads the workers' starts over one computation's time, so that their results
+        arrive evenly instead of in pairs (and each starts from a newer request)."""
+        with self._lock:
+            if self._workers < 2 or not self._typical:
+                return
+            wait = self._typical / WORKERS - (time.perf_counter() - self._last_start)
+        if wait > 0:
+            time.sleep(wait)
 
     def poll(self) -> bool:
         """Shows the newest finished result (main thread); True when the view changed.
 
-        The worker is already computing the next request meanwhile, if there is one."""
+        The workers are already computing the next requests meanwhile, if there are any."""
         with self._lock:
             finished, self._finished = self._finished, None
             error, self._error = self._error, None
+            if finished:
+                self._shown_order = finished[0]
         if error is not None:
             raise error  # engine errors surface on the main thread
-        self._start_worker()  # a request that came while the worker was stopping
+        self._start_worker()  # a request that came while a worker was stopping
         if finished:
-            self.show(*finished)
+            self.show(*finished[1])
         return finished is not None
 
     @property
     def busy(self) -> bool:
         with self._lock:
-            return self._future is not None or self._finished is not None
+            return self._workers > 0 or self._finished is not None
 
     def close(self) -> None:
         """Removes the preview object and shows the original again."""

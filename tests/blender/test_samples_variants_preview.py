@@ -93,6 +93,26 @@ def test_preview_session(ts, scene):
     assert session.ratio == 0.05
     # the worker went from 0.3 to 0.05 on its own: nothing is left to show
     assert not session.busy and not session.poll()
+    # A quick drag: two workers may run at once, but what is shown follows the requests' order
+    # and ends on the last one.
+    drag = [0.4, 0.3, 0.25, 0.2, 0.15, 0.12, 0.1, 0.08]
+    shown = []
+    for ratio in drag:
+        session.request(ratio)
+        if session.poll():
+            shown.append(session.ratio)
+        time.sleep(0.002)
+    for _ in range(2000):
+        if session.poll():
+            shown.append(session.ratio)
+        if not session.busy:
+            break
+        time.sleep(0.005)
+    assert shown and shown[-1] == drag[-1]
+    assert [drag.index(r) for r in shown] == sorted(drag.index(r) for r in shown)
+    assert len(set(shown)) == len(shown)
+    expected = session.prepared.mesh.decimate(ratio=drag[-1], seed=4)
+    assert len(session.mesh.vertices) == expected.num_vertices
     # an engine error in the worker surfaces on the main thread, at the next poll
     session.options = dict(session.options, placement="no such placement")
     session.request(0.2)
@@ -100,7 +120,7 @@ def test_preview_session(ts, scene):
         for _ in range(2000):
             session.poll()
             time.sleep(0.005)
-    assert session.ratio == 0.05
+    assert session.ratio == drag[-1]
     name = session.preview.name
     session.close()
     assert not obj.hide_get()

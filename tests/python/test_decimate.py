@@ -204,6 +204,21 @@ def test_serial_and_parallel_runs_agree():
     assert len(set(outputs_by_thread_count(SERIAL_PARALLEL_SCRIPT).values())) == 1
 
 
+def test_concurrent_calls_on_one_mesh_agree_with_serial_ones():
+    # The live preview decimates on two threads at once; each call then gets its share of the
+    # cores (and the importance table is shared): results must be those of one call at a time.
+    from concurrent.futures import ThreadPoolExecutor
+
+    mesh = Mesh(*meshgen.icosphere(7))  # above the parallel threshold
+    ratios = (0.2, 0.05, 0.1, 0.02)
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        together = list(pool.map(lambda r: mesh.decimate(ratio=r, seed=5), ratios))
+    for ratio, got in zip(ratios, together):
+        alone = mesh.decimate(ratio=ratio, seed=5)
+        for name in ("triangles", "kept", "labels", "samples"):
+            np.testing.assert_array_equal(getattr(got, name), getattr(alone, name), err_msg=f"{ratio} {name}")
+
+
 def test_triangle_target_within_one_percent():
     mesh = load(DATA / "genus0/cgal_fandisk.off")
     for target in (500, 2000, 6000):
