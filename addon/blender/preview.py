@@ -115,13 +115,14 @@ class PreviewSession:
                 order = self._started_count
             try:
                 finished = self.compute(ratio)
-                self._typical = 0.7 * self._typical + 0.3 * finished[3] if self._typical else finished[3]
             except Exception as error:  # noqa: BLE001 - handed to the main thread
                 with self._lock:
                     self._error, self._started = error, None
                     self._workers -= 1
                 return
             with self._lock:
+                seconds = finished[3]
+                self._typical = 0.7 * self._typical + 0.3 * seconds if self._typical else seconds
                 # A newer result replaces one not shown yet; an older one than shown is dropped.
                 newest = self._finished[0] if self._finished else self._shown_order
                 if order > newest:

@@ -198,7 +198,7 @@ double solve_rate(const ImportanceTable& table, double target) {
   // curves' sqrt makes the true sum larger, so this start is at or below the root... unless
   // clamping dominates, which the bracket handles.
   double k = std::min(hi, (target - table.corners) / table.total_q);
-  for (int it = 0; it < 100; ++it) {
+  for (int it = 0; it < 50; ++it) {
     const double f = evaluate(k, slope) - target;
     if (std::abs(f) <= std::max(0.5, 1e-4 * target)) break;
     if (f < 0) lo = k;
