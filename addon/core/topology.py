@@ -123,7 +123,7 @@ class ComponentGenerators:
     """Generator edges of one closed orientable manifold component (thesis 3.2.3, 4.2.1).
 
     ``edges`` are the 2g edges left unpaired by the persistence pairing of the component
-    (computed tree-cotree in linear time; see native/include/topstoc/generators.hpp), ordered
+    (computed tree-cotree in linear time; see native/include/topstoc/topology/generators.hpp), ordered
     by the length of their loop, shortest first. ``loops[i]`` is a simple closed vertex cycle that starts with ``edges[i]`` and
     closes back to its first vertex; the loops form a basis of H1 over Z2. ``cut_edges`` are the
     generator edges plus the tree edges joining the loops: cutting the surface along them leaves

@@ -5,9 +5,9 @@
 
 #include "caller_order.hpp"
 #include "convert.hpp"
-#include "topstoc/validate.hpp"
-#include "topstoc/decimate.hpp"
-#include "topstoc/quality.hpp"
+#include "topstoc/core/validate.hpp"
+#include "topstoc/decimate/decimate.hpp"
+#include "topstoc/core/quality.hpp"
 
 namespace topstoc::python {
 

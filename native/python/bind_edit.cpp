@@ -3,9 +3,9 @@
 #include <pybind11/stl.h>
 
 #include "convert.hpp"
-#include "topstoc/edit.hpp"
-#include "topstoc/fill_holes.hpp"
-#include "topstoc/remove_handle.hpp"
+#include "topstoc/edit/edit.hpp"
+#include "topstoc/edit/fill_holes.hpp"
+#include "topstoc/edit/remove_handle.hpp"
 
 namespace topstoc::python {
 

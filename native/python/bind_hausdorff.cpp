@@ -2,7 +2,7 @@
 #include <cmath>
 
 #include "convert.hpp"
-#include "topstoc/hausdorff.hpp"
+#include "topstoc/distance/hausdorff.hpp"
 
 namespace topstoc::python {
 

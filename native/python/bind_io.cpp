@@ -3,7 +3,7 @@
 #include <pybind11/stl.h>
 
 #include "convert.hpp"
-#include "topstoc/io.hpp"
+#include "topstoc/io/io.hpp"
 
 namespace topstoc::python {
 

@@ -3,11 +3,11 @@
 #include <pybind11/stl.h>
 
 #include "convert.hpp"
-#include "topstoc/validate.hpp"
-#include "topstoc/loops.hpp"
-#include "topstoc/mesh.hpp"
-#include "topstoc/self_intersections.hpp"
-#include "topstoc/tetrahedralize.hpp"
+#include "topstoc/core/validate.hpp"
+#include "topstoc/topology/loops.hpp"
+#include "topstoc/core/mesh.hpp"
+#include "topstoc/core/self_intersections.hpp"
+#include "topstoc/topology/tetrahedralize.hpp"
 
 namespace topstoc::python {
 

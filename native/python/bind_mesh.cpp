@@ -3,8 +3,8 @@
 
 #include "caller_order.hpp"
 #include "convert.hpp"
-#include "topstoc/features.hpp"
-#include "topstoc/mesh.hpp"
+#include "topstoc/decimate/features.hpp"
+#include "topstoc/core/mesh.hpp"
 
 namespace topstoc::python {
 

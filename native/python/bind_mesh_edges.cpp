@@ -1,6 +1,6 @@
 // Binding for the edges of a triangle list (what Blender's edge and loop arrays hold).
 #include "convert.hpp"
-#include "topstoc/mesh_edges.hpp"
+#include "topstoc/core/mesh_edges.hpp"
 
 namespace topstoc::python {
 

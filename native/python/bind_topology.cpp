@@ -1,9 +1,9 @@
 // Bindings for topology: invariants per component and generator edges, as plain arrays.
 // topstoc.core.topology turns them into dataclasses.
 #include "convert.hpp"
-#include "topstoc/complex.hpp"
-#include "topstoc/generators.hpp"
-#include "topstoc/topology.hpp"
+#include "topstoc/topology/complex.hpp"
+#include "topstoc/topology/generators.hpp"
+#include "topstoc/topology/topology.hpp"
 
 namespace topstoc::python {
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "topstoc/mesh.hpp"
+#include "topstoc/core/mesh.hpp"
 
 namespace topstoc::python {
 

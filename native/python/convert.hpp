@@ -6,7 +6,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
-#include "topstoc/parallel.hpp"
+#include "topstoc/core/parallel.hpp"
 
 #include <cstdint>
 #include <string>

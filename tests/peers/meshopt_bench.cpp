@@ -15,7 +15,7 @@
 #include <cstdlib>
 #include <vector>
 
-#include "topstoc/io.hpp"
+#include "topstoc/io/io.hpp"
 
 namespace {
 

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "topstoc/io.hpp"
+#include "topstoc/io/io.hpp"
 
 namespace {
 

@@ -1,0 +1,81 @@
+// Feature layout: the edges that no cluster may cross, and what follows from them.
+//
+// Feature edges are mesh boundary edges, non-manifold edges, borders between faces with
+// different region ids (materials, UV islands), edges the caller flags (UV seams, sharp
+// edges) and, on request, creases sharper than a feature angle. Cutting the mesh along them splits each vertex into sectors (fans of triangles);
+// the decimation treats every sector as its own side of a border. Feature vertices are
+// reached by the flood fill only along feature edges, so each border is sampled and
+// partitioned as a curve of its own and survives into the output; corners (where curves
+// meet or end, and pinched vertices) are always kept.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "topstoc/core/mesh.hpp"
+
+namespace topstoc {
+
+/// One table another module derives from a layout and its mesh and keeps between calls
+/// (sampling keeps its per-vertex importance there: a slider re-decimating with the same
+/// parameters then skips recomputing it). Copies start empty; safe to use from many threads.
+class DerivedTable {
+ public:
+  DerivedTable() = default;
+  DerivedTable(const DerivedTable&) {}
+  DerivedTable& operator=(const DerivedTable&) { return *this; }
+  std::shared_ptr<const void> get() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return table_;
+  }
+  void set(std::shared_ptr<const void> table) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    table_ = std::move(table);
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  mutable std::shared_ptr<const void> table_;
+};
+
+struct FeatureLayout {
+  std::vector<uint8_t> edge_feature;    ///< per edge: 1 if no cluster may cross it
+  std::vector<int32_t> feature_edges;   ///< ids of the feature edges
+  std::vector<int32_t> feature_degree;  ///< per vertex: number of feature edges
+  std::vector<int32_t> sectors;         ///< per vertex: fans once feature edges are cut
+  std::vector<int32_t> sector_of_slot;  ///< per slot of mesh.vertex_faces(): sector of that face
+  std::vector<uint8_t> vertex_feature;  ///< per vertex: on a feature curve, or a corner
+  std::vector<uint8_t> vertex_corner;   ///< per vertex: always kept
+  /// Curves: open segments run from corner to corner (both included); closed loops hold only
+  /// curve vertices (start not repeated).
+  std::vector<int32_t> curve_offsets{0};
+  std::vector<int32_t> curve_vertices;
+  std::vector<uint8_t> curve_closed;
+  std::vector<int32_t> vertex_curve;  ///< curve of each non-corner feature vertex, else -1
+  /// 6 * (sectors - (sum of incident edge copies) / 2 + incident faces / 3): summed over a
+  /// cluster's vertices it gives six times the cluster's Euler characteristic up to the terms
+  /// of edges and faces shared with other clusters (see partition.cpp).
+  std::vector<int32_t> chi_constant;
+  DerivedTable sampling_table;  ///< sampling.cpp's importance table for its last parameters
+  int32_t region_border_edges = 0;
+  int32_t flagged_edges = 0;
+  int32_t crease_edges = 0;
+
+  int32_t num_curves() const { return static_cast<int32_t>(curve_closed.size()); }
+  /// Copies of edge e in the mesh cut along the feature edges.
+  int32_t edge_copies(const Mesh& mesh, int32_t e) const { return edge_feature[e] ? mesh.edge_face_count(e) : 1; }
+  /// Sector of face f at vertex v (f must contain v).
+  int32_t sector_of(const Mesh& mesh, int32_t v, int32_t f) const;
+};
+
+/// face_region: one id per caller triangle (indexed like the caller's triangle array), or null.
+/// flagged_edges: pairs of caller vertex ids; each must be an edge of the mesh (else
+/// std::invalid_argument). feature_angle (radians, 0 = off): edges whose two triangles meet at a
+/// dihedral angle above it (creases) become features too, so sharp edges are sampled as curves.
+std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, const int32_t* face_region,
+                                                          int64_t face_region_count, const int32_t* flagged_edges,
+                                                          int64_t num_flagged_edges, double feature_angle = 0.0);
+
+}  // namespace topstoc

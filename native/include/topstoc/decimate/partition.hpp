@@ -1,0 +1,81 @@
+// Emission of the decimated triangles from a clustering, and the checks that the result is
+// homeomorphic to the input.
+//
+// Each input face whose corners lie in three clusters emits the triangle of those clusters'
+// samples. The result is accepted when, per component of the input,
+//   - every vertex is reached by some sample;
+//   - the triangles around every manifold sample form one consistently oriented fan;
+//   - every decimated edge has the triangles expected: two inside a surface, one per side
+//     along a feature curve (boundary: one, border between two regions: two, ...);
+//   - no triangle appears twice (a triangle emitted twice with opposite orientations, around a
+//     cluster that has no other triangle, is dropped instead: see partition.cpp);
+//   - every closed feature curve is split among at least three clusters;
+//   - the Euler characteristic is unchanged.
+// A manifold, consistently oriented result with the same Euler characteristic and the same
+// boundary loops as the input component is homeomorphic to it (classification of surfaces),
+// so these output checks are the guarantee. When only the Euler characteristic fails, the
+// clusters that are not disks (closed ball property, Edelsbrunner & Shah 1997) are located on
+// the mesh cut along the features and split. Each failure names the clusters to split; the
+// decimation adds samples there and re-floods.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "topstoc/decimate/clustering.hpp"
+#include "topstoc/decimate/features.hpp"
+#include "topstoc/core/mesh.hpp"
+
+namespace topstoc {
+
+struct PartitionIssues {
+  int32_t unreached = 0;      ///< vertices no sample reaches
+  int32_t non_disk = 0;       ///< clusters that are not one disk per side (diagnosis only)
+  int32_t bad_edge = 0;       ///< cluster pairs with more or fewer triangles than expected
+  int32_t duplicate = 0;      ///< decimated triangles emitted twice
+  int32_t bad_link = 0;       ///< samples whose triangles do not form one oriented fan
+  int32_t short_loop = 0;     ///< closed feature curves with fewer than three clusters
+  int32_t isolated = 0;       ///< required samples (corners, control points) without a triangle
+  int32_t bad_component = 0;  ///< components whose Euler characteristic changed
+  int32_t sliver = 0;         ///< decimated triangles of (numerically) zero area
+  int32_t pillows = 0;        ///< opposite triangle pairs dropped (not an issue)
+  int32_t absorbed = 0;       ///< samples left without triangles, absorbed by a neighbour (not an issue)
+  int32_t topological() const {
+    return unreached + non_disk + bad_edge + duplicate + bad_link + short_loop + isolated + bad_component;
+  }
+};
+
+struct Partition {
+  std::vector<int32_t> triangles;    ///< 3 sample ranks per decimated triangle, input orientation
+  std::vector<int32_t> source_face;  ///< mesh face each triangle was emitted from
+  PartitionIssues issues;
+  std::vector<int32_t> split_clusters;  ///< ranks of clusters to split (sorted, unique)
+  std::vector<int32_t> new_samples;     ///< vertices to add as samples directly
+  std::vector<uint8_t> absorbed;        ///< per rank: 1 if the sample has no triangle (not in the output)
+};
+
+/// Which faces emit a triangle, kept between the rounds of one decimation: after flood_add,
+/// only the faces around the vertices that changed are evaluated again.
+struct EmitState {
+  std::vector<uint8_t> emits;    ///< per face: corners in three clusters
+  std::vector<int32_t> changed;  ///< vertices relabelled since the last check (flood_add fills it)
+  bool valid = false;            ///< emits matches the clustering as of the last check
+};
+
+/// Emits triangles and checks them. `required` marks vertices whose samples must appear in the
+/// output (control points); corners are always required. Other samples left without a
+/// triangle are absorbed by their neighbours. candidate_faces, if given, lists (in increasing
+/// order) a superset of the faces whose corners lie in three clusters (the fast path, thesis
+/// 4.1.1); otherwise every face is scanned.
+/// With an EmitState that is valid, only the faces around state->changed are evaluated.
+Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
+                          const Clustering& clustering, const std::vector<uint8_t>& required, bool check_slivers,
+                          const std::vector<int32_t>* candidate_faces = nullptr, EmitState* state = nullptr);
+
+/// Six times the Euler characteristic of every cluster on the mesh cut along the feature
+/// edges (one pass over all faces). A cluster is one disk per side exactly when the value is
+/// six times the number of sectors at its sample.
+std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layout, int32_t num_samples,
+                                    const Clustering& clustering);
+
+}  // namespace topstoc

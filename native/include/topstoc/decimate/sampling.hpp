@@ -1,0 +1,78 @@
+// Stochastic vertex selection (thesis 4.1, 4.3, 4.4, 4.6; SPEC §1.2 and §1.5).
+//
+// Every vertex gets a probability p(v) from its importance weight and the user's guidance, and
+// a seeded fixed-size draw picks the samples. Without guidance the draw hits the target count
+// exactly (Pareto sampling, Rosén 1997: keys (U/(1-U)) / (p/(1-p)), the smallest win, which
+// keeps inclusion probabilities close to p). With guidance the count is the sum of the
+// probabilities: user input wins over the target (thesis 4.3).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "topstoc/decimate/features.hpp"
+#include "topstoc/core/mesh.hpp"
+
+namespace topstoc {
+
+enum class DensityMode { Off, Uniform, Adaptive, Euclidean };
+
+/// View-dependent guidance (thesis 4.4).
+struct ViewGuidance {
+  bool enabled = false;
+  bool perspective = true;
+  double eye[3] = {0, 0, 0};         ///< camera position (perspective)
+  double direction[3] = {0, 0, -1};  ///< viewing direction (orthographic)
+  double back_ratio = 0.25;          ///< back-facing vertices: p *= back_ratio
+  double silhouette_angle = 0.35;    ///< θ in radians: band |n·v| <= (1 - cos θ) / 2 keeps p = 1
+  double silhouette_falloff = 0.1;   ///< width in |n·v| over which p returns to its value
+  bool frustum = false;              ///< cull outside the view volume
+  double view_projection[16] = {};   ///< row-major world -> clip matrix
+  double outside_probability = 0.0;  ///< cap on p outside the frustum
+};
+
+/// A box region (thesis 4.6): vertices with |world_to_box * p|_inf <= 1 take guidance `value`.
+struct BoxGuidance {
+  double world_to_box[16];  ///< row-major affine matrix
+  double value;             ///< u in [-1, 1]
+};
+
+struct SamplingParams {
+  double adaptivity = 0.5;              ///< α in [0, 1]: 0 uniform, 1 fully weight-driven
+  double flat_floor = 0.25;             ///< p never drops below flat_floor * k for u = 0 (the thesis' tweak)
+  bool area_weighted = false;           ///< scale p by the vertex's share of the area (irregular meshes)
+  const double* guidance = nullptr;     ///< u per caller vertex in [-1, 1], or null
+  ViewGuidance view;
+  std::vector<BoxGuidance> boxes;
+  uint64_t seed = 0;
+  DensityMode density = DensityMode::Off;
+  int32_t density_rings = 0;            ///< ε (uniform) or ε_big (adaptive) in rings; 0 = from the target
+  double density_ratio = 2.0;           ///< ε_big / ε_small for adaptive density (>= 2 per the thesis)
+  double density_epsilon = 0.0;         ///< Euclidean ε; 0 = from the target and the mean edge length
+};
+
+struct SampleSet {
+  std::vector<int32_t> samples;  ///< sorted vertex ids
+  int32_t forced = 0;            ///< corners and u = 1 vertices
+  int32_t density_rejected = 0;  ///< candidates skipped by density control
+  bool guided = false;           ///< guidance, view or boxes changed the probabilities
+  double expected = 0.0;         ///< sum of the probabilities
+  double rate = 0.0;             ///< the base rate k that was used
+};
+
+/// True when any guidance source is active (then the count follows the probabilities).
+bool is_guided(const Mesh& mesh, const SamplingParams& params);
+
+/// p(v) for base rate k (fraction of vertices kept). Corners get 1, isolated vertices 0, feature
+/// curve vertices sqrt(p) so that borders keep the spacing of the surface samples.
+std::vector<double> sampling_probabilities(const Mesh& mesh, const FeatureLayout& layout,
+                                           const SamplingParams& params, double k);
+
+/// Draws the samples for a target vertex count (exact without guidance).
+SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const SamplingParams& params,
+                         int32_t target_vertices);
+
+/// Checks parameter ranges; throws std::invalid_argument naming the parameter.
+void validate_sampling_params(const Mesh& mesh, const SamplingParams& params);
+
+}  // namespace topstoc

@@ -1,0 +1,476 @@
+#include "topstoc/decimate/decimate.hpp"
+#include "topstoc/core/parallel.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "topstoc/decimate/clustering.hpp"
+#include "topstoc/decimate/placement.hpp"
+#include "topstoc/decimate/refine.hpp"
+
+namespace topstoc {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Rounds in which zero-area triangles are still repaired; after that they are only counted
+// (an input with collinear vertices may not allow removing them all).
+constexpr int32_t kSliverRounds = 8;
+// Rounds of splitting the widest clusters to make up for absorbed ones (see cluster_and_emit).
+constexpr int32_t kMaxTopUpRounds = 12;
+constexpr int32_t kSmallTopUp = 3;       // top-ups this small may be undone and retried
+constexpr size_t kMaxTopUpRetries = 12;  // clusters tried for them
+
+void accumulate(PartitionIssues& into, const PartitionIssues& add) {
+  into.unreached += add.unreached;
+  into.non_disk += add.non_disk;
+  into.bad_edge += add.bad_edge;
+  into.duplicate += add.duplicate;
+  into.bad_link += add.bad_link;
+  into.short_loop += add.short_loop;
+  into.isolated += add.isolated;
+  into.sliver += add.sliver;
+  into.bad_component += add.bad_component;
+  into.pillows += add.pillows;
+  into.absorbed += add.absorbed;
+}
+
+// New samples that split the given clusters: the vertex farthest from the cluster's sample,
+// avoiding vertices the user excluded (u = -1) while others exist; lowest id on ties. A cluster
+// of one vertex cannot split, so its neighbouring clusters split instead.
+std::vector<int32_t> splitting_vertices(const Mesh& mesh, const Clustering& c, const std::vector<int32_t>& samples,
+                                        const std::vector<int32_t>& clusters, const std::vector<uint8_t>& avoid) {
+  const int32_t n = mesh.num_vertices();
+  const int32_t num_samples = static_cast<int32_t>(samples.size());
+  std::vector<int32_t> result;
+  std::vector<uint8_t> wanted(num_samples, 0);
+  for (int32_t s : clusters) wanted[s] = 1;
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<int32_t> best(num_samples, -1);
+    auto better = [&](int32_t v, int32_t w) {  // is v a better split vertex than w?
+      if (w < 0) return true;
+      const bool av = !avoid.empty() && avoid[v], aw = !avoid.empty() && avoid[w];
+      if (av != aw) return aw;
+      return c.dist[v] > c.dist[w];
+    };
+    for (int32_t v = 0; v < n; ++v) {
+      const int32_t s = c.label[v];
+      if (s < 0 || !wanted[s] || c.dist[v] == 0) continue;
+      if (better(v, best[s])) best[s] = v;
+    }
+    std::vector<uint8_t> neighbours(num_samples, 0);
+    bool any_singleton = false;
+    for (int32_t s = 0; s < num_samples; ++s) {
+      if (!wanted[s]) continue;
+      if (best[s] >= 0) {
+        result.push_back(best[s]);
+        continue;
+      }
+      // Singleton: split the clusters around it instead (second pass only).
+      any_singleton = true;
+      const auto& ao = mesh.adjacency_offsets();
+      const int32_t sample_vertex = samples[s];
+      for (int32_t i = ao[sample_vertex]; i < ao[sample_vertex + 1]; ++i) {
+        const int32_t t = c.label[mesh.adjacency()[i]];
+        if (t >= 0 && t != s) neighbours[t] = 1;
+      }
+    }
+    if (!any_singleton || pass == 1) break;
+    wanted = neighbours;
+  }
+  std::sort(result.begin(), result.end());
+  result.erase(std::unique(result.begin(), result.end()), result.end());
+  return result;
+}
+
+// Corner of the caller's mesh that carries the attributes (UV, colour) an output corner needs:
+// a corner of the sample vertex on the same side of every border as the input face the output
+// triangle came from. Walks the flood's steps back from the face's corner to the sample,
+// carrying the current face across edges so the side is kept.
+int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Clustering& c, int32_t face,
+                         int32_t slot, int32_t sample_vertex) {
+  const auto& faces = mesh.faces();
+  const auto& efo = mesh.edge_face_offsets();
+  const auto& ef = mesh.edge_faces();
+  auto corner_of = [&](int32_t f, int32_t v) {
+    for (int j = 0; j < 3; ++j)
+      if (faces[3 * size_t(f) + j] == v) return 3 * mesh.face_source()[f] + j;
+    return -1;
+  };
+  if (layout.sectors[sample_vertex] <= 1) {
+    // One side only: any face of the sample will do.
+    return corner_of(mesh.vertex_faces()[mesh.vertex_face_offsets()[sample_vertex]], sample_vertex);
+  }
+  int32_t current = face;
+  int32_t x = faces[3 * size_t(face) + slot];
+  for (int32_t guard = 0; x != sample_vertex && guard <= mesh.num_vertices(); ++guard) {
+    const int32_t p = step_towards_sample(mesh, layout, c, x);
+    if (p < 0) break;
+    const int32_t e = mesh.find_edge(x, p);
+    const int32_t side = layout.sector_of(mesh, x, current);
+    int32_t next = ef[efo[e]];
+    for (int32_t i = efo[e]; i < efo[e + 1]; ++i)
+      if (layout.sector_of(mesh, x, ef[i]) == side) {
+        next = ef[i];
+        break;
+      }
+    current = next;
+    x = p;
+  }
+  return corner_of(current, sample_vertex);
+}
+
+DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
+                      Clustering& clustering, const Partition& partition, Placement placement,
+                      DecimateResult result) {
+  const auto start = Clock::now();
+  const int32_t k = static_cast<int32_t>(samples.size());
+  // Output vertices: the samples that carry triangles, in sample order.
+  std::vector<int32_t> output_index(k, -1);
+  for (int32_t s = 0; s < k; ++s)
+    if (!partition.absorbed[s]) {
+      output_index[s] = static_cast<int32_t>(result.kept.size());
+      result.kept.push_back(samples[s]);
+    }
+  // Vertices of absorbed clusters join a neighbouring cluster that survives (lowest rank,
+  // repeated outwards), so every input vertex maps to an output vertex.
+  std::vector<int32_t>& label = clustering.label;
+  const auto& ao = mesh.adjacency_offsets();
+  const auto& adj = mesh.adjacency();
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+      if (label[v] < 0 || !partition.absorbed[label[v]]) continue;
+      int32_t best = -1;
+      for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
+        const int32_t l = label[adj[i]];
+        if (l >= 0 && !partition.absorbed[l] && (best < 0 || l < best)) best = l;
+      }
+      if (best >= 0) {
+        label[v] = best;
+        changed = true;
+      }
+    }
+  }
+  const std::vector<double> filtered =
+      placement == Placement::Filtered ? filtered_positions(mesh, layout, samples, clustering) : std::vector<double>();
+  result.positions.resize(3 * result.kept.size());
+  for (int32_t s = 0; s < k; ++s) {
+    if (output_index[s] < 0) continue;
+    for (int j = 0; j < 3; ++j)
+      result.positions[3 * size_t(output_index[s]) + j] =
+          filtered.empty() ? mesh.position(samples[s])[j] : filtered[3 * size_t(s) + j];
+  }
+  // A sample with one sector has one corner to copy attributes from, whatever the triangle:
+  // find it once per sample (others walk per output corner, see attribute_corner).
+  std::vector<int32_t> single_corner(k, -1);
+#pragma omp parallel for schedule(static) if (k >= kParallelMin)
+  for (int32_t s = 0; s < k; ++s)
+    if (output_index[s] >= 0 && layout.sectors[samples[s]] <= 1)
+      single_corner[s] = attribute_corner(mesh, layout, clustering, -1, -1, samples[s]);
+  const size_t t = partition.source_face.size();
+  result.triangles.resize(3 * t);
+  result.face_source.resize(t);
+  result.corner_source.resize(3 * t);
+#pragma omp parallel for schedule(static) if (t >= kParallelMin)
+  for (size_t i = 0; i < t; ++i) {
+    const int32_t f = partition.source_face[i];
+    result.face_source[i] = mesh.face_source()[f];
+    for (int j = 0; j < 3; ++j) {
+      const int32_t rank = partition.triangles[3 * i + j];
+      result.triangles[3 * i + j] = output_index[rank];
+      result.corner_source[3 * i + j] = single_corner[rank] >= 0
+                                            ? single_corner[rank]
+                                            : attribute_corner(mesh, layout, clustering, f, j, samples[rank]);
+    }
+  }
+  // Public ids are the caller's.
+  const auto& source = mesh.vertex_source();
+  for (auto& v : result.kept) v = source[v];
+  for (auto& v : samples) v = source[v];
+  result.labels.resize(label.size());
+  for (size_t v = 0; v < label.size(); ++v)
+    result.labels[source[v]] = label[v] >= 0 ? output_index[label[v]] : -1;
+  result.samples = std::move(samples);
+  result.seconds_output = seconds_since(start);
+  return result;
+}
+
+// Floods, checks and repairs until the partition passes (see partition.hpp).
+// How far a result may miss an unguided target: 0.5 % (within the promised 1 %), so that the
+// usual handful of absorbed clusters costs no extra round; below 200 vertices, nothing.
+int32_t budget_tolerance(int32_t target) { return int32_t(0.005 * target); }
+
+// The `count` widest clusters (largest flood distance, then lowest rank) that can split.
+std::vector<int32_t> widest_clusters(const Clustering& c, const std::vector<uint8_t>& absorbed, int32_t count,
+                                     const std::vector<int32_t>& excluded) {
+  std::vector<int32_t> radius(absorbed.size(), 0);
+  for (size_t v = 0; v < c.label.size(); ++v)
+    if (c.label[v] >= 0) radius[c.label[v]] = std::max(radius[c.label[v]], c.dist[v]);
+  for (int32_t s : excluded) radius[s] = 0;
+  std::vector<int32_t> ranks;
+  for (int32_t s = 0; s < int32_t(absorbed.size()); ++s)
+    if (!absorbed[s] && radius[s] > 0) ranks.push_back(s);
+  const size_t take = std::min<size_t>(ranks.size(), size_t(std::max(0, count)));
+  std::partial_sort(ranks.begin(), ranks.begin() + take, ranks.end(), [&](int32_t a, int32_t b) {
+    return radius[a] > radius[b] || (radius[a] == radius[b] && a < b);
+  });
+  ranks.resize(take);
+  return ranks;
+}
+
+DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
+                                Placement placement, int32_t max_rounds, bool repair_slivers, bool fast_path,
+                                const std::vector<uint8_t>& avoid, const std::vector<uint8_t>& required,
+                                int32_t top_up_to, DecimateResult result) {
+  auto start = Clock::now();
+  Clustering clustering;
+  std::vector<int32_t> cross_edges;
+  flood(mesh, layout, samples, clustering, fast_path ? &cross_edges : nullptr);
+  result.seconds_clustering = seconds_since(start);
+  result.fast_path = fast_path;
+  start = Clock::now();
+  Partition partition;
+  EmitState emit;  // later rounds re-evaluate only the faces around relabelled vertices
+  // The last few top-up samples can overshoot (a split may revive an absorbed neighbour): then
+  // the state before them is restored and the next widest clusters are tried instead.
+  struct Snapshot {
+    size_t samples = 0;
+    Clustering clustering;
+    RepairStats repairs;
+    int32_t top_up_samples = 0;
+    std::vector<int32_t> tried;
+    bool active = false;
+  } snapshot;
+  for (int32_t round = 0;; ++round) {
+    const bool slivers = repair_slivers && round < kSliverRounds;
+    if (round == 0 && fast_path) {
+      // Only faces around cluster borders can hold three clusters; keep them in face order.
+      std::vector<uint8_t> near_border(mesh.num_faces(), 0);
+      const auto& efo = mesh.edge_face_offsets();
+      const auto& ef = mesh.edge_faces();
+      for (int32_t e : cross_edges)
+        for (int32_t j = efo[e]; j < efo[e + 1]; ++j) near_border[ef[j]] = 1;
+      std::vector<int32_t> candidates;
+      for (int32_t f = 0; f < mesh.num_faces(); ++f)
+        if (near_border[f]) candidates.push_back(f);
+      partition = check_partition(mesh, layout, samples, clustering, required, slivers, &candidates, &emit);
+    } else {
+      partition = check_partition(mesh, layout, samples, clustering, required, slivers, nullptr, &emit);
+    }
+    accumulate(result.repairs.found, partition.issues);
+    const bool clean = partition.issues.topological() == 0 && (!slivers || partition.issues.sliver == 0);
+    std::vector<int32_t> to_split = partition.split_clusters;
+    if (clean) {
+      // Exact budget: absorbed clusters leave the output, so a clean result can fall short of
+      // the target. Split the widest clusters at their farthest vertex until it is met.
+      const int32_t kept = int32_t(samples.size()) - partition.issues.absorbed;
+      if (snapshot.active && kept > top_up_to && snapshot.tried.size() < kMaxTopUpRetries) {
+        samples.resize(snapshot.samples);
+        clustering = snapshot.clustering;
+        emit = EmitState();
+        result.repairs.rounds = snapshot.repairs.rounds;
+        result.repairs.samples_added = snapshot.repairs.samples_added;
+        result.top_up_samples = snapshot.top_up_samples;
+        partition = check_partition(mesh, layout, samples, clustering, required, false, nullptr, &emit);
+      } else if (top_up_to <= 0 || kept >= top_up_to - budget_tolerance(top_up_to) ||
+                 result.top_up_rounds >= kMaxTopUpRounds) {
+        break;
+      } else {
+        snapshot = Snapshot();
+      }
+      int32_t need = top_up_to - (int32_t(samples.size()) - partition.issues.absorbed);
+      // Some new samples get absorbed in turn: ask for that many more, so that one round
+      // usually lands on the target (a small overshoot stays within the budget tolerance).
+      if (need > kSmallTopUp)
+        need += int32_t(std::ceil(1.5 * need * double(partition.issues.absorbed) / double(samples.size())));
+      if (need <= kSmallTopUp && !snapshot.active) {
+        snapshot.active = true;
+        snapshot.samples = samples.size();
+        snapshot.clustering = clustering;
+        snapshot.repairs = result.repairs;
+        snapshot.top_up_samples = result.top_up_samples;
+      }
+      to_split = widest_clusters(clustering, partition.absorbed, need, snapshot.tried);
+      if (snapshot.active) snapshot.tried.insert(snapshot.tried.end(), to_split.begin(), to_split.end());
+      if (to_split.empty()) break;
+      ++result.top_up_rounds;
+    }
+    std::vector<int32_t> added = clean ? std::vector<int32_t>() : partition.new_samples;
+    const auto split = splitting_vertices(mesh, clustering, samples, to_split, avoid);
+    added.insert(added.end(), split.begin(), split.end());
+    std::sort(added.begin(), added.end());
+    added.erase(std::unique(added.begin(), added.end()), added.end());
+    added.erase(std::remove_if(added.begin(), added.end(), [&](int32_t v) { return clustering.dist[v] == 0; }),
+                added.end());
+    if (added.empty() || round >= max_rounds) {
+      result.repairs.remaining = partition.issues;
+      if (!slivers) result.repairs.remaining.sliver = 0;
+      break;
+    }
+    const int32_t first_new = static_cast<int32_t>(samples.size());
+    samples.insert(samples.end(), added.begin(), added.end());
+    flood_add(mesh, layout, samples, first_new, clustering, &emit.changed);
+    if (clean) {
+      result.top_up_samples += static_cast<int32_t>(added.size());
+    } else {
+      result.repairs.rounds += 1;
+      result.repairs.samples_added += static_cast<int32_t>(added.size());
+    }
+  }
+  // Zero-area triangles left after the repair rounds are reported, not hidden.
+  if (partition.issues.sliver > 0 && partition.issues.topological() == 0)
+    result.repairs.remaining.sliver = partition.issues.sliver;
+  result.seconds_checking = seconds_since(start);
+  return finish(mesh, layout, std::move(samples), clustering, partition, placement, std::move(result));
+}
+
+int32_t active_vertices(const Mesh& mesh) {
+  return mesh.num_vertices() - mesh.report().isolated_vertices;
+}
+
+}  // namespace
+
+namespace {
+
+// One pass: draw samples for `target`, then flood, check, repair, emit.
+DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
+                             int32_t target, int32_t top_up_to) {
+  const int32_t active = active_vertices(mesh);
+  const auto start = Clock::now();
+  SampleSet set = select_samples(mesh, layout, params.sampling, target);
+  DecimateResult result;
+  result.target_vertices = params.target_vertices;
+  result.selected = static_cast<int32_t>(set.samples.size());
+  result.forced = set.forced;
+  result.density_rejected = set.density_rejected;
+  result.guided = set.guided;
+  result.expected_vertices = set.expected;
+  result.rate = set.rate;
+  result.seconds_sampling = seconds_since(start);
+  // Vertices the user excluded (u = -1) are the last choice when a repair needs a new sample;
+  // control points (u = 1) must stay in the output.
+  std::vector<uint8_t> avoid, required(mesh.num_vertices(), 0);
+  if (params.sampling.guidance || !params.sampling.boxes.empty()) {
+    const auto p = sampling_probabilities(mesh, layout, params.sampling, set.rate);
+    avoid.resize(p.size());
+    for (size_t v = 0; v < p.size(); ++v) {
+      avoid[v] = p[v] <= 0.0;
+      required[v] = p[v] >= 1.0;
+    }
+  }
+  const bool fast = params.fast_path == 1 || (params.fast_path < 0 && target < 0.05 * active);
+  return cluster_and_emit(mesh, layout, std::move(set.samples), params.placement, params.max_repair_rounds, true,
+                          fast, avoid, required, set.guided ? 0 : top_up_to, std::move(result));
+}
+
+}  // namespace
+
+DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params) {
+  const int32_t active = active_vertices(mesh);
+  if (!(params.refine == 0.0 || params.refine >= 1.0))
+    throw std::invalid_argument("refine must be 0 (off) or at least 1, got " + std::to_string(params.refine));
+  if (params.refine >= 1.0 && params.target_vertices >= 1 && params.target_vertices <= active) {
+    // Refined: TopStoc to `refine` times the target, then collapses down to it. A guided
+    // first pass keeps the count its probabilities give; the collapses keep that proportion.
+    DecimateParams first = params;
+    first.refine = 0.0;
+    first.target_vertices = int32_t(std::min<double>(active, std::ceil(params.refine * params.target_vertices)));
+    DecimateResult result = decimate(mesh, layout, first);
+    RefineParams refine;
+    refine.target_vertices = result.guided
+        ? std::max(1, int32_t(std::lround(double(result.kept.size()) * params.target_vertices / first.target_vertices)))
+        : params.target_vertices;
+    refine.guidance = params.sampling.guidance;
+    refine_by_collapses(mesh, layout, refine, result);
+    result.target_vertices = params.target_vertices;
+    return result;
+  }
+  if (params.target_vertices < 1)
+    throw std::invalid_argument("target must be at least 1 vertex, got " + std::to_string(params.target_vertices));
+  if (params.target_vertices > active)
+    throw std::invalid_argument("target of " + std::to_string(params.target_vertices) +
+                                " vertices exceeds the mesh's " + std::to_string(active) + " vertices in triangles");
+  if (params.max_repair_rounds < 0) throw std::invalid_argument("max_repair_rounds must be >= 0");
+  const int32_t target = params.target_vertices;
+  // Without guidance the budget is exact. Repairs add samples and absorbed clusters remove
+  // some; a shortfall is topped up inside the pass (widest clusters split), an excess (the
+  // topology needed more than drawn) is drawn again lower and topped up. Guided decimations
+  // keep the count the probabilities give (user input wins, thesis 4.3).
+  DecimateResult best = decimate_once(mesh, layout, params, target, target);
+  const auto excess = [&](const DecimateResult& r) { return int32_t(r.kept.size()) - target; };
+  const int32_t tolerance = budget_tolerance(target);
+  int32_t drawn = target;
+  for (int pass = 0; pass < params.budget_passes && !best.guided && excess(best) > tolerance; ++pass) {
+    drawn = std::max(1, drawn - excess(best) - tolerance);
+    DecimateResult r = decimate_once(mesh, layout, params, drawn, target);
+    if (std::abs(excess(r)) < std::abs(excess(best))) best = std::move(r);
+  }
+  return best;
+}
+
+DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
+                                     Placement placement, int32_t max_repair_rounds, int32_t refine_vertices,
+                                     const double* guidance) {
+  if (samples.empty()) throw std::invalid_argument("the sample list is empty");
+  const auto& vfo = mesh.vertex_face_offsets();
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const int32_t v = samples[i];
+    if (v < 0 || v >= mesh.num_vertices())
+      throw std::invalid_argument("sample " + std::to_string(i) + " is vertex " + std::to_string(v) +
+                                  ", outside [0, " + std::to_string(mesh.num_vertices()) + ")");
+    samples[i] = mesh.vertex_index()[v];
+    if (vfo[samples[i]] == vfo[samples[i] + 1])
+      throw std::invalid_argument("sample " + std::to_string(i) + " is vertex " + std::to_string(v) +
+                                  ", which lies in no triangle");
+  }
+  DecimateResult result;
+  result.target_vertices = static_cast<int32_t>(samples.size());
+  result.selected = result.target_vertices;
+  // Saved lists come from a finished decimation; only topology is re-checked, so the same
+  // list always gives the same mesh.
+  result = cluster_and_emit(mesh, layout, std::move(samples), placement, max_repair_rounds, false, false, {},
+                            std::vector<uint8_t>(mesh.num_vertices(), 0), 0, std::move(result));
+  if (refine_vertices > 0) {
+    RefineParams refine;
+    refine.target_vertices = refine_vertices;
+    refine.guidance = guidance;
+    refine_by_collapses(mesh, layout, refine, result);
+  }
+  return result;
+}
+
+DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layout, DecimateParams params,
+                                     int32_t target_triangles, int max_iterations) {
+  const int32_t active = active_vertices(mesh);
+  if (target_triangles < 1) throw std::invalid_argument("target must be at least 1 triangle");
+  if (target_triangles > mesh.num_faces())
+    throw std::invalid_argument("target of " + std::to_string(target_triangles) + " triangles exceeds the mesh's " +
+                                std::to_string(mesh.num_faces()) + " triangles");
+  // First guess from the input's triangle-to-vertex ratio, then correct by what came out.
+  double vertices = double(target_triangles) * active / mesh.num_faces();
+  DecimateResult best;
+  int32_t best_error = INT32_MAX;
+  for (int it = 0; it < std::max(1, max_iterations); ++it) {
+    params.target_vertices = std::clamp(int32_t(std::lround(vertices)), 1, active);
+    DecimateResult r = decimate(mesh, layout, params);
+    const int32_t got = static_cast<int32_t>(r.face_source.size());
+    const int32_t error = std::abs(got - target_triangles);
+    if (error < best_error) {
+      best_error = error;
+      best = std::move(r);
+    }
+    if (error <= 0.01 * target_triangles || got == 0) break;
+    vertices = std::max(1.0, vertices * double(target_triangles) / got);
+  }
+  return best;
+}
+
+}  // namespace topstoc

@@ -1,0 +1,197 @@
+#include "topstoc/decimate/features.hpp"
+#include "topstoc/core/parallel.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "core/fans.hpp"
+
+namespace topstoc {
+
+int32_t FeatureLayout::sector_of(const Mesh& mesh, int32_t v, int32_t f) const {
+  const auto& vfo = mesh.vertex_face_offsets();
+  const auto& vf = mesh.vertex_faces();
+  for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i)
+    if (vf[i] == f) return sector_of_slot[i];
+  return -1;
+}
+
+namespace {
+
+void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t face_region_count,
+                        const int32_t* flagged, int64_t num_flagged, double feature_angle, FeatureLayout& layout) {
+  const int32_t num_edges = mesh.num_edges();
+  layout.edge_feature.assign(num_edges, 0);
+  const auto& efo = mesh.edge_face_offsets();
+  const auto& ef = mesh.edge_faces();
+  const auto& source = mesh.face_source();
+  if (face_region && face_region_count != mesh.report().input_triangles)
+    throw std::invalid_argument("face regions have " + std::to_string(face_region_count) +
+                                " entries, but the mesh has " + std::to_string(mesh.report().input_triangles) +
+                                " triangles");
+  for (int32_t e = 0; e < num_edges; ++e) {
+    const int32_t k = efo[e + 1] - efo[e];
+    if (k != 2) {
+      layout.edge_feature[e] = 1;  // boundary or non-manifold
+    } else if (face_region && face_region[source[ef[efo[e]]]] != face_region[source[ef[efo[e] + 1]]]) {
+      layout.edge_feature[e] = 1;
+      ++layout.region_border_edges;
+    }
+  }
+  for (int64_t i = 0; i < num_flagged; ++i) {
+    const int32_t a = flagged[2 * i], b = flagged[2 * i + 1];
+    const int32_t n = mesh.num_vertices();
+    const bool in_range = a >= 0 && a < n && b >= 0 && b < n;
+    const int32_t e = in_range ? mesh.find_edge(mesh.vertex_index()[a], mesh.vertex_index()[b]) : -1;
+    if (e < 0)
+      throw std::invalid_argument("border edge " + std::to_string(i) + " (" + std::to_string(a) + ", " +
+                                  std::to_string(b) + ") is not an edge of the mesh");
+    if (!layout.edge_feature[e]) ++layout.flagged_edges;
+    layout.edge_feature[e] = 1;
+  }
+  if (feature_angle > 0) {
+    // Creases: the angle between the two triangles' normals exceeds the feature angle.
+    const double threshold = std::cos(feature_angle);
+    const auto& faces = mesh.faces();
+    auto unit_normal = [&](int32_t f, double* n) {
+      const double* a = mesh.position(faces[3 * size_t(f)]);
+      const double* b = mesh.position(faces[3 * size_t(f) + 1]);
+      const double* c = mesh.position(faces[3 * size_t(f) + 2]);
+      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
+      const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      if (len == 0) return false;
+      n[0] /= len, n[1] /= len, n[2] /= len;
+      return true;
+    };
+    for (int32_t e = 0; e < num_edges; ++e) {
+      if (layout.edge_feature[e] || efo[e + 1] - efo[e] != 2) continue;
+      double n0[3], n1[3];
+      if (!unit_normal(ef[efo[e]], n0) || !unit_normal(ef[efo[e] + 1], n1)) continue;
+      if (n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] < threshold) {
+        layout.edge_feature[e] = 1;
+        ++layout.crease_edges;
+      }
+    }
+  }
+  for (int32_t e = 0; e < num_edges; ++e)
+    if (layout.edge_feature[e]) layout.feature_edges.push_back(e);
+}
+
+void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
+  const int32_t n = mesh.num_vertices();
+  const auto& ao = mesh.adjacency_offsets();
+  const auto& ae = mesh.adjacency_edge();
+  const auto& vfo = mesh.vertex_face_offsets();
+  layout.feature_degree.assign(n, 0);
+  layout.sectors.assign(n, 0);
+  layout.sector_of_slot.assign(mesh.vertex_faces().size(), 0);
+  layout.vertex_feature.assign(n, 0);
+  layout.vertex_corner.assign(n, 0);
+  layout.chi_constant.assign(n, 0);
+#pragma omp parallel if (n >= kParallelMin)
+  {
+    std::vector<int32_t> fan_of_slot;
+#pragma omp for schedule(static)
+    for (int32_t v = 0; v < n; ++v) {
+      if (vfo[v] == vfo[v + 1]) continue;  // isolated: belongs to no cluster
+      int32_t degree = 0, copies = 0, first_copies = -1;
+      bool same_copies = true;
+      for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
+        const int32_t e = ae[i];
+        const int32_t c = layout.edge_copies(mesh, e);
+        copies += c;
+        if (layout.edge_feature[e]) {
+          ++degree;
+          if (first_copies < 0) first_copies = c;
+          same_copies = same_copies && c == first_copies;
+        }
+      }
+      // A manifold vertex without feature edges is one sector (slots stay 0); others need the fans.
+      int32_t sectors = 1;
+      if (degree > 0 || !mesh.manifold_vertex()[v]) {
+        sectors = vertex_fans(mesh, v, [&](int32_t e) { return layout.edge_feature[e] != 0; }, fan_of_slot);
+        std::copy(fan_of_slot.begin(), fan_of_slot.end(), layout.sector_of_slot.begin() + vfo[v]);
+      }
+      layout.feature_degree[v] = degree;
+      layout.sectors[v] = sectors;
+      layout.vertex_feature[v] = degree > 0 || sectors > 1;
+      // A curve vertex continues one curve: two feature edges of the same kind and one sector
+      // per side. Everything else on a feature (ends, junctions, pinches) is a corner.
+      const bool curve_vertex = degree == 2 && same_copies && sectors == first_copies;
+      layout.vertex_corner[v] = layout.vertex_feature[v] && !curve_vertex;
+      const int32_t faces = vfo[v + 1] - vfo[v];
+      layout.chi_constant[v] = 6 * sectors - 3 * copies + 2 * faces;
+    }
+  }
+}
+
+void trace_curves(const Mesh& mesh, FeatureLayout& layout) {
+  const int32_t n = mesh.num_vertices();
+  const auto& ao = mesh.adjacency_offsets();
+  const auto& adj = mesh.adjacency();
+  const auto& ae = mesh.adjacency_edge();
+  std::vector<uint8_t> visited(mesh.num_edges(), 0);
+  layout.vertex_curve.assign(n, -1);
+  // Next feature edge at curve vertex v other than the one we came by.
+  auto step = [&](int32_t v, int32_t from_edge, int32_t& next_vertex, int32_t& next_edge) {
+    for (int32_t i = ao[v]; i < ao[v + 1]; ++i)
+      if (layout.edge_feature[ae[i]] && ae[i] != from_edge) {
+        next_vertex = adj[i];
+        next_edge = ae[i];
+        return true;
+      }
+    return false;
+  };
+  auto walk = [&](int32_t start, int32_t first_vertex, int32_t first_edge, bool closed) {
+    const int32_t curve = layout.num_curves();
+    layout.curve_vertices.push_back(start);
+    visited[first_edge] = 1;
+    int32_t v = first_vertex, e = first_edge;
+    while (v != start && !layout.vertex_corner[v]) {
+      layout.curve_vertices.push_back(v);
+      layout.vertex_curve[v] = curve;
+      int32_t nv = -1, ne = -1;
+      if (!step(v, e, nv, ne)) break;
+      visited[ne] = 1;
+      v = nv;
+      e = ne;
+    }
+    if (!closed) layout.curve_vertices.push_back(v);  // the end corner
+    if (closed) layout.vertex_curve[start] = curve;
+    layout.curve_offsets.push_back(static_cast<int32_t>(layout.curve_vertices.size()));
+    layout.curve_closed.push_back(closed ? 1 : 0);
+  };
+  // Open segments start at corners, in vertex order.
+  for (int32_t c = 0; c < n; ++c) {
+    if (!layout.vertex_corner[c]) continue;
+    for (int32_t i = ao[c]; i < ao[c + 1]; ++i)
+      if (layout.edge_feature[ae[i]] && !visited[ae[i]]) walk(c, adj[i], ae[i], false);
+  }
+  // What remains are closed loops of curve vertices.
+  for (int32_t v = 0; v < n; ++v) {
+    if (!layout.vertex_feature[v] || layout.vertex_corner[v] || layout.vertex_curve[v] >= 0) continue;
+    for (int32_t i = ao[v]; i < ao[v + 1]; ++i)
+      if (layout.edge_feature[ae[i]] && !visited[ae[i]]) {
+        walk(v, adj[i], ae[i], true);
+        break;
+      }
+  }
+}
+
+}  // namespace
+
+std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, const int32_t* face_region,
+                                                          int64_t face_region_count, const int32_t* flagged_edges,
+                                                          int64_t num_flagged_edges, double feature_angle) {
+  if (!(feature_angle >= 0.0 && feature_angle <= M_PI))
+    throw std::invalid_argument("feature angle must lie in [0, pi] radians");
+  auto layout = std::make_shared<FeatureLayout>();
+  mark_feature_edges(mesh, face_region, face_region_count, flagged_edges, num_flagged_edges, feature_angle, *layout);
+  compute_sectors_and_corners(mesh, *layout);
+  trace_curves(mesh, *layout);
+  return layout;
+}
+
+}  // namespace topstoc

@@ -1,0 +1,478 @@
+#include "topstoc/decimate/partition.hpp"
+#include "topstoc/core/parallel.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <climits>
+#include <cmath>
+#include <unordered_map>
+
+namespace topstoc {
+
+namespace {
+
+inline uint64_t pair_key(int32_t a, int32_t b) {
+  if (a > b) std::swap(a, b);
+  return (uint64_t(uint32_t(a)) << 32) | uint32_t(b);
+}
+
+// Adds one sample per group of unreached vertices (the lowest id of each group).
+void seed_unreached(const Mesh& mesh, const Clustering& c, Partition& out) {
+  const int32_t n = mesh.num_vertices();
+  const auto& vfo = mesh.vertex_face_offsets();
+  const auto& ao = mesh.adjacency_offsets();
+  const auto& adj = mesh.adjacency();
+  std::vector<uint8_t> seen(n, 0);
+  std::vector<int32_t> stack;
+  for (int32_t v = 0; v < n; ++v) {
+    if (c.label[v] >= 0 || vfo[v] == vfo[v + 1] || seen[v]) continue;
+    out.new_samples.push_back(v);
+    seen[v] = 1;
+    stack.push_back(v);
+    while (!stack.empty()) {
+      const int32_t x = stack.back();
+      stack.pop_back();
+      ++out.issues.unreached;
+      for (int32_t i = ao[x]; i < ao[x + 1]; ++i) {
+        const int32_t u = adj[i];
+        if (!seen[u] && c.label[u] < 0) {
+          seen[u] = 1;
+          stack.push_back(u);
+        }
+      }
+    }
+  }
+}
+
+// The link of one sample: its neighbours in the decimated mesh and, for each triangle (s, a,
+// b) around it, the arc a -> b. Valences are small, so lookups are linear scans.
+struct Link {
+  struct Neighbour {
+    int32_t id;
+    int32_t out = 0, in = 0;  // arcs leaving / entering this neighbour
+    int32_t next = -1;        // index of the neighbour the arc leaving it goes to
+  };
+  std::vector<Neighbour> neighbours;
+  int32_t arcs = 0;
+  bool reversed = false;  // some arc a -> b has its reverse b -> a too
+
+  void clear() {
+    neighbours.clear();
+    arcs = 0;
+    reversed = false;
+  }
+  int32_t index(int32_t id) {
+    for (size_t i = 0; i < neighbours.size(); ++i)
+      if (neighbours[i].id == id) return int32_t(i);
+    neighbours.push_back({id});
+    return int32_t(neighbours.size() - 1);
+  }
+  void add(int32_t from, int32_t to) {
+    const int32_t a = index(from), b = index(to);
+    if (neighbours[b].next == a) reversed = true;
+    ++neighbours[a].out, ++neighbours[b].in;
+    neighbours[a].next = b;
+    ++arcs;
+  }
+  /// A triangle appears twice: once more in the same orientation, or in both.
+  bool repeated() const {
+    if (reversed) return true;
+    for (const auto& n : neighbours)
+      if (n.out > 1 || n.in > 1) return true;
+    return false;
+  }
+  /// The arcs form one path or one cycle: the triangles around the sample are one consistently
+  /// oriented fan. (Call only when !repeated(): every neighbour then has out, in <= 1.)
+  bool single_fan() const {
+    int32_t start = 0, starts = 0;
+    for (size_t i = 0; i < neighbours.size(); ++i)
+      if (neighbours[i].in == 0) start = int32_t(i), ++starts;
+    if (starts > 1) return false;
+    int32_t walked = 0;
+    for (int32_t v = start; walked <= arcs;) {
+      const int32_t w = neighbours[v].next;
+      if (w < 0) break;  // end of a path
+      ++walked;
+      if (w == start) break;  // closed the cycle
+      v = w;
+    }
+    return walked == arcs;
+  }
+};
+
+// Triangle i as seen from its lowest rank s: (b, c) such that (s, b, c) is a rotation of it.
+inline std::array<int32_t, 2> rotated_from_lowest(const int32_t* t) {
+  const int j = (t[0] < t[1] && t[0] < t[2]) ? 0 : (t[1] < t[2] ? 1 : 2);
+  return {t[(j + 1) % 3], t[(j + 2) % 3]};
+}
+
+// Collects per-thread lists of marked clusters into one sorted, unique list.
+struct Marks {
+  std::vector<std::vector<int32_t>> per_thread;
+  explicit Marks(int threads) : per_thread(threads) {}
+  void add(int32_t s) { per_thread[omp_get_thread_num()].push_back(s); }
+  void merge_into(std::vector<int32_t>& out) const {
+    for (const auto& list : per_thread) out.insert(out.end(), list.begin(), list.end());
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+};
+
+}  // namespace
+
+std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layout, int32_t num_samples,
+                                    const Clustering& c) {
+  // 6 chi = sum over the cluster's vertices of the layout's per-vertex constant, corrected by
+  // the edges and faces the cluster shares with others (see FeatureLayout::chi_constant).
+  std::vector<int64_t> chi6(num_samples, 0);
+  const auto& label = c.label;
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+    if (label[v] >= 0) chi6[label[v]] += layout.chi_constant[v];
+  const auto& faces = mesh.faces();
+  const auto& fe = mesh.face_edges();
+  const auto& efo = mesh.edge_face_offsets();
+  const auto& ef = mesh.edge_faces();
+  const auto& ev = mesh.edge_vertices();
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+    const int32_t la = label[faces[3 * size_t(f)]], lb = label[faces[3 * size_t(f) + 1]],
+                  lc = label[faces[3 * size_t(f) + 2]];
+    if (la == lb && lb == lc) continue;
+    chi6[la] -= 2, chi6[lb] -= 2, chi6[lc] -= 2;
+    for (int s = 0; s < 3; ++s) {
+      const int32_t e = fe[3 * size_t(f) + s];
+      if (ef[efo[e]] != f) continue;  // each edge once, from its first face
+      const int32_t lx = label[ev[2 * size_t(e)]], ly = label[ev[2 * size_t(e) + 1]];
+      if (lx == ly) continue;
+      const int32_t copies = layout.edge_copies(mesh, e);
+      chi6[lx] += 3 * copies, chi6[ly] += 3 * copies;
+    }
+  }
+  return chi6;
+}
+
+Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
+                          const Clustering& c, const std::vector<uint8_t>& required, bool check_slivers,
+                          const std::vector<int32_t>* candidate_faces, EmitState* state) {
+  Partition out;
+  const int32_t n = mesh.num_vertices();
+  const int32_t k = static_cast<int32_t>(samples.size());
+  const auto& label = c.label;
+  const auto& vfo = mesh.vertex_face_offsets();
+  for (int32_t v = 0; v < n; ++v)
+    if (label[v] < 0 && vfo[v] != vfo[v + 1]) {
+      seed_unreached(mesh, c, out);
+      return out;  // the other checks need every vertex in a cluster
+    }
+  const int threads = omp_get_max_threads();
+  Marks marks(threads);
+
+  // --- emit: faces whose corners lie in three clusters ------------------------------------------
+  const auto& faces = mesh.faces();
+  const int32_t m = mesh.num_faces();
+  EmitState local;
+  EmitState& emit = state ? *state : local;
+  auto three_clusters = [&](int32_t f) {
+    const int32_t la = label[faces[3 * size_t(f)]], lb = label[faces[3 * size_t(f) + 1]],
+                  lc = label[faces[3 * size_t(f) + 2]];
+    return uint8_t(la != lb && lb != lc && lc != la);
+  };
+  if (emit.valid) {
+    // Only faces around relabelled vertices can have changed.
+    const auto& vfo = mesh.vertex_face_offsets();
+    const auto& vf = mesh.vertex_faces();
+    for (int32_t v : emit.changed)
+      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) emit.emits[vf[i]] = three_clusters(vf[i]);
+  } else {
+    emit.emits.assign(m, 0);
+    const int64_t count = candidate_faces ? int64_t(candidate_faces->size()) : int64_t(m);
+#pragma omp parallel for schedule(static) if (count >= kParallelMin)
+    for (int64_t i = 0; i < count; ++i) {
+      const int32_t f = candidate_faces ? (*candidate_faces)[i] : int32_t(i);
+      emit.emits[f] = three_clusters(f);
+    }
+    emit.valid = true;
+  }
+  emit.changed.clear();
+  {
+    // Collect in face order (static chunks keep the serial order).
+    std::vector<std::vector<int32_t>> found(threads);
+#pragma omp parallel if (m >= kParallelMin)
+    {
+      auto& mine = found[omp_get_thread_num()];
+#pragma omp for schedule(static)
+      for (int32_t f = 0; f < m; ++f)
+        if (emit.emits[f]) mine.push_back(f);
+    }
+    std::vector<size_t> start(threads + 1, 0);
+    for (int i = 0; i < threads; ++i) start[i + 1] = start[i] + found[i].size();
+    out.source_face.resize(start[threads]);
+    out.triangles.resize(3 * start[threads]);
+#pragma omp parallel if (m >= kParallelMin)
+    {
+      const int me = omp_get_thread_num();
+      for (int list = me; list < threads; list += omp_get_num_threads())
+        for (size_t i = 0; i < found[list].size(); ++i) {
+          const int32_t f = found[list][i];
+          const size_t at = start[list] + i;
+          out.source_face[at] = f;
+          for (int j = 0; j < 3; ++j) out.triangles[3 * at + j] = label[faces[3 * size_t(f) + j]];
+        }
+    }
+  }
+  const int32_t emitted = static_cast<int32_t>(out.source_face.size());
+
+  // --- feature pairs: clusters adjacent along a feature curve, with the copies of their edge ---
+  std::unordered_map<uint64_t, int32_t> feature_copies;
+  for (int32_t e : layout.feature_edges) {
+    const int32_t lx = label[mesh.edge_vertices()[2 * size_t(e)]], ly = label[mesh.edge_vertices()[2 * size_t(e) + 1]];
+    if (lx != ly) feature_copies[pair_key(lx, ly)] += layout.edge_copies(mesh, e);
+  }
+
+  // --- the arcs of each sample's link ---------------------------------------------------------
+  // Triangle (a, b, c) gives a the arc b -> c, b the arc c -> a and c the arc a -> b. Stored per
+  // sample in one array, so that evaluating a sample reads one short contiguous run.
+  struct Arc {
+    int32_t from, to, triangle;
+  };
+  std::vector<int32_t> arc_offsets(k + 1, 0);
+  for (int32_t x : out.triangles) ++arc_offsets[x + 1];
+  for (int32_t s = 0; s < k; ++s) arc_offsets[s + 1] += arc_offsets[s];
+  std::vector<Arc> arcs(out.triangles.size());
+  {
+    std::vector<int32_t> fill(arc_offsets.begin(), arc_offsets.end() - 1);
+    for (int32_t i = 0; i < emitted; ++i) {
+      const int32_t* t = &out.triangles[3 * size_t(i)];
+      arcs[fill[t[0]]++] = {t[1], t[2], i};
+      arcs[fill[t[1]]++] = {t[2], t[0], i};
+      arcs[fill[t[2]]++] = {t[0], t[1], i};
+    }
+  }
+  auto incident = [&](int32_t s) { return arc_offsets[s + 1] - arc_offsets[s]; };
+
+  // --- per sample: one oriented fan, expected edge multiplicities, Euler contributions ----------
+  // Each triangle (s, a, b) around sample s is an arc a -> b of s's link. Six times a component's
+  // Euler characteristic is the sum over its samples of 6 - 3 (neighbours) + 2 (triangles),
+  // counting only samples that keep a triangle. A triangle emitted twice shows up as a repeated
+  // or reversed arc; such samples are set aside and settled after the pass (see below).
+  const int32_t num_components = mesh.num_components();
+  std::vector<int64_t> chi6_out(k, 0);
+  out.absorbed.assign(k, 0);
+  std::vector<uint8_t> drop(emitted, 0);
+  bool any_dropped = false;  // drop is read only once pillows are dropped
+  std::vector<std::vector<uint64_t>> seen_pairs(threads);
+  std::vector<std::vector<int32_t>> repeated_lists(threads);
+  int32_t bad_link = 0, bad_edge = 0, isolated = 0, absorbed = 0;
+  // Returns false (and changes nothing) when the link repeats a triangle.
+  auto evaluate = [&](int32_t s, Link& link, std::vector<uint64_t>& seen, int32_t& links, int32_t& edges,
+                      int32_t& lonely, int32_t& eaten) {
+    link.clear();
+    for (int32_t i = arc_offsets[s]; i < arc_offsets[s + 1]; ++i)
+      if (!any_dropped || !drop[arcs[i].triangle]) link.add(arcs[i].from, arcs[i].to);
+    if (link.repeated()) return false;
+    if (link.arcs == 0) {
+      // No triangle: the neighbours absorbed this cluster (the pillow case) unless the sample
+      // must stay. The Euler characteristic check confirms the topology either way.
+      if (required[samples[s]] || layout.vertex_corner[samples[s]]) {
+        ++lonely;
+        marks.add(s);
+      } else {
+        ++eaten;
+        out.absorbed[s] = 1;
+      }
+      return true;
+    }
+    chi6_out[s] = 6 - 3 * int64_t(link.neighbours.size()) + 2 * int64_t(link.arcs);
+    for (const auto& nb : link.neighbours) {
+      if (nb.id < s) continue;  // each pair once
+      int32_t expected = 2;
+      auto it = feature_copies.empty() ? feature_copies.end() : feature_copies.find(pair_key(s, nb.id));
+      if (it != feature_copies.end()) {
+        expected = it->second;
+        seen.push_back(it->first);
+      }
+      if (nb.in + nb.out != expected) {
+        ++edges;
+        marks.add(s), marks.add(nb.id);
+      }
+    }
+    if (mesh.manifold_vertex()[samples[s]] && !link.single_fan()) {
+      ++links;
+      marks.add(s);
+    }
+    return true;
+  };
+#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed) if (k >= kParallelMin)
+  {
+    Link link;
+    auto& seen = seen_pairs[omp_get_thread_num()];
+    auto& repeated = repeated_lists[omp_get_thread_num()];
+#pragma omp for schedule(dynamic, 256)
+    for (int32_t s = 0; s < k; ++s)
+      if (!evaluate(s, link, seen, bad_link, bad_edge, isolated, absorbed)) repeated.push_back(s);
+  }
+
+  // --- repeated triangles: pillows and duplicates ------------------------------------------------
+  // A small cluster can sit between two others that wrap around it, touching it along its whole
+  // border: their triangle is emitted twice, facing opposite ways, and the small cluster has no
+  // other triangle. Dropping both copies gives the nerve of the partition in which the small
+  // cluster joined its neighbours, so no sample is needed. Any other repeat is an issue. Every
+  // sample of a repeated triangle sees the repeat in its link, so the set-aside samples hold
+  // all of them; they are evaluated again once the pillows are gone.
+  std::vector<int32_t> repeated;
+  for (const auto& list : repeated_lists) repeated.insert(repeated.end(), list.begin(), list.end());
+  std::sort(repeated.begin(), repeated.end());
+  if (!repeated.empty()) {
+    std::vector<std::pair<std::array<int32_t, 3>, int32_t>> keyed;  // sorted triple, triangle
+    for (int32_t s : repeated)
+      for (int32_t i = arc_offsets[s]; i < arc_offsets[s + 1]; ++i) {
+        const int32_t* t = &out.triangles[3 * size_t(arcs[i].triangle)];
+        if (std::min({t[0], t[1], t[2]}) != s) continue;  // each triangle from its lowest sample
+        std::array<int32_t, 3> key = {t[0], t[1], t[2]};
+        std::sort(key.begin(), key.end());
+        keyed.push_back({key, arcs[i].triangle});
+      }
+    std::sort(keyed.begin(), keyed.end());
+    for (size_t a = 0; a < keyed.size();) {
+      size_t b = a;
+      while (b < keyed.size() && keyed[b].first == keyed[a].first) ++b;
+      if (b - a >= 2) {
+        const int32_t* t0 = &out.triangles[3 * size_t(keyed[a].second)];
+        const int32_t* t1 = &out.triangles[3 * size_t(keyed[a + 1].second)];
+        const bool opposite = b - a == 2 && rotated_from_lowest(t0)[0] == rotated_from_lowest(t1)[1];
+        const bool absorbs = incident(t0[0]) == 2 || incident(t0[1]) == 2 || incident(t0[2]) == 2;
+        if (opposite && absorbs) {
+          ++out.issues.pillows;
+          drop[keyed[a].second] = drop[keyed[a + 1].second] = 1;
+          any_dropped = true;
+        } else {
+          ++out.issues.duplicate;
+          for (int j = 0; j < 3; ++j) marks.add(t0[j]);
+        }
+      }
+      a = b;
+    }
+    Link link;
+    for (int32_t s : repeated)
+      if (!evaluate(s, link, seen_pairs[0], bad_link, bad_edge, isolated, absorbed)) marks.add(s);
+  }
+  out.issues.bad_link = bad_link;
+  out.issues.bad_edge = bad_edge;
+  out.issues.isolated = isolated;
+  out.issues.absorbed = absorbed;
+  {
+    // Feature pairs without a triangle between them: the border between them collapsed.
+    std::vector<uint64_t> seen;
+    for (const auto& list : seen_pairs) seen.insert(seen.end(), list.begin(), list.end());
+    std::sort(seen.begin(), seen.end());
+    for (const auto& [key, copies] : feature_copies)
+      if (!std::binary_search(seen.begin(), seen.end(), key)) {
+        ++out.issues.bad_edge;
+        marks.add(int32_t(key >> 32)), marks.add(int32_t(key & 0xffffffffu));
+      }
+  }
+  {
+    // Dropped pillows leave the output.
+    int32_t kept = 0;
+    for (int32_t i = 0; i < emitted; ++i) {
+      if (drop[i]) continue;
+      for (int j = 0; j < 3; ++j) out.triangles[3 * size_t(kept) + j] = out.triangles[3 * size_t(i) + j];
+      out.source_face[kept++] = out.source_face[i];
+    }
+    out.triangles.resize(3 * size_t(kept));
+    out.source_face.resize(kept);
+  }
+
+  // --- Euler characteristic per component -------------------------------------------------------
+  // A component that lost all its triangles fails too (a torus has chi = 0 with or without).
+  std::vector<int64_t> component_chi6(num_components, 0);
+  std::vector<int32_t> component_triangles(num_components, 0);
+  for (int32_t s = 0; s < k; ++s) component_chi6[mesh.component()[samples[s]]] += chi6_out[s];
+  for (int32_t f : out.source_face) ++component_triangles[mesh.component()[faces[3 * size_t(f)]]];
+  std::vector<uint8_t> failing(num_components, 0);
+  for (int32_t comp = 0; comp < num_components; ++comp)
+    if (component_chi6[comp] != 6 * mesh.component_euler()[comp] || component_triangles[comp] == 0) {
+      failing[comp] = 1;
+      ++out.issues.bad_component;
+    }
+  marks.merge_into(out.split_clusters);
+  if (out.issues.bad_component > 0 && out.issues.topological() == out.issues.bad_component) {
+    // Only the Euler characteristic names a problem: find the clusters that are not disks.
+    const auto chi6 = cluster_euler6(mesh, layout, k, c);
+    for (int32_t s = 0; s < k; ++s)
+      if (failing[mesh.component()[samples[s]]] && chi6[s] != 6 * int64_t(layout.sectors[samples[s]])) {
+        ++out.issues.non_disk;
+        out.split_clusters.push_back(s);
+      }
+    if (out.issues.non_disk == 0) {
+      // Nothing local to blame: split the widest cluster of each failing component.
+      std::vector<int32_t> widest(num_components, -1);
+      for (int32_t v = 0; v < n; ++v) {
+        const int32_t comp = mesh.component()[v];
+        if (label[v] < 0 || !failing[comp]) continue;
+        if (widest[comp] < 0 || c.dist[v] > c.dist[widest[comp]]) widest[comp] = v;
+      }
+      for (int32_t v : widest)
+        if (v >= 0) out.new_samples.push_back(v);
+    }
+  }
+
+  // --- closed feature curves need three clusters to stay loops ---------------------------------
+  for (int32_t curve = 0; curve < layout.num_curves(); ++curve) {
+    if (!layout.curve_closed[curve]) continue;
+    const int32_t b = layout.curve_offsets[curve], e = layout.curve_offsets[curve + 1];
+    int32_t changes = 0, farthest = -1;
+    for (int32_t i = b; i < e; ++i) {
+      const int32_t v = layout.curve_vertices[i];
+      const int32_t w = layout.curve_vertices[i + 1 < e ? i + 1 : b];
+      changes += label[v] != label[w];
+      if (c.dist[v] > 0 && (farthest < 0 || c.dist[v] > c.dist[farthest])) farthest = v;
+    }
+    if (changes < 3) {
+      ++out.issues.short_loop;
+      if (farthest >= 0) out.new_samples.push_back(farthest);
+    }
+  }
+
+  // --- triangles of zero area (collinear samples) ------------------------------------------------
+  if (check_slivers) {
+    const int32_t t = static_cast<int32_t>(out.source_face.size());
+    // The samples' positions gathered once, in rank order: the triangles then read a compact
+    // array instead of the whole mesh's.
+    std::vector<double> at(3 * size_t(k));
+#pragma omp parallel for schedule(static) if (k >= kParallelMin)
+    for (int32_t s = 0; s < k; ++s)
+      for (int j = 0; j < 3; ++j) at[3 * size_t(s) + j] = mesh.position(samples[s])[j];
+    std::vector<uint8_t> sliver(t, 0);
+    int32_t slivers = 0;
+#pragma omp parallel for schedule(static) reduction(+ : slivers) if (t >= kParallelMin)
+    for (int32_t i = 0; i < t; ++i) {
+      const double* p[3];
+      for (int j = 0; j < 3; ++j) p[j] = &at[3 * size_t(out.triangles[3 * size_t(i) + j])];
+      double u[3], w[3], longest = 0;
+      for (int a = 0; a < 3; ++a) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
+      for (int j = 0; j < 3; ++j) {
+        const double* q0 = p[j];
+        const double* q1 = p[(j + 1) % 3];
+        longest = std::max(longest, (q1[0] - q0[0]) * (q1[0] - q0[0]) + (q1[1] - q0[1]) * (q1[1] - q0[1]) +
+                                        (q1[2] - q0[2]) * (q1[2] - q0[2]));
+      }
+      const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
+      if (std::sqrt(cx * cx + cy * cy + cz * cz) <= 1e-9 * longest) {
+        sliver[i] = 1;
+        ++slivers;
+      }
+    }
+    out.issues.sliver += slivers;
+    for (int32_t i = 0; i < t && slivers > 0; ++i)
+      if (sliver[i])
+        for (int j = 0; j < 3; ++j) out.split_clusters.push_back(out.triangles[3 * size_t(i) + j]);
+  }
+  std::sort(out.split_clusters.begin(), out.split_clusters.end());
+  out.split_clusters.erase(std::unique(out.split_clusters.begin(), out.split_clusters.end()),
+                           out.split_clusters.end());
+  return out;
+}
+
+}  // namespace topstoc

@@ -1,0 +1,478 @@
+#include "topstoc/decimate/sampling.hpp"
+#include "topstoc/core/parallel.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <limits>
+#include <memory>
+#include <omp.h>
+
+#include "topstoc/core/random.hpp"
+
+namespace topstoc {
+
+namespace {
+
+constexpr uint64_t kStreamSelection = 1;
+
+enum VertexClass : uint8_t { kIsolated = 0, kSurface = 1, kCurve = 2, kCorner = 3 };
+
+std::vector<uint8_t> classify(const Mesh& mesh, const FeatureLayout& layout) {
+  const int32_t n = mesh.num_vertices();
+  const auto& vfo = mesh.vertex_face_offsets();
+  std::vector<uint8_t> cls(n);
+  for (int32_t v = 0; v < n; ++v)
+    cls[v] = vfo[v] == vfo[v + 1] ? kIsolated
+             : layout.vertex_corner[v] ? kCorner
+             : layout.vertex_feature[v] ? kCurve
+                                        : kSurface;
+  return cls;
+}
+
+// Importance factor q(v) = 1 + α (x / x̄ - 1), floored so flat regions are not starved.
+// With area weighting, q is also scaled by the vertex's area over the mean, so that samples
+// per unit area, not per vertex, follow the weights on irregularly tessellated meshes.
+inline double importance(const Mesh& mesh, const SamplingParams& params, int32_t v) {
+  const double mean = mesh.mean_weight();
+  const double q = std::max(mean > 0 ? 1.0 + params.adaptivity * (mesh.weights()[v] / mean - 1.0) : 1.0,
+                            params.flat_floor);
+  if (!params.area_weighted || mesh.mean_vertex_area() <= 0) return q;
+  return q * mesh.vertex_areas()[v] / mesh.mean_vertex_area();
+}
+
+bool inside_box(const BoxGuidance& box, const double* p) {
+  const double* m = box.world_to_box;
+  for (int r = 0; r < 3; ++r) {
+    const double c = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
+    if (std::abs(c) > 1.0) return false;
+  }
+  return true;
+}
+
+bool inside_frustum(const ViewGuidance& view, const double* p) {
+  const double* m = view.view_projection;
+  double clip[4];
+  for (int r = 0; r < 4; ++r) clip[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
+  if (clip[3] <= 0) return false;
+  for (int r = 0; r < 3; ++r)
+    if (std::abs(clip[r]) > clip[3]) return false;
+  return true;
+}
+
+// Silhouette band, back faces and frustum (thesis 4.4) applied to p for one vertex.
+double apply_view(const ViewGuidance& view, const double* position, const double* normal, double p) {
+  double to_eye[3];
+  if (view.perspective) {
+    for (int k = 0; k < 3; ++k) to_eye[k] = view.eye[k] - position[k];
+  } else {
+    for (int k = 0; k < 3; ++k) to_eye[k] = -view.direction[k];
+  }
+  const double len = std::sqrt(to_eye[0] * to_eye[0] + to_eye[1] * to_eye[1] + to_eye[2] * to_eye[2]);
+  const double facing = len > 0 ? (normal[0] * to_eye[0] + normal[1] * to_eye[1] + normal[2] * to_eye[2]) / len : 1.0;
+  const double band = (1.0 - std::cos(view.silhouette_angle)) / 2.0;
+  const double away = std::abs(facing);
+  if (facing < 0) p *= view.back_ratio;
+  if (away <= band) {
+    p = 1.0;
+  } else if (view.silhouette_falloff > 0 && away < band + view.silhouette_falloff) {
+    const double t = (away - band) / view.silhouette_falloff;  // 0 at the band, 1 outside
+    p = (1.0 - t) * 1.0 + t * p;
+  }
+  if (view.frustum && !inside_frustum(view, position)) p = std::min(p, view.outside_probability);
+  return p;
+}
+
+// Per-vertex class and importance q (0 where not sampled stochastically), with q sorted per
+// class for solving the rate. Depends on the mesh, the layout and three parameters only, so it
+// is kept on the layout and reused while they stay the same (a slider changes only the target).
+struct ImportanceTable {
+  double adaptivity = 0.0, flat_floor = 0.0;
+  bool area_weighted = false;
+  std::vector<uint8_t> cls;
+  std::vector<double> q;
+  std::vector<double> surface_q, surface_sum;    // sorted ascending; prefix sums of q
+  std::vector<double> curve_q, curve_sqrt_sum;   // sorted ascending; prefix sums of sqrt(q)
+  double corners = 0.0;
+  double total_q = 0.0;  // over surface and curve vertices
+  int32_t active = 0;    // vertices in triangles
+};
+
+std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const FeatureLayout& layout,
+                                                        const SamplingParams& params) {
+  auto cached = std::static_pointer_cast<const ImportanceTable>(layout.sampling_table.get());
+  if (cached && cached->adaptivity == params.adaptivity && cached->flat_floor == params.flat_floor &&
+      cached->area_weighted == params.area_weighted && int32_t(cached->cls.size()) == mesh.num_vertices())
+    return cached;
+  auto table = std::make_shared<ImportanceTable>();
+  table->adaptivity = params.adaptivity;
+  table->flat_floor = params.flat_floor;
+  table->area_weighted = params.area_weighted;
+  table->cls = classify(mesh, layout);
+  const auto& cls = table->cls;
+  const int32_t n = mesh.num_vertices();
+  table->q.assign(n, 0.0);
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v)
+    if (cls[v] == kSurface || cls[v] == kCurve) table->q[v] = importance(mesh, params, v);
+  for (int32_t v = 0; v < n; ++v) {
+    if (cls[v] == kSurface) table->surface_q.push_back(table->q[v]);
+    else if (cls[v] == kCurve) table->curve_q.push_back(table->q[v]);
+    else if (cls[v] == kCorner) table->corners += 1.0;
+    table->active += cls[v] != kIsolated;
+    table->total_q += table->q[v];
+  }
+  std::sort(table->surface_q.begin(), table->surface_q.end());
+  std::sort(table->curve_q.begin(), table->curve_q.end());
+  table->surface_sum.assign(1, 0.0);
+  for (double q : table->surface_q) table->surface_sum.push_back(table->surface_sum.back() + q);
+  table->curve_sqrt_sum.assign(1, 0.0);
+  for (double q : table->curve_q) table->curve_sqrt_sum.push_back(table->curve_sqrt_sum.back() + std::sqrt(q));
+  layout.sampling_table.set(table);
+  return table;
+}
+
+bool has_per_vertex_guidance(const SamplingParams& params) {
+  return params.guidance || !params.boxes.empty() || params.view.enabled;
+}
+
+double surface_probability(const Mesh& mesh, const SamplingParams& params, int32_t v, double k, double q) {
+  const double* position = mesh.position(v);
+  double u = params.guidance ? params.guidance[mesh.vertex_source()[v]] : 0.0;
+  for (const auto& box : params.boxes)
+    if (inside_box(box, position)) u = box.value;
+  if (u >= 1.0) return 1.0;   // a control point
+  if (u <= -1.0) return 0.0;  // never sampled (topology may still need it)
+  const double p0 = std::min(1.0, k * q);
+  double p = u > 0 ? p0 + (1.0 - p0) * u : p0 * (1.0 + u);
+  if (params.view.enabled) p = apply_view(params.view, position, &mesh.normals()[3 * size_t(v)], p);
+  return std::clamp(p, 0.0, 1.0);
+}
+
+std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& cls, const std::vector<double>& q,
+                                  const SamplingParams& params, double k) {
+  const int32_t n = mesh.num_vertices();
+  std::vector<double> p(n);
+  const bool guided = has_per_vertex_guidance(params);
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) {
+    switch (cls[v]) {
+      case kIsolated: p[v] = 0.0; break;
+      case kCorner: p[v] = 1.0; break;
+      default: {
+        const double surface = guided ? surface_probability(mesh, params, v, k, q[v]) : std::min(1.0, k * q[v]);
+        p[v] = cls[v] == kCurve ? std::sqrt(surface) : surface;
+      }
+    }
+  }
+  return p;
+}
+
+// Without guidance: the base rate k whose probabilities sum to the target. The sum is
+// increasing and concave in k (min(1, k q) and sqrt are), so Newton steps taken from below stay
+// below the root and converge monotonically; a bracket guards against round-off. The draw
+// fixes the count anyway, so k need only be close. Each evaluation reads the sorted q and
+// their prefix sums: the vertices with k q < 1 are a prefix, the rest count 1 each.
+double solve_rate(const ImportanceTable& table, double target) {
+  const size_t surfaces = table.surface_q.size(), curves = table.curve_q.size();
+  double min_q = 1e300;
+  if (surfaces) min_q = std::min(min_q, table.surface_q.front());
+  if (curves) min_q = std::min(min_q, table.curve_q.front());
+  // Sum of the probabilities at k and its derivative.
+  auto evaluate = [&](double k, double& slope) {
+    const double limit = k > 0 ? 1.0 / k : std::numeric_limits<double>::infinity();
+    const size_t s = std::lower_bound(table.surface_q.begin(), table.surface_q.end(), limit) - table.surface_q.begin();
+    const size_t c = std::lower_bound(table.curve_q.begin(), table.curve_q.end(), limit) - table.curve_q.begin();
+    const double root = std::sqrt(k);
+    slope = table.surface_sum[s] + (k > 0 ? 0.5 * table.curve_sqrt_sum[c] / root : 0.0);
+    return table.corners + k * table.surface_sum[s] + double(surfaces - s) + root * table.curve_sqrt_sum[c] +
+           double(curves - c);
+  };
+  if (table.total_q <= 0 || target <= table.corners) return 0.0;
+  double lo = 0.0, hi = min_q < 1e300 ? 1.0 / min_q : 1.0;
+  double slope = 0.0;
+  if (evaluate(hi, slope) <= target) return hi;
+  // Start from the rate that would be exact if nothing clamped and there were no curves; the
+  // curves' sqrt makes the true sum larger, so this start is at or below the root... unless
+  // clamping dominates, which the bracket handles.
+  double k = std::min(hi, (target - table.corners) / table.total_q);
+  for (int it = 0; it < 50; ++it) {
+    const double f = evaluate(k, slope) - target;
+    if (std::abs(f) <= std::max(0.5, 1e-4 * target)) break;
+    if (f < 0) lo = k;
+    else hi = k;
+    double next = slope > 0 ? k - f / slope : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    k = next;
+  }
+  return k;
+}
+
+struct Candidate {
+  double key;
+  int32_t vertex;
+  bool operator<(const Candidate& o) const { return key < o.key || (key == o.key && vertex < o.vertex); }
+};
+
+// Candidates with Pareto key (U / (1 - U)) ((1 - p) / p) below `threshold`, in vertex order.
+// The uniform U of a vertex depends on the seed and its caller id only.
+std::vector<Candidate> pareto_candidates(const Mesh& mesh, uint64_t seed, const std::vector<double>& p,
+                                         double threshold) {
+  const int32_t n = mesh.num_vertices();
+  const int threads = omp_get_max_threads();
+  std::vector<std::vector<Candidate>> found(threads);
+#pragma omp parallel if (n >= kParallelMin)
+  {
+    auto& mine = found[omp_get_thread_num()];
+#pragma omp for schedule(static)
+    for (int32_t v = 0; v < n; ++v) {
+      if (!(p[v] > 0.0 && p[v] < 1.0)) continue;
+      const double u = uniform01(seed, kStreamSelection, uint64_t(mesh.vertex_source()[v]));
+      const double key = (u / (1.0 - u)) * ((1.0 - p[v]) / p[v]);
+      if (key < threshold) mine.push_back({key, v});
+    }
+  }
+  std::vector<Candidate> out;
+  for (auto& list : found) out.insert(out.end(), list.begin(), list.end());
+  return out;
+}
+
+// Breadth-first ball of `rings` hops around `center`, restricted by `follow(slot)`; calls
+// visit(v) for each vertex reached (center included).
+template <class Follow, class Visit>
+void ring_ball(const Mesh& mesh, int32_t center, int32_t rings, std::vector<int32_t>& stamp, int32_t stamp_id,
+               std::vector<int32_t>& queue, Follow follow, Visit visit) {
+  const auto& ao = mesh.adjacency_offsets();
+  const auto& adj = mesh.adjacency();
+  queue.clear();
+  queue.push_back(center);
+  stamp[center] = stamp_id;
+  size_t head = 0;
+  for (int32_t ring = 0; ring <= rings && head < queue.size(); ++ring) {
+    const size_t end = queue.size();
+    for (; head < end; ++head) {
+      const int32_t v = queue[head];
+      visit(v);
+      if (ring == rings) continue;
+      for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
+        const int32_t u = adj[i];
+        if (stamp[u] != stamp_id && follow(v, i, u)) {
+          stamp[u] = stamp_id;
+          queue.push_back(u);
+        }
+      }
+    }
+  }
+}
+
+double mean_edge_length(const Mesh& mesh) {
+  const auto& ev = mesh.edge_vertices();
+  double total = 0.0;
+  const int32_t m = mesh.num_edges();
+#pragma omp parallel for schedule(static) reduction(+ : total) if (m >= kParallelMin)
+  for (int32_t e = 0; e < m; ++e) {
+    const double* a = mesh.position(ev[2 * e]);
+    const double* b = mesh.position(ev[2 * e + 1]);
+    total += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+  }
+  return m ? total / m : 0.0;
+}
+
+// Poisson-disk rejection (thesis 4.1.2): candidates in key order, each accepted sample blocks
+// its neighbourhood. Surface samples block surface vertices; curve samples and corners block
+// both, so borders keep their own spacing. Stops at `count` samples; if rejection leaves too
+// few, the rejected candidates are taken back in key order.
+template <class AllCandidates>
+std::vector<int32_t> select_with_density(const Mesh& mesh, const FeatureLayout& layout,
+                                         const std::vector<uint8_t>& cls, const SamplingParams& params,
+                                         std::vector<int32_t> forced, std::vector<Candidate> candidates,
+                                         AllCandidates all_candidates, int32_t count, int32_t& rejected_out) {
+  const int32_t n = mesh.num_vertices();
+  const double r = std::sqrt(double(std::max<int32_t>(1, n)) / (3.0 * std::max<int32_t>(1, count)));
+  const int32_t eps_uniform = params.density_rings > 0 ? params.density_rings : std::max(1, int32_t(std::lround(r)));
+  const int32_t eps_big = params.density_rings > 0 ? params.density_rings : std::max(2, int32_t(std::lround(1.25 * r)));
+  const int32_t eps_small = std::max(1, int32_t(eps_big / std::max(1.0, params.density_ratio)));
+  const double eps_euclid = params.density_epsilon > 0 ? params.density_epsilon : r * mean_edge_length(mesh);
+  const auto& feature = layout.vertex_feature;
+  const auto& ae = mesh.adjacency_edge();
+
+  std::vector<uint8_t> blocked(n, 0);
+  std::vector<int32_t> stamp(n, -1), queue;
+  int32_t stamp_id = 0;
+  auto block_around = [&](int32_t s) {
+    const bool surface = cls[s] == kSurface;
+    int32_t rings = eps_uniform;
+    if (params.density == DensityMode::Adaptive)
+      rings = mesh.weights()[s] > mesh.mean_weight() ? eps_small : eps_big;
+    const double* ps = mesh.position(s);
+    const bool euclid = params.density == DensityMode::Euclidean;
+    const int32_t max_rings = euclid ? n : rings;
+    ++stamp_id;
+    // Surface samples spread over surface vertices only; border samples along borders and into the surface.
+    ring_ball(
+        mesh, s, max_rings, stamp, stamp_id, queue,
+        [&](int32_t, int32_t slot, int32_t u) {
+          if (euclid) {
+            const double* pu = mesh.position(u);
+            const double d2 = (pu[0] - ps[0]) * (pu[0] - ps[0]) + (pu[1] - ps[1]) * (pu[1] - ps[1]) +
+                              (pu[2] - ps[2]) * (pu[2] - ps[2]);
+            if (d2 > eps_euclid * eps_euclid) return false;
+          }
+          if (surface) return !feature[u];
+          return feature[u] ? layout.edge_feature[ae[slot]] != 0 : true;
+        },
+        [&](int32_t v) { blocked[v] = 1; });
+  };
+  std::vector<int32_t> chosen = std::move(forced);
+  for (int32_t s : chosen) block_around(s);
+  std::vector<Candidate> skipped;
+  // Sort candidates lazily in chunks: usually only the first ~2 count are ever looked at.
+  size_t sorted_end = 0;
+  auto ensure_sorted = [&](size_t i) {
+    if (i < sorted_end) return;
+    const size_t chunk = std::max<size_t>(2 * size_t(count) + 64, sorted_end);
+    const size_t end = std::min(candidates.size(), sorted_end + chunk);
+    std::nth_element(candidates.begin() + sorted_end, candidates.begin() + (end - 1), candidates.end());
+    std::sort(candidates.begin() + sorted_end, candidates.begin() + end);
+    sorted_end = end;
+  };
+  int32_t rejected = 0;
+  bool complete = false;  // candidates holds every vertex with 0 < p < 1
+  for (size_t i = 0; int32_t(chosen.size()) < count; ++i) {
+    if (i == candidates.size()) {
+      if (complete) break;
+      // The kept superset ran out: continue with the candidates it did not hold, in key order.
+      std::vector<Candidate> everything = all_candidates();
+      std::sort(everything.begin(), everything.end());
+      const Candidate last = i > 0 ? candidates[i - 1] : Candidate{-1.0, -1};
+      std::vector<Candidate> rest;
+      for (const auto& c : everything)
+        if (last < c) rest.push_back(c);
+      candidates.resize(i);
+      candidates.insert(candidates.end(), rest.begin(), rest.end());
+      sorted_end = candidates.size();
+      complete = true;
+      if (i == candidates.size()) break;
+    }
+    ensure_sorted(i);
+    const int32_t v = candidates[i].vertex;
+    if (blocked[v]) {
+      ++rejected;
+      skipped.push_back(candidates[i]);
+      continue;
+    }
+    chosen.push_back(v);
+    block_around(v);
+  }
+  for (size_t i = 0; i < skipped.size() && int32_t(chosen.size()) < count; ++i) {
+    chosen.push_back(skipped[i].vertex);
+    --rejected;
+  }
+  rejected_out = rejected;
+  return chosen;
+}
+
+}  // namespace
+
+bool is_guided(const Mesh& mesh, const SamplingParams& params) {
+  if (params.view.enabled || !params.boxes.empty()) return true;
+  if (params.guidance)
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+      if (params.guidance[v] != 0.0) return true;  // indexed by caller id; any order will do
+  return false;
+}
+
+void validate_sampling_params(const Mesh& mesh, const SamplingParams& params) {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok) throw std::invalid_argument(message);
+  };
+  require(params.adaptivity >= 0.0 && params.adaptivity <= 1.0, "adaptivity must lie in [0, 1]");
+  require(params.flat_floor >= 0.0 && params.flat_floor <= 1.0, "flat_floor must lie in [0, 1]");
+  require(params.density_rings >= 0, "density_rings must be >= 0");
+  require(params.density_ratio >= 1.0, "density_ratio must be >= 1");
+  require(params.density_epsilon >= 0.0 && std::isfinite(params.density_epsilon), "density_epsilon must be >= 0");
+  if (params.guidance)
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+      const double u = params.guidance[v];
+      if (!(u >= -1.0 && u <= 1.0))
+        throw std::invalid_argument("guidance of vertex " + std::to_string(v) + " is " + std::to_string(u) +
+                                    "; it must lie in [-1, 1]");
+    }
+  for (size_t b = 0; b < params.boxes.size(); ++b) {
+    const auto& box = params.boxes[b];
+    require(box.value >= -1.0 && box.value <= 1.0, "box " + std::to_string(b) + " guidance must lie in [-1, 1]");
+    for (double x : box.world_to_box) require(std::isfinite(x), "box " + std::to_string(b) + " matrix is not finite");
+  }
+  if (params.view.enabled) {
+    const auto& view = params.view;
+    require(view.back_ratio >= 0.0 && view.back_ratio <= 1.0, "view back_ratio must lie in [0, 1]");
+    require(view.silhouette_angle >= 0.0 && view.silhouette_angle <= M_PI, "silhouette angle must lie in [0, pi]");
+    require(view.silhouette_falloff >= 0.0, "silhouette falloff must be >= 0");
+    require(view.outside_probability >= 0.0 && view.outside_probability <= 1.0,
+            "outside-frustum probability must lie in [0, 1]");
+    double d2 = 0;
+    for (double x : view.direction) d2 += x * x;
+    require(view.perspective || d2 > 0, "view direction must not be zero");
+    for (double x : view.eye) require(std::isfinite(x), "view eye position is not finite");
+    for (double x : view.view_projection) require(std::isfinite(x), "view-projection matrix is not finite");
+  }
+}
+
+std::vector<double> sampling_probabilities(const Mesh& mesh, const FeatureLayout& layout,
+                                           const SamplingParams& params, double k) {
+  const auto table = importance_table(mesh, layout, params);
+  return probabilities(mesh, table->cls, table->q, params, k);
+}
+
+SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const SamplingParams& params,
+                         int32_t target_vertices) {
+  validate_sampling_params(mesh, params);
+  const int32_t n = mesh.num_vertices();
+  const auto table = importance_table(mesh, layout, params);
+  const auto& cls = table->cls;
+  const int32_t active = table->active;
+  SampleSet out;
+  out.guided = is_guided(mesh, params);
+  const int32_t target = std::clamp(target_vertices, 0, active);
+  out.rate = out.guided ? double(target) / double(std::max(1, active)) : solve_rate(*table, target);
+  const auto p = probabilities(mesh, cls, table->q, params, out.rate);
+  double expected = 0.0;
+  for (double x : p) expected += x;
+  out.expected = expected;
+  const int32_t count = out.guided ? int32_t(std::lround(expected)) : target;
+
+  // Pareto keys: with threshold 1 the expected number of keys below it is exactly the sum of
+  // the probabilities, so a slightly larger threshold keeps a small superset of what the draw
+  // needs; if it falls short (tiny targets), the threshold grows.
+  std::vector<int32_t> forced;
+  for (int32_t v = 0; v < n; ++v)
+    if (p[v] >= 1.0) forced.push_back(v);
+  out.forced = static_cast<int32_t>(forced.size());
+  const int32_t free_count = std::max<int32_t>(0, count - out.forced);
+  const bool density = params.density != DensityMode::Off;
+  std::vector<Candidate> candidates;
+  for (double threshold = density ? 3.0 : 1.25;; threshold *= 4) {
+    candidates = pareto_candidates(mesh, params.seed, p, threshold);
+    const bool everything = threshold > 1e6;
+    if (everything || int64_t(candidates.size()) >= int64_t(density ? 2 : 1) * free_count + 16) break;
+  }
+  if (!density) {
+    out.samples = std::move(forced);
+    const size_t take = std::min<size_t>(free_count, candidates.size());
+    if (take > 0) {
+      std::nth_element(candidates.begin(), candidates.begin() + (take - 1), candidates.end());
+      for (size_t i = 0; i < take; ++i) out.samples.push_back(candidates[i].vertex);
+    }
+  } else {
+    // Density control may reject many candidates: if the kept superset runs out, take all.
+    auto all = [&]() { return pareto_candidates(mesh, params.seed, p, std::numeric_limits<double>::infinity()); };
+    out.samples = select_with_density(mesh, layout, cls, params, std::move(forced), std::move(candidates), all,
+                                      std::max(count, out.forced), out.density_rejected);
+  }
+  std::sort(out.samples.begin(), out.samples.end());
+  return out;
+}
+
+}  // namespace topstoc

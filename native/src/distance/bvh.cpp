@@ -1,0 +1,225 @@
+#include "topstoc/distance/bvh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace topstoc {
+
+namespace {
+
+constexpr int32_t kLeafSize = 4;
+
+inline double dot(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+inline double distance2(const double* a, const double* b) {
+  const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+  return dot(d, d);
+}
+
+// Closest point of segment [a, b] to p (a point when a == b).
+double closest_point_on_segment(const double* p, const double* a, const double* b, double* out) {
+  const double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double ap[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+  const double length2 = dot(ab, ab);
+  const double t = length2 > 0.0 ? std::clamp(dot(ap, ab) / length2, 0.0, 1.0) : 0.0;
+  for (int k = 0; k < 3; ++k) out[k] = a[k] + t * ab[k];
+  return distance2(p, out);
+}
+
+// Squared distance from p to an axis-aligned box (0 inside).
+inline double box_distance2(const double* p, const double* lo, const double* hi) {
+  double d2 = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const double below = lo[k] - p[k], above = p[k] - hi[k];
+    const double d = below > 0.0 ? below : (above > 0.0 ? above : 0.0);
+    d2 += d * d;
+  }
+  return d2;
+}
+
+// A box whose distance exceeds the best one by less than this relative slack is still opened, so
+// that rounding in the box test never hides a triangle at the same distance (exact ties matter
+// for the deterministic lower-id tie-break).
+constexpr double kPruneSlack = 1.0 + 1e-12;
+
+}  // namespace
+
+double closest_point_on_triangle(const double* p, const double* a, const double* b, const double* c,
+                                 double* closest) {
+  // Voronoi regions of the corners, then the edges, then the interior (the region tests of
+  // Ericson, Real-Time Collision Detection, 5.1.5), with guarded divisions so that degenerate
+  // triangles never produce NaN.
+  const double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double ac[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const double ap[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  auto set = [&](const double* q) {
+    for (int k = 0; k < 3; ++k) closest[k] = q[k];
+    return distance2(p, closest);
+  };
+  if (d1 <= 0.0 && d2 <= 0.0) return set(a);
+  const double bp[3] = {p[0] - b[0], p[1] - b[1], p[2] - b[2]};
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0.0 && d4 <= d3) return set(b);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 && d1 - d3 > 0.0) {
+    const double v = d1 / (d1 - d3);
+    const double q[3] = {a[0] + v * ab[0], a[1] + v * ab[1], a[2] + v * ab[2]};
+    return set(q);
+  }
+  const double cp[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0.0 && d5 <= d6) return set(c);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 && d2 - d6 > 0.0) {
+    const double w = d2 / (d2 - d6);
+    const double q[3] = {a[0] + w * ac[0], a[1] + w * ac[1], a[2] + w * ac[2]};
+    return set(q);
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 && (d4 - d3) + (d5 - d6) > 0.0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    const double q[3] = {b[0] + w * (c[0] - b[0]), b[1] + w * (c[1] - b[1]), b[2] + w * (c[2] - b[2])};
+    return set(q);
+  }
+  const double denominator = va + vb + vc;
+  if (denominator > 0.0) {
+    const double v = vb / denominator, w = vc / denominator;
+    const double q[3] = {a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w, a[2] + ab[2] * v + ac[2] * w};
+    return set(q);
+  }
+  // Degenerate triangle: it is the union of its three sides.
+  double best = std::numeric_limits<double>::infinity();
+  const double* corners[3] = {a, b, c};
+  for (int side = 0; side < 3; ++side) {
+    double q[3];
+    const double d = closest_point_on_segment(p, corners[side], corners[(side + 1) % 3], q);
+    if (d < best) {
+      best = d;
+      for (int k = 0; k < 3; ++k) closest[k] = q[k];
+    }
+  }
+  return best;
+}
+
+TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int64_t num_triangles) {
+  const int32_t m = static_cast<int32_t>(num_triangles);
+  corners_.resize(9 * size_t(m));
+  std::vector<double> centroids(3 * size_t(m));
+  std::vector<double> unordered(9 * size_t(m));
+#pragma omp parallel for schedule(static) if(m >= 100000)
+  for (int32_t f = 0; f < m; ++f)
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 3; ++k) {
+        const double x = positions[3 * size_t(triangles[3 * size_t(f) + c]) + k];
+        unordered[9 * size_t(f) + 3 * c + k] = x;
+        centroids[3 * size_t(f) + k] += x / 3.0;
+      }
+  std::vector<int32_t> order(m);
+  std::iota(order.begin(), order.end(), 0);
+  nodes_.reserve(2 * size_t(m / kLeafSize + 1));
+  build(0, m, unordered, centroids, order);
+  // Store the corners in leaf order so that a leaf's triangles sit together in memory.
+  triangle_ids_ = order;
+#pragma omp parallel for schedule(static) if(m >= 100000)
+  for (int32_t s = 0; s < m; ++s)
+    std::copy_n(&unordered[9 * size_t(order[s])], 9, &corners_[9 * size_t(s)]);
+}
+
+int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>& corners,
+                           const std::vector<double>& centroids, std::vector<int32_t>& order) {
+  // Median split along the longest axis of the centroids' box: a balanced tree, built in
+  // O(m log m), that serves nearest-point queries well.
+  const int32_t index = static_cast<int32_t>(nodes_.size());
+  nodes_.push_back(Node{});
+  Node node{};
+  double centre_lo[3], centre_hi[3];
+  for (int k = 0; k < 3; ++k) {
+    node.lo[k] = centre_lo[k] = std::numeric_limits<double>::infinity();
+    node.hi[k] = centre_hi[k] = -std::numeric_limits<double>::infinity();
+  }
+  for (int32_t i = begin; i < end; ++i) {
+    const int32_t f = order[i];
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 3; ++k) {
+        node.lo[k] = std::min(node.lo[k], corners[9 * size_t(f) + 3 * c + k]);
+        node.hi[k] = std::max(node.hi[k], corners[9 * size_t(f) + 3 * c + k]);
+      }
+    for (int k = 0; k < 3; ++k) {
+      centre_lo[k] = std::min(centre_lo[k], centroids[3 * size_t(f) + k]);
+      centre_hi[k] = std::max(centre_hi[k], centroids[3 * size_t(f) + k]);
+    }
+  }
+  if (end - begin <= kLeafSize) {
+    node.first = begin;
+    node.count = end - begin;
+  } else {
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (centre_hi[k] - centre_lo[k] > centre_hi[axis] - centre_lo[axis]) axis = k;
+    const int32_t middle = begin + (end - begin) / 2;
+    std::nth_element(order.begin() + begin, order.begin() + middle, order.begin() + end, [&](int32_t x, int32_t y) {
+      const double cx = centroids[3 * size_t(x) + axis], cy = centroids[3 * size_t(y) + axis];
+      return cx < cy || (cx == cy && x < y);
+    });
+    build(begin, middle, corners, centroids, order);
+    node.first = build(middle, end, corners, centroids, order);
+    node.count = 0;
+  }
+  nodes_[index] = node;
+  return index;
+}
+
+double TriangleBvh::slot_distance2(const double* p, int32_t slot, double* closest) const {
+  const double* t = &corners_[9 * size_t(slot)];
+  return closest_point_on_triangle(p, t, t + 3, t + 6, closest);
+}
+
+ClosestHit TriangleBvh::closest(const double* p, int32_t hint_slot) const {
+  ClosestHit hit;
+  hit.distance2 = std::numeric_limits<double>::infinity();
+  auto consider = [&](int32_t slot) {
+    double q[3];
+    const double d2 = slot_distance2(p, slot, q);
+    if (d2 < hit.distance2 || (d2 == hit.distance2 && triangle_ids_[slot] < hit.triangle)) {
+      hit.distance2 = d2;
+      hit.triangle = triangle_ids_[slot];
+      hit.slot = slot;
+      for (int k = 0; k < 3; ++k) hit.point[k] = q[k];
+    }
+  };
+  if (hint_slot >= 0 && hint_slot < int32_t(triangle_ids_.size())) consider(hint_slot);
+
+  struct Entry {
+    int32_t node;
+    double distance2;
+  };
+  Entry stack[128];
+  int depth = 0;
+  stack[depth++] = {0, box_distance2(p, nodes_[0].lo, nodes_[0].hi)};
+  while (depth > 0) {
+    const Entry entry = stack[--depth];
+    if (entry.distance2 > hit.distance2 * kPruneSlack) continue;
+    const Node& node = nodes_[entry.node];
+    if (node.count > 0) {
+      for (int32_t s = node.first; s < node.first + node.count; ++s) consider(s);
+      continue;
+    }
+    const int32_t left = entry.node + 1, right = node.first;
+    const double dl = box_distance2(p, nodes_[left].lo, nodes_[left].hi);
+    const double dr = box_distance2(p, nodes_[right].lo, nodes_[right].hi);
+    // Push the farther child first so that the nearer one is searched first.
+    if (dl <= dr) {
+      if (dr <= hit.distance2 * kPruneSlack) stack[depth++] = {right, dr};
+      if (dl <= hit.distance2 * kPruneSlack) stack[depth++] = {left, dl};
+    } else {
+      if (dl <= hit.distance2 * kPruneSlack) stack[depth++] = {left, dl};
+      if (dr <= hit.distance2 * kPruneSlack) stack[depth++] = {right, dr};
+    }
+  }
+  return hit;
+}
+
+}  // namespace topstoc

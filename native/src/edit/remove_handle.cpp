@@ -1,0 +1,112 @@
+#include "topstoc/edit/remove_handle.hpp"
+
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace topstoc {
+
+namespace {
+
+// Whether the first vertices of all cut sides are still connected after the cut (union-find
+// over the triangles' edges).
+bool sides_connected(const EditResult& cut) {
+  std::vector<int32_t> parent(cut.vertex_source.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (size_t t = 0; t < cut.triangles.size(); t += 3)
+    for (int c = 0; c < 2; ++c) {
+      const int32_t a = find(cut.triangles[t + c]), b = find(cut.triangles[t + c + 1]);
+      if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+    }
+  for (const CutSide& side : cut.cut_sides)
+    if (find(side.vertices.front()) != find(cut.cut_sides.front().vertices.front())) return false;
+  return true;
+}
+
+// Pulls the copies of the cut loop apart (see RemoveHandleOptions::separation).
+void separate_sides(EditResult& cut, double fraction) {
+  const size_t n = cut.vertex_source.size();
+  std::vector<uint8_t> on_side(n, 0);
+  std::vector<int32_t> side_vertices;
+  for (const CutSide& side : cut.cut_sides)
+    for (int32_t v : side.vertices) on_side[v] = 1, side_vertices.push_back(v);
+  // Mean of every side vertex's neighbours off the cut (they all lie in its own sector).
+  std::vector<double> sum(3 * n, 0.0);
+  std::vector<int32_t> count(n, 0), touching;
+  const size_t m = cut.triangles.size() / 3;
+  for (size_t t = 0; t < m; ++t) {
+    const int32_t* c = &cut.triangles[3 * t];
+    if (!on_side[c[0]] && !on_side[c[1]] && !on_side[c[2]]) continue;
+    touching.push_back(static_cast<int32_t>(t));
+    for (int i = 0; i < 3; ++i) {
+      if (!on_side[c[i]]) continue;
+      for (int j = 1; j < 3; ++j) {
+        const int32_t w = c[(i + j) % 3];
+        if (on_side[w]) continue;
+        for (int a = 0; a < 3; ++a) sum[3 * size_t(c[i]) + a] += cut.positions[3 * size_t(w) + a];
+        ++count[c[i]];
+      }
+    }
+  }
+  const std::vector<double> before = cut.positions;
+  auto normal = [](const std::vector<double>& p, const int32_t* c, double* out) {
+    const double *a = &p[3 * size_t(c[0])], *b = &p[3 * size_t(c[1])], *d = &p[3 * size_t(c[2])];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    out[0] = u[1] * w[2] - u[2] * w[1], out[1] = u[2] * w[0] - u[0] * w[2], out[2] = u[0] * w[1] - u[1] * w[0];
+  };
+  // Move, then halve the move of every vertex of a triangle that turned over or lost most of its
+  // area, a few times; what still fails stays where it was.
+  std::vector<double> step(n, fraction);
+  for (int round = 0; round < 6; ++round) {
+    for (int32_t v : side_vertices) {
+      const double s = count[v] ? step[v] : 0.0;
+      for (int a = 0; a < 3; ++a) {
+        const size_t i = 3 * size_t(v) + a;
+        cut.positions[i] = count[v] ? before[i] + s * (sum[i] / count[v] - before[i]) : before[i];
+      }
+    }
+    bool bad = false;
+    for (int32_t t : touching) {
+      const int32_t* c = &cut.triangles[3 * size_t(t)];
+      double old_normal[3], new_normal[3];
+      normal(before, c, old_normal);
+      normal(cut.positions, c, new_normal);
+      const double old_area = std::sqrt(old_normal[0] * old_normal[0] + old_normal[1] * old_normal[1] +
+                                        old_normal[2] * old_normal[2]);
+      const double agree = old_normal[0] * new_normal[0] + old_normal[1] * new_normal[1] + old_normal[2] * new_normal[2];
+      if (agree > 0.25 * old_area * old_area) continue;
+      bad = true;
+      for (int i = 0; i < 3; ++i) step[c[i]] = round < 5 ? step[c[i]] * 0.5 : 0.0;
+    }
+    if (!bad) break;
+  }
+}
+
+}  // namespace
+
+EditResult remove_handle(const double* positions, int32_t num_vertices, const int32_t* triangles,
+                         int64_t num_triangles, const int32_t* loop, int32_t loop_size,
+                         const RemoveHandleOptions& options) {
+  EditResult cut = cut_along_loop(positions, num_vertices, triangles, num_triangles, loop, loop_size);
+  std::vector<std::vector<int32_t>> holes;
+  for (const CutSide& side : cut.cut_sides) {
+    if (!side.closed)
+      throw std::invalid_argument("loop vertex " + std::to_string(cut.vertex_source[side.vertices.front()]) +
+                                  " lies on the mesh boundary: removing a handle there would merge the cut with "
+                                  "that boundary (cut and fill holes separately to do that on purpose)");
+    holes.push_back(side.vertices);
+  }
+  if (!options.allow_separating && !sides_connected(cut))
+    throw std::invalid_argument("the loop separates its component (cutting along it splits the surface in two): it "
+                                "goes around no handle or tunnel");
+  if (options.separation > 0) separate_sides(cut, options.separation);
+  fill_loops_into(cut, holes, options.fill);
+  return cut;
+}
+
+}  // namespace topstoc

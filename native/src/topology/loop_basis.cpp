@@ -1,0 +1,272 @@
+#include "topstoc/topology/loop_basis.hpp"
+
+#include <algorithm>
+#include <functional>
+#include <stdexcept>
+#include <tuple>
+
+#include "topstoc/topology/shortest_paths.hpp"
+
+namespace topstoc {
+
+std::vector<std::vector<int32_t>> simple_cycles(const ClosedSurface& s, const std::vector<int32_t>& edges) {
+  // Remaining cycle edges around each vertex (small lists: a cycle has few edges per vertex).
+  std::vector<std::pair<int32_t, int32_t>> incidences;  // (vertex, edge)
+  for (int32_t e : edges) {
+    incidences.emplace_back(s.edge_vertices[2 * size_t(e)], e);
+    incidences.emplace_back(s.edge_vertices[2 * size_t(e) + 1], e);
+  }
+  std::sort(incidences.begin(), incidences.end());
+  std::vector<uint8_t> used_edge(s.num_edges(), 0);
+  auto next_edge = [&](int32_t v) {
+    auto it = std::lower_bound(incidences.begin(), incidences.end(), std::make_pair(v, -1));
+    for (; it != incidences.end() && it->first == v; ++it)
+      if (!used_edge[it->second]) return it->second;
+    return -1;
+  };
+  auto other = [&](int32_t e, int32_t v) {
+    const int32_t a = s.edge_vertices[2 * size_t(e)];
+    return a == v ? s.edge_vertices[2 * size_t(e) + 1] : a;
+  };
+  // Walk along unused edges; whenever the walk returns to a vertex on it, cut off that cycle.
+  std::vector<std::vector<int32_t>> cycles;
+  std::vector<int32_t> walk;
+  std::vector<int32_t> position_on_walk(s.num_vertices(), -1);
+  for (const auto& start : incidences) {
+    if (used_edge[start.second]) continue;
+    walk.assign(1, start.first);
+    position_on_walk[start.first] = 0;
+    while (!walk.empty()) {
+      const int32_t v = walk.back();
+      const int32_t e = next_edge(v);
+      if (e < 0) {  // dead end: only happens when the edge set is not a cycle
+        for (int32_t u : walk) position_on_walk[u] = -1;
+        walk.clear();
+        break;
+      }
+      used_edge[e] = 1;
+      const int32_t u = other(e, v);
+      if (position_on_walk[u] >= 0) {
+        const int32_t from = position_on_walk[u];
+        cycles.emplace_back(walk.begin() + from, walk.end());
+        for (size_t i = from + 1; i < walk.size(); ++i) position_on_walk[walk[i]] = -1;
+        walk.resize(from + 1);
+        if (walk.size() == 1 && next_edge(u) < 0) {
+          position_on_walk[u] = -1;
+          walk.clear();
+        }
+      } else {
+        position_on_walk[u] = int32_t(walk.size());
+        walk.push_back(u);
+      }
+    }
+  }
+  return cycles;
+}
+
+double loop_length(const ClosedSurface& s, const std::vector<int32_t>& loop, const std::vector<double>& weight) {
+  double total = 0.0;
+  for (size_t i = 0; i < loop.size(); ++i) total += weight[s.find_edge(loop[i], loop[(i + 1) % loop.size()])];
+  return total;
+}
+
+namespace {
+
+enum Kind { kHandle = 0, kTunnel = 1, kNeither = 2 };
+
+struct Candidate {
+  double length;
+  int32_t kind;
+  int64_t order;  // tie-break: creation order (deterministic)
+  std::vector<int32_t> vertices;
+  Z2Vector cls;
+};
+
+// Pairs each of the k loops with one of the k cycles whose coefficient is 1 (Kuhn's matching;
+// a perfect matching exists because the coefficient matrix is invertible over Z2).
+std::vector<int32_t> match(const std::vector<std::vector<uint8_t>>& coefficient) {
+  const int32_t k = int32_t(coefficient.size());
+  std::vector<int32_t> cycle_of_loop(k, -1), loop_of_cycle(k, -1);
+  for (int32_t start = 0; start < k; ++start) {
+    std::vector<uint8_t> visited(k, 0);
+    std::function<bool(int32_t)> augment = [&](int32_t loop) {
+      for (int32_t c = 0; c < k; ++c) {
+        if (!coefficient[loop][c] || visited[c]) continue;
+        visited[c] = 1;
+        if (loop_of_cycle[c] < 0 || augment(loop_of_cycle[c])) {
+          loop_of_cycle[c] = loop;
+          cycle_of_loop[loop] = c;
+          return true;
+        }
+      }
+      return false;
+    };
+    if (!augment(start)) throw std::logic_error("the chosen loops are not a basis of their subspace");
+  }
+  return cycle_of_loop;
+}
+
+}  // namespace
+
+std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomology& h, const std::vector<PersistentCycle>& cycles,
+                                       const std::vector<double>& weight, int32_t max_roots, Progress* progress) {
+  const int32_t dim = h.dimension(), g = dim / 2, n = s.num_vertices();
+  std::vector<SelectedLoop> out;
+  if (g == 0) return out;
+  // Coordinates in the basis (handle cycles, tunnel cycles) tell the two subspaces apart.
+  std::vector<const PersistentCycle*> ordered;
+  for (const auto& c : cycles) if (c.handle) ordered.push_back(&c);
+  for (const auto& c : cycles) if (!c.handle) ordered.push_back(&c);
+  Z2Basis split(dim);
+  for (const auto* c : ordered)
+    if (!split.insert(h.class_of_edges(c->edges)))
+      throw std::logic_error("the handle and tunnel cycles are not independent in H1");
+  auto kind_of = [&](const Z2Vector& x, Z2Vector* coefficients = nullptr) {
+    Z2Vector used;
+    if (!split.reduce(x, used).zero() || used.zero()) return int32_t(kNeither);
+    if (coefficients) *coefficients = used;
+    bool handle_part = false, tunnel_part = false;
+    for (int32_t i = 0; i < dim; ++i)
+      if (used.get(i)) (i < g ? handle_part : tunnel_part) = true;
+    return handle_part && tunnel_part ? int32_t(kNeither) : handle_part ? int32_t(kHandle) : int32_t(kTunnel);
+  };
+
+  std::vector<Candidate> candidates;
+  int64_t order = 0;
+  // The simple pieces of the persistence cycles.
+  for (const auto* c : ordered)
+    for (auto& loop : simple_cycles(s, c->edges)) {
+      Z2Vector cls = h.class_of_loop(s, loop);
+      const int32_t kind = kind_of(cls);
+      if (kind == kNeither) continue;
+      const double length = loop_length(s, loop, weight);
+      candidates.push_back({length, kind, order++, std::move(loop), std::move(cls)});
+    }
+
+  // Roots: spread along each persistence cycle, then farthest-point samples.
+  std::vector<int32_t> roots;
+  std::vector<uint8_t> is_root(n, 0);
+  auto add_root = [&](int32_t v) {
+    if (!is_root[v]) {
+      is_root[v] = 1;
+      roots.push_back(v);
+    }
+  };
+  for (const auto* c : ordered) {
+    add_root(s.edge_vertices[2 * size_t(c->generator_edge)]);
+    const size_t k = c->edges.size();
+    for (size_t i = 1; i <= 3 && k; ++i) add_root(s.edge_vertices[2 * size_t(c->edges[(i * k) / 4 % k])]);
+  }
+  if (max_roots <= 0) max_roots = 12 + 4 * dim;
+  max_roots = std::min(max_roots, n);
+
+  ShortestPaths sp(s, weight);
+  const int32_t words = (dim + 63) / 64;
+  std::vector<uint64_t> prefix(size_t(words) * n);
+  std::vector<double> nearest_root(n, ShortestPaths::kInfinity);
+  std::vector<uint32_t> mark(n, 0);
+  uint32_t mark_stamp = 0;
+  struct Local {
+    double bound;
+    int32_t edge, kind;
+  };
+  std::vector<Local> local;
+  for (size_t r = 0; r < roots.size() && int32_t(r) < max_roots; ++r) {
+    if (progress) progress->update(double(r) / max_roots);
+    const int32_t root = roots[r];
+    sp.run({root}, [](int32_t) { return true; });
+    // Class of the tree path from the root to each vertex.
+    for (int32_t v : sp.settled()) {
+      uint64_t* pv = &prefix[size_t(words) * v];
+      const int32_t p = sp.parent(v);
+      if (p < 0) {
+        std::fill(pv, pv + words, 0);
+      } else {
+        std::copy(&prefix[size_t(words) * p], &prefix[size_t(words) * p] + words, pv);
+        h.add_edge(pv, sp.parent_edge(v));
+      }
+      nearest_root[v] = std::min(nearest_root[v], sp.distance(v));
+    }
+    // Fundamental cycles of the non-tree edges, shortest (through the root) first.
+    local.clear();
+    Z2Vector cls(dim);
+    for (int32_t e = 0; e < s.num_edges(); ++e) {
+      const int32_t a = s.edge_vertices[2 * size_t(e)], b = s.edge_vertices[2 * size_t(e) + 1];
+      if (sp.parent_edge(a) == e || sp.parent_edge(b) == e) continue;
+      for (int32_t k = 0; k < words; ++k) cls.words[k] = prefix[size_t(words) * a + k] ^ prefix[size_t(words) * b + k];
+      h.add_edge(cls, e);
+      if (cls.zero()) continue;
+      const int32_t kind = kind_of(cls);
+      if (kind != kNeither) local.push_back({sp.distance(a) + weight[e] + sp.distance(b), e, kind});
+    }
+    std::sort(local.begin(), local.end(), [](const Local& x, const Local& y) {
+      return std::tie(x.bound, x.edge) < std::tie(y.bound, y.edge);
+    });
+    Z2Basis kept[2] = {Z2Basis(dim), Z2Basis(dim)};
+    for (const Local& c : local) {
+      if (kept[c.kind].rank() == g) {
+        if (kept[1 - c.kind].rank() == g) break;
+        continue;
+      }
+      const int32_t a = s.edge_vertices[2 * size_t(c.edge)], b = s.edge_vertices[2 * size_t(c.edge) + 1];
+      for (int32_t k = 0; k < words; ++k) cls.words[k] = prefix[size_t(words) * a + k] ^ prefix[size_t(words) * b + k];
+      h.add_edge(cls, c.edge);
+      if (!kept[c.kind].insert(cls)) continue;
+      // The simple cycle: tree paths from a and b up to their lowest common ancestor.
+      ++mark_stamp;
+      for (int32_t v = a; v >= 0; v = sp.parent(v)) mark[v] = mark_stamp;
+      int32_t lca = b;
+      while (mark[lca] != mark_stamp) lca = sp.parent(lca);
+      std::vector<int32_t> loop;
+      for (int32_t v = a; v != lca; v = sp.parent(v)) loop.push_back(v);
+      loop.push_back(lca);
+      std::reverse(loop.begin(), loop.end());  // lca ... a
+      std::vector<int32_t> down;
+      for (int32_t v = b; v != lca; v = sp.parent(v)) down.push_back(v);
+      loop.insert(loop.end(), down.begin(), down.end());  // then b ... (child of lca)
+      const double length = loop_length(s, loop, weight);
+      candidates.push_back({length, c.kind, order++, std::move(loop), cls});
+    }
+    // Next root: the persistence-cycle roots first, then the vertex farthest from all roots.
+    if (r + 1 == roots.size() && int32_t(roots.size()) < max_roots) {
+      int32_t far = -1;
+      for (int32_t v = 0; v < n; ++v)
+        if (!is_root[v] && (far < 0 || nearest_root[v] > nearest_root[far])) far = v;
+      if (far >= 0) add_root(far);
+    }
+  }
+
+  // Shortest first, keep what extends the handle or the tunnel basis.
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
+    return std::tie(x.length, x.order) < std::tie(y.length, y.order);
+  });
+  Z2Basis chosen[2] = {Z2Basis(dim), Z2Basis(dim)};
+  std::vector<const Candidate*> picked[2];
+  for (const auto& c : candidates)
+    if (chosen[c.kind].rank() < g && chosen[c.kind].insert(c.cls)) picked[c.kind].push_back(&c);
+  if (chosen[0].rank() < g || chosen[1].rank() < g)
+    throw std::logic_error("found only " + std::to_string(chosen[0].rank()) + " handle and " +
+                           std::to_string(chosen[1].rank()) + " tunnel loops that are simple, of " + std::to_string(g));
+
+  // Match loops with generator edges through their coefficients in the persistence basis.
+  for (int32_t kind : {int32_t(kHandle), int32_t(kTunnel)}) {
+    std::vector<std::vector<uint8_t>> coefficient(g, std::vector<uint8_t>(g, 0));
+    for (int32_t k = 0; k < g; ++k) {
+      Z2Vector used;
+      kind_of(picked[kind][k]->cls, &used);
+      for (int32_t i = 0; i < g; ++i) coefficient[k][i] = used.get(kind == kHandle ? i : g + i);
+    }
+    const auto cycle_of_loop = match(coefficient);
+    for (int32_t k = 0; k < g; ++k) {
+      SelectedLoop loop;
+      loop.handle = kind == kHandle;
+      loop.vertices = picked[kind][k]->vertices;
+      loop.length = picked[kind][k]->length;
+      loop.generator_edge = ordered[(kind == kHandle ? 0 : g) + cycle_of_loop[k]]->generator_edge;
+      out.push_back(std::move(loop));
+    }
+  }
+  return out;
+}
+
+}  // namespace topstoc
