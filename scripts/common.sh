@@ -32,7 +32,9 @@ ensure_packages() {
 build() {
   echo "== building (cmake -S . -B build && cmake --build build)"
   mkdir -p build
-  /usr/bin/cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >build/configure.log 2>&1 ||
+  local launcher=()  # ccache, when installed, makes rebuilds in other clones cheap
+  command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  /usr/bin/cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" >build/configure.log 2>&1 ||
     { cat build/configure.log; return 1; }
   /usr/bin/cmake --build build -j"$(nproc)" >build/build.log 2>&1 ||
     { grep -E -B2 -A6 "error" build/build.log | head -60; return 1; }

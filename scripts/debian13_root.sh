@@ -1,0 +1,50 @@
+#!/bin/bash
+# Makes (once) and caches a Debian 13 "trixie" root for the suites that need CPython 3.13 or a
+# newer real Blender than Debian 12's: Debian 13 has Python 3.13 and Blender 4.3.
+#
+#   scripts/debian13_root.sh            prints the root's path, creating it on first use
+#   scripts/debian13_root.sh run CMD    runs CMD (bash) inside it, this checkout at /opt/project
+#
+# The root lives in ${TOPSTOC_CACHE:-/var/cache/topstoc}/trixie-root (about 1.5 GB, ~5 min to
+# make), outside the checkout, so CI runs on fresh clones reuse it. Needs root and debootstrap.
+set -u
+CACHE=${TOPSTOC_CACHE:-/var/cache/topstoc}
+ROOTFS=$CACHE/trixie-root
+PACKAGES="python3 python3-venv python3-dev blender xvfb xauth ca-certificates libgl1-mesa-dri"
+
+make_root() {
+  command -v debootstrap >/dev/null ||
+    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -q debootstrap >/dev/null; } || return 1
+  local tmp=$CACHE/trixie-root.partial
+  rm -rf "$tmp"; mkdir -p "$CACHE"
+  echo "== making a Debian 13 root in $ROOTFS (once; ~5 min)" >&2
+  debootstrap --variant=minbase trixie "$tmp" http://deb.debian.org/debian >"$CACHE/debootstrap.log" 2>&1 ||
+    { tail -20 "$CACHE/debootstrap.log" >&2; return 1; }
+  cp /etc/resolv.conf "$tmp/etc/resolv.conf"
+  if ls /usr/local/share/ca-certificates/*.crt >/dev/null 2>&1; then
+    mkdir -p "$tmp/usr/local/share/ca-certificates"
+    cp /usr/local/share/ca-certificates/*.crt "$tmp/usr/local/share/ca-certificates/"
+  fi
+  chroot "$tmp" /bin/bash -c "apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -q \
+    --no-install-recommends $PACKAGES >/dev/null && update-ca-certificates >/dev/null 2>&1" ||
+    { echo "error: could not install $PACKAGES in the Debian 13 root" >&2; return 1; }
+  mv "$tmp" "$ROOTFS"
+}
+
+# Runs a command inside the root with /proc, /sys, /dev and this checkout mounted.
+run_in_root() {
+  local project; project=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+  local mounts=(proc sys dev dev/pts opt/project)
+  mkdir -p "$ROOTFS/opt/project"
+  mount -t proc proc "$ROOTFS/proc"; mount -t sysfs sys "$ROOTFS/sys"
+  mount --bind /dev "$ROOTFS/dev"; mount --bind /dev/pts "$ROOTFS/dev/pts"
+  mount --bind "$project" "$ROOTFS/opt/project"
+  chroot "$ROOTFS" /usr/bin/env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
+    LANG=C.UTF-8 /bin/bash -c "cd /opt/project && $*"
+  local rc=$?
+  for ((i=${#mounts[@]}-1; i>=0; i--)); do umount -l "$ROOTFS/${mounts[$i]}" 2>/dev/null; done
+  return $rc
+}
+
+[ -d "$ROOTFS" ] || make_root || exit 1
+if [ "${1:-}" = run ]; then shift; run_in_root "$@"; else echo "$ROOTFS"; fi
