@@ -21,21 +21,15 @@ import numpy as np
 
 from ..core import loops as core_loops
 from ..core.topology import Topology, topology as compute_topology
+from ..core.errors import TopStocError
 from . import mesh_io, watch
 from .cache import prepared_meshes
 
 SEARCH_KINDS = ("HANDLE", "TUNNEL")
 
 
-class AnalysisError(ValueError):
+class AnalysisError(TopStocError):
     """An analysis that cannot run (message for the panel and the status bar)."""
-
-
-def _check(obj) -> None:
-    if obj is None or obj.type != "MESH":
-        raise AnalysisError(f"'{getattr(obj, 'name', obj)}' is not a mesh object")
-    if obj.mode == "EDIT":
-        raise AnalysisError(f"'{obj.name}' is in Edit Mode; switch to Object Mode")
 
 
 def loose_edges(mesh) -> np.ndarray:
@@ -83,7 +77,7 @@ def analyse(obj, carried_loops: Optional[list] = None) -> Topology:
     """
     topology = obj.topstoc.topology
     try:
-        _check(obj)
+        mesh_io.check_mesh_object(obj, AnalysisError)
         start = time.perf_counter()
         mesh = obj.data
         arrays = mesh_io.read_mesh(mesh)
@@ -108,7 +102,7 @@ def _store(obj, info, arrays, wires, stamp: str, seconds: float, carried_loops) 
     count = len(info.components)
     component_of = info.vertex_component
     edges = mesh_io._indices(mesh.edges, "vertices", len(mesh.edges), 2)
-    polygon_first = mesh_io.loop_vertices(mesh)[mesh_io._indices(mesh.polygons, "loop_start", len(mesh.polygons))] \
+    polygon_first = mesh_io.corner_vertices(mesh)[mesh_io._indices(mesh.polygons, "loop_start", len(mesh.polygons))] \
         if len(mesh.polygons) else np.zeros(0, dtype=np.int32)
     edges_per = _per_component(component_of, edges[:, 0] if len(edges) else edges.reshape(-1), count)
     faces_per = _per_component(component_of, polygon_first, count)
@@ -242,7 +236,7 @@ class LoopSearch:
 
 def start_search(obj) -> LoopSearch:
     """Reads the mesh (main thread) for a search. Raises AnalysisError for unusable meshes."""
-    _check(obj)
+    mesh_io.check_mesh_object(obj, AnalysisError)
     if len(obj.data.polygons) == 0:
         raise AnalysisError(f"'{obj.name}' has no faces")
     try:

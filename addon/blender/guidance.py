@@ -19,11 +19,12 @@ from mathutils import Matrix, Vector
 from ..core import guidance as rules
 from ..core.attributes import uv_seam_edges
 from ..core.decimate import Box, View
+from ..core.errors import TopStocError
 from . import mesh_io
 from .props import DEFAULT_COLOR_LAYER
 
 
-class GuidanceError(ValueError):
+class GuidanceError(TopStocError):
     """A guidance setting that cannot be honoured (message names the setting)."""
 
 
@@ -69,7 +70,7 @@ def read_color_guidance(mesh, name: str) -> np.ndarray:
     if key == "color":
         rgb = rules.linear_to_srgb(rgb)
     if attribute.domain == "CORNER":
-        corner_vertex = mesh_io.loop_vertices(mesh)
+        corner_vertex = mesh_io.corner_vertices(mesh)
         rgb = rules.corner_to_vertex_mean(len(mesh.vertices), corner_vertex, rgb)
     return rules.color_to_guidance(rgb)
 
@@ -96,7 +97,7 @@ def _borders(obj, settings, arrays: mesh_io.MeshArrays, sources: list) -> Option
     if not parts:
         return None
     # Only edges of triangles can be borders (loose edges carry no faces to separate).
-    edges = rules.mesh_edges(arrays.triangles)
+    edges = rules.undirected_edges(arrays.triangles)
     borders = rules.edges_in(edges, np.concatenate(parts))
     return borders if len(borders) else None
 

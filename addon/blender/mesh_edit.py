@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
+from ..core.errors import TopStocError
 from . import mesh_io
 
 # Per-element properties read and written through foreach_get/set where the Blender version has them.
@@ -32,7 +33,7 @@ _POLYGON_FLAGS = ("select", "hide", "use_freestyle_mark")
 _SKIPPED = {"position", "material_index", "sharp_face", "normal"}
 
 
-class EditError(ValueError):
+class EditError(TopStocError):
     """An edit that cannot be written (message for the status bar)."""
 
 
@@ -47,7 +48,6 @@ class PolygonLayout:
     corner_vertex: np.ndarray   #: (c,) vertex of each corner
     corner_loop: np.ndarray     #: (c,) input loop whose data the corner takes, or -1
     polygon_source: np.ndarray  #: (p,) input polygon whose data the polygon takes, or -1
-    patch_polygons: np.ndarray  #: (p,) True for polygons the edit created (hole patches)
     corner_patch: np.ndarray    #: (c,) index of the patch a corner belongs to, or -1
 
 
@@ -111,8 +111,6 @@ def polygon_layout(arrays: mesh_io.MeshArrays, result) -> PolygonLayout:
         vertices=np.asarray(result.vertices, dtype=np.float64), vertex_source=np.asarray(result.vertex_source),
         loop_start=loop_start, loop_total=loop_total, corner_vertex=corner_vertex.astype(np.int64),
         corner_loop=corner_loop.astype(np.int64), polygon_source=np.concatenate([keep, tri_polygon]).astype(np.int64),
-        patch_polygons=np.concatenate([np.zeros(len(keep) + len(broken_rows), dtype=bool),
-                                       np.ones(len(patch_rows), dtype=bool)]),
         corner_patch=corner_patch)
 
 

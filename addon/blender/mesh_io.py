@@ -73,7 +73,16 @@ def _indices(collection, key: str, count: int, width: int = 1) -> np.ndarray:
     return _get(collection, key, count, width, np.uint32).view(np.int32)
 
 
-def loop_vertices(mesh) -> np.ndarray:
+def check_mesh_object(obj, error: type) -> None:
+    """Raises ``error`` (a TopStocError) unless ``obj`` is a mesh object whose data can be read
+    (not in Edit Mode, where the mesh datablock lags behind the edit mesh)."""
+    if obj is None or obj.type != "MESH":
+        raise error(f"'{getattr(obj, 'name', obj)}' is not a mesh object")
+    if obj.mode == "EDIT":
+        raise error(f"'{obj.name}' is in Edit Mode; switch to Object Mode")
+
+
+def corner_vertices(mesh) -> np.ndarray:
     """Vertex of every loop (face corner)."""
     corner_vert = mesh.attributes.get(".corner_vert")  # Blender 3.6+: a plain int attribute
     if corner_vert is not None:
@@ -103,7 +112,7 @@ def read_mesh(mesh: bpy.types.Mesh) -> MeshArrays:
     n, m = len(mesh.vertices), len(mesh.loop_triangles)
     vertices = _get(mesh.vertices, "co", n, 3, np.float32).astype(np.float64)
     triangle_loops = _indices(mesh.loop_triangles, "loops", m, 3)
-    triangles = loop_vertices(mesh)[triangle_loops]
+    triangles = corner_vertices(mesh)[triangle_loops]
     return MeshArrays(vertices, triangles, _triangle_polygons(mesh, m), triangle_loops,
                       _polygon_materials(mesh), num_edges=len(mesh.edges), num_loops=len(mesh.loops))
 

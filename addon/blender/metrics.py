@@ -18,12 +18,13 @@ from ..core.colors import error_colors
 from ..core.guidance import srgb_to_linear
 from ..core.hausdorff import hausdorff
 from ..core.native import engine
+from ..core.errors import TopStocError
 from . import mesh_io, watch
 
 ERROR_ATTRIBUTE = "TopStoc Error"
 
 
-class MetricsError(ValueError):
+class MetricsError(TopStocError):
     """A measurement that cannot run (message for the panel and the status bar)."""
 
 
@@ -37,8 +38,7 @@ def reference_of(obj):
 
 
 def _arrays(obj, role: str) -> mesh_io.MeshArrays:
-    if obj.mode == "EDIT":
-        raise MetricsError(f"'{obj.name}' is in Edit Mode; switch to Object Mode")
+    mesh_io.check_mesh_object(obj, MetricsError)
     arrays = mesh_io.read_mesh(obj.data)
     if len(arrays.triangles) == 0:
         raise MetricsError(f"{role} '{obj.name}' has no faces")
@@ -75,8 +75,7 @@ def measure(obj, reference=None, samples: int = None) -> dict:
     settings = obj.topstoc.metrics
     reference = reference if reference is not None else reference_of(obj)
     try:
-        if obj.type != "MESH":
-            raise MetricsError(f"'{obj.name}' is not a mesh")
+        mesh_io.check_mesh_object(obj, MetricsError)
         if reference is None:
             raise MetricsError(f"'{obj.name}' has no original to compare with: pick one under Original")
         start = time.perf_counter()

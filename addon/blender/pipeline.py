@@ -4,7 +4,6 @@ write the output, remember the samples. Shared by the operators, the preview and
 from __future__ import annotations
 
 import hashlib
-import inspect
 import json
 import os
 import time
@@ -14,7 +13,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from ..core.decimate import decimate as decimate_function
+from ..core.errors import TopStocError
 from . import mesh_io
 from .cache import Prepared, prepared_meshes
 from .guidance import EngineGuidance, gather
@@ -22,7 +21,7 @@ from .guidance import EngineGuidance, gather
 LAST_SAMPLES = "Last"
 
 
-class DecimationError(ValueError):
+class DecimationError(TopStocError):
     """A decimation that cannot run (message for the status bar / batch log)."""
 
 
@@ -38,11 +37,6 @@ class Run:
     seconds: float            #: read + prepare + decimate
 
 
-def has_max_error() -> bool:
-    """True when the engine offers the max-deviation target (Hausdorff issue)."""
-    return "max_error" in inspect.signature(decimate_function).parameters
-
-
 def target_kwargs(params, prepared: Prepared) -> dict:
     """The engine target for a DecimationParameters holder."""
     mode = params.target_mode
@@ -52,8 +46,6 @@ def target_kwargs(params, prepared: Prepared) -> dict:
         return {"vertices": int(params.vertices)}
     if mode == "TRIANGLES":
         return {"triangles": int(params.triangles)}
-    if not has_max_error():
-        raise DecimationError("the max-deviation target needs the Hausdorff engine, which this build lacks")
     if params.max_error_relative:  # the panel says percent; the engine takes a fraction of the diagonal
         return {"max_error": float(params.max_error) / 100.0, "relative": True}
     return {"max_error": float(params.max_error)}
@@ -64,16 +56,9 @@ def options_kwargs(params) -> dict:
                 placement=params.placement, refine=int(params.refine))
 
 
-def check_mesh(obj) -> None:
-    if obj is None or obj.type != "MESH":
-        raise DecimationError(f"'{getattr(obj, 'name', obj)}' is not a mesh object")
-    if obj.mode == "EDIT":
-        raise DecimationError(f"'{obj.name}' is in Edit Mode; switch to Object Mode")
-
-
 def prepare(obj) -> Prepared:
     """The cached prepared mesh of ``obj``, with a clear error for unusable meshes."""
-    check_mesh(obj)
+    mesh_io.check_mesh_object(obj, DecimationError)
     if len(obj.data.polygons) == 0:
         raise DecimationError(f"'{obj.name}' has no faces to decimate")
     try:

@@ -39,7 +39,7 @@ def connectivity_stamp(mesh: bpy.types.Mesh) -> str:
     h.update(np.array([len(mesh.vertices), len(mesh.edges), len(mesh.polygons)], dtype=np.int64).data)
     h.update(mesh_io._indices(mesh.edges, "vertices", len(mesh.edges), 2).data)
     h.update(mesh_io._indices(mesh.polygons, "loop_start", len(mesh.polygons)).data)
-    h.update(mesh_io.loop_vertices(mesh).data)
+    h.update(mesh_io.corner_vertices(mesh).data)
     return h.hexdigest()
 
 

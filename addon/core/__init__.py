@@ -9,6 +9,7 @@ from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decim
                        sampling_probabilities)
 from .edit import EditResult, cut_along_loop, delete_faces, fill_holes, fill_loops, remove_handle
 from .error_bound import ErrorBoundReport
+from .errors import TopStocError
 from .hausdorff import Distance, HausdorffResult, OneSidedDistance, closest_points, hausdorff
 from .io import MeshData, read_mesh, write_mesh
 from .loops import (Cancelled, ComponentLoops, Loop, LoopsResult, handle_tunnel_loops, self_intersections,
@@ -20,6 +21,8 @@ from .topology import ComponentGenerators, ComponentTopology, Topology, generato
 __all__ = [
     "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
     "decimate_with_samples", "sampling_probabilities",
+    # the base of every error TopStoc raises on purpose (a ValueError)
+    "TopStocError",
     # editing (topstoc.core.edit also has boundary_loops and the result's parts)
     "EditResult", "cut_along_loop", "delete_faces", "fill_holes", "fill_loops", "remove_handle",
     # measurement (hausdorff.py) and error-bounded decimation (error_bound.py)

@@ -141,7 +141,7 @@ def combine(sources: Iterable[Tuple[np.ndarray, float]], num_vertices: int) -> O
     return u
 
 
-def mesh_edges(triangles: np.ndarray) -> np.ndarray:
+def undirected_edges(triangles: np.ndarray) -> np.ndarray:
     """The distinct undirected edges (k, 2) of the triangles (low id first), sorted."""
     triangles = np.asarray(triangles, dtype=np.int64)
     if len(triangles) == 0:

@@ -57,7 +57,7 @@ def test_material_guidance_takes_the_largest_slot_weight():
 
 def test_mesh_edges_and_edges_in():
     v, f = meshgen.grid(3, 2)
-    edges = rules.mesh_edges(f)
+    edges = rules.undirected_edges(f)
     brute = sorted({(min(a, b), max(a, b)) for t in f.tolist() for a, b in itertools.combinations(t, 2)})
     assert [tuple(e) for e in edges.tolist()] == brute
     picked = rules.edges_in(edges, [[1, 0], [0, 11], [5, 4]])

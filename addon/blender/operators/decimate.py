@@ -7,7 +7,7 @@ import time
 import bpy
 
 from .. import pipeline
-from ..guidance import GuidanceError
+from ...core.errors import TopStocError
 from ..props import DecimationParameters, copy_parameters
 
 
@@ -51,7 +51,7 @@ class TOPSTOC_OT_guided_decimate(DecimationParameters, bpy.types.Operator):
                     pipeline.store_samples(run)
                 outputs.append(pipeline.write_output(run, self.output))
                 lines.append(pipeline.summary(run))
-            except (pipeline.DecimationError, GuidanceError) as error:
+            except TopStocError as error:
                 failures.append(str(error))
         for message in failures:
             self.report({"ERROR"}, message)

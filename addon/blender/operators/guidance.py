@@ -39,7 +39,7 @@ def write_guidance(obj, vertex_mask: np.ndarray, polygon_mask: np.ndarray, u: fl
         count, mask = len(mesh.vertices), vertex_mask
     else:
         count = len(mesh.loops)
-        loop_vertex = mesh_io.loop_vertices(mesh)
+        loop_vertex = mesh_io.corner_vertices(mesh)
         if polygon_mask is not None:
             loop_polygon = np.repeat(np.arange(len(mesh.polygons)),
                                      mesh_io._indices(mesh.polygons, "loop_total", len(mesh.polygons)))

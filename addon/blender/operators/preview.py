@@ -7,7 +7,7 @@ import math
 import bpy
 
 from .. import pipeline
-from ..guidance import GuidanceError
+from ...core.errors import TopStocError
 from ..preview import PreviewSession
 from ..props import DecimationParameters, copy_parameters
 
@@ -33,7 +33,7 @@ Enter or click applies, Esc or right-click restores"""
         obj = context.object
         try:
             self.session = PreviewSession(context, obj, self, context.region_data)
-        except (pipeline.DecimationError, GuidanceError, ValueError) as error:
+        except ValueError as error:  # TopStocError or an engine refusal
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         self.active = self.session.prepared.mesh.report()
@@ -87,7 +87,7 @@ Enter or click applies, Esc or right-click restores"""
                 if self.output == "NEW_OBJECT":
                     pipeline.store_samples(run)
                 pipeline.write_output(run, self.output)
-            except (pipeline.DecimationError, GuidanceError) as error:
+            except TopStocError as error:
                 self.report({"ERROR"}, str(error))
                 return {"CANCELLED"}
             self.report({"INFO"}, f"TopStoc: {pipeline.summary(run)}")

@@ -6,7 +6,7 @@ import bpy
 from bpy.props import StringProperty
 
 from .. import pipeline
-from ..guidance import GuidanceError
+from ...core.errors import TopStocError
 
 
 class TOPSTOC_OT_save_samples(bpy.types.Operator):
@@ -52,7 +52,7 @@ class TOPSTOC_OT_restore_samples(bpy.types.Operator):
         obj = context.object
         try:
             run = pipeline.restore(context, obj, self.name)
-        except (pipeline.DecimationError, GuidanceError) as error:
+        except TopStocError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         out = pipeline.write_output(run, "NEW_OBJECT", name=f"{obj.name}_{self.name}")

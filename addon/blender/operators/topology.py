@@ -232,7 +232,7 @@ def run_edit(operator, context, compute, dropped: int = -1, verb: str = "edited"
             result = compute(obj, arrays)
             carried = analysis.carry_loops(obj, result, dropped)
             mesh_edit.apply_edit(obj, arrays, result)
-        except (ValueError, mesh_edit.EditError) as error:
+        except ValueError as error:  # EditError or an engine refusal
             return refuse(f"'{obj.name}': {error}")
         watch.bump(obj)
         try:

@@ -7,7 +7,7 @@ import numpy as np
 from mathutils import Vector
 
 from .. import pipeline
-from ..guidance import GuidanceError
+from ...core.errors import TopStocError
 from ..props import DecimationParameters, copy_parameters
 
 
@@ -71,7 +71,7 @@ class _VariantsBase(DecimationParameters):
         obj = context.object
         try:
             runs = pipeline.decimate_many(context, obj, self, self.variants(context))
-        except (pipeline.DecimationError, GuidanceError) as error:
+        except TopStocError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         names = self.names(obj, runs)

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import bpy
 
-from ..pipeline import has_max_error
 
 CATEGORY = "TopStoc"
 
@@ -35,8 +34,6 @@ class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
             row = layout.row(align=True)
             row.prop(settings, "max_error")
             row.prop(settings, "max_error_relative", text="%")
-            if not has_max_error():
-                layout.label(text="Needs the Hausdorff engine (not in this build)", icon="ERROR")
         col = layout.column(align=True)
         col.prop(settings, "seed")
         col.prop(settings, "adaptivity")

@@ -8,14 +8,12 @@ the work itself (mesh preparation, seams, decimation), without reading and writi
 
 from __future__ import annotations
 
-import inspect
 import os
 import time
 
 import numpy as np
 
 from ..attributes import material_regions, transfer_attributes, uv_seam_edges
-from ..decimate import decimate as core_decimate
 from ..io import dropped_attributes, mesh_format, read_mesh, write_mesh
 from ..mesh import Mesh
 from . import print_json
@@ -88,11 +86,6 @@ def load_guidance(path: str, num_vertices: int) -> np.ndarray:
     return u
 
 
-def _supports_max_error() -> bool:
-    parameters = inspect.signature(core_decimate).parameters
-    return "max_error" in parameters and "relative" in parameters
-
-
 def _relative_library(library: str, source: str, destination: str) -> str:
     """An mtllib path that still points at the input's .mtl from the output's folder."""
     here = os.path.join(os.path.dirname(os.path.abspath(source)), library)
@@ -113,9 +106,6 @@ def _error_bound_report(result) -> dict:
 
 def run(args) -> int:
     mesh_format(args.output)  # fail on a bad output name before doing any work
-    if args.max_error is not None and not _supports_max_error():
-        raise ValueError("--max-error needs the error-bounded decimation, which this build does not have yet; "
-                         "use --ratio, --vertices or --triangles")
     data = read_mesh(args.input)
     if data.num_triangles == 0:
         raise ValueError(f"{args.input}: the mesh has no triangles")
