@@ -52,9 +52,9 @@ def _target(args, diagonal: float) -> dict:
     if args.ratio is not None:
         return {"ratio": args.ratio}
     if args.vertices is not None:
-        return {"vertices": args.vertices}
+        return {"target_vertices": args.vertices}
     if args.triangles is not None:
-        return {"triangles": args.triangles}
+        return {"target_triangles": args.triangles}
     text = args.max_error.strip()
     try:
         if text.endswith("%"):
@@ -103,7 +103,7 @@ class _Params:
     """DecimationParameters for the pipeline from the command line."""
 
     def __init__(self, args, target: dict):
-        self.target_mode = {"ratio": "RATIO", "vertices": "VERTICES", "triangles": "TRIANGLES",
+        self.target_mode = {"ratio": "RATIO", "target_vertices": "VERTICES", "target_triangles": "TRIANGLES",
                             "max_error": "MAX_ERROR"}[next(iter(target))]
         self.ratio = args.ratio or 0.1
         self.vertices = args.vertices or 1

@@ -43,9 +43,9 @@ def target_kwargs(params, prepared: Prepared) -> dict:
     if mode == "RATIO":
         return {"ratio": float(params.ratio)}
     if mode == "VERTICES":
-        return {"vertices": int(params.vertices)}
+        return {"target_vertices": int(params.vertices)}
     if mode == "TRIANGLES":
-        return {"triangles": int(params.triangles)}
+        return {"target_triangles": int(params.triangles)}
     if params.max_error_relative:  # the panel says percent; the engine takes a fraction of the diagonal
         return {"max_error": float(params.max_error) / 100.0, "relative": True}
     return {"max_error": float(params.max_error)}

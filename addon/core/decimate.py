@@ -16,13 +16,16 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from dataclasses import dataclass, field
-from typing import Optional, Sequence
+from typing import TYPE_CHECKING, Optional, Sequence
 
 import numpy as np
 
-from .mesh import Mesh
 from .native import engine
+
+if TYPE_CHECKING:  # for annotations only: mesh.py imports this module
+    from .mesh import Mesh
 
 DENSITY_MODES = ("off", "uniform", "adaptive", "euclidean")
 PLACEMENTS = ("subsample", "filtered")
@@ -202,14 +205,25 @@ def target_vertex_count(mesh: Mesh, ratio=None, vertices=None) -> int:
             raise ValueError(f"ratio must lie in (0, 1], got {ratio!r}")
         return max(1, int(round(ratio * active)))
     if isinstance(vertices, bool) or not isinstance(vertices, (int, np.integer)):
-        raise ValueError(f"vertices must be an integer, got {vertices!r}")
+        raise ValueError(f"target_vertices must be an integer, got {vertices!r}")
     if not 1 <= vertices <= active:
         raise ValueError(f"vertex target {vertices} is outside [1, {active}] (vertices in triangles)")
     return int(vertices)
 
 
-def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] = None,
-             triangles: Optional[int] = None, *, seed: int = 0, adaptivity: float = 0.5,
+def _renamed(old: str, old_value, new: str, new_value):
+    """The value given for a renamed keyword: the old name still works, with a warning."""
+    if old_value is None:
+        return new_value
+    if new_value is not None:
+        raise ValueError(f"give {new} only, not also its old name {old}")
+    warnings.warn(f"decimate({old}=...) is deprecated; use {new}=...", DeprecationWarning, stacklevel=3)
+    return old_value
+
+
+def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optional[int] = None,
+             target_triangles: Optional[int] = None, *, vertices: Optional[int] = None,
+             triangles: Optional[int] = None, seed: int = 0, adaptivity: float = 0.5,
              flat_floor: float = 0.25, area_weighted: bool = False, feature_angle: float = 0.0,
              density: str = "off", density_rings: int = 0,
              density_ratio: float = 2.0, density_epsilon: float = 0.0, guidance=None,
@@ -219,7 +233,8 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
              max_error: Optional[float] = None, relative: bool = False) -> DecimateResult:
     """Decimates ``mesh`` with TopStoc. Give exactly one target.
 
-    ratio: fraction of the vertices to keep, in (0, 1]. vertices / triangles: counts.
+    ratio: fraction of the vertices to keep, in (0, 1]. target_vertices / target_triangles:
+    counts (``vertices=`` / ``triangles=`` are their deprecated old names).
     seed: the same seed gives the same mesh. adaptivity: 0 samples uniformly, 1 follows the
     normal-deviation weights fully. flat_floor: flat regions keep at least this fraction of the
     base rate (the thesis' tweak against slivers). area_weighted: probabilities per unit area
@@ -241,15 +256,18 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
     (absolute, or a fraction of the bounding-box diagonal with ``relative=True``), found by a
     search over re-decimations with the same seed; ``result.error_bound`` tells how it went.
     """
-    given = [name for name, value in (("ratio", ratio), ("vertices", vertices), ("triangles", triangles),
-                                      ("max_error", max_error)) if value is not None]
+    vertices = _renamed("vertices", vertices, "target_vertices", target_vertices)  # the counts asked for
+    triangles = _renamed("triangles", triangles, "target_triangles", target_triangles)
+    given = [name for name, value in (("ratio", ratio), ("target_vertices", vertices),
+                                      ("target_triangles", triangles), ("max_error", max_error)) if value is not None]
     if len(given) != 1:
-        raise ValueError(f"give exactly one target (ratio, vertices, triangles or max_error), got {given or 'none'}")
+        raise ValueError("give exactly one target (ratio, target_vertices, target_triangles or max_error), "
+                         f"got {given or 'none'}")
     if max_error is not None:  # error-bounded: a search over vertex targets (error_bound.py)
         from .error_bound import search_vertex_count
 
         def decimate_at(count: int) -> DecimateResult:
-            return decimate(mesh, vertices=count, seed=seed, adaptivity=adaptivity, flat_floor=flat_floor,
+            return decimate(mesh, target_vertices=count, seed=seed, adaptivity=adaptivity, flat_floor=flat_floor,
                             area_weighted=area_weighted, feature_angle=feature_angle, density=density, density_rings=density_rings, density_ratio=density_ratio,
                             density_epsilon=density_epsilon, guidance=guidance, regions=regions,
                             borders=borders, view=view, boxes=boxes, placement=placement,
@@ -270,7 +288,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
     target_triangles = 0
     if triangles is not None:
         if isinstance(triangles, bool) or not isinstance(triangles, (int, np.integer)):
-            raise ValueError(f"triangles must be an integer, got {triangles!r}")
+            raise ValueError(f"target_triangles must be an integer, got {triangles!r}")
         if not 1 <= triangles <= mesh.num_triangles:
             raise ValueError(f"triangle target {triangles} is outside [1, {mesh.num_triangles}]")
         target_triangles = int(triangles)
@@ -281,7 +299,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
     if not 0 <= feature_angle <= math.pi:
         raise ValueError(f"feature_angle must lie in [0, pi] radians, got {feature_angle!r}")
     layout = mesh.feature_layout(regions, borders, feature_angle)
-    parameters = dict(ratio=ratio, vertices=vertices, triangles=triangles, seed=int(seed),
+    parameters = dict(ratio=ratio, target_vertices=vertices, target_triangles=triangles, seed=int(seed),
                       adaptivity=adaptivity, flat_floor=flat_floor, area_weighted=bool(area_weighted),
                       feature_angle=float(feature_angle), density=density,
                       density_rings=density_rings, density_ratio=density_ratio,

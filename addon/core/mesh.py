@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .decimate import decimate, decimate_with_samples
 from .native import engine
 
 
@@ -163,16 +164,12 @@ class Mesh:
             self._layouts[key] = layout
         return layout
 
-    def decimate(self, ratio=None, vertices=None, triangles=None, **options):
+    def decimate(self, ratio=None, target_vertices=None, target_triangles=None, **options):
         """TopStoc decimation; see topstoc.core.decimate.decimate for every option."""
-        from .decimate import decimate
-
-        return decimate(self, ratio=ratio, vertices=vertices, triangles=triangles, **options)
+        return decimate(self, ratio, target_vertices, target_triangles, **options)
 
     def decimate_with_samples(self, samples, **options):
         """Re-creates a decimation from its saved sample list (thesis 4.1.3)."""
-        from .decimate import decimate_with_samples
-
         return decimate_with_samples(self, samples, **options)
 
     def __repr__(self) -> str:

@@ -75,7 +75,7 @@ def test_several_components_and_tiny_targets():
     mesh = Mesh(v, t)
     expected = reference.invariants(mesh.num_vertices, mesh.triangles)
     for target in (3, 30, 300):
-        result = mesh.decimate(vertices=target, seed=target)
+        result = mesh.decimate(target_vertices=target, seed=target)
         check_output(mesh, result, expected)
         # far too small for three components with genus 1 and 3: the engine adds what they need
         if target == 3:
@@ -222,7 +222,7 @@ def test_concurrent_calls_on_one_mesh_agree_with_serial_ones():
 def test_triangle_target_within_one_percent():
     mesh = load(DATA / "genus0/cgal_fandisk.off")
     for target in (500, 2000, 6000):
-        r = mesh.decimate(triangles=target, seed=1)
+        r = mesh.decimate(target_triangles=target, seed=1)
         assert abs(r.num_triangles - target) <= 0.01 * target
 
 
@@ -252,7 +252,7 @@ def test_nonmanifold_input_is_decimated_without_damage():
                   [0, 1, 4], [0, 5, 1], [1, 5, 4], [0, 4, 5], [0, 1, 6]])
     mesh = Mesh(v, t)
     assert mesh.report().nonmanifold_edges == 1
-    r = mesh.decimate(vertices=4, seed=0)
+    r = mesh.decimate(target_vertices=4, seed=0)
     degenerate, duplicates = reference.degenerate_or_duplicate(r.triangles)
     assert degenerate == 0 and duplicates == 0
     # the non-manifold edge is a corner-to-corner feature: both ends stay
@@ -263,11 +263,11 @@ def test_nonmanifold_input_is_decimated_without_damage():
     (dict(ratio=0), r"ratio must lie in \(0, 1\]"),
     (dict(ratio=1.5), r"ratio must lie in \(0, 1\]"),
     (dict(ratio=float("nan")), r"ratio must lie in \(0, 1\]"),
-    (dict(vertices=0), r"outside \[1, 642\]"),
-    (dict(vertices=10**6), r"outside \[1, 642\]"),
-    (dict(vertices=2.5), "must be an integer"),
-    (dict(triangles=0), r"outside \[1, 1280\]"),
-    (dict(ratio=0.1, vertices=10), "exactly one target"),
+    (dict(target_vertices=0), r"outside \[1, 642\]"),
+    (dict(target_vertices=10**6), r"outside \[1, 642\]"),
+    (dict(target_vertices=2.5), "must be an integer"),
+    (dict(target_triangles=0), r"outside \[1, 1280\]"),
+    (dict(ratio=0.1, target_vertices=10), "exactly one target"),
     (dict(), "exactly one target"),
     (dict(ratio=0.1, seed=-1), "seed"),
     (dict(ratio=0.1, placement="moved"), "placement"),
@@ -326,3 +326,15 @@ def test_fast_path_gives_the_same_mesh():
             np.testing.assert_array_equal(getattr(fast, name), getattr(full, name), err_msg=name)
     # off unless asked for: the full scan is the faster one in this engine (see decimate.hpp)
     assert not mesh.decimate(ratio=0.03, seed=5).stats.fast_path
+
+
+def test_old_target_keywords_still_work_with_a_warning():
+    mesh = Mesh(*meshgen.icosphere(3))
+    for old, new in (("vertices", "target_vertices"), ("triangles", "target_triangles")):
+        with pytest.warns(DeprecationWarning, match=f"use {new}="):
+            before = mesh.decimate(**{old: 100}, seed=2)
+        after = mesh.decimate(**{new: 100}, seed=2)
+        np.testing.assert_array_equal(before.vertices, after.vertices)
+        np.testing.assert_array_equal(before.triangles, after.triangles)
+        with pytest.raises(ValueError, match=f"give {new} only"):
+            mesh.decimate(**{old: 100, new: 100})

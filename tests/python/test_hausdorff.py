@@ -65,7 +65,7 @@ def eight(data_dir):
 
 @pytest.fixture(scope="module")
 def eight_decimated(eight):
-    return topstoc.Mesh(*eight).decimate(vertices=40, seed=3)
+    return topstoc.Mesh(*eight).decimate(target_vertices=40, seed=3)
 
 
 # --- exactness ---------------------------------------------------------------------------------
@@ -291,7 +291,7 @@ def test_error_bounded_decimation_meets_the_bound_with_a_minimal_count(data_dir,
     # minimal within the resolution: the target just below was measured above the bound
     assert 0 < report.target_vertices - report.failed_target <= report.resolution
     assert report.resolution == max(1, int(0.01 * report.target_vertices))
-    below = mesh.decimate(vertices=report.failed_target, seed=5)
+    below = mesh.decimate(target_vertices=report.failed_target, seed=5)
     again = topstoc.hausdorff(mesh, below, step=report.step, percentile=0)
     assert again.symmetric.max == pytest.approx(report.failed_error, rel=1e-12)
     assert again.symmetric.max > absolute

@@ -143,7 +143,7 @@ def test_tiny_targets_and_several_components():
     mesh = Mesh(v, t)
     expected = reference.invariants(mesh.num_vertices, mesh.triangles)
     for target in (3, 30, 300):
-        r = mesh.decimate(vertices=target, seed=target, refine=5)
+        r = mesh.decimate(target_vertices=target, seed=target, refine=5)
         check_output(mesh, r, expected)
 
 
@@ -159,7 +159,7 @@ def test_bad_refine_values(refine):
 def test_triangle_and_error_targets():
     v, t = reference.read_off(DATA / "genus0/cgal_fandisk.off")
     mesh = Mesh(v, t)
-    r = mesh.decimate(triangles=2000, refine=4, placement="filtered")
+    r = mesh.decimate(target_triangles=2000, refine=4, placement="filtered")
     assert abs(r.num_triangles - 2000) <= 20
     # error-bounded: the bound holds, measured independently of the search, and the refined
     # result needs far fewer vertices than plain TopStoc (measured: 592 vs 5996)

@@ -107,7 +107,7 @@ def test_borders_are_sampled_as_curves():
 @pytest.mark.parametrize("target", [12, 100, 700, 2000])
 def test_exact_budget_without_guidance(sphere, target):
     for seed in range(5):
-        result = sphere.decimate(vertices=target, seed=seed)
+        result = sphere.decimate(target_vertices=target, seed=seed)
         assert abs(result.num_vertices - target) <= max(1, 0.005 * target)
         assert not result.stats.guided
 

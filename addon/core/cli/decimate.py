@@ -121,7 +121,8 @@ def run(args) -> int:
         bound, relative = parse_max_error(args.max_error)
         result = mesh.decimate(max_error=bound, relative=relative, **options)
     else:
-        result = mesh.decimate(ratio=args.ratio, vertices=args.vertices, triangles=args.triangles, **options)
+        result = mesh.decimate(ratio=args.ratio, target_vertices=args.vertices, target_triangles=args.triangles,
+                               **options)
     seconds = time.perf_counter() - start
 
     output = transfer_attributes(data, result)
