@@ -164,16 +164,8 @@ class DecimateResult:
 
 
 def _result(raw: dict, parameters: dict) -> DecimateResult:
-    repairs = raw["repairs"]
-    stats = DecimateStats(
-        target_vertices=raw["target_vertices"], selected=raw["selected"], forced=raw["forced"],
-        density_rejected=raw["density_rejected"], guided=raw["guided"],
-        expected_vertices=raw["expected_vertices"], rate=raw["rate"], fast_path=raw["fast_path"],
-        repair_rounds=repairs["rounds"], repairs=repairs["samples_added"], top_up=raw["top_up_samples"],
-        issues_found=dict(repairs["found"]), issues_remaining=dict(repairs["remaining"]),
-        seconds=dict(raw["seconds"]), refine_vertices=raw["refine_vertices"],
-        refine_collapses=raw["refine_collapses"])
-    return DecimateResult(vertices=raw["positions"], triangles=raw["triangles"], kept=raw["kept"],
+    stats = DecimateStats(**{f.name: raw[f.name] for f in dataclasses.fields(DecimateStats)})  # same names
+    return DecimateResult(vertices=raw["vertices"], triangles=raw["triangles"], kept=raw["kept"],
                           face_source=raw["face_source"], corner_source=raw["corner_source"],
                           labels=raw["labels"], samples=raw["samples"], stats=stats,
                           parameters=parameters)

@@ -191,7 +191,7 @@ def _result(raw: dict, vertices: np.ndarray, triangles) -> EditResult:
                      triangles=slice(p["first_triangle"], p["first_triangle"] + p["num_triangles"]),
                      vertices=slice(p["first_vertex"], p["first_vertex"] + p["num_vertices"]),
                      method=p["method"], normal=p["normal"]) for p in raw["patches"]]
-    return EditResult(vertices=raw["positions"], triangles=raw["triangles"],
+    return EditResult(vertices=raw["vertices"], triangles=raw["triangles"],
                       vertex_source=raw["vertex_source"], face_source=raw["face_source"],
                       corner_source=raw["corner_source"], input_vertices=len(vertices),
                       input_triangles=len(triangles), cut_sides=sides, patches=patches)

@@ -88,7 +88,7 @@ py::dict result_dict(DecimateResult&& r) {
   py::dict d;
   d["samples"] = to_array(std::move(r.samples));
   d["kept"] = to_array(std::move(r.kept));
-  d["positions"] = to_array(std::move(r.positions), 3);
+  d["vertices"] = to_array(std::move(r.positions), 3);
   d["triangles"] = to_array(std::move(r.triangles), 3);
   d["face_source"] = to_array(std::move(r.face_source));
   d["corner_source"] = to_array(std::move(r.corner_source), 3);
@@ -101,15 +101,13 @@ py::dict result_dict(DecimateResult&& r) {
   d["expected_vertices"] = r.expected_vertices;
   d["rate"] = r.rate;
   d["fast_path"] = r.fast_path;
-  d["top_up_samples"] = r.top_up_samples;
+  d["top_up"] = r.top_up_samples;
   d["refine_vertices"] = r.refine_vertices;
   d["refine_collapses"] = r.refine_collapses;
-  py::dict repairs;
-  repairs["rounds"] = r.repairs.rounds;
-  repairs["samples_added"] = r.repairs.samples_added;
-  repairs["found"] = issues_dict(r.repairs.found);
-  repairs["remaining"] = issues_dict(r.repairs.remaining);
-  d["repairs"] = repairs;
+  d["repair_rounds"] = r.repairs.rounds;  // the keys are the Python names (DecimateStats)
+  d["repairs"] = r.repairs.samples_added;
+  d["issues_found"] = issues_dict(r.repairs.found);
+  d["issues_remaining"] = issues_dict(r.repairs.remaining);
   py::dict seconds;
   seconds["sampling"] = r.seconds_sampling;
   seconds["clustering"] = r.seconds_clustering;
