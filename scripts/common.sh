@@ -8,7 +8,7 @@ cd "$ROOT"
 RUNTIME_PACKAGES="blender cmake g++ make pybind11-dev libopenmesh-dev libtet1.5-dev libphat-dev
   python3 python3-dev python3-numpy python3-pytest"
 TEST_PACKAGES="libmeshoptimizer-dev libcgal-dev python3-gudhi python3-scipy python3-venv xvfb
-  xauth git ca-certificates"
+  xauth git ca-certificates doctest-dev"
 
 as_root() {
   if [ "$(id -u)" = 0 ]; then "$@";

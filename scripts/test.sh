@@ -1,5 +1,5 @@
 #!/bin/bash
-# Runs every test: C++ engine and Python API (plain python3), the add-on inside Debian's
+# Runs every test: C++ engine (tests/native, ctest), Python API (plain python3), the add-on inside Debian's
 # Blender 3.4, the add-on as an extension in Blender 4.2+ (PyPI's bpy in .venv), and the real
 # GUI under Xvfb. Installs what is missing first. Exit code 0 only if every suite passed.
 set -o pipefail
@@ -35,6 +35,7 @@ run() {  # run NAME COMMAND...
   if "$@"; then echo "== $name: passed"; else echo "== $name: FAILED"; failed+=("$name"); fi
 }
 PYTEST_ARGS=(-q -p no:cacheprovider)
+run "C++ engine (doctest, ctest)" /usr/bin/ctest --test-dir build --output-on-failure
 run "engine and Python API (python3 + pymeshlab)" $VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/python
 run "Python API with NumPy 2 (PyPI)" $VENV2/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/python
 if [ -d tests/blender ]; then

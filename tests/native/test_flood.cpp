@@ -1,0 +1,120 @@
+// Clustering: flood() against the definition (each vertex joins the sample of least
+// (hop distance, rank), by a breadth-first search per sample), and flood_add() against flood()
+// on the whole sample list, as clustering.hpp promises.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <climits>
+#include <numeric>
+#include <queue>
+#include <random>
+#include <vector>
+
+#include "meshes.hpp"
+#include "topstoc/decimate/clustering.hpp"
+#include "topstoc/decimate/features.hpp"
+#include "topstoc/io/io.hpp"
+
+using namespace topstoc;
+
+namespace {
+
+Mesh make_mesh(const topstoc_test::Arrays& a) { return Mesh(a.positions, a.triangles.data(), a.num_triangles()); }
+
+std::shared_ptr<const FeatureLayout> no_features(const Mesh& mesh) {
+  return build_feature_layout(mesh, nullptr, 0, nullptr, 0, 0.0);
+}
+
+std::vector<int32_t> random_samples(int32_t n, int32_t count, std::mt19937& random) {
+  std::vector<int32_t> ids(n);
+  std::iota(ids.begin(), ids.end(), 0);
+  std::shuffle(ids.begin(), ids.end(), random);
+  ids.resize(count);
+  return ids;
+}
+
+// The definition, without features: a breadth-first search from every sample.
+Clustering brute_clustering(const Mesh& mesh, const std::vector<int32_t>& samples) {
+  const int32_t n = mesh.num_vertices();
+  Clustering c{std::vector<int32_t>(n, -1), std::vector<int32_t>(n, INT32_MAX)};
+  const auto& offsets = mesh.adjacency_offsets();
+  const auto& adjacency = mesh.adjacency();
+  for (int32_t rank = 0; rank < int32_t(samples.size()); ++rank) {
+    std::vector<int32_t> hops(n, -1);
+    std::queue<int32_t> queue;
+    hops[samples[rank]] = 0;
+    queue.push(samples[rank]);
+    while (!queue.empty()) {
+      const int32_t v = queue.front();
+      queue.pop();
+      for (int32_t s = offsets[v]; s < offsets[v + 1]; ++s)
+        if (hops[adjacency[s]] < 0) hops[adjacency[s]] = hops[v] + 1, queue.push(adjacency[s]);
+    }
+    for (int32_t v = 0; v < n; ++v)
+      if (hops[v] >= 0 && (hops[v] < c.dist[v] || (hops[v] == c.dist[v] && rank < c.label[v])))
+        c.dist[v] = hops[v], c.label[v] = rank;
+  }
+  return c;
+}
+
+void check_flood_add_equals_flood(const Mesh& mesh, const FeatureLayout& layout, std::mt19937& random) {
+  const int32_t n = mesh.num_vertices();
+  for (int round = 0; round < 10; ++round) {
+    const int32_t total = 2 + int32_t(random() % std::max(2, n / 4));
+    const auto samples = random_samples(n, total, random);
+    const int32_t first_new = 1 + int32_t(random() % (total - 1));
+    Clustering whole, incremental;
+    flood(mesh, layout, samples, whole);
+    const std::vector<int32_t> first(samples.begin(), samples.begin() + first_new);
+    flood(mesh, layout, first, incremental);
+    const Clustering before = incremental;
+    std::vector<int32_t> changed;
+    flood_add(mesh, layout, samples, first_new, incremental, &changed);
+    CHECK(incremental.label == whole.label);
+    CHECK(incremental.dist == whole.dist);
+    // `changed` names every vertex whose label or distance changed (and only such vertices).
+    std::sort(changed.begin(), changed.end());
+    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+    std::vector<int32_t> differ;
+    for (int32_t v = 0; v < n; ++v)
+      if (before.label[v] != whole.label[v] || before.dist[v] != whole.dist[v]) differ.push_back(v);
+    CHECK(changed == differ);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("flood gives every vertex the sample of least (hops, rank), as a search per sample does") {
+  std::mt19937 random(23);
+  const Mesh mesh = make_mesh(topstoc_test::torus(12, 9));
+  const auto layout = no_features(mesh);
+  for (int round = 0; round < 10; ++round) {
+    const auto samples = random_samples(mesh.num_vertices(), 1 + int32_t(random() % 20), random);
+    Clustering c;
+    flood(mesh, *layout, samples, c);
+    const Clustering expected = brute_clustering(mesh, samples);
+    CHECK(c.label == expected.label);
+    CHECK(c.dist == expected.dist);
+  }
+}
+
+TEST_CASE("flood_add gives exactly what flood gives on the whole sample list") {
+  std::mt19937 random(29);
+  SUBCASE("torus, no features") {
+    const Mesh mesh = make_mesh(topstoc_test::torus(20, 11));
+    check_flood_add_equals_flood(mesh, *no_features(mesh), random);
+  }
+  SUBCASE("grid with a boundary, a border curve across it") {
+    const Mesh mesh = make_mesh(topstoc_test::grid(14, 10));
+    std::vector<int32_t> border;  // the column i = 7, as caller vertex pairs
+    for (int32_t j = 0; j < 10; ++j) border.insert(border.end(), {7 * 11 + j, 7 * 11 + j + 1});
+    const auto layout = build_feature_layout(mesh, nullptr, 0, border.data(), int64_t(border.size() / 2), 0.0);
+    CHECK(layout->feature_edges.size() == 2 * (14 + 10) + 10);  // the boundary and the border
+    check_flood_add_equals_flood(mesh, *layout, random);
+  }
+  SUBCASE("a genus-2 test mesh (tests/data)") {
+    const MeshFile file = read_mesh_path(TOPSTOC_TEST_DATA "/genus_positive/cgal_eight.off");
+    const Mesh mesh(file.positions, file.triangles.data(), file.num_triangles());
+    check_flood_add_equals_flood(mesh, *no_features(mesh), random);
+  }
+}
