@@ -1,4 +1,4 @@
-"""Batch decimation in Blender (SPEC section 6):
+"""Batch decimation in Blender (docs/design.md §6):
 
     blender -b --factory-startup --python-exit-code 1 --python build/python/topstoc/batch.py -- \\
         --input FILE... (--ratio R | --vertices N | --triangles N | --max-error E[%]) [--seed S] \\

@@ -1,4 +1,4 @@
-"""Batch decimation inside Blender: mesh files and .blend files (SPEC section 6).
+"""Batch decimation inside Blender: mesh files and .blend files (docs/design.md §6).
 
 Mesh files (OBJ, PLY, OFF, STL, optionally .gz/.bz2) go through topstoc.core.io in the file's
 own vertex order and are written in the same format, with UVs, vertex colours and materials

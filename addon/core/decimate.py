@@ -1,11 +1,11 @@
-"""TopStoc decimation on numpy arrays (thesis 4.1, 4.3-4.6; SPEC section 1).
+"""TopStoc decimation on numpy arrays (thesis 4.1, 4.3-4.6; docs/design.md §2).
 
 The output's vertices are input vertices (or, with ``placement="filtered"``, points close to
 them); each output triangle comes from one input triangle and keeps its orientation. The
 topology of every manifold component (components, genus, boundary loops) is kept; where plain
 clustering would break it, samples are added and the result says how many.
 
-Guidance convention (SPEC 1.2): ``u`` in [-1, 1] per vertex. ``u = 0`` follows the global
+Guidance convention (docs/design.md §2.2): ``u`` in [-1, 1] per vertex. ``u = 0`` follows the global
 target; ``u > 0`` raises the probability towards 1 (``u = 1``: always kept, a control point);
 ``u < 0`` lowers it towards 0 (``u = -1``: never sampled unless the topology needs it). With
 any guidance, view or box active, the vertex count follows the probabilities (user input wins
@@ -336,7 +336,7 @@ def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, fe
 def sampling_probabilities(mesh: Mesh, rate: float, *, adaptivity: float = 0.5,
                            flat_floor: float = 0.25, guidance=None, regions=None, borders=None,
                            view: Optional[View] = None, boxes: Sequence[Box] = ()) -> np.ndarray:
-    """The probability p(v) each vertex gets at base rate ``rate`` (SPEC 1.2), for inspection."""
+    """The probability p(v) each vertex gets at base rate ``rate`` (docs/design.md §2.2), for inspection."""
     if not 0 <= rate <= 1:
         raise ValueError(f"rate must lie in [0, 1], got {rate!r}")
     layout = mesh.feature_layout(regions, borders)

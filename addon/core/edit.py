@@ -1,4 +1,4 @@
-"""Topology editing on numpy arrays (thesis 4.2.2; SPEC section 3).
+"""Topology editing on numpy arrays (thesis 4.2.2; docs/design.md §4.5).
 
 Delete faces, cut along a closed edge loop, fill holes, and remove a handle or tunnel (cut along
 its loop, fill both holes: the genus drops by one and nothing else changes).

@@ -1,4 +1,4 @@
-"""Error-bounded decimation (SPEC 1.7): the fewest vertices whose symmetric Hausdorff error stays
+"""Error-bounded decimation (docs/design.md §2.11): the fewest vertices whose symmetric Hausdorff error stays
 under a bound.
 
 A re-decimation of a prepared mesh costs milliseconds, so the search simply tries vertex

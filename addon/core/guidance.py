@@ -1,6 +1,6 @@
 """Guidance maths for the add-on and the batch tool (no Blender needed).
 
-Every guidance source gives a value ``u`` in [-1, 1] per vertex (SPEC 1.2): ``u = 0`` follows
+Every guidance source gives a value ``u`` in [-1, 1] per vertex (docs/design.md §2.2): ``u = 0`` follows
 the global target, ``u > 0`` keeps more (``u = 1``: always kept), ``u < 0`` keeps less
 (``u = -1``: never sampled unless the topology needs it).
 

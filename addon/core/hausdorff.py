@@ -1,4 +1,4 @@
-"""Hausdorff distance between two triangle meshes (SPEC section 2; thesis 4.7.1, A.5).
+"""Hausdorff distance between two triangle meshes (docs/design.md §3; thesis 4.7.1, A.5).
 
 >>> result = hausdorff((vertices, triangles), decimated)      # original first
 >>> result.symmetric.max, result.forward.mean, result.diagonal
@@ -96,7 +96,7 @@ class HausdorffResult:
                                    symmetric=self.symmetric.scaled(factor), relative=True)
 
     def as_dict(self) -> dict:
-        """The figures as plain numbers (the ``measure --json`` document, SPEC section 6)."""
+        """The figures as plain numbers (the ``measure --json`` document, docs/design.md §6)."""
         return {
             "forward": self.forward.as_dict(),
             "backward": self.backward.as_dict(),

@@ -1,4 +1,4 @@
-"""Handle and tunnel loops (SPEC section 3; thesis 3.2.2-3.2.4, 4.2.1, 5.2.2).
+"""Handle and tunnel loops (docs/design.md §4.3; thesis 3.2.2-3.2.4, 4.2.1, 5.2.2).
 
 On a closed surface in space, a *handle loop* bounds a disk inside the solid but not outside
 (it goes around a handle, like the meridian of a cup's handle); a *tunnel loop* bounds outside
@@ -117,7 +117,7 @@ class LoopsResult:
         return sum(c.genus for c in self.components if c.status == "ok")
 
     def as_json(self) -> dict:
-        """The ``loops --json`` document (SPEC section 6), vertex ids as plain lists."""
+        """The ``loops --json`` document (docs/design.md §6), vertex ids as plain lists."""
         def loop_json(loop: Loop) -> dict:
             return {"vertices": loop.vertices.tolist(), "generator": list(loop.generator),
                     "length": loop.length, "initial_length": loop.initial_length}

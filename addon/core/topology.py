@@ -1,6 +1,6 @@
 """Topology of a triangle mesh: invariants per connected component and generator edges.
 
-SPEC section 3, thesis chapter 3 and 4.2.1. Works on any triangle mesh read as a simplicial
+docs/design.md §4.1, thesis chapter 3 and 4.2.1. Works on any triangle mesh read as a simplicial
 complex over Z2, in the caller's vertex ids:
 
 * every vertex is a 0-simplex, also an unused one: an isolated vertex is a component of its
@@ -103,7 +103,7 @@ class ComponentTopology:
                 f"genus undefined, betti {b0}/{b1}/{b2}")
 
     def to_dict(self) -> dict:
-        """JSON-ready description (SPEC section 6 keys plus the details)."""
+        """JSON-ready description (docs/design.md §6 keys plus the details)."""
         return {
             "index": self.index, "kind": self.kind, "summary": self.summary,
             "vertices": self.vertices, "edges": self.edges, "faces": self.faces, "euler": self.euler,
@@ -184,7 +184,7 @@ class Topology:
         return f"{count} components ({', '.join(parts)}){extra}, betti {b0}/{b1}/{b2}"
 
     def to_dict(self) -> dict:
-        """JSON-ready (SPEC section 6: ``betti`` and ``components``; plus totals and generators)."""
+        """JSON-ready (docs/design.md §6: ``betti`` and ``components``; plus totals and generators)."""
         out = {"betti": list(self.betti), "vertices": self.vertices, "edges": self.edges,
                "faces": self.faces, "euler": self.euler, "summary": self.summary(),
                "collapsed_triangles": self.collapsed_triangles,

@@ -210,7 +210,7 @@ void bind_decimate(py::module_& m) {
       },
       py::arg("mesh"), py::arg("layout"), py::arg("rate"), py::arg("seed") = 0, py::arg("adaptivity") = 0.5,
       py::arg("flat_floor") = 0.25, py::arg("area_weighted") = false, py::arg("guidance") = py::none(), py::arg("view") = py::none(),
-      py::arg("boxes") = py::none(), "Per-vertex sampling probability p(v) for base rate k (SPEC 1.2).");
+      py::arg("boxes") = py::none(), "Per-vertex sampling probability p(v) for base rate k (docs/design.md §2.2).");
 
   m.def(
       "aspect_ratio_stats",

@@ -1,4 +1,4 @@
-"""Batch decimation through Blender's command line (SPEC section 6): exit codes, JSON report,
+"""Batch decimation through Blender's command line (docs/design.md §6): exit codes, JSON report,
 outputs that really are decimated."""
 
 import importlib

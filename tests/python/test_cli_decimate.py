@@ -1,4 +1,4 @@
-"""The ``decimate`` command line (SPEC section 6), run as a subprocess like a user would."""
+"""The ``decimate`` command line (docs/design.md §6), run as a subprocess like a user would."""
 
 import functools
 import inspect

@@ -1,4 +1,4 @@
-"""``python3 -m topstoc fill-holes`` and ``remove-handle`` (SPEC section 6)."""
+"""``python3 -m topstoc fill-holes`` and ``remove-handle`` (docs/design.md §6)."""
 
 import json
 

@@ -1,4 +1,4 @@
-"""The ``loops`` command line (SPEC section 6), run as a subprocess like a user would."""
+"""The ``loops`` command line (docs/design.md §6), run as a subprocess like a user would."""
 
 import functools
 import gzip

@@ -1,4 +1,4 @@
-"""``python3 -m topstoc topology IN`` (SPEC section 6): JSON keys and values, text report, errors."""
+"""``python3 -m topstoc topology IN`` (docs/design.md §6): JSON keys and values, text report, errors."""
 
 import functools
 import json

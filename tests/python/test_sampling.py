@@ -1,4 +1,4 @@
-"""Sampling probabilities (SPEC 1.2) and the draw: formulas, exact budget, inclusion rates,
+"""Sampling probabilities (docs/design.md §2.2) and the draw: formulas, exact budget, inclusion rates,
 determinism and density control."""
 
 import math
@@ -24,7 +24,7 @@ def slab():
 
 
 def base_probability(mesh, rate, adaptivity, floor=0.25):
-    """SPEC 1.2 without guidance, recomputed from the independent weights."""
+    """docs/design.md §2.2 without guidance, recomputed from the independent weights."""
     x = reference.importance_weights(mesh.vertices, mesh.triangles)
     q = np.maximum(floor, 1 + adaptivity * (x / x.mean() - 1))
     return np.clip(rate * q, 0, 1)

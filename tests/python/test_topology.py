@@ -277,7 +277,7 @@ def test_to_dict_has_the_cli_keys():
     assert sorted(c["boundary_loops"][0]) == [0, 1, 2, 3, 5, 6, 7, 8]
 
 
-# --- bad input (SPEC section 5) --------------------------------------------------------------
+# --- bad input (docs/design.md §5) --------------------------------------------------------------
 
 def test_empty_mesh():
     info = topology(np.zeros((0, 3)), np.zeros((0, 3), np.int32))

@@ -1,4 +1,4 @@
-"""Command line: ``python3 -m topstoc SUBCOMMAND ...`` (SPEC section 6).
+"""Command line: ``python3 -m topstoc SUBCOMMAND ...`` (docs/design.md §6).
 
 Each subcommand lives in its own module here and provides ``add_parser(subparsers)`` and
 ``run(args) -> int``. Errors print one clear line on standard error and exit non-zero.

@@ -1,4 +1,4 @@
-"""``python3 -m topstoc decimate IN OUT``: TopStoc decimation of a mesh file (SPEC section 6).
+"""``python3 -m topstoc decimate IN OUT``: TopStoc decimation of a mesh file (docs/design.md §6).
 
 The output keeps the input's UVs, vertex colours and materials: material borders and UV
 seams are passed to the decimation as borders, so they survive, and the attributes are

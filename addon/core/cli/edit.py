@@ -1,4 +1,4 @@
-"""``fill-holes IN OUT`` and ``remove-handle IN OUT --index K`` (SPEC section 6).
+"""``fill-holes IN OUT`` and ``remove-handle IN OUT --index K`` (docs/design.md §6).
 
 Both write the edited mesh (same attributes as the input: UVs, vertex colours and materials
 carry over; patches take them from the hole's border) and print the new mesh's topology, with

@@ -1,4 +1,4 @@
-"""``loops IN``: handle and tunnel loops of a mesh file (SPEC section 6).
+"""``loops IN``: handle and tunnel loops of a mesh file (docs/design.md §6).
 
 Prints, per component (ordered by smallest vertex id), the genus and the g handle and g tunnel
 loops as vertex ids in the file's vertex order, with their lengths. With --json the document

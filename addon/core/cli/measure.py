@@ -1,4 +1,4 @@
-"""``measure A B``: Hausdorff distance between two mesh files (SPEC section 6).
+"""``measure A B``: Hausdorff distance between two mesh files (docs/design.md §6).
 
 A is the original, B its approximation. Prints forward (A to B), backward (B to A) and
 symmetric figures, each max, mean, RMS and a percentile, and the bounding-box diagonal of A.

@@ -1,4 +1,4 @@
-"""``python3 -m topstoc topology IN``: topological invariants of a mesh file (SPEC section 6).
+"""``python3 -m topstoc topology IN``: topological invariants of a mesh file (docs/design.md §6).
 
 Prints per connected component V, E, F, Euler characteristic, Betti numbers over Z2, whether
 it is closed, orientable and manifold, its genus (or cross-caps) and boundary loops. With

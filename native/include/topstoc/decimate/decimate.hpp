@@ -1,4 +1,4 @@
-// TopStoc decimation (thesis 4.1; SPEC §1): sample, flood, check, repair, emit.
+// TopStoc decimation (thesis 4.1; docs/design.md §2): sample, flood, check, repair, emit.
 //
 // The output's vertices are input vertices (or, in filtered mode, points near them); every
 // output triangle comes from one input triangle whose corners lie in three different clusters,

@@ -1,4 +1,4 @@
-// Filtered vertex placement (SPEC §1.6): instead of keeping each sample where it is, move it to
+// Filtered vertex placement (docs/design.md §2.9): instead of keeping each sample where it is, move it to
 // the point that minimises the summed squared distance to the planes of its cluster's
 // triangles (quadric error, Garland & Heckbert 1997, as used for vertex clustering by
 // Lindstrom 2000). Small eigenvalues of the quadric are truncated so that flat and cylindrical

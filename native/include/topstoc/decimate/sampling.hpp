@@ -1,4 +1,4 @@
-// Stochastic vertex selection (thesis 4.1, 4.3, 4.4, 4.6; SPEC §1.2 and §1.5).
+// Stochastic vertex selection (thesis 4.1, 4.3, 4.4, 4.6; docs/design.md §2.2-2.4).
 //
 // Every vertex gets a probability p(v) from its importance weight and the user's guidance, and
 // a seeded fixed-size draw picks the samples. Without guidance the draw hits the target count

@@ -1,4 +1,4 @@
-// Hausdorff distance between two triangle meshes (SPEC §2; thesis 4.7.1, A.5).
+// Hausdorff distance between two triangle meshes (docs/design.md §3; thesis 4.7.1, A.5).
 //
 // One-sided distance from surface A to surface B: A is sampled, and every sample's nearest
 // point on B is found through B's bounding volume hierarchy (bvh.hpp). The sampling follows

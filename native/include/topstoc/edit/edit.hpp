@@ -1,4 +1,4 @@
-// Topology editing on the caller's arrays (thesis 4.2.2, SPEC section 3): delete faces, cut
+// Topology editing on the caller's arrays (thesis 4.2.2, docs/design.md §4.5): delete faces, cut
 // along a closed edge loop. Hole filling is in fill_holes.hpp, handle removal (cut + fill) in
 // remove_handle.hpp; all of them return an EditResult.
 //

@@ -1,4 +1,4 @@
-// Boundary loops and hole filling (thesis 4.2.2; SPEC section 3).
+// Boundary loops and hole filling (thesis 4.2.2; docs/design.md §4.5).
 //
 // A hole is a boundary loop: a cycle of edges with one triangle each. Filling it adds a patch
 // of triangles over the hole's own vertices (hole_triangulation.hpp says how), oriented like the

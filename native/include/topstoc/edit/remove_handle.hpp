@@ -1,4 +1,4 @@
-// Killing a handle or tunnel (thesis 4.2.2, SPEC section 3): cut the surface along a loop that
+// Killing a handle or tunnel (thesis 4.2.2, docs/design.md §4.5): cut the surface along a loop that
 // goes around it, then fill the two holes the cut opened. On a closed orientable component of
 // genus g this leaves genus g - 1 and changes nothing else: the same number of components and
 // boundary loops, every vertex off the loop where it was. The two copies of the loop are first

@@ -1,4 +1,4 @@
-// Handle and tunnel loops of every closed, orientable, manifold component (SPEC §3; thesis
+// Handle and tunnel loops of every closed, orientable, manifold component (docs/design.md §4.3; thesis
 // 3.2.2-3.2.4, 4.2.1, 5.2.2; Dey, Li, Sun 2007).
 //
 // A loop on a closed surface in R^3 is a handle loop when it bounds inside the solid (it is

@@ -1,4 +1,4 @@
-// Topological invariants of a simplicial complex, per connected component (SPEC section 3,
+// Topological invariants of a simplicial complex, per connected component (docs/design.md §4.1,
 // thesis 3.1 and 4.2.1), for any triangle mesh: several components, open or closed,
 // orientable or not, manifold or not, with wire edges and isolated vertices.
 //
