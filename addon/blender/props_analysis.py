@@ -35,23 +35,29 @@ def _redraw(_self, context):
                 area.tag_redraw()
 
 
-class TOPSTOC_PG_component(bpy.types.PropertyGroup):
-    """Invariants of one connected component (counts in Blender's terms: polygons, edges)."""
+class _Invariants:
+    """What a component and the whole mesh both report (a mixin: Blender registers the
+    properties of a property group's bases too)."""
 
     vertices: IntProperty(name="Vertices")
     edges: IntProperty(name="Edges")
     faces: IntProperty(name="Faces")
     triangles: IntProperty(name="Triangles")
-    euler: IntProperty(name="Euler Characteristic")
     betti0: IntProperty(name="β0")
     betti1: IntProperty(name="β1")
     betti2: IntProperty(name="β2")
-    genus: IntProperty(name="Genus", description="-1 where undefined (non-manifold, non-orientable)")
     boundary_loops: IntProperty(name="Boundary Loops")
+    summary: StringProperty(name="Summary")
+
+
+class TOPSTOC_PG_component(_Invariants, bpy.types.PropertyGroup):
+    """Invariants of one connected component (counts in Blender's terms: polygons, edges)."""
+
+    euler: IntProperty(name="Euler Characteristic")
+    genus: IntProperty(name="Genus", description="-1 where undefined (non-manifold, non-orientable)")
     closed: BoolProperty(name="Closed")
     manifold: BoolProperty(name="Manifold")
     orientable: BoolProperty(name="Orientable")
-    summary: StringProperty(name="Summary")
 
 
 class TOPSTOC_PG_loop(bpy.types.PropertyGroup):
@@ -64,7 +70,7 @@ class TOPSTOC_PG_loop(bpy.types.PropertyGroup):
     fillable: BoolProperty(name="Fillable", default=True)
 
 
-class TOPSTOC_PG_topology(bpy.types.PropertyGroup):
+class TOPSTOC_PG_topology(_Invariants, bpy.types.PropertyGroup):
     """Topology of an object's mesh (the Topology panel's data)."""
 
     state: EnumProperty(name="State", items=STATES, default="NONE")
@@ -73,21 +79,12 @@ class TOPSTOC_PG_topology(bpy.types.PropertyGroup):
     seconds: FloatProperty(name="Analysis Time", subtype="TIME_ABSOLUTE", unit="TIME_ABSOLUTE")
     revision: IntProperty(name="Revision", description="Changes whenever the results change")
 
-    vertices: IntProperty(name="Vertices")
-    edges: IntProperty(name="Edges")
-    faces: IntProperty(name="Faces")
-    triangles: IntProperty(name="Triangles")
     euler: IntProperty(name="χ")
-    betti0: IntProperty(name="β0")
-    betti1: IntProperty(name="β1")
-    betti2: IntProperty(name="β2")
     genus: IntProperty(name="Genus", description="Sum over the components; -1 if any is undefined")
-    boundary_loops: IntProperty(name="Boundary Loops")
     nonmanifold_edges: IntProperty(name="Non-Manifold Edges")
     nonmanifold_vertices: IntProperty(name="Non-Manifold Vertices")
     isolated_vertices: IntProperty(name="Isolated Vertices")
     duplicate_triangles: IntProperty(name="Duplicate Triangles")
-    summary: StringProperty(name="Summary")
     components: CollectionProperty(type=TOPSTOC_PG_component)
     component_index: IntProperty(name="Component")
 

@@ -226,7 +226,7 @@ def test_metrics_panel_rows(mods, decimated):
 
 
 def test_metrics_panels_draw_measured_and_failed_states(mods, decimated):
-    from test_registration import RecordingLayout
+    from test_registration import fake_panel
 
     out = decimated[1]
     seen = set()
@@ -236,7 +236,7 @@ def test_metrics_panels_draw_measured_and_failed_states(mods, decimated):
         if state == "ERROR":
             out.topstoc.metrics.state, out.topstoc.metrics.message = "ERROR", "something clear"
         for cls in mods.panel.CLASSES:
-            fake = type("P", (), {"layout": RecordingLayout(seen)})()
+            fake = fake_panel(cls, seen)
             if hasattr(cls, "draw_header"):
                 cls.draw_header(fake, bpy.context)
             cls.draw(fake, bpy.context)

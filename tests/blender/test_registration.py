@@ -64,6 +64,13 @@ class RecordingLayout:
         return lambda *a, **k: None
 
 
+def fake_panel(cls, seen):
+    """Stands in for an instance of panel ``cls`` (only Blender makes those): a recording layout
+    and the panel's own methods that its draw calls on self."""
+    methods = {"draw_mesh": cls.draw_mesh} if hasattr(cls, "draw_mesh") else {}
+    return type("P", (), {"layout": RecordingLayout(seen), **methods})()
+
+
 @pytest.mark.parametrize("kind", ["mesh", "empty"])
 def test_panels_draw(ts, scene, kind):
     obj = make_object("Ball", *meshgen.icosphere(1))
@@ -81,7 +88,7 @@ def test_panels_draw(ts, scene, kind):
         for cls in module.CLASSES:
             if issubclass(cls, bpy.types.UIList):
                 continue
-            fake = type("P", (), {"layout": RecordingLayout(seen)})()
+            fake = fake_panel(cls, seen)
             for mode in ("RATIO", "VERTICES", "TRIANGLES", "MAX_ERROR"):
                 scene.topstoc.target_mode = mode
                 if hasattr(cls, "draw_header"):

@@ -353,7 +353,7 @@ def test_overlay_arrays_follow_the_analysis(mods, scene):
 
 
 def test_topology_panels_draw_in_every_state(mods, scene):
-    from test_registration import RecordingLayout
+    from test_registration import fake_panel
 
     obj = load("Eight", "genus_positive/cgal_eight.off")
     seen = set()
@@ -369,7 +369,7 @@ def test_topology_panels_draw_in_every_state(mods, scene):
                 continue
             if hasattr(cls, "poll") and not cls.poll(bpy.context):
                 continue
-            fake = type("P", (), {"layout": RecordingLayout(seen)})()
+            fake = fake_panel(cls, seen)
             cls.draw(fake, bpy.context)
     assert {"topstoc.analyse", "topstoc.find_loops", "topstoc.loop_step", "topstoc.select_loop",
             "topstoc.cut_loop", "topstoc.remove_loop", "topstoc.fill_holes", "topstoc.delete_faces",

@@ -5,15 +5,10 @@ from __future__ import annotations
 import bpy
 
 from .. import metrics
-from .panels import _Panel
+from .panels import _MeshPanel, _Panel
 
 SIDES = (("symmetric", "Symmetric"), ("forward", "Forward (original → this)"),
          ("backward", "Backward (this → original)"))
-
-
-def _mesh(context):
-    obj = context.active_object
-    return obj if obj is not None and obj.type == "MESH" else None
 
 
 def distance_rows(obj) -> list:
@@ -27,17 +22,12 @@ def distance_rows(obj) -> list:
     return rows
 
 
-class TOPSTOC_PT_metrics(_Panel, bpy.types.Panel):
+class TOPSTOC_PT_metrics(_MeshPanel, bpy.types.Panel):
     bl_label = "Metrics"
     bl_idname = "TOPSTOC_PT_metrics"
     bl_order = 20
 
-    def draw(self, context):
-        layout = self.layout
-        obj = _mesh(context)
-        if obj is None:
-            layout.label(text="Select a mesh")
-            return
+    def draw_mesh(self, context, layout, obj):
         settings = obj.topstoc.metrics
         layout.use_property_split = True
         layout.use_property_decorate = False

@@ -1,5 +1,5 @@
 """Decimation panels: target and options, guidance sources, preview/multiview/LODs, samples."""
-# Shared by every panel of the tab: ui/topology.py and ui/metrics.py use _Panel and CATEGORY.
+# Shared by every panel of the tab: ui/topology.py and ui/metrics.py use _Panel, _MeshPanel and _mesh.
 
 from __future__ import annotations
 
@@ -13,6 +13,23 @@ class _Panel:
     bl_space_type = "VIEW_3D"
     bl_region_type = "UI"
     bl_category = CATEGORY
+
+
+def _mesh(context):
+    """The active object if it is a mesh, else None."""
+    obj = context.active_object
+    return obj if obj is not None and obj.type == "MESH" else None
+
+
+class _MeshPanel(_Panel):
+    """A panel about the active mesh object: asks for one when there is none."""
+
+    def draw(self, context):
+        obj = _mesh(context)
+        if obj is None:
+            self.layout.label(text="Select a mesh")
+            return
+        self.draw_mesh(context, self.layout, obj)
 
 
 class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):

@@ -8,14 +8,9 @@ import bpy
 
 from .. import analysis
 from ..operators.topology import running
-from .panels import _Panel
+from .panels import _MeshPanel, _Panel, _mesh
 
 KIND_ICONS = {"HANDLE": "MOD_CURVE", "TUNNEL": "MOD_SCREW", "BOUNDARY": "MOD_EDGESPLIT"}
-
-
-def _mesh(context):
-    obj = context.active_object
-    return obj if obj is not None and obj.type == "MESH" else None
 
 
 def wrapped(layout, context, text: str, icon: str = "NONE") -> None:
@@ -62,17 +57,12 @@ class TOPSTOC_UL_loops(bpy.types.UIList):
         split.label(text=f"{item.num_edges} edges", icon="ERROR" if warning else "NONE")
 
 
-class TOPSTOC_PT_topology(_Panel, bpy.types.Panel):
+class TOPSTOC_PT_topology(_MeshPanel, bpy.types.Panel):
     bl_label = "Topology"
     bl_idname = "TOPSTOC_PT_topology"
     bl_order = 10
 
-    def draw(self, context):
-        layout = self.layout
-        obj = _mesh(context)
-        if obj is None:
-            layout.label(text="Select a mesh")
-            return
+    def draw_mesh(self, context, layout, obj):
         topology = obj.topstoc.topology
         row = layout.row(align=True)
         row.operator("topstoc.analyse", icon="VIEWZOOM")
@@ -96,23 +86,31 @@ class TOPSTOC_PT_topology(_Panel, bpy.types.Panel):
         layout.label(text=f"Analysed in {1000 * topology.seconds:.0f} ms")
 
 
-class TOPSTOC_PT_topology_components(_Panel, bpy.types.Panel):
+def _analysed(context):
+    """The active mesh's topology results once it has been analysed, else None."""
+    obj = _mesh(context)
+    return obj.topstoc.topology if obj is not None and obj.topstoc.topology.state == "OK" else None
+
+
+class _AnalysedPanel(_Panel):
+    """A sub-panel shown once the active mesh has been analysed."""
+
+    @classmethod
+    def poll(cls, context):
+        return _analysed(context) is not None
+
+
+class TOPSTOC_PT_topology_components(_AnalysedPanel, bpy.types.Panel):
     bl_label = "Components"
     bl_idname = "TOPSTOC_PT_topology_components"
     bl_parent_id = "TOPSTOC_PT_topology"
     bl_options = {"DEFAULT_CLOSED"}
 
-    @classmethod
-    def poll(cls, context):
-        obj = _mesh(context)
-        return obj is not None and obj.topstoc.topology.state == "OK"
-
     def draw(self, context):
         layout = self.layout
-        obj = _mesh(context)
-        if obj is None:
+        topology = _analysed(context)
+        if topology is None:
             return
-        topology = obj.topstoc.topology
         layout.template_list("TOPSTOC_UL_components", "", topology, "components", topology, "component_index",
                              rows=3)
         if 0 <= topology.component_index < len(topology.components):
@@ -125,22 +123,17 @@ class TOPSTOC_PT_topology_components(_Panel, bpy.types.Panel):
                 ("Orientable", "yes" if c.orientable else "no")])
 
 
-class TOPSTOC_PT_topology_loops(_Panel, bpy.types.Panel):
+class TOPSTOC_PT_topology_loops(_AnalysedPanel, bpy.types.Panel):
     bl_label = "Loops"
     bl_idname = "TOPSTOC_PT_topology_loops"
     bl_parent_id = "TOPSTOC_PT_topology"
 
-    @classmethod
-    def poll(cls, context):
-        obj = _mesh(context)
-        return obj is not None and obj.topstoc.topology.state == "OK"
-
     def draw(self, context):
         layout = self.layout
-        obj = _mesh(context)
-        if obj is None:
+        topology = _analysed(context)
+        if topology is None:
             return
-        topology = obj.topstoc.topology
+        obj = topology.id_data  # the object the results are stored on
         if topology.loops_message:
             wrapped(layout, context, topology.loops_message,
                     "ERROR" if topology.loops_state == "ERROR" else "INFO")
