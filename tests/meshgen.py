@@ -101,6 +101,15 @@ def genus_slab(genus: int, scale: int = 2):
     return voxel_surface(filled)
 
 
+def genus_grid(rows: int, columns: int, scale=(1, 1, 1)):
+    """A slab with rows x columns square holes in a grid (closed, orientable, genus rows*columns).
+
+    scale: voxels per cell along x, y, z (a finer surface of the same genus)."""
+    cells = np.ones((2 * rows + 1, 2 * columns + 1, 1), dtype=bool)
+    cells[1::2, 1::2, 0] = False
+    return voxel_surface(np.kron(cells, np.ones(scale, dtype=bool)))
+
+
 def disjoint(*meshes):
     """Several meshes side by side as one mesh (vertex ids offset, positions shifted apart)."""
     vertices, faces, offset, shift = [], [], 0, 0.0

@@ -9,6 +9,8 @@ skips cleanly when ../shared is absent):
   slab12_l3   a voxel slab with 12 holes (genus 12), 3 times:   117,760 triangles
   turbine_l3  the turbine, three times:                       1,181,440 triangles
   slab12_l5   the slab, five times:                           1,884,160 triangles
+  grid133     a slab with 7 x 19 holes (genus 133):              14,912 triangles
+  grid133_l3  the same, Loop-subdivided three times:            954,368 triangles
 Times (medians of --repeats runs, file reading excluded): `mesh` = topstoc.Mesh (validation,
 adjacency), `loops` = handle_tunnel_loops on it, `total` = both, and the loops' own stages.
 CPU seconds are printed too: on a shared machine the wall clock also measures the neighbours.
@@ -21,6 +23,7 @@ span the outside, tunnels the reverse, all span the surface).
 
 import argparse
 import os
+import resource
 import pathlib
 import statistics
 import subprocess
@@ -41,22 +44,28 @@ from topstoc.core.io import MeshData  # noqa: E402
 SHARED = ROOT.parent / "shared"
 OUT = ROOT / "build" / "bench_meshes"
 CASES = [("turbine_l1", "turbine", 1), ("slab12_l3", "slab12", 3), ("turbine_l3", "turbine", 3),
-         ("slab12_l5", "slab12", 5)]
+         ("slab12_l5", "slab12", 5), ("grid133", "grid133", 0), ("grid133_l3", "grid133", 3)]
 
 
 def base_mesh(name: str) -> pathlib.Path:
     if name == "turbine":
         return SHARED / "meshes" / "genus_positive" / "cgal_turbine.off"
-    path = OUT / "slab12.off"
+    path = OUT / f"{name}.off"
     if not path.exists():
         import meshgen
 
-        vertices, triangles = meshgen.genus_slab(12)
+        OUT.mkdir(parents=True, exist_ok=True)
+        if name == "slab12":
+            vertices, triangles = meshgen.genus_slab(12)
+        else:  # grid133: genus 133 in few triangles, where the genus dominates the cost
+            vertices, triangles = meshgen.genus_grid(7, 19, scale=(2, 2, 3))
         write_mesh(path, MeshData(vertices=vertices, triangles=triangles))
     return path
 
 
 def make(name: str, base: str, levels: int) -> pathlib.Path:
+    if levels == 0:
+        return base_mesh(base)
     path = OUT / f"{name}.ply"
     if not path.exists():
         OUT.mkdir(parents=True, exist_ok=True)
@@ -127,6 +136,8 @@ def main() -> int:
               f"{component.analysed_vertices} vertices / {component.tetrahedra} tetrahedra tetrahedralized")
         print(f"total {median(0) + median(1):.3f} s (mesh {median(0):.3f} s + loops {median(1):.3f} s), "
               f"CPU {median(2) + median(3):.3f} s; medians of {args.repeats}, load average {os.getloadavg()[0]:.2f}")
+        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+        print(f"peak resident memory of this process so far: {peak:.0f} MB (one case alone: --only {name})")
         stages = {k: statistics.median(r[4].seconds[k] for r in runs) for k in stage_names}
         print("stages (s): " + ", ".join(f"{k} {v:.3f}" for k, v in stages.items()))
         for kind, loops in (("handles", component.handles), ("tunnels", component.tunnels)):

@@ -1,6 +1,7 @@
 #include "topstoc/topology/loop_basis.hpp"
 
 #include <algorithm>
+#include <array>
 #include <functional>
 #include <stdexcept>
 #include <tuple>
@@ -106,6 +107,22 @@ std::vector<int32_t> match(const std::vector<std::vector<uint8_t>>& coefficient)
   return cycle_of_loop;
 }
 
+// Sorts the candidates shortest first and takes, per kind, those that extend the kind's basis
+// (a matroid greedy: the result is a shortest basis among the candidates). Returns the picks
+// per kind; both have g entries when the candidates span both subspaces.
+std::array<std::vector<const Candidate*>, 2> pick_shortest(std::vector<Candidate>& candidates, int32_t dim, int32_t g) {
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
+    return std::tie(x.length, x.order) < std::tie(y.length, y.order);
+  });
+  Z2Basis chosen[2] = {Z2Basis(dim), Z2Basis(dim)};
+  std::array<std::vector<const Candidate*>, 2> picked;
+  for (const auto& c : candidates) {
+    if (chosen[c.kind].rank() < g && chosen[c.kind].insert(c.cls)) picked[c.kind].push_back(&c);
+    if (chosen[0].rank() == g && chosen[1].rank() == g) break;
+  }
+  return picked;
+}
+
 }  // namespace
 
 std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomology& h, const std::vector<PersistentCycle>& cycles,
@@ -113,7 +130,11 @@ std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomo
   const int32_t dim = h.dimension(), g = dim / 2, n = s.num_vertices();
   std::vector<SelectedLoop> out;
   if (g == 0) return out;
-  // Coordinates in the basis (handle cycles, tunnel cycles) tell the two subspaces apart.
+  // Coordinates in the basis (handle cycles, tunnel cycles) tell the two subspaces apart: bits
+  // 0..g-1 are the handle cycles' coefficients, g..2g-1 the tunnel cycles'. Every class below is
+  // kept in these coordinates, so telling a handle from a tunnel reads two halves of a bit
+  // vector instead of eliminating against the cycle basis once per edge and root (which made
+  // the selection cubic in the genus).
   std::vector<const PersistentCycle*> ordered;
   for (const auto& c : cycles) if (c.handle) ordered.push_back(&c);
   for (const auto& c : cycles) if (!c.handle) ordered.push_back(&c);
@@ -121,14 +142,44 @@ std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomo
   for (const auto* c : ordered)
     if (!split.insert(h.class_of_edges(c->edges)))
       throw std::logic_error("the handle and tunnel cycles are not independent in H1");
-  auto kind_of = [&](const Z2Vector& x, Z2Vector* coefficients = nullptr) {
-    Z2Vector used;
-    if (!split.reduce(x, used).zero() || used.zero()) return int32_t(kNeither);
-    if (coefficients) *coefficients = used;
-    bool handle_part = false, tunnel_part = false;
+  const int32_t words = (dim + 63) / 64;
+  // Row i: the coefficients of generator i's unit vector in the cycle basis (the inverse matrix).
+  std::vector<Z2Vector> to_cycle_basis(dim);
+  for (int32_t i = 0; i < dim; ++i) {
+    Z2Vector unit(dim);
+    unit.flip(i);
+    split.reduce(unit, to_cycle_basis[i]);
+  }
+  auto in_cycle_basis = [&](const Z2Vector& x) {
+    Z2Vector c(dim);
     for (int32_t i = 0; i < dim; ++i)
-      if (used.get(i)) (i < g ? handle_part : tunnel_part) = true;
-    return handle_part && tunnel_part ? int32_t(kNeither) : handle_part ? int32_t(kHandle) : int32_t(kTunnel);
+      if (x.get(i)) c.add(to_cycle_basis[i]);
+    return c;
+  };
+  // Each edge's coordinates, converted once.
+  std::vector<uint64_t> edge_class(size_t(words) * s.num_edges(), 0);
+  for (int32_t e = 0; e < s.num_edges(); ++e) {
+    uint64_t* out = &edge_class[size_t(words) * e];
+    h.for_each_crossing(e, [&](int32_t j, int) {
+      for (int32_t k = 0; k < words; ++k) out[k] ^= to_cycle_basis[j].words[k];
+    });
+  }
+  auto add_edge = [&](uint64_t* x, int32_t e) {
+    const uint64_t* c = &edge_class[size_t(words) * e];
+    for (int32_t k = 0; k < words; ++k) x[k] ^= c[k];
+  };
+  auto kind_of = [&](const Z2Vector& c) {
+    bool handle_part = false, tunnel_part = false;
+    for (int32_t k = 0; k < words; ++k) {
+      const uint64_t w = c.words[k];
+      if (!w) continue;
+      const int32_t lo = 64 * k;  // bits lo..lo+63 of this word; bit i is a handle when i < g
+      const uint64_t handle_mask = g <= lo ? 0 : g - lo >= 64 ? ~uint64_t(0) : (uint64_t(1) << (g - lo)) - 1;
+      if (w & handle_mask) handle_part = true;
+      if (w & ~handle_mask) tunnel_part = true;
+    }
+    if (handle_part == tunnel_part) return int32_t(kNeither);  // mixed, or the zero class
+    return handle_part ? int32_t(kHandle) : int32_t(kTunnel);
   };
 
   std::vector<Candidate> candidates;
@@ -136,7 +187,7 @@ std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomo
   // The simple pieces of the persistence cycles.
   for (const auto* c : ordered)
     for (auto& loop : simple_cycles(s, c->edges)) {
-      Z2Vector cls = h.class_of_loop(s, loop);
+      Z2Vector cls = in_cycle_basis(h.class_of_loop(s, loop));
       const int32_t kind = kind_of(cls);
       if (kind == kNeither) continue;
       const double length = loop_length(s, loop, weight);
@@ -152,8 +203,10 @@ std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomo
       roots.push_back(v);
     }
   };
+  // One root on every cycle before the second on any: the short loops of every handle appear
+  // early, so the cutoff below falls early.
+  for (const auto* c : ordered) add_root(s.edge_vertices[2 * size_t(c->generator_edge)]);
   for (const auto* c : ordered) {
-    add_root(s.edge_vertices[2 * size_t(c->generator_edge)]);
     const size_t k = c->edges.size();
     for (size_t i = 1; i <= 3 && k; ++i) add_root(s.edge_vertices[2 * size_t(c->edges[(i * k) / 4 % k])]);
   }
@@ -161,7 +214,6 @@ std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomo
   max_roots = std::min(max_roots, n);
 
   ShortestPaths sp(s, weight);
-  const int32_t words = (dim + 63) / 64;
   std::vector<uint64_t> prefix(size_t(words) * n);
   std::vector<double> nearest_root(n, ShortestPaths::kInfinity);
   std::vector<uint32_t> mark(n, 0);
@@ -171,10 +223,22 @@ std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomo
     int32_t edge, kind;
   };
   std::vector<Local> local;
+  // No loop longer than `cutoff` can be chosen: the candidates found so far that are at most
+  // that long already span both subspaces, and the final pick takes loops shortest first. So
+  // each root only grows its tree to that distance and looks at the edges inside it, and longer
+  // candidates are dropped: once every handle has a root nearby, a root costs what lies near it,
+  // not the whole surface, and the selection grows about linearly with the genus.
+  double cutoff = ShortestPaths::kInfinity;
+  auto lower_cutoff = [&]() {
+    const auto picked = pick_shortest(candidates, dim, g);
+    if (int32_t(picked[0].size()) < g || int32_t(picked[1].size()) < g) return;
+    cutoff = std::max(picked[0].back()->length, picked[1].back()->length);
+    while (!candidates.empty() && candidates.back().length > cutoff) candidates.pop_back();
+  };
   for (size_t r = 0; r < roots.size() && int32_t(r) < max_roots; ++r) {
     if (progress) progress->update(double(r) / max_roots);
     const int32_t root = roots[r];
-    sp.run({root}, [](int32_t) { return true; });
+    sp.run({root}, [](int32_t) { return true; }, [](int32_t) { return true; }, -1, cutoff);
     // Class of the tree path from the root to each vertex.
     for (int32_t v : sp.settled()) {
       uint64_t* pv = &prefix[size_t(words) * v];
@@ -183,34 +247,41 @@ std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomo
         std::fill(pv, pv + words, 0);
       } else {
         std::copy(&prefix[size_t(words) * p], &prefix[size_t(words) * p] + words, pv);
-        h.add_edge(pv, sp.parent_edge(v));
+        add_edge(pv, sp.parent_edge(v));
       }
       nearest_root[v] = std::min(nearest_root[v], sp.distance(v));
     }
-    // Fundamental cycles of the non-tree edges, shortest (through the root) first.
+    // Fundamental cycles of the non-tree edges between settled vertices, shortest (through the
+    // root) first.
     local.clear();
     Z2Vector cls(dim);
-    for (int32_t e = 0; e < s.num_edges(); ++e) {
-      const int32_t a = s.edge_vertices[2 * size_t(e)], b = s.edge_vertices[2 * size_t(e) + 1];
-      if (sp.parent_edge(a) == e || sp.parent_edge(b) == e) continue;
-      for (int32_t k = 0; k < words; ++k) cls.words[k] = prefix[size_t(words) * a + k] ^ prefix[size_t(words) * b + k];
-      h.add_edge(cls, e);
-      if (cls.zero()) continue;
-      const int32_t kind = kind_of(cls);
-      if (kind != kNeither) local.push_back({sp.distance(a) + weight[e] + sp.distance(b), e, kind});
-    }
-    std::sort(local.begin(), local.end(), [](const Local& x, const Local& y) {
-      return std::tie(x.bound, x.edge) < std::tie(y.bound, y.edge);
-    });
+    for (int32_t a : sp.settled())
+      for (int32_t i = s.adjacency_offsets[a]; i < s.adjacency_offsets[a + 1]; ++i) {
+        const int32_t b = s.adjacency[i], e = s.adjacency_edge[i];
+        if (b < a || !sp.is_settled(b) || sp.parent_edge(a) == e || sp.parent_edge(b) == e) continue;
+        const double bound = sp.distance(a) + weight[e] + sp.distance(b);
+        if (bound > cutoff) continue;
+        for (int32_t k = 0; k < words; ++k) cls.words[k] = prefix[size_t(words) * a + k] ^ prefix[size_t(words) * b + k];
+        add_edge(cls.words.data(), e);
+        const int32_t kind = kind_of(cls);
+        if (kind != kNeither) local.push_back({bound, e, kind});
+      }
+    // Taken shortest first from a heap: the loop below usually stops long before the end, so a
+    // full sort of every non-tree edge per root would be wasted (same order: the key is total).
+    auto later = [](const Local& x, const Local& y) { return std::tie(x.bound, x.edge) > std::tie(y.bound, y.edge); };
+    std::make_heap(local.begin(), local.end(), later);
     Z2Basis kept[2] = {Z2Basis(dim), Z2Basis(dim)};
-    for (const Local& c : local) {
+    while (!local.empty()) {
+      std::pop_heap(local.begin(), local.end(), later);
+      const Local c = local.back();
+      local.pop_back();
       if (kept[c.kind].rank() == g) {
         if (kept[1 - c.kind].rank() == g) break;
         continue;
       }
       const int32_t a = s.edge_vertices[2 * size_t(c.edge)], b = s.edge_vertices[2 * size_t(c.edge) + 1];
       for (int32_t k = 0; k < words; ++k) cls.words[k] = prefix[size_t(words) * a + k] ^ prefix[size_t(words) * b + k];
-      h.add_edge(cls, c.edge);
+      add_edge(cls.words.data(), c.edge);
       if (!kept[c.kind].insert(cls)) continue;
       // The simple cycle: tree paths from a and b up to their lowest common ancestor.
       ++mark_stamp;
@@ -227,6 +298,8 @@ std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomo
       const double length = loop_length(s, loop, weight);
       candidates.push_back({length, c.kind, order++, std::move(loop), cls});
     }
+    // Often enough to follow the cutoff down, rarely enough that the picks cost little.
+    if ((r & (r + 1)) == 0 || r % 64 == 63) lower_cutoff();
     // Next root: the persistence-cycle roots first, then the vertex farthest from all roots.
     if (r + 1 == roots.size() && int32_t(roots.size()) < max_roots) {
       int32_t far = -1;
@@ -237,25 +310,16 @@ std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomo
   }
 
   // Shortest first, keep what extends the handle or the tunnel basis.
-  std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
-    return std::tie(x.length, x.order) < std::tie(y.length, y.order);
-  });
-  Z2Basis chosen[2] = {Z2Basis(dim), Z2Basis(dim)};
-  std::vector<const Candidate*> picked[2];
-  for (const auto& c : candidates)
-    if (chosen[c.kind].rank() < g && chosen[c.kind].insert(c.cls)) picked[c.kind].push_back(&c);
-  if (chosen[0].rank() < g || chosen[1].rank() < g)
-    throw std::logic_error("found only " + std::to_string(chosen[0].rank()) + " handle and " +
-                           std::to_string(chosen[1].rank()) + " tunnel loops that are simple, of " + std::to_string(g));
+  const auto picked = pick_shortest(candidates, dim, g);
+  if (int32_t(picked[0].size()) < g || int32_t(picked[1].size()) < g)
+    throw std::logic_error("found only " + std::to_string(picked[0].size()) + " handle and " +
+                           std::to_string(picked[1].size()) + " tunnel loops that are simple, of " + std::to_string(g));
 
   // Match loops with generator edges through their coefficients in the persistence basis.
   for (int32_t kind : {int32_t(kHandle), int32_t(kTunnel)}) {
     std::vector<std::vector<uint8_t>> coefficient(g, std::vector<uint8_t>(g, 0));
-    for (int32_t k = 0; k < g; ++k) {
-      Z2Vector used;
-      kind_of(picked[kind][k]->cls, &used);
-      for (int32_t i = 0; i < g; ++i) coefficient[k][i] = used.get(kind == kHandle ? i : g + i);
-    }
+    for (int32_t k = 0; k < g; ++k)
+      for (int32_t i = 0; i < g; ++i) coefficient[k][i] = picked[kind][k]->cls.get(kind == kHandle ? i : g + i);
     const auto cycle_of_loop = match(coefficient);
     for (int32_t k = 0; k < g; ++k) {
       SelectedLoop loop;

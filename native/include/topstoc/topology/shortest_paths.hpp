@@ -79,6 +79,8 @@ class ShortestPaths {
   }
   /// Settled vertices, in order of distance.
   const std::vector<int32_t>& settled() const { return settled_; }
+  /// Whether the last run settled v (its distance and parent are final).
+  bool is_settled(int32_t v) const { return settled_flag_[v] == run_; }
 
   static constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
