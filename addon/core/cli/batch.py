@@ -40,6 +40,9 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--blender", metavar="PATH",
                         help="Blender executable, or a Python with PyPI's bpy, for Blender formats "
                              "(default: $TOPSTOC_BLENDER or blender on PATH)")
+    parser.add_argument("--chunk", metavar="I/N",
+                        help="run only the I-th of N chunks of the inputs (1-based, every N-th file of the "
+                             "sorted list), for farm managers; manifest and report get a -chunkIofN suffix")
     parser.add_argument("--json", metavar="REPORT.json", help=f"report file (default DIR/{REPORT_NAME})")
     parser.add_argument("--no-resume", action="store_true", help="redo assets the manifest lists as done")
     parser.add_argument("--progress", choices=("auto", "bar", "lines"), default="auto",
@@ -104,14 +107,33 @@ def _summary(entry: dict) -> str:
     return f"{entry['vertices_in']} -> {entry['vertices_out']} vertices, {entry['triangles_out']} triangles"
 
 
+def parse_chunk(text: str) -> tuple:
+    """'2/8' -> (2, 8); ValueError unless 1 <= I <= N."""
+    try:
+        index, count = (int(part) for part in text.split("/"))
+    except ValueError:
+        raise ValueError(f"--chunk must look like I/N (e.g. 2/8), got {text!r}") from None
+    if not 1 <= index <= count:
+        raise ValueError(f"--chunk I/N needs 1 <= I <= N, got {text!r}")
+    return index, count
+
+
 def run(args) -> int:
     settings = batch_settings.from_args(args)
     started = time.perf_counter()
     inputs = find_inputs(args.input)
+    suffix = ""
+    if args.chunk:
+        index, count = parse_chunk(args.chunk)
+        inputs = inputs[index - 1::count]
+        suffix = f"-chunk{index}of{count}"
     if not inputs:
+        if args.chunk:  # more chunks than files: an empty chunk is not an error
+            print(f"topstoc batch: chunk {args.chunk} has no inputs", flush=True)
+            return 0
         raise ValueError("no input assets found")
     os.makedirs(args.output, exist_ok=True)
-    manifest = Manifest(args.output)
+    manifest = Manifest(args.output, suffix)
     fingerprint = batch_settings.digest(settings)
     tasks, keys, skipped = [], {}, []
     for index, path in enumerate(inputs):
@@ -151,7 +173,7 @@ def run(args) -> int:
             progress.advance(path, f"FAILED: {outcome['message']}", failed=True)
         manifest.append(record)
 
-    workers = os.cpu_count() or 1 if args.workers is None else args.workers
+    workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     if workers < 0:
         raise ValueError(f"--workers must be 0 (serial) or more, got {workers}")
 
@@ -176,7 +198,7 @@ def run(args) -> int:
               "seconds": time.perf_counter() - started,
               "results": [results[i] for i in sorted(results)],
               "failures": [failures[i] for i in sorted(failures)], "skipped": skipped}
-    report_path = args.json or os.path.join(args.output, REPORT_NAME)
+    report_path = args.json or os.path.join(args.output, REPORT_NAME.replace(".json", suffix + ".json"))
     temporary = f"{report_path}.tmp{os.getpid()}"
     with open(temporary, "w") as stream:
         json.dump(report, stream, indent=2, default=lambda v: v.tolist() if hasattr(v, "tolist") else str(v))
