@@ -51,8 +51,15 @@ def _params(settings: dict):
     return SimpleNamespace(target_mode="RATIO", **settings["options"])
 
 
+def _bone_shapes(bpy) -> set:
+    """Meshes drawn as bones (e.g. the glTF importer's "Icosphere"): not part of the asset."""
+    return {bone.custom_shape.name for obj in bpy.context.scene.objects if obj.type == "ARMATURE" and obj.pose
+            for bone in obj.pose.bones if bone.custom_shape is not None}
+
+
 def _mesh_objects(bpy, path: str, names) -> list:
-    objects = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+    shapes = _bone_shapes(bpy)
+    objects = [o for o in bpy.context.scene.objects if o.type == "MESH" and o.name not in shapes]
     if names:
         missing = [name for name in names if bpy.data.objects.get(name) is None]
         if missing:
