@@ -246,3 +246,14 @@ def test_lod_chain_in_one_file_and_one_file_per_lod(ts, scene, tmp_path):
         assert obj.name == f"Body_LOD{index}"
         assert len(obj.data.polygons) == entry["objects"][0]["lods"][index]["triangles"]
     assert json.dumps(entry)  # the report entry is plain JSON
+
+
+def test_usd_without_usd_support_is_a_clear_failure(ts, scene, tmp_path):
+    if bpy.app.build_options.usd:
+        pytest.skip("this Blender has USD")
+    source = tmp_path / "asset.usdc"
+    source.write_bytes(b"PXR-USDC")
+    batch_run = importlib.import_module(ts.__name__ + ".core.batch_run")
+    outcome = batch_run.run_asset(str(source), str(tmp_path), _settings(ts, "--ratio", "0.5"), _runner())
+    assert outcome["status"] == "failed"
+    assert "built without USD" in outcome["message"], outcome["message"]
