@@ -48,8 +48,10 @@ def find_inputs(paths) -> list:
         if os.path.isdir(path):
             names = sorted(os.path.join(root, name) for root, _, files in os.walk(path) for name in files
                            if asset_kind(name) is not None)
-        else:
+        elif os.path.exists(path):
             names = [path]
+        else:
+            raise FileNotFoundError(f"{path}: no such file or folder")
         for name in names:
             if os.path.abspath(name) not in seen:
                 seen.add(os.path.abspath(name))

@@ -90,8 +90,11 @@ def _check_names(tasks, out_dir, settings) -> None:
 
     owners = {}
     for _, path in tasks:
-        names = output_paths(path, out_dir, settings) if asset_kind(path) == "mesh" else \
-            [os.path.join(out_dir, os.path.basename(path))]
+        if asset_kind(path) == "mesh":
+            names = output_paths(path, out_dir, settings)
+        else:
+            stem, ext = os.path.splitext(os.path.basename(path))
+            names = [os.path.join(out_dir, stem + ("." + settings["format"] if settings["format"] else ext.lower()))]
         for name in names:
             if name in owners:
                 raise ValueError(f"{owners[name]} and {path} would both write {name}; "
