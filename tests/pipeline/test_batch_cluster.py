@@ -197,3 +197,40 @@ def test_openjd_template_runs_the_chunks(library, serial, tmp_path):
     assert outputs(out) == expected
     reports = [report(out, f"topstoc-report-chunk{i}of3.json") for i in (1, 2, 3)]
     assert sorted(len(r["results"]) for r in reports) == [3, 3, 4]
+
+
+MAKE_BLEND = """
+import sys, bpy
+sys.path.insert(0, {tests!r})
+import meshgen
+for obj in list(bpy.data.objects):
+    bpy.data.objects.remove(obj)
+v, f = meshgen.torus(24, 12)
+mesh = bpy.data.meshes.new("Ring")
+mesh.from_pydata(v.tolist(), [], f.tolist())
+bpy.context.scene.collection.objects.link(bpy.data.objects.new("Ring", mesh))
+bpy.ops.wm.save_as_mainfile(filepath={path!r})
+"""
+
+
+def test_blender_assets_run_a_blender_per_task(library, tmp_path):
+    blender = shutil.which("blender")
+    if blender is None:
+        pytest.skip("no blender on PATH")
+    inputs = tmp_path / "inputs"
+    inputs.mkdir()
+    scene = inputs / "scene.blend"
+    subprocess.run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr",
+                    MAKE_BLEND.format(tests=str(ROOT / "tests"), path=str(scene))],
+                   check=True, capture_output=True, timeout=300)
+    shutil.copy(library[0], inputs)
+    out = tmp_path / "out"
+    done = batch("--input", inputs, "--output", out, "--ratio", "0.25", "0.1", "--workers", 2, "--blender", blender)
+    assert done.returncode == 0, done.stdout + done.stderr
+    data = report(out)
+    by_name = {pathlib.Path(r["input"]).name: r for r in data["results"]}
+    [ring] = by_name["scene.blend"]["objects"]
+    assert [lod["object"] for lod in ring["lods"]] == ["Ring_LOD0", "Ring_LOD1"]
+    assert all(abs(lod["vertices"] - r * 288) <= 3 for lod, r in zip(ring["lods"], (0.25, 0.1)))
+    assert (out / "scene.blend").is_file() and not list(out.glob(".topstoc-partial*"))
+    assert len(by_name[library[0].name]["lods"]) == 2
