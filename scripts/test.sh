@@ -28,6 +28,17 @@ if [ ! -x $VENV2/bin/python ] || ! $VENV2/bin/python -c "import numpy, scipy, gu
     echo "warning: could not prepare $VENV2; the NumPy 2 suite will fail" >&2
 fi
 
+# The batch at studio scale (tests/pipeline): dask.distributed, tqdm and openjd-cli from PyPI, in a
+# venv cached outside the checkout (system site packages: numpy, pytest from Debian).
+PIPELINE_VENV=${TOPSTOC_CACHE:-/var/cache/topstoc}/venv-pipeline
+if [ ! -x $PIPELINE_VENV/bin/python ] || ! $PIPELINE_VENV/bin/python -c "import distributed, tqdm" 2>/dev/null ||
+   [ ! -x $PIPELINE_VENV/bin/openjd ]; then
+  echo "== preparing $PIPELINE_VENV (dask, distributed, tqdm, openjd-cli from PyPI)"
+  mkdir -p "$(dirname $PIPELINE_VENV)" && /usr/bin/python3 -m venv --system-site-packages $PIPELINE_VENV &&
+    $PIPELINE_VENV/bin/pip install -q --disable-pip-version-check dask distributed tqdm openjd-cli ||
+    echo "warning: could not prepare $PIPELINE_VENV; the pipeline suite will fail" >&2
+fi
+
 failed=()
 run() {  # run NAME COMMAND...
   local name=$1; shift
@@ -38,6 +49,8 @@ PYTEST_ARGS=(-q -p no:cacheprovider)
 run "C++ engine (doctest, ctest)" /usr/bin/ctest --test-dir build --output-on-failure
 run "engine and Python API (python3 + pymeshlab)" $VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/python
 run "Python API with NumPy 2 (PyPI)" $VENV2/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/python
+run "batch on Dask and OpenJD (venv-pipeline)" env PATH="$PIPELINE_VENV/bin:$PATH" \
+  $PIPELINE_VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/pipeline
 if [ -d tests/blender ]; then
   run "add-on in Blender $(blender -v 2>/dev/null | head -1 | awk '{print $2}')" \
     blender -b --factory-startup --python-exit-code 1 --python-expr \

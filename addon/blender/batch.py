@@ -1,11 +1,17 @@
-"""Batch decimation inside Blender: mesh files and .blend files (docs/design.md §6).
+"""Batch decimation inside Blender (or PyPI's bpy): mesh files and Blender's own formats (docs/design.md §6).
 
-Mesh files (OBJ, PLY, OFF, STL, optionally .gz/.bz2) go through topstoc.core.io in the file's
-own vertex order and are written in the same format, with UVs, vertex colours and materials
-carried over; UV seams and material borders are kept. A .blend file is opened, its mesh
-objects (all, or those named with --objects) are decimated in place with the guidance stored
-on them, and the file is saved under the output folder. One progress line per input, a JSON
-report, and exit code 1 when any input failed (the others are still processed).
+Mesh files (OBJ, PLY, OFF, STL, optionally .gz/.bz2) go through topstoc.core.batch_mesh (the
+same code ``topstoc batch`` runs without Blender). .blend files are opened; glTF/GLB, FBX and
+USD are imported with Blender's importers into an empty scene. Their mesh objects (all, or
+those named with --objects) are decimated with the add-on's pipeline (the Guided Decimate
+operator's: guidance stored on the objects, UVs, colours, materials, vertex groups and
+whatever else the pipeline carries) and the scene is written back with Blender's exporter
+(the input's format, or --format), atomically. A LOD chain (several target values) makes
+objects ``<name>_LOD0 … _LODn`` next to each source object (which is then removed), all in one
+file, or one file per LOD (``<stem>_LOD<i>.<ext>``) with --lod-files. Screen-size targets use
+the bounding sphere of all decimated meshes in world space (the asset's screen size). One
+progress line per input, a JSON report (per LOD: counts and the measured Hausdorff error),
+exit code 1 when any input failed (the others are still processed).
 """
 
 from __future__ import annotations
@@ -16,9 +22,13 @@ import os
 import sys
 import time
 import traceback
+from types import SimpleNamespace
 
+import numpy as np
 
-from ..core.mesh import Mesh
+from ..core import batch_settings
+from ..core.batch_mesh import decimate_mesh_file, lod_error
+from ..core.prune import prune_small_parts
 
 BLEND = ".blend"
 
@@ -26,148 +36,192 @@ BLEND = ".blend"
 def parse_args(argv):
     parser = argparse.ArgumentParser(
         prog="blender -b --python topstoc/batch.py --",
-        description="Decimate meshes and .blend files with TopStoc.")
+        description="Decimate mesh files, .blend, glTF/GLB, FBX and USD files with TopStoc.")
     parser.add_argument("--input", nargs="+", required=True, metavar="FILE",
-                        help="mesh files (.obj .ply .off .stl, optionally .gz/.bz2) or .blend files")
-    target = parser.add_mutually_exclusive_group(required=True)
-    target.add_argument("--ratio", type=float, help="fraction of the vertices to keep, in (0, 1]")
-    target.add_argument("--vertices", type=int, help="output vertex count")
-    target.add_argument("--triangles", type=int, help="output triangle count")
-    target.add_argument("--max-error", metavar="E[%]",
-                        help="largest Hausdorff deviation, absolute or in %% of the bounding-box diagonal")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--adaptivity", type=float, default=0.5)
-    parser.add_argument("--density", choices=("off", "uniform", "adaptive"), default="off")
-    parser.add_argument("--placement", choices=("subsample", "filtered"), default="subsample")
-    parser.add_argument("--refine", type=int, default=0, metavar="F",
-                        help="0: off; F: TopStoc to F x the target, then quadric collapses (8: quality)")
-    parser.add_argument("--objects", nargs="+", metavar="NAME", help="objects to decimate in .blend inputs "
-                                                                      "(default: every mesh object)")
+                        help="mesh files (.obj .ply .off .stl, optionally .gz/.bz2), .blend, .gltf/.glb, "
+                             ".fbx or .usd/.usda/.usdc files")
     parser.add_argument("--output", required=True, metavar="DIR")
     parser.add_argument("--json", metavar="REPORT.json", help="write the report here")
+    batch_settings.add_arguments(parser)
     return parser.parse_args(argv)
 
 
-def _target(args, diagonal: float) -> dict:
-    if args.ratio is not None:
-        return {"ratio": args.ratio}
-    if args.vertices is not None:
-        return {"target_vertices": args.vertices}
-    if args.triangles is not None:
-        return {"target_triangles": args.triangles}
-    text = args.max_error.strip()
-    try:
-        if text.endswith("%"):
-            return {"max_error": float(text[:-1]) / 100.0, "relative": True}
-        return {"max_error": float(text)}
-    except ValueError:
-        raise ValueError(f"--max-error must be a number or a percentage, got '{args.max_error}'") from None
+def _params(settings: dict):
+    """The pipeline's parameter holder (its options; the target is passed explicitly)."""
+    return SimpleNamespace(target_mode="RATIO", **settings["options"])
 
 
-def _options(args) -> dict:
-    return dict(seed=args.seed, adaptivity=args.adaptivity, density=args.density, placement=args.placement,
-                refine=args.refine)
+def _bone_shapes(bpy) -> set:
+    """Meshes drawn as bones (e.g. the glTF importer's "Icosphere"): not part of the asset."""
+    return {bone.custom_shape.name for obj in bpy.context.scene.objects if obj.type == "ARMATURE" and obj.pose
+            for bone in obj.pose.bones if bone.custom_shape is not None}
 
 
-def decimate_mesh_file(path: str, out_dir: str, args) -> dict:
-    """Decimates one mesh file; returns its report entry."""
-    from ..core import attributes, io
-
-    data = io.read_mesh(path)
-    if data.num_triangles == 0:
-        raise ValueError(f"{path}: no faces to decimate")
-    start = time.perf_counter()
-    mesh = Mesh(data.vertices, data.triangles)
-    borders = None
-    if data.corner_uvs is not None:
-        seams = attributes.uv_seam_edges(data.triangles, data.corner_uvs)
-        borders = seams if len(seams) else None
-    result = mesh.decimate(**_target(args, mesh.diagonal), **_options(args), borders=borders,
-                           regions=attributes.material_regions(data))
-    seconds = time.perf_counter() - start
-    out = attributes.transfer_attributes(data, result)
-    target = os.path.join(out_dir, os.path.basename(path))
-    io.write_mesh(target, out)
-    return {"input": path, "output": target, "vertices_in": data.num_vertices,
-            "vertices_out": result.num_vertices, "triangles_out": result.num_triangles,
-            "seconds": seconds, "repairs": result.stats.repairs, "error": _achieved_error(result)}
-
-
-def _achieved_error(result):
-    """The measured symmetric Hausdorff error for --max-error runs, else None."""
-    bound = getattr(result, "error_bound", None)
-    return None if bound is None else float(bound.achieved_error)
-
-
-class _Params:
-    """DecimationParameters for the pipeline from the command line."""
-
-    def __init__(self, args, target: dict):
-        self.target_mode = {"ratio": "RATIO", "target_vertices": "VERTICES", "target_triangles": "TRIANGLES",
-                            "max_error": "MAX_ERROR"}[next(iter(target))]
-        self.ratio = args.ratio or 0.1
-        self.vertices = args.vertices or 1
-        self.triangles = args.triangles or 1
-        self.max_error = target.get("max_error", 0.0) * (100.0 if target.get("relative") else 1.0)
-        self.max_error_relative = bool(target.get("relative"))
-        self.seed, self.adaptivity, self.density = args.seed, args.adaptivity, args.density
-        self.placement, self.refine = args.placement, args.refine
-
-
-def decimate_blend_file(path: str, out_dir: str, args) -> dict:
-    """Decimates the mesh objects of a .blend file in place and saves a copy in ``out_dir``."""
-    import bpy
-
-    from . import pipeline
-
-    if not os.path.isfile(path):
-        raise FileNotFoundError(f"{path}: no such file")
-    bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
-    objects = [o for o in bpy.data.objects if o.type == "MESH"]
-    if args.objects:
-        missing = [name for name in args.objects if bpy.data.objects.get(name) is None]
+def _mesh_objects(bpy, path: str, names) -> list:
+    shapes = _bone_shapes(bpy)
+    objects = [o for o in bpy.context.scene.objects if o.type == "MESH" and o.name not in shapes]
+    if names:
+        missing = [name for name in names if bpy.data.objects.get(name) is None]
         if missing:
             raise ValueError(f"{path}: no object named {', '.join(repr(m) for m in missing)}")
-        objects = [bpy.data.objects[name] for name in args.objects]
+        objects = [bpy.data.objects[name] for name in names]
         wrong = [o.name for o in objects if o.type != "MESH"]
         if wrong:
             raise ValueError(f"{path}: {', '.join(wrong)} is not a mesh object")
     if not objects:
         raise ValueError(f"{path}: no mesh objects")
-    entries, seconds = [], 0.0
-    vertices_in = vertices_out = triangles_out = 0
+    return objects
+
+
+def _world_vertices(objects) -> np.ndarray:
+    """Every vertex of ``objects`` in world space (for the asset's bounding sphere)."""
+    chunks = []
+    for obj in objects:
+        count = len(obj.data.vertices)
+        local = np.empty(count * 3, dtype=np.float64)
+        obj.data.vertices.foreach_get("co", local)
+        matrix = np.array(obj.matrix_world, dtype=np.float64)
+        local = local.reshape(-1, 3)
+        chunks.append(local @ matrix[:3, :3].T + matrix[:3, 3])
+    return np.concatenate(chunks) if chunks else np.zeros((0, 3))
+
+
+def _world_scale(obj) -> float:
+    """Largest scale factor of the object's world matrix: local lengths x this = world lengths."""
+    return float(max(abs(s) for s in obj.matrix_world.to_scale())) or 1.0
+
+
+def _copy_armature_modifiers(source, target) -> None:
+    """A LOD object must deform like its source for skinned export: copy Armature modifiers when
+    the pipeline did not already copy the source's modifiers."""
+    if len(target.modifiers):
+        return
+    for modifier in source.modifiers:
+        if modifier.type == "ARMATURE":
+            copy = target.modifiers.new(modifier.name, "ARMATURE")
+            copy.object = modifier.object
+            copy.use_vertex_groups = modifier.use_vertex_groups
+            copy.use_bone_envelopes = modifier.use_bone_envelopes
+
+
+def _decimate_object(bpy, pipeline, obj, settings, targets) -> tuple:
+    """Decimates one object once per LOD; returns (report entry, LOD objects)."""
+    scale = _world_scale(obj)
+    n = len(obj.data.vertices)
+    lods, lod_objects = [], []
+    for index, (target, screen) in enumerate(targets):
+        if screen is not None:  # world units -> the object's own units
+            target = {"max_error": target["max_error"] / scale}
+        run = pipeline.decimate(bpy.context, obj, _params(settings), target=target)
+        entry = {"lod": index, "target": target}
+        if screen is not None and settings["prune_pixels"] > 0:
+            run.result, pruned = prune_small_parts(run.result, settings["prune_pixels"] * screen.world_per_pixel / scale)
+            entry["pruned"] = pruned.as_dict()
+        bound = getattr(run.result, "error_bound", None)
+        error = lod_error(run.prepared.mesh, run.result, None)
+        error["hausdorff_world"] = error["hausdorff"] * scale
+        if screen is not None:
+            error["hausdorff_pixels"] = screen.to_pixels(error["hausdorff_world"])
+            error["screen"] = screen.as_dict()
+        entry.update(vertices=run.result.num_vertices, triangles=run.result.num_triangles,
+                     repairs=run.result.stats.repairs, seconds=run.seconds,
+                     search_error=None if bound is None else float(bound.achieved_error), **error)
+        if settings["chain"]:
+            name = batch_settings.lod_name(obj.name, index, settings)
+            lod = pipeline.write_output(run, "NEW_OBJECT", name=name)
+            lod.name = name  # the source keeps its name until it is removed below
+            _copy_armature_modifiers(obj, lod)
+            entry["object"] = lod.name
+            lod_objects.append(lod)
+        else:
+            pipeline.write_output(run, "IN_PLACE")
+        lods.append(entry)
+    report = {"object": obj.name, "vertices_in": n, "vertices_out": lods[0]["vertices"],
+              "triangles_out": lods[0]["triangles"], "seconds": sum(lod["seconds"] for lod in lods),
+              "repairs": lods[0]["repairs"], "error": lods[0]["search_error"], "lods": lods}
+    return report, lod_objects
+
+
+def _rename_chain(bpy, sources, chains) -> None:
+    """Removes the sources of a LOD chain and gives their LODs the final ``<name>_LOD<i>`` names."""
+    for source, lods in zip(sources, chains):
+        name = source.name
+        children = list(source.children)
+        mesh = source.data
+        bpy.data.objects.remove(source)
+        if mesh.users == 0:
+            bpy.data.meshes.remove(mesh)
+        for index, lod in enumerate(lods):
+            lod.name = f"{name}_LOD{index}"
+        for child in children:  # children of a removed source hang under its LOD0
+            if lods:
+                child.parent = lods[0]
+
+
+def decimate_scene_file(path: str, out_dir: str, settings: dict) -> dict:
+    """Decimates the mesh objects of a .blend, glTF/GLB, FBX or USD file and writes the result."""
+    import bpy
+
+    from . import pipeline, scene_io
+
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"{path}: no such file")
+    if path.lower().endswith(BLEND):
+        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
+    else:
+        scene_io.import_file(path)
+    objects = _mesh_objects(bpy, path, settings["objects"])
+    asset = _world_vertices(objects)
+    targets = batch_settings.engine_targets(settings, asset)
+    entries, chains, sources = [], [], []
     done = set()
     for obj in objects:
-        if obj.data.name in done:  # a mesh shared by several objects is decimated once
+        if obj.data.name in done and not settings["chain"]:  # a shared mesh is decimated once
             continue
         done.add(obj.data.name)
-        n = len(obj.data.vertices)
-        prepared = pipeline.prepare(obj)
-        params = _Params(args, _target(args, prepared.mesh.diagonal))
-        run = pipeline.decimate(bpy.context, obj, params)
-        pipeline.write_output(run, "IN_PLACE")
-        seconds += run.seconds
-        vertices_in += n
-        vertices_out += run.result.num_vertices
-        triangles_out += run.result.num_triangles
-        entries.append({"object": obj.name, "vertices_in": n, "vertices_out": run.result.num_vertices,
-                        "triangles_out": run.result.num_triangles, "seconds": run.seconds,
-                        "repairs": run.result.stats.repairs, "error": _achieved_error(run.result)})
-    target = os.path.join(out_dir, os.path.basename(path))
-    bpy.context.preferences.filepaths.save_version = 0  # no .blend1 backups next to the outputs
-    bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(target), copy=True)
-    return {"input": path, "output": target, "vertices_in": vertices_in, "vertices_out": vertices_out,
-            "triangles_out": triangles_out, "seconds": seconds, "error": None, "objects": entries}
+        entry, lod_objects = _decimate_object(bpy, pipeline, obj, settings, targets)
+        entries.append(entry)
+        if settings["chain"]:
+            sources.append(obj)
+            chains.append(lod_objects)
+    if settings["chain"]:
+        _rename_chain(bpy, sources, chains)
+        for entry, lods in zip(entries, chains):
+            for lod_entry, lod in zip(entry["lods"], lods):
+                lod_entry["object"] = lod.name
+
+    name = os.path.basename(path)
+    stem, ext = os.path.splitext(name)
+    ext = "." + settings["format"] if settings["format"] else ext
+    outputs = []
+    if settings["chain"] and settings["lod_files"]:
+        others = [o for o in bpy.context.scene.objects if o.type != "MESH"]  # armatures, empties
+        for index in range(len(targets)):
+            lod_set = [lods[index] for lods in chains] + others
+            outputs.append(scene_io.save(os.path.join(out_dir, f"{stem}_LOD{index}{ext}"), lod_set)[-1])
+    else:
+        outputs.append(scene_io.save(os.path.join(out_dir, stem + ext))[-1])
+    return {"input": path, "output": outputs[0], "outputs": outputs,
+            "vertices_in": sum(e["vertices_in"] for e in entries),
+            "vertices_out": sum(e["vertices_out"] for e in entries),
+            "triangles_out": sum(e["triangles_out"] for e in entries),
+            "seconds": sum(e["seconds"] for e in entries), "error": None, "objects": entries}
 
 
 def _register_addon() -> None:
-    """The .blend path reads guidance settings stored on objects: register the add-on's types."""
+    """Blender formats read the guidance settings of the scene and objects: register the add-on."""
     import bpy
 
     from .. import register
 
     if not hasattr(bpy.types.Object, "topstoc"):
         register()
+
+
+def _is_mesh_file(path: str) -> bool:
+    from ..core.batch_run import asset_kind
+
+    return asset_kind(path) == "mesh"
 
 
 def main(argv=None) -> int:
@@ -177,6 +231,11 @@ def main(argv=None) -> int:
         args = parse_args(argv)
     except SystemExit as exit_:
         return int(exit_.code or 0)
+    try:
+        settings = batch_settings.from_args(args)
+    except ValueError as error:
+        print(f"topstoc batch: error: {error}", file=sys.stderr, flush=True)
+        return 1
     os.makedirs(args.output, exist_ok=True)
     report = {"results": [], "failures": []}
     total = len(args.input)
@@ -184,13 +243,16 @@ def main(argv=None) -> int:
         prefix = f"topstoc batch [{i}/{total}] {path}"
         print(f"{prefix}: decimating ...", flush=True)
         try:
-            if path.lower().endswith(BLEND):
-                _register_addon()
-                entry = decimate_blend_file(path, args.output, args)
+            if _is_mesh_file(path):
+                entry = decimate_mesh_file(path, args.output, settings)
             else:
-                entry = decimate_mesh_file(path, args.output, args)
+                _register_addon()
+                entry = decimate_scene_file(path, args.output, settings)
         except Exception as error:  # one broken input must not stop the batch
-            message = str(error).splitlines()[0] if str(error) else type(error).__name__
+            lines = [line.strip() for line in str(error).splitlines() if line.strip()]
+            message = lines[0] if lines else type(error).__name__
+            if "Traceback" in message and len(lines) > 1:  # an importer's or exporter's own exception
+                message = "Blender: " + lines[-1]
             message = message[len("Error: "):] if message.startswith("Error: ") else message  # bpy.ops
             if not isinstance(error, (ValueError, OSError, RuntimeError)):
                 traceback.print_exc()
@@ -201,7 +263,9 @@ def main(argv=None) -> int:
         print(f"{prefix}: {entry['vertices_in']} -> {entry['vertices_out']} vertices, "
               f"{entry['triangles_out']} triangles in {entry['seconds']:.3f} s -> {entry['output']}", flush=True)
     if args.json:
-        with open(args.json, "w") as stream:
-            json.dump(report, stream, indent=2)
+        temporary = f"{args.json}.tmp{os.getpid()}"
+        with open(temporary, "w") as stream:
+            json.dump(report, stream, indent=2, default=lambda v: v.tolist() if hasattr(v, "tolist") else str(v))
+        os.replace(temporary, args.json)
     print(f"topstoc batch: {len(report['results'])} done, {len(report['failures'])} failed", flush=True)
     return 1 if report["failures"] else 0

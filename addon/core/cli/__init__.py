@@ -12,7 +12,7 @@ import json
 import sys
 
 # Subcommand modules, in the order --help lists them.
-SUBCOMMANDS = ("decimate", "measure", "topology", "loops", "edit")
+SUBCOMMANDS = ("decimate", "batch", "measure", "topology", "loops", "edit")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,93 @@
+"""One batch asset that is a mesh file (OBJ, PLY, OFF, STL, optionally .gz/.bz2), without Blender.
+
+The file is read in its own vertex order, decimated once per LOD (UV seams and material
+borders kept as borders, so UVs, vertex colours and materials carry over exactly), optionally
+pruned of small parts (screen targets), measured against the original with the project's
+Hausdorff distance and written atomically (topstoc.core.io.write_mesh: temporary file, then
+rename). A LOD chain gives one file per LOD, ``<stem>_LOD<i>.<ext>``.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+
+from . import batch_settings
+from .attributes import material_regions, transfer_attributes, uv_seam_edges
+from .hausdorff import hausdorff
+from .io import mesh_format, read_mesh, write_mesh
+from .mesh import Mesh
+from .prune import prune_small_parts
+
+#: samples on the original for the per-LOD error in the report: 100 per input triangle, within
+#: these bounds (dense enough on small assets, bounded cost on large ones)
+REPORT_SAMPLES = (10_000, 50_000)
+
+
+def output_paths(path: str, out_dir: str, settings: dict) -> list:
+    """The files the asset ``path`` is written to, one per LOD."""
+    kind, compression = mesh_format(path)
+    name = os.path.basename(os.fspath(path))
+    stem = name[:name.lower().rindex("." + kind)]
+    if settings["format"]:
+        kind, compression = mesh_format("x." + settings["format"])
+    ext = "." + kind + ("." + compression if compression else "")
+    return [os.path.join(out_dir, batch_settings.lod_name(stem, i, settings) + ext)
+            for i in range(len(settings["values"]))]
+
+
+def _relative_library(library: str, source: str, destination: str) -> str:
+    """An mtllib path that still points at the input's .mtl from the output's folder."""
+    here = os.path.join(os.path.dirname(os.path.abspath(source)), library)
+    if os.path.isabs(library) or not os.path.exists(here):
+        return library
+    return os.path.relpath(here, os.path.dirname(os.path.abspath(destination)))
+
+
+def lod_error(original, result, screen) -> dict:
+    """Measured symmetric Hausdorff error of a LOD (absolute, relative, in pixels)."""
+    low, high = REPORT_SAMPLES
+    samples = int(min(high, max(low, 100 * original.num_triangles)))
+    measured = hausdorff(original, result, samples=samples, percentile=0.0)
+    error = float(measured.symmetric.max)
+    entry = {"hausdorff": error, "hausdorff_samples": samples, "hausdorff_relative": error / measured.diagonal if measured.diagonal else 0.0}
+    if screen is not None:
+        entry["hausdorff_pixels"] = screen.to_pixels(error)
+        entry["screen"] = screen.as_dict()
+    return entry
+
+
+def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
+    """Decimates one mesh file into ``out_dir``; returns its report entry."""
+    outputs = output_paths(path, out_dir, settings)
+    data = read_mesh(path)
+    if data.num_triangles == 0:
+        raise ValueError(f"{path}: no faces to decimate")
+    start = time.perf_counter()
+    mesh = Mesh(data.vertices, data.triangles)
+    seams = None if data.corner_uvs is None else uv_seam_edges(data.triangles, data.corner_uvs)
+    layout = dict(regions=material_regions(data), borders=seams if seams is not None and len(seams) else None)
+    lods = []
+    for index, ((target, screen), output) in enumerate(zip(batch_settings.engine_targets(settings, data.vertices),
+                                                          outputs)):
+        started = time.perf_counter()
+        result = mesh.decimate(**target, **settings["options"], **layout)
+        entry = {"lod": index, "output": output, "target": target}
+        if screen is not None and settings["prune_pixels"] > 0:
+            result, pruned = prune_small_parts(result, settings["prune_pixels"] * screen.world_per_pixel)
+            entry["pruned"] = pruned.as_dict()
+        bound = getattr(result, "error_bound", None)
+        entry.update(vertices=result.num_vertices, triangles=result.num_triangles, repairs=result.stats.repairs,
+                     search_error=None if bound is None else float(bound.achieved_error),
+                     **lod_error(mesh, result, screen))
+        out = transfer_attributes(data, result)
+        out.material_libraries = [_relative_library(lib, path, output) for lib in out.material_libraries]
+        write_mesh(output, out)
+        entry["seconds"] = time.perf_counter() - started
+        lods.append(entry)
+    first = lods[0]
+    return {"input": os.fspath(path), "output": first["output"], "outputs": outputs,
+            "vertices_in": data.num_vertices, "triangles_in": data.num_triangles,
+            "vertices_out": first["vertices"], "triangles_out": first["triangles"],
+            "seconds": time.perf_counter() - start, "repairs": first["repairs"], "error": first["search_error"],
+            "lods": lods}

@@ -1,0 +1,196 @@
+"""Running batch assets: one task per asset, serially or on a Dask cluster.
+
+``run_asset`` is the task. Mesh files are decimated in the worker's own process
+(topstoc.core.batch_mesh); Blender formats (.blend, glTF/GLB, FBX, USD) run one Blender per
+asset: ``blender -b`` or a Python with PyPI's ``bpy`` (``--blender``), which runs the add-on's
+batch (topstoc.blender.batch) and writes its files atomically. A task never raises for a bad
+asset: it returns a failure record, so the other assets go on and Dask does not retry a
+deterministic failure. A worker that dies (killed, out of memory) is a different matter: Dask
+reschedules its tasks on the other workers; the outputs are written to temporary names and
+renamed, so a killed task leaves no half-written output.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import tempfile
+import time
+import traceback
+
+from . import batch_settings
+
+MESH_EXTENSIONS = (".obj", ".ply", ".off", ".stl")
+COMPRESSED = (".gz", ".bz2")
+
+
+def asset_kind(path: str):
+    """"mesh" for OBJ/PLY/OFF/STL (optionally compressed), "blender" for Blender's formats, else None."""
+    name = os.fspath(path).lower()
+    for suffix in COMPRESSED:
+        if name.endswith(suffix):
+            name = name[:-len(suffix)]
+    ext = os.path.splitext(name)[1]
+    if ext in MESH_EXTENSIONS:
+        return "mesh"
+    if ext[1:] in batch_settings.BLENDER_FORMATS:
+        return "blender"
+    return None
+
+
+def find_inputs(paths) -> list:
+    """Files named, and the supported files under folders named (sorted), in order, no repeats."""
+    found, seen = [], set()
+    for path in paths:
+        path = os.fspath(path)
+        if os.path.isdir(path):
+            names = sorted(os.path.join(root, name) for root, _, files in os.walk(path) for name in files
+                           if asset_kind(name) is not None)
+        elif os.path.exists(path):
+            names = [path]
+        else:
+            raise FileNotFoundError(f"{path}: no such file or folder")
+        for name in names:
+            if os.path.abspath(name) not in seen:
+                seen.add(os.path.abspath(name))
+                found.append(name)
+    return found
+
+
+def package_root() -> str:
+    """The folder holding the topstoc package (put on the Blender subprocess's sys.path)."""
+    return os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def blender_command(blender: str) -> list:
+    """The command that runs the add-on's batch with ``blender``: a Blender executable, or a Python
+    interpreter that has PyPI's ``bpy`` (its name starts with "python")."""
+    package = os.path.basename(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    if os.path.basename(blender).startswith("python"):
+        code = (f"import sys; sys.path.insert(0, {package_root()!r}); "
+                f"from {package}.blender.batch import main; sys.exit(main(sys.argv[1:]))")
+        return [blender, "-c", code]
+    script = os.path.join(package_root(), package, "batch.py")
+    return [blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python", script, "--"]
+
+
+def find_blender(blender: str = None) -> str:
+    """``blender`` itself, or the Blender on PATH; ValueError when there is none."""
+    found = blender or os.environ.get("TOPSTOC_BLENDER") or shutil.which("blender")
+    if not found:
+        raise ValueError("Blender formats (.blend, glTF, FBX, USD) need a Blender: install one (blender on PATH), "
+                         "or pass --blender /path/to/blender or --blender /venv/bin/python (with PyPI's bpy)")
+    return found
+
+
+def run_blender_asset(path: str, out_dir: str, settings: dict, blender: str) -> dict:
+    """One Blender-format asset through a Blender subprocess; its report entry."""
+    with tempfile.TemporaryDirectory(prefix="topstoc-batch-") as scratch:
+        report = os.path.join(scratch, "report.json")
+        command = blender_command(blender) + ["--input", os.path.abspath(path), "--output", os.path.abspath(out_dir),
+                                              "--json", report, *batch_settings.to_argv(settings)]
+        env = dict(os.environ)
+        env.pop("PYTHONPATH", None)  # the subprocess finds the package through the path given above
+        done = subprocess.run(command, capture_output=True, text=True, env=env, cwd=scratch)
+        if not os.path.exists(report):
+            tail = (done.stderr or done.stdout).strip().splitlines()[-3:]
+            raise RuntimeError(f"Blender exited with code {done.returncode} and no report: {' | '.join(tail)}")
+        with open(report) as stream:
+            data = json.load(stream)
+    if data["failures"]:
+        raise RuntimeError(data["failures"][0]["message"])
+    entry = data["results"][0]
+    entry["input"] = os.fspath(path)
+    return entry
+
+
+def run_asset(path: str, out_dir: str, settings: dict, blender: str = None) -> dict:
+    """The batch task: ``{"status": "done", "entry": ...}`` or ``{"status": "failed", "message": ...}``."""
+    started = time.perf_counter()
+    try:
+        kind = asset_kind(path)
+        if kind == "mesh":
+            from .batch_mesh import decimate_mesh_file
+
+            entry = decimate_mesh_file(path, out_dir, settings)
+        elif kind == "blender":
+            entry = run_blender_asset(path, out_dir, settings, find_blender(blender))
+        else:
+            raise ValueError(f"{path}: not a supported asset (mesh files {', '.join(MESH_EXTENSIONS)}, "
+                             f"or {', '.join('.' + f for f in batch_settings.BLENDER_FORMATS)})")
+    except Exception as error:  # one broken asset must not stop the batch
+        message = str(error).splitlines()[0] if str(error) else type(error).__name__
+        if not isinstance(error, (ValueError, OSError, RuntimeError)):
+            message += " (" + traceback.format_exc().strip().splitlines()[-1] + ")"
+        return {"status": "failed", "input": os.fspath(path), "message": message,
+                "wall_seconds": time.perf_counter() - started, "pid": os.getpid()}
+    return {"status": "done", "input": os.fspath(path), "entry": entry,
+            "wall_seconds": time.perf_counter() - started, "pid": os.getpid()}
+
+
+def run_serial(tasks, out_dir, settings, blender, on_result) -> None:
+    """Runs (index, path) tasks one after another in this process."""
+    for index, path in tasks:
+        on_result(index, run_asset(path, out_dir, settings, blender))
+
+
+def _local_cluster(workers: int):
+    from distributed import LocalCluster
+
+    threads = str(max(1, (os.cpu_count() or 1) // workers))  # the engine's OpenMP threads per worker
+    return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                        env={"OMP_NUM_THREADS": threads}, silence_logs=40)
+
+
+def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, scheduler: str = None,
+             on_start=None) -> None:
+    """Runs (index, path) tasks on a Dask cluster: ``scheduler`` (tcp://HOST:PORT) or a local
+    cluster of ``workers`` processes. ``on_start(client)`` is called once the workers are up."""
+    try:
+        from distributed import Client, as_completed
+    except ImportError:
+        raise ValueError("the Dask runner needs dask.distributed: pip install 'dask[distributed]' tqdm "
+                         "(or run serially with --workers 0)") from None
+    cluster = None if scheduler else _local_cluster(workers)
+    try:
+        with Client(scheduler or cluster) as client:
+            if on_start is not None:
+                on_start(client)
+            futures = {}
+            for index, path in tasks:
+                future = client.submit(run_asset, path, os.path.abspath(out_dir), settings, blender,
+                                       key=f"topstoc-batch-{index}-{os.path.basename(path)}", pure=False)
+                futures[future] = (index, path)
+            for future in as_completed(futures):
+                index, path = futures[future]
+                try:
+                    outcome = future.result()
+                except Exception as error:  # e.g. KilledWorker: the asset killed several workers
+                    outcome = {"status": "failed", "input": path,
+                               "message": f"{type(error).__name__}: {str(error).splitlines()[0] if str(error) else ''}"}
+                on_result(index, outcome)
+    finally:
+        if cluster is not None:
+            cluster.close()
+
+
+def remove_stale_temporaries(outputs) -> int:
+    """Removes temporaries a killed task left next to ``outputs``; returns how many."""
+    removed = 0
+    for output in outputs:
+        folder, name = os.path.split(output)
+        try:
+            names = os.listdir(folder or ".")
+        except OSError:
+            continue
+        for other in names:
+            if other.startswith(name + ".tmp"):
+                try:
+                    os.remove(os.path.join(folder, other))
+                    removed += 1
+                except OSError:
+                    pass
+    return removed
+

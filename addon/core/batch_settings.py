@@ -1,0 +1,151 @@
+"""Batch settings: the command-line options shared by ``topstoc batch`` and the Blender batch, and
+the plain dictionary they become (JSON-able: it keys the manifest and travels to workers and
+to the Blender subprocess unchanged).
+
+Targets take one value (one output) or several (a LOD chain ``_LOD0 … _LODn``, one LOD per
+value): ``--ratio 1 0.5 0.25``, ``--screen-pixels 800 200 50``. Screen-size targets
+(topstoc.core.screen_size) become a max-error target per asset.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+
+from .screen_size import DEFAULT_FOV_DEGREES, DEFAULT_PIXEL_ERROR, DEFAULT_RESOLUTION
+
+TARGET_KINDS = ("ratio", "vertices", "triangles", "max_error", "screen_pixels", "screen_distance")
+SCREEN_KINDS = ("screen_pixels", "screen_distance")
+#: Blender's own formats (imported and exported by Blender), by extension.
+BLENDER_FORMATS = ("blend", "gltf", "glb", "fbx", "usd", "usda", "usdc", "usdz")
+
+
+def add_arguments(parser) -> None:
+    """The batch options (everything but --input/--output and the runner's own options)."""
+    target = parser.add_mutually_exclusive_group(required=True)
+    target.add_argument("--ratio", type=float, nargs="+", metavar="R", help="fraction of the vertices to keep")
+    target.add_argument("--vertices", type=int, nargs="+", metavar="N", help="output vertex count")
+    target.add_argument("--triangles", type=int, nargs="+", metavar="N", help="output triangle count")
+    target.add_argument("--max-error", nargs="+", metavar="E[%]",
+                        help="largest Hausdorff deviation, absolute or in %% of the bounding-box diagonal")
+    target.add_argument("--screen-pixels", type=float, nargs="+", metavar="N",
+                        help="LOD for the asset covering N pixels (projected bounding-sphere diameter)")
+    target.add_argument("--screen-distance", type=float, nargs="+", metavar="D",
+                        help="LOD for the asset seen from distance D (with --fov and --resolution)")
+    parser.add_argument("--pixel-error", type=float, default=DEFAULT_PIXEL_ERROR, metavar="PX",
+                        help=f"screen targets: allowed deviation in pixels (default {DEFAULT_PIXEL_ERROR:g})")
+    parser.add_argument("--fov", type=float, default=DEFAULT_FOV_DEGREES, metavar="DEG",
+                        help=f"--screen-distance: vertical field of view (default {DEFAULT_FOV_DEGREES:g})")
+    parser.add_argument("--resolution", type=int, default=DEFAULT_RESOLUTION, metavar="ROWS",
+                        help=f"--screen-distance: vertical resolution in pixels (default {DEFAULT_RESOLUTION})")
+    parser.add_argument("--prune-pixels", type=float, default=0.0, metavar="PX",
+                        help="screen targets: drop disconnected parts smaller than PX pixels (default off)")
+    parser.add_argument("--lod-files", action="store_true",
+                        help="LOD chains: one file per LOD (<name>_LOD<i>.<ext>) instead of all LOD "
+                             "objects in one file (mesh files always get one file per LOD)")
+    parser.add_argument("--format", metavar="EXT", help="write outputs in this format (default: the input's)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--adaptivity", type=float, default=0.5)
+    parser.add_argument("--density", choices=("off", "uniform", "adaptive"), default="off")
+    parser.add_argument("--placement", choices=("subsample", "filtered"), default="subsample")
+    parser.add_argument("--refine", type=int, default=0, metavar="F",
+                        help="0: off; F: TopStoc to F x the target, then quadric collapses (8: quality)")
+    parser.add_argument("--objects", nargs="+", metavar="NAME",
+                        help="Blender formats: objects to decimate (default: every mesh object)")
+
+
+def parse_max_error(text: str) -> tuple:
+    """'0.01' -> (0.01, False): absolute; '0.5%' -> (0.005, True): a fraction of the diagonal."""
+    text = str(text).strip()
+    relative = text.endswith("%")
+    try:
+        value = float(text.rstrip("%"))
+    except ValueError:
+        raise ValueError(f"--max-error must be a number, optionally followed by %, got {text!r}") from None
+    if not math.isfinite(value) or value <= 0:
+        raise ValueError(f"--max-error must be positive, got {text!r}")
+    return (value / 100.0, True) if relative else (value, False)
+
+
+def from_args(args) -> dict:
+    """The settings dictionary of parsed arguments; ValueError for inconsistent values."""
+    kind = next(k for k in TARGET_KINDS if getattr(args, k) is not None)
+    values = list(getattr(args, kind))
+    if kind == "max_error":
+        values = [parse_max_error(v) for v in values]
+    elif kind == "ratio" and not all(0 < v <= 1 for v in values):
+        raise ValueError(f"--ratio values must lie in (0, 1], got {values}")
+    elif kind in ("vertices", "triangles") and not all(v >= 1 for v in values):
+        raise ValueError(f"--{kind} values must be positive, got {values}")
+    elif kind in SCREEN_KINDS and not all(math.isfinite(v) and v > 0 for v in values):
+        raise ValueError(f"--{kind.replace('_', '-')} values must be positive, got {values}")
+    if args.prune_pixels and kind not in SCREEN_KINDS:
+        raise ValueError("--prune-pixels needs a screen target (--screen-pixels or --screen-distance)")
+    for name in ("pixel_error", "fov", "resolution"):
+        if not getattr(args, name) > 0:
+            raise ValueError(f"--{name.replace('_', '-')} must be positive, got {getattr(args, name)}")
+    if args.prune_pixels < 0:
+        raise ValueError(f"--prune-pixels must not be negative, got {args.prune_pixels}")
+    out_format = None
+    if args.format:
+        out_format = args.format.lower().lstrip(".")
+    return {"target": kind, "values": values, "chain": len(values) > 1,
+            "pixel_error": args.pixel_error, "fov": args.fov, "resolution": args.resolution,
+            "prune_pixels": args.prune_pixels, "lod_files": bool(args.lod_files), "format": out_format,
+            "options": {"seed": args.seed, "adaptivity": args.adaptivity, "density": args.density,
+                        "placement": args.placement, "refine": args.refine},
+            "objects": list(args.objects) if args.objects else None}
+
+
+def to_argv(settings: dict) -> list:
+    """Command-line arguments that reproduce ``settings`` (for the Blender subprocess)."""
+    kind, values = settings["target"], settings["values"]
+    if kind == "max_error":
+        values = [f"{v * 100!r}%" if relative else repr(v) for v, relative in values]
+    argv = [f"--{kind.replace('_', '-')}", *map(str, values),
+            "--pixel-error", repr(settings["pixel_error"]), "--fov", repr(settings["fov"]),
+            "--resolution", str(settings["resolution"]), "--prune-pixels", repr(settings["prune_pixels"])]
+    if settings["lod_files"]:
+        argv.append("--lod-files")
+    if settings["format"]:
+        argv += ["--format", settings["format"]]
+    for name, value in settings["options"].items():
+        argv += [f"--{name}", str(value)]
+    if settings["objects"]:
+        argv += ["--objects", *settings["objects"]]
+    return argv
+
+
+def digest(settings: dict) -> str:
+    """A short fingerprint of the settings (part of the manifest key)."""
+    text = json.dumps(settings, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def lod_name(name: str, index: int, settings: dict) -> str:
+    """``name`` for a single target, ``name_LOD<index>`` in a chain."""
+    return f"{name}_LOD{index}" if settings["chain"] else name
+
+
+def engine_targets(settings: dict, vertices) -> list:
+    """One (engine target kwargs, ScreenTarget or None) per LOD for an asset whose vertices
+    (world space, all meshes together) are ``vertices``."""
+    from .screen_size import screen_target
+
+    kind = settings["target"]
+    targets = []
+    for value in settings["values"]:
+        if kind == "max_error":
+            bound, relative = value
+            targets.append(({"max_error": bound, "relative": relative}, None))
+        elif kind in SCREEN_KINDS:
+            screen = screen_target(vertices, pixel_error=settings["pixel_error"], fov_degrees=settings["fov"],
+                                   resolution=settings["resolution"],
+                                   **{"pixels" if kind == "screen_pixels" else "distance": value})
+            targets.append(({"max_error": screen.max_error}, screen))
+        elif kind == "ratio":
+            targets.append(({"ratio": value}, None))
+        else:  # vertices / triangles: counts
+            targets.append(({f"target_{kind}": value}, None))
+    return targets

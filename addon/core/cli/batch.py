@@ -1,0 +1,211 @@
+"""``topstoc batch``: many assets, one task each, on a Dask cluster, a local one, or serially.
+
+    topstoc batch --input FILE_OR_DIR... --output DIR (--ratio R... | --screen-pixels N... | ...)
+                  [--workers N | --scheduler tcp://HOST:PORT] [--blender PATH] [--json REPORT]
+
+Mesh files need no Blender; .blend, glTF/GLB, FBX and USD run one Blender per asset. A rerun
+into the same DIR skips the assets the manifest (DIR/topstoc-manifest.jsonl) lists as done
+with the same content and settings. Exit code 0 when every asset is done, 1 when any failed.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+
+from .. import batch_settings
+from ..batch_run import find_inputs, remove_stale_temporaries, run_dask, run_serial
+from ..manifest import Manifest, content_hash, task_key
+
+REPORT_NAME = "topstoc-report.json"
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "batch", help="decimate many assets (Dask cluster, local workers or serial)",
+        description="Decimate many assets into DIR, one task per asset, with resume. Mesh files "
+                    "(OBJ, PLY, OFF, STL) need no Blender; .blend, glTF/GLB, FBX and USD run a Blender "
+                    "per asset. Give one target value per output, or several for a LOD chain.")
+    parser.add_argument("--input", nargs="+", required=True, metavar="PATH",
+                        help="asset files, or folders (searched recursively for supported files)")
+    parser.add_argument("--output", required=True, metavar="DIR")
+    batch_settings.add_arguments(parser)
+    runner = parser.add_mutually_exclusive_group()
+    runner.add_argument("--workers", type=int, metavar="N",
+                        help="local cluster of N worker processes (default: one per core); 0 runs serially "
+                             "in this process, without Dask")
+    runner.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="a running Dask scheduler")
+    parser.add_argument("--blender", metavar="PATH",
+                        help="Blender executable, or a Python with PyPI's bpy, for Blender formats "
+                             "(default: $TOPSTOC_BLENDER or blender on PATH)")
+    parser.add_argument("--chunk", metavar="I/N",
+                        help="run only the I-th of N chunks of the inputs (1-based, every N-th file of the "
+                             "sorted list), for farm managers; manifest and report get a -chunkIofN suffix")
+    parser.add_argument("--json", metavar="REPORT.json", help=f"report file (default DIR/{REPORT_NAME})")
+    parser.add_argument("--no-resume", action="store_true", help="redo assets the manifest lists as done")
+    parser.add_argument("--progress", choices=("auto", "bar", "lines"), default="auto",
+                        help="progress bar on a terminal, plain lines otherwise (default auto)")
+    parser.set_defaults(run=run)
+
+
+class Progress:
+    """A tqdm bar on a terminal, else one line per asset on standard output."""
+
+    def __init__(self, total: int, mode: str):
+        self.total, self.count, self.bar = total, 0, None
+        if mode == "bar" or (mode == "auto" and sys.stderr.isatty()):
+            try:
+                from tqdm import tqdm
+                self.bar = tqdm(total=total, unit="asset", desc="topstoc batch", file=sys.stderr)
+            except ImportError:
+                self.bar = None
+
+    def line(self, text: str) -> None:
+        if self.bar is not None:
+            self.bar.write(text, file=sys.stderr)
+        else:
+            print(text, flush=True)
+
+    def advance(self, path: str, text: str, failed: bool = False) -> None:
+        self.count += 1
+        if self.bar is not None:
+            self.bar.update(1)
+            if failed:
+                self.bar.write(f"topstoc batch: {path}: {text}", file=sys.stderr)
+        else:
+            print(f"topstoc batch [{self.count}/{self.total}] {path}: {text}", flush=True,
+                  file=sys.stderr if failed else sys.stdout)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _check_names(tasks, out_dir, settings) -> None:
+    """Two inputs must not write the same output file."""
+    from ..batch_mesh import output_paths
+    from ..batch_run import asset_kind
+
+    owners = {}
+    for _, path in tasks:
+        if asset_kind(path) == "mesh":
+            names = output_paths(path, out_dir, settings)
+        else:
+            stem, ext = os.path.splitext(os.path.basename(path))
+            names = [os.path.join(out_dir, stem + ("." + settings["format"] if settings["format"] else ext.lower()))]
+        for name in names:
+            if name in owners:
+                raise ValueError(f"{owners[name]} and {path} would both write {name}; "
+                                 "batch them into different output folders")
+            owners[name] = path
+
+
+def _summary(entry: dict) -> str:
+    lods = entry.get("lods") or []
+    if len(lods) > 1:
+        counts = " / ".join(str(lod["vertices"]) for lod in lods)
+        return f"{entry['vertices_in']} -> {counts} vertices ({len(lods)} LODs)"
+    return f"{entry['vertices_in']} -> {entry['vertices_out']} vertices, {entry['triangles_out']} triangles"
+
+
+def parse_chunk(text: str) -> tuple:
+    """'2/8' -> (2, 8); ValueError unless 1 <= I <= N."""
+    try:
+        index, count = (int(part) for part in text.split("/"))
+    except ValueError:
+        raise ValueError(f"--chunk must look like I/N (e.g. 2/8), got {text!r}") from None
+    if not 1 <= index <= count:
+        raise ValueError(f"--chunk I/N needs 1 <= I <= N, got {text!r}")
+    return index, count
+
+
+def run(args) -> int:
+    settings = batch_settings.from_args(args)
+    started = time.perf_counter()
+    inputs = find_inputs(args.input)
+    suffix = ""
+    if args.chunk:
+        index, count = parse_chunk(args.chunk)
+        inputs = inputs[index - 1::count]
+        suffix = f"-chunk{index}of{count}"
+    if not inputs:
+        if args.chunk:  # more chunks than files: an empty chunk is not an error
+            print(f"topstoc batch: chunk {args.chunk} has no inputs", flush=True)
+            return 0
+        raise ValueError("no input assets found")
+    os.makedirs(args.output, exist_ok=True)
+    manifest = Manifest(args.output, suffix)
+    fingerprint = batch_settings.digest(settings)
+    tasks, keys, skipped = [], {}, []
+    for index, path in enumerate(inputs):
+        try:
+            sha = content_hash(path)
+        except OSError as error:
+            sha = f"unreadable: {error.strerror}"  # the task reports the error
+        keys[index] = (task_key(path, sha, fingerprint), sha)
+        record = None if args.no_resume else manifest.finished(keys[index][0])
+        if record is not None:
+            skipped.append({"input": path, "outputs": record["outputs"]})
+        else:
+            tasks.append((index, path))
+    _check_names(tasks, args.output, settings)
+
+    progress = Progress(len(inputs), args.progress)
+    for item in skipped:
+        progress.advance(item["input"], "skipped (done in an earlier run)")
+    results, failures, outputs = {}, {}, []
+
+    def on_result(index, outcome):
+        path = inputs[index]
+        key, sha = keys[index]
+        record = {"key": key, "input": path, "sha256": sha, "settings": fingerprint, "status": outcome["status"],
+                  "wall_seconds": outcome.get("wall_seconds"), "worker_pid": outcome.get("pid")}
+        if outcome["status"] == "done":
+            entry = outcome["entry"]
+            entry["wall_seconds"] = outcome.get("wall_seconds")
+            record["outputs"] = entry.get("outputs") or [entry["output"]]
+            record["entry"] = entry
+            results[index] = entry
+            outputs.extend(record["outputs"])
+            progress.advance(path, _summary(entry))
+        else:
+            record["message"] = outcome["message"]
+            failures[index] = {"input": path, "message": outcome["message"]}
+            progress.advance(path, f"FAILED: {outcome['message']}", failed=True)
+        manifest.append(record)
+
+    workers = (os.cpu_count() or 1) if args.workers is None else args.workers
+    if workers < 0:
+        raise ValueError(f"--workers must be 0 (serial) or more, got {workers}")
+
+    def announce(client):
+        pids = sorted(client.run(os.getpid).values())
+        where = args.scheduler or "local cluster"
+        progress.line(f"topstoc batch: {len(tasks)} assets to run ({len(skipped)} skipped) on {where}, "
+                      f"{len(pids)} workers (pids {' '.join(map(str, pids))})")
+
+    try:
+        if tasks and (args.scheduler or workers > 0):
+            run_dask(tasks, args.output, settings, args.blender, on_result, workers=workers,
+                     scheduler=args.scheduler, on_start=announce)
+        elif tasks:
+            progress.line(f"topstoc batch: {len(tasks)} assets to run ({len(skipped)} skipped), serially")
+            run_serial(tasks, args.output, settings, args.blender, on_result)
+    finally:
+        progress.close()
+    remove_stale_temporaries(outputs)
+
+    report = {"settings": settings, "runner": {"scheduler": args.scheduler, "workers": 0 if args.scheduler else workers},
+              "seconds": time.perf_counter() - started,
+              "results": [results[i] for i in sorted(results)],
+              "failures": [failures[i] for i in sorted(failures)], "skipped": skipped}
+    report_path = args.json or os.path.join(args.output, REPORT_NAME.replace(".json", suffix + ".json"))
+    temporary = f"{report_path}.tmp{os.getpid()}"
+    with open(temporary, "w") as stream:
+        json.dump(report, stream, indent=2, default=lambda v: v.tolist() if hasattr(v, "tolist") else str(v))
+    os.replace(temporary, report_path)
+    print(f"topstoc batch: {len(results)} done, {len(skipped)} skipped, {len(failures)} failed "
+          f"in {report['seconds']:.1f} s; report {report_path}", flush=True)
+    return 1 if failures else 0

@@ -1,0 +1,109 @@
+"""Batch throughput: assets per minute serially in one Blender, serially without Blender, and on a
+local Dask cluster with 2 worker processes, same assets, same run; overhead per asset.
+
+    PATH=/var/cache/topstoc/venv-pipeline/bin:$PATH \\
+        /var/cache/topstoc/venv-pipeline/bin/python tests/bench/bench_batch.py [--count 200] [--ratio 0.3]
+
+The assets (the test meshes and synthetic ones at subdivision levels 0 and 1, under random
+similarity transforms, OBJ/PLY/OFF) are generated into a temporary folder. Each mode writes its
+own output folder; outputs of the three runs must be byte-identical (checked). Overhead per
+asset = (wall time x processes - summed per-asset work) / assets: process start-up, reading,
+writing, measuring, scheduling. The JSON report of the cluster run is printed at the end
+(--report FILE keeps the whole report).
+"""
+
+import argparse
+import json
+import os
+import pathlib
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+BUILD = pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build"))
+sys.path.insert(0, str(BUILD / "python"))
+sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from machine import machine  # noqa: E402
+
+from assets import make_assets  # noqa: E402
+
+
+def outputs(folder) -> dict:
+    return {p.name: p.read_bytes() for p in sorted(pathlib.Path(folder).iterdir())
+            if p.is_file() and not p.name.startswith("topstoc-")}
+
+
+def timed(command, env) -> float:
+    start = time.perf_counter()
+    done = subprocess.run(command, capture_output=True, text=True, env=env)
+    seconds = time.perf_counter() - start
+    if done.returncode != 0:
+        sys.exit(f"failed: {' '.join(map(str, command[:6]))} ...\n{done.stderr[-2000:]}")
+    return seconds
+
+
+def work_seconds(report: dict) -> float:
+    return sum(entry["seconds"] for entry in report["results"])
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--count", type=int, default=200)
+    parser.add_argument("--ratio", default="0.3")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--report", help="keep the cluster run's JSON report here")
+    args = parser.parse_args()
+    blender = shutil.which("blender")
+    env = dict(os.environ, PYTHONPATH=str(BUILD / "python"))
+    with tempfile.TemporaryDirectory(prefix="topstoc-bench-batch-") as tmp:
+        tmp = pathlib.Path(tmp)
+        paths = make_assets(tmp / "assets", args.count, levels=(0, 1))
+        triangles = 0
+        from topstoc.core.io import read_mesh
+        triangles = sum(read_mesh(p).num_triangles for p in paths)
+        print(f"bench_batch: {len(paths)} assets, {triangles:,} triangles in all "
+              f"({triangles // len(paths):,} per asset), --ratio {args.ratio}")
+        print(f"machine: {machine()}")
+        rows = []
+        if blender:
+            out = tmp / "blender"
+            seconds = timed([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+                             str(BUILD / "python" / "topstoc" / "batch.py"), "--", "--input", *map(str, paths),
+                             "--output", str(out), "--ratio", args.ratio, "--json", str(tmp / "blender.json")], env)
+            report = json.loads((tmp / "blender.json").read_text())
+            rows.append(("serial, one Blender (blender -b batch.py)", seconds, 1, report, out))
+        for label, workers in (("serial, no Blender (topstoc batch --workers 0)", 0),
+                               (f"local Dask cluster, {args.workers} workers", args.workers)):
+            out = tmp / f"workers{workers}"
+            seconds = timed([sys.executable, "-m", "topstoc", "batch", "--input", str(tmp / "assets"), "--output",
+                             str(out), "--ratio", args.ratio, "--workers", str(workers), "--progress", "lines"], env)
+            report = json.loads((out / "topstoc-report.json").read_text())
+            rows.append((label, seconds, max(1, workers), report, out))
+        reference = outputs(rows[0][4])
+        identical = all(outputs(row[4]) == reference for row in rows[1:])
+        print(f"\n| mode | wall s | assets/min | work s (sum) | overhead ms/asset |")
+        print("|---|---|---|---|---|")
+        for label, seconds, processes, report, _ in rows:
+            n = len(report["results"])
+            overhead = (seconds * processes - work_seconds(report)) / n
+            print(f"| {label} | {seconds:.1f} | {60 * n / seconds:.0f} | {work_seconds(report):.1f} | "
+                  f"{1000 * overhead:.0f} |")
+        base = rows[0][1]
+        for label, seconds, *_ in rows[1:]:
+            print(f"{label}: {base / seconds:.2f}x the speed of '{rows[0][0]}'")
+        print(f"outputs byte-identical across the modes: {identical}")
+        cluster = rows[-1][3]
+        if args.report:
+            pathlib.Path(args.report).write_text(json.dumps(cluster, indent=2))
+        print("\ncluster run's report (first result; --report keeps all):")
+        print(json.dumps({key: value for key, value in cluster.items() if key != "results"} |
+                         {"results": cluster["results"][:1], "results_total": len(cluster["results"])}, indent=2))
+        return 0 if identical else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

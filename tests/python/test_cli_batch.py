@@ -1,0 +1,68 @@
+"""``topstoc batch`` serially (--workers 0, no Dask needed): LOD chains of mesh files, format
+conversion, chunks, and clear errors. The Dask runner is tested in tests/pipeline."""
+
+import functools
+import json
+
+import cli
+import meshgen
+from topstoc.core.io import MeshData, read_mesh, write_mesh
+
+batch = functools.partial(cli.run, "batch", timeout=300)
+
+
+def _torus(folder, name="ring.obj"):
+    folder.mkdir(exist_ok=True)
+    v, f = meshgen.torus(24, 12)
+    write_mesh(folder / name, MeshData(vertices=v, triangles=f))
+    return folder / name
+
+
+def test_lod_chain_of_a_mesh_file_converted_to_ply(tmp_path):
+    source = _torus(tmp_path / "in")
+    out = tmp_path / "out"
+    done = batch("--input", source, "--output", out, "--ratio", 1, 0.5, 0.2, "--format", "ply", "--workers", 0)
+    assert done.returncode == 0, done.stderr
+    [entry] = json.loads((out / "topstoc-report.json").read_text())["results"]
+    names = [lod["output"].rsplit("/", 1)[-1] for lod in entry["lods"]]
+    assert names == ["ring_LOD0.ply", "ring_LOD1.ply", "ring_LOD2.ply"]
+    counts = [read_mesh(out / name).num_vertices for name in names]
+    assert counts == [lod["vertices"] for lod in entry["lods"]] and counts[0] == 288 > counts[1] > counts[2]
+    errors = [lod["hausdorff"] for lod in entry["lods"]]
+    assert errors[0] < 1e-12 and 0 < errors[1] < errors[2]
+
+
+def test_chunks_split_the_inputs_and_empty_chunks_are_fine(tmp_path):
+    for i in range(3):
+        _torus(tmp_path / "in", f"ring{i}.off")
+    out = tmp_path / "out"
+    seen = []
+    for index in (1, 2, 3, 4):
+        done = batch("--input", tmp_path / "in", "--output", out, "--ratio", 0.5, "--chunk", f"{index}/4",
+                     "--workers", 0)
+        assert done.returncode == 0, done.stderr
+        if index < 4:
+            report = json.loads((out / f"topstoc-report-chunk{index}of4.json").read_text())
+            seen += [r["input"].rsplit("/", 1)[-1] for r in report["results"]]
+        else:
+            assert "has no inputs" in done.stdout
+    assert sorted(seen) == ["ring0.off", "ring1.off", "ring2.off"]
+    # The chunks' manifests together make a full rerun skip everything.
+    done = batch("--input", tmp_path / "in", "--output", out, "--ratio", 0.5, "--workers", 0)
+    assert len(json.loads((out / "topstoc-report.json").read_text())["skipped"]) == 3
+
+
+def test_clear_errors(tmp_path):
+    a = _torus(tmp_path / "a", "ring.obj")
+    b = _torus(tmp_path / "b", "ring.obj")
+    done = batch("--input", a, b, "--output", tmp_path / "out", "--ratio", 0.5, "--workers", 0)
+    cli.assert_one_error_line("batch", done, "would both write")
+    done = batch("--input", a, "--output", tmp_path / "out", "--ratio", 0.5, "--chunk", "5/4", "--workers", 0)
+    cli.assert_one_error_line("batch", done, "--chunk")
+    done = batch("--input", a, "--output", tmp_path / "out", "--ratio", 1.5, "--workers", 0)
+    cli.assert_one_error_line("batch", done, "--ratio values must lie in (0, 1]")
+    done = batch("--input", tmp_path / "nothing", "--output", tmp_path / "out", "--ratio", 0.5, "--workers", 0)
+    cli.assert_one_error_line("batch", done, "nothing: no such file or folder")
+    (tmp_path / "empty").mkdir()
+    done = batch("--input", tmp_path / "empty", "--output", tmp_path / "out", "--ratio", 0.5, "--workers", 0)
+    cli.assert_one_error_line("batch", done, "no input assets found")
