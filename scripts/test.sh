@@ -61,6 +61,15 @@ if [ -d tests/gui ]; then
   run "real Blender GUI under Xvfb" $VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/gui
 fi
 
+# The release files as users get them (root only: the roots are entered with chroot): the wheels
+# and the extension zip are built (scripts/build_wheels.sh, build_extension.sh), then installed in
+# cached minimal Debian 12/13 roots without the build's libraries and in Debian 13's Blender 4.3.
+if [ "$(id -u)" = 0 ]; then
+  run "release wheels and extension zip" bash -c "scripts/build_wheels.sh && scripts/build_extension.sh"
+  run "install tests (bare Debian roots, Blender 4.3 extension, Blender 3.4 legacy zip)" \
+    /usr/bin/python3 -m pytest "${PYTEST_ARGS[@]}" tests/install
+fi
+
 if [ ${#failed[@]} -gt 0 ]; then
   echo "FAILED: ${failed[*]}"
   exit 1

@@ -31,7 +31,11 @@ def test_manifest_version_matches_bl_info():
 
 def test_staged_package_has_the_manifest_next_to_init():
     package = pathlib.Path(topstoc.__file__).parent
-    assert (package / "blender_manifest.toml").read_text() == (ROOT / "blender_manifest.toml").read_text()
+    staged = tomllib.loads((package / "blender_manifest.toml").read_text())
+    release = tomllib.loads((ROOT / "blender_manifest.toml").read_text())
+    # The staged package holds its module itself: the release's topstoc_native wheels are dropped.
+    assert "wheels" not in staged and len(release.pop("wheels")) == 2
+    assert staged == release
     assert list(package.glob("_topstoc*.so"))
 
 
@@ -45,3 +49,18 @@ def test_import_never_needs_bpy():
                           env={"PYTHONPATH": f"{pathlib.Path(topstoc.__file__).parents[1]}:{tests}"})
     assert done.returncode == 0, done.stderr
     assert int(done.stdout) == 81
+
+
+def test_manifest_lists_the_native_wheel_for_each_blender_python():
+    """Blender 4.2-5.0 embed CPython 3.11, 5.1+ CPython 3.13: one topstoc_native wheel each."""
+    import re
+
+    manifest = tomllib.loads((ROOT / "blender_manifest.toml").read_text())
+    assert manifest["platforms"] == ["linux-x64"]
+    pattern = re.compile(r"\./wheels/topstoc_native-(?P<version>[^-]+)-(?P<py>cp3\d+)-(?P=py)-"
+                         r"manylinux_2_(?P<glibc>\d+)_x86_64\.whl")
+    matches = [pattern.fullmatch(w) for w in manifest["wheels"]]
+    assert all(matches), manifest["wheels"]
+    assert sorted(m["py"] for m in matches) == ["cp311", "cp313"]
+    assert {m["version"] for m in matches} == {manifest["version"]}
+    assert all(int(m["glibc"]) <= 35 for m in matches)  # Ubuntu 22.04's glibc 2.35 at most
