@@ -38,7 +38,20 @@ def label_fits(texts, sidebar):
     return widest, blf.dimensions(0, widest)[0], column
 
 
+def open_advanced():
+    """Shows the Advanced sub-panel open (Blender 3.4 has no API to open a panel): registers the
+    decimation sub-panels again, in their order, with Advanced no longer closed by default."""
+    names = ("TOPSTOC_PT_advanced", "TOPSTOC_PT_guidance", "TOPSTOC_PT_variants", "TOPSTOC_PT_samples")
+    classes = [getattr(bpy.types, name) for name in names]
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)
+    classes[0].bl_options = set()
+    for cls in classes:
+        bpy.utils.register_class(cls)
+
+
 def steps():
+    open_advanced()
     obj = bpy.data.objects["Suzanne"]
     for other in bpy.context.view_layer.objects:
         other.select_set(False)
@@ -95,6 +108,8 @@ def steps():
     # a keymap's or script's explicit property wins over the panel on invoke; the rest comes
     # from the panel (background Blender cannot check this: it runs exec without a window)
     settings.output, settings.ratio = "NEW_OBJECT", 0.5
+    obj.select_set(True)
+    bpy.context.view_layer.objects.active = obj
     n = len(obj.data.vertices)
     names = set(bpy.data.objects.keys())
     with session.override():

@@ -22,8 +22,8 @@ def _estimate_text(context, settings) -> str:
         return ""
     estimate = face_estimate(settings, obj.data)
     if estimate is None:
-        return "Face count: found when run"
-    return f"Face count: ≈ {estimate:,} of {input_triangles(obj.data):,}"
+        return "Face Count: when run"
+    return f"Face Count ≈ {estimate:,}"
 
 
 class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
@@ -56,13 +56,15 @@ class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
         estimate = _estimate_text(context, settings)
         if estimate:
             layout.label(text=estimate, icon="MESH_DATA")
-        layout.prop(settings, "quality", expand=True)
+        layout.prop(settings, "quality")
         row = layout.row(align=True, heading="Symmetry")
         row.prop(settings, "use_symmetry", text="")
         sub = row.row(align=True)
         sub.active = settings.use_symmetry
         sub.prop(settings, "symmetry_axis", expand=True)
-        layout.prop(settings, "output", expand=True)
+        row = layout.row(align=True)  # full width: "New Object" does not fit beside a label
+        row.use_property_split = False
+        row.prop(settings, "output", expand=True)
         col = layout.column(align=True)
         col.operator("topstoc.guided_decimate", icon="MOD_DECIM")
         col.operator("topstoc.preview", icon="HIDE_OFF")
@@ -96,7 +98,7 @@ class TOPSTOC_PT_advanced(_Panel, bpy.types.Panel):
         col.prop(settings, "placement")
         col.prop(settings, "refine")
         if settings.quality != "CUSTOM":
-            layout.label(text="Quality sets Placement and Refine", icon="INFO")
+            layout.label(text="Set by Quality", icon="INFO")
 
 
 class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
@@ -124,11 +126,11 @@ class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
             if obj.data.color_attributes.get(s.color_attribute) is not None:
                 box.prop_search(s, "color_attribute", obj.data, "color_attributes", text="Layer")
             else:  # no red "invalid" field before the layer exists: offer to make it
-                box.label(text="No guidance colours painted yet", icon="INFO")
+                box.label(text="Not painted yet", icon="INFO")
             box.prop(s, "color_strength")
             row = box.row(align=True)
-            row.operator("topstoc.add_guidance_layer", icon="BRUSH_DATA")
-            row.operator("topstoc.show_guidance", icon="SHADING_SOLID")
+            row.operator("topstoc.add_guidance_layer", text="Add Layer", icon="BRUSH_DATA")
+            row.operator("topstoc.show_guidance", text="Show", icon="SHADING_SOLID")
         if context.mode == "EDIT_MESH":
             row = box.row(align=True)
             for level, label in (("KEEP", "Keep"), ("MORE", "More"), ("NEUTRAL", "Neutral"), ("LESS", "Less"),

@@ -42,8 +42,9 @@ def help_rows(topology) -> list:
             ("χ", str(topology.euler), "euler"), ("Genus", genus, "genus"),
             ("Components", str(len(topology.components)), "components"),
             ("Holes", str(topology.boundary_loops), "boundary"),
-            ("Non-Manifold Edges", str(topology.nonmanifold_edges), "nonmanifold_edges"),
-            ("Non-Manifold Verts", str(topology.nonmanifold_vertices), "nonmanifold_vertices"),
+            ("Non-Manifold", "", None),  # a heading: the full names do not fit the sidebar
+            ("   Edges", str(topology.nonmanifold_edges), "nonmanifold_edges"),
+            ("   Vertices", str(topology.nonmanifold_vertices), "nonmanifold_vertices"),
             ("Loose Vertices", str(topology.isolated_vertices), "isolated")]
     if topology.duplicate_triangles:
         rows.append(("Repeated Faces", str(topology.duplicate_triangles), "faces"))
@@ -78,8 +79,10 @@ def _table(layout, rows, factor: float = 0.62) -> None:
         split = line.split(factor=factor, align=True)
         split.label(text=label)
         split.label(text=value)
-        if len(row) > 2:
+        if len(row) > 2 and row[2]:
             help_button(line, row[2])
+        elif len(row) > 2:
+            line.label(text="", icon="BLANK1")
 
 
 class TOPSTOC_UL_components(bpy.types.UIList):
@@ -89,7 +92,7 @@ class TOPSTOC_UL_components(bpy.types.UIList):
 
 class TOPSTOC_UL_loops(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
-        split = layout.split(factor=0.55, align=True)
+        split = layout.split(factor=0.62, align=True)
         split.label(text=item.name, icon=KIND_ICONS.get(item.kind, "DOT"))
         warning = item.kind == "BOUNDARY" and not item.fillable
         split.label(text=f"{item.num_edges} edges", icon="ERROR" if warning else "NONE")
@@ -199,7 +202,7 @@ class TOPSTOC_PT_topology_loops(_Panel, bpy.types.Panel):
             row.operator("topstoc.cut_loop", text="Cut")
             row.operator("topstoc.remove_loop", text="Remove")
         row = layout.row()
-        row.label(text=f"{active.name}: {active.num_edges} edges, length {active.length:.4g}")
+        row.label(text=f"{active.num_edges} edges, length {active.length:.4g}")
         help_button(row, {"HANDLE": "handle", "TUNNEL": "tunnel"}.get(active.kind, "boundary_loop"))
         wrapped(layout, context, HELP[{"HANDLE": "handle", "TUNNEL": "tunnel"}.get(active.kind, "boundary_loop")])
 
