@@ -140,6 +140,8 @@ def test_auto_regenerate_is_debounced(ts, scene):
     np.testing.assert_array_equal(positions(out.data), before)
     assert regenerate.run_pending(now=time.monotonic() + 2 * regenerate.DEBOUNCE) is None
     np.testing.assert_allclose(positions(out.data), 1.5 * before, rtol=1e-6)
+    assert bpy.app.timers.is_registered(regenerate.run_pending)  # the handler started the timer
+    bpy.app.timers.unregister(regenerate.run_pending)  # no event loop here to run it
 
 
 def preset_values(path):
@@ -224,3 +226,26 @@ def test_face_count_estimate_matches_the_result(ts, scene):
         assert abs(estimate - actual) <= 0.05 * actual, (mode, estimate, actual)
     settings.target_mode = "MAX_ERROR"
     assert pipeline.face_estimate(settings, obj.data) is None
+
+
+def test_topology_help_covers_every_figure_and_loop_kind(ts, scene):
+    import importlib
+
+    help_text = importlib.import_module(f"{ts.__name__}.blender.topology_help").HELP
+    panel = importlib.import_module(f"{ts.__name__}.blender.ui.topology")
+    obj = make_object("Torus", *meshgen.torus(24, 12))
+    assert bpy.ops.topstoc.analyse() == {"FINISHED"}
+    rows = panel.help_rows(obj.topstoc.topology)
+    topics = [topic for _label, _value, topic in rows if topic]
+    assert len(topics) >= 11 and all(topic in help_text for topic in topics)
+    explain = bpy.types.TOPSTOC_OT_explain
+    for topic in topics + ["handle", "tunnel", "cut", "remove", "why", "repairs"]:
+        props = type("P", (), {"topic": topic})()
+        assert explain.description(bpy.context, props) == help_text[topic]
+    assert "handle" in help_text["genus"].lower() and "print" in help_text["why"]
+    summary = panel.plain_summary(obj.topstoc.topology)  # a closed torus: one handle, printable
+    assert "1 handle" in summary and "ready to print" in summary
+    kinds = {item.identifier: item.description
+             for item in ts.blender.props_analysis.TOPSTOC_PG_loop.bl_rna.properties["kind"].enum_items}
+    assert "ring on a finger" in kinds["HANDLE"] and "thread through a ring" in kinds["TUNNEL"]
+    assert "genus drops" in bpy.ops.topstoc.remove_loop.get_rna_type().description

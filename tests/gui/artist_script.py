@@ -120,4 +120,45 @@ def steps():
           f"{len(obj.data.vertices)} of {n}")
 
 
+    # a big mesh: the preview starts at once, says it is preparing, and Esc cancels it cleanly
+    yield from big_mesh_preview(obj)
+
+
+def big_mesh_preview(source):
+
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+    import meshgen
+    from topstoc.blender import mesh_io
+    from topstoc.core.io import read_mesh
+
+    data = read_mesh(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "open_boundary",
+                                  "kivy_suzanne_monkey.obj"))
+    vertices, triangles = meshgen.subdivide(data.vertices, data.triangles, 4)  # 1.0M triangles
+    mesh = bpy.data.meshes.new("Big")
+    mesh_io.fill_geometry(mesh, vertices, triangles)
+    big = bpy.data.objects.new("Big", mesh)
+    bpy.context.scene.collection.objects.link(big)
+    for other in bpy.context.view_layer.objects:
+        other.select_set(False)
+    big.select_set(True)
+    bpy.context.view_layer.objects.active = big
+    source.hide_set(True)
+    settings = bpy.context.scene.topstoc
+    settings.target_mode, settings.ratio = "VERTICES", 0.3
+    report["values"]["big_triangles"] = int(len(triangles))
+    window, area, region, _space = view3d()
+    with session.override():
+        started = bpy.ops.topstoc.preview("INVOKE_DEFAULT")
+    check("big preview starts at once", started == {"RUNNING_MODAL"})
+    yield 0.01
+    preparing = "Big_TopStocPreview" not in bpy.data.objects
+    report["values"]["big_still_preparing_at_shot"] = preparing
+    shot("preview_preparing", [big])
+    window.event_simulate(type="ESC", value="PRESS")
+    window.event_simulate(type="ESC", value="RELEASE")
+    yield 0.5
+    check("Esc cancels the big preview", "Big_TopStocPreview" not in bpy.data.objects and not big.hide_get())
+    check("the panel's target is back", settings.target_mode == "VERTICES" and abs(settings.ratio - 0.3) < 1e-6)
+
+
 session.run(steps)

@@ -85,7 +85,7 @@ Enter or click applies, Esc or right-click restores"""
         if event is not None:
             self.start_x = event.mouse_x
         self.start_ratio = self.ratio
-        self.session.update(self.ratio)
+        self.session.update(self.ratio)  # the first result at once (a prepared mesh decimates in ms)
         self._follow(context)
         self._header(context)
         return {"RUNNING_MODAL"}
@@ -115,6 +115,11 @@ Enter or click applies, Esc or right-click restores"""
     def _header(self, context):
         s = self.session
         result = s.result
+        if result is None:
+            seconds = time.perf_counter() - self.started
+            self._status(context, f"TopStoc: decimating '{s.obj.name}' at ratio {self.ratio:.4f} ... "
+                                  f"{seconds:.1f} s   Esc: cancel")
+            return
         quality = "" if self.quality == "FAST" else f"  (preview: Fast; Enter applies at {self.quality.title()})"
         self._status(context,
                      f"TopStoc ratio {s.ratio:.4f}: {result.num_vertices:,} vertices, {result.num_triangles:,} "
@@ -163,13 +168,15 @@ Enter or click applies, Esc or right-click restores"""
             self._follow(context)
         elif event.type == "TIMER":
             try:
-                if self.session.poll():
+                if self.session.poll() or self.session.result is None:
                     self._header(context)
             except ValueError as error:
                 self._finish(context)
                 self.report({"ERROR"}, str(error))
                 return {"CANCELLED"}
         elif event.type in {"RET", "NUMPAD_ENTER", "LEFTMOUSE"} and event.value == "PRESS":
+            if self.session.result is None:
+                return {"RUNNING_MODAL"}  # nothing shown yet to apply
             obj, ratio = self.session.obj, self.session.ratio
             self._finish(context)
             self.target_mode, self.ratio = "RATIO", ratio
