@@ -8,10 +8,10 @@ background mode.
 import bpy
 from bpy.app.handlers import persistent
 
-from . import operators, overlays, props, ui, watch
+from . import operators, overlays, presets, props, regenerate, ui, watch
 from .cache import prepared_meshes
 
-MODULES = (props, operators, ui, watch, overlays)
+MODULES = (props, operators, presets, ui, watch, regenerate, overlays)
 
 
 @persistent

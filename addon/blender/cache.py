@@ -51,6 +51,21 @@ class PreparedCache:
             self._entries.popitem(last=False)
         return entry
 
+    def find(self, mesh_data):
+        """(arrays, digest, entry or None): the mesh read now and its cached preparation, if any
+        (the live preview prepares a miss on a worker thread and hands it to ``add``)."""
+        arrays = mesh_io.read_mesh(mesh_data)
+        digest = arrays.digest()
+        return arrays, digest, self._entries.get((mesh_data.name_full, digest))
+
+    def add(self, mesh_data, arrays, digest: str, mesh: Mesh) -> Prepared:
+        """Stores a preparation made elsewhere (same rules as ``get``)."""
+        entry = Prepared(arrays, mesh, digest)
+        self._entries[(mesh_data.name_full, digest)] = entry
+        while len(self._entries) > self.capacity:
+            self._entries.popitem(last=False)
+        return entry
+
     def clear(self) -> None:
         self._entries.clear()
 

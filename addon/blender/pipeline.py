@@ -14,7 +14,8 @@ import bpy
 import numpy as np
 
 from ..core.errors import TopStocError
-from . import mesh_io
+from ..core.symmetry import decimate_symmetric as symmetric_decimate
+from . import carry, mesh_io
 from .cache import Prepared, prepared_meshes
 from .guidance import EngineGuidance, gather
 
@@ -35,6 +36,14 @@ class Run:
     result: object            #: topstoc.core.DecimateResult
     parameters: dict          #: what reproduces it (target, seed, options)
     seconds: float            #: read + prepare + decimate
+    settings: dict = None     #: the panel settings it ran with (Regenerate re-runs them)
+
+
+def settings_of(params) -> dict:
+    """The DecimationParameters values of a holder, as plain JSON-able values."""
+    from .props import DecimationParameters
+
+    return {name: getattr(params, name) for name in DecimationParameters.__annotations__ if hasattr(params, name)}
 
 
 def target_kwargs(params, prepared: Prepared) -> dict:
@@ -51,9 +60,57 @@ def target_kwargs(params, prepared: Prepared) -> dict:
     return {"max_error": float(params.max_error)}
 
 
+def quality_options(quality: str) -> dict:
+    """The engine options behind the panel's Quality choice (the one place to re-point when the
+    engine gains its own fast/quality mode). None for CUSTOM: the Advanced settings apply."""
+    if quality == "FAST":
+        return {"placement": "subsample", "refine": 0}
+    if quality == "QUALITY":
+        return {"placement": "filtered", "refine": 8}
+    return None
+
+
 def options_kwargs(params) -> dict:
-    return dict(seed=int(params.seed), adaptivity=float(params.adaptivity), density=params.density,
-                placement=params.placement, refine=int(params.refine))
+    options = dict(seed=int(params.seed), adaptivity=float(params.adaptivity), density=params.density,
+                   placement=params.placement, refine=int(params.refine))
+    options.update(quality_options(getattr(params, "quality", "CUSTOM")) or {})
+    return options
+
+
+def symmetry_axis(params):
+    """The mirror axis ("X", "Y", "Z") when symmetry is on, else None."""
+    return params.symmetry_axis if getattr(params, "use_symmetry", False) else None
+
+
+def run_engine(mesh, target: dict, options: dict, guidance_kwargs: dict, axis=None):
+    """One engine decimation, mirror-symmetric when ``axis`` is given (core/symmetry.py)."""
+    if axis is None:
+        return mesh.decimate(**target, **options, **guidance_kwargs)
+    return symmetric_decimate(mesh, axis, **target, **options, **guidance_kwargs)
+
+
+def input_triangles(mesh) -> int:
+    """Triangles of a Blender mesh after triangulation (each n-gon gives n - 2)."""
+    return max(0, len(mesh.loops) - 2 * len(mesh.polygons))
+
+
+def face_estimate(params, mesh):
+    """The output's triangle count the target will give, estimated without decimating (like
+    the Decimate modifier's Face Count): a triangulated surface has about two triangles per
+    vertex, so the count scales with the kept vertices. None for a max-deviation target."""
+    triangles, vertices = input_triangles(mesh), len(mesh.vertices)
+    if triangles == 0 or vertices == 0:
+        return 0
+    mode = params.target_mode
+    if mode == "TRIANGLES":
+        return min(int(params.triangles), triangles)
+    if mode == "RATIO":
+        kept = params.ratio * vertices
+    elif mode == "VERTICES":
+        kept = min(int(params.vertices), vertices)
+    else:
+        return None
+    return max(1, int(round(triangles * kept / vertices)))
 
 
 def prepare(obj) -> Prepared:
@@ -79,20 +136,11 @@ def decimate(context, obj, params, *, seed_offset: int = 0, target: dict = None,
     options = options_kwargs(params)
     options["seed"] += seed_offset
     try:
-        result = prepared.mesh.decimate(**target, **options, **guidance.decimate_kwargs())
+        result = run_engine(prepared.mesh, target, options, guidance.decimate_kwargs(), symmetry_axis(params))
     except ValueError as error:
         raise DecimationError(f"'{obj.name}': {error}") from None
-    parameters = dict(target, **options, sources=guidance.sources)
-    return Run(obj, prepared, guidance, result, parameters, time.perf_counter() - start)
-
-
-def _link_like(source, new) -> None:
-    collections = source.users_collection or (bpy.context.scene.collection,)
-    for collection in collections:
-        collection.objects.link(new)
-    new.parent = source.parent
-    new.matrix_parent_inverse = source.matrix_parent_inverse.copy()
-    new.matrix_world = source.matrix_world.copy()
+    parameters = dict(target, **options, sources=guidance.sources, symmetry=symmetry_axis(params))
+    return Run(obj, prepared, guidance, result, parameters, time.perf_counter() - start, settings_of(params))
 
 
 def _object_materials(source, new) -> None:
@@ -102,28 +150,52 @@ def _object_materials(source, new) -> None:
             new.material_slots[index].material = slot.material
 
 
-def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None) -> bpy.types.Object:
-    """Writes a Run as a new object (default) or into the object itself; returns the object."""
+def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bool = True,
+                 into: bpy.types.Object = None) -> bpy.types.Object:
+    """Writes a Run as a new object (default), into the object itself (IN_PLACE) or into an
+    earlier result ``into`` (Regenerate); returns the object written.
+
+    Shape keys, vertex groups, modifiers, parent, collections and custom properties follow the
+    source (see carry.py). A new object goes beside the original (``place``; a rigged original
+    is hidden instead); LOD chains and multiview lay their objects out themselves. Regenerating
+    keeps the result's own transform, modifiers and materials and replaces only its mesh.
+    """
     obj = run.obj
-    groups = mesh_io.collect_vertex_groups(obj, np.asarray(run.result.kept))
-    if mode == "IN_PLACE":
-        old = obj.data
-        mesh = mesh_io.build_result_mesh(old, run.prepared.arrays, run.result, old.name + "_TopStoc")
+    kept = np.asarray(run.result.kept)
+    groups = mesh_io.collect_vertex_groups(obj, kept)
+    shape_keys = carry.read_shape_keys(obj.data)
+    if mode == "IN_PLACE" or into is not None:
+        target = obj if into is None else into
+        old = target.data
+        mesh = mesh_io.build_result_mesh(obj.data, run.prepared.arrays, run.result, old.name + "_TopStoc")
+        if into is not None:  # the result's own material choices win over the source's
+            mesh.materials.clear()
+            for material in old.materials:
+                mesh.materials.append(material)
+            carry.copy_custom_properties(old, mesh)
         old_name = old.name
-        obj.data = mesh
+        target.data = mesh
         if old.users == 0:
             bpy.data.meshes.remove(old)
         mesh.name = old_name
-        target = obj
     else:
         name = name or f"{obj.name}_TopStoc"
         mesh = mesh_io.build_result_mesh(obj.data, run.prepared.arrays, run.result, name)
+        carry.copy_custom_properties(obj.data, mesh)
         target = bpy.data.objects.new(name, mesh)
-        _link_like(obj, target)
+        carry.link_like(obj, target, bpy.context.scene)
         _object_materials(obj, target)
+        carry.copy_modifiers(obj, target)
+        carry.copy_custom_properties(obj, target)
+        if place:
+            carry.place_beside(obj, target)
     mesh_io.apply_vertex_groups(target, groups)
+    carry.write_shape_keys(target, shape_keys, run.prepared.arrays.vertices, run.result.vertices, kept)
     target["topstoc_source"] = obj.name
     target["topstoc_parameters"] = json.dumps(run.parameters)
+    if target is not obj and run.settings is not None:  # what Regenerate needs (regenerate.py)
+        target.topstoc.source = obj
+        target.topstoc.settings = json.dumps(run.settings)
     return target
 
 
@@ -187,7 +259,8 @@ def summary(run: Run, seconds: float = None) -> str:
     if bound is not None:
         text += f", deviation {bound.achieved_error:.4g} <= {bound.max_error:.4g}"
     if run.result.stats.repairs:
-        text += f" ({run.result.stats.repairs} topology repairs)"
+        text += (f" ({run.result.stats.repairs} topology repairs: vertices kept so that no hole closed and "
+                 f"no handle or piece was lost)")
     return text
 
 
@@ -202,8 +275,10 @@ def decimate_many(context, obj, params, variants) -> list:
     prepared.mesh.feature_layout(guidance.regions, guidance.borders)  # built once, shared by the threads
     options = options_kwargs(params)
 
+    axis = symmetry_axis(params)
+
     def one(target, seed):
-        return prepared.mesh.decimate(**target, **dict(options, seed=seed), **guidance.decimate_kwargs())
+        return run_engine(prepared.mesh, target, dict(options, seed=seed), guidance.decimate_kwargs(), axis)
 
     try:
         with ThreadPoolExecutor(max_workers=max(1, min(len(variants), os.cpu_count() or 1))) as pool:
@@ -211,5 +286,12 @@ def decimate_many(context, obj, params, variants) -> list:
     except ValueError as error:
         raise DecimationError(f"'{obj.name}': {error}") from None
     seconds = time.perf_counter() - start
+    settings = settings_of(params)
+
+    def settings_for(target, seed):
+        if "ratio" not in target:
+            return None
+        return dict(settings, target_mode="RATIO", ratio=target["ratio"], seed=seed)
+
     return [Run(obj, prepared, guidance, result, dict(target, **dict(options, seed=seed), sources=guidance.sources),
-                seconds) for (target, seed), result in zip(variants, results)]
+                seconds, settings_for(target, seed)) for (target, seed), result in zip(variants, results)]

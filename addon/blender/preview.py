@@ -49,6 +49,8 @@ class PreviewSession:
         for collection in obj.users_collection or (context.scene.collection,):
             collection.objects.link(self.preview)
         self.preview.matrix_world = obj.matrix_world.copy()
+        self.preview.show_wire = True      # at 10 % one judges the mesh by its edges
+        self.preview.show_all_edges = True
         self.was_hidden = obj.hide_get()
         obj.hide_set(True)
         self._pool = ThreadPoolExecutor(max_workers=WORKERS)

@@ -27,9 +27,19 @@ DENSITY_MODES = [
     ("adaptive", "Adaptive", "Larger spacing where the surface is flat (thesis 4.1.2)"),
 ]
 OUTPUT_MODES = [
-    ("NEW_OBJECT", "New Object", "Put the result in a new object next to the original"),
+    ("NEW_OBJECT", "New Object", "Put the result in a new object beside the original (offset along X by its "
+                                 "width); a rigged original stays where it is and is hidden instead"),
     ("IN_PLACE", "In Place", "Replace the object's mesh (undo restores it)"),
 ]
+QUALITY_MODES = [
+    ("FAST", "Fast", "Plain TopStoc: output vertices are input vertices; fastest, what the live preview shows"),
+    ("QUALITY", "Quality", "Lower deviation from the original: vertices placed in their cluster and "
+                           "refined by quadric error (slower on big meshes)"),
+    ("CUSTOM", "Custom", "Use the Placement and Refine settings under Advanced"),
+]
+SYMMETRY_AXES = [("X", "X", "Mirror across the object's local YZ plane"),
+                 ("Y", "Y", "Mirror across the object's local XZ plane"),
+                 ("Z", "Z", "Mirror across the object's local XY plane")]
 PLACEMENTS = [
     ("subsample", "Subsample", "Output vertices are input vertices (attributes copy exactly)"),
     ("filtered", "Filtered", "Move vertices to the quadric-optimal point of their cluster"),
@@ -50,11 +60,20 @@ class DecimationParameters:
     max_error_relative: BoolProperty(name="Percent of Diagonal",
                                      description="Max deviation in % of the bounding-box diagonal",
                                      default=True)
+    quality: EnumProperty(name="Quality", items=QUALITY_MODES, default="FAST",
+                          description="Fast or lower-deviation result (Custom: the Advanced settings)")
+    use_symmetry: BoolProperty(name="Symmetry", default=False,
+                               description="A mirror-symmetric mesh gives a mirror-symmetric result "
+                                           "(as the Decimate modifier's Symmetry)")
+    symmetry_axis: EnumProperty(name="Axis", items=SYMMETRY_AXES, default="X",
+                                description="Local axis across which the mesh mirrors")
     seed: IntProperty(name="Seed", description="The same seed gives the same result", default=0, min=0)
     adaptivity: FloatProperty(name="Adaptivity", description="0 samples uniformly, 1 follows curvature fully",
                               default=0.5, min=0.0, max=1.0, subtype="FACTOR")
-    density: EnumProperty(name="Density Control", items=DENSITY_MODES, default="off")
-    placement: EnumProperty(name="Placement", items=PLACEMENTS, default="subsample")
+    density: EnumProperty(name="Density", items=DENSITY_MODES, default="off",
+                          description="Density control: keep samples apart (Poisson-disk rejection)")
+    placement: EnumProperty(name="Placement", items=PLACEMENTS, default="subsample",
+                            description="Where output vertices go (used when Quality is Custom)")
     refine: IntProperty(name="Refine", default=0, min=0, max=32,
                         description="0: off (fastest, for live previews). N: TopStoc keeps N times the target, "
                                     "then vertices are dropped by quadric error against the original (lower "
@@ -63,10 +82,47 @@ class DecimationParameters:
     output: EnumProperty(name="Output", items=OUTPUT_MODES, default="NEW_OBJECT")
 
 
+class OperatorParameters:
+    """DecimationParameters for operators (a mixin). They are not remembered between calls
+    (SKIP_SAVE): Blender would otherwise fill them from the last call and mark them as set, so
+    the panel's settings could not fill what a call leaves out (see fill_from_scene)."""
+
+
+def _skip_save(annotation):
+    # annotations are strings here (from __future__ import annotations): evaluate them first
+    deferred = eval(annotation, globals()) if isinstance(annotation, str) else annotation
+    return deferred.function(**dict(deferred.keywords, options={"SKIP_SAVE"}))
+
+
+OperatorParameters.__annotations__ = {name: _skip_save(annotation)
+                                      for name, annotation in DecimationParameters.__annotations__.items()}
+
+
 def copy_parameters(source, target) -> None:
     """Copies every DecimationParameters property from one holder to another."""
     for name in DecimationParameters.__annotations__:
         setattr(target, name, getattr(source, name))
+
+
+def explicit_engine_options(operator) -> None:
+    """A call that sets Placement or Refine but not Quality means those values: Quality becomes
+    Custom (scripts written before the Quality choice keep working; the redo panel too)."""
+    is_set = operator.properties.is_property_set
+    if (is_set("placement") or is_set("refine")) and not is_set("quality"):
+        operator.quality = "CUSTOM"
+
+
+def settings_names() -> list:
+    """Names of the DecimationParameters properties."""
+    return list(DecimationParameters.__annotations__)
+
+
+def fill_from_scene(operator, scene_settings) -> None:
+    """An operator's invoke: the scene's settings, except the properties the caller set
+    explicitly (a script's or keymap's ``output='IN_PLACE'`` wins over the panel)."""
+    for name in DecimationParameters.__annotations__:
+        if not operator.properties.is_property_set(name):
+            setattr(operator, name, getattr(scene_settings, name))
 
 
 class TOPSTOC_PG_sample_set(bpy.types.PropertyGroup):
@@ -112,6 +168,12 @@ class TOPSTOC_PG_object(bpy.types.PropertyGroup):
                               description="This cube empty sets the guidance of the vertices inside it")
     box_weight: FloatProperty(name="Box Weight", default=1.0, min=-1.0, max=1.0,
                               description="Guidance inside the box (-1 drop ... 1 keep)")
+
+    source: PointerProperty(type=bpy.types.Object, name="Source",
+                            description="The object this result was decimated from (Regenerate re-runs it)")
+    settings: StringProperty(name="Settings", description="The decimation settings of this result (JSON)")
+    auto_regenerate: BoolProperty(name="Auto Regenerate", default=False,
+                                  description="Regenerate this result shortly after its source changes")
 
     sample_sets: CollectionProperty(type=TOPSTOC_PG_sample_set)
     sample_set_index: IntProperty(name="Sample Set")

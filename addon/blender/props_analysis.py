@@ -16,9 +16,9 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
                        PointerProperty, StringProperty)
 
 LOOP_KINDS = [
-    ("HANDLE", "Handle", "Goes around a handle: bounds a disk inside the solid (yellow)"),
-    ("TUNNEL", "Tunnel", "Goes through a hole: bounds a disk outside the solid (turquoise)"),
-    ("BOUNDARY", "Boundary", "A boundary loop (hole) of the surface (red vertices)"),
+    ("HANDLE", "Handle", "Goes around a handle, like a ring on a finger (yellow); cutting it opens the handle"),
+    ("TUNNEL", "Tunnel", "Goes through a handle's hole, like a thread through a ring (turquoise)"),
+    ("BOUNDARY", "Boundary", "The rim of an open hole (red vertices); Fill closes it"),
 ]
 STATES = [
     ("NONE", "None", "Not analysed yet"),

@@ -47,6 +47,7 @@ def steps():
     check("preview object shown, original hidden", preview is not None and bpy.data.objects["Torus"].hide_get())
     n = len(bpy.data.objects["Torus"].data.vertices)
     check("preview at 10 %", preview is not None and abs(len(preview.data.vertices) - 0.1 * n) <= 0.01 * n)
+    check("preview shows its wireframe", preview is not None and preview.show_wire and preview.show_all_edges)
     # 2: drag 150 px right: the ratio doubles; the preview follows
     for k in range(1, 11):
         window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=cx + 15 * k, y=cy)
@@ -55,6 +56,7 @@ def steps():
     preview = bpy.data.objects.get("Torus_TopStocPreview")
     check("preview follows the drag to 20 %", preview is not None
           and abs(len(preview.data.vertices) - 0.2 * n) <= 0.01 * n)
+    check("the sidebar ratio follows the drag", abs(bpy.context.scene.topstoc.ratio - 0.2) < 0.005)
     # 3: Enter applies: a new object at 20 %, the preview gone, the original visible again
     window.event_simulate(type="RET", value="PRESS")
     window.event_simulate(type="RET", value="RELEASE")

@@ -160,7 +160,9 @@ def test_operator_new_object_keeps_original(ts, scene):
     out = bpy.data.objects["Donut_TopStoc"]
     assert bpy.context.view_layer.objects.active == out
     assert 0 < len(out.data.vertices) < len(obj.data.vertices)
-    assert tuple(out.matrix_world.translation) == tuple(obj.matrix_world.translation)
+    xs = [c[0] for c in obj.bound_box]  # beside the original, offset by its width along X
+    assert tuple(out.matrix_world.translation) == pytest.approx((1.1 * (max(xs) - min(xs)), 0.0, 0.0))
+    assert not obj.hide_get()
     assert out["topstoc_source"] == "Donut"
 
 

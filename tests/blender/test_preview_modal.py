@@ -20,4 +20,4 @@ def test_preview_modal_drag_apply_cancel(ts):
                           capture_output=True, text=True, timeout=300, env=env)
     lines = [line for line in done.stdout.splitlines() if line.startswith("preview check")]
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
-    assert len(lines) == 8 and all(line.endswith(": ok") for line in lines), lines
+    assert len(lines) == 10 and all(line.endswith(": ok") for line in lines), lines

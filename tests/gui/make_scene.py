@@ -7,7 +7,7 @@
 Reads any mesh format through topstoc.core.io; --subdivide splits every triangle into four
 (midpoint subdivision: same shape and topology, more triangles); --transform moves, rotates and
 scales the object non-uniformly (overlays must follow); --decimate adds "<name>_TopStoc" at the
-same place; --measure stores the Hausdorff figures on the decimated object; --analyse and
+same place (moved back from beside the original); --measure stores the Hausdorff figures on the decimated object; --analyse and
 --loops store the topology and the handle/tunnel loops on the mesh. The default scene's cube
 is removed. Exits non-zero on any failure.
 """
@@ -70,6 +70,7 @@ def main():
     if args.decimate:
         assert bpy.ops.topstoc.guided_decimate(ratio=args.decimate) == {"FINISHED"}
         out = bpy.data.objects[args.name + "_TopStoc"]
+        out.matrix_world = obj.matrix_world.copy()  # on top of the original (the output goes beside it)
         if args.measure:
             bpy.context.view_layer.objects.active = out
             assert bpy.ops.topstoc.measure() == {"FINISHED"}

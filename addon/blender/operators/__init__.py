@@ -2,19 +2,21 @@
 
 import bpy
 
-from . import decimate, guidance, metrics, preview, samples, topology, variants
+from . import decimate, explain, guidance, import_off, metrics, preview, regenerate, samples, topology, variants
 
-MODULES = (decimate, guidance, preview, samples, variants, topology, metrics)
+MODULES = (decimate, guidance, preview, samples, variants, regenerate, topology, metrics, import_off, explain)
 
 
 def register():
     for module in MODULES:
         for cls in module.CLASSES:
             bpy.utils.register_class(cls)
+    import_off.register_menu()
 
 
 def unregister():
     topology.cancel_all()
+    import_off.unregister_menu()
     for module in reversed(MODULES):
         for cls in reversed(module.CLASSES):
             bpy.utils.unregister_class(cls)

@@ -8,14 +8,15 @@ import bpy
 
 from .. import pipeline
 from ...core.errors import TopStocError
-from ..props import DecimationParameters, copy_parameters
+from ..props import OperatorParameters, explicit_engine_options, fill_from_scene
+from . import polls
 
 
 def selected_meshes(context):
     return [obj for obj in context.selected_objects if obj.type == "MESH"]
 
 
-class TOPSTOC_OT_guided_decimate(DecimationParameters, bpy.types.Operator):
+class TOPSTOC_OT_guided_decimate(OperatorParameters, bpy.types.Operator):
     """Decimate the selected meshes with TopStoc, honouring their guidance"""
 
     bl_idname = "topstoc.guided_decimate"
@@ -24,10 +25,10 @@ class TOPSTOC_OT_guided_decimate(DecimationParameters, bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return context.mode == "OBJECT" and bool(selected_meshes(context))
+        return polls.refuse(cls, polls.selected_meshes(context))
 
     def invoke(self, context, event):
-        copy_parameters(context.scene.topstoc, self)  # the panel's settings; the redo panel tweaks them
+        fill_from_scene(self, context.scene.topstoc)  # the panel's settings; the redo panel tweaks them
         return self.execute(context)
 
     def draw(self, context):
@@ -38,10 +39,15 @@ class TOPSTOC_OT_guided_decimate(DecimationParameters, bpy.types.Operator):
         layout.prop(self, field)
         if self.target_mode == "MAX_ERROR":
             layout.prop(self, "max_error_relative")
+        layout.prop(self, "quality")
+        row = layout.row(align=True)
+        row.prop(self, "use_symmetry")
+        row.prop(self, "symmetry_axis", expand=True)
         for name in ("seed", "adaptivity", "density", "placement", "refine", "output"):
             layout.prop(self, name)
 
     def execute(self, context):
+        explicit_engine_options(self)
         start = time.perf_counter()
         outputs, lines, failures = [], [], []
         for obj in selected_meshes(context):

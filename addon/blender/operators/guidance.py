@@ -8,6 +8,7 @@ from bpy.props import EnumProperty, FloatProperty
 
 from ...core import guidance as rules
 from .. import mesh_io
+from . import polls
 
 LEVELS = [("KEEP", "Keep", "Always keep (u = 1)"), ("MORE", "More", "More detail (u = 0.5)"),
           ("NEUTRAL", "Neutral", "Follow the global target (u = 0)"),
@@ -66,7 +67,10 @@ class TOPSTOC_OT_add_guidance_layer(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return context.object is not None and context.object.type == "MESH" and context.mode != "EDIT_MESH"
+        reason = polls.active_mesh(context)
+        if reason is None and context.mode == "EDIT_MESH":
+            reason = "Switch to Object Mode first"
+        return polls.refuse(cls, reason)
 
     def execute(self, context):
         ensure_layer(context.object)
@@ -94,7 +98,8 @@ class TOPSTOC_OT_set_guidance(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return context.mode == "EDIT_MESH" and context.edit_object is not None
+        return polls.refuse(cls, None if context.mode == "EDIT_MESH" and context.edit_object is not None
+                            else "Works in Edit Mode: select vertices or faces first")
 
     def execute(self, context):
         obj = context.edit_object
@@ -120,9 +125,10 @@ class TOPSTOC_OT_show_guidance(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        obj = context.object
-        return (obj is not None and obj.type == "MESH" and context.space_data is not None
-                and context.space_data.type == "VIEW_3D")
+        reason = polls.active_mesh(context)
+        if reason is None and (context.space_data is None or context.space_data.type != "VIEW_3D"):
+            reason = "Run this from a 3D Viewport"
+        return polls.refuse(cls, reason)
 
     def execute(self, context):
         obj = context.object
@@ -149,7 +155,7 @@ class TOPSTOC_OT_add_box(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return context.mode == "OBJECT"
+        return polls.refuse(cls, polls.object_mode(context))
 
     def execute(self, context):
         box = bpy.data.objects.new("TopStoc Box", None)

@@ -10,6 +10,7 @@ from bpy.props import FloatProperty, IntProperty
 from mathutils import Euler, Vector
 
 from .. import metrics
+from . import polls
 
 
 def _mesh_object(context):
@@ -27,7 +28,7 @@ triangle quality (aspect ratio)"""
 
     @classmethod
     def poll(cls, context):
-        return _mesh_object(context) is not None and context.mode == "OBJECT"
+        return polls.refuse(cls, polls.active_mesh_in_object_mode(context))
 
     def execute(self, context):
         obj = _mesh_object(context)
@@ -55,8 +56,10 @@ exports) and show it in Solid mode"""
 
     @classmethod
     def poll(cls, context):
-        obj = _mesh_object(context)
-        return obj is not None and context.mode == "OBJECT" and obj.topstoc.metrics.state == "OK"
+        reason = polls.active_mesh_in_object_mode(context)
+        if reason is None and context.active_object.topstoc.metrics.state != "OK":
+            reason = "Measure first: the colours show the measured error"
+        return polls.refuse(cls, reason)
 
     def execute(self, context):
         obj = _mesh_object(context)
@@ -108,8 +111,10 @@ class TOPSTOC_OT_turntable(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return (context.active_object is not None and context.area is not None and context.area.type == "VIEW_3D"
-                and context.space_data.region_3d is not None)
+        reason = "Select an object first" if context.active_object is None else polls.view_3d(context)
+        if reason is None and context.space_data.region_3d is None:
+            reason = "Run this from a 3D Viewport"
+        return polls.refuse(cls, reason)
 
     def invoke(self, context, event):
         view = context.space_data.region_3d

@@ -7,6 +7,7 @@ from bpy.props import StringProperty
 
 from .. import pipeline
 from ...core.errors import TopStocError
+from . import polls
 
 
 class TOPSTOC_OT_save_samples(bpy.types.Operator):
@@ -20,8 +21,10 @@ class TOPSTOC_OT_save_samples(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        obj = context.object
-        return obj is not None and obj.type == "MESH" and pipeline.LAST_SAMPLES in obj.topstoc.sample_sets
+        reason = polls.active_mesh(context)
+        if reason is None and pipeline.LAST_SAMPLES not in context.active_object.topstoc.sample_sets:
+            reason = "Run Guided Decimate (New Object) first: it remembers the samples it used"
+        return polls.refuse(cls, reason)
 
     def execute(self, context):
         sets = context.object.topstoc.sample_sets
@@ -45,8 +48,10 @@ class TOPSTOC_OT_restore_samples(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        obj = context.object
-        return context.mode == "OBJECT" and obj is not None and obj.type == "MESH" and len(obj.topstoc.sample_sets)
+        reason = polls.active_mesh_in_object_mode(context)
+        if reason is None and not len(context.active_object.topstoc.sample_sets):
+            reason = "This object has no saved samples"
+        return polls.refuse(cls, reason)
 
     def execute(self, context):
         obj = context.object

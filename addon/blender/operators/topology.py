@@ -17,6 +17,7 @@ from bpy.props import EnumProperty
 
 from ...core import edit
 from .. import analysis, mesh_edit, mesh_io, watch
+from . import polls
 
 #: Searches running in the background, by object name (the panel shows their progress).
 running: dict = {}
@@ -37,6 +38,16 @@ def _mesh_object(context):
 def _object_or_edit_mode(context) -> bool:
     obj = _mesh_object(context)
     return obj is not None and context.mode in {"OBJECT", "EDIT_MESH"} and obj.name not in running
+
+
+def _why_not_editable(context):
+    """Reason the topology tools cannot run now (None: they can)."""
+    reason = polls.active_mesh(context)
+    if reason is None and context.mode not in {"OBJECT", "EDIT_MESH"}:
+        reason = "Switch to Object or Edit Mode first"
+    if reason is None and context.active_object.name in running:
+        reason = "A loop search is running on this object (Esc cancels it)"
+    return reason
 
 
 class _ObjectModeSection:
@@ -65,8 +76,8 @@ def _redraw_panels(context) -> None:
 
 
 class TOPSTOC_OT_analyse(bpy.types.Operator):
-    """Compute V, E, F, the Betti numbers, χ and the genus per component, boundary loops, \
-non-manifold elements and the generator edges (fast)"""
+    """Count the pieces, handles (genus) and open holes of the mesh and check that it is \
+manifold: V, E, F, Betti numbers, χ per piece (fast)"""
 
     bl_idname = "topstoc.analyse"
     bl_label = "Analyse"
@@ -74,7 +85,7 @@ non-manifold elements and the generator edges (fast)"""
 
     @classmethod
     def poll(cls, context):
-        return _object_or_edit_mode(context)
+        return polls.refuse(cls, _why_not_editable(context))
 
     def execute(self, context):
         obj = _mesh_object(context)
@@ -90,8 +101,8 @@ non-manifold elements and the generator edges (fast)"""
 
 
 class TOPSTOC_OT_find_loops(bpy.types.Operator):
-    """Find the handle and tunnel loops of every closed component (TetGen + persistence). \
-Runs in the background; Esc cancels"""
+    """Find the loops around (handle) and through (tunnel) each handle of the closed pieces, \
+to cut or remove unwanted handles before decimating or printing. Runs in the background; Esc cancels"""
 
     bl_idname = "topstoc.find_loops"
     bl_label = "Find Handles & Tunnels"
@@ -99,8 +110,10 @@ Runs in the background; Esc cancels"""
 
     @classmethod
     def poll(cls, context):
-        obj = _mesh_object(context)
-        return obj is not None and context.mode == "OBJECT" and obj.name not in running
+        reason = polls.active_mesh_in_object_mode(context)
+        if reason is None and context.active_object.name in running:
+            reason = "A loop search is already running on this object"
+        return polls.refuse(cls, reason)
 
     def execute(self, context):  # synchronous: background mode, scripts
         obj = _mesh_object(context)
@@ -175,8 +188,10 @@ class TOPSTOC_OT_loop_step(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        obj = _mesh_object(context)
-        return obj is not None and len(obj.topstoc.topology.loops) > 0
+        reason = polls.active_mesh(context)
+        if reason is None and not len(context.active_object.topstoc.topology.loops):
+            reason = "No loops yet: press Find Loops first"
+        return polls.refuse(cls, reason)
 
     def execute(self, context):
         topology = _mesh_object(context).topstoc.topology
@@ -188,13 +203,20 @@ class TOPSTOC_OT_loop_step(bpy.types.Operator):
 class _LoopOperator:
     @classmethod
     def poll(cls, context):
-        obj = _mesh_object(context)
-        return (obj is not None and _object_or_edit_mode(context) and analysis.active_loop(obj) is not None
-                and cls.kinds_ok(analysis.active_loop(obj).kind))
+        reason = _why_not_editable(context)
+        if reason is None:
+            loop = analysis.active_loop(context.active_object)
+            if loop is None:
+                reason = "No active loop: press Find Loops, then pick one in the list"
+            elif not cls.kinds_ok(loop.kind):
+                reason = cls.kind_message
+        return polls.refuse(cls, reason)
 
     @staticmethod
     def kinds_ok(kind) -> bool:
         return True
+
+    kind_message = ""
 
     def edit_active_loop(self, context, edit_function, verb: str) -> set:
         """Runs ``edit_function(vertices, triangles, loop_ids)`` on the active loop."""
@@ -298,7 +320,8 @@ class TOPSTOC_OT_select_loop(_LoopOperator, bpy.types.Operator):
 
 
 class TOPSTOC_OT_cut_loop(_LoopOperator, bpy.types.Operator):
-    """Cut the surface open along the active loop (two new boundary loops)"""
+    """Cut the surface open along the active loop: the handle becomes two holes with rims \
+(genus -1, two new boundary loops)"""
 
     bl_idname = "topstoc.cut_loop"
     bl_label = "Cut Along Loop"
@@ -308,13 +331,15 @@ class TOPSTOC_OT_cut_loop(_LoopOperator, bpy.types.Operator):
     def kinds_ok(kind) -> bool:
         return kind != "BOUNDARY"
 
+    kind_message = "The active loop is a boundary (a hole's rim): fill it with Fill Holes instead"
+
     def execute(self, context):
         return self.edit_active_loop(context, edit.cut_along_loop, "cut along")
 
 
 class TOPSTOC_OT_remove_loop(_LoopOperator, bpy.types.Operator):
-    """Remove the handle or tunnel the active loop goes around: cut along it and fill both \
-holes (the genus drops by one)"""
+    """Remove the handle the active loop goes around or through: cut along it and fill both \
+holes (the genus drops by one; e.g. a scan's tiny unwanted handle)"""
 
     bl_idname = "topstoc.remove_loop"
     bl_label = "Remove"
@@ -323,6 +348,8 @@ holes (the genus drops by one)"""
     @staticmethod
     def kinds_ok(kind) -> bool:
         return kind != "BOUNDARY"
+
+    kind_message = "The active loop is a boundary (a hole's rim): fill it with Fill Holes instead"
 
     def execute(self, context):
         return self.edit_active_loop(context, edit.remove_handle, "removed")
@@ -334,7 +361,8 @@ FILL_MODES = [("ACTIVE", "Active Loop", "Fill the active boundary loop"),
 
 
 class TOPSTOC_OT_fill_holes(bpy.types.Operator):
-    """Fill holes (planar projection and 2D triangulation, robust fallbacks)"""
+    """Close open holes, as a watertight 3D print needs (planar projection and 2D \
+triangulation, robust fallbacks)"""
 
     bl_idname = "topstoc.fill_holes"
     bl_label = "Fill Holes"
@@ -344,7 +372,7 @@ class TOPSTOC_OT_fill_holes(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return _object_or_edit_mode(context)
+        return polls.refuse(cls, _why_not_editable(context))
 
     def execute(self, context):
         obj = _mesh_object(context)
@@ -383,7 +411,7 @@ class TOPSTOC_OT_delete_faces(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return _object_or_edit_mode(context)
+        return polls.refuse(cls, _why_not_editable(context))
 
     def execute(self, context):
         def compute(o, arrays):

@@ -8,7 +8,8 @@ from mathutils import Vector
 
 from .. import pipeline
 from ...core.errors import TopStocError
-from ..props import DecimationParameters, copy_parameters
+from ..props import OperatorParameters, explicit_engine_options, fill_from_scene
+from . import polls
 
 
 def parse_ratios(text: str) -> list:
@@ -49,16 +50,15 @@ def _lay_out(source, objects, collection) -> None:
         obj.location.x += step * (i + 1)
 
 
-class _VariantsBase(DecimationParameters):
+class _VariantsBase(OperatorParameters):
     bl_options = {"REGISTER", "UNDO"}
 
     @classmethod
     def poll(cls, context):
-        obj = context.object
-        return context.mode == "OBJECT" and obj is not None and obj.type == "MESH"
+        return polls.refuse(cls, polls.active_mesh_in_object_mode(context))
 
     def invoke(self, context, event):
-        copy_parameters(context.scene.topstoc, self)
+        fill_from_scene(self, context.scene.topstoc)
         return self.execute(context)
 
     def variants(self, context) -> list:
@@ -68,6 +68,7 @@ class _VariantsBase(DecimationParameters):
         raise NotImplementedError
 
     def execute(self, context):
+        explicit_engine_options(self)
         obj = context.object
         try:
             runs = pipeline.decimate_many(context, obj, self, self.variants(context))
@@ -75,7 +76,7 @@ class _VariantsBase(DecimationParameters):
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         names = self.names(obj, runs)
-        outputs = [pipeline.write_output(run, "NEW_OBJECT", name=name) for run, name in zip(runs, names)]
+        outputs = [pipeline.write_output(run, "NEW_OBJECT", name=name, place=False) for run, name in zip(runs, names)]
         _lay_out(obj, outputs, _collection(context, self.collection_name(obj)))
         counts = ", ".join(f"{run.result.num_vertices:,}" for run in runs)
         self.report({"INFO"}, f"TopStoc: {len(runs)} variants of {obj.name} ({counts} vertices) "
@@ -93,8 +94,10 @@ class TOPSTOC_OT_multiview(_VariantsBase, bpy.types.Operator):
     variance: bpy.props.FloatProperty(name="Variance", default=0.25, min=0.0, max=0.95, subtype="FACTOR")
 
     def invoke(self, context, event):
-        self.count = context.scene.topstoc.variants
-        self.variance = context.scene.topstoc.variance
+        if not self.properties.is_property_set("count"):
+            self.count = context.scene.topstoc.variants
+        if not self.properties.is_property_set("variance"):
+            self.variance = context.scene.topstoc.variance
         return super().invoke(context, event)
 
     def variants(self, context):
@@ -117,7 +120,8 @@ class TOPSTOC_OT_lod_chain(_VariantsBase, bpy.types.Operator):
     ratios: bpy.props.StringProperty(name="Ratios", default="1.0, 0.5, 0.25, 0.1")
 
     def invoke(self, context, event):
-        self.ratios = context.scene.topstoc.lod_ratios
+        if not self.properties.is_property_set("ratios"):
+            self.ratios = context.scene.topstoc.lod_ratios
         return super().invoke(context, event)
 
     def variants(self, context):

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import bpy
 
+from ..pipeline import face_estimate
 
 CATEGORY = "TopStoc"
 
@@ -30,6 +31,14 @@ class _MeshPanel(_Panel):
             self.layout.label(text="Select a mesh")
             return
         self.draw_mesh(context, self.layout, obj)
+def _estimate_text(context, settings) -> str:
+    obj = context.active_object
+    if obj is None or obj.type != "MESH":
+        return ""
+    estimate = face_estimate(settings, obj.data)
+    if estimate is None:
+        return "Face Count: when run"
+    return f"Face Count ≈ {estimate:,}"
 
 
 class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
@@ -40,26 +49,69 @@ class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
     def draw(self, context):
         layout = self.layout
         settings = context.scene.topstoc
-        layout.prop(settings, "target_mode")
+        row = layout.row(align=True)
+        row.menu("TOPSTOC_MT_presets", text="Presets")
+        row.operator("topstoc.preset_add", text="", icon="ADD")
+        row.operator("topstoc.preset_add", text="", icon="REMOVE").remove_active = True
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        col = layout.column(align=True)
+        col.prop(settings, "target_mode")
         if settings.target_mode == "RATIO":
-            layout.prop(settings, "ratio")
+            col.prop(settings, "ratio")
         elif settings.target_mode == "VERTICES":
-            layout.prop(settings, "vertices")
+            col.prop(settings, "vertices")
         elif settings.target_mode == "TRIANGLES":
-            layout.prop(settings, "triangles")
+            col.prop(settings, "triangles")
         else:
-            row = layout.row(align=True)
-            row.prop(settings, "max_error")
-            row.prop(settings, "max_error_relative", text="%")
+            col.prop(settings, "max_error")
+            col.prop(settings, "max_error_relative", text="Percent")
+        estimate = _estimate_text(context, settings)
+        if estimate:
+            layout.label(text=estimate, icon="MESH_DATA")
+        layout.prop(settings, "quality")
+        row = layout.row(align=True, heading="Symmetry")
+        row.prop(settings, "use_symmetry", text="")
+        sub = row.row(align=True)
+        sub.active = settings.use_symmetry
+        sub.prop(settings, "symmetry_axis", expand=True)
+        row = layout.row(align=True)  # full width: "New Object" does not fit beside a label
+        row.use_property_split = False
+        row.prop(settings, "output", expand=True)
+        col = layout.column(align=True)
+        col.operator("topstoc.guided_decimate", icon="MOD_DECIM")
+        col.operator("topstoc.preview", icon="HIDE_OFF")
+        obj = context.active_object
+        if obj is not None and obj.type == "MESH" and obj.topstoc.settings:
+            box = layout.box()
+            source = obj.topstoc.source
+            box.label(text=f"Result of {source.name}" if source else "Source deleted", icon="LINKED")
+            row = box.row(align=True)
+            row.operator("topstoc.regenerate", icon="FILE_REFRESH")
+            row.prop(obj.topstoc, "auto_regenerate", text="Auto")
+
+
+class TOPSTOC_PT_advanced(_Panel, bpy.types.Panel):
+    bl_label = "Advanced"
+    bl_idname = "TOPSTOC_PT_advanced"
+    bl_parent_id = "TOPSTOC_PT_decimate"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        settings = context.scene.topstoc
+        layout.use_property_split = True
+        layout.use_property_decorate = False
         col = layout.column(align=True)
         col.prop(settings, "seed")
         col.prop(settings, "adaptivity")
         layout.prop(settings, "density")
-        layout.prop(settings, "placement")
-        layout.prop(settings, "refine")
-        layout.prop(settings, "output", expand=True)
-        layout.operator("topstoc.guided_decimate", icon="MOD_DECIM")
-        layout.operator("topstoc.preview", icon="HIDE_OFF")
+        col = layout.column(align=True)
+        col.active = settings.quality == "CUSTOM"
+        col.prop(settings, "placement")
+        col.prop(settings, "refine")
+        if settings.quality != "CUSTOM":
+            layout.label(text="Set by Quality", icon="INFO")
 
 
 class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
@@ -84,11 +136,14 @@ class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
         box = layout.box()
         box.prop(s, "use_color")
         if s.use_color:
-            box.prop_search(s, "color_attribute", obj.data, "color_attributes")
+            if obj.data.color_attributes.get(s.color_attribute) is not None:
+                box.prop_search(s, "color_attribute", obj.data, "color_attributes", text="Layer")
+            else:  # no red "invalid" field before the layer exists: offer to make it
+                box.label(text="Not painted yet", icon="INFO")
             box.prop(s, "color_strength")
             row = box.row(align=True)
-            row.operator("topstoc.add_guidance_layer", icon="BRUSH_DATA")
-            row.operator("topstoc.show_guidance", icon="SHADING_SOLID")
+            row.operator("topstoc.add_guidance_layer", text="Add Layer", icon="BRUSH_DATA")
+            row.operator("topstoc.show_guidance", text="Show", icon="SHADING_SOLID")
         if context.mode == "EDIT_MESH":
             row = box.row(align=True)
             for level, label in (("KEEP", "Keep"), ("MORE", "More"), ("NEUTRAL", "Neutral"), ("LESS", "Less"),
@@ -166,4 +221,4 @@ class TOPSTOC_PT_samples(_Panel, bpy.types.Panel):
             row.operator("topstoc.remove_samples", text="", icon="X").name = entry.name
 
 
-CLASSES = (TOPSTOC_PT_decimate, TOPSTOC_PT_guidance, TOPSTOC_PT_variants, TOPSTOC_PT_samples)
+CLASSES = (TOPSTOC_PT_decimate, TOPSTOC_PT_advanced, TOPSTOC_PT_guidance, TOPSTOC_PT_variants, TOPSTOC_PT_samples)

@@ -7,6 +7,7 @@ import textwrap
 import bpy
 
 from .. import analysis
+from ..topology_help import HELP
 from ..operators.topology import running
 from .panels import _MeshPanel, _Panel, _mesh
 
@@ -24,24 +25,59 @@ def wrapped(layout, context, text: str, icon: str = "NONE") -> None:
 
 def invariant_rows(topology) -> list:
     """(label, value) pairs of the panel's table, in Blender's counts (polygons, edges)."""
+    return [(label, value) for label, value, _topic in help_rows(topology)]
+
+
+def help_rows(topology) -> list:
+    """(label, value, help topic) rows of the panel's table (topology_help.HELP)."""
     genus = "undefined" if topology.genus < 0 else str(topology.genus)
-    return [("Vertices", f"{topology.vertices:,}"), ("Edges", f"{topology.edges:,}"),
-            ("Faces", f"{topology.faces:,}"), ("Triangles", f"{topology.triangles:,}"),
-            ("β0 / β1 / β2", f"{topology.betti0} / {topology.betti1} / {topology.betti2}"),
-            ("χ", str(topology.euler)), ("Genus", genus), ("Components", str(len(topology.components))),
-            ("Boundary Loops", str(topology.boundary_loops)),
-            ("Non-Manifold Edges", str(topology.nonmanifold_edges)),
-            ("Non-Manifold Verts", str(topology.nonmanifold_vertices)),
-            ("Isolated Vertices", str(topology.isolated_vertices))] + \
-        ([("Repeated Faces (counted once)", str(topology.duplicate_triangles))] if topology.duplicate_triangles else [])
+    rows = [("Vertices", f"{topology.vertices:,}", "vertices"), ("Edges", f"{topology.edges:,}", "edges"),
+            ("Faces", f"{topology.faces:,}", "faces"), ("Triangles", f"{topology.triangles:,}", "triangles"),
+            ("β0 / β1 / β2", f"{topology.betti0} / {topology.betti1} / {topology.betti2}", "betti"),
+            ("χ", str(topology.euler), "euler"), ("Genus", genus, "genus"),
+            ("Components", str(len(topology.components)), "components"),
+            ("Holes", str(topology.boundary_loops), "boundary"),
+            ("Non-Manifold", "", None),  # a heading: the full names do not fit the sidebar
+            ("   Edges", str(topology.nonmanifold_edges), "nonmanifold_edges"),
+            ("   Vertices", str(topology.nonmanifold_vertices), "nonmanifold_vertices"),
+            ("Loose Vertices", str(topology.isolated_vertices), "isolated")]
+    if topology.duplicate_triangles:
+        rows.append(("Repeated Faces", str(topology.duplicate_triangles), "faces"))
+    return rows
 
 
-def _table(layout, rows, factor: float = 0.68) -> None:
+def plain_summary(topology) -> str:
+    """One info line an artist can act on."""
+    pieces = len(topology.components)
+    parts = [f"{pieces} piece{'s' if pieces != 1 else ''}"]
+    if topology.genus > 0:
+        parts.append(f"{topology.genus} handle{'s' if topology.genus != 1 else ''} (donut-like holes through it)")
+    if topology.boundary_loops:
+        parts.append(f"{topology.boundary_loops} open hole{'s' if topology.boundary_loops != 1 else ''}")
+    bad = topology.nonmanifold_edges + topology.nonmanifold_vertices
+    if bad:
+        parts.append(f"{bad} non-manifold spots")
+    printable = not topology.boundary_loops and not bad
+    verdict = "closed and manifold: ready to print" if printable else "not watertight: fix before printing"
+    return ", ".join(parts) + f"; {verdict}"
+
+
+def help_button(layout, topic: str) -> None:
+    layout.operator("topstoc.explain", text="", icon="QUESTION", emboss=False).topic = topic
+
+
+def _table(layout, rows, factor: float = 0.62) -> None:
     col = layout.column(align=True)
-    for label, value in rows:
-        split = col.split(factor=factor, align=True)
+    for row in rows:
+        label, value = row[0], row[1]
+        line = col.row(align=True)
+        split = line.split(factor=factor, align=True)
         split.label(text=label)
         split.label(text=value)
+        if len(row) > 2 and row[2]:
+            help_button(line, row[2])
+        elif len(row) > 2:
+            line.label(text="", icon="BLANK1")
 
 
 class TOPSTOC_UL_components(bpy.types.UIList):
@@ -51,7 +87,7 @@ class TOPSTOC_UL_components(bpy.types.UIList):
 
 class TOPSTOC_UL_loops(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
-        split = layout.split(factor=0.55, align=True)
+        split = layout.split(factor=0.62, align=True)
         split.label(text=item.name, icon=KIND_ICONS.get(item.kind, "DOT"))
         warning = item.kind == "BOUNDARY" and not item.fillable
         split.label(text=f"{item.num_edges} edges", icon="ERROR" if warning else "NONE")
@@ -66,7 +102,7 @@ class TOPSTOC_PT_topology(_MeshPanel, bpy.types.Panel):
         topology = obj.topstoc.topology
         row = layout.row(align=True)
         row.operator("topstoc.analyse", icon="VIEWZOOM")
-        row.operator("topstoc.find_loops", icon="MOD_SCREW")
+        row.operator("topstoc.find_loops", text="Find Loops", icon="MOD_SCREW")
         search = running.get(obj.name)
         if search is not None:
             layout.label(text=f"{search.stage}: {100 * search.fraction:.0f} %"
@@ -81,8 +117,12 @@ class TOPSTOC_PT_topology(_MeshPanel, bpy.types.Panel):
             layout.label(text="Figures as of the last mode switch", icon="EDITMODE_HLT")
         elif not analysis.is_current(obj):
             layout.label(text="The mesh changed: Analyse again", icon="ERROR")
+        wrapped(layout, context, plain_summary(topology), "INFO")
         wrapped(layout, context, topology.summary)
-        _table(layout.box(), invariant_rows(topology))
+        _table(layout.box(), help_rows(topology))
+        row = layout.row()
+        row.label(text="Why does this matter?")
+        help_button(row, "why")
         layout.label(text=f"Analysed in {1000 * topology.seconds:.0f} ms")
 
 
@@ -138,7 +178,7 @@ class TOPSTOC_PT_topology_loops(_AnalysedPanel, bpy.types.Panel):
             wrapped(layout, context, topology.loops_message,
                     "ERROR" if topology.loops_state == "ERROR" else "INFO")
         if not topology.loops:
-            layout.label(text="No loops: Find Handles & Tunnels (closed surfaces)")
+            layout.label(text="No loops yet: press Find Loops")
             return
         layout.template_list("TOPSTOC_UL_loops", "", topology, "loops", topology, "loop_index", rows=4)
         active = analysis.active_loop(obj)
@@ -154,7 +194,10 @@ class TOPSTOC_PT_topology_loops(_AnalysedPanel, bpy.types.Panel):
         else:
             row.operator("topstoc.cut_loop", text="Cut")
             row.operator("topstoc.remove_loop", text="Remove")
-        layout.label(text=f"{active.name}: {active.num_edges} edges, length {active.length:.4g}")
+        row = layout.row()
+        row.label(text=f"{active.num_edges} edges, length {active.length:.4g}")
+        help_button(row, {"HANDLE": "handle", "TUNNEL": "tunnel"}.get(active.kind, "boundary_loop"))
+        wrapped(layout, context, HELP[{"HANDLE": "handle", "TUNNEL": "tunnel"}.get(active.kind, "boundary_loop")])
 
 
 class TOPSTOC_PT_topology_edit(_Panel, bpy.types.Panel):
