@@ -38,9 +38,12 @@ def parse_args(argv):
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--adaptivity", type=float, default=0.5)
     parser.add_argument("--density", choices=("off", "uniform", "adaptive"), default="off")
-    parser.add_argument("--placement", choices=("subsample", "filtered"), default="subsample")
-    parser.add_argument("--refine", type=int, default=0, metavar="F",
-                        help="0: off; F: TopStoc to F x the target, then quadric collapses (8: quality)")
+    parser.add_argument("--mode", choices=("quality", "fast"), default="quality",
+                        help="quality (default): TopStoc then quadric edge collapses; fast: plain TopStoc")
+    parser.add_argument("--placement", choices=("subsample", "filtered"), default=None,
+                        help="default: set by --mode")
+    parser.add_argument("--refine", type=float, default=None, metavar="F",
+                        help="0: off; F: TopStoc to F x the target, then quadric collapses (default: set by --mode)")
     parser.add_argument("--objects", nargs="+", metavar="NAME", help="objects to decimate in .blend inputs "
                                                                       "(default: every mesh object)")
     parser.add_argument("--output", required=True, metavar="DIR")
@@ -70,8 +73,8 @@ def _target(args, diagonal: float) -> dict:
 
 
 def _options(args) -> dict:
-    return dict(seed=args.seed, adaptivity=args.adaptivity, density=args.density, placement=args.placement,
-                refine=args.refine)
+    return dict(seed=args.seed, adaptivity=args.adaptivity, density=args.density, mode=args.mode,
+                placement=args.placement, refine=args.refine)
 
 
 def decimate_mesh_file(path: str, out_dir: str, args) -> dict:
@@ -116,6 +119,7 @@ class _Params:
         self.max_error = target.get("max_error", 0.0) * (100.0 if target.get("relative") else 1.0)
         self.max_error_relative = bool(target.get("relative"))
         self.seed, self.adaptivity, self.density = args.seed, args.adaptivity, args.density
+        self.quality_mode = args.mode.upper()
         self.placement, self.refine = args.placement, args.refine
 
 

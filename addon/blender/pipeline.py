@@ -60,8 +60,15 @@ def target_kwargs(params, prepared: Prepared) -> dict:
 
 
 def options_kwargs(params) -> dict:
-    return dict(seed=int(params.seed), adaptivity=float(params.adaptivity), density=params.density,
-                placement=params.placement, refine=int(params.refine))
+    """Engine options for a DecimationParameters holder. Quality mode (the default) uses the
+    engine's quality settings; Fast mode the holder's placement and refinement (by default
+    the thesis' plain TopStoc)."""
+    mode = str(getattr(params, "quality_mode", "QUALITY")).lower()
+    options = dict(seed=int(params.seed), adaptivity=float(params.adaptivity), density=params.density, mode=mode)
+    if mode == "fast":
+        options.update(placement=params.placement or None,
+                       refine=None if params.refine is None else float(params.refine))
+    return options
 
 
 def check_mesh(obj) -> None:
@@ -203,6 +210,9 @@ def summary(run: Run, seconds: float = None) -> str:
         text += f", deviation {bound.achieved_error:.4g} <= {bound.max_error:.4g}"
     if run.result.stats.repairs:
         text += f" ({run.result.stats.repairs} topology repairs)"
+    over = getattr(run.result.stats, "over_budget", 0)
+    if over:
+        text += f", {over:,} vertices over the target ({run.result.stats.over_budget_reason})"
     return text
 
 

@@ -34,6 +34,12 @@ PLACEMENTS = [
     ("subsample", "Subsample", "Output vertices are input vertices (attributes copy exactly)"),
     ("filtered", "Filtered", "Move vertices to the quadric-optimal point of their cluster"),
 ]
+QUALITY_MODES = [
+    ("QUALITY", "Quality", "TopStoc to a few times the target, then edge collapses by quadric error: the "
+                           "cleanest result (the live preview shows it when the drag pauses)"),
+    ("FAST", "Fast", "The thesis' plain TopStoc: milliseconds, higher deviation (what the live preview "
+                     "shows while dragging)"),
+]
 
 
 class DecimationParameters:
@@ -54,12 +60,14 @@ class DecimationParameters:
     adaptivity: FloatProperty(name="Adaptivity", description="0 samples uniformly, 1 follows curvature fully",
                               default=0.5, min=0.0, max=1.0, subtype="FACTOR")
     density: EnumProperty(name="Density Control", items=DENSITY_MODES, default="off")
-    placement: EnumProperty(name="Placement", items=PLACEMENTS, default="subsample")
+    quality_mode: EnumProperty(name="Mode", items=QUALITY_MODES, default="QUALITY")
+    placement: EnumProperty(name="Placement", items=PLACEMENTS, default="subsample",
+                            description="Fast mode only: keep input positions, or move vertices to their "
+                                        "cluster's quadric-optimal point")
     refine: IntProperty(name="Refine", default=0, min=0, max=32,
-                        description="0: off (fastest, for live previews). N: TopStoc keeps N times the target, "
-                                    "then vertices are dropped by quadric error against the original (lower "
-                                    "deviation, seconds on million-triangle meshes); 8 with Filtered placement "
-                                    "is the quality setting")
+                        description="Fast mode only. 0: off (plain TopStoc, fastest). N: TopStoc keeps N times "
+                                    "the target, then edge collapses by quadric error thin it (Quality mode "
+                                    "does this with its own settings)")
     output: EnumProperty(name="Output", items=OUTPUT_MODES, default="NEW_OBJECT")
 
 
