@@ -146,8 +146,9 @@ bool has_per_vertex_guidance(const SamplingParams& params) {
 }  // namespace
 
 double guidance_multiplier(double u) {
-  if (u >= 1.0) return kForcedMultiplier;
-  if (u <= -1.0) return 0.0;
+  // Within 1/256 of +-1 (what 8-bit painted colours can reach) is a hard keep or drop.
+  if (u >= 1.0 - 1.0 / 256.0) return kForcedMultiplier;
+  if (u <= -1.0 + 1.0 / 256.0) return 0.0;
   return u == 0.0 ? 1.0 : std::pow((1.0 + u) / (1.0 - u), 2.0);
 }
 

@@ -64,7 +64,7 @@ struct SampleSet {
 
 /// Guidance u as a density multiplier: ((1 + u) / (1 - u))^2 for -1 < u < 1 (u = 0.5: nine
 /// times the density, -0.5: a ninth), 0 for u = -1 (never sampled), kForcedMultiplier for u = 1
-/// (a control point). Paint redistributes the budget: the rate is solved so that the guided
+/// (a control point); within 1/256 of +-1 counts as +-1 (8-bit painted colours). Paint redistributes the budget: the rate is solved so that the guided
 /// probabilities min(1, k q m) still sum to the target.
 constexpr double kForcedMultiplier = -1.0;
 double guidance_multiplier(double u);
