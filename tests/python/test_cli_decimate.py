@@ -51,8 +51,10 @@ def test_triangle_and_ratio_targets(tmp_path):
 
 def test_same_seed_same_file_other_seed_other_file(tmp_path):
     source = DATA / "genus_positive" / "cgal_knot1.off"
+    # (fast mode: in the quality mode at 20 % the stochastic pass keeps every vertex, so the
+    # seed does not matter there)
     for name, seed in (("a.ply", 7), ("b.ply", 7), ("c.ply", 8)):
-        run_json(source, tmp_path / name, "--ratio", 0.2, "--seed", seed)
+        run_json(source, tmp_path / name, "--ratio", 0.2, "--seed", seed, "--mode", "fast")
     assert (tmp_path / "a.ply").read_bytes() == (tmp_path / "b.ply").read_bytes()
     assert (tmp_path / "a.ply").read_bytes() != (tmp_path / "c.ply").read_bytes()
 

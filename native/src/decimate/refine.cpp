@@ -13,6 +13,10 @@ namespace topstoc {
 
 namespace {
 
+// Collapses may not make a triangle thinner than this shape quality (see Collapser::shape;
+// 0.1 is an aspect ratio of about 5-10 by the thesis' measure) unless it already was.
+constexpr double kMinShape = 0.1;
+
 class Collapser {
  public:
   // curve: per output vertex, the feature curve it lies on (it may then move only along it), or
@@ -27,6 +31,7 @@ class Collapser {
         heap_(static_cast<int32_t>(result.kept.size())) {
     const size_t n = r_.kept.size(), m = r_.face_source.size();
     count_.assign(quota_.size(), 0);
+    alive_vertices_ = static_cast<int32_t>(n);
     for (int32_t b : bin_) ++count_[b];
     vertex_faces_.resize(n);
     for (size_t t = 0; t < m; ++t)
@@ -40,12 +45,13 @@ class Collapser {
   /// Collapses an edge of every zero-area triangle where a collapse is allowed (the triangle
   /// and its neighbour across the edge vanish; no collapse creates a new one). Returns the
   /// collapses made.
-  int32_t remove_zero_area() {
+  int32_t remove_zero_area(double min_shape = 0.0, int32_t keep = 0) {
     int32_t collapses = 0;
     for (bool progress = true; progress;) {
       progress = false;
       for (size_t t = 0; t < alive_face_.size(); ++t) {
-        if (!alive_face_[t] || !zero_area(int32_t(t))) continue;
+        if (alive_vertices_ <= keep) return collapses;
+        if (!alive_face_[t] || !(zero_area(int32_t(t)) || thin(int32_t(t), min_shape))) continue;
         const int32_t* c = &r_.triangles[3 * t];
         for (int j = 0; j < 6; ++j) {
           const int32_t u = c[j % 3], v = c[(j % 3 + (j < 3 ? 1 : 2)) % 3];
@@ -68,10 +74,9 @@ class Collapser {
 
   /// Collapses until `target` vertices remain or no collapse is allowed; returns the count.
   int32_t run(int32_t target) {
-    int32_t alive = static_cast<int32_t>(r_.kept.size());
     int32_t collapses = 0;
     for (;;) {
-      if (alive <= target) break;
+      if (alive_vertices_ <= target) break;
       if (heap_.empty()) {
         // Some region could not reach its quota: the others give the rest, by cost alone.
         if (!use_quota_) break;
@@ -96,7 +101,6 @@ class Collapser {
         continue;
       }
       collapse(u, v);
-      --alive;
       ++collapses;
     }
     return collapses;
@@ -197,6 +201,15 @@ class Collapser {
         queue(u, v, c);
         return;
       }
+  }
+
+  bool thin(int32_t t, double min_shape) const {
+    if (min_shape <= 0.0) return false;
+    double n[3];
+    const int32_t* c = &r_.triangles[3 * size_t(t)];
+    normal(c, c[0], &r_.positions[3 * size_t(c[0])], n);
+    return shape(c, c[0], &r_.positions[3 * size_t(c[0])], std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])) <
+           min_shape;
   }
 
   bool zero_area(int32_t t) const {
@@ -313,8 +326,23 @@ class Collapser {
       const double len2 = after[0] * after[0] + after[1] * after[1] + after[2] * after[2];
       // No flip, no near-fold (normal turned by more than ~80 degrees), no loss of area.
       if (!(dot > 0.17 * std::sqrt(len2 * before2)) || len2 <= 1e-24 * before2) return false;
+      // No sliver: a triangle may not end up thinner than kMinShape unless it was already.
+      if (shape(c, moved, x, std::sqrt(len2)) < kMinShape &&
+          shape(c, moved, &r_.positions[3 * size_t(moved)], std::sqrt(before2)) >= kMinShape)
+        return false;
     }
     return true;
+  }
+
+  // Shape quality 2 sqrt(3) |n| / (sum of squared edges) of triangle c with `replace` at `at`
+  // (|n| = twice its area): 1 for an equilateral triangle, 0 for a degenerate one.
+  double shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const {
+    const double* p[3];
+    for (int j = 0; j < 3; ++j) p[j] = c[j] == replace ? at : &r_.positions[3 * size_t(c[j])];
+    double edges = 0;
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) edges += (p[j][i] - p[(j + 1) % 3][i]) * (p[j][i] - p[(j + 1) % 3][i]);
+    return edges > 0 ? 2.0 * std::sqrt(3.0) * twice_area / edges : 0.0;
   }
 
   // Normal (unnormalised) of triangle c with vertex `replace` standing at `at`.
@@ -363,6 +391,7 @@ class Collapser {
     }
     if (curve_[u] >= 0) --curve_size_[curve_[u]];
     --count_[bin_[u]];
+    --alive_vertices_;
     vertex_faces_[u].clear();
     merged_into_[u] = v;
     quadric_[v].add(quadric_[u]);
@@ -392,6 +421,7 @@ class Collapser {
   std::vector<int32_t> corner_sector_;
   std::vector<int32_t> bin_, quota_, count_;  // per vertex its guidance bin; per bin quota, alive count
   bool use_quota_ = true;
+  int32_t alive_vertices_ = 0;
 
  public:
   bool optimal_placement = true;  // off: every collapse is a half-edge collapse (positions kept)
@@ -566,7 +596,10 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
     result.refine_collapses += collapser.remove_zero_area();
   } else {
     result.refine_vertices = params.target_vertices;
-    result.refine_collapses = collapser.run(params.target_vertices);
+    // Slivers the stochastic pass left (near-collinear corners) go first: the collapses thin
+    // the result anyway, and none of them makes a new one (Collapser::keeps_shape).
+    result.refine_collapses = collapser.remove_zero_area(kMinShape, params.target_vertices);
+    result.refine_collapses += collapser.run(params.target_vertices);
     result.refine_collapses += collapser.remove_zero_area();
   }
   result.repairs.remaining.sliver = collapser.zero_area_faces();
