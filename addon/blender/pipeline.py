@@ -165,6 +165,7 @@ def store_samples(run: Run, name: str = LAST_SAMPLES) -> None:
         entry.name = name
     # A refined result replays with its refinement target and the same per-vertex guidance.
     entry.parameters = json.dumps(dict(run.parameters, refine_vertices=int(run.result.stats.refine_vertices),
+                                       placement=run.result.parameters.get("placement", "subsample"),
                                        guidance_digest=guidance_digest(run.guidance.guidance)))
     entry.mesh_digest = run.prepared.digest
     entry.layout_digest = run.guidance.layout_digest()
