@@ -60,20 +60,27 @@ def target_kwargs(params, prepared: Prepared) -> dict:
     return {"max_error": float(params.max_error)}
 
 
-def quality_options(quality: str) -> dict:
-    """The engine options behind the panel's Quality choice (the one place to re-point when the
-    engine gains its own fast/quality mode). None for CUSTOM: the Advanced settings apply."""
-    if quality == "FAST":
-        return {"placement": "subsample", "refine": 0}
+def quality_options(quality: str):
+    """The engine options behind the panel's Quality choice; None for CUSTOM (the Advanced
+    placement and refinement apply)."""
     if quality == "QUALITY":
-        return {"placement": "filtered", "refine": 8}
+        return {"mode": "quality"}
+    if quality == "FAST":
+        return {"mode": "fast"}
     return None
 
 
 def options_kwargs(params) -> dict:
-    options = dict(seed=int(params.seed), adaptivity=float(params.adaptivity), density=params.density,
-                   placement=params.placement, refine=int(params.refine))
-    options.update(quality_options(getattr(params, "quality", "CUSTOM")) or {})
+    """Engine options for a DecimationParameters holder: the Quality choice picks the engine's
+    mode; Custom (or a holder without the choice, as the batch's) gives placement and refinement
+    itself, on the holder's mode (fast unless it says otherwise)."""
+    options = dict(seed=int(params.seed), adaptivity=float(params.adaptivity), density=params.density)
+    chosen = quality_options(getattr(params, "quality", "CUSTOM"))
+    if chosen is not None:
+        options.update(chosen)
+    else:
+        options.update(mode=getattr(params, "mode", None) or "fast", placement=params.placement or None,
+                       refine=None if params.refine is None else float(params.refine))
     return options
 
 
@@ -215,6 +222,7 @@ def store_samples(run: Run, name: str = LAST_SAMPLES) -> None:
         entry.name = name
     # A refined result replays with its refinement target and the same per-vertex guidance.
     entry.parameters = json.dumps(dict(run.parameters, refine_vertices=int(run.result.stats.refine_vertices),
+                                       placement=run.result.parameters.get("placement", "subsample"),
                                        guidance_digest=guidance_digest(run.guidance.guidance)))
     entry.mesh_digest = run.prepared.digest
     entry.layout_digest = run.guidance.layout_digest()
@@ -261,6 +269,9 @@ def summary(run: Run, seconds: float = None) -> str:
     if run.result.stats.repairs:
         text += (f" ({run.result.stats.repairs} topology repairs: vertices kept so that no hole closed and "
                  f"no handle or piece was lost)")
+    over = getattr(run.result.stats, "over_budget", 0)
+    if over:
+        text += f", {over:,} vertices over the target ({run.result.stats.over_budget_reason})"
     return text
 
 

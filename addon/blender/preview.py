@@ -13,6 +13,11 @@ is bound by memory latency more than by arithmetic, so two running side by side 
 each show nearly twice as many updates per second as one using both threads (horse, 1.55M
 triangles, ratios 5-20 %: 14.7 vs 8.8 per second outside Blender). Results are shown in the
 order they were requested: one that finishes after a newer one was shown is dropped.
+
+While the user drags, the preview shows the fast mode (plain TopStoc, milliseconds); when the
+drag pauses for PAUSE_SECONDS and the chosen mode is quality, the same ratio is computed in
+quality mode in the background and replaces the fast result when it is ready (the paint means
+the same in both modes, so the density does not jump).
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ from .guidance import gather
 
 PREVIEW_SUFFIX = "_TopStocPreview"
 WORKERS = 2 if (os.cpu_count() or 1) >= 2 else 1
+PAUSE_SECONDS = 0.35  # a drag paused this long gets the quality result
 
 
 class PreviewSession:
@@ -42,6 +48,9 @@ class PreviewSession:
         self.guidance = gather(obj, self.prepared.arrays, context.scene, None, region_3d)
         self.prepared.mesh.feature_layout(self.guidance.regions, self.guidance.borders)
         self.options = pipeline.options_kwargs(params)
+        # While dragging: the fast mode; on a pause: the chosen mode (if it is not fast already).
+        self.drag_options = dict(self.options, mode="fast", placement=None, refine=None) \
+            if self.options.get("mode", "quality") != "fast" else self.options
         self.mesh = bpy.data.meshes.new(obj.name + PREVIEW_SUFFIX)
         for material in obj.data.materials:
             self.mesh.materials.append(material)
@@ -65,35 +74,41 @@ class PreviewSession:
         self._last_start = 0.0                 # when the newest computation started
         self._typical = 0.0                    # running average of a computation's seconds
         self.ratio: Optional[float] = None
+        self.final = False                     # the shown result is in the chosen mode
+        self._last_shown = time.perf_counter()
         self.result = None
         self.seconds_decimate = 0.0
         self.seconds_write = 0.0
 
-    def compute(self, ratio: float):
-        """Decimates at ``ratio`` and derives the result's edges (any thread: the main thread
-        then only copies arrays into the preview mesh)."""
+    def compute(self, ratio: float, final: bool = False):
+        """Decimates at ``ratio`` (fast, or in the chosen mode with ``final``) and derives the
+        result's edges (any thread: the main thread then only copies arrays into the preview)."""
         start = time.perf_counter()
-        result = self.prepared.mesh.decimate(ratio=ratio, **self.options, **self.guidance.decimate_kwargs())
+        options = self.options if final else self.drag_options
+        result = self.prepared.mesh.decimate(ratio=ratio, **options, **self.guidance.decimate_kwargs())
         edges = mesh_edges(result.triangles, len(result.vertices))
-        return ratio, result, edges, time.perf_counter() - start
+        return (ratio, final or options is self.options), result, edges, time.perf_counter() - start
 
-    def show(self, ratio: float, result, edges, seconds: float) -> None:
-        """Puts a result into the preview object (main thread)."""
+    def show(self, key, result, edges, seconds: float) -> None:
+        """Puts a result into the preview object (main thread); key: ratio or (ratio, final)."""
         start = time.perf_counter()
+        ratio, final = key if isinstance(key, tuple) else (key, False)
         mesh_io.fill_geometry(self.mesh, result.vertices, result.triangles, edges)
-        self.ratio, self.result, self.seconds_decimate = ratio, result, seconds
+        self.ratio, self.final, self.result, self.seconds_decimate = ratio, final, result, seconds
         self.seconds_write = time.perf_counter() - start
+        self._last_shown = time.perf_counter()
 
-    def update(self, ratio: float) -> None:
+    def update(self, ratio: float, final: bool = False) -> None:
         """Synchronous update (benchmarks, tests)."""
-        self.show(*self.compute(ratio))
+        self.show(*self.compute(ratio, final))
         with self._lock:
-            self._started = ratio
+            self._started = (ratio, final)
 
-    def request(self, ratio: float) -> None:
-        """Asks for ``ratio``; only the latest request is computed."""
+    def request(self, ratio: float, final: bool = False) -> None:
+        """Asks for ``ratio`` (fast while dragging; ``final``: the chosen mode); only the latest
+        request is computed."""
         with self._lock:
-            self._pending = ratio
+            self._pending = (ratio, final)
         self._start_worker()
 
     def _start_worker(self) -> None:
@@ -107,16 +122,16 @@ class PreviewSession:
         while True:
             self._stagger()
             with self._lock:
-                ratio, self._pending = self._pending, None
-                if ratio is None or ratio == self._started:
+                key, self._pending = self._pending, None
+                if key is None or key == self._started:
                     self._workers -= 1
                     return
-                self._started = ratio
+                self._started = key
                 self._started_count += 1
                 self._last_start = time.perf_counter()
                 order = self._started_count
             try:
-                finished = self.compute(ratio)
+                finished = self.compute(*key)
             except Exception as error:  # noqa: BLE001 - handed to the main thread
                 with self._lock:
                     self._error, self._started = error, None
@@ -154,6 +169,12 @@ class PreviewSession:
         self._start_worker()  # a request that came while a worker was stopping
         if finished:
             self.show(*finished[1])
+        elif not self.final and self.ratio is not None and not self.busy \
+                and time.perf_counter() - self._last_shown >= PAUSE_SECONDS:
+            with self._lock:
+                idle = self._pending is None
+            if idle:  # the drag paused: replace the fast result with the chosen mode's
+                self.request(self.ratio, final=True)
         return finished is not None
 
     @property

@@ -31,18 +31,19 @@ OUTPUT_MODES = [
                                  "width); a rigged original stays where it is and is hidden instead"),
     ("IN_PLACE", "In Place", "Replace the object's mesh (undo restores it)"),
 ]
-QUALITY_MODES = [
-    ("FAST", "Fast", "Plain TopStoc: output vertices are input vertices; fastest, what the live preview shows"),
-    ("QUALITY", "Quality", "Lower deviation from the original: vertices placed in their cluster and "
-                           "refined by quadric error (slower on big meshes)"),
-    ("CUSTOM", "Custom", "Use the Placement and Refine settings under Advanced"),
-]
 SYMMETRY_AXES = [("X", "X", "Mirror across the object's local YZ plane"),
                  ("Y", "Y", "Mirror across the object's local XZ plane"),
                  ("Z", "Z", "Mirror across the object's local XY plane")]
 PLACEMENTS = [
     ("subsample", "Subsample", "Output vertices are input vertices (attributes copy exactly)"),
     ("filtered", "Filtered", "Move vertices to the quadric-optimal point of their cluster"),
+]
+QUALITY_MODES = [
+    ("QUALITY", "Quality", "TopStoc to a few times the target, then edge collapses by quadric error: the "
+                           "cleanest result (the live preview shows it when the drag pauses)"),
+    ("FAST", "Fast", "The thesis' plain TopStoc: output vertices are input vertices; milliseconds, higher "
+                     "deviation (what the live preview shows while dragging)"),
+    ("CUSTOM", "Custom", "Plain TopStoc with the Placement and Refine settings under Advanced"),
 ]
 
 
@@ -60,7 +61,7 @@ class DecimationParameters:
     max_error_relative: BoolProperty(name="Percent of Diagonal",
                                      description="Max deviation in % of the bounding-box diagonal",
                                      default=True)
-    quality: EnumProperty(name="Quality", items=QUALITY_MODES, default="FAST",
+    quality: EnumProperty(name="Quality", items=QUALITY_MODES, default="QUALITY",
                           description="Fast or lower-deviation result (Custom: the Advanced settings)")
     use_symmetry: BoolProperty(name="Symmetry", default=False,
                                description="A mirror-symmetric mesh gives a mirror-symmetric result "
@@ -75,10 +76,9 @@ class DecimationParameters:
     placement: EnumProperty(name="Placement", items=PLACEMENTS, default="subsample",
                             description="Where output vertices go (used when Quality is Custom)")
     refine: IntProperty(name="Refine", default=0, min=0, max=32,
-                        description="0: off (fastest, for live previews). N: TopStoc keeps N times the target, "
-                                    "then vertices are dropped by quadric error against the original (lower "
-                                    "deviation, seconds on million-triangle meshes); 8 with Filtered placement "
-                                    "is the quality setting")
+                        description="Fast mode only. 0: off (plain TopStoc, fastest). N: TopStoc keeps N times "
+                                    "the target, then edge collapses by quadric error thin it (Quality mode "
+                                    "does this with its own settings)")
     output: EnumProperty(name="Output", items=OUTPUT_MODES, default="NEW_OBJECT")
 
 

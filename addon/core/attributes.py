@@ -5,6 +5,12 @@ region, so attributes carry over exactly when the decimation is told where they 
 materials as per-triangle regions, UV seams as flagged edges (``Mesh.decimate(regions=...,
 borders=...)``). Afterwards ``DecimateResult.corner_source`` and ``face_source`` say which input
 corner and triangle each output corner and triangle takes its attributes from.
+
+The quality mode moves free vertices (optimal placement; never vertices on a border or seam).
+A moved vertex takes its attributes interpolated, barycentrically, from the closest input
+triangle of the region it stands for (the input triangles touching its cluster): the weights
+lie in [0, 1] and sum to 1, so every value stays within the range of that triangle's corners.
+Vertices that did not move keep their input corner's values exactly.
 """
 
 from __future__ import annotations
@@ -54,16 +60,86 @@ def material_regions(data: MeshData) -> Optional[np.ndarray]:
     return data.triangle_material
 
 
+def _clamped_barycentric(points, a, b, c):
+    """Barycentric weights of each point's projection onto triangle (a, b, c), negative weights
+    clamped to 0 and the rest renormalised (so inside the triangle), and the distance from the
+    point to the weighted point. Degenerate triangles get their first corner."""
+    e0, e1, d = b - a, c - a, points - a
+    d00, d01, d11 = (e0 * e0).sum(1), (e0 * e1).sum(1), (e1 * e1).sum(1)
+    d20, d21 = (d * e0).sum(1), (d * e1).sum(1)
+    denominator = d00 * d11 - d01 * d01
+    ok = denominator > 0
+    safe = np.where(ok, denominator, 1.0)
+    w1 = np.where(ok, (d11 * d20 - d01 * d21) / safe, 0.0)
+    w2 = np.where(ok, (d00 * d21 - d01 * d20) / safe, 0.0)
+    w = np.clip(np.stack([1.0 - w1 - w2, w1, w2], axis=1), 0.0, None)
+    total = w.sum(1, keepdims=True)
+    w = np.where(total > 0, w / np.where(total > 0, total, 1.0), [1.0, 0.0, 0.0])
+    at = w[:, :1] * a + w[:, 1:2] * b + w[:, 2:] * c
+    return w, np.linalg.norm(points - at, axis=1)
+
+
+def moved_vertex_sources(data: MeshData, result):
+    """For each output vertex that does not stand at its input vertex: the input triangle and
+    barycentric weights its attributes come from (face -1 and weights (1, 0, 0) for the others).
+    The triangle is the closest (after clamping into it) among the input triangles touching the
+    vertex's cluster."""
+    vertices = np.asarray(result.vertices, dtype=np.float64)
+    kept = np.asarray(result.kept, dtype=np.int64)
+    face = np.full(len(vertices), -1, dtype=np.int64)
+    weights = np.zeros((len(vertices), 3))
+    weights[:, 0] = 1.0
+    moved = np.flatnonzero(np.any(vertices != data.vertices[kept], axis=1))
+    if len(moved) == 0:
+        return face, weights
+    triangles = np.asarray(data.triangles, dtype=np.int64)
+    labels = np.asarray(result.labels, dtype=np.int64)
+    is_moved = np.zeros(len(vertices), dtype=bool)
+    is_moved[moved] = True
+    # (output vertex, input triangle) pairs: each triangle is a candidate for the clusters its
+    # corners lie in
+    owner = labels[triangles]                                  # (m, 3)
+    pair_vertex = owner.ravel()
+    pair_face = np.repeat(np.arange(len(triangles)), 3)
+    keep = pair_vertex >= 0
+    keep[keep] = is_moved[pair_vertex[keep]]
+    pair_vertex, pair_face = pair_vertex[keep], pair_face[keep]
+    pair_unique = np.unique(pair_vertex * len(triangles) + pair_face)
+    pair_vertex, pair_face = pair_unique // len(triangles), pair_unique % len(triangles)
+    corners = data.vertices[triangles[pair_face]]
+    w, distance = _clamped_barycentric(vertices[pair_vertex], corners[:, 0], corners[:, 1], corners[:, 2])
+    order = np.lexsort((pair_face, distance, pair_vertex))    # per vertex: closest first, lowest id on ties
+    first = order[np.r_[True, pair_vertex[order][1:] != pair_vertex[order][:-1]]]
+    face[pair_vertex[first]] = pair_face[first]
+    weights[pair_vertex[first]] = w[first]
+    return face, weights
+
+
 def transfer_attributes(data: MeshData, result) -> MeshData:
     """The decimated mesh ``result`` (a DecimateResult of ``data``) with ``data``'s UVs,
-    vertex colours and materials carried over through its source maps."""
+    vertex colours and materials carried over through its source maps; moved vertices
+    interpolate them (see the module docs)."""
     corner_source = np.asarray(result.corner_source, dtype=np.int64)
     face_source = np.asarray(result.face_source, dtype=np.int64)
     kept = np.asarray(result.kept, dtype=np.int64)
+    triangles = np.asarray(result.triangles, dtype=np.int64)
+    need = data.corner_uvs is not None or data.vertex_colors is not None
+    source_face, weights = moved_vertex_sources(data, result) if need else (None, None)
     uvs = None
     if data.corner_uvs is not None:
-        uvs = data.corner_uvs.reshape(-1, 2)[corner_source.ravel()].reshape(-1, 3, 2)
-    colors = None if data.vertex_colors is None else data.vertex_colors[kept]
+        uvs = data.corner_uvs.reshape(-1, 2)[corner_source.ravel()].reshape(-1, 3, 2).copy()
+        corner_vertex = triangles.ravel()
+        moved = source_face[corner_vertex] >= 0
+        f = source_face[corner_vertex[moved]]
+        uvs.reshape(-1, 2)[moved] = np.einsum("kj,kjc->kc", weights[corner_vertex[moved]], data.corner_uvs[f])
+    colors = None
+    if data.vertex_colors is not None:
+        colors = data.vertex_colors[kept].astype(np.float64)
+        moved = np.flatnonzero(source_face >= 0)
+        input_triangles = np.asarray(data.triangles, dtype=np.int64)
+        colors[moved] = np.einsum("kj,kjc->kc", weights[moved],
+                                  data.vertex_colors[input_triangles[source_face[moved]]])
+        colors = colors.astype(data.vertex_colors.dtype)
     materials = None if data.triangle_material is None else data.triangle_material[face_source]
     return MeshData(vertices=result.vertices, triangles=result.triangles, corner_uvs=uvs, vertex_colors=colors,
                     triangle_material=materials, material_names=data.material_names,

@@ -48,9 +48,12 @@ def add_arguments(parser) -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--adaptivity", type=float, default=0.5)
     parser.add_argument("--density", choices=("off", "uniform", "adaptive"), default="off")
-    parser.add_argument("--placement", choices=("subsample", "filtered"), default="subsample")
-    parser.add_argument("--refine", type=int, default=0, metavar="F",
-                        help="0: off; F: TopStoc to F x the target, then quadric collapses (8: quality)")
+    parser.add_argument("--mode", choices=("quality", "fast"), default="quality",
+                        help="quality (default): TopStoc then quadric edge collapses; fast: plain TopStoc")
+    parser.add_argument("--placement", choices=("subsample", "filtered"), default=None,
+                        help="default: set by --mode")
+    parser.add_argument("--refine", type=float, default=None, metavar="F",
+                        help="0: off; F: TopStoc to F x the target, then quadric collapses (default: set by --mode)")
     parser.add_argument("--objects", nargs="+", metavar="NAME",
                         help="Blender formats: objects to decimate (default: every mesh object)")
 
@@ -94,7 +97,7 @@ def from_args(args) -> dict:
             "pixel_error": args.pixel_error, "fov": args.fov, "resolution": args.resolution,
             "prune_pixels": args.prune_pixels, "lod_files": bool(args.lod_files), "format": out_format,
             "options": {"seed": args.seed, "adaptivity": args.adaptivity, "density": args.density,
-                        "placement": args.placement, "refine": args.refine},
+                        "mode": args.mode, "placement": args.placement, "refine": args.refine},
             "objects": list(args.objects) if args.objects else None}
 
 
@@ -111,7 +114,8 @@ def to_argv(settings: dict) -> list:
     if settings["format"]:
         argv += ["--format", settings["format"]]
     for name, value in settings["options"].items():
-        argv += [f"--{name}", str(value)]
+        if value is not None:  # None: the mode decides
+            argv += [f"--{name}", str(value)]
     if settings["objects"]:
         argv += ["--objects", *settings["objects"]]
     return argv

@@ -5,11 +5,18 @@ them); each output triangle comes from one input triangle and keeps its orientat
 topology of every manifold component (components, genus, boundary loops) is kept; where plain
 clustering would break it, samples are added and the result says how many.
 
+Two modes (``mode=``): ``"quality"`` (the default) runs TopStoc to a few times the target,
+then quadric-ordered edge collapses thin it to the target (``refine``, filtered placement);
+``"fast"`` is the thesis' plain TopStoc (what the live preview shows while the slider moves).
+
 Guidance convention (docs/design.md §2.2): ``u`` in [-1, 1] per vertex. ``u = 0`` follows the global
-target; ``u > 0`` raises the probability towards 1 (``u = 1``: always kept, a control point);
-``u < 0`` lowers it towards 0 (``u = -1``: never sampled unless the topology needs it). With
-any guidance, view or box active, the vertex count follows the probabilities (user input wins
-over the target, thesis 4.3); without, the target is met within 0.5 %.
+target; ``u > 0`` asks for more density, ``u < 0`` for less: a density multiplier
+``((1 + u) / (1 - u))**2`` (u = 0.5: nine times, -0.5: a ninth). ``u = 1`` is a control point
+(always kept), ``u = -1`` is never sampled unless the topology needs it. Paint redistributes
+the budget, it does not change it: the target is met within 1 % whatever is painted, in both
+modes, and a painted region gets the same share of it in both. Only control points (and
+corners of borders) or the topology can push the count over; ``stats.over_budget`` and
+``stats.over_budget_reason`` then say by how much and why.
 """
 
 from __future__ import annotations
@@ -29,6 +36,11 @@ if TYPE_CHECKING:  # for annotations only: mesh.py imports this module
 
 DENSITY_MODES = ("off", "uniform", "adaptive", "euclidean")
 PLACEMENTS = ("subsample", "filtered")
+MODES = ("quality", "fast")
+#: quality mode: TopStoc keeps this many times the target before the collapses.
+QUALITY_REFINE = 8.0
+#: how far over the target a result may land before it counts as over budget
+BUDGET_TOLERANCE = 0.01
 
 
 @dataclass
@@ -117,6 +129,22 @@ class DecimateStats:
     seconds: dict               #: per stage: sampling, clustering, checking, output, refine
     refine_vertices: int = 0    #: target of the quadric refinement (0: not refined)
     refine_collapses: int = 0   #: collapses the refinement made
+    output_vertices: int = 0    #: vertices of the result
+
+    @property
+    def over_budget(self) -> int:
+        """Vertices above the target when the result misses it by more than 1 % (else 0)."""
+        excess = self.output_vertices - self.target_vertices
+        return excess if excess > max(1, BUDGET_TOLERANCE * self.target_vertices) else 0
+
+    @property
+    def over_budget_reason(self) -> str:
+        """Why the result is over budget: "" (it is not), "control points" (the vertices that
+        must stay, u = 1 and border corners, outnumber the target) or "topology" (samples the
+        topology needed)."""
+        if not self.over_budget:
+            return ""
+        return "control points" if self.forced >= self.target_vertices else "topology"
 
     @property
     def topology_kept(self) -> bool:
@@ -164,7 +192,8 @@ class DecimateResult:
 
 
 def _result(raw: dict, parameters: dict) -> DecimateResult:
-    stats = DecimateStats(**{f.name: raw[f.name] for f in dataclasses.fields(DecimateStats)})  # same names
+    stats = DecimateStats(**{f.name: raw[f.name] for f in dataclasses.fields(DecimateStats)  # same names
+                             if f.name != "output_vertices"}, output_vertices=len(raw["vertices"]))
     return DecimateResult(vertices=raw["vertices"], triangles=raw["triangles"], kept=raw["kept"],
                           face_source=raw["face_source"], corner_source=raw["corner_source"],
                           labels=raw["labels"], samples=raw["samples"], stats=stats,
@@ -220,8 +249,8 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
              density: str = "off", density_rings: int = 0,
              density_ratio: float = 2.0, density_epsilon: float = 0.0, guidance=None,
              regions=None, borders=None, view: Optional[View] = None,
-             boxes: Sequence[Box] = (), placement: str = "subsample",
-             fast_path: Optional[bool] = None, max_repair_rounds: int = 200, refine: float = 0.0,
+             boxes: Sequence[Box] = (), mode: str = "quality", placement: Optional[str] = None,
+             fast_path: Optional[bool] = None, max_repair_rounds: int = 200, refine: Optional[float] = None,
              max_error: Optional[float] = None, relative: bool = False) -> DecimateResult:
     """Decimates ``mesh`` with TopStoc. Give exactly one target.
 
@@ -238,12 +267,14 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     or "euclidean" (density_epsilon, 0 = automatic). guidance: u per vertex (module docs).
     regions: an id per input triangle (materials, UV islands), borders: (k, 2) vertex pairs;
     no cluster crosses either, and both survive exactly. view, boxes: see View and Box.
+    mode: "quality" (default): placement "filtered" and refine QUALITY_REFINE; "fast": the
+    thesis' TopStoc, placement "subsample", no refinement. placement and refine, when given,
+    override what the mode sets.
     placement: "subsample" keeps input positions, "filtered" moves surface vertices to the
     quadric-optimal point of their cluster (borders stay).
-    refine: 0 = off (fastest). f >= 1: TopStoc keeps f times the target, then half-edge
-    collapses ordered by quadric error against the input thin it to the target (every output
-    vertex still an input vertex, topology and borders kept, guidance weighting the costs).
-    Lower error at a higher cost; 3 is a good start.
+    refine: 0 = off (fastest). f >= 1: TopStoc keeps f times the target, then edge collapses
+    ordered by quadric error against the input thin it to the target (topology and borders
+    kept, painted regions keeping their share of the budget). Lower error at a higher cost.
     max_error: the fewest vertices whose symmetric Hausdorff error stays within this bound
     (absolute, or a fraction of the bounding-box diagonal with ``relative=True``), found by a
     search over re-decimations with the same seed; ``result.error_bound`` tells how it went.
@@ -255,6 +286,12 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     if len(given) != 1:
         raise ValueError("give exactly one target (ratio, target_vertices, target_triangles or max_error), "
                          f"got {given or 'none'}")
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
+    if placement is None:
+        placement = "filtered" if mode == "quality" else "subsample"
+    if refine is None:
+        refine = QUALITY_REFINE if mode == "quality" else 0.0
     if max_error is not None:  # error-bounded: a search over vertex targets (error_bound.py)
         from .error_bound import search_vertex_count
 
@@ -295,7 +332,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
                       adaptivity=adaptivity, flat_floor=flat_floor, area_weighted=bool(area_weighted),
                       feature_angle=float(feature_angle), density=density,
                       density_rings=density_rings, density_ratio=density_ratio,
-                      density_epsilon=density_epsilon, placement=placement, refine=float(refine))
+                      density_epsilon=density_epsilon, mode=mode, placement=placement, refine=float(refine))
     raw = engine.decimate(
         mesh.native, layout, target_vertices=target, target_triangles=target_triangles,
         seed=int(seed), adaptivity=float(adaptivity), flat_floor=float(flat_floor),

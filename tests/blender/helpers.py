@@ -72,6 +72,7 @@ class Params:
         self.adaptivity = 0.5
         self.density = "off"
         self.placement, self.refine = "subsample", 0
+        self.quality = "FAST"  # exact input positions; tests that want Quality say so
         self.output = "NEW_OBJECT"
         for key, value in kw.items():
             setattr(self, key, value)

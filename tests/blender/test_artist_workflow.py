@@ -170,8 +170,8 @@ def test_presets_are_installed_and_apply(ts, scene):
 
 def test_quality_choice_maps_onto_engine_options(ts, scene):
     pipeline = ts.blender.pipeline
-    assert pipeline.quality_options("FAST") == {"placement": "subsample", "refine": 0}
-    assert pipeline.quality_options("QUALITY") == {"placement": "filtered", "refine": 8}
+    assert pipeline.quality_options("FAST") == {"mode": "fast"}
+    assert pipeline.quality_options("QUALITY") == {"mode": "quality"}
     import json
 
     obj = ball()

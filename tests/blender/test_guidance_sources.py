@@ -104,7 +104,11 @@ def test_strength_scales_a_source(ts, scene):
     obj.topstoc.color_strength = 0.5   # keep at half strength = "more"
     r = run(ts, obj, ratio=0.05).result
     inside = np.isin(np.flatnonzero(half), r.kept).mean()
-    assert 0.3 < inside < 0.9  # p = k + (1 - k) * 0.5, not 1
+    outside = np.isin(np.flatnonzero(~half), r.kept).mean()
+    # u = 0.5 is "more", not a control point: nine times the density ((1 + u) / (1 - u))^2,
+    # within the same budget (5 %)
+    assert 5 < inside / outside < 13 and inside < 0.9, (inside, outside)
+    assert abs(r.num_vertices - round(0.05 * len(v))) <= max(1, 0.01 * 0.05 * len(v))
 
 
 def test_material_slot_weights_and_borders(ts, scene):

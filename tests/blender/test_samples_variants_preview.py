@@ -73,11 +73,11 @@ def test_preview_session(ts, scene):
     obj = make_object("Donut", *meshgen.torus(64, 32))
     from helpers import Params
 
-    session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(seed=4))
+    session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(seed=4, quality="QUALITY"))
     assert obj.hide_get()
     for ratio in (0.5, 0.1, 0.02):
         session.update(ratio)
-        expected = session.prepared.mesh.decimate(ratio=ratio, seed=4)
+        expected = session.prepared.mesh.decimate(ratio=ratio, seed=4, mode="fast")
         assert len(session.mesh.vertices) == expected.num_vertices
         assert len(session.mesh.polygons) == expected.num_triangles
     # Asynchronous path: only the latest request is computed.
@@ -111,10 +111,21 @@ def test_preview_session(ts, scene):
     assert shown and shown[-1] == drag[-1]
     assert [drag.index(r) for r in shown] == sorted(drag.index(r) for r in shown)
     assert len(set(shown)) == len(shown)
-    expected = session.prepared.mesh.decimate(ratio=drag[-1], seed=4)
-    assert len(session.mesh.vertices) == expected.num_vertices
+    expected = session.prepared.mesh.decimate(ratio=drag[-1], seed=4, mode="fast")
+    assert len(session.mesh.vertices) == expected.num_vertices and not session.final
+    # the drag pauses: the quality result replaces the fast one
+    for _ in range(4000):
+        session.poll()
+        if session.final:
+            break
+        time.sleep(0.005)
+    assert session.final and session.ratio == drag[-1]
+    quality = session.prepared.mesh.decimate(ratio=drag[-1], seed=4)
+    np.testing.assert_array_equal(session.result.vertices, quality.vertices)
+    assert len(session.mesh.vertices) == quality.num_vertices
     # an engine error in the worker surfaces on the main thread, at the next poll
     session.options = dict(session.options, placement="no such placement")
+    session.drag_options = dict(session.drag_options, placement="no such placement")
     session.request(0.2)
     with pytest.raises(ValueError, match="placement"):
         for _ in range(2000):
@@ -136,7 +147,7 @@ def test_refined_decimation_keeps_uvs_and_restores(ts, scene):
     bpy.ops.object.mode_set(mode="OBJECT")
     obj.topstoc.use_uv_seams = True
     plain_run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.1, seed=3))
-    assert bpy.ops.topstoc.guided_decimate(ratio=0.1, seed=3, refine=6, placement="subsample") == {"FINISHED"}
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.1, seed=3, quality="CUSTOM", refine=6, placement="subsample") == {"FINISHED"}
     first = bpy.data.objects["Knot_TopStoc"]
     assert len(first.data.vertices) <= max(plain_run.result.num_vertices, plain_run.result.stats.target_vertices)
     # every output corner carries exactly the UV its input corner had (no island crossed)

@@ -60,7 +60,7 @@ def test_transfer_copies_through_the_source_maps():
     data = read_mesh(DATA / "uv_materials" / "spider" / "spider.obj")
     mesh = Mesh(data.vertices, data.triangles)
     result = mesh.decimate(ratio=0.5, regions=material_regions(data),
-                           borders=uv_seam_edges(data.triangles, data.corner_uvs))
+                           borders=uv_seam_edges(data.triangles, data.corner_uvs), mode="fast")
     out = transfer_attributes(data, result)
     np.testing.assert_array_equal(out.triangle_material, data.triangle_material[result.face_source])
     flat = data.corner_uvs.reshape(-1, 2)
@@ -74,3 +74,46 @@ def test_transfer_copies_through_the_source_maps():
 def test_single_material_is_no_region():
     assert material_regions(MeshData(vertices=np.zeros((3, 3)), triangles=[[0, 1, 2]],
                                      triangle_material=[0], material_names=["a"])) is None
+
+
+def test_quality_mode_interpolates_moved_vertices_and_keeps_seams_exact():
+    data = read_mesh(DATA / "uv_materials" / "spider" / "spider.obj")
+    mesh = Mesh(data.vertices, data.triangles)
+    seams = uv_seam_edges(data.triangles, data.corner_uvs)
+    for ratio in (0.3, 0.1):
+        result = mesh.decimate(ratio=ratio, regions=material_regions(data), borders=seams)  # quality
+        out = transfer_attributes(data, result)
+        moved = np.any(result.vertices != data.vertices[result.kept], axis=1)
+        assert moved.sum() >= 10  # the spider is mostly seams: few vertices are free to move
+        # vertices on a seam or material border never move, and keep their corners' UVs exactly
+        on_seam = np.zeros(len(data.vertices), bool)
+        on_seam[seams.ravel()] = True
+        assert not moved[on_seam[result.kept]].any()
+        flat = data.corner_uvs.reshape(-1, 2)
+        exact = ~moved[result.triangles.ravel()]
+        np.testing.assert_array_equal(out.corner_uvs.reshape(-1, 2)[exact], flat[result.corner_source.ravel()][exact])
+        # a moved vertex's UV lies within the range of one input triangle's corner UVs, the
+        # triangle being one of its cluster (checked by brute force over those triangles)
+        for v in np.flatnonzero(moved)[:200]:
+            uv = out.corner_uvs.reshape(-1, 2)[np.flatnonzero(result.triangles.ravel() == v)]
+            assert np.allclose(uv, uv[0])  # one value per interior vertex
+            cluster = np.flatnonzero(result.labels == v)
+            candidates = np.flatnonzero(np.isin(data.triangles, cluster).any(axis=1))
+            lo, hi = data.corner_uvs[candidates].min(axis=1), data.corner_uvs[candidates].max(axis=1)
+            assert np.any(np.all((lo - 1e-12 <= uv[0]) & (uv[0] <= hi + 1e-12), axis=1)), v
+
+
+def test_quality_mode_colours_within_the_source_triangle():
+    vertices, triangles = torus(40, 20)
+    colors = np.random.default_rng(1).random((len(vertices), 3))
+    data = MeshData(vertices=vertices, triangles=triangles, vertex_colors=colors)
+    result = Mesh(vertices, triangles).decimate(ratio=0.25, seed=2)
+    out = transfer_attributes(data, result)
+    moved = np.any(result.vertices != vertices[result.kept], axis=1)
+    assert moved.any()
+    np.testing.assert_array_equal(out.vertex_colors[~moved], colors[result.kept[~moved]])
+    for v in np.flatnonzero(moved):
+        cluster = np.flatnonzero(result.labels == v)
+        candidates = np.flatnonzero(np.isin(triangles, cluster).any(axis=1))
+        lo, hi = colors[triangles[candidates]].min(axis=1), colors[triangles[candidates]].max(axis=1)
+        assert np.any(np.all((lo - 1e-12 <= out.vertex_colors[v]) & (out.vertex_colors[v] <= hi + 1e-12), axis=1))

@@ -1,4 +1,5 @@
-"""TopStoc decimation: topology, budget, guidance, borders, determinism and bad input.
+"""TopStoc decimation: topology, budget, guidance, borders, determinism and bad input (most in
+the fast mode, the thesis' TopStoc; topology also in the quality mode, see test_refine.py).
 
 Topology is checked with tests/reference.py (scipy connected components), never with the
 engine's own checks.
@@ -34,9 +35,18 @@ def check_output(mesh, result, expected_invariants):
     directed = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
     assert len(np.unique(directed, axis=0)) == len(directed)
     assert reference.invariants(result.num_vertices, tri) == expected_invariants
-    # every output vertex is the input vertex it stands for, and each triangle's corners are
-    # the samples of its source triangle's clusters
-    np.testing.assert_array_equal(result.vertices, mesh.vertices[result.kept])
+    assert np.isfinite(result.vertices).all()
+    # zero-area triangles: none on smooth meshes (test_budget.py); where an input's coincident
+    # or collinear vertices leave some that no allowed collapse removes (measured: 0-5 in 36
+    # decimations of a CAD part and of a mesh whose holes touch), the result reports them
+    p = result.vertices[tri]
+    flat = np.flatnonzero(np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1) == 0)
+    assert len(flat) == result.stats.issues_remaining["sliver"]
+    # plain TopStoc (fast mode, subsample): every output vertex is the input vertex it stands
+    # for; quality mode moves free vertices (placement, collapses)
+    if result.parameters.get("placement") == "subsample" and not result.parameters.get("refine"):
+        np.testing.assert_array_equal(result.vertices, mesh.vertices[result.kept])
+    # each triangle's corners are the samples of its source triangle's clusters
     source = mesh.triangles[result.face_source]
     np.testing.assert_array_equal(result.labels[source], tri)
 
@@ -46,17 +56,23 @@ def test_topology_kept_for_every_seed_and_ratio(path):
     mesh = load(path)
     expected = reference.invariants(mesh.num_vertices, mesh.triangles)
     assert all(manifold and orientable for _, _, manifold, orientable in expected)
-    for ratio in RATIOS:
-        for seed in SEEDS:
-            result = mesh.decimate(ratio=ratio, seed=seed)
-            check_output(mesh, result, expected)
-            assert result.stats.topology_kept
-            target = result.stats.target_vertices
-            miss = result.num_vertices - target
-            if mesh.num_vertices >= 1000:
-                # the budget holds within 1 %, unless the topology needs more samples than the
-                # target allows: then the excess is the repairs the result reports
-                assert abs(miss) <= 0.01 * target or 0 < miss <= result.stats.repairs, (ratio, seed, miss)
+    for mode, seeds in (("fast", SEEDS), ("quality", SEEDS[:5])):
+        for ratio in RATIOS:
+            for seed in seeds:
+                result = mesh.decimate(ratio=ratio, seed=seed, mode=mode)
+                check_output(mesh, result, expected)
+                assert result.stats.topology_kept
+                target = result.stats.target_vertices
+                miss = result.num_vertices - target
+                if mesh.num_vertices >= 1000:
+                    # the budget holds within 1 %, unless the topology needs more samples than
+                    # the target allows: then the excess is the repairs the result reports
+                    # (or below it by the collapses that removed zero-area triangles)
+                    assert abs(miss) <= 0.01 * target or 0 < miss <= result.stats.repairs \
+                        or 0 < -miss <= 0.01 * target + result.stats.refine_collapses \
+                        or (mode == "quality" and result.stats.over_budget_reason == "topology"
+                            and result.num_vertices <= mesh.decimate(ratio=ratio, seed=seed, mode="fast").num_vertices), \
+                        (mode, ratio, seed, miss)
 
 
 def test_big_shared_meshes_keep_topology(shared_meshes):
@@ -65,7 +81,7 @@ def test_big_shared_meshes_keep_topology(shared_meshes):
         expected = reference.invariants(mesh.num_vertices, mesh.triangles)
         for ratio in RATIOS:
             for seed in range(3):
-                result = mesh.decimate(ratio=ratio, seed=seed)
+                result = mesh.decimate(mode="fast", ratio=ratio, seed=seed)
                 check_output(mesh, result, expected)
                 assert abs(result.num_vertices - result.stats.target_vertices) <= 0.01 * result.stats.target_vertices
 
@@ -75,7 +91,7 @@ def test_several_components_and_tiny_targets():
     mesh = Mesh(v, t)
     expected = reference.invariants(mesh.num_vertices, mesh.triangles)
     for target in (3, 30, 300):
-        result = mesh.decimate(target_vertices=target, seed=target)
+        result = mesh.decimate(mode="fast", target_vertices=target, seed=target)
         check_output(mesh, result, expected)
         # far too small for three components with genus 1 and 3: the engine adds what they need
         if target == 3:
@@ -103,7 +119,7 @@ def test_regions_are_never_crossed_and_survive():
             regions_of_vertex[x].add(int(regions[f]))
     for ratio in RATIOS:
         for seed in range(5):
-            r = mesh.decimate(ratio=ratio, seed=seed, regions=regions)
+            r = mesh.decimate(mode="fast", ratio=ratio, seed=seed, regions=regions)
             out_regions = regions[r.face_source]
             # each region decimates to a surface of the same topology, with the same borders
             got = region_invariants(r.num_vertices, r.triangles, out_regions)
@@ -127,8 +143,8 @@ def test_flagged_border_edges_act_like_region_borders():
     same = np.all(e[0::2] == e[1::2], axis=1)
     assert same.all()  # closed manifold: every edge has exactly two sides
     border = e[0::2][regions[f[0::2]] != regions[f[1::2]]]
-    a = mesh.decimate(ratio=0.05, seed=4, regions=regions)
-    b = mesh.decimate(ratio=0.05, seed=4, borders=border)
+    a = mesh.decimate(mode="fast", ratio=0.05, seed=4, regions=regions)
+    b = mesh.decimate(mode="fast", ratio=0.05, seed=4, borders=border)
     np.testing.assert_array_equal(a.triangles, b.triangles)
     np.testing.assert_array_equal(a.kept, b.kept)
 
@@ -143,7 +159,7 @@ def test_control_points_kept_and_excluded_vertices_absent():
     drop = np.flatnonzero(v[:, 2] > 0.7)
     u[drop] = -1.0
     for seed in range(5):
-        r = mesh.decimate(ratio=0.02, seed=seed, guidance=u)
+        r = mesh.decimate(mode="fast", ratio=0.02, seed=seed, guidance=u)
         assert set(keep) <= set(r.kept)
         assert not set(drop) & set(r.kept)
         check_output(mesh, r, reference.invariants(len(v), t))
@@ -154,7 +170,7 @@ def test_painted_region_keeps_more_vertices():
     mesh = Mesh(v, t)
     painted = v[:, 0] > 0
     u = np.where(painted, 0.5, 0.0)
-    r = mesh.decimate(ratio=0.02, seed=1, guidance=u)
+    r = mesh.decimate(mode="fast", ratio=0.02, seed=1, guidance=u)
     inside = painted[r.kept].sum()
     outside = (~painted[r.kept]).sum()
     # p = k + (1 - k) 0.5 ~ 0.51 vs k = 0.02 per vertex: far more than 5x denser
@@ -165,7 +181,8 @@ def test_view_dependent_keeps_the_front():
     from topstoc.core import View
     v, t = meshgen.icosphere(5)
     mesh = Mesh(v, t)
-    r = mesh.decimate(ratio=0.05, seed=2, view=View(eye=[0, 0, 10], back_ratio=0.1))
+    # the silhouette band is kept (p = 1, about 300 vertices): a budget that leaves room for more
+    r = mesh.decimate(mode="fast", ratio=0.15, seed=2, view=View(eye=[0, 0, 10], back_ratio=0.1))
     front = v[r.kept][:, 2] > 0.3
     back = v[r.kept][:, 2] < -0.3
     assert front.sum() > 5 * back.sum()
@@ -176,13 +193,13 @@ def test_same_seed_identical_arrays_and_samples_restore():
     v, t, regions = sphere_with_regions()
     mesh = Mesh(v, t)
     for placement in ("subsample", "filtered"):
-        a = mesh.decimate(ratio=0.03, seed=11, regions=regions, placement=placement)
-        b = mesh.decimate(ratio=0.03, seed=11, regions=regions, placement=placement)
+        a = mesh.decimate(mode="fast", ratio=0.03, seed=11, regions=regions, placement=placement)
+        b = mesh.decimate(mode="fast", ratio=0.03, seed=11, regions=regions, placement=placement)
         c = mesh.decimate_with_samples(a.samples, regions=regions, placement=placement)
         for other in (b, c):
             for name in ("vertices", "triangles", "kept", "face_source", "corner_source", "labels", "samples"):
                 np.testing.assert_array_equal(getattr(a, name), getattr(other, name), err_msg=name)
-    assert not np.array_equal(mesh.decimate(ratio=0.03, seed=12).kept, a.kept)
+    assert not np.array_equal(mesh.decimate(mode="fast", ratio=0.03, seed=12).kept, a.kept)
 
 
 SERIAL_PARALLEL_SCRIPT = """
@@ -193,7 +210,7 @@ from topstoc.core import Mesh
 mesh = Mesh(*meshgen.icosphere(7))  # 164k vertices: above the parallel threshold
 digest = hashlib.sha256()
 for options in (dict(ratio=0.2), dict(ratio=0.02), dict(ratio=0.05, refine=4, placement="filtered")):
-    r = mesh.decimate(seed=3, density="adaptive", **options)
+    r = mesh.decimate(mode="fast", seed=3, density="adaptive", **options)
     for a in (r.vertices, r.triangles, r.kept, r.corner_source, r.labels, r.samples):
         digest.update(a.tobytes())
 print(digest.hexdigest())
@@ -212,9 +229,9 @@ def test_concurrent_calls_on_one_mesh_agree_with_serial_ones():
     mesh = Mesh(*meshgen.icosphere(7))  # above the parallel threshold
     ratios = (0.2, 0.05, 0.1, 0.02)
     with ThreadPoolExecutor(max_workers=2) as pool:
-        together = list(pool.map(lambda r: mesh.decimate(ratio=r, seed=5), ratios))
+        together = list(pool.map(lambda r: mesh.decimate(mode="fast", ratio=r, seed=5), ratios))
     for ratio, got in zip(ratios, together):
-        alone = mesh.decimate(ratio=ratio, seed=5)
+        alone = mesh.decimate(mode="fast", ratio=ratio, seed=5)
         for name in ("triangles", "kept", "labels", "samples"):
             np.testing.assert_array_equal(getattr(got, name), getattr(alone, name), err_msg=f"{ratio} {name}")
 
@@ -222,7 +239,7 @@ def test_concurrent_calls_on_one_mesh_agree_with_serial_ones():
 def test_triangle_target_within_one_percent():
     mesh = load(DATA / "genus0/cgal_fandisk.off")
     for target in (500, 2000, 6000):
-        r = mesh.decimate(target_triangles=target, seed=1)
+        r = mesh.decimate(mode="fast", target_triangles=target, seed=1)
         assert abs(r.num_triangles - target) <= 0.01 * target
 
 
@@ -230,8 +247,8 @@ def test_filtered_placement_moves_surface_samples_only():
     v, t = meshgen.grid(30, 30)
     v[:, 2] = np.sin(v[:, 0] / 4) * np.cos(v[:, 1] / 5) * 3
     mesh = Mesh(v, t)
-    plain = mesh.decimate(ratio=0.05, seed=2)
-    filtered = mesh.decimate(ratio=0.05, seed=2, placement="filtered")
+    plain = mesh.decimate(mode="fast", ratio=0.05, seed=2)
+    filtered = mesh.decimate(mode="fast", ratio=0.05, seed=2, placement="filtered")
     np.testing.assert_array_equal(plain.triangles, filtered.triangles)
     moved = np.linalg.norm(filtered.vertices - plain.vertices, axis=1)
     border = (v[plain.kept, 0] % 30 == 0) | (v[plain.kept, 1] % 30 == 0)
@@ -252,7 +269,7 @@ def test_nonmanifold_input_is_decimated_without_damage():
                   [0, 1, 4], [0, 5, 1], [1, 5, 4], [0, 4, 5], [0, 1, 6]])
     mesh = Mesh(v, t)
     assert mesh.report().nonmanifold_edges == 1
-    r = mesh.decimate(target_vertices=4, seed=0)
+    r = mesh.decimate(mode="fast", target_vertices=4, seed=0)
     degenerate, duplicates = reference.degenerate_or_duplicate(r.triangles)
     assert degenerate == 0 and duplicates == 0
     # the non-manifold edge is a corner-to-corner feature: both ends stay
@@ -278,7 +295,7 @@ def test_nonmanifold_input_is_decimated_without_damage():
 def test_bad_decimation_arguments(kwargs, message):
     mesh = Mesh(*meshgen.icosphere(3))
     with pytest.raises(ValueError, match=message):
-        mesh.decimate(**kwargs)
+        mesh.decimate(mode="fast", **kwargs)
 
 
 @pytest.mark.parametrize("samples, message", [
@@ -298,8 +315,8 @@ def test_creases_become_borders_on_hard_surface_models():
     import math
     layout = mesh.feature_layout(feature_angle=math.radians(40))
     assert layout.crease_edges > 500 and layout.corners > 0
-    plain = mesh.decimate(ratio=0.05, seed=1)
-    creased = mesh.decimate(ratio=0.05, seed=1, feature_angle=math.radians(40))
+    plain = mesh.decimate(mode="fast", ratio=0.05, seed=1)
+    creased = mesh.decimate(mode="fast", ratio=0.05, seed=1, feature_angle=math.radians(40))
     target = plain.stats.target_vertices
     for result in (plain, creased):  # still the exact budget
         assert abs(result.num_vertices - target) <= max(1, 0.01 * target)
@@ -319,13 +336,13 @@ def test_fast_path_gives_the_same_mesh():
     v, t, regions = sphere_with_regions()
     mesh = Mesh(v, t)
     for ratio in (0.2, 0.03, 0.005):
-        fast = mesh.decimate(ratio=ratio, seed=5, regions=regions, fast_path=True)
-        full = mesh.decimate(ratio=ratio, seed=5, regions=regions, fast_path=False)
+        fast = mesh.decimate(mode="fast", ratio=ratio, seed=5, regions=regions, fast_path=True)
+        full = mesh.decimate(mode="fast", ratio=ratio, seed=5, regions=regions, fast_path=False)
         assert fast.stats.fast_path and not full.stats.fast_path
         for name in ("triangles", "kept", "face_source", "corner_source", "labels", "samples"):
             np.testing.assert_array_equal(getattr(fast, name), getattr(full, name), err_msg=name)
     # off unless asked for: the full scan is the faster one in this engine (see decimate.hpp)
-    assert not mesh.decimate(ratio=0.03, seed=5).stats.fast_path
+    assert not mesh.decimate(mode="fast", ratio=0.03, seed=5).stats.fast_path
 
 
 def test_old_target_keywords_still_work_with_a_warning():

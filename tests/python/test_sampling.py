@@ -53,7 +53,10 @@ def test_guidance_formulas(sphere):
     u = rng.choice([-1.0, -0.5, 0.0, 0.25, 1.0], size=n)
     p = sampling_probabilities(sphere, 0.2, adaptivity=0.0, guidance=u)
     k = 0.2
-    expected = np.where(u > 0, k + (1 - k) * u, k * (1 + u))
+    # a density multiplier ((1 + u) / (1 - u))^2; u = 1 a control point, u = -1 never sampled
+    with np.errstate(divide="ignore"):
+        multiplier = ((1 + u) / (1 - u)) ** 2
+    expected = np.where(u >= 1, 1.0, np.where(u <= -1, 0.0, np.minimum(1.0, k * multiplier)))
     np.testing.assert_allclose(p, expected, atol=1e-12)
     assert np.all(p[u == 1] == 1) and np.all(p[u == -1] == 0)
 
@@ -107,40 +110,45 @@ def test_borders_are_sampled_as_curves():
 @pytest.mark.parametrize("target", [12, 100, 700, 2000])
 def test_exact_budget_without_guidance(sphere, target):
     for seed in range(5):
-        result = sphere.decimate(target_vertices=target, seed=seed)
+        result = sphere.decimate(mode="fast", target_vertices=target, seed=seed)
         assert abs(result.num_vertices - target) <= max(1, 0.005 * target)
         assert not result.stats.guided
 
 
-def test_guided_count_follows_the_probabilities(sphere):
+def test_guided_draw_keeps_the_budget(sphere):
+    # paint redistributes the budget: the rate is solved so the guided probabilities sum to the
+    # target (128 of 2562 here), and the draw takes exactly that many
     u = np.where(sphere.vertices[:, 2] > 0.3, 0.6, -0.4)
-    result = sphere.decimate(ratio=0.05, seed=2, guidance=u)
+    result = sphere.decimate(ratio=0.05, seed=2, guidance=u, mode="fast")
+    target = round(0.05 * sphere.num_vertices)
     assert result.stats.guided
-    assert result.stats.selected == round(result.stats.expected_vertices)
-    # the base rate is the target over the vertices: 128 / 2562 here
-    assert result.stats.rate == pytest.approx(round(0.05 * sphere.num_vertices) / sphere.num_vertices)
+    assert result.stats.selected == target
     p = sampling_probabilities(sphere, result.stats.rate, guidance=u)
     assert result.stats.expected_vertices == pytest.approx(p.sum())
+    assert abs(p.sum() - target) <= 0.5
+    # the painted part is sampled (0.6 / -0.4)-times denser: multipliers 16 and 0.18
+    painted = sphere.vertices[:, 2] > 0.3
+    assert p[painted].mean() == pytest.approx(min(1.0, 16 * result.stats.rate) * 1.0, rel=0.3)
 
 
 def test_inclusion_frequencies_match_probabilities():
     mesh = Mesh(*meshgen.icosphere(3))
-    u = np.where(mesh.vertices[:, 0] > 0, 0.5, -0.5)  # p = 0.55 and 0.05 at rate 0.1, adaptivity 0
-    p = sampling_probabilities(mesh, 0.1, adaptivity=0.0, guidance=u)
+    u = np.where(mesh.vertices[:, 0] > 0, 0.5, -0.5)  # multipliers 9 and 1/9, adaptivity 0
     counts = np.zeros(mesh.num_vertices)
     runs = 300
     for seed in range(runs):
-        r = mesh.decimate(ratio=0.1, seed=seed, adaptivity=0.0, guidance=u)
+        r = mesh.decimate(ratio=0.1, seed=seed, adaptivity=0.0, guidance=u, mode="fast")
         counts[r.samples[:r.stats.selected]] += 1
+    p = sampling_probabilities(mesh, r.stats.rate, adaptivity=0.0, guidance=u)
     frequency = counts / runs
     for group in (u > 0, u < 0):
         assert frequency[group].mean() == pytest.approx(p[group].mean(), abs=0.01)
 
 
 def test_same_seed_same_draw_other_seed_other_draw(sphere):
-    a = sphere.decimate(ratio=0.05, seed=7)
-    b = sphere.decimate(ratio=0.05, seed=7)
-    c = sphere.decimate(ratio=0.05, seed=8)
+    a = sphere.decimate(mode="fast", ratio=0.05, seed=7)
+    b = sphere.decimate(mode="fast", ratio=0.05, seed=7)
+    c = sphere.decimate(mode="fast", ratio=0.05, seed=8)
     np.testing.assert_array_equal(a.samples, b.samples)
     assert not np.array_equal(a.samples, c.samples)
 
@@ -153,14 +161,14 @@ def hop_distances(mesh, sources):
 
 
 def test_uniform_density_keeps_samples_apart(sphere):
-    result = sphere.decimate(ratio=0.02, seed=1, density="uniform", density_rings=3, adaptivity=0.0)
+    result = sphere.decimate(mode="fast", ratio=0.02, seed=1, density="uniform", density_rings=3, adaptivity=0.0)
     drawn = result.samples[:result.stats.selected]
     assert result.stats.density_rejected > 0
     d = hop_distances(sphere, drawn)[:, drawn]
     np.fill_diagonal(d, np.inf)
     assert d.min() > 3
     # without density control, some samples do come that close
-    plain = sphere.decimate(ratio=0.02, seed=1, adaptivity=0.0)
+    plain = sphere.decimate(mode="fast", ratio=0.02, seed=1, adaptivity=0.0)
     drawn = plain.samples[:plain.stats.selected]
     d = hop_distances(sphere, drawn)[:, drawn]
     np.fill_diagonal(d, np.inf)
@@ -170,7 +178,7 @@ def test_uniform_density_keeps_samples_apart(sphere):
 def test_adaptive_density_uses_smaller_rings_on_detail():
     # eps_big = 4 where x < mean (flat), eps_small = 2 where x > mean (detail)
     slab = Mesh(*meshgen.genus_slab(2, scale=6))
-    result = slab.decimate(ratio=0.02, seed=3, adaptivity=0.0, density="adaptive", density_rings=4,
+    result = slab.decimate(mode="fast", ratio=0.02, seed=3, adaptivity=0.0, density="adaptive", density_rings=4,
                            density_ratio=2.0)
     drawn = result.samples[:result.stats.selected]
     x = slab.weights
@@ -188,8 +196,8 @@ def test_adaptive_density_uses_smaller_rings_on_detail():
 
 def test_density_control_improves_mean_aspect_ratio():
     mesh = Mesh(*meshgen.icosphere(5))
-    plain = [mesh.decimate(ratio=0.02, seed=s).aspect_ratio()["mean"] for s in range(8)]
-    spaced = [mesh.decimate(ratio=0.02, seed=s, density="uniform").aspect_ratio()["mean"] for s in range(8)]
+    plain = [mesh.decimate(mode="fast", ratio=0.02, seed=s).aspect_ratio()["mean"] for s in range(8)]
+    spaced = [mesh.decimate(mode="fast", ratio=0.02, seed=s, density="uniform").aspect_ratio()["mean"] for s in range(8)]
     assert np.mean(spaced) < np.mean(plain)
 
 
@@ -207,4 +215,4 @@ def test_density_control_improves_mean_aspect_ratio():
 def test_bad_sampling_parameters(options, message):
     mesh = Mesh(*meshgen.icosphere(4))
     with pytest.raises(ValueError, match=message):
-        mesh.decimate(ratio=0.1, **options)
+        mesh.decimate(mode="fast", ratio=0.1, **options)

@@ -72,10 +72,10 @@ Enter or click applies, Esc or right-click restores"""
     def _open(self, context, event=None):
         """Preparation done: opens the preview session (guidance, preview object)."""
         obj = bpy.data.objects.get(self.obj_name)
-        fast = SimpleNamespace(**{name: getattr(self, name) for name in settings_names()})
-        fast.quality = "FAST"  # the drag needs milliseconds; Enter applies at the chosen quality
+        # The session shows Fast while the slider moves and the chosen quality when it rests.
+        settings = SimpleNamespace(**{name: getattr(self, name) for name in settings_names()})
         try:
-            self.session = PreviewSession(context, obj, fast, context.region_data)
+            self.session = PreviewSession(context, obj, settings, context.region_data)
         except (pipeline.DecimationError, GuidanceError, ValueError) as error:
             self._finish(context)
             self.report({"ERROR"}, str(error))
@@ -121,7 +121,8 @@ Enter or click applies, Esc or right-click restores"""
             self._status(context, f"TopStoc: decimating '{s.obj.name}' at ratio {self.ratio:.4f} ... "
                                   f"{seconds:.1f} s   Esc: cancel")
             return
-        quality = "" if self.quality == "FAST" else f"  (preview: Fast; Enter applies at {self.quality.title()})"
+        quality = "" if self.quality == "FAST" else \
+            f"  ({self.quality.title() if s.final else 'Fast while dragging'})"
         self._status(context,
                      f"TopStoc ratio {s.ratio:.4f}: {result.num_vertices:,} vertices, {result.num_triangles:,} "
                      f"triangles ({1000 * s.seconds_decimate:.0f} ms + {1000 * s.seconds_write:.0f} ms){quality}   "

@@ -39,13 +39,15 @@ def add_parser(subparsers) -> None:
                         help="0 samples uniformly, 1 follows curvature fully (default 0.5)")
     parser.add_argument("--density", choices=DENSITIES, default="off",
                         help="Poisson-disk density control of the samples (default off)")
-    parser.add_argument("--placement", choices=("subsample", "filtered"), default="subsample",
+    parser.add_argument("--mode", choices=("quality", "fast"), default="quality",
+                        help="quality (default): TopStoc to a few times the target, then quadric edge "
+                             "collapses; fast: the thesis' plain TopStoc (milliseconds, higher deviation)")
+    parser.add_argument("--placement", choices=("subsample", "filtered"), default=None,
                         help="keep input positions, or move surface vertices to their cluster's "
-                             "quadric-optimal point (default subsample)")
-    parser.add_argument("--refine", type=int, default=0, metavar="F",
-                        help="0: off (default). F >= 1: TopStoc keeps F x the target, then vertices are "
-                             "dropped by quadric error (lower deviation, slower; 8 with --placement filtered "
-                             "is the quality setting)")
+                             "quadric-optimal point (default: filtered in quality mode, subsample in fast)")
+    parser.add_argument("--refine", type=float, default=None, metavar="F",
+                        help="0: off. F >= 1: TopStoc keeps F x the target, then edge collapses by quadric "
+                             "error (default: set by --mode)")
     parser.add_argument("--guidance", metavar="FILE.npy",
                         help="per-vertex guidance u in [-1, 1] in the input file's vertex order "
                              "(STL: welded order); 1 keeps a vertex, -1 avoids it")
@@ -115,7 +117,7 @@ def run(args) -> int:
     mesh = Mesh(data.vertices, data.triangles)
     seams = None if data.corner_uvs is None else uv_seam_edges(data.triangles, data.corner_uvs)
     options = dict(seed=args.seed, adaptivity=args.adaptivity, density=args.density, guidance=guidance,
-                   placement=args.placement, refine=args.refine,
+                   mode=args.mode, placement=args.placement, refine=args.refine,
                    regions=material_regions(data), borders=seams if seams is not None and len(seams) else None)
     if args.max_error is not None:
         bound, relative = parse_max_error(args.max_error)
@@ -154,7 +156,8 @@ def run(args) -> int:
             "guided": stats.guided,
             "samples_selected": stats.selected,
             "density_rejected": stats.density_rejected,
-            "refine": {"factor": args.refine, "placement": args.placement, "vertices": stats.refine_vertices,
+            "refine": {"mode": args.mode, "factor": result.parameters["refine"],
+                       "placement": result.parameters["placement"], "vertices": stats.refine_vertices,
                        "collapses": stats.refine_collapses},
             "aspect_ratio": result.aspect_ratio(),
             **_error_bound_report(result),

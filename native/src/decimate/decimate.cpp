@@ -368,7 +368,7 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
   }
   const bool fast = params.fast_path == 1 || (params.fast_path < 0 && target < 0.05 * active);
   return cluster_and_emit(mesh, layout, std::move(set.samples), params.placement, params.max_repair_rounds, true,
-                          fast, avoid, required, set.guided ? 0 : top_up_to, std::move(result));
+                          fast, avoid, required, top_up_to, std::move(result));
 }
 
 }  // namespace
@@ -378,19 +378,19 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
   if (!(params.refine == 0.0 || params.refine >= 1.0))
     throw std::invalid_argument("refine must be 0 (off) or at least 1, got " + std::to_string(params.refine));
   if (params.refine >= 1.0 && params.target_vertices >= 1 && params.target_vertices <= active) {
-    // Refined: TopStoc to `refine` times the target, then collapses down to it. A guided
-    // first pass keeps the count its probabilities give; the collapses keep that proportion.
+    // Refined: TopStoc to `refine` times the target, then collapses down to it. Painted
+    // regions keep the share of the budget the guidance gives them (see refine.hpp).
     DecimateParams first = params;
     first.refine = 0.0;
     first.target_vertices = int32_t(std::min<double>(active, std::ceil(params.refine * params.target_vertices)));
     DecimateResult result = decimate(mesh, layout, first);
+    const std::vector<double> multipliers = guidance_multipliers(mesh, params.sampling);
     RefineParams refine;
-    refine.target_vertices = result.guided
-        ? std::max(1, int32_t(std::lround(double(result.kept.size()) * params.target_vertices / first.target_vertices)))
-        : params.target_vertices;
-    refine.guidance = params.sampling.guidance;
+    refine.target_vertices = params.target_vertices;
+    refine.multipliers = &multipliers;
     refine_by_collapses(mesh, layout, refine, result);
     result.target_vertices = params.target_vertices;
+    result.forced = std::max(result.forced, int32_t(std::count(multipliers.begin(), multipliers.end(), kForcedMultiplier)));
     return result;
   }
   if (params.target_vertices < 1)
@@ -403,15 +403,24 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
   // Without guidance the budget is exact. Repairs add samples and absorbed clusters remove
   // some; a shortfall is topped up inside the pass (widest clusters split), an excess (the
   // topology needed more than drawn) is drawn again lower and topped up. Guided decimations
-  // keep the count the probabilities give (user input wins, thesis 4.3).
+  // too: the guidance redistributes the budget, it does not change it.
   DecimateResult best = decimate_once(mesh, layout, params, target, target);
   const auto excess = [&](const DecimateResult& r) { return int32_t(r.kept.size()) - target; };
   const int32_t tolerance = budget_tolerance(target);
   int32_t drawn = target;
-  for (int pass = 0; pass < params.budget_passes && !best.guided && excess(best) > tolerance; ++pass) {
+  for (int pass = 0; pass < params.budget_passes && excess(best) > tolerance && best.forced < target; ++pass) {
     drawn = std::max(1, drawn - excess(best) - tolerance);
     DecimateResult r = decimate_once(mesh, layout, params, drawn, target);
     if (std::abs(excess(r)) < std::abs(excess(best))) best = std::move(r);
+  }
+  // An input with collinear vertices can leave zero-area triangles the repairs could not
+  // remove: collapse one edge of each (never an output with a zero-area triangle).
+  if (has_zero_area(best)) {
+    const std::vector<double> multipliers = guidance_multipliers(mesh, params.sampling);
+    RefineParams cleanup;
+    cleanup.multipliers = &multipliers;
+    cleanup.zero_area_only = true;
+    refine_by_collapses(mesh, layout, cleanup, best);
   }
   return best;
 }
@@ -439,10 +448,27 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
   result = cluster_and_emit(mesh, layout, std::move(samples), placement, max_repair_rounds, false, false, {},
                             std::vector<uint8_t>(mesh.num_vertices(), 0), 0, std::move(result));
   if (refine_vertices > 0) {
+    std::vector<double> multipliers;
+    if (guidance) {
+      SamplingParams sampling;
+      sampling.guidance = guidance;
+      multipliers = guidance_multipliers(mesh, sampling);
+    }
     RefineParams refine;
     refine.target_vertices = refine_vertices;
-    refine.guidance = guidance;
+    refine.multipliers = guidance ? &multipliers : nullptr;
     refine_by_collapses(mesh, layout, refine, result);
+  } else if (has_zero_area(result)) {  // as decimate() does
+    std::vector<double> multipliers;
+    if (guidance) {
+      SamplingParams sampling;
+      sampling.guidance = guidance;
+      multipliers = guidance_multipliers(mesh, sampling);
+    }
+    RefineParams cleanup;
+    cleanup.multipliers = guidance ? &multipliers : nullptr;
+    cleanup.zero_area_only = true;
+    refine_by_collapses(mesh, layout, cleanup, result);
   }
   return result;
 }

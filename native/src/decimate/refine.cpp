@@ -13,17 +13,26 @@ namespace topstoc {
 
 namespace {
 
+// Collapses may not make a triangle thinner than this shape quality (see Collapser::shape;
+// 0.1 is an aspect ratio of about 5-10 by the thesis' measure) unless it already was.
+constexpr double kMinShape = 0.1;
+
 class Collapser {
  public:
   // curve: per output vertex, the feature curve it lies on (it may then move only along it), or
   // -1; corner_sector: per output corner, the sector (side of the borders) of its vertex.
   Collapser(DecimateResult& result, std::vector<Quadric> quadrics, std::vector<double> weight,
             std::vector<uint8_t> locked, std::vector<int32_t> curve, std::vector<int32_t> curve_size,
-            std::vector<uint8_t> curve_closed, std::vector<int32_t> corner_sector)
+            std::vector<uint8_t> curve_closed, std::vector<int32_t> corner_sector, std::vector<int32_t> bin,
+            std::vector<int32_t> quota)
       : r_(result), quadric_(std::move(quadrics)), weight_(std::move(weight)), locked_(std::move(locked)),
         curve_(std::move(curve)), curve_size_(std::move(curve_size)), curve_closed_(std::move(curve_closed)),
-        corner_sector_(std::move(corner_sector)), heap_(static_cast<int32_t>(result.kept.size())) {
+        corner_sector_(std::move(corner_sector)), bin_(std::move(bin)), quota_(std::move(quota)),
+        heap_(static_cast<int32_t>(result.kept.size())) {
     const size_t n = r_.kept.size(), m = r_.face_source.size();
+    count_.assign(quota_.size(), 0);
+    alive_vertices_ = static_cast<int32_t>(n);
+    for (int32_t b : bin_) ++count_[b];
     vertex_faces_.resize(n);
     for (size_t t = 0; t < m; ++t)
       for (int j = 0; j < 3; ++j) vertex_faces_[r_.triangles[3 * t + j]].push_back(int32_t(t));
@@ -33,12 +42,55 @@ class Collapser {
     for (int32_t u = 0; u < int32_t(n); ++u) update(u);
   }
 
+  /// Collapses an edge of every zero-area triangle where a collapse is allowed (the triangle
+  /// and its neighbour across the edge vanish; no collapse creates a new one). Returns the
+  /// collapses made.
+  int32_t remove_zero_area(double min_shape = 0.0, int32_t keep = 0) {
+    int32_t collapses = 0;
+    for (bool progress = true; progress;) {
+      progress = false;
+      for (size_t t = 0; t < alive_face_.size(); ++t) {
+        if (alive_vertices_ <= keep) return collapses;
+        if (!alive_face_[t] || !(zero_area(int32_t(t)) || thin(int32_t(t), min_shape))) continue;
+        const int32_t* c = &r_.triangles[3 * t];
+        for (int j = 0; j < 6; ++j) {
+          const int32_t u = c[j % 3], v = c[(j % 3 + (j < 3 ? 1 : 2)) % 3];
+          if (locked_[u] || !allowed(u, v)) continue;
+          collapse(u, v);
+          ++collapses;
+          progress = true;
+          break;
+        }
+      }
+    }
+    return collapses;
+  }
+
+  int32_t zero_area_faces() const {
+    int32_t count = 0;
+    for (size_t t = 0; t < alive_face_.size(); ++t) count += alive_face_[t] && zero_area(int32_t(t));
+    return count;
+  }
+
   /// Collapses until `target` vertices remain or no collapse is allowed; returns the count.
   int32_t run(int32_t target) {
-    int32_t alive = static_cast<int32_t>(r_.kept.size());
     int32_t collapses = 0;
-    while (alive > target && !heap_.empty()) {
+    for (;;) {
+      if (alive_vertices_ <= target) break;
+      if (heap_.empty()) {
+        // Some region could not reach its quota: the others give the rest, by cost alone.
+        if (!use_quota_) break;
+        use_quota_ = false;
+        for (int32_t u = 0; u < int32_t(merged_into_.size()); ++u)
+          if (merged_into_[u] < 0) update(u);
+        continue;
+      }
       const int32_t u = heap_.top(), v = target_[u];
+      if (at_quota(u)) {
+        target_[u] = -1;
+        heap_.remove(u);
+        continue;
+      }
       // Collapses next to `v` may have changed its cost or ruled it out: look again.
       if (merged_into_[v] >= 0 || heap_.top_key() != cost(u, v)) {
         update(u);
@@ -49,7 +101,6 @@ class Collapser {
         continue;
       }
       collapse(u, v);
-      --alive;
       ++collapses;
     }
     return collapses;
@@ -88,9 +139,40 @@ class Collapser {
   }
 
  private:
+  // Both ends free (off every border curve, not locked): the edge collapses to the point that
+  // minimises the summed quadric; otherwise `from` moves onto `to` (half-edge collapse), so
+  // border vertices stay input vertices on their curve.
+  bool free_pair(int32_t from, int32_t to) const {
+    return optimal_placement && curve_[from] < 0 && curve_[to] < 0 && !locked_[to] && !locked_[from];
+  }
+
+  // Where the collapse of `from` into `to` puts the survivor.
+  void placement(int32_t from, int32_t to, double x[3]) const {
+    const double* pt = &r_.positions[3 * size_t(to)];
+    for (int i = 0; i < 3; ++i) x[i] = pt[i];
+    if (!free_pair(from, to)) return;
+    Quadric q = quadric_[from];
+    q.add(quadric_[to]);
+    const double* pf = &r_.positions[3 * size_t(from)];
+    double d[3], length2 = 0;
+    for (int i = 0; i < 3; ++i) d[i] = pt[i] - pf[i], length2 += d[i] * d[i];
+    if (q.minimum(x)) {
+      // Trust the optimum only near the edge (a nearly flat or straight neighbourhood makes it
+      // drift along the surface).
+      double far2 = 0;
+      for (int i = 0; i < 3; ++i) far2 += (x[i] - 0.5 * (pf[i] + pt[i])) * (x[i] - 0.5 * (pf[i] + pt[i]));
+      if (far2 <= length2) return;
+    }
+    // The best point on the edge: E(pf + t d) is quadratic in t.
+    const double t = std::clamp(q.line_minimum(pf, d), 0.0, 1.0);
+    for (int i = 0; i < 3; ++i) x[i] = pf[i] + t * d[i];
+  }
+
   double cost(int32_t from, int32_t to) const {
-    const double* x = &r_.positions[3 * size_t(to)];
-    return weight_[from] * std::max(0.0, quadric_[from].error(x) + quadric_[to].error(x));
+    double x[3];
+    placement(from, to, x);
+    const double w = free_pair(from, to) ? std::max(weight_[from], weight_[to]) : weight_[from];
+    return w * std::max(0.0, quadric_[from].error(x) + quadric_[to].error(x));
   }
 
   // Queues u's cheapest collapse. Checks wait until it is popped (most queued collapses are
@@ -99,7 +181,7 @@ class Collapser {
   void update(int32_t u, bool checked = false) {
     target_[u] = -1;
     heap_.remove(u);
-    if (locked_[u]) return;
+    if (locked_[u] || at_quota(u)) return;
     neighbours(u, options_);
     if (!checked) {  // the cheapest, lowest id on ties
       int32_t best = -1;
@@ -120,6 +202,24 @@ class Collapser {
         return;
       }
   }
+
+  bool thin(int32_t t, double min_shape) const {
+    if (min_shape <= 0.0) return false;
+    double n[3];
+    const int32_t* c = &r_.triangles[3 * size_t(t)];
+    normal(c, c[0], &r_.positions[3 * size_t(c[0])], n);
+    return shape(c, c[0], &r_.positions[3 * size_t(c[0])], std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])) <
+           min_shape;
+  }
+
+  bool zero_area(int32_t t) const {
+    double n[3];
+    const int32_t* c = &r_.triangles[3 * size_t(t)];
+    normal(c, c[0], &r_.positions[3 * size_t(c[0])], n);
+    return n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0;
+  }
+
+  bool at_quota(int32_t u) const { return use_quota_ && count_[bin_[u]] <= quota_[bin_[u]]; }
 
   void queue(int32_t u, int32_t v, double c) {
     target_[u] = v;
@@ -196,30 +296,68 @@ class Collapser {
     }
     if (shared != count) return false;
     if (nu.size() + nv.size() < size_t(shared) + 5) return false;  // v would keep < 3 neighbours
-    for (int32_t t : vertex_faces_[u]) {
-      if (has(t, v)) continue;
+    double x[3];
+    placement(u, v, x);
+    return keeps_shape(u, v, x) && keeps_shape(v, u, x);
+  }
+
+  // Do the triangles of `moved` that do not hold `other` keep their side and some area when
+  // `moved` stands at x?
+  bool keeps_shape(int32_t moved, int32_t other, const double* x) const {
+    // A zero-area triangle has no side to keep: it must gain area facing like the fan.
+    double fan[3] = {0, 0, 0};
+    for (int32_t t : vertex_faces_[moved]) {
+      double n[3];
+      normal(&r_.triangles[3 * size_t(t)], moved, &r_.positions[3 * size_t(moved)], n);
+      for (int i = 0; i < 3; ++i) fan[i] += n[i];
+    }
+    for (int32_t t : vertex_faces_[moved]) {
+      if (has(t, other)) continue;
       const int32_t* c = &r_.triangles[3 * size_t(t)];
       double before[3], after[3];
-      normal(c, u, u, before);
-      normal(c, u, v, after);
+      normal(c, moved, &r_.positions[3 * size_t(moved)], before);
+      normal(c, moved, x, after);
+      double before2 = before[0] * before[0] + before[1] * before[1] + before[2] * before[2];
+      if (before2 == 0.0) {
+        for (int i = 0; i < 3; ++i) before[i] = fan[i];
+        before2 = fan[0] * fan[0] + fan[1] * fan[1] + fan[2] * fan[2];
+      }
       const double dot = before[0] * after[0] + before[1] * after[1] + before[2] * after[2];
       const double len2 = after[0] * after[0] + after[1] * after[1] + after[2] * after[2];
-      if (!(dot > 0.0) || len2 <= 1e-24 * (before[0] * before[0] + before[1] * before[1] + before[2] * before[2]))
-        return false;  // would flip or lose its area
+      // No flip, no near-fold (normal turned by more than ~80 degrees), no loss of area.
+      if (!(dot > 0.17 * std::sqrt(len2 * before2)) || len2 <= 1e-24 * before2) return false;
+      // No sliver: a triangle may not end up thinner than kMinShape unless it was already.
+      if (shape(c, moved, x, std::sqrt(len2)) < kMinShape &&
+          shape(c, moved, &r_.positions[3 * size_t(moved)], std::sqrt(before2)) >= kMinShape)
+        return false;
     }
     return true;
   }
 
-  // Normal (unnormalised) of triangle c with vertex `replace` standing at the position of `with`.
-  void normal(const int32_t* c, int32_t replace, int32_t with, double n[3]) const {
+  // Shape quality 2 sqrt(3) |n| / (sum of squared edges) of triangle c with `replace` at `at`
+  // (|n| = twice its area): 1 for an equilateral triangle, 0 for a degenerate one.
+  double shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const {
     const double* p[3];
-    for (int j = 0; j < 3; ++j) p[j] = &r_.positions[3 * size_t(c[j] == replace ? with : c[j])];
+    for (int j = 0; j < 3; ++j) p[j] = c[j] == replace ? at : &r_.positions[3 * size_t(c[j])];
+    double edges = 0;
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) edges += (p[j][i] - p[(j + 1) % 3][i]) * (p[j][i] - p[(j + 1) % 3][i]);
+    return edges > 0 ? 2.0 * std::sqrt(3.0) * twice_area / edges : 0.0;
+  }
+
+  // Normal (unnormalised) of triangle c with vertex `replace` standing at `at`.
+  void normal(const int32_t* c, int32_t replace, const double* at, double n[3]) const {
+    const double* p[3];
+    for (int j = 0; j < 3; ++j) p[j] = c[j] == replace ? at : &r_.positions[3 * size_t(c[j])];
     double a[3], b[3];
     for (int i = 0; i < 3; ++i) a[i] = p[1][i] - p[0][i], b[i] = p[2][i] - p[0][i];
     n[0] = a[1] * b[2] - a[2] * b[1], n[1] = a[2] * b[0] - a[0] * b[2], n[2] = a[0] * b[1] - a[1] * b[0];
   }
 
   void collapse(int32_t u, int32_t v) {
+    double x[3];
+    placement(u, v, x);
+    for (int i = 0; i < 3; ++i) r_.positions[3 * size_t(v) + i] = x[i];
     // The triangles on the edge vanish. On each side of u's borders one of them had a corner at
     // v: u's other triangles on that side take that corner (and its sector) where they meet v.
     struct Side {
@@ -252,6 +390,8 @@ class Collapser {
       vertex_faces_[v].push_back(t);
     }
     if (curve_[u] >= 0) --curve_size_[curve_[u]];
+    --count_[bin_[u]];
+    --alive_vertices_;
     vertex_faces_[u].clear();
     merged_into_[u] = v;
     quadric_[v].add(quadric_[u]);
@@ -262,7 +402,7 @@ class Collapser {
     update(v);
     neighbours(v, star_);
     for (int32_t x : star_) {
-      if (locked_[x]) continue;
+      if (locked_[x] || at_quota(x)) continue;
       if (target_[x] < 0 || target_[x] == u || target_[x] == v) {
         update(x);
       } else {
@@ -279,6 +419,14 @@ class Collapser {
   std::vector<int32_t> curve_, curve_size_;
   std::vector<uint8_t> curve_closed_;
   std::vector<int32_t> corner_sector_;
+  std::vector<int32_t> bin_, quota_, count_;  // per vertex its guidance bin; per bin quota, alive count
+  bool use_quota_ = true;
+  int32_t alive_vertices_ = 0;
+
+ public:
+  bool optimal_placement = true;  // off: every collapse is a half-edge collapse (positions kept)
+
+ private:
   std::vector<std::vector<int32_t>> vertex_faces_;
   std::vector<uint8_t> alive_face_;
   std::vector<int32_t> merged_into_, target_;
@@ -287,12 +435,72 @@ class Collapser {
   std::vector<std::pair<double, int32_t>> costs_;
 };
 
+// Guidance bins: 0 for m = 0 (never sampled), 1 for control points, then m on a quarter-octave
+// scale.
+constexpr int32_t kBins = 2 + 81;
+int32_t guidance_bin(double m) {
+  if (m == kForcedMultiplier) return 1;
+  if (m <= 0.0) return 0;
+  return 2 + 40 + std::clamp(int32_t(std::lround(4.0 * std::log2(m))), -40, 40);
+}
+
+// Vertex quota per bin (see RefineParams): sum over the bin's vertices of min(1, k m), k solved
+// so the quotas sum to `target`, rounded by largest remainder.
+std::vector<int32_t> bin_quotas(const std::vector<double>& vertices, const std::vector<double>& multiplier_sum,
+                                int32_t target) {
+  const int32_t bins = int32_t(vertices.size());
+  std::vector<double> mean(bins, 0.0);
+  for (int32_t b = 2; b < bins; ++b) mean[b] = vertices[b] > 0 ? multiplier_sum[b] / vertices[b] : 0.0;
+  auto total = [&](double k) {
+    double sum = vertices[1];
+    for (int32_t b = 2; b < bins; ++b) sum += vertices[b] * std::min(1.0, k * mean[b]);
+    return sum;
+  };
+  std::vector<double> exact(bins, 0.0);
+  exact[1] = std::min<double>(vertices[1], target);
+  if (vertices[1] < target) {
+    double lo = 0.0, hi = 1.0;
+    while (total(hi) < target && hi < 1e30) hi *= 2.0;
+    for (int it = 0; it < 200; ++it) {
+      const double k = 0.5 * (lo + hi);
+      (total(k) < target ? lo : hi) = k;
+    }
+    for (int32_t b = 2; b < bins; ++b) exact[b] = vertices[b] * std::min(1.0, hi * mean[b]);
+  }
+  std::vector<int32_t> quota(bins);
+  int32_t assigned = 0;
+  std::vector<std::pair<double, int32_t>> remainder;
+  for (int32_t b = 0; b < bins; ++b) {
+    quota[b] = int32_t(std::floor(exact[b]));
+    assigned += quota[b];
+    remainder.push_back({-(exact[b] - quota[b]), b});
+  }
+  std::sort(remainder.begin(), remainder.end());
+  for (size_t i = 0; assigned < target && i < remainder.size(); ++i)
+    if (quota[remainder[i].second] < vertices[remainder[i].second]) ++quota[remainder[i].second], ++assigned;
+  return quota;
+}
+
 }  // namespace
+
+bool has_zero_area(const DecimateResult& result) {
+  const auto& p = result.positions;
+  for (size_t t = 0; t < result.triangles.size(); t += 3) {
+    const double* a = &p[3 * size_t(result.triangles[t])];
+    const double* b = &p[3 * size_t(result.triangles[t + 1])];
+    const double* c = &p[3 * size_t(result.triangles[t + 2])];
+    double u[3], w[3];
+    for (int i = 0; i < 3; ++i) u[i] = b[i] - a[i], w[i] = c[i] - a[i];
+    if (u[1] * w[2] - u[2] * w[1] == 0.0 && u[2] * w[0] - u[0] * w[2] == 0.0 && u[0] * w[1] - u[1] * w[0] == 0.0)
+      return true;
+  }
+  return false;
+}
 
 void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
                          DecimateResult& result) {
   const auto start = std::chrono::steady_clock::now();
-  if (params.target_vertices < 1)
+  if (params.target_vertices < 1 && !params.zero_area_only)
     throw std::invalid_argument("refine target must be at least 1 vertex, got " +
                                 std::to_string(params.target_vertices));
   const size_t n = result.kept.size();
@@ -349,14 +557,28 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
   std::vector<double> weight(n, 1.0);
   std::vector<uint8_t> locked(n, 0);
   std::vector<int32_t> curve(n, -1), curve_size(layout.num_curves(), 0);
+  auto multiplier = [&](int32_t v) { return params.multipliers ? (*params.multipliers)[v] : 1.0; };
+  std::vector<int32_t> bin(n);
   for (size_t i = 0; i < n; ++i) {
     const int32_t v = index[result.kept[i]];
-    const double u = params.guidance ? params.guidance[result.kept[i]] : 0.0;
+    const double m = multiplier(v);
     if (layout.vertex_feature[v]) curve[i] = layout.vertex_curve[v];
     if (curve[i] >= 0) ++curve_size[curve[i]];
-    locked[i] = layout.vertex_corner[v] || (layout.vertex_feature[v] && curve[i] < 0) || u >= 1.0;
-    weight[i] = std::pow(16.0, u);
+    locked[i] = layout.vertex_corner[v] || (layout.vertex_feature[v] && curve[i] < 0) || m == kForcedMultiplier;
+    if (m == kForcedMultiplier)  // a control point stays where the user put it
+      for (int k = 0; k < 3; ++k) result.positions[3 * i + k] = mesh.position(v)[k];
+    weight[i] = m == kForcedMultiplier ? 1.0 : std::max(m, 1.0 / 81.0);
+    bin[i] = guidance_bin(m);
   }
+  std::vector<double> bin_vertices(kBins, 0.0), bin_multipliers(kBins, 0.0);
+  const auto& vfo = mesh.vertex_face_offsets();
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+    if (vfo[v] < vfo[v + 1]) {
+      const int32_t b = guidance_bin(multiplier(v));
+      bin_vertices[b] += 1.0;
+      bin_multipliers[b] += multiplier(v);
+    }
+  std::vector<int32_t> quota = bin_quotas(bin_vertices, bin_multipliers, params.target_vertices);
   // Sector of every output corner at its vertex, from the input corner it copies.
   std::vector<int32_t> internal_face(mesh.report().input_triangles, -1);
   for (int32_t f = 0; f < mesh.num_faces(); ++f) internal_face[mesh.face_source()[f]] = f;
@@ -367,9 +589,20 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
       corner_sector[c] = layout.sector_of(mesh, vertex, internal_face[result.corner_source[c] / 3]);
   }
   Collapser collapser(result, std::move(quadrics), std::move(weight), std::move(locked), std::move(curve),
-                      std::move(curve_size), layout.curve_closed, std::move(corner_sector));
-  result.refine_vertices = params.target_vertices;
-  result.refine_collapses = collapser.run(params.target_vertices);
+                      std::move(curve_size), layout.curve_closed, std::move(corner_sector), std::move(bin),
+                      std::move(quota));
+  if (params.zero_area_only) {
+    collapser.optimal_placement = false;  // the caller's positions (e.g. input vertices) stay
+    result.refine_collapses += collapser.remove_zero_area();
+  } else {
+    result.refine_vertices = params.target_vertices;
+    // Slivers the stochastic pass left (near-collinear corners) go first: the collapses thin
+    // the result anyway, and none of them makes a new one (Collapser::keeps_shape).
+    result.refine_collapses = collapser.remove_zero_area(kMinShape, params.target_vertices);
+    result.refine_collapses += collapser.run(params.target_vertices);
+    result.refine_collapses += collapser.remove_zero_area();
+  }
+  result.repairs.remaining.sliver = collapser.zero_area_faces();
   collapser.write_back();
   result.seconds_refine = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

@@ -138,21 +138,47 @@ bool has_per_vertex_guidance(const SamplingParams& params) {
   return params.guidance || !params.boxes.empty() || params.view.enabled;
 }
 
-double surface_probability(const Mesh& mesh, const SamplingParams& params, int32_t v, double k, double q) {
-  const double* position = mesh.position(v);
-  double u = params.guidance ? params.guidance[mesh.vertex_source()[v]] : 0.0;
-  for (const auto& box : params.boxes)
-    if (inside_box(box, position)) u = box.value;
-  if (u >= 1.0) return 1.0;   // a control point
-  if (u <= -1.0) return 0.0;  // never sampled (topology may still need it)
-  const double p0 = std::min(1.0, k * q);
-  double p = u > 0 ? p0 + (1.0 - p0) * u : p0 * (1.0 + u);
-  if (params.view.enabled) p = apply_view(params.view, position, &mesh.normals()[3 * size_t(v)], p);
+// Guidance u per vertex (boxes override the painted value): the density multiplier m(u) =
+// ((1 + u) / (1 - u))^2, so u = 0.5 asks for 9 times the density, -0.5 for a ninth; u = 1 is
+// a control point (kForced), u = -1 never sampled (0). A multiplier, not a probability, so
+// paint redistributes the budget: the rate is solved so the probabilities still sum to the
+// target (more here means less elsewhere).
+}  // namespace
+
+double guidance_multiplier(double u) {
+  // Within 1/256 of +-1 (what 8-bit painted colours can reach) is a hard keep or drop.
+  if (u >= 1.0 - 1.0 / 256.0) return kForcedMultiplier;
+  if (u <= -1.0 + 1.0 / 256.0) return 0.0;
+  return u == 0.0 ? 1.0 : std::pow((1.0 + u) / (1.0 - u), 2.0);
+}
+
+std::vector<double> guidance_multipliers(const Mesh& mesh, const SamplingParams& params) {
+  const int32_t n = mesh.num_vertices();
+  std::vector<double> m(n, 1.0);
+  if (!params.guidance && params.boxes.empty()) return m;
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) {
+    double u = params.guidance ? params.guidance[mesh.vertex_source()[v]] : 0.0;
+    for (const auto& box : params.boxes)
+      if (inside_box(box, mesh.position(v))) u = box.value;
+    m[v] = guidance_multiplier(u);
+  }
+  return m;
+}
+
+namespace {
+
+double surface_probability(const Mesh& mesh, const SamplingParams& params, int32_t v, double k, double q,
+                           double multiplier) {
+  if (multiplier == kForcedMultiplier) return 1.0;  // a control point
+  if (multiplier <= 0.0) return 0.0;      // never sampled (topology may still need it)
+  double p = std::min(1.0, k * q * multiplier);
+  if (params.view.enabled) p = apply_view(params.view, mesh.position(v), &mesh.normals()[3 * size_t(v)], p);
   return std::clamp(p, 0.0, 1.0);
 }
 
 std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& cls, const std::vector<double>& q,
-                                  const SamplingParams& params, double k) {
+                                  const std::vector<double>& multiplier, const SamplingParams& params, double k) {
   const int32_t n = mesh.num_vertices();
   std::vector<double> p(n);
   const bool guided = has_per_vertex_guidance(params);
@@ -162,12 +188,55 @@ std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& 
       case kIsolated: p[v] = 0.0; break;
       case kCorner: p[v] = 1.0; break;
       default: {
-        const double surface = guided ? surface_probability(mesh, params, v, k, q[v]) : std::min(1.0, k * q[v]);
+        const double surface =
+            guided ? surface_probability(mesh, params, v, k, q[v], multiplier[v]) : std::min(1.0, k * q[v]);
         p[v] = cls[v] == kCurve ? std::sqrt(surface) : surface;
       }
     }
   }
   return p;
+}
+
+// With guidance: the base rate k whose guided probabilities sum to the target. The sum only
+// grows with k; it is bracketed by doubling, then found by regula falsi (Illinois variant),
+// each step one parallel pass over the vertices. When the forced vertices alone exceed the
+// target, k = 0 (the count is then theirs, reported as over budget).
+double solve_guided_rate(const Mesh& mesh, const std::vector<uint8_t>& cls, const std::vector<double>& q,
+                         const std::vector<double>& multiplier, const SamplingParams& params, double target) {
+  auto excess = [&](double k) {
+    const auto p = probabilities(mesh, cls, q, multiplier, params, k);
+    double sum = 0.0;
+    for (double x : p) sum += x;
+    return sum - target;
+  };
+  const double tolerance = std::max(0.5, 1e-4 * target);
+  double lo = 0.0, f_lo = excess(0.0);
+  if (f_lo >= -tolerance) return 0.0;
+  double hi = std::max(1e-12, target / std::max<double>(1.0, double(mesh.num_vertices())));
+  double f_hi = excess(hi);
+  for (int i = 0; f_hi < 0 && i < 200; ++i) {
+    lo = hi, f_lo = f_hi;
+    hi *= 2.0;
+    f_hi = excess(hi);
+  }
+  if (f_hi <= tolerance) return hi;  // everything that can be sampled is
+  int side = 0;
+  for (int it = 0; it < 60; ++it) {
+    double k = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+    if (!(k > lo && k < hi)) k = 0.5 * (lo + hi);
+    const double f = excess(k);
+    if (std::abs(f) <= tolerance) return k;
+    if (f < 0) {
+      lo = k, f_lo = f;
+      if (side == -1) f_hi *= 0.5;
+      side = -1;
+    } else {
+      hi = k, f_hi = f;
+      if (side == 1) f_lo *= 0.5;
+      side = 1;
+    }
+  }
+  return 0.5 * (lo + hi);
 }
 
 // Without guidance: the base rate k whose probabilities sum to the target. The sum is
@@ -423,7 +492,7 @@ void validate_sampling_params(const Mesh& mesh, const SamplingParams& params) {
 std::vector<double> sampling_probabilities(const Mesh& mesh, const FeatureLayout& layout,
                                            const SamplingParams& params, double k) {
   const auto table = importance_table(mesh, layout, params);
-  return probabilities(mesh, table->cls, table->q, params, k);
+  return probabilities(mesh, table->cls, table->q, guidance_multipliers(mesh, params), params, k);
 }
 
 SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const SamplingParams& params,
@@ -436,12 +505,15 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
   SampleSet out;
   out.guided = is_guided(mesh, params);
   const int32_t target = std::clamp(target_vertices, 0, active);
-  out.rate = out.guided ? double(target) / double(std::max(1, active)) : solve_rate(*table, target);
-  const auto p = probabilities(mesh, cls, table->q, params, out.rate);
+  const auto multiplier = guidance_multipliers(mesh, params);
+  out.rate = out.guided ? solve_guided_rate(mesh, cls, table->q, multiplier, params, target) : solve_rate(*table, target);
+  const auto p = probabilities(mesh, cls, table->q, multiplier, params, out.rate);
   double expected = 0.0;
   for (double x : p) expected += x;
   out.expected = expected;
-  const int32_t count = out.guided ? int32_t(std::lround(expected)) : target;
+  // The draw takes exactly the target, guided or not; only vertices with p = 1 (corners,
+  // control points) can push it over.
+  const int32_t count = target;
 
   // Pareto keys: with threshold 1 the expected number of keys below it is exactly the sum of
   // the probabilities, so a slightly larger threshold keeps a small superset of what the draw

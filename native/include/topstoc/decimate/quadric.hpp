@@ -41,6 +41,32 @@ struct Quadric {
     const double ax2 = a[2] * x[0] + a[4] * x[1] + a[5] * x[2];
     return x[0] * ax0 + x[1] * ax1 + x[2] * ax2 + 2.0 * (b[0] * x[0] + b[1] * x[1] + b[2] * x[2]) + c;
   }
+
+  /// The point minimising the error, A x = -b, into x; false when A is close to singular
+  /// (determinant below 1e-6 of the cube of its mean eigenvalue: a flat or straight
+  /// neighbourhood, where the minimum is a plane or a line, not a point).
+  bool minimum(double x[3]) const {
+    const double c00 = a[3] * a[5] - a[4] * a[4], c01 = a[2] * a[4] - a[1] * a[5], c02 = a[1] * a[4] - a[2] * a[3];
+    const double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
+    const double mean = (a[0] + a[3] + a[5]) / 3.0;
+    if (!(mean > 0) || !(std::abs(det) > 1e-6 * mean * mean * mean)) return false;
+    const double c11 = a[0] * a[5] - a[2] * a[2], c12 = a[1] * a[2] - a[0] * a[4], c22 = a[0] * a[3] - a[1] * a[1];
+    // x = -A^-1 b with the adjugate (A symmetric).
+    x[0] = -(c00 * b[0] + c01 * b[1] + c02 * b[2]) / det;
+    x[1] = -(c01 * b[0] + c11 * b[1] + c12 * b[2]) / det;
+    x[2] = -(c02 * b[0] + c12 * b[1] + c22 * b[2]) / det;
+    return std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
+  }
+
+  /// t minimising the error along p + t d (unclamped; 0 when the error is flat along d).
+  double line_minimum(const double* p, const double* d) const {
+    const double ad0 = a[0] * d[0] + a[1] * d[1] + a[2] * d[2];
+    const double ad1 = a[1] * d[0] + a[3] * d[1] + a[4] * d[2];
+    const double ad2 = a[2] * d[0] + a[4] * d[1] + a[5] * d[2];
+    const double curvature = d[0] * ad0 + d[1] * ad1 + d[2] * ad2;
+    const double slope = p[0] * ad0 + p[1] * ad1 + p[2] * ad2 + b[0] * d[0] + b[1] * d[1] + b[2] * d[2];
+    return curvature > 0 ? -slope / curvature : 0.0;
+  }
 };
 
 }  // namespace topstoc

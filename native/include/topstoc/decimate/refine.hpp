@@ -1,17 +1,20 @@
 // Quadric refinement: a TopStoc result with a few times the wanted vertices, thinned to the
-// target by greedy half-edge collapses ordered by quadric error (Garland & Heckbert 1997).
+// target by greedy edge collapses ordered by quadric error (Garland & Heckbert 1997).
 //
 // The stochastic pass does the heavy lifting on the full mesh (fast, topology checked); the
 // collapses then pick which of its vertices to drop by how far that takes the surface from the
 // *input* (each output vertex carries the summed quadric of the input triangles of its cluster).
-// A collapse moves vertex u onto its neighbour v, so every output vertex is still an input
-// vertex (or its filtered position) and positions never move. A collapse is done only if it
-// keeps every guarantee of the decimation: the link condition holds (so the surface stays a
-// manifold of the same topology), no triangle flips or loses all area, and a vertex on a
+// An edge between two free vertices (off every border curve, not locked) collapses to the point
+// minimising the summed quadric (Garland & Heckbert's optimal placement; near-singular quadrics
+// and optima far from the edge fall back to the best point on the edge). Any other collapse
+// moves vertex u onto its neighbour v (a half-edge collapse), so border vertices remain input
+// vertices. A collapse is done only if it keeps every guarantee of the decimation: the link
+// condition holds (so the surface stays a manifold of the same topology), no triangle around
+// either end flips, folds (normal turned by more than ~80 degrees) or loses all area, and a vertex on a
 // border curve (boundary, UV seam, material border, flagged edge) moves only along its curve,
 // onto the next vertex of the same curve or a corner, so borders keep their course and their
 // sides and attributes keep carrying over exactly. Corners never move, closed curves keep three
-// vertices. User guidance scales the costs; control points are never removed.
+// vertices. User guidance sets per-region quotas (RefineParams); control points are never removed.
 #pragma once
 
 #include <cstdint>
@@ -25,12 +28,21 @@ namespace topstoc {
 
 struct RefineParams {
   int32_t target_vertices = 0;
-  /// u per caller vertex in [-1, 1] (the decimation's guidance), or null. Removing a vertex
-  /// costs 16^u times its quadric error (painted detail is dearer to remove, u = -1 cheaper);
-  /// u = 1 vertices (control points) are never removed. A flat painted region still thins out
-  /// (its error is zero whatever the weight): plain TopStoc follows paint more strictly.
-  const double* guidance = nullptr;
+  /// The guidance as density multipliers per internal vertex (guidance_multipliers), or null.
+  /// Painted regions keep their share of the budget: the input vertices are binned by their
+  /// multiplier m, each bin gets the quota sum over its vertices of min(1, k m) with k solved
+  /// so that the quotas sum to the target (the fast mode's expected count with a flat
+  /// importance), and collapses stop taking vertices from a bin at its quota. Only when some
+  /// bin cannot reach its quota do the others give more. m = 0 (u = -1) has quota 0; control
+  /// points (u = 1) are never removed. Removing a vertex also costs m times its quadric error.
+  const std::vector<double>* multipliers = nullptr;
+  /// Only collapse edges of zero-area triangles (what an input with collinear vertices can
+  /// leave after the stochastic pass); every refinement ends with this step too.
+  bool zero_area_only = false;
 };
+
+/// True when some output triangle of `result` has zero area.
+bool has_zero_area(const DecimateResult& result);
 
 /// Thins `result` (a finished decimation of `mesh`, in the caller's ids) to
 /// params.target_vertices output vertices where collapses allow; updates every field of the

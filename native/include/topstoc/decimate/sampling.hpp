@@ -3,8 +3,10 @@
 // Every vertex gets a probability p(v) from its importance weight and the user's guidance, and
 // a seeded fixed-size draw picks the samples. Without guidance the draw hits the target count
 // exactly (Pareto sampling, Rosén 1997: keys (U/(1-U)) / (p/(1-p)), the smallest win, which
-// keeps inclusion probabilities close to p). With guidance the count is the sum of the
-// probabilities: user input wins over the target (thesis 4.3).
+// keeps inclusion probabilities close to p). Guidance scales the probabilities (a density
+// multiplier per vertex) and the rate is solved so that they still sum to the target: paint
+// redistributes the budget. Only vertices that must stay (corners, control points u = 1) can
+// push the count over it.
 #pragma once
 
 #include <cstdint>
@@ -59,6 +61,16 @@ struct SampleSet {
   double expected = 0.0;         ///< sum of the probabilities
   double rate = 0.0;             ///< the base rate k that was used
 };
+
+/// Guidance u as a density multiplier: ((1 + u) / (1 - u))^2 for -1 < u < 1 (u = 0.5: nine
+/// times the density, -0.5: a ninth), 0 for u = -1 (never sampled), kForcedMultiplier for u = 1
+/// (a control point); within 1/256 of +-1 counts as +-1 (8-bit painted colours). Paint redistributes the budget: the rate is solved so that the guided
+/// probabilities min(1, k q m) still sum to the target.
+constexpr double kForcedMultiplier = -1.0;
+double guidance_multiplier(double u);
+
+/// m per internal vertex from the painted guidance and the boxes (boxes win where they hold it).
+std::vector<double> guidance_multipliers(const Mesh& mesh, const SamplingParams& params);
 
 /// True when any guidance source is active (then the count follows the probabilities).
 bool is_guided(const Mesh& mesh, const SamplingParams& params);

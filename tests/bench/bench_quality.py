@@ -1,0 +1,312 @@
+#!/usr/bin/python3
+"""Result quality next to the quadric decimators, measured in one run (issue 16 benchmark).
+
+    .venv/bin/python tests/bench/bench_quality.py [--ratios 0.1,0.02] [--samples 300000] [--meshes a,b]
+
+For each real mesh (tests/data and ../shared/meshes) and each ratio of its triangles, TopStoc's
+quality mode (the default) and fast mode decimate it; every peer then decimates the same input
+to the triangle count of our quality result:
+  - Blender's Decimate modifier (Collapse, triangulated), in Debian's `blender -b` (one process);
+  - MeshLab's meshing_decimation_quadric_edge_collapse (pymeshlab; optimal placement, preserve
+    topology and boundary);
+  - meshopt_simplify (build/peers/meshopt_simplify; build with -DTOPSTOC_PEERS=ON);
+  - fast-simplification (PyPI), from a venv the benchmark makes under ${TOPSTOC_CACHE}.
+Figures per output: symmetric Hausdorff max and mean in % of the input's bounding-box diagonal
+(topstoc.hausdorff, the same sampling for all), triangle aspect ratio (thesis eq. 4.2) mean and
+99th percentile, degenerate (zero-area) triangles, whether the topology of every component
+(genus, boundary loops, manifold, orientation) was kept, and the time of the decimation itself.
+Prints one table per case, then medians over the meshes of our figure / the peer's figure.
+A peer that is not available is reported as missing, never silently skipped.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import pathlib
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "build" / "python"))
+sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+
+from topstoc.core import Mesh, hausdorff, read_mesh, topology  # noqa: E402
+from machine import machine  # noqa: E402
+
+SHARED = ROOT.parent / "shared" / "meshes"
+if not SHARED.exists():
+    SHARED = pathlib.Path("/work/shared/meshes")
+DATA = ROOT / "tests" / "data"
+MESHES = [
+    DATA / "genus0/cgal_ChineseDragon-10kv.off",
+    DATA / "genus0/cgal_fandisk.off",
+    SHARED / "genus0/cgal_armadillo.off",
+    SHARED / "genus0/cgal_bunny00.off",
+    SHARED / "genus0/petsc_horse.ply.bz2",
+    DATA / "genus_positive/cgal_turbine.off",
+    DATA / "genus_positive/cgal_elephant.off",
+    DATA / "genus_positive/cgal_knot1.off",
+    DATA / "genus_positive/cgal_anchor_dense.off",
+    DATA / "genus_positive/cgal_couplingdown.off",
+    DATA / "open_boundary/cgal_mushroom.off",
+    DATA / "open_boundary/cgal_elephant-with-holes.off",
+]
+MESHOPT = ROOT / "build" / "peers" / "meshopt_simplify"
+CACHE = pathlib.Path(os.environ.get("TOPSTOC_CACHE", "/var/cache/topstoc"))
+
+BLENDER_SCRIPT = r"""
+import json, sys, time
+import bpy, bmesh
+import numpy as np
+jobs = json.load(open(sys.argv[sys.argv.index("--") + 1]))
+for job in jobs:
+    data = np.load(job["input"])
+    v, t = data["vertices"], data["triangles"]
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    mesh = bpy.data.meshes.new("m")
+    mesh.from_pydata(v.tolist(), [], t.tolist())
+    mesh.update()
+    obj = bpy.data.objects.new("m", mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    mod = obj.modifiers.new("d", "DECIMATE")
+    mod.decimate_type = "COLLAPSE"
+    mod.ratio = job["ratio"]
+    mod.use_collapse_triangulate = True
+    start = time.perf_counter()
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    evaluated = obj.evaluated_get(depsgraph)
+    out = evaluated.to_mesh()
+    seconds = time.perf_counter() - start
+    out.calc_loop_triangles()
+    ov = np.empty(3 * len(out.vertices)); out.vertices.foreach_get("co", ov)
+    ot = np.empty(3 * len(out.loop_triangles), dtype=np.int32); out.loop_triangles.foreach_get("vertices", ot)
+    np.savez(job["output"], vertices=ov.reshape(-1, 3), triangles=ot.reshape(-1, 3), seconds=seconds)
+    evaluated.to_mesh_clear()
+"""
+
+FAST_SIMPLIFICATION_SCRIPT = r"""
+import json, sys, time
+import numpy as np
+import fast_simplification
+for job in json.load(open(sys.argv[1])):
+    data = np.load(job["input"])
+    start = time.perf_counter()
+    v, t = fast_simplification.simplify(data["vertices"].astype(np.float32), data["triangles"].astype(np.int32),
+                                        target_reduction=job["reduction"])
+    seconds = time.perf_counter() - start
+    np.savez(job["output"], vertices=v, triangles=t, seconds=seconds)
+"""
+
+
+def aspect_ratios(vertices, triangles) -> np.ndarray:
+    """Thesis eq. 4.2 per triangle: e0 e1 e2 / (8 (s - e0)(s - e1)(s - e2)); inf when degenerate."""
+    p = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles, dtype=np.int64)]
+    e = np.stack([np.linalg.norm(p[:, 1] - p[:, 2], axis=1), np.linalg.norm(p[:, 2] - p[:, 0], axis=1),
+                  np.linalg.norm(p[:, 0] - p[:, 1], axis=1)], axis=1)
+    s = e.sum(axis=1) / 2
+    denominator = 8 * (s - e[:, 0]) * (s - e[:, 1]) * (s - e[:, 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ar = np.where(denominator > 0, e.prod(axis=1) / denominator, np.inf)
+    return ar
+
+
+def zero_area(vertices, triangles) -> int:
+    p = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles, dtype=np.int64)]
+    return int(np.count_nonzero(np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1) == 0))
+
+
+def signature(vertices, triangles):
+    """Per surface component: (genus, boundary loops, manifold, consistently oriented), sorted."""
+    top = topology(vertices, triangles)
+    return sorted((c.genus if c.genus is not None else -1, len(c.boundary_loops), bool(c.manifold),
+                   bool(c.consistently_oriented)) for c in top.components if c.faces > 0)
+
+
+def measure(source, vertices, triangles, samples):
+    if len(triangles) == 0:
+        return None
+    d = hausdorff(source, (vertices, triangles), samples=samples, relative=True, percentile=0)
+    ar = aspect_ratios(vertices, triangles)
+    finite = ar[np.isfinite(ar)]
+    return {"triangles": len(triangles), "max": 100 * d.symmetric.max, "mean": 100 * d.symmetric.mean,
+            "ar_mean": float(finite.mean()) if len(finite) else float("inf"),
+            "ar_p99": float(np.percentile(finite, 99)) if len(finite) else float("inf"),
+            "zero_area": zero_area(vertices, triangles)}
+
+
+def fast_simplification_python() -> str | None:
+    """A Python with fast-simplification: this one, or a venv made once under TOPSTOC_CACHE."""
+    try:
+        import fast_simplification  # noqa: F401
+        return sys.executable
+    except ImportError:
+        pass
+    venv = CACHE / "venv-fast-simplification"
+    python = venv / "bin" / "python"
+    if not python.exists():
+        try:
+            subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", str(venv)], check=True)
+            subprocess.run([str(python), "-m", "pip", "install", "-q", "fast-simplification"], check=True)
+        except (subprocess.CalledProcessError, OSError) as error:
+            print(f"note: could not install fast-simplification ({error})")
+            return None
+    return str(python)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--ratios", default="0.1,0.02")
+    parser.add_argument("--samples", type=int, default=300_000, help="Hausdorff samples on the input")
+    parser.add_argument("--meshes", default="", help="comma-separated name fragments to run only those")
+    parser.add_argument("--json", metavar="FILE", help="write every figure here")
+    args = parser.parse_args()
+    ratios = [float(r) for r in args.ratios.split(",")]
+    meshes = [m for m in MESHES if m.exists() and (not args.meshes or any(f in m.name for f in args.meshes.split(",")))]
+    print(f"machine: {machine()}")
+    print(f"meshes: {len(meshes)} ({', '.join(m.name for m in meshes)}); ratios {ratios}; "
+          f"Hausdorff samples {args.samples}")
+    work = pathlib.Path(tempfile.mkdtemp(prefix="bench_quality_"))
+    cases = []
+    blender_jobs, fs_jobs = [], []
+    for path in meshes:
+        data = read_mesh(path)
+        mesh = Mesh(data.vertices, data.triangles)
+        source = (mesh.vertices, mesh.triangles)
+        source_signature = signature(*source)
+        np.savez(work / f"{path.stem}.npz", vertices=mesh.vertices, triangles=mesh.triangles)
+        off = work / f"{path.stem}.off"
+        with open(off, "w") as handle:
+            handle.write(f"OFF\n{len(mesh.vertices)} {len(mesh.triangles)} 0\n")
+            np.savetxt(handle, mesh.vertices, fmt="%.17g")
+            np.savetxt(handle, np.column_stack([np.full(len(mesh.triangles), 3), mesh.triangles]), fmt="%d")
+        for ratio in ratios:
+            target = max(4, int(round(ratio * len(mesh.triangles))))
+            case = {"mesh": path.name, "ratio": ratio, "input_triangles": len(mesh.triangles), "tools": {}}
+            for mode in ("quality", "fast"):
+                start = time.perf_counter()
+                result = mesh.decimate(triangles=target, seed=0, mode=mode)
+                seconds = time.perf_counter() - start
+                figures = measure(source, result.vertices, result.triangles, args.samples)
+                figures.update(seconds=seconds,
+                               topology=signature(result.vertices, result.triangles) == source_signature)
+                case["tools"][f"topstoc {mode}"] = figures
+            ours = case["tools"]["topstoc quality"]["triangles"]
+            case["peer_triangles"] = ours
+            stem = f"{path.stem}_{ratio}"
+            blender_jobs.append({"input": str(work / f"{path.stem}.npz"), "output": str(work / f"{stem}_blender.npz"),
+                                 "ratio": ours / len(mesh.triangles)})
+            fs_jobs.append({"input": str(work / f"{path.stem}.npz"), "output": str(work / f"{stem}_fs.npz"),
+                            "reduction": 1.0 - ours / len(mesh.triangles)})
+            # MeshLab
+            try:
+                import pymeshlab
+                ms = pymeshlab.MeshSet()
+                ms.add_mesh(pymeshlab.Mesh(mesh.vertices, mesh.triangles))
+                start = time.perf_counter()
+                ms.meshing_decimation_quadric_edge_collapse(targetfacenum=ours, optimalplacement=True,
+                                                            preservetopology=True, preserveboundary=True)
+                seconds = time.perf_counter() - start
+                m = ms.current_mesh()
+                case["tools"]["MeshLab"] = dict(measure(source, m.vertex_matrix(), m.face_matrix(), args.samples),
+                                                seconds=seconds,
+                                                topology=signature(m.vertex_matrix(), m.face_matrix()) == source_signature)
+            except ImportError:
+                case["tools"]["MeshLab"] = None
+            # meshoptimizer
+            if MESHOPT.exists():
+                out = work / f"{stem}_meshopt.off"
+                done = subprocess.run([str(MESHOPT), str(off), str(out), str(3 * ours)], capture_output=True,
+                                      text=True, check=True)
+                report = json.loads(done.stdout)
+                got = read_mesh(out)
+                case["tools"]["meshopt_simplify"] = dict(
+                    measure(source, got.vertices, got.triangles, args.samples), seconds=report.get("seconds"),
+                    topology=signature(got.vertices, got.triangles) == source_signature)
+            else:
+                case["tools"]["meshopt_simplify"] = None
+            case["source"] = source
+            case["signature"] = source_signature
+            cases.append(case)
+    # Blender, all jobs in one process
+    blender = shutil.which("blender")
+    if blender:
+        (work / "jobs.json").write_text(json.dumps(blender_jobs))
+        (work / "blender_decimate.py").write_text(BLENDER_SCRIPT)
+        subprocess.run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+                        str(work / "blender_decimate.py"), "--", str(work / "jobs.json")],
+                       capture_output=True, text=True, check=True)
+    python = fast_simplification_python()
+    if python:
+        (work / "fs_jobs.json").write_text(json.dumps(fs_jobs))
+        (work / "fs.py").write_text(FAST_SIMPLIFICATION_SCRIPT)
+        subprocess.run([python, str(work / "fs.py"), str(work / "fs_jobs.json")], check=True)
+    for case, bjob, fjob in zip(cases, blender_jobs, fs_jobs):
+        for name, job, present in (("Blender Collapse", bjob, blender), ("fast-simplification", fjob, python)):
+            if not present or not os.path.exists(job["output"]):
+                case["tools"][name] = None
+                continue
+            got = np.load(job["output"])
+            case["tools"][name] = dict(measure(case["source"], got["vertices"], got["triangles"], args.samples),
+                                       seconds=float(got["seconds"]),
+                                       topology=signature(got["vertices"], got["triangles"]) == case["signature"])
+    shutil.rmtree(work, ignore_errors=True)
+
+    names = ["topstoc quality", "topstoc fast", "Blender Collapse", "MeshLab", "meshopt_simplify",
+             "fast-simplification"]
+    for case in cases:
+        print(f"\n{case['mesh']} at {case['ratio']:.0%} ({case['input_triangles']} triangles -> "
+              f"peers at {case['peer_triangles']})")
+        print(f"  {'tool':21s} {'tris':>6s} {'max %':>7s} {'mean %':>8s} {'AR mean':>8s} {'AR p99':>8s} "
+              f"{'zero':>4s} {'topo':>4s} {'s':>7s}")
+        for name in names:
+            f = case["tools"].get(name)
+            if f is None:
+                print(f"  {name:21s} (not available)")
+                continue
+            seconds = f"{f['seconds']:.3f}" if f.get("seconds") is not None else "-"
+            print(f"  {name:21s} {f['triangles']:6d} {f['max']:7.3f} {f['mean']:8.4f} {f['ar_mean']:8.3f} "
+                  f"{f['ar_p99']:8.2f} {f['zero_area']:4d} {'yes' if f['topology'] else 'NO':>4s} {seconds:>7s}")
+
+    print("\nMedians over the cases of topstoc quality / peer (below 1: ours is better), worst case in brackets:")
+    for name in names[2:]:
+        pairs = [(c["tools"]["topstoc quality"], c["tools"][name]) for c in cases if c["tools"].get(name)]
+        if not pairs:
+            print(f"  {name}: not available")
+            continue
+        parts = []
+        for key in ("mean", "max", "ar_mean"):
+            values = [a[key] / b[key] for a, b in pairs if b[key] > 0]
+            parts.append(f"{key} {statistics.median(values):.3f} [{max(values):.2f}]")
+        topo = sum(b["topology"] for _, b in pairs)
+        parts.append(f"peer keeps topology {topo}/{len(pairs)}")
+        print(f"  vs {name}: " + ", ".join(parts))
+    ours = [c["tools"]["topstoc quality"] for c in cases]
+    print(f"  topstoc quality keeps topology {sum(o['topology'] for o in ours)}/{len(ours)}, "
+          f"zero-area triangles {sum(o['zero_area'] for o in ours)}")
+    better = []
+    for c in cases:
+        peers = [c["tools"][n]["mean"] for n in ("Blender Collapse", "MeshLab") if c["tools"].get(n)]
+        if peers:
+            better.append(c["tools"]["topstoc quality"]["mean"] / min(peers))
+    if better:
+        print(f"  mean error / better of Blender Collapse and MeshLab: median {statistics.median(better):.3f}, "
+              f"worst {max(better):.2f}  (goal <= 1.0)")
+    if args.json:
+        for case in cases:
+            case.pop("source", None)
+        pathlib.Path(args.json).write_text(json.dumps(cases, indent=1, default=str))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
