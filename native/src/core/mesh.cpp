@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
+#include <utility>
 
 #include "core/fans.hpp"
 #include "topstoc/core/validate.hpp"
@@ -57,7 +58,7 @@ Mesh::Mesh(std::vector<double> positions, const int32_t* triangles, int64_t num_
                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
   validate_and_copy_faces(triangles, num_triangles);
-  reorder_for_locality();
+  reorder_for_locality(lo, hi);
   build_vertex_faces();
   build_adjacency_and_edges();
   build_edge_faces();
@@ -137,16 +138,26 @@ uint64_t spread_bits(uint64_t x) {
   x = (x | x << 2) & 0x1249249249249249ull;
   return x;
 }
+
+// Sorts (key, vertex) pairs by key, ties by vertex, as std::sort on the pairs would: a stable
+// least-significant-digit radix sort over the bits the keys use, on input in vertex order.
+void radix_sort_keys(std::vector<std::pair<uint64_t, int32_t>>& keyed, int key_bits) {
+  constexpr int kDigit = 11;
+  std::vector<std::pair<uint64_t, int32_t>> other(keyed.size());
+  std::vector<size_t> count(size_t(1) << kDigit);
+  for (int shift = 0; shift < key_bits; shift += kDigit) {
+    std::fill(count.begin(), count.end(), 0);
+    for (const auto& k : keyed) ++count[(k.first >> shift) & ((1u << kDigit) - 1)];
+    size_t sum = 0;
+    for (auto& c : count) sum += std::exchange(c, sum);
+    for (const auto& k : keyed) other[count[(k.first >> shift) & ((1u << kDigit) - 1)]++] = k;
+    keyed.swap(other);
+  }
+}
 }  // namespace
 
-void Mesh::reorder_for_locality() {
+void Mesh::reorder_for_locality(const double* lo, const double* hi) {
   const int32_t n = num_vertices_;
-  double lo[3] = {positions_[0], positions_[1], positions_[2]}, hi[3] = {lo[0], lo[1], lo[2]};
-  for (int32_t v = 0; v < n; ++v)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], positions_[3 * size_t(v) + k]);
-      hi[k] = std::max(hi[k], positions_[3 * size_t(v) + k]);
-    }
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
   std::vector<std::pair<uint64_t, int32_t>> keyed(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
@@ -158,10 +169,11 @@ void Mesh::reorder_for_locality() {
     }
     keyed[v] = {key, v};
   }
-  std::sort(keyed.begin(), keyed.end());
+  radix_sort_keys(keyed, 63);
   vertex_source_.resize(n);
   vertex_index_.resize(n);
   std::vector<double> moved(positions_.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t i = 0; i < n; ++i) {
     const int32_t old = keyed[i].second;
     vertex_source_[i] = old;
@@ -169,7 +181,9 @@ void Mesh::reorder_for_locality() {
     for (int k = 0; k < 3; ++k) moved[3 * size_t(i) + k] = positions_[3 * size_t(old) + k];
   }
   positions_.swap(moved);
-  for (auto& v : faces_) v = vertex_index_[v];
+  const int64_t corners = static_cast<int64_t>(faces_.size());
+#pragma omp parallel for schedule(static) if (corners >= kParallelMin)
+  for (int64_t i = 0; i < corners; ++i) faces_[i] = vertex_index_[faces_[i]];
   // Faces in order of their lowest vertex (a stable counting sort keeps ties in input order).
   const int32_t m = num_faces();
   std::vector<int32_t> offsets(n + 1, 0);
@@ -179,6 +193,7 @@ void Mesh::reorder_for_locality() {
   std::vector<int32_t> order(m);
   for (int32_t f = 0; f < m; ++f) order[offsets[lowest(f)]++] = f;
   std::vector<int32_t> faces(faces_.size()), source(m);
+#pragma omp parallel for schedule(static) if (m >= kParallelMin)
   for (int32_t i = 0; i < m; ++i) {
     for (int c = 0; c < 3; ++c) faces[3 * size_t(i) + c] = faces_[3 * size_t(order[i]) + c];
     source[i] = face_source_[order[i]];
@@ -314,8 +329,7 @@ void Mesh::compute_normals_and_weights() {
   normals_.assign(3 * size_t(n), 0.0);
   weights_.assign(n, 0.0);
   vertex_areas_.assign(n, 0.0);
-  double total_area = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : total_area) if (n >= kParallelMin)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     double sum[3] = {0, 0, 0}, area = 0.0;
     for (int32_t i = vertex_face_offsets_[v]; i < vertex_face_offsets_[v + 1]; ++i) {
@@ -326,15 +340,12 @@ void Mesh::compute_normals_and_weights() {
       area += std::sqrt(fn[0] * fn[0] + fn[1] * fn[1] + fn[2] * fn[2]) / 6.0;  // a third of half the cross
     }
     vertex_areas_[v] = area;
-    total_area += area;
     const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
     if (len > 0)
       for (int k = 0; k < 3; ++k) normals_[3 * size_t(v) + k] = sum[k] / len;
   }
   // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
-  double total = 0.0;
-  int64_t counted = 0;
-#pragma omp parallel for schedule(static) reduction(+ : total, counted) if (n >= kParallelMin)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     const int32_t b = adjacency_offsets_[v], e = adjacency_offsets_[v + 1];
     if (b == e) continue;
@@ -346,6 +357,14 @@ void Mesh::compute_normals_and_weights() {
     }
     const double x = (double(e - b) - dots) / (2.0 * double(e - b));
     weights_[v] = std::clamp(x, 0.0, 1.0);
+  }
+  // The means are summed in vertex order on one thread: an OpenMP reduction adds in an order
+  // that depends on the number of threads, and so would change the last bits of the result.
+  double total = 0.0, total_area = 0.0;
+  int64_t counted = 0;
+  for (int32_t v = 0; v < n; ++v) {
+    total_area += vertex_areas_[v];
+    if (adjacency_offsets_[v] == adjacency_offsets_[v + 1]) continue;
     total += weights_[v];
     ++counted;
   }

@@ -95,7 +95,7 @@ class Mesh {
 
  private:
   void validate_and_copy_faces(const int32_t* triangles, int64_t num_triangles);
-  void reorder_for_locality();
+  void reorder_for_locality(const double* lo, const double* hi);
   void build_vertex_faces();
   void build_adjacency_and_edges();
   void build_edge_faces();
