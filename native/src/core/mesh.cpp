@@ -372,6 +372,35 @@ void Mesh::compute_normals_and_weights() {
   mean_vertex_area_ = counted ? total_area / double(counted) : 0.0;
 }
 
+bool Mesh::one_oriented_fan(int32_t v) const {
+  const int32_t begin = vertex_face_offsets_[v], count = vertex_face_offsets_[v + 1] - begin;
+  auto corner = [&](int32_t f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
+    return t[0] == v ? 0 : t[1] == v ? 1 : 2;
+  };
+  // Each boundary side arriving at v starts a chain of faces; more than one chain is a pinch.
+  int32_t start = vertex_faces_[begin], chains = 0;
+  for (int32_t i = begin; i < begin + count; ++i) {
+    const int32_t f = vertex_faces_[i];
+    if (edge_face_count(face_edges_[3 * size_t(f) + (corner(f) + 2) % 3]) == 1) {
+      start = f;
+      if (++chains > 1) return false;
+    }
+  }
+  // Walk across the sides leaving v (the next face arrives at v by the same edge) until the
+  // chain ends or the cycle closes; one fan holds every face of v.
+  int32_t f = start, visited = 1;
+  while (visited <= count) {
+    const int32_t e = face_edges_[3 * size_t(f) + corner(f)];
+    if (edge_face_count(e) != 2) break;
+    const int32_t* ef = &edge_faces_[edge_face_offsets_[e]];
+    f = ef[0] == f ? ef[1] : ef[0];
+    if (f == start) break;
+    ++visited;
+  }
+  return visited == count;
+}
+
 void Mesh::compute_components_and_manifoldness() {
   const int32_t n = num_vertices_;
   component_.assign(n, -1);
@@ -413,7 +442,11 @@ void Mesh::compute_components_and_manifoldness() {
         if (edge_face_count(adjacency_edge_[i]) > 2) nonmanifold_edge = true;
         if (inconsistent_edge_[adjacency_edge_[i]]) flipped = true;
       }
-      const int32_t fans = vertex_fans(*this, v, [](int32_t) { return false; }, fan_of_slot);
+      // Fans only matter to tell pinched vertices; on consistently oriented two-face edges a
+      // walk around v answers that without the general grouping.
+      const int32_t fans = nonmanifold_edge ? 1
+                           : flipped        ? vertex_fans(*this, v, [](int32_t) { return false; }, fan_of_slot)
+                                            : (one_oriented_fan(v) ? 1 : 2);
       if (fans > 1 || nonmanifold_edge || flipped) {
         manifold_vertex_[v] = 0;
         if (fans > 1 && !nonmanifold_edge) ++pinched;  // pinched, not merely on a bad edge

@@ -101,6 +101,9 @@ class Mesh {
   void build_edge_faces();
   void compute_normals_and_weights();
   void compute_components_and_manifoldness();
+  /// Whether the triangles around v form one fan, given that every edge at v has at most two
+  /// triangles, oriented consistently.
+  bool one_oriented_fan(int32_t v) const;
 
   int32_t num_vertices_ = 0;
   std::vector<double> positions_;
