@@ -83,8 +83,10 @@ void Mesh::validate_and_copy_faces(const int32_t* triangles, int64_t num_triangl
   }
   // Drop exact duplicates (same vertex set, either orientation): bucket by smallest vertex, then
   // compare the sorted triples inside each small bucket. The first occurrence is kept.
+  const int64_t k = static_cast<int64_t>(candidates.size());
   std::vector<std::array<int32_t, 3>> sorted(candidates.size());
-  for (size_t i = 0; i < candidates.size(); ++i) {
+#pragma omp parallel for schedule(static) if (k >= kParallelMin)
+  for (int64_t i = 0; i < k; ++i) {
     const int32_t* t = triangles + 3 * size_t(candidates[i]);
     sorted[i] = {t[0], t[1], t[2]};
     std::sort(sorted[i].begin(), sorted[i].end());
@@ -97,7 +99,9 @@ void Mesh::validate_and_copy_faces(const int32_t* triangles, int64_t num_triangl
     std::vector<int32_t> fill(bucket_offsets.begin(), bucket_offsets.end() - 1);
     for (size_t i = 0; i < sorted.size(); ++i) bucket[fill[sorted[i][0]]++] = int32_t(i);
   }
+  // Buckets are disjoint, so they are scanned in parallel.
   std::vector<uint8_t> duplicate(candidates.size(), 0);
+#pragma omp parallel for schedule(static) if (num_vertices_ >= kParallelMin)
   for (int32_t v = 0; v < num_vertices_; ++v) {
     const int32_t b = bucket_offsets[v], e = bucket_offsets[v + 1];
     for (int32_t i = b; i < e; ++i) {
@@ -106,21 +110,31 @@ void Mesh::validate_and_copy_faces(const int32_t* triangles, int64_t num_triangl
         if (!duplicate[bucket[j]] && sorted[bucket[j]] == sorted[bucket[i]]) duplicate[bucket[j]] = 1;
     }
   }
-  faces_.reserve(3 * candidates.size());
-  for (size_t i = 0; i < candidates.size(); ++i) {
-    const int32_t f = candidates[i];
+  for (int64_t i = 0; i < k; ++i)
     if (duplicate[i]) {
       ++report_.duplicate_triangles;
-      report_.dropped_triangles.push_back(f);
-      continue;
+      report_.dropped_triangles.push_back(candidates[i]);
     }
-    const int32_t* t = triangles + 3 * size_t(f);
-    faces_.insert(faces_.end(), t, t + 3);
-    face_source_.push_back(f);
+  const int64_t kept = k - report_.duplicate_triangles;
+  face_source_.resize(kept);
+  if (report_.duplicate_triangles == 0) {
+    std::copy(candidates.begin(), candidates.end(), face_source_.begin());
+  } else {
+    int64_t j = 0;
+    for (int64_t i = 0; i < k; ++i)
+      if (!duplicate[i]) face_source_[j++] = candidates[i];
+  }
+  faces_.resize(3 * kept);
+  int32_t zero_area = 0;
+#pragma omp parallel for schedule(static) reduction(+ : zero_area) if (kept >= kParallelMin)
+  for (int64_t i = 0; i < kept; ++i) {
+    const int32_t* t = triangles + 3 * size_t(face_source_[i]);
+    std::copy(t, t + 3, faces_.begin() + 3 * i);
     double n[3];
     cross(position(t[0]), position(t[1]), position(t[2]), n);
-    if (n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0) ++report_.zero_area_triangles;
+    if (n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0) ++zero_area;
   }
+  report_.zero_area_triangles = zero_area;
   std::sort(report_.dropped_triangles.begin(), report_.dropped_triangles.end());
   if (faces_.empty())
     throw std::invalid_argument("mesh has no valid triangles: all " + std::to_string(num_triangles) +
