@@ -276,16 +276,28 @@ void Mesh::build_adjacency_and_edges() {
       }
     }
   }
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  // Slots towards lower neighbours: v's lower neighbours u come in increasing order, and so do
+  // the edges (u, v) as u grows, so one cursor per vertex fills them without searching.
+  std::vector<int32_t> cursor(adjacency_offsets_.begin(), adjacency_offsets_.end() - 1);
   for (int32_t v = 0; v < n; ++v)
-    for (int32_t i = adjacency_offsets_[v]; i < adjacency_offsets_[v + 1]; ++i) {
-      const int32_t u = adjacency_[i];
-      if (u < v) {
-        const auto* begin = adjacency_.data() + adjacency_offsets_[u];
-        const auto* end = adjacency_.data() + adjacency_offsets_[u + 1];
-        adjacency_edge_[i] = adjacency_edge_[std::lower_bound(begin, end, v) - adjacency_.data()];
+    for (int32_t i = adjacency_offsets_[v + 1] - greater[v]; i < adjacency_offsets_[v + 1]; ++i)
+      adjacency_edge_[cursor[adjacency_[i]]++] = adjacency_edge_[i];
+  // The edge of each face side, found by its lower endpoint among its higher neighbours.
+  face_edges_.resize(faces_.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) {
+    const int32_t* first = adjacency_.data() + adjacency_offsets_[v + 1] - greater[v];
+    const int32_t* last = adjacency_.data() + adjacency_offsets_[v + 1];
+    for (int32_t i = vertex_face_offsets_[v]; i < vertex_face_offsets_[v + 1]; ++i) {
+      const int32_t f = vertex_faces_[i];
+      const int32_t* t = &faces_[3 * size_t(f)];
+      const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+      for (int side : {c, (c + 2) % 3}) {
+        const int32_t u = t[side == c ? (c + 1) % 3 : side];
+        if (u > v) face_edges_[3 * size_t(f) + side] = edge_base[v] + int32_t(std::lower_bound(first, last, u) - first);
       }
     }
+  }
 }
 
 int32_t Mesh::find_edge(int32_t a, int32_t b) const {
@@ -298,10 +310,6 @@ int32_t Mesh::find_edge(int32_t a, int32_t b) const {
 
 void Mesh::build_edge_faces() {
   const int32_t m = num_faces();
-  face_edges_.resize(faces_.size());
-#pragma omp parallel for schedule(static) if (m >= kParallelMin)
-  for (int32_t f = 0; f < m; ++f)
-    for (int c = 0; c < 3; ++c) face_edges_[3 * f + c] = find_edge(faces_[3 * f + c], faces_[3 * f + (c + 1) % 3]);
   edge_face_offsets_.assign(num_edges() + 1, 0);
   for (int32_t e : face_edges_) ++edge_face_offsets_[e];
   exclusive_scan(edge_face_offsets_);
