@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
+#include <utility>
 
 #include "core/fans.hpp"
 #include "topstoc/core/validate.hpp"
@@ -57,7 +58,7 @@ Mesh::Mesh(std::vector<double> positions, const int32_t* triangles, int64_t num_
                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
   validate_and_copy_faces(triangles, num_triangles);
-  reorder_for_locality();
+  reorder_for_locality(lo, hi);
   build_vertex_faces();
   build_adjacency_and_edges();
   build_edge_faces();
@@ -82,8 +83,10 @@ void Mesh::validate_and_copy_faces(const int32_t* triangles, int64_t num_triangl
   }
   // Drop exact duplicates (same vertex set, either orientation): bucket by smallest vertex, then
   // compare the sorted triples inside each small bucket. The first occurrence is kept.
+  const int64_t k = static_cast<int64_t>(candidates.size());
   std::vector<std::array<int32_t, 3>> sorted(candidates.size());
-  for (size_t i = 0; i < candidates.size(); ++i) {
+#pragma omp parallel for schedule(static) if (k >= kParallelMin)
+  for (int64_t i = 0; i < k; ++i) {
     const int32_t* t = triangles + 3 * size_t(candidates[i]);
     sorted[i] = {t[0], t[1], t[2]};
     std::sort(sorted[i].begin(), sorted[i].end());
@@ -96,7 +99,9 @@ void Mesh::validate_and_copy_faces(const int32_t* triangles, int64_t num_triangl
     std::vector<int32_t> fill(bucket_offsets.begin(), bucket_offsets.end() - 1);
     for (size_t i = 0; i < sorted.size(); ++i) bucket[fill[sorted[i][0]]++] = int32_t(i);
   }
+  // Buckets are disjoint, so they are scanned in parallel.
   std::vector<uint8_t> duplicate(candidates.size(), 0);
+#pragma omp parallel for schedule(static) if (num_vertices_ >= kParallelMin)
   for (int32_t v = 0; v < num_vertices_; ++v) {
     const int32_t b = bucket_offsets[v], e = bucket_offsets[v + 1];
     for (int32_t i = b; i < e; ++i) {
@@ -105,21 +110,31 @@ void Mesh::validate_and_copy_faces(const int32_t* triangles, int64_t num_triangl
         if (!duplicate[bucket[j]] && sorted[bucket[j]] == sorted[bucket[i]]) duplicate[bucket[j]] = 1;
     }
   }
-  faces_.reserve(3 * candidates.size());
-  for (size_t i = 0; i < candidates.size(); ++i) {
-    const int32_t f = candidates[i];
+  for (int64_t i = 0; i < k; ++i)
     if (duplicate[i]) {
       ++report_.duplicate_triangles;
-      report_.dropped_triangles.push_back(f);
-      continue;
+      report_.dropped_triangles.push_back(candidates[i]);
     }
-    const int32_t* t = triangles + 3 * size_t(f);
-    faces_.insert(faces_.end(), t, t + 3);
-    face_source_.push_back(f);
+  const int64_t kept = k - report_.duplicate_triangles;
+  face_source_.resize(kept);
+  if (report_.duplicate_triangles == 0) {
+    std::copy(candidates.begin(), candidates.end(), face_source_.begin());
+  } else {
+    int64_t j = 0;
+    for (int64_t i = 0; i < k; ++i)
+      if (!duplicate[i]) face_source_[j++] = candidates[i];
+  }
+  faces_.resize(3 * kept);
+  int32_t zero_area = 0;
+#pragma omp parallel for schedule(static) reduction(+ : zero_area) if (kept >= kParallelMin)
+  for (int64_t i = 0; i < kept; ++i) {
+    const int32_t* t = triangles + 3 * size_t(face_source_[i]);
+    std::copy(t, t + 3, faces_.begin() + 3 * i);
     double n[3];
     cross(position(t[0]), position(t[1]), position(t[2]), n);
-    if (n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0) ++report_.zero_area_triangles;
+    if (n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0) ++zero_area;
   }
+  report_.zero_area_triangles = zero_area;
   std::sort(report_.dropped_triangles.begin(), report_.dropped_triangles.end());
   if (faces_.empty())
     throw std::invalid_argument("mesh has no valid triangles: all " + std::to_string(num_triangles) +
@@ -137,16 +152,26 @@ uint64_t spread_bits(uint64_t x) {
   x = (x | x << 2) & 0x1249249249249249ull;
   return x;
 }
+
+// Sorts (key, vertex) pairs by key, ties by vertex, as std::sort on the pairs would: a stable
+// least-significant-digit radix sort over the bits the keys use, on input in vertex order.
+void radix_sort_keys(std::vector<std::pair<uint64_t, int32_t>>& keyed, int key_bits) {
+  constexpr int kDigit = 11;
+  std::vector<std::pair<uint64_t, int32_t>> other(keyed.size());
+  std::vector<size_t> count(size_t(1) << kDigit);
+  for (int shift = 0; shift < key_bits; shift += kDigit) {
+    std::fill(count.begin(), count.end(), 0);
+    for (const auto& k : keyed) ++count[(k.first >> shift) & ((1u << kDigit) - 1)];
+    size_t sum = 0;
+    for (auto& c : count) sum += std::exchange(c, sum);
+    for (const auto& k : keyed) other[count[(k.first >> shift) & ((1u << kDigit) - 1)]++] = k;
+    keyed.swap(other);
+  }
+}
 }  // namespace
 
-void Mesh::reorder_for_locality() {
+void Mesh::reorder_for_locality(const double* lo, const double* hi) {
   const int32_t n = num_vertices_;
-  double lo[3] = {positions_[0], positions_[1], positions_[2]}, hi[3] = {lo[0], lo[1], lo[2]};
-  for (int32_t v = 0; v < n; ++v)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], positions_[3 * size_t(v) + k]);
-      hi[k] = std::max(hi[k], positions_[3 * size_t(v) + k]);
-    }
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
   std::vector<std::pair<uint64_t, int32_t>> keyed(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
@@ -158,10 +183,11 @@ void Mesh::reorder_for_locality() {
     }
     keyed[v] = {key, v};
   }
-  std::sort(keyed.begin(), keyed.end());
+  radix_sort_keys(keyed, 63);
   vertex_source_.resize(n);
   vertex_index_.resize(n);
   std::vector<double> moved(positions_.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t i = 0; i < n; ++i) {
     const int32_t old = keyed[i].second;
     vertex_source_[i] = old;
@@ -169,7 +195,9 @@ void Mesh::reorder_for_locality() {
     for (int k = 0; k < 3; ++k) moved[3 * size_t(i) + k] = positions_[3 * size_t(old) + k];
   }
   positions_.swap(moved);
-  for (auto& v : faces_) v = vertex_index_[v];
+  const int64_t corners = static_cast<int64_t>(faces_.size());
+#pragma omp parallel for schedule(static) if (corners >= kParallelMin)
+  for (int64_t i = 0; i < corners; ++i) faces_[i] = vertex_index_[faces_[i]];
   // Faces in order of their lowest vertex (a stable counting sort keeps ties in input order).
   const int32_t m = num_faces();
   std::vector<int32_t> offsets(n + 1, 0);
@@ -179,6 +207,7 @@ void Mesh::reorder_for_locality() {
   std::vector<int32_t> order(m);
   for (int32_t f = 0; f < m; ++f) order[offsets[lowest(f)]++] = f;
   std::vector<int32_t> faces(faces_.size()), source(m);
+#pragma omp parallel for schedule(static) if (m >= kParallelMin)
   for (int32_t i = 0; i < m; ++i) {
     for (int c = 0; c < 3; ++c) faces[3 * size_t(i) + c] = faces_[3 * size_t(order[i]) + c];
     source[i] = face_source_[order[i]];
@@ -247,16 +276,28 @@ void Mesh::build_adjacency_and_edges() {
       }
     }
   }
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  // Slots towards lower neighbours: v's lower neighbours u come in increasing order, and so do
+  // the edges (u, v) as u grows, so one cursor per vertex fills them without searching.
+  std::vector<int32_t> cursor(adjacency_offsets_.begin(), adjacency_offsets_.end() - 1);
   for (int32_t v = 0; v < n; ++v)
-    for (int32_t i = adjacency_offsets_[v]; i < adjacency_offsets_[v + 1]; ++i) {
-      const int32_t u = adjacency_[i];
-      if (u < v) {
-        const auto* begin = adjacency_.data() + adjacency_offsets_[u];
-        const auto* end = adjacency_.data() + adjacency_offsets_[u + 1];
-        adjacency_edge_[i] = adjacency_edge_[std::lower_bound(begin, end, v) - adjacency_.data()];
+    for (int32_t i = adjacency_offsets_[v + 1] - greater[v]; i < adjacency_offsets_[v + 1]; ++i)
+      adjacency_edge_[cursor[adjacency_[i]]++] = adjacency_edge_[i];
+  // The edge of each face side, found by its lower endpoint among its higher neighbours.
+  face_edges_.resize(faces_.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) {
+    const int32_t* first = adjacency_.data() + adjacency_offsets_[v + 1] - greater[v];
+    const int32_t* last = adjacency_.data() + adjacency_offsets_[v + 1];
+    for (int32_t i = vertex_face_offsets_[v]; i < vertex_face_offsets_[v + 1]; ++i) {
+      const int32_t f = vertex_faces_[i];
+      const int32_t* t = &faces_[3 * size_t(f)];
+      const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+      for (int side : {c, (c + 2) % 3}) {
+        const int32_t u = t[side == c ? (c + 1) % 3 : side];
+        if (u > v) face_edges_[3 * size_t(f) + side] = edge_base[v] + int32_t(std::lower_bound(first, last, u) - first);
       }
     }
+  }
 }
 
 int32_t Mesh::find_edge(int32_t a, int32_t b) const {
@@ -269,10 +310,6 @@ int32_t Mesh::find_edge(int32_t a, int32_t b) const {
 
 void Mesh::build_edge_faces() {
   const int32_t m = num_faces();
-  face_edges_.resize(faces_.size());
-#pragma omp parallel for schedule(static) if (m >= kParallelMin)
-  for (int32_t f = 0; f < m; ++f)
-    for (int c = 0; c < 3; ++c) face_edges_[3 * f + c] = find_edge(faces_[3 * f + c], faces_[3 * f + (c + 1) % 3]);
   edge_face_offsets_.assign(num_edges() + 1, 0);
   for (int32_t e : face_edges_) ++edge_face_offsets_[e];
   exclusive_scan(edge_face_offsets_);
@@ -314,8 +351,7 @@ void Mesh::compute_normals_and_weights() {
   normals_.assign(3 * size_t(n), 0.0);
   weights_.assign(n, 0.0);
   vertex_areas_.assign(n, 0.0);
-  double total_area = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : total_area) if (n >= kParallelMin)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     double sum[3] = {0, 0, 0}, area = 0.0;
     for (int32_t i = vertex_face_offsets_[v]; i < vertex_face_offsets_[v + 1]; ++i) {
@@ -326,15 +362,12 @@ void Mesh::compute_normals_and_weights() {
       area += std::sqrt(fn[0] * fn[0] + fn[1] * fn[1] + fn[2] * fn[2]) / 6.0;  // a third of half the cross
     }
     vertex_areas_[v] = area;
-    total_area += area;
     const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
     if (len > 0)
       for (int k = 0; k < 3; ++k) normals_[3 * size_t(v) + k] = sum[k] / len;
   }
   // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
-  double total = 0.0;
-  int64_t counted = 0;
-#pragma omp parallel for schedule(static) reduction(+ : total, counted) if (n >= kParallelMin)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     const int32_t b = adjacency_offsets_[v], e = adjacency_offsets_[v + 1];
     if (b == e) continue;
@@ -346,11 +379,48 @@ void Mesh::compute_normals_and_weights() {
     }
     const double x = (double(e - b) - dots) / (2.0 * double(e - b));
     weights_[v] = std::clamp(x, 0.0, 1.0);
+  }
+  // The means are summed in vertex order on one thread: an OpenMP reduction adds in an order
+  // that depends on the number of threads, and so would change the last bits of the result.
+  double total = 0.0, total_area = 0.0;
+  int64_t counted = 0;
+  for (int32_t v = 0; v < n; ++v) {
+    total_area += vertex_areas_[v];
+    if (adjacency_offsets_[v] == adjacency_offsets_[v + 1]) continue;
     total += weights_[v];
     ++counted;
   }
   mean_weight_ = counted ? total / double(counted) : 0.0;
   mean_vertex_area_ = counted ? total_area / double(counted) : 0.0;
+}
+
+bool Mesh::one_oriented_fan(int32_t v) const {
+  const int32_t begin = vertex_face_offsets_[v], count = vertex_face_offsets_[v + 1] - begin;
+  auto corner = [&](int32_t f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
+    return t[0] == v ? 0 : t[1] == v ? 1 : 2;
+  };
+  // Each boundary side arriving at v starts a chain of faces; more than one chain is a pinch.
+  int32_t start = vertex_faces_[begin], chains = 0;
+  for (int32_t i = begin; i < begin + count; ++i) {
+    const int32_t f = vertex_faces_[i];
+    if (edge_face_count(face_edges_[3 * size_t(f) + (corner(f) + 2) % 3]) == 1) {
+      start = f;
+      if (++chains > 1) return false;
+    }
+  }
+  // Walk across the sides leaving v (the next face arrives at v by the same edge) until the
+  // chain ends or the cycle closes; one fan holds every face of v.
+  int32_t f = start, visited = 1;
+  while (visited <= count) {
+    const int32_t e = face_edges_[3 * size_t(f) + corner(f)];
+    if (edge_face_count(e) != 2) break;
+    const int32_t* ef = &edge_faces_[edge_face_offsets_[e]];
+    f = ef[0] == f ? ef[1] : ef[0];
+    if (f == start) break;
+    ++visited;
+  }
+  return visited == count;
 }
 
 void Mesh::compute_components_and_manifoldness() {
@@ -394,7 +464,11 @@ void Mesh::compute_components_and_manifoldness() {
         if (edge_face_count(adjacency_edge_[i]) > 2) nonmanifold_edge = true;
         if (inconsistent_edge_[adjacency_edge_[i]]) flipped = true;
       }
-      const int32_t fans = vertex_fans(*this, v, [](int32_t) { return false; }, fan_of_slot);
+      // Fans only matter to tell pinched vertices; on consistently oriented two-face edges a
+      // walk around v answers that without the general grouping.
+      const int32_t fans = nonmanifold_edge ? 1
+                           : flipped        ? vertex_fans(*this, v, [](int32_t) { return false; }, fan_of_slot)
+                                            : (one_oriented_fan(v) ? 1 : 2);
       if (fans > 1 || nonmanifold_edge || flipped) {
         manifold_vertex_[v] = 0;
         if (fans > 1 && !nonmanifold_edge) ++pinched;  // pinched, not merely on a bad edge

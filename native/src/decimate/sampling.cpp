@@ -338,14 +338,18 @@ void ring_ball(const Mesh& mesh, int32_t center, int32_t rings, std::vector<int3
 
 double mean_edge_length(const Mesh& mesh) {
   const auto& ev = mesh.edge_vertices();
-  double total = 0.0;
   const int32_t m = mesh.num_edges();
-#pragma omp parallel for schedule(static) reduction(+ : total) if (m >= kParallelMin)
+  std::vector<double> length(m);
+#pragma omp parallel for schedule(static) if (m >= kParallelMin)
   for (int32_t e = 0; e < m; ++e) {
     const double* a = mesh.position(ev[2 * e]);
     const double* b = mesh.position(ev[2 * e + 1]);
-    total += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+    length[e] = std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
   }
+  // Summed in edge order on one thread: a reduction's order, and so its last bits, would depend
+  // on the number of threads.
+  double total = 0.0;
+  for (double l : length) total += l;
   return m ? total / m : 0.0;
 }
 

@@ -95,12 +95,15 @@ class Mesh {
 
  private:
   void validate_and_copy_faces(const int32_t* triangles, int64_t num_triangles);
-  void reorder_for_locality();
+  void reorder_for_locality(const double* lo, const double* hi);
   void build_vertex_faces();
   void build_adjacency_and_edges();
   void build_edge_faces();
   void compute_normals_and_weights();
   void compute_components_and_manifoldness();
+  /// Whether the triangles around v form one fan, given that every edge at v has at most two
+  /// triangles, oriented consistently.
+  bool one_oriented_fan(int32_t v) const;
 
   int32_t num_vertices_ = 0;
   std::vector<double> positions_;
