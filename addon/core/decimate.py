@@ -200,7 +200,10 @@ def target_vertex_count(mesh: Mesh, ratio=None, vertices=None) -> int:
     active = _active_vertices(mesh)
     if ratio is not None:
         return max(1, int(round(params.number("ratio", ratio, 0, 1, low_open=True) * active)))
-    return params.integer("vertices (the target; at most the vertices in triangles)", vertices, 1, active)
+    vertices = params.integer("vertices", vertices)
+    if not 1 <= vertices <= active:
+        raise ValueError(f"vertex target {vertices} is outside [1, {active}] (vertices in triangles)")
+    return vertices
 
 
 def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] = None,
@@ -270,7 +273,9 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
     max_repair_rounds = params.integer("max_repair_rounds", max_repair_rounds, 0, 2**31 - 1)
     target_triangles = 0
     if triangles is not None:
-        target_triangles = params.integer("triangles (the target)", triangles, 1, mesh.num_triangles)
+        target_triangles = params.integer("triangles", triangles)
+        if not 1 <= target_triangles <= mesh.num_triangles:
+            raise ValueError(f"triangle target {target_triangles} is outside [1, {mesh.num_triangles}]")
         target = 1
     else:
         target = target_vertex_count(mesh, ratio, vertices)
