@@ -261,9 +261,10 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, vertices: Optional[int] 
     if placement not in PLACEMENTS:
         raise ValueError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
     seed = params.seed(seed)
-    refine = params.number("refine", refine, 0)
+    refine_wanted = "0 (off) or a factor of at least 1"
+    refine = params.number("refine", refine, 0, expected=refine_wanted)
     if 0 < refine < 1:
-        raise ValueError(f"refine must be 0 (off) or a factor of at least 1, got {refine!r}")
+        refine = params.number("refine", refine, 1, expected=refine_wanted)  # raises
     adaptivity = params.number("adaptivity", adaptivity, 0, 1)
     flat_floor = params.number("flat_floor", flat_floor, 0, 1)
     feature_angle = params.number("feature_angle (radians)", feature_angle, 0, math.pi)

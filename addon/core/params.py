@@ -45,23 +45,27 @@ def optional_integer(name: str, value, low: Optional[int] = None, high: Optional
     return None if value is None else integer(name, value, low, high)
 
 
-def integer(name: str, value, low: Optional[int] = None, high: Optional[int] = None) -> int:
-    """``value`` as a Python int in [low, high] (None: unbounded); ValueError otherwise."""
+def integer(name: str, value, low: Optional[int] = None, high: Optional[int] = None, *,
+            expected: Optional[str] = None) -> int:
+    """``value`` as a Python int in [low, high] (None: unbounded); ValueError otherwise.
+    ``expected`` replaces the range in the message ("must be {expected}, got ...")."""
     if _is_bool(value) or not isinstance(value, (numbers.Integral, np.integer)):
-        raise ValueError(f"{name} must be an integer, got {_shown(value)}")
+        raise ValueError(f"{name} must be {expected or 'an integer'}, got {_shown(value)}")
     exact = int(value)  # arbitrary precision: the comparison below cannot overflow
     if (low is not None and exact < low) or (high is not None and exact > high):
-        raise ValueError(f"{name} must lie in {_range_text(low, high, False, False)}, got {_shown(value)}")
+        wanted = f"be {expected}" if expected else f"lie in {_range_text(low, high, False, False)}"
+        raise ValueError(f"{name} must {wanted}, got {_shown(value)}")
     return exact
 
 
 def number(name: str, value, low: Optional[float] = None, high: Optional[float] = None, *,
-           low_open: bool = False, high_open: bool = False, finite: bool = True) -> float:
+           low_open: bool = False, high_open: bool = False, finite: bool = True,
+           expected: Optional[str] = None) -> float:
     """``value`` as a Python float in the range given (open ends when low_open / high_open;
     None: unbounded) and finite unless ``finite=False``; ValueError for anything else, NaN
-    included."""
+    included. ``expected`` replaces the range in the message ("must be {expected}, got ...")."""
     if _is_bool(value) or not isinstance(value, (numbers.Real, np.integer, np.floating)):
-        raise ValueError(f"{name} must be a number, got {_shown(value)}")
+        raise ValueError(f"{name} must be {expected or 'a number'}, got {_shown(value)}")
     try:
         real = float(value)
     except OverflowError:  # an int beyond the double range
@@ -69,7 +73,8 @@ def number(name: str, value, low: Optional[float] = None, high: Optional[float] 
     below = low is not None and (real < low or (low_open and real == low))
     above = high is not None and (real > high or (high_open and real == high))
     if math.isnan(real) or below or above or (finite and math.isinf(real)):
-        raise ValueError(f"{name} must lie in {_range_text(low, high, low_open, high_open)}, got {_shown(value)}")
+        wanted = f"be {expected}" if expected else f"lie in {_range_text(low, high, low_open, high_open)}"
+        raise ValueError(f"{name} must {wanted}, got {_shown(value)}")
     return real
 
 

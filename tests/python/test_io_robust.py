@@ -53,6 +53,11 @@ def test_two_face_elements_and_repeated_properties_are_refused(tmp_path):
                                         "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 1\n")
     with pytest.raises(ValueError, match="a second 'face' element"):
         read_mesh(tmp_path / "faces.ply")
+    (tmp_path / "lists.ply").write_text(base + "element face 1\nproperty list uchar int vertex_indices\n"
+                                        "property list uchar int vertex_index\nend_header\n"
+                                        "0 0 0\n1 0 0\n0 1 0\n3 0 1 2 3 0 2 1\n")
+    with pytest.raises(ValueError, match="two vertex index lists"):
+        read_mesh(tmp_path / "lists.ply")
     (tmp_path / "twice.ply").write_text(base + "property float x\nend_header\n")
     with pytest.raises(ValueError, match="property 'x' declared twice in element 'vertex'"):
         read_mesh(tmp_path / "twice.ply")

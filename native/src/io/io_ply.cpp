@@ -150,6 +150,12 @@ PlyHeader parse_header(const char* data, size_t size) {
         property.role = Role::Indices;
       }
       if (element.name == "face" && list && name == "texcoord") property.role = Role::TexCoord;
+      // Two index lists would be read as one polygon of both.
+      if (property.role == Role::Indices)
+        for (const auto& other : element.properties)
+          if (other.role == Role::Indices)
+            fail_at_line(number, "the face element has two vertex index lists ('" + other.name + "' and " +
+                                     quote(name) + ")");
       element.properties.push_back(std::move(property));
     } else {
       // Not a keyword: old exporters wrote free text here (Blender 2.4x: "Created by Blender3D
