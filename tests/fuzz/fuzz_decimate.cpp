@@ -67,15 +67,21 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (double x : positions) finite = finite && std::isfinite(x);
   bool in_range = true;
   for (int32_t v : triangles) in_range = in_range && v >= 0 && v < n;
+  bool any_triangle = false;  // three distinct corners (Mesh drops the others and needs one)
+  for (int32_t t = 0; t < m; ++t) {
+    const int32_t* c = &triangles[3 * size_t(t)];
+    any_triangle = any_triangle || (c[0] != c[1] && c[1] != c[2] && c[0] != c[2]);
+  }
+  const bool valid = finite && in_range && any_triangle;
 
   Mesh* mesh = nullptr;
   try {
     mesh = new Mesh(positions, triangles.data(), m);
   } catch (const std::invalid_argument&) {
-    require(!finite || !in_range, "Mesh refused finite, in-range arrays");
+    require(!valid, "Mesh refused finite, in-range arrays with a proper triangle");
     return 0;
   }
-  require(finite && in_range, "Mesh accepted non-finite coordinates or indices out of range");
+  require(valid, "Mesh accepted non-finite coordinates, indices out of range or no proper triangle");
   try {
     const auto layout = build_feature_layout(*mesh, nullptr, 0, nullptr, 0, (flags & 4) ? 0.5 : 0.0);
     DecimateParams params;
