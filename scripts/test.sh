@@ -51,6 +51,9 @@ run "engine and Python API (python3 + pymeshlab)" $VENV/bin/python -m pytest "${
 run "Python API with NumPy 2 (PyPI)" $VENV2/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/python
 run "batch on Dask and OpenJD (venv-pipeline)" env PATH="$PIPELINE_VENV/bin:$PATH" \
   $PIPELINE_VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/pipeline
+# Fuzz targets (clang, ASan + UBSan): every kept input once, then 5 s of new inputs per target.
+# Long runs: scripts/fuzz.sh SECONDS. The Python suite under ASan + UBSan: scripts/sanitize.sh.
+run "fuzzing, short pass (scripts/fuzz.sh 5)" scripts/fuzz.sh 5
 if [ -d tests/blender ]; then
   run "add-on in Blender $(blender -v 2>/dev/null | head -1 | awk '{print $2}')" \
     blender -b --factory-startup --python-exit-code 1 --python-expr \

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, Optional, Sequence
 
 import numpy as np
 
+from . import params
 from .native import engine
 
 if TYPE_CHECKING:  # for annotations only: mesh.py imports this module
@@ -222,14 +223,11 @@ def target_vertex_count(mesh: Mesh, ratio=None, vertices=None) -> int:
     """Vertex target from a ratio (of the vertices in triangles) or an explicit count."""
     active = _active_vertices(mesh)
     if ratio is not None:
-        if not (isinstance(ratio, (int, float)) and 0 < ratio <= 1):
-            raise ValueError(f"ratio must lie in (0, 1], got {ratio!r}")
-        return max(1, int(round(ratio * active)))
-    if isinstance(vertices, bool) or not isinstance(vertices, (int, np.integer)):
-        raise ValueError(f"target_vertices must be an integer, got {vertices!r}")
+        return max(1, int(round(params.number("ratio", ratio, 0, 1, low_open=True) * active)))
+    vertices = params.integer("target_vertices", vertices)
     if not 1 <= vertices <= active:
         raise ValueError(f"vertex target {vertices} is outside [1, {active}] (vertices in triangles)")
-    return int(vertices)
+    return vertices
 
 
 def _renamed(old: str, old_value, new: str, new_value):
@@ -309,24 +307,27 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
         raise ValueError(f"density must be one of {DENSITY_MODES}, got {density!r}")
     if placement not in PLACEMENTS:
         raise ValueError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
-    if isinstance(refine, bool) or not isinstance(refine, (int, float, np.integer, np.floating)) \
-            or not (refine == 0 or 1 <= refine < math.inf):
-        raise ValueError(f"refine must be 0 (off) or a factor of at least 1, got {refine!r}")
+    seed = params.seed(seed)
+    refine_wanted = "0 (off) or a factor of at least 1"
+    refine = params.number("refine", refine, 0, expected=refine_wanted)
+    if 0 < refine < 1:
+        refine = params.number("refine", refine, 1, expected=refine_wanted)  # raises
+    adaptivity = params.number("adaptivity", adaptivity, 0, 1)
+    flat_floor = params.number("flat_floor", flat_floor, 0, 1)
+    feature_angle = params.number("feature_angle (radians)", feature_angle, 0, math.pi)
+    density_rings = params.integer("density_rings", density_rings, 0, 2**31 - 1)
+    density_ratio = params.number("density_ratio", density_ratio, 1)
+    density_epsilon = params.number("density_epsilon", density_epsilon, 0)
+    max_repair_rounds = params.integer("max_repair_rounds", max_repair_rounds, 0, 2**31 - 1)
     target_triangles = 0
     if triangles is not None:
-        if isinstance(triangles, bool) or not isinstance(triangles, (int, np.integer)):
-            raise ValueError(f"target_triangles must be an integer, got {triangles!r}")
-        if not 1 <= triangles <= mesh.num_triangles:
-            raise ValueError(f"triangle target {triangles} is outside [1, {mesh.num_triangles}]")
-        target_triangles = int(triangles)
+        target_triangles = params.integer("target_triangles", triangles)
+        if not 1 <= target_triangles <= mesh.num_triangles:
+            raise ValueError(f"triangle target {target_triangles} is outside [1, {mesh.num_triangles}]")
         target = 1
     else:
         target = target_vertex_count(mesh, ratio, vertices)
     u = _guidance(mesh, guidance)
-    if not 0 <= feature_angle <= math.pi:
-        raise ValueError(f"feature_angle must lie in [0, pi] radians, got {feature_angle!r}")
     layout = mesh.feature_layout(regions, borders, feature_angle)
     parameters = dict(ratio=ratio, target_vertices=vertices, target_triangles=triangles, seed=int(seed),
                       adaptivity=adaptivity, flat_floor=flat_floor, area_weighted=bool(area_weighted),
@@ -360,9 +361,8 @@ def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, fe
     samples = np.asarray(samples)
     if samples.ndim != 1 or samples.dtype.kind not in "iu":
         raise ValueError(f"samples must be a 1-D integer array, got {samples.dtype} {samples.shape}")
-    if isinstance(refine_vertices, bool) or not isinstance(refine_vertices, (int, np.integer)) \
-            or refine_vertices < 0:
-        raise ValueError(f"refine_vertices must be a non-negative integer, got {refine_vertices!r}")
+    refine_vertices = params.integer("refine_vertices", refine_vertices, 0, 2**31 - 1)
+    feature_angle = params.number("feature_angle (radians)", feature_angle, 0, math.pi)
     layout = mesh.feature_layout(regions, borders, feature_angle)
     raw = engine.decimate_with_samples(mesh.native, layout, samples, placement=placement,
                                        refine_vertices=int(refine_vertices), guidance=_guidance(mesh, guidance))
@@ -374,8 +374,9 @@ def sampling_probabilities(mesh: Mesh, rate: float, *, adaptivity: float = 0.5,
                            flat_floor: float = 0.25, guidance=None, regions=None, borders=None,
                            view: Optional[View] = None, boxes: Sequence[Box] = ()) -> np.ndarray:
     """The probability p(v) each vertex gets at base rate ``rate`` (docs/design.md §2.2), for inspection."""
-    if not 0 <= rate <= 1:
-        raise ValueError(f"rate must lie in [0, 1], got {rate!r}")
+    rate = params.number("rate", rate, 0, 1)
+    adaptivity = params.number("adaptivity", adaptivity, 0, 1)
+    flat_floor = params.number("flat_floor", flat_floor, 0, 1)
     layout = mesh.feature_layout(regions, borders)
     return engine.sampling_probabilities(
         mesh.native, layout, float(rate), adaptivity=float(adaptivity), flat_floor=float(flat_floor),

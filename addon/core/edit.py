@@ -22,6 +22,7 @@ from typing import List, Optional, Sequence
 import numpy as np
 
 from .mesh import as_vertices
+from . import params
 from .native import engine
 
 #: Patch methods, from the thesis' planar projection to the last resort (hole_triangulation.hpp).
@@ -205,7 +206,8 @@ def _loop(loop) -> np.ndarray:
 
 
 def _fill_options(planar: bool, max_dp_corners: int, refine: bool, fair: bool) -> dict:
-    return dict(planar=bool(planar), max_dp_corners=int(max_dp_corners), refine=bool(refine), fair=bool(fair))
+    return dict(planar=bool(planar), max_dp_corners=params.integer("max_dp_corners", max_dp_corners, 3, 2**31 - 1),
+                refine=bool(refine), fair=bool(fair))
 
 
 def boundary_loops(vertices, triangles) -> List[BoundaryLoop]:
@@ -270,8 +272,7 @@ def fill_holes(vertices, triangles, holes: Optional[Sequence[int]] = None, *, ma
         if holes.dtype.kind not in "iu":
             raise ValueError(f"holes must be loop indices, got {holes.dtype}")
         holes = holes.astype(np.int64)
-    if max_edges is not None and max_edges < 3:
-        raise ValueError(f"max_edges must be at least 3, got {max_edges}")
+    max_edges = params.optional_integer("max_edges", max_edges, 3, 2**31 - 1)
     vertices = as_vertices(vertices)
     raw = engine.fill_holes(vertices, triangles, holes, max_edges=max_edges or 0, skip_unfillable=skip_unfillable,
                             weld_pinches=weld_pinches, **_fill_options(planar, max_dp_corners, refine, fair))
@@ -302,7 +303,7 @@ def remove_handle(vertices, triangles, loop: Sequence[int], *, allow_separating:
     """
     vertices = as_vertices(vertices)
     raw = engine.remove_handle(vertices, triangles, _loop(loop), allow_separating=allow_separating,
-                               separation=float(separation),
+                               separation=params.number("separation", separation, 0, 1, high_open=True),
                                **_fill_options(planar, max_dp_corners, refine, fair))
     return _result(raw, vertices, triangles)
 

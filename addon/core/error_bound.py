@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 from .hausdorff import as_surface
+from . import params
 from .native import engine
 
 DEFAULT_SEARCH_SAMPLES = 50_000
@@ -57,13 +58,9 @@ def search_vertex_count(mesh, max_error: float, decimate_at: Callable[[int], obj
     ``max(1, resolution * target)``. samples: measurement density on the original.
     Returns (DecimateResult, ErrorBoundReport).
     """
-    if isinstance(max_error, bool) or not isinstance(max_error, (int, float)) \
-            or not math.isfinite(max_error) or max_error < 0:
-        raise ValueError(f"max_error must be a non-negative number, got {max_error!r}")
-    if not (isinstance(resolution, (int, float)) and 0 <= resolution < 1):
-        raise ValueError(f"resolution must lie in [0, 1), got {resolution!r}")
-    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
-        raise ValueError(f"samples must be a positive integer, got {samples!r}")
+    max_error = params.number("max_error", max_error, 0)
+    resolution = params.number("resolution", resolution, 0, 1, high_open=True)
+    samples = params.integer("samples", samples, 1, 2**62)
     started = time.perf_counter()
     original = as_surface(mesh, "mesh")
     bound = max_error * original.diagonal if relative else float(max_error)

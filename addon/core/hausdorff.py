@@ -27,6 +27,7 @@ from typing import Optional
 
 import numpy as np
 
+from . import params
 from .native import engine
 
 DEFAULT_SAMPLES = 1_000_000
@@ -148,10 +149,7 @@ def result_from_engine(raw: dict, percentile: float, relative: bool = False) -> 
 
 def check_percentile(percentile: float) -> float:
     """Percentile rank in percent, (0, 100]; 0 skips it."""
-    if isinstance(percentile, bool) or not isinstance(percentile, (int, float, np.floating)) \
-            or not 0 <= percentile <= 100:
-        raise ValueError(f"percentile must be a number in (0, 100] (or 0 to skip it), got {percentile!r}")
-    return float(percentile)
+    return params.number("percentile (0 skips it)", percentile, 0, 100)
 
 
 def hausdorff(a, b, *, samples: Optional[int] = None, step: Optional[float] = None,
@@ -168,10 +166,9 @@ def hausdorff(a, b, *, samples: Optional[int] = None, step: Optional[float] = No
         raise ValueError("give samples or step, not both")
     if samples is None:
         samples = DEFAULT_SAMPLES
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
-        raise ValueError(f"samples must be a positive integer, got {samples!r}")
-    if step is not None and not (isinstance(step, (int, float, np.floating)) and np.isfinite(step) and step > 0):
-        raise ValueError(f"step must be a positive number, got {step!r}")
+    samples = params.integer("samples", samples, 1, 2**62)
+    if step is not None:
+        step = params.number("step", step, 0, low_open=True)
     percentile = check_percentile(percentile)
     surface_a = as_surface(a, "first mesh")
     surface_b = as_surface(b, "second mesh")

@@ -14,6 +14,19 @@ What each format carries, reading and writing: OBJ positions, polygons, UVs (vt)
 (usemtl names, mtllib) and vertex colours (``v x y z r g b``); PLY positions, polygons, vertex
 colours and UVs (per vertex, or MeshLab's per-face ``texcoord`` list); OFF positions, polygons
 and vertex colours (COFF); STL positions and triangles.
+
+Sloppy files that Blender, MeshLab and assimp read are read too, with a ``MeshFileWarning``
+saying what was skipped: PLY header lines that are no keyword (old Blender wrote "Created by
+Blender3D ..."), names (usemtl, mtllib) that are not UTF-8 (decoded as Latin-1, which never
+fails). Layouts that cannot be read unambiguously are errors (two PLY ``vertex`` elements).
+
+Compressed files are decompressed in pieces and refused once the output passes
+``max_decompressed_bytes`` (default ``MAX_DECOMPRESSED_BYTES`` = 2 GiB; ``None`` = no limit):
+a small .gz made to expand to many gigabytes stops with a ValueError instead of filling
+memory. Raise the limit for larger files.
+
+Writing refuses OBJ material or library names that would read back differently (a line
+break, '#', a trailing backslash, white space at either end, ``(null)``): OBJ has no escapes.
 """
 
 from __future__ import annotations
@@ -21,6 +34,7 @@ from __future__ import annotations
 import bz2
 import gzip
 import os
+import warnings
 import zlib
 from dataclasses import dataclass, field
 from typing import List, Optional
@@ -124,33 +138,98 @@ def mesh_format(path) -> tuple:
     return ext[1:], compression
 
 
-def _decompress(name: str, raw: bytes, compression: Optional[str]) -> bytes:
+#: Default cap on a compressed file's decompressed size (read_mesh's max_decompressed_bytes).
+MAX_DECOMPRESSED_BYTES = 2 << 30
+_CHUNK = 1 << 20
+
+
+class MeshFileWarning(UserWarning):
+    """A mesh file was read, but something in it was skipped or reinterpreted (the message says what)."""
+
+
+def _new_decompressor(compression: str):
+    if compression == "gz":
+        return zlib.decompressobj(wbits=16 + zlib.MAX_WBITS)  # gzip header and trailer checked
+    return bz2.BZ2Decompressor()
+
+
+def _decompress(name: str, raw: bytes, compression: Optional[str], limit: Optional[int]) -> bytes:
+    """raw decompressed in pieces, never past ``limit`` bytes; concatenated gzip or bzip2
+    members are read one after the other, as gzip and bzip2 themselves do."""
+    if compression is None:
+        return raw
+    parts, total = [], 0
+    view = memoryview(raw)
     try:
-        if compression == "gz":
-            return gzip.decompress(raw)
-        if compression == "bz2":
-            return bz2.decompress(raw)
-    except (OSError, EOFError, ValueError, zlib.error) as error:
+        while True:
+            decompressor = _new_decompressor(compression)
+            while True:
+                room = _CHUNK if limit is None else min(_CHUNK, limit - total + 1)
+                if compression == "gz":
+                    piece = decompressor.decompress(view, room)
+                    view = memoryview(decompressor.unconsumed_tail)
+                    done = decompressor.eof
+                else:
+                    piece = decompressor.decompress(view, room)
+                    view = memoryview(b"")  # BZ2Decompressor keeps what it has not used
+                    done = decompressor.eof
+                total += len(piece)
+                if limit is not None and total > limit:
+                    raise ValueError(f"{name}: decompresses to more than {limit} bytes (the limit, "
+                                     f"max_decompressed_bytes; the file has {len(raw)} compressed bytes)")
+                parts.append(piece)
+                if done:
+                    break
+                if not piece and (compression == "gz" and not view
+                                  or compression == "bz2" and decompressor.needs_input):
+                    raise EOFError("the compressed data ends early")
+            rest = decompressor.unused_data
+            if not rest.strip(b"\0"):  # trailing zero padding, as gzip(1) tolerates
+                break
+            view = memoryview(rest)
+    except (OSError, EOFError, zlib.error) as error:
         raise ValueError(f"{name}: cannot decompress ({compression}): {error}") from None
-    return raw
+    return b"".join(parts)
 
 
-def read_mesh(path) -> MeshData:
+def _decode_names(name: str, raw_names) -> List[str]:
+    """Names from the file's bytes: UTF-8, else Latin-1 (every byte is a Latin-1 character)."""
+    names = []
+    for raw in raw_names:
+        try:
+            names.append(raw.decode("utf-8"))
+        except UnicodeDecodeError:
+            decoded = raw.decode("latin-1")
+            warnings.warn(f"{name}: name {decoded!r} is not UTF-8; read as Latin-1", MeshFileWarning, stacklevel=3)
+            names.append(decoded)
+    return names
+
+
+def read_mesh(path, max_decompressed_bytes: Optional[int] = MAX_DECOMPRESSED_BYTES) -> MeshData:
     """Reads a mesh file (see the module docs for formats and conventions).
 
     Raises FileNotFoundError / OSError when the file cannot be read, ValueError (naming the
     file, and the line or element) for an unknown extension, an empty PLY or OFF, unparseable
-    content or indices out of range. An empty OBJ or STL reads as an empty mesh.
+    content, indices out of range, or a compressed file expanding past
+    ``max_decompressed_bytes`` (None: no limit). An empty OBJ or STL reads as an empty mesh.
+    What was skipped in a sloppy file is reported as a MeshFileWarning.
     """
     name = os.fspath(path)
     kind, compression = mesh_format(name)
+    if max_decompressed_bytes is not None and (isinstance(max_decompressed_bytes, bool) or
+                                               not isinstance(max_decompressed_bytes, int) or
+                                               max_decompressed_bytes < 0):
+        raise ValueError(f"max_decompressed_bytes must be a non-negative int or None, "
+                         f"got {max_decompressed_bytes!r}")
     with open(name, "rb") as stream:
         raw = stream.read()
-    data = _decompress(name, raw, compression)
+    data = _decompress(name, raw, compression, max_decompressed_bytes)
     try:
         parsed = engine.read_mesh(data, kind)
     except ValueError as error:
         raise ValueError(f"{name}: {error}") from None
+    for message in parsed["warnings"]:
+        warnings.warn(f"{name}: {message}", MeshFileWarning, stacklevel=2)
     m = len(parsed["triangles"])
     uvs = parsed["corner_uvs"]
     return MeshData(vertices=parsed["vertices"], triangles=parsed["triangles"],
@@ -158,8 +237,8 @@ def read_mesh(path) -> MeshData:
                     corner_uvs=None if uvs is None else uvs.reshape(m, 3, 2),
                     vertex_colors=parsed["vertex_colors"],
                     triangle_material=parsed["triangle_material"],
-                    material_names=parsed["material_names"],
-                    material_libraries=parsed["material_libraries"],
+                    material_names=_decode_names(name, parsed["material_names"]),
+                    material_libraries=_decode_names(name, parsed["material_libraries"]),
                     skipped_faces=int(parsed["skipped_faces"]))
 
 

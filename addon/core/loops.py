@@ -27,6 +27,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from .mesh import Mesh
+from . import params
 from .native import engine
 
 #: Raised when a progress callback returns False.
@@ -189,18 +190,9 @@ def handle_tunnel_loops(mesh, triangles=None, *, coarse_vertices: Optional[int] 
     mesh = _as_mesh(mesh, triangles)
     if metric not in METRICS:
         raise ValueError(f"metric must be one of {METRICS}, got {metric!r}")
-    if coarse_vertices is None:
-        coarse = -1
-    elif isinstance(coarse_vertices, bool) or not isinstance(coarse_vertices, (int, np.integer)) \
-            or coarse_vertices < 0:
-        raise ValueError(f"coarse_vertices must be None or a non-negative integer, got {coarse_vertices!r}")
-    else:
-        coarse = int(coarse_vertices)
-    if isinstance(full_route_faces, bool) or not isinstance(full_route_faces, (int, np.integer)) \
-            or full_route_faces < 0:
-        raise ValueError(f"full_route_faces must be a non-negative integer, got {full_route_faces!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+    coarse = -1 if coarse_vertices is None else params.integer("coarse_vertices", coarse_vertices, 0, 2**31 - 1)
+    full_route_faces = params.integer("full_route_faces", full_route_faces, 0, 2**31 - 1)
+    seed = params.seed(seed)
     if progress is not None and not callable(progress):
         raise ValueError("progress must be callable as progress(fraction, stage)")
     raw = engine.handle_tunnel_loops(

@@ -27,6 +27,13 @@ std::vector<double> floats_from(const py::handle& object, int64_t rows, int64_t 
   return std::vector<double>(a.data(), a.data() + a.size());
 }
 
+// Names as the file's bytes: their encoding is the Python layer's business (io.py).
+py::list bytes_list(const std::vector<std::string>& names) {
+  py::list out;
+  for (const auto& name : names) out.append(py::bytes(name));
+  return out;
+}
+
 py::object optional_array(std::vector<double>&& values, int64_t columns) {
   if (values.empty()) return py::none();
   return to_array(std::move(values), columns);
@@ -49,8 +56,9 @@ void bind_io(py::module_& m) {
         py::dict d;
         d["polygons"] = file.polygons;
         d["skipped_faces"] = file.skipped_faces;
-        d["material_names"] = file.material_names;
-        d["material_libraries"] = file.material_libraries;
+        d["material_names"] = bytes_list(file.material_names);
+        d["material_libraries"] = bytes_list(file.material_libraries);
+        d["warnings"] = file.warnings;  // built from quote(): plain ASCII
         const int32_t channels = file.color_channels;
         d["vertices"] = to_array(std::move(file.positions), 3);
         d["triangles"] = to_array(std::move(file.triangles), 3);
@@ -62,7 +70,8 @@ void bind_io(py::module_& m) {
         return d;
       },
       py::arg("data"), py::arg("format"),
-      "Parses a mesh file's bytes ('obj', 'ply', 'off', 'stl'): a dict of arrays in the file's vertex order.");
+      "Parses a mesh file's bytes ('obj', 'ply', 'off', 'stl'): a dict of arrays in the file's vertex order; "
+      "material_names and material_libraries as bytes, warnings as str.");
 
   m.def(
       "write_mesh",

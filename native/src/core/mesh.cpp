@@ -178,8 +178,11 @@ void Mesh::reorder_for_locality(const double* lo, const double* hi) {
   for (int32_t v = 0; v < n; ++v) {
     uint64_t key = 0;
     for (int k = 0; k < 3; ++k) {
+      // Differences near the double range overflow to inf and inf / inf is NaN, which
+      // std::clamp passes through: NaN goes to 0 (converting it to an integer is undefined).
       const double t = (positions_[3 * size_t(v) + k] - lo[k]) / extent;
-      key |= spread_bits(uint64_t(std::clamp(t, 0.0, 1.0) * 2097151.0)) << k;
+      const double unit = t >= 0.0 ? std::min(t, 1.0) : 0.0;
+      key |= spread_bits(uint64_t(unit * 2097151.0)) << k;
     }
     keyed[v] = {key, v};
   }

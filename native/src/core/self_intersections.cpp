@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <mutex>
+#include <stdexcept>
 
 namespace topstoc {
 
@@ -76,9 +77,15 @@ bool degenerate(const double* a, const double* b, const double* c) {
   return !lifted(a, b, c, up);
 }
 
+// A triangle naming one vertex twice: a segment or a point, not a triangle.
+bool repeats_vertex(const int32_t* t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
+
 }  // namespace
 
 bool triangles_intersect(const double* positions, const int32_t* t1, const int32_t* t2) {
+  // The shared-vertex cases below need three distinct corners per triangle.
+  if (repeats_vertex(t1) || repeats_vertex(t2))
+    throw std::invalid_argument("triangles_intersect: a triangle names one vertex twice");
   auto p = [&](int32_t v) { return positions + 3 * size_t(v); };
   int shared = 0;
   for (int i = 0; i < 3; ++i)
@@ -151,19 +158,27 @@ std::vector<std::pair<int32_t, int32_t>> self_intersections(const double* positi
   double cell = 2.0 * mean;
   for (int k = 0; k < 3; ++k) cell = std::max(cell, (hi[k] - lo[k]) / 1024.0);
   if (!(cell > 0)) cell = 1.0;
+  if (!std::isfinite(cell)) cell = INFINITY;  // coordinates near the double range: one cell
+  // Cell coordinates clamped in double first: converting NaN or an out-of-range double to an
+  // integer is undefined behaviour (non-finite or huge coordinates land in the border cells).
+  const auto cell_of = [&](double offset, int64_t last) -> int64_t {
+    const double x = offset / cell;
+    return x >= 0 ? (x < double(last) ? int64_t(x) : last) : 0;
+  };
   int64_t dims[3];
-  for (int k = 0; k < 3; ++k) dims[k] = std::max<int64_t>(1, int64_t((hi[k] - lo[k]) / cell) + 1);
+  for (int k = 0; k < 3; ++k) dims[k] = cell_of(hi[k] - lo[k], 1024) + 1;
   auto cell_range = [&](int32_t t, int64_t* from, int64_t* to) {
     const double* b = &box[6 * size_t(t)];
     for (int k = 0; k < 3; ++k) {
-      from[k] = std::min<int64_t>(dims[k] - 1, int64_t((b[k] - lo[k]) / cell));
-      to[k] = std::min<int64_t>(dims[k] - 1, int64_t((b[3 + k] - lo[k]) / cell));
+      from[k] = cell_of(b[k] - lo[k], dims[k] - 1);
+      to[k] = cell_of(b[3 + k] - lo[k], dims[k] - 1);
     }
   };
   // (cell, triangle) entries, grouped by cell.
   std::vector<std::pair<int64_t, int32_t>> entries;
   entries.reserve(4 * size_t(num_triangles));
   for (int32_t t = 0; t < num_triangles; ++t) {
+    if (repeats_vertex(triangles + 3 * size_t(t))) continue;  // no area: reported as (t, t) only
     int64_t from[3], to[3];
     cell_range(t, from, to);
     for (int64_t x = from[0]; x <= to[0]; ++x)
@@ -178,7 +193,7 @@ std::vector<std::pair<int32_t, int32_t>> self_intersections(const double* positi
 
   for (int32_t t = 0; t < num_triangles; ++t) {
     const double* a = positions + 3 * size_t(triangles[3 * size_t(t)]);
-    if (degenerate(a, positions + 3 * size_t(triangles[3 * size_t(t) + 1]), positions + 3 * size_t(triangles[3 * size_t(t) + 2])))
+    if (repeats_vertex(triangles + 3 * size_t(t)) || degenerate(a, positions + 3 * size_t(triangles[3 * size_t(t) + 1]), positions + 3 * size_t(triangles[3 * size_t(t) + 2])))
       pairs.emplace_back(t, t);
   }
   const int64_t cells = int64_t(starts.size()) - 1;

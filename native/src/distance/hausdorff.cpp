@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -34,6 +35,14 @@ double triangle_area(const double* a, const double* b, const double* c) {
 
 // Subdivisions of a length for a step, as a double so that absurd steps cannot overflow.
 double divisions(double len, double step) { return std::max(1.0, std::ceil(len / step)); }
+
+// A number for a message: "%.6g" (std::to_string prints 1e-9 as 0.000000, and converting a
+// huge count to an integer first would be undefined).
+std::string shown(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", x);
+  return buffer;
+}
 
 struct Lengths {
   std::vector<double> edge;     // per edge
@@ -150,12 +159,12 @@ const TriangleBvh& Surface::bvh() const {
 
 SurfaceSamples sample_surface(const Surface& surface, double step) {
   if (!(step > 0.0) || !std::isfinite(step))
-    throw std::invalid_argument("sample step must be a positive number, got " + std::to_string(step));
+    throw std::invalid_argument("sample step must be a positive number, got " + shown(step));
   const Lengths lengths = surface_lengths(surface);
   const int64_t vertices = used_vertex_count(surface);
   const double wanted = sample_count(lengths, vertices, step);
   if (wanted > double(kMaxSamples))
-    throw std::invalid_argument("sample step " + std::to_string(step) + " would need " + std::to_string(int64_t(wanted)) +
+    throw std::invalid_argument("sample step " + shown(step) + " would need " + shown(wanted) +
                                 " samples (more than " + std::to_string(kMaxSamples) + "): use a larger step");
 
   const auto& p = surface.positions();

@@ -62,7 +62,8 @@ void validate_for_writing(const MeshFile& mesh) {
          std::to_string(m));
   if (!mesh.corner_uvs.empty() && int64_t(mesh.corner_uvs.size()) != 6 * m)
     fail("corner_uvs must hold 6 numbers per triangle");
-  if (!mesh.vertex_colors.empty() &&
+  // Writers index colours by color_channels alone: both must agree (0 = no colours).
+  if ((!mesh.vertex_colors.empty() || mesh.color_channels != 0) &&
       ((mesh.color_channels != 3 && mesh.color_channels != 4) ||
        int64_t(mesh.vertex_colors.size()) != mesh.color_channels * n))
     fail("vertex_colors must hold 3 or 4 numbers per vertex");
@@ -82,9 +83,7 @@ void validate_for_writing(const MeshFile& mesh) {
       fail("triangle " + std::to_string(t) + " has material " + std::to_string(id) + ", outside [-1, " +
            std::to_string(names) + ")");
   }
-  for (const auto& name : mesh.material_names)
-    if (name.empty() || name.find_first_of("\r\n") != std::string::npos)
-      fail("material names must be non-empty single lines, got " + quote(name));
+  // Names matter to OBJ only, which checks them itself (obj_name_problem).
 }
 
 }  // namespace io_detail

@@ -163,6 +163,12 @@ void group_corners(const PolygonGroup& group, std::vector<int64_t>& corners);
 /// Checks array sizes and index ranges of a mesh about to be written.
 void validate_for_writing(const MeshFile& mesh);
 
+/// Why `name` (a usemtl material when `material`, else an mtllib argument) would not read back
+/// from an OBJ file exactly as written; empty when it would. The reader takes the rest of the
+/// line, comments ('#') removed, a trailing '\\' joining the next line, white space trimmed,
+/// and "(null)" meaning no material.
+std::string obj_name_problem(std::string_view name, bool material);
+
 // One reader and one writer per format (io_obj.cpp, io_ply.cpp, io_off.cpp, io_stl.cpp).
 MeshFile read_obj(const char* data, size_t size);
 MeshFile read_ply(const char* data, size_t size);

@@ -166,7 +166,26 @@ MeshFile read_obj(const char* data, size_t size) {
   return mesh;
 }
 
+std::string obj_name_problem(std::string_view name, bool material) {
+  if (name.empty()) return "it is empty";
+  if (name.find('\n') != std::string_view::npos) return "it holds a line break";
+  if (name.find('#') != std::string_view::npos) return "it holds '#', which starts a comment in OBJ";
+  if (is_space(name.front()) || is_space(name.back())) return "it starts or ends with white space";
+  if (name.back() == '\\') return "it ends with a backslash, which continues the line in OBJ";
+  if (material && name == "(null)") return "'(null)' is how OBJ files say \"no material\"";
+  return {};
+}
+
 std::string write_obj(const MeshFile& mesh) {
+  // OBJ has no escapes: a name that would read back differently is refused, not altered.
+  const auto check_names = [](const std::vector<std::string>& names, bool material) {
+    for (const auto& name : names)
+      if (const std::string problem = obj_name_problem(name, material); !problem.empty())
+        throw std::invalid_argument(std::string(material ? "material name " : "material library name ") +
+                                    quote(name) + " cannot be written to OBJ: " + problem);
+  };
+  check_names(mesh.material_names, true);
+  check_names(mesh.material_libraries, false);
   std::string out = "# written by TopStoc\n";
   out.reserve(size_t(mesh.num_vertices()) * 64 + mesh.triangles.size() * (mesh.corner_uvs.empty() ? 9 : 24));
   for (const auto& library : mesh.material_libraries) out += "mtllib " + library + "\n";
@@ -189,7 +208,7 @@ std::string write_obj(const MeshFile& mesh) {
     corner_vt.assign(mesh.triangles.size(), -1);
     for (size_t c = 0; c < mesh.triangles.size(); ++c) {
       const double u = mesh.corner_uvs[2 * c], w = mesh.corner_uvs[2 * c + 1];
-      if (std::isnan(u) || std::isnan(w)) continue;
+      if (std::isnan(u) && std::isnan(w)) continue;  // no UV (one NaN coordinate is written as read)
       std::pair<uint64_t, uint64_t> key;
       std::memcpy(&key.first, &u, 8);
       std::memcpy(&key.second, &w, 8);
@@ -218,13 +237,11 @@ std::string write_obj(const MeshFile& mesh) {
       out += '\n';
     }
     group_corners(group, corners);
-    bool uv_complete = with_uvs;
-    for (int64_t c : corners) uv_complete = uv_complete && corner_vt[c] >= 0;
     out += 'f';
-    for (int64_t c : corners) {
+    for (int64_t c : corners) {  // "v/vt" where the corner has a UV, "v" where it has none
       out += ' ';
       append_number(out, int64_t(mesh.triangles[c]) + 1);
-      if (uv_complete) out += '/', append_number(out, corner_vt[c] + 1);
+      if (with_uvs && corner_vt[c] >= 0) out += '/', append_number(out, corner_vt[c] + 1);
     }
     out += '\n';
   }

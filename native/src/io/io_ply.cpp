@@ -83,6 +83,7 @@ struct PlyHeader {
   std::vector<PlyElement> elements;
   const char* body = nullptr;
   size_t body_line = 0;  // line number where an ascii body starts
+  std::vector<std::string> warnings;
 };
 
 PlyHeader parse_header(const char* data, size_t size) {
@@ -115,6 +116,12 @@ PlyHeader parse_header(const char* data, size_t size) {
       if (!next_token(rest, name) || !next_token(rest, count) || !parse_int(count, element.count) || element.count < 0)
         fail_at_line(number, "element needs a name and a count");
       element.name = std::string(name);
+      // The body reader keeps one array per vertex property and one face list: a second block
+      // would be read into arrays sized for the first.
+      if (element.name == "vertex" || element.name == "face")
+        for (const auto& other : header.elements)
+          if (other.name == element.name)
+            fail_at_line(number, "a second '" + element.name + "' element; a PLY file must have one");
       header.elements.push_back(std::move(element));
     } else if (token == "property") {
       if (header.elements.empty()) fail_at_line(number, "property before any element");
@@ -133,6 +140,9 @@ PlyHeader parse_header(const char* data, size_t size) {
       if (property.type == PlyType::None) fail_at_line(number, "unknown property type " + quote(type));
       if (!next_token(rest, name)) fail_at_line(number, "property without a name");
       property.name = std::string(name);
+      for (const auto& other : element.properties)
+        if (other.name == property.name)
+          fail_at_line(number, "property " + quote(name) + " declared twice in element '" + element.name + "'");
       const bool list = property.count_type != PlyType::None;
       if (element.name == "vertex" && !list) property.role = vertex_role(name);
       if (element.name == "face" && list && (name == "vertex_indices" || name == "vertex_index")) {
@@ -140,9 +150,18 @@ PlyHeader parse_header(const char* data, size_t size) {
         property.role = Role::Indices;
       }
       if (element.name == "face" && list && name == "texcoord") property.role = Role::TexCoord;
+      // Two index lists would be read as one polygon of both.
+      if (property.role == Role::Indices)
+        for (const auto& other : element.properties)
+          if (other.role == Role::Indices)
+            fail_at_line(number, "the face element has two vertex index lists ('" + other.name + "' and " +
+                                     quote(name) + ")");
       element.properties.push_back(std::move(property));
     } else {
-      fail_at_line(number, "unexpected header line starting with " + quote(token));
+      // Not a keyword: old exporters wrote free text here (Blender 2.4x: "Created by Blender3D
+      // 247 - www.blender.org, source file: ..."). It defines nothing, so it is skipped.
+      header.warnings.push_back("line " + std::to_string(number) + ": skipped unknown PLY header line " +
+                                quote(line));
     }
   }
   if (!has_format) throw std::invalid_argument("the header has no format line");
@@ -271,6 +290,7 @@ class AsciiSource {
 template <class Source>
 MeshFile read_body(const PlyHeader& header, Source& source) {
   MeshFile mesh;
+  mesh.warnings = header.warnings;
   std::vector<double> vertex_uvs;
   bool face_texcoords = false;
   for (const auto& element : header.elements) {

@@ -4,7 +4,9 @@
 // Two triangles intersect when they share more than their common vertices or edge: crossing
 // or touching triangles, a triangle folded onto its neighbour across their edge, two fans
 // overlapping at a shared vertex. Zero-area triangles are reported too (paired with
-// themselves): TetGen cannot keep them either. A uniform grid finds the candidate pairs.
+// themselves): TetGen cannot keep them either. A triangle that names one vertex twice (a
+// segment or a point) is reported that way only and not tested against the others: the pair
+// tests assume three distinct corners. A uniform grid finds the candidate pairs.
 #pragma once
 
 #include <cstdint>
@@ -20,7 +22,8 @@ std::vector<std::pair<int32_t, int32_t>> self_intersections(const double* positi
                                                             int64_t max_pairs = 0);
 
 /// True when triangles (a, b, c) and (p, q, r) (vertex ids into positions) intersect other than in
-/// shared vertices or a shared edge.
+/// shared vertices or a shared edge. Each triangle must name three distinct vertices (throws
+/// std::invalid_argument otherwise).
 bool triangles_intersect(const double* positions, const int32_t* t1, const int32_t* t2);
 
 }  // namespace topstoc

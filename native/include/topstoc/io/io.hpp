@@ -40,6 +40,7 @@ struct MeshFile {
   std::vector<int32_t> triangle_material; ///< per triangle: index into material_names, -1 = none
   std::vector<std::string> material_names;      ///< OBJ usemtl names in order of first use
   std::vector<std::string> material_libraries;  ///< OBJ mtllib arguments, as written
+  std::vector<std::string> warnings;  ///< what a reader skipped in a sloppy file (e.g. unknown PLY header lines)
 
   int64_t num_vertices() const { return int64_t(positions.size() / 3); }
   int64_t num_triangles() const { return int64_t(triangles.size() / 3); }
@@ -47,8 +48,12 @@ struct MeshFile {
 
 /// Parses `size` bytes of a file in `format`. Throws std::invalid_argument naming the line
 /// (text) or element row (binary) and the problem: unparseable content, truncated data,
-/// indices out of range. An empty OBJ or STL is an empty mesh; an empty PLY or OFF (no header)
-/// is an error.
+/// indices out of range, element layouts it cannot read unambiguously (a PLY with two
+/// `vertex` or `face` elements, a property declared twice). Counts are checked against the
+/// bytes left before anything is allocated for them. An empty OBJ or STL is an empty mesh; an
+/// empty PLY or OFF (no header) is an error. Sloppiness real files show is tolerated and noted
+/// in MeshFile::warnings: a PLY header line that is no keyword (old Blender wrote "Created by
+/// Blender3D ..."). Names (OBJ usemtl, mtllib) are kept as bytes, whatever their encoding.
 MeshFile read_mesh_file(const char* data, size_t size, MeshFormat format);
 
 /// Serialises `mesh` in `format` and returns the file's bytes:
@@ -59,7 +64,8 @@ MeshFile read_mesh_file(const char* data, size_t size, MeshFormat format);
 ///      has one UV, else MeshLab's per-face `texcoord` list; materials are not stored;
 /// OFF: polygons and colours (COFF); no UVs or materials;
 /// STL: binary, float32 positions and facet normals, triangles only.
-/// Throws std::invalid_argument when arrays disagree in size or an index is out of range.
+/// Throws std::invalid_argument when arrays disagree in size, an index is out of range, or an
+/// OBJ material or library name would not read back as written (see obj_name_problem).
 std::string write_mesh_file(const MeshFile& mesh, MeshFormat format);
 
 /// Format from a file name's extension (.obj .ply .off .stl, any case; a trailing .gz or
