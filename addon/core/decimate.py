@@ -114,11 +114,17 @@ class DecimateStats:
     seconds: dict               #: per stage: sampling, clustering, checking, output, refine
     refine_vertices: int = 0    #: target of the quadric refinement (0: not refined)
     refine_collapses: int = 0   #: collapses the refinement made
+    #: the final check of the output against the input's components (manifold, orientation,
+    #: components, Euler characteristic, boundary loops, duplicates, finite coordinates; see
+    #: native verify.hpp). All zero except ``zero_area`` whenever ``topology_kept`` is True: a
+    #: violation the repairs did not report raises instead of returning.
+    output_check: dict = field(default_factory=dict)
 
     @property
     def topology_kept(self) -> bool:
         """True when no topological issue remained (see issues_remaining)."""
-        return not any(v for k, v in self.issues_remaining.items() if k != "sliver")
+        return not any(v for k, v in self.issues_remaining.items() if k != "sliver") and \
+            not any(v for k, v in self.output_check.items() if k != "zero_area")
 
 
 @dataclass(frozen=True)
@@ -169,7 +175,7 @@ def _result(raw: dict, parameters: dict) -> DecimateResult:
         repair_rounds=repairs["rounds"], repairs=repairs["samples_added"], top_up=raw["top_up_samples"],
         issues_found=dict(repairs["found"]), issues_remaining=dict(repairs["remaining"]),
         seconds=dict(raw["seconds"]), refine_vertices=raw["refine_vertices"],
-        refine_collapses=raw["refine_collapses"])
+        refine_collapses=raw["refine_collapses"], output_check=dict(raw["output_check"]))
     return DecimateResult(vertices=raw["positions"], triangles=raw["triangles"], kept=raw["kept"],
                           face_source=raw["face_source"], corner_source=raw["corner_source"],
                           labels=raw["labels"], samples=raw["samples"], stats=stats,

@@ -752,3 +752,27 @@ def test_fill_random_holes_always_closes_the_surface():
         if all(loop.fillable for loop in loops):
             closed_surface_summary(result.triangles)  # asserts closed, manifold, oriented
         assert np.all(areas(result.vertices, result.triangles) > 0), trial
+
+
+@pytest.mark.parametrize("name", ["cgal_anchor_dense.off", "cgal_couplingdown.off", "cgal_elephant.off",
+                                  "cgal_eight.off"])
+def test_removing_every_handle_never_makes_the_surface_intersect_itself(data_dir, tmp_path, name):
+    """Issue 17: handle loops found again after every removal (TetGen inside the volume, so
+    every intermediate surface must be free of self-intersections), removed one by one down to
+    genus 0. Each surface is also checked by the exact self-intersection test (and by CGAL's
+    when the peer is built)."""
+    loops = pytest.importorskip("topstoc.core.loops", reason="topstoc.core.loops is not in this build")
+    vertices, triangles = read_off(data_dir / "genus_positive" / name)
+    genus = (2 - closed_surface_summary(triangles)[1]) // 2
+    current_v, current_t = vertices, triangles
+    for step in range(genus):
+        found = loops.handle_tunnel_loops(current_v, current_t).handles
+        assert len(found) == genus - step, (name, step)
+        result = edit.remove_handle(current_v, current_t, found[0].vertices)
+        current_v, current_t = result.vertices, result.triangles
+        assert closed_surface_summary(current_t) == (1, 2 - 2 * (genus - step - 1)), (name, step)
+        assert len(loops.self_intersections(current_v, current_t)) == 0, (name, step)
+        if step == genus - 1:
+            pairs = cgal_new_intersections(tmp_path, current_v, current_t, 0)
+            assert not pairs, (name, pairs[:5])
+    assert summary(current_v, current_t) == (1, 0, True, True, [0])

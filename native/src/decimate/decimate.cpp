@@ -167,6 +167,11 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
     for (int j = 0; j < 3; ++j)
       result.positions[3 * size_t(output_index[s]) + j] =
           filtered.empty() ? mesh.position(samples[s])[j] : filtered[3 * size_t(s) + j];
+    // A filtered point that is not finite (should not happen: placement works in normalised
+    // coordinates) falls back to the sample itself rather than reaching the output.
+    const double* p = &result.positions[3 * size_t(output_index[s])];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      for (int j = 0; j < 3; ++j) result.positions[3 * size_t(output_index[s]) + j] = mesh.position(samples[s])[j];
   }
   // A sample with one sector has one corner to copy attributes from, whatever the triangle:
   // find it once per sample (others walk per output corner, see attribute_corner).
@@ -310,7 +315,10 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     added.erase(std::unique(added.begin(), added.end()), added.end());
     added.erase(std::remove_if(added.begin(), added.end(), [&](int32_t v) { return clustering.dist[v] == 0; }),
                 added.end());
-    if (added.empty() || round >= max_rounds) {
+    // Components no sample reached get one before anything else can be checked; that is not
+    // a repair round (without it max_repair_rounds = 0 returned an empty mesh).
+    const bool seeding = partition.issues.unreached > 0;
+    if (added.empty() || (round >= max_rounds && !seeding)) {
       result.repairs.remaining = partition.issues;
       if (!slivers) result.repairs.remaining.sliver = 0;
       break;
@@ -320,6 +328,9 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     flood_add(mesh, layout, samples, first_new, clustering, &emit.changed);
     if (clean) {
       result.top_up_samples += static_cast<int32_t>(added.size());
+    } else if (seeding) {
+      result.repairs.samples_added += static_cast<int32_t>(added.size());
+      --round;  // does not use up a repair round
     } else {
       result.repairs.rounds += 1;
       result.repairs.samples_added += static_cast<int32_t>(added.size());
@@ -330,6 +341,18 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     result.repairs.remaining.sliver = partition.issues.sliver;
   result.seconds_checking = seconds_since(start);
   return finish(mesh, layout, std::move(samples), clustering, partition, placement, std::move(result));
+}
+
+// The final check (verify.hpp): a result whose repairs left no issue must pass it; otherwise
+// something the partition checks missed would be returned as success, so it is an error.
+DecimateResult verified(const Mesh& mesh, DecimateResult result) {
+  std::vector<int32_t> kept(result.kept.size());
+  for (size_t i = 0; i < kept.size(); ++i) kept[i] = mesh.vertex_index()[result.kept[i]];
+  result.output_check = check_output(mesh, kept, result.positions, result.triangles);
+  if (result.output_check.violations() > 0 && result.repairs.remaining.topological() == 0)
+    throw std::runtime_error("decimation output failed its final check (" + result.output_check.describe() +
+                             "); please report this mesh and the parameters");
+  return result;
 }
 
 int32_t active_vertices(const Mesh& mesh) {
@@ -391,7 +414,7 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
     refine.guidance = params.sampling.guidance;
     refine_by_collapses(mesh, layout, refine, result);
     result.target_vertices = params.target_vertices;
-    return result;
+    return verified(mesh, std::move(result));
   }
   if (params.target_vertices < 1)
     throw std::invalid_argument("target must be at least 1 vertex, got " + std::to_string(params.target_vertices));
@@ -413,7 +436,7 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
     DecimateResult r = decimate_once(mesh, layout, params, drawn, target);
     if (std::abs(excess(r)) < std::abs(excess(best))) best = std::move(r);
   }
-  return best;
+  return verified(mesh, std::move(best));
 }
 
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
@@ -444,7 +467,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
     refine.guidance = guidance;
     refine_by_collapses(mesh, layout, refine, result);
   }
-  return result;
+  return verified(mesh, std::move(result));
 }
 
 DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layout, DecimateParams params,
