@@ -384,6 +384,9 @@ void bracket_max(const Surface& from, const Surface& to, OneSidedDistance& side,
   side.max = bracket.lower;
   std::copy_n(bracket.lower_point, 3, side.max_point);
   side.max_upper = bracket.upper;
+  // Per-triangle errors stay consistent with the max (face_max.max() == max).
+  if (bracket.lower_triangle >= 0)
+    side.face_max[bracket.lower_triangle] = std::max(side.face_max[bracket.lower_triangle], bracket.lower);
   side.refine_queries = bracket.queries;
 }
 

@@ -5,12 +5,15 @@
 //   max over T of d <= max(d0, d1, d2) + r(T),
 // where r(T) is the largest distance from a point of T to its nearest corner: the circumradius
 // for a triangle without an obtuse angle, half the longest side otherwise (the nearest-corner
-// distance peaks at the circumcentre when it lies in T, on the boundary when not). The search
+// distance peaks at the circumcentre when it lies in T, on the boundary when not). A second
+// bound: d(x) <= dist(x, B_j) for any triangle B_j of B, a convex function of x, so over T it
+// peaks at a corner; B_j is taken among the triangles nearest to T's corners and centroid (this
+// one makes nearly coincident surfaces cheap, where the first bound never gets small). The search
 // keeps every triangle whose bound exceeds the best distance found so far by more than the
 // tolerance, splits the one with the highest bound into four at its edge midpoints, measures the
 // three new corners, and stops when no triangle can hide a larger distance. This is the scheme of
 // CGAL's bounded_error_Hausdorff_distance (Krivograd, Trlep and Zalik 2008; Tang et al. 2009),
-// with a simpler per-triangle bound.
+// with simple per-triangle bounds.
 #pragma once
 
 #include <cstdint>
@@ -24,6 +27,7 @@ struct MaxBracket {
   double lower = 0.0;          ///< a distance attained at a point of A: the true max is at least this
   double upper = 0.0;          ///< no point of A is farther than this from B
   double lower_point[3] = {0, 0, 0};
+  int32_t lower_triangle = -1; ///< triangle of A holding lower_point when the refinement found it (else -1)
   int64_t queries = 0;         ///< closest-point queries made by the refinement
   bool converged = true;       ///< upper <= lower * (1 + tolerance) (false when the query budget ran out)
 };
