@@ -47,7 +47,8 @@ def test_stress_pass_finds_nothing():
     assert counts["ok"] == counts["decimations"] == 400, counts
 
 
-@pytest.mark.parametrize("name", ["decimate_hull_nonmanifold_output", "decimate_grid_holes_loops_merged"])
+@pytest.mark.parametrize("name", ["decimate_hull_nonmanifold_output", "decimate_grid_holes_loops_merged",
+                                  "decimate_fast_path_crease_lost_face"])
 def test_regressions(name):
     data = np.load(REGRESSIONS / f"{name}.npz")
     params = json.loads((REGRESSIONS / f"{name}.json").read_text())
