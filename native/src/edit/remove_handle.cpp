@@ -148,7 +148,7 @@ EditResult remove_handle(const double* positions, int32_t num_vertices, const in
     fill.refine = attempt.refine;
     fill.fair = attempt.fair;
     fill_loops_into(candidate, holes, fill);
-    if (!edit_intersects(candidate)) return candidate;
+    if (options.allow_self_intersections || !edit_intersects(candidate)) return candidate;
   }
   throw std::invalid_argument("removing the handle along this loop would make the surface intersect itself (every "
                               "fill patch tried crosses the surface); try a shorter or flatter loop around it");
