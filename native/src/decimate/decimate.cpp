@@ -375,18 +375,18 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
 
 // The final check (verify.hpp): a result whose repairs left no issue must pass it; otherwise
 // something the partition checks missed would be returned as success, so it is an error.
-void check_result(const Mesh& mesh, DecimateResult& result) {
+void check_result(const Mesh& mesh, const FeatureLayout& layout, DecimateResult& result) {
   std::vector<int32_t> kept(result.kept.size());
   for (size_t i = 0; i < kept.size(); ++i) kept[i] = mesh.vertex_index()[result.kept[i]];
-  result.output_check = check_output(mesh, kept, result.positions, result.triangles);
+  result.output_check = check_output(mesh, layout, kept, result.positions, result.triangles);
 }
 
 bool topology_kept(const DecimateResult& result) {
   return result.repairs.remaining.topological() == 0 && result.output_check.violations() == 0;
 }
 
-DecimateResult verified(const Mesh& mesh, DecimateResult result) {
-  check_result(mesh, result);
+DecimateResult verified(const Mesh& mesh, const FeatureLayout& layout, DecimateResult result) {
+  check_result(mesh, layout, result);
   if (result.output_check.violations() > 0 && result.repairs.remaining.topological() == 0)
     throw std::runtime_error("decimation output failed its final check (" + result.output_check.describe() +
                              "); please report this mesh and the parameters");
@@ -452,7 +452,7 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
     refine.guidance = params.sampling.guidance;
     refine_by_collapses(mesh, layout, refine, result);
     result.target_vertices = params.target_vertices;
-    return verified(mesh, std::move(result));
+    return verified(mesh, layout, std::move(result));
   }
   if (params.target_vertices < 1)
     throw std::invalid_argument("target must be at least 1 vertex, got " + std::to_string(params.target_vertices));
@@ -474,7 +474,7 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
     DecimateResult r = decimate_once(mesh, layout, params, drawn, target);
     if (std::abs(excess(r)) < std::abs(excess(best))) best = std::move(r);
   }
-  check_result(mesh, best);
+  check_result(mesh, layout, best);
   if (best.fast_path && !topology_kept(best)) {
     // The fast path's candidate faces can miss an emitting face (seen once in 55,000 random
     // decimations with creases: one triangle lost, so the repairs chased an issue they could
@@ -483,7 +483,7 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
     every_face.fast_path = 0;
     return decimate(mesh, layout, every_face);
   }
-  return verified(mesh, std::move(best));
+  return verified(mesh, layout, std::move(best));
 }
 
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
@@ -514,7 +514,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
     refine.guidance = guidance;
     refine_by_collapses(mesh, layout, refine, result);
   }
-  return verified(mesh, std::move(result));
+  return verified(mesh, layout, std::move(result));
 }
 
 DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layout, DecimateParams params,

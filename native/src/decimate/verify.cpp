@@ -83,27 +83,15 @@ std::string OutputCheck::describe() const {
   return text;
 }
 
-std::vector<int32_t> component_boundary_loops(const Mesh& mesh) {
-  // On a manifold surface every boundary vertex has two boundary edges, so the loops are the
-  // connected pieces of the boundary edges.
-  const int32_t n = mesh.num_vertices();
-  UnionFind sets(n);
-  std::vector<uint8_t> on_boundary(n, 0);
-  const auto& ev = mesh.edge_vertices();
-  for (int32_t e = 0; e < mesh.num_edges(); ++e)
-    if (mesh.edge_face_count(e) == 1) {
-      const int32_t a = ev[2 * size_t(e)], b = ev[2 * size_t(e) + 1];
-      on_boundary[a] = on_boundary[b] = 1;
-      sets.unite(a, b);
-    }
+std::vector<int32_t> component_boundary_loops(const Mesh& mesh, const FeatureLayout& layout) {
   std::vector<int32_t> loops(mesh.num_components(), 0);
-  for (int32_t v = 0; v < n; ++v)
-    if (on_boundary[v] && sets.find(v) == v) ++loops[mesh.component()[v]];
+  for (size_t i = 0; i + 1 < layout.boundary_loop_offsets.size(); ++i)
+    ++loops[mesh.component()[layout.boundary_loop_vertices[layout.boundary_loop_offsets[i]]]];
   return loops;
 }
 
-OutputCheck check_output(const Mesh& mesh, const std::vector<int32_t>& kept, const std::vector<double>& positions,
-                         const std::vector<int32_t>& triangles) {
+OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& kept,
+                         const std::vector<double>& positions, const std::vector<int32_t>& triangles) {
   OutputCheck check;
   const int32_t n = static_cast<int32_t>(kept.size());
   const int32_t t = static_cast<int32_t>(triangles.size() / 3);
@@ -201,7 +189,7 @@ OutputCheck check_output(const Mesh& mesh, const std::vector<int32_t>& kept, con
     }
     if (on_boundary[v] && boundary.find(v) == v) ++loops[comp];
   }
-  const auto input_loops = component_boundary_loops(mesh);
+  const auto input_loops = component_boundary_loops(mesh, layout);
   for (int32_t comp = 0; comp < num_components; ++comp) {
     if (roots[comp] == -2) ++check.split_components;
     if (!manifold[comp] || triangles_in[comp] == 0) continue;

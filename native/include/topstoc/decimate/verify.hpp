@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "topstoc/core/mesh.hpp"
+#include "topstoc/decimate/features.hpp"
 
 namespace topstoc {
 
@@ -42,12 +43,13 @@ struct OutputCheck {
   std::string describe() const;
 };
 
-/// Boundary loops (cycles of edges with one triangle) per component of the mesh.
-std::vector<int32_t> component_boundary_loops(const Mesh& mesh);
+/// Boundary loops (cycles of edges with one triangle) per component of the mesh, from the
+/// layout's list of them (built once per layout, so a re-decimation does not scan the edges).
+std::vector<int32_t> component_boundary_loops(const Mesh& mesh, const FeatureLayout& layout);
 
 /// Checks a decimated surface. kept: the input vertex (internal id) of each output vertex;
 /// positions: 3 per output vertex; triangles: 3 indices into kept per output triangle.
-OutputCheck check_output(const Mesh& mesh, const std::vector<int32_t>& kept, const std::vector<double>& positions,
-                         const std::vector<int32_t>& triangles);
+OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& kept,
+                         const std::vector<double>& positions, const std::vector<int32_t>& triangles);
 
 }  // namespace topstoc
