@@ -9,10 +9,11 @@ from topstoc.core.topology import topology
 
 
 def gudhi_betti(num_vertices, triangles, edges=None):
-    """Z2 Betti numbers by GUDHI of the complex spanned by the arrays: every vertex, triangles
-    with three distinct vertices, and the edge spanned by a triangle with a repeated vertex."""
+    """Z2 Betti numbers by GUDHI of the complex spanned by the faces: triangles with three
+    distinct vertices, the edge spanned by a triangle with a repeated vertex, extra edges, and
+    their vertices (a vertex in nothing is no part of the surface; MeshLab counts the same).
+    num_vertices is kept for the callers' convenience and not used."""
     tree = gudhi.SimplexTree()
-    tree.insert_batch(np.arange(num_vertices).reshape(1, -1), np.zeros(num_vertices))
     tri = np.sort(np.asarray(triangles, dtype=np.int64).reshape(-1, 3), axis=1)
     proper = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2])
     if proper.any():

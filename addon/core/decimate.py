@@ -131,6 +131,11 @@ class DecimateStats:
     refine_vertices: int = 0    #: target of the quadric refinement (0: not refined)
     refine_collapses: int = 0   #: collapses the refinement made
     output_vertices: int = 0    #: vertices of the result
+    #: the final check of the output against the input's components (manifold, orientation,
+    #: components, Euler characteristic, boundary loops, duplicates, finite coordinates; see
+    #: native verify.hpp). All zero except ``zero_area`` whenever ``topology_kept`` is True: a
+    #: violation the repairs did not report raises instead of returning.
+    output_check: dict = field(default_factory=dict)
 
     @property
     def over_budget(self) -> int:
@@ -150,7 +155,8 @@ class DecimateStats:
     @property
     def topology_kept(self) -> bool:
         """True when no topological issue remained (see issues_remaining)."""
-        return not any(v for k, v in self.issues_remaining.items() if k != "sliver")
+        return not any(v for k, v in self.issues_remaining.items() if k != "sliver") and \
+            not any(v for k, v in self.output_check.items() if k != "zero_area")
 
 
 @dataclass(frozen=True)

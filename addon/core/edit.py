@@ -290,7 +290,7 @@ def fill_loops(vertices, triangles, loops: Sequence[Sequence[int]], *, planar: b
 
 def remove_handle(vertices, triangles, loop: Sequence[int], *, allow_separating: bool = False,
                   separation: float = 0.25, planar: bool = True, max_dp_corners: int = 300, refine: bool = False,
-                  fair: bool = False) -> EditResult:
+                  fair: bool = False, allow_self_intersections: bool = False) -> EditResult:
     """Removes the handle or tunnel that ``loop`` goes around: cut along it, fill both holes.
 
     The genus of that component drops by one; components and boundary loops stay. A loop that
@@ -300,10 +300,17 @@ def remove_handle(vertices, triangles, loop: Sequence[int], *, allow_separating:
     Only the loop's vertices move: each copy goes ``separation`` of the way towards its
     neighbours on its own side (less where a triangle would turn over), so the two patches do
     not lie on top of each other; 0 leaves them in place, coinciding.
+
+    The edit never makes the surface intersect itself: when a patch (or a moved triangle)
+    would cross the surface, the copies are pulled apart more or less and refined, faired
+    patches are tried; if none is free of intersections, ValueError names the problem (a
+    shorter loop around the same handle usually works: see topstoc.core.loops).
+    ``allow_self_intersections=True`` returns the first candidate instead.
     """
     vertices = as_vertices(vertices)
     raw = engine.remove_handle(vertices, triangles, _loop(loop), allow_separating=allow_separating,
                                separation=params.number("separation", separation, 0, 1, high_open=True),
+                               allow_self_intersections=bool(allow_self_intersections),
                                **_fill_options(planar, max_dp_corners, refine, fair))
     return _result(raw, vertices, triangles)
 

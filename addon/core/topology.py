@@ -3,9 +3,10 @@
 docs/design.md §4.1, thesis chapter 3 and 4.2.1. Works on any triangle mesh read as a simplicial
 complex over Z2, in the caller's vertex ids:
 
-* every vertex is a 0-simplex, also an unused one: an isolated vertex is a component of its
-  own, counted in betti[0] and listed in ``Topology.isolated_vertices`` (not in
-  ``Topology.components``, which would otherwise hold one object per point of a point cloud);
+* the Betti numbers and the Euler characteristic describe the surface (and wire edges): the
+  complex of the triangles and edges with their vertices, as GUDHI and MeshLab count it. A
+  vertex in no triangle or edge is no part of it: it is listed apart in
+  ``Topology.isolated_vertices`` and counted in no Betti number;
 * a triangle with three distinct vertices is a 2-simplex; repeated copies (same vertex set,
   any order) count once (``duplicate_triangles``);
 * a triangle with a repeated vertex is read as the edge (or vertex) it spans
@@ -145,11 +146,11 @@ class ComponentGenerators:
 @dataclass(frozen=True)
 class Topology:
     """Invariants of a whole mesh: totals, Betti numbers, one :class:`ComponentTopology` per
-    connected component with at least one edge, and the isolated vertices (each a component
-    too: betti[0] = len(components) + len(isolated_vertices))."""
+    connected component with at least one edge, and the isolated vertices apart (in no
+    component and no Betti number: betti[0] = len(components))."""
 
-    betti: tuple[int, int, int]
-    vertices: int
+    betti: tuple[int, int, int]  #: of the triangles and edges (isolated vertices not counted)
+    vertices: int  #: all vertices, isolated ones included
     edges: int
     faces: int
     components: list[ComponentTopology]
@@ -161,7 +162,8 @@ class Topology:
 
     @property
     def euler(self) -> int:
-        return self.vertices - self.edges + self.faces
+        """V - E + F of the triangles and edges (isolated vertices not counted): b0 - b1 + b2."""
+        return self.vertices - len(self.isolated_vertices) - self.edges + self.faces
 
     def triangle_component(self, triangles) -> np.ndarray:
         """Component index of each of the caller's triangles."""
@@ -259,7 +261,7 @@ def topology(vertices, triangles, edges=None, generators: bool = False) -> Topol
         g["component"] = int(renumber[g["component"]])
         gens.append(_generators_from(g))
     return Topology(
-        betti=tuple(int(b) for b in raw["betti"]), vertices=int(raw["num_vertices"]),
+        betti=tuple(int(sum(b[d] for b in cols["betti"])) for d in range(3)), vertices=int(raw["num_vertices"]),
         edges=int(raw["num_edges"]), faces=int(raw["num_triangles"]), components=components,
         isolated_vertices=native["first_vertex"][~kept], vertex_component=component_of,
         collapsed_triangles=int(raw["collapsed_triangles"]),

@@ -165,7 +165,8 @@ void bind_edit(py::module_& m) {
   m.def(
       "remove_handle",
       [](const py::handle& vertices, const py::handle& triangles, const py::handle& loop, bool allow_separating,
-         double separation, bool planar, int32_t max_dp_corners, bool refine, bool fair) {
+         double separation, bool planar, int32_t max_dp_corners, bool refine, bool fair,
+         bool allow_self_intersections) {
         if (!(separation >= 0.0 && separation < 1.0))
           throw py::value_error("separation must lie in [0, 1), got " + std::to_string(separation));
         Arrays a = arrays_from(vertices, triangles);
@@ -174,6 +175,7 @@ void bind_edit(py::module_& m) {
         options.fill = fill_options(planar, max_dp_corners, refine, fair);
         options.allow_separating = allow_separating;
         options.separation = separation;
+        options.allow_self_intersections = allow_self_intersections;
         EditResult r;
         {
           EngineCall call;
@@ -184,6 +186,7 @@ void bind_edit(py::module_& m) {
       },
       py::arg("vertices"), py::arg("triangles"), py::arg("loop"), py::arg("allow_separating") = false,
       py::arg("separation") = 0.25, py::arg("planar") = true, py::arg("max_dp_corners") = 300, py::arg("refine") = false, py::arg("fair") = false,
+      py::arg("allow_self_intersections") = false,
       "Cuts along a handle or tunnel loop and fills both holes: the genus drops by one.");
 }
 

@@ -23,6 +23,8 @@ py::dict one_sided_dict(OneSidedDistance&& d) {
   out["percentile"] = d.percentile;
   out["max_point"] = copy_array(std::vector<double>(d.max_point, d.max_point + 3));
   out["samples"] = d.samples;
+  out["max_upper"] = d.max_upper;
+  out["refine_queries"] = d.refine_queries;
   out["vertex_distance"] = to_array(std::move(d.vertex_distance));
   out["face_max"] = to_array(std::move(d.face_max));
   return out;
@@ -34,6 +36,7 @@ py::dict result_dict(HausdorffResult&& r) {
   out["backward"] = one_sided_dict(std::move(r.backward));
   py::dict symmetric;
   symmetric["max"] = r.symmetric_max;
+  symmetric["max_upper"] = r.symmetric_max_upper;
   symmetric["mean"] = r.symmetric_mean;
   symmetric["rms"] = r.symmetric_rms;
   symmetric["percentile"] = r.symmetric_percentile;
@@ -113,11 +116,12 @@ void bind_hausdorff(py::module_& m) {
 
   m.def(
       "hausdorff",
-      [](const Surface& a, const Surface& b, int64_t samples, double step, double percentile) {
+      [](const Surface& a, const Surface& b, int64_t samples, double step, double percentile, double max_tolerance) {
         HausdorffParams params;
         params.samples = samples;
         params.step = step;
         params.percentile = percentile;
+        params.max_tolerance = max_tolerance;
         HausdorffResult r;
         {
           EngineCall call;
@@ -126,19 +130,20 @@ void bind_hausdorff(py::module_& m) {
         return result_dict(std::move(r));
       },
       py::arg("a"), py::arg("b"), py::arg("samples") = 1000000, py::arg("step") = 0.0, py::arg("percentile") = 0.95,
+      py::arg("max_tolerance") = 1e-3,
       "Forward (A to B), backward (B to A) and symmetric Hausdorff distance.");
 
   m.def(
       "hausdorff_with_samples",
-      [](const Surface& a, const SurfaceSamples& a_samples, const Surface& b, double percentile) {
+      [](const Surface& a, const SurfaceSamples& a_samples, const Surface& b, double percentile, double max_tolerance) {
         HausdorffResult r;
         {
           EngineCall call;
-          r = hausdorff(a, a_samples, b, percentile);
+          r = hausdorff(a, a_samples, b, percentile, max_tolerance);
         }
         return result_dict(std::move(r));
       },
-      py::arg("a"), py::arg("a_samples"), py::arg("b"), py::arg("percentile") = 0.95,
+      py::arg("a"), py::arg("a_samples"), py::arg("b"), py::arg("percentile") = 0.95, py::arg("max_tolerance") = 1e-3,
       "Hausdorff distance reusing samples of A taken earlier (B is sampled with their step).");
 }
 

@@ -55,7 +55,9 @@ def test_betti_numbers_equal_gudhi(name):
     info = topology(vertices, triangles, edges)
     assert info.betti == gudhi_betti(len(vertices), triangles, edges)
     isolated = len(info.isolated_vertices)
-    assert info.betti == tuple(np.sum([c.betti for c in info.components] + [(isolated, 0, 0)], axis=0))
+    # the surface's numbers: isolated vertices are listed apart and counted in none
+    assert info.betti == tuple(np.sum([c.betti for c in info.components] + [(0, 0, 0)], axis=0))
+    assert info.euler == info.betti[0] - info.betti[1] + info.betti[2]
     # Euler-Poincare per component, and totals
     for c in info.components:
         assert c.euler == c.vertices - c.edges + c.faces == c.betti[0] - c.betti[1] + c.betti[2]
@@ -121,7 +123,7 @@ def test_summaries():
     assert topology(*with_isolated(meshgen.torus(8, 6), 2)).summary() == \
         "1 component: genus 1, closed, orientable, 2 isolated vertices"
     assert topology(*with_isolated(meshgen.disjoint(meshgen.torus(8, 6), meshgen.grid(2, 2)), 1)).summary() == \
-        "2 components (2 surfaces), 1 isolated vertex, betti 3/2/1"
+        "2 components (2 surfaces), 1 isolated vertex, betti 2/2/1"
     assert topology(np.zeros((3, 3)), np.zeros((0, 3), int)).summary() == "3 isolated vertices"
 
 
@@ -249,11 +251,12 @@ def test_isolated_vertices_listed_apart():
     vertices = np.concatenate([np.full((2, 3), 5.0), vertices])  # two more, before the torus
     info = topology(vertices, triangles + 2)
     assert info.isolated_vertices.tolist() == [0, 1, 50, 51, 52]
-    assert info.betti == (6, 2, 1) and [c.first_vertex for c in info.components] == [2]
+    assert info.betti == (1, 2, 1) and [c.first_vertex for c in info.components] == [2]
+    assert info.euler == 0 and "5 isolated vertices" in info.summary()
     assert info.vertex_component.tolist() == [-1, -1] + [0] * 48 + [-1] * 3
     assert info.to_dict()["isolated_vertices"] == [0, 1, 50, 51, 52]
     cloud = topology(np.random.default_rng(1).random((200000, 3)), np.zeros((0, 3), np.int32))
-    assert cloud.betti == (200000, 0, 0) and cloud.components == [] and len(cloud.isolated_vertices) == 200000
+    assert cloud.betti == (0, 0, 0) and cloud.components == [] and len(cloud.isolated_vertices) == 200000
 
 
 def test_components_numbered_by_smallest_vertex():

@@ -52,7 +52,7 @@ def run(args) -> int:
     if len(info.components) > TEXT_COMPONENTS:
         print(f"  ... and {len(info.components) - TEXT_COMPONENTS} more components (--json lists all)")
     if len(info.isolated_vertices):
-        print(f"  {len(info.isolated_vertices)} isolated vertices (in no edge or triangle; each counts in betti 0)")
+        print(f"  {len(info.isolated_vertices)} isolated vertices (in no edge or triangle; not counted in the Betti numbers)")
     for g in info.generators:
         lengths = ", ".join(str(len(loop)) for loop in g.loops)
         print(f"  component {g.component}: {len(g.edges)} generator edges" + (f", loop lengths {lengths}" if lengths else ""))

@@ -167,6 +167,11 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
     for (int j = 0; j < 3; ++j)
       result.positions[3 * size_t(output_index[s]) + j] =
           filtered.empty() ? mesh.position(samples[s])[j] : filtered[3 * size_t(s) + j];
+    // A filtered point that is not finite (should not happen: placement works in normalised
+    // coordinates) falls back to the sample itself rather than reaching the output.
+    const double* p = &result.positions[3 * size_t(output_index[s])];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      for (int j = 0; j < 3; ++j) result.positions[3 * size_t(output_index[s]) + j] = mesh.position(samples[s])[j];
   }
   // A sample with one sector has one corner to copy attributes from, whatever the triangle:
   // find it once per sample (others walk per output corner, see attribute_corner).
@@ -258,6 +263,11 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       const auto& ef = mesh.edge_faces();
       for (int32_t e : cross_edges)
         for (int32_t j = efo[e]; j < efo[e + 1]; ++j) near_border[ef[j]] = 1;
+      // The flood does not step between two samples along a feature edge, so such an edge
+      // is not among the crossings: a triangle bounded by features (a crease corner on a
+      // small mesh) could be missed and its output triangle lost. Feature faces are few.
+      for (int32_t e : layout.feature_edges)
+        for (int32_t j = efo[e]; j < efo[e + 1]; ++j) near_border[ef[j]] = 1;
       std::vector<int32_t> candidates;
       for (int32_t f = 0; f < mesh.num_faces(); ++f)
         if (near_border[f]) candidates.push_back(f);
@@ -310,7 +320,35 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     added.erase(std::unique(added.begin(), added.end()), added.end());
     added.erase(std::remove_if(added.begin(), added.end(), [&](int32_t v) { return clustering.dist[v] == 0; }),
                 added.end());
-    if (added.empty() || round >= max_rounds) {
+    if (added.empty() && !clean) {
+      // Every cluster named is a single vertex and so are its neighbours (seen with creases
+      // cutting a small mesh into short curves): the round would end with the issue reported.
+      // Sample the vertices next to the named clusters instead, or failing that the widest
+      // clusters anywhere; more samples always converge (all of them give the input back).
+      std::vector<uint8_t> named(samples.size(), 0);
+      for (int32_t s : partition.split_clusters) named[s] = 1;
+      const auto& ao = mesh.adjacency_offsets();
+      const auto& adj = mesh.adjacency();
+      for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+        if (clustering.label[v] < 0 || clustering.dist[v] == 0) continue;
+        for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
+          const int32_t l = clustering.label[adj[i]];
+          if (l >= 0 && named[l]) {
+            added.push_back(v);
+            break;
+          }
+        }
+      }
+      if (added.empty()) {
+        const auto widest = widest_clusters(clustering, partition.absorbed,
+                                            std::max<int32_t>(4, int32_t(samples.size()) / 8), {});
+        added = splitting_vertices(mesh, clustering, samples, widest, avoid);
+      }
+    }
+    // Components no sample reached get one before anything else can be checked; that is not
+    // a repair round (without it max_repair_rounds = 0 returned an empty mesh).
+    const bool seeding = partition.issues.unreached > 0;
+    if (added.empty() || (round >= max_rounds && !seeding)) {
       result.repairs.remaining = partition.issues;
       if (!slivers) result.repairs.remaining.sliver = 0;
       break;
@@ -320,6 +358,9 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     flood_add(mesh, layout, samples, first_new, clustering, &emit.changed);
     if (clean) {
       result.top_up_samples += static_cast<int32_t>(added.size());
+    } else if (seeding) {
+      result.repairs.samples_added += static_cast<int32_t>(added.size());
+      --round;  // does not use up a repair round
     } else {
       result.repairs.rounds += 1;
       result.repairs.samples_added += static_cast<int32_t>(added.size());
@@ -330,6 +371,26 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     result.repairs.remaining.sliver = partition.issues.sliver;
   result.seconds_checking = seconds_since(start);
   return finish(mesh, layout, std::move(samples), clustering, partition, placement, std::move(result));
+}
+
+// The final check (verify.hpp): a result whose repairs left no issue must pass it; otherwise
+// something the partition checks missed would be returned as success, so it is an error.
+void check_result(const Mesh& mesh, const FeatureLayout& layout, DecimateResult& result) {
+  std::vector<int32_t> kept(result.kept.size());
+  for (size_t i = 0; i < kept.size(); ++i) kept[i] = mesh.vertex_index()[result.kept[i]];
+  result.output_check = check_output(mesh, layout, kept, result.positions, result.triangles);
+}
+
+bool topology_kept(const DecimateResult& result) {
+  return result.repairs.remaining.topological() == 0 && result.output_check.violations() == 0;
+}
+
+DecimateResult verified(const Mesh& mesh, const FeatureLayout& layout, DecimateResult result) {
+  check_result(mesh, layout, result);
+  if (result.output_check.violations() > 0 && result.repairs.remaining.topological() == 0)
+    throw std::runtime_error("decimation output failed its final check (" + result.output_check.describe() +
+                             "); please report this mesh and the parameters");
+  return result;
 }
 
 int32_t active_vertices(const Mesh& mesh) {
@@ -391,7 +452,7 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
     refine_by_collapses(mesh, layout, refine, result);
     result.target_vertices = params.target_vertices;
     result.forced = std::max(result.forced, int32_t(std::count(multipliers.begin(), multipliers.end(), kForcedMultiplier)));
-    return result;
+    return verified(mesh, layout, std::move(result));
   }
   if (params.target_vertices < 1)
     throw std::invalid_argument("target must be at least 1 vertex, got " + std::to_string(params.target_vertices));
@@ -422,7 +483,16 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
     cleanup.zero_area_only = true;
     refine_by_collapses(mesh, layout, cleanup, best);
   }
-  return best;
+  check_result(mesh, layout, best);
+  if (best.fast_path && !topology_kept(best)) {
+    // The fast path's candidate faces can miss an emitting face (seen once in 55,000 random
+    // decimations with creases: one triangle lost, so the repairs chased an issue they could
+    // not see). Scanning every face instead is the repair.
+    DecimateParams every_face = params;
+    every_face.fast_path = 0;
+    return decimate(mesh, layout, every_face);
+  }
+  return verified(mesh, layout, std::move(best));
 }
 
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
@@ -470,7 +540,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
     cleanup.zero_area_only = true;
     refine_by_collapses(mesh, layout, cleanup, result);
   }
-  return result;
+  return verified(mesh, layout, std::move(result));
 }
 
 DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layout, DecimateParams params,

@@ -180,6 +180,40 @@ void trace_curves(const Mesh& mesh, FeatureLayout& layout) {
   }
 }
 
+void collect_boundary_loops(const Mesh& mesh, FeatureLayout& layout) {
+  const int32_t n = mesh.num_vertices();
+  const auto& ev = mesh.edge_vertices();
+  std::vector<int32_t> parent(n);
+  for (int32_t v = 0; v < n; ++v) parent[v] = v;
+  auto find = [&](int32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::vector<uint8_t> on_boundary(n, 0);
+  bool any = false;
+  for (int32_t e = 0; e < mesh.num_edges(); ++e)
+    if (mesh.edge_face_count(e) == 1) {
+      const int32_t a = ev[2 * size_t(e)], b = ev[2 * size_t(e) + 1];
+      on_boundary[a] = on_boundary[b] = 1;
+      any = true;
+      const int32_t ra = find(a), rb = find(b);
+      if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+    }
+  if (!any) return;
+  // Group the boundary vertices by root, loops in order of their lowest vertex.
+  std::vector<int32_t> loop_of(n, -1), sizes;
+  for (int32_t v = 0; v < n; ++v)
+    if (on_boundary[v] && find(v) == v) loop_of[v] = int32_t(sizes.size()), sizes.push_back(0);
+  for (int32_t v = 0; v < n; ++v)
+    if (on_boundary[v]) ++sizes[loop_of[find(v)]];
+  layout.boundary_loop_offsets.assign(sizes.size() + 1, 0);
+  for (size_t i = 0; i < sizes.size(); ++i) layout.boundary_loop_offsets[i + 1] = layout.boundary_loop_offsets[i] + sizes[i];
+  layout.boundary_loop_vertices.resize(layout.boundary_loop_offsets.back());
+  std::vector<int32_t> fill(layout.boundary_loop_offsets.begin(), layout.boundary_loop_offsets.end() - 1);
+  for (int32_t v = 0; v < n; ++v)
+    if (on_boundary[v]) layout.boundary_loop_vertices[fill[loop_of[find(v)]]++] = v;
+}
+
 }  // namespace
 
 std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, const int32_t* face_region,
@@ -191,6 +225,7 @@ std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, cons
   mark_feature_edges(mesh, face_region, face_region_count, flagged_edges, num_flagged_edges, feature_angle, *layout);
   compute_sectors_and_corners(mesh, *layout);
   trace_curves(mesh, *layout);
+  collect_boundary_loops(mesh, *layout);
   return layout;
 }
 

@@ -1,5 +1,6 @@
 #include "topstoc/decimate/partition.hpp"
 #include "topstoc/core/parallel.hpp"
+#include "../core/fans.hpp"
 
 #include <omp.h>
 
@@ -82,6 +83,26 @@ struct Link {
     for (const auto& n : neighbours)
       if (n.out > 1 || n.in > 1) return true;
     return false;
+  }
+  /// Fans: paths and cycles of arcs. (Call only when !repeated().)
+  int32_t fans() const {
+    int32_t count = 0, covered = 0;
+    for (size_t i = 0; i < neighbours.size(); ++i) {
+      if (neighbours[i].in != 0) continue;
+      ++count;  // a path starts here
+      for (int32_t v = int32_t(i); neighbours[v].next >= 0; v = neighbours[v].next) ++covered;
+    }
+    // The arcs not on a path lie on cycles; walk each once.
+    std::vector<uint8_t> seen(neighbours.size(), 0);
+    for (size_t i = 0; i < neighbours.size() && covered < arcs; ++i) {
+      if (seen[i] || neighbours[i].in == 0 || neighbours[i].next < 0) continue;
+      bool on_path = false;
+      int32_t v = int32_t(i), steps = 0;
+      while (!seen[v] && neighbours[v].next >= 0 && steps <= arcs) seen[v] = 1, v = neighbours[v].next, ++steps;
+      if (v != int32_t(i)) on_path = true;  // reached a path's end or another walk
+      if (!on_path) ++count, covered += steps;
+    }
+    return count;
   }
   /// The arcs form one path or one cycle: the triangles around the sample are one consistently
   /// oriented fan. (Call only when !repeated(): every neighbour then has out, in <= 1.)
@@ -257,6 +278,10 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // counting only samples that keep a triangle. A triangle emitted twice shows up as a repeated
   // or reversed arc; such samples are set aside and settled after the pass (see below).
   const int32_t num_components = mesh.num_components();
+  auto input_fans = [&](int32_t v) {  // fans of the input around v, nothing blocked
+    std::vector<int32_t> fan_of_slot;
+    return vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot);
+  };
   std::vector<int64_t> chi6_out(k, 0);
   out.absorbed.assign(k, 0);
   std::vector<uint8_t> drop(emitted, 0);
@@ -300,6 +325,12 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     if (mesh.manifold_vertex()[samples[s]] && !link.single_fan()) {
       ++links;
       marks.add(s);
+    } else if (!mesh.manifold_vertex()[samples[s]] && link.fans() != input_fans(samples[s])) {
+      // A pinched vertex (a bowtie's centre) keeps one fan per fan of the input; with one
+      // lost, a whole wing is gone although the Euler characteristic may not show it.
+      ++links;
+      marks.add(s);
+      for (const auto& nb : link.neighbours) marks.add(nb.id);
     }
     return true;
   };
@@ -353,9 +384,27 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
       }
       a = b;
     }
+    // A sample whose link still repeats an arc is not a manifold vertex of the output: an
+    // edge with four triangles (two tetrahedra sharing an edge) or a triangle left twice. It
+    // must count as an issue: its Euler contribution was never added, and leaving both out
+    // can make the characteristic come out right by accident (a torus as a ring of
+    // tetrahedra), so without the count such an output passed every check.
     Link link;
     for (int32_t s : repeated)
-      if (!evaluate(s, link, seen_pairs[0], bad_link, bad_edge, isolated, absorbed)) marks.add(s);
+      if (!evaluate(s, link, seen_pairs[0], bad_link, bad_edge, isolated, absorbed)) {
+        marks.add(s);
+        // A non-manifold input edge kept as a feature legitimately has more than two triangles.
+        bool expected = false;
+        for (const auto& nb : link.neighbours)
+          if (nb.in > 1 || nb.out > 1) {
+            const auto it = feature_copies.find(pair_key(s, nb.id));
+            if (it != feature_copies.end() && it->second > 2) expected = true;
+          }
+        if (expected) continue;
+        ++bad_link;
+        for (const auto& nb : link.neighbours)
+          if (nb.in > 1 || nb.out > 1) marks.add(nb.id);  // the other end of the crowded edge
+      }
   }
   out.issues.bad_link = bad_link;
   out.issues.bad_edge = bad_edge;
@@ -430,6 +479,27 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
       if (c.dist[v] > 0 && (farthest < 0 || c.dist[v] > c.dist[farthest])) farthest = v;
     }
     if (changes < 3) {
+      ++out.issues.short_loop;
+      if (farthest >= 0) out.new_samples.push_back(farthest);
+    }
+  }
+
+  // --- boundary loops need three clusters too ---------------------------------------------------
+  // Corners (e.g. where creases meet a hole) split a boundary loop into open curves, which the
+  // closed-curve check above does not see: a hole met by only two clusters closes up (two
+  // boundary curves become one interior edge), and only the Euler characteristic noticed, with
+  // nothing local to split (hundreds of repair rounds, 6 loops -> 4 at the limit).
+  const int32_t boundary_loops = int32_t(layout.boundary_loop_offsets.size()) - 1;
+  for (int32_t loop = 0; loop < boundary_loops; ++loop) {
+    const int32_t b = layout.boundary_loop_offsets[loop], e = layout.boundary_loop_offsets[loop + 1];
+    int32_t seen[3] = {-1, -1, -1}, distinct = 0, farthest = -1;
+    for (int32_t i = b; i < e; ++i) {
+      const int32_t v = layout.boundary_loop_vertices[i];
+      const int32_t l = label[v];
+      if (distinct < 3 && l != seen[0] && l != seen[1] && l != seen[2]) seen[distinct++] = l;
+      if (c.dist[v] > 0 && (farthest < 0 || c.dist[v] > c.dist[farthest])) farthest = v;
+    }
+    if (distinct < 3 && e - b >= 3) {
       ++out.issues.short_loop;
       if (farthest >= 0) out.new_samples.push_back(farthest);
     }

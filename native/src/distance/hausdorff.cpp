@@ -1,4 +1,5 @@
 #include "topstoc/distance/hausdorff.hpp"
+#include "topstoc/distance/bounded_max.hpp"
 #include "topstoc/core/validate.hpp"
 #include "topstoc/core/parallel.hpp"
 
@@ -310,29 +311,37 @@ OneSidedDistance one_sided_distance(const Surface& from, const SurfaceSamples& s
   r.max = count ? distance[arg] : 0.0;
   if (count) std::copy_n(&samples.points[3 * size_t(arg)], 3, r.max_point);
 
-  // Area-weighted mean and RMS over the face samples, summed in a fixed order.
+  // Area-weighted mean and RMS over the face samples, summed in a fixed order. Weights are
+  // taken relative to the largest and distances relative to the max: with coordinates of 1e150
+  // an area times a distance overflows (NaN means before).
+  double largest_weight = 0.0;
+  for (int64_t f = 0; f < m; ++f)
+    if (std::isfinite(samples.face_weight[f])) largest_weight = std::max(largest_weight, samples.face_weight[f]);
+  const double unit = r.max > 0.0 && std::isfinite(r.max) ? r.max : 1.0;
   double area = 0.0, sum = 0.0, sum2 = 0.0;
-  for (int64_t f = 0; f < m; ++f) {
+  for (int64_t f = 0; f < m && largest_weight > 0.0; ++f) {
     double face_sum = 0.0, face_sum2 = 0.0;
     for (int64_t i = samples.face_offsets[f]; i < samples.face_offsets[f + 1]; ++i) {
-      face_sum += distance[i];
-      face_sum2 += distance[i] * distance[i];
+      const double x = distance[i] / unit;
+      face_sum += x;
+      face_sum2 += x * x;
     }
-    const double w = samples.face_weight[f];
+    const double w = samples.face_weight[f] / largest_weight;
     area += w * double(samples.face_offsets[f + 1] - samples.face_offsets[f]);
     sum += w * face_sum;
     sum2 += w * face_sum2;
   }
   if (area > 0.0) {
-    r.mean = sum / area;
-    r.rms = std::sqrt(sum2 / area);
+    r.mean = unit * (sum / area);
+    r.rms = unit * std::sqrt(sum2 / area);
   } else {  // a surface without area: plain average over all samples
+    sum = sum2 = 0.0;
     for (int64_t i = 0; i < count; ++i) {
-      sum += distance[i];
-      sum2 += distance[i] * distance[i];
+      sum += distance[i] / unit;
+      sum2 += (distance[i] / unit) * (distance[i] / unit);
     }
-    r.mean = count ? sum / double(count) : 0.0;
-    r.rms = count ? std::sqrt(sum2 / double(count)) : 0.0;
+    r.mean = count ? unit * (sum / double(count)) : 0.0;
+    r.rms = count ? unit * std::sqrt(sum2 / double(count)) : 0.0;
   }
 
   // Percentile: the smallest distance d with at least the asked fraction of the area within d.
@@ -343,7 +352,7 @@ OneSidedDistance one_sided_distance(const Surface& from, const SurfaceSamples& s
     ranked.reserve(count - first_face);
     for (int64_t f = 0; f < m; ++f)
       for (int64_t i = samples.face_offsets[f]; i < samples.face_offsets[f + 1]; ++i)
-        ranked.emplace_back(distance[i], area > 0.0 ? samples.face_weight[f] : 1.0);
+        ranked.emplace_back(distance[i], area > 0.0 ? samples.face_weight[f] / largest_weight : 1.0);
     std::sort(ranked.begin(), ranked.end());
     double total = 0.0;
     for (const auto& x : ranked) total += x.second;
@@ -377,12 +386,29 @@ OneSidedDistance one_sided_distance(const Surface& from, const SurfaceSamples& s
   return r;
 }
 
-HausdorffResult hausdorff(const Surface& a, const SurfaceSamples& a_samples, const Surface& b, double percentile) {
+// Replaces the sampled max (a lower bound) by a bracket within the tolerance (bounded_max.hpp).
+void bracket_max(const Surface& from, const Surface& to, OneSidedDistance& side, double tolerance) {
+  if (!(tolerance > 0.0)) return;
+  const MaxBracket bracket = bound_max_distance(from, side.vertex_distance, to, side.max, side.max_point, tolerance);
+  side.max = bracket.lower;
+  std::copy_n(bracket.lower_point, 3, side.max_point);
+  side.max_upper = bracket.upper;
+  // Per-triangle errors stay consistent with the max (face_max.max() == max).
+  if (bracket.lower_triangle >= 0)
+    side.face_max[bracket.lower_triangle] = std::max(side.face_max[bracket.lower_triangle], bracket.lower);
+  side.refine_queries = bracket.queries;
+}
+
+HausdorffResult hausdorff(const Surface& a, const SurfaceSamples& a_samples, const Surface& b, double percentile,
+                          double max_tolerance) {
   HausdorffResult r;
   r.step = a_samples.step;
   r.diagonal = a.diagonal();
   r.forward = one_sided_distance(a, a_samples, b, percentile);
   r.backward = one_sided_distance(b, sample_surface(b, a_samples.step), a, percentile);
+  bracket_max(a, b, r.forward, max_tolerance);
+  bracket_max(b, a, r.backward, max_tolerance);
+  r.symmetric_max_upper = std::max(r.forward.max_upper, r.backward.max_upper);
   r.symmetric_max = std::max(r.forward.max, r.backward.max);
   r.symmetric_mean = std::max(r.forward.mean, r.backward.mean);
   r.symmetric_rms = std::max(r.forward.rms, r.backward.rms);
@@ -394,7 +420,7 @@ HausdorffResult hausdorff(const Surface& a, const Surface& b, const HausdorffPar
   if (params.step < 0.0 || std::isnan(params.step))
     throw std::invalid_argument("sample step must not be negative, got " + std::to_string(params.step));
   const double step = params.step > 0.0 ? params.step : step_for_sample_count(a, params.samples);
-  return hausdorff(a, sample_surface(a, step), b, params.percentile);
+  return hausdorff(a, sample_surface(a, step), b, params.percentile, params.max_tolerance);
 }
 
 }  // namespace topstoc

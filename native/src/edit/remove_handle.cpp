@@ -1,4 +1,5 @@
 #include "topstoc/edit/remove_handle.hpp"
+#include "topstoc/core/self_intersections.hpp"
 
 #include <cmath>
 #include <numeric>
@@ -87,6 +88,27 @@ void separate_sides(EditResult& cut, double fraction) {
   }
 }
 
+// Whether a triangle the edit created or moved (a patch triangle, or one touching a moved copy
+// of the loop) intersects any other triangle of the result. Intersections among untouched input
+// triangles were there before and are not the edit's doing.
+bool edit_intersects(const EditResult& r) {
+  const int32_t n = static_cast<int32_t>(r.vertex_source.size());
+  const int32_t m = static_cast<int32_t>(r.triangles.size() / 3);
+  std::vector<uint8_t> moved(n, 0);
+  for (const CutSide& side : r.cut_sides)
+    for (int32_t v : side.vertices) moved[v] = 1;
+  for (int32_t v = 0; v < n; ++v)
+    if (r.vertex_source[v] < 0) moved[v] = 1;
+  std::vector<uint8_t> touched(m, 0);
+  for (int32_t t = 0; t < m; ++t) {
+    const int32_t* c = &r.triangles[3 * size_t(t)];
+    touched[t] = r.face_source[t] < 0 || moved[c[0]] || moved[c[1]] || moved[c[2]];
+  }
+  for (const auto& [a, b] : self_intersections(r.positions.data(), n, r.triangles.data(), m))
+    if (touched[a] || touched[b]) return true;
+  return false;
+}
+
 }  // namespace
 
 EditResult remove_handle(const double* positions, int32_t num_vertices, const int32_t* triangles,
@@ -104,9 +126,32 @@ EditResult remove_handle(const double* positions, int32_t num_vertices, const in
   if (!options.allow_separating && !sides_connected(cut))
     throw std::invalid_argument("the loop separates its component (cutting along it splits the surface in two): it "
                                 "goes around no handle or tunnel");
-  if (options.separation > 0) separate_sides(cut, options.separation);
-  fill_loops_into(cut, holes, options.fill);
-  return cut;
+  // An edit must never make the surface self-intersect: a patch that crosses the surface
+  // (a hole whose loop is far from planar, two patches too close) is tried again with the
+  // copies pulled apart more or less and with a refined, faired patch; the first candidate
+  // free of intersections wins. (Found when removing the handles of a genus-6 part one by
+  // one: the fourth patch crossed the surface and TetGen refused the next step.)
+  struct Attempt {
+    double separation;
+    bool refine, fair;
+  };
+  const double s0 = options.separation;
+  const Attempt attempts[] = {
+      {s0, options.fill.refine, options.fill.fair}, {s0, true, true},         {0.5 * s0, true, true},
+      {std::min(0.45, 1.6 * s0), true, true},        {0.5 * s0, options.fill.refine, options.fill.fair},
+      {0.1 * s0, true, true},                        {std::min(0.45, 1.6 * s0), options.fill.refine, options.fill.fair},
+  };
+  for (const Attempt& attempt : attempts) {
+    EditResult candidate = cut;
+    if (attempt.separation > 0) separate_sides(candidate, attempt.separation);
+    FillOptions fill = options.fill;
+    fill.refine = attempt.refine;
+    fill.fair = attempt.fair;
+    fill_loops_into(candidate, holes, fill);
+    if (options.allow_self_intersections || !edit_intersects(candidate)) return candidate;
+  }
+  throw std::invalid_argument("removing the handle along this loop would make the surface intersect itself (every "
+                              "fill patch tried crosses the surface); try a shorter or flatter loop around it");
 }
 
 }  // namespace topstoc

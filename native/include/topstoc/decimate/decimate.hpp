@@ -14,6 +14,7 @@
 #include "topstoc/decimate/features.hpp"
 #include "topstoc/core/mesh.hpp"
 #include "topstoc/decimate/partition.hpp"
+#include "topstoc/decimate/verify.hpp"
 #include "topstoc/decimate/sampling.hpp"
 
 namespace topstoc {
@@ -68,6 +69,7 @@ struct DecimateResult {
   int32_t refine_collapses = 0;        ///< collapses it made
   double seconds_sampling = 0, seconds_clustering = 0, seconds_checking = 0, seconds_output = 0;
   double seconds_refine = 0;
+  OutputCheck output_check;            ///< the final check of the output (verify.hpp)
 };
 
 /// Decimates to params.target_vertices (1 <= target). Throws std::invalid_argument on bad params.

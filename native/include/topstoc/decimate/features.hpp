@@ -54,6 +54,10 @@ struct FeatureLayout {
   std::vector<int32_t> curve_vertices;
   std::vector<uint8_t> curve_closed;
   std::vector<int32_t> vertex_curve;  ///< curve of each non-corner feature vertex, else -1
+  /// Mesh boundary loops (connected sets of edges with one triangle), as vertex sets: each must
+  /// meet three clusters or it closes up in the output, whatever corners split it into curves.
+  std::vector<int32_t> boundary_loop_offsets{0};
+  std::vector<int32_t> boundary_loop_vertices;
   /// 6 * (sectors - (sum of incident edge copies) / 2 + incident faces / 3): summed over a
   /// cluster's vertices it gives six times the cluster's Euler characteristic up to the terms
   /// of edges and faces shared with other clusters (see partition.cpp).

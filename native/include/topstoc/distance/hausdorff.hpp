@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -87,7 +88,11 @@ struct OneSidedDistance {
   double mean = 0.0;          ///< area-weighted
   double rms = 0.0;           ///< area-weighted
   double percentile = 0.0;    ///< distance below which the asked fraction of the area lies (NaN if not asked)
-  double max_point[3] = {0, 0, 0};  ///< the sample where the maximum was found
+  double max_point[3] = {0, 0, 0};  ///< the point where the maximum was found
+  /// No point of the sampled surface is farther than this: with bounded-error refinement
+  /// (bounded_max.hpp) max <= true maximum <= max_upper <= max * (1 + tolerance); without it, +inf.
+  double max_upper = std::numeric_limits<double>::infinity();
+  int64_t refine_queries = 0;       ///< closest-point queries the refinement made
   int64_t samples = 0;
   std::vector<double> vertex_distance;  ///< per vertex of the sampled surface; NaN for vertices in no triangle
   std::vector<double> face_max;         ///< per triangle: max over its face, edge and corner samples
@@ -102,12 +107,14 @@ struct HausdorffParams {
   int64_t samples = 1000000;   ///< wanted samples on the first surface (ignored when step > 0)
   double step = 0.0;           ///< sample spacing; 0 = derive from `samples`
   double percentile = 0.95;    ///< fraction for the k-th ranked distance; <= 0 skips it
+  double max_tolerance = 1e-3; ///< relative gap allowed between max and max_upper; <= 0: sampled max only
 };
 
 struct HausdorffResult {
   OneSidedDistance forward;    ///< from A to B: samples on A (per-vertex errors of A)
   OneSidedDistance backward;   ///< from B to A: samples on B (per-face errors of B)
   double symmetric_max = 0.0, symmetric_mean = 0.0, symmetric_rms = 0.0, symmetric_percentile = 0.0;
+  double symmetric_max_upper = std::numeric_limits<double>::infinity();  ///< guaranteed bound (see max_upper)
   double diagonal = 0.0;       ///< bounding-box diagonal of A
   double step = 0.0;           ///< sample spacing used on both surfaces
 };
@@ -117,6 +124,7 @@ struct HausdorffResult {
 HausdorffResult hausdorff(const Surface& a, const Surface& b, const HausdorffParams& params);
 
 /// The same, reusing samples of A taken earlier (their step is used for B too).
-HausdorffResult hausdorff(const Surface& a, const SurfaceSamples& a_samples, const Surface& b, double percentile);
+HausdorffResult hausdorff(const Surface& a, const SurfaceSamples& a_samples, const Surface& b, double percentile,
+                          double max_tolerance = 1e-3);
 
 }  // namespace topstoc

@@ -21,6 +21,10 @@ struct RemoveHandleOptions {
   /// Each copy of a loop vertex moves this fraction of the way towards the mean of its
   /// neighbours off the cut (less where a triangle would turn over); 0 keeps the copies in place.
   double separation = 0.25;
+  /// By default a result in which a patch or a moved triangle intersects the surface is never
+  /// returned: other patches are tried, then std::invalid_argument. True returns the first
+  /// candidate whatever it intersects (for callers that only need the topology).
+  bool allow_self_intersections = false;
 };
 
 /// Cuts along the closed edge loop (see cut_along_loop) and fills every side of the cut (see

@@ -1,0 +1,42 @@
+// A guaranteed bracket on the one-sided Hausdorff maximum (the sampled max is only a lower bound).
+//
+// The distance to a surface, d(x) = min over y in B of |x - y|, is 1-Lipschitz. On a triangle T of
+// A with corner distances d0, d1, d2 every point x lies within r(T) of some corner, so
+//   max over T of d <= max(d0, d1, d2) + r(T),
+// where r(T) is the largest distance from a point of T to its nearest corner: the circumradius
+// for a triangle without an obtuse angle, half the longest side otherwise (the nearest-corner
+// distance peaks at the circumcentre when it lies in T, on the boundary when not). A second
+// bound: d(x) <= dist(x, B_j) for any triangle B_j of B, a convex function of x, so over T it
+// peaks at a corner; B_j is taken among the triangles nearest to T's corners and centroid (this
+// one makes nearly coincident surfaces cheap, where the first bound never gets small). The search
+// keeps every triangle whose bound exceeds the best distance found so far by more than the
+// tolerance, splits the one with the highest bound into four at its edge midpoints, measures the
+// three new corners, and stops when no triangle can hide a larger distance. This is the scheme of
+// CGAL's bounded_error_Hausdorff_distance (Krivograd, Trlep and Zalik 2008; Tang et al. 2009),
+// with simple per-triangle bounds.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "topstoc/distance/hausdorff.hpp"
+
+namespace topstoc {
+
+struct MaxBracket {
+  double lower = 0.0;          ///< a distance attained at a point of A: the true max is at least this
+  double upper = 0.0;          ///< no point of A is farther than this from B
+  double lower_point[3] = {0, 0, 0};
+  int32_t lower_triangle = -1; ///< triangle of A holding lower_point when the refinement found it (else -1)
+  int64_t queries = 0;         ///< closest-point queries made by the refinement
+  bool converged = true;       ///< upper <= lower * (1 + tolerance) (false when the query budget ran out)
+};
+
+/// Brackets max over A of dist(x, B). start: the distance and point already known (e.g. the
+/// sampled max); vertex_distance: the distance of every vertex of A used by a triangle.
+/// relative_tolerance > 0; max_queries bounds the work (the bracket stays valid when it is hit).
+MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& vertex_distance, const Surface& to,
+                              double start, const double* start_point, double relative_tolerance,
+                              int64_t max_queries = 4000000);
+
+}  // namespace topstoc

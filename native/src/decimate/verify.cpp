@@ -1,0 +1,202 @@
+#include "topstoc/decimate/verify.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "../core/union_find.hpp"
+
+namespace topstoc {
+
+namespace {
+
+// Triangles around each output vertex (CSR), in triangle order.
+struct VertexTriangles {
+  std::vector<int32_t> offsets, triangles;
+  VertexTriangles(int32_t n, const std::vector<int32_t>& tris) : offsets(n + 1, 0), triangles(tris.size()) {
+    for (int32_t v : tris) ++offsets[v + 1];
+    for (int32_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
+    std::vector<int32_t> fill(offsets.begin(), offsets.end() - 1);
+    for (size_t i = 0; i < tris.size(); ++i) triangles[fill[tris[i]]++] = int32_t(i / 3);
+  }
+};
+
+// The link of one output vertex v: for each triangle (v, a, b) the arc a -> b.
+struct LinkArcs {
+  struct Neighbour {
+    int32_t id, out = 0, in = 0, next = -1;
+  };
+  std::vector<Neighbour> neighbours;
+  int32_t arcs = 0;
+  int32_t index(int32_t id) {
+    for (size_t i = 0; i < neighbours.size(); ++i)
+      if (neighbours[i].id == id) return int32_t(i);
+    neighbours.push_back({id});
+    return int32_t(neighbours.size() - 1);
+  }
+  void add(int32_t from, int32_t to) {
+    const int32_t a = index(from), b = index(to);
+    ++neighbours[a].out, ++neighbours[b].in;
+    neighbours[a].next = b;
+    ++arcs;
+  }
+  // With every neighbour at in, out <= 1 the arcs are disjoint paths and cycles: one fan when
+  // a walk from the only path start (or anywhere on a cycle) covers every arc.
+  bool one_fan() const {
+    int32_t start = 0, starts = 0;
+    for (size_t i = 0; i < neighbours.size(); ++i)
+      if (neighbours[i].in == 0) start = int32_t(i), ++starts;
+    if (starts > 1) return false;
+    int32_t walked = 0;
+    for (int32_t x = start; walked <= arcs;) {
+      const int32_t y = neighbours[x].next;
+      if (y < 0) break;
+      ++walked;
+      if (y == start) break;
+      x = y;
+    }
+    return walked == arcs;
+  }
+};
+
+void add_count(std::string& text, int32_t count, const char* what) {
+  if (count == 0) return;
+  if (!text.empty()) text += ", ";
+  text += std::to_string(count) + " " + what;
+}
+
+}  // namespace
+
+std::string OutputCheck::describe() const {
+  std::string text;
+  add_count(text, nonfinite, "vertices with non-finite coordinates");
+  add_count(text, repeated_corner, "triangles with a repeated corner");
+  add_count(text, duplicate, "duplicate triangles");
+  add_count(text, nonmanifold_edges, "non-manifold edges");
+  add_count(text, nonmanifold_vertices, "non-manifold vertices");
+  add_count(text, inconsistent_edges, "inconsistently oriented edges");
+  add_count(text, mixed_triangles, "triangles joining different input components");
+  add_count(text, lost_components, "input components lost");
+  add_count(text, split_components, "input components split apart");
+  add_count(text, euler_changed, "components whose Euler characteristic changed");
+  add_count(text, boundary_loops_changed, "components whose boundary loops changed");
+  return text;
+}
+
+std::vector<int32_t> component_boundary_loops(const Mesh& mesh, const FeatureLayout& layout) {
+  std::vector<int32_t> loops(mesh.num_components(), 0);
+  for (size_t i = 0; i + 1 < layout.boundary_loop_offsets.size(); ++i)
+    ++loops[mesh.component()[layout.boundary_loop_vertices[layout.boundary_loop_offsets[i]]]];
+  return loops;
+}
+
+OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& kept,
+                         const std::vector<double>& positions, const std::vector<int32_t>& triangles) {
+  OutputCheck check;
+  const int32_t n = static_cast<int32_t>(kept.size());
+  const int32_t t = static_cast<int32_t>(triangles.size() / 3);
+  const int32_t num_components = mesh.num_components();
+  for (int32_t v = 0; v < n; ++v)
+    if (!std::isfinite(positions[3 * size_t(v)]) || !std::isfinite(positions[3 * size_t(v) + 1]) ||
+        !std::isfinite(positions[3 * size_t(v) + 2]))
+      ++check.nonfinite;
+
+  // Which input components are manifold, oriented surfaces (the guarantee's domain).
+  std::vector<uint8_t> manifold(num_components, 1);
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+    if (mesh.component()[v] >= 0 && !mesh.manifold_vertex()[v]) manifold[mesh.component()[v]] = 0;
+  std::vector<int32_t> component_of(n);
+  for (int32_t v = 0; v < n; ++v) component_of[v] = mesh.component()[kept[v]];
+
+  // Per triangle: repeated corners, mixed components, zero area.
+  std::vector<int32_t> triangles_in(num_components, 0);
+  std::vector<int64_t> euler(num_components, 0);  // V - E + F of the output piece
+  for (int32_t i = 0; i < t; ++i) {
+    const int32_t* c = &triangles[3 * size_t(i)];
+    if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) {
+      ++check.repeated_corner;
+      continue;
+    }
+    const int32_t comp = component_of[c[0]];
+    if (component_of[c[1]] != comp || component_of[c[2]] != comp) ++check.mixed_triangles;
+    ++triangles_in[comp];
+    ++euler[comp];
+    const double* p[3] = {&positions[3 * size_t(c[0])], &positions[3 * size_t(c[1])], &positions[3 * size_t(c[2])]};
+    double u[3], w[3], longest = 0;
+    for (int a = 0; a < 3; ++a) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
+    for (int j = 0; j < 3; ++j) {
+      double d = 0;
+      for (int a = 0; a < 3; ++a) d += (p[(j + 1) % 3][a] - p[j][a]) * (p[(j + 1) % 3][a] - p[j][a]);
+      longest = std::max(longest, d);
+    }
+    const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
+    if (!(std::sqrt(cx * cx + cy * cy + cz * cz) > 1e-9 * longest)) ++check.zero_area;
+  }
+  for (int32_t comp = 0; comp < num_components; ++comp)
+    if (triangles_in[comp] == 0) ++check.lost_components;
+
+  // Per vertex: its link gives the edges (each counted at its lower end), their triangle
+  // counts and directions, duplicates, the fan, and the boundary.
+  VertexTriangles around(n, triangles);
+  UnionFind pieces(n), boundary(n);
+  std::vector<uint8_t> on_boundary(n, 0), used(n, 0);
+  LinkArcs link;
+  std::vector<std::array<int32_t, 2>> corner_pairs;
+  for (int32_t v = 0; v < n; ++v) {
+    link.neighbours.clear();
+    link.arcs = 0;
+    corner_pairs.clear();
+    for (int32_t i = around.offsets[v]; i < around.offsets[v + 1]; ++i) {
+      const int32_t* c = &triangles[3 * size_t(around.triangles[i])];
+      if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
+      const int j = c[0] == v ? 0 : c[1] == v ? 1 : 2;
+      const int32_t a = c[(j + 1) % 3], b = c[(j + 2) % 3];
+      link.add(a, b);
+      pieces.unite(v, a);
+      if (v < a && v < b) corner_pairs.push_back({std::min(a, b), std::max(a, b)});
+    }
+    if (link.arcs == 0) continue;
+    used[v] = 1;
+    std::sort(corner_pairs.begin(), corner_pairs.end());
+    for (size_t i = 1; i < corner_pairs.size(); ++i)
+      if (corner_pairs[i] == corner_pairs[i - 1]) ++check.duplicate;
+    const int32_t comp = component_of[v];
+    ++euler[comp];
+    bool crowded = false;
+    for (const auto& nb : link.neighbours) {
+      const int32_t count = nb.in + nb.out;
+      if (nb.id > v) --euler[comp];
+      if (count > 2 || nb.in > 1 || nb.out > 1) crowded = true;
+      if (!manifold[comp]) continue;
+      if (nb.id > v && count > 2) ++check.nonmanifold_edges;
+      if (nb.id > v && count <= 2 && (nb.in > 1 || nb.out > 1)) ++check.inconsistent_edges;
+      if (count == 1) {
+        on_boundary[v] = 1;
+        boundary.unite(v, nb.id);
+      }
+    }
+    if (manifold[comp] && !crowded && !link.one_fan()) ++check.nonmanifold_vertices;
+  }
+  std::vector<int32_t> roots(num_components, -1), loops(num_components, 0);
+  for (int32_t v = 0; v < n; ++v) {
+    if (!used[v]) continue;
+    const int32_t comp = component_of[v];
+    const int32_t root = pieces.find(v);
+    if (roots[comp] < 0) {
+      roots[comp] = root;
+    } else if (roots[comp] != root) {
+      roots[comp] = -2;  // counted once below
+    }
+    if (on_boundary[v] && boundary.find(v) == v) ++loops[comp];
+  }
+  const auto input_loops = component_boundary_loops(mesh, layout);
+  for (int32_t comp = 0; comp < num_components; ++comp) {
+    if (roots[comp] == -2) ++check.split_components;
+    if (!manifold[comp] || triangles_in[comp] == 0) continue;
+    if (euler[comp] != mesh.component_euler()[comp]) ++check.euler_changed;
+    if (loops[comp] != input_loops[comp]) ++check.boundary_loops_changed;
+  }
+  return check;
+}
+
+}  // namespace topstoc

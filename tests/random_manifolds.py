@@ -1,0 +1,217 @@
+"""Random valid manifolds with known topology, and an independent check of a decimation's
+output against its input (numpy and scipy only, no topstoc code).
+
+A deterministic generator (numpy's PCG64 from a seed) instead of hypothesis: the same seed
+always gives the same mesh, so any failure found by the stress script is reproducible from two
+numbers, and CI needs nothing from PyPI.
+"""
+
+import numpy as np
+from scipy.spatial import ConvexHull
+
+
+def hull(rng):
+    """Convex hull of 6..160 random points on an ellipsoid: a sphere (genus 0)."""
+    n = int(rng.integers(6, 160))
+    p = rng.normal(size=(n, 3))
+    p /= np.linalg.norm(p, axis=1, keepdims=True)
+    p *= rng.uniform(0.3, 2.0, size=3)
+    h = ConvexHull(p)
+    t = h.simplices.copy()
+    centre = p.mean(axis=0)
+    normal = np.cross(p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]])
+    flip = np.einsum("ij,ij->i", normal, p[t[:, 0]] - centre) < 0
+    t[flip] = t[flip][:, [0, 2, 1]]
+    used = np.unique(t)
+    remap = np.full(n, -1)
+    remap[used] = np.arange(len(used))
+    return p[used], remap[t]
+
+
+def torus(rng):
+    """A torus as an nu x nv grid (3..24 x 3..12), jittered: genus 1."""
+    nu, nv = int(rng.integers(3, 25)), int(rng.integers(3, 13))
+    major = rng.uniform(1.0, 2.0)
+    minor = rng.uniform(0.15, 0.8) * major
+    u = np.arange(nu) * 2 * np.pi / nu + rng.uniform(-0.2, 0.2, nu) * np.pi / nu
+    v = np.arange(nv) * 2 * np.pi / nv
+    uu, vv = np.meshgrid(u, v, indexing="ij")
+    p = np.stack([(major + minor * np.cos(vv)) * np.cos(uu), (major + minor * np.cos(vv)) * np.sin(uu),
+                  minor * np.sin(vv)], -1).reshape(-1, 3)
+    p += rng.normal(scale=0.02 * minor, size=p.shape)
+    idx = lambda i, j: (i % nu) * nv + (j % nv)  # noqa: E731
+    t = []
+    for i in range(nu):
+        for j in range(nv):
+            a, b, c, d = idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)
+            t += [(a, b, c), (a, c, d)] if rng.random() < 0.5 else [(a, b, d), (b, c, d)]
+    return p, np.array(t)
+
+
+def grid_with_holes(rng):
+    """An n x m grid (3..20) with up to 6 square holes that share no vertex with each other or
+    the border, bent in z: a disk with `holes` holes (1 + holes boundary loops)."""
+    n, m = int(rng.integers(3, 21)), int(rng.integers(3, 21))
+    xs, ys = np.meshgrid(np.arange(n + 1, dtype=float), np.arange(m + 1, dtype=float), indexing="ij")
+    z = rng.uniform(0, 0.8) * np.sin(xs * rng.uniform(0.2, 1.5)) + rng.uniform(0, 0.5) * np.cos(ys)
+    p = np.stack([xs, ys, z], -1).reshape(-1, 3) + rng.normal(scale=0.05, size=((n + 1) * (m + 1), 3))
+    cells = [(i, j) for i in range(1, n - 1, 2) for j in range(1, m - 1, 2)]
+    rng.shuffle(cells)
+    holes = set(map(tuple, cells[:int(rng.integers(0, 7))]))
+    idx = lambda i, j: i * (m + 1) + j  # noqa: E731
+    t = []
+    for i in range(n):
+        for j in range(m):
+            if (i, j) in holes:
+                continue
+            a, b, c, d = idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)
+            t += [(a, b, c), (a, c, d)] if rng.random() < 0.5 else [(a, b, d), (b, c, d)]
+    return p, np.array(t)
+
+
+def icosphere(rng):
+    """An icosahedron subdivided 0..2 times, radially jittered: a sphere."""
+    from meshgen import icosphere as sphere
+    p, t = sphere(int(rng.integers(0, 3)))
+    return p * rng.uniform(0.8, 1.2, size=(len(p), 1)), t
+
+
+KINDS = (hull, torus, grid_with_holes, icosphere)
+
+
+def random_manifold(seed):
+    """1..4 random surfaces side by side, vertices and triangles shuffled, corners rotated."""
+    rng = np.random.default_rng(seed)
+    parts = [KINDS[int(rng.integers(len(KINDS)))](rng) for _ in range(int(rng.integers(1, 5)))]
+    points, triangles, offset = [], [], 0
+    for k, (p, t) in enumerate(parts):
+        points.append(p + np.array([k * 50.0, 0, 0]))
+        triangles.append(t + offset)
+        offset += len(p)
+    p, t = np.concatenate(points), np.concatenate(triangles)
+    order = rng.permutation(len(p))
+    inverse = np.empty_like(order)
+    inverse[order] = np.arange(len(p))
+    p, t = p[order], inverse[t]
+    t = t[rng.permutation(len(t))]
+    roll = rng.integers(0, 3, len(t))
+    t = np.stack([t[np.arange(len(t)), (roll + j) % 3] for j in range(3)], 1)
+    return p, t.astype(np.int32)
+
+
+# --- the independent check ------------------------------------------------------------------
+
+def _components(n, a, b):
+    """Component label (the smallest member) of each of n nodes joined by edges (a, b): hooking
+    and pointer jumping in numpy (scipy's graph set-up costs more than the work on small meshes)."""
+    label = np.arange(n)
+    a, b = np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64)
+    while len(a):
+        la, lb = label[a], label[b]
+        differ = la != lb
+        if not differ.any():
+            break
+        la, lb = la[differ], lb[differ]
+        np.minimum.at(label, np.maximum(la, lb), np.minimum(la, lb))
+        while True:
+            jumped = label[label]
+            if np.array_equal(jumped, label):
+                break
+            label = jumped
+    return label
+
+
+def surface_facts(n, t):
+    """Per vertex its component (-1 if in no triangle), and per component: Euler
+    characteristic, boundary loops, manifold and oriented (bool)."""
+    t = np.asarray(t, dtype=np.int64).reshape(-1, 3)
+    m = len(t)
+    used = np.zeros(n, bool)
+    used[t.ravel()] = True
+    comp = _components(n, np.concatenate([t[:, 0], t[:, 1]]), np.concatenate([t[:, 1], t[:, 2]]))
+    labels = np.unique(comp[used])
+    comp = np.where(used, np.searchsorted(labels, comp), -1)
+    k = len(labels)
+    tail = np.concatenate([t[:, 0], t[:, 1], t[:, 2]])  # directed edge j*m+f: corner j -> j+1
+    head = np.concatenate([t[:, 1], t[:, 2], t[:, 0]])
+    directed_key = tail * n + head
+    low, high = np.minimum(tail, head), np.maximum(tail, head)
+    keys, edge_of, count = np.unique(low * n + high, return_inverse=True, return_counts=True)
+    edge_of = edge_of.ravel()
+    edges = np.stack([keys // n, keys % n], 1)
+    _, directed_count = np.unique(directed_key, return_counts=True)
+    # fans: corners (3 * f + j) joined across the edges at their vertex that have two triangles
+    corner_tail = np.concatenate([3 * np.arange(m), 3 * np.arange(m) + 1, 3 * np.arange(m) + 2])
+    corner_head = np.concatenate([3 * np.arange(m) + 1, 3 * np.arange(m) + 2, 3 * np.arange(m)])
+    order = np.argsort(edge_of, kind="stable")
+    two = order[count[edge_of[order]] == 2]
+    x, y = two[0::2], two[1::2]
+    same = tail[y] == tail[x]
+    ja = np.concatenate([corner_tail[x], corner_head[x]])
+    jb = np.concatenate([np.where(same, corner_tail[y], corner_head[y]), np.where(same, corner_head[y], corner_tail[y])])
+    fans = _components(3 * m, ja, jb)
+    corner_vertex = t.ravel()
+    pairs = np.unique(corner_vertex * (3 * m) + fans)
+    fans_at = np.bincount(pairs // (3 * m), minlength=n)
+    bad_vertex = fans_at > 1
+    bad_edge = count > 2
+    manifold = np.ones(k, bool)
+    manifold[comp[np.flatnonzero(bad_vertex)]] = False
+    manifold[comp[edges[bad_edge, 0]]] = False
+    oriented = np.ones(k, bool)
+    dkeys, dcount = np.unique(directed_key, return_counts=True)
+    oriented[comp[dkeys[dcount > 1] // n]] = False
+    euler = (np.bincount(comp[used], minlength=k) - np.bincount(comp[edges[:, 0]], minlength=k)
+             + np.bincount(comp[t[:, 0]], minlength=k))
+    boundary = edges[count == 1]
+    loops = np.zeros(k, int)
+    if len(boundary):
+        bcomp = _components(n, boundary[:, 0], boundary[:, 1])
+        on = np.unique(boundary.ravel())
+        roots = np.unique(comp[on] * n + bcomp[on])
+        loops = np.bincount(roots // n, minlength=k)
+    return dict(component=comp, components=k, euler=euler, loops=loops, manifold=manifold, oriented=oriented,
+                nonmanifold_edges=int(bad_edge.sum()), nonmanifold_vertices=int(bad_vertex.sum()),
+                inconsistent=int((directed_count > 1).sum()))
+
+
+def check_decimation(vertices, triangles, out_vertices, out_triangles, kept, before=None):
+    """Violations of the guarantees by a decimation of a manifold input, as a list of strings
+    (empty when every guarantee holds). before: surface_facts of the input, if known."""
+    problems = []
+    n = len(vertices)
+    if before is None:
+        before = surface_facts(n, triangles)
+    ot = np.asarray(out_triangles, dtype=np.int64).reshape(-1, 3)
+    if not np.isfinite(out_vertices).all():
+        problems.append("non-finite coordinates")
+    if len(ot) and ((ot[:, 0] == ot[:, 1]) | (ot[:, 1] == ot[:, 2]) | (ot[:, 2] == ot[:, 0])).any():
+        return problems + ["triangle with a repeated corner"]
+    st = np.sort(ot, axis=1)
+    nn = max(1, len(out_vertices))
+    if len(np.unique((st[:, 0] * nn + st[:, 1]) * nn + st[:, 2])) != len(ot):
+        problems.append("duplicate triangles")
+    after = surface_facts(len(out_vertices), ot)
+    if after["nonmanifold_edges"] or after["nonmanifold_vertices"]:
+        problems.append(f"non-manifold output ({after['nonmanifold_edges']} edges, "
+                        f"{after['nonmanifold_vertices']} vertices)")
+    if after["inconsistent"]:
+        problems.append(f"{after['inconsistent']} inconsistently oriented edges")
+    # map output components to input components through kept vertices
+    in_comp_of_out = before["component"][np.asarray(kept)]
+    if after["components"] != before["components"]:
+        problems.append(f"{before['components']} components became {after['components']}")
+        return problems
+    mapping = {}
+    for c in range(after["components"]):
+        members = np.unique(in_comp_of_out[after["component"] == c])
+        if len(members) != 1 or int(members[0]) in mapping.values():
+            problems.append("output components do not match the input's")
+            return problems
+        mapping[c] = int(members[0])
+    for c, ci in mapping.items():
+        if after["euler"][c] != before["euler"][ci]:
+            problems.append(f"component {ci}: Euler characteristic {before['euler'][ci]} -> {after['euler'][c]}")
+        if after["loops"][c] != before["loops"][ci]:
+            problems.append(f"component {ci}: boundary loops {before['loops'][ci]} -> {after['loops'][c]}")
+    return problems
