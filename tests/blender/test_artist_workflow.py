@@ -98,7 +98,7 @@ def test_greyed_out_buttons_say_why(ts, scene, operator, setup, message):
 
 def test_regenerate_after_a_source_edit_keeps_the_results_own_edits(ts, scene):
     obj = ball()
-    bpy.ops.topstoc.guided_decimate(ratio=0.2, seed=3)
+    bpy.ops.topstoc.guided_decimate(ratio=0.2, seed=3, quality="FAST")
     out = bpy.context.active_object
     first = positions(out.data).copy()
     material = bpy.data.materials.new("ArtistChoice")
@@ -127,7 +127,7 @@ def test_regenerate_after_a_source_edit_keeps_the_results_own_edits(ts, scene):
 def test_auto_regenerate_is_debounced(ts, scene):
     regenerate = ts.blender.regenerate
     obj = ball()
-    bpy.ops.topstoc.guided_decimate(ratio=0.2)
+    bpy.ops.topstoc.guided_decimate(ratio=0.2, quality="FAST")
     out = bpy.context.active_object
     out.topstoc.auto_regenerate = True
     co = positions(obj.data) * 1.5
@@ -181,8 +181,8 @@ def test_quality_choice_maps_onto_engine_options(ts, scene):
         bpy.ops.topstoc.guided_decimate(ratio=0.2, quality=quality)
         outputs[quality] = bpy.context.active_object
     parameters = json.loads(outputs["QUALITY"]["topstoc_parameters"])
-    assert parameters["placement"] == "filtered" and parameters["refine"] == 8
-    assert json.loads(outputs["FAST"]["topstoc_parameters"])["refine"] == 0
+    assert parameters["mode"] == "quality"
+    assert json.loads(outputs["FAST"]["topstoc_parameters"])["mode"] == "fast"
     fast, quality = (positions(outputs[q].data) for q in ("FAST", "QUALITY"))
     assert len(fast) != len(quality) or not np.array_equal(fast, quality)  # not the same run
 

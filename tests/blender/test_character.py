@@ -82,7 +82,7 @@ def test_shape_keys_and_rig_follow_the_source(ts, scene, output):
     body, rig = make_character()
     state = source_state(body)
     source_name = body.name
-    assert bpy.ops.topstoc.guided_decimate(ratio=0.3, output=output) == {"FINISHED"}
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.3, output=output, quality="FAST") == {"FINISHED"}
     out = bpy.context.active_object if output == "NEW_OBJECT" else bpy.data.objects[source_name]
     if output == "NEW_OBJECT":
         assert out is not body and body.hide_get()  # a rigged original is hidden, not moved
@@ -95,7 +95,7 @@ def test_shape_keys_and_rig_follow_the_source(ts, scene, output):
 
 def test_armature_deforms_the_result_like_the_source(ts, scene):
     body, rig = make_character()
-    assert bpy.ops.topstoc.guided_decimate(ratio=0.3, output="NEW_OBJECT") == {"FINISHED"}
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.3, output="NEW_OBJECT", quality="FAST") == {"FINISHED"}
     out = bpy.context.active_object
     kept = kept_ids(body.data, out.data)
     body.hide_set(False)  # hidden objects may be left out of the viewport's evaluation
@@ -130,7 +130,7 @@ def test_filtered_placement_moves_each_key_with_its_vertex(ts, scene):
 def test_lod_chain_carries_shape_keys(ts, scene):
     body, rig = make_character()
     state = source_state(body)
-    assert bpy.ops.topstoc.lod_chain(ratios="1.0, 0.4, 0.15") == {"FINISHED"}
+    assert bpy.ops.topstoc.lod_chain(ratios="1.0, 0.4, 0.15", quality="FAST") == {"FINISHED"}
     lods = [bpy.data.objects[f"Body_LOD{i}"] for i in range(3)]
     for lod in lods:
         lookup = {tuple(p): i for i, p in enumerate(state["co"].tolist())}
@@ -164,7 +164,7 @@ def test_blend_batch_keeps_shape_keys(ts, scene, tmp_path):
                    check=True, capture_output=True, timeout=120)
     out_dir = tmp_path / "out"
     done = subprocess.run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
-                           str(PACKAGE / "batch.py"), "--", "--input", str(source), "--ratio", "0.3",
+                           str(PACKAGE / "batch.py"), "--", "--input", str(source), "--ratio", "0.3", "--mode", "fast",
                            "--output", str(out_dir), "--json", str(tmp_path / "report.json")],
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
