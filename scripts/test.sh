@@ -1,7 +1,10 @@
 #!/bin/bash
 # Runs every test: C++ engine and Python API (plain python3), the add-on inside Debian's
-# Blender 3.4, the add-on as an extension in Blender 4.2+ (PyPI's bpy in .venv), and the real
-# GUI under Xvfb. Installs what is missing first. Exit code 0 only if every suite passed.
+# Blender 3.4 (legacy add-on) and as an extension in PyPI's bpy 4.2 (.venv), 4.5 LTS and 5.0
+# (CPython 3.11) and 5.2 LTS (CPython 3.13, in a Debian 13 root), and the real GUI under Xvfb in
+# Blender 3.4 and Debian 13's Blender 4.3. Installs what is missing first; the bpy venvs and the
+# Debian 13 root are cached outside the checkout in ${TOPSTOC_CACHE:-/var/cache/topstoc} (the
+# first run downloads ~2.5 GB). Prints each suite's time. Exit code 0 only if every suite passed.
 set -o pipefail
 source "$(dirname "$0")/common.sh"
 ensure_packages $RUNTIME_PACKAGES $TEST_PACKAGES || exit 1
@@ -28,11 +31,17 @@ if [ ! -x $VENV2/bin/python ] || ! $VENV2/bin/python -c "import numpy, scipy, gu
     echo "warning: could not prepare $VENV2; the NumPy 2 suite will fail" >&2
 fi
 
+# PyPI's bpy versions under test (pinned; the newest of each line when this was written).
+BPY_311=(4.5.15 5.0.1)   # Blender 4.5 LTS and 5.0: CPython 3.11, venvs on this host
+BPY_313=5.2.3            # Blender 5.2 LTS: CPython 3.13, which Debian 12 lacks: Debian 13 root
+CACHE=${TOPSTOC_CACHE:-/var/cache/topstoc}
+
 failed=()
 run() {  # run NAME COMMAND...
-  local name=$1; shift
+  local name=$1 start=$SECONDS; shift
   echo "== $name"
-  if "$@"; then echo "== $name: passed"; else echo "== $name: FAILED"; failed+=("$name"); fi
+  if "$@"; then echo "== $name: passed ($((SECONDS - start)) s)"
+  else echo "== $name: FAILED ($((SECONDS - start)) s)"; failed+=("$name"); fi
 }
 PYTEST_ARGS=(-q -p no:cacheprovider)
 run "engine and Python API (python3 + pymeshlab)" $VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/python
@@ -42,9 +51,31 @@ if [ -d tests/blender ]; then
     blender -b --factory-startup --python-exit-code 1 --python-expr \
     "import sys, pytest; sys.exit(pytest.main(['-q', '-p', 'no:cacheprovider', 'tests/blender']))"
   run "add-on as an extension in Blender 4.2 (bpy)" env TOPSTOC_BPY=1 $VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/blender
+  for version in "${BPY_311[@]}"; do
+    venv=$CACHE/venvs/bpy-$version
+    if scripts/bpy_venv.sh "$venv" "$version" /usr/bin/python3; then
+      run "add-on as an extension in Blender $version (bpy)" env TOPSTOC_BPY=1 $venv/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/blender
+    else
+      failed+=("bpy $version venv")
+    fi
+  done
 fi
 if [ -d tests/gui ]; then
   run "real Blender GUI under Xvfb" $VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/gui
+fi
+
+# Debian 13 root (made once, cached): CPython 3.13 for bpy 5.2 and a real Blender 4.3 for the GUI.
+# Toolchain, the cp313 test build (build-trixie/) and the venv go into the root's "test" layer.
+IN_ROOT=(env TOPSTOC_ROOT_LAYER=test scripts/debian13_root.sh run)
+echo "== preparing the Debian 13 root (toolchain, cp313 build, bpy $BPY_313)"
+if "${IN_ROOT[@]}" "scripts/debian13_prepare.sh $BPY_313"; then
+  ROOT_PYTHON=/opt/venvs/bpy-$BPY_313/bin/python
+  [ -d tests/blender ] && run "add-on as an extension in Blender $BPY_313 (bpy, CPython 3.13, Debian 13 root)" \
+    "${IN_ROOT[@]}" "TOPSTOC_BPY=1 TOPSTOC_BUILD=/opt/project/build-trixie $ROOT_PYTHON -m pytest ${PYTEST_ARGS[*]} tests/blender"
+  [ -d tests/gui ] && run "real Blender 4.3 GUI under Xvfb (Debian 13 root)" \
+    "${IN_ROOT[@]}" "TOPSTOC_BLENDER=/usr/bin/blender TOPSTOC_BUILD=/opt/project/build-trixie $ROOT_PYTHON -m pytest ${PYTEST_ARGS[*]} tests/gui"
+else
+  failed+=("Debian 13 root")
 fi
 
 if [ ${#failed[@]} -gt 0 ]; then
