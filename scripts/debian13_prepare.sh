@@ -7,6 +7,8 @@ set -u
 source "$(dirname "$0")/common.sh"
 BPY_313=${1:?usage: debian13_prepare.sh BPY_VERSION}
 export CCACHE_DIR=/var/cache/ccache
-ensure_packages cmake make g++ ccache pybind11-dev libopenmesh-dev libtet1.5-dev libphat-dev || exit 1
+# python3-numpy: Debian 13's own Blender 4.3 (GUI suite) runs the system CPython 3.13, and a
+# minimal root does not have numpy, which the add-on needs.
+ensure_packages cmake make g++ ccache pybind11-dev libopenmesh-dev libtet1.5-dev libphat-dev python3-numpy || exit 1
 build build-trixie -DTOPSTOC_PEERS=OFF || exit 1
 scripts/bpy_venv.sh "/opt/venvs/bpy-$BPY_313" "$BPY_313" /usr/bin/python3

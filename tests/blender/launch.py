@@ -59,7 +59,7 @@ def background(script=None, *args, expr=None, timeout=300, env=None) -> subproce
 def windowed(script, *options, timeout=300, env=None) -> subprocess.CompletedProcess:
     """Runs ``script`` in a windowed Blender under Xvfb (skips where there is no window to open)."""
     if IS_MODULE:
-        pytest.skip("PyPI's bpy is a module without a window; needs a Blender binary (runs under 3.4 and 4.3)")
+        pytest.skip("PyPI's bpy is a module without a window; runs in the suite under a Blender binary (Debian's 3.4)")
     if XVFB is None:
         pytest.skip("needs xvfb-run")
     command = [XVFB, "-a", BINARY, "--factory-startup", *options, "--python", str(script)]
