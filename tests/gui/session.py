@@ -157,7 +157,8 @@ def _view_pixels():
     def capture():
         x, y, width, height = gpu.state.viewport_get()
         buffer = gpu.state.active_framebuffer_get().read_color(x, y, width, height, 4, 0, "FLOAT")
-        captured.append(np.asarray(buffer, dtype=np.float32).reshape(height, width, 4))
+        # to_list: the Buffer's array interface reports reversed strides in Blender 4.3
+        captured.append(np.array(buffer.to_list(), dtype=np.float32).reshape(height, width, 4))
 
     handler = bpy.types.SpaceView3D.draw_handler_add(capture, (), "WINDOW", "POST_PIXEL")
     try:
@@ -177,6 +178,7 @@ def shot(name, objects=()):
     """Screenshot of the whole window -> OUT/name.png and OUT/name.npy; records object rects."""
     path = os.path.join(OUT, name + ".png")
     if bpy.app.version >= (4, 0, 0):
+        report["values"]["capture"] = "view framebuffer"
         pixels = _view_pixels()
         image = bpy.data.images.new(name, pixels.shape[1], pixels.shape[0], alpha=True)
         image.pixels.foreach_set(pixels.ravel())
