@@ -24,15 +24,29 @@ IS_MODULE = BINARY is None
 XVFB = shutil.which("xvfb-run")
 _KEPT = ("PATH", "HOME", "LANG", "LC_ALL", "TMPDIR", "USER", "LOGNAME")
 
-# Runs argv[1] (a file) or argv[2] (code, when argv[1] is "-") as `blender -b` would.
-_MODULE_MAIN = """import runpy, sys
+# Runs argv[1] (a file) or argv[2] (code, when argv[1] is empty) as `blender -b --python-exit-code 1`
+# would, then leaves with os._exit: bpy 4.5's module deadlocks in interpreter shutdown after a script
+# that used it (seen with batch.py: outputs written, then every thread waiting on a futex).
+_MODULE_MAIN = """import os, runpy, sys, traceback
 script, code = sys.argv[1], sys.argv[2]
 sys.argv = ["blender", "-b", "--python", script or "-"] + sys.argv[3:]
 import bpy
-if script:
-    runpy.run_path(script, run_name="__main__")
-else:
-    exec(compile(code, "<python-expr>", "exec"), {"__name__": "__main__"})
+status = 0
+try:
+    if script:
+        runpy.run_path(script, run_name="__main__")
+    else:
+        exec(compile(code, "<python-expr>", "exec"), {"__name__": "__main__"})
+except SystemExit as done:
+    if isinstance(done.code, str):
+        print(done.code, file=sys.stderr)
+    status = done.code if isinstance(done.code, int) else int(done.code is not None)
+except BaseException:
+    traceback.print_exc()
+    status = 1
+sys.stdout.flush()
+sys.stderr.flush()
+os._exit(status)
 """
 
 
