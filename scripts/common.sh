@@ -28,15 +28,17 @@ ensure_packages() {
     as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}" >/dev/null
 }
 
-# Builds the module against /usr/bin/python3 and stages build/python/topstoc.
+# Builds the module against /usr/bin/python3 and stages DIR/python/topstoc: build [DIR [CMAKE_ARGS...]]
+# (DIR defaults to build; the Debian 13 root builds its CPython 3.13 module into build-trixie).
 build() {
-  echo "== building (cmake -S . -B build && cmake --build build)"
-  mkdir -p build
+  local dir=${1:-build}; [ $# -gt 0 ] && shift
+  echo "== building (cmake -S . -B $dir && cmake --build $dir)"
+  mkdir -p "$dir"
   local launcher=()  # ccache, when installed, makes rebuilds in other clones cheap
   command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-  /usr/bin/cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" >build/configure.log 2>&1 ||
-    { cat build/configure.log; return 1; }
-  /usr/bin/cmake --build build -j"$(nproc)" >build/build.log 2>&1 ||
-    { grep -E -B2 -A6 "error" build/build.log | head -60; return 1; }
-  test -f build/python/topstoc/__init__.py && ls build/python/topstoc/_topstoc*.so >/dev/null
+  /usr/bin/cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "$@" >"$dir/configure.log" 2>&1 ||
+    { cat "$dir/configure.log"; return 1; }
+  /usr/bin/cmake --build "$dir" -j"$(nproc)" >"$dir/build.log" 2>&1 ||
+    { grep -E -B2 -A6 "error" "$dir/build.log" | head -60; return 1; }
+  test -f "$dir/python/topstoc/__init__.py" && ls "$dir"/python/topstoc/_topstoc*.so >/dev/null
 }

@@ -31,19 +31,28 @@ make_root() {
   mv "$tmp" "$ROOTFS"
 }
 
-# Runs a command inside the root with /proc, /sys, /dev and this checkout mounted.
+# Runs a command inside the root with /proc, /sys, /dev and this checkout mounted. The mounts live
+# in a private mount namespace (unshare), so runs from several checkouts at once neither see nor
+# unmount each other's /opt/project, and nothing stays mounted when the command ends.
+# With TOPSTOC_ROOT_LAYER=NAME the root is seen through a writable overlay kept in
+# $CACHE/trixie-NAME: what that run installs (compilers, -dev libraries, venvs) stays in the layer
+# and the base root keeps none of the build's libraries (the install tests need such a root).
 run_in_root() {
   local project; project=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-  local mounts=(proc sys dev dev/pts opt/project)
-  mkdir -p "$ROOTFS/opt/project"
-  mount -t proc proc "$ROOTFS/proc"; mount -t sysfs sys "$ROOTFS/sys"
-  mount --bind /dev "$ROOTFS/dev"; mount --bind /dev/pts "$ROOTFS/dev/pts"
-  mount --bind "$project" "$ROOTFS/opt/project"
-  chroot "$ROOTFS" /usr/bin/env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
-    LANG=C.UTF-8 /bin/bash -c "cd /opt/project && $*"
-  local rc=$?
-  for ((i=${#mounts[@]}-1; i>=0; i--)); do umount -l "$ROOTFS/${mounts[$i]}" 2>/dev/null; done
-  return $rc
+  local layer=""
+  [ -n "${TOPSTOC_ROOT_LAYER:-}" ] && layer=$CACHE/trixie-$TOPSTOC_ROOT_LAYER
+  mkdir -p "$ROOTFS/opt/project" ${layer:+"$layer/upper" "$layer/work" "$layer/merged"}
+  ROOTFS=$ROOTFS LAYER=$layer PROJECT=$project unshare --mount --propagation private /bin/bash -c '
+    root=$ROOTFS
+    if [ -n "$LAYER" ]; then
+      mount -t overlay overlay -o "lowerdir=$ROOTFS,upperdir=$LAYER/upper,workdir=$LAYER/work" \
+        "$LAYER/merged" || exit 1
+      root=$LAYER/merged
+    fi
+    mount -t proc proc "$root/proc" && mount -t sysfs sys "$root/sys" &&
+    mount --rbind /dev "$root/dev" && mount --bind "$PROJECT" "$root/opt/project" || exit 1
+    exec chroot "$root" /usr/bin/env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
+      LANG=C.UTF-8 /bin/bash -c "cd /opt/project && $1"' _ "$*"
 }
 
 [ -d "$ROOTFS" ] || make_root || exit 1

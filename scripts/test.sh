@@ -1,7 +1,12 @@
 #!/bin/bash
-# Runs every test: C++ engine (tests/native, ctest), Python API (plain python3), the add-on inside Debian's
-# Blender 3.4, the add-on as an extension in Blender 4.2+ (PyPI's bpy in .venv), and the real
-# GUI under Xvfb. Installs what is missing first. Exit code 0 only if every suite passed.
+# Runs every test: the C++ engine (tests/native, ctest), the Python API (plain python3 and NumPy 2),
+# the batch on Dask, a short fuzzing pass, the add-on inside Debian's Blender 3.4 (legacy add-on)
+# and as an extension in PyPI's bpy 4.2 (.venv), 4.5 LTS and 5.0 (CPython 3.11) and 5.2 LTS
+# (CPython 3.13, in a Debian 13 root), the real GUI under Xvfb in Blender 3.4 and Debian 13's
+# Blender 4.3, and (as root) the release wheels and extension installed in bare roots. Installs
+# what is missing first; the bpy venvs, the pipeline venv and the Debian roots are cached outside
+# the checkout in ${TOPSTOC_CACHE:-/var/cache/topstoc} (the first run downloads ~3 GB). Prints each
+# suite's time. Exit code 0 only if every suite passed.
 set -o pipefail
 source "$(dirname "$0")/common.sh"
 ensure_packages $RUNTIME_PACKAGES $TEST_PACKAGES || exit 1
@@ -39,11 +44,17 @@ if [ ! -x $PIPELINE_VENV/bin/python ] || ! $PIPELINE_VENV/bin/python -c "import 
     echo "warning: could not prepare $PIPELINE_VENV; the pipeline suite will fail" >&2
 fi
 
+# PyPI's bpy versions under test (pinned; the newest of each line when this was written).
+BPY_311=(4.5.15 5.0.1)   # Blender 4.5 LTS and 5.0: CPython 3.11, venvs on this host
+BPY_313=5.2.3            # Blender 5.2 LTS: CPython 3.13, which Debian 12 lacks: Debian 13 root
+CACHE=${TOPSTOC_CACHE:-/var/cache/topstoc}
+
 failed=()
 run() {  # run NAME COMMAND...
-  local name=$1; shift
+  local name=$1 start=$SECONDS; shift
   echo "== $name"
-  if "$@"; then echo "== $name: passed"; else echo "== $name: FAILED"; failed+=("$name"); fi
+  if "$@"; then echo "== $name: passed ($((SECONDS - start)) s)"
+  else echo "== $name: FAILED ($((SECONDS - start)) s)"; failed+=("$name"); fi
 }
 PYTEST_ARGS=(-q -p no:cacheprovider)
 run "C++ engine (doctest, ctest)" /usr/bin/ctest --test-dir build --output-on-failure
@@ -59,9 +70,33 @@ if [ -d tests/blender ]; then
     blender -b --factory-startup --python-exit-code 1 --python-expr \
     "import sys, pytest; sys.exit(pytest.main(['-q', '-p', 'no:cacheprovider', 'tests/blender']))"
   run "add-on as an extension in Blender 4.2 (bpy)" env TOPSTOC_BPY=1 $VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/blender
+  for version in "${BPY_311[@]}"; do
+    venv=$CACHE/venvs/bpy-$version
+    if scripts/bpy_venv.sh "$venv" "$version" /usr/bin/python3; then
+      run "add-on as an extension in Blender $version (bpy)" env TOPSTOC_BPY=1 $venv/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/blender
+    else
+      failed+=("bpy $version venv")
+    fi
+  done
 fi
 if [ -d tests/gui ]; then
   run "real Blender GUI under Xvfb" $VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/gui
+fi
+
+# Debian 13 root (made once, cached): CPython 3.13 for bpy 5.2 and a real Blender 4.3 for the GUI.
+# Toolchain, the cp313 test build (build-trixie/) and the venv go into the root's "test" layer.
+IN_ROOT=(env TOPSTOC_ROOT_LAYER=test scripts/debian13_root.sh run)
+if [ "$(id -u)" != 0 ]; then
+  echo "== skipped: bpy $BPY_313 and Blender 4.3 suites (the Debian 13 root needs root: run as root)"
+elif echo "== preparing the Debian 13 root (toolchain, cp313 build, bpy $BPY_313)" &&
+     "${IN_ROOT[@]}" "scripts/debian13_prepare.sh $BPY_313"; then
+  ROOT_PYTHON=/opt/venvs/bpy-$BPY_313/bin/python
+  [ -d tests/blender ] && run "add-on as an extension in Blender $BPY_313 (bpy, CPython 3.13, Debian 13 root)" \
+    "${IN_ROOT[@]}" "TOPSTOC_BPY=1 TOPSTOC_BUILD=/opt/project/build-trixie $ROOT_PYTHON -m pytest ${PYTEST_ARGS[*]} tests/blender"
+  [ -d tests/gui ] && run "real Blender 4.3 GUI under Xvfb (Debian 13 root)" \
+    "${IN_ROOT[@]}" "TOPSTOC_BLENDER=/usr/bin/blender TOPSTOC_BUILD=/opt/project/build-trixie $ROOT_PYTHON -m pytest ${PYTEST_ARGS[*]} tests/gui"
+else
+  failed+=("Debian 13 root")
 fi
 
 # The release files as users get them (root only: the roots are entered with chroot): the wheels

@@ -138,7 +138,7 @@ def _fill_polygons(mesh, layout: PolygonLayout, loose_edges: np.ndarray) -> None
         mesh.polygons.foreach_set("loop_start", layout.loop_start.astype(np.int32))
         if bpy.app.version < (4, 0, 0):
             mesh.polygons.foreach_set("loop_total", layout.loop_total.astype(np.int32))
-    mesh.update(calc_edges=True)
+    mesh_io.calc_edges(mesh)
 
 
 def _gather(values: np.ndarray, source: np.ndarray) -> np.ndarray:
@@ -196,12 +196,12 @@ def _edge_sources(old_mesh, new_mesh, vertex_source: np.ndarray) -> np.ndarray:
     return np.where(found, order[position], -1)
 
 
-def _copy_flags(collection_old, collection_new, names, source: np.ndarray) -> None:
+def _copy_flags(collection_old, collection_new, names, source: np.ndarray, unreadable=()) -> None:
     if len(collection_new) == 0 or len(collection_old) == 0:
         return
     element = collection_old[0]
     for name in names:
-        if not hasattr(element, name):
+        if not hasattr(element, name) or name in unreadable:
             continue
         value = getattr(element, name)
         dtype = bool if isinstance(value, bool) else np.float32
@@ -278,7 +278,7 @@ def build_edited_mesh(old, arrays: mesh_io.MeshArrays, result, new) -> bpy.types
 
     edge_source = _edge_sources(old, new, layout.vertex_source)
     _copy_flags(old.vertices, new.vertices, _VERTEX_FLAGS, layout.vertex_source)
-    _copy_flags(old.edges, new.edges, _EDGE_FLAGS, edge_source)
+    _copy_flags(old.edges, new.edges, _EDGE_FLAGS, edge_source, unreadable=mesh_io.mistyped_edge_flags(old))
     _copy_flags(old.polygons, new.polygons, _POLYGON_FLAGS, polygon_source)
     _copy_attributes(old, new, layout, result, edge_source, uv_names)
     colors = old.color_attributes

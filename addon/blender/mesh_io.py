@@ -197,7 +197,38 @@ def fill_geometry(mesh: bpy.types.Mesh, vertices: np.ndarray, triangles: np.ndar
             mesh.edges.add(len(edges))
             _set_int_field(mesh, ".edge_verts", mesh.edges, "vertices", edges.vertices)
             _set_int_field(mesh, ".corner_edge", mesh.loops, "edge_index", edges.corner_edge)
-    mesh.update(calc_edges=m > 0 and edges is None)
+    calc_edges(mesh, m > 0 and edges is None)
+
+
+# Edge flags (MeshEdge properties) Blender keeps as edge attributes, with the type each must have.
+_EDGE_FLAG_ATTRIBUTES = {"select": (".select_edge", "BOOLEAN"), "hide": (".hide_edge", "BOOLEAN"),
+                         "use_seam": (".uv_seam", "BOOLEAN"), "use_edge_sharp": ("sharp_edge", "BOOLEAN"),
+                         "use_freestyle_mark": ("freestyle_edge", "BOOLEAN"),
+                         "crease": ("crease_edge", "FLOAT"), "bevel_weight": ("bevel_weight_edge", "FLOAT")}
+
+
+def mistyped_edge_flags(mesh: bpy.types.Mesh) -> dict:
+    """{edge flag: its attribute} for flags whose attribute has the wrong domain or type.
+
+    Blender 5.0.x's edge pass (``update(calc_edges=True)``, ``from_pydata``) gives ``.select_edge``
+    the type of ``.edge_verts`` (INT32_2D): reading ``MeshEdge.select`` then gives garbage and
+    writing it crashes Blender. Such flags are neither read nor written.
+    """
+    found = {}
+    for flag, (name, data_type) in _EDGE_FLAG_ATTRIBUTES.items():
+        attribute = mesh.attributes.get(name)
+        if attribute is not None and (attribute.domain != "EDGE" or attribute.data_type != data_type):
+            found[flag] = attribute
+    return found
+
+
+def calc_edges(mesh: bpy.types.Mesh, calc: bool = True) -> None:
+    """``mesh.update(calc_edges=calc)``, then removes edge-flag attributes it left mistyped (see
+    :func:`mistyped_edge_flags`). Nothing is lost: fresh edges carry no flags, and a later write
+    creates the attribute with the right type."""
+    mesh.update(calc_edges=calc)
+    for attribute in mistyped_edge_flags(mesh).values():
+        mesh.attributes.remove(attribute)
 
 
 def _set_int_field(mesh, attribute: str, collection, key: str, values: np.ndarray) -> None:

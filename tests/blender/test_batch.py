@@ -4,23 +4,18 @@ outputs that really are decimated."""
 import importlib
 import importlib.util
 import json
-import shutil
-import subprocess
 
 import bpy
 import numpy as np
 import pytest
 
 from conftest import DATA, PACKAGE
-
-BLENDER = shutil.which("blender")
-pytestmark = pytest.mark.skipif(BLENDER is None, reason="no blender executable on PATH")
+from launch import background
 
 
 def batch(*args, timeout=300):
-    command = [BLENDER, "-b", "--factory-startup", "--python-exit-code", "1",
-               "--python", str(PACKAGE / "batch.py"), "--", *map(str, args)]
-    return subprocess.run(command, capture_output=True, text=True, timeout=timeout)
+    """The batch command in the Blender under test (see launch.py)."""
+    return background(PACKAGE / "batch.py", *args, timeout=timeout)
 
 
 def has_io(ts):
@@ -45,9 +40,8 @@ bpy.ops.wm.save_as_mainfile(filepath={path!r})
 def blend_file(ts, scene, tmp_path):
     """A .blend with two mesh objects, written by the same Blender that runs the batch."""
     path = tmp_path / "scene.blend"
-    code = MAKE_SCENE.format(tests=str(DATA.parent), path=str(path))
-    subprocess.run([BLENDER, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr", code],
-                   check=True, capture_output=True, timeout=120)
+    done = background(expr=MAKE_SCENE.format(tests=str(DATA.parent), path=str(path)), timeout=120)
+    assert done.returncode == 0 and path.exists(), done.stdout[-2000:] + done.stderr[-2000:]
     return path
 
 

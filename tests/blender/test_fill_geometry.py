@@ -95,3 +95,32 @@ def test_small_empty_and_degenerate_input(ts, scene):
     degenerate = bpy.data.meshes.new("degenerate")
     ts.blender.mesh_io.fill_geometry(degenerate, vertices, np.array([[0, 1, 2], [1, 3, 3]], dtype=np.int32))
     assert len(degenerate.polygons) == 2 and len(degenerate.edges) >= 3
+
+
+def test_edge_flags_writable_after_blenders_edge_pass(ts):
+    """Blender 5.0.x's edge pass leaves ``.select_edge`` typed INT32_2D and writing
+    ``MeshEdge.select`` then crashes; mesh_io.calc_edges removes such a layer, so the flag
+    copy after an edit (mesh_edit) writes and reads back the flags it was given."""
+    vertices, triangles = meshgen.icosphere(1)
+    mesh = bpy.data.meshes.new("flags")
+    m = len(triangles)
+    mesh.vertices.add(len(vertices))
+    mesh.loops.add(3 * m)
+    mesh.polygons.add(m)
+    mesh.vertices.foreach_set("co", vertices.astype(np.float32).ravel())
+    mesh.loops.foreach_set("vertex_index", triangles.astype(np.int32).ravel())
+    mesh.polygons.foreach_set("loop_start", np.arange(0, 3 * m, 3, dtype=np.int32))
+    if bpy.app.version < (4, 0, 0):
+        mesh.polygons.foreach_set("loop_total", np.full(m, 3, dtype=np.int32))
+    ts.blender.mesh_io.calc_edges(mesh)
+    for attribute in mesh.attributes:
+        if attribute.name in (".select_edge", ".hide_edge", "sharp_edge"):
+            assert (attribute.domain, attribute.data_type) == ("EDGE", "BOOLEAN"), attribute.name
+    flags = np.arange(len(mesh.edges)) % 3 == 0
+    for name in ("select", "hide", "use_edge_sharp"):
+        mesh.edges.foreach_set(name, flags)
+        read = np.zeros(len(mesh.edges), dtype=bool)
+        mesh.edges.foreach_get(name, read)
+        np.testing.assert_array_equal(read, flags)
+    assert mesh.validate() is False  # nothing to correct
+    bpy.data.meshes.remove(mesh)

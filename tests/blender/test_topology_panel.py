@@ -434,3 +434,37 @@ def test_loops_through_quad_diagonals_cut_and_remove(mods, scene):
             assert sorted(tuple(uv[i].uv) for i in poly.loop_indices) == uv_before[key]
             kept += 1
     assert kept >= 20 * 10 - 2 * 20 - 2
+
+
+def test_edit_on_a_from_pydata_mesh_keeps_edge_flags(mods, scene):
+    """A mesh made by a script (from_pydata, left as Blender makes it: in 5.0.x with a mistyped
+    ``.select_edge``) is edited in place without crashing; seams and sharp edges carry over, the
+    mistyped selection is not read, and the result's edge flags are writable."""
+    vertices, faces = meshgen.torus(16, 8)
+    mesh = bpy.data.meshes.new("Scripted")
+    mesh.from_pydata(vertices.tolist(), [], faces.tolist())
+    obj = bpy.data.objects.new("Scripted", mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    select_only(obj)
+    pairs = np.sort(np.array([e.vertices[:] for e in mesh.edges]), axis=1)
+    marked = np.arange(len(mesh.edges)) % 4 == 0
+    mesh.edges.foreach_set("use_seam", marked)
+    mesh.edges.foreach_set("use_edge_sharp", marked)
+    marked_pairs = {tuple(p) for p in pairs[marked].tolist()}
+    readable = "select" not in mods.mesh_edit.mesh_io.mistyped_edge_flags(mesh)
+    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), dtype=bool))
+    mesh.polygons[3].select = True
+    assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
+    out = obj.data
+    assert len(out.polygons) == len(faces) - 1
+    assert mods.mesh_edit.mesh_io.mistyped_edge_flags(out) == {}
+    out_pairs = [tuple(sorted(e.vertices[:])) for e in out.edges]
+    # delete_faces keeps every vertex (same ids), so edges are compared by their vertex pairs
+    assert {p for p, e in zip(out_pairs, out.edges) if e.use_seam} == marked_pairs
+    assert {p for p, e in zip(out_pairs, out.edges) if e.use_edge_sharp} == marked_pairs
+    flags = np.arange(len(out.edges)) % 3 == 0
+    out.edges.foreach_set("select", flags)
+    read = np.zeros(len(out.edges), dtype=bool)
+    out.edges.foreach_get("select", read)
+    np.testing.assert_array_equal(read, flags)
+    print("edge selection readable on the input:", readable)

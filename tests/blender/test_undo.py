@@ -1,23 +1,14 @@
 """Undo restores in-place results (runs a windowed Blender under Xvfb: undo needs a window)."""
 
 import os
-import shutil
-import subprocess
-
-import pytest
 
 from conftest import BUILD
-
-XVFB = shutil.which("xvfb-run")
-BLENDER = shutil.which("blender")
+from launch import clean_environment, windowed
 
 
-@pytest.mark.skipif(XVFB is None or BLENDER is None, reason="needs xvfb-run and a blender executable")
 def test_undo_and_redo_in_a_window(ts):
     script = os.path.join(os.path.dirname(__file__), "undo_script.py")
-    env = dict(os.environ, TOPSTOC_BUILD_PYTHON=str(BUILD / "python"))
-    done = subprocess.run([XVFB, "-a", BLENDER, "--factory-startup", "--python", script],
-                          capture_output=True, text=True, timeout=300, env=env)
+    done = windowed(script, env=clean_environment(TOPSTOC_BUILD_PYTHON=BUILD / "python"))
     lines = [line for line in done.stdout.splitlines() if line.startswith("undo check")]
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
     assert len(lines) == 5 and all(line.endswith(": ok") for line in lines), lines

@@ -4,6 +4,10 @@ The tests themselves run in plain Python (no bpy): they read the script's report
 screenshots' pixels (.npy) and check colours in the objects' screen regions.
 
     python -m pytest tests/gui        # needs xvfb-run, blender and a build (skips otherwise)
+    TOPSTOC_BLENDER=/path/to/blender TOPSTOC_BUILD=build-trixie python -m pytest tests/gui
+
+TOPSTOC_BLENDER picks the Blender binary (default: `blender` on PATH); TOPSTOC_BUILD the staged
+build whose module that Blender's Python can load (build-trixie for Debian 13's Blender 4.3).
 """
 
 import json
@@ -19,11 +23,15 @@ BUILD = pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build"))
 DATA = ROOT / "tests" / "data"
 HERE = pathlib.Path(__file__).resolve().parent
 XVFB = shutil.which("xvfb-run")
-BLENDER = shutil.which("blender")
+BLENDER = shutil.which(os.environ.get("TOPSTOC_BLENDER", "blender"))
+_KEPT = ("PATH", "HOME", "LANG", "LC_ALL", "TMPDIR", "USER", "LOGNAME", "TOPSTOC_DOC_SHOTS")
 
 
 def _environment():
-    return dict(os.environ, TOPSTOC_BUILD_PYTHON=str(BUILD / "python"), PYTHONPATH="")
+    """A clean environment for Blender: nothing of this process's (OCIO, PYTHONPATH, BLENDER_*)."""
+    env = {key: os.environ[key] for key in _KEPT if key in os.environ}
+    env["TOPSTOC_BUILD_PYTHON"] = str(BUILD / "python")
+    return env
 
 
 @pytest.fixture(scope="session")

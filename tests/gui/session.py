@@ -145,17 +145,56 @@ def view_rect():
     return [region.x, region.y, region.x + region.width, region.y + region.height]
 
 
+def _view_pixels():
+    """(window height, width, 4) RGBA of the window with the 3D view's pixels in place, read from
+    the view's framebuffer in a draw handler (Blender 4.x: screen.screenshot reads the front
+    buffer, which is black under Xvfb). Only the 3D view is filled: every check looks there."""
+    import gpu
+
+    window, area, region, _space = view3d()
+    captured = []
+
+    def capture():
+        x, y, width, height = gpu.state.viewport_get()
+        buffer = gpu.state.active_framebuffer_get().read_color(x, y, width, height, 4, 0, "FLOAT")
+        # to_list: the Buffer's array interface reports reversed strides in Blender 4.3
+        captured.append(np.array(buffer.to_list(), dtype=np.float32).reshape(height, width, 4))
+
+    handler = bpy.types.SpaceView3D.draw_handler_add(capture, (), "WINDOW", "POST_PIXEL")
+    try:
+        with bpy.context.temp_override(window=window, area=area, region=region):
+            bpy.ops.wm.redraw_timer(type="DRAW", iterations=1)
+    finally:
+        bpy.types.SpaceView3D.draw_handler_remove(handler, "WINDOW")
+    if not captured:
+        raise RuntimeError("the 3D view was not drawn for the screenshot")
+    pixels = np.zeros((window.height, window.width, 4), dtype=np.float32)
+    view = captured[-1][:region.height, :region.width]
+    pixels[region.y:region.y + view.shape[0], region.x:region.x + view.shape[1]] = view
+    return pixels
+
+
 def shot(name, objects=()):
     """Screenshot of the whole window -> OUT/name.png and OUT/name.npy; records object rects."""
     path = os.path.join(OUT, name + ".png")
-    window, area, region, _space = view3d()
-    with bpy.context.temp_override(window=window, area=area, region=region):
-        bpy.ops.screen.screenshot(filepath=path)
-    image = bpy.data.images.load(path)
-    pixels = np.empty(image.size[0] * image.size[1] * 4, dtype=np.float32)
-    image.pixels.foreach_get(pixels)
-    np.save(os.path.join(OUT, name + ".npy"), pixels.reshape(image.size[1], image.size[0], 4))
-    bpy.data.images.remove(image)
+    if bpy.app.version >= (4, 0, 0):
+        report["values"]["capture"] = "view framebuffer"
+        pixels = _view_pixels()
+        image = bpy.data.images.new(name, pixels.shape[1], pixels.shape[0], alpha=True)
+        image.pixels.foreach_set(pixels.ravel())
+        image.filepath_raw, image.file_format = path, "PNG"
+        image.save()
+        bpy.data.images.remove(image)
+        np.save(os.path.join(OUT, name + ".npy"), pixels)
+    else:
+        window, area, region, _space = view3d()
+        with bpy.context.temp_override(window=window, area=area, region=region):
+            bpy.ops.screen.screenshot(filepath=path)
+        image = bpy.data.images.load(path)
+        pixels = np.empty(image.size[0] * image.size[1] * 4, dtype=np.float32)
+        image.pixels.foreach_get(pixels)
+        np.save(os.path.join(OUT, name + ".npy"), pixels.reshape(image.size[1], image.size[0], 4))
+        bpy.data.images.remove(image)
     report["shots"][name] = path
     report["regions"][name] = {"view": view_rect(), **{o.name: screen_rect(o) for o in objects}}
 

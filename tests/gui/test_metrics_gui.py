@@ -59,6 +59,9 @@ def test_legend_shows_with_the_error_colours(report):
 
 
 def test_colour_attribute_shows_errors_without_the_overlay(report):
+    if report["values"].get("capture") == "view framebuffer":
+        pytest.skip("Blender 4.x capture (the 3D view's framebuffer read in a draw handler) holds the "
+                    "overlays but not the solid-mode shading of meshes; checked in Blender 3.4")
     shot = image(report, "error_attribute")
     rect = report["regions"]["error_attribute"]["Dragon_TopStoc"]
     # Solid mode shades the attribute colours, so compare hue classes rather than exact colours:
