@@ -325,8 +325,15 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       // cutting a small mesh into short curves): the round would end with the issue reported.
       // Sample the vertices next to the named clusters instead, or failing that the widest
       // clusters anywhere; more samples always converge (all of them give the input back).
+      // Only in manifold components: an issue on a non-manifold part of the input (a fin, a
+      // pinched vertex) is in the input itself, and chasing it would sample the whole mesh.
+      std::vector<uint8_t> manifold_component(mesh.num_components(), 1);
+      for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+        if (mesh.component()[v] >= 0 && !mesh.manifold_vertex()[v]) manifold_component[mesh.component()[v]] = 0;
       std::vector<uint8_t> named(samples.size(), 0);
-      for (int32_t s : partition.split_clusters) named[s] = 1;
+      bool any_named = false;
+      for (int32_t s : partition.split_clusters)
+        if (manifold_component[mesh.component()[samples[s]]]) named[s] = 1, any_named = true;
       const auto& ao = mesh.adjacency_offsets();
       const auto& adj = mesh.adjacency();
       for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
@@ -339,7 +346,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
           }
         }
       }
-      if (added.empty()) {
+      if (added.empty() && any_named) {
         const auto widest = widest_clusters(clustering, partition.absorbed,
                                             std::max<int32_t>(4, int32_t(samples.size()) / 8), {});
         added = splitting_vertices(mesh, clustering, samples, widest, avoid);
