@@ -325,11 +325,12 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       // cutting a small mesh into short curves): the round would end with the issue reported.
       // Sample the vertices next to the named clusters instead, or failing that the widest
       // clusters anywhere; more samples always converge (all of them give the input back).
-      // Only in manifold components: an issue on a non-manifold part of the input (a fin, a
-      // pinched vertex) is in the input itself, and chasing it would sample the whole mesh.
+      // Not in components with a non-manifold edge: an issue there (a fin) is in the input
+      // itself, and chasing it would sample the whole mesh. (Pinched vertices are repairable:
+      // each fan gets its own clusters.)
       std::vector<uint8_t> manifold_component(mesh.num_components(), 1);
-      for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-        if (mesh.component()[v] >= 0 && !mesh.manifold_vertex()[v]) manifold_component[mesh.component()[v]] = 0;
+      for (int32_t e = 0; e < int32_t(mesh.edge_vertices().size() / 2); ++e)
+        if (mesh.edge_face_count(e) > 2) manifold_component[mesh.component()[mesh.edge_vertices()[2 * size_t(e)]]] = 0;
       std::vector<uint8_t> named(samples.size(), 0);
       bool any_named = false;
       for (int32_t s : partition.split_clusters)
