@@ -168,15 +168,6 @@ def _assert_follows_the_input(source, output):
             assert weight == pytest.approx(source["weights"][i][group], abs=1e-3)
 
 
-def _pipeline_keeps_shape_keys(ts):
-    """Issue 18 makes the pipeline carry shape keys; until it is merged the batch cannot."""
-    import inspect
-
-    source = inspect.getsource(importlib.import_module(ts.__name__ + ".blender.mesh_io"))
-    source += inspect.getsource(importlib.import_module(ts.__name__ + ".blender.pipeline"))
-    return "shape_key" in source
-
-
 @pytest.mark.parametrize("kind", FORMATS)
 def test_round_trip_keeps_what_the_add_on_keeps(ts, scene, tmp_path, kind):
     if kind.startswith("usd") and not bpy.app.build_options.usd:
@@ -205,8 +196,6 @@ def test_round_trip_keeps_what_the_add_on_keeps(ts, scene, tmp_path, kind):
     assert after["armature"] and before["armature"]
     _assert_follows_the_input(before, after)
     assert sorted(before["keys"]) == ["Bulge"]
-    if not _pipeline_keeps_shape_keys(ts):
-        pytest.xfail("shape keys through the add-on's pipeline come with issue 18")
     assert sorted(after["keys"]) == ["Bulge"]
     index_in = {_key(p): i for i, p in enumerate(before["positions"])}
     for vertex, position in enumerate(after["positions"]):
