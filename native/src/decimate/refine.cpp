@@ -570,6 +570,16 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
     weight[i] = m == kForcedMultiplier ? 1.0 : std::max(m, 1.0 / 81.0);
     bin[i] = guidance_bin(m);
   }
+  // A pinched input vertex (several fans) and every vertex of its output triangles stay put:
+  // the link condition sees one vertex, not the fans, and a collapse there could delete a
+  // whole fan (a wing of a bowtie) while every count the final check compares stays the same.
+  const auto& manifold_vertex = mesh.manifold_vertex();
+  for (size_t t = 0; t < result.triangles.size() / 3; ++t) {
+    bool pinched = false;
+    for (int j = 0; j < 3; ++j) pinched |= !manifold_vertex[index[result.kept[result.triangles[3 * t + j]]]];
+    if (pinched)
+      for (int j = 0; j < 3; ++j) locked[result.triangles[3 * t + j]] = 1;
+  }
   std::vector<double> bin_vertices(kBins, 0.0), bin_multipliers(kBins, 0.0);
   const auto& vfo = mesh.vertex_face_offsets();
   for (int32_t v = 0; v < mesh.num_vertices(); ++v)
