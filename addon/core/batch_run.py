@@ -69,8 +69,11 @@ def blender_command(blender: str) -> list:
     interpreter that has PyPI's ``bpy`` (its name starts with "python")."""
     package = os.path.basename(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     if os.path.basename(blender).startswith("python"):
-        code = (f"import sys; sys.path.insert(0, {package_root()!r}); "
-                f"from {package}.blender.batch import main; sys.exit(main(sys.argv[1:]))")
+        # os._exit, not sys.exit: PyPI's bpy 4.5 deadlocks in interpreter shutdown after a batch
+        # (outputs already written atomically; the exit status is what counts).
+        code = (f"import os, sys; sys.path.insert(0, {package_root()!r}); "
+                f"from {package}.blender.batch import main; status = main(sys.argv[1:]); "
+                f"sys.stdout.flush(); sys.stderr.flush(); os._exit(int(status or 0))")
         return [blender, "-c", code]
     script = os.path.join(package_root(), package, "batch.py")
     return [blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python", script, "--"]
