@@ -6,8 +6,6 @@ the .blend batch."""
 
 import json
 import math
-import subprocess
-import sys
 
 import bpy
 import numpy as np
@@ -154,19 +152,15 @@ bpy.ops.wm.save_as_mainfile(filepath={path!r})
 
 
 def test_blend_batch_keeps_shape_keys(ts, scene, tmp_path):
-    import shutil
-    blender = shutil.which("blender")
-    if blender is None:
-        pytest.skip("no blender executable on PATH")
+    import launch  # the Blender under test (binary or bpy module), in a clean environment
+
     source = tmp_path / "character.blend"
     code = MAKE_CHARACTER.format(tests=str(DATA.parent / "blender"), path=str(source))
-    subprocess.run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr", code],
-                   check=True, capture_output=True, timeout=120)
+    made = launch.background(expr=code, timeout=120)
+    assert made.returncode == 0, made.stderr
     out_dir = tmp_path / "out"
-    done = subprocess.run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
-                           str(PACKAGE / "batch.py"), "--", "--input", str(source), "--ratio", "0.3", "--mode", "fast",
-                           "--output", str(out_dir), "--json", str(tmp_path / "report.json")],
-                          capture_output=True, text=True, timeout=300)
+    done = launch.background(PACKAGE / "batch.py", "--input", source, "--ratio", "0.3", "--mode", "fast",
+                             "--output", out_dir, "--json", tmp_path / "report.json", timeout=300)
     assert done.returncode == 0, done.stderr
     report = json.loads((tmp_path / "report.json").read_text())
     assert report["results"][0]["objects"][0]["object"] == "Body"

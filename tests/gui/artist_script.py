@@ -27,7 +27,8 @@ def label_fits(texts, sidebar):
     import blf
 
     scale = bpy.context.preferences.system.ui_scale or 1.0
-    style = bpy.context.preferences.ui_styles[0].widget_label
+    styles = bpy.context.preferences.ui_styles[0]
+    style = getattr(styles, "widget_label", None) or styles.widget  # widget_label is gone in 4.x
     try:
         blf.size(0, style.points * scale)
     except TypeError:  # Blender before 4.0 takes a dpi argument
