@@ -1,6 +1,7 @@
 #include "topstoc/decimate/partition.hpp"
 #include "topstoc/core/parallel.hpp"
 #include "../core/fans.hpp"
+#include "link_arcs.hpp"
 
 #include <omp.h>
 
@@ -46,82 +47,6 @@ void seed_unreached(const Mesh& mesh, const Clustering& c, Partition& out) {
     }
   }
 }
-
-// The link of one sample: its neighbours in the decimated mesh and, for each triangle (s, a,
-// b) around it, the arc a -> b. Valences are small, so lookups are linear scans.
-struct Link {
-  struct Neighbour {
-    int32_t id;
-    int32_t out = 0, in = 0;  // arcs leaving / entering this neighbour
-    int32_t next = -1;        // index of the neighbour the arc leaving it goes to
-  };
-  std::vector<Neighbour> neighbours;
-  int32_t arcs = 0;
-  bool reversed = false;  // some arc a -> b has its reverse b -> a too
-
-  void clear() {
-    neighbours.clear();
-    arcs = 0;
-    reversed = false;
-  }
-  int32_t index(int32_t id) {
-    for (size_t i = 0; i < neighbours.size(); ++i)
-      if (neighbours[i].id == id) return int32_t(i);
-    neighbours.push_back({id});
-    return int32_t(neighbours.size() - 1);
-  }
-  void add(int32_t from, int32_t to) {
-    const int32_t a = index(from), b = index(to);
-    if (neighbours[b].next == a) reversed = true;
-    ++neighbours[a].out, ++neighbours[b].in;
-    neighbours[a].next = b;
-    ++arcs;
-  }
-  /// A triangle appears twice: once more in the same orientation, or in both.
-  bool repeated() const {
-    if (reversed) return true;
-    for (const auto& n : neighbours)
-      if (n.out > 1 || n.in > 1) return true;
-    return false;
-  }
-  /// Fans: paths and cycles of arcs. (Call only when !repeated().)
-  int32_t fans() const {
-    int32_t count = 0, covered = 0;
-    for (size_t i = 0; i < neighbours.size(); ++i) {
-      if (neighbours[i].in != 0) continue;
-      ++count;  // a path starts here
-      for (int32_t v = int32_t(i); neighbours[v].next >= 0; v = neighbours[v].next) ++covered;
-    }
-    // The arcs not on a path lie on cycles; walk each once.
-    std::vector<uint8_t> seen(neighbours.size(), 0);
-    for (size_t i = 0; i < neighbours.size() && covered < arcs; ++i) {
-      if (seen[i] || neighbours[i].in == 0 || neighbours[i].next < 0) continue;
-      bool on_path = false;
-      int32_t v = int32_t(i), steps = 0;
-      while (!seen[v] && neighbours[v].next >= 0 && steps <= arcs) seen[v] = 1, v = neighbours[v].next, ++steps;
-      if (v != int32_t(i)) on_path = true;  // reached a path's end or another walk
-      if (!on_path) ++count, covered += steps;
-    }
-    return count;
-  }
-  /// The arcs form one path or one cycle: the triangles around the sample are one consistently
-  /// oriented fan. (Call only when !repeated(): every neighbour then has out, in <= 1.)
-  bool single_fan() const {
-    int32_t start = 0, starts = 0;
-    for (size_t i = 0; i < neighbours.size(); ++i)
-      if (neighbours[i].in == 0) start = int32_t(i), ++starts;
-    if (starts > 1) return false;
-    int32_t walked = 0;
-    for (int32_t v = start; walked <= arcs;) {
-      const int32_t w = neighbours[v].next;
-      if (w < 0) break;  // end of a path
-      ++walked;
-      if (w == start) break;  // closed the cycle
-      v = w;
-    }
-    return walked == arcs;
-  }
-};
 
 // Triangle i as seen from its lowest rank s: (b, c) such that (s, b, c) is a rotation of it.
 inline std::array<int32_t, 2> rotated_from_lowest(const int32_t* t) {
@@ -290,7 +215,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   std::vector<std::vector<int32_t>> repeated_lists(threads);
   int32_t bad_link = 0, bad_edge = 0, isolated = 0, absorbed = 0;
   // Returns false (and changes nothing) when the link repeats a triangle.
-  auto evaluate = [&](int32_t s, Link& link, std::vector<uint64_t>& seen, int32_t& links, int32_t& edges,
+  auto evaluate = [&](int32_t s, LinkArcs& link, std::vector<uint64_t>& seen, int32_t& links, int32_t& edges,
                       int32_t& lonely, int32_t& eaten) {
     link.clear();
     for (int32_t i = arc_offsets[s]; i < arc_offsets[s + 1]; ++i)
@@ -336,7 +261,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   };
 #pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed) if (k >= kParallelMin)
   {
-    Link link;
+    LinkArcs link;
     auto& seen = seen_pairs[omp_get_thread_num()];
     auto& repeated = repeated_lists[omp_get_thread_num()];
 #pragma omp for schedule(dynamic, 256)
@@ -389,7 +314,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     // must count as an issue: its Euler contribution was never added, and leaving both out
     // can make the characteristic come out right by accident (a torus as a ring of
     // tetrahedra), so without the count such an output passed every check.
-    Link link;
+    LinkArcs link;
     for (int32_t s : repeated)
       if (!evaluate(s, link, seen_pairs[0], bad_link, bad_edge, isolated, absorbed)) {
         marks.add(s);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "../core/union_find.hpp"
+#include "link_arcs.hpp"
 
 namespace topstoc {
 
@@ -18,44 +19,6 @@ struct VertexTriangles {
     for (int32_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
     std::vector<int32_t> fill(offsets.begin(), offsets.end() - 1);
     for (size_t i = 0; i < tris.size(); ++i) triangles[fill[tris[i]]++] = int32_t(i / 3);
-  }
-};
-
-// The link of one output vertex v: for each triangle (v, a, b) the arc a -> b.
-struct LinkArcs {
-  struct Neighbour {
-    int32_t id, out = 0, in = 0, next = -1;
-  };
-  std::vector<Neighbour> neighbours;
-  int32_t arcs = 0;
-  int32_t index(int32_t id) {
-    for (size_t i = 0; i < neighbours.size(); ++i)
-      if (neighbours[i].id == id) return int32_t(i);
-    neighbours.push_back({id});
-    return int32_t(neighbours.size() - 1);
-  }
-  void add(int32_t from, int32_t to) {
-    const int32_t a = index(from), b = index(to);
-    ++neighbours[a].out, ++neighbours[b].in;
-    neighbours[a].next = b;
-    ++arcs;
-  }
-  // With every neighbour at in, out <= 1 the arcs are disjoint paths and cycles: one fan when
-  // a walk from the only path start (or anywhere on a cycle) covers every arc.
-  bool one_fan() const {
-    int32_t start = 0, starts = 0;
-    for (size_t i = 0; i < neighbours.size(); ++i)
-      if (neighbours[i].in == 0) start = int32_t(i), ++starts;
-    if (starts > 1) return false;
-    int32_t walked = 0;
-    for (int32_t x = start; walked <= arcs;) {
-      const int32_t y = neighbours[x].next;
-      if (y < 0) break;
-      ++walked;
-      if (y == start) break;
-      x = y;
-    }
-    return walked == arcs;
   }
 };
 
@@ -143,8 +106,7 @@ OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const st
   LinkArcs link;
   std::vector<std::array<int32_t, 2>> corner_pairs;
   for (int32_t v = 0; v < n; ++v) {
-    link.neighbours.clear();
-    link.arcs = 0;
+    link.clear();
     corner_pairs.clear();
     for (int32_t i = around.offsets[v]; i < around.offsets[v + 1]; ++i) {
       const int32_t* c = &triangles[3 * size_t(around.triangles[i])];
@@ -175,7 +137,7 @@ OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const st
         boundary.unite(v, nb.id);
       }
     }
-    if (manifold[comp] && !crowded && !link.one_fan()) ++check.nonmanifold_vertices;
+    if (manifold[comp] && !crowded && !link.single_fan()) ++check.nonmanifold_vertices;
   }
   std::vector<int32_t> roots(num_components, -1), loops(num_components, 0);
   for (int32_t v = 0; v < n; ++v) {

@@ -1,0 +1,86 @@
+// The link of one vertex of a triangle mesh, as arcs: for each triangle (s, a, b) around
+// vertex s, the arc a -> b. Shared by the partition check (a sample's link in the decimated mesh
+// before it is emitted) and the final output check (an output vertex's link). Valences are
+// small, so lookups are linear scans.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace topstoc {
+
+struct LinkArcs {
+  struct Neighbour {
+    int32_t id;
+    int32_t out = 0, in = 0;  // arcs leaving / entering this neighbour
+    int32_t next = -1;        // index of the neighbour the arc leaving it goes to
+  };
+  std::vector<Neighbour> neighbours;
+  int32_t arcs = 0;
+  bool reversed = false;  // some arc a -> b has its reverse b -> a too
+
+  void clear() {
+    neighbours.clear();
+    arcs = 0;
+    reversed = false;
+  }
+  int32_t index(int32_t id) {
+    for (size_t i = 0; i < neighbours.size(); ++i)
+      if (neighbours[i].id == id) return int32_t(i);
+    neighbours.push_back({id});
+    return int32_t(neighbours.size() - 1);
+  }
+  void add(int32_t from, int32_t to) {
+    const int32_t a = index(from), b = index(to);
+    if (neighbours[b].next == a) reversed = true;
+    ++neighbours[a].out, ++neighbours[b].in;
+    neighbours[a].next = b;
+    ++arcs;
+  }
+  /// A triangle appears twice: once more in the same orientation, or in both.
+  bool repeated() const {
+    if (reversed) return true;
+    for (const auto& n : neighbours)
+      if (n.out > 1 || n.in > 1) return true;
+    return false;
+  }
+  /// Fans: paths and cycles of arcs. (Call only when !repeated().)
+  int32_t fans() const {
+    int32_t count = 0, covered = 0;
+    for (size_t i = 0; i < neighbours.size(); ++i) {
+      if (neighbours[i].in != 0) continue;
+      ++count;  // a path starts here
+      for (int32_t v = int32_t(i); neighbours[v].next >= 0; v = neighbours[v].next) ++covered;
+    }
+    // The arcs not on a path lie on cycles; walk each once.
+    std::vector<uint8_t> seen(neighbours.size(), 0);
+    for (size_t i = 0; i < neighbours.size() && covered < arcs; ++i) {
+      if (seen[i] || neighbours[i].in == 0 || neighbours[i].next < 0) continue;
+      bool on_path = false;
+      int32_t v = int32_t(i), steps = 0;
+      while (!seen[v] && neighbours[v].next >= 0 && steps <= arcs) seen[v] = 1, v = neighbours[v].next, ++steps;
+      if (v != int32_t(i)) on_path = true;  // reached a path's end or another walk
+      if (!on_path) ++count, covered += steps;
+    }
+    return count;
+  }
+  /// The arcs form one path or one cycle: the triangles around the sample are one consistently
+  /// oriented fan. (Call only when !repeated(): every neighbour then has out, in <= 1.)
+  bool single_fan() const {
+    int32_t start = 0, starts = 0;
+    for (size_t i = 0; i < neighbours.size(); ++i)
+      if (neighbours[i].in == 0) start = int32_t(i), ++starts;
+    if (starts > 1) return false;
+    int32_t walked = 0;
+    for (int32_t v = start; walked <= arcs;) {
+      const int32_t w = neighbours[v].next;
+      if (w < 0) break;  // end of a path
+      ++walked;
+      if (w == start) break;  // closed the cycle
+      v = w;
+    }
+    return walked == arcs;
+  }
+};
+
+}  // namespace topstoc
