@@ -227,6 +227,16 @@ class _LoopOperator:
                         dropped=index, verb=f"{verb} {analysis.active_loop(obj).name}", uses_loop=True)
 
 
+class _HandleLoopOperator(_LoopOperator):
+    """An edit of the handle a loop goes around or through: a boundary loop has none."""
+
+    @staticmethod
+    def kinds_ok(kind) -> bool:
+        return kind != "BOUNDARY"
+
+    kind_message = "The active loop is a boundary (a hole's rim): fill it with Fill Holes instead"
+
+
 def run_edit(operator, context, compute, dropped: int = -1, verb: str = "edited", uses_loop: bool = False) -> set:
     """Runs ``compute(obj, arrays) -> EditResult`` on the active mesh, writes it, re-analyses.
 
@@ -319,7 +329,7 @@ class TOPSTOC_OT_select_loop(_LoopOperator, bpy.types.Operator):
         return {"FINISHED"}
 
 
-class TOPSTOC_OT_cut_loop(_LoopOperator, bpy.types.Operator):
+class TOPSTOC_OT_cut_loop(_HandleLoopOperator, bpy.types.Operator):
     """Cut the surface open along the active loop: the handle becomes two holes with rims \
 (genus -1, two new boundary loops)"""
 
@@ -327,29 +337,17 @@ class TOPSTOC_OT_cut_loop(_LoopOperator, bpy.types.Operator):
     bl_label = "Cut Along Loop"
     bl_options = {"REGISTER", "UNDO"}
 
-    @staticmethod
-    def kinds_ok(kind) -> bool:
-        return kind != "BOUNDARY"
-
-    kind_message = "The active loop is a boundary (a hole's rim): fill it with Fill Holes instead"
-
     def execute(self, context):
         return self.edit_active_loop(context, edit.cut_along_loop, "cut along")
 
 
-class TOPSTOC_OT_remove_loop(_LoopOperator, bpy.types.Operator):
+class TOPSTOC_OT_remove_loop(_HandleLoopOperator, bpy.types.Operator):
     """Remove the handle the active loop goes around or through: cut along it and fill both \
 holes (the genus drops by one; e.g. a scan's tiny unwanted handle)"""
 
     bl_idname = "topstoc.remove_loop"
     bl_label = "Remove"
     bl_options = {"REGISTER", "UNDO"}
-
-    @staticmethod
-    def kinds_ok(kind) -> bool:
-        return kind != "BOUNDARY"
-
-    kind_message = "The active loop is a boundary (a hole's rim): fill it with Fill Holes instead"
 
     def execute(self, context):
         return self.edit_active_loop(context, edit.remove_handle, "removed")
