@@ -88,7 +88,7 @@ py::dict result_dict(DecimateResult&& r) {
   py::dict d;
   d["samples"] = to_array(std::move(r.samples));
   d["kept"] = to_array(std::move(r.kept));
-  d["vertices"] = to_array(std::move(r.positions), 3);
+  d["vertices"] = to_array(std::move(r.vertices), 3);
   d["triangles"] = to_array(std::move(r.triangles), 3);
   d["face_source"] = to_array(std::move(r.face_source));
   d["corner_source"] = to_array(std::move(r.corner_source), 3);
@@ -101,13 +101,13 @@ py::dict result_dict(DecimateResult&& r) {
   d["expected_vertices"] = r.expected_vertices;
   d["rate"] = r.rate;
   d["fast_path"] = r.fast_path;
-  d["top_up"] = r.top_up_samples;
+  d["top_up"] = r.top_up;
   d["refine_vertices"] = r.refine_vertices;
   d["refine_collapses"] = r.refine_collapses;
-  d["repair_rounds"] = r.repairs.rounds;  // the keys are the Python names (DecimateStats)
-  d["repairs"] = r.repairs.samples_added;
-  d["issues_found"] = issues_dict(r.repairs.found);
-  d["issues_remaining"] = issues_dict(r.repairs.remaining);
+  d["repair_rounds"] = r.repair_rounds;
+  d["repairs"] = r.repairs;
+  d["issues_found"] = issues_dict(r.issues_found);
+  d["issues_remaining"] = issues_dict(r.issues_remaining);
   const OutputCheck& c = r.output_check;
   py::dict check;
   check["nonfinite"] = c.nonfinite;

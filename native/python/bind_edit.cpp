@@ -36,7 +36,7 @@ FillOptions fill_options(bool planar, int32_t max_dp_corners, bool refine, bool 
 
 py::dict result_dict(EditResult&& r) {
   py::dict d;
-  d["vertices"] = to_array(std::move(r.positions), 3);
+  d["vertices"] = to_array(std::move(r.vertices), 3);
   d["triangles"] = to_array(std::move(r.triangles), 3);
   d["vertex_source"] = to_array(std::move(r.vertex_source));
   d["face_source"] = to_array(std::move(r.face_source));

@@ -60,7 +60,7 @@ void bind_io(py::module_& m) {
         d["material_libraries"] = bytes_list(file.material_libraries);
         d["warnings"] = file.warnings;  // built from quote(): plain ASCII
         const int32_t channels = file.color_channels;
-        d["vertices"] = to_array(std::move(file.positions), 3);
+        d["vertices"] = to_array(std::move(file.vertices), 3);
         d["triangles"] = to_array(std::move(file.triangles), 3);
         d["triangle_polygon"] = to_array(std::move(file.triangle_polygon));
         d["corner_uvs"] = optional_array(std::move(file.corner_uvs), 6);
@@ -81,7 +81,7 @@ void bind_io(py::module_& m) {
          const std::vector<std::string>& material_libraries) {
         const MeshFormat kind = format_from(format);
         MeshFile file;
-        file.positions = positions_from(vertices, "vertices");
+        file.vertices = positions_from(vertices, "vertices");
         file.triangles = indices_from(triangles, 3, "triangles");
         const int64_t n = file.num_vertices(), t = file.num_triangles();
         file.triangle_polygon = ids_from(triangle_polygon, t, "triangle_polygon");

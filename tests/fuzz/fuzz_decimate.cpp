@@ -91,7 +91,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     params.placement = (flags & 2) ? Placement::Filtered : Placement::Subsample;
     const DecimateResult result = decimate(*mesh, *layout, params);
     const size_t kept = result.kept.size();
-    require(result.positions.size() == 3 * kept, "positions: 3 per kept vertex");
+    require(result.vertices.size() == 3 * kept, "positions: 3 per kept vertex");
     require(result.triangles.size() % 3 == 0, "triangles: 3 per triangle");
     require(result.face_source.size() == result.triangles.size() / 3, "face_source size");
     require(result.corner_source.size() == result.triangles.size(), "corner_source size");

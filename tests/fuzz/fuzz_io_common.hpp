@@ -29,8 +29,8 @@ inline void require(bool ok, const char* what) {
 
 // The arrays of one MeshFile agree in size and every index is in range.
 inline void check_consistent(const MeshFile& mesh) {
-  const size_t n = mesh.positions.size() / 3, m = mesh.triangles.size() / 3;
-  require(mesh.positions.size() % 3 == 0, "positions not 3 per vertex");
+  const size_t n = mesh.vertices.size() / 3, m = mesh.triangles.size() / 3;
+  require(mesh.vertices.size() % 3 == 0, "positions not 3 per vertex");
   require(mesh.triangles.size() % 3 == 0, "triangles not 3 per triangle");
   require(mesh.triangle_polygon.size() == m, "triangle_polygon size");
   require(mesh.corner_uvs.empty() || mesh.corner_uvs.size() == 6 * m, "corner_uvs size");
@@ -78,7 +78,7 @@ inline std::vector<std::string> triangle_materials(const MeshFile& mesh) {
 inline std::vector<float> float_soup(const MeshFile& mesh) {
   std::vector<float> soup;
   for (int32_t v : mesh.triangles)
-    for (int k = 0; k < 3; ++k) soup.push_back(float(mesh.positions[3 * size_t(v) + k]));
+    for (int k = 0; k < 3; ++k) soup.push_back(float(mesh.vertices[3 * size_t(v) + k]));
   return soup;
 }
 
@@ -112,7 +112,7 @@ inline void check_round_trip(const MeshFile& first, MeshFormat format) {
     require(same_floats(float_soup(first), float_soup(second)), "STL round trip: corner positions differ");
     return;
   }
-  require(same_numbers(first.positions, second.positions), "round trip: positions differ");
+  require(same_numbers(first.vertices, second.vertices), "round trip: positions differ");
   require(first.triangles == second.triangles, "round trip: triangles differ");
   require(polygon_starts(first) == polygon_starts(second), "round trip: polygons differ");
   require(first.color_channels == second.color_channels, "round trip: colour channels differ");

@@ -114,7 +114,7 @@ TEST_CASE("flood_add gives exactly what flood gives on the whole sample list") {
   }
   SUBCASE("a genus-2 test mesh (tests/data)") {
     const MeshFile file = read_mesh_path(TOPSTOC_TEST_DATA "/genus_positive/cgal_eight.off");
-    const Mesh mesh(file.positions, file.triangles.data(), file.num_triangles());
+    const Mesh mesh(file.vertices, file.triangles.data(), file.num_triangles());
     check_flood_add_equals_flood(mesh, *no_features(mesh), random);
   }
 }

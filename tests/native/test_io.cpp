@@ -16,10 +16,10 @@ namespace {
 MeshFile sample_file(bool float32_exact) {
   const auto grid = topstoc_test::grid(3, 2);
   MeshFile f;
-  f.positions = grid.positions;
+  f.vertices = grid.positions;
   std::mt19937 random(31);
   std::uniform_real_distribution<double> jitter(-0.5, 0.5);
-  for (double& x : f.positions) x = float32_exact ? double(float(x + jitter(random))) : x + jitter(random) / 3.0;
+  for (double& x : f.vertices) x = float32_exact ? double(float(x + jitter(random))) : x + jitter(random) / 3.0;
   f.triangles = grid.triangles;
   for (int32_t t = 0; t < f.num_triangles(); ++t) f.triangle_polygon.push_back(t);
   f.polygons = f.num_triangles();
@@ -38,7 +38,7 @@ TEST_CASE("OBJ, PLY and OFF round trips keep positions, triangles and polygons e
   for (MeshFormat format : {MeshFormat::Obj, MeshFormat::Ply, MeshFormat::Off}) {
     CAPTURE(int(format));
     const MeshFile back = round_trip(f, format);
-    CHECK(back.positions == f.positions);
+    CHECK(back.vertices == f.vertices);
     CHECK(back.triangles == f.triangles);
     CHECK(back.triangle_polygon == f.triangle_polygon);
     CHECK(back.polygons == f.polygons);
@@ -53,8 +53,8 @@ TEST_CASE("STL round trip: float32 positions, triangles welded back in order of 
   for (int64_t t = 0; t < f.num_triangles(); ++t)
     for (int c = 0; c < 3; ++c)
       for (int k = 0; k < 3; ++k)
-        CHECK(back.positions[3 * size_t(back.triangles[3 * t + c]) + k] ==
-              f.positions[3 * size_t(f.triangles[3 * t + c]) + k]);
+        CHECK(back.vertices[3 * size_t(back.triangles[3 * t + c]) + k] ==
+              f.vertices[3 * size_t(f.triangles[3 * t + c]) + k]);
   CHECK(back.num_vertices() == f.num_vertices());  // every grid vertex is used, so welding finds them all
 }
 

@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
   const double fraction = std::atof(argv[2]);
   const int repeats = argc > 3 ? std::max(1, std::atoi(argv[3])) : 5;
   const topstoc::MeshFile mesh = topstoc::read_mesh_path(argv[1]);
-  std::vector<float> positions(mesh.positions.begin(), mesh.positions.end());
+  std::vector<float> positions(mesh.vertices.begin(), mesh.vertices.end());
   std::vector<unsigned> indices(mesh.triangles.begin(), mesh.triangles.end());
   const size_t vertex_count = positions.size() / 3;
   const size_t target = size_t(fraction * double(indices.size())) / 3 * 3;

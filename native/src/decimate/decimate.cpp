@@ -161,17 +161,17 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   }
   const std::vector<double> filtered =
       placement == Placement::Filtered ? filtered_positions(mesh, layout, samples, clustering) : std::vector<double>();
-  result.positions.resize(3 * result.kept.size());
+  result.vertices.resize(3 * result.kept.size());
   for (int32_t s = 0; s < k; ++s) {
     if (output_index[s] < 0) continue;
     for (int j = 0; j < 3; ++j)
-      result.positions[3 * size_t(output_index[s]) + j] =
+      result.vertices[3 * size_t(output_index[s]) + j] =
           filtered.empty() ? mesh.position(samples[s])[j] : filtered[3 * size_t(s) + j];
     // A filtered point that is not finite (should not happen: placement works in normalised
     // coordinates) falls back to the sample itself rather than reaching the output.
-    const double* p = &result.positions[3 * size_t(output_index[s])];
+    const double* p = &result.vertices[3 * size_t(output_index[s])];
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-      for (int j = 0; j < 3; ++j) result.positions[3 * size_t(output_index[s]) + j] = mesh.position(samples[s])[j];
+      for (int j = 0; j < 3; ++j) result.vertices[3 * size_t(output_index[s]) + j] = mesh.position(samples[s])[j];
   }
   // A sample with one sector has one corner to copy attributes from, whatever the triangle:
   // find it once per sample (others walk per output corner, see attribute_corner).
@@ -249,8 +249,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
   struct Snapshot {
     size_t samples = 0;
     Clustering clustering;
-    RepairStats repairs;
-    int32_t top_up_samples = 0;
+    int32_t repair_rounds = 0, repairs = 0, top_up = 0;
     std::vector<int32_t> tried;
     bool active = false;
   } snapshot;
@@ -275,7 +274,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     } else {
       partition = check_partition(mesh, layout, samples, clustering, required, slivers, nullptr, &emit);
     }
-    accumulate(result.repairs.found, partition.issues);
+    accumulate(result.issues_found, partition.issues);
     const bool clean = partition.issues.topological() == 0 && (!slivers || partition.issues.sliver == 0);
     std::vector<int32_t> to_split = partition.split_clusters;
     if (clean) {
@@ -286,9 +285,9 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
         samples.resize(snapshot.samples);
         clustering = snapshot.clustering;
         emit = EmitState();
-        result.repairs.rounds = snapshot.repairs.rounds;
-        result.repairs.samples_added = snapshot.repairs.samples_added;
-        result.top_up_samples = snapshot.top_up_samples;
+        result.repair_rounds = snapshot.repair_rounds;
+        result.repairs = snapshot.repairs;
+        result.top_up = snapshot.top_up;
         partition = check_partition(mesh, layout, samples, clustering, required, false, nullptr, &emit);
       } else if (top_up_to <= 0 || kept >= top_up_to - budget_tolerance(top_up_to) ||
                  result.top_up_rounds >= kMaxTopUpRounds) {
@@ -305,8 +304,9 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
         snapshot.active = true;
         snapshot.samples = samples.size();
         snapshot.clustering = clustering;
+        snapshot.repair_rounds = result.repair_rounds;
         snapshot.repairs = result.repairs;
-        snapshot.top_up_samples = result.top_up_samples;
+        snapshot.top_up = result.top_up;
       }
       to_split = widest_clusters(clustering, partition.absorbed, need, snapshot.tried);
       if (snapshot.active) snapshot.tried.insert(snapshot.tried.end(), to_split.begin(), to_split.end());
@@ -357,26 +357,26 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     // a repair round (without it max_repair_rounds = 0 returned an empty mesh).
     const bool seeding = partition.issues.unreached > 0;
     if (added.empty() || (round >= max_rounds && !seeding)) {
-      result.repairs.remaining = partition.issues;
-      if (!slivers) result.repairs.remaining.sliver = 0;
+      result.issues_remaining = partition.issues;
+      if (!slivers) result.issues_remaining.sliver = 0;
       break;
     }
     const int32_t first_new = static_cast<int32_t>(samples.size());
     samples.insert(samples.end(), added.begin(), added.end());
     flood_add(mesh, layout, samples, first_new, clustering, &emit.changed);
     if (clean) {
-      result.top_up_samples += static_cast<int32_t>(added.size());
+      result.top_up += static_cast<int32_t>(added.size());
     } else if (seeding) {
-      result.repairs.samples_added += static_cast<int32_t>(added.size());
+      result.repairs += static_cast<int32_t>(added.size());
       --round;  // does not use up a repair round
     } else {
-      result.repairs.rounds += 1;
-      result.repairs.samples_added += static_cast<int32_t>(added.size());
+      result.repair_rounds += 1;
+      result.repairs += static_cast<int32_t>(added.size());
     }
   }
   // Zero-area triangles left after the repair rounds are reported, not hidden.
   if (partition.issues.sliver > 0 && partition.issues.topological() == 0)
-    result.repairs.remaining.sliver = partition.issues.sliver;
+    result.issues_remaining.sliver = partition.issues.sliver;
   result.seconds_checking = seconds_since(start);
   return finish(mesh, layout, std::move(samples), clustering, partition, placement, std::move(result));
 }
@@ -386,19 +386,24 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
 void check_result(const Mesh& mesh, const FeatureLayout& layout, DecimateResult& result) {
   std::vector<int32_t> kept(result.kept.size());
   for (size_t i = 0; i < kept.size(); ++i) kept[i] = mesh.vertex_index()[result.kept[i]];
-  result.output_check = check_output(mesh, layout, kept, result.positions, result.triangles);
+  result.output_check = check_output(mesh, layout, kept, result.vertices, result.triangles);
 }
 
 bool topology_kept(const DecimateResult& result) {
-  return result.repairs.remaining.topological() == 0 && result.output_check.violations() == 0;
+  return result.issues_remaining.topological() == 0 && result.output_check.violations() == 0;
+}
+
+// A checked result, unless its check found a violation the repairs did not report.
+DecimateResult reported(DecimateResult result) {
+  if (result.output_check.violations() > 0 && result.issues_remaining.topological() == 0)
+    throw std::runtime_error("decimation output failed its final check (" + result.output_check.describe() +
+                             "); please report this mesh and the parameters");
+  return result;
 }
 
 DecimateResult verified(const Mesh& mesh, const FeatureLayout& layout, DecimateResult result) {
   check_result(mesh, layout, result);
-  if (result.output_check.violations() > 0 && result.repairs.remaining.topological() == 0)
-    throw std::runtime_error("decimation output failed its final check (" + result.output_check.describe() +
-                             "); please report this mesh and the parameters");
-  return result;
+  return reported(std::move(result));
 }
 
 int32_t active_vertices(const Mesh& mesh) {
@@ -500,7 +505,7 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
     every_face.fast_path = 0;
     return decimate(mesh, layout, every_face);
   }
-  return verified(mesh, layout, std::move(best));
+  return reported(std::move(best));  // checked above
 }
 
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
@@ -525,7 +530,9 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
   // list always gives the same mesh.
   result = cluster_and_emit(mesh, layout, std::move(samples), placement, max_repair_rounds, false, false, {},
                             std::vector<uint8_t>(mesh.num_vertices(), 0), 0, std::move(result));
-  if (refine_vertices > 0) {
+  // A refined result is thinned again; an unrefined one loses its zero-area triangles, as
+  // decimate() does.
+  if (refine_vertices > 0 || has_zero_area(result)) {
     std::vector<double> multipliers;
     if (guidance) {
       SamplingParams sampling;
@@ -533,20 +540,10 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
       multipliers = guidance_multipliers(mesh, sampling);
     }
     RefineParams refine;
-    refine.target_vertices = refine_vertices;
     refine.multipliers = guidance ? &multipliers : nullptr;
+    refine.target_vertices = refine_vertices;
+    refine.zero_area_only = refine_vertices == 0;
     refine_by_collapses(mesh, layout, refine, result);
-  } else if (has_zero_area(result)) {  // as decimate() does
-    std::vector<double> multipliers;
-    if (guidance) {
-      SamplingParams sampling;
-      sampling.guidance = guidance;
-      multipliers = guidance_multipliers(mesh, sampling);
-    }
-    RefineParams cleanup;
-    cleanup.multipliers = guidance ? &multipliers : nullptr;
-    cleanup.zero_area_only = true;
-    refine_by_collapses(mesh, layout, cleanup, result);
   }
   return verified(mesh, layout, std::move(result));
 }

@@ -116,11 +116,11 @@ class Collapser {
       if (merged_into_[v] < 0) {
         new_index[v] = next;
         r_.kept[next] = r_.kept[v];
-        for (int i = 0; i < 3; ++i) r_.positions[3 * size_t(next) + i] = r_.positions[3 * size_t(v) + i];
+        for (int i = 0; i < 3; ++i) r_.vertices[3 * size_t(next) + i] = r_.vertices[3 * size_t(v) + i];
         ++next;
       }
     r_.kept.resize(next);
-    r_.positions.resize(3 * size_t(next));
+    r_.vertices.resize(3 * size_t(next));
     size_t faces = 0;
     for (size_t t = 0; t < alive_face_.size(); ++t) {
       if (!alive_face_[t]) continue;
@@ -148,12 +148,12 @@ class Collapser {
 
   // Where the collapse of `from` into `to` puts the survivor.
   void placement(int32_t from, int32_t to, double x[3]) const {
-    const double* pt = &r_.positions[3 * size_t(to)];
+    const double* pt = &r_.vertices[3 * size_t(to)];
     for (int i = 0; i < 3; ++i) x[i] = pt[i];
     if (!free_pair(from, to)) return;
     Quadric q = quadric_[from];
     q.add(quadric_[to]);
-    const double* pf = &r_.positions[3 * size_t(from)];
+    const double* pf = &r_.vertices[3 * size_t(from)];
     double d[3], length2 = 0;
     for (int i = 0; i < 3; ++i) d[i] = pt[i] - pf[i], length2 += d[i] * d[i];
     if (q.minimum(x)) {
@@ -207,15 +207,15 @@ class Collapser {
     if (min_shape <= 0.0) return false;
     double n[3];
     const int32_t* c = &r_.triangles[3 * size_t(t)];
-    normal(c, c[0], &r_.positions[3 * size_t(c[0])], n);
-    return shape(c, c[0], &r_.positions[3 * size_t(c[0])], std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])) <
+    normal(c, c[0], &r_.vertices[3 * size_t(c[0])], n);
+    return shape(c, c[0], &r_.vertices[3 * size_t(c[0])], std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])) <
            min_shape;
   }
 
   bool zero_area(int32_t t) const {
     double n[3];
     const int32_t* c = &r_.triangles[3 * size_t(t)];
-    normal(c, c[0], &r_.positions[3 * size_t(c[0])], n);
+    normal(c, c[0], &r_.vertices[3 * size_t(c[0])], n);
     return n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0;
   }
 
@@ -308,14 +308,14 @@ class Collapser {
     double fan[3] = {0, 0, 0};
     for (int32_t t : vertex_faces_[moved]) {
       double n[3];
-      normal(&r_.triangles[3 * size_t(t)], moved, &r_.positions[3 * size_t(moved)], n);
+      normal(&r_.triangles[3 * size_t(t)], moved, &r_.vertices[3 * size_t(moved)], n);
       for (int i = 0; i < 3; ++i) fan[i] += n[i];
     }
     for (int32_t t : vertex_faces_[moved]) {
       if (has(t, other)) continue;
       const int32_t* c = &r_.triangles[3 * size_t(t)];
       double before[3], after[3];
-      normal(c, moved, &r_.positions[3 * size_t(moved)], before);
+      normal(c, moved, &r_.vertices[3 * size_t(moved)], before);
       normal(c, moved, x, after);
       double before2 = before[0] * before[0] + before[1] * before[1] + before[2] * before[2];
       if (before2 == 0.0) {
@@ -328,7 +328,7 @@ class Collapser {
       if (!(dot > 0.17 * std::sqrt(len2 * before2)) || len2 <= 1e-24 * before2) return false;
       // No sliver: a triangle may not end up thinner than kMinShape unless it was already.
       if (shape(c, moved, x, std::sqrt(len2)) < kMinShape &&
-          shape(c, moved, &r_.positions[3 * size_t(moved)], std::sqrt(before2)) >= kMinShape)
+          shape(c, moved, &r_.vertices[3 * size_t(moved)], std::sqrt(before2)) >= kMinShape)
         return false;
     }
     return true;
@@ -338,7 +338,7 @@ class Collapser {
   // (|n| = twice its area): 1 for an equilateral triangle, 0 for a degenerate one.
   double shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const {
     const double* p[3];
-    for (int j = 0; j < 3; ++j) p[j] = c[j] == replace ? at : &r_.positions[3 * size_t(c[j])];
+    for (int j = 0; j < 3; ++j) p[j] = c[j] == replace ? at : &r_.vertices[3 * size_t(c[j])];
     double edges = 0;
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) edges += (p[j][i] - p[(j + 1) % 3][i]) * (p[j][i] - p[(j + 1) % 3][i]);
@@ -348,7 +348,7 @@ class Collapser {
   // Normal (unnormalised) of triangle c with vertex `replace` standing at `at`.
   void normal(const int32_t* c, int32_t replace, const double* at, double n[3]) const {
     const double* p[3];
-    for (int j = 0; j < 3; ++j) p[j] = c[j] == replace ? at : &r_.positions[3 * size_t(c[j])];
+    for (int j = 0; j < 3; ++j) p[j] = c[j] == replace ? at : &r_.vertices[3 * size_t(c[j])];
     double a[3], b[3];
     for (int i = 0; i < 3; ++i) a[i] = p[1][i] - p[0][i], b[i] = p[2][i] - p[0][i];
     n[0] = a[1] * b[2] - a[2] * b[1], n[1] = a[2] * b[0] - a[0] * b[2], n[2] = a[0] * b[1] - a[1] * b[0];
@@ -357,7 +357,7 @@ class Collapser {
   void collapse(int32_t u, int32_t v) {
     double x[3];
     placement(u, v, x);
-    for (int i = 0; i < 3; ++i) r_.positions[3 * size_t(v) + i] = x[i];
+    for (int i = 0; i < 3; ++i) r_.vertices[3 * size_t(v) + i] = x[i];
     // The triangles on the edge vanish. On each side of u's borders one of them had a corner at
     // v: u's other triangles on that side take that corner (and its sector) where they meet v.
     struct Side {
@@ -484,7 +484,7 @@ std::vector<int32_t> bin_quotas(const std::vector<double>& vertices, const std::
 }  // namespace
 
 bool has_zero_area(const DecimateResult& result) {
-  const auto& p = result.positions;
+  const auto& p = result.vertices;
   for (size_t t = 0; t < result.triangles.size(); t += 3) {
     const double* a = &p[3 * size_t(result.triangles[t])];
     const double* b = &p[3 * size_t(result.triangles[t + 1])];
@@ -566,7 +566,7 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
     if (curve[i] >= 0) ++curve_size[curve[i]];
     locked[i] = layout.vertex_corner[v] || (layout.vertex_feature[v] && curve[i] < 0) || m == kForcedMultiplier;
     if (m == kForcedMultiplier)  // a control point stays where the user put it
-      for (int k = 0; k < 3; ++k) result.positions[3 * i + k] = mesh.position(v)[k];
+      for (int k = 0; k < 3; ++k) result.vertices[3 * i + k] = mesh.position(v)[k];
     weight[i] = m == kForcedMultiplier ? 1.0 : std::max(m, 1.0 / 81.0);
     bin[i] = guidance_bin(m);
   }
@@ -612,7 +612,7 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
     result.refine_collapses += collapser.run(params.target_vertices);
     result.refine_collapses += collapser.remove_zero_area();
   }
-  result.repairs.remaining.sliver = collapser.zero_area_faces();
+  result.issues_remaining.sliver = collapser.zero_area_faces();
   collapser.write_back();
   result.seconds_refine = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

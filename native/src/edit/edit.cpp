@@ -64,7 +64,7 @@ EditResult delete_faces(const double* positions, int32_t num_vertices, const int
     if (use[v] == 1) continue;
     new_id[v] = static_cast<int32_t>(r.vertex_source.size());
     r.vertex_source.push_back(v);
-    r.positions.insert(r.positions.end(), positions + 3 * size_t(v), positions + 3 * size_t(v) + 3);
+    r.vertices.insert(r.vertices.end(), positions + 3 * size_t(v), positions + 3 * size_t(v) + 3);
   }
   for (int64_t t = 0; t < num_triangles; ++t) {
     if (deleted[t]) continue;
@@ -86,7 +86,7 @@ EditResult cut_along_loop(const double* positions, int32_t num_vertices, const i
   const VertexTriangles around = vertex_triangles(triangles, num_triangles, num_vertices, on_loop.data());
 
   EditResult r;
-  r.positions.assign(positions, positions + 3 * size_t(num_vertices));
+  r.vertices.assign(positions, positions + 3 * size_t(num_vertices));
   r.triangles.assign(triangles, triangles + 3 * num_triangles);
   r.vertex_source.resize(num_vertices);
   for (int32_t v = 0; v < num_vertices; ++v) r.vertex_source[v] = v;
@@ -132,7 +132,7 @@ EditResult cut_along_loop(const double* positions, int32_t num_vertices, const i
       if (s == keep) continue;
       copy_of[i][s] = static_cast<int32_t>(r.vertex_source.size());
       r.vertex_source.push_back(v);
-      r.positions.insert(r.positions.end(), positions + 3 * size_t(v), positions + 3 * size_t(v) + 3);
+      r.vertices.insert(r.vertices.end(), positions + 3 * size_t(v), positions + 3 * size_t(v) + 3);
     }
   }
   // Re-point every triangle corner at a loop vertex to the copy of its sector.

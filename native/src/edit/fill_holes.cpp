@@ -170,7 +170,7 @@ class HoleIndex {
 // patches make manifold.
 void fill_impl(EditResult& r, const std::vector<std::vector<int32_t>>& holes, const FillOptions& options,
                const std::vector<uint8_t>* pinch) {
-  const double* positions = r.positions.data();
+  const double* positions = r.vertices.data();
   const int32_t* triangles = r.triangles.data();
   const int32_t num_vertices = static_cast<int32_t>(r.vertex_source.size());
   const int64_t num_triangles = int64_t(r.face_source.size());
@@ -289,7 +289,7 @@ void fill_impl(EditResult& r, const std::vector<std::vector<int32_t>>& holes, co
     filled.num_vertices = static_cast<int32_t>(patch.added_points.size() / 3);
     filled.method = patch.method;
     std::copy(patch.normal, patch.normal + 3, filled.normal);
-    r.positions.insert(r.positions.end(), patch.added_points.begin(), patch.added_points.end());
+    r.vertices.insert(r.vertices.end(), patch.added_points.begin(), patch.added_points.end());
     r.vertex_source.insert(r.vertex_source.end(), size_t(filled.num_vertices), -1);
     for (const auto& t : patch.triangles) {
       r.face_source.push_back(-1);
@@ -307,7 +307,7 @@ void fill_impl(EditResult& r, const std::vector<std::vector<int32_t>>& holes, co
 // The unedited mesh as an edit result: copies, identity maps.
 EditResult unedited(const double* positions, int32_t num_vertices, const int32_t* triangles, int64_t num_triangles) {
   EditResult r;
-  r.positions.assign(positions, positions + 3 * size_t(num_vertices));
+  r.vertices.assign(positions, positions + 3 * size_t(num_vertices));
   r.triangles.assign(triangles, triangles + 3 * num_triangles);
   r.vertex_source.resize(num_vertices);
   for (int32_t v = 0; v < num_vertices; ++v) r.vertex_source[v] = v;
@@ -486,12 +486,12 @@ EditResult fill_holes(const double* positions, int32_t num_vertices, const int32
     if (v < size_t(num_vertices) && welding.target[v] >= 0) continue;
     new_id[v] = next;
     r.vertex_source[next] = r.vertex_source[v];
-    std::copy(&r.positions[3 * v], &r.positions[3 * v] + 3, &r.positions[3 * size_t(next)]);
+    std::copy(&r.vertices[3 * v], &r.vertices[3 * v] + 3, &r.vertices[3 * size_t(next)]);
     ++next;
   }
   const int32_t removed = static_cast<int32_t>(r.vertex_source.size()) - next;
   r.vertex_source.resize(next);
-  r.positions.resize(3 * size_t(next));
+  r.vertices.resize(3 * size_t(next));
   for (int32_t& v : r.triangles) v = new_id[v];
   for (FilledHole& p : r.patches) {
     for (int32_t& v : p.boundary) v = new_id[v];

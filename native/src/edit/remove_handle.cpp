@@ -49,12 +49,12 @@ void separate_sides(EditResult& cut, double fraction) {
       for (int j = 1; j < 3; ++j) {
         const int32_t w = c[(i + j) % 3];
         if (on_side[w]) continue;
-        for (int a = 0; a < 3; ++a) sum[3 * size_t(c[i]) + a] += cut.positions[3 * size_t(w) + a];
+        for (int a = 0; a < 3; ++a) sum[3 * size_t(c[i]) + a] += cut.vertices[3 * size_t(w) + a];
         ++count[c[i]];
       }
     }
   }
-  const std::vector<double> before = cut.positions;
+  const std::vector<double> before = cut.vertices;
   auto normal = [](const std::vector<double>& p, const int32_t* c, double* out) {
     const double *a = &p[3 * size_t(c[0])], *b = &p[3 * size_t(c[1])], *d = &p[3 * size_t(c[2])];
     const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
@@ -68,7 +68,7 @@ void separate_sides(EditResult& cut, double fraction) {
       const double s = count[v] ? step[v] : 0.0;
       for (int a = 0; a < 3; ++a) {
         const size_t i = 3 * size_t(v) + a;
-        cut.positions[i] = count[v] ? before[i] + s * (sum[i] / count[v] - before[i]) : before[i];
+        cut.vertices[i] = count[v] ? before[i] + s * (sum[i] / count[v] - before[i]) : before[i];
       }
     }
     bool bad = false;
@@ -76,7 +76,7 @@ void separate_sides(EditResult& cut, double fraction) {
       const int32_t* c = &cut.triangles[3 * size_t(t)];
       double old_normal[3], new_normal[3];
       normal(before, c, old_normal);
-      normal(cut.positions, c, new_normal);
+      normal(cut.vertices, c, new_normal);
       const double old_area = std::sqrt(old_normal[0] * old_normal[0] + old_normal[1] * old_normal[1] +
                                         old_normal[2] * old_normal[2]);
       const double agree = old_normal[0] * new_normal[0] + old_normal[1] * new_normal[1] + old_normal[2] * new_normal[2];
@@ -104,7 +104,7 @@ bool edit_intersects(const EditResult& r) {
     const int32_t* c = &r.triangles[3 * size_t(t)];
     touched[t] = r.face_source[t] < 0 || moved[c[0]] || moved[c[1]] || moved[c[2]];
   }
-  for (const auto& [a, b] : self_intersections(r.positions.data(), n, r.triangles.data(), m))
+  for (const auto& [a, b] : self_intersections(r.vertices.data(), n, r.triangles.data(), m))
     if (touched[a] || touched[b]) return true;
   return false;
 }

@@ -54,7 +54,7 @@ void group_corners(const PolygonGroup& group, std::vector<int64_t>& corners) {
 
 void validate_for_writing(const MeshFile& mesh) {
   const auto fail = [](const std::string& message) { throw std::invalid_argument(message); };
-  if (mesh.positions.size() % 3) fail("positions must hold 3 numbers per vertex");
+  if (mesh.vertices.size() % 3) fail("positions must hold 3 numbers per vertex");
   if (mesh.triangles.size() % 3) fail("triangles must hold 3 indices per triangle");
   const int64_t n = mesh.num_vertices(), m = mesh.num_triangles();
   if (!mesh.triangle_polygon.empty() && int64_t(mesh.triangle_polygon.size()) != m)

@@ -79,7 +79,7 @@ MeshFile read_obj(const char* data, size_t size) {
         ++count;
       }
       if (count < 3) fail_at_line(number, "vertex needs 3 coordinates, got " + std::to_string(count));
-      mesh.positions.insert(mesh.positions.end(), values, values + 3);
+      mesh.vertices.insert(mesh.vertices.end(), values, values + 3);
       // "v x y z r g b [a]" is the common colour extension; "v x y z w" has no colour.
       const bool has_color = count >= 6;
       if (has_color) {
@@ -192,7 +192,7 @@ std::string write_obj(const MeshFile& mesh) {
   const int64_t n = mesh.num_vertices();
   for (int64_t v = 0; v < n; ++v) {
     out += "v";
-    for (int k = 0; k < 3; ++k) out += ' ', append_number(out, mesh.positions[3 * v + k]);
+    for (int k = 0; k < 3; ++k) out += ' ', append_number(out, mesh.vertices[3 * v + k]);
     for (int k = 0; k < mesh.color_channels; ++k) out += ' ', append_number(out, mesh.vertex_colors[mesh.color_channels * v + k]);
     out += '\n';
   }

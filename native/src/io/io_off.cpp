@@ -71,7 +71,7 @@ MeshFile read_off(const char* data, size_t size) {
   if (n > INT32_MAX || faces > INT32_MAX) fail_at_line(lines.number(), "too many vertices or faces");
 
   MeshFile mesh;
-  mesh.positions.reserve(std::min(3 * size_t(n), size));  // counts may lie: the file's size bounds them
+  mesh.vertices.reserve(std::min(3 * size_t(n), size));  // counts may lie: the file's size bounds them
   std::vector<double> colors;
   int color_channels = 0;
   bool integer_colors = true;
@@ -92,7 +92,7 @@ MeshFile read_off(const char* data, size_t size) {
       tokens.push_back(token);
     }
     if (values.size() < 3) fail_at_line(number, "vertex needs 3 coordinates, got " + std::to_string(values.size()));
-    mesh.positions.insert(mesh.positions.end(), values.begin(), values.begin() + 3);
+    mesh.vertices.insert(mesh.vertices.end(), values.begin(), values.begin() + 3);
     if (header.color) {
       const int channels = int(values.size()) - 3 - normal_values - texture_values;
       if (channels != 3 && channels != 4)
@@ -154,7 +154,7 @@ std::string write_off(const MeshFile& mesh) {
   for (int64_t v = 0; v < mesh.num_vertices(); ++v) {
     for (int k = 0; k < 3; ++k) {
       if (k) out += ' ';
-      append_number(out, mesh.positions[3 * v + k]);
+      append_number(out, mesh.vertices[3 * v + k]);
     }
     for (int k = 0; k < mesh.color_channels; ++k) {
       const double c = mesh.vertex_colors[mesh.color_channels * v + k];

@@ -191,16 +191,10 @@ class BinarySource {
   }
 
   int64_t integer(PlyType type) {
-    switch (type) {
-      case PlyType::Int8: return load<int8_t>();
-      case PlyType::UInt8: return load<uint8_t>();
-      case PlyType::Int16: return load<int16_t>();
-      case PlyType::UInt16: return load<uint16_t>();
-      case PlyType::Int32: return load<int32_t>();
-      case PlyType::UInt32: return load<uint32_t>();
-      default: break;
-    }
-    throw std::invalid_argument("bad integer type");
+    // Every PLY integer type is exact in a double.
+    if (type == PlyType::Float32 || type == PlyType::Float64 || type == PlyType::None)
+      throw std::invalid_argument("bad integer type");
+    return static_cast<int64_t>(number(type));
   }
 
   std::string where() const { return ""; }
@@ -320,7 +314,7 @@ MeshFile read_body(const PlyHeader& header, Source& source) {
                                   " rows, more than the " + std::to_string(source.remaining()) +
                                   " bytes left in the file can hold");
     if (is_vertex) {
-      mesh.positions.assign(3 * size_t(element.count), 0.0);
+      mesh.vertices.assign(3 * size_t(element.count), 0.0);
       if (colors) {
         mesh.color_channels = has[int(Role::Alpha)] ? 4 : 3;
         mesh.vertex_colors.assign(size_t(mesh.color_channels * element.count), 1.0);
@@ -357,9 +351,9 @@ MeshFile read_body(const PlyHeader& header, Source& source) {
           const double value = source.number(p.type);
           if (!is_vertex) continue;
           switch (p.role) {
-            case Role::X: mesh.positions[3 * row] = value; break;
-            case Role::Y: mesh.positions[3 * row + 1] = value; break;
-            case Role::Z: mesh.positions[3 * row + 2] = value; break;
+            case Role::X: mesh.vertices[3 * row] = value; break;
+            case Role::Y: mesh.vertices[3 * row + 1] = value; break;
+            case Role::Z: mesh.vertices[3 * row + 2] = value; break;
             case Role::Red:
             case Role::Green:
             case Role::Blue:
@@ -464,7 +458,7 @@ MeshFile read_ply(const char* data, size_t size) {
 std::string write_ply(const MeshFile& mesh) {
   const int64_t n = mesh.num_vertices();
   const auto groups = polygon_groups(mesh);
-  const bool float_positions = all_floats(mesh.positions);
+  const bool float_positions = all_floats(mesh.vertices);
   const bool colors = mesh.color_channels > 0;
   const bool byte_colors = colors && all_bytes(mesh.vertex_colors);
   const bool float_colors = colors && all_floats(mesh.vertex_colors);
@@ -495,7 +489,7 @@ std::string write_ply(const MeshFile& mesh) {
   out.reserve(out.size() + size_t(n) * (3 * 8 + 4 * 8 + 2 * 8) + groups.size() * 16 + mesh.triangles.size() * 4);
   BinaryWriter writer(out);
   for (int64_t v = 0; v < n; ++v) {
-    for (int k = 0; k < 3; ++k) writer.put_real(mesh.positions[3 * v + k], float_positions);
+    for (int k = 0; k < 3; ++k) writer.put_real(mesh.vertices[3 * v + k], float_positions);
     for (int k = 0; k < mesh.color_channels; ++k) {
       const double c = mesh.vertex_colors[mesh.color_channels * v + k];
       if (byte_colors) writer.put(uint8_t(std::lround(c * 255.0)));

@@ -29,13 +29,13 @@ class Welder {
     for (size_t slot = hash(bits) & mask;; slot = (slot + 1) & mask) {
       const int32_t v = slots_[slot];
       if (v < 0) {
-        const auto added = static_cast<int32_t>(mesh_.positions.size() / 3);
-        mesh_.positions.insert(mesh_.positions.end(), p, p + 3);
+        const auto added = static_cast<int32_t>(mesh_.vertices.size() / 3);
+        mesh_.vertices.insert(mesh_.vertices.end(), p, p + 3);
         slots_[slot] = added;
         if (2 * size_t(added + 1) > slots_.size()) grow();
         return added;
       }
-      if (std::memcmp(&mesh_.positions[3 * size_t(v)], p, sizeof p) == 0) return v;
+      if (std::memcmp(&mesh_.vertices[3 * size_t(v)], p, sizeof p) == 0) return v;
     }
   }
 
@@ -50,10 +50,10 @@ class Welder {
   void grow() {
     slots_.assign(2 * slots_.size(), -1);
     const size_t mask = slots_.size() - 1;
-    const auto n = static_cast<int32_t>(mesh_.positions.size() / 3);
+    const auto n = static_cast<int32_t>(mesh_.vertices.size() / 3);
     for (int32_t v = 0; v < n; ++v) {
       uint64_t bits[3];
-      std::memcpy(bits, &mesh_.positions[3 * size_t(v)], sizeof bits);
+      std::memcpy(bits, &mesh_.vertices[3 * size_t(v)], sizeof bits);
       size_t slot = hash(bits) & mask;
       while (slots_[slot] >= 0) slot = (slot + 1) & mask;
       slots_[slot] = v;
@@ -178,7 +178,7 @@ std::string write_stl(const MeshFile& mesh) {
   out.reserve(84 + 50 * size_t(m));
   for (int64_t t = 0; t < m; ++t) {
     const double* p[3];
-    for (int c = 0; c < 3; ++c) p[c] = &mesh.positions[3 * size_t(mesh.triangles[3 * t + c])];
+    for (int c = 0; c < 3; ++c) p[c] = &mesh.vertices[3 * size_t(mesh.triangles[3 * t + c])];
     const double a[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
     const double b[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
     double normal[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};

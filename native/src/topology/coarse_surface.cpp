@@ -12,8 +12,8 @@ namespace {
 
 void describe(const Mesh& mesh, CoarseMesh& coarse) {
   const auto& d = coarse.decimation;
-  coarse.topology_kept = d.repairs.remaining.topological() == 0;
-  coarse.mesh = std::make_unique<Mesh>(d.positions, d.triangles.data(), int64_t(d.triangles.size() / 3));
+  coarse.topology_kept = d.issues_remaining.topological() == 0;
+  coarse.mesh = std::make_unique<Mesh>(d.vertices, d.triangles.data(), int64_t(d.triangles.size() / 3));
   coarse.components = component_vertices(*coarse.mesh);
   coarse.checks = check_closed_surfaces(*coarse.mesh, coarse.components);
   coarse.fine_component.clear();
@@ -29,13 +29,13 @@ void describe(const Mesh& mesh, CoarseMesh& coarse) {
 std::vector<int32_t> intersecting_vertices(const Mesh& mesh, const DecimateResult& d, const std::vector<uint8_t>& wanted,
                                            int32_t& pairs) {
   const int32_t num_triangles = int32_t(d.triangles.size() / 3);
-  const int32_t num_vertices = int32_t(d.positions.size() / 3);
+  const int32_t num_vertices = int32_t(d.vertices.size() / 3);
   auto component_of_triangle = [&](int32_t t) {
     return mesh.component()[mesh.vertex_index()[d.kept[d.triangles[3 * size_t(t)]]]];
   };
   std::vector<uint8_t> flagged(num_vertices, 0);
   pairs = 0;
-  for (const auto& [s, t] : self_intersections(d.positions.data(), num_vertices, d.triangles.data(), num_triangles)) {
+  for (const auto& [s, t] : self_intersections(d.vertices.data(), num_vertices, d.triangles.data(), num_triangles)) {
     const int32_t c = component_of_triangle(s);
     if (c != component_of_triangle(t) || !wanted[c]) continue;
     ++pairs;

@@ -38,18 +38,11 @@ struct DecimateParams {
   double refine = 0.0;
 };
 
-struct RepairStats {
-  int32_t rounds = 0;          ///< re-flood rounds after the first check
-  int32_t samples_added = 0;   ///< samples added to restore topology or shape
-  PartitionIssues found;       ///< issues found over all rounds
-  PartitionIssues remaining;   ///< issues left when the round limit was hit (normally none)
-};
-
 struct DecimateResult {
   // All vertex ids below are the caller's (see Mesh::vertex_source).
   std::vector<int32_t> samples;        ///< the full sample list: feed it back to reproduce this result
   std::vector<int32_t> kept;           ///< input vertex of each output vertex (samples with triangles)
-  std::vector<double> positions;       ///< 3 per output vertex
+  std::vector<double> vertices;        ///< positions, 3 per output vertex
   std::vector<int32_t> triangles;      ///< 3 per output triangle, indices into kept
   std::vector<int32_t> face_source;    ///< caller's triangle each output triangle comes from
   std::vector<int32_t> corner_source;  ///< 3 per output triangle: caller's corner 3 * triangle + slot
@@ -62,8 +55,12 @@ struct DecimateResult {
   double expected_vertices = 0.0;      ///< sum of the sampling probabilities
   double rate = 0.0;                   ///< base rate k used for the probabilities
   bool fast_path = false;
-  RepairStats repairs;
-  int32_t top_up_samples = 0;          ///< samples added to make up for absorbed clusters
+  // The field names are the Python result's (DecimateStats): the bindings copy, never rename.
+  int32_t repair_rounds = 0;           ///< re-flood rounds after the first check
+  int32_t repairs = 0;                 ///< samples added to restore topology or shape
+  PartitionIssues issues_found;        ///< issues found over all rounds
+  PartitionIssues issues_remaining;    ///< issues left when the round limit was hit (normally none)
+  int32_t top_up = 0;                  ///< samples added to make up for absorbed clusters
   int32_t top_up_rounds = 0;
   int32_t refine_vertices = 0;         ///< target of the quadric refinement (0: none)
   int32_t refine_collapses = 0;        ///< collapses it made

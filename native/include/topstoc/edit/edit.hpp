@@ -37,7 +37,7 @@ struct CutSide {
 };
 
 struct EditResult {
-  std::vector<double> positions;      ///< 3 per vertex
+  std::vector<double> vertices;       ///< 3 per vertex (positions)
   std::vector<int32_t> triangles;     ///< 3 per triangle
   std::vector<int32_t> vertex_source; ///< per vertex: the input vertex it copies, -1 if created
   std::vector<int32_t> face_source;   ///< per triangle: its input triangle, -1 if created

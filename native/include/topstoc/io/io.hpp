@@ -29,7 +29,7 @@ enum class MeshFormat { Obj, Ply, Off, Stl };
 
 /// A mesh file's contents as plain arrays. Optional arrays are empty when the file has none.
 struct MeshFile {
-  std::vector<double> positions;          ///< 3 per vertex, in the file's vertex order
+  std::vector<double> vertices;           ///< positions, 3 per vertex, in the file's vertex order
   std::vector<int32_t> triangles;         ///< 3 per triangle: polygons fan-triangulated (v0, vi, vi+1)
   std::vector<int32_t> triangle_polygon;  ///< per triangle: index of its face in the file
   int64_t polygons = 0;                   ///< faces in the file, including skipped ones
@@ -42,7 +42,7 @@ struct MeshFile {
   std::vector<std::string> material_libraries;  ///< OBJ mtllib arguments, as written
   std::vector<std::string> warnings;  ///< what a reader skipped in a sloppy file (e.g. unknown PLY header lines)
 
-  int64_t num_vertices() const { return int64_t(positions.size() / 3); }
+  int64_t num_vertices() const { return int64_t(vertices.size() / 3); }
   int64_t num_triangles() const { return int64_t(triangles.size() / 3); }
 };
 
