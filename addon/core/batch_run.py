@@ -7,7 +7,8 @@ batch (topstoc.blender.batch) and writes its files atomically. A task never rais
 asset: it returns a failure record, so the other assets go on and Dask does not retry a
 deterministic failure. A worker that dies (killed, out of memory) is a different matter: Dask
 reschedules its tasks on the other workers; the outputs are written to temporary names and
-renamed, so a killed task leaves no half-written output.
+renamed, so a killed task leaves no half-written output, and its Blender child dies with it
+(topstoc.core.child_process).
 """
 
 from __future__ import annotations
@@ -15,12 +16,11 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import subprocess
 import tempfile
 import time
 import traceback
 
-from . import batch_settings
+from . import batch_settings, child_process
 
 MESH_EXTENSIONS = (".obj", ".ply", ".off", ".stl")
 COMPRESSED = (".gz", ".bz2")
@@ -96,7 +96,9 @@ def run_blender_asset(path: str, out_dir: str, settings: dict, blender: str) -> 
                                               "--json", report, *batch_settings.to_argv(settings)]
         env = dict(os.environ)
         env.pop("PYTHONPATH", None)  # the subprocess finds the package through the path given above
-        done = subprocess.run(command, capture_output=True, text=True, env=env, cwd=scratch)
+        # The Blender child dies with this worker: a killed worker's task is rerun elsewhere,
+        # and its Blender must not go on as an orphan.
+        done = child_process.run(command, capture_output=True, text=True, env=env, cwd=scratch)
         if not os.path.exists(report):
             tail = (done.stderr or done.stdout).strip().splitlines()[-3:]
             raise RuntimeError(f"Blender exited with code {done.returncode} and no report: {' | '.join(tail)}")
@@ -180,7 +182,8 @@ def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, 
 
 
 def remove_stale_temporaries(outputs) -> int:
-    """Removes temporaries a killed task left next to ``outputs``; returns how many."""
+    """Removes what a killed task left next to ``outputs``: ``<name>.tmp<pid>`` files (mesh
+    files) and ``.topstoc-partial-<name>-*`` scratch folders (Blender formats); returns how many."""
     removed = 0
     for output in outputs:
         folder, name = os.path.split(output)
@@ -189,11 +192,15 @@ def remove_stale_temporaries(outputs) -> int:
         except OSError:
             continue
         for other in names:
-            if other.startswith(name + ".tmp"):
-                try:
-                    os.remove(os.path.join(folder, other))
-                    removed += 1
-                except OSError:
-                    pass
+            stale = os.path.join(folder, other)
+            try:
+                if other.startswith(name + ".tmp"):
+                    os.remove(stale)
+                elif other.startswith(f".topstoc-partial-{name}-") and os.path.isdir(stale):
+                    shutil.rmtree(stale)
+                else:
+                    continue
+                removed += 1
+            except OSError:
+                pass
     return removed
-
