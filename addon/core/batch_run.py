@@ -165,7 +165,8 @@ def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, 
                 on_start(client)
             futures = {}
             for index, path in tasks:
-                future = client.submit(run_asset, path, os.path.abspath(out_dir), settings, blender,
+                # Absolute paths: a worker on another machine does not run in this folder.
+                future = client.submit(run_asset, os.path.abspath(path), os.path.abspath(out_dir), settings, blender,
                                        key=f"topstoc-batch-{index}-{os.path.basename(path)}", pure=False)
                 futures[future] = (index, path)
             for future in as_completed(futures):
@@ -175,6 +176,9 @@ def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, 
                 except Exception as error:  # e.g. KilledWorker: the asset killed several workers
                     outcome = {"status": "failed", "input": path,
                                "message": f"{type(error).__name__}: {str(error).splitlines()[0] if str(error) else ''}"}
+                outcome["input"] = path   # the report names inputs as given, whatever the runner
+                if "entry" in outcome:
+                    outcome["entry"]["input"] = path
                 on_result(index, outcome)
     finally:
         if cluster is not None:
