@@ -21,6 +21,7 @@ import time
 import traceback
 
 from . import batch_settings, child_process
+from .errors import TopStocError
 
 MESH_EXTENSIONS = (".obj", ".ply", ".off", ".stl")
 COMPRESSED = (".gz", ".bz2")
@@ -149,6 +150,31 @@ def _local_cluster(workers: int):
                         env={"OMP_NUM_THREADS": threads}, silence_logs=40)
 
 
+def package_version() -> tuple:
+    """This topstoc's version, where it runs (called on the scheduler and the workers)."""
+    from .. import bl_info
+
+    return tuple(bl_info["version"])
+
+
+def check_cluster(client) -> None:
+    """TopStocError unless the scheduler and every worker run this topstoc: Dask unpickles the
+    tasks on the scheduler too, and a machine without it would fail every asset one by one."""
+    here = package_version()
+    for where, call in (("the scheduler", client.run_on_scheduler), ("a worker", client.run)):
+        try:
+            found = call(package_version)
+        except Exception as error:  # the remote side's import error, in whatever wrapping
+            reason = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+            raise TopStocError(f"{where} of {client.scheduler.address} cannot import topstoc ({reason}): every "
+                               "machine of the cluster, the scheduler's too, needs the same topstoc "
+                               "(pip install of the same wheel, or PYTHONPATH to the same build)") from None
+        versions = set(found.values()) if isinstance(found, dict) else {found}
+        if versions != {here}:
+            raise TopStocError(f"{where} runs topstoc {' / '.join('.'.join(map(str, v)) for v in sorted(versions))}, "
+                               f"this machine {'.'.join(map(str, here))}: install the same version everywhere")
+
+
 def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, scheduler: str = None,
              on_start=None) -> None:
     """Runs (index, path) tasks on a Dask cluster: ``scheduler`` (tcp://HOST:PORT) or a local
@@ -161,6 +187,8 @@ def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, 
     cluster = None if scheduler else _local_cluster(workers)
     try:
         with Client(scheduler or cluster) as client:
+            if scheduler:
+                check_cluster(client)
             if on_start is not None:
                 on_start(client)
             futures = {}

@@ -4,7 +4,8 @@ batch started from a fourth place, inputs and outputs in a shared folder. The ma
 network namespaces on this host (own network stack and address each, joined by a bridge; the
 file system is shared as NFS would share it), so this needs root; it is skipped otherwise.
 The outputs must equal the serial batch byte for byte, and the work must have been done by the
-worker processes of both nodes.
+worker processes of both nodes. A scheduler or worker without topstoc is a clear error (plain
+processes on this host).
 """
 
 import contextlib
@@ -130,3 +131,41 @@ def test_batch_on_a_scheduler_and_workers_on_other_machines(cluster, tmp_path):
     on_node = {node: net.pids(node) for node in NODES}
     assert done_by <= on_node["node1"] | on_node["node2"], (done_by, on_node)
     assert all(done_by & pids for pids in on_node.values()), (done_by, on_node)
+
+
+@pytest.mark.parametrize("missing", ["scheduler", "worker"])
+def test_a_machine_without_topstoc_is_a_clear_error(missing, tmp_path):
+    """A scheduler or worker that cannot import topstoc stops the batch at the start with one
+    clear line (not a cryptic failure per asset). Plain processes on this host: no root needed."""
+    dask = _dask()
+    if dask is None:
+        pytest.skip(f"no dask command next to {sys.executable}")
+    with_topstoc = dict(os.environ, PYTHONPATH=str(BUILD / "python"))
+    without = {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
+    if subprocess.run([sys.executable, "-c", "import topstoc"], env=without, cwd="/", capture_output=True).returncode == 0:
+        pytest.skip(f"{sys.executable} imports topstoc without PYTHONPATH")
+    address_file = tmp_path / "scheduler.json"
+    started = []
+    try:
+        for role, command in (("scheduler", [dask, "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard"]),
+                              ("worker", [dask, "worker", "--nworkers", "1", "--nthreads", "1", "--no-dashboard"])):
+            with open(tmp_path / f"{role}.log", "w") as log:
+                started.append(subprocess.Popen(
+                    [*command, "--scheduler-file", str(address_file)], cwd="/", start_new_session=True,
+                    env=without if role == missing else with_topstoc, stdout=log, stderr=subprocess.STDOUT))
+        from distributed import Client
+        with Client(scheduler_file=str(address_file), timeout="60s") as client:
+            client.wait_for_workers(1, timeout=120)
+            address = client.scheduler.address
+        inputs = make_assets(tmp_path / "assets", 3, bases=("torus",), levels=(0,))[0].parent
+        done = batch("--input", inputs, "--output", tmp_path / "out", *TARGET, "--scheduler", address)
+    finally:
+        for process in started:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+    assert done.returncode == 1
+    [line] = done.stderr.strip().splitlines()
+    where = "the scheduler" if missing == "scheduler" else "a worker"
+    assert line.startswith(f"topstoc batch: error: {where} of {address} cannot import topstoc"), line
+    assert "the same topstoc" in line
+    assert outputs(tmp_path / "out") == {}
