@@ -18,7 +18,7 @@ from conftest import ROOT
 pytest.importorskip("distributed")
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc; PR_SET_PDEATHSIG")
 
-TARGET = ("--ratio", "0.5", "0.2", "0.05")   # a LOD chain: the big asset keeps Blender busy for seconds
+TARGET = ("--ratio", "0.2")
 
 MAKE_GLB = """
 import sys, bpy
@@ -53,7 +53,7 @@ def _runner(kind):
 
 @pytest.fixture(scope="module")
 def library(tmp_path_factory):
-    """A 262k-triangle torus (several seconds in Blender) and three small ones, as GLB."""
+    """A 262k-triangle torus (seconds of Blender's time) and two small ones, as GLB."""
     blender = shutil.which("blender")
     if blender is None:
         pytest.skip("no blender on PATH to make the glTF assets")
@@ -63,7 +63,7 @@ def library(tmp_path_factory):
                    check=True, capture_output=True, timeout=300)
     folder = tmp_path_factory.mktemp("glb")
     shutil.copy(made / "big.glb", folder / "a_big.glb")   # sorted first: the first task
-    for i in range(3):
+    for i in range(2):
         shutil.copy(made / "ring.glb", folder / f"b_ring{i}.glb")
     return folder
 
@@ -110,11 +110,11 @@ def test_a_killed_workers_blender_child_dies_and_its_asset_is_rerun(kind, librar
     try:
         child, worker = _blender_child(run, big, run.worker_pids())
         seen = time.monotonic()
-        time.sleep(0.5)   # past its start-up: the child is working on the asset
+        time.sleep(0.3)   # the child is under way
         assert alive(child), "the Blender child ended before the worker could be killed:\n" + run.output()
         os.kill(worker, signal.SIGKILL)
         killed = time.monotonic()
-        while alive(child) and time.monotonic() - killed < 1.5:
+        while alive(child) and time.monotonic() - killed < 1.0:
             time.sleep(0.01)
         assert not alive(child), f"the Blender child {child} of killed worker {worker} runs on as an orphan"
         returncode = run.finish()
@@ -122,13 +122,13 @@ def test_a_killed_workers_blender_child_dies_and_its_asset_is_rerun(kind, librar
         run.stop()
         _kill_what_is_left(library)
     # The child had work left when it died: it would not have ended by itself that soon.
-    assert serial_big["wall_seconds"] > (killed - seen) + 1.5 + 0.5, serial_big["wall_seconds"]
+    assert serial_big["wall_seconds"] > (killed - seen) + 1.0 + 0.5, serial_big["wall_seconds"]
     assert returncode == 0, run.output()
     assert processes(str(library)) == {}   # no Blender or bpy process left for these assets
-    assert outputs(out) == outputs(serial) and len(outputs(out)) == 4
+    assert outputs(out) == outputs(serial) and len(outputs(out)) == 3
     assert leftovers(out) == []
     data = report(out)
-    assert len(data["results"]) == 4 and not data["failures"]
+    assert len(data["results"]) == 3 and not data["failures"]
     [record] = [r for r in manifest(out) if r["input"] == big]
     assert record["status"] == "done" and record["worker_pid"] != worker   # rerun elsewhere
 
@@ -144,7 +144,7 @@ def test_a_killed_batch_leaves_no_worker_or_blender_and_resumes(library, serial_
     try:
         workers = run.worker_pids()
         child, _ = _blender_child(run, str(library / "a_big.glb"), workers)
-        time.sleep(0.5)
+        time.sleep(0.3)
         run.process.kill()
         run.finish()
         deadline = time.monotonic() + 15
