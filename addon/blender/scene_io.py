@@ -154,7 +154,8 @@ def save(path: str, objects=None) -> list:
     folder = os.path.dirname(path)
     kind = extension(path)
     os.makedirs(folder, exist_ok=True)
-    scratch = tempfile.mkdtemp(prefix=".topstoc-partial-", dir=folder)
+    # Named after the output, so the batch can remove what a killed Blender left (batch_run).
+    scratch = tempfile.mkdtemp(prefix=f".topstoc-partial-{os.path.basename(path)}-", dir=folder)
     try:
         staged = os.path.join(scratch, os.path.basename(path))
         if kind == "blend":

@@ -48,7 +48,10 @@ def lod_error(original, result, screen) -> dict:
     """Measured symmetric Hausdorff error of a LOD (absolute, relative, in pixels)."""
     low, high = REPORT_SAMPLES
     samples = int(min(high, max(low, 100 * original.num_triangles)))
-    measured = hausdorff(original, result, samples=samples, percentile=0.0)
+    # The sampled maximum (max_tolerance=0): refining it towards a guaranteed bound took 13.5 s
+    # instead of 0.34 s (a 65k-triangle torus at ratio 0.2, 50 times the decimation's time) and
+    # moved the figure by under 0.1 %.
+    measured = hausdorff(original, result, samples=samples, percentile=0.0, max_tolerance=0.0)
     error = float(measured.symmetric.max)
     entry = {"hausdorff": error, "hausdorff_samples": samples, "hausdorff_relative": error / measured.diagonal if measured.diagonal else 0.0}
     if screen is not None:

@@ -7,7 +7,8 @@ batch (topstoc.blender.batch) and writes its files atomically. A task never rais
 asset: it returns a failure record, so the other assets go on and Dask does not retry a
 deterministic failure. A worker that dies (killed, out of memory) is a different matter: Dask
 reschedules its tasks on the other workers; the outputs are written to temporary names and
-renamed, so a killed task leaves no half-written output.
+renamed, so a killed task leaves no half-written output, and its Blender child dies with it
+(topstoc.core.child_process).
 """
 
 from __future__ import annotations
@@ -15,12 +16,12 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import subprocess
 import tempfile
 import time
 import traceback
 
-from . import batch_settings
+from . import batch_settings, child_process
+from .errors import TopStocError
 
 MESH_EXTENSIONS = (".obj", ".ply", ".off", ".stl")
 COMPRESSED = (".gz", ".bz2")
@@ -96,7 +97,9 @@ def run_blender_asset(path: str, out_dir: str, settings: dict, blender: str) -> 
                                               "--json", report, *batch_settings.to_argv(settings)]
         env = dict(os.environ)
         env.pop("PYTHONPATH", None)  # the subprocess finds the package through the path given above
-        done = subprocess.run(command, capture_output=True, text=True, env=env, cwd=scratch)
+        # The Blender child dies with this worker: a killed worker's task is rerun elsewhere,
+        # and its Blender must not go on as an orphan.
+        done = child_process.run(command, capture_output=True, text=True, env=env, cwd=scratch)
         if not os.path.exists(report):
             tail = (done.stderr or done.stdout).strip().splitlines()[-3:]
             raise RuntimeError(f"Blender exited with code {done.returncode} and no report: {' | '.join(tail)}")
@@ -147,6 +150,31 @@ def _local_cluster(workers: int):
                         env={"OMP_NUM_THREADS": threads}, silence_logs=40)
 
 
+def package_version() -> tuple:
+    """This topstoc's version, where it runs (called on the scheduler and the workers)."""
+    from .. import bl_info
+
+    return tuple(bl_info["version"])
+
+
+def check_cluster(client) -> None:
+    """TopStocError unless the scheduler and every worker run this topstoc: Dask unpickles the
+    tasks on the scheduler too, and a machine without it would fail every asset one by one."""
+    here = package_version()
+    for where, call in (("the scheduler", client.run_on_scheduler), ("a worker", client.run)):
+        try:
+            found = call(package_version)
+        except Exception as error:  # the remote side's import error, in whatever wrapping
+            reason = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+            raise TopStocError(f"{where} of {client.scheduler.address} cannot import topstoc ({reason}): every "
+                               "machine of the cluster, the scheduler's too, needs the same topstoc "
+                               "(pip install of the same wheel, or PYTHONPATH to the same build)") from None
+        versions = set(found.values()) if isinstance(found, dict) else {found}
+        if versions != {here}:
+            raise TopStocError(f"{where} runs topstoc {' / '.join('.'.join(map(str, v)) for v in sorted(versions))}, "
+                               f"this machine {'.'.join(map(str, here))}: install the same version everywhere")
+
+
 def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, scheduler: str = None,
              on_start=None) -> None:
     """Runs (index, path) tasks on a Dask cluster: ``scheduler`` (tcp://HOST:PORT) or a local
@@ -159,11 +187,14 @@ def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, 
     cluster = None if scheduler else _local_cluster(workers)
     try:
         with Client(scheduler or cluster) as client:
+            if scheduler:
+                check_cluster(client)
             if on_start is not None:
                 on_start(client)
             futures = {}
             for index, path in tasks:
-                future = client.submit(run_asset, path, os.path.abspath(out_dir), settings, blender,
+                # Absolute paths: a worker on another machine does not run in this folder.
+                future = client.submit(run_asset, os.path.abspath(path), os.path.abspath(out_dir), settings, blender,
                                        key=f"topstoc-batch-{index}-{os.path.basename(path)}", pure=False)
                 futures[future] = (index, path)
             for future in as_completed(futures):
@@ -173,6 +204,9 @@ def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, 
                 except Exception as error:  # e.g. KilledWorker: the asset killed several workers
                     outcome = {"status": "failed", "input": path,
                                "message": f"{type(error).__name__}: {str(error).splitlines()[0] if str(error) else ''}"}
+                outcome["input"] = path   # the report names inputs as given, whatever the runner
+                if "entry" in outcome:
+                    outcome["entry"]["input"] = path
                 on_result(index, outcome)
     finally:
         if cluster is not None:
@@ -180,7 +214,8 @@ def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, 
 
 
 def remove_stale_temporaries(outputs) -> int:
-    """Removes temporaries a killed task left next to ``outputs``; returns how many."""
+    """Removes what a killed task left next to ``outputs``: ``<name>.tmp<pid>`` files (mesh
+    files) and ``.topstoc-partial-<name>-*`` scratch folders (Blender formats); returns how many."""
     removed = 0
     for output in outputs:
         folder, name = os.path.split(output)
@@ -189,11 +224,15 @@ def remove_stale_temporaries(outputs) -> int:
         except OSError:
             continue
         for other in names:
-            if other.startswith(name + ".tmp"):
-                try:
-                    os.remove(os.path.join(folder, other))
-                    removed += 1
-                except OSError:
-                    pass
+            stale = os.path.join(folder, other)
+            try:
+                if other.startswith(name + ".tmp"):
+                    os.remove(stale)
+                elif other.startswith(f".topstoc-partial-{name}-") and os.path.isdir(stale):
+                    shutil.rmtree(stale)
+                else:
+                    continue
+                removed += 1
+            except OSError:
+                pass
     return removed
-

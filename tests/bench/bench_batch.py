@@ -8,8 +8,9 @@ The assets (the test meshes and synthetic ones at subdivision levels 0 and 1, un
 similarity transforms, OBJ/PLY/OFF) are generated into a temporary folder. Each mode writes its
 own output folder; outputs of the three runs must be byte-identical (checked). Overhead per
 asset = (wall time x processes - summed per-asset work) / assets: process start-up, reading,
-writing, measuring, scheduling. The JSON report of the cluster run is printed at the end
-(--report FILE keeps the whole report).
+writing, measuring, scheduling (the cluster's start-up included). The JSON report of the cluster
+run is printed at the end (--report FILE keeps the whole report); --json FILE writes the figures
+(per mode: wall and work seconds, assets per minute, overhead, load average before and after).
 """
 
 import argparse
@@ -37,13 +38,19 @@ def outputs(folder) -> dict:
             if p.is_file() and not p.name.startswith("topstoc-")}
 
 
-def timed(command, env) -> float:
+def load() -> float:
+    return os.getloadavg()[0]
+
+
+def timed(command, env) -> tuple:
+    """(wall seconds, 1-minute load average before, after)."""
+    before = load()
     start = time.perf_counter()
     done = subprocess.run(command, capture_output=True, text=True, env=env)
     seconds = time.perf_counter() - start
     if done.returncode != 0:
         sys.exit(f"failed: {' '.join(map(str, command[:6]))} ...\n{done.stderr[-2000:]}")
-    return seconds
+    return seconds, before, load()
 
 
 def work_seconds(report: dict) -> float:
@@ -56,47 +63,57 @@ def main() -> int:
     parser.add_argument("--ratio", default="0.3")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--report", help="keep the cluster run's JSON report here")
+    parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args()
     blender = shutil.which("blender")
     env = dict(os.environ, PYTHONPATH=str(BUILD / "python"))
     with tempfile.TemporaryDirectory(prefix="topstoc-bench-batch-") as tmp:
         tmp = pathlib.Path(tmp)
         paths = make_assets(tmp / "assets", args.count, levels=(0, 1))
-        triangles = 0
         from topstoc.core.io import read_mesh
         triangles = sum(read_mesh(p).num_triangles for p in paths)
         print(f"bench_batch: {len(paths)} assets, {triangles:,} triangles in all "
               f"({triangles // len(paths):,} per asset), --ratio {args.ratio}")
         print(f"machine: {machine()}")
         rows = []
-        if blender:
+        if blender is None:
+            print("no blender on PATH: the one-Blender row is left out")
+        else:
             out = tmp / "blender"
-            seconds = timed([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+            seconds, *loads = timed([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
                              str(BUILD / "python" / "topstoc" / "batch.py"), "--", "--input", *map(str, paths),
                              "--output", str(out), "--ratio", args.ratio, "--json", str(tmp / "blender.json")], env)
             report = json.loads((tmp / "blender.json").read_text())
-            rows.append(("serial, one Blender (blender -b batch.py)", seconds, 1, report, out))
+            rows.append(("serial, one Blender (blender -b batch.py)", seconds, 1, report, out, loads))
         for label, workers in (("serial, no Blender (topstoc batch --workers 0)", 0),
                                (f"local Dask cluster, {args.workers} workers", args.workers)):
             out = tmp / f"workers{workers}"
-            seconds = timed([sys.executable, "-m", "topstoc", "batch", "--input", str(tmp / "assets"), "--output",
+            seconds, *loads = timed([sys.executable, "-m", "topstoc", "batch", "--input", str(tmp / "assets"), "--output",
                              str(out), "--ratio", args.ratio, "--workers", str(workers), "--progress", "lines"], env)
             report = json.loads((out / "topstoc-report.json").read_text())
-            rows.append((label, seconds, max(1, workers), report, out))
+            rows.append((label, seconds, max(1, workers), report, out, loads))
         reference = outputs(rows[0][4])
         identical = all(outputs(row[4]) == reference for row in rows[1:])
-        print(f"\n| mode | wall s | assets/min | work s (sum) | overhead ms/asset |")
-        print("|---|---|---|---|---|")
-        for label, seconds, processes, report, _ in rows:
+        print("\n| mode | wall s | assets/min | work s (sum) | overhead ms/asset | load before / after |")
+        print("|---|---|---|---|---|---|")
+        figures = []
+        for label, seconds, processes, report, _, loads in rows:
             n = len(report["results"])
             overhead = (seconds * processes - work_seconds(report)) / n
+            figures.append({"mode": label, "assets": n, "processes": processes, "wall_seconds": seconds,
+                            "assets_per_minute": 60 * n / seconds, "work_seconds": work_seconds(report),
+                            "overhead_ms_per_asset": 1000 * overhead, "load_before": loads[0], "load_after": loads[1]})
             print(f"| {label} | {seconds:.1f} | {60 * n / seconds:.0f} | {work_seconds(report):.1f} | "
-                  f"{1000 * overhead:.0f} |")
+                  f"{1000 * overhead:.0f} | {loads[0]:.2f} / {loads[1]:.2f} |")
         base = rows[0][1]
         for label, seconds, *_ in rows[1:]:
             print(f"{label}: {base / seconds:.2f}x the speed of '{rows[0][0]}'")
         print(f"outputs byte-identical across the modes: {identical}")
         cluster = rows[-1][3]
+        if args.json:
+            pathlib.Path(args.json).write_text(json.dumps(
+                {"machine": machine(), "assets": len(paths), "triangles": triangles, "ratio": args.ratio,
+                 "outputs_identical": identical, "modes": figures}, indent=2))
         if args.report:
             pathlib.Path(args.report).write_text(json.dumps(cluster, indent=2))
         print("\ncluster run's report (first result; --report keeps all):")

@@ -12,34 +12,17 @@ import shutil
 import signal
 import subprocess
 import sys
-import time
 
 import pytest
 
-import cli
 from assets import make_assets
+from batch_runs import batch, leftovers, outputs, report
 from conftest import BUILD, ROOT
 
 pytest.importorskip("distributed")
 
 ASSETS = 50
 TARGET = ("--ratio", "0.5")
-BOOKKEEPING = ("topstoc-manifest", "topstoc-report")
-
-
-def batch(*args, timeout=600):
-    return cli.run("batch", *args, "--progress", "lines", timeout=timeout)
-
-
-def outputs(folder) -> dict:
-    """Output files (not the manifest or report) and their bytes."""
-    folder = pathlib.Path(folder)
-    return {p.name: p.read_bytes() for p in sorted(folder.iterdir())
-            if p.is_file() and not p.name.startswith(BOOKKEEPING)}
-
-
-def report(folder, name="topstoc-report.json") -> dict:
-    return json.loads((pathlib.Path(folder) / name).read_text())
 
 
 @pytest.fixture(scope="module")
@@ -156,8 +139,7 @@ def test_a_killed_worker_loses_nothing(library, serial, tmp_path):
     assert process.returncode == 0, errors
     assert killed_at < ASSETS and progress == ASSETS
     assert outputs(tmp_path) == outputs(serial)
-    leftovers = [p.name for p in tmp_path.iterdir() if ".tmp" in p.name or p.name.startswith(".topstoc-partial")]
-    assert leftovers == []
+    assert leftovers(tmp_path) == []
     data = report(tmp_path)
     assert len(data["results"]) == ASSETS and not data["failures"]
 

@@ -46,16 +46,18 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--json", metavar="REPORT.json", help=f"report file (default DIR/{REPORT_NAME})")
     parser.add_argument("--no-resume", action="store_true", help="redo assets the manifest lists as done")
     parser.add_argument("--progress", choices=("auto", "bar", "lines"), default="auto",
-                        help="progress bar on a terminal, plain lines otherwise (default auto)")
+                        help="auto (default): a progress bar on a terminal, plain lines when the output goes to a "
+                             "file or pipe")
     parser.set_defaults(run=run)
 
 
 class Progress:
-    """A tqdm bar on a terminal, else one line per asset on standard output."""
+    """A tqdm bar (on standard error) when standard output and error are both a terminal, else one
+    line per asset on standard output: ``topstoc batch > log`` gets the lines in its log."""
 
     def __init__(self, total: int, mode: str):
         self.total, self.count, self.bar = total, 0, None
-        if mode == "bar" or (mode == "auto" and sys.stderr.isatty()):
+        if mode == "bar" or (mode == "auto" and sys.stdout.isatty() and sys.stderr.isatty()):
             try:
                 from tqdm import tqdm
                 self.bar = tqdm(total=total, unit="asset", desc="topstoc batch", file=sys.stderr)
