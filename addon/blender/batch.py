@@ -28,6 +28,7 @@ import numpy as np
 from ..core import batch_settings
 from ..core.batch_mesh import decimate_mesh_file, lod_error
 from ..core.prune import prune_small_parts
+from ..core.errors import TopStocError
 
 BLEND = ".blend"
 
@@ -62,13 +63,13 @@ def _mesh_objects(bpy, path: str, names) -> list:
     if names:
         missing = [name for name in names if bpy.data.objects.get(name) is None]
         if missing:
-            raise ValueError(f"{path}: no object named {', '.join(repr(m) for m in missing)}")
+            raise TopStocError(f"{path}: no object named {', '.join(repr(m) for m in missing)}")
         objects = [bpy.data.objects[name] for name in names]
         wrong = [o.name for o in objects if o.type != "MESH"]
         if wrong:
-            raise ValueError(f"{path}: {', '.join(wrong)} is not a mesh object")
+            raise TopStocError(f"{path}: {', '.join(wrong)} is not a mesh object")
     if not objects:
-        raise ValueError(f"{path}: no mesh objects")
+        raise TopStocError(f"{path}: no mesh objects")
     return objects
 
 

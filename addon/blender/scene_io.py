@@ -16,6 +16,7 @@ import shutil
 import tempfile
 
 import bpy
+from ..core.errors import TopStocError
 
 IMPORTERS = {"gltf": "gltf", "glb": "gltf", "fbx": "fbx", "usd": "usd", "usda": "usd", "usdc": "usd", "usdz": "usd"}
 _ADDONS = {"gltf": "io_scene_gltf2", "fbx": "io_scene_fbx"}
@@ -44,8 +45,8 @@ def _supported(operator, options: dict) -> dict:
 
 def _check_usd(path: str) -> None:
     if not bpy.app.build_options.usd:
-        raise ValueError(f"{path}: this Blender ({bpy.app.version_string}) was built without USD; "
-                         "use PyPI's bpy or a Blender from blender.org")
+        raise TopStocError(f"{path}: this Blender ({bpy.app.version_string}) was built without USD; "
+                           "use PyPI's bpy or a Blender from blender.org")
 
 
 def _numpy_alias_for_old_importers() -> None:
@@ -105,7 +106,7 @@ def import_file(path: str) -> None:
     """Reads a glTF/GLB, FBX or USD file into an empty scene."""
     kind = IMPORTERS.get(extension(path))
     if kind is None:
-        raise ValueError(f"{path}: not a glTF, FBX or USD file")
+        raise TopStocError(f"{path}: not a glTF, FBX or USD file")
     if not os.path.isfile(path):
         raise FileNotFoundError(f"{path}: no such file")
     clear_scene()
@@ -143,7 +144,7 @@ def _export(kind: str, filepath: str, selected: bool) -> None:
         options = dict(selected_objects_only=selected, export_uvmaps=True, export_materials=True,
                        export_armatures=True, export_shapekeys=True)
     else:
-        raise ValueError(f"cannot export .{kind} (Blender formats: blend, gltf, glb, fbx, usd, usda, usdc, usdz)")
+        raise TopStocError(f"cannot export .{kind} (Blender formats: blend, gltf, glb, fbx, usd, usda, usdc, usdz)")
     operator(filepath=filepath, **_supported(operator, options))
 
 
@@ -168,7 +169,7 @@ def save(path: str, objects=None) -> list:
                     obj.select_set(obj in objects)
             _export(kind, staged, selected)
         if not os.path.exists(staged):
-            raise RuntimeError(f"{path}: the exporter wrote nothing")
+            raise TopStocError(f"{path}: the exporter wrote nothing")
         produced = sorted(name for name in os.listdir(scratch) if name != os.path.basename(path))
         written = []
         for name in produced + [os.path.basename(path)]:

@@ -18,6 +18,7 @@ from .hausdorff import hausdorff
 from .io import mesh_format, read_mesh, write_mesh
 from .mesh import Mesh
 from .prune import prune_small_parts
+from .errors import TopStocError
 
 #: samples on the original for the per-LOD error in the report: 100 per input triangle, within
 #: these bounds (dense enough on small assets, bounded cost on large ones)
@@ -65,7 +66,7 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
     outputs = output_paths(path, out_dir, settings)
     data = read_mesh(path)
     if data.num_triangles == 0:
-        raise ValueError(f"{path}: no faces to decimate")
+        raise TopStocError(f"{path}: no faces to decimate")
     start = time.perf_counter()
     mesh = Mesh(data.vertices, data.triangles)
     seams = None if data.corner_uvs is None else uv_seam_edges(data.triangles, data.corner_uvs)

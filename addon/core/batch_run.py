@@ -84,14 +84,16 @@ def find_blender(blender: str = None) -> str:
     """``blender`` itself, or the Blender on PATH; ValueError when there is none."""
     found = blender or os.environ.get("TOPSTOC_BLENDER") or shutil.which("blender")
     if not found:
-        raise ValueError("Blender formats (.blend, glTF, FBX, USD) need a Blender: install one (blender on PATH), "
-                         "or pass --blender /path/to/blender or --blender /venv/bin/python (with PyPI's bpy)")
+        raise TopStocError("Blender formats (.blend, glTF, FBX, USD) need a Blender: install one (blender on PATH), "
+                           "or pass --blender /path/to/blender or --blender /venv/bin/python (with PyPI's bpy)")
     return found
 
 
 def run_blender_asset(path: str, out_dir: str, settings: dict, blender: str) -> dict:
     """One Blender-format asset through a Blender subprocess; its report entry."""
-    with tempfile.TemporaryDirectory(prefix="topstoc-batch-") as scratch:
+    # The scratch folder names its owner: a killed worker cannot remove it, the next batch does
+    # (remove_orphaned_scratch).
+    with tempfile.TemporaryDirectory(prefix=f"{SCRATCH_PREFIX}{os.getpid()}-") as scratch:
         report = os.path.join(scratch, "report.json")
         command = blender_command(blender) + ["--input", os.path.abspath(path), "--output", os.path.abspath(out_dir),
                                               "--json", report, *batch_settings.to_argv(settings)]
@@ -102,11 +104,11 @@ def run_blender_asset(path: str, out_dir: str, settings: dict, blender: str) -> 
         done = child_process.run(command, capture_output=True, text=True, env=env, cwd=scratch)
         if not os.path.exists(report):
             tail = (done.stderr or done.stdout).strip().splitlines()[-3:]
-            raise RuntimeError(f"Blender exited with code {done.returncode} and no report: {' | '.join(tail)}")
+            raise TopStocError(f"Blender exited with code {done.returncode} and no report: {' | '.join(tail)}")
         with open(report) as stream:
             data = json.load(stream)
     if data["failures"]:
-        raise RuntimeError(data["failures"][0]["message"])
+        raise TopStocError(data["failures"][0]["message"])
     entry = data["results"][0]
     entry["input"] = os.fspath(path)
     return entry
@@ -124,8 +126,8 @@ def run_asset(path: str, out_dir: str, settings: dict, blender: str = None) -> d
         elif kind == "blender":
             entry = run_blender_asset(path, out_dir, settings, find_blender(blender))
         else:
-            raise ValueError(f"{path}: not a supported asset (mesh files {', '.join(MESH_EXTENSIONS)}, "
-                             f"or {', '.join('.' + f for f in batch_settings.BLENDER_FORMATS)})")
+            raise TopStocError(f"{path}: not a supported asset (mesh files {', '.join(MESH_EXTENSIONS)}, "
+                               f"or {', '.join('.' + f for f in batch_settings.BLENDER_FORMATS)})")
     except Exception as error:  # one broken asset must not stop the batch
         message = str(error).splitlines()[0] if str(error) else type(error).__name__
         if not isinstance(error, (ValueError, OSError, RuntimeError)):
@@ -182,8 +184,8 @@ def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, 
     try:
         from distributed import Client, as_completed
     except ImportError:
-        raise ValueError("the Dask runner needs dask.distributed: pip install 'dask[distributed]' tqdm "
-                         "(or run serially with --workers 0)") from None
+        raise TopStocError("the Dask runner needs dask.distributed: pip install 'dask[distributed]' tqdm "
+                           "(or run serially with --workers 0)") from None
     cluster = None if scheduler else _local_cluster(workers)
     try:
         with Client(scheduler or cluster) as client:
@@ -211,6 +213,39 @@ def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, 
     finally:
         if cluster is not None:
             cluster.close()
+
+
+SCRATCH_PREFIX = "topstoc-batch-"
+
+
+def remove_orphaned_scratch(folder: str = None) -> int:
+    """Removes ``topstoc-batch-<pid>-*`` scratch folders (in the temporary folder) whose process
+    is gone: what a killed worker's Blender task left. Returns how many."""
+    folder = folder or tempfile.gettempdir()
+    removed = 0
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return 0
+    for name in names:
+        if not name.startswith(SCRATCH_PREFIX):
+            continue
+        pid = name[len(SCRATCH_PREFIX):].split("-", 1)[0]
+        if not pid.isdigit() or _alive(int(pid)):
+            continue
+        shutil.rmtree(os.path.join(folder, name), ignore_errors=True)
+        removed += 1
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's process: alive
+        return True
+    return True
 
 
 def remove_stale_temporaries(outputs) -> int:

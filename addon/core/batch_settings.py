@@ -14,6 +14,7 @@ import json
 import math
 
 from .screen_size import DEFAULT_FOV_DEGREES, DEFAULT_PIXEL_ERROR, DEFAULT_RESOLUTION
+from .errors import TopStocError
 
 TARGET_KINDS = ("ratio", "vertices", "triangles", "max_error", "screen_pixels", "screen_distance")
 SCREEN_KINDS = ("screen_pixels", "screen_distance")
@@ -65,9 +66,9 @@ def parse_max_error(text: str) -> tuple:
     try:
         value = float(text.rstrip("%"))
     except ValueError:
-        raise ValueError(f"--max-error must be a number, optionally followed by %, got {text!r}") from None
+        raise TopStocError(f"--max-error must be a number, optionally followed by %, got {text!r}") from None
     if not math.isfinite(value) or value <= 0:
-        raise ValueError(f"--max-error must be positive, got {text!r}")
+        raise TopStocError(f"--max-error must be positive, got {text!r}")
     return (value / 100.0, True) if relative else (value, False)
 
 
@@ -78,18 +79,18 @@ def from_args(args) -> dict:
     if kind == "max_error":
         values = [parse_max_error(v) for v in values]
     elif kind == "ratio" and not all(0 < v <= 1 for v in values):
-        raise ValueError(f"--ratio values must lie in (0, 1], got {values}")
+        raise TopStocError(f"--ratio values must lie in (0, 1], got {values}")
     elif kind in ("vertices", "triangles") and not all(v >= 1 for v in values):
-        raise ValueError(f"--{kind} values must be positive, got {values}")
+        raise TopStocError(f"--{kind} values must be positive, got {values}")
     elif kind in SCREEN_KINDS and not all(math.isfinite(v) and v > 0 for v in values):
-        raise ValueError(f"--{kind.replace('_', '-')} values must be positive, got {values}")
+        raise TopStocError(f"--{kind.replace('_', '-')} values must be positive, got {values}")
     if args.prune_pixels and kind not in SCREEN_KINDS:
-        raise ValueError("--prune-pixels needs a screen target (--screen-pixels or --screen-distance)")
+        raise TopStocError("--prune-pixels needs a screen target (--screen-pixels or --screen-distance)")
     for name in ("pixel_error", "fov", "resolution"):
         if not getattr(args, name) > 0:
-            raise ValueError(f"--{name.replace('_', '-')} must be positive, got {getattr(args, name)}")
+            raise TopStocError(f"--{name.replace('_', '-')} must be positive, got {getattr(args, name)}")
     if args.prune_pixels < 0:
-        raise ValueError(f"--prune-pixels must not be negative, got {args.prune_pixels}")
+        raise TopStocError(f"--prune-pixels must not be negative, got {args.prune_pixels}")
     out_format = None
     if args.format:
         out_format = args.format.lower().lstrip(".")

@@ -31,6 +31,7 @@ import numpy as np
 
 from . import params
 from .native import engine
+from .errors import TopStocError
 
 if TYPE_CHECKING:  # for annotations only: mesh.py imports this module
     from .mesh import Mesh
@@ -66,7 +67,7 @@ class View:
 
     def as_engine(self) -> dict:
         if (self.eye is None) == (self.direction is None):
-            raise ValueError("a view needs exactly one of eye (perspective) or direction (orthographic)")
+            raise TopStocError("a view needs exactly one of eye (perspective) or direction (orthographic)")
         d = {
             "perspective": self.eye is not None,
             "back_ratio": float(self.back_ratio),
@@ -100,7 +101,7 @@ class Box:
         center = np.asarray(center, dtype=np.float64).reshape(3)
         half = np.asarray(half_size, dtype=np.float64).reshape(3)
         if np.any(half <= 0):
-            raise ValueError("box half sizes must be positive")
+            raise TopStocError("box half sizes must be positive")
         m = np.eye(4)
         m[:3, :3] = np.diag(1.0 / half)
         m[:3, 3] = -center / half
@@ -212,11 +213,11 @@ def _guidance(mesh: Mesh, guidance) -> Optional[np.ndarray]:
         return None
     u = np.asarray(guidance, dtype=np.float64)
     if u.shape != (mesh.native.report["input_vertices"],):
-        raise ValueError(f"guidance must hold one value per vertex ({mesh.vertices.shape[0]}), "
-                         f"got shape {u.shape}")
+        raise TopStocError(f"guidance must hold one value per vertex ({mesh.vertices.shape[0]}), "
+                           f"got shape {u.shape}")
     bad = np.flatnonzero(~np.isfinite(u) | (u < -1) | (u > 1))
     if len(bad):
-        raise ValueError(f"guidance of vertex {bad[0]} is {u[bad[0]]}; it must lie in [-1, 1]")
+        raise TopStocError(f"guidance of vertex {bad[0]} is {u[bad[0]]}; it must lie in [-1, 1]")
     return u
 
 
@@ -232,7 +233,7 @@ def target_vertex_count(mesh: Mesh, ratio=None, vertices=None) -> int:
         return max(1, int(round(params.number("ratio", ratio, 0, 1, low_open=True) * active)))
     vertices = params.integer("target_vertices", vertices)
     if not 1 <= vertices <= active:
-        raise ValueError(f"vertex target {vertices} is outside [1, {active}] (vertices in triangles)")
+        raise TopStocError(f"vertex target {vertices} is outside [1, {active}] (vertices in triangles)")
     return vertices
 
 
@@ -241,7 +242,7 @@ def _renamed(old: str, old_value, new: str, new_value):
     if old_value is None:
         return new_value
     if new_value is not None:
-        raise ValueError(f"give {new} only, not also its old name {old}")
+        raise TopStocError(f"give {new} only, not also its old name {old}")
     warnings.warn(f"decimate({old}=...) is deprecated; use {new}=...", DeprecationWarning, stacklevel=3)
     return old_value
 
@@ -288,10 +289,10 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     given = [name for name, value in (("ratio", ratio), ("target_vertices", vertices),
                                       ("target_triangles", triangles), ("max_error", max_error)) if value is not None]
     if len(given) != 1:
-        raise ValueError("give exactly one target (ratio, target_vertices, target_triangles or max_error), "
-                         f"got {given or 'none'}")
+        raise TopStocError("give exactly one target (ratio, target_vertices, target_triangles or max_error), "
+                           f"got {given or 'none'}")
     if mode not in MODES:
-        raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
+        raise TopStocError(f"mode must be one of {MODES}, got {mode!r}")
     if placement is None:
         placement = "filtered" if mode == "quality" else "subsample"
     if refine is None:
@@ -310,9 +311,9 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
         return dataclasses.replace(result, error_bound=report,
                                    parameters={**result.parameters, "max_error": max_error, "relative": relative})
     if density not in DENSITY_MODES:
-        raise ValueError(f"density must be one of {DENSITY_MODES}, got {density!r}")
+        raise TopStocError(f"density must be one of {DENSITY_MODES}, got {density!r}")
     if placement not in PLACEMENTS:
-        raise ValueError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
+        raise TopStocError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
     seed = params.seed(seed)
     refine_wanted = "0 (off) or a factor of at least 1"
     refine = params.number("refine", refine, 0, expected=refine_wanted)
@@ -329,7 +330,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     if triangles is not None:
         target_triangles = params.integer("target_triangles", triangles)
         if not 1 <= target_triangles <= mesh.num_triangles:
-            raise ValueError(f"triangle target {target_triangles} is outside [1, {mesh.num_triangles}]")
+            raise TopStocError(f"triangle target {target_triangles} is outside [1, {mesh.num_triangles}]")
         target = 1
     else:
         target = target_vertex_count(mesh, ratio, vertices)
@@ -363,10 +364,10 @@ def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, fe
     and the same ``guidance``.
     """
     if placement not in PLACEMENTS:
-        raise ValueError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
+        raise TopStocError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
     samples = np.asarray(samples)
     if samples.ndim != 1 or samples.dtype.kind not in "iu":
-        raise ValueError(f"samples must be a 1-D integer array, got {samples.dtype} {samples.shape}")
+        raise TopStocError(f"samples must be a 1-D integer array, got {samples.dtype} {samples.shape}")
     refine_vertices = params.integer("refine_vertices", refine_vertices, 0, 2**31 - 1)
     feature_angle = params.number("feature_angle (radians)", feature_angle, 0, math.pi)
     layout = mesh.feature_layout(regions, borders, feature_angle)

@@ -24,6 +24,7 @@ import numpy as np
 from .mesh import as_vertices
 from . import params
 from .native import engine
+from .errors import TopStocError
 
 #: Patch methods, from the thesis' planar projection to the last resort (hole_triangulation.hpp).
 FILL_METHODS = ("planar", "minimum_weight", "split", "fan")
@@ -157,7 +158,7 @@ class EditResult:
         elif values.ndim >= 1 and values.shape[0] == 3 * m:
             shaped, flat = False, values
         else:
-            raise ValueError(f"corner data must be shaped ({m}, 3, ...) or ({3 * m}, ...), got {values.shape}")
+            raise TopStocError(f"corner data must be shaped ({m}, 3, ...) or ({3 * m}, ...), got {values.shape}")
         source = self.corner_source.reshape(-1)
         out = _gather(flat, source, fill)
         if fill is None:
@@ -172,7 +173,7 @@ class EditResult:
 def _rows(values, count: int, what: str) -> np.ndarray:
     values = np.asarray(values)
     if values.ndim == 0 or values.shape[0] != count:
-        raise ValueError(f"per-{what} data must have one row per input {what} ({count}), got shape {values.shape}")
+        raise TopStocError(f"per-{what} data must have one row per input {what} ({count}), got shape {values.shape}")
     return values
 
 
@@ -201,7 +202,7 @@ def _result(raw: dict, vertices: np.ndarray, triangles) -> EditResult:
 def _loop(loop) -> np.ndarray:
     array = np.asarray(loop)
     if array.ndim != 1 or (array.size and array.dtype.kind not in "iu"):
-        raise ValueError(f"a loop must be a 1-D sequence of vertex ids, got {array.dtype} array of shape {array.shape}")
+        raise TopStocError(f"a loop must be a 1-D sequence of vertex ids, got {array.dtype} array of shape {array.shape}")
     return array.astype(np.int64)
 
 
@@ -229,11 +230,11 @@ def delete_faces(vertices, triangles, faces) -> EditResult:
     faces = np.asarray(faces)
     if faces.dtype == bool:
         if faces.shape != (len(triangles),):
-            raise ValueError(f"a face mask needs one entry per triangle ({len(triangles)}), got shape {faces.shape}")
+            raise TopStocError(f"a face mask needs one entry per triangle ({len(triangles)}), got shape {faces.shape}")
         faces = np.flatnonzero(faces)
     elif faces.ndim != 1 or (faces.size and faces.dtype.kind not in "iu"):
-        raise ValueError(f"faces must be triangle indices or a boolean mask, got {faces.dtype} array "
-                         f"of shape {faces.shape}")
+        raise TopStocError(f"faces must be triangle indices or a boolean mask, got {faces.dtype} array "
+                           f"of shape {faces.shape}")
     vertices = as_vertices(vertices)
     return _result(engine.delete_faces(vertices, triangles, faces.astype(np.int64)), vertices, triangles)
 
@@ -268,9 +269,9 @@ def fill_holes(vertices, triangles, holes: Optional[Sequence[int]] = None, *, ma
     if holes is not None:
         holes = np.atleast_1d(np.asarray(holes))
         if holes.size == 0:
-            raise ValueError("holes is empty: pass None to fill every hole")
+            raise TopStocError("holes is empty: pass None to fill every hole")
         if holes.dtype.kind not in "iu":
-            raise ValueError(f"holes must be loop indices, got {holes.dtype}")
+            raise TopStocError(f"holes must be loop indices, got {holes.dtype}")
         holes = holes.astype(np.int64)
     max_edges = params.optional_integer("max_edges", max_edges, 3, 2**31 - 1)
     vertices = as_vertices(vertices)

@@ -22,6 +22,7 @@ from typing import Callable
 from .hausdorff import as_surface
 from . import params
 from .native import engine
+from .errors import TopStocError
 
 DEFAULT_SEARCH_SAMPLES = 50_000
 MAX_TOLERANCE = 1e-3  #: relative bracket of the Hausdorff max in each probe (see hausdorff.py)
@@ -120,7 +121,7 @@ def search_vertex_count(mesh, max_error: float, decimate_at: Callable[[int], obj
         probe(hi)  # the full count: only reached when every smaller target failed
     result, error = results[hi]
     if error > bound:
-        raise ValueError(f"no decimation meets max_error {bound:g}: even all {hi} vertices measure {error:g}")
+        raise TopStocError(f"no decimation meets max_error {bound:g}: even all {hi} vertices measure {error:g}")
     failed_error = results[lo][1] if lo in results else math.inf
     return result, ErrorBoundReport(
         max_error=bound, achieved_error=error, target_vertices=hi, output_vertices=result.num_vertices,

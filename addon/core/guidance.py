@@ -40,6 +40,7 @@ from __future__ import annotations
 from typing import Iterable, Optional, Sequence, Tuple
 
 import numpy as np
+from .errors import TopStocError
 
 #: Direct-selection levels (thesis fig. 4.13): name -> u.
 GUIDANCE_LEVELS = {"KEEP": 1.0, "MORE": 0.5, "NEUTRAL": 0.0, "LESS": -0.5, "DROP": -1.0}
@@ -74,7 +75,7 @@ def color_to_guidance(srgb: np.ndarray) -> np.ndarray:
     """Guidance from display (sRGB) colours of shape (..., 3 or 4): ``u = red - blue``."""
     srgb = np.asarray(srgb, dtype=np.float64)
     if srgb.ndim < 1 or srgb.shape[-1] not in (3, 4):
-        raise ValueError(f"colours must have 3 or 4 channels, got shape {srgb.shape}")
+        raise TopStocError(f"colours must have 3 or 4 channels, got shape {srgb.shape}")
     u = np.clip(srgb[..., 0], 0, 1) - np.clip(srgb[..., 2], 0, 1)
     return np.where(np.isfinite(u), u, 0.0)
 
@@ -82,7 +83,7 @@ def color_to_guidance(srgb: np.ndarray) -> np.ndarray:
 def vertex_group_guidance(weights: np.ndarray, assigned: np.ndarray, mapping: str = "DETAIL") -> np.ndarray:
     """Guidance from vertex-group weights (one per vertex); unassigned vertices get 0."""
     if mapping not in VERTEX_GROUP_MAPPINGS:
-        raise ValueError(f"vertex group mapping must be one of {VERTEX_GROUP_MAPPINGS}, got {mapping!r}")
+        raise TopStocError(f"vertex group mapping must be one of {VERTEX_GROUP_MAPPINGS}, got {mapping!r}")
     w = np.clip(np.asarray(weights, dtype=np.float64), 0.0, 1.0)
     if mapping == "DETAIL":
         u = w
@@ -126,7 +127,7 @@ def combine(sources: Iterable[Tuple[np.ndarray, float]], num_vertices: int) -> O
     for values, strength in sources:
         values = np.asarray(values, dtype=np.float64)
         if values.shape != (num_vertices,):
-            raise ValueError(f"a guidance source has shape {values.shape}, expected ({num_vertices},)")
+            raise TopStocError(f"a guidance source has shape {values.shape}, expected ({num_vertices},)")
         s = float(np.clip(strength, 0.0, 1.0))
         c = s * np.clip(np.nan_to_num(values, nan=0.0), -1.0, 1.0)
         total += c

@@ -36,6 +36,7 @@ import numpy as np
 
 from . import params
 from .native import engine
+from .errors import TopStocError
 
 DEFAULT_SAMPLES = 1_000_000
 
@@ -132,8 +133,8 @@ def _mesh_arrays(mesh, what: str):
         return mesh
     if hasattr(mesh, "vertices") and hasattr(mesh, "triangles"):
         return mesh.vertices, mesh.triangles
-    raise ValueError(f"{what} must be (vertices, triangles) or have .vertices and .triangles, "
-                     f"got {type(mesh).__name__}")
+    raise TopStocError(f"{what} must be (vertices, triangles) or have .vertices and .triangles, "
+                       f"got {type(mesh).__name__}")
 
 
 def as_surface(mesh, what: str = "mesh"):
@@ -146,12 +147,12 @@ def as_surface(mesh, what: str = "mesh"):
     elif hasattr(mesh, "vertices") and hasattr(mesh, "triangles"):
         vertices, triangles = mesh.vertices, mesh.triangles
     else:
-        raise ValueError(f"{what} must be (vertices, triangles) or have .vertices and .triangles, "
-                         f"got {type(mesh).__name__}")
+        raise TopStocError(f"{what} must be (vertices, triangles) or have .vertices and .triangles, "
+                           f"got {type(mesh).__name__}")
     try:
         return engine.Surface(vertices, triangles)
     except ValueError as error:
-        raise ValueError(f"{what}: {error}") from None
+        raise TopStocError(f"{what}: {error}") from None
 
 
 def _one_sided(raw: dict) -> OneSidedDistance:
@@ -189,9 +190,9 @@ def hausdorff(a, b, *, samples: Optional[int] = None, step: Optional[float] = No
     """
     if isinstance(max_tolerance, bool) or not isinstance(max_tolerance, (int, float, np.floating)) \
             or not 0 <= max_tolerance < float("inf"):
-        raise ValueError(f"max_tolerance must be a non-negative number, got {max_tolerance!r}")
+        raise TopStocError(f"max_tolerance must be a non-negative number, got {max_tolerance!r}")
     if samples is not None and step is not None:
-        raise ValueError("give samples or step, not both")
+        raise TopStocError("give samples or step, not both")
     if samples is None:
         samples = DEFAULT_SAMPLES
     samples = params.integer("samples", samples, 1, 2**62)

@@ -29,6 +29,7 @@ import numpy as np
 from .mesh import Mesh
 from . import params
 from .native import engine
+from .errors import TopStocError
 
 #: Raised when a progress callback returns False.
 Cancelled = engine.Cancelled
@@ -141,12 +142,12 @@ class LoopsResult:
 def _as_mesh(mesh, triangles) -> Mesh:
     if isinstance(mesh, Mesh):
         if triangles is not None:
-            raise ValueError("triangles are given by the Mesh already")
+            raise TopStocError("triangles are given by the Mesh already")
         return mesh
     if triangles is None:
         if hasattr(mesh, "vertices") and hasattr(mesh, "triangles"):  # MeshData
             return Mesh(mesh.vertices, mesh.triangles)
-        raise ValueError("give a topstoc.Mesh, a MeshData, or vertices and triangles")
+        raise TopStocError("give a topstoc.Mesh, a MeshData, or vertices and triangles")
     return Mesh(mesh, triangles)
 
 
@@ -189,12 +190,12 @@ def handle_tunnel_loops(mesh, triangles=None, *, coarse_vertices: Optional[int] 
     """
     mesh = _as_mesh(mesh, triangles)
     if metric not in METRICS:
-        raise ValueError(f"metric must be one of {METRICS}, got {metric!r}")
+        raise TopStocError(f"metric must be one of {METRICS}, got {metric!r}")
     coarse = -1 if coarse_vertices is None else params.integer("coarse_vertices", coarse_vertices, 0, 2**31 - 1)
     full_route_faces = params.integer("full_route_faces", full_route_faces, 0, 2**31 - 1)
     seed = params.seed(seed)
     if progress is not None and not callable(progress):
-        raise ValueError("progress must be callable as progress(fraction, stage)")
+        raise TopStocError("progress must be callable as progress(fraction, stage)")
     raw = engine.handle_tunnel_loops(
         mesh.native, coarse_vertices=coarse, full_route_faces=int(full_route_faces),
         shorten=bool(shorten), count_edges=metric == "edges", seed=int(seed), progress=progress)
@@ -215,7 +216,7 @@ def shorten_loop(mesh, loop, triangles=None, *, metric: str = "length") -> np.nd
     """
     mesh = _as_mesh(mesh, triangles)
     if metric not in METRICS:
-        raise ValueError(f"metric must be one of {METRICS}, got {metric!r}")
+        raise TopStocError(f"metric must be one of {METRICS}, got {metric!r}")
     return engine.shorten_loop(mesh.native, np.asarray(loop), count_edges=metric == "edges")
 
 

@@ -9,6 +9,7 @@ import numpy as np
 
 from .decimate import decimate, decimate_with_samples
 from .native import engine
+from .errors import TopStocError
 
 
 @dataclass(frozen=True)
@@ -61,16 +62,16 @@ def as_vertices(vertices) -> np.ndarray:
     """The caller's vertex array as numpy, checked to be floats of shape (n, 3) (ValueError)."""
     array = np.asarray(vertices)
     if array.ndim != 2 or array.shape[1] != 3 or array.dtype.kind != "f":
-        raise ValueError(f"vertices must be a float32 or float64 array of shape (n, 3), "
-                         f"got {array.dtype} array of shape {array.shape}")
+        raise TopStocError(f"vertices must be a float32 or float64 array of shape (n, 3), "
+                           f"got {array.dtype} array of shape {array.shape}")
     return array
 
 
 def _as_triangles(triangles) -> np.ndarray:
     array = np.asarray(triangles)
     if array.ndim != 2 or array.shape[1] != 3 or array.dtype.kind not in "iu":
-        raise ValueError(f"triangles must be an int32 or int64 array of shape (m, 3), "
-                         f"got {array.dtype} array of shape {array.shape}")
+        raise TopStocError(f"triangles must be an int32 or int64 array of shape (m, 3), "
+                           f"got {array.dtype} array of shape {array.shape}")
     return array
 
 

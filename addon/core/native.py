@@ -13,6 +13,7 @@ import importlib.util
 import os
 
 from . import native_diagnosis
+from .errors import TopStocError
 
 # Idle OpenMP threads sleep instead of spinning: spinning threads look busy to the engine's
 # free-core count (and to everyone else's). Only takes effect if libgomp is not loaded yet
@@ -47,5 +48,7 @@ def _load():
 
 
 engine = _load()
+# Bad input the engine names (std::invalid_argument) is raised as TopStocError, a ValueError.
+engine._set_error_class(TopStocError)
 
 __all__ = ["engine"]

@@ -18,6 +18,7 @@ import numbers
 from typing import Optional
 
 import numpy as np
+from .errors import TopStocError
 
 #: Seeds are 64-bit unsigned integers in the engine.
 SEED_MAX = 2**64 - 1
@@ -50,11 +51,11 @@ def integer(name: str, value, low: Optional[int] = None, high: Optional[int] = N
     """``value`` as a Python int in [low, high] (None: unbounded); ValueError otherwise.
     ``expected`` replaces the range in the message ("must be {expected}, got ...")."""
     if _is_bool(value) or not isinstance(value, (numbers.Integral, np.integer)):
-        raise ValueError(f"{name} must be {expected or 'an integer'}, got {_shown(value)}")
+        raise TopStocError(f"{name} must be {expected or 'an integer'}, got {_shown(value)}")
     exact = int(value)  # arbitrary precision: the comparison below cannot overflow
     if (low is not None and exact < low) or (high is not None and exact > high):
         wanted = f"be {expected}" if expected else f"lie in {_range_text(low, high, False, False)}"
-        raise ValueError(f"{name} must {wanted}, got {_shown(value)}")
+        raise TopStocError(f"{name} must {wanted}, got {_shown(value)}")
     return exact
 
 
@@ -65,16 +66,16 @@ def number(name: str, value, low: Optional[float] = None, high: Optional[float] 
     None: unbounded) and finite unless ``finite=False``; ValueError for anything else, NaN
     included. ``expected`` replaces the range in the message ("must be {expected}, got ...")."""
     if _is_bool(value) or not isinstance(value, (numbers.Real, np.integer, np.floating)):
-        raise ValueError(f"{name} must be {expected or 'a number'}, got {_shown(value)}")
+        raise TopStocError(f"{name} must be {expected or 'a number'}, got {_shown(value)}")
     try:
         real = float(value)
     except OverflowError:  # an int beyond the double range
-        raise ValueError(f"{name} is too large: {_shown(value)}") from None
+        raise TopStocError(f"{name} is too large: {_shown(value)}") from None
     below = low is not None and (real < low or (low_open and real == low))
     above = high is not None and (real > high or (high_open and real == high))
     if math.isnan(real) or below or above or (finite and math.isinf(real)):
         wanted = f"be {expected}" if expected else f"lie in {_range_text(low, high, low_open, high_open)}"
-        raise ValueError(f"{name} must {wanted}, got {_shown(value)}")
+        raise TopStocError(f"{name} must {wanted}, got {_shown(value)}")
     return real
 
 

@@ -14,6 +14,7 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
+from .errors import TopStocError
 
 
 @dataclass(frozen=True)
@@ -63,7 +64,7 @@ def prune_small_parts(result, min_size: float):
     """(pruned result, PruneReport): ``result`` (a DecimateResult) without its parts smaller
     than ``min_size`` (bounding-box diagonal, world units)."""
     if not np.isfinite(min_size) or min_size < 0:
-        raise ValueError(f"the pruning size must be a non-negative number, got {min_size!r}")
+        raise TopStocError(f"the pruning size must be a non-negative number, got {min_size!r}")
     vertices = np.asarray(result.vertices, dtype=np.float64)
     triangles = np.asarray(result.triangles, dtype=np.int64)
     if len(triangles) == 0:

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
+from .errors import TopStocError
 
 DEFAULT_FOV_DEGREES = 60.0
 DEFAULT_RESOLUTION = 1080
@@ -67,9 +68,9 @@ def bounding_sphere(vertices) -> tuple:
     """(centre, radius): bounding-box centre and the largest vertex distance from it."""
     v = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
     if len(v) == 0:
-        raise ValueError("a bounding sphere needs at least one vertex")
+        raise TopStocError("a bounding sphere needs at least one vertex")
     if not np.isfinite(v).all():
-        raise ValueError("vertex coordinates must be finite")
+        raise TopStocError("vertex coordinates must be finite")
     centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
     radius = float(np.sqrt(((v - centre) ** 2).sum(axis=1).max()))
     return centre, radius
@@ -78,7 +79,7 @@ def bounding_sphere(vertices) -> tuple:
 def _positive(name: str, value) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
             or not math.isfinite(value) or value <= 0:
-        raise ValueError(f"{name} must be a positive number, got {value!r}")
+        raise TopStocError(f"{name} must be a positive number, got {value!r}")
     return float(value)
 
 
@@ -90,11 +91,11 @@ def projected_pixels(radius: float, distance: float, fov_degrees: float = DEFAUL
     distance = _positive("distance", distance)
     fov = _positive("fov", fov_degrees)
     if fov >= 180:
-        raise ValueError(f"fov must lie in (0, 180) degrees, got {fov_degrees!r}")
+        raise TopStocError(f"fov must lie in (0, 180) degrees, got {fov_degrees!r}")
     resolution = _positive("resolution", resolution)
     if distance <= radius:
-        raise ValueError(f"distance {distance:g} must exceed the bounding-sphere radius {radius:g} "
-                         "(the camera would be inside the object)")
+        raise TopStocError(f"distance {distance:g} must exceed the bounding-sphere radius {radius:g} "
+                           "(the camera would be inside the object)")
     return resolution * math.tan(math.asin(radius / distance)) / math.tan(math.radians(fov) / 2)
 
 
@@ -104,11 +105,11 @@ def screen_target(vertices, *, pixels: float = None, distance: float = None,
     """The world-space target for an object (its ``vertices``) covering ``pixels`` pixels, or
     seen from ``distance`` with ``fov_degrees`` / ``resolution``; exactly one of the two."""
     if (pixels is None) == (distance is None):
-        raise ValueError("give exactly one of pixels (projected diameter) or distance")
+        raise TopStocError("give exactly one of pixels (projected diameter) or distance")
     pixel_error = _positive("pixel_error", pixel_error)
     _, radius = bounding_sphere(vertices)
     if radius == 0:
-        raise ValueError("the object has no extent (all vertices coincide)")
+        raise TopStocError("the object has no extent (all vertices coincide)")
     if distance is not None:
         distance = _positive("distance", distance)
         pixels = projected_pixels(radius, distance, fov_degrees, resolution)

@@ -22,6 +22,7 @@ vertices, without a second refinement.
 from __future__ import annotations
 
 import numpy as np
+from .errors import TopStocError
 
 AXES = {"X": 0, "Y": 1, "Z": 2}
 MAX_ROUNDS = 6
@@ -42,7 +43,7 @@ def mirror_partners(vertices, axis: str = "X", tolerance: float = None) -> np.nd
     bounding-box diagonal). Vertices on the plane are their own partners.
     """
     if axis not in AXES:
-        raise ValueError(f"symmetry axis must be one of {tuple(AXES)}, got {axis!r}")
+        raise TopStocError(f"symmetry axis must be one of {tuple(AXES)}, got {axis!r}")
     v = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
     n = len(v)
     partner = np.full(n, -1, dtype=np.int64)
@@ -51,7 +52,7 @@ def mirror_partners(vertices, axis: str = "X", tolerance: float = None) -> np.nd
     diagonal = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0))) or 1.0
     tol = tolerance if tolerance is not None else 1e-5 * diagonal
     if not tol > 0:
-        raise ValueError(f"tolerance must be positive, got {tolerance!r}")
+        raise TopStocError(f"tolerance must be positive, got {tolerance!r}")
     mirrored = v.copy()
     mirrored[:, AXES[axis]] *= -1.0
     both = np.vstack([v, mirrored])

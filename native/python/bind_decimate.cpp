@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "caller_order.hpp"
+#include <stdexcept>
+
 #include "convert.hpp"
 #include "topstoc/core/validate.hpp"
 #include "topstoc/decimate/decimate.hpp"
@@ -18,20 +20,20 @@ DensityMode density_from(const std::string& name) {
   if (name == "uniform") return DensityMode::Uniform;
   if (name == "adaptive") return DensityMode::Adaptive;
   if (name == "euclidean") return DensityMode::Euclidean;
-  throw py::value_error("density must be 'off', 'uniform', 'adaptive' or 'euclidean', got '" + name + "'");
+  throw std::invalid_argument("density must be 'off', 'uniform', 'adaptive' or 'euclidean', got '" + name + "'");
 }
 
 Placement placement_from(const std::string& name) {
   if (name == "subsample") return Placement::Subsample;
   if (name == "filtered") return Placement::Filtered;
-  throw py::value_error("placement must be 'subsample' or 'filtered', got '" + name + "'");
+  throw std::invalid_argument("placement must be 'subsample' or 'filtered', got '" + name + "'");
 }
 
 template <size_t N>
 void fill(const py::handle& object, double (&out)[N], const char* what) {
   auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(object);
   if (!values || size_t(values.size()) != N)
-    throw py::value_error(std::string(what) + " must hold " + std::to_string(N) + " numbers");
+    throw std::invalid_argument(std::string(what) + " must hold " + std::to_string(N) + " numbers");
   for (size_t i = 0; i < N; ++i) out[i] = values.data()[i];
 }
 
@@ -59,7 +61,7 @@ std::vector<BoxGuidance> boxes_from(const py::handle& object) {
   if (object.is_none()) return boxes;
   for (const auto& item : object) {
     auto pair = py::cast<py::tuple>(item);
-    if (pair.size() != 2) throw py::value_error("each box must be (world_to_box 4x4 matrix, value)");
+    if (pair.size() != 2) throw std::invalid_argument("each box must be (world_to_box 4x4 matrix, value)");
     BoxGuidance box{};
     fill(pair[0], box.world_to_box, "box matrix");
     box.value = py::cast<double>(pair[1]);
@@ -196,7 +198,7 @@ void bind_decimate(py::module_& m) {
          int32_t max_repair_rounds, int32_t refine_vertices, const py::handle& guidance) {
         auto ids = ids_from(samples, -1, "samples");
         const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
-        if (refine_vertices < 0) throw py::value_error("refine_vertices must be >= 0");
+        if (refine_vertices < 0) throw std::invalid_argument("refine_vertices must be >= 0");
         DecimateResult r;
         {
           EngineCall call;

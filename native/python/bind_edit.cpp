@@ -2,6 +2,8 @@
 // remove a handle. Arrays in, a dict of arrays out (see addon/core/edit.py for the Python API).
 #include <pybind11/stl.h>
 
+#include <stdexcept>
+
 #include "convert.hpp"
 #include "topstoc/edit/edit.hpp"
 #include "topstoc/edit/fill_holes.hpp"
@@ -20,12 +22,12 @@ struct Arrays {
 
 Arrays arrays_from(const py::handle& vertices, const py::handle& triangles) {
   Arrays a{positions_from(vertices, "vertices"), indices_from(triangles, 3, "triangles")};
-  if (a.positions.size() / 3 > size_t(INT32_MAX)) throw py::value_error("mesh is too large: more than 2^31 vertices");
+  if (a.positions.size() / 3 > size_t(INT32_MAX)) throw std::invalid_argument("mesh is too large: more than 2^31 vertices");
   return a;
 }
 
 FillOptions fill_options(bool planar, int32_t max_dp_corners, bool refine, bool fair) {
-  if (max_dp_corners < 3) throw py::value_error("max_dp_corners must be at least 3, got " + std::to_string(max_dp_corners));
+  if (max_dp_corners < 3) throw std::invalid_argument("max_dp_corners must be at least 3, got " + std::to_string(max_dp_corners));
   FillOptions o;
   o.triangulation.planar = planar;
   o.triangulation.max_dp_corners = max_dp_corners;
@@ -125,7 +127,7 @@ void bind_edit(py::module_& m) {
         HoleSelection selection;
         selection.holes = ids_from(holes, -1, "holes");
         if (!holes.is_none() && selection.holes.empty())
-          throw py::value_error("holes is empty: pass None to fill every hole");
+          throw std::invalid_argument("holes is empty: pass None to fill every hole");
         selection.max_edges = max_edges;
         selection.skip_unfillable = skip_unfillable;
         selection.weld_pinches = weld_pinches;
@@ -168,7 +170,7 @@ void bind_edit(py::module_& m) {
          double separation, bool planar, int32_t max_dp_corners, bool refine, bool fair,
          bool allow_self_intersections) {
         if (!(separation >= 0.0 && separation < 1.0))
-          throw py::value_error("separation must lie in [0, 1), got " + std::to_string(separation));
+          throw std::invalid_argument("separation must lie in [0, 1), got " + std::to_string(separation));
         Arrays a = arrays_from(vertices, triangles);
         const auto ids = ids_from(loop, -1, "loop");
         RemoveHandleOptions options;

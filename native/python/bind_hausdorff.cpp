@@ -1,6 +1,8 @@
 // Bindings for the Hausdorff measurement: surfaces, their samples, closest points, distances.
 #include <cmath>
 
+#include <stdexcept>
+
 #include "convert.hpp"
 #include "topstoc/distance/hausdorff.hpp"
 
@@ -93,7 +95,7 @@ void bind_hausdorff(py::module_& m) {
         const int64_t n = int64_t(p.size() / 3);
         for (int64_t i = 0; i < n; ++i)
           if (!std::isfinite(p[3 * i]) || !std::isfinite(p[3 * i + 1]) || !std::isfinite(p[3 * i + 2]))
-            throw py::value_error("point " + std::to_string(i) + " has a non-finite coordinate");
+            throw std::invalid_argument("point " + std::to_string(i) + " has a non-finite coordinate");
         std::vector<ClosestHit> hits;
         {
           EngineCall call;

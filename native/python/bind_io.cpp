@@ -2,6 +2,8 @@
 // decompresses and names the file).
 #include <pybind11/stl.h>
 
+#include <stdexcept>
+
 #include "convert.hpp"
 #include "topstoc/io/io.hpp"
 
@@ -14,7 +16,7 @@ MeshFormat format_from(const std::string& name) {
   if (name == "ply") return MeshFormat::Ply;
   if (name == "off") return MeshFormat::Off;
   if (name == "stl") return MeshFormat::Stl;
-  throw py::value_error("format must be 'obj', 'ply', 'off' or 'stl', got '" + name + "'");
+  throw std::invalid_argument("format must be 'obj', 'ply', 'off' or 'stl', got '" + name + "'");
 }
 
 // (rows, columns) float array (or None -> empty) as row-major doubles.
@@ -22,7 +24,7 @@ std::vector<double> floats_from(const py::handle& object, int64_t rows, int64_t 
   if (object.is_none()) return {};
   auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(object);
   if (!a || a.ndim() != 2 || a.shape(0) != rows || a.shape(1) != columns)
-    throw py::value_error(std::string(what) + " must be a float array of shape (" + std::to_string(rows) + ", " +
+    throw std::invalid_argument(std::string(what) + " must be a float array of shape (" + std::to_string(rows) + ", " +
                           std::to_string(columns) + ")");
   return std::vector<double>(a.data(), a.data() + a.size());
 }
@@ -47,7 +49,7 @@ void bind_io(py::module_& m) {
       [](const py::buffer& data, const std::string& format) {
         const MeshFormat kind = format_from(format);
         const py::buffer_info info = data.request();
-        if (info.itemsize != 1 || info.ndim != 1) throw py::value_error("data must be a bytes-like object");
+        if (info.itemsize != 1 || info.ndim != 1) throw std::invalid_argument("data must be a bytes-like object");
         MeshFile file;
         {
           EngineCall call;
@@ -89,7 +91,7 @@ void bind_io(py::module_& m) {
         if (!vertex_colors.is_none()) {
           auto a = py::array::ensure(vertex_colors);
           if (!a || a.ndim() != 2 || (a.shape(1) != 3 && a.shape(1) != 4))
-            throw py::value_error("vertex_colors must be a float array of shape (n, 3) or (n, 4)");
+            throw std::invalid_argument("vertex_colors must be a float array of shape (n, 3) or (n, 4)");
           file.color_channels = int32_t(a.shape(1));
           file.vertex_colors = floats_from(vertex_colors, n, file.color_channels, "vertex_colors");
         }

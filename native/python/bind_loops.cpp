@@ -2,6 +2,8 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include <stdexcept>
+
 #include "convert.hpp"
 #include "topstoc/core/validate.hpp"
 #include "topstoc/topology/loops.hpp"
@@ -148,7 +150,7 @@ void bind_loops(py::module_& m) {
         std::vector<uint8_t> used(n, 0);
         for (int32_t v : t) used[v] = 1;
         for (int64_t v = 0; v < n; ++v)
-          if (!used[v]) throw py::value_error("vertex " + std::to_string(v) + " is in no triangle");
+          if (!used[v]) throw std::invalid_argument("vertex " + std::to_string(v) + " is in no triangle");
         TetMesh tets;
         {
           EngineCall call;

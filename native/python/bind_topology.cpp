@@ -1,5 +1,7 @@
 // Bindings for topology: invariants per component and generator edges, as plain arrays.
 // topstoc.core.topology turns them into dataclasses.
+#include <stdexcept>
+
 #include "convert.hpp"
 #include "topstoc/topology/complex.hpp"
 #include "topstoc/topology/generators.hpp"
@@ -81,7 +83,7 @@ void bind_topology(py::module_& m) {
         const auto tris = indices_array(triangles, 3, "triangles");  // read only: no copy
         std::vector<int32_t> wires;
         if (!edges.is_none()) wires = indices_from(edges, 2, "edges");
-        if (positions.shape(0) > INT32_MAX) throw py::value_error("more than 2^31 vertices");
+        if (positions.shape(0) > INT32_MAX) throw std::invalid_argument("more than 2^31 vertices");
         const double* coordinates = positions.data();
         const auto num_vertices = static_cast<int32_t>(positions.shape(0));
         TopologyReport report;

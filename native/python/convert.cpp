@@ -15,12 +15,12 @@ std::string describe(const py::array& a) {
 }
 
 py::array as_array(const py::handle& object, const char* what) {
-  if (object.is_none()) throw py::value_error(std::string(what) + " is None");
+  if (object.is_none()) throw std::invalid_argument(std::string(what) + " is None");
   try {
     return py::array::ensure(object);
   } catch (const py::error_already_set&) {
   }
-  throw py::value_error(std::string(what) + " must be an array");
+  throw std::invalid_argument(std::string(what) + " must be an array");
 }
 
 }  // namespace
@@ -28,7 +28,7 @@ py::array as_array(const py::handle& object, const char* what) {
 py::array_t<double, py::array::c_style> positions_array(const py::handle& object, const char* what) {
   py::array a = as_array(object, what);
   if (!a || a.ndim() != 2 || a.shape(1) != 3 || (a.dtype().kind() != 'f'))
-    throw py::value_error(std::string(what) + " must be a float32 or float64 array of shape (n, 3), got " +
+    throw std::invalid_argument(std::string(what) + " must be a float32 or float64 array of shape (n, 3), got " +
                           (a ? describe(a) : std::string("something else")));
   return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
 }
@@ -41,7 +41,7 @@ std::vector<double> positions_from(const py::handle& object, const char* what) {
 std::vector<int32_t> indices_from(const py::handle& object, int64_t columns, const char* what) {
   py::array a = as_array(object, what);
   if (!a || a.ndim() != 2 || a.shape(1) != columns || (a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
-    throw py::value_error(std::string(what) + " must be an int32 or int64 array of shape (m, " +
+    throw std::invalid_argument(std::string(what) + " must be an int32 or int64 array of shape (m, " +
                           std::to_string(columns) + "), got " + (a ? describe(a) : std::string("something else")));
   // int32 in C order (what io and Blender hand over) is copied as is: no int64 detour.
   if (py::isinstance<py::array_t<int32_t, py::array::c_style>>(a)) {
@@ -53,7 +53,7 @@ std::vector<int32_t> indices_from(const py::handle& object, int64_t columns, con
   for (py::ssize_t i = 0; i < d.size(); ++i) {
     const int64_t x = d.data()[i];
     if (x < INT32_MIN || x > INT32_MAX)
-      throw py::value_error(std::string(what) + " row " + std::to_string(i / columns) + " holds " + std::to_string(x) +
+      throw std::invalid_argument(std::string(what) + " row " + std::to_string(i / columns) + " holds " + std::to_string(x) +
                             ", outside the 32-bit index range");
     out[i] = static_cast<int32_t>(x);
   }
@@ -71,15 +71,15 @@ std::vector<double> scalars_from(const py::handle& object, int64_t n, const char
   if (object.is_none()) return {};
   py::array a = as_array(object, what);
   if (!a || a.ndim() != 1 || (a.dtype().kind() != 'f' && a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
-    throw py::value_error(std::string(what) + " must be a 1-D float array, got " +
+    throw std::invalid_argument(std::string(what) + " must be a 1-D float array, got " +
                           (a ? describe(a) : std::string("something else")));
   if (a.shape(0) != n)
-    throw py::value_error(std::string(what) + " has " + std::to_string(a.shape(0)) + " entries, expected " +
+    throw std::invalid_argument(std::string(what) + " has " + std::to_string(a.shape(0)) + " entries, expected " +
                           std::to_string(n));
   auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
   std::vector<double> out(d.data(), d.data() + d.size());
   for (size_t i = 0; i < out.size(); ++i)
-    if (std::isnan(out[i])) throw py::value_error(std::string(what) + " entry " + std::to_string(i) + " is NaN");
+    if (std::isnan(out[i])) throw std::invalid_argument(std::string(what) + " entry " + std::to_string(i) + " is NaN");
   return out;
 }
 
@@ -87,17 +87,17 @@ std::vector<int32_t> ids_from(const py::handle& object, int64_t n, const char* w
   if (object.is_none()) return {};
   py::array a = as_array(object, what);
   if (!a || a.ndim() != 1 || (a.dtype().kind() != 'i' && a.dtype().kind() != 'u'))
-    throw py::value_error(std::string(what) + " must be a 1-D integer array, got " +
+    throw std::invalid_argument(std::string(what) + " must be a 1-D integer array, got " +
                           (a ? describe(a) : std::string("something else")));
   if (n >= 0 && a.shape(0) != n)
-    throw py::value_error(std::string(what) + " has " + std::to_string(a.shape(0)) + " entries, expected " +
+    throw std::invalid_argument(std::string(what) + " has " + std::to_string(a.shape(0)) + " entries, expected " +
                           std::to_string(n));
   auto d = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
   std::vector<int32_t> out(d.size());
   for (py::ssize_t i = 0; i < d.size(); ++i) {
     const int64_t x = d.data()[i];
     if (x < INT32_MIN || x > INT32_MAX)
-      throw py::value_error(std::string(what) + " entry " + std::to_string(i) + " is outside the 32-bit range");
+      throw std::invalid_argument(std::string(what) + " entry " + std::to_string(i) + " is outside the 32-bit range");
     out[i] = static_cast<int32_t>(x);
   }
   return out;

@@ -4,10 +4,12 @@ outputs equal the serial batch byte for byte. Runs with Debian's Blender (``blen
 and with PyPI's bpy (the checkout's .venv, or $TOPSTOC_BPY_PYTHON), whichever are there."""
 
 import os
+import pathlib
 import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 
 import pytest
@@ -127,6 +129,8 @@ def test_a_killed_workers_blender_child_dies_and_its_asset_is_rerun(kind, librar
     assert processes(str(library)) == {}   # no Blender or bpy process left for these assets
     assert outputs(out) == outputs(serial) and len(outputs(out)) == 3
     assert leftovers(out) == []
+    # the killed task's scratch folder (named after its worker) was removed at the end
+    assert not list(pathlib.Path(tempfile.gettempdir()).glob(f"topstoc-batch-{worker}-*"))
     data = report(out)
     assert len(data["results"]) == 3 and not data["failures"]
     [record] = [r for r in manifest(out) if r["input"] == big]

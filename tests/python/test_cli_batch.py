@@ -66,3 +66,35 @@ def test_clear_errors(tmp_path):
     (tmp_path / "empty").mkdir()
     done = batch("--input", tmp_path / "empty", "--output", tmp_path / "out", "--ratio", 0.5, "--workers", 0)
     cli.assert_one_error_line("batch", done, "no input assets found")
+
+
+def test_orphaned_scratch_of_dead_processes_is_removed(tmp_path):
+    """A worker killed during a Blender task leaves its scratch folder; the next batch removes
+    the folders whose owner is gone, and only those."""
+    import os
+    import subprocess
+    import sys
+
+    from topstoc.core.batch_run import remove_orphaned_scratch
+
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    dead_pid = int(gone.stdout)
+    names = {f"topstoc-batch-{dead_pid}-abc": False, f"topstoc-batch-{os.getpid()}-def": True,
+             "topstoc-batch-notapid-x": True, "unrelated-1": True}
+    for name in names:
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "report.json").write_text("{}")
+    assert remove_orphaned_scratch(str(tmp_path)) == 1
+    assert {p.name for p in tmp_path.iterdir()} == {name for name, kept in names.items() if kept}
+
+
+def test_progress_summary_of_a_scene_with_lods():
+    """A Blender asset's LOD chain: the progress line sums each LOD over the scene's objects."""
+    from topstoc.core.cli.batch import _summary
+
+    entry = {"vertices_in": 300, "vertices_out": 150, "triangles_out": 290,
+             "objects": [{"lods": [{"vertices": 100}, {"vertices": 40}, {"vertices": 10}]},
+                         {"lods": [{"vertices": 50}, {"vertices": 20}, {"vertices": 5}]}]}
+    assert _summary(entry) == "300 -> 150 / 60 / 15 vertices (3 LODs)"
+    single = {"vertices_in": 300, "vertices_out": 150, "triangles_out": 290, "objects": [{"lods": [{"vertices": 150}]}]}
+    assert _summary(single) == "300 -> 150 vertices, 290 triangles"

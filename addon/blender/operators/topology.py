@@ -18,6 +18,7 @@ from bpy.props import EnumProperty
 from ...core import edit
 from .. import analysis, mesh_edit, mesh_io, watch
 from . import polls
+from ...core.errors import TopStocError
 
 #: Searches running in the background, by object name (the panel shows their progress).
 running: dict = {}
@@ -387,14 +388,14 @@ triangulation, robust fallbacks)"""
         def compute(o, arrays):
             holes = edit.boundary_loops(arrays.vertices, arrays.triangles)
             if not holes:
-                raise ValueError("the mesh has no holes")
+                raise TopStocError("the mesh has no holes")
             if mode == "ALL":
                 return edit.fill_holes(arrays.vertices, arrays.triangles, skip_unfillable=True)
             selected = mesh_io._get(o.data.vertices, "select", len(o.data.vertices), 1, bool)
             picked = [i for i, hole in enumerate(holes)
                       if (selected[hole.vertices] & selected[np.roll(hole.vertices, -1)]).any()]
             if not picked:
-                raise ValueError("no hole has a selected boundary edge")
+                raise TopStocError("no hole has a selected boundary edge")
             return edit.fill_holes(arrays.vertices, arrays.triangles, holes=picked)
 
         return run_edit(self, context, compute, verb="holes filled")
@@ -415,7 +416,7 @@ class TOPSTOC_OT_delete_faces(bpy.types.Operator):
         def compute(o, arrays):
             selected = mesh_io._get(o.data.polygons, "select", len(o.data.polygons), 1, bool)
             if not selected.any():
-                raise ValueError("no faces are selected")
+                raise TopStocError("no faces are selected")
             return edit.delete_faces(arrays.vertices, arrays.triangles, selected[arrays.triangle_polygon])
 
         return run_edit(self, context, compute, verb="faces deleted")

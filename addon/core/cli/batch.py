@@ -16,8 +16,9 @@ import sys
 import time
 
 from .. import batch_settings
-from ..batch_run import find_inputs, remove_stale_temporaries, run_dask, run_serial
+from ..batch_run import find_inputs, remove_orphaned_scratch, remove_stale_temporaries, run_dask, run_serial
 from ..manifest import Manifest, content_hash, task_key
+from ..errors import TopStocError
 
 REPORT_NAME = "topstoc-report.json"
 
@@ -99,16 +100,26 @@ def _check_names(tasks, out_dir, settings) -> None:
             names = [os.path.join(out_dir, stem + ("." + settings["format"] if settings["format"] else ext.lower()))]
         for name in names:
             if name in owners:
-                raise ValueError(f"{owners[name]} and {path} would both write {name}; "
-                                 "batch them into different output folders")
+                raise TopStocError(f"{owners[name]} and {path} would both write {name}; "
+                                   "batch them into different output folders")
             owners[name] = path
 
 
+def _lod_vertices(entry: dict) -> list:
+    """Vertices per LOD: a mesh file's ``lods``, or summed over a scene's objects."""
+    if entry.get("lods"):
+        return [lod["vertices"] for lod in entry["lods"]]
+    per_object = [obj.get("lods") or [] for obj in entry.get("objects") or []]
+    if not per_object:
+        return []
+    return [sum(lods[i]["vertices"] for lods in per_object if i < len(lods))
+            for i in range(max(len(lods) for lods in per_object))]
+
+
 def _summary(entry: dict) -> str:
-    lods = entry.get("lods") or []
+    lods = _lod_vertices(entry)
     if len(lods) > 1:
-        counts = " / ".join(str(lod["vertices"]) for lod in lods)
-        return f"{entry['vertices_in']} -> {counts} vertices ({len(lods)} LODs)"
+        return f"{entry['vertices_in']} -> {' / '.join(map(str, lods))} vertices ({len(lods)} LODs)"
     return f"{entry['vertices_in']} -> {entry['vertices_out']} vertices, {entry['triangles_out']} triangles"
 
 
@@ -117,9 +128,9 @@ def parse_chunk(text: str) -> tuple:
     try:
         index, count = (int(part) for part in text.split("/"))
     except ValueError:
-        raise ValueError(f"--chunk must look like I/N (e.g. 2/8), got {text!r}") from None
+        raise TopStocError(f"--chunk must look like I/N (e.g. 2/8), got {text!r}") from None
     if not 1 <= index <= count:
-        raise ValueError(f"--chunk I/N needs 1 <= I <= N, got {text!r}")
+        raise TopStocError(f"--chunk I/N needs 1 <= I <= N, got {text!r}")
     return index, count
 
 
@@ -136,7 +147,7 @@ def run(args) -> int:
         if args.chunk:  # more chunks than files: an empty chunk is not an error
             print(f"topstoc batch: chunk {args.chunk} has no inputs", flush=True)
             return 0
-        raise ValueError("no input assets found")
+        raise TopStocError("no input assets found")
     os.makedirs(args.output, exist_ok=True)
     manifest = Manifest(args.output, suffix)
     fingerprint = batch_settings.digest(settings)
@@ -180,7 +191,7 @@ def run(args) -> int:
 
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     if workers < 0:
-        raise ValueError(f"--workers must be 0 (serial) or more, got {workers}")
+        raise TopStocError(f"--workers must be 0 (serial) or more, got {workers}")
 
     def announce(client):
         pids = sorted(client.run(os.getpid).values())
@@ -198,6 +209,7 @@ def run(args) -> int:
     finally:
         progress.close()
     remove_stale_temporaries(outputs)
+    remove_orphaned_scratch()
 
     report = {"settings": settings, "runner": {"scheduler": args.scheduler, "workers": 0 if args.scheduler else workers},
               "seconds": time.perf_counter() - started,

@@ -17,6 +17,7 @@ from ..attributes import material_regions, transfer_attributes, uv_seam_edges
 from ..io import dropped_attributes, mesh_format, read_mesh, write_mesh
 from ..mesh import Mesh
 from . import print_json
+from ..errors import TopStocError
 
 DENSITIES = ("off", "uniform", "adaptive")
 
@@ -62,9 +63,9 @@ def parse_max_error(text: str) -> tuple:
     try:
         value = float(text.strip().rstrip("%"))
     except ValueError:
-        raise ValueError(f"--max-error must be a number, optionally followed by %, got {text!r}") from None
+        raise TopStocError(f"--max-error must be a number, optionally followed by %, got {text!r}") from None
     if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"--max-error must be positive, got {text!r}")
+        raise TopStocError(f"--max-error must be positive, got {text!r}")
     return (value / 100.0, True) if relative else (value, False)
 
 
@@ -75,16 +76,16 @@ def load_guidance(path: str, num_vertices: int) -> np.ndarray:
     except FileNotFoundError:
         raise
     except (OSError, ValueError) as error:
-        raise ValueError(f"{path}: not a readable .npy file ({error})") from None
+        raise TopStocError(f"{path}: not a readable .npy file ({error})") from None
     if u.dtype.kind not in "fiub":
-        raise ValueError(f"{path}: guidance must be numbers, got dtype {u.dtype}")
+        raise TopStocError(f"{path}: guidance must be numbers, got dtype {u.dtype}")
     if u.shape != (num_vertices,):
-        raise ValueError(f"{path}: guidance must hold one value per input vertex ({num_vertices}), "
-                         f"got shape {u.shape}")
+        raise TopStocError(f"{path}: guidance must hold one value per input vertex ({num_vertices}), "
+                           f"got shape {u.shape}")
     u = u.astype(np.float64)
     bad = np.flatnonzero(~(np.abs(u) <= 1))  # also catches NaN
     if len(bad):
-        raise ValueError(f"{path}: guidance of vertex {bad[0]} is {u[bad[0]]}; values must lie in [-1, 1]")
+        raise TopStocError(f"{path}: guidance of vertex {bad[0]} is {u[bad[0]]}; values must lie in [-1, 1]")
     return u
 
 
@@ -110,7 +111,7 @@ def run(args) -> int:
     mesh_format(args.output)  # fail on a bad output name before doing any work
     data = read_mesh(args.input)
     if data.num_triangles == 0:
-        raise ValueError(f"{args.input}: the mesh has no triangles")
+        raise TopStocError(f"{args.input}: the mesh has no triangles")
     guidance = None if args.guidance is None else load_guidance(args.guidance, data.num_vertices)
 
     start = time.perf_counter()

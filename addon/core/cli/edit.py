@@ -13,6 +13,7 @@ import time
 import numpy as np
 
 from . import print_json
+from ..errors import TopStocError
 
 
 def add_parser(subparsers) -> None:
@@ -61,9 +62,9 @@ def _ids(text: str, what: str) -> list:
     try:
         values = [int(x) for x in text.replace(" ", "").split(",") if x != ""]
     except ValueError:
-        raise ValueError(f"{what} must be comma-separated integers, got {text!r}") from None
+        raise TopStocError(f"{what} must be comma-separated integers, got {text!r}") from None
     if not values:
-        raise ValueError(f"{what} is empty")
+        raise TopStocError(f"{what} is empty")
     return values
 
 
@@ -74,7 +75,7 @@ def run_fill(args) -> int:
     data = read_mesh(args.input)
     holes = _ids(args.holes, "--holes") if args.holes is not None else None
     if args.max_edges is not None and args.max_edges < 3:
-        raise ValueError(f"--max-edges must be at least 3, got {args.max_edges}")
+        raise TopStocError(f"--max-edges must be at least 3, got {args.max_edges}")
     start = time.perf_counter()
     result = fill_holes(data.vertices, data.triangles, holes=holes, max_edges=args.max_edges,
                         skip_unfillable=args.skip_unfillable, weld_pinches=not args.no_weld, fair=args.fair)
@@ -102,7 +103,7 @@ def run_remove_handle(args) -> int:
     loops_seconds = 0.0
     if args.loop is not None:
         if args.tunnel:
-            raise ValueError("--tunnel goes with --index, not --loop")
+            raise TopStocError("--tunnel goes with --index, not --loop")
         loop = np.asarray(_ids(args.loop, "--loop"))
         kind = "given"
     else:
@@ -113,7 +114,7 @@ def run_remove_handle(args) -> int:
         kind = "tunnel" if args.tunnel else "handle"
         candidates = found.tunnels if args.tunnel else found.handles
         if not 0 <= args.index < len(candidates):
-            raise ValueError(f"--index {args.index} is out of range: the mesh has {len(candidates)} {kind} loops")
+            raise TopStocError(f"--index {args.index} is out of range: the mesh has {len(candidates)} {kind} loops")
         loop = np.asarray(candidates[args.index].vertices)
     result = remove_handle(data.vertices, data.triangles, loop, allow_separating=args.allow_separating,
                            fair=args.fair)

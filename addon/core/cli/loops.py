@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from ..errors import TopStocError
 
 
 def add_parser(subparsers) -> None:
@@ -38,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
 
     data = read_mesh(args.input)
     if args.coarse_vertices is not None and args.coarse_vertices <= 0:
-        raise ValueError(f"--coarse-vertices must be positive, got {args.coarse_vertices}")
+        raise TopStocError(f"--coarse-vertices must be positive, got {args.coarse_vertices}")
     started = time.perf_counter()
     mesh = Mesh(data.vertices, data.triangles)
     result = handle_tunnel_loops(mesh, coarse_vertices=0 if args.full else args.coarse_vertices,
