@@ -14,7 +14,7 @@ import bpy
 import numpy as np
 
 from ..core.errors import TopStocError
-from ..core.symmetry import decimate_symmetric as symmetric_decimate
+from ..core.symmetry import decimate_mirrored
 from . import carry, mesh_io
 from .cache import Prepared, prepared_meshes
 from .guidance import EngineGuidance, gather
@@ -91,9 +91,7 @@ def symmetry_axis(params):
 
 def run_engine(mesh, target: dict, options: dict, guidance_kwargs: dict, axis=None):
     """One engine decimation, mirror-symmetric when ``axis`` is given (core/symmetry.py)."""
-    if axis is None:
-        return mesh.decimate(**target, **options, **guidance_kwargs)
-    return symmetric_decimate(mesh, axis, **target, **options, **guidance_kwargs)
+    return decimate_mirrored(mesh, axis, **target, **options, **guidance_kwargs)
 
 
 def input_triangles(mesh) -> int:
