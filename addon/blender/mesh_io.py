@@ -106,21 +106,52 @@ def _polygon_materials(mesh) -> np.ndarray:
     return _get(mesh.polygons, "material_index", p, 1, np.int32)
 
 
+def _triangle_loop_starts(mesh) -> Optional[np.ndarray]:
+    """The polygons' first loops when every polygon is a triangle whose loops follow the previous
+    polygon's (how Blender stores meshes), else None. Blender triangulates such a polygon into
+    itself, corners in loop order, so its loop triangles need not be read one by one."""
+    p = len(mesh.polygons)
+    if len(mesh.loops) != 3 * p:  # every polygon has 3 loops or more: all are triangles exactly then
+        return None
+    starts = _indices(mesh.polygons, "loop_start", p)
+    return starts if np.array_equal(starts, np.arange(0, 3 * p, 3, dtype=np.int32)) else None
+
+
 def read_mesh(mesh: bpy.types.Mesh) -> MeshArrays:
     """Reads positions and the loop triangulation of ``mesh`` (object mode data)."""
-    mesh.calc_loop_triangles()
-    n, m = len(mesh.vertices), len(mesh.loop_triangles)
+    n = len(mesh.vertices)
     vertices = _get(mesh.vertices, "co", n, 3, np.float32).astype(np.float64)
-    triangle_loops = _indices(mesh.loop_triangles, "loops", m, 3)
-    triangles = corner_vertices(mesh)[triangle_loops]
-    return MeshArrays(vertices, triangles, _triangle_polygons(mesh, m), triangle_loops,
+    corners = corner_vertices(mesh)
+    if _triangle_loop_starts(mesh) is not None:  # a triangle mesh: the loop triangles are the polygons
+        m = len(mesh.polygons)
+        triangle_loops = np.arange(3 * m, dtype=np.int32).reshape(m, 3)
+        triangle_polygons = np.arange(m, dtype=np.int32)
+        triangles = corners.reshape(m, 3)
+    else:
+        mesh.calc_loop_triangles()
+        m = len(mesh.loop_triangles)
+        triangle_loops = _indices(mesh.loop_triangles, "loops", m, 3)
+        triangle_polygons = _triangle_polygons(mesh, m)
+        triangles = corners[triangle_loops]
+    return MeshArrays(vertices, triangles, triangle_polygons, triangle_loops,
                       _polygon_materials(mesh), num_edges=len(mesh.edges), num_loops=len(mesh.loops))
 
 
 def read_edges(mesh: bpy.types.Mesh, flag: str) -> np.ndarray:
-    """(k, 2) vertex pairs of the edges whose boolean ``flag`` is set (use_seam, use_edge_sharp)."""
+    """(k, 2) vertex pairs of the edges whose boolean ``flag`` is set (use_seam, use_edge_sharp).
+
+    Blender 4.0+ keeps these flags as edge attributes that exist only when some edge has the
+    flag: none means no read at all (a flag per edge through MeshEdge costs ~30 ms per million
+    edges, on the Live Preview's start)."""
     count = len(mesh.edges)
-    flags = _get(mesh.edges, flag, count, 1, bool)
+    name = _EDGE_FLAG_ATTRIBUTES[flag][0]
+    attribute = mesh.attributes.get(name) if bpy.app.version >= (4, 0, 0) else None
+    if bpy.app.version >= (4, 0, 0) and (attribute is None or flag in mistyped_edge_flags(mesh)):
+        if attribute is None:
+            return np.zeros((0, 2), dtype=np.int32)
+        attribute = None  # mistyped by Blender 5.0's edge pass: read through MeshEdge instead
+    flags = (_get(attribute.data, "value", count, 1, bool) if attribute is not None
+             else _get(mesh.edges, flag, count, 1, bool))
     if not flags.any():
         return np.zeros((0, 2), dtype=np.int32)
     edges = _get(mesh.edges, "vertices", count, 2, np.int32)

@@ -118,17 +118,28 @@ def face_estimate(params, mesh):
     return max(1, int(round(triangles * kept / vertices)))
 
 
-def prepare(obj) -> Prepared:
-    """The cached prepared mesh of ``obj``, with a clear error for unusable meshes."""
+def check_decimatable(obj) -> None:
+    """Raises DecimationError unless ``obj`` is a mesh object with faces, in Object Mode."""
     mesh_io.check_mesh_object(obj, DecimationError)
     if len(obj.data.polygons) == 0:
         raise DecimationError(f"'{obj.name}' has no faces to decimate")
+
+
+def prepare(obj) -> Prepared:
+    """The cached prepared mesh of ``obj``, with a clear error for unusable meshes."""
+    check_decimatable(obj)
+    return prepare_arrays(obj.name, obj.data.name_full, mesh_io.read_mesh(obj.data))
+
+
+def prepare_arrays(obj_name: str, mesh_name: str, arrays: mesh_io.MeshArrays, progress=None) -> Prepared:
+    """``prepare`` for arrays already read (any thread: no Blender data is touched); progress:
+    see :class:`topstoc.core.Mesh` (its False raises ``Cancelled``)."""
     try:
-        prepared = prepared_meshes.get(obj.data)
+        prepared = prepared_meshes.prepare(mesh_name, arrays, progress)
     except ValueError as error:
-        raise DecimationError(f"'{obj.name}': {error}") from None
+        raise DecimationError(f"'{obj_name}': {error}") from None
     if prepared.mesh.num_triangles == 0:
-        raise DecimationError(f"'{obj.name}' has only degenerate faces")
+        raise DecimationError(f"'{obj_name}' has only degenerate faces")
     return prepared
 
 

@@ -74,12 +74,13 @@ def test_preview_session(ts, scene):
     from helpers import Params
 
     session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(seed=4, quality="QUALITY"))
-    assert obj.hide_get()
+    assert not obj.hide_get() and session.preview is None  # nothing changes before a result shows
     for ratio in (0.5, 0.1, 0.02):
         session.update(ratio)
         expected = session.prepared.mesh.decimate(ratio=ratio, seed=4, mode="fast")
         assert len(session.mesh.vertices) == expected.num_vertices
         assert len(session.mesh.polygons) == expected.num_triangles
+        assert obj.hide_get()
     # Asynchronous path: only the latest request is computed.
     session.request(0.3)
     session.request(0.05)
