@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
+from ..core.attributes import moved_vertices
 from ..core.errors import TopStocError
 from ..core.symmetry import decimate_mirrored
 from . import carry, mesh_io
@@ -178,12 +179,14 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
     """
     obj = run.obj
     kept = np.asarray(run.result.kept)
+    arrays = run.prepared.arrays
+    moved = moved_vertices(arrays.vertices, arrays.triangles, run.result)  # quality mode: interpolated
     groups = mesh_io.collect_vertex_groups(obj, kept)
     shape_keys = carry.read_shape_keys(obj.data)
     if mode == "IN_PLACE" or into is not None:
         target = obj if into is None else into
         old = target.data
-        mesh = mesh_io.build_result_mesh(obj.data, run.prepared.arrays, run.result, old.name + "_TopStoc")
+        mesh = mesh_io.build_result_mesh(obj.data, arrays, run.result, old.name + "_TopStoc", moved)
         if into is not None:  # the result's own material choices win over the source's
             mesh.materials.clear()
             for material in old.materials:
@@ -196,7 +199,7 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
         mesh.name = old_name
     else:
         name = name or f"{obj.name}_TopStoc"
-        mesh = mesh_io.build_result_mesh(obj.data, run.prepared.arrays, run.result, name)
+        mesh = mesh_io.build_result_mesh(obj.data, arrays, run.result, name, moved)
         carry.copy_custom_properties(obj.data, mesh)
         target = bpy.data.objects.new(name, mesh)
         carry.link_like(obj, target, bpy.context.scene)
@@ -206,7 +209,7 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
         if place:
             carry.place_beside(obj, target)
     mesh_io.apply_vertex_groups(target, groups)
-    carry.write_shape_keys(target, shape_keys, run.prepared.arrays.vertices, run.result.vertices, kept)
+    carry.write_shape_keys(target, shape_keys, arrays.vertices, run.result.vertices, kept, moved, arrays.triangles)
     target["topstoc_source"] = obj.name
     target["topstoc_parameters"] = json.dumps(run.parameters)
     if target is not obj and run.settings is not None:  # what Regenerate needs (regenerate.py)
