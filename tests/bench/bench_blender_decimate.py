@@ -2,6 +2,7 @@
 
     blender -b --factory-startup --python tests/bench/bench_blender_decimate.py -- [--ratios 0.01 0.1]
         [--mesh PATH] [--repeat 3] [--updates 20]
+    .venv/bin/python tests/bench/bench_blender_decimate.py -- ...   (PyPI's bpy)
 
 On the 1.55M-triangle horse (../shared/meshes/big, skipped when absent): time to first result
 (read the Blender mesh + prepare + decimate + write the new object with attributes) and the time
@@ -19,8 +20,8 @@ import statistics
 import sys
 import time
 
-import addon_utils
-import bpy
+import bpy  # first: PyPI's bpy module makes addon_utils importable
+import addon_utils  # noqa: E402
 import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
