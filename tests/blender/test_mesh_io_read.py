@@ -2,7 +2,6 @@
 polygons; Blender 4.0+ edge flags from their attributes) give what Blender's own per-element
 accessors give."""
 
-import bpy
 import numpy as np
 import pytest
 
