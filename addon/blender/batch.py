@@ -47,8 +47,10 @@ def parse_args(argv):
 
 
 def _params(settings: dict):
-    """The pipeline's parameter holder (its options; the target is passed explicitly)."""
-    return SimpleNamespace(target_mode="RATIO", **settings["options"])
+    """The pipeline's parameter holder (its options and symmetry; the target is passed explicitly)."""
+    axis = settings.get("symmetry")
+    return SimpleNamespace(target_mode="RATIO", use_symmetry=axis is not None, symmetry_axis=axis or "X",
+                           **settings["options"])
 
 
 def _bone_shapes(bpy) -> set:
@@ -113,7 +115,7 @@ def _decimate_object(bpy, pipeline, obj, settings, targets) -> tuple:
         if screen is not None:  # world units -> the object's own units
             target = {"max_error": target["max_error"] / scale}
         run = pipeline.decimate(bpy.context, obj, _params(settings), target=target)
-        entry = {"lod": index, "target": target}
+        entry = {"lod": index, "target": target, "symmetry": settings.get("symmetry")}
         if screen is not None and settings["prune_pixels"] > 0:
             run.result, pruned = prune_small_parts(run.result, settings["prune_pixels"] * screen.world_per_pixel / scale)
             entry["pruned"] = pruned.as_dict()

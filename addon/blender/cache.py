@@ -8,6 +8,7 @@ re-prepares: a stale mesh can never be used. The cache holds a few meshes only (
 
 from __future__ import annotations
 
+import threading
 from collections import OrderedDict
 from dataclasses import dataclass
 
@@ -25,49 +26,44 @@ class Prepared:
 
 
 class PreparedCache:
-    """Least-recently-used cache of prepared meshes."""
+    """Least-recently-used cache of prepared meshes; ``prepare`` may run on any thread (the live
+    preview prepares on a worker), the bookkeeping is locked."""
 
     def __init__(self, capacity: int = 2):
         self.capacity = capacity
         self._entries: OrderedDict = OrderedDict()
+        self._lock = threading.Lock()
         self.hits = 0
         self.misses = 0
 
     def get(self, mesh_data) -> Prepared:
-        """The prepared form of a bpy Mesh, re-prepared when its geometry changed."""
-        arrays = mesh_io.read_mesh(mesh_data)
-        digest = arrays.digest()
-        key = (mesh_data.name_full, digest)
-        entry = self._entries.get(key)
-        if entry is not None:
-            self._entries.move_to_end(key)
-            self.hits += 1
-            entry.arrays = arrays  # same geometry; loop/polygon maps refreshed all the same
-            return entry
-        self.misses += 1
-        entry = Prepared(arrays, Mesh(arrays.vertices, arrays.triangles), digest)
-        self._entries[key] = entry
-        while len(self._entries) > self.capacity:
-            self._entries.popitem(last=False)
-        return entry
+        """The prepared form of a bpy Mesh, re-prepared when its geometry changed (main thread)."""
+        return self.prepare(mesh_data.name_full, mesh_io.read_mesh(mesh_data))
 
-    def find(self, mesh_data):
-        """(arrays, digest, entry or None): the mesh read now and its cached preparation, if any
-        (the live preview prepares a miss on a worker thread and hands it to ``add``)."""
-        arrays = mesh_io.read_mesh(mesh_data)
+    def prepare(self, name: str, arrays: mesh_io.MeshArrays, progress=None) -> Prepared:
+        """The preparation of ``arrays`` read from the mesh datablock ``name`` (its ``name_full``):
+        cached, or made now (any thread; reads no Blender data). ``progress`` is handed to
+        :class:`Mesh` (its False cancels with ``Cancelled``; nothing is cached then)."""
         digest = arrays.digest()
-        return arrays, digest, self._entries.get((mesh_data.name_full, digest))
-
-    def add(self, mesh_data, arrays, digest: str, mesh: Mesh) -> Prepared:
-        """Stores a preparation made elsewhere (same rules as ``get``)."""
-        entry = Prepared(arrays, mesh, digest)
-        self._entries[(mesh_data.name_full, digest)] = entry
-        while len(self._entries) > self.capacity:
-            self._entries.popitem(last=False)
+        key = (name, digest)
+        with self._lock:
+            entry = self._entries.get(key)
+            if entry is not None:
+                self._entries.move_to_end(key)
+                self.hits += 1
+                entry.arrays = arrays  # same geometry; loop/polygon maps refreshed all the same
+                return entry
+            self.misses += 1
+        entry = Prepared(arrays, Mesh(arrays.vertices, arrays.triangles, progress=progress), digest)
+        with self._lock:
+            self._entries[key] = entry
+            while len(self._entries) > self.capacity:
+                self._entries.popitem(last=False)
         return entry
 
     def clear(self) -> None:
-        self._entries.clear()
+        with self._lock:
+            self._entries.clear()
 
 
 #: The add-on's cache (cleared on unregister and when a file is loaded).

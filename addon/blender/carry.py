@@ -3,14 +3,17 @@ collections and custom properties (vertex groups and mesh attributes: see mesh_i
 
 Shape keys: the result has every key of the source with its name, value, slider range, mute
 flag, interpolation, vertex group and relative key. A key's position at output vertex ``i`` is
-the output position plus the key's offset at the input vertex ``kept[i]`` it stands for:
+the output position plus the key's offset (key minus mesh position) at the place it stands for:
 
-    key_out[i] = position_out[i] + (key_in[kept[i]] - position_in[kept[i]])
+    key_out[i] = position_out[i] + (key_in[kept[i]] - position_in[kept[i]])   (did not move)
+    key_out[i] = position_out[i] + sum_j w_j (key_in[t_j] - position_in[t_j])  (moved)
 
-With subsample placement the output vertex *is* ``kept[i]``, so every key equals the source's
-key there exactly. With filtered placement the vertex moved to the quadric-optimal point of its
-cluster and the key's offset moves with it (the morph is translated, not re-interpolated:
-clusters are small, and the kept vertex's offset is the one the artist sculpted).
+A vertex that did not move is the input vertex ``kept[i]``, so every key equals the source's key
+there exactly. A vertex the quality mode moved (filtered placement, quadric collapses) takes each
+key's offset interpolated at its place on the basis: ``t`` is the input triangle its attributes
+come from and ``w`` its barycentric weights there (topstoc.core.attributes.moved_vertices, the
+same as for UVs and colours), so the morph follows the surface the vertex now stands on.
+Vertex-group weights (the rig's) are the kept vertex's in either case.
 """
 
 from __future__ import annotations
@@ -19,6 +22,8 @@ from dataclasses import dataclass, field
 
 import bpy
 import numpy as np
+
+from ..core.attributes import MovedVertices, point_values
 
 KEY_SETTINGS = ("value", "slider_min", "slider_max", "mute", "interpolation", "vertex_group")
 
@@ -55,16 +60,23 @@ def read_shape_keys(mesh: bpy.types.Mesh) -> ShapeKeys:
 
 
 def write_shape_keys(obj: bpy.types.Object, keys: ShapeKeys, source_positions: np.ndarray,
-                     output_positions: np.ndarray, kept: np.ndarray) -> None:
-    """Adds ``keys`` to ``obj``'s mesh (which has none yet), following the output vertices."""
+                     output_positions: np.ndarray, kept: np.ndarray, moved: MovedVertices = None,
+                     source_triangles: np.ndarray = None) -> None:
+    """Adds ``keys`` to ``obj``'s mesh (which has none yet), following the output vertices;
+    ``moved`` (with the source's triangles) says where moved vertices take their offsets from."""
     if not keys.names:
         return
     kept = np.asarray(kept, dtype=np.int64)
-    moved = np.asarray(output_positions, dtype=np.float64) - source_positions[kept]
+    output_positions = np.asarray(output_positions, dtype=np.float64)
+    shift = output_positions - source_positions[kept]  # zero where the vertex did not move
+    at = moved.moved if moved is not None else np.zeros(0, dtype=np.int64)
     blocks = []
     for name, co, settings in zip(keys.names, keys.coordinates, keys.settings):
         block = obj.shape_key_add(name=name, from_mix=False)
-        values = co[kept] + moved
+        values = co[kept] + shift
+        if len(at):
+            offsets = point_values(co - source_positions, kept, moved, source_triangles)
+            values[at] = output_positions[at] + offsets[at]
         if len(values):
             block.data.foreach_set("co", np.ascontiguousarray(values, dtype=np.float32).ravel())
         blocks.append(block)

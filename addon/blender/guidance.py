@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import hashlib
 from dataclasses import dataclass, field
-from typing import List, Optional
+from typing import Callable, List, Optional
 
 import bpy
 import numpy as np
@@ -60,46 +60,60 @@ def _matrix(m: Matrix) -> np.ndarray:
 
 def read_color_guidance(mesh, name: str) -> np.ndarray:
     """u per vertex from a colour attribute (rules in topstoc.core.guidance)."""
+    return _read_color(mesh, name)()
+
+
+def _read_color(mesh, name: str) -> Callable[[], np.ndarray]:
+    """Reads a colour attribute; returns the function giving u per vertex from it."""
     attribute = mesh.color_attributes.get(name)
     if attribute is None:
         raise GuidanceError(f"colour attribute '{name}' not found on mesh '{mesh.name}' "
                             "(paint it in Vertex Paint mode or use 'Add Guidance Layer')")
     count = len(mesh.vertices) if attribute.domain == "POINT" else len(mesh.loops)
     values, key = mesh_io.read_attribute(attribute, count)
-    rgb = values[:, :3].astype(np.float64)
-    if key == "color":
-        rgb = rules.linear_to_srgb(rgb)
-    if attribute.domain == "CORNER":
-        corner_vertex = mesh_io.corner_vertices(mesh)
-        rgb = rules.corner_to_vertex_mean(len(mesh.vertices), corner_vertex, rgb)
-    return rules.color_to_guidance(rgb)
+    corner_vertex = mesh_io.corner_vertices(mesh) if attribute.domain == "CORNER" else None
+    n = len(mesh.vertices)
+
+    def guidance() -> np.ndarray:
+        rgb = values[:, :3].astype(np.float64)
+        if key == "color":
+            rgb = rules.linear_to_srgb(rgb)
+        if corner_vertex is not None:
+            rgb = rules.corner_to_vertex_mean(n, corner_vertex, rgb)
+        return rules.color_to_guidance(rgb)
+
+    return guidance
 
 
-def _borders(obj, settings, arrays: mesh_io.MeshArrays, sources: list) -> Optional[np.ndarray]:
+def _read_borders(obj, settings, arrays: mesh_io.MeshArrays) -> Callable[[list], Optional[np.ndarray]]:
+    """Reads seams and sharp edges; returns the function giving the border edges (it appends
+    what it found to the list of sources it is given)."""
     mesh = obj.data
-    parts = []
-    if settings.use_uv_seams:
-        for name, uv in mesh_io.read_uv_maps(mesh).items():
-            corner_uv = uv[arrays.triangle_loops]
-            seams = uv_seam_edges(arrays.triangles, corner_uv)
+    uv_maps = mesh_io.read_uv_maps(mesh) if settings.use_uv_seams else {}
+    marked = mesh_io.read_edges(mesh, "use_seam") if settings.use_uv_seams else np.zeros((0, 2), np.int32)
+    sharp = mesh_io.read_edges(mesh, "use_edge_sharp") if settings.use_sharp else np.zeros((0, 2), np.int32)
+
+    def borders(sources: list) -> Optional[np.ndarray]:
+        parts = []
+        for name, uv in uv_maps.items():
+            seams = uv_seam_edges(arrays.triangles, uv[arrays.triangle_loops])
             if len(seams):
                 parts.append(seams)
                 sources.append(f"UV seams of '{name}' ({len(seams)} edges)")
-        marked = mesh_io.read_edges(mesh, "use_seam")
         if len(marked):
             parts.append(marked)
             sources.append(f"marked seams ({len(marked)} edges)")
-    if settings.use_sharp:
-        sharp = mesh_io.read_edges(mesh, "use_edge_sharp")
         if len(sharp):
             parts.append(sharp)
             sources.append(f"sharp edges ({len(sharp)})")
-    if not parts:
-        return None
-    # Only edges of triangles can be borders (loose edges carry no faces to separate).
-    edges = rules.undirected_edges(arrays.triangles)
-    borders = rules.edges_in(edges, np.concatenate(parts))
-    return borders if len(borders) else None
+        if not parts:
+            return None
+        # Only edges of triangles can be borders (loose edges carry no faces to separate).
+        edges = rules.undirected_edges(arrays.triangles)
+        found = rules.edges_in(edges, np.concatenate(parts))
+        return found if len(found) else None
+
+    return borders
 
 
 def _boxes(obj, scene) -> List[Box]:
@@ -147,44 +161,44 @@ def _viewport_view(obj, region_3d) -> View:
 
 def gather(obj, arrays: mesh_io.MeshArrays, scene, depsgraph=None, region_3d=None) -> EngineGuidance:
     """Reads every enabled guidance source of ``obj`` into engine arguments."""
+    return read(obj, arrays, scene, depsgraph, region_3d)()
+
+
+def read(obj, arrays: mesh_io.MeshArrays, scene, depsgraph=None,
+         region_3d=None) -> Callable[[], EngineGuidance]:
+    """Reads every enabled guidance source of ``obj`` (Blender data: the main thread) and returns
+    the function that turns what was read into engine arguments (numpy only: any thread; the
+    live preview runs it on its worker). Settings that cannot be honoured raise GuidanceError
+    here, while reading."""
     settings = obj.topstoc
     scene_settings = scene.topstoc
     n = len(arrays.vertices)
-    out = EngineGuidance()
-    sources = []
+    names = []    # what each source is called, in order
+    sources = []  # (function giving u, strength) per guidance source
 
     if settings.use_vertex_group:
         group = obj.vertex_groups.get(settings.vertex_group)
         if group is None:
             raise GuidanceError(f"vertex group '{settings.vertex_group}' not found on '{obj.name}'")
         weights, assigned = mesh_io.read_vertex_group(obj, group.index)
-        u = rules.vertex_group_guidance(weights, assigned, settings.vertex_group_mapping)
-        sources.append((u, settings.vertex_group_strength))
-        out.sources.append(f"vertex group '{group.name}'")
+        mapping = settings.vertex_group_mapping
+        sources.append((lambda: rules.vertex_group_guidance(weights, assigned, mapping),
+                        settings.vertex_group_strength))
+        names.append(f"vertex group '{group.name}'")
     if settings.use_color and settings.color_attribute:
         mesh = obj.data
         if mesh.color_attributes.get(settings.color_attribute) is not None:
-            sources.append((read_color_guidance(mesh, settings.color_attribute), settings.color_strength))
-            out.sources.append(f"painted '{settings.color_attribute}'")
+            sources.append((_read_color(mesh, settings.color_attribute), settings.color_strength))
+            names.append(f"painted '{settings.color_attribute}'")
         elif settings.color_attribute != DEFAULT_COLOR_LAYER:  # the default layer may not exist yet
             raise GuidanceError(f"colour attribute '{settings.color_attribute}' not found on '{obj.name}'")
+    material_weights = None
     if settings.use_materials and len(arrays.polygon_material):
-        weights = list(settings.material_weights)[:max(len(obj.material_slots), 1)]
-        if any(w != 0.0 for w in weights):
-            u = rules.material_guidance(n, arrays.triangles, arrays.triangle_material, weights)
-            sources.append((u, settings.material_strength))
-            out.sources.append("material slot weights")
-        if len(np.unique(arrays.polygon_material)) > 1:
-            out.regions = rules.compact_regions(arrays.triangle_material)
-            out.sources.append("material borders")
-    out.guidance = rules.combine(sources, n)
-    detail = []
-    out.borders = _borders(obj, settings, arrays, detail)
-    out.sources.extend(detail)
-    if scene_settings.use_boxes:
-        out.boxes = _boxes(obj, scene)
-        if out.boxes:
-            out.sources.append(f"{len(out.boxes)} box{'es' if len(out.boxes) > 1 else ''}")
+        material_weights = list(settings.material_weights)[:max(len(obj.material_slots), 1)]
+        material_strength = settings.material_strength
+    borders = _read_borders(obj, settings, arrays)
+    boxes = _boxes(obj, scene) if scene_settings.use_boxes else []
+    view = None
     if scene_settings.use_view:
         if scene_settings.view_source == "CAMERA":
             view = _camera_view(obj, scene, depsgraph or bpy.context.evaluated_depsgraph_get())
@@ -196,6 +210,27 @@ def gather(obj, arrays: mesh_io.MeshArrays, scene, depsgraph=None, region_3d=Non
         if not scene_settings.use_frustum:
             view.view_projection = None
         view.outside_probability = scene_settings.outside_probability
-        out.view = view
-        out.sources.append("camera view" if scene_settings.view_source == "CAMERA" else "viewport view")
-    return out
+    view_name = "camera view" if scene_settings.view_source == "CAMERA" else "viewport view"
+
+    def engine_guidance() -> EngineGuidance:
+        out = EngineGuidance(sources=list(names))
+        values = [(guidance(), strength) for guidance, strength in sources]
+        if material_weights is not None:
+            if any(w != 0.0 for w in material_weights):
+                u = rules.material_guidance(n, arrays.triangles, arrays.triangle_material, material_weights)
+                values.append((u, material_strength))
+                out.sources.append("material slot weights")
+            if len(np.unique(arrays.polygon_material)) > 1:
+                out.regions = rules.compact_regions(arrays.triangle_material)
+                out.sources.append("material borders")
+        out.guidance = rules.combine(values, n)
+        out.borders = borders(out.sources)
+        out.boxes = boxes
+        if boxes:
+            out.sources.append(f"{len(boxes)} box{'es' if len(boxes) > 1 else ''}")
+        if view is not None:
+            out.view = view
+            out.sources.append(view_name)
+        return out
+
+    return engine_guidance

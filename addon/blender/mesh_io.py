@@ -4,7 +4,7 @@ Reading triangulates n-gons through Blender's loop triangles and keeps, for ever
 its polygon and the loop of each corner, so results can take every attribute exactly from
 the face and corner they came from. Writing builds a triangle mesh from a DecimateResult and
 copies UV maps, colour and generic attributes, materials, smooth flags, custom split normals
-and vertex groups.
+and vertex groups (vertices the quality mode moved interpolate theirs).
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from typing import Optional
 import bpy
 import numpy as np
 
+from ..core.attributes import MovedVertices, corner_values, moved_vertices, point_values
 from ..core.mesh_edges import mesh_edges
 
 # Attribute data type -> (foreach key, values per element, numpy dtype)
@@ -33,6 +34,8 @@ _ATTRIBUTE_LAYOUT = {
 }
 # Attributes written through dedicated paths (positions, topology, materials, smoothing).
 _SKIPPED_ATTRIBUTES = {"position", "material_index", "sharp_face", "sharp_edge", "normal"}
+# Attribute types whose values a moved vertex interpolates (the others take the nearest corner's).
+_INTERPOLATED = {"FLOAT", "FLOAT2", "FLOAT_VECTOR", "FLOAT_COLOR", "BYTE_COLOR"}
 
 
 @dataclass
@@ -106,21 +109,52 @@ def _polygon_materials(mesh) -> np.ndarray:
     return _get(mesh.polygons, "material_index", p, 1, np.int32)
 
 
+def _triangle_loop_starts(mesh) -> Optional[np.ndarray]:
+    """The polygons' first loops when every polygon is a triangle whose loops follow the previous
+    polygon's (how Blender stores meshes), else None. Blender triangulates such a polygon into
+    itself, corners in loop order, so its loop triangles need not be read one by one."""
+    p = len(mesh.polygons)
+    if len(mesh.loops) != 3 * p:  # every polygon has 3 loops or more: all are triangles exactly then
+        return None
+    starts = _indices(mesh.polygons, "loop_start", p)
+    return starts if np.array_equal(starts, np.arange(0, 3 * p, 3, dtype=np.int32)) else None
+
+
 def read_mesh(mesh: bpy.types.Mesh) -> MeshArrays:
     """Reads positions and the loop triangulation of ``mesh`` (object mode data)."""
-    mesh.calc_loop_triangles()
-    n, m = len(mesh.vertices), len(mesh.loop_triangles)
+    n = len(mesh.vertices)
     vertices = _get(mesh.vertices, "co", n, 3, np.float32).astype(np.float64)
-    triangle_loops = _indices(mesh.loop_triangles, "loops", m, 3)
-    triangles = corner_vertices(mesh)[triangle_loops]
-    return MeshArrays(vertices, triangles, _triangle_polygons(mesh, m), triangle_loops,
+    corners = corner_vertices(mesh)
+    if _triangle_loop_starts(mesh) is not None:  # a triangle mesh: the loop triangles are the polygons
+        m = len(mesh.polygons)
+        triangle_loops = np.arange(3 * m, dtype=np.int32).reshape(m, 3)
+        triangle_polygons = np.arange(m, dtype=np.int32)
+        triangles = corners.reshape(m, 3)
+    else:
+        mesh.calc_loop_triangles()
+        m = len(mesh.loop_triangles)
+        triangle_loops = _indices(mesh.loop_triangles, "loops", m, 3)
+        triangle_polygons = _triangle_polygons(mesh, m)
+        triangles = corners[triangle_loops]
+    return MeshArrays(vertices, triangles, triangle_polygons, triangle_loops,
                       _polygon_materials(mesh), num_edges=len(mesh.edges), num_loops=len(mesh.loops))
 
 
 def read_edges(mesh: bpy.types.Mesh, flag: str) -> np.ndarray:
-    """(k, 2) vertex pairs of the edges whose boolean ``flag`` is set (use_seam, use_edge_sharp)."""
+    """(k, 2) vertex pairs of the edges whose boolean ``flag`` is set (use_seam, use_edge_sharp).
+
+    Blender 4.0+ keeps these flags as edge attributes that exist only when some edge has the
+    flag: none means no read at all (a flag per edge through MeshEdge costs ~30 ms per million
+    edges, on the Live Preview's start)."""
     count = len(mesh.edges)
-    flags = _get(mesh.edges, flag, count, 1, bool)
+    name = _EDGE_FLAG_ATTRIBUTES[flag][0]
+    attribute = mesh.attributes.get(name) if bpy.app.version >= (4, 0, 0) else None
+    if bpy.app.version >= (4, 0, 0) and (attribute is None or flag in mistyped_edge_flags(mesh)):
+        if attribute is None:
+            return np.zeros((0, 2), dtype=np.int32)
+        attribute = None  # mistyped by Blender 5.0's edge pass: read through MeshEdge instead
+    flags = (_get(attribute.data, "value", count, 1, bool) if attribute is not None
+             else _get(mesh.edges, flag, count, 1, bool))
     if not flags.any():
         return np.zeros((0, 2), dtype=np.int32)
     edges = _get(mesh.edges, "vertices", count, 2, np.int32)
@@ -281,20 +315,33 @@ def _custom_normals(mesh) -> Optional[np.ndarray]:
     return _get(mesh.loops, "normal", len(mesh.loops), 3, np.float32)
 
 
-def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: str) -> bpy.types.Mesh:
+def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: str,
+                      moved: Optional[MovedVertices] = None) -> bpy.types.Mesh:
     """A new mesh datablock holding ``result`` with the source's attributes carried over.
 
     Points take the attributes of their kept input vertex, faces those of their source
-    polygon, corners those of the input loop ``corner_source`` names. Edge attributes
-    (creases, bevel weights, seam/sharp flags) are not carried: output edges are new.
+    polygon, corners those of the input loop ``corner_source`` names. Vertices the quality mode
+    moved (``moved``, found when not given) take point and corner values interpolated in their
+    source triangle (topstoc.core.attributes; corners from that triangle's own loops, so UV
+    seams stay exact); integers, flags and rotations take the nearest corner's value. Edge
+    attributes (creases, bevel weights, seam/sharp flags) are not carried: output edges are new.
     """
     out = bpy.data.meshes.new(name)
     fill_geometry(out, result.vertices, result.triangles)
     kept = np.asarray(result.kept, dtype=np.int64)
     face_polygon = arrays.triangle_polygon[np.asarray(result.face_source, dtype=np.int64)]
     corner_loop = arrays.triangle_loops.reshape(-1)[np.asarray(result.corner_source, dtype=np.int64).reshape(-1)]
-    source_index = {"POINT": kept, "FACE": face_polygon, "CORNER": corner_loop}
     m = len(result.triangles)
+    if moved is None:
+        moved = moved_vertices(arrays.vertices, arrays.triangles, result)
+
+    def carried(values, domain: str, nearest: bool = False) -> np.ndarray:
+        """Source values of one domain for the output's elements of that domain."""
+        if domain == "POINT":
+            return point_values(values, kept, moved, arrays.triangles, nearest)
+        if domain == "CORNER":
+            return corner_values(values, corner_loop, result.triangles, moved, arrays.triangle_loops, nearest)
+        return values[face_polygon]
 
     for material in source.materials:
         out.materials.append(material)
@@ -314,14 +361,14 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
         values = _get(uv.data, "uv", len(source.loops), 2, np.float32)
         new = out.uv_layers.new(name=uv.name, do_init=False)
         if m:
-            new.data.foreach_set("uv", values[corner_loop].ravel())
+            new.data.foreach_set("uv", carried(values, "CORNER").ravel())
     if source.uv_layers.active is not None:
         out.uv_layers.active_index = source.uv_layers.active_index
 
     for attribute in source.attributes:
         name_ = attribute.name
         if (name_.startswith(".") or name_ in _SKIPPED_ATTRIBUTES or name_ in uv_names
-                or attribute.domain not in source_index):
+                or attribute.domain not in ("POINT", "FACE", "CORNER")):
             continue
         count = _domain_size(source, attribute.domain)
         read = read_attribute(attribute, count)
@@ -333,7 +380,7 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
             if target is not None:
                 out.attributes.remove(target)
             target = out.attributes.new(name_, attribute.data_type, attribute.domain)
-        picked = values[source_index[attribute.domain]]
+        picked = carried(values, attribute.domain, nearest=attribute.data_type not in _INTERPOLATED)
         if len(picked):
             target.data.foreach_set(key, np.ascontiguousarray(picked).ravel())
     colors = source.color_attributes
@@ -349,6 +396,10 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
         if hasattr(out, "use_auto_smooth"):  # Blender < 4.1 needs auto smooth for custom normals
             out.use_auto_smooth = True
             out.auto_smooth_angle = source.auto_smooth_angle
-        out.normals_split_custom_set(normals[corner_loop])
+        corner_normals = carried(normals, "CORNER")
+        mixed = moved.face[np.asarray(result.triangles).ravel()] >= 0  # interpolated: unit length again
+        length = np.linalg.norm(corner_normals[mixed], axis=1, keepdims=True)
+        corner_normals[mixed] = corner_normals[mixed] / np.where(length > 0, length, 1)
+        out.normals_split_custom_set(corner_normals)
     out.update()
     return out

@@ -13,8 +13,9 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
+from ..core.attributes import moved_vertices
 from ..core.errors import TopStocError
-from ..core.symmetry import decimate_symmetric as symmetric_decimate
+from ..core.symmetry import decimate_mirrored
 from . import carry, mesh_io
 from .cache import Prepared, prepared_meshes
 from .guidance import EngineGuidance, gather
@@ -91,9 +92,7 @@ def symmetry_axis(params):
 
 def run_engine(mesh, target: dict, options: dict, guidance_kwargs: dict, axis=None):
     """One engine decimation, mirror-symmetric when ``axis`` is given (core/symmetry.py)."""
-    if axis is None:
-        return mesh.decimate(**target, **options, **guidance_kwargs)
-    return symmetric_decimate(mesh, axis, **target, **options, **guidance_kwargs)
+    return decimate_mirrored(mesh, axis, **target, **options, **guidance_kwargs)
 
 
 def input_triangles(mesh) -> int:
@@ -120,17 +119,28 @@ def face_estimate(params, mesh):
     return max(1, int(round(triangles * kept / vertices)))
 
 
-def prepare(obj) -> Prepared:
-    """The cached prepared mesh of ``obj``, with a clear error for unusable meshes."""
+def check_decimatable(obj) -> None:
+    """Raises DecimationError unless ``obj`` is a mesh object with faces, in Object Mode."""
     mesh_io.check_mesh_object(obj, DecimationError)
     if len(obj.data.polygons) == 0:
         raise DecimationError(f"'{obj.name}' has no faces to decimate")
+
+
+def prepare(obj) -> Prepared:
+    """The cached prepared mesh of ``obj``, with a clear error for unusable meshes."""
+    check_decimatable(obj)
+    return prepare_arrays(obj.name, obj.data.name_full, mesh_io.read_mesh(obj.data))
+
+
+def prepare_arrays(obj_name: str, mesh_name: str, arrays: mesh_io.MeshArrays, progress=None) -> Prepared:
+    """``prepare`` for arrays already read (any thread: no Blender data is touched); progress:
+    see :class:`topstoc.core.Mesh` (its False raises ``Cancelled``)."""
     try:
-        prepared = prepared_meshes.get(obj.data)
+        prepared = prepared_meshes.prepare(mesh_name, arrays, progress)
     except ValueError as error:
-        raise DecimationError(f"'{obj.name}': {error}") from None
+        raise DecimationError(f"'{obj_name}': {error}") from None
     if prepared.mesh.num_triangles == 0:
-        raise DecimationError(f"'{obj.name}' has only degenerate faces")
+        raise DecimationError(f"'{obj_name}' has only degenerate faces")
     return prepared
 
 
@@ -169,12 +179,14 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
     """
     obj = run.obj
     kept = np.asarray(run.result.kept)
+    arrays = run.prepared.arrays
+    moved = moved_vertices(arrays.vertices, arrays.triangles, run.result)  # quality mode: interpolated
     groups = mesh_io.collect_vertex_groups(obj, kept)
     shape_keys = carry.read_shape_keys(obj.data)
     if mode == "IN_PLACE" or into is not None:
         target = obj if into is None else into
         old = target.data
-        mesh = mesh_io.build_result_mesh(obj.data, run.prepared.arrays, run.result, old.name + "_TopStoc")
+        mesh = mesh_io.build_result_mesh(obj.data, arrays, run.result, old.name + "_TopStoc", moved)
         if into is not None:  # the result's own material choices win over the source's
             mesh.materials.clear()
             for material in old.materials:
@@ -187,7 +199,7 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
         mesh.name = old_name
     else:
         name = name or f"{obj.name}_TopStoc"
-        mesh = mesh_io.build_result_mesh(obj.data, run.prepared.arrays, run.result, name)
+        mesh = mesh_io.build_result_mesh(obj.data, arrays, run.result, name, moved)
         carry.copy_custom_properties(obj.data, mesh)
         target = bpy.data.objects.new(name, mesh)
         carry.link_like(obj, target, bpy.context.scene)
@@ -197,7 +209,7 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
         if place:
             carry.place_beside(obj, target)
     mesh_io.apply_vertex_groups(target, groups)
-    carry.write_shape_keys(target, shape_keys, run.prepared.arrays.vertices, run.result.vertices, kept)
+    carry.write_shape_keys(target, shape_keys, arrays.vertices, run.result.vertices, kept, moved, arrays.triangles)
     target["topstoc_source"] = obj.name
     target["topstoc_parameters"] = json.dumps(run.parameters)
     if target is not obj and run.settings is not None:  # what Regenerate needs (regenerate.py)

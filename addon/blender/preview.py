@@ -1,5 +1,13 @@
 """Live preview: re-decimates the cached prepared mesh while the user drags, off the main thread.
 
+Starting is immediate: creating a PreviewSession reads the mesh arrays and hands them to a
+worker, then reads the guidance sources (Blender data can only be read on the main thread) and
+returns. The worker fingerprints the arrays, prepares the mesh when the cache does not hold it
+(reporting its progress, which the operator shows; ``close`` cancels the preparation in the
+engine, not only the wait), turns the guidance read into engine arguments (UV seams, material
+regions: numpy work that takes seconds on big UV-mapped meshes) and decimates the first request. Nothing in the scene changes before the first result: the preview
+object is made, and the original hidden, when ``poll`` shows it.
+
 A PreviewSession owns a temporary object that shows the current result (geometry only, no
 attributes: the final result is written with every attribute when the user applies). Engine
 calls release the GIL, so the interface stays responsive even when one update is slow; the
@@ -15,9 +23,9 @@ triangles, ratios 5-20 %: 14.7 vs 8.8 per second outside Blender). Results are s
 order they were requested: one that finishes after a newer one was shown is dropped.
 
 While the user drags, the preview shows the fast mode (plain TopStoc, milliseconds); when the
-drag pauses for PAUSE_SECONDS and the chosen mode is quality, the same ratio is computed in
-quality mode in the background and replaces the fast result when it is ready (the paint means
-the same in both modes, so the density does not jump).
+drag pauses for PAUSE_SECONDS and the chosen mode is quality (or symmetry is on), the same ratio
+is computed with the chosen settings in the background and replaces the fast result when it is
+ready (the paint means the same in both modes, so the density does not jump).
 """
 
 from __future__ import annotations
@@ -30,43 +38,48 @@ from typing import Optional
 
 import bpy
 
+from ..core.loops import Cancelled
 from ..core.mesh_edges import mesh_edges
 from . import mesh_io, pipeline
-from .guidance import gather
+from .guidance import read as read_guidance
 
 PREVIEW_SUFFIX = "_TopStocPreview"
 WORKERS = 2 if (os.cpu_count() or 1) >= 2 else 1
-PAUSE_SECONDS = 0.35  # a drag paused this long gets the quality result
+PAUSE_SECONDS = 0.35  # a drag paused this long gets the chosen mode's result
+THREAD_PREFIX = "topstoc-preview"
 
 
 class PreviewSession:
-    """Preview of one object's decimation at a changing ratio."""
+    """Preview of one object's decimation at a changing ratio.
 
-    def __init__(self, context, obj, params, region_3d=None):
+    ratio: the first request (computed as soon as the mesh is prepared); without it nothing is
+    computed until ``request`` or ``update``.
+    """
+
+    def __init__(self, context, obj, params, region_3d=None, ratio: Optional[float] = None):
+        pipeline.check_decimatable(obj)
         self.obj = obj
-        self.prepared = pipeline.prepare(obj)
-        self.guidance = gather(obj, self.prepared.arrays, context.scene, None, region_3d)
-        self.prepared.mesh.feature_layout(self.guidance.regions, self.guidance.borders)
+        arrays = mesh_io.read_mesh(obj.data)  # the main thread's work: Blender data
+        self.num_triangles = len(arrays.triangles)
+        self.guidance = None                   # made by the worker from what is read below
+        self._read_guidance = None             # the rules to run on it (guidance.read)
+        self._guidance_read = threading.Event()
         self.options = pipeline.options_kwargs(params)
-        # While dragging: the fast mode; on a pause: the chosen mode (if it is not fast already).
-        self.drag_options = dict(self.options, mode="fast", placement=None, refine=None) \
-            if self.options.get("mode", "quality") != "fast" else self.options
-        self.mesh = bpy.data.meshes.new(obj.name + PREVIEW_SUFFIX)
-        for material in obj.data.materials:
-            self.mesh.materials.append(material)
-        self.preview = bpy.data.objects.new(obj.name + PREVIEW_SUFFIX, self.mesh)
-        for collection in obj.users_collection or (context.scene.collection,):
-            collection.objects.link(self.preview)
-        self.preview.matrix_world = obj.matrix_world.copy()
-        self.preview.show_wire = True      # at 10 % one judges the mesh by its edges
-        self.preview.show_all_edges = True
+        self.axis = pipeline.symmetry_axis(params)
+        # While dragging: the fast mode; on a pause: the chosen settings (unless they are the same).
+        chosen_is_fast = self.options.get("mode", "quality") == "fast" and self.axis is None
+        self.drag_options = self.options if chosen_is_fast else \
+            dict(self.options, mode="fast", placement=None, refine=None)
+        self.prepared = None                   # set by the worker once the mesh is prepared
+        self.mesh = self.preview = None        # made when the first result is shown
         self.was_hidden = obj.hide_get()
-        obj.hide_set(True)
-        self._pool = ThreadPoolExecutor(max_workers=WORKERS)
         self._lock = threading.Lock()
-        self._workers = 0                      # worker loops running
-        self._pending: Optional[float] = None  # latest ratio asked for and not yet started
-        self._started: Optional[float] = None  # ratio of the newest computation started
+        self._ready = threading.Event()        # preparation finished (or failed)
+        self._cancel = threading.Event()       # close() asks the preparation to stop
+        self._progress = (0.0, "fingerprint")  # preparation: fraction done and current step
+        self._workers = 1                      # worker loops running (the start job counts)
+        self._pending = (ratio, False) if ratio is not None else None  # latest request not started
+        self._started: Optional[tuple] = None  # newest computation started
         self._started_count = 0                # computations started (their order numbers)
         self._shown_order = 0                  # order number of the result shown last
         self._finished = None                  # (order, result) newest computed, not shown yet
@@ -74,46 +87,121 @@ class PreviewSession:
         self._last_start = 0.0                 # when the newest computation started
         self._typical = 0.0                    # running average of a computation's seconds
         self.ratio: Optional[float] = None
-        self.final = False                     # the shown result is in the chosen mode
+        self.final = False                     # the shown result has the chosen settings
         self._last_shown = time.perf_counter()
         self.result = None
         self.seconds_decimate = 0.0
         self.seconds_write = 0.0
+        self._pool = ThreadPoolExecutor(max_workers=WORKERS, thread_name_prefix=THREAD_PREFIX)
+        self.start = self._pool.submit(self._start, obj.name, obj.data.name_full, arrays)
+        try:  # Blender data only; turning it into engine arguments is the worker's
+            self._read_guidance = read_guidance(obj, arrays, context.scene, None, region_3d)
+        except BaseException:
+            self.close()  # stops the preparation just started
+            raise
+        finally:
+            self._guidance_read.set()
+
+    # -- starting (worker) ----------------------------------------------------------------
+
+    def _report(self, fraction: float, stage: str) -> bool:
+        """The engine's progress callback during preparation; False stops it (Cancelled)."""
+        self._progress = (fraction, stage)
+        return not self._cancel.is_set()
+
+    def _start(self, obj_name: str, mesh_name: str, arrays) -> None:
+        """Prepares (or finds) the mesh, then works on the requests like any worker."""
+        try:
+            prepared = pipeline.prepare_arrays(obj_name, mesh_name, arrays, self._report)
+            self._guidance_read.wait()
+            if self._read_guidance is None:  # reading it failed: the session is closed
+                raise Cancelled("cancelled: the guidance could not be read")
+            self.guidance = self._read_guidance()
+            prepared.mesh.feature_layout(self.guidance.regions, self.guidance.borders)  # shared by the workers
+        except BaseException as error:  # noqa: BLE001 - handed to the main thread (Cancelled too)
+            with self._lock:
+                self._error, self._workers = error, self._workers - 1
+            self._ready.set()
+            raise
+        with self._lock:
+            self.prepared = prepared
+        self._ready.set()
+        self._work()
+
+    @property
+    def preparing(self) -> bool:
+        """True until the mesh is prepared (or its preparation failed)."""
+        return not self._ready.is_set()
+
+    def progress(self) -> tuple:
+        """(fraction done, step name) of the preparation."""
+        return self._progress
+
+    def wait_prepared(self, timeout: float = None) -> None:
+        """Blocks until the mesh is prepared; raises the preparation's error."""
+        self._ready.wait(timeout)
+        with self._lock:
+            error = self._error if self.prepared is None else None
+            if error is not None:
+                self._error = None
+        if error is not None:
+            raise error
+
+    # -- decimating ---------------------------------------------------------------------------
 
     def compute(self, ratio: float, final: bool = False):
-        """Decimates at ``ratio`` (fast, or in the chosen mode with ``final``) and derives the
+        """Decimates at ``ratio`` (fast, or with the chosen settings with ``final``) and derives the
         result's edges (any thread: the main thread then only copies arrays into the preview)."""
         start = time.perf_counter()
         options = self.options if final else self.drag_options
-        result = self.prepared.mesh.decimate(ratio=ratio, **options, **self.guidance.decimate_kwargs())
+        result = pipeline.run_engine(self.prepared.mesh, {"ratio": ratio}, options,
+                                     self.guidance.decimate_kwargs(), self.axis if final else None)
         edges = mesh_edges(result.triangles, len(result.vertices))
         return (ratio, final or options is self.options), result, edges, time.perf_counter() - start
+
+    def _make_preview(self) -> None:
+        """The preview object, beside the hidden original (main thread, first result)."""
+        obj = self.obj
+        self.mesh = bpy.data.meshes.new(obj.name + PREVIEW_SUFFIX)
+        for material in obj.data.materials:
+            self.mesh.materials.append(material)
+        self.preview = bpy.data.objects.new(obj.name + PREVIEW_SUFFIX, self.mesh)
+        for collection in obj.users_collection or (bpy.context.scene.collection,):
+            collection.objects.link(self.preview)
+        self.preview.matrix_world = obj.matrix_world.copy()
+        self.preview.show_wire = True      # at 10 % one judges the mesh by its edges
+        self.preview.show_all_edges = True
+        obj.hide_set(True)
 
     def show(self, key, result, edges, seconds: float) -> None:
         """Puts a result into the preview object (main thread); key: ratio or (ratio, final)."""
         start = time.perf_counter()
         ratio, final = key if isinstance(key, tuple) else (key, False)
+        if self.preview is None:
+            self._make_preview()
         mesh_io.fill_geometry(self.mesh, result.vertices, result.triangles, edges)
         self.ratio, self.final, self.result, self.seconds_decimate = ratio, final, result, seconds
         self.seconds_write = time.perf_counter() - start
         self._last_shown = time.perf_counter()
 
     def update(self, ratio: float, final: bool = False) -> None:
-        """Synchronous update (benchmarks, tests)."""
+        """Synchronous update (benchmarks, tests); waits for the preparation first."""
+        self.wait_prepared()
         self.show(*self.compute(ratio, final))
         with self._lock:
             self._started = (ratio, final)
 
     def request(self, ratio: float, final: bool = False) -> None:
-        """Asks for ``ratio`` (fast while dragging; ``final``: the chosen mode); only the latest
-        request is computed."""
+        """Asks for ``ratio`` (fast while dragging; ``final``: the chosen settings); only the
+        latest request is computed (after the preparation, if it still runs)."""
         with self._lock:
             self._pending = (ratio, final)
         self._start_worker()
 
     def _start_worker(self) -> None:
         with self._lock:
-            if self._workers < WORKERS and self._pending is not None and self._pending != self._started:
+            if (self.prepared is not None and self._workers < WORKERS and self._pending is not None
+                    and self._pending != self._started and not self._cancel.is_set()):
                 self._workers += 1
                 self._pool.submit(self._work)
 
@@ -123,7 +211,7 @@ class PreviewSession:
             self._stagger()
             with self._lock:
                 key, self._pending = self._pending, None
-                if key is None or key == self._started:
+                if key is None or key == self._started or self._cancel.is_set():
                     self._workers -= 1
                     return
                 self._started = key
@@ -158,7 +246,8 @@ class PreviewSession:
     def poll(self) -> bool:
         """Shows the newest finished result (main thread); True when the view changed.
 
-        The workers are already computing the next requests meanwhile, if there are any."""
+        The workers are already computing the next requests meanwhile, if there are any. A
+        failed preparation or decimation raises here (DecimationError, or the engine's error)."""
         with self._lock:
             finished, self._finished = self._finished, None
             error, self._error = self._error, None
@@ -173,7 +262,7 @@ class PreviewSession:
                 and time.perf_counter() - self._last_shown >= PAUSE_SECONDS:
             with self._lock:
                 idle = self._pending is None
-            if idle:  # the drag paused: replace the fast result with the chosen mode's
+            if idle:  # the drag paused: replace the fast result with the chosen settings'
                 self.request(self.ratio, final=True)
         return finished is not None
 
@@ -183,10 +272,20 @@ class PreviewSession:
             return self._workers > 0 or self._finished is not None
 
     def close(self) -> None:
-        """Removes the preview object and shows the original again."""
+        """Removes the preview object and shows the original again. Returns at once: a running
+        preparation is cancelled in the engine (at its next step) and a running decimation ends
+        unseen; workers never touch Blender data, so nothing waits for them."""
+        self._cancel.set()
         with self._lock:
-            self._pending = None  # the worker stops after its current computation
-        self._pool.shutdown(wait=True)
-        bpy.data.objects.remove(self.preview)
-        bpy.data.meshes.remove(self.mesh)
-        self.obj.hide_set(self.was_hidden)
+            self._pending = None
+        self._pool.shutdown(wait=False)
+        if self.preview is not None:
+            bpy.data.objects.remove(self.preview)
+            bpy.data.meshes.remove(self.mesh)
+            self.preview = self.mesh = None
+            self.obj.hide_set(self.was_hidden)
+
+
+def cancelled(error: BaseException) -> bool:
+    """True for the engine's Cancelled (a preparation stopped by ``close``)."""
+    return isinstance(error, Cancelled)

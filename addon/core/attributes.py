@@ -15,6 +15,7 @@ Vertices that did not move keep their input corner's values exactly.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
@@ -79,22 +80,38 @@ def _clamped_barycentric(points, a, b, c):
     return w, np.linalg.norm(points - at, axis=1)
 
 
-def moved_vertex_sources(data: MeshData, result):
-    """For each output vertex that does not stand at its input vertex: the input triangle and
-    barycentric weights its attributes come from (face -1 and weights (1, 0, 0) for the others).
-    The triangle is the closest (after clamping into it) among the input triangles touching the
-    vertex's cluster."""
-    vertices = np.asarray(result.vertices, dtype=np.float64)
+@dataclass
+class MovedVertices:
+    """Where each output vertex's attributes come from: its kept input vertex (``face`` -1), or,
+    for a vertex that does not stand at its input vertex, barycentric ``weights`` in input
+    triangle ``face``."""
+
+    face: np.ndarray     #: (n_out,) int64 input triangle, -1 for vertices that did not move
+    weights: np.ndarray  #: (n_out, 3) float64, in [0, 1], summing to 1
+
+    @property
+    def moved(self) -> np.ndarray:
+        """Output vertices that moved."""
+        return np.flatnonzero(self.face >= 0)
+
+
+def moved_vertices(vertices, triangles, result) -> MovedVertices:
+    """For each output vertex of ``result`` (a DecimateResult of the mesh ``vertices``,
+    ``triangles``) that does not stand at its input vertex: the input triangle and barycentric
+    weights its attributes come from. The triangle is the closest (after clamping into it) among
+    the input triangles touching the vertex's cluster."""
+    input_vertices = np.asarray(vertices, dtype=np.float64)
+    out_vertices = np.asarray(result.vertices, dtype=np.float64)
     kept = np.asarray(result.kept, dtype=np.int64)
-    face = np.full(len(vertices), -1, dtype=np.int64)
-    weights = np.zeros((len(vertices), 3))
+    face = np.full(len(out_vertices), -1, dtype=np.int64)
+    weights = np.zeros((len(out_vertices), 3))
     weights[:, 0] = 1.0
-    moved = np.flatnonzero(np.any(vertices != data.vertices[kept], axis=1))
+    moved = np.flatnonzero(np.any(out_vertices != input_vertices[kept], axis=1))
     if len(moved) == 0:
-        return face, weights
-    triangles = np.asarray(data.triangles, dtype=np.int64)
+        return MovedVertices(face, weights)
+    triangles = np.asarray(triangles, dtype=np.int64)
     labels = np.asarray(result.labels, dtype=np.int64)
-    is_moved = np.zeros(len(vertices), dtype=bool)
+    is_moved = np.zeros(len(out_vertices), dtype=bool)
     is_moved[moved] = True
     # (output vertex, input triangle) pairs: each triangle is a candidate for the clusters its
     # corners lie in
@@ -106,40 +123,71 @@ def moved_vertex_sources(data: MeshData, result):
     pair_vertex, pair_face = pair_vertex[keep], pair_face[keep]
     pair_unique = np.unique(pair_vertex * len(triangles) + pair_face)
     pair_vertex, pair_face = pair_unique // len(triangles), pair_unique % len(triangles)
-    corners = data.vertices[triangles[pair_face]]
-    w, distance = _clamped_barycentric(vertices[pair_vertex], corners[:, 0], corners[:, 1], corners[:, 2])
+    corners = input_vertices[triangles[pair_face]]
+    w, distance = _clamped_barycentric(out_vertices[pair_vertex], corners[:, 0], corners[:, 1], corners[:, 2])
     order = np.lexsort((pair_face, distance, pair_vertex))    # per vertex: closest first, lowest id on ties
     first = order[np.r_[True, pair_vertex[order][1:] != pair_vertex[order][:-1]]]
     face[pair_vertex[first]] = pair_face[first]
     weights[pair_vertex[first]] = w[first]
-    return face, weights
+    return MovedVertices(face, weights)
+
+
+def _combine(values: np.ndarray, corners: np.ndarray, weights: np.ndarray, nearest: bool) -> np.ndarray:
+    """values at ``corners`` (k, 3) combined with ``weights`` (k, 3): barycentric, or the value
+    of the heaviest corner (``nearest``: integers, flags, rotations)."""
+    if nearest:
+        return values[corners[np.arange(len(corners)), np.argmax(weights, axis=1)]]
+    mixed = np.einsum("kj,kj...->k...", weights, values[corners].astype(np.float64))
+    return mixed.astype(values.dtype, copy=False)
+
+
+def point_values(values, kept, moved: MovedVertices, triangles, nearest: bool = False) -> np.ndarray:
+    """Per-vertex ``values`` (one row per input vertex) for the output vertices: the kept vertex's
+    where the vertex did not move, else interpolated in its source triangle."""
+    values = np.asarray(values)
+    out = values[np.asarray(kept, dtype=np.int64)].copy()
+    at = moved.moved
+    if len(at):
+        corners = np.asarray(triangles, dtype=np.int64)[moved.face[at]]
+        out[at] = _combine(values, corners, moved.weights[at], nearest)
+    return out
+
+
+def corner_values(values, corner_source, output_triangles, moved: MovedVertices, triangle_corners,
+                  nearest: bool = False) -> np.ndarray:
+    """Per-corner ``values`` for the output corners (flat, 3 per output triangle).
+
+    values: one row per input corner; corner_source: the input corner each output corner copies
+    (flat); triangle_corners: (m, 3) the input corner of each input triangle's corners. Corners
+    of moved vertices are interpolated in the vertex's source triangle, from that triangle's own
+    corners, so a value that differs across a seam never mixes the two sides."""
+    values = np.asarray(values)
+    out = values[np.asarray(corner_source, dtype=np.int64).ravel()].copy()
+    corner_vertex = np.asarray(output_triangles, dtype=np.int64).ravel()
+    at = np.flatnonzero(moved.face[corner_vertex] >= 0)
+    if len(at):
+        vertex = corner_vertex[at]
+        corners = np.asarray(triangle_corners, dtype=np.int64)[moved.face[vertex]]
+        out[at] = _combine(values, corners, moved.weights[vertex], nearest)
+    return out
 
 
 def transfer_attributes(data: MeshData, result) -> MeshData:
     """The decimated mesh ``result`` (a DecimateResult of ``data``) with ``data``'s UVs,
     vertex colours and materials carried over through its source maps; moved vertices
     interpolate them (see the module docs)."""
-    corner_source = np.asarray(result.corner_source, dtype=np.int64)
     face_source = np.asarray(result.face_source, dtype=np.int64)
-    kept = np.asarray(result.kept, dtype=np.int64)
-    triangles = np.asarray(result.triangles, dtype=np.int64)
     need = data.corner_uvs is not None or data.vertex_colors is not None
-    source_face, weights = moved_vertex_sources(data, result) if need else (None, None)
+    moved = moved_vertices(data.vertices, data.triangles, result) if need else None
     uvs = None
     if data.corner_uvs is not None:
-        uvs = data.corner_uvs.reshape(-1, 2)[corner_source.ravel()].reshape(-1, 3, 2).copy()
-        corner_vertex = triangles.ravel()
-        moved = source_face[corner_vertex] >= 0
-        f = source_face[corner_vertex[moved]]
-        uvs.reshape(-1, 2)[moved] = np.einsum("kj,kjc->kc", weights[corner_vertex[moved]], data.corner_uvs[f])
+        m = len(data.triangles)
+        flat = corner_values(data.corner_uvs.reshape(-1, 2), result.corner_source, result.triangles, moved,
+                             np.arange(3 * m).reshape(m, 3))
+        uvs = flat.reshape(-1, 3, 2)
     colors = None
     if data.vertex_colors is not None:
-        colors = data.vertex_colors[kept].astype(np.float64)
-        moved = np.flatnonzero(source_face >= 0)
-        input_triangles = np.asarray(data.triangles, dtype=np.int64)
-        colors[moved] = np.einsum("kj,kjc->kc", weights[moved],
-                                  data.vertex_colors[input_triangles[source_face[moved]]])
-        colors = colors.astype(data.vertex_colors.dtype)
+        colors = point_values(data.vertex_colors, result.kept, moved, data.triangles)
     materials = None if data.triangle_material is None else data.triangle_material[face_source]
     return MeshData(vertices=result.vertices, triangles=result.triangles, corner_uvs=uvs, vertex_colors=colors,
                     triangle_material=materials, material_names=data.material_names,

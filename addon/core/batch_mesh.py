@@ -19,6 +19,7 @@ from .io import mesh_format, read_mesh, write_mesh
 from .mesh import Mesh
 from .prune import prune_small_parts
 from .errors import TopStocError
+from .symmetry import decimate_mirrored
 
 #: samples on the original for the per-LOD error in the report: 100 per input triangle, within
 #: these bounds (dense enough on small assets, bounded cost on large ones)
@@ -75,8 +76,8 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
     for index, ((target, screen), output) in enumerate(zip(batch_settings.engine_targets(settings, data.vertices),
                                                           outputs)):
         started = time.perf_counter()
-        result = mesh.decimate(**target, **settings["options"], **layout)
-        entry = {"lod": index, "output": output, "target": target}
+        result = decimate_mirrored(mesh, settings.get("symmetry"), **target, **settings["options"], **layout)
+        entry = {"lod": index, "output": output, "target": target, "symmetry": settings.get("symmetry")}
         if screen is not None and settings["prune_pixels"] > 0:
             result, pruned = prune_small_parts(result, settings["prune_pixels"] * screen.world_per_pixel)
             entry["pruned"] = pruned.as_dict()

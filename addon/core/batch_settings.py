@@ -55,6 +55,9 @@ def add_arguments(parser) -> None:
                         help="default: set by --mode")
     parser.add_argument("--refine", type=float, default=None, metavar="F",
                         help="0: off; F: TopStoc to F x the target, then quadric collapses (default: set by --mode)")
+    parser.add_argument("--symmetry", type=str.upper, choices=("X", "Y", "Z"), metavar="{x,y,z}",
+                        help="mirror-symmetric results across the plane through the origin normal to this "
+                             "axis (object-local in Blender formats)")
     parser.add_argument("--objects", nargs="+", metavar="NAME",
                         help="Blender formats: objects to decimate (default: every mesh object)")
 
@@ -94,7 +97,8 @@ def from_args(args) -> dict:
     out_format = None
     if args.format:
         out_format = args.format.lower().lstrip(".")
-    return {"target": kind, "values": values, "chain": len(values) > 1,
+    symmetry = {"symmetry": args.symmetry} if args.symmetry else {}  # absent when off: older digests hold
+    return {**symmetry, "target": kind, "values": values, "chain": len(values) > 1,
             "pixel_error": args.pixel_error, "fov": args.fov, "resolution": args.resolution,
             "prune_pixels": args.prune_pixels, "lod_files": bool(args.lod_files), "format": out_format,
             "options": {"seed": args.seed, "adaptivity": args.adaptivity, "density": args.density,
@@ -117,6 +121,8 @@ def to_argv(settings: dict) -> list:
     for name, value in settings["options"].items():
         if value is not None:  # None: the mode decides
             argv += [f"--{name}", str(value)]
+    if settings.get("symmetry"):
+        argv += ["--symmetry", settings["symmetry"]]
     if settings["objects"]:
         argv += ["--objects", *settings["objects"]]
     return argv

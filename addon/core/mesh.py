@@ -94,10 +94,13 @@ class Mesh:
     >>> result.vertices, result.triangles
     """
 
-    def __init__(self, vertices, triangles):
+    def __init__(self, vertices, triangles, progress=None):
+        """progress: optional ``progress(fraction, stage)``, called from the preparing thread at
+        each step (validate, order, adjacency, normals and weights, components); returning False
+        stops the preparation with ``topstoc.core.Cancelled`` (the live preview's Esc)."""
         vertices = as_vertices(vertices)
         triangles = _as_triangles(triangles)
-        self._native = engine.Mesh(vertices, triangles)
+        self._native = engine.Mesh(vertices, triangles, progress=progress)
         self._vertices = np.array(vertices, dtype=np.float64)
         self._vertices.setflags(write=False)
         self._triangles = np.array(triangles, dtype=np.int64).astype(np.int32)

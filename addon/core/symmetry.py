@@ -98,17 +98,35 @@ def _symmetric_part(vertices, partner) -> np.ndarray:
     return np.asarray(vertices, dtype=np.int64)[keep]
 
 
+def parse_axis(text) -> str:
+    """'x' / 'X' -> 'X'; ValueError naming the accepted axes otherwise."""
+    axis = str(text).strip().upper()
+    if axis not in AXES:
+        raise ValueError(f"symmetry axis must be one of {', '.join(AXES)}, got {text!r}")
+    return axis
+
+
+def decimate_mirrored(mesh, axis=None, **options):
+    """``mesh.decimate(**options)``, made mirror-symmetric across ``axis`` ("X", "Y", "Z") when it
+    is given (the add-on, the command line and the batch all decimate through this)."""
+    if axis is None:
+        return mesh.decimate(**options)
+    return decimate_symmetric(mesh, parse_axis(axis), **options)
+
+
 def decimate_symmetric(mesh, axis: str = "X", *, tolerance: float = None, regions=None, borders=None,
                        feature_angle: float = 0.0, placement: str = "subsample", guidance=None, **options):
     """``mesh.decimate(...)`` with a mirror-symmetric result (see the module docs).
 
     The result's ``parameters`` record ``symmetry`` (the axis) and its ``samples`` reproduce it
-    through ``decimate_with_samples`` like any result.
+    through ``decimate_with_samples`` like any result. placement None (the mode's choice) is
+    subsample: the mirrored rebuild keeps input vertices in either mode.
     """
     import dataclasses
 
     from .decimate import decimate, decimate_with_samples
 
+    placement = placement or "subsample"
     layout = dict(regions=regions, borders=borders, feature_angle=feature_angle)
     plain = decimate(mesh, placement=placement, guidance=guidance, **layout, **options)
     partner = mirror_partners(mesh.vertices, axis, tolerance)

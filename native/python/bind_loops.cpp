@@ -84,14 +84,7 @@ void bind_loops(py::module_& m) {
         params.count_edges = count_edges;
         params.max_roots = max_roots;
         params.seed = seed;
-        if (!progress.is_none()) {
-          // Called from the worker without the GIL: take it only for the call (Progress throttles).
-          params.progress = [progress](double fraction, const char* stage) {
-            py::gil_scoped_acquire gil;
-            const py::object answer = progress(fraction, stage);
-            return answer.is_none() || py::cast<bool>(answer);
-          };
-        }
+        params.progress = progress_from(progress);
         LoopsResult r;
         {
           EngineCall call;

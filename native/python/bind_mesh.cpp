@@ -31,13 +31,15 @@ py::dict report_dict(const MeshReport& r) {
 
 void bind_mesh(py::module_& m) {
   py::class_<Mesh, std::shared_ptr<Mesh>>(m, "Mesh", "Prepared triangle mesh (validated, with adjacency and weights).")
-      .def(py::init([](const py::handle& vertices, const py::handle& triangles) {
+      .def(py::init([](const py::handle& vertices, const py::handle& triangles, const py::object& progress) {
              auto positions = positions_from(vertices, "vertices");
              auto tris = indices_from(triangles, 3, "triangles");
+             auto callback = progress_from(progress);
              EngineCall call;
-             return std::make_shared<Mesh>(std::move(positions), tris.data(), int64_t(tris.size() / 3));
+             return std::make_shared<Mesh>(std::move(positions), tris.data(), int64_t(tris.size() / 3), callback);
            }),
-           py::arg("vertices"), py::arg("triangles"))
+           py::arg("vertices"), py::arg("triangles"), py::arg("progress") = py::none(),
+           "progress(fraction, stage) hears each preparation step; returning False raises Cancelled.")
       .def_property_readonly("num_vertices", &Mesh::num_vertices)
       .def_property_readonly("num_faces", &Mesh::num_faces)
       .def_property_readonly("num_edges", &Mesh::num_edges)

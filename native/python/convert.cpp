@@ -1,6 +1,7 @@
 #include "convert.hpp"
 
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 namespace topstoc::python {
@@ -101,6 +102,22 @@ std::vector<int32_t> ids_from(const py::handle& object, int64_t n, const char* w
     out[i] = static_cast<int32_t>(x);
   }
   return out;
+}
+
+ProgressCallback progress_from(const py::object& callback, const char* what) {
+  if (callback.is_none()) return {};
+  if (!PyCallable_Check(callback.ptr()))
+    throw py::type_error(std::string(what) + " must be callable as " + what + "(fraction, stage), got " +
+                         std::string(py::str(py::type::of(callback).attr("__name__"))));
+  std::shared_ptr<py::object> held(new py::object(callback), [](py::object* p) {
+    py::gil_scoped_acquire gil;
+    delete p;
+  });
+  return [held](double fraction, const char* stage) {
+    py::gil_scoped_acquire gil;
+    const py::object answer = (*held)(fraction, stage);
+    return answer.is_none() || py::cast<bool>(answer);
+  };
 }
 
 }  // namespace topstoc::python

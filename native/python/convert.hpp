@@ -7,6 +7,7 @@
 #include <pybind11/pybind11.h>
 
 #include "topstoc/core/parallel.hpp"
+#include "topstoc/core/progress.hpp"
 
 #include <cstdint>
 #include <string>
@@ -36,6 +37,12 @@ std::vector<double> scalars_from(const py::handle& array, int64_t n, const char*
 
 /// 1-D integer array of length n (or None -> empty).
 std::vector<int32_t> ids_from(const py::handle& array, int64_t n, const char* what);
+
+/// A ProgressCallback that calls the Python callable ``callback(fraction, stage)`` from an engine
+/// thread, taking the GIL only for the call (Progress throttles them); its answer False cancels.
+/// None gives no callback. The callable is held so that copying the callback between threads
+/// never touches Python reference counts without the GIL.
+ProgressCallback progress_from(const py::object& callback, const char* what = "progress");
 
 /// Scope of one engine call: releases the GIL and sizes OpenMP teams to this call's share of
 /// the cores free now.

@@ -66,6 +66,7 @@ def steps():
     check("preview removed", "Torus_TopStocPreview" not in bpy.data.objects
           and not bpy.data.objects["Torus"].hide_get())
     check("ratio stored in the panel", abs(bpy.context.scene.topstoc.ratio - 0.2) < 0.005)
+    check("no modal timer left after Enter", not operators.running)
     # 4: a second preview cancelled with Esc leaves nothing behind
     bpy.data.objects["Torus_TopStoc"].select_set(False)
     bpy.context.view_layer.objects.active = bpy.data.objects["Torus"]
@@ -80,6 +81,46 @@ def steps():
     yield 0.5
     names = sorted(o.name for o in bpy.data.objects if o.type == "MESH")
     check("Esc restores", names == ["Cube", "Torus", "Torus_TopStoc"] and not bpy.data.objects["Torus"].hide_get())
+    check("no modal timer left behind", not operators.running)
+    # 5: Esc while the mesh is being prepared (the engine held at its adjacency step by a gate in
+    # the progress callback): invoke has returned, nothing changed; Esc stops the engine there
+    import threading
+
+    torus = bpy.data.objects["Torus"]
+    before = [tuple(v.co) for v in torus.data.vertices]
+    sessions.prepared_meshes_clear()
+    gate, held = threading.Event(), []
+    report = sessions.PreviewSession._report
+
+    def gated(session, fraction, stage):
+        report(session, fraction, stage)
+        if stage == "adjacency":
+            held.append(session)
+            gate.wait(30)
+        return report(session, fraction, stage)
+
+    sessions.PreviewSession._report = gated
+    try:
+        with bpy.context.temp_override(window=window, area=area, region=region):
+            started = bpy.ops.topstoc.preview("INVOKE_DEFAULT")
+        check("invoke returns while the mesh is prepared", started == {"RUNNING_MODAL"} and operators.running)
+        yield 0.5
+        check("preparing: nothing changed yet", bool(held) and held[0].preparing
+              and "Torus_TopStocPreview" not in bpy.data.objects and not torus.hide_get())
+        window.event_simulate(type="ESC", value="PRESS")
+        window.event_simulate(type="ESC", value="RELEASE")
+        yield 0.2
+        gate.set()
+        yield 1.0
+    finally:
+        gate.set()
+        sessions.PreviewSession._report = report
+    error = held[0].start.exception() if held and held[0].start.done() else None
+    check("Esc stopped the preparation in the engine", sessions.cancelled(error)
+          and not any(t.name.startswith("topstoc-preview") for t in threading.enumerate()))
+    check("Esc during preparation leaves the object untouched", not operators.running
+          and "Torus_TopStocPreview" not in bpy.data.objects and not torus.hide_get()
+          and [tuple(v.co) for v in torus.data.vertices] == before)
 
 
 def run():
@@ -97,6 +138,9 @@ def run():
 try:
     addon_utils.enable("topstoc", default_set=True)
     bpy.ops.mesh.primitive_torus_add(major_segments=96, minor_segments=48)
+    sessions = sys.modules["topstoc.blender.preview"]
+    sessions.prepared_meshes_clear = sys.modules["topstoc.blender.cache"].prepared_meshes.clear
+    operators = sys.modules["topstoc.blender.operators.preview"]
     state["steps"] = steps()
     bpy.app.timers.register(run, first_interval=1.0)
 except Exception:

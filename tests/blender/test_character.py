@@ -110,7 +110,11 @@ def test_armature_deforms_the_result_like_the_source(ts, scene):
     np.testing.assert_allclose(posed_out, posed_source[kept], atol=1e-5)
 
 
-def test_filtered_placement_moves_each_key_with_its_vertex(ts, scene):
+def test_filtered_placement_interpolates_each_keys_offset(ts, scene):
+    """A moved vertex's offset (key minus position) is interpolated on the input surface it stands
+    on: it lies within the offsets of one input triangle of its cluster (checked by brute force
+    over that cluster's triangles); a vertex that did not move keeps its input key exactly.
+    (tests/blender/test_moved_attributes.py checks the interpolation itself.)"""
     body, _rig = make_character()
     state = source_state(body)
     params = Params(ratio=0.3, quality="CUSTOM", placement="filtered", refine=0)
@@ -118,11 +122,21 @@ def test_filtered_placement_moves_each_key_with_its_vertex(ts, scene):
     out = ts.blender.pipeline.write_output(run)
     kept = np.asarray(run.result.kept)
     out_co = positions(out.data).astype(np.float64)
-    assert np.abs(out_co - state["co"][kept]).max() > 1e-4  # vertices did move
+    moved = np.flatnonzero(np.any(out_co != state["co"][kept], axis=1))
+    assert np.abs(out_co - state["co"][kept]).max() > 1e-4 and len(moved)  # vertices did move
+    still = np.setdiff1d(np.arange(len(kept)), moved)
+    body.data.calc_loop_triangles()
+    triangles = np.array([tuple(t.vertices) for t in body.data.loop_triangles])
+    labels = np.asarray(run.result.labels)
     for name, (co, _settings, _relative) in key_table(out.data).items():
+        np.testing.assert_array_equal(co[still], state["keys"][name][0][kept[still]], err_msg=name)
+        source_offset = state["keys"][name][0].astype(np.float64) - state["co"]
         offset = co.astype(np.float64) - out_co
-        expected = state["keys"][name][0].astype(np.float64)[kept] - state["co"][kept]
-        np.testing.assert_allclose(offset, expected, atol=1e-5, err_msg=name)
+        for v in moved:
+            cluster = np.flatnonzero(labels == v)
+            candidates = triangles[np.isin(triangles, cluster).any(axis=1)]
+            lo, hi = source_offset[candidates].min(axis=1), source_offset[candidates].max(axis=1)
+            assert np.any(np.all((lo - 1e-5 <= offset[v]) & (offset[v] <= hi + 1e-5), axis=1)), (name, v)
 
 
 def test_lod_chain_carries_shape_keys(ts, scene):

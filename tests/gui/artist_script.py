@@ -4,6 +4,8 @@ with its wireframe, and the Topology panel's plain-words help. Screenshots + rep
 
 import os
 import sys
+import threading
+import time
 
 import bpy
 
@@ -138,6 +140,9 @@ def big_mesh_preview(source):
     mesh = bpy.data.meshes.new("Big")
     mesh_io.fill_geometry(mesh, vertices, triangles)
     big = bpy.data.objects.new("Big", mesh)
+    # Xvfb's software rasteriser takes seconds to draw a million triangles (a GPU milliseconds),
+    # and the event loop waits for each frame: drawn as its bounds, Esc reaches the modal in time
+    big.display_type = "BOUNDS"
     bpy.context.scene.collection.objects.link(big)
     for other in bpy.context.view_layer.objects:
         other.select_set(False)
@@ -148,17 +153,73 @@ def big_mesh_preview(source):
     settings.target_mode, settings.ratio = "VERTICES", 0.3
     report["values"]["big_triangles"] = int(len(triangles))
     window, area, region, _space = view3d()
-    with session.override():
-        started = bpy.ops.topstoc.preview("INVOKE_DEFAULT")
-    check("big preview starts at once", started == {"RUNNING_MODAL"})
-    yield 0.01
-    preparing = "Big_TopStocPreview" not in bpy.data.objects
-    report["values"]["big_still_preparing_at_shot"] = preparing
-    shot("preview_preparing", [big])
-    window.event_simulate(type="ESC", value="PRESS")
-    window.event_simulate(type="ESC", value="RELEASE")
-    yield 0.5
-    check("Esc cancels the big preview", "Big_TopStocPreview" not in bpy.data.objects and not big.hide_get())
+    sessions = sys.modules[ADDON.__name__ + ".blender.preview"]
+    operators = sys.modules[ADDON.__name__ + ".blender.operators.preview"]
+    created = []
+    original_init = sessions.PreviewSession.__init__
+
+    def remember(self, *args, **kwargs):
+        original_init(self, *args, **kwargs)
+        created.append(self)
+
+    # Under Xvfb's software rasteriser on a loaded machine a frame can take a second, longer than
+    # the preparation: the engine is held at its adjacency step (a gate in the progress callback)
+    # until Esc has been handled, so that Esc surely comes while it prepares
+    gate, held = threading.Event(), []
+    report_progress = sessions.PreviewSession._report
+
+    def gated(preview_session, fraction, stage):
+        report_progress(preview_session, fraction, stage)
+        if stage == "adjacency" and not held:
+            held.append(stage)
+            gate.wait(30)
+        return report_progress(preview_session, fraction, stage)  # asked again after the wait
+
+    yield 0.5  # the new mesh settles (drawn once) before the artist starts the preview
+    sessions.PreviewSession.__init__ = remember
+    sessions.PreviewSession._report = gated
+    try:
+        # 1: invoke returns while the mesh is still being prepared; Esc stops the engine
+        clock, cpu = time.perf_counter(), time.thread_time()
+        with session.override():
+            started = bpy.ops.topstoc.preview("INVOKE_DEFAULT")
+        report["values"]["big_invoke_seconds"] = time.perf_counter() - clock
+        report["values"]["big_invoke_cpu_seconds"] = time.thread_time() - cpu
+        first = created[-1] if created else None
+        check("big preview starts at once", started == {"RUNNING_MODAL"} and first is not None and first.preparing,
+              f"{report['values']['big_invoke_seconds']:.3f} s, {report['values']['big_invoke_cpu_seconds']:.3f} s CPU")
+        yield 0.05
+        was_preparing = first.preparing
+        window.event_simulate(type="ESC", value="PRESS")
+        window.event_simulate(type="ESC", value="RELEASE")
+        while operators.running:
+            yield 0.02
+        gate.set()
+        escaped = time.perf_counter()
+        while not first.start.done() and time.perf_counter() - escaped < 10:
+            yield 0.02
+        report["values"]["big_cancel_seconds"] = time.perf_counter() - escaped
+        error = first.start.exception() if first.start.done() else None
+        check("Esc stops the preparation in the engine", was_preparing and sessions.cancelled(error),
+              f"{report['values']['big_cancel_seconds']:.3f} s: {error!r}")
+        yield 0.3
+        check("Esc cancels the big preview", "Big_TopStocPreview" not in bpy.data.objects and not big.hide_get()
+              and len(big.data.polygons) == len(triangles))
+        check("no preview thread or modal timer left", not operators.running
+              and not any(t.name.startswith(sessions.THREAD_PREFIX) for t in threading.enumerate()))
+        # 2: the header while preparing (a screenshot), then Esc
+        with session.override():
+            bpy.ops.topstoc.preview("INVOKE_DEFAULT")
+        yield 0.01
+        report["values"]["big_still_preparing_at_shot"] = created[-1].preparing
+        shot("preview_preparing", [big])
+        window.event_simulate(type="ESC", value="PRESS")
+        window.event_simulate(type="ESC", value="RELEASE")
+        yield 0.5
+    finally:
+        gate.set()
+        sessions.PreviewSession.__init__ = original_init
+        sessions.PreviewSession._report = report_progress
     check("the panel's target is back", settings.target_mode == "VERTICES" and abs(settings.ratio - 0.3) < 1e-6)
 
 

@@ -117,3 +117,23 @@ def test_quality_mode_colours_within_the_source_triangle():
         candidates = np.flatnonzero(np.isin(triangles, cluster).any(axis=1))
         lo, hi = colors[triangles[candidates]].min(axis=1), colors[triangles[candidates]].max(axis=1)
         assert np.any(np.all((lo - 1e-12 <= out.vertex_colors[v]) & (out.vertex_colors[v] <= hi + 1e-12), axis=1))
+
+
+def test_point_and_corner_values_by_hand():
+    """Two input triangles sharing edge (1, 2), with a seam there (corner values differ across
+    it); output vertex 0 stays at input vertex 0, output vertex 1 moved into triangle 1."""
+    from topstoc.core.attributes import MovedVertices, corner_values, point_values
+
+    triangles = np.array([[0, 1, 2], [2, 1, 3]])
+    moved = MovedVertices(face=np.array([-1, 1]), weights=np.array([[1.0, 0, 0], [0.2, 0.3, 0.5]]))
+    kept = np.array([0, 3])
+    values = np.array([[0.0], [10.0], [20.0], [30.0]], dtype=np.float32)
+    out = point_values(values, kept, moved, triangles)
+    assert out.dtype == np.float32
+    np.testing.assert_allclose(out[:, 0], [0.0, 0.2 * 20 + 0.3 * 10 + 0.5 * 30])
+    ids = np.arange(4, dtype=np.int32)[:, None]
+    np.testing.assert_array_equal(point_values(ids, kept, moved, triangles, nearest=True)[:, 0], [0, 3])
+    # corners: 6 input corners (triangle-major); the output triangle (0, 1, 1)'s corners copy corners 0, 4, 4
+    corner = np.array([[1.0], [2.0], [3.0], [-3.0], [-2.0], [-1.0]])  # triangle 1's side of the seam is negative
+    flat = corner_values(corner, np.array([0, 4, 4]), np.array([[0, 1, 1]]), moved, np.arange(6).reshape(2, 3))
+    np.testing.assert_allclose(flat[:, 0], [1.0, 0.2 * -3 + 0.3 * -2 + 0.5 * -1, 0.2 * -3 + 0.3 * -2 + 0.5 * -1])

@@ -106,3 +106,47 @@ def test_components_and_diagonal():
     assert mesh.report().components == 3
     lo, hi = mesh.vertices.min(0), mesh.vertices.max(0)
     assert mesh.diagonal == pytest.approx(np.linalg.norm(hi - lo))
+
+
+# -- preparation progress and cancellation (the live preview's Esc) ------------------------------
+
+STEPS = ["validate", "order", "adjacency", "normals and weights", "components"]
+
+
+def test_progress_hears_every_preparation_step():
+    v, t = meshgen.torus(48, 24)
+    heard = []
+    mesh = Mesh(v, t, progress=lambda fraction, stage: heard.append((fraction, stage)))
+    assert [stage for _, stage in heard] == STEPS
+    fractions = [fraction for fraction, _ in heard]
+    assert fractions == sorted(fractions) and fractions[0] == 0.0 and fractions[-1] < 1.0
+    plain = Mesh(v, t)
+    np.testing.assert_array_equal(mesh.weights, plain.weights)  # progress changes nothing
+
+
+@pytest.mark.parametrize("stop_at", STEPS)
+def test_progress_answering_false_cancels_at_that_step(stop_at):
+    from topstoc.core import Cancelled
+
+    v, t = meshgen.torus(48, 24)
+    heard = []
+
+    def progress(fraction, stage):
+        heard.append(stage)
+        return stage != stop_at
+
+    with pytest.raises(Cancelled, match=stop_at):
+        Mesh(v, t, progress=progress)
+    assert heard == STEPS[:STEPS.index(stop_at) + 1]
+
+
+def test_progress_errors_are_clear():
+    v, t = meshgen.torus(12, 6)
+    with pytest.raises(TypeError, match="progress must be callable"):
+        Mesh(v, t, progress=5)
+
+    def broken(fraction, stage):
+        raise KeyError("from the callback")
+
+    with pytest.raises(KeyError, match="from the callback"):  # the caller's own error comes through
+        Mesh(v, t, progress=broken)

@@ -1,32 +1,32 @@
 """Modal live preview: drag the mouse to change the ratio, Enter applies, Esc restores.
 
-Starting is immediate: the mesh is read on the main thread, and a mesh not prepared yet is
-prepared on a worker thread (the engine releases the GIL) while the header and status bar show
-what is happening with a wait cursor; Esc cancels then too. The preview always shows the Fast
-result with its wireframe; Enter writes the result at the panel's Quality. The sidebar's ratio
-follows the drag (and goes back on cancel).
+Starting is immediate: invoke reads the mesh and its guidance (the only main-thread work) and
+returns; the preview session fingerprints, prepares (when the mesh is not cached) and decimates
+on a worker thread while the header and status bar show the preparation's progress with a wait
+cursor. Esc cancels then too, and the engine stops preparing (not only the waiting); the object
+is left as it was. The preview shows the Fast result with its wireframe while dragging and the
+chosen Quality when the drag pauses; Enter writes the result at the panel's settings. The
+sidebar's ratio follows the drag (and goes back on cancel).
 """
 
 from __future__ import annotations
 
 import math
 import time
-from concurrent.futures import ThreadPoolExecutor
 from types import SimpleNamespace
 
 import bpy
 
-from ...core.mesh import Mesh
-from .. import mesh_io, pipeline
+from .. import pipeline
 from ...core.errors import TopStocError
-from ..cache import prepared_meshes
 from ..guidance import GuidanceError
-from ..preview import PreviewSession
+from ..preview import PreviewSession, cancelled
 from ..props import OperatorParameters, fill_from_scene, settings_names
 from . import polls
 
 PIXELS_PER_DOUBLING = 150.0  # mouse travel that doubles (or halves) the ratio
-_preparer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="topstoc-prepare")
+#: Live previews whose modal timer is running (tests check that none is left behind).
+running: set = set()
 
 
 class TOPSTOC_OT_preview(OperatorParameters, bpy.types.Operator):
@@ -41,71 +41,28 @@ Enter or click applies, Esc or right-click restores"""
     def poll(cls, context):
         return polls.refuse(cls, polls.active_mesh_in_object_mode(context) or polls.view_3d(context))
 
-    # -- starting: read, prepare off the main thread, then open the session ----------------
-
     def invoke(self, context, event):
         fill_from_scene(self, context.scene.topstoc)
         obj = context.object
-        self.session = None
         self.saved_scene = (context.scene.topstoc.target_mode, context.scene.topstoc.ratio)
-        self.start_x = event.mouse_x
         self.started = time.perf_counter()
-        try:
-            mesh_io.check_mesh_object(obj, pipeline.DecimationError)
-            arrays, digest, entry = prepared_meshes.find(obj.data)
-        except ValueError as error:  # TopStocError or an engine refusal
+        settings = SimpleNamespace(**{name: getattr(self, name) for name in settings_names()})
+        try:  # reads the mesh and guidance; preparing and decimating go on in a worker
+            self.session = PreviewSession(context, obj, settings, context.region_data, ratio=self.ratio)
+        except (pipeline.DecimationError, GuidanceError, ValueError) as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         self.obj_name = obj.name
-        self.preparing = None
-        if entry is None:  # prepare on a worker: the window stays responsive and Esc works
-            self.pending = (arrays, digest)
-            self.preparing = _preparer.submit(Mesh, arrays.vertices, arrays.triangles)
-        self.timer = context.window_manager.event_timer_add(1.0 / 60.0, window=context.window)
-        context.window_manager.modal_handler_add(self)
-        context.window.cursor_modal_set("WAIT")
-        self._status(context, f"TopStoc: preparing '{obj.name}' ({len(arrays.triangles):,} triangles) ...")
-        if self.preparing is None:
-            return self._open(context, event)
-        return {"RUNNING_MODAL"}
-
-    def _open(self, context, event=None):
-        """Preparation done: opens the preview session (guidance, preview object)."""
-        obj = bpy.data.objects.get(self.obj_name)
-        # The session shows Fast while the slider moves and the chosen quality when it rests.
-        settings = SimpleNamespace(**{name: getattr(self, name) for name in settings_names()})
-        try:
-            self.session = PreviewSession(context, obj, settings, context.region_data)
-        except (pipeline.DecimationError, GuidanceError, ValueError) as error:
-            self._finish(context)
-            self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
-        context.window.cursor_modal_restore()
-        active = self.session.prepared.mesh.report()
-        self.min_ratio = 1.0 / max(1, active.input_vertices - active.isolated_vertices)
-        if event is not None:
-            self.start_x = event.mouse_x
+        self.start_x = event.mouse_x
         self.start_ratio = self.ratio
-        self.session.update(self.ratio)  # the first result at once (a prepared mesh decimates in ms)
-        self._follow(context)
+        self.min_ratio = 1.0 / max(1, len(obj.data.vertices))  # refined once the mesh is prepared
+        self.timer = context.window_manager.event_timer_add(1.0 / 60.0, window=context.window)
+        running.add(self.timer)
+        context.window_manager.modal_handler_add(self)
+        context.window.cursor_modal_set("WAIT")  # until the first result shows
+        self.waiting = True
         self._header(context)
         return {"RUNNING_MODAL"}
-
-    def _poll_preparation(self, context):
-        if not self.preparing.done():
-            seconds = time.perf_counter() - self.started
-            self._status(context, f"TopStoc: preparing '{self.obj_name}' ... {seconds:.1f} s   Esc: cancel")
-            return {"RUNNING_MODAL"}
-        try:
-            mesh = self.preparing.result()
-        except ValueError as error:
-            self._finish(context)
-            self.report({"ERROR"}, f"'{self.obj_name}': {error}")
-            return {"CANCELLED"}
-        obj = bpy.data.objects.get(self.obj_name)
-        prepared_meshes.add(obj.data, *self.pending, mesh)
-        self.preparing = None
-        return self._open(context)
 
     # -- feedback -----------------------------------------------------------------------------
 
@@ -116,12 +73,17 @@ Enter or click applies, Esc or right-click restores"""
     def _header(self, context):
         s = self.session
         result = s.result
+        seconds = time.perf_counter() - self.started
+        if s.preparing:
+            fraction, stage = s.progress()
+            self._status(context, f"TopStoc: preparing '{self.obj_name}' ({s.num_triangles:,} triangles): "
+                                  f"{100 * fraction:.0f} % ({stage})  {seconds:.1f} s   Esc: cancel")
+            return
         if result is None:
-            seconds = time.perf_counter() - self.started
-            self._status(context, f"TopStoc: decimating '{s.obj.name}' at ratio {self.ratio:.4f} ... "
+            self._status(context, f"TopStoc: decimating '{self.obj_name}' at ratio {self.ratio:.4f} ... "
                                   f"{seconds:.1f} s   Esc: cancel")
             return
-        quality = "" if self.quality == "FAST" else \
+        quality = "" if s.drag_options is s.options else \
             f"  ({self.quality.title() if s.final else 'Fast while dragging'})"
         self._status(context,
                      f"TopStoc ratio {s.ratio:.4f}: {result.num_vertices:,} vertices, {result.num_triangles:,} "
@@ -139,43 +101,53 @@ Enter or click applies, Esc or right-click restores"""
 
     def _finish(self, context, restore_scene: bool = False):
         context.window_manager.event_timer_remove(self.timer)
+        running.discard(self.timer)
         context.area.header_text_set(None)
         context.workspace.status_text_set(None)
         context.window.cursor_modal_restore()
-        if self.session is not None:
-            self.session.close()
+        self.session.close()  # cancels a preparation still running
         if restore_scene:
             context.scene.topstoc.target_mode, context.scene.topstoc.ratio = self.saved_scene
 
+    def _fail(self, context, error):
+        self._finish(context, restore_scene=True)
+        self.report({"ERROR"}, str(error))
+        return {"CANCELLED"}
+
     # -- the drag -----------------------------------------------------------------------------
+
+    def _set_ratio(self, context, ratio):
+        self.ratio = min(1.0, max(self.min_ratio, ratio))
+        self.session.request(self.ratio)
+        self._follow(context)
 
     def modal(self, context, event):
         if event.type in {"ESC", "RIGHTMOUSE"} and event.value == "PRESS":
-            self._finish(context, restore_scene=True)  # a preparation still running is left to finish
+            self._finish(context, restore_scene=True)
             return {"CANCELLED"}
-        if self.preparing is not None:
-            if event.type == "TIMER":
-                return self._poll_preparation(context)
-            return {"RUNNING_MODAL"}
         if event.type == "MOUSEMOVE":
             exponent = (event.mouse_x - self.start_x) / PIXELS_PER_DOUBLING
-            self.ratio = min(1.0, max(self.min_ratio, self.start_ratio * math.pow(2.0, exponent)))
-            self.session.request(self.ratio)
-            self._follow(context)
+            self._set_ratio(context, self.start_ratio * math.pow(2.0, exponent))
         elif event.type in {"WHEELUPMOUSE", "WHEELDOWNMOUSE"}:
             factor = 1.05 if event.type == "WHEELUPMOUSE" else 1 / 1.05
             self.start_ratio = min(1.0, max(self.min_ratio, self.start_ratio * factor))
-            self.ratio = min(1.0, max(self.min_ratio, self.ratio * factor))
-            self.session.request(self.ratio)
-            self._follow(context)
+            self._set_ratio(context, self.ratio * factor)
         elif event.type == "TIMER":
+            was_preparing = self.session.preparing
             try:
-                if self.session.poll() or self.session.result is None:
-                    self._header(context)
-            except ValueError as error:
-                self._finish(context)
-                self.report({"ERROR"}, str(error))
-                return {"CANCELLED"}
+                shown = self.session.poll()
+            except (ValueError, RuntimeError) as error:  # a failed preparation or decimation
+                if cancelled(error):
+                    return {"RUNNING_MODAL"}
+                return self._fail(context, error)
+            if was_preparing and not self.session.preparing and self.session.prepared is not None:
+                active = self.session.prepared.mesh.report()
+                self.min_ratio = 1.0 / max(1, active.input_vertices - active.isolated_vertices)
+            if shown and self.waiting:
+                context.window.cursor_modal_restore()
+                self.waiting = False
+            if shown or self.session.result is None:
+                self._header(context)
         elif event.type in {"RET", "NUMPAD_ENTER", "LEFTMOUSE"} and event.value == "PRESS":
             if self.session.result is None:
                 return {"RUNNING_MODAL"}  # nothing shown yet to apply

@@ -16,6 +16,7 @@ import numpy as np
 from ..attributes import material_regions, transfer_attributes, uv_seam_edges
 from ..io import dropped_attributes, mesh_format, read_mesh, write_mesh
 from ..mesh import Mesh
+from ..symmetry import AXES, decimate_mirrored
 from . import print_json
 from ..errors import TopStocError
 
@@ -49,6 +50,9 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--refine", type=float, default=None, metavar="F",
                         help="0: off. F >= 1: TopStoc keeps F x the target, then edge collapses by quadric "
                              "error (default: set by --mode)")
+    parser.add_argument("--symmetry", type=str.upper, choices=AXES, metavar="{x,y,z}",
+                        help="mirror-symmetric result across the plane through the origin normal to this "
+                             "axis (like Blender's Decimate modifier; the input must be symmetric there)")
     parser.add_argument("--guidance", metavar="FILE.npy",
                         help="per-vertex guidance u in [-1, 1] in the input file's vertex order "
                              "(STL: welded order); 1 keeps a vertex, -1 avoids it")
@@ -122,10 +126,10 @@ def run(args) -> int:
                    regions=material_regions(data), borders=seams if seams is not None and len(seams) else None)
     if args.max_error is not None:
         bound, relative = parse_max_error(args.max_error)
-        result = mesh.decimate(max_error=bound, relative=relative, **options)
+        result = decimate_mirrored(mesh, args.symmetry, max_error=bound, relative=relative, **options)
     else:
-        result = mesh.decimate(ratio=args.ratio, target_vertices=args.vertices, target_triangles=args.triangles,
-                               **options)
+        result = decimate_mirrored(mesh, args.symmetry, ratio=args.ratio, target_vertices=args.vertices,
+                                   target_triangles=args.triangles, **options)
     seconds = time.perf_counter() - start
 
     output = transfer_attributes(data, result)
@@ -148,6 +152,7 @@ def run(args) -> int:
                                                     ("triangles", args.triangles), ("max_error", args.max_error))
                        if value is not None},
             "seed": args.seed,
+            "symmetry": args.symmetry,
             "seconds": seconds,
             "seconds_by_stage": {"prepare": seconds - sum(stats.seconds.values()), **stats.seconds},
             "repairs": stats.repairs,

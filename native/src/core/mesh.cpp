@@ -36,8 +36,10 @@ void exclusive_scan(std::vector<int32_t>& counts) {
 
 }  // namespace
 
-Mesh::Mesh(std::vector<double> positions, const int32_t* triangles, int64_t num_triangles)
+Mesh::Mesh(std::vector<double> positions, const int32_t* triangles, int64_t num_triangles,
+           const ProgressCallback& progress_callback)
     : positions_(std::move(positions)) {
+  Progress progress(progress_callback);  // steps at their share of the time on the horse; may throw Cancelled
   if (positions_.size() % 3 != 0) throw std::invalid_argument("positions must hold 3 coordinates per vertex");
   if (positions_.size() / 3 > size_t(INT32_MAX))
     throw std::invalid_argument("mesh is too large: more than 2^31 vertices");
@@ -57,12 +59,17 @@ Mesh::Mesh(std::vector<double> positions, const int32_t* triangles, int64_t num_
   diagonal_ = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
+  progress.stage("validate", 0.0, 0.2);
   validate_and_copy_faces(triangles, num_triangles);
+  progress.stage("order", 0.2, 0.4);
   reorder_for_locality(lo, hi);
+  progress.stage("adjacency", 0.4, 0.72);
   build_vertex_faces();
   build_adjacency_and_edges();
   build_edge_faces();
+  progress.stage("normals and weights", 0.72, 0.82);
   compute_normals_and_weights();
+  progress.stage("components", 0.82, 1.0);
   compute_components_and_manifoldness();
 }
 

@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "topstoc/core/progress.hpp"
+
 namespace topstoc {
 
 /// What validation found and repaired. Counts refer to the caller's arrays.
@@ -39,7 +41,10 @@ struct MeshReport {
 class Mesh {
  public:
   /// positions: 3n coordinates; triangles: 3m vertex indices. Throws std::invalid_argument.
-  Mesh(std::vector<double> positions, const int32_t* triangles, int64_t num_triangles);
+  /// progress (optional) hears each preparation step; returning false stops the preparation
+  /// with Cancelled (the live preview's Esc).
+  Mesh(std::vector<double> positions, const int32_t* triangles, int64_t num_triangles,
+       const ProgressCallback& progress = {});
 
   int32_t num_vertices() const { return num_vertices_; }
   int32_t num_faces() const { return static_cast<int32_t>(faces_.size() / 3); }

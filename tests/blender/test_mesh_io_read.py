@@ -1,0 +1,56 @@
+"""Reading a Blender mesh into arrays: the shortcuts (a triangle mesh's loop triangles are its
+polygons; Blender 4.0+ edge flags from their attributes) give what Blender's own per-element
+accessors give."""
+
+import numpy as np
+import pytest
+
+import meshgen
+from helpers import make_object
+
+
+def reference_triangulation(mesh):
+    """Loop triangles read one by one through Blender's API (the independent reference)."""
+    mesh.calc_loop_triangles()
+    tris = mesh.loop_triangles
+    return (np.array([tuple(t.vertices) for t in tris]), np.array([tuple(t.loops) for t in tris]),
+            np.array([t.polygon_index for t in tris]))
+
+
+@pytest.mark.parametrize("kind", ["triangles", "quads and triangles"])
+def test_read_mesh_matches_blenders_loop_triangles(ts, scene, kind):
+    if kind == "triangles":
+        obj = make_object("Ball", *meshgen.icosphere(3))
+    else:  # a grid of quads, its last rows split into triangles, and one pentagon
+        k = 8
+        vertices = [(i, j, 0.1 * ((i * j) % 3)) for i in range(k) for j in range(k)]
+        faces = []
+        for i in range(k - 1):
+            for j in range(k - 1):
+                a, b, c, d = i * k + j, (i + 1) * k + j, (i + 1) * k + j + 1, i * k + j + 1
+                faces += [(a, b, c, d)] if i < 4 else [(a, b, c), (a, c, d)]
+        vertices.append((-1.0, 3.5, 0.0))
+        faces.append((0, 1, 2, 3, len(vertices) - 1)[::-1])
+        obj = make_object("Grid", vertices, faces)
+        assert len(obj.data.loops) != 3 * len(obj.data.polygons)
+    arrays = ts.blender.mesh_io.read_mesh(obj.data)
+    triangles, loops, polygon = reference_triangulation(obj.data)
+    np.testing.assert_array_equal(arrays.triangles, triangles)
+    np.testing.assert_array_equal(arrays.triangle_loops, loops)
+    np.testing.assert_array_equal(arrays.triangle_polygon, polygon)
+    assert arrays.triangles.dtype == np.int32 and arrays.triangle_loops.dtype == np.int32
+    co = np.array([tuple(v.co) for v in obj.data.vertices])
+    np.testing.assert_array_equal(arrays.vertices, co)
+
+
+@pytest.mark.parametrize("flag", ["use_seam", "use_edge_sharp"])
+def test_read_edges_matches_the_per_edge_flags(ts, scene, flag):
+    obj = make_object("Ball", *meshgen.icosphere(2))
+    mesh = obj.data
+    read_edges = ts.blender.mesh_io.read_edges
+    assert read_edges(mesh, flag).shape == (0, 2)  # none flagged (4.0+: no attribute at all)
+    for index in (3, 17, 40):
+        setattr(mesh.edges[index], flag, True)
+    expected = np.array([tuple(e.vertices) for e in mesh.edges if getattr(e, flag)])
+    np.testing.assert_array_equal(read_edges(mesh, flag), expected)
+    assert len(expected) == 3
