@@ -102,7 +102,7 @@ def parse_axis(text) -> str:
     """'x' / 'X' -> 'X'; ValueError naming the accepted axes otherwise."""
     axis = str(text).strip().upper()
     if axis not in AXES:
-        raise ValueError(f"symmetry axis must be one of {', '.join(AXES)}, got {text!r}")
+        raise TopStocError(f"symmetry axis must be one of {', '.join(AXES)}, got {text!r}")
     return axis
 
 
