@@ -147,8 +147,7 @@ def read_edges(mesh: bpy.types.Mesh, flag: str) -> np.ndarray:
     flag: none means no read at all (a flag per edge through MeshEdge costs ~30 ms per million
     edges, on the Live Preview's start)."""
     count = len(mesh.edges)
-    name = _EDGE_FLAG_ATTRIBUTES[flag][0]
-    attribute = mesh.attributes.get(name) if bpy.app.version >= (4, 0, 0) else None
+    attribute = _flag_attribute(mesh, flag) if bpy.app.version >= (4, 0, 0) else None
     if bpy.app.version >= (4, 0, 0) and (attribute is None or flag in mistyped_edge_flags(mesh)):
         if attribute is None:
             return np.zeros((0, 2), dtype=np.int32)
@@ -234,11 +233,22 @@ def fill_geometry(mesh: bpy.types.Mesh, vertices: np.ndarray, triangles: np.ndar
     calc_edges(mesh, m > 0 and edges is None)
 
 
-# Edge flags (MeshEdge properties) Blender keeps as edge attributes, with the type each must have.
-_EDGE_FLAG_ATTRIBUTES = {"select": (".select_edge", "BOOLEAN"), "hide": (".hide_edge", "BOOLEAN"),
-                         "use_seam": (".uv_seam", "BOOLEAN"), "use_edge_sharp": ("sharp_edge", "BOOLEAN"),
-                         "use_freestyle_mark": ("freestyle_edge", "BOOLEAN"),
-                         "crease": ("crease_edge", "FLOAT"), "bevel_weight": ("bevel_weight_edge", "FLOAT")}
+# Edge flags (MeshEdge properties) Blender keeps as edge attributes: their names (seams are
+# ".uv_seam" in 4.x and "uv_seam" from 5.0) and the type each must have.
+_EDGE_FLAG_ATTRIBUTES = {"select": ((".select_edge",), "BOOLEAN"), "hide": ((".hide_edge",), "BOOLEAN"),
+                         "use_seam": ((".uv_seam", "uv_seam"), "BOOLEAN"),
+                         "use_edge_sharp": (("sharp_edge",), "BOOLEAN"),
+                         "use_freestyle_mark": (("freestyle_edge",), "BOOLEAN"),
+                         "crease": (("crease_edge",), "FLOAT"), "bevel_weight": (("bevel_weight_edge",), "FLOAT")}
+
+
+def _flag_attribute(mesh: bpy.types.Mesh, flag: str):
+    """The attribute that holds edge ``flag`` in this Blender, None when there is none."""
+    for name in _EDGE_FLAG_ATTRIBUTES[flag][0]:
+        attribute = mesh.attributes.get(name)
+        if attribute is not None:
+            return attribute
+    return None
 
 
 def mistyped_edge_flags(mesh: bpy.types.Mesh) -> dict:
@@ -249,8 +259,8 @@ def mistyped_edge_flags(mesh: bpy.types.Mesh) -> dict:
     writing it crashes Blender. Such flags are neither read nor written.
     """
     found = {}
-    for flag, (name, data_type) in _EDGE_FLAG_ATTRIBUTES.items():
-        attribute = mesh.attributes.get(name)
+    for flag, (_names, data_type) in _EDGE_FLAG_ATTRIBUTES.items():
+        attribute = _flag_attribute(mesh, flag)
         if attribute is not None and (attribute.domain != "EDGE" or attribute.data_type != data_type):
             found[flag] = attribute
     return found
