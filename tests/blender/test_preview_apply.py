@@ -81,6 +81,8 @@ def test_a_rested_quality_result_is_applied_as_shown(ts, scene, donut, monkeypat
         assert [m for m, _t, _thread in engine.calls] == ["fast", "quality"]
         shown_vertices = positions(session.mesh).copy()
         shown_triangles = triangles_of(session.mesh)
+        session.request(0.1)  # a mouse move that ends at the same ratio keeps the Quality result
+        assert not session.busy and not session.poll() and session.final and engine.count() == 2
         run = session.apply(0.1)
         assert run is not None and not session.applying
         assert engine.count() == 2  # no second decimation
