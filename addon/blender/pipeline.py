@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from ..core.attributes import moved_vertices, point_weights
+from ..core.attributes import MovedVertices, moved_vertices, point_weights
 from ..core.errors import TopStocError
 from ..core.symmetry import decimate_mirrored
 from . import carry, mesh_io
@@ -38,6 +38,7 @@ class Run:
     parameters: dict          #: what reproduces it (target, seed, options)
     seconds: float            #: read + prepare + decimate
     settings: dict = None     #: the panel settings it ran with (Regenerate re-runs them)
+    moved: MovedVertices = None  #: where moved vertices take their attributes (found when written if None)
 
 
 def settings_of(params) -> dict:
@@ -162,10 +163,10 @@ def decimate(context, obj, params, *, seed_offset: int = 0, target: dict = None,
 
 
 def make_run(obj, prepared: Prepared, guidance: EngineGuidance, result, target: dict, options: dict, axis,
-             seconds: float, settings: dict) -> Run:
+             seconds: float, settings: dict, moved: MovedVertices = None) -> Run:
     """The Run of a finished engine decimation (``run_engine``'s target, options and axis)."""
     parameters = dict(target, **options, sources=guidance.sources, symmetry=axis)
-    return Run(obj, prepared, guidance, result, parameters, seconds, settings)
+    return Run(obj, prepared, guidance, result, parameters, seconds, settings, moved)
 
 
 def _object_materials(source, new) -> None:
@@ -198,7 +199,8 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
     obj = run.obj
     kept = np.asarray(run.result.kept)
     arrays = run.prepared.arrays
-    moved = moved_vertices(arrays.vertices, arrays.triangles, run.result)  # quality mode: interpolated
+    moved = run.moved if run.moved is not None else \
+        moved_vertices(arrays.vertices, arrays.triangles, run.result)  # quality mode: interpolated
     group_names, weights = skin_weights(obj, arrays, kept, moved)
     shape_keys = carry.read_shape_keys(obj.data)
     if mode == "IN_PLACE" or into is not None:

@@ -38,6 +38,7 @@ from typing import Optional
 
 import bpy
 
+from ..core.attributes import moved_vertices
 from ..core.loops import Cancelled
 from ..core.mesh_edges import mesh_edges
 from . import mesh_io, pipeline
@@ -90,7 +91,10 @@ class PreviewSession:
         self.ratio: Optional[float] = None
         self.final = False                     # the shown result has the chosen settings
         self._last_shown = time.perf_counter()
-        self._applying = None                  # key of the result Enter asked for, while it is computed
+        self._applying = None                  # key of the result Enter asked for, until it is written
+        self._to_apply = None                  # (ratio, result, seconds) of it, once computed
+        self._sources = None                   # (result, MovedVertices or None while found) of the newest
+                                               # chosen-settings result: the write's numpy part, on a worker
         self.apply_started = None              # when Enter asked for it
         self.final_seconds = None              # seconds of the latest computation with the chosen settings
         self.result = None
@@ -250,8 +254,13 @@ class PreviewSession:
                     self.final_seconds = seconds
                 # A newer result replaces one not shown yet; an older one than shown is dropped.
                 newest = self._finished[0] if self._finished else self._shown_order
+                sources = False
                 if order > newest:
                     self._finished = (order, finished)
+                    if key[1]:  # a result Enter may write: find its attribute sources now
+                        self._sources, sources = (finished[1], None), True
+            if sources:
+                self._find_sources(finished[1])
 
     def _stagger(self) -> None:
         """Spreads the workers' starts over one computation's time, so that their results
@@ -297,27 +306,36 @@ class PreviewSession:
         """Enter: the pipeline Run to write, at ``ratio`` with the chosen settings.
 
         When the result shown was made with exactly those (the chosen mode's result after the drag
-        rested at this ratio, or any result when the chosen settings are the fast ones) it is
-        returned as it is: no second decimation. Otherwise it is computed on a worker like any
-        request and this returns None; ``poll_apply`` gives the Run once it is ready."""
+        rested at this ratio, or any result when the chosen settings are the fast ones) it is the
+        one written: no second decimation. Otherwise it is computed on a worker like any request.
+        The Run also carries where moved vertices take their attributes from (numpy work that
+        takes seconds on big quality results), found on a worker as soon as such a result is
+        computed. Returns None while either is on its way; ``poll_apply`` then gives the Run."""
         key = self.key(ratio, True)
-        if self.result is not None and (self.ratio, self.final) == key:
-            return self._run(ratio, self.result, self.seconds_decimate)
         with self._lock:
             self._applying = key
+            self._to_apply = None
+            if self.result is not None and (self.ratio, self.final) == key:
+                self._to_apply = (ratio, self.result, self.seconds_decimate)
         self.apply_started = time.perf_counter()
-        self.request(ratio, final=True)
-        return None
+        if self._to_apply is None:
+            self.request(ratio, final=True)
+        return self.poll_apply()
 
     @property
     def applying(self) -> bool:
-        """True while the result to apply is being computed."""
+        """True while the result to apply (or its attribute sources) is being computed."""
         return self._applying is not None
 
+    @property
+    def apply_computed(self) -> bool:
+        """True once the result to apply is computed (only its attribute sources are awaited)."""
+        return self._to_apply is not None
+
     def poll_apply(self):
-        """While applying (main thread): the Run once its result is computed, else None. Results
-        of the drag that finish meanwhile are dropped (the preview is about to go); a failed
-        decimation raises here."""
+        """While applying (main thread): the Run once its result and attribute sources are ready,
+        else None. Results of the drag that finish meanwhile are dropped (the preview is about to
+        go); a failed decimation raises here."""
         with self._lock:
             finished, self._finished = self._finished, None
             error, self._error = self._error, None
@@ -326,16 +344,47 @@ class PreviewSession:
         if error is not None:
             raise error
         self._start_worker()
-        if finished is None or finished[1][0] != self._applying:
+        if self._applying is None:
             return None
-        (ratio, _final), result, _edges, seconds = finished[1]
-        self._applying = None
-        return self._run(ratio, result, seconds)
+        if self._to_apply is None and finished is not None and finished[1][0] == self._applying:
+            (ratio, _final), result, _edges, seconds = finished[1]
+            self._to_apply = (ratio, result, seconds)
+        if self._to_apply is None:
+            return None
+        ratio, result, seconds = self._to_apply
+        moved = self._sources_of(result)
+        if moved is None:
+            return None
+        self._applying = self._to_apply = None
+        return self._run(ratio, result, seconds, moved)
 
-    def _run(self, ratio: float, result, seconds: float):
+    def _find_sources(self, result) -> None:
+        """Where the moved vertices of ``result`` take their attributes from (any thread)."""
+        arrays = self.prepared.arrays
+        try:
+            moved = moved_vertices(arrays.vertices, arrays.triangles, result)
+        except Exception as error:  # noqa: BLE001 - handed to the main thread
+            with self._lock:
+                self._error = error
+            return
+        with self._lock:
+            if self._sources is not None and self._sources[0] is result:
+                self._sources = (result, moved)
+
+    def _sources_of(self, result):
+        """The attribute sources of ``result`` when found, else None (a worker finds them: the one
+        that computed it, or one started here for a result computed elsewhere)."""
+        with self._lock:
+            if self._sources is not None and self._sources[0] is result:
+                return self._sources[1]
+            self._sources = (result, None)
+        self._pool.submit(self._find_sources, result)
+        return None
+
+    def _run(self, ratio: float, result, seconds: float, moved):
         """The pipeline Run of a result of this session (what pipeline.write_output takes)."""
         return pipeline.make_run(self.obj, self.prepared, self.guidance, result, {"ratio": ratio}, self.options,
-                                 self.axis, seconds, dict(self.settings, target_mode="RATIO", ratio=ratio))
+                                 self.axis, seconds, dict(self.settings, target_mode="RATIO", ratio=ratio), moved)
 
     def close(self) -> None:
         """Removes the preview object and shows the original again. Returns at once: a running
@@ -343,7 +392,7 @@ class PreviewSession:
         unseen; workers never touch Blender data, so nothing waits for them."""
         self._cancel.set()
         with self._lock:
-            self._pending = self._applying = self._finished = None
+            self._pending = self._applying = self._to_apply = self._finished = self._sources = None
         self._pool.shutdown(wait=False)
         if self.preview is not None:
             bpy.data.objects.remove(self.preview)

@@ -77,7 +77,7 @@ def test_a_rested_quality_result_is_applied_as_shown(ts, scene, donut, monkeypat
     try:
         assert wait_for(lambda: session.poll() or session.final)  # the fast result, then the rested quality one
         assert wait_for(lambda: (session.poll(), session.final)[1]), engine.calls
-        assert session.ratio == 0.1 and not session.busy
+        assert wait_for(lambda: not session.busy) and session.ratio == 0.1  # its attribute sources found too
         assert [m for m, _t, _thread in engine.calls] == ["fast", "quality"]
         shown_vertices = positions(session.mesh).copy()
         shown_triangles = triangles_of(session.mesh)
@@ -86,9 +86,13 @@ def test_a_rested_quality_result_is_applied_as_shown(ts, scene, donut, monkeypat
         run = session.apply(0.1)
         assert run is not None and not session.applying
         assert engine.count() == 2  # no second decimation
+        assert run.moved is not None and len(run.moved.moved) > 50  # found on the worker, for the write
     finally:
         session.close()
+    written = []
+    monkeypatch.setattr(pipeline, "moved_vertices", lambda *args: written.append(args))
     out = pipeline.write_output(run)
+    assert not written  # the write did not look for them again
     np.testing.assert_array_equal(positions(out.data), shown_vertices)
     np.testing.assert_array_equal(triangles_of(out.data), shown_triangles)
     # ... and that is the Quality result at 10 %: the operator's own decimation gives the same samples
@@ -112,6 +116,7 @@ def test_with_fast_chosen_the_drag_result_is_applied_as_shown(ts, scene, donut, 
         assert wait_for(lambda: not session.busy)
         calls = engine.count()
         run = session.apply(0.2)
+        assert run is not None and len(run.moved.moved) == 0  # Fast: no vertex moved
         assert run is not None and engine.count() == calls == 2
     finally:
         session.close()
@@ -191,3 +196,34 @@ def test_closing_while_applying_writes_nothing_and_leaves_no_thread(ts, scene, d
     assert session.poll_apply() is None
     assert set(bpy.data.objects.keys()) == names and not donut.hide_get()
     assert snapshot(donut.data) == before
+
+
+def test_enter_before_the_attribute_sources_are_found_waits_for_them(ts, scene, donut, monkeypatch):
+    """The rested Quality result shows before the worker has found where its moved vertices take
+    their attributes from: Enter then waits for that (no new decimation), on the modal's timer."""
+    preview = ts.blender.preview
+    engine = EngineCalls(monkeypatch, ts.blender.pipeline)
+    gate, held, threads = threading.Event(), threading.Event(), []
+    find = preview.moved_vertices
+
+    def held_moved_vertices(*args):
+        threads.append(threading.current_thread().name)
+        held.set()
+        gate.wait(30)
+        return find(*args)
+
+    monkeypatch.setattr(preview, "moved_vertices", held_moved_vertices)
+    session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=6), ratio=0.1)
+    try:
+        assert wait_for(lambda: (session.poll(), session.final)[1] and held.is_set())
+        assert session.apply(0.1) is None and session.applying and session.apply_computed
+        assert session.poll_apply() is None
+        gate.set()
+        runs = []
+        assert wait_for(lambda: runs.append(session.poll_apply()) or runs[-1] is not None)
+        assert len(runs[-1].moved.moved) > 50 and not session.applying
+        assert engine.count() == 2  # fast, quality: nothing decimated again
+        assert threads and all(t.startswith(preview.THREAD_PREFIX) for t in threads)  # not the main thread
+    finally:
+        gate.set()
+        session.close()

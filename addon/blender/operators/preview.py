@@ -12,7 +12,9 @@ Enter (or a click) applies the dragged ratio at the panel's settings. When the r
 is that result (the chosen Quality after the drag rested there) it is written as it is. Otherwise
 the preview's worker computes it while the header and status bar count the seconds and the
 cursor waits; the modal keeps running until it is ready (Esc cancels: nothing is written), then
-writes it. Either way the source changes only when the operator finishes, in one undo step.
+writes it. Where moved vertices take their attributes from is found on a worker too, as soon as
+a Quality result is computed. Either way the source changes only when the operator finishes, in
+one undo step.
 """
 
 from __future__ import annotations
@@ -82,9 +84,12 @@ Enter or click applies, Esc or right-click restores"""
         seconds = time.perf_counter() - self.started
         if s.applying:
             waited = time.perf_counter() - s.apply_started
-            estimate = f" of about {s.final_seconds:.1f} s" if s.final_seconds else ""
-            self._status(context, f"TopStoc: computing the {self.quality.title()} result at ratio {self.ratio:.4f} "
-                                  f"to apply ... {waited:.1f} s{estimate}   Esc: cancel")
+            if s.apply_computed:
+                doing = "interpolating the attributes of moved vertices"
+            else:
+                estimate = f" of about {s.final_seconds:.1f} s" if s.final_seconds else ""
+                doing = f"computing the {self.quality.title()} result{estimate}"
+            self._status(context, f"TopStoc: applying ratio {self.ratio:.4f}: {doing} ... {waited:.1f} s   Esc: cancel")
             return
         if s.preparing:
             fraction, stage = s.progress()
