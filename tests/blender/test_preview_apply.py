@@ -227,3 +227,25 @@ def test_enter_before_the_attribute_sources_are_found_waits_for_them(ts, scene, 
     finally:
         gate.set()
         session.close()
+
+
+def test_a_rested_symmetric_result_is_applied_as_shown(ts, scene, donut, monkeypatch):
+    """Symmetry with Fast chosen: the drag shows plain Fast results, the rest the mirrored one,
+    which Enter writes without decimating again."""
+    preview = ts.blender.preview
+    engine = EngineCalls(monkeypatch, ts.blender.pipeline)
+    params = Params(quality="FAST", seed=2, use_symmetry=True, symmetry_axis="X")
+    session = preview.PreviewSession(bpy.context, donut, params, ratio=0.1)
+    try:
+        assert wait_for(lambda: (session.poll(), session.final)[1]) and wait_for(lambda: not session.busy)
+        calls = engine.count()
+        run = session.apply(0.1)
+        assert run is not None and engine.count() == calls == 2
+    finally:
+        session.close()
+    expected = ts.blender.pipeline.decimate(bpy.context, donut, params).result
+    np.testing.assert_array_equal(np.asarray(run.result.vertices), np.asarray(expected.vertices))
+    assert run.parameters["symmetry"] == "X"
+    co = np.asarray(run.result.vertices)
+    mirrored = {tuple(np.round(p * [-1, 1, 1], 5)) for p in co}
+    assert mirrored == {tuple(np.round(p, 5)) for p in co}  # the result is mirror-symmetric
