@@ -5,7 +5,6 @@ check and exits 0 only when all hold."""
 import os
 import sys
 import threading
-import time
 import traceback
 
 import addon_utils

@@ -138,7 +138,7 @@ def test_applying_during_a_drag_computes_the_chosen_settings_on_the_worker(ts, s
         assert time.perf_counter() - start < 0.5
         assert engine.held.wait(10) and session.applying
         assert session.poll_apply() is None  # the main thread is free while the worker computes
-        mode, target, thread = next(call for call in engine.calls if call[0] == "quality")
+        _mode, target, thread = next(call for call in engine.calls if call[0] == "quality")
         assert target == {"ratio": 0.17} and thread.startswith(preview.THREAD_PREFIX)
         engine.gate.set()
         runs = []
