@@ -13,7 +13,7 @@ there exactly. A vertex the quality mode moved (filtered placement, quadric coll
 key's offset interpolated at its place on the basis: ``t`` is the input triangle its attributes
 come from and ``w`` its barycentric weights there (topstoc.core.attributes.moved_vertices, the
 same as for UVs and colours), so the morph follows the surface the vertex now stands on.
-Vertex-group weights (the rig's) are the kept vertex's in either case.
+Vertex-group weights (the rig's skin) are mixed at the same place (pipeline.skin_weights).
 """
 
 from __future__ import annotations

@@ -3,8 +3,9 @@
 Reading triangulates n-gons through Blender's loop triangles and keeps, for every triangle,
 its polygon and the loop of each corner, so results can take every attribute exactly from
 the face and corner they came from. Writing builds a triangle mesh from a DecimateResult and
-copies UV maps, colour and generic attributes, materials, smooth flags, custom split normals
-and vertex groups (vertices the quality mode moved interpolate theirs).
+copies UV maps, colour and generic attributes, materials, smooth flags and custom split normals
+(vertices the quality mode moved interpolate theirs); vertex-group weights are read and written
+sparsely (read_vertex_weights, write_vertex_weights).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from typing import Optional
 import bpy
 import numpy as np
 
-from ..core.attributes import MovedVertices, corner_values, moved_vertices, point_values
+from ..core.attributes import MovedVertices, SparseWeights, corner_values, moved_vertices, point_values
 from ..core.mesh_edges import mesh_edges
 
 # Attribute data type -> (foreach key, values per element, numpy dtype)
@@ -286,34 +287,66 @@ def _set_int_field(mesh, attribute: str, collection, key: str, values: np.ndarra
         collection.foreach_set(key, flat.view(np.uint32))
 
 
-def collect_vertex_groups(obj, kept: np.ndarray) -> dict:
-    """{group name: (output vertex ids, weights)} for the kept vertices of ``obj``.
+def read_vertex_weights(obj, vertex_ids) -> tuple:
+    """(group names in index order, SparseWeights of the given vertices: rows are their ids).
 
-    Walks only the kept vertices (Blender has no bulk accessor for deform weights).
-    """
-    if not obj.vertex_groups:
-        return {}
-    names = {group.index: group.name for group in obj.vertex_groups}
-    out: dict = {name: ([], []) for name in names.values()}
-    vertices = obj.data.vertices
+    Walks only those vertices (Blender has no bulk accessor for deform weights)."""
+    names = [group.name for group in obj.vertex_groups]
+    rows, columns, values = [], [], []
+    if names:
+        vertices = obj.data.vertices
+        for v in np.unique(np.asarray(vertex_ids, dtype=np.int64)).tolist():
+            for g in vertices[v].groups:
+                if g.group < len(names):  # a weight left by a deleted group is not carried
+                    rows.append(v)
+                    columns.append(g.group)
+                    values.append(g.weight)
+    return names, SparseWeights(np.asarray(rows, dtype=np.int64), np.asarray(columns, dtype=np.int64),
+                                np.asarray(values, dtype=np.float64))
+
+
+def write_vertex_weights(obj, names: list, weights: SparseWeights) -> None:
+    """Writes ``weights`` (rows: ``obj``'s vertices, columns: indices into ``names``) into the
+    object's vertex groups, creating every named group that is missing (in ``names``' order)."""
+    groups = [obj.vertex_groups.get(name) or obj.vertex_groups.new(name=name) for name in names]
+    if len(weights.vertex) == 0:
+        return
+    value = np.asarray(weights.weight, dtype=np.float32)  # what Blender stores
+    column = np.asarray(weights.group, dtype=np.int64)
+    order = np.lexsort((value, column))
+    vertex, column, value = np.asarray(weights.vertex)[order], column[order], value[order]
+    # one bulk call per group and distinct weight
+    starts = np.flatnonzero(np.r_[True, (column[1:] != column[:-1]) | (value[1:] != value[:-1])])
+    ends = np.r_[starts[1:], len(order)]
+    for start, end in zip(starts.tolist(), ends.tolist()):
+        groups[column[start]].add(vertex[start:end].tolist(), float(value[start]), "REPLACE")
+
+
+def collect_vertex_groups(obj, kept: np.ndarray) -> dict:
+    """{group name: (output vertex ids, weights)} for the kept vertices of ``obj`` (output
+    vertex i is input vertex kept[i])."""
+    kept = np.asarray(kept, dtype=np.int64)
+    names, weights = read_vertex_weights(obj, kept)
+    row = {v: [] for v in np.unique(kept).tolist()}
     for i, v in enumerate(kept.tolist()):
-        for g in vertices[v].groups:
-            name = names.get(g.group)
-            if name is not None:
-                out[name][0].append(i)
-                out[name][1].append(g.weight)
+        row[v].append(i)
+    out: dict = {name: ([], []) for name in names}
+    for v, g, w in zip(weights.vertex.tolist(), weights.group.tolist(), weights.weight.tolist()):
+        for i in row[v]:
+            out[names[g]][0].append(i)
+            out[names[g]][1].append(w)
     return out
 
 
 def apply_vertex_groups(obj, groups: dict) -> None:
     """Writes collected weights into ``obj``'s mesh, creating missing groups by name."""
-    for name, (ids, values) in groups.items():
-        group = obj.vertex_groups.get(name) or obj.vertex_groups.new(name=name)
-        if not ids:
-            continue
-        ids, values = np.asarray(ids), np.asarray(values)
-        for value in np.unique(values):  # one bulk call per distinct weight
-            group.add(ids[values == value].tolist(), float(value), "REPLACE")
+    names = list(groups)
+    vertex = [np.asarray(ids, dtype=np.int64) for ids, _ in groups.values()]
+    weight = [np.asarray(values, dtype=np.float64) for _, values in groups.values()]
+    column = [np.full(len(ids), g, dtype=np.int64) for g, ids in enumerate(vertex)]
+    empty = [np.zeros(0, dtype=np.int64)]
+    write_vertex_weights(obj, names, SparseWeights(np.concatenate(vertex + empty), np.concatenate(column + empty),
+                                                   np.concatenate(weight + [np.zeros(0)])))
 
 
 def _custom_normals(mesh) -> Optional[np.ndarray]:

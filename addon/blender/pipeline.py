@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from ..core.attributes import moved_vertices
+from ..core.attributes import MovedVertices, moved_vertices, point_weights
 from ..core.errors import TopStocError
 from ..core.symmetry import decimate_mirrored
 from . import carry, mesh_io
@@ -38,6 +38,7 @@ class Run:
     parameters: dict          #: what reproduces it (target, seed, options)
     seconds: float            #: read + prepare + decimate
     settings: dict = None     #: the panel settings it ran with (Regenerate re-runs them)
+    moved: MovedVertices = None  #: where moved vertices take their attributes (found when written if None)
 
 
 def settings_of(params) -> dict:
@@ -152,12 +153,20 @@ def decimate(context, obj, params, *, seed_offset: int = 0, target: dict = None,
     target = target if target is not None else target_kwargs(params, prepared)
     options = options_kwargs(params)
     options["seed"] += seed_offset
+    axis = symmetry_axis(params)
     try:
-        result = run_engine(prepared.mesh, target, options, guidance.decimate_kwargs(), symmetry_axis(params))
+        result = run_engine(prepared.mesh, target, options, guidance.decimate_kwargs(), axis)
     except ValueError as error:
         raise DecimationError(f"'{obj.name}': {error}") from None
-    parameters = dict(target, **options, sources=guidance.sources, symmetry=symmetry_axis(params))
-    return Run(obj, prepared, guidance, result, parameters, time.perf_counter() - start, settings_of(params))
+    return make_run(obj, prepared, guidance, result, target, options, axis, time.perf_counter() - start,
+                    settings_of(params))
+
+
+def make_run(obj, prepared: Prepared, guidance: EngineGuidance, result, target: dict, options: dict, axis,
+             seconds: float, settings: dict, moved: MovedVertices = None) -> Run:
+    """The Run of a finished engine decimation (``run_engine``'s target, options and axis)."""
+    parameters = dict(target, **options, sources=guidance.sources, symmetry=axis)
+    return Run(obj, prepared, guidance, result, parameters, seconds, settings, moved)
 
 
 def _object_materials(source, new) -> None:
@@ -165,6 +174,16 @@ def _object_materials(source, new) -> None:
         if slot.link == "OBJECT" and index < len(new.material_slots):
             new.material_slots[index].link = "OBJECT"
             new.material_slots[index].material = slot.material
+
+
+def skin_weights(obj, arrays: mesh_io.MeshArrays, kept: np.ndarray, moved) -> tuple:
+    """(group names, the output vertices' vertex-group weights): a vertex that did not move keeps
+    its input vertex's; a moved one mixes its source triangle's (core/attributes.point_weights),
+    rescaled to sum to 1 when the source's weights read (those of the kept vertices and of the
+    moved vertices' triangles) all sum to 1."""
+    corners = np.asarray(arrays.triangles, dtype=np.int64)[moved.face[moved.moved]].ravel()
+    names, source = mesh_io.read_vertex_weights(obj, np.concatenate([kept, corners]))
+    return names, point_weights(source, kept, moved, arrays.triangles, normalise=source.normalised())
 
 
 def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bool = True,
@@ -180,8 +199,9 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
     obj = run.obj
     kept = np.asarray(run.result.kept)
     arrays = run.prepared.arrays
-    moved = moved_vertices(arrays.vertices, arrays.triangles, run.result)  # quality mode: interpolated
-    groups = mesh_io.collect_vertex_groups(obj, kept)
+    moved = run.moved if run.moved is not None else \
+        moved_vertices(arrays.vertices, arrays.triangles, run.result)  # quality mode: interpolated
+    group_names, weights = skin_weights(obj, arrays, kept, moved)
     shape_keys = carry.read_shape_keys(obj.data)
     if mode == "IN_PLACE" or into is not None:
         target = obj if into is None else into
@@ -208,7 +228,7 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
         carry.copy_custom_properties(obj, target)
         if place:
             carry.place_beside(obj, target)
-    mesh_io.apply_vertex_groups(target, groups)
+    mesh_io.write_vertex_weights(target, group_names, weights)
     carry.write_shape_keys(target, shape_keys, arrays.vertices, run.result.vertices, kept, moved, arrays.triangles)
     target["topstoc_source"] = obj.name
     target["topstoc_parameters"] = json.dumps(run.parameters)

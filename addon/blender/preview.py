@@ -38,6 +38,7 @@ from typing import Optional
 
 import bpy
 
+from ..core.attributes import moved_vertices
 from ..core.loops import Cancelled
 from ..core.mesh_edges import mesh_edges
 from . import mesh_io, pipeline
@@ -66,6 +67,7 @@ class PreviewSession:
         self._guidance_read = threading.Event()
         self.options = pipeline.options_kwargs(params)
         self.axis = pipeline.symmetry_axis(params)
+        self.settings = pipeline.settings_of(params)  # what an applied result remembers (Regenerate)
         # While dragging: the fast mode; on a pause: the chosen settings (unless they are the same).
         chosen_is_fast = self.options.get("mode", "quality") == "fast" and self.axis is None
         self.drag_options = self.options if chosen_is_fast else \
@@ -78,7 +80,7 @@ class PreviewSession:
         self._cancel = threading.Event()       # close() asks the preparation to stop
         self._progress = (0.0, "fingerprint")  # preparation: fraction done and current step
         self._workers = 1                      # worker loops running (the start job counts)
-        self._pending = (ratio, False) if ratio is not None else None  # latest request not started
+        self._pending = self.key(ratio, False) if ratio is not None else None  # latest request not started
         self._started: Optional[tuple] = None  # newest computation started
         self._started_count = 0                # computations started (their order numbers)
         self._shown_order = 0                  # order number of the result shown last
@@ -89,6 +91,12 @@ class PreviewSession:
         self.ratio: Optional[float] = None
         self.final = False                     # the shown result has the chosen settings
         self._last_shown = time.perf_counter()
+        self._applying = None                  # key of the result Enter asked for, until it is written
+        self._to_apply = None                  # (ratio, result, seconds) of it, once computed
+        self._sources = None                   # (result, MovedVertices or None while found) of the newest
+                                               # chosen-settings result: the write's numpy part, on a worker
+        self.apply_started = None              # when Enter asked for it
+        self.final_seconds = None              # seconds of the latest computation with the chosen settings
         self.result = None
         self.seconds_decimate = 0.0
         self.seconds_write = 0.0
@@ -149,6 +157,11 @@ class PreviewSession:
 
     # -- decimating ---------------------------------------------------------------------------
 
+    def key(self, ratio: float, final: bool) -> tuple:
+        """A request's key (ratio, made with the chosen settings): a drag result is final when the
+        chosen settings are the fast ones."""
+        return ratio, bool(final) or self.drag_options is self.options
+
     def compute(self, ratio: float, final: bool = False):
         """Decimates at ``ratio`` (fast, or with the chosen settings with ``final``) and derives the
         result's edges (any thread: the main thread then only copies arrays into the preview)."""
@@ -157,7 +170,7 @@ class PreviewSession:
         result = pipeline.run_engine(self.prepared.mesh, {"ratio": ratio}, options,
                                      self.guidance.decimate_kwargs(), self.axis if final else None)
         edges = mesh_edges(result.triangles, len(result.vertices))
-        return (ratio, final or options is self.options), result, edges, time.perf_counter() - start
+        return self.key(ratio, final), result, edges, time.perf_counter() - start
 
     def _make_preview(self) -> None:
         """The preview object, beside the hidden original (main thread, first result)."""
@@ -189,13 +202,19 @@ class PreviewSession:
         self.wait_prepared()
         self.show(*self.compute(ratio, final))
         with self._lock:
-            self._started = (ratio, final)
+            self._started = self.key(ratio, final)
 
     def request(self, ratio: float, final: bool = False) -> None:
         """Asks for ``ratio`` (fast while dragging; ``final``: the chosen settings); only the
-        latest request is computed (after the preparation, if it still runs)."""
+        latest request is computed (after the preparation, if it still runs). Back at the ratio
+        whose chosen-settings result is on screen, that result stays: nothing is computed and
+        the results still on their way are dropped."""
         with self._lock:
-            self._pending = (ratio, final)
+            if not final and self.final and ratio == self.ratio:
+                self._pending = self._finished = self._started = None
+                self._shown_order = self._started_count
+                return
+            self._pending = self.key(ratio, final)
         self._start_worker()
 
     def _start_worker(self) -> None:
@@ -226,12 +245,22 @@ class PreviewSession:
                     self._workers -= 1
                 return
             with self._lock:
+                if self._cancel.is_set():  # closed meanwhile: the result ends unseen
+                    self._workers -= 1
+                    return
                 seconds = finished[3]
                 self._typical = 0.7 * self._typical + 0.3 * seconds if self._typical else seconds
+                if key[1] and self.options is not self.drag_options:
+                    self.final_seconds = seconds
                 # A newer result replaces one not shown yet; an older one than shown is dropped.
                 newest = self._finished[0] if self._finished else self._shown_order
+                sources = False
                 if order > newest:
                     self._finished = (order, finished)
+                    if key[1]:  # a result Enter may write: find its attribute sources now
+                        self._sources, sources = (finished[1], None), True
+            if sources:
+                self._find_sources(finished[1])
 
     def _stagger(self) -> None:
         """Spreads the workers' starts over one computation's time, so that their results
@@ -271,13 +300,99 @@ class PreviewSession:
         with self._lock:
             return self._workers > 0 or self._finished is not None
 
+    # -- applying ------------------------------------------------------------------------------
+
+    def apply(self, ratio: float):
+        """Enter: the pipeline Run to write, at ``ratio`` with the chosen settings.
+
+        When the result shown was made with exactly those (the chosen mode's result after the drag
+        rested at this ratio, or any result when the chosen settings are the fast ones) it is the
+        one written: no second decimation. Otherwise it is computed on a worker like any request.
+        The Run also carries where moved vertices take their attributes from (numpy work that
+        takes seconds on big quality results), found on a worker as soon as such a result is
+        computed. Returns None while either is on its way; ``poll_apply`` then gives the Run."""
+        key = self.key(ratio, True)
+        with self._lock:
+            self._applying = key
+            self._to_apply = None
+            if self.result is not None and (self.ratio, self.final) == key:
+                self._to_apply = (ratio, self.result, self.seconds_decimate)
+        self.apply_started = time.perf_counter()
+        if self._to_apply is None:
+            self.request(ratio, final=True)
+        return self.poll_apply()
+
+    @property
+    def applying(self) -> bool:
+        """True while the result to apply (or its attribute sources) is being computed."""
+        return self._applying is not None
+
+    @property
+    def apply_computed(self) -> bool:
+        """True once the result to apply is computed (only its attribute sources are awaited)."""
+        return self._to_apply is not None
+
+    def poll_apply(self):
+        """While applying (main thread): the Run once its result and attribute sources are ready,
+        else None. Results of the drag that finish meanwhile are dropped (the preview is about to
+        go); a failed decimation raises here."""
+        with self._lock:
+            finished, self._finished = self._finished, None
+            error, self._error = self._error, None
+            if finished:
+                self._shown_order = finished[0]
+        if error is not None:
+            raise error
+        self._start_worker()
+        if self._applying is None:
+            return None
+        if self._to_apply is None and finished is not None and finished[1][0] == self._applying:
+            (ratio, _final), result, _edges, seconds = finished[1]
+            self._to_apply = (ratio, result, seconds)
+        if self._to_apply is None:
+            return None
+        ratio, result, seconds = self._to_apply
+        moved = self._sources_of(result)
+        if moved is None:
+            return None
+        self._applying = self._to_apply = None
+        return self._run(ratio, result, seconds, moved)
+
+    def _find_sources(self, result) -> None:
+        """Where the moved vertices of ``result`` take their attributes from (any thread)."""
+        arrays = self.prepared.arrays
+        try:
+            moved = moved_vertices(arrays.vertices, arrays.triangles, result)
+        except Exception as error:  # noqa: BLE001 - handed to the main thread
+            with self._lock:
+                self._error = error
+            return
+        with self._lock:
+            if self._sources is not None and self._sources[0] is result:
+                self._sources = (result, moved)
+
+    def _sources_of(self, result):
+        """The attribute sources of ``result`` when found, else None (a worker finds them: the one
+        that computed it, or one started here for a result computed elsewhere)."""
+        with self._lock:
+            if self._sources is not None and self._sources[0] is result:
+                return self._sources[1]
+            self._sources = (result, None)
+        self._pool.submit(self._find_sources, result)
+        return None
+
+    def _run(self, ratio: float, result, seconds: float, moved):
+        """The pipeline Run of a result of this session (what pipeline.write_output takes)."""
+        return pipeline.make_run(self.obj, self.prepared, self.guidance, result, {"ratio": ratio}, self.options,
+                                 self.axis, seconds, dict(self.settings, target_mode="RATIO", ratio=ratio), moved)
+
     def close(self) -> None:
         """Removes the preview object and shows the original again. Returns at once: a running
         preparation is cancelled in the engine (at its next step) and a running decimation ends
         unseen; workers never touch Blender data, so nothing waits for them."""
         self._cancel.set()
         with self._lock:
-            self._pending = None
+            self._pending = self._applying = self._to_apply = self._finished = self._sources = None
         self._pool.shutdown(wait=False)
         if self.preview is not None:
             bpy.data.objects.remove(self.preview)

@@ -10,7 +10,8 @@ The quality mode moves free vertices (optimal placement; never vertices on a bor
 A moved vertex takes its attributes interpolated, barycentrically, from the closest input
 triangle of the region it stands for (the input triangles touching its cluster): the weights
 lie in [0, 1] and sum to 1, so every value stays within the range of that triangle's corners.
-Vertices that did not move keep their input corner's values exactly.
+Vertices that did not move keep their input corner's values exactly. Sparse per-vertex weights
+(Blender's vertex groups, the skin) mix the same way, group by group (``point_weights``).
 """
 
 from __future__ import annotations
@@ -59,6 +60,11 @@ def material_regions(data: MeshData) -> Optional[np.ndarray]:
     if data.triangle_material is None or len(np.unique(data.triangle_material)) < 2:
         return None
     return data.triangle_material
+
+
+# Pairs per block in moved_vertices: numpy's temporaries stay in the cache (the same numbers, 3.5x
+# faster than one pass over 4.6 million pairs here).
+PAIRS_PER_BLOCK = 1 << 14
 
 
 def _clamped_barycentric(points, a, b, c):
@@ -118,15 +124,27 @@ def moved_vertices(vertices, triangles, result) -> MovedVertices:
     owner = labels[triangles]                                  # (m, 3)
     pair_vertex = owner.ravel()
     pair_face = np.repeat(np.arange(len(triangles)), 3)
-    keep = pair_vertex >= 0
+    repeated = np.zeros(owner.shape, dtype=bool)               # a corner in an earlier corner's cluster
+    repeated[:, 1] = owner[:, 1] == owner[:, 0]
+    repeated[:, 2] = (owner[:, 2] == owner[:, 0]) | (owner[:, 2] == owner[:, 1])
+    keep = (pair_vertex >= 0) & ~repeated.ravel()
     keep[keep] = is_moved[pair_vertex[keep]]
     pair_vertex, pair_face = pair_vertex[keep], pair_face[keep]
-    pair_unique = np.unique(pair_vertex * len(triangles) + pair_face)
-    pair_vertex, pair_face = pair_unique // len(triangles), pair_unique % len(triangles)
-    corners = input_vertices[triangles[pair_face]]
-    w, distance = _clamped_barycentric(out_vertices[pair_vertex], corners[:, 0], corners[:, 1], corners[:, 2])
-    order = np.lexsort((pair_face, distance, pair_vertex))    # per vertex: closest first, lowest id on ties
-    first = order[np.r_[True, pair_vertex[order][1:] != pair_vertex[order][:-1]]]
+    order = np.argsort(pair_vertex, kind="stable")             # by vertex, then triangle (already in order)
+    pair_vertex, pair_face = pair_vertex[order], pair_face[order]
+    w, distance = np.empty((len(pair_vertex), 3)), np.empty(len(pair_vertex))
+    for start in range(0, len(pair_vertex), PAIRS_PER_BLOCK):
+        block = slice(start, start + PAIRS_PER_BLOCK)
+        corners = input_vertices[triangles[pair_face[block]]]
+        w[block], distance[block] = _clamped_barycentric(out_vertices[pair_vertex[block]], corners[:, 0],
+                                                         corners[:, 1], corners[:, 2])
+    # per vertex the closest, the lowest triangle id on ties: the pairs are sorted by vertex, then
+    # triangle, so the first pair at its vertex's minimum distance
+    starts = np.flatnonzero(np.r_[True, pair_vertex[1:] != pair_vertex[:-1]])
+    closest = np.minimum.reduceat(distance, starts)
+    group = np.cumsum(np.r_[False, pair_vertex[1:] != pair_vertex[:-1]])
+    at_minimum = np.flatnonzero(distance == closest[group])
+    first = at_minimum[np.r_[True, group[at_minimum][1:] != group[at_minimum][:-1]]]
     face[pair_vertex[first]] = pair_face[first]
     weights[pair_vertex[first]] = w[first]
     return MovedVertices(face, weights)
@@ -151,6 +169,70 @@ def point_values(values, kept, moved: MovedVertices, triangles, nearest: bool = 
         corners = np.asarray(triangles, dtype=np.int64)[moved.face[at]]
         out[at] = _combine(values, corners, moved.weights[at], nearest)
     return out
+
+
+@dataclass
+class SparseWeights:
+    """Sparse per-vertex weights (Blender's vertex groups): one entry per (vertex, group) that
+    has a weight; a vertex without an entry for a group is not in it."""
+
+    vertex: np.ndarray  #: (k,) int64
+    group: np.ndarray   #: (k,) int64
+    weight: np.ndarray  #: (k,) float64
+
+    def normalised(self, tolerance: float = 1e-4) -> bool:
+        """True when every vertex with an entry has weights summing to 1 (within ``tolerance``)."""
+        if len(self.vertex) == 0:
+            return False
+        rows, inverse = np.unique(self.vertex, return_inverse=True)
+        sums = np.bincount(inverse, weights=self.weight, minlength=len(rows))
+        return bool(np.all(np.abs(sums - 1.0) <= tolerance))
+
+
+def point_weights(weights: SparseWeights, kept, moved: MovedVertices, triangles,
+                  normalise: bool = False) -> SparseWeights:
+    """Sparse per-vertex ``weights`` (rows are input vertices) for the output vertices.
+
+    A vertex that did not move takes its kept vertex's entries exactly (zero weights too). A
+    moved vertex takes, for every group any corner of its source triangle is in, the barycentric
+    mix of the corners' weights (a corner outside the group counts 0), so it can join a group
+    only a neighbour was in; mixes that come out 0 are dropped. Mixing keeps sums: corners whose
+    weights sum to 1 give a vertex whose weights sum to 1. ``normalise`` rescales each moved
+    vertex's weights to sum to 1 (a normalised skin, whose triangles may still have a corner
+    without weights)."""
+    kept = np.asarray(kept, dtype=np.int64)
+    order = np.argsort(np.asarray(weights.vertex, dtype=np.int64), kind="stable")
+    vertex = np.asarray(weights.vertex, dtype=np.int64)[order]
+    group = np.asarray(weights.group, dtype=np.int64)[order]
+    weight = np.asarray(weights.weight, dtype=np.float64)[order]
+    # (output vertex, input vertex, factor): the kept vertex, or the three corners of the source triangle
+    at = moved.moved
+    still = np.flatnonzero(moved.face < 0)
+    pair_out = np.concatenate([still, np.repeat(at, 3)])
+    pair_in = np.concatenate([kept[still], np.asarray(triangles, dtype=np.int64)[moved.face[at]].ravel()])
+    pair_factor = np.concatenate([np.ones(len(still)), moved.weights[at].ravel()])
+    # every entry of each pair's input vertex
+    first = np.searchsorted(vertex, pair_in, side="left")
+    count = np.searchsorted(vertex, pair_in, side="right") - first
+    total = int(count.sum())
+    starts = np.repeat(first - (np.cumsum(count) - count), count)
+    entry = starts + np.arange(total)
+    out_vertex = np.repeat(pair_out, count)
+    out_group = group[entry]
+    out_weight = weight[entry] * np.repeat(pair_factor, count)
+    # a moved vertex's corners contribute to the same groups: sum them
+    groups = int(group.max()) + 1 if len(group) else 1
+    keys, inverse = np.unique(out_vertex * groups + out_group, return_inverse=True)
+    summed = np.bincount(inverse, weights=out_weight, minlength=len(keys))
+    out_vertex, out_group = keys // groups, keys % groups
+    is_moved = moved.face[out_vertex] >= 0
+    keep = ~is_moved | (summed != 0.0)
+    out_vertex, out_group, summed, is_moved = out_vertex[keep], out_group[keep], summed[keep], is_moved[keep]
+    if normalise and is_moved.any():
+        sums = np.bincount(out_vertex[is_moved], weights=summed[is_moved], minlength=len(moved.face))
+        scale = sums[out_vertex[is_moved]]
+        summed[is_moved] = summed[is_moved] / np.where(scale > 0, scale, 1.0)
+    return SparseWeights(out_vertex, out_group, summed)
 
 
 def corner_values(values, corner_source, output_triangles, moved: MovedVertices, triangle_corners,

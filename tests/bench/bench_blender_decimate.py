@@ -8,8 +8,9 @@ On the 1.55M-triangle horse (../shared/meshes/big, skipped when absent): time to
 (read the Blender mesh + prepare + decimate + write the new object with attributes) and the time
 of one live-preview update (re-decimate the cached mesh + write the preview mesh), next to the
 Decimate modifier applied at the same ratio in the same run, the rate of updates shown
-during a simulated drag of the modal slider, and the Live Preview's start (control back to the
-user, first result shown) on an unprepared and a prepared mesh. Prints medians and ratios.
+during a simulated drag of the modal slider, the Live Preview's start (control back to the
+user, first result shown) on an unprepared and a prepared mesh, and its Enter with Quality chosen
+(main-thread seconds before and now). Prints medians and ratios.
 """
 
 import argparse
@@ -58,7 +59,8 @@ def make_object(name, vertices, triangles):
 
 
 class Params:
-    def __init__(self, ratio):
+    def __init__(self, ratio, quality="CUSTOM"):
+        self.quality = quality  # CUSTOM: the placement and refine below (fast mode)
         self.target_mode, self.ratio, self.seed, self.adaptivity = "RATIO", ratio, 1, 0.5
         self.density, self.placement, self.refine, self.output = "off", "subsample", 0, "NEW_OBJECT"
         self.vertices = self.triangles = 1
@@ -96,7 +98,7 @@ def stages(obj, ratio):
     t["prepare"], clock = time.perf_counter() - clock, time.perf_counter()
     mesh.feature_layout(None, None)
     t["layout"], clock = time.perf_counter() - clock, time.perf_counter()
-    result = mesh.decimate(ratio=ratio, seed=1)
+    result = mesh.decimate(ratio=ratio, seed=1, mode="fast")  # as the first result (Params: fast)
     t["decimate"], clock = time.perf_counter() - clock, time.perf_counter()
     written = bpy.data.meshes.new("stage")
     mesh_io.fill_geometry(written, result.vertices, result.triangles)
@@ -155,6 +157,40 @@ def preview_drag(obj, ratio, seconds=4.0, event_interval=0.01):
     return shown / elapsed
 
 
+def preview_apply(obj, ratio):
+    """Live Preview's Enter with Quality chosen, main-thread seconds (what freezes the interface):
+    (before: decimating again at Quality on the main thread, then writing; now, a rested result:
+    writing the Quality result on screen; now, Enter during the drag: seconds until written, the
+    main thread only polling meanwhile, and its busy part: apply, polls and the write)."""
+    pipeline, params = ts.blender.pipeline, Params(ratio, quality="QUALITY")
+    session = ts.blender.preview.PreviewSession(bpy.context, obj, params, ratio=ratio)
+    while not session.final:  # the fast result, then the rested Quality one
+        session.poll()
+        time.sleep(0.005)
+    start = time.perf_counter()
+    out = pipeline.write_output(pipeline.decimate(bpy.context, obj, params))
+    before = time.perf_counter() - start
+    remove(out)
+    start = time.perf_counter()
+    out = pipeline.write_output(session.apply(ratio))
+    rested = time.perf_counter() - start
+    remove(out)
+    start = time.perf_counter()
+    run, busy = session.apply(ratio * 1.1), time.perf_counter() - start
+    while run is None:
+        time.sleep(1 / 60)  # the modal timer
+        clock = time.perf_counter()
+        run = session.poll_apply()
+        busy += time.perf_counter() - clock
+    clock = time.perf_counter()
+    out = pipeline.write_output(run)
+    busy += time.perf_counter() - clock
+    dragged = time.perf_counter() - start
+    remove(out)
+    session.close()
+    return before, rested, dragged, busy
+
+
 def modifier_apply(obj, ratio):
     copy = obj.copy()
     copy.data = obj.data.copy()
@@ -207,6 +243,7 @@ def main(argv):
         drag_rate = preview_drag(obj, ratio)
         starts = {kind: [preview_start(obj, ratio, kind == "prepared") for _ in range(args.repeat)]
                   for kind in ("unprepared", "prepared")}
+        applies = [preview_apply(obj, ratio) for _ in range(args.repeat)]
         modifier = [modifier_apply(obj, ratio) for _ in range(args.modifier_repeat)]
         first = statistics.median(firsts)
         update = statistics.median(updates)
@@ -224,6 +261,10 @@ def main(argv):
                   f"after {first * 1000:7.1f} ms (medians of {len(runs)})")
         print(f"  TopStoc slider drag    {drag_rate:8.1f} updates shown per second (modal path: a ratio "
               f"requested every 10 ms, decimation on a worker thread while the main thread writes)")
+        before, rested, dragged, busy = (statistics.median(a[i] for a in applies) for i in range(4))
+        print(f"  Live Preview Enter (Quality): before {before:.3f} s on the main thread (decimate again + write); "
+              f"now {rested:.3f} s for a rested result (write only, {before / rested:.1f}x less), during a drag "
+              f"{dragged:.3f} s until written with {busy:.3f} s of it on the main thread (medians of {len(applies)})")
         if modifier:
             mod_seconds = statistics.median(s for s, _ in modifier)
             print(f"  Blender Decimate modifier (Collapse) apply {mod_seconds:8.3f} s (median of "

@@ -4,6 +4,7 @@ check and exits 0 only when all hold."""
 
 import os
 import sys
+import threading
 import traceback
 
 import addon_utils
@@ -14,8 +15,9 @@ failures = []
 state = {}
 
 
-def check(name, ok):
-    print(f"preview check {name}: {'ok' if ok else 'FAILED'}", flush=True)
+def check(name, ok, detail=""):
+    print(f"preview check {name}: {'ok' if ok else 'FAILED'}" + ("" if ok or not detail else f" ({detail})"),
+          flush=True)
     if not ok:
         failures.append(name)
 
@@ -60,7 +62,10 @@ def steps():
     # 3: Enter applies: a new object at 20 %, the preview gone, the original visible again
     window.event_simulate(type="RET", value="PRESS")
     window.event_simulate(type="RET", value="RELEASE")
-    yield 1.0
+    for _ in range(100):  # the Quality result may still be on its way (a loaded machine)
+        yield 0.1
+        if not operators.running:
+            break
     out = bpy.data.objects.get("Torus_TopStoc")
     check("Enter applies", out is not None and abs(len(out.data.vertices) - 0.2 * n) <= 0.01 * n)
     check("preview removed", "Torus_TopStocPreview" not in bpy.data.objects
@@ -84,8 +89,6 @@ def steps():
     check("no modal timer left behind", not operators.running)
     # 5: Esc while the mesh is being prepared (the engine held at its adjacency step by a gate in
     # the progress callback): invoke has returned, nothing changed; Esc stops the engine there
-    import threading
-
     torus = bpy.data.objects["Torus"]
     before = [tuple(v.co) for v in torus.data.vertices]
     sessions.prepared_meshes_clear()
@@ -121,6 +124,196 @@ def steps():
     check("Esc during preparation leaves the object untouched", not operators.running
           and "Torus_TopStocPreview" not in bpy.data.objects and not torus.hide_get()
           and [tuple(v.co) for v in torus.data.vertices] == before)
+    yield from apply_steps(window, area, region, cx, cy)
+
+
+class EngineCalls:
+    """Wraps the pipeline's run_engine (every preview computation goes through it): counts the
+    calls and holds quality ones while ``gate`` is closed."""
+
+    def __init__(self, pipeline):
+        self.pipeline, self.original = pipeline, pipeline.run_engine
+        self.calls, self.gate, self.held = [], threading.Event(), threading.Event()
+        self.gate.set()
+
+        def run_engine(mesh, target, options, guidance_kwargs, axis=None):
+            self.calls.append((options.get("mode"), target, threading.current_thread().name))
+            if options.get("mode") == "quality" and not self.gate.is_set():
+                self.held.set()
+                self.gate.wait(30)
+            return self.original(mesh, target, options, guidance_kwargs, axis)
+
+        pipeline.run_engine = run_engine
+
+    def restore(self):
+        self.gate.set()
+        self.pipeline.run_engine = self.original
+
+
+def mesh_arrays(mesh):
+    co = [tuple(v.co) for v in mesh.vertices]
+    return co, [tuple(p.vertices) for p in mesh.polygons]
+
+
+def apply_steps(window, area, region, cx, cy):
+    """Enter applies the result on screen when it has the settings applied (no second
+    decimation), otherwise computes it on the worker while the modal keeps running; Esc then
+    cancels; undo takes the source back in one step."""
+    settings = bpy.context.scene.topstoc
+    for obj in list(bpy.data.objects):
+        if obj.name.startswith("Torus_TopStoc"):
+            bpy.data.objects.remove(obj)
+    torus = bpy.data.objects["Torus"]
+    n = len(torus.data.vertices)
+    created = []
+    original_init = sessions.PreviewSession.__init__
+
+    def remember(self, *args, **kwargs):
+        original_init(self, *args, **kwargs)
+        created.append(self)
+
+    def start(ratio):
+        torus.select_set(True)
+        bpy.context.view_layer.objects.active = torus
+        settings.target_mode, settings.ratio = "RATIO", ratio
+        window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=cx, y=cy)
+        yield 0.2  # the move is handled before the preview starts (it starts where the mouse is)
+        with bpy.context.temp_override(window=window, area=area, region=region):
+            started = bpy.ops.topstoc.preview("INVOKE_DEFAULT")
+        if started != {"RUNNING_MODAL"}:
+            raise RuntimeError(f"the preview did not start: {started}")
+
+    def press(key):
+        window.event_simulate(type=key, value="PRESS")
+        window.event_simulate(type=key, value="RELEASE")
+
+    engine = EngineCalls(sessions.pipeline)
+    sessions.PreviewSession.__init__ = remember
+    settings.quality, settings.output, settings.seed = "QUALITY", "NEW_OBJECT", 4
+    try:
+        # 6: the drag rests: the Quality result shows; Enter writes exactly that mesh, no new decimation
+        yield from start(0.1)
+        for _ in range(200):
+            yield 0.05
+            if created and created[-1].final:
+                break
+        session = created[-1]
+        shown = mesh_arrays(session.mesh) if session.final else None
+        calls = len(engine.calls)
+        press("RET")
+        for _ in range(200):
+            yield 0.05
+            if not operators.running:
+                break
+        out = bpy.data.objects.get("Torus_TopStoc")
+        check("a rested quality result shows", shown is not None and [c[0] for c in engine.calls] == ["fast", "quality"])
+        check("Enter writes the mesh shown", out is not None and mesh_arrays(out.data) == shown)
+        check("... without a second decimation", len(engine.calls) == calls and not operators.running)
+        reference = sessions.pipeline.decimate(bpy.context, torus, settings).result
+        check("... which is the Quality result", out is not None and len(out.data.vertices) == reference.num_vertices
+              and [tuple(map(float, v)) for v in reference.vertices.astype("float32")] == mesh_arrays(out.data)[0])
+        bpy.data.objects.remove(out)
+
+        # 7: Enter during the drag: the Quality result at the dragged ratio is computed on the worker
+        engine.calls.clear()
+        yield from start(0.1)
+        for _ in range(200):
+            yield 0.05
+            if created[-1].result is not None:
+                break
+        engine.gate.clear()
+        window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=cx + 75, y=cy)
+        press("RET")
+        session = created[-1]
+        # simulated events are handled when the window's event loop comes round (late under load)
+        for _ in range(200):
+            yield 0.05
+            if engine.held.is_set() or not operators.running:
+                break
+        check("Enter during the drag keeps the modal running while the worker computes",
+              operators.running and session.applying and engine.held.is_set()
+              and "Torus_TopStoc" not in bpy.data.objects)
+        final = [c for c in engine.calls if c[0] == "quality"]
+        check("... the chosen Quality at the dragged ratio, on the worker", len(final) == 1
+              and abs(final[0][1]["ratio"] - 0.1 * 2 ** 0.5) < 0.002
+              and final[0][2].startswith(sessions.THREAD_PREFIX), str(final))
+        engine.gate.set()
+        for _ in range(200):
+            yield 0.05
+            if not operators.running:
+                break
+        out = bpy.data.objects.get("Torus_TopStoc")
+        reference = sessions.pipeline.decimate(bpy.context, torus, settings).result
+        check("... then writes it", out is not None and abs(settings.ratio - final[0][1]["ratio"]) < 1e-6
+              and [tuple(map(float, v)) for v in reference.vertices.astype("float32")] == mesh_arrays(out.data)[0])
+        check("... and leaves no preview, thread or timer", "Torus_TopStocPreview" not in bpy.data.objects
+              and not torus.hide_get() and not operators.running
+              and not any(t.name.startswith(sessions.THREAD_PREFIX) for t in threading.enumerate()))
+        bpy.data.objects.remove(out)
+
+        # 8: Esc while the result to apply is computed: nothing written, the source as it was
+        before = mesh_arrays(torus.data)
+        names = sorted(bpy.data.objects.keys())
+        yield from start(0.1)
+        for _ in range(200):
+            yield 0.05
+            if created[-1].result is not None:
+                break
+        engine.held.clear()
+        engine.gate.clear()
+        window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=cx + 40, y=cy)
+        press("RET")
+        for _ in range(200):
+            yield 0.05
+            if engine.held.is_set() or not operators.running:
+                break
+        applying = created[-1].applying and engine.held.is_set()
+        press("ESC")
+        for _ in range(200):
+            yield 0.05
+            if not operators.running:
+                break
+        check("Esc during the final computation cancels", applying and not operators.running
+              and sorted(bpy.data.objects.keys()) == names and not torus.hide_get()
+              and mesh_arrays(torus.data) == before,
+              f"applying {applying}, running {bool(operators.running)}, objects {sorted(bpy.data.objects.keys())} "
+              f"(before {names}), hidden {torus.hide_get()}, unchanged {mesh_arrays(torus.data) == before}")
+        engine.gate.set()
+        for _ in range(200):
+            yield 0.05
+            if not any(t.name.startswith(sessions.THREAD_PREFIX) for t in threading.enumerate()):
+                break
+        yield 0.3
+        check("... the computation ends unseen: no thread, timer or object left",
+              not any(t.name.startswith(sessions.THREAD_PREFIX) for t in threading.enumerate())
+              and not operators.running and sorted(bpy.data.objects.keys()) == names
+              and abs(settings.ratio - 0.1) < 1e-6)
+
+        # 9: In Place, then one undo: the source is back
+        settings.output = "IN_PLACE"
+        with bpy.context.temp_override(window=window, area=area, region=region):
+            bpy.ops.ed.undo_push(message="before the preview")
+        yield from start(0.1)
+        for _ in range(200):
+            yield 0.05
+            if created[-1].final:
+                break
+        press("RET")
+        for _ in range(200):
+            yield 0.05
+            if not operators.running:
+                break
+        applied = len(bpy.data.objects["Torus"].data.vertices)
+        with bpy.context.temp_override(window=window, area=area, region=region):
+            bpy.ops.ed.undo()
+        yield 0.3
+        torus = bpy.data.objects["Torus"]
+        check("In Place applies, one undo restores the source", applied < 0.2 * n
+              and mesh_arrays(torus.data) == before and "Torus_TopStocPreview" not in bpy.data.objects,
+              f"{applied} of {n}")
+    finally:
+        engine.restore()
+        sessions.PreviewSession.__init__ = original_init
 
 
 def run():

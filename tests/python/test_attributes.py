@@ -137,3 +137,69 @@ def test_point_and_corner_values_by_hand():
     corner = np.array([[1.0], [2.0], [3.0], [-3.0], [-2.0], [-1.0]])  # triangle 1's side of the seam is negative
     flat = corner_values(corner, np.array([0, 4, 4]), np.array([[0, 1, 1]]), moved, np.arange(6).reshape(2, 3))
     np.testing.assert_allclose(flat[:, 0], [1.0, 0.2 * -3 + 0.3 * -2 + 0.5 * -1, 0.2 * -3 + 0.3 * -2 + 0.5 * -1])
+
+
+def dense_weights(weights, rows, columns):
+    """(rows, columns) weights and membership of a SparseWeights, one row per vertex."""
+    table = np.zeros((rows, columns))
+    member = np.zeros((rows, columns), dtype=bool)
+    for v, g, w in zip(weights.vertex.tolist(), weights.group.tolist(), weights.weight.tolist()):
+        assert not member[v, g], (v, g)  # one entry per (vertex, group)
+        table[v, g], member[v, g] = w, True
+    return table, member
+
+
+def test_point_weights_by_hand():
+    """Vertex 0 did not move (its zero weight in group 2 stays); vertex 1 moved into triangle 1,
+    whose corners 2, 1, 3 have weights in groups 0, 1 and 2 (corner 3 only in group 2)."""
+    from topstoc.core.attributes import MovedVertices, SparseWeights, point_weights
+
+    triangles = np.array([[0, 1, 2], [2, 1, 3]])
+    moved = MovedVertices(face=np.array([-1, 1]), weights=np.array([[1.0, 0, 0], [0.2, 0.3, 0.5]]))
+    source = SparseWeights(vertex=np.array([0, 0, 1, 2, 2, 3]), group=np.array([0, 2, 1, 0, 1, 2]),
+                           weight=np.array([1.0, 0.0, 1.0, 0.25, 0.75, 1.0]))
+    out = point_weights(source, np.array([0, 3]), moved, triangles)
+    table, member = dense_weights(out, 2, 3)
+    np.testing.assert_array_equal(member[0], [True, False, True])        # kept exactly, the 0 too
+    np.testing.assert_array_equal(table[0], [1.0, 0.0, 0.0])
+    np.testing.assert_allclose(table[1], [0.2 * 0.25, 0.2 * 0.75 + 0.3 * 1.0, 0.5 * 1.0])  # group 0 via corner 2 only
+    assert member[1].all() and abs(table[1].sum() - 1.0) < 1e-12       # normalised corners, normalised mix
+    # a corner with barycentric weight 0 gives nothing: no group with a zero mix
+    flat = MovedVertices(face=np.array([-1, 1]), weights=np.array([[1.0, 0, 0], [0.0, 1.0, 0.0]]))
+    table, member = dense_weights(point_weights(source, np.array([0, 3]), flat, triangles), 2, 3)
+    np.testing.assert_array_equal(member[1], [False, True, False])
+    # normalise: a corner without weights (vertex 4) would leave the mix short of 1
+    source4 = SparseWeights(vertex=np.array([1, 2]), group=np.array([0, 0]), weight=np.array([1.0, 1.0]))
+    tri = MovedVertices(face=np.array([0]), weights=np.array([[0.5, 0.25, 0.25]]))
+    short = point_weights(source4, np.array([4]), tri, np.array([[4, 1, 2]]))
+    np.testing.assert_allclose(short.weight, [0.5])
+    assert source4.normalised() and not short.normalised()
+    full = point_weights(source4, np.array([4]), tri, np.array([[4, 1, 2]]), normalise=True)
+    np.testing.assert_allclose(full.weight, [1.0])
+
+
+def test_point_weights_match_a_dense_mix_on_a_quality_decimation():
+    """Random sparse weights on a torus through a quality decimation against the dense
+    reference: kept vertices copy their rows, moved ones mix their source triangle's rows."""
+    from topstoc.core.attributes import SparseWeights, moved_vertices, point_weights
+
+    vertices, triangles = torus(40, 20)
+    rng = np.random.default_rng(5)
+    n, groups = len(vertices), 6
+    member = rng.random((n, groups)) < 0.4
+    table = np.where(member, rng.random((n, groups)), 0.0)
+    table[member & (rng.random((n, groups)) < 0.1)] = 0.0              # some explicit zero weights
+    rows, columns = np.nonzero(member)
+    source = SparseWeights(rows, columns, table[rows, columns])
+    result = Mesh(vertices, triangles).decimate(ratio=0.2, seed=4)
+    moved = moved_vertices(vertices, triangles, result)
+    assert len(moved.moved) > 50
+    out_table, out_member = dense_weights(point_weights(source, result.kept, moved, triangles), len(result.kept), groups)
+    still = moved.face < 0
+    np.testing.assert_array_equal(out_table[still], table[result.kept[still]])
+    np.testing.assert_array_equal(out_member[still], member[result.kept[still]])
+    at = moved.moved
+    corners = triangles[moved.face[at]]
+    expected = np.einsum("kj,kjg->kg", moved.weights[at], table[corners])
+    np.testing.assert_allclose(out_table[at], expected, atol=1e-12)
+    np.testing.assert_array_equal(out_member[at], expected != 0)

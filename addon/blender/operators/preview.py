@@ -5,8 +5,16 @@ returns; the preview session fingerprints, prepares (when the mesh is not cached
 on a worker thread while the header and status bar show the preparation's progress with a wait
 cursor. Esc cancels then too, and the engine stops preparing (not only the waiting); the object
 is left as it was. The preview shows the Fast result with its wireframe while dragging and the
-chosen Quality when the drag pauses; Enter writes the result at the panel's settings. The
-sidebar's ratio follows the drag (and goes back on cancel).
+chosen Quality when the drag pauses. The sidebar's ratio follows the drag (and goes back on
+cancel).
+
+Enter (or a click) applies the dragged ratio at the panel's settings. When the result on screen
+is that result (the chosen Quality after the drag rested there) it is written as it is. Otherwise
+the preview's worker computes it while the header and status bar count the seconds and the
+cursor waits; the modal keeps running until it is ready (Esc cancels: nothing is written), then
+writes it. Where moved vertices take their attributes from is found on a worker too, as soon as
+a Quality result is computed. Either way the source changes only when the operator finishes, in
+one undo step.
 """
 
 from __future__ import annotations
@@ -74,6 +82,15 @@ Enter or click applies, Esc or right-click restores"""
         s = self.session
         result = s.result
         seconds = time.perf_counter() - self.started
+        if s.applying:
+            waited = time.perf_counter() - s.apply_started
+            if s.apply_computed:
+                doing = "interpolating the attributes of moved vertices"
+            else:
+                estimate = f" of about {s.final_seconds:.1f} s" if s.final_seconds else ""
+                doing = f"computing the {self.quality.title()} result{estimate}"
+            self._status(context, f"TopStoc: applying ratio {self.ratio:.4f}: {doing} ... {waited:.1f} s   Esc: cancel")
+            return
         if s.preparing:
             fraction, stage = s.progress()
             self._status(context, f"TopStoc: preparing '{self.obj_name}' ({s.num_triangles:,} triangles): "
@@ -125,6 +142,8 @@ Enter or click applies, Esc or right-click restores"""
         if event.type in {"ESC", "RIGHTMOUSE"} and event.value == "PRESS":
             self._finish(context, restore_scene=True)
             return {"CANCELLED"}
+        if self.session.applying:  # the drag is over: only the result to apply is awaited
+            return self._poll_apply(context) if event.type == "TIMER" else {"RUNNING_MODAL"}
         if event.type == "MOUSEMOVE":
             exponent = (event.mouse_x - self.start_x) / PIXELS_PER_DOUBLING
             self._set_ratio(context, self.start_ratio * math.pow(2.0, exponent))
@@ -151,21 +170,40 @@ Enter or click applies, Esc or right-click restores"""
         elif event.type in {"RET", "NUMPAD_ENTER", "LEFTMOUSE"} and event.value == "PRESS":
             if self.session.result is None:
                 return {"RUNNING_MODAL"}  # nothing shown yet to apply
-            obj, ratio = self.session.obj, self.session.ratio
-            self._finish(context)
-            self.target_mode, self.ratio = "RATIO", ratio
-            context.scene.topstoc.target_mode, context.scene.topstoc.ratio = "RATIO", ratio
-            try:
-                run = pipeline.decimate(context, obj, self, region_3d=context.region_data)
-                if self.output == "NEW_OBJECT":
-                    pipeline.store_samples(run)
-                pipeline.write_output(run, self.output)
-            except TopStocError as error:
-                self.report({"ERROR"}, str(error))
-                return {"CANCELLED"}
-            self.report({"INFO"}, f"TopStoc: {pipeline.summary(run)}")
-            return {"FINISHED"}
+            self.target_mode = "RATIO"
+            self._follow(context)
+            run = self.session.apply(self.ratio)  # the result shown, when it is the one to apply
+            if run is not None:
+                return self._apply(context, run)
+            context.window.cursor_modal_set("WAIT")
+            self._header(context)
         return {"RUNNING_MODAL"}
+
+    # -- applying -----------------------------------------------------------------------------
+
+    def _poll_apply(self, context):
+        try:
+            run = self.session.poll_apply()
+        except (ValueError, RuntimeError) as error:  # the final decimation failed
+            return self._fail(context, error)
+        if run is None:
+            self._header(context)
+            return {"RUNNING_MODAL"}
+        return self._apply(context, run)
+
+    def _apply(self, context, run):
+        """Writes the result (main thread); the preview goes first, so the source is shown again."""
+        start = time.perf_counter()
+        self._finish(context)
+        try:
+            if self.output == "NEW_OBJECT":
+                pipeline.store_samples(run)
+            pipeline.write_output(run, self.output)
+        except TopStocError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"TopStoc: {pipeline.summary(run, run.seconds + time.perf_counter() - start)}")
+        return {"FINISHED"}
 
 
 CLASSES = (TOPSTOC_OT_preview,)
