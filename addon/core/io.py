@@ -41,6 +41,7 @@ from typing import List, Optional
 
 import numpy as np
 
+from .errors import TopStocError
 from .native import engine
 
 FORMATS = ("obj", "ply", "off", "stl")
@@ -78,7 +79,7 @@ class MeshData:
         self.vertices = np.asarray(self.vertices, dtype=np.float64).reshape(-1, 3)
         triangles = np.asarray(self.triangles, dtype=np.int64).reshape(-1, 3)
         if triangles.size and (triangles.min() < 0 or triangles.max() > np.iinfo(np.int32).max):
-            raise ValueError(f"triangle indices must lie in [0, 2**31), got "
+            raise TopStocError(f"triangle indices must lie in [0, 2**31), got "
                              f"[{triangles.min()}, {triangles.max()}]")
         self.triangles = triangles.astype(np.int32)
         m = len(self.triangles)
@@ -133,7 +134,7 @@ def mesh_format(path) -> tuple:
         compression = ext[1:]
         stem, ext = os.path.splitext(stem)
     if ext[1:] not in FORMATS:
-        raise ValueError(f"{name}: unknown mesh file extension {ext or '(none)'!r}; expected one of "
+        raise TopStocError(f"{name}: unknown mesh file extension {ext or '(none)'!r}; expected one of "
                          f"{', '.join('.' + f for f in FORMATS)} (optionally followed by .gz or .bz2)")
     return ext[1:], compression
 
@@ -175,7 +176,7 @@ def _decompress(name: str, raw: bytes, compression: Optional[str], limit: Option
                     done = decompressor.eof
                 total += len(piece)
                 if limit is not None and total > limit:
-                    raise ValueError(f"{name}: decompresses to more than {limit} bytes (the limit, "
+                    raise TopStocError(f"{name}: decompresses to more than {limit} bytes (the limit, "
                                      f"max_decompressed_bytes; the file has {len(raw)} compressed bytes)")
                 parts.append(piece)
                 if done:
@@ -188,7 +189,7 @@ def _decompress(name: str, raw: bytes, compression: Optional[str], limit: Option
                 break
             view = memoryview(rest)
     except (OSError, EOFError, zlib.error) as error:
-        raise ValueError(f"{name}: cannot decompress ({compression}): {error}") from None
+        raise TopStocError(f"{name}: cannot decompress ({compression}): {error}") from None
     return b"".join(parts)
 
 
@@ -219,7 +220,7 @@ def read_mesh(path, max_decompressed_bytes: Optional[int] = MAX_DECOMPRESSED_BYT
     if max_decompressed_bytes is not None and (isinstance(max_decompressed_bytes, bool) or
                                                not isinstance(max_decompressed_bytes, int) or
                                                max_decompressed_bytes < 0):
-        raise ValueError(f"max_decompressed_bytes must be a non-negative int or None, "
+        raise TopStocError(f"max_decompressed_bytes must be a non-negative int or None, "
                          f"got {max_decompressed_bytes!r}")
     with open(name, "rb") as stream:
         raw = stream.read()
@@ -227,7 +228,7 @@ def read_mesh(path, max_decompressed_bytes: Optional[int] = MAX_DECOMPRESSED_BYT
     try:
         parsed = engine.read_mesh(data, kind)
     except ValueError as error:
-        raise ValueError(f"{name}: {error}") from None
+        raise TopStocError(f"{name}: {error}") from None
     for message in parsed["warnings"]:
         warnings.warn(f"{name}: {message}", MeshFileWarning, stacklevel=2)
     m = len(parsed["triangles"])
@@ -245,11 +246,11 @@ def read_mesh(path, max_decompressed_bytes: Optional[int] = MAX_DECOMPRESSED_BYT
 def encode_mesh(data: MeshData, kind: str) -> bytes:
     """The bytes of ``data`` written as ``kind`` ("obj", "ply", "off" or "stl"), uncompressed."""
     if kind not in FORMATS:
-        raise ValueError(f"format must be one of {FORMATS}, got {kind!r}")
+        raise TopStocError(f"format must be one of {FORMATS}, got {kind!r}")
     m = data.num_triangles
     uvs = None if data.corner_uvs is None else np.asarray(data.corner_uvs, dtype=np.float64)
     if uvs is not None and uvs.shape != (m, 3, 2):
-        raise ValueError(f"corner_uvs must have shape ({m}, 3, 2), got {uvs.shape}")
+        raise TopStocError(f"corner_uvs must have shape ({m}, 3, 2), got {uvs.shape}")
     return engine.write_mesh(kind, data.vertices, data.triangles,
                              triangle_polygon=data.triangle_polygon,
                              corner_uvs=None if uvs is None else uvs.reshape(m, 6),
@@ -277,7 +278,7 @@ def write_mesh(path, data: MeshData) -> None:
     try:
         payload = encode_mesh(data, kind)
     except ValueError as error:
-        raise ValueError(f"{name}: {error}") from None
+        raise TopStocError(f"{name}: {error}") from None
     if compression == "gz":
         payload = gzip.compress(payload, compresslevel=6, mtime=0)
     elif compression == "bz2":

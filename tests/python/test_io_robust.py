@@ -185,6 +185,14 @@ def test_writers_refuse_non_finite_colours_and_infinite_uvs_where_the_format_car
     write_mesh(tmp_path / "u.off", triangle_data(corner_uvs=uvs))  # OFF drops UVs
 
 
+def test_write_errors_are_topstoc_errors(tmp_path):
+    import topstoc
+    data = triangle_data()
+    data.vertices[0, 0] = np.inf
+    with pytest.raises(topstoc.TopStocError, match="vertex 0 cannot be written"):
+        write_mesh(tmp_path / "e.ply", data)
+
+
 def test_a_file_with_nan_reads_but_is_not_written_on(tmp_path):
     (tmp_path / "nan.obj").write_text("v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     data = read_mesh(tmp_path / "nan.obj")  # read as it is (topstoc.Mesh refuses it by vertex)
