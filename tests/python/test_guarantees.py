@@ -154,6 +154,16 @@ def test_independent_pinched_check_sees_a_lost_wing():
     assert joined
 
 
+@pytest.mark.parametrize("name", ["decimate_pinched_hole_closed", "decimate_pinched_wing_lost"])
+def test_pinched_regressions(name):
+    # Found by tests/stress/decimate_stress.py on pinched surfaces (README in tests/data/regressions)
+    data = np.load(REGRESSIONS / f"{name}.npz")
+    params = json.loads((REGRESSIONS / f"{name}.json").read_text())
+    result = topstoc.Mesh(data["vertices"], data["triangles"]).decimate(**params)
+    assert result.stats.repair_rounds < 50
+    assert_pinched_guarantees(data["vertices"], data["triangles"], result)
+
+
 def test_samples_without_the_pinched_vertex_keep_both_wings():
     # Regression: a sample list without the bowtie's centre; the second wing's clusters were
     # absorbed and one wing was returned as success. Corners are now added to the list.

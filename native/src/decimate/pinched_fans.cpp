@@ -26,37 +26,6 @@ bool oriented_consistently(const Mesh& mesh, int32_t e) {
   return direction[0] != direction[1];
 }
 
-struct Fan {
-  int32_t sheet;
-  bool closed;
-};
-
-// Sheets of the input: faces joined across edges with exactly two faces.
-UnionFind input_sheets(const Mesh& mesh) {
-  UnionFind sheets(mesh.num_faces());
-  for (int32_t e = 0; e < mesh.num_edges(); ++e)
-    if (mesh.edge_face_count(e) == 2)
-      sheets.unite(mesh.edge_faces()[mesh.edge_face_offsets()[e]], mesh.edge_faces()[mesh.edge_face_offsets()[e] + 1]);
-  return sheets;
-}
-
-// The fans of pinched input vertex v, each with its sheet and whether it closes around v.
-std::vector<Fan> input_fans(const Mesh& mesh, UnionFind& sheets, int32_t v) {
-  std::vector<int32_t> fan_of_slot;
-  const int32_t count = vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot);
-  std::vector<Fan> fans(count, Fan{-1, true});
-  const auto& vfo = mesh.vertex_face_offsets();
-  for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-    const int32_t f = mesh.vertex_faces()[i];
-    Fan& fan = fans[fan_of_slot[i - vfo[v]]];
-    fan.sheet = sheets.find(f);
-    const int32_t* t = &mesh.faces()[3 * size_t(f)];
-    const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-    for (int side : {c, (c + 2) % 3})
-      if (mesh.edge_face_count(mesh.face_edges()[3 * size_t(f) + side]) == 1) fan.closed = false;
-  }
-  return fans;
-}
 
 // The fans of output vertex o from its triangles (ids into `triangles`), joined across the
 // edges at o that exactly two of them share; empty when an edge at o has more than two.
@@ -121,6 +90,33 @@ bool fans_match(std::vector<Fan> input, const std::vector<Fan>& output) {
 
 }  // namespace
 
+std::vector<int32_t> face_sheets(const Mesh& mesh) {
+  UnionFind sheets(mesh.num_faces());
+  for (int32_t e = 0; e < mesh.num_edges(); ++e)
+    if (mesh.edge_face_count(e) == 2)
+      sheets.unite(mesh.edge_faces()[mesh.edge_face_offsets()[e]], mesh.edge_faces()[mesh.edge_face_offsets()[e] + 1]);
+  std::vector<int32_t> sheet(mesh.num_faces());
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) sheet[f] = sheets.find(f);  // roots are the lowest faces
+  return sheet;
+}
+
+std::vector<Fan> input_fans(const Mesh& mesh, const std::vector<int32_t>& face_sheet, int32_t v) {
+  std::vector<int32_t> fan_of_slot;
+  const int32_t count = vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot);
+  std::vector<Fan> fans(count, Fan{-1, true});
+  const auto& vfo = mesh.vertex_face_offsets();
+  for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
+    const int32_t f = mesh.vertex_faces()[i];
+    Fan& fan = fans[fan_of_slot[i - vfo[v]]];
+    fan.sheet = face_sheet[f];
+    const int32_t* t = &mesh.faces()[3 * size_t(f)];
+    const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+    for (int side : {c, (c + 2) % 3})
+      if (mesh.edge_face_count(mesh.face_edges()[3 * size_t(f) + side]) == 1) fan.closed = false;
+  }
+  return fans;
+}
+
 PinchedVertices find_pinched_vertices(const Mesh& mesh) {
   PinchedVertices out;
   if (mesh.report().nonmanifold_vertices == 0) return out;
@@ -174,7 +170,7 @@ int32_t changed_pinched_fans(const Mesh& mesh, const PinchedVertices& pinched, c
     const int32_t* c = &triangles[3 * size_t(i)];
     return c[0] != c[1] && c[1] != c[2] && c[2] != c[0];
   };
-  UnionFind sheets = input_sheets(mesh);
+  const std::vector<int32_t> sheet = face_sheets(mesh);
 
   // Output sheets: triangles joined across edges that exactly two of them share.
   std::vector<std::array<int32_t, 3>> sides;  // lower end, upper end, triangle
@@ -198,7 +194,7 @@ int32_t changed_pinched_fans(const Mesh& mesh, const PinchedVertices& pinched, c
   auto sheets_of = [&](int32_t v, std::vector<int32_t>& into) {
     into.clear();
     for (int32_t i = mesh.vertex_face_offsets()[v]; i < mesh.vertex_face_offsets()[v + 1]; ++i)
-      into.push_back(sheets.find(mesh.vertex_faces()[i]));
+      into.push_back(sheet[mesh.vertex_faces()[i]]);
     std::sort(into.begin(), into.end());
     into.erase(std::unique(into.begin(), into.end()), into.end());
   };
@@ -247,7 +243,7 @@ int32_t changed_pinched_fans(const Mesh& mesh, const PinchedVertices& pinched, c
       ++changed;  // the pinch is gone (pinched vertices are always kept)
       continue;
     }
-    if (!fans_match(input_fans(mesh, sheets, v), output_fans(o, around[k], triangles, out_sheets, sheet_of_output_sheet)))
+    if (!fans_match(input_fans(mesh, sheet, v), output_fans(o, around[k], triangles, out_sheets, sheet_of_output_sheet)))
       ++changed;
   }
   return changed;

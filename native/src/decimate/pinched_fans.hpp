@@ -30,6 +30,18 @@ struct PinchedVertices {
 /// The pinched vertices of the input (empty vectors when there are none, the usual case).
 PinchedVertices find_pinched_vertices(const Mesh& mesh);
 
+/// Sheet of every input face: faces joined across edges with exactly two faces, named by the
+/// lowest face of each sheet.
+std::vector<int32_t> face_sheets(const Mesh& mesh);
+
+struct Fan {
+  int32_t sheet;  ///< the sheet its triangles lie on
+  bool closed;    ///< it goes all around the vertex (no edge at the vertex with one triangle)
+};
+
+/// The fans of input vertex v (pinched or not; no edge at it with three triangles or more).
+std::vector<Fan> input_fans(const Mesh& mesh, const std::vector<int32_t>& face_sheet, int32_t v);
+
 /// Boundary loops per component, counted as the output check counts them: boundary edges
 /// (one triangle) joined at shared vertices, so two loops touching at a pinch count once.
 std::vector<int32_t> boundary_edge_groups(const Mesh& mesh);
