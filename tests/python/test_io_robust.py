@@ -304,6 +304,49 @@ def test_fuzz_seeds_and_found_inputs_read_or_fail_cleanly_and_round_trip(tmp_pat
             np.testing.assert_array_equal(back.triangles, data.triangles, err_msg=str(path))
 
 
+def test_round_trip_fuzz_inputs_cross_formats(tmp_path):
+    """tests/fuzz's round_trip inputs (first byte: the reader) through the Python API: what reads
+    is written in each other format and reads back with the same counts and, where both formats
+    hold them, the same positions (float32 in STL), colours and UVs."""
+    files = sorted(p for folder in (FUZZ_SEEDS / "round_trip", FUZZ_REGRESSIONS / "round_trip")
+                   if folder.exists() for p in folder.iterdir() if p.is_file())
+    assert len(files) >= 19
+    kinds = ("obj", "ply", "off", "stl")
+    checked = 0
+    for path in files:
+        raw = path.read_bytes()
+        source = kinds[raw[0] % 4]
+        (tmp_path / f"in.{source}").write_bytes(raw[1:])
+        try:
+            data, _ = read_quietly(tmp_path / f"in.{source}")
+        except ValueError:
+            continue
+        for kind in kinds:
+            if kind == source:
+                continue
+            out = tmp_path / f"out.{kind}"
+            try:
+                write_mesh(out, data)
+            except ValueError as error:
+                assert "cannot be written" in str(error), (path, kind, error)
+                continue
+            back, messages = read_quietly(out)
+            assert messages == [], (path, kind)
+            assert len(back.triangles) == len(data.triangles), (path, kind)
+            if kind == "stl":
+                np.testing.assert_array_equal(back.vertices[back.triangles].astype(np.float32),
+                                              data.vertices[data.triangles].astype(np.float32), err_msg=str(path))
+                continue
+            np.testing.assert_array_equal(back.vertices, data.vertices, err_msg=f"{path} -> {kind}")
+            np.testing.assert_array_equal(back.triangles, data.triangles, err_msg=f"{path} -> {kind}")
+            if data.vertex_colors is not None and len(data.vertices):
+                np.testing.assert_array_equal(back.vertex_colors, data.vertex_colors, err_msg=f"{path} -> {kind}")
+            if kind in ("obj", "ply") and data.corner_uvs is not None and not np.isnan(data.corner_uvs).all():
+                np.testing.assert_array_equal(back.corner_uvs, data.corner_uvs, err_msg=f"{path} -> {kind}")
+            checked += 1
+    assert checked >= 30
+
+
 # --- compressed input ---------------------------------------------------------------------------
 
 def bomb(size):
