@@ -7,13 +7,14 @@
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     e.g. scripts/fuzz.sh 600 fuzz_read_ply
 # Targets: fuzz_read_obj fuzz_read_ply fuzz_read_off fuzz_read_stl (reader, then writer ->
-# reader round trip) and fuzz_decimate (Mesh + decimate on arbitrary arrays). One core.
+# reader round trip), fuzz_round_trip (any reader, then each other format's writer -> reader;
+# the first byte picks the reader) and fuzz_decimate (Mesh + decimate on arbitrary arrays). One core.
 set -o pipefail
 source "$(dirname "$0")/common.sh"
 SECONDS_EACH=${1:-10}
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(fuzz_read_obj fuzz_read_ply fuzz_read_off fuzz_read_stl fuzz_decimate)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(fuzz_read_obj fuzz_read_ply fuzz_read_off fuzz_read_stl fuzz_round_trip fuzz_decimate)
 ensure_packages $RUNTIME_PACKAGES clang-14 libclang-rt-14-dev libomp-14-dev || exit 1
 
 BUILD=${TOPSTOC_FUZZ_BUILD:-build-fuzz}

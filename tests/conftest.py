@@ -15,6 +15,17 @@ for path in (str(BUILD / "python"), str(ROOT / "tests")):
     if path not in sys.path:
         sys.path.insert(0, path)
 
+#: What a sanitizer build needs in every process that loads the module (scripts/sanitize.sh).
+SANITIZER_VARIABLES = ("LD_PRELOAD", "ASAN_OPTIONS", "UBSAN_OPTIONS")
+
+
+def bare_env(**variables) -> dict:
+    """An environment of just ``variables`` for a subprocess, plus the sanitizer runtime's
+    variables when they are set (without them an ASan build cannot load)."""
+    env = {name: os.environ[name] for name in SANITIZER_VARIABLES if name in os.environ}
+    env.update(variables)
+    return env
+
 
 @pytest.fixture(scope="session")
 def data_dir() -> pathlib.Path:

@@ -99,6 +99,44 @@ def random_manifold(seed):
     return p, t.astype(np.int32)
 
 
+def pinched_surface(seed):
+    """2..4 random surfaces glued at vertices (pinched vertices, several fans each): all at one
+    vertex (a spider of wings) or in a chain, one vertex per neighbouring pair. Shuffled and
+    rotated like random_manifold; the parts overlap in space (the topology is what is tested)."""
+    rng = np.random.default_rng(seed)
+    parts = [KINDS[int(rng.integers(len(KINDS)))](rng) for _ in range(int(rng.integers(2, 5)))]
+    spider = rng.random() < 0.5
+    points, triangles, glue, offset = [], [], {}, 0
+    anchor = None  # (global id, position) where the next part is glued
+    for p, t in parts:
+        hub, tail = (int(x) for x in rng.choice(len(p), size=2, replace=False))
+        if anchor is not None:
+            glue[offset + hub] = anchor[0]
+            p = p - p[hub] + anchor[1]
+        if anchor is None or not spider:
+            end = hub if spider else tail
+            anchor = (offset + end, p[end])
+        points.append(p)
+        triangles.append(t + offset)
+        offset += len(p)
+    p, t = np.concatenate(points), np.concatenate(triangles)
+    ids = np.arange(len(p))
+    for source, target in glue.items():
+        ids[source] = target
+    keep = np.ones(len(p), bool)
+    keep[list(glue)] = False
+    new_id = np.cumsum(keep) - 1
+    t, p = new_id[ids[t]], p[keep]
+    order = rng.permutation(len(p))
+    inverse = np.empty_like(order)
+    inverse[order] = np.arange(len(p))
+    p, t = p[order], inverse[t]
+    t = t[rng.permutation(len(t))]
+    roll = rng.integers(0, 3, len(t))
+    t = np.stack([t[np.arange(len(t)), (roll + j) % 3] for j in range(3)], 1)
+    return p, t.astype(np.int32)
+
+
 # --- the independent check ------------------------------------------------------------------
 
 def _components(n, a, b):
@@ -121,6 +159,35 @@ def _components(n, a, b):
     return label
 
 
+def _corner_fans(n, t):
+    """Fan label of every corner (3 * f + j): corners joined across the edges at their vertex
+    that have exactly two triangles."""
+    m = len(t)
+    tail = np.concatenate([t[:, 0], t[:, 1], t[:, 2]])  # directed edge j*m+f: corner j -> j+1
+    head = np.concatenate([t[:, 1], t[:, 2], t[:, 0]])
+    _, edge_of, count = np.unique(np.minimum(tail, head) * n + np.maximum(tail, head), return_inverse=True,
+                                  return_counts=True)
+    edge_of = edge_of.ravel()
+    corner_tail = np.concatenate([3 * np.arange(m), 3 * np.arange(m) + 1, 3 * np.arange(m) + 2])
+    corner_head = np.concatenate([3 * np.arange(m) + 1, 3 * np.arange(m) + 2, 3 * np.arange(m)])
+    order = np.argsort(edge_of, kind="stable")
+    two = order[count[edge_of[order]] == 2]
+    x, y = two[0::2], two[1::2]
+    same = tail[y] == tail[x]
+    ja = np.concatenate([corner_tail[x], corner_head[x]])
+    jb = np.concatenate([np.where(same, corner_tail[y], corner_head[y]), np.where(same, corner_head[y], corner_tail[y])])
+    return _components(3 * m, ja, jb)
+
+
+def _fans_per_vertex(n, t):
+    t = np.asarray(t, dtype=np.int64).reshape(-1, 3)
+    m = len(t)
+    if m == 0:
+        return np.zeros(n, int)
+    pairs = np.unique(t.ravel() * (3 * m) + _corner_fans(n, t))
+    return np.bincount(pairs // (3 * m), minlength=n)
+
+
 def surface_facts(n, t):
     """Per vertex its component (-1 if in no triangle), and per component: Euler
     characteristic, boundary loops, manifold and oriented (bool)."""
@@ -140,19 +207,7 @@ def surface_facts(n, t):
     edge_of = edge_of.ravel()
     edges = np.stack([keys // n, keys % n], 1)
     _, directed_count = np.unique(directed_key, return_counts=True)
-    # fans: corners (3 * f + j) joined across the edges at their vertex that have two triangles
-    corner_tail = np.concatenate([3 * np.arange(m), 3 * np.arange(m) + 1, 3 * np.arange(m) + 2])
-    corner_head = np.concatenate([3 * np.arange(m) + 1, 3 * np.arange(m) + 2, 3 * np.arange(m)])
-    order = np.argsort(edge_of, kind="stable")
-    two = order[count[edge_of[order]] == 2]
-    x, y = two[0::2], two[1::2]
-    same = tail[y] == tail[x]
-    ja = np.concatenate([corner_tail[x], corner_head[x]])
-    jb = np.concatenate([np.where(same, corner_tail[y], corner_head[y]), np.where(same, corner_head[y], corner_tail[y])])
-    fans = _components(3 * m, ja, jb)
-    corner_vertex = t.ravel()
-    pairs = np.unique(corner_vertex * (3 * m) + fans)
-    fans_at = np.bincount(pairs // (3 * m), minlength=n)
+    fans_at = _fans_per_vertex(n, t)
     bad_vertex = fans_at > 1
     bad_edge = count > 2
     manifold = np.ones(k, bool)
@@ -215,3 +270,56 @@ def check_decimation(vertices, triangles, out_vertices, out_triangles, kept, bef
         if after["loops"][c] != before["loops"][ci]:
             problems.append(f"component {ci}: boundary loops {before['loops'][ci]} -> {after['loops'][c]}")
     return problems
+
+
+def unpinch(n, t):
+    """Splits every vertex with several fans into one vertex per fan (the first fan keeps the
+    id, the others get new ids from n on). Returns the new triangles and the original vertex
+    of every vertex of the result."""
+    t = np.asarray(t, dtype=np.int64).reshape(-1, 3)
+    m = len(t)
+    if m == 0:
+        return t, np.arange(n)
+    fans = _corner_fans(n, t)
+    corner_vertex = t.ravel()
+    key = corner_vertex * (3 * m) + fans  # one key per (vertex, fan)
+    keys, fan_index = np.unique(key, return_inverse=True)
+    key_vertex = keys // (3 * m)
+    first = np.ones(len(keys), bool)
+    first[1:] = key_vertex[1:] != key_vertex[:-1]
+    new_id = np.where(first, key_vertex, n + np.cumsum(~first) - 1)
+    origin = np.concatenate([np.arange(n), key_vertex[~first]])
+    return new_id[fan_index.ravel()].reshape(-1, 3), origin
+
+
+def check_pinched_decimation(vertices, triangles, out_vertices, out_triangles, kept):
+    """Violations by a decimation of a surface that is manifold but for pinched vertices: each
+    pinched input vertex must be kept, and splitting every pinched vertex of the input and of
+    the output into one vertex per fan must give a decimation that check_decimation accepts
+    (the same wings, each homeomorphic to its input, nothing lost or merged)."""
+    n = len(vertices)
+    facts = surface_facts(n, triangles)
+    kept = np.asarray(kept)
+    fans_at = _fans_per_vertex(n, triangles)
+    missing = np.setdiff1d(np.flatnonzero(fans_at > 1), kept)
+    problems = [f"pinched input vertices not kept: {missing.tolist()}"] if len(missing) else []
+    ot = np.asarray(out_triangles, dtype=np.int64).reshape(-1, 3)
+    if len(ot) and ((ot[:, 0] == ot[:, 1]) | (ot[:, 1] == ot[:, 2]) | (ot[:, 2] == ot[:, 0])).any():
+        return problems + ["triangle with a repeated corner"]
+    split_in, origin_in = unpinch(n, triangles)
+    split_out, origin_out = unpinch(len(out_vertices), ot)
+    # Each output fan copy maps to the input copy of its vertex on the wing its triangles' other
+    # corners come from (their own input copies, where they have one).
+    in_facts = surface_facts(len(origin_in), split_in)
+    copies = {}
+    for c, v in enumerate(origin_in):
+        copies.setdefault(int(v), []).append(c)
+    split_kept = np.array([copies[int(kept[v])][0] for v in origin_out])
+    for j in np.flatnonzero(np.array([len(copies[int(kept[v])]) > 1 for v in origin_out])):
+        wings = [in_facts["component"][split_kept[x]] for tri in split_out[(split_out == j).any(1)]
+                 for x in tri if x != j and len(copies[int(kept[origin_out[x]])]) == 1]
+        candidates = copies[int(kept[origin_out[j]])]
+        match = [c for c in candidates if wings and in_facts["component"][c] == max(set(wings), key=wings.count)]
+        split_kept[j] = match[0] if match else candidates[0]
+    return problems + check_decimation(np.asarray(vertices)[origin_in], split_in,
+                                       np.asarray(out_vertices)[origin_out], split_out, split_kept, in_facts)

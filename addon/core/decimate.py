@@ -21,6 +21,7 @@ corners of borders) or the topology can push the count over; ``stats.over_budget
 
 from __future__ import annotations
 
+import collections.abc
 import dataclasses
 import math
 import warnings
@@ -65,22 +66,26 @@ class View:
     view_projection: Optional[np.ndarray] = None
     outside_probability: float = 0.0
 
+    def __post_init__(self):
+        self.as_engine()  # refuse bad fields where the view is made (and again where it is used)
+
     def as_engine(self) -> dict:
+        """The engine's view, every field checked (core/params.py): ParameterError names the field."""
         if (self.eye is None) == (self.direction is None):
-            raise TopStocError("a view needs exactly one of eye (perspective) or direction (orthographic)")
+            raise params.ParameterError("a view needs exactly one of eye (perspective) or direction (orthographic)")
         d = {
             "perspective": self.eye is not None,
-            "back_ratio": float(self.back_ratio),
-            "silhouette_angle": float(self.silhouette_angle),
-            "silhouette_falloff": float(self.silhouette_falloff),
-            "outside_probability": float(self.outside_probability),
+            "back_ratio": params.number("view back_ratio", self.back_ratio, 0, 1),
+            "silhouette_angle": params.number("view silhouette_angle (radians)", self.silhouette_angle, 0, math.pi),
+            "silhouette_falloff": params.number("view silhouette_falloff", self.silhouette_falloff, 0),
+            "outside_probability": params.number("view outside_probability", self.outside_probability, 0, 1),
         }
         if self.eye is not None:
-            d["eye"] = np.asarray(self.eye, dtype=np.float64).reshape(3)
+            d["eye"] = params.array("view eye", self.eye, (3,))
         else:
-            d["direction"] = np.asarray(self.direction, dtype=np.float64).reshape(3)
+            d["direction"] = params.array("view direction", self.direction, (3,), nonzero=True)
         if self.view_projection is not None:
-            d["view_projection"] = np.asarray(self.view_projection, dtype=np.float64).reshape(4, 4)
+            d["view_projection"] = params.array("view view_projection", self.view_projection, (4, 4))
         return d
 
 
@@ -95,20 +100,43 @@ class Box:
     world_to_box: np.ndarray
     value: float
 
+    def __post_init__(self):
+        self.as_engine()
+
     @classmethod
     def from_center_size(cls, center, half_size, value: float) -> "Box":
-        """Axis-aligned box from its centre and half extents."""
-        center = np.asarray(center, dtype=np.float64).reshape(3)
-        half = np.asarray(half_size, dtype=np.float64).reshape(3)
+        """Axis-aligned box from its centre and half extents (each > 0)."""
+        center = params.array("box center", center, (3,))
+        half = params.array("box half_size", half_size, (3,))
         if np.any(half <= 0):
-            raise TopStocError("box half sizes must be positive")
+            raise params.ParameterError(f"box half sizes must be positive, got {half.tolist()}")
         m = np.eye(4)
         m[:3, :3] = np.diag(1.0 / half)
         m[:3, 3] = -center / half
         return cls(m, value)
 
     def as_engine(self):
-        return (np.asarray(self.world_to_box, dtype=np.float64).reshape(4, 4), float(self.value))
+        """(world_to_box, value) for the engine, checked (core/params.py)."""
+        return (params.array("box world_to_box", self.world_to_box, (4, 4)),
+                params.number("box value", self.value, -1, 1))
+
+
+def _engine_view(view) -> Optional[dict]:
+    if view is None:
+        return None
+    if not isinstance(view, View):
+        raise params.ParameterError(f"view must be a topstoc View, got {type(view).__name__}")
+    return view.as_engine()
+
+
+def _engine_boxes(boxes) -> Optional[list]:
+    if isinstance(boxes, (Box, str, bytes)) or not isinstance(boxes, collections.abc.Iterable):
+        raise params.ParameterError(f"boxes must be a list of topstoc Box, got {type(boxes).__name__}")
+    boxes = list(boxes)
+    for i, box in enumerate(boxes):
+        if not isinstance(box, Box):
+            raise params.ParameterError(f"boxes[{i}] must be a topstoc Box, got {type(box).__name__}")
+    return [box.as_engine() for box in boxes] or None
 
 
 @dataclass(frozen=True)
@@ -347,8 +375,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
         area_weighted=bool(area_weighted), guidance=u,
         density=density, density_rings=int(density_rings), density_ratio=float(density_ratio),
         density_epsilon=float(density_epsilon),
-        view=view.as_engine() if view is not None else None,
-        boxes=[box.as_engine() for box in boxes] or None, placement=placement,
+        view=_engine_view(view), boxes=_engine_boxes(boxes), placement=placement,
         fast_path=0 if fast_path is None else int(bool(fast_path)),
         max_repair_rounds=int(max_repair_rounds), refine=float(refine))
     return _result(raw, parameters)
@@ -387,5 +414,4 @@ def sampling_probabilities(mesh: Mesh, rate: float, *, adaptivity: float = 0.5,
     layout = mesh.feature_layout(regions, borders)
     return engine.sampling_probabilities(
         mesh.native, layout, float(rate), adaptivity=float(adaptivity), flat_floor=float(flat_floor),
-        guidance=_guidance(mesh, guidance), view=view.as_engine() if view is not None else None,
-        boxes=[box.as_engine() for box in boxes] or None)
+        guidance=_guidance(mesh, guidance), view=_engine_view(view), boxes=_engine_boxes(boxes))

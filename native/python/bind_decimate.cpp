@@ -124,6 +124,7 @@ py::dict result_dict(DecimateResult&& r) {
   check["split_components"] = c.split_components;
   check["euler_changed"] = c.euler_changed;
   check["boundary_loops_changed"] = c.boundary_loops_changed;
+  check["pinched_fans_changed"] = c.pinched_fans_changed;
   d["output_check"] = check;
   py::dict seconds;
   seconds["sampling"] = r.seconds_sampling;

@@ -1,7 +1,9 @@
-// What every reader fuzz target checks (fuzz_read_*.cpp): the reader either throws
-// std::invalid_argument or returns arrays that agree with each other; what it returns is then
-// written back in the same format and read again, and the second read must equal the first in
-// everything the format carries. A writer may refuse only OBJ names that would not read back.
+// What the reader fuzz targets check (fuzz_read_*.cpp, fuzz_round_trip.cpp): the reader either
+// throws std::invalid_argument or returns arrays that agree with each other; what it returns is
+// then written in a format (the same one, or each other one) and read again, and the second
+// read must equal the first in everything the written format carries. A writer may refuse only
+// what no file of that format can hold (an OBJ name that would not read back, a number that is
+// not finite, a coordinate past binary STL's float32 range), and only when the mesh holds it.
 // Any other exception, a disagreement or a sanitizer report ends the run (abort = a crash for
 // libFuzzer, which keeps the input).
 #pragma once
@@ -89,44 +91,87 @@ inline bool same_floats(const std::vector<float>& a, const std::vector<float>& b
   return true;
 }
 
-inline void check_round_trip(const MeshFile& first, MeshFormat format) {
+inline bool carries_colors(MeshFormat f) { return f != MeshFormat::Stl; }
+inline bool carries_uvs(MeshFormat f) { return f == MeshFormat::Obj || f == MeshFormat::Ply; }
+
+// The mesh holds a number `target` carries but no file should (check_numbers_for_writing).
+inline bool has_unwritable_numbers(const MeshFile& mesh, MeshFormat target) {
+  for (double x : mesh.vertices)
+    if (!std::isfinite(x)) return true;
+  if (carries_colors(target))
+    for (double x : mesh.vertex_colors)
+      if (!std::isfinite(x)) return true;
+  if (carries_uvs(target))
+    for (double x : mesh.corner_uvs)
+      if (std::isinf(x)) return true;
+  return false;
+}
+
+// A corner position past float32's range (binary STL).
+inline bool beyond_float32(const MeshFile& mesh) {
+  for (int32_t v : mesh.triangles)
+    for (int k = 0; k < 3; ++k)
+      if (std::isinf(float(mesh.vertices[3 * size_t(v) + k]))) return true;
+  return false;
+}
+
+// Whether a writer's refusal is one of the allowed ones, for this mesh.
+inline bool allowed_refusal(const MeshFile& mesh, MeshFormat target, const char* what) {
+  if (target == MeshFormat::Obj && std::strstr(what, "cannot be written to OBJ")) return true;  // no escapes
+  if (std::strstr(what, "cannot be written: ") && has_unwritable_numbers(mesh, target)) return true;
+  if (target == MeshFormat::Stl && std::strstr(what, "cannot be written to binary STL") && beyond_float32(mesh))
+    return true;
+  return false;
+}
+
+// Writes `first` (as read) in `target`, reads it back and compares what `target` carries.
+inline void check_written_as(const MeshFile& first, MeshFormat target) {
   std::string bytes;
   try {
-    bytes = write_mesh_file(first, format);
+    bytes = write_mesh_file(first, target);
   } catch (const std::invalid_argument& error) {
-    // OBJ has no escapes: names that would read back differently are refused, with a message.
-    if (format == MeshFormat::Obj && std::strstr(error.what(), "cannot be written to OBJ")) return;
-    std::fprintf(stderr, "writer refused a mesh its reader returned: %s\n", error.what());
+    if (allowed_refusal(first, target, error.what())) return;
+    std::fprintf(stderr, "writer refused a mesh a reader returned: %s\n", error.what());
     std::abort();
   }
   MeshFile second;
   try {
-    second = read_mesh_file(bytes.data(), bytes.size(), format);
+    second = read_mesh_file(bytes.data(), bytes.size(), target);
   } catch (const std::invalid_argument& error) {
     std::fprintf(stderr, "written file does not read back: %s\n", error.what());
     std::abort();
   }
   check_consistent(second);
   require(second.warnings.empty(), "written file reads back with warnings");
-  if (format == MeshFormat::Stl) {
-    require(same_floats(float_soup(first), float_soup(second)), "STL round trip: corner positions differ");
+  if (target == MeshFormat::Stl) {  // a float32 triangle soup
+    require(second.triangles.size() == first.triangles.size(), "STL: triangle count differs");
+    require(same_floats(float_soup(first), float_soup(second)), "STL: corner positions differ");
     return;
   }
-  require(same_numbers(first.vertices, second.vertices), "round trip: positions differ");
-  require(first.triangles == second.triangles, "round trip: triangles differ");
-  require(polygon_starts(first) == polygon_starts(second), "round trip: polygons differ");
-  require(first.color_channels == second.color_channels, "round trip: colour channels differ");
-  require(same_numbers(first.vertex_colors, second.vertex_colors), "round trip: colours differ");
-  if (format != MeshFormat::Off) {  // OFF stores no UVs
-    // NaN is "no UV": a file whose UVs are all NaN and one without UVs say the same.
-    require(has_uvs(first) == has_uvs(second), "round trip: UVs appear or vanish");
-    if (has_uvs(first)) require(same_numbers(first.corner_uvs, second.corner_uvs), "round trip: UVs differ");
+  require(same_numbers(first.vertices, second.vertices), "positions differ");
+  require(first.triangles == second.triangles, "triangles differ");
+  require(polygon_starts(first) == polygon_starts(second), "polygons differ");
+  if (carries_colors(target)) {
+    // Without vertices there are no colours to keep: a PLY header may still declare RGBA.
+    if (!first.vertices.empty()) require(first.color_channels == second.color_channels, "colour channels differ");
+    require(same_numbers(first.vertex_colors, second.vertex_colors), "colours differ");
+  } else {
+    require(second.color_channels == 0, "colours appear");
   }
-  if (format == MeshFormat::Obj) {
-    require(triangle_materials(first) == triangle_materials(second), "round trip: materials differ");
-    require(first.material_libraries == second.material_libraries, "round trip: material libraries differ");
+  // NaN is "no UV": a file whose UVs are all NaN and one without UVs say the same.
+  if (carries_uvs(target)) {
+    require(has_uvs(first) == has_uvs(second), "UVs appear or vanish");
+    if (has_uvs(first)) require(same_numbers(first.corner_uvs, second.corner_uvs), "UVs differ");
+  } else {
+    require(!has_uvs(second), "UVs appear");
+  }
+  if (target == MeshFormat::Obj) {
+    require(triangle_materials(first) == triangle_materials(second), "materials differ");
+    require(first.material_libraries == second.material_libraries, "material libraries differ");
   }
 }
+
+inline void check_round_trip(const MeshFile& first, MeshFormat format) { check_written_as(first, format); }
 
 // The whole check for one input: read, and if that succeeds, check and round-trip.
 inline int run(const uint8_t* data, size_t size, MeshFormat format) {

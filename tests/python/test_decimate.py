@@ -221,6 +221,27 @@ def test_serial_and_parallel_runs_agree():
     assert len(set(outputs_by_thread_count(SERIAL_PARALLEL_SCRIPT).values())) == 1
 
 
+SUMS_SCRIPT = """
+import sys
+sys.path[:0] = sys.argv[1:3]
+import meshgen
+from topstoc.core.native import engine
+vertices, triangles = meshgen.icosphere(7)  # 327,680 triangles: above the parallel threshold
+vertices = vertices * (1 + 0.01 * ((vertices * 1e4) % 1))  # uneven, so the order of sums shows
+stats = engine.aspect_ratio_stats(vertices, triangles)
+surface = engine.Surface(vertices, triangles)
+print(stats["mean"].hex(), stats["max"].hex(), engine.step_for_sample_count(surface, 3000000).hex())
+"""
+
+
+def test_parallel_sums_are_the_same_to_the_bit():
+    # The aspect-ratio mean was an OpenMP reduction: its last bits followed the thread count.
+    # (Threads follow the free cores: on a busy machine "2" may run on fewer; the C++ test
+    # test_ordered_sum.cpp sets the team size itself.)
+    outputs = outputs_by_thread_count(SUMS_SCRIPT, counts=("1", "2"))
+    assert outputs["1"] == outputs["2"], outputs
+
+
 def test_concurrent_calls_on_one_mesh_agree_with_serial_ones():
     # The live preview decimates on two threads at once; each call then gets its share of the
     # cores (and the importance table is shared): results must be those of one call at a time.

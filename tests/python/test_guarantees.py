@@ -101,6 +101,84 @@ def test_bowtie_of_two_grids_keeps_both_wings():
         assert (centroid[:, 0] + centroid[:, 1] > 0).any() and (centroid[:, 0] + centroid[:, 1] < 0).any()
 
 
+# --- pinched vertices: every input fan must still be a fan of the output vertex -------------
+
+def assert_pinched_guarantees(vertices, triangles, result):
+    assert result.stats.topology_kept, result.stats.issues_remaining
+    assert not any(v for k, v in result.stats.output_check.items() if k != "zero_area"), result.stats.output_check
+    assert random_manifolds.check_pinched_decimation(vertices, triangles, result.vertices, result.triangles,
+                                                     result.kept) == []
+
+
+def wings(count, size=3):
+    """`count` open fans of `size` triangles around vertex 0 (a bowtie for two, a spider for more)."""
+    angle = lambda w, r: 2 * np.pi * (w + 0.8 * r / size) / count  # noqa: E731
+    v = [[0.0, 0.0, 0.0]] + [[np.cos(angle(w, r)), np.sin(angle(w, r)), 0.1 * w]
+                             for w in range(count) for r in range(size + 1)]
+    t = [[0, 1 + w * (size + 1) + r, 2 + w * (size + 1) + r] for w in range(count) for r in range(size)]
+    return np.array(v), np.array(t)
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_random_pinched_surfaces_keep_every_fan(seed):
+    # 2-4 random surfaces glued at one vertex (a spider of wings) or in a chain
+    vertices, triangles = random_manifolds.pinched_surface(seed)
+    mesh = topstoc.Mesh(vertices, triangles)
+    assert mesh.report().nonmanifold_vertices >= 1
+    rng = np.random.default_rng(seed)
+    for _ in range(6):
+        assert_pinched_guarantees(vertices, triangles, mesh.decimate(**random_parameters(rng)))
+
+
+@pytest.mark.parametrize("count", [2, 3, 6])
+@pytest.mark.parametrize("mode", ["fast", "quality"])
+def test_bowtie_and_spider_keep_their_wings(count, mode):
+    vertices, triangles = wings(count, size=5)
+    mesh = topstoc.Mesh(vertices, triangles)
+    for ratio in (0.05, 0.3, 0.7, 1.0):
+        r = mesh.decimate(ratio=ratio, mode=mode, seed=3)
+        assert r.stats.output_check["pinched_fans_changed"] == 0
+        assert_pinched_guarantees(vertices, triangles, r)
+
+
+def test_independent_pinched_check_sees_a_lost_wing():
+    # what decimate_with_samples returned for the regression below: the first wing alone,
+    # with every count (Euler characteristic 1, one boundary group, one component) unchanged
+    vertices, triangles = wings(2, size=2)
+    kept = [0, 1, 2, 3]
+    problems = random_manifolds.check_pinched_decimation(vertices, triangles, vertices[kept],
+                                                         np.array([[0, 1, 2], [0, 2, 3]]), kept)
+    assert "2 components became 1" in problems
+    joined = random_manifolds.check_pinched_decimation(  # the wings joined into one fan
+        vertices, triangles, vertices, np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5], [0, 5, 6]]), range(7))
+    assert joined
+
+
+@pytest.mark.parametrize("name", ["decimate_pinched_hole_closed", "decimate_pinched_wing_lost"])
+def test_pinched_regressions(name):
+    # Found by tests/stress/decimate_stress.py on pinched surfaces (README in tests/data/regressions)
+    data = np.load(REGRESSIONS / f"{name}.npz")
+    params = json.loads((REGRESSIONS / f"{name}.json").read_text())
+    result = topstoc.Mesh(data["vertices"], data["triangles"]).decimate(**params)
+    assert result.stats.repair_rounds < 50
+    assert_pinched_guarantees(data["vertices"], data["triangles"], result)
+
+
+def test_samples_without_the_pinched_vertex_keep_both_wings():
+    # Regression: a sample list without the bowtie's centre; the second wing's clusters were
+    # absorbed and one wing was returned as success. Corners are now added to the list.
+    data = np.load(REGRESSIONS / "decimate_with_samples_bowtie_wing_lost.npz")
+    samples = json.loads((REGRESSIONS / "decimate_with_samples_bowtie_wing_lost.json").read_text())["samples"]
+    mesh = topstoc.Mesh(data["vertices"], data["triangles"])
+    assert 0 not in samples and mesh.report().nonmanifold_vertices == 1
+    result = mesh.decimate_with_samples(samples)
+    assert 0 in result.kept
+    assert_pinched_guarantees(data["vertices"], data["triangles"], result)
+    # a list that already holds every corner is replayed unchanged
+    again = mesh.decimate_with_samples(result.samples)
+    assert np.array_equal(again.triangles, result.triangles)
+
+
 @pytest.mark.parametrize("scale", [1e-80, 1.0, 1e80, 1e150])
 def test_filtered_placement_stays_finite_at_any_scale(scale):
     vertices, triangles = random_manifolds.random_manifold(11)

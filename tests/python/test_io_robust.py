@@ -132,6 +132,75 @@ def test_reproducer_with_trailing_backslash_is_refused_not_corrupted(tmp_path):
         write_mesh(tmp_path / "copy.obj", data)
 
 
+# --- numbers a format cannot carry ----------------------------------------------------------------
+
+def test_stl_writer_refuses_coordinates_past_float32(tmp_path):
+    # binary STL is float32: 1e39 was written as inf
+    data = triangle_data()
+    data.vertices[3] = [1.0, 1e39, 0.5]
+    with pytest.raises(ValueError, match=r"s.stl: vertex 3 cannot be written to binary STL: coordinate 1e\+39 is "
+                                         r"beyond float32's range \(\+-3.40282e\+38\); scale the mesh, or write PLY"):
+        write_mesh(tmp_path / "s.stl", data)
+    assert not (tmp_path / "s.stl").exists()
+    for suffix in (".ply", ".obj", ".off"):  # doubles: written and read back exactly
+        write_mesh(tmp_path / f"s{suffix}", data)
+        np.testing.assert_array_equal(read_mesh(tmp_path / f"s{suffix}").vertices, data.vertices)
+
+
+def test_stl_keeps_the_largest_float32_and_rounds_below_its_precision(tmp_path):
+    data = triangle_data()
+    big = float(np.finfo(np.float32).max)
+    data.vertices[1] = [big, -big, 1e-50]
+    write_mesh(tmp_path / "s.stl", data)
+    back = read_mesh(tmp_path / "s.stl")
+    corner = back.vertices[back.triangles[0, 1]]
+    assert corner.tolist() == [big, -big, 0.0]  # 1e-50 is below float32's smallest step: 0
+
+
+@pytest.mark.parametrize("suffix", [".obj", ".ply", ".off", ".stl"])
+def test_writers_refuse_non_finite_positions_by_vertex(tmp_path, suffix):
+    for bad in (np.nan, np.inf, -np.inf):
+        data = triangle_data()
+        data.vertices[2, 1] = bad
+        with pytest.raises(ValueError, match=f"vertex 2 cannot be written: coordinate {bad} is not finite"):
+            write_mesh(tmp_path / f"n{suffix}", data)
+        assert not (tmp_path / f"n{suffix}").exists()
+
+
+def test_writers_refuse_non_finite_colours_and_infinite_uvs_where_the_format_carries_them(tmp_path):
+    colours = np.full((4, 3), 0.5)
+    colours[1, 2] = np.nan
+    for suffix in (".obj", ".ply", ".off"):
+        with pytest.raises(ValueError, match="vertex 1 cannot be written: colour nan is not finite"):
+            write_mesh(tmp_path / f"c{suffix}", triangle_data(vertex_colors=colours))
+    write_mesh(tmp_path / "c.stl", triangle_data(vertex_colors=colours))  # STL drops colours
+    uvs = np.full((2, 3, 2), np.nan)  # NaN: corners without a UV (allowed)
+    uvs[0] = [[0, 0], [1, 0], [0, 1]]
+    write_mesh(tmp_path / "u.obj", triangle_data(corner_uvs=uvs))
+    uvs[1, 2, 0] = np.inf
+    for suffix in (".obj", ".ply"):
+        with pytest.raises(ValueError, match=r"triangle 1 corner 2 cannot be written: UV inf is infinite "
+                                             r"\(NaN marks a corner without a UV\)"):
+            write_mesh(tmp_path / f"u{suffix}", triangle_data(corner_uvs=uvs))
+    write_mesh(tmp_path / "u.off", triangle_data(corner_uvs=uvs))  # OFF drops UVs
+
+
+def test_write_errors_are_topstoc_errors(tmp_path):
+    import topstoc
+    data = triangle_data()
+    data.vertices[0, 0] = np.inf
+    with pytest.raises(topstoc.TopStocError, match="vertex 0 cannot be written"):
+        write_mesh(tmp_path / "e.ply", data)
+
+
+def test_a_file_with_nan_reads_but_is_not_written_on(tmp_path):
+    (tmp_path / "nan.obj").write_text("v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    data = read_mesh(tmp_path / "nan.obj")  # read as it is (topstoc.Mesh refuses it by vertex)
+    assert np.isnan(data.vertices[0, 2])
+    with pytest.raises(ValueError, match="vertex 0 cannot be written: coordinate nan is not finite"):
+        write_mesh(tmp_path / "copy.ply", data)
+
+
 @pytest.mark.parametrize("name", ["with spaces inside", "a\rb", "unicodé 材料", "back\\slash inside", "(nul)",
                                   "semi;colon/slash", "x" * 300])
 def test_names_that_can_be_written_read_back_exactly(tmp_path, name):
@@ -202,7 +271,8 @@ def test_every_write_round_trips(tmp_path, seed, suffix):
 
 def test_fuzz_seeds_and_found_inputs_read_or_fail_cleanly_and_round_trip(tmp_path):
     """Every kept fuzz input (tests/fuzz) through the Python API: read or a ValueError; what
-    reads writes back (or is refused by name) and reads back the same."""
+    reads writes back (or is refused: an OBJ name, a number no file should carry) and reads
+    back the same."""
     files = sorted(p for folder in (FUZZ_SEEDS, FUZZ_REGRESSIONS) if folder.exists()
                    for p in folder.rglob("*") if p.is_file())
     assert len(files) >= 15
@@ -221,12 +291,60 @@ def test_fuzz_seeds_and_found_inputs_read_or_fail_cleanly_and_round_trip(tmp_pat
         try:
             write_mesh(out, data)
         except ValueError as error:
-            assert kind == "obj" and "cannot be written to OBJ" in str(error), (path, error)
+            names = kind == "obj" and "cannot be written to OBJ" in str(error)
+            unwritable = (not np.isfinite(data.vertices).all()  # a reader hands "nan" through
+                          or (data.vertex_colors is not None and not np.isfinite(data.vertex_colors).all())
+                          or (data.corner_uvs is not None and np.isinf(data.corner_uvs).any()))
+            numbers = "cannot be written: " in str(error) and unwritable
+            assert names or numbers, (path, error)
             continue
         back, messages = read_quietly(out)
         assert messages == [], path
         if kind != "stl":
             np.testing.assert_array_equal(back.triangles, data.triangles, err_msg=str(path))
+
+
+def test_round_trip_fuzz_inputs_cross_formats(tmp_path):
+    """tests/fuzz's round_trip inputs (first byte: the reader) through the Python API: what reads
+    is written in each other format and reads back with the same counts and, where both formats
+    hold them, the same positions (float32 in STL), colours and UVs."""
+    files = sorted(p for folder in (FUZZ_SEEDS / "round_trip", FUZZ_REGRESSIONS / "round_trip")
+                   if folder.exists() for p in folder.iterdir() if p.is_file())
+    assert len(files) >= 19
+    kinds = ("obj", "ply", "off", "stl")
+    checked = 0
+    for path in files:
+        raw = path.read_bytes()
+        source = kinds[raw[0] % 4]
+        (tmp_path / f"in.{source}").write_bytes(raw[1:])
+        try:
+            data, _ = read_quietly(tmp_path / f"in.{source}")
+        except ValueError:
+            continue
+        for kind in kinds:
+            if kind == source:
+                continue
+            out = tmp_path / f"out.{kind}"
+            try:
+                write_mesh(out, data)
+            except ValueError as error:
+                assert "cannot be written" in str(error), (path, kind, error)
+                continue
+            back, messages = read_quietly(out)
+            assert messages == [], (path, kind)
+            assert len(back.triangles) == len(data.triangles), (path, kind)
+            if kind == "stl":
+                np.testing.assert_array_equal(back.vertices[back.triangles].astype(np.float32),
+                                              data.vertices[data.triangles].astype(np.float32), err_msg=str(path))
+                continue
+            np.testing.assert_array_equal(back.vertices, data.vertices, err_msg=f"{path} -> {kind}")
+            np.testing.assert_array_equal(back.triangles, data.triangles, err_msg=f"{path} -> {kind}")
+            if data.vertex_colors is not None and len(data.vertices):
+                np.testing.assert_array_equal(back.vertex_colors, data.vertex_colors, err_msg=f"{path} -> {kind}")
+            if kind in ("obj", "ply") and data.corner_uvs is not None and not np.isnan(data.corner_uvs).all():
+                np.testing.assert_array_equal(back.corner_uvs, data.corner_uvs, err_msg=f"{path} -> {kind}")
+            checked += 1
+    assert checked >= 30
 
 
 # --- compressed input ---------------------------------------------------------------------------

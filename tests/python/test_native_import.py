@@ -14,7 +14,7 @@ import sysconfig
 
 import pytest
 
-from conftest import BUILD
+from conftest import BUILD, bare_env
 
 STAGED = BUILD / "python" / "topstoc"
 SUFFIX = importlib.machinery.EXTENSION_SUFFIXES[0]  # e.g. .cpython-311-x86_64-linux-gnu.so
@@ -41,7 +41,7 @@ def package(tmp_path) -> pathlib.Path:
 
 def import_native(path: pathlib.Path) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-c", "import topstoc.core.native as n; print(n.engine.__file__)"],
-                          cwd=path, env={"PYTHONPATH": str(path), "PATH": "/usr/bin:/bin"},
+                          cwd=path, env=bare_env(PYTHONPATH=str(path), PATH="/usr/bin:/bin"),
                           capture_output=True, text=True, timeout=60)
 
 

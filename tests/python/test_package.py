@@ -6,6 +6,7 @@ import sys
 import tomllib
 
 import topstoc
+from conftest import bare_env
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
@@ -46,7 +47,7 @@ def test_import_never_needs_bpy():
             "print(m.decimate(ratio=0.5).num_vertices)")
     tests = str(ROOT / "tests")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          env={"PYTHONPATH": f"{pathlib.Path(topstoc.__file__).parents[1]}:{tests}"})
+                          env=bare_env(PYTHONPATH=f"{pathlib.Path(topstoc.__file__).parents[1]}:{tests}"))
     assert done.returncode == 0, done.stderr
     assert int(done.stdout) == 81
 

@@ -176,3 +176,73 @@ def test_sampling_probabilities_rate(mesh):
     np.testing.assert_array_equal(p32, sampling_probabilities(mesh, 0.25))
     with pytest.raises(ValueError, match="rate must be a number, got True"):
         sampling_probabilities(mesh, True)
+
+
+# --- View and Box guidance (decimate.View / decimate.Box) ----------------------------------------
+
+@pytest.mark.parametrize("fields, message", [
+    (dict(eye=[0, 0]), r"view eye must be 3 numbers, got shape \(2,\)"),
+    (dict(eye=[0, 0, float("nan")]), r"view eye must hold finite numbers, got nan at \[2\]"),
+    (dict(eye=[[0, 0], [1]]), "view eye must be 3 numbers, got"),
+    (dict(eye="abc"), "view eye must be 3 numbers, got <U3 values"),
+    (dict(direction=[0, 0, 0]), "view direction must not be zero"),
+    (dict(direction=[True, False, True]), "view direction must be 3 numbers, got booleans"),
+    (dict(direction=[0, np.inf, 1]), r"view direction must hold finite numbers, got inf at \[1\]"),
+    (dict(eye=[0, 0, 5], direction=[0, 0, 1]), "exactly one of eye .* or direction"),
+    (dict(), "exactly one of eye .* or direction"),
+    (dict(eye=[0, 0, 5], back_ratio=True), "view back_ratio must be a number, got True"),
+    (dict(eye=[0, 0, 5], back_ratio=1.5), r"view back_ratio must lie in \[0, 1\], got 1.5"),
+    (dict(eye=[0, 0, 5], silhouette_angle=4), r"view silhouette_angle \(radians\) must lie in \[0, 3.14159"),
+    (dict(eye=[0, 0, 5], silhouette_falloff=float("inf")), r"view silhouette_falloff must lie in \[0, inf\), got inf"),
+    (dict(eye=[0, 0, 5], silhouette_falloff=-0.1), r"view silhouette_falloff must lie in \[0, inf\)"),
+    (dict(eye=[0, 0, 5], outside_probability=np.float32(1.5)), r"outside_probability must lie in \[0, 1\], got 1.5 \(float32\)"),
+    (dict(eye=[0, 0, 5], view_projection=np.eye(3)), r"view view_projection must be a 4 x 4 matrix, got shape \(3, 3\)"),
+    (dict(eye=[0, 0, 5], view_projection=np.full((4, 4), np.nan)), r"view_projection must hold finite numbers, got nan at \[0, 0\]"),
+])
+def test_view_fields_are_checked(fields, message):
+    with pytest.raises(topstoc.TopStocError, match=message):
+        topstoc.View(**fields)
+
+
+def test_view_accepts_numpy_numbers_and_is_checked_again_where_used(mesh):
+    view = topstoc.View(eye=np.float32([0, 0, 5]), back_ratio=np.float32(0.5), silhouette_angle=np.float64(0.3))
+    engine = view.as_engine()
+    assert engine["back_ratio"] == 0.5 and engine["eye"].dtype == np.float64 and engine["eye"].shape == (3,)
+    view.back_ratio = 2.0  # changed after it was made: refused where the decimation uses it
+    with pytest.raises(topstoc.TopStocError, match=r"view back_ratio must lie in \[0, 1\], got 2.0"):
+        mesh.decimate(ratio=0.5, view=view)
+    with pytest.raises(topstoc.TopStocError, match="view must be a topstoc View, got dict"):
+        mesh.decimate(ratio=0.5, view={"eye": [0, 0, 5]})
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda: topstoc.Box(np.eye(4), 2.0), r"box value must lie in \[-1, 1\], got 2.0"),
+    (lambda: topstoc.Box(np.eye(4), float("nan")), r"box value must lie in \[-1, 1\], got nan"),
+    (lambda: topstoc.Box(np.eye(4), True), "box value must be a number, got True"),
+    (lambda: topstoc.Box(np.eye(3), 0.5), r"box world_to_box must be a 4 x 4 matrix, got shape \(3, 3\)"),
+    (lambda: topstoc.Box(np.diag([1, 1, np.inf, 1]), 0.5), r"world_to_box must hold finite numbers, got inf at \[2, 2\]"),
+    (lambda: topstoc.Box.from_center_size([0, 0], [1, 1, 1], 0.5), r"box center must be 3 numbers, got shape \(2,\)"),
+    (lambda: topstoc.Box.from_center_size([0, 0, 0], [1, np.nan, 1], 0.5), r"box half_size must hold finite numbers, got nan at \[1\]"),
+    (lambda: topstoc.Box.from_center_size([0, 0, 0], [1, 0, 1], 0.5), r"box half sizes must be positive, got \[1.0, 0.0, 1.0\]"),
+])
+def test_box_fields_are_checked(make, message):
+    with pytest.raises(topstoc.TopStocError, match=message):
+        make()
+
+
+def test_boxes_must_be_boxes(mesh):
+    box = topstoc.Box.from_center_size([0, 0, 0], [1, 1, 1], np.float32(0.5))
+    assert box.as_engine()[1] == 0.5
+    with pytest.raises(topstoc.TopStocError, match="boxes must be a list of topstoc Box, got Box"):
+        mesh.decimate(ratio=0.5, boxes=box)
+    with pytest.raises(topstoc.TopStocError, match="boxes\\[1\\] must be a topstoc Box, got int"):
+        mesh.decimate(ratio=0.5, boxes=[box, 3])
+    box.value = -3  # changed after it was made
+    with pytest.raises(topstoc.TopStocError, match=r"box value must lie in \[-1, 1\], got -3"):
+        mesh.decimate(ratio=0.5, boxes=(box,))
+
+
+def test_parameter_errors_are_topstoc_errors():
+    with pytest.raises(topstoc.TopStocError):
+        params.number("ratio", True, 0, 1)
+    assert issubclass(params.ParameterError, ValueError)

@@ -5,9 +5,11 @@
 Every result's engine-side final check (stats.output_check) must be clean, and the
 independent numpy check runs on every K-th result (--check-every, default all).
 Meshes come from tests/random_manifolds.py (hulls, tori, grids with holes, icospheres, 1-4 of
-them side by side); each is decimated several times with random ratio, seed, placement,
+them side by side; every PINCHED-th mesh instead 2-4 of them glued at vertices, a spider of
+wings or a chain); each is decimated several times with random ratio, seed, placement,
 refinement, feature angle and fast path. Every result with ``topology_kept`` is checked by
-random_manifolds.check_decimation (numpy/scipy, no topstoc code). Counts, per outcome:
+random_manifolds.check_decimation, or check_pinched_decimation for glued meshes (numpy/scipy,
+no topstoc code). Counts, per outcome:
   ok          topology kept and the independent check agrees
   reported    topology_kept == False (the repair-round limit hit; honest, but counted)
   raised      the engine's final check raised instead of returning
@@ -30,6 +32,14 @@ import random_manifolds  # noqa: E402
 import topstoc  # noqa: E402
 
 DECIMATIONS_PER_MESH = 8
+PINCHED = 4  # every 4th mesh is a pinched surface (mesh index 3, 7, 11, ...)
+
+
+def generated_mesh(mesh_seed):
+    """The mesh for (seed, index), and whether it is a pinched surface."""
+    if mesh_seed[1] % PINCHED == PINCHED - 1:
+        return random_manifolds.pinched_surface(list(mesh_seed)), True
+    return random_manifolds.random_manifold(list(mesh_seed)), False
 
 
 def random_parameters(rng):
@@ -53,7 +63,7 @@ def engine_check_clean(result):
 
 
 def run(count, seed, save=None, quiet=False, check_every=1, progress=0):
-    counts = dict(ok=0, reported=0, raised=0, unreported=0, crashed=0, independently_checked=0)
+    counts = dict(ok=0, reported=0, raised=0, unreported=0, crashed=0, independently_checked=0, pinched=0)
     rng = np.random.default_rng(seed)
     start = time.time()
     done = 0
@@ -61,9 +71,9 @@ def run(count, seed, save=None, quiet=False, check_every=1, progress=0):
     while done < count:
         mesh_seed = (seed, mesh_index)
         mesh_index += 1
-        vertices, triangles = random_manifolds.random_manifold(list(mesh_seed))
+        (vertices, triangles), pinched = generated_mesh(mesh_seed)
         mesh = topstoc.Mesh(vertices, triangles)
-        before = random_manifolds.surface_facts(len(vertices), triangles)
+        before = None if pinched else random_manifolds.surface_facts(len(vertices), triangles)
         for _ in range(min(DECIMATIONS_PER_MESH, count - done)):
             params = random_parameters(rng)
             outcome, detail = "ok", ""
@@ -75,8 +85,12 @@ def run(count, seed, save=None, quiet=False, check_every=1, progress=0):
                     problems = [] if engine_check_clean(r) else [f"engine check: {r.stats.output_check}"]
                     if done % check_every == 0:
                         counts["independently_checked"] += 1
-                        problems += random_manifolds.check_decimation(vertices, triangles, r.vertices,
-                                                                      r.triangles, r.kept, before)
+                        if pinched:
+                            problems += random_manifolds.check_pinched_decimation(vertices, triangles, r.vertices,
+                                                                                  r.triangles, r.kept)
+                        else:
+                            problems += random_manifolds.check_decimation(vertices, triangles, r.vertices,
+                                                                          r.triangles, r.kept, before)
                     if problems:
                         outcome, detail = "unreported", "; ".join(problems)
             except RuntimeError as error:
@@ -84,6 +98,7 @@ def run(count, seed, save=None, quiet=False, check_every=1, progress=0):
             except Exception as error:  # noqa: BLE001 - everything else is a crash to report
                 outcome, detail = "crashed", f"{type(error).__name__}: {error}"
             counts[outcome] += 1
+            counts["pinched"] += pinched
             done += 1
             if progress and done % progress == 0:
                 print(json.dumps({**counts, "decimations": done, "seconds": round(time.time() - start, 1)}),

@@ -1,5 +1,5 @@
 #include "topstoc/core/quality.hpp"
-#include "topstoc/core/parallel.hpp"
+#include "ordered_sum.hpp"
 
 #include <cmath>
 #include <limits>
@@ -22,25 +22,36 @@ double aspect_ratio(const double* a, const double* b, const double* c) {
 }
 
 AspectStats aspect_ratio_stats(const double* positions, const int32_t* triangles, int64_t num_triangles) {
+  struct Partial {
+    double sum = 0.0, max = 0.0;
+    int64_t counted = 0, degenerate = 0;
+  };
+  // Fixed blocks summed in order (ordered_sum.hpp): the mean is the same to the bit on any
+  // number of threads (an OpenMP reduction's last bits followed the thread count).
+  const Partial total = ordered_reduce<Partial>(
+      num_triangles,
+      [&](Partial& p, int64_t t) {
+        const int32_t* tri = triangles + 3 * t;
+        const double ar = aspect_ratio(positions + 3 * size_t(tri[0]), positions + 3 * size_t(tri[1]),
+                                       positions + 3 * size_t(tri[2]));
+        if (std::isinf(ar)) {
+          ++p.degenerate;
+        } else {
+          p.sum += ar;
+          ++p.counted;
+          p.max = ar > p.max ? ar : p.max;
+        }
+      },
+      [](Partial& into, const Partial& p) {
+        into.sum += p.sum;
+        into.counted += p.counted;
+        into.degenerate += p.degenerate;
+        into.max = p.max > into.max ? p.max : into.max;
+      });
   AspectStats stats;
-  double sum = 0.0, max = 0.0;
-  int64_t counted = 0, degenerate = 0;
-#pragma omp parallel for schedule(static) reduction(+ : sum, counted, degenerate) reduction(max : max) if (num_triangles >= kParallelMin)
-  for (int64_t t = 0; t < num_triangles; ++t) {
-    const int32_t* tri = triangles + 3 * t;
-    const double ar = aspect_ratio(positions + 3 * size_t(tri[0]), positions + 3 * size_t(tri[1]),
-                                   positions + 3 * size_t(tri[2]));
-    if (std::isinf(ar)) {
-      ++degenerate;
-    } else {
-      sum += ar;
-      ++counted;
-      max = ar > max ? ar : max;
-    }
-  }
-  stats.mean = counted ? sum / double(counted) : 0.0;
-  stats.max = max;
-  stats.degenerate = static_cast<int32_t>(degenerate);
+  stats.mean = total.counted ? total.sum / double(total.counted) : 0.0;
+  stats.max = total.max;
+  stats.degenerate = static_cast<int32_t>(total.degenerate);
   return stats;
 }
 

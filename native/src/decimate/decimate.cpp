@@ -523,6 +523,14 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
       throw std::invalid_argument("sample " + std::to_string(i) + " is vertex " + std::to_string(v) +
                                   ", which lies in no triangle");
   }
+  // Corners (feature corners, pinched vertices) are always kept, as decimate() keeps them: a
+  // list from a finished decimation holds them all, and a list without a bowtie's centre lost
+  // a whole wing (the wing's clusters were absorbed and every count stayed the same). Missing
+  // ones are appended, so the given samples keep their ranks.
+  std::vector<uint8_t> listed(mesh.num_vertices(), 0);
+  for (int32_t v : samples) listed[v] = 1;
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+    if (layout.vertex_corner[v] && !listed[v]) samples.push_back(v);
   DecimateResult result;
   result.target_vertices = static_cast<int32_t>(samples.size());
   result.selected = result.target_vertices;

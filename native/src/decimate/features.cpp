@@ -1,11 +1,13 @@
 #include "topstoc/decimate/features.hpp"
 #include "topstoc/core/parallel.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "core/fans.hpp"
+#include "pinched_fans.hpp"
 
 namespace topstoc {
 
@@ -180,38 +182,75 @@ void trace_curves(const Mesh& mesh, FeatureLayout& layout) {
   }
 }
 
+// Boundary loops as cycles of boundary edges. At a vertex the two boundary edges of one fan
+// continue each other; at a pinched vertex (several open fans) each fan's pair is its own
+// passage, so a hole whose rim runs through a pinch stays a loop of its own. (Joining every
+// boundary edge at a shared vertex merged that hole with the other wing's rim: the merged loop
+// met three clusters while the hole met two and closed up, with nothing local to split.)
 void collect_boundary_loops(const Mesh& mesh, FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
   const auto& ev = mesh.edge_vertices();
-  std::vector<int32_t> parent(n);
-  for (int32_t v = 0; v < n; ++v) parent[v] = v;
+  const auto& ao = mesh.adjacency_offsets();
+  const auto& ae = mesh.adjacency_edge();
+  std::vector<int32_t> boundary_edges;
+  for (int32_t e = 0; e < mesh.num_edges(); ++e)
+    if (mesh.edge_face_count(e) == 1) boundary_edges.push_back(e);
+  if (boundary_edges.empty()) return;
+  std::vector<int32_t> slot_of(mesh.num_edges(), -1);  // boundary edge -> index in boundary_edges
+  for (size_t i = 0; i < boundary_edges.size(); ++i) slot_of[boundary_edges[i]] = int32_t(i);
+  std::vector<int32_t> parent(boundary_edges.size());
+  for (size_t i = 0; i < parent.size(); ++i) parent[i] = int32_t(i);
   auto find = [&](int32_t x) {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
   };
-  std::vector<uint8_t> on_boundary(n, 0);
-  bool any = false;
-  for (int32_t e = 0; e < mesh.num_edges(); ++e)
-    if (mesh.edge_face_count(e) == 1) {
-      const int32_t a = ev[2 * size_t(e)], b = ev[2 * size_t(e) + 1];
-      on_boundary[a] = on_boundary[b] = 1;
-      any = true;
-      const int32_t ra = find(a), rb = find(b);
-      if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+  auto unite = [&](int32_t a, int32_t b) {
+    const int32_t ra = find(a), rb = find(b);
+    if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+  };
+  std::vector<int32_t> fan_of_slot, at_vertex, fan_of_edge;
+  for (int32_t v = 0; v < n; ++v) {
+    at_vertex.clear();
+    for (int32_t i = ao[v]; i < ao[v + 1]; ++i)
+      if (slot_of[ae[i]] >= 0) at_vertex.push_back(ae[i]);
+    if (at_vertex.size() < 2) continue;
+    if (mesh.manifold_vertex()[v]) {  // one fan: its two boundary edges
+      for (size_t k = 1; k < at_vertex.size(); ++k) unite(slot_of[at_vertex[0]], slot_of[at_vertex[k]]);
+      continue;
     }
-  if (!any) return;
-  // Group the boundary vertices by root, loops in order of their lowest vertex.
-  std::vector<int32_t> loop_of(n, -1), sizes;
-  for (int32_t v = 0; v < n; ++v)
-    if (on_boundary[v] && find(v) == v) loop_of[v] = int32_t(sizes.size()), sizes.push_back(0);
-  for (int32_t v = 0; v < n; ++v)
-    if (on_boundary[v]) ++sizes[loop_of[find(v)]];
-  layout.boundary_loop_offsets.assign(sizes.size() + 1, 0);
-  for (size_t i = 0; i < sizes.size(); ++i) layout.boundary_loop_offsets[i + 1] = layout.boundary_loop_offsets[i] + sizes[i];
-  layout.boundary_loop_vertices.resize(layout.boundary_loop_offsets.back());
-  std::vector<int32_t> fill(layout.boundary_loop_offsets.begin(), layout.boundary_loop_offsets.end() - 1);
-  for (int32_t v = 0; v < n; ++v)
-    if (on_boundary[v]) layout.boundary_loop_vertices[fill[loop_of[find(v)]]++] = v;
+    vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot);
+    fan_of_edge.clear();
+    for (int32_t e : at_vertex) {  // the fan of the edge's one face
+      const int32_t f = mesh.edge_faces()[mesh.edge_face_offsets()[e]];
+      int32_t fan = -1;
+      for (int32_t i = mesh.vertex_face_offsets()[v]; i < mesh.vertex_face_offsets()[v + 1]; ++i)
+        if (mesh.vertex_faces()[i] == f) fan = fan_of_slot[i - mesh.vertex_face_offsets()[v]];
+      fan_of_edge.push_back(fan);
+    }
+    for (size_t k = 0; k < at_vertex.size(); ++k)
+      for (size_t j = 0; j < k; ++j)
+        if (fan_of_edge[j] == fan_of_edge[k]) unite(slot_of[at_vertex[j]], slot_of[at_vertex[k]]);
+  }
+  // Loops in order of their lowest edge (so of their lowest vertex on manifold meshes), each
+  // as the set of its vertices.
+  std::vector<int32_t> loop_of(boundary_edges.size(), -1);
+  int32_t loops = 0;
+  for (size_t i = 0; i < boundary_edges.size(); ++i)
+    if (find(int32_t(i)) == int32_t(i)) loop_of[i] = loops++;
+  std::vector<std::vector<int32_t>> vertices(loops);
+  for (size_t i = 0; i < boundary_edges.size(); ++i) {
+    auto& list = vertices[loop_of[find(int32_t(i))]];
+    list.push_back(ev[2 * size_t(boundary_edges[i])]);
+    list.push_back(ev[2 * size_t(boundary_edges[i]) + 1]);
+  }
+  layout.boundary_loop_offsets.assign(1, 0);
+  layout.boundary_loop_vertices.clear();
+  for (auto& list : vertices) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    layout.boundary_loop_vertices.insert(layout.boundary_loop_vertices.end(), list.begin(), list.end());
+    layout.boundary_loop_offsets.push_back(int32_t(layout.boundary_loop_vertices.size()));
+  }
 }
 
 }  // namespace
@@ -226,6 +265,11 @@ std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, cons
   compute_sectors_and_corners(mesh, *layout);
   trace_curves(mesh, *layout);
   collect_boundary_loops(mesh, *layout);
+  PinchedVertices pinched = find_pinched_vertices(mesh);
+  if (pinched.count > 0) {
+    layout->vertex_pinched = std::move(pinched.pinched);
+    layout->face_sheet = face_sheets(mesh);
+  }
   return layout;
 }
 

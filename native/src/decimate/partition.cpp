@@ -2,6 +2,7 @@
 #include "topstoc/core/parallel.hpp"
 #include "../core/fans.hpp"
 #include "link_arcs.hpp"
+#include "pinched_fans.hpp"
 
 #include <omp.h>
 
@@ -203,7 +204,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // counting only samples that keep a triangle. A triangle emitted twice shows up as a repeated
   // or reversed arc; such samples are set aside and settled after the pass (see below).
   const int32_t num_components = mesh.num_components();
-  auto input_fans = [&](int32_t v) {  // fans of the input around v, nothing blocked
+  auto input_fan_count = [&](int32_t v) {  // fans of the input around v, nothing blocked
     std::vector<int32_t> fan_of_slot;
     return vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot);
   };
@@ -214,6 +215,36 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   std::vector<std::vector<uint64_t>> seen_pairs(threads);
   std::vector<std::vector<int32_t>> repeated_lists(threads);
   int32_t bad_link = 0, bad_edge = 0, isolated = 0, absorbed = 0;
+  // At a pinched sample each input fan must come out as a fan of its own sheet: the arcs from
+  // one sheet's faces form that sheet's fans (as many open and closed), and no fan mixes
+  // sheets. Counting the fans alone let a small wing vanish while another wing, split at the
+  // pinch, made up the count.
+  auto pinched_link_kept = [&](int32_t s, const LinkArcs& link) {
+    const int32_t v = samples[s];
+    if (layout.vertex_pinched.empty() || !layout.vertex_pinched[v]) return link.fans() == input_fan_count(v);
+    const auto fans = input_fans(mesh, layout.face_sheet, v);
+    if (link.fans() != int32_t(fans.size())) return false;
+    std::vector<int32_t> sheets;
+    for (const Fan& f : fans) sheets.push_back(f.sheet);
+    std::sort(sheets.begin(), sheets.end());
+    sheets.erase(std::unique(sheets.begin(), sheets.end()), sheets.end());
+    LinkArcs part;
+    int32_t arcs_on_sheets = 0;
+    for (int32_t sheet : sheets) {
+      part.clear();
+      for (int32_t i = arc_offsets[s]; i < arc_offsets[s + 1]; ++i)
+        if ((!any_dropped || !drop[arcs[i].triangle]) && layout.face_sheet[out.source_face[arcs[i].triangle]] == sheet)
+          part.add(arcs[i].from, arcs[i].to);
+      arcs_on_sheets += part.arcs;
+      if (part.repeated()) return false;
+      int32_t open = 0, closed = 0, paths = 0;
+      for (const Fan& f : fans)
+        if (f.sheet == sheet) ++(f.closed ? closed : open);
+      for (const auto& nb : part.neighbours) paths += nb.in == 0;
+      if (paths != open || part.fans() - paths != closed) return false;
+    }
+    return arcs_on_sheets == link.arcs;
+  };
   // Returns false (and changes nothing) when the link repeats a triangle.
   auto evaluate = [&](int32_t s, LinkArcs& link, std::vector<uint64_t>& seen, int32_t& links, int32_t& edges,
                       int32_t& lonely, int32_t& eaten) {
@@ -250,7 +281,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     if (mesh.manifold_vertex()[samples[s]] && !link.single_fan()) {
       ++links;
       marks.add(s);
-    } else if (!mesh.manifold_vertex()[samples[s]] && link.fans() != input_fans(samples[s])) {
+    } else if (!mesh.manifold_vertex()[samples[s]] && !pinched_link_kept(s, link)) {
       // A pinched vertex (a bowtie's centre) keeps one fan per fan of the input; with one
       // lost, a whole wing is gone although the Euler characteristic may not show it.
       ++links;

@@ -6,6 +6,7 @@
 
 #include "../core/union_find.hpp"
 #include "link_arcs.hpp"
+#include "pinched_fans.hpp"
 
 namespace topstoc {
 
@@ -43,6 +44,7 @@ std::string OutputCheck::describe() const {
   add_count(text, split_components, "input components split apart");
   add_count(text, euler_changed, "components whose Euler characteristic changed");
   add_count(text, boundary_loops_changed, "components whose boundary loops changed");
+  add_count(text, pinched_fans_changed, "pinched vertices whose fans changed");
   return text;
 }
 
@@ -64,10 +66,14 @@ OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const st
         !std::isfinite(positions[3 * size_t(v) + 2]))
       ++check.nonfinite;
 
-  // Which input components are manifold, oriented surfaces (the guarantee's domain).
+  // Which input components are manifold, oriented surfaces (the guarantee's domain), allowing
+  // pinched vertices: their fans are compared one by one below.
+  const PinchedVertices pinched = find_pinched_vertices(mesh);
   std::vector<uint8_t> manifold(num_components, 1);
   for (int32_t v = 0; v < mesh.num_vertices(); ++v)
     if (mesh.component()[v] >= 0 && !mesh.manifold_vertex()[v]) manifold[mesh.component()[v]] = 0;
+  for (int32_t comp = 0; comp < num_components && pinched.count > 0; ++comp)
+    if (pinched.pinched_surface[comp]) manifold[comp] = 1;
   std::vector<int32_t> component_of(n);
   for (int32_t v = 0; v < n; ++v) component_of[v] = mesh.component()[kept[v]];
 
@@ -137,7 +143,8 @@ OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const st
         boundary.unite(v, nb.id);
       }
     }
-    if (manifold[comp] && !crowded && !link.single_fan()) ++check.nonmanifold_vertices;
+    const bool pinched_input = pinched.count > 0 && pinched.pinched[kept[v]];
+    if (manifold[comp] && !crowded && !pinched_input && !link.single_fan()) ++check.nonmanifold_vertices;
   }
   std::vector<int32_t> roots(num_components, -1), loops(num_components, 0);
   for (int32_t v = 0; v < n; ++v) {
@@ -151,13 +158,20 @@ OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const st
     }
     if (on_boundary[v] && boundary.find(v) == v) ++loops[comp];
   }
-  const auto input_loops = component_boundary_loops(mesh, layout);
+  auto input_loops = component_boundary_loops(mesh, layout);
+  if (pinched.count > 0) {
+    // Loops touching at a pinch are one group of boundary edges, as counted on the output.
+    const auto groups = boundary_edge_groups(mesh);
+    for (int32_t comp = 0; comp < num_components; ++comp)
+      if (pinched.pinched_surface[comp]) input_loops[comp] = groups[comp];
+  }
   for (int32_t comp = 0; comp < num_components; ++comp) {
     if (roots[comp] == -2) ++check.split_components;
     if (!manifold[comp] || triangles_in[comp] == 0) continue;
     if (euler[comp] != mesh.component_euler()[comp]) ++check.euler_changed;
     if (loops[comp] != input_loops[comp]) ++check.boundary_loops_changed;
   }
+  check.pinched_fans_changed = changed_pinched_fans(mesh, pinched, kept, triangles);
   return check;
 }
 

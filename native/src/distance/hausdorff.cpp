@@ -2,6 +2,7 @@
 #include "topstoc/distance/bounded_max.hpp"
 #include "topstoc/core/validate.hpp"
 #include "topstoc/core/parallel.hpp"
+#include "../core/ordered_sum.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -77,16 +78,16 @@ int64_t used_vertex_count(const Surface& s) {
 }
 
 // Samples sample_surface would make for `step` (as a double: it may be huge).
+// Summed in fixed blocks (ordered_sum.hpp): the terms are whole numbers, exact in any order below
+// 2^53, but an absurd step's count (reported in the error message) would otherwise round
+// differently on different thread counts.
 double sample_count(const Lengths& l, int64_t vertices, double step) {
-  double edge_samples = 0.0, face_samples = 0.0;
-  const int64_t num_edges = int64_t(l.edge.size()), m = int64_t(l.longest.size());
-#pragma omp parallel for schedule(static) reduction(+ : edge_samples) if(num_edges >= kParallelMin)
-  for (int64_t i = 0; i < num_edges; ++i) edge_samples += divisions(l.edge[i], step) - 1.0;
-#pragma omp parallel for schedule(static) reduction(+ : face_samples) if(m >= kParallelMin)
-  for (int64_t f = 0; f < m; ++f) {
+  const double edge_samples =
+      ordered_sum(int64_t(l.edge.size()), [&](int64_t i) { return divisions(l.edge[i], step) - 1.0; });
+  const double face_samples = ordered_sum(int64_t(l.longest.size()), [&](int64_t f) {
     const double n = divisions(l.longest[f], step);
-    face_samples += n * n;
-  }
+    return n * n;
+  });
   return double(vertices) + edge_samples + face_samples;
 }
 

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <stdexcept>
 
@@ -86,6 +88,31 @@ void validate_for_writing(const MeshFile& mesh) {
   // Names matter to OBJ only, which checks them itself (obj_name_problem).
 }
 
+// A reader may hand NaN or infinity through (an OBJ "nan"), but no file should carry them on:
+// other programs read them as garbage or not at all.
+void check_numbers_for_writing(const MeshFile& mesh, bool colors, bool uvs) {
+  const auto fail = [](const std::string& message) { throw std::invalid_argument(message); };
+  for (size_t i = 0; i < mesh.vertices.size(); ++i)
+    if (!std::isfinite(mesh.vertices[i]))
+      fail("vertex " + std::to_string(i / 3) + " cannot be written: coordinate " + shown_number(mesh.vertices[i]) +
+           " is not finite");
+  for (size_t i = 0; colors && i < mesh.vertex_colors.size(); ++i)
+    if (!std::isfinite(mesh.vertex_colors[i]))
+      fail("vertex " + std::to_string(i / mesh.color_channels) + " cannot be written: colour " +
+           shown_number(mesh.vertex_colors[i]) + " is not finite");
+  for (size_t i = 0; uvs && i < mesh.corner_uvs.size(); ++i)
+    if (std::isinf(mesh.corner_uvs[i]))
+      fail("triangle " + std::to_string(i / 6) + " corner " + std::to_string(i / 2 % 3) +
+           " cannot be written: UV " + shown_number(mesh.corner_uvs[i]) +
+           " is infinite (NaN marks a corner without a UV)");
+}
+
+std::string shown_number(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", x);
+  return buffer;
+}
+
 }  // namespace io_detail
 
 MeshFile read_mesh_file(const char* data, size_t size, MeshFormat format) {
@@ -100,6 +127,9 @@ MeshFile read_mesh_file(const char* data, size_t size, MeshFormat format) {
 
 std::string write_mesh_file(const MeshFile& mesh, MeshFormat format) {
   io_detail::validate_for_writing(mesh);
+  // Numbers are checked where the format carries them (OFF has no UVs, STL only positions).
+  const bool colors = format != MeshFormat::Stl, uvs = format == MeshFormat::Obj || format == MeshFormat::Ply;
+  io_detail::check_numbers_for_writing(mesh, colors, uvs);
   switch (format) {
     case MeshFormat::Obj: return io_detail::write_obj(mesh);
     case MeshFormat::Ply: return io_detail::write_ply(mesh);

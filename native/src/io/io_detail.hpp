@@ -163,6 +163,14 @@ void group_corners(const PolygonGroup& group, std::vector<int64_t>& corners);
 /// Checks array sizes and index ranges of a mesh about to be written.
 void validate_for_writing(const MeshFile& mesh);
 
+/// Checks the numbers a format carries (positions always; colours, UVs when asked): no file
+/// should carry a coordinate or colour that is not finite, nor an infinite UV (NaN is a corner
+/// without one). Refusals say "cannot be written" and name the vertex or corner.
+void check_numbers_for_writing(const MeshFile& mesh, bool colors, bool uvs);
+
+/// "%.6g" of a number, for messages (1e-09, 3.40282e+38, nan).
+std::string shown_number(double x);
+
 /// Why `name` (a usemtl material when `material`, else an mtllib argument) would not read back
 /// from an OBJ file exactly as written; empty when it would. The reader takes the rest of the
 /// line, comments ('#') removed, a trailing '\\' joining the next line, white space trimmed,

@@ -186,7 +186,18 @@ std::string write_stl(const MeshFile& mesh) {
     for (double& x : normal) x = length > 0 ? x / length : 0.0;
     for (double x : normal) store_f32_le(out, float(x));
     for (int c = 0; c < 3; ++c)
-      for (int k = 0; k < 3; ++k) store_f32_le(out, float(p[c][k]));
+      for (int k = 0; k < 3; ++k) {
+        // float32: past its range a coordinate would be written as infinity. (Below its
+        // precision values round, to zero under 1.4e-45: that is the format's precision.)
+        const float x = float(p[c][k]);
+        if (std::isinf(x))
+          throw std::invalid_argument("vertex " + std::to_string(mesh.triangles[3 * t + c]) +
+                                      " cannot be written to binary STL: coordinate " + shown_number(p[c][k]) +
+                                      " is beyond float32's range (+-" +
+                                      shown_number(std::numeric_limits<float>::max()) +
+                                      "); scale the mesh, or write PLY, OBJ or OFF, which keep doubles");
+        store_f32_le(out, x);
+      }
     out += '\0';
     out += '\0';
   }

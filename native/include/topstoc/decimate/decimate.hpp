@@ -73,7 +73,8 @@ struct DecimateResult {
 DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params);
 
 /// Re-creates a decimation from a saved sample list (thesis 4.1.3). A refined result also
-/// needs its refine_vertices and the guidance it was made with.
+/// needs its refine_vertices and the guidance it was made with. Corners the list lacks (feature
+/// corners, pinched vertices: always kept) are appended to it.
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                      Placement placement, int32_t max_repair_rounds = 200,
                                      int32_t refine_vertices = 0, const double* guidance = nullptr);

@@ -54,10 +54,17 @@ struct FeatureLayout {
   std::vector<int32_t> curve_vertices;
   std::vector<uint8_t> curve_closed;
   std::vector<int32_t> vertex_curve;  ///< curve of each non-corner feature vertex, else -1
-  /// Mesh boundary loops (connected sets of edges with one triangle), as vertex sets: each must
-  /// meet three clusters or it closes up in the output, whatever corners split it into curves.
+  /// Mesh boundary loops (cycles of edges with one triangle, continued at a vertex within one
+  /// fan: loops touching at a pinch stay apart), as vertex sets: each must meet three clusters
+  /// or it closes up in the output, whatever corners split it into curves.
   std::vector<int32_t> boundary_loop_offsets{0};
   std::vector<int32_t> boundary_loop_vertices;
+  /// Only when the mesh has pinched vertices (else empty): which vertices are pinched (several
+  /// fans, every edge at them one- or two-sided and consistently oriented) and the sheet of
+  /// every face (faces joined across two-face edges), so that the partition check can ask each
+  /// fan of a pinched sample to stay on its own sheet.
+  std::vector<uint8_t> vertex_pinched;
+  std::vector<int32_t> face_sheet;
   /// 6 * (sectors - (sum of incident edge copies) / 2 + incident faces / 3): summed over a
   /// cluster's vertices it gives six times the cluster's Euler characteristic up to the terms
   /// of edges and faces shared with other clusters (see partition.cpp).

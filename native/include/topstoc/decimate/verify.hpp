@@ -2,10 +2,13 @@
 //
 // The partition checks (partition.hpp) decide where to add samples; this check is independent of
 // them and reads only the output arrays, so a blind spot there cannot turn into a silent lie.
-// Per input component whose surface is manifold and consistently oriented, the output piece
+// Per input component whose surface is manifold and consistently oriented (or would be, but for
+// pinched vertices), the output piece
 // must be one connected, manifold (edges and vertices), consistently oriented surface with the
 // input's Euler characteristic and number of boundary loops: by the classification of surfaces
-// that makes it homeomorphic to the input. For every component: no triangle with a repeated
+// that makes it homeomorphic to the input. At each pinched input vertex every fan must still be
+// a fan of its output vertex (same count, open or closed, same sheet: pinched_fans.hpp), since
+// no count above sees a bowtie's wing lost or merged there. For every component: no triangle with a repeated
 // corner, none twice, no coordinate that is not finite. Zero-area triangles are counted (the
 // decimation reports them; an input of collinear vertices may not allow removing them all).
 #pragma once
@@ -32,12 +35,13 @@ struct OutputCheck {
   int32_t split_components = 0;       ///< input components whose output falls apart
   int32_t euler_changed = 0;          ///< manifold input components whose Euler characteristic changed
   int32_t boundary_loops_changed = 0; ///< manifold input components whose number of boundary loops changed
+  int32_t pinched_fans_changed = 0;   ///< pinched input vertices whose fans are not those of their output vertex
 
   /// Everything but zero_area: a violation of a promised guarantee.
   int32_t violations() const {
     return nonfinite + repeated_corner + duplicate + nonmanifold_edges + nonmanifold_vertices +
            inconsistent_edges + mixed_triangles + lost_components + split_components + euler_changed +
-           boundary_loops_changed;
+           boundary_loops_changed + pinched_fans_changed;
   }
   /// "3 non-manifold edges, 1 component whose Euler characteristic changed", or "" when clean.
   std::string describe() const;
