@@ -32,10 +32,12 @@ py::dict report_dict(const MeshReport& r) {
 void bind_mesh(py::module_& m) {
   py::class_<Mesh, std::shared_ptr<Mesh>>(m, "Mesh", "Prepared triangle mesh (validated, with adjacency and weights).")
       .def(py::init([](const py::handle& vertices, const py::handle& triangles) {
-             auto positions = positions_from(vertices, "vertices");
-             auto tris = indices_from(triangles, 3, "triangles");
+             // The caller's buffers are read in place when they already are float64 and int32.
+             const auto positions = positions_array(vertices, "vertices");
+             const auto tris = indices_array(triangles, 3, "triangles");
              EngineCall call;
-             return std::make_shared<Mesh>(std::move(positions), tris.data(), int64_t(tris.size() / 3));
+             return std::make_shared<Mesh>(positions.data(), int64_t(positions.size() / 3), tris.data(),
+                                           int64_t(tris.size() / 3));
            }),
            py::arg("vertices"), py::arg("triangles"))
       .def_property_readonly("num_vertices", &Mesh::num_vertices)

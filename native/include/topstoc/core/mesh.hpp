@@ -39,7 +39,9 @@ struct MeshReport {
 class Mesh {
  public:
   /// positions: 3n coordinates; triangles: 3m vertex indices. Throws std::invalid_argument.
-  Mesh(std::vector<double> positions, const int32_t* triangles, int64_t num_triangles);
+  Mesh(const std::vector<double>& positions, const int32_t* triangles, int64_t num_triangles);
+  /// The same from the caller's buffers (read during construction only, never kept).
+  Mesh(const double* positions, int64_t num_vertices, const int32_t* triangles, int64_t num_triangles);
 
   int32_t num_vertices() const { return num_vertices_; }
   int32_t num_faces() const { return static_cast<int32_t>(faces_.size() / 3); }
@@ -95,15 +97,11 @@ class Mesh {
 
  private:
   void validate_and_copy_faces(const int32_t* triangles, int64_t num_triangles);
-  void reorder_for_locality(const double* lo, const double* hi);
+  void reorder_for_locality(const double* positions, const double* lo, const double* hi);
+  void drop_duplicate_faces(const std::vector<int32_t>& lowest_offsets);
   void build_vertex_faces();
+  /// The one-ring pass: adjacency, edges, normals, areas, weights, manifoldness, components.
   void build_adjacency_and_edges();
-  void build_edge_faces();
-  void compute_normals_and_weights();
-  void compute_components_and_manifoldness();
-  /// Whether the triangles around v form one fan, given that every edge at v has at most two
-  /// triangles, oriented consistently.
-  bool one_oriented_fan(int32_t v) const;
 
   int32_t num_vertices_ = 0;
   std::vector<double> positions_;
@@ -115,7 +113,7 @@ class Mesh {
   double mean_weight_ = 0.0, diagonal_ = 0.0, mean_vertex_area_ = 0.0;
   std::vector<int32_t> component_;
   std::vector<int64_t> component_euler_;
-  std::vector<uint8_t> manifold_vertex_, inconsistent_edge_;
+  std::vector<uint8_t> manifold_vertex_;
   MeshReport report_;
 };
 
