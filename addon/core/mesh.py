@@ -96,22 +96,30 @@ class Mesh:
     def __init__(self, vertices, triangles):
         vertices = as_vertices(vertices)
         triangles = _as_triangles(triangles)
+        # The engine copies what it needs (reading float64 and int32 arrays in place) and can
+        # give the caller's arrays back: the read-only copies below are made on first use only.
         self._native = engine.Mesh(vertices, triangles)
-        self._vertices = np.array(vertices, dtype=np.float64)
-        self._vertices.setflags(write=False)
-        self._triangles = np.array(triangles, dtype=np.int64).astype(np.int32)
-        self._triangles.setflags(write=False)
+        self._vertices = None
+        self._triangles = None
         self._layouts: dict = {}
 
     # -- the caller's data, read-only --------------------------------------------------------
     @property
     def vertices(self) -> np.ndarray:
         """(n, 3) float64 positions as given (read-only copy)."""
+        if self._vertices is None:
+            vertices = self._native.caller_vertices
+            vertices.setflags(write=False)
+            self._vertices = vertices
         return self._vertices
 
     @property
     def triangles(self) -> np.ndarray:
         """(m, 3) int32 triangles as given, including any the validation dropped (read-only)."""
+        if self._triangles is None:
+            triangles = self._native.caller_triangles
+            triangles.setflags(write=False)
+            self._triangles = triangles
         return self._triangles
 
     @property

@@ -51,6 +51,10 @@ void bind_mesh(py::module_& m) {
       .def_property_readonly("component", [](const Mesh& mesh) { return to_array(by_caller(mesh, mesh.component(), 1)); })
       .def_property_readonly("faces", [](const Mesh& mesh) { return to_array(caller_ids(mesh, mesh.faces()), 3); })
       .def_property_readonly("face_source", [](const Mesh& mesh) { return copy_array(mesh.face_source()); })
+      // The caller's arrays as given (float64 positions; triangles with the dropped ones).
+      .def_property_readonly("caller_vertices",
+                             [](const Mesh& mesh) { return to_array(by_caller(mesh, mesh.positions(), 3), 3); })
+      .def_property_readonly("caller_triangles", [](const Mesh& mesh) { return to_array(mesh.caller_triangles(), 3); })
       .def_property_readonly("edges", [](const Mesh& mesh) { return to_array(caller_ids(mesh, mesh.edge_vertices()), 2); })
       .def_property_readonly("report", [](const Mesh& mesh) { return report_dict(mesh.report()); });
 

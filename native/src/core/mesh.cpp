@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -108,13 +109,13 @@ Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangl
   diagonal_ = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
-  validate_and_copy_faces(triangles, num_triangles);
-  reorder_for_locality(positions, lo, hi);
+  validate_faces(triangles, num_triangles);
+  reorder_for_locality(positions, triangles, lo, hi);
   build_vertex_faces();
   build_adjacency_and_edges();
 }
 
-void Mesh::validate_and_copy_faces(const int32_t* triangles, int64_t num_triangles) {
+void Mesh::validate_faces(const int32_t* triangles, int64_t num_triangles) {
   // One pass for both checks. An out-of-range index is an error, not something to repair (the
   // shared check names the row); a repeated vertex drops the triangle.
   const int64_t m = num_triangles;
@@ -128,29 +129,24 @@ void Mesh::validate_and_copy_faces(const int32_t* triangles, int64_t num_triangl
   }
   if (out_of_range) require_indices_in_range(triangles, num_triangles, 3, num_vertices_, "triangle");
   report_.degenerate_triangles = degenerate;
-  const int64_t kept = m - degenerate;
-  face_source_.resize(kept);
-  faces_.resize(3 * kept);
+  // The candidates, in input order; duplicates among them go once the vertices are renumbered.
+  face_source_.resize(m - degenerate);
   if (degenerate == 0) {
 #pragma omp parallel for schedule(static) if (m >= kParallelMin)
-    for (int64_t f = 0; f < m; ++f) {
-      face_source_[f] = int32_t(f);
-      for (int c = 0; c < 3; ++c) faces_[3 * f + c] = triangles[3 * f + c];
-    }
+    for (int64_t f = 0; f < m; ++f) face_source_[f] = int32_t(f);
   } else {
     int64_t j = 0;
     for (int64_t f = 0; f < m; ++f) {
       const int32_t* t = triangles + 3 * f;
       if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
         report_.dropped_triangles.push_back(static_cast<int32_t>(f));
-        continue;
+        dropped_rows_.insert(dropped_rows_.end(), t, t + 3);
+      } else {
+        face_source_[j++] = int32_t(f);
       }
-      face_source_[j] = int32_t(f);
-      for (int c = 0; c < 3; ++c) faces_[3 * j + c] = t[c];
-      ++j;
     }
   }
-  if (faces_.empty())
+  if (face_source_.empty())
     throw std::invalid_argument("mesh has no valid triangles: all " + std::to_string(num_triangles) +
                                 " repeat a vertex or duplicate another");
 }
@@ -168,7 +164,8 @@ uint64_t spread_bits(uint64_t x) {
 }
 }  // namespace
 
-void Mesh::reorder_for_locality(const double* positions, const double* lo, const double* hi) {
+void Mesh::reorder_for_locality(const double* positions, const int32_t* triangles, const double* lo,
+                                 const double* hi) {
   const int32_t n = num_vertices_;
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
   std::vector<uint64_t> key(n), other_key(n);
@@ -218,25 +215,19 @@ void Mesh::reorder_for_locality(const double* positions, const double* lo, const
     vertex_index_[old] = i;
     for (int k = 0; k < 3; ++k) positions_[3 * size_t(i) + k] = positions[3 * size_t(old) + k];
   }
-  // Faces in the new numbering, in order of their lowest vertex (a stable counting sort keeps
-  // ties in input order).
-  const int32_t m = num_faces();
-  std::vector<int32_t> lowest(m);
-#pragma omp parallel for schedule(static) if (m >= kParallelMin)
-  for (int32_t f = 0; f < m; ++f) {
-    int32_t* t = &faces_[3 * size_t(f)];
-    for (int c = 0; c < 3; ++c) t[c] = vertex_index_[t[c]];
-    lowest[f] = std::min({t[0], t[1], t[2]});
-  }
-  std::vector<int32_t> faces(faces_.size()), source(m), lowest_offsets;
+  // The candidate faces in the new numbering, in order of their lowest vertex (a stable counting
+  // sort keeps ties in input order), read straight from the caller's array.
+  const int32_t m = static_cast<int32_t>(face_source_.size());
+  auto corner = [&](int64_t i, int c) { return vertex_index_[triangles[3 * size_t(face_source_[i]) + c]]; };
+  faces_.resize(3 * size_t(m));
+  std::vector<int32_t> source(m), lowest_offsets;
   stable_counting_sort(
-      m, n, [&](int64_t f) { return lowest[f]; },
-      [&](int64_t f, int32_t at) {
-        for (int c = 0; c < 3; ++c) faces[3 * size_t(at) + c] = faces_[3 * size_t(f) + c];
-        source[at] = face_source_[f];
+      m, n, [&](int64_t i) { return std::min({corner(i, 0), corner(i, 1), corner(i, 2)}); },
+      [&](int64_t i, int32_t at) {
+        for (int c = 0; c < 3; ++c) faces_[3 * size_t(at) + c] = corner(i, c);
+        source[at] = face_source_[i];
       },
       lowest_offsets);
-  faces_.swap(faces);
   face_source_.swap(source);
   drop_duplicate_faces(lowest_offsets);
 }
@@ -278,18 +269,40 @@ void Mesh::drop_duplicate_faces(const std::vector<int32_t>& lowest_offsets) {
   }
   if (duplicates == 0) return;
   report_.duplicate_triangles = duplicates;
+  // Dropped triangles (the repeated-vertex ones are there already) in input order, with rows.
+  std::vector<std::pair<int32_t, std::array<int32_t, 3>>> dropped;
+  for (size_t i = 0; i < report_.dropped_triangles.size(); ++i)
+    dropped.push_back({report_.dropped_triangles[i], {dropped_rows_[3 * i], dropped_rows_[3 * i + 1], dropped_rows_[3 * i + 2]}});
   int32_t kept = 0;
   for (int32_t f = 0; f < m; ++f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
     if (duplicate[f]) {
-      report_.dropped_triangles.push_back(face_source_[f]);
+      dropped.push_back({face_source_[f], {vertex_source_[t[0]], vertex_source_[t[1]], vertex_source_[t[2]]}});
       continue;
     }
-    for (int c = 0; c < 3; ++c) faces_[3 * size_t(kept) + c] = faces_[3 * size_t(f) + c];
+    for (int c = 0; c < 3; ++c) faces_[3 * size_t(kept) + c] = t[c];
     face_source_[kept++] = face_source_[f];
   }
   faces_.resize(3 * size_t(kept));
   face_source_.resize(kept);
-  std::sort(report_.dropped_triangles.begin(), report_.dropped_triangles.end());
+  std::sort(dropped.begin(), dropped.end());
+  report_.dropped_triangles.clear();
+  dropped_rows_.clear();
+  for (const auto& [index, row] : dropped) {
+    report_.dropped_triangles.push_back(index);
+    dropped_rows_.insert(dropped_rows_.end(), row.begin(), row.end());
+  }
+}
+
+std::vector<int32_t> Mesh::caller_triangles() const {
+  std::vector<int32_t> out(3 * size_t(report_.input_triangles));
+  const int32_t m = num_faces();
+#pragma omp parallel for schedule(static) if (m >= kParallelMin)
+  for (int32_t f = 0; f < m; ++f)
+    for (int c = 0; c < 3; ++c) out[3 * size_t(face_source_[f]) + c] = vertex_source_[faces_[3 * size_t(f) + c]];
+  for (size_t i = 0; i < report_.dropped_triangles.size(); ++i)
+    for (int c = 0; c < 3; ++c) out[3 * size_t(report_.dropped_triangles[i]) + c] = dropped_rows_[3 * i + c];
+  return out;
 }
 
 void Mesh::build_vertex_faces() {

@@ -56,6 +56,9 @@ class Mesh {
   /// Caller's id of each internal vertex, and internal id of each caller vertex.
   const std::vector<int32_t>& vertex_source() const { return vertex_source_; }
   const std::vector<int32_t>& vertex_index() const { return vertex_index_; }
+  /// The caller's triangle array as given (3 per triangle, dropped ones included), rebuilt from
+  /// the kept faces and the dropped rows: a copy of the input need not be kept.
+  std::vector<int32_t> caller_triangles() const;
 
   // Vertex adjacency, CSR with sorted neighbours; adjacency_edge gives the edge id of each slot.
   const std::vector<int32_t>& adjacency_offsets() const { return adjacency_offsets_; }
@@ -96,8 +99,8 @@ class Mesh {
   const MeshReport& report() const { return report_; }
 
  private:
-  void validate_and_copy_faces(const int32_t* triangles, int64_t num_triangles);
-  void reorder_for_locality(const double* positions, const double* lo, const double* hi);
+  void validate_faces(const int32_t* triangles, int64_t num_triangles);
+  void reorder_for_locality(const double* positions, const int32_t* triangles, const double* lo, const double* hi);
   void drop_duplicate_faces(const std::vector<int32_t>& lowest_offsets);
   void build_vertex_faces();
   /// The one-ring pass: adjacency, edges, normals, areas, weights, manifoldness, components.
@@ -115,6 +118,7 @@ class Mesh {
   std::vector<int64_t> component_euler_;
   std::vector<uint8_t> manifold_vertex_;
   MeshReport report_;
+  std::vector<int32_t> dropped_rows_;  ///< the caller's corners of each dropped triangle, in report order
 };
 
 }  // namespace topstoc
