@@ -13,7 +13,7 @@ int32_t FeatureLayout::sector_of(const Mesh& mesh, int32_t v, int32_t f) const {
   const auto& vfo = mesh.vertex_face_offsets();
   const auto& vf = mesh.vertex_faces();
   for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i)
-    if (vf[i] == f) return sector_of_slot[i];
+    if (vf[i] == f) return sectors[v] <= 1 ? 0 : sector_of_slot[i];
   return -1;
 }
 
@@ -30,15 +30,18 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
     throw std::invalid_argument("face regions have " + std::to_string(face_region_count) +
                                 " entries, but the mesh has " + std::to_string(mesh.report().input_triangles) +
                                 " triangles");
+  int32_t region_borders = 0;
+#pragma omp parallel for schedule(static) reduction(+ : region_borders) if (num_edges >= kParallelMin)
   for (int32_t e = 0; e < num_edges; ++e) {
     const int32_t k = efo[e + 1] - efo[e];
     if (k != 2) {
       layout.edge_feature[e] = 1;  // boundary or non-manifold
     } else if (face_region && face_region[source[ef[efo[e]]]] != face_region[source[ef[efo[e] + 1]]]) {
       layout.edge_feature[e] = 1;
-      ++layout.region_border_edges;
+      ++region_borders;
     }
   }
+  layout.region_border_edges = region_borders;
   for (int64_t i = 0; i < num_flagged; ++i) {
     const int32_t a = flagged[2 * i], b = flagged[2 * i + 1];
     const int32_t n = mesh.num_vertices();
@@ -65,15 +68,18 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
       n[0] /= len, n[1] /= len, n[2] /= len;
       return true;
     };
+    int32_t creases = 0;
+#pragma omp parallel for schedule(static) reduction(+ : creases) if (num_edges >= kParallelMin)
     for (int32_t e = 0; e < num_edges; ++e) {
       if (layout.edge_feature[e] || efo[e + 1] - efo[e] != 2) continue;
       double n0[3], n1[3];
       if (!unit_normal(ef[efo[e]], n0) || !unit_normal(ef[efo[e] + 1], n1)) continue;
       if (n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] < threshold) {
         layout.edge_feature[e] = 1;
-        ++layout.crease_edges;
+        ++creases;
       }
     }
+    layout.crease_edges = creases;
   }
   for (int32_t e = 0; e < num_edges; ++e)
     if (layout.edge_feature[e]) layout.feature_edges.push_back(e);
@@ -86,7 +92,11 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   const auto& vfo = mesh.vertex_face_offsets();
   layout.feature_degree.assign(n, 0);
   layout.sectors.assign(n, 0);
-  layout.sector_of_slot.assign(mesh.vertex_faces().size(), 0);
+  // Sectors per face slot matter only where a vertex has more than one (see sector_of).
+  const auto& report = mesh.report();
+  if (!layout.feature_edges.empty() || report.nonmanifold_vertices > 0 || report.nonmanifold_edges > 0 ||
+      report.inconsistent_edges > 0)
+    layout.sector_of_slot.assign(mesh.vertex_faces().size(), 0);
   layout.vertex_feature.assign(n, 0);
   layout.vertex_corner.assign(n, 0);
   layout.chi_constant.assign(n, 0);
@@ -181,6 +191,7 @@ void trace_curves(const Mesh& mesh, FeatureLayout& layout) {
 }
 
 void collect_boundary_loops(const Mesh& mesh, FeatureLayout& layout) {
+  if (mesh.report().boundary_edges == 0) return;
   const int32_t n = mesh.num_vertices();
   const auto& ev = mesh.edge_vertices();
   std::vector<int32_t> parent(n);
