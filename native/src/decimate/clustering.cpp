@@ -54,8 +54,10 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
     const int32_t* front = frontier.data();
     // Relaxes the neighbours of frontier[i]. Shared: other threads lower keys too, so keys are
     // lowered with an atomic minimum and each vertex is queued once by an atomic flag; alone,
-    // plain stores do (locked instructions would stall this latency-bound loop).
-    auto relax = [&](int64_t i, std::vector<int32_t>& mine, std::vector<int32_t>& my_cross, auto shared) {
+    // plain stores do (locked instructions would stall this latency-bound loop). Cross: record
+    // the edges between clusters (known at compile time, so the full fill's test costs nothing
+    // elsewhere).
+    auto relax = [&](int64_t i, std::vector<int32_t>& mine, std::vector<int32_t>& my_cross, auto shared, auto cross) {
       // The frontier is known ahead: fetch the rows and keys the next iterations will read.
       if (i + 16 < count) __builtin_prefetch(&ao[front[i + 16]]);
       if (i + 8 < count) {
@@ -70,13 +72,15 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
       const int32_t v = front[i];
       const int32_t rank = rank_of(__atomic_load_n(&keys[v], __ATOMIC_RELAXED));
       const uint64_t candidate = (d << 32) | uint32_t(rank);
-      for (int32_t j = ao[v]; j < ao[v + 1]; ++j) {
+      const int32_t end = ao[v + 1];
+      for (int32_t j = ao[v]; j < end; ++j) {
         const int32_t u = adj[j];
         uint64_t held = __atomic_load_n(&keys[u], __ATOMIC_RELAXED);
-        // Keys at distance <= level are final during this pass.
-        if (cross_edges && held != kUnreached && dist_of(held) <= level && rank_of(held) != rank &&
-            (dist_of(held) < level || u > v))
-          my_cross.push_back(ae[j]);
+        if constexpr (decltype(cross)::value) {
+          // Keys at distance <= level are final during this pass.
+          if (held != kUnreached && dist_of(held) <= level && rank_of(held) != rank && (dist_of(held) < level || u > v))
+            my_cross.push_back(ae[j]);
+        }
         if (candidate >= held) continue;
         // Feature vertices are entered only along feature edges.
         if (vertex_feature[u] && !edge_feature[ae[j]]) continue;
@@ -100,9 +104,16 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
         }
       }
     };
+    auto relax_range = [&](int64_t i, std::vector<int32_t>& mine, std::vector<int32_t>& my_cross, auto shared) {
+      if (cross_edges) relax(i, mine, my_cross, shared, std::true_type());
+      else relax(i, mine, my_cross, shared, std::false_type());
+    };
     const int team = count >= kParallelMin / 16 ? threads : 1;
     if (team == 1) {
-      for (int64_t i = 0; i < count; ++i) relax(i, next[0], cross[0], std::false_type());
+      if (cross_edges)
+        for (int64_t i = 0; i < count; ++i) relax(i, next[0], cross[0], std::false_type(), std::true_type());
+      else
+        for (int64_t i = 0; i < count; ++i) relax(i, next[0], cross[0], std::false_type(), std::false_type());
     } else {
 #pragma omp parallel num_threads(team)
       {
@@ -113,8 +124,8 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
         // different parts of the mesh instead of trading cache lines.
 #pragma omp for schedule(static)
         for (int64_t i = 0; i < count; ++i) {
-          if (alone) relax(i, next[me], cross[me], std::false_type());
-          else relax(i, next[me], cross[me], std::true_type());
+          if (alone) relax_range(i, next[me], cross[me], std::false_type());
+          else relax_range(i, next[me], cross[me], std::true_type());
         }
       }
     }
@@ -160,8 +171,13 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
                     std::vector<int32_t>* changed) {
   const int32_t n = mesh.num_vertices();
   std::vector<uint64_t> key(n);
+  if (first_new == 0) {  // a full fill: nothing reached yet (the clustering is not read)
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) key[v] = c.label[v] < 0 ? kUnreached : pack(c.dist[v], c.label[v]);
+    for (int32_t v = 0; v < n; ++v) key[v] = kUnreached;
+  } else {
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (int32_t v = 0; v < n; ++v) key[v] = c.label[v] < 0 ? kUnreached : pack(c.dist[v], c.label[v]);
+  }
   std::vector<int32_t> frontier;
   for (size_t r = size_t(first_new); r < samples.size(); ++r) {
     const int32_t s = samples[r];
@@ -186,8 +202,8 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
 void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples, Clustering& out,
            std::vector<int32_t>* cross_edges) {
   const int32_t n = mesh.num_vertices();
-  out.label.assign(n, -1);
-  out.dist.assign(n, INT_MAX);
+  out.label.resize(n);  // every entry is written by the fill
+  out.dist.resize(n);
   if (cross_edges) cross_edges->clear();
   seed_and_relax(mesh, layout, samples, 0, out, cross_edges, nullptr);
 }

@@ -106,11 +106,13 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   const int32_t k = static_cast<int32_t>(samples.size());
   const auto& label = c.label;
   const auto& vfo = mesh.vertex_face_offsets();
-  for (int32_t v = 0; v < n; ++v)
-    if (label[v] < 0 && vfo[v] != vfo[v + 1]) {
-      seed_unreached(mesh, c, out);
-      return out;  // the other checks need every vertex in a cluster
-    }
+  int unreached = 0;
+#pragma omp parallel for schedule(static) reduction(| : unreached) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) unreached |= label[v] < 0 && vfo[v] != vfo[v + 1];
+  if (unreached) {
+    seed_unreached(mesh, c, out);
+    return out;  // the other checks need every vertex in a cluster
+  }
   const int threads = omp_get_max_threads();
   Marks marks(threads);
 
@@ -124,26 +126,14 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
                   lc = label[faces[3 * size_t(f) + 2]];
     return uint8_t(la != lb && lb != lc && lc != la);
   };
+  // Emitting faces in face order: each thread takes one contiguous run (static schedule) and
+  // the runs are joined in thread order.
+  std::vector<std::vector<int32_t>> found(threads);
   if (emit.valid) {
     // Only faces around relabelled vertices can have changed.
-    const auto& vfo = mesh.vertex_face_offsets();
     const auto& vf = mesh.vertex_faces();
     for (int32_t v : emit.changed)
       for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) emit.emits[vf[i]] = three_clusters(vf[i]);
-  } else {
-    emit.emits.assign(m, 0);
-    const int64_t count = candidate_faces ? int64_t(candidate_faces->size()) : int64_t(m);
-#pragma omp parallel for schedule(static) if (count >= kParallelMin)
-    for (int64_t i = 0; i < count; ++i) {
-      const int32_t f = candidate_faces ? (*candidate_faces)[i] : int32_t(i);
-      emit.emits[f] = three_clusters(f);
-    }
-    emit.valid = true;
-  }
-  emit.changed.clear();
-  {
-    // Collect in face order (static chunks keep the serial order).
-    std::vector<std::vector<int32_t>> found(threads);
 #pragma omp parallel if (m >= kParallelMin)
     {
       auto& mine = found[omp_get_thread_num()];
@@ -151,11 +141,28 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
       for (int32_t f = 0; f < m; ++f)
         if (emit.emits[f]) mine.push_back(f);
     }
+  } else {
+    // First check: evaluate and collect in one pass.
+    emit.emits.assign(m, 0);
+    const int64_t count = candidate_faces ? int64_t(candidate_faces->size()) : int64_t(m);
+#pragma omp parallel if (count >= kParallelMin)
+    {
+      auto& mine = found[omp_get_thread_num()];
+#pragma omp for schedule(static)
+      for (int64_t i = 0; i < count; ++i) {
+        const int32_t f = candidate_faces ? (*candidate_faces)[i] : int32_t(i);
+        if ((emit.emits[f] = three_clusters(f))) mine.push_back(f);
+      }
+    }
+    emit.valid = true;
+  }
+  emit.changed.clear();
+  {
     std::vector<size_t> start(threads + 1, 0);
     for (int i = 0; i < threads; ++i) start[i + 1] = start[i] + found[i].size();
     out.source_face.resize(start[threads]);
     out.triangles.resize(3 * start[threads]);
-#pragma omp parallel if (m >= kParallelMin)
+#pragma omp parallel if (start[threads] >= size_t(kParallelMin) / 4)
     {
       const int me = omp_get_thread_num();
       for (int list = me; list < threads; list += omp_get_num_threads())
@@ -182,6 +189,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   struct Arc {
     int32_t from, to, triangle;
   };
+  // Serial: a parallel counting sort cost more per thread than this whole loop (each sample
+  // has few arcs).
   std::vector<int32_t> arc_offsets(k + 1, 0);
   for (int32_t x : out.triangles) ++arc_offsets[x + 1];
   for (int32_t s = 0; s < k; ++s) arc_offsets[s + 1] += arc_offsets[s];
