@@ -268,7 +268,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     }
     return true;
   };
-#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed) if (k >= kParallelMin)
+#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed) if (k >= kParallelMinCostly)
   {
     LinkArcs link;
     auto& seen = seen_pairs[omp_get_thread_num()];

@@ -344,6 +344,28 @@ std::vector<Candidate> pareto_candidates(const Mesh& mesh, uint64_t seed, const 
   return out;
 }
 
+// Sorts distinct vertex ids in [0, n): a bit per vertex, read back in order (a tenth of the cost of
+// std::sort for a 10 % sample of a million vertices).
+void sort_vertex_ids(std::vector<int32_t>& ids, int32_t n) {
+  if (ids.size() < 4096) {
+    std::sort(ids.begin(), ids.end());
+    return;
+  }
+  std::vector<uint64_t> bits((size_t(n) + 63) / 64, 0);
+  for (int32_t v : ids) {
+    uint64_t& word = bits[size_t(v) >> 6];
+    const uint64_t bit = uint64_t(1) << (v & 63);
+    if (word & bit) {  // a repeated id would be lost: sort the plain way
+      std::sort(ids.begin(), ids.end());
+      return;
+    }
+    word |= bit;
+  }
+  size_t at = 0;
+  for (size_t w = 0; w < bits.size(); ++w)
+    for (uint64_t word = bits[w]; word; word &= word - 1) ids[at++] = int32_t(64 * w + size_t(__builtin_ctzll(word)));
+}
+
 // Breadth-first ball of `rings` hops around `center`, restricted by `follow(slot)`; calls
 // visit(v) for each vertex reached (center included).
 template <class Follow, class Visit>
@@ -545,7 +567,8 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
   SampleSet out;
   out.guided = is_guided(mesh, params);
   const int32_t target = std::clamp(target_vertices, 0, active);
-  const auto multiplier = guidance_multipliers(mesh, params);
+  // Multipliers are read only with per-vertex guidance (all ones otherwise: not made).
+  const auto multiplier = has_per_vertex_guidance(params) ? guidance_multipliers(mesh, params) : std::vector<double>();
   out.rate = out.guided ? solve_guided_rate(mesh, cls, table->q, multiplier, params, target) : solve_rate(*table, target);
   const auto p = probabilities(mesh, cls, table->q, multiplier, params, out.rate);
   double expected = 0.0;
@@ -583,7 +606,7 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
     out.samples = select_with_density(mesh, layout, cls, params, std::move(forced), std::move(candidates), all,
                                       std::max(count, out.forced), out.density_rejected);
   }
-  std::sort(out.samples.begin(), out.samples.end());
+  sort_vertex_ids(out.samples, n);
   return out;
 }
 
