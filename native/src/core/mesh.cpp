@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "core/counting_sort.hpp"
+#include "core/union_find.hpp"
 #include "topstoc/core/validate.hpp"
 
 namespace topstoc {
@@ -40,32 +41,6 @@ int64_t vertex_count(const std::vector<double>& positions) {
   if (positions.size() % 3 != 0) throw std::invalid_argument("positions must hold 3 coordinates per vertex");
   return int64_t(positions.size() / 3);
 }
-
-// Union-find over vertices that threads may share: a root is linked below a smaller root with a
-// compare-and-swap, so every root is the lowest vertex of its set whatever the interleaving, and
-// the sets come out the same for any number of threads. Path halving only ever points a vertex
-// at one of its ancestors, so a lost update does no harm.
-struct SharedUnionFind {
-  int32_t* parent;
-  int32_t find(int32_t x) const {
-    for (;;) {
-      const int32_t p = __atomic_load_n(&parent[x], __ATOMIC_RELAXED);
-      if (p == x) return x;
-      const int32_t grand = __atomic_load_n(&parent[p], __ATOMIC_RELAXED);
-      if (grand != p) __atomic_store_n(&parent[x], grand, __ATOMIC_RELAXED);
-      x = grand;
-    }
-  }
-  void unite(int32_t a, int32_t b) const {
-    for (;;) {
-      int32_t ra = find(a), rb = find(b);
-      if (ra == rb) return;
-      if (ra > rb) std::swap(ra, rb);
-      int32_t expected = rb;
-      if (__atomic_compare_exchange_n(&parent[rb], &expected, ra, false, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) return;
-    }
-  }
-};
 
 // Sorts a vertex's few link ends; valences are small, so insertion sort wins.
 void sort_small(uint64_t* first, uint64_t* last) {
@@ -333,9 +308,7 @@ void Mesh::build_adjacency_and_edges() {
   vertex_areas_.assign(n, 0.0);
   manifold_vertex_.assign(n, 1);
   face_edges_.resize(faces_.size());
-  component_.resize(n);  // the union-find's parents until the components are numbered
-  std::iota(component_.begin(), component_.end(), 0);
-  const SharedUnionFind sets{component_.data()};
+  SharedUnionFind sets(n);  // components: each set's root is its lowest vertex
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
 #pragma omp parallel reduction(+ : boundary, nonmanifold_edges, inconsistent, pinched, zero_area) if (n >= kParallelMin)
   {
@@ -539,6 +512,7 @@ void Mesh::build_adjacency_and_edges() {
   std::vector<int32_t>& root = sides;
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) root[v] = sets.find(v);
+  component_.swap(sets.parents());  // reused for the component ids, in place of the parents
   int32_t components = 0;
   for (int32_t v = 0; v < n; ++v) {
     if (vfo[v] == vfo[v + 1]) component_[v] = -1;
