@@ -32,15 +32,8 @@ constexpr uint64_t kUnreached = ~uint64_t(0);
 // prefetched. On the 775k-vertex horse at 1 % on one thread this took the flood from about 80
 // to about 52 ms (medians of 31, same run); keeping vertices in discovery order, or blocking
 // the mesh into cache-sized pieces flooded one at a time, measured no better.
-//
-// A full fill (no cross edges, nothing recorded) may also pull instead of push: once the
-// frontier is a good part of what is left, every vertex not reached yet looks at its neighbours
-// for the lowest rank at distance `level` (Beamer's direction-optimising search). That reads
-// each row in order with no atomics, and gives exactly what pushing gives: a vertex still
-// unreached at this level takes (level + 1, the lowest rank among its neighbours at `level`).
 void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> frontier, int32_t level,
-                  std::vector<uint64_t>& key, std::vector<int32_t>* cross_edges, std::vector<int32_t>* changed,
-                  int64_t unreached = -1) {
+                  std::vector<uint64_t>& key, std::vector<int32_t>* cross_edges, std::vector<int32_t>* changed) {
   const int32_t n = mesh.num_vertices();
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
@@ -53,65 +46,10 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   uint64_t* keys = key.data();
   uint8_t* in_next = queued.data();
   if (!std::is_sorted(frontier.begin(), frontier.end())) std::sort(frontier.begin(), frontier.end());
-  const bool may_pull = unreached >= 0 && !cross_edges && !changed;
-  bool pulled = false;
-  std::vector<int32_t> waiting;  // once pulling: the vertices not reached yet, in order
   while (!frontier.empty()) {
     // Every vertex is lowered at one level at most, so the frontiers list each change once.
     if (changed) changed->insert(changed->end(), frontier.begin(), frontier.end());
     const uint64_t d = uint64_t(level) + 1;
-    if (may_pull && int64_t(frontier.size()) * 5 >= unreached * 2) {
-      // Pull: the vertices not reached yet, in order, each written by the one thread that owns
-      // it. The first pull lists them; later ones keep those still unreached.
-      if (!pulled) {
-        std::vector<std::vector<int32_t>> lists(threads);
-#pragma omp parallel if (n >= kParallelMin)
-        {
-          auto& mine = lists[omp_get_thread_num()];
-#pragma omp for schedule(static)
-          for (int32_t u = 0; u < n; ++u)
-            if (keys[u] == kUnreached && ao[u] != ao[u + 1]) mine.push_back(u);
-        }
-        for (auto& list : lists) waiting.insert(waiting.end(), list.begin(), list.end());
-        pulled = true;
-      }
-      const int64_t count = int64_t(waiting.size());
-      std::vector<std::vector<int32_t>> still(threads);
-#pragma omp parallel if (count >= kParallelMin / 4)
-      {
-        auto& mine = next[omp_get_thread_num()];
-        auto& left = still[omp_get_thread_num()];
-#pragma omp for schedule(static)
-        for (int64_t i = 0; i < count; ++i) {
-          const int32_t u = waiting[i];
-          if (__atomic_load_n(&keys[u], __ATOMIC_RELAXED) != kUnreached) continue;  // pushed since
-          const bool entered_by_features = vertex_feature[u];
-          uint64_t best = kUnreached;
-          for (int32_t j = ao[u]; j < ao[u + 1]; ++j) {
-            // Keys of this level's vertices are final; those written now are one level further.
-            const uint64_t held = __atomic_load_n(&keys[adj[j]], __ATOMIC_RELAXED);
-            if (dist_of(held) == level && held < best && (!entered_by_features || edge_feature[ae[j]])) best = held;
-          }
-          if (best != kUnreached) {
-            __atomic_store_n(&keys[u], best + (uint64_t(1) << 32), __ATOMIC_RELAXED);
-            mine.push_back(u);
-          } else {
-            left.push_back(u);
-          }
-        }
-      }
-      waiting.clear();
-      for (auto& list : still) waiting.insert(waiting.end(), list.begin(), list.end());
-      // The runs are in vertex order, one per thread in thread order.
-      frontier.clear();
-      for (auto& list : next) {
-        frontier.insert(frontier.end(), list.begin(), list.end());
-        list.clear();
-      }
-      unreached -= int64_t(frontier.size());
-      ++level;
-      continue;
-    }
     const int64_t count = int64_t(frontier.size());
     const int32_t* front = frontier.data();
     // Relaxes the neighbours of frontier[i]. Shared: other threads lower keys too, so keys are
@@ -224,7 +162,6 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
         cross_edges->insert(cross_edges->end(), list.begin(), list.end());
         list.clear();
       }
-    if (may_pull) unreached -= int64_t(frontier.size());
     ++level;
   }
 }
@@ -252,9 +189,7 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
     key[s] = pack(0, static_cast<int32_t>(r));
     frontier.push_back(s);
   }
-  // A full fill may pull (see relax_levels); it counts the vertices not reached yet.
-  const int64_t unreached = first_new == 0 ? int64_t(n) - int64_t(frontier.size()) : -1;
-  relax_levels(mesh, layout, std::move(frontier), 0, key, cross_edges, changed, unreached);
+  relax_levels(mesh, layout, std::move(frontier), 0, key, cross_edges, changed);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
     c.label[v] = key[v] == kUnreached ? -1 : rank_of(key[v]);

@@ -108,7 +108,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   const auto& vfo = mesh.vertex_face_offsets();
   int unreached = 0;
 #pragma omp parallel for schedule(static) reduction(| : unreached) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) unreached |= label[v] < 0 && vfo[v] != vfo[v + 1];
+  for (int32_t v = 0; v < n; ++v)
+    if (label[v] < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
   if (unreached) {
     seed_unreached(mesh, c, out);
     return out;  // the other checks need every vertex in a cluster
@@ -126,37 +127,33 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
                   lc = label[faces[3 * size_t(f) + 2]];
     return uint8_t(la != lb && lb != lc && lc != la);
   };
-  // Emitting faces in face order: each thread takes one contiguous run (static schedule) and
-  // the runs are joined in thread order.
-  std::vector<std::vector<int32_t>> found(threads);
   if (emit.valid) {
     // Only faces around relabelled vertices can have changed.
     const auto& vf = mesh.vertex_faces();
     for (int32_t v : emit.changed)
       for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) emit.emits[vf[i]] = three_clusters(vf[i]);
-#pragma omp parallel if (m >= kParallelMin)
-    {
-      auto& mine = found[omp_get_thread_num()];
-#pragma omp for schedule(static)
-      for (int32_t f = 0; f < m; ++f)
-        if (emit.emits[f]) mine.push_back(f);
-    }
   } else {
-    // First check: evaluate and collect in one pass.
     emit.emits.assign(m, 0);
     const int64_t count = candidate_faces ? int64_t(candidate_faces->size()) : int64_t(m);
-#pragma omp parallel if (count >= kParallelMin)
-    {
-      auto& mine = found[omp_get_thread_num()];
-#pragma omp for schedule(static)
-      for (int64_t i = 0; i < count; ++i) {
-        const int32_t f = candidate_faces ? (*candidate_faces)[i] : int32_t(i);
-        if ((emit.emits[f] = three_clusters(f))) mine.push_back(f);
-      }
+#pragma omp parallel for schedule(static) if (count >= kParallelMin)
+    for (int64_t i = 0; i < count; ++i) {
+      const int32_t f = candidate_faces ? (*candidate_faces)[i] : int32_t(i);
+      emit.emits[f] = three_clusters(f);
     }
     emit.valid = true;
   }
   emit.changed.clear();
+  // Emitting faces in face order: each thread collects one contiguous run (static schedule) and
+  // the runs are joined in thread order. (A separate pass: pushing while testing made the test
+  // loop slower than both loops together.)
+  std::vector<std::vector<int32_t>> found(threads);
+#pragma omp parallel if (m >= kParallelMin)
+  {
+    auto& mine = found[omp_get_thread_num()];
+#pragma omp for schedule(static)
+    for (int32_t f = 0; f < m; ++f)
+      if (emit.emits[f]) mine.push_back(f);
+  }
   {
     std::vector<size_t> start(threads + 1, 0);
     for (int i = 0; i < threads; ++i) start[i + 1] = start[i] + found[i].size();
