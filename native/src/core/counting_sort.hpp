@@ -18,8 +18,8 @@ namespace topstoc {
 
 /// place(i, position) receives each item's position in the sorted order; offsets (buckets + 1
 /// entries) receives the first position of every bucket and, last, the count.
-template <class Key, class Place>
-void stable_counting_sort(int64_t count, int32_t buckets, Key key, Place place, std::vector<int32_t>& offsets) {
+template <class Key, class Place, class Offsets>
+void stable_counting_sort(int64_t count, int32_t buckets, Key key, Place place, Offsets& offsets) {
   if (count > INT32_MAX) throw std::invalid_argument("mesh is too large: more than 2^31 incidences");
   const int team = count >= kParallelMin ? omp_get_max_threads() : 1;
   offsets.resize(size_t(buckets) + 1);
@@ -27,7 +27,7 @@ void stable_counting_sort(int64_t count, int32_t buckets, Key key, Place place, 
     std::fill(offsets.begin(), offsets.end(), 0);
     for (int64_t i = 0; i < count; ++i) ++offsets[key(i) + 1];
     for (int32_t b = 0; b < buckets; ++b) offsets[b + 1] += offsets[b];
-    std::vector<int32_t> next(offsets.begin(), offsets.end() - 1);
+    std::vector<int32_t> next(offsets.begin(), offsets.end() - 1);  // (serial: small meshes)
     for (int64_t i = 0; i < count; ++i) place(i, next[key(i)]++);
     return;
   }

@@ -27,7 +27,8 @@ void cross(const double* a, const double* b, const double* c, double* out) {
 }
 
 // Exclusive prefix sum in place over counts[0..n), with counts[n] receiving the total.
-void exclusive_scan(std::vector<int32_t>& counts) {
+template <class Counts>
+void exclusive_scan(Counts& counts) {
   int64_t sum = 0;
   for (auto& c : counts) {
     const int64_t x = c;
@@ -143,10 +144,12 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
                                  const double* hi) {
   const int32_t n = num_vertices_;
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
-  std::vector<uint64_t> key(n), other_key(n);
-  std::vector<int32_t> other_vertex(n);
+  Buffer<uint64_t> key(n), other_key(n);
+  Buffer<int32_t> other_vertex(n);
+  vertex_source_.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
+    vertex_source_[v] = v;
     uint64_t k = 0;
     for (int axis = 0; axis < 3; ++axis) {
       // Differences near the double range overflow to inf and inf / inf is NaN, which
@@ -159,8 +162,6 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
   }
   // Vertices by key, ties by vertex: a stable least-significant-digit radix sort over the 63
   // bits the keys use, starting from vertex order.
-  vertex_source_.resize(n);
-  std::iota(vertex_source_.begin(), vertex_source_.end(), 0);
   {
     constexpr int kDigit = 11;
     constexpr uint64_t kMask = (1u << kDigit) - 1;
@@ -179,9 +180,9 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
       vertex_source_.swap(other_vertex);
     }
   }
-  std::vector<uint64_t>().swap(key);
-  std::vector<uint64_t>().swap(other_key);
-  std::vector<int32_t>().swap(other_vertex);
+  Buffer<uint64_t>().swap(key);
+  Buffer<uint64_t>().swap(other_key);
+  Buffer<int32_t>().swap(other_vertex);
   vertex_index_.resize(n);
   positions_.resize(3 * size_t(n));
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
@@ -190,24 +191,51 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     vertex_index_[old] = i;
     for (int k = 0; k < 3; ++k) positions_[3 * size_t(i) + k] = positions[3 * size_t(old) + k];
   }
-  // The candidate faces in the new numbering, in order of their lowest vertex (a stable counting
-  // sort keeps ties in input order), read straight from the caller's array.
+  // The candidate faces in the new numbering, in order of their lowest vertex, ties in input
+  // order, read straight from the caller's array. A counting sort with a bucket per vertex
+  // scattered every face to a random place (130 ms on the horse, one thread); instead the keys
+  // (lowest vertex, candidate) are radix-sorted in two passes of about ten bits, whose scatters
+  // stay within a few thousand cache lines, and the faces are then gathered in order.
   const int32_t m = static_cast<int32_t>(face_source_.size());
   auto corner = [&](int64_t i, int c) { return vertex_index_[triangles[3 * size_t(face_source_[i]) + c]]; };
+  Buffer<uint64_t> keyed(m);
+#pragma omp parallel for schedule(static) if (m >= kParallelMin)
+  for (int32_t i = 0; i < m; ++i)
+    keyed[i] = (uint64_t(uint32_t(std::min({corner(i, 0), corner(i, 1), corner(i, 2)}))) << 32) | uint32_t(i);
+  {
+    int bits = 1;
+    while (bits < 31 && (int64_t(1) << bits) < int64_t(n)) ++bits;
+    const int passes = (bits + 10) / 11, digit = (bits + passes - 1) / passes;
+    const uint64_t mask = (uint64_t(1) << digit) - 1;
+    Buffer<uint64_t> other(m);
+    Buffer<int32_t> ignored;
+    for (int pass = 0; pass < passes; ++pass) {
+      const int shift = 32 + pass * digit;
+      const uint64_t* from = keyed.data();
+      stable_counting_sort(
+          m, int32_t(mask + 1), [&](int64_t i) { return int32_t((from[i] >> shift) & mask); },
+          [&](int64_t i, int32_t at) { other[at] = from[i]; }, ignored);
+      keyed.swap(other);
+    }
+  }
   faces_.resize(3 * size_t(m));
-  std::vector<int32_t> source(m), lowest_offsets;
-  stable_counting_sort(
-      m, n, [&](int64_t i) { return std::min({corner(i, 0), corner(i, 1), corner(i, 2)}); },
-      [&](int64_t i, int32_t at) {
-        for (int c = 0; c < 3; ++c) faces_[3 * size_t(at) + c] = corner(i, c);
-        source[at] = face_source_[i];
-      },
-      lowest_offsets);
+  Buffer<int32_t> source(m), lowest_offsets(size_t(n) + 1);
+#pragma omp parallel for schedule(static) if (m >= kParallelMin)
+  for (int32_t j = 0; j < m; ++j) {
+    const int64_t i = int64_t(keyed[j] & 0xffffffffu);
+    for (int c = 0; c < 3; ++c) faces_[3 * size_t(j) + c] = corner(i, c);
+    source[j] = face_source_[i];
+    // The runs of each lowest vertex: every vertex after the previous face's lowest, up to
+    // this face's, starts here.
+    const int64_t lowest = int64_t(keyed[j] >> 32), previous = j ? int64_t(keyed[j - 1] >> 32) : -1;
+    for (int64_t v = previous + 1; v <= lowest; ++v) lowest_offsets[v] = j;
+  }
+  for (int64_t v = int64_t(keyed[m - 1] >> 32) + 1; v <= int64_t(n); ++v) lowest_offsets[v] = m;
   face_source_.swap(source);
   drop_duplicate_faces(lowest_offsets);
 }
 
-void Mesh::drop_duplicate_faces(const std::vector<int32_t>& lowest_offsets) {
+void Mesh::drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets) {
   // Duplicates (the same three vertices, either orientation) share their lowest vertex, so they
   // sit in one run of the sorted faces, which holds them in input order: the first is kept.
   const int32_t n = num_vertices_;
@@ -302,11 +330,14 @@ void Mesh::build_adjacency_and_edges() {
   // v is a manifold vertex, and each face side's rank among v's higher neighbours (an edge
   // belongs to its lower end); also the normal and the area. Neighbours wait in `scratch` (at
   // twice the vertex's first face slot: it has at most two per face) until the offsets are known.
-  std::vector<int32_t> scratch(2 * vertex_faces_.size());
-  std::vector<int32_t> degree(n + 1, 0), greater(n + 1, 0), sides(n + 1, 0), euler(n, 0);
-  normals_.assign(3 * size_t(n), 0.0);
-  vertex_areas_.assign(n, 0.0);
-  manifold_vertex_.assign(n, 1);
+  // Buffers are written on the threads that fill them (see core/buffer.hpp): every entry a loop
+  // skips is set explicitly.
+  Buffer<int32_t> scratch(2 * vertex_faces_.size());
+  Buffer<int32_t> degree(n + 1), greater(n + 1), sides(n + 1), euler(n);
+  degree[n] = greater[n] = sides[n] = 0;
+  normals_.resize(3 * size_t(n));
+  vertex_areas_.resize(n);
+  manifold_vertex_.resize(n);
   face_edges_.resize(faces_.size());
   SharedUnionFind sets(n);  // components: each set's root is its lowest vertex
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
@@ -317,7 +348,13 @@ void Mesh::build_adjacency_and_edges() {
 #pragma omp for schedule(static)
     for (int32_t v = 0; v < n; ++v) {
       const int32_t first = vfo[v], k = vfo[v + 1] - first;
-      if (k == 0) continue;  // isolated: no neighbours, in no component
+      manifold_vertex_[v] = 1;
+      if (k == 0) {  // isolated: no neighbours, in no component
+        degree[v] = greater[v] = sides[v] = euler[v] = 0;
+        normals_[3 * size_t(v)] = normals_[3 * size_t(v) + 1] = normals_[3 * size_t(v) + 2] = 0.0;
+        vertex_areas_[v] = 0.0;
+        continue;
+      }
       ends.resize(2 * size_t(k));
       end_rank.resize(2 * size_t(k));
       corner.resize(k);
@@ -344,8 +381,7 @@ void Mesh::build_adjacency_and_edges() {
       }
       vertex_areas_[v] = area;
       const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
-      if (len > 0)
-        for (int j = 0; j < 3; ++j) normals_[3 * size_t(v) + j] = sum[j] / len;
+      for (int j = 0; j < 3; ++j) normals_[3 * size_t(v) + j] = len > 0 ? sum[j] / len : 0.0;
       sort_small(ends.data(), ends.data() + ends.size());
       int32_t* neighbours = scratch.data() + 2 * size_t(first);
       int32_t d = 0;
@@ -435,9 +471,9 @@ void Mesh::build_adjacency_and_edges() {
 
   adjacency_offsets_.swap(degree);
   exclusive_scan(adjacency_offsets_);
-  std::vector<int32_t>& edge_base = greater;  // first edge id of each vertex's higher neighbours
+  Buffer<int32_t>& edge_base = greater;  // first edge id of each vertex's higher neighbours
   exclusive_scan(edge_base);
-  std::vector<int32_t>& side_base = sides;  // first slot of each vertex's edges in edge_faces
+  Buffer<int32_t>& side_base = sides;  // first slot of each vertex's edges in edge_faces
   exclusive_scan(side_base);
   const int32_t num_edges = edge_base[n];
   adjacency_.resize(adjacency_offsets_[n]);
@@ -445,7 +481,7 @@ void Mesh::build_adjacency_and_edges() {
   edge_vertices_.resize(2 * size_t(num_edges));
   edge_face_offsets_.resize(size_t(num_edges) + 1);
   edge_faces_.resize(faces_.size());
-  weights_.assign(n, 0.0);
+  weights_.resize(n);
 
   // Second pass: the neighbours into place, edge ids (numbered by lower end, then higher end),
   // the faces of each edge in increasing order, and the importance weight, which needs the
@@ -456,7 +492,10 @@ void Mesh::build_adjacency_and_edges() {
 #pragma omp for schedule(static)
     for (int32_t v = 0; v < n; ++v) {
       const int32_t d = adjacency_offsets_[v + 1] - adjacency_offsets_[v];
-      if (d == 0) continue;
+      if (d == 0) {
+        weights_[v] = 0.0;
+        continue;
+      }
       const int32_t* neighbours = scratch.data() + 2 * size_t(vfo[v]);
       const int32_t higher = edge_base[v + 1] - edge_base[v], lower = d - higher;
       std::copy(neighbours, neighbours + d, adjacency_.begin() + adjacency_offsets_[v]);
@@ -509,10 +548,10 @@ void Mesh::build_adjacency_and_edges() {
   // Components, numbered in order of their lowest vertex (each set's root), and the Euler
   // characteristic V - E + F of each from every vertex's share: itself, the edges to its higher
   // neighbours and the faces it is the lowest vertex of.
-  std::vector<int32_t>& root = sides;
+  Buffer<int32_t>& root = sides;
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) root[v] = sets.find(v);
-  component_.swap(sets.parents());  // reused for the component ids, in place of the parents
+  component_.resize(n);
   int32_t components = 0;
   for (int32_t v = 0; v < n; ++v) {
     if (vfo[v] == vfo[v + 1]) component_[v] = -1;
