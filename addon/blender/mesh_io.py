@@ -9,13 +9,13 @@ and vertex groups.
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass
 from typing import Optional
 
 import bpy
 import numpy as np
 
+from ..core.digest import array_digest
 from ..core.mesh_edges import mesh_edges
 
 # Attribute data type -> (foreach key, values per element, numpy dtype)
@@ -53,11 +53,7 @@ class MeshArrays:
 
     def digest(self) -> str:
         """Fingerprint of the geometry the engine uses (positions and triangles)."""
-        h = hashlib.blake2b(digest_size=16)
-        for array in (self.vertices, self.triangles):
-            h.update(str(array.shape).encode())
-            h.update(np.ascontiguousarray(array).data)
-        return h.hexdigest()
+        return array_digest(self.vertices, self.triangles)
 
 
 def _get(collection, key: str, count: int, width: int, dtype) -> np.ndarray:

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass
 
 import numpy as np
 
 from .decimate import decimate, decimate_with_samples
+from .digest import array_digest
 from .native import engine
 
 
@@ -74,12 +74,8 @@ def _as_triangles(triangles) -> np.ndarray:
     return array
 
 
-def _digest(array) -> bytes | None:
-    if array is None:
-        return None
-    data = np.ascontiguousarray(array)
-    return hashlib.blake2b(data.tobytes() + str(data.dtype).encode() + str(data.shape).encode(),
-                           digest_size=16).digest()
+def _digest(array) -> str | None:
+    return None if array is None else array_digest(array)
 
 
 class Mesh:

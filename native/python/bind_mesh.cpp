@@ -4,6 +4,7 @@
 #include "caller_order.hpp"
 #include "convert.hpp"
 #include "topstoc/decimate/features.hpp"
+#include "topstoc/core/digest.hpp"
 #include "topstoc/core/mesh.hpp"
 
 namespace topstoc::python {
@@ -78,6 +79,21 @@ void bind_mesh(py::module_& m) {
       .def_property_readonly("num_curves", &FeatureLayout::num_curves)
       .def_property_readonly("edge_feature", [](const FeatureLayout& l) { return copy_array(l.edge_feature); })
       .def_property_readonly("vertex_feature", [](const FeatureLayout& l) { return copy_array(l.vertex_feature); });
+
+  m.def(
+      "content_digest",
+      [](const py::buffer& data) {
+        const py::buffer_info info = data.request();
+        if (!PyBuffer_IsContiguous(info.view(), 'C'))
+          throw py::value_error("content_digest needs a contiguous buffer (np.ascontiguousarray)");
+        std::array<uint64_t, 2> digest;
+        {
+          EngineCall call;
+          digest = content_digest(info.ptr, size_t(info.size) * size_t(info.itemsize));
+        }
+        return py::bytes(reinterpret_cast<const char*>(digest.data()), sizeof digest);
+      },
+      py::arg("data"), "16-byte digest of a contiguous buffer's bytes (not cryptographic; for caches).");
 
   m.def(
       "build_feature_layout",
