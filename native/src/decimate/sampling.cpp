@@ -582,8 +582,17 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
   // the probabilities, so a slightly larger threshold keeps a small superset of what the draw
   // needs; if it falls short (tiny targets), the threshold grows.
   std::vector<int32_t> forced;
-  for (int32_t v = 0; v < n; ++v)
-    if (p[v] >= 1.0) forced.push_back(v);
+  {
+    std::vector<std::vector<int32_t>> found(omp_get_max_threads());
+#pragma omp parallel if (n >= kParallelMin)
+    {
+      auto& mine = found[omp_get_thread_num()];
+#pragma omp for schedule(static)  // runs in thread order: joined, they keep vertex order
+      for (int32_t v = 0; v < n; ++v)
+        if (p[v] >= 1.0) mine.push_back(v);
+    }
+    for (const auto& list : found) forced.insert(forced.end(), list.begin(), list.end());
+  }
   out.forced = static_cast<int32_t>(forced.size());
   const int32_t free_count = std::max<int32_t>(0, count - out.forced);
   const bool density = params.density != DensityMode::Off;
