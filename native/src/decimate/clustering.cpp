@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -129,11 +130,12 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
         }
       }
     }
-    // Next frontier in vertex order: a short one sorted, a long one read off the flags.
+    // Next frontier in vertex order: a short one sorted, a longer one read off the flags, eight
+    // at a time (sorting a few ten thousand vertices per level was a third of the flood at 1 %).
     size_t total = 0;
     for (const auto& list : next) total += list.size();
     frontier.clear();
-    if (total * 16 < size_t(n)) {
+    if (total * 256 < size_t(n)) {
       for (auto& list : next) {
         for (int32_t u : list) in_next[u] = 0;
         frontier.insert(frontier.end(), list.begin(), list.end());
@@ -142,16 +144,25 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
       std::sort(frontier.begin(), frontier.end());
     } else {
       for (auto& list : next) list.clear();
+      const int64_t words = int64_t(n) / 8;
 #pragma omp parallel if (total >= size_t(kParallelMin))
       {
         auto& mine = next[omp_get_thread_num()];
 #pragma omp for schedule(static)
-        for (int32_t v = 0; v < n; ++v)
-          if (in_next[v]) {
-            in_next[v] = 0;
-            mine.push_back(v);
-          }
+        for (int64_t w = 0; w < words; ++w) {
+          uint64_t word;
+          std::memcpy(&word, in_next + 8 * w, 8);
+          if (!word) continue;
+          std::memset(in_next + 8 * w, 0, 8);
+          for (int b = 0; b < 8; ++b)
+            if ((word >> (8 * b)) & 0xff) mine.push_back(int32_t(8 * w + b));
+        }
       }
+      for (int32_t v = int32_t(8 * words); v < n; ++v)  // the last few, past the whole words
+        if (in_next[v]) {
+          in_next[v] = 0;
+          next[threads - 1].push_back(v);
+        }
       for (auto& list : next) {
         frontier.insert(frontier.end(), list.begin(), list.end());
         list.clear();
