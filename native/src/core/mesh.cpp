@@ -88,7 +88,7 @@ Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangl
   validate_faces(triangles, num_triangles);
   reorder_for_locality(positions, triangles, lo, hi);
   build_vertex_faces();
-  build_adjacency_and_edges();
+  build_adjacency();
 }
 
 void Mesh::validate_faces(const int32_t* triangles, int64_t num_triangles) {
@@ -327,49 +327,46 @@ void Mesh::build_vertex_faces() {
   report_.isolated_vertices = isolated;
 }
 
-void Mesh::build_adjacency_and_edges() {
+void Mesh::build_adjacency() {
   const int32_t n = num_vertices_;
-  const int32_t m = num_faces();
   const auto& vfo = vertex_face_offsets_;
   // First pass, per vertex, from its faces alone: the link (for each face (v, a, b) the arc
-  // a -> b) gives the sorted neighbours, the triangles and directions of every edge at v, whether
-  // v is a manifold vertex, and each face side's rank among v's higher neighbours (an edge
-  // belongs to its lower end); also the normal and the area. Neighbours wait in `scratch` (at
-  // twice the vertex's first face slot: it has at most two per face) until the offsets are known.
+  // a -> b) gives the sorted neighbours, the triangles and directions of every edge at v (each
+  // edge counted at its lower end) and whether v is a manifold vertex; also the normal and the
+  // area. Neighbours wait in `scratch` (at twice the vertex's first face slot: it has at most two
+  // per face) until the offsets are known. Edge ids and tables come later, on demand
+  // (build_edges).
   // Buffers are written on the threads that fill them (see core/buffer.hpp): every entry a loop
   // skips is set explicitly.
   Buffer<int32_t> scratch(2 * vertex_faces_.size());
-  Buffer<int32_t> degree(n + 1), greater(n + 1), sides(n + 1), euler(n);
-  degree[n] = greater[n] = sides[n] = 0;
+  Buffer<int32_t> degree(n + 1), greater(n + 1), euler(n);
+  degree[n] = greater[n] = 0;
   normals_.resize(3 * size_t(n));
   vertex_areas_.resize(n);
   manifold_vertex_.resize(n);
-  face_edges_.resize(faces_.size());
   SharedUnionFind sets(n);  // components: each set's root is its lowest vertex
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
 #pragma omp parallel reduction(+ : boundary, nonmanifold_edges, inconsistent, pinched, zero_area) if (n >= kParallelMin)
   {
     std::vector<uint64_t> ends;                   // (neighbour, 2 slot + (1 if the arc enters it))
-    std::vector<int32_t> end_rank, in, out, next, corner;
+    std::vector<int32_t> end_rank, in, out, next;
 #pragma omp for schedule(static)
     for (int32_t v = 0; v < n; ++v) {
       const int32_t first = vfo[v], k = vfo[v + 1] - first;
       manifold_vertex_[v] = 1;
       if (k == 0) {  // isolated: no neighbours, in no component
-        degree[v] = greater[v] = sides[v] = euler[v] = 0;
+        degree[v] = greater[v] = euler[v] = 0;
         normals_[3 * size_t(v)] = normals_[3 * size_t(v) + 1] = normals_[3 * size_t(v) + 2] = 0.0;
         vertex_areas_[v] = 0.0;
         continue;
       }
       ends.resize(2 * size_t(k));
       end_rank.resize(2 * size_t(k));
-      corner.resize(k);
       double sum[3] = {0, 0, 0}, area = 0.0;
       int32_t lowest_of = 0;  // faces whose lowest vertex is v
       for (int32_t i = 0; i < k; ++i) {
         const int32_t* t = &faces_[3 * size_t(vertex_faces_[first + i])];
         const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-        corner[i] = c;
         // Area-weighted: the unnormalised face normal (twice the area) summed at each corner.
         double fn[3];
         cross(position(t[0]), position(t[1]), position(t[2]), fn);
@@ -409,25 +406,16 @@ void Mesh::build_adjacency_and_edges() {
       // Edge (v, u) has in + out triangles; two are consistent when they traverse it in opposite
       // directions (one arc leaves u, one enters it). Each edge is counted at its lower end.
       bool nonmanifold_edge = false, flipped = false;
-      int32_t higher_sides = 0;
       for (int32_t r = 0; r < d; ++r) {
         const int32_t count = in[r] + out[r];
         const bool bad_direction = count == 2 && !(in[r] == 1 && out[r] == 1);
         nonmanifold_edge |= count > 2;
         flipped |= bad_direction;
         if (r < lower) continue;
-        higher_sides += count;
         boundary += count == 1;
         nonmanifold_edges += count >= 3;
         inconsistent += bad_direction;
         sets.unite(v, neighbours[r]);
-      }
-      sides[v] = higher_sides;
-      for (int32_t i = 0; i < k; ++i) {
-        const size_t f = size_t(vertex_faces_[first + i]);
-        const int c = corner[i];
-        if (end_rank[2 * i] >= lower) face_edges_[3 * f + c] = end_rank[2 * i] - lower;
-        if (end_rank[2 * i + 1] >= lower) face_edges_[3 * f + (c + 2) % 3] = end_rank[2 * i + 1] - lower;
       }
       // Fans: with every edge at v on at most two triangles, consistently oriented, the arcs are
       // paths and cycles, and one fan means exactly one of them. With flipped edges the fans are
@@ -477,84 +465,36 @@ void Mesh::build_adjacency_and_edges() {
 
   adjacency_offsets_.swap(degree);
   exclusive_scan(adjacency_offsets_);
-  Buffer<int32_t>& edge_base = greater;  // first edge id of each vertex's higher neighbours
-  exclusive_scan(edge_base);
-  Buffer<int32_t>& side_base = sides;  // first slot of each vertex's edges in edge_faces
-  exclusive_scan(side_base);
-  const int32_t num_edges = edge_base[n];
+  exclusive_scan(greater);
+  num_edges_ = greater[n];
   adjacency_.resize(adjacency_offsets_[n]);
-  adjacency_edge_.resize(adjacency_offsets_[n]);
-  edge_vertices_.resize(2 * size_t(num_edges));
-  edge_face_offsets_.resize(size_t(num_edges) + 1);
-  edge_faces_.resize(faces_.size());
   weights_.resize(n);
 
-  // Second pass: the neighbours into place, edge ids (numbered by lower end, then higher end),
-  // the faces of each edge in increasing order, and the importance weight, which needs the
+  // Second pass: the neighbours into place and the importance weight, which needs the
   // neighbours' normals from the first pass.
-#pragma omp parallel if (n >= kParallelMin)
-  {
-    std::vector<int32_t> fill;
-#pragma omp for schedule(static)
-    for (int32_t v = 0; v < n; ++v) {
-      const int32_t d = adjacency_offsets_[v + 1] - adjacency_offsets_[v];
-      if (d == 0) {
-        weights_[v] = 0.0;
-        continue;
-      }
-      const int32_t* neighbours = scratch.data() + 2 * size_t(vfo[v]);
-      const int32_t higher = edge_base[v + 1] - edge_base[v], lower = d - higher;
-      std::copy(neighbours, neighbours + d, adjacency_.begin() + adjacency_offsets_[v]);
-      // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
-      const double* nv = &normals_[3 * size_t(v)];
-      double dots = 0.0;
-      for (int32_t r = 0; r < d; ++r) {
-        const double* nu = &normals_[3 * size_t(neighbours[r])];
-        dots += nv[0] * nu[0] + nv[1] * nu[1] + nv[2] * nu[2];
-      }
-      weights_[v] = std::clamp((double(d) - dots) / (2.0 * double(d)), 0.0, 1.0);
-      for (int32_t r = lower; r < d; ++r) {
-        const int32_t u = neighbours[r], e = edge_base[v] + (r - lower);
-        adjacency_edge_[adjacency_offsets_[v] + r] = e;
-        edge_vertices_[2 * size_t(e)] = v;
-        edge_vertices_[2 * size_t(e) + 1] = u;
-        // The same edge in u's row, among u's lower neighbours (sorted, and v is one of them).
-        const int32_t* row = scratch.data() + 2 * size_t(vfo[u]);
-        const int32_t u_lower = (adjacency_offsets_[u + 1] - adjacency_offsets_[u]) - (edge_base[u + 1] - edge_base[u]);
-        adjacency_edge_[adjacency_offsets_[u] + int32_t(std::lower_bound(row, row + u_lower, v) - row)] = e;
-      }
-      // Triangles per edge from the ranks the first pass left in face_edges, then the faces.
-      fill.assign(higher, 0);
-      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-        const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
-        const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-        if (t[(c + 1) % 3] > v) ++fill[face_edges_[3 * size_t(vertex_faces_[i]) + c]];
-        if (t[(c + 2) % 3] > v) ++fill[face_edges_[3 * size_t(vertex_faces_[i]) + (c + 2) % 3]];
-      }
-      int32_t at = side_base[v];
-      for (int32_t j = 0; j < higher; ++j) {
-        edge_face_offsets_[edge_base[v] + j] = at;
-        at += std::exchange(fill[j], at);
-      }
-      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-        const int32_t f = vertex_faces_[i];
-        const int32_t* t = &faces_[3 * size_t(f)];
-        const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-        for (int side : {c, (c + 2) % 3}) {
-          if (t[side == c ? (c + 1) % 3 : side] < v) continue;  // the edge belongs to the other end
-          int32_t& slot = face_edges_[3 * size_t(f) + side];
-          edge_faces_[fill[slot]++] = f;
-          slot += edge_base[v];
-        }
-      }
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) {
+    const int32_t d = adjacency_offsets_[v + 1] - adjacency_offsets_[v];
+    if (d == 0) {
+      weights_[v] = 0.0;
+      continue;
     }
+    const int32_t* neighbours = scratch.data() + 2 * size_t(vfo[v]);
+    std::copy(neighbours, neighbours + d, adjacency_.begin() + adjacency_offsets_[v]);
+    // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
+    const double* nv = &normals_[3 * size_t(v)];
+    double dots = 0.0;
+    for (int32_t r = 0; r < d; ++r) {
+      const double* nu = &normals_[3 * size_t(neighbours[r])];
+      dots += nv[0] * nu[0] + nv[1] * nu[1] + nv[2] * nu[2];
+    }
+    weights_[v] = std::clamp((double(d) - dots) / (2.0 * double(d)), 0.0, 1.0);
   }
-  edge_face_offsets_[num_edges] = side_base[n];
 
   // Components, numbered in order of their lowest vertex (each set's root), and the Euler
   // characteristic V - E + F of each from every vertex's share: itself, the edges to its higher
   // neighbours and the faces it is the lowest vertex of.
-  Buffer<int32_t>& root = sides;
+  Buffer<int32_t>& root = greater;  // its offsets are no longer needed
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) root[v] = sets.find(v);
   component_.resize(n);
@@ -582,8 +522,93 @@ void Mesh::build_adjacency_and_edges() {
   mean_vertex_area_ = counted ? total_area / double(counted) : 0.0;
 }
 
+void Mesh::build_edges() const {
+  std::call_once(edges_once_, [this] {
+    const int32_t n = num_vertices_;
+    const auto& ao = adjacency_offsets_;
+    const auto& vfo = vertex_face_offsets_;
+    // Per vertex: where it sits in its own sorted row (its lower neighbours come first), and
+    // how many face sides lead to higher neighbours (each edge belongs to its lower end).
+    Buffer<int32_t> lower(n), edge_base(n + 1), side_base(n + 1);
+    edge_base[n] = side_base[n] = 0;
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (int32_t v = 0; v < n; ++v) {
+      const int32_t* row = adjacency_.data() + ao[v];
+      const int32_t d = ao[v + 1] - ao[v];
+      lower[v] = int32_t(std::lower_bound(row, row + d, v) - row);
+      edge_base[v] = d - lower[v];
+      int32_t sides = 0;
+      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
+        const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
+        const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+        sides += (t[(c + 1) % 3] > v) + (t[(c + 2) % 3] > v);
+      }
+      side_base[v] = sides;
+    }
+    exclusive_scan(edge_base);
+    exclusive_scan(side_base);
+    adjacency_edge_.resize(ao[n]);
+    edge_vertices_.resize(2 * size_t(num_edges_));
+    edge_face_offsets_.resize(size_t(num_edges_) + 1);
+    edge_faces_.resize(faces_.size());
+    face_edges_.resize(faces_.size());
+    // Edges numbered by lower end, then higher end; each vertex writes its own edges: their
+    // slots in both rows, their ends, the edge of each face side it owns, and its edges' faces
+    // in increasing order.
+#pragma omp parallel if (n >= kParallelMin)
+    {
+      std::vector<int32_t> fill;
+#pragma omp for schedule(static)
+      for (int32_t v = 0; v < n; ++v) {
+        const int32_t* row = adjacency_.data() + ao[v];
+        const int32_t d = ao[v + 1] - ao[v], low = lower[v], higher = d - low;
+        for (int32_t r = low; r < d; ++r) {
+          const int32_t u = row[r], e = edge_base[v] + (r - low);
+          adjacency_edge_[ao[v] + r] = e;
+          edge_vertices_[2 * size_t(e)] = v;
+          edge_vertices_[2 * size_t(e) + 1] = u;
+          // The same edge in u's row, among u's lower neighbours (sorted, and v is one of them).
+          const int32_t* u_row = adjacency_.data() + ao[u];
+          adjacency_edge_[ao[u] + int32_t(std::lower_bound(u_row, u_row + lower[u], v) - u_row)] = e;
+        }
+        fill.assign(higher, 0);
+        auto rank = [&](int32_t u) { return int32_t(std::lower_bound(row + low, row + d, u) - (row + low)); };
+        for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
+          const int32_t f = vertex_faces_[i];
+          const int32_t* t = &faces_[3 * size_t(f)];
+          const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+          for (int side : {c, (c + 2) % 3}) {
+            const int32_t u = t[side == c ? (c + 1) % 3 : side];
+            if (u < v) continue;  // the edge belongs to the other end
+            const int32_t j = rank(u);
+            face_edges_[3 * size_t(f) + side] = edge_base[v] + j;
+            ++fill[j];
+          }
+        }
+        int32_t at = side_base[v];
+        for (int32_t j = 0; j < higher; ++j) {
+          edge_face_offsets_[edge_base[v] + j] = at;
+          at += std::exchange(fill[j], at);
+        }
+        for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
+          const int32_t f = vertex_faces_[i];
+          const int32_t* t = &faces_[3 * size_t(f)];
+          const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+          for (int side : {c, (c + 2) % 3}) {
+            if (t[side == c ? (c + 1) % 3 : side] < v) continue;
+            edge_faces_[fill[face_edges_[3 * size_t(f) + side] - edge_base[v]]++] = f;
+          }
+        }
+      }
+    }
+    edge_face_offsets_[num_edges_] = side_base[n];
+    edges_built_.store(true, std::memory_order_release);
+  });
+}
+
 int32_t Mesh::find_edge(int32_t a, int32_t b) const {
   if (a < 0 || a >= num_vertices_ || b < 0 || b >= num_vertices_) return -1;
+  ensure_edges();
   const auto* begin = adjacency_.data() + adjacency_offsets_[a];
   const auto* end = adjacency_.data() + adjacency_offsets_[a + 1];
   const auto* it = std::lower_bound(begin, end, b);

@@ -38,7 +38,9 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   const int32_t n = mesh.num_vertices();
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
-  const auto& ae = mesh.adjacency_edge();
+  // Edge ids are read only at feature vertices and for cross edges: without either the mesh
+  // need not build its edge tables.
+  const int32_t* ae = cross_edges || layout.has_feature_vertices ? mesh.adjacency_edge().data() : nullptr;
   const auto& edge_feature = layout.edge_feature;
   const auto& vertex_feature = layout.vertex_feature;
   std::vector<uint8_t> queued(n, 0);
@@ -227,12 +229,12 @@ void flood_add(const Mesh& mesh, const FeatureLayout& layout, const std::vector<
 int32_t step_towards_sample(const Mesh& mesh, const FeatureLayout& layout, const Clustering& c, int32_t x) {
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
-  const auto& ae = mesh.adjacency_edge();
   int32_t best = -1;
   for (int32_t j = ao[x]; j < ao[x + 1]; ++j) {
     const int32_t p = adj[j];
     if (c.label[p] != c.label[x] || c.dist[p] != c.dist[x] - 1) continue;
-    if (layout.vertex_feature[x] && !layout.edge_feature[ae[j]]) continue;  // the fill could not come this way
+    // The fill could not come this way (edge ids are read at feature vertices only).
+    if (layout.vertex_feature[x] && !layout.edge_feature[mesh.adjacency_edge()[j]]) continue;
     if (best < 0 || p < best) best = p;
   }
   return best;

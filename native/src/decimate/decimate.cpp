@@ -99,8 +99,6 @@ std::vector<int32_t> splitting_vertices(const Mesh& mesh, const Clustering& c, c
 int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Clustering& c, int32_t face,
                          int32_t slot, int32_t sample_vertex) {
   const auto& faces = mesh.faces();
-  const auto& efo = mesh.edge_face_offsets();
-  const auto& ef = mesh.edge_faces();
   auto corner_of = [&](int32_t f, int32_t v) {
     for (int j = 0; j < 3; ++j)
       if (faces[3 * size_t(f) + j] == v) return 3 * mesh.face_source()[f] + j;
@@ -110,6 +108,8 @@ int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Cl
     // One side only: any face of the sample will do.
     return corner_of(mesh.vertex_faces()[mesh.vertex_face_offsets()[sample_vertex]], sample_vertex);
   }
+  const auto& efo = mesh.edge_face_offsets();  // (built on first use: only borders come here)
+  const auto& ef = mesh.edge_faces();
   int32_t current = face;
   int32_t x = faces[3 * size_t(face) + slot];
   for (int32_t guard = 0; x != sample_vertex && guard <= mesh.num_vertices(); ++guard) {

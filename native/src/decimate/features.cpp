@@ -1,6 +1,7 @@
 #include "topstoc/decimate/features.hpp"
 #include "topstoc/core/parallel.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -23,13 +24,18 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
                         const int32_t* flagged, int64_t num_flagged, double feature_angle, FeatureLayout& layout) {
   const int32_t num_edges = mesh.num_edges();
   layout.edge_feature.assign(num_edges, 0);
-  const auto& efo = mesh.edge_face_offsets();
-  const auto& ef = mesh.edge_faces();
-  const auto& source = mesh.face_source();
   if (face_region && face_region_count != mesh.report().input_triangles)
     throw std::invalid_argument("face regions have " + std::to_string(face_region_count) +
                                 " entries, but the mesh has " + std::to_string(mesh.report().input_triangles) +
                                 " triangles");
+  // A closed manifold mesh without regions, flagged edges or creases has no feature edge: the
+  // mesh then need not build its edge tables for this.
+  if (!face_region && num_flagged == 0 && feature_angle <= 0 && mesh.report().boundary_edges == 0 &&
+      mesh.report().nonmanifold_edges == 0)
+    return;
+  const auto& efo = mesh.edge_face_offsets();
+  const auto& ef = mesh.edge_faces();
+  const auto& source = mesh.face_source();
   int32_t region_borders = 0;
 #pragma omp parallel for schedule(static) reduction(+ : region_borders) if (num_edges >= kParallelMin)
   for (int32_t e = 0; e < num_edges; ++e) {
@@ -88,7 +94,8 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
 void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
   const auto& ao = mesh.adjacency_offsets();
-  const auto& ae = mesh.adjacency_edge();
+  const bool featureless = layout.feature_edges.empty();  // every edge one copy, none a feature
+  const int32_t* ae = featureless ? nullptr : mesh.adjacency_edge().data();
   const auto& vfo = mesh.vertex_face_offsets();
   layout.feature_degree.assign(n, 0);
   layout.sectors.assign(n, 0);
@@ -106,9 +113,9 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
 #pragma omp for schedule(static)
     for (int32_t v = 0; v < n; ++v) {
       if (vfo[v] == vfo[v + 1]) continue;  // isolated: belongs to no cluster
-      int32_t degree = 0, copies = 0, first_copies = -1;
+      int32_t degree = 0, copies = featureless ? ao[v + 1] - ao[v] : 0, first_copies = -1;
       bool same_copies = true;
-      for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
+      for (int32_t i = ao[v]; i < ao[v + 1] && !featureless; ++i) {
         const int32_t e = ae[i];
         const int32_t c = layout.edge_copies(mesh, e);
         copies += c;
@@ -139,11 +146,12 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
 
 void trace_curves(const Mesh& mesh, FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
+  layout.vertex_curve.assign(n, -1);
+  if (layout.feature_edges.empty()) return;  // no curves
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
   const auto& ae = mesh.adjacency_edge();
   std::vector<uint8_t> visited(mesh.num_edges(), 0);
-  layout.vertex_curve.assign(n, -1);
   // Next feature edge at curve vertex v other than the one we came by.
   auto step = [&](int32_t v, int32_t from_edge, int32_t& next_vertex, int32_t& next_edge) {
     for (int32_t i = ao[v]; i < ao[v + 1]; ++i)
@@ -235,6 +243,8 @@ std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, cons
   auto layout = std::make_shared<FeatureLayout>();
   mark_feature_edges(mesh, face_region, face_region_count, flagged_edges, num_flagged_edges, feature_angle, *layout);
   compute_sectors_and_corners(mesh, *layout);
+  layout->has_feature_vertices =
+      std::find(layout->vertex_feature.begin(), layout->vertex_feature.end(), 1) != layout->vertex_feature.end();
   trace_curves(mesh, *layout);
   collect_boundary_loops(mesh, *layout);
   return layout;

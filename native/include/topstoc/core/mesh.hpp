@@ -14,7 +14,9 @@
 // maps the caller's vertex ids in.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -47,7 +49,7 @@ class Mesh {
 
   int32_t num_vertices() const { return num_vertices_; }
   int32_t num_faces() const { return static_cast<int32_t>(faces_.size() / 3); }
-  int32_t num_edges() const { return static_cast<int32_t>(edge_vertices_.size() / 2); }
+  int32_t num_edges() const { return num_edges_; }
 
   const double* position(int32_t v) const { return &positions_[3 * size_t(v)]; }
   const Buffer<double>& positions() const { return positions_; }
@@ -65,17 +67,22 @@ class Mesh {
   // Vertex adjacency, CSR with sorted neighbours; adjacency_edge gives the edge id of each slot.
   const Buffer<int32_t>& adjacency_offsets() const { return adjacency_offsets_; }
   const Buffer<int32_t>& adjacency() const { return adjacency_; }
-  const Buffer<int32_t>& adjacency_edge() const { return adjacency_edge_; }
+  const Buffer<int32_t>& adjacency_edge() const { return ensure_edges(), adjacency_edge_; }
   // Faces around each vertex, CSR.
   const Buffer<int32_t>& vertex_face_offsets() const { return vertex_face_offsets_; }
   const Buffer<int32_t>& vertex_faces() const { return vertex_faces_; }
-  // Edges (lower id first), the faces of each edge (CSR) and the edge of each face side.
-  const Buffer<int32_t>& edge_vertices() const { return edge_vertices_; }
-  const Buffer<int32_t>& edge_face_offsets() const { return edge_face_offsets_; }
-  const Buffer<int32_t>& edge_faces() const { return edge_faces_; }
+  // Edges (lower id first), the faces of each edge (CSR) and the edge of each face side. These
+  // tables (about a third of the mesh's memory) are built on first use, once, whichever thread
+  // asks: a decimation of a closed mesh without borders never needs them.
+  const Buffer<int32_t>& edge_vertices() const { return ensure_edges(), edge_vertices_; }
+  const Buffer<int32_t>& edge_face_offsets() const { return ensure_edges(), edge_face_offsets_; }
+  const Buffer<int32_t>& edge_faces() const { return ensure_edges(), edge_faces_; }
   /// face_edges[3f + c] is the edge from corner c to corner c+1 of face f.
-  const Buffer<int32_t>& face_edges() const { return face_edges_; }
-  int32_t edge_face_count(int32_t e) const { return edge_face_offsets_[e + 1] - edge_face_offsets_[e]; }
+  const Buffer<int32_t>& face_edges() const { return ensure_edges(), face_edges_; }
+  int32_t edge_face_count(int32_t e) const {
+    ensure_edges();
+    return edge_face_offsets_[e + 1] - edge_face_offsets_[e];
+  }
   /// Edge id between a and b, or -1.
   int32_t find_edge(int32_t a, int32_t b) const;
 
@@ -105,15 +112,23 @@ class Mesh {
   void reorder_for_locality(const double* positions, const int32_t* triangles, const double* lo, const double* hi);
   void drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets);
   void build_vertex_faces();
-  /// The one-ring pass: adjacency, edges, normals, areas, weights, manifoldness, components.
-  void build_adjacency_and_edges();
+  /// The one-ring pass: adjacency, normals, areas, weights, manifoldness, components.
+  void build_adjacency();
+  void ensure_edges() const {
+    if (!edges_built_.load(std::memory_order_acquire)) build_edges();
+  }
+  void build_edges() const;
 
   int32_t num_vertices_ = 0;
   Buffer<double> positions_;
   Buffer<int32_t> faces_, face_source_, vertex_source_, vertex_index_;
   Buffer<int32_t> vertex_face_offsets_, vertex_faces_;
-  Buffer<int32_t> adjacency_offsets_, adjacency_, adjacency_edge_;
-  Buffer<int32_t> edge_vertices_, edge_face_offsets_, edge_faces_, face_edges_;
+  Buffer<int32_t> adjacency_offsets_, adjacency_;
+  int32_t num_edges_ = 0;
+  // Built on first use (ensure_edges).
+  mutable Buffer<int32_t> adjacency_edge_, edge_vertices_, edge_face_offsets_, edge_faces_, face_edges_;
+  mutable std::once_flag edges_once_;
+  mutable std::atomic<bool> edges_built_{false};
   Buffer<double> normals_, weights_, vertex_areas_;
   double mean_weight_ = 0.0, diagonal_ = 0.0, mean_vertex_area_ = 0.0;
   Buffer<int32_t> component_;

@@ -49,6 +49,7 @@ struct FeatureLayout {
   /// (a manifold mesh without feature edges); use sector_of().
   std::vector<int32_t> sector_of_slot;
   std::vector<uint8_t> vertex_feature;  ///< per vertex: on a feature curve, or a corner
+  bool has_feature_vertices = false;    ///< any vertex_feature set (else no edge ids are needed)
   std::vector<uint8_t> vertex_corner;   ///< per vertex: always kept
   /// Curves: open segments run from corner to corner (both included); closed loops hold only
   /// curve vertices (start not repeated).
