@@ -10,7 +10,6 @@ sparsely (read_vertex_weights, write_vertex_weights).
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass
 from typing import Optional
 
@@ -18,6 +17,7 @@ import bpy
 import numpy as np
 
 from ..core.attributes import MovedVertices, SparseWeights, corner_values, moved_vertices, point_values
+from ..core.digest import array_digest
 from ..core.mesh_edges import mesh_edges
 
 # Attribute data type -> (foreach key, values per element, numpy dtype)
@@ -57,11 +57,7 @@ class MeshArrays:
 
     def digest(self) -> str:
         """Fingerprint of the geometry the engine uses (positions and triangles)."""
-        h = hashlib.blake2b(digest_size=16)
-        for array in (self.vertices, self.triangles):
-            h.update(str(array.shape).encode())
-            h.update(np.ascontiguousarray(array).data)
-        return h.hexdigest()
+        return array_digest(self.vertices, self.triangles)
 
 
 def _get(collection, key: str, count: int, width: int, dtype) -> np.ndarray:

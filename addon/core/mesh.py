@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass
 
 import numpy as np
 
 from .decimate import decimate, decimate_with_samples
+from .digest import array_digest
 from .native import engine
 from .errors import TopStocError
 
@@ -75,12 +75,8 @@ def _as_triangles(triangles) -> np.ndarray:
     return array
 
 
-def _digest(array) -> bytes | None:
-    if array is None:
-        return None
-    data = np.ascontiguousarray(array)
-    return hashlib.blake2b(data.tobytes() + str(data.dtype).encode() + str(data.shape).encode(),
-                           digest_size=16).digest()
+def _digest(array) -> str | None:
+    return None if array is None else array_digest(array)
 
 
 class Mesh:
@@ -100,22 +96,30 @@ class Mesh:
         stops the preparation with ``topstoc.core.Cancelled`` (the live preview's Esc)."""
         vertices = as_vertices(vertices)
         triangles = _as_triangles(triangles)
+        # The engine copies what it needs (reading float64 and int32 arrays in place) and can
+        # give the caller's arrays back: the read-only copies below are made on first use only.
         self._native = engine.Mesh(vertices, triangles, progress=progress)
-        self._vertices = np.array(vertices, dtype=np.float64)
-        self._vertices.setflags(write=False)
-        self._triangles = np.array(triangles, dtype=np.int64).astype(np.int32)
-        self._triangles.setflags(write=False)
+        self._vertices = None
+        self._triangles = None
         self._layouts: dict = {}
 
     # -- the caller's data, read-only --------------------------------------------------------
     @property
     def vertices(self) -> np.ndarray:
         """(n, 3) float64 positions as given (read-only copy)."""
+        if self._vertices is None:
+            vertices = self._native.caller_vertices
+            vertices.setflags(write=False)
+            self._vertices = vertices
         return self._vertices
 
     @property
     def triangles(self) -> np.ndarray:
         """(m, 3) int32 triangles as given, including any the validation dropped (read-only)."""
+        if self._triangles is None:
+            triangles = self._native.caller_triangles
+            triangles.setflags(write=False)
+            self._triangles = triangles
         return self._triangles
 
     @property

@@ -4,6 +4,7 @@
 #include "caller_order.hpp"
 #include "convert.hpp"
 #include "topstoc/decimate/features.hpp"
+#include "topstoc/core/digest.hpp"
 #include "topstoc/core/mesh.hpp"
 
 namespace topstoc::python {
@@ -32,11 +33,13 @@ py::dict report_dict(const MeshReport& r) {
 void bind_mesh(py::module_& m) {
   py::class_<Mesh, std::shared_ptr<Mesh>>(m, "Mesh", "Prepared triangle mesh (validated, with adjacency and weights).")
       .def(py::init([](const py::handle& vertices, const py::handle& triangles, const py::object& progress) {
-             auto positions = positions_from(vertices, "vertices");
-             auto tris = indices_from(triangles, 3, "triangles");
+             // The caller's buffers are read in place when they already are float64 and int32.
+             const auto positions = positions_array(vertices, "vertices");
+             const auto tris = indices_array(triangles, 3, "triangles");
              auto callback = progress_from(progress);
              EngineCall call;
-             return std::make_shared<Mesh>(std::move(positions), tris.data(), int64_t(tris.size() / 3), callback);
+             return std::make_shared<Mesh>(positions.data(), int64_t(positions.size() / 3), tris.data(),
+                                           int64_t(tris.size() / 3), callback);
            }),
            py::arg("vertices"), py::arg("triangles"), py::arg("progress") = py::none(),
            "progress(fraction, stage) hears each preparation step; returning False raises Cancelled.")
@@ -51,6 +54,10 @@ void bind_mesh(py::module_& m) {
       .def_property_readonly("component", [](const Mesh& mesh) { return to_array(by_caller(mesh, mesh.component(), 1)); })
       .def_property_readonly("faces", [](const Mesh& mesh) { return to_array(caller_ids(mesh, mesh.faces()), 3); })
       .def_property_readonly("face_source", [](const Mesh& mesh) { return copy_array(mesh.face_source()); })
+      // The caller's arrays as given (float64 positions; triangles with the dropped ones).
+      .def_property_readonly("caller_vertices",
+                             [](const Mesh& mesh) { return to_array(by_caller(mesh, mesh.positions(), 3), 3); })
+      .def_property_readonly("caller_triangles", [](const Mesh& mesh) { return to_array(mesh.caller_triangles(), 3); })
       .def_property_readonly("edges", [](const Mesh& mesh) { return to_array(caller_ids(mesh, mesh.edge_vertices()), 2); })
       .def_property_readonly("report", [](const Mesh& mesh) { return report_dict(mesh.report()); });
 
@@ -74,6 +81,21 @@ void bind_mesh(py::module_& m) {
       .def_property_readonly("num_curves", &FeatureLayout::num_curves)
       .def_property_readonly("edge_feature", [](const FeatureLayout& l) { return copy_array(l.edge_feature); })
       .def_property_readonly("vertex_feature", [](const FeatureLayout& l) { return copy_array(l.vertex_feature); });
+
+  m.def(
+      "content_digest",
+      [](const py::buffer& data) {
+        const py::buffer_info info = data.request();
+        if (!PyBuffer_IsContiguous(info.view(), 'C'))
+          throw py::value_error("content_digest needs a contiguous buffer (np.ascontiguousarray)");
+        std::array<uint64_t, 2> digest;
+        {
+          EngineCall call;
+          digest = content_digest(info.ptr, size_t(info.size) * size_t(info.itemsize));
+        }
+        return py::bytes(reinterpret_cast<const char*>(digest.data()), sizeof digest);
+      },
+      py::arg("data"), "16-byte digest of a contiguous buffer's bytes (not cryptographic; for caches).");
 
   m.def(
       "build_feature_layout",

@@ -10,9 +10,9 @@
 namespace topstoc::python {
 
 /// Per-vertex values (`width` per vertex) reordered from internal to caller order.
-template <class T>
-std::vector<T> by_caller(const Mesh& mesh, const std::vector<T>& values, size_t width = 1) {
-  std::vector<T> out(values.size());
+template <class Values>
+std::vector<typename Values::value_type> by_caller(const Mesh& mesh, const Values& values, size_t width = 1) {
+  std::vector<typename Values::value_type> out(values.size());
   const auto& source = mesh.vertex_source();
   for (size_t v = 0; v < source.size(); ++v)
     for (size_t k = 0; k < width; ++k) out[width * size_t(source[v]) + k] = values[width * v + k];
@@ -20,7 +20,8 @@ std::vector<T> by_caller(const Mesh& mesh, const std::vector<T>& values, size_t 
 }
 
 /// Internal vertex ids replaced by the caller's.
-inline std::vector<int32_t> caller_ids(const Mesh& mesh, const std::vector<int32_t>& ids) {
+template <class Ids>
+std::vector<int32_t> caller_ids(const Mesh& mesh, const Ids& ids) {
   std::vector<int32_t> out(ids.size());
   for (size_t i = 0; i < ids.size(); ++i) out[i] = mesh.vertex_source()[ids[i]];
   return out;

@@ -64,9 +64,9 @@ py::array_t<T> to_array(std::vector<T>&& data, int64_t columns = 0) {
   return py::array_t<T>({int64_t(owned->size()) / columns, columns}, {columns * item, item}, owned->data(), release);
 }
 
-template <class T>
-py::array_t<T> copy_array(const std::vector<T>& data, int64_t columns = 0) {
-  return to_array(std::vector<T>(data), columns);
+template <class T, class Allocator>
+py::array_t<T> copy_array(const std::vector<T, Allocator>& data, int64_t columns = 0) {
+  return to_array(std::vector<T>(data.begin(), data.end()), columns);
 }
 
 // One binding function per concept; each lives in its own bind_*.cpp.

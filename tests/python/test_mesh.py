@@ -150,3 +150,26 @@ def test_progress_errors_are_clear():
 
     with pytest.raises(KeyError, match="from the callback"):  # the caller's own error comes through
         Mesh(v, t, progress=broken)
+
+
+def test_vertices_and_triangles_give_back_the_callers_arrays_as_they_were():
+    # The engine keeps no copy of the input: both are rebuilt from the prepared mesh (kept
+    # faces, the rows of dropped ones), and must equal the input, dropped triangles included,
+    # even when the caller changes its arrays afterwards.
+    v, t = tetrahedron()
+    vertices = np.vstack([v, [[5, 5, 5]]]).astype(np.float32)
+    triangles = np.vstack([t, [[0, 0, 1]], [[2, 0, 1]], [[1, 3, 3]], [[0, 1, 2]]]).astype(np.int64)
+    expected_v, expected_t = vertices.astype(np.float64), triangles.astype(np.int32)
+    mesh = Mesh(vertices, triangles)
+    vertices[:] = 0
+    triangles[:] = 0
+    assert list(mesh.report().dropped_triangles) == [4, 5, 6, 7]
+    assert mesh.vertices.dtype == np.float64 and mesh.triangles.dtype == np.int32
+    np.testing.assert_array_equal(mesh.vertices, expected_v)
+    np.testing.assert_array_equal(mesh.triangles, expected_t)
+    shuffled = np.random.default_rng(3).permutation(len(meshgen.torus(12, 8)[0]))
+    tv, tt = meshgen.torus(12, 8)
+    order = np.argsort(shuffled)
+    mesh = Mesh(tv[shuffled], order[tt])
+    np.testing.assert_array_equal(mesh.vertices, tv[shuffled])
+    np.testing.assert_array_equal(mesh.triangles, order[tt])

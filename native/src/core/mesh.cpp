@@ -1,6 +1,8 @@
 #include "topstoc/core/mesh.hpp"
 #include "topstoc/core/parallel.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -8,7 +10,8 @@
 #include <stdexcept>
 #include <utility>
 
-#include "core/fans.hpp"
+#include "core/counting_sort.hpp"
+#include "core/union_find.hpp"
 #include "topstoc/core/validate.hpp"
 
 namespace topstoc {
@@ -24,7 +27,8 @@ void cross(const double* a, const double* b, const double* c, double* out) {
 }
 
 // Exclusive prefix sum in place over counts[0..n), with counts[n] receiving the total.
-void exclusive_scan(std::vector<int32_t>& counts) {
+template <class Counts>
+void exclusive_scan(Counts& counts) {
   int64_t sum = 0;
   for (auto& c : counts) {
     const int64_t x = c;
@@ -34,116 +38,96 @@ void exclusive_scan(std::vector<int32_t>& counts) {
   if (sum > INT32_MAX) throw std::invalid_argument("mesh is too large: more than 2^31 incidences");
 }
 
+int64_t vertex_count(const std::vector<double>& positions) {
+  if (positions.size() % 3 != 0) throw std::invalid_argument("positions must hold 3 coordinates per vertex");
+  return int64_t(positions.size() / 3);
+}
+
+// Sorts a vertex's few link ends; valences are small, so insertion sort wins.
+void sort_small(uint64_t* first, uint64_t* last) {
+  if (last - first > 32) {
+    std::sort(first, last);
+    return;
+  }
+  for (uint64_t* i = first + 1; i < last; ++i) {
+    const uint64_t x = *i;
+    uint64_t* j = i;
+    for (; j > first && *(j - 1) > x; --j) *j = *(j - 1);
+    *j = x;
+  }
+}
+
 }  // namespace
 
-Mesh::Mesh(std::vector<double> positions, const int32_t* triangles, int64_t num_triangles,
-           const ProgressCallback& progress_callback)
-    : positions_(std::move(positions)) {
+Mesh::Mesh(const std::vector<double>& positions, const int32_t* triangles, int64_t num_triangles,
+           const ProgressCallback& progress)
+    : Mesh(positions.data(), vertex_count(positions), triangles, num_triangles, progress) {}
+
+Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangles, int64_t num_triangles,
+           const ProgressCallback& progress_callback) {
   Progress progress(progress_callback);  // steps at their share of the time on the horse; may throw Cancelled
-  if (positions_.size() % 3 != 0) throw std::invalid_argument("positions must hold 3 coordinates per vertex");
-  if (positions_.size() / 3 > size_t(INT32_MAX))
-    throw std::invalid_argument("mesh is too large: more than 2^31 vertices");
-  num_vertices_ = static_cast<int32_t>(positions_.size() / 3);
+  if (num_vertices > int64_t(INT32_MAX)) throw std::invalid_argument("mesh is too large: more than 2^31 vertices");
+  num_vertices_ = static_cast<int32_t>(num_vertices);
   report_.input_vertices = num_vertices_;
   report_.input_triangles = static_cast<int32_t>(num_triangles);
   if (num_vertices_ == 0) throw std::invalid_argument("mesh has no vertices");
   if (num_triangles <= 0) throw std::invalid_argument("mesh has no triangles");
   if (num_triangles > INT32_MAX / 3) throw std::invalid_argument("mesh is too large: more than 2^31 / 3 triangles");
-  require_finite_positions(positions_.data(), num_vertices_);
-  double lo[3] = {positions_[0], positions_[1], positions_[2]}, hi[3] = {lo[0], lo[1], lo[2]};
-  for (int32_t v = 0; v < num_vertices_; ++v)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], positions_[3 * size_t(v) + k]);
-      hi[k] = std::max(hi[k], positions_[3 * size_t(v) + k]);
-    }
+  require_finite_positions(positions, num_vertices_);
+  // Minimum and maximum are exact, so the box is the same on any number of threads.
+  double lo0 = positions[0], lo1 = positions[1], lo2 = positions[2], hi0 = lo0, hi1 = lo1, hi2 = lo2;
+  const int32_t n = num_vertices_;
+#pragma omp parallel for schedule(static) reduction(min : lo0, lo1, lo2) reduction(max : hi0, hi1, hi2) \
+    if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) {
+    const double* p = positions + 3 * size_t(v);
+    lo0 = std::min(lo0, p[0]), lo1 = std::min(lo1, p[1]), lo2 = std::min(lo2, p[2]);
+    hi0 = std::max(hi0, p[0]), hi1 = std::max(hi1, p[1]), hi2 = std::max(hi2, p[2]);
+  }
+  const double lo[3] = {lo0, lo1, lo2}, hi[3] = {hi0, hi1, hi2};
   diagonal_ = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
-  progress.stage("validate", 0.0, 0.2);
-  validate_and_copy_faces(triangles, num_triangles);
-  progress.stage("order", 0.2, 0.4);
-  reorder_for_locality(lo, hi);
-  progress.stage("adjacency", 0.4, 0.72);
+  progress.stage("validate", 0.0, 0.15);
+  validate_faces(triangles, num_triangles);
+  progress.stage("order", 0.15, 0.45);
+  reorder_for_locality(positions, triangles, lo, hi);
   build_vertex_faces();
-  build_adjacency_and_edges();
-  build_edge_faces();
-  progress.stage("normals and weights", 0.72, 0.82);
-  compute_normals_and_weights();
-  progress.stage("components", 0.82, 1.0);
-  compute_components_and_manifoldness();
+  build_adjacency(progress);
 }
 
-void Mesh::validate_and_copy_faces(const int32_t* triangles, int64_t num_triangles) {
-  // Range check first: an out-of-range index is an error, not something to repair.
-  require_indices_in_range(triangles, num_triangles, 3, num_vertices_, "triangle");
-  // Drop triangles with a repeated vertex.
-  std::vector<int32_t> candidates;
-  candidates.reserve(num_triangles);
-  for (int64_t f = 0; f < num_triangles; ++f) {
+void Mesh::validate_faces(const int32_t* triangles, int64_t num_triangles) {
+  // One pass for both checks. An out-of-range index is an error, not something to repair (the
+  // shared check names the row); a repeated vertex drops the triangle.
+  const int64_t m = num_triangles;
+  const uint32_t n = uint32_t(num_vertices_);
+  int out_of_range = 0, degenerate = 0;
+#pragma omp parallel for schedule(static) reduction(| : out_of_range) reduction(+ : degenerate) if (m >= kParallelMin)
+  for (int64_t f = 0; f < m; ++f) {
     const int32_t* t = triangles + 3 * f;
-    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
-      ++report_.degenerate_triangles;
-      report_.dropped_triangles.push_back(static_cast<int32_t>(f));
-    } else {
-      candidates.push_back(static_cast<int32_t>(f));
-    }
+    out_of_range |= (uint32_t(t[0]) >= n) | (uint32_t(t[1]) >= n) | (uint32_t(t[2]) >= n);
+    degenerate += (t[0] == t[1]) | (t[1] == t[2]) | (t[2] == t[0]);
   }
-  // Drop exact duplicates (same vertex set, either orientation): bucket by smallest vertex, then
-  // compare the sorted triples inside each small bucket. The first occurrence is kept.
-  const int64_t k = static_cast<int64_t>(candidates.size());
-  std::vector<std::array<int32_t, 3>> sorted(candidates.size());
-#pragma omp parallel for schedule(static) if (k >= kParallelMin)
-  for (int64_t i = 0; i < k; ++i) {
-    const int32_t* t = triangles + 3 * size_t(candidates[i]);
-    sorted[i] = {t[0], t[1], t[2]};
-    std::sort(sorted[i].begin(), sorted[i].end());
-  }
-  std::vector<int32_t> bucket_offsets(num_vertices_ + 1, 0);
-  for (const auto& t : sorted) ++bucket_offsets[t[0]];
-  exclusive_scan(bucket_offsets);
-  std::vector<int32_t> bucket(candidates.size());
-  {
-    std::vector<int32_t> fill(bucket_offsets.begin(), bucket_offsets.end() - 1);
-    for (size_t i = 0; i < sorted.size(); ++i) bucket[fill[sorted[i][0]]++] = int32_t(i);
-  }
-  // Buckets are disjoint, so they are scanned in parallel.
-  std::vector<uint8_t> duplicate(candidates.size(), 0);
-#pragma omp parallel for schedule(static) if (num_vertices_ >= kParallelMin)
-  for (int32_t v = 0; v < num_vertices_; ++v) {
-    const int32_t b = bucket_offsets[v], e = bucket_offsets[v + 1];
-    for (int32_t i = b; i < e; ++i) {
-      if (duplicate[bucket[i]]) continue;
-      for (int32_t j = i + 1; j < e; ++j)
-        if (!duplicate[bucket[j]] && sorted[bucket[j]] == sorted[bucket[i]]) duplicate[bucket[j]] = 1;
-    }
-  }
-  for (int64_t i = 0; i < k; ++i)
-    if (duplicate[i]) {
-      ++report_.duplicate_triangles;
-      report_.dropped_triangles.push_back(candidates[i]);
-    }
-  const int64_t kept = k - report_.duplicate_triangles;
-  face_source_.resize(kept);
-  if (report_.duplicate_triangles == 0) {
-    std::copy(candidates.begin(), candidates.end(), face_source_.begin());
+  if (out_of_range) require_indices_in_range(triangles, num_triangles, 3, num_vertices_, "triangle");
+  report_.degenerate_triangles = degenerate;
+  // The candidates, in input order; duplicates among them go once the vertices are renumbered.
+  face_source_.resize(m - degenerate);
+  if (degenerate == 0) {
+#pragma omp parallel for schedule(static) if (m >= kParallelMin)
+    for (int64_t f = 0; f < m; ++f) face_source_[f] = int32_t(f);
   } else {
     int64_t j = 0;
-    for (int64_t i = 0; i < k; ++i)
-      if (!duplicate[i]) face_source_[j++] = candidates[i];
+    for (int64_t f = 0; f < m; ++f) {
+      const int32_t* t = triangles + 3 * f;
+      if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
+        report_.dropped_triangles.push_back(static_cast<int32_t>(f));
+        dropped_rows_.insert(dropped_rows_.end(), t, t + 3);
+      } else {
+        face_source_[j++] = int32_t(f);
+      }
+    }
   }
-  faces_.resize(3 * kept);
-  int32_t zero_area = 0;
-#pragma omp parallel for schedule(static) reduction(+ : zero_area) if (kept >= kParallelMin)
-  for (int64_t i = 0; i < kept; ++i) {
-    const int32_t* t = triangles + 3 * size_t(face_source_[i]);
-    std::copy(t, t + 3, faces_.begin() + 3 * i);
-    double n[3];
-    cross(position(t[0]), position(t[1]), position(t[2]), n);
-    if (n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0) ++zero_area;
-  }
-  report_.zero_area_triangles = zero_area;
-  std::sort(report_.dropped_triangles.begin(), report_.dropped_triangles.end());
-  if (faces_.empty())
+  if (face_source_.empty())
     throw std::invalid_argument("mesh has no valid triangles: all " + std::to_string(num_triangles) +
                                 " repeat a vertex or duplicate another");
 }
@@ -159,237 +143,379 @@ uint64_t spread_bits(uint64_t x) {
   x = (x | x << 2) & 0x1249249249249249ull;
   return x;
 }
-
-// Sorts (key, vertex) pairs by key, ties by vertex, as std::sort on the pairs would: a stable
-// least-significant-digit radix sort over the bits the keys use, on input in vertex order.
-void radix_sort_keys(std::vector<std::pair<uint64_t, int32_t>>& keyed, int key_bits) {
-  constexpr int kDigit = 11;
-  std::vector<std::pair<uint64_t, int32_t>> other(keyed.size());
-  std::vector<size_t> count(size_t(1) << kDigit);
-  for (int shift = 0; shift < key_bits; shift += kDigit) {
-    std::fill(count.begin(), count.end(), 0);
-    for (const auto& k : keyed) ++count[(k.first >> shift) & ((1u << kDigit) - 1)];
-    size_t sum = 0;
-    for (auto& c : count) sum += std::exchange(c, sum);
-    for (const auto& k : keyed) other[count[(k.first >> shift) & ((1u << kDigit) - 1)]++] = k;
-    keyed.swap(other);
-  }
-}
 }  // namespace
 
-void Mesh::reorder_for_locality(const double* lo, const double* hi) {
+void Mesh::reorder_for_locality(const double* positions, const int32_t* triangles, const double* lo,
+                                 const double* hi) {
   const int32_t n = num_vertices_;
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
-  std::vector<std::pair<uint64_t, int32_t>> keyed(n);
+  Buffer<uint64_t> key(n), other_key(n);
+  Buffer<int32_t> other_vertex(n);
+  vertex_source_.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
-    uint64_t key = 0;
-    for (int k = 0; k < 3; ++k) {
+    vertex_source_[v] = v;
+    uint64_t k = 0;
+    for (int axis = 0; axis < 3; ++axis) {
       // Differences near the double range overflow to inf and inf / inf is NaN, which
-      // std::clamp passes through: NaN goes to 0 (converting it to an integer is undefined).
-      const double t = (positions_[3 * size_t(v) + k] - lo[k]) / extent;
+      // std::min passes through: NaN goes to 0 (converting it to an integer is undefined).
+      const double t = (positions[3 * size_t(v) + axis] - lo[axis]) / extent;
       const double unit = t >= 0.0 ? std::min(t, 1.0) : 0.0;
-      key |= spread_bits(uint64_t(unit * 2097151.0)) << k;
+      k |= spread_bits(uint64_t(unit * 2097151.0)) << axis;
     }
-    keyed[v] = {key, v};
+    key[v] = k;
   }
-  radix_sort_keys(keyed, 63);
-  vertex_source_.resize(n);
+  // Vertices by key, ties by vertex: a stable least-significant-digit radix sort over the 63
+  // bits the keys use, starting from vertex order.
+  {
+    constexpr int kDigit = 11;
+    constexpr uint64_t kMask = (1u << kDigit) - 1;
+    std::vector<int32_t> offsets;
+    for (int shift = 0; shift < 63; shift += kDigit) {
+      const uint64_t* from_key = key.data();
+      const int32_t* from_vertex = vertex_source_.data();
+      stable_counting_sort(
+          n, int32_t(kMask + 1), [&](int64_t i) { return int32_t((from_key[i] >> shift) & kMask); },
+          [&](int64_t i, int32_t at) {
+            other_key[at] = from_key[i];
+            other_vertex[at] = from_vertex[i];
+          },
+          offsets);
+      key.swap(other_key);
+      vertex_source_.swap(other_vertex);
+    }
+  }
+  Buffer<uint64_t>().swap(key);
+  Buffer<uint64_t>().swap(other_key);
+  Buffer<int32_t>().swap(other_vertex);
   vertex_index_.resize(n);
-  std::vector<double> moved(positions_.size());
+  positions_.resize(3 * size_t(n));
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t i = 0; i < n; ++i) {
-    const int32_t old = keyed[i].second;
-    vertex_source_[i] = old;
+    const int32_t old = vertex_source_[i];
     vertex_index_[old] = i;
-    for (int k = 0; k < 3; ++k) moved[3 * size_t(i) + k] = positions_[3 * size_t(old) + k];
+    for (int k = 0; k < 3; ++k) positions_[3 * size_t(i) + k] = positions[3 * size_t(old) + k];
   }
-  positions_.swap(moved);
-  const int64_t corners = static_cast<int64_t>(faces_.size());
-#pragma omp parallel for schedule(static) if (corners >= kParallelMin)
-  for (int64_t i = 0; i < corners; ++i) faces_[i] = vertex_index_[faces_[i]];
-  // Faces in order of their lowest vertex (a stable counting sort keeps ties in input order).
-  const int32_t m = num_faces();
-  std::vector<int32_t> offsets(n + 1, 0);
-  auto lowest = [&](int32_t f) { return std::min({faces_[3 * f], faces_[3 * f + 1], faces_[3 * f + 2]}); };
-  for (int32_t f = 0; f < m; ++f) ++offsets[lowest(f) + 1];
-  for (int32_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
-  std::vector<int32_t> order(m);
-  for (int32_t f = 0; f < m; ++f) order[offsets[lowest(f)]++] = f;
-  std::vector<int32_t> faces(faces_.size()), source(m);
+  // The candidate faces in the new numbering, in order of their lowest vertex, ties in input
+  // order, read straight from the caller's array. A counting sort with a bucket per vertex
+  // scattered every face to a random place (130 ms on the horse, one thread); instead the keys
+  // (lowest vertex, candidate) are radix-sorted in two passes of about ten bits, whose scatters
+  // stay within a few thousand cache lines, and the faces are then gathered in order.
+  const int32_t m = static_cast<int32_t>(face_source_.size());
+  auto corner = [&](int64_t i, int c) { return vertex_index_[triangles[3 * size_t(face_source_[i]) + c]]; };
+  Buffer<uint64_t> keyed(m);
 #pragma omp parallel for schedule(static) if (m >= kParallelMin)
-  for (int32_t i = 0; i < m; ++i) {
-    for (int c = 0; c < 3; ++c) faces[3 * size_t(i) + c] = faces_[3 * size_t(order[i]) + c];
-    source[i] = face_source_[order[i]];
+  for (int32_t i = 0; i < m; ++i)
+    keyed[i] = (uint64_t(uint32_t(std::min({corner(i, 0), corner(i, 1), corner(i, 2)}))) << 32) | uint32_t(i);
+  {
+    int bits = 1;
+    while (bits < 31 && (int64_t(1) << bits) < int64_t(n)) ++bits;
+    const int passes = (bits + 10) / 11, digit = (bits + passes - 1) / passes;
+    const uint64_t mask = (uint64_t(1) << digit) - 1;
+    Buffer<uint64_t> other(m);
+    Buffer<int32_t> ignored;
+    for (int pass = 0; pass < passes; ++pass) {
+      const int shift = 32 + pass * digit;
+      const uint64_t* from = keyed.data();
+      stable_counting_sort(
+          m, int32_t(mask + 1), [&](int64_t i) { return int32_t((from[i] >> shift) & mask); },
+          [&](int64_t i, int32_t at) { other[at] = from[i]; }, ignored);
+      keyed.swap(other);
+    }
   }
-  faces_.swap(faces);
+  faces_.resize(3 * size_t(m));
+  Buffer<int32_t> source(m), lowest_offsets(size_t(n) + 1);
+#pragma omp parallel for schedule(static) if (m >= kParallelMin)
+  for (int32_t j = 0; j < m; ++j) {
+    // The caller's rows are read in a new order: fetch a few faces ahead.
+    if (j + 16 < m) __builtin_prefetch(&triangles[3 * size_t(face_source_[keyed[j + 16] & 0xffffffffu])]);
+    if (j + 8 < m) {
+      const int32_t* ahead = &triangles[3 * size_t(face_source_[keyed[j + 8] & 0xffffffffu])];
+      for (int c = 0; c < 3; ++c) __builtin_prefetch(&vertex_index_[ahead[c]]);
+    }
+    const int64_t i = int64_t(keyed[j] & 0xffffffffu);
+    for (int c = 0; c < 3; ++c) faces_[3 * size_t(j) + c] = corner(i, c);
+    source[j] = face_source_[i];
+    // The runs of each lowest vertex: every vertex after the previous face's lowest, up to
+    // this face's, starts here.
+    const int64_t lowest = int64_t(keyed[j] >> 32), previous = j ? int64_t(keyed[j - 1] >> 32) : -1;
+    for (int64_t v = previous + 1; v <= lowest; ++v) lowest_offsets[v] = j;
+  }
+  for (int64_t v = int64_t(keyed[m - 1] >> 32) + 1; v <= int64_t(n); ++v) lowest_offsets[v] = m;
   face_source_.swap(source);
+  drop_duplicate_faces(lowest_offsets);
+}
+
+void Mesh::drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets) {
+  // Duplicates (the same three vertices, either orientation) share their lowest vertex, so they
+  // sit in one run of the sorted faces, which holds them in input order: the first is kept.
+  const int32_t n = num_vertices_;
+  const int32_t m = num_faces();
+  std::vector<uint8_t> duplicate(m, 0);
+  int32_t duplicates = 0;
+#pragma omp parallel reduction(+ : duplicates) if (n >= kParallelMin)
+  {
+    std::vector<std::pair<uint64_t, int32_t>> run;  // (other two vertices, face), long runs only
+#pragma omp for schedule(static)
+    for (int32_t v = 0; v < n; ++v) {
+      const int32_t b = lowest_offsets[v], e = lowest_offsets[v + 1];
+      if (e - b < 2) continue;
+      auto others = [&](int32_t f) {
+        const int32_t* t = &faces_[3 * size_t(f)];
+        const int32_t x = t[0] == v ? t[1] : t[0], y = t[2] == v ? t[1] : t[2];
+        return (uint64_t(uint32_t(std::min(x, y))) << 32) | uint32_t(std::max(x, y));
+      };
+      if (e - b <= 16) {
+        for (int32_t i = b; i < e; ++i) {
+          if (duplicate[i]) continue;
+          const uint64_t key = others(i);
+          for (int32_t j = i + 1; j < e; ++j)
+            if (!duplicate[j] && others(j) == key) duplicate[j] = 1, ++duplicates;
+        }
+      } else {  // a fan around a low vertex: sort instead of comparing every pair
+        run.clear();
+        for (int32_t i = b; i < e; ++i) run.push_back({others(i), i});
+        std::sort(run.begin(), run.end());
+        for (size_t i = 1; i < run.size(); ++i)
+          if (run[i].first == run[i - 1].first) duplicate[run[i].second] = 1, ++duplicates;
+      }
+    }
+  }
+  if (duplicates == 0) return;
+  report_.duplicate_triangles = duplicates;
+  // Dropped triangles (the repeated-vertex ones are there already) in input order, with rows.
+  std::vector<std::pair<int32_t, std::array<int32_t, 3>>> dropped;
+  for (size_t i = 0; i < report_.dropped_triangles.size(); ++i)
+    dropped.push_back({report_.dropped_triangles[i], {dropped_rows_[3 * i], dropped_rows_[3 * i + 1], dropped_rows_[3 * i + 2]}});
+  int32_t kept = 0;
+  for (int32_t f = 0; f < m; ++f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
+    if (duplicate[f]) {
+      dropped.push_back({face_source_[f], {vertex_source_[t[0]], vertex_source_[t[1]], vertex_source_[t[2]]}});
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) faces_[3 * size_t(kept) + c] = t[c];
+    face_source_[kept++] = face_source_[f];
+  }
+  faces_.resize(3 * size_t(kept));
+  face_source_.resize(kept);
+  std::sort(dropped.begin(), dropped.end());
+  report_.dropped_triangles.clear();
+  dropped_rows_.clear();
+  for (const auto& [index, row] : dropped) {
+    report_.dropped_triangles.push_back(index);
+    dropped_rows_.insert(dropped_rows_.end(), row.begin(), row.end());
+  }
+}
+
+std::vector<int32_t> Mesh::caller_triangles() const {
+  std::vector<int32_t> out(3 * size_t(report_.input_triangles));
+  const int32_t m = num_faces();
+#pragma omp parallel for schedule(static) if (m >= kParallelMin)
+  for (int32_t f = 0; f < m; ++f)
+    for (int c = 0; c < 3; ++c) out[3 * size_t(face_source_[f]) + c] = vertex_source_[faces_[3 * size_t(f) + c]];
+  for (size_t i = 0; i < report_.dropped_triangles.size(); ++i)
+    for (int c = 0; c < 3; ++c) out[3 * size_t(report_.dropped_triangles[i]) + c] = dropped_rows_[3 * i + c];
+  return out;
 }
 
 void Mesh::build_vertex_faces() {
-  const int32_t m = num_faces();
-  vertex_face_offsets_.assign(num_vertices_ + 1, 0);
-  for (int32_t v : faces_) ++vertex_face_offsets_[v];
-  exclusive_scan(vertex_face_offsets_);
+  // Each vertex's faces in increasing order: a stable counting sort of the corners.
   vertex_faces_.resize(faces_.size());
-  std::vector<int32_t> fill(vertex_face_offsets_.begin(), vertex_face_offsets_.end() - 1);
-  for (int32_t f = 0; f < m; ++f)
-    for (int c = 0; c < 3; ++c) vertex_faces_[fill[faces_[3 * f + c]]++] = f;
-  for (int32_t v = 0; v < num_vertices_; ++v)
-    if (vertex_face_offsets_[v + 1] == vertex_face_offsets_[v]) ++report_.isolated_vertices;
+  stable_counting_sort(
+      int64_t(faces_.size()), num_vertices_, [&](int64_t c) { return faces_[c]; },
+      [&](int64_t c, int32_t at) { vertex_faces_[at] = int32_t(c / 3); }, vertex_face_offsets_);
+  int32_t isolated = 0;
+  const int32_t n = num_vertices_;
+#pragma omp parallel for schedule(static) reduction(+ : isolated) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) isolated += vertex_face_offsets_[v + 1] == vertex_face_offsets_[v];
+  report_.isolated_vertices = isolated;
 }
 
-void Mesh::build_adjacency_and_edges() {
+void Mesh::build_adjacency(Progress& progress) {
+  progress.stage("adjacency", 0.45, 0.8);
   const int32_t n = num_vertices_;
-  // Each vertex sees at most two neighbours per incident face: gather, sort, unique in place.
-  std::vector<int32_t> scratch(2 * vertex_faces_.size());
-  std::vector<int32_t> degree(n + 1, 0);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
-    int32_t* out = scratch.data() + 2 * size_t(vertex_face_offsets_[v]);
-    int32_t k = 0;
-    for (int32_t i = vertex_face_offsets_[v]; i < vertex_face_offsets_[v + 1]; ++i) {
-      const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
-      for (int c = 0; c < 3; ++c)
-        if (t[c] != v) out[k++] = t[c];
+  const auto& vfo = vertex_face_offsets_;
+  // First pass, per vertex, from its faces alone: the link (for each face (v, a, b) the arc
+  // a -> b) gives the sorted neighbours, the triangles and directions of every edge at v (each
+  // edge counted at its lower end) and whether v is a manifold vertex; also the normal and the
+  // area. Neighbours wait in `scratch` (at twice the vertex's first face slot: it has at most two
+  // per face) until the offsets are known. Edge ids and tables come later, on demand
+  // (build_edges).
+  // Buffers are written on the threads that fill them (see core/buffer.hpp): every entry a loop
+  // skips is set explicitly.
+  Buffer<int32_t> scratch(2 * vertex_faces_.size());
+  Buffer<int32_t> degree(n + 1), greater(n + 1), euler(n);
+  degree[n] = greater[n] = 0;
+  normals_.resize(3 * size_t(n));
+  vertex_areas_.resize(n);
+  manifold_vertex_.resize(n);
+  SharedUnionFind sets(n);  // components: each set's root is its lowest vertex
+  int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
+#pragma omp parallel reduction(+ : boundary, nonmanifold_edges, inconsistent, pinched, zero_area) if (n >= kParallelMin)
+  {
+    std::vector<uint64_t> ends;                   // (neighbour, 2 slot + (1 if the arc enters it))
+    std::vector<int32_t> end_rank, in, out, next;
+#pragma omp for schedule(static)
+    for (int32_t v = 0; v < n; ++v) {
+      const int32_t first = vfo[v], k = vfo[v + 1] - first;
+      manifold_vertex_[v] = 1;
+      if (k == 0) {  // isolated: no neighbours, in no component
+        degree[v] = greater[v] = euler[v] = 0;
+        normals_[3 * size_t(v)] = normals_[3 * size_t(v) + 1] = normals_[3 * size_t(v) + 2] = 0.0;
+        vertex_areas_[v] = 0.0;
+        continue;
+      }
+      ends.resize(2 * size_t(k));
+      end_rank.resize(2 * size_t(k));
+      double sum[3] = {0, 0, 0}, area = 0.0;
+      int32_t lowest_of = 0;  // faces whose lowest vertex is v
+      for (int32_t i = 0; i < k; ++i) {
+        const int32_t* t = &faces_[3 * size_t(vertex_faces_[first + i])];
+        const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+        // Area-weighted: the unnormalised face normal (twice the area) summed at each corner.
+        double fn[3];
+        cross(position(t[0]), position(t[1]), position(t[2]), fn);
+        sum[0] += fn[0];
+        sum[1] += fn[1];
+        sum[2] += fn[2];
+        area += std::sqrt(fn[0] * fn[0] + fn[1] * fn[1] + fn[2] * fn[2]) / 6.0;  // a third of half the cross
+        const int32_t a = t[(c + 1) % 3], b = t[(c + 2) % 3];
+        if (v < a && v < b) {
+          ++lowest_of;
+          if (fn[0] == 0.0 && fn[1] == 0.0 && fn[2] == 0.0) ++zero_area;
+        }
+        ends[2 * size_t(i)] = (uint64_t(uint32_t(a)) << 32) | uint32_t(2 * i);         // side v -> a
+        ends[2 * size_t(i) + 1] = (uint64_t(uint32_t(b)) << 32) | uint32_t(2 * i + 1);  // side b -> v
+      }
+      vertex_areas_[v] = area;
+      const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+      for (int j = 0; j < 3; ++j) normals_[3 * size_t(v) + j] = len > 0 ? sum[j] / len : 0.0;
+      int32_t* neighbours = scratch.data() + 2 * size_t(first);
+      int32_t d = 0;
+      sort_small(ends.data(), ends.data() + ends.size());
+      in.clear(), out.clear();
+      for (const uint64_t end : ends) {
+        const int32_t u = int32_t(end >> 32), tag = int32_t(end & 0xffffffffu);
+        if (d == 0 || neighbours[d - 1] != u) {
+          neighbours[d++] = u;
+          in.push_back(0), out.push_back(0);
+        }
+        end_rank[tag] = d - 1;
+        if (tag & 1) ++in[d - 1];
+        else ++out[d - 1];
+      }
+      const int32_t lower = int32_t(std::lower_bound(neighbours, neighbours + d, v) - neighbours);
+      degree[v] = d;
+      greater[v] = d - lower;
+      euler[v] = 1 - (d - lower) + lowest_of;
+      // Edge (v, u) has in + out triangles; two are consistent when they traverse it in opposite
+      // directions (one arc leaves u, one enters it). Each edge is counted at its lower end.
+      bool nonmanifold_edge = false, flipped = false;
+      for (int32_t r = 0; r < d; ++r) {
+        const int32_t count = in[r] + out[r];
+        const bool bad_direction = count == 2 && !(in[r] == 1 && out[r] == 1);
+        nonmanifold_edge |= count > 2;
+        flipped |= bad_direction;
+        if (r < lower) continue;
+        boundary += count == 1;
+        nonmanifold_edges += count >= 3;
+        inconsistent += bad_direction;
+        sets.unite(v, neighbours[r]);
+      }
+      // Fans: with every edge at v on at most two triangles, consistently oriented, the arcs are
+      // paths and cycles, and one fan means exactly one of them. With flipped edges the fans are
+      // the groups of arcs that share a neighbour (their faces share that edge).
+      int32_t fans = 1;
+      if (!nonmanifold_edge) {
+        next.assign(d, -1);
+        if (!flipped) {
+          int32_t start = 0, starts = 0;
+          for (int32_t i = 0; i < k; ++i) next[end_rank[2 * i]] = end_rank[2 * i + 1];
+          for (int32_t r = 0; r < d; ++r)
+            if (in[r] == 0) start = r, ++starts;
+          int32_t walked = 0;
+          if (starts <= 1)
+            for (int32_t x = start; walked <= k;) {
+              const int32_t w = next[x];
+              if (w < 0) break;  // end of a path
+              ++walked;
+              if (w == start) break;  // closed the cycle
+              x = w;
+            }
+          fans = walked == k ? 1 : 2;
+        } else {
+          for (int32_t r = 0; r < d; ++r) next[r] = r;  // a union-find over the neighbours
+          auto root = [&](int32_t x) {
+            while (next[x] != x) x = next[x] = next[next[x]];
+            return x;
+          };
+          fans = d;
+          for (int32_t i = 0; i < k; ++i) {
+            const int32_t x = root(end_rank[2 * i]), y = root(end_rank[2 * i + 1]);
+            if (x != y) next[std::max(x, y)] = std::min(x, y), --fans;
+          }
+        }
+      }
+      if (fans > 1 || nonmanifold_edge || flipped) {
+        manifold_vertex_[v] = 0;
+        if (fans > 1 && !nonmanifold_edge) ++pinched;  // pinched, not merely on a bad edge
+      }
     }
-    std::sort(out, out + k);
-    degree[v] = static_cast<int32_t>(std::unique(out, out + k) - out);
   }
-  adjacency_offsets_ = degree;
+  report_.boundary_edges = boundary;
+  report_.nonmanifold_edges = nonmanifold_edges;
+  report_.inconsistent_edges = inconsistent;
+  report_.nonmanifold_vertices = pinched;
+  report_.zero_area_triangles = zero_area;
+
+  adjacency_offsets_.swap(degree);
   exclusive_scan(adjacency_offsets_);
+  exclusive_scan(greater);
+  num_edges_ = greater[n];
   adjacency_.resize(adjacency_offsets_[n]);
-  adjacency_edge_.resize(adjacency_offsets_[n]);
-  // Edge ids: edges are numbered by their lower endpoint, then by the higher one.
-  std::vector<int32_t> greater(n + 1, 0);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
-    const int32_t* src = scratch.data() + 2 * size_t(vertex_face_offsets_[v]);
-    std::copy(src, src + degree[v], adjacency_.begin() + adjacency_offsets_[v]);
-    greater[v] = static_cast<int32_t>(src + degree[v] - std::upper_bound(src, src + degree[v], v));
-  }
-  std::vector<int32_t> edge_base = greater;
-  exclusive_scan(edge_base);
-  const int32_t num_edges = edge_base[n];
-  edge_vertices_.resize(2 * size_t(num_edges));
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
-    const int32_t b = adjacency_offsets_[v], e = adjacency_offsets_[v + 1];
-    const int32_t first_greater = e - greater[v];
-    for (int32_t i = b; i < e; ++i) {
-      const int32_t u = adjacency_[i];
-      if (i >= first_greater) {
-        const int32_t id = edge_base[v] + (i - first_greater);
-        adjacency_edge_[i] = id;
-        edge_vertices_[2 * size_t(id)] = v;
-        edge_vertices_[2 * size_t(id) + 1] = u;
-      }
-    }
-  }
-  // Slots towards lower neighbours: v's lower neighbours u come in increasing order, and so do
-  // the edges (u, v) as u grows, so one cursor per vertex fills them without searching.
-  std::vector<int32_t> cursor(adjacency_offsets_.begin(), adjacency_offsets_.end() - 1);
-  for (int32_t v = 0; v < n; ++v)
-    for (int32_t i = adjacency_offsets_[v + 1] - greater[v]; i < adjacency_offsets_[v + 1]; ++i)
-      adjacency_edge_[cursor[adjacency_[i]]++] = adjacency_edge_[i];
-  // The edge of each face side, found by its lower endpoint among its higher neighbours.
-  face_edges_.resize(faces_.size());
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
-    const int32_t* first = adjacency_.data() + adjacency_offsets_[v + 1] - greater[v];
-    const int32_t* last = adjacency_.data() + adjacency_offsets_[v + 1];
-    for (int32_t i = vertex_face_offsets_[v]; i < vertex_face_offsets_[v + 1]; ++i) {
-      const int32_t f = vertex_faces_[i];
-      const int32_t* t = &faces_[3 * size_t(f)];
-      const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-      for (int side : {c, (c + 2) % 3}) {
-        const int32_t u = t[side == c ? (c + 1) % 3 : side];
-        if (u > v) face_edges_[3 * size_t(f) + side] = edge_base[v] + int32_t(std::lower_bound(first, last, u) - first);
-      }
-    }
-  }
-}
+  weights_.resize(n);
 
-int32_t Mesh::find_edge(int32_t a, int32_t b) const {
-  if (a < 0 || a >= num_vertices_ || b < 0 || b >= num_vertices_) return -1;
-  const auto* begin = adjacency_.data() + adjacency_offsets_[a];
-  const auto* end = adjacency_.data() + adjacency_offsets_[a + 1];
-  const auto* it = std::lower_bound(begin, end, b);
-  return (it != end && *it == b) ? adjacency_edge_[it - adjacency_.data()] : -1;
-}
-
-void Mesh::build_edge_faces() {
-  const int32_t m = num_faces();
-  edge_face_offsets_.assign(num_edges() + 1, 0);
-  for (int32_t e : face_edges_) ++edge_face_offsets_[e];
-  exclusive_scan(edge_face_offsets_);
-  edge_faces_.resize(face_edges_.size());
-  std::vector<int32_t> fill(edge_face_offsets_.begin(), edge_face_offsets_.end() - 1);
-  for (int32_t f = 0; f < m; ++f)
-    for (int c = 0; c < 3; ++c) edge_faces_[fill[face_edges_[3 * f + c]]++] = f;
-  inconsistent_edge_.assign(num_edges(), 0);
-  for (int32_t e = 0; e < num_edges(); ++e) {
-    const int32_t k = edge_face_count(e);
-    if (k == 1) ++report_.boundary_edges;
-    if (k >= 3) ++report_.nonmanifold_edges;
-    if (k == 2) {
-      // Consistent orientation: the two faces traverse the edge in opposite directions.
-      const int32_t a = edge_vertices_[2 * e];
-      auto forward = [&](int32_t f) {
-        for (int c = 0; c < 3; ++c)
-          if (face_edges_[3 * f + c] == e) return faces_[3 * f + c] == a;
-        return false;
-      };
-      if (forward(edge_faces_[edge_face_offsets_[e]]) == forward(edge_faces_[edge_face_offsets_[e] + 1])) {
-        ++report_.inconsistent_edges;
-        inconsistent_edge_[e] = 1;
-      }
-    }
-  }
-}
-
-void Mesh::compute_normals_and_weights() {
-  const int32_t n = num_vertices_;
-  const int32_t m = num_faces();
-  // Area-weighted: the unnormalised face normal (twice the area) summed at each corner.
-  std::vector<double> face_normals(3 * size_t(m));
-#pragma omp parallel for schedule(static) if (m >= kParallelMin)
-  for (int32_t f = 0; f < m; ++f) {
-    const int32_t* t = &faces_[3 * size_t(f)];
-    cross(position(t[0]), position(t[1]), position(t[2]), &face_normals[3 * size_t(f)]);
-  }
-  normals_.assign(3 * size_t(n), 0.0);
-  weights_.assign(n, 0.0);
-  vertex_areas_.assign(n, 0.0);
+  progress.stage("normals and weights", 0.8, 0.92);
+  // Second pass: the neighbours into place and the importance weight, which needs the
+  // neighbours' normals from the first pass.
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
-    double sum[3] = {0, 0, 0}, area = 0.0;
-    for (int32_t i = vertex_face_offsets_[v]; i < vertex_face_offsets_[v + 1]; ++i) {
-      const double* fn = &face_normals[3 * size_t(vertex_faces_[i])];
-      sum[0] += fn[0];
-      sum[1] += fn[1];
-      sum[2] += fn[2];
-      area += std::sqrt(fn[0] * fn[0] + fn[1] * fn[1] + fn[2] * fn[2]) / 6.0;  // a third of half the cross
+    const int32_t d = adjacency_offsets_[v + 1] - adjacency_offsets_[v];
+    if (d == 0) {
+      weights_[v] = 0.0;
+      continue;
     }
-    vertex_areas_[v] = area;
-    const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
-    if (len > 0)
-      for (int k = 0; k < 3; ++k) normals_[3 * size_t(v) + k] = sum[k] / len;
-  }
-  // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
-    const int32_t b = adjacency_offsets_[v], e = adjacency_offsets_[v + 1];
-    if (b == e) continue;
+    const int32_t* neighbours = scratch.data() + 2 * size_t(vfo[v]);
+    std::copy(neighbours, neighbours + d, adjacency_.begin() + adjacency_offsets_[v]);
+    // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
     const double* nv = &normals_[3 * size_t(v)];
     double dots = 0.0;
-    for (int32_t i = b; i < e; ++i) {
-      const double* nu = &normals_[3 * size_t(adjacency_[i])];
+    for (int32_t r = 0; r < d; ++r) {
+      const double* nu = &normals_[3 * size_t(neighbours[r])];
       dots += nv[0] * nu[0] + nv[1] * nu[1] + nv[2] * nu[2];
     }
-    const double x = (double(e - b) - dots) / (2.0 * double(e - b));
-    weights_[v] = std::clamp(x, 0.0, 1.0);
+    weights_[v] = std::clamp((double(d) - dots) / (2.0 * double(d)), 0.0, 1.0);
   }
+
+  progress.stage("components", 0.92, 1.0);
+  // Components, numbered in order of their lowest vertex (each set's root), and the Euler
+  // characteristic V - E + F of each from every vertex's share: itself, the edges to its higher
+  // neighbours and the faces it is the lowest vertex of.
+  Buffer<int32_t>& root = greater;  // its offsets are no longer needed
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) root[v] = sets.find(v);
+  component_.resize(n);
+  int32_t components = 0;
+  for (int32_t v = 0; v < n; ++v) {
+    if (vfo[v] == vfo[v + 1]) component_[v] = -1;
+    else component_[v] = root[v] == v ? components++ : component_[root[v]];
+  }
+  report_.components = components;
+  component_euler_.assign(components, 0);
+  for (int32_t v = 0; v < n; ++v)
+    if (component_[v] >= 0) component_euler_[component_[v]] += euler[v];
+
   // The means are summed in vertex order on one thread: an OpenMP reduction adds in an order
   // that depends on the number of threads, and so would change the last bits of the result.
   double total = 0.0, total_area = 0.0;
@@ -404,88 +530,97 @@ void Mesh::compute_normals_and_weights() {
   mean_vertex_area_ = counted ? total_area / double(counted) : 0.0;
 }
 
-bool Mesh::one_oriented_fan(int32_t v) const {
-  const int32_t begin = vertex_face_offsets_[v], count = vertex_face_offsets_[v + 1] - begin;
-  auto corner = [&](int32_t f) {
-    const int32_t* t = &faces_[3 * size_t(f)];
-    return t[0] == v ? 0 : t[1] == v ? 1 : 2;
-  };
-  // Each boundary side arriving at v starts a chain of faces; more than one chain is a pinch.
-  int32_t start = vertex_faces_[begin], chains = 0;
-  for (int32_t i = begin; i < begin + count; ++i) {
-    const int32_t f = vertex_faces_[i];
-    if (edge_face_count(face_edges_[3 * size_t(f) + (corner(f) + 2) % 3]) == 1) {
-      start = f;
-      if (++chains > 1) return false;
+void Mesh::build_edges() const {
+  std::call_once(edges_once_, [this] {
+    const int32_t n = num_vertices_;
+    const auto& ao = adjacency_offsets_;
+    const auto& vfo = vertex_face_offsets_;
+    // Per vertex: where it sits in its own sorted row (its lower neighbours come first), and
+    // how many face sides lead to higher neighbours (each edge belongs to its lower end).
+    Buffer<int32_t> lower(n), edge_base(n + 1), side_base(n + 1);
+    edge_base[n] = side_base[n] = 0;
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (int32_t v = 0; v < n; ++v) {
+      const int32_t* row = adjacency_.data() + ao[v];
+      const int32_t d = ao[v + 1] - ao[v];
+      lower[v] = int32_t(std::lower_bound(row, row + d, v) - row);
+      edge_base[v] = d - lower[v];
+      int32_t sides = 0;
+      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
+        const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
+        const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+        sides += (t[(c + 1) % 3] > v) + (t[(c + 2) % 3] > v);
+      }
+      side_base[v] = sides;
     }
-  }
-  // Walk across the sides leaving v (the next face arrives at v by the same edge) until the
-  // chain ends or the cycle closes; one fan holds every face of v.
-  int32_t f = start, visited = 1;
-  while (visited <= count) {
-    const int32_t e = face_edges_[3 * size_t(f) + corner(f)];
-    if (edge_face_count(e) != 2) break;
-    const int32_t* ef = &edge_faces_[edge_face_offsets_[e]];
-    f = ef[0] == f ? ef[1] : ef[0];
-    if (f == start) break;
-    ++visited;
-  }
-  return visited == count;
+    exclusive_scan(edge_base);
+    exclusive_scan(side_base);
+    adjacency_edge_.resize(ao[n]);
+    edge_vertices_.resize(2 * size_t(num_edges_));
+    edge_face_offsets_.resize(size_t(num_edges_) + 1);
+    edge_faces_.resize(faces_.size());
+    face_edges_.resize(faces_.size());
+    // Edges numbered by lower end, then higher end; each vertex writes its own edges: their
+    // slots in both rows, their ends, the edge of each face side it owns, and its edges' faces
+    // in increasing order.
+#pragma omp parallel if (n >= kParallelMin)
+    {
+      std::vector<int32_t> fill;
+#pragma omp for schedule(static)
+      for (int32_t v = 0; v < n; ++v) {
+        const int32_t* row = adjacency_.data() + ao[v];
+        const int32_t d = ao[v + 1] - ao[v], low = lower[v], higher = d - low;
+        for (int32_t r = low; r < d; ++r) {
+          const int32_t u = row[r], e = edge_base[v] + (r - low);
+          adjacency_edge_[ao[v] + r] = e;
+          edge_vertices_[2 * size_t(e)] = v;
+          edge_vertices_[2 * size_t(e) + 1] = u;
+          // The same edge in u's row, among u's lower neighbours (sorted, and v is one of them).
+          const int32_t* u_row = adjacency_.data() + ao[u];
+          adjacency_edge_[ao[u] + int32_t(std::lower_bound(u_row, u_row + lower[u], v) - u_row)] = e;
+        }
+        fill.assign(higher, 0);
+        auto rank = [&](int32_t u) { return int32_t(std::lower_bound(row + low, row + d, u) - (row + low)); };
+        for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
+          const int32_t f = vertex_faces_[i];
+          const int32_t* t = &faces_[3 * size_t(f)];
+          const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+          for (int side : {c, (c + 2) % 3}) {
+            const int32_t u = t[side == c ? (c + 1) % 3 : side];
+            if (u < v) continue;  // the edge belongs to the other end
+            const int32_t j = rank(u);
+            face_edges_[3 * size_t(f) + side] = edge_base[v] + j;
+            ++fill[j];
+          }
+        }
+        int32_t at = side_base[v];
+        for (int32_t j = 0; j < higher; ++j) {
+          edge_face_offsets_[edge_base[v] + j] = at;
+          at += std::exchange(fill[j], at);
+        }
+        for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
+          const int32_t f = vertex_faces_[i];
+          const int32_t* t = &faces_[3 * size_t(f)];
+          const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+          for (int side : {c, (c + 2) % 3}) {
+            if (t[side == c ? (c + 1) % 3 : side] < v) continue;
+            edge_faces_[fill[face_edges_[3 * size_t(f) + side] - edge_base[v]]++] = f;
+          }
+        }
+      }
+    }
+    edge_face_offsets_[num_edges_] = side_base[n];
+    edges_built_.store(true, std::memory_order_release);
+  });
 }
 
-void Mesh::compute_components_and_manifoldness() {
-  const int32_t n = num_vertices_;
-  component_.assign(n, -1);
-  std::vector<int32_t> stack;
-  int32_t components = 0;
-  for (int32_t s = 0; s < n; ++s) {
-    if (component_[s] >= 0 || adjacency_offsets_[s] == adjacency_offsets_[s + 1]) continue;
-    component_[s] = components;
-    stack.push_back(s);
-    while (!stack.empty()) {
-      const int32_t v = stack.back();
-      stack.pop_back();
-      for (int32_t i = adjacency_offsets_[v]; i < adjacency_offsets_[v + 1]; ++i)
-        if (component_[adjacency_[i]] < 0) {
-          component_[adjacency_[i]] = components;
-          stack.push_back(adjacency_[i]);
-        }
-    }
-    ++components;
-  }
-  report_.components = components;
-  component_euler_.assign(components, 0);
-  for (int32_t v = 0; v < n; ++v)
-    if (component_[v] >= 0) ++component_euler_[component_[v]];
-  for (int32_t e = 0; e < num_edges(); ++e) --component_euler_[component_[edge_vertices_[2 * e]]];
-  for (int32_t f = 0; f < num_faces(); ++f) ++component_euler_[component_[faces_[3 * f]]];
-
-  manifold_vertex_.assign(n, 1);
-  int32_t pinched = 0;
-#pragma omp parallel reduction(+ : pinched) if (n >= kParallelMin)
-  {
-    std::vector<int32_t> fan_of_slot;
-#pragma omp for schedule(static)
-    for (int32_t v = 0; v < n; ++v) {
-      if (vertex_face_offsets_[v] == vertex_face_offsets_[v + 1]) continue;
-      bool nonmanifold_edge = false, flipped = false;
-      for (int32_t i = adjacency_offsets_[v]; i < adjacency_offsets_[v + 1]; ++i)
-      {
-        if (edge_face_count(adjacency_edge_[i]) > 2) nonmanifold_edge = true;
-        if (inconsistent_edge_[adjacency_edge_[i]]) flipped = true;
-      }
-      // Fans only matter to tell pinched vertices; on consistently oriented two-face edges a
-      // walk around v answers that without the general grouping.
-      const int32_t fans = nonmanifold_edge ? 1
-                           : flipped        ? vertex_fans(*this, v, [](int32_t) { return false; }, fan_of_slot)
-                                            : (one_oriented_fan(v) ? 1 : 2);
-      if (fans > 1 || nonmanifold_edge || flipped) {
-        manifold_vertex_[v] = 0;
-        if (fans > 1 && !nonmanifold_edge) ++pinched;  // pinched, not merely on a bad edge
-      }
-    }
-  }
-  report_.nonmanifold_vertices = pinched;
+int32_t Mesh::find_edge(int32_t a, int32_t b) const {
+  if (a < 0 || a >= num_vertices_ || b < 0 || b >= num_vertices_) return -1;
+  ensure_edges();
+  const auto* begin = adjacency_.data() + adjacency_offsets_[a];
+  const auto* end = adjacency_.data() + adjacency_offsets_[a + 1];
+  const auto* it = std::lower_bound(begin, end, b);
+  return (it != end && *it == b) ? adjacency_edge_[it - adjacency_.data()] : -1;
 }
 
 }  // namespace topstoc

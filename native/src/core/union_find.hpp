@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <numeric>
+#include <utility>
 #include <vector>
 
 namespace topstoc {
@@ -44,6 +45,42 @@ class UnionFind {
       parent_[a] = b;
     return true;
   }
+
+ private:
+  std::vector<int32_t> parent_;
+};
+
+/// Union-find that threads may share: a root is linked below a smaller root with a
+/// compare-and-swap, so every root is the smallest element of its set whatever the interleaving,
+/// and the sets come out the same for any number of threads. Path halving only ever points an
+/// element at one of its ancestors, so a lost update does no harm. Read roots once every join is
+/// done (find is then exact).
+class SharedUnionFind {
+ public:
+  explicit SharedUnionFind(int32_t n = 0) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+
+  int32_t find(int32_t x) {
+    for (;;) {
+      const int32_t p = __atomic_load_n(&parent_[x], __ATOMIC_RELAXED);
+      if (p == x) return x;
+      const int32_t grand = __atomic_load_n(&parent_[p], __ATOMIC_RELAXED);
+      if (grand != p) __atomic_store_n(&parent_[x], grand, __ATOMIC_RELAXED);
+      x = grand;
+    }
+  }
+
+  void unite(int32_t a, int32_t b) {
+    for (;;) {
+      int32_t ra = find(a), rb = find(b);
+      if (ra == rb) return;
+      if (ra > rb) std::swap(ra, rb);
+      int32_t expected = rb;
+      if (__atomic_compare_exchange_n(&parent_[rb], &expected, ra, false, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) return;
+    }
+  }
+
+  /// The parents, for a caller that keeps its own array of roots afterwards.
+  std::vector<int32_t>& parents() { return parent_; }
 
  private:
   std::vector<int32_t> parent_;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -37,7 +38,9 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   const int32_t n = mesh.num_vertices();
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
-  const auto& ae = mesh.adjacency_edge();
+  // Edge ids are read only at feature vertices and for cross edges: without either the mesh
+  // need not build its edge tables.
+  const int32_t* ae = cross_edges || layout.has_feature_vertices ? mesh.adjacency_edge().data() : nullptr;
   const auto& edge_feature = layout.edge_feature;
   const auto& vertex_feature = layout.vertex_feature;
   std::vector<uint8_t> queued(n, 0);
@@ -45,7 +48,7 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   std::vector<std::vector<int32_t>> next(threads), cross(threads);
   uint64_t* keys = key.data();
   uint8_t* in_next = queued.data();
-  std::sort(frontier.begin(), frontier.end());
+  if (!std::is_sorted(frontier.begin(), frontier.end())) std::sort(frontier.begin(), frontier.end());
   while (!frontier.empty()) {
     // Every vertex is lowered at one level at most, so the frontiers list each change once.
     if (changed) changed->insert(changed->end(), frontier.begin(), frontier.end());
@@ -54,8 +57,10 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
     const int32_t* front = frontier.data();
     // Relaxes the neighbours of frontier[i]. Shared: other threads lower keys too, so keys are
     // lowered with an atomic minimum and each vertex is queued once by an atomic flag; alone,
-    // plain stores do (locked instructions would stall this latency-bound loop).
-    auto relax = [&](int64_t i, std::vector<int32_t>& mine, std::vector<int32_t>& my_cross, auto shared) {
+    // plain stores do (locked instructions would stall this latency-bound loop). Cross: record
+    // the edges between clusters (known at compile time, so the full fill's test costs nothing
+    // elsewhere).
+    auto relax = [&](int64_t i, std::vector<int32_t>& mine, std::vector<int32_t>& my_cross, auto shared, auto cross) {
       // The frontier is known ahead: fetch the rows and keys the next iterations will read.
       if (i + 16 < count) __builtin_prefetch(&ao[front[i + 16]]);
       if (i + 8 < count) {
@@ -70,13 +75,15 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
       const int32_t v = front[i];
       const int32_t rank = rank_of(__atomic_load_n(&keys[v], __ATOMIC_RELAXED));
       const uint64_t candidate = (d << 32) | uint32_t(rank);
-      for (int32_t j = ao[v]; j < ao[v + 1]; ++j) {
+      const int32_t end = ao[v + 1];
+      for (int32_t j = ao[v]; j < end; ++j) {
         const int32_t u = adj[j];
         uint64_t held = __atomic_load_n(&keys[u], __ATOMIC_RELAXED);
-        // Keys at distance <= level are final during this pass.
-        if (cross_edges && held != kUnreached && dist_of(held) <= level && rank_of(held) != rank &&
-            (dist_of(held) < level || u > v))
-          my_cross.push_back(ae[j]);
+        if constexpr (decltype(cross)::value) {
+          // Keys at distance <= level are final during this pass.
+          if (held != kUnreached && dist_of(held) <= level && rank_of(held) != rank && (dist_of(held) < level || u > v))
+            my_cross.push_back(ae[j]);
+        }
         if (candidate >= held) continue;
         // Feature vertices are entered only along feature edges.
         if (vertex_feature[u] && !edge_feature[ae[j]]) continue;
@@ -100,9 +107,16 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
         }
       }
     };
+    auto relax_range = [&](int64_t i, std::vector<int32_t>& mine, std::vector<int32_t>& my_cross, auto shared) {
+      if (cross_edges) relax(i, mine, my_cross, shared, std::true_type());
+      else relax(i, mine, my_cross, shared, std::false_type());
+    };
     const int team = count >= kParallelMin / 16 ? threads : 1;
     if (team == 1) {
-      for (int64_t i = 0; i < count; ++i) relax(i, next[0], cross[0], std::false_type());
+      if (cross_edges)
+        for (int64_t i = 0; i < count; ++i) relax(i, next[0], cross[0], std::false_type(), std::true_type());
+      else
+        for (int64_t i = 0; i < count; ++i) relax(i, next[0], cross[0], std::false_type(), std::false_type());
     } else {
 #pragma omp parallel num_threads(team)
       {
@@ -113,16 +127,17 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
         // different parts of the mesh instead of trading cache lines.
 #pragma omp for schedule(static)
         for (int64_t i = 0; i < count; ++i) {
-          if (alone) relax(i, next[me], cross[me], std::false_type());
-          else relax(i, next[me], cross[me], std::true_type());
+          if (alone) relax_range(i, next[me], cross[me], std::false_type());
+          else relax_range(i, next[me], cross[me], std::true_type());
         }
       }
     }
-    // Next frontier in vertex order: a short one sorted, a long one read off the flags.
+    // Next frontier in vertex order: a short one sorted, a longer one read off the flags, eight
+    // at a time (sorting a few ten thousand vertices per level was a third of the flood at 1 %).
     size_t total = 0;
     for (const auto& list : next) total += list.size();
     frontier.clear();
-    if (total * 16 < size_t(n)) {
+    if (total * 256 < size_t(n)) {
       for (auto& list : next) {
         for (int32_t u : list) in_next[u] = 0;
         frontier.insert(frontier.end(), list.begin(), list.end());
@@ -131,16 +146,25 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
       std::sort(frontier.begin(), frontier.end());
     } else {
       for (auto& list : next) list.clear();
+      const int64_t words = int64_t(n) / 8;
 #pragma omp parallel if (total >= size_t(kParallelMin))
       {
         auto& mine = next[omp_get_thread_num()];
 #pragma omp for schedule(static)
-        for (int32_t v = 0; v < n; ++v)
-          if (in_next[v]) {
-            in_next[v] = 0;
-            mine.push_back(v);
-          }
+        for (int64_t w = 0; w < words; ++w) {
+          uint64_t word;
+          std::memcpy(&word, in_next + 8 * w, 8);
+          if (!word) continue;
+          std::memset(in_next + 8 * w, 0, 8);
+          for (int b = 0; b < 8; ++b)
+            if ((word >> (8 * b)) & 0xff) mine.push_back(int32_t(8 * w + b));
+        }
       }
+      for (int32_t v = int32_t(8 * words); v < n; ++v)  // the last few, past the whole words
+        if (in_next[v]) {
+          in_next[v] = 0;
+          next[threads - 1].push_back(v);
+        }
       for (auto& list : next) {
         frontier.insert(frontier.end(), list.begin(), list.end());
         list.clear();
@@ -160,8 +184,13 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
                     std::vector<int32_t>* changed) {
   const int32_t n = mesh.num_vertices();
   std::vector<uint64_t> key(n);
+  if (first_new == 0) {  // a full fill: nothing reached yet (the clustering is not read)
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) key[v] = c.label[v] < 0 ? kUnreached : pack(c.dist[v], c.label[v]);
+    for (int32_t v = 0; v < n; ++v) key[v] = kUnreached;
+  } else {
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (int32_t v = 0; v < n; ++v) key[v] = c.label[v] < 0 ? kUnreached : pack(c.dist[v], c.label[v]);
+  }
   std::vector<int32_t> frontier;
   for (size_t r = size_t(first_new); r < samples.size(); ++r) {
     const int32_t s = samples[r];
@@ -186,8 +215,8 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
 void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples, Clustering& out,
            std::vector<int32_t>* cross_edges) {
   const int32_t n = mesh.num_vertices();
-  out.label.assign(n, -1);
-  out.dist.assign(n, INT_MAX);
+  out.label.resize(n);  // every entry is written by the fill
+  out.dist.resize(n);
   if (cross_edges) cross_edges->clear();
   seed_and_relax(mesh, layout, samples, 0, out, cross_edges, nullptr);
 }
@@ -200,12 +229,12 @@ void flood_add(const Mesh& mesh, const FeatureLayout& layout, const std::vector<
 int32_t step_towards_sample(const Mesh& mesh, const FeatureLayout& layout, const Clustering& c, int32_t x) {
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
-  const auto& ae = mesh.adjacency_edge();
   int32_t best = -1;
   for (int32_t j = ao[x]; j < ao[x + 1]; ++j) {
     const int32_t p = adj[j];
     if (c.label[p] != c.label[x] || c.dist[p] != c.dist[x] - 1) continue;
-    if (layout.vertex_feature[x] && !layout.edge_feature[ae[j]]) continue;  // the fill could not come this way
+    // The fill could not come this way (edge ids are read at feature vertices only).
+    if (layout.vertex_feature[x] && !layout.edge_feature[mesh.adjacency_edge()[j]]) continue;
     if (best < 0 || p < best) best = p;
   }
   return best;

@@ -1,6 +1,8 @@
 #include "topstoc/decimate/decimate.hpp"
 #include "topstoc/core/parallel.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -97,8 +99,6 @@ std::vector<int32_t> splitting_vertices(const Mesh& mesh, const Clustering& c, c
 int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Clustering& c, int32_t face,
                          int32_t slot, int32_t sample_vertex) {
   const auto& faces = mesh.faces();
-  const auto& efo = mesh.edge_face_offsets();
-  const auto& ef = mesh.edge_faces();
   auto corner_of = [&](int32_t f, int32_t v) {
     for (int j = 0; j < 3; ++j)
       if (faces[3 * size_t(f) + j] == v) return 3 * mesh.face_source()[f] + j;
@@ -108,6 +108,8 @@ int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Cl
     // One side only: any face of the sample will do.
     return corner_of(mesh.vertex_faces()[mesh.vertex_face_offsets()[sample_vertex]], sample_vertex);
   }
+  const auto& efo = mesh.edge_face_offsets();  // (built on first use: only borders come here)
+  const auto& ef = mesh.edge_faces();
   int32_t current = face;
   int32_t x = faces[3 * size_t(face) + slot];
   for (int32_t guard = 0; x != sample_vertex && guard <= mesh.num_vertices(); ++guard) {
@@ -141,13 +143,28 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
     }
   // Vertices of absorbed clusters join a neighbouring cluster that survives (lowest rank,
   // repeated outwards), so every input vertex maps to an output vertex.
+  // Only vertices of clusters absorbed at the start ever change, so the passes visit just them,
+  // in vertex order as passes over every vertex did (found by one parallel scan; usually none).
   std::vector<int32_t>& label = clustering.label;
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
-  for (bool changed = true; changed;) {
+  std::vector<int32_t> orphans;
+  if (std::find(partition.absorbed.begin(), partition.absorbed.end(), 1) != partition.absorbed.end()) {
+    const int32_t n = mesh.num_vertices();
+    std::vector<std::vector<int32_t>> found(omp_get_max_threads());
+#pragma omp parallel if (n >= kParallelMin)
+    {
+      auto& mine = found[omp_get_thread_num()];
+#pragma omp for schedule(static)
+      for (int32_t v = 0; v < n; ++v)
+        if (label[v] >= 0 && partition.absorbed[label[v]]) mine.push_back(v);
+    }
+    for (const auto& list : found) orphans.insert(orphans.end(), list.begin(), list.end());
+  }
+  for (bool changed = !orphans.empty(); changed;) {
     changed = false;
-    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-      if (label[v] < 0 || !partition.absorbed[label[v]]) continue;
+    for (int32_t v : orphans) {
+      if (!partition.absorbed[label[v]]) continue;
       int32_t best = -1;
       for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
         const int32_t l = label[adj[i]];
@@ -201,8 +218,9 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   for (auto& v : result.kept) v = source[v];
   for (auto& v : samples) v = source[v];
   result.labels.resize(label.size());
-  for (size_t v = 0; v < label.size(); ++v)
-    result.labels[source[v]] = label[v] >= 0 ? output_index[label[v]] : -1;
+  const int64_t n = int64_t(label.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int64_t v = 0; v < n; ++v) result.labels[source[v]] = label[v] >= 0 ? output_index[label[v]] : -1;
   result.samples = std::move(samples);
   result.seconds_output = seconds_since(start);
   return result;

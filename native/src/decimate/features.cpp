@@ -15,7 +15,7 @@ int32_t FeatureLayout::sector_of(const Mesh& mesh, int32_t v, int32_t f) const {
   const auto& vfo = mesh.vertex_face_offsets();
   const auto& vf = mesh.vertex_faces();
   for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i)
-    if (vf[i] == f) return sector_of_slot[i];
+    if (vf[i] == f) return sectors[v] <= 1 ? 0 : sector_of_slot[i];
   return -1;
 }
 
@@ -25,22 +25,30 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
                         const int32_t* flagged, int64_t num_flagged, double feature_angle, FeatureLayout& layout) {
   const int32_t num_edges = mesh.num_edges();
   layout.edge_feature.assign(num_edges, 0);
-  const auto& efo = mesh.edge_face_offsets();
-  const auto& ef = mesh.edge_faces();
-  const auto& source = mesh.face_source();
   if (face_region && face_region_count != mesh.report().input_triangles)
     throw std::invalid_argument("face regions have " + std::to_string(face_region_count) +
                                 " entries, but the mesh has " + std::to_string(mesh.report().input_triangles) +
                                 " triangles");
+  // A closed manifold mesh without regions, flagged edges or creases has no feature edge: the
+  // mesh then need not build its edge tables for this.
+  if (!face_region && num_flagged == 0 && feature_angle <= 0 && mesh.report().boundary_edges == 0 &&
+      mesh.report().nonmanifold_edges == 0)
+    return;
+  const auto& efo = mesh.edge_face_offsets();
+  const auto& ef = mesh.edge_faces();
+  const auto& source = mesh.face_source();
+  int32_t region_borders = 0;
+#pragma omp parallel for schedule(static) reduction(+ : region_borders) if (num_edges >= kParallelMin)
   for (int32_t e = 0; e < num_edges; ++e) {
     const int32_t k = efo[e + 1] - efo[e];
     if (k != 2) {
       layout.edge_feature[e] = 1;  // boundary or non-manifold
     } else if (face_region && face_region[source[ef[efo[e]]]] != face_region[source[ef[efo[e] + 1]]]) {
       layout.edge_feature[e] = 1;
-      ++layout.region_border_edges;
+      ++region_borders;
     }
   }
+  layout.region_border_edges = region_borders;
   for (int64_t i = 0; i < num_flagged; ++i) {
     const int32_t a = flagged[2 * i], b = flagged[2 * i + 1];
     const int32_t n = mesh.num_vertices();
@@ -67,15 +75,18 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
       n[0] /= len, n[1] /= len, n[2] /= len;
       return true;
     };
+    int32_t creases = 0;
+#pragma omp parallel for schedule(static) reduction(+ : creases) if (num_edges >= kParallelMin)
     for (int32_t e = 0; e < num_edges; ++e) {
       if (layout.edge_feature[e] || efo[e + 1] - efo[e] != 2) continue;
       double n0[3], n1[3];
       if (!unit_normal(ef[efo[e]], n0) || !unit_normal(ef[efo[e] + 1], n1)) continue;
       if (n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] < threshold) {
         layout.edge_feature[e] = 1;
-        ++layout.crease_edges;
+        ++creases;
       }
     }
+    layout.crease_edges = creases;
   }
   for (int32_t e = 0; e < num_edges; ++e)
     if (layout.edge_feature[e]) layout.feature_edges.push_back(e);
@@ -84,11 +95,16 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
 void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
   const auto& ao = mesh.adjacency_offsets();
-  const auto& ae = mesh.adjacency_edge();
+  const bool featureless = layout.feature_edges.empty();  // every edge one copy, none a feature
+  const int32_t* ae = featureless ? nullptr : mesh.adjacency_edge().data();
   const auto& vfo = mesh.vertex_face_offsets();
   layout.feature_degree.assign(n, 0);
   layout.sectors.assign(n, 0);
-  layout.sector_of_slot.assign(mesh.vertex_faces().size(), 0);
+  // Sectors per face slot matter only where a vertex has more than one (see sector_of).
+  const auto& report = mesh.report();
+  if (!layout.feature_edges.empty() || report.nonmanifold_vertices > 0 || report.nonmanifold_edges > 0 ||
+      report.inconsistent_edges > 0)
+    layout.sector_of_slot.assign(mesh.vertex_faces().size(), 0);
   layout.vertex_feature.assign(n, 0);
   layout.vertex_corner.assign(n, 0);
   layout.chi_constant.assign(n, 0);
@@ -98,9 +114,9 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
 #pragma omp for schedule(static)
     for (int32_t v = 0; v < n; ++v) {
       if (vfo[v] == vfo[v + 1]) continue;  // isolated: belongs to no cluster
-      int32_t degree = 0, copies = 0, first_copies = -1;
+      int32_t degree = 0, copies = featureless ? ao[v + 1] - ao[v] : 0, first_copies = -1;
       bool same_copies = true;
-      for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
+      for (int32_t i = ao[v]; i < ao[v + 1] && !featureless; ++i) {
         const int32_t e = ae[i];
         const int32_t c = layout.edge_copies(mesh, e);
         copies += c;
@@ -131,11 +147,12 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
 
 void trace_curves(const Mesh& mesh, FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
+  layout.vertex_curve.assign(n, -1);
+  if (layout.feature_edges.empty()) return;  // no curves
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
   const auto& ae = mesh.adjacency_edge();
   std::vector<uint8_t> visited(mesh.num_edges(), 0);
-  layout.vertex_curve.assign(n, -1);
   // Next feature edge at curve vertex v other than the one we came by.
   auto step = [&](int32_t v, int32_t from_edge, int32_t& next_vertex, int32_t& next_edge) {
     for (int32_t i = ao[v]; i < ao[v + 1]; ++i)
@@ -188,6 +205,7 @@ void trace_curves(const Mesh& mesh, FeatureLayout& layout) {
 // boundary edge at a shared vertex merged that hole with the other wing's rim: the merged loop
 // met three clusters while the hole met two and closed up, with nothing local to split.)
 void collect_boundary_loops(const Mesh& mesh, FeatureLayout& layout) {
+  if (mesh.report().boundary_edges == 0) return;
   const int32_t n = mesh.num_vertices();
   const auto& ev = mesh.edge_vertices();
   const auto& ao = mesh.adjacency_offsets();
@@ -263,6 +281,8 @@ std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, cons
   auto layout = std::make_shared<FeatureLayout>();
   mark_feature_edges(mesh, face_region, face_region_count, flagged_edges, num_flagged_edges, feature_angle, *layout);
   compute_sectors_and_corners(mesh, *layout);
+  layout->has_feature_vertices =
+      std::find(layout->vertex_feature.begin(), layout->vertex_feature.end(), 1) != layout->vertex_feature.end();
   trace_curves(mesh, *layout);
   collect_boundary_loops(mesh, *layout);
   PinchedVertices pinched = find_pinched_vertices(mesh);

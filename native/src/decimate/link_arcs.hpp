@@ -25,10 +25,13 @@ struct LinkArcs {
     reversed = false;
   }
   int32_t index(int32_t id) {
-    for (size_t i = 0; i < neighbours.size(); ++i)
-      if (neighbours[i].id == id) return int32_t(i);
+    // Raw pointers: the vector's size is read once, not on every step of this hot loop.
+    const Neighbour* first = neighbours.data();
+    const Neighbour* last = first + neighbours.size();
+    for (const Neighbour* p = first; p != last; ++p)
+      if (p->id == id) return int32_t(p - first);
     neighbours.push_back({id});
-    return int32_t(neighbours.size() - 1);
+    return int32_t(last - first);
   }
   void add(int32_t from, int32_t to) {
     const int32_t a = index(from), b = index(to);

@@ -107,11 +107,14 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   const int32_t k = static_cast<int32_t>(samples.size());
   const auto& label = c.label;
   const auto& vfo = mesh.vertex_face_offsets();
+  int unreached = 0;
+#pragma omp parallel for schedule(static) reduction(| : unreached) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v)
-    if (label[v] < 0 && vfo[v] != vfo[v + 1]) {
-      seed_unreached(mesh, c, out);
-      return out;  // the other checks need every vertex in a cluster
-    }
+    if (label[v] < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
+  if (unreached) {
+    seed_unreached(mesh, c, out);
+    return out;  // the other checks need every vertex in a cluster
+  }
   const int threads = omp_get_max_threads();
   Marks marks(threads);
 
@@ -127,7 +130,6 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   };
   if (emit.valid) {
     // Only faces around relabelled vertices can have changed.
-    const auto& vfo = mesh.vertex_face_offsets();
     const auto& vf = mesh.vertex_faces();
     for (int32_t v : emit.changed)
       for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) emit.emits[vf[i]] = three_clusters(vf[i]);
@@ -142,21 +144,23 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     emit.valid = true;
   }
   emit.changed.clear();
-  {
-    // Collect in face order (static chunks keep the serial order).
-    std::vector<std::vector<int32_t>> found(threads);
+  // Emitting faces in face order: each thread collects one contiguous run (static schedule) and
+  // the runs are joined in thread order. (A separate pass: pushing while testing made the test
+  // loop slower than both loops together.)
+  std::vector<std::vector<int32_t>> found(threads);
 #pragma omp parallel if (m >= kParallelMin)
-    {
-      auto& mine = found[omp_get_thread_num()];
+  {
+    auto& mine = found[omp_get_thread_num()];
 #pragma omp for schedule(static)
-      for (int32_t f = 0; f < m; ++f)
-        if (emit.emits[f]) mine.push_back(f);
-    }
+    for (int32_t f = 0; f < m; ++f)
+      if (emit.emits[f]) mine.push_back(f);
+  }
+  {
     std::vector<size_t> start(threads + 1, 0);
     for (int i = 0; i < threads; ++i) start[i + 1] = start[i] + found[i].size();
     out.source_face.resize(start[threads]);
     out.triangles.resize(3 * start[threads]);
-#pragma omp parallel if (m >= kParallelMin)
+#pragma omp parallel if (start[threads] >= size_t(kParallelMin) / 4)
     {
       const int me = omp_get_thread_num();
       for (int list = me; list < threads; list += omp_get_num_threads())
@@ -183,6 +187,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   struct Arc {
     int32_t from, to, triangle;
   };
+  // Serial: a parallel counting sort cost more per thread than this whole loop (each sample
+  // has few arcs).
   std::vector<int32_t> arc_offsets(k + 1, 0);
   for (int32_t x : out.triangles) ++arc_offsets[x + 1];
   for (int32_t s = 0; s < k; ++s) arc_offsets[s + 1] += arc_offsets[s];
@@ -290,7 +296,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     }
     return true;
   };
-#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed) if (k >= kParallelMin)
+#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed) if (k >= kParallelMinCostly)
   {
     LinkArcs link;
     auto& seen = seen_pairs[omp_get_thread_num()];

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "../core/union_find.hpp"
+#include "topstoc/core/parallel.hpp"
 #include "link_arcs.hpp"
 #include "pinched_fans.hpp"
 
@@ -105,47 +106,62 @@ OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const st
     if (triangles_in[comp] == 0) ++check.lost_components;
 
   // Per vertex: its link gives the edges (each counted at its lower end), their triangle
-  // counts and directions, duplicates, the fan, and the boundary.
+  // counts and directions, duplicates, the fan, and the boundary. Vertices share only the sets
+  // they join (union-finds whose roots do not depend on the order of joins) and the counts, so
+  // they run on all threads and the result does not depend on how many.
   VertexTriangles around(n, triangles);
-  UnionFind pieces(n), boundary(n);
+  SharedUnionFind pieces(n), boundary(n);
   std::vector<uint8_t> on_boundary(n, 0), used(n, 0);
-  LinkArcs link;
-  std::vector<std::array<int32_t, 2>> corner_pairs;
-  for (int32_t v = 0; v < n; ++v) {
-    link.clear();
-    corner_pairs.clear();
-    for (int32_t i = around.offsets[v]; i < around.offsets[v + 1]; ++i) {
-      const int32_t* c = &triangles[3 * size_t(around.triangles[i])];
-      if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
-      const int j = c[0] == v ? 0 : c[1] == v ? 1 : 2;
-      const int32_t a = c[(j + 1) % 3], b = c[(j + 2) % 3];
-      link.add(a, b);
-      pieces.unite(v, a);
-      if (v < a && v < b) corner_pairs.push_back({std::min(a, b), std::max(a, b)});
-    }
-    if (link.arcs == 0) continue;
-    used[v] = 1;
-    std::sort(corner_pairs.begin(), corner_pairs.end());
-    for (size_t i = 1; i < corner_pairs.size(); ++i)
-      if (corner_pairs[i] == corner_pairs[i - 1]) ++check.duplicate;
-    const int32_t comp = component_of[v];
-    ++euler[comp];
-    bool crowded = false;
-    for (const auto& nb : link.neighbours) {
-      const int32_t count = nb.in + nb.out;
-      if (nb.id > v) --euler[comp];
-      if (count > 2 || nb.in > 1 || nb.out > 1) crowded = true;
-      if (!manifold[comp]) continue;
-      if (nb.id > v && count > 2) ++check.nonmanifold_edges;
-      if (nb.id > v && count <= 2 && (nb.in > 1 || nb.out > 1)) ++check.inconsistent_edges;
-      if (count == 1) {
-        on_boundary[v] = 1;
-        boundary.unite(v, nb.id);
+  int32_t duplicate = 0, nonmanifold_edges = 0, inconsistent_edges = 0, nonmanifold_vertices = 0;
+#pragma omp parallel reduction(+ : duplicate, nonmanifold_edges, inconsistent_edges, nonmanifold_vertices) \
+    if (n >= kParallelMinCostly)
+  {
+    LinkArcs link;
+    std::vector<std::array<int32_t, 2>> corner_pairs;
+    std::vector<int64_t> my_euler(num_components, 0);
+#pragma omp for schedule(dynamic, 512)
+    for (int32_t v = 0; v < n; ++v) {
+      link.clear();
+      corner_pairs.clear();
+      for (int32_t i = around.offsets[v]; i < around.offsets[v + 1]; ++i) {
+        const int32_t* c = &triangles[3 * size_t(around.triangles[i])];
+        if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
+        const int j = c[0] == v ? 0 : c[1] == v ? 1 : 2;
+        const int32_t a = c[(j + 1) % 3], b = c[(j + 2) % 3];
+        link.add(a, b);
+        pieces.unite(v, a);
+        if (v < a && v < b) corner_pairs.push_back({std::min(a, b), std::max(a, b)});
       }
+      if (link.arcs == 0) continue;
+      used[v] = 1;
+      std::sort(corner_pairs.begin(), corner_pairs.end());
+      for (size_t i = 1; i < corner_pairs.size(); ++i)
+        if (corner_pairs[i] == corner_pairs[i - 1]) ++duplicate;
+      const int32_t comp = component_of[v];
+      ++my_euler[comp];
+      bool crowded = false;
+      for (const auto& nb : link.neighbours) {
+        const int32_t count = nb.in + nb.out;
+        if (nb.id > v) --my_euler[comp];
+        if (count > 2 || nb.in > 1 || nb.out > 1) crowded = true;
+        if (!manifold[comp]) continue;
+        if (nb.id > v && count > 2) ++nonmanifold_edges;
+        if (nb.id > v && count <= 2 && (nb.in > 1 || nb.out > 1)) ++inconsistent_edges;
+        if (count == 1) {
+          on_boundary[v] = 1;
+          boundary.unite(v, nb.id);
+        }
+      }
+      const bool pinched_input = pinched.count > 0 && pinched.pinched[kept[v]];
+      if (manifold[comp] && !crowded && !pinched_input && !link.single_fan()) ++nonmanifold_vertices;
     }
-    const bool pinched_input = pinched.count > 0 && pinched.pinched[kept[v]];
-    if (manifold[comp] && !crowded && !pinched_input && !link.single_fan()) ++check.nonmanifold_vertices;
+#pragma omp critical(topstoc_output_euler)
+    for (int32_t comp = 0; comp < num_components; ++comp) euler[comp] += my_euler[comp];
   }
+  check.duplicate += duplicate;
+  check.nonmanifold_edges += nonmanifold_edges;
+  check.inconsistent_edges += inconsistent_edges;
+  check.nonmanifold_vertices += nonmanifold_vertices;
   std::vector<int32_t> roots(num_components, -1), loops(num_components, 0);
   for (int32_t v = 0; v < n; ++v) {
     if (!used[v]) continue;

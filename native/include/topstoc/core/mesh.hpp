@@ -14,10 +14,13 @@
 // maps the caller's vertex ids in.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <mutex>
 #include <string>
 #include <vector>
 
+#include "topstoc/core/buffer.hpp"
 #include "topstoc/core/progress.hpp"
 
 namespace topstoc {
@@ -43,85 +46,101 @@ class Mesh {
   /// positions: 3n coordinates; triangles: 3m vertex indices. Throws std::invalid_argument.
   /// progress (optional) hears each preparation step; returning false stops the preparation
   /// with Cancelled (the live preview's Esc).
-  Mesh(std::vector<double> positions, const int32_t* triangles, int64_t num_triangles,
+  Mesh(const std::vector<double>& positions, const int32_t* triangles, int64_t num_triangles,
+       const ProgressCallback& progress = {});
+  /// The same from the caller's buffers (read during construction only, never kept).
+  Mesh(const double* positions, int64_t num_vertices, const int32_t* triangles, int64_t num_triangles,
        const ProgressCallback& progress = {});
 
   int32_t num_vertices() const { return num_vertices_; }
   int32_t num_faces() const { return static_cast<int32_t>(faces_.size() / 3); }
-  int32_t num_edges() const { return static_cast<int32_t>(edge_vertices_.size() / 2); }
+  int32_t num_edges() const { return num_edges_; }
 
   const double* position(int32_t v) const { return &positions_[3 * size_t(v)]; }
-  const std::vector<double>& positions() const { return positions_; }
+  const Buffer<double>& positions() const { return positions_; }
   /// Kept triangles (3 per face, corners in the caller's order) and each one's index in the
   /// caller's triangle array.
-  const std::vector<int32_t>& faces() const { return faces_; }
-  const std::vector<int32_t>& face_source() const { return face_source_; }
+  const Buffer<int32_t>& faces() const { return faces_; }
+  const Buffer<int32_t>& face_source() const { return face_source_; }
   /// Caller's id of each internal vertex, and internal id of each caller vertex.
-  const std::vector<int32_t>& vertex_source() const { return vertex_source_; }
-  const std::vector<int32_t>& vertex_index() const { return vertex_index_; }
+  const Buffer<int32_t>& vertex_source() const { return vertex_source_; }
+  const Buffer<int32_t>& vertex_index() const { return vertex_index_; }
+  /// The caller's triangle array as given (3 per triangle, dropped ones included), rebuilt from
+  /// the kept faces and the dropped rows: a copy of the input need not be kept.
+  std::vector<int32_t> caller_triangles() const;
 
   // Vertex adjacency, CSR with sorted neighbours; adjacency_edge gives the edge id of each slot.
-  const std::vector<int32_t>& adjacency_offsets() const { return adjacency_offsets_; }
-  const std::vector<int32_t>& adjacency() const { return adjacency_; }
-  const std::vector<int32_t>& adjacency_edge() const { return adjacency_edge_; }
+  const Buffer<int32_t>& adjacency_offsets() const { return adjacency_offsets_; }
+  const Buffer<int32_t>& adjacency() const { return adjacency_; }
+  const Buffer<int32_t>& adjacency_edge() const { return ensure_edges(), adjacency_edge_; }
   // Faces around each vertex, CSR.
-  const std::vector<int32_t>& vertex_face_offsets() const { return vertex_face_offsets_; }
-  const std::vector<int32_t>& vertex_faces() const { return vertex_faces_; }
-  // Edges (lower id first), the faces of each edge (CSR) and the edge of each face side.
-  const std::vector<int32_t>& edge_vertices() const { return edge_vertices_; }
-  const std::vector<int32_t>& edge_face_offsets() const { return edge_face_offsets_; }
-  const std::vector<int32_t>& edge_faces() const { return edge_faces_; }
+  const Buffer<int32_t>& vertex_face_offsets() const { return vertex_face_offsets_; }
+  const Buffer<int32_t>& vertex_faces() const { return vertex_faces_; }
+  // Edges (lower id first), the faces of each edge (CSR) and the edge of each face side. These
+  // tables (about a third of the mesh's memory) are built on first use, once, whichever thread
+  // asks: a decimation of a closed mesh without borders never needs them.
+  const Buffer<int32_t>& edge_vertices() const { return ensure_edges(), edge_vertices_; }
+  const Buffer<int32_t>& edge_face_offsets() const { return ensure_edges(), edge_face_offsets_; }
+  const Buffer<int32_t>& edge_faces() const { return ensure_edges(), edge_faces_; }
   /// face_edges[3f + c] is the edge from corner c to corner c+1 of face f.
-  const std::vector<int32_t>& face_edges() const { return face_edges_; }
-  int32_t edge_face_count(int32_t e) const { return edge_face_offsets_[e + 1] - edge_face_offsets_[e]; }
+  const Buffer<int32_t>& face_edges() const { return ensure_edges(), face_edges_; }
+  int32_t edge_face_count(int32_t e) const {
+    ensure_edges();
+    return edge_face_offsets_[e + 1] - edge_face_offsets_[e];
+  }
   /// Edge id between a and b, or -1.
   int32_t find_edge(int32_t a, int32_t b) const;
 
   /// Unit area-weighted vertex normals (zero for vertices without area).
-  const std::vector<double>& normals() const { return normals_; }
+  const Buffer<double>& normals() const { return normals_; }
   /// A third of the area of the triangles around each vertex, and its mean over vertices in faces.
-  const std::vector<double>& vertex_areas() const { return vertex_areas_; }
+  const Buffer<double>& vertex_areas() const { return vertex_areas_; }
   double mean_vertex_area() const { return mean_vertex_area_; }
   /// Importance weight x(v) of thesis eq. 4.1, in [0, 1]; mean over vertices in faces.
-  const std::vector<double>& weights() const { return weights_; }
+  const Buffer<double>& weights() const { return weights_; }
   double mean_weight() const { return mean_weight_; }
   /// Connected component of each vertex (-1 for isolated vertices).
-  const std::vector<int32_t>& component() const { return component_; }
+  const Buffer<int32_t>& component() const { return component_; }
   int32_t num_components() const { return report_.components; }
   /// Euler characteristic V - E + F of each component.
-  const std::vector<int64_t>& component_euler() const { return component_euler_; }
+  const Buffer<int64_t>& component_euler() const { return component_euler_; }
   /// True where the vertex's triangles form one consistently oriented fan and none of its
   /// edges is non-manifold.
-  const std::vector<uint8_t>& manifold_vertex() const { return manifold_vertex_; }
+  const Buffer<uint8_t>& manifold_vertex() const { return manifold_vertex_; }
   /// Length of the bounding box diagonal.
   double diagonal() const { return diagonal_; }
 
   const MeshReport& report() const { return report_; }
 
  private:
-  void validate_and_copy_faces(const int32_t* triangles, int64_t num_triangles);
-  void reorder_for_locality(const double* lo, const double* hi);
+  void validate_faces(const int32_t* triangles, int64_t num_triangles);
+  void reorder_for_locality(const double* positions, const int32_t* triangles, const double* lo, const double* hi);
+  void drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets);
   void build_vertex_faces();
-  void build_adjacency_and_edges();
-  void build_edge_faces();
-  void compute_normals_and_weights();
-  void compute_components_and_manifoldness();
-  /// Whether the triangles around v form one fan, given that every edge at v has at most two
-  /// triangles, oriented consistently.
-  bool one_oriented_fan(int32_t v) const;
+  /// The one-ring pass: adjacency, normals, areas, weights, manifoldness, components.
+  void build_adjacency(Progress& progress);
+  void ensure_edges() const {
+    if (!edges_built_.load(std::memory_order_acquire)) build_edges();
+  }
+  void build_edges() const;
 
   int32_t num_vertices_ = 0;
-  std::vector<double> positions_;
-  std::vector<int32_t> faces_, face_source_, vertex_source_, vertex_index_;
-  std::vector<int32_t> vertex_face_offsets_, vertex_faces_;
-  std::vector<int32_t> adjacency_offsets_, adjacency_, adjacency_edge_;
-  std::vector<int32_t> edge_vertices_, edge_face_offsets_, edge_faces_, face_edges_;
-  std::vector<double> normals_, weights_, vertex_areas_;
+  Buffer<double> positions_;
+  Buffer<int32_t> faces_, face_source_, vertex_source_, vertex_index_;
+  Buffer<int32_t> vertex_face_offsets_, vertex_faces_;
+  Buffer<int32_t> adjacency_offsets_, adjacency_;
+  int32_t num_edges_ = 0;
+  // Built on first use (ensure_edges).
+  mutable Buffer<int32_t> adjacency_edge_, edge_vertices_, edge_face_offsets_, edge_faces_, face_edges_;
+  mutable std::once_flag edges_once_;
+  mutable std::atomic<bool> edges_built_{false};
+  Buffer<double> normals_, weights_, vertex_areas_;
   double mean_weight_ = 0.0, diagonal_ = 0.0, mean_vertex_area_ = 0.0;
-  std::vector<int32_t> component_;
-  std::vector<int64_t> component_euler_;
-  std::vector<uint8_t> manifold_vertex_, inconsistent_edge_;
+  Buffer<int32_t> component_;
+  Buffer<int64_t> component_euler_;
+  Buffer<uint8_t> manifold_vertex_;
   MeshReport report_;
+  Buffer<int32_t> dropped_rows_;  ///< the caller's corners of each dropped triangle, in report order
 };
 
 }  // namespace topstoc

@@ -10,6 +10,11 @@ namespace topstoc {
 /// 500-vertex decimation took 1.3 s with spinning threads and 8 ms without).
 constexpr int64_t kParallelMin = 100000;
 
+/// The same for loops whose every step costs about as much as a hundred steps of a plain loop
+/// (a sample's link in the partition check, an output vertex's fan): worth two threads much
+/// sooner (at 10 % of a million-vertex mesh the partition check's per-sample loop ran on one).
+constexpr int64_t kParallelMinCostly = kParallelMin / 50;
+
 /// Cores not busy right now: the online cores (capped by OMP_NUM_THREADS) minus the other
 /// runnable threads the kernel counts at this instant (/proc/loadavg), at least 1. An
 /// instantaneous count, unlike libgomp's dynamic mode, which follows the 15-minute load

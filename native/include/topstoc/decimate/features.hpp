@@ -45,8 +45,11 @@ struct FeatureLayout {
   std::vector<int32_t> feature_edges;   ///< ids of the feature edges
   std::vector<int32_t> feature_degree;  ///< per vertex: number of feature edges
   std::vector<int32_t> sectors;         ///< per vertex: fans once feature edges are cut
-  std::vector<int32_t> sector_of_slot;  ///< per slot of mesh.vertex_faces(): sector of that face
+  /// Per slot of mesh.vertex_faces(): sector of that face. Empty when every vertex is one sector
+  /// (a manifold mesh without feature edges); use sector_of().
+  std::vector<int32_t> sector_of_slot;
   std::vector<uint8_t> vertex_feature;  ///< per vertex: on a feature curve, or a corner
+  bool has_feature_vertices = false;    ///< any vertex_feature set (else no edge ids are needed)
   std::vector<uint8_t> vertex_corner;   ///< per vertex: always kept
   /// Curves: open segments run from corner to corner (both included); closed loops hold only
   /// curve vertices (start not repeated).
