@@ -21,6 +21,17 @@ namespace topstoc {
 
 enum class Placement { Subsample, Filtered };
 
+/// Attributes that enter the collapse cost (vertex_quadrics.hpp): per caller corner (3 per
+/// caller triangle) `channels` values, each channel's multiplied by its weight before use. An
+/// attribute difference d in a channel of weight w costs as much as a displacement by w d in
+/// the normalised coordinates (bounding box centred, half extent 1). values null: none.
+struct CornerAttributes {
+  const double* values = nullptr;
+  int channels = 0;
+  const double* weights = nullptr;
+};
+
+
 struct DecimateParams {
   int32_t target_vertices = 0;  ///< wanted output vertices (exact without guidance, before repairs)
   SamplingParams sampling;
@@ -36,6 +47,7 @@ struct DecimateParams {
   /// Quadric refinement (refine.hpp): 0 = off; f > 1 keeps f times the target with TopStoc,
   /// then quadric-ordered collapses thin the result to the target (better error, slower).
   double refine = 0.0;
+  CornerAttributes attributes;  ///< attribute-aware cost of the refinement
 };
 
 struct DecimateResult {
@@ -76,7 +88,8 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
 /// needs its refine_vertices and the guidance it was made with.
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                      Placement placement, int32_t max_repair_rounds = 200,
-                                     int32_t refine_vertices = 0, const double* guidance = nullptr);
+                                     int32_t refine_vertices = 0, const double* guidance = nullptr,
+                                     const CornerAttributes& attributes = {});
 
 /// Decimates to about `target_triangles` output triangles (within 1 % where the mesh allows),
 /// re-decimating with a corrected vertex target up to `max_iterations` times.

@@ -39,6 +39,10 @@ struct RefineParams {
   /// Only collapse edges of zero-area triangles (what an input with collinear vertices can
   /// leave after the stochastic pass); every refinement ends with this step too.
   bool zero_area_only = false;
+  /// Finally move every free vertex to its quadric's minimum (filtered placement on the final
+  /// clusters): what placement="filtered" means for a refined result.
+  bool refit = false;
+  CornerAttributes attributes;
 };
 
 /// True when some output triangle of `result` has zero area.
