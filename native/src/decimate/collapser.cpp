@@ -22,6 +22,7 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   const size_t m = tri_.size() / 3;
   count_.assign(s_.quota.size(), 0);
   alive_vertices_ = n;
+  alive_faces_ = static_cast<int32_t>(m);
   for (int32_t b : s_.bin) ++count_[b];
   begin_.assign(n, 0);
   size_.assign(n, 0);
@@ -222,7 +223,7 @@ int32_t Collapser::zero_area_faces() const {
   return count;
 }
 
-int32_t Collapser::remove_thin(double min_shape, int32_t keep) {
+int32_t Collapser::remove_thin(double min_shape, Stop keep) {
   // No collapse makes a new thin or zero-area triangle (keeps_shape), so the candidates are
   // known up front; a failed one may pass after its neighbours collapsed, hence the rounds.
   const int32_t m = static_cast<int32_t>(alive_face_.size());
@@ -236,7 +237,7 @@ int32_t Collapser::remove_thin(double min_shape, int32_t keep) {
   for (bool progress = !candidates.empty(); progress;) {
     progress = false;
     for (int32_t t : candidates) {
-      if (alive_vertices_ <= keep) return collapses;
+      if (reached(keep)) return collapses;
       if (!alive_face_[t] || !(zero_area(t) || thin(t, min_shape))) continue;
       const int32_t* c = &tri_[3 * size_t(t)];
       for (int j = 0; j < 6; ++j) {
@@ -259,14 +260,14 @@ int32_t Collapser::batch_size(int32_t excess) const {
   return std::clamp(std::min(excess / 64, alive_vertices_ / 1024), 1, 128);
 }
 
-int32_t Collapser::run(int32_t target) {
+int32_t Collapser::run(Stop target) {
   enum Status : uint8_t { kReady, kEvaluate, kEvaluateChecked, kWait };
   int32_t collapses = 0;
   std::vector<int32_t> batch, reserved, pending, survivors, pair_from, pair_to;
   std::vector<double> batch_key, pair_cost_from, pair_cost_to;
   std::vector<uint8_t> status, pending_checked;
   std::vector<Best> pending_best;
-  while (alive_vertices_ > target) {
+  while (!reached(target)) {
     if (heap_.empty()) {
       // Some region could not reach its quota: the others give the rest, by cost alone.
       if (!use_quota_) break;
@@ -276,7 +277,7 @@ int32_t Collapser::run(int32_t target) {
       continue;
     }
     // The cheapest queued collapses, in cost order.
-    const int32_t size = batch_size(alive_vertices_ - target);
+    const int32_t size = batch_size(target.faces > 0 ? (alive_faces_ - target.faces) / 2 : alive_vertices_ - target.vertices);
     batch.clear();
     batch_key.clear();
     while (int32_t(batch.size()) < size && !heap_.empty()) {
@@ -329,7 +330,7 @@ int32_t Collapser::run(int32_t target) {
         pending_checked.push_back(status[i] == kEvaluateChecked);
         continue;
       }
-      if (alive_vertices_ <= target) {
+      if (reached(target)) {
         queue(u, v, batch_key[i]);
         continue;
       }
@@ -581,6 +582,7 @@ void Collapser::collapse(int32_t u, int32_t v) {
   for (const int32_t* t = faces_begin(u); t != faces_end(u); ++t) {
     if (!has(*t, v)) continue;
     alive_face_[*t] = 0;
+    --alive_faces_;
     Side side{sector_at(*t, u), -1, -1};
     for (int j = 0; j < 3; ++j) {
       const int32_t w = tri_[3 * size_t(*t) + j];

@@ -45,11 +45,15 @@ class Collapser {
   /// triangles and corner_source (3 per face) are updated in place as corners are renamed.
   Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corner_source, CollapseSetup setup);
 
+  /// Where collapses stop: at this many vertices, or (faces > 0) at this many triangles.
+  struct Stop {
+    int32_t vertices = 0, faces = 0;
+  };
   /// Collapses an edge of every zero-area triangle, and of every triangle with a shape quality
-  /// below min_shape, where a collapse is allowed, while more than `keep` vertices remain.
-  int32_t remove_thin(double min_shape, int32_t keep);
-  /// Collapses in cost order until `target` vertices remain or no collapse is allowed.
-  int32_t run(int32_t target);
+  /// below min_shape, where a collapse is allowed, until `keep` is reached.
+  int32_t remove_thin(double min_shape, Stop keep);
+  /// Collapses in cost order until `target` is reached or no collapse is allowed.
+  int32_t run(Stop target);
   /// Moves every free vertex to its quadric's minimum along the directions it constrains, at
   /// most radius2[v] (squared, normalised) away, where no triangle folds or becomes a sliver.
   int32_t refit(const std::vector<double>& radius2);
@@ -88,6 +92,9 @@ class Collapser {
   int32_t batch_size(int32_t excess) const;
   void queue(int32_t u, int32_t v, double c);
   bool at_quota(int32_t u) const { return use_quota_ && count_[s_.bin[u]] <= s_.quota[s_.bin[u]]; }
+  bool reached(Stop stop) const {
+    return stop.faces > 0 ? alive_faces_ <= stop.faces : alive_vertices_ <= stop.vertices;
+  }
   bool queues(int32_t u) const { return !s_.locked[u] && !at_quota(u); }
   bool allowed(int32_t u, int32_t v, Scratch& scratch) const;
   bool keeps_shape(int32_t moved, int32_t other, const double* x) const;
@@ -116,7 +123,7 @@ class Collapser {
   CollapseSetup s_;
   std::vector<int32_t> count_;  // per bin: vertices alive
   bool use_quota_ = true;
-  int32_t alive_vertices_ = 0;
+  int32_t alive_vertices_ = 0, alive_faces_ = 0;
   std::vector<int32_t> pool_, begin_, size_, capacity_;  // vertex -> faces
   std::vector<uint8_t> alive_face_, dirty_, placed_;
   std::vector<int32_t> merged_into_, target_;

@@ -499,35 +499,53 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
 
 }  // namespace
 
+namespace {
+
+// TopStoc to a few times the target, then collapses down to it (refine.hpp). Painted regions
+// keep the share of the budget the guidance gives them. target_triangles > 0: the collapses
+// stop there instead (the vertex target then sets the first pass and the guidance quotas).
+DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
+                       int32_t target_triangles) {
+  const int32_t active = active_vertices(mesh);
+  DecimateParams first = params;
+  first.refine = 0.0;
+  first.placement = Placement::Subsample;  // the refinement places the vertices it keeps
+  first.target_vertices = int32_t(std::min<double>(
+      active, std::max(std::ceil(params.refine * params.target_vertices),
+                       double(params.target_vertices) + std::max(0, params.refine_collapses))));
+  DecimateResult result = stochastic_pass(mesh, layout, first, true);
+  const std::vector<double> multipliers = guidance_multipliers(mesh, params.sampling);
+  RefineParams refine;
+  refine.target_vertices = params.target_vertices;
+  refine.target_triangles = target_triangles;
+  refine.multipliers = &multipliers;
+  refine.refit = params.placement == Placement::Filtered;
+  refine.attributes = params.attributes;
+  refine_by_collapses(mesh, layout, refine, result);
+  result.target_vertices = params.target_vertices;
+  // What must stay whatever the target: border corners and control points (the first pass
+  // may have drawn every vertex, which says nothing about the budget).
+  result.forced = 0;
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+    result.forced += layout.vertex_corner[v] || multipliers[v] == kForcedMultiplier;
+  return verified(mesh, layout, std::move(result));
+}
+
+}  // namespace
+
 DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params) {
   const int32_t active = active_vertices(mesh);
   if (!(params.refine == 0.0 || params.refine >= 1.0))
     throw std::invalid_argument("refine must be 0 (off) or at least 1, got " + std::to_string(params.refine));
-  if (params.refine >= 1.0 && params.target_vertices >= 1 && params.target_vertices <= active) {
-    // Refined: TopStoc to `refine` times the target, then collapses down to it. Painted
-    // regions keep the share of the budget the guidance gives them (see refine.hpp).
-    DecimateParams first = params;
-    first.refine = 0.0;
-    first.placement = Placement::Subsample;  // the refinement places the vertices it keeps
-    first.target_vertices = int32_t(std::min<double>(active, std::ceil(params.refine * params.target_vertices)));
-    DecimateResult result = stochastic_pass(mesh, layout, first, true);
-    const std::vector<double> multipliers = guidance_multipliers(mesh, params.sampling);
-    RefineParams refine;
-    refine.target_vertices = params.target_vertices;
-    refine.multipliers = &multipliers;
-    refine.refit = params.placement == Placement::Filtered;
-    refine.attributes = params.attributes;
-    refine_by_collapses(mesh, layout, refine, result);
-    result.target_vertices = params.target_vertices;
-    result.forced = std::max(result.forced, int32_t(std::count(multipliers.begin(), multipliers.end(), kForcedMultiplier)));
-    return verified(mesh, layout, std::move(result));
-  }
+  if (params.refine >= 1.0 && params.target_vertices >= 1 && params.target_vertices <= active)
+    return refined(mesh, layout, params, 0);
   return stochastic_pass(mesh, layout, params, false);
 }
 
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                      Placement placement, int32_t max_repair_rounds, int32_t refine_vertices,
-                                     const double* guidance, const CornerAttributes& attributes) {
+                                     const double* guidance, const CornerAttributes& attributes,
+                                     int32_t refine_triangles) {
   if (samples.empty()) throw std::invalid_argument("the sample list is empty");
   const auto& vfo = mesh.vertex_face_offsets();
   for (size_t i = 0; i < samples.size(); ++i) {
@@ -561,6 +579,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
     RefineParams refine;
     refine.multipliers = guidance ? &multipliers : nullptr;
     refine.target_vertices = refine_vertices;
+    refine.target_triangles = refine_vertices > 0 ? refine_triangles : 0;
     refine.zero_area_only = refine_vertices == 0;
     refine.refit = refine_vertices > 0 && placement == Placement::Filtered;
     refine.attributes = attributes;
@@ -578,6 +597,11 @@ DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layo
                                 std::to_string(mesh.num_faces()) + " triangles");
   // First guess from the input's triangle-to-vertex ratio, then correct by what came out.
   double vertices = double(target_triangles) * active / mesh.num_faces();
+  if (params.refine >= 1.0) {
+    // The collapses stop at the triangle count itself: one pass.
+    params.target_vertices = std::clamp(int32_t(std::lround(vertices)), 1, active);
+    return refined(mesh, layout, params, target_triangles);
+  }
   DecimateResult best;
   int32_t best_error = INT32_MAX;
   for (int it = 0; it < std::max(1, max_iterations); ++it) {

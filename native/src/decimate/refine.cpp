@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -66,57 +67,105 @@ std::vector<int32_t> bin_quotas(const std::vector<double>& vertices, const std::
 
 // Centre and half extent of the bounding box (halves taken first so that neither overflows):
 // quadrics hold squared areas, which overflow at coordinates of 1e80 and underflow at 1e-80.
-void bounding_box(const Mesh& mesh, double center[3], double& extent) {
+void bounding_box(const Mesh& mesh, double center[3], double& extent, double& diagonal) {
   double low[3] = {INFINITY, INFINITY, INFINITY}, high[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (int32_t v = 0; v < mesh.num_vertices(); ++v)
     for (int i = 0; i < 3; ++i) low[i] = std::min(low[i], mesh.position(v)[i]), high[i] = std::max(high[i], mesh.position(v)[i]);
   extent = 0;
+  double half[3] = {0, 0, 0};
   for (int i = 0; i < 3; ++i) {
     center[i] = mesh.num_vertices() > 0 ? 0.5 * low[i] + 0.5 * high[i] : 0.0;
-    extent = std::max(extent, mesh.num_vertices() > 0 ? 0.5 * high[i] - 0.5 * low[i] : 0.0);
+    half[i] = mesh.num_vertices() > 0 ? 0.5 * high[i] - 0.5 * low[i] : 0.0;
+    extent = std::max(extent, half[i]);
   }
   if (!(extent > 0) || !std::isfinite(extent) || !std::isfinite(1.0 / extent)) extent = 1.0;
+  // The diagonal in normalised units (half extents divided by the largest: no overflow).
+  diagonal = 2.0 * std::sqrt((half[0] / extent) * (half[0] / extent) + (half[1] / extent) * (half[1] / extent) +
+                             (half[2] / extent) * (half[2] / extent));
+  if (!(diagonal > 0) || !std::isfinite(diagonal)) diagonal = 1.0;
 }
 
-// Each output vertex stands for the input triangles of its cluster (each triangle counted once
-// per cluster it touches) and for the border edges in it: planes through each border edge,
+// Per input vertex, a third of the quadric of each triangle around it (in normalised
+// coordinates), so that a cluster's sum weighs each triangle by the share of its corners in the
+// cluster. It depends on the mesh only: kept with the layout, re-decimations skip it.
+struct QuadricTable {
+  double center[3] = {0, 0, 0}, extent = 1.0;
+  double diagonal = 1.0;  // of the bounding box, normalised
+  std::vector<double> quadric;  // 10 per vertex
+};
+
+std::shared_ptr<const QuadricTable> vertex_quadric_table(const Mesh& mesh, const FeatureLayout& layout) {
+  auto cached = std::static_pointer_cast<const QuadricTable>(layout.quadric_table.get());
+  if (cached && cached->quadric.size() == 10 * size_t(mesh.num_vertices())) return cached;
+  auto table = std::make_shared<QuadricTable>();
+  bounding_box(mesh, table->center, table->extent, table->diagonal);
+  const int32_t n = mesh.num_vertices();
+  table->quadric.assign(10 * size_t(n), 0.0);
+  const auto& faces = mesh.faces();
+  const auto& vfo = mesh.vertex_face_offsets();
+  const auto& vf = mesh.vertex_faces();
+  const double scale = 1.0 / table->extent;
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) {
+    double* sum = &table->quadric[10 * size_t(v)];
+    for (int32_t k = vfo[v]; k < vfo[v + 1]; ++k) {
+      const int32_t* t = &faces[3 * size_t(vf[k])];
+      double p[3][3], face[10], area;
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) p[j][i] = (mesh.position(t[j])[i] - table->center[i]) * scale;
+      if (!VertexQuadrics::plane(p[0], p[1], p[2], face, &area)) continue;
+      for (int i = 0; i < 10; ++i) sum[i] += face[i] * (1.0 / 3.0);
+    }
+  }
+  layout.quadric_table.set(table);
+  return table;
+}
+
+// Each output vertex stands for the input triangles of its cluster (each weighed by the share of
+// its corners in the cluster) and for the border edges in it: planes through each border edge,
 // perpendicular to its triangles, keep collapses from pulling a border (boundary, seam,
-// material edge) off its course. Each thread owns a range of clusters and adds the faces
-// touching them in face order, so the sums do not depend on the number of threads.
+// material edge) off its course. Each thread owns a range of clusters and adds to them in input
+// order, so the sums do not depend on the number of threads.
 VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
-                                const std::vector<int32_t>& label, int32_t clusters, const double center[3],
-                                double extent) {
+                                const std::vector<int32_t>& label, int32_t clusters, const QuadricTable& table) {
   const int channels = params.attributes.values ? params.attributes.channels : 0;
   VertexQuadrics quadrics(clusters, channels);
   const auto& faces = mesh.faces();
   const auto& face_source = mesh.face_source();
   const int stride = quadrics.stride();
-  const double scale = 1.0 / extent;
+  const double* center = table.center;
+  const double scale = 1.0 / table.extent;
   auto unit = [&](int32_t v, double* p) {
     for (int i = 0; i < 3; ++i) p[i] = (mesh.position(v)[i] - center[i]) * scale;
   };
-  const int32_t m = mesh.num_faces();
-#pragma omp parallel if (m >= kParallelMin)
+  const int32_t n = mesh.num_vertices(), m = mesh.num_faces();
+#pragma omp parallel if (n >= kParallelMin)
   {
     const int32_t threads = omp_get_num_threads(), me = omp_get_thread_num();
     const int32_t low = int32_t(int64_t(clusters) * me / threads), high = int32_t(int64_t(clusters) * (me + 1) / threads);
-    std::vector<double> face(stride), values(3 * size_t(std::max(channels, 1)));
-    for (int32_t f = 0; f < m; ++f) {
-      const int32_t* t = &faces[3 * size_t(f)];
-      const int32_t l[3] = {label[t[0]], label[t[1]], label[t[2]]};
-      const bool mine[3] = {l[0] >= low && l[0] < high, l[1] >= low && l[1] < high && l[1] != l[0],
-                            l[2] >= low && l[2] < high && l[2] != l[0] && l[2] != l[1]};
-      if (!(mine[0] || mine[1] || mine[2])) continue;
-      double p[3][3];
-      for (int j = 0; j < 3; ++j) unit(t[j], p[j]);
-      if (channels > 0)
+    if (channels == 0) {
+      for (int32_t v = 0; v < n; ++v)
+        if (label[v] >= low && label[v] < high) quadrics.add(label[v], &table.quadric[10 * size_t(v)]);
+    } else {
+      // Attributes: each face's generalised quadric, a third to the cluster of each corner.
+      std::vector<double> face(stride), values(3 * size_t(channels));
+      for (int32_t f = 0; f < m; ++f) {
+        const int32_t* t = &faces[3 * size_t(f)];
+        const int32_t l[3] = {label[t[0]], label[t[1]], label[t[2]]};
+        if (!((l[0] >= low && l[0] < high) || (l[1] >= low && l[1] < high) || (l[2] >= low && l[2] < high)))
+          continue;
+        double p[3][3];
+        for (int j = 0; j < 3; ++j) unit(t[j], p[j]);
         for (int j = 0; j < 3; ++j)
           for (int a = 0; a < channels; ++a)
             values[size_t(j) * channels + a] =
-                params.attributes.values[(3 * size_t(face_source[f]) + j) * channels + a] * params.attributes.weights[a];
-      if (!quadrics.face(p[0], p[1], p[2], values.data(), face.data())) continue;
-      for (int j = 0; j < 3; ++j)
-        if (mine[j]) quadrics.add(l[j], face.data());
+                params.attributes.values[(3 * size_t(face_source[f]) + j) * channels + a] *
+                params.attributes.weights[a] * table.diagonal;
+        if (!quadrics.face(p[0], p[1], p[2], values.data(), face.data())) continue;
+        for (double& x : face) x *= 1.0 / 3.0;
+        for (int j = 0; j < 3; ++j)
+          if (l[j] >= low && l[j] < high) quadrics.add(l[j], face.data());
+      }
     }
   }
   const auto& ev = mesh.edge_vertices();
@@ -177,10 +226,12 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
   const auto& source = mesh.vertex_source();
   const auto& index = mesh.vertex_index();
   CollapseSetup setup;
-  bounding_box(mesh, setup.center, setup.extent);
+  const auto table = vertex_quadric_table(mesh, layout);
+  for (int i = 0; i < 3; ++i) setup.center[i] = table->center[i];
+  setup.extent = table->extent;
   std::vector<int32_t> label(mesh.num_vertices());
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) label[v] = result.labels[source[v]];
-  setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, setup.center, setup.extent);
+  setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *table);
   setup.world = result.vertices;
   setup.positions.resize(3 * size_t(n));
   setup.weight.assign(n, 1.0);
@@ -247,13 +298,15 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
   const double center[3] = {setup.center[0], setup.center[1], setup.center[2]}, extent = setup.extent;  // zero-area clean-up keeps the caller's positions
   Collapser collapser(result.triangles, result.corner_source, std::move(setup));
   if (params.zero_area_only) {
-    result.refine_collapses += collapser.remove_thin(0.0, 0);
+    result.refine_collapses += collapser.remove_thin(0.0, {});
   } else {
     result.refine_vertices = params.target_vertices;
+    result.refine_triangles = params.target_triangles;
     // Slivers the stochastic pass left (near-collinear corners) go first: the collapses thin
     // the result anyway, and none of them makes a new one (Collapser::keeps_shape).
-    result.refine_collapses = collapser.remove_thin(kSliverShape, params.target_vertices);
-    result.refine_collapses += collapser.run(params.target_vertices);
+    const Collapser::Stop stop{params.target_vertices, params.target_triangles};
+    result.refine_collapses = collapser.remove_thin(kSliverShape, stop);
+    result.refine_collapses += collapser.run(stop);
     if (params.refit) {
       // Each vertex may move as far as its cluster reaches (as filtered placement allows).
       std::vector<double> radius2(n, 0.0);
@@ -270,7 +323,7 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
       }
       collapser.refit(radius2);
     }
-    result.refine_collapses += collapser.remove_thin(0.0, 0);
+    result.refine_collapses += collapser.remove_thin(0.0, {});
   }
   result.issues_remaining.sliver = collapser.zero_area_faces();
   // Compact: surviving vertices and faces in their old order, labels followed along the collapses.

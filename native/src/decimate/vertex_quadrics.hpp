@@ -39,10 +39,9 @@ class VertexQuadrics {
   double* at(int32_t v) { return &data_[size_t(v) * stride_]; }
   const double* at(int32_t v) const { return &data_[size_t(v) * stride_]; }
 
-  /// Writes face (p0, p1, p2)'s quadric into out (stride() doubles): its plane weighted by its
-  /// area and, with channels, its attribute fields through `values` (3 corners × channels).
-  /// Returns false (out untouched) for a face of zero area.
-  bool face(const double* p0, const double* p1, const double* p2, const double* values, double* out) const {
+  /// The plain quadric of face (p0, p1, p2), its plane weighted by its area, into out (10
+  /// doubles), and the area into *area. False (out untouched) for a face of zero area.
+  static bool plane(const double* p0, const double* p1, const double* p2, double* out, double* area) {
     double e1[3], e2[3];
     for (int i = 0; i < 3; ++i) e1[i] = p1[i] - p0[i], e2[i] = p2[i] - p0[i];
     const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
@@ -55,13 +54,26 @@ class VertexQuadrics {
     out[3] = w * u[1] * u[1], out[4] = w * u[1] * u[2], out[5] = w * u[2] * u[2];
     for (int i = 0; i < 3; ++i) out[6 + i] = w * d * u[i];
     out[9] = w * d * d;
+    *area = w;
+    return true;
+  }
+
+  /// Writes face (p0, p1, p2)'s quadric into out (stride() doubles): its plane weighted by its
+  /// area and, with channels, its attribute fields through `values` (3 corners × channels).
+  /// Returns false (out untouched) for a face of zero area.
+  bool face(const double* p0, const double* p1, const double* p2, const double* values, double* out) const {
+    double w;
+    if (!plane(p0, p1, p2, out, &w)) return false;
     if (channels_ == 0) return true;
     out[10] = w;
+    double e1[3], e2[3];
+    for (int i = 0; i < 3; ++i) e1[i] = p1[i] - p0[i], e2[i] = p2[i] - p0[i];
     const double g11 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
     const double g12 = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2];
     const double g22 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+    const double len2 = 4.0 * w * w;  // |e1 × e2|², the Gram determinant
     for (int j = 0; j < channels_; ++j) {
-      // g in the face's plane with g·e1 = s1 − s0, g·e2 = s2 − s0 (Gram system, det = len2).
+      // g in the face's plane with g·e1 = s1 − s0, g·e2 = s2 − s0 (Gram system).
       const double s0 = values[j], ds1 = values[channels_ + j] - s0, ds2 = values[2 * channels_ + j] - s0;
       const double a = (g22 * ds1 - g12 * ds2) / len2, b = (g11 * ds2 - g12 * ds1) / len2;
       const double g[3] = {a * e1[0] + b * e2[0], a * e1[1] + b * e2[1], a * e1[2] + b * e2[2]};

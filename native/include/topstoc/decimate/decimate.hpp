@@ -23,8 +23,8 @@ enum class Placement { Subsample, Filtered };
 
 /// Attributes that enter the collapse cost (vertex_quadrics.hpp): per caller corner (3 per
 /// caller triangle) `channels` values, each channel's multiplied by its weight before use. An
-/// attribute difference d in a channel of weight w costs as much as a displacement by w d in
-/// the normalised coordinates (bounding box centred, half extent 1). values null: none.
+/// attribute difference d in a channel of weight w costs as much as moving the surface by w d
+/// bounding-box diagonals. values null: none.
 struct CornerAttributes {
   const double* values = nullptr;
   int channels = 0;
@@ -47,6 +47,10 @@ struct DecimateParams {
   /// Quadric refinement (refine.hpp): 0 = off; f > 1 keeps f times the target with TopStoc,
   /// then quadric-ordered collapses thin the result to the target (better error, slower).
   double refine = 0.0;
+  /// With refine: the first pass keeps at least this many vertices more than the target (all
+  /// of them when that covers the mesh). Small meshes then skip the stochastic pass, whose
+  /// choices cost quality, and big ones keep refine times the target, which bounds the time.
+  int32_t refine_collapses = 0;
   CornerAttributes attributes;  ///< attribute-aware cost of the refinement
 };
 
@@ -75,6 +79,7 @@ struct DecimateResult {
   int32_t top_up = 0;                  ///< samples added to make up for absorbed clusters
   int32_t top_up_rounds = 0;
   int32_t refine_vertices = 0;         ///< target of the quadric refinement (0: none)
+  int32_t refine_triangles = 0;        ///< its triangle target, when it had one (0: none)
   int32_t refine_collapses = 0;        ///< collapses it made
   double seconds_sampling = 0, seconds_clustering = 0, seconds_checking = 0, seconds_output = 0;
   double seconds_refine = 0;
@@ -89,7 +94,7 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                      Placement placement, int32_t max_repair_rounds = 200,
                                      int32_t refine_vertices = 0, const double* guidance = nullptr,
-                                     const CornerAttributes& attributes = {});
+                                     const CornerAttributes& attributes = {}, int32_t refine_triangles = 0);
 
 /// Decimates to about `target_triangles` output triangles (within 1 % where the mesh allows),
 /// re-decimating with a corrected vertex target up to `max_iterations` times.

@@ -28,6 +28,9 @@ namespace topstoc {
 
 struct RefineParams {
   int32_t target_vertices = 0;
+  /// > 0: collapse until this many triangles remain instead (the vertex target then only sets
+  /// the guidance quotas).
+  int32_t target_triangles = 0;
   /// The guidance as density multipliers per internal vertex (guidance_multipliers), or null.
   /// Painted regions keep their share of the budget: the input vertices are binned by their
   /// multiplier m, each bin gets the quota sum over its vertices of min(1, k m) with k solved
