@@ -50,24 +50,41 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   merged_from_.assign(n, -1);
   scratch_.resize(std::max(1, omp_get_max_threads()));
   for (Scratch& scratch : scratch_) scratch.mark.assign(n, 0);
-  // Every vertex's cheapest collapse, each edge evaluated once where it costs the same both ways.
+  // Every vertex's cheapest collapse, each edge evaluated once (from its lower end) where it
+  // costs the same both ways. A thread owns the lower ends it evaluates; what it finds for the
+  // higher ends is merged afterwards. The cheapest by (cost, id) does not depend on the order.
   std::vector<double> best_cost(n, 0.0);
-  for (int32_t u = 0; u < n; ++u) {
-    const bool u_queues = !s_.locked[u] && !at_quota(u);
-    neighbours(u, scratch_[0], options_);
-    for (int32_t v : options_) {
-      if (v < u) continue;
-      const bool v_queues = !s_.locked[v] && !at_quota(v);
-      const double uv = u_queues ? cost(u, v) : 0.0;
-      const double vu = v_queues ? (u_queues && free_pair(u, v) ? uv : cost(v, u)) : 0.0;
-      if (u_queues && (target_[u] < 0 || uv < best_cost[u] || (uv == best_cost[u] && v < target_[u])))
-        target_[u] = v, best_cost[u] = uv;
-      if (v_queues && (target_[v] < 0 || vu < best_cost[v] || (vu == best_cost[v] && u < target_[v])))
-        target_[v] = u, best_cost[v] = vu;
+  auto better = [&](int32_t u, int32_t v, double c) {
+    return target_[u] < 0 || c < best_cost[u] || (c == best_cost[u] && v < target_[u]);
+  };
+  const int threads = static_cast<int>(scratch_.size());
+  std::vector<std::vector<std::pair<int32_t, Best>>> found(threads);
+#pragma omp parallel num_threads(threads) if (n >= 10000)
+  {
+    Scratch& scratch = scratch_[omp_get_thread_num()];
+    auto& mine = found[omp_get_thread_num()];
+    std::vector<int32_t> around;
+#pragma omp for schedule(static)
+    for (int32_t u = 0; u < n; ++u) {
+      const bool u_queues = queues(u);
+      neighbours(u, scratch, around);
+      for (int32_t v : around) {
+        if (v < u) continue;
+        const bool v_queues = queues(v);
+        const double uv = u_queues ? cost(u, v) : 0.0;
+        if (u_queues && better(u, v, uv)) target_[u] = v, best_cost[u] = uv;
+        if (v_queues) mine.push_back({v, {u, u_queues && free_pair(u, v) ? uv : cost(v, u)}});
+      }
     }
   }
+  for (const auto& list : found)
+    for (const auto& [v, offer] : list)
+      if (better(v, offer.target, offer.cost)) target_[v] = offer.target, best_cost[v] = offer.cost;
+  std::vector<int32_t> ids;
+  std::vector<double> keys;
   for (int32_t u = 0; u < n; ++u)
-    if (target_[u] >= 0) queue(u, target_[u], best_cost[u]);
+    if (target_[u] >= 0) ids.push_back(u), keys.push_back(best_cost[u]);
+  heap_.assign(ids, keys);
 }
 
 int32_t Collapser::survivor(int32_t v) {
