@@ -234,6 +234,26 @@ bool Collapser::thin(int32_t t, double min_shape) const {
   return shape(c, c[0], position(c[0]), std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])) < min_shape;
 }
 
+std::vector<int32_t> Collapser::zero_area_face_list() const {
+  std::vector<int32_t> list;
+  for (int32_t t = 0; t < int32_t(alive_face_.size()); ++t)
+    if (alive_face_[t] && zero_area(t)) list.push_back(t);
+  return list;
+}
+
+bool Collapser::place(int32_t v, const double* world, int32_t face) {
+  double at[3];
+  for (int i = 0; i < 3; ++i) at[i] = (world[i] - s_.center[i]) * (1.0 / s_.extent);
+  if (!keeps_shape(v, -1, at)) return false;
+  double* p = &s_.positions[3 * size_t(v)];
+  double* w = &s_.world[3 * size_t(v)];
+  double keep_p[3], keep_w[3];
+  for (int i = 0; i < 3; ++i) keep_p[i] = p[i], keep_w[i] = w[i], p[i] = at[i], w[i] = world[i];
+  if (!zero_area(face)) return true;
+  for (int i = 0; i < 3; ++i) p[i] = keep_p[i], w[i] = keep_w[i];  // no gain: back
+  return false;
+}
+
 int32_t Collapser::zero_area_faces() const {
   int32_t count = 0;
   for (size_t t = 0; t < alive_face_.size(); ++t) count += alive_face_[t] && zero_area(int32_t(t));
@@ -518,7 +538,10 @@ bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x) const
     double before2 = before[0] * before[0] + before[1] * before[1] + before[2] * before[2];
     const double area2 = before2;
     if (before2 == 0.0) {
-      // A zero-area triangle has no side to keep: it must gain area facing like the fan.
+      // A zero-area triangle has no side to keep. Staying degenerate is no worse (collapsing
+      // coincident vertices one by one is how a fan of them disappears); gaining area, it
+      // must face like the fan.
+      if (after[0] == 0.0 && after[1] == 0.0 && after[2] == 0.0) continue;
       for (int i = 0; i < 3; ++i) before[i] = 0.0;
       for (const int32_t* f = faces_begin(moved); f != faces_end(moved); ++f) {
         double n[3];

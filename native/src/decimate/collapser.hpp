@@ -59,6 +59,11 @@ class Collapser {
   int32_t refit(const std::vector<double>& radius2);
 
   int32_t zero_area_faces() const;
+  std::vector<int32_t> zero_area_face_list() const;
+  /// Moves v to the input position `world` when no triangle around it folds, loses area or
+  /// becomes a sliver and triangle `face` gains area; false (nothing moved) otherwise.
+  bool place(int32_t v, const double* world, int32_t face);
+  bool zero_area(int32_t t) const;
   bool face_alive(int32_t t) const { return alive_face_[t] != 0; }
   bool vertex_alive(int32_t v) const { return merged_into_[v] < 0; }
   int32_t survivor(int32_t v);
@@ -102,7 +107,6 @@ class Collapser {
   bool thinner(const int32_t* c, int32_t replace, const double* at, double twice_area2) const;
   double squared_edges(const int32_t* c, int32_t replace, const double* at) const;
   void normal(const int32_t* c, int32_t replace, const double* at, double n[3]) const;
-  bool zero_area(int32_t t) const;
   bool thin(int32_t t, double min_shape) const;
   void collapse(int32_t u, int32_t v);
   void move_to(int32_t v, const double* x);

@@ -200,6 +200,51 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
   return quadrics;
 }
 
+// Zero-area triangles no collapse may remove (collinear or coincident input vertices where the
+// topology needs every vertex) lose a corner to another input vertex of its cluster: a free
+// corner (off every border) takes the first member, in input order, where the triangle gains
+// area and none around it folds, loses area or becomes a sliver. The output vertex then stands
+// for that input vertex (kept, position and attribute corners), so positions remain input
+// positions in fast mode. Vertices the guidance excludes (u = -1) are never taken.
+void relocate_zero_area(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
+                        const std::vector<int32_t>& label, DecimateResult& result, Collapser& collapser) {
+  const int32_t n = static_cast<int32_t>(result.kept.size());
+  std::vector<int32_t> offsets(n + 1, 0), members(mesh.num_vertices());
+  for (int32_t w = 0; w < mesh.num_vertices(); ++w)
+    if (label[w] >= 0) ++offsets[collapser.survivor(label[w]) + 1];
+  for (int32_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
+  std::vector<int32_t> fill(offsets.begin(), offsets.end() - 1);
+  for (int32_t w = 0; w < mesh.num_vertices(); ++w)
+    if (label[w] >= 0) members[fill[collapser.survivor(label[w])]++] = w;
+  const auto& source = mesh.vertex_source();
+  const auto& index = mesh.vertex_index();
+  const auto& vfo = mesh.vertex_face_offsets();
+  const auto& vf = mesh.vertex_faces();
+  const auto& faces = mesh.faces();
+  for (int32_t t : collapser.zero_area_face_list()) {
+    if (!collapser.face_alive(t) || !collapser.zero_area(t)) continue;
+    for (int j = 0; j < 3 && collapser.zero_area(t); ++j) {
+      const int32_t v = result.triangles[3 * size_t(t) + j];
+      if (!collapser.is_free(v)) continue;
+      for (int32_t i = offsets[v]; i < offsets[v + 1]; ++i) {
+        const int32_t w = members[i];
+        if (w == index[result.kept[v]] || layout.vertex_feature[w] || vfo[w] == vfo[w + 1]) continue;
+        if (params.multipliers && (*params.multipliers)[w] == 0.0) continue;
+        if (!collapser.place(v, mesh.position(w), t)) continue;
+        result.kept[v] = source[w];
+        // Attributes from a corner of w (one sector: any of its triangles).
+        const int32_t f = vf[vfo[w]];
+        int32_t slot = 0;
+        while (faces[3 * size_t(f) + slot] != w) ++slot;
+        const int32_t corner = 3 * mesh.face_source()[f] + slot;
+        for (size_t c = 0; c < result.triangles.size(); ++c)
+          if (result.triangles[c] == v) result.corner_source[c] = corner;
+        break;
+      }
+    }
+  }
+}
+
 }  // namespace
 
 bool has_zero_area(const DecimateResult& result) {
@@ -325,6 +370,7 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
     }
     result.refine_collapses += collapser.remove_thin(0.0, {});
   }
+  if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
   result.issues_remaining.sliver = collapser.zero_area_faces();
   // Compact: surviving vertices and faces in their old order, labels followed along the collapses.
   std::vector<int32_t> new_index(n, -1);
