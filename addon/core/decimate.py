@@ -38,12 +38,12 @@ if TYPE_CHECKING:  # for annotations only: mesh.py imports this module
 DENSITY_MODES = ("off", "uniform", "adaptive", "euclidean")
 PLACEMENTS = ("subsample", "filtered")
 MODES = ("quality", "fast")
-#: quality mode: TopStoc keeps this many times the target before the collapses ...
-QUALITY_REFINE = 2.0
-#: ... and at least this many vertices more (the whole mesh when that covers it): small and
-#: mid-sized meshes go through the collapses alone, which gives the lowest error; on big ones
-#: the stochastic pass does the bulk of the work (docs/design.md §2.10).
-QUALITY_COLLAPSES = 20_000
+#: quality mode: the collapses remove at most max(QUALITY_COLLAPSES, target / 4) vertices
+#: after a stochastic first pass (the time then grows with the target, not with the mesh), and
+#: start from the whole mesh when it has at most 5 * QUALITY_COLLAPSES vertices (the lowest
+#: error; docs/design.md §2.10)
+QUALITY_REFINE = 1.0
+QUALITY_COLLAPSES = 10_000
 #: default weight of an attribute channel in the collapse cost (see decimate's attributes)
 ATTRIBUTE_WEIGHT = 0.1
 #: the most attribute channels the collapse cost takes
@@ -319,9 +319,8 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     or "euclidean" (density_epsilon, 0 = automatic). guidance: u per vertex (module docs).
     regions: an id per input triangle (materials, UV islands), borders: (k, 2) vertex pairs;
     no cluster crosses either, and both survive exactly. view, boxes: see View and Box.
-    mode: "quality" (default): placement "filtered" and refinement from TopStoc at
-    QUALITY_REFINE times the target and at least QUALITY_COLLAPSES vertices more (the whole mesh
-    when that covers it); "fast": the thesis' TopStoc, placement "subsample", no refinement.
+    mode: "quality" (default): placement "filtered" and quadric collapses after a TopStoc pass
+    (see QUALITY_COLLAPSES); "fast": the thesis' TopStoc, placement "subsample", no refinement.
     placement and refine, when given, override what the mode sets.
     placement: "subsample" keeps input positions, "filtered" moves surface vertices to the
     quadric-optimal point of their cluster (borders stay).

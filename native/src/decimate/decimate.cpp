@@ -501,6 +501,14 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
 
 namespace {
 
+// Vertices the first pass of a refined decimation keeps (see DecimateParams::refine_collapses).
+int32_t first_pass_vertices(const DecimateParams& params, int32_t active) {
+  const double target = params.target_vertices, collapses = std::max(0, params.refine_collapses);
+  if (collapses > 0 && active <= 5.0 * collapses) return active;
+  const double extra = collapses > 0 ? std::max(collapses, 0.25 * target) : 0.0;
+  return int32_t(std::min<double>(active, std::max(std::ceil(params.refine * target), target + extra)));
+}
+
 // TopStoc to a few times the target, then collapses down to it (refine.hpp). Painted regions
 // keep the share of the budget the guidance gives them. target_triangles > 0: the collapses
 // stop there instead (the vertex target then sets the first pass and the guidance quotas).
@@ -510,9 +518,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   DecimateParams first = params;
   first.refine = 0.0;
   first.placement = Placement::Subsample;  // the refinement places the vertices it keeps
-  first.target_vertices = int32_t(std::min<double>(
-      active, std::max(std::ceil(params.refine * params.target_vertices),
-                       double(params.target_vertices) + std::max(0, params.refine_collapses))));
+  first.target_vertices = first_pass_vertices(params, active);
   DecimateResult result = stochastic_pass(mesh, layout, first, true);
   const std::vector<double> multipliers = guidance_multipliers(mesh, params.sampling);
   RefineParams refine;

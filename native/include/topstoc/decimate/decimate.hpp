@@ -47,9 +47,10 @@ struct DecimateParams {
   /// Quadric refinement (refine.hpp): 0 = off; f > 1 keeps f times the target with TopStoc,
   /// then quadric-ordered collapses thin the result to the target (better error, slower).
   double refine = 0.0;
-  /// With refine: the first pass keeps at least this many vertices more than the target (all
-  /// of them when that covers the mesh). Small meshes then skip the stochastic pass, whose
-  /// choices cost quality, and big ones keep refine times the target, which bounds the time.
+  /// With refine, C > 0: the first pass keeps at least target + max(C, target / 4) vertices,
+  /// and all of them when the mesh has at most 5 C. Small meshes then skip the stochastic
+  /// pass, whose choices cost quality; on big ones the collapses' time grows with the target,
+  /// not with the mesh, while the stochastic pass does the bulk.
   int32_t refine_collapses = 0;
   CornerAttributes attributes;  ///< attribute-aware cost of the refinement
 };
