@@ -40,8 +40,16 @@ if TYPE_CHECKING:  # for annotations only: mesh.py imports this module
 DENSITY_MODES = ("off", "uniform", "adaptive", "euclidean")
 PLACEMENTS = ("subsample", "filtered")
 MODES = ("quality", "fast")
-#: quality mode: TopStoc keeps this many times the target before the collapses.
-QUALITY_REFINE = 8.0
+#: quality mode: the collapses remove at most max(QUALITY_COLLAPSES, target / 4) vertices
+#: after a stochastic first pass (the time then grows with the target, not with the mesh), and
+#: start from the whole mesh when it has at most 5 * QUALITY_COLLAPSES vertices (the lowest
+#: error; docs/design.md §2.10)
+QUALITY_REFINE = 1.0
+QUALITY_COLLAPSES = 10_000
+#: default weight of an attribute channel in the collapse cost (see decimate's attributes)
+ATTRIBUTE_WEIGHT = 0.1
+#: the most attribute channels the collapse cost takes
+MAX_ATTRIBUTE_CHANNELS = 16
 #: how far over the target a result may land before it counts as over budget
 BUDGET_TOLERANCE = 0.01
 
@@ -158,6 +166,7 @@ class DecimateStats:
     issues_remaining: dict      #: what was left (all zero unless the round limit was hit)
     seconds: dict               #: per stage: sampling, clustering, checking, output, refine
     refine_vertices: int = 0    #: target of the quadric refinement (0: not refined)
+    refine_triangles: int = 0   #: its triangle target, when it had one
     refine_collapses: int = 0   #: collapses the refinement made
     output_vertices: int = 0    #: vertices of the result
     #: the final check of the output against the input's components (manifold, orientation,
@@ -198,7 +207,8 @@ class DecimateResult:
     ``(j, c)`` should take: a corner of the kept vertex on the same side of every border.
     ``labels[v]`` is the output vertex whose cluster holds input vertex ``v`` (-1 for vertices
     in no triangle). ``samples`` (with the same mesh, borders and placement; for a refined
-    result also ``stats.refine_vertices`` and the guidance) reproduces the result exactly
+    result also ``stats.refine_vertices``, ``stats.refine_triangles``, the guidance and the
+    attributes) reproduces the result exactly
     through ``Mesh.decimate_with_samples``.
     """
 
@@ -249,6 +259,43 @@ def _guidance(mesh: Mesh, guidance) -> Optional[np.ndarray]:
     return u
 
 
+def _attributes(mesh: Mesh, attributes, weights):
+    """Attributes for the collapse cost as (flat per-corner values, per-channel weights), or
+    (None, None). attributes: (n, k) per vertex or (m, 3, k) per corner of the caller's
+    triangles; weights: a number or one per channel."""
+    if attributes is None:
+        if weights is not None:
+            raise ValueError("attribute_weights given without attributes")
+        return None, None
+    values = np.asarray(attributes)
+    if values.dtype.kind not in "fiu":
+        raise ValueError(f"attributes must be a float array, got {values.dtype}")
+    values = values.astype(np.float64)
+    n, m = mesh.native.report["input_vertices"], len(mesh.triangles)
+    if values.ndim == 1 and len(values) == n:
+        values = values[:, None]
+    if values.ndim == 2 and values.shape[0] == n:
+        values = values[mesh.triangles]                     # per vertex -> per corner
+    elif not (values.ndim == 3 and values.shape[:2] == (m, 3)):
+        raise ValueError(f"attributes must have shape (n, k) per vertex ({n} vertices) or (m, 3, k) per "
+                         f"corner ({m} triangles), got {values.shape}")
+    channels = values.shape[2]
+    if not 1 <= channels <= MAX_ATTRIBUTE_CHANNELS:
+        raise ValueError(f"attributes must have 1 to {MAX_ATTRIBUTE_CHANNELS} channels, got {channels}")
+    bad = np.argwhere(~np.isfinite(values))
+    if len(bad):
+        t, c, k = bad[0]
+        raise ValueError(f"attribute {k} of corner {c} of triangle {t} is {values[t, c, k]}; it must be finite")
+    w = np.asarray(ATTRIBUTE_WEIGHT if weights is None else weights, dtype=np.float64)
+    if w.ndim == 0:
+        w = np.full(channels, float(w))
+    if w.shape != (channels,):
+        raise ValueError(f"attribute_weights must be a number or one per channel ({channels}), got shape {w.shape}")
+    if not np.all(np.isfinite(w) & (w >= 0)):
+        raise ValueError(f"attribute_weights must be finite and >= 0, got {w}")
+    return np.ascontiguousarray(values).ravel(), np.ascontiguousarray(w)
+
+
 def _active_vertices(mesh: Mesh) -> int:
     report = mesh.native.report
     return report["input_vertices"] - report["isolated_vertices"]
@@ -284,7 +331,8 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
              regions=None, borders=None, view: Optional[View] = None,
              boxes: Sequence[Box] = (), mode: str = "quality", placement: Optional[str] = None,
              fast_path: Optional[bool] = None, max_repair_rounds: int = 200, refine: Optional[float] = None,
-             max_error: Optional[float] = None, relative: bool = False) -> DecimateResult:
+             max_error: Optional[float] = None, relative: bool = False, attributes=None,
+             attribute_weights=None) -> DecimateResult:
     """Decimates ``mesh`` with TopStoc. Give exactly one target.
 
     ratio: fraction of the vertices to keep, in (0, 1]. target_vertices / target_triangles:
@@ -300,14 +348,21 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     or "euclidean" (density_epsilon, 0 = automatic). guidance: u per vertex (module docs).
     regions: an id per input triangle (materials, UV islands), borders: (k, 2) vertex pairs;
     no cluster crosses either, and both survive exactly. view, boxes: see View and Box.
-    mode: "quality" (default): placement "filtered" and refine QUALITY_REFINE; "fast": the
-    thesis' TopStoc, placement "subsample", no refinement. placement and refine, when given,
-    override what the mode sets.
+    mode: "quality" (default): placement "filtered" and quadric collapses after a TopStoc pass
+    (see QUALITY_COLLAPSES); "fast": the thesis' TopStoc, placement "subsample", no refinement.
+    placement and refine, when given, override what the mode sets.
     placement: "subsample" keeps input positions, "filtered" moves surface vertices to the
     quadric-optimal point of their cluster (borders stay).
     refine: 0 = off (fastest). f >= 1: TopStoc keeps f times the target, then edge collapses
     ordered by quadric error against the input thin it to the target (topology and borders
     kept, painted regions keeping their share of the budget). Lower error at a higher cost.
+    attributes: UVs, colours, normals... that should survive the collapses: (n, k) per vertex
+    or (m, 3, k) per corner of the caller's triangles (per corner for UVs with seams). They
+    enter the collapse cost as generalised quadrics (docs/design.md §2.10): with weight w, a
+    difference d in a channel costs as much as moving the surface by w * d bounding-box
+    diagonals. attribute_weights: a number or one per channel (default ATTRIBUTE_WEIGHT).
+    Only the refinement (quality mode) uses them; output attributes still come from the input
+    through corner_source (topstoc.core.attributes interpolates those of moved vertices).
     max_error: the fewest vertices whose symmetric Hausdorff error stays within this bound
     (absolute, or a fraction of the bounding-box diagonal with ``relative=True``), found by a
     search over re-decimations with the same seed; ``result.error_bound`` tells how it went.
@@ -323,8 +378,11 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
         raise TopStocError(f"mode must be one of {MODES}, got {mode!r}")
     if placement is None:
         placement = "filtered" if mode == "quality" else "subsample"
+    refine_asked = refine  # the error-bounded search re-decimates with the caller's own choice
+    refine_collapses = 0
     if refine is None:
         refine = QUALITY_REFINE if mode == "quality" else 0.0
+        refine_collapses = QUALITY_COLLAPSES if mode == "quality" else 0
     if max_error is not None:  # error-bounded: a search over vertex targets (error_bound.py)
         from .error_bound import search_vertex_count
 
@@ -332,8 +390,9 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
             return decimate(mesh, target_vertices=count, seed=seed, adaptivity=adaptivity, flat_floor=flat_floor,
                             area_weighted=area_weighted, feature_angle=feature_angle, density=density, density_rings=density_rings, density_ratio=density_ratio,
                             density_epsilon=density_epsilon, guidance=guidance, regions=regions,
-                            borders=borders, view=view, boxes=boxes, placement=placement,
-                            fast_path=fast_path, max_repair_rounds=max_repair_rounds, refine=refine)
+                            borders=borders, view=view, boxes=boxes, mode=mode, placement=placement,
+                            fast_path=fast_path, max_repair_rounds=max_repair_rounds, refine=refine_asked,
+                            attributes=attributes, attribute_weights=attribute_weights)
 
         result, report = search_vertex_count(mesh, max_error, decimate_at, relative=relative)
         return dataclasses.replace(result, error_bound=report,
@@ -363,12 +422,15 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     else:
         target = target_vertex_count(mesh, ratio, vertices)
     u = _guidance(mesh, guidance)
+    attribute_values, attribute_weights = _attributes(mesh, attributes, attribute_weights)
     layout = mesh.feature_layout(regions, borders, feature_angle)
     parameters = dict(ratio=ratio, target_vertices=vertices, target_triangles=triangles, seed=int(seed),
                       adaptivity=adaptivity, flat_floor=flat_floor, area_weighted=bool(area_weighted),
                       feature_angle=float(feature_angle), density=density,
                       density_rings=density_rings, density_ratio=density_ratio,
-                      density_epsilon=density_epsilon, mode=mode, placement=placement, refine=float(refine))
+                      density_epsilon=density_epsilon, mode=mode, placement=placement, refine=float(refine),
+                      refine_collapses=refine_collapses,
+                      attribute_channels=0 if attribute_weights is None else len(attribute_weights))
     raw = engine.decimate(
         mesh.native, layout, target_vertices=target, target_triangles=target_triangles,
         seed=int(seed), adaptivity=float(adaptivity), flat_floor=float(flat_floor),
@@ -377,18 +439,20 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
         density_epsilon=float(density_epsilon),
         view=_engine_view(view), boxes=_engine_boxes(boxes), placement=placement,
         fast_path=0 if fast_path is None else int(bool(fast_path)),
-        max_repair_rounds=int(max_repair_rounds), refine=float(refine))
+        max_repair_rounds=int(max_repair_rounds), refine=float(refine), refine_collapses=int(refine_collapses),
+        attributes=attribute_values, attribute_weights=attribute_weights)
     return _result(raw, parameters)
 
 
 def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, feature_angle: float = 0.0,
-                          placement: str = "subsample", refine_vertices: int = 0,
-                          guidance=None) -> DecimateResult:
+                          placement: str = "subsample", refine_vertices: int = 0, refine_triangles: int = 0,
+                          guidance=None, attributes=None, attribute_weights=None) -> DecimateResult:
     """Re-creates a decimation from ``DecimateResult.samples`` (thesis 4.1.3).
 
     With the same mesh, regions, borders, feature angle and placement the output is identical.
-    A refined result (``refine`` > 0) also needs ``refine_vertices=result.stats.refine_vertices``
-    and the same ``guidance``.
+    A refined result (``refine`` > 0) also needs ``refine_vertices=result.stats.refine_vertices``,
+    ``refine_triangles=result.stats.refine_triangles`` and the same ``guidance`` and
+    ``attributes``.
     """
     if placement not in PLACEMENTS:
         raise TopStocError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
@@ -396,12 +460,16 @@ def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, fe
     if samples.ndim != 1 or samples.dtype.kind not in "iu":
         raise TopStocError(f"samples must be a 1-D integer array, got {samples.dtype} {samples.shape}")
     refine_vertices = params.integer("refine_vertices", refine_vertices, 0, 2**31 - 1)
+    refine_triangles = params.integer("refine_triangles", refine_triangles, 0, 2**31 - 1)
     feature_angle = params.number("feature_angle (radians)", feature_angle, 0, math.pi)
+    attribute_values, attribute_weights = _attributes(mesh, attributes, attribute_weights)
     layout = mesh.feature_layout(regions, borders, feature_angle)
     raw = engine.decimate_with_samples(mesh.native, layout, samples, placement=placement,
-                                       refine_vertices=int(refine_vertices), guidance=_guidance(mesh, guidance))
+                                       refine_vertices=int(refine_vertices), guidance=_guidance(mesh, guidance),
+                                       refine_triangles=int(refine_triangles), attributes=attribute_values,
+                                       attribute_weights=attribute_weights)
     return _result(raw, dict(samples=len(samples), placement=placement, feature_angle=feature_angle,
-                             refine_vertices=int(refine_vertices)))
+                             refine_vertices=int(refine_vertices), refine_triangles=int(refine_triangles)))
 
 
 def sampling_probabilities(mesh: Mesh, rate: float, *, adaptivity: float = 0.5,

@@ -105,6 +105,7 @@ py::dict result_dict(DecimateResult&& r) {
   d["fast_path"] = r.fast_path;
   d["top_up"] = r.top_up;
   d["refine_vertices"] = r.refine_vertices;
+  d["refine_triangles"] = r.refine_triangles;
   d["refine_collapses"] = r.refine_collapses;
   d["repair_rounds"] = r.repair_rounds;
   d["repairs"] = r.repairs;
@@ -156,6 +157,32 @@ SamplingParams sampling_from(const Mesh& mesh, uint64_t seed, double adaptivity,
   return s;
 }
 
+// Attributes for the collapse cost: `values` flat, 3 corners per caller triangle times
+// `weights` channels (shapes are checked in Python), or None.
+struct AttributeArrays {
+  std::vector<double> values, weights;
+  CornerAttributes view(int64_t triangles) const {
+    CornerAttributes a;
+    if (values.empty() || weights.empty()) return a;
+    if (int64_t(values.size()) != 3 * triangles * int64_t(weights.size()))
+      throw std::invalid_argument("attributes must hold 3 values per triangle corner and channel");
+    a.values = values.data();
+    a.channels = static_cast<int>(weights.size());
+    a.weights = weights.data();
+    return a;
+  }
+};
+
+AttributeArrays attributes_from(const Mesh& mesh, const py::handle& values, const py::handle& weights) {
+  AttributeArrays a;
+  if (values.is_none()) return a;
+  if (weights.is_none()) throw std::invalid_argument("attributes need attribute_weights");
+  a.weights = scalars_from(weights, static_cast<int64_t>(py::len(weights)), "attribute_weights");
+  const int64_t count = 3 * int64_t(mesh.report().input_triangles) * int64_t(a.weights.size());
+  a.values = scalars_from(values, count, "attributes");
+  return a;
+}
+
 }  // namespace
 
 void bind_decimate(py::module_& m) {
@@ -166,7 +193,7 @@ void bind_decimate(py::module_& m) {
          const std::string& density,
          int32_t density_rings, double density_ratio, double density_epsilon, const py::handle& view,
          const py::handle& boxes, const std::string& placement, int fast_path, int32_t max_repair_rounds,
-         double refine) {
+         double refine, int32_t refine_collapses, const py::handle& attributes, const py::handle& attribute_weights) {
         const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
         DecimateParams params;
         params.sampling = sampling_from(mesh, seed, adaptivity, flat_floor, area_weighted, u, density, density_rings,
@@ -177,6 +204,9 @@ void bind_decimate(py::module_& m) {
         params.max_repair_rounds = max_repair_rounds;
         params.target_vertices = target_vertices;
         params.refine = refine;
+        params.refine_collapses = refine_collapses;
+        const AttributeArrays arrays = attributes_from(mesh, attributes, attribute_weights);
+        params.attributes = arrays.view(mesh.report().input_triangles);
         DecimateResult r;
         {
           EngineCall call;
@@ -190,26 +220,32 @@ void bind_decimate(py::module_& m) {
       py::arg("guidance") = py::none(), py::arg("density") = "off", py::arg("density_rings") = 0, py::arg("density_ratio") = 2.0,
       py::arg("density_epsilon") = 0.0, py::arg("view") = py::none(), py::arg("boxes") = py::none(),
       py::arg("placement") = "subsample", py::arg("fast_path") = 0, py::arg("max_repair_rounds") = 200,
-      py::arg("refine") = 0.0,
+      py::arg("refine") = 0.0, py::arg("refine_collapses") = 0, py::arg("attributes") = py::none(),
+      py::arg("attribute_weights") = py::none(),
       "TopStoc decimation to a vertex target (or a triangle target when target_triangles > 0).");
 
   m.def(
       "decimate_with_samples",
       [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& samples, const std::string& placement,
-         int32_t max_repair_rounds, int32_t refine_vertices, const py::handle& guidance) {
+         int32_t max_repair_rounds, int32_t refine_vertices, const py::handle& guidance, int32_t refine_triangles,
+         const py::handle& attributes, const py::handle& attribute_weights) {
         auto ids = ids_from(samples, -1, "samples");
         const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
         if (refine_vertices < 0) throw std::invalid_argument("refine_vertices must be >= 0");
+        if (refine_triangles < 0) throw std::invalid_argument("refine_triangles must be >= 0");
+        const AttributeArrays arrays = attributes_from(mesh, attributes, attribute_weights);
         DecimateResult r;
         {
           EngineCall call;
           r = decimate_with_samples(mesh, layout, std::move(ids), placement_from(placement), max_repair_rounds,
-                                    refine_vertices, u.empty() ? nullptr : u.data());
+                                    refine_vertices, u.empty() ? nullptr : u.data(),
+                                    arrays.view(mesh.report().input_triangles), refine_triangles);
         }
         return result_dict(std::move(r));
       },
       py::arg("mesh"), py::arg("layout"), py::arg("samples"), py::arg("placement") = "subsample",
       py::arg("max_repair_rounds") = 200, py::arg("refine_vertices") = 0, py::arg("guidance") = py::none(),
+      py::arg("refine_triangles") = 0, py::arg("attributes") = py::none(), py::arg("attribute_weights") = py::none(),
       "Re-creates a decimation from its saved sample list.");
 
   m.def(

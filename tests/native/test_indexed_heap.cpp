@@ -70,3 +70,28 @@ TEST_CASE("indexed heap under random set, re-key and remove agrees with a sorted
     if (!sorted.empty()) CHECK(heap.top() == sorted.begin()->second);
   }
 }
+
+TEST_CASE("indexed heap built at once pops like one built by inserts") {
+  std::mt19937 random(7);
+  const int32_t n = 400;
+  IndexedHeap built(n), inserted(n);
+  built.set(3, 1.0);  // assign replaces what was there
+  std::vector<int32_t> ids;
+  std::vector<double> keys;
+  for (int32_t id = 0; id < n; ++id)
+    if (random() % 3 != 0) {
+      ids.push_back(id);
+      keys.push_back(double(random() % 40));  // many ties
+      inserted.set(id, keys.back());
+    }
+  built.assign(ids, keys);
+  CHECK(built.contains(3) == inserted.contains(3));
+  while (!inserted.empty()) {
+    REQUIRE_FALSE(built.empty());
+    CHECK(built.top() == inserted.top());
+    CHECK(built.top_key() == inserted.top_key());
+    built.remove(built.top());
+    inserted.remove(inserted.top());
+  }
+  CHECK(built.empty());
+}

@@ -465,26 +465,14 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
 
 }  // namespace
 
-DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params) {
+namespace {
+
+// TopStoc to params.target_vertices. `refined`: a first pass the refinement thins next, which
+// removes zero-area triangles and whose output is checked after it, so neither happens here
+// (except the check that decides whether a fast-path miss must be redone).
+DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
+                               bool refined) {
   const int32_t active = active_vertices(mesh);
-  if (!(params.refine == 0.0 || params.refine >= 1.0))
-    throw std::invalid_argument("refine must be 0 (off) or at least 1, got " + std::to_string(params.refine));
-  if (params.refine >= 1.0 && params.target_vertices >= 1 && params.target_vertices <= active) {
-    // Refined: TopStoc to `refine` times the target, then collapses down to it. Painted
-    // regions keep the share of the budget the guidance gives them (see refine.hpp).
-    DecimateParams first = params;
-    first.refine = 0.0;
-    first.target_vertices = int32_t(std::min<double>(active, std::ceil(params.refine * params.target_vertices)));
-    DecimateResult result = decimate(mesh, layout, first);
-    const std::vector<double> multipliers = guidance_multipliers(mesh, params.sampling);
-    RefineParams refine;
-    refine.target_vertices = params.target_vertices;
-    refine.multipliers = &multipliers;
-    refine_by_collapses(mesh, layout, refine, result);
-    result.target_vertices = params.target_vertices;
-    result.forced = std::max(result.forced, int32_t(std::count(multipliers.begin(), multipliers.end(), kForcedMultiplier)));
-    return verified(mesh, layout, std::move(result));
-  }
   if (params.target_vertices < 1)
     throw std::invalid_argument("target must be at least 1 vertex, got " + std::to_string(params.target_vertices));
   if (params.target_vertices > active)
@@ -507,13 +495,14 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
   }
   // An input with collinear vertices can leave zero-area triangles the repairs could not
   // remove: collapse one edge of each (never an output with a zero-area triangle).
-  if (has_zero_area(best)) {
+  if (!refined && has_zero_area(best)) {
     const std::vector<double> multipliers = guidance_multipliers(mesh, params.sampling);
     RefineParams cleanup;
     cleanup.multipliers = &multipliers;
     cleanup.zero_area_only = true;
     refine_by_collapses(mesh, layout, cleanup, best);
   }
+  if (refined && !best.fast_path) return best;
   check_result(mesh, layout, best);
   if (best.fast_path && !topology_kept(best)) {
     // The fast path's candidate faces can miss an emitting face (seen once in 55,000 random
@@ -521,14 +510,66 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
     // not see). Scanning every face instead is the repair.
     DecimateParams every_face = params;
     every_face.fast_path = 0;
-    return decimate(mesh, layout, every_face);
+    return stochastic_pass(mesh, layout, every_face, refined);
   }
   return reported(std::move(best));  // checked above
 }
 
+}  // namespace
+
+namespace {
+
+// Vertices the first pass of a refined decimation keeps (see DecimateParams::refine_collapses).
+int32_t first_pass_vertices(const DecimateParams& params, int32_t active) {
+  const double target = params.target_vertices, collapses = std::max(0, params.refine_collapses);
+  if (collapses > 0 && active <= 5.0 * collapses) return active;
+  const double extra = collapses > 0 ? std::max(collapses, 0.25 * target) : 0.0;
+  return int32_t(std::min<double>(active, std::max(std::ceil(params.refine * target), target + extra)));
+}
+
+// TopStoc to a few times the target, then collapses down to it (refine.hpp). Painted regions
+// keep the share of the budget the guidance gives them. target_triangles > 0: the collapses
+// stop there instead (the vertex target then sets the first pass and the guidance quotas).
+DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
+                       int32_t target_triangles) {
+  const int32_t active = active_vertices(mesh);
+  DecimateParams first = params;
+  first.refine = 0.0;
+  first.placement = Placement::Subsample;  // the refinement places the vertices it keeps
+  first.target_vertices = first_pass_vertices(params, active);
+  DecimateResult result = stochastic_pass(mesh, layout, first, true);
+  const std::vector<double> multipliers = guidance_multipliers(mesh, params.sampling);
+  RefineParams refine;
+  refine.target_vertices = params.target_vertices;
+  refine.target_triangles = target_triangles;
+  refine.multipliers = &multipliers;
+  refine.refit = params.placement == Placement::Filtered;
+  refine.attributes = params.attributes;
+  refine_by_collapses(mesh, layout, refine, result);
+  result.target_vertices = params.target_vertices;
+  // What must stay whatever the target: border corners and control points (the first pass
+  // may have drawn every vertex, which says nothing about the budget).
+  result.forced = 0;
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+    result.forced += layout.vertex_corner[v] || multipliers[v] == kForcedMultiplier;
+  return verified(mesh, layout, std::move(result));
+}
+
+}  // namespace
+
+DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params) {
+  const int32_t active = active_vertices(mesh);
+  if (!(params.refine == 0.0 || params.refine >= 1.0))
+    throw std::invalid_argument("refine must be 0 (off) or at least 1, got " + std::to_string(params.refine));
+  if (params.refine >= 1.0 && params.target_vertices >= 1 && params.target_vertices <= active)
+    return refined(mesh, layout, params, 0);
+  return stochastic_pass(mesh, layout, params, false);
+}
+
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                      Placement placement, int32_t max_repair_rounds, int32_t refine_vertices,
-                                     const double* guidance) {
+                                     const double* guidance, const CornerAttributes& attributes,
+                                     int32_t refine_triangles) {
   if (samples.empty()) throw std::invalid_argument("the sample list is empty");
   const auto& vfo = mesh.vertex_face_offsets();
   for (size_t i = 0; i < samples.size(); ++i) {
@@ -554,7 +595,9 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
   result.selected = result.target_vertices;
   // Saved lists come from a finished decimation; only topology is re-checked, so the same
   // list always gives the same mesh.
-  result = cluster_and_emit(mesh, layout, std::move(samples), placement, max_repair_rounds, false, false, {},
+  // A refined result's first pass keeps input positions: the refinement places what it keeps.
+  result = cluster_and_emit(mesh, layout, std::move(samples), refine_vertices > 0 ? Placement::Subsample : placement,
+                            max_repair_rounds, false, false, {},
                             std::vector<uint8_t>(mesh.num_vertices(), 0), 0, std::move(result));
   // A refined result is thinned again; an unrefined one loses its zero-area triangles, as
   // decimate() does.
@@ -568,7 +611,10 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
     RefineParams refine;
     refine.multipliers = guidance ? &multipliers : nullptr;
     refine.target_vertices = refine_vertices;
+    refine.target_triangles = refine_vertices > 0 ? refine_triangles : 0;
     refine.zero_area_only = refine_vertices == 0;
+    refine.refit = refine_vertices > 0 && placement == Placement::Filtered;
+    refine.attributes = attributes;
     refine_by_collapses(mesh, layout, refine, result);
   }
   return verified(mesh, layout, std::move(result));
@@ -583,6 +629,11 @@ DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layo
                                 std::to_string(mesh.num_faces()) + " triangles");
   // First guess from the input's triangle-to-vertex ratio, then correct by what came out.
   double vertices = double(target_triangles) * active / mesh.num_faces();
+  if (params.refine >= 1.0) {
+    // The collapses stop at the triangle count itself: one pass.
+    params.target_vertices = std::clamp(int32_t(std::lround(vertices)), 1, active);
+    return refined(mesh, layout, params, target_triangles);
+  }
   DecimateResult best;
   int32_t best_error = INT32_MAX;
   for (int it = 0; it < std::max(1, max_iterations); ++it) {

@@ -4,6 +4,7 @@
 // entries those copies, not the collapses, dominated the time).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -29,6 +30,17 @@ class IndexedHeap {
       heap_[position_[id]].key = key;
     }
     sift_down(sift_up(position_[id]));
+  }
+
+  /// Replaces the contents with these ids and keys (each id at most once), in linear time.
+  void assign(const std::vector<int32_t>& ids, const std::vector<double>& keys) {
+    for (const Entry& e : heap_) position_[e.id] = -1;
+    heap_.clear();
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      position_[ids[i]] = static_cast<int32_t>(heap_.size());
+      heap_.push_back({keys[i], ids[i]});
+    }
+    for (int32_t at = static_cast<int32_t>(heap_.size()) / 2 - 1; at >= 0; --at) sift_down(at);
   }
 
   void remove(int32_t id) {

@@ -2,438 +2,22 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-#include "decimate/indexed_heap.hpp"
-#include "topstoc/decimate/quadric.hpp"
+#include <omp.h>
+
+#include "decimate/collapser.hpp"
+#include "topstoc/core/parallel.hpp"
 
 namespace topstoc {
 
 namespace {
 
-// Collapses may not make a triangle thinner than this shape quality (see Collapser::shape;
-// 0.1 is an aspect ratio of about 5-10 by the thesis' measure) unless it already was.
-constexpr double kMinShape = 0.1;
-
-class Collapser {
- public:
-  // curve: per output vertex, the feature curve it lies on (it may then move only along it), or
-  // -1; corner_sector: per output corner, the sector (side of the borders) of its vertex.
-  Collapser(DecimateResult& result, std::vector<Quadric> quadrics, std::vector<double> weight,
-            std::vector<uint8_t> locked, std::vector<int32_t> curve, std::vector<int32_t> curve_size,
-            std::vector<uint8_t> curve_closed, std::vector<int32_t> corner_sector, std::vector<int32_t> bin,
-            std::vector<int32_t> quota)
-      : r_(result), quadric_(std::move(quadrics)), weight_(std::move(weight)), locked_(std::move(locked)),
-        curve_(std::move(curve)), curve_size_(std::move(curve_size)), curve_closed_(std::move(curve_closed)),
-        corner_sector_(std::move(corner_sector)), bin_(std::move(bin)), quota_(std::move(quota)),
-        heap_(static_cast<int32_t>(result.kept.size())) {
-    const size_t n = r_.kept.size(), m = r_.face_source.size();
-    count_.assign(quota_.size(), 0);
-    alive_vertices_ = static_cast<int32_t>(n);
-    for (int32_t b : bin_) ++count_[b];
-    vertex_faces_.resize(n);
-    for (size_t t = 0; t < m; ++t)
-      for (int j = 0; j < 3; ++j) vertex_faces_[r_.triangles[3 * t + j]].push_back(int32_t(t));
-    alive_face_.assign(m, 1);
-    merged_into_.assign(n, -1);
-    target_.assign(n, -1);
-    for (int32_t u = 0; u < int32_t(n); ++u) update(u);
-  }
-
-  /// Collapses an edge of every zero-area triangle where a collapse is allowed (the triangle
-  /// and its neighbour across the edge vanish; no collapse creates a new one). Returns the
-  /// collapses made.
-  int32_t remove_zero_area(double min_shape = 0.0, int32_t keep = 0) {
-    int32_t collapses = 0;
-    for (bool progress = true; progress;) {
-      progress = false;
-      for (size_t t = 0; t < alive_face_.size(); ++t) {
-        if (alive_vertices_ <= keep) return collapses;
-        if (!alive_face_[t] || !(zero_area(int32_t(t)) || thin(int32_t(t), min_shape))) continue;
-        const int32_t* c = &r_.triangles[3 * t];
-        for (int j = 0; j < 6; ++j) {
-          const int32_t u = c[j % 3], v = c[(j % 3 + (j < 3 ? 1 : 2)) % 3];
-          if (locked_[u] || !allowed(u, v)) continue;
-          collapse(u, v);
-          ++collapses;
-          progress = true;
-          break;
-        }
-      }
-    }
-    return collapses;
-  }
-
-  int32_t zero_area_faces() const {
-    int32_t count = 0;
-    for (size_t t = 0; t < alive_face_.size(); ++t) count += alive_face_[t] && zero_area(int32_t(t));
-    return count;
-  }
-
-  /// Collapses until `target` vertices remain or no collapse is allowed; returns the count.
-  int32_t run(int32_t target) {
-    int32_t collapses = 0;
-    for (;;) {
-      if (alive_vertices_ <= target) break;
-      if (heap_.empty()) {
-        // Some region could not reach its quota: the others give the rest, by cost alone.
-        if (!use_quota_) break;
-        use_quota_ = false;
-        for (int32_t u = 0; u < int32_t(merged_into_.size()); ++u)
-          if (merged_into_[u] < 0) update(u);
-        continue;
-      }
-      const int32_t u = heap_.top(), v = target_[u];
-      if (at_quota(u)) {
-        target_[u] = -1;
-        heap_.remove(u);
-        continue;
-      }
-      // Collapses next to `v` may have changed its cost or ruled it out: look again.
-      if (merged_into_[v] >= 0 || heap_.top_key() != cost(u, v)) {
-        update(u);
-        continue;
-      }
-      if (!allowed(u, v)) {
-        update(u, true);
-        continue;
-      }
-      collapse(u, v);
-      ++collapses;
-    }
-    return collapses;
-  }
-
-  /// Compacts the result: surviving vertices and faces in their old order, labels followed
-  /// along the collapses.
-  void write_back() {
-    const int32_t n = static_cast<int32_t>(r_.kept.size());
-    std::vector<int32_t> new_index(n, -1);
-    int32_t next = 0;
-    for (int32_t v = 0; v < n; ++v)
-      if (merged_into_[v] < 0) {
-        new_index[v] = next;
-        r_.kept[next] = r_.kept[v];
-        for (int i = 0; i < 3; ++i) r_.vertices[3 * size_t(next) + i] = r_.vertices[3 * size_t(v) + i];
-        ++next;
-      }
-    r_.kept.resize(next);
-    r_.vertices.resize(3 * size_t(next));
-    size_t faces = 0;
-    for (size_t t = 0; t < alive_face_.size(); ++t) {
-      if (!alive_face_[t]) continue;
-      for (int j = 0; j < 3; ++j) {
-        r_.triangles[3 * faces + j] = new_index[r_.triangles[3 * t + j]];
-        r_.corner_source[3 * faces + j] = r_.corner_source[3 * t + j];
-      }
-      r_.face_source[faces] = r_.face_source[t];
-      ++faces;
-    }
-    r_.triangles.resize(3 * faces);
-    r_.corner_source.resize(3 * faces);
-    r_.face_source.resize(faces);
-    for (auto& label : r_.labels)
-      if (label >= 0) label = new_index[survivor(label)];
-  }
-
- private:
-  // Both ends free (off every border curve, not locked): the edge collapses to the point that
-  // minimises the summed quadric; otherwise `from` moves onto `to` (half-edge collapse), so
-  // border vertices stay input vertices on their curve.
-  bool free_pair(int32_t from, int32_t to) const {
-    return optimal_placement && curve_[from] < 0 && curve_[to] < 0 && !locked_[to] && !locked_[from];
-  }
-
-  // Where the collapse of `from` into `to` puts the survivor.
-  void placement(int32_t from, int32_t to, double x[3]) const {
-    const double* pt = &r_.vertices[3 * size_t(to)];
-    for (int i = 0; i < 3; ++i) x[i] = pt[i];
-    if (!free_pair(from, to)) return;
-    Quadric q = quadric_[from];
-    q.add(quadric_[to]);
-    const double* pf = &r_.vertices[3 * size_t(from)];
-    double d[3], length2 = 0;
-    for (int i = 0; i < 3; ++i) d[i] = pt[i] - pf[i], length2 += d[i] * d[i];
-    if (q.minimum(x)) {
-      // Trust the optimum only near the edge (a nearly flat or straight neighbourhood makes it
-      // drift along the surface).
-      double far2 = 0;
-      for (int i = 0; i < 3; ++i) far2 += (x[i] - 0.5 * (pf[i] + pt[i])) * (x[i] - 0.5 * (pf[i] + pt[i]));
-      if (far2 <= length2) return;
-    }
-    // The best point on the edge: E(pf + t d) is quadratic in t.
-    const double t = std::clamp(q.line_minimum(pf, d), 0.0, 1.0);
-    for (int i = 0; i < 3; ++i) x[i] = pf[i] + t * d[i];
-  }
-
-  double cost(int32_t from, int32_t to) const {
-    double x[3];
-    placement(from, to, x);
-    const double w = free_pair(from, to) ? std::max(weight_[from], weight_[to]) : weight_[from];
-    return w * std::max(0.0, quadric_[from].error(x) + quadric_[to].error(x));
-  }
-
-  // Queues u's cheapest collapse. Checks wait until it is popped (most queued collapses are
-  // superseded before that); with `checked`, the cheapest one that passes them. None: u
-  // waits until a collapse next to it calls update again.
-  void update(int32_t u, bool checked = false) {
-    target_[u] = -1;
-    heap_.remove(u);
-    if (locked_[u] || at_quota(u)) return;
-    neighbours(u, options_);
-    if (!checked) {  // the cheapest, lowest id on ties
-      int32_t best = -1;
-      double best_cost = 0;
-      for (int32_t v : options_) {
-        const double c = cost(u, v);
-        if (best < 0 || c < best_cost) best = v, best_cost = c;
-      }
-      if (best >= 0) queue(u, best, best_cost);
-      return;
-    }
-    costs_.clear();
-    for (int32_t v : options_) costs_.push_back({cost(u, v), v});
-    std::sort(costs_.begin(), costs_.end());
-    for (const auto& [c, v] : costs_)
-      if (allowed(u, v)) {
-        queue(u, v, c);
-        return;
-      }
-  }
-
-  bool thin(int32_t t, double min_shape) const {
-    if (min_shape <= 0.0) return false;
-    double n[3];
-    const int32_t* c = &r_.triangles[3 * size_t(t)];
-    normal(c, c[0], &r_.vertices[3 * size_t(c[0])], n);
-    return shape(c, c[0], &r_.vertices[3 * size_t(c[0])], std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])) <
-           min_shape;
-  }
-
-  bool zero_area(int32_t t) const {
-    double n[3];
-    const int32_t* c = &r_.triangles[3 * size_t(t)];
-    normal(c, c[0], &r_.vertices[3 * size_t(c[0])], n);
-    return n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0;
-  }
-
-  bool at_quota(int32_t u) const { return use_quota_ && count_[bin_[u]] <= quota_[bin_[u]]; }
-
-  void queue(int32_t u, int32_t v, double c) {
-    target_[u] = v;
-    heap_.set(u, c);
-  }
-
-  int32_t survivor(int32_t v) {
-    int32_t root = v;
-    while (merged_into_[root] >= 0) root = merged_into_[root];
-    while (merged_into_[v] >= 0) {
-      const int32_t up = merged_into_[v];
-      merged_into_[v] = root;
-      v = up;
-    }
-    return root;
-  }
-
-  void neighbours(int32_t v, std::vector<int32_t>& out) const {
-    out.clear();
-    for (int32_t t : vertex_faces_[v])
-      for (int j = 0; j < 3; ++j)
-        if (r_.triangles[3 * size_t(t) + j] != v) out.push_back(r_.triangles[3 * size_t(t) + j]);
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-  }
-
-  bool has(int32_t t, int32_t v) const {
-    const int32_t* c = &r_.triangles[3 * size_t(t)];
-    return c[0] == v || c[1] == v || c[2] == v;
-  }
-
-  int32_t sector_at(int32_t t, int32_t v) const {
-    for (int j = 0; j < 3; ++j)
-      if (r_.triangles[3 * size_t(t) + j] == v) return corner_sector_[3 * size_t(t) + j];
-    return -1;
-  }
-
-  // Link condition (Dey et al. 1999): u and v share exactly the vertices opposite their edge,
-  // and v keeps at least three neighbours; then the surface stays a manifold of the same
-  // topology. An interior u may go to any neighbour; a u on a border curve only along the
-  // curve (the edge must separate u's sectors, or be a boundary edge), so every border keeps
-  // its course and its sides.
-  bool allowed(int32_t u, int32_t v) {
-    std::vector<int32_t>& nu = scratch_;
-    std::vector<int32_t>& nv = scratch_other_;
-    neighbours(u, nu);
-    if (!std::binary_search(nu.begin(), nu.end(), v)) return false;
-    int32_t on_edge[2], count = 0;
-    for (int32_t t : vertex_faces_[u])
-      if (has(t, v)) {
-        if (count == 2) return false;
-        on_edge[count++] = t;
-      }
-    const bool closed_fan = nu.size() == vertex_faces_[u].size();
-    if (curve_[u] < 0) {
-      if (!closed_fan || count != 2) return false;
-    } else {
-      if (curve_[v] != curve_[u] && !locked_[v]) return false;
-      const bool boundary_edge = count == 1 && nu.size() == vertex_faces_[u].size() + 1;
-      const bool border_edge = count == 2 && closed_fan && sector_at(on_edge[0], u) != sector_at(on_edge[1], u);
-      if (!boundary_edge && !border_edge) return false;
-      if (curve_closed_[curve_[u]] && curve_size_[curve_[u]] <= 3) return false;
-    }
-    neighbours(v, nv);
-    int32_t shared = 0;
-    for (size_t i = 0, j = 0; i < nu.size() && j < nv.size();) {
-      if (nu[i] < nv[j]) {
-        ++i;
-      } else if (nu[i] > nv[j]) {
-        ++j;
-      } else {
-        ++shared, ++i, ++j;
-      }
-    }
-    if (shared != count) return false;
-    if (nu.size() + nv.size() < size_t(shared) + 5) return false;  // v would keep < 3 neighbours
-    double x[3];
-    placement(u, v, x);
-    return keeps_shape(u, v, x) && keeps_shape(v, u, x);
-  }
-
-  // Do the triangles of `moved` that do not hold `other` keep their side and some area when
-  // `moved` stands at x?
-  bool keeps_shape(int32_t moved, int32_t other, const double* x) const {
-    // A zero-area triangle has no side to keep: it must gain area facing like the fan.
-    double fan[3] = {0, 0, 0};
-    for (int32_t t : vertex_faces_[moved]) {
-      double n[3];
-      normal(&r_.triangles[3 * size_t(t)], moved, &r_.vertices[3 * size_t(moved)], n);
-      for (int i = 0; i < 3; ++i) fan[i] += n[i];
-    }
-    for (int32_t t : vertex_faces_[moved]) {
-      if (has(t, other)) continue;
-      const int32_t* c = &r_.triangles[3 * size_t(t)];
-      double before[3], after[3];
-      normal(c, moved, &r_.vertices[3 * size_t(moved)], before);
-      normal(c, moved, x, after);
-      double before2 = before[0] * before[0] + before[1] * before[1] + before[2] * before[2];
-      if (before2 == 0.0) {
-        for (int i = 0; i < 3; ++i) before[i] = fan[i];
-        before2 = fan[0] * fan[0] + fan[1] * fan[1] + fan[2] * fan[2];
-      }
-      const double dot = before[0] * after[0] + before[1] * after[1] + before[2] * after[2];
-      const double len2 = after[0] * after[0] + after[1] * after[1] + after[2] * after[2];
-      // No flip, no near-fold (normal turned by more than ~80 degrees), no loss of area.
-      if (!(dot > 0.17 * std::sqrt(len2 * before2)) || len2 <= 1e-24 * before2) return false;
-      // No sliver: a triangle may not end up thinner than kMinShape unless it was already.
-      if (shape(c, moved, x, std::sqrt(len2)) < kMinShape &&
-          shape(c, moved, &r_.vertices[3 * size_t(moved)], std::sqrt(before2)) >= kMinShape)
-        return false;
-    }
-    return true;
-  }
-
-  // Shape quality 2 sqrt(3) |n| / (sum of squared edges) of triangle c with `replace` at `at`
-  // (|n| = twice its area): 1 for an equilateral triangle, 0 for a degenerate one.
-  double shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const {
-    const double* p[3];
-    for (int j = 0; j < 3; ++j) p[j] = c[j] == replace ? at : &r_.vertices[3 * size_t(c[j])];
-    double edges = 0;
-    for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) edges += (p[j][i] - p[(j + 1) % 3][i]) * (p[j][i] - p[(j + 1) % 3][i]);
-    return edges > 0 ? 2.0 * std::sqrt(3.0) * twice_area / edges : 0.0;
-  }
-
-  // Normal (unnormalised) of triangle c with vertex `replace` standing at `at`.
-  void normal(const int32_t* c, int32_t replace, const double* at, double n[3]) const {
-    const double* p[3];
-    for (int j = 0; j < 3; ++j) p[j] = c[j] == replace ? at : &r_.vertices[3 * size_t(c[j])];
-    double a[3], b[3];
-    for (int i = 0; i < 3; ++i) a[i] = p[1][i] - p[0][i], b[i] = p[2][i] - p[0][i];
-    n[0] = a[1] * b[2] - a[2] * b[1], n[1] = a[2] * b[0] - a[0] * b[2], n[2] = a[0] * b[1] - a[1] * b[0];
-  }
-
-  void collapse(int32_t u, int32_t v) {
-    double x[3];
-    placement(u, v, x);
-    for (int i = 0; i < 3; ++i) r_.vertices[3 * size_t(v) + i] = x[i];
-    // The triangles on the edge vanish. On each side of u's borders one of them had a corner at
-    // v: u's other triangles on that side take that corner (and its sector) where they meet v.
-    struct Side {
-      int32_t sector, corner, corner_sector;
-    };
-    Side sides[2];
-    int32_t num_sides = 0;
-    for (int32_t t : vertex_faces_[u]) {
-      if (!has(t, v)) continue;
-      alive_face_[t] = 0;
-      Side side{sector_at(t, u), -1, -1};
-      for (int j = 0; j < 3; ++j) {
-        const int32_t w = r_.triangles[3 * size_t(t) + j];
-        if (w == v) side.corner = r_.corner_source[3 * size_t(t) + j], side.corner_sector = corner_sector_[3 * size_t(t) + j];
-        if (w == u) continue;
-        auto& list = vertex_faces_[w];
-        list.erase(std::find(list.begin(), list.end(), t));
-      }
-      sides[num_sides++] = side;
-    }
-    for (int32_t t : vertex_faces_[u]) {
-      if (!alive_face_[t]) continue;
-      for (int j = 0; j < 3; ++j)
-        if (r_.triangles[3 * size_t(t) + j] == u) {
-          const Side& side = (num_sides == 2 && corner_sector_[3 * size_t(t) + j] == sides[1].sector) ? sides[1] : sides[0];
-          r_.triangles[3 * size_t(t) + j] = v;
-          r_.corner_source[3 * size_t(t) + j] = side.corner;
-          corner_sector_[3 * size_t(t) + j] = side.corner_sector;
-        }
-      vertex_faces_[v].push_back(t);
-    }
-    if (curve_[u] >= 0) --curve_size_[curve_[u]];
-    --count_[bin_[u]];
-    --alive_vertices_;
-    vertex_faces_[u].clear();
-    merged_into_[u] = v;
-    quadric_[v].add(quadric_[u]);
-    heap_.remove(u);
-    // v's costs all change (its quadric grew); around it only collapses onto v or u change,
-    // or a new edge to v may be cheaper than what a vertex had queued. Checks that failed
-    // may pass now: a vertex without a queued collapse looks again.
-    update(v);
-    neighbours(v, star_);
-    for (int32_t x : star_) {
-      if (locked_[x] || at_quota(x)) continue;
-      if (target_[x] < 0 || target_[x] == u || target_[x] == v) {
-        update(x);
-      } else {
-        const double c = cost(x, v);
-        if (c < heap_.key_of(x)) queue(x, v, c);
-      }
-    }
-  }
-
-  DecimateResult& r_;
-  std::vector<Quadric> quadric_;
-  std::vector<double> weight_;
-  std::vector<uint8_t> locked_;
-  std::vector<int32_t> curve_, curve_size_;
-  std::vector<uint8_t> curve_closed_;
-  std::vector<int32_t> corner_sector_;
-  std::vector<int32_t> bin_, quota_, count_;  // per vertex its guidance bin; per bin quota, alive count
-  bool use_quota_ = true;
-  int32_t alive_vertices_ = 0;
-
- public:
-  bool optimal_placement = true;  // off: every collapse is a half-edge collapse (positions kept)
-
- private:
-  std::vector<std::vector<int32_t>> vertex_faces_;
-  std::vector<uint8_t> alive_face_;
-  std::vector<int32_t> merged_into_, target_;
-  IndexedHeap heap_;
-  std::vector<int32_t> scratch_, scratch_other_, options_, star_;
-  std::vector<std::pair<double, int32_t>> costs_;
-};
+// Slivers (shape quality below this, see Collapser) the stochastic pass left are collapsed first.
+constexpr double kSliverShape = 0.1;
 
 // Guidance bins: 0 for m = 0 (never sampled), 1 for control points, then m on a quarter-octave
 // scale.
@@ -481,6 +65,186 @@ std::vector<int32_t> bin_quotas(const std::vector<double>& vertices, const std::
   return quota;
 }
 
+// Centre and half extent of the bounding box (halves taken first so that neither overflows):
+// quadrics hold squared areas, which overflow at coordinates of 1e80 and underflow at 1e-80.
+void bounding_box(const Mesh& mesh, double center[3], double& extent, double& diagonal) {
+  double low[3] = {INFINITY, INFINITY, INFINITY}, high[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+    for (int i = 0; i < 3; ++i) low[i] = std::min(low[i], mesh.position(v)[i]), high[i] = std::max(high[i], mesh.position(v)[i]);
+  extent = 0;
+  double half[3] = {0, 0, 0};
+  for (int i = 0; i < 3; ++i) {
+    center[i] = mesh.num_vertices() > 0 ? 0.5 * low[i] + 0.5 * high[i] : 0.0;
+    half[i] = mesh.num_vertices() > 0 ? 0.5 * high[i] - 0.5 * low[i] : 0.0;
+    extent = std::max(extent, half[i]);
+  }
+  if (!(extent > 0) || !std::isfinite(extent) || !std::isfinite(1.0 / extent)) extent = 1.0;
+  // The diagonal in normalised units (half extents divided by the largest: no overflow).
+  diagonal = 2.0 * std::sqrt((half[0] / extent) * (half[0] / extent) + (half[1] / extent) * (half[1] / extent) +
+                             (half[2] / extent) * (half[2] / extent));
+  if (!(diagonal > 0) || !std::isfinite(diagonal)) diagonal = 1.0;
+}
+
+// Per input vertex, a third of the quadric of each triangle around it (in normalised
+// coordinates), so that a cluster's sum weighs each triangle by the share of its corners in the
+// cluster. It depends on the mesh only: kept with the layout, re-decimations skip it.
+struct QuadricTable {
+  double center[3] = {0, 0, 0}, extent = 1.0;
+  double diagonal = 1.0;  // of the bounding box, normalised
+  std::vector<double> quadric;  // 10 per vertex
+};
+
+std::shared_ptr<const QuadricTable> vertex_quadric_table(const Mesh& mesh, const FeatureLayout& layout) {
+  auto cached = std::static_pointer_cast<const QuadricTable>(layout.quadric_table.get());
+  if (cached && cached->quadric.size() == 10 * size_t(mesh.num_vertices())) return cached;
+  auto table = std::make_shared<QuadricTable>();
+  bounding_box(mesh, table->center, table->extent, table->diagonal);
+  const int32_t n = mesh.num_vertices();
+  table->quadric.assign(10 * size_t(n), 0.0);
+  const auto& faces = mesh.faces();
+  const auto& vfo = mesh.vertex_face_offsets();
+  const auto& vf = mesh.vertex_faces();
+  const double scale = 1.0 / table->extent;
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) {
+    double* sum = &table->quadric[10 * size_t(v)];
+    for (int32_t k = vfo[v]; k < vfo[v + 1]; ++k) {
+      const int32_t* t = &faces[3 * size_t(vf[k])];
+      double p[3][3], face[10], area;
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) p[j][i] = (mesh.position(t[j])[i] - table->center[i]) * scale;
+      if (!VertexQuadrics::plane(p[0], p[1], p[2], face, &area)) continue;
+      for (int i = 0; i < 10; ++i) sum[i] += face[i] * (1.0 / 3.0);
+    }
+  }
+  layout.quadric_table.set(table);
+  return table;
+}
+
+// Each output vertex stands for the input triangles of its cluster (each weighed by the share of
+// its corners in the cluster) and for the border edges in it: planes through each border edge,
+// perpendicular to its triangles, keep collapses from pulling a border (boundary, seam,
+// material edge) off its course. Each thread owns a range of clusters and adds to them in input
+// order, so the sums do not depend on the number of threads.
+VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
+                                const std::vector<int32_t>& label, int32_t clusters, const QuadricTable& table) {
+  const int channels = params.attributes.values ? params.attributes.channels : 0;
+  VertexQuadrics quadrics(clusters, channels);
+  const auto& faces = mesh.faces();
+  const auto& face_source = mesh.face_source();
+  const int stride = quadrics.stride();
+  const double* center = table.center;
+  const double scale = 1.0 / table.extent;
+  auto unit = [&](int32_t v, double* p) {
+    for (int i = 0; i < 3; ++i) p[i] = (mesh.position(v)[i] - center[i]) * scale;
+  };
+  const int32_t n = mesh.num_vertices(), m = mesh.num_faces();
+#pragma omp parallel if (n >= kParallelMin)
+  {
+    const int32_t threads = omp_get_num_threads(), me = omp_get_thread_num();
+    const int32_t low = int32_t(int64_t(clusters) * me / threads), high = int32_t(int64_t(clusters) * (me + 1) / threads);
+    if (channels == 0) {
+      for (int32_t v = 0; v < n; ++v)
+        if (label[v] >= low && label[v] < high) quadrics.add(label[v], &table.quadric[10 * size_t(v)]);
+    } else {
+      // Attributes: each face's generalised quadric, a third to the cluster of each corner.
+      std::vector<double> face(stride), values(3 * size_t(channels));
+      for (int32_t f = 0; f < m; ++f) {
+        const int32_t* t = &faces[3 * size_t(f)];
+        const int32_t l[3] = {label[t[0]], label[t[1]], label[t[2]]};
+        if (!((l[0] >= low && l[0] < high) || (l[1] >= low && l[1] < high) || (l[2] >= low && l[2] < high)))
+          continue;
+        double p[3][3];
+        for (int j = 0; j < 3; ++j) unit(t[j], p[j]);
+        for (int j = 0; j < 3; ++j)
+          for (int a = 0; a < channels; ++a)
+            values[size_t(j) * channels + a] =
+                params.attributes.values[(3 * size_t(face_source[f]) + j) * channels + a] *
+                params.attributes.weights[a] * table.diagonal;
+        if (!quadrics.face(p[0], p[1], p[2], values.data(), face.data())) continue;
+        for (double& x : face) x *= 1.0 / 3.0;
+        for (int j = 0; j < 3; ++j)
+          if (l[j] >= low && l[j] < high) quadrics.add(l[j], face.data());
+      }
+    }
+  }
+  const auto& ev = mesh.edge_vertices();
+  const auto& efo = mesh.edge_face_offsets();
+  const auto& ef = mesh.edge_faces();
+  for (int32_t e : layout.feature_edges) {
+    const int32_t* ab = &ev[2 * size_t(e)];
+    double a[3], b[3];
+    unit(ab[0], a);
+    unit(ab[1], b);
+    for (int32_t i = efo[e]; i < efo[e + 1]; ++i) {
+      const int32_t* t = &faces[3 * size_t(ef[i])];
+      int32_t opposite = t[0];
+      for (int j = 0; j < 3; ++j)
+        if (t[j] != ab[0] && t[j] != ab[1]) opposite = t[j];
+      // The plane holding the edge and the face normal, weighted by the edge length squared.
+      double c[3], u[3], w[3], n[3];
+      unit(opposite, c);
+      for (int k = 0; k < 3; ++k) u[k] = b[k] - a[k], w[k] = c[k] - a[k];
+      n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
+      double side[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
+      const double len = std::sqrt(side[0] * side[0] + side[1] * side[1] + side[2] * side[2]);
+      if (!(len > 0)) continue;
+      for (double& x : side) x /= len;
+      const double d = -(side[0] * a[0] + side[1] * a[1] + side[2] * a[2]);
+      const double weight = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+      int32_t l[2] = {label[ab[0]], label[ab[1]]};
+      for (int j = 0; j < 2; ++j)
+        if (l[j] >= 0 && (j == 0 || l[j] != l[0])) VertexQuadrics::add_plane(quadrics.at(l[j]), side, d, weight);
+    }
+  }
+  return quadrics;
+}
+
+// Zero-area triangles no collapse may remove (collinear or coincident input vertices where the
+// topology needs every vertex) lose a corner to another input vertex of its cluster: a free
+// corner (off every border) takes the first member, in input order, where the triangle gains
+// area and none around it folds, loses area or becomes a sliver. The output vertex then stands
+// for that input vertex (kept, position and attribute corners), so positions remain input
+// positions in fast mode. Vertices the guidance excludes (u = -1) are never taken.
+void relocate_zero_area(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
+                        const std::vector<int32_t>& label, DecimateResult& result, Collapser& collapser) {
+  const int32_t n = static_cast<int32_t>(result.kept.size());
+  std::vector<int32_t> offsets(n + 1, 0), members(mesh.num_vertices());
+  for (int32_t w = 0; w < mesh.num_vertices(); ++w)
+    if (label[w] >= 0) ++offsets[collapser.survivor(label[w]) + 1];
+  for (int32_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
+  std::vector<int32_t> fill(offsets.begin(), offsets.end() - 1);
+  for (int32_t w = 0; w < mesh.num_vertices(); ++w)
+    if (label[w] >= 0) members[fill[collapser.survivor(label[w])]++] = w;
+  const auto& source = mesh.vertex_source();
+  const auto& index = mesh.vertex_index();
+  const auto& vfo = mesh.vertex_face_offsets();
+  const auto& vf = mesh.vertex_faces();
+  const auto& faces = mesh.faces();
+  for (int32_t t : collapser.zero_area_face_list()) {
+    if (!collapser.face_alive(t) || !collapser.zero_area(t)) continue;
+    for (int j = 0; j < 3 && collapser.zero_area(t); ++j) {
+      const int32_t v = result.triangles[3 * size_t(t) + j];
+      if (!collapser.is_free(v)) continue;
+      for (int32_t i = offsets[v]; i < offsets[v + 1]; ++i) {
+        const int32_t w = members[i];
+        if (w == index[result.kept[v]] || layout.vertex_feature[w] || vfo[w] == vfo[w + 1]) continue;
+        if (params.multipliers && (*params.multipliers)[w] == 0.0) continue;
+        if (!collapser.place(v, mesh.position(w), t)) continue;
+        result.kept[v] = source[w];
+        // Attributes from a corner of w (one sector: any of its triangles).
+        const int32_t f = vf[vfo[w]];
+        int32_t slot = 0;
+        while (faces[3 * size_t(f) + slot] != w) ++slot;
+        const int32_t corner = 3 * mesh.face_source()[f] + slot;
+        for (size_t c = 0; c < result.triangles.size(); ++c)
+          if (result.triangles[c] == v) result.corner_source[c] = corner;
+        break;
+      }
+    }
+  }
+}
+
 }  // namespace
 
 bool has_zero_area(const DecimateResult& result) {
@@ -503,117 +267,138 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
   if (params.target_vertices < 1 && !params.zero_area_only)
     throw std::invalid_argument("refine target must be at least 1 vertex, got " +
                                 std::to_string(params.target_vertices));
-  const size_t n = result.kept.size();
+  const int32_t n = static_cast<int32_t>(result.kept.size());
   const auto& source = mesh.vertex_source();
   const auto& index = mesh.vertex_index();
-  // Each output vertex stands for the input triangles of its cluster, and for the border
-  // edges in it: planes through each border edge, perpendicular to its triangles, keep
-  // collapses from pulling a border (boundary, seam, material edge) off its course.
-  std::vector<Quadric> quadrics(n);
-  const auto& faces = mesh.faces();
-  auto label_of = [&](int32_t v) { return result.labels[source[v]]; };
-  auto add_to_clusters = [&](const Quadric& q, const int32_t* vertices, int count) {
-    int32_t l[3];
-    for (int j = 0; j < count; ++j) {
-      l[j] = label_of(vertices[j]);
-      bool repeated = l[j] < 0;
-      for (int i = 0; i < j; ++i) repeated = repeated || l[i] == l[j];
-      if (!repeated) quadrics[l[j]].add(q);
-    }
-  };
-  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
-    const int32_t* t = &faces[3 * size_t(f)];
-    Quadric plane;
-    plane.add_triangle(mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
-    add_to_clusters(plane, t, 3);
-  }
-  const auto& ev = mesh.edge_vertices();
-  const auto& efo = mesh.edge_face_offsets();
-  const auto& ef = mesh.edge_faces();
-  for (int32_t e : layout.feature_edges) {
-    const int32_t* ab = &ev[2 * size_t(e)];
-    const double* a = mesh.position(ab[0]);
-    const double* b = mesh.position(ab[1]);
-    for (int32_t i = efo[e]; i < efo[e + 1]; ++i) {
-      const int32_t* t = &faces[3 * size_t(ef[i])];
-      int32_t opposite = t[0];
-      for (int j = 0; j < 3; ++j)
-        if (t[j] != ab[0] && t[j] != ab[1]) opposite = t[j];
-      // A triangle standing on the edge, perpendicular to the face: its plane holds the
-      // edge and the face normal; the edge length squared as its weight.
-      const double* c = mesh.position(opposite);
-      double u[3], w[3], n[3], top[3];
-      for (int k = 0; k < 3; ++k) u[k] = b[k] - a[k], w[k] = c[k] - a[k];
-      n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
-      const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-      if (len == 0) continue;
-      const double edge = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-      for (int k = 0; k < 3; ++k) top[k] = a[k] + n[k] / len * 2.0 * edge;  // area = edge^2
-      Quadric plane;
-      plane.add_triangle(a, b, top);
-      add_to_clusters(plane, ab, 2);
-    }
-  }
-  std::vector<double> weight(n, 1.0);
-  std::vector<uint8_t> locked(n, 0);
-  std::vector<int32_t> curve(n, -1), curve_size(layout.num_curves(), 0);
-  auto multiplier = [&](int32_t v) { return params.multipliers ? (*params.multipliers)[v] : 1.0; };
-  std::vector<int32_t> bin(n);
-  for (size_t i = 0; i < n; ++i) {
+  CollapseSetup setup;
+  const auto table = vertex_quadric_table(mesh, layout);
+  for (int i = 0; i < 3; ++i) setup.center[i] = table->center[i];
+  setup.extent = table->extent;
+  std::vector<int32_t> label(mesh.num_vertices());
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) label[v] = result.labels[source[v]];
+  setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *table);
+  setup.world = result.vertices;
+  setup.positions.resize(3 * size_t(n));
+  setup.weight.assign(n, 1.0);
+  setup.locked.assign(n, 0);
+  setup.curve.assign(n, -1);
+  setup.curve_size.assign(layout.num_curves(), 0);
+  setup.curve_closed = layout.curve_closed;
+  setup.bin.resize(n);
+  const bool guided = params.multipliers &&
+                      std::any_of(params.multipliers->begin(), params.multipliers->end(), [](double m) { return m != 1.0; });
+  auto multiplier = [&](int32_t v) { return guided ? (*params.multipliers)[v] : 1.0; };
+  for (int32_t i = 0; i < n; ++i) {
     const int32_t v = index[result.kept[i]];
     const double m = multiplier(v);
-    if (layout.vertex_feature[v]) curve[i] = layout.vertex_curve[v];
-    if (curve[i] >= 0) ++curve_size[curve[i]];
-    locked[i] = layout.vertex_corner[v] || (layout.vertex_feature[v] && curve[i] < 0) || m == kForcedMultiplier;
+    if (layout.vertex_feature[v]) setup.curve[i] = layout.vertex_curve[v];
+    if (setup.curve[i] >= 0) ++setup.curve_size[setup.curve[i]];
+    setup.locked[i] = layout.vertex_corner[v] || (layout.vertex_feature[v] && setup.curve[i] < 0) || m == kForcedMultiplier;
     if (m == kForcedMultiplier)  // a control point stays where the user put it
-      for (int k = 0; k < 3; ++k) result.vertices[3 * i + k] = mesh.position(v)[k];
-    weight[i] = m == kForcedMultiplier ? 1.0 : std::max(m, 1.0 / 81.0);
-    bin[i] = guidance_bin(m);
+      for (int k = 0; k < 3; ++k) setup.world[3 * size_t(i) + k] = mesh.position(v)[k];
+    setup.weight[i] = m == kForcedMultiplier ? 1.0 : std::max(m, 1.0 / 81.0);
+    setup.bin[i] = guidance_bin(m);
   }
+  for (size_t i = 0; i < setup.world.size(); ++i)
+    setup.positions[i] = (setup.world[i] - setup.center[i % 3]) * (1.0 / setup.extent);
   // A pinched input vertex (several fans) and every vertex of its output triangles stay put:
   // the link condition sees one vertex, not the fans, and a collapse there could delete a
   // whole fan (a wing of a bowtie) while every count the final check compares stays the same.
   const auto& manifold_vertex = mesh.manifold_vertex();
-  for (size_t t = 0; t < result.triangles.size() / 3; ++t) {
-    bool pinched = false;
-    for (int j = 0; j < 3; ++j) pinched |= !manifold_vertex[index[result.kept[result.triangles[3 * t + j]]]];
-    if (pinched)
-      for (int j = 0; j < 3; ++j) locked[result.triangles[3 * t + j]] = 1;
-  }
+  if (mesh.report().nonmanifold_vertices > 0)
+    for (size_t t = 0; t < result.triangles.size() / 3; ++t) {
+      bool pinched = false;
+      for (int j = 0; j < 3; ++j) pinched |= !manifold_vertex[index[result.kept[result.triangles[3 * t + j]]]];
+      if (pinched)
+        for (int j = 0; j < 3; ++j) setup.locked[result.triangles[3 * t + j]] = 1;
+    }
   std::vector<double> bin_vertices(kBins, 0.0), bin_multipliers(kBins, 0.0);
   const auto& vfo = mesh.vertex_face_offsets();
-  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-    if (vfo[v] < vfo[v + 1]) {
-      const int32_t b = guidance_bin(multiplier(v));
-      bin_vertices[b] += 1.0;
-      bin_multipliers[b] += multiplier(v);
-    }
-  std::vector<int32_t> quota = bin_quotas(bin_vertices, bin_multipliers, params.target_vertices);
-  // Sector of every output corner at its vertex, from the input corner it copies.
-  std::vector<int32_t> internal_face(mesh.report().input_triangles, -1);
-  for (int32_t f = 0; f < mesh.num_faces(); ++f) internal_face[mesh.face_source()[f]] = f;
-  std::vector<int32_t> corner_sector(result.corner_source.size(), 0);
-  for (size_t c = 0; c < corner_sector.size(); ++c) {
-    const int32_t vertex = index[result.kept[result.triangles[c]]];
-    if (layout.sectors[vertex] > 1)
-      corner_sector[c] = layout.sector_of(mesh, vertex, internal_face[result.corner_source[c] / 3]);
+  if (guided) {
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+      if (vfo[v] < vfo[v + 1]) {
+        const int32_t b = guidance_bin(multiplier(v));
+        bin_vertices[b] += 1.0;
+        bin_multipliers[b] += multiplier(v);
+      }
+  } else {
+    const int32_t b = guidance_bin(1.0);
+    bin_vertices[b] = mesh.num_vertices() - mesh.report().isolated_vertices;
+    bin_multipliers[b] = bin_vertices[b];
   }
-  Collapser collapser(result, std::move(quadrics), std::move(weight), std::move(locked), std::move(curve),
-                      std::move(curve_size), layout.curve_closed, std::move(corner_sector), std::move(bin),
-                      std::move(quota));
+  setup.quota = bin_quotas(bin_vertices, bin_multipliers, params.target_vertices);
+  // Sector of every output corner at its vertex, from the input corner it copies.
+  setup.corner_sector.assign(result.corner_source.size(), 0);
+  std::vector<int32_t> internal_face;
+  for (size_t c = 0; c < setup.corner_sector.size(); ++c) {
+    const int32_t vertex = index[result.kept[result.triangles[c]]];
+    if (layout.sectors[vertex] <= 1) continue;
+    if (internal_face.empty()) {
+      internal_face.assign(mesh.report().input_triangles, -1);
+      for (int32_t f = 0; f < mesh.num_faces(); ++f) internal_face[mesh.face_source()[f]] = f;
+    }
+    setup.corner_sector[c] = layout.sector_of(mesh, vertex, internal_face[result.corner_source[c] / 3]);
+  }
+  setup.optimal_placement = !params.zero_area_only;
+  const double center[3] = {setup.center[0], setup.center[1], setup.center[2]}, extent = setup.extent;  // zero-area clean-up keeps the caller's positions
+  Collapser collapser(result.triangles, result.corner_source, std::move(setup));
   if (params.zero_area_only) {
-    collapser.optimal_placement = false;  // the caller's positions (e.g. input vertices) stay
-    result.refine_collapses += collapser.remove_zero_area();
+    result.refine_collapses += collapser.remove_thin(0.0, {});
   } else {
     result.refine_vertices = params.target_vertices;
+    result.refine_triangles = params.target_triangles;
     // Slivers the stochastic pass left (near-collinear corners) go first: the collapses thin
     // the result anyway, and none of them makes a new one (Collapser::keeps_shape).
-    result.refine_collapses = collapser.remove_zero_area(kMinShape, params.target_vertices);
-    result.refine_collapses += collapser.run(params.target_vertices);
-    result.refine_collapses += collapser.remove_zero_area();
+    const Collapser::Stop stop{params.target_vertices, params.target_triangles};
+    result.refine_collapses = collapser.remove_thin(kSliverShape, stop);
+    result.refine_collapses += collapser.run(stop);
+    if (params.refit) {
+      // Each vertex may move as far as its cluster reaches (as filtered placement allows).
+      std::vector<double> radius2(n, 0.0);
+      for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+        if (label[v] < 0) continue;
+        const int32_t s = collapser.survivor(label[v]);
+        const double* p = collapser.position(s);
+        double d2 = 0;
+        for (int i = 0; i < 3; ++i) {
+          const double d = (mesh.position(v)[i] - center[i]) * (1.0 / extent) - p[i];
+          d2 += d * d;
+        }
+        radius2[s] = std::max(radius2[s], d2);
+      }
+      collapser.refit(radius2);
+    }
+    result.refine_collapses += collapser.remove_thin(0.0, {});
   }
+  if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
   result.issues_remaining.sliver = collapser.zero_area_faces();
-  collapser.write_back();
+  // Compact: surviving vertices and faces in their old order, labels followed along the collapses.
+  std::vector<int32_t> new_index(n, -1);
+  int32_t next = 0;
+  for (int32_t v = 0; v < n; ++v)
+    if (collapser.vertex_alive(v)) {
+      new_index[v] = next;
+      result.kept[next] = result.kept[v];
+      for (int i = 0; i < 3; ++i) result.vertices[3 * size_t(next) + i] = collapser.world(v)[i];
+      ++next;
+    }
+  result.kept.resize(next);
+  result.vertices.resize(3 * size_t(next));
+  size_t faces = 0;
+  for (size_t t = 0; t < result.face_source.size(); ++t) {
+    if (!collapser.face_alive(int32_t(t))) continue;
+    for (int j = 0; j < 3; ++j) {
+      result.triangles[3 * faces + j] = new_index[result.triangles[3 * t + j]];
+      result.corner_source[3 * faces + j] = result.corner_source[3 * t + j];
+    }
+    result.face_source[faces] = result.face_source[t];
+    ++faces;
+  }
+  result.triangles.resize(3 * faces);
+  result.corner_source.resize(3 * faces);
+  result.face_source.resize(faces);
+  for (auto& l : result.labels)
+    if (l >= 0) l = new_index[collapser.survivor(l)];
   result.seconds_refine = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

@@ -21,6 +21,17 @@ namespace topstoc {
 
 enum class Placement { Subsample, Filtered };
 
+/// Attributes that enter the collapse cost (vertex_quadrics.hpp): per caller corner (3 per
+/// caller triangle) `channels` values, each channel's multiplied by its weight before use. An
+/// attribute difference d in a channel of weight w costs as much as moving the surface by w d
+/// bounding-box diagonals. values null: none.
+struct CornerAttributes {
+  const double* values = nullptr;
+  int channels = 0;
+  const double* weights = nullptr;
+};
+
+
 struct DecimateParams {
   int32_t target_vertices = 0;  ///< wanted output vertices (exact without guidance, before repairs)
   SamplingParams sampling;
@@ -36,6 +47,12 @@ struct DecimateParams {
   /// Quadric refinement (refine.hpp): 0 = off; f > 1 keeps f times the target with TopStoc,
   /// then quadric-ordered collapses thin the result to the target (better error, slower).
   double refine = 0.0;
+  /// With refine, C > 0: the first pass keeps at least target + max(C, target / 4) vertices,
+  /// and all of them when the mesh has at most 5 C. Small meshes then skip the stochastic
+  /// pass, whose choices cost quality; on big ones the collapses' time grows with the target,
+  /// not with the mesh, while the stochastic pass does the bulk.
+  int32_t refine_collapses = 0;
+  CornerAttributes attributes;  ///< attribute-aware cost of the refinement
 };
 
 struct DecimateResult {
@@ -63,6 +80,7 @@ struct DecimateResult {
   int32_t top_up = 0;                  ///< samples added to make up for absorbed clusters
   int32_t top_up_rounds = 0;
   int32_t refine_vertices = 0;         ///< target of the quadric refinement (0: none)
+  int32_t refine_triangles = 0;        ///< its triangle target, when it had one (0: none)
   int32_t refine_collapses = 0;        ///< collapses it made
   double seconds_sampling = 0, seconds_clustering = 0, seconds_checking = 0, seconds_output = 0;
   double seconds_refine = 0;
@@ -77,7 +95,8 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
 /// corners, pinched vertices: always kept) are appended to it.
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                      Placement placement, int32_t max_repair_rounds = 200,
-                                     int32_t refine_vertices = 0, const double* guidance = nullptr);
+                                     int32_t refine_vertices = 0, const double* guidance = nullptr,
+                                     const CornerAttributes& attributes = {}, int32_t refine_triangles = 0);
 
 /// Decimates to about `target_triangles` output triangles (within 1 % where the mesh allows),
 /// re-decimating with a corrected vertex target up to `max_iterations` times.

@@ -73,6 +73,7 @@ struct FeatureLayout {
   /// of edges and faces shared with other clusters (see partition.cpp).
   std::vector<int32_t> chi_constant;
   DerivedTable sampling_table;  ///< sampling.cpp's importance table for its last parameters
+  DerivedTable quadric_table;   ///< refine.cpp's per-vertex quadrics (they depend on the mesh only)
   int32_t region_border_edges = 0;
   int32_t flagged_edges = 0;
   int32_t crease_edges = 0;

@@ -28,6 +28,9 @@ namespace topstoc {
 
 struct RefineParams {
   int32_t target_vertices = 0;
+  /// > 0: collapse until this many triangles remain instead (the vertex target then only sets
+  /// the guidance quotas).
+  int32_t target_triangles = 0;
   /// The guidance as density multipliers per internal vertex (guidance_multipliers), or null.
   /// Painted regions keep their share of the budget: the input vertices are binned by their
   /// multiplier m, each bin gets the quota sum over its vertices of min(1, k m) with k solved
@@ -39,6 +42,10 @@ struct RefineParams {
   /// Only collapse edges of zero-area triangles (what an input with collinear vertices can
   /// leave after the stochastic pass); every refinement ends with this step too.
   bool zero_area_only = false;
+  /// Finally move every free vertex to its quadric's minimum (filtered placement on the final
+  /// clusters): what placement="filtered" means for a refined result.
+  bool refit = false;
+  CornerAttributes attributes;
 };
 
 /// True when some output triangle of `result` has zero area.

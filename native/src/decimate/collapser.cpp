@@ -1,0 +1,706 @@
+#include "decimate/collapser.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <omp.h>
+
+namespace topstoc {
+
+namespace {
+
+// Collapses may not make a triangle thinner than this shape quality (Collapser::shape; 0.1 is
+// an aspect ratio of about 5-10 by the thesis' measure) unless it already was.
+constexpr double kMinShape = 0.1;
+
+}  // namespace
+
+Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corner_source, CollapseSetup setup)
+    : tri_(triangles), corner_source_(corner_source), s_(std::move(setup)),
+      heap_(static_cast<int32_t>(s_.weight.size())) {
+  const int32_t n = static_cast<int32_t>(s_.weight.size());
+  const size_t m = tri_.size() / 3;
+  count_.assign(s_.quota.size(), 0);
+  alive_vertices_ = n;
+  alive_faces_ = static_cast<int32_t>(m);
+  for (int32_t b : s_.bin) ++count_[b];
+  begin_.assign(n, 0);
+  size_.assign(n, 0);
+  capacity_.assign(n, 0);
+  for (int32_t v : tri_) ++capacity_[v];
+  int32_t offset = 0;
+  for (int32_t v = 0; v < n; ++v) {
+    begin_[v] = offset;
+    offset += capacity_[v];
+  }
+  pool_.reserve(size_t(offset) + size_t(offset) / 2);
+  pool_.resize(offset);
+  for (size_t t = 0; t < m; ++t)
+    for (int j = 0; j < 3; ++j) {
+      const int32_t v = tri_[3 * t + j];
+      pool_[begin_[v] + size_[v]++] = int32_t(t);
+    }
+  alive_face_.assign(m, 1);
+  dirty_.assign(n, 0);
+  placed_.assign(n, 0);
+  merged_into_.assign(n, -1);
+  target_.assign(n, -1);
+  waiting_.assign(n, 0);
+  settled_.assign(n, 0);
+  merged_from_.assign(n, -1);
+  scratch_.resize(std::max(1, omp_get_max_threads()));
+  for (Scratch& scratch : scratch_) scratch.mark.assign(n, 0);
+  // Every vertex's cheapest collapse, each edge evaluated once (from its lower end) where it
+  // costs the same both ways. A thread owns the lower ends it evaluates; what it finds for the
+  // higher ends is merged afterwards. The cheapest by (cost, id) does not depend on the order.
+  std::vector<double> best_cost(n, 0.0);
+  auto better = [&](int32_t u, int32_t v, double c) {
+    return target_[u] < 0 || c < best_cost[u] || (c == best_cost[u] && v < target_[u]);
+  };
+  const int threads = static_cast<int>(scratch_.size());
+  std::vector<std::vector<std::pair<int32_t, Best>>> found(threads);
+#pragma omp parallel num_threads(threads) if (n >= 10000)
+  {
+    Scratch& scratch = scratch_[omp_get_thread_num()];
+    auto& mine = found[omp_get_thread_num()];
+    std::vector<int32_t> around;
+#pragma omp for schedule(static)
+    for (int32_t u = 0; u < n; ++u) {
+      const bool u_queues = queues(u);
+      neighbours(u, scratch, around);
+      for (int32_t v : around) {
+        if (v < u) continue;
+        const bool v_queues = queues(v);
+        const double uv = u_queues ? cost(u, v) : 0.0;
+        if (u_queues && better(u, v, uv)) target_[u] = v, best_cost[u] = uv;
+        if (v_queues) mine.push_back({v, {u, u_queues && free_pair(u, v) ? uv : cost(v, u)}});
+      }
+    }
+  }
+  for (const auto& list : found)
+    for (const auto& [v, offer] : list)
+      if (better(v, offer.target, offer.cost)) target_[v] = offer.target, best_cost[v] = offer.cost;
+  std::vector<int32_t> ids;
+  std::vector<double> keys;
+  for (int32_t u = 0; u < n; ++u)
+    if (target_[u] >= 0) ids.push_back(u), keys.push_back(best_cost[u]);
+  heap_.assign(ids, keys);
+}
+
+int32_t Collapser::survivor(int32_t v) {
+  int32_t root = v;
+  while (merged_into_[root] >= 0) root = merged_into_[root];
+  while (merged_into_[v] >= 0) {
+    const int32_t up = merged_into_[v];
+    merged_into_[v] = root;
+    v = up;
+  }
+  return root;
+}
+
+void Collapser::neighbours(int32_t v, Scratch& scratch, std::vector<int32_t>& out) const {
+  out.clear();
+  const uint32_t stamp = ++scratch.stamp;
+  for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t)
+    for (int j = 0; j < 3; ++j) {
+      const int32_t w = tri_[3 * size_t(*t) + j];
+      if (w != v && scratch.mark[w] != stamp) {
+        scratch.mark[w] = stamp;
+        out.push_back(w);
+      }
+    }
+}
+
+int32_t Collapser::sector_at(int32_t t, int32_t v) const {
+  for (int j = 0; j < 3; ++j)
+    if (tri_[3 * size_t(t) + j] == v) return s_.corner_sector[3 * size_t(t) + j];
+  return -1;
+}
+
+void Collapser::remove_face(int32_t v, int32_t t) {
+  int32_t* list = &pool_[begin_[v]];
+  const int32_t size = size_[v];
+  for (int32_t i = 0; i < size; ++i)
+    if (list[i] == t) {  // keep the order: it decides ties and summation order
+      std::copy(list + i + 1, list + size, list + i);
+      --size_[v];
+      return;
+    }
+}
+
+void Collapser::append_faces(int32_t v, const int32_t* faces, int32_t count) {
+  if (size_[v] + count > capacity_[v]) {
+    // Out of room: the list moves to the end of the pool with space to grow.
+    const int32_t capacity = 2 * (size_[v] + count);
+    const int32_t start = static_cast<int32_t>(pool_.size());
+    pool_.resize(pool_.size() + capacity);
+    std::copy(pool_.begin() + begin_[v], pool_.begin() + begin_[v] + size_[v], pool_.begin() + start);
+    begin_[v] = start;
+    capacity_[v] = capacity;
+  }
+  std::copy(faces, faces + count, pool_.begin() + begin_[v] + size_[v]);
+  size_[v] += count;
+}
+
+bool Collapser::placement(int32_t from, int32_t to, const Quadric& q, double x[3]) const {
+  const double* pt = position(to);
+  for (int i = 0; i < 3; ++i) x[i] = pt[i];
+  if (!free_pair(from, to)) return false;
+  // The same point either way round, so that the edge costs the same from both ends.
+  if (from > to) std::swap(from, to), pt = position(to);
+  const double* pf = position(from);
+  double d[3], length2 = 0;
+  for (int i = 0; i < 3; ++i) d[i] = pt[i] - pf[i], length2 += d[i] * d[i];
+  if (q.minimum(x)) {
+    // Trust the optimum only near the edge (a nearly flat or straight neighbourhood makes it
+    // drift along the surface).
+    double far2 = 0;
+    for (int i = 0; i < 3; ++i) far2 += (x[i] - 0.5 * (pf[i] + pt[i])) * (x[i] - 0.5 * (pf[i] + pt[i]));
+    if (far2 <= length2) return true;
+  }
+  // The best point on the edge: E(pf + t d) is quadratic in t.
+  const double t = std::clamp(q.line_minimum(pf, d), 0.0, 1.0);
+  for (int i = 0; i < 3; ++i) x[i] = pf[i] + t * d[i];
+  return false;
+}
+
+double Collapser::cost(int32_t from, int32_t to) const {
+  Quadric q;
+  s_.quadrics.reduced(from, to, q);
+  double x[3];
+  placement(from, to, q, x);
+  const double w = free_pair(from, to) ? std::max(s_.weight[from], s_.weight[to]) : s_.weight[from];
+  return w * std::max(0.0, q.error(x));
+}
+
+void Collapser::queue(int32_t u, int32_t v, double c) {
+  target_[u] = v;
+  dirty_[u] = 0;
+  heap_.set(u, c);
+}
+
+// u's cheapest collapse (lowest id on ties), or none (target -1) for a locked vertex or one at
+// its quota. Checks wait until it is popped (most queued collapses are superseded before that);
+// with `checked`, the cheapest one that passes them. Reads the state only: safe in parallel.
+Collapser::Best Collapser::evaluate(int32_t u, bool checked, Scratch& scratch) const {
+  Best best;
+  if (s_.locked[u] || at_quota(u)) return best;
+  neighbours(u, scratch, scratch.list);
+  if (!checked) {
+    for (int32_t v : scratch.list) {
+      const double c = cost(u, v);
+      if (best.target < 0 || c < best.cost || (c == best.cost && v < best.target)) best = {v, c};
+    }
+    return best;
+  }
+  scratch.costs.clear();
+  for (int32_t v : scratch.list) scratch.costs.push_back({cost(u, v), v});
+  std::sort(scratch.costs.begin(), scratch.costs.end());
+  for (const auto& [c, v] : scratch.costs)
+    if (allowed(u, v, scratch)) return {v, c};
+  return best;
+}
+
+// Queues u's cheapest collapse, or takes u out of the queue when it has none: it waits until a
+// collapse next to it looks again.
+void Collapser::update(int32_t u, bool checked) { settle(u, evaluate(u, checked, scratch_[0])); }
+
+void Collapser::settle(int32_t u, Best best) {
+  if (best.target >= 0) {
+    queue(u, best.target, best.cost);
+  } else {
+    target_[u] = -1;
+    dirty_[u] = 0;
+    heap_.remove(u);
+  }
+}
+
+bool Collapser::zero_area(int32_t t) const {
+  // In the caller's coordinates: that is what the output holds.
+  const int32_t* c = &tri_[3 * size_t(t)];
+  const double* a = world(c[0]);
+  const double* b = world(c[1]);
+  const double* d = world(c[2]);
+  double u[3], w[3];
+  for (int i = 0; i < 3; ++i) u[i] = b[i] - a[i], w[i] = d[i] - a[i];
+  return u[1] * w[2] - u[2] * w[1] == 0.0 && u[2] * w[0] - u[0] * w[2] == 0.0 && u[0] * w[1] - u[1] * w[0] == 0.0;
+}
+
+bool Collapser::thin(int32_t t, double min_shape) const {
+  if (min_shape <= 0.0) return false;
+  double n[3];
+  const int32_t* c = &tri_[3 * size_t(t)];
+  normal(c, c[0], position(c[0]), n);
+  return shape(c, c[0], position(c[0]), std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])) < min_shape;
+}
+
+std::vector<int32_t> Collapser::zero_area_face_list() const {
+  std::vector<int32_t> list;
+  for (int32_t t = 0; t < int32_t(alive_face_.size()); ++t)
+    if (alive_face_[t] && zero_area(t)) list.push_back(t);
+  return list;
+}
+
+bool Collapser::place(int32_t v, const double* world, int32_t face) {
+  double at[3];
+  for (int i = 0; i < 3; ++i) at[i] = (world[i] - s_.center[i]) * (1.0 / s_.extent);
+  if (!keeps_shape(v, -1, at)) return false;
+  double* p = &s_.positions[3 * size_t(v)];
+  double* w = &s_.world[3 * size_t(v)];
+  double keep_p[3], keep_w[3];
+  for (int i = 0; i < 3; ++i) keep_p[i] = p[i], keep_w[i] = w[i], p[i] = at[i], w[i] = world[i];
+  if (!zero_area(face)) return true;
+  for (int i = 0; i < 3; ++i) p[i] = keep_p[i], w[i] = keep_w[i];  // no gain: back
+  return false;
+}
+
+int32_t Collapser::zero_area_faces() const {
+  int32_t count = 0;
+  for (size_t t = 0; t < alive_face_.size(); ++t) count += alive_face_[t] && zero_area(int32_t(t));
+  return count;
+}
+
+int32_t Collapser::remove_thin(double min_shape, Stop keep) {
+  // No collapse makes a new thin or zero-area triangle (keeps_shape), so the candidates are
+  // known up front; a failed one may pass after its neighbours collapsed, hence the rounds.
+  const int32_t m = static_cast<int32_t>(alive_face_.size());
+  std::vector<uint8_t> flagged(m, 0);
+#pragma omp parallel for schedule(static) if (m >= 100000)
+  for (int32_t t = 0; t < m; ++t) flagged[t] = alive_face_[t] && (zero_area(t) || thin(t, min_shape));
+  std::vector<int32_t> candidates;
+  for (int32_t t = 0; t < m; ++t)
+    if (flagged[t]) candidates.push_back(t);
+  int32_t collapses = 0;
+  for (bool progress = !candidates.empty(); progress;) {
+    progress = false;
+    for (int32_t t : candidates) {
+      if (reached(keep)) return collapses;
+      if (!alive_face_[t] || !(zero_area(t) || thin(t, min_shape))) continue;
+      const int32_t* c = &tri_[3 * size_t(t)];
+      for (int j = 0; j < 6; ++j) {
+        const int32_t u = c[j % 3], v = c[(j % 3 + (j < 3 ? 1 : 2)) % 3];
+        if (s_.locked[u] || !allowed(u, v, scratch_[0])) continue;
+        collapse(u, v);
+        refresh(u, v);
+        ++collapses;
+        progress = true;
+        break;
+      }
+    }
+  }
+  return collapses;
+}
+
+// Collapses per batch: 1 (exactly greedy) near the end and on small meshes, up to 128 when
+// many remain, so that the checks and costs of a batch can run in parallel.
+int32_t Collapser::batch_size(int32_t excess) const {
+  return std::clamp(std::min(excess / 64, alive_vertices_ / 1024), 1, 128);
+}
+
+int32_t Collapser::run(Stop target) {
+  enum Status : uint8_t { kReady, kEvaluate, kEvaluateChecked, kWait };
+  int32_t collapses = 0;
+  std::vector<int32_t> batch, reserved, pending, survivors, pair_from, pair_to;
+  std::vector<double> batch_key, pair_cost_from, pair_cost_to;
+  std::vector<uint8_t> status, pending_checked;
+  std::vector<Best> pending_best;
+  while (!reached(target)) {
+    if (heap_.empty()) {
+      // Some region could not reach its quota: the others give the rest, by cost alone.
+      if (!use_quota_) break;
+      use_quota_ = false;
+      for (int32_t u = 0; u < int32_t(merged_into_.size()); ++u)
+        if (merged_into_[u] < 0) update(u);
+      continue;
+    }
+    // The cheapest queued collapses, in cost order.
+    const int32_t size = batch_size(target.faces > 0 ? (alive_faces_ - target.faces) / 2 : alive_vertices_ - target.vertices);
+    batch.clear();
+    batch_key.clear();
+    while (int32_t(batch.size()) < size && !heap_.empty()) {
+      const int32_t u = heap_.top();
+      const double key = heap_.top_key();
+      heap_.remove(u);
+      if (at_quota(u)) {
+        target_[u] = -1;
+        continue;
+      }
+      batch.push_back(u);
+      batch_key.push_back(key);
+    }
+    // Reserve, in cost order, the neighbourhoods of collapses no earlier one of the batch
+    // touches: applied in any order they see the state at the start of the batch, so their
+    // checks and costs can be computed at once (in parallel). The others wait in the queue.
+    const uint32_t ring = ++ring_stamp_;
+    const int32_t count = int32_t(batch.size());
+    status.assign(count, kReady);
+    reserved.clear();
+    for (int32_t i = 0; i < count; ++i) {
+      const int32_t u = batch[i], v = target_[u];
+      if (dirty_[u] || merged_into_[v] >= 0) {
+        status[i] = kEvaluate;  // its key was a lower bound, or its collapse went stale
+      } else if (mark_ring(u, v, ring)) {
+        reserved.push_back(i);
+      } else {
+        status[i] = kWait;
+        queue(u, v, batch_key[i]);
+      }
+    }
+    const int32_t checks = int32_t(reserved.size());
+#pragma omp parallel for schedule(dynamic, 4) if (checks >= 16)
+    for (int32_t k = 0; k < checks; ++k) {
+      const int32_t i = reserved[k], u = batch[i], v = target_[u];
+      if (batch_key[i] != cost(u, v)) {
+        status[i] = kEvaluate;
+      } else if (!allowed(u, v, scratch_[omp_get_thread_num()])) {
+        status[i] = kEvaluateChecked;
+      }
+    }
+    pending.clear();
+    pending_checked.clear();
+    survivors.clear();
+    for (int32_t i = 0; i < count; ++i) {
+      const int32_t u = batch[i], v = target_[u];
+      if (status[i] == kWait) continue;
+      if (status[i] != kReady) {
+        pending.push_back(u);
+        pending_checked.push_back(status[i] == kEvaluateChecked);
+        continue;
+      }
+      if (reached(target)) {
+        queue(u, v, batch_key[i]);
+        continue;
+      }
+      if (at_quota(u)) {
+        target_[u] = -1;
+        continue;
+      }
+      collapse(u, v);
+      survivors.push_back(v);
+      ++collapses;
+    }
+    // Costs after the batch (in parallel): every collapse of each survivor v and, from each
+    // neighbour x, the collapse onto v (the same number when both are free); popped vertices
+    // that need a new evaluation.
+    pair_from.clear();
+    pair_to.clear();
+    for (int32_t v : survivors) {
+      neighbours(v, scratch_[0], scratch_[0].list);
+      for (int32_t x : scratch_[0].list) pair_from.push_back(v), pair_to.push_back(x);
+    }
+    const int32_t pairs = int32_t(pair_from.size()), evaluations = int32_t(pending.size());
+    pair_cost_from.assign(pairs, 0.0);
+    pair_cost_to.assign(pairs, 0.0);
+    pending_best.assign(evaluations, Best());
+#pragma omp parallel if (pairs + 8 * evaluations >= 64)
+    {
+#pragma omp for schedule(static) nowait
+      for (int32_t i = 0; i < pairs; ++i) {
+        const int32_t v = pair_from[i], x = pair_to[i];
+        const bool v_queues = queues(v), x_queues = queues(x);
+        if (v_queues) pair_cost_from[i] = cost(v, x);
+        if (x_queues) pair_cost_to[i] = v_queues && free_pair(x, v) ? pair_cost_from[i] : cost(x, v);
+      }
+#pragma omp for schedule(dynamic, 4)
+      for (int32_t i = 0; i < evaluations; ++i)
+        pending_best[i] = evaluate(pending[i], pending_checked[i], scratch_[omp_get_thread_num()]);
+    }
+    for (int32_t i = 0; i < evaluations; ++i) {
+      settle(pending[i], pending_best[i]);
+      settled_[pending[i]] = ring;  // settled: the neighbour updates below leave it alone
+    }
+    for (int32_t i = 1, start = 0; i <= pairs; ++i) {
+      if (i < pairs && pair_from[i] == pair_from[start]) continue;
+      // pairs [start, i) belong to one survivor
+      const int32_t v = pair_from[start];
+      Best best;
+      if (queues(v))
+        for (int32_t k = start; k < i; ++k)
+          if (best.target < 0 || pair_cost_from[k] < best.cost ||
+              (pair_cost_from[k] == best.cost && pair_to[k] < best.target))
+            best = {pair_to[k], pair_cost_from[k]};
+      settle(v, best);
+      for (int32_t k = start; k < i; ++k) {
+        const int32_t x = pair_to[k];
+        if (settled_[x] != ring) offer(x, v, merged_from_[v], pair_cost_to[k]);
+      }
+      start = i;
+    }
+  }
+  return collapses;
+}
+
+// Marks u, v and their neighbours for this batch; false (nothing marked) if any already is.
+bool Collapser::mark_ring(int32_t u, int32_t v, uint32_t ring) {
+  for (int32_t w : {u, v})
+    if (waiting_[w] == ring) return false;
+  for (int32_t w : {u, v})
+    for (const int32_t* t = faces_begin(w); t != faces_end(w); ++t)
+      for (int j = 0; j < 3; ++j)
+        if (waiting_[tri_[3 * size_t(*t) + j]] == ring) return false;
+  for (int32_t w : {u, v})
+    for (const int32_t* t = faces_begin(w); t != faces_end(w); ++t)
+      for (int j = 0; j < 3; ++j) waiting_[tri_[3 * size_t(*t) + j]] = ring;
+  return true;
+}
+
+// x's collapse onto the survivor v of a collapse of `removed` now costs c. A neighbour queued
+// for the removed vertex or for v keeps its old cost as a lower bound (dirty) unless the new
+// collapse onto v is at least as cheap; others take v if it is now cheaper. A neighbour without
+// a queued collapse (its checks failed) looks again.
+void Collapser::offer(int32_t x, int32_t v, int32_t removed, double c) {
+  if (!queues(x)) return;
+  if (target_[x] < 0) {
+    update(x);
+    return;
+  }
+  const double key = heap_.key_of(x);
+  if (dirty_[x] || target_[x] == removed || target_[x] == v) {
+    if (c <= key) {
+      queue(x, v, c);
+    } else {
+      dirty_[x] = 1;
+    }
+  } else if (c < key) {
+    queue(x, v, c);
+  }
+}
+
+// Link condition (Dey et al. 1999): u and v share exactly the vertices opposite their edge, and
+// v keeps at least three neighbours; then the surface stays a manifold of the same topology. An
+// interior u may go to any neighbour; a u on a border curve only along the curve (the edge must
+// separate u's sectors, or be a boundary edge), so every border keeps its course and its sides.
+bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
+  std::vector<uint32_t>& mark = scratch.mark;
+  const uint32_t su = ++scratch.stamp;
+  int32_t nu = 0, faces_u = 0;
+  bool found = false;
+  int32_t on_edge[2], count = 0;
+  for (const int32_t* t = faces_begin(u); t != faces_end(u); ++t) {
+    ++faces_u;
+    bool with_v = false;
+    for (int j = 0; j < 3; ++j) {
+      const int32_t w = tri_[3 * size_t(*t) + j];
+      if (w == u) continue;
+      with_v |= w == v;
+      if (mark[w] != su) {
+        mark[w] = su;
+        ++nu;
+      }
+    }
+    if (with_v) {
+      if (count == 2) return false;
+      on_edge[count++] = *t;
+      found = true;
+    }
+  }
+  if (!found) return false;
+  const bool closed_fan = nu == faces_u;
+  const int32_t cu = s_.curve[u];
+  if (cu < 0) {
+    if (!closed_fan || count != 2) return false;
+  } else {
+    if (s_.curve[v] != cu && !s_.locked[v]) return false;
+    const bool boundary_edge = count == 1 && nu == faces_u + 1;
+    const bool border_edge = count == 2 && closed_fan && sector_at(on_edge[0], u) != sector_at(on_edge[1], u);
+    if (!boundary_edge && !border_edge) return false;
+    if (s_.curve_closed[cu] && s_.curve_size[cu] <= 3) return false;
+  }
+  const uint32_t sv = ++scratch.stamp;
+  int32_t nv = 0, shared = 0;
+  for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t)
+    for (int j = 0; j < 3; ++j) {
+      const int32_t w = tri_[3 * size_t(*t) + j];
+      if (w == v || mark[w] == sv) continue;
+      shared += mark[w] == su;
+      mark[w] = sv;
+      ++nv;
+    }
+  if (shared != count) return false;
+  if (nu + nv < shared + 5) return false;  // v would keep < 3 neighbours
+  Quadric q;
+  s_.quadrics.reduced(u, v, q);
+  double x[3];
+  placement(u, v, q, x);
+  return keeps_shape(u, v, x) && keeps_shape(v, u, x);
+}
+
+// Do the triangles of `moved` that do not hold `other` keep their side and some area when
+// `moved` stands at x (other = -1: all of them)?
+bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x) const {
+  const double* p = position(moved);
+  for (const int32_t* t = faces_begin(moved); t != faces_end(moved); ++t) {
+    if (other >= 0 && has(*t, other)) continue;
+    const int32_t* c = &tri_[3 * size_t(*t)];
+    double before[3], after[3];
+    normal(c, moved, p, before);
+    normal(c, moved, x, after);
+    double before2 = before[0] * before[0] + before[1] * before[1] + before[2] * before[2];
+    const double area2 = before2;
+    if (before2 == 0.0) {
+      // A zero-area triangle has no side to keep. Staying degenerate is no worse (collapsing
+      // coincident vertices one by one is how a fan of them disappears); gaining area, it
+      // must face like the fan.
+      if (after[0] == 0.0 && after[1] == 0.0 && after[2] == 0.0) continue;
+      for (int i = 0; i < 3; ++i) before[i] = 0.0;
+      for (const int32_t* f = faces_begin(moved); f != faces_end(moved); ++f) {
+        double n[3];
+        normal(&tri_[3 * size_t(*f)], moved, p, n);
+        for (int i = 0; i < 3; ++i) before[i] += n[i];
+      }
+      before2 = before[0] * before[0] + before[1] * before[1] + before[2] * before[2];
+    }
+    const double dot = before[0] * after[0] + before[1] * after[1] + before[2] * after[2];
+    const double len2 = after[0] * after[0] + after[1] * after[1] + after[2] * after[2];
+    // No flip, no near-fold (normal turned by more than ~80 degrees: cos > 0.17), no loss of area.
+    if (!(dot > 0.0) || dot * dot <= 0.0289 * len2 * before2 || len2 <= 1e-24 * before2) return false;
+    // No sliver: a triangle may not end up thinner than kMinShape unless it was already.
+    if (thinner(c, moved, x, len2) && !thinner(c, moved, p, area2)) return false;
+  }
+  return true;
+}
+
+// Shape quality 2 sqrt(3) |n| / (sum of squared edges) of triangle c with `replace` at `at`
+// (|n| = twice its area): 1 for an equilateral triangle, 0 for a degenerate one.
+double Collapser::shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const {
+  const double edges = squared_edges(c, replace, at);
+  return edges > 0 ? 2.0 * std::sqrt(3.0) * twice_area / edges : 0.0;
+}
+
+// shape(...) < kMinShape without roots, from |n|² = twice_area2.
+bool Collapser::thinner(const int32_t* c, int32_t replace, const double* at, double twice_area2) const {
+  const double edges = squared_edges(c, replace, at);
+  return !(12.0 * twice_area2 >= kMinShape * kMinShape * edges * edges) || edges == 0.0;
+}
+
+double Collapser::squared_edges(const int32_t* c, int32_t replace, const double* at) const {
+  const double* p[3];
+  for (int j = 0; j < 3; ++j) p[j] = c[j] == replace ? at : position(c[j]);
+  double edges = 0;
+  for (int j = 0; j < 3; ++j) {
+    const double* a = p[j];
+    const double* b = p[j == 2 ? 0 : j + 1];
+    edges += (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+  }
+  return edges;
+}
+
+// Normal (unnormalised) of triangle c with vertex `replace` standing at `at`.
+void Collapser::normal(const int32_t* c, int32_t replace, const double* at, double n[3]) const {
+  const double* p[3];
+  for (int j = 0; j < 3; ++j) p[j] = c[j] == replace ? at : position(c[j]);
+  double a[3], b[3];
+  for (int i = 0; i < 3; ++i) a[i] = p[1][i] - p[0][i], b[i] = p[2][i] - p[0][i];
+  n[0] = a[1] * b[2] - a[2] * b[1], n[1] = a[2] * b[0] - a[0] * b[2], n[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+void Collapser::move_to(int32_t v, const double* x) {
+  double* p = &s_.positions[3 * size_t(v)];
+  double* w = &s_.world[3 * size_t(v)];
+  for (int i = 0; i < 3; ++i) {
+    if (p[i] == x[i]) continue;  // unmoved coordinates keep their exact input value
+    p[i] = x[i];
+    w[i] = x[i] * s_.extent + s_.center[i];
+  }
+}
+
+void Collapser::collapse(int32_t u, int32_t v) {
+  {
+    Quadric q;
+    s_.quadrics.reduced(u, v, q);
+    double x[3];
+    placed_[v] = placement(u, v, q, x);
+    move_to(v, x);
+  }
+  // The triangles on the edge vanish. On each side of u's borders one of them had a corner at
+  // v: u's other triangles on that side take that corner (and its sector) where they meet v.
+  struct Side {
+    int32_t sector, corner, corner_sector;
+  };
+  Side sides[2];
+  int32_t num_sides = 0;
+  for (const int32_t* t = faces_begin(u); t != faces_end(u); ++t) {
+    if (!has(*t, v)) continue;
+    alive_face_[*t] = 0;
+    --alive_faces_;
+    Side side{sector_at(*t, u), -1, -1};
+    for (int j = 0; j < 3; ++j) {
+      const int32_t w = tri_[3 * size_t(*t) + j];
+      if (w == v) side.corner = corner_source_[3 * size_t(*t) + j], side.corner_sector = s_.corner_sector[3 * size_t(*t) + j];
+      if (w != u) remove_face(w, *t);
+    }
+    sides[num_sides++] = side;
+  }
+  moved_faces_.clear();
+  for (const int32_t* t = faces_begin(u); t != faces_end(u); ++t) {
+    if (!alive_face_[*t]) continue;
+    for (int j = 0; j < 3; ++j)
+      if (tri_[3 * size_t(*t) + j] == u) {
+        const size_t corner = 3 * size_t(*t) + j;
+        const Side& side = (num_sides == 2 && s_.corner_sector[corner] == sides[1].sector) ? sides[1] : sides[0];
+        tri_[corner] = v;
+        corner_source_[corner] = side.corner;
+        s_.corner_sector[corner] = side.corner_sector;
+      }
+    moved_faces_.push_back(*t);
+  }
+  append_faces(v, moved_faces_.data(), static_cast<int32_t>(moved_faces_.size()));
+  if (s_.curve[u] >= 0) --s_.curve_size[s_.curve[u]];
+  --count_[s_.bin[u]];
+  --alive_vertices_;
+  size_[u] = 0;
+  merged_into_[u] = v;
+  s_.quadrics.merge(v, u);
+  heap_.remove(u);
+  target_[u] = -1;
+  merged_from_[v] = u;
+}
+
+// After collapsing u into v, alone: v's collapses all change (its quadric grew, it may have
+// moved); each neighbour is offered the collapse onto v.
+void Collapser::refresh(int32_t u, int32_t v) {
+  Scratch& scratch = scratch_[0];
+  neighbours(v, scratch, star_);
+  const bool v_queues = queues(v);
+  Best best;
+  for (int32_t x : star_) {
+    // An edge between free vertices costs the same both ways: one evaluation serves both.
+    const double to_x = v_queues ? cost(v, x) : 0.0;
+    if (v_queues && (best.target < 0 || to_x < best.cost || (to_x == best.cost && x < best.target))) best = {x, to_x};
+    if (queues(x)) offer(x, v, u, v_queues && free_pair(x, v) ? to_x : cost(x, v));
+  }
+  settle(v, best);
+}
+
+int32_t Collapser::refit(const std::vector<double>& radius2) {
+  // Targets in parallel (they depend on each vertex's own quadric only), moves in order (a
+  // move's checks see the neighbours already moved).
+  const int32_t n = static_cast<int32_t>(merged_into_.size());
+  std::vector<double> goal(3 * size_t(n));
+  std::vector<uint8_t> better(n, 0);
+#pragma omp parallel for schedule(static) if (n >= 10000)
+  for (int32_t v = 0; v < n; ++v) {
+    // A vertex a collapse put at its quadric's minimum is there already.
+    if (merged_into_[v] >= 0 || !is_free(v) || size_[v] == 0 || placed_[v]) continue;
+    Quadric q;
+    s_.quadrics.reduced(v, -1, q);
+    const double* p = position(v);
+    double step[3];
+    if (!q.truncated_step(p, step)) continue;
+    const double len2 = step[0] * step[0] + step[1] * step[1] + step[2] * step[2];
+    if (!(len2 > 0)) continue;
+    const double scale = len2 > radius2[v] ? std::sqrt(radius2[v] / len2) : 1.0;
+    double* x = &goal[3 * size_t(v)];
+    for (int i = 0; i < 3; ++i) x[i] = p[i] + scale * step[i];
+    better[v] = q.error(x) < q.error(p);
+  }
+  int32_t moved = 0;
+  for (int32_t v = 0; v < n; ++v)
+    if (better[v] && keeps_shape(v, -1, &goal[3 * size_t(v)])) {
+      move_to(v, &goal[3 * size_t(v)]);
+      ++moved;
+    }
+  return moved;
+}
+
+}  // namespace topstoc

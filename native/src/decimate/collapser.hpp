@@ -1,0 +1,143 @@
+// Greedy edge collapses on a triangle soup with flat, allocation-free bookkeeping (refine.cpp
+// sets it up; docs/design.md §2.10).
+//
+// Each vertex keeps its cheapest allowed collapse in an indexed heap. Costs are quadric errors
+// (vertex_quadrics.hpp) times a guidance weight; an edge between two free vertices collapses to
+// the point minimising the summed quadric, any other edge moves one end onto the other, so
+// border vertices stay input vertices on their curve. After a collapse only the survivor's
+// collapses are recomputed in full; a neighbour whose queued collapse went to the removed vertex
+// or the survivor keeps its old cost as a lower bound and is recomputed when it reaches the top
+// (lazy evaluation: the order stays exactly greedy, with far fewer cost evaluations).
+//
+// Vertex-to-face lists live in one pool (a CSR with slack: a list that outgrows its slot moves
+// to the end of the pool), neighbour sets are found with a stamp per vertex instead of sorting,
+// so a collapse allocates nothing.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "decimate/indexed_heap.hpp"
+#include "decimate/vertex_quadrics.hpp"
+
+namespace topstoc {
+
+/// What the collapses know about each vertex. Positions are normalised (centred on the bounding
+/// box and divided by its half extent) so that quadrics neither overflow nor underflow; `world`
+/// holds the caller's coordinates, which stay exact for every vertex that does not move.
+struct CollapseSetup {
+  VertexQuadrics quadrics{0, 0};
+  std::vector<double> positions;      ///< normalised, 3 per vertex
+  std::vector<double> world;          ///< caller's coordinates, 3 per vertex
+  double center[3] = {0, 0, 0}, extent = 1.0;
+  std::vector<double> weight;         ///< cost multiplier per vertex (guidance)
+  std::vector<uint8_t> locked;        ///< never moves, never removed
+  std::vector<int32_t> curve;         ///< feature curve of the vertex (it moves only along it), or -1
+  std::vector<int32_t> curve_size;    ///< per curve: its vertices
+  std::vector<uint8_t> curve_closed;  ///< per curve
+  std::vector<int32_t> corner_sector; ///< per corner: the sector (side of the borders) of its vertex
+  std::vector<int32_t> bin, quota;    ///< per vertex its guidance bin; per bin the vertices to keep
+  bool optimal_placement = true;      ///< off: every collapse is a half-edge collapse
+};
+
+class Collapser {
+ public:
+  /// triangles and corner_source (3 per face) are updated in place as corners are renamed.
+  Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corner_source, CollapseSetup setup);
+
+  /// Where collapses stop: at this many vertices, or (faces > 0) at this many triangles.
+  struct Stop {
+    int32_t vertices = 0, faces = 0;
+  };
+  /// Collapses an edge of every zero-area triangle, and of every triangle with a shape quality
+  /// below min_shape, where a collapse is allowed, until `keep` is reached.
+  int32_t remove_thin(double min_shape, Stop keep);
+  /// Collapses in cost order until `target` is reached or no collapse is allowed.
+  int32_t run(Stop target);
+  /// Moves every free vertex to its quadric's minimum along the directions it constrains, at
+  /// most radius2[v] (squared, normalised) away, where no triangle folds or becomes a sliver.
+  int32_t refit(const std::vector<double>& radius2);
+
+  int32_t zero_area_faces() const;
+  std::vector<int32_t> zero_area_face_list() const;
+  /// Moves v to the input position `world` when no triangle around it folds, loses area or
+  /// becomes a sliver and triangle `face` gains area; false (nothing moved) otherwise.
+  bool place(int32_t v, const double* world, int32_t face);
+  bool zero_area(int32_t t) const;
+  bool face_alive(int32_t t) const { return alive_face_[t] != 0; }
+  bool vertex_alive(int32_t v) const { return merged_into_[v] < 0; }
+  int32_t survivor(int32_t v);
+  const double* world(int32_t v) const { return &s_.world[3 * size_t(v)]; }
+  const double* position(int32_t v) const { return &s_.positions[3 * size_t(v)]; }
+  bool is_free(int32_t v) const { return s_.curve[v] < 0 && !s_.locked[v]; }
+
+ private:
+  bool free_pair(int32_t from, int32_t to) const {
+    return s_.optimal_placement && is_free(from) && is_free(to);
+  }
+  bool placement(int32_t from, int32_t to, const Quadric& q, double x[3]) const;
+  double cost(int32_t from, int32_t to) const;
+  // Per-thread scratch: a stamp per vertex marks sets without clearing.
+  struct Scratch {
+    std::vector<uint32_t> mark;
+    uint32_t stamp = 0;
+    std::vector<int32_t> list;
+    std::vector<std::pair<double, int32_t>> costs;
+  };
+  struct Best {
+    int32_t target = -1;
+    double cost = 0.0;
+  };
+  Best evaluate(int32_t u, bool checked, Scratch& scratch) const;
+  void update(int32_t u, bool checked = false);
+  void settle(int32_t u, Best best);
+  void offer(int32_t x, int32_t v, int32_t removed, double c);
+  void refresh(int32_t u, int32_t v);
+  bool mark_ring(int32_t u, int32_t v, uint32_t ring);
+  int32_t batch_size(int32_t excess) const;
+  void queue(int32_t u, int32_t v, double c);
+  bool at_quota(int32_t u) const { return use_quota_ && count_[s_.bin[u]] <= s_.quota[s_.bin[u]]; }
+  bool reached(Stop stop) const {
+    return stop.faces > 0 ? alive_faces_ <= stop.faces : alive_vertices_ <= stop.vertices;
+  }
+  bool queues(int32_t u) const { return !s_.locked[u] && !at_quota(u); }
+  bool allowed(int32_t u, int32_t v, Scratch& scratch) const;
+  bool keeps_shape(int32_t moved, int32_t other, const double* x) const;
+  double shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const;
+  bool thinner(const int32_t* c, int32_t replace, const double* at, double twice_area2) const;
+  double squared_edges(const int32_t* c, int32_t replace, const double* at) const;
+  void normal(const int32_t* c, int32_t replace, const double* at, double n[3]) const;
+  bool thin(int32_t t, double min_shape) const;
+  void collapse(int32_t u, int32_t v);
+  void move_to(int32_t v, const double* x);
+  void neighbours(int32_t v, Scratch& scratch, std::vector<int32_t>& out) const;
+  int32_t sector_at(int32_t t, int32_t v) const;
+  bool has(int32_t t, int32_t v) const {
+    const int32_t* c = &tri_[3 * size_t(t)];
+    return c[0] == v || c[1] == v || c[2] == v;
+  }
+  // The live faces of v.
+  const int32_t* faces_begin(int32_t v) const { return &pool_[begin_[v]]; }
+  const int32_t* faces_end(int32_t v) const { return &pool_[begin_[v]] + size_[v]; }
+  void remove_face(int32_t v, int32_t t);
+  void append_faces(int32_t v, const int32_t* faces, int32_t count);
+
+  std::vector<int32_t>& tri_;
+  std::vector<int32_t>& corner_source_;
+  CollapseSetup s_;
+  std::vector<int32_t> count_;  // per bin: vertices alive
+  bool use_quota_ = true;
+  int32_t alive_vertices_ = 0, alive_faces_ = 0;
+  std::vector<int32_t> pool_, begin_, size_, capacity_;  // vertex -> faces
+  std::vector<uint8_t> alive_face_, dirty_, placed_;
+  std::vector<int32_t> merged_into_, target_;
+  IndexedHeap heap_;
+  std::vector<int32_t> merged_from_;  // per survivor: the vertex its last collapse removed
+  std::vector<uint32_t> waiting_;      // per vertex: the batch whose collapses touched it
+  std::vector<uint32_t> settled_;      // per vertex: the batch that evaluated it anew
+  uint32_t ring_stamp_ = 0;
+  std::vector<Scratch> scratch_;
+  std::vector<int32_t> options_, star_, moved_faces_;
+};
+
+}  // namespace topstoc
