@@ -87,7 +87,7 @@ void bind_mesh(py::module_& m) {
       [](const py::buffer& data) {
         const py::buffer_info info = data.request();
         if (!PyBuffer_IsContiguous(info.view(), 'C'))
-          throw py::value_error("content_digest needs a contiguous buffer (np.ascontiguousarray)");
+          throw std::invalid_argument("content_digest needs a contiguous buffer (np.ascontiguousarray)");
         std::array<uint64_t, 2> digest;
         {
           EngineCall call;

@@ -64,7 +64,9 @@ def decimated(ts, scene):
     obj = make_object("Ring", *meshgen.torus(40, 16))
     obj.location = (3, 0, 0)
     obj.rotation_euler = (0.3, 0.2, 0.1)
-    assert bpy.ops.topstoc.guided_decimate(ratio=0.12, seed=4) == {"FINISHED"}
+    # Fast mode: output vertices are input vertices, which the per-face check below relies on
+    # (a face's sampled maximum bounds its interior only when its corners lie on the original).
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.12, seed=4, quality="FAST") == {"FINISHED"}
     out = bpy.data.objects["Ring_TopStoc"]
     out.location = (10, 0, 0)  # moved next to the original: still compared in its own frame
     out.topstoc.metrics.samples = 20000
