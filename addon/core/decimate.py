@@ -43,7 +43,8 @@ MODES = ("quality", "fast")
 #: quality mode: the collapses remove at most max(QUALITY_COLLAPSES, target / 4) vertices
 #: after a stochastic first pass (the time then grows with the target, not with the mesh), and
 #: start from the whole mesh when it has at most 5 * QUALITY_COLLAPSES vertices (the lowest
-#: error; docs/design.md §2.10)
+#: error; docs/design.md §2.10). QUALITY_REFINE only marks the refinement as on: an explicit
+#: refine=f sizes the first pass as f times the target instead of the budget.
 QUALITY_REFINE = 1.0
 QUALITY_COLLAPSES = 10_000
 #: default weight of an attribute channel in the collapse cost (see decimate's attributes)
@@ -351,11 +352,16 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     mode: "quality" (default): placement "filtered" and quadric collapses after a TopStoc pass
     (see QUALITY_COLLAPSES); "fast": the thesis' TopStoc, placement "subsample", no refinement.
     placement and refine, when given, override what the mode sets.
-    placement: "subsample" keeps input positions, "filtered" moves surface vertices to the
-    quadric-optimal point of their cluster (borders stay).
-    refine: 0 = off (fastest). f >= 1: TopStoc keeps f times the target, then edge collapses
-    ordered by quadric error against the input thin it to the target (topology and borders
-    kept, painted regions keeping their share of the budget). Lower error at a higher cost.
+    placement: "subsample" keeps the first pass's input positions, "filtered" moves surface
+    vertices to the quadric-optimal point of their cluster (borders stay). In quality mode the
+    collapses themselves place a vertex joining two free vertices at the quadric optimum either
+    way; placement only decides the final re-fit.
+    refine: None = the mode's own (quality: the first pass keeps the target plus
+    max(QUALITY_COLLAPSES, target / 4) vertices, or the whole mesh up to 5 * QUALITY_COLLAPSES;
+    fast: 0). 0 = off (fastest). f >= 1: TopStoc keeps f times the target (so refine=1 leaves
+    the collapses almost nothing to do), then edge collapses ordered by quadric error against
+    the input thin it to the target (topology and borders kept, painted regions keeping their
+    share of the budget). Lower error at a higher cost.
     attributes: UVs, colours, normals... that should survive the collapses: (n, k) per vertex
     or (m, 3, k) per corner of the caller's triangles (per corner for UVs with seams). They
     enter the collapse cost as generalised quadrics (docs/design.md §2.10): with weight w, a

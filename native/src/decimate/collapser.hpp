@@ -7,7 +7,9 @@
 // border vertices stay input vertices on their curve. After a collapse only the survivor's
 // collapses are recomputed in full; a neighbour whose queued collapse went to the removed vertex
 // or the survivor keeps its old cost as a lower bound and is recomputed when it reaches the top
-// (lazy evaluation: the order stays exactly greedy, with far fewer cost evaluations).
+// (lazy evaluation: far fewer cost evaluations). Collapses are taken in batches of independent
+// ones from the top of the queue, so the order is greedy among independent collapses, not
+// strictly one at a time; a batch depends only on the queue, so serial = parallel.
 //
 // Vertex-to-face lists live in one pool (a CSR with slack: a list that outgrows its slot moves
 // to the end of the pool), neighbour sets are found with a stamp per vertex instead of sorting,
