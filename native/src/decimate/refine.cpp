@@ -205,7 +205,8 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
 // corner (off every border) takes the first member in the prepared mesh's vertex order (so the
 // choice is deterministic) where the triangle gains area and none around it folds, loses area
 // or becomes a sliver. The output vertex then stands for that input vertex (kept, position and
-// attribute corners), so positions remain input positions in fast mode. Vertices the guidance excludes (u = -1) are never taken.
+// attribute corners), so positions remain input positions in fast mode. Vertices the guidance
+// excludes (u = -1) are never taken.
 void relocate_zero_area(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
                         const std::vector<int32_t>& label, DecimateResult& result, Collapser& collapser) {
   const int32_t n = static_cast<int32_t>(result.kept.size());
