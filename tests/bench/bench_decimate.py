@@ -7,7 +7,7 @@ Default mesh: ../shared/meshes/big/horse_loop2_1.55M.ply (skips cleanly when abs
   - first decimation: topstoc.Mesh (validation, adjacency, weights) + decimate, file read excluded;
   - re-decimation: decimate on the prepared mesh (what a slider drag costs), seeds 0..R-1;
   - first and re-decimation in the fast mode (plain TopStoc, what the live slider shows);
-  - the quality mode (the default: filtered placement, refine 8) on the prepared mesh, 3 seeds,
+  - the quality mode (the default: first pass, collapses, filtered re-fit) on the prepared mesh, 3 seeds,
     and cold (prepare + quality decimation at the first ratio);
   - meshopt_simplify (QEM edge collapse) and meshopt_simplifySloppy (grid clustering), via
     build/peers/meshopt_bench on the same file and the same vertex fraction of the index count.
@@ -111,7 +111,7 @@ def main() -> int:
     if rows[0][4]:
         simplify = rows[0][4]["simplify"]["median_seconds"]
         print(f"\nfirst decimation vs meshopt_simplify at {ratios[0]:.0%}: {simplify / statistics.median(first):.1f}x faster")
-    print(f"\nquality mode (the default; TopStoc to 8x the target, quadric edge collapses; see "
+    print(f"\nquality mode (the default; a TopStoc first pass, then quadric edge collapses; see "
           f"bench_quality.py for its error): cold at {ratios[0]:.0%} {cold_quality_seconds:.2f} s "
           f"({cold_quality.num_vertices} v); re-decimation:")
     for ratio, _, _, _, peer, refined, refined_result in rows:
