@@ -1,21 +1,26 @@
-"""UVs and colours in the collapse cost (topstoc.core.appearance): they keep a UV-mapped mesh's texture where it was, and weight 0 is the
+"""UVs and colours in the collapse cost (topstoc.core.appearance, ``topstoc decimate
+--attribute-weight``): they keep a UV-mapped mesh's texture where it was, and weight 0 is the
 geometry-only result to the bit.
 
 The distortion is measured against the closed-form mapping of tests/uv_cylinder.py (a cylinder
 whose texture is stretched along its straight axis, with a seam).
 """
 
+import functools
+
 import numpy as np
 import pytest
 
+import cli
 from topstoc.core import Mesh
 from topstoc.core.appearance import appearance_attributes, fill_missing_uvs
 from topstoc.core.attributes import transfer_attributes, uv_seam_edges
 from topstoc.core.decimate import ATTRIBUTE_WEIGHT
 from topstoc.core.errors import TopStocError
-from topstoc.core.io import MeshData
+from topstoc.core.io import MeshData, read_mesh, write_mesh
 from uv_cylinder import uv_cylinder, uv_distortion
 
+run_json = functools.partial(cli.run_json, "decimate")
 TARGET = 150  # vertices, of 1920
 
 
@@ -105,3 +110,45 @@ def test_missing_uvs_take_their_vertex_mean_or_the_overall_mean():
 def test_bad_input_is_a_clear_error(call, fragment):
     with pytest.raises(TopStocError, match=fragment.replace("(", r"\(")):
         call()
+
+
+# -- the command line -------------------------------------------------------------------------
+
+def _cylinder_file(tmp_path):
+    vertices, triangles, uvs = uv_cylinder()
+    path = tmp_path / "cylinder.obj"
+    write_mesh(path, MeshData(vertices=vertices, triangles=triangles, corner_uvs=uvs))
+    return path
+
+
+def test_cli_uses_the_files_uvs_and_says_so(tmp_path):
+    source = _cylinder_file(tmp_path)
+    default = run_json(source, tmp_path / "default.obj", "--vertices", TARGET)
+    off = run_json(source, tmp_path / "off.obj", "--vertices", TARGET, "--attribute-weight", 0)
+    assert default["attributes"] == {"weight": ATTRIBUTE_WEIGHT, "channels": ["uv.u", "uv.v"],
+                                     "uv_corners_filled": 0}
+    assert off["attributes"] == {"weight": 0.0, "channels": [], "uv_corners_filled": 0}
+    assert default["output"]["vertices"] == off["output"]["vertices"]
+    errors = {}
+    for name in ("default", "off"):
+        written = read_mesh(tmp_path / f"{name}.obj")
+        errors[name] = uv_distortion(written.vertices, written.triangles, written.corner_uvs)
+    assert errors["default"]["rms"] < 0.5 * errors["off"]["rms"], errors
+    fast = run_json(source, tmp_path / "fast.obj", "--vertices", TARGET, "--mode", "fast")
+    assert fast["attributes"]["channels"] == []
+
+
+def test_cli_weight_zero_writes_the_geometry_only_file(tmp_path):
+    source = _cylinder_file(tmp_path)
+    run_json(source, tmp_path / "off.obj", "--vertices", TARGET, "--attribute-weight", 0)
+    data = read_mesh(source)
+    result = Mesh(data.vertices, data.triangles).decimate(
+        target_vertices=TARGET, borders=uv_seam_edges(data.triangles, data.corner_uvs))
+    write_mesh(tmp_path / "plain.obj", transfer_attributes(data, result))
+    assert (tmp_path / "off.obj").read_bytes() == (tmp_path / "plain.obj").read_bytes()
+
+
+def test_cli_refuses_a_negative_weight(tmp_path):
+    done = cli.run("decimate", _cylinder_file(tmp_path), tmp_path / "x.obj", "--ratio", 0.5,
+                   "--attribute-weight", -1)
+    cli.assert_one_error_line("decimate", done, "attribute weight", ">= 0")
