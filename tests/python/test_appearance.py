@@ -7,6 +7,7 @@ whose texture is stretched along its straight axis, with a seam).
 """
 
 import functools
+import json
 
 import numpy as np
 import pytest
@@ -152,3 +153,39 @@ def test_cli_refuses_a_negative_weight(tmp_path):
     done = cli.run("decimate", _cylinder_file(tmp_path), tmp_path / "x.obj", "--ratio", 0.5,
                    "--attribute-weight", -1)
     cli.assert_one_error_line("decimate", done, "attribute weight", ">= 0")
+
+
+# -- the batch (mesh files) -------------------------------------------------------------------
+
+def test_batch_uses_the_files_uvs_unless_the_weight_is_zero(tmp_path):
+    source = _cylinder_file(tmp_path)
+    errors, reports = {}, {}
+    for name, extra in (("default", ()), ("off", ("--attribute-weight", 0))):
+        out = tmp_path / name
+        done = cli.run("batch", "--input", source, "--output", out, "--vertices", TARGET, "--workers", 0, *extra)
+        assert done.returncode == 0, done.stderr
+        report = json.loads((out / "topstoc-report.json").read_text())
+        [reports[name]] = report["results"]
+        written = read_mesh(out / "cylinder.obj")
+        errors[name] = uv_distortion(written.vertices, written.triangles, written.corner_uvs)
+        assert ("attribute_weight" in report["settings"]) == (name == "off")  # fingerprint unchanged at the default
+    assert reports["default"]["attributes"] == ["uv.u", "uv.v"] and reports["off"]["attributes"] == []
+    assert reports["default"]["vertices_out"] == reports["off"]["vertices_out"]
+    assert errors["default"]["rms"] < 0.5 * errors["off"]["rms"], errors
+
+
+def test_batch_settings_carry_the_weight_to_blender():
+    import argparse
+
+    from topstoc.core import batch_settings
+
+    parser = argparse.ArgumentParser()
+    batch_settings.add_arguments(parser)
+    default = batch_settings.from_args(parser.parse_args(["--ratio", "0.5"]))
+    assert "attribute_weight" not in default  # older manifests' fingerprints hold
+    chosen = batch_settings.from_args(parser.parse_args(["--ratio", "0.5", "--attribute-weight", "0.25"]))
+    argv = batch_settings.to_argv(chosen)
+    assert argv[argv.index("--attribute-weight") + 1] == "0.25"
+    assert batch_settings.from_args(parser.parse_args(argv)) == chosen
+    with pytest.raises(TopStocError, match="attribute weight"):
+        batch_settings.from_args(parser.parse_args(["--ratio", "0.5", "--attribute-weight", "-1"]))
