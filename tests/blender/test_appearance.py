@@ -121,3 +121,12 @@ def test_fast_mode_passes_nothing(ts, scene):
         runs.append(positions(bpy.context.active_object.data))
         select_only(obj)
     np.testing.assert_array_equal(runs[0], runs[1])
+
+
+def test_restored_samples_reproduce_a_result_that_kept_the_uvs(ts, scene):
+    obj = cylinder()
+    first = positions(decimate(obj).data)
+    assert json.loads(obj.topstoc.sample_sets["Last"].parameters)["attributes"] == ["UV map 'Stretched'"]
+    select_only(obj)
+    assert bpy.ops.topstoc.restore_samples(name="Last") == {"FINISHED"}
+    np.testing.assert_array_equal(positions(bpy.data.objects["Cylinder_Last"].data), first)
