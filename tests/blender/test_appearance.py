@@ -130,3 +130,21 @@ def test_restored_samples_reproduce_a_result_that_kept_the_uvs(ts, scene):
     select_only(obj)
     assert bpy.ops.topstoc.restore_samples(name="Last") == {"FINISHED"}
     np.testing.assert_array_equal(positions(bpy.data.objects["Cylinder_Last"].data), first)
+
+
+def test_regenerate_keeps_the_weight_a_result_ran_with(ts, scene):
+    obj = cylinder()
+    kept = decimate(obj)
+    off = decimate(obj, attribute_weight=0.0)
+    first = {out.name: positions(out.data) for out in (kept, off)}
+    assert json.loads(off.topstoc.settings)["attribute_weight"] == 0.0
+    legacy = decimate(obj, attribute_weight=0.0)  # as a result saved before the setting existed
+    settings = json.loads(legacy.topstoc.settings)
+    del settings["attribute_weight"]
+    legacy.topstoc.settings = json.dumps(settings)
+    for out in (kept, off, legacy):
+        select_only(out)
+        assert bpy.ops.topstoc.regenerate() == {"FINISHED"}
+    np.testing.assert_array_equal(positions(kept.data), first[kept.name])
+    np.testing.assert_array_equal(positions(off.data), first[off.name])
+    np.testing.assert_array_equal(positions(legacy.data), first[off.name])
