@@ -27,6 +27,7 @@ import numpy as np
 
 from ..core import batch_settings
 from ..core.batch_mesh import decimate_mesh_file, lod_error
+from ..core.decimate import ATTRIBUTE_WEIGHT
 from ..core.prune import prune_small_parts
 from ..core.errors import TopStocError
 
@@ -47,10 +48,11 @@ def parse_args(argv):
 
 
 def _params(settings: dict):
-    """The pipeline's parameter holder (its options and symmetry; the target is passed explicitly)."""
+    """The pipeline's parameter holder (its options, symmetry and attribute weight; the target is passed
+    explicitly)."""
     axis = settings.get("symmetry")
     return SimpleNamespace(target_mode="RATIO", use_symmetry=axis is not None, symmetry_axis=axis or "X",
-                           **settings["options"])
+                           attribute_weight=settings.get("attribute_weight", ATTRIBUTE_WEIGHT), **settings["options"])
 
 
 def _bone_shapes(bpy) -> set:

@@ -8,6 +8,7 @@ status bar; nothing is modified.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 from dataclasses import dataclass, field
 from typing import Callable, List, Optional
@@ -17,6 +18,7 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 from ..core import guidance as rules
+from ..core.appearance import Appearance, appearance_attributes
 from ..core.attributes import uv_seam_edges
 from ..core.decimate import Box, View
 from ..core.errors import TopStocError
@@ -38,10 +40,15 @@ class EngineGuidance:
     view: Optional[View] = None
     boxes: List[Box] = field(default_factory=list)
     sources: List[str] = field(default_factory=list)
+    #: the look to keep (active UV map, colours), made when a decimation needs it (pipeline.run_engine)
+    appearance: Callable[[], Appearance] = Appearance
+    appearance_sources: List[str] = field(default_factory=list)  #: what ``appearance`` holds
 
     def decimate_kwargs(self) -> dict:
+        """The engine's guidance arguments, plus ``appearance`` (pipeline.run_engine turns it into
+        attributes at the settings' weight when the refinement runs)."""
         return dict(guidance=self.guidance, regions=self.regions, borders=self.borders, view=self.view,
-                    boxes=self.boxes)
+                    boxes=self.boxes, appearance=self.appearance)
 
     def layout_kwargs(self) -> dict:
         """The part that restoring from samples needs (the feature layout)."""
@@ -114,6 +121,55 @@ def _read_borders(obj, settings, arrays: mesh_io.MeshArrays) -> Callable[[list],
         return found if len(found) else None
 
     return borders
+
+
+def appearance_color(mesh, settings):
+    """The colour attribute that is part of the asset's look: the active one, or the render one
+    when the active one is the guidance paint layer; None if both are guidance (or there are none).
+    Guidance paint (the object's painted-guidance layer, or the default layer's name) says where
+    to keep detail, it is not appearance, so it never enters the cost."""
+    guidance_layers = {settings.color_attribute, DEFAULT_COLOR_LAYER}
+    colors = mesh.color_attributes
+    candidates = [colors.active_color]
+    if 0 <= colors.render_color_index < len(colors):
+        candidates.append(colors[colors.render_color_index])
+    for attribute in candidates:
+        if attribute is not None and attribute.name not in guidance_layers:
+            return attribute
+    return None
+
+
+def _read_appearance(obj, arrays: mesh_io.MeshArrays) -> tuple:
+    """Reads the active UV map and the appearance colour (appearance_color); returns (the
+    function giving the engine's attributes, what they hold). Colours enter as sRGB in [0, 1]."""
+    mesh = obj.data
+    names, uv, color, color_key, color_domain = [], None, None, None, None
+    layer = mesh.uv_layers.active
+    if layer is not None:
+        uv = mesh_io.read_uv_map(mesh, layer.name)
+        names.append(f"UV map '{layer.name}'")
+    attribute = appearance_color(mesh, obj.topstoc)
+    if attribute is not None and attribute.domain in ("POINT", "CORNER"):
+        count = len(mesh.vertices) if attribute.domain == "POINT" else len(mesh.loops)
+        read = mesh_io.read_attribute(attribute, count)
+        if read is not None:
+            color, color_key = read
+            color_domain = attribute.domain
+            names.append(f"colours '{attribute.name}'")
+
+    @functools.lru_cache(maxsize=1)
+    def appearance() -> Appearance:
+        corner_uvs = None if uv is None else uv[arrays.triangle_loops]
+        rgb = None
+        if color is not None:
+            rgb = color[:, :3].astype(np.float64)
+            if color_key == "color":  # linear floats: compare colours as they look
+                rgb = rules.linear_to_srgb(rgb)
+            if color_domain == "CORNER":
+                rgb = rgb[arrays.triangle_loops]
+        return appearance_attributes(arrays.triangles, corner_uvs, rgb)
+
+    return appearance, names
 
 
 def _boxes(obj, scene) -> List[Box]:
@@ -197,6 +253,7 @@ def read(obj, arrays: mesh_io.MeshArrays, scene, depsgraph=None,
         material_weights = list(settings.material_weights)[:max(len(obj.material_slots), 1)]
         material_strength = settings.material_strength
     borders = _read_borders(obj, settings, arrays)
+    appearance, appearance_sources = _read_appearance(obj, arrays)
     boxes = _boxes(obj, scene) if scene_settings.use_boxes else []
     view = None
     if scene_settings.use_view:
@@ -213,7 +270,7 @@ def read(obj, arrays: mesh_io.MeshArrays, scene, depsgraph=None,
     view_name = "camera view" if scene_settings.view_source == "CAMERA" else "viewport view"
 
     def engine_guidance() -> EngineGuidance:
-        out = EngineGuidance(sources=list(names))
+        out = EngineGuidance(sources=list(names), appearance=appearance, appearance_sources=list(appearance_sources))
         values = [(guidance(), strength) for guidance, strength in sources]
         if material_weights is not None:
             if any(w != 0.0 for w in material_weights):

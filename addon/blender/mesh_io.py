@@ -162,6 +162,11 @@ def read_uv_maps(mesh: bpy.types.Mesh) -> dict:
     return {uv.name: _get(uv.data, "uv", len(mesh.loops), 2, np.float32) for uv in mesh.uv_layers}
 
 
+def read_uv_map(mesh: bpy.types.Mesh, name: str) -> np.ndarray:
+    """(num_loops, 2) float32 UVs of one UV map."""
+    return _get(mesh.uv_layers[name].data, "uv", len(mesh.loops), 2, np.float32)
+
+
 def read_attribute(attribute, count: int) -> Optional[np.ndarray]:
     """(values as (count, width), foreach key) of a generic attribute; None if unsupported."""
     layout = _ATTRIBUTE_LAYOUT.get(attribute.data_type)

@@ -13,7 +13,9 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
+from ..core.appearance import refines
 from ..core.attributes import MovedVertices, moved_vertices, point_weights
+from ..core.decimate import ATTRIBUTE_WEIGHT
 from ..core.errors import TopStocError
 from ..core.symmetry import decimate_mirrored
 from . import carry, mesh_io
@@ -76,7 +78,8 @@ def options_kwargs(params) -> dict:
     """Engine options for a DecimationParameters holder: the Quality choice picks the engine's
     mode; Custom (or a holder without the choice, as the batch's) gives placement and refinement
     itself, on the holder's mode (fast unless it says otherwise)."""
-    options = dict(seed=int(params.seed), adaptivity=float(params.adaptivity), density=params.density)
+    options = dict(seed=int(params.seed), adaptivity=float(params.adaptivity), density=params.density,
+                   attribute_weight=float(getattr(params, "attribute_weight", ATTRIBUTE_WEIGHT)))
     chosen = quality_options(getattr(params, "quality", "CUSTOM"))
     if chosen is not None:
         options.update(chosen)
@@ -91,9 +94,29 @@ def symmetry_axis(params):
     return params.symmetry_axis if getattr(params, "use_symmetry", False) else None
 
 
+def attribute_kwargs(options: dict, appearance) -> dict:
+    """The engine's ``attributes`` for ``options`` (options_kwargs'): the look (``appearance``,
+    a function giving core.appearance.Appearance) at the options' ``attribute_weight`` when the
+    refinement runs (quality mode; the only stage that uses them), else nothing."""
+    weight = options.get("attribute_weight", ATTRIBUTE_WEIGHT)
+    if appearance is None or weight == 0 or not refines(options.get("mode", "quality"), options.get("refine")):
+        return {}
+    return appearance().decimate_kwargs(weight)
+
+
 def run_engine(mesh, target: dict, options: dict, guidance_kwargs: dict, axis=None):
-    """One engine decimation, mirror-symmetric when ``axis`` is given (core/symmetry.py)."""
-    return decimate_mirrored(mesh, axis, **target, **options, **guidance_kwargs)
+    """One engine decimation, mirror-symmetric when ``axis`` is given (core/symmetry.py); the
+    guidance's ``appearance`` enters as attributes (attribute_kwargs)."""
+    engine_options = dict(options)
+    engine_guidance = dict(guidance_kwargs)
+    attributes = attribute_kwargs(engine_options, engine_guidance.pop("appearance", None))
+    engine_options.pop("attribute_weight", None)
+    return decimate_mirrored(mesh, axis, **target, **engine_options, **engine_guidance, **attributes)
+
+
+def attribute_sources(options: dict, guidance: EngineGuidance) -> list:
+    """What of the look entered the cost of a decimation with ``options`` (for its parameters)."""
+    return list(guidance.appearance_sources) if attribute_kwargs(options, guidance.appearance) else []
 
 
 def input_triangles(mesh) -> int:
@@ -165,7 +188,8 @@ def decimate(context, obj, params, *, seed_offset: int = 0, target: dict = None,
 def make_run(obj, prepared: Prepared, guidance: EngineGuidance, result, target: dict, options: dict, axis,
              seconds: float, settings: dict, moved: MovedVertices = None) -> Run:
     """The Run of a finished engine decimation (``run_engine``'s target, options and axis)."""
-    parameters = dict(target, **options, sources=guidance.sources, symmetry=axis)
+    parameters = dict(target, **options, sources=guidance.sources, symmetry=axis,
+                      attributes=attribute_sources(options, guidance))
     return Run(obj, prepared, guidance, result, parameters, seconds, settings, moved)
 
 
@@ -282,10 +306,13 @@ def restore(context, obj, name: str) -> Run:
         raise DecimationError(f"the painted guidance of '{obj.name}' changed since the refined samples "
                               f"'{name}' were saved")
     samples = np.asarray(entry["samples"], dtype=np.int32)
+    # a refined result used the look at its weight (sets saved before attributes existed: none)
+    attributes = attribute_kwargs(dict(parameters, attribute_weight=parameters.get("attribute_weight", 0.0)),
+                                  guidance.appearance) if refine_vertices else {}
     result = prepared.mesh.decimate_with_samples(samples, placement=parameters.get("placement", "subsample"),
                                                  refine_vertices=refine_vertices,
                                                  guidance=guidance.guidance if refine_vertices else None,
-                                                 **guidance.layout_kwargs())
+                                                 **guidance.layout_kwargs(), **attributes)
     return Run(obj, prepared, guidance, result, parameters, time.perf_counter() - start)
 
 
@@ -336,5 +363,6 @@ def decimate_many(context, obj, params, variants) -> list:
             return None
         return dict(settings, target_mode="RATIO", ratio=target["ratio"], seed=seed)
 
-    return [Run(obj, prepared, guidance, result, dict(target, **dict(options, seed=seed), sources=guidance.sources),
+    return [Run(obj, prepared, guidance, result, dict(target, **dict(options, seed=seed), sources=guidance.sources,
+                                                       attributes=attribute_sources(options, guidance)),
                 seconds, settings_for(target, seed)) for (target, seed), result in zip(variants, results)]

@@ -8,6 +8,7 @@ import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
                        FloatVectorProperty, IntProperty, PointerProperty, StringProperty)
 
+from ..core.decimate import ATTRIBUTE_WEIGHT
 from . import props_analysis
 from .props_analysis import TOPSTOC_PG_metrics, TOPSTOC_PG_overlays, TOPSTOC_PG_topology
 
@@ -79,6 +80,12 @@ class DecimationParameters:
                         description="Fast mode only. 0: off (plain TopStoc, fastest). N: TopStoc keeps N times "
                                     "the target, then edge collapses by quadric error thin it (Quality mode "
                                     "does this with its own settings)")
+    attribute_weight: FloatProperty(
+        name="Keep UVs / Colours", default=ATTRIBUTE_WEIGHT, min=0.0, soft_max=1.0, precision=3,
+        description="How much Quality mode protects the look: the active UV map and colour attribute "
+                    "(never the guidance paint) are weighed with the shape, so textures stretch less and "
+                    "colours smear less. A UV or colour difference of 1 costs like moving the surface by "
+                    "this fraction of the object's size. 0: shape only. Fast mode ignores it")
     output: EnumProperty(name="Output", items=OUTPUT_MODES, default="NEW_OBJECT")
 
 

@@ -52,7 +52,8 @@ def regenerate(context, result_obj) -> pipeline.Run:
     reason = why_not(result_obj)
     if reason is not None:
         raise pipeline.DecimationError(reason)
-    params = SimpleNamespace(**json.loads(result_obj.topstoc.settings))
+    # results made before UVs and colours entered the cost ran without them: keep it so
+    params = SimpleNamespace(**{"attribute_weight": 0.0, **json.loads(result_obj.topstoc.settings)})
     run = pipeline.decimate(context, result_obj.topstoc.source, params)
     pipeline.write_output(run, into=result_obj)
     return run

@@ -13,6 +13,8 @@ import os
 import time
 
 from . import batch_settings
+from .appearance import Appearance, appearance_attributes, refines
+from .decimate import ATTRIBUTE_WEIGHT
 from .attributes import material_regions, transfer_attributes, uv_seam_edges
 from .hausdorff import hausdorff
 from .io import mesh_format, read_mesh, write_mesh
@@ -72,11 +74,17 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
     mesh = Mesh(data.vertices, data.triangles)
     seams = None if data.corner_uvs is None else uv_seam_edges(data.triangles, data.corner_uvs)
     layout = dict(regions=material_regions(data), borders=seams if seams is not None and len(seams) else None)
+    weight = settings.get("attribute_weight", ATTRIBUTE_WEIGHT)
+    options = settings["options"]
+    appearance = Appearance()  # the look, where the refinement runs
+    if weight > 0 and refines(options.get("mode") or "quality", options.get("refine")):
+        appearance = appearance_attributes(data.triangles, data.corner_uvs, data.vertex_colors)
+    layout.update(appearance.decimate_kwargs(weight))
     lods = []
     for index, ((target, screen), output) in enumerate(zip(batch_settings.engine_targets(settings, data.vertices),
                                                           outputs)):
         started = time.perf_counter()
-        result = decimate_mirrored(mesh, settings.get("symmetry"), **target, **settings["options"], **layout)
+        result = decimate_mirrored(mesh, settings.get("symmetry"), **target, **options, **layout)
         entry = {"lod": index, "output": output, "target": target, "symmetry": settings.get("symmetry")}
         if screen is not None and settings["prune_pixels"] > 0:
             result, pruned = prune_small_parts(result, settings["prune_pixels"] * screen.world_per_pixel)
@@ -95,4 +103,5 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
             "vertices_in": data.num_vertices, "triangles_in": data.num_triangles,
             "vertices_out": first["vertices"], "triangles_out": first["triangles"],
             "seconds": time.perf_counter() - start, "repairs": first["repairs"], "error": first["search_error"],
+            "attributes": appearance.channels if appearance.decimate_kwargs(weight) else [],
             "lods": lods}

@@ -13,6 +13,8 @@ import hashlib
 import json
 import math
 
+from .appearance import attribute_weight
+from .decimate import ATTRIBUTE_WEIGHT
 from .screen_size import DEFAULT_FOV_DEGREES, DEFAULT_PIXEL_ERROR, DEFAULT_RESOLUTION
 from .errors import TopStocError
 
@@ -55,6 +57,10 @@ def add_arguments(parser) -> None:
                         help="default: set by --mode")
     parser.add_argument("--refine", type=float, default=None, metavar="F",
                         help="0: off; F: TopStoc to F x the target, then quadric collapses (default: set by --mode)")
+    parser.add_argument("--attribute-weight", type=float, default=ATTRIBUTE_WEIGHT, metavar="W",
+                        help="how much UVs and colours count in quality mode's collapses (mesh files: the "
+                             "file's UVs and vertex colours; Blender formats: the active UV map and colour "
+                             f"attribute); default {ATTRIBUTE_WEIGHT}, 0 = geometry only")
     parser.add_argument("--symmetry", type=str.upper, choices=("X", "Y", "Z"), metavar="{x,y,z}",
                         help="mirror-symmetric results across the plane through the origin normal to this "
                              "axis (object-local in Blender formats)")
@@ -97,8 +103,11 @@ def from_args(args) -> dict:
     out_format = None
     if args.format:
         out_format = args.format.lower().lstrip(".")
-    symmetry = {"symmetry": args.symmetry} if args.symmetry else {}  # absent when off: older digests hold
-    return {**symmetry, "target": kind, "values": values, "chain": len(values) > 1,
+    optional = {"symmetry": args.symmetry} if args.symmetry else {}  # absent when off: older digests hold
+    weight = attribute_weight(args.attribute_weight)
+    if weight != ATTRIBUTE_WEIGHT:  # absent at the default, likewise
+        optional["attribute_weight"] = weight
+    return {**optional, "target": kind, "values": values, "chain": len(values) > 1,
             "pixel_error": args.pixel_error, "fov": args.fov, "resolution": args.resolution,
             "prune_pixels": args.prune_pixels, "lod_files": bool(args.lod_files), "format": out_format,
             "options": {"seed": args.seed, "adaptivity": args.adaptivity, "density": args.density,
@@ -123,6 +132,8 @@ def to_argv(settings: dict) -> list:
             argv += [f"--{name}", str(value)]
     if settings.get("symmetry"):
         argv += ["--symmetry", settings["symmetry"]]
+    if "attribute_weight" in settings:
+        argv += ["--attribute-weight", repr(settings["attribute_weight"])]
     if settings["objects"]:
         argv += ["--objects", *settings["objects"]]
     return argv

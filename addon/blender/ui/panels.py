@@ -106,6 +106,9 @@ class TOPSTOC_PT_advanced(_Panel, bpy.types.Panel):
         col.prop(settings, "seed")
         col.prop(settings, "adaptivity")
         layout.prop(settings, "density")
+        row = layout.row()
+        row.active = settings.quality != "FAST"  # only the refinement weighs UVs and colours
+        row.prop(settings, "attribute_weight")
         col = layout.column(align=True)
         col.active = settings.quality == "CUSTOM"
         col.prop(settings, "placement")

@@ -2,7 +2,9 @@
 
 The output keeps the input's UVs, vertex colours and materials: material borders and UV
 seams are passed to the decimation as borders, so they survive, and the attributes are
-copied through the result's corner and face source maps. ``seconds`` in the JSON report is
+copied through the result's corner and face source maps. In quality mode the UVs and colours
+also enter the collapse cost (``--attribute-weight``, topstoc.core.appearance), so a UV-mapped
+asset keeps its look. ``seconds`` in the JSON report is
 the work itself (mesh preparation, seams, decimation), without reading and writing files.
 """
 
@@ -13,8 +15,10 @@ import time
 
 import numpy as np
 
+from ..appearance import Appearance, appearance_attributes, attribute_weight, refines
 from ..attributes import material_regions, transfer_attributes, uv_seam_edges
 from ..io import dropped_attributes, mesh_format, read_mesh, write_mesh
+from ..decimate import ATTRIBUTE_WEIGHT
 from ..mesh import Mesh
 from ..symmetry import AXES, decimate_mirrored
 from . import print_json
@@ -50,6 +54,10 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--refine", type=float, default=None, metavar="F",
                         help="0: off. F >= 1: TopStoc keeps F x the target, then edge collapses by quadric "
                              "error (default: set by --mode)")
+    parser.add_argument("--attribute-weight", type=float, default=ATTRIBUTE_WEIGHT, metavar="W",
+                        help="how much the input's UVs and vertex colours count in quality mode's collapses: "
+                             "a difference d costs as much as moving the surface by W x d bounding-box "
+                             f"diagonals (default {ATTRIBUTE_WEIGHT}; 0 = geometry only; fast mode ignores it)")
     parser.add_argument("--symmetry", type=str.upper, choices=AXES, metavar="{x,y,z}",
                         help="mirror-symmetric result across the plane through the origin normal to this "
                              "axis (like Blender's Decimate modifier; the input must be symmetric there)")
@@ -117,13 +125,19 @@ def run(args) -> int:
     if data.num_triangles == 0:
         raise TopStocError(f"{args.input}: the mesh has no triangles")
     guidance = None if args.guidance is None else load_guidance(args.guidance, data.num_vertices)
+    weight = attribute_weight(args.attribute_weight)
 
     start = time.perf_counter()
     mesh = Mesh(data.vertices, data.triangles)
     seams = None if data.corner_uvs is None else uv_seam_edges(data.triangles, data.corner_uvs)
+    appearance = Appearance()  # UVs and colours count only where the refinement runs
+    if weight > 0 and refines(args.mode, args.refine):
+        appearance = appearance_attributes(data.triangles, data.corner_uvs, data.vertex_colors)
+    attributes = appearance.decimate_kwargs(weight)
     options = dict(seed=args.seed, adaptivity=args.adaptivity, density=args.density, guidance=guidance,
                    mode=args.mode, placement=args.placement, refine=args.refine,
-                   regions=material_regions(data), borders=seams if seams is not None and len(seams) else None)
+                   regions=material_regions(data), borders=seams if seams is not None and len(seams) else None,
+                   **attributes)
     if args.max_error is not None:
         bound, relative = parse_max_error(args.max_error)
         result = decimate_mirrored(mesh, args.symmetry, max_error=bound, relative=relative, **options)
@@ -165,6 +179,8 @@ def run(args) -> int:
             "refine": {"mode": args.mode, "factor": result.parameters["refine"],
                        "placement": result.parameters["placement"], "vertices": stats.refine_vertices,
                        "collapses": stats.refine_collapses},
+            "attributes": {"weight": weight if attributes else 0.0, "channels": appearance.channels,
+                           "uv_corners_filled": appearance.uv_corners_filled},
             "aspect_ratio": result.aspect_ratio(),
             **_error_bound_report(result),
         })
