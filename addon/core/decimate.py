@@ -266,11 +266,11 @@ def _attributes(mesh: Mesh, attributes, weights):
     triangles; weights: a number or one per channel."""
     if attributes is None:
         if weights is not None:
-            raise ValueError("attribute_weights given without attributes")
+            raise TopStocError("attribute_weights given without attributes")
         return None, None
     values = np.asarray(attributes)
     if values.dtype.kind not in "fiu":
-        raise ValueError(f"attributes must be a float array, got {values.dtype}")
+        raise TopStocError(f"attributes must be a float array, got {values.dtype}")
     values = values.astype(np.float64)
     n, m = mesh.native.report["input_vertices"], len(mesh.triangles)
     if values.ndim == 1 and len(values) == n:
@@ -278,22 +278,22 @@ def _attributes(mesh: Mesh, attributes, weights):
     if values.ndim == 2 and values.shape[0] == n:
         values = values[mesh.triangles]                     # per vertex -> per corner
     elif not (values.ndim == 3 and values.shape[:2] == (m, 3)):
-        raise ValueError(f"attributes must have shape (n, k) per vertex ({n} vertices) or (m, 3, k) per "
-                         f"corner ({m} triangles), got {values.shape}")
+        raise TopStocError(f"attributes must have shape (n, k) per vertex ({n} vertices) or (m, 3, k) per "
+                           f"corner ({m} triangles), got {values.shape}")
     channels = values.shape[2]
     if not 1 <= channels <= MAX_ATTRIBUTE_CHANNELS:
-        raise ValueError(f"attributes must have 1 to {MAX_ATTRIBUTE_CHANNELS} channels, got {channels}")
+        raise TopStocError(f"attributes must have 1 to {MAX_ATTRIBUTE_CHANNELS} channels, got {channels}")
     bad = np.argwhere(~np.isfinite(values))
     if len(bad):
         t, c, k = bad[0]
-        raise ValueError(f"attribute {k} of corner {c} of triangle {t} is {values[t, c, k]}; it must be finite")
+        raise TopStocError(f"attribute {k} of corner {c} of triangle {t} is {values[t, c, k]}; it must be finite")
     w = np.asarray(ATTRIBUTE_WEIGHT if weights is None else weights, dtype=np.float64)
     if w.ndim == 0:
         w = np.full(channels, float(w))
     if w.shape != (channels,):
-        raise ValueError(f"attribute_weights must be a number or one per channel ({channels}), got shape {w.shape}")
+        raise TopStocError(f"attribute_weights must be a number or one per channel ({channels}), got shape {w.shape}")
     if not np.all(np.isfinite(w) & (w >= 0)):
-        raise ValueError(f"attribute_weights must be finite and >= 0, got {w}")
+        raise TopStocError(f"attribute_weights must be finite and >= 0, got {w}")
     return np.ascontiguousarray(values).ravel(), np.ascontiguousarray(w)
 
 
