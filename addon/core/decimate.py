@@ -165,7 +165,7 @@ class DecimateStats:
     top_up: int                 #: samples added to make up for clusters absorbed by neighbours
     issues_found: dict          #: what the checks found over all rounds
     issues_remaining: dict      #: what was left (all zero unless the round limit was hit)
-    seconds: dict               #: per stage: sampling, clustering, checking, output, refine
+    seconds: dict               #: per stage: sampling, clustering, checking, output, refine, verify (the final output check)
     refine_vertices: int = 0    #: target of the quadric refinement (0: not refined)
     refine_triangles: int = 0   #: its triangle target, when it had one
     refine_collapses: int = 0   #: collapses the refinement made

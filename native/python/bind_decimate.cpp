@@ -132,6 +132,7 @@ py::dict result_dict(DecimateResult&& r) {
   seconds["clustering"] = r.seconds_clustering;
   seconds["checking"] = r.seconds_checking;
   seconds["output"] = r.seconds_output;
+  seconds["verify"] = r.seconds_verify;
   seconds["refine"] = r.seconds_refine;
   d["seconds"] = seconds;
   return d;

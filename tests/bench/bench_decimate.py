@@ -94,12 +94,12 @@ def main() -> int:
 
     print(f"\nprepare (validation, Morton order, adjacency, normals, weights): median {median_ms(prepare):.0f} ms")
     print(f"first decimation at {ratios[0]:.0%} (prepare + decimate): median {median_ms(first):.0f} ms")
-    print("\n| target | ours: re-decimation | stages (sampling / clustering / checking / output) | "
+    print("\n| target | ours: re-decimation | stages (sampling / clustering / checking / output / final check) | "
           "meshopt_simplify | meshopt_simplifySloppy | simplify / ours | sloppy / ours |")
     print("|---|---|---|---|---|---|---|")
     for ratio, seconds, stages, result, peer, _, _ in rows:
         ours = median_ms(seconds)
-        stage_text = " / ".join(f"{median_ms(stages[k]):.0f}" for k in ("sampling", "clustering", "checking", "output"))
+        stage_text = " / ".join(f"{median_ms(stages[k]):.0f}" for k in ("sampling", "clustering", "checking", "output", "verify"))
         if peer:
             simplify = 1000 * peer["simplify"]["median_seconds"]
             sloppy = 1000 * peer["simplify_sloppy"]["median_seconds"]

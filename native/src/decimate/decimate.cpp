@@ -402,9 +402,11 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
 // The final check (verify.hpp): a result whose repairs left no issue must pass it; otherwise
 // something the partition checks missed would be returned as success, so it is an error.
 void check_result(const Mesh& mesh, const FeatureLayout& layout, DecimateResult& result) {
+  const auto start = Clock::now();
   std::vector<int32_t> kept(result.kept.size());
   for (size_t i = 0; i < kept.size(); ++i) kept[i] = mesh.vertex_index()[result.kept[i]];
   result.output_check = check_output(mesh, layout, kept, result.vertices, result.triangles);
+  result.seconds_verify = seconds_since(start);
 }
 
 bool topology_kept(const DecimateResult& result) {

@@ -83,6 +83,7 @@ struct DecimateResult {
   int32_t refine_triangles = 0;        ///< its triangle target, when it had one (0: none)
   int32_t refine_collapses = 0;        ///< collapses it made
   double seconds_sampling = 0, seconds_clustering = 0, seconds_checking = 0, seconds_output = 0;
+  double seconds_verify = 0;  ///< the final output check (verify.hpp)
   double seconds_refine = 0;
   OutputCheck output_check;            ///< the final check of the output (verify.hpp)
 };
