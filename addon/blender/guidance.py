@@ -19,7 +19,7 @@ from mathutils import Matrix, Vector
 
 from ..core import guidance as rules
 from ..core.appearance import Appearance, appearance_attributes
-from ..core.attributes import uv_seam_edges
+from ..core.attributes import hard_normal_edges, uv_seam_edges
 from ..core.decimate import Box, View
 from ..core.errors import TopStocError
 from . import mesh_io
@@ -93,12 +93,14 @@ def _read_color(mesh, name: str) -> Callable[[], np.ndarray]:
 
 
 def _read_borders(obj, settings, arrays: mesh_io.MeshArrays) -> Callable[[list], Optional[np.ndarray]]:
-    """Reads seams and sharp edges; returns the function giving the border edges (it appends
-    what it found to the list of sources it is given)."""
+    """Reads seams, sharp edges and the hard edges of custom normals; returns the function giving
+    the border edges (it appends what it found to the list of sources it is given). A hard edge is
+    a border so that each side's output corners take that side's normals, as at a UV seam."""
     mesh = obj.data
     uv_maps = mesh_io.read_uv_maps(mesh) if settings.use_uv_seams else {}
     marked = mesh_io.read_edges(mesh, "use_seam") if settings.use_uv_seams else np.zeros((0, 2), np.int32)
     sharp = mesh_io.read_edges(mesh, "use_edge_sharp") if settings.use_sharp else np.zeros((0, 2), np.int32)
+    normals = mesh_io.read_custom_normals(mesh) if settings.use_hard_normals else None
 
     def borders(sources: list) -> Optional[np.ndarray]:
         parts = []
@@ -113,6 +115,11 @@ def _read_borders(obj, settings, arrays: mesh_io.MeshArrays) -> Callable[[list],
         if len(sharp):
             parts.append(sharp)
             sources.append(f"sharp edges ({len(sharp)})")
+        if normals is not None:
+            hard = hard_normal_edges(arrays.triangles, normals[arrays.triangle_loops])
+            if len(hard):
+                parts.append(hard)
+                sources.append(f"hard edges of the custom normals ({len(hard)} edges)")
         if not parts:
             return None
         # Only edges of triangles can be borders (loose edges carry no faces to separate).
@@ -140,8 +147,10 @@ def appearance_color(mesh, settings):
 
 
 def _read_appearance(obj, arrays: mesh_io.MeshArrays) -> tuple:
-    """Reads the active UV map and the appearance colour (appearance_color); returns (the
-    function giving the engine's attributes, what they hold). Colours enter as sRGB in [0, 1]."""
+    """Reads the active UV map, the appearance colour (appearance_color) and the custom normals
+    (mesh_io.read_custom_normals; normals Blender derives from the shape are left out, see
+    core/appearance.py); returns (the function giving the engine's attributes, what they hold).
+    Colours enter as sRGB in [0, 1]."""
     mesh = obj.data
     names, uv, color, color_key, color_domain = [], None, None, None, None
     layer = mesh.uv_layers.active
@@ -156,6 +165,9 @@ def _read_appearance(obj, arrays: mesh_io.MeshArrays) -> tuple:
             color, color_key = read
             color_domain = attribute.domain
             names.append(f"colours '{attribute.name}'")
+    normals = mesh_io.read_custom_normals(mesh)
+    if normals is not None:
+        names.append("custom normals")
 
     @functools.lru_cache(maxsize=1)
     def appearance() -> Appearance:
@@ -167,7 +179,8 @@ def _read_appearance(obj, arrays: mesh_io.MeshArrays) -> tuple:
                 rgb = rules.linear_to_srgb(rgb)
             if color_domain == "CORNER":
                 rgb = rgb[arrays.triangle_loops]
-        return appearance_attributes(arrays.triangles, corner_uvs, rgb)
+        corner_normals = None if normals is None else normals[arrays.triangle_loops]
+        return appearance_attributes(arrays.triangles, corner_uvs, rgb, corner_normals)
 
     return appearance, names
 

@@ -285,7 +285,7 @@ def build_edited_mesh(old, arrays: mesh_io.MeshArrays, result, new) -> bpy.types
     if colors.active_color is not None and new.color_attributes.get(colors.active_color.name) is not None:
         new.color_attributes.active_color = new.color_attributes[colors.active_color.name]
 
-    normals = mesh_io._custom_normals(old)
+    normals = mesh_io.read_custom_normals(old)
     if normals is not None and len(layout.corner_loop):
         if hasattr(new, "use_auto_smooth"):
             new.use_auto_smooth = True

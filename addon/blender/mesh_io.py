@@ -350,11 +350,15 @@ def apply_vertex_groups(obj, groups: dict) -> None:
                                                    np.concatenate(weight + [np.zeros(0)])))
 
 
-def _custom_normals(mesh) -> Optional[np.ndarray]:
+def read_custom_normals(mesh) -> Optional[np.ndarray]:
+    """(num_loops, 3) float32 custom split normals per corner, or None when the mesh shows none:
+    it has no custom normals, or (Blender < 4.1) auto smooth is off, so they are not used."""
     if not mesh.has_custom_normals:
         return None
-    if hasattr(mesh, "corner_normals"):  # Blender 4.1+
+    if hasattr(mesh, "corner_normals"):  # Blender 4.1+: custom normals are corner normals
         return _get(mesh.corner_normals, "vector", len(mesh.loops), 3, np.float32)
+    if not mesh.use_auto_smooth:  # Blender < 4.1 ignores custom normals without auto smooth
+        return None
     mesh.calc_normals_split()
     return _get(mesh.loops, "normal", len(mesh.loops), 3, np.float32)
 
@@ -435,7 +439,7 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
         if render is not None:
             out.color_attributes.render_color_index = list(out.color_attributes).index(render)
 
-    normals = _custom_normals(source)
+    normals = read_custom_normals(source)
     if normals is not None and m:
         if hasattr(out, "use_auto_smooth"):  # Blender < 4.1 needs auto smooth for custom normals
             out.use_auto_smooth = True

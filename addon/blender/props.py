@@ -81,11 +81,12 @@ class DecimationParameters:
                                     "the target, then edge collapses by quadric error thin it (Quality mode "
                                     "does this with its own settings)")
     attribute_weight: FloatProperty(
-        name="Keep UVs / Colours", default=ATTRIBUTE_WEIGHT, min=0.0, soft_max=1.0, precision=3,
-        description="How much Quality mode protects the look: the active UV map and colour attribute "
-                    "(never the guidance paint) are weighed with the shape, so textures stretch less and "
-                    "colours smear less. A UV or colour difference of 1 costs like moving the surface by "
-                    "this fraction of the object's size. 0: shape only. Fast mode ignores it")
+        name="Keep Appearance", default=ATTRIBUTE_WEIGHT, min=0.0, soft_max=1.0, precision=3,
+        description="How much Quality mode protects the look: the active UV map, the colour attribute "
+                    "(never the guidance paint) and custom normals are weighed with the shape, so textures "
+                    "stretch less, colours smear less and hard-surface shading stays. A UV or colour "
+                    "difference of 1, or normals about 1 radian apart, costs like moving the surface by this "
+                    "fraction of the object's size. 0: shape only. Fast mode ignores it")
     output: EnumProperty(name="Output", items=OUTPUT_MODES, default="NEW_OBJECT")
 
 
@@ -170,6 +171,10 @@ class TOPSTOC_PG_object(bpy.types.PropertyGroup):
     material_strength: FloatProperty(name="Strength", default=1.0, min=0.0, max=1.0, subtype="FACTOR")
     use_sharp: BoolProperty(name="Keep Sharp Edges", description="No cluster crosses an edge marked sharp",
                             default=False)
+    use_hard_normals: BoolProperty(name="Keep Hard Normals",
+                                   description="No cluster crosses a hard edge of the custom normals (where "
+                                               "their shading breaks), so each side keeps its own normals",
+                                   default=True)
 
     box_enabled: BoolProperty(name="Guidance Box",
                               description="This cube empty sets the guidance of the vertices inside it")

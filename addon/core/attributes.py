@@ -31,26 +31,48 @@ def uv_seam_edges(triangles, corner_uvs) -> np.ndarray:
     are borders anyway). Triangles with a repeated vertex are ignored, as topstoc.Mesh drops
     them; corners without UVs (NaN) match each other.
     """
+    def differ(a, b):
+        return ~((a == b) | (np.isnan(a) & np.isnan(b))).all(axis=1)
+
+    return _seam_edges(triangles, np.asarray(corner_uvs, dtype=np.float64).reshape(-1, 3, 2), differ)
+
+
+HARD_NORMAL_ANGLE = 1.0  # degrees: corner normals further apart than this at a vertex make a hard edge
+
+
+def hard_normal_edges(triangles, corner_normals, angle: float = HARD_NORMAL_ANGLE) -> np.ndarray:
+    """Edges whose triangles disagree on the (unit) normals at its ends by more than ``angle``
+    degrees, a hard edge of custom split normals: (k, 2) int32 vertex pairs; as uv_seam_edges."""
+    limit = 2 * np.sin(np.radians(angle) / 2)  # chord between unit vectors that far apart
+
+    def differ(a, b):
+        return (np.linalg.norm(a[:, :3] - b[:, :3], axis=1) > limit) | (np.linalg.norm(a[:, 3:] - b[:, 3:], axis=1) > limit)
+
+    return _seam_edges(triangles, np.asarray(corner_normals, dtype=np.float64).reshape(-1, 3, 3), differ)
+
+
+def _seam_edges(triangles, corner_values, differ) -> np.ndarray:
+    """Edges whose triangles' corner values at its ends ``differ`` (a test on rows of both ends'
+    values, lower vertex first, against the edge's first triangle's)."""
     t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
-    uv = np.asarray(corner_uvs, dtype=np.float64).reshape(-1, 3, 2)
+    values = np.asarray(corner_values)
+    k = values.shape[2]
     keep = (t[:, 0] != t[:, 1]) & (t[:, 1] != t[:, 2]) & (t[:, 2] != t[:, 0])
-    t, uv = t[keep], uv[keep]
+    t, values = t[keep], values[keep]
     if len(t) == 0:
         return np.zeros((0, 2), dtype=np.int32)
     nxt = [1, 2, 0]
     a, b = t.ravel(), t[:, nxt].ravel()
-    uv_a, uv_b = uv.reshape(-1, 2), uv[:, nxt].reshape(-1, 2)
-    # Orient every half-edge from its lower to its higher vertex, UVs along with it.
+    value_a, value_b = values.reshape(-1, k), values[:, nxt].reshape(-1, k)
+    # Orient every half-edge from its lower to its higher vertex, values along with it.
     flip = a > b
     low, high = np.where(flip, b, a), np.where(flip, a, b)
-    uv_low = np.where(flip[:, None], uv_b, uv_a)
-    uv_high = np.where(flip[:, None], uv_a, uv_b)
-    values = np.concatenate([uv_low, uv_high], axis=1)
+    value_low = np.where(flip[:, None], value_b, value_a)
+    value_high = np.where(flip[:, None], value_a, value_b)
+    both = np.concatenate([value_low, value_high], axis=1)
     keys, first, group = np.unique(low * (high.max() + 1) + high, return_index=True, return_inverse=True)
-    reference = values[first][group]
-    same = (values == reference) | (np.isnan(values) & np.isnan(reference))
     differs = np.zeros(len(keys), dtype=bool)
-    np.logical_or.at(differs, group, ~same.all(axis=1))
+    np.logical_or.at(differs, group, differ(both, both[first][group]))
     seams = first[differs]
     return np.stack([low[seams], high[seams]], axis=1).astype(np.int32)
 

@@ -107,7 +107,7 @@ class TOPSTOC_PT_advanced(_Panel, bpy.types.Panel):
         col.prop(settings, "adaptivity")
         layout.prop(settings, "density")
         row = layout.row()
-        row.active = settings.quality != "FAST"  # only the refinement weighs UVs and colours
+        row.active = settings.quality != "FAST"  # only the refinement weighs UVs, colours and normals
         row.prop(settings, "attribute_weight")
         col = layout.column(align=True)
         col.active = settings.quality == "CUSTOM"
@@ -167,6 +167,7 @@ class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
             box.prop(s, "material_strength")
         layout.prop(s, "use_uv_seams")
         layout.prop(s, "use_sharp")
+        layout.prop(s, "use_hard_normals")
         box = layout.box()
         box.prop(scene, "use_boxes")
         if scene.use_boxes:
