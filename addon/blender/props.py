@@ -81,7 +81,7 @@ class DecimationParameters:
                                     "the target, then edge collapses by quadric error thin it (Quality mode "
                                     "does this with its own settings)")
     attribute_weight: FloatProperty(
-        name="Keep Appearance", default=ATTRIBUTE_WEIGHT, min=0.0, soft_max=1.0, precision=3,
+        name="Appearance", default=ATTRIBUTE_WEIGHT, min=0.0, soft_max=1.0, precision=3,
         description="How much Quality mode protects the look: the active UV map, the colour attribute "
                     "(never the guidance paint) and custom normals are weighed with the shape, so textures "
                     "stretch less, colours smear less and hard-surface shading stays. A UV or colour "

@@ -1,5 +1,5 @@
 """The add-on puts the look into Quality mode's cost: the active UV map and the appearance colour
-go to the engine as attributes (Advanced > Keep Appearance, 0 = off), the guidance paint never.
+go to the engine as attributes (Advanced > Appearance, 0 = off), the guidance paint never.
 
 Effects are measured, not mocked: the UV-seamed cylinder of tests/uv_cylinder.py has its texture
 stretched along the straight axis, and the UV error of a result is measured against the

@@ -1,5 +1,5 @@
 """The add-on keeps a hard-surface object's custom normals: their hard edges are borders (Guidance
-> Keep Hard Normals) and the normals enter Quality mode's cost (Advanced > Keep Appearance, 0 =
+> Keep Hard Normals) and the normals enter Quality mode's cost (Advanced > Appearance, 0 =
 off); objects whose normals Blender derives from the shape are unchanged.
 
 Effects are measured on the capped cylinder of tests/capped_cylinder.py (hard rims, caps whose

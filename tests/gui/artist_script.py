@@ -37,7 +37,8 @@ def label_fits(texts, sidebar):
         blf.size(0, int(style.points * scale), 72)
     widest = max(texts, key=lambda t: blf.dimensions(0, t)[0])
     margin = 2 * 10 * scale + 20 * scale  # panel margins and the split's padding (Blender's ui_layout)
-    column = 0.4 * (sidebar.width - margin)
+    # less the label's own text margins: 66 px of "Appearance" against 75 px was drawn cut
+    column = 0.4 * (sidebar.width - margin) - 10 * scale
     return widest, blf.dimensions(0, widest)[0], column
 
 
@@ -70,6 +71,7 @@ def steps():
     session.keep_for_docs("artist_panel", "artist-panel.png")
     settings = bpy.context.scene.topstoc
     labels = []
+    # (Appearance is a full-width slider with its name inside, not in the label column)
     for name in ("target_mode", "ratio", "seed", "adaptivity", "density", "placement", "refine"):
         labels.append(settings.bl_rna.properties[name].name)
     widest, width, column = label_fits(labels, sidebar)

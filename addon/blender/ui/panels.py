@@ -108,7 +108,8 @@ class TOPSTOC_PT_advanced(_Panel, bpy.types.Panel):
         layout.prop(settings, "density")
         row = layout.row()
         row.active = settings.quality != "FAST"  # only the refinement weighs UVs, colours and normals
-        row.prop(settings, "attribute_weight")
+        row.use_property_split = False  # the name inside a full-width slider: it fits the sidebar
+        row.prop(settings, "attribute_weight", slider=True)
         col = layout.column(align=True)
         col.active = settings.quality == "CUSTOM"
         col.prop(settings, "placement")
