@@ -142,8 +142,9 @@ def read_edges(mesh: bpy.types.Mesh, flag: str) -> np.ndarray:
     """(k, 2) vertex pairs of the edges whose boolean ``flag`` is set (use_seam, use_edge_sharp).
 
     Blender 4.0+ keeps these flags as edge attributes that exist only when some edge has the
-    flag: none means no read at all (a flag per edge through MeshEdge costs ~30 ms per million
-    edges, on the Live Preview's start)."""
+    flag: none means no read at all (a flag per edge through MeshEdge costs ~20 ns, 46 ms for
+    2.3M edges on the Live Preview's start); 3.x copies them from its edge array
+    (_legacy_edge_flags)."""
     count = len(mesh.edges)
     attribute = _flag_attribute(mesh, flag) if bpy.app.version >= (4, 0, 0) else None
     if bpy.app.version >= (4, 0, 0) and (attribute is None or flag in mistyped_edge_flags(mesh)):
