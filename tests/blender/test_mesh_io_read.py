@@ -2,6 +2,7 @@
 polygons; Blender 4.0+ edge flags from their attributes) give what Blender's own per-element
 accessors give."""
 
+import bpy
 import numpy as np
 import pytest
 
@@ -54,3 +55,29 @@ def test_read_edges_matches_the_per_edge_flags(ts, scene, flag):
     expected = np.array([tuple(e.vertices) for e in mesh.edges if getattr(e, flag)])
     np.testing.assert_array_equal(read_edges(mesh, flag), expected)
     assert len(expected) == 3
+
+
+@pytest.mark.parametrize("flag", ["use_seam", "use_edge_sharp"])
+def test_read_edges_keeps_each_flag_apart_from_the_others(ts, scene, flag):
+    """Every edge flagged some way (the other flag, hidden, selected, creased, bevel weight; Blender
+    3.x keeps them side by side in one MEdge): only ``flag`` is read, as MeshEdge gives it."""
+    obj = make_object("Ball", *meshgen.icosphere(4))
+    mesh = obj.data
+    other = "use_edge_sharp" if flag == "use_seam" else "use_seam"
+    rng = np.random.default_rng(7)
+    for edge in mesh.edges:
+        setattr(edge, flag, bool(rng.random() < 0.3))
+        setattr(edge, other, bool(rng.random() < 0.5))
+        edge.select = bool(rng.random() < 0.5)
+        edge.hide = bool(rng.random() < 0.2)
+    if hasattr(mesh.edges[0], "crease"):  # Blender < 4.0
+        for edge in list(mesh.edges)[::3]:
+            edge.crease = 0.75
+            edge.bevel_weight = 1.0
+    expected = np.array([tuple(e.vertices) for e in mesh.edges if getattr(e, flag)])
+    found = ts.blender.mesh_io.read_edges(mesh, flag)
+    assert found.dtype == np.int32 and len(expected) > 100
+    np.testing.assert_array_equal(found, expected)
+    if (3, 0, 0) <= bpy.app.version < (4, 0, 0):  # read from the MEdge array, not edge by edge
+        np.testing.assert_array_equal(ts.blender.mesh_io._legacy_edge_flags(mesh, flag),
+                                      [getattr(e, flag) for e in mesh.edges])
