@@ -256,6 +256,9 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
     carry.write_shape_keys(target, shape_keys, arrays.vertices, run.result.vertices, kept, moved, arrays.triangles)
     target["topstoc_source"] = obj.name
     target["topstoc_parameters"] = json.dumps(run.parameters)
+    # Over the target (control points painted, or what the topology needs): the panel says so.
+    target["topstoc_over_budget"] = int(getattr(run.result.stats, "over_budget", 0))
+    target["topstoc_over_budget_reason"] = str(getattr(run.result.stats, "over_budget_reason", ""))
     if target is not obj and run.settings is not None:  # what Regenerate needs (regenerate.py)
         target.topstoc.source = obj
         target.topstoc.settings = json.dumps(run.settings)

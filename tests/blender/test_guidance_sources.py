@@ -250,3 +250,22 @@ def test_guidance_layer_and_palette(ts, scene):
     rules = ts.core.guidance
     decoded = [rules.color_to_guidance(np.array(c.color)[None])[0] for c in palette.colors]
     np.testing.assert_allclose(decoded, [1.0, 0.5, 0.0, -0.5, -1.0], atol=1e-6)
+
+
+def test_control_points_over_the_target_are_reported_on_the_result(ts, scene):
+    """Issue 16: only control points (u = 1) may push the count over the target; the status line
+    and the result object (which the panel reads) say by how much and why. A result within the
+    target stores 0."""
+    obj, v, f = sphere()
+    keep = v[:, 2] > 0.3  # about a third of the sphere as control points, far over 5 %
+    paint(ts, obj, keep, 1.0)
+    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.05))
+    over, reason = run.result.stats.over_budget, run.result.stats.over_budget_reason
+    assert run.result.num_vertices >= keep.sum() > round(0.05 * len(v))
+    assert over == run.result.num_vertices - round(0.05 * len(v)) and reason == "control points"
+    out = ts.blender.pipeline.write_output(run)
+    assert out["topstoc_over_budget"] == over and out["topstoc_over_budget_reason"] == reason
+    assert f"{over:,} vertices over the target (control points)" in ts.blender.pipeline.summary(run)
+    plain, _, _ = sphere("Plain")
+    out = ts.blender.pipeline.write_output(ts.blender.pipeline.decimate(bpy.context, plain, Params(ratio=0.05)))
+    assert out["topstoc_over_budget"] == 0 and out["topstoc_over_budget_reason"] == ""

@@ -3,11 +3,22 @@
 
 from __future__ import annotations
 
+import textwrap
+
 import bpy
 
 from ..pipeline import face_estimate
 
 CATEGORY = "TopStoc"
+
+
+def wrapped(layout, context, text: str, icon: str = "NONE") -> None:
+    """A long message as several labels, wrapped to the sidebar's width."""
+    scale = (context.preferences.system.ui_scale if context.preferences else 0.0) or 1.0  # 0 in background
+    pixels = context.region.width if context.region else 300
+    width = max(16, int((pixels - 50 * scale) / (7 * scale)))
+    for i, line in enumerate(textwrap.wrap(text, width) or [""]):
+        layout.label(text=line, icon=icon if i == 0 else "BLANK1")
 
 
 class _Panel:
@@ -82,6 +93,10 @@ class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
         col.operator("topstoc.guided_decimate", icon="MOD_DECIM")
         col.operator("topstoc.preview", icon="HIDE_OFF")
         obj = context.active_object
+        over = obj.get("topstoc_over_budget", 0) if obj is not None else 0
+        if over:
+            wrapped(layout, context, f"{over:,} vertices over the target: "
+                    f"{obj.get('topstoc_over_budget_reason', '')}", "ERROR")
         if obj is not None and obj.type == "MESH" and obj.topstoc.settings:
             box = layout.box()
             source = obj.topstoc.source

@@ -2,25 +2,14 @@
 
 from __future__ import annotations
 
-import textwrap
-
 import bpy
 
 from .. import analysis
 from ..topology_help import HELP
 from ..operators.topology import running
-from .panels import _MeshPanel, _Panel, _mesh
+from .panels import _MeshPanel, _Panel, _mesh, wrapped
 
 KIND_ICONS = {"HANDLE": "MOD_CURVE", "TUNNEL": "MOD_SCREW", "BOUNDARY": "MOD_EDGESPLIT"}
-
-
-def wrapped(layout, context, text: str, icon: str = "NONE") -> None:
-    """A long message as several labels, wrapped to the sidebar's width."""
-    scale = (context.preferences.system.ui_scale if context.preferences else 0.0) or 1.0  # 0 in background
-    pixels = context.region.width if context.region else 300
-    width = max(16, int((pixels - 50 * scale) / (7 * scale)))
-    for i, line in enumerate(textwrap.wrap(text, width) or [""]):
-        layout.label(text=line, icon=icon if i == 0 else "BLANK1")
 
 
 def invariant_rows(topology) -> list:
