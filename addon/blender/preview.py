@@ -357,7 +357,7 @@ class PreviewSession:
         if self._applying is None:
             return None
         if self._to_apply is None and finished is not None and finished[1][0] == self._applying:
-            (ratio, _final), result, _edges, seconds = finished[1]
+            (ratio, _final), result, _edges, seconds, _flags = finished[1]
             self._to_apply = (ratio, result, seconds)
         if self._to_apply is None:
             return None
