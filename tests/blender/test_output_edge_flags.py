@@ -171,3 +171,19 @@ def test_a_mesh_without_flags_gets_none(ts, scene):
         assert not edge_flag(mesh, flag).any()
     names = {attribute.name for attribute in mesh.attributes}
     assert not names & {".uv_seam", "uv_seam", "sharp_edge"}
+
+
+def test_flags_not_used_as_borders_follow_the_rule(ts, flagged_sphere):
+    """With Keep UV Seams and Keep Sharp Edges off the curves are not sampled as curves: an output
+    edge is still flagged exactly where the rule finds a chain (here: few or none)."""
+    obj = flagged_sphere
+    obj.topstoc.use_uv_seams = obj.topstoc.use_sharp = False
+    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.15, seed=4, quality="QUALITY"))
+    out = ts.blender.pipeline.write_output(run).data
+    kept = np.asarray(run.result.kept)
+    moved = np.any(positions(out) != positions(obj.data)[kept], axis=1)
+    out_pairs = edge_pairs(out)
+    for flag in FLAGS:
+        want = expected_flags(edge_pairs(obj.data)[edge_flag(obj.data, flag)], out_pairs, kept, moved)
+        np.testing.assert_array_equal(edge_flag(out, flag), want, err_msg=flag)
+        print(flag, "not borders: flagged out", int(want.sum()))
