@@ -3,8 +3,9 @@
 Reading triangulates n-gons through Blender's loop triangles and keeps, for every triangle,
 its polygon and the loop of each corner, so results can take every attribute exactly from
 the face and corner they came from. Writing builds a triangle mesh from a DecimateResult and
-copies UV maps, colour and generic attributes, materials, smooth flags and custom split normals
-(vertices the quality mode moved interpolate theirs); vertex-group weights are read and written
+copies UV maps, colour and generic attributes, materials, smooth flags, custom split normals
+(vertices the quality mode moved interpolate theirs) and the seam and sharp flags of edges along
+the input's flagged curves (core/edge_flags.py); vertex-group weights are read and written
 sparsely (read_vertex_weights, write_vertex_weights).
 """
 
@@ -19,6 +20,7 @@ import numpy as np
 
 from ..core.attributes import MovedVertices, SparseWeights, corner_values, moved_vertices, point_values
 from ..core.digest import array_digest
+from ..core.edge_flags import carried_edge_flags
 from ..core.mesh_edges import mesh_edges
 
 # Attribute data type -> (foreach key, values per element, numpy dtype)
@@ -283,6 +285,56 @@ _EDGE_FLAG_ATTRIBUTES = {"select": ((".select_edge",), "BOOLEAN"), "hide": ((".h
                          "crease": (("crease_edge",), "FLOAT"), "bevel_weight": (("bevel_weight_edge",), "FLOAT")}
 
 
+CARRIED_EDGE_FLAGS = ("use_seam", "use_edge_sharp")
+
+
+def read_carried_edge_flags(source: bpy.types.Mesh) -> dict:
+    """{flag: (k, 2) flagged input vertex pairs} of the edge flags a result carries."""
+    return {flag: read_edges(source, flag) for flag in CARRIED_EDGE_FLAGS}
+
+
+def output_edge_flags(flagged: dict, edges: np.ndarray, kept, moved=None) -> dict:
+    """{flag: bool per output edge} for ``read_carried_edge_flags``' input flags (core/edge_flags.py's
+    rule; ``moved``: output vertices not at their input vertex); flags set nowhere are left out.
+    Touches no Blender data (the preview calls it on a worker)."""
+    out = {}
+    for flag, pairs in flagged.items():
+        if len(pairs):
+            values = carried_edge_flags(pairs, edges, kept, moved)
+            if values.any():
+                out[flag] = values
+    return out
+
+
+def carry_edge_flags(source: bpy.types.Mesh, out: bpy.types.Mesh, kept, moved=None) -> None:
+    """Sets the seam and sharp flags of ``out``'s edges (a result of ``source``; output vertex i
+    stands for input vertex kept[i]) where they follow a flagged input curve."""
+    flagged = read_carried_edge_flags(source)
+    if len(out.edges) and any(len(pairs) for pairs in flagged.values()):
+        edges = _get(out.edges, "vertices", len(out.edges), 2, np.int32)
+        write_edge_flags(out, output_edge_flags(flagged, edges, kept, moved))
+
+
+def write_edge_flags(mesh: bpy.types.Mesh, flags: dict) -> None:
+    """Writes boolean edge flags ({flag: bool per edge}: use_seam, use_edge_sharp) of a mesh whose
+    edges carry none yet. Blender 4.0+ keeps them as edge attributes (".uv_seam", 5.0+ "uv_seam";
+    "sharp_edge") made here; 3.x as bits of its edges, written through MeshEdge."""
+    for flag, values in flags.items():
+        values = np.ascontiguousarray(values, dtype=bool)
+        if bpy.app.version < (4, 0, 0):
+            mesh.edges.foreach_set(flag, values)
+            continue
+        attribute = _flag_attribute(mesh, flag)
+        if attribute is not None and (attribute.domain, attribute.data_type) != ("EDGE", "BOOLEAN"):
+            mesh.attributes.remove(attribute)  # mistyped (see mistyped_edge_flags): made anew
+            attribute = None
+        if attribute is None:
+            names = _EDGE_FLAG_ATTRIBUTES[flag][0]
+            attribute = mesh.attributes.new(names[-1] if bpy.app.version >= (5, 0, 0) else names[0],
+                                            "BOOLEAN", "EDGE")
+        attribute.data.foreach_set("value", values)
+
+
 def _flag_attribute(mesh: bpy.types.Mesh, flag: str):
     """The attribute that holds edge ``flag`` in this Blender, None when there is none."""
     for name in _EDGE_FLAG_ATTRIBUTES[flag][0]:
@@ -410,8 +462,9 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
     polygon, corners those of the input loop ``corner_source`` names. Vertices the quality mode
     moved (``moved``, found when not given) take point and corner values interpolated in their
     source triangle (topstoc.core.attributes; corners from that triangle's own loops, so UV
-    seams stay exact); integers, flags and rotations take the nearest corner's value. Edge
-    attributes (creases, bevel weights, seam/sharp flags) are not carried: output edges are new.
+    seams stay exact); integers, flags and rotations take the nearest corner's value. Output
+    edges are new: seam and sharp flags mark the output edges that follow a flagged input curve
+    (carry_edge_flags); creases and bevel weights are not carried.
     """
     out = bpy.data.meshes.new(name)
     fill_geometry(out, result.vertices, result.triangles)
@@ -477,6 +530,7 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
         render = out.color_attributes.get(colors[colors.render_color_index].name)
         if render is not None:
             out.color_attributes.render_color_index = list(out.color_attributes).index(render)
+    carry_edge_flags(source, out, kept, moved.face >= 0)
 
     normals = read_custom_normals(source)
     if normals is not None and m:

@@ -37,6 +37,7 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import Optional
 
 import bpy
+import numpy as np
 
 from ..core.attributes import moved_vertices
 from ..core.loops import Cancelled
@@ -61,6 +62,7 @@ class PreviewSession:
         pipeline.check_decimatable(obj)
         self.obj = obj
         arrays = mesh_io.read_mesh(obj.data)  # the main thread's work: Blender data
+        self._edge_flags = mesh_io.read_carried_edge_flags(obj.data)  # seams, sharp edges the preview shows
         self.num_triangles = len(arrays.triangles)
         self.guidance = None                   # made by the worker from what is read below
         self._read_guidance = None             # the rules to run on it (guidance.read)
@@ -170,7 +172,12 @@ class PreviewSession:
         result = pipeline.run_engine(self.prepared.mesh, {"ratio": ratio}, options,
                                      self.guidance.decimate_kwargs(), self.axis if final else None)
         edges = mesh_edges(result.triangles, len(result.vertices))
-        return self.key(ratio, final), result, edges, time.perf_counter() - start
+        flags = {}
+        if any(len(pairs) for pairs in self._edge_flags.values()):
+            kept = np.asarray(result.kept, dtype=np.int64)
+            moved = np.any(np.asarray(result.vertices) != self.prepared.arrays.vertices[kept], axis=1)
+            flags = mesh_io.output_edge_flags(self._edge_flags, edges.vertices, kept, moved)
+        return self.key(ratio, final), result, edges, time.perf_counter() - start, flags
 
     def _make_preview(self) -> None:
         """The preview object, beside the hidden original (main thread, first result)."""
@@ -186,13 +193,16 @@ class PreviewSession:
         self.preview.show_all_edges = True
         obj.hide_set(True)
 
-    def show(self, key, result, edges, seconds: float) -> None:
-        """Puts a result into the preview object (main thread); key: ratio or (ratio, final)."""
+    def show(self, key, result, edges, seconds: float, flags: dict = None) -> None:
+        """Puts a result into the preview object (main thread); key: ratio or (ratio, final);
+        flags: its edges' seam and sharp flags (mesh_io.output_edge_flags)."""
         start = time.perf_counter()
         ratio, final = key if isinstance(key, tuple) else (key, False)
         if self.preview is None:
             self._make_preview()
         mesh_io.fill_geometry(self.mesh, result.vertices, result.triangles, edges)
+        if flags and len(self.mesh.edges) == len(edges):  # (Blender's own edge pass: other edges)
+            mesh_io.write_edge_flags(self.mesh, flags)
         self.ratio, self.final, self.result, self.seconds_decimate = ratio, final, result, seconds
         self.seconds_write = time.perf_counter() - start
         self._last_shown = time.perf_counter()
@@ -347,7 +357,7 @@ class PreviewSession:
         if self._applying is None:
             return None
         if self._to_apply is None and finished is not None and finished[1][0] == self._applying:
-            (ratio, _final), result, _edges, seconds = finished[1]
+            (ratio, _final), result, _edges, seconds, _flags = finished[1]
             self._to_apply = (ratio, result, seconds)
         if self._to_apply is None:
             return None
