@@ -277,7 +277,7 @@ def fill_geometry(mesh: bpy.types.Mesh, vertices: np.ndarray, triangles: np.ndar
 
 
 # Edge flags (MeshEdge properties) Blender keeps as edge attributes: their names (seams are
-# ".uv_seam" in 4.x and "uv_seam" from 5.0) and the type each must have.
+# ".uv_seam" in 4.0-4.4 and "uv_seam" from 4.5, as bpy 4.2 and 4.5 show) and the type each must have.
 _EDGE_FLAG_ATTRIBUTES = {"select": ((".select_edge",), "BOOLEAN"), "hide": ((".hide_edge",), "BOOLEAN"),
                          "use_seam": ((".uv_seam", "uv_seam"), "BOOLEAN"),
                          "use_edge_sharp": (("sharp_edge",), "BOOLEAN"),
@@ -317,7 +317,7 @@ def carry_edge_flags(source: bpy.types.Mesh, out: bpy.types.Mesh, kept, moved=No
 
 def write_edge_flags(mesh: bpy.types.Mesh, flags: dict) -> None:
     """Writes boolean edge flags ({flag: bool per edge}: use_seam, use_edge_sharp) of a mesh whose
-    edges carry none yet. Blender 4.0+ keeps them as edge attributes (".uv_seam", 5.0+ "uv_seam";
+    edges carry none yet. Blender 4.0+ keeps them as edge attributes (".uv_seam", 4.5+ "uv_seam";
     "sharp_edge") made here; 3.x as bits of its edges, written through MeshEdge."""
     for flag, values in flags.items():
         values = np.ascontiguousarray(values, dtype=bool)
@@ -330,7 +330,7 @@ def write_edge_flags(mesh: bpy.types.Mesh, flags: dict) -> None:
             attribute = None
         if attribute is None:
             names = _EDGE_FLAG_ATTRIBUTES[flag][0]
-            attribute = mesh.attributes.new(names[-1] if bpy.app.version >= (5, 0, 0) else names[0],
+            attribute = mesh.attributes.new(names[-1] if bpy.app.version >= (4, 5, 0) else names[0],
                                             "BOOLEAN", "EDGE")
         attribute.data.foreach_set("value", values)
 

@@ -133,7 +133,7 @@ def test_flags_follow_the_flagged_curves(ts, flagged_sphere, quality):
     assert (quality == "QUALITY") == bool(moved.any())  # the quality mode moved some vertices
     figures = check_flags(obj.data, out.data, kept, moved)
     if bpy.app.version >= (4, 0, 0):  # Blender's own names and types, so its tools see them
-        seam = ".uv_seam" if bpy.app.version < (5, 0, 0) else "uv_seam"
+        seam = ".uv_seam" if bpy.app.version < (4, 5, 0) else "uv_seam"
         for name in (seam, "sharp_edge"):
             assert (out.data.attributes[name].domain, out.data.attributes[name].data_type) == ("EDGE", "BOOLEAN")
     assert out.data.validate() is False  # nothing for Blender to correct
