@@ -277,7 +277,8 @@ def fill_geometry(mesh: bpy.types.Mesh, vertices: np.ndarray, triangles: np.ndar
 
 
 # Edge flags (MeshEdge properties) Blender keeps as edge attributes: their names (seams are
-# ".uv_seam" in 4.0-4.4 and "uv_seam" from 4.5, as bpy 4.2 and 4.5 show) and the type each must have.
+# ".uv_seam" in 4.0-4.4 and "uv_seam" from 4.5: Blender 4.2 and 4.3 show the first, 4.5 the second)
+# and the type each must have.
 _EDGE_FLAG_ATTRIBUTES = {"select": ((".select_edge",), "BOOLEAN"), "hide": ((".hide_edge",), "BOOLEAN"),
                          "use_seam": ((".uv_seam", "uv_seam"), "BOOLEAN"),
                          "use_edge_sharp": (("sharp_edge",), "BOOLEAN"),
