@@ -4,7 +4,9 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <climits>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -14,12 +16,9 @@ namespace topstoc {
 
 namespace {
 
-// (distance, rank) packed so that one integer comparison orders them lexicographically.
-inline uint64_t pack(int32_t dist, int32_t rank) { return (uint64_t(uint32_t(dist)) << 32) | uint32_t(rank); }
 inline int32_t dist_of(uint64_t key) { return int32_t(key >> 32); }
 inline int32_t rank_of(uint64_t key) { return int32_t(key & 0xffffffffu); }
-constexpr uint64_t kUnreached = ~uint64_t(0);
-
+constexpr uint64_t kUnreached = kUnreachedKey;
 
 // Level-synchronous relaxation from `frontier` (all at distance `level`): a neighbour improves
 // when (level + 1, rank) beats what it holds. Keys are lowered with an atomic minimum, so the
@@ -179,17 +178,21 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   }
 }
 
+// Sets the samples from first_new on (distance 0) and relaxes from them. The keys of a full
+// fill are set to unreached first; flood_add starts from the clustering it is given.
+// Sets the samples from first_new on (distance 0) and relaxes from them. The keys of a full
+// fill are set to unreached first; flood_add starts from the clustering it is given.
 void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
                     int32_t first_new, Clustering& c, std::vector<int32_t>* cross_edges,
                     std::vector<int32_t>* changed) {
   const int32_t n = mesh.num_vertices();
-  std::vector<uint64_t> key(n);
+  std::vector<uint64_t>& key = c.key;
   if (first_new == 0) {  // a full fill: nothing reached yet (the clustering is not read)
+    key.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (int32_t v = 0; v < n; ++v) key[v] = kUnreached;
-  } else {
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-    for (int32_t v = 0; v < n; ++v) key[v] = c.label[v] < 0 ? kUnreached : pack(c.dist[v], c.label[v]);
+  } else if (int32_t(key.size()) != n) {
+    throw std::invalid_argument("flood_add: the clustering is not one of this mesh");
   }
   std::vector<int32_t> frontier;
   for (size_t r = size_t(first_new); r < samples.size(); ++r) {
@@ -199,24 +202,16 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
                                   std::to_string(n) + ")");
     if (key[s] != kUnreached && dist_of(key[s]) == 0)
       throw std::invalid_argument("vertex " + std::to_string(s) + " is sampled twice");
-    key[s] = pack(0, static_cast<int32_t>(r));
+    key[s] = cluster_key(0, static_cast<int32_t>(r));
     frontier.push_back(s);
   }
   relax_levels(mesh, layout, std::move(frontier), 0, key, cross_edges, changed);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
-    c.label[v] = key[v] == kUnreached ? -1 : rank_of(key[v]);
-    c.dist[v] = key[v] == kUnreached ? INT_MAX : dist_of(key[v]);
-  }
 }
 
 }  // namespace
 
 void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples, Clustering& out,
            std::vector<int32_t>* cross_edges) {
-  const int32_t n = mesh.num_vertices();
-  out.label.resize(n);  // every entry is written by the fill
-  out.dist.resize(n);
   if (cross_edges) cross_edges->clear();
   seed_and_relax(mesh, layout, samples, 0, out, cross_edges, nullptr);
 }
@@ -232,7 +227,7 @@ int32_t step_towards_sample(const Mesh& mesh, const FeatureLayout& layout, const
   int32_t best = -1;
   for (int32_t j = ao[x]; j < ao[x + 1]; ++j) {
     const int32_t p = adj[j];
-    if (c.label[p] != c.label[x] || c.dist[p] != c.dist[x] - 1) continue;
+    if (c.label(p) != c.label(x) || c.dist(p) != c.dist(x) - 1) continue;
     // The fill could not come this way (edge ids are read at feature vertices only).
     if (layout.vertex_feature[x] && !layout.edge_feature[mesh.adjacency_edge()[j]]) continue;
     if (best < 0 || p < best) best = p;

@@ -60,11 +60,11 @@ std::vector<int32_t> splitting_vertices(const Mesh& mesh, const Clustering& c, c
       if (w < 0) return true;
       const bool av = !avoid.empty() && avoid[v], aw = !avoid.empty() && avoid[w];
       if (av != aw) return aw;
-      return c.dist[v] > c.dist[w];
+      return c.dist(v) > c.dist(w);
     };
     for (int32_t v = 0; v < n; ++v) {
-      const int32_t s = c.label[v];
-      if (s < 0 || !wanted[s] || c.dist[v] == 0) continue;
+      const int32_t s = c.label(v);
+      if (s < 0 || !wanted[s] || c.dist(v) == 0) continue;
       if (better(v, best[s])) best[s] = v;
     }
     std::vector<uint8_t> neighbours(num_samples, 0);
@@ -80,7 +80,7 @@ std::vector<int32_t> splitting_vertices(const Mesh& mesh, const Clustering& c, c
       const auto& ao = mesh.adjacency_offsets();
       const int32_t sample_vertex = samples[s];
       for (int32_t i = ao[sample_vertex]; i < ao[sample_vertex + 1]; ++i) {
-        const int32_t t = c.label[mesh.adjacency()[i]];
+        const int32_t t = c.label(mesh.adjacency()[i]);
         if (t >= 0 && t != s) neighbours[t] = 1;
       }
     }
@@ -145,7 +145,7 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   // repeated outwards), so every input vertex maps to an output vertex.
   // Only vertices of clusters absorbed at the start ever change, so the passes visit just them,
   // in vertex order as passes over every vertex did (found by one parallel scan; usually none).
-  std::vector<int32_t>& label = clustering.label;
+  auto label = [&clustering](int32_t v) { return clustering.label(v); };
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
   std::vector<int32_t> orphans;
@@ -157,21 +157,21 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
       auto& mine = found[omp_get_thread_num()];
 #pragma omp for schedule(static)
       for (int32_t v = 0; v < n; ++v)
-        if (label[v] >= 0 && partition.absorbed[label[v]]) mine.push_back(v);
+        if (label(v) >= 0 && partition.absorbed[label(v)]) mine.push_back(v);
     }
     for (const auto& list : found) orphans.insert(orphans.end(), list.begin(), list.end());
   }
   for (bool changed = !orphans.empty(); changed;) {
     changed = false;
     for (int32_t v : orphans) {
-      if (!partition.absorbed[label[v]]) continue;
+      if (!partition.absorbed[label(v)]) continue;
       int32_t best = -1;
       for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
-        const int32_t l = label[adj[i]];
+        const int32_t l = label(adj[i]);
         if (l >= 0 && !partition.absorbed[l] && (best < 0 || l < best)) best = l;
       }
       if (best >= 0) {
-        label[v] = best;
+        clustering.relabel(v, best);
         changed = true;
       }
     }
@@ -217,10 +217,10 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   const auto& source = mesh.vertex_source();
   for (auto& v : result.kept) v = source[v];
   for (auto& v : samples) v = source[v];
-  result.labels.resize(label.size());
-  const int64_t n = int64_t(label.size());
+  result.labels.resize(clustering.key.size());
+  const int64_t n = int64_t(clustering.key.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int64_t v = 0; v < n; ++v) result.labels[source[v]] = label[v] >= 0 ? output_index[label[v]] : -1;
+  for (int64_t v = 0; v < n; ++v) result.labels[source[v]] = label(v) >= 0 ? output_index[label(v)] : -1;
   result.samples = std::move(samples);
   result.seconds_output = seconds_since(start);
   return result;
@@ -235,8 +235,8 @@ int32_t budget_tolerance(int32_t target) { return int32_t(0.005 * target); }
 std::vector<int32_t> widest_clusters(const Clustering& c, const std::vector<uint8_t>& absorbed, int32_t count,
                                      const std::vector<int32_t>& excluded) {
   std::vector<int32_t> radius(absorbed.size(), 0);
-  for (size_t v = 0; v < c.label.size(); ++v)
-    if (c.label[v] >= 0) radius[c.label[v]] = std::max(radius[c.label[v]], c.dist[v]);
+  for (int32_t v = 0; v < c.num_vertices(); ++v)
+    if (c.label(v) >= 0) radius[c.label(v)] = std::max(radius[c.label(v)], c.dist(v));
   for (int32_t s : excluded) radius[s] = 0;
   std::vector<int32_t> ranks;
   for (int32_t s = 0; s < int32_t(absorbed.size()); ++s)
@@ -336,7 +336,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     added.insert(added.end(), split.begin(), split.end());
     std::sort(added.begin(), added.end());
     added.erase(std::unique(added.begin(), added.end()), added.end());
-    added.erase(std::remove_if(added.begin(), added.end(), [&](int32_t v) { return clustering.dist[v] == 0; }),
+    added.erase(std::remove_if(added.begin(), added.end(), [&](int32_t v) { return clustering.dist(v) == 0; }),
                 added.end());
     if (added.empty() && !clean) {
       // Every cluster named is a single vertex and so are its neighbours (seen with creases
@@ -356,9 +356,9 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       const auto& ao = mesh.adjacency_offsets();
       const auto& adj = mesh.adjacency();
       for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-        if (clustering.label[v] < 0 || clustering.dist[v] == 0) continue;
+        if (clustering.label(v) < 0 || clustering.dist(v) == 0) continue;
         for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
-          const int32_t l = clustering.label[adj[i]];
+          const int32_t l = clustering.label(adj[i]);
           if (l >= 0 && named[l]) {
             added.push_back(v);
             break;

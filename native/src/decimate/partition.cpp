@@ -30,7 +30,7 @@ void seed_unreached(const Mesh& mesh, const Clustering& c, Partition& out) {
   std::vector<uint8_t> seen(n, 0);
   std::vector<int32_t> stack;
   for (int32_t v = 0; v < n; ++v) {
-    if (c.label[v] >= 0 || vfo[v] == vfo[v + 1] || seen[v]) continue;
+    if (c.label(v) >= 0 || vfo[v] == vfo[v + 1] || seen[v]) continue;
     out.new_samples.push_back(v);
     seen[v] = 1;
     stack.push_back(v);
@@ -40,7 +40,7 @@ void seed_unreached(const Mesh& mesh, const Clustering& c, Partition& out) {
       ++out.issues.unreached;
       for (int32_t i = ao[x]; i < ao[x + 1]; ++i) {
         const int32_t u = adj[i];
-        if (!seen[u] && c.label[u] < 0) {
+        if (!seen[u] && c.label(u) < 0) {
           seen[u] = 1;
           stack.push_back(u);
         }
@@ -74,23 +74,23 @@ std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layou
   // 6 chi = sum over the cluster's vertices of the layout's per-vertex constant, corrected by
   // the edges and faces the cluster shares with others (see FeatureLayout::chi_constant).
   std::vector<int64_t> chi6(num_samples, 0);
-  const auto& label = c.label;
+  auto label = [&c](int32_t v) { return c.label(v); };
   for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-    if (label[v] >= 0) chi6[label[v]] += layout.chi_constant[v];
+    if (label(v) >= 0) chi6[label(v)] += layout.chi_constant[v];
   const auto& faces = mesh.faces();
   const auto& fe = mesh.face_edges();
   const auto& efo = mesh.edge_face_offsets();
   const auto& ef = mesh.edge_faces();
   const auto& ev = mesh.edge_vertices();
   for (int32_t f = 0; f < mesh.num_faces(); ++f) {
-    const int32_t la = label[faces[3 * size_t(f)]], lb = label[faces[3 * size_t(f) + 1]],
-                  lc = label[faces[3 * size_t(f) + 2]];
+    const int32_t la = label(faces[3 * size_t(f)]), lb = label(faces[3 * size_t(f) + 1]),
+                  lc = label(faces[3 * size_t(f) + 2]);
     if (la == lb && lb == lc) continue;
     chi6[la] -= 2, chi6[lb] -= 2, chi6[lc] -= 2;
     for (int s = 0; s < 3; ++s) {
       const int32_t e = fe[3 * size_t(f) + s];
       if (ef[efo[e]] != f) continue;  // each edge once, from its first face
-      const int32_t lx = label[ev[2 * size_t(e)]], ly = label[ev[2 * size_t(e) + 1]];
+      const int32_t lx = label(ev[2 * size_t(e)]), ly = label(ev[2 * size_t(e) + 1]);
       if (lx == ly) continue;
       const int32_t copies = layout.edge_copies(mesh, e);
       chi6[lx] += 3 * copies, chi6[ly] += 3 * copies;
@@ -105,12 +105,12 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   Partition out;
   const int32_t n = mesh.num_vertices();
   const int32_t k = static_cast<int32_t>(samples.size());
-  const auto& label = c.label;
+  auto label = [&c](int32_t v) { return c.label(v); };
   const auto& vfo = mesh.vertex_face_offsets();
   int unreached = 0;
 #pragma omp parallel for schedule(static) reduction(| : unreached) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v)
-    if (label[v] < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
+    if (label(v) < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
   if (unreached) {
     seed_unreached(mesh, c, out);
     return out;  // the other checks need every vertex in a cluster
@@ -124,8 +124,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   EmitState local;
   EmitState& emit = state ? *state : local;
   auto three_clusters = [&](int32_t f) {
-    const int32_t la = label[faces[3 * size_t(f)]], lb = label[faces[3 * size_t(f) + 1]],
-                  lc = label[faces[3 * size_t(f) + 2]];
+    const int32_t la = label(faces[3 * size_t(f)]), lb = label(faces[3 * size_t(f) + 1]),
+                  lc = label(faces[3 * size_t(f) + 2]);
     return uint8_t(la != lb && lb != lc && lc != la);
   };
   if (emit.valid) {
@@ -168,7 +168,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
           const int32_t f = found[list][i];
           const size_t at = start[list] + i;
           out.source_face[at] = f;
-          for (int j = 0; j < 3; ++j) out.triangles[3 * at + j] = label[faces[3 * size_t(f) + j]];
+          for (int j = 0; j < 3; ++j) out.triangles[3 * at + j] = label(faces[3 * size_t(f) + j]);
         }
     }
   }
@@ -177,7 +177,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // --- feature pairs: clusters adjacent along a feature curve, with the copies of their edge ---
   std::unordered_map<uint64_t, int32_t> feature_copies;
   for (int32_t e : layout.feature_edges) {
-    const int32_t lx = label[mesh.edge_vertices()[2 * size_t(e)]], ly = label[mesh.edge_vertices()[2 * size_t(e) + 1]];
+    const int32_t lx = label(mesh.edge_vertices()[2 * size_t(e)]), ly = label(mesh.edge_vertices()[2 * size_t(e) + 1]);
     if (lx != ly) feature_copies[pair_key(lx, ly)] += layout.edge_copies(mesh, e);
   }
 
@@ -421,8 +421,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
       std::vector<int32_t> widest(num_components, -1);
       for (int32_t v = 0; v < n; ++v) {
         const int32_t comp = mesh.component()[v];
-        if (label[v] < 0 || !failing[comp]) continue;
-        if (widest[comp] < 0 || c.dist[v] > c.dist[widest[comp]]) widest[comp] = v;
+        if (label(v) < 0 || !failing[comp]) continue;
+        if (widest[comp] < 0 || c.dist(v) > c.dist(widest[comp])) widest[comp] = v;
       }
       for (int32_t v : widest)
         if (v >= 0) out.new_samples.push_back(v);
@@ -437,8 +437,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     for (int32_t i = b; i < e; ++i) {
       const int32_t v = layout.curve_vertices[i];
       const int32_t w = layout.curve_vertices[i + 1 < e ? i + 1 : b];
-      changes += label[v] != label[w];
-      if (c.dist[v] > 0 && (farthest < 0 || c.dist[v] > c.dist[farthest])) farthest = v;
+      changes += label(v) != label(w);
+      if (c.dist(v) > 0 && (farthest < 0 || c.dist(v) > c.dist(farthest))) farthest = v;
     }
     if (changes < 3) {
       ++out.issues.short_loop;
@@ -457,9 +457,9 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     int32_t seen[3] = {-1, -1, -1}, distinct = 0, farthest = -1;
     for (int32_t i = b; i < e; ++i) {
       const int32_t v = layout.boundary_loop_vertices[i];
-      const int32_t l = label[v];
+      const int32_t l = label(v);
       if (distinct < 3 && l != seen[0] && l != seen[1] && l != seen[2]) seen[distinct++] = l;
-      if (c.dist[v] > 0 && (farthest < 0 || c.dist[v] > c.dist[farthest])) farthest = v;
+      if (c.dist(v) > 0 && (farthest < 0 || c.dist(v) > c.dist(farthest))) farthest = v;
     }
     if (distinct < 3 && e - b >= 3) {
       ++out.issues.short_loop;

@@ -11,7 +11,7 @@ std::vector<double> filtered_positions(const Mesh& mesh, const FeatureLayout& la
                                        const std::vector<int32_t>& samples, const Clustering& clustering) {
   const int32_t k = static_cast<int32_t>(samples.size());
   const int32_t n = mesh.num_vertices();
-  const auto& label = clustering.label;
+  auto label = [&clustering](int32_t v) { return clustering.label(v); };
   const auto& faces = mesh.faces();
   // Quadrics hold squared areas: with coordinates of 1e80 they overflow (all-NaN output), with
   // 1e-80 they underflow. Work in coordinates centred on the bounding box and scaled by its
@@ -37,18 +37,18 @@ std::vector<double> filtered_positions(const Mesh& mesh, const FeatureLayout& la
     const int32_t* t = &faces[3 * size_t(f)];
     Quadric plane;
     plane.add_triangle(at(t[0]), at(t[1]), at(t[2]));
-    const int32_t l[3] = {label[t[0]], label[t[1]], label[t[2]]};
+    const int32_t l[3] = {label(t[0]), label(t[1]), label(t[2])};
     for (int j = 0; j < 3; ++j)
       if (!((j > 0 && l[j] == l[0]) || (j > 1 && l[j] == l[1]))) quadrics[l[j]].add(plane);  // each cluster once
   }
   // Radius of each cluster around its sample: the bound on how far the sample may move.
   std::vector<double> radius2(k, 0.0);
   for (int32_t v = 0; v < n; ++v) {
-    if (label[v] < 0) continue;
+    if (label(v) < 0) continue;
     const double* p = at(v);
-    const double* s = at(samples[label[v]]);
+    const double* s = at(samples[label(v)]);
     const double d2 = (p[0] - s[0]) * (p[0] - s[0]) + (p[1] - s[1]) * (p[1] - s[1]) + (p[2] - s[2]) * (p[2] - s[2]);
-    radius2[label[v]] = std::max(radius2[label[v]], d2);
+    radius2[label(v)] = std::max(radius2[label(v)], d2);
   }
 #pragma omp parallel for schedule(static) if (k >= kParallelMin)
   for (int32_t s = 0; s < k; ++s) {

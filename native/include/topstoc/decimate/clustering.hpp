@@ -16,10 +16,24 @@
 
 namespace topstoc {
 
+/// Per vertex, (hop distance, rank of its sample) packed into one word, distance high: one
+/// integer comparison orders them as the definition does, and the flood lowers both with one
+/// atomic minimum. The fill writes the words in place, so a flood needs no second copy and
+/// no pass to unpack them.
 struct Clustering {
-  std::vector<int32_t> label;  ///< rank of the vertex's sample, -1 if unreached
-  std::vector<int32_t> dist;   ///< hop distance to that sample (INT32_MAX if unreached)
+  std::vector<uint64_t> key;
+  /// Rank of v's sample, -1 if no sample reaches v.
+  int32_t label(int32_t v) const { return int32_t(uint32_t(key[v])); }
+  /// Hop distance from v to its sample, INT32_MAX if no sample reaches v.
+  int32_t dist(int32_t v) const { return int32_t(key[v] >> 32); }
+  /// v now belongs to the cluster of rank `rank` (its distance is kept).
+  void relabel(int32_t v, int32_t rank) { key[v] = (key[v] & ~uint64_t(0xffffffffu)) | uint32_t(rank); }
+  int32_t num_vertices() const { return static_cast<int32_t>(key.size()); }
 };
+
+/// The key of a vertex no sample reaches: distance INT32_MAX, rank -1; above every real key.
+constexpr uint64_t kUnreachedKey = (uint64_t(INT32_MAX) << 32) | 0xffffffffu;
+inline uint64_t cluster_key(int32_t dist, int32_t rank) { return (uint64_t(uint32_t(dist)) << 32) | uint32_t(rank); }
 
 /// Floods from `samples` (distinct vertex ids; rank = position). If cross_edges is given it
 /// receives every edge between two clusters, once: the faces around them are the candidates
