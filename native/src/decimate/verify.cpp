@@ -1,10 +1,13 @@
 #include "topstoc/decimate/verify.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 
 #include "../core/union_find.hpp"
+#include "topstoc/core/buffer.hpp"
 #include "topstoc/core/parallel.hpp"
 #include "link_arcs.hpp"
 #include "pinched_fans.hpp"
@@ -13,14 +16,59 @@ namespace topstoc {
 
 namespace {
 
-// Triangles around each output vertex (CSR), in triangle order.
-struct VertexTriangles {
-  std::vector<int32_t> offsets, triangles;
-  VertexTriangles(int32_t n, const std::vector<int32_t>& tris) : offsets(n + 1, 0), triangles(tris.size()) {
-    for (int32_t v : tris) ++offsets[v + 1];
-    for (int32_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
-    std::vector<int32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (size_t i = 0; i < tris.size(); ++i) triangles[fill[tris[i]]++] = int32_t(i / 3);
+// The link of every output vertex as arcs, stored contiguously per vertex (CSR): triangle
+// (a, b, c) gives a the arc b -> c, b the arc c -> a and c the arc a -> b, in triangle order.
+// Triangles with a repeated corner give none. The vertex pass then reads one short run per
+// vertex instead of its triangles scattered over the triangle array. Each thread owns a range
+// of vertices: it reads every triangle and writes only the arcs of its own vertices, so the
+// order does not depend on the number of threads.
+struct VertexArcs {
+  Buffer<int32_t> offsets;
+  Buffer<std::array<int32_t, 2>> arcs;
+  Buffer<int32_t> fill;  // per vertex: where its next arc goes
+  VertexArcs(int32_t n, const std::vector<int32_t>& tris) : offsets(n + 1), fill(n) {
+    const int64_t t = int64_t(tris.size() / 3);
+    auto valid = [&](int64_t i) {
+      const int32_t* c = &tris[3 * i];
+      return c[0] != c[1] && c[1] != c[2] && c[2] != c[0];
+    };
+    const bool parallel = t >= kParallelMin;
+    const int threads = parallel ? omp_get_max_threads() : 1;
+    std::vector<int64_t> range_arcs(threads + 1, 0);
+#pragma omp parallel num_threads(threads)
+    {
+      const int me = omp_get_thread_num(), team = omp_get_num_threads();
+      const int32_t lo = int32_t(int64_t(n) * me / team), hi = int32_t(int64_t(n) * (me + 1) / team);
+      // Counts: offsets[v + 1] holds v's (each range writes its own slots lo + 1 .. hi).
+      for (int32_t v = lo; v < hi; ++v) offsets[v + 1] = 0;
+      for (int64_t i = 0; i < t; ++i)
+        if (valid(i))
+          for (int j = 0; j < 3; ++j) {
+            const int32_t v = tris[3 * i + j];
+            if (v >= lo && v < hi) ++offsets[v + 1];
+          }
+      int64_t sum = 0;
+      for (int32_t v = lo; v < hi; ++v) sum += offsets[v + 1];
+      range_arcs[me + 1] = sum;
+#pragma omp barrier
+#pragma omp single
+      {
+        for (int r = 0; r < team; ++r) range_arcs[r + 1] += range_arcs[r];
+        arcs.resize(range_arcs[team]);
+        offsets[0] = 0;
+      }
+      // Ends: offsets[v + 1] is where v's arcs end and v + 1's start.
+      int64_t end = range_arcs[me];
+      for (int32_t v = lo; v < hi; ++v) offsets[v + 1] = int32_t(end += offsets[v + 1]);
+#pragma omp barrier
+      for (int32_t v = lo; v < hi; ++v) fill[v] = offsets[v];
+      for (int64_t i = 0; i < t; ++i) {
+        if (!valid(i)) continue;
+        const int32_t* c = &tris[3 * i];
+        for (int j = 0; j < 3; ++j)
+          if (c[j] >= lo && c[j] < hi) arcs[fill[c[j]]++] = {c[(j + 1) % 3], c[(j + 2) % 3]};
+      }
+    }
   }
 };
 
@@ -62,46 +110,63 @@ OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const st
   const int32_t n = static_cast<int32_t>(kept.size());
   const int32_t t = static_cast<int32_t>(triangles.size() / 3);
   const int32_t num_components = mesh.num_components();
+  int32_t nonfinite = 0;
+#pragma omp parallel for schedule(static) reduction(+ : nonfinite) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v)
-    if (!std::isfinite(positions[3 * size_t(v)]) || !std::isfinite(positions[3 * size_t(v) + 1]) ||
-        !std::isfinite(positions[3 * size_t(v) + 2]))
-      ++check.nonfinite;
+    nonfinite += !std::isfinite(positions[3 * size_t(v)]) || !std::isfinite(positions[3 * size_t(v) + 1]) ||
+                 !std::isfinite(positions[3 * size_t(v) + 2]);
+  check.nonfinite = nonfinite;
 
   // Which input components are manifold, oriented surfaces (the guarantee's domain), allowing
   // pinched vertices: their fans are compared one by one below.
   const PinchedVertices pinched = find_pinched_vertices(mesh);
   std::vector<uint8_t> manifold(num_components, 1);
-  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-    if (mesh.component()[v] >= 0 && !mesh.manifold_vertex()[v]) manifold[mesh.component()[v]] = 0;
+  const MeshReport& report = mesh.report();
+  if (report.nonmanifold_vertices + report.nonmanifold_edges + report.inconsistent_edges > 0)  // else all are
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+      if (mesh.component()[v] >= 0 && !mesh.manifold_vertex()[v]) manifold[mesh.component()[v]] = 0;
   for (int32_t comp = 0; comp < num_components && pinched.count > 0; ++comp)
     if (pinched.pinched_surface[comp]) manifold[comp] = 1;
   std::vector<int32_t> component_of(n);
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) component_of[v] = mesh.component()[kept[v]];
 
-  // Per triangle: repeated corners, mixed components, zero area.
+  // Per triangle: repeated corners, mixed components, zero area; triangles per component
+  // (counted per thread, summed after: integers, so the order does not matter).
   std::vector<int32_t> triangles_in(num_components, 0);
   std::vector<int64_t> euler(num_components, 0);  // V - E + F of the output piece
-  for (int32_t i = 0; i < t; ++i) {
-    const int32_t* c = &triangles[3 * size_t(i)];
-    if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) {
-      ++check.repeated_corner;
-      continue;
+  int32_t repeated_corner = 0, mixed_triangles = 0, zero_area = 0;
+#pragma omp parallel reduction(+ : repeated_corner, mixed_triangles, zero_area) if (t >= kParallelMin)
+  {
+    std::vector<int32_t> mine(num_components, 0);
+#pragma omp for schedule(static)
+    for (int32_t i = 0; i < t; ++i) {
+      const int32_t* c = &triangles[3 * size_t(i)];
+      if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) {
+        ++repeated_corner;
+        continue;
+      }
+      const int32_t comp = component_of[c[0]];
+      if (component_of[c[1]] != comp || component_of[c[2]] != comp) ++mixed_triangles;
+      ++mine[comp];
+      const double* p[3] = {&positions[3 * size_t(c[0])], &positions[3 * size_t(c[1])], &positions[3 * size_t(c[2])]};
+      double u[3], w[3], longest = 0;
+      for (int a = 0; a < 3; ++a) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
+      for (int j = 0; j < 3; ++j) {
+        double d = 0;
+        for (int a = 0; a < 3; ++a) d += (p[(j + 1) % 3][a] - p[j][a]) * (p[(j + 1) % 3][a] - p[j][a]);
+        longest = std::max(longest, d);
+      }
+      const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
+      if (!(std::sqrt(cx * cx + cy * cy + cz * cz) > 1e-9 * longest)) ++zero_area;
     }
-    const int32_t comp = component_of[c[0]];
-    if (component_of[c[1]] != comp || component_of[c[2]] != comp) ++check.mixed_triangles;
-    ++triangles_in[comp];
-    ++euler[comp];
-    const double* p[3] = {&positions[3 * size_t(c[0])], &positions[3 * size_t(c[1])], &positions[3 * size_t(c[2])]};
-    double u[3], w[3], longest = 0;
-    for (int a = 0; a < 3; ++a) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
-    for (int j = 0; j < 3; ++j) {
-      double d = 0;
-      for (int a = 0; a < 3; ++a) d += (p[(j + 1) % 3][a] - p[j][a]) * (p[(j + 1) % 3][a] - p[j][a]);
-      longest = std::max(longest, d);
-    }
-    const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
-    if (!(std::sqrt(cx * cx + cy * cy + cz * cz) > 1e-9 * longest)) ++check.zero_area;
+#pragma omp critical(topstoc_output_triangles)
+    for (int32_t comp = 0; comp < num_components; ++comp) triangles_in[comp] += mine[comp];
   }
+  check.repeated_corner = repeated_corner;
+  check.mixed_triangles = mixed_triangles;
+  check.zero_area = zero_area;
+  for (int32_t comp = 0; comp < num_components; ++comp) euler[comp] += triangles_in[comp];
   for (int32_t comp = 0; comp < num_components; ++comp)
     if (triangles_in[comp] == 0) ++check.lost_components;
 
@@ -109,7 +174,7 @@ OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const st
   // counts and directions, duplicates, the fan, and the boundary. Vertices share only the sets
   // they join (union-finds whose roots do not depend on the order of joins) and the counts, so
   // they run on all threads and the result does not depend on how many.
-  VertexTriangles around(n, triangles);
+  const VertexArcs around(n, triangles);
   SharedUnionFind pieces(n), boundary(n);
   std::vector<uint8_t> on_boundary(n, 0), used(n, 0);
   int32_t duplicate = 0, nonmanifold_edges = 0, inconsistent_edges = 0, nonmanifold_vertices = 0;
@@ -124,25 +189,23 @@ OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const st
       link.clear();
       corner_pairs.clear();
       for (int32_t i = around.offsets[v]; i < around.offsets[v + 1]; ++i) {
-        const int32_t* c = &triangles[3 * size_t(around.triangles[i])];
-        if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
-        const int j = c[0] == v ? 0 : c[1] == v ? 1 : 2;
-        const int32_t a = c[(j + 1) % 3], b = c[(j + 2) % 3];
+        const int32_t a = around.arcs[i][0], b = around.arcs[i][1];
         link.add(a, b);
-        pieces.unite(v, a);
-        if (v < a && v < b) corner_pairs.push_back({std::min(a, b), std::max(a, b)});
+        if (v < a && v < b) {
+          // A triangle over the same three vertices as an earlier one (at its lowest corner).
+          const std::array<int32_t, 2> pair = {std::min(a, b), std::max(a, b)};
+          duplicate += std::count(corner_pairs.begin(), corner_pairs.end(), pair) > 0;
+          corner_pairs.push_back(pair);
+        }
       }
       if (link.arcs == 0) continue;
       used[v] = 1;
-      std::sort(corner_pairs.begin(), corner_pairs.end());
-      for (size_t i = 1; i < corner_pairs.size(); ++i)
-        if (corner_pairs[i] == corner_pairs[i - 1]) ++duplicate;
       const int32_t comp = component_of[v];
       ++my_euler[comp];
       bool crowded = false;
       for (const auto& nb : link.neighbours) {
         const int32_t count = nb.in + nb.out;
-        if (nb.id > v) --my_euler[comp];
+        if (nb.id > v) --my_euler[comp], pieces.unite(v, nb.id);  // each edge once
         if (count > 2 || nb.in > 1 || nb.out > 1) crowded = true;
         if (!manifold[comp]) continue;
         if (nb.id > v && count > 2) ++nonmanifold_edges;
