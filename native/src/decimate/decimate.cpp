@@ -179,6 +179,7 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   const std::vector<double> filtered =
       placement == Placement::Filtered ? filtered_positions(mesh, layout, samples, clustering) : std::vector<double>();
   result.vertices.resize(3 * result.kept.size());
+#pragma omp parallel for schedule(static) if (k >= kParallelMinCostly)
   for (int32_t s = 0; s < k; ++s) {
     if (output_index[s] < 0) continue;
     for (int j = 0; j < 3; ++j)
@@ -191,12 +192,19 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
       for (int j = 0; j < 3; ++j) result.vertices[3 * size_t(output_index[s]) + j] = mesh.position(samples[s])[j];
   }
   // A sample with one sector has one corner to copy attributes from, whatever the triangle:
-  // find it once per sample (others walk per output corner, see attribute_corner).
+  // find it once per sample (others walk per output corner, see attribute_corner). Each is a
+  // chain of four reads far apart in memory (its first face, the face's corners and caller id),
+  // so the loop runs on all threads from a few thousand samples on, and the first reads are
+  // fetched a few samples ahead (horse at 10 %: 7.7 ms on one thread before).
   std::vector<int32_t> single_corner(k, -1);
-#pragma omp parallel for schedule(static) if (k >= kParallelMin)
-  for (int32_t s = 0; s < k; ++s)
+  const auto& vfo = mesh.vertex_face_offsets();
+#pragma omp parallel for schedule(static) if (k >= kParallelMinCostly)
+  for (int32_t s = 0; s < k; ++s) {
+    if (s + 8 < k) __builtin_prefetch(&vfo[samples[s + 8]]);
+    if (s + 4 < k) __builtin_prefetch(&mesh.vertex_faces()[vfo[samples[s + 4]]]);
     if (output_index[s] >= 0 && layout.sectors[samples[s]] <= 1)
       single_corner[s] = attribute_corner(mesh, layout, clustering, -1, -1, samples[s]);
+  }
   const size_t t = partition.source_face.size();
   result.triangles.resize(3 * t);
   result.face_source.resize(t);
