@@ -128,48 +128,51 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
                   lc = label(faces[3 * size_t(f) + 2]);
     return uint8_t(la != lb && lb != lc && lc != la);
   };
+  // Every face is tested (a first check), or only those around relabelled vertices (later
+  // rounds) or the candidates (fast path). Then the emitting faces are written in face order:
+  // each thread counts those of its run of faces (static schedule, the same runs in both loops),
+  // and writes them from where the runs before it end.
+  const bool test_all = !emit.valid && !candidate_faces;
   if (emit.valid) {
-    // Only faces around relabelled vertices can have changed.
     const auto& vf = mesh.vertex_faces();
     for (int32_t v : emit.changed)
       for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) emit.emits[vf[i]] = three_clusters(vf[i]);
-  } else {
+  } else if (candidate_faces) {
     emit.emits.assign(m, 0);
-    const int64_t count = candidate_faces ? int64_t(candidate_faces->size()) : int64_t(m);
+    const int64_t count = int64_t(candidate_faces->size());
 #pragma omp parallel for schedule(static) if (count >= kParallelMin)
-    for (int64_t i = 0; i < count; ++i) {
-      const int32_t f = candidate_faces ? (*candidate_faces)[i] : int32_t(i);
-      emit.emits[f] = three_clusters(f);
-    }
-    emit.valid = true;
+    for (int64_t i = 0; i < count; ++i) emit.emits[(*candidate_faces)[i]] = three_clusters((*candidate_faces)[i]);
+  } else {
+    emit.emits.resize(m);
   }
+  emit.valid = true;
   emit.changed.clear();
-  // Emitting faces in face order: each thread collects one contiguous run (static schedule) and
-  // the runs are joined in thread order. (A separate pass: pushing while testing made the test
-  // loop slower than both loops together.)
-  std::vector<std::vector<int32_t>> found(threads);
-#pragma omp parallel if (m >= kParallelMin)
+  const int team = m >= kParallelMin ? threads : 1;
+  std::vector<int64_t> run_start(team + 1, 0);
+#pragma omp parallel num_threads(team)
   {
-    auto& mine = found[omp_get_thread_num()];
+    const int me = omp_get_thread_num();
+    int64_t mine = 0;
 #pragma omp for schedule(static)
-    for (int32_t f = 0; f < m; ++f)
-      if (emit.emits[f]) mine.push_back(f);
-  }
-  {
-    std::vector<size_t> start(threads + 1, 0);
-    for (int i = 0; i < threads; ++i) start[i + 1] = start[i] + found[i].size();
-    out.source_face.resize(start[threads]);
-    out.triangles.resize(3 * start[threads]);
-#pragma omp parallel if (start[threads] >= size_t(kParallelMin) / 4)
+    for (int32_t f = 0; f < m; ++f) {
+      if (test_all) emit.emits[f] = three_clusters(f);
+      mine += emit.emits[f];
+    }
+    run_start[me + 1] = mine;
+#pragma omp barrier
+#pragma omp single
     {
-      const int me = omp_get_thread_num();
-      for (int list = me; list < threads; list += omp_get_num_threads())
-        for (size_t i = 0; i < found[list].size(); ++i) {
-          const int32_t f = found[list][i];
-          const size_t at = start[list] + i;
-          out.source_face[at] = f;
-          for (int j = 0; j < 3; ++j) out.triangles[3 * at + j] = label(faces[3 * size_t(f) + j]);
-        }
+      for (int r = 0; r < omp_get_num_threads(); ++r) run_start[r + 1] += run_start[r];
+      out.source_face.resize(run_start[omp_get_num_threads()]);
+      out.triangles.resize(3 * out.source_face.size());
+    }
+    int64_t at = run_start[me];
+#pragma omp for schedule(static)
+    for (int32_t f = 0; f < m; ++f) {
+      if (!emit.emits[f]) continue;
+      out.source_face[at] = f;
+      for (int j = 0; j < 3; ++j) out.triangles[3 * at + j] = label(faces[3 * size_t(f) + j]);
+      ++at;
     }
   }
   const int32_t emitted = static_cast<int32_t>(out.source_face.size());
@@ -383,7 +386,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
         marks.add(int32_t(key >> 32)), marks.add(int32_t(key & 0xffffffffu));
       }
   }
-  {
+  if (any_dropped) {
     // Dropped pillows leave the output.
     int32_t kept = 0;
     for (int32_t i = 0; i < emitted; ++i) {
@@ -397,10 +400,15 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
 
   // --- Euler characteristic per component -------------------------------------------------------
   // A component that lost all its triangles fails too (a torus has chi = 0 with or without).
+  // (Triangles are counted by their first corner's sample: its component is the face's, and
+  // the samples' components are k reads instead of a face and a vertex far apart per triangle.)
   std::vector<int64_t> component_chi6(num_components, 0);
-  std::vector<int32_t> component_triangles(num_components, 0);
-  for (int32_t s = 0; s < k; ++s) component_chi6[mesh.component()[samples[s]]] += chi6_out[s];
-  for (int32_t f : out.source_face) ++component_triangles[mesh.component()[faces[3 * size_t(f)]]];
+  std::vector<int32_t> component_triangles(num_components, 0), sample_component(k);
+  for (int32_t s = 0; s < k; ++s) {
+    sample_component[s] = mesh.component()[samples[s]];
+    component_chi6[sample_component[s]] += chi6_out[s];
+  }
+  for (size_t i = 0; i < out.source_face.size(); ++i) ++component_triangles[sample_component[out.triangles[3 * i]]];
   std::vector<uint8_t> failing(num_components, 0);
   for (int32_t comp = 0; comp < num_components; ++comp)
     if (component_chi6[comp] != 6 * mesh.component_euler()[comp] || component_triangles[comp] == 0) {
@@ -473,7 +481,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     // The samples' positions gathered once, in rank order: the triangles then read a compact
     // array instead of the whole mesh's.
     std::vector<double> at(3 * size_t(k));
-#pragma omp parallel for schedule(static) if (k >= kParallelMin)
+#pragma omp parallel for schedule(static) if (k >= kParallelMinCostly)
     for (int32_t s = 0; s < k; ++s)
       for (int j = 0; j < 3; ++j) at[3 * size_t(s) + j] = mesh.position(samples[s])[j];
     std::vector<uint8_t> sliver(t, 0);
