@@ -44,15 +44,32 @@ _INTERPOLATED = {"FLOAT", "FLOAT2", "FLOAT_VECTOR", "FLOAT_COLOR", "BYTE_COLOR"}
 
 @dataclass
 class MeshArrays:
-    """A Blender mesh as the engine sees it (object-local coordinates)."""
+    """A Blender mesh as the engine sees it (object-local coordinates).
+
+    For a mesh of triangles stored in loop order (Blender's usual layout) the triangles are the
+    polygons and their corners the loops in order: ``triangle_polygon`` and ``triangle_loops``
+    are then made when first read (``None`` given), since the Live Preview's start, which reads
+    the mesh on the main thread, rarely needs them (two arrays of 6 and 19 MB on the horse)."""
 
     vertices: np.ndarray          #: (n, 3) float64
     triangles: np.ndarray         #: (m, 3) int32 vertex ids (loop triangles)
-    triangle_polygon: np.ndarray  #: (m,) int32 polygon of each triangle
-    triangle_loops: np.ndarray    #: (m, 3) int32 loop of each triangle corner
+    _triangle_polygon: Optional[np.ndarray]  #: (m,) int32 polygon of each triangle
+    _triangle_loops: Optional[np.ndarray]    #: (m, 3) int32 loop of each triangle corner
     polygon_material: np.ndarray  #: (p,) int32 material slot per polygon
     num_edges: int
     num_loops: int
+
+    @property
+    def triangle_polygon(self) -> np.ndarray:
+        if self._triangle_polygon is None:
+            self._triangle_polygon = np.arange(len(self.triangles), dtype=np.int32)
+        return self._triangle_polygon
+
+    @property
+    def triangle_loops(self) -> np.ndarray:
+        if self._triangle_loops is None:
+            self._triangle_loops = np.arange(3 * len(self.triangles), dtype=np.int32).reshape(-1, 3)
+        return self._triangle_loops
 
     @property
     def triangle_material(self) -> np.ndarray:
@@ -127,8 +144,7 @@ def read_mesh(mesh: bpy.types.Mesh) -> MeshArrays:
     corners = corner_vertices(mesh)
     if _triangle_loop_starts(mesh) is not None:  # a triangle mesh: the loop triangles are the polygons
         m = len(mesh.polygons)
-        triangle_loops = np.arange(3 * m, dtype=np.int32).reshape(m, 3)
-        triangle_polygons = np.arange(m, dtype=np.int32)
+        triangle_loops = triangle_polygons = None  # in order: made when read (MeshArrays)
         triangles = corners.reshape(m, 3)
     else:
         mesh.calc_loop_triangles()
