@@ -275,8 +275,10 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
   const auto table = vertex_quadric_table(mesh, layout);
   for (int i = 0; i < 3; ++i) setup.center[i] = table->center[i];
   setup.extent = table->extent;
-  std::vector<int32_t> label(mesh.num_vertices());
-  for (int32_t v = 0; v < mesh.num_vertices(); ++v) label[v] = result.labels[source[v]];
+  const int32_t num_input = mesh.num_vertices();
+  std::vector<int32_t> label(num_input);
+#pragma omp parallel for schedule(static) if (num_input >= kParallelMin)
+  for (int32_t v = 0; v < num_input; ++v) label[v] = result.labels[source[v]];
   setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *table);
   setup.world = result.vertices;
   setup.positions.resize(3 * size_t(n));
@@ -355,17 +357,28 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
     result.refine_collapses += collapser.run(stop);
     if (params.refit) {
       // Each vertex may move as far as its cluster reaches (as filtered placement allows).
+      // (Survivors found first: the lookup compresses paths, so it runs on one thread; the
+      // maxima per thread are merged after, which gives the same whatever the thread count.)
+      std::vector<int32_t> survivor(n);
+      for (int32_t v = 0; v < n; ++v) survivor[v] = collapser.survivor(v);
       std::vector<double> radius2(n, 0.0);
-      for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-        if (label[v] < 0) continue;
-        const int32_t s = collapser.survivor(label[v]);
-        const double* p = collapser.position(s);
-        double d2 = 0;
-        for (int i = 0; i < 3; ++i) {
-          const double d = (mesh.position(v)[i] - center[i]) * (1.0 / extent) - p[i];
-          d2 += d * d;
+#pragma omp parallel if (num_input >= kParallelMin)
+      {
+        std::vector<double> mine(n, 0.0);
+#pragma omp for schedule(static) nowait
+        for (int32_t v = 0; v < num_input; ++v) {
+          if (label[v] < 0) continue;
+          const int32_t s = survivor[label[v]];
+          const double* p = collapser.position(s);
+          double d2 = 0;
+          for (int i = 0; i < 3; ++i) {
+            const double d = (mesh.position(v)[i] - center[i]) * (1.0 / extent) - p[i];
+            d2 += d * d;
+          }
+          mine[s] = std::max(mine[s], d2);
         }
-        radius2[s] = std::max(radius2[s], d2);
+#pragma omp critical(topstoc_refit_radius)
+        for (int32_t v = 0; v < n; ++v) radius2[v] = std::max(radius2[v], mine[v]);
       }
       collapser.refit(radius2);
     }
@@ -398,8 +411,12 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
   result.triangles.resize(3 * faces);
   result.corner_source.resize(3 * faces);
   result.face_source.resize(faces);
-  for (auto& l : result.labels)
-    if (l >= 0) l = new_index[collapser.survivor(l)];
+  std::vector<int32_t> final_index(n);
+  for (int32_t v = 0; v < n; ++v) final_index[v] = new_index[collapser.survivor(v)];
+  const int64_t labels = int64_t(result.labels.size());
+#pragma omp parallel for schedule(static) if (labels >= kParallelMin)
+  for (int64_t i = 0; i < labels; ++i)
+    if (result.labels[i] >= 0) result.labels[i] = final_index[result.labels[i]];
   result.seconds_refine = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
