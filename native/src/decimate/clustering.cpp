@@ -146,7 +146,7 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
     } else {
       for (auto& list : next) list.clear();
       const int64_t words = int64_t(n) / 8;
-#pragma omp parallel if (total >= size_t(kParallelMin))
+#pragma omp parallel if (n >= kParallelMin)  // the scan reads every flag, however few are set
       {
         auto& mine = next[omp_get_thread_num()];
 #pragma omp for schedule(static)
