@@ -118,7 +118,7 @@ void sort_ascending(std::vector<double>& values) {
     std::sort(values.begin(), values.end());
     return;
   }
-  constexpr int kDigit = 11;
+  constexpr int kDigit = 16;  // 4 passes at most (11-bit digits took 5-6 on real weights)
   constexpr uint64_t kMask = (uint64_t(1) << kDigit) - 1;
   std::vector<double> other(values.size());
   std::vector<int32_t> offsets;
@@ -153,6 +153,7 @@ std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const 
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v)
     if (cls[v] == kSurface || cls[v] == kCurve) table->q[v] = importance(mesh, params, v);
+  table->surface_q.reserve(n);
   for (int32_t v = 0; v < n; ++v) {
     if (cls[v] == kSurface) table->surface_q.push_back(table->q[v]);
     else if (cls[v] == kCurve) table->curve_q.push_back(table->q[v]);
@@ -162,10 +163,14 @@ std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const 
   }
   sort_ascending(table->surface_q);
   sort_ascending(table->curve_q);
-  table->surface_sum.assign(1, 0.0);
-  for (double q : table->surface_q) table->surface_sum.push_back(table->surface_sum.back() + q);
-  table->curve_sqrt_sum.assign(1, 0.0);
-  for (double q : table->curve_q) table->curve_sqrt_sum.push_back(table->curve_sqrt_sum.back() + std::sqrt(q));
+  // Prefix sums, in order (their last bits are part of the result).
+  table->surface_sum.resize(table->surface_q.size() + 1);
+  table->surface_sum[0] = 0.0;
+  for (size_t i = 0; i < table->surface_q.size(); ++i) table->surface_sum[i + 1] = table->surface_sum[i] + table->surface_q[i];
+  table->curve_sqrt_sum.resize(table->curve_q.size() + 1);
+  table->curve_sqrt_sum[0] = 0.0;
+  for (size_t i = 0; i < table->curve_q.size(); ++i)
+    table->curve_sqrt_sum[i + 1] = table->curve_sqrt_sum[i] + std::sqrt(table->curve_q[i]);
   layout.sampling_table.set(table);
   return table;
 }
