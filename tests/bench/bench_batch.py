@@ -1,5 +1,6 @@
-"""Batch throughput: assets per minute serially in one Blender, serially without Blender, and on a
-local Dask cluster with 2 worker processes, same assets, same run; overhead per asset.
+"""Batch throughput: assets per minute serially in one Blender, serially without Blender, on a
+local Dask cluster with 2 worker processes, and as 2 chunk processes side by side (--chunk, as a
+farm runs the OpenJD template), same assets, same run; overhead per asset.
 
     PATH=/var/cache/topstoc/venv-pipeline/bin:$PATH \\
         /var/cache/topstoc/venv-pipeline/bin/python tests/bench/bench_batch.py [--count 200] [--ratio 0.3]
@@ -53,6 +54,19 @@ def timed(command, env) -> tuple:
     return seconds, before, load()
 
 
+def timed_side_by_side(commands, env) -> tuple:
+    """timed() for processes that run at the same time (wall seconds until the last ends)."""
+    before = load()
+    start = time.perf_counter()
+    running = [subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
+               for command in commands]
+    for process, command in zip(running, commands):
+        _, error = process.communicate()
+        if process.returncode != 0:
+            sys.exit(f"failed: {' '.join(map(str, command[:6]))} ...\n{error[-2000:]}")
+    return time.perf_counter() - start, before, load()
+
+
 def work_seconds(report: dict) -> float:
     return sum(entry["seconds"] for entry in report["results"])
 
@@ -92,6 +106,19 @@ def main() -> int:
                              str(out), "--ratio", args.ratio, "--workers", str(workers), "--progress", "lines"], env)
             report = json.loads((out / "topstoc-report.json").read_text())
             rows.append((label, seconds, max(1, workers), report, out, loads))
+        # The folder split into chunks run side by side, one process each with the engine on one
+        # thread (what the OpenJD template gives a farm: no Dask, each chunk its own task).
+        chunks = max(2, args.workers)
+        out = tmp / "chunks"
+        chunk_env = dict(env, OMP_NUM_THREADS="1")
+        seconds, *loads = timed_side_by_side(
+            [[sys.executable, "-m", "topstoc", "batch", "--input", str(tmp / "assets"), "--output", str(out),
+              "--ratio", args.ratio, "--workers", "0", "--chunk", f"{i}/{chunks}", "--progress", "lines"]
+             for i in range(1, chunks + 1)], chunk_env)
+        merged = {"results": [entry for i in range(1, chunks + 1)
+                              for entry in json.loads((out / f"topstoc-report-chunk{i}of{chunks}.json").read_text())["results"]]}
+        rows.append((f"{chunks} chunk processes side by side (--chunk I/{chunks} --workers 0, one thread each)",
+                     seconds, chunks, merged, out, loads))
         reference = outputs(rows[0][4])
         identical = all(outputs(row[4]) == reference for row in rows[1:])
         print("\n| mode | wall s | assets/min | work s (sum) | overhead ms/asset | load before / after |")
@@ -109,7 +136,7 @@ def main() -> int:
         for label, seconds, *_ in rows[1:]:
             print(f"{label}: {base / seconds:.2f}x the speed of '{rows[0][0]}'")
         print(f"outputs byte-identical across the modes: {identical}")
-        cluster = rows[-1][3]
+        cluster = next(row[3] for row in rows if row[0].startswith("local Dask cluster"))
         if args.json:
             pathlib.Path(args.json).write_text(json.dumps(
                 {"machine": machine(), "assets": len(paths), "triangles": triangles, "ratio": args.ratio,
