@@ -25,8 +25,7 @@ namespace {
 struct VertexArcs {
   Buffer<int32_t> offsets;
   Buffer<std::array<int32_t, 2>> arcs;
-  Buffer<int32_t> fill;  // per vertex: where its next arc goes
-  VertexArcs(int32_t n, const std::vector<int32_t>& tris) : offsets(n + 1), fill(n) {
+  VertexArcs(int32_t n, const std::vector<int32_t>& tris) : offsets(n + 1) {
     const int64_t t = int64_t(tris.size() / 3);
     auto valid = [&](int64_t i) {
       const int32_t* c = &tris[3 * i];
@@ -35,6 +34,7 @@ struct VertexArcs {
     const bool parallel = t >= kParallelMin;
     const int threads = parallel ? omp_get_max_threads() : 1;
     std::vector<int64_t> range_arcs(threads + 1, 0);
+    Buffer<int32_t> fill(n);  // per vertex: where its next arc goes
 #pragma omp parallel num_threads(threads)
     {
       const int me = omp_get_thread_num(), team = omp_get_num_threads();
