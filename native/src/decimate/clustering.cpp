@@ -155,8 +155,11 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
           std::memcpy(&word, in_next + 8 * w, 8);
           if (!word) continue;
           std::memset(in_next + 8 * w, 0, 8);
-          for (int b = 0; b < 8; ++b)
-            if ((word >> (8 * b)) & 0xff) mine.push_back(int32_t(8 * w + b));
+          // The flags (0 or 1) as the bits of one byte, walked bit by bit: testing the eight
+          // bytes one by one mispredicted on frontiers of a few percent of the vertices.
+          for (uint32_t bits = uint32_t(((word & 0x0101010101010101ull) * 0x0102040810204080ull) >> 56); bits;
+               bits &= bits - 1)
+            mine.push_back(int32_t(8 * w + __builtin_ctz(bits)));
         }
       }
       for (int32_t v = int32_t(8 * words); v < n; ++v)  // the last few, past the whole words
