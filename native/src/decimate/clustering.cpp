@@ -182,8 +182,6 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
 
 // Sets the samples from first_new on (distance 0) and relaxes from them. The keys of a full
 // fill are set to unreached first; flood_add starts from the clustering it is given.
-// Sets the samples from first_new on (distance 0) and relaxes from them. The keys of a full
-// fill are set to unreached first; flood_add starts from the clustering it is given.
 void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
                     int32_t first_new, Clustering& c, std::vector<int32_t>* cross_edges,
                     std::vector<int32_t>* changed) {
