@@ -31,12 +31,15 @@ export SOURCE_DATE_EPOCH=${SOURCE_DATE_EPOCH:-$(git log -1 --format=%ct 2>/dev/n
 VERSION=$(sed -n 's/^version = "\(.*\)"/\1/p' pyproject.toml | head -1)
 OUT=build/wheels            # raw (unrepaired) wheels and work folders
 rm -rf "$OUT" dist; mkdir -p "$OUT/raw" dist
-launcher=(); command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+# ccache only when installed (a fresh machine has none; the build must not ask for it)
+launcher=(); pip_launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache) &&
+  pip_launcher=(--config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache)
 
 # --- CPython 3.11: pip's build frontend drives scikit-build-core and CMake ----------------------
 echo "== cp311: pip wheel ."
 pip wheel . --no-build-isolation --no-deps -q --disable-pip-version-check -w "$OUT/raw" \
-  --config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache >"$OUT/cp311.log" 2>&1 ||
+  "${pip_launcher[@]}" >"$OUT/cp311.log" 2>&1 ||
   { tail -40 "$OUT/cp311.log"; exit 1; }
 WHEEL311=$(ls "$OUT"/raw/topstoc-"$VERSION"-cp311-cp311-*.whl)
 unzip -q -o "$WHEEL311" 'topstoc/_topstoc.*.so' -d "$OUT/cp311-module"  # the module as installed
