@@ -32,7 +32,7 @@ make_root() {
 }
 
 # Runs a command inside the root with /proc, /sys, /dev and this checkout mounted. The mounts live
-# in a private mount namespace (unshare), so runs from several checkouts at once neither see nor
+# in a private mount namespace (scripts/private_mounts.sh), so runs from several checkouts at once neither see nor
 # unmount each other's /opt/project, and nothing stays mounted when the command ends.
 # With TOPSTOC_ROOT_LAYER=NAME the root is seen through a writable overlay kept in
 # $CACHE/trixie-NAME: what that run installs (compilers, -dev libraries, venvs) stays in the layer
@@ -42,7 +42,7 @@ run_in_root() {
   local layer=""
   [ -n "${TOPSTOC_ROOT_LAYER:-}" ] && layer=$CACHE/trixie-$TOPSTOC_ROOT_LAYER
   mkdir -p "$ROOTFS/opt/project" ${layer:+"$layer/upper" "$layer/work" "$layer/merged"}
-  ROOTFS=$ROOTFS LAYER=$layer PROJECT=$project unshare --mount --propagation private /bin/bash -c '
+  ROOTFS=$ROOTFS LAYER=$layer PROJECT=$project "$project/scripts/private_mounts.sh" /bin/bash -c '
     root=$ROOTFS
     if [ -n "$LAYER" ]; then
       mount -t overlay overlay -o "lowerdir=$ROOTFS,upperdir=$LAYER/upper,workdir=$LAYER/work" \

@@ -4,12 +4,12 @@
 #   scripts/in_root.sh ROOTFS DIR 'COMMAND'
 #
 # The mounts (/proc, /sys, /dev, a fresh /tmp, DIR) live in a private mount namespace
-# (unshare -m): they vanish when the command ends and parallel runs never see each other's.
+# (scripts/private_mounts.sh): they vanish when the command ends and parallel runs never see each other's.
 # The environment is clean (HOME=/work, TMPDIR=/work/tmp), so nothing of this host leaks in.
 set -eu
 rootfs=$(cd "${1:?rootfs}" && pwd); work=$(cd "${2:?dir}" && pwd); shift 2
 mkdir -p "$rootfs/work" "$work/tmp"
-exec unshare --mount --propagation private /bin/bash -c '
+exec "$(dirname "${BASH_SOURCE[0]}")/private_mounts.sh" /bin/bash -c '
   set -e; r=$1; w=$2; shift 2
   mount -t proc proc "$r/proc"; mount -t sysfs sys "$r/sys"; mount --rbind /dev "$r/dev"
   mount -t tmpfs tmpfs "$r/tmp"; mount --bind "$w" "$r/work"
