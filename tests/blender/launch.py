@@ -15,6 +15,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 
 import bpy
 import pytest
@@ -66,8 +67,7 @@ def background(script=None, *args, expr=None, timeout=300, env=None) -> subproce
     else:
         source = ["--python", str(script)] if script else ["--python-expr", expr]
         command = [BINARY, "-b", "--factory-startup", "--python-exit-code", "1", *source, "--", *args]
-    return subprocess.run(command, capture_output=True, text=True, timeout=timeout,
-                          env=env if env is not None else clean_environment())
+    return _run_keeping_crash_report(command, env if env is not None else clean_environment(), timeout)
 
 
 def windowed(script, *options, timeout=300, env=None) -> subprocess.CompletedProcess:
@@ -77,5 +77,18 @@ def windowed(script, *options, timeout=300, env=None) -> subprocess.CompletedPro
     if XVFB is None:
         pytest.skip("needs xvfb-run")
     command = [XVFB, "-a", BINARY, "--factory-startup", *options, "--python", str(script)]
-    return subprocess.run(command, capture_output=True, text=True, timeout=timeout,
-                          env=env if env is not None else clean_environment())
+    return _run_keeping_crash_report(command, env if env is not None else clean_environment(), timeout)
+
+
+def _run_keeping_crash_report(command, env, timeout) -> subprocess.CompletedProcess:
+    """Runs ``command`` with a temp folder of its own; when Blender crashed, the report it wrote
+    there (blender.crash.txt: the backtrace) is added to the captured stderr, so that a rare
+    crash in a test run can be read afterwards."""
+    with tempfile.TemporaryDirectory(prefix="topstoc-blender-") as temp:
+        done = subprocess.run(command, capture_output=True, text=True, timeout=timeout,
+                              env={**env, "TMPDIR": temp, "TEMP": temp})
+        report = os.path.join(temp, "blender.crash.txt")
+        if done.returncode != 0 and os.path.exists(report):
+            with open(report, errors="replace") as crash:
+                done.stderr += f"\n--- {report} ---\n" + crash.read()
+    return done
