@@ -58,7 +58,8 @@ class PreviewSession:
     computed until ``request`` or ``update``.
     """
 
-    def __init__(self, context, obj, params, region_3d=None, ratio: Optional[float] = None):
+    def __init__(self, context, obj, params, region_3d=None, ratio: Optional[float] = None,
+                 deferred: bool = False):
         pipeline.check_decimatable(obj)
         self.obj = obj
         arrays = mesh_io.read_mesh(obj.data)  # the main thread's work: Blender data
@@ -103,7 +104,10 @@ class PreviewSession:
         self.seconds_decimate = 0.0
         self.seconds_write = 0.0
         self._pool = ThreadPoolExecutor(max_workers=WORKERS, thread_name_prefix=THREAD_PREFIX)
-        self.start = self._pool.submit(self._start, obj.name, obj.data.name_full, arrays)
+        self.start = None                      # the start job (a Future), once begun
+        self._start_args = (obj.name, obj.data.name_full, arrays)
+        if not deferred:
+            self.begin()
         try:  # Blender data only; turning it into engine arguments is the worker's
             self._read_guidance = read_guidance(obj, arrays, context.scene, None, region_3d)
         except BaseException:
@@ -113,6 +117,15 @@ class PreviewSession:
             self._guidance_read.set()
 
     # -- starting (worker) ----------------------------------------------------------------
+
+    def begin(self) -> None:
+        """Starts the worker that prepares the mesh (once). An operator's invoke makes the session
+        ``deferred`` and begins it at its first modal event: Blender 3.4 crashes (a dict read
+        without the GIL in its context lookup) when a Python thread runs while the operator
+        called through bpy.ops with a context override is still in Blender's C code."""
+        if self.start is None and not self._cancel.is_set():
+            self.start = self._pool.submit(self._start, *self._start_args)
+            self._start_args = None
 
     def _report(self, fraction: float, stage: str) -> bool:
         """The engine's progress callback during preparation; False stops it (Cancelled)."""

@@ -45,6 +45,12 @@ def steps():
         result = bpy.ops.topstoc.preview("INVOKE_DEFAULT")
     check("modal started", result == {"RUNNING_MODAL"})
     yield 0.5
+    # The worker begins at the modal's first event (PreviewSession.begin), which a loaded
+    # machine under Xvfb delivers late: wait for the result up to 10 s.
+    waited = 0.0
+    while "Torus_TopStocPreview" not in bpy.data.objects and waited < 10:
+        yield 0.1
+        waited += 0.1
     preview = bpy.data.objects.get("Torus_TopStocPreview")
     check("preview object shown, original hidden", preview is not None and bpy.data.objects["Torus"].hide_get())
     n = len(bpy.data.objects["Torus"].data.vertices)
@@ -108,6 +114,10 @@ def steps():
             started = bpy.ops.topstoc.preview("INVOKE_DEFAULT")
         check("invoke returns while the mesh is prepared", started == {"RUNNING_MODAL"} and operators.running)
         yield 0.5
+        waited = 0.0
+        while not held and waited < 10:  # the worker begins at the modal's first event
+            yield 0.1
+            waited += 0.1
         check("preparing: nothing changed yet", bool(held) and held[0].preparing
               and "Torus_TopStocPreview" not in bpy.data.objects and not torus.hide_get())
         window.event_simulate(type="ESC", value="PRESS")

@@ -86,6 +86,9 @@ def steps():
         started = bpy.ops.topstoc.preview("INVOKE_DEFAULT")
     check("preview started", started == {"RUNNING_MODAL"})
     yield 1.5
+    begun = time.perf_counter()
+    while "Suzanne_TopStocPreview" not in bpy.data.objects and time.perf_counter() - begun < 10:
+        yield 0.1  # the worker begins at the modal's first event (PreviewSession.begin)
     preview = bpy.data.objects.get("Suzanne_TopStocPreview")
     check("preview object with wireframe", preview is not None and preview.show_wire)
     shot("preview_wire", [preview])
@@ -191,6 +194,9 @@ def big_mesh_preview(source):
         check("big preview starts at once", started == {"RUNNING_MODAL"} and first is not None and first.preparing,
               f"{report['values']['big_invoke_seconds']:.3f} s, {report['values']['big_invoke_cpu_seconds']:.3f} s CPU")
         yield 0.05
+        begun = time.perf_counter()
+        while first is not None and first.start is None and time.perf_counter() - begun < 10:
+            yield 0.02  # the worker begins at the modal's first event (PreviewSession.begin)
         was_preparing = first.preparing
         window.event_simulate(type="ESC", value="PRESS")
         window.event_simulate(type="ESC", value="RELEASE")

@@ -56,7 +56,8 @@ Enter or click applies, Esc or right-click restores"""
         self.started = time.perf_counter()
         settings = SimpleNamespace(**{name: getattr(self, name) for name in settings_names()})
         try:  # reads the mesh and guidance; preparing and decimating go on in a worker
-            self.session = PreviewSession(context, obj, settings, context.region_data, ratio=self.ratio)
+            self.session = PreviewSession(context, obj, settings, context.region_data, ratio=self.ratio,
+                                          deferred=True)  # begun by the first modal event (begin)
         except (pipeline.DecimationError, GuidanceError, ValueError) as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
@@ -142,6 +143,7 @@ Enter or click applies, Esc or right-click restores"""
         if event.type in {"ESC", "RIGHTMOUSE"} and event.value == "PRESS":
             self._finish(context, restore_scene=True)
             return {"CANCELLED"}
+        self.session.begin()  # after invoke has returned to Blender (see PreviewSession.begin)
         if self.session.applying:  # the drag is over: only the result to apply is awaited
             return self._poll_apply(context) if event.type == "TIMER" else {"RUNNING_MODAL"}
         if event.type == "MOUSEMOVE":
