@@ -137,8 +137,10 @@ to cut or remove unwanted handles before decimating or printing. Runs in the bac
             return {"CANCELLED"}
         self.object_name = obj.name
         running[obj.name] = self.search
+        # Started by the first modal event, after invoke has returned to Blender: a thread running
+        # while bpy.ops with a context override is still in Blender's C code crashes Blender 3.4
+        # (see preview.PreviewSession.begin).
         self.thread = threading.Thread(target=self.search.run, name="TopStoc loops", daemon=True)
-        self.thread.start()
         wm = context.window_manager
         wm.progress_begin(0, 100)
         self.timer = wm.event_timer_add(0.1, window=context.window)
@@ -151,6 +153,8 @@ to cut or remove unwanted handles before decimating or printing. Runs in the bac
 
     def modal(self, context, event):
         search = self.search
+        if self.thread.ident is None:
+            self.thread.start()
         if event.type == "ESC" and event.value == "PRESS":
             search.cancelled = True  # the engine stops at its next progress report
         if event.type != "TIMER":
