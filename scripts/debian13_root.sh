@@ -32,8 +32,9 @@ make_root() {
 }
 
 # Runs a command inside the root with /proc, /sys, /dev and this checkout mounted. The mounts live
-# in a private mount namespace (scripts/private_mounts.sh), so runs from several checkouts at once neither see nor
-# unmount each other's /opt/project, and nothing stays mounted when the command ends.
+# in a private mount namespace (scripts/private_mounts.sh), so runs from several checkouts at
+# once neither see nor unmount each other's /opt/project, and nothing stays mounted when the
+# command ends.
 # With TOPSTOC_ROOT_LAYER=NAME the root is seen through a writable overlay kept in
 # $CACHE/trixie-NAME: what that run installs (compilers, -dev libraries, venvs) stays in the layer
 # and the base root keeps none of the build's libraries (the install tests need such a root).

@@ -8,8 +8,8 @@
 # fresh Debian root made with debootstrap, as ../shared/tools/fresh-debian.sh runs the Quick
 # start) "/" is not a mount point and that step fails with "cannot change root filesystem
 # propagation". There the namespace keeps the propagation it inherits, which is as private only
-# when no mount seen here is shared: checked (in /proc), else an error names the problem (a shared mount
-# would carry our mounts out to the host).
+# when no mount seen here is shared: checked (in /proc), else an error names the problem (a
+# shared mount would carry our mounts out to the host).
 if unshare --mount --propagation private true 2>/dev/null; then
   exec unshare --mount --propagation private "$@"
 fi

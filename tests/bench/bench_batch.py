@@ -45,13 +45,7 @@ def load() -> float:
 
 def timed(command, env) -> tuple:
     """(wall seconds, 1-minute load average before, after)."""
-    before = load()
-    start = time.perf_counter()
-    done = subprocess.run(command, capture_output=True, text=True, env=env)
-    seconds = time.perf_counter() - start
-    if done.returncode != 0:
-        sys.exit(f"failed: {' '.join(map(str, command[:6]))} ...\n{done.stderr[-2000:]}")
-    return seconds, before, load()
+    return timed_side_by_side([command], env)
 
 
 def timed_side_by_side(commands, env) -> tuple:

@@ -69,7 +69,6 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
         __builtin_prefetch(&adj[ao[ahead]]);
         __builtin_prefetch(&keys[ahead]);
       }
-
       const int32_t v = front[i];
       const int32_t rank = rank_of(__atomic_load_n(&keys[v], __ATOMIC_RELAXED));
       const uint64_t candidate = (d << 32) | uint32_t(rank);
