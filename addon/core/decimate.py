@@ -160,6 +160,10 @@ class DecimateStats:
     expected_vertices: float    #: sum of the sampling probabilities
     rate: float                 #: base rate k used for the probabilities
     fast_path: bool             #: candidate faces collected during the flood
+    #: the draw for the target updated the kept flood of an earlier decimation of this mesh (a
+    #: nearby target, same seed) instead of flooding afresh; the result is the same (see
+    #: Mesh.layout_and_floods; the lower draws made when repairs overshoot flood afresh)
+    flood_updated: bool
     repair_rounds: int          #: re-flood rounds needed to keep the topology
     repairs: int                #: samples added to keep the topology
     top_up: int                 #: samples added to make up for clusters absorbed by neighbours
@@ -429,7 +433,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
         target = target_vertex_count(mesh, ratio, vertices)
     u = _guidance(mesh, guidance)
     attribute_values, attribute_weights = _attributes(mesh, attributes, attribute_weights)
-    layout = mesh.feature_layout(regions, borders, feature_angle)
+    layout, floods = mesh.layout_and_floods(regions, borders, feature_angle)
     parameters = dict(ratio=ratio, target_vertices=vertices, target_triangles=triangles, seed=int(seed),
                       adaptivity=adaptivity, flat_floor=flat_floor, area_weighted=bool(area_weighted),
                       feature_angle=float(feature_angle), density=density,
@@ -446,7 +450,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
         view=_engine_view(view), boxes=_engine_boxes(boxes), placement=placement,
         fast_path=0 if fast_path is None else int(bool(fast_path)),
         max_repair_rounds=int(max_repair_rounds), refine=float(refine), refine_collapses=int(refine_collapses),
-        attributes=attribute_values, attribute_weights=attribute_weights)
+        attributes=attribute_values, attribute_weights=attribute_weights, flood_caches=floods)
     return _result(raw, parameters)
 
 

@@ -103,6 +103,7 @@ py::dict result_dict(DecimateResult&& r) {
   d["expected_vertices"] = r.expected_vertices;
   d["rate"] = r.rate;
   d["fast_path"] = r.fast_path;
+  d["flood_updated"] = r.flood_updated;
   d["top_up"] = r.top_up;
   d["refine_vertices"] = r.refine_vertices;
   d["refine_triangles"] = r.refine_triangles;
@@ -187,6 +188,12 @@ AttributeArrays attributes_from(const Mesh& mesh, const py::handle& values, cons
 }  // namespace
 
 void bind_decimate(py::module_& m) {
+  py::class_<FloodCachePool>(m, "FloodCachePool",
+                             "Floods of earlier decimations of one mesh and feature layout, reused by nearby targets.")
+      .def(py::init<size_t>(), py::arg("capacity") = 2)
+      .def("clear", &FloodCachePool::clear, "Frees the caches not in use.")
+      .def_property_readonly("size", &FloodCachePool::size, "Caches held (in use or not).");
+
   m.def(
       "decimate",
       [](const Mesh& mesh, const FeatureLayout& layout, int32_t target_vertices, int32_t target_triangles,
@@ -194,7 +201,8 @@ void bind_decimate(py::module_& m) {
          const std::string& density,
          int32_t density_rings, double density_ratio, double density_epsilon, const py::handle& view,
          const py::handle& boxes, const std::string& placement, int fast_path, int32_t max_repair_rounds,
-         double refine, int32_t refine_collapses, const py::handle& attributes, const py::handle& attribute_weights) {
+         double refine, int32_t refine_collapses, const py::handle& attributes, const py::handle& attribute_weights,
+         const py::handle& flood_caches) {
         const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
         DecimateParams params;
         params.sampling = sampling_from(mesh, seed, adaptivity, flat_floor, area_weighted, u, density, density_rings,
@@ -208,6 +216,7 @@ void bind_decimate(py::module_& m) {
         params.refine_collapses = refine_collapses;
         const AttributeArrays arrays = attributes_from(mesh, attributes, attribute_weights);
         params.attributes = arrays.view(mesh.report().input_triangles);
+        params.flood_caches = flood_caches.is_none() ? nullptr : flood_caches.cast<FloodCachePool*>();
         DecimateResult r;
         {
           EngineCall call;
@@ -222,7 +231,7 @@ void bind_decimate(py::module_& m) {
       py::arg("density_epsilon") = 0.0, py::arg("view") = py::none(), py::arg("boxes") = py::none(),
       py::arg("placement") = "subsample", py::arg("fast_path") = 0, py::arg("max_repair_rounds") = 200,
       py::arg("refine") = 0.0, py::arg("refine_collapses") = 0, py::arg("attributes") = py::none(),
-      py::arg("attribute_weights") = py::none(),
+      py::arg("attribute_weights") = py::none(), py::arg("flood_caches") = py::none(),
       "TopStoc decimation to a vertex target (or a triangle target when target_triangles > 0).");
 
   m.def(

@@ -1,6 +1,7 @@
 // Clustering: flood() against the definition (each vertex joins the sample of least
 // (hop distance, rank), by a breadth-first search per sample), and flood_add() against flood()
-// on the whole sample list, as clustering.hpp promises.
+// on the whole sample list, and flood_update() against flood() on the new list, as
+// clustering.hpp promises.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -83,6 +84,56 @@ void check_flood_add_equals_flood(const Mesh& mesh, const FeatureLayout& layout,
   }
 }
 
+// A random sorted subset of [0, n) of `count` vertices.
+std::vector<int32_t> sorted_samples(int32_t n, int32_t count, std::mt19937& random) {
+  auto ids = random_samples(n, count, random);
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+// The sample vertex and distance of every vertex (what stays when ranks are renumbered).
+std::vector<std::pair<int32_t, int32_t>> identities(const Clustering& c, const std::vector<int32_t>& samples) {
+  std::vector<std::pair<int32_t, int32_t>> out;
+  for (int32_t v = 0; v < c.num_vertices(); ++v)
+    out.push_back(c.label(v) < 0 ? std::make_pair(-1, -1) : std::make_pair(samples[c.label(v)], c.dist(v)));
+  return out;
+}
+
+// Old and new lists that overlap as slider steps do (a few percent replaced), or not at all.
+void check_flood_update_equals_flood(const Mesh& mesh, const FeatureLayout& layout, std::mt19937& random) {
+  const int32_t n = mesh.num_vertices();
+  for (int round = 0; round < 12; ++round) {
+    const int32_t count = 1 + int32_t(random() % std::max(2, n / 4));
+    const auto old_samples = sorted_samples(n, count, random);
+    std::vector<int32_t> samples;
+    const uint32_t keep_percent = round % 3 == 0 ? 0 : 80 + random() % 21;  // share of old samples kept
+    for (int32_t v : old_samples)
+      if (random() % 100 < keep_percent) samples.push_back(v);
+    std::vector<uint8_t> listed(n, 0);
+    for (int32_t v : samples) listed[v] = 1;
+    int32_t add = int32_t(random() % (count / 4 + 2));
+    for (int32_t v : random_samples(n, n, random))
+      if (add > 0 && !listed[v]) listed[v] = 1, samples.push_back(v), --add;
+    if (samples.empty()) samples.push_back(old_samples.front());
+    std::sort(samples.begin(), samples.end());
+    Clustering whole, updated;
+    flood(mesh, layout, samples, whole);
+    flood(mesh, layout, old_samples, updated);
+    const auto before = identities(updated, old_samples);
+    std::vector<int32_t> changed;
+    flood_update(mesh, layout, old_samples, samples, updated, &changed);
+    CHECK(updated.key == whole.key);
+    // `changed` names every vertex whose sample or distance changed, and only those.
+    std::sort(changed.begin(), changed.end());
+    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+    const auto after = identities(whole, samples);
+    std::vector<int32_t> differ;
+    for (int32_t v = 0; v < n; ++v)
+      if (before[v] != after[v]) differ.push_back(v);
+    CHECK(changed == differ);
+  }
+}
+
 }  // namespace
 
 TEST_CASE("flood gives every vertex the sample of least (hops, rank), as a search per sample does") {
@@ -117,4 +168,47 @@ TEST_CASE("flood_add gives exactly what flood gives on the whole sample list") {
     const Mesh mesh(file.vertices, file.triangles.data(), file.num_triangles());
     check_flood_add_equals_flood(mesh, *no_features(mesh), random);
   }
+}
+
+TEST_CASE("flood_update gives exactly what flood gives on the new sample list") {
+  std::mt19937 random(31);
+  SUBCASE("torus, no features") {
+    const Mesh mesh = make_mesh(topstoc_test::torus(20, 11));
+    check_flood_update_equals_flood(mesh, *no_features(mesh), random);
+  }
+  SUBCASE("grid with a boundary, a border curve across it") {
+    const Mesh mesh = make_mesh(topstoc_test::grid(14, 10));
+    std::vector<int32_t> border;
+    for (int32_t j = 0; j < 10; ++j) border.insert(border.end(), {7 * 11 + j, 7 * 11 + j + 1});
+    const auto layout = build_feature_layout(mesh, nullptr, 0, border.data(), int64_t(border.size() / 2), 0.0);
+    check_flood_update_equals_flood(mesh, *layout, random);
+  }
+  SUBCASE("a genus-2 test mesh (tests/data)") {
+    const MeshFile file = read_mesh_path(TOPSTOC_TEST_DATA "/genus_positive/cgal_eight.off");
+    const Mesh mesh(file.vertices, file.triangles.data(), file.num_triangles());
+    check_flood_update_equals_flood(mesh, *no_features(mesh), random);
+  }
+  SUBCASE("a mesh with holes (tests/data): boundary curves") {
+    const MeshFile file = read_mesh_path(TOPSTOC_TEST_DATA "/open_boundary/cgal_elephant-with-holes.off");
+    const Mesh mesh(file.vertices, file.triangles.data(), file.num_triangles());
+    for (int i = 0; i < 4; ++i) check_flood_update_equals_flood(mesh, *no_features(mesh), random);
+  }
+  SUBCASE("two tori: a piece can lose all its samples") {
+    auto a = topstoc_test::torus(9, 7);
+    const auto b = topstoc_test::torus(6, 5, 1.0, 0.3);
+    const int32_t offset = int32_t(a.positions.size() / 3);
+    for (size_t i = 0; i < b.positions.size(); ++i) a.positions.push_back(b.positions[i] + (i % 3 == 0 ? 5.0 : 0.0));
+    for (int32_t v : b.triangles) a.triangles.push_back(v + offset);
+    const Mesh mesh = make_mesh(a);
+    for (int i = 0; i < 4; ++i) check_flood_update_equals_flood(mesh, *no_features(mesh), random);
+  }
+}
+
+TEST_CASE("flood_update refuses lists that are not increasing vertex ids") {
+  const Mesh mesh = make_mesh(topstoc_test::torus(8, 6));
+  const auto layout = no_features(mesh);
+  Clustering c;
+  flood(mesh, *layout, {1, 5, 9}, c);
+  CHECK_THROWS_AS(flood_update(mesh, *layout, {1, 5, 9}, {9, 5}, c), std::invalid_argument);
+  CHECK_THROWS_AS(flood_update(mesh, *layout, {1, 5, 9}, {1, 1000}, c), std::invalid_argument);
 }

@@ -34,8 +34,11 @@ constexpr uint64_t kUnreached = kUnreachedKey;
 // the mesh into cache-sized pieces flooded one at a time, measured no better. Fetching the
 // neighbours' keys ahead as well cost more instructions than it saved (paired runs, 2026-11-27:
 // the flood 0.87-0.94x without it, with the bit-mask frontier scan below).
+// Seeds (flood_update: kept vertices around emptied clusters, as (distance << 32 | vertex),
+// sorted) join the frontier at the level of their distance.
 void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> frontier, int32_t level,
-                  std::vector<uint64_t>& key, std::vector<int32_t>* cross_edges, std::vector<int32_t>* changed) {
+                  std::vector<uint64_t>& key, std::vector<int32_t>* cross_edges, std::vector<int32_t>* changed,
+                  const std::vector<uint64_t>& seeds = {}) {
   const int32_t n = mesh.num_vertices();
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
@@ -50,9 +53,24 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   uint64_t* keys = key.data();
   uint8_t* in_next = queued.data();
   if (!std::is_sorted(frontier.begin(), frontier.end())) std::sort(frontier.begin(), frontier.end());
-  while (!frontier.empty()) {
+  size_t next_seed = 0;
+  while (!frontier.empty() || next_seed < seeds.size()) {
     // Every vertex is lowered at one level at most, so the frontiers list each change once.
     if (changed) changed->insert(changed->end(), frontier.begin(), frontier.end());
+    if (next_seed < seeds.size()) {
+      if (frontier.empty()) level = std::max(level, int32_t(seeds[next_seed] >> 32));
+      // A seed lowered by a new sample meanwhile relaxes from its new level (or is here already).
+      const size_t had = frontier.size();
+      for (; next_seed < seeds.size() && int32_t(seeds[next_seed] >> 32) <= level; ++next_seed) {
+        const int32_t v = int32_t(uint32_t(seeds[next_seed]));
+        if (dist_of(keys[v]) == level) frontier.push_back(v);
+      }
+      if (frontier.size() > had) {
+        std::sort(frontier.begin(), frontier.end());
+        frontier.erase(std::unique(frontier.begin(), frontier.end()), frontier.end());
+      }
+      if (frontier.empty()) continue;
+    }
     const uint64_t d = uint64_t(level) + 1;
     const int64_t count = int64_t(frontier.size());
     const int32_t* front = frontier.data();
@@ -208,6 +226,64 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
 }
 
 }  // namespace
+
+void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& old_samples,
+                  const std::vector<int32_t>& samples, Clustering& c, std::vector<int32_t>* changed) {
+  const int32_t n = mesh.num_vertices();
+  std::vector<uint64_t>& key = c.key;
+  if (int32_t(key.size()) != n) throw std::invalid_argument("flood_update: the clustering is not one of this mesh");
+  for (const auto* list : {&old_samples, &samples})
+    for (size_t i = 0; i < list->size(); ++i)
+      if ((*list)[i] < 0 || (*list)[i] >= n || (i > 0 && (*list)[i] <= (*list)[i - 1]))
+        throw std::invalid_argument("flood_update: sample lists must be increasing vertex ids of the mesh");
+  // Both lists are sorted, so the samples in both keep their order: their new ranks compare as
+  // the old ones did, and every key of a kept cluster stays what flood() would give it.
+  std::vector<int32_t> new_rank(old_samples.size(), -1), frontier;
+  for (size_t i = 0, j = 0; i < old_samples.size() || j < samples.size();) {
+    if (j == samples.size() || (i < old_samples.size() && old_samples[i] < samples[j])) {
+      ++i;  // removed
+    } else if (i == old_samples.size() || samples[j] < old_samples[i]) {
+      frontier.push_back(samples[j]);  // added
+      ++j;
+    } else {
+      new_rank[i++] = int32_t(j++);
+    }
+  }
+  // Kept clusters take their new ranks; the vertices of removed ones are emptied (unreached).
+  const int threads = omp_get_max_threads();
+  std::vector<std::vector<int32_t>> emptied_by_thread(threads);
+#pragma omp parallel if (n >= kParallelMin)
+  {
+    auto& mine = emptied_by_thread[omp_get_thread_num()];
+#pragma omp for schedule(static)
+    for (int32_t v = 0; v < n; ++v) {
+      const uint64_t k = key[v];
+      if (k == kUnreached) continue;
+      const int32_t rank = new_rank[rank_of(k)];
+      if (rank < 0) {
+        key[v] = kUnreached;
+        mine.push_back(v);
+      } else {
+        key[v] = cluster_key(dist_of(k), rank);
+      }
+    }
+  }
+  // Emptied vertices are refilled from the kept vertices around them, each entering the fill
+  // at its own distance, and from the added samples (a multi-source search, as in flood()).
+  const auto& ao = mesh.adjacency_offsets();
+  const auto& adj = mesh.adjacency();
+  std::vector<uint64_t> seeds;
+  for (const auto& emptied : emptied_by_thread) {
+    for (int32_t v : emptied)
+      for (int32_t j = ao[v]; j < ao[v + 1]; ++j)
+        if (key[adj[j]] != kUnreached) seeds.push_back((uint64_t(dist_of(key[adj[j]])) << 32) | uint32_t(adj[j]));
+    if (changed) changed->insert(changed->end(), emptied.begin(), emptied.end());
+  }
+  std::sort(seeds.begin(), seeds.end());
+  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+  for (int32_t s : frontier) key[s] = cluster_key(0, int32_t(std::lower_bound(samples.begin(), samples.end(), s) - samples.begin()));
+  relax_levels(mesh, layout, std::move(frontier), 0, key, nullptr, changed, seeds);
+}
 
 void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples, Clustering& out,
            std::vector<int32_t>* cross_edges) {

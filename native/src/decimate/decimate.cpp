@@ -5,11 +5,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <exception>
+#include <memory>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "topstoc/decimate/clustering.hpp"
+#include "topstoc/decimate/flood_cache.hpp"
 #include "topstoc/decimate/placement.hpp"
 #include "topstoc/decimate/refine.hpp"
 
@@ -260,16 +263,39 @@ std::vector<int32_t> widest_clusters(const Clustering& c, const std::vector<uint
 DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                 Placement placement, int32_t max_rounds, bool repair_slivers, bool fast_path,
                                 const std::vector<uint8_t>& avoid, const std::vector<uint8_t>& required,
-                                int32_t top_up_to, DecimateResult result) {
+                                int32_t top_up_to, FloodCache* cache, DecimateResult result) {
   auto start = Clock::now();
   Clustering clustering;
   std::vector<int32_t> cross_edges;
-  flood(mesh, layout, samples, clustering, fast_path ? &cross_edges : nullptr);
+  EmitState emit;  // later rounds re-evaluate only the faces around relabelled vertices
+  if (cache && cache->holds(mesh, layout) && cache->worth_updating(samples)) {
+    // The cached flood becomes this one (the same keys a fresh flood gives); the first check
+    // then re-tests only the faces around the vertices that changed. The cache keeps the
+    // flood without the repairs below.
+    flood_update(mesh, layout, cache->samples, samples, cache->clustering, &emit.changed);
+    cache->samples = samples;
+    clustering = cache->clustering;
+    if (cache->emits_valid) {
+      emit.emits = cache->emits;
+      emit.valid = true;
+    } else {
+      emit.changed.clear();  // every face is tested
+    }
+    result.flood_updated = true;
+  } else {
+    flood(mesh, layout, samples, clustering, fast_path ? &cross_edges : nullptr);
+    if (cache) {
+      cache->mesh = &mesh;
+      cache->layout = &layout;
+      cache->samples = samples;
+      cache->clustering = clustering;
+      cache->emits_valid = false;
+    }
+  }
   result.seconds_clustering = seconds_since(start);
   result.fast_path = fast_path;
   start = Clock::now();
   Partition partition;
-  EmitState emit;  // later rounds re-evaluate only the faces around relabelled vertices
   // The last few top-up samples can overshoot (a split may revive an absorbed neighbour): then
   // the state before them is restored and the next widest clusters are tried instead.
   struct Snapshot {
@@ -299,6 +325,14 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       partition = check_partition(mesh, layout, samples, clustering, required, slivers, &candidates, &emit);
     } else {
       partition = check_partition(mesh, layout, samples, clustering, required, slivers, nullptr, &emit);
+    }
+    if (cache) {
+      // Emits of the cached flood, from the first check only (repairs change the clustering
+      // from here on, and seeding rounds repeat round 0). An early return (unreached
+      // vertices) tested none.
+      cache->emits_valid = emit.valid && emit.changed.empty();
+      if (cache->emits_valid) cache->emits = emit.emits;
+      cache = nullptr;
     }
     accumulate(result.issues_found, partition.issues);
     const bool clean = partition.issues.topological() == 0 && (!slivers || partition.issues.sliver == 0);
@@ -442,9 +476,28 @@ int32_t active_vertices(const Mesh& mesh) {
 
 namespace {
 
+// A cache of the pool for one decimation: none without a pool or when all are in use. One left
+// half-updated by an exception is emptied.
+class BorrowedCache {
+ public:
+  explicit BorrowedCache(FloodCachePool* pool) : pool_(pool), cache_(pool ? pool->take() : nullptr) {}
+  ~BorrowedCache() {
+    if (!pool_ || !cache_) return;
+    if (std::uncaught_exceptions() > 0) cache_->clear();
+    pool_->give_back(std::move(cache_));
+  }
+  BorrowedCache(const BorrowedCache&) = delete;
+  BorrowedCache& operator=(const BorrowedCache&) = delete;
+  FloodCache* get() const { return cache_.get(); }
+
+ private:
+  FloodCachePool* pool_;
+  std::unique_ptr<FloodCache> cache_;
+};
+
 // One pass: draw samples for `target`, then flood, check, repair, emit.
 DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
-                             int32_t target, int32_t top_up_to) {
+                             int32_t target, int32_t top_up_to, FloodCache* cache) {
   const int32_t active = active_vertices(mesh);
   const auto start = Clock::now();
   SampleSet set = select_samples(mesh, layout, params.sampling, target);
@@ -469,8 +522,10 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
     }
   }
   const bool fast = params.fast_path == 1 || (params.fast_path < 0 && target < 0.05 * active);
+  // The fast path finds emitting faces from the flood's crossings, which can miss one that
+  // a full scan (and so an updated flood) finds: its results are its own, never updated.
   return cluster_and_emit(mesh, layout, std::move(set.samples), params.placement, params.max_repair_rounds, true,
-                          fast, avoid, required, top_up_to, std::move(result));
+                          fast, avoid, required, top_up_to, fast ? nullptr : cache, std::move(result));
 }
 
 }  // namespace
@@ -494,14 +549,23 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
   // some; a shortfall is topped up inside the pass (widest clusters split), an excess (the
   // topology needed more than drawn) is drawn again lower and topped up. Guided decimations
   // too: the guidance redistributes the budget, it does not change it.
-  DecimateResult best = decimate_once(mesh, layout, params, target, target);
+  // The kept flood serves the draw for the target: the next decimation's draw is near that
+  // one, not near the lower draws below (on a mesh whose topology needs many repairs, 1 sample).
+  DecimateResult best;
+  {
+    BorrowedCache cache(params.flood_caches);
+    best = decimate_once(mesh, layout, params, target, target, cache.get());
+  }
   const auto excess = [&](const DecimateResult& r) { return int32_t(r.kept.size()) - target; };
   const int32_t tolerance = budget_tolerance(target);
   int32_t drawn = target;
   for (int pass = 0; pass < params.budget_passes && excess(best) > tolerance && best.forced < target; ++pass) {
     drawn = std::max(1, drawn - excess(best) - tolerance);
-    DecimateResult r = decimate_once(mesh, layout, params, drawn, target);
-    if (std::abs(excess(r)) < std::abs(excess(best))) best = std::move(r);
+    DecimateResult r = decimate_once(mesh, layout, params, drawn, target, nullptr);
+    if (std::abs(excess(r)) < std::abs(excess(best))) {
+      r.flood_updated = best.flood_updated;  // (it tells of the draw for the target)
+      best = std::move(r);
+    }
   }
   // An input with collinear vertices can leave zero-area triangles the repairs could not
   // remove: collapse one edge of each (never an output with a zero-area triangle).
@@ -608,7 +672,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
   // A refined result's first pass keeps input positions: the refinement places what it keeps.
   result = cluster_and_emit(mesh, layout, std::move(samples), refine_vertices > 0 ? Placement::Subsample : placement,
                             max_repair_rounds, false, false, {},
-                            std::vector<uint8_t>(mesh.num_vertices(), 0), 0, std::move(result));
+                            std::vector<uint8_t>(mesh.num_vertices(), 0), 0, nullptr, std::move(result));
   // A refined result is thinned again; an unrefined one loses its zero-area triangles, as
   // decimate() does.
   if (refine_vertices > 0 || has_zero_area(result)) {

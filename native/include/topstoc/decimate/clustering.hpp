@@ -51,4 +51,13 @@ int32_t step_towards_sample(const Mesh& mesh, const FeatureLayout& layout, const
 void flood_add(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
                int32_t first_new, Clustering& clustering, std::vector<int32_t>* changed = nullptr);
 
+/// Turns the clustering of old_samples into exactly what flood() gives for `samples` (both
+/// increasing vertex ids; ranks are positions): kept clusters take their new ranks, removed
+/// ones are refilled from around them, added samples relax outwards. Nearby targets of one
+/// decimation share most samples (a slider step replaces a few percent), so most of the mesh
+/// is only relabelled. changed, if given, receives every vertex whose sample or distance
+/// changed (possibly twice).
+void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& old_samples,
+                  const std::vector<int32_t>& samples, Clustering& clustering, std::vector<int32_t>* changed = nullptr);
+
 }  // namespace topstoc

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "topstoc/decimate/features.hpp"
+#include "topstoc/decimate/flood_cache.hpp"
 #include "topstoc/core/mesh.hpp"
 #include "topstoc/decimate/partition.hpp"
 #include "topstoc/decimate/verify.hpp"
@@ -53,6 +54,10 @@ struct DecimateParams {
   /// not with the mesh, while the stochastic pass does the bulk.
   int32_t refine_collapses = 0;
   CornerAttributes attributes;  ///< attribute-aware cost of the refinement
+  /// Floods of earlier decimations of this mesh and layout (flood_cache.hpp), or null: the
+  /// result is the same either way, nearby targets of one seed come sooner (not with the fast
+  /// path, whose results can differ from a full scan's).
+  FloodCachePool* flood_caches = nullptr;
 };
 
 struct DecimateResult {
@@ -72,6 +77,7 @@ struct DecimateResult {
   double expected_vertices = 0.0;      ///< sum of the sampling probabilities
   double rate = 0.0;                   ///< base rate k used for the probabilities
   bool fast_path = false;
+  bool flood_updated = false;          ///< the draw for the target updated a kept flood (flood_cache.hpp)
   // The field names are the Python result's (DecimateStats): the bindings copy, never rename.
   int32_t repair_rounds = 0;           ///< re-flood rounds after the first check
   int32_t repairs = 0;                 ///< samples added to restore topology or shape
