@@ -1,5 +1,6 @@
 #include "topstoc/decimate/clustering.hpp"
 #include "topstoc/core/parallel.hpp"
+#include "../core/byte_flags.hpp"
 
 #include <omp.h>
 
@@ -167,14 +168,10 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
         auto& mine = next[omp_get_thread_num()];
 #pragma omp for schedule(static)
         for (int64_t w = 0; w < words; ++w) {
-          uint64_t word;
-          std::memcpy(&word, in_next + 8 * w, 8);
+          const uint64_t word = flag_word(in_next + 8 * w);
           if (!word) continue;
           std::memset(in_next + 8 * w, 0, 8);
-          // The flags (0 or 1) as the bits of one byte, walked bit by bit: testing the eight
-          // bytes one by one mispredicted on frontiers of a few percent of the vertices.
-          for (uint32_t bits = uint32_t(((word & 0x0101010101010101ull) * 0x0102040810204080ull) >> 56); bits;
-               bits &= bits - 1)
+          for (uint32_t bits = flag_bits(word); bits; bits &= bits - 1)
             mine.push_back(int32_t(8 * w + __builtin_ctz(bits)));
         }
       }

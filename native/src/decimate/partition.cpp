@@ -2,6 +2,7 @@
 #include "topstoc/core/parallel.hpp"
 #include "../core/fans.hpp"
 #include "link_arcs.hpp"
+#include "../core/byte_flags.hpp"
 #include "pinched_fans.hpp"
 
 #include <omp.h>
@@ -148,33 +149,45 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   emit.valid = true;
   emit.changed.clear();
   const int team = m >= kParallelMin ? threads : 1;
+  if (test_all) {
+#pragma omp parallel for schedule(static) num_threads(team)
+    for (int32_t f = 0; f < m; ++f) emit.emits[f] = three_clusters(f);
+  }
+  // Eight faces at a time (a tenth of them emit at most); the last few faces after the whole
+  // words are appended at the end.
+  const uint8_t* emits = emit.emits.data();
+  const int64_t words = m / 8;
+  auto write = [&](int64_t at, int32_t f) {
+    out.source_face[at] = f;
+    for (int j = 0; j < 3; ++j) out.triangles[3 * at + j] = label(faces[3 * size_t(f) + j]);
+  };
+  int64_t tail = 0;
+  for (int32_t f = int32_t(8 * words); f < m; ++f) tail += emits[f];
   std::vector<int64_t> run_start(team + 1, 0);
 #pragma omp parallel num_threads(team)
   {
     const int me = omp_get_thread_num();
     int64_t mine = 0;
 #pragma omp for schedule(static)
-    for (int32_t f = 0; f < m; ++f) {
-      if (test_all) emit.emits[f] = three_clusters(f);
-      mine += emit.emits[f];
-    }
+    for (int64_t w = 0; w < words; ++w) mine += __builtin_popcountll(flag_word(emits + 8 * w));
     run_start[me + 1] = mine;
 #pragma omp barrier
 #pragma omp single
     {
       for (int r = 0; r < omp_get_num_threads(); ++r) run_start[r + 1] += run_start[r];
-      out.source_face.resize(run_start[omp_get_num_threads()]);
+      out.source_face.resize(run_start[omp_get_num_threads()] + tail);
       out.triangles.resize(3 * out.source_face.size());
     }
     int64_t at = run_start[me];
 #pragma omp for schedule(static)
-    for (int32_t f = 0; f < m; ++f) {
-      if (!emit.emits[f]) continue;
-      out.source_face[at] = f;
-      for (int j = 0; j < 3; ++j) out.triangles[3 * at + j] = label(faces[3 * size_t(f) + j]);
-      ++at;
+    for (int64_t w = 0; w < words; ++w) {
+      const uint64_t word = flag_word(emits + 8 * w);
+      if (!word) continue;
+      for (uint32_t bits = flag_bits(word); bits; bits &= bits - 1) write(at++, int32_t(8 * w + __builtin_ctz(bits)));
     }
   }
+  for (int64_t f = 8 * words, at = int64_t(out.source_face.size()) - tail; f < m; ++f)
+    if (emits[f]) write(at++, int32_t(f));
   const int32_t emitted = static_cast<int32_t>(out.source_face.size());
 
   // --- feature pairs: clusters adjacent along a feature curve, with the copies of their edge ---
