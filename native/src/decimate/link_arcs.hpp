@@ -15,7 +15,36 @@ struct LinkArcs {
     int32_t out = 0, in = 0;  // arcs leaving / entering this neighbour
     int32_t next = -1;        // index of the neighbour the arc leaving it goes to
   };
-  std::vector<Neighbour> neighbours;
+  /// The neighbours of the current link. Its storage outlives clear(), and the ids sit in an
+  /// array of their own, so a lookup scans a few packed integers and adding one allocates
+  /// nothing (this list is rebuilt for every sample and every output vertex).
+  class Neighbours {
+   public:
+    const Neighbour* begin() const { return items_.data(); }
+    const Neighbour* end() const { return items_.data() + size_; }
+    size_t size() const { return size_t(size_); }
+    Neighbour& operator[](size_t i) { return items_[i]; }
+    const Neighbour& operator[](size_t i) const { return items_[i]; }
+    void clear() { size_ = 0; }
+    int32_t index(int32_t id) {
+      const int32_t* ids = ids_.data();
+      for (int32_t i = 0; i < size_; ++i)
+        if (ids[i] == id) return i;
+      if (size_ == int32_t(ids_.size())) {
+        ids_.resize(2 * ids_.size() + 16);
+        items_.resize(ids_.size());
+      }
+      ids_[size_] = id;
+      items_[size_] = {id};
+      return size_++;
+    }
+
+   private:
+    std::vector<int32_t> ids_;
+    std::vector<Neighbour> items_;
+    int32_t size_ = 0;
+  };
+  Neighbours neighbours;
   int32_t arcs = 0;
   bool reversed = false;  // some arc a -> b has its reverse b -> a too
 
@@ -24,15 +53,7 @@ struct LinkArcs {
     arcs = 0;
     reversed = false;
   }
-  int32_t index(int32_t id) {
-    // Raw pointers: the vector's size is read once, not on every step of this hot loop.
-    const Neighbour* first = neighbours.data();
-    const Neighbour* last = first + neighbours.size();
-    for (const Neighbour* p = first; p != last; ++p)
-      if (p->id == id) return int32_t(p - first);
-    neighbours.push_back({id});
-    return int32_t(last - first);
-  }
+  int32_t index(int32_t id) { return neighbours.index(id); }
   void add(int32_t from, int32_t to) {
     const int32_t a = index(from), b = index(to);
     if (neighbours[b].next == a) reversed = true;
