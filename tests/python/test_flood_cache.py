@@ -92,11 +92,14 @@ def test_regions_guidance_and_triangle_targets():
         assert_same(got, fresh(mesh, mode="fast", target_triangles=triangles, seed=2, regions=regions))
 
 
-def test_another_seed_a_far_target_or_the_fast_path_floods_afresh():
+def test_another_seed_a_far_lower_target_or_the_fast_path_floods_afresh():
     mesh = load(DATA / "genus0/cgal_ChineseDragon-10kv.off")
-    mesh.decimate(mode="fast", ratio=0.1, seed=1)
-    assert not mesh.decimate(mode="fast", ratio=0.1, seed=2).stats.flood_updated
+    mesh.decimate(mode="fast", ratio=0.2, seed=1)
     assert not mesh.decimate(mode="fast", ratio=0.2, seed=2).stats.flood_updated
+    # half the samples removed: refilling their clusters costs more than a fresh flood
+    assert not mesh.decimate(mode="fast", ratio=0.1, seed=2).stats.flood_updated
+    # twice the samples: the added ones take their share of the kept clusters
+    assert mesh.decimate(mode="fast", ratio=0.2, seed=2).stats.flood_updated
     assert mesh.decimate(mode="fast", ratio=0.202, seed=2).stats.flood_updated
     # the fast path's candidate faces can miss one a full scan finds: it never updates
     assert not mesh.decimate(mode="fast", ratio=0.204, seed=2, fast_path=True).stats.flood_updated

@@ -36,7 +36,7 @@ constexpr uint64_t kUnreached = kUnreachedKey;
 // neighbours' keys ahead as well cost more instructions than it saved (paired runs, 2026-11-27:
 // the flood 0.87-0.94x without it, with the bit-mask frontier scan below).
 // Seeds (flood_update: kept vertices around emptied clusters, as (distance << 32 | vertex),
-// sorted) join the frontier at the level of their distance.
+// ordered by distance) join the frontier at the level of their distance.
 void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> frontier, int32_t level,
                   std::vector<uint64_t>& key, std::vector<int32_t>* cross_edges, std::vector<int32_t>* changed,
                   const std::vector<uint64_t>& seeds = {}) {
@@ -61,15 +61,12 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
     if (next_seed < seeds.size()) {
       if (frontier.empty()) level = std::max(level, int32_t(seeds[next_seed] >> 32));
       // A seed lowered by a new sample meanwhile relaxes from its new level (or is here already).
-      const size_t had = frontier.size();
       for (; next_seed < seeds.size() && int32_t(seeds[next_seed] >> 32) <= level; ++next_seed) {
         const int32_t v = int32_t(uint32_t(seeds[next_seed]));
         if (dist_of(keys[v]) == level) frontier.push_back(v);
       }
-      if (frontier.size() > had) {
-        std::sort(frontier.begin(), frontier.end());
-        frontier.erase(std::unique(frontier.begin(), frontier.end()), frontier.end());
-      }
+      // (A seed lowered at this very level is listed twice: relaxing it again changes
+      // nothing, and the frontier's order only matters for memory locality.)
       if (frontier.empty()) continue;
     }
     const uint64_t d = uint64_t(level) + 1;
@@ -267,17 +264,30 @@ void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vect
   }
   // Emptied vertices are refilled from the kept vertices around them, each entering the fill
   // at its own distance, and from the added samples (a multi-source search, as in flood()).
+  // Seeds are listed once each (a flag per vertex) and ordered by distance with a counting
+  // sort; within a distance they stay in the order found, near vertex order (sorting them
+  // fully cost more than a fresh flood when a tenth of the samples went).
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
-  std::vector<uint64_t> seeds;
+  std::vector<uint64_t> found;
+  std::vector<uint8_t> listed(n, 0);
+  int32_t farthest = 0;
   for (const auto& emptied : emptied_by_thread) {
     for (int32_t v : emptied)
-      for (int32_t j = ao[v]; j < ao[v + 1]; ++j)
-        if (key[adj[j]] != kUnreached) seeds.push_back((uint64_t(dist_of(key[adj[j]])) << 32) | uint32_t(adj[j]));
+      for (int32_t j = ao[v]; j < ao[v + 1]; ++j) {
+        const int32_t u = adj[j];
+        if (key[u] == kUnreached || listed[u]) continue;
+        listed[u] = 1;
+        found.push_back((uint64_t(dist_of(key[u])) << 32) | uint32_t(u));
+        farthest = std::max(farthest, dist_of(key[u]));
+      }
     if (changed) changed->insert(changed->end(), emptied.begin(), emptied.end());
   }
-  std::sort(seeds.begin(), seeds.end());
-  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+  std::vector<size_t> at(size_t(farthest) + 2, 0);
+  for (uint64_t s : found) ++at[(s >> 32) + 1];
+  for (size_t d = 1; d < at.size(); ++d) at[d] += at[d - 1];
+  std::vector<uint64_t> seeds(found.size());
+  for (uint64_t s : found) seeds[at[s >> 32]++] = s;
   for (int32_t s : frontier) key[s] = cluster_key(0, int32_t(std::lower_bound(samples.begin(), samples.end(), s) - samples.begin()));
   relax_levels(mesh, layout, std::move(frontier), 0, key, nullptr, changed, seeds);
 }

@@ -2,11 +2,13 @@
 
 namespace topstoc {
 
-// Updating relabels every vertex (one pass) and refills the clusters around removed and added
-// samples; a fresh flood fills everything. On the horse (one thread, flood and first check,
-// 2026-11-27) updating wins up to about a sixth of the samples replaced: at 10 %, 2.9 % replaced
-// 31 against 57 ms, 9.1 % 48 against 58, 16.7 % 63 against 59; at 1 %, 2.9 % 12 against 50 ms,
-// 9.1 % 22 against 51. An eighth is the limit (a 0.3 % slider step replaces about 3 %).
+// Updating relabels every vertex (one pass), then refills the clusters of removed samples
+// from around them and lets added samples take their share. A fresh flood fills everything.
+// Removed samples cost about three times what added ones do (a whole cluster refilled against
+// part of one taken over). On the horse (one thread, flood and first check, 2026-11-27):
+//   at 10 %: 33 % added 76 against 81 ms fresh; 25 % removed 61 against 61; 43 % removed 84
+//   against 62; at 1 %: 33 % added 23 against 41; 43 % removed 38 against 41.
+// So a draw updates when added + 3 removed is at most the samples drawn.
 bool FloodCache::worth_updating(const std::vector<int32_t>& drawn) const {
   size_t shared = 0;
   for (size_t i = 0, j = 0; i < samples.size() && j < drawn.size();) {
@@ -14,8 +16,8 @@ bool FloodCache::worth_updating(const std::vector<int32_t>& drawn) const {
     else if (drawn[j] < samples[i]) ++j;
     else ++shared, ++i, ++j;
   }
-  const size_t replaced = (samples.size() - shared) + (drawn.size() - shared);
-  return 8 * replaced <= drawn.size();
+  const size_t removed = samples.size() - shared, added = drawn.size() - shared;
+  return added + 3 * removed <= drawn.size();
 }
 
 void FloodCache::clear() {

@@ -6,7 +6,7 @@
 // cache turns the cached flood into its own with flood_update (clustering.hpp) and re-tests
 // only the faces around the vertices that changed, which gives exactly the clustering and the
 // emitting faces a fresh flood gives: the result is the same mesh, only sooner. Draws that
-// share little (another seed, a far target) flood afresh and refill the cache.
+// share little (another seed, a far lower target) flood afresh and refill the cache.
 #pragma once
 
 #include <cstdint>
