@@ -138,13 +138,16 @@ def preview_start(obj, ratio, prepared):
     return control, cpu, first
 
 
-def preview_drag(obj, ratio, seconds=4.0, event_interval=0.01):
+def preview_drag(obj, ratio, seconds=4.0, event_interval=0.01, span=2.0):
     """Updates shown per second during a drag, the way the modal slider runs: a new ratio is
     requested every ``event_interval`` (mouse events), the worker thread decimates the latest
-    request while the main thread writes the previous result into the preview object."""
+    request while the main thread writes the previous result into the preview object. The
+    ratios go back and forth over [ratio / span, ratio * span] in 50 events (0.5 s): span 2 is
+    a sweep over a factor of four, span 1.1 a fine adjustment around the ratio (0.4 % a step),
+    where nearby requests update each other's floods (native flood_cache.hpp)."""
     session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(ratio))
     session.update(ratio)  # warm
-    sweep = np.geomspace(ratio / 2, min(1.0, ratio * 2), 50)
+    sweep = np.geomspace(ratio / span, min(1.0, ratio * span), 50)
     shown, start, i = 0, time.perf_counter(), 0
     while time.perf_counter() - start < seconds:
         session.request(float(sweep[i % len(sweep)] if (i // len(sweep)) % 2 == 0 else sweep[-1 - i % len(sweep)]))
@@ -241,6 +244,7 @@ def main(argv):
         split = stages(obj, ratio)
         updates, _ = preview_updates(obj, ratio, args.updates)
         drag_rate = preview_drag(obj, ratio)
+        fine_rate = preview_drag(obj, ratio, span=1.1)
         starts = {kind: [preview_start(obj, ratio, kind == "prepared") for _ in range(args.repeat)]
                   for kind in ("unprepared", "prepared")}
         applies = [preview_apply(obj, ratio) for _ in range(args.repeat)]
@@ -260,7 +264,10 @@ def main(argv):
                   f"{cpu * 1000:5.1f} ms of it main-thread CPU (goal <= {goal * 1000:.0f} ms); first result shown "
                   f"after {first * 1000:7.1f} ms (medians of {len(runs)})")
         print(f"  TopStoc slider drag    {drag_rate:8.1f} updates shown per second (modal path: a ratio "
-              f"requested every 10 ms, decimation on a worker thread while the main thread writes)")
+              f"requested every 10 ms, decimation on a worker thread while the main thread writes; "
+              f"sweep over [{ratio / 2:g}, {min(1, 2 * ratio):g}] and back every second)")
+        print(f"  TopStoc slider drag    {fine_rate:8.1f} updates shown per second (the same, fine adjustment "
+              f"over [{ratio / 1.1:.4g}, {min(1, 1.1 * ratio):.4g}]: nearby requests update kept floods)")
         before, rested, dragged, busy = (statistics.median(a[i] for a in applies) for i in range(4))
         print(f"  Live Preview Enter (Quality): before {before:.3f} s on the main thread (decimate again + write); "
               f"now {rested:.3f} s for a rested result (write only, {before / rested:.1f}x less), during a drag "

@@ -5,7 +5,9 @@
 
 Default mesh: ../shared/meshes/big/horse_loop2_1.55M.ply (skips cleanly when absent). Times:
   - first decimation: topstoc.Mesh (validation, adjacency, weights) + decimate, file read excluded;
-  - re-decimation: decimate on the prepared mesh (what a slider drag costs), seeds 0..R-1;
+  - re-decimation: decimate on the prepared mesh, seeds 0..R-1 (each floods afresh);
+  - slider step: the same seed at ratios 1 % apart, up and back down (what a slider drag costs:
+    each updates the kept flood of the one before, native flood_cache.hpp);
   - first and re-decimation in the fast mode (plain TopStoc, what the live slider shows);
   - the quality mode (the default: first pass, collapses, filtered re-fit) on the prepared mesh, 3 seeds,
     and cold (prepare + quality decimation at the first ratio);
@@ -80,6 +82,16 @@ def main() -> int:
             seconds.append(time.perf_counter() - start)
             for name, value in result.stats.seconds.items():
                 stages.setdefault(name, []).append(value)
+        steps = []  # a drag: the same seed, ratios 1 % apart, each updating the flood before it
+        path_ratios = [ratio * (1 + 0.01 * i) for i in list(range(-args.repeats, args.repeats + 1))]
+        mesh.decimate(ratio=path_ratios[0] * 0.99, seed=1, mode="fast")
+        updated = 0
+        for step in path_ratios + path_ratios[::-1]:
+            start = time.perf_counter()
+            step_result = mesh.decimate(ratio=step, seed=1, mode="fast")
+            steps.append(time.perf_counter() - start)
+            updated += step_result.stats.flood_updated
+        steps = (steps, updated)
         peer = None
         if PEER.exists():
             out = subprocess.run([str(PEER), str(path), str(ratio), str(args.repeats)], capture_output=True,
@@ -90,31 +102,35 @@ def main() -> int:
             start = time.perf_counter()
             refined_result = mesh.decimate(ratio=ratio, seed=seed, **REFINED)
             refined.append(time.perf_counter() - start)
-        rows.append((ratio, seconds, stages, result, peer, refined, refined_result))
+        rows.append((ratio, seconds, stages, result, peer, refined, refined_result, steps))
 
     print(f"\nprepare (validation, Morton order, adjacency, normals, weights): median {median_ms(prepare):.0f} ms")
     print(f"first decimation at {ratios[0]:.0%} (prepare + decimate): median {median_ms(first):.0f} ms")
     print("\n| target | ours: re-decimation | stages (sampling / clustering / checking / output / final check) | "
-          "meshopt_simplify | meshopt_simplifySloppy | simplify / ours | sloppy / ours |")
-    print("|---|---|---|---|---|---|---|")
-    for ratio, seconds, stages, result, peer, _, _ in rows:
-        ours = median_ms(seconds)
+          "slider step | meshopt_simplify | meshopt_simplifySloppy | simplify / ours | sloppy / ours | "
+          "simplify / slider step |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for ratio, seconds, stages, result, peer, _, _, (steps, updated) in rows:
+        ours, step = median_ms(seconds), median_ms(steps)
         stage_text = " / ".join(f"{median_ms(stages[k]):.0f}" for k in ("sampling", "clustering", "checking", "output", "verify"))
+        step_text = f"{step:.0f} ms ({updated} of {len(steps)} updated)"
         if peer:
             simplify = 1000 * peer["simplify"]["median_seconds"]
             sloppy = 1000 * peer["simplify_sloppy"]["median_seconds"]
             print(f"| {ratio:.0%} ({result.num_vertices} v, {result.num_triangles} t) | {ours:.0f} ms | {stage_text} ms | "
-                  f"{simplify:.0f} ms ({peer['simplify']['vertices']} v) | {sloppy:.0f} ms ({peer['simplify_sloppy']['vertices']} v) | "
-                  f"{simplify / ours:.1f}x | {sloppy / ours:.2f}x |")
+                  f"{step_text} | {simplify:.0f} ms ({peer['simplify']['vertices']} v) | "
+                  f"{sloppy:.0f} ms ({peer['simplify_sloppy']['vertices']} v) | "
+                  f"{simplify / ours:.1f}x | {sloppy / ours:.2f}x | {simplify / step:.1f}x |")
         else:
-            print(f"| {ratio:.0%} | {ours:.0f} ms | {stage_text} ms | (build/peers/meshopt_bench missing) | | | |")
+            print(f"| {ratio:.0%} | {ours:.0f} ms | {stage_text} ms | {step_text} | (build/peers/meshopt_bench missing) "
+                  "| | | | |")
     if rows[0][4]:
         simplify = rows[0][4]["simplify"]["median_seconds"]
         print(f"\nfirst decimation vs meshopt_simplify at {ratios[0]:.0%}: {simplify / statistics.median(first):.1f}x faster")
     print(f"\nquality mode (the default; a TopStoc first pass, then quadric edge collapses; see "
           f"bench_quality.py for its error): cold at {ratios[0]:.0%} {cold_quality_seconds:.2f} s "
           f"({cold_quality.num_vertices} v); re-decimation:")
-    for ratio, _, _, _, peer, refined, refined_result in rows:
+    for ratio, _, _, _, peer, refined, refined_result, _ in rows:
         ours = statistics.median(refined)
         text = f"  {ratio:.0%} ({refined_result.num_vertices} v): median {1000 * ours:.0f} ms " \
                f"(refinement {1000 * refined_result.stats.seconds['refine']:.0f} ms)"
