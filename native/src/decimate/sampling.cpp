@@ -338,9 +338,14 @@ std::vector<Candidate> pareto_candidates(const Mesh& mesh, uint64_t seed, const 
     auto& mine = found[omp_get_thread_num()];
 #pragma omp for schedule(static)
     for (int32_t v = 0; v < n; ++v) {
-      if (!(p[v] > 0.0 && p[v] < 1.0)) continue;
+      const double pv = p[v];
+      if (!(pv > 0.0 && pv < 1.0)) continue;
       const double u = uniform01(seed, kStreamSelection, uint64_t(mesh.vertex_source()[v]));
-      const double key = (u / (1.0 - u)) * ((1.0 - p[v]) / p[v]);
+      // key < threshold without the two divisions (most vertices fail it); the key itself
+      // is computed as before for those that pass. A vertex whose rounding differs sits at
+      // the threshold, far above the keys the draw takes (the threshold leaves a margin).
+      if (u * (1.0 - pv) >= threshold * pv * (1.0 - u)) continue;
+      const double key = (u / (1.0 - u)) * ((1.0 - pv) / pv);
       if (key < threshold) mine.push_back({key, v});
     }
   }
