@@ -354,6 +354,7 @@ void Mesh::build_adjacency(Progress& progress) {
   normals_.resize(3 * size_t(n));
   vertex_areas_.resize(n);
   manifold_vertex_.resize(n);
+  first_corner_.resize(n);
   SharedUnionFind sets(n);  // components: each set's root is its lowest vertex
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
 #pragma omp parallel reduction(+ : boundary, nonmanifold_edges, inconsistent, pinched, zero_area) if (n >= kParallelMin)
@@ -365,6 +366,7 @@ void Mesh::build_adjacency(Progress& progress) {
       const int32_t first = vfo[v], k = vfo[v + 1] - first;
       manifold_vertex_[v] = 1;
       if (k == 0) {  // isolated: no neighbours, in no component
+        first_corner_[v] = -1;
         degree[v] = greater[v] = euler[v] = 0;
         normals_[3 * size_t(v)] = normals_[3 * size_t(v) + 1] = normals_[3 * size_t(v) + 2] = 0.0;
         vertex_areas_[v] = 0.0;
@@ -377,6 +379,7 @@ void Mesh::build_adjacency(Progress& progress) {
       for (int32_t i = 0; i < k; ++i) {
         const int32_t* t = &faces_[3 * size_t(vertex_faces_[first + i])];
         const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+        if (i == 0) first_corner_[v] = 3 * face_source_[vertex_faces_[first]] + c;
         // Area-weighted: the unnormalised face normal (twice the area) summed at each corner.
         double fn[3];
         cross(position(t[0]), position(t[1]), position(t[2]), fn);
