@@ -26,6 +26,13 @@ std::shared_ptr<const FeatureLayout> no_features(const Mesh& mesh) {
   return build_feature_layout(mesh, nullptr, 0, nullptr, 0, 0.0);
 }
 
+// The 14 x 10 grid's boundary and, as a border, its column i = 7 (caller vertex pairs).
+std::shared_ptr<const FeatureLayout> column_border(const Mesh& mesh) {
+  std::vector<int32_t> border;
+  for (int32_t j = 0; j < 10; ++j) border.insert(border.end(), {7 * 11 + j, 7 * 11 + j + 1});
+  return build_feature_layout(mesh, nullptr, 0, border.data(), int64_t(border.size() / 2), 0.0);
+}
+
 std::vector<int32_t> random_samples(int32_t n, int32_t count, std::mt19937& random) {
   std::vector<int32_t> ids(n);
   std::iota(ids.begin(), ids.end(), 0);
@@ -60,6 +67,27 @@ Clustering brute_clustering(const Mesh& mesh, const std::vector<int32_t>& sample
   return c;
 }
 
+// The sample vertex and distance of every vertex (what stays when ranks are renumbered).
+std::vector<std::pair<int32_t, int32_t>> identities(const Clustering& c, const std::vector<int32_t>& samples) {
+  std::vector<std::pair<int32_t, int32_t>> out;
+  for (int32_t v = 0; v < c.num_vertices(); ++v)
+    out.push_back(c.label(v) < 0 ? std::make_pair(-1, -1) : std::make_pair(samples[c.label(v)], c.dist(v)));
+  return out;
+}
+
+// `changed` (repeats allowed) names every vertex whose sample or distance differs between the
+// two clusterings, and only those.
+void check_changed(std::vector<int32_t> changed, const Clustering& before, const std::vector<int32_t>& before_samples,
+                   const Clustering& after, const std::vector<int32_t>& after_samples) {
+  std::sort(changed.begin(), changed.end());
+  changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+  const auto was = identities(before, before_samples), is = identities(after, after_samples);
+  std::vector<int32_t> differ;
+  for (int32_t v = 0; v < before.num_vertices(); ++v)
+    if (was[v] != is[v]) differ.push_back(v);
+  CHECK(changed == differ);
+}
+
 void check_flood_add_equals_flood(const Mesh& mesh, const FeatureLayout& layout, std::mt19937& random) {
   const int32_t n = mesh.num_vertices();
   for (int round = 0; round < 10; ++round) {
@@ -74,13 +102,7 @@ void check_flood_add_equals_flood(const Mesh& mesh, const FeatureLayout& layout,
     std::vector<int32_t> changed;
     flood_add(mesh, layout, samples, first_new, incremental, &changed);
     CHECK(incremental.key == whole.key);
-    // `changed` names every vertex whose label or distance changed (and only such vertices).
-    std::sort(changed.begin(), changed.end());
-    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
-    std::vector<int32_t> differ;
-    for (int32_t v = 0; v < n; ++v)
-      if (before.key[v] != whole.key[v]) differ.push_back(v);
-    CHECK(changed == differ);
+    check_changed(changed, before, first, whole, samples);
   }
 }
 
@@ -89,14 +111,6 @@ std::vector<int32_t> sorted_samples(int32_t n, int32_t count, std::mt19937& rand
   auto ids = random_samples(n, count, random);
   std::sort(ids.begin(), ids.end());
   return ids;
-}
-
-// The sample vertex and distance of every vertex (what stays when ranks are renumbered).
-std::vector<std::pair<int32_t, int32_t>> identities(const Clustering& c, const std::vector<int32_t>& samples) {
-  std::vector<std::pair<int32_t, int32_t>> out;
-  for (int32_t v = 0; v < c.num_vertices(); ++v)
-    out.push_back(c.label(v) < 0 ? std::make_pair(-1, -1) : std::make_pair(samples[c.label(v)], c.dist(v)));
-  return out;
 }
 
 // Old and new lists that overlap as slider steps do (a few percent replaced), or not at all.
@@ -119,18 +133,11 @@ void check_flood_update_equals_flood(const Mesh& mesh, const FeatureLayout& layo
     Clustering whole, updated;
     flood(mesh, layout, samples, whole);
     flood(mesh, layout, old_samples, updated);
-    const auto before = identities(updated, old_samples);
+    const Clustering before = updated;
     std::vector<int32_t> changed;
     flood_update(mesh, layout, old_samples, samples, updated, &changed);
     CHECK(updated.key == whole.key);
-    // `changed` names every vertex whose sample or distance changed, and only those.
-    std::sort(changed.begin(), changed.end());
-    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
-    const auto after = identities(whole, samples);
-    std::vector<int32_t> differ;
-    for (int32_t v = 0; v < n; ++v)
-      if (before[v] != after[v]) differ.push_back(v);
-    CHECK(changed == differ);
+    check_changed(changed, before, old_samples, whole, samples);
   }
 }
 
@@ -149,49 +156,33 @@ TEST_CASE("flood gives every vertex the sample of least (hops, rank), as a searc
   }
 }
 
-TEST_CASE("flood_add gives exactly what flood gives on the whole sample list") {
+// Both incremental updates against a fresh flood, on each mesh.
+void check_updates(const Mesh& mesh, const FeatureLayout& layout, std::mt19937& random) {
+  check_flood_add_equals_flood(mesh, layout, random);
+  check_flood_update_equals_flood(mesh, layout, random);
+}
+
+TEST_CASE("flood_add and flood_update give exactly what flood gives on the whole new sample list") {
   std::mt19937 random(29);
   SUBCASE("torus, no features") {
     const Mesh mesh = make_mesh(topstoc_test::torus(20, 11));
-    check_flood_add_equals_flood(mesh, *no_features(mesh), random);
+    check_updates(mesh, *no_features(mesh), random);
   }
   SUBCASE("grid with a boundary, a border curve across it") {
     const Mesh mesh = make_mesh(topstoc_test::grid(14, 10));
-    std::vector<int32_t> border;  // the column i = 7, as caller vertex pairs
-    for (int32_t j = 0; j < 10; ++j) border.insert(border.end(), {7 * 11 + j, 7 * 11 + j + 1});
-    const auto layout = build_feature_layout(mesh, nullptr, 0, border.data(), int64_t(border.size() / 2), 0.0);
+    const auto layout = column_border(mesh);
     CHECK(layout->feature_edges.size() == 2 * (14 + 10) + 10);  // the boundary and the border
-    check_flood_add_equals_flood(mesh, *layout, random);
+    check_updates(mesh, *layout, random);
   }
   SUBCASE("a genus-2 test mesh (tests/data)") {
     const MeshFile file = read_mesh_path(TOPSTOC_TEST_DATA "/genus_positive/cgal_eight.off");
     const Mesh mesh(file.vertices, file.triangles.data(), file.num_triangles());
-    check_flood_add_equals_flood(mesh, *no_features(mesh), random);
-  }
-}
-
-TEST_CASE("flood_update gives exactly what flood gives on the new sample list") {
-  std::mt19937 random(31);
-  SUBCASE("torus, no features") {
-    const Mesh mesh = make_mesh(topstoc_test::torus(20, 11));
-    check_flood_update_equals_flood(mesh, *no_features(mesh), random);
-  }
-  SUBCASE("grid with a boundary, a border curve across it") {
-    const Mesh mesh = make_mesh(topstoc_test::grid(14, 10));
-    std::vector<int32_t> border;
-    for (int32_t j = 0; j < 10; ++j) border.insert(border.end(), {7 * 11 + j, 7 * 11 + j + 1});
-    const auto layout = build_feature_layout(mesh, nullptr, 0, border.data(), int64_t(border.size() / 2), 0.0);
-    check_flood_update_equals_flood(mesh, *layout, random);
-  }
-  SUBCASE("a genus-2 test mesh (tests/data)") {
-    const MeshFile file = read_mesh_path(TOPSTOC_TEST_DATA "/genus_positive/cgal_eight.off");
-    const Mesh mesh(file.vertices, file.triangles.data(), file.num_triangles());
-    check_flood_update_equals_flood(mesh, *no_features(mesh), random);
+    check_updates(mesh, *no_features(mesh), random);
   }
   SUBCASE("a mesh with holes (tests/data): boundary curves") {
     const MeshFile file = read_mesh_path(TOPSTOC_TEST_DATA "/open_boundary/cgal_elephant-with-holes.off");
     const Mesh mesh(file.vertices, file.triangles.data(), file.num_triangles());
-    for (int i = 0; i < 4; ++i) check_flood_update_equals_flood(mesh, *no_features(mesh), random);
+    for (int i = 0; i < 4; ++i) check_updates(mesh, *no_features(mesh), random);
   }
   SUBCASE("two tori: a piece can lose all its samples") {
     auto a = topstoc_test::torus(9, 7);
@@ -200,7 +191,7 @@ TEST_CASE("flood_update gives exactly what flood gives on the new sample list") 
     for (size_t i = 0; i < b.positions.size(); ++i) a.positions.push_back(b.positions[i] + (i % 3 == 0 ? 5.0 : 0.0));
     for (int32_t v : b.triangles) a.triangles.push_back(v + offset);
     const Mesh mesh = make_mesh(a);
-    for (int i = 0; i < 4; ++i) check_flood_update_equals_flood(mesh, *no_features(mesh), random);
+    for (int i = 0; i < 4; ++i) check_updates(mesh, *no_features(mesh), random);
   }
 }
 
