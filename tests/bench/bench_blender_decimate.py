@@ -259,10 +259,10 @@ def main(argv):
               f"= {1 / update:.1f} updates/s one after another")
         for kind, runs in starts.items():
             goal = 0.5 if kind == "unprepared" else 0.1
-            control, cpu, first = (statistics.median(run[i] for run in runs) for i in range(3))
+            control, cpu, shown = (statistics.median(run[i] for run in runs) for i in range(3))
             print(f"  Live Preview start, {kind:10s}: control back (progress shown) after {control * 1000:6.1f} ms, "
                   f"{cpu * 1000:5.1f} ms of it main-thread CPU (goal <= {goal * 1000:.0f} ms); first result shown "
-                  f"after {first * 1000:7.1f} ms (medians of {len(runs)})")
+                  f"after {shown * 1000:7.1f} ms (medians of {len(runs)})")
         print(f"  TopStoc slider drag    {drag_rate:8.1f} updates shown per second (modal path: a ratio "
               f"requested every 10 ms, decimation on a worker thread while the main thread writes; "
               f"sweep over [{ratio / 2:g}, {min(1, 2 * ratio):g}] and back every second)")
