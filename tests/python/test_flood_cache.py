@@ -151,3 +151,22 @@ def test_random_manifolds_and_pinched_surfaces(seed):
         updated += got.stats.flood_updated
         assert_same(got, plain.decimate(**options))
     assert updated > 0
+
+
+def test_a_pool_never_serves_another_mesh_or_layout():
+    """Kept floods are told apart by the mesh's and layout's serial numbers, not addresses: one
+    pool used (through the engine) for another mesh, or another layout, floods afresh."""
+    from topstoc.core.native import engine
+    dragon = load(DATA / "genus0/cgal_ChineseDragon-10kv.off")
+    other = Mesh(dragon.vertices * 2.0, dragon.triangles)  # same size, other mesh
+    pool = engine.FloodCachePool()
+    plain, creased = dragon.feature_layout(), dragon.feature_layout(feature_angle=0.5)
+
+    def run(mesh, layout, target):
+        return engine.decimate(mesh.native, layout, target_vertices=target, seed=1, flood_caches=pool)["flood_updated"]
+
+    assert not run(dragon, plain, 1000)
+    assert run(dragon, plain, 1010)
+    assert not run(other, other.feature_layout(), 1020)
+    assert not run(dragon, creased, 1030)
+    assert pool.size == 1  # one thread: the same cache each time, refilled

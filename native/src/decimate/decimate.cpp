@@ -276,8 +276,8 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
   } else {
     flood(mesh, layout, samples, clustering, fast_path ? &cross_edges : nullptr);
     if (cache) {
-      cache->mesh = &mesh;
-      cache->layout = &layout;
+      cache->mesh = mesh.serial();
+      cache->layout = layout.serial;
       cache->samples = samples;
       cache->clustering = clustering;
       cache->emits_valid = false;
@@ -474,7 +474,7 @@ class BorrowedCache {
   explicit BorrowedCache(FloodCachePool* pool) : pool_(pool), cache_(pool ? pool->take() : nullptr) {}
   ~BorrowedCache() {
     if (!pool_ || !cache_) return;
-    if (std::uncaught_exceptions() > 0) cache_->clear();
+    if (std::uncaught_exceptions() > exceptions_) cache_->clear();
     pool_->give_back(std::move(cache_));
   }
   BorrowedCache(const BorrowedCache&) = delete;
@@ -484,6 +484,7 @@ class BorrowedCache {
  private:
   FloodCachePool* pool_;
   std::unique_ptr<FloodCache> cache_;
+  int exceptions_ = std::uncaught_exceptions();  // in flight when borrowed (a handler may borrow)
 };
 
 // One pass: draw samples for `target`, then flood, check, repair, emit.

@@ -21,8 +21,7 @@ bool FloodCache::worth_updating(const std::vector<int32_t>& drawn) const {
 }
 
 void FloodCache::clear() {
-  mesh = nullptr;
-  layout = nullptr;
+  mesh = layout = 0;
   samples = {};
   clustering = {};
   emits = {};

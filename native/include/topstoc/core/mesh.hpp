@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "topstoc/core/serial.hpp"
 #include "topstoc/core/buffer.hpp"
 #include "topstoc/core/progress.hpp"
 
@@ -114,6 +115,8 @@ class Mesh {
   double diagonal() const { return diagonal_; }
 
   const MeshReport& report() const { return report_; }
+  /// A number no other Mesh of this process has (what caches tell meshes apart by).
+  uint64_t serial() const { return serial_; }
 
  private:
   void validate_faces(const int32_t* triangles, int64_t num_triangles);
@@ -127,6 +130,7 @@ class Mesh {
   }
   void build_edges() const;
 
+  uint64_t serial_ = new_serial();
   int32_t num_vertices_ = 0;
   Buffer<double> positions_;
   Buffer<int32_t> faces_, face_source_, vertex_source_, vertex_index_;

@@ -14,6 +14,7 @@
 #include <mutex>
 #include <vector>
 
+#include "topstoc/core/serial.hpp"
 #include "topstoc/core/mesh.hpp"
 
 namespace topstoc {
@@ -41,6 +42,7 @@ class DerivedTable {
 };
 
 struct FeatureLayout {
+  uint64_t serial = new_serial();       ///< no other layout of this process has it (for caches)
   std::vector<uint8_t> edge_feature;    ///< per edge: 1 if no cluster may cross it
   std::vector<int32_t> feature_edges;   ///< ids of the feature edges
   std::vector<int32_t> feature_degree;  ///< per vertex: number of feature edges

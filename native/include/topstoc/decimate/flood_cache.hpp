@@ -21,15 +21,14 @@
 namespace topstoc {
 
 struct FloodCache {
-  const Mesh* mesh = nullptr;            ///< what the cache was made on (null: empty)
-  const FeatureLayout* layout = nullptr;
+  uint64_t mesh = 0, layout = 0;         ///< serials of what the cache was made on (0: empty)
   std::vector<int32_t> samples;          ///< the drawn samples (increasing vertex ids)
   Clustering clustering;                 ///< flood(samples)
   std::vector<uint8_t> emits;            ///< per face: corners in three clusters of that flood
   bool emits_valid = false;              ///< emits is filled (a fast-path flood leaves it empty)
 
   bool holds(const Mesh& m, const FeatureLayout& l) const {
-    return mesh == &m && layout == &l && clustering.num_vertices() == m.num_vertices();
+    return mesh == m.serial() && layout == l.serial && clustering.num_vertices() == m.num_vertices();
   }
   /// True when updating this cache to `drawn` is cheaper than a fresh flood.
   bool worth_updating(const std::vector<int32_t>& drawn) const;
