@@ -1,6 +1,7 @@
 #include "topstoc/decimate/clustering.hpp"
 #include "topstoc/core/parallel.hpp"
 #include "../core/byte_flags.hpp"
+#include "../core/counting_sort.hpp"
 
 #include <omp.h>
 
@@ -232,13 +233,13 @@ void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vect
         throw std::invalid_argument("flood_update: sample lists must be increasing vertex ids of the mesh");
   // Both lists are sorted, so the samples in both keep their order: their new ranks compare as
   // the old ones did, and every key of a kept cluster stays what flood() would give it.
-  std::vector<int32_t> new_rank(old_samples.size(), -1), frontier;
+  std::vector<int32_t> new_rank(old_samples.size(), -1), frontier, added_rank;
   for (size_t i = 0, j = 0; i < old_samples.size() || j < samples.size();) {
     if (j == samples.size() || (i < old_samples.size() && old_samples[i] < samples[j])) {
       ++i;  // removed
     } else if (i == old_samples.size() || samples[j] < old_samples[i]) {
       frontier.push_back(samples[j]);  // added
-      ++j;
+      added_rank.push_back(int32_t(j++));
     } else {
       new_rank[i++] = int32_t(j++);
     }
@@ -264,9 +265,9 @@ void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vect
   }
   // Emptied vertices are refilled from the kept vertices around them, each entering the fill
   // at its own distance, and from the added samples (a multi-source search, as in flood()).
-  // Seeds are listed once each (a flag per vertex) and ordered by distance with a counting
-  // sort; within a distance they stay in the order found, near vertex order (sorting them
-  // fully cost more than a fresh flood when a tenth of the samples went).
+  // Seeds are listed once each (a flag per vertex) and ordered by distance with a stable
+  // counting sort; within a distance they stay in the order found, near vertex order (sorting
+  // them fully cost more than a fresh flood when a tenth of the samples went).
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
   std::vector<uint64_t> found;
@@ -283,12 +284,12 @@ void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vect
       }
     if (changed) changed->insert(changed->end(), emptied.begin(), emptied.end());
   }
-  std::vector<size_t> at(size_t(farthest) + 2, 0);
-  for (uint64_t s : found) ++at[(s >> 32) + 1];
-  for (size_t d = 1; d < at.size(); ++d) at[d] += at[d - 1];
   std::vector<uint64_t> seeds(found.size());
-  for (uint64_t s : found) seeds[at[s >> 32]++] = s;
-  for (int32_t s : frontier) key[s] = cluster_key(0, int32_t(std::lower_bound(samples.begin(), samples.end(), s) - samples.begin()));
+  std::vector<int32_t> level_start;
+  stable_counting_sort(
+      int64_t(found.size()), farthest + 1, [&](int64_t i) { return int32_t(found[i] >> 32); },
+      [&](int64_t i, int32_t at) { seeds[at] = found[i]; }, level_start);
+  for (size_t i = 0; i < frontier.size(); ++i) key[frontier[i]] = cluster_key(0, added_rank[i]);
   relax_levels(mesh, layout, std::move(frontier), 0, key, nullptr, changed, seeds);
 }
 

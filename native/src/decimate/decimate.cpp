@@ -267,7 +267,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     cache->samples = samples;
     clustering = cache->clustering;
     if (cache->emits_valid) {
-      emit.emits = cache->emits;
+      emit.emits = std::move(cache->emits);  // given back after the first check, updated
       emit.valid = true;
     } else {
       emit.changed.clear();  // every face is tested
