@@ -79,13 +79,12 @@ def _mesh_objects(bpy, path: str, names) -> list:
 
 def _world_vertices(objects) -> np.ndarray:
     """Every vertex of ``objects`` in world space (for the asset's bounding sphere)."""
+    from . import mesh_io
+
     chunks = []
     for obj in objects:
-        count = len(obj.data.vertices)
-        local = np.empty(count * 3, dtype=np.float64)
-        obj.data.vertices.foreach_get("co", local)
+        local = mesh_io.read_positions(obj.data).astype(np.float64)
         matrix = np.array(obj.matrix_world, dtype=np.float64)
-        local = local.reshape(-1, 3)
         chunks.append(local @ matrix[:3, :3].T + matrix[:3, 3])
     return np.concatenate(chunks) if chunks else np.zeros((0, 3))
 

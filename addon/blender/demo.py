@@ -121,10 +121,10 @@ def main(argv=None) -> int:
     scene = bpy.context.scene
     obj = _load(args.input, scene)
     # Guidance as an artist would paint it: the top fifth keeps more, the bottom fifth less.
-    co = np.empty(3 * len(obj.data.vertices), dtype=np.float32)
-    obj.data.vertices.foreach_get("co", co)
+    from . import mesh_io
+
     world = np.array(obj.matrix_world)
-    points = co.reshape(-1, 3) @ world[:3, :3].T + world[:3, 3]
+    points = mesh_io.read_positions(obj.data) @ world[:3, :3].T + world[:3, 3]
     extent = points.max(axis=0) - points.min(axis=0)
     z = points[:, 2] if extent[1] <= extent[2] else points[:, 1]  # "up" as the render shows it
     low, high = np.quantile(z, [0.2, 0.8])

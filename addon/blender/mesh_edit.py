@@ -125,16 +125,15 @@ def _polygon_corners(arrays, polygons: int):
 
 def _fill_polygons(mesh, layout: PolygonLayout, loose_edges: np.ndarray) -> None:
     mesh.vertices.add(len(layout.vertices))
-    if len(layout.vertices):
-        mesh.vertices.foreach_set("co", layout.vertices.astype(np.float32).ravel())
+    mesh_io.write_positions(mesh, layout.vertices)
     if len(loose_edges):
         mesh.edges.add(len(loose_edges))
-        mesh.edges.foreach_set("vertices", loose_edges.astype(np.int32).ravel())
+        mesh_io._set_int_field(mesh, ".edge_verts", mesh.edges, "vertices", loose_edges)
     corners = len(layout.corner_vertex)
     mesh.loops.add(corners)
     mesh.polygons.add(len(layout.loop_total))
     if corners:
-        mesh.loops.foreach_set("vertex_index", layout.corner_vertex.astype(np.int32))
+        mesh_io._set_int_field(mesh, ".corner_vert", mesh.loops, "vertex_index", layout.corner_vertex)
         mesh.polygons.foreach_set("loop_start", layout.loop_start.astype(np.int32))
         if bpy.app.version < (4, 0, 0):
             mesh.polygons.foreach_set("loop_total", layout.loop_total.astype(np.int32))
@@ -258,13 +257,10 @@ def build_edited_mesh(old, arrays: mesh_io.MeshArrays, result, new) -> bpy.types
             new.materials.append(material)
     polygon_source = layout.polygon_source
     if len(polygon_source) and np.any(arrays.polygon_material):
-        new.polygons.foreach_set("material_index", _gather(arrays.polygon_material, polygon_source).astype(np.int32))
-    sharp = old.attributes.get("sharp_face")
-    if len(polygon_source) and (sharp is not None or bpy.app.version < (4, 0, 0)):
-        smooth = (~mesh_io._get(sharp.data, "value", len(old.polygons), 1, bool) if sharp is not None
-                  else mesh_io._get(old.polygons, "use_smooth", len(old.polygons), 1, bool))
-        if smooth.any():
-            new.polygons.foreach_set("use_smooth", _gather(smooth, polygon_source))
+        mesh_io.write_polygon_materials(new, _gather(arrays.polygon_material, polygon_source))
+    smooth = mesh_io.read_polygon_smooth(old) if len(polygon_source) else None
+    if smooth is not None:
+        mesh_io.write_polygon_smooth(new, _gather(smooth, polygon_source))
 
     uv_names = set()
     for uv in old.uv_layers:

@@ -38,7 +38,7 @@ class Primitive:
 
 
 def positions(mesh) -> np.ndarray:
-    return mesh_io._get(mesh.vertices, "co", len(mesh.vertices), 3, np.float32)
+    return mesh_io.read_positions(mesh)
 
 
 def _id_array(group, key: str, dtype=np.int32) -> np.ndarray:

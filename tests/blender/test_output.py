@@ -87,6 +87,27 @@ def test_uvs_and_materials_survive_exactly(ts, scene, path):
     assert [m.name for m in mesh.materials] == [m.name for m in source.materials]
 
 
+@pytest.mark.parametrize("shading", ["flat", "smooth", "mixed"])
+def test_shading_and_materials_come_from_the_source_face(ts, scene, shading):
+    """Each output face takes its source face's smooth flag and material, whatever Blender's
+    default for new faces (flat before 4.0, smooth after). Set and read back per face through
+    MeshPolygon, the path the add-on's bulk writes avoid."""
+    vertices, faces = meshgen.icosphere(3)
+    obj = make_object("Shaded", vertices, faces)
+    for slot in range(3):
+        obj.data.materials.append(bpy.data.materials.new(f"Slot{slot}"))
+    source = obj.data
+    for poly in source.polygons:
+        poly.use_smooth = {"flat": False, "smooth": True, "mixed": poly.index % 3 == 0}[shading]
+        poly.material_index = poly.index % 3
+    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.3))
+    mesh = ts.blender.pipeline.write_output(run).data
+    assert 0 < len(mesh.polygons) < len(source.polygons)
+    source_polygon = run.prepared.arrays.triangle_polygon[run.result.face_source]
+    assert [p.use_smooth for p in mesh.polygons] == [source.polygons[int(s)].use_smooth for s in source_polygon]
+    assert [p.material_index for p in mesh.polygons] == [int(s) % 3 for s in source_polygon]
+
+
 def test_attributes_and_vertex_groups_carry_over(ts, scene):
     vertices, faces = meshgen.torus(24, 12)
     obj = make_object("Torus", vertices, faces)

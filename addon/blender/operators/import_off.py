@@ -11,6 +11,7 @@ from bpy.props import CollectionProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 
 from ...core.io import read_mesh
+from .. import mesh_io
 
 
 def polygon_corners(triangles: np.ndarray, triangle_polygon: np.ndarray):
@@ -32,9 +33,9 @@ def mesh_from_file(path: str, name: str) -> bpy.types.Mesh:
     corners, totals = polygon_corners(data.triangles, data.triangle_polygon)
     mesh = bpy.data.meshes.new(name)
     mesh.vertices.add(data.num_vertices)
-    mesh.vertices.foreach_set("co", data.vertices.astype(np.float32).ravel())
+    mesh_io.write_positions(mesh, data.vertices)
     mesh.loops.add(len(corners))
-    mesh.loops.foreach_set("vertex_index", corners)
+    mesh_io._set_int_field(mesh, ".corner_vert", mesh.loops, "vertex_index", corners)
     mesh.polygons.add(len(totals))
     mesh.polygons.foreach_set("loop_start", np.r_[0, np.cumsum(totals)[:-1]].astype(np.int32))
     if bpy.app.version < (4, 0, 0):  # loop_total is derived from loop_start in 4.0+
