@@ -188,7 +188,7 @@ def point_values(values, kept, moved: MovedVertices, triangles, nearest: bool = 
     out = values[np.asarray(kept, dtype=np.int64)].copy()
     at = moved.moved
     if len(at):
-        corners = np.asarray(triangles, dtype=np.int64)[moved.face[at]]
+        corners = np.asarray(triangles)[moved.face[at]].astype(np.int64)
         out[at] = _combine(values, corners, moved.weights[at], nearest)
     return out
 
@@ -231,7 +231,7 @@ def point_weights(weights: SparseWeights, kept, moved: MovedVertices, triangles,
     at = moved.moved
     still = np.flatnonzero(moved.face < 0)
     pair_out = np.concatenate([still, np.repeat(at, 3)])
-    pair_in = np.concatenate([kept[still], np.asarray(triangles, dtype=np.int64)[moved.face[at]].ravel()])
+    pair_in = np.concatenate([kept[still], np.asarray(triangles)[moved.face[at]].astype(np.int64).ravel()])
     pair_factor = np.concatenate([np.ones(len(still)), moved.weights[at].ravel()])
     # every entry of each pair's input vertex
     first = np.searchsorted(vertex, pair_in, side="left")
@@ -271,7 +271,7 @@ def corner_values(values, corner_source, output_triangles, moved: MovedVertices,
     at = np.flatnonzero(moved.face[corner_vertex] >= 0)
     if len(at):
         vertex = corner_vertex[at]
-        corners = np.asarray(triangle_corners, dtype=np.int64)[moved.face[vertex]]
+        corners = np.asarray(triangle_corners)[moved.face[vertex]].astype(np.int64)
         out[at] = _combine(values, corners, moved.weights[vertex], nearest)
     return out
 
