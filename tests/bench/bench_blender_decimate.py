@@ -174,24 +174,29 @@ def preview_apply(obj, ratio):
     out = pipeline.write_output(pipeline.decimate(bpy.context, obj, params))
     before = time.perf_counter() - start
     remove(out)
-    start = time.perf_counter()
-    out = pipeline.write_output(session.apply(ratio))
-    rested = time.perf_counter() - start
+    rested, _, out = applied(session, ratio)
     remove(out)
+    dragged, busy, out = applied(session, ratio * 1.1)
+    remove(out)
+    session.close()
+    return before, rested, dragged, busy
+
+
+def applied(session, ratio):
+    """Enter at ``ratio`` the way the modal runs it: apply, then poll at the modal timer's rate
+    until the Run is ready (a rested result's attribute sources may still be found on a worker),
+    then write. Seconds until written, the main thread's busy part of them, and the output object."""
     start = time.perf_counter()
-    run, busy = session.apply(ratio * 1.1), time.perf_counter() - start
+    run, busy = session.apply(ratio), time.perf_counter() - start
     while run is None:
         time.sleep(1 / 60)  # the modal timer
         clock = time.perf_counter()
         run = session.poll_apply()
         busy += time.perf_counter() - clock
     clock = time.perf_counter()
-    out = pipeline.write_output(run)
+    out = ts.blender.pipeline.write_output(run)
     busy += time.perf_counter() - clock
-    dragged = time.perf_counter() - start
-    remove(out)
-    session.close()
-    return before, rested, dragged, busy
+    return time.perf_counter() - start, busy, out
 
 
 def modifier_apply(obj, ratio):
