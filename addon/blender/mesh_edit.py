@@ -265,10 +265,9 @@ def build_edited_mesh(old, arrays: mesh_io.MeshArrays, result, new) -> bpy.types
     uv_names = set()
     for uv in old.uv_layers:
         uv_names.add(uv.name)
-        values = mesh_io._get(uv.data, "uv", len(old.loops), 2, np.float32)
-        layer = new.uv_layers.get(uv.name) or new.uv_layers.new(name=uv.name, do_init=False)
-        if len(layout.corner_loop):
-            layer.data.foreach_set("uv", _patch_mean(values, layout.corner_loop, layout.corner_patch).ravel())
+        values = mesh_io.read_uv_map(old, uv.name)
+        mesh_io.write_uv_map(new, uv.name, _patch_mean(values, layout.corner_loop, layout.corner_patch)
+                             if len(layout.corner_loop) else values[:0])
     if old.uv_layers.active is not None:
         new.uv_layers.active_index = old.uv_layers.active_index
 

@@ -79,5 +79,30 @@ def test_read_edges_keeps_each_flag_apart_from_the_others(ts, scene, flag):
     assert found.dtype == np.int32 and len(expected) > 100
     np.testing.assert_array_equal(found, expected)
     if (3, 0, 0) <= bpy.app.version < (4, 0, 0):  # read from the MEdge array, not edge by edge
-        np.testing.assert_array_equal(ts.blender.mesh_io._legacy_edge_flags(mesh, flag),
+        np.testing.assert_array_equal(ts.blender.dna_arrays.edge_flag(mesh, flag),
                                       [getattr(e, flag) for e in mesh.edges])
+
+
+def test_polygon_materials_and_corners_match_the_per_element_accessors(ts, scene):
+    """Loops' vertices, polygons' first loops and material slots as read (Blender 3.x: from the
+    MLoop and MPoly arrays in one pass) equal what RNA gives element by element."""
+    vertices, faces = meshgen.torus(24, 12)
+    faces = [tuple(f) for f in faces]
+    quads = [(a, b, c, d) for (a, b, c), (_, _, d) in zip(faces[0:40:2], faces[1:40:2])]  # merged pairs
+    obj = make_object("Mixed", vertices, quads + faces[40:])
+    mesh = obj.data
+    for slot in range(3):
+        mesh.materials.append(bpy.data.materials.new(f"Slot{slot}"))
+    for polygon in mesh.polygons:
+        polygon.material_index = (polygon.index * 7) % 3
+    mesh_io, dna = ts.blender.mesh_io, ts.blender.dna_arrays
+    corners = np.array([loop.vertex_index for loop in mesh.loops])
+    np.testing.assert_array_equal(mesh_io.corner_vertices(mesh), corners)
+    arrays = mesh_io.read_mesh(mesh)
+    np.testing.assert_array_equal(arrays.polygon_material, [p.material_index for p in mesh.polygons])
+    if (3, 0, 0) <= bpy.app.version < (3, 6, 0):  # these Blenders keep MLoop and MPoly arrays
+        np.testing.assert_array_equal(dna.loop_vertices(mesh), corners)
+        np.testing.assert_array_equal(dna.polygon_starts(mesh), [p.loop_start for p in mesh.polygons])
+    elif bpy.app.version >= (4, 0, 0):
+        assert dna.loop_vertices(mesh) is None and dna.polygon_starts(mesh) is None
+    assert dna._view(mesh.loops, dna.MEDGE) is None  # a layout of another size is refused

@@ -1,0 +1,86 @@
+"""Blender 3.x mesh arrays read in one pass from the DNA structs behind them.
+
+Blender 3.x keeps edges, loops and polygons as arrays of C structs (MEdge, MLoop, MPoly).
+foreach_get copies a field out of them element by element: 5-20 ns an element, so 21 ms for
+the vertex ids of the horse's 4.65M loops and 46 ms for the seam flags of its 2.3M edges, most
+of the Live Preview's start in Blender 3.4. Here the array is viewed at the first element's
+address and the fields are copied out with numpy.
+
+A view is used only when the array looks like the layout below: its elements are contiguous
+with the struct's size, and at sampled elements every field read here equals what RNA gives.
+Otherwise (another Blender, another layout) the functions return None and the caller reads
+through RNA. The view is checked before anything is copied out of it, and every result is a
+copy: nothing keeps pointing into Blender's memory.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from typing import Optional
+
+import bpy
+import numpy as np
+
+# DNA_meshdata_types.h in 3.x
+MEDGE = np.dtype([("v", "<u4", 2), ("crease", "u1"), ("bweight", "u1"), ("flag", "<i2")])
+MLOOP = np.dtype([("v", "<u4"), ("e", "<u4")])
+MPOLY = np.dtype([("loopstart", "<i4"), ("totloop", "<i4"), ("mat_nr", "<i2"), ("flag", "u1"), ("pad", "u1")])
+EDGE_FLAG_BITS = {"use_seam": 1 << 2, "use_edge_sharp": 1 << 9}  # ME_SEAM, ME_SHARP
+LAYOUT_SAMPLES = 64
+
+
+def _view(collection, dtype: np.dtype) -> Optional[np.ndarray]:
+    """The struct array behind ``collection`` as a numpy view (valid until Blender changes the
+    mesh: callers copy out of it at once), or None outside 3.x or when it is not contiguous."""
+    count = len(collection)
+    if not (3, 0, 0) <= bpy.app.version < (4, 0, 0) or count < 2:
+        return None
+    first = collection[0].as_pointer()
+    if collection[1].as_pointer() - first != dtype.itemsize or \
+            collection[count - 1].as_pointer() - first != dtype.itemsize * (count - 1):
+        return None
+    return np.frombuffer((ctypes.c_char * (dtype.itemsize * count)).from_address(first), dtype=dtype)
+
+
+def _samples(count: int, extra=()) -> list:
+    """Elements whose fields are compared with RNA's: spread over the array, plus ``extra``."""
+    spread = np.unique(np.linspace(0, count - 1, LAYOUT_SAMPLES).astype(np.int64)).tolist()
+    return spread + [int(i) for i in extra]
+
+
+def edge_flag(mesh: bpy.types.Mesh, flag: str) -> Optional[np.ndarray]:
+    """``flag`` ("use_seam" or "use_edge_sharp") of every edge, from MEdge.flag."""
+    raw = _view(mesh.edges, MEDGE) if flag in EDGE_FLAG_BITS else None
+    if raw is None:
+        return None
+    flags = (raw["flag"] & EDGE_FLAG_BITS[flag]) != 0
+    for i in _samples(len(flags), np.flatnonzero(flags)[:LAYOUT_SAMPLES]):
+        edge = mesh.edges[i]
+        if tuple(edge.vertices) != tuple(raw["v"][i].tolist()) or getattr(edge, flag) != bool(flags[i]):
+            return None
+    return flags
+
+
+def loop_vertices(mesh: bpy.types.Mesh) -> Optional[np.ndarray]:
+    """(loops,) int32 vertex of every loop, from MLoop.v."""
+    raw = _view(mesh.loops, MLOOP)
+    if raw is None:
+        return None
+    for i in _samples(len(raw)):
+        loop = mesh.loops[i]
+        if (loop.vertex_index, loop.edge_index) != (raw["v"][i], raw["e"][i]):
+            return None
+    return raw["v"].astype(np.int32)
+
+
+def polygon_starts(mesh: bpy.types.Mesh) -> Optional[np.ndarray]:
+    """(polygons,) int32 first loop of every polygon, from MPoly.loopstart. (Its material slot
+    is not read: 3.4 keeps that in the "material_index" attribute and leaves MPoly.mat_nr 0.)"""
+    raw = _view(mesh.polygons, MPOLY)
+    if raw is None:
+        return None
+    for i in _samples(len(raw)):
+        polygon = mesh.polygons[i]
+        if (polygon.loop_start, polygon.loop_total) != (raw["loopstart"][i], raw["totloop"][i]):
+            return None
+    return raw["loopstart"].copy()
