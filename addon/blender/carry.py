@@ -24,6 +24,7 @@ import bpy
 import numpy as np
 
 from ..core.attributes import MovedVertices, point_values
+from . import dna_arrays
 
 KEY_SETTINGS = ("value", "slider_min", "slider_max", "mute", "interpolation", "vertex_group")
 
@@ -49,9 +50,11 @@ def read_shape_keys(mesh: bpy.types.Mesh) -> ShapeKeys:
     keys.reference = key.reference_key.name
     n = len(mesh.vertices)
     for block in key.key_blocks:
-        co = np.empty(3 * n, dtype=np.float32)
-        if n:
-            block.data.foreach_get("co", co)
+        co = dna_arrays.shape_key_positions(block) if len(block.data) == n else None
+        if co is None:
+            co = np.empty(3 * n, dtype=np.float32)
+            if n:
+                block.data.foreach_get("co", co)
         keys.names.append(block.name)
         keys.coordinates.append(co.reshape(n, 3).astype(np.float64))
         keys.settings.append({name: getattr(block, name) for name in KEY_SETTINGS})

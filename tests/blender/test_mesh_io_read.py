@@ -106,3 +106,20 @@ def test_polygon_materials_and_corners_match_the_per_element_accessors(ts, scene
     elif bpy.app.version >= (4, 0, 0):
         assert dna.loop_vertices(mesh) is None and dna.polygon_starts(mesh) is None
     assert dna._view(mesh.loops, dna.MEDGE) is None  # a layout of another size is refused
+
+
+def test_shape_keys_are_read_as_blender_gives_them(ts, scene):
+    """A shape key's positions, copied from its float array in one pass, equal what
+    ShapeKeyPoint.co gives point by point, for the basis and a key with random offsets."""
+    obj = make_object("Morph", *meshgen.icosphere(3))
+    obj.shape_key_add(name="Basis")
+    key = obj.shape_key_add(name="Smile", from_mix=False)
+    rng = np.random.default_rng(3)
+    for point in key.data:
+        point.co = tuple(np.array(point.co) + rng.normal(0, 0.1, 3))
+    keys = ts.blender.carry.read_shape_keys(obj.data)
+    assert keys.names == ["Basis", "Smile"]
+    for block, read in zip(obj.data.shape_keys.key_blocks, keys.coordinates):
+        expected = np.array([tuple(point.co) for point in block.data])
+        np.testing.assert_array_equal(read, expected)
+        np.testing.assert_array_equal(ts.blender.dna_arrays.shape_key_positions(block), expected)
