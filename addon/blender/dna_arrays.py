@@ -1,11 +1,13 @@
 """Mesh arrays read in one pass from the DNA structs behind them.
 
-Blender 3.x keeps edges, loops and polygons as arrays of C structs (MEdge, MLoop, MPoly), and
-every version keeps a shape key's positions as one float array (KeyBlock.data). foreach_get
-copies a field out of them element by element: 5-20 ns an element in 3.4, so 21 ms for the
-vertex ids of the horse's 4.65M loops and 46 ms for the seam flags of its 2.3M edges, most of
-the Live Preview's start; 57-70 ms for one shape key of its 780k vertices in 3.4 to 4.5. Here
-the array is viewed at the first element's address and the fields are copied out with numpy.
+Blender 3.x keeps edges, loops and polygons as arrays of C structs (MEdge, MLoop, MPoly); every
+version keeps a shape key's positions as one float array (KeyBlock.data) and a byte colour
+attribute as one array of 4 bytes an element. foreach_get copies a field out of them element by
+element: 5-20 ns an element in 3.4, so 21 ms for the vertex ids of the horse's 4.65M loops and
+46 ms for the seam flags of its 2.3M edges, most of the Live Preview's start; 57-70 ms for one
+shape key of its 780k vertices in 3.4 to 4.5, and 172 ms for the sRGB values of a colour per
+corner in 4.5 (a painted guidance layer). Here the array is viewed at the first element's
+address and the fields are copied out with numpy.
 
 A view is used only when the array looks like the layout below: its elements are contiguous
 with the struct's size, and at sampled elements every field read here equals what RNA gives.
@@ -97,3 +99,16 @@ def shape_key_positions(block) -> Optional[np.ndarray]:
         if tuple(block.data[i].co) != tuple(raw[i].tolist()):
             return None
     return raw.copy()
+
+
+def byte_colors_srgb(attribute) -> Optional[np.ndarray]:
+    """(count, 4) float32 stored sRGB values of a byte colour attribute, as ``color_srgb`` gives
+    them (each byte / 255), from its array of 4 bytes an element."""
+    raw = _view(attribute.data, np.dtype(("u1", 4)), legacy=False)
+    if raw is None:
+        return None
+    values = raw.astype(np.float32) / np.float32(255)
+    for i in _samples(len(raw)):
+        if tuple(attribute.data[i].color_srgb) != tuple(values[i].tolist()):
+            return None
+    return values

@@ -308,6 +308,9 @@ def read_attribute(attribute, count: int) -> Optional[np.ndarray]:
     key, width, dtype = layout
     if attribute.data_type == "BYTE_COLOR" and count and hasattr(attribute.data[0], "color_srgb"):
         key = "color_srgb"  # the stored sRGB bytes, exactly (no linear round trip)
+        values = dna_arrays.byte_colors_srgb(attribute) if len(attribute.data) == count else None
+        if values is not None:
+            return values, key
     return _get(attribute.data, key, count, width, dtype).reshape(count, width), key
 
 

@@ -123,3 +123,22 @@ def test_shape_keys_are_read_as_blender_gives_them(ts, scene):
         expected = np.array([tuple(point.co) for point in block.data])
         np.testing.assert_array_equal(read, expected)
         np.testing.assert_array_equal(ts.blender.dna_arrays.shape_key_positions(block), expected)
+
+
+@pytest.mark.parametrize("domain", ["POINT", "CORNER"])
+def test_byte_colours_are_read_as_their_stored_srgb_values(ts, scene, domain):
+    """A byte colour layer, copied from its bytes in one pass, gives what ByteColorAttributeValue
+    .color_srgb gives element by element: every one of the 256 byte values, each channel."""
+    obj = make_object("Painted", *meshgen.icosphere(3))
+    mesh = obj.data
+    layer = mesh.color_attributes.new("Paint", "BYTE_COLOR", domain)
+    count = len(mesh.vertices) if domain == "POINT" else len(mesh.loops)
+    stored = np.random.default_rng(5).integers(0, 256, (count, 4))
+    stored[:64, 0] = np.arange(64) * 4 + 3
+    layer.data.foreach_set("color_srgb", (stored / 255.0).astype(np.float32).ravel())
+    expected = np.array([tuple(value.color_srgb) for value in layer.data], dtype=np.float32)
+    assert len(np.unique(np.round(expected * 255))) == 256
+    values, key = ts.blender.mesh_io.read_attribute(layer, count)
+    assert key == "color_srgb"
+    np.testing.assert_array_equal(values, expected)
+    np.testing.assert_array_equal(ts.blender.dna_arrays.byte_colors_srgb(layer), expected)
