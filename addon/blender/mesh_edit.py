@@ -84,8 +84,7 @@ def polygon_layout(arrays: mesh_io.MeshArrays, result) -> PolygonLayout:
     starts, totals = _polygon_corners(arrays, polygons)
     keep = np.flatnonzero(intact)
     keep_totals = totals[keep]
-    keep_loops = np.concatenate([np.arange(s, s + t) for s, t in zip(starts[keep], keep_totals)]) \
-        if len(keep) else np.zeros(0, dtype=np.int64)
+    keep_loops = _ranges(starts[keep], keep_totals)
     # Triangles of broken polygons and patch triangles become triangle polygons.
     broken_rows = rows[~intact[arrays.triangle_polygon[face_source[rows]]]]
     patch_rows = np.flatnonzero(~from_input)
@@ -114,12 +113,28 @@ def polygon_layout(arrays: mesh_io.MeshArrays, result) -> PolygonLayout:
         corner_patch=corner_patch)
 
 
+def _ranges(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """The integers start, start + 1, ..., start + length - 1 of every (start, length), in order."""
+    lengths = np.asarray(lengths, dtype=np.int64)
+    offsets = np.cumsum(lengths) - lengths
+    return np.repeat(np.asarray(starts, dtype=np.int64) - offsets, lengths) + np.arange(int(lengths.sum()))
+
+
 def _polygon_corners(arrays, polygons: int):
-    """(loop_start, loop_total) per polygon, from the triangles' loops (polygons are fans)."""
+    """(loop_start, loop_total) per polygon, from the triangles' loops (polygons are fans). The
+    triangles are grouped by polygon (Blender lists a polygon's loop triangles together, in
+    polygon order: then no sort is needed) and each group's smallest and largest loop taken."""
+    triangle_polygon = np.asarray(arrays.triangle_polygon, dtype=np.int64)
+    order = None if np.all(triangle_polygon[1:] >= triangle_polygon[:-1]) else \
+        np.argsort(triangle_polygon, kind="stable")
+    grouped = triangle_polygon if order is None else triangle_polygon[order]
+    loops = arrays.triangle_loops if order is None else arrays.triangle_loops[order]
     starts = np.full(polygons, np.iinfo(np.int64).max, dtype=np.int64)
-    np.minimum.at(starts, arrays.triangle_polygon, arrays.triangle_loops.min(axis=1))
     ends = np.full(polygons, -1, dtype=np.int64)
-    np.maximum.at(ends, arrays.triangle_polygon, arrays.triangle_loops.max(axis=1))
+    if len(grouped):
+        first = np.flatnonzero(np.r_[True, grouped[1:] != grouped[:-1]])
+        starts[grouped[first]] = np.minimum.reduceat(loops.min(axis=1), first)
+        ends[grouped[first]] = np.maximum.reduceat(loops.max(axis=1), first)
     return starts, ends - starts + 1
 
 
@@ -195,28 +210,58 @@ def _edge_sources(old_mesh, new_mesh, vertex_source: np.ndarray) -> np.ndarray:
     return np.where(found, order[position], -1)
 
 
-def _copy_flags(collection_old, collection_new, names, source: np.ndarray, unreadable=()) -> None:
+_COLLECTIONS = {"POINT": "vertices", "EDGE": "edges", "FACE": "polygons"}
+
+
+def _copy_flags(old, new, domain: str, names, source: np.ndarray, unreadable=()) -> None:
+    """Element flags of ``old``'s elements of ``domain`` onto ``new``'s (each from its source
+    element, unflagged without one)."""
+    collection_old, collection_new = getattr(old, _COLLECTIONS[domain]), getattr(new, _COLLECTIONS[domain])
     if len(collection_new) == 0 or len(collection_old) == 0:
         return
+    names = [name for name in names if name not in unreadable]
+    as_attributes = mesh_io.ELEMENT_FLAG_ATTRIBUTES[domain] if bpy.app.version >= (4, 0, 0) else {}
+    _copy_flag_attributes(old, new, domain, [name for name in names if name in as_attributes], source)
     element = collection_old[0]
     for name in names:
-        if not hasattr(element, name) or name in unreadable:
+        if name in as_attributes or not hasattr(element, name):
             continue
-        value = getattr(element, name)
-        dtype = bool if isinstance(value, bool) else np.float32
-        old = mesh_io._get(collection_old, name, len(collection_old), 1, dtype)
-        new = _gather(old, source)
-        if new.any():
-            collection_new.foreach_set(name, new)
+        dtype = bool if isinstance(getattr(element, name), bool) else np.float32
+        picked = _gather(mesh_io._get(collection_old, name, len(collection_old), 1, dtype), source)
+        if picked.any():
+            collection_new.foreach_set(name, picked)
+
+
+def _copy_flag_attributes(old, new, domain: str, names, source: np.ndarray) -> None:
+    """Blender 4.0+: flags are attributes, present only when some element has the flag."""
+    for name in names:
+        attribute = mesh_io.element_flag_attribute(old, domain, name)
+        kind = mesh_io.ELEMENT_FLAG_ATTRIBUTES[domain][name][1]
+        if attribute is None or (attribute.domain, attribute.data_type) != (domain, kind):
+            continue  # none flagged (the default), or mistyped (see mesh_io.mistyped_edge_flags)
+        values, key = mesh_io.read_attribute(attribute, mesh_io._domain_size(old, domain))
+        picked = _gather(values[:, 0], source)
+        target = new.attributes.get(attribute.name)
+        if target is not None and (target.domain, target.data_type) != (domain, kind):
+            new.attributes.remove(target)
+            target = None
+        if picked.any():
+            if target is None:
+                target = new.attributes.new(attribute.name, kind, domain)
+            target.data.foreach_set(key, picked)
 
 
 def _copy_attributes(old, new, layout: PolygonLayout, result, edge_source: np.ndarray, uv_names: set) -> None:
     sources = {"POINT": layout.vertex_source, "FACE": layout.polygon_source, "EDGE": edge_source,
                "CORNER": layout.corner_loop}
+    # flags (4.0+: attributes such as "sharp_edge" too) go through _copy_flags
+    flag_names = {name for flags in mesh_io.ELEMENT_FLAG_ATTRIBUTES.values() for names, _ in flags.values()
+                  for name in names} if bpy.app.version >= (4, 0, 0) else set()
     for attribute in old.attributes:
         name = attribute.name
         # internal ("." names: selection, hiding, topology) go through the element flags above
-        if name in _SKIPPED or name.startswith(".") or name in uv_names or attribute.domain not in sources:
+        if name in _SKIPPED or name.startswith(".") or name in uv_names or attribute.domain not in sources \
+                or name in flag_names:
             continue
         read = mesh_io.read_attribute(attribute, mesh_io._domain_size(old, attribute.domain))
         if read is None:
@@ -272,9 +317,9 @@ def build_edited_mesh(old, arrays: mesh_io.MeshArrays, result, new) -> bpy.types
         new.uv_layers.active_index = old.uv_layers.active_index
 
     edge_source = _edge_sources(old, new, layout.vertex_source)
-    _copy_flags(old.vertices, new.vertices, _VERTEX_FLAGS, layout.vertex_source)
-    _copy_flags(old.edges, new.edges, _EDGE_FLAGS, edge_source, unreadable=mesh_io.mistyped_edge_flags(old))
-    _copy_flags(old.polygons, new.polygons, _POLYGON_FLAGS, polygon_source)
+    _copy_flags(old, new, "POINT", _VERTEX_FLAGS, layout.vertex_source)
+    _copy_flags(old, new, "EDGE", _EDGE_FLAGS, edge_source, unreadable=mesh_io.mistyped_edge_flags(old))
+    _copy_flags(old, new, "FACE", _POLYGON_FLAGS, polygon_source)
     _copy_attributes(old, new, layout, result, edge_source, uv_names)
     colors = old.color_attributes
     if colors.active_color is not None and new.color_attributes.get(colors.active_color.name) is not None:

@@ -468,3 +468,51 @@ def test_edit_on_a_from_pydata_mesh_keeps_edge_flags(mods, scene):
     out.edges.foreach_get("select", read)
     np.testing.assert_array_equal(read, flags)
     print("edge selection readable on the input:", readable)
+
+
+def test_an_edit_keeps_every_element_flag(mods, scene):
+    """Fill Holes on a torus with a hole, whose vertices, edges and faces carry every flag the
+    edit copies, set element by element: every element that was there keeps its flags, read back
+    element by element (Blender 4.0+ keeps them as attributes, copied as such; 3.x in its
+    structs). Crease is an attribute from 4.0 on, freestyle marks are gone in 5.0."""
+    vertices, faces = meshgen.torus(16, 8)
+    obj = make_object("Flags", vertices, [f for i, f in enumerate(faces) if i != 3])
+    mesh = obj.data
+    rng = np.random.default_rng(11)
+    flags = {"vertices": ["select", "hide"],
+             "edges": ["select", "hide", "use_seam", "use_edge_sharp", "use_freestyle_mark", "crease"],
+             "polygons": ["select", "hide", "use_freestyle_mark"]}
+    for collection, names in flags.items():
+        names[:] = [name for name in names if hasattr(getattr(mesh, collection)[0], name)]
+        for element in getattr(mesh, collection):
+            for name in names:
+                setattr(element, name, 0.5 * (rng.random() < 0.3) if name == "crease" else bool(rng.random() < 0.3))
+    crease = None
+    if not hasattr(mesh.edges[0], "crease"):  # Blender 4.0+
+        crease = (rng.random(len(mesh.edges)) < 0.3).astype(np.float32) * 0.5
+        mesh.attributes.new("crease_edge", "FLOAT", "EDGE").data.foreach_set("value", crease)
+
+    def key(collection, element):
+        return element.index if collection == "vertices" else tuple(sorted(element.vertices[:]))
+
+    def table(m, collection):
+        return {key(collection, e): tuple(getattr(e, name) for name in flags[collection])
+                for e in getattr(m, collection)}
+
+    def creases(m):
+        values = np.empty(len(m.edges), dtype=np.float32)
+        m.attributes["crease_edge"].data.foreach_get("value", values)
+        return {key("edges", e): float(values[e.index]) for e in m.edges}
+
+    before = {collection: table(mesh, collection) for collection in flags}
+    crease_before = creases(mesh) if crease is not None else None
+    assert bpy.ops.topstoc.fill_holes(mode="ALL") == {"FINISHED"}
+    out = obj.data
+    assert len(out.polygons) > len(mesh.polygons) - 1 and len(out.vertices) >= len(vertices)
+    for collection in flags:
+        after = {k: v for k, v in table(out, collection).items() if k in before[collection]}
+        wrong = [(k, before[collection][k], v) for k, v in after.items() if before[collection][k] != v]
+        assert len(after) == len(before[collection]) and not wrong, (collection, wrong[:5], len(wrong))
+    if crease is not None:
+        after = creases(out)
+        assert all(after[k] == v for k, v in crease_before.items()) and max(after.values()) == 0.5

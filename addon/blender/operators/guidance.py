@@ -108,8 +108,8 @@ class TOPSTOC_OT_set_guidance(bpy.types.Operator):
         bpy.ops.object.mode_set(mode="OBJECT")
         try:
             mesh = obj.data
-            vertex_mask = mesh_io._get(mesh.vertices, "select", len(mesh.vertices), 1, bool)
-            polygon_mask = mesh_io._get(mesh.polygons, "select", len(mesh.polygons), 1, bool) if faces else None
+            vertex_mask = mesh_io.read_element_flag(mesh, "POINT", "select")
+            polygon_mask = mesh_io.read_element_flag(mesh, "FACE", "select") if faces else None
             count = write_guidance(obj, vertex_mask, polygon_mask, u)
         finally:
             bpy.ops.object.mode_set(mode="EDIT")

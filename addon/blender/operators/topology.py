@@ -395,7 +395,7 @@ triangulation, robust fallbacks)"""
                 raise TopStocError("the mesh has no holes")
             if mode == "ALL":
                 return edit.fill_holes(arrays.vertices, arrays.triangles, skip_unfillable=True)
-            selected = mesh_io._get(o.data.vertices, "select", len(o.data.vertices), 1, bool)
+            selected = mesh_io.read_element_flag(o.data, "POINT", "select")
             picked = [i for i, hole in enumerate(holes)
                       if (selected[hole.vertices] & selected[np.roll(hole.vertices, -1)]).any()]
             if not picked:
@@ -418,7 +418,7 @@ class TOPSTOC_OT_delete_faces(bpy.types.Operator):
 
     def execute(self, context):
         def compute(o, arrays):
-            selected = mesh_io._get(o.data.polygons, "select", len(o.data.polygons), 1, bool)
+            selected = mesh_io.read_element_flag(o.data, "FACE", "select")
             if not selected.any():
                 raise TopStocError("no faces are selected")
             return edit.delete_faces(arrays.vertices, arrays.triangles, selected[arrays.triangle_polygon])
