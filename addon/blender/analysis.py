@@ -39,7 +39,7 @@ def loose_edges(mesh) -> np.ndarray:
         return np.zeros((0, 2), dtype=np.int32)
     used = np.zeros(count, dtype=bool)
     if len(mesh.loops):
-        used[mesh_io._indices(mesh.loops, "edge_index", len(mesh.loops))] = True
+        used[mesh_io.corner_edges(mesh)] = True
     return mesh_io._indices(mesh.edges, "vertices", count, 2)[~used]
 
 

@@ -65,8 +65,8 @@ def edge_flag(mesh: bpy.types.Mesh, flag: str) -> Optional[np.ndarray]:
     return flags
 
 
-def loop_vertices(mesh: bpy.types.Mesh) -> Optional[np.ndarray]:
-    """(loops,) int32 vertex of every loop, from MLoop.v."""
+def loop_indices(mesh: bpy.types.Mesh, field: str) -> Optional[np.ndarray]:
+    """(loops,) int32 vertex ("v") or edge ("e") of every loop, from MLoop."""
     raw = _view(mesh.loops, MLOOP)
     if raw is None:
         return None
@@ -74,7 +74,7 @@ def loop_vertices(mesh: bpy.types.Mesh) -> Optional[np.ndarray]:
         loop = mesh.loops[i]
         if (loop.vertex_index, loop.edge_index) != (raw["v"][i], raw["e"][i]):
             return None
-    return raw["v"].astype(np.int32)
+    return raw[field].astype(np.int32)
 
 
 def polygon_starts(mesh: bpy.types.Mesh) -> Optional[np.ndarray]:

@@ -185,8 +185,17 @@ def corner_vertices(mesh) -> np.ndarray:
     corner_vert = mesh.attributes.get(".corner_vert")  # Blender 3.6+: a plain int attribute
     if corner_vert is not None:
         return _get(corner_vert.data, "value", len(mesh.loops), 1, np.int32)
-    legacy = dna_arrays.loop_vertices(mesh)
+    legacy = dna_arrays.loop_indices(mesh, "v")
     return legacy if legacy is not None else _indices(mesh.loops, "vertex_index", len(mesh.loops))
+
+
+def corner_edges(mesh) -> np.ndarray:
+    """Edge of every loop (face corner)."""
+    corner_edge = mesh.attributes.get(".corner_edge")  # Blender 3.6+: a plain int attribute
+    if corner_edge is not None:
+        return _get(corner_edge.data, "value", len(mesh.loops), 1, np.int32)
+    legacy = dna_arrays.loop_indices(mesh, "e")
+    return legacy if legacy is not None else _indices(mesh.loops, "edge_index", len(mesh.loops))
 
 
 def _triangle_polygons(mesh, count: int) -> np.ndarray:

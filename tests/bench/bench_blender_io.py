@@ -7,7 +7,8 @@ On the 1.55M-triangle horse (../shared/meshes/big, skipped when absent), given a
 byte colour per corner and shape keys, each row times one mesh_io / carry function and, in the
 same run, the foreach_get / foreach_set call through the per-element property it replaces
 (MeshVertex.co, MeshUVLoop.uv, ByteColorAttributeValue.color_srgb, ShapeKeyPoint.co, MeshLoop
-.vertex_index), checks that both give the same values, and prints the ratio. Medians of 5.
+.vertex_index), checks that both give the same values, and prints the ratio. Medians of 5. The
+last row writes a topology edit back (Delete Faces) against Blender's own Edit Mode delete.
 """
 
 import os
@@ -105,7 +106,44 @@ def main():
     row("write positions (write_positions)", lambda: mesh_io.write_positions(out, data.vertices),
         lambda: out.vertices.foreach_set("co", data.vertices.astype(np.float32).ravel()),
         lambda: (mesh_io.read_positions(out), data.vertices.astype(np.float32)))
+    edit_row(data)
     return 0
+
+
+def edit_row(data):
+    """Delete 200 faces of the horse: TopStoc's Delete Faces operator (read, engine edit, write
+    the mesh back with its attributes and flags, re-analyse) against Blender's own Edit Mode
+    delete, mode switches included (what an artist would otherwise do). One run each, fresh
+    objects with a vertex group on a third of the vertices."""
+    times = {}
+    for kind in ("topstoc", "blender"):
+        mesh = bpy.data.meshes.new(kind)
+        ts.blender.mesh_io.fill_geometry(mesh, data.vertices, data.triangles)
+        obj = bpy.data.objects.new(kind, mesh)
+        bpy.context.scene.collection.objects.link(obj)
+        group = obj.vertex_groups.new(name="Group")
+        group.add(list(range(0, len(mesh.vertices), 3)), 0.5, "REPLACE")
+        for other in bpy.context.scene.objects:
+            other.select_set(other is obj)
+        bpy.context.view_layer.objects.active = obj
+        chosen = np.zeros(len(mesh.polygons), dtype=bool)
+        chosen[:200] = True
+        mesh.vertices.foreach_set("select", np.zeros(len(mesh.vertices), dtype=bool))
+        mesh.edges.foreach_set("select", np.zeros(len(mesh.edges), dtype=bool))
+        mesh.polygons.foreach_set("select", chosen)
+        start = time.perf_counter()
+        if kind == "topstoc":
+            assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
+        else:
+            bpy.context.tool_settings.mesh_select_mode = (False, False, True)
+            bpy.ops.object.mode_set(mode="EDIT")
+            bpy.ops.mesh.delete(type="FACE")
+            bpy.ops.object.mode_set(mode="OBJECT")
+        times[kind] = time.perf_counter() - start
+        assert len(obj.data.polygons) == len(data.triangles) - 200, (kind, len(obj.data.polygons))
+        bpy.data.objects.remove(obj)
+    print(f"  {'delete 200 faces (Delete Faces operator)':44s} {times['topstoc'] * 1000:8.1f} ms   "
+          f"Edit Mode delete {times['blender'] * 1000:8.1f} ms   {times['blender'] / times['topstoc']:6.2f}x (one run)")
 
 
 if __name__ == "__main__":

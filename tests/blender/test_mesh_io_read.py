@@ -98,13 +98,15 @@ def test_polygon_materials_and_corners_match_the_per_element_accessors(ts, scene
     mesh_io, dna = ts.blender.mesh_io, ts.blender.dna_arrays
     corners = np.array([loop.vertex_index for loop in mesh.loops])
     np.testing.assert_array_equal(mesh_io.corner_vertices(mesh), corners)
+    np.testing.assert_array_equal(mesh_io.corner_edges(mesh), [loop.edge_index for loop in mesh.loops])
     arrays = mesh_io.read_mesh(mesh)
     np.testing.assert_array_equal(arrays.polygon_material, [p.material_index for p in mesh.polygons])
     if (3, 0, 0) <= bpy.app.version < (3, 6, 0):  # these Blenders keep MLoop and MPoly arrays
-        np.testing.assert_array_equal(dna.loop_vertices(mesh), corners)
+        np.testing.assert_array_equal(dna.loop_indices(mesh, "v"), corners)
+        np.testing.assert_array_equal(dna.loop_indices(mesh, "e"), [loop.edge_index for loop in mesh.loops])
         np.testing.assert_array_equal(dna.polygon_starts(mesh), [p.loop_start for p in mesh.polygons])
     elif bpy.app.version >= (4, 0, 0):
-        assert dna.loop_vertices(mesh) is None and dna.polygon_starts(mesh) is None
+        assert dna.loop_indices(mesh, "v") is None and dna.polygon_starts(mesh) is None
     assert dna._view(mesh.loops, dna.MEDGE) is None  # a layout of another size is refused
 
 
