@@ -182,20 +182,22 @@ def write_polygon_smooth(mesh, smooth: np.ndarray) -> None:
 
 def corner_vertices(mesh) -> np.ndarray:
     """Vertex of every loop (face corner)."""
-    corner_vert = mesh.attributes.get(".corner_vert")  # Blender 3.6+: a plain int attribute
-    if corner_vert is not None:
-        return _get(corner_vert.data, "value", len(mesh.loops), 1, np.int32)
-    legacy = dna_arrays.loop_indices(mesh, "v")
-    return legacy if legacy is not None else _indices(mesh.loops, "vertex_index", len(mesh.loops))
+    return _corner_indices(mesh, ".corner_vert", "v", "vertex_index")
 
 
 def corner_edges(mesh) -> np.ndarray:
     """Edge of every loop (face corner)."""
-    corner_edge = mesh.attributes.get(".corner_edge")  # Blender 3.6+: a plain int attribute
-    if corner_edge is not None:
-        return _get(corner_edge.data, "value", len(mesh.loops), 1, np.int32)
-    legacy = dna_arrays.loop_indices(mesh, "e")
-    return legacy if legacy is not None else _indices(mesh.loops, "edge_index", len(mesh.loops))
+    return _corner_indices(mesh, ".corner_edge", "e", "edge_index")
+
+
+def _corner_indices(mesh, attribute: str, dna_field: str, key: str) -> np.ndarray:
+    """A loop index field: the internal attribute (3.6+: a plain int array), or MLoop's field
+    copied in one pass (3.x), or MeshLoop's property loop by loop."""
+    layer = mesh.attributes.get(attribute)
+    if layer is not None:
+        return _get(layer.data, "value", len(mesh.loops), 1, np.int32)
+    legacy = dna_arrays.loop_indices(mesh, dna_field)
+    return legacy if legacy is not None else _indices(mesh.loops, key, len(mesh.loops))
 
 
 def _triangle_polygons(mesh, count: int) -> np.ndarray:
