@@ -28,6 +28,7 @@ import numpy as np
 MEDGE = np.dtype([("v", "<u4", 2), ("crease", "u1"), ("bweight", "u1"), ("flag", "<i2")])
 MLOOP = np.dtype([("v", "<u4"), ("e", "<u4")])
 MPOLY = np.dtype([("loopstart", "<i4"), ("totloop", "<i4"), ("mat_nr", "<i2"), ("flag", "u1"), ("pad", "u1")])
+KEY_POINT = np.dtype([("co", "<f4", 3)])  # a shape key's positions: float[3] per point
 EDGE_FLAG_BITS = {"use_seam": 1 << 2, "use_edge_sharp": 1 << 9}  # ME_SEAM, ME_SHARP
 LAYOUT_SAMPLES = 64
 
@@ -44,6 +45,20 @@ def _view(collection, dtype: np.dtype, legacy: bool = True) -> Optional[np.ndarr
             collection[count - 1].as_pointer() - first != dtype.itemsize * (count - 1):
         return None
     return np.frombuffer((ctypes.c_char * (dtype.itemsize * count)).from_address(first), dtype=dtype)
+
+
+def _checked_view(collection, dtype: np.dtype, fields: dict, legacy: bool = True) -> Optional[np.ndarray]:
+    """``_view``, when at every sampled element each of ``fields`` ({view field: RNA property})
+    equals what RNA gives; else None."""
+    raw = _view(collection, dtype, legacy)
+    if raw is None:
+        return None
+    for i in _samples(len(raw)):
+        element = collection[i]
+        for field, prop in fields.items():
+            if not np.array_equal(np.asarray(getattr(element, prop), dtype=np.float64), raw[field][i]):
+                return None
+    return raw
 
 
 def _samples(count: int, extra=()) -> list:
@@ -67,38 +82,21 @@ def edge_flag(mesh: bpy.types.Mesh, flag: str) -> Optional[np.ndarray]:
 
 def loop_indices(mesh: bpy.types.Mesh, field: str) -> Optional[np.ndarray]:
     """(loops,) int32 vertex ("v") or edge ("e") of every loop, from MLoop."""
-    raw = _view(mesh.loops, MLOOP)
-    if raw is None:
-        return None
-    for i in _samples(len(raw)):
-        loop = mesh.loops[i]
-        if (loop.vertex_index, loop.edge_index) != (raw["v"][i], raw["e"][i]):
-            return None
-    return raw[field].astype(np.int32)
+    raw = _checked_view(mesh.loops, MLOOP, {"v": "vertex_index", "e": "edge_index"})
+    return raw[field].astype(np.int32) if raw is not None else None
 
 
 def polygon_starts(mesh: bpy.types.Mesh) -> Optional[np.ndarray]:
     """(polygons,) int32 first loop of every polygon, from MPoly.loopstart. (Its material slot
     is not read: 3.4 keeps that in the "material_index" attribute and leaves MPoly.mat_nr 0.)"""
-    raw = _view(mesh.polygons, MPOLY)
-    if raw is None:
-        return None
-    for i in _samples(len(raw)):
-        polygon = mesh.polygons[i]
-        if (polygon.loop_start, polygon.loop_total) != (raw["loopstart"][i], raw["totloop"][i]):
-            return None
-    return raw["loopstart"].copy()
+    raw = _checked_view(mesh.polygons, MPOLY, {"loopstart": "loop_start", "totloop": "loop_total"})
+    return raw["loopstart"].copy() if raw is not None else None
 
 
 def shape_key_positions(block) -> Optional[np.ndarray]:
     """(n, 3) float32 positions of a shape key (a KeyBlock), from its float array."""
-    raw = _view(block.data, np.dtype(("<f4", 3)), legacy=False)
-    if raw is None:
-        return None
-    for i in _samples(len(raw)):
-        if tuple(block.data[i].co) != tuple(raw[i].tolist()):
-            return None
-    return raw.copy()
+    raw = _checked_view(block.data, KEY_POINT, {"co": "co"}, legacy=False)
+    return raw.view(np.float32).reshape(-1, 3).copy() if raw is not None else None  # (a field copy is slower)
 
 
 def byte_colors_srgb(attribute) -> Optional[np.ndarray]:

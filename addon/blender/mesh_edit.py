@@ -24,6 +24,7 @@ import bpy
 import numpy as np
 
 from ..core.errors import TopStocError
+from ..core.ranges import concatenated_ranges
 from . import mesh_io
 
 # Per-element properties read and written through foreach_get/set where the Blender version has them.
@@ -84,7 +85,7 @@ def polygon_layout(arrays: mesh_io.MeshArrays, result) -> PolygonLayout:
     starts, totals = _polygon_corners(arrays, polygons)
     keep = np.flatnonzero(intact)
     keep_totals = totals[keep]
-    keep_loops = _ranges(starts[keep], keep_totals)
+    keep_loops = concatenated_ranges(starts[keep], keep_totals)
     # Triangles of broken polygons and patch triangles become triangle polygons.
     broken_rows = rows[~intact[arrays.triangle_polygon[face_source[rows]]]]
     patch_rows = np.flatnonzero(~from_input)
@@ -111,13 +112,6 @@ def polygon_layout(arrays: mesh_io.MeshArrays, result) -> PolygonLayout:
         loop_start=loop_start, loop_total=loop_total, corner_vertex=corner_vertex.astype(np.int64),
         corner_loop=corner_loop.astype(np.int64), polygon_source=np.concatenate([keep, tri_polygon]).astype(np.int64),
         corner_patch=corner_patch)
-
-
-def _ranges(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
-    """The integers start, start + 1, ..., start + length - 1 of every (start, length), in order."""
-    lengths = np.asarray(lengths, dtype=np.int64)
-    offsets = np.cumsum(lengths) - lengths
-    return np.repeat(np.asarray(starts, dtype=np.int64) - offsets, lengths) + np.arange(int(lengths.sum()))
 
 
 def _polygon_corners(arrays, polygons: int):
@@ -214,13 +208,11 @@ def _edge_sources(old_mesh, new_mesh, vertex_source: np.ndarray) -> np.ndarray:
     return np.where(found, order[position], -1)
 
 
-_COLLECTIONS = {"POINT": "vertices", "EDGE": "edges", "FACE": "polygons"}
-
-
 def _copy_flags(old, new, domain: str, names, source: np.ndarray, unreadable=()) -> None:
     """Element flags of ``old``'s elements of ``domain`` onto ``new``'s (each from its source
     element, unflagged without one)."""
-    collection_old, collection_new = getattr(old, _COLLECTIONS[domain]), getattr(new, _COLLECTIONS[domain])
+    collection_old = getattr(old, mesh_io.DOMAIN_COLLECTIONS[domain])
+    collection_new = getattr(new, mesh_io.DOMAIN_COLLECTIONS[domain])
     if len(collection_new) == 0 or len(collection_old) == 0:
         return
     names = [name for name in names if name not in unreadable]
@@ -245,14 +237,8 @@ def _copy_flag_attributes(old, new, domain: str, names, source: np.ndarray) -> N
             continue  # none flagged (the default), or mistyped (see mesh_io.mistyped_edge_flags)
         values, key = mesh_io.read_attribute(attribute, mesh_io._domain_size(old, domain))
         picked = _gather(values[:, 0], source)
-        target = new.attributes.get(attribute.name)
-        if target is not None and (target.domain, target.data_type) != (domain, kind):
-            new.attributes.remove(target)
-            target = None
         if picked.any():
-            if target is None:
-                target = new.attributes.new(attribute.name, kind, domain)
-            target.data.foreach_set(key, picked)
+            mesh_io.attribute_for_write(new, attribute.name, kind, domain).data.foreach_set(key, picked)
 
 
 def _copy_attributes(old, new, layout: PolygonLayout, result, edge_source: np.ndarray, uv_names: set) -> None:
@@ -278,11 +264,7 @@ def _copy_attributes(old, new, layout: PolygonLayout, result, edge_source: np.nd
             picked = _patch_mean(values, layout.corner_loop, layout.corner_patch)
         else:
             picked = _gather(values, sources[domain])
-        target = new.attributes.get(name)
-        if target is None or target.domain != domain or target.data_type != attribute.data_type:
-            if target is not None:
-                new.attributes.remove(target)
-            target = new.attributes.new(name, attribute.data_type, domain)
+        target = mesh_io.attribute_for_write(new, name, attribute.data_type, domain)
         if len(picked):
             target.data.foreach_set(key, np.ascontiguousarray(picked).ravel())
 

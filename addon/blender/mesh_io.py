@@ -27,6 +27,7 @@ from ..core.attributes import MovedVertices, SparseWeights, corner_values, moved
 from ..core.digest import array_digest
 from ..core.edge_flags import carried_edge_flags
 from ..core.mesh_edges import mesh_edges
+from ..core.ranges import matching_rows
 from . import dna_arrays
 
 # Attribute data type -> (foreach key, values per element, numpy dtype)
@@ -108,6 +109,25 @@ def check_mesh_object(obj, error: type) -> None:
         raise error(f"'{obj.name}' is in Edit Mode; switch to Object Mode")
 
 
+def _typed_attribute(mesh, name: str, domain: str, data_type: str):
+    """``mesh``'s attribute ``name`` when it has that domain and type, else None."""
+    attribute = mesh.attributes.get(name)
+    if attribute is not None and (attribute.domain, attribute.data_type) == (domain, data_type):
+        return attribute
+    return None
+
+
+def attribute_for_write(mesh, name: str, data_type: str, domain: str):
+    """``mesh``'s attribute ``name`` of that type and domain: the one it has, or made now (one of
+    that name with another type or domain is replaced). Making an attribute invalidates Python
+    references to the mesh's other attributes."""
+    attribute = mesh.attributes.get(name)
+    if attribute is not None and (attribute.domain, attribute.data_type) != (domain, data_type):
+        mesh.attributes.remove(attribute)
+        attribute = None
+    return attribute if attribute is not None else mesh.attributes.new(name, data_type, domain)
+
+
 def _position_attribute(mesh):
     """The "position" attribute where Blender keeps positions as a plain float3 array (3.5+).
     Its foreach_get/set copy the array at once; MeshVertex.co goes through RNA one vertex at a time
@@ -115,10 +135,7 @@ def _position_attribute(mesh):
     ``co``, under 1 ms through the attribute)."""
     if bpy.app.version < (3, 5, 0):  # positions live in MVert; a layer of that name is the user's
         return None
-    attribute = mesh.attributes.get("position")
-    if attribute is not None and attribute.domain == "POINT" and attribute.data_type == "FLOAT_VECTOR":
-        return attribute
-    return None
+    return _typed_attribute(mesh, "position", "POINT", "FLOAT_VECTOR")
 
 
 def read_positions(mesh) -> np.ndarray:
@@ -145,10 +162,7 @@ def write_polygon_materials(mesh, materials: np.ndarray) -> None:
     MeshPolygon.material_index goes one polygon at a time (225 ms for 1.55M in 4.5)."""
     values = np.ascontiguousarray(materials, dtype=np.int32)
     if bpy.app.version >= (4, 0, 0):
-        attribute = mesh.attributes.get("material_index")
-        if attribute is None:
-            attribute = mesh.attributes.new("material_index", "INT", "FACE")
-        attribute.data.foreach_set("value", values)
+        attribute_for_write(mesh, "material_index", "INT", "FACE").data.foreach_set("value", values)
     else:
         mesh.polygons.foreach_set("material_index", values)
 
@@ -156,8 +170,8 @@ def write_polygon_materials(mesh, materials: np.ndarray) -> None:
 def read_polygon_smooth(mesh) -> Optional[np.ndarray]:
     """Every polygon's smooth flag, or None when all are smooth (Blender 4.0+ without a
     "sharp_face" attribute)."""
-    sharp = mesh.attributes.get("sharp_face")
-    if sharp is not None and sharp.domain == "FACE" and sharp.data_type == "BOOLEAN":
+    sharp = _typed_attribute(mesh, "sharp_face", "FACE", "BOOLEAN")
+    if sharp is not None:
         return ~_get(sharp.data, "value", len(mesh.polygons), 1, bool)
     if bpy.app.version >= (4, 0, 0):
         return None
@@ -172,10 +186,7 @@ def write_polygon_smooth(mesh, smooth: np.ndarray) -> None:
     smooth = np.asarray(smooth, dtype=bool)
     if bpy.app.version >= (4, 0, 0):
         if not smooth.all():
-            attribute = mesh.attributes.get("sharp_face")
-            if attribute is None:
-                attribute = mesh.attributes.new("sharp_face", "BOOLEAN", "FACE")
-            attribute.data.foreach_set("value", ~smooth)
+            attribute_for_write(mesh, "sharp_face", "BOOLEAN", "FACE").data.foreach_set("value", ~smooth)
     elif smooth.any():
         mesh.polygons.foreach_set("use_smooth", smooth)
 
@@ -279,10 +290,7 @@ def _uv_attribute(mesh, name: str):
     the UVs of 4.65M corners, 6 ms through the attribute); None before 3.5."""
     if bpy.app.version < (3, 5, 0):
         return None
-    attribute = mesh.attributes.get(name)
-    if attribute is not None and attribute.domain == "CORNER" and attribute.data_type == "FLOAT2":
-        return attribute
-    return None
+    return _typed_attribute(mesh, name, "CORNER", "FLOAT2")
 
 
 def read_uv_maps(mesh: bpy.types.Mesh) -> dict:
@@ -344,9 +352,12 @@ def read_vertex_group(obj: bpy.types.Object, group_index: int, vertex_ids=None):
     return weights, assigned
 
 
+# The mesh collection holding each attribute domain's elements.
+DOMAIN_COLLECTIONS = {"POINT": "vertices", "EDGE": "edges", "FACE": "polygons", "CORNER": "loops"}
+
+
 def _domain_size(mesh, domain: str) -> int:
-    return {"POINT": len(mesh.vertices), "EDGE": len(mesh.edges), "FACE": len(mesh.polygons),
-            "CORNER": len(mesh.loops)}.get(domain, -1)
+    return len(getattr(mesh, DOMAIN_COLLECTIONS[domain])) if domain in DOMAIN_COLLECTIONS else -1
 
 
 def fill_geometry(mesh: bpy.types.Mesh, vertices: np.ndarray, triangles: np.ndarray, edges=None) -> None:
@@ -406,7 +417,7 @@ ELEMENT_FLAG_ATTRIBUTES = {
 
 def read_element_flag(mesh: bpy.types.Mesh, domain: str, flag: str) -> np.ndarray:
     """``flag`` ("select" or "hide") of every element of ``domain`` (POINT, EDGE, FACE) as bools."""
-    collection = {"POINT": mesh.vertices, "EDGE": mesh.edges, "FACE": mesh.polygons}[domain]
+    collection = getattr(mesh, DOMAIN_COLLECTIONS[domain])
     if bpy.app.version < (4, 0, 0):
         return _get(collection, flag, len(collection), 1, bool)
     attribute = element_flag_attribute(mesh, domain, flag)
@@ -418,11 +429,7 @@ def read_element_flag(mesh: bpy.types.Mesh, domain: str, flag: str) -> np.ndarra
 def element_flag_attribute(mesh: bpy.types.Mesh, domain: str, flag: str):
     """The attribute that holds ``flag`` (one of ELEMENT_FLAG_ATTRIBUTES) of ``domain``'s elements
     in Blender 4.0+, None when there is none: no element has the flag."""
-    for name in ELEMENT_FLAG_ATTRIBUTES[domain][flag][0]:
-        attribute = mesh.attributes.get(name)
-        if attribute is not None:
-            return attribute
-    return None
+    return _first_attribute(mesh, ELEMENT_FLAG_ATTRIBUTES[domain][flag][0])
 
 
 def read_carried_edge_flags(source: bpy.types.Mesh) -> dict:
@@ -461,20 +468,20 @@ def write_edge_flags(mesh: bpy.types.Mesh, flags: dict) -> None:
         if bpy.app.version < (4, 0, 0):
             mesh.edges.foreach_set(flag, values)
             continue
-        attribute = _flag_attribute(mesh, flag)
-        if attribute is not None and (attribute.domain, attribute.data_type) != ("EDGE", "BOOLEAN"):
-            mesh.attributes.remove(attribute)  # mistyped (see mistyped_edge_flags): made anew
-            attribute = None
-        if attribute is None:
-            names = _EDGE_FLAG_ATTRIBUTES[flag][0]
-            attribute = mesh.attributes.new(names[-1] if bpy.app.version >= (4, 5, 0) else names[0],
-                                            "BOOLEAN", "EDGE")
-        attribute.data.foreach_set("value", values)
+        existing = _flag_attribute(mesh, flag)  # a mistyped one (mistyped_edge_flags) is made anew
+        names = _EDGE_FLAG_ATTRIBUTES[flag][0]
+        name = existing.name if existing is not None else names[-1] if bpy.app.version >= (4, 5, 0) else names[0]
+        attribute_for_write(mesh, name, "BOOLEAN", "EDGE").data.foreach_set("value", values)
 
 
 def _flag_attribute(mesh: bpy.types.Mesh, flag: str):
     """The attribute that holds edge ``flag`` in this Blender, None when there is none."""
-    for name in _EDGE_FLAG_ATTRIBUTES[flag][0]:
+    return _first_attribute(mesh, _EDGE_FLAG_ATTRIBUTES[flag][0])
+
+
+def _first_attribute(mesh: bpy.types.Mesh, names):
+    """The first of ``names`` that ``mesh`` has as an attribute, or None."""
+    for name in names:
         attribute = mesh.attributes.get(name)
         if attribute is not None:
             return attribute
@@ -558,12 +565,9 @@ def collect_vertex_groups(obj, kept: np.ndarray) -> dict:
     if not len(obj.vertex_groups):
         return {}
     names, weights = read_vertex_weights(obj, kept)
-    # every output vertex of each weight's input vertex: kept sorted (stable), then its range
+    # every output vertex of each weight's input vertex (kept sorted stably: outputs in order)
     order = np.argsort(kept, kind="stable")
-    sorted_kept = kept[order]
-    first = np.searchsorted(sorted_kept, weights.vertex, side="left")
-    count = np.searchsorted(sorted_kept, weights.vertex, side="right") - first
-    rows = np.repeat(first - (np.cumsum(count) - count), count) + np.arange(int(count.sum()))
+    rows, count = matching_rows(kept[order], weights.vertex)
     output, group, weight = order[rows], np.repeat(weights.group, count), np.repeat(weights.weight, count)
     return {name: (output[group == g].tolist(), weight[group == g].tolist()) for g, name in enumerate(names)}
 
@@ -646,11 +650,7 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
         if read is None:
             continue
         values, key = read
-        target = out.attributes.get(name_)
-        if target is None or target.domain != attribute.domain or target.data_type != attribute.data_type:
-            if target is not None:
-                out.attributes.remove(target)
-            target = out.attributes.new(name_, attribute.data_type, attribute.domain)
+        target = attribute_for_write(out, name_, attribute.data_type, attribute.domain)
         picked = carried(values, attribute.domain, nearest=attribute.data_type not in _INTERPOLATED)
         if len(picked):
             target.data.foreach_set(key, np.ascontiguousarray(picked).ravel())

@@ -205,7 +205,7 @@ def skin_weights(obj, arrays: mesh_io.MeshArrays, kept: np.ndarray, moved) -> tu
     its input vertex's; a moved one mixes its source triangle's (core/attributes.point_weights),
     rescaled to sum to 1 when the source's weights read (those of the kept vertices and of the
     moved vertices' triangles) all sum to 1."""
-    corners = arrays.triangles[moved.face[moved.moved]].astype(np.int64).ravel()  # not a copy of every triangle
+    corners = moved.source_corners(arrays.triangles, moved.moved).ravel()
     names, source = mesh_io.read_vertex_weights(obj, np.concatenate([kept, corners]))
     return names, point_weights(source, kept, moved, arrays.triangles, normalise=source.normalised())
 

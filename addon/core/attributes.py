@@ -22,6 +22,7 @@ from typing import Optional
 import numpy as np
 
 from .io import MeshData
+from .ranges import matching_rows
 
 
 def uv_seam_edges(triangles, corner_uvs) -> np.ndarray:
@@ -122,6 +123,11 @@ class MovedVertices:
         """Output vertices that moved."""
         return np.flatnonzero(self.face >= 0)
 
+    def source_corners(self, triangles, vertices) -> np.ndarray:
+        """(k, 3) int64 input vertices of the source triangles of the moved output ``vertices``
+        (gathered before widening: ``triangles`` may be the whole input mesh)."""
+        return np.asarray(triangles)[self.face[vertices]].astype(np.int64)
+
 
 def moved_vertices(vertices, triangles, result) -> MovedVertices:
     """For each output vertex of ``result`` (a DecimateResult of the mesh ``vertices``,
@@ -188,7 +194,7 @@ def point_values(values, kept, moved: MovedVertices, triangles, nearest: bool = 
     out = values[np.asarray(kept, dtype=np.int64)].copy()
     at = moved.moved
     if len(at):
-        corners = np.asarray(triangles)[moved.face[at]].astype(np.int64)
+        corners = moved.source_corners(triangles, at)
         out[at] = _combine(values, corners, moved.weights[at], nearest)
     return out
 
@@ -231,14 +237,10 @@ def point_weights(weights: SparseWeights, kept, moved: MovedVertices, triangles,
     at = moved.moved
     still = np.flatnonzero(moved.face < 0)
     pair_out = np.concatenate([still, np.repeat(at, 3)])
-    pair_in = np.concatenate([kept[still], np.asarray(triangles)[moved.face[at]].astype(np.int64).ravel()])
+    pair_in = np.concatenate([kept[still], moved.source_corners(triangles, at).ravel()])
     pair_factor = np.concatenate([np.ones(len(still)), moved.weights[at].ravel()])
     # every entry of each pair's input vertex
-    first = np.searchsorted(vertex, pair_in, side="left")
-    count = np.searchsorted(vertex, pair_in, side="right") - first
-    total = int(count.sum())
-    starts = np.repeat(first - (np.cumsum(count) - count), count)
-    entry = starts + np.arange(total)
+    entry, count = matching_rows(vertex, pair_in)
     out_vertex = np.repeat(pair_out, count)
     out_group = group[entry]
     out_weight = weight[entry] * np.repeat(pair_factor, count)
@@ -271,7 +273,7 @@ def corner_values(values, corner_source, output_triangles, moved: MovedVertices,
     at = np.flatnonzero(moved.face[corner_vertex] >= 0)
     if len(at):
         vertex = corner_vertex[at]
-        corners = np.asarray(triangle_corners)[moved.face[vertex]].astype(np.int64)
+        corners = moved.source_corners(triangle_corners, vertex)
         out[at] = _combine(values, corners, moved.weights[vertex], nearest)
     return out
 

@@ -13,7 +13,6 @@ last row writes a topology edit back (Delete Faces) against Blender's own Edit M
 
 import os
 import pathlib
-import platform
 import statistics
 import sys
 import time
@@ -21,6 +20,9 @@ import time
 import bpy  # first: PyPI's bpy module makes addon_utils importable
 import addon_utils  # noqa: E402
 import numpy as np
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from machine import machine  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HORSE = ROOT.parent / "shared" / "meshes" / "big" / "horse_loop2_1.55M.ply"
@@ -75,9 +77,7 @@ def main():
         block.data.foreach_set("co", (data.vertices + rng.normal(0, 0.01, data.vertices.shape)).astype(np.float32).ravel())
     blocks = mesh.shape_keys.key_blocks
 
-    cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")),
-               platform.processor())
-    print(f"machine: {os.cpu_count()} cores, {cpu}; Blender {bpy.app.version_string}")
+    print(f"machine: {machine()}; Blender {bpy.app.version_string}")
     print(f"mesh: {HORSE.name} ({n:,} vertices, {corners:,} corners), a UV map, a byte colour per corner, "
           f"{SHAPE_KEYS} shape keys")
     row("positions (read_positions)", lambda: mesh_io.read_positions(mesh),
