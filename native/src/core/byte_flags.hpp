@@ -20,4 +20,8 @@ inline uint32_t flag_bits(uint64_t word) {
   return uint32_t(((word & 0x0101010101010101ull) * 0x0102040810204080ull) >> 56);
 }
 
+/// How many of a word's flags (bytes 0 or 1) are set: the bytes summed into the top one by a
+/// multiply (a portable build has no popcount instruction and calls a library function).
+inline uint32_t flag_count(uint64_t word) { return uint32_t((word * 0x0101010101010101ull) >> 56); }
+
 }  // namespace topstoc

@@ -173,7 +173,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     const int me = omp_get_thread_num();
     int64_t mine = 0;
 #pragma omp for schedule(static)
-    for (int64_t w = 0; w < words; ++w) mine += __builtin_popcountll(flag_word(emits + 8 * w));
+    for (int64_t w = 0; w < words; ++w) mine += flag_count(flag_word(emits + 8 * w));
     run_start[me + 1] = mine;
 #pragma omp barrier
 #pragma omp single
