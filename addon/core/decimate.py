@@ -179,6 +179,8 @@ class DecimateStats:
     #: native verify.hpp). All zero except ``zero_area`` whenever ``topology_kept`` is True: a
     #: violation the repairs did not report raises instead of returning.
     output_check: dict = field(default_factory=dict)
+    #: the final check ran; False only for a draft (``decimate(draft=True)``), which leaves it out
+    output_checked: bool = True
 
     @property
     def over_budget(self) -> int:
@@ -196,8 +198,11 @@ class DecimateStats:
         return "control points" if self.forced >= self.target_vertices else "topology"
 
     @property
-    def topology_kept(self) -> bool:
-        """True when no topological issue remained (see issues_remaining)."""
+    def topology_kept(self) -> Optional[bool]:
+        """True when no topological issue remained (see issues_remaining) and the final check
+        confirmed it; None for a draft, whose output was not re-checked."""
+        if not self.output_checked:
+            return None
         return not any(v for k, v in self.issues_remaining.items() if k != "sliver") and \
             not any(v for k, v in self.output_check.items() if k != "zero_area")
 
@@ -337,7 +342,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
              boxes: Sequence[Box] = (), mode: str = "quality", placement: Optional[str] = None,
              fast_path: Optional[bool] = None, max_repair_rounds: int = 200, refine: Optional[float] = None,
              max_error: Optional[float] = None, relative: bool = False, attributes=None,
-             attribute_weights=None) -> DecimateResult:
+             attribute_weights=None, draft: bool = False) -> DecimateResult:
     """Decimates ``mesh`` with TopStoc. Give exactly one target.
 
     ratio: fraction of the vertices to keep, in (0, 1]. target_vertices / target_triangles:
@@ -376,6 +381,11 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     max_error: the fewest vertices whose symmetric Hausdorff error stays within this bound
     (absolute, or a fraction of the bounding-box diagonal with ``relative=True``), found by a
     search over re-decimations with the same seed; ``result.error_bound`` tells how it went.
+    draft: a live-preview frame (fast mode only): the same vertices and triangles, without
+    face_source, corner_source and labels (empty arrays) and without the final output check
+    (``stats.output_checked`` False, ``stats.topology_kept`` None). The partition checks and
+    repairs still run; what a draft skips is the independent re-check, so show drafts while a
+    slider moves and decimate in full for what is kept.
     """
     vertices = _renamed("vertices", vertices, "target_vertices", target_vertices)  # the counts asked for
     triangles = _renamed("triangles", triangles, "target_triangles", target_triangles)
@@ -386,6 +396,9 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
                            f"got {given or 'none'}")
     if mode not in MODES:
         raise TopStocError(f"mode must be one of {MODES}, got {mode!r}")
+    if draft and (mode != "fast" or refine or max_error is not None):
+        raise TopStocError("draft=True is for preview frames of the fast mode: give mode='fast', no refine "
+                           "and no max_error")
     if placement is None:
         placement = "filtered" if mode == "quality" else "subsample"
     refine_asked = refine  # the error-bounded search re-decimates with the caller's own choice
@@ -450,7 +463,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
         view=_engine_view(view), boxes=_engine_boxes(boxes), placement=placement,
         fast_path=0 if fast_path is None else int(bool(fast_path)),
         max_repair_rounds=int(max_repair_rounds), refine=float(refine), refine_collapses=int(refine_collapses),
-        attributes=attribute_values, attribute_weights=attribute_weights, flood_caches=floods)
+        attributes=attribute_values, attribute_weights=attribute_weights, flood_caches=floods, draft=bool(draft))
     return _result(raw, parameters)
 
 

@@ -128,6 +128,7 @@ py::dict result_dict(DecimateResult&& r) {
   check["boundary_loops_changed"] = c.boundary_loops_changed;
   check["pinched_fans_changed"] = c.pinched_fans_changed;
   d["output_check"] = check;
+  d["output_checked"] = r.output_checked;
   py::dict seconds;
   seconds["sampling"] = r.seconds_sampling;
   seconds["clustering"] = r.seconds_clustering;
@@ -202,7 +203,7 @@ void bind_decimate(py::module_& m) {
          int32_t density_rings, double density_ratio, double density_epsilon, const py::handle& view,
          const py::handle& boxes, const std::string& placement, int fast_path, int32_t max_repair_rounds,
          double refine, int32_t refine_collapses, const py::handle& attributes, const py::handle& attribute_weights,
-         const py::handle& flood_caches) {
+         const py::handle& flood_caches, bool draft) {
         const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
         DecimateParams params;
         params.sampling = sampling_from(mesh, seed, adaptivity, flat_floor, area_weighted, u, density, density_rings,
@@ -217,6 +218,7 @@ void bind_decimate(py::module_& m) {
         const AttributeArrays arrays = attributes_from(mesh, attributes, attribute_weights);
         params.attributes = arrays.view(mesh.report().input_triangles);
         params.flood_caches = flood_caches.is_none() ? nullptr : flood_caches.cast<FloodCachePool*>();
+        params.draft = draft;
         DecimateResult r;
         {
           EngineCall call;
@@ -231,7 +233,7 @@ void bind_decimate(py::module_& m) {
       py::arg("density_epsilon") = 0.0, py::arg("view") = py::none(), py::arg("boxes") = py::none(),
       py::arg("placement") = "subsample", py::arg("fast_path") = 0, py::arg("max_repair_rounds") = 200,
       py::arg("refine") = 0.0, py::arg("refine_collapses") = 0, py::arg("attributes") = py::none(),
-      py::arg("attribute_weights") = py::none(), py::arg("flood_caches") = py::none(),
+      py::arg("attribute_weights") = py::none(), py::arg("flood_caches") = py::none(), py::arg("draft") = false,
       "TopStoc decimation to a vertex target (or a triangle target when target_triangles > 0).");
 
   m.def(

@@ -130,7 +130,7 @@ int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Cl
 }
 
 DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
-                      Clustering& clustering, const Partition& partition, Placement placement,
+                      Clustering& clustering, const Partition& partition, Placement placement, bool draft,
                       DecimateResult result) {
   const auto start = Clock::now();
   const int32_t k = static_cast<int32_t>(samples.size());
@@ -148,8 +148,10 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   auto label = [&clustering](int32_t v) { return clustering.label(v); };
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
+  // (A draft keeping input positions reads neither labels nor the clusters: it skips this.)
   std::vector<int32_t> orphans;
-  if (std::find(partition.absorbed.begin(), partition.absorbed.end(), 1) != partition.absorbed.end()) {
+  const bool relabel = !draft || placement == Placement::Filtered;
+  if (relabel && std::find(partition.absorbed.begin(), partition.absorbed.end(), 1) != partition.absorbed.end()) {
     const int32_t n = mesh.num_vertices();
     std::vector<std::vector<int32_t>> found(omp_get_max_threads());
 #pragma omp parallel if (n >= kParallelMin)
@@ -191,6 +193,21 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
       for (int j = 0; j < 3; ++j) result.vertices[3 * size_t(output_index[s]) + j] = mesh.position(samples[s])[j];
   }
+  const size_t t = partition.source_face.size();
+  result.triangles.resize(3 * t);
+  auto publish_ids = [&]() {  // public ids are the caller's
+    const auto& source = mesh.vertex_source();
+    for (auto& v : result.kept) v = source[v];
+    for (auto& v : samples) v = source[v];
+    result.samples = std::move(samples);
+    result.seconds_output = seconds_since(start);
+  };
+  if (draft) {  // geometry only (DecimateParams::draft)
+#pragma omp parallel for schedule(static) if (t >= kParallelMin)
+    for (size_t i = 0; i < 3 * t; ++i) result.triangles[i] = output_index[partition.triangles[i]];
+    publish_ids();
+    return result;
+  }
   // A sample with one sector has one corner to copy attributes from, whatever the triangle:
   // the mesh's first corner of it (others walk per output corner, see attribute_corner).
   // Looking the corner up here instead (its first face, the face's corners, the caller's id:
@@ -199,8 +216,6 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
 #pragma omp parallel for schedule(static) if (k >= kParallelMinCostly)
   for (int32_t s = 0; s < k; ++s)
     if (output_index[s] >= 0 && layout.sectors[samples[s]] <= 1) single_corner[s] = mesh.first_corner()[samples[s]];
-  const size_t t = partition.source_face.size();
-  result.triangles.resize(3 * t);
   result.face_source.resize(t);
   result.corner_source.resize(3 * t);
 #pragma omp parallel for schedule(static) if (t >= kParallelMin)
@@ -215,16 +230,12 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
                                             : attribute_corner(mesh, layout, clustering, f, j, samples[rank]);
     }
   }
-  // Public ids are the caller's.
   const auto& source = mesh.vertex_source();
-  for (auto& v : result.kept) v = source[v];
-  for (auto& v : samples) v = source[v];
   result.labels.resize(clustering.key.size());
   const int64_t n = int64_t(clustering.key.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int64_t v = 0; v < n; ++v) result.labels[source[v]] = label(v) >= 0 ? output_index[label(v)] : -1;
-  result.samples = std::move(samples);
-  result.seconds_output = seconds_since(start);
+  publish_ids();
   return result;
 }
 
@@ -254,7 +265,7 @@ std::vector<int32_t> widest_clusters(const Clustering& c, const std::vector<uint
 DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                 Placement placement, int32_t max_rounds, bool repair_slivers, bool fast_path,
                                 const std::vector<uint8_t>& avoid, const std::vector<uint8_t>& required,
-                                int32_t top_up_to, FloodCache* cache, DecimateResult result) {
+                                int32_t top_up_to, FloodCache* cache, bool draft, DecimateResult result) {
   auto start = Clock::now();
   Clustering clustering;
   std::vector<int32_t> cross_edges;
@@ -429,7 +440,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
   if (partition.issues.sliver > 0 && partition.issues.topological() == 0)
     result.issues_remaining.sliver = partition.issues.sliver;
   result.seconds_checking = seconds_since(start);
-  return finish(mesh, layout, std::move(samples), clustering, partition, placement, std::move(result));
+  return finish(mesh, layout, std::move(samples), clustering, partition, placement, draft, std::move(result));
 }
 
 // The final check (verify.hpp): a result whose repairs left no issue must pass it; otherwise
@@ -439,6 +450,7 @@ void check_result(const Mesh& mesh, const FeatureLayout& layout, DecimateResult&
   std::vector<int32_t> kept(result.kept.size());
   for (size_t i = 0; i < kept.size(); ++i) kept[i] = mesh.vertex_index()[result.kept[i]];
   result.output_check = check_output(mesh, layout, kept, result.vertices, result.triangles);
+  result.output_checked = true;
   result.seconds_verify = seconds_since(start);
 }
 
@@ -517,7 +529,7 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
   // The fast path finds emitting faces from the flood's crossings, which can miss one that
   // a full scan (and so an updated flood) finds: its results are its own, never updated.
   return cluster_and_emit(mesh, layout, std::move(set.samples), params.placement, params.max_repair_rounds, true,
-                          fast, avoid, required, top_up_to, fast ? nullptr : cache, std::move(result));
+                          fast, avoid, required, top_up_to, fast ? nullptr : cache, params.draft, std::move(result));
 }
 
 }  // namespace
@@ -562,13 +574,22 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
   // An input with collinear vertices can leave zero-area triangles the repairs could not
   // remove: collapse one edge of each (never an output with a zero-area triangle).
   if (!refined && has_zero_area(best)) {
+    if (params.draft) {
+      // The cleanup follows the result's labels and corners, which a draft leaves out: this
+      // (rare: collinear input vertices) frame is made in full.
+      DecimateParams full = params;
+      full.draft = false;
+      return stochastic_pass(mesh, layout, full, refined);
+    }
     const std::vector<double> multipliers = guidance_multipliers(mesh, params.sampling);
     RefineParams cleanup;
     cleanup.multipliers = &multipliers;
     cleanup.zero_area_only = true;
     refine_by_collapses(mesh, layout, cleanup, best);
   }
-  if (refined && !best.fast_path) return best;
+  // A draft's output is not re-checked; a fast-path result is, since the check decides
+  // whether it must be redone.
+  if ((refined || params.draft) && !best.fast_path) return best;
   check_result(mesh, layout, best);
   if (best.fast_path && !topology_kept(best)) {
     // The fast path's candidate faces can miss an emitting face (seen once in 55,000 random
@@ -598,6 +619,7 @@ int32_t first_pass_vertices(const DecimateParams& params, int32_t active) {
 // stop there instead (the vertex target then sets the first pass and the guidance quotas).
 DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
                        int32_t target_triangles) {
+  if (params.draft) throw std::invalid_argument("a draft is plain TopStoc: refine must be 0");
   const int32_t active = active_vertices(mesh);
   DecimateParams first = params;
   first.refine = 0.0;
@@ -664,7 +686,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
   // A refined result's first pass keeps input positions: the refinement places what it keeps.
   result = cluster_and_emit(mesh, layout, std::move(samples), refine_vertices > 0 ? Placement::Subsample : placement,
                             max_repair_rounds, false, false, {},
-                            std::vector<uint8_t>(mesh.num_vertices(), 0), 0, nullptr, std::move(result));
+                            std::vector<uint8_t>(mesh.num_vertices(), 0), 0, nullptr, false, std::move(result));
   // A refined result is thinned again; an unrefined one loses its zero-area triangles, as
   // decimate() does.
   if (refine_vertices > 0 || has_zero_area(result)) {
@@ -705,7 +727,7 @@ DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layo
   for (int it = 0; it < std::max(1, max_iterations); ++it) {
     params.target_vertices = std::clamp(int32_t(std::lround(vertices)), 1, active);
     DecimateResult r = decimate(mesh, layout, params);
-    const int32_t got = static_cast<int32_t>(r.face_source.size());
+    const int32_t got = static_cast<int32_t>(r.triangles.size() / 3);
     const int32_t error = std::abs(got - target_triangles);
     if (error < best_error) {
       best_error = error;

@@ -58,6 +58,12 @@ struct DecimateParams {
   /// result is the same either way, nearby targets of one seed come sooner (not with the fast
   /// path, whose results can differ from a full scan's).
   FloodCachePool* flood_caches = nullptr;
+  /// A live-preview frame (plain TopStoc only, refine 0): the output's geometry (samples, kept,
+  /// vertices, triangles) without face_source, corner_source and labels, and without the final
+  /// output check (verify.hpp) unless the fast path needs it. The partition checks and repairs
+  /// run as always, so the mesh is the one a full decimation gives; output_checked tells that
+  /// it was not re-checked. (Horse at 10 %, one thread: 10 + 5 of about 75 ms.)
+  bool draft = false;
 };
 
 struct DecimateResult {
@@ -92,6 +98,7 @@ struct DecimateResult {
   double seconds_verify = 0;  ///< the final output check (verify.hpp)
   double seconds_refine = 0;
   OutputCheck output_check;            ///< the final check of the output (verify.hpp)
+  bool output_checked = false;         ///< the final check ran (always, except for drafts)
 };
 
 /// Decimates to params.target_vertices (1 <= target). Throws std::invalid_argument on bad params.

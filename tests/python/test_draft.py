@@ -1,0 +1,112 @@
+"""Drafts (``decimate(draft=True)``): the live preview's frames while a slider moves. A draft
+must be the full fast decimation's mesh (the same samples, vertices and triangles), without
+the attribute sources and labels and without the final output check, and must say so: its
+``output_checked`` is False and its ``topology_kept`` None, never True.
+
+Every draft here is compared with a full decimation made on a mesh that keeps no flood, so the
+comparison also covers drafts that updated a kept flood (the drag's case)."""
+
+import pathlib
+import sys
+
+import numpy as np
+import pytest
+
+import meshgen
+import reference
+from topstoc.core import Mesh, TopStocError
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
+import random_manifolds  # noqa: E402
+
+DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
+GEOMETRY = ("samples", "kept", "vertices", "triangles")
+LEFT_OUT = ("face_source", "corner_source", "labels")
+
+
+def assert_draft_of(draft, full) -> bool:
+    """Checks a draft against the full decimation; False when the frame was made in full (zero-area
+    triangles to clean up: then it must be the full result, checked)."""
+    made_in_full = draft.stats.output_checked
+    for name in GEOMETRY + (LEFT_OUT if made_in_full else ()):
+        np.testing.assert_array_equal(getattr(draft, name), getattr(full, name), err_msg=name)
+    assert draft.stats.issues_found == full.stats.issues_found
+    assert (draft.stats.repairs, draft.stats.top_up) == (full.stats.repairs, full.stats.top_up)
+    assert full.stats.output_checked and full.stats.topology_kept
+    if made_in_full:
+        assert draft.stats.topology_kept and draft.stats.issues_found["sliver"] > 0
+        return False
+    assert draft.stats.topology_kept is None
+    for name in LEFT_OUT:
+        assert len(getattr(draft, name)) == 0, name
+    assert draft.stats.seconds["verify"] == 0.0
+    return True
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_a_drag_of_drafts_gives_the_full_meshes(seed):
+    """Random hulls, tori, grids with holes, several components and surfaces glued at vertices
+    (tests/random_manifolds.py), 12 steps of a drag each."""
+    make = random_manifolds.pinched_surface if seed % 3 == 2 else random_manifolds.random_manifold
+    vertices, triangles = make(seed)
+    mesh, plain = Mesh(vertices, triangles), Mesh(vertices, triangles, keep_floods=False)
+    rng = np.random.default_rng(seed)
+    ratio, drafts = rng.uniform(0.05, 0.5), 0
+    for _ in range(12):
+        ratio = float(np.clip(ratio * (1 + rng.uniform(-0.1, 0.1)), 0.02, 0.9))
+        draft = mesh.decimate(ratio=ratio, seed=seed, mode="fast", draft=True)
+        drafts += assert_draft_of(draft, plain.decimate(ratio=ratio, seed=seed, mode="fast"))
+    assert drafts >= 10
+
+
+@pytest.mark.parametrize("name", ["genus_positive/cgal_elephant.off", "open_boundary/cgal_mushroom.off",
+                                  "genus0/cgal_fandisk.off", "nonmanifold_degenerate/cgal_degtri_sliding.off"])
+def test_real_meshes_with_guidance_creases_and_triangle_targets(name):
+    vertices, triangles = reference.read_off(DATA / name)
+    mesh, plain = Mesh(vertices, triangles), Mesh(vertices, triangles, keep_floods=False)
+    u = np.clip(vertices[:, 0] - vertices[:, 0].mean(), -0.6, 0.6) / max(1e-9, np.ptp(vertices[:, 0]))
+    cases = [dict(ratio=0.1, seed=1), dict(ratio=0.03, seed=2, guidance=u), dict(ratio=0.2, seed=3, feature_angle=0.6),
+             dict(target_triangles=max(4, len(triangles) // 20), seed=4)]
+    drafts = 0
+    for options in cases:
+        draft = mesh.decimate(mode="fast", draft=True, **options)
+        drafts += assert_draft_of(draft, plain.decimate(mode="fast", **options))
+    assert drafts >= 1  # (cgal_degtri_sliding's zero-area triangles make three of its frames in full)
+
+
+def test_collinear_vertices_make_the_frame_in_full():
+    """The zero-area cleanup follows labels and corners, which a draft leaves out: such a frame
+    (the genus-133 grid at 5 %, see test_zero_area.py) comes out as the full decimation."""
+    vertices, triangles = meshgen.genus_grid(7, 19, scale=(2, 2, 3))
+    mesh = Mesh(vertices, triangles, keep_floods=False)
+    full_frames = 0
+    for seed in range(4):
+        full = mesh.decimate(ratio=0.05, seed=seed, mode="fast")
+        draft = mesh.decimate(ratio=0.05, seed=seed, mode="fast", draft=True)
+        for name in GEOMETRY + LEFT_OUT:
+            if draft.stats.output_checked or name in GEOMETRY:
+                np.testing.assert_array_equal(getattr(draft, name), getattr(full, name), err_msg=name)
+        full_frames += draft.stats.output_checked
+    assert full_frames > 0  # the case was met
+
+
+def test_the_fast_path_is_always_checked():
+    """The fast path's check decides whether to redo its result, so a draft on it is checked."""
+    vertices, triangles = reference.read_off(DATA / "genus_positive/cgal_elephant.off")
+    mesh = Mesh(vertices, triangles, keep_floods=False)
+    draft = mesh.decimate(ratio=0.02, seed=3, mode="fast", fast_path=True, draft=True)
+    full = mesh.decimate(ratio=0.02, seed=3, mode="fast", fast_path=True)
+    assert draft.stats.output_checked and draft.stats.topology_kept
+    for name in GEOMETRY:
+        np.testing.assert_array_equal(getattr(draft, name), getattr(full, name), err_msg=name)
+
+
+@pytest.mark.parametrize("options", [dict(), dict(mode="quality"), dict(mode="fast", refine=2.0),
+                                     dict(mode="fast", max_error=0.01, ratio=None)])
+def test_a_draft_is_plain_topstoc_only(options):
+    mesh = Mesh(*meshgen.torus(24, 12))
+    options = dict(dict(ratio=0.2), **options)
+    if options["ratio"] is None:
+        del options["ratio"]
+    with pytest.raises(TopStocError, match="draft"):
+        mesh.decimate(draft=True, **options)
