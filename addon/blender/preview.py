@@ -22,10 +22,13 @@ each show nearly twice as many updates per second as one using both threads (hor
 triangles, ratios 5-20 %: 14.7 vs 8.8 per second outside Blender). Results are shown in the
 order they were requested: one that finishes after a newer one was shown is dropped.
 
-While the user drags, the preview shows the fast mode (plain TopStoc, milliseconds); when the
-drag pauses for PAUSE_SECONDS and the chosen mode is quality (or symmetry is on), the same ratio
-is computed with the chosen settings in the background and replaces the fast result when it is
-ready (the paint means the same in both modes, so the density does not jump).
+While the user drags, the preview shows drafts of the fast mode (plain TopStoc, milliseconds):
+the geometry without the attribute sources and without the engine's final output check (its
+partition checks and repairs still run; core.decimate's ``draft``). When the drag pauses for
+PAUSE_SECONDS, the same ratio is computed in full with the chosen settings in the background,
+checked, and replaces the draft when it is ready (the paint means the same in both modes, so
+the density does not jump); Enter writes only such a result. On the horse (1.55M triangles) at
+10 % a draft takes about a fifth less than a full fast decimation.
 """
 
 from __future__ import annotations
@@ -71,10 +74,8 @@ class PreviewSession:
         self.options = pipeline.options_kwargs(params)
         self.axis = pipeline.symmetry_axis(params)
         self.settings = pipeline.settings_of(params)  # what an applied result remembers (Regenerate)
-        # While dragging: the fast mode; on a pause: the chosen settings (unless they are the same).
-        chosen_is_fast = self.options.get("mode", "quality") == "fast" and self.axis is None
-        self.drag_options = self.options if chosen_is_fast else \
-            dict(self.options, mode="fast", placement=None, refine=None)
+        # While dragging: drafts of the fast mode; on a pause: the chosen settings, in full.
+        self.drag_options = dict(self.options, mode="fast", placement=None, refine=None, draft=True)
         self.prepared = None                   # set by the worker once the mesh is prepared
         self.mesh = self.preview = None        # made when the first result is shown
         self.was_hidden = obj.hide_get()
@@ -173,9 +174,8 @@ class PreviewSession:
     # -- decimating ---------------------------------------------------------------------------
 
     def key(self, ratio: float, final: bool) -> tuple:
-        """A request's key (ratio, made with the chosen settings): a drag result is final when the
-        chosen settings are the fast ones."""
-        return ratio, bool(final) or self.drag_options is self.options
+        """A request's key: (ratio, made in full with the chosen settings)."""
+        return ratio, bool(final)
 
     def compute(self, ratio: float, final: bool = False):
         """Decimates at ``ratio`` (fast, or with the chosen settings with ``final``) and derives the
@@ -273,7 +273,7 @@ class PreviewSession:
                     return
                 seconds = finished[3]
                 self._typical = 0.7 * self._typical + 0.3 * seconds if self._typical else seconds
-                if key[1] and self.options is not self.drag_options:
+                if key[1]:
                     self.final_seconds = seconds
                 # A newer result replaces one not shown yet; an older one than shown is dropped.
                 newest = self._finished[0] if self._finished else self._shown_order

@@ -105,7 +105,10 @@ def test_a_rested_quality_result_is_applied_as_shown(ts, scene, donut, monkeypat
     assert '"ratio": 0.1' in out["topstoc_parameters"] and '"mode": "quality"' in out["topstoc_parameters"]
 
 
-def test_with_fast_chosen_the_drag_result_is_applied_as_shown(ts, scene, donut, monkeypatch):
+def test_with_fast_chosen_the_drag_shows_drafts_and_the_rested_result_is_applied_as_shown(ts, scene, donut,
+                                                                                          monkeypatch):
+    """Drag frames are drafts (no attribute sources, no final output check); the rested result
+    is the full fast decimation, checked, with the draft's geometry, and Enter writes it as shown."""
     preview = ts.blender.preview
     engine = EngineCalls(monkeypatch, ts.blender.pipeline)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="FAST", seed=2), ratio=0.1)
@@ -113,15 +116,24 @@ def test_with_fast_chosen_the_drag_result_is_applied_as_shown(ts, scene, donut, 
         assert wait_for(lambda: session.poll())
         session.request(0.2)
         assert wait_for(lambda: (session.poll(), session.ratio)[1] == 0.2)
+        draft = session.result
+        assert not session.final and not draft.stats.output_checked and draft.stats.topology_kept is None
+        assert len(draft.face_source) == len(draft.labels) == 0
+        assert wait_for(lambda: (session.poll(), session.final)[1])  # the drag rested
+        rested = session.result
+        assert rested.stats.output_checked and rested.stats.topology_kept
+        np.testing.assert_array_equal(rested.triangles, draft.triangles)
+        np.testing.assert_array_equal(rested.vertices, draft.vertices)
         assert wait_for(lambda: not session.busy)
         calls = engine.count()
         run = session.apply(0.2)
         assert run is not None and len(run.moved.moved) == 0  # Fast: no vertex moved
-        assert run is not None and engine.count() == calls == 2
+        assert run.result is rested and engine.count() == calls == 3  # 0.1, 0.2 drafts; 0.2 in full
     finally:
         session.close()
     expected = reference(ts, donut, 0.2, "FAST", 2)
     np.testing.assert_array_equal(np.asarray(run.result.samples), np.asarray(expected.samples))
+    np.testing.assert_array_equal(np.asarray(run.result.face_source), np.asarray(expected.face_source))
 
 
 def test_applying_during_a_drag_computes_the_chosen_settings_on_the_worker(ts, scene, donut, monkeypatch):

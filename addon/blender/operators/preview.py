@@ -101,8 +101,7 @@ Enter or click applies, Esc or right-click restores"""
             self._status(context, f"TopStoc: decimating '{self.obj_name}' at ratio {self.ratio:.4f} ... "
                                   f"{seconds:.1f} s   Esc: cancel")
             return
-        quality = "" if s.drag_options is s.options else \
-            f"  ({self.quality.title() if s.final else 'Fast while dragging'})"
+        quality = f"  ({self.quality.title() if s.final else 'Fast draft while dragging'})"
         self._status(context,
                      f"TopStoc ratio {s.ratio:.4f}: {result.num_vertices:,} vertices, {result.num_triangles:,} "
                      f"triangles ({1000 * s.seconds_decimate:.0f} ms + {1000 * s.seconds_write:.0f} ms){quality}   "
