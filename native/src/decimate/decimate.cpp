@@ -331,7 +331,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     if (cache) {
       // Emits of the cached flood, from the first check only (repairs change the clustering
       // from here on, and seeding rounds repeat round 0). An early return (unreached
-      // vertices) tested none.
+      // vertices) leaves them valid only after testing every face.
       cache->emits_valid = emit.valid && emit.changed.empty();
       if (cache->emits_valid) cache->emits = emit.emits;
       cache = nullptr;

@@ -108,16 +108,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   const int32_t k = static_cast<int32_t>(samples.size());
   auto label = [&c](int32_t v) { return c.label(v); };
   const auto& vfo = mesh.vertex_face_offsets();
-  int unreached = 0;
-#pragma omp parallel for schedule(static) reduction(| : unreached) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v)
-    if (label(v) < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
-  if (unreached) {
-    seed_unreached(mesh, c, out);
-    return out;  // the other checks need every vertex in a cluster
-  }
   const int threads = omp_get_max_threads();
-  Marks marks(threads);
 
   // --- emit: faces whose corners lie in three clusters ------------------------------------------
   const auto& faces = mesh.faces();
@@ -138,7 +129,34 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // the samples: 46 against 35 ms for the check): beyond a sixteenth, every face is tested.
   if (emit.valid && int64_t(emit.changed.size()) > n / 16) emit.valid = false;
   const bool test_all = !emit.valid && !candidate_faces;
-  if (emit.valid) {
+  // Vertices in a face but in no cluster stop the check here: the other checks need every
+  // vertex in a cluster. Testing every face reads every such vertex's label and notes them on
+  // the way (the emits then hold for this clustering, as after any test); otherwise the
+  // vertices are scanned.
+  const int team = m >= kParallelMin ? threads : 1;
+  int unreached = 0;
+  if (test_all) {
+    emit.emits.resize(m);
+#pragma omp parallel for schedule(static) num_threads(team) reduction(| : unreached)
+    for (int32_t f = 0; f < m; ++f) {
+      const int32_t la = label(faces[3 * size_t(f)]), lb = label(faces[3 * size_t(f) + 1]),
+                    lc = label(faces[3 * size_t(f) + 2]);
+      emit.emits[f] = uint8_t(la != lb && lb != lc && lc != la);
+      unreached |= (la | lb | lc) < 0;
+    }
+    emit.valid = true;
+    emit.changed.clear();
+  } else {
+#pragma omp parallel for schedule(static) reduction(| : unreached) if (n >= kParallelMin)
+    for (int32_t v = 0; v < n; ++v)
+      if (label(v) < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
+  }
+  if (unreached) {
+    seed_unreached(mesh, c, out);
+    return out;
+  }
+  Marks marks(threads);
+  if (!test_all && emit.valid) {
     const auto& vf = mesh.vertex_faces();
     for (int32_t v : emit.changed)
       for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) emit.emits[vf[i]] = three_clusters(vf[i]);
@@ -147,16 +165,9 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     const int64_t count = int64_t(candidate_faces->size());
 #pragma omp parallel for schedule(static) if (count >= kParallelMin)
     for (int64_t i = 0; i < count; ++i) emit.emits[(*candidate_faces)[i]] = three_clusters((*candidate_faces)[i]);
-  } else {
-    emit.emits.resize(m);
   }
   emit.valid = true;
   emit.changed.clear();
-  const int team = m >= kParallelMin ? threads : 1;
-  if (test_all) {
-#pragma omp parallel for schedule(static) num_threads(team)
-    for (int32_t f = 0; f < m; ++f) emit.emits[f] = three_clusters(f);
-  }
   // Eight faces at a time (a tenth of them emit at most); the last few faces after the whole
   // words are appended at the end.
   const uint8_t* emits = emit.emits.data();
@@ -516,7 +527,11 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
                                         (q1[2] - q0[2]) * (q1[2] - q0[2]));
       }
       const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
-      if (std::sqrt(cx * cx + cy * cy + cz * cz) <= 1e-9 * longest) {
+      const double c2 = cx * cx + cy * cy + cz * cz;
+      // Far above the bound (squared, with a margin of 2 for rounding; only where the squares
+      // stay normal numbers) the square root is not needed: nearly every triangle is.
+      const bool clearly_not = longest > 1e-140 && c2 > 2e-18 * longest * longest;
+      if (!clearly_not && std::sqrt(c2) <= 1e-9 * longest) {
         sliver[i] = 1;
         ++slivers;
       }
