@@ -14,6 +14,8 @@ no topstoc code). Counts, per outcome:
   reported    topology_kept == False (the repair-round limit hit; honest, but counted)
   raised      the engine's final check raised instead of returning
   unreported  topology_kept == True but the independent check found a violation (a lie)
+  draft_differs  a draft (decimate(draft=True), one in ten, fast mode) whose samples, vertices
+              or triangles differ from the full decimation's (made after it and checked as above)
   crashed     any other exception
 Exit code 1 when anything but `ok` happened. Failing cases are written to --save as .npz
 (vertices, triangles) + .json (parameters), ready for tests/data/regressions.
@@ -42,7 +44,9 @@ def generated_mesh(mesh_seed):
     return random_manifolds.random_manifold(list(mesh_seed)), False
 
 
-def random_parameters(rng):
+def random_parameters(rng, drafts=False):
+    """Random decimation parameters; with ``drafts``, one set in ten asks for a fast-mode draft
+    (the same draws either way)."""
     params = dict(ratio=float(rng.uniform(0.02, 0.95)), seed=int(rng.integers(0, 2**31)))
     if rng.random() < 0.3:
         params["placement"] = "filtered"
@@ -54,6 +58,9 @@ def random_parameters(rng):
         params["fast_path"] = bool(rng.random() < 0.5)
     if rng.random() < 0.1:
         params["density"] = "uniform"
+    if rng.random() < 0.1 and drafts:
+        params.pop("refine", None)
+        params.update(mode="fast", draft=True)
     return params
 
 
@@ -63,7 +70,8 @@ def engine_check_clean(result):
 
 
 def run(count, seed, save=None, quiet=False, check_every=1, progress=0):
-    counts = dict(ok=0, reported=0, raised=0, unreported=0, crashed=0, independently_checked=0, pinched=0)
+    counts = dict(ok=0, reported=0, raised=0, unreported=0, draft_differs=0, crashed=0, independently_checked=0,
+                  pinched=0, drafts=0)
     rng = np.random.default_rng(seed)
     start = time.time()
     done = 0
@@ -75,11 +83,19 @@ def run(count, seed, save=None, quiet=False, check_every=1, progress=0):
         mesh = topstoc.Mesh(vertices, triangles)
         before = None if pinched else random_manifolds.surface_facts(len(vertices), triangles)
         for _ in range(min(DECIMATIONS_PER_MESH, count - done)):
-            params = random_parameters(rng)
+            params = random_parameters(rng, drafts=True)
             outcome, detail = "ok", ""
             try:
-                r = mesh.decimate(**params)
-                if not r.stats.topology_kept:
+                full_params = {name: value for name, value in params.items() if name != "draft"}
+                draft = mesh.decimate(**params) if params.get("draft") else None
+                r = mesh.decimate(**full_params)
+                if draft is not None:
+                    counts["drafts"] += 1
+                    differ = [name for name in ("samples", "vertices", "triangles")
+                              if not np.array_equal(getattr(draft, name), getattr(r, name))]
+                if draft is not None and differ:
+                    outcome, detail = "draft_differs", ", ".join(differ)
+                elif not r.stats.topology_kept:
                     outcome, detail = "reported", str(r.stats.issues_remaining)
                 else:
                     problems = [] if engine_check_clean(r) else [f"engine check: {r.stats.output_check}"]
