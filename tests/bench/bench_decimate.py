@@ -8,7 +8,10 @@ Default mesh: ../shared/meshes/big/horse_loop2_1.55M.ply (skips cleanly when abs
   - re-decimation: decimate on the prepared mesh, seeds 0..R-1 (each floods afresh);
   - slider step: the same seed at ratios 1 % apart, up and back down (what a slider drag costs:
     each updates the kept flood of the one before, native flood_cache.hpp);
-  - first and re-decimation in the fast mode (plain TopStoc, what the live slider shows);
+  - first and re-decimation in the fast mode (plain TopStoc);
+  - the same as drafts (draft=True: what the live slider shows while it moves; no attribute
+    sources and no final output check), re-decimation with seeds R..2R-1 (unused, so each floods
+    afresh) and slider steps;
   - the quality mode (the default: first pass, collapses, filtered re-fit) on the prepared mesh, 3 seeds,
     and cold (prepare + quality decimation at the first ratio);
   - meshopt_simplify (QEM edge collapse) and meshopt_simplifySloppy (grid clustering), via
@@ -92,6 +95,17 @@ def main() -> int:
             steps.append(time.perf_counter() - start)
             updated += step_result.stats.flood_updated
         steps = (steps, updated)
+        drafts = []  # live-preview frames: other seeds, each flooding afresh
+        for seed in range(args.repeats, 2 * args.repeats):
+            start = time.perf_counter()
+            mesh.decimate(ratio=ratio, seed=seed, mode="fast", draft=True)
+            drafts.append(time.perf_counter() - start)
+        draft_steps = []
+        mesh.decimate(ratio=path_ratios[0] * 0.99, seed=2, mode="fast", draft=True)
+        for step in path_ratios + path_ratios[::-1]:
+            start = time.perf_counter()
+            mesh.decimate(ratio=step, seed=2, mode="fast", draft=True)
+            draft_steps.append(time.perf_counter() - start)
         peer = None
         if PEER.exists():
             out = subprocess.run([str(PEER), str(path), str(ratio), str(args.repeats)], capture_output=True,
@@ -102,7 +116,7 @@ def main() -> int:
             start = time.perf_counter()
             refined_result = mesh.decimate(ratio=ratio, seed=seed, **REFINED)
             refined.append(time.perf_counter() - start)
-        rows.append((ratio, seconds, stages, result, peer, refined, refined_result, steps))
+        rows.append((ratio, seconds, stages, result, peer, refined, refined_result, steps, (drafts, draft_steps)))
 
     print(f"\nprepare (validation, Morton order, adjacency, normals, weights): median {median_ms(prepare):.0f} ms")
     print(f"first decimation at {ratios[0]:.0%} (prepare + decimate): median {median_ms(first):.0f} ms")
@@ -110,7 +124,7 @@ def main() -> int:
           "slider step | meshopt_simplify | meshopt_simplifySloppy | simplify / ours | sloppy / ours | "
           "simplify / slider step |")
     print("|---|---|---|---|---|---|---|---|---|")
-    for ratio, seconds, stages, result, peer, _, _, (steps, updated) in rows:
+    for ratio, seconds, stages, result, peer, _, _, (steps, updated), _ in rows:
         ours, step = median_ms(seconds), median_ms(steps)
         stage_text = " / ".join(f"{median_ms(stages[k]):.0f}" for k in ("sampling", "clustering", "checking", "output", "verify"))
         step_text = f"{step:.0f} ms ({updated} of {len(steps)} updated)"
@@ -124,13 +138,19 @@ def main() -> int:
         else:
             print(f"| {ratio:.0%} | {ours:.0f} ms | {stage_text} ms | {step_text} | (build/peers/meshopt_bench missing) "
                   "| | | | |")
+    print("\n| target | draft re-decimation, another seed | draft slider step | meshopt_simplify / draft |")
+    print("|---|---|---|---|")
+    for ratio, _, _, _, peer, _, _, _, (drafts, draft_steps) in rows:
+        ours = median_ms(drafts)
+        ratio_text = f"{1000 * peer['simplify']['median_seconds'] / ours:.1f}x" if peer else ""
+        print(f"| {ratio:.0%} | {ours:.0f} ms | {median_ms(draft_steps):.0f} ms | {ratio_text} |")
     if rows[0][4]:
         simplify = rows[0][4]["simplify"]["median_seconds"]
         print(f"\nfirst decimation vs meshopt_simplify at {ratios[0]:.0%}: {simplify / statistics.median(first):.1f}x faster")
     print(f"\nquality mode (the default; a TopStoc first pass, then quadric edge collapses; see "
           f"bench_quality.py for its error): cold at {ratios[0]:.0%} {cold_quality_seconds:.2f} s "
           f"({cold_quality.num_vertices} v); re-decimation:")
-    for ratio, _, _, _, peer, refined, refined_result, _ in rows:
+    for ratio, _, _, _, peer, refined, refined_result, _, _ in rows:
         ours = statistics.median(refined)
         text = f"  {ratio:.0%} ({refined_result.num_vertices} v): median {1000 * ours:.0f} ms " \
                f"(refinement {1000 * refined_result.stats.seconds['refine']:.0f} ms)"
