@@ -139,6 +139,20 @@ def pinched_surface(seed):
 
 # --- the independent check ------------------------------------------------------------------
 
+def drag_case(seed, steps=12, step=0.06):
+    """A slider drag over a random surface: (vertices, triangles, ratios, rng). Every third seed
+    gives a pinched surface, the others a random manifold; the ratios start in [0.05, 0.5] and
+    change by up to ``step`` (relative) each, within [0.02, 0.9]; ``rng`` draws on from there."""
+    make = pinched_surface if seed % 3 == 2 else random_manifold
+    vertices, triangles = make(seed)
+    rng = np.random.default_rng(seed)
+    ratio, ratios = rng.uniform(0.05, 0.5), []
+    for _ in range(steps):
+        ratio = float(np.clip(ratio * (1 + rng.uniform(-step, step)), 0.02, 0.9))
+        ratios.append(ratio)
+    return vertices, triangles, ratios, rng
+
+
 def _components(n, a, b):
     """Component label (the smallest member) of each of n nodes joined by edges (a, b): hooking
     and pointer jumping in numpy (scipy's graph set-up costs more than the work on small meshes)."""

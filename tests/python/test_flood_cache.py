@@ -139,13 +139,10 @@ def test_threads_sharing_a_mesh_get_the_fresh_results():
 def test_random_manifolds_and_pinched_surfaces(seed):
     """Random hulls, tori, grids with holes, several components, and surfaces glued at vertices
     (tests/random_manifolds.py): a drag of 12 steps gives the fresh results."""
-    make = random_manifolds.pinched_surface if seed % 3 == 2 else random_manifolds.random_manifold
-    vertices, triangles = make(seed)
+    vertices, triangles, ratios, rng = random_manifolds.drag_case(seed)
     mesh, plain = Mesh(vertices, triangles), Mesh(vertices, triangles, keep_floods=False)
-    rng = np.random.default_rng(seed)
-    ratio, updated = rng.uniform(0.05, 0.5), 0
-    for _ in range(12):
-        ratio = float(np.clip(ratio * (1 + rng.uniform(-0.06, 0.06)), 0.02, 0.9))
+    updated = 0
+    for ratio in ratios:
         options = dict(mode=str(rng.choice(["fast", "quality"])), ratio=ratio, seed=seed)
         got = mesh.decimate(**options)
         updated += got.stats.flood_updated
