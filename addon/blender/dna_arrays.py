@@ -14,6 +14,12 @@ with the struct's size, and at sampled elements every field read here equals wha
 Otherwise (another Blender, another layout) the functions return None and the caller reads
 through RNA. The view is checked before anything is copied out of it, and every result is a
 copy: nothing keeps pointing into Blender's memory.
+
+Writing goes the same way for the geometry of a new 3.x mesh (loops, polygons, edges), which
+foreach_set also fills field by field: 14 ms of each Live Preview frame at 10 % of the horse in
+3.4. A fresh array holds zeros, so its layout is probed instead: values set through RNA at its
+first and last elements must show in the view's fields before anything is written through it;
+otherwise the functions write nothing and return False, and the caller uses foreach_set.
 """
 
 from __future__ import annotations
@@ -65,6 +71,58 @@ def _samples(count: int, extra=()) -> list:
     """Elements whose fields are compared with RNA's: spread over the array, plus ``extra``."""
     spread = np.unique(np.linspace(0, count - 1, LAYOUT_SAMPLES).astype(np.int64)).tolist()
     return spread + [int(i) for i in extra]
+
+
+def _probed_view(collection, dtype: np.dtype, fields: dict) -> Optional[np.ndarray]:
+    """``_view`` of a 3.x struct array about to be overwritten, when small values set through
+    RNA ({view field: property}, a different value per field and element) at its first and last
+    elements show in the view's fields; else None."""
+    raw = _view(collection, dtype)
+    if raw is None:
+        return None
+    value = 1
+    for i in (0, len(raw) - 1):
+        for field, prop in fields.items():
+            size = int(np.prod(dtype[field].shape)) if dtype[field].shape else 1
+            values = list(range(value, value + size))
+            value += size
+            try:
+                setattr(collection[i], prop, values if dtype[field].shape else values[0])
+            except (AttributeError, TypeError, ValueError):  # read-only or ranged elsewhere
+                return None
+            if raw[field][i].tolist() != (values if dtype[field].shape else values[0]):
+                return None
+    return raw
+
+
+def write_loops(mesh: bpy.types.Mesh, vertices: np.ndarray, edges: np.ndarray) -> bool:
+    """Sets every loop's vertex and edge (MLoop.v, MLoop.e); False when it wrote nothing."""
+    raw = _probed_view(mesh.loops, MLOOP, {"v": "vertex_index", "e": "edge_index"})
+    if raw is None:
+        return False
+    raw["v"] = vertices
+    raw["e"] = edges
+    return True
+
+
+def write_polygon_loops(mesh: bpy.types.Mesh, starts: np.ndarray, totals) -> bool:
+    """Sets every polygon's first loop and loop count (MPoly.loopstart, totloop); False when it
+    wrote nothing."""
+    raw = _probed_view(mesh.polygons, MPOLY, {"loopstart": "loop_start", "totloop": "loop_total"})
+    if raw is None:
+        return False
+    raw["loopstart"] = starts
+    raw["totloop"] = totals
+    return True
+
+
+def write_edges(mesh: bpy.types.Mesh, pairs: np.ndarray) -> bool:
+    """Sets every edge's two vertices (MEdge.v1, v2); False when it wrote nothing."""
+    raw = _probed_view(mesh.edges, MEDGE, {"v": "vertices"})
+    if raw is None:
+        return False
+    raw["v"] = pairs
+    return True
 
 
 def edge_flag(mesh: bpy.types.Mesh, flag: str) -> Optional[np.ndarray]:
