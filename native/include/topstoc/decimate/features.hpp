@@ -75,6 +75,7 @@ struct FeatureLayout {
   /// of edges and faces shared with other clusters (see partition.cpp).
   std::vector<int32_t> chi_constant;
   DerivedTable sampling_table;  ///< sampling.cpp's importance table for its last parameters
+  DerivedTable selection_uniforms;  ///< sampling.cpp's per-vertex uniforms of the seed drawn last
   DerivedTable quadric_table;   ///< refine.cpp's per-vertex quadrics (they depend on the mesh only)
   int32_t region_border_edges = 0;
   int32_t flagged_edges = 0;
