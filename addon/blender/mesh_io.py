@@ -381,7 +381,8 @@ def fill_geometry(mesh: bpy.types.Mesh, vertices: np.ndarray, triangles: np.ndar
     write_positions(mesh, vertices)
     if m:
         # Blender 3.x: loops, polygons and edges straight into their struct arrays
-        # (dna_arrays; 14 -> 4 ms for a 150k-triangle preview frame in 3.4), else foreach_set.
+        # (dna_arrays; a 150k-triangle preview frame in 3.4: 9-13 ms instead of 13-18), else
+        # foreach_set.
         corners = np.ascontiguousarray(triangles, dtype=np.int32).ravel()
         starts = np.arange(0, 3 * m, 3, dtype=np.int32)
         if not dna_arrays.write_polygon_loops(mesh, starts, 3):
