@@ -17,9 +17,10 @@ copy: nothing keeps pointing into Blender's memory.
 
 Writing goes the same way for the geometry of a new 3.x mesh (loops, polygons, edges), which
 foreach_set also fills field by field: about a third of the 13-18 ms that writing a Live
-Preview frame at 10 % of the horse took in 3.4. A fresh array holds zeros, so its layout is probed instead: values set through RNA at its
-first and last elements must show in the view's fields before anything is written through it;
-otherwise the functions write nothing and return False, and the caller uses foreach_set.
+Preview frame at 10 % of the horse took in 3.4. A fresh array holds zeros, so its layout is
+probed instead: values set through RNA at its first and last elements must show in the view's
+fields before anything is written through it; otherwise the functions write nothing and return
+False, and the caller uses foreach_set.
 """
 
 from __future__ import annotations
@@ -95,34 +96,31 @@ def _probed_view(collection, dtype: np.dtype, fields: dict) -> Optional[np.ndarr
     return raw
 
 
-def write_loops(mesh: bpy.types.Mesh, vertices: np.ndarray, edges: np.ndarray) -> bool:
-    """Sets every loop's vertex and edge (MLoop.v, MLoop.e); False when it wrote nothing."""
-    raw = _probed_view(mesh.loops, MLOOP, {"v": "vertex_index", "e": "edge_index"})
+def _write_fields(collection, dtype: np.dtype, fields: dict) -> bool:
+    """Writes whole fields of a 3.x struct array ({view field: (RNA property, values)}) once its
+    layout is probed (``_probed_view``); False when it wrote nothing."""
+    raw = _probed_view(collection, dtype, {field: prop for field, (prop, _values) in fields.items()})
     if raw is None:
         return False
-    raw["v"] = vertices
-    raw["e"] = edges
+    for field, (_prop, values) in fields.items():
+        raw[field] = values
     return True
+
+
+def write_loops(mesh: bpy.types.Mesh, vertices: np.ndarray, edges: np.ndarray) -> bool:
+    """Sets every loop's vertex and edge (MLoop.v, MLoop.e); False when it wrote nothing."""
+    return _write_fields(mesh.loops, MLOOP, {"v": ("vertex_index", vertices), "e": ("edge_index", edges)})
 
 
 def write_polygon_loops(mesh: bpy.types.Mesh, starts: np.ndarray, totals) -> bool:
     """Sets every polygon's first loop and loop count (MPoly.loopstart, totloop); False when it
     wrote nothing."""
-    raw = _probed_view(mesh.polygons, MPOLY, {"loopstart": "loop_start", "totloop": "loop_total"})
-    if raw is None:
-        return False
-    raw["loopstart"] = starts
-    raw["totloop"] = totals
-    return True
+    return _write_fields(mesh.polygons, MPOLY, {"loopstart": ("loop_start", starts), "totloop": ("loop_total", totals)})
 
 
 def write_edges(mesh: bpy.types.Mesh, pairs: np.ndarray) -> bool:
     """Sets every edge's two vertices (MEdge.v1, v2); False when it wrote nothing."""
-    raw = _probed_view(mesh.edges, MEDGE, {"v": "vertices"})
-    if raw is None:
-        return False
-    raw["v"] = pairs
-    return True
+    return _write_fields(mesh.edges, MEDGE, {"v": ("vertices", pairs)})
 
 
 def edge_flag(mesh: bpy.types.Mesh, flag: str) -> Optional[np.ndarray]:
