@@ -74,53 +74,39 @@ def _samples(count: int, extra=()) -> list:
     return spread + [int(i) for i in extra]
 
 
-def _probed_view(collection, dtype: np.dtype, fields: dict) -> Optional[np.ndarray]:
+def _probed_view(collection, dtype: np.dtype, field: str, prop: str) -> Optional[np.ndarray]:
     """``_view`` of a 3.x struct array about to be overwritten, when small values set through
-    RNA ({view field: property}, a different value per field and element) at its first and last
-    elements show in the view's fields; else None."""
+    RNA's ``prop`` at its first and last elements show in the view's ``field``; else None."""
     raw = _view(collection, dtype)
     if raw is None:
         return None
-    value = 1
-    for i in (0, len(raw) - 1):
-        for field, prop in fields.items():
-            size = int(np.prod(dtype[field].shape)) if dtype[field].shape else 1
-            values = list(range(value, value + size))
-            value += size
-            try:
-                setattr(collection[i], prop, values if dtype[field].shape else values[0])
-            except (AttributeError, TypeError, ValueError):  # read-only or ranged elsewhere
-                return None
-            if raw[field][i].tolist() != (values if dtype[field].shape else values[0]):
-                return None
+    shape = dtype[field].shape
+    for i, first in ((0, 1), (len(raw) - 1, 1 + max(1, int(np.prod(shape))))):
+        probe = list(range(first, first + int(np.prod(shape)))) if shape else first
+        try:
+            setattr(collection[i], prop, probe)
+        except (AttributeError, TypeError, ValueError):  # read-only or ranged elsewhere
+            return None
+        if raw[field][i].tolist() != probe:
+            return None
     return raw
 
 
-def _write_fields(collection, dtype: np.dtype, fields: dict) -> bool:
-    """Writes whole fields of a 3.x struct array ({view field: (RNA property, values)}) once its
-    layout is probed (``_probed_view``); False when it wrote nothing."""
-    raw = _probed_view(collection, dtype, {field: prop for field, (prop, _values) in fields.items()})
+# RNA index property -> the 3.x struct and field behind it (the names are unique across loops,
+# edges and polygons).
+STRUCT_FIELDS = {"vertex_index": (MLOOP, "v"), "edge_index": (MLOOP, "e"), "vertices": (MEDGE, "v"),
+                 "loop_start": (MPOLY, "loopstart"), "loop_total": (MPOLY, "totloop")}
+
+
+def write_field(collection, prop: str, values: np.ndarray) -> bool:
+    """Sets ``prop`` (a key of STRUCT_FIELDS) of every element of a 3.x loop, edge or polygon
+    array to ``values`` (flat, or one row per element) in one pass; False when it wrote nothing."""
+    dtype, field = STRUCT_FIELDS[prop]
+    raw = _probed_view(collection, dtype, field, prop)
     if raw is None:
         return False
-    for field, (_prop, values) in fields.items():
-        raw[field] = values
+    raw[field] = np.reshape(values, raw[field].shape)
     return True
-
-
-def write_loops(mesh: bpy.types.Mesh, vertices: np.ndarray, edges: np.ndarray) -> bool:
-    """Sets every loop's vertex and edge (MLoop.v, MLoop.e); False when it wrote nothing."""
-    return _write_fields(mesh.loops, MLOOP, {"v": ("vertex_index", vertices), "e": ("edge_index", edges)})
-
-
-def write_polygon_loops(mesh: bpy.types.Mesh, starts: np.ndarray, totals) -> bool:
-    """Sets every polygon's first loop and loop count (MPoly.loopstart, totloop); False when it
-    wrote nothing."""
-    return _write_fields(mesh.polygons, MPOLY, {"loopstart": ("loop_start", starts), "totloop": ("loop_total", totals)})
-
-
-def write_edges(mesh: bpy.types.Mesh, pairs: np.ndarray) -> bool:
-    """Sets every edge's two vertices (MEdge.v1, v2); False when it wrote nothing."""
-    return _write_fields(mesh.edges, MEDGE, {"v": ("vertices", pairs)})
 
 
 def edge_flag(mesh: bpy.types.Mesh, flag: str) -> Optional[np.ndarray]:

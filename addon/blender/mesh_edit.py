@@ -143,9 +143,7 @@ def _fill_polygons(mesh, layout: PolygonLayout, loose_edges: np.ndarray) -> None
     mesh.polygons.add(len(layout.loop_total))
     if corners:
         mesh_io._set_int_field(mesh, ".corner_vert", mesh.loops, "vertex_index", layout.corner_vertex)
-        mesh.polygons.foreach_set("loop_start", layout.loop_start.astype(np.int32))
-        if bpy.app.version < (4, 0, 0):
-            mesh.polygons.foreach_set("loop_total", layout.loop_total.astype(np.int32))
+        mesh_io.write_polygon_loops(mesh, layout.loop_start, layout.loop_total)
     mesh_io.calc_edges(mesh)
 
 

@@ -380,23 +380,13 @@ def fill_geometry(mesh: bpy.types.Mesh, vertices: np.ndarray, triangles: np.ndar
     mesh.polygons.add(m)
     write_positions(mesh, vertices)
     if m:
-        # Blender 3.x: loops, polygons and edges straight into their struct arrays
-        # (dna_arrays; a 150k-triangle preview frame in 3.4: 9-13 ms instead of 13-18), else
-        # foreach_set.
         corners = np.ascontiguousarray(triangles, dtype=np.int32).ravel()
-        starts = np.arange(0, 3 * m, 3, dtype=np.int32)
-        if not dna_arrays.write_polygon_loops(mesh, starts, 3):
-            mesh.polygons.foreach_set("loop_start", starts.view(np.uint32))
-            if bpy.app.version < (4, 0, 0):  # loop_total became derived from loop_start in 4.0
-                mesh.polygons.foreach_set("loop_total", np.full(m, 3, dtype=np.uint32))
+        _set_int_field(mesh, ".corner_vert", mesh.loops, "vertex_index", corners)
+        write_polygon_loops(mesh, np.arange(0, 3 * m, 3), np.full(m, 3))
         if edges is not None:
             mesh.edges.add(len(edges))
-            if not dna_arrays.write_edges(mesh, edges.vertices):
-                _set_int_field(mesh, ".edge_verts", mesh.edges, "vertices", edges.vertices)
-        if edges is None or not dna_arrays.write_loops(mesh, corners, edges.corner_edge.ravel()):
-            _set_int_field(mesh, ".corner_vert", mesh.loops, "vertex_index", corners)
-            if edges is not None:
-                _set_int_field(mesh, ".corner_edge", mesh.loops, "edge_index", edges.corner_edge)
+            _set_int_field(mesh, ".edge_verts", mesh.edges, "vertices", edges.vertices)
+            _set_int_field(mesh, ".corner_edge", mesh.loops, "edge_index", edges.corner_edge)
     calc_edges(mesh, m > 0 and edges is None)
 
 
@@ -520,15 +510,25 @@ def calc_edges(mesh: bpy.types.Mesh, calc: bool = True) -> None:
         mesh.attributes.remove(attribute)
 
 
-def _set_int_field(mesh, attribute: str, collection, key: str, values: np.ndarray) -> None:
-    """Writes an index field: the internal attribute where Blender has one (3.6+/4.0+: a plain
-    int array), else the struct field through a uint32 buffer (foreach_set's raw-copy path)."""
+def _set_int_field(mesh, attribute: Optional[str], collection, key: str, values: np.ndarray) -> None:
+    """Writes an index field: the internal attribute where Blender has one (``attribute``, 3.6+ /
+    4.0+: a plain int array; None where no version has one), else the 3.x struct field in one
+    pass (dna_arrays.write_field: a 150k-triangle preview frame's geometry in 3.4 took 9-13 ms
+    instead of 13-18), else through a uint32 buffer (foreach_set, which 3.x copies field by
+    field)."""
     flat = np.ascontiguousarray(values, dtype=np.int32).ravel()
-    layer = mesh.attributes.get(attribute)
+    layer = mesh.attributes.get(attribute) if attribute else None
     if layer is not None:
         layer.data.foreach_set("value", flat)
-    else:
+    elif not dna_arrays.write_field(collection, key, flat):
         collection.foreach_set(key, flat.view(np.uint32))
+
+
+def write_polygon_loops(mesh, starts: np.ndarray, totals: np.ndarray) -> None:
+    """Every polygon's first loop and loop count (Blender 4.0+ derives the count from the starts)."""
+    _set_int_field(mesh, None, mesh.polygons, "loop_start", starts)
+    if bpy.app.version < (4, 0, 0):
+        _set_int_field(mesh, None, mesh.polygons, "loop_total", totals)
 
 
 def read_vertex_weights(obj, vertex_ids) -> tuple:

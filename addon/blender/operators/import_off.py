@@ -37,9 +37,7 @@ def mesh_from_file(path: str, name: str) -> bpy.types.Mesh:
     mesh.loops.add(len(corners))
     mesh_io._set_int_field(mesh, ".corner_vert", mesh.loops, "vertex_index", corners)
     mesh.polygons.add(len(totals))
-    mesh.polygons.foreach_set("loop_start", np.r_[0, np.cumsum(totals)[:-1]].astype(np.int32))
-    if bpy.app.version < (4, 0, 0):  # loop_total is derived from loop_start in 4.0+
-        mesh.polygons.foreach_set("loop_total", totals)
+    mesh_io.write_polygon_loops(mesh, np.r_[0, np.cumsum(totals)[:-1]], totals)
     mesh.update(calc_edges=True)
     if data.vertex_colors is not None:
         colors = np.ones((data.num_vertices, 4), dtype=np.float32)

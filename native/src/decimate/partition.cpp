@@ -115,11 +115,12 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   const int32_t m = mesh.num_faces();
   EmitState local;
   EmitState& emit = state ? *state : local;
-  auto three_clusters = [&](int32_t f) {
-    const int32_t la = label(faces[3 * size_t(f)]), lb = label(faces[3 * size_t(f) + 1]),
-                  lc = label(faces[3 * size_t(f) + 2]);
-    return uint8_t(la != lb && lb != lc && lc != la);
+  auto corner_labels = [&](int32_t f) {
+    return std::array<int32_t, 3>{label(faces[3 * size_t(f)]), label(faces[3 * size_t(f) + 1]),
+                                  label(faces[3 * size_t(f) + 2])};
   };
+  auto distinct = [](const std::array<int32_t, 3>& l) { return uint8_t(l[0] != l[1] && l[1] != l[2] && l[2] != l[0]); };
+  auto three_clusters = [&](int32_t f) { return distinct(corner_labels(f)); };
   // Every face is tested (a first check), or only those around relabelled vertices (later
   // rounds) or the candidates (fast path). Then the emitting faces are written in face order:
   // each thread counts those of its run of faces (static schedule, the same runs in both loops),
@@ -139,10 +140,9 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     emit.emits.resize(m);
 #pragma omp parallel for schedule(static) num_threads(team) reduction(| : unreached)
     for (int32_t f = 0; f < m; ++f) {
-      const int32_t la = label(faces[3 * size_t(f)]), lb = label(faces[3 * size_t(f) + 1]),
-                    lc = label(faces[3 * size_t(f) + 2]);
-      emit.emits[f] = uint8_t(la != lb && lb != lc && lc != la);
-      unreached |= (la | lb | lc) < 0;
+      const auto l = corner_labels(f);
+      emit.emits[f] = distinct(l);
+      unreached |= (l[0] | l[1] | l[2]) < 0;
     }
     emit.valid = true;
     emit.changed.clear();
