@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <numeric>
+#include <random>
 #include <set>
 #include <vector>
 
@@ -82,4 +83,87 @@ TEST_CASE("rejected: an octahedron in three clusters (the output would be a doub
 
 TEST_CASE("rejected: a grid (a disk) in two clusters") {
   check_rejected(check(topstoc_test::grid(6, 6), {0, 48}));
+}
+
+namespace {
+
+// `count` distinct vertices (mesh ids) drawn at random.
+std::vector<int32_t> random_vertices(int32_t n, int32_t count, std::mt19937& random) {
+  std::vector<int32_t> ids(n);
+  std::iota(ids.begin(), ids.end(), 0);
+  std::shuffle(ids.begin(), ids.end(), random);
+  ids.resize(count);
+  return ids;
+}
+
+void check_same(const Partition& a, const Partition& b) {
+  CHECK(a.triangles == b.triangles);
+  CHECK(a.source_face == b.source_face);
+  CHECK(a.split_clusters == b.split_clusters);
+  CHECK(a.new_samples == b.new_samples);
+  CHECK(a.absorbed == b.absorbed);
+  const auto& x = a.issues;
+  const auto& y = b.issues;
+  CHECK(std::vector<int32_t>{x.unreached, x.non_disk, x.bad_edge, x.duplicate, x.bad_link, x.short_loop, x.isolated,
+                             x.bad_component, x.sliver, x.pillows, x.absorbed} ==
+        std::vector<int32_t>{y.unreached, y.non_disk, y.bad_edge, y.duplicate, y.bad_link, y.short_loop, y.isolated,
+                             y.bad_component, y.sliver, y.pillows, y.absorbed});
+}
+
+}  // namespace
+
+TEST_CASE("a check after flood_add evaluates only the changed links and finds what a check from scratch finds") {
+  // Few samples at first (many issues), then a few more per round, as the repair rounds add
+  // them: every round's incremental check must equal a full one of the same clustering.
+  const auto torus = topstoc_test::torus(24, 16);
+  const auto grid = topstoc_test::grid(14, 10);
+  const Mesh torus_mesh(torus.positions, torus.triangles.data(), torus.num_triangles());
+  const Mesh grid_mesh(grid.positions, grid.triangles.data(), grid.num_triangles());
+  std::vector<int32_t> halves(torus_mesh.num_faces());  // two regions: closed feature curves
+  for (int32_t f = 0; f < torus_mesh.num_faces(); ++f)
+    halves[f] = torus_mesh.position(torus_mesh.faces()[3 * size_t(f)])[0] > 0;
+  std::vector<int32_t> border;  // the grid's column i = 7 as a border (caller vertex pairs)
+  for (int32_t j = 0; j < 10; ++j) border.insert(border.end(), {7 * 11 + j, 7 * 11 + j + 1});
+  const struct {
+    const Mesh* mesh;
+    std::shared_ptr<const FeatureLayout> layout;
+  } cases[] = {
+      {&torus_mesh, build_feature_layout(torus_mesh, nullptr, 0, nullptr, 0, 0.0)},
+      {&torus_mesh, build_feature_layout(torus_mesh, halves.data(), int64_t(halves.size()), nullptr, 0, 0.0)},
+      {&grid_mesh, build_feature_layout(grid_mesh, nullptr, 0, border.data(), int64_t(border.size() / 2), 0.0)},
+  };
+  int64_t incremental_rounds = 0;
+  for (const auto& kase : cases) {
+    const Mesh& mesh = *kase.mesh;
+    for (uint32_t seed = 1; seed <= 60; ++seed) {
+      std::mt19937 random(seed);
+      std::vector<int32_t> samples = random_vertices(mesh.num_vertices(), 4 + int32_t(seed % 5), random);
+      Clustering clustering;
+      flood(mesh, *kase.layout, samples, clustering);
+      const std::vector<uint8_t> required(mesh.num_vertices(), 0);
+      CheckState state;
+      for (int round = 0; round < 10; ++round) {
+        const bool slivers = round < 6;
+        const Partition kept = check_partition(mesh, *kase.layout, samples, clustering, required, slivers, nullptr, &state);
+        const Partition fresh = check_partition(mesh, *kase.layout, samples, clustering, required, slivers);
+        check_same(kept, fresh);
+        incremental_rounds += round > 0 && state.links_valid;
+        // Add what the check asks for, or else a few unsampled vertices.
+        std::vector<uint8_t> sampled(mesh.num_vertices(), 0);
+        for (int32_t v : samples) sampled[v] = 1;
+        std::vector<int32_t> added;
+        for (int32_t v : kept.new_samples)
+          if (!sampled[v]) sampled[v] = 1, added.push_back(v);
+        for (int32_t tries = 0; added.size() < 3 && tries < 100; ++tries) {
+          const int32_t v = int32_t(random() % uint32_t(mesh.num_vertices()));
+          if (!sampled[v]) sampled[v] = 1, added.push_back(v);
+        }
+        if (added.empty()) break;
+        const int32_t first_new = int32_t(samples.size());
+        samples.insert(samples.end(), added.begin(), added.end());
+        flood_add(mesh, *kase.layout, samples, first_new, clustering, &state.changed);
+      }
+    }
+  }
+  CHECK(incremental_rounds > 200);
 }

@@ -269,19 +269,19 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
   auto start = Clock::now();
   Clustering clustering;
   std::vector<int32_t> cross_edges;
-  EmitState emit;  // later rounds re-evaluate only the faces around relabelled vertices
+  CheckState checked;  // later rounds re-test only what the relabelled vertices changed
   if (cache && cache->holds(mesh, layout) && cache->worth_updating(samples)) {
     // The cached flood becomes this one (the same keys a fresh flood gives); the first check
     // then re-tests only the faces around the vertices that changed. The cache keeps the
     // flood without the repairs below.
-    flood_update(mesh, layout, cache->samples, samples, cache->clustering, &emit.changed);
+    flood_update(mesh, layout, cache->samples, samples, cache->clustering, &checked.changed);
     cache->samples = samples;
     clustering = cache->clustering;
     if (cache->emits_valid) {
-      emit.emits = std::move(cache->emits);  // given back after the first check, updated
-      emit.valid = true;
+      checked.emits = std::move(cache->emits);  // given back after the first check, updated
+      checked.valid = true;
     } else {
-      emit.changed.clear();  // every face is tested
+      checked.changed.clear();  // every face is tested
     }
     result.flood_updated = true;
   } else {
@@ -324,16 +324,16 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       std::vector<int32_t> candidates;
       for (int32_t f = 0; f < mesh.num_faces(); ++f)
         if (near_border[f]) candidates.push_back(f);
-      partition = check_partition(mesh, layout, samples, clustering, required, slivers, &candidates, &emit);
+      partition = check_partition(mesh, layout, samples, clustering, required, slivers, &candidates, &checked);
     } else {
-      partition = check_partition(mesh, layout, samples, clustering, required, slivers, nullptr, &emit);
+      partition = check_partition(mesh, layout, samples, clustering, required, slivers, nullptr, &checked);
     }
     if (cache) {
       // Emits of the cached flood, from the first check only (repairs change the clustering
       // from here on, and seeding rounds repeat round 0). An early return (unreached
       // vertices) leaves them valid only after testing every face.
-      cache->emits_valid = emit.valid && emit.changed.empty();
-      if (cache->emits_valid) cache->emits = emit.emits;
+      cache->emits_valid = checked.valid && checked.changed.empty();
+      if (cache->emits_valid) cache->emits = checked.emits;
       cache = nullptr;
     }
     accumulate(result.issues_found, partition.issues);
@@ -346,11 +346,11 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       if (snapshot.active && kept > top_up_to && snapshot.tried.size() < kMaxTopUpRetries) {
         samples.resize(snapshot.samples);
         clustering = snapshot.clustering;
-        emit = EmitState();
+        checked = CheckState();
         result.repair_rounds = snapshot.repair_rounds;
         result.repairs = snapshot.repairs;
         result.top_up = snapshot.top_up;
-        partition = check_partition(mesh, layout, samples, clustering, required, false, nullptr, &emit);
+        partition = check_partition(mesh, layout, samples, clustering, required, false, nullptr, &checked);
       } else if (top_up_to <= 0 || kept >= top_up_to - budget_tolerance(top_up_to) ||
                  result.top_up_rounds >= kMaxTopUpRounds) {
         break;
@@ -425,7 +425,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     }
     const int32_t first_new = static_cast<int32_t>(samples.size());
     samples.insert(samples.end(), added.begin(), added.end());
-    flood_add(mesh, layout, samples, first_new, clustering, &emit.changed);
+    flood_add(mesh, layout, samples, first_new, clustering, &checked.changed);
     if (clean) {
       result.top_up += static_cast<int32_t>(added.size());
     } else if (seeding) {

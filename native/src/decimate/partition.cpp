@@ -68,6 +68,93 @@ struct Marks {
   }
 };
 
+constexpr uint8_t kUntested = 2;  // a triangle's zero-area flag before it is tested
+
+// Samples whose link may differ from the last check's (1 per rank): the corners of every
+// triangle emitted then or now but not both (both lists are in face order, so one walk
+// compares them), the new samples, both samples of every feature pair whose expected copies
+// changed, and those the last check named. Every other sample's link is the same triangles
+// as then. Triangles emitted both times keep their zero-area flags when `sliver` is given.
+std::vector<uint8_t> changed_links(const CheckState& last, const Partition& out, int32_t k,
+                                   const std::vector<std::pair<uint64_t, int32_t>>& feature_pairs,
+                                   std::vector<uint8_t>* sliver) {
+  std::vector<uint8_t> affected(k, 0);
+  std::fill(affected.begin() + last.samples, affected.end(), 1);
+  const auto& was = last.emitted_faces;
+  const auto& now = out.source_face;
+  auto mark = [&](const std::vector<int32_t>& triangles, size_t i) {
+    for (int j = 0; j < 3; ++j) affected[triangles[3 * i + j]] = 1;
+  };
+  size_t i = 0, j = 0;
+  while (i < was.size() || j < now.size()) {
+    if (j == now.size() || (i < was.size() && was[i] < now[j])) {
+      mark(last.emitted_triangles, i++);  // no longer emitted
+    } else if (i == was.size() || now[j] < was[i]) {
+      mark(out.triangles, j++);  // emitted now
+    } else {
+      if (std::equal(&out.triangles[3 * j], &out.triangles[3 * j] + 3, &last.emitted_triangles[3 * i])) {
+        if (sliver) (*sliver)[j] = last.emitted_sliver[i];
+      } else {
+        mark(last.emitted_triangles, i), mark(out.triangles, j);
+      }
+      ++i, ++j;
+    }
+  }
+  auto mark_pair = [&](uint64_t key) { affected[int32_t(key >> 32)] = affected[int32_t(key & 0xffffffffu)] = 1; };
+  size_t a = 0, b = 0;
+  const auto& then = last.feature_pairs;
+  while (a < then.size() || b < feature_pairs.size()) {
+    if (b == feature_pairs.size() || (a < then.size() && then[a].first < feature_pairs[b].first)) {
+      mark_pair(then[a++].first);
+    } else if (a == then.size() || feature_pairs[b].first < then[a].first) {
+      mark_pair(feature_pairs[b++].first);
+    } else {
+      if (then[a].second != feature_pairs[b].second) mark_pair(then[a].first);
+      ++a, ++b;
+    }
+  }
+  for (int32_t s : last.revisit) affected[s] = 1;
+  return affected;
+}
+
+// Sets sliver[i] for the triangles listed: 1 when triangle i (sample ranks) has zero area
+// relative to its longest edge, else 0.
+void test_slivers(const Mesh& mesh, const std::vector<int32_t>& samples, const std::vector<int32_t>& triangles,
+                  const std::vector<int32_t>& listed, std::vector<uint8_t>& sliver) {
+  const int64_t count = int64_t(listed.size());
+  const int32_t k = int32_t(samples.size());
+  // Testing many triangles, the samples' positions are gathered first, in rank order: the
+  // triangles then read a compact array instead of the whole mesh's.
+  std::vector<double> at;
+  if (3 * count > k) {
+    at.resize(3 * size_t(k));
+#pragma omp parallel for schedule(static) if (k >= kParallelMinCostly)
+    for (int32_t s = 0; s < k; ++s)
+      for (int j = 0; j < 3; ++j) at[3 * size_t(s) + j] = mesh.position(samples[s])[j];
+  }
+  auto position = [&](int32_t s) { return at.empty() ? mesh.position(samples[s]) : &at[3 * size_t(s)]; };
+#pragma omp parallel for schedule(static) if (count >= kParallelMin)
+  for (int64_t l = 0; l < count; ++l) {
+    const int32_t i = listed[l];
+    const double* p[3];
+    for (int j = 0; j < 3; ++j) p[j] = position(triangles[3 * size_t(i) + j]);
+    double u[3], w[3], longest = 0;
+    for (int a = 0; a < 3; ++a) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
+    for (int j = 0; j < 3; ++j) {
+      const double* q0 = p[j];
+      const double* q1 = p[(j + 1) % 3];
+      longest = std::max(longest, (q1[0] - q0[0]) * (q1[0] - q0[0]) + (q1[1] - q0[1]) * (q1[1] - q0[1]) +
+                                      (q1[2] - q0[2]) * (q1[2] - q0[2]));
+    }
+    const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
+    const double c2 = cx * cx + cy * cy + cz * cz;
+    // Far above the bound (squared, with a margin of 2 for rounding; only where the squares
+    // stay normal numbers) the square root is not needed: nearly every triangle is.
+    const bool clearly_not = longest > 1e-140 && c2 > 2e-18 * longest * longest;
+    sliver[i] = !clearly_not && std::sqrt(c2) <= 1e-9 * longest;
+  }
+}
+
 }  // namespace
 
 std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layout, int32_t num_samples,
@@ -102,7 +189,7 @@ std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layou
 
 Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
                           const Clustering& c, const std::vector<uint8_t>& required, bool check_slivers,
-                          const std::vector<int32_t>* candidate_faces, EmitState* state) {
+                          const std::vector<int32_t>* candidate_faces, CheckState* state) {
   Partition out;
   const int32_t n = mesh.num_vertices();
   const int32_t k = static_cast<int32_t>(samples.size());
@@ -113,8 +200,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // --- emit: faces whose corners lie in three clusters ------------------------------------------
   const auto& faces = mesh.faces();
   const int32_t m = mesh.num_faces();
-  EmitState local;
-  EmitState& emit = state ? *state : local;
+  CheckState local;
+  CheckState& carried = state ? *state : local;  // what the last check left, and what this one leaves
   auto corner_labels = [&](int32_t f) {
     return std::array<int32_t, 3>{label(faces[3 * size_t(f)]), label(faces[3 * size_t(f) + 1]),
                                   label(faces[3 * size_t(f) + 2])};
@@ -128,8 +215,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // Re-testing the faces around many changed vertices, scattered over the mesh, costs more
   // than testing every face in order (horse at 10 %, a flood update that removed a tenth of
   // the samples: 46 against 35 ms for the check): beyond a sixteenth, every face is tested.
-  if (emit.valid && int64_t(emit.changed.size()) > n / 16) emit.valid = false;
-  const bool test_all = !emit.valid && !candidate_faces;
+  if (carried.valid && int64_t(carried.changed.size()) > n / 16) carried.valid = false;
+  const bool test_all = !carried.valid && !candidate_faces;
   // Vertices in a face but in no cluster stop the check here: the other checks need every
   // vertex in a cluster. Testing every face reads every such vertex's label and notes them on
   // the way (the emits then hold for this clustering, as after any test); otherwise the
@@ -137,15 +224,15 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   const int team = m >= kParallelMin ? threads : 1;
   int unreached = 0;
   if (test_all) {
-    emit.emits.resize(m);
+    carried.emits.resize(m);
 #pragma omp parallel for schedule(static) num_threads(team) reduction(| : unreached)
     for (int32_t f = 0; f < m; ++f) {
       const auto l = corner_labels(f);
-      emit.emits[f] = distinct(l);
+      carried.emits[f] = distinct(l);
       unreached |= (l[0] | l[1] | l[2]) < 0;
     }
-    emit.valid = true;
-    emit.changed.clear();
+    carried.valid = true;
+    carried.changed.clear();
   } else {
 #pragma omp parallel for schedule(static) reduction(| : unreached) if (n >= kParallelMin)
     for (int32_t v = 0; v < n; ++v)
@@ -153,24 +240,25 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   }
   if (unreached) {
     seed_unreached(mesh, c, out);
+    carried.links_valid = false;
     return out;
   }
   Marks marks(threads);
-  if (!test_all && emit.valid) {
+  if (!test_all && carried.valid) {
     const auto& vf = mesh.vertex_faces();
-    for (int32_t v : emit.changed)
-      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) emit.emits[vf[i]] = three_clusters(vf[i]);
+    for (int32_t v : carried.changed)
+      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) carried.emits[vf[i]] = three_clusters(vf[i]);
   } else if (candidate_faces) {
-    emit.emits.assign(m, 0);
+    carried.emits.assign(m, 0);
     const int64_t count = int64_t(candidate_faces->size());
 #pragma omp parallel for schedule(static) if (count >= kParallelMin)
-    for (int64_t i = 0; i < count; ++i) emit.emits[(*candidate_faces)[i]] = three_clusters((*candidate_faces)[i]);
+    for (int64_t i = 0; i < count; ++i) carried.emits[(*candidate_faces)[i]] = three_clusters((*candidate_faces)[i]);
   }
-  emit.valid = true;
-  emit.changed.clear();
+  carried.valid = true;
+  carried.changed.clear();
   // Eight faces at a time (a tenth of them emit at most); the last few faces after the whole
   // words are appended at the end.
-  const uint8_t* emits = emit.emits.data();
+  const uint8_t* emits = carried.emits.data();
   const int64_t words = m / 8;
   auto write = [&](int64_t at, int32_t f) {
     out.source_face[at] = f;
@@ -211,6 +299,21 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     const int32_t lx = label(mesh.edge_vertices()[2 * size_t(e)]), ly = label(mesh.edge_vertices()[2 * size_t(e) + 1]);
     if (lx != ly) feature_copies[pair_key(lx, ly)] += layout.edge_copies(mesh, e);
   }
+  std::vector<std::pair<uint64_t, int32_t>> feature_pairs(feature_copies.begin(), feature_copies.end());
+  std::sort(feature_pairs.begin(), feature_pairs.end());
+
+  // --- the samples to evaluate ------------------------------------------------------------------
+  // All of them, or after a repair round only those whose link may have changed; the others
+  // keep what the last check found. Unchanged triangles keep their zero-area flags too.
+  const bool incremental = carried.links_valid && carried.samples <= k;
+  std::vector<uint8_t> sliver;  // per emitted triangle: 0, 1 or kUntested
+  if (check_slivers) sliver.assign(emitted, kUntested);
+  std::vector<uint8_t> affected =
+      incremental ? changed_links(carried, out, k, feature_pairs, check_slivers && carried.slivers_checked ? &sliver : nullptr)
+                  : std::vector<uint8_t>(k, 1);
+  std::vector<int32_t> todo;
+  for (int32_t s = 0; s < k; ++s)
+    if (affected[s]) todo.push_back(s);
 
   // --- the arcs of each sample's link ---------------------------------------------------------
   // Triangle (a, b, c) gives a the arc b -> c, b the arc c -> a and c the arc a -> b. Stored per
@@ -218,19 +321,19 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   struct Arc {
     int32_t from, to, triangle;
   };
-  // Serial: a parallel counting sort cost more per thread than this whole loop (each sample
-  // has few arcs).
+  // Only the samples to evaluate get their arcs. Serial: a parallel counting sort cost more
+  // per thread than this whole loop (each sample has few arcs).
   std::vector<int32_t> arc_offsets(k + 1, 0);
-  for (int32_t x : out.triangles) ++arc_offsets[x + 1];
+  for (int32_t x : out.triangles) arc_offsets[x + 1] += affected[x];
   for (int32_t s = 0; s < k; ++s) arc_offsets[s + 1] += arc_offsets[s];
-  std::vector<Arc> arcs(out.triangles.size());
+  std::vector<Arc> arcs(arc_offsets[k]);
   {
     std::vector<int32_t> fill(arc_offsets.begin(), arc_offsets.end() - 1);
     for (int32_t i = 0; i < emitted; ++i) {
       const int32_t* t = &out.triangles[3 * size_t(i)];
-      arcs[fill[t[0]]++] = {t[1], t[2], i};
-      arcs[fill[t[1]]++] = {t[2], t[0], i};
-      arcs[fill[t[2]]++] = {t[0], t[1], i};
+      if (affected[t[0]]) arcs[fill[t[0]]++] = {t[1], t[2], i};
+      if (affected[t[1]]) arcs[fill[t[1]]++] = {t[2], t[0], i};
+      if (affected[t[2]]) arcs[fill[t[2]]++] = {t[0], t[1], i};
     }
   }
   auto incident = [&](int32_t s) { return arc_offsets[s + 1] - arc_offsets[s]; };
@@ -247,10 +350,18 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   };
   std::vector<int64_t> chi6_out(k, 0);
   out.absorbed.assign(k, 0);
+  if (incremental) {
+    std::copy(carried.chi6.begin(), carried.chi6.end(), chi6_out.begin());
+    std::copy(carried.absorbed.begin(), carried.absorbed.end(), out.absorbed.begin());
+    for (int32_t s : todo) chi6_out[s] = 0, out.absorbed[s] = 0;
+  }
   std::vector<uint8_t> drop(emitted, 0);
   bool any_dropped = false;  // drop is read only once pillows are dropped
   std::vector<std::vector<uint64_t>> seen_pairs(threads);
-  std::vector<std::vector<int32_t>> repeated_lists(threads);
+  if (incremental)  // the pairs seen by samples not evaluated again (a pair is seen from its lower rank)
+    for (uint64_t key : carried.seen_pairs)
+      if (!affected[int32_t(key >> 32)]) seen_pairs[0].push_back(key);
+  std::vector<std::vector<int32_t>> repeated_lists(threads), named_lists(threads);
   int32_t bad_link = 0, bad_edge = 0, isolated = 0, absorbed = 0;
   // At a pinched sample each input fan must come out as a fan of its own sheet: the arcs from
   // one sheet's faces form that sheet's fans (as many open and closed), and no fan mixes
@@ -327,14 +438,21 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     }
     return true;
   };
-#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed) if (k >= kParallelMinCostly)
+  const int64_t evaluated = int64_t(todo.size());
+#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed) if (evaluated >= kParallelMinCostly)
   {
     LinkArcs link;
     auto& seen = seen_pairs[omp_get_thread_num()];
     auto& repeated = repeated_lists[omp_get_thread_num()];
+    auto& named = named_lists[omp_get_thread_num()];
 #pragma omp for schedule(dynamic, 256)
-    for (int32_t s = 0; s < k; ++s)
-      if (!evaluate(s, link, seen, bad_link, bad_edge, isolated, absorbed)) repeated.push_back(s);
+    for (int64_t i = 0; i < evaluated; ++i) {
+      const int32_t s = todo[i], issues_before = bad_link + bad_edge + isolated;
+      if (!evaluate(s, link, seen, bad_link, bad_edge, isolated, absorbed))
+        repeated.push_back(s);
+      else if (bad_link + bad_edge + isolated != issues_before)
+        named.push_back(s);
+    }
   }
 
   // --- repeated triangles: pillows and duplicates ------------------------------------------------
@@ -402,17 +520,47 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   out.issues.bad_link = bad_link;
   out.issues.bad_edge = bad_edge;
   out.issues.isolated = isolated;
-  out.issues.absorbed = absorbed;
-  {
-    // Feature pairs without a triangle between them: the border between them collapsed.
-    std::vector<uint64_t> seen;
-    for (const auto& list : seen_pairs) seen.insert(seen.end(), list.begin(), list.end());
-    std::sort(seen.begin(), seen.end());
-    for (const auto& [key, copies] : feature_copies)
-      if (!std::binary_search(seen.begin(), seen.end(), key)) {
-        ++out.issues.bad_edge;
-        marks.add(int32_t(key >> 32)), marks.add(int32_t(key & 0xffffffffu));
+  (void)absorbed;  // counted over every sample below: those not evaluated again keep theirs
+  out.issues.absorbed = int32_t(std::count(out.absorbed.begin(), out.absorbed.end(), uint8_t(1)));
+  // Feature pairs without a triangle between them: the border between them collapsed.
+  std::vector<uint64_t> seen;
+  for (const auto& list : seen_pairs) seen.insert(seen.end(), list.begin(), list.end());
+  std::sort(seen.begin(), seen.end());
+  for (const auto& [key, copies] : feature_pairs)
+    if (!std::binary_search(seen.begin(), seen.end(), key)) {
+      ++out.issues.bad_edge;
+      marks.add(int32_t(key >> 32)), marks.add(int32_t(key & 0xffffffffu));
+    }
+
+  // --- triangles of zero area (collinear samples) ------------------------------------------------
+  if (check_slivers) {
+    std::vector<int32_t> untested;
+    for (int32_t i = 0; i < emitted; ++i)
+      if (sliver[i] == kUntested) untested.push_back(i);
+    test_slivers(mesh, samples, out.triangles, untested, sliver);
+    for (int32_t i = 0; i < emitted; ++i)
+      if (sliver[i] && !(any_dropped && drop[i])) {
+        ++out.issues.sliver;
+        for (int j = 0; j < 3; ++j) out.split_clusters.push_back(out.triangles[3 * size_t(i) + j]);
       }
+  }
+
+  // What the next round's check starts from: the triangles before pillows are dropped (a
+  // pillow's samples are evaluated again anyway), and what each sample's link gave.
+  if (state) {
+    carried.links_valid = true;
+    carried.samples = k;
+    carried.emitted_faces = out.source_face;
+    carried.emitted_triangles = out.triangles;
+    carried.emitted_sliver = std::move(sliver);
+    carried.slivers_checked = check_slivers;
+    carried.chi6 = chi6_out;
+    carried.absorbed = out.absorbed;
+    carried.revisit.clear();
+    for (const auto* lists : {&repeated_lists, &named_lists})
+      for (const auto& list : *lists) carried.revisit.insert(carried.revisit.end(), list.begin(), list.end());
+    carried.seen_pairs = seen;
+    carried.feature_pairs = std::move(feature_pairs);
   }
   if (any_dropped) {
     // Dropped pillows leave the output.
@@ -503,44 +651,6 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     }
   }
 
-  // --- triangles of zero area (collinear samples) ------------------------------------------------
-  if (check_slivers) {
-    const int32_t t = static_cast<int32_t>(out.source_face.size());
-    // The samples' positions gathered once, in rank order: the triangles then read a compact
-    // array instead of the whole mesh's.
-    std::vector<double> at(3 * size_t(k));
-#pragma omp parallel for schedule(static) if (k >= kParallelMinCostly)
-    for (int32_t s = 0; s < k; ++s)
-      for (int j = 0; j < 3; ++j) at[3 * size_t(s) + j] = mesh.position(samples[s])[j];
-    std::vector<uint8_t> sliver(t, 0);
-    int32_t slivers = 0;
-#pragma omp parallel for schedule(static) reduction(+ : slivers) if (t >= kParallelMin)
-    for (int32_t i = 0; i < t; ++i) {
-      const double* p[3];
-      for (int j = 0; j < 3; ++j) p[j] = &at[3 * size_t(out.triangles[3 * size_t(i) + j])];
-      double u[3], w[3], longest = 0;
-      for (int a = 0; a < 3; ++a) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
-      for (int j = 0; j < 3; ++j) {
-        const double* q0 = p[j];
-        const double* q1 = p[(j + 1) % 3];
-        longest = std::max(longest, (q1[0] - q0[0]) * (q1[0] - q0[0]) + (q1[1] - q0[1]) * (q1[1] - q0[1]) +
-                                        (q1[2] - q0[2]) * (q1[2] - q0[2]));
-      }
-      const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
-      const double c2 = cx * cx + cy * cy + cz * cz;
-      // Far above the bound (squared, with a margin of 2 for rounding; only where the squares
-      // stay normal numbers) the square root is not needed: nearly every triangle is.
-      const bool clearly_not = longest > 1e-140 && c2 > 2e-18 * longest * longest;
-      if (!clearly_not && std::sqrt(c2) <= 1e-9 * longest) {
-        sliver[i] = 1;
-        ++slivers;
-      }
-    }
-    out.issues.sliver += slivers;
-    for (int32_t i = 0; i < t && slivers > 0; ++i)
-      if (sliver[i])
-        for (int j = 0; j < 3; ++j) out.split_clusters.push_back(out.triangles[3 * size_t(i) + j]);
-  }
   std::sort(out.split_clusters.begin(), out.split_clusters.end());
   out.split_clusters.erase(std::unique(out.split_clusters.begin(), out.split_clusters.end()),
                            out.split_clusters.end());

@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "topstoc/decimate/clustering.hpp"
@@ -54,12 +55,28 @@ struct Partition {
   std::vector<uint8_t> absorbed;        ///< per rank: 1 if the sample has no triangle (not in the output)
 };
 
-/// Which faces emit a triangle, kept between the rounds of one decimation: after flood_add,
-/// only the faces around the vertices that changed are evaluated again.
-struct EmitState {
+/// What the last check of one decimation found, kept for the next round's check. After
+/// flood_add only the faces around the vertices that changed are tested again, and only the
+/// samples whose link (the triangles around them) may differ are evaluated again: a repair
+/// round relabels a few hundred vertices of a mesh of a million.
+struct CheckState {
+  // Which faces emit a triangle.
   std::vector<uint8_t> emits;    ///< per face: corners in three clusters
   std::vector<int32_t> changed;  ///< vertices relabelled since the last check (flood_add fills it)
   bool valid = false;            ///< emits matches the clustering as of the last check
+
+  // The samples' links as the last check evaluated them.
+  bool links_valid = false;                ///< the fields below hold the last check's
+  int32_t samples = 0;                     ///< how many samples it had (new ones are appended)
+  std::vector<int32_t> emitted_faces;      ///< every triangle it emitted (pillows included): source face
+  std::vector<int32_t> emitted_triangles;  ///< ... and its 3 sample ranks
+  std::vector<uint8_t> emitted_sliver;     ///< ... and whether it has zero area (if slivers_checked)
+  bool slivers_checked = false;
+  std::vector<int64_t> chi6;                                ///< per sample: its Euler contribution, times 6
+  std::vector<uint8_t> absorbed;                            ///< per sample: no triangle, absorbed
+  std::vector<int32_t> revisit;                             ///< samples with an issue or a repeated triangle
+  std::vector<uint64_t> seen_pairs;                         ///< feature pairs found in a link, sorted
+  std::vector<std::pair<uint64_t, int32_t>> feature_pairs;  ///< feature pairs and their copies, sorted
 };
 
 /// Emits triangles and checks them. `required` marks vertices whose samples must appear in the
@@ -67,10 +84,12 @@ struct EmitState {
 /// triangle are absorbed by their neighbours. candidate_faces, if given, lists (in increasing
 /// order) a superset of the faces whose corners lie in three clusters (the fast path, thesis
 /// 4.1.1); otherwise every face is scanned.
-/// With an EmitState that is valid, only the faces around state->changed are evaluated.
+/// With a CheckState whose emits are valid, only the faces around state->changed are tested;
+/// with its links valid too, only the samples whose links may have changed are evaluated (the
+/// others keep what the last check found, which is what evaluating them again gives).
 Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
                           const Clustering& clustering, const std::vector<uint8_t>& required, bool check_slivers,
-                          const std::vector<int32_t>* candidate_faces = nullptr, EmitState* state = nullptr);
+                          const std::vector<int32_t>* candidate_faces = nullptr, CheckState* state = nullptr);
 
 /// Six times the Euler characteristic of every cluster on the mesh cut along the feature
 /// edges (one pass over all faces). A cluster is one disk per side exactly when the value is
