@@ -107,4 +107,29 @@ struct LinkArcs {
   }
 };
 
+/// True when `count` >= 3 arcs (fields `from`, `to`) form one cycle: following each arc to the
+/// arc leaving its head (the first such) comes back to the start after exactly `count` arcs.
+/// Then the arcs' tails are `count` distinct vertices, each with one arc in and one out: the
+/// link of a vertex inside a surface, one consistently oriented fan (what LinkArcs finds with
+/// !repeated(), single_fan() and every neighbour's in + out == 2). The common case, checked
+/// without building the LinkArcs; false for anything else.
+template <class Arc>
+bool one_cycle(const Arc* arcs, int32_t count) {
+  if (count < 3) return false;  // two arcs a -> b, b -> a are one triangle twice
+  const int32_t start = arcs[0].from;
+  int32_t at = arcs[0].to, steps = 1;
+  while (at != start) {
+    if (++steps > count) return false;  // a cycle that misses the start
+    int32_t next = -1;
+    for (int32_t j = 1; j < count; ++j)
+      if (arcs[j].from == at) {
+        next = j;
+        break;
+      }
+    if (next < 0) return false;  // a path's end
+    at = arcs[next].to;
+  }
+  return steps == count;
+}
+
 }  // namespace topstoc

@@ -396,6 +396,25 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // Returns false (and changes nothing) when the link repeats a triangle.
   auto evaluate = [&](int32_t s, LinkArcs& link, std::vector<uint64_t>& seen, int32_t& links, int32_t& edges,
                       int32_t& lonely, int32_t& eaten) {
+    // Most samples: inside a surface, one closed fan, no pillow. Then every neighbour's edge
+    // has two triangles, and only feature pairs expect something else.
+    const Arc* around = &arcs[arc_offsets[s]];
+    if (!any_dropped && mesh.manifold_vertex()[samples[s]] && one_cycle(around, incident(s))) {
+      chi6_out[s] = 6 - incident(s);  // 6 - 3 neighbours + 2 triangles, as many of each
+      if (feature_copies.empty()) return true;
+      for (int32_t i = 0; i < incident(s); ++i) {
+        const int32_t nb = around[i].from;
+        if (nb < s) continue;  // each pair once
+        const auto it = feature_copies.find(pair_key(s, nb));
+        if (it == feature_copies.end()) continue;
+        seen.push_back(it->first);
+        if (it->second != 2) {
+          ++edges;
+          marks.add(s), marks.add(nb);
+        }
+      }
+      return true;
+    }
     link.clear();
     for (int32_t i = arc_offsets[s]; i < arc_offsets[s + 1]; ++i)
       if (!any_dropped || !drop[arcs[i].triangle]) link.add(arcs[i].from, arcs[i].to);

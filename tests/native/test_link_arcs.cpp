@@ -1,0 +1,60 @@
+// one_cycle (link_arcs.hpp), the partition check's shortcut for a closed fan, against the
+// general LinkArcs on every arc set drawn: random arcs among a few vertices, and shuffled
+// cycles, some with one arc changed.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#include "decimate/link_arcs.hpp"
+
+using topstoc::LinkArcs;
+
+namespace {
+
+struct Arc {
+  int32_t from, to;
+};
+
+// What one_cycle claims, from the general structure: no repeat, one fan, and it is closed
+// (every neighbour has an arc in and one out), with at least three arcs.
+bool closed_fan(const std::vector<Arc>& arcs) {
+  LinkArcs link;
+  for (const Arc& a : arcs) link.add(a.from, a.to);
+  if (arcs.size() < 3 || link.repeated() || link.fans() != 1) return false;
+  for (const auto& nb : link.neighbours)
+    if (nb.in != 1 || nb.out != 1) return false;
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("one_cycle is true exactly for a closed fan of three or more arcs") {
+  std::mt19937 random(7);
+  int32_t cycles = 0, others = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::vector<Arc> arcs;
+    const int32_t count = 1 + int32_t(random() % 9);
+    if (trial % 2 == 0) {  // a cycle through `count` distinct vertices, shuffled, maybe broken
+      std::vector<int32_t> ring(count);
+      std::iota(ring.begin(), ring.end(), 10);
+      std::shuffle(ring.begin(), ring.end(), random);
+      for (int32_t i = 0; i < count; ++i) arcs.push_back({ring[i], ring[(i + 1) % count]});
+      if (random() % 3 == 0) arcs[random() % count].to = 10 + int32_t(random() % (count + 1));
+      if (random() % 4 == 0) arcs.pop_back();
+    } else {  // arcs among few vertices: repeats, reversals, paths, several cycles
+      for (int32_t i = 0; i < count; ++i) {
+        const int32_t a = int32_t(random() % 6), b = int32_t(random() % 6);
+        if (a != b) arcs.push_back({a, b});
+      }
+    }
+    std::shuffle(arcs.begin(), arcs.end(), random);
+    const bool expected = closed_fan(arcs);
+    CHECK(topstoc::one_cycle(arcs.data(), int32_t(arcs.size())) == expected);
+    ++(expected ? cycles : others);
+  }
+  CHECK(cycles > 1000);
+  CHECK(others > 1000);
+}
