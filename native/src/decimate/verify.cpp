@@ -23,8 +23,11 @@ namespace {
 // of vertices: it reads every triangle and writes only the arcs of its own vertices, so the
 // order does not depend on the number of threads.
 struct VertexArcs {
+  struct Arc {
+    int32_t from, to;
+  };
   Buffer<int32_t> offsets;
-  Buffer<std::array<int32_t, 2>> arcs;
+  Buffer<Arc> arcs;
   VertexArcs(int32_t n, const std::vector<int32_t>& tris) : offsets(n + 1) {
     const int64_t t = int64_t(tris.size() / 3);
     auto valid = [&](int64_t i) {
@@ -186,10 +189,22 @@ OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const st
     std::vector<int64_t> my_euler(num_components, 0);
 #pragma omp for schedule(dynamic, 512)
     for (int32_t v = 0; v < n; ++v) {
+      const int32_t count = around.offsets[v + 1] - around.offsets[v];
+      const VertexArcs::Arc* arcs = &around.arcs[around.offsets[v]];
+      if (one_cycle(arcs, count) && manifold[component_of[v]]) {
+        // The common case, one closed fan (link_arcs.hpp): each neighbour edge has two
+        // triangles, one each way, and no triangle repeats; only the edges are counted.
+        used[v] = 1;
+        int64_t& euler_v = my_euler[component_of[v]];
+        ++euler_v;
+        for (int32_t i = 0; i < count; ++i)
+          if (arcs[i].from > v) --euler_v, pieces.unite(v, arcs[i].from);
+        continue;
+      }
       link.clear();
       corner_pairs.clear();
       for (int32_t i = around.offsets[v]; i < around.offsets[v + 1]; ++i) {
-        const int32_t a = around.arcs[i][0], b = around.arcs[i][1];
+        const int32_t a = around.arcs[i].from, b = around.arcs[i].to;
         link.add(a, b);
         if (v < a && v < b) {
           // A triangle over the same three vertices as an earlier one (at its lowest corner).
