@@ -1,9 +1,12 @@
 // Small meshes built in code for the C++ tests: a torus grid (genus 1), an octahedron (genus 0)
-// and a planar grid (one boundary loop), each as plain arrays.
+// and a planar grid (one boundary loop), each as plain arrays; and random samples on them.
 #pragma once
 
 #include <cmath>
+#include <algorithm>
 #include <cstdint>
+#include <numeric>
+#include <random>
 #include <vector>
 
 namespace topstoc_test {
@@ -55,6 +58,15 @@ inline Arrays octahedron() {
     a.triangles.insert(a.triangles.end(), {0, e0, e1, 5, e1, e0});
   }
   return a;
+}
+
+/// `count` distinct vertex ids below n, drawn at random.
+inline std::vector<int32_t> random_samples(int32_t n, int32_t count, std::mt19937& random) {
+  std::vector<int32_t> ids(n);
+  std::iota(ids.begin(), ids.end(), 0);
+  std::shuffle(ids.begin(), ids.end(), random);
+  ids.resize(count);
+  return ids;
 }
 
 }  // namespace topstoc_test

@@ -33,14 +33,6 @@ std::shared_ptr<const FeatureLayout> column_border(const Mesh& mesh) {
   return build_feature_layout(mesh, nullptr, 0, border.data(), int64_t(border.size() / 2), 0.0);
 }
 
-std::vector<int32_t> random_samples(int32_t n, int32_t count, std::mt19937& random) {
-  std::vector<int32_t> ids(n);
-  std::iota(ids.begin(), ids.end(), 0);
-  std::shuffle(ids.begin(), ids.end(), random);
-  ids.resize(count);
-  return ids;
-}
-
 // The definition, without features: a breadth-first search from every sample.
 Clustering brute_clustering(const Mesh& mesh, const std::vector<int32_t>& samples) {
   const int32_t n = mesh.num_vertices();
@@ -92,7 +84,7 @@ void check_flood_add_equals_flood(const Mesh& mesh, const FeatureLayout& layout,
   const int32_t n = mesh.num_vertices();
   for (int round = 0; round < 10; ++round) {
     const int32_t total = 2 + int32_t(random() % std::max(2, n / 4));
-    const auto samples = random_samples(n, total, random);
+    const auto samples = topstoc_test::random_samples(n, total, random);
     const int32_t first_new = 1 + int32_t(random() % (total - 1));
     Clustering whole, incremental;
     flood(mesh, layout, samples, whole);
@@ -108,7 +100,7 @@ void check_flood_add_equals_flood(const Mesh& mesh, const FeatureLayout& layout,
 
 // A random sorted subset of [0, n) of `count` vertices.
 std::vector<int32_t> sorted_samples(int32_t n, int32_t count, std::mt19937& random) {
-  auto ids = random_samples(n, count, random);
+  auto ids = topstoc_test::random_samples(n, count, random);
   std::sort(ids.begin(), ids.end());
   return ids;
 }
@@ -126,7 +118,7 @@ void check_flood_update_equals_flood(const Mesh& mesh, const FeatureLayout& layo
     std::vector<uint8_t> listed(n, 0);
     for (int32_t v : samples) listed[v] = 1;
     int32_t add = int32_t(random() % (count / 4 + 2));
-    for (int32_t v : random_samples(n, n, random))
+    for (int32_t v : topstoc_test::random_samples(n, n, random))
       if (add > 0 && !listed[v]) listed[v] = 1, samples.push_back(v), --add;
     if (samples.empty()) samples.push_back(old_samples.front());
     std::sort(samples.begin(), samples.end());
@@ -148,7 +140,7 @@ TEST_CASE("flood gives every vertex the sample of least (hops, rank), as a searc
   const Mesh mesh = make_mesh(topstoc_test::torus(12, 9));
   const auto layout = no_features(mesh);
   for (int round = 0; round < 10; ++round) {
-    const auto samples = random_samples(mesh.num_vertices(), 1 + int32_t(random() % 20), random);
+    const auto samples = topstoc_test::random_samples(mesh.num_vertices(), 1 + int32_t(random() % 20), random);
     Clustering c;
     flood(mesh, *layout, samples, c);
     const Clustering expected = brute_clustering(mesh, samples);

@@ -87,15 +87,6 @@ TEST_CASE("rejected: a grid (a disk) in two clusters") {
 
 namespace {
 
-// `count` distinct vertices (mesh ids) drawn at random.
-std::vector<int32_t> random_vertices(int32_t n, int32_t count, std::mt19937& random) {
-  std::vector<int32_t> ids(n);
-  std::iota(ids.begin(), ids.end(), 0);
-  std::shuffle(ids.begin(), ids.end(), random);
-  ids.resize(count);
-  return ids;
-}
-
 void check_same(const Partition& a, const Partition& b) {
   CHECK(a.triangles == b.triangles);
   CHECK(a.source_face == b.source_face);
@@ -137,7 +128,7 @@ TEST_CASE("a check after flood_add evaluates only the changed links and finds wh
     const Mesh& mesh = *kase.mesh;
     for (uint32_t seed = 1; seed <= 60; ++seed) {
       std::mt19937 random(seed);
-      std::vector<int32_t> samples = random_vertices(mesh.num_vertices(), 4 + int32_t(seed % 5), random);
+      std::vector<int32_t> samples = topstoc_test::random_samples(mesh.num_vertices(), 4 + int32_t(seed % 5), random);
       Clustering clustering;
       flood(mesh, *kase.layout, samples, clustering);
       const std::vector<uint8_t> required(mesh.num_vertices(), 0);
