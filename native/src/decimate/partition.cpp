@@ -398,7 +398,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
                       int32_t& lonely, int32_t& eaten) {
     // Most samples: inside a surface, one closed fan, no pillow. Then every neighbour's edge
     // has two triangles, and only feature pairs expect something else.
-    const Arc* around = &arcs[arc_offsets[s]];
+    const Arc* around = arcs.data() + arc_offsets[s];
     if (!any_dropped && mesh.manifold_vertex()[samples[s]] && one_cycle(around, incident(s))) {
       chi6_out[s] = 6 - incident(s);  // 6 - 3 neighbours + 2 triangles, as many of each
       if (feature_copies.empty()) return true;

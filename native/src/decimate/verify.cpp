@@ -190,7 +190,7 @@ OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const st
 #pragma omp for schedule(dynamic, 512)
     for (int32_t v = 0; v < n; ++v) {
       const int32_t count = around.offsets[v + 1] - around.offsets[v];
-      const VertexArcs::Arc* arcs = &around.arcs[around.offsets[v]];
+      const VertexArcs::Arc* arcs = around.arcs.data() + around.offsets[v];
       if (one_cycle(arcs, count) && manifold[component_of[v]]) {
         // The common case, one closed fan (link_arcs.hpp): each neighbour edge has two
         // triangles, one each way, and no triangle repeats; only the edges are counted.
