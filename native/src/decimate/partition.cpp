@@ -348,10 +348,11 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     std::vector<int32_t> fan_of_slot;
     return vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot);
   };
-  std::vector<int64_t> chi6_out(k, 0);
+  // The last check's values are taken over (new samples start at 0) and handed back below.
+  std::vector<int64_t> chi6_out = incremental ? std::move(carried.chi6) : std::vector<int64_t>();
+  chi6_out.resize(k, 0);
   out.absorbed.assign(k, 0);
   if (incremental) {
-    std::copy(carried.chi6.begin(), carried.chi6.end(), chi6_out.begin());
     std::copy(carried.absorbed.begin(), carried.absorbed.end(), out.absorbed.begin());
     for (int32_t s : todo) chi6_out[s] = 0, out.absorbed[s] = 0;
   }
@@ -362,7 +363,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     for (uint64_t key : carried.seen_pairs)
       if (!affected[int32_t(key >> 32)]) seen_pairs[0].push_back(key);
   std::vector<std::vector<int32_t>> repeated_lists(threads), named_lists(threads);
-  int32_t bad_link = 0, bad_edge = 0, isolated = 0, absorbed = 0;
+  int32_t bad_link = 0, bad_edge = 0, isolated = 0;
   // At a pinched sample each input fan must come out as a fan of its own sheet: the arcs from
   // one sheet's faces form that sheet's fans (as many open and closed), and no fan mixes
   // sheets. Counting the fans alone let a small wing vanish while another wing, split at the
@@ -393,26 +394,31 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     }
     return arcs_on_sheets == link.arcs;
   };
+  // The edge between sample s and its neighbour nb (each pair once, from its lower rank) has
+  // `triangles` triangles: two inside a surface, a feature pair's copies along a curve.
+  auto check_edge = [&](int32_t s, int32_t nb, int32_t triangles, std::vector<uint64_t>& seen, int32_t& edges) {
+    if (nb < s) return;
+    int32_t expected = 2;
+    const auto it = feature_copies.empty() ? feature_copies.end() : feature_copies.find(pair_key(s, nb));
+    if (it != feature_copies.end()) {
+      expected = it->second;
+      seen.push_back(it->first);
+    }
+    if (triangles != expected) {
+      ++edges;
+      marks.add(s), marks.add(nb);
+    }
+  };
   // Returns false (and changes nothing) when the link repeats a triangle.
   auto evaluate = [&](int32_t s, LinkArcs& link, std::vector<uint64_t>& seen, int32_t& links, int32_t& edges,
-                      int32_t& lonely, int32_t& eaten) {
+                      int32_t& lonely) {
     // Most samples: inside a surface, one closed fan, no pillow. Then every neighbour's edge
     // has two triangles, and only feature pairs expect something else.
     const Arc* around = arcs.data() + arc_offsets[s];
     if (!any_dropped && mesh.manifold_vertex()[samples[s]] && one_cycle(around, incident(s))) {
       chi6_out[s] = 6 - incident(s);  // 6 - 3 neighbours + 2 triangles, as many of each
-      if (feature_copies.empty()) return true;
-      for (int32_t i = 0; i < incident(s); ++i) {
-        const int32_t nb = around[i].from;
-        if (nb < s) continue;  // each pair once
-        const auto it = feature_copies.find(pair_key(s, nb));
-        if (it == feature_copies.end()) continue;
-        seen.push_back(it->first);
-        if (it->second != 2) {
-          ++edges;
-          marks.add(s), marks.add(nb);
-        }
-      }
+      if (!feature_copies.empty())
+        for (int32_t i = 0; i < incident(s); ++i) check_edge(s, around[i].from, 2, seen, edges);
       return true;
     }
     link.clear();
@@ -426,25 +432,12 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
         ++lonely;
         marks.add(s);
       } else {
-        ++eaten;
         out.absorbed[s] = 1;
       }
       return true;
     }
     chi6_out[s] = 6 - 3 * int64_t(link.neighbours.size()) + 2 * int64_t(link.arcs);
-    for (const auto& nb : link.neighbours) {
-      if (nb.id < s) continue;  // each pair once
-      int32_t expected = 2;
-      auto it = feature_copies.empty() ? feature_copies.end() : feature_copies.find(pair_key(s, nb.id));
-      if (it != feature_copies.end()) {
-        expected = it->second;
-        seen.push_back(it->first);
-      }
-      if (nb.in + nb.out != expected) {
-        ++edges;
-        marks.add(s), marks.add(nb.id);
-      }
-    }
+    for (const auto& nb : link.neighbours) check_edge(s, nb.id, nb.in + nb.out, seen, edges);
     if (mesh.manifold_vertex()[samples[s]] && !link.single_fan()) {
       ++links;
       marks.add(s);
@@ -458,7 +451,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     return true;
   };
   const int64_t evaluated = int64_t(todo.size());
-#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated, absorbed) if (evaluated >= kParallelMinCostly)
+#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated) if (evaluated >= kParallelMinCostly)
   {
     LinkArcs link;
     auto& seen = seen_pairs[omp_get_thread_num()];
@@ -467,7 +460,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
 #pragma omp for schedule(dynamic, 256)
     for (int64_t i = 0; i < evaluated; ++i) {
       const int32_t s = todo[i], issues_before = bad_link + bad_edge + isolated;
-      if (!evaluate(s, link, seen, bad_link, bad_edge, isolated, absorbed))
+      if (!evaluate(s, link, seen, bad_link, bad_edge, isolated))
         repeated.push_back(s);
       else if (bad_link + bad_edge + isolated != issues_before)
         named.push_back(s);
@@ -521,7 +514,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     // tetrahedra), so without the count such an output passed every check.
     LinkArcs link;
     for (int32_t s : repeated)
-      if (!evaluate(s, link, seen_pairs[0], bad_link, bad_edge, isolated, absorbed)) {
+      if (!evaluate(s, link, seen_pairs[0], bad_link, bad_edge, isolated)) {
         marks.add(s);
         // A non-manifold input edge kept as a feature legitimately has more than two triangles.
         bool expected = false;
@@ -539,7 +532,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   out.issues.bad_link = bad_link;
   out.issues.bad_edge = bad_edge;
   out.issues.isolated = isolated;
-  (void)absorbed;  // counted over every sample below: those not evaluated again keep theirs
+  // Counted over every sample: those not evaluated again keep theirs.
   out.issues.absorbed = int32_t(std::count(out.absorbed.begin(), out.absorbed.end(), uint8_t(1)));
   // Feature pairs without a triangle between them: the border between them collapsed.
   std::vector<uint64_t> seen;
@@ -573,12 +566,11 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     carried.emitted_triangles = out.triangles;
     carried.emitted_sliver = std::move(sliver);
     carried.slivers_checked = check_slivers;
-    carried.chi6 = chi6_out;
     carried.absorbed = out.absorbed;
     carried.revisit.clear();
     for (const auto* lists : {&repeated_lists, &named_lists})
       for (const auto& list : *lists) carried.revisit.insert(carried.revisit.end(), list.begin(), list.end());
-    carried.seen_pairs = seen;
+    carried.seen_pairs = std::move(seen);
     carried.feature_pairs = std::move(feature_pairs);
   }
   if (any_dropped) {
@@ -603,6 +595,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     sample_component[s] = mesh.component()[samples[s]];
     component_chi6[sample_component[s]] += chi6_out[s];
   }
+  if (state) carried.chi6 = std::move(chi6_out);  // for the next round's check
   for (size_t i = 0; i < out.source_face.size(); ++i) ++component_triangles[sample_component[out.triangles[3 * i]]];
   std::vector<uint8_t> failing(num_components, 0);
   for (int32_t comp = 0; comp < num_components; ++comp)
