@@ -103,28 +103,37 @@ void check_same(const Partition& a, const Partition& b) {
 
 }  // namespace
 
+// The meshes the incremental checks are compared on: a torus without features and with two
+// regions (closed feature curves), and a grid whose column i = 7 is a border.
+struct IncrementalCases {
+  struct Case {
+    const Mesh* mesh;
+    std::shared_ptr<const FeatureLayout> layout;
+  };
+  topstoc_test::Arrays torus_arrays = topstoc_test::torus(24, 16), grid_arrays = topstoc_test::grid(14, 10);
+  Mesh torus{torus_arrays.positions, torus_arrays.triangles.data(), torus_arrays.num_triangles()};
+  Mesh grid{grid_arrays.positions, grid_arrays.triangles.data(), grid_arrays.num_triangles()};
+  std::vector<Case> cases;
+
+  IncrementalCases() {
+    std::vector<int32_t> halves(torus.num_faces());
+    for (int32_t f = 0; f < torus.num_faces(); ++f) halves[f] = torus.position(torus.faces()[3 * size_t(f)])[0] > 0;
+    std::vector<int32_t> border;  // caller vertex pairs
+    for (int32_t j = 0; j < 10; ++j) border.insert(border.end(), {7 * 11 + j, 7 * 11 + j + 1});
+    cases = {{&torus, build_feature_layout(torus, nullptr, 0, nullptr, 0, 0.0)},
+             {&torus, build_feature_layout(torus, halves.data(), int64_t(halves.size()), nullptr, 0, 0.0)},
+             {&grid, build_feature_layout(grid, nullptr, 0, border.data(), int64_t(border.size() / 2), 0.0)}};
+  }
+  const std::vector<Case>& all() const { return cases; }
+  std::vector<Case> with_features() const { return {cases[1], cases[2]}; }
+};
+
 TEST_CASE("a check after flood_add evaluates only the changed links and finds what a check from scratch finds") {
   // Few samples at first (many issues), then a few more per round, as the repair rounds add
   // them: every round's incremental check must equal a full one of the same clustering.
-  const auto torus = topstoc_test::torus(24, 16);
-  const auto grid = topstoc_test::grid(14, 10);
-  const Mesh torus_mesh(torus.positions, torus.triangles.data(), torus.num_triangles());
-  const Mesh grid_mesh(grid.positions, grid.triangles.data(), grid.num_triangles());
-  std::vector<int32_t> halves(torus_mesh.num_faces());  // two regions: closed feature curves
-  for (int32_t f = 0; f < torus_mesh.num_faces(); ++f)
-    halves[f] = torus_mesh.position(torus_mesh.faces()[3 * size_t(f)])[0] > 0;
-  std::vector<int32_t> border;  // the grid's column i = 7 as a border (caller vertex pairs)
-  for (int32_t j = 0; j < 10; ++j) border.insert(border.end(), {7 * 11 + j, 7 * 11 + j + 1});
-  const struct {
-    const Mesh* mesh;
-    std::shared_ptr<const FeatureLayout> layout;
-  } cases[] = {
-      {&torus_mesh, build_feature_layout(torus_mesh, nullptr, 0, nullptr, 0, 0.0)},
-      {&torus_mesh, build_feature_layout(torus_mesh, halves.data(), int64_t(halves.size()), nullptr, 0, 0.0)},
-      {&grid_mesh, build_feature_layout(grid_mesh, nullptr, 0, border.data(), int64_t(border.size() / 2), 0.0)},
-  };
+  const IncrementalCases cases;
   int64_t incremental_rounds = 0;
-  for (const auto& kase : cases) {
+  for (const auto& kase : cases.all()) {
     const Mesh& mesh = *kase.mesh;
     for (uint32_t seed = 1; seed <= 60; ++seed) {
       std::mt19937 random(seed);
@@ -163,23 +172,8 @@ TEST_CASE("a check after relabelling feature vertices by hand finds what a check
   // Vertices on feature curves moved to a neighbour's cluster, a few at a time: this changes
   // the triangle count expected between feature pairs, sometimes with no emitted triangle
   // changing around the vertex, which the flood_add rounds above rarely do.
-  const auto torus = topstoc_test::torus(24, 16);
-  const auto grid = topstoc_test::grid(14, 10);
-  const Mesh torus_mesh(torus.positions, torus.triangles.data(), torus.num_triangles());
-  const Mesh grid_mesh(grid.positions, grid.triangles.data(), grid.num_triangles());
-  std::vector<int32_t> halves(torus_mesh.num_faces());
-  for (int32_t f = 0; f < torus_mesh.num_faces(); ++f)
-    halves[f] = torus_mesh.position(torus_mesh.faces()[3 * size_t(f)])[0] > 0;
-  std::vector<int32_t> border;
-  for (int32_t j = 0; j < 10; ++j) border.insert(border.end(), {7 * 11 + j, 7 * 11 + j + 1});
-  const struct {
-    const Mesh* mesh;
-    std::shared_ptr<const FeatureLayout> layout;
-  } cases[] = {
-      {&torus_mesh, build_feature_layout(torus_mesh, halves.data(), int64_t(halves.size()), nullptr, 0, 0.0)},
-      {&grid_mesh, build_feature_layout(grid_mesh, nullptr, 0, border.data(), int64_t(border.size() / 2), 0.0)},
-  };
-  for (const auto& kase : cases) {
+  const IncrementalCases cases;
+  for (const auto& kase : cases.with_features()) {
     const Mesh& mesh = *kase.mesh;
     const auto& ao = mesh.adjacency_offsets();
     const auto& adj = mesh.adjacency();
