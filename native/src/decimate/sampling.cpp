@@ -12,6 +12,7 @@
 #include <omp.h>
 
 #include "core/counting_sort.hpp"
+#include "core/ordered_sum.hpp"
 #include "topstoc/core/random.hpp"
 
 namespace topstoc {
@@ -218,6 +219,18 @@ double surface_probability(const Mesh& mesh, const SamplingParams& params, int32
   return std::clamp(p, 0.0, 1.0);
 }
 
+// A vertex's probability at rate k from its class and importance, without per-vertex guidance.
+inline double plain_probability(uint8_t cls, double q, double k) {
+  switch (cls) {
+    case kIsolated: return 0.0;
+    case kCorner: return 1.0;
+    default: {
+      const double surface = std::min(1.0, k * q);
+      return cls == kCurve ? std::sqrt(surface) : surface;
+    }
+  }
+}
+
 std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& cls, const std::vector<double>& q,
                                   const std::vector<double>& multiplier, const SamplingParams& params, double k) {
   const int32_t n = mesh.num_vertices();
@@ -225,14 +238,11 @@ std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& 
   const bool guided = has_per_vertex_guidance(params);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
-    switch (cls[v]) {
-      case kIsolated: p[v] = 0.0; break;
-      case kCorner: p[v] = 1.0; break;
-      default: {
-        const double surface =
-            guided ? surface_probability(mesh, params, v, k, q[v], multiplier[v]) : std::min(1.0, k * q[v]);
-        p[v] = cls[v] == kCurve ? std::sqrt(surface) : surface;
-      }
+    if (!guided || cls[v] == kIsolated || cls[v] == kCorner) {
+      p[v] = plain_probability(cls[v], q[v], k);
+    } else {
+      const double surface = surface_probability(mesh, params, v, k, q[v], multiplier[v]);
+      p[v] = cls[v] == kCurve ? std::sqrt(surface) : surface;
     }
   }
   return p;
@@ -349,31 +359,42 @@ std::shared_ptr<const SelectionUniforms> selection_uniforms(const Mesh& mesh, co
   return table;
 }
 
-// Candidates with Pareto key (U / (1 - U)) ((1 - p) / p) below `threshold`, in vertex order.
+// Candidates with Pareto key (U / (1 - U)) ((1 - p) / p) below `threshold`, in vertex order;
+// probability(v) gives p. The same pass gives the vertices with p = 1 (in vertex order) and the
+// sum of all p (the same to the bit for any thread count) when asked for.
+template <typename Probability>
 std::vector<Candidate> pareto_candidates(const Mesh& mesh, const SelectionUniforms& uniforms,
-                                         const std::vector<double>& p, double threshold) {
-  const int32_t n = mesh.num_vertices();
-  const int threads = omp_get_max_threads();
-  std::vector<std::vector<Candidate>> found(threads);
-#pragma omp parallel if (n >= kParallelMin)
-  {
-    auto& mine = found[omp_get_thread_num()];
-#pragma omp for schedule(static)
-    for (int32_t v = 0; v < n; ++v) {
-      const double pv = p[v];
-      if (!(pv > 0.0 && pv < 1.0)) continue;
-      const double u = uniforms.u[v];
-      // key < threshold without the two divisions (most vertices fail it); the key itself
-      // is computed as before for those that pass. A vertex whose rounding differs sits at
-      // the threshold, far above the keys the draw takes (the threshold leaves a margin).
-      if (u * (1.0 - pv) >= threshold * pv * (1.0 - u)) continue;
-      const double key = (u / (1.0 - u)) * ((1.0 - pv) / pv);
-      if (key < threshold) mine.push_back({key, v});
-    }
-  }
-  std::vector<Candidate> out;
-  for (auto& list : found) out.insert(out.end(), list.begin(), list.end());
-  return out;
+                                         const Probability& probability, double threshold,
+                                         std::vector<int32_t>* forced = nullptr, double* sum = nullptr) {
+  struct Found {
+    double sum = 0.0;
+    std::vector<int32_t> forced;
+    std::vector<Candidate> candidates;
+  };
+  const Found found = ordered_reduce<Found>(
+      mesh.num_vertices(),
+      [&](Found& block, int64_t i) {
+        const int32_t v = int32_t(i);
+        const double pv = probability(v);
+        block.sum += pv;
+        if (pv >= 1.0 && forced) block.forced.push_back(v);
+        if (!(pv > 0.0 && pv < 1.0)) return;
+        const double u = uniforms.u[v];
+        // key < threshold without the two divisions (most vertices fail it); the key itself
+        // is computed as before for those that pass. A vertex whose rounding differs sits at
+        // the threshold, far above the keys the draw takes (the threshold leaves a margin).
+        if (u * (1.0 - pv) >= threshold * pv * (1.0 - u)) return;
+        const double key = (u / (1.0 - u)) * ((1.0 - pv) / pv);
+        if (key < threshold) block.candidates.push_back({key, v});
+      },
+      [](Found& total, const Found& block) {
+        total.sum += block.sum;
+        total.forced.insert(total.forced.end(), block.forced.begin(), block.forced.end());
+        total.candidates.insert(total.candidates.end(), block.candidates.begin(), block.candidates.end());
+      });
+  if (forced) *forced = found.forced;
+  if (sum) *sum = found.sum;
+  return found.candidates;
 }
 
 // Sorts distinct vertex ids in [0, n): a bit per vertex, read back in order (a tenth of the cost of
@@ -602,51 +623,53 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
   // Multipliers are read only with per-vertex guidance (all ones otherwise: not made).
   const auto multiplier = has_per_vertex_guidance(params) ? guidance_multipliers(mesh, params) : std::vector<double>();
   out.rate = out.guided ? solve_guided_rate(mesh, cls, table->q, multiplier, params, target) : solve_rate(*table, target);
-  const auto p = probabilities(mesh, cls, table->q, multiplier, params, out.rate);
-  double expected = 0.0;
-  for (double x : p) expected += x;
-  out.expected = expected;
   // The draw takes exactly the target, guided or not; only vertices with p = 1 (corners,
   // control points) can push it over.
   const int32_t count = target;
-
-  // Pareto keys: with threshold 1 the expected number of keys below it is exactly the sum of
-  // the probabilities, so a slightly larger threshold keeps a small superset of what the draw
-  // needs; if it falls short (tiny targets), the threshold grows.
-  std::vector<int32_t> forced;
-  {
-    std::vector<std::vector<int32_t>> found(omp_get_max_threads());
-#pragma omp parallel if (n >= kParallelMin)
-    {
-      auto& mine = found[omp_get_thread_num()];
-#pragma omp for schedule(static)  // runs in thread order: joined, they keep vertex order
-      for (int32_t v = 0; v < n; ++v)
-        if (p[v] >= 1.0) mine.push_back(v);
-    }
-    for (const auto& list : found) forced.insert(forced.end(), list.begin(), list.end());
-  }
-  out.forced = static_cast<int32_t>(forced.size());
-  const int32_t free_count = std::max<int32_t>(0, count - out.forced);
   const bool density = params.density != DensityMode::Off;
-  std::vector<Candidate> candidates;
   const auto uniforms = selection_uniforms(mesh, layout, params.seed);
-  for (double threshold = density ? 3.0 : 1.25;; threshold *= 4) {
-    candidates = pareto_candidates(mesh, *uniforms, p, threshold);
-    const bool everything = threshold > 1e6;
-    if (everything || int64_t(candidates.size()) >= int64_t(density ? 2 : 1) * free_count + 16) break;
-  }
-  if (!density) {
-    out.samples = std::move(forced);
-    const size_t take = std::min<size_t>(free_count, candidates.size());
-    if (take > 0) {
-      std::nth_element(candidates.begin(), candidates.begin() + (take - 1), candidates.end());
-      for (size_t i = 0; i < take; ++i) out.samples.push_back(candidates[i].vertex);
+  auto draw = [&](const auto& probability) {
+    // Pareto keys: with threshold 1 the expected number of keys below it is exactly the sum of
+    // the probabilities, so a slightly larger threshold keeps a small superset of what the draw
+    // needs; if it falls short (tiny targets), the threshold grows. The first pass also finds
+    // the forced vertices and the expected count.
+    const double first_threshold = density ? 3.0 : 1.25;
+    std::vector<int32_t> forced;
+    std::vector<Candidate> candidates =
+        pareto_candidates(mesh, *uniforms, probability, first_threshold, &forced, &out.expected);
+    out.forced = static_cast<int32_t>(forced.size());
+    const int32_t free_count = std::max<int32_t>(0, count - out.forced);
+    for (double threshold = first_threshold;
+         threshold <= 1e6 && int64_t(candidates.size()) < int64_t(density ? 2 : 1) * free_count + 16;) {
+      threshold *= 4;
+      candidates = pareto_candidates(mesh, *uniforms, probability, threshold);
     }
+    if (!density) {
+      out.samples = std::move(forced);
+      const size_t take = std::min<size_t>(free_count, candidates.size());
+      if (take > 0) {
+        std::nth_element(candidates.begin(), candidates.begin() + (take - 1), candidates.end());
+        for (size_t i = 0; i < take; ++i) out.samples.push_back(candidates[i].vertex);
+      }
+    } else {
+      // Density control may reject many candidates: if the kept superset runs out, take all.
+      auto all = [&]() {
+        return pareto_candidates(mesh, *uniforms, probability, std::numeric_limits<double>::infinity());
+      };
+      out.samples = select_with_density(mesh, layout, cls, params, std::move(forced), std::move(candidates), all,
+                                        std::max(count, out.forced), out.density_rejected);
+    }
+  };
+  if (!has_per_vertex_guidance(params)) {
+    // Without per-vertex guidance p is a formula of the class, q and the rate: computed where
+    // it is read instead of written to and read back from n doubles (a slider draws anew for
+    // every frame).
+    const auto& q = table->q;
+    const double rate = out.rate;
+    draw([&cls, &q, rate](int32_t v) { return plain_probability(cls[v], q[v], rate); });
   } else {
-    // Density control may reject many candidates: if the kept superset runs out, take all.
-    auto all = [&]() { return pareto_candidates(mesh, *uniforms, p, std::numeric_limits<double>::infinity()); };
-    out.samples = select_with_density(mesh, layout, cls, params, std::move(forced), std::move(candidates), all,
-                                      std::max(count, out.forced), out.density_rejected);
+    const auto p = probabilities(mesh, cls, table->q, multiplier, params, out.rate);
+    draw([&p](int32_t v) { return p[v]; });
   }
   sort_vertex_ids(out.samples, n);
   return out;
