@@ -371,7 +371,7 @@ std::vector<Candidate> pareto_candidates(const Mesh& mesh, const SelectionUnifor
     std::vector<int32_t> forced;
     std::vector<Candidate> candidates;
   };
-  const Found found = ordered_reduce<Found>(
+  Found found = ordered_reduce<Found>(
       mesh.num_vertices(),
       [&](Found& block, int64_t i) {
         const int32_t v = int32_t(i);
@@ -392,9 +392,9 @@ std::vector<Candidate> pareto_candidates(const Mesh& mesh, const SelectionUnifor
         total.forced.insert(total.forced.end(), block.forced.begin(), block.forced.end());
         total.candidates.insert(total.candidates.end(), block.candidates.begin(), block.candidates.end());
       });
-  if (forced) *forced = found.forced;
+  if (forced) *forced = std::move(found.forced);
   if (sum) *sum = found.sum;
-  return found.candidates;
+  return std::move(found.candidates);
 }
 
 // Sorts distinct vertex ids in [0, n): a bit per vertex, read back in order (a tenth of the cost of
