@@ -227,17 +227,15 @@ def _polygon_materials(mesh) -> np.ndarray:
     return _get(mesh.polygons, "material_index", p, 1, np.int32)
 
 
-def _triangle_loop_starts(mesh) -> Optional[np.ndarray]:
-    """The polygons' first loops when every polygon is a triangle whose loops follow the previous
-    polygon's (how Blender stores meshes), else None. Blender triangulates such a polygon into
-    itself, corners in loop order, so its loop triangles need not be read one by one."""
+def _triangles_in_loop_order(mesh) -> bool:
+    """True when every polygon is a triangle whose loops follow the previous polygon's (how
+    Blender stores meshes). Blender triangulates such a polygon into itself, corners in loop
+    order, so its loop triangles need not be read one by one."""
     p = len(mesh.polygons)
     if len(mesh.loops) != 3 * p:  # every polygon has 3 loops or more: all are triangles exactly then
-        return None
-    starts = dna_arrays.polygon_starts(mesh)
-    if starts is None:
-        starts = _indices(mesh.polygons, "loop_start", p)
-    return starts if np.array_equal(starts, np.arange(0, 3 * p, 3, dtype=np.int32)) else None
+        return False
+    in_order = dna_arrays.triangles_in_loop_order(mesh)
+    return in_order if in_order is not None else dna_arrays.every_third(_indices(mesh.polygons, "loop_start", p))
 
 
 def read_mesh(mesh: bpy.types.Mesh) -> MeshArrays:
@@ -245,7 +243,7 @@ def read_mesh(mesh: bpy.types.Mesh) -> MeshArrays:
     n = len(mesh.vertices)
     vertices = read_positions(mesh).astype(np.float64)
     corners = corner_vertices(mesh)
-    if _triangle_loop_starts(mesh) is not None:  # a triangle mesh: the loop triangles are the polygons
+    if _triangles_in_loop_order(mesh):  # a triangle mesh: the loop triangles are the polygons
         m = len(mesh.polygons)
         triangle_loops = triangle_polygons = None  # in order: made when read (MeshArrays)
         triangles = corners.reshape(m, 3)
@@ -265,7 +263,7 @@ def read_edges(mesh: bpy.types.Mesh, flag: str) -> np.ndarray:
     Blender 4.0+ keeps these flags as edge attributes that exist only when some edge has the
     flag: none means no read at all (a flag per edge through MeshEdge costs ~20 ns, 46 ms for
     2.3M edges on the Live Preview's start); 3.x copies them from its edge array
-    (dna_arrays.edge_flag)."""
+    (dna_arrays.flagged_edges)."""
     count = len(mesh.edges)
     attribute = _flag_attribute(mesh, flag) if bpy.app.version >= (4, 0, 0) else None
     if bpy.app.version >= (4, 0, 0) and (attribute is None or flag in mistyped_edge_flags(mesh)):
@@ -275,9 +273,10 @@ def read_edges(mesh: bpy.types.Mesh, flag: str) -> np.ndarray:
     if attribute is not None:
         flags = _get(attribute.data, "value", count, 1, bool)
     else:
-        flags = dna_arrays.edge_flag(mesh, flag)
-        if flags is None:
-            flags = _get(mesh.edges, flag, count, 1, bool)
+        pairs = dna_arrays.flagged_edges(mesh, flag)
+        if pairs is not None:
+            return pairs
+        flags = _get(mesh.edges, flag, count, 1, bool)
     if not flags.any():
         return np.zeros((0, 2), dtype=np.int32)
     edges = _get(mesh.edges, "vertices", count, 2, np.int32)

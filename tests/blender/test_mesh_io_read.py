@@ -79,8 +79,28 @@ def test_read_edges_keeps_each_flag_apart_from_the_others(ts, scene, flag):
     assert found.dtype == np.int32 and len(expected) > 100
     np.testing.assert_array_equal(found, expected)
     if (3, 0, 0) <= bpy.app.version < (4, 0, 0):  # read from the MEdge array, not edge by edge
-        np.testing.assert_array_equal(ts.blender.dna_arrays.edge_flag(mesh, flag),
-                                      [getattr(e, flag) for e in mesh.edges])
+        np.testing.assert_array_equal(ts.blender.dna_arrays.flagged_edges(mesh, flag), expected)
+
+
+def test_flags_and_loop_order_are_scanned_block_by_block(ts, scene):
+    """The scans that make no array of the mesh's size (dna_arrays.SCAN_BLOCK at a time) find
+    what lies past the first block: flagged edges there, and a polygon out of loop order there."""
+    dna = ts.blender.dna_arrays
+    starts = np.arange(0, 3 * 200_000, 3, dtype=np.int32)
+    assert dna.every_third(starts) and dna.every_third(starts[:0])
+    starts[150_000] += 1
+    assert not dna.every_third(starts)
+    obj = make_object("Ball", *meshgen.icosphere(6))  # 122,880 edges: two blocks
+    mesh = obj.data
+    assert len(mesh.edges) > dna.SCAN_BLOCK
+    for index in (5, dna.SCAN_BLOCK - 1, dna.SCAN_BLOCK, len(mesh.edges) - 1):
+        mesh.edges[index].use_seam = True
+    expected = np.array([tuple(mesh.edges[i].vertices) for i in (5, dna.SCAN_BLOCK - 1, dna.SCAN_BLOCK,
+                                                                  len(mesh.edges) - 1)])
+    np.testing.assert_array_equal(ts.blender.mesh_io.read_edges(mesh, "use_seam"), expected)
+    if (3, 0, 0) <= bpy.app.version < (4, 0, 0):
+        np.testing.assert_array_equal(dna.flagged_edges(mesh, "use_seam"), expected)
+        assert dna.triangles_in_loop_order(mesh) is True
 
 
 def test_polygon_materials_and_corners_match_the_per_element_accessors(ts, scene):
@@ -104,9 +124,11 @@ def test_polygon_materials_and_corners_match_the_per_element_accessors(ts, scene
     if (3, 0, 0) <= bpy.app.version < (3, 6, 0):  # these Blenders keep MLoop and MPoly arrays
         np.testing.assert_array_equal(dna.loop_indices(mesh, "v"), corners)
         np.testing.assert_array_equal(dna.loop_indices(mesh, "e"), [loop.edge_index for loop in mesh.loops])
-        np.testing.assert_array_equal(dna.polygon_starts(mesh), [p.loop_start for p in mesh.polygons])
+        assert dna.triangles_in_loop_order(mesh) is False  # quads among the triangles
+        ball = make_object("Ball", *meshgen.icosphere(2)).data
+        assert dna.triangles_in_loop_order(ball) is True
     elif bpy.app.version >= (4, 0, 0):
-        assert dna.loop_indices(mesh, "v") is None and dna.polygon_starts(mesh) is None
+        assert dna.loop_indices(mesh, "v") is None and dna.triangles_in_loop_order(mesh) is None
     assert dna._view(mesh.loops, dna.MEDGE) is None  # a layout of another size is refused
 
 
