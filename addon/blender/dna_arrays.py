@@ -31,6 +31,8 @@ from typing import Optional
 import bpy
 import numpy as np
 
+from ..core import fresh_memory
+
 # DNA_meshdata_types.h in 3.x
 MEDGE = np.dtype([("v", "<u4", 2), ("crease", "u1"), ("bweight", "u1"), ("flag", "<i2")])
 MLOOP = np.dtype([("v", "<u4"), ("e", "<u4")])
@@ -134,7 +136,11 @@ def flagged_edges(mesh: bpy.types.Mesh, flag: str) -> Optional[np.ndarray]:
 def loop_indices(mesh: bpy.types.Mesh, field: str) -> Optional[np.ndarray]:
     """(loops,) int32 vertex ("v") or edge ("e") of every loop, from MLoop."""
     raw = _checked_view(mesh.loops, MLOOP, {"v": "vertex_index", "e": "edge_index"})
-    return raw[field].astype(np.int32) if raw is not None else None
+    if raw is None:
+        return None
+    out = fresh_memory.empty(len(raw), np.int32)
+    np.copyto(out, raw[field], casting="unsafe")  # (uint32 ids below 2^31: the same values)
+    return out
 
 
 def triangles_in_loop_order(mesh: bpy.types.Mesh) -> Optional[bool]:

@@ -26,6 +26,7 @@ import numpy as np
 from ..core.attributes import MovedVertices, SparseWeights, corner_values, moved_vertices, point_values
 from ..core.digest import array_digest
 from ..core.edge_flags import carried_edge_flags
+from ..core import fresh_memory
 from ..core.mesh_edges import mesh_edges
 from ..core.ranges import matching_rows
 from . import dna_arrays
@@ -88,7 +89,7 @@ class MeshArrays:
 
 
 def _get(collection, key: str, count: int, width: int, dtype) -> np.ndarray:
-    buffer = np.empty(count * width, dtype=dtype)
+    buffer = fresh_memory.empty(count * width, dtype)
     if count:
         collection.foreach_get(key, buffer)
     return buffer.reshape(count, width) if width > 1 else buffer
@@ -241,7 +242,8 @@ def _triangles_in_loop_order(mesh) -> bool:
 def read_mesh(mesh: bpy.types.Mesh) -> MeshArrays:
     """Reads positions and the loop triangulation of ``mesh`` (object mode data)."""
     n = len(mesh.vertices)
-    vertices = read_positions(mesh).astype(np.float64)
+    vertices = fresh_memory.empty(3 * n, np.float64).reshape(n, 3)
+    np.copyto(vertices, read_positions(mesh))
     corners = corner_vertices(mesh)
     if _triangles_in_loop_order(mesh):  # a triangle mesh: the loop triangles are the polygons
         m = len(mesh.polygons)
