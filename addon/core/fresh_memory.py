@@ -2,8 +2,9 @@
 
 Reading a Blender mesh copies it into new arrays: about 47 MB on the main thread for the
 1.55M-triangle horse when the Live Preview starts. The kernel maps new memory a page at a time,
-on first touch. Where the process allocates with jemalloc (Blender's own builds on Linux, such
-as Debian's 3.4 here), freed memory goes back to the kernel after a few seconds, so a start
+on first touch. Where the process allocates with jemalloc and exports its mallctl (Debian's
+Blender 3.4 here; a build that links it statically without exporting it is not recognised and
+keeps np.empty), freed memory goes back to the kernel after a few seconds, so a start
 after a pause faulted in every page again (and numpy's request for 2 MB pages on large arrays
 may make the kernel compact memory first): the prepared start took 129-200 ms of main-thread
 time after 6 s pauses (2026-11-27). An anonymous mapping with MAP_POPULATE maps all its pages in
