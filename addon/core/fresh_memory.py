@@ -2,15 +2,20 @@
 
 Reading a Blender mesh copies it into new arrays: about 47 MB on the main thread for the
 1.55M-triangle horse when the Live Preview starts. The kernel maps new memory a page at a time,
-on first touch. Where the process allocates with jemalloc and exports its mallctl (Debian's
-Blender 3.4 here; a build that links it statically without exporting it is not recognised and
-keeps np.empty), freed memory goes back to the kernel after a few seconds, so a start
-after a pause faulted in every page again (and numpy's request for 2 MB pages on large arrays
-may make the kernel compact memory first): the prepared start took 129-200 ms of main-thread
-time after 6 s pauses (2026-11-27). An anonymous mapping with MAP_POPULATE maps all its pages in
+on first touch. Where the process allocates with jemalloc, freed memory goes back to the
+kernel after a few seconds, so a start after a pause faulted in every page again (and numpy's
+request for 2 MB pages on large arrays may make the kernel compact memory first): in Debian's
+Blender 3.4 the prepared start took 129-200 ms of main-thread time after 6 s pauses
+(2026-11-27). An anonymous mapping with MAP_POPULATE maps all its pages in
 one system call: 44-69 ms. With glibc's allocator (PyPI's bpy, plain Python) freed memory is
 reused without faults and a fresh mapping costs more (bpy 4.5: 29-38 against 8-9 ms), so
 there arrays come from np.empty as before.
+
+jemalloc is recognised by a function only it defines, visible to dlsym: `mallctl` where it is a
+shared library (Debian's Blender 3.4 links libjemalloc.so.2), `mallocx` where a program links it
+statically. Blender's own Linux builds do that and export only the names their symbol map lists
+(source/creator/symbols_unix.map: Py*, malloc*, free, ... and nothing else), so `mallctl` is
+hidden there while `mallocx`, matching malloc*, is exported.
 """
 
 from __future__ import annotations
@@ -24,6 +29,9 @@ import numpy as np
 # Below this the allocator's own free lists serve (and a mapping per array would cost more).
 POPULATE_MIN_BYTES = 1 << 20
 
+# Functions of jemalloc's own API, with and without the prefix some platforms' builds give it.
+JEMALLOC_FUNCTIONS = ("mallctl", "mallocx", "je_mallctl", "je_mallocx")
+
 
 @functools.lru_cache(maxsize=None)
 def _populate_flag() -> int:
@@ -35,7 +43,7 @@ def _populate_flag() -> int:
         process = ctypes.CDLL(None)
     except (OSError, TypeError):  # no dlopen(NULL) (Windows)
         return 0
-    return flag if any(hasattr(process, name) for name in ("mallctl", "je_mallctl")) else 0
+    return flag if any(hasattr(process, name) for name in JEMALLOC_FUNCTIONS) else 0
 
 
 def empty(count: int, dtype) -> np.ndarray:
