@@ -151,6 +151,7 @@ std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const 
   const auto& cls = table->cls;
   const int32_t n = mesh.num_vertices();
   table->q.assign(n, 0.0);
+  if (params.area_weighted) mesh.vertex_areas();  // built on first use: here, on all threads, not inside the loop
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v)
     if (cls[v] == kSurface || cls[v] == kCurve) table->q[v] = importance(mesh, params, v);

@@ -97,9 +97,11 @@ class Mesh {
 
   /// Unit area-weighted vertex normals (zero for vertices without area).
   const Buffer<double>& normals() const { return normals_; }
-  /// A third of the area of the triangles around each vertex, and its mean over vertices in faces.
-  const Buffer<double>& vertex_areas() const { return vertex_areas_; }
-  double mean_vertex_area() const { return mean_vertex_area_; }
+  /// A third of the area of the triangles around each vertex, and its mean over vertices in
+  /// faces. Computed on first use, once, whichever thread asks: only area-weighted sampling
+  /// reads them.
+  const Buffer<double>& vertex_areas() const { return ensure_vertex_areas(), vertex_areas_; }
+  double mean_vertex_area() const { return ensure_vertex_areas(), mean_vertex_area_; }
   /// Importance weight x(v) of thesis eq. 4.1, in [0, 1]; mean over vertices in faces.
   const Buffer<double>& weights() const { return weights_; }
   double mean_weight() const { return mean_weight_; }
@@ -123,12 +125,16 @@ class Mesh {
   void reorder_for_locality(const double* positions, const int32_t* triangles, const double* lo, const double* hi);
   void drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets);
   void build_vertex_faces();
-  /// The one-ring pass: adjacency, normals, areas, weights, manifoldness, components.
+  /// The one-ring pass: adjacency, normals, weights, manifoldness, components.
   void build_adjacency(Progress& progress);
   void ensure_edges() const {
     if (!edges_built_.load(std::memory_order_acquire)) build_edges();
   }
   void build_edges() const;
+  void ensure_vertex_areas() const {
+    if (!areas_built_.load(std::memory_order_acquire)) build_vertex_areas();
+  }
+  void build_vertex_areas() const;
 
   uint64_t serial_ = new_serial();
   int32_t num_vertices_ = 0;
@@ -141,8 +147,13 @@ class Mesh {
   mutable Buffer<int32_t> adjacency_edge_, edge_vertices_, edge_face_offsets_, edge_faces_, face_edges_;
   mutable std::once_flag edges_once_;
   mutable std::atomic<bool> edges_built_{false};
-  Buffer<double> normals_, weights_, vertex_areas_;
-  double mean_weight_ = 0.0, diagonal_ = 0.0, mean_vertex_area_ = 0.0;
+  Buffer<double> normals_, weights_;
+  double mean_weight_ = 0.0, diagonal_ = 0.0;
+  // Built on first use (ensure_vertex_areas).
+  mutable Buffer<double> vertex_areas_;
+  mutable double mean_vertex_area_ = 0.0;
+  mutable std::once_flag areas_once_;
+  mutable std::atomic<bool> areas_built_{false};
   Buffer<int32_t> component_;
   Buffer<int64_t> component_euler_;
   Buffer<uint8_t> manifold_vertex_;
