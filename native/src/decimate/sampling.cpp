@@ -36,14 +36,15 @@ std::vector<uint8_t> classify(const Mesh& mesh, const FeatureLayout& layout) {
 }
 
 // Importance factor q(v) = 1 + α (x / x̄ - 1), floored so flat regions are not starved.
-// With area weighting, q is also scaled by the vertex's area over the mean, so that samples
-// per unit area, not per vertex, follow the weights on irregularly tessellated meshes.
-inline double importance(const Mesh& mesh, const SamplingParams& params, int32_t v) {
+// With area weighting (`area`: the vertex areas, `mean_area` their mean), q is also scaled by the
+// vertex's area over the mean, so that samples per unit area, not per vertex, follow the weights
+// on irregularly tessellated meshes.
+inline double importance(const Mesh& mesh, const SamplingParams& params, int32_t v, const double* area,
+                         double mean_area) {
   const double mean = mesh.mean_weight();
   const double q = std::max(mean > 0 ? 1.0 + params.adaptivity * (mesh.weights()[v] / mean - 1.0) : 1.0,
                             params.flat_floor);
-  if (!params.area_weighted || mesh.mean_vertex_area() <= 0) return q;
-  return q * mesh.vertex_areas()[v] / mesh.mean_vertex_area();
+  return area ? q * area[v] / mean_area : q;
 }
 
 bool inside_box(const BoxGuidance& box, const double* p) {
@@ -151,10 +152,12 @@ std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const 
   const auto& cls = table->cls;
   const int32_t n = mesh.num_vertices();
   table->q.assign(n, 0.0);
-  if (params.area_weighted) mesh.vertex_areas();  // built on first use: here, on all threads, not inside the loop
+  // The vertex areas are built on first use: asked for once, before the loop (on all threads).
+  const double mean_area = params.area_weighted ? mesh.mean_vertex_area() : 0.0;
+  const double* area = mean_area > 0 ? mesh.vertex_areas().data() : nullptr;
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v)
-    if (cls[v] == kSurface || cls[v] == kCurve) table->q[v] = importance(mesh, params, v);
+    if (cls[v] == kSurface || cls[v] == kCurve) table->q[v] = importance(mesh, params, v, area, mean_area);
   table->surface_q.reserve(n);
   for (int32_t v = 0; v < n; ++v) {
     if (cls[v] == kSurface) table->surface_q.push_back(table->q[v]);
