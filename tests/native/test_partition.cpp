@@ -168,6 +168,50 @@ TEST_CASE("a check after flood_add evaluates only the changed links and finds wh
   CHECK(incremental_rounds > 200);
 }
 
+TEST_CASE("a check after flood_update, given the old flood's triangles in the new ranks, finds what a check from scratch finds") {
+  // The slider's case (flood_cache.hpp): a kept flood of other samples is updated, and its
+  // emitted triangles are taken over except around the vertices that changed.
+  const IncrementalCases cases;
+  int64_t patched = 0;
+  for (const auto& kase : cases.all()) {
+    const Mesh& mesh = *kase.mesh;
+    const std::vector<uint8_t> required(mesh.num_vertices(), 0);
+    for (uint32_t seed = 1; seed <= 60; ++seed) {
+      std::mt19937 random(seed);
+      auto pool = topstoc_test::random_samples(mesh.num_vertices(), 70, random);
+      std::vector<int32_t> old_samples(pool.begin(), pool.begin() + 55 + int32_t(seed % 5));
+      // The new draw keeps most old samples, drops a few and adds a few (both lists increasing;
+      // few enough that the check re-tests around the changed vertices only).
+      std::vector<int32_t> samples;
+      for (size_t i = 0; i < old_samples.size(); ++i)
+        if (random() % 40 != 0) samples.push_back(old_samples[i]);
+      for (size_t i = old_samples.size(); i < pool.size(); ++i)
+        if (random() % 6 == 0) samples.push_back(pool[i]);
+      std::sort(old_samples.begin(), old_samples.end());
+      std::sort(samples.begin(), samples.end());
+      Clustering clustering;
+      flood(mesh, *kase.layout, old_samples, clustering);
+      CheckState first;
+      check_partition(mesh, *kase.layout, old_samples, clustering, required, false, nullptr, &first);
+      CheckState state;
+      std::vector<int32_t> new_rank;
+      flood_update(mesh, *kase.layout, old_samples, samples, clustering, &state.changed, &new_rank);
+      state.emits = first.emits;
+      state.valid = first.valid;
+      state.emitted_faces = first.emitted_faces;
+      state.emitted_triangles = first.emitted_triangles;
+      for (int32_t& rank : state.emitted_triangles) rank = new_rank[rank];
+      state.emitted_valid = first.emitted_valid;
+      const bool can_patch = state.valid && state.emitted_valid && state.changed.size() <= size_t(mesh.num_vertices() / 16);
+      const Partition kept = check_partition(mesh, *kase.layout, samples, clustering, required, true, nullptr, &state);
+      const Partition fresh = check_partition(mesh, *kase.layout, samples, clustering, required, true);
+      check_same(kept, fresh);
+      patched += can_patch && kept.issues.unreached == 0;
+    }
+  }
+  CHECK(patched > 30);
+}
+
 TEST_CASE("a check after relabelling feature vertices by hand finds what a check from scratch finds") {
   // Vertices on feature curves moved to a neighbour's cluster, a few at a time: this changes
   // the triangle count expected between feature pairs, sometimes with no emitted triangle

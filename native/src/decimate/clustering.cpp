@@ -223,7 +223,8 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
 }  // namespace
 
 void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& old_samples,
-                  const std::vector<int32_t>& samples, Clustering& c, std::vector<int32_t>* changed) {
+                  const std::vector<int32_t>& samples, Clustering& c, std::vector<int32_t>* changed,
+                  std::vector<int32_t>* new_rank_out) {
   const int32_t n = mesh.num_vertices();
   std::vector<uint64_t>& key = c.key;
   if (int32_t(key.size()) != n) throw std::invalid_argument("flood_update: the clustering is not one of this mesh");
@@ -291,6 +292,7 @@ void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vect
       [&](int64_t i, int32_t at) { seeds[at] = found[i]; }, level_start);
   for (size_t i = 0; i < frontier.size(); ++i) key[frontier[i]] = cluster_key(0, added_rank[i]);
   relax_levels(mesh, layout, std::move(frontier), 0, key, nullptr, changed, seeds);
+  if (new_rank_out) *new_rank_out = std::move(new_rank);
 }
 
 void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples, Clustering& out,

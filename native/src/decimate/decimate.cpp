@@ -274,12 +274,22 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     // The cached flood becomes this one (the same keys a fresh flood gives); the first check
     // then re-tests only the faces around the vertices that changed. The cache keeps the
     // flood without the repairs below.
-    flood_update(mesh, layout, cache->samples, samples, cache->clustering, &checked.changed);
+    std::vector<int32_t> new_rank;
+    flood_update(mesh, layout, cache->samples, samples, cache->clustering, &checked.changed, &new_rank);
     cache->samples = samples;
     clustering = cache->clustering;
     if (cache->emits_valid) {
       checked.emits = std::move(cache->emits);  // given back after the first check, updated
       checked.valid = true;
+      if (cache->emitted_valid) {
+        // The cached flood's triangles, in the new ranks: the check re-writes only those of
+        // the faces around changed vertices (whose old ranks may be gone).
+        checked.emitted_faces = std::move(cache->emitted_faces);
+        checked.emitted_triangles = std::move(cache->emitted_triangles);
+        for (int32_t& rank : checked.emitted_triangles) rank = new_rank[rank];
+        checked.emitted_valid = true;
+        cache->emitted_valid = false;
+      }
     } else {
       checked.changed.clear();  // every face is tested
     }
@@ -291,7 +301,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       cache->layout = layout.serial;
       cache->samples = samples;
       cache->clustering = clustering;
-      cache->emits_valid = false;
+      cache->emits_valid = cache->emitted_valid = false;
     }
   }
   result.seconds_clustering = seconds_since(start);
@@ -334,6 +344,11 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       // vertices) leaves them valid only after testing every face.
       cache->emits_valid = checked.valid && checked.changed.empty();
       if (cache->emits_valid) cache->emits = checked.emits;
+      cache->emitted_valid = cache->emits_valid && checked.emitted_valid;
+      if (cache->emitted_valid) {
+        cache->emitted_faces = checked.emitted_faces;
+        cache->emitted_triangles = checked.emitted_triangles;
+      }
       cache = nullptr;
     }
     accumulate(result.issues_found, partition.issues);

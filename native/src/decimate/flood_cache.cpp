@@ -29,6 +29,9 @@ void FloodCache::clear() {
   clustering = {};
   emits = {};
   emits_valid = false;
+  emitted_faces = {};
+  emitted_triangles = {};
+  emitted_valid = false;
 }
 
 std::unique_ptr<FloodCache> FloodCachePool::take() {

@@ -69,6 +69,28 @@ struct Marks {
   }
 };
 
+// The faces around the given vertices, each once, in increasing order. The vertices (a flood's
+// frontiers, scattered over the mesh) are put in vertex order first, and the faces are read back
+// in face order: both walk the mesh's arrays in order instead of at random.
+std::vector<int32_t> faces_around(const Mesh& mesh, const std::vector<int32_t>& vertices) {
+  const auto& vfo = mesh.vertex_face_offsets();
+  const auto& vf = mesh.vertex_faces();
+  auto set = [](std::vector<uint64_t>& bits, int32_t i) { bits[size_t(i) >> 6] |= uint64_t(1) << (i & 63); };
+  auto for_each_set = [](const std::vector<uint64_t>& bits, auto visit) {
+    for (size_t w = 0; w < bits.size(); ++w)
+      for (uint64_t word = bits[w]; word; word &= word - 1) visit(int32_t(64 * w + size_t(__builtin_ctzll(word))));
+  };
+  std::vector<uint64_t> vertex_bits((size_t(mesh.num_vertices()) + 63) / 64, 0);
+  std::vector<uint64_t> face_bits((size_t(mesh.num_faces()) + 63) / 64, 0);
+  for (int32_t v : vertices) set(vertex_bits, v);
+  for_each_set(vertex_bits, [&](int32_t v) {
+    for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) set(face_bits, vf[i]);
+  });
+  std::vector<int32_t> faces;
+  for_each_set(face_bits, [&](int32_t f) { faces.push_back(f); });
+  return faces;
+}
+
 constexpr uint8_t kUntested = 2;  // a triangle's zero-area flag before it is tested
 
 // Samples whose link may differ from the last check's (1 per rank): the corners of every
@@ -210,9 +232,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   auto distinct = [](const std::array<int32_t, 3>& l) { return uint8_t(l[0] != l[1] && l[1] != l[2] && l[2] != l[0]); };
   auto three_clusters = [&](int32_t f) { return distinct(corner_labels(f)); };
   // Every face is tested (a first check), or only those around relabelled vertices (later
-  // rounds) or the candidates (fast path). Then the emitting faces are written in face order:
-  // each thread counts those of its run of faces (static schedule, the same runs in both loops),
-  // and writes them from where the runs before it end.
+  // rounds) or the candidates (fast path). Then the emitting faces are written in face order.
   // Re-testing the faces around many changed vertices, scattered over the mesh, costs more
   // than testing every face in order (horse at 10 %, a flood update that removed a tenth of
   // the samples: 46 against 35 ms for the check): beyond a sixteenth, every face is tested.
@@ -241,14 +261,23 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   }
   if (unreached) {
     seed_unreached(mesh, c, out);
-    carried.links_valid = false;
+    carried.emitted_valid = carried.links_valid = false;
     return out;
   }
   Marks marks(threads);
+  // Faces re-tested around the changed vertices (increasing): every other face keeps its
+  // corners' labels, so when the last check's triangles are known, only these are written anew.
+  std::vector<int32_t> retested, fresh_faces, fresh_triangles;  // ... and those that emit now
+  const bool patch = !test_all && carried.valid && carried.emitted_valid;
   if (!test_all && carried.valid) {
-    const auto& vf = mesh.vertex_faces();
-    for (int32_t v : carried.changed)
-      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) carried.emits[vf[i]] = three_clusters(vf[i]);
+    retested = faces_around(mesh, carried.changed);
+    for (int32_t f : retested) {
+      const auto l = corner_labels(f);
+      carried.emits[f] = distinct(l);
+      if (!patch || !carried.emits[f]) continue;
+      fresh_faces.push_back(f);
+      fresh_triangles.insert(fresh_triangles.end(), l.begin(), l.end());
+    }
   } else if (candidate_faces) {
     carried.emits.assign(m, 0);
     const int64_t count = int64_t(candidate_faces->size());
@@ -257,41 +286,72 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   }
   carried.valid = true;
   carried.changed.clear();
-  // Eight faces at a time (a tenth of them emit at most); the last few faces after the whole
-  // words are appended at the end.
-  const uint8_t* emits = carried.emits.data();
-  const int64_t words = m / 8;
-  auto write = [&](int64_t at, int32_t f) {
-    out.source_face[at] = f;
-    for (int j = 0; j < 3; ++j) out.triangles[3 * at + j] = label(faces[3 * size_t(f) + j]);
-  };
-  int64_t tail = 0;
-  for (int32_t f = int32_t(8 * words); f < m; ++f) tail += emits[f];
-  std::vector<int64_t> run_start(team + 1, 0);
+  if (patch) {
+    // The last check's triangles without the re-tested faces, merged with the re-tested faces
+    // that emit now (all three lists increasing).
+    const auto& was_faces = carried.emitted_faces;
+    const auto& was_triangles = carried.emitted_triangles;
+    const size_t was = was_faces.size(), fresh = fresh_faces.size(), count = retested.size();
+    out.source_face.resize(was + fresh);
+    out.triangles.resize(3 * (was + fresh));
+    size_t i = 0, e = 0, r = 0, at = 0;
+    auto put = [&](int32_t f, const int32_t* t) {
+      out.source_face[at] = f;
+      std::copy(t, t + 3, &out.triangles[3 * at++]);
+    };
+    while (i < was || e < fresh) {
+      if (e == fresh || (i < was && was_faces[i] < fresh_faces[e])) {
+        const int32_t f = was_faces[i];
+        while (r < count && retested[r] < f) ++r;
+        if (r == count || retested[r] != f) put(f, &was_triangles[3 * i]);  // not re-tested: unchanged
+        ++i;
+      } else {
+        if (i < was && was_faces[i] == fresh_faces[e]) ++i;  // emitted then and now: the new labels
+        put(fresh_faces[e], &fresh_triangles[3 * e]);
+        ++e;
+      }
+    }
+    out.source_face.resize(at);
+    out.triangles.resize(3 * at);
+  } else {
+    // Every emitting face, in face order: each thread counts those of its run of faces (static
+    // schedule, the same runs in both loops) and writes them from where the runs before it end.
+    // Eight faces at a time (a tenth of them emit at most); the last few faces after the whole
+    // words are appended at the end.
+    const uint8_t* emits = carried.emits.data();
+    const int64_t words = m / 8;
+    auto write = [&](int64_t at, int32_t f) {
+      out.source_face[at] = f;
+      for (int j = 0; j < 3; ++j) out.triangles[3 * at + j] = label(faces[3 * size_t(f) + j]);
+    };
+    int64_t tail = 0;
+    for (int32_t f = int32_t(8 * words); f < m; ++f) tail += emits[f];
+    std::vector<int64_t> run_start(team + 1, 0);
 #pragma omp parallel num_threads(team)
-  {
-    const int me = omp_get_thread_num();
-    int64_t mine = 0;
+    {
+      const int me = omp_get_thread_num();
+      int64_t mine = 0;
 #pragma omp for schedule(static)
-    for (int64_t w = 0; w < words; ++w) mine += flag_count(flag_word(emits + 8 * w));
-    run_start[me + 1] = mine;
+      for (int64_t w = 0; w < words; ++w) mine += flag_count(flag_word(emits + 8 * w));
+      run_start[me + 1] = mine;
 #pragma omp barrier
 #pragma omp single
-    {
-      for (int r = 0; r < omp_get_num_threads(); ++r) run_start[r + 1] += run_start[r];
-      out.source_face.resize(run_start[omp_get_num_threads()] + tail);
-      out.triangles.resize(3 * out.source_face.size());
-    }
-    int64_t at = run_start[me];
+      {
+        for (int r = 0; r < omp_get_num_threads(); ++r) run_start[r + 1] += run_start[r];
+        out.source_face.resize(run_start[omp_get_num_threads()] + tail);
+        out.triangles.resize(3 * out.source_face.size());
+      }
+      int64_t at = run_start[me];
 #pragma omp for schedule(static)
-    for (int64_t w = 0; w < words; ++w) {
-      const uint64_t word = flag_word(emits + 8 * w);
-      if (!word) continue;
-      for (uint32_t bits = flag_bits(word); bits; bits &= bits - 1) write(at++, int32_t(8 * w + __builtin_ctz(bits)));
+      for (int64_t w = 0; w < words; ++w) {
+        const uint64_t word = flag_word(emits + 8 * w);
+        if (!word) continue;
+        for (uint32_t bits = flag_bits(word); bits; bits &= bits - 1) write(at++, int32_t(8 * w + __builtin_ctz(bits)));
+      }
     }
+    for (int64_t f = 8 * words, at = int64_t(out.source_face.size()) - tail; f < m; ++f)
+      if (emits[f]) write(at++, int32_t(f));
   }
-  for (int64_t f = 8 * words, at = int64_t(out.source_face.size()) - tail; f < m; ++f)
-    if (emits[f]) write(at++, int32_t(f));
   const int32_t emitted = static_cast<int32_t>(out.source_face.size());
 
   // --- feature pairs: clusters adjacent along a feature curve, with the copies of their edge ---
@@ -563,7 +623,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // What the next round's check starts from: the triangles before pillows are dropped (a
   // pillow's samples are evaluated again anyway), and what each sample's link gave.
   if (state) {
-    carried.links_valid = true;
+    carried.emitted_valid = carried.links_valid = true;
     carried.samples = k;
     carried.emitted_faces = out.source_face;
     carried.emitted_triangles = out.triangles;

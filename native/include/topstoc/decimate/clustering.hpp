@@ -56,8 +56,9 @@ void flood_add(const Mesh& mesh, const FeatureLayout& layout, const std::vector<
 /// ones are refilled from around them, added samples relax outwards. Nearby targets of one
 /// decimation share most samples (a slider step replaces a few percent), so most of the mesh
 /// is only relabelled. changed, if given, receives every vertex whose sample or distance
-/// changed (possibly twice).
+/// changed (possibly twice); new_rank, if given, each old sample's new rank (-1: removed).
 void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& old_samples,
-                  const std::vector<int32_t>& samples, Clustering& clustering, std::vector<int32_t>* changed = nullptr);
+                  const std::vector<int32_t>& samples, Clustering& clustering, std::vector<int32_t>* changed = nullptr,
+                  std::vector<int32_t>* new_rank = nullptr);
 
 }  // namespace topstoc
