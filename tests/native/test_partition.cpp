@@ -212,6 +212,42 @@ TEST_CASE("a check after flood_update, given the old flood's triangles in the ne
   CHECK(patched > 30);
 }
 
+TEST_CASE("a check after flood_update that leaves a small component without samples finds it unreached") {
+  // A torus and a lone triangle; the update drops the triangle's only sample. Its three
+  // vertices are emptied and stay so: the check that takes the kept triangles over must still
+  // find them (it scans only the changed vertices).
+  auto arrays = topstoc_test::torus(24, 16);
+  const int32_t first = int32_t(arrays.positions.size() / 3);
+  arrays.positions.insert(arrays.positions.end(), {5, 0, 0, 6, 0, 0, 5, 1, 0});
+  arrays.triangles.insert(arrays.triangles.end(), {first, first + 1, first + 2});
+  const Mesh mesh(arrays.positions, arrays.triangles.data(), arrays.num_triangles());
+  const auto layout = build_feature_layout(mesh, nullptr, 0, nullptr, 0, 0.0);
+  const std::vector<uint8_t> required(mesh.num_vertices(), 0);
+  const int32_t lone = mesh.vertex_index()[first];  // the triangle's first vertex, in the mesh's order
+  std::mt19937 random(7);
+  std::vector<int32_t> samples;
+  for (int32_t v : topstoc_test::random_samples(mesh.num_vertices(), 80, random))
+    if (mesh.component()[v] == mesh.component()[mesh.vertex_index()[0]]) samples.push_back(v);
+  std::vector<int32_t> old_samples = samples;
+  old_samples.push_back(lone);
+  std::sort(old_samples.begin(), old_samples.end());
+  std::sort(samples.begin(), samples.end());
+  Clustering clustering;
+  flood(mesh, *layout, old_samples, clustering);
+  CheckState state;
+  const Partition before = check_partition(mesh, *layout, old_samples, clustering, required, false, nullptr, &state);
+  REQUIRE(before.issues.unreached == 0);
+  REQUIRE(state.emitted_valid);
+  std::vector<int32_t> new_rank;
+  state.changed.clear();
+  flood_update(mesh, *layout, old_samples, samples, clustering, &state.changed, &new_rank);
+  for (int32_t& rank : state.emitted_triangles) rank = new_rank[rank];
+  REQUIRE(state.changed.size() <= size_t(mesh.num_vertices() / 16));  // the patched path
+  const Partition kept = check_partition(mesh, *layout, samples, clustering, required, false, nullptr, &state);
+  CHECK(kept.issues.unreached == 3);
+  check_same(kept, check_partition(mesh, *layout, samples, clustering, required, false));
+}
+
 TEST_CASE("a check after relabelling feature vertices by hand finds what a check from scratch finds") {
   // Vertices on feature curves moved to a neighbour's cluster, a few at a time: this changes
   // the triangle count expected between feature pairs, sometimes with no emitted triangle

@@ -238,13 +238,20 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // the samples: 46 against 35 ms for the check): beyond a sixteenth, every face is tested.
   if (carried.valid && int64_t(carried.changed.size()) > n / 16) carried.valid = false;
   const bool test_all = !carried.valid && !candidate_faces;
+  // Faces re-tested around the changed vertices (increasing): every other face keeps its
+  // corners' labels, so when the last check's triangles are known, only these are written anew.
+  const bool patch = !test_all && carried.valid && carried.emitted_valid;
   // Vertices in a face but in no cluster stop the check here: the other checks need every
   // vertex in a cluster. Testing every face reads every such vertex's label and notes them on
   // the way (the emits then hold for this clustering, as after any test); otherwise the
-  // vertices are scanned.
+  // vertices are scanned: only the changed ones when the last check got past this test (its
+  // triangles are known only then).
   const int team = m >= kParallelMin ? threads : 1;
   int unreached = 0;
-  if (test_all) {
+  if (patch) {
+    for (int32_t v : carried.changed)
+      if (label(v) < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
+  } else if (test_all) {
     carried.emits.resize(m);
 #pragma omp parallel for schedule(static) num_threads(team) reduction(| : unreached)
     for (int32_t f = 0; f < m; ++f) {
@@ -265,10 +272,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     return out;
   }
   Marks marks(threads);
-  // Faces re-tested around the changed vertices (increasing): every other face keeps its
-  // corners' labels, so when the last check's triangles are known, only these are written anew.
   std::vector<int32_t> retested, fresh_faces, fresh_triangles;  // ... and those that emit now
-  const bool patch = !test_all && carried.valid && carried.emitted_valid;
   if (!test_all && carried.valid) {
     retested = faces_around(mesh, carried.changed);
     for (int32_t f : retested) {
