@@ -3,6 +3,7 @@
 #include "../core/fans.hpp"
 #include "link_arcs.hpp"
 #include "../core/byte_flags.hpp"
+#include "../core/id_bits.hpp"
 #include "pinched_fans.hpp"
 
 #include <omp.h>
@@ -75,19 +76,13 @@ struct Marks {
 std::vector<int32_t> faces_around(const Mesh& mesh, const std::vector<int32_t>& vertices) {
   const auto& vfo = mesh.vertex_face_offsets();
   const auto& vf = mesh.vertex_faces();
-  auto set = [](std::vector<uint64_t>& bits, int32_t i) { bits[size_t(i) >> 6] |= uint64_t(1) << (i & 63); };
-  auto for_each_set = [](const std::vector<uint64_t>& bits, auto visit) {
-    for (size_t w = 0; w < bits.size(); ++w)
-      for (uint64_t word = bits[w]; word; word &= word - 1) visit(int32_t(64 * w + size_t(__builtin_ctzll(word))));
-  };
-  std::vector<uint64_t> vertex_bits((size_t(mesh.num_vertices()) + 63) / 64, 0);
-  std::vector<uint64_t> face_bits((size_t(mesh.num_faces()) + 63) / 64, 0);
-  for (int32_t v : vertices) set(vertex_bits, v);
-  for_each_set(vertex_bits, [&](int32_t v) {
-    for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) set(face_bits, vf[i]);
+  IdBits vertex_set(mesh.num_vertices()), face_set(mesh.num_faces());
+  for (int32_t v : vertices) vertex_set.insert(v);
+  vertex_set.for_each([&](int32_t v) {
+    for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) face_set.insert(vf[i]);
   });
   std::vector<int32_t> faces;
-  for_each_set(face_bits, [&](int32_t f) { faces.push_back(f); });
+  face_set.for_each([&](int32_t f) { faces.push_back(f); });
   return faces;
 }
 
@@ -238,8 +233,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // the samples: 46 against 35 ms for the check): beyond a sixteenth, every face is tested.
   if (carried.valid && int64_t(carried.changed.size()) > n / 16) carried.valid = false;
   const bool test_all = !carried.valid && !candidate_faces;
-  // Faces re-tested around the changed vertices (increasing): every other face keeps its
-  // corners' labels, so when the last check's triangles are known, only these are written anew.
+  // Re-testing around changed vertices with the last check's triangles known: every other face
+  // keeps its corners' labels, so only the re-tested faces' triangles are written anew.
   const bool patch = !test_all && carried.valid && carried.emitted_valid;
   // Vertices in a face but in no cluster stop the check here: the other checks need every
   // vertex in a cluster. Testing every face reads every such vertex's label and notes them on
@@ -272,7 +267,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     return out;
   }
   Marks marks(threads);
-  std::vector<int32_t> retested, fresh_faces, fresh_triangles;  // ... and those that emit now
+  // The faces re-tested around the changed vertices (increasing), and those that emit now.
+  std::vector<int32_t> retested, fresh_faces, fresh_triangles;
   if (!test_all && carried.valid) {
     retested = faces_around(mesh, carried.changed);
     for (int32_t f : retested) {

@@ -12,6 +12,7 @@
 #include <omp.h>
 
 #include "core/counting_sort.hpp"
+#include "core/id_bits.hpp"
 #include "core/ordered_sum.hpp"
 #include "topstoc/core/random.hpp"
 
@@ -408,19 +409,14 @@ void sort_vertex_ids(std::vector<int32_t>& ids, int32_t n) {
     std::sort(ids.begin(), ids.end());
     return;
   }
-  std::vector<uint64_t> bits((size_t(n) + 63) / 64, 0);
-  for (int32_t v : ids) {
-    uint64_t& word = bits[size_t(v) >> 6];
-    const uint64_t bit = uint64_t(1) << (v & 63);
-    if (word & bit) {  // a repeated id would be lost: sort the plain way
+  IdBits bits(n);
+  for (int32_t v : ids)
+    if (!bits.insert(v)) {  // a repeated id would be lost: sort the plain way
       std::sort(ids.begin(), ids.end());
       return;
     }
-    word |= bit;
-  }
   size_t at = 0;
-  for (size_t w = 0; w < bits.size(); ++w)
-    for (uint64_t word = bits[w]; word; word &= word - 1) ids[at++] = int32_t(64 * w + size_t(__builtin_ctzll(word)));
+  bits.for_each([&](int32_t v) { ids[at++] = v; });
 }
 
 // Breadth-first ball of `rings` hops around `center`, restricted by `follow(slot)`; calls
