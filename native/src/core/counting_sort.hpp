@@ -32,6 +32,9 @@ void stable_counting_sort(int64_t count, int32_t buckets, Key key, Place place, 
     return;
   }
   std::unique_ptr<int32_t[]> cursors;  // per thread and bucket: counts, then the next position
+  // Rows a whole number of cache lines long plus one: with few buckets (distances in a flood
+  // update) the threads' rows would otherwise share lines that every item writes.
+  const size_t row = (size_t(buckets) + 15) / 16 * 16 + 16;
   std::vector<int64_t> range_start;    // per thread: first position of its range of buckets
 #pragma omp parallel num_threads(team)
   {
@@ -39,10 +42,10 @@ void stable_counting_sort(int64_t count, int32_t buckets, Key key, Place place, 
     const int threads = omp_get_num_threads(), me = omp_get_thread_num();
 #pragma omp single
     {
-      cursors.reset(new int32_t[size_t(threads) * buckets]);  // each thread clears its own row
+      cursors.reset(new int32_t[size_t(threads) * row]);  // each thread clears its own row
       range_start.assign(threads + 1, 0);
     }
-    int32_t* mine = cursors.get() + size_t(me) * buckets;
+    int32_t* mine = cursors.get() + size_t(me) * row;
     std::fill(mine, mine + buckets, 0);
     const int64_t begin = count * me / threads, end = count * (me + 1) / threads;
     for (int64_t i = begin; i < end; ++i) ++mine[key(i)];
@@ -51,7 +54,7 @@ void stable_counting_sort(int64_t count, int32_t buckets, Key key, Place place, 
     const int32_t first = int32_t(int64_t(buckets) * me / threads), last = int32_t(int64_t(buckets) * (me + 1) / threads);
     int64_t total = 0;
     for (int32_t b = first; b < last; ++b)
-      for (int t = 0; t < threads; ++t) total += cursors[size_t(t) * buckets + b];
+      for (int t = 0; t < threads; ++t) total += cursors[size_t(t) * row + b];
     range_start[me + 1] = total;
 #pragma omp barrier
 #pragma omp single
@@ -60,8 +63,8 @@ void stable_counting_sort(int64_t count, int32_t buckets, Key key, Place place, 
     for (int32_t b = first; b < last; ++b) {
       offsets[b] = int32_t(at);
       for (int t = 0; t < threads; ++t) {
-        const int32_t n = cursors[size_t(t) * buckets + b];
-        cursors[size_t(t) * buckets + b] = int32_t(at);
+        const int32_t n = cursors[size_t(t) * row + b];
+        cursors[size_t(t) * row + b] = int32_t(at);
         at += n;
       }
     }

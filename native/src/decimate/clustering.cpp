@@ -2,6 +2,7 @@
 #include "topstoc/core/parallel.hpp"
 #include "../core/byte_flags.hpp"
 #include "../core/counting_sort.hpp"
+#include "../core/per_thread.hpp"
 
 #include <omp.h>
 
@@ -51,7 +52,7 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   const auto& vertex_feature = layout.vertex_feature;
   std::vector<uint8_t> queued(n, 0);
   const int threads = omp_get_max_threads();
-  std::vector<std::vector<int32_t>> next(threads), cross(threads);
+  PerThread<std::vector<int32_t>> next(threads), cross(threads);
   uint64_t* keys = key.data();
   uint8_t* in_next = queued.data();
   if (!std::is_sorted(frontier.begin(), frontier.end())) std::sort(frontier.begin(), frontier.end());
@@ -149,21 +150,19 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
     // Next frontier in vertex order: a short one sorted, a longer one read off the flags, eight
     // at a time (sorting a few ten thousand vertices per level was a third of the flood at 1 %).
     size_t total = 0;
-    for (const auto& list : next) total += list.size();
+    for (int t = 0; t < threads; ++t) total += next[t].size();
     frontier.clear();
     if (total * 256 < size_t(n)) {
-      for (auto& list : next) {
-        for (int32_t u : list) in_next[u] = 0;
-        frontier.insert(frontier.end(), list.begin(), list.end());
-        list.clear();
-      }
+      for (int t = 0; t < threads; ++t)
+        for (int32_t u : next[t]) in_next[u] = 0;
+      append_and_clear(next, frontier);
       std::sort(frontier.begin(), frontier.end());
     } else {
-      for (auto& list : next) list.clear();
+      for (int t = 0; t < threads; ++t) next[t].clear();
       const int64_t words = int64_t(n) / 8;
 #pragma omp parallel if (n >= kParallelMin)  // the scan reads every flag, however few are set
       {
-        auto& mine = next[omp_get_thread_num()];
+        auto& mine = next.mine();
 #pragma omp for schedule(static)
         for (int64_t w = 0; w < words; ++w) {
           const uint64_t word = flag_word(in_next + 8 * w);
@@ -178,16 +177,9 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
           in_next[v] = 0;
           next[threads - 1].push_back(v);
         }
-      for (auto& list : next) {
-        frontier.insert(frontier.end(), list.begin(), list.end());
-        list.clear();
-      }
+      append_and_clear(next, frontier);
     }
-    if (cross_edges)
-      for (auto& list : cross) {
-        cross_edges->insert(cross_edges->end(), list.begin(), list.end());
-        list.clear();
-      }
+    if (cross_edges) append_and_clear(cross, *cross_edges);
     ++level;
   }
 }
@@ -247,10 +239,10 @@ void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vect
   }
   // Kept clusters take their new ranks; the vertices of removed ones are emptied (unreached).
   const int threads = omp_get_max_threads();
-  std::vector<std::vector<int32_t>> emptied_by_thread(threads);
+  PerThread<std::vector<int32_t>> emptied_by_thread(threads);
 #pragma omp parallel if (n >= kParallelMin)
   {
-    auto& mine = emptied_by_thread[omp_get_thread_num()];
+    auto& mine = emptied_by_thread.mine();
 #pragma omp for schedule(static)
     for (int32_t v = 0; v < n; ++v) {
       const uint64_t k = key[v];
@@ -274,7 +266,8 @@ void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vect
   std::vector<uint64_t> found;
   std::vector<uint8_t> listed(n, 0);
   int32_t farthest = 0;
-  for (const auto& emptied : emptied_by_thread) {
+  for (int t = 0; t < threads; ++t) {
+    const auto& emptied = emptied_by_thread[t];
     for (int32_t v : emptied)
       for (int32_t j = ao[v]; j < ao[v + 1]; ++j) {
         const int32_t u = adj[j];

@@ -48,8 +48,8 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   waiting_.assign(n, 0);
   settled_.assign(n, 0);
   merged_from_.assign(n, -1);
-  scratch_.resize(std::max(1, omp_get_max_threads()));
-  for (Scratch& scratch : scratch_) scratch.mark.assign(n, 0);
+  scratch_ = PerThread<Scratch>(std::max(1, omp_get_max_threads()));
+  for (int t = 0; t < scratch_.size(); ++t) scratch_[t].mark.assign(n, 0);
   // Every vertex's cheapest collapse, each edge evaluated once (from its lower end) where it
   // costs the same both ways. A thread owns the lower ends it evaluates; what it finds for the
   // higher ends is merged afterwards. The cheapest by (cost, id) does not depend on the order.
@@ -57,12 +57,12 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   auto better = [&](int32_t u, int32_t v, double c) {
     return target_[u] < 0 || c < best_cost[u] || (c == best_cost[u] && v < target_[u]);
   };
-  const int threads = static_cast<int>(scratch_.size());
-  std::vector<std::vector<std::pair<int32_t, Best>>> found(threads);
+  const int threads = scratch_.size();
+  PerThread<std::vector<std::pair<int32_t, Best>>> found(threads);
 #pragma omp parallel num_threads(threads) if (n >= 10000)
   {
-    Scratch& scratch = scratch_[omp_get_thread_num()];
-    auto& mine = found[omp_get_thread_num()];
+    Scratch& scratch = scratch_.mine();
+    auto& mine = found.mine();
     std::vector<int32_t> around;
 #pragma omp for schedule(static)
     for (int32_t u = 0; u < n; ++u) {
@@ -77,8 +77,8 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
       }
     }
   }
-  for (const auto& list : found)
-    for (const auto& [v, offer] : list)
+  for (int t = 0; t < threads; ++t)
+    for (const auto& [v, offer] : found[t])
       if (better(v, offer.target, offer.cost)) target_[v] = offer.target, best_cost[v] = offer.cost;
   std::vector<int32_t> ids;
   std::vector<double> keys;
@@ -352,7 +352,7 @@ int32_t Collapser::run(Stop target) {
       const int32_t i = reserved[k], u = batch[i], v = target_[u];
       if (batch_key[i] != cost(u, v)) {
         status[i] = kEvaluate;
-      } else if (!allowed(u, v, scratch_[omp_get_thread_num()])) {
+      } else if (!allowed(u, v, scratch_.mine())) {
         status[i] = kEvaluateChecked;
       }
     }
@@ -403,7 +403,7 @@ int32_t Collapser::run(Stop target) {
       }
 #pragma omp for schedule(dynamic, 4)
       for (int32_t i = 0; i < evaluations; ++i)
-        pending_best[i] = evaluate(pending[i], pending_checked[i], scratch_[omp_get_thread_num()]);
+        pending_best[i] = evaluate(pending[i], pending_checked[i], scratch_.mine());
     }
     for (int32_t i = 0; i < evaluations; ++i) {
       settle(pending[i], pending_best[i]);

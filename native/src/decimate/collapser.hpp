@@ -21,6 +21,7 @@
 
 #include "decimate/indexed_heap.hpp"
 #include "decimate/vertex_quadrics.hpp"
+#include "core/per_thread.hpp"
 
 namespace topstoc {
 
@@ -138,7 +139,7 @@ class Collapser {
   std::vector<uint32_t> waiting_;      // per vertex: the batch whose collapses touched it
   std::vector<uint32_t> settled_;      // per vertex: the batch that evaluated it anew
   uint32_t ring_stamp_ = 0;
-  std::vector<Scratch> scratch_;
+  PerThread<Scratch> scratch_{0};  // one per thread, each on its own cache lines
   std::vector<int32_t> options_, star_, moved_faces_;
 };
 

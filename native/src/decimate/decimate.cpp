@@ -15,6 +15,7 @@
 #include "topstoc/decimate/flood_cache.hpp"
 #include "topstoc/decimate/placement.hpp"
 #include "topstoc/decimate/refine.hpp"
+#include "../core/per_thread.hpp"
 
 namespace topstoc {
 
@@ -153,15 +154,15 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   const bool relabel = !draft || placement == Placement::Filtered;
   if (relabel && std::find(partition.absorbed.begin(), partition.absorbed.end(), 1) != partition.absorbed.end()) {
     const int32_t n = mesh.num_vertices();
-    std::vector<std::vector<int32_t>> found(omp_get_max_threads());
+    PerThread<std::vector<int32_t>> found(omp_get_max_threads());
 #pragma omp parallel if (n >= kParallelMin)
     {
-      auto& mine = found[omp_get_thread_num()];
+      auto& mine = found.mine();
 #pragma omp for schedule(static)
       for (int32_t v = 0; v < n; ++v)
         if (label(v) >= 0 && partition.absorbed[label(v)]) mine.push_back(v);
     }
-    for (const auto& list : found) orphans.insert(orphans.end(), list.begin(), list.end());
+    append_and_clear(found, orphans);
   }
   for (bool changed = !orphans.empty(); changed;) {
     changed = false;

@@ -4,6 +4,7 @@
 #include "link_arcs.hpp"
 #include "../core/byte_flags.hpp"
 #include "../core/id_bits.hpp"
+#include "../core/per_thread.hpp"
 #include "pinched_fans.hpp"
 
 #include <omp.h>
@@ -60,11 +61,11 @@ inline std::array<int32_t, 2> rotated_from_lowest(const int32_t* t) {
 
 // Collects per-thread lists of marked clusters into one sorted, unique list.
 struct Marks {
-  std::vector<std::vector<int32_t>> per_thread;
+  PerThread<std::vector<int32_t>> per_thread;
   explicit Marks(int threads) : per_thread(threads) {}
-  void add(int32_t s) { per_thread[omp_get_thread_num()].push_back(s); }
-  void merge_into(std::vector<int32_t>& out) const {
-    for (const auto& list : per_thread) out.insert(out.end(), list.begin(), list.end());
+  void add(int32_t s) { per_thread.mine().push_back(s); }
+  void merge_into(std::vector<int32_t>& out) {
+    append_and_clear(per_thread, out);
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
   }
@@ -421,11 +422,11 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   }
   std::vector<uint8_t> drop(emitted, 0);
   bool any_dropped = false;  // drop is read only once pillows are dropped
-  std::vector<std::vector<uint64_t>> seen_pairs(threads);
+  PerThread<std::vector<uint64_t>> seen_pairs(threads);
   if (incremental)  // the pairs seen by samples not evaluated again (a pair is seen from its lower rank)
     for (uint64_t key : carried.seen_pairs)
       if (!affected[int32_t(key >> 32)]) seen_pairs[0].push_back(key);
-  std::vector<std::vector<int32_t>> repeated_lists(threads), named_lists(threads);
+  PerThread<std::vector<int32_t>> repeated_lists(threads), named_lists(threads);
   int32_t bad_link = 0, bad_edge = 0, isolated = 0;
   // At a pinched sample each input fan must come out as a fan of its own sheet: the arcs from
   // one sheet's faces form that sheet's fans (as many open and closed), and no fan mixes
@@ -517,9 +518,9 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
 #pragma omp parallel reduction(+ : bad_link, bad_edge, isolated) if (evaluated >= kParallelMinCostly)
   {
     LinkArcs link;
-    auto& seen = seen_pairs[omp_get_thread_num()];
-    auto& repeated = repeated_lists[omp_get_thread_num()];
-    auto& named = named_lists[omp_get_thread_num()];
+    auto& seen = seen_pairs.mine();
+    auto& repeated = repeated_lists.mine();
+    auto& named = named_lists.mine();
 #pragma omp for schedule(dynamic, 256)
     for (int64_t i = 0; i < evaluated; ++i) {
       const int32_t s = todo[i], issues_before = bad_link + bad_edge + isolated;
@@ -538,7 +539,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // sample of a repeated triangle sees the repeat in its link, so the set-aside samples hold
   // all of them; they are evaluated again once the pillows are gone.
   std::vector<int32_t> repeated;
-  for (const auto& list : repeated_lists) repeated.insert(repeated.end(), list.begin(), list.end());
+  for (int t = 0; t < threads; ++t) repeated.insert(repeated.end(), repeated_lists[t].begin(), repeated_lists[t].end());
   std::sort(repeated.begin(), repeated.end());
   if (!repeated.empty()) {
     std::vector<std::pair<std::array<int32_t, 3>, int32_t>> keyed;  // sorted triple, triangle
@@ -599,7 +600,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   out.issues.absorbed = int32_t(std::count(out.absorbed.begin(), out.absorbed.end(), uint8_t(1)));
   // Feature pairs without a triangle between them: the border between them collapsed.
   std::vector<uint64_t> seen;
-  for (const auto& list : seen_pairs) seen.insert(seen.end(), list.begin(), list.end());
+  append_and_clear(seen_pairs, seen);
   std::sort(seen.begin(), seen.end());
   for (const auto& [key, copies] : feature_pairs)
     if (!std::binary_search(seen.begin(), seen.end(), key)) {
@@ -631,8 +632,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     carried.slivers_checked = check_slivers;
     carried.absorbed = out.absorbed;
     carried.revisit.clear();
-    for (const auto* lists : {&repeated_lists, &named_lists})
-      for (const auto& list : *lists) carried.revisit.insert(carried.revisit.end(), list.begin(), list.end());
+    append_and_clear(repeated_lists, carried.revisit);
+    append_and_clear(named_lists, carried.revisit);
     carried.seen_pairs = std::move(seen);
     carried.feature_pairs = std::move(feature_pairs);
   }
