@@ -3,6 +3,7 @@
 // on the whole sample list, and flood_update() against flood() on the new list, as
 // clustering.hpp promises.
 #include <doctest/doctest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <climits>
@@ -146,6 +147,35 @@ TEST_CASE("flood gives every vertex the sample of least (hops, rank), as a searc
     const Clustering expected = brute_clustering(mesh, samples);
     CHECK(c.key == expected.key);
   }
+}
+
+// Large enough for the threads to share a level (a frontier of kParallelMin / 16 vertices or
+// more): each thread owns a range of vertex ids and hands the lowerings of others' vertices
+// over after the level. Every team size must give the one-thread keys and crossing edges.
+TEST_CASE("flood on several threads gives the keys and crossing edges of one thread") {
+  std::mt19937 random(31);
+  const Mesh mesh = make_mesh(topstoc_test::torus(300, 160));  // 48,000 vertices
+  const auto layout = no_features(mesh);
+  const int before = omp_get_max_threads();
+  for (const int32_t count : {9000, 1500}) {  // the first level parallel, or only later ones
+    const auto samples = topstoc_test::random_samples(mesh.num_vertices(), count, random);
+    auto run = [&](int threads, std::vector<int32_t>& cross) {
+      omp_set_num_threads(threads);
+      Clustering c;
+      flood(mesh, *layout, samples, c, &cross);
+      std::sort(cross.begin(), cross.end());
+      return c;
+    };
+    std::vector<int32_t> cross_one, cross_many;
+    const Clustering one = run(1, cross_one);
+    CHECK(std::adjacent_find(cross_one.begin(), cross_one.end()) == cross_one.end());  // each edge once
+    for (const int threads : {2, 3, 7}) {
+      const Clustering many = run(threads, cross_many);
+      CHECK(many.key == one.key);
+      CHECK(cross_many == cross_one);
+    }
+  }
+  omp_set_num_threads(before);
 }
 
 // Both incremental updates against a fresh flood, on each mesh.
