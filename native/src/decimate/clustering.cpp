@@ -60,6 +60,7 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   const int32_t* ae = cross_edges || layout.has_feature_vertices ? mesh.adjacency_edge().data() : nullptr;
   const auto& edge_feature = layout.edge_feature;
   const auto& vertex_feature = layout.vertex_feature;
+  const bool has_features = layout.has_feature_vertices;  // else vertex_feature is all zero
   std::vector<uint8_t> queued(n, 0);
   const int threads = omp_get_max_threads();
   PerThread<std::vector<int32_t>> next(threads), cross(threads);
@@ -113,7 +114,7 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
         }
         if (candidate >= held) continue;
         // Feature vertices are entered only along feature edges.
-        if (vertex_feature[u] && !edge_feature[ae[j]]) continue;
+        if (has_features && vertex_feature[u] && !edge_feature[ae[j]]) continue;
         if (u < lo || u >= hi) {
           outbox.push_back({u, candidate});
         } else {
