@@ -171,8 +171,9 @@ TEST_CASE("a check after flood_add evaluates only the changed links and finds wh
 TEST_CASE("a check after flood_update, given the old flood's triangles in the new ranks, finds what a check from scratch finds") {
   // The slider's case (flood_cache.hpp): a kept flood of other samples is updated, and its
   // emitted triangles are taken over except around the vertices that changed.
+  // The old check's zero-area flags come along too (the flat grid has collinear samples).
   const IncrementalCases cases;
-  int64_t patched = 0;
+  int64_t patched = 0, patched_with_slivers = 0;
   for (const auto& kase : cases.all()) {
     const Mesh& mesh = *kase.mesh;
     const std::vector<uint8_t> required(mesh.num_vertices(), 0);
@@ -192,7 +193,7 @@ TEST_CASE("a check after flood_update, given the old flood's triangles in the ne
       Clustering clustering;
       flood(mesh, *kase.layout, old_samples, clustering);
       CheckState first;
-      check_partition(mesh, *kase.layout, old_samples, clustering, required, false, nullptr, &first);
+      check_partition(mesh, *kase.layout, old_samples, clustering, required, true, nullptr, &first);
       CheckState state;
       std::vector<int32_t> new_rank;
       flood_update(mesh, *kase.layout, old_samples, samples, clustering, &state.changed, &new_rank);
@@ -201,15 +202,19 @@ TEST_CASE("a check after flood_update, given the old flood's triangles in the ne
       state.emitted_faces = first.emitted_faces;
       state.emitted_triangles = first.emitted_triangles;
       for (int32_t& rank : state.emitted_triangles) rank = new_rank[rank];
+      state.emitted_sliver = first.emitted_sliver;
+      state.slivers_checked = first.slivers_checked;
       state.emitted_valid = first.emitted_valid;
       const bool can_patch = state.valid && state.emitted_valid && state.changed.size() <= size_t(mesh.num_vertices() / 16);
       const Partition kept = check_partition(mesh, *kase.layout, samples, clustering, required, true, nullptr, &state);
       const Partition fresh = check_partition(mesh, *kase.layout, samples, clustering, required, true);
       check_same(kept, fresh);
       patched += can_patch && kept.issues.unreached == 0;
+      patched_with_slivers += can_patch && kept.issues.unreached == 0 && fresh.issues.sliver > 0;
     }
   }
   CHECK(patched > 30);
+  CHECK(patched_with_slivers > 5);
 }
 
 TEST_CASE("a check after flood_update that leaves a small component without samples finds it unreached") {

@@ -287,6 +287,8 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
         // the faces around changed vertices (whose old ranks may be gone).
         checked.emitted_faces = std::move(cache->emitted_faces);
         checked.emitted_triangles = std::move(cache->emitted_triangles);
+        checked.emitted_sliver = std::move(cache->emitted_sliver);  // (the same vertices: same areas)
+        checked.slivers_checked = cache->slivers_checked;
         for (int32_t& rank : checked.emitted_triangles) rank = new_rank[rank];
         checked.emitted_valid = true;
         cache->emitted_valid = false;
@@ -349,6 +351,8 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       if (cache->emitted_valid) {
         cache->emitted_faces = checked.emitted_faces;
         cache->emitted_triangles = checked.emitted_triangles;
+        cache->emitted_sliver = checked.emitted_sliver;
+        cache->slivers_checked = checked.slivers_checked;
       }
       cache = nullptr;
     }

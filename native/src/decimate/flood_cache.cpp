@@ -31,6 +31,8 @@ void FloodCache::clear() {
   emits_valid = false;
   emitted_faces = {};
   emitted_triangles = {};
+  emitted_sliver = {};
+  slivers_checked = false;
   emitted_valid = false;
 }
 

@@ -270,6 +270,11 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   Marks marks(threads);
   // The faces re-tested around the changed vertices (increasing), and those that emit now.
   std::vector<int32_t> retested, fresh_faces, fresh_triangles;
+  // Zero-area flags of the triangles taken over (a triangle is the same three vertices), when
+  // the last check tested them; the re-tested faces' triangles are tested below.
+  std::vector<uint8_t> kept_sliver;
+  const bool keep_slivers = patch && check_slivers && carried.slivers_checked &&
+                            carried.emitted_sliver.size() == carried.emitted_faces.size();
   if (!test_all && carried.valid) {
     retested = faces_around(mesh, carried.changed);
     for (int32_t f : retested) {
@@ -295,25 +300,29 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     const size_t was = was_faces.size(), fresh = fresh_faces.size(), count = retested.size();
     out.source_face.resize(was + fresh);
     out.triangles.resize(3 * (was + fresh));
+    if (keep_slivers) kept_sliver.resize(was + fresh);
     size_t i = 0, e = 0, r = 0, at = 0;
-    auto put = [&](int32_t f, const int32_t* t) {
+    auto put = [&](int32_t f, const int32_t* t, uint8_t sliver) {
       out.source_face[at] = f;
+      if (keep_slivers) kept_sliver[at] = sliver;
       std::copy(t, t + 3, &out.triangles[3 * at++]);
     };
     while (i < was || e < fresh) {
       if (e == fresh || (i < was && was_faces[i] < fresh_faces[e])) {
         const int32_t f = was_faces[i];
         while (r < count && retested[r] < f) ++r;
-        if (r == count || retested[r] != f) put(f, &was_triangles[3 * i]);  // not re-tested: unchanged
+        if (r == count || retested[r] != f)  // not re-tested: unchanged
+          put(f, &was_triangles[3 * i], keep_slivers ? carried.emitted_sliver[i] : kUntested);
         ++i;
       } else {
         if (i < was && was_faces[i] == fresh_faces[e]) ++i;  // emitted then and now: the new labels
-        put(fresh_faces[e], &fresh_triangles[3 * e]);
+        put(fresh_faces[e], &fresh_triangles[3 * e], kUntested);
         ++e;
       }
     }
     out.source_face.resize(at);
     out.triangles.resize(3 * at);
+    if (keep_slivers) kept_sliver.resize(at);
   } else {
     // Every emitting face, in face order: each thread counts those of its run of faces (static
     // schedule, the same runs in both loops) and writes them from where the runs before it end.
@@ -369,7 +378,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // keep what the last check found. Unchanged triangles keep their zero-area flags too.
   const bool incremental = carried.links_valid && carried.samples <= k;
   std::vector<uint8_t> sliver;  // per emitted triangle: 0, 1 or kUntested
-  if (check_slivers) sliver.assign(emitted, kUntested);
+  if (keep_slivers) sliver = std::move(kept_sliver);
+  else if (check_slivers) sliver.assign(emitted, kUntested);
   std::vector<uint8_t> affected =
       incremental ? changed_links(carried, out, k, feature_pairs, check_slivers && carried.slivers_checked ? &sliver : nullptr)
                   : std::vector<uint8_t>(k, 1);

@@ -28,6 +28,8 @@ struct FloodCache {
   bool emits_valid = false;              ///< emits is filled (a fast-path flood leaves it empty)
   std::vector<int32_t> emitted_faces;    ///< the faces that emit, increasing (if emitted_valid)
   std::vector<int32_t> emitted_triangles;  ///< ... and their corners' sample ranks in that flood
+  std::vector<uint8_t> emitted_sliver;     ///< ... and whether each has zero area (if slivers_checked)
+  bool slivers_checked = false;
   bool emitted_valid = false;
 
   bool holds(const Mesh& m, const FeatureLayout& l) const {
@@ -41,7 +43,7 @@ struct FloodCache {
 /// The caches of one mesh and layout, shared by the threads that decimate it: each decimation
 /// takes one that no other is using (or a new one, up to `capacity`) and gives it back. The
 /// preview's two workers thus each find the flood of the request before their last.
-/// Memory: 9 bytes per vertex, 1 per triangle and 16 per emitted triangle per cache.
+/// Memory: 9 bytes per vertex, 1 per triangle and 17 per emitted triangle per cache.
 class FloodCachePool {
  public:
   explicit FloodCachePool(size_t capacity = 2) : capacity_(capacity) {}

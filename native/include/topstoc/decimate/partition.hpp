@@ -70,12 +70,12 @@ struct CheckState {
   bool emitted_valid = false;              ///< the two lists below are the last check's
   std::vector<int32_t> emitted_faces;      ///< every triangle it emitted (pillows included): source face
   std::vector<int32_t> emitted_triangles;  ///< ... and its 3 sample ranks
+  std::vector<uint8_t> emitted_sliver;     ///< ... and whether it has zero area (if slivers_checked)
+  bool slivers_checked = false;
 
   // The samples' links as the last check evaluated them.
   bool links_valid = false;                ///< the fields below hold the last check's
   int32_t samples = 0;                     ///< how many samples it had (new ones are appended)
-  std::vector<uint8_t> emitted_sliver;     ///< ... and whether it has zero area (if slivers_checked)
-  bool slivers_checked = false;
   std::vector<int64_t> chi6;                                ///< per sample: its Euler contribution, times 6
   std::vector<uint8_t> absorbed;                            ///< per sample: no triangle, absorbed
   std::vector<int32_t> revisit;                             ///< samples with an issue or a repeated triangle
