@@ -18,8 +18,9 @@ notice (the modal timer) or to write the result.
 Two workers run when the machine has two cores or more: while one decimates, the next request
 starts on the other, and the engine gives each call its share of the free cores. A decimation
 is bound by memory latency more than by arithmetic, so two running side by side on one thread
-each show nearly twice as many updates per second as one using both threads (horse, 1.55M
-triangles, ratios 5-20 %: 14.7 vs 8.8 per second outside Blender). Results are shown in the
+each show more updates per second than one using both threads (horse, 1.55M triangles, the
+drag benchmark at 10 % in bpy 4.5, 2026-11-28: sweep 14.2-15.4 vs 11.2-12.5, fine adjustment
+24.2-28.2 vs 19.0-19.2 per second). Results are shown in the
 order they were requested: one that finishes after a newer one was shown is dropped.
 
 While the user drags, the preview shows drafts of the fast mode (plain TopStoc, milliseconds):
