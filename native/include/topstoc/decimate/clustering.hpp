@@ -18,8 +18,8 @@ namespace topstoc {
 
 /// Per vertex, (hop distance, rank of its sample) packed into one word, distance high: one
 /// integer comparison orders them as the definition does, and the flood lowers both with one
-/// atomic minimum. The fill writes the words in place, so a flood needs no second copy and
-/// no pass to unpack them.
+/// store. The fill writes the words in place, so a flood needs no second copy and no pass to
+/// unpack them.
 struct Clustering {
   std::vector<uint64_t> key;
   /// Rank of v's sample, -1 if no sample reaches v.
