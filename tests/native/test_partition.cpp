@@ -199,11 +199,8 @@ TEST_CASE("a check after flood_update, given the old flood's triangles in the ne
       flood_update(mesh, *kase.layout, old_samples, samples, clustering, &state.changed, &new_rank);
       state.emits = first.emits;
       state.valid = first.valid;
-      state.emitted_faces = first.emitted_faces;
-      state.emitted_triangles = first.emitted_triangles;
-      for (int32_t& rank : state.emitted_triangles) rank = new_rank[rank];
-      state.emitted_sliver = first.emitted_sliver;
-      state.slivers_checked = first.slivers_checked;
+      state.emitted = first.emitted;
+      state.emitted.renumber(new_rank);
       state.emitted_valid = first.emitted_valid;
       const bool can_patch = state.valid && state.emitted_valid && state.changed.size() <= size_t(mesh.num_vertices() / 16);
       const Partition kept = check_partition(mesh, *kase.layout, samples, clustering, required, true, nullptr, &state);
@@ -246,7 +243,7 @@ TEST_CASE("a check after flood_update that leaves a small component without samp
   std::vector<int32_t> new_rank;
   state.changed.clear();
   flood_update(mesh, *layout, old_samples, samples, clustering, &state.changed, &new_rank);
-  for (int32_t& rank : state.emitted_triangles) rank = new_rank[rank];
+  state.emitted.renumber(new_rank);
   REQUIRE(state.changed.size() <= size_t(mesh.num_vertices() / 16));  // the patched path
   const Partition kept = check_partition(mesh, *layout, samples, clustering, required, false, nullptr, &state);
   CHECK(kept.issues.unreached == 3);

@@ -285,11 +285,8 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       if (cache->emitted_valid) {
         // The cached flood's triangles, in the new ranks: the check re-writes only those of
         // the faces around changed vertices (whose old ranks may be gone).
-        checked.emitted_faces = std::move(cache->emitted_faces);
-        checked.emitted_triangles = std::move(cache->emitted_triangles);
-        checked.emitted_sliver = std::move(cache->emitted_sliver);  // (the same vertices: same areas)
-        checked.slivers_checked = cache->slivers_checked;
-        for (int32_t& rank : checked.emitted_triangles) rank = new_rank[rank];
+        checked.emitted = std::move(cache->emitted);  // (zero-area flags: the same vertices, same areas)
+        checked.emitted.renumber(new_rank);
         checked.emitted_valid = true;
         cache->emitted_valid = false;
       }
@@ -348,12 +345,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       cache->emits_valid = checked.valid && checked.changed.empty();
       if (cache->emits_valid) cache->emits = checked.emits;
       cache->emitted_valid = cache->emits_valid && checked.emitted_valid;
-      if (cache->emitted_valid) {
-        cache->emitted_faces = checked.emitted_faces;
-        cache->emitted_triangles = checked.emitted_triangles;
-        cache->emitted_sliver = checked.emitted_sliver;
-        cache->slivers_checked = checked.slivers_checked;
-      }
+      if (cache->emitted_valid) cache->emitted = checked.emitted;
       cache = nullptr;
     }
     accumulate(result.issues_found, partition.issues);

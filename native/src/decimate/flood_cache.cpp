@@ -29,10 +29,7 @@ void FloodCache::clear() {
   clustering = {};
   emits = {};
   emits_valid = false;
-  emitted_faces = {};
-  emitted_triangles = {};
-  emitted_sliver = {};
-  slivers_checked = false;
+  emitted = {};
   emitted_valid = false;
 }
 

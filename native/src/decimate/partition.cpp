@@ -99,7 +99,7 @@ std::vector<uint8_t> changed_links(const CheckState& last, const Partition& out,
                                    std::vector<uint8_t>* sliver) {
   std::vector<uint8_t> affected(k, 0);
   std::fill(affected.begin() + last.samples, affected.end(), 1);
-  const auto& was = last.emitted_faces;
+  const auto& was = last.emitted.faces;
   const auto& now = out.source_face;
   auto mark = [&](const std::vector<int32_t>& triangles, size_t i) {
     for (int j = 0; j < 3; ++j) affected[triangles[3 * i + j]] = 1;
@@ -107,14 +107,14 @@ std::vector<uint8_t> changed_links(const CheckState& last, const Partition& out,
   size_t i = 0, j = 0;
   while (i < was.size() || j < now.size()) {
     if (j == now.size() || (i < was.size() && was[i] < now[j])) {
-      mark(last.emitted_triangles, i++);  // no longer emitted
+      mark(last.emitted.triangles, i++);  // no longer emitted
     } else if (i == was.size() || now[j] < was[i]) {
       mark(out.triangles, j++);  // emitted now
     } else {
-      if (std::equal(&out.triangles[3 * j], &out.triangles[3 * j] + 3, &last.emitted_triangles[3 * i])) {
-        if (sliver) (*sliver)[j] = last.emitted_sliver[i];
+      if (std::equal(&out.triangles[3 * j], &out.triangles[3 * j] + 3, &last.emitted.triangles[3 * i])) {
+        if (sliver) (*sliver)[j] = last.emitted.sliver[i];
       } else {
-        mark(last.emitted_triangles, i), mark(out.triangles, j);
+        mark(last.emitted.triangles, i), mark(out.triangles, j);
       }
       ++i, ++j;
     }
@@ -273,8 +273,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // Zero-area flags of the triangles taken over (a triangle is the same three vertices), when
   // the last check tested them; the re-tested faces' triangles are tested below.
   std::vector<uint8_t> kept_sliver;
-  const bool keep_slivers = patch && check_slivers && carried.slivers_checked &&
-                            carried.emitted_sliver.size() == carried.emitted_faces.size();
+  const bool keep_slivers = patch && check_slivers && carried.emitted.slivers_checked &&
+                            carried.emitted.sliver.size() == carried.emitted.faces.size();
   if (!test_all && carried.valid) {
     retested = faces_around(mesh, carried.changed);
     for (int32_t f : retested) {
@@ -295,8 +295,8 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   if (patch) {
     // The last check's triangles without the re-tested faces, merged with the re-tested faces
     // that emit now (all three lists increasing).
-    const auto& was_faces = carried.emitted_faces;
-    const auto& was_triangles = carried.emitted_triangles;
+    const auto& was_faces = carried.emitted.faces;
+    const auto& was_triangles = carried.emitted.triangles;
     const size_t was = was_faces.size(), fresh = fresh_faces.size(), count = retested.size();
     out.source_face.resize(was + fresh);
     out.triangles.resize(3 * (was + fresh));
@@ -312,7 +312,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
         const int32_t f = was_faces[i];
         while (r < count && retested[r] < f) ++r;
         if (r == count || retested[r] != f)  // not re-tested: unchanged
-          put(f, &was_triangles[3 * i], keep_slivers ? carried.emitted_sliver[i] : kUntested);
+          put(f, &was_triangles[3 * i], keep_slivers ? carried.emitted.sliver[i] : kUntested);
         ++i;
       } else {
         if (i < was && was_faces[i] == fresh_faces[e]) ++i;  // emitted then and now: the new labels
@@ -381,7 +381,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   if (keep_slivers) sliver = std::move(kept_sliver);
   else if (check_slivers) sliver.assign(emitted, kUntested);
   std::vector<uint8_t> affected =
-      incremental ? changed_links(carried, out, k, feature_pairs, check_slivers && carried.slivers_checked ? &sliver : nullptr)
+      incremental ? changed_links(carried, out, k, feature_pairs, check_slivers && carried.emitted.slivers_checked ? &sliver : nullptr)
                   : std::vector<uint8_t>(k, 1);
   std::vector<int32_t> todo;
   for (int32_t s = 0; s < k; ++s)
@@ -636,10 +636,10 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   if (state) {
     carried.emitted_valid = carried.links_valid = true;
     carried.samples = k;
-    carried.emitted_faces = out.source_face;
-    carried.emitted_triangles = out.triangles;
-    carried.emitted_sliver = std::move(sliver);
-    carried.slivers_checked = check_slivers;
+    carried.emitted.faces = out.source_face;
+    carried.emitted.triangles = out.triangles;
+    carried.emitted.sliver = std::move(sliver);
+    carried.emitted.slivers_checked = check_slivers;
     carried.absorbed = out.absorbed;
     carried.revisit.clear();
     append_and_clear(repeated_lists, carried.revisit);

@@ -17,6 +17,7 @@
 #include "topstoc/core/mesh.hpp"
 #include "topstoc/decimate/clustering.hpp"
 #include "topstoc/decimate/features.hpp"
+#include "topstoc/decimate/partition.hpp"
 
 namespace topstoc {
 
@@ -26,10 +27,7 @@ struct FloodCache {
   Clustering clustering;                 ///< flood(samples)
   std::vector<uint8_t> emits;            ///< per face: corners in three clusters of that flood
   bool emits_valid = false;              ///< emits is filled (a fast-path flood leaves it empty)
-  std::vector<int32_t> emitted_faces;    ///< the faces that emit, increasing (if emitted_valid)
-  std::vector<int32_t> emitted_triangles;  ///< ... and their corners' sample ranks in that flood
-  std::vector<uint8_t> emitted_sliver;     ///< ... and whether each has zero area (if slivers_checked)
-  bool slivers_checked = false;
+  EmittedTriangles emitted;              ///< what the first check of that flood emitted (if emitted_valid)
   bool emitted_valid = false;
 
   bool holds(const Mesh& m, const FeatureLayout& l) const {

@@ -55,6 +55,20 @@ struct Partition {
   std::vector<uint8_t> absorbed;        ///< per rank: 1 if the sample has no triangle (not in the output)
 };
 
+/// The triangles a check emitted, in face order: a later check over nearly the same clustering
+/// (a repair round, or a slider frame from a kept flood) takes them over (FloodCache keeps one).
+struct EmittedTriangles {
+  std::vector<int32_t> faces;      ///< every triangle emitted (pillows included): source face
+  std::vector<int32_t> triangles;  ///< ... and its 3 sample ranks
+  std::vector<uint8_t> sliver;     ///< ... and whether it has zero area (if slivers_checked)
+  bool slivers_checked = false;
+  /// Puts the triangles in the ranks of another sample list (flood_update's new_rank; a
+  /// removed sample's triangles are all re-tested, so its -1 is never read).
+  void renumber(const std::vector<int32_t>& new_rank) {
+    for (int32_t& rank : triangles) rank = new_rank[rank];
+  }
+};
+
 /// What the last check of one decimation found, kept for the next round's check. After
 /// flood_add only the faces around the vertices that changed are tested again, and only the
 /// samples whose link (the triangles around them) may differ are evaluated again: a repair
@@ -67,11 +81,8 @@ struct CheckState {
 
   // The triangles the last check emitted: a check that re-tests the faces around a few changed
   // vertices takes the others over from here instead of reading every emitting face's labels.
-  bool emitted_valid = false;              ///< the two lists below are the last check's
-  std::vector<int32_t> emitted_faces;      ///< every triangle it emitted (pillows included): source face
-  std::vector<int32_t> emitted_triangles;  ///< ... and its 3 sample ranks
-  std::vector<uint8_t> emitted_sliver;     ///< ... and whether it has zero area (if slivers_checked)
-  bool slivers_checked = false;
+  bool emitted_valid = false;  ///< `emitted` holds the last check's
+  EmittedTriangles emitted;
 
   // The samples' links as the last check evaluated them.
   bool links_valid = false;                ///< the fields below hold the last check's
