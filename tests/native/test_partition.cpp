@@ -168,16 +168,19 @@ TEST_CASE("a check after flood_add evaluates only the changed links and finds wh
   CHECK(incremental_rounds > 200);
 }
 
-TEST_CASE("a check after flood_update, given the old flood's triangles in the new ranks, finds what a check from scratch finds") {
+TEST_CASE("a check after flood_update, given the old flood's triangles and links in the new ranks, finds what a check from scratch finds") {
   // The slider's case (flood_cache.hpp): a kept flood of other samples is updated, and its
-  // emitted triangles are taken over except around the vertices that changed.
+  // emitted triangles are taken over except around the vertices that changed, and what its
+  // check found per sample except for the samples whose links changed.
   // The old check's zero-area flags come along too (the flat grid has collinear samples).
+  // Every other draw, the samples left without a triangle become control points, which must
+  // then count as isolated (a slider frame's control points follow its rate).
   const IncrementalCases cases;
-  int64_t patched = 0, patched_with_slivers = 0;
+  int64_t patched = 0, patched_with_slivers = 0, newly_required = 0;
   for (const auto& kase : cases.all()) {
     const Mesh& mesh = *kase.mesh;
-    const std::vector<uint8_t> required(mesh.num_vertices(), 0);
-    for (uint32_t seed = 1; seed <= 60; ++seed) {
+    const std::vector<uint8_t> none_required(mesh.num_vertices(), 0);
+    for (uint32_t seed = 1; seed <= 240; ++seed) {
       std::mt19937 random(seed);
       auto pool = topstoc_test::random_samples(mesh.num_vertices(), 70, random);
       std::vector<int32_t> old_samples(pool.begin(), pool.begin() + 55 + int32_t(seed % 5));
@@ -193,25 +196,37 @@ TEST_CASE("a check after flood_update, given the old flood's triangles in the ne
       Clustering clustering;
       flood(mesh, *kase.layout, old_samples, clustering);
       CheckState first;
-      check_partition(mesh, *kase.layout, old_samples, clustering, required, true, nullptr, &first);
+      check_partition(mesh, *kase.layout, old_samples, clustering, none_required, true, nullptr, &first);
       CheckState state;
       std::vector<int32_t> new_rank;
       flood_update(mesh, *kase.layout, old_samples, samples, clustering, &state.changed, &new_rank);
+      std::vector<uint8_t> required = none_required;
+      if (seed % 2 == 0) {
+        const Partition absorbing = check_partition(mesh, *kase.layout, samples, clustering, none_required, true);
+        for (size_t s = 0; s < absorbing.absorbed.size(); ++s) required[samples[s]] = absorbing.absorbed[s];
+      }
       state.emits = first.emits;
       state.valid = first.valid;
       state.emitted = first.emitted;
       state.emitted.renumber(new_rank);
       state.emitted_valid = first.emitted_valid;
+      if (first.links_valid) {
+        state.links = first.links;
+        state.links.renumber(new_rank, int32_t(samples.size()));
+        state.links_valid = true;
+      }
       const bool can_patch = state.valid && state.emitted_valid && state.changed.size() <= size_t(mesh.num_vertices() / 16);
       const Partition kept = check_partition(mesh, *kase.layout, samples, clustering, required, true, nullptr, &state);
       const Partition fresh = check_partition(mesh, *kase.layout, samples, clustering, required, true);
       check_same(kept, fresh);
       patched += can_patch && kept.issues.unreached == 0;
       patched_with_slivers += can_patch && kept.issues.unreached == 0 && fresh.issues.sliver > 0;
+      newly_required += can_patch && fresh.issues.isolated > 0;
     }
   }
   CHECK(patched > 30);
   CHECK(patched_with_slivers > 5);
+  CHECK(newly_required > 3);
 }
 
 TEST_CASE("a check after flood_update that leaves a small component without samples finds it unreached") {

@@ -289,6 +289,14 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
         checked.emitted.renumber(new_rank);
         checked.emitted_valid = true;
         cache->emitted_valid = false;
+        if (cache->links_valid) {
+          // And what it found per sample: only the samples whose triangles changed are
+          // evaluated again.
+          checked.links = std::move(cache->links);
+          checked.links.renumber(new_rank, int32_t(samples.size()));
+          checked.links_valid = true;
+          cache->links_valid = false;
+        }
       }
     } else {
       checked.changed.clear();  // every face is tested
@@ -301,7 +309,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       cache->layout = layout.serial;
       cache->samples = samples;
       cache->clustering = clustering;
-      cache->emits_valid = cache->emitted_valid = false;
+      cache->emits_valid = cache->emitted_valid = cache->links_valid = false;
     }
   }
   result.seconds_clustering = seconds_since(start);
@@ -346,6 +354,8 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       if (cache->emits_valid) cache->emits = checked.emits;
       cache->emitted_valid = cache->emits_valid && checked.emitted_valid;
       if (cache->emitted_valid) cache->emitted = checked.emitted;
+      cache->links_valid = cache->emitted_valid && checked.links_valid;
+      if (cache->links_valid) cache->links = checked.links;
       cache = nullptr;
     }
     accumulate(result.issues_found, partition.issues);

@@ -31,6 +31,8 @@ void FloodCache::clear() {
   emits_valid = false;
   emitted = {};
   emitted_valid = false;
+  links = {};
+  links_valid = false;
 }
 
 std::unique_ptr<FloodCache> FloodCachePool::take() {

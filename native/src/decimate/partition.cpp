@@ -98,11 +98,12 @@ std::vector<uint8_t> changed_links(const CheckState& last, const Partition& out,
                                    const std::vector<std::pair<uint64_t, int32_t>>& feature_pairs,
                                    std::vector<uint8_t>* sliver) {
   std::vector<uint8_t> affected(k, 0);
-  std::fill(affected.begin() + last.samples, affected.end(), 1);
+  std::fill(affected.begin() + last.links.samples, affected.end(), 1);
   const auto& was = last.emitted.faces;
   const auto& now = out.source_face;
   auto mark = [&](const std::vector<int32_t>& triangles, size_t i) {
-    for (int j = 0; j < 3; ++j) affected[triangles[3 * i + j]] = 1;
+    for (int j = 0; j < 3; ++j)
+      if (triangles[3 * i + j] >= 0) affected[triangles[3 * i + j]] = 1;  // (-1: a sample removed since)
   };
   size_t i = 0, j = 0;
   while (i < was.size() || j < now.size()) {
@@ -121,7 +122,7 @@ std::vector<uint8_t> changed_links(const CheckState& last, const Partition& out,
   }
   auto mark_pair = [&](uint64_t key) { affected[int32_t(key >> 32)] = affected[int32_t(key & 0xffffffffu)] = 1; };
   size_t a = 0, b = 0;
-  const auto& then = last.feature_pairs;
+  const auto& then = last.links.feature_pairs;
   while (a < then.size() || b < feature_pairs.size()) {
     if (b == feature_pairs.size() || (a < then.size() && then[a].first < feature_pairs[b].first)) {
       mark_pair(then[a++].first);
@@ -132,7 +133,7 @@ std::vector<uint8_t> changed_links(const CheckState& last, const Partition& out,
       ++a, ++b;
     }
   }
-  for (int32_t s : last.revisit) affected[s] = 1;
+  for (int32_t s : last.links.revisit) affected[s] = 1;
   return affected;
 }
 
@@ -175,6 +176,43 @@ void test_slivers(const Mesh& mesh, const std::vector<int32_t>& samples, const s
 }
 
 }  // namespace
+
+void SampleLinks::renumber(const std::vector<int32_t>& new_rank, int32_t count) {
+  std::vector<int64_t> new_chi6(count, 0);
+  std::vector<uint8_t> new_absorbed(count, 0), taken(count, 0);
+  std::vector<int32_t> new_revisit;
+  for (size_t s = 0; s < new_rank.size(); ++s) {
+    const int32_t r = new_rank[s];
+    if (r < 0) continue;
+    new_chi6[r] = chi6[s];
+    new_absorbed[r] = absorbed[s];
+    taken[r] = 1;
+    if (absorbed[s]) new_revisit.push_back(r);
+  }
+  for (int32_t r = 0; r < count; ++r)
+    if (!taken[r]) new_revisit.push_back(r);
+  for (int32_t s : revisit)
+    if (new_rank[s] >= 0) new_revisit.push_back(new_rank[s]);
+  // Ranks keep their order, so the renumbered keys stay sorted. A pair with a removed sample
+  // is dropped: the other sample's link had a triangle with it, so it changed, or had none
+  // (an issue the check finds from the pairs, not the links).
+  auto renumbered = [&](uint64_t key) {
+    const int32_t a = new_rank[int32_t(key >> 32)], b = new_rank[int32_t(key & 0xffffffffu)];
+    return a < 0 || b < 0 ? uint64_t(-1) : pair_key(a, b);
+  };
+  size_t kept = 0;
+  for (uint64_t key : seen_pairs)
+    if (const uint64_t k = renumbered(key); k != uint64_t(-1)) seen_pairs[kept++] = k;
+  seen_pairs.resize(kept);
+  kept = 0;
+  for (const auto& [key, copies] : feature_pairs)
+    if (const uint64_t k = renumbered(key); k != uint64_t(-1)) feature_pairs[kept++] = {k, copies};
+  feature_pairs.resize(kept);
+  samples = count;
+  chi6 = std::move(new_chi6);
+  absorbed = std::move(new_absorbed);
+  revisit = std::move(new_revisit);
+}
 
 std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layout, int32_t num_samples,
                                     const Clustering& c) {
@@ -376,7 +414,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // --- the samples to evaluate ------------------------------------------------------------------
   // All of them, or after a repair round only those whose link may have changed; the others
   // keep what the last check found. Unchanged triangles keep their zero-area flags too.
-  const bool incremental = carried.links_valid && carried.samples <= k;
+  const bool incremental = carried.links_valid && carried.emitted_valid && carried.links.samples <= k;
   std::vector<uint8_t> sliver;  // per emitted triangle: 0, 1 or kUntested
   if (keep_slivers) sliver = std::move(kept_sliver);
   else if (check_slivers) sliver.assign(emitted, kUntested);
@@ -423,18 +461,18 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     return vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot);
   };
   // The last check's values are taken over (new samples start at 0) and handed back below.
-  std::vector<int64_t> chi6_out = incremental ? std::move(carried.chi6) : std::vector<int64_t>();
+  std::vector<int64_t> chi6_out = incremental ? std::move(carried.links.chi6) : std::vector<int64_t>();
   chi6_out.resize(k, 0);
   out.absorbed.assign(k, 0);
   if (incremental) {
-    std::copy(carried.absorbed.begin(), carried.absorbed.end(), out.absorbed.begin());
+    std::copy(carried.links.absorbed.begin(), carried.links.absorbed.end(), out.absorbed.begin());
     for (int32_t s : todo) chi6_out[s] = 0, out.absorbed[s] = 0;
   }
   std::vector<uint8_t> drop(emitted, 0);
   bool any_dropped = false;  // drop is read only once pillows are dropped
   PerThread<std::vector<uint64_t>> seen_pairs(threads);
   if (incremental)  // the pairs seen by samples not evaluated again (a pair is seen from its lower rank)
-    for (uint64_t key : carried.seen_pairs)
+    for (uint64_t key : carried.links.seen_pairs)
       if (!affected[int32_t(key >> 32)]) seen_pairs[0].push_back(key);
   PerThread<std::vector<int32_t>> repeated_lists(threads), named_lists(threads);
   int32_t bad_link = 0, bad_edge = 0, isolated = 0;
@@ -635,17 +673,17 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // pillow's samples are evaluated again anyway), and what each sample's link gave.
   if (state) {
     carried.emitted_valid = carried.links_valid = true;
-    carried.samples = k;
+    carried.links.samples = k;
     carried.emitted.faces = out.source_face;
     carried.emitted.triangles = out.triangles;
     carried.emitted.sliver = std::move(sliver);
     carried.emitted.slivers_checked = check_slivers;
-    carried.absorbed = out.absorbed;
-    carried.revisit.clear();
-    append_and_clear(repeated_lists, carried.revisit);
-    append_and_clear(named_lists, carried.revisit);
-    carried.seen_pairs = std::move(seen);
-    carried.feature_pairs = std::move(feature_pairs);
+    carried.links.absorbed = out.absorbed;
+    carried.links.revisit.clear();
+    append_and_clear(repeated_lists, carried.links.revisit);
+    append_and_clear(named_lists, carried.links.revisit);
+    carried.links.seen_pairs = std::move(seen);
+    carried.links.feature_pairs = std::move(feature_pairs);
   }
   if (any_dropped) {
     // Dropped pillows leave the output.
@@ -669,7 +707,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     sample_component[s] = mesh.component()[samples[s]];
     component_chi6[sample_component[s]] += chi6_out[s];
   }
-  if (state) carried.chi6 = std::move(chi6_out);  // for the next round's check
+  if (state) carried.links.chi6 = std::move(chi6_out);  // for the next round's check
   for (size_t i = 0; i < out.source_face.size(); ++i) ++component_triangles[sample_component[out.triangles[3 * i]]];
   std::vector<uint8_t> failing(num_components, 0);
   for (int32_t comp = 0; comp < num_components; ++comp)

@@ -1,12 +1,14 @@
 // What one decimation leaves for the next on the same mesh and feature layout: the flood of
-// its drawn samples (before any repair) and which faces that flood emits.
+// its drawn samples (before any repair), which faces that flood emits, and what its first
+// check found.
 //
 // A slider drag asks for nearby targets with the same seed, and their draws share most samples
 // (horse at 10 %: a 0.3 % step keeps 77,419 of 77,425 and adds 2,325). A decimation given a
-// cache turns the cached flood into its own with flood_update (clustering.hpp) and re-tests
-// only the faces around the vertices that changed, which gives exactly the clustering and the
-// emitting faces a fresh flood gives: the result is the same mesh, only sooner. Draws that
-// share little (another seed, a far lower target) flood afresh and refill the cache.
+// cache turns the cached flood into its own with flood_update (clustering.hpp), re-tests only
+// the faces around the vertices that changed and evaluates only the samples whose triangles
+// changed, which gives exactly the clustering, the emitting faces and the issues a fresh flood
+// gives: the result is the same mesh, only sooner. Draws that share little (another seed, a far
+// lower target) flood afresh and refill the cache.
 #pragma once
 
 #include <cstdint>
@@ -29,6 +31,8 @@ struct FloodCache {
   bool emits_valid = false;              ///< emits is filled (a fast-path flood leaves it empty)
   EmittedTriangles emitted;              ///< what the first check of that flood emitted (if emitted_valid)
   bool emitted_valid = false;
+  SampleLinks links;                     ///< what that check found per sample (if links_valid)
+  bool links_valid = false;
 
   bool holds(const Mesh& m, const FeatureLayout& l) const {
     return mesh == m.serial() && layout == l.serial && clustering.num_vertices() == m.num_vertices();
@@ -41,7 +45,7 @@ struct FloodCache {
 /// The caches of one mesh and layout, shared by the threads that decimate it: each decimation
 /// takes one that no other is using (or a new one, up to `capacity`) and gives it back. The
 /// preview's two workers thus each find the flood of the request before their last.
-/// Memory: 9 bytes per vertex, 1 per triangle and 17 per emitted triangle per cache.
+/// Memory: 9 bytes per vertex, 1 per triangle, 17 per emitted triangle and 9 per sample per cache.
 class FloodCachePool {
  public:
   explicit FloodCachePool(size_t capacity = 2) : capacity_(capacity) {}

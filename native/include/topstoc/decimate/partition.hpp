@@ -69,6 +69,23 @@ struct EmittedTriangles {
   }
 };
 
+/// What a check found from each sample's link (the triangles around it). A later check over
+/// nearly the same triangles evaluates only the samples whose link changed and takes the
+/// others' over (FloodCache keeps one).
+struct SampleLinks {
+  int32_t samples = 0;                                      ///< how many samples (those appended later are new)
+  std::vector<int64_t> chi6;                                ///< per sample: its Euler contribution, times 6
+  std::vector<uint8_t> absorbed;                            ///< per sample: no triangle, absorbed
+  std::vector<int32_t> revisit;                             ///< samples to evaluate again whatever changes
+  std::vector<uint64_t> seen_pairs;                         ///< feature pairs found in a link, sorted
+  std::vector<std::pair<uint64_t, int32_t>> feature_pairs;  ///< feature pairs and their copies, sorted
+  /// Puts everything in the ranks of another sample list of `count` samples (flood_update's
+  /// new_rank, -1 for a removed sample). Samples that are new or absorbed (whether a sample
+  /// may be absorbed depends on the decimation's control points) join the revisit list; pairs
+  /// with a removed sample are dropped.
+  void renumber(const std::vector<int32_t>& new_rank, int32_t count);
+};
+
 /// What the last check of one decimation found, kept for the next round's check. After
 /// flood_add only the faces around the vertices that changed are tested again, and only the
 /// samples whose link (the triangles around them) may differ are evaluated again: a repair
@@ -84,14 +101,9 @@ struct CheckState {
   bool emitted_valid = false;  ///< `emitted` holds the last check's
   EmittedTriangles emitted;
 
-  // The samples' links as the last check evaluated them.
-  bool links_valid = false;                ///< the fields below hold the last check's
-  int32_t samples = 0;                     ///< how many samples it had (new ones are appended)
-  std::vector<int64_t> chi6;                                ///< per sample: its Euler contribution, times 6
-  std::vector<uint8_t> absorbed;                            ///< per sample: no triangle, absorbed
-  std::vector<int32_t> revisit;                             ///< samples with an issue or a repeated triangle
-  std::vector<uint64_t> seen_pairs;                         ///< feature pairs found in a link, sorted
-  std::vector<std::pair<uint64_t, int32_t>> feature_pairs;  ///< feature pairs and their copies, sorted
+  // The samples' links as the last check evaluated them (needs `emitted` valid too).
+  bool links_valid = false;
+  SampleLinks links;
 };
 
 /// Emits triangles and checks them. `required` marks vertices whose samples must appear in the
