@@ -12,6 +12,7 @@
 #include <omp.h>
 
 #include "core/counting_sort.hpp"
+#include "topstoc/core/buffer.hpp"
 #include "core/id_bits.hpp"
 #include "core/ordered_sum.hpp"
 #include "topstoc/core/random.hpp"
@@ -300,21 +301,24 @@ double solve_guided_rate(const Mesh& mesh, const std::vector<uint8_t>& cls, cons
 // below the root and converge monotonically; a bracket guards against round-off. The draw
 // fixes the count anyway, so k need only be close. Each evaluation reads the sorted q and
 // their prefix sums: the vertices with k q < 1 are a prefix, the rest count 1 each.
-double solve_rate(const ImportanceTable& table, double target) {
+// The sum of the probabilities without guidance at rate k (the expected sample count), and
+// its derivative.
+double expected_count(const ImportanceTable& table, double k, double& slope) {
   const size_t surfaces = table.surface_q.size(), curves = table.curve_q.size();
+  const double limit = k > 0 ? 1.0 / k : std::numeric_limits<double>::infinity();
+  const size_t s = std::lower_bound(table.surface_q.begin(), table.surface_q.end(), limit) - table.surface_q.begin();
+  const size_t c = std::lower_bound(table.curve_q.begin(), table.curve_q.end(), limit) - table.curve_q.begin();
+  const double root = std::sqrt(k);
+  slope = table.surface_sum[s] + (k > 0 ? 0.5 * table.curve_sqrt_sum[c] / root : 0.0);
+  return table.corners + k * table.surface_sum[s] + double(surfaces - s) + root * table.curve_sqrt_sum[c] +
+         double(curves - c);
+}
+
+double solve_rate(const ImportanceTable& table, double target) {
   double min_q = 1e300;
-  if (surfaces) min_q = std::min(min_q, table.surface_q.front());
-  if (curves) min_q = std::min(min_q, table.curve_q.front());
-  // Sum of the probabilities at k and its derivative.
-  auto evaluate = [&](double k, double& slope) {
-    const double limit = k > 0 ? 1.0 / k : std::numeric_limits<double>::infinity();
-    const size_t s = std::lower_bound(table.surface_q.begin(), table.surface_q.end(), limit) - table.surface_q.begin();
-    const size_t c = std::lower_bound(table.curve_q.begin(), table.curve_q.end(), limit) - table.curve_q.begin();
-    const double root = std::sqrt(k);
-    slope = table.surface_sum[s] + (k > 0 ? 0.5 * table.curve_sqrt_sum[c] / root : 0.0);
-    return table.corners + k * table.surface_sum[s] + double(surfaces - s) + root * table.curve_sqrt_sum[c] +
-           double(curves - c);
-  };
+  if (!table.surface_q.empty()) min_q = std::min(min_q, table.surface_q.front());
+  if (!table.curve_q.empty()) min_q = std::min(min_q, table.curve_q.front());
+  auto evaluate = [&](double k, double& slope) { return expected_count(table, k, slope); };
   if (table.total_q <= 0 || target <= table.corners) return 0.0;
   double lo = 0.0, hi = min_q < 1e300 ? 1.0 / min_q : 1.0;
   double slope = 0.0;
@@ -350,10 +354,11 @@ struct SelectionUniforms {
 };
 
 std::shared_ptr<const SelectionUniforms> selection_uniforms(const Mesh& mesh, const FeatureLayout& layout,
-                                                            uint64_t seed) {
+                                                            uint64_t seed, bool& reused) {
   auto cached = std::static_pointer_cast<const SelectionUniforms>(layout.selection_uniforms.get());
   const int32_t n = mesh.num_vertices();
-  if (cached && cached->seed == seed && int32_t(cached->u.size()) == n) return cached;
+  reused = cached && cached->seed == seed && int32_t(cached->u.size()) == n;
+  if (reused) return cached;
   auto table = std::make_shared<SelectionUniforms>();
   table->seed = seed;
   table->u.resize(n);
@@ -362,6 +367,17 @@ std::shared_ptr<const SelectionUniforms> selection_uniforms(const Mesh& mesh, co
     table->u[v] = uniform01(seed, kStreamSelection, uint64_t(mesh.vertex_source()[v]));
   layout.selection_uniforms.set(table);
   return table;
+}
+
+// True when a vertex of uniform u and probability pv (0 < pv < 1) has its Pareto key
+// (u / (1 - u)) ((1 - pv) / pv) below `threshold`; the key is set then.
+inline bool pareto_key_below(double u, double pv, double threshold, double& key) {
+  // key < threshold without the two divisions (most vertices fail it); the key itself is
+  // computed as before for those that pass. A vertex whose rounding differs sits at the
+  // threshold, far above the keys the draw takes (the threshold leaves a margin).
+  if (u * (1.0 - pv) >= threshold * pv * (1.0 - u)) return false;
+  key = (u / (1.0 - u)) * ((1.0 - pv) / pv);
+  return key < threshold;
 }
 
 // Candidates with Pareto key (U / (1 - U)) ((1 - p) / p) below `threshold`, in vertex order;
@@ -383,14 +399,9 @@ std::vector<Candidate> pareto_candidates(const Mesh& mesh, const SelectionUnifor
         const double pv = probability(v);
         block.sum += pv;
         if (pv >= 1.0 && forced) block.forced.push_back(v);
-        if (!(pv > 0.0 && pv < 1.0)) return;
-        const double u = uniforms.u[v];
-        // key < threshold without the two divisions (most vertices fail it); the key itself
-        // is computed as before for those that pass. A vertex whose rounding differs sits at
-        // the threshold, far above the keys the draw takes (the threshold leaves a margin).
-        if (u * (1.0 - pv) >= threshold * pv * (1.0 - u)) return;
-        const double key = (u / (1.0 - u)) * ((1.0 - pv) / pv);
-        if (key < threshold) block.candidates.push_back({key, v});
+        double key;
+        if (pv > 0.0 && pv < 1.0 && pareto_key_below(uniforms.u[v], pv, threshold, key))
+          block.candidates.push_back({key, v});
       },
       [](Found& total, const Found& block) {
         total.sum += block.sum;
@@ -400,6 +411,100 @@ std::vector<Candidate> pareto_candidates(const Mesh& mesh, const SelectionUnifor
   if (forced) *forced = std::move(found.forced);
   if (sum) *sum = found.sum;
   return std::move(found.candidates);
+}
+
+// A slider draws again and again with one seed at changing rates k. Without guidance, a
+// vertex's key falls below the draw's first threshold T exactly when k exceeds
+//   r(v) = p* / q(v) on a surface, p*^2 / q(v) on a curve, where p* = U / (U + T (1 - U))
+// (the key is below T when p > p*, and p = k q or sqrt(k q)). So, with the vertices ordered by
+// r, the candidates at any rate are among a prefix: a draw tests those (horse at 10 %: about
+// 100,000 of 776,000 vertices) with the same test as the pass over all vertices, and finds
+// the same candidates. Ordered by buckets of r, each in vertex order, with each vertex's U and
+// q alongside: read in this order from the per-vertex arrays, the prefix cost more than a pass
+// over every vertex.
+constexpr double kFirstThreshold = 1.25;  // the first threshold without density control
+constexpr int32_t kRateBuckets = 8 * 20;   // an eighth of a binade each, from 2^-12 to 2^8
+
+struct CandidateOrder {
+  uint64_t seed = 0;
+  std::shared_ptr<const ImportanceTable> table;  // the table it was made from
+  std::vector<int32_t> corners;                  // always drawn (p = 1)
+  std::vector<int32_t> offsets;                  // the first position of every bucket, then the count
+  Buffer<int32_t> vertices;                      // surface and curve vertices with q > 0, by bucket of r
+  Buffer<double> u;                              // ... their uniforms
+  Buffer<double> q;                              // ... their q, negated on a curve
+};
+
+// Buckets 9 % wide (the exponent and the top three bits of the mantissa): few enough for one
+// counting pass (one over 65,536 buckets of 3 % took 15-21 ms on the horse, its writes
+// scattered over as many places). Smaller r share the first bucket (candidates at any rate a
+// slider asks for), larger ones the last.
+inline int32_t rate_bucket(double r) {
+  uint64_t bits;
+  std::memcpy(&bits, &r, sizeof bits);  // r >= 0
+  const int64_t eighths = int64_t(bits >> 49) - int64_t(1023 - 12) * 8;
+  return int32_t(std::clamp<int64_t>(eighths, 0, kRateBuckets - 1));
+}
+
+// The order for this seed and table: made on the second draw with the same seed (a slider's),
+// so that a single decimation does not pay for it; null until then.
+std::shared_ptr<const CandidateOrder> candidate_order(const Mesh& mesh, const FeatureLayout& layout,
+                                                      const std::shared_ptr<const ImportanceTable>& table,
+                                                      const SelectionUniforms& uniforms, bool uniforms_reused) {
+  auto cached = std::static_pointer_cast<const CandidateOrder>(layout.candidate_order.get());
+  if (cached && cached->seed == uniforms.seed && cached->table == table) return cached;
+  if (!uniforms_reused) return nullptr;
+  auto order = std::make_shared<CandidateOrder>();
+  order->seed = uniforms.seed;
+  order->table = table;
+  const int32_t n = mesh.num_vertices();
+  constexpr int32_t kNone = kRateBuckets;  // not drawn at random: a corner, isolated, or q = 0
+  Buffer<uint8_t> bucket(n);
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) {
+    const uint8_t cls = table->cls[v];
+    const double q = table->q[v], u = uniforms.u[v];
+    const double p_star = u / (u + kFirstThreshold * (1.0 - u));
+    bucket[v] = uint8_t((cls != kSurface && cls != kCurve) || !(q > 0.0) ? kNone
+                        : cls == kCurve                                  ? rate_bucket(p_star * p_star / q)
+                                                                         : rate_bucket(p_star / q));
+  }
+  for (int32_t v = 0; v < n; ++v)
+    if (table->cls[v] == kCorner) order->corners.push_back(v);
+  order->vertices.resize(n);
+  order->u.resize(n);
+  order->q.resize(n);
+  stable_counting_sort(n, kNone + 1, [&](int64_t v) { return bucket[v]; },
+                       [&](int64_t v, int32_t at) {
+                         order->vertices[at] = int32_t(v);
+                         order->u[at] = uniforms.u[v];
+                         order->q[at] = table->cls[v] == kCurve ? -table->q[v] : table->q[v];
+                       },
+                       order->offsets);
+  const int32_t drawn = order->offsets[kNone];
+  order->vertices.resize(drawn);
+  order->u.resize(drawn);
+  order->q.resize(drawn);
+  order->offsets.resize(kNone + 1);
+  layout.candidate_order.set(order);
+  return order;
+}
+
+// What pareto_candidates(threshold kFirstThreshold) finds without guidance, from the order.
+void candidates_in_order(const CandidateOrder& order, double rate, std::vector<int32_t>& forced,
+                         std::vector<Candidate>& candidates) {
+  forced = order.corners;
+  // Every vertex whose test can pass has r at most the rate (up to rounding: a margin). (On
+  // one thread: two took as long, 2.5 against 2.3 ms on the horse.)
+  const int32_t end = order.offsets[rate_bucket(rate * (1.0 + 1e-6)) + 1];
+  for (int32_t i = 0; i < end; ++i) {
+    const double q = order.q[i];
+    const double pv = plain_probability(q < 0 ? kCurve : kSurface, std::abs(q), rate);
+    double key;
+    if (pv >= 1.0) forced.push_back(order.vertices[i]);
+    else if (pv > 0.0 && pareto_key_below(order.u[i], pv, kFirstThreshold, key))
+      candidates.push_back({key, order.vertices[i]});
+  }
 }
 
 // Sorts distinct vertex ids in [0, n): a bit per vertex, read back in order (a tenth of the cost of
@@ -627,20 +732,32 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
   // control points) can push it over.
   const int32_t count = target;
   const bool density = params.density != DensityMode::Off;
-  const auto uniforms = selection_uniforms(mesh, layout, params.seed);
+  bool uniforms_reused = false;
+  const auto uniforms = selection_uniforms(mesh, layout, params.seed, uniforms_reused);
+  const bool plain = !has_per_vertex_guidance(params);
+  // (The order's pass gives the candidates of the first threshold only.)
+  const auto order = plain && !density ? candidate_order(mesh, layout, table, *uniforms, uniforms_reused) : nullptr;
   auto draw = [&](const auto& probability) {
     // Pareto keys: with threshold 1 the expected number of keys below it is exactly the sum of
     // the probabilities, so a slightly larger threshold keeps a small superset of what the draw
     // needs; if it falls short (tiny targets), the threshold grows. The first pass also finds
-    // the forced vertices and the expected count.
-    const double first_threshold = density ? 3.0 : 1.25;
+    // the forced vertices (and, with guidance, the expected count). A slider's later draws
+    // find the same in the kept order.
+    const double first_threshold = density ? 3.0 : kFirstThreshold;
     std::vector<int32_t> forced;
-    std::vector<Candidate> candidates =
-        pareto_candidates(mesh, *uniforms, probability, first_threshold, &forced, &out.expected);
+    std::vector<Candidate> candidates;
+    if (order) candidates_in_order(*order, out.rate, forced, candidates);
+    else candidates = pareto_candidates(mesh, *uniforms, probability, first_threshold, &forced, plain ? nullptr : &out.expected);
+    // Without guidance the sum of the probabilities comes from the table: the same value
+    // whichever way the candidates were found.
+    double slope;
+    if (plain) out.expected = expected_count(*table, out.rate, slope);
     out.forced = static_cast<int32_t>(forced.size());
     const int32_t free_count = std::max<int32_t>(0, count - out.forced);
+    // (Nothing to widen when the forced vertices fill the count: ten passes found no candidate
+    // at rate 0.)
     for (double threshold = first_threshold;
-         threshold <= 1e6 && int64_t(candidates.size()) < int64_t(density ? 2 : 1) * free_count + 16;) {
+         free_count > 0 && threshold <= 1e6 && int64_t(candidates.size()) < int64_t(density ? 2 : 1) * free_count + 16;) {
       threshold *= 4;
       candidates = pareto_candidates(mesh, *uniforms, probability, threshold);
     }
@@ -660,7 +777,7 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
                                         std::max(count, out.forced), out.density_rejected);
     }
   };
-  if (!has_per_vertex_guidance(params)) {
+  if (plain) {
     // Without per-vertex guidance p is a formula of the class, q and the rate: computed where
     // it is read instead of written to and read back from n doubles (a slider draws anew for
     // every frame).

@@ -1,0 +1,104 @@
+// The draw without guidance against its definition (sampling.hpp): the vertices with p = 1, and
+// of the others the target's remainder with the smallest Pareto keys (U/(1-U)) ((1-p)/p), U the
+// vertex's uniform for the seed. A slider's draws with one seed take a faster way after the
+// first (a candidate order kept on the layout); both ways must give the definition's samples.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <functional>
+#include <memory>
+#include <numeric>
+#include <vector>
+
+#include "meshes.hpp"
+#include "topstoc/core/random.hpp"
+#include "topstoc/decimate/features.hpp"
+#include "topstoc/decimate/sampling.hpp"
+#include "topstoc/io/io.hpp"
+
+using namespace topstoc;
+
+namespace {
+
+// The definition, by sorting every vertex's key.
+std::vector<int32_t> defined_draw(const Mesh& mesh, const FeatureLayout& layout, const SamplingParams& params,
+                                  int32_t target, double rate) {
+  const auto p = sampling_probabilities(mesh, layout, params, rate);
+  std::vector<int32_t> drawn;
+  std::vector<std::pair<double, int32_t>> keys;
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    if (p[v] >= 1.0) {
+      drawn.push_back(v);
+    } else if (p[v] > 0.0) {
+      const double u = uniform01(params.seed, 1, uint64_t(mesh.vertex_source()[v]));
+      keys.push_back({(u / (1.0 - u)) * ((1.0 - p[v]) / p[v]), v});
+    }
+  }
+  std::sort(keys.begin(), keys.end());
+  const size_t take = std::min(keys.size(), size_t(std::max<int64_t>(0, int64_t(target) - int64_t(drawn.size()))));
+  for (size_t i = 0; i < take; ++i) drawn.push_back(keys[i].second);
+  std::sort(drawn.begin(), drawn.end());
+  return drawn;
+}
+
+// Targets from most vertices down to fewer than the corners, and back up; two seeds. Each draw is
+// made on a fresh layout (a first draw: every vertex tested) and on one layout kept across the
+// draws of a seed (a slider: the kept order after the first), and both must be the definition.
+void check_draws(const Mesh& mesh, const std::function<std::shared_ptr<const FeatureLayout>()>& make_layout) {
+  const auto layout = make_layout();
+  const int32_t n = mesh.num_vertices();
+  int32_t corners = 0;
+  for (int32_t v = 0; v < n; ++v) corners += layout->vertex_corner[v];
+  std::vector<int32_t> targets;
+  for (double f : {0.6, 0.3, 0.2, 0.1, 0.05, 0.02, 0.01, 0.003}) targets.push_back(std::max(1, int32_t(f * n)));
+  targets.push_back(corners + 3);
+  targets.push_back(corners / 2);
+  for (double f : {0.004, 0.04, 0.4, 0.97}) targets.push_back(int32_t(f * n));
+  for (uint64_t seed : {1, 2}) {
+    SamplingParams params;
+    params.seed = seed;
+    const auto slider = make_layout();
+    int32_t ordered = 0;
+    for (int32_t target : targets) {
+      CAPTURE(seed);
+      CAPTURE(target);
+      const SampleSet first = select_samples(mesh, *make_layout(), params, target);
+      const SampleSet later = select_samples(mesh, *slider, params, target);
+      const auto defined = defined_draw(mesh, *layout, params, target, first.rate);
+      CHECK(first.samples == defined);
+      CHECK(later.samples == defined);
+      CHECK(later.forced == first.forced);
+      CHECK(later.expected == first.expected);  // to the bit, whichever way
+      const auto p = sampling_probabilities(mesh, *layout, params, first.rate);
+      CHECK(first.expected == doctest::Approx(std::accumulate(p.begin(), p.end(), 0.0)).epsilon(1e-9));
+      ordered += slider->candidate_order.get() != nullptr;
+    }
+    CHECK(ordered == int32_t(targets.size()) - 1);  // every draw after the first had the order
+  }
+}
+
+}  // namespace
+
+TEST_CASE("draws without guidance take the smallest Pareto keys, the first draw of a seed and the later ones") {
+  SUBCASE("a mesh with holes (tests/data): boundary curves, p = sqrt(k q)") {
+    const MeshFile file = read_mesh_path(TOPSTOC_TEST_DATA "/open_boundary/cgal_elephant-with-holes.off");
+    const Mesh mesh(file.vertices, file.triangles.data(), file.num_triangles());
+    auto make_layout = [&]() { return build_feature_layout(mesh, nullptr, 0, nullptr, 0, 0.0); };
+    const auto layout = make_layout();
+    REQUIRE(std::count(layout->vertex_feature.begin(), layout->vertex_feature.end(), 1) > 100);
+    check_draws(mesh, make_layout);
+  }
+  SUBCASE("a grid with a row and a column as borders: corners, p = 1") {
+    const auto arrays = topstoc_test::grid(60, 50);
+    const Mesh mesh(arrays.positions, arrays.triangles.data(), arrays.num_triangles());
+    std::vector<int32_t> border;
+    for (int32_t j = 0; j < 50; ++j) border.insert(border.end(), {20 * 51 + j, 20 * 51 + j + 1});  // column 20
+    for (int32_t i = 0; i < 60; ++i) border.insert(border.end(), {i * 51 + 30, (i + 1) * 51 + 30});  // row 30
+    auto make_layout = [&]() {
+      return build_feature_layout(mesh, nullptr, 0, border.data(), int64_t(border.size() / 2), 0.0);
+    };
+    const auto layout = make_layout();
+    REQUIRE(std::count(layout->vertex_corner.begin(), layout->vertex_corner.end(), 1) >= 5);
+    check_draws(mesh, make_layout);
+  }
+}
