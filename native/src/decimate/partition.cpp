@@ -412,8 +412,9 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   std::sort(feature_pairs.begin(), feature_pairs.end());
 
   // --- the samples to evaluate ------------------------------------------------------------------
-  // All of them, or after a repair round only those whose link may have changed; the others
-  // keep what the last check found. Unchanged triangles keep their zero-area flags too.
+  // All of them, or after a repair round or a flood update (a slider frame) only those whose
+  // link may have changed; the others keep what the last check found. Unchanged triangles keep
+  // their zero-area flags too.
   const bool incremental = carried.links_valid && carried.emitted_valid && carried.links.samples <= k;
   std::vector<uint8_t> sliver;  // per emitted triangle: 0, 1 or kUntested
   if (keep_slivers) sliver = std::move(kept_sliver);
