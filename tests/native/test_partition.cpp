@@ -197,7 +197,7 @@ TEST_CASE("a check after flood_update, given the old flood's triangles and links
       flood(mesh, *kase.layout, old_samples, clustering);
       CheckState first;
       check_partition(mesh, *kase.layout, old_samples, clustering, none_required, true, nullptr, &first);
-      CheckState state;
+      CheckState state = first;
       std::vector<int32_t> new_rank;
       flood_update(mesh, *kase.layout, old_samples, samples, clustering, &state.changed, &new_rank);
       std::vector<uint8_t> required = none_required;
@@ -205,16 +205,7 @@ TEST_CASE("a check after flood_update, given the old flood's triangles and links
         const Partition absorbing = check_partition(mesh, *kase.layout, samples, clustering, none_required, true);
         for (size_t s = 0; s < absorbing.absorbed.size(); ++s) required[samples[s]] = absorbing.absorbed[s];
       }
-      state.emits = first.emits;
-      state.valid = first.valid;
-      state.emitted = first.emitted;
-      state.emitted.renumber(new_rank);
-      state.emitted_valid = first.emitted_valid;
-      if (first.links_valid) {
-        state.links = first.links;
-        state.links.renumber(new_rank, int32_t(samples.size()));
-        state.links_valid = true;
-      }
+      state.renumber(new_rank, int32_t(samples.size()));
       const bool can_patch = state.valid && state.emitted_valid && state.changed.size() <= size_t(mesh.num_vertices() / 16);
       const Partition kept = check_partition(mesh, *kase.layout, samples, clustering, required, true, nullptr, &state);
       const Partition fresh = check_partition(mesh, *kase.layout, samples, clustering, required, true);
@@ -258,7 +249,7 @@ TEST_CASE("a check after flood_update that leaves a small component without samp
   std::vector<int32_t> new_rank;
   state.changed.clear();
   flood_update(mesh, *layout, old_samples, samples, clustering, &state.changed, &new_rank);
-  state.emitted.renumber(new_rank);
+  state.renumber(new_rank, int32_t(samples.size()));
   REQUIRE(state.changed.size() <= size_t(mesh.num_vertices() / 16));  // the patched path
   const Partition kept = check_partition(mesh, *layout, samples, clustering, required, false, nullptr, &state);
   CHECK(kept.issues.unreached == 3);

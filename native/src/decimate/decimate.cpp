@@ -275,32 +275,19 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     // The cached flood becomes this one (the same keys a fresh flood gives); the first check
     // then re-tests only the faces around the vertices that changed. The cache keeps the
     // flood without the repairs below.
+    // The first check of the cached flood, given back after this one's, updated. In the new
+    // ranks, its triangles are taken over except around the vertices that changed (whose old
+    // ranks may be gone; zero-area flags: the same vertices, same areas), and its per-sample
+    // findings except for the samples whose triangles changed.
+    checked = std::move(cache->first_check);
+    cache->first_check = CheckState();
+    checked.changed.clear();
     std::vector<int32_t> new_rank;
     flood_update(mesh, layout, cache->samples, samples, cache->clustering, &checked.changed, &new_rank);
     cache->samples = samples;
     clustering = cache->clustering;
-    if (cache->emits_valid) {
-      checked.emits = std::move(cache->emits);  // given back after the first check, updated
-      checked.valid = true;
-      if (cache->emitted_valid) {
-        // The cached flood's triangles, in the new ranks: the check re-writes only those of
-        // the faces around changed vertices (whose old ranks may be gone).
-        checked.emitted = std::move(cache->emitted);  // (zero-area flags: the same vertices, same areas)
-        checked.emitted.renumber(new_rank);
-        checked.emitted_valid = true;
-        cache->emitted_valid = false;
-        if (cache->links_valid) {
-          // And what it found per sample: only the samples whose triangles changed are
-          // evaluated again.
-          checked.links = std::move(cache->links);
-          checked.links.renumber(new_rank, int32_t(samples.size()));
-          checked.links_valid = true;
-          cache->links_valid = false;
-        }
-      }
-    } else {
-      checked.changed.clear();  // every face is tested
-    }
+    checked.renumber(new_rank, int32_t(samples.size()));
+    if (!checked.valid) checked.changed.clear();  // every face is tested
     result.flood_updated = true;
   } else {
     flood(mesh, layout, samples, clustering, fast_path ? &cross_edges : nullptr);
@@ -309,7 +296,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       cache->layout = layout.serial;
       cache->samples = samples;
       cache->clustering = clustering;
-      cache->emits_valid = cache->emitted_valid = cache->links_valid = false;
+      cache->first_check = CheckState();
     }
   }
   result.seconds_clustering = seconds_since(start);
@@ -347,15 +334,10 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       partition = check_partition(mesh, layout, samples, clustering, required, slivers, nullptr, &checked);
     }
     if (cache) {
-      // Emits of the cached flood, from the first check only (repairs change the clustering
-      // from here on, and seeding rounds repeat round 0). An early return (unreached
-      // vertices) leaves them valid only after testing every face.
-      cache->emits_valid = checked.valid && checked.changed.empty();
-      if (cache->emits_valid) cache->emits = checked.emits;
-      cache->emitted_valid = cache->emits_valid && checked.emitted_valid;
-      if (cache->emitted_valid) cache->emitted = checked.emitted;
-      cache->links_valid = cache->emitted_valid && checked.links_valid;
-      if (cache->links_valid) cache->links = checked.links;
+      // What the first check found, for the cached flood (repairs change the clustering from
+      // here on, and seeding rounds repeat round 0).
+      cache->first_check = checked;
+      cache->first_check.keep_complete();
       cache = nullptr;
     }
     accumulate(result.issues_found, partition.issues);

@@ -27,12 +27,7 @@ void FloodCache::clear() {
   mesh = layout = 0;
   samples = {};
   clustering = {};
-  emits = {};
-  emits_valid = false;
-  emitted = {};
-  emitted_valid = false;
-  links = {};
-  links_valid = false;
+  first_check = {};
 }
 
 std::unique_ptr<FloodCache> FloodCachePool::take() {

@@ -27,12 +27,8 @@ struct FloodCache {
   uint64_t mesh = 0, layout = 0;         ///< serials of what the cache was made on (0: empty)
   std::vector<int32_t> samples;          ///< the drawn samples (increasing vertex ids)
   Clustering clustering;                 ///< flood(samples)
-  std::vector<uint8_t> emits;            ///< per face: corners in three clusters of that flood
-  bool emits_valid = false;              ///< emits is filled (a fast-path flood leaves it empty)
-  EmittedTriangles emitted;              ///< what the first check of that flood emitted (if emitted_valid)
-  bool emitted_valid = false;
-  SampleLinks links;                     ///< what that check found per sample (if links_valid)
-  bool links_valid = false;
+  CheckState first_check;                ///< what the first check of that flood found (its emitting
+                                         ///< faces, triangles and per-sample findings, where valid)
 
   bool holds(const Mesh& m, const FeatureLayout& l) const {
     return mesh == m.serial() && layout == l.serial && clustering.num_vertices() == m.num_vertices();

@@ -104,6 +104,21 @@ struct CheckState {
   // The samples' links as the last check evaluated them (needs `emitted` valid too).
   bool links_valid = false;
   SampleLinks links;
+
+  /// Puts the triangles and the per-sample findings in the ranks of flood_update's new sample
+  /// list of `count` samples (new_rank: each old sample's new rank, -1 if removed).
+  void renumber(const std::vector<int32_t>& new_rank, int32_t count) {
+    if (emitted_valid) emitted.renumber(new_rank);
+    if (links_valid) links.renumber(new_rank, count);
+  }
+  /// Keeps only what a later check may take over: a check that stopped at unreached vertices
+  /// after re-testing around changed ones leaves `changed` set, and each part needs the one
+  /// before it (the links the triangles, the triangles the emits).
+  void keep_complete() {
+    valid = valid && changed.empty();
+    emitted_valid = emitted_valid && valid;
+    links_valid = links_valid && emitted_valid;
+  }
 };
 
 /// Emits triangles and checks them. `required` marks vertices whose samples must appear in the
