@@ -12,18 +12,19 @@
 #include <omp.h>
 
 #include "core/counting_sort.hpp"
-#include "topstoc/core/buffer.hpp"
 #include "core/id_bits.hpp"
 #include "core/ordered_sum.hpp"
+#include "decimate/candidate_order.hpp"
+#include "decimate/draw.hpp"
 #include "topstoc/core/random.hpp"
 
 namespace topstoc {
 
+using namespace draw;  // the classes, tables and key test shared with candidate_order.cpp
+
 namespace {
 
 constexpr uint64_t kStreamSelection = 1;
-
-enum VertexClass : uint8_t { kIsolated = 0, kSurface = 1, kCurve = 2, kCorner = 3 };
 
 std::vector<uint8_t> classify(const Mesh& mesh, const FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
@@ -90,21 +91,6 @@ double apply_view(const ViewGuidance& view, const double* position, const double
   if (view.frustum && !inside_frustum(view, position)) p = std::min(p, view.outside_probability);
   return p;
 }
-
-// Per-vertex class and importance q (0 where not sampled stochastically), with q sorted per
-// class for solving the rate. Depends on the mesh, the layout and three parameters only, so it
-// is kept on the layout and reused while they stay the same (a slider changes only the target).
-struct ImportanceTable {
-  double adaptivity = 0.0, flat_floor = 0.0;
-  bool area_weighted = false;
-  std::vector<uint8_t> cls;
-  std::vector<double> q;
-  std::vector<double> surface_q, surface_sum;    // sorted ascending; prefix sums of q
-  std::vector<double> curve_q, curve_sqrt_sum;   // sorted ascending; prefix sums of sqrt(q)
-  double corners = 0.0;
-  double total_q = 0.0;  // over surface and curve vertices
-  int32_t active = 0;    // vertices in triangles
-};
 
 // Sorts ascending, exactly as std::sort would: non-negative doubles order like their bit patterns,
 // so a radix sort over the bits that differ does it in a few linear passes (the importance table
@@ -225,18 +211,6 @@ double surface_probability(const Mesh& mesh, const SamplingParams& params, int32
   return std::clamp(p, 0.0, 1.0);
 }
 
-// A vertex's probability at rate k from its class and importance, without per-vertex guidance.
-inline double plain_probability(uint8_t cls, double q, double k) {
-  switch (cls) {
-    case kIsolated: return 0.0;
-    case kCorner: return 1.0;
-    default: {
-      const double surface = std::min(1.0, k * q);
-      return cls == kCurve ? std::sqrt(surface) : surface;
-    }
-  }
-}
-
 std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& cls, const std::vector<double>& q,
                                   const std::vector<double>& multiplier, const SamplingParams& params, double k) {
   const int32_t n = mesh.num_vertices();
@@ -339,20 +313,7 @@ double solve_rate(const ImportanceTable& table, double target) {
   return k;
 }
 
-struct Candidate {
-  double key;
-  int32_t vertex;
-  bool operator<(const Candidate& o) const { return key < o.key || (key == o.key && vertex < o.vertex); }
-};
-
-// The uniform U of every vertex for one seed (it depends on the seed and the vertex's caller id
-// only), kept with the layout for the seed drawn last: a slider's draws read them instead of
-// hashing every vertex again (5 of a draft's 50 ms on the horse at 10 %, one thread).
-struct SelectionUniforms {
-  uint64_t seed = 0;
-  std::vector<double> u;
-};
-
+// This seed's uniforms, from the layout when they are there (`reused`), else made and kept there.
 std::shared_ptr<const SelectionUniforms> selection_uniforms(const Mesh& mesh, const FeatureLayout& layout,
                                                             uint64_t seed, bool& reused) {
   auto cached = std::static_pointer_cast<const SelectionUniforms>(layout.selection_uniforms.get());
@@ -367,17 +328,6 @@ std::shared_ptr<const SelectionUniforms> selection_uniforms(const Mesh& mesh, co
     table->u[v] = uniform01(seed, kStreamSelection, uint64_t(mesh.vertex_source()[v]));
   layout.selection_uniforms.set(table);
   return table;
-}
-
-// True when a vertex of uniform u and probability pv (0 < pv < 1) has its Pareto key
-// (u / (1 - u)) ((1 - pv) / pv) below `threshold`; the key is set then.
-inline bool pareto_key_below(double u, double pv, double threshold, double& key) {
-  // key < threshold without the two divisions (most vertices fail it); the key itself is
-  // computed as before for those that pass. A vertex whose rounding differs sits at the
-  // threshold, far above the keys the draw takes (the threshold leaves a margin).
-  if (u * (1.0 - pv) >= threshold * pv * (1.0 - u)) return false;
-  key = (u / (1.0 - u)) * ((1.0 - pv) / pv);
-  return key < threshold;
 }
 
 // Candidates with Pareto key (U / (1 - U)) ((1 - p) / p) below `threshold`, in vertex order;
@@ -411,100 +361,6 @@ std::vector<Candidate> pareto_candidates(const Mesh& mesh, const SelectionUnifor
   if (forced) *forced = std::move(found.forced);
   if (sum) *sum = found.sum;
   return std::move(found.candidates);
-}
-
-// A slider draws again and again with one seed at changing rates k. Without guidance, a
-// vertex's key falls below the draw's first threshold T exactly when k exceeds
-//   r(v) = p* / q(v) on a surface, p*^2 / q(v) on a curve, where p* = U / (U + T (1 - U))
-// (the key is below T when p > p*, and p = k q or sqrt(k q)). So, with the vertices ordered by
-// r, the candidates at any rate are among a prefix: a draw tests those (horse at 10 %: about
-// 100,000 of 776,000 vertices) with the same test as the pass over all vertices, and finds
-// the same candidates. Ordered by buckets of r, each in vertex order, with each vertex's U and
-// q alongside: read in this order from the per-vertex arrays, the prefix cost more than a pass
-// over every vertex.
-constexpr double kFirstThreshold = 1.25;  // the first threshold without density control
-constexpr int32_t kRateBuckets = 8 * 20;   // an eighth of a binade each, from 2^-12 to 2^8
-
-struct CandidateOrder {
-  uint64_t seed = 0;
-  std::shared_ptr<const ImportanceTable> table;  // the table it was made from
-  std::vector<int32_t> corners;                  // always drawn (p = 1)
-  std::vector<int32_t> offsets;                  // the first position of every bucket, then the count
-  Buffer<int32_t> vertices;                      // surface and curve vertices with q > 0, by bucket of r
-  Buffer<double> u;                              // ... their uniforms
-  Buffer<double> q;                              // ... their q, negated on a curve
-};
-
-// Buckets 9 % wide (the exponent and the top three bits of the mantissa): few enough for one
-// counting pass (one over 65,536 buckets of 3 % took 15-21 ms on the horse, its writes
-// scattered over as many places). Smaller r share the first bucket (candidates at any rate a
-// slider asks for), larger ones the last.
-inline int32_t rate_bucket(double r) {
-  uint64_t bits;
-  std::memcpy(&bits, &r, sizeof bits);  // r >= 0
-  const int64_t eighths = int64_t(bits >> 49) - int64_t(1023 - 12) * 8;
-  return int32_t(std::clamp<int64_t>(eighths, 0, kRateBuckets - 1));
-}
-
-// The order for this seed and table: made on the second draw with the same seed (a slider's),
-// so that a single decimation does not pay for it; null until then.
-std::shared_ptr<const CandidateOrder> candidate_order(const Mesh& mesh, const FeatureLayout& layout,
-                                                      const std::shared_ptr<const ImportanceTable>& table,
-                                                      const SelectionUniforms& uniforms, bool uniforms_reused) {
-  auto cached = std::static_pointer_cast<const CandidateOrder>(layout.candidate_order.get());
-  if (cached && cached->seed == uniforms.seed && cached->table == table) return cached;
-  if (!uniforms_reused) return nullptr;
-  auto order = std::make_shared<CandidateOrder>();
-  order->seed = uniforms.seed;
-  order->table = table;
-  const int32_t n = mesh.num_vertices();
-  constexpr int32_t kNone = kRateBuckets;  // not drawn at random: a corner, isolated, or q = 0
-  Buffer<uint8_t> bucket(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
-    const uint8_t cls = table->cls[v];
-    const double q = table->q[v], u = uniforms.u[v];
-    const double p_star = u / (u + kFirstThreshold * (1.0 - u));
-    bucket[v] = uint8_t((cls != kSurface && cls != kCurve) || !(q > 0.0) ? kNone
-                        : cls == kCurve                                  ? rate_bucket(p_star * p_star / q)
-                                                                         : rate_bucket(p_star / q));
-  }
-  for (int32_t v = 0; v < n; ++v)
-    if (table->cls[v] == kCorner) order->corners.push_back(v);
-  order->vertices.resize(n);
-  order->u.resize(n);
-  order->q.resize(n);
-  stable_counting_sort(n, kNone + 1, [&](int64_t v) { return bucket[v]; },
-                       [&](int64_t v, int32_t at) {
-                         order->vertices[at] = int32_t(v);
-                         order->u[at] = uniforms.u[v];
-                         order->q[at] = table->cls[v] == kCurve ? -table->q[v] : table->q[v];
-                       },
-                       order->offsets);
-  const int32_t drawn = order->offsets[kNone];
-  order->vertices.resize(drawn);
-  order->u.resize(drawn);
-  order->q.resize(drawn);
-  order->offsets.resize(kNone + 1);
-  layout.candidate_order.set(order);
-  return order;
-}
-
-// What pareto_candidates(threshold kFirstThreshold) finds without guidance, from the order.
-void candidates_in_order(const CandidateOrder& order, double rate, std::vector<int32_t>& forced,
-                         std::vector<Candidate>& candidates) {
-  forced = order.corners;
-  // Every vertex whose test can pass has r at most the rate (up to rounding: a margin). (On
-  // one thread: two took as long, 2.5 against 2.3 ms on the horse.)
-  const int32_t end = order.offsets[rate_bucket(rate * (1.0 + 1e-6)) + 1];
-  for (int32_t i = 0; i < end; ++i) {
-    const double q = order.q[i];
-    const double pv = plain_probability(q < 0 ? kCurve : kSurface, std::abs(q), rate);
-    double key;
-    if (pv >= 1.0) forced.push_back(order.vertices[i]);
-    else if (pv > 0.0 && pareto_key_below(order.u[i], pv, kFirstThreshold, key))
-      candidates.push_back({key, order.vertices[i]});
-  }
 }
 
 // Sorts distinct vertex ids in [0, n): a bit per vertex, read back in order (a tenth of the cost of
