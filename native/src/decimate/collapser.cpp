@@ -9,9 +9,12 @@ namespace topstoc {
 
 namespace {
 
-// Collapses may not make a triangle thinner than this shape quality (Collapser::shape; 0.1 is
-// an aspect ratio of about 5-10 by the thesis' measure) unless it already was.
+// Collapses and moves may not leave a triangle thinner than this shape quality (Collapser::shape;
+// 0.1 is an aspect ratio of about 5-10 by the thesis' measure) or, one that was thinner already,
+// thinner than kThinShape; either may go lower only as far as the thinnest triangle around the
+// move was (Collapser::shape_floor2).
 constexpr double kMinShape = 0.1;
+constexpr double kThinShape = 0.5 * kMinShape;
 
 }  // namespace
 
@@ -244,7 +247,8 @@ std::vector<int32_t> Collapser::zero_area_face_list() const {
 bool Collapser::place(int32_t v, const double* world, int32_t face) {
   double at[3];
   for (int i = 0; i < 3; ++i) at[i] = (world[i] - s_.center[i]) * (1.0 / s_.extent);
-  if (!keeps_shape(v, -1, at)) return false;
+  ShapeFloor floor{v, -1};
+  if (!keeps_shape(v, -1, at, floor)) return false;
   double* p = &s_.positions[3 * size_t(v)];
   double* w = &s_.world[3 * size_t(v)];
   double keep_p[3], keep_w[3];
@@ -261,8 +265,9 @@ int32_t Collapser::zero_area_faces() const {
 }
 
 int32_t Collapser::remove_thin(double min_shape, Stop keep) {
-  // No collapse makes a new thin or zero-area triangle (keeps_shape), so the candidates are
-  // known up front; a failed one may pass after its neighbours collapsed, hence the rounds.
+  // Candidates are found up front: a collapse makes no zero-area triangle, and a thin one only
+  // beside one as thin or thinner (keeps_shape); a failed candidate may pass after its
+  // neighbours collapsed, hence the rounds.
   const int32_t m = static_cast<int32_t>(alive_face_.size());
   std::vector<uint8_t> flagged(m, 0);
 #pragma omp parallel for schedule(static) if (m >= 100000)
@@ -522,12 +527,34 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
   s_.quadrics.reduced(u, v, q);
   double x[3];
   placement(u, v, q, x);
-  return keeps_shape(u, v, x) && keeps_shape(v, u, x);
+  ShapeFloor floor{u, v};
+  return keeps_shape(u, v, x, floor) && keeps_shape(v, u, x, floor);
+}
+
+// The squared shape quality of the thinnest triangle with area around `v`, capped at kMinShape's:
+// a move or collapse at v may leave a triangle that thin, so that it never makes the worst
+// triangle around it worse, and a needle (the ends of an input edge far shorter than its
+// neighbours, kept by the first pass) can collapse even when a neighbour then ends a little below
+// kMinShape. Before this floor, a triangle could not end below kMinShape unless it already was,
+// and then with no limit: such needles stayed and stretched as their far corner moved (the
+// Chinese dragon at 10 %: a worst aspect ratio of 7,949 by thesis eq. 4.2, 152 with the floor;
+// Blender's Decimate 831). The limit kThinShape for already thin triangles keeps the freedom
+// CAD meshes' long strips need (without it, the coupling at 10 % had twice the mean error).
+double Collapser::shape_floor2(int32_t v) const {
+  double floor2 = kMinShape * kMinShape;
+  for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) {
+    const int32_t* c = &tri_[3 * size_t(*t)];
+    double n[3];
+    normal(c, v, position(v), n);
+    const double area2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2], edges = squared_edges(c, v, position(v));
+    if (area2 > 0.0 && edges > 0.0) floor2 = std::min(floor2, 12.0 * area2 / (edges * edges));
+  }
+  return floor2;
 }
 
 // Do the triangles of `moved` that do not hold `other` keep their side and some area when
 // `moved` stands at x (other = -1: all of them)?
-bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x) const {
+bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const {
   const double* p = position(moved);
   for (const int32_t* t = faces_begin(moved); t != faces_end(moved); ++t) {
     if (other >= 0 && has(*t, other)) continue;
@@ -554,8 +581,14 @@ bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x) const
     const double len2 = after[0] * after[0] + after[1] * after[1] + after[2] * after[2];
     // No flip, no near-fold (normal turned by more than ~80 degrees: cos > 0.17), no loss of area.
     if (!(dot > 0.0) || dot * dot <= 0.0289 * len2 * before2 || len2 <= 1e-24 * before2) return false;
-    // No sliver: a triangle may not end up thinner than kMinShape unless it was already.
-    if (thinner(c, moved, x, len2) && !thinner(c, moved, p, area2)) return false;
+    // No sliver: not thinner than the floor (at most kMinShape), unless the triangle was
+    // thinner than kMinShape already and stays within kThinShape.
+    if (!thinner(c, moved, x, len2, kMinShape * kMinShape)) continue;
+    if (floor.value2 < 0.0)
+      floor.value2 = floor.b < 0 ? shape_floor2(floor.a) : std::min(shape_floor2(floor.a), shape_floor2(floor.b));
+    if (thinner(c, moved, x, len2, floor.value2) &&
+        (!thinner(c, moved, p, area2, kMinShape * kMinShape) || thinner(c, moved, x, len2, kThinShape * kThinShape)))
+      return false;
   }
   return true;
 }
@@ -567,10 +600,11 @@ double Collapser::shape(const int32_t* c, int32_t replace, const double* at, dou
   return edges > 0 ? 2.0 * std::sqrt(3.0) * twice_area / edges : 0.0;
 }
 
-// shape(...) < kMinShape without roots, from |n|² = twice_area2.
-bool Collapser::thinner(const int32_t* c, int32_t replace, const double* at, double twice_area2) const {
+// shape(...)² < shape2 without roots, from |n|² = twice_area2.
+bool Collapser::thinner(const int32_t* c, int32_t replace, const double* at, double twice_area2,
+                        double shape2) const {
   const double edges = squared_edges(c, replace, at);
-  return !(12.0 * twice_area2 >= kMinShape * kMinShape * edges * edges) || edges == 0.0;
+  return !(12.0 * twice_area2 >= shape2 * edges * edges) || edges == 0.0;
 }
 
 double Collapser::squared_edges(const int32_t* c, int32_t replace, const double* at) const {
@@ -695,11 +729,13 @@ int32_t Collapser::refit(const std::vector<double>& radius2) {
     better[v] = q.error(x) < q.error(p);
   }
   int32_t moved = 0;
-  for (int32_t v = 0; v < n; ++v)
-    if (better[v] && keeps_shape(v, -1, &goal[3 * size_t(v)])) {
+  for (int32_t v = 0; v < n; ++v) {
+    ShapeFloor floor{v, -1};
+    if (better[v] && keeps_shape(v, -1, &goal[3 * size_t(v)], floor)) {
       move_to(v, &goal[3 * size_t(v)]);
       ++moved;
     }
+  }
   return moved;
 }
 

@@ -105,9 +105,16 @@ class Collapser {
   }
   bool queues(int32_t u) const { return !s_.locked[u] && !at_quota(u); }
   bool allowed(int32_t u, int32_t v, Scratch& scratch) const;
-  bool keeps_shape(int32_t moved, int32_t other, const double* x) const;
+  // The shape floor of one move or collapse (shape_floor2 of its ends), found when a triangle
+  // first ends below kMinShape: most moves leave none there.
+  struct ShapeFloor {
+    int32_t a, b;          // the ends (b = -1: a move)
+    double value2 = -1.0;  // not found yet
+  };
+  bool keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const;
+  double shape_floor2(int32_t v) const;
   double shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const;
-  bool thinner(const int32_t* c, int32_t replace, const double* at, double twice_area2) const;
+  bool thinner(const int32_t* c, int32_t replace, const double* at, double twice_area2, double shape2) const;
   double squared_edges(const int32_t* c, int32_t replace, const double* at) const;
   void normal(const int32_t* c, int32_t replace, const double* at, double n[3]) const;
   bool thin(int32_t t, double min_shape) const;

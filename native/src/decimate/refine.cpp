@@ -350,8 +350,9 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
   } else {
     result.refine_vertices = params.target_vertices;
     result.refine_triangles = params.target_triangles;
-    // Slivers the stochastic pass left (near-collinear corners) go first: the collapses thin
-    // the result anyway, and none of them makes a new one (Collapser::keeps_shape).
+    // Slivers the stochastic pass left (near-collinear corners, needles) go first: the
+    // collapses thin the result anyway, and none of them makes a triangle thinner than the
+    // thinnest around it was (Collapser::keeps_shape).
     const Collapser::Stop stop{params.target_vertices, params.target_triangles};
     result.refine_collapses = collapser.remove_thin(kSliverShape, stop);
     result.refine_collapses += collapser.run(stop);

@@ -10,7 +10,9 @@
 // moves vertex u onto its neighbour v (a half-edge collapse), so border vertices remain input
 // vertices. A collapse is done only if it keeps every guarantee of the decimation: the link
 // condition holds (so the surface stays a manifold of the same topology), no triangle around
-// either end flips, folds (normal turned by more than ~80 degrees) or loses all area, and a vertex on a
+// either end flips, folds (normal turned by more than ~80 degrees), loses all area or ends
+// thinner than shape quality 0.1 (0.05 for one thinner already) and than the thinnest triangle
+// around it was, and a vertex on a
 // border curve (boundary, UV seam, material border, flagged edge) moves only along its curve,
 // onto the next vertex of the same curve or a corner, so borders keep their course and their
 // sides and attributes keep carrying over exactly. Corners never move, closed curves keep three
