@@ -225,6 +225,17 @@ def homology_rank(triangles, cycles):
     return gf2_rank(boundaries + chains) - base
 
 
+def aspect_ratios(vertices, triangles):
+    """Thesis eq. 4.2 per triangle: e0 e1 e2 / (8 (s - e0)(s - e1)(s - e2)); inf when degenerate."""
+    p = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles, dtype=np.int64)]
+    e = np.stack([np.linalg.norm(p[:, 1] - p[:, 2], axis=1), np.linalg.norm(p[:, 2] - p[:, 0], axis=1),
+                  np.linalg.norm(p[:, 0] - p[:, 1], axis=1)], axis=1)
+    s = e.sum(axis=1) / 2
+    denominator = 8 * (s - e[:, 0]) * (s - e[:, 1]) * (s - e[:, 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(denominator > 0, e.prod(axis=1) / denominator, np.inf)
+
+
 def degenerate_or_duplicate(triangles):
     """(number of triangles with a repeated vertex, number of repeated vertex sets)."""
     t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)

@@ -41,6 +41,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 from topstoc.core import Mesh, hausdorff, read_mesh, topology  # noqa: E402
 from machine import machine  # noqa: E402
+from reference import aspect_ratios  # noqa: E402
 
 SHARED = ROOT.parent / "shared" / "meshes"
 if not SHARED.exists():
@@ -106,18 +107,6 @@ for job in json.load(open(sys.argv[1])):
     seconds = time.perf_counter() - start
     np.savez(job["output"], vertices=v, triangles=t, seconds=seconds)
 """
-
-
-def aspect_ratios(vertices, triangles) -> np.ndarray:
-    """Thesis eq. 4.2 per triangle: e0 e1 e2 / (8 (s - e0)(s - e1)(s - e2)); inf when degenerate."""
-    p = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles, dtype=np.int64)]
-    e = np.stack([np.linalg.norm(p[:, 1] - p[:, 2], axis=1), np.linalg.norm(p[:, 2] - p[:, 0], axis=1),
-                  np.linalg.norm(p[:, 0] - p[:, 1], axis=1)], axis=1)
-    s = e.sum(axis=1) / 2
-    denominator = 8 * (s - e[:, 0]) * (s - e[:, 1]) * (s - e[:, 2])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ar = np.where(denominator > 0, e.prod(axis=1) / denominator, np.inf)
-    return ar
 
 
 def zero_area(vertices, triangles) -> int:

@@ -16,6 +16,12 @@ namespace {
 constexpr double kMinShape = 0.1;
 constexpr double kThinShape = 0.5 * kMinShape;
 
+// True when a triangle with |n|² = twice_area2 and squared edge lengths summing to `edges` has a
+// shape quality (Collapser::shape) below sqrt(shape2): without roots or divisions.
+bool thinner(double twice_area2, double edges, double shape2) {
+  return !(12.0 * twice_area2 >= shape2 * edges * edges) || edges == 0.0;
+}
+
 }  // namespace
 
 Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corner_source, CollapseSetup setup)
@@ -583,11 +589,13 @@ bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, Shape
     if (!(dot > 0.0) || dot * dot <= 0.0289 * len2 * before2 || len2 <= 1e-24 * before2) return false;
     // No sliver: not thinner than the floor (at most kMinShape), unless the triangle was
     // thinner than kMinShape already and stays within kThinShape.
-    if (!thinner(c, moved, x, len2, kMinShape * kMinShape)) continue;
+    const double edges = squared_edges(c, moved, x);
+    if (!thinner(len2, edges, kMinShape * kMinShape)) continue;
     if (floor.value2 < 0.0)
       floor.value2 = floor.b < 0 ? shape_floor2(floor.a) : std::min(shape_floor2(floor.a), shape_floor2(floor.b));
-    if (thinner(c, moved, x, len2, floor.value2) &&
-        (!thinner(c, moved, p, area2, kMinShape * kMinShape) || thinner(c, moved, x, len2, kThinShape * kThinShape)))
+    if (thinner(len2, edges, floor.value2) &&
+        (!thinner(area2, squared_edges(c, moved, p), kMinShape * kMinShape) ||
+         thinner(len2, edges, kThinShape * kThinShape)))
       return false;
   }
   return true;
@@ -598,13 +606,6 @@ bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, Shape
 double Collapser::shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const {
   const double edges = squared_edges(c, replace, at);
   return edges > 0 ? 2.0 * std::sqrt(3.0) * twice_area / edges : 0.0;
-}
-
-// shape(...)² < shape2 without roots, from |n|² = twice_area2.
-bool Collapser::thinner(const int32_t* c, int32_t replace, const double* at, double twice_area2,
-                        double shape2) const {
-  const double edges = squared_edges(c, replace, at);
-  return !(12.0 * twice_area2 >= shape2 * edges * edges) || edges == 0.0;
 }
 
 double Collapser::squared_edges(const int32_t* c, int32_t replace, const double* at) const {

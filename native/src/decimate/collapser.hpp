@@ -114,7 +114,6 @@ class Collapser {
   bool keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const;
   double shape_floor2(int32_t v) const;
   double shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const;
-  bool thinner(const int32_t* c, int32_t replace, const double* at, double twice_area2, double shape2) const;
   double squared_edges(const int32_t* c, int32_t replace, const double* at) const;
   void normal(const int32_t* c, int32_t replace, const double* at, double n[3]) const;
   bool thin(int32_t t, double min_shape) const;

@@ -57,7 +57,6 @@ inline double plain_probability(uint8_t cls, double q, double k) {
   }
 }
 
-
 // True when a vertex of uniform u and probability pv (0 < pv < 1) has its Pareto key
 // (u / (1 - u)) ((1 - pv) / pv) below `threshold`; the key is set then.
 inline bool pareto_key_below(double u, double pv, double threshold, double& key) {
@@ -68,6 +67,5 @@ inline bool pareto_key_below(double u, double pv, double threshold, double& key)
   key = (u / (1.0 - u)) * ((1.0 - pv) / pv);
   return key < threshold;
 }
-
 
 }  // namespace topstoc::draw
