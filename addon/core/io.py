@@ -41,6 +41,7 @@ from typing import List, Optional
 
 import numpy as np
 
+from . import atomic
 from .native import engine
 from .errors import TopStocError
 
@@ -270,8 +271,8 @@ def write_mesh(path, data: MeshData) -> None:
     """Writes ``data`` in the format the extension names; .gz (or .bz2) compresses.
 
     Formats carry what they can (CARRIES, dropped_attributes); PLY is written binary little-endian, STL
-    binary. The file is written to a temporary name first and then renamed, so a failed write
-    never leaves a half-written file at ``path``.
+    binary. The file is written atomically (topstoc.core.atomic): a failed or interrupted write
+    never leaves a half-written file at ``path``, and a symlink at ``path`` is written through.
     """
     name = os.fspath(path)
     kind, compression = mesh_format(name)
@@ -283,13 +284,4 @@ def write_mesh(path, data: MeshData) -> None:
         payload = gzip.compress(payload, compresslevel=6, mtime=0)
     elif compression == "bz2":
         payload = bz2.compress(payload)
-    temporary = f"{name}.tmp{os.getpid()}"
-    try:
-        with open(temporary, "wb") as stream:
-            stream.write(payload)
-        os.replace(temporary, name)
-    except OSError as error:
-        raise OSError(error.errno, f"{name}: cannot write the file ({error.strerror})") from None
-    finally:
-        if os.path.exists(temporary):
-            os.remove(temporary)
+    atomic.write_bytes(name, payload)

@@ -11,6 +11,7 @@ import importlib
 import json
 import sys
 
+from ..errors import one_line
 # Subcommand modules, in the order --help lists them.
 SUBCOMMANDS = ("decimate", "batch", "measure", "topology", "loops", "edit")
 
@@ -52,8 +53,7 @@ def main(argv=None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except (ValueError, OSError, RuntimeError) as error:
-        message = str(error).splitlines()[0] if str(error) else type(error).__name__
-        print(f"topstoc {args.command}: error: {message}", file=sys.stderr)
+        print(f"topstoc {args.command}: error: {one_line(error)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print(f"topstoc {args.command}: interrupted", file=sys.stderr)

@@ -14,6 +14,7 @@ import numpy as np
 
 from . import print_json
 from ..errors import TopStocError
+from ..output_guard import add_overwrite_argument, check_output
 
 
 def add_parser(subparsers) -> None:
@@ -56,6 +57,7 @@ def _patch_options(parser) -> None:
     parser.add_argument("--fair", action="store_true",
                         help="refine the patches to the surrounding density and fair them (adds vertices)")
     parser.add_argument("--json", action="store_true", help="print a JSON report")
+    add_overwrite_argument(parser)
 
 
 def _ids(text: str, what: str) -> list:
@@ -69,6 +71,7 @@ def _ids(text: str, what: str) -> list:
 
 
 def run_fill(args) -> int:
+    check_output(args.output, [args.input], overwrite=args.overwrite)
     from ..edit import fill_holes
     from ..io import read_mesh
 
@@ -95,6 +98,7 @@ def run_fill(args) -> int:
 
 
 def run_remove_handle(args) -> int:
+    check_output(args.output, [args.input], overwrite=args.overwrite)
     from ..edit import remove_handle
     from ..io import read_mesh
 

@@ -9,7 +9,9 @@ from __future__ import annotations
 import argparse
 import time
 
+from .. import atomic
 from ..hausdorff import DEFAULT_SAMPLES, hausdorff
+from ..output_guard import check_output
 
 
 def add_parser(subparsers) -> None:
@@ -34,19 +36,27 @@ def add_parser(subparsers) -> None:
     parser.set_defaults(run=run)
 
 
+def errors_file(name: str) -> str:
+    """The --errors file: numpy's own rule, ".npz" appended unless the name ends with it."""
+    return name if name.endswith(".npz") else name + ".npz"
+
+
 def run(args: argparse.Namespace) -> int:
     from ..io import read_mesh  # imported here so that --help works without the readers
 
+    errors = None if args.errors is None else errors_file(args.errors)
+    check_output(errors, [args.a, args.b])
     a = read_mesh(args.a)
     b = read_mesh(args.b)
     started = time.perf_counter()
     result = hausdorff(a, b, samples=args.samples, step=args.step, percentile=args.percentile,
                        relative=args.relative)
     seconds = time.perf_counter() - started
-    if args.errors:
+    if errors is not None:
         import numpy as np
 
-        np.savez_compressed(args.errors, vertex_error=result.vertex_error, face_error=result.face_error)
+        atomic.write_file(errors, lambda stream: np.savez_compressed(
+            stream, vertex_error=result.vertex_error, face_error=result.face_error))
     document = result.as_dict()
     document["seconds"] = seconds
     document["a"] = {"path": args.a, "vertices": len(a.vertices), "triangles": len(a.triangles)}
