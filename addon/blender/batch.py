@@ -17,7 +17,6 @@ exit code 1 when any input failed (the others are still processed).
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 import traceback
@@ -29,7 +28,9 @@ from ..core import batch_settings
 from ..core.batch_mesh import decimate_mesh_file, lod_error
 from ..core.decimate import ATTRIBUTE_WEIGHT
 from ..core.prune import prune_small_parts
-from ..core.errors import TopStocError
+from ..core.batch_run import misnamed_failure, utf8_name, write_report
+from ..core.errors import TopStocError, one_line, shown_path
+from ..core.output_guard import check_folders, check_output, output_folder
 
 BLEND = ".blend"
 
@@ -236,14 +237,20 @@ def main(argv=None) -> int:
         return int(exit_.code or 0)
     try:
         settings = batch_settings.from_args(args)
-    except ValueError as error:
-        print(f"topstoc batch: error: {error}", file=sys.stderr, flush=True)
+        check_folders(args.input, args.output)
+        check_output(args.json, args.input)
+        output_folder(args.output)
+    except (ValueError, OSError) as error:
+        print(f"topstoc batch: error: {one_line(error)}", file=sys.stderr, flush=True)
         return 1
-    os.makedirs(args.output, exist_ok=True)
     report = {"results": [], "failures": []}
     total = len(args.input)
     for i, path in enumerate(args.input, 1):
-        prefix = f"topstoc batch [{i}/{total}] {path}"
+        prefix = f"topstoc batch [{i}/{total}] {shown_path(path)}"
+        if not utf8_name(path):
+            report["failures"].append(misnamed_failure(path))
+            print(f"{prefix}: FAILED: {report['failures'][-1]['message']}", file=sys.stderr, flush=True)
+            continue
         print(f"{prefix}: decimating ...", flush=True)
         try:
             if _is_mesh_file(path):
@@ -252,13 +259,7 @@ def main(argv=None) -> int:
                 _register_addon()
                 entry = decimate_scene_file(path, args.output, settings)
         except Exception as error:  # one broken input must not stop the batch
-            lines = [line.strip() for line in str(error).splitlines() if line.strip()]
-            message = lines[0] if lines else type(error).__name__
-            if "Traceback" in message and len(lines) > 1:  # an importer's or exporter's own exception
-                message = "Blender: " + lines[-1]
-            message = message[len("Error: "):] if message.startswith("Error: ") else message  # bpy.ops
-            if not isinstance(error, (ValueError, OSError, RuntimeError)):
-                traceback.print_exc()
+            message = _failure_message(error)
             report["failures"].append({"input": path, "message": message})
             print(f"{prefix}: FAILED: {message}", file=sys.stderr, flush=True)
             continue
@@ -266,9 +267,19 @@ def main(argv=None) -> int:
         print(f"{prefix}: {entry['vertices_in']} -> {entry['vertices_out']} vertices, "
               f"{entry['triangles_out']} triangles in {entry['seconds']:.3f} s -> {entry['output']}", flush=True)
     if args.json:
-        temporary = f"{args.json}.tmp{os.getpid()}"
-        with open(temporary, "w") as stream:
-            json.dump(report, stream, indent=2, default=lambda v: v.tolist() if hasattr(v, "tolist") else str(v))
-        os.replace(temporary, args.json)
+        write_report(args.json, report)
     print(f"topstoc batch: {len(report['results'])} done, {len(report['failures'])} failed", flush=True)
     return 1 if report["failures"] else 0
+
+
+def _failure_message(error: Exception) -> str:
+    """One line for a failed input: an importer's or exporter's own traceback shortened to its
+    last line; a traceback printed only for errors nobody raised on purpose."""
+    lines = [line.strip() for line in str(error).splitlines() if line.strip()]
+    message = one_line(error)
+    if "Traceback" in message and len(lines) > 1:
+        message = "Blender: " + lines[-1]
+    message = message[len("Error: "):] if message.startswith("Error: ") else message  # bpy.ops
+    if not isinstance(error, (ValueError, OSError, RuntimeError)):
+        traceback.print_exc()
+    return message

@@ -16,6 +16,7 @@ import shutil
 import tempfile
 
 import bpy
+from ..core import atomic
 from ..core.errors import TopStocError
 
 IMPORTERS = {"gltf": "gltf", "glb": "gltf", "fbx": "fbx", "usd": "usd", "usda": "usd", "usdc": "usd", "usdz": "usd"}
@@ -150,8 +151,9 @@ def _export(kind: str, filepath: str, selected: bool) -> None:
 
 def save(path: str, objects=None) -> list:
     """Writes the scene (or only ``objects`` and what they need) to ``path`` atomically; returns the
-    files written (the main file last)."""
-    path = os.path.abspath(path)
+    files written (the main file last). A symlink at ``path`` is written through: its target is
+    replaced, the link kept."""
+    path = atomic.target(os.path.abspath(path))
     folder = os.path.dirname(path)
     kind = extension(path)
     os.makedirs(folder, exist_ok=True)

@@ -20,8 +20,9 @@ import tempfile
 import time
 import traceback
 
-from . import batch_settings, child_process
-from .errors import TopStocError
+from . import atomic, batch_settings, child_process
+from .atomic import pid_alive
+from .errors import TopStocError, one_line, shown_path
 
 MESH_EXTENSIONS = (".obj", ".ply", ".off", ".stl")
 COMPRESSED = (".gz", ".bz2")
@@ -58,6 +59,27 @@ def find_inputs(paths) -> list:
                 seen.add(os.path.abspath(name))
                 found.append(name)
     return found
+
+
+def utf8_name(path) -> bool:
+    """Whether a file name is valid UTF-8 (reports, manifests and Dask keys need text)."""
+    try:
+        os.fspath(path).encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
+def misnamed_failure(path) -> dict:
+    """The report's failure of an input whose name is not valid UTF-8 (shown with its bytes escaped)."""
+    return {"input": shown_path(path), "message": f"{shown_path(path)}: the file name is not valid UTF-8; rename the file"}
+
+
+def write_report(path: str, report: dict) -> None:
+    """Writes a batch report atomically; when that fails, an earlier run's report there is removed
+    too, so that no stale report passes for this run's."""
+    text = json.dumps(report, indent=2, default=lambda v: v.tolist() if hasattr(v, "tolist") else str(v))
+    atomic.write_text(path, text, discard_old=True)
 
 
 def package_root() -> str:
@@ -129,7 +151,7 @@ def run_asset(path: str, out_dir: str, settings: dict, blender: str = None) -> d
             raise TopStocError(f"{path}: not a supported asset (mesh files {', '.join(MESH_EXTENSIONS)}, "
                                f"or {', '.join('.' + f for f in batch_settings.BLENDER_FORMATS)})")
     except Exception as error:  # one broken asset must not stop the batch
-        message = str(error).splitlines()[0] if str(error) else type(error).__name__
+        message = one_line(error)
         if not isinstance(error, (ValueError, OSError, RuntimeError)):
             message += " (" + traceback.format_exc().strip().splitlines()[-1] + ")"
         return {"status": "failed", "input": os.fspath(path), "message": message,
@@ -231,21 +253,11 @@ def remove_orphaned_scratch(folder: str = None) -> int:
         if not name.startswith(SCRATCH_PREFIX):
             continue
         pid = name[len(SCRATCH_PREFIX):].split("-", 1)[0]
-        if not pid.isdigit() or _alive(int(pid)):
+        if not pid.isdigit() or pid_alive(int(pid)):
             continue
         shutil.rmtree(os.path.join(folder, name), ignore_errors=True)
         removed += 1
     return removed
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except OSError:  # another user's process: alive
-        return True
-    return True
 
 
 def remove_stale_temporaries(outputs) -> int:

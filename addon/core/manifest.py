@@ -8,7 +8,10 @@ appended by the one process that drives the batch (never by workers) as results 
      "outputs": [...], "entry": {...}}
 
 ``key`` = SHA-256 of the input's absolute path, its content hash and the settings fingerprint,
-so an edited input or other settings make the asset run again. An asset is skipped when its
+so an edited input or other settings make the asset run again. Content alone cannot tell an
+input from a LOD an earlier run wrote (a LOD is new content, so it would be decimated again):
+outputs never go where inputs are read (topstoc.core.output_guard), and an input that is one of
+the outputs the manifest lists (the same file, under any name) is refused (``check_inputs``). An asset is skipped when its
 last record in any of the folder's manifests is "done" and every output it lists still exists. Each record is written with one
 ``write`` and flushed to disk, so a batch killed mid-write loses at most that last line, which a
 rerun ignores (and redoes the asset).
@@ -19,6 +22,9 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+
+from .errors import TopStocError, shown_path
+from .output_guard import file_identity
 
 MANIFEST_NAME = "topstoc-manifest.jsonl"
 
@@ -64,6 +70,20 @@ class Manifest:
         if not all(os.path.exists(path) for path in record.get("outputs", [])):
             return None
         return record
+
+    def check_inputs(self, inputs) -> None:
+        """TopStocError when one of ``inputs`` is a file an earlier run into this folder wrote."""
+        written = {}
+        for record in self.records.values():
+            for output in record.get("outputs") or []:
+                identity = file_identity(output)
+                if identity is not None:
+                    written[identity] = output
+        for path in inputs:
+            output = written.get(file_identity(path))
+            if output is not None:
+                raise TopStocError(f"{shown_path(path)}: is {shown_path(output)}, an output of an earlier batch "
+                                   f"({self.path}); it would be decimated again")
 
     def append(self, record: dict) -> None:
         line = json.dumps(record, sort_keys=True, default=_plain) + "\n"

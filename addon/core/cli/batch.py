@@ -10,15 +10,16 @@ with the same content and settings. Exit code 0 when every asset is done, 1 when
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 import time
 
 from .. import batch_settings
-from ..batch_run import find_inputs, remove_orphaned_scratch, remove_stale_temporaries, run_dask, run_serial
+from ..batch_run import (find_inputs, misnamed_failure, remove_orphaned_scratch, remove_stale_temporaries,
+                         run_dask, run_serial, utf8_name, write_report)
 from ..manifest import Manifest, content_hash, task_key
 from ..errors import TopStocError
+from ..output_guard import check_folders, check_output, check_outputs, output_folder
 
 REPORT_NAME = "topstoc-report.json"
 
@@ -86,8 +87,8 @@ class Progress:
             self.bar.close()
 
 
-def _check_names(tasks, out_dir, settings) -> None:
-    """Two inputs must not write the same output file."""
+def _check_names(tasks, out_dir, settings, inputs) -> None:
+    """Two inputs must not write the same output file, nor any output be an input."""
     from ..batch_mesh import output_paths
     from ..batch_run import asset_kind
 
@@ -103,6 +104,7 @@ def _check_names(tasks, out_dir, settings) -> None:
                 raise TopStocError(f"{owners[name]} and {path} would both write {name}; "
                                    "batch them into different output folders")
             owners[name] = path
+    check_outputs(owners, inputs)
 
 
 def _lod_vertices(entry: dict) -> list:
@@ -148,11 +150,18 @@ def run(args) -> int:
             print(f"topstoc batch: chunk {args.chunk} has no inputs", flush=True)
             return 0
         raise TopStocError("no input assets found")
-    os.makedirs(args.output, exist_ok=True)
+    report_path = args.json or os.path.join(args.output, REPORT_NAME.replace(".json", suffix + ".json"))
+    check_folders(args.input, args.output)
+    check_output(report_path, inputs)
+    output_folder(args.output)
     manifest = Manifest(args.output, suffix)
+    manifest.check_inputs(inputs)
     fingerprint = batch_settings.digest(settings)
-    tasks, keys, skipped = [], {}, []
+    tasks, keys, skipped, resumed, misnamed = [], {}, [], {}, []
     for index, path in enumerate(inputs):
+        if not utf8_name(path):
+            misnamed.append(index)  # fails alone, below: it cannot be keyed, reported or printed
+            continue
         try:
             sha = content_hash(path)
         except OSError as error:
@@ -161,14 +170,19 @@ def run(args) -> int:
         record = None if args.no_resume else manifest.finished(keys[index][0])
         if record is not None:
             skipped.append({"input": path, "outputs": record["outputs"]})
+            if "entry" in record:
+                resumed[index] = dict(record["entry"], resumed=True)
         else:
             tasks.append((index, path))
-    _check_names(tasks, args.output, settings)
+    _check_names(tasks, args.output, settings, inputs)
 
     progress = Progress(len(inputs), args.progress)
     for item in skipped:
         progress.advance(item["input"], "skipped (done in an earlier run)")
     results, failures, outputs = {}, {}, []
+    for index in misnamed:
+        failures[index] = misnamed_failure(inputs[index])
+        progress.advance(failures[index]["input"], f"FAILED: {failures[index]['message']}", failed=True)
 
     def on_result(index, outcome):
         path = inputs[index]
@@ -211,15 +225,12 @@ def run(args) -> int:
     remove_stale_temporaries(outputs)
     remove_orphaned_scratch()
 
+    finished = {**resumed, **results}  # the figures of assets done in earlier runs stay in the report
     report = {"settings": settings, "runner": {"scheduler": args.scheduler, "workers": 0 if args.scheduler else workers},
               "seconds": time.perf_counter() - started,
-              "results": [results[i] for i in sorted(results)],
+              "results": [finished[i] for i in sorted(finished)],
               "failures": [failures[i] for i in sorted(failures)], "skipped": skipped}
-    report_path = args.json or os.path.join(args.output, REPORT_NAME.replace(".json", suffix + ".json"))
-    temporary = f"{report_path}.tmp{os.getpid()}"
-    with open(temporary, "w") as stream:
-        json.dump(report, stream, indent=2, default=lambda v: v.tolist() if hasattr(v, "tolist") else str(v))
-    os.replace(temporary, report_path)
+    write_report(report_path, report)
     print(f"topstoc batch: {len(results)} done, {len(skipped)} skipped, {len(failures)} failed "
           f"in {report['seconds']:.1f} s; report {report_path}", flush=True)
     return 1 if failures else 0
