@@ -259,7 +259,7 @@ def _result(raw: dict, parameters: dict) -> DecimateResult:
 def _guidance(mesh: Mesh, guidance) -> Optional[np.ndarray]:
     if guidance is None:
         return None
-    u = np.asarray(guidance, dtype=np.float64)
+    u = params.real_array("guidance", guidance, "one number in [-1, 1] per vertex", booleans=True)
     if u.shape != (mesh.native.report["input_vertices"],):
         raise TopStocError(f"guidance must hold one value per vertex ({mesh.vertices.shape[0]}), "
                            f"got shape {u.shape}")

@@ -10,7 +10,8 @@ using them, so that all of them accept the same things and fail the same way:
 - NaN is refused; infinity only where the range allows it;
 - the message names the parameter, the range and the value as given;
 - arrays (:func:`array`: points, directions, matrices) must have the shape asked for and hold
-  finite numbers.
+  finite numbers; :func:`real_array` refuses strings, complex numbers and objects in any array
+  parameter (guidance too), which NumPy would otherwise convert or truncate silently.
 
 Every refusal is a :class:`ParameterError`, a :class:`~.errors.TopStocError` (so a ValueError).
 """
@@ -19,6 +20,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import reprlib
 from typing import Optional
 
 import numpy as np
@@ -94,20 +96,27 @@ def seed(value, name: str = "seed") -> int:
     return integer(name, value, 0, SEED_MAX)
 
 
+def real_array(name: str, value, expected: str, *, booleans: bool = False) -> np.ndarray:
+    """``value`` (numbers of any shape) as a float64 array; ParameterError for strings, complex
+    numbers, objects, ragged lists (and booleans unless ``booleans``). ``expected`` says what
+    the parameter must be ("3 numbers") in the message."""
+    try:
+        data = np.asarray(value)
+    except Exception:  # noqa: BLE001 - ragged nested lists and the like
+        raise ParameterError(f"{name} must be {expected}, got {reprlib.repr(value)}") from None
+    if data.dtype.kind not in ("iufb" if booleans else "iuf"):
+        what = "booleans" if data.dtype.kind == "b" else f"{data.dtype} values"
+        raise ParameterError(f"{name} must be {expected}, got {what}: {reprlib.repr(value)}")
+    return data.astype(np.float64)
+
+
 def array(name: str, value, shape: tuple, *, nonzero: bool = False) -> np.ndarray:
     """``value`` (a sequence or array of numbers) as a float64 array of exactly ``shape``, every
     entry finite (and not all zero when ``nonzero``); ParameterError otherwise."""
     expected = f"{shape[0]} numbers" if len(shape) == 1 else "a " + " x ".join(map(str, shape)) + " matrix"
-    try:
-        data = np.asarray(value)
-    except Exception:  # noqa: BLE001 - ragged nested lists and the like
-        raise ParameterError(f"{name} must be {expected}, got {value!r}") from None
-    if data.dtype.kind not in "iuf":
-        what = "booleans" if data.dtype.kind == "b" else f"{data.dtype} values"
-        raise ParameterError(f"{name} must be {expected}, got {what}: {value!r}")
+    data = real_array(name, value, expected)
     if data.shape != tuple(shape):
         raise ParameterError(f"{name} must be {expected}, got shape {data.shape}")
-    data = data.astype(np.float64)
     if not np.isfinite(data).all():
         where = tuple(int(i) for i in np.argwhere(~np.isfinite(data))[0])
         raise ParameterError(f"{name} must hold finite numbers, got {data[where]} at [{', '.join(map(str, where))}]")
