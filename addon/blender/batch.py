@@ -30,7 +30,7 @@ from ..core.decimate import ATTRIBUTE_WEIGHT
 from ..core.prune import prune_small_parts
 from ..core.batch_run import misnamed_failure, utf8_name, write_report
 from ..core.errors import TopStocError, one_line, shown_path
-from ..core.output_guard import check_folders, check_output, output_folder
+from ..core.output_guard import check_folders, prepare_output, output_folder
 
 BLEND = ".blend"
 
@@ -238,7 +238,7 @@ def main(argv=None) -> int:
     try:
         settings = batch_settings.from_args(args)
         check_folders(args.input, args.output)
-        check_output(args.json, args.input)
+        prepare_output(args.json, args.input)
         output_folder(args.output)
     except (ValueError, OSError) as error:
         print(f"topstoc batch: error: {one_line(error)}", file=sys.stderr, flush=True)

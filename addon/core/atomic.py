@@ -9,9 +9,12 @@ file is removed:
   naming the file, without Python's ``[Errno N]`` prefix;
 - SIGTERM or SIGINT while it exists removes it, then the signal takes its usual course (SIGTERM
   ends the process as before, SIGINT raises KeyboardInterrupt). Handlers can only be set in the
-  main thread; elsewhere (a Dask worker's task) the next run sweeps up instead;
-- SIGKILL cannot be caught: the next write to the same target removes the temporary files whose
-  process is gone (``sweep``).
+  main thread and only over handlers Python can put back; elsewhere (a Dask worker's task,
+  Blender's own handlers) the next write sweeps up instead;
+- SIGKILL cannot be caught: ``sweep`` removes the temporary files whose process is gone; the
+  commands call it before they write (topstoc.core.output_guard.prepare_output), the batch
+  after its run (topstoc.core.batch_run.remove_stale_temporaries). Not on every write: a
+  folder of many outputs would be listed once per file.
 """
 
 from __future__ import annotations
@@ -77,7 +80,8 @@ def sweep(path) -> int:
 
 @contextmanager
 def _signals_raise():
-    """While inside: SIGTERM and SIGINT raise _Signalled (main thread only; ignored signals stay ignored)."""
+    """While inside: SIGTERM and SIGINT raise _Signalled (main thread only; ignored signals and
+    handlers set outside Python stay as they are)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -87,7 +91,9 @@ def _signals_raise():
 
     previous = {}
     for signum in (signal.SIGTERM, signal.SIGINT):
-        if signal.getsignal(signum) is not signal.SIG_IGN:
+        current = signal.getsignal(signum)
+        # None: a handler set outside Python (Blender's), which could not be put back
+        if current is not None and current is not signal.SIG_IGN:
             previous[signum] = signal.signal(signum, handler)
     try:
         yield
@@ -109,7 +115,6 @@ def write_file(path, write, *, discard_old: bool = False) -> None:
     ``discard_old``: when the write fails, the file already at the target is removed too (a
     report of an earlier run, which would otherwise pass for this run's)."""
     final = target(path)
-    sweep(final)
     temporary = f"{final}.tmp{os.getpid()}"
     try:
         with _signals_raise():

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 
+from . import atomic
 from .errors import TopStocError, shown_path
 
 
@@ -45,19 +46,21 @@ def _folders_holding(path) -> list:
             found.append(identity)
 
 
-def check_output(output, inputs, *, overwrite: bool = False) -> None:
-    """Refuses ``output`` when it is one of ``inputs`` (None entries, and a None output, skipped).
-    ``overwrite`` allows replacing the first input, the one file a single-file command transforms."""
+def prepare_output(output, inputs, *, overwrite: bool = False) -> None:
+    """Refuses ``output`` when it is one of ``inputs`` (None entries, and a None output, skipped),
+    then removes the temporary files killed writers of it left (atomic.sweep). ``overwrite``
+    allows replacing the first input, the one file a single-file command transforms."""
     if output is None:
         return
     for index, given in enumerate(inputs):
         if given is None or not same_file(given, output):
             continue
         if overwrite and index == 0:
-            return
+            continue
         alias = "" if os.path.abspath(given) == os.path.abspath(output) else f" {shown_path(given)}"
         hint = ", or pass --overwrite to replace the input" if index == 0 else ""
         raise TopStocError(f"{shown_path(output)}: the output is the input file{alias}; write to another file{hint}")
+    atomic.sweep(output)
 
 
 def check_folders(inputs, out_dir) -> None:

@@ -244,6 +244,6 @@ def test_usd_without_usd_support_is_a_clear_failure(ts, scene, tmp_path):
     source = tmp_path / "asset.usdc"
     source.write_bytes(b"PXR-USDC")
     batch_run = importlib.import_module(ts.__name__ + ".core.batch_run")
-    outcome = batch_run.run_asset(str(source), str(tmp_path), _settings(ts, "--ratio", "0.5"), _runner())
+    outcome = batch_run.run_asset(str(source), str(tmp_path / "out"), _settings(ts, "--ratio", "0.5"), _runner())
     assert outcome["status"] == "failed"
     assert "built without USD" in outcome["message"], outcome["message"]

@@ -38,6 +38,11 @@ def report(folder, name="topstoc-report.json") -> dict:
     return json.loads((pathlib.Path(folder) / name).read_text())
 
 
+def ran(data: dict) -> list:
+    """The report's results of the assets this run decimated (not those resumed from an earlier run)."""
+    return [entry for entry in data["results"] if not entry.get("resumed")]
+
+
 def manifest(folder) -> list:
     return [json.loads(line) for line in (pathlib.Path(folder) / "topstoc-manifest.jsonl").open()]
 

@@ -16,7 +16,7 @@ import sys
 import pytest
 
 from assets import make_assets
-from batch_runs import batch, leftovers, outputs, report
+from batch_runs import batch, leftovers, outputs, ran, report
 from conftest import BUILD, ROOT
 
 pytest.importorskip("distributed")
@@ -62,7 +62,9 @@ def test_resume_skips_done_work(library, serial, tmp_path):
     done = batch("--input", library[0].parent, "--output", out, *TARGET, "--workers", 0)
     assert done.returncode == 0, done.stderr
     data = report(out)
-    assert len(data["skipped"]) == ASSETS and not data["results"]
+    assert len(data["skipped"]) == ASSETS and not ran(data)
+    # the figures of the earlier run stay in the report
+    assert [{k: v for k, v in r.items() if k != "resumed"} for r in data["results"]] == report(serial)["results"]
     assert {name: (out / name).stat().st_mtime_ns for name in outputs(out)} == before
     # An edited input, a deleted output and other settings make exactly those run again.
     inputs = tmp_path / "inputs"
@@ -76,7 +78,7 @@ def test_resume_skips_done_work(library, serial, tmp_path):
     text = manifest.read_text()
     manifest.write_text(text[:-40])
     done = batch("--input", inputs, "--output", rerun, *TARGET, "--workers", 0)
-    assert len(report(rerun)["results"]) == 1 and len(report(rerun)["skipped"]) == 9
+    assert len(ran(report(rerun))) == 1 and len(report(rerun)["skipped"]) == 9
     edited = sorted(inputs.iterdir())[3]
     edited.write_bytes(edited.read_bytes() + b"\n")
     deleted = sorted(outputs(rerun))[7]
@@ -84,12 +86,13 @@ def test_resume_skips_done_work(library, serial, tmp_path):
     done = batch("--input", inputs, "--output", rerun, *TARGET, "--workers", 0)
     assert done.returncode == 0, done.stderr
     data = report(rerun)
-    assert sorted(pathlib.Path(r["input"]).name for r in data["results"]) == sorted([edited.name, deleted])
+    assert sorted(pathlib.Path(r["input"]).name for r in ran(data)) == sorted([edited.name, deleted])
+    assert len(data["results"]) == 10
     assert len(data["skipped"]) == 8
     expected = {name: data for name, data in outputs(serial).items() if name in {p.name for p in library[:10]}}
     assert outputs(rerun) == expected   # the edit is a trailing newline: the same mesh
     done = batch("--input", inputs, "--output", rerun, "--ratio", "0.4", "--workers", 0)
-    assert len(report(rerun)["results"]) == 10
+    assert len(ran(report(rerun))) == 10
 
 
 def test_a_failing_asset_is_reported_and_the_others_go_on(library, tmp_path):

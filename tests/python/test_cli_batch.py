@@ -98,3 +98,39 @@ def test_progress_summary_of_a_scene_with_lods():
     assert _summary(entry) == "300 -> 150 / 60 / 15 vertices (3 LODs)"
     single = {"vertices_in": 300, "vertices_out": 150, "triangles_out": 290, "objects": [{"lods": [{"vertices": 150}]}]}
     assert _summary(single) == "300 -> 150 vertices, 290 triangles"
+
+
+def test_a_resumed_batch_keeps_the_finished_assets_figures(tmp_path):
+    for name in ("a.obj", "b.off"):
+        _torus(tmp_path / "in", name)
+    out = tmp_path / "out"
+    assert batch("--input", tmp_path / "in", "--output", out, "--ratio", 0.5, 0.25, "--workers", 0).returncode == 0
+    first = json.loads((out / "topstoc-report.json").read_text())["results"]
+    _torus(tmp_path / "in", "c.ply")
+    done = batch("--input", tmp_path / "in", "--output", out, "--ratio", 0.5, 0.25, "--workers", 0)
+    assert done.returncode == 0, done.stderr
+    report = json.loads((out / "topstoc-report.json").read_text())
+    assert [r["input"].rsplit("/", 1)[-1] for r in report["results"]] == ["a.obj", "b.off", "c.ply"]
+    assert [r.get("resumed") for r in report["results"]] == [True, True, None]
+    for earlier, kept in zip(first, report["results"]):
+        assert [lod["vertices"] for lod in kept["lods"]] == [lod["vertices"] for lod in earlier["lods"]] == [144, 72]
+        assert kept["lods"][1]["hausdorff"] == earlier["lods"][1]["hausdorff"] > 0
+    assert len(report["skipped"]) == 2 and "1 done, 2 skipped" in done.stdout
+
+
+def test_a_file_name_that_is_not_utf8_fails_that_asset_only(tmp_path):
+    import os
+
+    source = _torus(tmp_path / "in", "ring.obj")
+    bad = os.path.join(os.fsencode(tmp_path / "in"), b"caf\xe9.obj")
+    with open(bad, "wb") as stream:
+        stream.write(source.read_bytes())
+    out = tmp_path / "out"
+    done = batch("--input", tmp_path / "in", "--output", out, "--ratio", 0.5, "--workers", 0)
+    assert done.returncode == 1
+    message = f"{tmp_path}/in/caf\\xe9.obj: the file name is not valid UTF-8; rename the file"
+    assert done.stderr.strip().splitlines() == [f"topstoc batch [1/2] {tmp_path}/in/caf\\xe9.obj: FAILED: {message}"]
+    report = json.loads((out / "topstoc-report.json").read_text())
+    assert report["failures"] == [{"input": f"{tmp_path}/in/caf\\xe9.obj", "message": message}]
+    assert [r["vertices_out"] for r in report["results"]] == [144]
+    assert sorted(os.listdir(out)) == ["ring.obj", "topstoc-manifest.jsonl", "topstoc-report.json"]

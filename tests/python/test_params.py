@@ -246,3 +246,21 @@ def test_parameter_errors_are_topstoc_errors():
     with pytest.raises(topstoc.TopStocError):
         params.number("ratio", True, 0, 1)
     assert issubclass(params.ParameterError, ValueError)
+
+
+# --- guidance (one number per vertex) ------------------------------------------------------------
+
+def test_guidance_refuses_what_is_not_real_numbers(mesh):
+    """Strings and complex numbers were converted by NumPy (complex silently dropping the
+    imaginary part) where every other array parameter refuses them."""
+    n = len(mesh.vertices)
+    for bad, what in ((["0.5"] * n, "<U3 values"), (np.full(n, 0.5 + 0.5j), "complex128 values"),
+                      (np.full(n, 0.5 + 0j), "complex128 values"), ([None] * n, "object values")):
+        with pytest.raises(params.ParameterError, match=f"guidance must be one number in .-1, 1. per vertex, got {what}"):
+            mesh.decimate(ratio=0.5, guidance=bad)
+    u = np.zeros(n)
+    u[:10] = 1
+    kept = mesh.decimate(mode="fast", ratio=0.5, seed=3, guidance=u)
+    for same in (u.astype(np.float32), u.astype(int), u.astype(bool), u.tolist()):  # numbers stay accepted
+        np.testing.assert_array_equal(mesh.decimate(mode="fast", ratio=0.5, seed=3, guidance=same).vertices,
+                                      kept.vertices)

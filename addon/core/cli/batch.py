@@ -19,7 +19,7 @@ from ..batch_run import (find_inputs, misnamed_failure, remove_orphaned_scratch,
                          run_dask, run_serial, utf8_name, write_report)
 from ..manifest import Manifest, content_hash, task_key
 from ..errors import TopStocError
-from ..output_guard import check_folders, check_output, check_outputs, output_folder
+from ..output_guard import check_folders, prepare_output, check_outputs, output_folder
 
 REPORT_NAME = "topstoc-report.json"
 
@@ -152,7 +152,7 @@ def run(args) -> int:
         raise TopStocError("no input assets found")
     report_path = args.json or os.path.join(args.output, REPORT_NAME.replace(".json", suffix + ".json"))
     check_folders(args.input, args.output)
-    check_output(report_path, inputs)
+    prepare_output(report_path, inputs)
     output_folder(args.output)
     manifest = Manifest(args.output, suffix)
     manifest.check_inputs(inputs)

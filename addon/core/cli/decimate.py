@@ -20,7 +20,7 @@ from ..attributes import material_regions, transfer_attributes, uv_seam_edges
 from ..io import dropped_attributes, mesh_format, read_mesh, write_mesh
 from ..decimate import ATTRIBUTE_WEIGHT
 from ..mesh import Mesh
-from ..output_guard import add_overwrite_argument, check_output
+from ..output_guard import add_overwrite_argument, prepare_output
 from ..symmetry import AXES, decimate_mirrored
 from . import print_json
 from ..errors import TopStocError
@@ -122,7 +122,7 @@ def _error_bound_report(result) -> dict:
 
 
 def run(args) -> int:
-    check_output(args.output, [args.input, args.guidance], overwrite=args.overwrite)
+    prepare_output(args.output, [args.input, args.guidance], overwrite=args.overwrite)
     mesh_format(args.output)  # fail on a bad output name before doing any work
     data = read_mesh(args.input)
     if data.num_triangles == 0:

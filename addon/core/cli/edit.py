@@ -14,7 +14,7 @@ import numpy as np
 
 from . import print_json
 from ..errors import TopStocError
-from ..output_guard import add_overwrite_argument, check_output
+from ..output_guard import add_overwrite_argument, prepare_output
 
 
 def add_parser(subparsers) -> None:
@@ -71,7 +71,7 @@ def _ids(text: str, what: str) -> list:
 
 
 def run_fill(args) -> int:
-    check_output(args.output, [args.input], overwrite=args.overwrite)
+    prepare_output(args.output, [args.input], overwrite=args.overwrite)
     from ..edit import fill_holes
     from ..io import read_mesh
 
@@ -98,7 +98,7 @@ def run_fill(args) -> int:
 
 
 def run_remove_handle(args) -> int:
-    check_output(args.output, [args.input], overwrite=args.overwrite)
+    prepare_output(args.output, [args.input], overwrite=args.overwrite)
     from ..edit import remove_handle
     from ..io import read_mesh
 

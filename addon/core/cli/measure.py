@@ -11,7 +11,7 @@ import time
 
 from .. import atomic
 from ..hausdorff import DEFAULT_SAMPLES, hausdorff
-from ..output_guard import check_output
+from ..output_guard import prepare_output
 
 
 def add_parser(subparsers) -> None:
@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
     from ..io import read_mesh  # imported here so that --help works without the readers
 
     errors = None if args.errors is None else errors_file(args.errors)
-    check_output(errors, [args.a, args.b])
+    prepare_output(errors, [args.a, args.b])
     a = read_mesh(args.a)
     b = read_mesh(args.b)
     started = time.perf_counter()
