@@ -72,7 +72,8 @@ def utf8_name(path) -> bool:
 
 def misnamed_failure(path) -> dict:
     """The report's failure of an input whose name is not valid UTF-8 (shown with its bytes escaped)."""
-    return {"input": shown_path(path), "message": f"{shown_path(path)}: the file name is not valid UTF-8; rename the file"}
+    shown = shown_path(path)
+    return {"input": shown, "message": f"{shown}: the file name is not valid UTF-8; rename the file"}
 
 
 def write_report(path: str, report: dict) -> None:

@@ -11,10 +11,11 @@ appended by the one process that drives the batch (never by workers) as results 
 so an edited input or other settings make the asset run again. Content alone cannot tell an
 input from a LOD an earlier run wrote (a LOD is new content, so it would be decimated again):
 outputs never go where inputs are read (topstoc.core.output_guard), and an input that is one of
-the outputs the manifest lists (the same file, under any name) is refused (``check_inputs``). An asset is skipped when its
-last record in any of the folder's manifests is "done" and every output it lists still exists. Each record is written with one
-``write`` and flushed to disk, so a batch killed mid-write loses at most that last line, which a
-rerun ignores (and redoes the asset).
+the outputs the manifest lists (the same file, under any name) is refused (``check_inputs``).
+An asset is skipped when its last record in any of the folder's manifests is "done" and every
+output it lists still exists. Each record is written with one ``write`` and flushed to disk, so
+a batch killed mid-write loses at most that last line, which a rerun ignores (and redoes the
+asset).
 """
 
 from __future__ import annotations

@@ -256,7 +256,8 @@ def test_guidance_refuses_what_is_not_real_numbers(mesh):
     n = len(mesh.vertices)
     for bad, what in ((["0.5"] * n, "<U3 values"), (np.full(n, 0.5 + 0.5j), "complex128 values"),
                       (np.full(n, 0.5 + 0j), "complex128 values"), ([None] * n, "object values")):
-        with pytest.raises(params.ParameterError, match=f"guidance must be one number in .-1, 1. per vertex, got {what}"):
+        expected = f"guidance must be one number in .-1, 1. per vertex, got {what}"
+        with pytest.raises(params.ParameterError, match=expected):
             mesh.decimate(ratio=0.5, guidance=bad)
     u = np.zeros(n)
     u[:10] = 1

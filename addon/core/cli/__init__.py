@@ -12,6 +12,7 @@ import json
 import sys
 
 from ..errors import one_line
+
 # Subcommand modules, in the order --help lists them.
 SUBCOMMANDS = ("decimate", "batch", "measure", "topology", "loops", "edit")
 
