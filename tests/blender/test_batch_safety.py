@@ -1,6 +1,7 @@
 """The Blender batch never writes into a folder it reads inputs from, says one line for an output
 that is a file, and writes a symlinked output through (docs/design.md §6.1)."""
 
+import json
 import os
 import sys
 
@@ -83,3 +84,19 @@ def test_symlinked_scene_output_is_written_through(ts, blend_file, tmp_path):
     except RuntimeError as error:
         pytest.skip(f"this Blender cannot read the batch Blender's file: {error}")
     assert len(bpy.data.objects["Ring"].data.vertices) == 100
+
+
+def test_a_file_name_that_is_not_utf8_fails_that_input_only(ts, tmp_path):
+    ring = _ring(ts, tmp_path / "in" / "ring.obj")
+    bad = os.path.join(os.fsencode(tmp_path / "in"), b"caf\xe9.obj")
+    with open(bad, "wb") as stream:
+        stream.write(ring.read_bytes())
+    report = tmp_path / "report.json"
+    done = batch("--input", os.fsdecode(bad), ring, "--output", tmp_path / "out", "--ratio", "0.5", "--json", report)
+    assert done.returncode == 1, done.stdout + done.stderr
+    shown = f"{tmp_path}/in/caf\\xe9.obj"
+    assert f"topstoc batch [1/2] {shown}: FAILED: {shown}: the file name is not valid UTF-8" in done.stderr
+    assert "Traceback" not in done.stderr and "topstoc batch: 1 done, 1 failed" in done.stdout
+    data = json.loads(report.read_text())
+    assert [f["input"] for f in data["failures"]] == [shown]
+    assert [r["vertices_out"] for r in data["results"]] == [144]
