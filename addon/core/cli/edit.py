@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from . import print_json
+from . import print_json, progress
 from ..errors import TopStocError
 
 
@@ -56,6 +56,7 @@ def _patch_options(parser) -> None:
     parser.add_argument("--fair", action="store_true",
                         help="refine the patches to the surrounding density and fair them (adds vertices)")
     parser.add_argument("--json", action="store_true", help="print a JSON report")
+    progress.add_arguments(parser)
 
 
 def _ids(text: str, what: str) -> list:

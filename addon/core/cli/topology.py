@@ -13,7 +13,7 @@ import time
 
 from ..io import read_mesh
 from ..topology import topology
-from . import print_json
+from . import print_json, progress
 
 #: Components listed in the text report before "... and N more".
 TEXT_COMPONENTS = 20
@@ -28,6 +28,7 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--generators", action="store_true",
                         help="also the 2g generator edges and loops of each closed orientable component")
     parser.add_argument("--json", action="store_true", help="print a JSON report")
+    progress.add_arguments(parser)
     parser.set_defaults(run=run)
 
 
