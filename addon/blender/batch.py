@@ -38,10 +38,7 @@ def parse_args(argv):
     parser = argparse.ArgumentParser(
         prog="blender -b --python topstoc/batch.py --",
         description="Decimate mesh files, .blend, glTF/GLB, FBX and USD files with TopStoc.")
-    parser.add_argument("--input", nargs="+", required=True, metavar="FILE",
-                        help="mesh files (.obj .ply .off .stl, optionally .gz/.bz2), .blend, .gltf/.glb, "
-                             ".fbx or .usd/.usda/.usdc files")
-    parser.add_argument("--output", required=True, metavar="DIR")
+    batch_settings.add_io_arguments(parser)  # files and folders, as topstoc batch takes them
     parser.add_argument("--json", metavar="REPORT.json", help="write the report here")
     batch_settings.add_arguments(parser)
     return parser.parse_args(argv)
@@ -234,15 +231,22 @@ def main(argv=None) -> int:
         args = parse_args(argv)
     except SystemExit as exit_:
         return int(exit_.code or 0)
+    from ..core.batch_run import find_inputs
+
     try:
         settings = batch_settings.from_args(args)
-    except ValueError as error:
-        print(f"topstoc batch: error: {error}", file=sys.stderr, flush=True)
+        inputs = find_inputs(args.input)
+        if not inputs:
+            raise TopStocError("no input assets found")
+    except (ValueError, OSError) as error:
+        from ..core.cli.messages import error_text
+
+        print(f"topstoc batch: error: {error_text(error)}", file=sys.stderr, flush=True)
         return 1
     os.makedirs(args.output, exist_ok=True)
     report = {"results": [], "failures": []}
-    total = len(args.input)
-    for i, path in enumerate(args.input, 1):
+    total = len(inputs)
+    for i, path in enumerate(inputs, 1):
         prefix = f"topstoc batch [{i}/{total}] {path}"
         print(f"{prefix}: decimating ...", flush=True)
         try:

@@ -98,3 +98,39 @@ def test_progress_summary_of_a_scene_with_lods():
     assert _summary(entry) == "300 -> 150 / 60 / 15 vertices (3 LODs)"
     single = {"vertices_in": 300, "vertices_out": 150, "triangles_out": 290, "objects": [{"lods": [{"vertices": 150}]}]}
     assert _summary(single) == "300 -> 150 vertices, 290 triangles"
+
+
+def test_lod_chains_are_finest_first_whatever_the_order_given(tmp_path):
+    source = _torus(tmp_path / "in")
+    for order in ((0.1, 0.5), (0.5, 0.1)):
+        out = tmp_path / f"out{order[0]}"
+        done = batch("--input", source, "--output", out, "--ratio", *order, "--workers", 0)
+        assert done.returncode == 0, done.stderr
+        [entry] = json.loads((out / "topstoc-report.json").read_text())["results"]
+        assert [lod["target"] for lod in entry["lods"]] == [{"ratio": 0.5}, {"ratio": 0.1}]
+        counts = [read_mesh(out / f"ring_LOD{i}.obj").num_vertices for i in (0, 1)]
+        assert counts[0] > counts[1]  # LOD0 the most detailed
+    # error and distance targets: smaller is finer
+    out = tmp_path / "by_error"
+    done = batch("--input", source, "--output", out, "--max-error", "4%", "1%", "--workers", 0)
+    assert done.returncode == 0, done.stderr
+    [entry] = json.loads((out / "topstoc-report.json").read_text())["results"]
+    assert [lod["target"]["max_error"] for lod in entry["lods"]] == [0.01, 0.04]
+    assert entry["lods"][0]["vertices"] > entry["lods"][1]["vertices"]
+    mixed = batch("--input", source, "--output", tmp_path / "mixed", "--max-error", "1%", "0.1", "--workers", 0)
+    cli.assert_one_error_line("batch", mixed, "must all be in % or all absolute")
+
+
+def test_compressed_inputs_give_uncompressed_outputs_unless_asked(tmp_path):
+    v, f = meshgen.torus(24, 12)
+    (tmp_path / "in").mkdir()
+    write_mesh(tmp_path / "in" / "ring.ply.gz", MeshData(vertices=v, triangles=f))
+    done = batch("--input", tmp_path / "in", "--output", tmp_path / "plain", "--ratio", 0.5, "--workers", 0)
+    assert done.returncode == 0, done.stderr
+    assert [p.name for p in (tmp_path / "plain").glob("ring*")] == ["ring.ply"]
+    assert (tmp_path / "plain" / "ring.ply").read_bytes().startswith(b"ply\n")
+    kept = batch("--input", tmp_path / "in", "--output", tmp_path / "kept", "--ratio", 0.5, "--workers", 0,
+                 "--keep-compression")
+    assert kept.returncode == 0, kept.stderr
+    assert (tmp_path / "kept" / "ring.ply.gz").read_bytes()[:2] == b"\x1f\x8b"  # gzip magic
+    assert read_mesh(tmp_path / "kept" / "ring.ply.gz").num_vertices == read_mesh(tmp_path / "plain" / "ring.ply").num_vertices
