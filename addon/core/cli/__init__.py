@@ -59,12 +59,15 @@ def main(argv=None) -> int:
     try:
         with warnings.catch_warnings():
             warnings.showwarning = messages.show_warning
-            if isinstance(wants, bool):
-                progress.start(command, forced=wants, quiet=progress.quiet() or getattr(args, "json", False) is True)
+            stdout = sys.stdout
+            if isinstance(wants, bool) and progress.start(
+                    command, forced=wants, quiet=progress.quiet() or getattr(args, "json", False) is True):
+                sys.stdout = progress.StopOnOutput(stdout)
             try:
                 return int(args.run(args) or 0)
             finally:
                 progress.stop()
+                sys.stdout = stdout
     except BrokenPipeError:
         # The reader went away (e.g. `| head`): stop quietly, as Unix tools do.
         import os

@@ -71,6 +71,7 @@ class Progress:
             progress.attach(self.bar.clear, self.bar.refresh)
         elif not quiet and mode == "auto":
             progress.start("topstoc batch")  # a terminal without tqdm: a ticker line
+            progress.stage(f"0 of {total} assets done")
 
     def line(self, text: str) -> None:
         if self.quiet:
@@ -78,8 +79,7 @@ class Progress:
         if self.bar is not None:
             self.bar.write(text, file=sys.stderr)
         else:
-            progress.clear()
-            print(text, flush=True)
+            progress.print_line(text, sys.stdout)
 
     def advance(self, path: str, text: str, failed: bool = False) -> None:
         self.count += 1
@@ -88,10 +88,9 @@ class Progress:
             if failed:
                 self.bar.write(f"topstoc batch: {path}: {text}", file=sys.stderr)
         elif failed or not self.quiet:
-            progress.clear()
             progress.stage(f"{self.count} of {self.total} assets done")
-            print(f"topstoc batch [{self.count}/{self.total}] {path}: {text}", flush=True,
-                  file=sys.stderr if failed else sys.stdout)
+            progress.print_line(f"topstoc batch [{self.count}/{self.total}] {path}: {text}",
+                                sys.stderr if failed else sys.stdout)
 
     def close(self) -> None:
         progress.stop()

@@ -61,8 +61,7 @@ def error_text(error: BaseException) -> str:
 def print_error(command: str, text: str) -> None:
     from . import progress
 
-    progress.clear()
-    print(f"{command}: error: {text}", file=sys.stderr, flush=True)
+    progress.print_line(f"{command}: error: {text}", sys.stderr)
 
 
 def print_warning(text: str) -> None:
@@ -71,9 +70,8 @@ def print_warning(text: str) -> None:
 
     if progress.quiet():
         return
-    progress.clear()
     first = str(text).strip().splitlines()
-    print(f"topstoc: warning: {first[0] if first else 'warning'}", file=sys.stderr, flush=True)
+    progress.print_line(f"topstoc: warning: {first[0] if first else 'warning'}", sys.stderr)
 
 
 def show_warning(message, category, filename, lineno, file=None, line=None) -> None:

@@ -154,6 +154,31 @@ def stop() -> None:
         ticker.stop()
 
 
+def print_line(text: str, stream=None) -> None:
+    """Prints one line with the progress line out of its way (no redraw can cut in)."""
+    stream = stream or sys.stderr
+    with _lock:
+        clear()
+        stream.write(text + "\n")
+        stream.flush()
+
+
+class StopOnOutput:
+    """Standard output that ends the progress line at its first write: a command's report comes
+    when its work is done, and must not share a line with the progress."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def write(self, text):
+        if _state["ticker"] is not None:
+            stop()
+        return self._stream.write(text)
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 def stage(text: str) -> None:
     """Names what the command does now (shown on the progress line, if any)."""
     ticker = _state["ticker"]
