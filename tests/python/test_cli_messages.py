@@ -162,3 +162,36 @@ def test_symmetry_on_an_asymmetric_mesh_warns(tmp_path):
     # across y the torus is symmetric: no warning
     ok = cli.run("decimate", tmp_path / "ring.ply", tmp_path / "out.ply", "--ratio", 0.3, "--symmetry", "y")
     assert ok.returncode == 0 and ok.stderr == ""
+
+
+def test_on_a_terminal_progress_is_erased_before_the_report(tmp_path):
+    import os
+    import pty
+    import subprocess
+    import sys
+
+    from conftest import BUILD
+
+    primary, secondary = pty.openpty()
+    process = subprocess.Popen([sys.executable, "-m", "topstoc", "decimate", DATA / "genus_positive" /
+                                "cgal_elephant.off", tmp_path / "out.off", "--max-error", "0.3%"],
+                               stdout=secondary, stderr=secondary, env=dict(os.environ, PYTHONPATH=str(BUILD / "python")))
+    os.close(secondary)
+    chunks = []
+    while True:
+        try:
+            chunk = os.read(primary, 4096)
+        except OSError:  # EIO: the child closed the terminal
+            break
+        if not chunk:
+            break
+        chunks.append(chunk)
+    os.close(primary)
+    assert process.wait(timeout=120) == 0
+    text = b"".join(chunks).decode()
+    pieces = text.split("\r\x1b[K")
+    drawn = [p for p in pieces if p.startswith("topstoc decimate: ")]
+    assert drawn, text  # the search outlasts the one-second delay
+    # each drawn progress line is erased before anything else is written: nothing glued to it
+    assert all(re.fullmatch(r"topstoc decimate: .+ \.\.\. \d+ s", p) for p in drawn), drawn
+    assert pieces[-1].startswith(f"{DATA / 'genus_positive' / 'cgal_elephant.off'}: 2775 vertices")
