@@ -16,7 +16,6 @@ exit code 1 when any input failed (the others are still processed).
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import sys
@@ -35,9 +34,12 @@ BLEND = ".blend"
 
 
 def parse_args(argv):
-    parser = argparse.ArgumentParser(
+    from ..core.cli.messages import ArgumentParser
+
+    parser = ArgumentParser(
         prog="blender -b --python topstoc/batch.py --",
         description="Decimate mesh files, .blend, glTF/GLB, FBX and USD files with TopStoc.")
+    parser.command = "topstoc batch"  # errors as topstoc batch prints them
     batch_settings.add_io_arguments(parser)  # files and folders, as topstoc batch takes them
     parser.add_argument("--json", metavar="REPORT.json", help="write the report here")
     batch_settings.add_arguments(parser)

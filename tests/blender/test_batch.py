@@ -88,6 +88,9 @@ def test_named_objects_only(ts, blend_file, tmp_path):
 def test_bad_arguments_exit_non_zero(ts, tmp_path):
     done = batch("--input", DATA / "genus0" / "cgal_fandisk.off", "--output", tmp_path)
     assert done.returncode != 0 and "one of the arguments" in done.stderr
+    # one line, as topstoc batch prints it, no usage dump
+    [line] = [text for text in done.stderr.splitlines() if text.startswith("topstoc batch: error: ")]
+    assert "usage:" not in done.stderr and line.endswith("(see 'blender -b --python topstoc/batch.py -- --help')")
 
 
 def test_mesh_files(ts, tmp_path):

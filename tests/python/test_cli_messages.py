@@ -144,6 +144,9 @@ def _options(parser):
 def test_every_option_has_help():
     missing = [name for name, text in _options(build_parser()) if not text or not text.strip()]
     assert missing == []
+    for command in ("decimate", "batch", "measure", "topology", "loops", "fill-holes", "remove-handle"):
+        text = cli.run(command, "--help").stdout
+        assert "%%" not in text and text.startswith(f"usage: topstoc {command} "), command
     shown = cli.run("batch", "--help").stdout
     for option in ("--output DIR", "--seed S", "--adaptivity A", "--keep-compression", "--quiet"):
         assert option in shown

@@ -22,7 +22,7 @@ def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "measure", help="Hausdorff distance between two meshes",
         description="Hausdorff distance between A (the original) and B (its approximation), "
-                    "sampled on vertices, edges and faces (Metro / MESH style), in %% of A's bounding-box "
+                    "sampled on vertices, edges and faces (Metro / MESH style), in % of A's bounding-box "
                     "diagonal. Forward (A -> B): how far A's surface lies from B's (detail B misses); "
                     "backward (B -> A): how far B's surface lies from A's (where B strays); symmetric: "
                     "the larger of the two, the Hausdorff distance.")

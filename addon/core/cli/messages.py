@@ -83,13 +83,9 @@ class ArgumentParser(argparse.ArgumentParser):
     """argparse with a one-line usage error: ``topstoc decimate: error: ... (see topstoc decimate
     --help)``, exit 2, instead of the usage dump."""
 
+    #: the name errors start with (default: prog); the Blender batch's prog is a Blender command line
+    command = None
+
     def error(self, message):
-        name = command_name(self.prog)
-        print_error(name, f"{message} (see '{name} --help')")
+        print_error(self.command or self.prog, f"{message} (see '{self.prog} --help')")
         self.exit(EXIT_USAGE)
-
-
-def command_name(prog: str) -> str:
-    """'python3 -m topstoc decimate' -> 'topstoc decimate'."""
-    words = prog.split()
-    return " ".join(words[words.index("topstoc"):]) if "topstoc" in words else prog
