@@ -134,3 +134,28 @@ def test_compressed_inputs_give_uncompressed_outputs_unless_asked(tmp_path):
     assert kept.returncode == 0, kept.stderr
     assert (tmp_path / "kept" / "ring.ply.gz").read_bytes()[:2] == b"\x1f\x8b"  # gzip magic
     assert read_mesh(tmp_path / "kept" / "ring.ply.gz").num_vertices == read_mesh(tmp_path / "plain" / "ring.ply").num_vertices
+
+
+def test_warnings_come_back_with_the_asset_one_line_each(tmp_path):
+    (tmp_path / "in").mkdir()
+    (tmp_path / "in" / "old.ply").write_text(
+        "ply\nformat ascii 1.0\nCreated by Blender3D 247\nelement vertex 4\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")
+    done = batch("--input", tmp_path / "in", "--output", tmp_path / "out", "--ratio", 1, "--workers", 0)
+    assert done.returncode == 0, done.stderr
+    expected = f"topstoc: warning: {tmp_path / 'in' / 'old.ply'}: line 3: skipped unknown PLY header line 'Created by Blender3D 247'"
+    assert done.stderr.splitlines() == [expected]
+    [entry] = json.loads((tmp_path / "out" / "topstoc-report.json").read_text())["results"]
+    assert entry["warnings"] == [expected[len("topstoc: warning: "):]]
+    # the task itself carries them back (a Dask worker's outcome travels the same way)
+    from topstoc.core.batch_run import run_asset
+    from topstoc.core.batch_settings import from_args
+    from topstoc.core.cli import build_parser
+
+    settings = from_args(build_parser().parse_args(["batch", "--input", "x", "--output", "y", "--ratio", "1"]))
+    (tmp_path / "again").mkdir()
+    outcome = run_asset(str(tmp_path / "in" / "old.ply"), str(tmp_path / "again"), settings)
+    assert outcome["status"] == "done" and outcome["warnings"] == entry["warnings"]
+    quiet = batch("--input", tmp_path / "in", "--output", tmp_path / "q", "--ratio", 1, "--workers", 0, "--quiet")
+    assert quiet.returncode == 0 and quiet.stderr == ""

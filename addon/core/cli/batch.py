@@ -16,7 +16,7 @@ import sys
 import time
 
 from .. import batch_settings
-from . import progress
+from . import messages, progress
 from ..batch_run import find_inputs, remove_orphaned_scratch, remove_stale_temporaries, run_dask, run_serial
 from ..manifest import Manifest, content_hash, task_key
 from ..errors import TopStocError
@@ -183,6 +183,8 @@ def run(args) -> int:
     results, failures, outputs = {}, {}, []
 
     def on_result(index, outcome):
+        for text in outcome.get("warnings", ()):
+            messages.print_warning(text)
         path = inputs[index]
         key, sha = keys[index]
         record = {"key": key, "input": path, "sha256": sha, "settings": fingerprint, "status": outcome["status"],
