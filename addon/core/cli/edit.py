@@ -77,6 +77,7 @@ def run_fill(args) -> int:
     holes = _ids(args.holes, "--holes") if args.holes is not None else None
     if args.max_edges is not None and args.max_edges < 3:
         raise TopStocError(f"--max-edges must be at least 3, got {args.max_edges}")
+    progress.stage("filling holes")
     start = time.perf_counter()
     result = fill_holes(data.vertices, data.triangles, holes=holes, max_edges=args.max_edges,
                         skip_unfillable=args.skip_unfillable, weld_pinches=not args.no_weld, fair=args.fair)
@@ -100,6 +101,7 @@ def run_remove_handle(args) -> int:
     from ..io import read_mesh
 
     data = read_mesh(args.input)
+    progress.stage("removing the handle")
     start = time.perf_counter()
     loops_seconds = 0.0
     if args.loop is not None:

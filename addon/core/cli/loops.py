@@ -42,6 +42,7 @@ def run(args: argparse.Namespace) -> int:
     data = read_mesh(args.input)
     if args.coarse_vertices is not None and args.coarse_vertices <= 0:
         raise TopStocError(f"--coarse-vertices must be positive, got {args.coarse_vertices}")
+    progress.stage("finding handle and tunnel loops")
     started = time.perf_counter()
     mesh = Mesh(data.vertices, data.triangles)
     result = handle_tunnel_loops(mesh, coarse_vertices=0 if args.full else args.coarse_vertices,

@@ -34,6 +34,7 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     data = read_mesh(args.input)
+    progress.stage("analysing the topology")
     start = time.perf_counter()
     info = topology(data.vertices, data.triangles, generators=args.generators)
     seconds = time.perf_counter() - start
