@@ -48,14 +48,19 @@ def _copy_new(source: str, destination: str) -> bool:
 
 
 def _textures(library: str) -> list:
-    """The texture paths a .mtl file names, as written (the last word of each map statement)."""
+    """The texture paths a .mtl file names (options such as ``-s 1 1 1`` come first): the longest
+    tail of each map statement that is a file beside the library, else its last word."""
+    here = os.path.dirname(library)
+    found = []
     with open(library, "r", encoding="utf-8", errors="replace") as stream:
-        found = []
         for line in stream:
             match = TEXTURE_STATEMENTS.match(line)
-            if match:  # Windows exporters write .\name.jpg
-                found.append(match.group(2).split()[-1].replace("\\", "/"))
-        return found
+            if not match:
+                continue
+            words = match.group(2).replace("\\", "/").split()  # Windows exporters write .\name.jpg
+            tails = [" ".join(words[i:]) for i in range(len(words))]
+            found.append(next((t for t in tails if os.path.isfile(os.path.join(here, t))), words[-1]))
+    return found
 
 
 def _reference(path: str, output_dir: str) -> str:

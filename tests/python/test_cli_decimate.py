@@ -196,8 +196,9 @@ def _textured_obj(folder):
                                              material_names=["skin"], material_libraries=["ring.mtl"]))
     (folder / "textures").mkdir()
     (folder / "textures" / "skin.png").write_bytes(b"\x89PNG fake texture")
+    (folder / "wood grain.png").write_bytes(b"\x89PNG grain")
     (folder / "ring.mtl").write_text("newmtl skin\nKd 1 1 1\nmap_Kd -s 1 1 1 textures/skin.png\n"
-                                     "map_Bump gone.png\n")
+                                     "map_Ks -clamp on wood grain.png\nmap_Bump gone.png\n")
     return folder / "ring.obj"
 
 
@@ -210,11 +211,13 @@ def test_obj_materials_and_textures_follow_the_output(tmp_path):
     assert read_mesh(out / "low.obj").material_libraries == ["ring.mtl"]
     assert (out / "ring.mtl").read_bytes() == (source.parent / "ring.mtl").read_bytes()
     assert (out / "textures" / "skin.png").read_bytes() == b"\x89PNG fake texture"
-    assert sorted(p.name for p in out.iterdir()) == ["low.obj", "ring.mtl", "textures"]
+    assert (out / "wood grain.png").read_bytes() == b"\x89PNG grain"  # a name with a space, after options
+    assert sorted(p.name for p in out.iterdir()) == ["low.obj", "ring.mtl", "textures", "wood grain.png"]
     # the same folder as the input: nothing copied, the name kept
     run_json(source, source.parent / "low.obj", "--ratio", 0.3)
     assert read_mesh(source.parent / "low.obj").material_libraries == ["ring.mtl"]
-    assert sorted(p.name for p in source.parent.iterdir()) == ["low.obj", "ring.mtl", "ring.obj", "textures"]
+    assert sorted(p.name for p in source.parent.iterdir()) == ["low.obj", "ring.mtl", "ring.obj", "textures",
+                                                               "wood grain.png"]
 
 
 def test_an_existing_different_mtl_is_never_overwritten(tmp_path):
@@ -227,7 +230,7 @@ def test_an_existing_different_mtl_is_never_overwritten(tmp_path):
     assert done.stderr.splitlines() == [f"topstoc: warning: {out / 'ring.mtl'}: a different file already exists; "
                                         f"the output refers to {source.parent / 'ring.mtl'} instead"]
     assert (out / "ring.mtl").read_text() == "newmtl other\n"
-    assert not (out / "textures").exists()
+    assert not (out / "textures").exists() and not (out / "wood grain.png").exists()
     assert read_mesh(out / "low.obj").material_libraries == ["../src/ring.mtl"]
 
 
