@@ -159,3 +159,17 @@ def test_warnings_come_back_with_the_asset_one_line_each(tmp_path):
     assert outcome["status"] == "done" and outcome["warnings"] == entry["warnings"]
     quiet = batch("--input", tmp_path / "in", "--output", tmp_path / "q", "--ratio", 1, "--workers", 0, "--quiet")
     assert quiet.returncode == 0 and quiet.stderr == ""
+
+
+def test_obj_lods_get_the_mtl_beside_them_and_report_dropped_normals(tmp_path):
+    import pathlib
+
+    spider = pathlib.Path(__file__).resolve().parents[1] / "data" / "uv_materials" / "spider" / "spider.obj"
+    out = tmp_path / "out"
+    done = batch("--input", spider, "--output", out, "--ratio", 0.5, 0.2, "--workers", 0)
+    assert done.returncode == 0, done.stderr
+    [entry] = json.loads((out / "topstoc-report.json").read_text())["results"]
+    for lod in entry["lods"]:
+        assert read_mesh(lod["output"]).material_libraries == ["spider.mtl"]
+        assert lod["dropped_attributes"] == ["normals"]  # the spider's vn lines are not written
+    assert (out / "spider.mtl").read_bytes() == (spider.parent / "spider.mtl").read_bytes()
