@@ -167,7 +167,8 @@ def test_symmetry_on_an_asymmetric_mesh_warns(tmp_path):
     assert ok.returncode == 0 and ok.stderr == ""
 
 
-def test_on_a_terminal_progress_is_erased_before_the_report(tmp_path):
+def _on_a_terminal(*args) -> str:
+    """Everything ``topstoc ARGS`` writes to a terminal (stdout and stderr on one pty)."""
     import os
     import pty
     import subprocess
@@ -176,9 +177,8 @@ def test_on_a_terminal_progress_is_erased_before_the_report(tmp_path):
     from conftest import BUILD
 
     primary, secondary = pty.openpty()
-    process = subprocess.Popen([sys.executable, "-m", "topstoc", "decimate", DATA / "genus_positive" /
-                                "cgal_elephant.off", tmp_path / "out.off", "--max-error", "0.3%"],
-                               stdout=secondary, stderr=secondary, env=dict(os.environ, PYTHONPATH=str(BUILD / "python")))
+    process = subprocess.Popen([sys.executable, "-m", "topstoc", *map(str, args)], stdout=secondary,
+                               stderr=secondary, env=dict(os.environ, PYTHONPATH=str(BUILD / "python")))
     os.close(secondary)
     chunks = []
     while True:
@@ -191,10 +191,24 @@ def test_on_a_terminal_progress_is_erased_before_the_report(tmp_path):
         chunks.append(chunk)
     os.close(primary)
     assert process.wait(timeout=120) == 0
-    text = b"".join(chunks).decode()
+    return b"".join(chunks).decode()
+
+
+def test_on_a_terminal_progress_is_erased_before_the_report(tmp_path):
+    text = _on_a_terminal("decimate", DATA / "genus_positive" / "cgal_elephant.off", tmp_path / "out.off",
+                          "--max-error", "0.3%")
     pieces = text.split("\r\x1b[K")
     drawn = [p for p in pieces if p.startswith("topstoc decimate: ")]
     assert drawn, text  # the search outlasts the one-second delay
     # each drawn progress line is erased before anything else is written: nothing glued to it
     assert all(re.fullmatch(r"topstoc decimate: .+ \.\.\. \d+ s", p) for p in drawn), drawn
     assert pieces[-1].startswith(f"{DATA / 'genus_positive' / 'cgal_elephant.off'}: 2775 vertices")
+
+
+def test_on_a_terminal_a_long_batch_asset_shows_its_clock(tmp_path):
+    text = _on_a_terminal("batch", "--input", DATA / "genus_positive" / "cgal_elephant.off", "--output", tmp_path,
+                          "--max-error", "0.3%", "--workers", 0)
+    # a bar (tqdm installed) or the ticker line: either way the clock runs while the asset works
+    clocks = re.findall(r"topstoc batch: (?:0 of 1 assets done \.\.\. (\d+) s|.*?\| 0/1 \[(\d\d:\d\d)<)", text)
+    assert len(set(clocks)) >= 2, text  # redrawn with a later time while the one asset works
+    assert text.rstrip().splitlines()[-1].startswith("topstoc batch: 1 done, 0 skipped, 0 failed")
