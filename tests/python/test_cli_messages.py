@@ -176,7 +176,12 @@ def _on_a_terminal(*args) -> str:
 
     from conftest import BUILD
 
+    import fcntl
+    import struct
+    import termios
+
     primary, secondary = pty.openpty()
+    fcntl.ioctl(secondary, termios.TIOCSWINSZ, struct.pack("HHHH", 30, 100, 0, 0))  # tqdm needs a width
     process = subprocess.Popen([sys.executable, "-m", "topstoc", *map(str, args)], stdout=secondary,
                                stderr=secondary, env=dict(os.environ, PYTHONPATH=str(BUILD / "python")))
     os.close(secondary)
