@@ -160,6 +160,8 @@ def run(args) -> int:
             print(f"topstoc batch: chunk {args.chunk} has no inputs", flush=True)
             return 0
         raise TopStocError("no input assets found")
+    if os.path.exists(args.output) and not os.path.isdir(args.output):
+        raise TopStocError(f"{args.output}: is a file; --output names the folder the outputs go to")
     os.makedirs(args.output, exist_ok=True)
     manifest = Manifest(args.output, suffix)
     fingerprint = batch_settings.digest(settings)
