@@ -11,6 +11,8 @@ import errno
 import os
 import sys
 
+from . import progress
+
 EXIT_FAILURE = 1
 EXIT_USAGE = 2
 
@@ -59,15 +61,11 @@ def error_text(error: BaseException) -> str:
 
 
 def print_error(command: str, text: str) -> None:
-    from . import progress
-
     progress.print_line(f"{command}: error: {text}", sys.stderr)
 
 
 def print_warning(text: str) -> None:
     """``topstoc: warning: text`` on its own line (a progress line is cleared first)."""
-    from . import progress
-
     if progress.quiet():
         return
     first = str(text).strip().splitlines()
