@@ -16,6 +16,10 @@ bl_info = {
     "category": "Mesh",
 }
 
+#: The package version: bl_info's is the one place it is set (pyproject.toml, CMakeLists.txt and
+#: blender_manifest.toml repeat it; tests/python/test_cli_messages.py checks that they agree).
+__version__ = ".".join(map(str, bl_info["version"]))
+
 
 def __getattr__(name):
     """``topstoc.Mesh`` etc.: the core API, loaded on first use (PEP 562).

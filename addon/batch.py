@@ -1,7 +1,7 @@
 """Batch decimation in Blender (docs/design.md §6):
 
     blender -b --factory-startup --python-exit-code 1 --python build/python/topstoc/batch.py -- \\
-        --input FILE... (--ratio R | --vertices N | --triangles N | --max-error E[%]) [--seed S] \\
+        --input FILE_OR_DIR... (--ratio R | --vertices N | --triangles N | --max-error E[%]) [--seed S] \\
         --output DIR [--json REPORT.json]
 
 A thin launcher: puts the folder holding this package on sys.path, then runs

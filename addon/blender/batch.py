@@ -16,7 +16,6 @@ exit code 1 when any input failed (the others are still processed).
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
 import traceback
@@ -36,13 +35,13 @@ BLEND = ".blend"
 
 
 def parse_args(argv):
-    parser = argparse.ArgumentParser(
+    from ..core.cli.messages import ArgumentParser
+
+    parser = ArgumentParser(
         prog="blender -b --python topstoc/batch.py --",
         description="Decimate mesh files, .blend, glTF/GLB, FBX and USD files with TopStoc.")
-    parser.add_argument("--input", nargs="+", required=True, metavar="FILE",
-                        help="mesh files (.obj .ply .off .stl, optionally .gz/.bz2), .blend, .gltf/.glb, "
-                             ".fbx or .usd/.usda/.usdc files")
-    parser.add_argument("--output", required=True, metavar="DIR")
+    parser.command = "topstoc batch"  # errors as topstoc batch prints them
+    batch_settings.add_io_arguments(parser)  # files and folders, as topstoc batch takes them
     parser.add_argument("--json", metavar="REPORT.json", help="write the report here")
     batch_settings.add_arguments(parser)
     return parser.parse_args(argv)
@@ -235,17 +234,22 @@ def main(argv=None) -> int:
         args = parse_args(argv)
     except SystemExit as exit_:
         return int(exit_.code or 0)
+    from ..core.batch_run import find_inputs
+
     try:
         settings = batch_settings.from_args(args)
+        inputs = find_inputs(args.input)
+        if not inputs:
+            raise TopStocError("no input assets found")
         check_folders(args.input, args.output)
-        prepare_output(args.json, args.input)
+        prepare_output(args.json, inputs)
         output_folder(args.output)
     except (ValueError, OSError) as error:
         print(f"topstoc batch: error: {one_line(error)}", file=sys.stderr, flush=True)
         return 1
     report = {"results": [], "failures": []}
-    total = len(args.input)
-    for i, path in enumerate(args.input, 1):
+    total = len(inputs)
+    for i, path in enumerate(inputs, 1):
         prefix = f"topstoc batch [{i}/{total}] {shown_path(path)}"
         if not utf8_name(path):
             report["failures"].append(misnamed_failure(path))

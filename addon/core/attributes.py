@@ -297,4 +297,4 @@ def transfer_attributes(data: MeshData, result) -> MeshData:
     materials = None if data.triangle_material is None else data.triangle_material[face_source]
     return MeshData(vertices=result.vertices, triangles=result.triangles, corner_uvs=uvs, vertex_colors=colors,
                     triangle_material=materials, material_names=data.material_names,
-                    material_libraries=data.material_libraries)
+                    material_libraries=data.material_libraries, file_normals=data.file_normals)

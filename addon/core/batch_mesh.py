@@ -17,7 +17,8 @@ from .appearance import Appearance, appearance_attributes, refines
 from .decimate import ATTRIBUTE_WEIGHT
 from .attributes import material_regions, transfer_attributes, uv_seam_edges
 from .hausdorff import hausdorff
-from .io import mesh_format, read_mesh, write_mesh
+from .io import dropped_attributes, mesh_format, read_mesh, write_mesh
+from .materials import carry_libraries
 from .mesh import Mesh
 from .prune import prune_small_parts
 from .errors import TopStocError
@@ -29,8 +30,10 @@ REPORT_SAMPLES = (10_000, 50_000)
 
 
 def output_paths(path: str, out_dir: str, settings: dict) -> list:
-    """The files the asset ``path`` is written to, one per LOD."""
+    """The files the asset ``path`` is written to, one per LOD: in the input's format, uncompressed
+    unless settings keep compression (or --format names one)."""
     kind, compression = mesh_format(path)
+    compression = compression if settings.get("keep_compression") else None
     name = os.path.basename(os.fspath(path))
     stem = name[:name.lower().rindex("." + kind)]
     if settings["format"]:
@@ -38,14 +41,6 @@ def output_paths(path: str, out_dir: str, settings: dict) -> list:
     ext = "." + kind + ("." + compression if compression else "")
     return [os.path.join(out_dir, batch_settings.lod_name(stem, i, settings) + ext)
             for i in range(len(settings["values"]))]
-
-
-def _relative_library(library: str, source: str, destination: str) -> str:
-    """An mtllib path that still points at the input's .mtl from the output's folder."""
-    here = os.path.join(os.path.dirname(os.path.abspath(source)), library)
-    if os.path.isabs(library) or not os.path.exists(here):
-        return library
-    return os.path.relpath(here, os.path.dirname(os.path.abspath(destination)))
 
 
 def lod_error(original, result, screen) -> dict:
@@ -94,8 +89,9 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
                      search_error=None if bound is None else float(bound.achieved_error),
                      **lod_error(mesh, result, screen))
         out = transfer_attributes(data, result)
-        out.material_libraries = [_relative_library(lib, path, output) for lib in out.material_libraries]
+        out.material_libraries = carry_libraries(out.material_libraries, path, output)
         write_mesh(output, out)
+        entry["dropped_attributes"] = dropped_attributes(out, output)
         entry["seconds"] = time.perf_counter() - started
         lods.append(entry)
     first = lods[0]

@@ -19,6 +19,7 @@ import shutil
 import tempfile
 import time
 import traceback
+import warnings
 
 from . import atomic, batch_settings, child_process
 from .atomic import pid_alive
@@ -140,25 +141,34 @@ def run_blender_asset(path: str, out_dir: str, settings: dict, blender: str) -> 
 def run_asset(path: str, out_dir: str, settings: dict, blender: str = None) -> dict:
     """The batch task: ``{"status": "done", "entry": ...}`` or ``{"status": "failed", "message": ...}``."""
     started = time.perf_counter()
-    try:
-        kind = asset_kind(path)
-        if kind == "mesh":
-            from .batch_mesh import decimate_mesh_file
+    # Warnings travel back with the outcome (a Dask worker's stderr would print them in Python's
+    # file:line format, across the batch's progress bar); the batch prints them one line each.
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            kind = asset_kind(path)
+            if kind == "mesh":
+                from .batch_mesh import decimate_mesh_file
 
-            entry = decimate_mesh_file(path, out_dir, settings)
-        elif kind == "blender":
-            entry = run_blender_asset(path, out_dir, settings, find_blender(blender))
+                entry = decimate_mesh_file(path, out_dir, settings)
+            elif kind == "blender":
+                entry = run_blender_asset(path, out_dir, settings, find_blender(blender))
+            else:
+                raise TopStocError(f"{path}: not a supported asset (mesh files {', '.join(MESH_EXTENSIONS)}, "
+                                   f"or {', '.join('.' + f for f in batch_settings.BLENDER_FORMATS)})")
+        except Exception as error:  # one broken asset must not stop the batch
+            message = one_line(error)
+            if not isinstance(error, (ValueError, OSError, RuntimeError)):
+                message += " (" + traceback.format_exc().strip().splitlines()[-1] + ")"
+            outcome = {"status": "failed", "input": os.fspath(path), "message": message}
         else:
-            raise TopStocError(f"{path}: not a supported asset (mesh files {', '.join(MESH_EXTENSIONS)}, "
-                               f"or {', '.join('.' + f for f in batch_settings.BLENDER_FORMATS)})")
-    except Exception as error:  # one broken asset must not stop the batch
-        message = one_line(error)
-        if not isinstance(error, (ValueError, OSError, RuntimeError)):
-            message += " (" + traceback.format_exc().strip().splitlines()[-1] + ")"
-        return {"status": "failed", "input": os.fspath(path), "message": message,
-                "wall_seconds": time.perf_counter() - started, "pid": os.getpid()}
-    return {"status": "done", "input": os.fspath(path), "entry": entry,
-            "wall_seconds": time.perf_counter() - started, "pid": os.getpid()}
+            outcome = {"status": "done", "input": os.fspath(path), "entry": entry}
+    said = list(dict.fromkeys(str(w.message) for w in caught))  # once each, in order
+    if said:
+        outcome["warnings"] = said
+        if "entry" in outcome:
+            outcome["entry"]["warnings"] = said
+    return {**outcome, "wall_seconds": time.perf_counter() - started, "pid": os.getpid()}
 
 
 def run_serial(tasks, out_dir, settings, blender, on_result) -> None:

@@ -3,8 +3,9 @@ the plain dictionary they become (JSON-able: it keys the manifest and travels to
 to the Blender subprocess unchanged).
 
 Targets take one value (one output) or several (a LOD chain ``_LOD0 … _LODn``, one LOD per
-value): ``--ratio 1 0.5 0.25``, ``--screen-pixels 800 200 50``. Screen-size targets
-(topstoc.core.screen_size) become a max-error target per asset.
+value): ``--ratio 1 0.5 0.25``, ``--screen-pixels 800 200 50``. A chain is ordered finest first,
+as game engines number LODs: LOD0 is the most detailed, whatever order the values come in.
+Screen-size targets (topstoc.core.screen_size) become a max-error target per asset.
 """
 
 from __future__ import annotations
@@ -24,10 +25,27 @@ SCREEN_KINDS = ("screen_pixels", "screen_distance")
 BLENDER_FORMATS = ("blend", "gltf", "glb", "fbx", "usd", "usda", "usdc", "usdz")
 
 
+#: how each target kind orders a chain finest first: True = larger values are finer
+FINER_IS_LARGER = {"ratio": True, "vertices": True, "triangles": True, "screen_pixels": True,
+                   "max_error": False, "screen_distance": False}
+
+
+def add_io_arguments(parser) -> None:
+    """--input and --output, the same for ``topstoc batch`` and the Blender batch."""
+    parser.add_argument("--input", nargs="+", required=True, metavar="PATH",
+                        help="asset files, or folders (searched recursively for supported files): mesh files "
+                             "(.obj .ply .off .stl, optionally .gz/.bz2), .blend, .gltf/.glb, .fbx, .usd/.usda/.usdc/.usdz")
+    parser.add_argument("--output", required=True, metavar="DIR",
+                        help="folder for the outputs (created if missing), named like the inputs "
+                             "(<name>_LOD<i> in a chain)")
+
+
 def add_arguments(parser) -> None:
     """The batch options (everything but --input/--output and the runner's own options)."""
     target = parser.add_mutually_exclusive_group(required=True)
-    target.add_argument("--ratio", type=float, nargs="+", metavar="R", help="fraction of the vertices to keep")
+    target.add_argument("--ratio", type=float, nargs="+", metavar="R",
+                        help="fraction of the vertices to keep; several values make a LOD chain, "
+                             "ordered finest first (LOD0 the most detailed) whatever their order here")
     target.add_argument("--vertices", type=int, nargs="+", metavar="N", help="output vertex count")
     target.add_argument("--triangles", type=int, nargs="+", metavar="N", help="output triangle count")
     target.add_argument("--max-error", nargs="+", metavar="E[%]",
@@ -47,10 +65,17 @@ def add_arguments(parser) -> None:
     parser.add_argument("--lod-files", action="store_true",
                         help="LOD chains: one file per LOD (<name>_LOD<i>.<ext>) instead of all LOD "
                              "objects in one file (mesh files always get one file per LOD)")
-    parser.add_argument("--format", metavar="EXT", help="write outputs in this format (default: the input's)")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--adaptivity", type=float, default=0.5)
-    parser.add_argument("--density", choices=("off", "uniform", "adaptive"), default="off")
+    parser.add_argument("--format", metavar="EXT",
+                        help="write outputs in this format, e.g. obj, ply, ply.gz, glb (default: the input's, "
+                             "uncompressed)")
+    parser.add_argument("--keep-compression", action="store_true",
+                        help="mesh files: a compressed input (.gz, .bz2) gives a compressed output (default: "
+                             "uncompressed, which Blender and most tools import)")
+    parser.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (default 0)")
+    parser.add_argument("--adaptivity", type=float, default=0.5, metavar="A",
+                        help="0 samples uniformly, 1 follows curvature fully (default 0.5)")
+    parser.add_argument("--density", choices=("off", "uniform", "adaptive"), default="off",
+                        help="Poisson-disk density control of the samples (default off)")
     parser.add_argument("--mode", choices=("quality", "fast"), default="quality",
                         help="quality (default): TopStoc then quadric edge collapses; fast: plain TopStoc")
     parser.add_argument("--placement", choices=("subsample", "filtered"), default=None,
@@ -93,6 +118,7 @@ def from_args(args) -> dict:
         raise TopStocError(f"--{kind} values must be positive, got {values}")
     elif kind in SCREEN_KINDS and not all(math.isfinite(v) and v > 0 for v in values):
         raise TopStocError(f"--{kind.replace('_', '-')} values must be positive, got {values}")
+    values = finest_first(kind, values)
     if args.prune_pixels and kind not in SCREEN_KINDS:
         raise TopStocError("--prune-pixels needs a screen target (--screen-pixels or --screen-distance)")
     for name in ("pixel_error", "fov", "resolution"):
@@ -104,6 +130,8 @@ def from_args(args) -> dict:
     if args.format:
         out_format = args.format.lower().lstrip(".")
     optional = {"symmetry": args.symmetry} if args.symmetry else {}  # absent when off: older digests hold
+    if getattr(args, "keep_compression", False):
+        optional["keep_compression"] = True
     weight = attribute_weight(args.attribute_weight)
     if weight != ATTRIBUTE_WEIGHT:  # absent at the default, likewise
         optional["attribute_weight"] = weight
@@ -113,6 +141,16 @@ def from_args(args) -> dict:
             "options": {"seed": args.seed, "adaptivity": args.adaptivity, "density": args.density,
                         "mode": args.mode, "placement": args.placement, "refine": args.refine},
             "objects": list(args.objects) if args.objects else None}
+
+
+def finest_first(kind: str, values: list) -> list:
+    """A LOD chain's values ordered finest first (LOD0 the most detailed). --max-error values
+    must all be in % or all absolute (the two cannot be ordered without the mesh)."""
+    if kind == "max_error":
+        if len({relative for _, relative in values}) > 1:
+            raise TopStocError("--max-error values of a LOD chain must all be in % or all absolute")
+        return sorted(values, key=lambda value: value[0])
+    return sorted(values, reverse=FINER_IS_LARGER[kind])
 
 
 def to_argv(settings: dict) -> list:
@@ -127,6 +165,8 @@ def to_argv(settings: dict) -> list:
         argv.append("--lod-files")
     if settings["format"]:
         argv += ["--format", settings["format"]]
+    if settings.get("keep_compression"):
+        argv.append("--keep-compression")
     for name, value in settings["options"].items():
         if value is not None:  # None: the mode decides
             argv += [f"--{name}", str(value)]

@@ -1,5 +1,6 @@
 """TopStoc's error base class, and how any error reads to the user: one line naming its file."""
 
+import errno
 import os
 
 
@@ -17,18 +18,29 @@ def shown_path(path) -> str:
     return os.fsencode(path).decode("utf-8", "backslashreplace")
 
 
-def _system_reason(error: BaseException):
-    """The system's reason for an OSError in lower case ("is a directory"), else None."""
-    if isinstance(error, OSError) and error.errno is not None and error.strerror == os.strerror(error.errno):
-        return error.strerror[:1].lower() + error.strerror[1:]
-    return None
+#: OS errors in words where the system's own text reads oddly (others: its text, lower-cased).
+OS_ERROR_WORDS = {errno.EEXIST: "already exists", errno.ENOTDIR: "a part of the path is not a directory"}
+
+
+def _os_error_text(error: OSError) -> str:
+    """``[Errno 21] Is a directory: 'x'`` -> ``x: is a directory``; a message of ours that
+    carries an errno keeps its words, with the system's part said the same way."""
+    system = os.strerror(error.errno)
+    words = OS_ERROR_WORDS.get(error.errno) or system[:1].lower() + system[1:]
+    text = error.strerror if error.strerror is not None else (str(error) or words)
+    text = text.replace(system, words)
+    if error.filename is not None:
+        target = shown_path(error.filename)
+        if error.filename2 is not None:
+            target += f" -> {shown_path(error.filename2)}"
+        if target not in text:
+            text = f"{target}: {text}"
+    return text
 
 
 def one_line(error: BaseException) -> str:
     """The first line of ``error``'s message; an OSError from the system as ``FILE: reason``
     ("x.obj: is a directory"), without Python's ``[Errno N]`` prefix."""
-    reason = _system_reason(error)
-    if reason is not None:
-        return reason if error.filename is None else f"{shown_path(error.filename)}: {reason}"
-    text = str(error).strip()
+    text = _os_error_text(error) if isinstance(error, OSError) and error.errno is not None else str(error)
+    text = text.strip()
     return text.splitlines()[0] if text else type(error).__name__

@@ -34,6 +34,7 @@ from __future__ import annotations
 import bz2
 import gzip
 import os
+import re
 import warnings
 import zlib
 from dataclasses import dataclass, field
@@ -64,6 +65,8 @@ class MeshData:
     triangle_material: (m,) int32 index into material_names, -1 for faces without one.
     material_libraries: OBJ mtllib arguments as written (the .mtl files are not read).
     skipped_faces: faces with fewer than three corners (points, lines) in the file.
+    file_normals: the file stored normals (OBJ vn, PLY nx, NOFF), which are not read: a
+    written copy has none (dropped_attributes reports them).
     """
 
     vertices: np.ndarray
@@ -75,6 +78,7 @@ class MeshData:
     material_names: List[str] = field(default_factory=list)
     material_libraries: List[str] = field(default_factory=list)
     skipped_faces: int = 0
+    file_normals: bool = False
 
     def __post_init__(self):
         self.vertices = np.asarray(self.vertices, dtype=np.float64).reshape(-1, 3)
@@ -241,7 +245,7 @@ def read_mesh(path, max_decompressed_bytes: Optional[int] = MAX_DECOMPRESSED_BYT
                     triangle_material=parsed["triangle_material"],
                     material_names=_decode_names(name, parsed["material_names"]),
                     material_libraries=_decode_names(name, parsed["material_libraries"]),
-                    skipped_faces=int(parsed["skipped_faces"]))
+                    skipped_faces=int(parsed["skipped_faces"]), file_normals=_stores_normals(kind, data))
 
 
 def encode_mesh(data: MeshData, kind: str) -> bytes:
@@ -262,9 +266,24 @@ def encode_mesh(data: MeshData, kind: str) -> bytes:
 
 
 def dropped_attributes(data: MeshData, path) -> List[str]:
-    """The attributes of ``data`` that writing it to ``path`` would lose (see CARRIES)."""
+    """The attributes of ``data`` that writing it to ``path`` would lose (see CARRIES); "normals"
+    when its file had normals (never written: shading follows the written shape)."""
     kind, _ = mesh_format(path)
-    return [name for name in data.attributes() if name not in CARRIES[kind]]
+    lost = [name for name in data.attributes() if name not in CARRIES[kind]]
+    return lost + ["normals"] if data.file_normals else lost
+
+
+def _stores_normals(kind: str, data: bytes) -> bool:
+    """Whether a file's bytes hold normals: OBJ ``vn`` lines, PLY ``nx`` properties, NOFF."""
+    if kind == "obj":
+        return re.search(rb"(?m)^[ \t]*vn[ \t]", data) is not None
+    if kind == "ply":
+        header = data[:data.find(b"end_header")]
+        return re.search(rb"property\s+\w+\s+nx\b", header) is not None
+    if kind == "off":
+        words = data[:32].split()
+        return bool(words) and words[0].endswith(b"OFF") and b"N" in words[0][:-3]
+    return False
 
 
 def write_mesh(path, data: MeshData) -> None:

@@ -21,6 +21,8 @@ vertices, without a second refinement.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from .errors import TopStocError
 
@@ -98,6 +100,22 @@ def _symmetric_part(vertices, partner) -> np.ndarray:
     return np.asarray(vertices, dtype=np.int64)[keep]
 
 
+class SymmetryWarning(UserWarning):
+    """A symmetric decimation of a mesh that is not (wholly) symmetric: the result is symmetric
+    only where the input is."""
+
+
+def symmetry_warning(partner, axis: str):
+    """The warning text when vertices have no mirror partner across ``axis = 0``, else None."""
+    unpaired = int(np.count_nonzero(partner < 0))
+    if unpaired == 0:
+        return None
+    share = 100.0 * unpaired / len(partner)
+    return (f"--symmetry {axis.lower()}: the mesh is not symmetric across the plane {axis.lower()} = 0: "
+            f"{unpaired} of {len(partner)} vertices ({share:.3g} %) have no mirror partner; the result is "
+            "symmetric only where the input is")
+
+
 def parse_axis(text) -> str:
     """'x' / 'X' -> 'X'; ValueError naming the accepted axes otherwise."""
     axis = str(text).strip().upper()
@@ -130,6 +148,9 @@ def decimate_symmetric(mesh, axis: str = "X", *, tolerance: float = None, region
     layout = dict(regions=regions, borders=borders, feature_angle=feature_angle)
     plain = decimate(mesh, placement=placement, guidance=guidance, **layout, **options)
     partner = mirror_partners(mesh.vertices, axis, tolerance)
+    message = symmetry_warning(partner, axis)
+    if message:
+        warnings.warn(message, SymmetryWarning, stacklevel=3)
     forced = np.flatnonzero(np.asarray(guidance) >= 1.0) if guidance is not None else ()
     refined = plain.stats.refine_vertices > 0
     chosen = np.asarray(plain.kept if refined else plain.samples, dtype=np.int64)

@@ -88,6 +88,9 @@ def test_named_objects_only(ts, blend_file, tmp_path):
 def test_bad_arguments_exit_non_zero(ts, tmp_path):
     done = batch("--input", DATA / "genus0" / "cgal_fandisk.off", "--output", tmp_path)
     assert done.returncode != 0 and "one of the arguments" in done.stderr
+    # one line, as topstoc batch prints it, no usage dump
+    [line] = [text for text in done.stderr.splitlines() if text.startswith("topstoc batch: error: ")]
+    assert "usage:" not in done.stderr and line.endswith("(see 'blender -b --python topstoc/batch.py -- --help')")
 
 
 def test_mesh_files(ts, tmp_path):
@@ -111,6 +114,26 @@ def test_mesh_files(ts, tmp_path):
     spider = io.read_mesh(out / "spider.obj")
     assert spider.corner_uvs is not None and spider.triangle_material is not None
 
+
+
+def test_folders_as_topstoc_batch_takes_them(ts, tmp_path):
+    """A folder is searched recursively for supported files, as ``topstoc batch`` does."""
+    if not has_io(ts):
+        pytest.skip("topstoc.core.io is not in this build")
+    folder = tmp_path / "assets"
+    (folder / "sub").mkdir(parents=True)
+    for source, target in ((DATA / "genus0" / "cgal_fandisk.off", folder / "fandisk.off"),
+                           (DATA / "open_boundary" / "kivy_suzanne_monkey.obj", folder / "sub" / "suzanne.obj")):
+        target.write_bytes(source.read_bytes())
+    (folder / "notes.txt").write_text("not an asset")
+    report = tmp_path / "r.json"
+    done = batch("--input", folder, "--ratio", "0.3", "--output", tmp_path / "out", "--json", report)
+    assert done.returncode == 0, done.stdout + done.stderr
+    data = json.loads(report.read_text())
+    assert sorted(e["input"] for e in data["results"]) == [str(folder / "fandisk.off"), str(folder / "sub" / "suzanne.obj")]
+    assert (tmp_path / "out" / "fandisk.off").exists() and (tmp_path / "out" / "suzanne.obj").exists()
+    missing = batch("--input", tmp_path / "nowhere", "--ratio", "0.3", "--output", tmp_path / "out2")
+    assert missing.returncode == 1 and "nowhere: no such file or folder" in missing.stderr
 
 
 def test_max_error_target(ts, tmp_path):

@@ -219,3 +219,20 @@ def test_blender_assets_run_a_blender_per_task(library, tmp_path):
     assert all(abs(lod["vertices"] - r * 288) <= 3 for lod, r in zip(ring["lods"], (0.25, 0.1)))
     assert (out / "scene.blend").is_file() and not list(out.glob(".topstoc-partial*"))
     assert len(by_name[library[0].name]["lods"]) == 2
+
+
+def test_a_workers_warning_prints_one_line_in_the_driver(tmp_path):
+    """A Dask worker's warning travels back with the asset's outcome: one line on the driver's
+    stderr, not Python's file:line format on the worker's."""
+    (tmp_path / "in").mkdir()
+    (tmp_path / "in" / "old.ply").write_text(
+        "ply\nformat ascii 1.0\nCreated by Blender3D 247\nelement vertex 4\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")
+    done = batch("--input", tmp_path / "in", "--output", tmp_path / "out", "--ratio", "1", "--workers", 1)
+    assert done.returncode == 0, done.stderr
+    assert "MeshFileWarning" not in done.stderr
+    # (Dask may warn about the machine, e.g. a port in use: those lines are its own)
+    assert [line for line in done.stderr.splitlines() if "old.ply" in line] == [
+        f"topstoc: warning: {tmp_path / 'in' / 'old.ply'}: line 3: skipped unknown PLY header line "
+        "'Created by Blender3D 247'"]

@@ -134,3 +134,84 @@ def test_a_file_name_that_is_not_utf8_fails_that_asset_only(tmp_path):
     assert report["failures"] == [{"input": f"{tmp_path}/in/caf\\xe9.obj", "message": message}]
     assert [r["vertices_out"] for r in report["results"]] == [144]
     assert sorted(os.listdir(out)) == ["ring.obj", "topstoc-manifest.jsonl", "topstoc-report.json"]
+def test_lod_chains_are_finest_first_whatever_the_order_given(tmp_path):
+    source = _torus(tmp_path / "in")
+    for order in ((0.1, 0.5), (0.5, 0.1)):
+        out = tmp_path / f"out{order[0]}"
+        done = batch("--input", source, "--output", out, "--ratio", *order, "--workers", 0)
+        assert done.returncode == 0, done.stderr
+        [entry] = json.loads((out / "topstoc-report.json").read_text())["results"]
+        assert [lod["target"] for lod in entry["lods"]] == [{"ratio": 0.5}, {"ratio": 0.1}]
+        counts = [read_mesh(out / f"ring_LOD{i}.obj").num_vertices for i in (0, 1)]
+        assert counts[0] > counts[1]  # LOD0 the most detailed
+    # error and distance targets: smaller is finer
+    out = tmp_path / "by_error"
+    done = batch("--input", source, "--output", out, "--max-error", "4%", "1%", "--workers", 0)
+    assert done.returncode == 0, done.stderr
+    [entry] = json.loads((out / "topstoc-report.json").read_text())["results"]
+    assert [lod["target"]["max_error"] for lod in entry["lods"]] == [0.01, 0.04]
+    assert entry["lods"][0]["vertices"] > entry["lods"][1]["vertices"]
+    mixed = batch("--input", source, "--output", tmp_path / "mixed", "--max-error", "1%", "0.1", "--workers", 0)
+    cli.assert_one_error_line("batch", mixed, "must all be in % or all absolute")
+
+
+def test_compressed_inputs_give_uncompressed_outputs_unless_asked(tmp_path):
+    v, f = meshgen.torus(24, 12)
+    (tmp_path / "in").mkdir()
+    write_mesh(tmp_path / "in" / "ring.ply.gz", MeshData(vertices=v, triangles=f))
+    done = batch("--input", tmp_path / "in", "--output", tmp_path / "plain", "--ratio", 0.5, "--workers", 0)
+    assert done.returncode == 0, done.stderr
+    assert [p.name for p in (tmp_path / "plain").glob("ring*")] == ["ring.ply"]
+    assert (tmp_path / "plain" / "ring.ply").read_bytes().startswith(b"ply\n")
+    kept = batch("--input", tmp_path / "in", "--output", tmp_path / "kept", "--ratio", 0.5, "--workers", 0,
+                 "--keep-compression")
+    assert kept.returncode == 0, kept.stderr
+    assert (tmp_path / "kept" / "ring.ply.gz").read_bytes()[:2] == b"\x1f\x8b"  # gzip magic
+    assert read_mesh(tmp_path / "kept" / "ring.ply.gz").num_vertices == read_mesh(tmp_path / "plain" / "ring.ply").num_vertices
+
+
+def test_warnings_come_back_with_the_asset_one_line_each(tmp_path):
+    (tmp_path / "in").mkdir()
+    (tmp_path / "in" / "old.ply").write_text(
+        "ply\nformat ascii 1.0\nCreated by Blender3D 247\nelement vertex 4\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")
+    done = batch("--input", tmp_path / "in", "--output", tmp_path / "out", "--ratio", 1, "--workers", 0)
+    assert done.returncode == 0, done.stderr
+    expected = f"topstoc: warning: {tmp_path / 'in' / 'old.ply'}: line 3: skipped unknown PLY header line 'Created by Blender3D 247'"
+    assert done.stderr.splitlines() == [expected]
+    [entry] = json.loads((tmp_path / "out" / "topstoc-report.json").read_text())["results"]
+    assert entry["warnings"] == [expected[len("topstoc: warning: "):]]
+    # the task itself carries them back (a Dask worker's outcome travels the same way)
+    from topstoc.core.batch_run import run_asset
+    from topstoc.core.batch_settings import from_args
+    from topstoc.core.cli import build_parser
+
+    settings = from_args(build_parser().parse_args(["batch", "--input", "x", "--output", "y", "--ratio", "1"]))
+    (tmp_path / "again").mkdir()
+    outcome = run_asset(str(tmp_path / "in" / "old.ply"), str(tmp_path / "again"), settings)
+    assert outcome["status"] == "done" and outcome["warnings"] == entry["warnings"]
+    quiet = batch("--input", tmp_path / "in", "--output", tmp_path / "q", "--ratio", 1, "--workers", 0, "--quiet")
+    assert quiet.returncode == 0 and quiet.stderr == ""
+
+
+def test_obj_lods_get_the_mtl_beside_them_and_report_dropped_normals(tmp_path):
+    import pathlib
+
+    spider = pathlib.Path(__file__).resolve().parents[1] / "data" / "uv_materials" / "spider" / "spider.obj"
+    out = tmp_path / "out"
+    done = batch("--input", spider, "--output", out, "--ratio", 0.5, 0.2, "--workers", 0)
+    assert done.returncode == 0, done.stderr
+    [entry] = json.loads((out / "topstoc-report.json").read_text())["results"]
+    for lod in entry["lods"]:
+        assert read_mesh(lod["output"]).material_libraries == ["spider.mtl"]
+        assert lod["dropped_attributes"] == ["normals"]  # the spider's vn lines are not written
+    assert (out / "spider.mtl").read_bytes() == (spider.parent / "spider.mtl").read_bytes()
+
+
+def test_an_output_that_is_a_file_is_one_clear_line(tmp_path):
+    source = _torus(tmp_path / "in")
+    (tmp_path / "taken").write_text("a file")
+    done = batch("--input", source, "--output", tmp_path / "taken", "--ratio", 0.5, "--workers", 0)
+    cli.assert_one_error_line("batch", done, f"{tmp_path / 'taken'}: is a file; --output names the folder")
+    assert (tmp_path / "taken").read_text() == "a file"

@@ -65,10 +65,12 @@ def test_uvs_and_materials_survive(tmp_path, extra):
     report = run_json(source, tmp_path / "spider.obj", "--ratio", 0.4, *extra)
     original, written = read_mesh(source), read_mesh(tmp_path / "spider.obj")
     assert report["input"]["uv_seam_edges"] > 0
-    assert report["output"]["dropped_attributes"] == []
+    # the spider's vn lines are not written (shading follows the decimated shape): reported
+    assert report["output"]["dropped_attributes"] == ["normals"]
+    assert b"\nvn " in source.read_bytes() and b"\nvn " not in (tmp_path / "spider.obj").read_bytes()
     assert (report["refine"]["collapses"] > 0) == (extra != ("--mode", "fast"))
     to_ply = run_json(source, tmp_path / "spider.ply", "--ratio", 0.4, *extra)
-    assert to_ply["output"]["dropped_attributes"] == ["triangle_material"]
+    assert to_ply["output"]["dropped_attributes"] == ["triangle_material", "normals"]
     assert written.corner_uvs is not None and written.triangle_material is not None
     assert set(written.material_names) <= set(original.material_names)
     # Every output corner is an input corner: same position, same UV, same material; in the
@@ -90,8 +92,9 @@ def test_uvs_and_materials_survive(tmp_path, extra):
             key = (tuple(written.vertices[v]), tuple(written.corner_uvs[t, c]),
                    written.material_names[written.triangle_material[t]])
             assert key in corners, (t, c)
-    # mtllib still finds the input's .mtl from the output's folder.
-    assert (tmp_path / written.material_libraries[0]).resolve() == (source.parent / "spider.mtl").resolve()
+    # the .mtl is copied beside the output (another folder) and mtllib names the copy
+    assert written.material_libraries == ["spider.mtl"]
+    assert (tmp_path / "spider.mtl").read_bytes() == (source.parent / "spider.mtl").read_bytes()
 
 
 def test_vertex_colours_survive(tmp_path):
@@ -181,3 +184,65 @@ def test_max_error(tmp_path):
     assert 0 < bound["achieved_error"] <= bound["max_error"]
     bad = topstoc(source, tmp_path / "bad.off", "--max-error", "-1")
     assert_one_error_line(bad, "--max-error must be positive")
+
+
+def _textured_obj(folder):
+    """A UV-mapped torus OBJ with a .mtl naming one texture in a subfolder and one missing."""
+    folder.mkdir()
+    vertices, triangles = torus(24, 12)
+    uvs = np.stack([vertices[triangles][..., 0], vertices[triangles][..., 1]], axis=-1)
+    write_mesh(folder / "ring.obj", MeshData(vertices=vertices, triangles=triangles, corner_uvs=uvs,
+                                             triangle_material=np.zeros(len(triangles), np.int32),
+                                             material_names=["skin"], material_libraries=["ring.mtl"]))
+    (folder / "textures").mkdir()
+    (folder / "textures" / "skin.png").write_bytes(b"\x89PNG fake texture")
+    (folder / "wood grain.png").write_bytes(b"\x89PNG grain")
+    (folder / "ring.mtl").write_text("newmtl skin\nKd 1 1 1\nmap_Kd -s 1 1 1 textures/skin.png\n"
+                                     "map_Ks -clamp on wood grain.png\nmap_Bump gone.png\n")
+    return folder / "ring.obj"
+
+
+def test_obj_materials_and_textures_follow_the_output(tmp_path):
+    source = _textured_obj(tmp_path / "src")
+    out = tmp_path / "out"
+    out.mkdir()
+    report = run_json(source, out / "low.obj", "--ratio", 0.3)
+    assert report["output"]["dropped_attributes"] == []
+    assert read_mesh(out / "low.obj").material_libraries == ["ring.mtl"]
+    assert (out / "ring.mtl").read_bytes() == (source.parent / "ring.mtl").read_bytes()
+    assert (out / "textures" / "skin.png").read_bytes() == b"\x89PNG fake texture"
+    assert (out / "wood grain.png").read_bytes() == b"\x89PNG grain"  # a name with a space, after options
+    assert sorted(p.name for p in out.iterdir()) == ["low.obj", "ring.mtl", "textures", "wood grain.png"]
+    # the same folder as the input: nothing copied, the name kept
+    run_json(source, source.parent / "low.obj", "--ratio", 0.3)
+    assert read_mesh(source.parent / "low.obj").material_libraries == ["ring.mtl"]
+    assert sorted(p.name for p in source.parent.iterdir()) == ["low.obj", "ring.mtl", "ring.obj", "textures",
+                                                               "wood grain.png"]
+
+
+def test_an_existing_different_mtl_is_never_overwritten(tmp_path):
+    source = _textured_obj(tmp_path / "src")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "ring.mtl").write_text("newmtl other\n")
+    done = topstoc(source, out / "low.obj", "--ratio", 0.3)
+    assert done.returncode == 0
+    assert done.stderr.splitlines() == [f"topstoc: warning: {out / 'ring.mtl'}: a different file already exists; "
+                                        f"the output refers to {source.parent / 'ring.mtl'} instead"]
+    assert (out / "ring.mtl").read_text() == "newmtl other\n"
+    assert not (out / "textures").exists() and not (out / "wood grain.png").exists()
+    assert read_mesh(out / "low.obj").material_libraries == ["../src/ring.mtl"]
+
+
+def test_json_reports_the_attribute_weight_used_and_why_not(tmp_path):
+    source = DATA / "uv_materials" / "spider" / "spider.obj"
+    quality = run_json(source, tmp_path / "a.obj", "--ratio", 0.4)["attributes"]
+    assert quality["weight"] == quality["requested_weight"] == 0.1 and "unused_because" not in quality
+    assert quality["channels"] == ["uv.u", "uv.v"]
+    fast = run_json(source, tmp_path / "b.obj", "--ratio", 0.4, "--mode", "fast")["attributes"]
+    assert fast["weight"] == 0.0 and fast["requested_weight"] == 0.1
+    assert fast["unused_because"].startswith("fast mode")
+    bare = run_json(DATA / "genus_positive" / "cgal_eight.off", tmp_path / "c.off", "--ratio", 0.4)["attributes"]
+    assert bare["weight"] == 0.0 and bare["unused_because"] == "the input has no UVs or vertex colours"
+    off = run_json(source, tmp_path / "d.obj", "--ratio", 0.4, "--attribute-weight", 0)["attributes"]
+    assert off["weight"] == 0.0 and off["unused_because"] == "--attribute-weight 0"

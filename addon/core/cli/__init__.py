@@ -1,7 +1,9 @@
 """Command line: ``python3 -m topstoc SUBCOMMAND ...`` (docs/design.md §6).
 
 Each subcommand lives in its own module here and provides ``add_parser(subparsers)`` and
-``run(args) -> int``. Errors print one clear line on standard error and exit non-zero.
+``run(args) -> int``. Errors print one clear line on standard error and exit 1 (2 for a command
+line that cannot be parsed); warnings one line each (topstoc.core.cli.messages). Commands with
+``--progress`` / ``--quiet`` get a progress line for jobs over a second (topstoc.core.cli.progress).
 """
 
 from __future__ import annotations
@@ -10,16 +12,22 @@ import argparse
 import importlib
 import json
 import sys
+import warnings
 
-from ..errors import one_line
+from . import messages, progress
+
 
 # Subcommand modules, in the order --help lists them.
 SUBCOMMANDS = ("decimate", "batch", "measure", "topology", "loops", "edit")
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python3 -m topstoc",
-                                     description="TopStoc: guided decimation with topology control.")
+    from ... import __version__
+
+    parser = messages.ArgumentParser(prog="topstoc",
+                                     description="TopStoc: guided decimation with topology control. "
+                                                 "Run as `topstoc` (pip) or `python3 -m topstoc`.")
+    parser.add_argument("--version", action="version", version=f"topstoc {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="SUBCOMMAND")
     subparsers.required = True
     for name in SUBCOMMANDS:
@@ -46,16 +54,29 @@ def print_json(data) -> None:
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    command = f"topstoc {args.command}"
+    wants = getattr(args, "progress", None)  # batch has its own progress (a bar or lines)
+    progress.set_quiet(getattr(args, "quiet", False))
     try:
-        return int(args.run(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = messages.show_warning
+            stdout = sys.stdout
+            if isinstance(wants, bool) and progress.start(
+                    command, forced=wants, quiet=progress.quiet() or getattr(args, "json", False) is True):
+                sys.stdout = progress.StopOnOutput(stdout)
+            try:
+                return int(args.run(args) or 0)
+            finally:
+                progress.stop()
+                sys.stdout = stdout
     except BrokenPipeError:
         # The reader went away (e.g. `| head`): stop quietly, as Unix tools do.
         import os
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except (ValueError, OSError, RuntimeError) as error:
-        print(f"topstoc {args.command}: error: {one_line(error)}", file=sys.stderr)
-        return 1
+        messages.print_error(command, messages.error_text(error))
+        return messages.EXIT_FAILURE
     except KeyboardInterrupt:
-        print(f"topstoc {args.command}: interrupted", file=sys.stderr)
+        messages.print_error(command, "interrupted")
         return 130

@@ -15,6 +15,7 @@ import sys
 import time
 
 from .. import batch_settings
+from . import messages, progress
 from ..batch_run import (find_inputs, misnamed_failure, remove_orphaned_scratch, remove_stale_temporaries,
                          run_dask, run_serial, utf8_name, write_report)
 from ..manifest import Manifest, content_hash, task_key
@@ -30,9 +31,7 @@ def add_parser(subparsers) -> None:
         description="Decimate many assets into DIR, one task per asset, with resume. Mesh files "
                     "(OBJ, PLY, OFF, STL) need no Blender; .blend, glTF/GLB, FBX and USD run a Blender "
                     "per asset. Give one target value per output, or several for a LOD chain.")
-    parser.add_argument("--input", nargs="+", required=True, metavar="PATH",
-                        help="asset files, or folders (searched recursively for supported files)")
-    parser.add_argument("--output", required=True, metavar="DIR")
+    batch_settings.add_io_arguments(parser)
     batch_settings.add_arguments(parser)
     runner = parser.add_mutually_exclusive_group()
     runner.add_argument("--workers", type=int, metavar="N",
@@ -50,27 +49,38 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--progress", choices=("auto", "bar", "lines"), default="auto",
                         help="auto (default): a progress bar on a terminal, plain lines when the output goes to a "
                              "file or pipe")
+    parser.add_argument("--quiet", "-q", action="store_true",
+                        help="print only errors and the final summary line (no progress, no warnings)")
     parser.set_defaults(run=run)
 
 
 class Progress:
     """A tqdm bar (on standard error) when standard output and error are both a terminal, else one
-    line per asset on standard output: ``topstoc batch > log`` gets the lines in its log."""
+    line per asset on standard output: ``topstoc batch > log`` gets the lines in its log. The bar
+    is redrawn every second (its clock runs while a long asset works) and cleared before a
+    warning prints (topstoc.core.cli.progress). quiet: nothing but failures."""
 
-    def __init__(self, total: int, mode: str):
-        self.total, self.count, self.bar = total, 0, None
-        if mode == "bar" or (mode == "auto" and sys.stdout.isatty() and sys.stderr.isatty()):
+    def __init__(self, total: int, mode: str, quiet: bool = False):
+        self.total, self.count, self.bar, self.quiet = total, 0, None, quiet
+        if not quiet and (mode == "bar" or (mode == "auto" and sys.stdout.isatty() and sys.stderr.isatty())):
             try:
                 from tqdm import tqdm
                 self.bar = tqdm(total=total, unit="asset", desc="topstoc batch", file=sys.stderr)
             except ImportError:
                 self.bar = None
+        if self.bar is not None:
+            progress.attach(self.bar.clear, self.bar.refresh)
+        elif not quiet and mode == "auto":
+            progress.start("topstoc batch")  # a terminal without tqdm: a ticker line
+            progress.stage(f"0 of {total} assets done")
 
     def line(self, text: str) -> None:
+        if self.quiet:
+            return
         if self.bar is not None:
             self.bar.write(text, file=sys.stderr)
         else:
-            print(text, flush=True)
+            progress.print_line(text, sys.stdout)
 
     def advance(self, path: str, text: str, failed: bool = False) -> None:
         self.count += 1
@@ -78,11 +88,13 @@ class Progress:
             self.bar.update(1)
             if failed:
                 self.bar.write(f"topstoc batch: {path}: {text}", file=sys.stderr)
-        else:
-            print(f"topstoc batch [{self.count}/{self.total}] {path}: {text}", flush=True,
-                  file=sys.stderr if failed else sys.stdout)
+        elif failed or not self.quiet:
+            progress.stage(f"{self.count} of {self.total} assets done")
+            progress.print_line(f"topstoc batch [{self.count}/{self.total}] {path}: {text}",
+                                sys.stderr if failed else sys.stdout)
 
     def close(self) -> None:
+        progress.stop()
         if self.bar is not None:
             self.bar.close()
 
@@ -176,15 +188,17 @@ def run(args) -> int:
             tasks.append((index, path))
     _check_names(tasks, args.output, settings, inputs)
 
-    progress = Progress(len(inputs), args.progress)
+    bar = Progress(len(inputs), args.progress, args.quiet)
     for item in skipped:
-        progress.advance(item["input"], "skipped (done in an earlier run)")
+        bar.advance(item["input"], "skipped (done in an earlier run)")
     results, failures, outputs = {}, {}, []
     for index in misnamed:
         failures[index] = misnamed_failure(inputs[index])
         progress.advance(failures[index]["input"], f"FAILED: {failures[index]['message']}", failed=True)
 
     def on_result(index, outcome):
+        for text in outcome.get("warnings", ()):
+            messages.print_warning(text)
         path = inputs[index]
         key, sha = keys[index]
         record = {"key": key, "input": path, "sha256": sha, "settings": fingerprint, "status": outcome["status"],
@@ -196,11 +210,11 @@ def run(args) -> int:
             record["entry"] = entry
             results[index] = entry
             outputs.extend(record["outputs"])
-            progress.advance(path, _summary(entry))
+            bar.advance(path, _summary(entry))
         else:
             record["message"] = outcome["message"]
             failures[index] = {"input": path, "message": outcome["message"]}
-            progress.advance(path, f"FAILED: {outcome['message']}", failed=True)
+            bar.advance(path, f"FAILED: {outcome['message']}", failed=True)
         manifest.append(record)
 
     workers = (os.cpu_count() or 1) if args.workers is None else args.workers
@@ -210,7 +224,7 @@ def run(args) -> int:
     def announce(client):
         pids = sorted(client.run(os.getpid).values())
         where = args.scheduler or "local cluster"
-        progress.line(f"topstoc batch: {len(tasks)} assets to run ({len(skipped)} skipped) on {where}, "
+        bar.line(f"topstoc batch: {len(tasks)} assets to run ({len(skipped)} skipped) on {where}, "
                       f"{len(pids)} workers (pids {' '.join(map(str, pids))})")
 
     try:
@@ -218,10 +232,10 @@ def run(args) -> int:
             run_dask(tasks, args.output, settings, args.blender, on_result, workers=workers,
                      scheduler=args.scheduler, on_start=announce)
         elif tasks:
-            progress.line(f"topstoc batch: {len(tasks)} assets to run ({len(skipped)} skipped), serially")
+            bar.line(f"topstoc batch: {len(tasks)} assets to run ({len(skipped)} skipped), serially")
             run_serial(tasks, args.output, settings, args.blender, on_result)
     finally:
-        progress.close()
+        bar.close()
     remove_stale_temporaries(outputs)
     remove_orphaned_scratch()
 

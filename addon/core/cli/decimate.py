@@ -10,7 +10,6 @@ the work itself (mesh preparation, seams, decimation), without reading and writi
 
 from __future__ import annotations
 
-import os
 import time
 
 import numpy as np
@@ -21,8 +20,9 @@ from ..io import dropped_attributes, mesh_format, read_mesh, write_mesh
 from ..decimate import ATTRIBUTE_WEIGHT
 from ..mesh import Mesh
 from ..output_guard import add_overwrite_argument, prepare_output
+from ..materials import carry_libraries
 from ..symmetry import AXES, decimate_mirrored
-from . import print_json
+from . import print_json, progress
 from ..errors import TopStocError
 
 DENSITIES = ("off", "uniform", "adaptive")
@@ -67,6 +67,7 @@ def add_parser(subparsers) -> None:
                              "(STL: welded order); 1 keeps a vertex, -1 avoids it")
     parser.add_argument("--json", action="store_true", help="print a JSON report")
     add_overwrite_argument(parser)
+    progress.add_arguments(parser)
     parser.set_defaults(run=run)
 
 
@@ -103,14 +104,6 @@ def load_guidance(path: str, num_vertices: int) -> np.ndarray:
     return u
 
 
-def _relative_library(library: str, source: str, destination: str) -> str:
-    """An mtllib path that still points at the input's .mtl from the output's folder."""
-    here = os.path.join(os.path.dirname(os.path.abspath(source)), library)
-    if os.path.isabs(library) or not os.path.exists(here):
-        return library
-    return os.path.relpath(here, os.path.dirname(os.path.abspath(destination)))
-
-
 def _error_bound_report(result) -> dict:
     """How an error-bounded search went (absolute errors), when --max-error was used."""
     report = getattr(result, "error_bound", None)
@@ -121,9 +114,26 @@ def _error_bound_report(result) -> dict:
                             "probes": len(report.probes), "seconds": report.seconds}}
 
 
+def attribute_report(requested: float, used: bool, args, data, appearance) -> dict:
+    """The attribute weight the decimation used, and why it is 0 when it is."""
+    report = {"weight": requested if used else 0.0, "requested_weight": requested,
+              "channels": appearance.channels, "uv_corners_filled": appearance.uv_corners_filled}
+    if not used:
+        if requested == 0:
+            report["unused_because"] = "--attribute-weight 0"
+        elif not refines(args.mode, args.refine):
+            report["unused_because"] = f"{args.mode} mode without refinement (only the refinement weighs attributes)"
+        elif data.corner_uvs is None and data.vertex_colors is None:
+            report["unused_because"] = "the input has no UVs or vertex colours"
+        else:
+            report["unused_because"] = "the input's UVs and colours leave no channel to weigh"
+    return report
+
+
 def run(args) -> int:
     prepare_output(args.output, [args.input, args.guidance], overwrite=args.overwrite)
     mesh_format(args.output)  # fail on a bad output name before doing any work
+    progress.stage(f"reading {args.input}")
     data = read_mesh(args.input)
     if data.num_triangles == 0:
         raise TopStocError(f"{args.input}: the mesh has no triangles")
@@ -141,8 +151,10 @@ def run(args) -> int:
                    mode=args.mode, placement=args.placement, refine=args.refine,
                    regions=material_regions(data), borders=seams if seams is not None and len(seams) else None,
                    **attributes)
+    progress.stage("decimating")
     if args.max_error is not None:
         bound, relative = parse_max_error(args.max_error)
+        progress.stage(f"searching the vertex count for --max-error {args.max_error}")
         result = decimate_mirrored(mesh, args.symmetry, max_error=bound, relative=relative, **options)
     else:
         result = decimate_mirrored(mesh, args.symmetry, ratio=args.ratio, target_vertices=args.vertices,
@@ -150,7 +162,8 @@ def run(args) -> int:
     seconds = time.perf_counter() - start
 
     output = transfer_attributes(data, result)
-    output.material_libraries = [_relative_library(lib, args.input, args.output) for lib in output.material_libraries]
+    progress.stage(f"writing {args.output}")
+    output.material_libraries = carry_libraries(output.material_libraries, args.input, args.output)
     write_mesh(args.output, output)
     dropped = dropped_attributes(output, args.output)
 
@@ -182,13 +195,12 @@ def run(args) -> int:
             "refine": {"mode": args.mode, "factor": result.parameters["refine"],
                        "placement": result.parameters["placement"], "vertices": stats.refine_vertices,
                        "collapses": stats.refine_collapses},
-            "attributes": {"weight": weight if attributes else 0.0, "channels": appearance.channels,
-                           "uv_corners_filled": appearance.uv_corners_filled},
+            "attributes": attribute_report(weight, bool(attributes), args, data, appearance),
             "aspect_ratio": result.aspect_ratio(),
             **_error_bound_report(result),
         })
     else:
         print(f"{args.input}: {data.num_vertices} vertices, {data.num_triangles} triangles -> {args.output}: "
               f"{result.num_vertices} vertices, {result.num_triangles} triangles in {seconds:.3f} s "
-              f"({stats.repairs} repair samples)" + (f"; {args.output} cannot store {', '.join(dropped)}" if dropped else ""))
+              f"({stats.repairs} repair samples)" + (f"; not written: {', '.join(dropped)}" if dropped else ""))
     return 0

@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from . import print_json
+from . import print_json, progress
 from ..errors import TopStocError
 from ..output_guard import add_overwrite_argument, prepare_output
 
@@ -58,6 +58,7 @@ def _patch_options(parser) -> None:
                         help="refine the patches to the surrounding density and fair them (adds vertices)")
     parser.add_argument("--json", action="store_true", help="print a JSON report")
     add_overwrite_argument(parser)
+    progress.add_arguments(parser)
 
 
 def _ids(text: str, what: str) -> list:
@@ -79,6 +80,7 @@ def run_fill(args) -> int:
     holes = _ids(args.holes, "--holes") if args.holes is not None else None
     if args.max_edges is not None and args.max_edges < 3:
         raise TopStocError(f"--max-edges must be at least 3, got {args.max_edges}")
+    progress.stage("filling holes")
     start = time.perf_counter()
     result = fill_holes(data.vertices, data.triangles, holes=holes, max_edges=args.max_edges,
                         skip_unfillable=args.skip_unfillable, weld_pinches=not args.no_weld, fair=args.fair)
@@ -103,6 +105,7 @@ def run_remove_handle(args) -> int:
     from ..io import read_mesh
 
     data = read_mesh(args.input)
+    progress.stage("removing the handle")
     start = time.perf_counter()
     loops_seconds = 0.0
     if args.loop is not None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import time
 from ..errors import TopStocError
+from . import progress
 
 
 def add_parser(subparsers) -> None:
@@ -27,8 +28,9 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--no-shorten", action="store_true", help="return the loops as selected")
     parser.add_argument("--metric", choices=("length", "edges"), default="length",
                         help="choose and shorten loops by length (default) or edge count (the thesis)")
-    parser.add_argument("--seed", type=int, default=1, help="decimation seed of the coarse route")
+    parser.add_argument("--seed", type=int, default=1, metavar="S", help="decimation seed of the coarse route (default 1)")
     parser.add_argument("--json", action="store_true", help="print a JSON document")
+    progress.add_arguments(parser)
     parser.set_defaults(run=run)
 
 
@@ -40,6 +42,7 @@ def run(args: argparse.Namespace) -> int:
     data = read_mesh(args.input)
     if args.coarse_vertices is not None and args.coarse_vertices <= 0:
         raise TopStocError(f"--coarse-vertices must be positive, got {args.coarse_vertices}")
+    progress.stage("finding handle and tunnel loops")
     started = time.perf_counter()
     mesh = Mesh(data.vertices, data.triangles)
     result = handle_tunnel_loops(mesh, coarse_vertices=0 if args.full else args.coarse_vertices,

@@ -13,7 +13,7 @@ import time
 
 from ..io import read_mesh
 from ..topology import topology
-from . import print_json
+from . import print_json, progress
 
 #: Components listed in the text report before "... and N more".
 TEXT_COMPONENTS = 20
@@ -28,11 +28,13 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--generators", action="store_true",
                         help="also the 2g generator edges and loops of each closed orientable component")
     parser.add_argument("--json", action="store_true", help="print a JSON report")
+    progress.add_arguments(parser)
     parser.set_defaults(run=run)
 
 
 def run(args) -> int:
     data = read_mesh(args.input)
+    progress.stage("analysing the topology")
     start = time.perf_counter()
     info = topology(data.vertices, data.triangles, generators=args.generators)
     seconds = time.perf_counter() - start
