@@ -207,11 +207,3 @@ def test_obj_lods_get_the_mtl_beside_them_and_report_dropped_normals(tmp_path):
         assert read_mesh(lod["output"]).material_libraries == ["spider.mtl"]
         assert lod["dropped_attributes"] == ["normals"]  # the spider's vn lines are not written
     assert (out / "spider.mtl").read_bytes() == (spider.parent / "spider.mtl").read_bytes()
-
-
-def test_an_output_that_is_a_file_is_one_clear_line(tmp_path):
-    source = _torus(tmp_path / "in")
-    (tmp_path / "taken").write_text("a file")
-    done = batch("--input", source, "--output", tmp_path / "taken", "--ratio", 0.5, "--workers", 0)
-    cli.assert_one_error_line("batch", done, f"{tmp_path / 'taken'}: is a file; --output names the folder")
-    assert (tmp_path / "taken").read_text() == "a file"

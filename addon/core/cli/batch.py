@@ -194,7 +194,7 @@ def run(args) -> int:
     results, failures, outputs = {}, {}, []
     for index in misnamed:
         failures[index] = misnamed_failure(inputs[index])
-        progress.advance(failures[index]["input"], f"FAILED: {failures[index]['message']}", failed=True)
+        bar.advance(failures[index]["input"], f"FAILED: {failures[index]['message']}", failed=True)
 
     def on_result(index, outcome):
         for text in outcome.get("warnings", ()):
