@@ -47,6 +47,8 @@ def source_lines(figures: dict) -> list[str]:
     lines = [f"- Machine: {figures['machine']}", f"- Date: {figures['date']}"]
     if figures.get("method"):
         lines.append(f"- Method: {figures['method']}")
+    if figures.get("note") and not figures.get("carried_over"):
+        lines.append(f"- Note: {figures['note']}")
     return lines
 
 
