@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import json
 import pathlib
+import statistics
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -82,6 +83,41 @@ def render_decimate(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+QUALITY_PEERS = ("Blender Collapse", "MeshLab", "meshopt_simplify", "fast-simplification")
+QUALITY_FIGURES = (("mean", "mean error"), ("max", "max error"), ("ar_mean", "aspect ratio mean"),
+                   ("ar_max", "worst triangle"))
+
+
+def render_quality(name: str, figures: dict) -> str:
+    """bench_quality.py --json: the quality mode's error and shape over the peers' at its triangle count."""
+    cases = figures["cases"]
+    ours = [case["tools"]["topstoc quality"] for case in cases]
+    targets = ", ".join(f"{ratio:.0%}" for ratio in sorted({case["ratio"] for case in cases}, reverse=True))
+    out = [f"## Result quality next to the quadric decimators (`{name}`)", "",
+           f"`{figures['benchmark']}`: {len(cases)} cases ({len({c['mesh'] for c in cases})} meshes × "
+           f"{targets}); every peer decimates to the triangle count "
+           f"of our quality result; symmetric Hausdorff error with {figures['samples']:,} samples, aspect ratio as "
+           "thesis eq. 4.2. Medians over the cases of ours ÷ the peer's figure (below 1: ours is better), the "
+           "worst case in brackets.", "", *source_lines(figures), "",
+           "| Peer | " + " | ".join(label for _, label in QUALITY_FIGURES) + " | topology kept (peer) |",
+           "|---|" + "---|" * (len(QUALITY_FIGURES) + 1)]
+    for peer in QUALITY_PEERS:
+        pairs = [(case["tools"]["topstoc quality"], case["tools"][peer]) for case in cases if case["tools"].get(peer)]
+        if not pairs:
+            out.append(f"| {peer} | not available |" + " |" * len(QUALITY_FIGURES))
+            continue
+        cells = []
+        for key, _ in QUALITY_FIGURES:
+            ratios = [a[key] / b[key] for a, b in pairs if b[key] > 0]
+            cells.append(f"{statistics.median(ratios):.3f}× [{max(ratios):.2f}]" if ratios else "—")
+        kept = sum(bool(b["topology"]) for _, b in pairs)
+        out.append(f"| {peer} | " + " | ".join(cells) + f" | {kept}/{len(pairs)} |")
+    out += ["", f"TopStoc's quality mode kept the topology in {sum(bool(o['topology']) for o in ours)}/{len(ours)} "
+            f"cases, with {sum(o['zero_area'] for o in ours)} zero-area triangles and a worst aspect ratio of "
+            f"{max(o['ar_max'] for o in ours):.0f}."]
+    return "\n".join(out) + "\n"
+
+
 def render_carried_over(name: str, figures: dict) -> str:
     """Figures measured before the benchmarks saved JSON, kept as they were published."""
     out = [f"## {figures['title']} (`{name}`)", "", *source_lines(figures), "", figures["note"], "",
@@ -96,8 +132,10 @@ def render_result(path: pathlib.Path) -> str:
         return render_carried_over(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_decimate.py":
         return render_decimate(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_quality.py":
+        return render_quality(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
-                     "bench_decimate.py's --json and carried-over figures)")
+                     "the --json of bench_decimate.py and bench_quality.py, and carried-over figures)")
 
 
 def render() -> str:

@@ -61,3 +61,24 @@ def test_an_unknown_result_file_is_refused_by_name(tmp_path):
     path.write_text(json.dumps({"benchmark": "tests/bench/bench_other.py"}))
     with pytest.raises(SystemExit, match="mystery.json"):
         benchmarks_md.render_result(path)
+
+
+def _tool(mean, maximum, ar_mean, ar_max, topology=True, zero_area=0):
+    return {"triangles": 100, "mean": mean, "max": maximum, "ar_mean": ar_mean, "ar_p99": ar_max,
+            "ar_max": ar_max, "zero_area": zero_area, "topology": topology, "seconds": 0.1}
+
+
+def test_quality_results_render_medians_of_our_figure_over_the_peers():
+    ours = [_tool(1.0, 2.0, 1.2, 10.0), _tool(2.0, 2.0, 1.5, 40.0), _tool(3.0, 6.0, 1.3, 20.0, zero_area=1)]
+    blender = [_tool(2.0, 1.0, 1.2, 20.0), _tool(1.0, 4.0, 3.0, 20.0, topology=False), _tool(4.0, 3.0, 2.6, 10.0)]
+    cases = [{"mesh": f"m{i}.off", "ratio": 0.1, "input_triangles": 1000, "peer_triangles": 100,
+              "tools": {"topstoc quality": a, "Blender Collapse": b, "MeshLab": None}}
+             for i, (a, b) in enumerate(zip(ours, blender))]
+    text = benchmarks_md.render_quality("q.json", {"benchmark": "tests/bench/bench_quality.py", "machine": "m",
+                                                   "date": "2000-01-01", "samples": 1000, "cases": cases})
+    row = [line for line in text.splitlines() if line.startswith("| Blender Collapse")][0]
+    # mean: 0.5, 2, 0.75 -> 0.75 [2]; max: 2, 0.5, 2 -> 2 [2]; ar_mean: 1, 0.5, 0.5 -> 0.5 [1]; worst: 0.5, 2, 2
+    assert row == "| Blender Collapse | 0.750× [2.00] | 2.000× [2.00] | 0.500× [1.00] | 2.000× [2.00] | 2/3 |"
+    assert "| MeshLab | not available |" in text
+    assert "3 cases (3 meshes × 10%)" in text
+    assert "kept the topology in 3/3 cases, with 1 zero-area triangles and a worst aspect ratio of 40." in text
