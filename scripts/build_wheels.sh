@@ -24,7 +24,7 @@ if ! "$VENV/bin/python" -c "import scikit_build_core, pybind11, auditwheel, whee
   /usr/bin/python3 -m venv "$VENV"
   "$VENV/bin/pip" install -q --disable-pip-version-check $TOOLS
 fi
-export PATH=$VENV/bin:/usr/bin:/bin
+export PATH=$VENV/bin:/usr/sbin:/usr/bin:/sbin:/bin  # sbin: debian13_root.sh needs debootstrap and chroot
 # Same sources, same timestamps in the archives.
 export SOURCE_DATE_EPOCH=${SOURCE_DATE_EPOCH:-$(git log -1 --format=%ct 2>/dev/null || echo 315532800)}
 

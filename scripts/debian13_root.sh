@@ -8,6 +8,7 @@
 # The root lives in ${TOPSTOC_CACHE:-/var/cache/topstoc}/trixie-root (about 1.5 GB, ~5 min to
 # make), outside the checkout, so CI runs on fresh clones reuse it. Needs root and debootstrap.
 set -u
+export PATH=$PATH:/usr/sbin:/sbin  # debootstrap and chroot, whatever PATH the caller had
 CACHE=${TOPSTOC_CACHE:-/var/cache/topstoc}
 ROOTFS=$CACHE/trixie-root
 PACKAGES="python3 python3-venv python3-dev blender xvfb xauth ca-certificates libgl1-mesa-dri"

@@ -217,7 +217,7 @@ def run_dask(tasks, out_dir, settings, blender, on_result, *, workers: int = 0, 
     try:
         from distributed import Client, as_completed
     except ImportError:
-        raise TopStocError("the Dask runner needs dask.distributed: pip install 'dask[distributed]' tqdm "
+        raise TopStocError('the Dask runner needs Dask: pip install "topstoc[cluster]" '
                            "(or run serially with --workers 0)") from None
     cluster = None if scheduler else _local_cluster(workers)
     try:

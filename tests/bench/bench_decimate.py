@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Decimation speed next to meshoptimizer, measured in the same run (issue 2 benchmark).
 
-    /usr/bin/python3 tests/bench/bench_decimate.py [MESH] [--ratios 0.1,0.01] [--repeats 7]
+    /usr/bin/python3 tests/bench/bench_decimate.py [MESH] [--ratios 0.1,0.01] [--repeats 7] [--json FILE]
 
 Default mesh: ../shared/meshes/big/horse_loop2_1.55M.ply (skips cleanly when absent). Times:
   - first decimation: topstoc.Mesh (validation, adjacency, weights) + decimate, file read excluded;
@@ -16,7 +16,8 @@ Default mesh: ../shared/meshes/big/horse_loop2_1.55M.ply (skips cleanly when abs
     and cold (prepare + quality decimation at the first ratio);
   - meshopt_simplify (QEM edge collapse) and meshopt_simplifySloppy (grid clustering), via
     build/peers/meshopt_bench on the same file and the same vertex fraction of the index count.
-Prints medians, the ratios and the machine. Speed is never asserted in tests; it lives here.
+Prints medians, the ratios and the machine; --json FILE also writes them (scripts/benchmarks_md.py
+turns docs/bench_results/*.json into docs/benchmarks.md). Speed is never asserted in tests; it lives here.
 """
 
 import argparse
@@ -49,6 +50,7 @@ def main() -> int:
     parser.add_argument("mesh", nargs="?", default=str(DEFAULT_MESH))
     parser.add_argument("--ratios", default="0.1,0.01")
     parser.add_argument("--repeats", type=int, default=7)
+    parser.add_argument("--json", metavar="FILE", help="write the medians and the machine here")
     args = parser.parse_args()
     path = pathlib.Path(args.mesh)
     if not path.exists():
@@ -157,7 +159,29 @@ def main() -> int:
         if peer:
             text += f", meshopt_simplify / ours {peer['simplify']['median_seconds'] / ours:.2f}x"
         print(text)
+    if args.json:
+        figures = summary(path, data, args.repeats, prepare, first, cold_quality_seconds, rows)
+        pathlib.Path(args.json).write_text(json.dumps(figures, indent=1) + "\n")
     return 0
+
+
+def summary(path, data, repeats, prepare, first, cold_quality_seconds, rows) -> dict:
+    """The printed medians as one JSON-ready dict (milliseconds; peer None when not built)."""
+    out = {"benchmark": "tests/bench/bench_decimate.py", "machine": machine(),
+           "date": time.strftime("%Y-%m-%d", time.gmtime()), "repeats": repeats,
+           "mesh": {"name": path.name, "vertices": len(data.vertices), "triangles": len(data.triangles)},
+           "prepare_ms": median_ms(prepare), "first_ms": median_ms(first),
+           "cold_quality_ms": 1000 * cold_quality_seconds, "ratios": []}
+    for ratio, seconds, stages, result, peer, refined, refined_result, (steps, updated), (drafts, draft_steps) in rows:
+        out["ratios"].append({
+            "ratio": ratio, "vertices": result.num_vertices, "triangles": result.num_triangles,
+            "fast_ms": median_ms(seconds), "stages_ms": {k: median_ms(v) for k, v in stages.items()},
+            "slider_step_ms": median_ms(steps), "slider_steps": len(steps), "slider_steps_updated": updated,
+            "draft_ms": median_ms(drafts), "draft_step_ms": median_ms(draft_steps),
+            "quality_ms": 1000 * statistics.median(refined), "quality_vertices": refined_result.num_vertices,
+            "meshopt_simplify_ms": 1000 * peer["simplify"]["median_seconds"] if peer else None,
+            "meshopt_sloppy_ms": 1000 * peer["simplify_sloppy"]["median_seconds"] if peer else None})
+    return out
 
 
 if __name__ == "__main__":

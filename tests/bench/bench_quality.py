@@ -291,10 +291,13 @@ def main() -> int:
     if better:
         print(f"  mean error / better of Blender Collapse and MeshLab: median {statistics.median(better):.3f}, "
               f"worst {max(better):.2f}  (goal <= 1.0)")
-    if args.json:
+    if args.json:  # read by scripts/benchmarks_md.py (docs/bench_results/*.json)
         for case in cases:
             case.pop("source", None)
-        pathlib.Path(args.json).write_text(json.dumps(cases, indent=1, default=str))
+        pathlib.Path(args.json).write_text(json.dumps(
+            {"benchmark": "tests/bench/bench_quality.py", "machine": machine(),
+             "date": time.strftime("%Y-%m-%d", time.gmtime()), "samples": args.samples, "cases": cases},
+            indent=1, default=str) + "\n")
     return 0
 
 

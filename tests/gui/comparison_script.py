@@ -1,7 +1,7 @@
 """Run by test_comparison_gui.py in a windowed Blender under Xvfb: the original mesh, Blender's
 own Decimate modifier (Collapse) and TopStoc's Guided Decimate (default settings) side by side at
 the same triangle count, wireframe on, each labelled with its triangle count and its Hausdorff
-error against the original. The screenshot is the README's comparison picture
+error against the original. The screenshot is docs/benchmarks.md's comparison picture
 (TOPSTOC_DOC_SHOTS=docs/images keeps it as docs/images/comparison.png).
 
 Arguments after the output folder: the ratio of the input's triangles to ask TopStoc for."""

@@ -1,6 +1,6 @@
 """TopStoc next to Blender's own Decimate modifier (Collapse) in a real Blender window: the
 original, Collapse and TopStoc's default Guided Decimate at the same triangle count, wireframe on
-(the README's comparison picture: TOPSTOC_DOC_SHOTS=docs/images). The figures in the captions are
+(docs/benchmarks.md's comparison picture: TOPSTOC_DOC_SHOTS=docs/images). The figures in the captions are
 measured here with the project's Hausdorff distance; the benchmark over many meshes and peers is
 tests/bench/bench_quality.py."""
 

@@ -1,0 +1,166 @@
+#!/usr/bin/python3
+"""Makes docs/benchmarks.md from the benchmarks' saved figures and the hand-written notes.
+
+    python3 scripts/benchmarks_md.py           # rewrite docs/benchmarks.md
+    python3 scripts/benchmarks_md.py --check   # exit 1 when docs/benchmarks.md is not its output
+
+Inputs: docs/bench_results/*.json (written by `tests/bench/bench_*.py --json FILE`, or figures
+carried over from before the benchmarks wrote JSON, marked "carried_over") in name order, then
+docs/bench_notes/*.md (history, goals, explanations) in name order, appended as they are.
+tests/python/test_benchmarks_md.py checks that the committed file is this script's output.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+import statistics
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "docs" / "bench_results"
+NOTES = ROOT / "docs" / "bench_notes"
+OUTPUT = ROOT / "docs" / "benchmarks.md"
+
+HEADER = """# Benchmarks
+
+Speed and quality next to the peers, each peer measured in the same run (the ratios travel
+between machines better than the times). Made by `scripts/benchmarks_md.py` from the figures the
+benchmarks saved (`docs/bench_results/*.json`, written by `tests/bench/bench_*.py --json FILE`)
+and the notes in `docs/bench_notes/`; edit those, then run the script (a test checks this file
+is its output). Speed is never asserted in tests; it lives here.
+"""
+
+
+def ms(value: float) -> str:
+    """A time in milliseconds, rounded as the benchmarks print it."""
+    return f"{value / 1000:.2f} s" if value >= 1000 else f"{value:.0f} ms"
+
+
+def times(peer_ms, ours_ms) -> str:
+    """How many times faster ours is; a dash when the peer did not run."""
+    return "—" if peer_ms is None else f"{peer_ms / ours_ms:.1f}×"
+
+
+def source_lines(figures: dict) -> list[str]:
+    """Machine, method and date, stated once per result file."""
+    lines = [f"- Machine: {figures['machine']}", f"- Date: {figures['date']}"]
+    if figures.get("method"):
+        lines.append(f"- Method: {figures['method']}")
+    if figures.get("note") and not figures.get("carried_over"):
+        lines.append(f"- Note: {figures['note']}")
+    return lines
+
+
+def render_decimate(name: str, figures: dict) -> str:
+    """bench_decimate.py --json: the horse (or another mesh) in both modes next to meshoptimizer."""
+    mesh = figures["mesh"]
+    first = figures["ratios"][0]
+    out = [f"## Decimation speed (`{name}`)", "",
+           f"`{figures['benchmark']}` on {mesh['name']} ({mesh['vertices']:,} vertices, "
+           f"{mesh['triangles']:,} triangles): medians of {figures['repeats']} seeds per target, "
+           "the peer (`build/peers/meshopt_bench`, same file, same vertex fraction) in the same run.", "",
+           *source_lines(figures), "",
+           f"Prepare (validation, adjacency, weights): {ms(figures['prepare_ms'])}; first decimation "
+           f"at {first['ratio']:.0%} (prepare + fast decimate): {ms(figures['first_ms'])}, "
+           f"{times(first['meshopt_simplify_ms'], figures['first_ms'])} meshopt_simplify; "
+           f"quality mode cold (prepare + decimate at {first['ratio']:.0%}): {ms(figures['cold_quality_ms'])}.", "",
+           "| Target | Fast mode | Slider step | Live-preview frame / step | Quality mode (default) "
+           "| meshopt_simplify | meshopt_simplifySloppy | simplify ÷ fast | simplify ÷ quality |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for row in figures["ratios"]:
+        simplify, sloppy = row["meshopt_simplify_ms"], row["meshopt_sloppy_ms"]
+        out.append(
+            f"| {row['ratio']:.0%} ({row['vertices']:,} vertices) | {ms(row['fast_ms'])} "
+            f"| {ms(row['slider_step_ms'])} ({row['slider_steps_updated']} of {row['slider_steps']} updated) "
+            f"| {ms(row['draft_ms'])} / {ms(row['draft_step_ms'])} | {ms(row['quality_ms'])} "
+            f"| {'—' if simplify is None else ms(simplify)} | {'—' if sloppy is None else ms(sloppy)} "
+            f"| {times(simplify, row['fast_ms'])} | {times(simplify, row['quality_ms'])} |")
+    out += ["", "Fast-mode stages at each target (medians): " + "; ".join(
+        f"{row['ratio']:.0%}: " + ", ".join(f"{stage} {value:.0f}" for stage, value in row["stages_ms"].items()
+                                             if value > 0) + " ms" for row in figures["ratios"]) + "."]
+    return "\n".join(out) + "\n"
+
+
+QUALITY_PEERS = ("Blender Collapse", "MeshLab", "meshopt_simplify", "fast-simplification")
+QUALITY_FIGURES = (("mean", "mean error"), ("max", "max error"), ("ar_mean", "aspect ratio mean"),
+                   ("ar_max", "worst triangle"))
+
+
+def render_quality(name: str, figures: dict) -> str:
+    """bench_quality.py --json: the quality mode's error and shape over the peers' at its triangle count."""
+    cases = figures["cases"]
+    ours = [case["tools"]["topstoc quality"] for case in cases]
+    targets = ", ".join(f"{ratio:.0%}" for ratio in sorted({case["ratio"] for case in cases}, reverse=True))
+    out = [f"## Result quality next to the quadric decimators (`{name}`)", "",
+           f"`{figures['benchmark']}`: {len(cases)} cases ({len({c['mesh'] for c in cases})} meshes × "
+           f"{targets}); every peer decimates to the triangle count "
+           f"of our quality result; symmetric Hausdorff error with {figures['samples']:,} samples, aspect ratio as "
+           "thesis eq. 4.2. Medians over the cases of ours ÷ the peer's figure (below 1: ours is better), the "
+           "worst case in brackets.", "", *source_lines(figures), "",
+           "| Peer | " + " | ".join(label for _, label in QUALITY_FIGURES) + " | topology kept (peer) |",
+           "|---|" + "---|" * (len(QUALITY_FIGURES) + 1)]
+    for peer in QUALITY_PEERS:
+        pairs = [(case["tools"]["topstoc quality"], case["tools"][peer]) for case in cases if case["tools"].get(peer)]
+        if not pairs:
+            out.append(f"| {peer} | not available |" + " |" * len(QUALITY_FIGURES))
+            continue
+        cells = []
+        for key, _ in QUALITY_FIGURES:
+            ratios = [a[key] / b[key] for a, b in pairs if b[key] > 0]
+            cells.append(f"{statistics.median(ratios):.3f}× [{max(ratios):.2f}]" if ratios else "—")
+        kept = sum(bool(b["topology"]) for _, b in pairs)
+        out.append(f"| {peer} | " + " | ".join(cells) + f" | {kept}/{len(pairs)} |")
+    out += ["", f"TopStoc's quality mode kept the topology in {sum(bool(o['topology']) for o in ours)}/{len(ours)} "
+            f"cases, with {sum(o['zero_area'] for o in ours)} zero-area triangles and a worst aspect ratio of "
+            f"{max(o['ar_max'] for o in ours):.0f}."]
+    return "\n".join(out) + "\n"
+
+
+def render_carried_over(name: str, figures: dict) -> str:
+    """Figures measured before the benchmarks saved JSON, kept as they were published."""
+    out = [f"## {figures['title']} (`{name}`)", "", *source_lines(figures), "", figures["note"], "",
+           "| What | TopStoc | Peer, same run | Ratio |", "|---|---|---|---|"]
+    out += [f"| {row['what']} | {row['topstoc']} | {row['peer']} | {row['ratio']} |" for row in figures["rows"]]
+    return "\n".join(out) + "\n"
+
+
+def render_result(path: pathlib.Path) -> str:
+    figures = json.loads(path.read_text())
+    if isinstance(figures, dict) and figures.get("carried_over"):
+        return render_carried_over(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_decimate.py":
+        return render_decimate(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_quality.py":
+        return render_quality(path.name, figures)
+    raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
+                     "the --json of bench_decimate.py and bench_quality.py, and carried-over figures)")
+
+
+def render() -> str:
+    """The whole of docs/benchmarks.md."""
+    parts = [HEADER]
+    parts += [render_result(path) for path in sorted(RESULTS.glob("*.json"))]
+    parts += [path.read_text().rstrip("\n") + "\n" for path in sorted(NOTES.glob("*.md"))]
+    return "\n".join(parts)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--check", action="store_true", help="only compare; exit 1 when out of date")
+    args = parser.parse_args()
+    text = render()
+    if args.check:
+        if not OUTPUT.exists() or OUTPUT.read_text() != text:
+            print(f"{OUTPUT.relative_to(ROOT)} is out of date: run python3 scripts/benchmarks_md.py", file=sys.stderr)
+            return 1
+        return 0
+    temporary = OUTPUT.with_suffix(".md.tmp")
+    temporary.write_text(text)
+    temporary.replace(OUTPUT)  # atomic: never a half-written file under the final name
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,84 @@
+"""docs/benchmarks.md is scripts/benchmarks_md.py's output from the saved results and notes, so a
+figure changes only through a benchmark's JSON (or a note), and CI catches a hand edit."""
+
+import importlib.util
+import json
+
+import pytest
+
+from conftest import ROOT
+
+spec = importlib.util.spec_from_file_location("benchmarks_md", ROOT / "scripts" / "benchmarks_md.py")
+benchmarks_md = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(benchmarks_md)
+
+
+def test_committed_benchmarks_md_is_the_scripts_output():
+    assert (ROOT / "docs" / "benchmarks.md").read_text() == benchmarks_md.render(), \
+        "docs/benchmarks.md is out of date: run python3 scripts/benchmarks_md.py"
+
+
+def test_every_result_and_note_is_in_it():
+    text = benchmarks_md.render()
+    for path in sorted((ROOT / "docs" / "bench_results").glob("*.json")):
+        assert f"(`{path.name}`)" in text
+        figures = json.loads(path.read_text())
+        assert f"- Machine: {figures['machine']}" in text and f"- Date: {figures['date']}" in text
+    for path in sorted((ROOT / "docs" / "bench_notes").glob("*.md")):
+        assert path.read_text().strip() in text
+
+
+def _decimate_figures(simplify_ms):
+    return {"benchmark": "tests/bench/bench_decimate.py", "machine": "test machine", "date": "2000-01-01",
+            "repeats": 7, "mesh": {"name": "m.ply", "vertices": 1000, "triangles": 1996},
+            "prepare_ms": 5.0, "first_ms": 80.0, "cold_quality_ms": 1500.0,
+            "ratios": [{"ratio": 0.1, "vertices": 100, "triangles": 196, "fast_ms": 40.0,
+                        "stages_ms": {"sampling": 4.0, "refine": 0.0}, "slider_step_ms": 8.0,
+                        "slider_steps": 30, "slider_steps_updated": 29, "draft_ms": 30.0, "draft_step_ms": 4.0,
+                        "quality_ms": 250.0, "quality_vertices": 100,
+                        "meshopt_simplify_ms": simplify_ms, "meshopt_sloppy_ms": simplify_ms and 20.0}]}
+
+
+def test_decimate_results_render_their_ratios():
+    text = benchmarks_md.render_decimate("x.json", _decimate_figures(2000.0))
+    row = [line for line in text.splitlines() if line.startswith("| 10 %") or line.startswith("| 10%")][0]
+    cells = [cell.strip() for cell in row.strip("|").split("|")]
+    # 2000 / 40 and 2000 / 250, computed here; the first decimation 2000 / 80
+    assert cells == ["10% (100 vertices)", "40 ms", "8 ms (29 of 30 updated)", "30 ms / 4 ms", "250 ms",
+                     "2.00 s", "20 ms", "50.0×", "8.0×"]
+    assert "first decimation at 10% (prepare + fast decimate): 80 ms, 25.0× meshopt_simplify" in text
+    assert "sampling 4 ms" in text and "refine" not in text
+
+
+def test_missing_peer_is_a_dash_not_a_ratio():
+    row = [line for line in benchmarks_md.render_decimate("x.json", _decimate_figures(None)).splitlines()
+           if line.startswith("| 10%")][0]
+    assert row.endswith("| — | — | — | — |")
+
+
+def test_an_unknown_result_file_is_refused_by_name(tmp_path):
+    path = tmp_path / "mystery.json"
+    path.write_text(json.dumps({"benchmark": "tests/bench/bench_other.py"}))
+    with pytest.raises(SystemExit, match="mystery.json"):
+        benchmarks_md.render_result(path)
+
+
+def _tool(mean, maximum, ar_mean, ar_max, topology=True, zero_area=0):
+    return {"triangles": 100, "mean": mean, "max": maximum, "ar_mean": ar_mean, "ar_p99": ar_max,
+            "ar_max": ar_max, "zero_area": zero_area, "topology": topology, "seconds": 0.1}
+
+
+def test_quality_results_render_medians_of_our_figure_over_the_peers():
+    ours = [_tool(1.0, 2.0, 1.2, 10.0), _tool(2.0, 2.0, 1.5, 40.0), _tool(3.0, 6.0, 1.3, 20.0, zero_area=1)]
+    blender = [_tool(2.0, 1.0, 1.2, 20.0), _tool(1.0, 4.0, 3.0, 20.0, topology=False), _tool(4.0, 3.0, 2.6, 10.0)]
+    cases = [{"mesh": f"m{i}.off", "ratio": 0.1, "input_triangles": 1000, "peer_triangles": 100,
+              "tools": {"topstoc quality": a, "Blender Collapse": b, "MeshLab": None}}
+             for i, (a, b) in enumerate(zip(ours, blender))]
+    text = benchmarks_md.render_quality("q.json", {"benchmark": "tests/bench/bench_quality.py", "machine": "m",
+                                                   "date": "2000-01-01", "samples": 1000, "cases": cases})
+    row = [line for line in text.splitlines() if line.startswith("| Blender Collapse")][0]
+    # mean: 0.5, 2, 0.75 -> 0.75 [2]; max: 2, 0.5, 2 -> 2 [2]; ar_mean: 1, 0.5, 0.5 -> 0.5 [1]; worst: 0.5, 2, 2
+    assert row == "| Blender Collapse | 0.750× [2.00] | 2.000× [2.00] | 0.500× [1.00] | 2.000× [2.00] | 2/3 |"
+    assert "| MeshLab | not available |" in text
+    assert "3 cases (3 meshes × 10%)" in text
+    assert "kept the topology in 3/3 cases, with 1 zero-area triangles and a worst aspect ratio of 40." in text
