@@ -5,6 +5,7 @@
 >>> result = mesh.decimate(ratio=0.1, seed=1)
 """
 
+from .clean import CleanResult, clean
 from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
                        sampling_probabilities)
 from .edit import EditResult, cut_along_loop, delete_faces, fill_holes, fill_loops, remove_handle
@@ -24,6 +25,7 @@ __all__ = [
     # the base of every error TopStoc raises on purpose (a ValueError)
     "TopStocError",
     # editing (topstoc.core.edit also has boundary_loops and the result's parts)
+    "CleanResult", "clean",
     "EditResult", "cut_along_loop", "delete_faces", "fill_holes", "fill_loops", "remove_handle",
     # measurement (hausdorff.py) and error-bounded decimation (error_bound.py)
     "Distance", "ErrorBoundReport", "HausdorffResult", "OneSidedDistance", "closest_points", "hausdorff",

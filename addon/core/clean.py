@@ -214,7 +214,7 @@ def clean(vertices, triangles, *, max_handle: Size = None, max_hole: Size = None
     keep_largest: keep at least this many handles over the whole mesh (the largest: each round
     takes the shortest loops first); with it and no max_handle, every other handle goes.
     fair: refine the patches to the surrounding edge length and fair them (else flat, coarse).
-    max_rounds: bound on the rounds of loop computation (each removes at least one handle).
+    max_rounds: bound on the rounds (``CleanResult.rounds`` counts those that removed something).
     """
     from .topology import topology  # imported here: clean is importable without topology's cost
 
@@ -300,10 +300,10 @@ def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional
         budget = found.genus - keep_largest if keep_largest is not None else found.genus
         if rounds >= max_rounds or budget <= 0:
             break
-        rounds += 1
         state, count = _removal_round(state, found, size, budget, fair, failed, removed)
         if count == 0:
             break
+        rounds += 1
     _report_left(state, found, size, keep_largest, failed, left)
     return state, rounds
 

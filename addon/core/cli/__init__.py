@@ -18,7 +18,7 @@ from . import messages, progress
 
 
 # Subcommand modules, in the order --help lists them.
-SUBCOMMANDS = ("decimate", "batch", "measure", "topology", "loops", "edit")
+SUBCOMMANDS = ("decimate", "batch", "measure", "topology", "loops", "edit", "clean")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,172 @@
+"""topstoc.core.clean: small handles, tunnels and holes removed in one step (docs/design.md §4.6).
+
+Genus and holes are checked with GUDHI's Betti numbers, the untouched surface by comparing
+positions with the input through the result's maps, and the patches' shape with the thesis'
+aspect ratio computed in tests/reference.py.
+"""
+
+import numpy as np
+import pytest
+
+import cleanup_meshes
+import cli
+import reference
+from topology_checks import gudhi_betti
+from topstoc.core import edit
+from topstoc.core.clean import clean
+from topstoc.core.errors import TopStocError
+from topstoc.core.loops import self_intersections
+
+
+def genus(vertices, triangles):
+    """Genus of a closed connected orientable surface from GUDHI: beta1 / 2."""
+    betti = gudhi_betti(len(vertices), triangles)
+    assert betti[0] == 1 and betti[2] == 1, betti
+    return betti[1] // 2
+
+
+def patch_aspect(result):
+    """Worst aspect ratio over the triangles the clean-up created."""
+    created = result.edit.face_source < 0
+    return reference.aspect_ratios(result.vertices, result.triangles[created]).max()
+
+
+def assert_rest_unchanged(vertices, triangles, result):
+    """Every input triangle is still there with the same corners; one whose positions changed
+    touches a patch border (a copy of a cut loop, the only vertices a removal moves)."""
+    e = result.edit
+    kept = e.face_source >= 0
+    assert np.array_equal(np.sort(e.face_source[kept]), np.arange(len(triangles)))
+    assert np.array_equal(e.vertex_source[e.triangles[kept]], triangles[e.face_source[kept]])
+    same = np.all(e.vertices[e.triangles[kept]] == vertices[triangles[e.face_source[kept]]], axis=(1, 2))
+    border = np.zeros(e.num_vertices, dtype=bool)
+    for patch in e.patches:
+        border[patch.boundary] = True
+    moved = ~same
+    assert not (moved & ~border[e.triangles[kept]].any(axis=1)).any()
+    return int(moved.sum())
+
+
+@pytest.mark.parametrize("small,large,seed", [(6, 2, 1), (20, 1, 2)])
+def test_small_handles_go_large_ones_stay(small, large, seed):
+    vertices, triangles = cleanup_meshes.block_with_arches(small, large, jitter=0.05, seed=seed)
+    assert genus(vertices, triangles) == small + large
+    result = clean(vertices, triangles, max_handle=6.0, max_hole=0)
+    assert genus(result.vertices, result.triangles) == large
+    assert (result.genus_before, result.genus_after) == (small + large, large)
+    assert result.count("handle") + result.count("tunnel") == small and result.count("hole") == 0
+    # Unit arches: the shorter loop (handle or tunnel) is 4 edges, about 4 long.
+    assert all(item.edges == 4 and 3.5 < item.loop_length < 4.5 for item in result.removed)
+    # Each large handle leaves its handle and its tunnel loop, both about 12 long, above the size.
+    assert len(result.left) == 2 * large
+    assert all(item.loop_length > 6 and "not below the size" in item.reason for item in result.left)
+    assert len(self_intersections(result.vertices, result.triangles)) == 0
+    assert patch_aspect(result) <= 5
+    assert result.patch_aspect == pytest.approx(patch_aspect(result))
+    moved = assert_rest_unchanged(vertices, triangles, result)
+    assert 0 < moved <= sum(3 * 2 * item.edges for item in result.removed)
+
+
+def test_large_handle_gets_flat_patch_when_faired_caps_cross():
+    # A thick handle (4 x 4): faired caps continue the tube and bulge into each other, so the
+    # clean-up falls back to refined flat caps instead of leaving the handle.
+    vertices, triangles = cleanup_meshes.block_with_arches(2, 1, large_size=4, jitter=0.05, seed=3)
+    result = clean(vertices, triangles, max_handle=20.0)
+    assert genus(result.vertices, result.triangles) == 0
+    assert result.left == []
+    big = [item for item in result.removed if item.edges == 16]
+    assert len(big) == 1 and big[0].patch in ("refined", "flat")
+    assert len(self_intersections(result.vertices, result.triangles)) == 0
+    assert patch_aspect(result) <= 5
+    assert_rest_unchanged(vertices, triangles, result)
+
+
+def test_keep_largest():
+    vertices, triangles = cleanup_meshes.block_with_arches(5, 2, jitter=0.05, seed=4)
+    result = clean(vertices, triangles, keep_largest=2)
+    assert genus(result.vertices, result.triangles) == 2
+    assert result.count("handle") + result.count("tunnel") == 5
+    assert max(item.loop_length for item in result.removed) < min(item.loop_length for item in result.left)
+    assert all("largest" in item.reason for item in result.left)
+    both = clean(vertices, triangles, keep_largest=6, max_handle=6.0)  # keep_largest binds first
+    assert genus(both.vertices, both.triangles) == 6
+
+
+def test_small_holes_filled_large_ones_left():
+    vertices, triangles = cleanup_meshes.perforated_plate(25, 3, jitter=0.05, seed=5)
+    assert gudhi_betti(len(vertices), triangles)[1] == 28  # a disk with 28 holes
+    result = clean(vertices, triangles, max_hole=6.0)
+    assert gudhi_betti(len(result.vertices), result.triangles)[1] == 3
+    holes = edit.boundary_loops(result.vertices, result.triangles)
+    perimeters = sorted(len(h) for h in holes)
+    assert perimeters == [16, 16, 16, 160]
+    assert result.count("hole") == 25 and all(item.edges == 4 for item in result.removed)
+    assert sorted(item.loop_length > 6 for item in result.left if item.kind == "hole") == [True] * 4
+    assert any(item.kind == "component" and "open" in item.reason for item in result.left)
+    assert patch_aspect(result) <= 5
+    assert_rest_unchanged(vertices, triangles, result)
+    assert np.array_equal(result.vertices[:len(vertices)], vertices)  # filling moves nothing
+
+
+def test_larger_holes_are_refined_into_the_surface():
+    vertices, triangles = cleanup_meshes.perforated_plate(0, 3, jitter=0.05, seed=6)
+    result = clean(vertices, triangles, max_hole=20.0)
+    assert result.count("hole") == 3
+    assert np.count_nonzero(result.edit.vertex_source < 0) >= 3 * 4  # refined: 3 x 3 inner vertices or so
+    assert patch_aspect(result) <= 5
+    # Edge lengths of the patches match the plate's (unit quads: 1 and 1.41).
+    created = result.triangles[result.edit.face_source < 0]
+    p = result.vertices[created]
+    lengths = np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2)
+    assert 0.5 < lengths.mean() < 1.6
+
+
+def test_attributes_follow_the_composed_maps():
+    vertices, triangles = cleanup_meshes.block_with_arches(4, 0, jitter=0.05, seed=7)
+    result = clean(vertices, triangles, max_handle=6.0)
+    corner_ids = np.arange(3 * len(triangles)).reshape(-1, 3)
+    carried = result.edit.corner_attribute(corner_ids)
+    kept = result.edit.face_source >= 0
+    assert np.array_equal(carried[kept], corner_ids[result.edit.face_source[kept]])
+    colours = np.random.default_rng(0).random((len(vertices), 3))
+    out = result.edit.vertex_attribute(colours)
+    old = result.edit.vertex_source >= 0
+    assert np.array_equal(out[old], colours[result.edit.vertex_source[old]])
+    assert len(result.edit.patches) == 2 * 4  # two caps per removal, tagged with their report entry
+    assert sorted({p.hole for p in result.edit.patches}) == list(range(4))
+
+
+def test_sizes_relative_to_the_diagonal_and_zero():
+    vertices, triangles = cleanup_meshes.block_with_arches(3, 0, jitter=0.05, seed=8)
+    diagonal = np.linalg.norm(np.ptp(vertices, axis=0))
+    assert clean(vertices, triangles).max_handle == pytest.approx(0.01 * diagonal)
+    # 4-long loops are about 27 % of this block's diagonal.
+    assert clean(vertices, triangles, max_handle="20%").genus_after == 3
+    assert clean(vertices, triangles, max_handle="35%").genus_after == 0
+    nothing = clean(vertices, triangles, max_handle=0, max_hole=0)
+    assert np.array_equal(nothing.vertices, vertices) and np.array_equal(nothing.triangles, triangles)
+    assert nothing.removed == [] and nothing.rounds == 0
+    for bad in ("big", -1.0, "-2%", [1]):
+        with pytest.raises(TopStocError):
+            clean(vertices, triangles, max_handle=bad)
+    with pytest.raises(TopStocError):
+        clean(vertices, triangles, keep_largest=-1)
+
+
+def test_cli_clean(tmp_path):
+    from topstoc.core.io import MeshData, read_mesh, write_mesh
+
+    vertices, triangles = cleanup_meshes.block_with_arches(3, 1, jitter=0.05, seed=9)
+    source, target = tmp_path / "in.obj", tmp_path / "out.ply"
+    write_mesh(str(source), MeshData(vertices=vertices, triangles=triangles))
+    before = source.read_bytes()
+    report = cli.run_json("clean", source, target, "--max-handle", "6")
+    assert report["clean"]["genus_before"] == 4 and report["clean"]["genus_after"] == 1
+    assert report["clean"]["handles_removed"] == 3 and len(report["clean"]["left"]) == 2
+    assert report["summary"] == "1 component: genus 1, closed, orientable"
+    out = read_mesh(str(target))
+    assert genus(out.vertices, out.triangles) == 1
+    assert source.read_bytes() == before
+    done = cli.run("clean", source, target, "--max-handle", "6")
+    assert done.returncode == 0 and "removed 3 handles" in done.stdout and done.stdout.count("  left ") == 2
+    cli.assert_one_error_line("clean", cli.run("clean", source, target, "--max-hole", "x"), "max_hole")
