@@ -37,34 +37,27 @@ def block_with_arches(small: int, large: int = 0, *, large_size: int = 3, jitter
     return _jittered(vertices, jitter, seed), triangles
 
 
-def perforated_plate(small: int, large: int, *, side: int = 40, large_size: int = 4, jitter: float = 0.0,
-                     seed: int = 0):
-    """A flat grid (one border) with ``small`` one-quad holes (border 4) and ``large`` square
-    holes of ``large_size`` quads a side (border 4 * large_size), none touching another."""
+def perforated_plate(small: int, large: int, *, side: int = 40, small_size: int = 1, large_size: int = 4,
+                     jitter: float = 0.0, seed: int = 0):
+    """A flat grid (one border) with ``small`` square holes of ``small_size`` quads a side
+    (border 4 * small_size) and ``large`` of ``large_size``, at random places, each at least a
+    quad away from the others and from the plate's edge."""
     vertices, triangles = meshgen.grid(side, side)
     quads = triangles.reshape(-1, 2, 3)  # grid() emits the two triangles of quad (i, j) together
     remove = np.zeros((side, side), dtype=bool)
-    spots = [(i, j) for i in range(2, side - 2, 3) for j in range(2, side - 2, 3)]
     rng = np.random.default_rng(seed)
-    order = rng.permutation(len(spots))
-    big = 0
-    taken = np.zeros((side, side), dtype=bool)
-    for index in order:  # large holes first where they fit
-        i, j = spots[index]
-        if big < large and i + large_size + 1 < side - 1 and j + large_size + 1 < side - 1 and \
-                not taken[i - 1:i + large_size + 1, j - 1:j + large_size + 1].any():
-            remove[i:i + large_size, j:j + large_size] = True
-            taken[i - 1:i + large_size + 2, j - 1:j + large_size + 2] = True
-            big += 1
-    holes = 0
-    for index in order:
-        i, j = spots[index]
-        if holes < small and not taken[i - 1:i + 2, j - 1:j + 2].any():
-            remove[i, j] = True
-            taken[i - 1:i + 2, j - 1:j + 2] = True
-            holes += 1
-    if big < large or holes < small:
-        raise ValueError(f"a {side} x {side} plate holds {big} large and {holes} small holes, not {large} and {small}")
+    for count, size in ((large, large_size), (small, small_size)):
+        spots = [(i, j) for i in range(1, side - size, size + 1) for j in range(1, side - size, size + 1)]
+        placed = 0
+        for index in rng.permutation(len(spots)):
+            i, j = spots[index]
+            if placed == count:
+                break
+            if not remove[i - 1:i + size + 1, j - 1:j + size + 1].any():  # a quad between holes
+                remove[i:i + size, j:j + size] = True
+                placed += 1
+        if placed < count:
+            raise ValueError(f"a {side} x {side} plate holds {placed} holes of {size} quads, not {count}")
     kept = quads[~remove.reshape(-1)].reshape(-1, 3)
     return _jittered(vertices, jitter, seed), kept.astype(np.int32)
 

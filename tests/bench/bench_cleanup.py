@@ -1,0 +1,157 @@
+"""Benchmark: the topology clean-up (topstoc.core.clean) on meshes with many small defects.
+
+    /usr/bin/python3 tests/bench/bench_cleanup.py [--handles 10,100,300] [--holes 50,300,1000]
+
+Cases (tests/cleanup_meshes.py, positions jittered by 0.05 like a scan):
+  * block + k small arches + 4 large ones: genus k + 4; the small handles' loops are 4 long,
+    the large ones' 12; size 6. Figures: genus before/after, handles left above the size, loops
+    left below it (recomputed on the output), worst patch aspect (R / 2r), time.
+  * plate with k 2 x 2-quad holes (border 8) and 4 large ones (border 16); size 10. Figures: holes
+    left, worst patch aspect, the patches' largest distance from the plate's plane, input
+    triangles kept bit for bit, time; PyMeshFix (fill_small_boundaries, up to 10 boundary edges)
+    on the same input, run by the Python named in TOPSTOC_PYMESHFIX_PYTHON (a venv with
+    ``pip install pymeshfix``; default /tmp/clean-venv/bin/python), and its MeshFix.repair on
+    the handle case (it keeps handles: a reference for "the genus left").
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path[:0] = [str(ROOT / "build" / "python"), str(ROOT / "tests"), str(ROOT / "tests" / "bench")]
+
+import cleanup_meshes  # noqa: E402
+import reference  # noqa: E402
+from machine import machine  # noqa: E402
+from topstoc.core import edit  # noqa: E402
+from topstoc.core.clean import clean  # noqa: E402
+from topstoc.core.loops import handle_tunnel_loops  # noqa: E402
+from topstoc.core.topology import topology  # noqa: E402
+
+SIZE = 6.0
+HOLE_SIZE = 10.0
+PYMESHFIX = os.environ.get("TOPSTOC_PYMESHFIX_PYTHON", "/tmp/clean-venv/bin/python")
+
+# Run in the PyMeshFix venv: reads in.npz, writes out.npz with the result and its time.
+PEER = """
+import sys, time, numpy as np, pymeshfix
+data = np.load(sys.argv[1]); v, f = data["v"], data["f"].astype(np.int32)
+start = time.perf_counter()
+if sys.argv[3] == "fill":
+    mesh = pymeshfix.PyTMesh(); mesh.set_quiet(True); mesh.load_array(v, f)
+    mesh.fill_small_boundaries(nbe=10, refine=True)
+    v2, f2 = mesh.return_arrays()
+else:
+    fix = pymeshfix.MeshFix(v, f); fix.repair(); v2, f2 = fix.points, fix.faces
+np.savez(sys.argv[2], v=v2, f=f2, seconds=time.perf_counter() - start)
+"""
+
+
+def peer(vertices, triangles, mode: str):
+    """PyMeshFix's result (vertices, triangles, seconds), or None when it is not installed."""
+    if not pathlib.Path(PYMESHFIX).exists():
+        return None
+    with tempfile.TemporaryDirectory() as tmp:
+        source, target = pathlib.Path(tmp, "in.npz"), pathlib.Path(tmp, "out.npz")
+        np.savez(source, v=vertices, f=triangles)
+        subprocess.run([PYMESHFIX, "-c", PEER, str(source), str(target), mode], check=True)
+        out = np.load(target)
+        return out["v"], out["f"], float(out["seconds"])
+
+
+def genus(vertices, triangles) -> int:
+    return sum(c.genus or 0 for c in topology(vertices, triangles).components if c.kind == "surface")
+
+
+def kept_bit_for_bit(vertices, triangles, out_vertices, out_triangles) -> float:
+    """Fraction of input triangles found in the output with exactly the same corner positions
+    (any vertex numbering, any rotation of the corners)."""
+    def keys(v, t):
+        p = np.ascontiguousarray(v[np.asarray(t, dtype=np.int64)])
+        rows = p.reshape(len(t), 3, 3).view(np.dtype((np.void, 24))).reshape(len(t), 3)
+        return {frozenset(r.tobytes() for r in row) for row in rows}
+    before, after = keys(vertices, triangles), keys(out_vertices, out_triangles)
+    return len(before & after) / len(before)
+
+
+def created(vertices, triangles, out_vertices, out_triangles):
+    """(worst aspect of the output triangles that are not input triangles, largest |z| of the
+    output vertices that are not input vertices), matched by positions."""
+    p = np.ascontiguousarray(vertices[np.asarray(triangles, dtype=np.int64)]).reshape(len(triangles), 9)
+    old = {frozenset(map(bytes, row.reshape(3, 3))) for row in p}
+    q = np.ascontiguousarray(out_vertices[np.asarray(out_triangles, dtype=np.int64)]).reshape(len(out_triangles), 9)
+    new = np.array([frozenset(map(bytes, row.reshape(3, 3))) not in old for row in q])
+    aspect = float(reference.aspect_ratios(out_vertices, out_triangles[new]).max()) if new.any() else 1.0
+    points = {bytes(row) for row in np.ascontiguousarray(vertices)}
+    fresh = np.array([bytes(row) not in points for row in np.ascontiguousarray(out_vertices)])
+    return aspect, float(np.abs(out_vertices[fresh, 2]).max()) if fresh.any() else 0.0, int(fresh.sum())
+
+
+def bench_handles(k: int) -> None:
+    vertices, triangles = cleanup_meshes.block_with_arches(k, 4, jitter=0.05, seed=k)
+    start = time.perf_counter()
+    result = clean(vertices, triangles, max_handle=SIZE, max_hole=0)
+    seconds = time.perf_counter() - start
+    loops = handle_tunnel_loops(result.vertices, result.triangles)
+    below = sum(1 for loop in loops.handles + loops.tunnels if loop.length < SIZE)
+    print(f"handles k={k}: {len(triangles)} triangles, genus {result.genus_before} -> {result.genus_after} "
+          f"(handles left above the size: {result.genus_after}, loops left below it: {below}), "
+          f"removed {result.count('handle')} handle + {result.count('tunnel')} tunnel loops in {result.rounds} "
+          f"rounds, patch aspect <= {result.patch_aspect:.2f}, {seconds:.2f} s "
+          f"(loops and removals; {len(result.left)} loops reported left)")
+    fixed = peer(vertices, triangles, "repair")
+    if fixed is not None:
+        print(f"  PyMeshFix repair: genus {genus(vertices, triangles)} -> {genus(fixed[0], fixed[1])}, "
+              f"{fixed[2]:.2f} s, input triangles kept bit for bit "
+              f"{100 * kept_bit_for_bit(vertices, triangles, fixed[0], fixed[1]):.1f} %")
+
+
+def bench_holes(k: int) -> None:
+    side = int(np.ceil(3 * np.sqrt(1.4 * k))) + 16
+    vertices, triangles = cleanup_meshes.perforated_plate(k, 4, side=side, small_size=2, jitter=0.05, seed=k)
+    holes = len(edit.boundary_loops(vertices, triangles))
+    start = time.perf_counter()
+    result = clean(vertices, triangles, max_hole=HOLE_SIZE, max_handle=0)
+    seconds = time.perf_counter() - start
+    fresh = result.edit.vertex_source < 0
+    rise = float(np.abs(result.vertices[fresh, 2]).max()) if fresh.any() else 0.0
+    left = len(edit.boundary_loops(result.vertices, result.triangles))
+    kept = kept_bit_for_bit(vertices, triangles, result.vertices, result.triangles)
+    print(f"holes k={k}: {len(triangles)} triangles, {holes} borders -> {left} (the 4 large ones and the plate's "
+          f"edge stay), patch aspect <= {result.patch_aspect:.2f}, {int(fresh.sum())} vertices added, "
+          f"<= {rise:.3f} off the plane, "
+          f"input triangles kept bit for bit {100 * kept:.1f} %, {seconds:.3f} s")
+    fixed = peer(vertices, triangles, "fill")
+    if fixed is None:
+        print(f"  PyMeshFix: not installed for {PYMESHFIX}")
+        return
+    aspect, rise, added = created(vertices, triangles, fixed[0], fixed[1])
+    print(f"  PyMeshFix fill_small_boundaries(10): {holes} borders -> {len(edit.boundary_loops(fixed[0], fixed[1]))}, "
+          f"patch aspect <= {aspect:.2f}, {added} vertices added, <= {rise:.3f} off the plane, input triangles kept bit for bit "
+          f"{100 * kept_bit_for_bit(vertices, triangles, fixed[0], fixed[1]):.1f} %, {fixed[2]:.3f} s")
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--handles", default="10,100,300", help="small handle counts, comma-separated")
+    parser.add_argument("--holes", default="50,300,1000", help="small hole counts, comma-separated")
+    args = parser.parse_args(argv)
+    print(machine())
+    for k in (int(x) for x in args.handles.split(",") if x):
+        bench_handles(k)
+    for k in (int(x) for x in args.holes.split(",") if x):
+        bench_holes(k)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
