@@ -31,6 +31,7 @@ import numpy as np
 from . import edit
 from .edit import EditResult, Patch
 from .errors import TopStocError
+from .local_edit import LocalEditor
 from .mesh import as_vertices
 
 #: Default size of a small handle or hole, as a fraction of the bounding box's diagonal.
@@ -315,6 +316,7 @@ def _removal_round(state: EditResult, found, size: float, budget: int, fair: boo
                         key=lambda loop: (loop.length, loop.kind))
     used = np.zeros(state.num_vertices, dtype=bool)
     count, stale = 0, {}
+    editor = LocalEditor(state.vertices, state.triangles)
     for loop in candidates:
         if count >= budget or loop.length >= size:
             break
@@ -323,7 +325,7 @@ def _removal_round(state: EditResult, found, size: float, budget: int, fair: boo
         if used[ids].any() or key in failed:
             continue
         try:
-            step, style = _remove_one(state, ids, fair)
+            step, style = _remove_one(editor, state, ids, fair)
         except ValueError as error:
             # A loop that now separates was made redundant by a removal earlier in this round;
             # the next round's loops settle it. Anything else is this loop's own failure.
@@ -342,7 +344,7 @@ def _removal_round(state: EditResult, found, size: float, budget: int, fair: boo
     return state, count
 
 
-def _remove_one(state: EditResult, ids: np.ndarray, fair: bool) -> tuple:
+def _remove_one(editor: LocalEditor, state: EditResult, ids: np.ndarray, fair: bool) -> tuple:
     """remove_handle with the best patches that do not make the surface cross itself: faired,
     else refined but flat, else flat. A faired cap continues the tube it closes, so the two caps
     of a thick handle bulge towards each other and can cross; flat ones do not."""
@@ -350,7 +352,7 @@ def _remove_one(state: EditResult, ids: np.ndarray, fair: bool) -> tuple:
         (("flat", False, False),)
     for number, (style, refine, fair_patch) in enumerate(styles):
         try:
-            return edit.remove_handle(state.vertices, state.triangles, ids, refine=refine, fair=fair_patch), style
+            return editor.remove_handle(state.vertices, state.triangles, ids, refine=refine, fair=fair_patch), style
         except ValueError as error:
             if number + 1 == len(styles) or "intersect itself" not in str(error):
                 raise

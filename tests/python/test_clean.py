@@ -170,3 +170,29 @@ def test_cli_clean(tmp_path):
     done = cli.run("clean", source, target, "--max-handle", "6")
     assert done.returncode == 0 and "removed 3 handles" in done.stdout and done.stdout.count("  left ") == 2
     cli.assert_one_error_line("clean", cli.run("clean", source, target, "--max-hole", "x"), "max_hole")
+
+
+def test_local_removal_is_the_whole_mesh_edit(monkeypatch):
+    from topstoc.core import local_edit
+    from topstoc.core.local_edit import LocalEditor
+    from topstoc.core.loops import handle_tunnel_loops
+
+    vertices, triangles = cleanup_meshes.block_with_arches(30, 0, jitter=0.05, seed=10)
+    loop = min(handle_tunnel_loops(vertices, triangles).handles, key=lambda loop: loop.length).vertices
+    whole = edit.remove_handle(vertices, triangles, loop, refine=True, fair=True)
+    editor = LocalEditor(vertices, triangles)
+    sizes = []
+    original = edit.remove_handle
+
+    def recording(v, t, *args, **kwargs):
+        sizes.append(len(t))
+        return original(v, t, *args, **kwargs)
+
+    monkeypatch.setattr(local_edit.edit, "remove_handle", recording)
+    local = editor.remove_handle(vertices, triangles, loop, refine=True, fair=True)
+    assert len(sizes) == 1 and sizes[0] < len(triangles) / 4  # edited on a neighbourhood
+    for name in ("vertices", "triangles", "vertex_source", "face_source", "corner_source"):
+        assert np.array_equal(getattr(local, name), getattr(whole, name)), name
+    assert [p.boundary.tolist() for p in local.patches] == [p.boundary.tolist() for p in whole.patches]
+    corners = local.vertices[local.triangles]
+    assert np.array_equal(editor.low, corners.min(axis=1)) and np.array_equal(editor.high, corners.max(axis=1))
