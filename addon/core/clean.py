@@ -251,7 +251,10 @@ def _genus(info) -> int:
 
 
 def _fill_small_holes(vertices, triangles, size: float, fair: bool, removed: list, left: list) -> EditResult:
-    """Fills every fillable hole whose border is shorter than ``size``; reports the others."""
+    """Fills every fillable hole whose border is shorter than ``size``; reports the others.
+
+    A patch that would cross the surface is not kept: its hole is tried again with a flat patch
+    and otherwise left open (fill_holes itself does not look for crossings)."""
     holes = edit.boundary_loops(vertices, triangles)
     chosen = []
     for index, hole in enumerate(holes):
@@ -265,10 +268,40 @@ def _fill_small_holes(vertices, triangles, size: float, fair: bool, removed: lis
                              hole.vertices.astype(np.int32)))
         else:
             chosen.append(index)
-    start = identity(vertices, triangles)
-    if not chosen:
-        return start
-    filled = edit.fill_holes(vertices, triangles, holes=chosen, weld_pinches=False, refine=fair, fair=fair)
+    state = identity(vertices, triangles)
+    crossing = []
+    for _ in range(3):  # each pass drops the holes whose patches crossed; rarely more than one
+        if not chosen:
+            break
+        # A border through two vertices at one position (a pinch) is filled lobe by lobe, the
+        # twins welded: the one renumbering of the clean-up, done first so later steps append.
+        filled = edit.fill_holes(vertices, triangles, holes=chosen, refine=fair, fair=fair)
+        bad = _crossing_patches(filled)
+        if not bad:
+            state = _tagged(filled, chosen, holes, vertices, fair, removed)
+            chosen = []
+            break
+        crossing += sorted(bad)
+        chosen = [index for index in chosen if index not in bad]
+    crossing += chosen  # still crossing after the passes
+    for index in crossing:
+        state = _fill_flat_or_leave(state, holes[index], vertices, removed, left)
+    return state
+
+
+def _crossing_patches(result: EditResult) -> set:
+    """The holes (``Patch.hole``: boundary loop indices) whose patches cross another triangle."""
+    from .loops import self_intersections
+
+    owner = np.full(result.num_triangles, -1)
+    for patch in result.patches:
+        owner[patch.triangles] = patch.hole
+    pairs = self_intersections(result.vertices, result.triangles)
+    return set(owner[np.asarray(pairs, dtype=np.int64).reshape(-1)].tolist()) - {-1}
+
+
+def _tagged(filled: EditResult, chosen: list, holes: list, vertices, fair: bool, removed: list) -> EditResult:
+    """``filled`` with a report entry per hole and its patches tagged with that entry."""
     by_hole = {}
     for patch in filled.patches:
         by_hole.setdefault(patch.hole, []).append(patch)
@@ -279,9 +312,21 @@ def _fill_small_holes(vertices, triangles, size: float, fair: bool, removed: lis
         tag = len(removed)
         removed.append(Removed("hole", loop_length(vertices, hole.vertices), len(hole), area, aspect,
                                hole.vertices.astype(np.int32), "faired" if fair else "flat"))
-        patches += [Patch(hole=tag, boundary=p.boundary, triangles=p.triangles, vertices=p.vertices,
-                          method=p.method, normal=p.normal) for p in by_hole.get(index, [])]
-    return dataclasses.replace(compose(start, filled, tag=-1), patches=patches)
+        patches += [dataclasses.replace(p, hole=tag) for p in by_hole.get(index, [])]
+    return dataclasses.replace(filled, patches=patches)
+
+
+def _fill_flat_or_leave(state: EditResult, hole, vertices, removed: list, left: list) -> EditResult:
+    """Fills one hole with a flat patch if that crosses nothing, else reports it left."""
+    length = loop_length(vertices, hole.vertices)
+    ids = state.vertex_map()[hole.vertices]
+    step = edit.fill_loops(state.vertices, state.triangles, [ids])
+    if _crossing_patches(step):
+        left.append(Left("hole", length, "every patch tried crosses the surface", hole.vertices.astype(np.int32)))
+        return state
+    area, aspect = patch_quality(step.vertices, step.triangles, step.patches)
+    removed.append(Removed("hole", length, len(hole), area, aspect, hole.vertices.astype(np.int32), "flat"))
+    return compose(state, step, tag=len(removed) - 1)
 
 
 def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional[int], fair: bool,
