@@ -87,7 +87,10 @@ class Left:
 
 @dataclass(frozen=True)
 class CleanResult:
-    """The cleaned mesh (``edit``: arrays and maps to the input, like any edit) and the report."""
+    """The cleaned mesh (``edit``: arrays and maps to the input, like any edit) and the report.
+
+    ``seconds``: "holes" (filling), "handles" (removing, of which "loops" computing loops), "total".
+    """
 
     edit: EditResult
     removed: List[Removed]
@@ -237,7 +240,7 @@ def clean(vertices, triangles, *, max_handle: Size = None, max_hole: Size = None
     left: List[Left] = []
     state = _fill_small_holes(vertices, triangles, hole_size, fair, removed, left)
     seconds = {"holes": time.perf_counter() - started}
-    state, rounds = _remove_small_handles(state, handle_size, keep_largest, fair, max_rounds, removed, left)
+    state, rounds = _remove_small_handles(state, handle_size, keep_largest, fair, max_rounds, removed, left, seconds)
     seconds["handles"] = time.perf_counter() - started - seconds["holes"]
     genus_after = _genus(topology(state.vertices, state.triangles))
     seconds["total"] = time.perf_counter() - started
@@ -330,19 +333,23 @@ def _fill_flat_or_leave(state: EditResult, hole, vertices, removed: list, left: 
 
 
 def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional[int], fair: bool,
-                          max_rounds: int, removed: list, left: list) -> tuple:
-    """Rounds of loop computation and removal (module docstring); returns (state, rounds)."""
+                          max_rounds: int, removed: list, left: list, seconds: dict) -> tuple:
+    """Rounds of loop computation and removal (module docstring); returns (state, rounds).
+    Adds the time spent computing loops to ``seconds["loops"]``."""
     from .loops import handle_tunnel_loops
 
     failed = {}  # frozenset of vertex ids (stable: edits only append) -> why the removal failed
     rounds = 0
     while True:
+        started = time.perf_counter()
         try:
             found = handle_tunnel_loops(state.vertices, state.triangles)
         except ValueError as error:
             left.append(Left("component", 0.0, f"handle and tunnel loops not computed: {error}",
                              np.zeros(0, np.int32)))
             return state, rounds
+        finally:
+            seconds["loops"] = seconds.get("loops", 0.0) + time.perf_counter() - started
         budget = found.genus - keep_largest if keep_largest is not None else found.genus
         if rounds >= max_rounds or budget <= 0:
             break

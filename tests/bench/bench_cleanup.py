@@ -12,6 +12,9 @@ Cases (tests/cleanup_meshes.py, positions jittered by 0.05 like a scan):
     on the same input, run by the Python named in TOPSTOC_PYMESHFIX_PYTHON (a venv with
     ``pip install pymeshfix``; default /tmp/clean-venv/bin/python), and its MeshFix.repair on
     the handle case (it keeps handles: a reference for "the genus left").
+  * the criterion: on the elephant (tests/data, holes filled) and on unit arches, each handle
+    loop and each tunnel loop crossing it removed apart: does the shorter one give the smaller
+    patch area?
 """
 
 from __future__ import annotations
@@ -33,7 +36,8 @@ import cleanup_meshes  # noqa: E402
 import reference  # noqa: E402
 from machine import machine  # noqa: E402
 from topstoc.core import edit  # noqa: E402
-from topstoc.core.clean import clean  # noqa: E402
+from topstoc.core.clean import clean, patch_quality  # noqa: E402
+from topstoc.core.io import read_mesh  # noqa: E402
 from topstoc.core.loops import handle_tunnel_loops  # noqa: E402
 from topstoc.core.topology import topology  # noqa: E402
 
@@ -107,7 +111,7 @@ def bench_handles(k: int) -> None:
           f"(handles left above the size: {result.genus_after}, loops left below it: {below}), "
           f"removed {result.count('handle')} handle + {result.count('tunnel')} tunnel loops in {result.rounds} "
           f"rounds, patch aspect <= {result.patch_aspect:.2f}, {seconds:.2f} s "
-          f"(loops and removals; {len(result.left)} loops reported left)")
+          f"(of which computing loops {result.seconds.get('loops', 0):.2f} s; {len(result.left)} loops reported left)")
     fixed = peer(vertices, triangles, "repair")
     if fixed is not None:
         print(f"  PyMeshFix repair: genus {genus(vertices, triangles)} -> {genus(fixed[0], fixed[1])}, "
@@ -140,6 +144,34 @@ def bench_holes(k: int) -> None:
           f"{100 * kept_bit_for_bit(vertices, triangles, fixed[0], fixed[1]):.1f} %, {fixed[2]:.3f} s")
 
 
+def removal_area(vertices, triangles, loop):
+    """Patch area of removing the handle along ``loop`` (faired), or None when it fails."""
+    try:
+        result = edit.remove_handle(vertices, triangles, loop.vertices, refine=True, fair=True)
+    except ValueError:
+        return None
+    return patch_quality(result.vertices, result.triangles, result.patches)[0]
+
+
+def bench_criterion(name: str, vertices, triangles) -> None:
+    """Does the shorter of a handle's two loops also give the smaller patches? Each handle loop
+    is paired with the tunnel loops it crosses (shares a vertex with); both are removed apart."""
+    found = handle_tunnel_loops(vertices, triangles)
+    agree = total = 0
+    for handle in found.handles:
+        for tunnel in found.tunnels:
+            if not np.intersect1d(handle.vertices, tunnel.vertices).size:
+                continue
+            areas = [removal_area(vertices, triangles, loop) for loop in (handle, tunnel)]
+            short, long = (0, 1) if handle.length <= tunnel.length else (1, 0)
+            total += 1
+            agree += areas[short] is not None and (areas[long] is None or areas[short] <= areas[long])
+            print(f"  {name}: handle loop {handle.length:.4g} -> patch area "
+                  f"{'failed' if areas[0] is None else format(areas[0], '.4g')}, tunnel loop {tunnel.length:.4g} "
+                  f"-> {'failed' if areas[1] is None else format(areas[1], '.4g')}")
+    print(f"criterion on {name}: the shorter loop gave the smaller patch (or the only one) in {agree} of {total} pairs")
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--handles", default="10,100,300", help="small handle counts, comma-separated")
@@ -150,6 +182,11 @@ def main(argv=None) -> int:
         bench_handles(k)
     for k in (int(x) for x in args.holes.split(",") if x):
         bench_holes(k)
+    elephant = read_mesh(str(ROOT / "tests" / "data" / "open_boundary" / "cgal_elephant-with-holes.off"))
+    filled = edit.fill_holes(elephant.vertices, elephant.triangles, refine=True, fair=True)
+    bench_criterion("elephant (holes filled)", filled.vertices, filled.triangles)
+    v, t = cleanup_meshes.block_with_arches(6, 0, jitter=0.05, seed=1)
+    bench_criterion("6 unit arches", v, t)
     return 0
 
 
