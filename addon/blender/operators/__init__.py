@@ -2,9 +2,9 @@
 
 import bpy
 
-from . import decimate, explain, guidance, import_off, metrics, preview, regenerate, samples, topology, variants
+from . import clean, decimate, explain, guidance, import_off, metrics, preview, regenerate, samples, topology, variants
 
-MODULES = (decimate, guidance, preview, samples, variants, regenerate, topology, metrics, import_off, explain)
+MODULES = (decimate, guidance, preview, samples, variants, regenerate, topology, metrics, import_off, explain, clean)
 
 
 def register():

@@ -204,6 +204,7 @@ class TOPSTOC_PT_topology_edit(_Panel, bpy.types.Panel):
         col.operator("topstoc.fill_holes", text="Fill Selected Holes", icon="MOD_SOLIDIFY").mode = "SELECTED"
         col.operator("topstoc.fill_holes", text="Fill All Holes", icon="MOD_SOLIDIFY").mode = "ALL"
         col.operator("topstoc.delete_faces", icon="TRASH")
+        layout.operator("topstoc.clean", text="Clean Up Small Handles and Holes", icon="MOD_SMOOTH")
 
 
 class TOPSTOC_PT_topology_overlays(_Panel, bpy.types.Panel):
