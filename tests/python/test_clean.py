@@ -170,6 +170,10 @@ def test_cli_clean(tmp_path):
     done = cli.run("clean", source, target, "--max-handle", "6")
     assert done.returncode == 0 and "removed 3 handles" in done.stdout and done.stdout.count("  left ") == 2
     cli.assert_one_error_line("clean", cli.run("clean", source, target, "--max-hole", "x"), "max_hole")
+    cli.assert_one_error_line("clean", cli.run("clean", source, target, "--keep-largest", "-1"), "--keep-largest")
+    every = cli.run_json("clean", source, target, "--keep-largest", "0", "--flat")["clean"]
+    assert every["genus_after"] == 0 and every["handles_removed"] == 4
+    assert {item["patch"] for item in every["removed"]} == {"flat"}
 
 
 def test_local_removal_is_the_whole_mesh_edit(monkeypatch):
@@ -220,3 +224,22 @@ def test_scanned_elephant_holes_and_handles(data_dir):
     assert patch_aspect(result) <= 5
     pairs = np.asarray(self_intersections(result.vertices, result.triangles))
     assert not (result.edit.face_source < 0)[pairs].any()
+
+
+def test_a_failed_removal_is_reported_not_retried(monkeypatch):
+    from topstoc.core import local_edit
+
+    vertices, triangles = cleanup_meshes.block_with_arches(3, 1, jitter=0.05, seed=13)
+    calls = []
+
+    def refuse(v, t, loop, **options):
+        calls.append(options["fair"])
+        raise TopStocError("removing the handle along this loop would make the surface intersect itself")
+
+    monkeypatch.setattr(local_edit.edit, "remove_handle", refuse)
+    result = clean(vertices, triangles, max_handle=6.0)
+    assert result.removed == [] and result.genus_after == 4 and result.rounds == 0
+    failed = [item for item in result.left if item.reason.startswith("removal failed")]
+    assert len(failed) == 6 and all(item.loop_length < 6 for item in failed)  # both loops of each small arch
+    assert sum(item.loop_length >= 6 for item in result.left) == 2
+    assert len(calls) == 6 * 3  # faired, refined, flat once per loop, never again
