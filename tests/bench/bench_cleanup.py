@@ -12,6 +12,8 @@ Cases (tests/cleanup_meshes.py, positions jittered by 0.05 like a scan):
     on the same input, run by the Python named in TOPSTOC_PYMESHFIX_PYTHON (a venv with
     ``pip install pymeshfix``; default /tmp/clean-venv/bin/python), and its MeshFix.repair on
     the handle case (it keeps handles: a reference for "the genus left").
+  * the same blocks subdivided once and Taubin-smoothed: organic little handles (loops about
+    3.2, the large ones 11; size 5), where the faired caps are kept.
   * the criterion: on the elephant (tests/data, holes filled) and on unit arches, each handle
     loop and each tunnel loop crossing it removed apart: does the shorter one give the smaller
     patch area?
@@ -33,6 +35,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT / "build" / "python"), str(ROOT / "tests"), str(ROOT / "tests" / "bench")]
 
 import cleanup_meshes  # noqa: E402
+import meshgen  # noqa: E402
 import reference  # noqa: E402
 from machine import machine  # noqa: E402
 from topstoc.core import edit  # noqa: E402
@@ -100,14 +103,18 @@ def created(vertices, triangles, out_vertices, out_triangles):
     return aspect, float(np.abs(out_vertices[fresh, 2]).max()) if fresh.any() else 0.0, int(fresh.sum())
 
 
-def bench_handles(k: int) -> None:
-    vertices, triangles = cleanup_meshes.block_with_arches(k, 4, jitter=0.05, seed=k)
+def bench_handles(k: int, smooth: bool = False) -> None:
+    vertices, triangles = cleanup_meshes.block_with_arches(k, 4, jitter=0.0 if smooth else 0.05, seed=k)
+    size = SIZE
+    if smooth:  # subdivided and smoothed: organic little handles, loops about 3.2 (large ones 11)
+        vertices, triangles = meshgen.subdivide(vertices, triangles, 1)
+        vertices, size = cleanup_meshes.smoothed(vertices, triangles), 5.0
     start = time.perf_counter()
-    result = clean(vertices, triangles, max_handle=SIZE, max_hole=0)
+    result = clean(vertices, triangles, max_handle=size, max_hole=0)
     seconds = time.perf_counter() - start
     loops = handle_tunnel_loops(result.vertices, result.triangles)
-    below = sum(1 for loop in loops.handles + loops.tunnels if loop.length < SIZE)
-    print(f"handles k={k}: {len(triangles)} triangles, genus {result.genus_before} -> {result.genus_after} "
+    below = sum(1 for loop in loops.handles + loops.tunnels if loop.length < size)
+    print(f"handles k={k}{' smoothed' if smooth else ''}: {len(triangles)} triangles, genus {result.genus_before} -> {result.genus_after} "
           f"(handles left above the size: {result.genus_after}, loops left below it: {below}), "
           f"removed {result.count('handle')} handle + {result.count('tunnel')} tunnel loops in {result.rounds} "
           f"rounds, patch aspect <= {result.patch_aspect:.2f}, {seconds:.2f} s "
@@ -175,11 +182,14 @@ def bench_criterion(name: str, vertices, triangles) -> None:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--handles", default="10,100,300", help="small handle counts, comma-separated")
+    parser.add_argument("--smooth", default="10,100", help="small handle counts on smoothed blocks")
     parser.add_argument("--holes", default="50,300,1000", help="small hole counts, comma-separated")
     args = parser.parse_args(argv)
     print(machine())
     for k in (int(x) for x in args.handles.split(",") if x):
         bench_handles(k)
+    for k in (int(x) for x in args.smooth.split(",") if x):
+        bench_handles(k, smooth=True)
     for k in (int(x) for x in args.holes.split(",") if x):
         bench_holes(k)
     elephant = read_mesh(str(ROOT / "tests" / "data" / "open_boundary" / "cgal_elephant-with-holes.off"))

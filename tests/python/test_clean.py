@@ -10,6 +10,7 @@ import pytest
 
 import cleanup_meshes
 import cli
+import meshgen
 import reference
 from topology_checks import gudhi_betti
 from topstoc.core import edit
@@ -65,6 +66,21 @@ def test_small_handles_go_large_ones_stay(small, large, seed):
     assert result.patch_aspect == pytest.approx(patch_aspect(result))
     moved = assert_rest_unchanged(vertices, triangles, result)
     assert 0 < moved <= sum(3 * 2 * item.edges for item in result.removed)
+
+
+def test_smooth_little_handles_get_faired_caps():
+    vertices, triangles = cleanup_meshes.block_with_arches(8, 1)
+    vertices, triangles = meshgen.subdivide(vertices, triangles, 1)
+    vertices = cleanup_meshes.smoothed(vertices, triangles)
+    assert len(self_intersections(vertices, triangles)) == 0 and genus(vertices, triangles) == 9
+    result = clean(vertices, triangles, max_handle=5.0)  # smoothed unit arches' loops: about 3.2
+    assert genus(result.vertices, result.triangles) == 1
+    assert result.count("handle") + result.count("tunnel") == 8
+    assert {item.patch for item in result.removed} == {"faired"}
+    assert np.count_nonzero(result.edit.vertex_source < 0) > 0  # refined: the caps have inner vertices
+    assert len(self_intersections(result.vertices, result.triangles)) == 0
+    assert patch_aspect(result) <= 5
+    assert_rest_unchanged(vertices, triangles, result)
 
 
 def test_large_handle_gets_flat_patch_when_faired_caps_cross():
