@@ -12,8 +12,11 @@ Handles are removed in rounds: a round computes the loops of the current surface
 (topstoc.core.loops) and removes the shortest loops below the size that share no vertex with
 one removed before in the round. The 2g handle and tunnel loops of a component are independent
 in its homology, so disjoint ones do not separate the surface together, and each removal drops
-the genus by one; the next round recomputes the loops of what is left, since a removal changes
-the loops of the others. Each round is checked (components and genus) before it is kept.
+the genus by one (remove_handle checks anyway that each cut leaves its component in one
+piece, on the surface as it is then); the next round recomputes the loops of what is left,
+since a removal changes the loops of the others. A removal runs on the loop's neighbourhood
+(local_edit.py). Holes are filled first; a patch that would cross the surface is replaced by a
+flat one or its hole left open and reported.
 
 >>> result = clean(vertices, triangles, max_handle="1%", max_hole="1%")
 >>> result.vertices, result.triangles, result.removed, result.left
@@ -197,9 +200,7 @@ def compose(first: EditResult, second: EditResult, tag: int) -> EditResult:
     n = first.num_vertices
     if second.num_vertices < n or not np.array_equal(second.vertex_source[:n], np.arange(n)):
         raise TopStocError("internal: a clean-up step renumbered the vertices")
-    patches = list(first.patches) + [Patch(hole=tag, boundary=p.boundary, triangles=p.triangles,
-                                           vertices=p.vertices, method=p.method, normal=p.normal)
-                                     for p in second.patches]
+    patches = list(first.patches) + [dataclasses.replace(p, hole=tag) for p in second.patches]
     return EditResult(vertices=second.vertices, triangles=second.triangles,
                       vertex_source=_through(first.vertex_source, second.vertex_source),
                       face_source=_through(first.face_source, second.face_source),
