@@ -53,7 +53,8 @@ class Removed:
     worst aspect ratio (R / 2r, 1 for an equilateral triangle). ``vertices`` are the loop's
     vertices in the input's ids (a vertex the clean-up created has none: -1). ``patch`` says
     how the patches were made: "faired" (refined and faired), "refined" (refined, flat) or
-    "flat" (the border's vertices only), the first of these free of self-intersections.
+    "flat" (the border's vertices only), the first of these free of self-intersections; or
+    "welded" for a hole closed by welding its border's twin vertices (a crack), without patch.
     """
 
     kind: str
@@ -191,16 +192,17 @@ def _through(first: np.ndarray, second: np.ndarray) -> np.ndarray:
     return out
 
 
-def compose(first: EditResult, second: EditResult, tag: int) -> EditResult:
+def compose(first: EditResult, second: EditResult, tag: Optional[int] = None) -> EditResult:
     """``second`` (an edit of ``first``'s result) with its maps taken back to ``first``'s input.
 
     Cuts and fills keep every vertex and triangle id and append new ones, so ``first``'s patches
-    keep their places; ``second``'s patches get ``hole=tag`` (their entry in the report).
+    keep their places; ``second``'s patches get ``hole=tag`` (their entry in the report), or
+    keep theirs with None.
     """
     n = first.num_vertices
     if second.num_vertices < n or not np.array_equal(second.vertex_source[:n], np.arange(n)):
         raise TopStocError("internal: a clean-up step renumbered the vertices")
-    patches = list(first.patches) + [dataclasses.replace(p, hole=tag) for p in second.patches]
+    patches = list(first.patches) + [p if tag is None else dataclasses.replace(p, hole=tag) for p in second.patches]
     return EditResult(vertices=second.vertices, triangles=second.triangles,
                       vertex_source=_through(first.vertex_source, second.vertex_source),
                       face_source=_through(first.face_source, second.face_source),
@@ -257,8 +259,8 @@ def _genus(info) -> int:
 def _fill_small_holes(vertices, triangles, size: float, fair: bool, removed: list, left: list) -> EditResult:
     """Fills every fillable hole whose border is shorter than ``size``; reports the others.
 
-    A patch that would cross the surface is not kept: its hole is tried again with a flat patch
-    and otherwise left open (fill_holes itself does not look for crossings)."""
+    Patches that would cross the surface are not kept (fill_holes does not look): their holes
+    are tried again with flat patches, then left open and reported."""
     holes = edit.boundary_loops(vertices, triangles)
     chosen = []
     for index, hole in enumerate(holes):
@@ -272,65 +274,94 @@ def _fill_small_holes(vertices, triangles, size: float, fair: bool, removed: lis
                              hole.vertices.astype(np.int32)))
         else:
             chosen.append(index)
-    state = identity(vertices, triangles)
-    crossing = []
-    for _ in range(3):  # each pass drops the holes whose patches crossed; rarely more than one
+    state = None  # None: the input, untouched
+    for style in ("faired", "flat") if fair else ("flat",):
         if not chosen:
             break
-        # A border through two vertices at one position (a pinch) is filled lobe by lobe, the
-        # twins welded: the one renumbering of the clean-up, done first so later steps append.
-        filled = edit.fill_holes(vertices, triangles, holes=chosen, refine=fair, fair=fair)
-        bad = _crossing_patches(filled)
+        step, kept, chosen = _fill_without_crossings(vertices, triangles, state, holes, chosen, style)
+        if kept:
+            step = _tagged(step, kept, holes, vertices, style, removed)
+            state = step if state is None else compose(state, step)
+    for index in chosen:
+        left.append(Left("hole", loop_length(vertices, holes[index].vertices),
+                         "every patch tried crosses the surface", holes[index].vertices.astype(np.int32)))
+    return identity(vertices, triangles) if state is None else state
+
+
+def _fill_without_crossings(vertices, triangles, state: Optional[EditResult], holes: list, chosen: list,
+                            style: str) -> tuple:
+    """Fills the ``chosen`` holes, dropping (and filling again without) those whose patches cross
+    the surface, a few times. Returns (the fill, the holes it filled, the holes left)."""
+    dropped = []
+    for _ in range(3):
+        step = _fill(vertices, triangles, state, holes, chosen, style)
+        bad = crossing_patches(step)
         if not bad:
-            state = _tagged(filled, chosen, holes, vertices, fair, removed)
-            chosen = []
-            break
-        crossing += sorted(bad)
+            return step, chosen, dropped
+        dropped += sorted(bad)
         chosen = [index for index in chosen if index not in bad]
-    crossing += chosen  # still crossing after the passes
-    for index in crossing:
-        state = _fill_flat_or_leave(state, holes[index], vertices, removed, left)
-    return state
+        if not chosen:
+            break
+    return None, [], dropped + chosen
 
 
-def _crossing_patches(result: EditResult) -> set:
-    """The holes (``Patch.hole``: boundary loop indices) whose patches cross another triangle."""
+def _fill(vertices, triangles, state: Optional[EditResult], holes: list, chosen: list, style: str) -> EditResult:
+    """The ``chosen`` holes filled, patches tagged with their index into ``holes``. On the input,
+    a border through two vertices at one position (a pinch) is filled lobe by lobe, the twins
+    welded (a crack whose sides coincide closes without a patch): the clean-up's one
+    renumbering, done first so that later steps only append."""
+    refine = style == "faired"
+    if state is None:
+        return edit.fill_holes(vertices, triangles, holes=chosen, refine=refine, fair=refine)
+    ids = state.vertex_map()
+    step = edit.fill_loops(state.vertices, state.triangles, [ids[holes[index].vertices] for index in chosen],
+                           refine=refine, fair=refine)
+    return dataclasses.replace(step, patches=[dataclasses.replace(p, hole=chosen[p.hole]) for p in step.patches])
+
+
+def crossing_patches(result: EditResult) -> set:
+    """The ``Patch.hole`` values of the patches that cross another triangle of ``result``.
+
+    Only triangles whose bounding boxes meet a patch's box can cross it: those are tested
+    (exact tests, topstoc.core.loops.self_intersections), not the whole mesh."""
     from .loops import self_intersections
 
+    if not result.patches:
+        return set()
+    corners = result.vertices[result.triangles]
+    low, high = corners.min(axis=1), corners.max(axis=1)
+    order = np.argsort(low[:, 0], kind="stable")
+    sorted_low = low[order, 0]
+    reach = float((high[:, 0] - low[:, 0]).max())
+    near = [np.arange(p.triangles.start, p.triangles.stop) for p in result.patches]
+    for p in result.patches:
+        box_low, box_high = low[p.triangles].min(axis=0), high[p.triangles].max(axis=0)
+        span = order[np.searchsorted(sorted_low, box_low[0] - reach):np.searchsorted(sorted_low, box_high[0], "right")]
+        near.append(span[np.all(high[span] >= box_low, axis=1) & np.all(low[span] <= box_high, axis=1)])
+    rows = np.unique(np.concatenate(near))
     owner = np.full(result.num_triangles, -1)
-    for patch in result.patches:
-        owner[patch.triangles] = patch.hole
-    pairs = self_intersections(result.vertices, result.triangles)
-    return set(owner[np.asarray(pairs, dtype=np.int64).reshape(-1)].tolist()) - {-1}
+    for p in result.patches:
+        owner[p.triangles] = p.hole
+    pairs = np.asarray(self_intersections(result.vertices, result.triangles[rows]), dtype=np.int64).reshape(-1)
+    return set(owner[rows[pairs]].tolist()) - {-1}
 
 
-def _tagged(filled: EditResult, chosen: list, holes: list, vertices, fair: bool, removed: list) -> EditResult:
-    """``filled`` with a report entry per hole and its patches tagged with that entry."""
+def _tagged(filled: EditResult, chosen: list, holes: list, vertices, style: str, removed: list) -> EditResult:
+    """``filled`` with a report entry per hole, its patches tagged with that entry. A hole with
+    no patch was closed by welding its twin vertices."""
     by_hole = {}
     for patch in filled.patches:
         by_hole.setdefault(patch.hole, []).append(patch)
     patches = []
     for index in chosen:
         hole = holes[index]
-        area, aspect = patch_quality(filled.vertices, filled.triangles, by_hole.get(index, []))
+        own = by_hole.get(index, [])
+        area, aspect = patch_quality(filled.vertices, filled.triangles, own)
         tag = len(removed)
         removed.append(Removed("hole", loop_length(vertices, hole.vertices), len(hole), area, aspect,
-                               hole.vertices.astype(np.int32), "faired" if fair else "flat"))
-        patches += [dataclasses.replace(p, hole=tag) for p in by_hole.get(index, [])]
+                               hole.vertices.astype(np.int32), style if own else "welded"))
+        patches += [dataclasses.replace(p, hole=tag) for p in own]
     return dataclasses.replace(filled, patches=patches)
-
-
-def _fill_flat_or_leave(state: EditResult, hole, vertices, removed: list, left: list) -> EditResult:
-    """Fills one hole with a flat patch if that crosses nothing, else reports it left."""
-    length = loop_length(vertices, hole.vertices)
-    ids = state.vertex_map()[hole.vertices]
-    step = edit.fill_loops(state.vertices, state.triangles, [ids])
-    if _crossing_patches(step):
-        left.append(Left("hole", length, "every patch tried crosses the surface", hole.vertices.astype(np.int32)))
-        return state
-    area, aspect = patch_quality(step.vertices, step.triangles, step.patches)
-    removed.append(Removed("hole", length, len(hole), area, aspect, hole.vertices.astype(np.int32), "flat"))
-    return compose(state, step, tag=len(removed) - 1)
 
 
 def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional[int], fair: bool,

@@ -259,3 +259,30 @@ def test_a_failed_removal_is_reported_not_retried(monkeypatch):
     assert len(failed) == 6 and all(item.loop_length < 6 for item in failed)  # both loops of each small arch
     assert sum(item.loop_length >= 6 for item in result.left) == 2
     assert len(calls) == 6 * 3  # faired, refined, flat once per loop, never again
+
+
+def test_a_hole_whose_patch_would_cross_the_surface_stays_open():
+    from topstoc.core.clean import crossing_patches
+
+    vertices, triangles = cleanup_meshes.perforated_plate(2, 0, side=12, seed=14)
+    holes = edit.boundary_loops(vertices, triangles)
+    small = [i for i, h in enumerate(holes) if len(h) == 4]
+    pierced = holes[small[0]].vertices
+    centre = vertices[pierced].mean(axis=0)
+    # A separate triangle standing through the first hole: any patch of it crosses the triangle.
+    spike = centre + np.array([[-0.3, 0.0, -1.0], [0.3, 0.0, -1.0], [0.0, 0.0, 1.0]])
+    vertices = np.concatenate([vertices, spike])
+    triangles = np.concatenate([triangles, [[len(vertices) - 3, len(vertices) - 2, len(vertices) - 1]]])
+    result = clean(vertices, triangles, max_hole=6.0, max_handle=0)
+    assert result.count("hole") == 1
+    crossing = [item for item in result.left if item.reason == "every patch tried crosses the surface"]
+    assert len(crossing) == 1 and sorted(crossing[0].vertices) == sorted(pierced)
+    assert len(edit.boundary_loops(result.vertices, result.triangles)) == len(holes) - 1 + 1  # + the spike's
+    assert len(self_intersections(result.vertices, result.triangles)) == 0
+    # The local test finds what a whole-mesh test finds.
+    both = edit.fill_holes(vertices, triangles, holes=small)
+    pairs = np.asarray(self_intersections(both.vertices, both.triangles))
+    owner = np.full(both.num_triangles, -1)
+    for patch in both.patches:
+        owner[patch.triangles] = patch.hole
+    assert crossing_patches(both) == set(owner[pairs.reshape(-1)].tolist()) - {-1} == {small[0]}
