@@ -187,6 +187,8 @@ def test_cli_clean(tmp_path):
     assert done.returncode == 0 and "removed 3 handles" in done.stdout and done.stdout.count("  left ") == 2
     cli.assert_one_error_line("clean", cli.run("clean", source, target, "--max-hole", "x"), "max_hole")
     cli.assert_one_error_line("clean", cli.run("clean", source, target, "--keep-largest", "-1"), "--keep-largest")
+    cli.assert_one_error_line("clean", cli.run("clean", source, source), "in.obj")  # never over the input
+    assert source.read_bytes() == before
     every = cli.run_json("clean", source, target, "--keep-largest", "0", "--flat")["clean"]
     assert every["genus_after"] == 0 and every["handles_removed"] == 4
     assert {item["patch"] for item in every["removed"]} == {"flat"}

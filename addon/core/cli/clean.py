@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from . import print_json
 from ..errors import TopStocError
+from ..output_guard import add_overwrite_argument, prepare_output
 
 
 def add_parser(subparsers) -> None:
@@ -29,6 +30,7 @@ def add_parser(subparsers) -> None:
                         help="keep the N largest handles (with no --max-handle, remove all others)")
     parser.add_argument("--flat", action="store_true", help="flat patches with the border's vertices only")
     parser.add_argument("--json", action="store_true", help="print a JSON report")
+    add_overwrite_argument(parser)
     parser.set_defaults(run=run)
 
 
@@ -40,6 +42,7 @@ def run(args) -> int:
 
     if args.keep_largest is not None and args.keep_largest < 0:
         raise TopStocError(f"--keep-largest must be 0 or more, got {args.keep_largest}")
+    prepare_output(args.output, [args.input], overwrite=args.overwrite)
     data = read_mesh(args.input)
     result = clean(data.vertices, data.triangles, max_handle=args.max_handle, max_hole=args.max_hole,
                    keep_largest=args.keep_largest, fair=not args.flat)
