@@ -36,7 +36,8 @@ def _aliases(ring):
 
 @pytest.mark.parametrize("command, extra, names", [("decimate", ("--ratio", 0.5), slice(None)),
                                                    ("fill-holes", (), slice(3, None, 2)),
-                                                   ("remove-handle", ("--index", 0), slice(4, None))])
+                                                   ("remove-handle", ("--index", 0), slice(4, None)),
+                                                   ("clean", (), slice(1, None, 2))])
 def test_output_that_is_the_input_is_refused_under_every_name(ring, command, extra, names):
     before = ring.read_bytes()
     for output in _aliases(ring)[names]:
