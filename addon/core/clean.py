@@ -370,6 +370,8 @@ def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional
     Adds the time spent computing loops to ``seconds["loops"]``."""
     from .loops import handle_tunnel_loops
 
+    if state.num_triangles == 0:
+        return state, 0
     failed = {}  # frozenset of vertex ids (stable: edits only append) -> why the removal failed
     rounds = 0
     while True:
