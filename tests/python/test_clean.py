@@ -288,3 +288,18 @@ def test_a_hole_whose_patch_would_cross_the_surface_stays_open():
     for patch in both.patches:
         owner[patch.triangles] = patch.hole
     assert crossing_patches(both) == set(owner[pairs.reshape(-1)].tolist()) - {-1} == {small[0]}
+
+
+def test_cli_lists_handles_first_and_shortens_long_lists(tmp_path):
+    from topstoc.core.cli.clean import SHOWN
+    from topstoc.core.io import MeshData, write_mesh
+
+    vertices, triangles = cleanup_meshes.perforated_plate(SHOWN + 10, 1, side=40, seed=15)
+    source = tmp_path / "plate.obj"
+    write_mesh(str(source), MeshData(vertices=vertices, triangles=triangles))
+    done = cli.run("clean", source, tmp_path / "out.obj", "--max-hole", "6")
+    assert done.returncode == 0, done.stderr
+    items = [line for line in done.stdout.splitlines() if line.startswith(("  removed ", "  left "))][1:]
+    assert len(items) == SHOWN and items[0].startswith("  left hole")  # the large holes come before the filled
+    # SHOWN + 10 filled, 3 left (the large hole, the plate's edge, the open component): 13 not shown
+    assert done.stdout.splitlines()[-1] == "  ... and 13 more (--json lists every one)"

@@ -11,6 +11,9 @@ from . import print_json
 from ..errors import TopStocError
 from ..output_guard import add_overwrite_argument, prepare_output
 
+#: Lines of removed and left items printed without --json.
+SHOWN = 40
+
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
@@ -62,10 +65,17 @@ def run(args) -> int:
           f"below {result.max_handle:.6g}, genus {result.genus_before} -> {result.genus_after}; "
           f"filled {result.count('hole')} holes below {result.max_hole:.6g}; "
           f"worst patch aspect {result.patch_aspect:.3g}; {result.seconds['total']:.3f} s")
-    for item in result.removed:
-        print(f"  removed {item.kind}: {item.edges} edges, length {item.loop_length:.6g}, "
-              f"patch area {item.patch_area:.6g}, aspect {item.patch_aspect:.3g} ({item.patch})")
-    for item in result.left:
-        size = f" length {item.loop_length:.6g}" if item.loop_length > 0 else ""
-        print(f"  left {item.kind}{size}: {item.reason}")
+    def removed_line(item) -> str:
+        return (f"  removed {item.kind}: {item.edges} edges, length {item.loop_length:.6g}, patch area "
+                f"{item.patch_area:.6g}, aspect {item.patch_aspect:.3g} ({item.patch})")
+
+    # Handles first, then what was left, then the (often many) holes.
+    lines = [removed_line(item) for item in result.removed if item.kind != "hole"]
+    lines += [f"  left {item.kind}{f' length {item.loop_length:.6g}' if item.loop_length > 0 else ''}: "
+              f"{item.reason}" for item in result.left]
+    lines += [removed_line(item) for item in result.removed if item.kind == "hole"]
+    for line in lines[:SHOWN]:
+        print(line)
+    if len(lines) > SHOWN:
+        print(f"  ... and {len(lines) - SHOWN} more (--json lists every one)")
     return 0
