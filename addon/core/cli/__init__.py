@@ -10,6 +10,7 @@ import argparse
 import importlib
 import json
 import sys
+import warnings
 
 from ..errors import one_line
 
@@ -43,9 +44,19 @@ def print_json(data) -> None:
     sys.stdout.write("\n")
 
 
+def show_warnings_as_lines(command: str) -> None:
+    """Warnings (e.g. a MeshFileWarning: what a reader skipped) print as one line each on
+    standard error, named after the command, instead of Python's two-line file:line form."""
+    def show(message, category, filename, lineno, file=None, line=None):
+        text = str(message).splitlines()[0] if str(message) else category.__name__
+        print(f"topstoc {command}: warning: {text}", file=sys.stderr if file is None else file)
+    warnings.showwarning = show
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    show_warnings_as_lines(args.command)
     try:
         return int(args.run(args) or 0)
     except BrokenPipeError:

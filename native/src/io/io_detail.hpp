@@ -122,6 +122,15 @@ inline void add_polygon(MeshFile& mesh, const int32_t* corners, size_t count, co
   }
 }
 
+/// The warning for faces with fewer than three corners, which read as no triangle: the count
+/// and where the first one is (`first`, e.g. "line 12" or "face 3"). Nothing when none.
+inline void warn_skipped_faces(MeshFile& mesh, const std::string& first) {
+  if (mesh.skipped_faces == 0) return;
+  mesh.warnings.push_back("skipped " + std::to_string(mesh.skipped_faces) + " face" +
+                          (mesh.skipped_faces == 1 ? "" : "s") + " with fewer than 3 corners (the first at " +
+                          first + ")");
+}
+
 /// Throws when a triangle refers to a vertex outside [0, n). `what` names the element kind.
 inline void check_triangle_indices(const MeshFile& mesh, const char* what) {
   const int64_t n = mesh.num_vertices();
