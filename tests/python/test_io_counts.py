@@ -178,17 +178,18 @@ def test_ply_with_a_face_count_below_its_faces_is_refused(tmp_path, elephant, en
             re.escape(f"the file goes on after the rows its header declares ({counts}): {rest}"))
 
 
+@pytest.mark.parametrize("form", FORMS)
 @pytest.mark.parametrize("encoding", ENCODINGS)
-def test_ply_with_data_after_its_rows_or_cut_short_is_refused(tmp_path, elephant, encoding):
+def test_ply_with_data_after_its_rows_or_cut_short_is_refused(tmp_path, elephant, encoding, form):
     vertices, triangles = elephant.vertices[:10], np.array([[0, 1, 2], [2, 3, 4]])
     raw = ply_bytes(vertices, triangles, encoding)
     trailing = raw + (b"9 9 9\n" if encoding == "ascii" else b"\x01\x02\x03")
     what = "1 more line of data from line 24" if encoding == "ascii" else f"3 more bytes from byte {len(raw)}"
-    refused(write(tmp_path, "t.ply", trailing),
+    refused(write(tmp_path, "t.ply", trailing, form),
             re.escape("the file goes on after the rows its header declares "
                       f"(line 5: element vertex 10, line 9: element face 2): {what}"))
     cut = raw[:-3] if encoding != "ascii" else raw[:raw.rindex(b"3 2 3 4")]
-    refused(write(tmp_path, "c.ply", cut), r".*element 'face' row 1: the file ends in the middle of the data")
+    refused(write(tmp_path, "c.ply", cut, form), r".*element 'face' row 1: the file ends in the middle of the data")
 
 
 @pytest.mark.parametrize("encoding", ENCODINGS)
