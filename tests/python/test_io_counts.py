@@ -331,8 +331,10 @@ def test_cli_prints_a_skipped_face_warning_as_one_line(tmp_path, elephant):
 
 
 @pytest.mark.parametrize("command, extra", [("topology", []), ("decimate", ["out.stl", "--ratio", "0.5"]),
-                                            ("loops", [])])
+                                            ("loops", []), ("measure", [str(ELEPHANT)]),
+                                            ("fill-holes", ["out.stl"]), ("remove-handle", ["out.stl", "--index", "0"])])
 def test_every_command_refuses_an_empty_file_by_name(tmp_path, command, extra):
     path = write(tmp_path, "empty.stl", b"")
-    done = cli.run(command, path, *[tmp_path / e if e.endswith(".stl") else e for e in extra])
+    done = cli.run(command, path, *[tmp_path / e if e == "out.stl" else e for e in extra])
     cli.assert_one_error_line(command, done, f"{path}: the mesh has no triangles: the file is empty")
+    assert not (tmp_path / "out.stl").exists()
