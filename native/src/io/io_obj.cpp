@@ -137,8 +137,9 @@ MeshFile read_obj(const char* data, size_t size) {
         faces.corner_uv.push_back(int32_t(t));
       }
       const int64_t corners = int64_t(faces.corner_vertex.size()) - first_corner;
-      if (!last.empty() && cut_short(data, size, lines)) check_cut_corner(last, before_last, number);
-      if (corners < 3 && cut_short(data, size, lines))
+      const bool cut = cut_short(data, size, lines);
+      if (cut && !last.empty()) check_cut_corner(last, before_last, number);
+      if (cut && corners < 3)
         fail_at_line(number, "the file ends without a line end in a face of " + std::to_string(corners) +
                                  " corners: it looks cut short");
       if (corners < 3 && first_skipped == 0) first_skipped = number;
