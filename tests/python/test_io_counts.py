@@ -239,6 +239,15 @@ def test_off_cut_short_and_off_as_real_files_write_it(tmp_path, elephant):
     np.testing.assert_array_equal(data.triangles, elephant.triangles)
 
 
+@pytest.mark.parametrize("name, text, message", [
+    ("c.off", "OFF\n+-3 1 0\n", r"line 2: expected the vertex, face and edge counts, got '\+-3'"),
+    ("v.obj", "v +-1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", r"line 1: vertex coordinate '\+-1' is not a number"),
+])
+def test_numbers_take_one_sign(tmp_path, name, text, message):
+    # found by fuzz_read_off: "+-0" read as a count of 0 (the '+' dropped, then "-0" parsed)
+    refused(write(tmp_path, name, text.encode()), message)
+
+
 # --- OBJ: skipped faces warn; a cut last line is refused --------------------------------------------
 
 @pytest.mark.parametrize("form", FORMS)
