@@ -192,6 +192,12 @@ def test_ply_with_data_after_its_rows_or_cut_short_is_refused(tmp_path, elephant
     refused(write(tmp_path, "c.ply", cut, form), r".*element 'face' row 1: the file ends in the middle of the data")
 
 
+def test_ply_data_on_the_end_header_line_is_refused(tmp_path):
+    # found by fuzz_read_ply: bytes after "end_header" on its own line were skipped unread
+    raw = b"ply\nformat binary_big_endian 1.0\nelement vertex 0\nproperty float x\nend_header\x0b\x03\x00\x01"
+    refused(write(tmp_path, "h.ply", raw), r"line 5: unexpected '\\x03\\x00\\x01' after end_header")
+
+
 @pytest.mark.parametrize("encoding", ENCODINGS)
 def test_ply_as_real_files_write_it_still_reads(tmp_path, elephant, encoding):
     """Comments, obj_info, extra vertex properties, an extra element, CRLF, one line end (binary)

@@ -100,7 +100,11 @@ PlyHeader parse_header(const char* data, size_t size) {
     const size_t number = lines.number();
     rest = line;
     if (!next_token(rest, token)) continue;
-    if (token == "end_header") break;
+    if (token == "end_header") {
+      // The body starts after this line's end: bytes on the line itself would be skipped unread.
+      if (next_token(rest, token)) fail_at_line(number, "unexpected " + quote(token) + " after end_header");
+      break;
+    }
     if (token == "comment" || token == "obj_info") continue;
     if (token == "format") {
       std::string_view kind, version;
