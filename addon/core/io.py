@@ -16,9 +16,14 @@ colours and UVs (per vertex, or MeshLab's per-face ``texcoord`` list); OFF posit
 and vertex colours (COFF); STL positions and triangles.
 
 Sloppy files that Blender, MeshLab and assimp read are read too, with a ``MeshFileWarning``
-saying what was skipped: PLY header lines that are no keyword (old Blender wrote "Created by
-Blender3D ..."), names (usemtl, mtllib) that are not UTF-8 (decoded as Latin-1, which never
-fails). Layouts that cannot be read unambiguously are errors (two PLY ``vertex`` elements).
+saying what was skipped: faces with fewer than three corners (points, lines), PLY header lines
+that are no keyword (old Blender wrote "Created by Blender3D ..."), names (usemtl, mtllib) that
+are not UTF-8 (decoded as Latin-1, which never fails). Layouts that cannot be read
+unambiguously are errors (two PLY ``vertex`` elements), and so is data that disagrees with the
+counts the file declares, or a file that does not end where its format says (a binary STL of
+the wrong size, an ascii STL without ``endsolid``, rows past a PLY or OFF header's counts, an
+OBJ whose unterminated last line ends in an incomplete face): docs/robustness.md, "Mesh files".
+A file without triangles is an error too, unless ``allow_empty``.
 
 Compressed files are decompressed in pieces and refused once the output passes
 ``max_decompressed_bytes`` (default ``MAX_DECOMPRESSED_BYTES`` = 2 GiB; ``None`` = no limit):
@@ -211,14 +216,16 @@ def _decode_names(name: str, raw_names) -> List[str]:
     return names
 
 
-def read_mesh(path, max_decompressed_bytes: Optional[int] = MAX_DECOMPRESSED_BYTES) -> MeshData:
+def read_mesh(path, max_decompressed_bytes: Optional[int] = MAX_DECOMPRESSED_BYTES,
+              allow_empty: bool = False) -> MeshData:
     """Reads a mesh file (see the module docs for formats and conventions).
 
     Raises FileNotFoundError / OSError when the file cannot be read, ValueError (naming the
-    file, and the line or element) for an unknown extension, an empty PLY or OFF, unparseable
-    content, indices out of range, or a compressed file expanding past
-    ``max_decompressed_bytes`` (None: no limit). An empty OBJ or STL reads as an empty mesh.
-    What was skipped in a sloppy file is reported as a MeshFileWarning.
+    file, and the line or byte) for an unknown extension, unparseable content, data that does
+    not match the file's counts, a file cut short, indices out of range, a compressed file
+    expanding past ``max_decompressed_bytes`` (None: no limit), or a mesh without triangles
+    (an empty file included) unless ``allow_empty``. What was skipped in a sloppy file (faces
+    with fewer than 3 corners, ...) is reported as a MeshFileWarning, one line each.
     """
     name = os.fspath(path)
     kind, compression = mesh_format(name)
@@ -230,13 +237,20 @@ def read_mesh(path, max_decompressed_bytes: Optional[int] = MAX_DECOMPRESSED_BYT
     with open(name, "rb") as stream:
         raw = stream.read()
     data = _decompress(name, raw, compression, max_decompressed_bytes)
+    if not allow_empty and not data.strip():
+        raise TopStocError(f"{name}: the mesh has no triangles: the file is empty")
     try:
         parsed = engine.read_mesh(data, kind)
     except ValueError as error:
         raise TopStocError(f"{name}: {error}") from None
+    m = len(parsed["triangles"])
+    if m == 0 and not allow_empty:
+        n, skipped = len(parsed["vertices"]), int(parsed["skipped_faces"])
+        held = f"{n} vertices" if n != 1 else "1 vertex"
+        held += f", {skipped} faces with fewer than 3 corners" if skipped else ", no faces"
+        raise TopStocError(f"{name}: the mesh has no triangles (the file holds {held})")
     for message in parsed["warnings"]:
         warnings.warn(f"{name}: {message}", MeshFileWarning, stacklevel=2)
-    m = len(parsed["triangles"])
     uvs = parsed["corner_uvs"]
     return MeshData(vertices=parsed["vertices"], triangles=parsed["triangles"],
                     triangle_polygon=parsed["triangle_polygon"],

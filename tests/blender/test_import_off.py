@@ -43,3 +43,23 @@ def test_a_broken_file_is_reported(ts, scene, tmp_path):
     with pytest.raises(RuntimeError, match="broken.off"):
         bpy.ops.topstoc.import_off(filepath=str(path))
     assert len(bpy.data.objects) == 0
+
+
+def test_skipped_faces_are_reported_as_a_warning(ts, scene, tmp_path, capfd):
+    # A 2-corner face reads as no polygon; the reader's MeshFileWarning reaches the operator's report.
+    path = tmp_path / "lines.off"
+    path.write_text("OFF\n4 3 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n2 2 3\n3 0 2 3\n")
+    capfd.readouterr()
+    assert bpy.ops.topstoc.import_off(filepath=str(path)) == {"FINISHED"}
+    mesh = bpy.context.active_object.data
+    assert [tuple(p.vertices) for p in mesh.polygons] == [(0, 1, 2), (0, 2, 3)]
+    out, err = capfd.readouterr()
+    assert "lines.off: skipped 1 face with fewer than 3 corners (the first at line 8)" in out + err
+
+
+def test_an_empty_file_is_refused_by_name(ts, scene, tmp_path):
+    path = tmp_path / "empty.off"
+    path.write_text("OFF\n0 0 0\n")
+    with pytest.raises(RuntimeError, match="empty.off: the mesh has no triangles"):
+        bpy.ops.topstoc.import_off(filepath=str(path))
+    assert len(bpy.data.objects) == 0

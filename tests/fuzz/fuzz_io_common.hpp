@@ -14,6 +14,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "topstoc/io/io.hpp"
@@ -173,8 +174,10 @@ inline void check_written_as(const MeshFile& first, MeshFormat target) {
 
 inline void check_round_trip(const MeshFile& first, MeshFormat format) { check_written_as(first, format); }
 
-// The whole check for one input: read, and if that succeeds, check and round-trip.
-inline int run(const uint8_t* data, size_t size, MeshFormat format) {
+// The whole check for one input: read, and if that succeeds, check and round-trip. `counts`
+// (fuzz_counts.hpp) checks that what was read is what the bytes declare.
+inline int run(const uint8_t* data, size_t size, MeshFormat format,
+               void (*counts)(std::string_view, const MeshFile&) = nullptr) {
   MeshFile mesh;
   try {
     mesh = read_mesh_file(reinterpret_cast<const char*>(data), size, format);
@@ -182,6 +185,7 @@ inline int run(const uint8_t* data, size_t size, MeshFormat format) {
     return 0;  // refused with a message: fine
   }
   check_consistent(mesh);
+  if (counts) counts(std::string_view(reinterpret_cast<const char*>(data), size), mesh);
   check_round_trip(mesh, format);
   return 0;
 }

@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "meshes.hpp"
@@ -86,4 +88,32 @@ TEST_CASE("OBJ round trip keeps material names per triangle") {
   const MeshFile back = round_trip(f, MeshFormat::Obj);
   CHECK(back.material_names == f.material_names);
   CHECK(back.triangle_material == f.triangle_material);
+}
+
+TEST_CASE("a written file read with a byte or line more, or cut short, is refused (issue 37)") {
+  const MeshFile f = sample_file(true);
+  const auto refused = [](const std::string& bytes, MeshFormat format) {
+    try {
+      read_mesh_file(bytes.data(), bytes.size(), format);
+    } catch (const std::invalid_argument&) {
+      return true;
+    }
+    return false;
+  };
+  for (MeshFormat format : {MeshFormat::Ply, MeshFormat::Off, MeshFormat::Stl}) {
+    const std::string bytes = write_mesh_file(f, format);
+    CHECK_FALSE(refused(bytes, format));
+    CHECK(refused(bytes + (format == MeshFormat::Off ? "3 0 1 2\n" : "x"), format));
+    CHECK(refused(bytes.substr(0, bytes.size() - (format == MeshFormat::Off ? 8 : 1)), format));
+  }
+  // Binary PLY: one line end after the body is what some tools write, and still reads.
+  const std::string ply = write_mesh_file(f, MeshFormat::Ply);
+  CHECK_FALSE(refused(ply + "\n", MeshFormat::Ply));
+  CHECK_FALSE(refused(ply + "\r\n", MeshFormat::Ply));
+  CHECK(refused(ply + "\n\n", MeshFormat::Ply));
+  // OBJ has no counts: an unterminated last face line that is incomplete was cut.
+  const std::string obj = write_mesh_file(f, MeshFormat::Obj);
+  const std::string cut = obj.substr(0, obj.rfind(' '));  // the last face without its last corner
+  CHECK(refused(cut, MeshFormat::Obj));
+  CHECK_FALSE(refused(obj.substr(0, obj.size() - 1), MeshFormat::Obj));  // whole, no final line end
 }

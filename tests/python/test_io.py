@@ -7,6 +7,7 @@ import gzip
 import pathlib
 import re
 import struct
+import warnings
 
 import numpy as np
 import pytest
@@ -203,7 +204,7 @@ def licence_figures():
 @pytest.mark.parametrize("path", [p for p in MESH_FILES if p.name not in UNREADABLE],
                          ids=lambda p: p.name)
 def test_reads_like_the_reference(path):
-    data = read_mesh(path)
+    data = read_mesh(path, allow_empty=True)
     ref = reference(path)
     assert data.vertices.dtype == np.float64 and data.triangles.dtype == np.int32
     assert data.vertices.shape == ref["vertices"].shape
@@ -223,7 +224,7 @@ def test_statistics_match_licences_table():
     figures = licence_figures()
     assert len(figures) >= 20
     for relative, (welded_vertices, triangles) in figures.items():
-        data = read_mesh(DATA / relative)
+        data = read_mesh(DATA / relative, allow_empty=True)
         assert data.num_triangles == triangles, relative
         # The table counts the vertices that faces use, position-welded where meshstat could
         # weld without changing the topology, else as indexed.
@@ -260,8 +261,10 @@ def test_duck_and_spider_uvs_and_materials():
 
 
 @pytest.mark.parametrize("name", ["openscad_empty.stl"])
-def test_empty_stl_is_an_empty_mesh(name):
-    data = read_mesh(DATA / "nonmanifold_degenerate" / name)
+def test_empty_stl_is_an_error_unless_allowed(name):
+    with pytest.raises(ValueError, match=f"{name}: the mesh has no triangles: the file is empty"):
+        read_mesh(DATA / "nonmanifold_degenerate" / name)
+    data = read_mesh(DATA / "nonmanifold_degenerate" / name, allow_empty=True)
     assert data.vertices.shape == (0, 3) and data.triangles.shape == (0, 3)
 
 
@@ -445,7 +448,11 @@ usemtl first
 f 2 3 4 1
 """
     (tmp_path / "s.obj").write_text(text)
-    data = read_mesh(tmp_path / "s.obj")
+    line = text.splitlines().index("f 1 2") + 1
+    with pytest.warns(io.MeshFileWarning) as caught:
+        data = read_mesh(tmp_path / "s.obj")
+    assert [str(w.message) for w in caught] == [
+        f"{tmp_path / 's.obj'}: skipped 1 face with fewer than 3 corners (the first at line {line})"]
     np.testing.assert_array_equal(data.triangles, [[0, 1, 2], [0, 2, 3], [1, 2, 3], [1, 3, 0]])
     np.testing.assert_array_equal(data.triangle_polygon, [0, 1, 3, 3])  # the 2-corner face is index 2
     assert data.skipped_faces == 1
@@ -500,16 +507,29 @@ def test_unknown_extension(tmp_path):
         write_mesh(tmp_path / "mesh.fbx", attributed_mesh())
 
 
-@pytest.mark.parametrize("name", ["empty.ply", "empty.off"])
-def test_empty_ply_and_off_are_errors(tmp_path, name):
-    (tmp_path / name).write_bytes(b"")
-    with pytest.raises(ValueError, match=f"{name}: the file is empty"):
+@pytest.mark.parametrize("name", ["empty.ply", "empty.off", "empty.obj", "empty.stl", "empty.obj.gz"])
+@pytest.mark.parametrize("content", [b"", b"\n \r\n"])
+def test_empty_files_are_errors_in_every_format(tmp_path, name, content):
+    (tmp_path / name).write_bytes(gzip.compress(content) if name.endswith(".gz") else content)
+    with pytest.raises(ValueError, match=re.escape(name) + ": the mesh has no triangles: the file is empty"):
         read_mesh(tmp_path / name)
 
 
-def test_empty_obj_is_an_empty_mesh(tmp_path):
-    (tmp_path / "empty.obj").write_bytes(b"")
-    assert read_mesh(tmp_path / "empty.obj").num_vertices == 0
+@pytest.mark.parametrize("name, content, held", [
+    ("v.obj", "v 0 0 0\nv 1 0 0\n", "2 vertices, no faces"),
+    ("l.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n", "2 vertices, 1 faces with fewer than 3 corners"),
+    ("v.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+              "end_header\n0 0 0\n", "1 vertex, no faces"),
+    ("v.off", "OFF\n1 0 0\n0 0 0\n", "1 vertex, no faces"),
+    ("s.stl", "solid s\nendsolid s\n", "0 vertices, no faces"),
+])
+def test_files_without_triangles_are_errors_unless_allowed(tmp_path, name, content, held):
+    (tmp_path / name).write_text(content)
+    with pytest.raises(ValueError, match=re.escape(f"{name}: the mesh has no triangles (the file holds {held})")):
+        read_mesh(tmp_path / name)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # l.obj's skipped line
+        assert read_mesh(tmp_path / name, allow_empty=True).num_triangles == 0
 
 
 def test_unparseable_stl_names_file_and_line():
@@ -546,7 +566,7 @@ XYZ_HEADER = ("ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nprope
     ("m.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n", r"line 2: unknown PLY format"),
     ("n.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n",
      r"line 4: unknown property type 'float128'"),
-    ("o.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n", r"the file ends inside a facet"),
+    ("o.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n", r"line 4: the file ends inside a facet"),
     ("p.stl", "not an stl", r"not an STL file"),
 ])
 def test_bad_content_names_file_and_problem(tmp_path, name, content, message):
@@ -559,11 +579,12 @@ def test_truncated_binary_files(tmp_path):
     ply = _ply_bytes("little", [("float", "x"), ("float", "y"), ("float", "z")], [(0, 0, 0)] * 3,
                      "uchar", "int", [[0, 1, 2]] * 4)
     (tmp_path / "t.ply").write_bytes(ply[:-6])
-    with pytest.raises(ValueError, match=r"t\.ply: element 'face' row 3: the file ends in the middle of the data"):
+    with pytest.raises(ValueError, match=r"t\.ply: byte 249, element 'face' row 3: the file ends in the middle of the data"):
         read_mesh(tmp_path / "t.ply")
     stl = b"binary".ljust(80) + struct.pack("<I", 10) + b"\0" * 50 * 9
     (tmp_path / "t.stl").write_bytes(stl)
-    with pytest.raises(ValueError, match=r"t\.stl: binary STL header announces 10 triangles"):
+    with pytest.raises(ValueError, match=r"t\.stl: binary STL: the header says 10 triangles \(byte 80\), but the file "
+                                         r"ends at byte 534, inside triangle 9 \(50 bytes missing\)"):
         read_mesh(tmp_path / "t.stl")
 
 

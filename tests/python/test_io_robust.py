@@ -126,7 +126,7 @@ def test_obj_writer_refuses_library_names_that_would_not_read_back(tmp_path, nam
 
 
 def test_reproducer_with_trailing_backslash_is_refused_not_corrupted(tmp_path):
-    data = read_mesh(REGRESSIONS / "obj_roundtrip_min.obj")
+    data = read_mesh(REGRESSIONS / "obj_roundtrip_min.obj", allow_empty=True)
     assert data.material_libraries == ["\\"]
     with pytest.raises(ValueError, match="ends with a backslash"):
         write_mesh(tmp_path / "copy.obj", data)
@@ -344,7 +344,7 @@ def test_round_trip_fuzz_inputs_cross_formats(tmp_path):
             if kind in ("obj", "ply") and data.corner_uvs is not None and not np.isnan(data.corner_uvs).all():
                 np.testing.assert_array_equal(back.corner_uvs, data.corner_uvs, err_msg=f"{path} -> {kind}")
             checked += 1
-    assert checked >= 30
+    assert checked >= 29  # crash-1b6e44df has 60 bytes after its rows: refused since issue 37
 
 
 # --- compressed input ---------------------------------------------------------------------------

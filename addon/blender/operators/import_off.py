@@ -4,13 +4,14 @@ add-on's own reader (topstoc.core.io), which also takes .off.gz and per-vertex c
 from __future__ import annotations
 
 import os
+import warnings
 
 import bpy
 import numpy as np
 from bpy.props import CollectionProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 
-from ...core.io import read_mesh
+from ...core.io import MeshFileWarning, read_mesh
 from .. import mesh_io
 
 
@@ -28,8 +29,21 @@ def polygon_corners(triangles: np.ndarray, triangle_polygon: np.ndarray):
     return corners.astype(np.int32), totals.astype(np.int32)
 
 
-def mesh_from_file(path: str, name: str) -> bpy.types.Mesh:
-    data = read_mesh(path)
+def read_with_warnings(path: str):
+    """(MeshData, what the reader skipped: MeshFileWarning messages), for the operator's report."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", MeshFileWarning)
+        data = read_mesh(path)
+    for w in caught:
+        if not issubclass(w.category, MeshFileWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return data, [str(w.message) for w in caught if issubclass(w.category, MeshFileWarning)]
+
+
+def mesh_from_file(path: str, name: str, notes: list) -> bpy.types.Mesh:
+    """A Blender mesh of the file's polygons; the reader's warnings are appended to notes."""
+    data, messages = read_with_warnings(path)
+    notes.extend(m.replace(path, os.path.basename(path), 1) for m in messages)
     corners, totals = polygon_corners(data.triangles, data.triangle_polygon)
     mesh = bpy.data.meshes.new(name)
     mesh.vertices.add(data.num_vertices)
@@ -62,17 +76,19 @@ class TOPSTOC_OT_import_off(bpy.types.Operator, ImportHelper):
 
     def execute(self, context):
         paths = [os.path.join(self.directory, f.name) for f in self.files if f.name] or [self.filepath]
-        objects = []
+        objects, notes = [], []
         for path in paths:
             name = os.path.basename(path).split(".")[0] or "OFF"
             try:
-                mesh = mesh_from_file(path, name)
+                mesh = mesh_from_file(path, name, notes)
             except (OSError, ValueError) as error:
                 self.report({"ERROR"}, f"{os.path.basename(path)}: {error}")
                 continue
             obj = bpy.data.objects.new(name, mesh)
             context.collection.objects.link(obj)
             objects.append(obj)
+        for note in notes:  # what the reader skipped, e.g. faces with fewer than 3 corners
+            self.report({"WARNING"}, note)
         if not objects:
             return {"CANCELLED"}
         for obj in context.selected_objects:

@@ -63,15 +63,20 @@ inline bool next_token(std::string_view& text, std::string_view& token) {
   return true;
 }
 
+/// Drops one leading '+' of a number, unless a sign follows it ("+-1" is no number).
+inline void skip_plus(std::string_view& token) {
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+') token.remove_prefix(1);
+}
+
 /// Parses a whole token as a number (a leading '+' is allowed); false if anything is left over.
 inline bool parse_double(std::string_view token, double& out) {
-  if (!token.empty() && token[0] == '+') token.remove_prefix(1);
+  skip_plus(token);
   const auto result = std::from_chars(token.data(), token.data() + token.size(), out);
   return result.ec == std::errc() && result.ptr == token.data() + token.size() && !token.empty();
 }
 
 inline bool parse_int(std::string_view token, int64_t& out) {
-  if (!token.empty() && token[0] == '+') token.remove_prefix(1);
+  skip_plus(token);
   const auto result = std::from_chars(token.data(), token.data() + token.size(), out);
   return result.ec == std::errc() && result.ptr == token.data() + token.size() && !token.empty();
 }
@@ -120,6 +125,15 @@ inline void add_polygon(MeshFile& mesh, const int32_t* corners, size_t count, co
     }
     if (with_material) mesh.triangle_material.push_back(material);
   }
+}
+
+/// The warning for faces with fewer than three corners, which read as no triangle: the count
+/// and where the first one is (`first`, e.g. "line 12" or "face 3"). Nothing when none.
+inline void warn_skipped_faces(MeshFile& mesh, const std::string& first) {
+  if (mesh.skipped_faces == 0) return;
+  mesh.warnings.push_back("skipped " + std::to_string(mesh.skipped_faces) + " face" +
+                          (mesh.skipped_faces == 1 ? "" : "s") + " with fewer than 3 corners (the first at " +
+                          first + ")");
 }
 
 /// Throws when a triangle refers to a vertex outside [0, n). `what` names the element kind.

@@ -1,6 +1,7 @@
 // Wavefront OBJ: v (with optional r g b [a]), vt, f (any polygon, v, v/vt, v//vn, v/vt/vn,
 // negative = relative indices), usemtl, mtllib. Other statements (vn, g, o, s, l, p, ...) are
 // skipped. Materials are named by usemtl in order of first use; the .mtl file is not read.
+#include <algorithm>
 #include <string>
 #include <unordered_map>
 
@@ -38,6 +39,21 @@ struct ObjFaces {
   size_t max_vertex_line = 0, max_uv_line = 0;
 };
 
+// OBJ has no counts, so a file cut short is found only on its last line, and only when that line
+// has no line end (a cut at a line end leaves a complete-looking file): true for that line.
+bool cut_short(const char* data, size_t size, const TextLines& lines) {
+  return data[size - 1] != '\n' && lines.rest() == data + size;
+}
+
+// A corner of a face on a cut line: a trailing '/' ("12/", "12/3/") or fewer '/'-separated
+// parts than the corner before it ("1/1/1 2/2/2 3/3") says the corner was cut.
+void check_cut_corner(std::string_view corner, std::string_view previous, size_t line) {
+  const auto parts = [](std::string_view c) { return std::count(c.begin(), c.end(), '/'); };
+  if (corner.back() == '/' || (!previous.empty() && parts(corner) < parts(previous)))
+    fail_at_line(line, "the file ends without a line end in the face corner " + quote(corner) +
+                           ": it looks cut short");
+}
+
 }  // namespace
 
 MeshFile read_obj(const char* data, size_t size) {
@@ -49,6 +65,7 @@ MeshFile read_obj(const char* data, size_t size) {
   std::unordered_map<std::string, int32_t> material_ids;
   int32_t material = -1;
   bool any_material = false;
+  size_t first_skipped = 0;  // line of the first face with fewer than 3 corners
 
   TextLines lines(data, data + size);
   std::string_view line;
@@ -99,7 +116,11 @@ MeshFile read_obj(const char* data, size_t size) {
       if (count < 1) fail_at_line(number, "vt needs at least one coordinate");
       uv_table.insert(uv_table.end(), uv, uv + 2);
     } else if (keyword == "f" || keyword == "fo") {
+      const int64_t first_corner = int64_t(faces.corner_vertex.size());
+      std::string_view last, before_last;  // corners, for the cut-short check
       while (next_token(rest, token)) {
+        before_last = last;
+        last = token;
         const size_t slash = token.find('/');
         const int64_t v = resolve(token.substr(0, slash), mesh.num_vertices(), number, "vertex");
         if (v > faces.max_vertex) faces.max_vertex = v, faces.max_vertex_line = number;
@@ -115,6 +136,13 @@ MeshFile read_obj(const char* data, size_t size) {
         faces.corner_vertex.push_back(int32_t(v));
         faces.corner_uv.push_back(int32_t(t));
       }
+      const int64_t corners = int64_t(faces.corner_vertex.size()) - first_corner;
+      const bool cut = cut_short(data, size, lines);
+      if (cut && !last.empty()) check_cut_corner(last, before_last, number);
+      if (cut && corners < 3)
+        fail_at_line(number, "the file ends without a line end in a face of " + std::to_string(corners) +
+                                 " corners: it looks cut short");
+      if (corners < 3 && first_skipped == 0) first_skipped = number;
       faces.offsets.push_back(int64_t(faces.corner_vertex.size()));
       faces.material.push_back(material);
     } else if (keyword == "usemtl") {
@@ -163,6 +191,7 @@ MeshFile read_obj(const char* data, size_t size) {
     add_polygon(mesh, faces.corner_vertex.data() + begin, size_t(end - begin), with_uvs ? uvs.data() : nullptr,
                 faces.material[f], with_uvs, any_material);
   }
+  warn_skipped_faces(mesh, "line " + std::to_string(first_skipped));
   return mesh;
 }
 

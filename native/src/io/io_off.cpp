@@ -41,6 +41,18 @@ bool next_content(TextLines& lines, std::string_view& line) {
   return false;
 }
 
+// The counts must cover the whole file: more data after the faces means the header undercounts.
+void check_nothing_follows(TextLines& lines, size_t counts_line, int64_t n, int64_t faces) {
+  std::string_view line;
+  if (!next_content(lines, line)) return;
+  const size_t first_extra = lines.number();
+  size_t extra = 1;
+  while (next_content(lines, line)) ++extra;
+  fail_at_line(first_extra, "the header (line " + std::to_string(counts_line) + ") says " + std::to_string(n) +
+                                " vertices and " + std::to_string(faces) + " faces, but " + std::to_string(extra) +
+                                " more line" + (extra == 1 ? "" : "s") + " of data follow them");
+}
+
 }  // namespace
 
 MeshFile read_off(const char* data, size_t size) {
@@ -67,6 +79,7 @@ MeshFile read_off(const char* data, size_t size) {
     if (!next_content(lines, line)) throw std::invalid_argument("the file ends before the vertex and face counts");
     rest = line;
   }
+  const size_t counts_line = lines.number();
   const int64_t n = counts[0], faces = counts[1];
   if (n > INT32_MAX || faces > INT32_MAX) fail_at_line(lines.number(), "too many vertices or faces");
 
@@ -115,6 +128,7 @@ MeshFile read_off(const char* data, size_t size) {
   }
 
   std::vector<int32_t> corners;
+  size_t first_skipped = 0;
   mesh.triangles.reserve(std::min(3 * size_t(faces), size));
   for (int64_t f = 0; f < faces; ++f) {
     if (!next_content(lines, line))
@@ -136,7 +150,10 @@ MeshFile read_off(const char* data, size_t size) {
       corners.push_back(int32_t(index));
     }
     add_polygon(mesh, corners.data(), corners.size(), nullptr, -1, false, false);
+    if (count < 3 && mesh.skipped_faces == 1) first_skipped = number;
   }
+  check_nothing_follows(lines, counts_line, n, faces);
+  warn_skipped_faces(mesh, "line " + std::to_string(first_skipped));
   return mesh;
 }
 

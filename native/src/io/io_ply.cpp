@@ -27,6 +27,7 @@ struct PlyProperty {
 struct PlyElement {
   std::string name;
   int64_t count = 0;
+  size_t line = 0;  // of the header, for messages
   std::vector<PlyProperty> properties;
 };
 
@@ -99,7 +100,11 @@ PlyHeader parse_header(const char* data, size_t size) {
     const size_t number = lines.number();
     rest = line;
     if (!next_token(rest, token)) continue;
-    if (token == "end_header") break;
+    if (token == "end_header") {
+      // The body starts after this line's end: bytes on the line itself would be skipped unread.
+      if (next_token(rest, token)) fail_at_line(number, "unexpected " + quote(token) + " after end_header");
+      break;
+    }
     if (token == "comment" || token == "obj_info") continue;
     if (token == "format") {
       std::string_view kind, version;
@@ -116,6 +121,7 @@ PlyHeader parse_header(const char* data, size_t size) {
       if (!next_token(rest, name) || !next_token(rest, count) || !parse_int(count, element.count) || element.count < 0)
         fail_at_line(number, "element needs a name and a count");
       element.name = std::string(name);
+      element.line = number;
       // The body reader keeps one array per vertex property and one face list: a second block
       // would be read into arrays sized for the first.
       if (element.name == "vertex" || element.name == "face")
@@ -173,7 +179,8 @@ PlyHeader parse_header(const char* data, size_t size) {
 // Values of a binary body; throws on truncation.
 class BinarySource {
  public:
-  BinarySource(const char* begin, const char* end, bool swap) : cursor_(begin), end_(end), swap_(swap) {}
+  BinarySource(const char* file, const char* begin, const char* end, bool swap)
+      : file_(file), cursor_(begin), end_(end), swap_(swap) {}
 
   double number(PlyType type) {
     switch (type) {
@@ -197,8 +204,16 @@ class BinarySource {
     return static_cast<int64_t>(number(type));
   }
 
-  std::string where() const { return ""; }
+  std::string where() const { return "byte " + std::to_string(cursor_ - file_) + ", "; }
   size_t remaining() const { return size_t(end_ - cursor_); }
+  /// What follows the last row ("" when nothing does). One line end is tolerated: some tools
+  /// end every file with one.
+  std::string rest() const {
+    const size_t left = remaining();
+    if (left == 0 || (left == 1 && cursor_[0] == '\n') || (left == 2 && cursor_[0] == '\r' && cursor_[1] == '\n'))
+      return "";
+    return std::to_string(left) + " more bytes from byte " + std::to_string(cursor_ - file_);
+  }
   /// Fewest bytes a value of this property takes (an empty list: just its count).
   static size_t min_bytes(const PlyProperty& p) {
     return type_size(p.count_type != PlyType::None ? p.count_type : p.type);
@@ -230,6 +245,7 @@ class BinarySource {
     return value;
   }
 
+  const char* file_;
   const char* cursor_;
   const char* end_;
   bool swap_;
@@ -261,15 +277,32 @@ class AsciiSource {
 
   std::string where() const { return "line " + std::to_string(line_) + ", "; }
   size_t remaining() const { return size_t(end_ - cursor_); }
+  /// What follows the last row ("" when only white space does).
+  std::string rest() {
+    skip_space();
+    if (cursor_ == end_) return "";
+    const size_t first = line_;
+    size_t lines = 0;
+    for (; cursor_ < end_; ++lines) {
+      const char* stop = static_cast<const char*>(std::memchr(cursor_, '\n', size_t(end_ - cursor_)));
+      cursor_ = stop ? stop + 1 : end_;
+      skip_space();
+    }
+    return std::to_string(lines) + " more line" + (lines == 1 ? "" : "s") + " of data from line " + std::to_string(first);
+  }
   /// Fewest bytes a value takes: one character and a separator.
   static size_t min_bytes(const PlyProperty&) { return 2; }
 
  private:
-  std::string_view next() {
+  void skip_space() {
     while (cursor_ < end_ && (is_space(*cursor_) || *cursor_ == '\n')) {
       if (*cursor_ == '\n') ++line_;
       ++cursor_;
     }
+  }
+
+  std::string_view next() {
+    skip_space();
     if (cursor_ == end_) throw std::invalid_argument("the file ends in the middle of the data");
     const char* start = cursor_;
     while (cursor_ < end_ && !is_space(*cursor_) && *cursor_ != '\n') ++cursor_;
@@ -280,6 +313,18 @@ class AsciiSource {
   const char* end_;
   size_t line_;
 };
+
+// The file must end with the last row the header declares: more data means a count too small.
+template <class Source>
+void check_ends_after_rows(const PlyHeader& header, Source& source) {
+  const std::string rest = source.rest();
+  if (rest.empty()) return;
+  std::string counts;
+  for (const auto& element : header.elements)
+    counts += (counts.empty() ? "line " : ", line ") + std::to_string(element.line) + ": element " + element.name +
+              " " + std::to_string(element.count);
+  throw std::invalid_argument("the file goes on after the rows its header declares (" + counts + "): " + rest);
+}
 
 template <class Source>
 MeshFile read_body(const PlyHeader& header, Source& source) {
@@ -293,6 +338,7 @@ MeshFile read_body(const PlyHeader& header, Source& source) {
   }
   std::vector<int32_t> corners;
   std::vector<double> uvs;
+  int64_t first_skipped = 0;
   for (const auto& element : header.elements) {
     if (element.name == "tristrips" && element.count > 0)
       throw std::invalid_argument("triangle strips (element tristrips) are not supported");
@@ -372,6 +418,7 @@ MeshFile read_body(const PlyHeader& header, Source& source) {
                                         std::to_string(corners.size()) + " corners");
           add_polygon(mesh, corners.data(), corners.size(), face_texcoords ? uvs.data() : nullptr, -1, face_texcoords,
                       false);
+          if (corners.size() < 3 && mesh.skipped_faces == 1) first_skipped = row;
         }
       }
     } catch (const std::invalid_argument& error) {
@@ -379,7 +426,9 @@ MeshFile read_body(const PlyHeader& header, Source& source) {
                                   ": " + error.what());
     }
   }
+  check_ends_after_rows(header, source);
   check_triangle_indices(mesh, "face");
+  warn_skipped_faces(mesh, "face " + std::to_string(first_skipped));
   if (!face_texcoords && !vertex_uvs.empty()) {
     mesh.corner_uvs.resize(2 * mesh.triangles.size());
     for (size_t c = 0; c < mesh.triangles.size(); ++c) {
@@ -451,7 +500,7 @@ MeshFile read_ply(const char* data, size_t size) {
     return read_body(header, source);
   }
   const bool little = header.encoding == Encoding::BinaryLittle;
-  BinarySource source(header.body, end, little != host_is_little_endian());
+  BinarySource source(data, header.body, end, little != host_is_little_endian());
   return read_body(header, source);
 }
 

@@ -101,13 +101,18 @@ MeshFile read_binary(const char* data, uint32_t count) {
   return mesh;
 }
 
+// ascii STL: "solid [name]", facets of exactly three vertices ("facet normal ..", "outer loop",
+// 3 x "vertex x y z", "endloop", "endfacet"), "endsolid [name]"; several solids may follow each
+// other. The file must end after an endsolid: a file cut between two facets would otherwise
+// read as a smaller mesh.
 MeshFile read_ascii(const char* data, size_t size) {
   MeshFile mesh;
   Welder welder(mesh, size / 500);  // about 250 bytes of text per facet
   TextLines lines(data, data + size);
   std::string_view line, rest, token;
   std::vector<int32_t> corners;
-  bool in_facet = false;
+  bool in_solid = false, in_facet = false;
+  size_t solid_line = 0;
   while (lines.next(line)) {
     const size_t number = lines.number();
     rest = line;
@@ -120,24 +125,39 @@ MeshFile read_ascii(const char* data, size_t size) {
         if (!parse_double(token, x)) fail_at_line(number, "vertex coordinate " + quote(token) + " is not a number");
       }
       if (next_token(rest, token)) fail_at_line(number, "unexpected " + quote(token) + " after the vertex coordinates");
+      if (corners.size() == 3) fail_at_line(number, "a facet with more than 3 vertices");
       corners.push_back(welder.id(p[0], p[1], p[2]));
     } else if (token == "facet") {
+      if (!in_solid) fail_at_line(number, "facet outside a solid (after endsolid, or before solid)");
       if (in_facet) fail_at_line(number, "facet inside a facet (missing endfacet)");
       in_facet = true;
       corners.clear();
     } else if (token == "endfacet") {
       if (!in_facet) fail_at_line(number, "endfacet without facet");
+      if (corners.size() != 3)
+        fail_at_line(number, "a facet with " + std::to_string(corners.size()) + " vertices (STL facets have 3)");
       in_facet = false;
       add_polygon(mesh, corners.data(), corners.size(), nullptr, -1, false, false);
     } else if (token == "outer" || token == "endloop") {
       if (!in_facet) fail_at_line(number, quote(token) + " outside a facet");
-    } else if (token == "solid" || token == "endsolid") {
-      if (in_facet) fail_at_line(number, quote(token) + " inside a facet");
+    } else if (token == "solid") {
+      if (in_solid) fail_at_line(number, "solid inside a solid (missing endsolid)");
+      in_solid = true;
+      solid_line = number;
+    } else if (token == "endsolid") {
+      if (in_facet) fail_at_line(number, "'endsolid' inside a facet");
+      if (!in_solid) fail_at_line(number, "endsolid without solid");
+      in_solid = false;
     } else {
       fail_at_line(number, "unexpected " + quote(token));
     }
   }
-  if (in_facet) throw std::invalid_argument("the file ends inside a facet");
+  if (in_facet)
+    throw std::invalid_argument("line " + std::to_string(lines.number()) + ": the file ends inside a facet");
+  if (in_solid)
+    throw std::invalid_argument("line " + std::to_string(lines.number()) + ": the file ends without the 'endsolid' of "
+                                "the solid at line " + std::to_string(solid_line) + " (cut after facet " +
+                                std::to_string(mesh.polygons) + "?)");
   return mesh;
 }
 
@@ -147,22 +167,35 @@ bool starts_with_solid(const char* data, size_t size) {
   return size - i >= 5 && std::memcmp(data + i, "solid", 5) == 0;
 }
 
+// Text holds no NUL byte; a binary STL's facets almost always do (attribute bytes, zeros).
+bool looks_binary(const char* data, size_t size) { return std::memchr(data, '\0', size) != nullptr; }
+
+// A binary STL whose size disagrees with its triangle count (the uint32 at byte 80).
+[[noreturn]] void fail_binary_size(uint32_t count, size_t size) {
+  const size_t expected = 84 + 50 * size_t(count);
+  std::string message = "binary STL: the header says " + std::to_string(count) + " triangles (byte 80), ";
+  if (size > expected && (size - 84) % 50 == 0)
+    message += "the file holds " + std::to_string((size - 84) / 50) + " (" + std::to_string(size - expected) +
+               " more bytes from byte " + std::to_string(expected) + ")";
+  else if (size > expected)
+    message += "but the file goes on for " + std::to_string(size - expected) + " bytes after them (byte " +
+               std::to_string(expected) + ")";
+  else
+    message += "but the file ends at byte " + std::to_string(size) + ", inside triangle " +
+               std::to_string((size - 84) / 50) + " (" + std::to_string(expected - size) + " bytes missing)";
+  throw std::invalid_argument(message);
+}
+
 }  // namespace
 
+// Binary or ascii: a binary file may start with "solid" too, so the exact size decides first;
+// a file that starts with "solid" and holds a NUL byte is binary with a wrong count.
 MeshFile read_stl(const char* data, size_t size) {
   if (size == 0) return MeshFile();  // what some tools write for an empty model
   if (size >= 84) {
     const uint32_t count = load_u32_le(data + 80);
-    const size_t expected = 84 + 50 * size_t(count);
-    // Binary files may start with "solid" too: the exact size decides first.
-    if (size == expected) return read_binary(data, count);
-    if (!starts_with_solid(data, size)) {
-      if (size < expected)
-        throw std::invalid_argument("binary STL header announces " + std::to_string(count) + " triangles (" +
-                                    std::to_string(expected) + " bytes) but the file has " + std::to_string(size) +
-                                    " bytes");
-      return read_binary(data, count);  // trailing bytes after the facets are ignored
-    }
+    if (size == 84 + 50 * size_t(count)) return read_binary(data, count);
+    if (!starts_with_solid(data, size) || looks_binary(data, size)) fail_binary_size(count, size);
   }
   if (!starts_with_solid(data, size))
     throw std::invalid_argument("not an STL file: too short for binary and not starting with 'solid'");

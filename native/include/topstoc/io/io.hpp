@@ -47,13 +47,18 @@ struct MeshFile {
 };
 
 /// Parses `size` bytes of a file in `format`. Throws std::invalid_argument naming the line
-/// (text) or element row (binary) and the problem: unparseable content, truncated data,
+/// (text) or byte / element row (binary) and the problem: unparseable content, truncated data,
 /// indices out of range, element layouts it cannot read unambiguously (a PLY with two
-/// `vertex` or `face` elements, a property declared twice). Counts are checked against the
-/// bytes left before anything is allocated for them. An empty OBJ or STL is an empty mesh; an
-/// empty PLY or OFF (no header) is an error. Sloppiness real files show is tolerated and noted
-/// in MeshFile::warnings: a PLY header line that is no keyword (old Blender wrote "Created by
-/// Blender3D ..."). Names (OBJ usemtl, mtllib) are kept as bytes, whatever their encoding.
+/// `vertex` or `face` elements, a property declared twice). The data must match the counts
+/// the file declares exactly, and the file must end where its format says (docs/robustness.md,
+/// "Mesh files"): a binary STL's size is 84 + 50 x its triangle count; an ascii STL ends after
+/// an `endsolid`; a PLY or OFF file holds no data past its declared rows (white space, OFF
+/// comments and one line end after a binary PLY body aside); an OBJ whose last line has no line
+/// end and ends in an incomplete face is cut short. Counts are checked against the bytes left
+/// before anything is allocated for them. An empty OBJ is an empty mesh; an empty PLY, OFF or
+/// STL is an error. Sloppiness real files show is tolerated and noted in MeshFile::warnings: a
+/// PLY header line that is no keyword (old Blender wrote "Created by Blender3D ..."), faces with
+/// fewer than 3 corners (skipped). Names (OBJ usemtl, mtllib) are kept as bytes.
 MeshFile read_mesh_file(const char* data, size_t size, MeshFormat format);
 
 /// Serialises `mesh` in `format` and returns the file's bytes:
