@@ -244,95 +244,184 @@ std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layou
   return chi6;
 }
 
-Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
-                          const Clustering& c, const std::vector<uint8_t>& required, bool check_slivers,
-                          const std::vector<int32_t>* candidate_faces, CheckState* state) {
-  Partition out;
-  const int32_t n = mesh.num_vertices();
-  const int32_t k = static_cast<int32_t>(samples.size());
-  auto label = [&c](int32_t v) { return c.label(v); };
-  const auto& vfo = mesh.vertex_face_offsets();
-  const int threads = omp_get_max_threads();
+namespace {
 
-  // --- emit: faces whose corners lie in three clusters ------------------------------------------
-  const auto& faces = mesh.faces();
-  const int32_t m = mesh.num_faces();
-  CheckState local;
-  CheckState& carried = state ? *state : local;  // what the last check left, and what this one leaves
-  auto corner_labels = [&](int32_t f) {
-    return std::array<int32_t, 3>{label(faces[3 * size_t(f)]), label(faces[3 * size_t(f) + 1]),
-                                  label(faces[3 * size_t(f) + 2])};
-  };
-  auto distinct = [](const std::array<int32_t, 3>& l) { return uint8_t(l[0] != l[1] && l[1] != l[2] && l[2] != l[0]); };
-  auto three_clusters = [&](int32_t f) { return distinct(corner_labels(f)); };
-  // Every face is tested (a first check), or only those around relabelled vertices (later
-  // rounds) or the candidates (fast path). Then the emitting faces are written in face order.
-  // Re-testing the faces around many changed vertices, scattered over the mesh, costs more
-  // than testing every face in order (horse at 10 %, a flood update that removed a tenth of
-  // the samples: 46 against 35 ms for the check): beyond a sixteenth, every face is tested.
-  if (carried.valid && int64_t(carried.changed.size()) > n / 16) carried.valid = false;
-  const bool test_all = !carried.valid && !candidate_faces;
-  // Re-testing around changed vertices with the last check's triangles known: every other face
-  // keeps its corners' labels, so only the re-tested faces' triangles are written anew.
-  const bool patch = !test_all && carried.valid && carried.emitted_valid;
-  // Vertices in a face but in no cluster stop the check here: the other checks need every
-  // vertex in a cluster. Testing every face reads every such vertex's label and notes them on
-  // the way (the emits then hold for this clustering, as after any test); otherwise the
-  // vertices are scanned: only the changed ones when the last check got past this test (its
-  // triangles are known only then).
-  const int team = m >= kParallelMin ? threads : 1;
-  int unreached = 0;
-  if (patch) {
-    for (int32_t v : carried.changed)
-      if (label(v) < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
-  } else if (test_all) {
-    carried.emits.resize(m);
-#pragma omp parallel for schedule(static) num_threads(team) reduction(| : unreached)
-    for (int32_t f = 0; f < m; ++f) {
-      const auto l = corner_labels(f);
-      carried.emits[f] = distinct(l);
-      unreached |= (l[0] | l[1] | l[2]) < 0;
+// One arc of a sample's link: triangle (s, from, to) around sample s.
+struct Arc {
+  int32_t from, to, triangle;
+};
+
+// One run of check_partition: its inputs, what the last check carried, and what each stage
+// leaves for the next. The stages run in the order of run().
+class PartitionCheck {
+ public:
+  PartitionCheck(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
+                 const Clustering& c, const std::vector<uint8_t>& required, bool check_slivers,
+                 const std::vector<int32_t>* candidate_faces, CheckState* state)
+      : mesh(mesh), layout(layout), samples(samples), c(c), required(required), check_slivers(check_slivers),
+        candidate_faces(candidate_faces), state(state), carried(state ? *state : local), n(mesh.num_vertices()),
+        k(static_cast<int32_t>(samples.size())), m(mesh.num_faces()), threads(omp_get_max_threads()),
+        faces(mesh.faces()), vfo(mesh.vertex_face_offsets()), marks(threads) {}
+
+  Partition run() {
+    choose_faces_to_test();
+    if (!all_reached()) {
+      seed_unreached(mesh, c, out);
+      carried.emitted_valid = carried.links_valid = false;
+      return std::move(out);
     }
-    carried.valid = true;
-    carried.changed.clear();
-  } else {
-#pragma omp parallel for schedule(static) reduction(| : unreached) if (n >= kParallelMin)
-    for (int32_t v = 0; v < n; ++v)
-      if (label(v) < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
+    retest_faces();
+    if (patch) patch_triangles();
+    else write_emitting_faces();
+    emitted = static_cast<int32_t>(out.source_face.size());
+    collect_feature_pairs();
+    choose_samples_to_evaluate();
+    build_arcs();
+    evaluate_links();
+    settle_repeated_triangles();
+    count_link_issues();
+    if (check_slivers) find_slivers();
+    if (state) carry_links();
+    if (any_dropped) drop_pillows();
+    check_euler();
+    check_closed_curves();
+    check_boundary_loops();
+    std::sort(out.split_clusters.begin(), out.split_clusters.end());
+    out.split_clusters.erase(std::unique(out.split_clusters.begin(), out.split_clusters.end()),
+                             out.split_clusters.end());
+    return std::move(out);
   }
-  if (unreached) {
-    seed_unreached(mesh, c, out);
-    carried.emitted_valid = carried.links_valid = false;
-    return out;
-  }
-  Marks marks(threads);
+
+ private:
+  const Mesh& mesh;
+  const FeatureLayout& layout;
+  const std::vector<int32_t>& samples;
+  const Clustering& c;
+  const std::vector<uint8_t>& required;
+  const bool check_slivers;
+  const std::vector<int32_t>* candidate_faces;
+  CheckState* state;
+  CheckState local;
+  CheckState& carried;  // what the last check left, and what this one leaves
+  const int32_t n, k, m;
+  const int threads;
+  const Buffer<int32_t>& faces;
+  const Buffer<int32_t>& vfo;
+  Partition out;
+  Marks marks;
+
+  // Which faces are tested (choose_faces_to_test).
+  bool test_all = false, patch = false;
+  int team = 1;
   // The faces re-tested around the changed vertices (increasing), and those that emit now.
   std::vector<int32_t> retested, fresh_faces, fresh_triangles;
   // Zero-area flags of the triangles taken over (a triangle is the same three vertices), when
   // the last check tested them; the re-tested faces' triangles are tested below.
   std::vector<uint8_t> kept_sliver;
-  const bool keep_slivers = patch && check_slivers && carried.emitted.slivers_checked &&
-                            carried.emitted.sliver.size() == carried.emitted.faces.size();
-  if (!test_all && carried.valid) {
-    retested = faces_around(mesh, carried.changed);
-    for (int32_t f : retested) {
-      const auto l = corner_labels(f);
-      carried.emits[f] = distinct(l);
-      if (!patch || !carried.emits[f]) continue;
-      fresh_faces.push_back(f);
-      fresh_triangles.insert(fresh_triangles.end(), l.begin(), l.end());
-    }
-  } else if (candidate_faces) {
-    carried.emits.assign(m, 0);
-    const int64_t count = int64_t(candidate_faces->size());
-#pragma omp parallel for schedule(static) if (count >= kParallelMin)
-    for (int64_t i = 0; i < count; ++i) carried.emits[(*candidate_faces)[i]] = three_clusters((*candidate_faces)[i]);
+  bool keep_slivers = false;
+  int32_t emitted = 0;
+  // Clusters adjacent along a feature curve, with the copies of their edge.
+  std::unordered_map<uint64_t, int32_t> feature_copies;
+  std::vector<std::pair<uint64_t, int32_t>> feature_pairs;  // the same, sorted
+  // The samples to evaluate.
+  bool incremental = false;
+  std::vector<uint8_t> sliver;  // per emitted triangle: 0, 1 or kUntested
+  std::vector<uint8_t> affected;
+  std::vector<int32_t> todo;
+  // The arcs of the evaluated samples' links, per sample.
+  std::vector<int32_t> arc_offsets;
+  std::unique_ptr<Arc[]> arcs;
+  // What the links gave.
+  std::vector<int64_t> chi6_out;
+  std::vector<uint8_t> drop;
+  bool any_dropped = false;  // drop is read only once pillows are dropped
+  PerThread<std::vector<uint64_t>> seen_pairs{threads};
+  PerThread<std::vector<int32_t>> repeated_lists{threads}, named_lists{threads};
+  int32_t bad_link = 0, bad_edge = 0, isolated = 0;
+  std::vector<uint64_t> seen;
+
+  int32_t label(int32_t v) const { return c.label(v); }
+  std::array<int32_t, 3> corner_labels(int32_t f) const {
+    return {label(faces[3 * size_t(f)]), label(faces[3 * size_t(f) + 1]), label(faces[3 * size_t(f) + 2])};
   }
-  carried.valid = true;
-  carried.changed.clear();
-  if (patch) {
-    // The last check's triangles without the re-tested faces, merged with the re-tested faces
-    // that emit now (all three lists increasing).
+  static uint8_t distinct(const std::array<int32_t, 3>& l) {
+    return uint8_t(l[0] != l[1] && l[1] != l[2] && l[2] != l[0]);
+  }
+  uint8_t three_clusters(int32_t f) const { return distinct(corner_labels(f)); }
+  int32_t incident(int32_t s) const { return arc_offsets[s + 1] - arc_offsets[s]; }
+
+  // --- emit: faces whose corners lie in three clusters ------------------------------------------
+
+  // Every face is tested (a first check), or only those around relabelled vertices (later
+  // rounds) or the candidates (fast path). Then the emitting faces are written in face order.
+  // Re-testing the faces around many changed vertices, scattered over the mesh, costs more
+  // than testing every face in order: beyond a sixteenth of the vertices, every face is tested.
+  void choose_faces_to_test() {
+    if (carried.valid && int64_t(carried.changed.size()) > n / 16) carried.valid = false;
+    test_all = !carried.valid && !candidate_faces;
+    // Re-testing around changed vertices with the last check's triangles known: every other
+    // face keeps its corners' labels, so only the re-tested faces' triangles are written anew.
+    patch = !test_all && carried.valid && carried.emitted_valid;
+    team = m >= kParallelMin ? threads : 1;
+  }
+
+  // Vertices in a face but in no cluster stop the check here: the other checks need every
+  // vertex in a cluster. Testing every face reads every such vertex's label and notes them on
+  // the way (the emits then hold for this clustering, as after any test); otherwise the
+  // vertices are scanned: only the changed ones when the last check got past this test (its
+  // triangles are known only then).
+  bool all_reached() {
+    int unreached = 0;
+    if (patch) {
+      for (int32_t v : carried.changed)
+        if (label(v) < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
+    } else if (test_all) {
+      carried.emits.resize(m);
+      uint8_t* emits = carried.emits.data();
+#pragma omp parallel for schedule(static) num_threads(team) reduction(| : unreached)
+      for (int32_t f = 0; f < m; ++f) {
+        const auto l = corner_labels(f);
+        emits[f] = distinct(l);
+        unreached |= (l[0] | l[1] | l[2]) < 0;
+      }
+      carried.valid = true;
+      carried.changed.clear();
+    } else {
+#pragma omp parallel for schedule(static) reduction(| : unreached) if (n >= kParallelMin)
+      for (int32_t v = 0; v < n; ++v)
+        if (label(v) < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
+    }
+    return !unreached;
+  }
+
+  // Tests the faces around the changed vertices, or the candidates; notes the re-tested faces
+  // that emit now when the last check's triangles are patched.
+  void retest_faces() {
+    keep_slivers = patch && check_slivers && carried.emitted.slivers_checked &&
+                   carried.emitted.sliver.size() == carried.emitted.faces.size();
+    if (!test_all && carried.valid) {
+      retested = faces_around(mesh, carried.changed);
+      for (int32_t f : retested) {
+        const auto l = corner_labels(f);
+        carried.emits[f] = distinct(l);
+        if (!patch || !carried.emits[f]) continue;
+        fresh_faces.push_back(f);
+        fresh_triangles.insert(fresh_triangles.end(), l.begin(), l.end());
+      }
+    } else if (candidate_faces) {
+      carried.emits.assign(m, 0);
+      const int64_t count = int64_t(candidate_faces->size());
+#pragma omp parallel for schedule(static) if (count >= kParallelMin)
+      for (int64_t i = 0; i < count; ++i)
+        carried.emits[(*candidate_faces)[i]] = three_clusters((*candidate_faces)[i]);
+    }
+    carried.valid = true;
+    carried.changed.clear();
+  }
+
+  // The last check's triangles without the re-tested faces, merged with the re-tested faces
+  // that emit now (all three lists increasing).
+  void patch_triangles() {
     const auto& was_faces = carried.emitted.faces;
     const auto& was_triangles = carried.emitted.triangles;
     const size_t was = was_faces.size(), fresh = fresh_faces.size(), count = retested.size();
@@ -340,9 +429,9 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     out.triangles.resize(3 * (was + fresh));
     if (keep_slivers) kept_sliver.resize(was + fresh);
     size_t i = 0, e = 0, r = 0, at = 0;
-    auto put = [&](int32_t f, const int32_t* t, uint8_t sliver) {
+    auto put = [&](int32_t f, const int32_t* t, uint8_t flag) {
       out.source_face[at] = f;
-      if (keep_slivers) kept_sliver[at] = sliver;
+      if (keep_slivers) kept_sliver[at] = flag;
       std::copy(t, t + 3, &out.triangles[3 * at++]);
     };
     while (i < was || e < fresh) {
@@ -361,11 +450,13 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     out.source_face.resize(at);
     out.triangles.resize(3 * at);
     if (keep_slivers) kept_sliver.resize(at);
-  } else {
-    // Every emitting face, in face order: each thread counts those of its run of faces (static
-    // schedule, the same runs in both loops) and writes them from where the runs before it end.
-    // Eight faces at a time (a tenth of them emit at most); the last few faces after the whole
-    // words are appended at the end.
+  }
+
+  // Every emitting face, in face order: each thread counts those of its run of faces (static
+  // schedule, the same runs in both loops) and writes them from where the runs before it end.
+  // Eight faces at a time (a tenth of them emit at most); the last few faces after the whole
+  // words are appended at the end.
+  void write_emitting_faces() {
     const uint8_t* emits = carried.emits.data();
     const int64_t words = m / 8;
     auto write = [&](int64_t at, int32_t f) {
@@ -400,47 +491,44 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     for (int64_t f = 8 * words, at = int64_t(out.source_face.size()) - tail; f < m; ++f)
       if (emits[f]) write(at++, int32_t(f));
   }
-  const int32_t emitted = static_cast<int32_t>(out.source_face.size());
 
   // --- feature pairs: clusters adjacent along a feature curve, with the copies of their edge ---
-  std::unordered_map<uint64_t, int32_t> feature_copies;
-  for (int32_t e : layout.feature_edges) {
-    const int32_t lx = label(mesh.edge_vertices()[2 * size_t(e)]), ly = label(mesh.edge_vertices()[2 * size_t(e) + 1]);
-    if (lx != ly) feature_copies[pair_key(lx, ly)] += layout.edge_copies(mesh, e);
+  void collect_feature_pairs() {
+    for (int32_t e : layout.feature_edges) {
+      const int32_t lx = label(mesh.edge_vertices()[2 * size_t(e)]), ly = label(mesh.edge_vertices()[2 * size_t(e) + 1]);
+      if (lx != ly) feature_copies[pair_key(lx, ly)] += layout.edge_copies(mesh, e);
+    }
+    feature_pairs.assign(feature_copies.begin(), feature_copies.end());
+    std::sort(feature_pairs.begin(), feature_pairs.end());
   }
-  std::vector<std::pair<uint64_t, int32_t>> feature_pairs(feature_copies.begin(), feature_copies.end());
-  std::sort(feature_pairs.begin(), feature_pairs.end());
 
   // --- the samples to evaluate ------------------------------------------------------------------
   // All of them, or after a repair round or a flood update (a slider frame) only those whose
   // link may have changed; the others keep what the last check found. Unchanged triangles keep
   // their zero-area flags too.
-  const bool incremental = carried.links_valid && carried.emitted_valid && carried.links.samples <= k;
-  std::vector<uint8_t> sliver;  // per emitted triangle: 0, 1 or kUntested
-  if (keep_slivers) sliver = std::move(kept_sliver);
-  else if (check_slivers) sliver.assign(emitted, kUntested);
-  std::vector<uint8_t> affected =
-      incremental ? changed_links(carried, out, k, feature_pairs, check_slivers && carried.emitted.slivers_checked ? &sliver : nullptr)
-                  : std::vector<uint8_t>(k, 1);
-  std::vector<int32_t> todo;
-  for (int32_t s = 0; s < k; ++s)
-    if (affected[s]) todo.push_back(s);
+  void choose_samples_to_evaluate() {
+    incremental = carried.links_valid && carried.emitted_valid && carried.links.samples <= k;
+    if (keep_slivers) sliver = std::move(kept_sliver);
+    else if (check_slivers) sliver.assign(emitted, kUntested);
+    affected = incremental ? changed_links(carried, out, k, feature_pairs,
+                                           check_slivers && carried.emitted.slivers_checked ? &sliver : nullptr)
+                           : std::vector<uint8_t>(k, 1);
+    for (int32_t s = 0; s < k; ++s)
+      if (affected[s]) todo.push_back(s);
+  }
 
   // --- the arcs of each sample's link ---------------------------------------------------------
   // Triangle (a, b, c) gives a the arc b -> c, b the arc c -> a and c the arc a -> b. Stored per
-  // sample in one array, so that evaluating a sample reads one short contiguous run.
-  struct Arc {
-    int32_t from, to, triangle;
-  };
-  // Only the samples to evaluate get their arcs. Serial: a parallel counting sort cost more
-  // per thread than this whole loop (each sample has few arcs).
-  std::vector<int32_t> arc_offsets(k + 1, 0);
-  for (int32_t x : out.triangles) arc_offsets[x + 1] += affected[x];
-  for (int32_t s = 0; s < k; ++s) arc_offsets[s + 1] += arc_offsets[s];
-  // (Not value-initialised: the loop below writes every arc; zeroing them first was a serial
-  // pass over 5.6 MB at 10 % of the horse.)
-  std::unique_ptr<Arc[]> arcs(new Arc[size_t(arc_offsets[k])]);
-  {
+  // sample in one array, so that evaluating a sample reads one short contiguous run. Only the
+  // samples to evaluate get their arcs. Serial: a parallel counting sort cost more per thread
+  // than this whole loop (each sample has few arcs).
+  void build_arcs() {
+    arc_offsets.assign(k + 1, 0);
+    for (int32_t x : out.triangles) arc_offsets[x + 1] += affected[x];
+    for (int32_t s = 0; s < k; ++s) arc_offsets[s + 1] += arc_offsets[s];
+    // Not value-initialised: the loop below writes every arc, and zeroing them first is a
+    // serial pass over the whole array.
+    arcs.reset(new Arc[size_t(arc_offsets[k])]);
     std::vector<int32_t> fill(arc_offsets.begin(), arc_offsets.end() - 1);
     for (int32_t i = 0; i < emitted; ++i) {
       const int32_t* t = &out.triangles[3 * size_t(i)];
@@ -449,39 +537,114 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
       if (affected[t[2]]) arcs[fill[t[2]]++] = {t[0], t[1], i};
     }
   }
-  auto incident = [&](int32_t s) { return arc_offsets[s + 1] - arc_offsets[s]; };
 
   // --- per sample: one oriented fan, expected edge multiplicities, Euler contributions ----------
   // Each triangle (s, a, b) around sample s is an arc a -> b of s's link. Six times a component's
   // Euler characteristic is the sum over its samples of 6 - 3 (neighbours) + 2 (triangles),
   // counting only samples that keep a triangle. A triangle emitted twice shows up as a repeated
   // or reversed arc; such samples are set aside and settled after the pass (see below).
-  const int32_t num_components = mesh.num_components();
-  auto input_fan_count = [&](int32_t v) {  // fans of the input around v, nothing blocked
+  void evaluate_links() {
+    // The last check's values are taken over (new samples start at 0) and handed back below.
+    if (incremental) chi6_out = std::move(carried.links.chi6);
+    chi6_out.resize(k, 0);
+    out.absorbed.assign(k, 0);
+    if (incremental) {
+      std::copy(carried.links.absorbed.begin(), carried.links.absorbed.end(), out.absorbed.begin());
+      for (int32_t s : todo) chi6_out[s] = 0, out.absorbed[s] = 0;
+    }
+    drop.assign(emitted, 0);
+    if (incremental)  // the pairs seen by samples not evaluated again (a pair is seen from its lower rank)
+      for (uint64_t key : carried.links.seen_pairs)
+        if (!affected[int32_t(key >> 32)]) seen_pairs[0].push_back(key);
+    int32_t links = 0, edges = 0, lonely = 0;
+    const int64_t evaluated = int64_t(todo.size());
+#pragma omp parallel reduction(+ : links, edges, lonely) if (evaluated >= kParallelMinCostly)
+    {
+      LinkArcs link;
+      auto& seen_here = seen_pairs.mine();
+      auto& repeated = repeated_lists.mine();
+      auto& named = named_lists.mine();
+#pragma omp for schedule(dynamic, 256)
+      for (int64_t i = 0; i < evaluated; ++i) {
+        const int32_t s = todo[i], issues_before = links + edges + lonely;
+        if (!evaluate(s, link, seen_here, links, edges, lonely))
+          repeated.push_back(s);
+        else if (links + edges + lonely != issues_before)
+          named.push_back(s);
+      }
+    }
+    bad_link = links, bad_edge = edges, isolated = lonely;
+  }
+
+  // Evaluates sample s's link; returns false (and changes nothing) when it repeats a triangle.
+  bool evaluate(int32_t s, LinkArcs& link, std::vector<uint64_t>& seen_here, int32_t& links, int32_t& edges,
+                int32_t& lonely) {
+    // Most samples: inside a surface, one closed fan, no pillow. Then every neighbour's edge
+    // has two triangles, and only feature pairs expect something else.
+    const Arc* around = arcs.get() + arc_offsets[s];
+    if (!any_dropped && mesh.manifold_vertex()[samples[s]] && one_cycle(around, incident(s))) {
+      chi6_out[s] = 6 - incident(s);  // 6 - 3 neighbours + 2 triangles, as many of each
+      if (!feature_copies.empty())
+        for (int32_t i = 0; i < incident(s); ++i) check_edge(s, around[i].from, 2, seen_here, edges);
+      return true;
+    }
+    link.clear();
+    for (int32_t i = arc_offsets[s]; i < arc_offsets[s + 1]; ++i)
+      if (!any_dropped || !drop[arcs[i].triangle]) link.add(arcs[i].from, arcs[i].to);
+    if (link.repeated()) return false;
+    if (link.arcs == 0) {
+      // No triangle: the neighbours absorbed this cluster (the pillow case) unless the sample
+      // must stay. The Euler characteristic check confirms the topology either way.
+      if (required[samples[s]] || layout.vertex_corner[samples[s]]) {
+        ++lonely;
+        marks.add(s);
+      } else {
+        out.absorbed[s] = 1;
+      }
+      return true;
+    }
+    chi6_out[s] = 6 - 3 * int64_t(link.neighbours.size()) + 2 * int64_t(link.arcs);
+    for (const auto& nb : link.neighbours) check_edge(s, nb.id, nb.in + nb.out, seen_here, edges);
+    if (mesh.manifold_vertex()[samples[s]] && !link.single_fan()) {
+      ++links;
+      marks.add(s);
+    } else if (!mesh.manifold_vertex()[samples[s]] && !pinched_link_kept(s, link)) {
+      // A pinched vertex (a bowtie's centre) keeps one fan per fan of the input; with one
+      // lost, a whole wing is gone although the Euler characteristic may not show it.
+      ++links;
+      marks.add(s);
+      for (const auto& nb : link.neighbours) marks.add(nb.id);
+    }
+    return true;
+  }
+
+  // The edge between sample s and its neighbour nb (each pair once, from its lower rank) has
+  // `triangles` triangles: two inside a surface, a feature pair's copies along a curve.
+  void check_edge(int32_t s, int32_t nb, int32_t triangles, std::vector<uint64_t>& seen_here, int32_t& edges) {
+    if (nb < s) return;
+    int32_t expected = 2;
+    const auto it = feature_copies.empty() ? feature_copies.end() : feature_copies.find(pair_key(s, nb));
+    if (it != feature_copies.end()) {
+      expected = it->second;
+      seen_here.push_back(it->first);
+    }
+    if (triangles != expected) {
+      ++edges;
+      marks.add(s), marks.add(nb);
+    }
+  }
+
+  // Fans of the input around v, nothing blocked.
+  int32_t input_fan_count(int32_t v) const {
     std::vector<int32_t> fan_of_slot;
     return vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot);
-  };
-  // The last check's values are taken over (new samples start at 0) and handed back below.
-  std::vector<int64_t> chi6_out = incremental ? std::move(carried.links.chi6) : std::vector<int64_t>();
-  chi6_out.resize(k, 0);
-  out.absorbed.assign(k, 0);
-  if (incremental) {
-    std::copy(carried.links.absorbed.begin(), carried.links.absorbed.end(), out.absorbed.begin());
-    for (int32_t s : todo) chi6_out[s] = 0, out.absorbed[s] = 0;
   }
-  std::vector<uint8_t> drop(emitted, 0);
-  bool any_dropped = false;  // drop is read only once pillows are dropped
-  PerThread<std::vector<uint64_t>> seen_pairs(threads);
-  if (incremental)  // the pairs seen by samples not evaluated again (a pair is seen from its lower rank)
-    for (uint64_t key : carried.links.seen_pairs)
-      if (!affected[int32_t(key >> 32)]) seen_pairs[0].push_back(key);
-  PerThread<std::vector<int32_t>> repeated_lists(threads), named_lists(threads);
-  int32_t bad_link = 0, bad_edge = 0, isolated = 0;
+
   // At a pinched sample each input fan must come out as a fan of its own sheet: the arcs from
   // one sheet's faces form that sheet's fans (as many open and closed), and no fan mixes
   // sheets. Counting the fans alone let a small wing vanish while another wing, split at the
   // pinch, made up the count.
-  auto pinched_link_kept = [&](int32_t s, const LinkArcs& link) {
+  bool pinched_link_kept(int32_t s, const LinkArcs& link) const {
     const int32_t v = samples[s];
     if (layout.vertex_pinched.empty() || !layout.vertex_pinched[v]) return link.fans() == input_fan_count(v);
     const auto fans = input_fans(mesh, layout.face_sheet, v);
@@ -506,78 +669,6 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
       if (paths != open || part.fans() - paths != closed) return false;
     }
     return arcs_on_sheets == link.arcs;
-  };
-  // The edge between sample s and its neighbour nb (each pair once, from its lower rank) has
-  // `triangles` triangles: two inside a surface, a feature pair's copies along a curve.
-  auto check_edge = [&](int32_t s, int32_t nb, int32_t triangles, std::vector<uint64_t>& seen, int32_t& edges) {
-    if (nb < s) return;
-    int32_t expected = 2;
-    const auto it = feature_copies.empty() ? feature_copies.end() : feature_copies.find(pair_key(s, nb));
-    if (it != feature_copies.end()) {
-      expected = it->second;
-      seen.push_back(it->first);
-    }
-    if (triangles != expected) {
-      ++edges;
-      marks.add(s), marks.add(nb);
-    }
-  };
-  // Returns false (and changes nothing) when the link repeats a triangle.
-  auto evaluate = [&](int32_t s, LinkArcs& link, std::vector<uint64_t>& seen, int32_t& links, int32_t& edges,
-                      int32_t& lonely) {
-    // Most samples: inside a surface, one closed fan, no pillow. Then every neighbour's edge
-    // has two triangles, and only feature pairs expect something else.
-    const Arc* around = arcs.get() + arc_offsets[s];
-    if (!any_dropped && mesh.manifold_vertex()[samples[s]] && one_cycle(around, incident(s))) {
-      chi6_out[s] = 6 - incident(s);  // 6 - 3 neighbours + 2 triangles, as many of each
-      if (!feature_copies.empty())
-        for (int32_t i = 0; i < incident(s); ++i) check_edge(s, around[i].from, 2, seen, edges);
-      return true;
-    }
-    link.clear();
-    for (int32_t i = arc_offsets[s]; i < arc_offsets[s + 1]; ++i)
-      if (!any_dropped || !drop[arcs[i].triangle]) link.add(arcs[i].from, arcs[i].to);
-    if (link.repeated()) return false;
-    if (link.arcs == 0) {
-      // No triangle: the neighbours absorbed this cluster (the pillow case) unless the sample
-      // must stay. The Euler characteristic check confirms the topology either way.
-      if (required[samples[s]] || layout.vertex_corner[samples[s]]) {
-        ++lonely;
-        marks.add(s);
-      } else {
-        out.absorbed[s] = 1;
-      }
-      return true;
-    }
-    chi6_out[s] = 6 - 3 * int64_t(link.neighbours.size()) + 2 * int64_t(link.arcs);
-    for (const auto& nb : link.neighbours) check_edge(s, nb.id, nb.in + nb.out, seen, edges);
-    if (mesh.manifold_vertex()[samples[s]] && !link.single_fan()) {
-      ++links;
-      marks.add(s);
-    } else if (!mesh.manifold_vertex()[samples[s]] && !pinched_link_kept(s, link)) {
-      // A pinched vertex (a bowtie's centre) keeps one fan per fan of the input; with one
-      // lost, a whole wing is gone although the Euler characteristic may not show it.
-      ++links;
-      marks.add(s);
-      for (const auto& nb : link.neighbours) marks.add(nb.id);
-    }
-    return true;
-  };
-  const int64_t evaluated = int64_t(todo.size());
-#pragma omp parallel reduction(+ : bad_link, bad_edge, isolated) if (evaluated >= kParallelMinCostly)
-  {
-    LinkArcs link;
-    auto& seen = seen_pairs.mine();
-    auto& repeated = repeated_lists.mine();
-    auto& named = named_lists.mine();
-#pragma omp for schedule(dynamic, 256)
-    for (int64_t i = 0; i < evaluated; ++i) {
-      const int32_t s = todo[i], issues_before = bad_link + bad_edge + isolated;
-      if (!evaluate(s, link, seen, bad_link, bad_edge, isolated))
-        repeated.push_back(s);
-      else if (bad_link + bad_edge + isolated != issues_before)
-        named.push_back(s);
-    }
   }
 
   // --- repeated triangles: pillows and duplicates ------------------------------------------------
@@ -587,10 +678,38 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // cluster joined its neighbours, so no sample is needed. Any other repeat is an issue. Every
   // sample of a repeated triangle sees the repeat in its link, so the set-aside samples hold
   // all of them; they are evaluated again once the pillows are gone.
-  std::vector<int32_t> repeated;
-  for (int t = 0; t < threads; ++t) repeated.insert(repeated.end(), repeated_lists[t].begin(), repeated_lists[t].end());
-  std::sort(repeated.begin(), repeated.end());
-  if (!repeated.empty()) {
+  void settle_repeated_triangles() {
+    std::vector<int32_t> repeated;
+    for (int t = 0; t < threads; ++t) repeated.insert(repeated.end(), repeated_lists[t].begin(), repeated_lists[t].end());
+    std::sort(repeated.begin(), repeated.end());
+    if (repeated.empty()) return;
+    drop_opposite_pairs(repeated);
+    // A sample whose link still repeats an arc is not a manifold vertex of the output: an
+    // edge with four triangles (two tetrahedra sharing an edge) or a triangle left twice. It
+    // must count as an issue: its Euler contribution was never added, and leaving both out
+    // can make the characteristic come out right by accident (a torus as a ring of
+    // tetrahedra), so without the count such an output passed every check.
+    LinkArcs link;
+    for (int32_t s : repeated)
+      if (!evaluate(s, link, seen_pairs[0], bad_link, bad_edge, isolated)) {
+        marks.add(s);
+        // A non-manifold input edge kept as a feature legitimately has more than two triangles.
+        bool expected = false;
+        for (const auto& nb : link.neighbours)
+          if (nb.in > 1 || nb.out > 1) {
+            const auto it = feature_copies.find(pair_key(s, nb.id));
+            if (it != feature_copies.end() && it->second > 2) expected = true;
+          }
+        if (expected) continue;
+        ++bad_link;
+        for (const auto& nb : link.neighbours)
+          if (nb.in > 1 || nb.out > 1) marks.add(nb.id);  // the other end of the crowded edge
+      }
+  }
+
+  // The triangles the repeating samples emit, grouped by their corners: opposite pairs around
+  // an absorbed cluster are dropped (pillows), any other group is a duplicate.
+  void drop_opposite_pairs(const std::vector<int32_t>& repeated) {
     std::vector<std::pair<std::array<int32_t, 3>, int32_t>> keyed;  // sorted triple, triangle
     for (int32_t s : repeated)
       for (int32_t i = arc_offsets[s]; i < arc_offsets[s + 1]; ++i) {
@@ -620,45 +739,27 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
       }
       a = b;
     }
-    // A sample whose link still repeats an arc is not a manifold vertex of the output: an
-    // edge with four triangles (two tetrahedra sharing an edge) or a triangle left twice. It
-    // must count as an issue: its Euler contribution was never added, and leaving both out
-    // can make the characteristic come out right by accident (a torus as a ring of
-    // tetrahedra), so without the count such an output passed every check.
-    LinkArcs link;
-    for (int32_t s : repeated)
-      if (!evaluate(s, link, seen_pairs[0], bad_link, bad_edge, isolated)) {
-        marks.add(s);
-        // A non-manifold input edge kept as a feature legitimately has more than two triangles.
-        bool expected = false;
-        for (const auto& nb : link.neighbours)
-          if (nb.in > 1 || nb.out > 1) {
-            const auto it = feature_copies.find(pair_key(s, nb.id));
-            if (it != feature_copies.end() && it->second > 2) expected = true;
-          }
-        if (expected) continue;
-        ++bad_link;
-        for (const auto& nb : link.neighbours)
-          if (nb.in > 1 || nb.out > 1) marks.add(nb.id);  // the other end of the crowded edge
+  }
+
+  // The links' issue counts, and feature pairs without a triangle between them: the border
+  // between them collapsed.
+  void count_link_issues() {
+    out.issues.bad_link = bad_link;
+    out.issues.bad_edge = bad_edge;
+    out.issues.isolated = isolated;
+    // Counted over every sample: those not evaluated again keep theirs.
+    out.issues.absorbed = int32_t(std::count(out.absorbed.begin(), out.absorbed.end(), uint8_t(1)));
+    append_and_clear(seen_pairs, seen);
+    std::sort(seen.begin(), seen.end());
+    for (const auto& [key, copies] : feature_pairs)
+      if (!std::binary_search(seen.begin(), seen.end(), key)) {
+        ++out.issues.bad_edge;
+        marks.add(int32_t(key >> 32)), marks.add(int32_t(key & 0xffffffffu));
       }
   }
-  out.issues.bad_link = bad_link;
-  out.issues.bad_edge = bad_edge;
-  out.issues.isolated = isolated;
-  // Counted over every sample: those not evaluated again keep theirs.
-  out.issues.absorbed = int32_t(std::count(out.absorbed.begin(), out.absorbed.end(), uint8_t(1)));
-  // Feature pairs without a triangle between them: the border between them collapsed.
-  std::vector<uint64_t> seen;
-  append_and_clear(seen_pairs, seen);
-  std::sort(seen.begin(), seen.end());
-  for (const auto& [key, copies] : feature_pairs)
-    if (!std::binary_search(seen.begin(), seen.end(), key)) {
-      ++out.issues.bad_edge;
-      marks.add(int32_t(key >> 32)), marks.add(int32_t(key & 0xffffffffu));
-    }
 
   // --- triangles of zero area (collinear samples) ------------------------------------------------
-  if (check_slivers) {
+  void find_slivers() {
     std::vector<int32_t> untested;
     for (int32_t i = 0; i < emitted; ++i)
       if (sliver[i] == kUntested) untested.push_back(i);
@@ -672,7 +773,7 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
 
   // What the next round's check starts from: the triangles before pillows are dropped (a
   // pillow's samples are evaluated again anyway), and what each sample's link gave.
-  if (state) {
+  void carry_links() {
     carried.emitted_valid = carried.links_valid = true;
     carried.links.samples = k;
     carried.emitted.faces = out.source_face;
@@ -686,8 +787,9 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
     carried.links.seen_pairs = std::move(seen);
     carried.links.feature_pairs = std::move(feature_pairs);
   }
-  if (any_dropped) {
-    // Dropped pillows leave the output.
+
+  // Dropped pillows leave the output.
+  void drop_pillows() {
     int32_t kept = 0;
     for (int32_t i = 0; i < emitted; ++i) {
       if (drop[i]) continue;
@@ -702,84 +804,96 @@ Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const s
   // A component that lost all its triangles fails too (a torus has chi = 0 with or without).
   // (Triangles are counted by their first corner's sample: its component is the face's, and
   // the samples' components are k reads instead of a face and a vertex far apart per triangle.)
-  std::vector<int64_t> component_chi6(num_components, 0);
-  std::vector<int32_t> component_triangles(num_components, 0), sample_component(k);
-  for (int32_t s = 0; s < k; ++s) {
-    sample_component[s] = mesh.component()[samples[s]];
-    component_chi6[sample_component[s]] += chi6_out[s];
-  }
-  if (state) carried.links.chi6 = std::move(chi6_out);  // for the next round's check
-  for (size_t i = 0; i < out.source_face.size(); ++i) ++component_triangles[sample_component[out.triangles[3 * i]]];
-  std::vector<uint8_t> failing(num_components, 0);
-  for (int32_t comp = 0; comp < num_components; ++comp)
-    if (component_chi6[comp] != 6 * mesh.component_euler()[comp] || component_triangles[comp] == 0) {
-      failing[comp] = 1;
-      ++out.issues.bad_component;
+  void check_euler() {
+    const int32_t num_components = mesh.num_components();
+    std::vector<int64_t> component_chi6(num_components, 0);
+    std::vector<int32_t> component_triangles(num_components, 0), sample_component(k);
+    for (int32_t s = 0; s < k; ++s) {
+      sample_component[s] = mesh.component()[samples[s]];
+      component_chi6[sample_component[s]] += chi6_out[s];
     }
-  marks.merge_into(out.split_clusters);
-  if (out.issues.bad_component > 0 && out.issues.topological() == out.issues.bad_component) {
-    // Only the Euler characteristic names a problem: find the clusters that are not disks.
+    if (state) carried.links.chi6 = std::move(chi6_out);  // for the next round's check
+    for (size_t i = 0; i < out.source_face.size(); ++i) ++component_triangles[sample_component[out.triangles[3 * i]]];
+    std::vector<uint8_t> failing(num_components, 0);
+    for (int32_t comp = 0; comp < num_components; ++comp)
+      if (component_chi6[comp] != 6 * mesh.component_euler()[comp] || component_triangles[comp] == 0) {
+        failing[comp] = 1;
+        ++out.issues.bad_component;
+      }
+    marks.merge_into(out.split_clusters);
+    if (out.issues.bad_component > 0 && out.issues.topological() == out.issues.bad_component)
+      blame_non_disks(failing);
+  }
+
+  // Only the Euler characteristic names a problem: find the clusters that are not disks.
+  void blame_non_disks(const std::vector<uint8_t>& failing) {
     const auto chi6 = cluster_euler6(mesh, layout, k, c);
     for (int32_t s = 0; s < k; ++s)
       if (failing[mesh.component()[samples[s]]] && chi6[s] != 6 * int64_t(layout.sectors[samples[s]])) {
         ++out.issues.non_disk;
         out.split_clusters.push_back(s);
       }
-    if (out.issues.non_disk == 0) {
-      // Nothing local to blame: split the widest cluster of each failing component.
-      std::vector<int32_t> widest(num_components, -1);
-      for (int32_t v = 0; v < n; ++v) {
-        const int32_t comp = mesh.component()[v];
-        if (label(v) < 0 || !failing[comp]) continue;
-        if (widest[comp] < 0 || c.dist(v) > c.dist(widest[comp])) widest[comp] = v;
-      }
-      for (int32_t v : widest)
-        if (v >= 0) out.new_samples.push_back(v);
+    if (out.issues.non_disk > 0) return;
+    // Nothing local to blame: split the widest cluster of each failing component.
+    std::vector<int32_t> widest(mesh.num_components(), -1);
+    for (int32_t v = 0; v < n; ++v) {
+      const int32_t comp = mesh.component()[v];
+      if (label(v) < 0 || !failing[comp]) continue;
+      if (widest[comp] < 0 || c.dist(v) > c.dist(widest[comp])) widest[comp] = v;
     }
+    for (int32_t v : widest)
+      if (v >= 0) out.new_samples.push_back(v);
   }
 
   // --- closed feature curves need three clusters to stay loops ---------------------------------
-  for (int32_t curve = 0; curve < layout.num_curves(); ++curve) {
-    if (!layout.curve_closed[curve]) continue;
-    const int32_t b = layout.curve_offsets[curve], e = layout.curve_offsets[curve + 1];
-    int32_t changes = 0, farthest = -1;
-    for (int32_t i = b; i < e; ++i) {
-      const int32_t v = layout.curve_vertices[i];
-      const int32_t w = layout.curve_vertices[i + 1 < e ? i + 1 : b];
-      changes += label(v) != label(w);
-      if (c.dist(v) > 0 && (farthest < 0 || c.dist(v) > c.dist(farthest))) farthest = v;
-    }
-    if (changes < 3) {
-      ++out.issues.short_loop;
-      if (farthest >= 0) out.new_samples.push_back(farthest);
+  void check_closed_curves() {
+    for (int32_t curve = 0; curve < layout.num_curves(); ++curve) {
+      if (!layout.curve_closed[curve]) continue;
+      const int32_t b = layout.curve_offsets[curve], e = layout.curve_offsets[curve + 1];
+      int32_t changes = 0, farthest = -1;
+      for (int32_t i = b; i < e; ++i) {
+        const int32_t v = layout.curve_vertices[i];
+        const int32_t w = layout.curve_vertices[i + 1 < e ? i + 1 : b];
+        changes += label(v) != label(w);
+        if (c.dist(v) > 0 && (farthest < 0 || c.dist(v) > c.dist(farthest))) farthest = v;
+      }
+      if (changes < 3) {
+        ++out.issues.short_loop;
+        if (farthest >= 0) out.new_samples.push_back(farthest);
+      }
     }
   }
 
   // --- boundary loops need three clusters too ---------------------------------------------------
   // Corners (e.g. where creases meet a hole) split a boundary loop into open curves, which the
   // closed-curve check above does not see: a hole met by only two clusters closes up (two
-  // boundary curves become one interior edge), and only the Euler characteristic noticed, with
-  // nothing local to split (hundreds of repair rounds, 6 loops -> 4 at the limit).
-  const int32_t boundary_loops = int32_t(layout.boundary_loop_offsets.size()) - 1;
-  for (int32_t loop = 0; loop < boundary_loops; ++loop) {
-    const int32_t b = layout.boundary_loop_offsets[loop], e = layout.boundary_loop_offsets[loop + 1];
-    int32_t seen[3] = {-1, -1, -1}, distinct = 0, farthest = -1;
-    for (int32_t i = b; i < e; ++i) {
-      const int32_t v = layout.boundary_loop_vertices[i];
-      const int32_t l = label(v);
-      if (distinct < 3 && l != seen[0] && l != seen[1] && l != seen[2]) seen[distinct++] = l;
-      if (c.dist(v) > 0 && (farthest < 0 || c.dist(v) > c.dist(farthest))) farthest = v;
-    }
-    if (distinct < 3 && e - b >= 3) {
-      ++out.issues.short_loop;
-      if (farthest >= 0) out.new_samples.push_back(farthest);
+  // boundary curves become one interior edge), and only the Euler characteristic noticed it,
+  // with nothing local to split.
+  void check_boundary_loops() {
+    const int32_t boundary_loops = int32_t(layout.boundary_loop_offsets.size()) - 1;
+    for (int32_t loop = 0; loop < boundary_loops; ++loop) {
+      const int32_t b = layout.boundary_loop_offsets[loop], e = layout.boundary_loop_offsets[loop + 1];
+      int32_t met[3] = {-1, -1, -1}, count = 0, farthest = -1;
+      for (int32_t i = b; i < e; ++i) {
+        const int32_t v = layout.boundary_loop_vertices[i];
+        const int32_t l = label(v);
+        if (count < 3 && l != met[0] && l != met[1] && l != met[2]) met[count++] = l;
+        if (c.dist(v) > 0 && (farthest < 0 || c.dist(v) > c.dist(farthest))) farthest = v;
+      }
+      if (count < 3 && e - b >= 3) {
+        ++out.issues.short_loop;
+        if (farthest >= 0) out.new_samples.push_back(farthest);
+      }
     }
   }
+};
 
-  std::sort(out.split_clusters.begin(), out.split_clusters.end());
-  out.split_clusters.erase(std::unique(out.split_clusters.begin(), out.split_clusters.end()),
-                           out.split_clusters.end());
-  return out;
+}  // namespace
+
+Partition check_partition(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples,
+                          const Clustering& c, const std::vector<uint8_t>& required, bool check_slivers,
+                          const std::vector<int32_t>* candidate_faces, CheckState* state) {
+  return PartitionCheck(mesh, layout, samples, c, required, check_slivers, candidate_faces, state).run();
 }
 
 }  // namespace topstoc
