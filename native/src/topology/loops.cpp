@@ -145,63 +145,119 @@ std::string component_name(size_t index, const SurfaceCheck& check) {
   return "component " + std::to_string(index) + " (from vertex " + std::to_string(check.first_vertex) + ")";
 }
 
-}  // namespace
+// The loops found on one component's full surface (fine ids), by either route, before
+// shortening: the loops, the edge each crosses, and whether it is a handle.
+struct FoundLoops {
+  std::vector<std::vector<int32_t>> loops;
+  std::vector<std::pair<int32_t, int32_t>> generators;
+  std::vector<uint8_t> is_handle;
+  void clear() { loops.clear(), generators.clear(), is_handle.clear(); }
+};
 
-LoopsResult compute_loops(const Mesh& mesh, const LoopParams& params) {
-  LoopsResult result;
-  Progress progress(params.progress);
-  auto start = Clock::now();
-  progress.stage("prepare", 0.0, 0.03);
-  const auto components = component_vertices(mesh);
-  const auto checks = check_closed_surfaces(mesh, components);
-  std::vector<int32_t> order(components.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return checks[a].first_vertex < checks[b].first_vertex; });
+// One component's work: its full surface, its share of the progress bar, and what it found.
+struct ComponentJob {
+  int32_t k;  // index into result.components
+  ComponentLoops& out;
+  const SurfaceCheck& check;
+  int32_t fine_component;
+  double begin, end;
+  ClosedSurface fine;
+  std::vector<double> fine_weight;
+  FoundLoops found;
+  double at(double f) const { return begin + (end - begin) * f; }
+};
 
-  std::vector<int32_t> work;  // indices into result.components
-  int64_t work_faces = 0;
-  for (size_t k = 0; k < order.size(); ++k) {
-    const SurfaceCheck& check = checks[order[k]];
-    if (check.problem == "non-manifold" || check.problem == "non-orientable")
-      throw std::invalid_argument(component_name(k, check) + " is " + check.problem + ": " + check.detail +
-                                  "; handle and tunnel loops need closed, orientable, manifold surfaces");
-    ComponentLoops c;
-    c.first_vertex = check.first_vertex;
-    c.vertices = check.vertices;
-    c.edges = check.edges;
-    c.faces = check.faces;
-    c.boundary_loops = check.boundary_loops;
-    c.genus = check.genus();
-    c.status = check.problem.empty() ? "ok" : check.problem;
-    if (check.problem == "open")
-      c.detail = "no handle or tunnel loops on an open surface (" + std::to_string(check.boundary_loops) +
-                 " boundary loops, " + check.detail + ")";
-    if (check.problem.empty() && c.genus > 0) {
-      work.push_back(int32_t(k));
-      work_faces += c.faces;
+// One run of compute_loops: the components to analyse, the coarse decimations made for them,
+// and the result being filled. The stages run in the order of run().
+class LoopsComputation {
+ public:
+  LoopsComputation(const Mesh& mesh, const LoopParams& params) : mesh(mesh), params(params), progress(params.progress) {}
+
+  LoopsResult run() {
+    const auto start = Clock::now();
+    progress.stage("prepare", 0.0, 0.03);
+    components = component_vertices(mesh);
+    checks = check_closed_surfaces(mesh, components);
+    order.resize(components.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return checks[a].first_vertex < checks[b].first_vertex; });
+    describe_components();
+    result.seconds_prepare = seconds_since(start);
+    plan_coarse_route();
+    int64_t faces_done = 0;
+    for (int32_t k : work) {
+      ComponentLoops& out = result.components[k];
+      const double begin = 0.1 + 0.9 * double(faces_done) / double(work_faces);
+      const double end = 0.1 + 0.9 * double(faces_done + out.faces) / double(work_faces);
+      faces_done += out.faces;
+      ComponentJob job{k, out, checks[order[k]], order[k], begin, end, {}, {}, {}};
+      find_component_loops(job);
     }
-    result.components.push_back(std::move(c));
+    progress.stage("done", 1.0, 1.0);
+    return std::move(result);
   }
-  result.seconds_prepare = seconds_since(start);
 
-  // Which components take the coarse route (thesis 5.2.2).
-  // The automatic target is small: TetGen's time grows with it, and the refinement against
-  // self-intersections adds samples where the shape needs them.
-  const int32_t active = mesh.num_vertices() - mesh.report().isolated_vertices;
-  int64_t total_genus = 0;
-  for (int32_t k : work) total_genus += result.components[k].genus;
-  const int32_t base_target = params.coarse_vertices > 0
-                                  ? params.coarse_vertices
-                                  : int32_t(std::min<int64_t>(active, std::min<int64_t>(20000, 3000 + 100 * total_genus)));
-  std::vector<uint8_t> coarse_wanted(components.size(), 0);
-  for (int32_t k : work) {
-    const ComponentLoops& c = result.components[k];
-    const bool coarse = params.coarse_vertices > 0 || (params.coarse_vertices < 0 && c.faces > params.full_route_faces);
-    if (coarse && base_target < c.vertices) coarse_wanted[order[k]] = 1;
-  }
-  // Coarse decimations, made on first use; each retry doubles the target.
+ private:
+  const Mesh& mesh;
+  const LoopParams& params;
+  Progress progress;
+  LoopsResult result;
+  std::vector<std::vector<int32_t>> components;
+  std::vector<SurfaceCheck> checks;
+  std::vector<int32_t> order;  // components by first vertex
+  std::vector<int32_t> work;   // indices into result.components: closed surfaces of positive genus
+  int64_t work_faces = 0;
+  int32_t active = 0, base_target = 0;
+  std::vector<uint8_t> coarse_wanted;  // per component (mesh order)
   std::vector<std::unique_ptr<CoarseMesh>> levels;
-  auto coarse_level = [&](size_t level) -> const CoarseMesh& {
+
+  // Each component's counts and status, in first-vertex order; non-manifold or non-orientable
+  // components stop the run.
+  void describe_components() {
+    for (size_t k = 0; k < order.size(); ++k) {
+      const SurfaceCheck& check = checks[order[k]];
+      if (check.problem == "non-manifold" || check.problem == "non-orientable")
+        throw std::invalid_argument(component_name(k, check) + " is " + check.problem + ": " + check.detail +
+                                    "; handle and tunnel loops need closed, orientable, manifold surfaces");
+      ComponentLoops c;
+      c.first_vertex = check.first_vertex;
+      c.vertices = check.vertices;
+      c.edges = check.edges;
+      c.faces = check.faces;
+      c.boundary_loops = check.boundary_loops;
+      c.genus = check.genus();
+      c.status = check.problem.empty() ? "ok" : check.problem;
+      if (check.problem == "open")
+        c.detail = "no handle or tunnel loops on an open surface (" + std::to_string(check.boundary_loops) +
+                   " boundary loops, " + check.detail + ")";
+      if (check.problem.empty() && c.genus > 0) {
+        work.push_back(int32_t(k));
+        work_faces += c.faces;
+      }
+      result.components.push_back(std::move(c));
+    }
+  }
+
+  // Which components take the coarse route (thesis 5.2.2). The automatic target is small:
+  // TetGen's time grows with it, and the refinement against self-intersections adds samples
+  // where the shape needs them.
+  void plan_coarse_route() {
+    active = mesh.num_vertices() - mesh.report().isolated_vertices;
+    int64_t total_genus = 0;
+    for (int32_t k : work) total_genus += result.components[k].genus;
+    base_target = params.coarse_vertices > 0
+                      ? params.coarse_vertices
+                      : int32_t(std::min<int64_t>(active, std::min<int64_t>(20000, 3000 + 100 * total_genus)));
+    coarse_wanted.assign(components.size(), 0);
+    for (int32_t k : work) {
+      const ComponentLoops& c = result.components[k];
+      const bool coarse = params.coarse_vertices > 0 || (params.coarse_vertices < 0 && c.faces > params.full_route_faces);
+      if (coarse && base_target < c.vertices) coarse_wanted[order[k]] = 1;
+    }
+  }
+
+  // Coarse decimations, made on first use; each retry doubles the target.
+  const CoarseMesh& coarse_level(size_t level) {
     while (levels.size() <= level) {
       const auto t = Clock::now();
       progress.stage("decimate", 0.03, 0.1);
@@ -213,140 +269,151 @@ LoopsResult compute_loops(const Mesh& mesh, const LoopParams& params) {
       result.seconds_decimate += seconds_since(t);
     }
     return *levels[level];
-  };
+  }
 
-  int64_t faces_done = 0;
-  for (int32_t k : work) {
-    ComponentLoops& out = result.components[k];
-    const SurfaceCheck& check = checks[order[k]];
-    const int32_t fine_component = order[k];
-    const double begin = 0.1 + 0.9 * double(faces_done) / double(work_faces);
-    const double end = 0.1 + 0.9 * double(faces_done + out.faces) / double(work_faces);
-    auto at = [&](double f) { return begin + (end - begin) * f; };
-    faces_done += out.faces;
-
-    start = Clock::now();
-    const ClosedSurface fine = extract_surface(mesh, components[fine_component]);
-    const auto fine_weight = edge_weights(fine, params.count_edges);
+  // Steps 1-4 by either route, then step 5 and the checks, on the full surface.
+  void find_component_loops(ComponentJob& job) {
+    const auto start = Clock::now();
+    job.fine = extract_surface(mesh, components[job.fine_component]);
+    job.fine_weight = edge_weights(job.fine, params.count_edges);
     result.seconds_prepare += seconds_since(start);
+    bool coarse_route = coarse_wanted[job.fine_component];
+    if (coarse_route && !loops_by_coarse_route(job)) coarse_route = false;
+    if (!coarse_route) loops_by_full_route(job);
+    const SurfaceHomology homology(job.fine);
+    const auto classes = verify_loops(job, homology);
+    shorten_loops(job, homology, classes);
+  }
 
-    // Steps 1-4: loops on the full surface (fine ids), by either route.
-    std::vector<std::vector<int32_t>> loops;
-    std::vector<std::pair<int32_t, int32_t>> generators;
-    std::vector<uint8_t> is_handle;
-    bool coarse_route = coarse_wanted[fine_component];
+  // Tries the coarse decimations in turn; false when none gave loops (then the full route runs,
+  // if the component is small enough).
+  bool loops_by_coarse_route(ComponentJob& job) {
     std::string refusal;
-    if (coarse_route) {
-      bool done = false;
-      for (size_t level = 0; level < 3 && !done; ++level) {
-        const CoarseMesh& coarse = coarse_level(level);
-        if (!coarse.topology_kept) continue;
-        start = Clock::now();
-        CoarseView view = coarse_view(mesh, components[fine_component], fine, fine_component, out.genus, coarse);
-        result.seconds_map += seconds_since(start);
-        if (!view.why.empty()) continue;
-        Analysis analysis;
-        try {
-          analysis = analyse(view.surface, edge_weights(view.surface, params.count_edges), params, progress, result,
-                             at(0.0), at(0.6));
-        } catch (const TetgenRefused& refused) {
-          refusal = refusal_message(refused, [&](int32_t v) {
-            if (v < 0 || v >= view.surface.num_vertices()) return -1;
-            return coarse.decimation.kept[coarse.mesh->vertex_source()[view.surface.mesh_vertex[v]]];
-          });
-          refusal += " (on a coarse version)";
-          continue;
-        }
-        // Big moves are cheap on the coarse surface: tighten there first, then only locally.
-        start = Clock::now();
-        if (params.shorten) {
-          progress.stage("shorten (coarse)", at(0.55), at(0.6));
-          const auto coarse_weight = edge_weights(view.surface, params.count_edges);
-          const SurfaceHomology coarse_homology(view.surface);
-          LoopTightener coarse_tightener(view.surface, coarse_weight, &coarse_homology);
-          for (auto& loop : analysis.loops) loop.vertices = coarse_tightener.tighten(loop.vertices, TightenParams{}, &progress);
-        }
-        result.seconds_shorten += seconds_since(start);
-        start = Clock::now();
-        progress.stage("map to full mesh", at(0.6), at(0.65));
-        ClusterMap map(fine, fine_weight, std::move(view.cluster_of), std::move(view.representative));
-        try {
-          loops.clear();
-          generators.clear();
-          is_handle.clear();
-          for (const auto& loop : analysis.loops) {
-            loops.push_back(map.map_loop(loop.vertices));
-            const auto& ev = view.surface.edge_vertices;
-            generators.push_back(map.crossing_edge(ev[2 * size_t(loop.generator_edge)], ev[2 * size_t(loop.generator_edge) + 1]));
-            is_handle.push_back(loop.handle);
-          }
-        } catch (const std::logic_error&) {
-          result.seconds_map += seconds_since(start);
-          continue;  // clusters not as the decimation promised: try a finer one
-        }
-        result.seconds_map += seconds_since(start);
-        out.route = "coarse";
-        out.analysed_vertices = view.surface.num_vertices();
-        out.tetrahedra = analysis.tetrahedra;
-        done = true;
-      }
-      if (!done) {
-        if (out.faces > params.max_full_faces)
-          throw std::invalid_argument(component_name(k, check) + ": no coarse version could be tetrahedralized (" +
-                                      (refusal.empty() ? std::string("decimation did not keep the topology") : refusal) +
-                                      ") and the component is too large to try whole; use coarse_vertices = 0 to force it");
-        coarse_route = false;
-      }
-    }
-    if (!coarse_route) {
-      Analysis analysis;
-      try {
-        analysis = analyse(fine, fine_weight, params, progress, result, at(0.0), at(0.65));
-      } catch (const TetgenRefused& refused) {
-        throw std::invalid_argument(component_name(k, check) + ": " + refusal_message(refused, [&](int32_t v) {
-                                      if (v < 0 || v >= fine.num_vertices()) return -1;
-                                      return mesh.vertex_source()[fine.mesh_vertex[v]];
-                                    }));
-      }
-      for (const auto& loop : analysis.loops) {
-        loops.push_back(loop.vertices);
-        generators.emplace_back(fine.edge_vertices[2 * size_t(loop.generator_edge)],
-                                fine.edge_vertices[2 * size_t(loop.generator_edge) + 1]);
-        is_handle.push_back(loop.handle);
-      }
-      out.route = "full";
-      out.analysed_vertices = fine.num_vertices();
-      out.tetrahedra = analysis.tetrahedra;
-    }
+    for (size_t level = 0; level < 3; ++level)
+      if (loops_on_coarse_level(job, coarse_level(level), refusal)) return true;
+    if (job.out.faces > params.max_full_faces)
+      throw std::invalid_argument(component_name(job.k, job.check) + ": no coarse version could be tetrahedralized (" +
+                                  (refusal.empty() ? std::string("decimation did not keep the topology") : refusal) +
+                                  ") and the component is too large to try whole; use coarse_vertices = 0 to force it");
+    return false;
+  }
 
-    // Step 5 and the checks, on the full surface.
+  // Steps 1-4 on one coarse decimation, the loops mapped back to the full surface; false (with
+  // TetGen's reason in `refusal` when it refused) when this level cannot give them.
+  bool loops_on_coarse_level(ComponentJob& job, const CoarseMesh& coarse, std::string& refusal) {
+    if (!coarse.topology_kept) return false;
+    auto start = Clock::now();
+    CoarseView view = coarse_view(mesh, components[job.fine_component], job.fine, job.fine_component, job.out.genus, coarse);
+    result.seconds_map += seconds_since(start);
+    if (!view.why.empty()) return false;
+    Analysis analysis;
+    try {
+      analysis = analyse(view.surface, edge_weights(view.surface, params.count_edges), params, progress, result,
+                         job.at(0.0), job.at(0.6));
+    } catch (const TetgenRefused& refused) {
+      refusal = refusal_message(refused, [&](int32_t v) {
+        if (v < 0 || v >= view.surface.num_vertices()) return -1;
+        return coarse.decimation.kept[coarse.mesh->vertex_source()[view.surface.mesh_vertex[v]]];
+      });
+      refusal += " (on a coarse version)";
+      return false;
+    }
+    // Big moves are cheap on the coarse surface: tighten there first, then only locally.
     start = Clock::now();
-    progress.stage("verify", at(0.65), at(0.7));
-    const SurfaceHomology homology(fine);
-    std::vector<uint8_t> seen(fine.num_vertices(), 0);
+    if (params.shorten) {
+      progress.stage("shorten (coarse)", job.at(0.55), job.at(0.6));
+      const auto coarse_weight = edge_weights(view.surface, params.count_edges);
+      const SurfaceHomology coarse_homology(view.surface);
+      LoopTightener coarse_tightener(view.surface, coarse_weight, &coarse_homology);
+      for (auto& loop : analysis.loops) loop.vertices = coarse_tightener.tighten(loop.vertices, TightenParams{}, &progress);
+    }
+    result.seconds_shorten += seconds_since(start);
+    start = Clock::now();
+    progress.stage("map to full mesh", job.at(0.6), job.at(0.65));
+    ClusterMap map(job.fine, job.fine_weight, std::move(view.cluster_of), std::move(view.representative));
+    try {
+      job.found.clear();
+      for (const auto& loop : analysis.loops) {
+        job.found.loops.push_back(map.map_loop(loop.vertices));
+        const auto& ev = view.surface.edge_vertices;
+        job.found.generators.push_back(
+            map.crossing_edge(ev[2 * size_t(loop.generator_edge)], ev[2 * size_t(loop.generator_edge) + 1]));
+        job.found.is_handle.push_back(loop.handle);
+      }
+    } catch (const std::logic_error&) {
+      result.seconds_map += seconds_since(start);
+      return false;  // clusters not as the decimation promised: try a finer one
+    }
+    result.seconds_map += seconds_since(start);
+    job.out.route = "coarse";
+    job.out.analysed_vertices = view.surface.num_vertices();
+    job.out.tetrahedra = analysis.tetrahedra;
+    return true;
+  }
+
+  // Steps 1-4 on the whole component.
+  void loops_by_full_route(ComponentJob& job) {
+    const ClosedSurface& fine = job.fine;
+    Analysis analysis;
+    try {
+      analysis = analyse(fine, job.fine_weight, params, progress, result, job.at(0.0), job.at(0.65));
+    } catch (const TetgenRefused& refused) {
+      throw std::invalid_argument(component_name(job.k, job.check) + ": " + refusal_message(refused, [&](int32_t v) {
+                                    if (v < 0 || v >= fine.num_vertices()) return -1;
+                                    return mesh.vertex_source()[fine.mesh_vertex[v]];
+                                  }));
+    }
+    for (const auto& loop : analysis.loops) {
+      job.found.loops.push_back(loop.vertices);
+      job.found.generators.emplace_back(fine.edge_vertices[2 * size_t(loop.generator_edge)],
+                                        fine.edge_vertices[2 * size_t(loop.generator_edge) + 1]);
+      job.found.is_handle.push_back(loop.handle);
+    }
+    job.out.route = "full";
+    job.out.analysed_vertices = fine.num_vertices();
+    job.out.tetrahedra = analysis.tetrahedra;
+  }
+
+  // Step 5's checks: every loop is simple, there are 2g of them and they span H1. Returns
+  // each loop's class.
+  std::vector<Z2Vector> verify_loops(const ComponentJob& job, const SurfaceHomology& homology) {
+    const auto start = Clock::now();
+    progress.stage("verify", job.at(0.65), job.at(0.7));
+    std::vector<uint8_t> seen(job.fine.num_vertices(), 0);
     Z2Basis span(homology.dimension());
     std::vector<Z2Vector> classes;
-    for (const auto& loop : loops) {
-      check_simple(fine, loop, seen);
-      classes.push_back(homology.class_of_loop(fine, loop));
+    for (const auto& loop : job.found.loops) {
+      check_simple(job.fine, loop, seen);
+      classes.push_back(homology.class_of_loop(job.fine, loop));
       if (!span.insert(classes.back()))
-        throw std::logic_error(component_name(k, check) + ": the handle and tunnel loops do not span H1 of the surface");
+        throw std::logic_error(component_name(job.k, job.check) + ": the handle and tunnel loops do not span H1 of the surface");
     }
-    if (int32_t(loops.size()) != 2 * out.genus) throw std::logic_error(component_name(k, check) + ": wrong number of loops");
+    if (int32_t(job.found.loops.size()) != 2 * job.out.genus)
+      throw std::logic_error(component_name(job.k, job.check) + ": wrong number of loops");
     result.seconds_verify += seconds_since(start);
+    return classes;
+  }
 
-    start = Clock::now();
-    progress.stage("shorten", at(0.7), at(1.0));
+  // Shortens each loop (checking that it keeps its class and gets no longer) and hands the
+  // loops out in the caller's vertex ids.
+  void shorten_loops(ComponentJob& job, const SurfaceHomology& homology, const std::vector<Z2Vector>& classes) {
+    const ClosedSurface& fine = job.fine;
+    const auto& loops = job.found.loops;
+    ComponentLoops& out = job.out;
+    const auto start = Clock::now();
+    progress.stage("shorten", job.at(0.7), job.at(1.0));
     double checking = 0.0;  // spent verifying inside the shortening loop
     TightenParams local_moves;  // loops carried back from a tightened coarse loop need small moves only
     local_moves.max_window = 64;
-    LoopTightener tightener(fine, fine_weight, &homology);
-    const std::vector<double> euclidean = params.count_edges ? edge_weights(fine, false) : fine_weight;
+    LoopTightener tightener(fine, job.fine_weight, &homology);
+    const std::vector<double> euclidean = params.count_edges ? edge_weights(fine, false) : job.fine_weight;
+    std::vector<uint8_t> seen(fine.num_vertices(), 0);
+    auto to_caller = [&](int32_t v) { return mesh.vertex_source()[fine.mesh_vertex[v]]; };
     for (size_t i = 0; i < loops.size(); ++i) {
       HandleTunnelLoop loop;
-      loop.handle = is_handle[i];
+      loop.handle = job.found.is_handle[i];
       loop.initial_length = loop_length(fine, loops[i], euclidean);
-      for (int32_t v : loops[i]) loop.initial_vertices.push_back(mesh.vertex_source()[fine.mesh_vertex[v]]);
+      for (int32_t v : loops[i]) loop.initial_vertices.push_back(to_caller(v));
       std::vector<int32_t> shortened = loops[i];
       if (params.shorten) {
         progress.update(double(i) / double(loops.size()));
@@ -355,25 +422,28 @@ LoopsResult compute_loops(const Mesh& mesh, const LoopParams& params) {
         check_simple(fine, shortened, seen);
         if (!(homology.class_of_loop(fine, shortened) == classes[i]) ||
             homology.integer_class_of_loop(fine, shortened) != homology.integer_class_of_loop(fine, loops[i]))
-          throw std::logic_error(component_name(k, check) + ": shortening changed a loop's class");
-        if (loop_length(fine, shortened, fine_weight) > loop_length(fine, loops[i], fine_weight) * (1 + 1e-12))
-          throw std::logic_error(component_name(k, check) + ": shortening made a loop longer");
+          throw std::logic_error(component_name(job.k, job.check) + ": shortening changed a loop's class");
+        if (loop_length(fine, shortened, job.fine_weight) > loop_length(fine, loops[i], job.fine_weight) * (1 + 1e-12))
+          throw std::logic_error(component_name(job.k, job.check) + ": shortening made a loop longer");
         checking += seconds_since(verify_start);
       }
       loop.length = loop_length(fine, shortened, euclidean);
-      for (int32_t v : shortened) loop.vertices.push_back(mesh.vertex_source()[fine.mesh_vertex[v]]);
-      loop.generator[0] = mesh.vertex_source()[fine.mesh_vertex[generators[i].first]];
-      loop.generator[1] = mesh.vertex_source()[fine.mesh_vertex[generators[i].second]];
+      for (int32_t v : shortened) loop.vertices.push_back(to_caller(v));
+      loop.generator[0] = to_caller(job.found.generators[i].first);
+      loop.generator[1] = to_caller(job.found.generators[i].second);
       (loop.handle ? out.handles : out.tunnels).push_back(std::move(loop));
     }
     result.seconds_shorten += seconds_since(start) - checking;
     result.seconds_verify += checking;
     if (int32_t(out.handles.size()) != out.genus || int32_t(out.tunnels.size()) != out.genus)
-      throw std::logic_error(component_name(k, check) + ": expected " + std::to_string(out.genus) + " loops of each kind");
+      throw std::logic_error(component_name(job.k, job.check) + ": expected " + std::to_string(out.genus) +
+                             " loops of each kind");
   }
-  progress.stage("done", 1.0, 1.0);
-  return result;
-}
+};
+
+}  // namespace
+
+LoopsResult compute_loops(const Mesh& mesh, const LoopParams& params) { return LoopsComputation(mesh, params).run(); }
 
 std::vector<int32_t> shorten_loop(const Mesh& mesh, const std::vector<int32_t>& loop, const LoopParams& params,
                                   int32_t max_window) {
