@@ -123,52 +123,98 @@ std::array<std::vector<const Candidate*>, 2> pick_shortest(std::vector<Candidate
   return picked;
 }
 
-}  // namespace
+// A candidate loop found from a root: the fundamental cycle of non-tree edge `edge`, at most
+// `bound` long (through the root), of the given kind.
+struct LocalCycle {
+  double bound;
+  int32_t edge, kind;
+};
 
-std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomology& h, const std::vector<PersistentCycle>& cycles,
-                                       const std::vector<double>& weight, int32_t max_roots, Progress* progress) {
-  const int32_t dim = h.dimension(), g = dim / 2, n = s.num_vertices();
-  std::vector<SelectedLoop> out;
-  if (g == 0) return out;
+// One run of select_loops: the homology coordinates, the candidates found so far and the
+// roots grown from. The stages run in the order of run().
+class LoopSelection {
+ public:
+  LoopSelection(const ClosedSurface& s, const SurfaceHomology& h, const std::vector<PersistentCycle>& cycles,
+                const std::vector<double>& weight, int32_t max_roots, Progress* progress)
+      : s(s), h(h), cycles(cycles), weight(weight), max_roots(max_roots), progress(progress), dim(h.dimension()),
+        g(dim / 2), n(s.num_vertices()), words((dim + 63) / 64), split(dim) {}
+
+  std::vector<SelectedLoop> run() {
+    if (g == 0) return {};
+    to_cycle_coordinates();
+    convert_edge_classes();
+    collect_cycle_pieces();
+    seed_roots();
+    grow_from_roots();
+    // Shortest first, keep what extends the handle or the tunnel basis.
+    const auto picked = pick_shortest(candidates, dim, g);
+    if (int32_t(picked[0].size()) < g || int32_t(picked[1].size()) < g)
+      throw std::logic_error("found only " + std::to_string(picked[0].size()) + " handle and " +
+                             std::to_string(picked[1].size()) + " tunnel loops that are simple, of " + std::to_string(g));
+    return match_to_generators(picked);
+  }
+
+ private:
+  const ClosedSurface& s;
+  const SurfaceHomology& h;
+  const std::vector<PersistentCycle>& cycles;
+  const std::vector<double>& weight;
+  int32_t max_roots;
+  Progress* progress;
+  const int32_t dim, g, n, words;
+  std::vector<const PersistentCycle*> ordered;  // handle cycles, then tunnel cycles
+  Z2Basis split;
+  std::vector<Z2Vector> to_cycle_basis;  // row i: generator i's unit vector in the cycle basis
+  std::vector<uint64_t> edge_class;      // each edge's class in cycle coordinates, `words` words each
+  std::vector<Candidate> candidates;
+  int64_t order = 0;
+  std::vector<int32_t> roots;
+  std::vector<uint8_t> is_root;
+  double cutoff = ShortestPaths::kInfinity;
+
   // Coordinates in the basis (handle cycles, tunnel cycles) tell the two subspaces apart: bits
   // 0..g-1 are the handle cycles' coefficients, g..2g-1 the tunnel cycles'. Every class below is
   // kept in these coordinates, so telling a handle from a tunnel reads two halves of a bit
   // vector instead of eliminating against the cycle basis once per edge and root (which made
   // the selection cubic in the genus).
-  std::vector<const PersistentCycle*> ordered;
-  for (const auto& c : cycles) if (c.handle) ordered.push_back(&c);
-  for (const auto& c : cycles) if (!c.handle) ordered.push_back(&c);
-  Z2Basis split(dim);
-  for (const auto* c : ordered)
-    if (!split.insert(h.class_of_edges(c->edges)))
-      throw std::logic_error("the handle and tunnel cycles are not independent in H1");
-  const int32_t words = (dim + 63) / 64;
-  // Row i: the coefficients of generator i's unit vector in the cycle basis (the inverse matrix).
-  std::vector<Z2Vector> to_cycle_basis(dim);
-  for (int32_t i = 0; i < dim; ++i) {
-    Z2Vector unit(dim);
-    unit.flip(i);
-    split.reduce(unit, to_cycle_basis[i]);
+  void to_cycle_coordinates() {
+    for (const auto& c : cycles) if (c.handle) ordered.push_back(&c);
+    for (const auto& c : cycles) if (!c.handle) ordered.push_back(&c);
+    for (const auto* c : ordered)
+      if (!split.insert(h.class_of_edges(c->edges)))
+        throw std::logic_error("the handle and tunnel cycles are not independent in H1");
+    to_cycle_basis.resize(dim);
+    for (int32_t i = 0; i < dim; ++i) {
+      Z2Vector unit(dim);
+      unit.flip(i);
+      split.reduce(unit, to_cycle_basis[i]);
+    }
   }
-  auto in_cycle_basis = [&](const Z2Vector& x) {
+
+  Z2Vector in_cycle_basis(const Z2Vector& x) const {
     Z2Vector c(dim);
     for (int32_t i = 0; i < dim; ++i)
       if (x.get(i)) c.add(to_cycle_basis[i]);
     return c;
-  };
-  // Each edge's coordinates, converted once.
-  std::vector<uint64_t> edge_class(size_t(words) * s.num_edges(), 0);
-  for (int32_t e = 0; e < s.num_edges(); ++e) {
-    uint64_t* out = &edge_class[size_t(words) * e];
-    h.for_each_crossing(e, [&](int32_t j, int) {
-      for (int32_t k = 0; k < words; ++k) out[k] ^= to_cycle_basis[j].words[k];
-    });
   }
-  auto add_edge = [&](uint64_t* x, int32_t e) {
+
+  // Each edge's coordinates, converted once.
+  void convert_edge_classes() {
+    edge_class.assign(size_t(words) * s.num_edges(), 0);
+    for (int32_t e = 0; e < s.num_edges(); ++e) {
+      uint64_t* x = &edge_class[size_t(words) * e];
+      h.for_each_crossing(e, [&](int32_t j, int) {
+        for (int32_t k = 0; k < words; ++k) x[k] ^= to_cycle_basis[j].words[k];
+      });
+    }
+  }
+
+  void add_edge(uint64_t* x, int32_t e) const {
     const uint64_t* c = &edge_class[size_t(words) * e];
     for (int32_t k = 0; k < words; ++k) x[k] ^= c[k];
-  };
-  auto kind_of = [&](const Z2Vector& c) {
+  }
+
+  int32_t kind_of(const Z2Vector& c) const {
     bool handle_part = false, tunnel_part = false;
     for (int32_t k = 0; k < words; ++k) {
       const uint64_t w = c.words[k];
@@ -180,66 +226,81 @@ std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomo
     }
     if (handle_part == tunnel_part) return int32_t(kNeither);  // mixed, or the zero class
     return handle_part ? int32_t(kHandle) : int32_t(kTunnel);
-  };
+  }
 
-  std::vector<Candidate> candidates;
-  int64_t order = 0;
   // The simple pieces of the persistence cycles.
-  for (const auto* c : ordered)
-    for (auto& loop : simple_cycles(s, c->edges)) {
-      Z2Vector cls = in_cycle_basis(h.class_of_loop(s, loop));
-      const int32_t kind = kind_of(cls);
-      if (kind == kNeither) continue;
-      const double length = loop_length(s, loop, weight);
-      candidates.push_back({length, kind, order++, std::move(loop), std::move(cls)});
-    }
+  void collect_cycle_pieces() {
+    for (const auto* c : ordered)
+      for (auto& loop : simple_cycles(s, c->edges)) {
+        Z2Vector cls = in_cycle_basis(h.class_of_loop(s, loop));
+        const int32_t kind = kind_of(cls);
+        if (kind == kNeither) continue;
+        const double length = loop_length(s, loop, weight);
+        candidates.push_back({length, kind, order++, std::move(loop), std::move(cls)});
+      }
+  }
 
-  // Roots: spread along each persistence cycle, then farthest-point samples.
-  std::vector<int32_t> roots;
-  std::vector<uint8_t> is_root(n, 0);
-  auto add_root = [&](int32_t v) {
+  void add_root(int32_t v) {
     if (!is_root[v]) {
       is_root[v] = 1;
       roots.push_back(v);
     }
-  };
-  // One root on every cycle before the second on any: the short loops of every handle appear
-  // early, so the cutoff below falls early.
-  for (const auto* c : ordered) add_root(s.edge_vertices[2 * size_t(c->generator_edge)]);
-  for (const auto* c : ordered) {
-    const size_t k = c->edges.size();
-    for (size_t i = 1; i <= 3 && k; ++i) add_root(s.edge_vertices[2 * size_t(c->edges[(i * k) / 4 % k])]);
   }
-  if (max_roots <= 0) max_roots = 12 + 4 * dim;
-  max_roots = std::min(max_roots, n);
 
-  ShortestPaths sp(s, weight);
-  std::vector<uint64_t> prefix(size_t(words) * n);
-  std::vector<double> nearest_root(n, ShortestPaths::kInfinity);
-  std::vector<uint32_t> mark(n, 0);
-  uint32_t mark_stamp = 0;
-  struct Local {
-    double bound;
-    int32_t edge, kind;
-  };
-  std::vector<Local> local;
+  // Roots: spread along each persistence cycle, then farthest-point samples (grow_from_roots).
+  // One root on every cycle before the second on any: the short loops of every handle appear
+  // early, so the cutoff falls early.
+  void seed_roots() {
+    is_root.assign(n, 0);
+    for (const auto* c : ordered) add_root(s.edge_vertices[2 * size_t(c->generator_edge)]);
+    for (const auto* c : ordered) {
+      const size_t k = c->edges.size();
+      for (size_t i = 1; i <= 3 && k; ++i) add_root(s.edge_vertices[2 * size_t(c->edges[(i * k) / 4 % k])]);
+    }
+    if (max_roots <= 0) max_roots = 12 + 4 * dim;
+    max_roots = std::min(max_roots, n);
+  }
+
   // No loop longer than `cutoff` can be chosen: the candidates found so far that are at most
   // that long already span both subspaces, and the final pick takes loops shortest first. So
   // each root only grows its tree to that distance and looks at the edges inside it, and longer
   // candidates are dropped: once every handle has a root nearby, a root costs what lies near it,
   // not the whole surface, and the selection grows about linearly with the genus.
-  double cutoff = ShortestPaths::kInfinity;
-  auto lower_cutoff = [&]() {
+  void lower_cutoff() {
     const auto picked = pick_shortest(candidates, dim, g);
     if (int32_t(picked[0].size()) < g || int32_t(picked[1].size()) < g) return;
     cutoff = std::max(picked[0].back()->length, picked[1].back()->length);
     while (!candidates.empty() && candidates.back().length > cutoff) candidates.pop_back();
-  };
-  for (size_t r = 0; r < roots.size() && int32_t(r) < max_roots; ++r) {
-    if (progress) progress->update(double(r) / max_roots);
-    const int32_t root = roots[r];
-    sp.run({root}, [](int32_t) { return true; }, [](int32_t) { return true; }, -1, cutoff);
-    // Class of the tree path from the root to each vertex.
+  }
+
+  // Per root: a shortest-path tree to the cutoff, the classes of its paths, and the
+  // fundamental cycles of its non-tree edges that extend a kind's basis.
+  void grow_from_roots() {
+    ShortestPaths sp(s, weight);
+    std::vector<uint64_t> prefix(size_t(words) * n);
+    std::vector<double> nearest_root(n, ShortestPaths::kInfinity);
+    std::vector<uint32_t> mark(n, 0);
+    std::vector<LocalCycle> local;
+    for (size_t r = 0; r < roots.size() && int32_t(r) < max_roots; ++r) {
+      if (progress) progress->update(double(r) / max_roots);
+      sp.run({roots[r]}, [](int32_t) { return true; }, [](int32_t) { return true; }, -1, cutoff);
+      path_classes(sp, prefix, nearest_root);
+      local_cycles(sp, prefix, local);
+      take_local_cycles(sp, prefix, local, mark);
+      // Often enough to follow the cutoff down, rarely enough that the picks cost little.
+      if ((r & (r + 1)) == 0 || r % 64 == 63) lower_cutoff();
+      // Next root: the persistence-cycle roots first, then the vertex farthest from all roots.
+      if (r + 1 == roots.size() && int32_t(roots.size()) < max_roots) {
+        int32_t far = -1;
+        for (int32_t v = 0; v < n; ++v)
+          if (!is_root[v] && (far < 0 || nearest_root[v] > nearest_root[far])) far = v;
+        if (far >= 0) add_root(far);
+      }
+    }
+  }
+
+  // Class of the tree path from the root to each settled vertex.
+  void path_classes(const ShortestPaths& sp, std::vector<uint64_t>& prefix, std::vector<double>& nearest_root) const {
     for (int32_t v : sp.settled()) {
       uint64_t* pv = &prefix[size_t(words) * v];
       const int32_t p = sp.parent(v);
@@ -251,8 +312,17 @@ std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomo
       }
       nearest_root[v] = std::min(nearest_root[v], sp.distance(v));
     }
-    // Fundamental cycles of the non-tree edges between settled vertices, shortest (through the
-    // root) first.
+  }
+
+  // The class of the fundamental cycle of non-tree edge e = (a, b), into cls.
+  void cycle_class(const std::vector<uint64_t>& prefix, int32_t a, int32_t b, int32_t e, Z2Vector& cls) const {
+    for (int32_t k = 0; k < words; ++k) cls.words[k] = prefix[size_t(words) * a + k] ^ prefix[size_t(words) * b + k];
+    add_edge(cls.words.data(), e);
+  }
+
+  // Fundamental cycles of the non-tree edges between settled vertices within the cutoff, of
+  // one kind, as a heap shortest (through the root) first.
+  void local_cycles(const ShortestPaths& sp, const std::vector<uint64_t>& prefix, std::vector<LocalCycle>& local) const {
     local.clear();
     Z2Vector cls(dim);
     for (int32_t a : sp.settled())
@@ -261,76 +331,83 @@ std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomo
         if (b < a || !sp.is_settled(b) || sp.parent_edge(a) == e || sp.parent_edge(b) == e) continue;
         const double bound = sp.distance(a) + weight[e] + sp.distance(b);
         if (bound > cutoff) continue;
-        for (int32_t k = 0; k < words; ++k) cls.words[k] = prefix[size_t(words) * a + k] ^ prefix[size_t(words) * b + k];
-        add_edge(cls.words.data(), e);
+        cycle_class(prefix, a, b, e, cls);
         const int32_t kind = kind_of(cls);
         if (kind != kNeither) local.push_back({bound, e, kind});
       }
-    // Taken shortest first from a heap: the loop below usually stops long before the end, so a
-    // full sort of every non-tree edge per root would be wasted (same order: the key is total).
-    auto later = [](const Local& x, const Local& y) { return std::tie(x.bound, x.edge) > std::tie(y.bound, y.edge); };
     std::make_heap(local.begin(), local.end(), later);
+  }
+
+  // Taken shortest first from a heap: the loop usually stops long before the end, so a full
+  // sort of every non-tree edge per root would be wasted (same order: the key is total).
+  static bool later(const LocalCycle& x, const LocalCycle& y) { return std::tie(x.bound, x.edge) > std::tie(y.bound, y.edge); }
+
+  // Adds as candidates the local cycles that extend their kind's basis at this root.
+  void take_local_cycles(const ShortestPaths& sp, const std::vector<uint64_t>& prefix, std::vector<LocalCycle>& local,
+                         std::vector<uint32_t>& mark) {
     Z2Basis kept[2] = {Z2Basis(dim), Z2Basis(dim)};
+    Z2Vector cls(dim);
     while (!local.empty()) {
       std::pop_heap(local.begin(), local.end(), later);
-      const Local c = local.back();
+      const LocalCycle c = local.back();
       local.pop_back();
       if (kept[c.kind].rank() == g) {
         if (kept[1 - c.kind].rank() == g) break;
         continue;
       }
       const int32_t a = s.edge_vertices[2 * size_t(c.edge)], b = s.edge_vertices[2 * size_t(c.edge) + 1];
-      for (int32_t k = 0; k < words; ++k) cls.words[k] = prefix[size_t(words) * a + k] ^ prefix[size_t(words) * b + k];
-      add_edge(cls.words.data(), c.edge);
+      cycle_class(prefix, a, b, c.edge, cls);
       if (!kept[c.kind].insert(cls)) continue;
-      // The simple cycle: tree paths from a and b up to their lowest common ancestor.
-      ++mark_stamp;
-      for (int32_t v = a; v >= 0; v = sp.parent(v)) mark[v] = mark_stamp;
-      int32_t lca = b;
-      while (mark[lca] != mark_stamp) lca = sp.parent(lca);
-      std::vector<int32_t> loop;
-      for (int32_t v = a; v != lca; v = sp.parent(v)) loop.push_back(v);
-      loop.push_back(lca);
-      std::reverse(loop.begin(), loop.end());  // lca ... a
-      std::vector<int32_t> down;
-      for (int32_t v = b; v != lca; v = sp.parent(v)) down.push_back(v);
-      loop.insert(loop.end(), down.begin(), down.end());  // then b ... (child of lca)
+      auto loop = tree_cycle(sp, a, b, mark);
       const double length = loop_length(s, loop, weight);
       candidates.push_back({length, c.kind, order++, std::move(loop), cls});
     }
-    // Often enough to follow the cutoff down, rarely enough that the picks cost little.
-    if ((r & (r + 1)) == 0 || r % 64 == 63) lower_cutoff();
-    // Next root: the persistence-cycle roots first, then the vertex farthest from all roots.
-    if (r + 1 == roots.size() && int32_t(roots.size()) < max_roots) {
-      int32_t far = -1;
-      for (int32_t v = 0; v < n; ++v)
-        if (!is_root[v] && (far < 0 || nearest_root[v] > nearest_root[far])) far = v;
-      if (far >= 0) add_root(far);
-    }
   }
 
-  // Shortest first, keep what extends the handle or the tunnel basis.
-  const auto picked = pick_shortest(candidates, dim, g);
-  if (int32_t(picked[0].size()) < g || int32_t(picked[1].size()) < g)
-    throw std::logic_error("found only " + std::to_string(picked[0].size()) + " handle and " +
-                           std::to_string(picked[1].size()) + " tunnel loops that are simple, of " + std::to_string(g));
+  // The simple cycle through non-tree edge (a, b): tree paths from a and b up to their lowest
+  // common ancestor, as lca ... a, then b ... (child of lca).
+  std::vector<int32_t> tree_cycle(const ShortestPaths& sp, int32_t a, int32_t b, std::vector<uint32_t>& mark) {
+    ++mark_stamp;
+    for (int32_t v = a; v >= 0; v = sp.parent(v)) mark[v] = mark_stamp;
+    int32_t lca = b;
+    while (mark[lca] != mark_stamp) lca = sp.parent(lca);
+    std::vector<int32_t> loop;
+    for (int32_t v = a; v != lca; v = sp.parent(v)) loop.push_back(v);
+    loop.push_back(lca);
+    std::reverse(loop.begin(), loop.end());
+    std::vector<int32_t> down;
+    for (int32_t v = b; v != lca; v = sp.parent(v)) down.push_back(v);
+    loop.insert(loop.end(), down.begin(), down.end());
+    return loop;
+  }
+  uint32_t mark_stamp = 0;
 
   // Match loops with generator edges through their coefficients in the persistence basis.
-  for (int32_t kind : {int32_t(kHandle), int32_t(kTunnel)}) {
-    std::vector<std::vector<uint8_t>> coefficient(g, std::vector<uint8_t>(g, 0));
-    for (int32_t k = 0; k < g; ++k)
-      for (int32_t i = 0; i < g; ++i) coefficient[k][i] = picked[kind][k]->cls.get(kind == kHandle ? i : g + i);
-    const auto cycle_of_loop = match(coefficient);
-    for (int32_t k = 0; k < g; ++k) {
-      SelectedLoop loop;
-      loop.handle = kind == kHandle;
-      loop.vertices = picked[kind][k]->vertices;
-      loop.length = picked[kind][k]->length;
-      loop.generator_edge = ordered[(kind == kHandle ? 0 : g) + cycle_of_loop[k]]->generator_edge;
-      out.push_back(std::move(loop));
+  std::vector<SelectedLoop> match_to_generators(const std::array<std::vector<const Candidate*>, 2>& picked) const {
+    std::vector<SelectedLoop> out;
+    for (int32_t kind : {int32_t(kHandle), int32_t(kTunnel)}) {
+      std::vector<std::vector<uint8_t>> coefficient(g, std::vector<uint8_t>(g, 0));
+      for (int32_t k = 0; k < g; ++k)
+        for (int32_t i = 0; i < g; ++i) coefficient[k][i] = picked[kind][k]->cls.get(kind == kHandle ? i : g + i);
+      const auto cycle_of_loop = match(coefficient);
+      for (int32_t k = 0; k < g; ++k) {
+        SelectedLoop loop;
+        loop.handle = kind == kHandle;
+        loop.vertices = picked[kind][k]->vertices;
+        loop.length = picked[kind][k]->length;
+        loop.generator_edge = ordered[(kind == kHandle ? 0 : g) + cycle_of_loop[k]]->generator_edge;
+        out.push_back(std::move(loop));
+      }
     }
+    return out;
   }
-  return out;
+};
+
+}  // namespace
+
+std::vector<SelectedLoop> select_loops(const ClosedSurface& s, const SurfaceHomology& h, const std::vector<PersistentCycle>& cycles,
+                                       const std::vector<double>& weight, int32_t max_roots, Progress* progress) {
+  return LoopSelection(s, h, cycles, weight, max_roots, progress).run();
 }
 
 }  // namespace topstoc
