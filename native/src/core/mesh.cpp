@@ -57,6 +57,226 @@ void sort_small(uint64_t* first, uint64_t* last) {
   }
 }
 
+// The arrays the first adjacency pass reads and writes (the Mesh's own, by reference).
+struct OneRingArrays {
+  const Buffer<int32_t>& faces;
+  const Buffer<int32_t>& face_source;
+  const Buffer<int32_t>& vertex_faces;
+  const Buffer<int32_t>& vfo;
+  const Buffer<double>& positions;
+  Buffer<int32_t>& scratch;  // each vertex's sorted neighbours, at twice its first face slot
+  Buffer<int32_t>& degree;
+  Buffer<int32_t>& greater;  // neighbours above the vertex
+  Buffer<int32_t>& euler;    // the vertex's share of V - E + F
+  Buffer<int32_t>& first_corner;
+  Buffer<double>& normals;
+  Buffer<uint8_t>& manifold_vertex;
+  SharedUnionFind& sets;  // components: each set's root is its lowest vertex
+};
+
+// What the first pass counts over the mesh (each edge at its lower end).
+struct OneRingCounts {
+  int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
+};
+
+// The first adjacency pass at one vertex, from its faces alone, with one thread's scratch
+// lists: the link (for each face (v, a, b) the arc a -> b) gives the sorted neighbours, the
+// triangles and directions of every edge at v and whether v is a manifold vertex; also the
+// area-weighted normal.
+class OneRingScan {
+ public:
+  explicit OneRingScan(const OneRingArrays& a) : a(a) {}
+
+  void scan(int32_t v, OneRingCounts& counts) {
+    const int32_t first = a.vfo[v], k = a.vfo[v + 1] - first;
+    a.manifold_vertex[v] = 1;
+    if (k == 0) {  // isolated: no neighbours, in no component
+      a.first_corner[v] = -1;
+      a.degree[v] = a.greater[v] = a.euler[v] = 0;
+      a.normals[3 * size_t(v)] = a.normals[3 * size_t(v) + 1] = a.normals[3 * size_t(v) + 2] = 0.0;
+      return;
+    }
+    const int32_t lowest_of = read_faces(v, first, k, counts.zero_area);
+    int32_t* neighbours = a.scratch.data() + 2 * size_t(first);
+    const int32_t d = sort_neighbours(neighbours);
+    const int32_t lower = int32_t(std::lower_bound(neighbours, neighbours + d, v) - neighbours);
+    a.degree[v] = d;
+    a.greater[v] = d - lower;
+    a.euler[v] = 1 - (d - lower) + lowest_of;
+    bool nonmanifold_edge = false, flipped = false;
+    count_edges(v, neighbours, d, lower, counts, nonmanifold_edge, flipped);
+    const int32_t fans = nonmanifold_edge ? 1 : count_fans(k, d, flipped);
+    if (fans > 1 || nonmanifold_edge || flipped) {
+      a.manifold_vertex[v] = 0;
+      if (fans > 1 && !nonmanifold_edge) ++counts.pinched;  // pinched, not merely on a bad edge
+    }
+  }
+
+ private:
+  const OneRingArrays& a;
+  std::vector<uint64_t> ends;  // (neighbour, 2 slot + (1 if the arc enters it))
+  std::vector<int32_t> end_rank, in, out, next;
+
+  // Reads v's k faces: the first corner, the normal, the link's arc ends; counts the faces v
+  // is the lowest vertex of (returned) and, among them, those of zero area.
+  int32_t read_faces(int32_t v, int32_t first, int32_t k, int32_t& zero_area) {
+    ends.resize(2 * size_t(k));
+    end_rank.resize(2 * size_t(k));
+    double sum[3] = {0, 0, 0};
+    int32_t lowest_of = 0;
+    for (int32_t i = 0; i < k; ++i) {
+      const int32_t* t = &a.faces[3 * size_t(a.vertex_faces[first + i])];
+      const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+      if (i == 0) a.first_corner[v] = 3 * a.face_source[a.vertex_faces[first]] + c;
+      // Area-weighted: the unnormalised face normal (twice the area) summed at each corner.
+      double fn[3];
+      cross(&a.positions[3 * size_t(t[0])], &a.positions[3 * size_t(t[1])], &a.positions[3 * size_t(t[2])], fn);
+      sum[0] += fn[0];
+      sum[1] += fn[1];
+      sum[2] += fn[2];
+      const int32_t p = t[(c + 1) % 3], q = t[(c + 2) % 3];
+      if (v < p && v < q) {
+        ++lowest_of;
+        if (fn[0] == 0.0 && fn[1] == 0.0 && fn[2] == 0.0) ++zero_area;
+      }
+      ends[2 * size_t(i)] = (uint64_t(uint32_t(p)) << 32) | uint32_t(2 * i);         // side v -> p
+      ends[2 * size_t(i) + 1] = (uint64_t(uint32_t(q)) << 32) | uint32_t(2 * i + 1);  // side q -> v
+    }
+    const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+    for (int j = 0; j < 3; ++j) a.normals[3 * size_t(v) + j] = len > 0 ? sum[j] / len : 0.0;
+    return lowest_of;
+  }
+
+  // The distinct neighbours in increasing order (returns how many), with the arcs entering
+  // and leaving each and every arc end's neighbour rank.
+  int32_t sort_neighbours(int32_t* neighbours) {
+    int32_t d = 0;
+    sort_small(ends.data(), ends.data() + ends.size());
+    in.clear(), out.clear();
+    for (const uint64_t end : ends) {
+      const int32_t u = int32_t(end >> 32), tag = int32_t(end & 0xffffffffu);
+      if (d == 0 || neighbours[d - 1] != u) {
+        neighbours[d++] = u;
+        in.push_back(0), out.push_back(0);
+      }
+      end_rank[tag] = d - 1;
+      if (tag & 1) ++in[d - 1];
+      else ++out[d - 1];
+    }
+    return d;
+  }
+
+  // Edge (v, u) has in + out triangles; two are consistent when they traverse it in opposite
+  // directions (one arc leaves u, one enters it). Each edge is counted at its lower end.
+  void count_edges(int32_t v, const int32_t* neighbours, int32_t d, int32_t lower, OneRingCounts& counts,
+                   bool& nonmanifold_edge, bool& flipped) {
+    for (int32_t r = 0; r < d; ++r) {
+      const int32_t count = in[r] + out[r];
+      const bool bad_direction = count == 2 && !(in[r] == 1 && out[r] == 1);
+      nonmanifold_edge |= count > 2;
+      flipped |= bad_direction;
+      if (r < lower) continue;
+      counts.boundary += count == 1;
+      counts.nonmanifold_edges += count >= 3;
+      counts.inconsistent += bad_direction;
+      a.sets.unite(v, neighbours[r]);
+    }
+  }
+
+  // Fans: with every edge at v on at most two triangles, consistently oriented, the arcs are
+  // paths and cycles, and one fan means exactly one of them (then 1, else 2). With flipped
+  // edges the fans are the groups of arcs that share a neighbour (their faces share that edge).
+  int32_t count_fans(int32_t k, int32_t d, bool flipped) {
+    next.assign(d, -1);
+    if (!flipped) {
+      int32_t start = 0, starts = 0;
+      for (int32_t i = 0; i < k; ++i) next[end_rank[2 * i]] = end_rank[2 * i + 1];
+      for (int32_t r = 0; r < d; ++r)
+        if (in[r] == 0) start = r, ++starts;
+      int32_t walked = 0;
+      if (starts <= 1)
+        for (int32_t x = start; walked <= k;) {
+          const int32_t w = next[x];
+          if (w < 0) break;  // end of a path
+          ++walked;
+          if (w == start) break;  // closed the cycle
+          x = w;
+        }
+      return walked == k ? 1 : 2;
+    }
+    for (int32_t r = 0; r < d; ++r) next[r] = r;  // a union-find over the neighbours
+    auto root = [&](int32_t x) {
+      while (next[x] != x) x = next[x] = next[next[x]];
+      return x;
+    };
+    int32_t fans = d;
+    for (int32_t i = 0; i < k; ++i) {
+      const int32_t x = root(end_rank[2 * i]), y = root(end_rank[2 * i + 1]);
+      if (x != y) next[std::max(x, y)] = std::min(x, y), --fans;
+    }
+    return fans;
+  }
+};
+
+// Second adjacency pass: the neighbours into place and the importance weight, which needs the
+// neighbours' normals from the first pass.
+void place_neighbours_and_weigh(const Buffer<int32_t>& scratch, const Buffer<int32_t>& vfo, const Buffer<int32_t>& offsets,
+                                const Buffer<double>& normals, Buffer<int32_t>& adjacency, Buffer<double>& weights) {
+  const int32_t n = int32_t(offsets.size()) - 1;
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) {
+    const int32_t d = offsets[v + 1] - offsets[v];
+    if (d == 0) {
+      weights[v] = 0.0;
+      continue;
+    }
+    const int32_t* neighbours = scratch.data() + 2 * size_t(vfo[v]);
+    std::copy(neighbours, neighbours + d, adjacency.begin() + offsets[v]);
+    // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
+    const double* nv = &normals[3 * size_t(v)];
+    double dots = 0.0;
+    for (int32_t r = 0; r < d; ++r) {
+      const double* nu = &normals[3 * size_t(neighbours[r])];
+      dots += nv[0] * nu[0] + nv[1] * nu[1] + nv[2] * nu[2];
+    }
+    weights[v] = std::clamp((double(d) - dots) / (2.0 * double(d)), 0.0, 1.0);
+  }
+}
+
+// Components, numbered in order of their lowest vertex (each set's root), and the Euler
+// characteristic V - E + F of each from every vertex's share: itself, the edges to its higher
+// neighbours and the faces it is the lowest vertex of. Returns how many; `root` is scratch.
+int32_t number_components(SharedUnionFind& sets, const Buffer<int32_t>& vfo, const Buffer<int32_t>& euler,
+                          Buffer<int32_t>& root, Buffer<int32_t>& component, Buffer<int64_t>& component_euler) {
+  const int32_t n = int32_t(vfo.size()) - 1;
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) root[v] = sets.find(v);
+  component.resize(n);
+  int32_t components = 0;
+  for (int32_t v = 0; v < n; ++v) {
+    if (vfo[v] == vfo[v + 1]) component[v] = -1;
+    else component[v] = root[v] == v ? components++ : component[root[v]];
+  }
+  component_euler.assign(components, 0);
+  for (int32_t v = 0; v < n; ++v)
+    if (component[v] >= 0) component_euler[component[v]] += euler[v];
+  return components;
+}
+
+// The mean weight over vertices with neighbours, summed in vertex order on one thread: an
+// OpenMP reduction adds in an order that depends on the number of threads, and so would
+// change the last bits of the result.
+double mean_of_weights(const Buffer<int32_t>& offsets, const Buffer<double>& weights) {
+  double total = 0.0;
+  int64_t counted = 0;
+  for (size_t v = 0; v + 1 < offsets.size(); ++v) {
+    if (offsets[v] == offsets[v + 1]) continue;
+    total += weights[v];
+    ++counted;
+  }
+  return counted ? total / double(counted) : 0.0;
+}
+
 }  // namespace
 
 Mesh::Mesh(const std::vector<double>& positions, const int32_t* triangles, int64_t num_triangles,
@@ -340,12 +560,9 @@ void Mesh::build_adjacency(Progress& progress) {
   progress.stage("adjacency", 0.45, 0.8);
   const int32_t n = num_vertices_;
   const auto& vfo = vertex_face_offsets_;
-  // First pass, per vertex, from its faces alone: the link (for each face (v, a, b) the arc
-  // a -> b) gives the sorted neighbours, the triangles and directions of every edge at v (each
-  // edge counted at its lower end) and whether v is a manifold vertex; also the normal.
-  // Neighbours wait in `scratch` (at twice the vertex's first face slot: it has at most two
-  // per face) until the offsets are known. Edge ids and tables come later, on demand
-  // (build_edges).
+  // First pass, per vertex, from its faces alone (OneRingScan). Neighbours wait in `scratch`
+  // (at twice the vertex's first face slot: it has at most two per face) until the offsets are
+  // known. Edge ids and tables come later, on demand (build_edges).
   // Buffers are written on the threads that fill them (see core/buffer.hpp): every entry a loop
   // skips is set explicitly.
   Buffer<int32_t> scratch(2 * vertex_faces_.size());
@@ -354,117 +571,18 @@ void Mesh::build_adjacency(Progress& progress) {
   normals_.resize(3 * size_t(n));
   manifold_vertex_.resize(n);
   first_corner_.resize(n);
-  SharedUnionFind sets(n);  // components: each set's root is its lowest vertex
+  SharedUnionFind sets(n);
+  const OneRingArrays arrays{faces_, face_source_, vertex_faces_, vfo, positions_, scratch, degree, greater,
+                             euler, first_corner_, normals_, manifold_vertex_, sets};
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
 #pragma omp parallel reduction(+ : boundary, nonmanifold_edges, inconsistent, pinched, zero_area) if (n >= kParallelMin)
   {
-    std::vector<uint64_t> ends;                   // (neighbour, 2 slot + (1 if the arc enters it))
-    std::vector<int32_t> end_rank, in, out, next;
+    OneRingScan scan(arrays);
+    OneRingCounts mine;
 #pragma omp for schedule(static)
-    for (int32_t v = 0; v < n; ++v) {
-      const int32_t first = vfo[v], k = vfo[v + 1] - first;
-      manifold_vertex_[v] = 1;
-      if (k == 0) {  // isolated: no neighbours, in no component
-        first_corner_[v] = -1;
-        degree[v] = greater[v] = euler[v] = 0;
-        normals_[3 * size_t(v)] = normals_[3 * size_t(v) + 1] = normals_[3 * size_t(v) + 2] = 0.0;
-        continue;
-      }
-      ends.resize(2 * size_t(k));
-      end_rank.resize(2 * size_t(k));
-      double sum[3] = {0, 0, 0};
-      int32_t lowest_of = 0;  // faces whose lowest vertex is v
-      for (int32_t i = 0; i < k; ++i) {
-        const int32_t* t = &faces_[3 * size_t(vertex_faces_[first + i])];
-        const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-        if (i == 0) first_corner_[v] = 3 * face_source_[vertex_faces_[first]] + c;
-        // Area-weighted: the unnormalised face normal (twice the area) summed at each corner.
-        double fn[3];
-        cross(position(t[0]), position(t[1]), position(t[2]), fn);
-        sum[0] += fn[0];
-        sum[1] += fn[1];
-        sum[2] += fn[2];
-        const int32_t a = t[(c + 1) % 3], b = t[(c + 2) % 3];
-        if (v < a && v < b) {
-          ++lowest_of;
-          if (fn[0] == 0.0 && fn[1] == 0.0 && fn[2] == 0.0) ++zero_area;
-        }
-        ends[2 * size_t(i)] = (uint64_t(uint32_t(a)) << 32) | uint32_t(2 * i);         // side v -> a
-        ends[2 * size_t(i) + 1] = (uint64_t(uint32_t(b)) << 32) | uint32_t(2 * i + 1);  // side b -> v
-      }
-      const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
-      for (int j = 0; j < 3; ++j) normals_[3 * size_t(v) + j] = len > 0 ? sum[j] / len : 0.0;
-      int32_t* neighbours = scratch.data() + 2 * size_t(first);
-      int32_t d = 0;
-      sort_small(ends.data(), ends.data() + ends.size());
-      in.clear(), out.clear();
-      for (const uint64_t end : ends) {
-        const int32_t u = int32_t(end >> 32), tag = int32_t(end & 0xffffffffu);
-        if (d == 0 || neighbours[d - 1] != u) {
-          neighbours[d++] = u;
-          in.push_back(0), out.push_back(0);
-        }
-        end_rank[tag] = d - 1;
-        if (tag & 1) ++in[d - 1];
-        else ++out[d - 1];
-      }
-      const int32_t lower = int32_t(std::lower_bound(neighbours, neighbours + d, v) - neighbours);
-      degree[v] = d;
-      greater[v] = d - lower;
-      euler[v] = 1 - (d - lower) + lowest_of;
-      // Edge (v, u) has in + out triangles; two are consistent when they traverse it in opposite
-      // directions (one arc leaves u, one enters it). Each edge is counted at its lower end.
-      bool nonmanifold_edge = false, flipped = false;
-      for (int32_t r = 0; r < d; ++r) {
-        const int32_t count = in[r] + out[r];
-        const bool bad_direction = count == 2 && !(in[r] == 1 && out[r] == 1);
-        nonmanifold_edge |= count > 2;
-        flipped |= bad_direction;
-        if (r < lower) continue;
-        boundary += count == 1;
-        nonmanifold_edges += count >= 3;
-        inconsistent += bad_direction;
-        sets.unite(v, neighbours[r]);
-      }
-      // Fans: with every edge at v on at most two triangles, consistently oriented, the arcs are
-      // paths and cycles, and one fan means exactly one of them. With flipped edges the fans are
-      // the groups of arcs that share a neighbour (their faces share that edge).
-      int32_t fans = 1;
-      if (!nonmanifold_edge) {
-        next.assign(d, -1);
-        if (!flipped) {
-          int32_t start = 0, starts = 0;
-          for (int32_t i = 0; i < k; ++i) next[end_rank[2 * i]] = end_rank[2 * i + 1];
-          for (int32_t r = 0; r < d; ++r)
-            if (in[r] == 0) start = r, ++starts;
-          int32_t walked = 0;
-          if (starts <= 1)
-            for (int32_t x = start; walked <= k;) {
-              const int32_t w = next[x];
-              if (w < 0) break;  // end of a path
-              ++walked;
-              if (w == start) break;  // closed the cycle
-              x = w;
-            }
-          fans = walked == k ? 1 : 2;
-        } else {
-          for (int32_t r = 0; r < d; ++r) next[r] = r;  // a union-find over the neighbours
-          auto root = [&](int32_t x) {
-            while (next[x] != x) x = next[x] = next[next[x]];
-            return x;
-          };
-          fans = d;
-          for (int32_t i = 0; i < k; ++i) {
-            const int32_t x = root(end_rank[2 * i]), y = root(end_rank[2 * i + 1]);
-            if (x != y) next[std::max(x, y)] = std::min(x, y), --fans;
-          }
-        }
-      }
-      if (fans > 1 || nonmanifold_edge || flipped) {
-        manifold_vertex_[v] = 0;
-        if (fans > 1 && !nonmanifold_edge) ++pinched;  // pinched, not merely on a bad edge
-      }
-    }
+    for (int32_t v = 0; v < n; ++v) scan.scan(v, mine);
+    boundary += mine.boundary, nonmanifold_edges += mine.nonmanifold_edges, inconsistent += mine.inconsistent;
+    pinched += mine.pinched, zero_area += mine.zero_area;
   }
   report_.boundary_edges = boundary;
   report_.nonmanifold_edges = nonmanifold_edges;
@@ -480,55 +598,11 @@ void Mesh::build_adjacency(Progress& progress) {
   weights_.resize(n);
 
   progress.stage("normals and weights", 0.8, 0.92);
-  // Second pass: the neighbours into place and the importance weight, which needs the
-  // neighbours' normals from the first pass.
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
-    const int32_t d = adjacency_offsets_[v + 1] - adjacency_offsets_[v];
-    if (d == 0) {
-      weights_[v] = 0.0;
-      continue;
-    }
-    const int32_t* neighbours = scratch.data() + 2 * size_t(vfo[v]);
-    std::copy(neighbours, neighbours + d, adjacency_.begin() + adjacency_offsets_[v]);
-    // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
-    const double* nv = &normals_[3 * size_t(v)];
-    double dots = 0.0;
-    for (int32_t r = 0; r < d; ++r) {
-      const double* nu = &normals_[3 * size_t(neighbours[r])];
-      dots += nv[0] * nu[0] + nv[1] * nu[1] + nv[2] * nu[2];
-    }
-    weights_[v] = std::clamp((double(d) - dots) / (2.0 * double(d)), 0.0, 1.0);
-  }
-
+  place_neighbours_and_weigh(scratch, vfo, adjacency_offsets_, normals_, adjacency_, weights_);
   progress.stage("components", 0.92, 1.0);
-  // Components, numbered in order of their lowest vertex (each set's root), and the Euler
-  // characteristic V - E + F of each from every vertex's share: itself, the edges to its higher
-  // neighbours and the faces it is the lowest vertex of.
   Buffer<int32_t>& root = greater;  // its offsets are no longer needed
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) root[v] = sets.find(v);
-  component_.resize(n);
-  int32_t components = 0;
-  for (int32_t v = 0; v < n; ++v) {
-    if (vfo[v] == vfo[v + 1]) component_[v] = -1;
-    else component_[v] = root[v] == v ? components++ : component_[root[v]];
-  }
-  report_.components = components;
-  component_euler_.assign(components, 0);
-  for (int32_t v = 0; v < n; ++v)
-    if (component_[v] >= 0) component_euler_[component_[v]] += euler[v];
-
-  // The mean is summed in vertex order on one thread: an OpenMP reduction adds in an order that
-  // depends on the number of threads, and so would change the last bits of the result.
-  double total = 0.0;
-  int64_t counted = 0;
-  for (int32_t v = 0; v < n; ++v) {
-    if (adjacency_offsets_[v] == adjacency_offsets_[v + 1]) continue;
-    total += weights_[v];
-    ++counted;
-  }
-  mean_weight_ = counted ? total / double(counted) : 0.0;
+  report_.components = number_components(sets, vfo, euler, root, component_, component_euler_);
+  mean_weight_ = mean_of_weights(adjacency_offsets_, weights_);
 }
 
 // Apart from the one-ring pass: three square roots and divisions per face were a sixth of that
