@@ -263,45 +263,65 @@ std::vector<int32_t> widest_clusters(const Clustering& c, const std::vector<uint
   return ranks;
 }
 
-DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
-                                Placement placement, int32_t max_rounds, bool repair_slivers, bool fast_path,
-                                const std::vector<uint8_t>& avoid, const std::vector<uint8_t>& required,
-                                int32_t top_up_to, FloodCache* cache, bool draft, DecimateResult result) {
-  auto start = Clock::now();
+// One clustering of a decimation: the flood (fresh, or updated from the cache), then rounds of
+// checks, each followed by repairs (samples added where the check names a problem) or, once
+// clean, by top-ups towards the target. The stages run in the order of run().
+class ClusterRun {
+ public:
+  ClusterRun(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples, int32_t max_rounds,
+             bool repair_slivers, bool fast_path, const std::vector<uint8_t>& avoid, const std::vector<uint8_t>& required,
+             int32_t top_up_to, FloodCache* cache, DecimateResult result)
+      : mesh(mesh), layout(layout), max_rounds(max_rounds), repair_slivers(repair_slivers), fast_path(fast_path),
+        avoid(avoid), required(required), top_up_to(top_up_to), cache(cache), samples(std::move(samples)),
+        result(std::move(result)) {}
+
+  DecimateResult run(Placement placement, bool draft) {
+    auto start = Clock::now();
+    if (cache && cache->holds(mesh, layout) && cache->worth_updating(samples)) update_cached_flood();
+    else flood_afresh();
+    result.seconds_clustering = seconds_since(start);
+    result.fast_path = fast_path;
+    start = Clock::now();
+    for (int32_t round = 0;; ++round) {
+      const bool slivers = repair_slivers && round < kSliverRounds;
+      check(round, slivers);
+      accumulate(result.issues_found, partition.issues);
+      const bool clean = partition.issues.topological() == 0 && (!slivers || partition.issues.sliver == 0);
+      std::vector<int32_t> to_split = partition.split_clusters;
+      if (clean && !plan_top_up(to_split)) break;
+      std::vector<int32_t> added = samples_to_add(clean, to_split);
+      // Components no sample reached get one before anything else can be checked; that is not
+      // a repair round (without it max_repair_rounds = 0 returned an empty mesh).
+      const bool seeding = partition.issues.unreached > 0;
+      if (added.empty() || (round >= max_rounds && !seeding)) {
+        result.issues_remaining = partition.issues;
+        if (!slivers) result.issues_remaining.sliver = 0;
+        break;
+      }
+      add_samples(added, clean, seeding);
+      if (seeding && !clean) --round;  // does not use up a repair round
+    }
+    // Zero-area triangles left after the repair rounds are reported, not hidden.
+    if (partition.issues.sliver > 0 && partition.issues.topological() == 0)
+      result.issues_remaining.sliver = partition.issues.sliver;
+    result.seconds_checking = seconds_since(start);
+    return finish(mesh, layout, std::move(samples), clustering, partition, placement, draft, std::move(result));
+  }
+
+ private:
+  const Mesh& mesh;
+  const FeatureLayout& layout;
+  const int32_t max_rounds;
+  const bool repair_slivers, fast_path;
+  const std::vector<uint8_t>& avoid;
+  const std::vector<uint8_t>& required;
+  const int32_t top_up_to;
+  FloodCache* cache;  // until the first check is handed to it
+  std::vector<int32_t> samples;
+  DecimateResult result;
   Clustering clustering;
   std::vector<int32_t> cross_edges;
   CheckState checked;  // later rounds re-test only what the relabelled vertices changed
-  if (cache && cache->holds(mesh, layout) && cache->worth_updating(samples)) {
-    // The cached flood becomes this one (the same keys a fresh flood gives); the first check
-    // then re-tests only the faces around the vertices that changed. The cache keeps the
-    // flood without the repairs below.
-    // The first check of the cached flood, given back after this one's, updated. In the new
-    // ranks, its triangles are taken over except around the vertices that changed (whose old
-    // ranks may be gone; zero-area flags: the same vertices, same areas), and its per-sample
-    // findings except for the samples whose triangles changed.
-    checked = std::move(cache->first_check);
-    cache->first_check = CheckState();
-    checked.changed.clear();
-    std::vector<int32_t> new_rank;
-    flood_update(mesh, layout, cache->samples, samples, cache->clustering, &checked.changed, &new_rank);
-    cache->samples = samples;
-    clustering = cache->clustering;
-    checked.renumber(new_rank, int32_t(samples.size()));
-    if (!checked.valid) checked.changed.clear();  // every face is tested
-    result.flood_updated = true;
-  } else {
-    flood(mesh, layout, samples, clustering, fast_path ? &cross_edges : nullptr);
-    if (cache) {
-      cache->mesh = mesh.serial();
-      cache->layout = layout.serial;
-      cache->samples = samples;
-      cache->clustering = clustering;
-      cache->first_check = CheckState();
-    }
-  }
-  result.seconds_clustering = seconds_since(start);
-  result.fast_path = fast_path;
-  start = Clock::now();
   Partition partition;
   // The last few top-up samples can overshoot (a split may revive an absorbed neighbour): then
   // the state before them is restored and the next widest clusters are tried instead.
@@ -312,23 +332,41 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     std::vector<int32_t> tried;
     bool active = false;
   } snapshot;
-  for (int32_t round = 0;; ++round) {
-    const bool slivers = repair_slivers && round < kSliverRounds;
+
+  // The cached flood becomes this one (the same keys a fresh flood gives); the first check
+  // then re-tests only the faces around the vertices that changed. The cache keeps the flood
+  // without the repairs below.
+  // The first check of the cached flood, given back after this one's, updated. In the new
+  // ranks, its triangles are taken over except around the vertices that changed (whose old
+  // ranks may be gone; zero-area flags: the same vertices, same areas), and its per-sample
+  // findings except for the samples whose triangles changed.
+  void update_cached_flood() {
+    checked = std::move(cache->first_check);
+    cache->first_check = CheckState();
+    checked.changed.clear();
+    std::vector<int32_t> new_rank;
+    flood_update(mesh, layout, cache->samples, samples, cache->clustering, &checked.changed, &new_rank);
+    cache->samples = samples;
+    clustering = cache->clustering;
+    checked.renumber(new_rank, int32_t(samples.size()));
+    if (!checked.valid) checked.changed.clear();  // every face is tested
+    result.flood_updated = true;
+  }
+
+  void flood_afresh() {
+    flood(mesh, layout, samples, clustering, fast_path ? &cross_edges : nullptr);
+    if (!cache) return;
+    cache->mesh = mesh.serial();
+    cache->layout = layout.serial;
+    cache->samples = samples;
+    cache->clustering = clustering;
+    cache->first_check = CheckState();
+  }
+
+  // One round's partition check; the first check goes to the cache too.
+  void check(int32_t round, bool slivers) {
     if (round == 0 && fast_path) {
-      // Only faces around cluster borders can hold three clusters; keep them in face order.
-      std::vector<uint8_t> near_border(mesh.num_faces(), 0);
-      const auto& efo = mesh.edge_face_offsets();
-      const auto& ef = mesh.edge_faces();
-      for (int32_t e : cross_edges)
-        for (int32_t j = efo[e]; j < efo[e + 1]; ++j) near_border[ef[j]] = 1;
-      // The flood does not step between two samples along a feature edge, so such an edge
-      // is not among the crossings: a triangle bounded by features (a crease corner on a
-      // small mesh) could be missed and its output triangle lost. Feature faces are few.
-      for (int32_t e : layout.feature_edges)
-        for (int32_t j = efo[e]; j < efo[e + 1]; ++j) near_border[ef[j]] = 1;
-      std::vector<int32_t> candidates;
-      for (int32_t f = 0; f < mesh.num_faces(); ++f)
-        if (near_border[f]) candidates.push_back(f);
+      const auto candidates = faces_near_borders();
       partition = check_partition(mesh, layout, samples, clustering, required, slivers, &candidates, &checked);
     } else {
       partition = check_partition(mesh, layout, samples, clustering, required, slivers, nullptr, &checked);
@@ -340,45 +378,68 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       cache->first_check.keep_complete();
       cache = nullptr;
     }
-    accumulate(result.issues_found, partition.issues);
-    const bool clean = partition.issues.topological() == 0 && (!slivers || partition.issues.sliver == 0);
-    std::vector<int32_t> to_split = partition.split_clusters;
-    if (clean) {
-      // Exact budget: absorbed clusters leave the output, so a clean result can fall short of
-      // the target. Split the widest clusters at their farthest vertex until it is met.
-      const int32_t kept = int32_t(samples.size()) - partition.issues.absorbed;
-      if (snapshot.active && kept > top_up_to && snapshot.tried.size() < kMaxTopUpRetries) {
-        samples.resize(snapshot.samples);
-        clustering = snapshot.clustering;
-        checked = CheckState();
-        result.repair_rounds = snapshot.repair_rounds;
-        result.repairs = snapshot.repairs;
-        result.top_up = snapshot.top_up;
-        partition = check_partition(mesh, layout, samples, clustering, required, false, nullptr, &checked);
-      } else if (top_up_to <= 0 || kept >= top_up_to - budget_tolerance(top_up_to) ||
-                 result.top_up_rounds >= kMaxTopUpRounds) {
-        break;
-      } else {
-        snapshot = Snapshot();
-      }
-      int32_t need = top_up_to - (int32_t(samples.size()) - partition.issues.absorbed);
-      // Some new samples get absorbed in turn: ask for that many more, so that one round
-      // usually lands on the target (a small overshoot stays within the budget tolerance).
-      if (need > kSmallTopUp)
-        need += int32_t(std::ceil(1.5 * need * double(partition.issues.absorbed) / double(samples.size())));
-      if (need <= kSmallTopUp && !snapshot.active) {
-        snapshot.active = true;
-        snapshot.samples = samples.size();
-        snapshot.clustering = clustering;
-        snapshot.repair_rounds = result.repair_rounds;
-        snapshot.repairs = result.repairs;
-        snapshot.top_up = result.top_up;
-      }
-      to_split = widest_clusters(clustering, partition.absorbed, need, snapshot.tried);
-      if (snapshot.active) snapshot.tried.insert(snapshot.tried.end(), to_split.begin(), to_split.end());
-      if (to_split.empty()) break;
-      ++result.top_up_rounds;
+  }
+
+  // Only faces around cluster borders can hold three clusters; in face order.
+  std::vector<int32_t> faces_near_borders() const {
+    std::vector<uint8_t> near_border(mesh.num_faces(), 0);
+    const auto& efo = mesh.edge_face_offsets();
+    const auto& ef = mesh.edge_faces();
+    for (int32_t e : cross_edges)
+      for (int32_t j = efo[e]; j < efo[e + 1]; ++j) near_border[ef[j]] = 1;
+    // The flood does not step between two samples along a feature edge, so such an edge is
+    // not among the crossings: a triangle bounded by features (a crease corner on a small
+    // mesh) could be missed and its output triangle lost. Feature faces are few.
+    for (int32_t e : layout.feature_edges)
+      for (int32_t j = efo[e]; j < efo[e + 1]; ++j) near_border[ef[j]] = 1;
+    std::vector<int32_t> candidates;
+    for (int32_t f = 0; f < mesh.num_faces(); ++f)
+      if (near_border[f]) candidates.push_back(f);
+    return candidates;
+  }
+
+  // Exact budget: absorbed clusters leave the output, so a clean result can fall short of the
+  // target. Names in `to_split` the widest clusters to split at their farthest vertex; false
+  // when the result is final.
+  bool plan_top_up(std::vector<int32_t>& to_split) {
+    const int32_t kept = int32_t(samples.size()) - partition.issues.absorbed;
+    if (snapshot.active && kept > top_up_to && snapshot.tried.size() < kMaxTopUpRetries) {
+      samples.resize(snapshot.samples);
+      clustering = snapshot.clustering;
+      checked = CheckState();
+      result.repair_rounds = snapshot.repair_rounds;
+      result.repairs = snapshot.repairs;
+      result.top_up = snapshot.top_up;
+      partition = check_partition(mesh, layout, samples, clustering, required, false, nullptr, &checked);
+    } else if (top_up_to <= 0 || kept >= top_up_to - budget_tolerance(top_up_to) ||
+               result.top_up_rounds >= kMaxTopUpRounds) {
+      return false;
+    } else {
+      snapshot = Snapshot();
     }
+    int32_t need = top_up_to - (int32_t(samples.size()) - partition.issues.absorbed);
+    // Some new samples get absorbed in turn: ask for that many more, so that one round
+    // usually lands on the target (a small overshoot stays within the budget tolerance).
+    if (need > kSmallTopUp)
+      need += int32_t(std::ceil(1.5 * need * double(partition.issues.absorbed) / double(samples.size())));
+    if (need <= kSmallTopUp && !snapshot.active) {
+      snapshot.active = true;
+      snapshot.samples = samples.size();
+      snapshot.clustering = clustering;
+      snapshot.repair_rounds = result.repair_rounds;
+      snapshot.repairs = result.repairs;
+      snapshot.top_up = result.top_up;
+    }
+    to_split = widest_clusters(clustering, partition.absorbed, need, snapshot.tried);
+    if (snapshot.active) snapshot.tried.insert(snapshot.tried.end(), to_split.begin(), to_split.end());
+    if (to_split.empty()) return false;
+    ++result.top_up_rounds;
+    return true;
+  }
+
+  // The vertices to add as samples: those the check named, and a splitting vertex of each
+  // cluster to split; each once, none already a sample.
+  std::vector<int32_t> samples_to_add(bool clean, const std::vector<int32_t>& to_split) const {
     std::vector<int32_t> added = clean ? std::vector<int32_t>() : partition.new_samples;
     const auto split = splitting_vertices(mesh, clustering, samples, to_split, avoid);
     added.insert(added.end(), split.begin(), split.end());
@@ -386,47 +447,48 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
     added.erase(std::unique(added.begin(), added.end()), added.end());
     added.erase(std::remove_if(added.begin(), added.end(), [&](int32_t v) { return clustering.dist(v) == 0; }),
                 added.end());
-    if (added.empty() && !clean) {
-      // Every cluster named is a single vertex and so are its neighbours (seen with creases
-      // cutting a small mesh into short curves): the round would end with the issue reported.
-      // Sample the vertices next to the named clusters instead, or failing that the widest
-      // clusters anywhere; more samples always converge (all of them give the input back).
-      // Not in components with a non-manifold edge: an issue there (a fin) is in the input
-      // itself, and chasing it would sample the whole mesh. (Pinched vertices are repairable:
-      // each fan gets its own clusters.)
-      std::vector<uint8_t> manifold_component(mesh.num_components(), 1);
-      for (int32_t e = 0; e < int32_t(mesh.edge_vertices().size() / 2); ++e)
-        if (mesh.edge_face_count(e) > 2) manifold_component[mesh.component()[mesh.edge_vertices()[2 * size_t(e)]]] = 0;
-      std::vector<uint8_t> named(samples.size(), 0);
-      bool any_named = false;
-      for (int32_t s : partition.split_clusters)
-        if (manifold_component[mesh.component()[samples[s]]]) named[s] = 1, any_named = true;
-      const auto& ao = mesh.adjacency_offsets();
-      const auto& adj = mesh.adjacency();
-      for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-        if (clustering.label(v) < 0 || clustering.dist(v) == 0) continue;
-        for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
-          const int32_t l = clustering.label(adj[i]);
-          if (l >= 0 && named[l]) {
-            added.push_back(v);
-            break;
-          }
+    if (added.empty() && !clean) added = samples_next_to_named();
+    return added;
+  }
+
+  // Every cluster named is a single vertex and so are its neighbours (seen with creases
+  // cutting a small mesh into short curves): the round would end with the issue reported.
+  // Sample the vertices next to the named clusters instead, or failing that the widest
+  // clusters anywhere; more samples always converge (all of them give the input back).
+  // Not in components with a non-manifold edge: an issue there (a fin) is in the input
+  // itself, and chasing it would sample the whole mesh. (Pinched vertices are repairable:
+  // each fan gets its own clusters.)
+  std::vector<int32_t> samples_next_to_named() const {
+    std::vector<int32_t> added;
+    std::vector<uint8_t> manifold_component(mesh.num_components(), 1);
+    for (int32_t e = 0; e < int32_t(mesh.edge_vertices().size() / 2); ++e)
+      if (mesh.edge_face_count(e) > 2) manifold_component[mesh.component()[mesh.edge_vertices()[2 * size_t(e)]]] = 0;
+    std::vector<uint8_t> named(samples.size(), 0);
+    bool any_named = false;
+    for (int32_t s : partition.split_clusters)
+      if (manifold_component[mesh.component()[samples[s]]]) named[s] = 1, any_named = true;
+    const auto& ao = mesh.adjacency_offsets();
+    const auto& adj = mesh.adjacency();
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+      if (clustering.label(v) < 0 || clustering.dist(v) == 0) continue;
+      for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
+        const int32_t l = clustering.label(adj[i]);
+        if (l >= 0 && named[l]) {
+          added.push_back(v);
+          break;
         }
       }
-      if (added.empty() && any_named) {
-        const auto widest = widest_clusters(clustering, partition.absorbed,
-                                            std::max<int32_t>(4, int32_t(samples.size()) / 8), {});
-        added = splitting_vertices(mesh, clustering, samples, widest, avoid);
-      }
     }
-    // Components no sample reached get one before anything else can be checked; that is not
-    // a repair round (without it max_repair_rounds = 0 returned an empty mesh).
-    const bool seeding = partition.issues.unreached > 0;
-    if (added.empty() || (round >= max_rounds && !seeding)) {
-      result.issues_remaining = partition.issues;
-      if (!slivers) result.issues_remaining.sliver = 0;
-      break;
+    if (added.empty() && any_named) {
+      const auto widest = widest_clusters(clustering, partition.absorbed,
+                                          std::max<int32_t>(4, int32_t(samples.size()) / 8), {});
+      added = splitting_vertices(mesh, clustering, samples, widest, avoid);
     }
+    return added;
+  }
+
+  // Floods from the added samples and counts them as a top-up, a seeding or a repair round.
+  void add_samples(const std::vector<int32_t>& added, bool clean, bool seeding) {
     const int32_t first_new = static_cast<int32_t>(samples.size());
     samples.insert(samples.end(), added.begin(), added.end());
     flood_add(mesh, layout, samples, first_new, clustering, &checked.changed);
@@ -434,17 +496,20 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
       result.top_up += static_cast<int32_t>(added.size());
     } else if (seeding) {
       result.repairs += static_cast<int32_t>(added.size());
-      --round;  // does not use up a repair round
     } else {
       result.repair_rounds += 1;
       result.repairs += static_cast<int32_t>(added.size());
     }
   }
-  // Zero-area triangles left after the repair rounds are reported, not hidden.
-  if (partition.issues.sliver > 0 && partition.issues.topological() == 0)
-    result.issues_remaining.sliver = partition.issues.sliver;
-  result.seconds_checking = seconds_since(start);
-  return finish(mesh, layout, std::move(samples), clustering, partition, placement, draft, std::move(result));
+};
+
+DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
+                                Placement placement, int32_t max_rounds, bool repair_slivers, bool fast_path,
+                                const std::vector<uint8_t>& avoid, const std::vector<uint8_t>& required,
+                                int32_t top_up_to, FloodCache* cache, bool draft, DecimateResult result) {
+  return ClusterRun(mesh, layout, std::move(samples), max_rounds, repair_slivers, fast_path, avoid, required, top_up_to,
+                    cache, std::move(result))
+      .run(placement, draft);
 }
 
 // The final check (verify.hpp): a result whose repairs left no issue must pass it; otherwise
