@@ -134,7 +134,8 @@ def _top_level_paren(head):
             if depth == 0:
                 before = head[:k].rstrip()
                 if before.endswith("operator"):
-                    continue  # operator() — its parameters come in the next '('
+                    depth += 1  # operator() — its parameters come in the next '('
+                    continue
                 if _NAME.search(before):
                     return k
             depth += 1

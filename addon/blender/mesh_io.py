@@ -57,7 +57,7 @@ class MeshArrays:
     For a mesh of triangles stored in loop order (Blender's usual layout) the triangles are the
     polygons and their corners the loops in order: ``triangle_polygon`` and ``triangle_loops``
     are then made when first read (``None`` given), since the Live Preview's start, which reads
-    the mesh on the main thread, rarely needs them (two arrays of 6 and 19 MB on the horse)."""
+    the mesh on the main thread, rarely needs them (two arrays of 4 and 12 bytes a triangle)."""
 
     vertices: np.ndarray          #: (n, 3) float64
     triangles: np.ndarray         #: (m, 3) int32 vertex ids (loop triangles)
@@ -132,8 +132,7 @@ def attribute_for_write(mesh, name: str, data_type: str, domain: str):
 def _position_attribute(mesh):
     """The "position" attribute where Blender keeps positions as a plain float3 array (3.5+).
     Its foreach_get/set copy the array at once; MeshVertex.co goes through RNA one vertex at a time
-    there (the 780k-vertex horse in 4.5 and 5.0: 26-45 ms to read and 66-74 ms to write through
-    ``co``, under 1 ms through the attribute)."""
+    there, tens of times slower."""
     if bpy.app.version < (3, 5, 0):  # positions live in MVert; a layer of that name is the user's
         return None
     return _typed_attribute(mesh, "position", "POINT", "FLOAT_VECTOR")
@@ -160,7 +159,7 @@ def write_positions(mesh, vertices: np.ndarray) -> None:
 
 def write_polygon_materials(mesh, materials: np.ndarray) -> None:
     """Sets every polygon's material slot: the "material_index" attribute in 4.0+, where
-    MeshPolygon.material_index goes one polygon at a time (225 ms for 1.55M in 4.5)."""
+    MeshPolygon.material_index goes one polygon at a time."""
     values = np.ascontiguousarray(materials, dtype=np.int32)
     if bpy.app.version >= (4, 0, 0):
         attribute_for_write(mesh, "material_index", "INT", "FACE").data.foreach_set("value", values)
@@ -263,8 +262,8 @@ def read_edges(mesh: bpy.types.Mesh, flag: str) -> np.ndarray:
     """(k, 2) vertex pairs of the edges whose boolean ``flag`` is set (use_seam, use_edge_sharp).
 
     Blender 4.0+ keeps these flags as edge attributes that exist only when some edge has the
-    flag: none means no read at all (a flag per edge through MeshEdge costs ~20 ns, 46 ms for
-    2.3M edges on the Live Preview's start); 3.x copies them from its edge array
+    flag: none means no read at all (a flag per edge through MeshEdge is a large part of the Live
+    Preview's start); 3.x copies them from its edge array
     (dna_arrays.flagged_edges)."""
     count = len(mesh.edges)
     attribute = _flag_attribute(mesh, flag) if bpy.app.version >= (4, 0, 0) else None
@@ -287,8 +286,8 @@ def read_edges(mesh: bpy.types.Mesh, flag: str) -> np.ndarray:
 
 def _uv_attribute(mesh, name: str):
     """The float2 corner attribute Blender 3.5+ keeps a UV map in, whose foreach_get/set copy it
-    at once (MeshUVLoop.uv goes one corner at a time in 4.5: 200 ms to read and 215 ms to write
-    the UVs of 4.65M corners, 6 ms through the attribute); None before 3.5."""
+    at once (MeshUVLoop.uv goes one corner at a time in 4.5, tens of times slower); None before
+    3.5."""
     if bpy.app.version < (3, 5, 0):
         return None
     return _typed_attribute(mesh, name, "CORNER", "FLOAT2")
@@ -366,7 +365,7 @@ def fill_geometry(mesh: bpy.types.Mesh, vertices: np.ndarray, triangles: np.ndar
 
     ``edges`` (a :class:`topstoc.core.MeshEdges` of ``triangles``) is computed here when not
     given; the preview computes it on its worker thread. Writing the edges ourselves replaces
-    ``mesh.update(calc_edges=True)``, which took 40 ms of a 150k-triangle preview update.
+    ``mesh.update(calc_edges=True)``, which was a large part of a preview update.
     Triangles the engine cannot take (a repeated vertex) are left to Blender's edge pass.
     """
     mesh.clear_geometry()
@@ -404,8 +403,8 @@ _EDGE_FLAG_ATTRIBUTES = {"select": ((".select_edge",), "BOOLEAN"), "hide": ((".h
 CARRIED_EDGE_FLAGS = ("use_seam", "use_edge_sharp")
 
 # Element flags by domain that Blender 4.0+ keeps as attributes, present only while some element
-# has the flag (MeshVertex.select and the like go one element at a time there, 70-180 ms for the
-# horse's vertices, edges or polygons in 4.5): their names and type. Freestyle marks are not
+# has the flag (MeshVertex.select and the like go one element at a time there): their names
+# and type. Freestyle marks are not
 # among them: 4.x keeps them in layers of their own, and 5.0 has no such property.
 ELEMENT_FLAG_ATTRIBUTES = {
     "POINT": {"select": ((".select_vert",), "BOOLEAN"), "hide": ((".hide_vert",), "BOOLEAN")},
@@ -514,9 +513,8 @@ def calc_edges(mesh: bpy.types.Mesh, calc: bool = True) -> None:
 def _set_int_field(mesh, attribute: Optional[str], collection, key: str, values: np.ndarray) -> None:
     """Writes an index field: the internal attribute where Blender has one (``attribute``, 3.6+ /
     4.0+: a plain int array; None where no version has one), else the 3.x struct field in one
-    pass (dna_arrays.write_field: a 150k-triangle preview frame's geometry in 3.4 took 9-13 ms
-    instead of 13-18), else through a uint32 buffer (foreach_set, which 3.x copies field by
-    field)."""
+    pass (dna_arrays.write_field, about a third faster for a preview frame's geometry), else
+    through a uint32 buffer (foreach_set, which 3.x copies field by field)."""
     flat = np.ascontiguousarray(values, dtype=np.int32).ravel()
     layer = mesh.attributes.get(attribute) if attribute else None
     if layer is not None:

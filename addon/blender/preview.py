@@ -18,19 +18,17 @@ notice (the modal timer) or to write the result.
 Two workers run when the machine has two cores or more: while one decimates, the next request
 starts on the other, and the engine gives each call its share of the free cores. A decimation
 is bound by memory latency more than by arithmetic, so two running side by side on one thread
-each show more updates per second than one using both threads (horse, 1.55M triangles, the
-drag benchmark at 10 % in bpy 4.5, 2026-11-28: sweep 14.2-15.4 vs 11.2-12.5, fine adjustment
-24.2-28.2 vs 19.0-19.2 per second). Results are shown in the
-order they were requested: one that finishes after a newer one was shown is dropped.
+each show more updates per second than one using both threads (docs/benchmarks.md). Results
+are shown in the order they were requested: one that finishes after a newer one was shown is
+dropped.
 
 While the user drags, the preview shows drafts of the fast mode (plain TopStoc, milliseconds):
 the geometry without the attribute sources and without the engine's final output check (its
 partition checks and repairs still run; core.decimate's ``draft``). When the drag pauses for
 PAUSE_SECONDS, the same ratio is computed in full with the chosen settings in the background,
 checked, and replaces the draft when it is ready (the paint means the same in both modes, so
-the density does not jump); Enter writes only such a result. On the horse (1.55M triangles) at
-10 % a draft in a 5-20 % sweep takes 62-63 ms on one thread against 82-89 ms for the full fast
-decimation (2026-11-27, a slow run of the machine; 50 against 72 ms in a faster one).
+the density does not jump); Enter writes only such a result. A draft takes about three
+quarters of the full fast decimation's time.
 """
 
 from __future__ import annotations

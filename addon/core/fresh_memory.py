@@ -1,15 +1,14 @@
 """Large arrays whose memory is mapped in one call where the allocator would not reuse it.
 
-Reading a Blender mesh copies it into new arrays: about 47 MB on the main thread for the
-1.55M-triangle horse when the Live Preview starts. The kernel maps new memory a page at a time,
+Reading a Blender mesh copies it into new arrays: tens of MB on the main thread for a large mesh
+when the Live Preview starts. The kernel maps new memory a page at a time,
 on first touch. Where the process allocates with jemalloc, freed memory goes back to the
 kernel (blocks of 8 MB or more at once, smaller ones after a few seconds), so a start after a
 pause faulted in every page again (and numpy's request for 2 MB pages on large arrays may make
-the kernel compact memory first): in Debian's Blender 3.4 the prepared start took 129-200 ms of
-main-thread time after 6 s pauses (2026-11-27). An anonymous mapping with MAP_POPULATE maps all its pages in
-one system call: 44-69 ms. With glibc's allocator (PyPI's bpy, plain Python) freed memory is
-reused without faults and a fresh mapping costs more (bpy 4.5: 29-38 against 8-9 ms), so
-there arrays come from np.empty as before.
+the kernel compact memory first). An anonymous mapping with MAP_POPULATE maps all its pages in
+one system call, several times faster. With glibc's allocator (PyPI's bpy, plain Python) freed
+memory is reused without faults and a fresh mapping costs more, so there arrays come from
+np.empty as before (the runs: docs/benchmarks.md).
 
 jemalloc is recognised by a function only it defines, visible to dlsym: `mallctl` where it is a
 shared library (Debian's Blender 3.4 links libjemalloc.so.2), `mallocx` where a program links it

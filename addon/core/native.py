@@ -15,10 +15,10 @@ import os
 from . import native_diagnosis
 from .errors import TopStocError
 
-# Idle OpenMP threads spin briefly (about 100,000 turns, 1-3 ms), then sleep: a decimation runs
-# dozens of parallel loops with short serial stretches between them, and waking a sleeping
-# thread cost 0.1-0.2 ms per loop on the 2-core VM (PASSIVE: 10-20 % of a re-decimation of the
-# horse), while libgomp's default spins about 5 ms after every loop. The engine's free-core count
+# Idle OpenMP threads spin briefly (about 100,000 turns), then sleep: a decimation runs dozens
+# of parallel loops with short serial stretches between them, and waking a sleeping thread per
+# loop is a noticeable share of a re-decimation, while libgomp's default spin after every loop
+# keeps the cores busy long after. The engine's free-core count
 # does not mistake our own spinning threads for other programs' (parallel.cpp). Only takes
 # effect if libgomp is not loaded yet (plain Python, bpy and the extension's bundled libgomp);
 # Debian's Blender loads its own first. A user's OMP_WAIT_POLICY or GOMP_SPINCOUNT wins.

@@ -285,7 +285,7 @@ Mesh::Mesh(const std::vector<double>& positions, const int32_t* triangles, int64
 
 Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangles, int64_t num_triangles,
            const ProgressCallback& progress_callback) {
-  Progress progress(progress_callback);  // steps at their share of the time on the horse; may throw Cancelled
+  Progress progress(progress_callback);  // stages at their share of a large mesh's time; may throw Cancelled
   if (num_vertices > int64_t(INT32_MAX)) throw std::invalid_argument("mesh is too large: more than 2^31 vertices");
   num_vertices_ = static_cast<int32_t>(num_vertices);
   report_.input_vertices = num_vertices_;
@@ -417,13 +417,13 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     for (int k = 0; k < 3; ++k) positions_[3 * size_t(i) + k] = positions[3 * size_t(old) + k];
   }
   // The candidate faces in the new numbering, in order of their lowest vertex, ties in input
-  // order. A counting sort with a bucket per vertex scattered every face to a random place (130
-  // ms on the horse, one thread); instead the keys (lowest vertex, candidate) are radix-sorted in
+  // order. A counting sort with a bucket per vertex scatters every face to a random place;
+  // instead the keys (lowest vertex, candidate) are radix-sorted in
   // two passes of about ten bits, whose scatters stay within a few thousand cache lines, and the
   // faces are then gathered in order. They are renumbered while the keys are made, reading the
   // caller's rows in order: gathering renumbered rows reads one array in the new order instead
-  // of a caller's row and three of vertex_index_'s entries (the gather took 34-46 ms of a 200 ms
-  // preparation of the horse).
+  // of a caller's row and three of vertex_index_'s entries (the gather was a fifth of the
+  // preparation).
   const int32_t m = static_cast<int32_t>(face_source_.size());
   Buffer<uint64_t> keyed(m);
   Buffer<int32_t> renumbered(3 * size_t(m));
@@ -606,7 +606,7 @@ void Mesh::build_adjacency(Progress& progress) {
 }
 
 // Apart from the one-ring pass: three square roots and divisions per face were a sixth of that
-// pass on the horse, for a value only area-weighted sampling reads.
+// pass, for a value only area-weighted sampling reads.
 void Mesh::build_vertex_areas() const {
   std::call_once(areas_once_, [this] {
     const int32_t n = num_vertices_;

@@ -14,8 +14,8 @@ namespace {
 constexpr int32_t kRateBuckets = 8 * 20;  // an eighth of a binade each, from 2^-12 to 2^8
 
 // Buckets 9 % wide (the exponent and the top three bits of the mantissa): few enough for one
-// counting pass (one over 65,536 buckets of 3 % took 15-21 ms on the horse, its writes
-// scattered over as many places). Smaller r share the first bucket (candidates at any rate a
+// cheap counting pass (finer buckets scatter its writes over as many places). Smaller r share
+// the first bucket (candidates at any rate a
 // slider asks for), larger ones the last.
 inline int32_t rate_bucket(double r) {
   uint64_t bits;
@@ -71,8 +71,8 @@ std::shared_ptr<const CandidateOrder> candidate_order(const Mesh& mesh, const Fe
 void candidates_in_order(const CandidateOrder& order, double rate, std::vector<int32_t>& forced,
                          std::vector<Candidate>& candidates) {
   forced = order.corners;
-  // Every vertex whose test can pass has r at most the rate (up to rounding: a margin). (On
-  // one thread: two took as long, 2.5 against 2.3 ms on the horse.)
+  // Every vertex whose test can pass has r at most the rate (up to rounding: a margin). One
+  // thread: a second one does not make this short loop faster.
   const int32_t end = order.offsets[rate_bucket(rate * (1.0 + 1e-6)) + 1];
   for (int32_t i = 0; i < end; ++i) {
     const double q = order.q[i];

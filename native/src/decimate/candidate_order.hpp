@@ -4,8 +4,8 @@
 // vertex's key falls below the draw's first threshold T exactly when k exceeds
 //   r(v) = p* / q(v) on a surface, p*^2 / q(v) on a curve, where p* = U / (U + T (1 - U))
 // (the key is below T when p > p*, and p = k q or sqrt(k q)). So, with the vertices ordered by
-// r, the candidates at any rate are among a prefix: a draw tests those (horse at 10 %: about
-// 100,000 of 776,000 vertices) with the same test as the pass over all vertices, and finds
+// r, the candidates at any rate are among a prefix: a draw tests those (about an eighth of the
+// vertices at 10 %) with the same test as the pass over all vertices, and finds
 // the same candidates. Ordered by buckets of r, each in vertex order, with each vertex's U and
 // q alongside: read in this order from the per-vertex arrays, the prefix cost more than a pass
 // over every vertex.

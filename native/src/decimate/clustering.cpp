@@ -33,20 +33,17 @@ struct Lowering {
 // when (level + 1, rank) beats what it holds. Each key ends a level at the smallest offer made
 // to it, whichever thread made it and in whatever order, so the result is the same for any
 // thread count. Threads own ranges of vertex ids and lower only their own keys, with plain
-// stores; offers to another range are handed to its owner after the level. (An atomic minimum
-// on every key, the earlier scheme, cost the flood of the horse at 10 % on two threads 29-34
-// against 26 ms, and 40-43 against 36-38 at 1 %: alternating runs, 2026-11-28.)
+// stores; offers to another range are handed to its owner after the level (an atomic minimum
+// on every key, the earlier scheme, was slower).
 // Serves the full fill and incremental additions alike (only improvements propagate). With
 // cross_edges, every edge between two clusters is recorded once, from its farther end, when
 // both ends are final (only for a full fill).
 // The loop is bound by memory latency: each level's frontier is a thin ring around every
 // sample, spread over the whole mesh. So each frontier is walked in vertex order (vertices are
 // numbered along a space-filling curve) and the rows and keys a few vertices ahead are
-// prefetched. On the 775k-vertex horse at 1 % on one thread this took the flood from about 80
-// to about 52 ms (medians of 31, same run); keeping vertices in discovery order, or blocking
-// the mesh into cache-sized pieces flooded one at a time, measured no better. Fetching the
-// neighbours' keys ahead as well cost more instructions than it saved (paired runs, 2026-11-27:
-// the flood 0.87-0.94x without it, with the bit-mask frontier scan below).
+// prefetched, which cut the flood by about a third; discovery order, or cache-sized pieces
+// flooded one at a time, measured no better. Fetching the neighbours' keys ahead as well costs
+// more instructions than it saves.
 // Seeds (flood_update: kept vertices around emptied clusters, as (distance << 32 | vertex),
 // ordered by distance) join the frontier at the level of their distance.
 void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> frontier, int32_t level,

@@ -35,7 +35,7 @@ struct ImportanceTable {
 
 // The uniform U of every vertex for one seed (it depends on the seed and the vertex's caller id
 // only), kept with the layout for the seed drawn last: a slider's draws read them instead of
-// hashing every vertex again (5 of a draft's 50 ms on the horse at 10 %, one thread).
+// hashing every vertex again (a tenth of a draft's time).
 struct SelectionUniforms {
   uint64_t seed = 0;
   std::vector<double> u;

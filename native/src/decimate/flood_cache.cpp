@@ -5,10 +5,8 @@ namespace topstoc {
 // Updating relabels every vertex (one pass), then refills the clusters of removed samples
 // from around them and lets added samples take their share. A fresh flood fills everything.
 // Removed samples cost about three times what added ones do (a whole cluster refilled against
-// part of one taken over). On the horse (one thread, flood and first check, 2026-11-27):
-//   at 10 %: 33 % added 76 against 81 ms fresh; 25 % removed 61 against 61; 43 % removed 84
-//   against 62; at 1 %: 33 % added 23 against 41; 43 % removed 38 against 41.
-// So a draw updates when added + 3 removed is at most the samples drawn.
+// part of one taken over), so a draw updates when added + 3 removed is at most the samples
+// drawn (the runs behind the factor: docs/benchmarks.md).
 bool FloodCache::worth_updating(const std::vector<int32_t>& drawn) const {
   // Both lists are increasing: a merge, without branches (which side advances is a coin toss
   // for the predictor).

@@ -3,8 +3,8 @@
 //
 // Not cryptographic: 128 bits that change with any accidental change. Blocks of 1 MiB are
 // digested independently (on all threads) and folded in order, so the value does not depend on
-// the number of threads. Several times faster than blake2b, which cost the add-on 40 ms per
-// million-triangle mesh (and held the interpreter lock while it ran).
+// the number of threads. Several times faster than blake2b, which also held the interpreter
+// lock while it ran.
 #pragma once
 
 #include <array>

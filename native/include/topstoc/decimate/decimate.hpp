@@ -39,10 +39,9 @@ struct DecimateParams {
   Placement placement = Placement::Subsample;
   int32_t max_repair_rounds = 200;
   /// Collect candidate faces during the flood (thesis 4.1.1) instead of scanning all faces:
-  /// -1 below 5 % of the vertices, 0 never (default), 1 always. Measured on the 1.55M-triangle
-  /// horse, the scan of all faces' labels (parallel, streaming) is the faster one here: at 1 %
-  /// 104 ms per decimation without, 138 ms with (the border edges recorded during the flood
-  /// and the scattered face marks cost more than the labels they save reading).
+  /// -1 below 5 % of the vertices, 0 never (default), 1 always. The scan of all faces' labels
+  /// (parallel, streaming) measured faster: the border edges recorded during the flood and the
+  /// scattered face marks cost more than the labels they save reading.
   int fast_path = 0;
   int budget_passes = 2;        ///< extra draws when repairs overshoot the target (unguided only)
   /// Quadric refinement (refine.hpp): 0 = off; f > 1 keeps f times the target with TopStoc,
@@ -62,7 +61,7 @@ struct DecimateParams {
   /// vertices, triangles) without face_source, corner_source and labels, and without the final
   /// output check (verify.hpp) unless the fast path needs it. The partition checks and repairs
   /// run as always, so the mesh is the one a full decimation gives; output_checked tells that
-  /// it was not re-checked. (Horse, a 5-20 % sweep on one thread: 62-63 ms a frame, 82-89 in full.)
+  /// it was not re-checked. A frame takes about three quarters of a full decimation's time.
   bool draft = false;
 };
 

@@ -3,7 +3,7 @@
 // check found.
 //
 // A slider drag asks for nearby targets with the same seed, and their draws share most samples
-// (horse at 10 %: a 0.3 % step keeps 77,419 of 77,425 and adds 2,325). A decimation given a
+// (a small step keeps nearly all of them and adds a few percent). A decimation given a
 // cache turns the cached flood into its own with flood_update (clustering.hpp), re-tests only
 // the faces around the vertices that changed and evaluates only the samples whose triangles
 // changed, which gives exactly the clustering, the emitting faces and the issues a fresh flood

@@ -11,8 +11,7 @@
 // arrays, OpenMesh 9.0): every reader hands positions over as float32 (OFF/OBJ/PLY doubles lose
 // digits silently); the OBJ reader passes texture file indices, not usemtl material names; the
 // STL reader drops faces whose welded corners coincide; the PLY reader turns float colours into
-// bytes and was 4-5x slower than this reader on the 1.55M-triangle binary horse (0.67 s vs
-// 0.16 s in one run of tests/bench/bench_io.py on a loaded 2-core machine);
+// bytes and was several times slower than this reader on a large binary PLY (bench_io.py);
 // and on a malformed ascii STL (tests/data/nonmanifold_degenerate/openscad_unparseable.stl) it
 // reported success with one triangle. So every format is parsed here, from memory (the Python
 // layer decompresses .gz/.bz2), with errors that name the line or element.

@@ -18,7 +18,7 @@
 // already span nearby vertex ids; when the triangle order is coherent (consecutive triangles
 // close together) but the ids are scattered, vertices are numbered by first appearance in it
 // (Loop-subdivided meshes such as turbine x3); otherwise
-// (shuffled meshes such as horse_loop2_1.55M.ply) vertices follow a Z-order (Morton) curve of
+// (shuffled meshes) vertices follow a Z-order (Morton) curve of
 // their positions and triangles are sorted by lowest vertex, which halves the analysis time
 // there. Every vertex id inside the struct is internal; vertex_source maps back to the caller's
 // ids, vertex_index maps the caller's ids in. Results handed to callers use the caller's ids.
@@ -109,7 +109,7 @@ SimplicialComplex build_complex(const double* positions, int32_t num_vertices, c
 
 /// Same, into `out`, whose vectors keep the memory they already hold: callers that analyse
 /// mesh after mesh keep one complex around, since fresh pages (page faults and zeroing by the
-/// kernel) cost about as much as the work done on them (turbine x3: 40 of 105 ms).
+/// kernel) cost about as much as the work done on them.
 void build_complex(SimplicialComplex& out, const double* positions, int32_t num_vertices, const int32_t* triangles,
                    int64_t num_triangles, const int32_t* edges, int64_t num_edges);
 
