@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "topstoc/decimate/quadric.hpp"
+#include "decimate/quadric.hpp"
 
 using topstoc::Quadric;
 

@@ -13,8 +13,8 @@
 
 #include "topstoc/decimate/clustering.hpp"
 #include "topstoc/decimate/flood_cache.hpp"
-#include "topstoc/decimate/placement.hpp"
-#include "topstoc/decimate/refine.hpp"
+#include "decimate/placement.hpp"
+#include "decimate/refine.hpp"
 #include "../core/per_thread.hpp"
 
 namespace topstoc {

@@ -1,6 +1,6 @@
-#include "topstoc/decimate/placement.hpp"
+#include "decimate/placement.hpp"
 #include "topstoc/core/parallel.hpp"
-#include "topstoc/decimate/quadric.hpp"
+#include "decimate/quadric.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "topstoc/decimate/refine.hpp"
+#include "decimate/refine.hpp"
 
 #include <algorithm>
 #include <chrono>

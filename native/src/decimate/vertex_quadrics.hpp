@@ -25,7 +25,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "topstoc/decimate/quadric.hpp"
+#include "decimate/quadric.hpp"
 
 namespace topstoc {
 

@@ -1,4 +1,4 @@
-#include "topstoc/distance/bounded_max.hpp"
+#include "distance/bounded_max.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 #include "topstoc/distance/hausdorff.hpp"
-#include "topstoc/distance/bounded_max.hpp"
+#include "distance/bounded_max.hpp"
 #include "topstoc/core/validate.hpp"
 #include "topstoc/core/parallel.hpp"
 #include "../core/ordered_sum.hpp"

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "topstoc/core/incidence.hpp"
-#include "topstoc/edit/patch_fairing.hpp"
+#include "edit/patch_fairing.hpp"
 
 namespace topstoc {
 

@@ -1,4 +1,4 @@
-#include "topstoc/edit/patch_fairing.hpp"
+#include "edit/patch_fairing.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "topstoc/topology/closed_surface.hpp"
+#include "topology/closed_surface.hpp"
 
 #include <algorithm>
 #include <cmath>

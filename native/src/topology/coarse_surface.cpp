@@ -1,4 +1,4 @@
-#include "topstoc/topology/coarse_surface.hpp"
+#include "topology/coarse_surface.hpp"
 
 #include <algorithm>
 #include <cmath>

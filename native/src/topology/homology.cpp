@@ -1,4 +1,4 @@
-#include "topstoc/topology/homology.hpp"
+#include "topology/homology.hpp"
 
 #include <stdexcept>
 

@@ -1,4 +1,4 @@
-#include "topstoc/topology/loop_basis.hpp"
+#include "topology/loop_basis.hpp"
 
 #include <algorithm>
 #include <array>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "topstoc/topology/shortest_paths.hpp"
+#include "topology/shortest_paths.hpp"
 
 namespace topstoc {
 

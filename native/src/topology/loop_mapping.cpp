@@ -1,4 +1,4 @@
-#include "topstoc/topology/loop_mapping.hpp"
+#include "topology/loop_mapping.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "topstoc/topology/loop_shortening.hpp"
+#include "topology/loop_shortening.hpp"
 
 #include <algorithm>
 #include <queue>

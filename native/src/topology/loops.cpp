@@ -6,13 +6,13 @@
 #include <numeric>
 #include <stdexcept>
 
-#include "topstoc/topology/coarse_surface.hpp"
-#include "topstoc/topology/homology.hpp"
-#include "topstoc/topology/loop_basis.hpp"
-#include "topstoc/topology/loop_mapping.hpp"
-#include "topstoc/topology/loop_shortening.hpp"
-#include "topstoc/topology/persistence.hpp"
-#include "topstoc/topology/closed_surface.hpp"
+#include "topology/coarse_surface.hpp"
+#include "topology/homology.hpp"
+#include "topology/loop_basis.hpp"
+#include "topology/loop_mapping.hpp"
+#include "topology/loop_shortening.hpp"
+#include "topology/persistence.hpp"
+#include "topology/closed_surface.hpp"
 #include "topstoc/topology/tetrahedralize.hpp"
 
 namespace topstoc {

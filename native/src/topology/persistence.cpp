@@ -1,4 +1,4 @@
-#include "topstoc/topology/persistence.hpp"
+#include "topology/persistence.hpp"
 
 #include <algorithm>
 #include <stdexcept>

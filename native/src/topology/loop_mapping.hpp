@@ -14,8 +14,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "topstoc/topology/shortest_paths.hpp"
-#include "topstoc/topology/closed_surface.hpp"
+#include "topology/shortest_paths.hpp"
+#include "topology/closed_surface.hpp"
 
 namespace topstoc {
 

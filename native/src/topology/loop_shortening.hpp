@@ -21,10 +21,10 @@
 #include <cstdint>
 #include <vector>
 
-#include "topstoc/topology/homology.hpp"
+#include "topology/homology.hpp"
 #include "topstoc/core/progress.hpp"
-#include "topstoc/topology/shortest_paths.hpp"
-#include "topstoc/topology/closed_surface.hpp"
+#include "topology/shortest_paths.hpp"
+#include "topology/closed_surface.hpp"
 
 namespace topstoc {
 

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "topstoc/core/progress.hpp"
-#include "topstoc/topology/closed_surface.hpp"
+#include "topology/closed_surface.hpp"
 #include "topstoc/topology/tetrahedralize.hpp"
 
 namespace topstoc {

@@ -8,7 +8,7 @@
 #include <queue>
 #include <vector>
 
-#include "topstoc/topology/closed_surface.hpp"
+#include "topology/closed_surface.hpp"
 
 namespace topstoc {
 

@@ -17,7 +17,7 @@
 #include "topstoc/decimate/decimate.hpp"
 #include "topstoc/core/mesh.hpp"
 #include "topstoc/core/progress.hpp"
-#include "topstoc/topology/closed_surface.hpp"
+#include "topology/closed_surface.hpp"
 
 namespace topstoc {
 

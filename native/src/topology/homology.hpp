@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "topstoc/topology/closed_surface.hpp"
+#include "topology/closed_surface.hpp"
 
 namespace topstoc {
 

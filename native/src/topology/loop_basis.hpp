@@ -18,10 +18,10 @@
 #include <cstdint>
 #include <vector>
 
-#include "topstoc/topology/homology.hpp"
-#include "topstoc/topology/persistence.hpp"
+#include "topology/homology.hpp"
+#include "topology/persistence.hpp"
 #include "topstoc/core/progress.hpp"
-#include "topstoc/topology/closed_surface.hpp"
+#include "topology/closed_surface.hpp"
 
 namespace topstoc {
 
