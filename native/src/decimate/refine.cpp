@@ -262,92 +262,137 @@ bool has_zero_area(const DecimateResult& result) {
   return false;
 }
 
-void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
-                         DecimateResult& result) {
-  const auto start = std::chrono::steady_clock::now();
-  if (params.target_vertices < 1 && !params.zero_area_only)
-    throw std::invalid_argument("refine target must be at least 1 vertex, got " +
-                                std::to_string(params.target_vertices));
-  const int32_t n = static_cast<int32_t>(result.kept.size());
-  const auto& source = mesh.vertex_source();
-  const auto& index = mesh.vertex_index();
-  CollapseSetup setup;
-  const auto table = vertex_quadric_table(mesh, layout);
-  for (int i = 0; i < 3; ++i) setup.center[i] = table->center[i];
-  setup.extent = table->extent;
-  const int32_t num_input = mesh.num_vertices();
-  std::vector<int32_t> label(num_input);
+namespace {
+
+// One refinement of a decimation result: the collapser's setup from the result and the
+// layout, the collapses, the optional re-fit, and the result compacted. The stages run in the
+// order of run().
+class Refinement {
+ public:
+  Refinement(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params, DecimateResult& result)
+      : mesh(mesh), layout(layout), params(params), result(result), n(static_cast<int32_t>(result.kept.size())),
+        num_input(mesh.num_vertices()),
+        guided(params.multipliers && std::any_of(params.multipliers->begin(), params.multipliers->end(),
+                                                 [](double m) { return m != 1.0; })) {}
+
+  void run() {
+    const auto& source = mesh.vertex_source();
+    CollapseSetup setup;
+    const auto table = vertex_quadric_table(mesh, layout);
+    for (int i = 0; i < 3; ++i) setup.center[i] = table->center[i];
+    setup.extent = table->extent;
+    label.resize(num_input);
 #pragma omp parallel for schedule(static) if (num_input >= kParallelMin)
-  for (int32_t v = 0; v < num_input; ++v) label[v] = result.labels[source[v]];
-  setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *table);
-  setup.world = result.vertices;
-  setup.positions.resize(3 * size_t(n));
-  setup.weight.assign(n, 1.0);
-  setup.locked.assign(n, 0);
-  setup.curve.assign(n, -1);
-  setup.curve_size.assign(layout.num_curves(), 0);
-  setup.curve_closed = layout.curve_closed;
-  setup.bin.resize(n);
-  const bool guided = params.multipliers &&
-                      std::any_of(params.multipliers->begin(), params.multipliers->end(), [](double m) { return m != 1.0; });
-  auto multiplier = [&](int32_t v) { return guided ? (*params.multipliers)[v] : 1.0; };
-  for (int32_t i = 0; i < n; ++i) {
-    const int32_t v = index[result.kept[i]];
-    const double m = multiplier(v);
-    if (layout.vertex_feature[v]) setup.curve[i] = layout.vertex_curve[v];
-    if (setup.curve[i] >= 0) ++setup.curve_size[setup.curve[i]];
-    setup.locked[i] = layout.vertex_corner[v] || (layout.vertex_feature[v] && setup.curve[i] < 0) || m == kForcedMultiplier;
-    if (m == kForcedMultiplier)  // a control point stays where the user put it
-      for (int k = 0; k < 3; ++k) setup.world[3 * size_t(i) + k] = mesh.position(v)[k];
-    setup.weight[i] = m == kForcedMultiplier ? 1.0 : std::max(m, 1.0 / 81.0);
-    setup.bin[i] = guidance_bin(m);
+    for (int32_t v = 0; v < num_input; ++v) label[v] = result.labels[source[v]];
+    setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *table);
+    set_up_vertices(setup);
+    lock_pinched(setup);
+    setup.quota = quotas();
+    set_up_corner_sectors(setup);
+    setup.optimal_placement = !params.zero_area_only;
+    // The zero-area clean-up keeps the caller's positions.
+    const double center[3] = {setup.center[0], setup.center[1], setup.center[2]}, extent = setup.extent;
+    Collapser collapser(result.triangles, result.corner_source, std::move(setup));
+    collapse(collapser, center, extent);
+    if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
+    result.issues_remaining.sliver = collapser.zero_area_faces();
+    compact(collapser);
   }
-  for (size_t i = 0; i < setup.world.size(); ++i)
-    setup.positions[i] = (setup.world[i] - setup.center[i % 3]) * (1.0 / setup.extent);
+
+ private:
+  const Mesh& mesh;
+  const FeatureLayout& layout;
+  const RefineParams& params;
+  DecimateResult& result;
+  const int32_t n, num_input;
+  const bool guided;
+  std::vector<int32_t> label;  // per input vertex: its output vertex
+
+  double multiplier(int32_t v) const { return guided ? (*params.multipliers)[v] : 1.0; }
+
+  // Per output vertex: normalised position, weight, feature curve, lock and guidance bin.
+  void set_up_vertices(CollapseSetup& setup) const {
+    const auto& index = mesh.vertex_index();
+    setup.world = result.vertices;
+    setup.positions.resize(3 * size_t(n));
+    setup.weight.assign(n, 1.0);
+    setup.locked.assign(n, 0);
+    setup.curve.assign(n, -1);
+    setup.curve_size.assign(layout.num_curves(), 0);
+    setup.curve_closed = layout.curve_closed;
+    setup.bin.resize(n);
+    for (int32_t i = 0; i < n; ++i) {
+      const int32_t v = index[result.kept[i]];
+      const double m = multiplier(v);
+      if (layout.vertex_feature[v]) setup.curve[i] = layout.vertex_curve[v];
+      if (setup.curve[i] >= 0) ++setup.curve_size[setup.curve[i]];
+      setup.locked[i] = layout.vertex_corner[v] || (layout.vertex_feature[v] && setup.curve[i] < 0) || m == kForcedMultiplier;
+      if (m == kForcedMultiplier)  // a control point stays where the user put it
+        for (int k = 0; k < 3; ++k) setup.world[3 * size_t(i) + k] = mesh.position(v)[k];
+      setup.weight[i] = m == kForcedMultiplier ? 1.0 : std::max(m, 1.0 / 81.0);
+      setup.bin[i] = guidance_bin(m);
+    }
+    for (size_t i = 0; i < setup.world.size(); ++i)
+      setup.positions[i] = (setup.world[i] - setup.center[i % 3]) * (1.0 / setup.extent);
+  }
+
   // A pinched input vertex (several fans) and every vertex of its output triangles stay put:
   // the link condition sees one vertex, not the fans, and a collapse there could delete a
   // whole fan (a wing of a bowtie) while every count the final check compares stays the same.
-  const auto& manifold_vertex = mesh.manifold_vertex();
-  if (mesh.report().nonmanifold_vertices > 0)
+  void lock_pinched(CollapseSetup& setup) const {
+    const auto& index = mesh.vertex_index();
+    const auto& manifold_vertex = mesh.manifold_vertex();
+    if (mesh.report().nonmanifold_vertices == 0) return;
     for (size_t t = 0; t < result.triangles.size() / 3; ++t) {
       bool pinched = false;
       for (int j = 0; j < 3; ++j) pinched |= !manifold_vertex[index[result.kept[result.triangles[3 * t + j]]]];
       if (pinched)
         for (int j = 0; j < 3; ++j) setup.locked[result.triangles[3 * t + j]] = 1;
     }
-  std::vector<double> bin_vertices(kBins, 0.0), bin_multipliers(kBins, 0.0);
-  const auto& vfo = mesh.vertex_face_offsets();
-  if (guided) {
-    for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-      if (vfo[v] < vfo[v + 1]) {
-        const int32_t b = guidance_bin(multiplier(v));
-        bin_vertices[b] += 1.0;
-        bin_multipliers[b] += multiplier(v);
-      }
-  } else {
-    const int32_t b = guidance_bin(1.0);
-    bin_vertices[b] = mesh.num_vertices() - mesh.report().isolated_vertices;
-    bin_multipliers[b] = bin_vertices[b];
   }
-  setup.quota = bin_quotas(bin_vertices, bin_multipliers, params.target_vertices);
-  // Sector of every output corner at its vertex, from the input corner it copies.
-  setup.corner_sector.assign(result.corner_source.size(), 0);
-  std::vector<int32_t> internal_face;
-  for (size_t c = 0; c < setup.corner_sector.size(); ++c) {
-    const int32_t vertex = index[result.kept[result.triangles[c]]];
-    if (layout.sectors[vertex] <= 1) continue;
-    if (internal_face.empty()) {
-      internal_face.assign(mesh.report().input_triangles, -1);
-      for (int32_t f = 0; f < mesh.num_faces(); ++f) internal_face[mesh.face_source()[f]] = f;
+
+  // The target's share of each guidance bin, from the input vertices in it.
+  std::vector<int32_t> quotas() const {
+    std::vector<double> bin_vertices(kBins, 0.0), bin_multipliers(kBins, 0.0);
+    const auto& vfo = mesh.vertex_face_offsets();
+    if (guided) {
+      for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+        if (vfo[v] < vfo[v + 1]) {
+          const int32_t b = guidance_bin(multiplier(v));
+          bin_vertices[b] += 1.0;
+          bin_multipliers[b] += multiplier(v);
+        }
+    } else {
+      const int32_t b = guidance_bin(1.0);
+      bin_vertices[b] = mesh.num_vertices() - mesh.report().isolated_vertices;
+      bin_multipliers[b] = bin_vertices[b];
     }
-    setup.corner_sector[c] = layout.sector_of(mesh, vertex, internal_face[result.corner_source[c] / 3]);
+    return bin_quotas(bin_vertices, bin_multipliers, params.target_vertices);
   }
-  setup.optimal_placement = !params.zero_area_only;
-  const double center[3] = {setup.center[0], setup.center[1], setup.center[2]}, extent = setup.extent;  // zero-area clean-up keeps the caller's positions
-  Collapser collapser(result.triangles, result.corner_source, std::move(setup));
-  if (params.zero_area_only) {
-    result.refine_collapses += collapser.remove_thin(0.0, {});
-  } else {
+
+  // Sector of every output corner at its vertex, from the input corner it copies.
+  void set_up_corner_sectors(CollapseSetup& setup) const {
+    const auto& index = mesh.vertex_index();
+    setup.corner_sector.assign(result.corner_source.size(), 0);
+    std::vector<int32_t> internal_face;
+    for (size_t c = 0; c < setup.corner_sector.size(); ++c) {
+      const int32_t vertex = index[result.kept[result.triangles[c]]];
+      if (layout.sectors[vertex] <= 1) continue;
+      if (internal_face.empty()) {
+        internal_face.assign(mesh.report().input_triangles, -1);
+        for (int32_t f = 0; f < mesh.num_faces(); ++f) internal_face[mesh.face_source()[f]] = f;
+      }
+      setup.corner_sector[c] = layout.sector_of(mesh, vertex, internal_face[result.corner_source[c] / 3]);
+    }
+  }
+
+  // The collapses: only zero-area clean-up, or slivers first, then the target, then the
+  // optional re-fit and a last clean-up.
+  void collapse(Collapser& collapser, const double* center, double extent) {
+    if (params.zero_area_only) {
+      result.refine_collapses += collapser.remove_thin(0.0, {});
+      return;
+    }
     result.refine_vertices = params.target_vertices;
     result.refine_triangles = params.target_triangles;
     // Slivers the stochastic pass left (near-collinear corners, needles) go first: the
@@ -356,68 +401,83 @@ void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const Re
     const Collapser::Stop stop{params.target_vertices, params.target_triangles};
     result.refine_collapses = collapser.remove_thin(kSliverShape, stop);
     result.refine_collapses += collapser.run(stop);
-    if (params.refit) {
-      // Each vertex may move as far as its cluster reaches (as filtered placement allows).
-      // (Survivors found first: the lookup compresses paths, so it runs on one thread; the
-      // maxima per thread are merged after, which gives the same whatever the thread count.)
-      std::vector<int32_t> survivor(n);
-      for (int32_t v = 0; v < n; ++v) survivor[v] = collapser.survivor(v);
-      std::vector<double> radius2(n, 0.0);
-#pragma omp parallel if (num_input >= kParallelMin)
-      {
-        std::vector<double> mine(n, 0.0);
-#pragma omp for schedule(static) nowait
-        for (int32_t v = 0; v < num_input; ++v) {
-          if (label[v] < 0) continue;
-          const int32_t s = survivor[label[v]];
-          const double* p = collapser.position(s);
-          double d2 = 0;
-          for (int i = 0; i < 3; ++i) {
-            const double d = (mesh.position(v)[i] - center[i]) * (1.0 / extent) - p[i];
-            d2 += d * d;
-          }
-          mine[s] = std::max(mine[s], d2);
-        }
-#pragma omp critical(topstoc_refit_radius)
-        for (int32_t v = 0; v < n; ++v) radius2[v] = std::max(radius2[v], mine[v]);
-      }
-      collapser.refit(radius2);
-    }
+    if (params.refit) collapser.refit(cluster_radii(collapser, center, extent));
     result.refine_collapses += collapser.remove_thin(0.0, {});
   }
-  if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
-  result.issues_remaining.sliver = collapser.zero_area_faces();
-  // Compact: surviving vertices and faces in their old order, labels followed along the collapses.
-  std::vector<int32_t> new_index(n, -1);
-  int32_t next = 0;
-  for (int32_t v = 0; v < n; ++v)
-    if (collapser.vertex_alive(v)) {
-      new_index[v] = next;
-      result.kept[next] = result.kept[v];
-      for (int i = 0; i < 3; ++i) result.vertices[3 * size_t(next) + i] = collapser.world(v)[i];
-      ++next;
+
+  // Each vertex may move as far as its cluster reaches (as filtered placement allows): the
+  // squared radius of each surviving cluster, normalised. (Survivors found first: the lookup
+  // compresses paths, so it runs on one thread; the maxima per thread are merged after, which
+  // gives the same whatever the thread count.)
+  std::vector<double> cluster_radii(Collapser& collapser, const double* center, double extent) const {
+    std::vector<int32_t> survivor(n);
+    for (int32_t v = 0; v < n; ++v) survivor[v] = collapser.survivor(v);
+    std::vector<double> radius2(n, 0.0);
+#pragma omp parallel if (num_input >= kParallelMin)
+    {
+      std::vector<double> mine(n, 0.0);
+#pragma omp for schedule(static) nowait
+      for (int32_t v = 0; v < num_input; ++v) {
+        if (label[v] < 0) continue;
+        const int32_t s = survivor[label[v]];
+        const double* p = collapser.position(s);
+        double d2 = 0;
+        for (int i = 0; i < 3; ++i) {
+          const double d = (mesh.position(v)[i] - center[i]) * (1.0 / extent) - p[i];
+          d2 += d * d;
+        }
+        mine[s] = std::max(mine[s], d2);
+      }
+#pragma omp critical(topstoc_refit_radius)
+      for (int32_t v = 0; v < n; ++v) radius2[v] = std::max(radius2[v], mine[v]);
     }
-  result.kept.resize(next);
-  result.vertices.resize(3 * size_t(next));
-  size_t faces = 0;
-  for (size_t t = 0; t < result.face_source.size(); ++t) {
-    if (!collapser.face_alive(int32_t(t))) continue;
-    for (int j = 0; j < 3; ++j) {
-      result.triangles[3 * faces + j] = new_index[result.triangles[3 * t + j]];
-      result.corner_source[3 * faces + j] = result.corner_source[3 * t + j];
-    }
-    result.face_source[faces] = result.face_source[t];
-    ++faces;
+    return radius2;
   }
-  result.triangles.resize(3 * faces);
-  result.corner_source.resize(3 * faces);
-  result.face_source.resize(faces);
-  std::vector<int32_t> final_index(n);
-  for (int32_t v = 0; v < n; ++v) final_index[v] = new_index[collapser.survivor(v)];
-  const int64_t labels = int64_t(result.labels.size());
+
+  // Compact: surviving vertices and faces in their old order, labels followed along the collapses.
+  void compact(Collapser& collapser) {
+    std::vector<int32_t> new_index(n, -1);
+    int32_t next = 0;
+    for (int32_t v = 0; v < n; ++v)
+      if (collapser.vertex_alive(v)) {
+        new_index[v] = next;
+        result.kept[next] = result.kept[v];
+        for (int i = 0; i < 3; ++i) result.vertices[3 * size_t(next) + i] = collapser.world(v)[i];
+        ++next;
+      }
+    result.kept.resize(next);
+    result.vertices.resize(3 * size_t(next));
+    size_t faces = 0;
+    for (size_t t = 0; t < result.face_source.size(); ++t) {
+      if (!collapser.face_alive(int32_t(t))) continue;
+      for (int j = 0; j < 3; ++j) {
+        result.triangles[3 * faces + j] = new_index[result.triangles[3 * t + j]];
+        result.corner_source[3 * faces + j] = result.corner_source[3 * t + j];
+      }
+      result.face_source[faces] = result.face_source[t];
+      ++faces;
+    }
+    result.triangles.resize(3 * faces);
+    result.corner_source.resize(3 * faces);
+    result.face_source.resize(faces);
+    std::vector<int32_t> final_index(n);
+    for (int32_t v = 0; v < n; ++v) final_index[v] = new_index[collapser.survivor(v)];
+    const int64_t labels = int64_t(result.labels.size());
 #pragma omp parallel for schedule(static) if (labels >= kParallelMin)
-  for (int64_t i = 0; i < labels; ++i)
-    if (result.labels[i] >= 0) result.labels[i] = final_index[result.labels[i]];
+    for (int64_t i = 0; i < labels; ++i)
+      if (result.labels[i] >= 0) result.labels[i] = final_index[result.labels[i]];
+  }
+};
+
+}  // namespace
+
+void refine_by_collapses(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
+                         DecimateResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  if (params.target_vertices < 1 && !params.zero_area_only)
+    throw std::invalid_argument("refine target must be at least 1 vertex, got " +
+                                std::to_string(params.target_vertices));
+  Refinement(mesh, layout, params, result).run();
   result.seconds_refine = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

@@ -107,166 +107,234 @@ std::vector<int32_t> component_boundary_loops(const Mesh& mesh, const FeatureLay
   return loops;
 }
 
-OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& kept,
-                         const std::vector<double>& positions, const std::vector<int32_t>& triangles) {
+namespace {
+
+// Issues found at output vertices, counted per thread (summed by the OpenMP reduction).
+struct LinkIssues {
+  int32_t duplicate = 0, nonmanifold_edges = 0, inconsistent_edges = 0, nonmanifold_vertices = 0;
+};
+
+// One run of check_output: the output, the input components it must match, and what each
+// stage leaves for the next. The stages run in the order of run().
+class OutputChecker {
+ public:
+  OutputChecker(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& kept,
+                const std::vector<double>& positions, const std::vector<int32_t>& triangles)
+      : mesh(mesh), layout(layout), kept(kept), positions(positions), triangles(triangles),
+        n(static_cast<int32_t>(kept.size())), t(static_cast<int32_t>(triangles.size() / 3)),
+        num_components(mesh.num_components()), pinched(find_pinched_vertices(mesh)), pieces(n), boundary(n) {}
+
+  OutputCheck run() {
+    count_nonfinite();
+    find_surface_components();
+    check_triangles();
+    check_vertex_links();
+    compare_components();
+    check.pinched_fans_changed = changed_pinched_fans(mesh, pinched, kept, triangles);
+    return check;
+  }
+
+ private:
+  const Mesh& mesh;
+  const FeatureLayout& layout;
+  const std::vector<int32_t>& kept;
+  const std::vector<double>& positions;
+  const std::vector<int32_t>& triangles;
+  const int32_t n, t, num_components;
+  const PinchedVertices pinched;
   OutputCheck check;
-  const int32_t n = static_cast<int32_t>(kept.size());
-  const int32_t t = static_cast<int32_t>(triangles.size() / 3);
-  const int32_t num_components = mesh.num_components();
-  int32_t nonfinite = 0;
+  std::vector<uint8_t> manifold;        // per input component: in the guarantee's domain
+  std::vector<int32_t> component_of;    // per output vertex
+  std::vector<int32_t> triangles_in;    // per component
+  std::vector<int64_t> euler;           // per component: V - E + F of the output piece
+  SharedUnionFind pieces, boundary;     // output vertices joined by edges, by boundary edges
+  std::vector<uint8_t> on_boundary, used;
+
+  void count_nonfinite() {
+    int32_t nonfinite = 0;
 #pragma omp parallel for schedule(static) reduction(+ : nonfinite) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v)
-    nonfinite += !std::isfinite(positions[3 * size_t(v)]) || !std::isfinite(positions[3 * size_t(v) + 1]) ||
-                 !std::isfinite(positions[3 * size_t(v) + 2]);
-  check.nonfinite = nonfinite;
+    for (int32_t v = 0; v < n; ++v)
+      nonfinite += !std::isfinite(positions[3 * size_t(v)]) || !std::isfinite(positions[3 * size_t(v) + 1]) ||
+                   !std::isfinite(positions[3 * size_t(v) + 2]);
+    check.nonfinite = nonfinite;
+  }
 
   // Which input components are manifold, oriented surfaces (the guarantee's domain), allowing
-  // pinched vertices: their fans are compared one by one below.
-  const PinchedVertices pinched = find_pinched_vertices(mesh);
-  std::vector<uint8_t> manifold(num_components, 1);
-  const MeshReport& report = mesh.report();
-  if (report.nonmanifold_vertices + report.nonmanifold_edges + report.inconsistent_edges > 0)  // else all are
-    for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-      if (mesh.component()[v] >= 0 && !mesh.manifold_vertex()[v]) manifold[mesh.component()[v]] = 0;
-  for (int32_t comp = 0; comp < num_components && pinched.count > 0; ++comp)
-    if (pinched.pinched_surface[comp]) manifold[comp] = 1;
-  std::vector<int32_t> component_of(n);
+  // pinched vertices: their fans are compared one by one at the end.
+  void find_surface_components() {
+    manifold.assign(num_components, 1);
+    const MeshReport& report = mesh.report();
+    if (report.nonmanifold_vertices + report.nonmanifold_edges + report.inconsistent_edges > 0)  // else all are
+      for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+        if (mesh.component()[v] >= 0 && !mesh.manifold_vertex()[v]) manifold[mesh.component()[v]] = 0;
+    for (int32_t comp = 0; comp < num_components && pinched.count > 0; ++comp)
+      if (pinched.pinched_surface[comp]) manifold[comp] = 1;
+    component_of.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) component_of[v] = mesh.component()[kept[v]];
+    for (int32_t v = 0; v < n; ++v) component_of[v] = mesh.component()[kept[v]];
+  }
 
   // Per triangle: repeated corners, mixed components, zero area; triangles per component
   // (counted per thread, summed after: integers, so the order does not matter).
-  std::vector<int32_t> triangles_in(num_components, 0);
-  std::vector<int64_t> euler(num_components, 0);  // V - E + F of the output piece
-  int32_t repeated_corner = 0, mixed_triangles = 0, zero_area = 0;
+  void check_triangles() {
+    triangles_in.assign(num_components, 0);
+    euler.assign(num_components, 0);
+    int32_t repeated_corner = 0, mixed_triangles = 0, zero_area = 0;
 #pragma omp parallel reduction(+ : repeated_corner, mixed_triangles, zero_area) if (t >= kParallelMin)
-  {
-    std::vector<int32_t> mine(num_components, 0);
+    {
+      std::vector<int32_t> mine(num_components, 0);
 #pragma omp for schedule(static)
-    for (int32_t i = 0; i < t; ++i) {
-      const int32_t* c = &triangles[3 * size_t(i)];
-      if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) {
-        ++repeated_corner;
-        continue;
+      for (int32_t i = 0; i < t; ++i) {
+        const int32_t* c = &triangles[3 * size_t(i)];
+        if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) {
+          ++repeated_corner;
+          continue;
+        }
+        const int32_t comp = component_of[c[0]];
+        if (component_of[c[1]] != comp || component_of[c[2]] != comp) ++mixed_triangles;
+        ++mine[comp];
+        if (has_zero_area(c)) ++zero_area;
       }
-      const int32_t comp = component_of[c[0]];
-      if (component_of[c[1]] != comp || component_of[c[2]] != comp) ++mixed_triangles;
-      ++mine[comp];
-      const double* p[3] = {&positions[3 * size_t(c[0])], &positions[3 * size_t(c[1])], &positions[3 * size_t(c[2])]};
-      double u[3], w[3], longest = 0;
-      for (int a = 0; a < 3; ++a) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
-      for (int j = 0; j < 3; ++j) {
-        double d = 0;
-        for (int a = 0; a < 3; ++a) d += (p[(j + 1) % 3][a] - p[j][a]) * (p[(j + 1) % 3][a] - p[j][a]);
-        longest = std::max(longest, d);
-      }
-      const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
-      if (!(std::sqrt(cx * cx + cy * cy + cz * cz) > 1e-9 * longest)) ++zero_area;
-    }
 #pragma omp critical(topstoc_output_triangles)
-    for (int32_t comp = 0; comp < num_components; ++comp) triangles_in[comp] += mine[comp];
+      for (int32_t comp = 0; comp < num_components; ++comp) triangles_in[comp] += mine[comp];
+    }
+    check.repeated_corner = repeated_corner;
+    check.mixed_triangles = mixed_triangles;
+    check.zero_area = zero_area;
+    for (int32_t comp = 0; comp < num_components; ++comp) euler[comp] += triangles_in[comp];
+    for (int32_t comp = 0; comp < num_components; ++comp)
+      if (triangles_in[comp] == 0) ++check.lost_components;
   }
-  check.repeated_corner = repeated_corner;
-  check.mixed_triangles = mixed_triangles;
-  check.zero_area = zero_area;
-  for (int32_t comp = 0; comp < num_components; ++comp) euler[comp] += triangles_in[comp];
-  for (int32_t comp = 0; comp < num_components; ++comp)
-    if (triangles_in[comp] == 0) ++check.lost_components;
+
+  // Zero area relative to the longest edge.
+  bool has_zero_area(const int32_t* c) const {
+    const double* p[3] = {&positions[3 * size_t(c[0])], &positions[3 * size_t(c[1])], &positions[3 * size_t(c[2])]};
+    double u[3], w[3], longest = 0;
+    for (int a = 0; a < 3; ++a) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
+    for (int j = 0; j < 3; ++j) {
+      double d = 0;
+      for (int a = 0; a < 3; ++a) d += (p[(j + 1) % 3][a] - p[j][a]) * (p[(j + 1) % 3][a] - p[j][a]);
+      longest = std::max(longest, d);
+    }
+    const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
+    return !(std::sqrt(cx * cx + cy * cy + cz * cz) > 1e-9 * longest);
+  }
 
   // Per vertex: its link gives the edges (each counted at its lower end), their triangle
   // counts and directions, duplicates, the fan, and the boundary. Vertices share only the sets
   // they join (union-finds whose roots do not depend on the order of joins) and the counts, so
   // they run on all threads and the result does not depend on how many.
-  const VertexArcs around(n, triangles);
-  SharedUnionFind pieces(n), boundary(n);
-  std::vector<uint8_t> on_boundary(n, 0), used(n, 0);
-  int32_t duplicate = 0, nonmanifold_edges = 0, inconsistent_edges = 0, nonmanifold_vertices = 0;
+  void check_vertex_links() {
+    const VertexArcs around(n, triangles);
+    on_boundary.assign(n, 0);
+    used.assign(n, 0);
+    int32_t duplicate = 0, nonmanifold_edges = 0, inconsistent_edges = 0, nonmanifold_vertices = 0;
 #pragma omp parallel reduction(+ : duplicate, nonmanifold_edges, inconsistent_edges, nonmanifold_vertices) \
     if (n >= kParallelMinCostly)
-  {
-    LinkArcs link;
-    std::vector<std::array<int32_t, 2>> corner_pairs;
-    std::vector<int64_t> my_euler(num_components, 0);
+    {
+      LinkArcs link;
+      std::vector<std::array<int32_t, 2>> corner_pairs;
+      std::vector<int64_t> my_euler(num_components, 0);
+      LinkIssues mine;
 #pragma omp for schedule(dynamic, 512)
-    for (int32_t v = 0; v < n; ++v) {
-      const int32_t count = around.offsets[v + 1] - around.offsets[v];
-      const VertexArcs::Arc* arcs = around.arcs.data() + around.offsets[v];
-      if (one_cycle(arcs, count) && manifold[component_of[v]]) {
-        // The common case, one closed fan (link_arcs.hpp): each neighbour edge has two
-        // triangles, one each way, and no triangle repeats; only the edges are counted.
-        used[v] = 1;
-        int64_t& euler_v = my_euler[component_of[v]];
-        ++euler_v;
-        for (int32_t i = 0; i < count; ++i)
-          if (arcs[i].from > v) --euler_v, pieces.unite(v, arcs[i].from);
-        continue;
-      }
-      link.clear();
-      corner_pairs.clear();
-      for (int32_t i = around.offsets[v]; i < around.offsets[v + 1]; ++i) {
-        const int32_t a = around.arcs[i].from, b = around.arcs[i].to;
-        link.add(a, b);
-        if (v < a && v < b) {
-          // A triangle over the same three vertices as an earlier one (at its lowest corner).
-          const std::array<int32_t, 2> pair = {std::min(a, b), std::max(a, b)};
-          duplicate += std::count(corner_pairs.begin(), corner_pairs.end(), pair) > 0;
-          corner_pairs.push_back(pair);
+      for (int32_t v = 0; v < n; ++v) {
+        const int32_t count = around.offsets[v + 1] - around.offsets[v];
+        const VertexArcs::Arc* arcs = around.arcs.data() + around.offsets[v];
+        if (one_cycle(arcs, count) && manifold[component_of[v]]) {
+          // The common case, one closed fan (link_arcs.hpp): each neighbour edge has two
+          // triangles, one each way, and no triangle repeats; only the edges are counted.
+          used[v] = 1;
+          int64_t& euler_v = my_euler[component_of[v]];
+          ++euler_v;
+          for (int32_t i = 0; i < count; ++i)
+            if (arcs[i].from > v) --euler_v, pieces.unite(v, arcs[i].from);
+          continue;
         }
+        check_link(v, arcs, count, link, corner_pairs, my_euler, mine);
       }
-      if (link.arcs == 0) continue;
-      used[v] = 1;
-      const int32_t comp = component_of[v];
-      ++my_euler[comp];
-      bool crowded = false;
-      for (const auto& nb : link.neighbours) {
-        const int32_t count = nb.in + nb.out;
-        if (nb.id > v) --my_euler[comp], pieces.unite(v, nb.id);  // each edge once
-        if (count > 2 || nb.in > 1 || nb.out > 1) crowded = true;
-        if (!manifold[comp]) continue;
-        if (nb.id > v && count > 2) ++nonmanifold_edges;
-        if (nb.id > v && count <= 2 && (nb.in > 1 || nb.out > 1)) ++inconsistent_edges;
-        if (count == 1) {
-          on_boundary[v] = 1;
-          boundary.unite(v, nb.id);
-        }
-      }
-      const bool pinched_input = pinched.count > 0 && pinched.pinched[kept[v]];
-      if (manifold[comp] && !crowded && !pinched_input && !link.single_fan()) ++nonmanifold_vertices;
-    }
+      duplicate += mine.duplicate, nonmanifold_edges += mine.nonmanifold_edges;
+      inconsistent_edges += mine.inconsistent_edges, nonmanifold_vertices += mine.nonmanifold_vertices;
 #pragma omp critical(topstoc_output_euler)
-    for (int32_t comp = 0; comp < num_components; ++comp) euler[comp] += my_euler[comp];
-  }
-  check.duplicate += duplicate;
-  check.nonmanifold_edges += nonmanifold_edges;
-  check.inconsistent_edges += inconsistent_edges;
-  check.nonmanifold_vertices += nonmanifold_vertices;
-  std::vector<int32_t> roots(num_components, -1), loops(num_components, 0);
-  for (int32_t v = 0; v < n; ++v) {
-    if (!used[v]) continue;
-    const int32_t comp = component_of[v];
-    const int32_t root = pieces.find(v);
-    if (roots[comp] < 0) {
-      roots[comp] = root;
-    } else if (roots[comp] != root) {
-      roots[comp] = -2;  // counted once below
+      for (int32_t comp = 0; comp < num_components; ++comp) euler[comp] += my_euler[comp];
     }
-    if (on_boundary[v] && boundary.find(v) == v) ++loops[comp];
+    check.duplicate += duplicate;
+    check.nonmanifold_edges += nonmanifold_edges;
+    check.inconsistent_edges += inconsistent_edges;
+    check.nonmanifold_vertices += nonmanifold_vertices;
   }
-  auto input_loops = component_boundary_loops(mesh, layout);
-  if (pinched.count > 0) {
-    // Loops touching at a pinch are one group of boundary edges, as counted on the output.
-    const auto groups = boundary_edge_groups(mesh);
-    for (int32_t comp = 0; comp < num_components; ++comp)
-      if (pinched.pinched_surface[comp]) input_loops[comp] = groups[comp];
+
+  // Any other vertex: its link's arcs one by one (`count` of them from `arcs`).
+  void check_link(int32_t v, const VertexArcs::Arc* arcs, int32_t count, LinkArcs& link,
+                  std::vector<std::array<int32_t, 2>>& corner_pairs, std::vector<int64_t>& my_euler,
+                  LinkIssues& issues) {
+    link.clear();
+    corner_pairs.clear();
+    for (int32_t i = 0; i < count; ++i) {
+      const int32_t a = arcs[i].from, b = arcs[i].to;
+      link.add(a, b);
+      if (v < a && v < b) {
+        // A triangle over the same three vertices as an earlier one (at its lowest corner).
+        const std::array<int32_t, 2> pair = {std::min(a, b), std::max(a, b)};
+        issues.duplicate += std::count(corner_pairs.begin(), corner_pairs.end(), pair) > 0;
+        corner_pairs.push_back(pair);
+      }
+    }
+    if (link.arcs == 0) return;
+    used[v] = 1;
+    const int32_t comp = component_of[v];
+    ++my_euler[comp];
+    bool crowded = false;
+    for (const auto& nb : link.neighbours) {
+      const int32_t triangles_at = nb.in + nb.out;
+      if (nb.id > v) --my_euler[comp], pieces.unite(v, nb.id);  // each edge once
+      if (triangles_at > 2 || nb.in > 1 || nb.out > 1) crowded = true;
+      if (!manifold[comp]) continue;
+      if (nb.id > v && triangles_at > 2) ++issues.nonmanifold_edges;
+      if (nb.id > v && triangles_at <= 2 && (nb.in > 1 || nb.out > 1)) ++issues.inconsistent_edges;
+      if (triangles_at == 1) {
+        on_boundary[v] = 1;
+        boundary.unite(v, nb.id);
+      }
+    }
+    const bool pinched_input = pinched.count > 0 && pinched.pinched[kept[v]];
+    if (manifold[comp] && !crowded && !pinched_input && !link.single_fan()) ++issues.nonmanifold_vertices;
   }
-  for (int32_t comp = 0; comp < num_components; ++comp) {
-    if (roots[comp] == -2) ++check.split_components;
-    if (!manifold[comp] || triangles_in[comp] == 0) continue;
-    if (euler[comp] != mesh.component_euler()[comp]) ++check.euler_changed;
-    if (loops[comp] != input_loops[comp]) ++check.boundary_loops_changed;
+
+  // Per component: split into pieces, Euler characteristic and boundary loops against the input.
+  void compare_components() {
+    std::vector<int32_t> roots(num_components, -1), loops(num_components, 0);
+    for (int32_t v = 0; v < n; ++v) {
+      if (!used[v]) continue;
+      const int32_t comp = component_of[v];
+      const int32_t root = pieces.find(v);
+      if (roots[comp] < 0) {
+        roots[comp] = root;
+      } else if (roots[comp] != root) {
+        roots[comp] = -2;  // counted once below
+      }
+      if (on_boundary[v] && boundary.find(v) == v) ++loops[comp];
+    }
+    auto input_loops = component_boundary_loops(mesh, layout);
+    if (pinched.count > 0) {
+      // Loops touching at a pinch are one group of boundary edges, as counted on the output.
+      const auto groups = boundary_edge_groups(mesh);
+      for (int32_t comp = 0; comp < num_components; ++comp)
+        if (pinched.pinched_surface[comp]) input_loops[comp] = groups[comp];
+    }
+    for (int32_t comp = 0; comp < num_components; ++comp) {
+      if (roots[comp] == -2) ++check.split_components;
+      if (!manifold[comp] || triangles_in[comp] == 0) continue;
+      if (euler[comp] != mesh.component_euler()[comp]) ++check.euler_changed;
+      if (loops[comp] != input_loops[comp]) ++check.boundary_loops_changed;
+    }
   }
-  check.pinched_fans_changed = changed_pinched_fans(mesh, pinched, kept, triangles);
-  return check;
+};
+
+}  // namespace
+
+OutputCheck check_output(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& kept,
+                         const std::vector<double>& positions, const std::vector<int32_t>& triangles) {
+  return OutputChecker(mesh, layout, kept, positions, triangles).run();
 }
 
 }  // namespace topstoc
