@@ -309,12 +309,8 @@ int32_t Collapser::batch_size(int32_t excess) const {
 }
 
 int32_t Collapser::run(Stop target) {
-  enum Status : uint8_t { kReady, kEvaluate, kEvaluateChecked, kWait };
   int32_t collapses = 0;
-  std::vector<int32_t> batch, reserved, pending, survivors, pair_from, pair_to;
-  std::vector<double> batch_key, pair_cost_from, pair_cost_to;
-  std::vector<uint8_t> status, pending_checked;
-  std::vector<Best> pending_best;
+  Batch batch;
   while (!reached(target)) {
     if (heap_.empty()) {
       // Some region could not reach its quota: the others give the rest, by cost alone.
@@ -324,121 +320,152 @@ int32_t Collapser::run(Stop target) {
         if (merged_into_[u] < 0) update(u);
       continue;
     }
-    // The cheapest queued collapses, in cost order.
-    const int32_t size = batch_size(target.faces > 0 ? (alive_faces_ - target.faces) / 2 : alive_vertices_ - target.vertices);
-    batch.clear();
-    batch_key.clear();
-    while (int32_t(batch.size()) < size && !heap_.empty()) {
-      const int32_t u = heap_.top();
-      const double key = heap_.top_key();
-      heap_.remove(u);
-      if (at_quota(u)) {
-        target_[u] = -1;
-        continue;
-      }
-      batch.push_back(u);
-      batch_key.push_back(key);
-    }
-    // Reserve, in cost order, the neighbourhoods of collapses no earlier one of the batch
-    // touches: applied in any order they see the state at the start of the batch, so their
-    // checks and costs can be computed at once (in parallel). The others wait in the queue.
+    take_batch(batch, batch_size(target.faces > 0 ? (alive_faces_ - target.faces) / 2 : alive_vertices_ - target.vertices));
     const uint32_t ring = ++ring_stamp_;
-    const int32_t count = int32_t(batch.size());
-    status.assign(count, kReady);
-    reserved.clear();
-    for (int32_t i = 0; i < count; ++i) {
-      const int32_t u = batch[i], v = target_[u];
-      if (dirty_[u] || merged_into_[v] >= 0) {
-        status[i] = kEvaluate;  // its key was a lower bound, or its collapse went stale
-      } else if (mark_ring(u, v, ring)) {
-        reserved.push_back(i);
-      } else {
-        status[i] = kWait;
-        queue(u, v, batch_key[i]);
-      }
-    }
-    const int32_t checks = int32_t(reserved.size());
-#pragma omp parallel for schedule(dynamic, 4) if (checks >= 16)
-    for (int32_t k = 0; k < checks; ++k) {
-      const int32_t i = reserved[k], u = batch[i], v = target_[u];
-      if (batch_key[i] != cost(u, v)) {
-        status[i] = kEvaluate;
-      } else if (!allowed(u, v, scratch_.mine())) {
-        status[i] = kEvaluateChecked;
-      }
-    }
-    pending.clear();
-    pending_checked.clear();
-    survivors.clear();
-    for (int32_t i = 0; i < count; ++i) {
-      const int32_t u = batch[i], v = target_[u];
-      if (status[i] == kWait) continue;
-      if (status[i] != kReady) {
-        pending.push_back(u);
-        pending_checked.push_back(status[i] == kEvaluateChecked);
-        continue;
-      }
-      if (reached(target)) {
-        queue(u, v, batch_key[i]);
-        continue;
-      }
-      if (at_quota(u)) {
-        target_[u] = -1;
-        continue;
-      }
-      collapse(u, v);
-      survivors.push_back(v);
-      ++collapses;
-    }
-    // Costs after the batch (in parallel): every collapse of each survivor v and, from each
-    // neighbour x, the collapse onto v (the same number when both are free); popped vertices
-    // that need a new evaluation.
-    pair_from.clear();
-    pair_to.clear();
-    for (int32_t v : survivors) {
-      neighbours(v, scratch_[0], scratch_[0].list);
-      for (int32_t x : scratch_[0].list) pair_from.push_back(v), pair_to.push_back(x);
-    }
-    const int32_t pairs = int32_t(pair_from.size()), evaluations = int32_t(pending.size());
-    pair_cost_from.assign(pairs, 0.0);
-    pair_cost_to.assign(pairs, 0.0);
-    pending_best.assign(evaluations, Best());
-#pragma omp parallel if (pairs + 8 * evaluations >= 64)
-    {
-#pragma omp for schedule(static) nowait
-      for (int32_t i = 0; i < pairs; ++i) {
-        const int32_t v = pair_from[i], x = pair_to[i];
-        const bool v_queues = queues(v), x_queues = queues(x);
-        if (v_queues) pair_cost_from[i] = cost(v, x);
-        if (x_queues) pair_cost_to[i] = v_queues && free_pair(x, v) ? pair_cost_from[i] : cost(x, v);
-      }
-#pragma omp for schedule(dynamic, 4)
-      for (int32_t i = 0; i < evaluations; ++i)
-        pending_best[i] = evaluate(pending[i], pending_checked[i], scratch_.mine());
-    }
-    for (int32_t i = 0; i < evaluations; ++i) {
-      settle(pending[i], pending_best[i]);
-      settled_[pending[i]] = ring;  // settled: the neighbour updates below leave it alone
-    }
-    for (int32_t i = 1, start = 0; i <= pairs; ++i) {
-      if (i < pairs && pair_from[i] == pair_from[start]) continue;
-      // pairs [start, i) belong to one survivor
-      const int32_t v = pair_from[start];
-      Best best;
-      if (queues(v))
-        for (int32_t k = start; k < i; ++k)
-          if (best.target < 0 || pair_cost_from[k] < best.cost ||
-              (pair_cost_from[k] == best.cost && pair_to[k] < best.target))
-            best = {pair_to[k], pair_cost_from[k]};
-      settle(v, best);
-      for (int32_t k = start; k < i; ++k) {
-        const int32_t x = pair_to[k];
-        if (settled_[x] != ring) offer(x, v, merged_from_[v], pair_cost_to[k]);
-      }
-      start = i;
-    }
+    reserve_batch(batch, ring);
+    check_reserved(batch);
+    collapses += apply_batch(batch, target);
+    cost_after_batch(batch, ring);
+    settle_survivors(batch, ring);
   }
   return collapses;
+}
+
+// The cheapest queued collapses, in cost order (at most `size`).
+void Collapser::take_batch(Batch& batch, int32_t size) {
+  batch.vertices.clear();
+  batch.key.clear();
+  while (int32_t(batch.vertices.size()) < size && !heap_.empty()) {
+    const int32_t u = heap_.top();
+    const double key = heap_.top_key();
+    heap_.remove(u);
+    if (at_quota(u)) {
+      target_[u] = -1;
+      continue;
+    }
+    batch.vertices.push_back(u);
+    batch.key.push_back(key);
+  }
+}
+
+// Reserve, in cost order, the neighbourhoods of collapses no earlier one of the batch touches:
+// applied in any order they see the state at the start of the batch, so their checks and costs
+// can be computed at once (in parallel). The others wait in the queue.
+void Collapser::reserve_batch(Batch& batch, uint32_t ring) {
+  const int32_t count = int32_t(batch.vertices.size());
+  batch.status.assign(count, kReady);
+  batch.reserved.clear();
+  for (int32_t i = 0; i < count; ++i) {
+    const int32_t u = batch.vertices[i], v = target_[u];
+    if (dirty_[u] || merged_into_[v] >= 0) {
+      batch.status[i] = kEvaluate;  // its key was a lower bound, or its collapse went stale
+    } else if (mark_ring(u, v, ring)) {
+      batch.reserved.push_back(i);
+    } else {
+      batch.status[i] = kWait;
+      queue(u, v, batch.key[i]);
+    }
+  }
+}
+
+// The reserved collapses whose cost changed or which are no longer allowed are evaluated anew.
+void Collapser::check_reserved(Batch& batch) {
+  const int32_t checks = int32_t(batch.reserved.size());
+#pragma omp parallel for schedule(dynamic, 4) if (checks >= 16)
+  for (int32_t k = 0; k < checks; ++k) {
+    const int32_t i = batch.reserved[k], u = batch.vertices[i], v = target_[u];
+    if (batch.key[i] != cost(u, v)) {
+      batch.status[i] = kEvaluate;
+    } else if (!allowed(u, v, scratch_.mine())) {
+      batch.status[i] = kEvaluateChecked;
+    }
+  }
+}
+
+// Applies the ready collapses in cost order (until the target), notes those to evaluate anew
+// and the survivors; returns how many collapsed.
+int32_t Collapser::apply_batch(Batch& batch, Stop target) {
+  int32_t collapses = 0;
+  batch.pending.clear();
+  batch.pending_checked.clear();
+  batch.survivors.clear();
+  for (int32_t i = 0; i < int32_t(batch.vertices.size()); ++i) {
+    const int32_t u = batch.vertices[i], v = target_[u];
+    if (batch.status[i] == kWait) continue;
+    if (batch.status[i] != kReady) {
+      batch.pending.push_back(u);
+      batch.pending_checked.push_back(batch.status[i] == kEvaluateChecked);
+      continue;
+    }
+    if (reached(target)) {
+      queue(u, v, batch.key[i]);
+      continue;
+    }
+    if (at_quota(u)) {
+      target_[u] = -1;
+      continue;
+    }
+    collapse(u, v);
+    batch.survivors.push_back(v);
+    ++collapses;
+  }
+  return collapses;
+}
+
+// Costs after the batch (in parallel): every collapse of each survivor v and, from each
+// neighbour x, the collapse onto v (the same number when both are free); popped vertices that
+// need a new evaluation are evaluated and settled.
+void Collapser::cost_after_batch(Batch& batch, uint32_t ring) {
+  batch.pair_from.clear();
+  batch.pair_to.clear();
+  for (int32_t v : batch.survivors) {
+    neighbours(v, scratch_[0], scratch_[0].list);
+    for (int32_t x : scratch_[0].list) batch.pair_from.push_back(v), batch.pair_to.push_back(x);
+  }
+  const int32_t pairs = int32_t(batch.pair_from.size()), evaluations = int32_t(batch.pending.size());
+  batch.pair_cost_from.assign(pairs, 0.0);
+  batch.pair_cost_to.assign(pairs, 0.0);
+  batch.pending_best.assign(evaluations, Best());
+#pragma omp parallel if (pairs + 8 * evaluations >= 64)
+  {
+#pragma omp for schedule(static) nowait
+    for (int32_t i = 0; i < pairs; ++i) {
+      const int32_t v = batch.pair_from[i], x = batch.pair_to[i];
+      const bool v_queues = queues(v), x_queues = queues(x);
+      if (v_queues) batch.pair_cost_from[i] = cost(v, x);
+      if (x_queues) batch.pair_cost_to[i] = v_queues && free_pair(x, v) ? batch.pair_cost_from[i] : cost(x, v);
+    }
+#pragma omp for schedule(dynamic, 4)
+    for (int32_t i = 0; i < evaluations; ++i)
+      batch.pending_best[i] = evaluate(batch.pending[i], batch.pending_checked[i], scratch_.mine());
+  }
+  for (int32_t i = 0; i < evaluations; ++i) {
+    settle(batch.pending[i], batch.pending_best[i]);
+    settled_[batch.pending[i]] = ring;  // settled: the neighbour updates below leave it alone
+  }
+}
+
+// Each survivor takes its cheapest collapse; its neighbours not settled in this batch are
+// offered the collapse onto it.
+void Collapser::settle_survivors(const Batch& batch, uint32_t ring) {
+  const int32_t pairs = int32_t(batch.pair_from.size());
+  for (int32_t i = 1, start = 0; i <= pairs; ++i) {
+    if (i < pairs && batch.pair_from[i] == batch.pair_from[start]) continue;
+    // pairs [start, i) belong to one survivor
+    const int32_t v = batch.pair_from[start];
+    Best best;
+    if (queues(v))
+      for (int32_t k = start; k < i; ++k)
+        if (best.target < 0 || batch.pair_cost_from[k] < best.cost ||
+            (batch.pair_cost_from[k] == best.cost && batch.pair_to[k] < best.target))
+          best = {batch.pair_to[k], batch.pair_cost_from[k]};
+    settle(v, best);
+    for (int32_t k = start; k < i; ++k) {
+      const int32_t x = batch.pair_to[k];
+      if (settled_[x] != ring) offer(x, v, merged_from_[v], batch.pair_cost_to[k]);
+    }
+    start = i;
+  }
 }
 
 // Marks u, v and their neighbours for this batch; false (nothing marked) if any already is.

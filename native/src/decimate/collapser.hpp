@@ -98,6 +98,21 @@ class Collapser {
   void refresh(int32_t u, int32_t v);
   bool mark_ring(int32_t u, int32_t v, uint32_t ring);
   int32_t batch_size(int32_t excess) const;
+  // One batch of run(): the cheapest queued collapses, their status, and what they leave to
+  // evaluate and to cost again. Kept across batches so that its lists keep their memory.
+  enum BatchStatus : uint8_t { kReady, kEvaluate, kEvaluateChecked, kWait };
+  struct Batch {
+    std::vector<int32_t> vertices, reserved, pending, survivors, pair_from, pair_to;
+    std::vector<double> key, pair_cost_from, pair_cost_to;
+    std::vector<uint8_t> status, pending_checked;
+    std::vector<Best> pending_best;
+  };
+  void take_batch(Batch& batch, int32_t size);
+  void reserve_batch(Batch& batch, uint32_t ring);
+  void check_reserved(Batch& batch);
+  int32_t apply_batch(Batch& batch, Stop target);
+  void cost_after_batch(Batch& batch, uint32_t ring);
+  void settle_survivors(const Batch& batch, uint32_t ring);
   void queue(int32_t u, int32_t v, double c);
   bool at_quota(int32_t u) const { return use_quota_ && count_[s_.bin[u]] <= s_.quota[s_.bin[u]]; }
   bool reached(Stop stop) const {
