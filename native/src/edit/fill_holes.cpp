@@ -165,46 +165,74 @@ class HoleIndex {
   std::vector<std::array<int32_t, 2>> entries_;
 };
 
-// Fills holes of the mesh held in r in place (see fill_loops_into). Vertices flagged in `pinch`
-// may lie on several holes and need not be manifold yet: welded pinch points, which the
-// patches make manifold.
-void fill_impl(EditResult& r, const std::vector<std::vector<int32_t>>& holes, const FillOptions& options,
-               const std::vector<uint8_t>* pinch) {
-  const double* positions = r.vertices.data();
-  const int32_t* triangles = r.triangles.data();
-  const int32_t num_vertices = static_cast<int32_t>(r.vertex_source.size());
-  const int64_t num_triangles = int64_t(r.face_source.size());
-  const size_t count = holes.size();
-  auto pinched = [&](int32_t v) { return pinch && (*pinch)[v]; };
-  std::vector<int32_t> hole_of(num_vertices, -1);
-  std::vector<int32_t> all;
-  for (size_t h = 0; h < count; ++h) {
-    const auto& loop = holes[h];
-    if (loop.size() < 3)
-      throw std::invalid_argument(hole_name(h) + " has " + std::to_string(loop.size()) + " vertices; a hole needs 3");
-    for (size_t i = 0; i < loop.size(); ++i) {
-      const int32_t v = loop[i];
-      if (v < 0 || v >= num_vertices)
-        throw std::invalid_argument(hole_name(h) + " entry " + std::to_string(i) + " is vertex " + std::to_string(v) +
-                                    ", outside [0, " + std::to_string(num_vertices) + ")");
-      if (hole_of[v] == int32_t(h))
-        throw std::invalid_argument(hole_name(h) + " visits vertex " + std::to_string(v) + " twice");
-      if (hole_of[v] >= 0 && !pinched(v))
-        throw std::invalid_argument("vertex " + std::to_string(v) + " is on " + hole_name(hole_of[v]) + " and " +
-                                    hole_name(h));
-      hole_of[v] = static_cast<int32_t>(h);
-      all.push_back(v);
-    }
-  }
-  check_positions(positions, num_vertices, &all);
-  std::vector<uint8_t> on_hole(num_vertices, 0);
-  for (int32_t v : all) on_hole[v] = 1;
-  const VertexTriangles around = vertex_triangles(triangles, num_triangles, num_vertices, on_hole.data());
+// One fill_impl run: the holes checked, each oriented and prepared against its triangles,
+// patched independently (in parallel), and the patches appended to r.
+class HoleFilling {
+ public:
+  HoleFilling(EditResult& r, const std::vector<std::vector<int32_t>>& holes, const FillOptions& options,
+              const std::vector<uint8_t>* pinch)
+      : r(r), holes(holes), options(options), pinch(pinch), positions(r.vertices.data()), triangles(r.triangles.data()),
+        num_vertices(static_cast<int32_t>(r.vertex_source.size())), num_triangles(int64_t(r.face_source.size())),
+        count(holes.size()) {}
 
-  // Validate every hole and orient it against its triangles (serially: errors are thrown here).
-  std::vector<PreparedHole> prepared(count);
+  void run() {
+    const std::vector<int32_t> all = check_holes();
+    check_positions(positions, num_vertices, &all);
+    std::vector<uint8_t> on_hole(num_vertices, 0);
+    for (int32_t v : all) on_hole[v] = 1;
+    const VertexTriangles around = vertex_triangles(triangles, num_triangles, num_vertices, on_hole.data());
+    // Validate every hole and orient it against its triangles (serially: errors are thrown here).
+    prepared.resize(count);
+    for (size_t h = 0; h < count; ++h) prepare(h, oriented(h, around), around);
+    triangulate_all();
+    append_patches();
+  }
+
+ private:
+  EditResult& r;
+  const std::vector<std::vector<int32_t>>& holes;
+  const FillOptions& options;
+  const std::vector<uint8_t>* pinch;
+  const double* positions;
+  const int32_t* triangles;
+  const int32_t num_vertices;
+  const int64_t num_triangles;
+  const size_t count;
+  std::vector<PreparedHole> prepared;
+  std::vector<HoleTriangulation> patches;
   std::vector<StarEdge> star;
-  for (size_t h = 0; h < count; ++h) {
+
+  bool pinched(int32_t v) const { return pinch && (*pinch)[v]; }
+
+  // Every hole's vertices valid, none twice in a hole, none on two holes unless pinched;
+  // returns them all.
+  std::vector<int32_t> check_holes() const {
+    std::vector<int32_t> hole_of(num_vertices, -1);
+    std::vector<int32_t> all;
+    for (size_t h = 0; h < count; ++h) {
+      const auto& loop = holes[h];
+      if (loop.size() < 3)
+        throw std::invalid_argument(hole_name(h) + " has " + std::to_string(loop.size()) + " vertices; a hole needs 3");
+      for (size_t i = 0; i < loop.size(); ++i) {
+        const int32_t v = loop[i];
+        if (v < 0 || v >= num_vertices)
+          throw std::invalid_argument(hole_name(h) + " entry " + std::to_string(i) + " is vertex " + std::to_string(v) +
+                                      ", outside [0, " + std::to_string(num_vertices) + ")");
+        if (hole_of[v] == int32_t(h))
+          throw std::invalid_argument(hole_name(h) + " visits vertex " + std::to_string(v) + " twice");
+        if (hole_of[v] >= 0 && !pinched(v))
+          throw std::invalid_argument("vertex " + std::to_string(v) + " is on " + hole_name(hole_of[v]) + " and " +
+                                      hole_name(h));
+        hole_of[v] = static_cast<int32_t>(h);
+        all.push_back(v);
+      }
+    }
+    return all;
+  }
+
+  // Hole h's loop, checked to run along boundary edges past manifold vertices, and oriented so
+  // that the patch runs each side against the triangle beyond it.
+  std::vector<int32_t> oriented(size_t h, const VertexTriangles& around) {
     std::vector<int32_t> loop = holes[h];
     const int32_t k = static_cast<int32_t>(loop.size());
     int32_t votes = 0;
@@ -223,8 +251,14 @@ void fill_impl(EditResult& r, const std::vector<std::vector<int32_t>>& holes, co
       }
       votes += e->outgoing[0] ? 1 : -1;
     }
-    // The patch runs each side against the triangle beyond it.
     if (votes > 0) std::reverse(loop.begin(), loop.end());
+    return loop;
+  }
+
+  // The triangulation's input for hole h: points, the normals of the triangles along it, the
+  // corners to copy attributes from, the ring around it and the edges that already exist.
+  void prepare(size_t h, const std::vector<int32_t>& loop, const VertexTriangles& around) {
+    const int32_t k = static_cast<int32_t>(loop.size());
     const HoleIndex index(loop);
     PreparedHole& p = prepared[h];
     p.vertices = loop;
@@ -262,46 +296,59 @@ void fill_impl(EditResult& r, const std::vector<std::vector<int32_t>>& holes, co
   }
 
   // Triangulate (and optionally refine and fair) every hole independently.
-  std::vector<HoleTriangulation> patches(count);
+  void triangulate_all() {
+    patches.resize(count);
 #pragma omp parallel for schedule(dynamic, 1) if (count >= 16)
-  for (int64_t h = 0; h < int64_t(count); ++h) {
-    PreparedHole& p = prepared[h];
-    patches[h] = triangulate_hole(p.hole, options.triangulation);
-    if (options.refine || options.fair) {
-      PatchMesh patch{p.hole.points, patches[h].added_points, patches[h].triangles};
-      refine_patch(patch, p.ring, p.hole.forbidden);
-      if (options.fair) fair_patch(patch, p.ring);
-      patches[h].added_points = std::move(patch.added);
-      patches[h].triangles = std::move(patch.triangles);
+    for (int64_t h = 0; h < int64_t(count); ++h) {
+      PreparedHole& p = prepared[h];
+      patches[h] = triangulate_hole(p.hole, options.triangulation);
+      if (options.refine || options.fair) {
+        PatchMesh patch{p.hole.points, patches[h].added_points, patches[h].triangles};
+        refine_patch(patch, p.ring, p.hole.forbidden);
+        if (options.fair) fair_patch(patch, p.ring);
+        patches[h].added_points = std::move(patch.added);
+        patches[h].triangles = std::move(patch.triangles);
+      }
     }
   }
 
-  for (size_t h = 0; h < count; ++h) {
-    const PreparedHole& p = prepared[h];
-    const HoleTriangulation& patch = patches[h];
-    const int32_t k = static_cast<int32_t>(p.vertices.size());
-    FilledHole filled;
-    filled.hole = static_cast<int32_t>(h);
-    filled.boundary = p.vertices;
-    filled.first_triangle = static_cast<int32_t>(r.face_source.size());
-    filled.num_triangles = static_cast<int32_t>(patch.triangles.size());
-    filled.first_vertex = static_cast<int32_t>(r.vertex_source.size());
-    filled.num_vertices = static_cast<int32_t>(patch.added_points.size() / 3);
-    filled.method = patch.method;
-    std::copy(patch.normal, patch.normal + 3, filled.normal);
-    r.vertices.insert(r.vertices.end(), patch.added_points.begin(), patch.added_points.end());
-    r.vertex_source.insert(r.vertex_source.end(), size_t(filled.num_vertices), -1);
-    for (const auto& t : patch.triangles) {
-      r.face_source.push_back(-1);
-      for (int32_t corner : t) {
-        const bool existing = corner < k;
-        r.triangles.push_back(existing ? p.vertices[corner] : filled.first_vertex + corner - k);
-        const int32_t source = existing ? r.corner_source[p.side_corner[corner]] : -1;
-        r.corner_source.push_back(source);
+  // The patches' vertices and triangles appended to r, in hole order, with their records.
+  void append_patches() {
+    for (size_t h = 0; h < count; ++h) {
+      const PreparedHole& p = prepared[h];
+      const HoleTriangulation& patch = patches[h];
+      const int32_t k = static_cast<int32_t>(p.vertices.size());
+      FilledHole filled;
+      filled.hole = static_cast<int32_t>(h);
+      filled.boundary = p.vertices;
+      filled.first_triangle = static_cast<int32_t>(r.face_source.size());
+      filled.num_triangles = static_cast<int32_t>(patch.triangles.size());
+      filled.first_vertex = static_cast<int32_t>(r.vertex_source.size());
+      filled.num_vertices = static_cast<int32_t>(patch.added_points.size() / 3);
+      filled.method = patch.method;
+      std::copy(patch.normal, patch.normal + 3, filled.normal);
+      r.vertices.insert(r.vertices.end(), patch.added_points.begin(), patch.added_points.end());
+      r.vertex_source.insert(r.vertex_source.end(), size_t(filled.num_vertices), -1);
+      for (const auto& t : patch.triangles) {
+        r.face_source.push_back(-1);
+        for (int32_t corner : t) {
+          const bool existing = corner < k;
+          r.triangles.push_back(existing ? p.vertices[corner] : filled.first_vertex + corner - k);
+          const int32_t source = existing ? r.corner_source[p.side_corner[corner]] : -1;
+          r.corner_source.push_back(source);
+        }
       }
+      r.patches.push_back(std::move(filled));
     }
-    r.patches.push_back(std::move(filled));
   }
+};
+
+// Fills holes of the mesh held in r in place (see fill_loops_into). Vertices flagged in `pinch`
+// may lie on several holes and need not be manifold yet: welded pinch points, which the
+// patches make manifold.
+void fill_impl(EditResult& r, const std::vector<std::vector<int32_t>>& holes, const FillOptions& options,
+               const std::vector<uint8_t>* pinch) {
+  HoleFilling(r, holes, options, pinch).run();
 }
 
 // The unedited mesh as an edit result: copies, identity maps.

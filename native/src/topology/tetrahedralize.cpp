@@ -194,23 +194,23 @@ std::array<int32_t, 3> sorted3(int32_t a, int32_t b, int32_t c) {
   return k;
 }
 
-}  // namespace
-
-TetMesh tetrahedralize_surface(const double* positions, int32_t num_vertices, const int32_t* triangles,
-                               int32_t num_triangles, Progress* progress) {
-  // TetGen refuses a self-intersecting surface, often by crashing without a word: name the
-  // first offending pair instead.
-  const auto check_start = std::chrono::steady_clock::now();
+// TetGen refuses a self-intersecting surface, often by crashing without a word: name the
+// first offending pair instead.
+void refuse_self_intersections(const double* positions, int32_t num_vertices, const int32_t* triangles,
+                               int32_t num_triangles) {
   const auto crossing = self_intersections(positions, num_vertices, triangles, num_triangles, 1);
-  if (!crossing.empty()) {
-    const auto [a, b] = crossing.front();
-    std::vector<int32_t> vertices(triangles + 3 * size_t(a), triangles + 3 * size_t(a) + 3);
-    if (a == b) throw TetgenRefused(4, "the surface has a triangle without area", vertices);
-    vertices.insert(vertices.end(), triangles + 3 * size_t(b), triangles + 3 * size_t(b) + 3);
-    throw TetgenRefused(3, "the surface intersects itself", vertices);
-  }
-  const double seconds_check = std::chrono::duration<double>(std::chrono::steady_clock::now() - check_start).count();
-  // Input: the surface's vertices, then the 8 corners of a box around it.
+  if (crossing.empty()) return;
+  const auto [a, b] = crossing.front();
+  std::vector<int32_t> vertices(triangles + 3 * size_t(a), triangles + 3 * size_t(a) + 3);
+  if (a == b) throw TetgenRefused(4, "the surface has a triangle without area", vertices);
+  vertices.insert(vertices.end(), triangles + 3 * size_t(b), triangles + 3 * size_t(b) + 3);
+  throw TetgenRefused(3, "the surface intersects itself", vertices);
+}
+
+// TetGen's input: the surface's vertices, then the 8 corners of a box around it; the
+// surface's triangles, then the box's 6 quads. Fills mesh.points and mesh.tets.
+void tetrahedralize_in_box(const double* positions, int32_t num_vertices, const int32_t* triangles,
+                           int32_t num_triangles, Progress* progress, TetMesh& mesh) {
   std::vector<double> points(positions, positions + 3 * size_t(num_vertices));
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (int32_t v = 0; v < num_vertices; ++v)
@@ -246,16 +246,16 @@ TetMesh tetrahedralize_surface(const double* positions, int32_t num_vertices, co
   in.io.numberofpoints = num_vertices + 8;
   in.io.facetlist = facets.data();
   in.io.numberoffacets = int(facets.size());
-  TetMesh mesh;
-  mesh.num_surface_points = num_vertices;
-  mesh.seconds_check = seconds_check;
   run_tetgen(in.io, mesh.points, mesh.tets, progress);
   if (mesh.points.size() < 3 * size_t(num_vertices)) throw TetgenRefused(0, "TetGen lost surface vertices");
   for (size_t i = 0; i < 3 * size_t(num_vertices); ++i)
     if (mesh.points[i] != positions[i]) throw TetgenRefused(0, "TetGen moved or renumbered a surface vertex");
-  const int32_t num_tets = mesh.num_tets();
+}
 
-  // Distinct faces of the tetrahedra and the (one or two) tetrahedra of each.
+// Distinct faces of the tetrahedra (numbered in sorted corner order) and each tetrahedron's
+// faces; returns the (one or two) tetrahedra of each face, 2 per face, -1 for a face on the box.
+std::vector<int32_t> number_faces(TetMesh& mesh) {
+  const int32_t num_tets = mesh.num_tets();
   std::vector<FaceKey> keys(4 * size_t(num_tets));
   for (int32_t t = 0; t < num_tets; ++t) {
     const int32_t* c = &mesh.tets[4 * size_t(t)];
@@ -264,7 +264,7 @@ TetMesh tetrahedralize_surface(const double* positions, int32_t num_vertices, co
   }
   std::sort(keys.begin(), keys.end());
   mesh.tet_faces.assign(4 * size_t(num_tets), -1);
-  std::vector<int32_t> face_tets;  // 2 per face, -1 for a face on the box
+  std::vector<int32_t> face_tets;
   for (size_t i = 0; i < keys.size();) {
     size_t j = i;
     while (j < keys.size() && keys[j].v == keys[i].v) ++j;
@@ -280,28 +280,38 @@ TetMesh tetrahedralize_surface(const double* positions, int32_t num_vertices, co
     }
     i = j;
   }
-  // The surface triangles among them (faces were numbered in sorted key order: binary search).
-  auto face_of = [&](const std::array<int32_t, 3>& key) {
-    int32_t lo = 0, hi = mesh.num_faces();
-    while (lo < hi) {
-      const int32_t mid = lo + (hi - lo) / 2;
-      const std::array<int32_t, 3> at{mesh.faces[3 * size_t(mid)], mesh.faces[3 * size_t(mid) + 1], mesh.faces[3 * size_t(mid) + 2]};
-      if (at < key) lo = mid + 1; else hi = mid;
-    }
-    const bool found = lo < mesh.num_faces() && mesh.faces[3 * size_t(lo)] == key[0] &&
-                       mesh.faces[3 * size_t(lo) + 1] == key[1] && mesh.faces[3 * size_t(lo) + 2] == key[2];
-    return found ? lo : -1;
-  };
+  return face_tets;
+}
+
+// The face with these sorted corners (faces are in sorted key order: binary search), or -1.
+int32_t face_of(const TetMesh& mesh, const std::array<int32_t, 3>& key) {
+  int32_t lo = 0, hi = mesh.num_faces();
+  while (lo < hi) {
+    const int32_t mid = lo + (hi - lo) / 2;
+    const std::array<int32_t, 3> at{mesh.faces[3 * size_t(mid)], mesh.faces[3 * size_t(mid) + 1], mesh.faces[3 * size_t(mid) + 2]};
+    if (at < key) lo = mid + 1; else hi = mid;
+  }
+  const bool found = lo < mesh.num_faces() && mesh.faces[3 * size_t(lo)] == key[0] &&
+                     mesh.faces[3 * size_t(lo) + 1] == key[1] && mesh.faces[3 * size_t(lo) + 2] == key[2];
+  return found ? lo : -1;
+}
+
+// The surface triangles among the faces (mesh.surface_face); returns per face whether it is one.
+std::vector<uint8_t> find_surface_faces(TetMesh& mesh, const int32_t* triangles, int32_t num_triangles) {
   std::vector<uint8_t> on_surface(mesh.num_faces(), 0);
   mesh.surface_face.resize(num_triangles);
   for (int32_t t = 0; t < num_triangles; ++t) {
-    const int32_t f = face_of(sorted3(triangles[3 * size_t(t)], triangles[3 * size_t(t) + 1], triangles[3 * size_t(t) + 2]));
+    const int32_t f = face_of(mesh, sorted3(triangles[3 * size_t(t)], triangles[3 * size_t(t) + 1], triangles[3 * size_t(t) + 2]));
     if (f < 0) throw TetgenRefused(0, "TetGen did not keep surface triangle " + std::to_string(t));
     mesh.surface_face[t] = f;
     on_surface[f] = 1;
   }
-  // Flood fill from the box, never across the surface: reached tetrahedra are outside.
-  mesh.inside.assign(num_tets, 1);
+  return on_surface;
+}
+
+// Flood fill from the box, never across the surface: reached tetrahedra are outside.
+void mark_outside(TetMesh& mesh, const std::vector<int32_t>& face_tets, const std::vector<uint8_t>& on_surface) {
+  mesh.inside.assign(mesh.num_tets(), 1);
   std::vector<int32_t> stack;
   for (int32_t f = 0; f < mesh.num_faces(); ++f)
     if (face_tets[2 * size_t(f) + 1] < 0 && mesh.inside[face_tets[2 * size_t(f)]]) {
@@ -322,6 +332,21 @@ TetMesh tetrahedralize_surface(const double* positions, int32_t num_vertices, co
       }
     }
   }
+}
+
+}  // namespace
+
+TetMesh tetrahedralize_surface(const double* positions, int32_t num_vertices, const int32_t* triangles,
+                               int32_t num_triangles, Progress* progress) {
+  const auto check_start = std::chrono::steady_clock::now();
+  refuse_self_intersections(positions, num_vertices, triangles, num_triangles);
+  TetMesh mesh;
+  mesh.num_surface_points = num_vertices;
+  mesh.seconds_check = std::chrono::duration<double>(std::chrono::steady_clock::now() - check_start).count();
+  tetrahedralize_in_box(positions, num_vertices, triangles, num_triangles, progress, mesh);
+  const auto face_tets = number_faces(mesh);
+  const auto on_surface = find_surface_faces(mesh, triangles, num_triangles);
+  mark_outside(mesh, face_tets, on_surface);
   // A closed embedded surface has exactly one tetrahedron on each side of each of its triangles.
   for (int32_t t = 0; t < num_triangles; ++t) {
     const int32_t f = mesh.surface_face[t];
