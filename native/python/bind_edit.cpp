@@ -68,9 +68,8 @@ py::dict result_dict(EditResult&& r) {
   return d;
 }
 
-}  // namespace
-
-void bind_edit(py::module_& m) {
+// Edits that cut: deleting faces, cutting along a loop, and the boundary loops they leave.
+void bind_cuts(py::module_& m) {
   m.def(
       "delete_faces",
       [](const py::handle& vertices, const py::handle& triangles, const py::handle& faces) {
@@ -118,7 +117,10 @@ void bind_edit(py::module_& m) {
       },
       py::arg("triangles"), py::arg("num_vertices"),
       "Boundary loops as (vertex ids, first non-manifold vertex or -1, lone triangle), by lowest vertex.");
+}
 
+// Edits that fill: holes chosen by index, holes given as loops, and removing a handle.
+void bind_fills(py::module_& m) {
   m.def(
       "fill_holes",
       [](const py::handle& vertices, const py::handle& triangles, const py::handle& holes, int32_t max_edges,
@@ -190,6 +192,13 @@ void bind_edit(py::module_& m) {
       py::arg("separation") = 0.25, py::arg("planar") = true, py::arg("max_dp_corners") = 300, py::arg("refine") = false, py::arg("fair") = false,
       py::arg("allow_self_intersections") = false,
       "Cuts along a handle or tunnel loop and fills both holes: the genus drops by one.");
+}
+
+}  // namespace
+
+void bind_edit(py::module_& m) {
+  bind_cuts(m);
+  bind_fills(m);
 }
 
 }  // namespace topstoc::python

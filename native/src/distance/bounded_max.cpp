@@ -38,24 +38,50 @@ double nearest_corner_reach(const double p[3][3]) {
   return std::sqrt(longest2) * std::sqrt(a2 * b2 * c2 / area16);
 }
 
-}  // namespace
+// One bound_max_distance run: pieces of the sampled surface in a queue by their upper bound,
+// the worst split into four until the bound is within the tolerance of the best distance found.
+class MaxSearch {
+ public:
+  MaxSearch(const Surface& from, const std::vector<double>& vertex_distance, const Surface& to, double start,
+            const double* start_point, double relative_tolerance, int64_t max_queries)
+      : from(from), vertex_distance(vertex_distance), to_positions(to.positions()), to_triangles(to.triangles()),
+        bvh(to.bvh()), relative_tolerance(relative_tolerance), max_queries(max_queries),
+        floor(1e-13 * std::max(from.diagonal(), to.diagonal())) {
+    out.lower = start;
+    std::copy_n(start_point, 3, out.lower_point);
+  }
 
-MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& vertex_distance, const Surface& to,
-                              double start, const double* start_point, double relative_tolerance,
-                              int64_t max_queries) {
+  MaxBracket run() {
+    seed_pieces();
+    while (!open.empty()) {
+      if (tolerated(open.top().upper)) break;  // the best remaining cannot beat the tolerance
+      if (out.queries + 7 > max_queries) break;
+      const Piece piece = open.top();
+      open.pop();
+      subdivide(piece);
+    }
+    out.converged = open.empty() || tolerated(open.top().upper);
+    out.upper = std::max({out.lower, settled, open.empty() ? 0.0 : open.top().upper});
+    return out;
+  }
+
+ private:
+  const Surface& from;
+  const std::vector<double>& vertex_distance;
+  const std::vector<double>& to_positions;
+  const std::vector<int32_t>& to_triangles;
+  const TriangleBvh& bvh;
+  const double relative_tolerance;
+  const int64_t max_queries;
+  const double floor;  // a tiny absolute floor, so that identical surfaces (max 0) do not subdivide forever
   MaxBracket out;
-  out.lower = start;
-  std::copy_n(start_point, 3, out.lower_point);
-  const auto& positions = from.positions();
-  const auto& triangles = from.triangles();
-  const auto& to_positions = to.positions();
-  const auto& to_triangles = to.triangles();
-  const TriangleBvh& bvh = to.bvh();
-  // A tiny absolute floor, so that identical surfaces (max 0) do not subdivide forever.
-  const double floor = 1e-13 * std::max(from.diagonal(), to.diagonal());
-  auto tolerated = [&](double upper) { return upper <= std::max(out.lower * (1 + relative_tolerance), floor); };
   int32_t hint = -1;
-  auto query = [&](const double* x) {
+  std::priority_queue<Piece, std::vector<Piece>, ByUpper> open;
+  double settled = 0.0;  // the highest bound among pieces dropped as tolerated
+
+  bool tolerated(double upper) const { return upper <= std::max(out.lower * (1 + relative_tolerance), floor); }
+
+  ClosestHit query(const double* x) {
     const ClosestHit hit = bvh.closest(x, hint);
     hint = hit.slot;
     ++out.queries;
@@ -65,10 +91,11 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
       out.lower_triangle = -2;  // set by the caller of query
     }
     return hit;
-  };
-  // Two bounds (the distance is 1-Lipschitz; and the distance to one fixed triangle of the other
-  // surface is convex, so over the piece it peaks at a corner): the smaller one holds.
-  auto bound = [&](Piece& piece) {
+  }
+
+  // Two bounds (the distance is 1-Lipschitz; and the distance to one fixed triangle of the
+  // other surface is convex, so over the piece it peaks at a corner): the smaller one holds.
+  void bound(Piece& piece) const {
     double upper = std::max({piece.d[0], piece.d[1], piece.d[2]}) + nearest_corner_reach(piece.p);
     for (int32_t j : piece.near) {
       if (j < 0) continue;
@@ -80,52 +107,55 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
       upper = std::min(upper, std::sqrt(farthest));
     }
     piece.upper = upper;
-  };
-  auto centroid_near = [&](Piece& piece) {
+  }
+
+  void centroid_near(Piece& piece) {
     double centroid[3];
     for (int k = 0; k < 3; ++k) centroid[k] = (piece.p[0][k] + piece.p[1][k] + piece.p[2][k]) / 3.0;
     const ClosestHit hit = query(centroid);
     if (out.lower_triangle == -2) out.lower_triangle = piece.source;
     piece.near[3] = hit.triangle;
-  };
+  }
 
-  // Nearest triangle of every vertex used by the sampled surface.
-  std::vector<int32_t> vertex_near(from.num_vertices(), -1);
-  for (int32_t v = 0; v < from.num_vertices(); ++v)
-    if (from.used()[v]) vertex_near[v] = query(&positions[3 * size_t(v)]).triangle;
-  out.lower_triangle = -1;
-
-  std::priority_queue<Piece, std::vector<Piece>, ByUpper> open;
-  double settled = 0.0;  // the highest bound among pieces dropped as tolerated
-  auto keep = [&](const Piece& piece) {
-    if (tolerated(piece.upper)) {
-      settled = std::max(settled, piece.upper);
-    } else {
-      open.push(piece);
-    }
-  };
-  for (int32_t f = 0; f < from.num_triangles(); ++f) {
-    Piece piece;
-    piece.source = f;
-    for (int j = 0; j < 3; ++j) {
-      const int32_t v = triangles[3 * size_t(f) + j];
-      std::copy_n(&positions[3 * size_t(v)], 3, piece.p[j]);
-      piece.d[j] = vertex_distance[v];
-      piece.near[j] = vertex_near[v];
-    }
-    piece.near[3] = -1;
+  // Bounds a new piece (with its centroid's nearest triangle when the corners' do not settle
+  // it) and queues it unless tolerated.
+  void keep(Piece& piece) {
     bound(piece);
     if (!tolerated(piece.upper)) {
       centroid_near(piece);
       bound(piece);
     }
-    keep(piece);
+    if (tolerated(piece.upper)) {
+      settled = std::max(settled, piece.upper);
+    } else {
+      open.push(piece);
+    }
   }
-  while (!open.empty()) {
-    if (tolerated(open.top().upper)) break;  // the best remaining cannot beat the tolerance
-    if (out.queries + 7 > max_queries) break;
-    const Piece piece = open.top();
-    open.pop();
+
+  // The sampled surface's triangles as the first pieces, with each used vertex's nearest triangle.
+  void seed_pieces() {
+    const auto& positions = from.positions();
+    const auto& triangles = from.triangles();
+    std::vector<int32_t> vertex_near(from.num_vertices(), -1);
+    for (int32_t v = 0; v < from.num_vertices(); ++v)
+      if (from.used()[v]) vertex_near[v] = query(&positions[3 * size_t(v)]).triangle;
+    out.lower_triangle = -1;
+    for (int32_t f = 0; f < from.num_triangles(); ++f) {
+      Piece piece;
+      piece.source = f;
+      for (int j = 0; j < 3; ++j) {
+        const int32_t v = triangles[3 * size_t(f) + j];
+        std::copy_n(&positions[3 * size_t(v)], 3, piece.p[j]);
+        piece.d[j] = vertex_distance[v];
+        piece.near[j] = vertex_near[v];
+      }
+      piece.near[3] = -1;
+      keep(piece);
+    }
+  }
+
+  // Splits a piece at its edges' midpoints into four.
+  void subdivide(const Piece& piece) {
     double mid[3][3], dm[3];
     int32_t nm[3];
     for (int j = 0; j < 3; ++j) {
@@ -151,17 +181,17 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
         c.near[j] = near[child[j]];
       }
       c.near[3] = piece.near[3];
-      bound(c);
-      if (!tolerated(c.upper)) {
-        centroid_near(c);
-        bound(c);
-      }
       keep(c);
     }
   }
-  out.converged = open.empty() || tolerated(open.top().upper);
-  out.upper = std::max({out.lower, settled, open.empty() ? 0.0 : open.top().upper});
-  return out;
+};
+
+}  // namespace
+
+MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& vertex_distance, const Surface& to,
+                              double start, const double* start_point, double relative_tolerance,
+                              int64_t max_queries) {
+  return MaxSearch(from, vertex_distance, to, start, start_point, relative_tolerance, max_queries).run();
 }
 
 }  // namespace topstoc
