@@ -124,13 +124,16 @@ class OneRingScan {
     end_rank.resize(2 * size_t(k));
     double sum[3] = {0, 0, 0};
     int32_t lowest_of = 0;
+    const int32_t* faces = a.faces.data();
+    const int32_t* vertex_faces = a.vertex_faces.data() + first;
+    const double* positions = a.positions.data();
     for (int32_t i = 0; i < k; ++i) {
-      const int32_t* t = &a.faces[3 * size_t(a.vertex_faces[first + i])];
+      const int32_t* t = faces + 3 * size_t(vertex_faces[i]);
       const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-      if (i == 0) a.first_corner[v] = 3 * a.face_source[a.vertex_faces[first]] + c;
+      if (i == 0) a.first_corner[v] = 3 * a.face_source[vertex_faces[0]] + c;
       // Area-weighted: the unnormalised face normal (twice the area) summed at each corner.
       double fn[3];
-      cross(&a.positions[3 * size_t(t[0])], &a.positions[3 * size_t(t[1])], &a.positions[3 * size_t(t[2])], fn);
+      cross(positions + 3 * size_t(t[0]), positions + 3 * size_t(t[1]), positions + 3 * size_t(t[2]), fn);
       sum[0] += fn[0];
       sum[1] += fn[1];
       sum[2] += fn[2];
@@ -170,17 +173,19 @@ class OneRingScan {
   // directions (one arc leaves u, one enters it). Each edge is counted at its lower end.
   void count_edges(int32_t v, const int32_t* neighbours, int32_t d, int32_t lower, OneRingCounts& counts,
                    bool& nonmanifold_edge, bool& flipped) {
+    int32_t boundary = 0, nonmanifold = 0, inconsistent = 0;
     for (int32_t r = 0; r < d; ++r) {
       const int32_t count = in[r] + out[r];
       const bool bad_direction = count == 2 && !(in[r] == 1 && out[r] == 1);
       nonmanifold_edge |= count > 2;
       flipped |= bad_direction;
       if (r < lower) continue;
-      counts.boundary += count == 1;
-      counts.nonmanifold_edges += count >= 3;
-      counts.inconsistent += bad_direction;
+      boundary += count == 1;
+      nonmanifold += count >= 3;
+      inconsistent += bad_direction;
       a.sets.unite(v, neighbours[r]);
     }
+    counts.boundary += boundary, counts.nonmanifold_edges += nonmanifold, counts.inconsistent += inconsistent;
   }
 
   // Fans: with every edge at v on at most two triangles, consistently oriented, the arcs are
