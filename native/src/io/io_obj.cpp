@@ -54,146 +54,193 @@ void check_cut_corner(std::string_view corner, std::string_view previous, size_t
                            ": it looks cut short");
 }
 
+// One OBJ file read statement by statement into a MeshFile.
+class ObjReader {
+ public:
+  ObjReader(const char* data, size_t size) : data_(data), size_(size), lines_(data, data + size) {}
+
+  MeshFile read() {
+    std::string_view line;
+    while (next_statement(line)) {
+      const size_t number = lines_.number();
+      if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+      std::string_view rest = line, keyword;
+      if (!next_token(rest, keyword)) continue;
+      if (keyword == "v") read_vertex(rest, number);
+      else if (keyword == "vt") read_uv(rest, number);
+      else if (keyword == "f" || keyword == "fo") read_face(rest, number);
+      else if (keyword == "usemtl") read_usemtl(rest, number);
+      else if (keyword == "mtllib") read_mtllib(rest);
+    }
+    check_references();
+    take_colors();
+    add_polygons();
+    warn_skipped_faces(mesh_, "line " + std::to_string(first_skipped_));
+    return std::move(mesh_);
+  }
+
+ private:
+  // The next line, with a statement continued over several lines by '\' joined into one.
+  bool next_statement(std::string_view& line) {
+    if (!lines_.next(line)) return false;
+    if (line.empty() || line.back() != '\\') return true;
+    joined_.assign(line.substr(0, line.size() - 1));
+    joined_ += ' ';
+    while (lines_.next(line)) {
+      const bool more = !line.empty() && line.back() == '\\';
+      joined_.append(line.substr(0, line.size() - (more ? 1 : 0)));
+      if (!more) break;
+      joined_ += ' ';
+    }
+    line = joined_;
+    return true;
+  }
+
+  void read_vertex(std::string_view rest, size_t number) {
+    double values[7];
+    int count = 0;
+    std::string_view token;
+    while (next_token(rest, token)) {
+      if (count == 7) fail_at_line(number, "vertex has more than 7 numbers");
+      if (!parse_double(token, values[count])) fail_at_line(number, "vertex coordinate " + quote(token) + " is not a number");
+      ++count;
+    }
+    if (count < 3) fail_at_line(number, "vertex needs 3 coordinates, got " + std::to_string(count));
+    mesh_.vertices.insert(mesh_.vertices.end(), values, values + 3);
+    // "v x y z r g b [a]" is the common colour extension; "v x y z w" has no colour.
+    if (count >= 6) {
+      colors_.insert(colors_.end(), {values[3], values[4], values[5], count == 7 ? values[6] : 1.0});
+      if (count == 7) channels_ = 4;
+      ++colored_;
+    }
+  }
+
+  void read_uv(std::string_view rest, size_t number) {
+    double uv[2] = {0.0, 0.0};
+    int count = 0;
+    std::string_view token;
+    while (next_token(rest, token)) {
+      double value;
+      if (!parse_double(token, value)) fail_at_line(number, "texture coordinate " + quote(token) + " is not a number");
+      if (count < 2) uv[count] = value;
+      ++count;
+    }
+    if (count < 1) fail_at_line(number, "vt needs at least one coordinate");
+    uv_table_.insert(uv_table_.end(), uv, uv + 2);
+  }
+
+  // One corner "v", "v/vt", "v//vn" or "v/vt/vn", resolved and appended.
+  void read_corner(std::string_view token, size_t number) {
+    const size_t slash = token.find('/');
+    const int64_t v = resolve(token.substr(0, slash), mesh_.num_vertices(), number, "vertex");
+    if (v > faces_.max_vertex) faces_.max_vertex = v, faces_.max_vertex_line = number;
+    int64_t t = -1;
+    if (slash != std::string_view::npos) {
+      std::string_view uv_token = token.substr(slash + 1);
+      uv_token = uv_token.substr(0, uv_token.find('/'));
+      if (!uv_token.empty()) {
+        t = resolve(uv_token, int64_t(uv_table_.size() / 2), number, "texture coordinate");
+        if (t > faces_.max_uv) faces_.max_uv = t, faces_.max_uv_line = number;
+      }
+    }
+    faces_.corner_vertex.push_back(int32_t(v));
+    faces_.corner_uv.push_back(int32_t(t));
+  }
+
+  void read_face(std::string_view rest, size_t number) {
+    const int64_t first_corner = int64_t(faces_.corner_vertex.size());
+    std::string_view token, last, before_last;  // corners, for the cut-short check
+    while (next_token(rest, token)) {
+      before_last = last;
+      last = token;
+      read_corner(token, number);
+    }
+    const int64_t corners = int64_t(faces_.corner_vertex.size()) - first_corner;
+    const bool cut = cut_short(data_, size_, lines_);
+    if (cut && !last.empty()) check_cut_corner(last, before_last, number);
+    if (cut && corners < 3)
+      fail_at_line(number, "the file ends without a line end in a face of " + std::to_string(corners) +
+                               " corners: it looks cut short");
+    if (corners < 3 && first_skipped_ == 0) first_skipped_ = number;
+    faces_.offsets.push_back(int64_t(faces_.corner_vertex.size()));
+    faces_.material.push_back(material_);
+  }
+
+  void read_usemtl(std::string_view rest, size_t number) {
+    const std::string name(trim(rest));
+    if (name.empty()) fail_at_line(number, "usemtl without a material name");
+    any_material_ = true;
+    if (name == "(null)") {  // how the writer spells "no material" after a named one
+      material_ = -1;
+      return;
+    }
+    material_ = material_ids_.emplace(name, int32_t(mesh_.material_names.size())).first->second;
+    if (material_ == int32_t(mesh_.material_names.size())) mesh_.material_names.push_back(name);
+  }
+
+  void read_mtllib(std::string_view rest) {
+    const std::string name(trim(rest));
+    if (!name.empty()) mesh_.material_libraries.push_back(name);
+  }
+
+  // Forward references are allowed while reading; here every index must exist.
+  void check_references() const {
+    const int64_t n = mesh_.num_vertices();
+    if (faces_.max_vertex >= n)
+      fail_at_line(faces_.max_vertex_line, "face refers to vertex " + std::to_string(faces_.max_vertex + 1) +
+                                               ", but the file has " + std::to_string(n) + " vertices");
+    if (faces_.max_uv >= int64_t(uv_table_.size() / 2))
+      fail_at_line(faces_.max_uv_line, "face refers to texture coordinate " + std::to_string(faces_.max_uv + 1) +
+                                           ", but the file has " + std::to_string(uv_table_.size() / 2));
+  }
+
+  // Vertex colours are kept only when every vertex has one.
+  void take_colors() {
+    const int64_t n = mesh_.num_vertices();
+    if (colored_ != n || n == 0) return;
+    mesh_.color_channels = int32_t(channels_);
+    mesh_.vertex_colors.reserve(size_t(channels_ * n));
+    for (int64_t v = 0; v < n; ++v)
+      for (int64_t k = 0; k < channels_; ++k) mesh_.vertex_colors.push_back(colors_[4 * size_t(v) + k]);
+  }
+
+  void add_polygons() {
+    const bool with_uvs = faces_.max_uv >= 0;
+    std::vector<double> uvs;
+    const int64_t count = int64_t(faces_.offsets.size()) - 1;
+    for (int64_t f = 0; f < count; ++f) {
+      const int64_t begin = faces_.offsets[f], end = faces_.offsets[f + 1];
+      if (with_uvs) {
+        uvs.clear();
+        for (int64_t c = begin; c < end; ++c) {
+          const int32_t t = faces_.corner_uv[c];
+          uvs.push_back(t >= 0 ? uv_table_[2 * size_t(t)] : kNaN);
+          uvs.push_back(t >= 0 ? uv_table_[2 * size_t(t) + 1] : kNaN);
+        }
+      }
+      add_polygon(mesh_, faces_.corner_vertex.data() + begin, size_t(end - begin), with_uvs ? uvs.data() : nullptr,
+                  faces_.material[f], with_uvs, any_material_);
+    }
+  }
+
+  const char* data_;
+  size_t size_;
+  TextLines lines_;
+  std::string joined_;  // a statement continued over several lines with '\'
+  MeshFile mesh_;
+  std::vector<double> uv_table_;
+  std::vector<double> colors_;  // 4 per coloured vertex, alpha 1 unless given; kept if all are
+  int64_t colored_ = 0, channels_ = 3;
+  ObjFaces faces_;
+  std::unordered_map<std::string, int32_t> material_ids_;
+  int32_t material_ = -1;
+  bool any_material_ = false;
+  size_t first_skipped_ = 0;  // line of the first face with fewer than 3 corners
+};
+
 }  // namespace
 
-MeshFile read_obj(const char* data, size_t size) {
-  MeshFile mesh;
-  std::vector<double> uv_table;
-  std::vector<double> colors;  // 4 per coloured vertex, alpha 1 unless given; kept if all are
-  int64_t colored = 0, channels = 3;
-  ObjFaces faces;
-  std::unordered_map<std::string, int32_t> material_ids;
-  int32_t material = -1;
-  bool any_material = false;
-  size_t first_skipped = 0;  // line of the first face with fewer than 3 corners
-
-  TextLines lines(data, data + size);
-  std::string_view line;
-  std::string joined;  // a statement continued over several lines with '\'
-  while (lines.next(line)) {
-    if (!line.empty() && line.back() == '\\') {
-      joined.assign(line.substr(0, line.size() - 1));
-      joined += ' ';
-      while (lines.next(line)) {
-        const bool more = !line.empty() && line.back() == '\\';
-        joined.append(line.substr(0, line.size() - (more ? 1 : 0)));
-        if (!more) break;
-        joined += ' ';
-      }
-      line = joined;
-    }
-    const size_t number = lines.number();
-    if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-    std::string_view rest = line, keyword, token;
-    if (!next_token(rest, keyword)) continue;
-
-    if (keyword == "v") {
-      double values[7];
-      int count = 0;
-      while (next_token(rest, token)) {
-        if (count == 7) fail_at_line(number, "vertex has more than 7 numbers");
-        if (!parse_double(token, values[count])) fail_at_line(number, "vertex coordinate " + quote(token) + " is not a number");
-        ++count;
-      }
-      if (count < 3) fail_at_line(number, "vertex needs 3 coordinates, got " + std::to_string(count));
-      mesh.vertices.insert(mesh.vertices.end(), values, values + 3);
-      // "v x y z r g b [a]" is the common colour extension; "v x y z w" has no colour.
-      const bool has_color = count >= 6;
-      if (has_color) {
-        colors.insert(colors.end(), {values[3], values[4], values[5], count == 7 ? values[6] : 1.0});
-        if (count == 7) channels = 4;
-        ++colored;
-      }
-    } else if (keyword == "vt") {
-      double uv[2] = {0.0, 0.0};
-      int count = 0;
-      while (next_token(rest, token)) {
-        double value;
-        if (!parse_double(token, value)) fail_at_line(number, "texture coordinate " + quote(token) + " is not a number");
-        if (count < 2) uv[count] = value;
-        ++count;
-      }
-      if (count < 1) fail_at_line(number, "vt needs at least one coordinate");
-      uv_table.insert(uv_table.end(), uv, uv + 2);
-    } else if (keyword == "f" || keyword == "fo") {
-      const int64_t first_corner = int64_t(faces.corner_vertex.size());
-      std::string_view last, before_last;  // corners, for the cut-short check
-      while (next_token(rest, token)) {
-        before_last = last;
-        last = token;
-        const size_t slash = token.find('/');
-        const int64_t v = resolve(token.substr(0, slash), mesh.num_vertices(), number, "vertex");
-        if (v > faces.max_vertex) faces.max_vertex = v, faces.max_vertex_line = number;
-        int64_t t = -1;
-        if (slash != std::string_view::npos) {
-          std::string_view uv_token = token.substr(slash + 1);
-          uv_token = uv_token.substr(0, uv_token.find('/'));
-          if (!uv_token.empty()) {
-            t = resolve(uv_token, int64_t(uv_table.size() / 2), number, "texture coordinate");
-            if (t > faces.max_uv) faces.max_uv = t, faces.max_uv_line = number;
-          }
-        }
-        faces.corner_vertex.push_back(int32_t(v));
-        faces.corner_uv.push_back(int32_t(t));
-      }
-      const int64_t corners = int64_t(faces.corner_vertex.size()) - first_corner;
-      const bool cut = cut_short(data, size, lines);
-      if (cut && !last.empty()) check_cut_corner(last, before_last, number);
-      if (cut && corners < 3)
-        fail_at_line(number, "the file ends without a line end in a face of " + std::to_string(corners) +
-                                 " corners: it looks cut short");
-      if (corners < 3 && first_skipped == 0) first_skipped = number;
-      faces.offsets.push_back(int64_t(faces.corner_vertex.size()));
-      faces.material.push_back(material);
-    } else if (keyword == "usemtl") {
-      const std::string name(trim(rest));
-      if (name.empty()) fail_at_line(number, "usemtl without a material name");
-      any_material = true;
-      if (name == "(null)") {  // how the writer spells "no material" after a named one
-        material = -1;
-        continue;
-      }
-      material = material_ids.emplace(name, int32_t(mesh.material_names.size())).first->second;
-      if (material == int32_t(mesh.material_names.size())) mesh.material_names.push_back(name);
-    } else if (keyword == "mtllib") {
-      const std::string name(trim(rest));
-      if (!name.empty()) mesh.material_libraries.push_back(name);
-    }
-  }
-
-  const int64_t n = mesh.num_vertices();
-  if (faces.max_vertex >= n)
-    fail_at_line(faces.max_vertex_line, "face refers to vertex " + std::to_string(faces.max_vertex + 1) +
-                                            ", but the file has " + std::to_string(n) + " vertices");
-  if (faces.max_uv >= int64_t(uv_table.size() / 2))
-    fail_at_line(faces.max_uv_line, "face refers to texture coordinate " + std::to_string(faces.max_uv + 1) +
-                                        ", but the file has " + std::to_string(uv_table.size() / 2));
-  if (colored == n && n > 0) {
-    mesh.color_channels = int32_t(channels);
-    mesh.vertex_colors.reserve(size_t(channels * n));
-    for (int64_t v = 0; v < n; ++v)
-      for (int64_t k = 0; k < channels; ++k) mesh.vertex_colors.push_back(colors[4 * size_t(v) + k]);
-  }
-
-  const bool with_uvs = faces.max_uv >= 0;
-  std::vector<double> uvs;
-  const int64_t count = int64_t(faces.offsets.size()) - 1;
-  for (int64_t f = 0; f < count; ++f) {
-    const int64_t begin = faces.offsets[f], end = faces.offsets[f + 1];
-    if (with_uvs) {
-      uvs.clear();
-      for (int64_t c = begin; c < end; ++c) {
-        const int32_t t = faces.corner_uv[c];
-        uvs.push_back(t >= 0 ? uv_table[2 * size_t(t)] : kNaN);
-        uvs.push_back(t >= 0 ? uv_table[2 * size_t(t) + 1] : kNaN);
-      }
-    }
-    add_polygon(mesh, faces.corner_vertex.data() + begin, size_t(end - begin), with_uvs ? uvs.data() : nullptr,
-                faces.material[f], with_uvs, any_material);
-  }
-  warn_skipped_faces(mesh, "line " + std::to_string(first_skipped));
-  return mesh;
-}
+MeshFile read_obj(const char* data, size_t size) { return ObjReader(data, size).read(); }
 
 std::string obj_name_problem(std::string_view name, bool material) {
   if (name.empty()) return "it is empty";
