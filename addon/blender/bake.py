@@ -1,0 +1,352 @@
+"""A tangent-space normal map baked from a source object onto its decimated result (Cycles, CPU,
+selected-to-active), so a low LOD still shades like the sculpt.
+
+The result keeps its UV map (the decimation keeps UV seams exactly) or gets one from Blender's
+Smart UV Project with island gaps sized for the resolution. The rays reach from the measured
+Hausdorff distance between the two (core/normal_bake.py). The image is saved beside the .blend
+(or a given folder) or packed, and the result gets copies of its materials with an Image Texture
+and a Normal Map node feeding the shader's Normal input; the source's materials are untouched.
+The user's render engine, bake settings, selection, active object and visibility are restored.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass
+
+import bpy
+import numpy as np
+
+from ..core.errors import TopStocError
+from ..core.hausdorff import hausdorff
+from ..core.normal_bake import (MAX_OVERLAP, available_memory, check_memory, check_size, island_margin,
+                                overlap_fraction, ray_reach)
+from . import mesh_io
+
+BAKE_UV_NAME = "TopStoc Bake"  #: the UV map made when the result has no usable one
+HAUSDORFF_SAMPLES = 200_000
+NODE_LABEL = "TopStoc Normal Map"
+
+
+class BakeError(TopStocError):
+    """A bake that cannot run (one line for the status bar / batch log)."""
+
+
+@dataclass
+class Baked:
+    """A finished bake."""
+
+    image: bpy.types.Image
+    uv_map: str              #: the UV map the image is laid out on
+    unwrapped: bool          #: True when the UV map was made for the bake
+    hausdorff_max: float     #: world units
+    extrusion: float         #: cage extrusion (world units)
+    max_ray: float           #: max ray distance (world units)
+    path: str = ""           #: the saved file ("" when packed)
+
+
+def check_bakeable(source, result) -> None:
+    """One-line errors for what a bake cannot use: non-meshes, a source without faces, modifiers."""
+    for obj in (source, result):
+        mesh_io.check_mesh_object(obj, BakeError)
+    if len(source.data.polygons) == 0:
+        raise BakeError(f"'{source.name}' has no faces to bake a normal map from")
+    if len(result.data.polygons) == 0:
+        raise BakeError(f"'{result.name}' has no faces to bake a normal map onto")
+    for obj in (source, result):
+        live = [m.name for m in obj.modifiers if m.show_render or m.show_viewport]
+        if live:
+            raise BakeError(f"'{obj.name}' has modifiers that are not applied ({', '.join(live)}): apply or "
+                            f"disable them before baking normals")
+
+
+def _world_triangles(obj, matrix) -> tuple:
+    arrays = mesh_io.read_mesh(obj.data)
+    m = np.array(matrix, dtype=np.float64)
+    return arrays.vertices @ m[:3, :3].T + m[:3, 3], arrays.triangles
+
+
+def measure_reach(source, result) -> tuple:
+    """(Hausdorff max, extrusion, max ray distance) in world units, both meshes placed where the
+    source is (the result is baked there)."""
+    a = _world_triangles(source, source.matrix_world)
+    b = _world_triangles(result, source.matrix_world)
+    measured = hausdorff(a, b, samples=HAUSDORFF_SAMPLES, percentile=0)
+    distance = measured.symmetric.max_upper
+    if not np.isfinite(distance):
+        distance = measured.symmetric.max
+    return (distance, *ray_reach(distance, measured.diagonal))
+
+
+def uv_triangles(mesh, layer) -> np.ndarray:
+    """(m, 3, 2) UV coordinates of the mesh's loop triangles in ``layer``."""
+    mesh.calc_loop_triangles()
+    loops = np.empty(3 * len(mesh.loop_triangles), dtype=np.int32)
+    mesh.loop_triangles.foreach_get("loops", loops)
+    uv = np.empty(2 * len(mesh.loops), dtype=np.float32)
+    layer.data.foreach_get("uv", uv)
+    return uv.reshape(-1, 2)[loops].reshape(-1, 3, 2)
+
+
+def ensure_uv_map(obj, size: int, margin: int) -> tuple:
+    """(name of the UV map the bake uses, True when made now): the active one when every texel of
+    its layout belongs to one place of the surface, else a new one from Smart UV Project (made
+    active for the bake; the others stay). ``obj`` must be the only selected object and the active
+    one (Edit Mode edits them all)."""
+    uv_layers = obj.data.uv_layers
+    active = uv_layers.active
+    if active is not None and overlap_fraction(uv_triangles(obj.data, active)) <= MAX_OVERLAP:
+        return active.name, False
+    layer = uv_layers.get(BAKE_UV_NAME) or uv_layers.new(name=BAKE_UV_NAME)
+    if layer is None:
+        raise BakeError(f"'{obj.name}' has no room for another UV map (Blender allows 8)")
+    uv_layers.active = layer
+    bpy.ops.object.mode_set(mode="EDIT")
+    try:
+        bpy.ops.mesh.reveal()
+        bpy.ops.mesh.select_all(action="SELECT")
+        bpy.ops.uv.smart_project(island_margin=island_margin(margin, size))
+    finally:
+        bpy.ops.object.mode_set(mode="OBJECT")
+    return layer.name, True
+
+
+def new_image(name: str, size: int) -> bpy.types.Image:
+    """A flat tangent-space normal map (0.5, 0.5, 1) of ``size``², non-colour data."""
+    image = bpy.data.images.new(name, size, size, alpha=False, float_buffer=False)
+    image.generated_color = (0.5, 0.5, 1.0, 1.0)
+    image.colorspace_settings.name = "Non-Color"
+    return image
+
+
+def _shader_node(tree):
+    """The node whose "Normal" input the map feeds: the output's surface shader (Principled)."""
+    for node in tree.nodes:
+        if node.type == "OUTPUT_MATERIAL" and node.is_active_output and node.inputs["Surface"].links:
+            shader = node.inputs["Surface"].links[0].from_node
+            if "Normal" in shader.inputs:
+                return shader
+    return next((node for node in tree.nodes if node.type == "BSDF_PRINCIPLED"), None)
+
+
+def _new_material(name: str):
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    return material
+
+
+def wire_normal_map(material, image, uv_map: str) -> None:
+    """Adds an Image Texture (``image``, the active node: the bake writes into it) and a Normal Map
+    node on ``uv_map`` to ``material``, feeding its shader's Normal input; nothing else changes."""
+    material.use_nodes = True
+    tree = material.node_tree
+    shader = _shader_node(tree)
+    if shader is None:
+        raise BakeError(f"material '{material.name}' has no shader with a Normal input to wire the map to")
+    texture = tree.nodes.new("ShaderNodeTexImage")
+    texture.image = image
+    texture.label = NODE_LABEL
+    texture.location = (shader.location.x - 600, shader.location.y - 300)
+    coordinates = tree.nodes.new("ShaderNodeUVMap")  # the map's own UV map, whichever renders
+    coordinates.uv_map = uv_map
+    coordinates.location = (shader.location.x - 800, shader.location.y - 300)
+    tree.links.new(coordinates.outputs["UV"], texture.inputs["Vector"])
+    normal = tree.nodes.new("ShaderNodeNormalMap")
+    normal.space = "TANGENT"
+    normal.uv_map = uv_map
+    normal.location = (shader.location.x - 250, shader.location.y - 300)
+    tree.links.new(texture.outputs["Color"], normal.inputs["Color"])
+    tree.links.new(normal.outputs["Normal"], shader.inputs["Normal"])
+    for node in tree.nodes:
+        node.select = node is texture
+    tree.nodes.active = texture
+
+
+def give_materials(result, image, uv_map: str) -> list:
+    """Replaces the result's materials by copies (``<name>_TopStoc``) wired to the map; a result
+    without materials gets a new one. Returns the materials made."""
+    made, copies = [], {}
+    if not any(slot.material for slot in result.material_slots):
+        material = _new_material(f"{result.name}_TopStoc")
+        if len(result.material_slots) == 0:
+            result.data.materials.append(material)
+        for slot in result.material_slots:
+            slot.material = material
+        copies[None] = material
+    for slot in result.material_slots:
+        if slot.material is None or slot.material in copies.values():
+            continue
+        if slot.material.name not in copies:
+            copies[slot.material.name] = slot.material.copy()
+            copies[slot.material.name].name = f"{slot.material.name}_TopStoc"
+        slot.material = copies[slot.material.name]
+    for material in copies.values():
+        wire_normal_map(material, image, uv_map)
+        made.append(material)
+    return made
+
+
+class _SceneState:
+    """The render engine, Cycles device and samples, selection, active object, visibility and the
+    result's placement, put back when the ``with`` block ends, whatever happens in it."""
+
+    def __init__(self, context, source, result):
+        self.context, self.source, self.result = context, source, result
+        self.engine = context.scene.render.engine
+        self.selected = [obj for obj in context.view_layer.objects if obj.select_get()]
+        self.active = context.view_layer.objects.active
+        self.hidden = {obj: (obj.hide_get(), obj.hide_viewport, obj.hide_select) for obj in (source, result)}
+        self.matrix = result.matrix_world.copy()
+        self.cycles = None
+
+    def __enter__(self):
+        for obj in self.hidden:
+            obj.hide_set(False)
+            obj.hide_viewport = obj.hide_select = False
+        self.result.matrix_world = self.source.matrix_world.copy()
+        return self
+
+    def select(self, objects) -> None:
+        """Selects only ``objects``; the result is the active object."""
+        for obj in self.context.view_layer.objects:
+            obj.select_set(obj in objects)
+        self.context.view_layer.objects.active = self.result
+
+    def use_cycles(self) -> None:
+        scene = self.context.scene
+        scene.render.engine = "CYCLES"
+        self.cycles = (scene.cycles.device, scene.cycles.samples)
+        scene.cycles.device, scene.cycles.samples = "CPU", 1
+
+    def __exit__(self, *exc):
+        scene = self.context.scene
+        if self.cycles is not None:
+            scene.cycles.device, scene.cycles.samples = self.cycles
+        scene.render.engine = self.engine
+        self.result.matrix_world = self.matrix
+        for obj, (hidden, viewport, unselectable) in self.hidden.items():
+            obj.hide_viewport, obj.hide_select = viewport, unselectable
+            obj.hide_set(hidden)
+        for obj in self.context.view_layer.objects:
+            obj.select_set(obj in self.selected)
+        self.context.view_layer.objects.active = self.active
+        return False
+
+
+def _run_bake(extrusion: float, max_ray: float, margin: int, size: int, name: str) -> None:
+    """Bakes the selected objects' normals into the active object's active image nodes."""
+    try:
+        bpy.ops.object.bake(type="NORMAL", use_selected_to_active=True, use_cage=False,
+                            cage_extrusion=extrusion, max_ray_distance=max_ray, margin=margin,
+                            normal_space="TANGENT", target="IMAGE_TEXTURES", save_mode="INTERNAL",
+                            use_clear=True, width=size, height=size)
+    except RuntimeError as error:
+        raise BakeError(f"baking normals onto '{name}' failed: {str(error).strip().splitlines()[-1]}") from None
+
+
+def _write_png(image, path: str) -> None:
+    image.filepath_raw = path
+    image.file_format = "PNG"
+    image.save()
+
+
+def check_baked(image, result_name: str) -> None:
+    """Refuses a bake that wrote no normal anywhere (every texel the flat normal or no normal at
+    all): a Cycles that cannot bake (Debian's Blender 3.4 returns nothing) or rays that missed."""
+    pixels = np.empty(len(image.pixels), dtype=np.float32)
+    image.pixels.foreach_get(pixels)
+    normals = pixels.reshape(-1, image.channels)[:, :3] * 2.0 - 1.0
+    valid = np.linalg.norm(normals, axis=1) > 0.5
+    bent = np.abs(normals[valid] - (0.0, 0.0, 1.0)).max(axis=1, initial=0.0) > 0.02
+    if not bent.any():
+        raise BakeError(f"the bake onto '{result_name}' came back empty (no texel holds a normal of the "
+                        f"source): this Blender's Cycles does not bake selected-to-active")
+
+
+def save_image(image, folder: str, stem: str) -> str:
+    """Writes ``image`` as ``<folder>/<stem>_normal.png`` atomically (a free name: another file is
+    never overwritten) and points the image at it; returns the path."""
+    path = os.path.join(folder, f"{stem}_normal.png")
+    index = 1
+    while os.path.exists(path):
+        path = os.path.join(folder, f"{stem}_normal_{index}.png")
+        index += 1
+    handle, staged = tempfile.mkstemp(prefix=".topstoc-", suffix=".png", dir=folder)
+    os.close(handle)
+    try:
+        _write_png(image, staged)
+        os.replace(staged, path)
+    except (RuntimeError, OSError) as error:
+        if os.path.exists(staged):
+            os.remove(staged)
+        raise BakeError(f"could not save the normal map {path}: {str(error).strip()}") from None
+    image.filepath_raw = path
+    return path
+
+
+def pack_image(image) -> None:
+    """Packs the baked pixels into the .blend as PNG (a baked, unsaved image would pack its
+    generated colour instead: it is written to a temporary file and packed from there)."""
+    handle, staged = tempfile.mkstemp(prefix="topstoc-", suffix=".png")
+    os.close(handle)
+    try:
+        _write_png(image, staged)
+        image.pack()
+    except RuntimeError as error:
+        raise BakeError(f"could not pack the normal map '{image.name}': {str(error).strip()}") from None
+    finally:
+        os.remove(staged)
+    image.filepath_raw = f"//{bpy.path.clean_name(image.name)}.png"  # where Unpack would write it
+
+
+def bake_folder() -> str:
+    """The folder beside the saved .blend; an error for an unsaved file."""
+    if not bpy.data.filepath:
+        raise BakeError("save the .blend file first to keep normal maps beside it, or choose to pack them")
+    return os.path.dirname(bpy.path.abspath(bpy.data.filepath))
+
+
+def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16, store: str = "PACK",
+                 folder: str = None) -> Baked:
+    """Bakes ``source``'s shading normals onto ``result`` (its decimated copy) as a tangent-space
+    normal map of ``size``² with ``margin`` pixels of bleed. store: "PACK" (into the .blend) or
+    "FILE" (a PNG in ``folder``, by default beside the .blend)."""
+    size = check_size(size)
+    check_memory(size, available_memory())
+    check_bakeable(source, result)
+    if store == "FILE":
+        folder = folder or bake_folder()
+    hausdorff_max, extrusion, max_ray = measure_reach(source, result)
+    old_materials = [slot.material for slot in result.material_slots]
+    image, made = None, []
+    with _SceneState(context, source, result) as state:
+        try:
+            state.select([result])
+            active_uv = result.data.uv_layers.active_index
+            uv_map, unwrapped = ensure_uv_map(result, size, margin)
+            image = new_image(f"{result.name}_normal", size)
+            made = give_materials(result, image, uv_map)
+            state.select([source, result])
+            state.use_cycles()
+            _run_bake(extrusion, max_ray, margin, size, result.name)
+            check_baked(image, result.name)
+            if active_uv >= 0:  # the map made for the bake is not the one the user edits
+                result.data.uv_layers.active_index = active_uv
+            path = save_image(image, folder, bpy.path.clean_name(result.name)) if store == "FILE" else ""
+            if store != "FILE":
+                pack_image(image)
+        except BakeError:
+            _undo_materials(result, old_materials, made, image)
+            raise
+    return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, path)
+
+
+def _undo_materials(result, old_materials, made, image) -> None:
+    """Puts the result's materials back after a failed bake and removes what the bake made."""
+    for slot, material in zip(result.material_slots, old_materials):
+        slot.material = material
+    for material in made:
+        bpy.data.materials.remove(material)
+    if image is not None:
+        bpy.data.images.remove(image)
