@@ -197,13 +197,14 @@ class _SceneState:
         self.selected = [obj for obj in context.view_layer.objects if obj.select_get()]
         self.active = context.view_layer.objects.active
         self.hidden = {obj: (obj.hide_get(), obj.hide_viewport, obj.hide_select) for obj in (source, result)}
-        self.matrix = result.matrix_world.copy()
+        self.matrix = result.matrix_basis.copy()
         self.cycles = None
 
     def __enter__(self):
         for obj in self.hidden:
             obj.hide_set(False)
             obj.hide_viewport = obj.hide_select = False
+        self.context.view_layer.update()  # matrix_world of objects moved since the last update
         self.result.matrix_world = self.source.matrix_world.copy()
         return self
 
@@ -224,7 +225,7 @@ class _SceneState:
         if self.cycles is not None:
             scene.cycles.device, scene.cycles.samples = self.cycles
         scene.render.engine = self.engine
-        self.result.matrix_world = self.matrix
+        self.result.matrix_basis = self.matrix
         for obj, (hidden, viewport, unselectable) in self.hidden.items():
             obj.hide_viewport, obj.hide_select = viewport, unselectable
             obj.hide_set(hidden)
@@ -315,6 +316,7 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
     size = check_size(size)
     check_memory(size, available_memory())
     check_bakeable(source, result)
+    context.view_layer.update()  # the world matrices measure_reach reads
     if store == "FILE":
         folder = folder or bake_folder()
     hausdorff_max, extrusion, max_ray = measure_reach(source, result)

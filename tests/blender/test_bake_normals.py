@@ -16,7 +16,7 @@ import pytest
 
 import shading
 from conftest import DATA
-from helpers import positions, select_only
+from helpers import positions, select_only, snapshot
 
 RATIO = 0.02
 BAKE_SIZE = 512
@@ -123,9 +123,46 @@ CASES = [(sculpted_suzanne, True, 3.0),   # no UV map: Smart UV Project
          (duck, True, 1.5)]               # its own UV map overlaps (mirrored halves): a new one
 
 
+@pytest.fixture
+def bake(ts):
+    import importlib
+
+    return importlib.import_module(f"{ts.__name__}.blender.bake")
+
+
+def small_pair(name="small"):
+    """A bumped icosphere (1,280 triangles) and its 20 % LOD, not yet baked."""
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=4)
+    source = bumped(bpy.context.active_object)
+    source.name = name
+    return source
+
+
+@pytest.fixture
+def cycles_bakes(ts, bake, scene):
+    """Whether this Blender's Cycles bakes selected-to-active at all (Debian's Blender 3.4 returns
+    an empty map: bake_normals says so, see test_an_empty_bake_is_refused)."""
+    source = small_pair()
+    run = ts.blender.pipeline.decimate(bpy.context, source, params(0.2))
+    lod = ts.blender.pipeline.write_output(run, "NEW_OBJECT", place=False)
+    try:
+        bake.bake_normals(bpy.context, source, lod, size=64, margin=2)
+    except bake.BakeError as error:
+        if "came back empty" in str(error):
+            return False
+        raise
+    finally:
+        for obj in (source, lod):
+            bpy.data.objects.remove(obj)
+        for image in list(bpy.data.images):
+            bpy.data.images.remove(image)
+    return True
+
+
 @pytest.mark.parametrize("make, uv_made, closer", CASES, ids=["suzanne", "rock", "duck"])
-def test_baked_map_shades_like_the_source(ts, scene, tmp_path, make, uv_made, closer):
-    bake = pytest.importorskip(f"{ts.__name__}.blender.bake")
+def test_baked_map_shades_like_the_source(ts, bake, scene, tmp_path, cycles_bakes, make, uv_made, closer):
+    if not cycles_bakes:
+        pytest.skip(f"Blender {bpy.app.version_string}'s Cycles bakes nothing selected-to-active")
     source = make()
     bare = decimated(ts, source, source.name + "_bare")
     baked = decimated(ts, source, source.name + "_baked")
@@ -172,3 +209,59 @@ def test_baked_map_shades_like_the_source(ts, scene, tmp_path, make, uv_made, cl
     picture = os.path.join(out, f"bake_normals_{source.name.split('_')[0]}.png")
     shading.side_by_side([source, bare, baked], counts, picture)
     assert os.path.getsize(picture) < 500_000
+
+
+def test_the_user_state_comes_back(ts, bake, scene, cycles_bakes):
+    if not cycles_bakes:
+        pytest.skip(f"Blender {bpy.app.version_string}'s Cycles bakes nothing selected-to-active")
+    source = small_pair()
+    lod = decimated(ts, source, "lod")
+    lod.location = (5.0, 0.0, 0.0)
+    bystander = bpy.data.objects.new("bystander", None)
+    scene.collection.objects.link(bystander)
+    select_only(bystander)
+    source.hide_set(True)
+    scene.render.engine = "BLENDER_WORKBENCH"
+    before = snapshot(source.data), source.data.materials[0]
+    result = bake.bake_normals(bpy.context, source, lod, size=64, margin=2)
+    assert result.image.packed_file is not None
+    assert scene.render.engine == "BLENDER_WORKBENCH"
+    assert [o.name for o in bpy.context.selected_objects] == ["bystander"]
+    assert bpy.context.view_layer.objects.active == bystander
+    assert source.hide_get() and tuple(lod.location) == (5.0, 0.0, 0.0)
+    assert (snapshot(source.data), source.data.materials[0]) == before
+
+
+def test_an_empty_bake_is_refused_and_undone(ts, bake, scene, monkeypatch):
+    """A bake that writes nothing (Debian's Blender 3.4 does so) is an error, not a flat map; the
+    result's materials come back and nothing made is left."""
+    source = small_pair()
+    lod = decimated(ts, source, "lod")
+    materials = [slot.material for slot in lod.material_slots]
+    images = set(bpy.data.images)
+    monkeypatch.setattr(bake, "_run_bake", lambda *args: None)
+    with pytest.raises(bake.BakeError, match="came back empty"):
+        bake.bake_normals(bpy.context, source, lod, size=64, margin=2)
+    assert [slot.material for slot in lod.material_slots] == materials
+    assert not [m for m in bpy.data.materials if m.name.endswith("_TopStoc")]
+    assert set(bpy.data.images) == images
+
+
+def test_one_line_refusals(ts, bake, scene):
+    source = small_pair()
+    lod = decimated(ts, source, "lod")
+    images = set(bpy.data.images)
+    with pytest.raises(ts.core.errors.TopStocError, match="whole number of pixels from 16 to 16384"):
+        bake.bake_normals(bpy.context, source, lod, size=32768)
+    source.modifiers.new("bevel", "BEVEL")
+    with pytest.raises(bake.BakeError, match=r"'small[.0-9]*' has modifiers that are not applied \(bevel\)"):
+        bake.bake_normals(bpy.context, source, lod, size=64)
+    source.modifiers.clear()
+    with pytest.raises(bake.BakeError, match="save the .blend file first"):
+        bake.bake_normals(bpy.context, source, lod, size=64, store="FILE")
+    points = bpy.data.objects.new("points", bpy.data.meshes.new("points"))
+    points.data.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [])
+    scene.collection.objects.link(points)
+    with pytest.raises(bake.BakeError, match="'points' has no faces to bake a normal map from"):
+        bake.bake_normals(bpy.context, points, lod, size=64)
+    assert set(bpy.data.images) == images
