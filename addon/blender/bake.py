@@ -27,6 +27,7 @@ from . import mesh_io
 BAKE_UV_NAME = "TopStoc Bake"  #: the UV map made when the result has no usable one
 HAUSDORFF_SAMPLES = 200_000
 NODE_LABEL = "TopStoc Normal Map"
+DETAIL = 1e-3  #: surfaces farther apart than this x the diagonal must give a map that is not flat
 
 
 class BakeError(TopStocError):
@@ -68,15 +69,15 @@ def _world_triangles(obj, matrix) -> tuple:
 
 
 def measure_reach(source, result) -> tuple:
-    """(Hausdorff max, extrusion, max ray distance) in world units, both meshes placed where the
-    source is (the result is baked there)."""
+    """(Hausdorff max, bounding-box diagonal, extrusion, max ray distance) in world units, both
+    meshes placed where the source is (the result is baked there)."""
     a = _world_triangles(source, source.matrix_world)
     b = _world_triangles(result, source.matrix_world)
     measured = hausdorff(a, b, samples=HAUSDORFF_SAMPLES, percentile=0)
     distance = measured.symmetric.max_upper
     if not np.isfinite(distance):
         distance = measured.symmetric.max
-    return (distance, *ray_reach(distance, measured.diagonal))
+    return (distance, measured.diagonal, *ray_reach(distance, measured.diagonal))
 
 
 def uv_triangles(mesh, layer) -> np.ndarray:
@@ -319,7 +320,7 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
     context.view_layer.update()  # the world matrices measure_reach reads
     if store == "FILE":
         folder = folder or bake_folder()
-    hausdorff_max, extrusion, max_ray = measure_reach(source, result)
+    hausdorff_max, diagonal, extrusion, max_ray = measure_reach(source, result)
     old_materials = [slot.material for slot in result.material_slots]
     image, made = None, []
     with _SceneState(context, source, result) as state:
@@ -332,7 +333,8 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
             state.select([source, result])
             state.use_cycles()
             _run_bake(extrusion, max_ray, margin, size, result.name)
-            check_baked(image, result.name)
+            if hausdorff_max > DETAIL * diagonal:  # else a flat map is right (an LOD0 at ratio 1)
+                check_baked(image, result.name)
             if active_uv >= 0:  # the map made for the bake is not the one the user edits
                 result.data.uv_layers.active_index = active_uv
             path = save_image(image, folder, bpy.path.clean_name(result.name)) if store == "FILE" else ""
@@ -352,3 +354,19 @@ def _undo_materials(result, old_materials, made, image) -> None:
         bpy.data.materials.remove(material)
     if image is not None:
         bpy.data.images.remove(image)
+
+
+def bake_results(context, settings, pairs) -> tuple:
+    """Bakes every (source, result) pair with an operator's BakeParameters; returns (status lines,
+    one-line failures). A failed bake leaves its result as decimated."""
+    lines, failures = [], []
+    for source, result in pairs:
+        try:
+            baked = bake_normals(context, source, result, size=int(settings.bake_size),
+                                 margin=settings.bake_margin, store=settings.bake_store)
+        except TopStocError as error:
+            failures.append(f"Bake Normals: {error}")
+            continue
+        where = baked.path or "packed"
+        lines.append(f"{result.name}: {baked.image.size[0]}² normal map ({where}, reach {baked.extrusion:.4g})")
+    return lines, failures

@@ -90,6 +90,24 @@ class DecimationParameters:
     output: EnumProperty(name="Output", items=OUTPUT_MODES, default="NEW_OBJECT")
 
 
+BAKE_SIZES = [(str(2 ** k), f"{2 ** k}", f"A {2 ** k} x {2 ** k} normal map") for k in range(8, 14)]
+BAKE_STORES = [("PACK", "Pack", "Pack the normal map into the .blend file"),
+               ("FILE", "Beside .blend", "Save the normal map as a PNG beside the saved .blend file")]
+
+
+class BakeParameters:
+    """The "Bake Normals" option of Guided Decimate and the LOD chain (a mixin; blender/bake.py)."""
+
+    bake_normals: BoolProperty(name="Bake Normals", default=False,
+                               description="Bake a tangent-space normal map from the original onto each new "
+                                           "result (Cycles on the CPU), so a low LOD still shades like it")
+    bake_size: EnumProperty(name="Resolution", items=BAKE_SIZES, default="1024",
+                            description="Width and height of the normal map in pixels")
+    bake_margin: IntProperty(name="Margin", default=16, min=0, max=64, subtype="PIXEL",
+                             description="Pixels the map bleeds past every UV island (against seams in mipmaps)")
+    bake_store: EnumProperty(name="Image", items=BAKE_STORES, default="PACK")
+
+
 class OperatorParameters:
     """DecimationParameters for operators (a mixin). They are not remembered between calls
     (SKIP_SAVE): Blender would otherwise fill them from the last call and mark them as set, so
@@ -104,6 +122,14 @@ def _skip_save(annotation):
 
 OperatorParameters.__annotations__ = {name: _skip_save(annotation)
                                       for name, annotation in DecimationParameters.__annotations__.items()}
+
+
+class OperatorBakeParameters:
+    """BakeParameters for operators, not remembered between calls (as OperatorParameters)."""
+
+
+OperatorBakeParameters.__annotations__ = {name: _skip_save(annotation)
+                                          for name, annotation in BakeParameters.__annotations__.items()}
 
 
 def copy_parameters(source, target) -> None:
@@ -130,6 +156,9 @@ def fill_from_scene(operator, scene_settings) -> None:
     explicitly (a script's or keymap's ``output='IN_PLACE'`` wins over the panel)."""
     for name in DecimationParameters.__annotations__:
         if not operator.properties.is_property_set(name):
+            setattr(operator, name, getattr(scene_settings, name))
+    for name in BakeParameters.__annotations__:  # operators with the Bake Normals option
+        if hasattr(operator.properties, name) and not operator.properties.is_property_set(name):
             setattr(operator, name, getattr(scene_settings, name))
 
 
@@ -194,7 +223,7 @@ class TOPSTOC_PG_object(bpy.types.PropertyGroup):
     metrics: PointerProperty(type=TOPSTOC_PG_metrics)     #: the Metrics panel's results
 
 
-class TOPSTOC_PG_scene(DecimationParameters, bpy.types.PropertyGroup):
+class TOPSTOC_PG_scene(DecimationParameters, BakeParameters, bpy.types.PropertyGroup):
     """Scene-wide defaults: decimation parameters, boxes, view, multiview and LODs."""
 
     use_boxes: BoolProperty(name="Guidance Boxes", description="Use cube empties marked as guidance boxes",

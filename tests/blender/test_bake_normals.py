@@ -265,3 +265,48 @@ def test_one_line_refusals(ts, bake, scene):
     with pytest.raises(bake.BakeError, match="'points' has no faces to bake a normal map from"):
         bake.bake_normals(bpy.context, points, lod, size=64)
     assert set(bpy.data.images) == images
+
+
+def normal_map_image(obj):
+    """The image the result's first material feeds its Normal Map node with (None: no map)."""
+    for node in obj.material_slots[0].material.node_tree.nodes:
+        if node.type == "NORMAL_MAP" and node.inputs["Color"].links:
+            return node.inputs["Color"].links[0].from_node.image
+    return None
+
+
+def test_guided_decimate_bakes_on_request(ts, scene, cycles_bakes):
+    if not cycles_bakes:
+        pytest.skip(f"Blender {bpy.app.version_string}'s Cycles bakes nothing selected-to-active")
+    source = small_pair()
+    assert not scene.topstoc.bake_normals                       # off by default
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.2) == {"FINISHED"}
+    plain = bpy.context.active_object
+    assert plain is not source and normal_map_image(plain) is None
+    select_only(source)
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.2, bake_normals=True, bake_size="256",
+                                           bake_margin=4) == {"FINISHED"}
+    lod = bpy.context.active_object
+    image = normal_map_image(lod)
+    assert image is not None and tuple(image.size) == (256, 256) and image.packed_file is not None
+    assert normal_map_image(source) is None                     # the source's material is not edited
+    assert [o.name for o in bpy.context.selected_objects] == [lod.name]
+
+
+def test_lod_chain_bakes_every_level(ts, scene, cycles_bakes):
+    if not cycles_bakes:
+        pytest.skip(f"Blender {bpy.app.version_string}'s Cycles bakes nothing selected-to-active")
+    source = small_pair()
+    assert bpy.ops.topstoc.lod_chain(ratios="1.0, 0.1", bake_normals=True, bake_size="256") == {"FINISHED"}
+    lods = [bpy.data.objects[f"{source.name}_LOD{i}"] for i in range(2)]
+    images = [normal_map_image(lod) for lod in lods]
+    assert all(image is not None for image in images) and images[0] != images[1]
+    pixels = np.empty(256 * 256 * 4, dtype=np.float32)
+    images[0].pixels.foreach_get(pixels)
+    assert np.abs(pixels.reshape(-1, 4)[:, :2] - 0.5).max() < 0.02  # LOD0 is the source itself: flat
+
+
+def test_in_place_cannot_bake(ts, scene):
+    source = small_pair()
+    with pytest.raises(RuntimeError, match="Bake Normals needs Output: New Object"):
+        bpy.ops.topstoc.guided_decimate(ratio=0.2, output="IN_PLACE", bake_normals=True)

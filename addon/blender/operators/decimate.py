@@ -6,9 +6,10 @@ import time
 
 import bpy
 
-from .. import pipeline
+from .. import bake, pipeline
 from ...core.errors import TopStocError
-from ..props import OperatorParameters, explicit_engine_options, fill_from_scene
+from ..props import OperatorBakeParameters, OperatorParameters, explicit_engine_options, fill_from_scene
+from ..ui.panels import draw_bake
 from . import polls
 
 
@@ -16,7 +17,7 @@ def selected_meshes(context):
     return [obj for obj in context.selected_objects if obj.type == "MESH"]
 
 
-class TOPSTOC_OT_guided_decimate(OperatorParameters, bpy.types.Operator):
+class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy.types.Operator):
     """Decimate the selected meshes with TopStoc, honouring their guidance"""
 
     bl_idname = "topstoc.guided_decimate"
@@ -45,20 +46,28 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, bpy.types.Operator):
         row.prop(self, "symmetry_axis", expand=True)
         for name in ("seed", "adaptivity", "density", "placement", "refine", "output"):
             layout.prop(self, name)
+        draw_bake(layout, self)
 
     def execute(self, context):
         explicit_engine_options(self)
         start = time.perf_counter()
-        outputs, lines, failures = [], [], []
+        outputs, lines, failures, sources = [], [], [], []
         for obj in selected_meshes(context):
             try:
                 run = pipeline.decimate(context, obj, self, region_3d=context.region_data)
                 if self.output == "NEW_OBJECT":
                     pipeline.store_samples(run)
                 outputs.append(pipeline.write_output(run, self.output))
+                sources.append(obj)
                 lines.append(pipeline.summary(run))
             except TopStocError as error:
                 failures.append(str(error))
+        if self.bake_normals and outputs:
+            if self.output == "NEW_OBJECT":
+                failures += bake.bake_results(context, self, zip(sources, outputs))[1]
+            else:
+                failures.append("Bake Normals needs Output: New Object (in place, no original is left to "
+                                "bake from)")
         for message in failures:
             self.report({"ERROR"}, message)
         if not outputs:

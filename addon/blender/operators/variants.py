@@ -6,9 +6,9 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-from .. import pipeline
+from .. import bake, pipeline
 from ...core.errors import TopStocError
-from ..props import OperatorParameters, explicit_engine_options, fill_from_scene
+from ..props import OperatorBakeParameters, OperatorParameters, explicit_engine_options, fill_from_scene
 from . import polls
 
 
@@ -78,6 +78,9 @@ class _VariantsBase(OperatorParameters):
         names = self.names(obj, runs)
         outputs = [pipeline.write_output(run, "NEW_OBJECT", name=name, place=False) for run, name in zip(runs, names)]
         _lay_out(obj, outputs, _collection(context, self.collection_name(obj)))
+        if getattr(self, "bake_normals", False):
+            for message in bake.bake_results(context, self, [(obj, output) for output in outputs])[1]:
+                self.report({"ERROR"}, message)
         counts = ", ".join(f"{run.result.num_vertices:,}" for run in runs)
         self.report({"INFO"}, f"TopStoc: {len(runs)} variants of {obj.name} ({counts} vertices) "
                               f"in {runs[0].seconds:.3f} s")
@@ -111,7 +114,7 @@ class TOPSTOC_OT_multiview(_VariantsBase, bpy.types.Operator):
         return f"{obj.name} Multiview"
 
 
-class TOPSTOC_OT_lod_chain(_VariantsBase, bpy.types.Operator):
+class TOPSTOC_OT_lod_chain(_VariantsBase, OperatorBakeParameters, bpy.types.Operator):
     """LOD0 ... LODn at the given ratios, named and collected"""
 
     bl_idname = "topstoc.lod_chain"

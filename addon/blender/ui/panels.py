@@ -52,6 +52,15 @@ def _estimate_text(context, settings) -> str:
     return f"Face Count ≈ {estimate:,}"
 
 
+def draw_bake(layout, settings) -> None:
+    """The Bake Normals option and, when on, its settings (the panel and the operators' redo panels)."""
+    layout.prop(settings, "bake_normals")
+    if settings.bake_normals:
+        col = layout.column(align=True)
+        for name in ("bake_size", "bake_margin", "bake_store"):
+            col.prop(settings, name)
+
+
 class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
     bl_label = "Guided Decimation"
     bl_idname = "TOPSTOC_PT_decimate"
@@ -89,6 +98,7 @@ class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
         row = layout.row(align=True)  # full width: "New Object" does not fit beside a label
         row.use_property_split = False
         row.prop(settings, "output", expand=True)
+        draw_bake(layout, settings)
         col = layout.column(align=True)
         col.operator("topstoc.guided_decimate", icon="MOD_DECIM")
         col.operator("topstoc.preview", icon="HIDE_OFF")
