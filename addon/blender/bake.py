@@ -310,10 +310,10 @@ def bake_folder() -> str:
 
 
 def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16, store: str = "PACK",
-                 folder: str = None) -> Baked:
+                 folder: str = None, name: str = None) -> Baked:
     """Bakes ``source``'s shading normals onto ``result`` (its decimated copy) as a tangent-space
     normal map of ``size``² with ``margin`` pixels of bleed. store: "PACK" (into the .blend) or
-    "FILE" (a PNG in ``folder``, by default beside the .blend)."""
+    "FILE" (``<folder>/<name>_normal.png``; by default beside the .blend, named after the result)."""
     size = check_size(size)
     check_memory(size, available_memory())
     check_bakeable(source, result)
@@ -337,7 +337,7 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
                 check_baked(image, result.name)
             if active_uv >= 0:  # the map made for the bake is not the one the user edits
                 result.data.uv_layers.active_index = active_uv
-            path = save_image(image, folder, bpy.path.clean_name(result.name)) if store == "FILE" else ""
+            path = save_image(image, folder, bpy.path.clean_name(name or result.name)) if store == "FILE" else ""
             if store != "FILE":
                 pack_image(image)
         except BakeError:

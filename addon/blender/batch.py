@@ -29,6 +29,7 @@ from ..core.decimate import ATTRIBUTE_WEIGHT
 from ..core.prune import prune_small_parts
 from ..core.batch_run import misnamed_failure, utf8_name, write_report
 from ..core.errors import TopStocError, one_line, shown_path
+from ..core.normal_bake import check_size
 from ..core.output_guard import check_folders, prepare_output, output_folder
 
 BLEND = ".blend"
@@ -43,6 +44,10 @@ def parse_args(argv):
     parser.command = "topstoc batch"  # errors as topstoc batch prints them
     batch_settings.add_io_arguments(parser)  # files and folders, as topstoc batch takes them
     parser.add_argument("--json", metavar="REPORT.json", help="write the report here")
+    parser.add_argument("--bake-normals", type=int, metavar="SIZE",
+                        help="bake a SIZE x SIZE tangent-space normal map from each source onto each result "
+                             "(Blender formats; a PNG next to the output, used by its materials; margin "
+                             "SIZE/64 pixels)")
     batch_settings.add_arguments(parser)
     return parser.parse_args(argv)
 
@@ -107,6 +112,43 @@ def _copy_armature_modifiers(source, target) -> None:
             copy.use_bone_envelopes = modifier.use_bone_envelopes
 
 
+def _bake(bpy, source, result, settings, name: str) -> str:
+    """Bakes the normal map asked for (--bake-normals) from ``source`` onto ``result`` as
+    ``<output folder>/<name>_normal.png``; returns its path."""
+    from . import bake
+
+    size = settings["bake_normals"]
+    baked = bake.bake_normals(bpy.context, source, result, size=size, margin=bake_margin(size), store="FILE",
+                              folder=settings["bake_folder"], name=name)
+    return baked.path
+
+
+def bake_margin(size: int) -> int:
+    """The batch's bleed around UV islands: 16 pixels at 1024."""
+    return max(2, size // 64)
+
+
+def _write_in_place(bpy, pipeline, obj, run, settings, name: str):
+    """The pipeline's IN_PLACE write; with --bake-normals the original mesh is kept on a
+    temporary object to bake from, then removed. Returns the normal map's path or None."""
+    if not settings.get("bake_normals"):
+        pipeline.write_output(run, "IN_PLACE")
+        return None
+    original = obj.data
+    holder = bpy.data.objects.new(f"{obj.name} (original)", original)
+    bpy.context.scene.collection.objects.link(holder)
+    holder.matrix_world = obj.matrix_world.copy()
+    try:
+        pipeline.write_output(run, "IN_PLACE")
+        return _bake(bpy, holder, obj, settings, name)
+    finally:
+        bpy.data.objects.remove(holder)
+        if original.users == 0:
+            mesh_name = original.name
+            bpy.data.meshes.remove(original)
+            obj.data.name = mesh_name
+
+
 def _decimate_object(bpy, pipeline, obj, settings, targets) -> tuple:
     """Decimates one object once per LOD; returns (report entry, LOD objects)."""
     scale = _world_scale(obj)
@@ -133,11 +175,15 @@ def _decimate_object(bpy, pipeline, obj, settings, targets) -> tuple:
             name = batch_settings.lod_name(obj.name, index, settings)
             lod = pipeline.write_output(run, "NEW_OBJECT", name=name)
             lod.name = name  # the source keeps its name until it is removed below
+            if settings.get("bake_normals"):
+                entry["normal_map"] = _bake(bpy, obj, lod, settings, f"{settings['bake_stem']}_{name}")
             _copy_armature_modifiers(obj, lod)
             entry["object"] = lod.name
             lod_objects.append(lod)
         else:
-            pipeline.write_output(run, "IN_PLACE")
+            normal_map = _write_in_place(bpy, pipeline, obj, run, settings, f"{settings['bake_stem']}_{obj.name}")
+            if normal_map:
+                entry["normal_map"] = normal_map
         lods.append(entry)
     report = {"object": obj.name, "vertices_in": n, "vertices_out": lods[0]["vertices"],
               "triangles_out": lods[0]["triangles"], "seconds": sum(lod["seconds"] for lod in lods),
@@ -174,6 +220,8 @@ def decimate_scene_file(path: str, out_dir: str, settings: dict) -> dict:
     else:
         scene_io.import_file(path)
     objects = _mesh_objects(bpy, path, settings["objects"])
+    stem, _ = os.path.splitext(os.path.basename(path))
+    settings = dict(settings, bake_folder=out_dir, bake_stem=stem)
     asset = _world_vertices(objects)
     targets = batch_settings.engine_targets(settings, asset)
     entries, chains, sources = [], [], []
@@ -241,6 +289,8 @@ def main(argv=None) -> int:
         inputs = find_inputs(args.input)
         if not inputs:
             raise TopStocError("no input assets found")
+        if args.bake_normals is not None:
+            settings["bake_normals"] = check_size(args.bake_normals)
         check_folders(args.input, args.output)
         prepare_output(args.json, inputs)
         output_folder(args.output)
@@ -258,6 +308,9 @@ def main(argv=None) -> int:
         print(f"{prefix}: decimating ...", flush=True)
         try:
             if _is_mesh_file(path):
+                if settings.get("bake_normals"):
+                    raise TopStocError(f"{shown_path(path)}: --bake-normals needs a Blender format (.blend, glTF, "
+                                       f"FBX, USD): a mesh file has no material to hold the map")
                 entry = decimate_mesh_file(path, args.output, settings)
             else:
                 _register_addon()

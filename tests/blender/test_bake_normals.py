@@ -310,3 +310,60 @@ def test_in_place_cannot_bake(ts, scene):
     source = small_pair()
     with pytest.raises(RuntimeError, match="Bake Normals needs Output: New Object"):
         bpy.ops.topstoc.guided_decimate(ratio=0.2, output="IN_PLACE", bake_normals=True)
+
+
+def test_batch_writes_a_gltf_that_reimports_with_its_map(ts, scene, tmp_path, cycles_bakes):
+    """``--bake-normals SIZE``: the map is a PNG next to the output, the glTF's material uses it as
+    its normalTexture, and Blender's importer reads it back into a Normal Map node."""
+    if not cycles_bakes:
+        pytest.skip(f"Blender {bpy.app.version_string}'s Cycles bakes nothing selected-to-active")
+    import json
+    import subprocess
+    import sys
+
+    from test_batch_formats import _runner
+
+    batch_run = importlib_module(ts, "core.batch_run")
+    scene_io = importlib_module(ts, "blender.scene_io")
+    source_faces = len(small_pair("pebble").data.polygons)
+    bpy.ops.export_scene.gltf(filepath=str(tmp_path / "pebble.gltf"), export_format="GLTF_SEPARATE")
+    out = tmp_path / "out"
+    report = tmp_path / "report.json"
+    command = batch_run.blender_command(_runner()) + [
+        "--input", str(tmp_path / "pebble.gltf"), "--output", str(out), "--json", str(report),
+        "--ratio", "0.1", "--bake-normals", "128"]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    [lod] = json.loads(report.read_text())["results"][0]["objects"][0]["lods"]
+    assert lod["normal_map"] == str(out / "pebble_pebble_normal.png") and os.path.isfile(lod["normal_map"])
+    gltf = json.loads((out / "pebble.gltf").read_text())
+    [material] = gltf["materials"]
+    texture = gltf["textures"][material["normalTexture"]["index"]]
+    uri = gltf["images"][texture["source"]]["uri"]
+    assert os.path.isfile(out / uri)
+    scene_io.import_file(str(out / "pebble.gltf"))
+    [obj] = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+    image = normal_map_image(obj)
+    assert image is not None and tuple(image.size) == (128, 128)
+    assert len(obj.data.polygons) == lod["triangles"] < source_faces / 5
+
+
+def test_batch_refuses_mesh_files_and_bad_sizes(ts, scene, tmp_path):
+    import subprocess
+
+    from test_batch_formats import _runner
+
+    batch_run = importlib_module(ts, "core.batch_run")
+    command = batch_run.blender_command(_runner()) + [
+        "--input", str(DATA / "uv_materials/duck/duck_via_assimp.obj"), "--output", str(tmp_path / "out"),
+        "--ratio", "0.1", "--bake-normals"]
+    done = subprocess.run(command + ["100000"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 1 and "whole number of pixels from 16 to 16384, got 100000" in done.stderr
+    done = subprocess.run(command + ["64"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 1 and "--bake-normals needs a Blender format" in done.stderr
+
+
+def importlib_module(ts, name):
+    import importlib
+
+    return importlib.import_module(f"{ts.__name__}.{name}")
