@@ -145,7 +145,7 @@ def side_by_side(objects, captions, path: str, width: int = 768) -> None:
         text = bpy.data.curves.new(f"caption{index}", "FONT")
         text.body = caption
         text.align_x = "CENTER"
-        text.size = 0.09 * span
+        text.size = 0.075 * span
         text.materials.append(_caption_material())
         label = bpy.data.objects.new(f"caption{index}", text)
         label.rotation_euler = (math.radians(90), 0.0, 0.0)

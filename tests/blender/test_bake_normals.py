@@ -204,7 +204,7 @@ def test_baked_map_shades_like_the_source(ts, bake, scene, tmp_path, cycles_bake
     assert baked_difference * closer <= bare_difference
 
     out = os.environ.get("TOPSTOC_PICTURES") or folder
-    counts = [f"{label}: {triangles(obj):,} triangles" for label, obj in
+    counts = [f"{label}\n{triangles(obj):,} triangles" for label, obj in
               (("source", source), ("bare LOD", bare), ("LOD + normals", baked))]
     picture = os.path.join(out, f"bake_normals_{source.name.split('_')[0]}.png")
     shading.side_by_side([source, bare, baked], counts, picture)
