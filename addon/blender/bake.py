@@ -1,9 +1,11 @@
 """A tangent-space normal map baked from a source object onto its decimated result (Cycles, CPU,
 selected-to-active), so a low LOD still shades like the sculpt.
 
-The result keeps its UV map (the decimation keeps UV seams exactly) or gets one from Blender's
-Smart UV Project with island gaps sized for the resolution. The rays reach from the measured
-Hausdorff distance between the two (core/normal_bake.py). The image is saved beside the .blend
+The result keeps its UV map (the decimation keeps UV seams exactly) when every texel of it belongs
+to one place of the surface, else gets one from Blender's Smart UV Project with island gaps sized
+for the resolution. The rays reach from the measured Hausdorff distance between the two
+(core/normal_bake.py). Where Cycles bakes nothing (Debian's Blender 3.4), the same rays are cast
+by bake_raycast.py. The image is saved beside the .blend
 (or a given folder) or packed, and the result gets copies of its materials with an Image Texture
 and a Normal Map node feeding the shader's Normal input; the source's materials are untouched.
 The user's render engine, bake settings, selection, active object and visibility are restored.
@@ -22,7 +24,7 @@ from ..core.errors import TopStocError
 from ..core.hausdorff import hausdorff
 from ..core.normal_bake import (MAX_OVERLAP, available_memory, check_memory, check_size, island_margin,
                                 overlap_fraction, ray_reach)
-from . import mesh_io
+from . import bake_raycast, mesh_io
 
 BAKE_UV_NAME = "TopStoc Bake"  #: the UV map made when the result has no usable one
 HAUSDORFF_SAMPLES = 200_000
@@ -44,6 +46,7 @@ class Baked:
     hausdorff_max: float     #: world units
     extrusion: float         #: cage extrusion (world units)
     max_ray: float           #: max ray distance (world units)
+    method: str = "Cycles"   #: "Cycles", or "ray cast" where this Blender's Cycles baked nothing
     path: str = ""           #: the saved file ("" when packed)
 
 
@@ -103,6 +106,7 @@ def ensure_uv_map(obj, size: int, margin: int) -> tuple:
     if layer is None:
         raise BakeError(f"'{obj.name}' has no room for another UV map (Blender allows 8)")
     uv_layers.active = layer
+    name = layer.name  # Edit Mode rebuilds the layers: this reference goes stale (Blender 3.4)
     bpy.ops.object.mode_set(mode="EDIT")
     try:
         bpy.ops.mesh.reveal()
@@ -110,7 +114,7 @@ def ensure_uv_map(obj, size: int, margin: int) -> tuple:
         bpy.ops.uv.smart_project(island_margin=island_margin(margin, size))
     finally:
         bpy.ops.object.mode_set(mode="OBJECT")
-    return layer.name, True
+    return name, True
 
 
 def new_image(name: str, size: int) -> bpy.types.Image:
@@ -253,17 +257,29 @@ def _write_png(image, path: str) -> None:
     image.save()
 
 
-def check_baked(image, result_name: str) -> None:
-    """Refuses a bake that wrote no normal anywhere (every texel the flat normal or no normal at
-    all): a Cycles that cannot bake (Debian's Blender 3.4 returns nothing) or rays that missed."""
+def has_detail(image) -> bool:
+    """Whether some texel holds a unit normal more than a degree away from the flat (0, 0, 1): a
+    Cycles that cannot bake (Debian's Blender 3.4) leaves none (its texels (0, 0, 1) or zero)."""
     pixels = np.empty(len(image.pixels), dtype=np.float32)
     image.pixels.foreach_get(pixels)
     normals = pixels.reshape(-1, image.channels)[:, :3] * 2.0 - 1.0
-    valid = np.linalg.norm(normals, axis=1) > 0.5
-    bent = np.abs(normals[valid] - (0.0, 0.0, 1.0)).max(axis=1, initial=0.0) > 0.02
-    if not bent.any():
-        raise BakeError(f"the bake onto '{result_name}' came back empty (no texel holds a normal of the "
-                        f"source): this Blender's Cycles does not bake selected-to-active")
+    length = np.linalg.norm(normals, axis=1)
+    unit = normals[np.abs(length - 1.0) < 0.05] / length[np.abs(length - 1.0) < 0.05, None]
+    return bool((unit[:, 2] < np.cos(np.radians(1.0))).any())
+
+
+def _bake_image(source, result, image, uv_map: str, reach: tuple, margin: int, expect_detail: bool) -> str:
+    """Bakes into ``image`` with Cycles, or by ray casting when Cycles leaves the map flat though
+    the surfaces differ; returns which ("Cycles" or "ray cast")."""
+    extrusion, max_ray = reach
+    _run_bake(extrusion, max_ray, margin, image.size[0], result.name)
+    if not expect_detail or has_detail(image):
+        return "Cycles"
+    bake_raycast.bake(source, result, image, uv_map, extrusion, max_ray, margin)
+    if not has_detail(image):
+        raise BakeError(f"the bake onto '{result.name}' came back empty: no ray from it reached "
+                        f"'{source.name}'")
+    return "ray cast"
 
 
 def save_image(image, folder: str, stem: str) -> str:
@@ -332,9 +348,9 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
             made = give_materials(result, image, uv_map)
             state.select([source, result])
             state.use_cycles()
-            _run_bake(extrusion, max_ray, margin, size, result.name)
-            if hausdorff_max > DETAIL * diagonal:  # else a flat map is right (an LOD0 at ratio 1)
-                check_baked(image, result.name)
+            # surfaces this close give a flat map rightly (an LOD0 at ratio 1)
+            method = _bake_image(source, result, image, uv_map, (extrusion, max_ray), margin,
+                                 hausdorff_max > DETAIL * diagonal)
             if active_uv >= 0:  # the map made for the bake is not the one the user edits
                 result.data.uv_layers.active_index = active_uv
             path = save_image(image, folder, bpy.path.clean_name(name or result.name)) if store == "FILE" else ""
@@ -343,7 +359,7 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
         except BakeError:
             _undo_materials(result, old_materials, made, image)
             raise
-    return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, path)
+    return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, method, path)
 
 
 def _undo_materials(result, old_materials, made, image) -> None:

@@ -57,15 +57,12 @@ def island_margin(margin_pixels: int, size: int) -> float:
     return min(0.5, 2.0 * max(0, margin_pixels) / size)
 
 
-def overlap_fraction(uv_triangles: np.ndarray, resolution: int = 512) -> float:
-    """Share of the texels covered by a UV layout (``uv_triangles``: (m, 3, 2)) that more than one
-    triangle covers (texel centres, ``resolution``² texels over the unit square); 1.0 for a layout
-    that leaves the unit square (tiles, UDIMs): a single image cannot hold it either."""
+def rasterize(uv_triangles: np.ndarray, resolution: int, edges: bool = True) -> tuple:
+    """The texel centres (``resolution``² over the unit square) inside UV triangles: (texel index
+    y * resolution + x, triangle, (k, 3) barycentric weights), one row per texel and triangle.
+    ``edges``: a centre on an edge belongs to both triangles (no holes along shared edges);
+    False: to neither (two islands that only touch do not overlap)."""
     uv = np.asarray(uv_triangles, dtype=np.float64).reshape(-1, 3, 2)
-    if len(uv) == 0:
-        return 0.0
-    if uv.min() < 0.0 or uv.max() > 1.0:
-        return 1.0
     pixel = uv * resolution - 0.5                 # texel centres at whole numbers
     low = np.clip(np.ceil(pixel.min(axis=1)), 0, resolution - 1).astype(np.int64)
     high = np.clip(np.floor(pixel.max(axis=1)), 0, resolution - 1).astype(np.int64)
@@ -76,12 +73,46 @@ def overlap_fraction(uv_triangles: np.ndarray, resolution: int = 512) -> float:
     x = low[triangle, 0] + offset % np.maximum(width[triangle], 1)
     y = low[triangle, 1] + offset // np.maximum(width[triangle], 1)
     a, b, c = (pixel[triangle, k] for k in range(3))
-    sides = [(q[:, 0] - x) * (r[:, 1] - y) - (q[:, 1] - y) * (r[:, 0] - x) for q, r in ((a, b), (b, c), (c, a))]
-    inside = np.logical_or(np.logical_and.reduce([side > 0 for side in sides]),
-                           np.logical_and.reduce([side < 0 for side in sides]))
-    hits = np.bincount(y[inside] * resolution + x[inside], minlength=resolution * resolution)
+    # twice the signed areas of the sub-triangles opposite each corner
+    w = [(q[:, 0] - x) * (r[:, 1] - y) - (q[:, 1] - y) * (r[:, 0] - x) for q, r in ((b, c), (c, a), (a, b))]
+    weights = np.stack(w, axis=1)
+    if edges:
+        inside = ((weights >= 0).all(axis=1) | (weights <= 0).all(axis=1)) & (weights.sum(axis=1) != 0)
+    else:
+        inside = (weights > 0).all(axis=1) | (weights < 0).all(axis=1)
+    weights = weights[inside]
+    weights /= weights.sum(axis=1, keepdims=True)
+    return (y * resolution + x)[inside], triangle[inside], weights
+
+
+def overlap_fraction(uv_triangles: np.ndarray, resolution: int = 512) -> float:
+    """Share of the texels covered by a UV layout (``uv_triangles``: (m, 3, 2)) that more than one
+    triangle covers (texel centres, ``resolution``² texels over the unit square); 1.0 for a layout
+    that leaves the unit square (tiles, UDIMs): a single image cannot hold it either."""
+    uv = np.asarray(uv_triangles, dtype=np.float64).reshape(-1, 3, 2)
+    if len(uv) == 0:
+        return 0.0
+    if uv.min() < 0.0 or uv.max() > 1.0:
+        return 1.0
+    texels = rasterize(uv, resolution, edges=False)[0]
+    hits = np.bincount(texels, minlength=resolution * resolution)
     covered = np.count_nonzero(hits)
     return float(np.count_nonzero(hits > 1)) / covered if covered else 0.0
+
+
+def dilate(values: np.ndarray, filled: np.ndarray, steps: int) -> None:
+    """Grows the filled texels of ``values`` ((h, w, c), in place) ``steps`` texels into the empty
+    ones (``filled``: (h, w) bool, updated), each new texel the mean of its filled neighbours."""
+    for _ in range(steps):
+        padded = np.pad(values * filled[..., None], ((1, 1), (1, 1), (0, 0)))
+        present = np.pad(filled, 1).astype(np.int64)
+        total = padded[:-2, 1:-1] + padded[2:, 1:-1] + padded[1:-1, :-2] + padded[1:-1, 2:]
+        count = present[:-2, 1:-1] + present[2:, 1:-1] + present[1:-1, :-2] + present[1:-1, 2:]
+        grow = ~filled & (count > 0)
+        if not grow.any():
+            return
+        values[grow] = total[grow] / count[grow][:, None]
+        filled |= grow
 
 
 def available_memory():

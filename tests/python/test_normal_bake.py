@@ -54,3 +54,30 @@ def test_overlap_fraction():
     assert normal_bake.overlap_fraction(quarter, 256) == pytest.approx((1 / 16) / (1 / 2), rel=0.02)
     assert normal_bake.overlap_fraction(grid(2, 0.5, 1.5)) == 1.0  # tiles beyond the unit square
     assert normal_bake.overlap_fraction(np.zeros((0, 3, 2))) == 0.0
+
+
+def test_rasterize_gives_each_texel_centre_its_triangle_and_weights():
+    size = 32
+    triangles = grid(4)
+    texels, triangle, weights = normal_bake.rasterize(triangles, size)
+    assert np.allclose(weights.sum(axis=1), 1.0) and (weights >= 0).all()
+    centres = np.stack([(texels % size + 0.5) / size, (texels // size + 0.5) / size], axis=1)
+    assert np.allclose(np.einsum("ij,ijk->ik", weights, triangles[triangle]), centres)
+    assert len(np.unique(texels)) == size * size  # every texel centre, those on the diagonals too
+    strict = normal_bake.rasterize(triangles, size, edges=False)[0]
+    assert len(strict) == len(np.unique(strict)) < size * size  # on an edge: in neither triangle
+
+
+def test_dilate_grows_a_texel_by_one_ring_per_step():
+    values = np.zeros((9, 9, 3))
+    filled = np.zeros((9, 9), dtype=bool)
+    values[4, 4], filled[4, 4] = (1.0, 2.0, 3.0), True
+    normal_bake.dilate(values, filled, 2)
+    distance = np.abs(np.arange(9)[:, None] - 4) + np.abs(np.arange(9)[None, :] - 4)
+    assert np.array_equal(filled, distance <= 2)
+    assert np.allclose(values[filled], (1.0, 2.0, 3.0)) and not values[~filled].any()
+    corner = np.zeros((3, 3, 1))
+    reached = np.zeros((3, 3), dtype=bool)
+    corner[0, 0], reached[0, 0] = 1.0, True
+    normal_bake.dilate(corner, reached, 1)
+    assert not reached[2, 0] and not reached[0, 2]  # nothing wraps round the image's edges

@@ -1,0 +1,118 @@
+"""A normal-map bake without Cycles, for a Blender whose Cycles bakes nothing selected-to-active
+(Debian's Blender 3.4): the same rays as Cycles' bake (from the result's surface pushed out by the
+extrusion, inward along its smooth normal, at most the max ray distance; first hit on the source),
+cast with Blender's BVH tree, and the source's smooth normal at the hit written in the result's
+MikkTSpace tangent frame (what the Normal Map node reads back). Texel centres only, no antialiasing."""
+
+from __future__ import annotations
+
+import numpy as np
+from mathutils import Vector
+from mathutils.bvhtree import BVHTree
+
+from ..core.normal_bake import dilate, rasterize
+
+
+def _corner_normals(mesh) -> np.ndarray:
+    if hasattr(mesh, "corner_normals"):  # Blender 4.1+
+        normals = np.empty(3 * len(mesh.loops), dtype=np.float32)
+        mesh.corner_normals.foreach_get("vector", normals)
+        return normals.reshape(-1, 3).astype(np.float64)
+    mesh.calc_normals_split()
+    normals = np.empty(3 * len(mesh.loops), dtype=np.float32)
+    mesh.loops.foreach_get("normal", normals)
+    return normals.reshape(-1, 3).astype(np.float64)
+
+
+def _triangles(mesh) -> tuple:
+    """(loop ids (m, 3), vertex ids (m, 3)) of the loop triangles."""
+    mesh.calc_loop_triangles()
+    loops = np.empty(3 * len(mesh.loop_triangles), dtype=np.int32)
+    mesh.loop_triangles.foreach_get("loops", loops)
+    vertices = np.empty(3 * len(mesh.loop_triangles), dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", vertices)
+    return loops.reshape(-1, 3), vertices.reshape(-1, 3)
+
+
+def _world(mesh, matrix) -> np.ndarray:
+    co = np.empty(3 * len(mesh.vertices), dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    return co.reshape(-1, 3).astype(np.float64) @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+def _unit(vectors: np.ndarray) -> np.ndarray:
+    return vectors / np.maximum(np.linalg.norm(vectors, axis=-1, keepdims=True), 1e-30)
+
+
+def _tangent_frames(mesh, uv_map: str, rotation: np.ndarray) -> tuple:
+    """Per corner: world normal, tangent and bitangent sign (MikkTSpace on ``uv_map``)."""
+    normals = _unit(_corner_normals(mesh) @ np.linalg.inv(rotation))
+    mesh.calc_tangents(uvmap=uv_map)
+    tangents = np.empty(3 * len(mesh.loops), dtype=np.float32)
+    mesh.loops.foreach_get("tangent", tangents)
+    signs = np.empty(len(mesh.loops), dtype=np.float32)
+    mesh.loops.foreach_get("bitangent_sign", signs)
+    return normals, _unit(tangents.reshape(-1, 3) @ rotation.T), signs
+
+
+def _source_normals(mesh, matrix, hits, triangle_ids) -> np.ndarray:
+    """The source's smooth (corner) normal at each hit point of its loop triangles."""
+    loops, vertices = _triangles(mesh)
+    normals = _unit(_corner_normals(mesh) @ np.linalg.inv(matrix[:3, :3]))
+    corners = _world(mesh, matrix)[vertices[triangle_ids]]        # (k, 3, 3)
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    area = np.cross(b - a, c - a)
+    weights = np.stack([np.einsum("ij,ij->i", np.cross(c - b, hits - b), area),
+                        np.einsum("ij,ij->i", np.cross(a - c, hits - c), area),
+                        np.einsum("ij,ij->i", np.cross(b - a, hits - a), area)], axis=1)
+    weights /= np.maximum(weights.sum(axis=1, keepdims=True), 1e-30)
+    return _unit(np.einsum("ij,ijk->ik", weights, normals[loops[triangle_ids]]))
+
+
+def _cast(tree, origins, directions, reach) -> tuple:
+    """(hit locations, triangle ids, whether hit) of the first hits within ``reach``."""
+    hits = np.zeros_like(origins)
+    ids = np.zeros(len(origins), dtype=np.int64)
+    found = np.zeros(len(origins), dtype=bool)
+    for i, (origin, direction) in enumerate(zip(origins.tolist(), directions.tolist())):
+        location, _normal, index, _distance = tree.ray_cast(Vector(origin), Vector(direction), reach)
+        if index is not None:
+            hits[i], ids[i], found[i] = location, index, True
+    return hits, ids, found
+
+
+def bake(source, result, image, uv_map: str, extrusion: float, max_ray: float, margin: int) -> None:
+    """Writes the tangent-space normals of ``source`` seen from ``result`` (placed where the source
+    is) into ``image`` (square), laid out on ``uv_map``, with ``margin`` texels of bleed."""
+    size = image.size[0]
+    matrix = np.array(source.matrix_world, dtype=np.float64)
+    mesh = result.data
+    loops, vertices = _triangles(mesh)
+    uv = np.empty(2 * len(mesh.loops), dtype=np.float32)
+    mesh.uv_layers[uv_map].data.foreach_get("uv", uv)
+    texels, triangle, weights = rasterize(uv.reshape(-1, 2)[loops], size)
+    normals, tangents, signs = _tangent_frames(mesh, uv_map, matrix[:3, :3])
+    corner = loops[triangle]                                      # (k, 3) loops of each texel's triangle
+    points = np.einsum("ij,ijk->ik", weights, _world(mesh, matrix)[vertices[triangle]])
+    normal = _unit(np.einsum("ij,ijk->ik", weights, normals[corner]))
+    tangent = np.einsum("ij,ijk->ik", weights, tangents[corner])
+    tangent = _unit(tangent - normal * np.einsum("ij,ij->i", tangent, normal)[:, None])
+    bitangent = signs[corner[:, 0]][:, None] * np.cross(normal, tangent)
+
+    _, source_vertices = _triangles(source.data)
+    tree = BVHTree.FromPolygons(_world(source.data, matrix).tolist(), source_vertices.tolist())
+    hits, ids, found = _cast(tree, points + extrusion * normal, -normal, max_ray)
+    seen = normal.copy()
+    seen[found] = _source_normals(source.data, matrix, hits[found], ids[found])
+    encoded = np.stack([np.einsum("ij,ij->i", seen, axis) for axis in (tangent, bitangent, normal)], axis=1)
+
+    values = np.zeros((size * size, 3))
+    values[texels] = encoded * 0.5 + 0.5
+    filled = np.zeros(size * size, dtype=bool)
+    filled[texels] = True
+    values, filled = values.reshape(size, size, 3), filled.reshape(size, size)
+    dilate(values, filled, margin)
+    values[~filled] = (0.5, 0.5, 1.0)
+    pixels = np.concatenate([values, np.ones((size, size, 1))], axis=2).astype(np.float32)
+    image.pixels.foreach_set(pixels.ravel())
+    image.update()
