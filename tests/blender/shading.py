@@ -35,7 +35,7 @@ def setup(size: int = 256) -> None:
     sun_data.angle = 0.0
     if hasattr(sun_data, "use_shadow"):  # no cast shadows: the picture is N.L, what a normal map changes
         sun_data.use_shadow = False
-    if hasattr(sun_data, "cycles"):
+    if hasattr(getattr(sun_data, "cycles", None), "cast_shadow"):
         sun_data.cycles.cast_shadow = False
     sun = bpy.data.objects.new("sun", sun_data)
     sun.rotation_euler = SUN_DIRECTION
