@@ -282,12 +282,13 @@ def _bake_image(source, result, image, uv_map: str, reach: tuple, margin: int, e
     return "ray cast"
 
 
-def save_image(image, folder: str, stem: str) -> str:
-    """Writes ``image`` as ``<folder>/<stem>_normal.png`` atomically (a free name: another file is
-    never overwritten) and points the image at it; returns the path."""
+def save_image(image, folder: str, stem: str, replace: bool = False) -> str:
+    """Writes ``image`` as ``<folder>/<stem>_normal.png`` atomically and points the image at it;
+    returns the path. A file of that name is replaced only with ``replace`` (the batch's own
+    output), else the next free name is taken (``_1``, ``_2`` …)."""
     path = os.path.join(folder, f"{stem}_normal.png")
     index = 1
-    while os.path.exists(path):
+    while os.path.exists(path) and not replace:
         path = os.path.join(folder, f"{stem}_normal_{index}.png")
         index += 1
     handle, staged = tempfile.mkstemp(prefix=".topstoc-", suffix=".png", dir=folder)
@@ -326,10 +327,11 @@ def bake_folder() -> str:
 
 
 def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16, store: str = "PACK",
-                 folder: str = None, name: str = None) -> Baked:
+                 folder: str = None, name: str = None, replace: bool = False) -> Baked:
     """Bakes ``source``'s shading normals onto ``result`` (its decimated copy) as a tangent-space
     normal map of ``size``² with ``margin`` pixels of bleed. store: "PACK" (into the .blend) or
-    "FILE" (``<folder>/<name>_normal.png``; by default beside the .blend, named after the result)."""
+    "FILE" (``<folder>/<name>_normal.png``; by default beside the .blend, named after the result;
+    an existing file replaced only with ``replace``)."""
     size = check_size(size)
     check_memory(size, available_memory())
     check_bakeable(source, result)
@@ -353,7 +355,8 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
                                  hausdorff_max > DETAIL * diagonal)
             if active_uv >= 0:  # the map made for the bake is not the one the user edits
                 result.data.uv_layers.active_index = active_uv
-            path = save_image(image, folder, bpy.path.clean_name(name or result.name)) if store == "FILE" else ""
+            path = save_image(image, folder, bpy.path.clean_name(name or result.name), replace) \
+                if store == "FILE" else ""
             if store != "FILE":
                 pack_image(image)
         except BakeError:

@@ -119,7 +119,7 @@ def _bake(bpy, source, result, settings, name: str) -> str:
 
     size = settings["bake_normals"]
     baked = bake.bake_normals(bpy.context, source, result, size=size, margin=bake_margin(size), store="FILE",
-                              folder=settings["bake_folder"], name=name)
+                              folder=settings["bake_folder"], name=name, replace=True)
     return baked.path
 
 

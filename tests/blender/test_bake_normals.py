@@ -361,6 +361,9 @@ def test_batch_writes_a_gltf_that_reimports_with_its_map(ts, scene, tmp_path):
     image = normal_map_image(obj)
     assert image is not None and tuple(image.size) == (128, 128)
     assert len(obj.data.polygons) == lod["triangles"] < source_faces / 5
+    again = subprocess.run(command, capture_output=True, text=True, timeout=300)  # a new run replaces it
+    assert again.returncode == 0 and sorted(os.listdir(out)) == ["pebble.bin", "pebble.gltf",
+                                                                 "pebble_pebble_normal.png"]
 
 
 def test_batch_refuses_mesh_files_and_bad_sizes(ts, scene, tmp_path):
@@ -382,3 +385,19 @@ def importlib_module(ts, name):
     import importlib
 
     return importlib.import_module(f"{ts.__name__}.{name}")
+
+
+def test_a_map_beside_the_blend_never_replaces_a_file(ts, bake, scene, tmp_path, monkeypatch):
+    """Image: beside the .blend writes a PNG there (atomically, the image pointing at it) and takes
+    the next free name rather than write over a file."""
+    source = small_pair()
+    lod = decimated(ts, source, "lod")
+    (tmp_path / "lod_normal.png").write_bytes(b"the user's file")
+    monkeypatch.setattr(bake, "bake_folder", lambda: str(tmp_path))
+    result = bake.bake_normals(bpy.context, source, lod, size=64, margin=2, store="FILE")
+    assert result.path == str(tmp_path / "lod_normal_1.png") and result.image.packed_file is None
+    assert (tmp_path / "lod_normal.png").read_bytes() == b"the user's file"
+    assert sorted(os.listdir(tmp_path)) == ["lod_normal.png", "lod_normal_1.png"]  # no temporary left
+    reread = bpy.data.images.load(result.path)
+    assert tuple(reread.size) == (64, 64)
+    assert np.allclose(decoded(reread), decoded(result.image), atol=1 / 255)
