@@ -29,7 +29,6 @@ from ..core.decimate import ATTRIBUTE_WEIGHT
 from ..core.prune import prune_small_parts
 from ..core.batch_run import misnamed_failure, utf8_name, write_report
 from ..core.errors import TopStocError, one_line, shown_path
-from ..core.normal_bake import check_size
 from ..core.output_guard import check_folders, prepare_output, output_folder
 
 BLEND = ".blend"
@@ -44,10 +43,6 @@ def parse_args(argv):
     parser.command = "topstoc batch"  # errors as topstoc batch prints them
     batch_settings.add_io_arguments(parser)  # files and folders, as topstoc batch takes them
     parser.add_argument("--json", metavar="REPORT.json", help="write the report here")
-    parser.add_argument("--bake-normals", type=int, metavar="SIZE",
-                        help="bake a SIZE x SIZE tangent-space normal map from each source onto each result "
-                             "(Blender formats; a PNG next to the output, used by its materials; margin "
-                             "SIZE/64 pixels)")
     batch_settings.add_arguments(parser)
     return parser.parse_args(argv)
 
@@ -289,8 +284,6 @@ def main(argv=None) -> int:
         inputs = find_inputs(args.input)
         if not inputs:
             raise TopStocError("no input assets found")
-        if args.bake_normals is not None:
-            settings["bake_normals"] = check_size(args.bake_normals)
         check_folders(args.input, args.output)
         prepare_output(args.json, inputs)
         output_folder(args.output)
@@ -308,9 +301,6 @@ def main(argv=None) -> int:
         print(f"{prefix}: decimating ...", flush=True)
         try:
             if _is_mesh_file(path):
-                if settings.get("bake_normals"):
-                    raise TopStocError(f"{shown_path(path)}: --bake-normals needs a Blender format (.blend, glTF, "
-                                       f"FBX, USD): a mesh file has no material to hold the map")
                 entry = decimate_mesh_file(path, args.output, settings)
             else:
                 _register_addon()

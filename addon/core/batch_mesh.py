@@ -61,6 +61,9 @@ def lod_error(original, result, screen) -> dict:
 
 def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
     """Decimates one mesh file into ``out_dir``; returns its report entry."""
+    if settings.get("bake_normals"):
+        raise TopStocError(f"{path}: --bake-normals needs a Blender format (.blend, glTF, FBX, USD): a mesh "
+                           f"file has no material to hold the map")
     outputs = output_paths(path, out_dir, settings)
     data = read_mesh(path)
     if data.num_triangles == 0:

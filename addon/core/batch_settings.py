@@ -18,6 +18,7 @@ from .appearance import attribute_weight
 from .decimate import ATTRIBUTE_WEIGHT
 from .screen_size import DEFAULT_FOV_DEGREES, DEFAULT_PIXEL_ERROR, DEFAULT_RESOLUTION
 from .errors import TopStocError
+from .normal_bake import check_size
 
 TARGET_KINDS = ("ratio", "vertices", "triangles", "max_error", "screen_pixels", "screen_distance")
 SCREEN_KINDS = ("screen_pixels", "screen_distance")
@@ -68,6 +69,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--format", metavar="EXT",
                         help="write outputs in this format, e.g. obj, ply, ply.gz, glb (default: the input's, "
                              "uncompressed)")
+    parser.add_argument("--bake-normals", type=int, metavar="SIZE",
+                        help="Blender formats: bake a SIZE x SIZE tangent-space normal map from each source onto "
+                             "each result (a PNG next to the output, used by its materials; margin SIZE/64 px)")
     parser.add_argument("--keep-compression", action="store_true",
                         help="mesh files: a compressed input (.gz, .bz2) gives a compressed output (default: "
                              "uncompressed, which Blender and most tools import)")
@@ -135,6 +139,8 @@ def from_args(args) -> dict:
     weight = attribute_weight(args.attribute_weight)
     if weight != ATTRIBUTE_WEIGHT:  # absent at the default, likewise
         optional["attribute_weight"] = weight
+    if getattr(args, "bake_normals", None) is not None:  # absent when off, likewise
+        optional["bake_normals"] = check_size(args.bake_normals)
     return {**optional, "target": kind, "values": values, "chain": len(values) > 1,
             "pixel_error": args.pixel_error, "fov": args.fov, "resolution": args.resolution,
             "prune_pixels": args.prune_pixels, "lod_files": bool(args.lod_files), "format": out_format,
@@ -176,6 +182,8 @@ def to_argv(settings: dict) -> list:
         argv += ["--attribute-weight", repr(settings["attribute_weight"])]
     if settings["objects"]:
         argv += ["--objects", *settings["objects"]]
+    if settings.get("bake_normals"):
+        argv += ["--bake-normals", str(settings["bake_normals"])]
     return argv
 
 

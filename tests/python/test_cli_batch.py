@@ -207,3 +207,21 @@ def test_obj_lods_get_the_mtl_beside_them_and_report_dropped_normals(tmp_path):
         assert read_mesh(lod["output"]).material_libraries == ["spider.mtl"]
         assert lod["dropped_attributes"] == ["normals"]  # the spider's vn lines are not written
     assert (out / "spider.mtl").read_bytes() == (spider.parent / "spider.mtl").read_bytes()
+
+
+def test_bake_normals_is_checked_and_mesh_files_refuse_it(tmp_path):
+    """``--bake-normals SIZE`` reaches the Blender batch through the settings (to_argv); a bad size
+    is one error line, and a mesh file, which has no material for the map, fails with a reason."""
+    from topstoc.core import batch_settings
+
+    a = _torus(tmp_path / "a", "ring.obj")
+    done = batch("--input", a, "--output", tmp_path / "out", "--ratio", 0.5, "--bake-normals", 8, "--workers", 0)
+    cli.assert_one_error_line("batch", done, "normal map size must be a whole number of pixels from 16")
+    done = batch("--input", a, "--output", tmp_path / "out", "--ratio", 0.5, "--bake-normals", 64, "--workers", 0)
+    assert done.returncode == 1 and "--bake-normals needs a Blender format" in done.stdout + done.stderr
+    parser = __import__("argparse").ArgumentParser()
+    batch_settings.add_arguments(parser)
+    settings = batch_settings.from_args(parser.parse_args(["--ratio", "0.5", "--bake-normals", "512"]))
+    assert settings["bake_normals"] == 512 and batch_settings.to_argv(settings)[-2:] == ["--bake-normals", "512"]
+    plain = batch_settings.from_args(parser.parse_args(["--ratio", "0.5"]))
+    assert "bake_normals" not in plain and "--bake-normals" not in batch_settings.to_argv(plain)
