@@ -268,12 +268,16 @@ def _unit(v):
     return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
-def test_one_line_refusals(ts, bake, scene):
+def test_one_line_refusals(ts, bake, scene, monkeypatch):
     source = small_pair()
     lod = decimated(ts, source, "lod")
     images = set(bpy.data.images)
     with pytest.raises(ts.core.errors.TopStocError, match="whole number of pixels from 16 to 16384"):
         bake.bake_normals(bpy.context, source, lod, size=32768)
+    with monkeypatch.context() as low_memory:  # 1 GiB free: an 8192² map (1 GiB while baking) is refused
+        low_memory.setattr(bake, "available_memory", lambda: 2 ** 30)
+        with pytest.raises(ts.core.errors.TopStocError, match="8192x8192 normal map needs 1,024 MiB"):
+            bake.bake_normals(bpy.context, source, lod, size=8192)
     source.modifiers.new("bevel", "BEVEL")
     with pytest.raises(bake.BakeError, match=r"'small[.0-9]*' has modifiers that are not applied \(bevel\)"):
         bake.bake_normals(bpy.context, source, lod, size=64)

@@ -62,9 +62,11 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
                 lines.append(pipeline.summary(run))
             except TopStocError as error:
                 failures.append(str(error))
+        baked = []
         if self.bake_normals and outputs:
             if self.output == "NEW_OBJECT":
-                failures += bake.bake_results(context, self, zip(sources, outputs))[1]
+                baked, bake_failures = bake.bake_results(context, self, zip(sources, outputs))
+                failures += bake_failures
             else:
                 failures.append("Bake Normals needs Output: New Object (in place, no original is left to "
                                 "bake from)")
@@ -78,6 +80,8 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
             for obj in outputs:
                 obj.select_set(True)
             context.view_layer.objects.active = outputs[0]
+        for line in baked:
+            self.report({"INFO"}, f"TopStoc: {line}")
         seconds = time.perf_counter() - start
         if len(lines) == 1:
             self.report({"INFO"}, f"TopStoc: {lines[0]}; {seconds:.3f} s with output")

@@ -79,7 +79,10 @@ class _VariantsBase(OperatorParameters):
         outputs = [pipeline.write_output(run, "NEW_OBJECT", name=name, place=False) for run, name in zip(runs, names)]
         _lay_out(obj, outputs, _collection(context, self.collection_name(obj)))
         if getattr(self, "bake_normals", False):
-            for message in bake.bake_results(context, self, [(obj, output) for output in outputs])[1]:
+            baked, failures = bake.bake_results(context, self, [(obj, output) for output in outputs])
+            for line in baked:
+                self.report({"INFO"}, f"TopStoc: {line}")
+            for message in failures:
                 self.report({"ERROR"}, message)
         counts = ", ".join(f"{run.result.num_vertices:,}" for run in runs)
         self.report({"INFO"}, f"TopStoc: {len(runs)} variants of {obj.name} ({counts} vertices) "
