@@ -21,7 +21,6 @@ corners of borders) or the topology can push the count over; ``stats.over_budget
 
 from __future__ import annotations
 
-import collections.abc
 import dataclasses
 import math
 import warnings
@@ -30,122 +29,15 @@ from typing import TYPE_CHECKING, Optional, Sequence
 
 import numpy as np
 
-from . import params
-from .native import engine
+from . import budget, params
 from .errors import TopStocError
+from .job import (  # noqa: F401 - View, Box and the constants are this module's public names too
+    ATTRIBUTE_WEIGHT, DENSITY_MODES, MAX_ATTRIBUTE_CHANNELS, MODES, PLACEMENTS, QUALITY_COLLAPSES, QUALITY_REFINE,
+    Box, DecimationJob, View, attribute_arrays, guidance_values, make_job, target_vertex_count)
+from .native import engine
 
 if TYPE_CHECKING:  # for annotations only: mesh.py imports this module
     from .mesh import Mesh
-
-DENSITY_MODES = ("off", "uniform", "adaptive", "euclidean")
-PLACEMENTS = ("subsample", "filtered")
-MODES = ("quality", "fast")
-#: quality mode: the collapses remove at most max(QUALITY_COLLAPSES, target / 4) vertices
-#: after a stochastic first pass (the time then grows with the target, not with the mesh), and
-#: start from the whole mesh when it has at most 5 * QUALITY_COLLAPSES vertices (the lowest
-#: error; docs/design.md §2.10). QUALITY_REFINE only marks the refinement as on: an explicit
-#: refine=f sizes the first pass as f times the target instead of the budget.
-QUALITY_REFINE = 1.0
-QUALITY_COLLAPSES = 10_000
-#: default weight of an attribute channel in the collapse cost (see decimate's attributes)
-ATTRIBUTE_WEIGHT = 0.1
-#: the most attribute channels the collapse cost takes
-MAX_ATTRIBUTE_CHANNELS = 16
-#: how far over the target a result may land before it counts as over budget
-BUDGET_TOLERANCE = 0.01
-
-
-@dataclass
-class View:
-    """View-dependent guidance (thesis 4.4).
-
-    Perspective views give the camera position ``eye``; orthographic views the viewing
-    ``direction``. Back-facing vertices get ``p *= back_ratio``; vertices whose normal is within
-    the silhouette band ``|n.v| <= (1 - cos(silhouette_angle)) / 2`` are kept, with a linear
-    fall-off over ``silhouette_falloff`` (in units of ``|n.v|``). With a ``view_projection``
-    matrix (world to clip, 4x4, row-major as numpy prints it), vertices outside the frustum get
-    at most ``outside_probability``.
-    """
-
-    eye: Optional[Sequence[float]] = None
-    direction: Optional[Sequence[float]] = None
-    back_ratio: float = 0.25
-    silhouette_angle: float = math.radians(20.0)
-    silhouette_falloff: float = 0.1
-    view_projection: Optional[np.ndarray] = None
-    outside_probability: float = 0.0
-
-    def __post_init__(self):
-        self.as_engine()  # refuse bad fields where the view is made (and again where it is used)
-
-    def as_engine(self) -> dict:
-        """The engine's view, every field checked (core/params.py): ParameterError names the field."""
-        if (self.eye is None) == (self.direction is None):
-            raise params.ParameterError("a view needs exactly one of eye (perspective) or direction (orthographic)")
-        d = {
-            "perspective": self.eye is not None,
-            "back_ratio": params.number("view back_ratio", self.back_ratio, 0, 1),
-            "silhouette_angle": params.number("view silhouette_angle (radians)", self.silhouette_angle, 0, math.pi),
-            "silhouette_falloff": params.number("view silhouette_falloff", self.silhouette_falloff, 0),
-            "outside_probability": params.number("view outside_probability", self.outside_probability, 0, 1),
-        }
-        if self.eye is not None:
-            d["eye"] = params.array("view eye", self.eye, (3,))
-        else:
-            d["direction"] = params.array("view direction", self.direction, (3,), nonzero=True)
-        if self.view_projection is not None:
-            d["view_projection"] = params.array("view view_projection", self.view_projection, (4, 4))
-        return d
-
-
-@dataclass
-class Box:
-    """A box region (thesis 4.6): vertices inside take guidance ``value``.
-
-    ``world_to_box`` maps world coordinates into the box's frame, where the box is [-1, 1]^3
-    (a Blender cube empty of size 1 has exactly this frame: pass its inverted world matrix).
-    """
-
-    world_to_box: np.ndarray
-    value: float
-
-    def __post_init__(self):
-        self.as_engine()
-
-    @classmethod
-    def from_center_size(cls, center, half_size, value: float) -> "Box":
-        """Axis-aligned box from its centre and half extents (each > 0)."""
-        center = params.array("box center", center, (3,))
-        half = params.array("box half_size", half_size, (3,))
-        if np.any(half <= 0):
-            raise params.ParameterError(f"box half sizes must be positive, got {half.tolist()}")
-        m = np.eye(4)
-        m[:3, :3] = np.diag(1.0 / half)
-        m[:3, 3] = -center / half
-        return cls(m, value)
-
-    def as_engine(self):
-        """(world_to_box, value) for the engine, checked (core/params.py)."""
-        return (params.array("box world_to_box", self.world_to_box, (4, 4)),
-                params.number("box value", self.value, -1, 1))
-
-
-def _engine_view(view) -> Optional[dict]:
-    if view is None:
-        return None
-    if not isinstance(view, View):
-        raise params.ParameterError(f"view must be a topstoc View, got {type(view).__name__}")
-    return view.as_engine()
-
-
-def _engine_boxes(boxes) -> Optional[list]:
-    if isinstance(boxes, (Box, str, bytes)) or not isinstance(boxes, collections.abc.Iterable):
-        raise params.ParameterError(f"boxes must be a list of topstoc Box, got {type(boxes).__name__}")
-    boxes = list(boxes)
-    for i, box in enumerate(boxes):
-        if not isinstance(box, Box):
-            raise params.ParameterError(f"boxes[{i}] must be a topstoc Box, got {type(box).__name__}")
-    return [box.as_engine() for box in boxes] or None
 
 
 @dataclass(frozen=True)
@@ -181,21 +73,30 @@ class DecimateStats:
     output_check: dict = field(default_factory=dict)
     #: the final check ran; False only for a draft (``decimate(draft=True)``), which leaves it out
     output_checked: bool = True
+    control_points: int = 0     #: vertices the guidance keeps (u = 1)
+    zero_area_input: int = 0    #: input triangles without area (in double precision)
+    #: a mirror-symmetric result (core/symmetry.py): vertices of the plain decimation it was made from (else 0)
+    mirrored_from: int = 0
+    output_triangles: int = 0   #: triangles of the result
+    target_triangles: int = 0   #: the triangle target asked for (0: none)
 
     @property
     def over_budget(self) -> int:
         """Vertices above the target when the result misses it by more than 1 % (else 0)."""
         excess = self.output_vertices - self.target_vertices
-        return excess if excess > max(1, BUDGET_TOLERANCE * self.target_vertices) else 0
+        return excess if excess > budget.tolerance(self.target_vertices) else 0
 
     @property
     def over_budget_reason(self) -> str:
-        """Why the result is over budget: "" (it is not), "control points" (the vertices that
-        must stay, u = 1 and border corners, outnumber the target) or "topology" (samples the
-        topology needed)."""
-        if not self.over_budget:
-            return ""
-        return "control points" if self.forced >= self.target_vertices else "topology"
+        """Why the result is over budget: "" (it is not), "control points" (the vertices painted to
+        stay outnumber the target), "borders" (so do the corners of borders), "symmetry" (the
+        mirrored sample set) or "topology" (samples the topology needed); see core/budget.py."""
+        return budget.over_reason(self) if self.over_budget else ""
+
+    @property
+    def target_missed(self) -> Optional[budget.MissedTarget]:
+        """How far the result is from its vertex target and why, or None when it met it."""
+        return budget.missed_target(self)
 
     @property
     def topology_kept(self) -> Optional[bool]:
@@ -245,81 +146,6 @@ class DecimateResult:
     def aspect_ratio(self) -> dict:
         """Triangle aspect ratio (thesis eq. 4.2): mean, max and count of degenerate ones."""
         return engine.aspect_ratio_stats(self.vertices, self.triangles)
-
-
-def _result(raw: dict, parameters: dict) -> DecimateResult:
-    stats = DecimateStats(**{f.name: raw[f.name] for f in dataclasses.fields(DecimateStats)  # same names
-                             if f.name != "output_vertices"}, output_vertices=len(raw["vertices"]))
-    return DecimateResult(vertices=raw["vertices"], triangles=raw["triangles"], kept=raw["kept"],
-                          face_source=raw["face_source"], corner_source=raw["corner_source"],
-                          labels=raw["labels"], samples=raw["samples"], stats=stats,
-                          parameters=parameters)
-
-
-def _guidance(mesh: Mesh, guidance) -> Optional[np.ndarray]:
-    if guidance is None:
-        return None
-    u = params.real_array("guidance", guidance, "one number in [-1, 1] per vertex", booleans=True)
-    if u.shape != (mesh.native.report["input_vertices"],):
-        raise TopStocError(f"guidance must hold one value per vertex ({mesh.vertices.shape[0]}), "
-                           f"got shape {u.shape}")
-    bad = np.flatnonzero(~np.isfinite(u) | (u < -1) | (u > 1))
-    if len(bad):
-        raise TopStocError(f"guidance of vertex {bad[0]} is {u[bad[0]]}; it must lie in [-1, 1]")
-    return u
-
-
-def _attributes(mesh: Mesh, attributes, weights):
-    """Attributes for the collapse cost as (flat per-corner values, per-channel weights), or
-    (None, None). attributes: (n, k) per vertex or (m, 3, k) per corner of the caller's
-    triangles; weights: a number or one per channel."""
-    if attributes is None:
-        if weights is not None:
-            raise TopStocError("attribute_weights given without attributes")
-        return None, None
-    values = np.asarray(attributes)
-    if values.dtype.kind not in "fiu":
-        raise TopStocError(f"attributes must be a float array, got {values.dtype}")
-    values = values.astype(np.float64)
-    n, m = mesh.native.report["input_vertices"], len(mesh.triangles)
-    if values.ndim == 1 and len(values) == n:
-        values = values[:, None]
-    if values.ndim == 2 and values.shape[0] == n:
-        values = values[mesh.triangles]                     # per vertex -> per corner
-    elif not (values.ndim == 3 and values.shape[:2] == (m, 3)):
-        raise TopStocError(f"attributes must have shape (n, k) per vertex ({n} vertices) or (m, 3, k) per "
-                           f"corner ({m} triangles), got {values.shape}")
-    channels = values.shape[2]
-    if not 1 <= channels <= MAX_ATTRIBUTE_CHANNELS:
-        raise TopStocError(f"attributes must have 1 to {MAX_ATTRIBUTE_CHANNELS} channels, got {channels}")
-    bad = np.argwhere(~np.isfinite(values))
-    if len(bad):
-        t, c, k = bad[0]
-        raise TopStocError(f"attribute {k} of corner {c} of triangle {t} is {values[t, c, k]}; it must be finite")
-    w = np.asarray(ATTRIBUTE_WEIGHT if weights is None else weights, dtype=np.float64)
-    if w.ndim == 0:
-        w = np.full(channels, float(w))
-    if w.shape != (channels,):
-        raise TopStocError(f"attribute_weights must be a number or one per channel ({channels}), got shape {w.shape}")
-    if not np.all(np.isfinite(w) & (w >= 0)):
-        raise TopStocError(f"attribute_weights must be finite and >= 0, got {w}")
-    return np.ascontiguousarray(values).ravel(), np.ascontiguousarray(w)
-
-
-def _active_vertices(mesh: Mesh) -> int:
-    report = mesh.native.report
-    return report["input_vertices"] - report["isolated_vertices"]
-
-
-def target_vertex_count(mesh: Mesh, ratio=None, vertices=None) -> int:
-    """Vertex target from a ratio (of the vertices in triangles) or an explicit count."""
-    active = _active_vertices(mesh)
-    if ratio is not None:
-        return max(1, int(round(params.number("ratio", ratio, 0, 1, low_open=True) * active)))
-    vertices = params.integer("target_vertices", vertices)
-    if not 1 <= vertices <= active:
-        raise TopStocError(f"vertex target {vertices} is outside [1, {active}] (vertices in triangles)")
-    return vertices
 
 
 def _renamed(old: str, old_value, new: str, new_value):
@@ -387,84 +213,47 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     repairs still run; what a draft skips is the independent re-check, so show drafts while a
     slider moves and decimate in full for what is kept.
     """
-    vertices = _renamed("vertices", vertices, "target_vertices", target_vertices)  # the counts asked for
-    triangles = _renamed("triangles", triangles, "target_triangles", target_triangles)
-    given = [name for name, value in (("ratio", ratio), ("target_vertices", vertices),
-                                      ("target_triangles", triangles), ("max_error", max_error)) if value is not None]
-    if len(given) != 1:
-        raise TopStocError("give exactly one target (ratio, target_vertices, target_triangles or max_error), "
-                           f"got {given or 'none'}")
-    if mode not in MODES:
-        raise TopStocError(f"mode must be one of {MODES}, got {mode!r}")
-    if draft and (mode != "fast" or refine or max_error is not None):
-        raise TopStocError("draft=True is for preview frames of the fast mode: give mode='fast', no refine "
-                           "and no max_error")
-    if placement is None:
-        placement = "filtered" if mode == "quality" else "subsample"
-    refine_asked = refine  # the error-bounded search re-decimates with the caller's own choice
-    refine_collapses = 0
-    if refine is None:
-        refine = QUALITY_REFINE if mode == "quality" else 0.0
-        refine_collapses = QUALITY_COLLAPSES if mode == "quality" else 0
-    if max_error is not None:  # error-bounded: a search over vertex targets (error_bound.py)
+    job = make_job(mesh, ratio, _renamed("vertices", vertices, "target_vertices", target_vertices),
+                   _renamed("triangles", triangles, "target_triangles", target_triangles), max_error=max_error,
+                   relative=relative, seed=seed, adaptivity=adaptivity, flat_floor=flat_floor,
+                   area_weighted=area_weighted, feature_angle=feature_angle, density=density,
+                   density_rings=density_rings, density_ratio=density_ratio, density_epsilon=density_epsilon,
+                   guidance=guidance, regions=regions, borders=borders, view=view, boxes=boxes, mode=mode,
+                   placement=placement, fast_path=fast_path, max_repair_rounds=max_repair_rounds, refine=refine,
+                   attributes=attributes, attribute_weights=attribute_weights, draft=draft)
+    return run_job(mesh, job)
+
+
+def run_job(mesh: Mesh, job: DecimationJob) -> DecimateResult:
+    """Runs a DecimationJob (core/job.py): mirrored (core/symmetry.py), error-bounded (a search
+    over vertex counts, core/error_bound.py) or one engine call."""
+    if job.symmetry is not None:
+        from .symmetry import decimate_job_mirrored
+
+        return decimate_job_mirrored(mesh, job)
+    if job.target.max_error is not None:
         from .error_bound import search_vertex_count
 
-        def decimate_at(count: int) -> DecimateResult:
-            return decimate(mesh, target_vertices=count, seed=seed, adaptivity=adaptivity, flat_floor=flat_floor,
-                            area_weighted=area_weighted, feature_angle=feature_angle, density=density, density_rings=density_rings, density_ratio=density_ratio,
-                            density_epsilon=density_epsilon, guidance=guidance, regions=regions,
-                            borders=borders, view=view, boxes=boxes, mode=mode, placement=placement,
-                            fast_path=fast_path, max_repair_rounds=max_repair_rounds, refine=refine_asked,
-                            attributes=attributes, attribute_weights=attribute_weights)
+        result, report = search_vertex_count(mesh, job.target.max_error, lambda count: run_job(mesh, job.at(count)),
+                                             relative=job.target.relative)
+        return dataclasses.replace(result, error_bound=report, parameters={
+            **result.parameters, "max_error": job.target.max_error, "relative": job.target.relative})
+    layout, floods = mesh.layout_and_floods(job.regions, job.borders, job.feature_angle)
+    raw = engine.decimate(mesh.native, layout, job, flood_caches=floods)
+    return _result(raw, job.parameters(), mesh, job)
 
-        result, report = search_vertex_count(mesh, max_error, decimate_at, relative=relative)
-        return dataclasses.replace(result, error_bound=report,
-                                   parameters={**result.parameters, "max_error": max_error, "relative": relative})
-    if density not in DENSITY_MODES:
-        raise TopStocError(f"density must be one of {DENSITY_MODES}, got {density!r}")
-    if placement not in PLACEMENTS:
-        raise TopStocError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
-    seed = params.seed(seed)
-    refine_wanted = "0 (off) or a factor of at least 1"
-    refine = params.number("refine", refine, 0, expected=refine_wanted)
-    if 0 < refine < 1:
-        refine = params.number("refine", refine, 1, expected=refine_wanted)  # raises
-    adaptivity = params.number("adaptivity", adaptivity, 0, 1)
-    flat_floor = params.number("flat_floor", flat_floor, 0, 1)
-    feature_angle = params.number("feature_angle (radians)", feature_angle, 0, math.pi)
-    density_rings = params.integer("density_rings", density_rings, 0, 2**31 - 1)
-    density_ratio = params.number("density_ratio", density_ratio, 1)
-    density_epsilon = params.number("density_epsilon", density_epsilon, 0)
-    max_repair_rounds = params.integer("max_repair_rounds", max_repair_rounds, 0, 2**31 - 1)
-    target_triangles = 0
-    if triangles is not None:
-        target_triangles = params.integer("target_triangles", triangles)
-        if not 1 <= target_triangles <= mesh.num_triangles:
-            raise TopStocError(f"triangle target {target_triangles} is outside [1, {mesh.num_triangles}]")
-        target = 1
-    else:
-        target = target_vertex_count(mesh, ratio, vertices)
-    u = _guidance(mesh, guidance)
-    attribute_values, attribute_weights = _attributes(mesh, attributes, attribute_weights)
-    layout, floods = mesh.layout_and_floods(regions, borders, feature_angle)
-    parameters = dict(ratio=ratio, target_vertices=vertices, target_triangles=triangles, seed=int(seed),
-                      adaptivity=adaptivity, flat_floor=flat_floor, area_weighted=bool(area_weighted),
-                      feature_angle=float(feature_angle), density=density,
-                      density_rings=density_rings, density_ratio=density_ratio,
-                      density_epsilon=density_epsilon, mode=mode, placement=placement, refine=float(refine),
-                      refine_collapses=refine_collapses,
-                      attribute_channels=0 if attribute_weights is None else len(attribute_weights))
-    raw = engine.decimate(
-        mesh.native, layout, target_vertices=target, target_triangles=target_triangles,
-        seed=int(seed), adaptivity=float(adaptivity), flat_floor=float(flat_floor),
-        area_weighted=bool(area_weighted), guidance=u,
-        density=density, density_rings=int(density_rings), density_ratio=float(density_ratio),
-        density_epsilon=float(density_epsilon),
-        view=_engine_view(view), boxes=_engine_boxes(boxes), placement=placement,
-        fast_path=0 if fast_path is None else int(bool(fast_path)),
-        max_repair_rounds=int(max_repair_rounds), refine=float(refine), refine_collapses=int(refine_collapses),
-        attributes=attribute_values, attribute_weights=attribute_weights, flood_caches=floods, draft=bool(draft))
-    return _result(raw, parameters)
+
+def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob] = None) -> DecimateResult:
+    stats = DecimateStats(**{f.name: raw[f.name] for f in dataclasses.fields(DecimateStats)  # same names
+                             if f.name in raw}, output_vertices=len(raw["vertices"]),
+                          output_triangles=len(raw["triangles"]),
+                          target_triangles=0 if job is None else int(job.target.triangles or 0),
+                          control_points=0 if job is None else job.control_points,
+                          zero_area_input=mesh.native.report["zero_area_triangles"])
+    return DecimateResult(vertices=raw["vertices"], triangles=raw["triangles"], kept=raw["kept"],
+                          face_source=raw["face_source"], corner_source=raw["corner_source"],
+                          labels=raw["labels"], samples=raw["samples"], stats=stats,
+                          parameters=parameters)
 
 
 def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, feature_angle: float = 0.0,
@@ -485,14 +274,14 @@ def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, fe
     refine_vertices = params.integer("refine_vertices", refine_vertices, 0, 2**31 - 1)
     refine_triangles = params.integer("refine_triangles", refine_triangles, 0, 2**31 - 1)
     feature_angle = params.number("feature_angle (radians)", feature_angle, 0, math.pi)
-    attribute_values, attribute_weights = _attributes(mesh, attributes, attribute_weights)
+    attribute_values, attribute_weights = attribute_arrays(mesh, attributes, attribute_weights)
     layout = mesh.feature_layout(regions, borders, feature_angle)
     raw = engine.decimate_with_samples(mesh.native, layout, samples, placement=placement,
-                                       refine_vertices=int(refine_vertices), guidance=_guidance(mesh, guidance),
+                                       refine_vertices=int(refine_vertices), guidance=guidance_values(mesh, guidance),
                                        refine_triangles=int(refine_triangles), attributes=attribute_values,
                                        attribute_weights=attribute_weights)
     return _result(raw, dict(samples=len(samples), placement=placement, feature_angle=feature_angle,
-                             refine_vertices=int(refine_vertices), refine_triangles=int(refine_triangles)))
+                             refine_vertices=int(refine_vertices), refine_triangles=int(refine_triangles)), mesh)
 
 
 def sampling_probabilities(mesh: Mesh, rate: float, *, adaptivity: float = 0.5,
@@ -500,9 +289,7 @@ def sampling_probabilities(mesh: Mesh, rate: float, *, adaptivity: float = 0.5,
                            view: Optional[View] = None, boxes: Sequence[Box] = ()) -> np.ndarray:
     """The probability p(v) each vertex gets at base rate ``rate`` (docs/design.md §2.2), for inspection."""
     rate = params.number("rate", rate, 0, 1)
-    adaptivity = params.number("adaptivity", adaptivity, 0, 1)
-    flat_floor = params.number("flat_floor", flat_floor, 0, 1)
+    job = make_job(mesh, target_vertices=1, mode="fast", adaptivity=adaptivity, flat_floor=flat_floor,
+                   guidance=guidance, regions=regions, borders=borders, view=view, boxes=boxes)
     layout = mesh.feature_layout(regions, borders)
-    return engine.sampling_probabilities(
-        mesh.native, layout, float(rate), adaptivity=float(adaptivity), flat_floor=float(flat_floor),
-        guidance=_guidance(mesh, guidance), view=_engine_view(view), boxes=_engine_boxes(boxes))
+    return engine.sampling_probabilities(mesh.native, layout, float(rate), job)

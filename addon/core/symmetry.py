@@ -21,6 +21,7 @@ vertices, without a second refinement.
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -126,32 +127,37 @@ def parse_axis(text) -> str:
 
 def decimate_mirrored(mesh, axis=None, **options):
     """``mesh.decimate(**options)``, made mirror-symmetric across ``axis`` ("X", "Y", "Z") when it
-    is given (the add-on, the command line and the batch all decimate through this)."""
-    if axis is None:
-        return mesh.decimate(**options)
-    return decimate_symmetric(mesh, parse_axis(axis), **options)
+    is given."""
+    from .decimate import run_job
+    from .job import make_job
+
+    return run_job(mesh, make_job(mesh, symmetry=axis, **options))
 
 
-def decimate_symmetric(mesh, axis: str = "X", *, tolerance: float = None, regions=None, borders=None,
-                       feature_angle: float = 0.0, placement: str = "subsample", guidance=None, **options):
+def decimate_symmetric(mesh, axis: str = "X", *, tolerance: float = None, **options):
     """``mesh.decimate(...)`` with a mirror-symmetric result (see the module docs).
 
     The result's ``parameters`` record ``symmetry`` (the axis) and its ``samples`` reproduce it
     through ``decimate_with_samples`` like any result. placement None (the mode's choice) is
     subsample: the mirrored rebuild keeps input vertices in either mode.
     """
-    import dataclasses
+    return decimate_mirrored(mesh, parse_axis(axis), symmetry_tolerance=tolerance, **options)
 
-    from .decimate import decimate, decimate_with_samples
 
-    placement = placement or "subsample"
-    layout = dict(regions=regions, borders=borders, feature_angle=feature_angle)
-    plain = decimate(mesh, placement=placement, guidance=guidance, **layout, **options)
-    partner = mirror_partners(mesh.vertices, axis, tolerance)
+def decimate_job_mirrored(mesh, job):
+    """Runs a DecimationJob with a ``symmetry`` axis (core/job.py): the plain job's draw, mirrored.
+    The result's stats keep the plain job's target (``mirrored_from``: the plain result's
+    vertices), so a mirrored set larger than the target is reported over budget (core/budget.py)."""
+    from .decimate import decimate_with_samples, run_job
+
+    axis, placement = job.symmetry, job.placement
+    layout = dict(regions=job.regions, borders=job.borders, feature_angle=job.feature_angle)
+    plain = run_job(mesh, job.plain())
+    partner = mirror_partners(mesh.vertices, axis, job.symmetry_tolerance)
     message = symmetry_warning(partner, axis)
-    if message:
-        warnings.warn(message, SymmetryWarning, stacklevel=3)
-    forced = np.flatnonzero(np.asarray(guidance) >= 1.0) if guidance is not None else ()
+    if message:  # stacklevel: the caller of decimate_mirrored (through run_job)
+        warnings.warn(message, SymmetryWarning, stacklevel=4)
+    forced = np.flatnonzero(job.guidance >= 1.0) if job.guidance is not None else ()
     refined = plain.stats.refine_vertices > 0
     chosen = np.asarray(plain.kept if refined else plain.samples, dtype=np.int64)
     samples = symmetric_samples(chosen, mesh.vertices, partner, axis, forced)
@@ -168,7 +174,10 @@ def decimate_symmetric(mesh, axis: str = "X", *, tolerance: float = None, region
     parameters = dict(plain.parameters, symmetry=axis, symmetric_samples=len(samples))
     vertices = mirror_average(result.vertices, result.kept, partner, axis) if placement == "filtered" \
         else result.vertices
-    return dataclasses.replace(result, vertices=vertices, parameters=parameters)
+    stats = dataclasses.replace(result.stats, target_vertices=plain.stats.target_vertices,
+                                target_triangles=plain.stats.target_triangles, forced=plain.stats.forced,
+                                control_points=plain.stats.control_points, mirrored_from=plain.num_vertices)
+    return dataclasses.replace(result, vertices=vertices, parameters=parameters, stats=stats)
 
 
 def mirror_average(positions, kept, partner, axis: str) -> np.ndarray:

@@ -140,24 +140,57 @@ py::dict result_dict(DecimateResult&& r) {
   return d;
 }
 
-SamplingParams sampling_from(const Mesh& mesh, uint64_t seed, double adaptivity, double flat_floor, bool area_weighted,
-                             const std::vector<double>& guidance, const std::string& density, int32_t density_rings,
-                             double density_ratio, double density_epsilon, const py::handle& view,
-                             const py::handle& boxes) {
+// The float64 arrays of a job (core/job.py made them contiguous float64 of the right size),
+// held while the engine reads them in place.
+struct JobArrays {
+  py::array_t<double, py::array::c_style | py::array::forcecast> guidance, attributes, attribute_weights;
+};
+
+const double* data_of(py::array_t<double, py::array::c_style | py::array::forcecast>& array, const py::handle& from) {
+  if (from.is_none()) return nullptr;
+  array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(from);
+  return array.data();
+}
+
+// The sampling half of a DecimationJob (core/job.py); its ranges were checked when it was made,
+// the engine checks its own invariants (validate_sampling_params).
+SamplingParams sampling_from(const py::handle& job, JobArrays& arrays) {
   SamplingParams s;
-  s.seed = seed;
-  s.adaptivity = adaptivity;
-  s.flat_floor = flat_floor;
-  s.area_weighted = area_weighted;
-  s.guidance = guidance.empty() ? nullptr : guidance.data();
-  s.density = density_from(density);
-  s.density_rings = density_rings;
-  s.density_ratio = density_ratio;
-  s.density_epsilon = density_epsilon;
-  s.view = view_from(view);
-  s.boxes = boxes_from(boxes);
-  validate_sampling_params(mesh, s);
+  s.seed = job.attr("seed").cast<uint64_t>();
+  s.adaptivity = job.attr("adaptivity").cast<double>();
+  s.flat_floor = job.attr("flat_floor").cast<double>();
+  s.area_weighted = job.attr("area_weighted").cast<bool>();
+  s.guidance = data_of(arrays.guidance, job.attr("guidance"));
+  s.density = density_from(job.attr("density").cast<std::string>());
+  s.density_rings = job.attr("density_rings").cast<int32_t>();
+  s.density_ratio = job.attr("density_ratio").cast<double>();
+  s.density_epsilon = job.attr("density_epsilon").cast<double>();
+  s.view = view_from(job.attr("view"));
+  s.boxes = boxes_from(job.attr("boxes"));
   return s;
+}
+
+// A DecimationJob (core/job.py) as the engine's DecimateParams; `arrays` holds what they point into.
+DecimateParams params_from(const Mesh& mesh, const py::handle& job, JobArrays& arrays) {
+  DecimateParams params;
+  params.sampling = sampling_from(job, arrays);
+  params.target_vertices = job.attr("target").attr("vertex_count").cast<int32_t>();
+  params.placement = placement_from(job.attr("placement").cast<std::string>());
+  params.fast_path = job.attr("fast_path").cast<int>();
+  params.max_repair_rounds = job.attr("max_repair_rounds").cast<int32_t>();
+  params.refine = job.attr("refine").cast<double>();
+  params.refine_collapses = job.attr("refine_collapses").cast<int32_t>();
+  params.draft = job.attr("draft").cast<bool>();
+  const double* values = data_of(arrays.attributes, job.attr("attributes"));
+  const double* weights = data_of(arrays.attribute_weights, job.attr("attribute_weights"));
+  if (values && weights) {
+    params.attributes.values = values;
+    params.attributes.channels = static_cast<int>(arrays.attribute_weights.size());
+    params.attributes.weights = weights;
+    if (arrays.attributes.size() != 3 * int64_t(mesh.report().input_triangles) * params.attributes.channels)
+      throw std::invalid_argument("attributes must hold 3 values per triangle corner and channel");
+  }
+  return params;
 }
 
 // Attributes for the collapse cost: `values` flat, 3 corners per caller triangle times
@@ -197,28 +230,12 @@ void bind_decimate(py::module_& m) {
 
   m.def(
       "decimate",
-      [](const Mesh& mesh, const FeatureLayout& layout, int32_t target_vertices, int32_t target_triangles,
-         uint64_t seed, double adaptivity, double flat_floor, bool area_weighted, const py::handle& guidance,
-         const std::string& density,
-         int32_t density_rings, double density_ratio, double density_epsilon, const py::handle& view,
-         const py::handle& boxes, const std::string& placement, int fast_path, int32_t max_repair_rounds,
-         double refine, int32_t refine_collapses, const py::handle& attributes, const py::handle& attribute_weights,
-         const py::handle& flood_caches, bool draft) {
-        const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
-        DecimateParams params;
-        params.sampling = sampling_from(mesh, seed, adaptivity, flat_floor, area_weighted, u, density, density_rings,
-                                        density_ratio,
-                                        density_epsilon, view, boxes);
-        params.placement = placement_from(placement);
-        params.fast_path = fast_path;
-        params.max_repair_rounds = max_repair_rounds;
-        params.target_vertices = target_vertices;
-        params.refine = refine;
-        params.refine_collapses = refine_collapses;
-        const AttributeArrays arrays = attributes_from(mesh, attributes, attribute_weights);
-        params.attributes = arrays.view(mesh.report().input_triangles);
+      [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& job, const py::handle& flood_caches) {
+        JobArrays arrays;
+        DecimateParams params = params_from(mesh, job, arrays);
         params.flood_caches = flood_caches.is_none() ? nullptr : flood_caches.cast<FloodCachePool*>();
-        params.draft = draft;
+        const py::object triangles = job.attr("target").attr("triangles");
+        const int32_t target_triangles = triangles.is_none() ? 0 : triangles.cast<int32_t>();
         DecimateResult r;
         {
           EngineCall call;
@@ -227,14 +244,8 @@ void bind_decimate(py::module_& m) {
         }
         return result_dict(std::move(r));
       },
-      py::arg("mesh"), py::arg("layout"), py::arg("target_vertices") = 0, py::arg("target_triangles") = 0,
-      py::arg("seed") = 0, py::arg("adaptivity") = 0.5, py::arg("flat_floor") = 0.25, py::arg("area_weighted") = false,
-      py::arg("guidance") = py::none(), py::arg("density") = "off", py::arg("density_rings") = 0, py::arg("density_ratio") = 2.0,
-      py::arg("density_epsilon") = 0.0, py::arg("view") = py::none(), py::arg("boxes") = py::none(),
-      py::arg("placement") = "subsample", py::arg("fast_path") = 0, py::arg("max_repair_rounds") = 200,
-      py::arg("refine") = 0.0, py::arg("refine_collapses") = 0, py::arg("attributes") = py::none(),
-      py::arg("attribute_weights") = py::none(), py::arg("flood_caches") = py::none(), py::arg("draft") = false,
-      "TopStoc decimation to a vertex target (or a triangle target when target_triangles > 0).");
+      py::arg("mesh"), py::arg("layout"), py::arg("job"), py::arg("flood_caches") = py::none(),
+      "TopStoc decimation of a topstoc.core.job.DecimationJob (a triangle target when it has one).");
 
   m.def(
       "decimate_with_samples",
@@ -262,11 +273,9 @@ void bind_decimate(py::module_& m) {
 
   m.def(
       "sampling_probabilities",
-      [](const Mesh& mesh, const FeatureLayout& layout, double rate, uint64_t seed, double adaptivity,
-         double flat_floor, bool area_weighted, const py::handle& guidance, const py::handle& view,
-         const py::handle& boxes) {
-        const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
-        auto s = sampling_from(mesh, seed, adaptivity, flat_floor, area_weighted, u, "off", 0, 2.0, 0.0, view, boxes);
+      [](const Mesh& mesh, const FeatureLayout& layout, double rate, const py::handle& job) {
+        JobArrays arrays;
+        const SamplingParams s = sampling_from(job, arrays);
         std::vector<double> p;
         {
           EngineCall call;
@@ -274,9 +283,8 @@ void bind_decimate(py::module_& m) {
         }
         return to_array(std::move(p));
       },
-      py::arg("mesh"), py::arg("layout"), py::arg("rate"), py::arg("seed") = 0, py::arg("adaptivity") = 0.5,
-      py::arg("flat_floor") = 0.25, py::arg("area_weighted") = false, py::arg("guidance") = py::none(), py::arg("view") = py::none(),
-      py::arg("boxes") = py::none(), "Per-vertex sampling probability p(v) for base rate k (docs/design.md §2.2).");
+      py::arg("mesh"), py::arg("layout"), py::arg("rate"), py::arg("job"),
+      "Per-vertex sampling probability p(v) for base rate k of a DecimationJob's sampling (docs/design.md §2.2).");
 
   m.def(
       "aspect_ratio_stats",

@@ -617,6 +617,7 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
     throw std::invalid_argument("target of " + std::to_string(params.target_vertices) +
                                 " vertices exceeds the mesh's " + std::to_string(active) + " vertices in triangles");
   if (params.max_repair_rounds < 0) throw std::invalid_argument("max_repair_rounds must be >= 0");
+  validate_sampling_params(mesh, params.sampling);  // the engine's door: every caller's sampling checked here
   const int32_t target = params.target_vertices;
   // Without guidance the budget is exact. Repairs add samples and absorbed clusters remove
   // some; a shortfall is topped up inside the pass (widest clusters split), an excess (the

@@ -1,0 +1,94 @@
+"""A missed target, told the same way everywhere: command line, ``--json``, batch line and report,
+the add-on's status bar and panel (docs/design.md §2.3).
+
+A decimation misses its vertex target when it lands more than BUDGET_TOLERANCE (at least one
+vertex) away from it. Why, in the words every channel uses:
+
+- "control points": the vertices painted to stay (u = 1) outnumber the target;
+- "borders": corners of borders (seams, materials, sharp or hard-normal edges), always kept,
+  outnumber the target;
+- "topology": samples the topology needs (each loose piece keeps at least a triangle, each
+  hole and handle its loops);
+- "symmetry": the mirrored sample set is larger than the plain draw (core/symmetry.py);
+- "zero-area input": the input's triangles have no area in double precision (coordinates so
+  small that their squared lengths underflow), so the clean-up of zero-area triangles removes
+  vertices below the target.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+#: how far from the target a result may land before it counts as missing it
+BUDGET_TOLERANCE = 0.01
+
+
+def tolerance(target: int) -> float:
+    """Vertices a result may lie off ``target`` and still meet it."""
+    return max(1, BUDGET_TOLERANCE * target)
+
+
+@dataclass(frozen=True)
+class MissedTarget:
+    """A result that missed its target: ``got`` vertices (or triangles) for ``asked``, and why."""
+
+    asked: int
+    got: int
+    reason: str
+    unit: str = "vertices"
+
+    @property
+    def off(self) -> int:
+        """Vertices over (> 0) or under (< 0) the target."""
+        return self.got - self.asked
+
+    @property
+    def fraction(self) -> float:
+        """How far off, as a fraction of the target (+0.09: 9 % over)."""
+        return self.off / self.asked if self.asked else 0.0
+
+    def as_dict(self) -> dict:
+        """The ``target_missed`` object of the JSON reports."""
+        return {"asked": self.asked, "got": self.got, "unit": self.unit, "off": self.off,
+                "fraction": self.fraction, "reason": self.reason}
+
+    def text(self) -> str:
+        """One phrase for a report line: "target missed: 871 vertices for 796 (75 over, +9.4 %; symmetry)"."""
+        side = "over" if self.off > 0 else "under"
+        return (f"target missed: {self.got:,} {self.unit} for {self.asked:,} ({abs(self.off):,} {side}, "
+                f"{100 * self.fraction:+.1f} %; {self.reason})")
+
+
+def over_reason(stats) -> str:
+    """Why a result with these DecimateStats landed over its target (see the module docs)."""
+    if stats.forced >= stats.target_vertices:
+        return "control points" if stats.control_points else "borders"
+    if stats.mirrored_from and stats.mirrored_from - stats.target_vertices <= tolerance(stats.target_vertices):
+        return "symmetry"  # the plain draw met the target, its mirrored set did not
+    return "topology"
+
+
+def missed_target(stats) -> Optional[MissedTarget]:
+    """The MissedTarget of a result's DecimateStats, or None when it met its target (a triangle
+    target counts triangles, any other vertices)."""
+    unit = "triangles" if stats.target_triangles else "vertices"
+    asked, got = ((stats.target_triangles, stats.output_triangles) if stats.target_triangles
+                  else (stats.target_vertices, stats.output_vertices))
+    if abs(got - asked) <= tolerance(asked):
+        return None
+    if got > asked:
+        return MissedTarget(asked, got, over_reason(stats), unit)
+    return MissedTarget(asked, got, "zero-area input" if stats.zero_area_input else "absorbed clusters", unit)
+
+
+def missed_text(stats) -> str:
+    """``"; target missed: ..."`` for a report line, or "" when the target was met."""
+    missed = missed_target(stats)
+    return "" if missed is None else "; " + missed.text()
+
+
+def missed_dict(stats) -> Optional[dict]:
+    """The ``target_missed`` object of a JSON report, or None when the target was met."""
+    missed = missed_target(stats)
+    return None if missed is None else missed.as_dict()
