@@ -13,16 +13,12 @@ import os
 import time
 
 from . import batch_settings
-from .appearance import Appearance, appearance_attributes, refines
-from .decimate import ATTRIBUTE_WEIGHT
-from .attributes import material_regions, transfer_attributes, uv_seam_edges
+from .budget import missed_dict
 from .hausdorff import hausdorff
-from .io import dropped_attributes, mesh_format, read_mesh, write_mesh
-from .materials import carry_libraries
-from .mesh import Mesh
+from .io import mesh_format
+from .job import ATTRIBUTE_WEIGHT
+from .mesh_file_job import prepare_file, read_input
 from .prune import prune_small_parts
-from .errors import TopStocError
-from .symmetry import decimate_mirrored
 
 #: samples on the original for the per-LOD error in the report: 100 per input triangle, within
 #: these bounds (dense enough on small assets, bounded cost on large ones)
@@ -65,24 +61,16 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
         raise TopStocError(f"{path}: --bake-normals needs a Blender format (.blend, glTF, FBX, USD): a mesh "
                            f"file has no material to hold the map")
     outputs = output_paths(path, out_dir, settings)
-    data = read_mesh(path)
-    if data.num_triangles == 0:
-        raise TopStocError(f"{path}: no faces to decimate")
+    data = read_input(path)
     start = time.perf_counter()
-    mesh = Mesh(data.vertices, data.triangles)
-    seams = None if data.corner_uvs is None else uv_seam_edges(data.triangles, data.corner_uvs)
-    layout = dict(regions=material_regions(data), borders=seams if seams is not None and len(seams) else None)
-    weight = settings.get("attribute_weight", ATTRIBUTE_WEIGHT)
     options = settings["options"]
-    appearance = Appearance()  # the look, where the refinement runs
-    if weight > 0 and refines(options.get("mode") or "quality", options.get("refine")):
-        appearance = appearance_attributes(data.triangles, data.corner_uvs, data.vertex_colors)
-    layout.update(appearance.decimate_kwargs(weight))
+    source = prepare_file(path, data, options.get("mode"), options.get("refine"),
+                          settings.get("attribute_weight", ATTRIBUTE_WEIGHT))
     lods = []
     for index, ((target, screen), output) in enumerate(zip(batch_settings.engine_targets(settings, data.vertices),
                                                           outputs)):
         started = time.perf_counter()
-        result = decimate_mirrored(mesh, settings.get("symmetry"), **target, **options, **layout)
+        result = source.decimate(target, options, settings.get("symmetry"))
         entry = {"lod": index, "output": output, "target": target, "symmetry": settings.get("symmetry")}
         if screen is not None and settings["prune_pixels"] > 0:
             result, pruned = prune_small_parts(result, settings["prune_pixels"] * screen.world_per_pixel)
@@ -90,11 +78,8 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
         bound = getattr(result, "error_bound", None)
         entry.update(vertices=result.num_vertices, triangles=result.num_triangles, repairs=result.stats.repairs,
                      search_error=None if bound is None else float(bound.achieved_error),
-                     **lod_error(mesh, result, screen))
-        out = transfer_attributes(data, result)
-        out.material_libraries = carry_libraries(out.material_libraries, path, output)
-        write_mesh(output, out)
-        entry["dropped_attributes"] = dropped_attributes(out, output)
+                     target_missed=missed_dict(result.stats), **lod_error(source.mesh, result, screen))
+        entry["dropped_attributes"] = source.write(result, output)
         entry["seconds"] = time.perf_counter() - started
         lods.append(entry)
     first = lods[0]
@@ -102,5 +87,6 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
             "vertices_in": data.num_vertices, "triangles_in": data.num_triangles,
             "vertices_out": first["vertices"], "triangles_out": first["triangles"],
             "seconds": time.perf_counter() - start, "repairs": first["repairs"], "error": first["search_error"],
-            "attributes": appearance.channels if appearance.decimate_kwargs(weight) else [],
+            "target_missed": first["target_missed"],
+            "attributes": source.appearance.channels if source.attribute_kwargs else [],
             "lods": lods}

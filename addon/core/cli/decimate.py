@@ -14,16 +14,16 @@ import time
 
 import numpy as np
 
-from ..appearance import Appearance, appearance_attributes, attribute_weight, refines
-from ..attributes import material_regions, transfer_attributes, uv_seam_edges
-from ..io import dropped_attributes, mesh_format, read_mesh, write_mesh
-from ..decimate import ATTRIBUTE_WEIGHT
-from ..mesh import Mesh
-from ..output_guard import add_overwrite_argument, prepare_output
-from ..materials import carry_libraries
-from ..symmetry import AXES, decimate_mirrored
-from . import print_json, progress
+from ..appearance import attribute_weight, refines
+from ..batch_settings import parse_max_error
+from ..budget import missed_dict, missed_text
 from ..errors import TopStocError
+from ..io import mesh_format
+from ..job import ATTRIBUTE_WEIGHT
+from ..mesh_file_job import prepare_file, read_input
+from ..output_guard import add_overwrite_argument, prepare_output
+from ..symmetry import AXES
+from . import print_json, progress
 
 DENSITIES = ("off", "uniform", "adaptive")
 
@@ -69,19 +69,6 @@ def add_parser(subparsers) -> None:
     add_overwrite_argument(parser)
     progress.add_arguments(parser)
     parser.set_defaults(run=run)
-
-
-def parse_max_error(text: str) -> tuple:
-    """'0.01' -> (0.01, False): absolute; '0.5%' -> (0.005, True): a fraction of the
-    bounding-box diagonal. Raises ValueError."""
-    relative = text.strip().endswith("%")
-    try:
-        value = float(text.strip().rstrip("%"))
-    except ValueError:
-        raise TopStocError(f"--max-error must be a number, optionally followed by %, got {text!r}") from None
-    if not np.isfinite(value) or value <= 0:
-        raise TopStocError(f"--max-error must be positive, got {text!r}")
-    return (value / 100.0, True) if relative else (value, False)
 
 
 def load_guidance(path: str, num_vertices: int) -> np.ndarray:
@@ -130,46 +117,37 @@ def attribute_report(requested: float, used: bool, args, data, appearance) -> di
     return report
 
 
+def _target(args) -> dict:
+    """The decimation target of the arguments: ratio, a count, or an error bound."""
+    if args.max_error is not None:
+        bound, relative = parse_max_error(args.max_error)
+        return {"max_error": bound, "relative": relative}
+    return {"ratio": args.ratio, "target_vertices": args.vertices, "target_triangles": args.triangles}
+
+
 def run(args) -> int:
     prepare_output(args.output, [args.input, args.guidance], overwrite=args.overwrite)
     mesh_format(args.output)  # fail on a bad output name before doing any work
     progress.stage(f"reading {args.input}")
-    data = read_mesh(args.input)
-    if data.num_triangles == 0:
-        raise TopStocError(f"{args.input}: the mesh has no triangles")
+    data = read_input(args.input)
     guidance = None if args.guidance is None else load_guidance(args.guidance, data.num_vertices)
     weight = attribute_weight(args.attribute_weight)
+    target = _target(args)
 
     start = time.perf_counter()
-    mesh = Mesh(data.vertices, data.triangles)
-    seams = None if data.corner_uvs is None else uv_seam_edges(data.triangles, data.corner_uvs)
-    appearance = Appearance()  # UVs and colours count only where the refinement runs
-    if weight > 0 and refines(args.mode, args.refine):
-        appearance = appearance_attributes(data.triangles, data.corner_uvs, data.vertex_colors)
-    attributes = appearance.decimate_kwargs(weight)
+    source = prepare_file(args.input, data, args.mode, args.refine, weight)
     options = dict(seed=args.seed, adaptivity=args.adaptivity, density=args.density, guidance=guidance,
-                   mode=args.mode, placement=args.placement, refine=args.refine,
-                   regions=material_regions(data), borders=seams if seams is not None and len(seams) else None,
-                   **attributes)
-    progress.stage("decimating")
-    if args.max_error is not None:
-        bound, relative = parse_max_error(args.max_error)
-        progress.stage(f"searching the vertex count for --max-error {args.max_error}")
-        result = decimate_mirrored(mesh, args.symmetry, max_error=bound, relative=relative, **options)
-    else:
-        result = decimate_mirrored(mesh, args.symmetry, ratio=args.ratio, target_vertices=args.vertices,
-                                   target_triangles=args.triangles, **options)
+                   mode=args.mode, placement=args.placement, refine=args.refine)
+    progress.stage("decimating" if args.max_error is None else
+                   f"searching the vertex count for --max-error {args.max_error}")
+    result = source.decimate(target, options, args.symmetry)
     seconds = time.perf_counter() - start
-
-    output = transfer_attributes(data, result)
     progress.stage(f"writing {args.output}")
-    output.material_libraries = carry_libraries(output.material_libraries, args.input, args.output)
-    write_mesh(args.output, output)
-    dropped = dropped_attributes(output, args.output)
+    dropped = source.write(result, args.output)
 
-    stats = result.stats
+    stats, seams, appearance = result.stats, source.seams, source.appearance
     if args.json:
-        report = mesh.report()
+        report = source.mesh.report()
         print_json({
             "input": {"path": args.input, "vertices": data.num_vertices, "triangles": data.num_triangles,
                       "uvs": data.corner_uvs is not None, "vertex_colors": data.vertex_colors is not None,
@@ -181,6 +159,7 @@ def run(args) -> int:
             "target": {key: value for key, value in (("ratio", args.ratio), ("vertices", args.vertices),
                                                     ("triangles", args.triangles), ("max_error", args.max_error))
                        if value is not None},
+            "target_missed": missed_dict(stats),
             "seed": args.seed,
             "symmetry": args.symmetry,
             "seconds": seconds,
@@ -195,12 +174,13 @@ def run(args) -> int:
             "refine": {"mode": args.mode, "factor": result.parameters["refine"],
                        "placement": result.parameters["placement"], "vertices": stats.refine_vertices,
                        "collapses": stats.refine_collapses},
-            "attributes": attribute_report(weight, bool(attributes), args, data, appearance),
+            "attributes": attribute_report(weight, bool(source.attribute_kwargs), args, data, appearance),
             "aspect_ratio": result.aspect_ratio(),
             **_error_bound_report(result),
         })
     else:
         print(f"{args.input}: {data.num_vertices} vertices, {data.num_triangles} triangles -> {args.output}: "
               f"{result.num_vertices} vertices, {result.num_triangles} triangles in {seconds:.3f} s "
-              f"({stats.repairs} repair samples)" + (f"; not written: {', '.join(dropped)}" if dropped else ""))
+              f"({stats.repairs} repair samples)" + missed_text(stats)
+              + (f"; not written: {', '.join(dropped)}" if dropped else ""))
     return 0

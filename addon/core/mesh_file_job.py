@@ -1,0 +1,74 @@
+"""The one recipe that decimates a mesh file (docs/design.md §1.5, §6): read, prepare the Mesh,
+UV seams and material borders as borders, the look (UVs, colours) as attributes where the
+refinement runs, decimate (mirrored when asked), carry the attributes over, write atomically.
+
+``topstoc decimate`` (core/cli/decimate.py) runs it once; the batch (core/batch_mesh.py) once
+per LOD of each mesh file. The decimation itself is a DecimationJob (core/job.py).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from .appearance import Appearance, appearance_attributes, refines
+from .attributes import material_regions, transfer_attributes, uv_seam_edges
+from .decimate import DecimateResult, run_job
+from .errors import TopStocError
+from .io import MeshData, dropped_attributes, read_mesh, write_mesh
+from .job import DecimationJob, make_job
+from .materials import carry_libraries
+from .mesh import Mesh
+
+
+def read_input(path: str) -> MeshData:
+    """The mesh file ``path``; TopStocError when it has no triangles."""
+    data = read_mesh(path)
+    if data.num_triangles == 0:
+        raise TopStocError(f"{path}: the mesh has no triangles")
+    return data
+
+
+@dataclass
+class MeshFileJob:
+    """A mesh file prepared for decimation: the Mesh, its borders and its look."""
+
+    path: str
+    data: MeshData
+    mesh: Mesh
+    seams: Optional[np.ndarray]     #: UV seam edges (k, 2), or None without UVs
+    regions: Optional[np.ndarray]   #: material per triangle, or None
+    appearance: Appearance          #: the look, where the refinement runs (else empty)
+    attribute_kwargs: dict          #: ``attributes``/``attribute_weights`` for make_job, or {}
+
+    def job(self, target: dict, options: dict, symmetry=None) -> DecimationJob:
+        """The DecimationJob for one target (``ratio=``, ``target_vertices=``, ``max_error=``...)
+        and the decimate options (seed, mode, guidance...)."""
+        borders = self.seams if self.seams is not None and len(self.seams) else None
+        return make_job(self.mesh, **target, **options, symmetry=symmetry, regions=self.regions, borders=borders,
+                        **self.attribute_kwargs)
+
+    def decimate(self, target: dict, options: dict, symmetry=None) -> DecimateResult:
+        return run_job(self.mesh, self.job(target, options, symmetry))
+
+    def write(self, result: DecimateResult, output: str) -> list:
+        """Writes ``result`` with the input's attributes to ``output``; returns what its format
+        cannot store (io.dropped_attributes)."""
+        out = transfer_attributes(self.data, result)
+        out.material_libraries = carry_libraries(out.material_libraries, self.path, output)
+        write_mesh(output, out)
+        return dropped_attributes(out, output)
+
+
+def prepare_file(path: str, data: MeshData, mode: str = "quality", refine=None, weight: float = 0.0) -> MeshFileJob:
+    """The MeshFileJob of ``data`` (read from ``path``); the look enters at ``weight`` when the
+    refinement (``mode``, ``refine``) runs, the only stage that uses it."""
+    mesh = Mesh(data.vertices, data.triangles)
+    seams = None if data.corner_uvs is None else uv_seam_edges(data.triangles, data.corner_uvs)
+    appearance = Appearance()
+    if weight > 0 and refines(mode or "quality", refine):
+        appearance = appearance_attributes(data.triangles, data.corner_uvs, data.vertex_colors)
+    return MeshFileJob(path, data, mesh, seams, material_regions(data), appearance,
+                       appearance.decimate_kwargs(weight))
