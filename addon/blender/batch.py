@@ -25,6 +25,7 @@ import numpy as np
 
 from ..core import batch_settings
 from ..core.batch_mesh import decimate_mesh_file, lod_error
+from ..core.budget import missed_dict, report_missed
 from ..core.decimate import ATTRIBUTE_WEIGHT
 from ..core.prune import prune_small_parts
 from ..core.batch_run import misnamed_failure, utf8_name, write_report
@@ -164,7 +165,7 @@ def _decimate_object(bpy, pipeline, obj, settings, targets) -> tuple:
             error["hausdorff_pixels"] = screen.to_pixels(error["hausdorff_world"])
             error["screen"] = screen.as_dict()
         entry.update(vertices=run.result.num_vertices, triangles=run.result.num_triangles,
-                     repairs=run.result.stats.repairs, seconds=run.seconds,
+                     repairs=run.result.stats.repairs, seconds=run.seconds, target_missed=missed_dict(run.result.stats),
                      search_error=None if bound is None else float(bound.achieved_error), **error)
         if settings["chain"]:
             name = batch_settings.lod_name(obj.name, index, settings)
@@ -182,7 +183,8 @@ def _decimate_object(bpy, pipeline, obj, settings, targets) -> tuple:
         lods.append(entry)
     report = {"object": obj.name, "vertices_in": n, "vertices_out": lods[0]["vertices"],
               "triangles_out": lods[0]["triangles"], "seconds": sum(lod["seconds"] for lod in lods),
-              "repairs": lods[0]["repairs"], "error": lods[0]["search_error"], "lods": lods}
+              "repairs": lods[0]["repairs"], "error": lods[0]["search_error"],
+              "target_missed": lods[0]["target_missed"], "lods": lods}
     return report, lod_objects
 
 
@@ -312,7 +314,8 @@ def main(argv=None) -> int:
             continue
         report["results"].append(entry)
         print(f"{prefix}: {entry['vertices_in']} -> {entry['vertices_out']} vertices, "
-              f"{entry['triangles_out']} triangles in {entry['seconds']:.3f} s -> {entry['output']}", flush=True)
+              f"{entry['triangles_out']} triangles in {entry['seconds']:.3f} s -> {entry['output']}"
+              + "".join("; " + phrase for phrase in report_missed(entry)), flush=True)
     if args.json:
         write_report(args.json, report)
     print(f"topstoc batch: {len(report['results'])} done, {len(report['failures'])} failed", flush=True)

@@ -40,15 +40,9 @@ class EngineGuidance:
     view: Optional[View] = None
     boxes: List[Box] = field(default_factory=list)
     sources: List[str] = field(default_factory=list)
-    #: the look to keep (active UV map, colours), made when a decimation needs it (pipeline.run_engine)
+    #: the look to keep (active UV map, colours), made when a decimation needs it (pipeline.engine_job)
     appearance: Callable[[], Appearance] = Appearance
     appearance_sources: List[str] = field(default_factory=list)  #: what ``appearance`` holds
-
-    def decimate_kwargs(self) -> dict:
-        """The engine's guidance arguments, plus ``appearance`` (pipeline.run_engine turns it into
-        attributes at the settings' weight when the refinement runs)."""
-        return dict(guidance=self.guidance, regions=self.regions, borders=self.borders, view=self.view,
-                    boxes=self.boxes, appearance=self.appearance)
 
     def layout_kwargs(self) -> dict:
         """The part that restoring from samples needs (the feature layout)."""

@@ -1,5 +1,13 @@
 """One guided decimation of a Blender object: prepare (cached), gather guidance, decimate,
-write the output, remember the samples. Shared by the operators, the preview and the batch."""
+write the output, remember the samples. Shared by the operators, the preview and the batch.
+
+Every front end (Guided Decimate, Live Preview, LOD chain, Regenerate, the Blender batch) goes
+through ``engine_job``, the one adapter from the add-on to a core DecimationJob. Names here:
+``panel`` is a holder of the DecimationParameters values (an operator, the scene's settings, a
+namespace); ``options`` the make_job keywords its values give (decimate_options); ``settings``
+the panel's values as JSON (what Regenerate re-runs); ``parameters`` the record of what a
+result ran with (stored on the result object and with its samples).
+"""
 
 from __future__ import annotations
 
@@ -15,9 +23,10 @@ import numpy as np
 
 from ..core.appearance import refines
 from ..core.attributes import MovedVertices, moved_vertices, point_weights
-from ..core.decimate import ATTRIBUTE_WEIGHT
+from ..core.budget import missed_target
+from ..core.decimate import run_job
 from ..core.errors import TopStocError
-from ..core.symmetry import decimate_mirrored
+from ..core.job import ATTRIBUTE_WEIGHT, DecimationJob, make_job
 from . import carry, mesh_io
 from .cache import Prepared, prepared_meshes
 from .guidance import EngineGuidance, gather
@@ -43,80 +52,70 @@ class Run:
     moved: MovedVertices = None  #: where moved vertices take their attributes (found when written if None)
 
 
-def settings_of(params) -> dict:
-    """The DecimationParameters values of a holder, as plain JSON-able values."""
+def settings_of(panel) -> dict:
+    """The DecimationParameters values of a panel, as plain JSON-able values."""
     from .props import DecimationParameters
 
-    return {name: getattr(params, name) for name in DecimationParameters.__annotations__ if hasattr(params, name)}
+    return {name: getattr(panel, name) for name in DecimationParameters.__annotations__ if hasattr(panel, name)}
 
 
-def target_kwargs(params, prepared: Prepared) -> dict:
-    """The engine target for a DecimationParameters holder."""
-    mode = params.target_mode
+def target_kwargs(panel) -> dict:
+    """The decimation target of a panel (make_job's target keywords)."""
+    mode = panel.target_mode
     if mode == "RATIO":
-        return {"ratio": float(params.ratio)}
+        return {"ratio": float(panel.ratio)}
     if mode == "VERTICES":
-        return {"target_vertices": int(params.vertices)}
+        return {"target_vertices": int(panel.vertices)}
     if mode == "TRIANGLES":
-        return {"target_triangles": int(params.triangles)}
-    if params.max_error_relative:  # the panel says percent; the engine takes a fraction of the diagonal
-        return {"max_error": float(params.max_error) / 100.0, "relative": True}
-    return {"max_error": float(params.max_error)}
+        return {"target_triangles": int(panel.triangles)}
+    if panel.max_error_relative:  # the panel says percent; the engine takes a fraction of the diagonal
+        return {"max_error": float(panel.max_error) / 100.0, "relative": True}
+    return {"max_error": float(panel.max_error)}
 
 
-def quality_options(quality: str):
-    """The engine options behind the panel's Quality choice; None for CUSTOM (the Advanced
-    placement and refinement apply)."""
-    if quality == "QUALITY":
-        return {"mode": "quality"}
-    if quality == "FAST":
-        return {"mode": "fast"}
-    return None
+#: the engine mode behind the panel's Quality choice (Custom: the Advanced placement and refinement)
+QUALITY_MODES = {"QUALITY": "quality", "FAST": "fast"}
 
 
-def options_kwargs(params) -> dict:
-    """Engine options for a DecimationParameters holder: the Quality choice picks the engine's
-    mode; Custom (or a holder without the choice, as the batch's) gives placement and refinement
-    itself, on the holder's mode (fast unless it says otherwise)."""
-    options = dict(seed=int(params.seed), adaptivity=float(params.adaptivity), density=params.density,
-                   attribute_weight=float(getattr(params, "attribute_weight", ATTRIBUTE_WEIGHT)))
-    chosen = quality_options(getattr(params, "quality", "CUSTOM"))
-    if chosen is not None:
-        options.update(chosen)
+def decimate_options(panel) -> dict:
+    """make_job's keywords for a panel: seed, adaptivity, density, the mode its Quality choice
+    picks (Custom, or a holder without the choice as the batch's: placement and refinement
+    themselves, on the holder's mode, fast unless it says otherwise), the mirror axis when
+    symmetry is on, and ``attribute_weight``, the look's weight (engine_job makes it attributes)."""
+    options = dict(seed=int(panel.seed), adaptivity=float(panel.adaptivity), density=panel.density,
+                   attribute_weight=float(getattr(panel, "attribute_weight", ATTRIBUTE_WEIGHT)),
+                   symmetry=panel.symmetry_axis if getattr(panel, "use_symmetry", False) else None)
+    mode = QUALITY_MODES.get(getattr(panel, "quality", "CUSTOM"))
+    if mode is not None:
+        options.update(mode=mode)
     else:
-        options.update(mode=getattr(params, "mode", None) or "fast", placement=params.placement or None,
-                       refine=None if params.refine is None else float(params.refine))
+        options.update(mode=getattr(panel, "mode", None) or "fast", placement=panel.placement or None,
+                       refine=None if panel.refine is None else float(panel.refine))
     return options
 
 
-def symmetry_axis(params):
-    """The mirror axis ("X", "Y", "Z") when symmetry is on, else None."""
-    return params.symmetry_axis if getattr(params, "use_symmetry", False) else None
-
-
-def attribute_kwargs(options: dict, appearance) -> dict:
-    """The engine's ``attributes`` for ``options`` (options_kwargs'): the look (``appearance``,
-    a function giving core.appearance.Appearance) at the options' ``attribute_weight`` when the
-    refinement runs (quality mode; the only stage that uses them), else nothing."""
+def look_kwargs(options: dict, appearance) -> dict:
+    """The engine's ``attributes`` for ``options``: the look (``appearance``, a function giving
+    core.appearance.Appearance) at the options' ``attribute_weight`` when the refinement runs
+    (the only stage that uses it), else nothing."""
     weight = options.get("attribute_weight", ATTRIBUTE_WEIGHT)
     if appearance is None or weight == 0 or not refines(options.get("mode", "quality"), options.get("refine")):
         return {}
     return appearance().decimate_kwargs(weight)
 
 
-def run_engine(mesh, target: dict, options: dict, guidance_kwargs: dict, axis=None):
-    """One engine decimation, mirror-symmetric when ``axis`` is given (core/symmetry.py); the
-    guidance's ``appearance`` enters as attributes (attribute_kwargs)."""
-    engine_options = dict(options)
-    engine_guidance = dict(guidance_kwargs)
-    attributes = attribute_kwargs(engine_options, engine_guidance.pop("appearance", None))
-    engine_options.pop("attribute_weight", None)
-    return decimate_mirrored(mesh, axis, **target, **engine_options, **engine_guidance, **attributes)
+def engine_job(mesh, target: dict, options: dict, guidance: EngineGuidance) -> DecimationJob:
+    """The one adapter from the add-on to the engine: the DecimationJob (core/job.py) of a
+    target, a panel's options (decimate_options) and the guidance gathered from the scene."""
+    choices = {name: value for name, value in options.items() if name != "attribute_weight"}
+    return make_job(mesh, **target, **choices, guidance=guidance.guidance, regions=guidance.regions,
+                    borders=guidance.borders, view=guidance.view, boxes=guidance.boxes,
+                    **look_kwargs(options, guidance.appearance))
 
 
-def attribute_sources(options: dict, guidance: EngineGuidance) -> list:
-    """What of the look entered the cost of a decimation with ``options`` (for its parameters)."""
-    return list(guidance.appearance_sources) if attribute_kwargs(options, guidance.appearance) else []
+def run_engine(mesh, job: DecimationJob):
+    """One engine decimation of a job (every add-on decimation passes here)."""
+    return run_job(mesh, job)
 
 
 def input_triangles(mesh) -> int:
@@ -124,20 +123,20 @@ def input_triangles(mesh) -> int:
     return max(0, len(mesh.loops) - 2 * len(mesh.polygons))
 
 
-def face_estimate(params, mesh):
+def face_estimate(panel, mesh):
     """The output's triangle count the target will give, estimated without decimating (like
     the Decimate modifier's Face Count): a triangulated surface has about two triangles per
     vertex, so the count scales with the kept vertices. None for a max-deviation target."""
     triangles, vertices = input_triangles(mesh), len(mesh.vertices)
     if triangles == 0 or vertices == 0:
         return 0
-    mode = params.target_mode
+    mode = panel.target_mode
     if mode == "TRIANGLES":
-        return min(int(params.triangles), triangles)
+        return min(int(panel.triangles), triangles)
     if mode == "RATIO":
-        kept = params.ratio * vertices
+        kept = panel.ratio * vertices
     elif mode == "VERTICES":
-        kept = min(int(params.vertices), vertices)
+        kept = min(int(panel.vertices), vertices)
     else:
         return None
     return max(1, int(round(triangles * kept / vertices)))
@@ -168,29 +167,33 @@ def prepare_arrays(obj_name: str, mesh_name: str, arrays: mesh_io.MeshArrays, pr
     return prepared
 
 
-def decimate(context, obj, params, *, seed_offset: int = 0, target: dict = None, region_3d=None) -> Run:
-    """Decimates ``obj`` with the scene's guidance settings and ``params`` (nothing written)."""
+def decimate(context, obj, panel, *, target: dict = None, region_3d=None) -> Run:
+    """Decimates ``obj`` with the scene's guidance and a panel's settings (nothing written);
+    ``target`` replaces the panel's."""
     start = time.perf_counter()
     prepared = prepare(obj)
     guidance = gather(obj, prepared.arrays, context.scene, None, region_3d)
-    target = target if target is not None else target_kwargs(params, prepared)
-    options = options_kwargs(params)
-    options["seed"] += seed_offset
-    axis = symmetry_axis(params)
+    target = target if target is not None else target_kwargs(panel)
+    options = decimate_options(panel)
     try:
-        result = run_engine(prepared.mesh, target, options, guidance.decimate_kwargs(), axis)
+        result = run_engine(prepared.mesh, engine_job(prepared.mesh, target, options, guidance))
     except ValueError as error:
         raise DecimationError(f"'{obj.name}': {error}") from None
-    return make_run(obj, prepared, guidance, result, target, options, axis, time.perf_counter() - start,
-                    settings_of(params))
+    return make_run(obj, prepared, guidance, result, target, options, time.perf_counter() - start,
+                    settings_of(panel))
 
 
-def make_run(obj, prepared: Prepared, guidance: EngineGuidance, result, target: dict, options: dict, axis,
+def make_run(obj, prepared: Prepared, guidance: EngineGuidance, result, target: dict, options: dict,
              seconds: float, settings: dict, moved: MovedVertices = None) -> Run:
-    """The Run of a finished engine decimation (``run_engine``'s target, options and axis)."""
-    parameters = dict(target, **options, sources=guidance.sources, symmetry=axis,
-                      attributes=attribute_sources(options, guidance))
-    return Run(obj, prepared, guidance, result, parameters, seconds, settings, moved)
+    """The Run of a finished engine decimation of ``target`` with ``options`` (decimate_options')."""
+    return Run(obj, prepared, guidance, result, record(target, options, guidance, result), seconds, settings, moved)
+
+
+def record(target: dict, options: dict, guidance: EngineGuidance, result) -> dict:
+    """A Run's ``parameters``: the target, the options, the guidance's sources and the look's."""
+    used_look = bool(result.parameters.get("attribute_channels"))
+    return dict(target, **options, sources=guidance.sources,
+                attributes=list(guidance.appearance_sources) if used_look else [])
 
 
 def _object_materials(source, new) -> None:
@@ -256,9 +259,11 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
     carry.write_shape_keys(target, shape_keys, arrays.vertices, run.result.vertices, kept, moved, arrays.triangles)
     target["topstoc_source"] = obj.name
     target["topstoc_parameters"] = json.dumps(run.parameters)
-    # Over the target (control points painted, or what the topology needs): the panel says so.
-    target["topstoc_over_budget"] = int(getattr(run.result.stats, "over_budget", 0))
-    target["topstoc_over_budget_reason"] = str(getattr(run.result.stats, "over_budget_reason", ""))
+    # A missed target (control points painted, borders, symmetry, what the topology needs): the panel says so.
+    target["topstoc_over_budget"] = int(run.result.stats.over_budget)
+    target["topstoc_over_budget_reason"] = str(run.result.stats.over_budget_reason)
+    missed = missed_target(run.result.stats)
+    target["topstoc_target_missed"] = "" if missed is None else missed.text()
     if target is not obj and run.settings is not None:  # what Regenerate needs (regenerate.py)
         target.topstoc.source = obj
         target.topstoc.settings = json.dumps(run.settings)
@@ -310,7 +315,7 @@ def restore(context, obj, name: str) -> Run:
                               f"'{name}' were saved")
     samples = np.asarray(entry["samples"], dtype=np.int32)
     # a refined result used the look at its weight (sets saved before attributes existed: none)
-    attributes = attribute_kwargs(dict(parameters, attribute_weight=parameters.get("attribute_weight", 0.0)),
+    attributes = look_kwargs(dict(parameters, attribute_weight=parameters.get("attribute_weight", 0.0)),
                                   guidance.appearance) if refine_vertices else {}
     result = prepared.mesh.decimate_with_samples(samples, placement=parameters.get("placement", "subsample"),
                                                  refine_vertices=refine_vertices,
@@ -320,7 +325,7 @@ def restore(context, obj, name: str) -> Run:
 
 
 def summary(run: Run, seconds: float = None) -> str:
-    """One status-bar line: counts and time."""
+    """One status-bar line: counts and time, and a missed target (how far off and why)."""
     report = run.prepared.mesh.report()
     seconds = run.seconds if seconds is None else seconds
     text = (f"{run.obj.name}: {report.input_vertices:,} -> {run.result.num_vertices:,} vertices, "
@@ -331,13 +336,13 @@ def summary(run: Run, seconds: float = None) -> str:
     if run.result.stats.repairs:
         text += (f" ({run.result.stats.repairs} topology repairs: vertices kept so that no hole closed and "
                  f"no handle or piece was lost)")
-    over = getattr(run.result.stats, "over_budget", 0)
-    if over:
-        text += f", {over:,} vertices over the target ({run.result.stats.over_budget_reason})"
+    missed = missed_target(run.result.stats)
+    if missed is not None:
+        text += "; " + missed.text()
     return text
 
 
-def decimate_many(context, obj, params, variants) -> list:
+def decimate_many(context, obj, panel, variants) -> list:
     """Several decimations of one object in parallel (the engine releases the GIL).
 
     variants: (target kwargs, seed) pairs. Returns one Run per variant, in order.
@@ -346,26 +351,20 @@ def decimate_many(context, obj, params, variants) -> list:
     prepared = prepare(obj)
     guidance = gather(obj, prepared.arrays, context.scene)
     prepared.mesh.feature_layout(guidance.regions, guidance.borders)  # built once, shared by the threads
-    options = options_kwargs(params)
-
-    axis = symmetry_axis(params)
-
-    def one(target, seed):
-        return run_engine(prepared.mesh, target, dict(options, seed=seed), guidance.decimate_kwargs(), axis)
-
+    options = decimate_options(panel)
     try:
+        jobs = [engine_job(prepared.mesh, target, dict(options, seed=seed), guidance) for target, seed in variants]
         with ThreadPoolExecutor(max_workers=max(1, min(len(variants), os.cpu_count() or 1))) as pool:
-            results = list(pool.map(lambda v: one(*v), variants))
+            results = list(pool.map(lambda job: run_engine(prepared.mesh, job), jobs))
     except ValueError as error:
         raise DecimationError(f"'{obj.name}': {error}") from None
     seconds = time.perf_counter() - start
-    settings = settings_of(params)
+    settings = settings_of(panel)
 
     def settings_for(target, seed):
         if "ratio" not in target:
             return None
         return dict(settings, target_mode="RATIO", ratio=target["ratio"], seed=seed)
 
-    return [Run(obj, prepared, guidance, result, dict(target, **dict(options, seed=seed), sources=guidance.sources,
-                                                       attributes=attribute_sources(options, guidance)),
-                seconds, settings_for(target, seed)) for (target, seed), result in zip(variants, results)]
+    return [make_run(obj, prepared, guidance, result, target, dict(options, seed=seed), seconds,
+                     settings_for(target, seed)) for (target, seed), result in zip(variants, results)]

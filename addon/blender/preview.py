@@ -61,7 +61,7 @@ class PreviewSession:
     computed until ``request`` or ``update``.
     """
 
-    def __init__(self, context, obj, params, region_3d=None, ratio: Optional[float] = None,
+    def __init__(self, context, obj, panel, region_3d=None, ratio: Optional[float] = None,
                  deferred: bool = False):
         pipeline.check_decimatable(obj)
         self.obj = obj
@@ -71,11 +71,10 @@ class PreviewSession:
         self.guidance = None                   # made by the worker from what is read below
         self._read_guidance = None             # the rules to run on it (guidance.read)
         self._guidance_read = threading.Event()
-        self.options = pipeline.options_kwargs(params)
-        self.axis = pipeline.symmetry_axis(params)
-        self.settings = pipeline.settings_of(params)  # what an applied result remembers (Regenerate)
-        # While dragging: drafts of the fast mode; on a pause: the chosen settings, in full.
-        self.drag_options = dict(self.options, mode="fast", placement=None, refine=None, draft=True)
+        self.options = pipeline.decimate_options(panel)
+        self.settings = pipeline.settings_of(panel)  # what an applied result remembers (Regenerate)
+        # While dragging: drafts of the fast mode, unmirrored; on a pause: the chosen settings, in full.
+        self.drag_options = dict(self.options, mode="fast", placement=None, refine=None, draft=True, symmetry=None)
         self.prepared = None                   # set by the worker once the mesh is prepared
         self.mesh = self.preview = None        # made when the first result is shown
         self.was_hidden = obj.hide_get()
@@ -182,8 +181,8 @@ class PreviewSession:
         result's edges (any thread: the main thread then only copies arrays into the preview)."""
         start = time.perf_counter()
         options = self.options if final else self.drag_options
-        result = pipeline.run_engine(self.prepared.mesh, {"ratio": ratio}, options,
-                                     self.guidance.decimate_kwargs(), self.axis if final else None)
+        mesh = self.prepared.mesh
+        result = pipeline.run_engine(mesh, pipeline.engine_job(mesh, {"ratio": ratio}, options, self.guidance))
         edges = mesh_edges(result.triangles, len(result.vertices))
         flags = {}
         if any(len(pairs) for pairs in self._edge_flags.values()):
@@ -407,7 +406,7 @@ class PreviewSession:
     def _run(self, ratio: float, result, seconds: float, moved):
         """The pipeline Run of a result of this session (what pipeline.write_output takes)."""
         return pipeline.make_run(self.obj, self.prepared, self.guidance, result, {"ratio": ratio}, self.options,
-                                 self.axis, seconds, dict(self.settings, target_mode="RATIO", ratio=ratio), moved)
+                                 seconds, dict(self.settings, target_mode="RATIO", ratio=ratio), moved)
 
     def close(self) -> None:
         """Removes the preview object and shows the original again. Returns at once: a running

@@ -9,7 +9,9 @@ vertex) away from it. Why, in the words every channel uses:
   outnumber the target;
 - "topology": samples the topology needs (each loose piece keeps at least a triangle, each
   hole and handle its loops);
-- "symmetry": the mirrored sample set is larger than the plain draw (core/symmetry.py);
+- "symmetry": the mirrored sample set is larger (or, where partners of absorbed samples were
+  dropped, smaller) than the plain draw (core/symmetry.py);
+- "absorbed clusters": clusters that neighbours absorbed were not all made up for;
 - "zero-area input": the input's triangles have no area in double precision (coordinates so
   small that their squared lengths underflow), so the clean-up of zero-area triangles removes
   vertices below the target.
@@ -79,7 +81,9 @@ def missed_target(stats) -> Optional[MissedTarget]:
         return None
     if got > asked:
         return MissedTarget(asked, got, over_reason(stats), unit)
-    return MissedTarget(asked, got, "zero-area input" if stats.zero_area_input else "absorbed clusters", unit)
+    if stats.zero_area_input:
+        return MissedTarget(asked, got, "zero-area input", unit)
+    return MissedTarget(asked, got, "symmetry" if stats.mirrored_from else "absorbed clusters", unit)
 
 
 def missed_text(stats) -> str:
@@ -92,3 +96,18 @@ def missed_dict(stats) -> Optional[dict]:
     """The ``target_missed`` object of a JSON report, or None when the target was met."""
     missed = missed_target(stats)
     return None if missed is None else missed.as_dict()
+
+
+def report_missed(entry: dict) -> list:
+    """The missed targets of a batch report entry, one phrase each: its LODs' (a mesh file) or
+    its objects' LODs' (a scene file), named when there are several."""
+    phrases = []
+    for obj in [entry] + list(entry.get("objects") or []):
+        lods = obj.get("lods") or []
+        for lod in lods:
+            missed = lod.get("target_missed")
+            if missed:
+                name = (f"{obj['object']} " if "object" in obj else "") + (f"LOD{lod['lod']} " if len(lods) > 1 else "")
+                phrases.append(name + MissedTarget(missed["asked"], missed["got"], missed["reason"],
+                                                   missed["unit"]).text())
+    return phrases

@@ -24,6 +24,9 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
     bl_label = "Guided Decimate"
     bl_options = {"REGISTER", "UNDO"}
 
+    #: what the last run missed (set by execute, shown in the redo panel)
+    target_missed: bpy.props.StringProperty(options={"HIDDEN", "SKIP_SAVE"})
+
     @classmethod
     def poll(cls, context):
         return polls.refuse(cls, polls.selected_meshes(context))
@@ -46,12 +49,14 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
         row.prop(self, "symmetry_axis", expand=True)
         for name in ("seed", "adaptivity", "density", "placement", "refine", "output"):
             layout.prop(self, name)
+        for line in filter(None, self.target_missed.split("\n")):
+            layout.label(text=line, icon="ERROR")
         draw_bake(layout, self)
 
     def execute(self, context):
         explicit_engine_options(self)
         start = time.perf_counter()
-        outputs, lines, failures, sources = [], [], [], []
+        outputs, lines, failures, sources, missed = [], [], [], [], []
         for obj in selected_meshes(context):
             try:
                 run = pipeline.decimate(context, obj, self, region_3d=context.region_data)
@@ -60,6 +65,8 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
                 outputs.append(pipeline.write_output(run, self.output))
                 sources.append(obj)
                 lines.append(pipeline.summary(run))
+                if run.result.stats.target_missed is not None:
+                    missed.append(f"{obj.name}: {run.result.stats.target_missed.text()}")
             except TopStocError as error:
                 failures.append(str(error))
         baked = []
@@ -70,8 +77,11 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
             else:
                 failures.append("Bake Normals needs Output: New Object (in place, no original is left to "
                                 "bake from)")
+        self.target_missed = "\n".join(missed)
         for message in failures:
             self.report({"ERROR"}, message)
+        for message in missed:  # a missed target is a warning where the user looks, not a footnote
+            self.report({"WARNING"}, f"TopStoc: {message}")
         if not outputs:
             return {"CANCELLED"}
         if self.output == "NEW_OBJECT":

@@ -103,10 +103,11 @@ class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
         col.operator("topstoc.guided_decimate", icon="MOD_DECIM")
         col.operator("topstoc.preview", icon="HIDE_OFF")
         obj = context.active_object
-        over = obj.get("topstoc_over_budget", 0) if obj is not None else 0
-        if over:
-            wrapped(layout, context, f"{over:,} vertices over the target: "
-                    f"{obj.get('topstoc_over_budget_reason', '')}", "ERROR")
+        missed = obj.get("topstoc_target_missed", "") if obj is not None else ""
+        if not missed and obj is not None and obj.get("topstoc_over_budget", 0):  # results of older versions
+            missed = f"{obj['topstoc_over_budget']:,} vertices over the target: {obj.get('topstoc_over_budget_reason', '')}"
+        if missed:
+            wrapped(layout, context, missed, "ERROR")
         if obj is not None and obj.type == "MESH" and obj.topstoc.settings:
             box = layout.box()
             source = obj.topstoc.source

@@ -18,6 +18,7 @@ from .. import batch_settings
 from . import messages, progress
 from ..batch_run import (find_inputs, misnamed_failure, remove_orphaned_scratch, remove_stale_temporaries,
                          run_dask, run_serial, utf8_name, write_report)
+from ..budget import report_missed
 from ..manifest import Manifest, content_hash, task_key
 from ..errors import TopStocError
 from ..output_guard import check_folders, prepare_output, check_outputs, output_folder
@@ -133,8 +134,10 @@ def _lod_vertices(entry: dict) -> list:
 def _summary(entry: dict) -> str:
     lods = _lod_vertices(entry)
     if len(lods) > 1:
-        return f"{entry['vertices_in']} -> {' / '.join(map(str, lods))} vertices ({len(lods)} LODs)"
-    return f"{entry['vertices_in']} -> {entry['vertices_out']} vertices, {entry['triangles_out']} triangles"
+        text = f"{entry['vertices_in']} -> {' / '.join(map(str, lods))} vertices ({len(lods)} LODs)"
+    else:
+        text = f"{entry['vertices_in']} -> {entry['vertices_out']} vertices, {entry['triangles_out']} triangles"
+    return text + "".join("; " + phrase for phrase in report_missed(entry))
 
 
 def parse_chunk(text: str) -> tuple:
@@ -245,6 +248,8 @@ def run(args) -> int:
               "results": [finished[i] for i in sorted(finished)],
               "failures": [failures[i] for i in sorted(failures)], "skipped": skipped}
     write_report(report_path, report)
-    print(f"topstoc batch: {len(results)} done, {len(skipped)} skipped, {len(failures)} failed "
-          f"in {report['seconds']:.1f} s; report {report_path}", flush=True)
+    missed = sum(bool(report_missed(entry)) for entry in results.values())
+    print(f"topstoc batch: {len(results)} done" + (f" ({missed} missed their target)" if missed else "")
+          + f", {len(skipped)} skipped, {len(failures)} failed in {report['seconds']:.1f} s; report {report_path}",
+          flush=True)
     return 1 if failures else 0

@@ -1,0 +1,165 @@
+"""A missed target is reported in every channel (issue 37): the API's stats, the command line's
+line and --json, the batch's line and report. Three ways to miss: loose triangles (each piece
+keeps its three vertices: topology), a mirrored result (symmetry) and coordinates so small that
+every triangle has zero area in double precision. The expected counts are computed from the
+inputs here, not taken from a run."""
+
+import json
+
+import numpy as np
+import pytest
+
+import cli
+from test_symmetry import suzanne
+from topstoc.core import Mesh, read_mesh, write_mesh
+from topstoc.core.budget import MissedTarget, missed_target
+from topstoc.core.io import MeshData
+from topstoc.core.symmetry import decimate_mirrored
+
+from conftest import DATA
+
+LOOSE = 3724  # disjoint triangles, as the Wuson scan of issue 37
+
+
+def loose_triangles(count: int = LOOSE) -> MeshData:
+    """``count`` disjoint triangles on a grid: no piece can lose a vertex without vanishing."""
+    rng = np.random.default_rng(7)
+    corners = np.array([[0.0, 0.0, 0.0], [0.4, 0.0, 0.0], [0.0, 0.4, 0.1]])
+    side = int(np.ceil(np.sqrt(count)))
+    origins = np.array([[i % side, i // side, 0.0] for i in range(count)])
+    vertices = (origins[:, None, :] + corners[None] + rng.uniform(0, 0.05, (count, 3, 3))).reshape(-1, 3)
+    return MeshData(vertices=vertices, triangles=np.arange(3 * count, dtype=np.int32).reshape(-1, 3))
+
+
+def expected_loose(ratio: float) -> dict:
+    asked = max(1, round(ratio * 3 * LOOSE))
+    got = 3 * LOOSE  # every piece keeps its triangle
+    return {"asked": asked, "got": got, "unit": "vertices", "off": got - asked,
+            "fraction": pytest.approx((got - asked) / asked), "reason": "topology"}
+
+
+@pytest.fixture(scope="module")
+def loose_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("loose") / "loose.off"
+    write_mesh(path, loose_triangles())
+    return path
+
+
+def test_loose_triangles_api():
+    data = loose_triangles()
+    result = Mesh(data.vertices, data.triangles).decimate(ratio=0.1)
+    want = expected_loose(0.1)
+    missed = result.stats.target_missed
+    assert missed.as_dict() == want
+    assert result.stats.over_budget == want["off"] and result.stats.over_budget_reason == "topology"
+    assert missed.text() == (f"target missed: {want['got']:,} vertices for {want['asked']:,} "
+                             f"({want['off']:,} over, {100 * want['off'] / want['asked']:+.1f} %; topology)")
+
+
+def test_loose_triangles_command_line(loose_file, tmp_path):
+    want = expected_loose(0.1)
+    done = cli.run("decimate", loose_file, tmp_path / "out.off", "--ratio", "0.1")
+    assert done.returncode == 0, done.stderr
+    assert f"target missed: {want['got']:,} vertices for {want['asked']:,} ({want['off']:,} over" in done.stdout
+    assert done.stdout.rstrip().endswith("topology)")
+    report = cli.run_json("decimate", loose_file, tmp_path / "out2.off", "--ratio", "0.1")
+    assert report["target_missed"] == want
+    assert report["output"]["vertices"] == want["got"]
+
+
+def test_met_target_reports_no_miss(tmp_path):
+    path = DATA / "genus0/cgal_fandisk.off"
+    done = cli.run("decimate", path, tmp_path / "out.off", "--ratio", "0.1")
+    assert done.returncode == 0 and "target missed" not in done.stdout
+    assert cli.run_json("decimate", path, tmp_path / "out2.off", "--ratio", "0.1")["target_missed"] is None
+
+
+def test_loose_triangles_batch(loose_file, tmp_path):
+    want = expected_loose(0.1)
+    out = tmp_path / "out"
+    done = cli.run("batch", "--input", loose_file, "--output", out, "--ratio", "0.1", "--workers", "0",
+                   "--progress", "lines")
+    assert done.returncode == 0, done.stderr
+    line = next(text for text in done.stdout.splitlines() if "loose.off:" in text)
+    assert f"target missed: {want['got']:,} vertices for {want['asked']:,}" in line and "topology" in line
+    assert "1 done (1 missed their target)" in done.stdout
+    report = json.loads((out / "topstoc-report.json").read_text())
+    entry = report["results"][0]
+    assert entry["target_missed"] == want and entry["lods"][0]["target_missed"] == want
+
+
+def test_lod_chain_names_the_lod_that_missed(loose_file, tmp_path):
+    out = tmp_path / "out"
+    done = cli.run("batch", "--input", loose_file, "--output", out, "--ratio", "1.0", "0.1", "--workers", "0",
+                   "--progress", "lines")
+    assert done.returncode == 0, done.stderr
+    line = next(text for text in done.stdout.splitlines() if "loose.off:" in text)
+    assert "LOD1 target missed" in line and "LOD0 target missed" not in line
+    lods = json.loads((out / "topstoc-report.json").read_text())["results"][0]["lods"]
+    assert lods[0]["target_missed"] is None and lods[1]["target_missed"] == expected_loose(0.1)
+
+
+# -- symmetry ---------------------------------------------------------------------------------
+
+def test_symmetric_result_counts_in_the_budget():
+    """Suzanne at 5 %: the mirrored sample set outgrows the plain draw, which met the target."""
+    mesh = suzanne()
+    asked = round(0.05 * mesh.num_vertices)
+    plain = mesh.decimate(ratio=0.05, seed=0)
+    assert abs(plain.num_vertices - asked) <= 1
+    result = decimate_mirrored(mesh, "X", ratio=0.05, seed=0)
+    assert result.stats.target_vertices == asked and result.stats.mirrored_from > 0
+    assert result.num_vertices > asked * 1.01  # the case this test is about
+    assert result.stats.over_budget == result.num_vertices - asked
+    assert result.stats.over_budget_reason == "symmetry"
+    assert result.stats.target_missed == MissedTarget(asked, result.num_vertices, "symmetry")
+
+
+def test_symmetric_miss_on_the_command_line_and_batch(tmp_path):
+    mesh = suzanne()
+    path = tmp_path / "suzanne.obj"
+    write_mesh(path, MeshData(vertices=np.array(mesh.vertices), triangles=np.array(mesh.triangles)))
+    expected = decimate_mirrored(Mesh(read_mesh(path).vertices, read_mesh(path).triangles), "X", ratio=0.05)
+    want = expected.stats.target_missed.as_dict()
+    assert want["reason"] == "symmetry" and want["off"] > 0
+    report = cli.run_json("decimate", path, tmp_path / "out.obj", "--ratio", "0.05", "--symmetry", "x")
+    assert report["target_missed"] == {**want, "fraction": pytest.approx(want["fraction"])}
+    done = cli.run("batch", "--input", path, "--output", tmp_path / "out", "--ratio", "0.05", "--symmetry", "x",
+                   "--workers", "0", "--progress", "lines")
+    assert done.returncode == 0, done.stderr
+    assert f"target missed: {want['got']:,} vertices for {want['asked']:,}" in done.stdout
+    entry = json.loads((tmp_path / "out" / "topstoc-report.json").read_text())["results"][0]
+    assert entry["target_missed"]["reason"] == "symmetry" and entry["target_missed"]["got"] == want["got"]
+
+
+# -- coordinates so small that areas underflow -----------------------------------------------
+
+def test_tiny_coordinates_report_zero_area_input(tmp_path):
+    data = read_mesh(DATA / "genus0/cgal_fandisk.off")
+    tiny = data.vertices * 1e-200  # squared edge lengths (1e-400) underflow to 0
+    mesh = Mesh(tiny, data.triangles)
+    assert mesh.report().zero_area_triangles == len(data.triangles)
+    result = mesh.decimate(target_vertices=30)
+    assert result.num_vertices < 30 * 0.99  # the clean-up of zero-area triangles went below the target
+    missed = missed_target(result.stats)
+    assert missed == MissedTarget(30, result.num_vertices, "zero-area input")
+    assert result.stats.over_budget == 0  # under the target, not over it
+    path = tmp_path / "tiny.ply"
+    write_mesh(path, MeshData(vertices=tiny, triangles=data.triangles))
+    assert np.array_equal(read_mesh(path).vertices, tiny)
+    report = cli.run_json("decimate", path, tmp_path / "out.ply", "--vertices", "30")
+    assert report["target_missed"]["reason"] == "zero-area input"
+    assert report["target_missed"]["asked"] == 30 and report["target_missed"]["got"] == result.num_vertices
+
+
+def test_borders_reason_when_corners_outnumber_the_target():
+    """Every triangle its own region: every vertex is a border corner, kept whatever the target."""
+    data = read_mesh(DATA / "genus0/cgal_fandisk.off")
+    mesh = Mesh(data.vertices, data.triangles)
+    result = mesh.decimate(ratio=0.1, regions=np.arange(len(data.triangles)), mode="fast")
+    assert result.stats.forced >= result.stats.target_vertices
+    assert result.stats.over_budget_reason == "borders"
+    assert result.stats.target_missed.reason == "borders"
+    guided = mesh.decimate(ratio=0.01, guidance=np.ones(len(data.vertices)), mode="fast")
+    assert guided.stats.control_points == len(data.vertices)
+    assert guided.stats.over_budget_reason == "control points"
