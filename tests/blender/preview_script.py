@@ -146,12 +146,12 @@ class EngineCalls:
         self.calls, self.gate, self.held = [], threading.Event(), threading.Event()
         self.gate.set()
 
-        def run_engine(mesh, target, options, guidance_kwargs, axis=None):
-            self.calls.append((options.get("mode"), target, threading.current_thread().name))
-            if options.get("mode") == "quality" and not self.gate.is_set():
+        def run_engine(mesh, job):
+            self.calls.append((job.mode, job.target, threading.current_thread().name))
+            if job.mode == "quality" and not self.gate.is_set():
                 self.held.set()
                 self.gate.wait(30)
-            return self.original(mesh, target, options, guidance_kwargs, axis)
+            return self.original(mesh, job)
 
         pipeline.run_engine = run_engine
 

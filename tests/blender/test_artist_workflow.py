@@ -170,8 +170,16 @@ def test_presets_are_installed_and_apply(ts, scene):
 
 def test_quality_choice_maps_onto_engine_options(ts, scene):
     pipeline = ts.blender.pipeline
-    assert pipeline.quality_options("FAST") == {"mode": "fast"}
-    assert pipeline.quality_options("QUALITY") == {"mode": "quality"}
+    settings = scene.topstoc
+    for quality, mode in (("FAST", "fast"), ("QUALITY", "quality")):
+        settings.quality = quality
+        options = pipeline.decimate_options(settings)
+        assert options["mode"] == mode and "placement" not in options and "refine" not in options
+    settings.quality = "CUSTOM"  # the Advanced placement and refinement apply, on fast mode
+    options = pipeline.decimate_options(settings)
+    assert (options["mode"], options["placement"], options["refine"]) == ("fast", settings.placement,
+                                                                          float(settings.refine))
+    settings.quality = "QUALITY"
     import json
 
     obj = ball()

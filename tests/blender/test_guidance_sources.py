@@ -265,7 +265,11 @@ def test_control_points_over_the_target_are_reported_on_the_result(ts, scene):
     assert over == run.result.num_vertices - round(0.05 * len(v)) and reason == "control points"
     out = ts.blender.pipeline.write_output(run)
     assert out["topstoc_over_budget"] == over and out["topstoc_over_budget_reason"] == reason
-    assert f"{over:,} vertices over the target (control points)" in ts.blender.pipeline.summary(run)
+    target = round(0.05 * len(v))
+    assert (f"target missed: {run.result.num_vertices:,} vertices for {target:,} ({over:,} over"
+            in ts.blender.pipeline.summary(run)) and ts.blender.pipeline.summary(run).endswith("; control points)")
+    assert out["topstoc_target_missed"] == run.result.stats.target_missed.text()
     plain, _, _ = sphere("Plain")
     out = ts.blender.pipeline.write_output(ts.blender.pipeline.decimate(bpy.context, plain, Params(ratio=0.05)))
     assert out["topstoc_over_budget"] == 0 and out["topstoc_over_budget_reason"] == ""
+    assert out["topstoc_target_missed"] == ""

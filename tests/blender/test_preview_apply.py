@@ -29,12 +29,12 @@ class EngineCalls:
         self.held = threading.Event()
         original = pipeline.run_engine
 
-        def run_engine(mesh, target, options, guidance_kwargs, axis=None):
-            self.calls.append((options.get("mode"), target, threading.current_thread().name))
-            if options.get("mode") == "quality" and not self.gate.is_set():
+        def run_engine(mesh, job):
+            self.calls.append((job.mode, job.target, threading.current_thread().name))
+            if job.mode == "quality" and not self.gate.is_set():
                 self.held.set()
                 self.gate.wait(30)
-            return original(mesh, target, options, guidance_kwargs, axis)
+            return original(mesh, job)
 
         monkeypatch.setattr(pipeline, "run_engine", run_engine)
 
@@ -151,7 +151,7 @@ def test_applying_during_a_drag_computes_the_chosen_settings_on_the_worker(ts, s
         assert engine.held.wait(10) and session.applying
         assert session.poll_apply() is None  # the main thread is free while the worker computes
         _mode, target, thread = next(call for call in engine.calls if call[0] == "quality")
-        assert target == {"ratio": 0.17} and thread.startswith(preview.THREAD_PREFIX)
+        assert target.ratio == 0.17 and thread.startswith(preview.THREAD_PREFIX)
         engine.gate.set()
         runs = []
         assert wait_for(lambda: runs.append(session.poll_apply()) or runs[-1] is not None)
