@@ -153,6 +153,7 @@ def test_random_manifolds_and_pinched_surfaces(seed):
 def test_a_pool_never_serves_another_mesh_or_layout():
     """Kept floods are told apart by the mesh's and layout's serial numbers, not addresses: one
     pool used (through the engine) for another mesh, or another layout, floods afresh."""
+    from topstoc.core.job import make_job
     from topstoc.core.native import engine
     dragon = load(DATA / "genus0/cgal_ChineseDragon-10kv.off")
     other = Mesh(dragon.vertices * 2.0, dragon.triangles)  # same size, other mesh
@@ -160,7 +161,8 @@ def test_a_pool_never_serves_another_mesh_or_layout():
     plain, creased = dragon.feature_layout(), dragon.feature_layout(feature_angle=0.5)
 
     def run(mesh, layout, target):
-        return engine.decimate(mesh.native, layout, target_vertices=target, seed=1, flood_caches=pool)["flood_updated"]
+        job = make_job(mesh, target_vertices=target, seed=1, mode="fast")  # plain TopStoc, as the engine's defaults
+        return engine.decimate(mesh.native, layout, job, flood_caches=pool)["flood_updated"]
 
     assert not run(dragon, plain, 1000)
     assert run(dragon, plain, 1010)
