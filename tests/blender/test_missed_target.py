@@ -8,7 +8,7 @@ import bpy
 import numpy as np
 import pytest
 
-from conftest import PACKAGE
+from conftest import DATA, PACKAGE
 from helpers import make_object, select_only
 from launch import background
 
@@ -93,6 +93,33 @@ def test_status_line_and_redo_panel_text(ts, scene, capfd):
     select_only(obj)
     assert operator.execute(redo, bpy.context) == {"FINISHED"}
     assert redo.target_missed == "" and not any("target missed" in text for _, text in redo.reports)
+
+
+def test_lod_chain_reports_the_lod_that_missed(ts, scene, capfd):
+    loose_triangles()
+    capfd.readouterr()
+    assert bpy.ops.topstoc.lod_chain(ratios="1.0, 0.1") == {"FINISHED"}
+    reports = capfd.readouterr().out
+    assert f"Warning: TopStoc: Loose_LOD1: {expected_text()}" in reports and "Loose_LOD0: target" not in reports
+    assert bpy.data.objects["Loose_LOD0"]["topstoc_target_missed"] == ""
+    assert bpy.data.objects["Loose_LOD1"]["topstoc_target_missed"] == expected_text()
+
+
+def test_symmetry_over_the_target_is_reported(ts, scene):
+    """Suzanne mirrored at 5 %: the mirrored samples outgrow the plain draw's target."""
+    bpy.ops.wm.obj_import(filepath=str(DATA / "open_boundary/kivy_suzanne_monkey.obj"))
+    obj = bpy.context.selected_objects[0]
+    co = np.array([v.co for v in obj.data.vertices])
+    co[:, 0] -= 0.5 * (co[:, 0].min() + co[:, 0].max())  # mirror plane onto x = 0
+    obj.data.vertices.foreach_set("co", co.ravel())
+    obj.data.update()
+    select_only(obj)
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.05, use_symmetry=True, symmetry_axis="X") == {"FINISHED"}
+    out = bpy.context.active_object
+    asked, got = round(0.05 * len(obj.data.vertices)), len(out.data.vertices)
+    assert got > 1.01 * asked
+    assert out["topstoc_target_missed"].startswith(f"target missed: {got:,} vertices for {asked:,} ({got - asked:,} over")
+    assert out["topstoc_target_missed"].endswith("; symmetry)") and out["topstoc_over_budget_reason"] == "symmetry"
 
 
 MAKE_SCENE = """

@@ -87,6 +87,10 @@ class _VariantsBase(OperatorParameters):
         counts = ", ".join(f"{run.result.num_vertices:,}" for run in runs)
         self.report({"INFO"}, f"TopStoc: {len(runs)} variants of {obj.name} ({counts} vertices) "
                               f"in {runs[0].seconds:.3f} s")
+        for run, output in zip(runs, outputs):
+            missed = run.result.stats.target_missed
+            if missed is not None:
+                self.report({"WARNING"}, f"TopStoc: {output.name}: {missed.text()}")
         return {"FINISHED"}
 
 
