@@ -13,6 +13,7 @@
 #include "meshes.hpp"
 #include "topstoc/core/random.hpp"
 #include "topstoc/decimate/features.hpp"
+#include "topstoc/decimate/decimate.hpp"
 #include "topstoc/decimate/sampling.hpp"
 #include "topstoc/io/io.hpp"
 
@@ -101,4 +102,27 @@ TEST_CASE("draws without guidance take the smallest Pareto keys, the first draw 
     REQUIRE(std::count(layout->vertex_corner.begin(), layout->vertex_corner.end(), 1) >= 5);
     check_draws(mesh, make_layout);
   }
+}
+
+// The engine's door: decimate() checks the sampling parameters for every caller (the Python job
+// checks them first, with the parameter's name; a C++ caller has only this).
+TEST_CASE("decimate refuses sampling parameters out of range") {
+  const auto arrays = topstoc_test::torus(12, 8);
+  const Mesh mesh(arrays.positions, arrays.triangles.data(), arrays.num_triangles());
+  const auto layout = build_feature_layout(mesh, nullptr, 0, nullptr, 0, 0.0);
+  DecimateParams params;
+  params.target_vertices = 20;
+  CHECK(decimate(mesh, *layout, params).kept.size() > 0);
+  std::vector<double> guidance(mesh.num_vertices(), 0.0);
+  guidance[5] = 1.5;
+  params.sampling.guidance = guidance.data();
+  CHECK_THROWS_WITH_AS(decimate(mesh, *layout, params), "guidance of vertex 5 is 1.500000; it must lie in [-1, 1]",
+                       std::invalid_argument);
+  params.sampling.guidance = nullptr;
+  params.sampling.adaptivity = 1.5;
+  CHECK_THROWS_AS(decimate(mesh, *layout, params), std::invalid_argument);
+  params.sampling.adaptivity = 0.5;
+  params.refine = 2.0;  // the refined path checks too (its first pass is a stochastic pass)
+  params.sampling.density_ratio = 0.5;
+  CHECK_THROWS_AS(decimate(mesh, *layout, params), std::invalid_argument);
 }
