@@ -140,7 +140,7 @@ py::dict result_dict(DecimateResult&& r) {
   return d;
 }
 
-// The float64 arrays of a job (core/job.py made them contiguous float64 of the right size),
+// The float64 arrays of a call (core/job.py made them contiguous float64 of the right size),
 // held while the engine reads them in place.
 struct JobArrays {
   py::array_t<double, py::array::c_style | py::array::forcecast> guidance, attributes, attribute_weights;
@@ -150,6 +150,20 @@ const double* data_of(py::array_t<double, py::array::c_style | py::array::forcec
   if (from.is_none()) return nullptr;
   array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(from);
   return array.data();
+}
+
+// Attributes for the collapse cost (core/job.py's attribute_arrays: flat float64, 3 corners per
+// caller triangle times one value per channel, and the channels' weights), or none.
+CornerAttributes attributes_of(const Mesh& mesh, JobArrays& arrays, const py::handle& values,
+                               const py::handle& weights) {
+  CornerAttributes a;
+  a.values = data_of(arrays.attributes, values);
+  a.weights = data_of(arrays.attribute_weights, weights);
+  if (!a.values || !a.weights) return {};
+  a.channels = static_cast<int>(arrays.attribute_weights.size());
+  if (arrays.attributes.size() != 3 * int64_t(mesh.report().input_triangles) * a.channels)
+    throw std::invalid_argument("attributes must hold 3 values per triangle corner and channel");
+  return a;
 }
 
 // The sampling half of a DecimationJob (core/job.py); its ranges were checked when it was made,
@@ -181,42 +195,8 @@ DecimateParams params_from(const Mesh& mesh, const py::handle& job, JobArrays& a
   params.refine = job.attr("refine").cast<double>();
   params.refine_collapses = job.attr("refine_collapses").cast<int32_t>();
   params.draft = job.attr("draft").cast<bool>();
-  const double* values = data_of(arrays.attributes, job.attr("attributes"));
-  const double* weights = data_of(arrays.attribute_weights, job.attr("attribute_weights"));
-  if (values && weights) {
-    params.attributes.values = values;
-    params.attributes.channels = static_cast<int>(arrays.attribute_weights.size());
-    params.attributes.weights = weights;
-    if (arrays.attributes.size() != 3 * int64_t(mesh.report().input_triangles) * params.attributes.channels)
-      throw std::invalid_argument("attributes must hold 3 values per triangle corner and channel");
-  }
+  params.attributes = attributes_of(mesh, arrays, job.attr("attributes"), job.attr("attribute_weights"));
   return params;
-}
-
-// Attributes for the collapse cost: `values` flat, 3 corners per caller triangle times
-// `weights` channels (shapes are checked in Python), or None.
-struct AttributeArrays {
-  std::vector<double> values, weights;
-  CornerAttributes view(int64_t triangles) const {
-    CornerAttributes a;
-    if (values.empty() || weights.empty()) return a;
-    if (int64_t(values.size()) != 3 * triangles * int64_t(weights.size()))
-      throw std::invalid_argument("attributes must hold 3 values per triangle corner and channel");
-    a.values = values.data();
-    a.channels = static_cast<int>(weights.size());
-    a.weights = weights.data();
-    return a;
-  }
-};
-
-AttributeArrays attributes_from(const Mesh& mesh, const py::handle& values, const py::handle& weights) {
-  AttributeArrays a;
-  if (values.is_none()) return a;
-  if (weights.is_none()) throw std::invalid_argument("attributes need attribute_weights");
-  a.weights = scalars_from(weights, static_cast<int64_t>(py::len(weights)), "attribute_weights");
-  const int64_t count = 3 * int64_t(mesh.report().input_triangles) * int64_t(a.weights.size());
-  a.values = scalars_from(values, count, "attributes");
-  return a;
 }
 
 }  // namespace
@@ -252,17 +232,16 @@ void bind_decimate(py::module_& m) {
       [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& samples, const std::string& placement,
          int32_t max_repair_rounds, int32_t refine_vertices, const py::handle& guidance, int32_t refine_triangles,
          const py::handle& attributes, const py::handle& attribute_weights) {
+        // guidance, attributes and the counts were checked in Python (core/decimate.py, core/job.py)
         auto ids = ids_from(samples, -1, "samples");
-        const auto u = scalars_from(guidance, mesh.num_vertices(), "guidance");
-        if (refine_vertices < 0) throw std::invalid_argument("refine_vertices must be >= 0");
-        if (refine_triangles < 0) throw std::invalid_argument("refine_triangles must be >= 0");
-        const AttributeArrays arrays = attributes_from(mesh, attributes, attribute_weights);
+        JobArrays arrays;
+        const double* u = data_of(arrays.guidance, guidance);
+        const CornerAttributes corner_attributes = attributes_of(mesh, arrays, attributes, attribute_weights);
         DecimateResult r;
         {
           EngineCall call;
           r = decimate_with_samples(mesh, layout, std::move(ids), placement_from(placement), max_repair_rounds,
-                                    refine_vertices, u.empty() ? nullptr : u.data(),
-                                    arrays.view(mesh.report().input_triangles), refine_triangles);
+                                    refine_vertices, u, corner_attributes, refine_triangles);
         }
         return result_dict(std::move(r));
       },
