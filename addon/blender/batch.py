@@ -48,9 +48,9 @@ def parse_args(argv):
     return parser.parse_args(argv)
 
 
-def _params(settings: dict):
-    """The pipeline's parameter holder (its options, symmetry and attribute weight; the target is passed
-    explicitly)."""
+def _panel(settings: dict):
+    """A panel for the pipeline (pipeline.decimate_options reads it): the batch's options, symmetry
+    and attribute weight; the target is passed explicitly."""
     axis = settings.get("symmetry")
     return SimpleNamespace(target_mode="RATIO", use_symmetry=axis is not None, symmetry_axis=axis or "X",
                            attribute_weight=settings.get("attribute_weight", ATTRIBUTE_WEIGHT), **settings["options"])
@@ -153,7 +153,7 @@ def _decimate_object(bpy, pipeline, obj, settings, targets) -> tuple:
     for index, (target, screen) in enumerate(targets):
         if screen is not None:  # world units -> the object's own units
             target = {"max_error": target["max_error"] / scale}
-        run = pipeline.decimate(bpy.context, obj, _params(settings), target=target)
+        run = pipeline.decimate(bpy.context, obj, _panel(settings), target=target)
         entry = {"lod": index, "target": target, "symmetry": settings.get("symmetry")}
         if screen is not None and settings["prune_pixels"] > 0:
             run.result, pruned = prune_small_parts(run.result, settings["prune_pixels"] * screen.world_per_pixel / scale)

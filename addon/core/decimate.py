@@ -243,9 +243,14 @@ def run_job(mesh: Mesh, job: DecimationJob) -> DecimateResult:
     return _result(raw, job.parameters(), mesh, job)
 
 
+#: DecimateStats fields counted in Python; every other field is the engine result's of the same name
+_COUNTED_HERE = {"output_vertices", "output_triangles", "target_triangles", "control_points", "zero_area_input",
+                 "mirrored_from"}
+
+
 def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob] = None) -> DecimateResult:
     stats = DecimateStats(**{f.name: raw[f.name] for f in dataclasses.fields(DecimateStats)  # same names
-                             if f.name in raw}, output_vertices=len(raw["vertices"]),
+                             if f.name not in _COUNTED_HERE}, output_vertices=len(raw["vertices"]),
                           output_triangles=len(raw["triangles"]),
                           target_triangles=0 if job is None else int(job.target.triangles or 0),
                           control_points=0 if job is None else job.control_points,
