@@ -275,16 +275,21 @@ class DecimationJob:
                     attribute_channels=0 if self.attribute_weights is None else len(self.attribute_weights))
 
 
-def make_target(mesh: Mesh, ratio=None, vertices=None, triangles=None, max_error=None,
-                relative: bool = False) -> Target:
-    """The Target for exactly one of ratio, vertices, triangles, max_error (TopStocError otherwise)."""
+def one_target(ratio=None, vertices=None, triangles=None, max_error=None) -> None:
+    """TopStocError unless exactly one of ratio, vertices, triangles, max_error is given."""
     given = [name for name, value in (("ratio", ratio), ("target_vertices", vertices),
                                       ("target_triangles", triangles), ("max_error", max_error)) if value is not None]
     if len(given) != 1:
         raise TopStocError("give exactly one target (ratio, target_vertices, target_triangles or max_error), "
                            f"got {given or 'none'}")
-    if max_error is not None:  # checked by the search (error_bound.py), which takes it as given
-        return Target(max_error=max_error, relative=bool(relative))
+
+
+def make_target(mesh: Mesh, ratio=None, vertices=None, triangles=None, max_error=None,
+                relative: bool = False) -> Target:
+    """The Target for exactly one of ratio, vertices, triangles, max_error (TopStocError otherwise)."""
+    one_target(ratio, vertices, triangles, max_error)
+    if max_error is not None:
+        return Target(max_error=params.number("max_error", max_error, 0), relative=bool(relative))
     if triangles is not None:
         count = params.integer("target_triangles", triangles)
         if not 1 <= count <= mesh.num_triangles:
@@ -293,20 +298,25 @@ def make_target(mesh: Mesh, ratio=None, vertices=None, triangles=None, max_error
     return Target(ratio=ratio, vertices=vertices, vertex_count=target_vertex_count(mesh, ratio, vertices))
 
 
-def resolve_mode(mode: str, placement: Optional[str], refine, symmetry=None) -> tuple:
-    """(placement, refine, refine_collapses) for a mode and the caller's overrides (None: the
-    mode's own). A mirrored job keeps input positions unless told otherwise (core/symmetry.py)."""
+def resolve_placement(mode: str, placement: Optional[str], symmetry=None) -> str:
+    """The placement for a mode and the caller's choice (None: the mode's own). A mirrored job
+    keeps input positions unless told otherwise (core/symmetry.py)."""
     if placement is None:
         placement = "subsample" if symmetry is not None or mode == "fast" else "filtered"
     if placement not in PLACEMENTS:
         raise TopStocError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
+    return placement
+
+
+def resolve_refine(mode: str, refine) -> tuple:
+    """(refine, refine_collapses) for a mode and the caller's choice (None: the mode's own)."""
     if refine is None:
-        return placement, QUALITY_REFINE if mode == "quality" else 0.0, QUALITY_COLLAPSES if mode == "quality" else 0
+        return (QUALITY_REFINE, QUALITY_COLLAPSES) if mode == "quality" else (0.0, 0)
     wanted = "0 (off) or a factor of at least 1"
     refine = params.number("refine", refine, 0, expected=wanted)
     if 0 < refine < 1:
         params.number("refine", refine, 1, expected=wanted)  # raises
-    return placement, refine, 0
+    return refine, 0
 
 
 def make_job(mesh: Mesh, ratio=None, target_vertices=None, target_triangles=None, *, max_error=None,
@@ -315,9 +325,10 @@ def make_job(mesh: Mesh, ratio=None, target_vertices=None, target_triangles=None
              guidance=None, regions=None, borders=None, view=None, boxes=(), mode="quality", placement=None,
              fast_path=None, max_repair_rounds=200, refine=None, attributes=None, attribute_weights=None,
              draft=False, symmetry=None, symmetry_tolerance=None) -> DecimationJob:
-    """The DecimationJob for ``decimate``'s keywords (see there), every one checked here, once;
-    ``symmetry``: a mirror axis (core/symmetry.py). Raises TopStocError naming the bad one."""
-    target = make_target(mesh, ratio, target_vertices, target_triangles, max_error, relative)
+    """The DecimationJob for ``decimate``'s keywords (see there), every one checked here, once,
+    in the order ``decimate`` always checked them; ``symmetry``: a mirror axis (core/symmetry.py).
+    Raises TopStocError naming the bad one."""
+    one_target(ratio, target_vertices, target_triangles, max_error)
     if mode not in MODES:
         raise TopStocError(f"mode must be one of {MODES}, got {mode!r}")
     if draft and (mode != "fast" or refine or max_error is not None):
@@ -329,18 +340,22 @@ def make_job(mesh: Mesh, ratio=None, target_vertices=None, target_triangles=None
         from .symmetry import parse_axis
 
         symmetry = parse_axis(symmetry)
-    placement, refine, refine_collapses = resolve_mode(mode, placement, refine, symmetry)
+    placement = resolve_placement(mode, placement, symmetry)
+    seed = params.seed(seed)
+    refine, refine_collapses = resolve_refine(mode, refine)
+    numbers = dict(adaptivity=params.number("adaptivity", adaptivity, 0, 1),
+                   flat_floor=params.number("flat_floor", flat_floor, 0, 1),
+                   feature_angle=params.number("feature_angle (radians)", feature_angle, 0, math.pi),
+                   density_rings=params.integer("density_rings", density_rings, 0, 2**31 - 1),
+                   density_ratio=params.number("density_ratio", density_ratio, 1),
+                   density_epsilon=params.number("density_epsilon", density_epsilon, 0),
+                   max_repair_rounds=params.integer("max_repair_rounds", max_repair_rounds, 0, 2**31 - 1))
+    target = make_target(mesh, ratio, target_vertices, target_triangles, max_error, relative)
+    u = guidance_values(mesh, guidance)
     values, weights = attribute_arrays(mesh, attributes, attribute_weights)
     return DecimationJob(
         target=target, mode=mode, placement=placement, refine=float(refine), refine_collapses=refine_collapses,
-        seed=int(params.seed(seed)), adaptivity=params.number("adaptivity", adaptivity, 0, 1),
-        flat_floor=params.number("flat_floor", flat_floor, 0, 1), area_weighted=bool(area_weighted),
-        feature_angle=params.number("feature_angle (radians)", feature_angle, 0, math.pi),
-        density=density, density_rings=params.integer("density_rings", density_rings, 0, 2**31 - 1),
-        density_ratio=params.number("density_ratio", density_ratio, 1),
-        density_epsilon=params.number("density_epsilon", density_epsilon, 0),
-        guidance=guidance_values(mesh, guidance), view=engine_view(view), boxes=engine_boxes(boxes),
-        regions=regions, borders=borders, attributes=values, attribute_weights=weights,
-        fast_path=0 if fast_path is None else int(bool(fast_path)),
-        max_repair_rounds=params.integer("max_repair_rounds", max_repair_rounds, 0, 2**31 - 1),
-        draft=bool(draft), symmetry=symmetry, symmetry_tolerance=symmetry_tolerance)
+        seed=int(seed), area_weighted=bool(area_weighted), density=density, guidance=u,
+        view=engine_view(view), boxes=engine_boxes(boxes), regions=regions, borders=borders, attributes=values,
+        attribute_weights=weights, fast_path=0 if fast_path is None else int(bool(fast_path)), draft=bool(draft),
+        symmetry=symmetry, symmetry_tolerance=symmetry_tolerance, **numbers)
