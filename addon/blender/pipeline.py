@@ -23,7 +23,6 @@ import numpy as np
 
 from ..core.appearance import refines
 from ..core.attributes import MovedVertices, moved_vertices, point_weights
-from ..core.budget import missed_target
 from ..core.decimate import run_job
 from ..core.errors import TopStocError
 from ..core.job import ATTRIBUTE_WEIGHT, DecimationJob, make_job
@@ -262,7 +261,7 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
     # A missed target (control points painted, borders, symmetry, what the topology needs): the panel says so.
     target["topstoc_over_budget"] = int(run.result.stats.over_budget)
     target["topstoc_over_budget_reason"] = str(run.result.stats.over_budget_reason)
-    missed = missed_target(run.result.stats)
+    missed = run.result.stats.target_missed
     target["topstoc_target_missed"] = "" if missed is None else missed.text()
     if target is not obj and run.settings is not None:  # what Regenerate needs (regenerate.py)
         target.topstoc.source = obj
@@ -336,7 +335,7 @@ def summary(run: Run, seconds: float = None) -> str:
     if run.result.stats.repairs:
         text += (f" ({run.result.stats.repairs} topology repairs: vertices kept so that no hole closed and "
                  f"no handle or piece was lost)")
-    missed = missed_target(run.result.stats)
+    missed = run.result.stats.target_missed
     if missed is not None:
         text += "; " + missed.text()
     return text

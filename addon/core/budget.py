@@ -73,7 +73,9 @@ def over_reason(stats) -> str:
 
 def missed_target(stats) -> Optional[MissedTarget]:
     """The MissedTarget of a result's DecimateStats, or None when it met its target (a triangle
-    target counts triangles, any other vertices)."""
+    target counts triangles, any other vertices; a replay of samples asked for none)."""
+    if stats.replayed:
+        return None
     unit = "triangles" if stats.target_triangles else "vertices"
     asked, got = ((stats.target_triangles, stats.output_triangles) if stats.target_triangles
                   else (stats.target_vertices, stats.output_vertices))

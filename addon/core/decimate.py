@@ -78,6 +78,8 @@ class DecimateStats:
     #: a mirror-symmetric result (core/symmetry.py): vertices of the plain decimation it was made from (else 0)
     mirrored_from: int = 0
     output_triangles: int = 0   #: triangles of the result
+    #: re-created from a sample list (decimate_with_samples): no target was asked, none missed
+    replayed: bool = False
     target_triangles: int = 0   #: the triangle target asked for (0: none)
 
     @property
@@ -245,7 +247,7 @@ def run_job(mesh: Mesh, job: DecimationJob) -> DecimateResult:
 
 #: DecimateStats fields counted in Python; every other field is the engine result's of the same name
 _COUNTED_HERE = {"output_vertices", "output_triangles", "target_triangles", "control_points", "zero_area_input",
-                 "mirrored_from"}
+                 "mirrored_from", "replayed"}
 
 
 def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob] = None) -> DecimateResult:
@@ -254,7 +256,7 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
                           output_triangles=len(raw["triangles"]),
                           target_triangles=0 if job is None else int(job.target.triangles or 0),
                           control_points=0 if job is None else job.control_points,
-                          zero_area_input=mesh.native.report["zero_area_triangles"])
+                          zero_area_input=mesh.native.report["zero_area_triangles"], replayed=job is None)
     return DecimateResult(vertices=raw["vertices"], triangles=raw["triangles"], kept=raw["kept"],
                           face_source=raw["face_source"], corner_source=raw["corner_source"],
                           labels=raw["labels"], samples=raw["samples"], stats=stats,

@@ -176,7 +176,8 @@ def decimate_job_mirrored(mesh, job):
         else result.vertices
     stats = dataclasses.replace(result.stats, target_vertices=plain.stats.target_vertices,
                                 target_triangles=plain.stats.target_triangles, forced=plain.stats.forced,
-                                control_points=plain.stats.control_points, mirrored_from=plain.num_vertices)
+                                control_points=plain.stats.control_points, mirrored_from=plain.num_vertices,
+                                replayed=False)
     return dataclasses.replace(result, vertices=vertices, parameters=parameters, stats=stats)
 
 

@@ -163,3 +163,16 @@ def test_borders_reason_when_corners_outnumber_the_target():
     guided = mesh.decimate(ratio=0.01, guidance=np.ones(len(data.vertices)), mode="fast")
     assert guided.stats.control_points == len(data.vertices)
     assert guided.stats.over_budget_reason == "control points"
+
+
+def test_a_replay_of_samples_asked_for_no_target():
+    """decimate_with_samples re-creates a result; a refined one holds far more samples than
+    output vertices, which is no missed target (nothing was asked)."""
+    data = read_mesh(DATA / "genus0/cgal_fandisk.off")
+    mesh = Mesh(data.vertices, data.triangles)
+    result = mesh.decimate(ratio=0.05, seed=2)
+    assert len(result.samples) > 2 * result.num_vertices  # the refinement's first pass
+    again = mesh.decimate_with_samples(result.samples, placement=result.parameters["placement"],
+                                       refine_vertices=result.stats.refine_vertices)
+    assert again.num_vertices == result.num_vertices
+    assert again.stats.replayed and again.stats.target_missed is None
