@@ -15,9 +15,9 @@ import time
 from . import batch_settings
 from .budget import missed_dict
 from .hausdorff import hausdorff
-from .io import mesh_format
+from .io import mesh_format, read_mesh
 from .job import ATTRIBUTE_WEIGHT
-from .mesh_file_job import prepare_file, read_input
+from .mesh_file_job import prepare_file
 from .prune import prune_small_parts
 
 #: samples on the original for the per-LOD error in the report: 100 per input triangle, within
@@ -61,7 +61,7 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
         raise TopStocError(f"{path}: --bake-normals needs a Blender format (.blend, glTF, FBX, USD): a mesh "
                            f"file has no material to hold the map")
     outputs = output_paths(path, out_dir, settings)
-    data = read_input(path)
+    data = read_mesh(path)
     start = time.perf_counter()
     options = settings["options"]
     source = prepare_file(path, data, options.get("mode"), options.get("refine"),

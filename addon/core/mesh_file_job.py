@@ -1,6 +1,7 @@
-"""The one recipe that decimates a mesh file (docs/design.md §1.5, §6): read, prepare the Mesh,
-UV seams and material borders as borders, the look (UVs, colours) as attributes where the
-refinement runs, decimate (mirrored when asked), carry the attributes over, write atomically.
+"""The one recipe that decimates a mesh file read with io.read_mesh (docs/design.md §1.5, §6):
+prepare the Mesh, UV seams and material borders as borders, the look (UVs, colours) as
+attributes where the refinement runs, decimate (mirrored when asked), carry the attributes
+over, write atomically.
 
 ``topstoc decimate`` (core/cli/decimate.py) runs it once; the batch (core/batch_mesh.py) once
 per LOD of each mesh file. The decimation itself is a DecimationJob (core/job.py).
@@ -16,19 +17,10 @@ import numpy as np
 from .appearance import Appearance, appearance_attributes, refines
 from .attributes import material_regions, transfer_attributes, uv_seam_edges
 from .decimate import DecimateResult, run_job
-from .errors import TopStocError
-from .io import MeshData, dropped_attributes, read_mesh, write_mesh
+from .io import MeshData, dropped_attributes, write_mesh
 from .job import DecimationJob, make_job
 from .materials import carry_libraries
 from .mesh import Mesh
-
-
-def read_input(path: str) -> MeshData:
-    """The mesh file ``path``; TopStocError when it has no triangles."""
-    data = read_mesh(path)
-    if data.num_triangles == 0:
-        raise TopStocError(f"{path}: the mesh has no triangles")
-    return data
 
 
 @dataclass

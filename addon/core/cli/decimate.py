@@ -18,9 +18,9 @@ from ..appearance import attribute_weight, refines
 from ..batch_settings import parse_max_error
 from ..budget import missed_dict, missed_text
 from ..errors import TopStocError
-from ..io import mesh_format
+from ..io import mesh_format, read_mesh
 from ..job import ATTRIBUTE_WEIGHT
-from ..mesh_file_job import prepare_file, read_input
+from ..mesh_file_job import prepare_file
 from ..output_guard import add_overwrite_argument, prepare_output
 from ..symmetry import AXES
 from . import print_json, progress
@@ -129,7 +129,7 @@ def run(args) -> int:
     prepare_output(args.output, [args.input, args.guidance], overwrite=args.overwrite)
     mesh_format(args.output)  # fail on a bad output name before doing any work
     progress.stage(f"reading {args.input}")
-    data = read_input(args.input)
+    data = read_mesh(args.input)
     guidance = None if args.guidance is None else load_guidance(args.guidance, data.num_vertices)
     weight = attribute_weight(args.attribute_weight)
     target = _target(args)
