@@ -50,6 +50,8 @@ class Layout:
     def row(self, **kwargs):
         return self
 
+    column = row
+
     def label(self, text="", icon="NONE"):
         self.labels.append((text, icon))
 
