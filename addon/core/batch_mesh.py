@@ -14,6 +14,7 @@ import time
 
 from . import batch_settings
 from .budget import missed_dict
+from .errors import TopStocError
 from .hausdorff import hausdorff
 from .io import mesh_format, read_mesh
 from .job import ATTRIBUTE_WEIGHT
