@@ -3,6 +3,7 @@ implementation (tests/reference.py), loops found and stepped through, select / c
 fill / delete with the invariants updated and attributes kept, undo restoring the mesh and its
 analysis, bad input reported without a trace, and the overlays' arrays."""
 
+import contextlib
 import importlib
 
 import bpy
@@ -216,14 +217,42 @@ def test_fill_selected_all_and_delete_faces(mods, scene):
     assert_matches_reference(obj)
     mesh = obj.data
     mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), dtype=bool))
-    with pytest.raises(RuntimeError, match="no faces are selected"):
+    with in_edit_mode(), pytest.raises(RuntimeError, match="no faces are selected"):
         bpy.ops.topstoc.delete_faces()
     count = len(obj.data.polygons)
-    mesh.polygons[10].select = True
-    assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
+    obj.data.polygons[10].select = True
+    with in_edit_mode():
+        assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
     assert len(obj.data.polygons) == count - 1 and t.boundary_loops == 1
     assert_matches_reference(obj)
     assert t.genus == 3
+
+
+@contextlib.contextmanager
+def in_edit_mode():
+    """Edit Mode around a block (the selection set in Object Mode carries in and out)."""
+    bpy.ops.object.mode_set(mode="EDIT")
+    try:
+        yield
+    finally:
+        bpy.ops.object.mode_set(mode="OBJECT")
+
+
+def test_delete_faces_refuses_object_mode_and_an_empty_mesh_is_called_empty(mods, scene):
+    """Object Mode hides the selection (after an import it may be every face): Delete Selected
+    Faces acts only on what Edit Mode shows; a mesh with no faces is not "ready to print"."""
+    obj = load("Eight", "genus_positive/cgal_eight.off")
+    obj.data.polygons.foreach_set("select", np.ones(len(obj.data.polygons), dtype=bool))
+    count = len(obj.data.polygons)
+    with pytest.raises(RuntimeError, match="Edit Mode"):
+        bpy.ops.topstoc.delete_faces()
+    assert len(obj.data.polygons) == count
+    with in_edit_mode():
+        assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
+    assert len(obj.data.polygons) == 0
+    assert bpy.ops.topstoc.analyse() == {"FINISHED"}
+    summary = mods.panel.plain_summary(obj.topstoc.topology)
+    assert "empty" in summary and "ready to print" not in summary
 
 
 def test_edit_mode_operators_and_quads(mods, scene):
@@ -266,9 +295,6 @@ def prepare_for(operator, obj, mods):
     if operator in ("select_loop", "cut_loop", "remove_loop"):
         t.loop_index = [loop.kind for loop in t.loops].index("HANDLE")
         return {}
-    if operator == "delete_faces":
-        mesh.polygons[7].select = True
-        return {}
     # fill_holes: cut first (so there are holes), then select one of them
     t.loop_index = [loop.kind for loop in t.loops].index("HANDLE")
     assert bpy.ops.topstoc.cut_loop() == {"FINISHED"}
@@ -277,7 +303,7 @@ def prepare_for(operator, obj, mods):
     return {"mode": "SELECTED"}
 
 
-@pytest.mark.parametrize("operator", ["select_loop", "cut_loop", "remove_loop", "fill_holes", "delete_faces"])
+@pytest.mark.parametrize("operator", ["select_loop", "cut_loop", "remove_loop", "fill_holes"])  # delete: Edit Mode
 def test_every_operator_updates_the_invariants_and_undo_restores(mods, scene, operator):
     obj = load("Eight", "genus_positive/cgal_eight.off")
     name = obj.name
@@ -454,7 +480,8 @@ def test_edit_on_a_from_pydata_mesh_keeps_edge_flags(mods, scene):
     readable = "select" not in mods.mesh_edit.mesh_io.mistyped_edge_flags(mesh)
     mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), dtype=bool))
     mesh.polygons[3].select = True
-    assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
+    with in_edit_mode():
+        assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
     out = obj.data
     assert len(out.polygons) == len(faces) - 1
     assert mods.mesh_edit.mesh_io.mistyped_edge_flags(out) == {}
