@@ -90,11 +90,12 @@ class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
         if estimate:
             layout.label(text=estimate, icon="MESH_DATA")
         layout.prop(settings, "quality")
-        row = layout.row(align=True, heading="Symmetry")
-        row.prop(settings, "use_symmetry", text="")
-        sub = row.row(align=True)
+        row = layout.row()  # no label column: "Symmetry" does not fit it in every Blender's font
+        row.use_property_split = False
+        row.prop(settings, "use_symmetry")
+        sub = row.row()
         sub.active = settings.use_symmetry
-        sub.prop(settings, "symmetry_axis", expand=True)
+        sub.prop(settings, "symmetry_axis", text="")
         row = layout.row(align=True)  # full width: "New Object" does not fit beside a label
         row.use_property_split = False
         row.prop(settings, "output", expand=True)
@@ -110,10 +111,11 @@ class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
         if obj is not None and obj.type == "MESH" and obj.topstoc.settings:
             box = layout.box()
             source = obj.topstoc.source
-            box.label(text=f"Result of {source.name}" if source else "Source deleted", icon="LINKED")
-            row = box.row(align=True)
-            row.operator("topstoc.regenerate", icon="FILE_REFRESH")
-            row.prop(obj.topstoc, "auto_regenerate", text="Auto")
+            wrapped(box, context, f"Result of {source.name}" if source else "Source deleted", "LINKED")
+            col = box.column()  # one per line: side by side, a row's equal halves cut "Regenerate"
+            col.use_property_split = False  # the checkbox's name beside it, not in a label column
+            col.operator("topstoc.regenerate", icon="FILE_REFRESH")
+            col.prop(obj.topstoc, "auto_regenerate")
 
 
 class TOPSTOC_PT_advanced(_Panel, bpy.types.Panel):
@@ -170,14 +172,15 @@ class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
             else:  # no red "invalid" field before the layer exists: offer to make it
                 box.label(text="Not painted yet", icon="INFO")
             box.prop(s, "color_strength")
-            row = box.row(align=True)
-            row.operator("topstoc.add_guidance_layer", text="Add Layer", icon="BRUSH_DATA")
-            row.operator("topstoc.show_guidance", text="Show", icon="SHADING_SOLID")
-        if context.mode == "EDIT_MESH":
-            row = box.row(align=True)
-            for level, label in (("KEEP", "Keep"), ("MORE", "More"), ("NEUTRAL", "Neutral"), ("LESS", "Less"),
-                                 ("DROP", "Drop")):
-                row.operator("topstoc.set_guidance", text=label).level = level
+            col = box.column(align=True)  # side by side, each icon and name has half the width: too little
+            col.operator("topstoc.add_guidance_layer", text="Add Layer", icon="BRUSH_DATA")
+            col.operator("topstoc.show_guidance", text="Show", icon="SHADING_SOLID")
+        if context.mode == "EDIT_MESH":  # two rows: five buttons in one are cut
+            for levels in ((("KEEP", "Keep"), ("MORE", "More"), ("NEUTRAL", "Neutral")),
+                           (("LESS", "Less"), ("DROP", "Drop"))):
+                row = box.row(align=True)
+                for level, label in levels:
+                    row.operator("topstoc.set_guidance", text=label).level = level
         box = layout.box()
         box.prop(s, "use_vertex_group")
         if s.use_vertex_group:
@@ -220,11 +223,12 @@ class TOPSTOC_PT_variants(_Panel, bpy.types.Panel):
     def draw(self, context):
         layout = self.layout
         settings = context.scene.topstoc
-        row = layout.row(align=True)
-        row.prop(settings, "variants")
-        row.prop(settings, "variance")
+        col = layout.column(align=True)
+        col.prop(settings, "variants")
+        col.prop(settings, "variance")
         layout.operator("topstoc.multiview", icon="MOD_ARRAY")
-        layout.prop(settings, "lod_ratios")
+        layout.label(text="LOD ratios, finest first:")
+        layout.prop(settings, "lod_ratios", text="")
         layout.operator("topstoc.lod_chain", icon="MOD_DECIM")
 
 
@@ -240,13 +244,13 @@ class TOPSTOC_PT_samples(_Panel, bpy.types.Panel):
         if obj is None or obj.type != "MESH":
             return
         show = context.scene.topstoc.overlays
-        row = layout.row(align=True)  # the last decimation's samples and clusters (thesis fig. 4.1)
-        row.prop(show, "show_samples", toggle=True, icon="DOT")
-        row.prop(show, "show_clusters", toggle=True, icon="MOD_EXPLODE")
+        col = layout.column(align=True)  # the last decimation's samples and clusters (thesis fig. 4.1)
+        col.prop(show, "show_samples", toggle=True, icon="DOT")
+        col.prop(show, "show_clusters", toggle=True, icon="MOD_EXPLODE")
         layout.operator("topstoc.save_samples", icon="FILE_TICK")
         for entry in obj.topstoc.sample_sets:
             row = layout.row(align=True)
-            row.label(text=f"{entry.name}: {entry.vertices_out:,} v, {entry.triangles_out:,} t")
+            row.label(text=f"{entry.name}: {entry.vertices_out:,} vertices")
             row.operator("topstoc.restore_samples", text="", icon="RECOVER_LAST").name = entry.name
             row.operator("topstoc.remove_samples", text="", icon="X").name = entry.name
 
