@@ -23,7 +23,8 @@ from typing import Optional
 import bpy
 import numpy as np
 
-from ..core.attributes import MovedVertices, SparseWeights, corner_values, moved_vertices, point_values
+from ..core.attributes import (FLAT_CORNER_ANGLE, MovedVertices, SparseWeights, corner_values, moved_vertices,
+                               point_values)
 from ..core.digest import array_digest
 from ..core.edge_flags import carried_edge_flags
 from ..core import fresh_memory
@@ -603,6 +604,28 @@ def read_custom_normals(mesh) -> Optional[np.ndarray]:
     return _get(mesh.loops, "normal", len(mesh.loops), 3, np.float32)
 
 
+def flat_corners(source, normals, corner_loop) -> np.ndarray:
+    """Which output corners come from a flat-shaded input corner (its custom normal its polygon's,
+    within attributes.FLAT_CORNER_ANGLE): they take their output face's normal, so a faceted
+    asset stays faceted where the engine merged faces across edges that were not creases."""
+    count = len(source.polygons)
+    polygon_normals = _get(source.polygons, "normal", count, 3, np.float64)
+    totals = _get(source.polygons, "loop_total", count, 1, np.int64).ravel()
+    starts = _get(source.polygons, "loop_start", count, 1, np.int64).ravel()
+    order = np.argsort(starts, kind="stable")  # a polygon's loops are consecutive, polygons tile the loops
+    loop_polygon = np.repeat(order, totals[order])
+    cosine = (normals[corner_loop] * polygon_normals[loop_polygon[corner_loop]]).sum(axis=1)
+    return cosine >= np.cos(np.radians(FLAT_CORNER_ANGLE))
+
+
+def face_normals(vertices, triangles) -> np.ndarray:
+    """(m, 3) unit normals of triangles (zero for degenerate ones)."""
+    p = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles, dtype=np.int64)]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    return n / np.where(length > 0, length, 1.0)
+
+
 def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: str,
                       moved: Optional[MovedVertices] = None) -> bpy.types.Mesh:
     """A new mesh datablock holding ``result`` with the source's attributes carried over.
@@ -679,6 +702,8 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
         mixed = moved.face[np.asarray(result.triangles).ravel()] >= 0  # interpolated: unit length again
         length = np.linalg.norm(corner_normals[mixed], axis=1, keepdims=True)
         corner_normals[mixed] = corner_normals[mixed] / np.where(length > 0, length, 1)
+        flat = flat_corners(source, normals, corner_loop)
+        corner_normals[flat] = np.repeat(face_normals(result.vertices, result.triangles), 3, axis=0)[flat]
         out.normals_split_custom_set(corner_normals)
     out.update()
     return out
