@@ -604,6 +604,24 @@ def read_custom_normals(mesh) -> Optional[np.ndarray]:
     return _get(mesh.loops, "normal", len(mesh.loops), 3, np.float32)
 
 
+def _display_colors(source, out, guidance) -> None:
+    """The result's active and render colours: the source's, except that a guidance layer gives
+    way to the first other colour attribute (Blender always shows one when any exists)."""
+    colors = source.color_attributes
+    render = colors[colors.render_color_index] if 0 <= colors.render_color_index < len(colors) else None
+    others = [a for a in out.color_attributes if a.name not in guidance]
+    for attribute, setter in ((colors.active_color, "active"), (render, "render")):
+        chosen = out.color_attributes.get(attribute.name) if attribute is not None else None
+        if chosen is None or chosen.name in guidance:
+            chosen = others[0] if others else chosen
+        if chosen is None:
+            continue
+        if setter == "active":
+            out.color_attributes.active_color = chosen
+        else:
+            out.color_attributes.render_color_index = list(out.color_attributes).index(chosen)
+
+
 def flat_corners(source, normals, corner_loop) -> np.ndarray:
     """Which output corners come from a flat-shaded input corner (its custom normal its polygon's,
     within attributes.FLAT_CORNER_ANGLE): they take their output face's normal, so a faceted
@@ -627,8 +645,13 @@ def face_normals(vertices, triangles) -> np.ndarray:
 
 
 def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: str,
-                      moved: Optional[MovedVertices] = None) -> bpy.types.Mesh:
+                      moved: Optional[MovedVertices] = None, guidance: tuple = (), keep_guidance: bool = True
+                      ) -> bpy.types.Mesh:
     """A new mesh datablock holding ``result`` with the source's attributes carried over.
+
+    ``guidance``: the names of the guidance paint layers. They are never the result's active or
+    render colour (an exported LOD would show the paint), and not carried at all unless
+    ``keep_guidance`` (an object decimated in place keeps its paint; a new result does not need it).
 
     Points take the attributes of their kept input vertex, faces those of their source
     polygon, corners those of the input loop ``corner_source`` names. Vertices the quality mode
@@ -673,7 +696,7 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
     for attribute in source.attributes:
         name_ = attribute.name
         if (name_.startswith(".") or name_ in _SKIPPED_ATTRIBUTES or name_ in uv_names
-                or attribute.domain not in ("POINT", "FACE", "CORNER")):
+                or attribute.domain not in ("POINT", "FACE", "CORNER") or (name_ in guidance and not keep_guidance)):
             continue
         count = _domain_size(source, attribute.domain)
         read = read_attribute(attribute, count)
@@ -684,13 +707,7 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
         picked = carried(values, attribute.domain, nearest=attribute.data_type not in _INTERPOLATED)
         if len(picked):
             target.data.foreach_set(key, np.ascontiguousarray(picked).ravel())
-    colors = source.color_attributes
-    if colors.active_color is not None and out.color_attributes.get(colors.active_color.name) is not None:
-        out.color_attributes.active_color = out.color_attributes[colors.active_color.name]
-    if 0 <= colors.render_color_index < len(colors):
-        render = out.color_attributes.get(colors[colors.render_color_index].name)
-        if render is not None:
-            out.color_attributes.render_color_index = list(out.color_attributes).index(render)
+    _display_colors(source, out, guidance)
     carry_edge_flags(source, out, kept, moved.face >= 0)
 
     normals = read_custom_normals(source)
