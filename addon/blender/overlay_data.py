@@ -80,6 +80,9 @@ def topology_primitives(obj, show) -> list:
             continue
         if index == topology.loop_index:
             out.append(Primitive("active_loop", LINES, co[loop_segments(ids)], color[loop.kind], size="active"))
+            # its corners as dots of the same width: a loop of a few short edges stays visible when
+            # zoomed out, as a dot at least (Frame Loop then shows it whole)
+            out.append(Primitive("active_loop_points", POINTS, co[ids], color[loop.kind], size="active"))
         elif loop.kind in segments:
             segments[loop.kind].append(loop_segments(ids))
     for kind, name in (("HANDLE", "handles"), ("TUNNEL", "tunnels")):

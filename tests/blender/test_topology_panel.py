@@ -355,6 +355,46 @@ def test_nonmanifold_mesh_loop_search_reports_in_the_panel(mods, ts, scene):
     assert {p.name for p in shown} >= {"nonmanifold_edges"}
 
 
+def test_loop_view_looks_through_the_loop(ts):
+    """Frame Loop's view: centred on the loop, four radii away, along its plane's normal from the
+    viewer's side; a straight run of points keeps the view's direction."""
+    frame = importlib.import_module(f"{ts.__name__}.blender.operators.frame_loop")
+    rng = np.random.default_rng(3)
+    normal = np.array([1.0, 2.0, 2.0]) / 3.0
+    u = np.cross(normal, [0.0, 0.0, 1.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    angles = np.sort(rng.uniform(0, 2 * np.pi, 5))
+    centre = np.array([4.0, -1.0, 0.5])
+    points = centre + 0.02 * (np.cos(angles)[:, None] * u + np.sin(angles)[:, None] * v)
+    for viewer in (normal, -normal + [0.1, 0, 0]):
+        got_centre, distance, directions = frame.loop_view(points, viewer)
+        np.testing.assert_allclose(got_centre, points.mean(axis=0), atol=1e-12)
+        radius = np.linalg.norm(points - points.mean(axis=0), axis=1).max()
+        assert distance == pytest.approx(frame.RADII * radius)
+        first = directions[0]
+        assert abs(abs(first @ normal) - 1) < 1e-9 and first @ viewer > 0 and len(directions) == 7
+    line = np.outer(np.arange(4.0), [1.0, 0.0, 0.0])
+    assert len(frame.loop_view(line, normal)[2]) == 1  # a straight run: the present direction only
+
+
+def test_frame_loop_looks_from_outside(mods, scene, ts):
+    """A handle loop goes round a tube: through it (its plane's normal) the view would stand inside
+    the tube, so Frame Loop looks from a side the loop is seen from."""
+    frame = importlib.import_module(f"{ts.__name__}.blender.operators.frame_loop")
+    obj = make_object("Torus", *meshgen.torus(24, 12))
+    assert bpy.ops.topstoc.find_loops() == {"FINISHED"}
+    t = obj.topstoc.topology
+    handle = next(loop for loop in t.loops if loop.kind == "HANDLE")
+    points = positions(obj.data)[mods.analysis.loop_vertices(handle)].astype(np.float64)
+    centre, distance, directions = frame.loop_view(points, np.array([0.0, 0.0, 1.0]))
+    shares = [frame.visible_share(obj, centre + distance * d, points) for d in directions]
+    assert abs(directions[0][2]) < 1e-6  # round the tube: its plane is upright, the tube's axis level
+    print("visible shares of the handle loop per direction:", [round(x, 2) for x in shares])
+    assert shares[0] == shares[1] == 0.0  # through the tube: inside the mesh
+    assert max(shares) >= 0.4
+
+
 def test_overlay_arrays_follow_the_analysis(mods, scene):
     obj = load("Eight", "genus_positive/cgal_eight.off")
     bpy.ops.topstoc.find_loops()
@@ -366,6 +406,9 @@ def test_overlay_arrays_follow_the_analysis(mods, scene):
     active = mods.analysis.loop_vertices(t.loops[1])
     np.testing.assert_allclose(prims["active_loop"].positions.reshape(-1, 2, 3)[:, 0], co[active])
     assert prims["active_loop"].size == "active" and prims["active_loop"].color == mods.colors.HANDLE
+    # its corners as dots of the active width too: a tiny loop shows as a dot at least when zoomed out
+    np.testing.assert_allclose(prims["active_loop_points"].positions, co[active])
+    assert prims["active_loop_points"].size == "active" and prims["active_loop_points"].kind == "POINTS"
     handle_edges = sum(loop.num_edges for i, loop in enumerate(t.loops) if loop.kind == "HANDLE" and i != 1)
     assert len(prims["handles"]) == 2 * handle_edges and prims["tunnels"].color == mods.colors.TUNNEL
     assert len(prims["generators"]) == 2 * 4 and prims["generators"].color == mods.colors.GENERATOR

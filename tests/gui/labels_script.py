@@ -123,6 +123,39 @@ def steps():
     with session.override():
         bpy.ops.object.mode_set(mode="OBJECT")
     report["values"].pop("layouts")
+    yield from frame_the_shortest_loop(result)
+
+
+def loop_extent(obj, ids):
+    """Pixels the loop spans in the 3D view (the larger of its screen width and height)."""
+    from bpy_extras import view3d_utils
+    from mathutils import Vector
+
+    _window, _area, region, space = view3d()
+    points = [view3d_utils.location_3d_to_region_2d(region, space.region_3d, obj.matrix_world @ Vector(
+        obj.data.vertices[i].co)) for i in ids]
+    xs, ys = [p.x for p in points if p], [p.y for p in points if p]
+    return max(max(xs) - min(xs), max(ys) - min(ys)) if xs else 0.0
+
+
+def frame_the_shortest_loop(obj):
+    """Steps: Frame Loop on the shortest handle or tunnel loop makes it fill the view."""
+    topology = obj.topstoc.topology
+    loops = [i for i, loop in enumerate(topology.loops) if loop.kind in ("HANDLE", "TUNNEL")]
+    topology.loop_index = min(loops, key=lambda i: topology.loops[i].length)
+    ids = [int(i) for i in topology.loops[topology.loop_index]["vertices"]]
+    session.frame([obj], tilt=0.2, turn=0.0, distance_factor=20.0)  # zoomed out: the whole object small
+    yield 0.3
+    before = loop_extent(obj, ids)
+    with session.override():
+        done = bpy.ops.topstoc.frame_loop()
+    yield 0.5
+    after = loop_extent(obj, ids)
+    _window, _area, region, _space = view3d()
+    report["values"]["loop_extent"] = [len(ids), before, after, min(region.width, region.height)]
+    session.check("Frame Loop fills the view with the loop", done == {"FINISHED"} and before < 0.1 * after
+                  and after > 0.25 * min(region.width, region.height), f"{before:.0f} px -> {after:.0f} px")
+    shot("framed_loop", [obj])
 
 
 session.run(steps)

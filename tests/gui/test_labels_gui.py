@@ -1,6 +1,7 @@
 """Every text of the TopStoc panels whole at Blender's default sidebar width (one launch): each
 panel open, in Object and Edit Mode, its layout as Blender resolved it measured against the
-width Blender's layout rules give each button (label_widths.py)."""
+width Blender's layout rules give each button (label_widths.py). Then Frame Loop on the shortest
+handle or tunnel loop, from a view that shows the whole object small."""
 
 import pytest
 
@@ -19,6 +20,10 @@ def test_every_panel_was_measured(report):
     assert report["values"]["texts"]["object"] > 100 and report["values"]["texts"]["edit"] > 100
     # Blender's default sidebar, less its tab column and the panel margins
     assert 150 < report["values"]["content_width"] < 260, report["values"]
+
+
+def test_gui_checks_pass(report):
+    assert report["checks"] and all(report["checks"].values()), (report["checks"], report["values"].get("loop_extent"))
 
 
 def test_no_text_is_cut(report):

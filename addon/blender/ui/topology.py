@@ -178,6 +178,7 @@ class TOPSTOC_PT_topology_loops(_AnalysedPanel, bpy.types.Panel):
         if active is None:
             return
         row.separator()
+        row.operator("topstoc.frame_loop", text="Frame")
         row.operator("topstoc.select_loop", text="Select")
         row = layout.row(align=True)  # a second row: four buttons beside the arrows are cut
         if active.kind == "BOUNDARY":
