@@ -201,25 +201,33 @@ def test_fill_selected_all_and_delete_faces(mods, scene):
     assert holes >= 2
     mesh = obj.data
     before = len(mesh.polygons)
-    mesh.vertices.foreach_set("select", np.zeros(len(mesh.vertices), dtype=bool))
-    with pytest.raises(RuntimeError, match="no hole has a selected boundary edge"):
+    mesh.vertices.foreach_set("select", np.ones(len(mesh.vertices), dtype=bool))
+    with pytest.raises(RuntimeError, match="Edit Mode"):  # Object Mode: the selection is not shown
+        bpy.ops.topstoc.fill_holes(mode="SELECTED")
+    assert t.boundary_loops == holes
+    for items in (mesh.vertices, mesh.edges, mesh.polygons):  # Edit Mode flushes edges' to vertices
+        items.foreach_set("select", np.zeros(len(items), dtype=bool))
+    with in_edit_mode(), pytest.raises(RuntimeError, match="no hole has a selected boundary edge"):
         bpy.ops.topstoc.fill_holes(mode="SELECTED")
     assert len(obj.data.polygons) == before and t.boundary_loops == holes       # nothing lost
     assert t.edit_state == "ERROR" and "no hole has a selected boundary edge" in t.edit_message  # in the panel
     first = mods.analysis.loop_vertices([loop for loop in t.loops if loop.kind == "BOUNDARY"][0])
     mesh = obj.data
     mesh.vertices.foreach_set("select", np.isin(np.arange(len(mesh.vertices)), first[:2]))
-    assert bpy.ops.topstoc.fill_holes(mode="SELECTED") == {"FINISHED"}
+    with in_edit_mode():
+        assert bpy.ops.topstoc.fill_holes(mode="SELECTED") == {"FINISHED"}
     assert t.boundary_loops == holes - 1
     assert_matches_reference(obj)
     assert bpy.ops.topstoc.fill_holes(mode="ALL") == {"FINISHED"}
     assert t.boundary_loops == 0 and all(c.closed for c in t.components)
     assert_matches_reference(obj)
     mesh = obj.data
-    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), dtype=bool))
+    for items in (mesh.vertices, mesh.edges, mesh.polygons):
+        items.foreach_set("select", np.zeros(len(items), dtype=bool))
     with in_edit_mode(), pytest.raises(RuntimeError, match="no faces are selected"):
         bpy.ops.topstoc.delete_faces()
     count = len(obj.data.polygons)
+    bpy.context.tool_settings.mesh_select_mode = (False, False, True)
     obj.data.polygons[10].select = True
     with in_edit_mode():
         assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
@@ -295,12 +303,12 @@ def prepare_for(operator, obj, mods):
     if operator in ("select_loop", "cut_loop", "remove_loop"):
         t.loop_index = [loop.kind for loop in t.loops].index("HANDLE")
         return {}
-    # fill_holes: cut first (so there are holes), then select one of them
+    # fill_holes: cut first (so there are holes), then make one of them the active loop (filling
+    # the selected holes needs Edit Mode, which this Object Mode undo test does not enter)
     t.loop_index = [loop.kind for loop in t.loops].index("HANDLE")
     assert bpy.ops.topstoc.cut_loop() == {"FINISHED"}
-    hole = mods.analysis.loop_vertices([loop for loop in t.loops if loop.kind == "BOUNDARY"][0])
-    obj.data.vertices.foreach_set("select", np.isin(np.arange(len(obj.data.vertices)), hole))
-    return {"mode": "SELECTED"}
+    t.loop_index = [loop.kind for loop in t.loops].index("BOUNDARY")
+    return {"mode": "ACTIVE"}
 
 
 @pytest.mark.parametrize("operator", ["select_loop", "cut_loop", "remove_loop", "fill_holes"])  # delete: Edit Mode

@@ -380,6 +380,9 @@ triangulation, robust fallbacks)"""
     def execute(self, context):
         obj = _mesh_object(context)
         mode = self.mode
+        if mode == "SELECTED" and context.mode != "EDIT_MESH":  # Object Mode hides the selection
+            self.report({"ERROR"}, "TopStoc: select the holes' edges in Edit Mode")
+            return {"CANCELLED"}
         if mode == "ACTIVE":
             loop = analysis.active_loop(obj)
             if loop is None or loop.kind != "BOUNDARY":
