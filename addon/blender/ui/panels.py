@@ -3,8 +3,6 @@
 
 from __future__ import annotations
 
-import textwrap
-
 import bpy
 
 from ..pipeline import face_estimate
@@ -13,12 +11,34 @@ CATEGORY = "TopStoc"
 
 
 def wrapped(layout, context, text: str, icon: str = "NONE") -> None:
-    """A long message as several labels, wrapped to the sidebar's width."""
+    """A long message as several labels, broken between words where the sidebar's width ends
+    (measured in the UI font; a box's margins allowed for)."""
     scale = (context.preferences.system.ui_scale if context.preferences else 0.0) or 1.0  # 0 in background
+    unit = 20 * scale
     pixels = context.region.width if context.region else 300
-    width = max(16, int((pixels - 50 * scale) / (7 * scale)))
-    for i, line in enumerate(textwrap.wrap(text, width) or [""]):
-        layout.label(text=line, icon=icon if i == 0 else "BLANK1")
+    # the panel's content (less the tab column and margins), a box's margins, a label's own, its icon
+    width = pixels - 2.6 * unit - 0.5 * unit - 0.7 * unit - (unit if icon != "NONE" else 0)
+    lines, line = [], ""
+    for word in text.split():
+        candidate = f"{line} {word}" if line else word
+        if line and _text_width(context, candidate, scale) > width:
+            lines.append(line)
+            candidate = word
+        line = candidate
+    for i, part in enumerate(lines + [line]):
+        layout.label(text=part, icon=icon if i == 0 else ("BLANK1" if icon != "NONE" else "NONE"))
+
+
+def _text_width(context, text: str, scale: float) -> float:
+    """Width of ``text`` in pixels in the UI's widget font."""
+    import blf
+
+    points = context.preferences.ui_styles[0].widget.points if context.preferences else 11
+    try:
+        blf.size(0, points * scale)
+    except TypeError:  # Blender before 4.0 takes a dpi argument
+        blf.size(0, points * scale, 72)
+    return blf.dimensions(0, text)[0]
 
 
 class _Panel:
