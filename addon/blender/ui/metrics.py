@@ -41,7 +41,7 @@ class TOPSTOC_PT_metrics(_MeshPanel, bpy.types.Panel):
         reference = settings.reference or metrics.reference_of(obj)
         if reference is not None:  # the basic information (thesis 4.7): vertex counts of both meshes
             wrapped(col, context, f"{len(reference.data.vertices):,} → {len(obj.data.vertices):,} vertices "
-                                  f"({100.0 * len(obj.data.vertices) / max(1, len(reference.data.vertices)):.3g} %)")
+                                  f"({100.0 * len(obj.data.vertices) / max(1, len(reference.data.vertices)):.3g}\u00a0%)")
         layout.operator("topstoc.measure", icon="DRIVER_DISTANCE")
         if settings.state == "ERROR":
             layout.label(text=settings.message, icon="ERROR")

@@ -19,14 +19,15 @@ def wrapped(layout, context, text: str, icon: str = "NONE") -> None:
     # the panel's content (less the tab column and margins), a box's margins, a label's own, its icon
     width = pixels - 2.6 * unit - 0.5 * unit - 0.7 * unit - (unit if icon != "NONE" else 0)
     lines, line = [], ""
-    for word in text.split():
+    for word in text.split(" "):  # only at spaces: "3\u00a0%" (a no-break space) stays whole
         candidate = f"{line} {word}" if line else word
         if line and _text_width(context, candidate, scale) > width:
             lines.append(line)
             candidate = word
         line = candidate
+    col = layout.column(align=True)  # the lines of one message close together
     for i, part in enumerate(lines + [line]):
-        layout.label(text=part, icon=icon if i == 0 else ("BLANK1" if icon != "NONE" else "NONE"))
+        col.label(text=part, icon=icon if i == 0 else ("BLANK1" if icon != "NONE" else "NONE"))
 
 
 def _text_width(context, text: str, scale: float) -> float:
