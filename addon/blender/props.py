@@ -183,9 +183,9 @@ class TOPSTOC_PG_object(bpy.types.PropertyGroup):
     vertex_group: StringProperty(name="Group", description="Vertex group giving guidance")
     vertex_group_mapping: EnumProperty(
         name="Mapping", default="DETAIL",
-        items=[("DETAIL", "Weight = Detail", "u = w: weight 1 keeps every vertex, 0 is neutral"),
+        items=[("DETAIL", "Detail", "Weight = detail, u = w: weight 1 keeps every vertex, 0 is neutral"),
                ("SIGNED", "Signed", "u = 2w - 1: 1 keeps, 0.5 neutral, 0 drops"),
-               ("DECIMATE", "Blender Decimate", "u = 1 - w: weight 0 locks (as Blender's Decimate), 1 neutral")])
+               ("DECIMATE", "Inverse", "u = 1 - w: weight 0 locks, 1 neutral (as Blender's Decimate modifier)")])
     vertex_group_strength: FloatProperty(name="Strength", default=1.0, min=0.0, max=1.0, subtype="FACTOR")
 
     use_color: BoolProperty(name="Painted Guidance",
@@ -236,7 +236,7 @@ class TOPSTOC_PG_scene(DecimationParameters, BakeParameters, bpy.types.PropertyG
 
     use_view: BoolProperty(name="View-Dependent", description="Fewer vertices on back faces, keep silhouettes")
     view_source: EnumProperty(name="View", default="CAMERA",
-                              items=[("CAMERA", "Scene Camera", "The scene's active camera"),
+                              items=[("CAMERA", "Camera", "The scene's active camera"),
                                      ("VIEWPORT", "Viewport", "The current 3D viewport view")])
     back_ratio: FloatProperty(name="Back-Face Ratio", default=0.25, min=0.0, max=1.0, subtype="FACTOR")
     silhouette_angle: FloatProperty(name="Silhouette Band", default=math.radians(20.0), min=0.0,

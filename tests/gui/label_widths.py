@@ -108,12 +108,21 @@ def natural(item) -> float:
     return 10 * unit()
 
 
+def _with_label(items) -> bool:
+    """A row Blender made for a property's name beside its menu or field (ui_item_with_label,
+    outside a property split): its label's natural width is a third of the field's."""
+    return (len(items) == 2 and items[0].get("type") == 10240 and "rna" not in items[0]
+            and "rna" in items[1])
+
+
 def _row_widths(items, width: float, align: bool) -> list:
     """ui_litem_layout_row: shares ``width`` in proportion to the natural widths; items that would
     get less than min(2 units, natural) keep that minimum and the rest is shared again."""
     space = 0.0 if align else 0.3 * unit()
     available = width - (len(items) - 1) * space
     sizes = [natural(i) for i in items]
+    if _with_label(items):
+        sizes[0] = sizes[1] / 3
     fixed = [False] * len(items)
     while True:
         free_total = sum(s for s, f in zip(sizes, fixed) if not f)

@@ -114,6 +114,16 @@ def steps():
     yield from capture_layouts(classes)
     measure("object")
     shot("panels_object", [result])
+    # every option that shows more settings, on
+    settings = bpy.context.scene.topstoc
+    for name in ("bake_normals", "use_view", "use_frustum", "use_symmetry"):
+        if hasattr(settings, name):
+            setattr(settings, name, True)
+    result.topstoc.use_vertex_group = True
+    bpy.context.scene.topstoc.overlays.show_error = True
+    yield from capture_layouts(classes)
+    measure("options")
+    shot("panels_options", [result])
     with session.override():
         bpy.ops.object.mode_set(mode="EDIT")
     yield 0.5

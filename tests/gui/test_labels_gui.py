@@ -1,5 +1,6 @@
 """Every text of the TopStoc panels whole at Blender's default sidebar width (one launch): each
-panel open, in Object and Edit Mode, its layout as Blender resolved it measured against the
+panel open, in Object Mode (options off, then every option that shows more settings on) and
+Edit Mode, its layout as Blender resolved it measured against the
 width Blender's layout rules give each button (label_widths.py). Then Frame Loop on the shortest
 handle or tunnel loop, from a view that shows the whole object small."""
 
@@ -17,7 +18,8 @@ def report(gui, tmp_path_factory):
 
 
 def test_every_panel_was_measured(report):
-    assert report["values"]["texts"]["object"] > 100 and report["values"]["texts"]["edit"] > 100
+    texts = report["values"]["texts"]
+    assert texts["object"] > 100 and texts["edit"] > 100 and texts["options"] > texts["object"] + 5, texts
     # Blender's default sidebar, less its tab column and the panel margins
     assert 150 < report["values"]["content_width"] < 260, report["values"]
 

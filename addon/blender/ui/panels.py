@@ -75,11 +75,14 @@ def _estimate_text(context, settings) -> str:
 
 def draw_bake(layout, settings) -> None:
     """The Bake Normals option and, when on, its settings (the panel and the operators' redo panels)."""
-    layout.prop(settings, "bake_normals")
+    row = layout.row()  # the checkbox's name beside it over the full width: the value column cuts it
+    row.use_property_split = False
+    row.prop(settings, "bake_normals")
     if settings.bake_normals:
         col = layout.column(align=True)
-        for name in ("bake_size", "bake_margin", "bake_store"):
-            col.prop(settings, name)
+        col.prop(settings, "bake_size", text="Size")  # "Resolution" does not fit the label column
+        col.prop(settings, "bake_margin")
+        col.prop(settings, "bake_store")
 
 
 class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
@@ -204,10 +207,13 @@ class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
                     row.operator("topstoc.set_guidance", text=label).level = level
         box = layout.box()
         box.prop(s, "use_vertex_group")
-        if s.use_vertex_group:
-            box.prop_search(s, "vertex_group", obj, "vertex_groups")
-            box.prop(s, "vertex_group_mapping")
-            box.prop(s, "vertex_group_strength")
+        if s.use_vertex_group:  # a label column: beside its field a name gets a third and is cut
+            col = box.column()
+            col.use_property_split = True
+            col.use_property_decorate = False
+            col.prop_search(s, "vertex_group", obj, "vertex_groups")
+            col.prop(s, "vertex_group_mapping")
+            col.prop(s, "vertex_group_strength")
         box = layout.box()
         box.prop(s, "use_materials")
         if s.use_materials and obj.material_slots:
@@ -226,7 +232,10 @@ class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
         box = layout.box()
         box.prop(scene, "use_view")
         if scene.use_view:
-            box.prop(scene, "view_source")
+            col = box.column()
+            col.use_property_split = True  # as the vertex group's settings
+            col.use_property_decorate = False
+            col.prop(scene, "view_source")
             box.prop(scene, "back_ratio")
             box.prop(scene, "silhouette_angle")
             box.prop(scene, "silhouette_falloff")

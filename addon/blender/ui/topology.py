@@ -207,7 +207,8 @@ class TOPSTOC_PT_topology_edit(_Panel, bpy.types.Panel):
         col.operator("topstoc.fill_holes", text="Fill Selected Holes", icon="MOD_SOLIDIFY").mode = "SELECTED"
         col.operator("topstoc.fill_holes", text="Fill All Holes", icon="MOD_SOLIDIFY").mode = "ALL"
         col.operator("topstoc.delete_faces", icon="TRASH")
-        layout.operator("topstoc.clean", text="Clean Up Small Handles and Holes", icon="MOD_SMOOTH")
+        # the full name, "... Small Handles and Holes", does not fit the sidebar (the tooltip says it)
+        layout.operator("topstoc.clean", text="Clean Up Small Flaws", icon="MOD_SMOOTH")
 
 
 class TOPSTOC_PT_topology_overlays(_Panel, bpy.types.Panel):
