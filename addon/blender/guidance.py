@@ -124,18 +124,27 @@ def _read_borders(obj, settings, arrays: mesh_io.MeshArrays) -> Callable[[list],
     return borders
 
 
+def guidance_layers(obj) -> tuple:
+    """Names of the colour layers that hold guidance paint, not the asset's look."""
+    return _guidance_layer_names(obj.topstoc)
+
+
+def _guidance_layer_names(settings) -> tuple:
+    return (settings.color_attribute, DEFAULT_COLOR_LAYER)
+
+
 def appearance_color(mesh, settings):
     """The colour attribute that is part of the asset's look: the active one, or the render one
     when the active one is the guidance paint layer; None if both are guidance (or there are none).
     Guidance paint (the object's painted-guidance layer, or the default layer's name) says where
     to keep detail, it is not appearance, so it never enters the cost."""
-    guidance_layers = {settings.color_attribute, DEFAULT_COLOR_LAYER}
+    guidance = _guidance_layer_names(settings)
     colors = mesh.color_attributes
     candidates = [colors.active_color]
     if 0 <= colors.render_color_index < len(colors):
         candidates.append(colors[colors.render_color_index])
     for attribute in candidates:
-        if attribute is not None and attribute.name not in guidance_layers:
+        if attribute is not None and attribute.name not in guidance:
             return attribute
     return None
 

@@ -23,7 +23,8 @@ from typing import Optional
 import bpy
 import numpy as np
 
-from ..core.attributes import MovedVertices, SparseWeights, corner_values, moved_vertices, point_values
+from ..core.attributes import (FLAT_CORNER_ANGLE, MovedVertices, SparseWeights, corner_values, moved_vertices,
+                               point_values)
 from ..core.digest import array_digest
 from ..core.edge_flags import carried_edge_flags
 from ..core import fresh_memory
@@ -603,9 +604,54 @@ def read_custom_normals(mesh) -> Optional[np.ndarray]:
     return _get(mesh.loops, "normal", len(mesh.loops), 3, np.float32)
 
 
+def _display_colors(source, out, guidance) -> None:
+    """The result's active and render colours: the source's, except that a guidance layer gives
+    way to the first other colour attribute (Blender always shows one when any exists)."""
+    colors = source.color_attributes
+    render = colors[colors.render_color_index] if 0 <= colors.render_color_index < len(colors) else None
+    others = [a for a in out.color_attributes if a.name not in guidance]
+    for attribute, setter in ((colors.active_color, "active"), (render, "render")):
+        chosen = out.color_attributes.get(attribute.name) if attribute is not None else None
+        if chosen is None or chosen.name in guidance:
+            chosen = others[0] if others else chosen
+        if chosen is None:
+            continue
+        if setter == "active":
+            out.color_attributes.active_color = chosen
+        else:
+            out.color_attributes.render_color_index = list(out.color_attributes).index(chosen)
+
+
+def flat_corners(source, normals, corner_loop) -> np.ndarray:
+    """Which output corners come from a flat-shaded input corner (its custom normal its polygon's,
+    within attributes.FLAT_CORNER_ANGLE): they take their output face's normal, so a faceted
+    asset stays faceted where the engine merged faces across edges that were not creases."""
+    count = len(source.polygons)
+    polygon_normals = _get(source.polygons, "normal", count, 3, np.float64)
+    totals = _get(source.polygons, "loop_total", count, 1, np.int64).ravel()
+    starts = _get(source.polygons, "loop_start", count, 1, np.int64).ravel()
+    order = np.argsort(starts, kind="stable")  # a polygon's loops are consecutive, polygons tile the loops
+    loop_polygon = np.repeat(order, totals[order])
+    cosine = (normals[corner_loop] * polygon_normals[loop_polygon[corner_loop]]).sum(axis=1)
+    return cosine >= np.cos(np.radians(FLAT_CORNER_ANGLE))
+
+
+def face_normals(vertices, triangles) -> np.ndarray:
+    """(m, 3) unit normals of triangles (zero for degenerate ones)."""
+    p = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles, dtype=np.int64)]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    return n / np.where(length > 0, length, 1.0)
+
+
 def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: str,
-                      moved: Optional[MovedVertices] = None) -> bpy.types.Mesh:
+                      moved: Optional[MovedVertices] = None, guidance: tuple = (), keep_guidance: bool = True
+                      ) -> bpy.types.Mesh:
     """A new mesh datablock holding ``result`` with the source's attributes carried over.
+
+    ``guidance``: the names of the guidance paint layers. They are never the result's active or
+    render colour (an exported LOD would show the paint), and not carried at all unless
+    ``keep_guidance`` (an object decimated in place keeps its paint; a new result does not need it).
 
     Points take the attributes of their kept input vertex, faces those of their source
     polygon, corners those of the input loop ``corner_source`` names. Vertices the quality mode
@@ -650,7 +696,7 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
     for attribute in source.attributes:
         name_ = attribute.name
         if (name_.startswith(".") or name_ in _SKIPPED_ATTRIBUTES or name_ in uv_names
-                or attribute.domain not in ("POINT", "FACE", "CORNER")):
+                or attribute.domain not in ("POINT", "FACE", "CORNER") or (name_ in guidance and not keep_guidance)):
             continue
         count = _domain_size(source, attribute.domain)
         read = read_attribute(attribute, count)
@@ -661,13 +707,7 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
         picked = carried(values, attribute.domain, nearest=attribute.data_type not in _INTERPOLATED)
         if len(picked):
             target.data.foreach_set(key, np.ascontiguousarray(picked).ravel())
-    colors = source.color_attributes
-    if colors.active_color is not None and out.color_attributes.get(colors.active_color.name) is not None:
-        out.color_attributes.active_color = out.color_attributes[colors.active_color.name]
-    if 0 <= colors.render_color_index < len(colors):
-        render = out.color_attributes.get(colors[colors.render_color_index].name)
-        if render is not None:
-            out.color_attributes.render_color_index = list(out.color_attributes).index(render)
+    _display_colors(source, out, guidance)
     carry_edge_flags(source, out, kept, moved.face >= 0)
 
     normals = read_custom_normals(source)
@@ -679,6 +719,8 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
         mixed = moved.face[np.asarray(result.triangles).ravel()] >= 0  # interpolated: unit length again
         length = np.linalg.norm(corner_normals[mixed], axis=1, keepdims=True)
         corner_normals[mixed] = corner_normals[mixed] / np.where(length > 0, length, 1)
+        flat = flat_corners(source, normals, corner_loop)
+        corner_normals[flat] = np.repeat(face_normals(result.vertices, result.triangles), 3, axis=0)[flat]
         out.normals_split_custom_set(corner_normals)
     out.update()
     return out

@@ -140,6 +140,17 @@ def error_scale(obj, percent: float) -> float:
     return settings.backward_max
 
 
+def shared_error_percent(objects, percent: float) -> float:
+    """The error shown red, in % of each original's diagonal, for objects shown together, so that
+    one colour means one error on all of them and one legend holds: ``percent``, or (0) the
+    largest error measured on any of them (0 when none is measured)."""
+    if percent > 0:
+        return percent
+    largest = [100.0 * o.topstoc.metrics.backward_max / o.topstoc.metrics.diagonal for o in objects
+               if o.type == "MESH" and o.topstoc.metrics.state == "OK" and o.topstoc.metrics.diagonal > 0]
+    return max(largest, default=0.0)
+
+
 def write_error_colors(obj, percent: float = 0.0) -> bpy.types.Attribute:
     """Writes the per-face errors as a face-corner colour attribute (``ERROR_ATTRIBUTE``).
 

@@ -80,6 +80,9 @@ def topology_primitives(obj, show) -> list:
             continue
         if index == topology.loop_index:
             out.append(Primitive("active_loop", LINES, co[loop_segments(ids)], color[loop.kind], size="active"))
+            # its corners as dots of the same width: a loop of a few short edges stays visible when
+            # zoomed out, as a dot at least (Frame Loop then shows it whole)
+            out.append(Primitive("active_loop_points", POINTS, co[ids], color[loop.kind], size="active"))
         elif loop.kind in segments:
             segments[loop.kind].append(loop_segments(ids))
     for kind, name in (("HANDLE", "handles"), ("TUNNEL", "tunnels")):
@@ -108,15 +111,17 @@ def _corner_positions(obj):
     return arrays, arrays.vertices.astype(np.float32)[arrays.triangles.reshape(-1)]
 
 
-def error_primitives(obj, show) -> list:
-    """Per-face Hausdorff error colours with the overlay's scale (decimated objects)."""
+def error_primitives(obj, show, percent: float = None) -> list:
+    """Per-face Hausdorff error colours, red at ``percent`` of the original's diagonal (default:
+    the overlay's scale; the overlays pass metrics.shared_error_percent of the objects shown)."""
     if obj.type != "MESH" or not show.show_error or not metrics.is_current(obj):
         return []
     errors = metrics.face_errors(obj)
     if errors is None:
         return []
     arrays, corners = _corner_positions(obj)
-    face_colors = colors.error_colors(errors, metrics.error_scale(obj, show.error_scale))
+    percent = show.error_scale if percent is None else percent
+    face_colors = colors.error_colors(errors, metrics.error_scale(obj, percent))
     return [Primitive("error", TRIS, corners, colors=np.repeat(face_colors, 3, axis=0))]
 
 
@@ -175,7 +180,7 @@ def decimation_primitives(obj, show, context=None) -> list:
     return out
 
 
-def object_primitives(obj, show, context=None) -> list:
+def object_primitives(obj, show, context=None, error_percent: float = None) -> list:
     """Everything the overlays draw for one object, in draw order (faces first)."""
-    return (decimation_primitives(obj, show, context) + error_primitives(obj, show)
+    return (decimation_primitives(obj, show, context) + error_primitives(obj, show, error_percent)
             + topology_primitives(obj, show))

@@ -49,7 +49,7 @@ def _shader(kind: str):
     return shader
 
 
-def _signature(obj, show) -> tuple:
+def _signature(obj, show, error_percent: float) -> tuple:
     topology, metrics = obj.topstoc.topology, obj.topstoc.metrics
     last = obj.topstoc.sample_sets.get("Last")
     return (watch.epoch(obj), obj.data.name_full, obj.mode, topology.state, topology.revision,
@@ -57,18 +57,25 @@ def _signature(obj, show) -> tuple:
             (last.parameters, last.vertices_out) if last is not None else None,
             show.show_handles, show.show_tunnels, show.show_generators, show.show_boundary,
             show.show_nonmanifold, show.show_samples, show.show_clusters, show.show_error,
-            round(show.error_scale, 6))
+            round(show.error_scale, 6), round(error_percent, 9))
 
 
-def _batches_of(obj, show, context):
+def _error_percent(context, show) -> float:
+    """One error scale for every object shown (metrics.shared_error_percent)."""
+    from . import metrics
+
+    return metrics.shared_error_percent(context.visible_objects, show.error_scale) if show.show_error else 0.0
+
+
+def _batches_of(obj, show, context, error_percent: float):
     from gpu_extras.batch import batch_for_shader
 
-    signature = _signature(obj, show)
+    signature = _signature(obj, show, error_percent)
     cached = _batches.get(obj.name_full)
     if cached is not None and cached[0] == signature:
         return cached[1]
     built = []
-    for primitive in overlay_data.object_primitives(obj, show, context):
+    for primitive in overlay_data.object_primitives(obj, show, context, error_percent):
         if not len(primitive):
             continue
         shader = _shader(primitive.kind)
@@ -106,11 +113,12 @@ def _draw_view():
     gpu.state.blend_set("ALPHA")
     gpu.matrix.push_projection()
     gpu.matrix.load_projection_matrix(_biased_projection(gpu.matrix.get_projection_matrix()))
+    error_percent = _error_percent(context, show)
     try:
         for obj in context.visible_objects:
             if obj.type != "MESH" or obj.data is None:
                 continue
-            batches = _batches_of(obj, show, context)
+            batches = _batches_of(obj, show, context, error_percent)
             if not batches:
                 continue
             with gpu.matrix.push_pop():
@@ -162,7 +170,7 @@ def _draw_legend():
     from . import metrics
 
     show = context.scene.topstoc.overlays
-    scale = metrics.error_scale(obj, show.error_scale)
+    scale = metrics.error_scale(obj, _error_percent(context, show))  # the scale every object shown uses
     x0, y0 = LEGEND_MARGIN, LEGEND_MARGIN + 30
     steps = 32
     positions, corner_colors = [], []

@@ -28,7 +28,7 @@ from ..core.errors import TopStocError
 from ..core.job import ATTRIBUTE_WEIGHT, DecimationJob, make_job
 from . import carry, mesh_io
 from .cache import Prepared, prepared_meshes
-from .guidance import EngineGuidance, gather
+from .guidance import EngineGuidance, gather, guidance_layers
 
 LAST_SAMPLES = "Last"
 
@@ -232,7 +232,8 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
     if mode == "IN_PLACE" or into is not None:
         target = obj if into is None else into
         old = target.data
-        mesh = mesh_io.build_result_mesh(obj.data, arrays, run.result, old.name + "_TopStoc", moved)
+        mesh = mesh_io.build_result_mesh(obj.data, arrays, run.result, old.name + "_TopStoc", moved,
+                                         guidance_layers(obj), keep_guidance=into is None)
         if into is not None:  # the result's own material choices win over the source's
             mesh.materials.clear()
             for material in old.materials:
@@ -245,7 +246,8 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
         mesh.name = old_name
     else:
         name = name or f"{obj.name}_TopStoc"
-        mesh = mesh_io.build_result_mesh(obj.data, arrays, run.result, name, moved)
+        mesh = mesh_io.build_result_mesh(obj.data, arrays, run.result, name, moved, guidance_layers(obj),
+                                         keep_guidance=False)
         carry.copy_custom_properties(obj.data, mesh)
         target = bpy.data.objects.new(name, mesh)
         carry.link_like(obj, target, bpy.context.scene)

@@ -17,15 +17,16 @@ MAX_MATERIAL_SLOTS = 32
 DEFAULT_COLOR_LAYER = "TopStoc Guidance"
 
 TARGET_MODES = [
-    ("RATIO", "Ratio", "Fraction of the vertices to keep"),
+    ("RATIO", "Vertex Ratio", "Keep this fraction of the vertices (on a closed mesh about the same fraction of "
+                              "the faces; Blender's Decimate counts faces)"),
     ("VERTICES", "Vertices", "Number of output vertices"),
     ("TRIANGLES", "Triangles", "Number of output triangles"),
     ("MAX_ERROR", "Max Deviation", "Largest allowed Hausdorff deviation from the original"),
 ]
 DENSITY_MODES = [
-    ("off", "Off", "No density control"),
-    ("uniform", "Uniform", "Reject samples closer than a ring distance to another sample"),
-    ("adaptive", "Adaptive", "Larger spacing where the surface is flat (thesis 4.1.2)"),
+    ("off", "Free", "Kept vertices may lie close together"),
+    ("uniform", "Even", "Kept vertices stay at least one edge ring apart: more even triangles"),
+    ("adaptive", "By Detail", "Kept vertices lie further apart where the surface is flat (thesis 4.1.2)"),
 ]
 OUTPUT_MODES = [
     ("NEW_OBJECT", "New Object", "Put the result in a new object beside the original (offset along X by its "
@@ -36,8 +37,9 @@ SYMMETRY_AXES = [("X", "X", "Mirror across the object's local YZ plane"),
                  ("Y", "Y", "Mirror across the object's local XZ plane"),
                  ("Z", "Z", "Mirror across the object's local XY plane")]
 PLACEMENTS = [
-    ("subsample", "Subsample", "Output vertices are input vertices (attributes copy exactly)"),
-    ("filtered", "Filtered", "Move vertices to the quadric-optimal point of their cluster"),
+    ("subsample", "Original", "Every vertex of the result is a vertex of the original: UVs, colours and "
+                              "weights copy exactly"),
+    ("filtered", "Best Fit", "Vertices move to the point that keeps the shape best (quadric error)"),
 ]
 QUALITY_MODES = [
     ("QUALITY", "Quality", "TopStoc to a few times the target, then edge collapses by quadric error: the "
@@ -52,7 +54,7 @@ class DecimationParameters:
     """Decimation parameters shared by the operators and the scene defaults (a mixin)."""
 
     target_mode: EnumProperty(name="Target", items=TARGET_MODES, default="RATIO")
-    ratio: FloatProperty(name="Ratio", description="Fraction of the vertices to keep",
+    ratio: FloatProperty(name="Keep", description="Fraction of the vertices to keep (0.1: one in ten)",
                          default=0.1, min=1e-6, max=1.0, soft_min=0.001, precision=4,
                          subtype="FACTOR")
     vertices: IntProperty(name="Vertices", description="Number of output vertices", default=1000, min=1)
@@ -70,16 +72,18 @@ class DecimationParameters:
     symmetry_axis: EnumProperty(name="Axis", items=SYMMETRY_AXES, default="X",
                                 description="Local axis across which the mesh mirrors")
     seed: IntProperty(name="Seed", description="The same seed gives the same result", default=0, min=0)
-    adaptivity: FloatProperty(name="Adaptivity", description="0 samples uniformly, 1 follows curvature fully",
+    adaptivity: FloatProperty(name="Curvature",
+                              description="How much more detail curved parts keep than flat ones: 0 spreads the "
+                                          "vertices evenly, 1 puts them where the surface bends",
                               default=0.5, min=0.0, max=1.0, subtype="FACTOR")
-    density: EnumProperty(name="Density", items=DENSITY_MODES, default="off",
-                          description="Density control: keep samples apart (Poisson-disk rejection)")
-    placement: EnumProperty(name="Placement", items=PLACEMENTS, default="subsample",
-                            description="Where output vertices go (used when Quality is Custom)")
-    refine: IntProperty(name="Refine", default=0, min=0, max=32,
-                        description="Fast mode only. 0: off (plain TopStoc, fastest). N: TopStoc keeps N times "
-                                    "the target, then edge collapses by quadric error thin it (Quality mode "
-                                    "does this with its own settings)")
+    density: EnumProperty(name="Spacing", items=DENSITY_MODES, default="off",
+                          description="How far apart the kept vertices must be (Poisson-disk rejection)")
+    placement: EnumProperty(name="Position", items=PLACEMENTS, default="subsample",
+                            description="Where the result's vertices go (when Quality is Custom)")
+    refine: IntProperty(name="Clean-Up", default=0, min=0, max=32,
+                        description="When Quality is Custom. 0: off (fastest). N: first keep N times the target, "
+                                    "then remove the vertices whose loss changes the shape least (quadric edge "
+                                    "collapses): slower, closer to the original")
     attribute_weight: FloatProperty(
         name="Appearance", default=ATTRIBUTE_WEIGHT, min=0.0, soft_max=1.0, precision=3,
         description="How much Quality mode protects the look: the active UV map, the colour attribute "
@@ -179,9 +183,9 @@ class TOPSTOC_PG_object(bpy.types.PropertyGroup):
     vertex_group: StringProperty(name="Group", description="Vertex group giving guidance")
     vertex_group_mapping: EnumProperty(
         name="Mapping", default="DETAIL",
-        items=[("DETAIL", "Weight = Detail", "u = w: weight 1 keeps every vertex, 0 is neutral"),
+        items=[("DETAIL", "Detail", "Weight = detail, u = w: weight 1 keeps every vertex, 0 is neutral"),
                ("SIGNED", "Signed", "u = 2w - 1: 1 keeps, 0.5 neutral, 0 drops"),
-               ("DECIMATE", "Blender Decimate", "u = 1 - w: weight 0 locks (as Blender's Decimate), 1 neutral")])
+               ("DECIMATE", "Inverse", "u = 1 - w: weight 0 locks, 1 neutral (as Blender's Decimate modifier)")])
     vertex_group_strength: FloatProperty(name="Strength", default=1.0, min=0.0, max=1.0, subtype="FACTOR")
 
     use_color: BoolProperty(name="Painted Guidance",
@@ -232,7 +236,7 @@ class TOPSTOC_PG_scene(DecimationParameters, BakeParameters, bpy.types.PropertyG
 
     use_view: BoolProperty(name="View-Dependent", description="Fewer vertices on back faces, keep silhouettes")
     view_source: EnumProperty(name="View", default="CAMERA",
-                              items=[("CAMERA", "Scene Camera", "The scene's active camera"),
+                              items=[("CAMERA", "Camera", "The scene's active camera"),
                                      ("VIEWPORT", "Viewport", "The current 3D viewport view")])
     back_ratio: FloatProperty(name="Back-Face Ratio", default=0.25, min=0.0, max=1.0, subtype="FACTOR")
     silhouette_angle: FloatProperty(name="Silhouette Band", default=math.radians(20.0), min=0.0,
@@ -246,7 +250,7 @@ class TOPSTOC_PG_scene(DecimationParameters, BakeParameters, bpy.types.PropertyG
     variance: FloatProperty(name="Variance", description="± change of the target across the variants",
                             default=0.25, min=0.0, max=0.95, subtype="FACTOR")
     lod_ratios: StringProperty(name="LOD Ratios", default="1.0, 0.5, 0.25, 0.1",
-                               description="Comma-separated ratios, LOD0 first")
+                               description="Vertex ratios, comma-separated, LOD0 (the finest) first")
 
     overlays: PointerProperty(type=TOPSTOC_PG_overlays)
 

@@ -140,16 +140,16 @@ class TOPSTOC_PG_overlays(bpy.types.PropertyGroup):
                                 description="Draw the vertices on boundary loops (red)")
     show_nonmanifold: BoolProperty(name="Non-Manifold", default=True, update=_redraw,
                                    description="Draw non-manifold edges and vertices (orange)")
-    show_samples: BoolProperty(name="Samples", default=False, update=_redraw,
+    show_samples: BoolProperty(name="Show Kept Vertices", default=False, update=_redraw,
                                description="Draw the sampled vertices of the last decimation (blue)")
-    show_clusters: BoolProperty(name="Cluster Regions", default=False, update=_redraw,
+    show_clusters: BoolProperty(name="Show Regions", default=False, update=_redraw,
                                 description="Colour the original by the clusters of the last decimation "
                                             "(red: faces that became output triangles)")
     show_error: BoolProperty(name="Error Colours", default=False, update=_redraw,
                              description="Colour the decimated mesh by its Hausdorff error per face")
-    error_scale: FloatProperty(name="Scale", default=0.0, min=0.0, soft_max=5.0, precision=3, update=_redraw,
-                               description="Error (in % of the original's diagonal) shown red; 0 = the largest "
-                                           "error measured")
+    error_scale: FloatProperty(name="Red At", default=0.0, min=0.0, soft_max=5.0, precision=3, update=_redraw,
+                               description="The error shown red, in % of the original's diagonal; 0: the "
+                                           "largest error measured")
     line_width: FloatProperty(name="Line Width", default=3.0, min=1.0, max=20.0, update=_redraw)
     active_width: FloatProperty(name="Active Loop Width", default=7.0, min=1.0, max=30.0, update=_redraw)
     point_size: FloatProperty(name="Point Size", default=5.0, min=1.0, max=30.0, update=_redraw)

@@ -38,7 +38,12 @@ def uv_seam_edges(triangles, corner_uvs) -> np.ndarray:
     return _seam_edges(triangles, np.asarray(corner_uvs, dtype=np.float64).reshape(-1, 3, 2), differ)
 
 
-HARD_NORMAL_ANGLE = 1.0  # degrees: corner normals further apart than this at a vertex make a hard edge
+#: Degrees: corner normals further apart than this at a vertex make a hard edge. As Blender's auto
+#: smooth (30°): a flat-shaded asset, whose custom normals differ at every edge, breaks its shading
+#: only at its creases; at 1° every edge was a border and such an asset could not be decimated.
+HARD_NORMAL_ANGLE = 30.0
+#: Degrees: a corner whose custom normal is this close to its face's normal is flat shaded.
+FLAT_CORNER_ANGLE = 1.0
 
 
 def hard_normal_edges(triangles, corner_normals, angle: float = HARD_NORMAL_ANGLE) -> np.ndarray:

@@ -78,6 +78,9 @@ def steps():
           and not bpy.data.objects["Torus"].hide_get())
     check("ratio stored in the panel", abs(bpy.context.scene.topstoc.ratio - 0.2) < 0.005)
     check("no modal timer left after Enter", not operators.running)
+    selected = [o.name for o in bpy.context.view_layer.objects if o.select_get()]
+    check("the result selected and active after Enter (Guided Decimate usable)", out is not None
+          and selected == [out.name] and bpy.context.view_layer.objects.active == out, str(selected))
     # 4: a second preview cancelled with Esc leaves nothing behind
     bpy.data.objects["Torus_TopStoc"].select_set(False)
     bpy.context.view_layer.objects.active = bpy.data.objects["Torus"]

@@ -148,3 +148,25 @@ def test_regenerate_keeps_the_weight_a_result_ran_with(ts, scene):
     np.testing.assert_array_equal(positions(kept.data), first[kept.name])
     np.testing.assert_array_equal(positions(off.data), first[off.name])
     np.testing.assert_array_equal(positions(legacy.data), first[off.name])
+
+
+def test_guidance_paint_is_never_the_results_display_colour(ts, scene):
+    """Issue 38: the guidance layer, active for painting, became the result's active and render
+    colour, so an exported LOD showed the orange paint. A new result does not carry it (the source
+    keeps it, Regenerate reads it there); another colour attribute is shown instead."""
+    obj = cylinder("Painted", uv_maps=())
+    paint(obj, "Tint")
+    paint(obj, "TopStoc Guidance")  # painted last: the active one, as after painting
+    colors = obj.data.color_attributes
+    colors.render_color_index = list(colors).index(colors["TopStoc Guidance"])
+    assert colors.active_color.name == "TopStoc Guidance"
+    out = decimate(obj).data.color_attributes
+    assert [a.name for a in out] == ["Tint"]
+    assert out.active_color.name == "Tint" and out[out.render_color_index].name == "Tint"
+    assert "TopStoc Guidance" in obj.data.color_attributes  # the source keeps its paint
+    # in place, the object keeps its paint, but shows its own colours
+    select_only(obj)
+    assert bpy.ops.topstoc.guided_decimate(target_mode="VERTICES", vertices=TARGET, output="IN_PLACE") == {"FINISHED"}
+    colors = obj.data.color_attributes
+    assert {a.name for a in colors} == {"Tint", "TopStoc Guidance"}
+    assert colors.active_color.name == "Tint" and colors[colors.render_color_index].name == "Tint"

@@ -103,3 +103,44 @@ def test_custom_normals_without_auto_smooth_are_not_used(ts, scene):
     assert not out.data.has_custom_normals and not out.data.use_auto_smooth  # the look it had
     plain = decimate(cylinder("Plain", custom=False))
     np.testing.assert_array_equal(positions(out.data), positions(plain.data))
+
+
+def flat_shaded_fbx_suzanne(tmp_path):
+    """Suzanne subdivided twice (7,958 vertices), shaded flat, exported to FBX and imported back:
+    its custom normals split at every edge, as a faceted asset from another tool has them."""
+    bpy.ops.mesh.primitive_monkey_add()
+    obj = bpy.context.active_object
+    modifier = obj.modifiers.new("Subdivision", "SUBSURF")
+    modifier.levels = 2
+    bpy.ops.object.modifier_apply(modifier=modifier.name)
+    bpy.ops.object.shade_flat()
+    path = str(tmp_path / "suzanne.fbx")
+    assert bpy.ops.export_scene.fbx(filepath=path, use_selection=True) == {"FINISHED"}
+    bpy.data.objects.remove(obj)
+    assert bpy.ops.import_scene.fbx(filepath=path) == {"FINISHED"}
+    return bpy.context.selected_objects[0]
+
+
+def test_a_flat_shaded_fbx_asset_decimates_to_its_target(ts, scene, tmp_path):
+    """Issue 37: with hard edges at 1° every edge was a border (7,643 vertices for a 1,592 target).
+    At Blender's auto smooth angle (30°) only the creases are; the result stays faceted: each
+    corner's normal is its own face's."""
+    obj = flat_shaded_fbx_suzanne(tmp_path)
+    mesh = obj.data
+    normals = ts.blender.mesh_io.read_custom_normals(mesh)
+    assert len(mesh.vertices) == 7958 and normals is not None
+    assert len(np.unique(np.round(normals, 3), axis=0)) > len(mesh.vertices)  # split at every edge
+    select_only(obj)
+    target = round(0.2 * len(mesh.vertices))
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.2) == {"FINISHED"}
+    out = bpy.context.active_object
+    assert out is not obj and obj.topstoc.use_hard_normals
+    assert abs(len(out.data.vertices) - target) <= 0.01 * target, (len(out.data.vertices), target)
+    out_normals = ts.blender.mesh_io.read_custom_normals(out.data).astype(np.float64)
+    faces = np.array([p.vertices[:] for p in out.data.polygons])
+    p = positions(out.data)[faces]
+    face = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    face /= np.linalg.norm(face, axis=1, keepdims=True)
+    cosine = (out_normals.reshape(-1, 3, 3) * face[:, None, :]).sum(axis=2)
+    assert np.degrees(np.arccos(np.clip(cosine, -1, 1))).max() < 1.0  # faceted, as the input
+    print(f"flat-shaded FBX Suzanne: {len(out.data.vertices)} vertices for a target of {target}")

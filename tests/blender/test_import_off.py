@@ -63,3 +63,13 @@ def test_an_empty_file_is_refused_by_name(ts, scene, tmp_path):
     with pytest.raises(RuntimeError, match="empty.off: the mesh has no triangles"):
         bpy.ops.topstoc.import_off(filepath=str(path))
     assert len(bpy.data.objects) == 0
+
+
+def test_nothing_is_selected_after_import(ts, scene):
+    """As Blender's own importers: an invisible selection would be what Edit Mode's tools act on."""
+    assert bpy.ops.topstoc.import_off(filepath=str(DATA / "genus0" / "cgal_fandisk.off")) == {"FINISHED"}
+    mesh = bpy.context.active_object.data
+    for items in (mesh.vertices, mesh.edges, mesh.polygons):
+        flags = np.ones(len(items), dtype=bool)
+        items.foreach_get("select", flags)
+        assert len(items) > 0 and not flags.any()

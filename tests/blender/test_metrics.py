@@ -244,3 +244,42 @@ def test_metrics_panels_draw_measured_and_failed_states(mods, decimated):
             cls.draw(fake, bpy.context)
     assert {"topstoc.measure", "topstoc.write_error_colors", "topstoc.turntable", "reference", "samples",
             "show_error", "error_scale"} <= seen
+
+
+def test_objects_shown_together_share_one_error_scale(mods, decimated):
+    """Issue 38: each object was coloured on its own scale (red at its own largest error) under one
+    legend. Two results of one original, at 12 % and 40 %: one scale, the larger error's, for both;
+    the colour attribute written uses it too."""
+    original, coarse = decimated
+    assert bpy.ops.topstoc.measure() == {"FINISHED"}
+    select_only(original)
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.4, seed=4, quality="FAST") == {"FINISHED"}
+    fine = bpy.context.active_object
+    fine.topstoc.metrics.samples = 20000
+    assert bpy.ops.topstoc.measure() == {"FINISHED"}
+    show = bpy.context.scene.topstoc.overlays
+    show.show_error, show.error_scale = True, 0.0
+    m_coarse, m_fine = coarse.topstoc.metrics, fine.topstoc.metrics
+    assert m_coarse.backward_max > 1.5 * m_fine.backward_max and m_coarse.diagonal == pytest.approx(m_fine.diagonal)
+    shared = mods.metrics.shared_error_percent([original, coarse, fine], 0.0)
+    assert shared == pytest.approx(100 * m_coarse.backward_max / m_coarse.diagonal)
+    (primitive,) = mods.overlay_data.error_primitives(fine, show, shared)
+    red_at = m_coarse.backward_max * m_fine.diagonal / m_coarse.diagonal
+    expected = mods.colors.error_colors(mods.metrics.face_errors(fine), red_at)
+    np.testing.assert_allclose(primitive.colors[::3], expected, atol=1e-5)
+    own = mods.colors.error_colors(mods.metrics.face_errors(fine), m_fine.backward_max)
+    assert not np.allclose(primitive.colors[::3], own, atol=1e-3)  # not its own scale
+    assert mods.metrics.shared_error_percent([coarse, fine], 2.5) == 2.5  # a scale set by the user holds
+    select_only(fine)
+    assert bpy.ops.topstoc.write_error_colors() == {"FINISHED"}
+    mesh = fine.data
+    written = np.empty(4 * len(mesh.loops), dtype=np.float32)
+    mesh.color_attributes["TopStoc Error"].data.foreach_get("color", written)
+    first_loop = np.array([p.loop_start for p in mesh.polygons])
+    fine_errors = mods.metrics.face_errors(fine)
+    mesh.calc_loop_triangles()
+    polygon_error = np.zeros(len(mesh.polygons))
+    np.maximum.at(polygon_error, [t.polygon_index for t in mesh.loop_triangles], fine_errors)
+    srgb = mods.colors.error_colors(polygon_error, red_at)
+    linear = written.reshape(-1, 4)[first_loop]
+    np.testing.assert_allclose(linear[:, :3], mods.metrics.srgb_to_linear(srgb[:, :3]), atol=1e-4)

@@ -11,4 +11,4 @@ def test_preview_modal_drag_apply_cancel(ts):
     done = windowed(script, "--enable-event-simulate", env=clean_environment(TOPSTOC_BUILD_PYTHON=BUILD / "python"))
     lines = [line for line in done.stdout.splitlines() if line.startswith("preview check")]
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
-    assert len(lines) == 27 and all(line.endswith(": ok") for line in lines), lines
+    assert len(lines) == 28 and all(line.endswith(": ok") for line in lines), lines

@@ -14,7 +14,7 @@ from helpers import make_object
 OPERATORS = ("guided_decimate", "preview", "set_guidance", "add_guidance_layer", "show_guidance", "add_box",
              "multiview", "lod_chain", "save_samples", "restore_samples", "remove_samples",
              "measure", "write_error_colors", "turntable", "analyse", "find_loops", "loop_step", "select_loop",
-             "cut_loop", "remove_loop", "fill_holes", "delete_faces", "clean")
+             "cut_loop", "remove_loop", "fill_holes", "delete_faces", "clean", "frame_loop")
 PANEL_MODULES = ("panels", "topology", "metrics")
 
 

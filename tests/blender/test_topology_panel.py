@@ -3,6 +3,7 @@ implementation (tests/reference.py), loops found and stepped through, select / c
 fill / delete with the invariants updated and attributes kept, undo restoring the mesh and its
 analysis, bad input reported without a trace, and the overlays' arrays."""
 
+import contextlib
 import importlib
 
 import bpy
@@ -200,30 +201,66 @@ def test_fill_selected_all_and_delete_faces(mods, scene):
     assert holes >= 2
     mesh = obj.data
     before = len(mesh.polygons)
-    mesh.vertices.foreach_set("select", np.zeros(len(mesh.vertices), dtype=bool))
-    with pytest.raises(RuntimeError, match="no hole has a selected boundary edge"):
+    mesh.vertices.foreach_set("select", np.ones(len(mesh.vertices), dtype=bool))
+    with pytest.raises(RuntimeError, match="Edit Mode"):  # Object Mode: the selection is not shown
+        bpy.ops.topstoc.fill_holes(mode="SELECTED")
+    assert t.boundary_loops == holes
+    for items in (mesh.vertices, mesh.edges, mesh.polygons):  # Edit Mode flushes edges' to vertices
+        items.foreach_set("select", np.zeros(len(items), dtype=bool))
+    with in_edit_mode(), pytest.raises(RuntimeError, match="no hole has a selected boundary edge"):
         bpy.ops.topstoc.fill_holes(mode="SELECTED")
     assert len(obj.data.polygons) == before and t.boundary_loops == holes       # nothing lost
     assert t.edit_state == "ERROR" and "no hole has a selected boundary edge" in t.edit_message  # in the panel
     first = mods.analysis.loop_vertices([loop for loop in t.loops if loop.kind == "BOUNDARY"][0])
     mesh = obj.data
     mesh.vertices.foreach_set("select", np.isin(np.arange(len(mesh.vertices)), first[:2]))
-    assert bpy.ops.topstoc.fill_holes(mode="SELECTED") == {"FINISHED"}
+    with in_edit_mode():
+        assert bpy.ops.topstoc.fill_holes(mode="SELECTED") == {"FINISHED"}
     assert t.boundary_loops == holes - 1
     assert_matches_reference(obj)
     assert bpy.ops.topstoc.fill_holes(mode="ALL") == {"FINISHED"}
     assert t.boundary_loops == 0 and all(c.closed for c in t.components)
     assert_matches_reference(obj)
     mesh = obj.data
-    mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), dtype=bool))
-    with pytest.raises(RuntimeError, match="no faces are selected"):
+    for items in (mesh.vertices, mesh.edges, mesh.polygons):
+        items.foreach_set("select", np.zeros(len(items), dtype=bool))
+    with in_edit_mode(), pytest.raises(RuntimeError, match="no faces are selected"):
         bpy.ops.topstoc.delete_faces()
     count = len(obj.data.polygons)
-    mesh.polygons[10].select = True
-    assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
+    bpy.context.tool_settings.mesh_select_mode = (False, False, True)
+    obj.data.polygons[10].select = True
+    with in_edit_mode():
+        assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
     assert len(obj.data.polygons) == count - 1 and t.boundary_loops == 1
     assert_matches_reference(obj)
     assert t.genus == 3
+
+
+@contextlib.contextmanager
+def in_edit_mode():
+    """Edit Mode around a block (the selection set in Object Mode carries in and out)."""
+    bpy.ops.object.mode_set(mode="EDIT")
+    try:
+        yield
+    finally:
+        bpy.ops.object.mode_set(mode="OBJECT")
+
+
+def test_delete_faces_refuses_object_mode_and_an_empty_mesh_is_called_empty(mods, scene):
+    """Object Mode hides the selection (after an import it may be every face): Delete Selected
+    Faces acts only on what Edit Mode shows; a mesh with no faces is not "ready to print"."""
+    obj = load("Eight", "genus_positive/cgal_eight.off")
+    obj.data.polygons.foreach_set("select", np.ones(len(obj.data.polygons), dtype=bool))
+    count = len(obj.data.polygons)
+    with pytest.raises(RuntimeError, match="Edit Mode"):
+        bpy.ops.topstoc.delete_faces()
+    assert len(obj.data.polygons) == count
+    with in_edit_mode():
+        assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
+    assert len(obj.data.polygons) == 0
+    assert bpy.ops.topstoc.analyse() == {"FINISHED"}
+    summary = mods.panel.plain_summary(obj.topstoc.topology)
+    assert "empty" in summary and "ready to print" not in summary
 
 
 def test_edit_mode_operators_and_quads(mods, scene):
@@ -266,18 +303,15 @@ def prepare_for(operator, obj, mods):
     if operator in ("select_loop", "cut_loop", "remove_loop"):
         t.loop_index = [loop.kind for loop in t.loops].index("HANDLE")
         return {}
-    if operator == "delete_faces":
-        mesh.polygons[7].select = True
-        return {}
-    # fill_holes: cut first (so there are holes), then select one of them
+    # fill_holes: cut first (so there are holes), then make one of them the active loop (filling
+    # the selected holes needs Edit Mode, which this Object Mode undo test does not enter)
     t.loop_index = [loop.kind for loop in t.loops].index("HANDLE")
     assert bpy.ops.topstoc.cut_loop() == {"FINISHED"}
-    hole = mods.analysis.loop_vertices([loop for loop in t.loops if loop.kind == "BOUNDARY"][0])
-    obj.data.vertices.foreach_set("select", np.isin(np.arange(len(obj.data.vertices)), hole))
-    return {"mode": "SELECTED"}
+    t.loop_index = [loop.kind for loop in t.loops].index("BOUNDARY")
+    return {"mode": "ACTIVE"}
 
 
-@pytest.mark.parametrize("operator", ["select_loop", "cut_loop", "remove_loop", "fill_holes", "delete_faces"])
+@pytest.mark.parametrize("operator", ["select_loop", "cut_loop", "remove_loop", "fill_holes"])  # delete: Edit Mode
 def test_every_operator_updates_the_invariants_and_undo_restores(mods, scene, operator):
     obj = load("Eight", "genus_positive/cgal_eight.off")
     name = obj.name
@@ -329,6 +363,46 @@ def test_nonmanifold_mesh_loop_search_reports_in_the_panel(mods, ts, scene):
     assert {p.name for p in shown} >= {"nonmanifold_edges"}
 
 
+def test_loop_view_looks_through_the_loop(ts):
+    """Frame Loop's view: centred on the loop, four radii away, along its plane's normal from the
+    viewer's side; a straight run of points keeps the view's direction."""
+    frame = importlib.import_module(f"{ts.__name__}.blender.operators.frame_loop")
+    rng = np.random.default_rng(3)
+    normal = np.array([1.0, 2.0, 2.0]) / 3.0
+    u = np.cross(normal, [0.0, 0.0, 1.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    angles = np.sort(rng.uniform(0, 2 * np.pi, 5))
+    centre = np.array([4.0, -1.0, 0.5])
+    points = centre + 0.02 * (np.cos(angles)[:, None] * u + np.sin(angles)[:, None] * v)
+    for viewer in (normal, -normal + [0.1, 0, 0]):
+        got_centre, distance, directions = frame.loop_view(points, viewer)
+        np.testing.assert_allclose(got_centre, points.mean(axis=0), atol=1e-12)
+        radius = np.linalg.norm(points - points.mean(axis=0), axis=1).max()
+        assert distance == pytest.approx(frame.RADII * radius)
+        first = directions[0]
+        assert abs(abs(first @ normal) - 1) < 1e-9 and first @ viewer > 0 and len(directions) == 7
+    line = np.outer(np.arange(4.0), [1.0, 0.0, 0.0])
+    assert len(frame.loop_view(line, normal)[2]) == 1  # a straight run: the present direction only
+
+
+def test_frame_loop_looks_from_outside(mods, scene, ts):
+    """A handle loop goes round a tube: through it (its plane's normal) the view would stand inside
+    the tube, so Frame Loop looks from a side the loop is seen from."""
+    frame = importlib.import_module(f"{ts.__name__}.blender.operators.frame_loop")
+    obj = make_object("Torus", *meshgen.torus(24, 12))
+    assert bpy.ops.topstoc.find_loops() == {"FINISHED"}
+    t = obj.topstoc.topology
+    handle = next(loop for loop in t.loops if loop.kind == "HANDLE")
+    points = positions(obj.data)[mods.analysis.loop_vertices(handle)].astype(np.float64)
+    centre, distance, directions = frame.loop_view(points, np.array([0.0, 0.0, 1.0]))
+    shares = [frame.visible_share(obj, centre + distance * d, points) for d in directions]
+    assert abs(directions[0][2]) < 1e-6  # round the tube: its plane is upright, the tube's axis level
+    print("visible shares of the handle loop per direction:", [round(x, 2) for x in shares])
+    assert shares[0] == shares[1] == 0.0  # through the tube: inside the mesh
+    assert max(shares) >= 0.4
+
+
 def test_overlay_arrays_follow_the_analysis(mods, scene):
     obj = load("Eight", "genus_positive/cgal_eight.off")
     bpy.ops.topstoc.find_loops()
@@ -340,6 +414,9 @@ def test_overlay_arrays_follow_the_analysis(mods, scene):
     active = mods.analysis.loop_vertices(t.loops[1])
     np.testing.assert_allclose(prims["active_loop"].positions.reshape(-1, 2, 3)[:, 0], co[active])
     assert prims["active_loop"].size == "active" and prims["active_loop"].color == mods.colors.HANDLE
+    # its corners as dots of the active width too: a tiny loop shows as a dot at least when zoomed out
+    np.testing.assert_allclose(prims["active_loop_points"].positions, co[active])
+    assert prims["active_loop_points"].size == "active" and prims["active_loop_points"].kind == "POINTS"
     handle_edges = sum(loop.num_edges for i, loop in enumerate(t.loops) if loop.kind == "HANDLE" and i != 1)
     assert len(prims["handles"]) == 2 * handle_edges and prims["tunnels"].color == mods.colors.TUNNEL
     assert len(prims["generators"]) == 2 * 4 and prims["generators"].color == mods.colors.GENERATOR
@@ -454,7 +531,8 @@ def test_edit_on_a_from_pydata_mesh_keeps_edge_flags(mods, scene):
     readable = "select" not in mods.mesh_edit.mesh_io.mistyped_edge_flags(mesh)
     mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), dtype=bool))
     mesh.polygons[3].select = True
-    assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
+    with in_edit_mode():
+        assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
     out = obj.data
     assert len(out.polygons) == len(faces) - 1
     assert mods.mesh_edit.mesh_io.mistyped_edge_flags(out) == {}

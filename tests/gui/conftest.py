@@ -53,10 +53,12 @@ class GuiRunner:
         assert done.returncode == 0 and path.exists(), done.stdout[-3000:] + done.stderr[-3000:]
         return path
 
-    def run(self, script: str, scene: pathlib.Path, out: pathlib.Path, *args, timeout: int = 300) -> dict:
-        """Opens ``scene`` in a windowed Blender running tests/gui/<script>; returns its report."""
+    def run(self, script: str, scene: pathlib.Path, out: pathlib.Path, *args, timeout: int = 300,
+            screen: str = "1280x1024") -> dict:
+        """Opens ``scene`` in a windowed Blender running tests/gui/<script>; returns its report.
+        ``screen``: the Xvfb screen (the window fills it)."""
         out.mkdir(parents=True, exist_ok=True)
-        command = [XVFB, "-a", "-s", "-screen 0 1280x1024x24", BLENDER, "--factory-startup",
+        command = [XVFB, "-a", "-s", f"-screen 0 {screen}x24", BLENDER, "--factory-startup",
                    "--enable-event-simulate", str(scene),
                    "--python-exit-code", "1", "--python", str(HERE / script), "--", str(out), *map(str, args)]
         done = subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=_environment(),

@@ -2,9 +2,11 @@
 
 import bpy
 
-from . import clean, decimate, explain, guidance, import_off, metrics, preview, regenerate, samples, topology, variants
+from . import (clean, decimate, explain, frame_loop, guidance, import_off, metrics, preview, regenerate, samples,
+               topology, variants)
 
-MODULES = (decimate, guidance, preview, samples, variants, regenerate, topology, metrics, import_off, explain, clean)
+MODULES = (decimate, guidance, preview, samples, variants, regenerate, topology, frame_loop, metrics, import_off,
+           explain, clean)
 
 
 def register():

@@ -13,6 +13,15 @@ from ..ui.panels import draw_bake
 from . import polls
 
 
+def select_results(context, outputs) -> None:
+    """The results selected and the first active, nothing else (the next step acts on them)."""
+    for obj in context.selected_objects:
+        obj.select_set(False)
+    for obj in outputs:
+        obj.select_set(True)
+    context.view_layer.objects.active = outputs[0]
+
+
 def selected_meshes(context):
     return [obj for obj in context.selected_objects if obj.type == "MESH"]
 
@@ -85,11 +94,7 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
         if not outputs:
             return {"CANCELLED"}
         if self.output == "NEW_OBJECT":
-            for obj in context.selected_objects:
-                obj.select_set(False)
-            for obj in outputs:
-                obj.select_set(True)
-            context.view_layer.objects.active = outputs[0]
+            select_results(context, outputs)
         for line in baked:
             self.report({"INFO"}, f"TopStoc: {line}")
         seconds = time.perf_counter() - start

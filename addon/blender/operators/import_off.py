@@ -59,7 +59,14 @@ def mesh_from_file(path: str, name: str, notes: list) -> bpy.types.Mesh:
         layer = mesh.color_attributes.new("Col", "FLOAT_COLOR", "POINT")
         layer.data.foreach_set("color", colors.ravel())
     mesh.validate()
+    deselect_all(mesh)
     return mesh
+
+
+def deselect_all(mesh) -> None:
+    """Nothing selected, as Blender's own importers leave a mesh: Edit Mode tools act on a selection."""
+    for items in (mesh.vertices, mesh.edges, mesh.polygons):
+        items.foreach_set("select", np.zeros(len(items), dtype=bool))
 
 
 class TOPSTOC_OT_import_off(bpy.types.Operator, ImportHelper):

@@ -64,7 +64,9 @@ exports) and show it in Solid mode"""
     def execute(self, context):
         obj = _mesh_object(context)
         try:
-            metrics.write_error_colors(obj, context.scene.topstoc.overlays.error_scale)
+            # the overlay's colours: one scale for the objects shown together
+            metrics.write_error_colors(obj, metrics.shared_error_percent(
+                context.visible_objects, context.scene.topstoc.overlays.error_scale))
         except metrics.MetricsError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}

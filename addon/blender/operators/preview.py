@@ -31,6 +31,7 @@ from ..guidance import GuidanceError
 from ..preview import PreviewSession, cancelled
 from ..props import OperatorParameters, fill_from_scene, settings_names
 from . import polls
+from .decimate import select_results
 
 PIXELS_PER_DOUBLING = 150.0  # mouse travel that doubles (or halves) the ratio
 #: Live previews whose modal timer is running (tests check that none is left behind).
@@ -199,7 +200,7 @@ Enter or click applies, Esc or right-click restores"""
         try:
             if self.output == "NEW_OBJECT":
                 pipeline.store_samples(run)
-            pipeline.write_output(run, self.output)
+            select_results(context, [pipeline.write_output(run, self.output)])  # Guided Decimate stays usable
         except TopStocError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}

@@ -380,6 +380,9 @@ triangulation, robust fallbacks)"""
     def execute(self, context):
         obj = _mesh_object(context)
         mode = self.mode
+        if mode == "SELECTED" and context.mode != "EDIT_MESH":  # Object Mode hides the selection
+            self.report({"ERROR"}, "TopStoc: select the holes' edges in Edit Mode")
+            return {"CANCELLED"}
         if mode == "ACTIVE":
             loop = analysis.active_loop(obj)
             if loop is None or loop.kind != "BOUNDARY":
@@ -414,7 +417,11 @@ class TOPSTOC_OT_delete_faces(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return polls.refuse(cls, _why_not_editable(context))
+        # only a selection the user sees: in Object Mode it is hidden (an importer's may be everything)
+        reason = _why_not_editable(context)
+        if reason is None and context.mode != "EDIT_MESH":
+            reason = "Select the faces to delete in Edit Mode"
+        return polls.refuse(cls, reason)
 
     def execute(self, context):
         def compute(o, arrays):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import bpy
 
 from .. import metrics
-from .panels import _MeshPanel, _Panel
+from .panels import _MeshPanel, _Panel, wrapped
 
 SIDES = (("symmetric", "Symmetric"), ("forward", "Forward (original → this)"),
          ("backward", "Backward (this → original)"))
@@ -35,13 +35,13 @@ class TOPSTOC_PT_metrics(_MeshPanel, bpy.types.Panel):
         col.prop(settings, "reference")
         if settings.reference is None:
             implied = metrics.reference_of(obj)
-            col.label(text=f"Compares with '{implied.name}'" if implied else "Pick the original to compare with",
-                      icon="INFO")
+            wrapped(col, context, f"Compares with '{implied.name}'" if implied else
+                    "Pick the original to compare with", "INFO")
         col.prop(settings, "samples")
         reference = settings.reference or metrics.reference_of(obj)
         if reference is not None:  # the basic information (thesis 4.7): vertex counts of both meshes
-            col.label(text=f"{len(reference.data.vertices):,} → {len(obj.data.vertices):,} vertices "
-                           f"({100.0 * len(obj.data.vertices) / max(1, len(reference.data.vertices)):.3g} %)")
+            wrapped(col, context, f"{len(reference.data.vertices):,} → {len(obj.data.vertices):,} vertices "
+                                  f"({100.0 * len(obj.data.vertices) / max(1, len(reference.data.vertices)):.3g}\u00a0%)")
         layout.operator("topstoc.measure", icon="DRIVER_DISTANCE")
         if settings.state == "ERROR":
             layout.label(text=settings.message, icon="ERROR")
@@ -51,24 +51,20 @@ class TOPSTOC_PT_metrics(_MeshPanel, bpy.types.Panel):
         if not metrics.is_current(obj):
             layout.label(text="A mesh changed since: measure again", icon="ERROR")
         layout.use_property_split = False
-        for label, figures in distance_rows(obj):
+        for label, figures in distance_rows(obj):  # one line per figure: a column table cuts the values
             box = layout.box()
-            box.label(text=label)
-            grid = box.grid_flow(row_major=True, columns=3, even_columns=True, align=True)
+            wrapped(box, context, label)
+            col = box.column(align=True)
             for name, absolute, percent in figures:
-                grid.label(text=name)
-                grid.label(text=absolute)
-                grid.label(text=percent)
+                col.label(text=f"{name}: {percent} ({absolute})")
         box = layout.box()
-        box.label(text="Triangle Quality (aspect ratio)")
-        grid = box.grid_flow(row_major=True, columns=2, even_columns=True, align=True)
-        grid.label(text="Mean")
-        grid.label(text=f"{settings.aspect_mean:.3f}")
-        grid.label(text="Max")
-        grid.label(text=f"{settings.aspect_max:.3f}")
+        wrapped(box, context, "Triangle shape (aspect ratio, 1 is equilateral)")
+        col = box.column(align=True)
+        col.label(text=f"Mean: {settings.aspect_mean:.3f}")
+        col.label(text=f"Max: {settings.aspect_max:.3f}")
         if settings.degenerate:
-            box.label(text=f"{settings.degenerate} zero-area triangles", icon="ERROR")
-        layout.label(text=f"Original's diagonal: {settings.diagonal:.4g}")
+            wrapped(box, context, f"{settings.degenerate} zero-area triangles", "ERROR")
+        wrapped(layout, context, f"Original's diagonal: {settings.diagonal:.4g}")
         layout.label(text=f"Measured in {settings.seconds:.2f} s")
 
 
@@ -86,7 +82,7 @@ class TOPSTOC_PT_metrics_colors(_Panel, bpy.types.Panel):
         layout.use_property_decorate = False
         show = context.scene.topstoc.overlays
         layout.active = show.show_error
-        layout.prop(show, "error_scale", text="Red at (% diagonal)")
+        layout.prop(show, "error_scale")
         layout.operator("topstoc.write_error_colors", icon="GROUP_VCOL")
 
 

@@ -3,8 +3,6 @@
 
 from __future__ import annotations
 
-import textwrap
-
 import bpy
 
 from ..pipeline import face_estimate
@@ -13,12 +11,35 @@ CATEGORY = "TopStoc"
 
 
 def wrapped(layout, context, text: str, icon: str = "NONE") -> None:
-    """A long message as several labels, wrapped to the sidebar's width."""
+    """A long message as several labels, broken between words where the sidebar's width ends
+    (measured in the UI font; a box's margins allowed for)."""
     scale = (context.preferences.system.ui_scale if context.preferences else 0.0) or 1.0  # 0 in background
+    unit = 20 * scale
     pixels = context.region.width if context.region else 300
-    width = max(16, int((pixels - 50 * scale) / (7 * scale)))
-    for i, line in enumerate(textwrap.wrap(text, width) or [""]):
-        layout.label(text=line, icon=icon if i == 0 else "BLANK1")
+    # the panel's content (less the tab column and margins), a box's margins, a label's own, its icon
+    width = pixels - 2.6 * unit - 0.5 * unit - 0.7 * unit - (unit if icon != "NONE" else 0)
+    lines, line = [], ""
+    for word in text.split(" "):  # only at spaces: "3\u00a0%" (a no-break space) stays whole
+        candidate = f"{line} {word}" if line else word
+        if line and _text_width(context, candidate, scale) > width:
+            lines.append(line)
+            candidate = word
+        line = candidate
+    col = layout.column(align=True)  # the lines of one message close together
+    for i, part in enumerate(lines + [line]):
+        col.label(text=part, icon=icon if i == 0 else ("BLANK1" if icon != "NONE" else "NONE"))
+
+
+def _text_width(context, text: str, scale: float) -> float:
+    """Width of ``text`` in pixels in the UI's widget font."""
+    import blf
+
+    points = context.preferences.ui_styles[0].widget.points if context.preferences else 11
+    try:
+        blf.size(0, points * scale)
+    except TypeError:  # Blender before 4.0 takes a dpi argument
+        blf.size(0, points * scale, 72)
+    return blf.dimensions(0, text)[0]
 
 
 class _Panel:
@@ -54,11 +75,14 @@ def _estimate_text(context, settings) -> str:
 
 def draw_bake(layout, settings) -> None:
     """The Bake Normals option and, when on, its settings (the panel and the operators' redo panels)."""
-    layout.prop(settings, "bake_normals")
+    row = layout.row()  # the checkbox's name beside it over the full width: the value column cuts it
+    row.use_property_split = False
+    row.prop(settings, "bake_normals")
     if settings.bake_normals:
         col = layout.column(align=True)
-        for name in ("bake_size", "bake_margin", "bake_store"):
-            col.prop(settings, name)
+        col.prop(settings, "bake_size", text="Size")  # "Resolution" does not fit the label column
+        col.prop(settings, "bake_margin")
+        col.prop(settings, "bake_store")
 
 
 class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
@@ -90,11 +114,12 @@ class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
         if estimate:
             layout.label(text=estimate, icon="MESH_DATA")
         layout.prop(settings, "quality")
-        row = layout.row(align=True, heading="Symmetry")
-        row.prop(settings, "use_symmetry", text="")
-        sub = row.row(align=True)
+        row = layout.row()  # no label column: "Symmetry" does not fit it in every Blender's font
+        row.use_property_split = False
+        row.prop(settings, "use_symmetry")
+        sub = row.row()
         sub.active = settings.use_symmetry
-        sub.prop(settings, "symmetry_axis", expand=True)
+        sub.prop(settings, "symmetry_axis", text="")
         row = layout.row(align=True)  # full width: "New Object" does not fit beside a label
         row.use_property_split = False
         row.prop(settings, "output", expand=True)
@@ -111,10 +136,11 @@ class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
         if obj is not None and obj.type == "MESH" and obj.topstoc.settings:
             box = layout.box()
             source = obj.topstoc.source
-            box.label(text=f"Result of {source.name}" if source else "Source deleted", icon="LINKED")
-            row = box.row(align=True)
-            row.operator("topstoc.regenerate", icon="FILE_REFRESH")
-            row.prop(obj.topstoc, "auto_regenerate", text="Auto")
+            wrapped(box, context, f"Result of {source.name}" if source else "Source deleted", "LINKED")
+            col = box.column()  # one per line: side by side, a row's equal halves cut "Regenerate"
+            col.use_property_split = False  # the checkbox's name beside it, not in a label column
+            col.operator("topstoc.regenerate", icon="FILE_REFRESH")
+            col.prop(obj.topstoc, "auto_regenerate")
 
 
 class TOPSTOC_PT_advanced(_Panel, bpy.types.Panel):
@@ -171,20 +197,24 @@ class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
             else:  # no red "invalid" field before the layer exists: offer to make it
                 box.label(text="Not painted yet", icon="INFO")
             box.prop(s, "color_strength")
-            row = box.row(align=True)
-            row.operator("topstoc.add_guidance_layer", text="Add Layer", icon="BRUSH_DATA")
-            row.operator("topstoc.show_guidance", text="Show", icon="SHADING_SOLID")
-        if context.mode == "EDIT_MESH":
-            row = box.row(align=True)
-            for level, label in (("KEEP", "Keep"), ("MORE", "More"), ("NEUTRAL", "Neutral"), ("LESS", "Less"),
-                                 ("DROP", "Drop")):
-                row.operator("topstoc.set_guidance", text=label).level = level
+            col = box.column(align=True)  # side by side, each icon and name has half the width: too little
+            col.operator("topstoc.add_guidance_layer", text="Add Layer", icon="BRUSH_DATA")
+            col.operator("topstoc.show_guidance", text="Show", icon="SHADING_SOLID")
+        if context.mode == "EDIT_MESH":  # two rows: five buttons in one are cut
+            for levels in ((("KEEP", "Keep"), ("MORE", "More"), ("NEUTRAL", "Neutral")),
+                           (("LESS", "Less"), ("DROP", "Drop"))):
+                row = box.row(align=True)
+                for level, label in levels:
+                    row.operator("topstoc.set_guidance", text=label).level = level
         box = layout.box()
         box.prop(s, "use_vertex_group")
-        if s.use_vertex_group:
-            box.prop_search(s, "vertex_group", obj, "vertex_groups")
-            box.prop(s, "vertex_group_mapping")
-            box.prop(s, "vertex_group_strength")
+        if s.use_vertex_group:  # a label column: beside its field a name gets a third and is cut
+            col = box.column()
+            col.use_property_split = True
+            col.use_property_decorate = False
+            col.prop_search(s, "vertex_group", obj, "vertex_groups")
+            col.prop(s, "vertex_group_mapping")
+            col.prop(s, "vertex_group_strength")
         box = layout.box()
         box.prop(s, "use_materials")
         if s.use_materials and obj.material_slots:
@@ -203,7 +233,10 @@ class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
         box = layout.box()
         box.prop(scene, "use_view")
         if scene.use_view:
-            box.prop(scene, "view_source")
+            col = box.column()
+            col.use_property_split = True  # as the vertex group's settings
+            col.use_property_decorate = False
+            col.prop(scene, "view_source")
             box.prop(scene, "back_ratio")
             box.prop(scene, "silhouette_angle")
             box.prop(scene, "silhouette_falloff")
@@ -221,11 +254,12 @@ class TOPSTOC_PT_variants(_Panel, bpy.types.Panel):
     def draw(self, context):
         layout = self.layout
         settings = context.scene.topstoc
-        row = layout.row(align=True)
-        row.prop(settings, "variants")
-        row.prop(settings, "variance")
+        col = layout.column(align=True)
+        col.prop(settings, "variants")
+        col.prop(settings, "variance")
         layout.operator("topstoc.multiview", icon="MOD_ARRAY")
-        layout.prop(settings, "lod_ratios")
+        layout.label(text="LOD ratios, finest first:")
+        layout.prop(settings, "lod_ratios", text="")
         layout.operator("topstoc.lod_chain", icon="MOD_DECIM")
 
 
@@ -241,13 +275,13 @@ class TOPSTOC_PT_samples(_Panel, bpy.types.Panel):
         if obj is None or obj.type != "MESH":
             return
         show = context.scene.topstoc.overlays
-        row = layout.row(align=True)  # the last decimation's samples and clusters (thesis fig. 4.1)
-        row.prop(show, "show_samples", toggle=True, icon="DOT")
-        row.prop(show, "show_clusters", toggle=True, icon="MOD_EXPLODE")
+        col = layout.column(align=True)  # the last decimation's samples and clusters (thesis fig. 4.1)
+        col.prop(show, "show_samples", toggle=True, icon="DOT")
+        col.prop(show, "show_clusters", toggle=True, icon="MOD_EXPLODE")
         layout.operator("topstoc.save_samples", icon="FILE_TICK")
         for entry in obj.topstoc.sample_sets:
             row = layout.row(align=True)
-            row.label(text=f"{entry.name}: {entry.vertices_out:,} v, {entry.triangles_out:,} t")
+            row.label(text=f"{entry.name}: {entry.vertices_out:,} vertices")
             row.operator("topstoc.restore_samples", text="", icon="RECOVER_LAST").name = entry.name
             row.operator("topstoc.remove_samples", text="", icon="X").name = entry.name
 

@@ -26,7 +26,7 @@ def help_rows(topology) -> list:
             ("χ", str(topology.euler), "euler"), ("Genus", genus, "genus"),
             ("Components", str(len(topology.components)), "components"),
             ("Holes", str(topology.boundary_loops), "boundary"),
-            ("Non-Manifold", "", None),  # a heading: the full names do not fit the sidebar
+            ("Non-Manifold", "", None),  # a heading: "Non-Manifold Vertices: 0" does not fit the sidebar
             ("   Edges", str(topology.nonmanifold_edges), "nonmanifold_edges"),
             ("   Vertices", str(topology.nonmanifold_vertices), "nonmanifold_vertices"),
             ("Loose Vertices", str(topology.isolated_vertices), "isolated")]
@@ -37,6 +37,8 @@ def help_rows(topology) -> list:
 
 def plain_summary(topology) -> str:
     """One info line an artist can act on."""
+    if topology.faces == 0:
+        return "The mesh is empty: no faces"
     pieces = len(topology.components)
     parts = [f"{pieces} piece{'s' if pieces != 1 else ''}"]
     if topology.genus > 0:
@@ -55,14 +57,13 @@ def help_button(layout, topic: str) -> None:
     layout.operator("topstoc.explain", text="", icon="QUESTION", emboss=False).topic = topic
 
 
-def _table(layout, rows, factor: float = 0.62) -> None:
+def _table(layout, rows) -> None:
+    """One "name: value" line per row (a help button after it): two columns would cut big counts."""
     col = layout.column(align=True)
     for row in rows:
         label, value = row[0], row[1]
         line = col.row(align=True)
-        split = line.split(factor=factor, align=True)
-        split.label(text=label)
-        split.label(text=value)
+        line.label(text=f"{label}: {value}" if value else label)
         if len(row) > 2 and row[2]:
             help_button(line, row[2])
         elif len(row) > 2:
@@ -71,15 +72,15 @@ def _table(layout, rows, factor: float = 0.62) -> None:
 
 class TOPSTOC_UL_components(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
-        layout.label(text=f"{index}: {item.summary}", icon="MESH_DATA" if item.manifold else "ERROR")
+        genus = "genus undefined" if item.genus < 0 else f"genus {item.genus}"
+        layout.label(text=f"Piece {index + 1}: {genus}", icon="MESH_DATA" if item.manifold else "ERROR")
 
 
 class TOPSTOC_UL_loops(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
-        split = layout.split(factor=0.62, align=True)
-        split.label(text=item.name, icon=KIND_ICONS.get(item.kind, "DOT"))
         warning = item.kind == "BOUNDARY" and not item.fillable
-        split.label(text=f"{item.num_edges} edges", icon="ERROR" if warning else "NONE")
+        layout.label(text=f"{item.name}: {item.num_edges} edges",
+                     icon="ERROR" if warning else KIND_ICONS.get(item.kind, "DOT"))
 
 
 class TOPSTOC_PT_topology(_MeshPanel, bpy.types.Panel):
@@ -89,9 +90,9 @@ class TOPSTOC_PT_topology(_MeshPanel, bpy.types.Panel):
 
     def draw_mesh(self, context, layout, obj):
         topology = obj.topstoc.topology
-        row = layout.row(align=True)
-        row.operator("topstoc.analyse", icon="VIEWZOOM")
-        row.operator("topstoc.find_loops", text="Find Loops", icon="MOD_SCREW")
+        col = layout.column(align=True)  # side by side, "Find Loops" and its icon have too little width
+        col.operator("topstoc.analyse", icon="VIEWZOOM")
+        col.operator("topstoc.find_loops", text="Find Loops", icon="MOD_SCREW")
         search = running.get(obj.name)
         if search is not None:
             layout.label(text=f"{search.stage}: {100 * search.fraction:.0f} %"
@@ -103,14 +104,14 @@ class TOPSTOC_PT_topology(_MeshPanel, bpy.types.Panel):
             layout.label(text="Not analysed yet", icon="INFO")
             return
         if context.mode == "EDIT_MESH":
-            layout.label(text="Figures as of the last mode switch", icon="EDITMODE_HLT")
+            wrapped(layout, context, "Figures as of the last mode switch", "EDITMODE_HLT")
         elif not analysis.is_current(obj):
             layout.label(text="The mesh changed: Analyse again", icon="ERROR")
         wrapped(layout, context, plain_summary(topology), "INFO")
         wrapped(layout, context, topology.summary)
         _table(layout.box(), help_rows(topology))
         row = layout.row()
-        row.label(text="Why does this matter?")
+        row.label(text="Why it matters")
         help_button(row, "why")
         layout.label(text=f"Analysed in {1000 * topology.seconds:.0f} ms")
 
@@ -147,7 +148,7 @@ class TOPSTOC_PT_topology_components(_AnalysedPanel, bpy.types.Panel):
             _table(layout.box(), [
                 ("Vertices", f"{c.vertices:,}"), ("Edges", f"{c.edges:,}"), ("Faces", f"{c.faces:,}"),
                 ("β0 / β1 / β2", f"{c.betti0} / {c.betti1} / {c.betti2}"), ("χ", str(c.euler)),
-                ("Genus", "undefined" if c.genus < 0 else str(c.genus)), ("Boundary Loops", str(c.boundary_loops)),
+                ("Genus", "undefined" if c.genus < 0 else str(c.genus)), ("Holes", str(c.boundary_loops)),
                 ("Closed", "yes" if c.closed else "no"), ("Manifold", "yes" if c.manifold else "no"),
                 ("Orientable", "yes" if c.orientable else "no")])
 
@@ -177,7 +178,9 @@ class TOPSTOC_PT_topology_loops(_AnalysedPanel, bpy.types.Panel):
         if active is None:
             return
         row.separator()
+        row.operator("topstoc.frame_loop", text="Frame")
         row.operator("topstoc.select_loop", text="Select")
+        row = layout.row(align=True)  # a second row: four buttons beside the arrows are cut
         if active.kind == "BOUNDARY":
             row.operator("topstoc.fill_holes", text="Fill").mode = "ACTIVE"
         else:
@@ -204,7 +207,8 @@ class TOPSTOC_PT_topology_edit(_Panel, bpy.types.Panel):
         col.operator("topstoc.fill_holes", text="Fill Selected Holes", icon="MOD_SOLIDIFY").mode = "SELECTED"
         col.operator("topstoc.fill_holes", text="Fill All Holes", icon="MOD_SOLIDIFY").mode = "ALL"
         col.operator("topstoc.delete_faces", icon="TRASH")
-        layout.operator("topstoc.clean", text="Clean Up Small Handles and Holes", icon="MOD_SMOOTH")
+        # the full name, "... Small Handles and Holes", does not fit the sidebar (the tooltip says it)
+        layout.operator("topstoc.clean", text="Clean Up Small Flaws", icon="MOD_SMOOTH")
 
 
 class TOPSTOC_PT_topology_overlays(_Panel, bpy.types.Panel):
@@ -219,9 +223,7 @@ class TOPSTOC_PT_topology_overlays(_Panel, bpy.types.Panel):
         col = layout.column(align=True)
         for name in ("show_handles", "show_tunnels", "show_generators", "show_boundary", "show_nonmanifold"):
             col.prop(show, name)
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        col = layout.column(align=True)
+        col = layout.column(align=True)  # no label column: "Active Loop Width" does not fit one
         col.prop(show, "line_width")
         col.prop(show, "active_width")
         col.prop(show, "point_size")
