@@ -88,11 +88,54 @@ QUALITY_FIGURES = (("mean", "mean error"), ("max", "max error"), ("ar_mean", "as
                    ("ar_max", "worst triangle"))
 
 
+def percent(ratio: float) -> str:
+    return f"{ratio:.0%}" if round(ratio * 100, 6).is_integer() else f"{ratio:.1%}"
+
+
+def goal_ratios(case: dict) -> tuple:
+    """Issue 40's two figures: our mean over the better of Blender and MeshLab, our max over the best peer."""
+    tools = case["tools"]
+    means = [tools[n]["mean"] for n in ("Blender Collapse", "MeshLab") if tools.get(n)]
+    maxes = [tools[n]["max"] for n in QUALITY_PEERS if tools.get(n)]
+    ours = tools["topstoc quality"]
+    return (ours["mean"] / min(means) if means and min(means) > 0 else None,
+            ours["max"] / min(maxes) if maxes and min(maxes) > 0 else None)
+
+
+def goal_lines(cases: list) -> list:
+    """The goals' medians and worst cases, then one row per case."""
+    out = [""]
+    for index, (what, median_goal, every_goal) in enumerate((("mean ÷ the better of Blender and MeshLab", 0.9, 1.0),
+                                                              ("max ÷ the best peer", 1.0, 1.15))):
+        ranked = [(goal_ratios(c)[index], c) for c in cases if goal_ratios(c)[index] is not None]
+        if not ranked:
+            continue
+        worst, case = max(ranked, key=lambda pair: pair[0])
+        values = [v for v, _ in ranked]
+        target = percent(case["ratio"]) if case.get("ratio") is not None else f"{case['budget']} triangles"
+        out.append(f"- {what}: median {statistics.median(values):.3f} (goal ≤ {median_goal}), worst "
+                   f"{worst:.2f} ({case['mesh']} at {target}), above {every_goal} in "
+                   f"{sum(v > every_goal for v in values)}/{len(values)} cases (goal: none).")
+    out += ["", "| Mesh | Target | Triangles | Mean ÷ better of Blender, MeshLab | Max ÷ best peer | Topology kept |",
+            "|---|---|---|---|---|---|"]
+    for case in cases:
+        mean, worst = goal_ratios(case)
+        ours = case["tools"]["topstoc quality"]
+        target = percent(case["ratio"]) if case.get("ratio") is not None else f"{case['budget']} triangles"
+        cells = [f"{v:.2f}" if v is not None else "—" for v in (mean, worst)]
+        over = f" ({ours['over_budget_reason']})" if ours.get("over_budget") else ""
+        out.append(f"| {case['mesh']} | {target} | {ours['triangles']:,}{over} | {cells[0]} | {cells[1]} | "
+                   f"{'yes' if ours['topology'] else 'NO'} |")
+    return out
+
+
 def render_quality(name: str, figures: dict) -> str:
     """bench_quality.py --json: the quality mode's error and shape over the peers' at its triangle count."""
     cases = figures["cases"]
     ours = [case["tools"]["topstoc quality"] for case in cases]
-    targets = ", ".join(f"{ratio:.0%}" for ratio in sorted({case["ratio"] for case in cases}, reverse=True))
+    ratios = sorted({case["ratio"] for case in cases if case.get("ratio") is not None}, reverse=True)
+    budgets = sorted({case["budget"] for case in cases if case.get("ratio") is None}, reverse=True)
+    targets = ", ".join([percent(ratio) for ratio in ratios] + [f"{budget} triangles" for budget in budgets])
     out = [f"## Result quality next to the quadric decimators (`{name}`)", "",
            f"`{figures['benchmark']}`: {len(cases)} cases ({len({c['mesh'] for c in cases})} meshes × "
            f"{targets}); every peer decimates to the triangle count "
@@ -115,6 +158,7 @@ def render_quality(name: str, figures: dict) -> str:
     out += ["", f"TopStoc's quality mode kept the topology in {sum(bool(o['topology']) for o in ours)}/{len(ours)} "
             f"cases, with {sum(o['zero_area'] for o in ours)} zero-area triangles and a worst aspect ratio of "
             f"{max(o['ar_max'] for o in ours):.0f}."]
+    out += goal_lines(cases)
     return "\n".join(out) + "\n"
 
 

@@ -82,3 +82,22 @@ def test_quality_results_render_medians_of_our_figure_over_the_peers():
     assert "| MeshLab | not available |" in text
     assert "3 cases (3 meshes × 10%)" in text
     assert "kept the topology in 3/3 cases, with 1 zero-area triangles and a worst aspect ratio of 40." in text
+
+
+def test_quality_results_state_the_goals_per_case_and_name_the_worst():
+    ours = [_tool(1.0, 2.0, 1.2, 10.0), dict(_tool(2.0, 2.0, 1.5, 40.0), over_budget=3, over_budget_reason="topology")]
+    cases = [{"mesh": "a.off", "ratio": 0.005, "budget": None, "tools": {
+                  "topstoc quality": ours[0], "Blender Collapse": _tool(2.0, 4.0, 1, 1), "MeshLab": _tool(4.0, 1.0, 1, 1),
+                  "meshopt_simplify": None, "fast-simplification": _tool(0.5, 5.0, 1, 1)}},
+             {"mesh": "b.off", "ratio": None, "budget": 50, "tools": {
+                  "topstoc quality": ours[1], "Blender Collapse": None, "MeshLab": _tool(1.0, 1.0, 1, 1),
+                  "meshopt_simplify": _tool(1.0, 4.0, 1, 1), "fast-simplification": None}}]
+    text = benchmarks_md.render_quality("q.json", {"benchmark": "tests/bench/bench_quality.py", "machine": "m",
+                                                   "date": "2000-01-01", "samples": 1000, "cases": cases})
+    # mean over the better of Blender and MeshLab (fast-simplification is not in it): 1/2, 2/1
+    assert "median 1.250 (goal ≤ 0.9), worst 2.00 (b.off at 50 triangles), above 1.0 in 1/2" in text
+    # max over the best of all peers: 2/1, 2/1
+    assert "max ÷ the best peer: median 2.000 (goal ≤ 1.0), worst 2.00 (a.off at 0.5%), above 1.15 in 2/2" in text
+    assert "| a.off | 0.5% | 100 | 0.50 | 2.00 | yes |" in text
+    assert "| b.off | 50 triangles | 100 (topology) | 2.00 | 2.00 | yes |" in text
+    assert "2 cases (2 meshes × 0.5%, 50 triangles)" in text

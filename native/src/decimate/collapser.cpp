@@ -15,6 +15,8 @@ namespace {
 // move was (Collapser::shape_floor2).
 constexpr double kMinShape = 0.1;
 constexpr double kThinShape = 0.5 * kMinShape;
+// The most triangles an edge collapsed along a non-manifold curve may have (more stay).
+constexpr int32_t kMaxSheets = 8;
 
 // True when a triangle with |n|² = twice_area2 and squared edge lengths summing to `edges` has a
 // shape quality (Collapser::shape) below sqrt(shape2): without roots or divisions.
@@ -506,14 +508,16 @@ void Collapser::offer(int32_t x, int32_t v, int32_t removed, double c) {
 
 // Link condition (Dey et al. 1999): u and v share exactly the vertices opposite their edge, and
 // v keeps at least three neighbours; then the surface stays a manifold of the same topology. An
-// interior u may go to any neighbour; a u on a border curve only along the curve (the edge must
-// separate u's sectors, or be a boundary edge), so every border keeps its course and its sides.
+// interior u may go to any neighbour; a u on a border curve only along the curve, so every border
+// keeps its course and its sides: each of u's sectors (one for a boundary, two for a crease,
+// k for a non-manifold edge of k sheets) is a fan from the curve's other edge to this one and
+// holds exactly one of the edge's triangles.
 bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
   std::vector<uint32_t>& mark = scratch.mark;
   const uint32_t su = ++scratch.stamp;
   int32_t nu = 0, faces_u = 0;
   bool found = false;
-  int32_t on_edge[2], count = 0;
+  int32_t on_edge[kMaxSheets], count = 0;
   for (const int32_t* t = faces_begin(u); t != faces_end(u); ++t) {
     ++faces_u;
     bool with_v = false;
@@ -527,21 +531,22 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
       }
     }
     if (with_v) {
-      if (count == 2) return false;
+      if (count == kMaxSheets) return false;
       on_edge[count++] = *t;
       found = true;
     }
   }
   if (!found) return false;
-  const bool closed_fan = nu == faces_u;
   const int32_t cu = s_.curve[u];
   if (cu < 0) {
-    if (!closed_fan || count != 2) return false;
+    if (nu != faces_u || count != 2) return false;  // a closed fan around u
   } else {
     if (s_.curve[v] != cu && !s_.locked[v]) return false;
-    const bool boundary_edge = count == 1 && nu == faces_u + 1;
-    const bool border_edge = count == 2 && closed_fan && sector_at(on_edge[0], u) != sector_at(on_edge[1], u);
-    if (!boundary_edge && !border_edge) return false;
+    // count fans sharing only the curve's two neighbours of u have faces_u - count + 2 of them.
+    if (nu != faces_u - count + 2) return false;
+    for (int32_t i = 0; i < count; ++i)
+      for (int32_t j = 0; j < i; ++j)
+        if (sector_at(on_edge[i], u) == sector_at(on_edge[j], u)) return false;
     if (s_.curve_closed[cu] && s_.curve_size[cu] <= 3) return false;
   }
   const uint32_t sv = ++scratch.stamp;
@@ -554,7 +559,8 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
       mark[w] = sv;
       ++nv;
     }
-  if (shared != count) return false;
+  if (shared != count || duplicates_a_face(u, v, on_edge, count)) return false;
+  if (cu >= 0 && merges_unlike_edges(u, v, on_edge, count)) return false;
   if (nu + nv < shared + 5) return false;  // v would keep < 3 neighbours
   Quadric q;
   s_.quadrics.reduced(u, v, q);
@@ -562,6 +568,52 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
   placement(u, v, q, x);
   ShapeFloor floor{u, v};
   return keeps_shape(u, v, x, floor) && keeps_shape(v, u, x, floor);
+}
+
+// Would collapsing u into v turn a triangle (u, a, b) into one v already has? Only possible when
+// a and b are both opposite the edge, which the link condition allows; around a non-manifold
+// vertex (a sealed wing on a non-manifold edge) that would delete the wing.
+bool Collapser::duplicates_a_face(int32_t u, int32_t v, const int32_t* on_edge, int32_t count) const {
+  if (count < 2) return false;
+  int32_t opposite[kMaxSheets];
+  for (int32_t i = 0; i < count; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const int32_t w = tri_[3 * size_t(on_edge[i]) + j];
+      if (w != u && w != v) opposite[i] = w;
+    }
+  auto is_opposite = [&](int32_t w) { return std::find(opposite, opposite + count, w) != opposite + count; };
+  for (const int32_t* t = faces_begin(u); t != faces_end(u); ++t) {
+    if (has(*t, v)) continue;
+    int32_t pair[2], found = 0;
+    for (int j = 0; j < 3; ++j) {
+      const int32_t w = tri_[3 * size_t(*t) + j];
+      if (w != u && is_opposite(w)) pair[found++] = w;
+    }
+    if (found < 2) continue;
+    for (const int32_t* f = faces_begin(v); f != faces_end(v); ++f)
+      if (has(*f, pair[0]) && has(*f, pair[1])) return true;
+  }
+  return false;
+}
+
+// Collapsing u into v merges each edge (u, o) with (v, o), o opposite the edge: the merged edge
+// has the triangles of both but the vanished one on each. Unless one of them is an ordinary
+// two-triangle edge, that count is neither's: a sheet of a non-manifold curve that is a single
+// triangle, or a hole bounded by it, would vanish. (Interior u: all its edges are ordinary.)
+bool Collapser::merges_unlike_edges(int32_t u, int32_t v, const int32_t* on_edge, int32_t count) const {
+  for (int32_t i = 0; i < count; ++i) {
+    int32_t o = -1;
+    for (int j = 0; j < 3; ++j) {
+      const int32_t w = tri_[3 * size_t(on_edge[i]) + j];
+      if (w != u && w != v) o = w;
+    }
+    int32_t at_u = 0, at_v = 0;
+    for (const int32_t* t = faces_begin(u); t != faces_end(u); ++t) at_u += has(*t, o);
+    if (at_u == 2) continue;
+    for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) at_v += has(*t, o);
+    if (at_v != 2) return true;
+  }
+  return false;
 }
 
 // The squared shape quality of the thinnest triangle with area around `v`, capped at kMinShape's:
@@ -674,12 +726,13 @@ void Collapser::collapse(int32_t u, int32_t v) {
     placed_[v] = placement(u, v, q, x);
     move_to(v, x);
   }
-  // The triangles on the edge vanish. On each side of u's borders one of them had a corner at
-  // v: u's other triangles on that side take that corner (and its sector) where they meet v.
+  // The triangles on the edge vanish. On each side of u's borders (each sheet of a non-manifold
+  // curve) one of them had a corner at v: u's other triangles on that side take that corner (and
+  // its sector) where they meet v.
   struct Side {
     int32_t sector, corner, corner_sector;
   };
-  Side sides[2];
+  Side sides[kMaxSheets];
   int32_t num_sides = 0;
   for (const int32_t* t = faces_begin(u); t != faces_end(u); ++t) {
     if (!has(*t, v)) continue;
@@ -699,10 +752,12 @@ void Collapser::collapse(int32_t u, int32_t v) {
     for (int j = 0; j < 3; ++j)
       if (tri_[3 * size_t(*t) + j] == u) {
         const size_t corner = 3 * size_t(*t) + j;
-        const Side& side = (num_sides == 2 && s_.corner_sector[corner] == sides[1].sector) ? sides[1] : sides[0];
+        const Side* side = &sides[0];
+        for (int32_t i = 1; i < num_sides; ++i)
+          if (s_.corner_sector[corner] == sides[i].sector) side = &sides[i];
         tri_[corner] = v;
-        corner_source_[corner] = side.corner;
-        s_.corner_sector[corner] = side.corner_sector;
+        corner_source_[corner] = side->corner;
+        s_.corner_sector[corner] = side->corner_sector;
       }
     moved_faces_.push_back(*t);
   }

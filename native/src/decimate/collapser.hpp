@@ -120,6 +120,8 @@ class Collapser {
   }
   bool queues(int32_t u) const { return !s_.locked[u] && !at_quota(u); }
   bool allowed(int32_t u, int32_t v, Scratch& scratch) const;
+  bool duplicates_a_face(int32_t u, int32_t v, const int32_t* on_edge, int32_t count) const;
+  bool merges_unlike_edges(int32_t u, int32_t v, const int32_t* on_edge, int32_t count) const;
   // The shape floor of one move or collapse (shape_floor2 of its ends), found when a triangle
   // first ends below kMinShape: most moves leave none there.
   struct ShapeFloor {

@@ -28,6 +28,25 @@ int32_t guidance_bin(double m) {
   return 2 + 40 + std::clamp(int32_t(std::lround(4.0 * std::log2(m))), -40, 40);
 }
 
+// Vertices on an edge whose two triangles run along it the same way (inconsistently oriented).
+std::vector<uint8_t> on_inconsistent_edge(const Mesh& mesh) {
+  std::vector<uint8_t> flipped(mesh.num_vertices(), 0);
+  const auto& faces = mesh.faces();
+  const auto& face_edges = mesh.face_edges();
+  const auto& efo = mesh.edge_face_offsets();
+  const auto& edge_faces = mesh.edge_faces();
+  const auto& ev = mesh.edge_vertices();
+  auto starts_at = [&](int32_t f, int32_t e) {  // the corner the edge leaves in face f
+    for (int c = 0; c < 3; ++c)
+      if (face_edges[3 * size_t(f) + c] == e) return faces[3 * size_t(f) + c];
+    return -1;
+  };
+  for (int32_t e = 0; e + 1 < int32_t(efo.size()); ++e)
+    if (efo[e + 1] - efo[e] == 2 && starts_at(edge_faces[efo[e]], e) == starts_at(edge_faces[efo[e] + 1], e))
+      flipped[ev[2 * size_t(e)]] = flipped[ev[2 * size_t(e) + 1]] = 1;
+  return flipped;
+}
+
 // Vertex quota per bin (see RefineParams): sum over the bin's vertices of min(1, k m), k solved
 // so the quotas sum to `target`, rounded by largest remainder.
 std::vector<int32_t> bin_quotas(const std::vector<double>& vertices, const std::vector<double>& multiplier_sum,
@@ -286,7 +305,7 @@ class Refinement {
     for (int32_t v = 0; v < num_input; ++v) label[v] = result.labels[source[v]];
     setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *table);
     set_up_vertices(setup);
-    lock_pinched(setup);
+    lock_inconsistent(setup);
     setup.quota = quotas();
     set_up_corner_sectors(setup);
     setup.optimal_placement = !params.zero_area_only;
@@ -336,17 +355,19 @@ class Refinement {
       setup.positions[i] = (setup.world[i] - setup.center[i % 3]) * (1.0 / setup.extent);
   }
 
-  // A pinched input vertex (several fans) and every vertex of its output triangles stay put:
-  // the link condition sees one vertex, not the fans, and a collapse there could delete a
-  // whole fan (a wing of a bowtie) while every count the final check compares stays the same.
-  void lock_pinched(CollapseSetup& setup) const {
+  // Vertices next to a pinched vertex (several fans) or on a non-manifold edge are free: the
+  // collapses that would delete a wing or a sheet there are refused one by one
+  // (Collapser::duplicates_a_face, merges_unlike_edges). Freezing their rings had stopped
+  // scans and multi-part models far above the target. The triangles at an inconsistently
+  // oriented edge stay: collapsing it away would make its component consistently oriented.
+  void lock_inconsistent(CollapseSetup& setup) const {
+    if (mesh.report().inconsistent_edges == 0) return;
     const auto& index = mesh.vertex_index();
-    const auto& manifold_vertex = mesh.manifold_vertex();
-    if (mesh.report().nonmanifold_vertices == 0) return;
+    const auto flipped = on_inconsistent_edge(mesh);
     for (size_t t = 0; t < result.triangles.size() / 3; ++t) {
-      bool pinched = false;
-      for (int j = 0; j < 3; ++j) pinched |= !manifold_vertex[index[result.kept[result.triangles[3 * t + j]]]];
-      if (pinched)
+      bool at_flip = false;
+      for (int j = 0; j < 3; ++j) at_flip |= flipped[index[result.kept[result.triangles[3 * t + j]]]] != 0;
+      if (at_flip)
         for (int j = 0; j < 3; ++j) setup.locked[result.triangles[3 * t + j]] = 1;
     }
   }
