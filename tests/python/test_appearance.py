@@ -126,9 +126,10 @@ def test_cli_uses_the_files_uvs_and_says_so(tmp_path):
     source = _cylinder_file(tmp_path)
     default = run_json(source, tmp_path / "default.obj", "--vertices", TARGET)
     off = run_json(source, tmp_path / "off.obj", "--vertices", TARGET, "--attribute-weight", 0)
-    assert default["attributes"] == {"weight": ATTRIBUTE_WEIGHT, "channels": ["uv.u", "uv.v"],
-                                     "uv_corners_filled": 0}
-    assert off["attributes"] == {"weight": 0.0, "channels": [], "uv_corners_filled": 0}
+    assert default["attributes"] == {"weight": ATTRIBUTE_WEIGHT, "requested_weight": ATTRIBUTE_WEIGHT,
+                                     "channels": ["uv.u", "uv.v"], "uv_corners_filled": 0}
+    assert off["attributes"] == {"weight": 0.0, "requested_weight": 0.0, "channels": [], "uv_corners_filled": 0,
+                                 "unused_because": "--attribute-weight 0"}
     assert default["output"]["vertices"] == off["output"]["vertices"]
     errors = {}
     for name in ("default", "off"):

@@ -56,7 +56,7 @@ def test_a_signal_during_the_write_removes_the_temporary_file(ring, tmp_path, si
     assert child.returncode == status, stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ring.ply"]
     if signum == signal.SIGINT:
-        assert stderr.strip() == "topstoc decimate: interrupted"
+        assert stderr.strip() == "topstoc decimate: error: interrupted"
 
 
 def _dead_pid() -> int:
