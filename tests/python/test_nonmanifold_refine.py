@@ -72,7 +72,8 @@ def test_a_scan_with_non_manifold_edges_gets_nearer_its_target():
     expected = reference.invariants(len(mesh.vertices), cleaned)
     r = mesh.decimate(target_triangles=1110, seed=0)
     assert r.num_triangles < 2750, r.num_triangles  # under half of before
-    assert r.stats.over_budget_reason == "control points" and r.stats.forced >= r.stats.target_vertices
+    # the kept corners of the non-manifold curves (borders) outnumber the target: the reason says so
+    assert r.stats.over_budget_reason == "borders" and r.stats.forced >= r.stats.target_vertices
     assert reference.invariants(r.num_vertices, r.triangles) == expected
     assert reference.degenerate_or_duplicate(r.triangles) == (0, 0)
     assert not any(r.stats.output_check.values())
