@@ -248,7 +248,7 @@ def apply_steps(window, area, region, cx, cy):
               and "Torus_TopStoc" not in bpy.data.objects)
         final = [c for c in engine.calls if c[0] == "quality"]
         check("... the chosen Quality at the dragged ratio, on the worker", len(final) == 1
-              and abs(final[0][1]["ratio"] - 0.1 * 2 ** 0.5) < 0.002
+              and abs(final[0][1].ratio - 0.1 * 2 ** 0.5) < 0.002
               and final[0][2].startswith(sessions.THREAD_PREFIX), str(final))
         engine.gate.set()
         for _ in range(200):
@@ -257,7 +257,7 @@ def apply_steps(window, area, region, cx, cy):
                 break
         out = bpy.data.objects.get("Torus_TopStoc")
         reference = sessions.pipeline.decimate(bpy.context, torus, settings).result
-        check("... then writes it", out is not None and abs(settings.ratio - final[0][1]["ratio"]) < 1e-6
+        check("... then writes it", out is not None and abs(settings.ratio - final[0][1].ratio) < 1e-6
               and [tuple(map(float, v)) for v in reference.vertices.astype("float32")] == mesh_arrays(out.data)[0])
         check("... and leaves no preview, thread or timer", "Torus_TopStocPreview" not in bpy.data.objects
               and not torus.hide_get() and not operators.running

@@ -63,7 +63,8 @@ class Progress:
 
     def __init__(self, total: int, mode: str, quiet: bool = False):
         self.total, self.count, self.bar, self.quiet = total, 0, None, quiet
-        if not quiet and (mode == "bar" or (mode == "auto" and sys.stdout.isatty() and sys.stderr.isatty())):
+        on_terminal = sys.stdout.isatty() and sys.stderr.isatty()  # `| tee log`: lines only, no bar
+        if not quiet and (mode == "bar" or (mode == "auto" and on_terminal)):
             try:
                 from tqdm import tqdm
                 self.bar = tqdm(total=total, unit="asset", desc="topstoc batch", file=sys.stderr)
@@ -71,7 +72,7 @@ class Progress:
                 self.bar = None
         if self.bar is not None:
             progress.attach(self.bar.clear, self.bar.refresh)
-        elif not quiet and mode == "auto":
+        elif not quiet and mode == "auto" and on_terminal:
             progress.start("topstoc batch")  # a terminal without tqdm: a ticker line
             progress.stage(f"0 of {total} assets done")
 
