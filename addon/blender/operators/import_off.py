@@ -63,10 +63,17 @@ def mesh_from_file(path: str, name: str, notes: list) -> bpy.types.Mesh:
     return mesh
 
 
+#: Blender keeps the selection in these attributes; without them nothing is selected.
+SELECTION_ATTRIBUTES = (".select_vert", ".select_edge", ".select_poly")
+
+
 def deselect_all(mesh) -> None:
-    """Nothing selected, as Blender's own importers leave a mesh: Edit Mode tools act on a selection."""
-    for items in (mesh.vertices, mesh.edges, mesh.polygons):
-        items.foreach_set("select", np.zeros(len(items), dtype=bool))
+    """Nothing selected, as Blender's own importers leave a mesh: Edit Mode tools act on a selection.
+    The attributes are removed rather than written (writing "select" crashed bpy 5.0.1)."""
+    for name in SELECTION_ATTRIBUTES:
+        layer = mesh.attributes.get(name)
+        if layer is not None:
+            mesh.attributes.remove(layer)
 
 
 class TOPSTOC_OT_import_off(bpy.types.Operator, ImportHelper):
