@@ -26,6 +26,9 @@ def test_pyproject_declares_the_cluster_extra():
              for requirement in project["optional-dependencies"]["cluster"]}
     assert names == {"dask", "distributed", "tqdm"}
     assert not any(r.startswith(("dask", "distributed", "tqdm")) for r in project["dependencies"])
+    # the extras table holds extras only (a key after it in the file would land inside it)
+    assert set(project["optional-dependencies"]) == {"cluster"}
+    assert project["classifiers"]
 
 
 def test_run_dask_without_dask_names_the_extra(monkeypatch, tmp_path):
