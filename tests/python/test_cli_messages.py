@@ -167,8 +167,16 @@ def test_symmetry_on_an_asymmetric_mesh_warns(tmp_path):
     assert ok.returncode == 0 and ok.stderr == ""
 
 
-def _on_a_terminal(*args) -> str:
-    """Everything ``topstoc ARGS`` writes to a terminal (stdout and stderr on one pty)."""
+#: The command line with each mesh asset of a batch made 2.5 s slower, so that a clock redrawn every
+#: second shows at least two times however fast the machine is.
+SLOW_ASSETS = ("import sys, time; import topstoc.core.batch_mesh as m; real = m.decimate_mesh_file; "
+               "m.decimate_mesh_file = lambda *a, **k: (time.sleep(2.5), real(*a, **k))[1]; "
+               "from topstoc.core.cli import main; sys.exit(main(sys.argv[1:]))")
+
+
+def _on_a_terminal(*args, code: str = None) -> str:
+    """Everything ``topstoc ARGS`` writes to a terminal (stdout and stderr on one pty); ``code``:
+    Python run instead of ``-m topstoc`` (it reads ARGS from sys.argv[1:])."""
     import os
     import pty
     import subprocess
@@ -182,7 +190,8 @@ def _on_a_terminal(*args) -> str:
 
     primary, secondary = pty.openpty()
     fcntl.ioctl(secondary, termios.TIOCSWINSZ, struct.pack("HHHH", 30, 100, 0, 0))  # tqdm needs a width
-    process = subprocess.Popen([sys.executable, "-m", "topstoc", *map(str, args)], stdout=secondary,
+    command = [sys.executable, "-c", code] if code else [sys.executable, "-m", "topstoc"]
+    process = subprocess.Popen([*command, *map(str, args)], stdout=secondary,
                                stderr=secondary, env=dict(os.environ, PYTHONPATH=str(BUILD / "python")))
     os.close(secondary)
     chunks = []
@@ -212,7 +221,7 @@ def test_on_a_terminal_progress_is_erased_before_the_report(tmp_path):
 
 def test_on_a_terminal_a_long_batch_asset_shows_its_clock(tmp_path):
     text = _on_a_terminal("batch", "--input", DATA / "genus_positive" / "cgal_elephant.off", "--output", tmp_path,
-                          "--max-error", "0.3%", "--workers", 0)
+                          "--max-error", "0.3%", "--workers", 0, code=SLOW_ASSETS)
     # a bar (tqdm installed) or the ticker line: either way the clock runs while the asset works
     clocks = re.findall(r"topstoc batch: (?:0 of 1 assets done \.\.\. (\d+) s|.*?\| 0/1 \[(\d\d:\d\d)<)", text)
     assert len(set(clocks)) >= 2, text  # redrawn with a later time while the one asset works
