@@ -167,11 +167,12 @@ def test_symmetry_on_an_asymmetric_mesh_warns(tmp_path):
     assert ok.returncode == 0 and ok.stderr == ""
 
 
-#: The command line with each mesh asset of a batch made 2.5 s slower, so that a clock redrawn every
-#: second shows at least two times however fast the machine is.
-SLOW_ASSETS = ("import sys, time; import topstoc.core.batch_mesh as m; real = m.decimate_mesh_file; "
-               "m.decimate_mesh_file = lambda *a, **k: (time.sleep(2.5), real(*a, **k))[1]; "
-               "from topstoc.core.cli import main; sys.exit(main(sys.argv[1:]))")
+def _slowed(module: str, name: str, seconds: float) -> str:
+    """Python that runs the command line with ``module.name`` made ``seconds`` slower, so that a
+    progress line drawn after a second shows however fast the machine is."""
+    return (f"import sys, time; import {module} as m; real = m.{name}; "
+            f"m.{name} = lambda *a, **k: (time.sleep({seconds}), real(*a, **k))[1]; "
+            "from topstoc.core.cli import main; sys.exit(main(sys.argv[1:]))")
 
 
 def _on_a_terminal(*args, code: str = None) -> str:
@@ -210,7 +211,7 @@ def _on_a_terminal(*args, code: str = None) -> str:
 
 def test_on_a_terminal_progress_is_erased_before_the_report(tmp_path):
     text = _on_a_terminal("decimate", DATA / "genus_positive" / "cgal_elephant.off", tmp_path / "out.off",
-                          "--max-error", "0.3%")
+                          "--max-error", "0.3%", code=_slowed("topstoc.core.mesh_file_job", "prepare_file", 1.5))
     pieces = text.split("\r\x1b[K")
     drawn = [p for p in pieces if p.startswith("topstoc decimate: ")]
     assert drawn, text  # the search outlasts the one-second delay
@@ -221,7 +222,8 @@ def test_on_a_terminal_progress_is_erased_before_the_report(tmp_path):
 
 def test_on_a_terminal_a_long_batch_asset_shows_its_clock(tmp_path):
     text = _on_a_terminal("batch", "--input", DATA / "genus_positive" / "cgal_elephant.off", "--output", tmp_path,
-                          "--max-error", "0.3%", "--workers", 0, code=SLOW_ASSETS)
+                          "--max-error", "0.3%", "--workers", 0,
+                          code=_slowed("topstoc.core.batch_mesh", "decimate_mesh_file", 2.5))
     # a bar (tqdm installed) or the ticker line: either way the clock runs while the asset works
     clocks = re.findall(r"topstoc batch: (?:0 of 1 assets done \.\.\. (\d+) s|.*?\| 0/1 \[(\d\d:\d\d)<)", text)
     assert len(set(clocks)) >= 2, text  # redrawn with a later time while the one asset works
