@@ -25,7 +25,7 @@ import json
 import os
 
 from .errors import TopStocError, shown_path
-from .output_guard import file_identity
+from .output_guard import file_identity, identities
 
 MANIFEST_NAME = "topstoc-manifest.jsonl"
 
@@ -74,12 +74,7 @@ class Manifest:
 
     def check_inputs(self, inputs) -> None:
         """TopStocError when one of ``inputs`` is a file an earlier run into this folder wrote."""
-        written = {}
-        for record in self.records.values():
-            for output in record.get("outputs") or []:
-                identity = file_identity(output)
-                if identity is not None:
-                    written[identity] = output
+        written = identities(output for record in self.records.values() for output in record.get("outputs") or [])
         for path in inputs:
             output = written.get(file_identity(path))
             if output is not None:

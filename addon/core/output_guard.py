@@ -25,6 +25,16 @@ def file_identity(path):
     return status.st_dev, status.st_ino
 
 
+def identities(paths) -> dict:
+    """{(device, inode): path} of those ``paths`` that exist (the last path given for each file)."""
+    found = {}
+    for path in paths:
+        identity = file_identity(path)
+        if identity is not None:
+            found[identity] = path
+    return found
+
+
 def same_file(a, b) -> bool:
     """Whether ``a`` and ``b`` name one file (or would: a missing file is compared by its real path)."""
     first, second = file_identity(a), file_identity(b)
@@ -84,11 +94,7 @@ def check_folders(inputs, out_dir) -> None:
 
 def check_outputs(outputs, inputs) -> None:
     """Refuses when an existing output file is one of ``inputs`` under another name (a hard link)."""
-    taken = {}
-    for given in inputs:
-        identity = file_identity(given)
-        if identity is not None:
-            taken[identity] = given
+    taken = identities(inputs)
     for output in outputs:
         given = taken.get(file_identity(output))
         if given is not None:
