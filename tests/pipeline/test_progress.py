@@ -4,18 +4,15 @@ log, one plain line per asset and no carriage return; ``| tee log`` (standard er
 terminal) gives the log its lines."""
 
 import os
-import pty
 import re
-import select
-import struct
 import subprocess
 import sys
-import time
 
 import pytest
 
 from assets import make_assets
 from conftest import BUILD
+from terminal import open_terminal, read_all
 
 pytest.importorskip("tqdm")
 
@@ -43,34 +40,6 @@ def _env():
     return env
 
 
-def _terminal():
-    """A pseudo-terminal 100 columns wide: (master, slave)."""
-    import fcntl
-    import termios
-
-    master, slave = pty.openpty()
-    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 30, 100, 0, 0))
-    return master, slave
-
-
-def _read_all(master, process, timeout=600) -> str:
-    """Everything written to the terminal until the process ends."""
-    chunks, deadline = [], time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        ready, _, _ = select.select([master], [], [], 0.2)
-        if ready:
-            try:
-                data = os.read(master, 65536)
-            except OSError:   # EIO: every slave end is closed
-                break
-            if not data:
-                break
-            chunks.append(data)
-        elif process.poll() is not None:
-            break
-    return b"".join(chunks).decode(errors="replace")
-
-
 def _carriage_returns(text: str) -> int:
     """Carriage returns that redraw a line (the terminal turns each newline into \\r\\n)."""
     return len(re.findall(r"\r(?!\n)", text))
@@ -80,12 +49,12 @@ def _carriage_returns(text: str) -> int:
 def test_a_terminal_gets_a_bar_redrawn_in_place(library, tmp_path, workers):
     if workers:
         pytest.importorskip("distributed")
-    master, slave = _terminal()
+    master, slave = open_terminal()
     try:
         process = subprocess.Popen(_command(library, tmp_path, workers), stdin=slave, stdout=slave, stderr=slave,
                                    env=_env(), close_fds=True)
         os.close(slave)
-        text = _read_all(master, process)
+        text = read_all(master, process)
         assert process.wait(60) == 0, text
     finally:
         os.close(master)
@@ -111,13 +80,13 @@ def test_a_pipe_gets_one_plain_line_per_asset(library, tmp_path):
 
 def test_output_to_a_log_with_the_terminal_on_standard_error(library, tmp_path):
     """``topstoc batch ... | tee log``: the log gets the lines; no bar mixes into the terminal."""
-    master, slave = _terminal()
+    master, slave = open_terminal()
     try:
         process = subprocess.Popen(_command(library, tmp_path, 0), stdin=slave, stdout=subprocess.PIPE,
                                    stderr=slave, env=_env(), close_fds=True)
         os.close(slave)
         log = process.stdout.read().decode()
-        terminal = _read_all(master, process)
+        terminal = read_all(master, process)
         assert process.wait(60) == 0, terminal
     finally:
         os.close(master)

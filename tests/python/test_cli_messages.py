@@ -179,34 +179,21 @@ def _on_a_terminal(*args, code: str = None) -> str:
     """Everything ``topstoc ARGS`` writes to a terminal (stdout and stderr on one pty); ``code``:
     Python run instead of ``-m topstoc`` (it reads ARGS from sys.argv[1:])."""
     import os
-    import pty
     import subprocess
     import sys
 
     from conftest import BUILD
+    from terminal import open_terminal, read_all
 
-    import fcntl
-    import struct
-    import termios
-
-    primary, secondary = pty.openpty()
-    fcntl.ioctl(secondary, termios.TIOCSWINSZ, struct.pack("HHHH", 30, 100, 0, 0))  # tqdm needs a width
+    primary, secondary = open_terminal()
     command = [sys.executable, "-c", code] if code else [sys.executable, "-m", "topstoc"]
     process = subprocess.Popen([*command, *map(str, args)], stdout=secondary,
                                stderr=secondary, env=dict(os.environ, PYTHONPATH=str(BUILD / "python")))
     os.close(secondary)
-    chunks = []
-    while True:
-        try:
-            chunk = os.read(primary, 4096)
-        except OSError:  # EIO: the child closed the terminal
-            break
-        if not chunk:
-            break
-        chunks.append(chunk)
+    text = read_all(primary, process, timeout=120)
     os.close(primary)
     assert process.wait(timeout=120) == 0
-    return b"".join(chunks).decode()
+    return text
 
 
 def test_on_a_terminal_progress_is_erased_before_the_report(tmp_path):
