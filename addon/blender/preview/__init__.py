@@ -1,0 +1,2 @@
+"""Results kept live: prepared meshes cached per mesh state, change tracking, the modal live
+preview's session and Regenerate."""
