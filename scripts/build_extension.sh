@@ -3,7 +3,7 @@
 #   dist/topstoc-VERSION-linux_x64.zip  (blender --command extension build --split-platforms)
 # It holds the add-on package without a binary plus wheels/topstoc_native-*.whl (CPython 3.11 and
 # 3.13, from scripts/build_wheels.sh); Blender installs the wheel matching its Python and the
-# add-on imports topstoc_native._topstoc (addon/core/native.py). The Blender is Debian 13's 4.3 in
+# add-on imports topstoc_native._topstoc (addon/core/support/native.py). The Blender is Debian 13's 4.3 in
 # the cached root (scripts/debian13_root.sh), run through scripts/in_root.sh.
 set -eu -o pipefail
 cd "$(dirname "$0")/.."

@@ -1,6 +1,6 @@
 """A library of small assets made at run time for the batch tests and bench_batch.py: synthetic
 meshes and the test meshes, at several subdivision levels, under different transforms, written
-as OBJ / PLY / OFF (numpy and topstoc.core.io only)."""
+as OBJ / PLY / OFF (numpy and topstoc.core.api.io only)."""
 
 import pathlib
 
@@ -18,7 +18,7 @@ def _base(name: str):
         return meshgen.icosphere(2)
     if name == "torus":
         return meshgen.torus(24, 12)
-    from topstoc.core.io import read_mesh
+    from topstoc.core.api.io import read_mesh
 
     path = {"fandisk": DATA / "genus0" / "cgal_fandisk.off", "elephant": DATA / "genus_positive" / "cgal_elephant.off",
             "knot1": DATA / "genus_positive" / "cgal_knot1.off"}[name]
@@ -33,7 +33,7 @@ def _rotation(rng) -> np.ndarray:
 
 def make_assets(folder, count: int, *, seed: int = 0, levels=(0, 1), bases=BASES) -> list:
     """Writes ``count`` assets into ``folder``; returns their paths (sorted by name)."""
-    from topstoc.core.io import MeshData, write_mesh
+    from topstoc.core.api.io import MeshData, write_mesh
 
     folder = pathlib.Path(folder)
     folder.mkdir(parents=True, exist_ok=True)

@@ -80,7 +80,7 @@ def _unit(v):
 def shading_error(vertices, triangles, corner_normals, out_vertices, out_triangles, out_normals,
                   closest_points) -> dict:
     """{"mean", "rms"}: area-weighted angle in degrees between the input's shading normal and the
-    result's at the closest point (module docs); ``closest_points`` is topstoc.core.hausdorff's
+    result's at the closest point (module docs); ``closest_points`` is topstoc.core.api.hausdorff's
     (passed in: inside Blender the add-on's copy of the package must be used)."""
     v, t = np.asarray(vertices, dtype=np.float64), np.asarray(triangles, dtype=np.int64)
     corners = v[t]

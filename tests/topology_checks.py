@@ -5,7 +5,7 @@ import gudhi
 import numpy as np
 
 import reference
-from topstoc.core.topology import topology
+from topstoc.core.api.topology import topology
 
 
 def gudhi_betti(num_vertices, triangles, edges=None):

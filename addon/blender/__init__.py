@@ -8,8 +8,10 @@ background mode.
 import bpy
 from bpy.app.handlers import persistent
 
-from . import operators, overlays, presets, props, regenerate, ui, watch
-from .cache import prepared_meshes
+from . import operators, props, ui
+from .ui import overlays, presets
+from .preview import regenerate, watch
+from .preview.cache import prepared_meshes
 
 MODULES = (props, operators, presets, ui, watch, regenerate, overlays)
 

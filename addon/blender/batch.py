@@ -1,6 +1,6 @@
 """Batch decimation inside Blender (or PyPI's bpy): mesh files and Blender's own formats (docs/design.md §6).
 
-Mesh files (OBJ, PLY, OFF, STL, optionally .gz/.bz2) go through topstoc.core.batch_mesh (the
+Mesh files (OBJ, PLY, OFF, STL, optionally .gz/.bz2) go through topstoc.core.batch.mesh_asset (the
 same code ``topstoc batch`` runs without Blender). .blend files are opened; glTF/GLB, FBX and
 USD are imported with Blender's importers into an empty scene. Their mesh objects (all, or
 those named with --objects) are decimated with the add-on's pipeline (the Guided Decimate
@@ -23,14 +23,14 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ..core import batch_settings
-from ..core.batch_mesh import decimate_mesh_file, lod_error
-from ..core.budget import missed_dict, report_missed
-from ..core.decimate import ATTRIBUTE_WEIGHT
-from ..core.prune import prune_small_parts
-from ..core.batch_run import misnamed_failure, utf8_name, write_report
-from ..core.errors import TopStocError, one_line, shown_path
-from ..core.output_guard import check_folders, prepare_output, output_folder
+from ..core.batch import settings as batch_settings
+from ..core.batch.mesh_asset import decimate_mesh_file, lod_error
+from ..core.api.budget import missed_dict, report_missed
+from ..core.api.decimate import ATTRIBUTE_WEIGHT
+from ..core.batch.prune import prune_small_parts
+from ..core.batch.run import misnamed_failure, utf8_name, write_report
+from ..core.support.errors import TopStocError, one_line, shown_path
+from ..core.support.output_guard import check_folders, prepare_output, output_folder
 
 BLEND = ".blend"
 
@@ -80,7 +80,7 @@ def _mesh_objects(bpy, path: str, names) -> list:
 
 def _world_vertices(objects) -> np.ndarray:
     """Every vertex of ``objects`` in world space (for the asset's bounding sphere)."""
-    from . import mesh_io
+    from .io import mesh_io
 
     chunks = []
     for obj in objects:
@@ -111,7 +111,7 @@ def _copy_armature_modifiers(source, target) -> None:
 def _bake(bpy, source, result, settings, name: str) -> str:
     """Bakes the normal map asked for (--bake-normals) from ``source`` onto ``result`` as
     ``<output folder>/<name>_normal.png``; returns its path."""
-    from . import bake
+    from .decimation import bake
 
     size = settings["bake_normals"]
     baked = bake.bake_normals(bpy.context, source, result, size=size, margin=bake_margin(size), store="FILE",
@@ -208,7 +208,8 @@ def decimate_scene_file(path: str, out_dir: str, settings: dict) -> dict:
     """Decimates the mesh objects of a .blend, glTF/GLB, FBX or USD file and writes the result."""
     import bpy
 
-    from . import pipeline, scene_io
+    from .decimation import pipeline
+    from .io import scene_files as scene_io
 
     if not os.path.isfile(path):
         raise FileNotFoundError(f"{path}: no such file")
@@ -267,7 +268,7 @@ def _register_addon() -> None:
 
 
 def _is_mesh_file(path: str) -> bool:
-    from ..core.batch_run import asset_kind
+    from ..core.batch.run import asset_kind
 
     return asset_kind(path) == "mesh"
 
@@ -279,7 +280,7 @@ def main(argv=None) -> int:
         args = parse_args(argv)
     except SystemExit as exit_:
         return int(exit_.code or 0)
-    from ..core.batch_run import find_inputs
+    from ..core.batch.run import find_inputs
 
     try:
         settings = batch_settings.from_args(args)

@@ -1,6 +1,6 @@
 """The demo behind the README's main command (scripts/demo.sh).
 
-Imports a mesh (OBJ through Blender, other formats through topstoc.core.io; by default the
+Imports a mesh (OBJ through Blender, other formats through topstoc.core.api.io; by default the
 COLLADA duck bundled in tests/data, which has UV seams), paints
 guidance on it the way an artist would (the head: more detail), decimates it with
 the Guided Decimate operator at its default settings (Quality: what an artist gets by clicking
@@ -33,13 +33,13 @@ def _default_input() -> str:
 
 
 def _load(path: str, scene) -> bpy.types.Object:
-    """OBJ through Blender's importer (materials, UVs); other formats through topstoc.core.io."""
+    """OBJ through Blender's importer (materials, UVs); other formats through topstoc.core.api.io."""
     if path.lower().endswith(".obj"):
         bpy.ops.wm.obj_import(filepath=path)
         obj = bpy.context.selected_objects[0]
     else:
-        from ..core import io
-        from . import mesh_io
+        from ..core.api import io
+        from .io import mesh_io
 
         data = io.read_mesh(path)
         mesh = bpy.data.meshes.new(pathlib.Path(path).name.split(".")[0])
@@ -123,7 +123,7 @@ def main(argv=None) -> int:
     obj = _load(args.input, scene)
     # Guidance as an artist would paint it: the top fifth (the head) keeps more detail. The
     # budget stays the target's, so the rest gets less.
-    from . import mesh_io
+    from .io import mesh_io
 
     world = np.array(obj.matrix_world)
     points = mesh_io.read_positions(obj.data) @ world[:3, :3].T + world[:3, 3]

@@ -5,26 +5,26 @@
 >>> result = mesh.decimate(ratio=0.1, seed=1)
 """
 
-from .clean import CleanResult, clean
-from .decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
-                       sampling_probabilities)
-from .edit import EditResult, cut_along_loop, delete_faces, fill_holes, fill_loops, remove_handle
-from .error_bound import ErrorBoundReport
-from .errors import TopStocError
-from .hausdorff import Distance, HausdorffResult, OneSidedDistance, closest_points, hausdorff
-from .io import MeshData, read_mesh, write_mesh
-from .loops import (Cancelled, ComponentLoops, Loop, LoopsResult, handle_tunnel_loops, self_intersections,
-                    shorten_loop, tetrahedralize_surface)
-from .mesh import Mesh, MeshReport
-from .mesh_edges import MeshEdges, mesh_edges
-from .topology import ComponentGenerators, ComponentTopology, Topology, generators, topology
+from .api.clean import CleanResult, clean
+from .api.decimate import (Box, DecimateResult, DecimateStats, View, decimate, decimate_with_samples,
+                           sampling_probabilities)
+from .api.edit import EditResult, cut_along_loop, delete_faces, fill_holes, fill_loops, remove_handle
+from .api.error_bound import ErrorBoundReport
+from .support.errors import TopStocError
+from .api.hausdorff import Distance, HausdorffResult, OneSidedDistance, closest_points, hausdorff
+from .api.io import MeshData, read_mesh, write_mesh
+from .api.loops import (Cancelled, ComponentLoops, Loop, LoopsResult, handle_tunnel_loops, self_intersections,
+                        shorten_loop, tetrahedralize_surface)
+from .api.mesh import Mesh, MeshReport
+from .api.mesh_edges import MeshEdges, mesh_edges
+from .api.topology import ComponentGenerators, ComponentTopology, Topology, generators, topology
 
 __all__ = [
     "Box", "DecimateResult", "DecimateStats", "Mesh", "MeshReport", "View", "decimate",
     "decimate_with_samples", "sampling_probabilities",
     # the base of every error TopStoc raises on purpose (a ValueError)
     "TopStocError",
-    # editing (topstoc.core.edit also has boundary_loops and the result's parts)
+    # editing (topstoc.core.api.edit also has boundary_loops and the result's parts)
     "CleanResult", "clean",
     "EditResult", "cut_along_loop", "delete_faces", "fill_holes", "fill_loops", "remove_handle",
     # measurement (hausdorff.py) and error-bounded decimation (error_bound.py)

@@ -140,7 +140,7 @@ py::dict result_dict(DecimateResult&& r) {
   return d;
 }
 
-// The float64 arrays of a call (core/job.py made them contiguous float64 of the right size),
+// The float64 arrays of a call (core/api/job.py made them contiguous float64 of the right size),
 // held while the engine reads them in place.
 struct JobArrays {
   py::array_t<double, py::array::c_style | py::array::forcecast> guidance, attributes, attribute_weights;
@@ -152,7 +152,7 @@ const double* data_of(py::array_t<double, py::array::c_style | py::array::forcec
   return array.data();
 }
 
-// Attributes for the collapse cost (core/job.py's attribute_arrays: flat float64, 3 corners per
+// Attributes for the collapse cost (core/api/job.py's attribute_arrays: flat float64, 3 corners per
 // caller triangle times one value per channel, and the channels' weights), or none.
 CornerAttributes attributes_of(const Mesh& mesh, JobArrays& arrays, const py::handle& values,
                                const py::handle& weights) {
@@ -166,7 +166,7 @@ CornerAttributes attributes_of(const Mesh& mesh, JobArrays& arrays, const py::ha
   return a;
 }
 
-// The sampling half of a DecimationJob (core/job.py); its ranges were checked when it was made,
+// The sampling half of a DecimationJob (core/api/job.py); its ranges were checked when it was made,
 // the engine checks its own invariants (validate_sampling_params).
 SamplingParams sampling_from(const py::handle& job, JobArrays& arrays) {
   SamplingParams s;
@@ -184,7 +184,7 @@ SamplingParams sampling_from(const py::handle& job, JobArrays& arrays) {
   return s;
 }
 
-// A DecimationJob (core/job.py) as the engine's DecimateParams; `arrays` holds what they point into.
+// A DecimationJob (core/api/job.py) as the engine's DecimateParams; `arrays` holds what they point into.
 DecimateParams params_from(const Mesh& mesh, const py::handle& job, JobArrays& arrays) {
   DecimateParams params;
   params.sampling = sampling_from(job, arrays);
@@ -225,14 +225,14 @@ void bind_decimate(py::module_& m) {
         return result_dict(std::move(r));
       },
       py::arg("mesh"), py::arg("layout"), py::arg("job"), py::arg("flood_caches") = py::none(),
-      "TopStoc decimation of a topstoc.core.job.DecimationJob (a triangle target when it has one).");
+      "TopStoc decimation of a topstoc.core.api.job.DecimationJob (a triangle target when it has one).");
 
   m.def(
       "decimate_with_samples",
       [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& samples, const std::string& placement,
          int32_t max_repair_rounds, int32_t refine_vertices, const py::handle& guidance, int32_t refine_triangles,
          const py::handle& attributes, const py::handle& attribute_weights) {
-        // guidance, attributes and the counts were checked in Python (core/decimate.py, core/job.py)
+        // guidance, attributes and the counts were checked in Python (core/api/decimate.py, core/api/job.py)
         auto ids = ids_from(samples, -1, "samples");
         JobArrays arrays;
         const double* u = data_of(arrays.guidance, guidance);

@@ -1,5 +1,5 @@
 // Bindings for topology editing: delete faces, cut along a loop, boundary loops, fill holes,
-// remove a handle. Arrays in, a dict of arrays out (see addon/core/edit.py for the Python API).
+// remove a handle. Arrays in, a dict of arrays out (see addon/core/api/edit.py for the Python API).
 #include <pybind11/stl.h>
 
 #include <stdexcept>

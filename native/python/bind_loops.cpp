@@ -95,7 +95,7 @@ void bind_loops(py::module_& m) {
       py::arg("mesh"), py::arg("coarse_vertices") = -1, py::arg("full_route_faces") = 20000,
       py::arg("max_full_faces") = 400000, py::arg("shorten") = true, py::arg("count_edges") = false,
       py::arg("max_roots") = 0, py::arg("seed") = 1, py::arg("progress") = py::none(),
-      "Handle and tunnel loops of every closed orientable component (see topstoc.core.loops).");
+      "Handle and tunnel loops of every closed orientable component (see topstoc.core.api.loops).");
 
   m.def(
       "shorten_loop",

@@ -1,5 +1,5 @@
 // Bindings for topology: invariants per component and generator edges, as plain arrays.
-// topstoc.core.topology turns them into dataclasses.
+// topstoc.core.api.topology turns them into dataclasses.
 #include <stdexcept>
 
 #include "convert.hpp"
@@ -124,7 +124,7 @@ void bind_topology(py::module_& m) {
       "Invariants per connected component of the simplicial complex spanned by vertices (n, 3), "
       "triangles (m, 3) and optional extra edges (k, 2), in the caller's vertex ids; with generators=True "
       "also the 2g generator edges and loops of each closed orientable manifold component. Plain arrays; "
-      "see topstoc.core.topology for the documented Python API.");
+      "see topstoc.core.api.topology for the documented Python API.");
 }
 
 }  // namespace topstoc::python

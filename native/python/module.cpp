@@ -6,8 +6,8 @@
 
 namespace {
 
-// The Python class bad input is raised as (topstoc.core.errors.TopStocError, set by
-// topstoc.core.native right after the import; a plain ValueError until then). Owned for the
+// The Python class bad input is raised as (topstoc.core.support.errors.TopStocError, set by
+// topstoc.core.support.native right after the import; a plain ValueError until then). Owned for the
 // interpreter's lifetime: it must not be released after the interpreter has finalised.
 PyObject* error_class = nullptr;
 

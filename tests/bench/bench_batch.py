@@ -78,7 +78,7 @@ def main() -> int:
     with tempfile.TemporaryDirectory(prefix="topstoc-bench-batch-") as tmp:
         tmp = pathlib.Path(tmp)
         paths = make_assets(tmp / "assets", args.count, levels=(0, 1))
-        from topstoc.core.io import read_mesh
+        from topstoc.core.api.io import read_mesh
         triangles = sum(read_mesh(p).num_triangles for p in paths)
         print(f"bench_batch: {len(paths)} assets, {triangles:,} triangles in all "
               f"({triangles // len(paths):,} per asset), --ratio {args.ratio}")

@@ -52,7 +52,7 @@ def read_binary_ply(path):
 
 def make_object(name, vertices, triangles):
     mesh = bpy.data.meshes.new(name)
-    ts.blender.mesh_io.fill_geometry(mesh, vertices, triangles)
+    ts.blender.io.mesh_io.fill_geometry(mesh, vertices, triangles)
     obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     return obj
@@ -75,8 +75,8 @@ def remove(obj):
 
 def topstoc_first_result(obj, ratio):
     """Seconds of one cold Guided Decimate (cache emptied): read + prepare + decimate + write."""
-    pipeline = ts.blender.pipeline
-    ts.blender.cache.prepared_meshes.clear()
+    pipeline = ts.blender.decimation.pipeline
+    ts.blender.preview.cache.prepared_meshes.clear()
     start = time.perf_counter()
     run = pipeline.decimate(bpy.context, obj, Params(ratio))
     out = pipeline.write_output(run)
@@ -88,7 +88,7 @@ def topstoc_first_result(obj, ratio):
 
 def stages(obj, ratio):
     """The same work stage by stage (one run): where the first result's time goes."""
-    mesh_io, t = ts.blender.mesh_io, {}
+    mesh_io, t = ts.blender.io.mesh_io, {}
     clock = time.perf_counter()
     arrays = mesh_io.read_mesh(obj.data)
     t["read"], clock = time.perf_counter() - clock, time.perf_counter()
@@ -108,7 +108,7 @@ def stages(obj, ratio):
 
 
 def preview_updates(obj, ratio, count):
-    session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(ratio))
+    session = ts.blender.preview.session.PreviewSession(bpy.context, obj, Params(ratio))
     session.update(ratio)  # warm
     times = []
     for r in np.geomspace(ratio / 2, min(1.0, ratio * 2), count):
@@ -127,9 +127,9 @@ def preview_start(obj, ratio, prepared):
     other processes' load does not inflate), and seconds until the first result is shown (polled
     every 5 ms; the modal timer polls at 60 Hz). ``prepared``: the mesh is in the cache already."""
     if not prepared:
-        ts.blender.cache.prepared_meshes.clear()
+        ts.blender.preview.cache.prepared_meshes.clear()
     start, cpu = time.perf_counter(), time.thread_time()
-    session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(ratio), ratio=ratio)
+    session = ts.blender.preview.session.PreviewSession(bpy.context, obj, Params(ratio), ratio=ratio)
     control, cpu = time.perf_counter() - start, time.thread_time() - cpu
     while not session.poll():
         time.sleep(0.005)
@@ -145,7 +145,7 @@ def preview_drag(obj, ratio, seconds=4.0, event_interval=0.01, span=2.0):
     ratios go back and forth over [ratio / span, ratio * span] in 50 events (0.5 s): span 2 is
     a sweep over a factor of four, span 1.1 a fine adjustment around the ratio (0.4 % a step),
     where nearby requests update each other's floods (native flood_cache.hpp)."""
-    session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(ratio))
+    session = ts.blender.preview.session.PreviewSession(bpy.context, obj, Params(ratio))
     session.update(ratio)  # warm
     sweep = np.geomspace(ratio / span, min(1.0, ratio * span), 50)
     shown, start, i = 0, time.perf_counter(), 0
@@ -165,8 +165,8 @@ def preview_apply(obj, ratio):
     (before: decimating again at Quality on the main thread, then writing; now, a rested result:
     writing the Quality result on screen; now, Enter during the drag: seconds until written, the
     main thread only polling meanwhile, and its busy part: apply, polls and the write)."""
-    pipeline, params = ts.blender.pipeline, Params(ratio, quality="QUALITY")
-    session = ts.blender.preview.PreviewSession(bpy.context, obj, params, ratio=ratio)
+    pipeline, params = ts.blender.decimation.pipeline, Params(ratio, quality="QUALITY")
+    session = ts.blender.preview.session.PreviewSession(bpy.context, obj, params, ratio=ratio)
     while not session.final:  # the fast result, then the rested Quality one
         session.poll()
         time.sleep(0.005)
@@ -194,7 +194,7 @@ def applied(session, ratio):
         run = session.poll_apply()
         busy += time.perf_counter() - clock
     clock = time.perf_counter()
-    out = ts.blender.pipeline.write_output(run)
+    out = ts.blender.decimation.pipeline.write_output(run)
     busy += time.perf_counter() - clock
     return time.perf_counter() - start, busy, out
 
@@ -234,7 +234,7 @@ def main(argv):
     print(f"machine: {os.cpu_count()} cores, {cpu}; Blender {bpy.app.version_string}; "
           f"load average {os.getloadavg()[0]:.1f}; OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY', 'default')}")
     try:
-        from topstoc.core.io import read_mesh  # any format when the io module is built
+        from topstoc.core.api.io import read_mesh  # any format when the io module is built
         data = read_mesh(args.mesh)
         vertices, triangles = data.vertices, data.triangles
     except ImportError:
@@ -291,8 +291,8 @@ if __name__ == "__main__":
     sys.path.insert(0, str(pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build")) / "python"))
     addon_utils.enable("topstoc", default_set=True)
     import topstoc as ts  # noqa: E402
-    import topstoc.blender.pipeline  # noqa: E402,F401
-    import topstoc.blender.preview  # noqa: E402,F401
+    import topstoc.blender.decimation.pipeline  # noqa: E402,F401
+    import topstoc.blender.preview.session  # noqa: E402,F401
 
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     code = main(argv)

@@ -58,8 +58,8 @@ def main():
     if not HORSE.exists():
         print(f"skipped: {HORSE} is not available")
         return 0
-    mesh_io, carry = ts.blender.mesh_io, ts.blender.carry
-    data = ts.core.io.read_mesh(str(HORSE))
+    mesh_io, carry = ts.blender.io.mesh_io, ts.blender.io.carry
+    data = ts.core.api.io.read_mesh(str(HORSE))
     mesh = bpy.data.meshes.new("Horse")
     mesh_io.fill_geometry(mesh, data.vertices, data.triangles)
     obj = bpy.data.objects.new("Horse", mesh)
@@ -118,7 +118,7 @@ def edit_row(data):
     times = {}
     for kind in ("topstoc", "blender"):
         mesh = bpy.data.meshes.new(kind)
-        ts.blender.mesh_io.fill_geometry(mesh, data.vertices, data.triangles)
+        ts.blender.io.mesh_io.fill_geometry(mesh, data.vertices, data.triangles)
         obj = bpy.data.objects.new(kind, mesh)
         bpy.context.scene.collection.objects.link(obj)
         group = obj.vertex_groups.new(name="Group")
@@ -150,8 +150,8 @@ if __name__ == "__main__":
     sys.path.insert(0, str(pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build")) / "python"))
     addon_utils.enable("topstoc", default_set=True)
     import topstoc as ts  # noqa: E402
-    import topstoc.blender.carry  # noqa: E402,F401
-    import topstoc.blender.mesh_io  # noqa: E402,F401
+    import topstoc.blender.io.carry  # noqa: E402,F401
+    import topstoc.blender.io.mesh_io  # noqa: E402,F401
 
     code = main()
     sys.stdout.flush()

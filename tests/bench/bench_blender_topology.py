@@ -90,8 +90,8 @@ def main(argv):
                platform.processor())
     print(f"machine: {os.cpu_count()} cores, {cpu}; Blender {bpy.app.version_string}; "
           f"load average {os.getloadavg()[0]:.1f}")
-    from topstoc.blender import mesh_io
-    from topstoc.core import io
+    from topstoc.blender.io import mesh_io
+    from topstoc.core.api import io
 
     for spec in args.mesh:
         path, _, levels = spec.partition(":")

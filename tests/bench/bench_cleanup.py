@@ -1,4 +1,4 @@
-"""Benchmark: the topology clean-up (topstoc.core.clean) on meshes with many small defects.
+"""Benchmark: the topology clean-up (topstoc.core.api.clean) on meshes with many small defects.
 
     /usr/bin/python3 tests/bench/bench_cleanup.py [--handles 10,100,300] [--holes 50,300,1000]
 
@@ -38,11 +38,11 @@ import cleanup_meshes  # noqa: E402
 import meshgen  # noqa: E402
 import reference  # noqa: E402
 from machine import machine  # noqa: E402
-from topstoc.core import edit  # noqa: E402
-from topstoc.core.clean import clean, patch_quality  # noqa: E402
-from topstoc.core.io import read_mesh  # noqa: E402
-from topstoc.core.loops import handle_tunnel_loops  # noqa: E402
-from topstoc.core.topology import topology  # noqa: E402
+from topstoc.core.api import edit  # noqa: E402
+from topstoc.core.api.clean import clean, patch_quality  # noqa: E402
+from topstoc.core.api.io import read_mesh  # noqa: E402
+from topstoc.core.api.loops import handle_tunnel_loops  # noqa: E402
+from topstoc.core.api.topology import topology  # noqa: E402
 
 SIZE = 6.0
 HOLE_SIZE = 10.0

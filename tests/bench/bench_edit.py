@@ -7,7 +7,7 @@ Cases
     (500-vertex loop): cut + fill both holes.
   * turbine x3: ../shared/meshes/genus_positive/cgal_turbine.off after three rounds of Loop
     subdivision (1,181,440 triangles, genus 11); remove a handle along a handle loop of the
-    coarse mesh (topstoc.core.loops; a tree-cotree generator loop without it) carried through
+    coarse mesh (topstoc.core.api.loops; a tree-cotree generator loop without it) carried through
     the subdivision (its vertices keep their ids, edge midpoints join them).
   * elephant-with-holes: fill all 106 holes, ours vs CGAL's triangulate_hole (peer program
     build/peers/cgal_edit, timed inside the program, reading excluded).
@@ -37,7 +37,7 @@ sys.path[:0] = [str(ROOT / "build" / "python"), str(ROOT / "tests"), str(ROOT / 
 import meshgen  # noqa: E402
 from machine import machine  # noqa: E402
 from test_edit import generator_loop, read_off, write_off  # noqa: E402
-from topstoc.core import edit  # noqa: E402
+from topstoc.core.api import edit  # noqa: E402
 
 CGAL_EDIT = ROOT / "build" / "peers" / "cgal_edit"
 
@@ -122,7 +122,7 @@ def main(argv=None) -> int:
     if (SHARED / "tools" / "loop_subdiv.py").exists() and turbine.exists():
         coarse_v, coarse_t = read_off(turbine)
         try:  # a real handle loop when the loops module is built, else a tree-cotree generator
-            from topstoc.core.loops import handle_tunnel_loops
+            from topstoc.core.api.loops import handle_tunnel_loops
             loop, kind = handle_tunnel_loops(coarse_v, coarse_t).handles[0].vertices.tolist(), "handle loop"
         except ImportError:
             loop, kind = generator_loop(coarse_v, coarse_t), "generator loop"

@@ -35,7 +35,7 @@ import numpy as np  # noqa: E402
 import topstoc  # noqa: E402
 from peer_runs import (cgal_hausdorff, meshlab_hausdorff, meshopt_simplify, peer, read_off,  # noqa: E402
                        write_off)
-from topstoc.core.native import engine  # noqa: E402
+from topstoc.core.support.native import engine  # noqa: E402
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from machine import machine  # noqa: E402
 

@@ -1,10 +1,10 @@
-"""Mesh file reading and writing: topstoc.core.io against OpenMesh's readers, same run.
+"""Mesh file reading and writing: topstoc.core.api.io against OpenMesh's readers, same run.
 
     /usr/bin/python3 tests/bench/bench_io.py [RUNS]
 
 OpenMesh is timed by build/peers/plain_openmesh_read (its IOManager with a raw-array
 BaseImporter, in C++), next to topstoc's native reader in the same process; this script adds
-topstoc.core.io.read_mesh as Python users call it (file read included) and the writers.
+topstoc.core.api.io.read_mesh as Python users call it (file read included) and the writers.
 Needs ../shared/meshes (skips otherwise) and a build (cmake --build build).
 """
 
@@ -42,7 +42,7 @@ def main() -> int:
         print(f"skipped: {SHARED} is not available")
         return 0
     try:
-        from topstoc.core.io import read_mesh, write_mesh
+        from topstoc.core.api.io import read_mesh, write_mesh
     except ImportError as error:
         print(f"skipped: no build ({error})")
         return 0

@@ -39,7 +39,7 @@ sys.path.insert(0, str(ROOT / "tests" / "bench"))
 
 from machine import machine  # noqa: E402
 from topstoc.core import Mesh, handle_tunnel_loops, read_mesh, tetrahedralize_surface, write_mesh  # noqa: E402
-from topstoc.core.io import MeshData  # noqa: E402
+from topstoc.core.api.io import MeshData  # noqa: E402
 
 SHARED = ROOT.parent / "shared"
 OUT = ROOT / "build" / "bench_meshes"

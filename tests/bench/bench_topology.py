@@ -5,7 +5,7 @@
 The mesh is ../shared/meshes/genus_positive/cgal_turbine.off after three rounds of Loop
 subdivision by ../shared/tools/loop_subdiv.py (1,181,440 triangles, genus 11), made once into
 build/bench/ (never committed). Also times the 1.55M-triangle horse of ../shared/meshes/big.
-Ours: topstoc.core.topology.topology (invariants per component) and the same with
+Ours: topstoc.core.api.topology.topology (invariants per component) and the same with
 generators=True, as Python users call them (arrays in, dataclasses out). GUDHI 3.7: a
 SimplexTree of the mesh (insert_batch), Z2 persistence and betti_numbers(), in the same run.
 Goals (PEERS.md, issue 4): invariants <= 0.1 s, generators <= 0.3 s. Wall-clock medians are
@@ -49,8 +49,8 @@ def timed(function, runs: int):
 
 def read(path: pathlib.Path):
     try:
-        from topstoc.core.io import read_mesh
-    except ImportError:  # before topstoc.core.io: the shared tools' reader
+        from topstoc.core.api.io import read_mesh
+    except ImportError:  # before topstoc.core.api.io: the shared tools' reader
         sys.path.insert(0, str(SHARED / "tools"))
         import meshstat
         import numpy as np
@@ -73,7 +73,7 @@ def gudhi_betti(num_vertices, triangles):
 
 
 def bench(name, vertices, triangles, runs, gudhi_runs, generators=True):
-    from topstoc.core.topology import topology
+    from topstoc.core.api.topology import topology
 
     print(f"\n{name}: {len(vertices)} vertices, {len(triangles)} triangles")
     wall, cpu, info = timed(lambda: topology(vertices, triangles), runs)
@@ -105,7 +105,7 @@ def main() -> int:
         print(f"skipped: {TURBINE} is not available")
         return 0
     try:
-        import topstoc.core.topology  # noqa: F401
+        import topstoc.core.api.topology  # noqa: F401
     except ImportError as error:
         print(f"skipped: no build ({error})")
         return 0

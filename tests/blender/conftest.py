@@ -61,12 +61,12 @@ def addon_module():
 
 @pytest.fixture(scope="session")
 def ts(addon_module):
-    """The add-on package (``ts.core``, ``ts.blender.pipeline`` ...)."""
+    """The add-on package (``ts.core``, ``ts.blender.decimation.pipeline`` ...)."""
     import importlib
 
     package = sys.modules[addon_module]
-    for sub in ("core", "core.guidance", "blender.pipeline", "blender.mesh_io", "blender.preview",
-                "blender.cache", "blender.guidance"):
+    for sub in ("core", "core.api.guidance", "blender.decimation.pipeline", "blender.io.mesh_io",
+                "blender.preview.session", "blender.preview.cache", "blender.decimation.guidance"):
         importlib.import_module(f"{addon_module}.{sub}")
     return package
 

@@ -344,8 +344,8 @@ def run():
 try:
     addon_utils.enable("topstoc", default_set=True)
     bpy.ops.mesh.primitive_torus_add(major_segments=96, minor_segments=48)
-    sessions = sys.modules["topstoc.blender.preview"]
-    sessions.prepared_meshes_clear = sys.modules["topstoc.blender.cache"].prepared_meshes.clear
+    sessions = sys.modules["topstoc.blender.preview.session"]
+    sessions.prepared_meshes_clear = sys.modules["topstoc.blender.preview.cache"].prepared_meshes.clear
     operators = sys.modules["topstoc.blender.operators.preview"]
     state["steps"] = steps()
     bpy.app.timers.register(run, first_interval=1.0)

@@ -68,7 +68,7 @@ def test_the_active_uv_map_keeps_the_texture_in_place(ts, scene):
     # the result records what entered the cost
     parameters = json.loads(kept["topstoc_parameters"])
     assert parameters["attributes"] == ["UV map 'Stretched'"]
-    assert parameters["attribute_weight"] == pytest.approx(ts.blender.pipeline.ATTRIBUTE_WEIGHT)
+    assert parameters["attribute_weight"] == pytest.approx(ts.blender.decimation.pipeline.ATTRIBUTE_WEIGHT)
     assert json.loads(off["topstoc_parameters"])["attributes"] == []
 
 
@@ -85,7 +85,7 @@ def test_weight_zero_is_the_geometry_only_result(ts, scene):
     obj = cylinder()
     out = decimate(obj, attribute_weight=0.0)
     vertices, triangles, uvs = uv_cylinder()
-    seams = ts.core.attributes.uv_seam_edges(triangles, uvs)
+    seams = ts.core.carry.attributes.uv_seam_edges(triangles, uvs)
     mesh = ts.core.Mesh(positions(obj.data).astype(np.float64), triangles)
     plain = mesh.decimate(target_vertices=TARGET, borders=seams, mode="quality", seed=0, adaptivity=0.5)
     np.testing.assert_array_equal(positions(out.data), plain.vertices.astype(np.float32))

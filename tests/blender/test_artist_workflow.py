@@ -125,7 +125,7 @@ def test_regenerate_after_a_source_edit_keeps_the_results_own_edits(ts, scene):
 
 
 def test_auto_regenerate_is_debounced(ts, scene):
-    regenerate = ts.blender.regenerate
+    regenerate = ts.blender.preview.regenerate
     obj = ball()
     bpy.ops.topstoc.guided_decimate(ratio=0.2, quality="FAST")
     out = bpy.context.active_object
@@ -154,7 +154,7 @@ def preset_values(path):
 
 
 def test_presets_are_installed_and_apply(ts, scene):
-    presets = ts.blender.presets
+    presets = ts.blender.ui.presets
     folder = presets.user_preset_folder()
     names = sorted(n for n in os.listdir(presets.BUNDLED) if n.endswith(".py"))
     assert {"Game_LOD.py", "Scan_Clean-up.py", "Hard_Surface.py"} <= set(names)
@@ -169,7 +169,7 @@ def test_presets_are_installed_and_apply(ts, scene):
 
 
 def test_quality_choice_maps_onto_engine_options(ts, scene):
-    pipeline = ts.blender.pipeline
+    pipeline = ts.blender.decimation.pipeline
     settings = scene.topstoc
     for quality, mode in (("FAST", "fast"), ("QUALITY", "quality")):
         settings.quality = quality
@@ -223,7 +223,7 @@ def test_symmetry_gives_a_mirror_symmetric_result(ts, scene, quality):
 def test_face_count_estimate_matches_the_result(ts, scene):
     obj = ball()
     settings = scene.topstoc
-    pipeline = ts.blender.pipeline
+    pipeline = ts.blender.decimation.pipeline
     for mode, field, value in (("RATIO", "ratio", 0.2), ("VERTICES", "vertices", 150), ("TRIANGLES", "triangles", 300)):
         settings.target_mode = mode
         setattr(settings, field, value)
@@ -239,7 +239,7 @@ def test_face_count_estimate_matches_the_result(ts, scene):
 def test_topology_help_covers_every_figure_and_loop_kind(ts, scene):
     import importlib
 
-    help_text = importlib.import_module(f"{ts.__name__}.blender.topology_help").HELP
+    help_text = importlib.import_module(f"{ts.__name__}.blender.ui.topology_help").HELP
     panel = importlib.import_module(f"{ts.__name__}.blender.ui.topology")
     obj = make_object("Torus", *meshgen.torus(24, 12))
     assert bpy.ops.topstoc.analyse() == {"FINISHED"}
@@ -254,6 +254,6 @@ def test_topology_help_covers_every_figure_and_loop_kind(ts, scene):
     summary = panel.plain_summary(obj.topstoc.topology)  # a closed torus: one handle, printable
     assert "1 handle" in summary and "ready to print" in summary
     kinds = {item.identifier: item.description
-             for item in ts.blender.props_analysis.TOPSTOC_PG_loop.bl_rna.properties["kind"].enum_items}
+             for item in ts.blender.props.results.TOPSTOC_PG_loop.bl_rna.properties["kind"].enum_items}
     assert "ring on a finger" in kinds["HANDLE"] and "thread through a ring" in kinds["TUNNEL"]
     assert "genus drops" in bpy.ops.topstoc.remove_loop.get_rna_type().description

@@ -1,4 +1,4 @@
-"""Normal maps baked from the source onto a 2 % LOD (blender/bake.py): rendered under a fixed sun
+"""Normal maps baked from the source onto a 2 % LOD (blender/decimation/bake.py): rendered under a fixed sun
 and camera, the LOD with its baked map shades at least 3x closer to the source than the bare LOD,
 on a sculpted mesh (a subdivided, displaced Suzanne) and on a UV-mapped asset (the duck, whose UV
 map the LOD keeps). Also: the result's material gets the map and the source's is untouched, the
@@ -99,8 +99,8 @@ def duck():
 
 
 def decimated(ts, obj, name):
-    run = ts.blender.pipeline.decimate(bpy.context, obj, params())
-    lod = ts.blender.pipeline.write_output(run, "NEW_OBJECT", name=name, place=False)
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, params())
+    lod = ts.blender.decimation.pipeline.write_output(run, "NEW_OBJECT", name=name, place=False)
     return lod
 
 
@@ -127,7 +127,7 @@ CASES = [(sculpted_suzanne, True, 3.0),   # no UV map: Smart UV Project
 def bake(ts):
     import importlib
 
-    return importlib.import_module(f"{ts.__name__}.blender.bake")
+    return importlib.import_module(f"{ts.__name__}.blender.decimation.bake")
 
 
 def small_pair(name="small"):
@@ -143,8 +143,8 @@ def cycles_bakes(ts, bake, scene):
     """Whether this Blender's Cycles bakes selected-to-active at all (Debian's Blender 3.4 returns
     an empty map: bake_normals casts the rays itself, bake_raycast.py)."""
     source = small_pair()
-    run = ts.blender.pipeline.decimate(bpy.context, source, params(0.2))
-    lod = ts.blender.pipeline.write_output(run, "NEW_OBJECT", place=False)
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, source, params(0.2))
+    lod = ts.blender.decimation.pipeline.write_output(run, "NEW_OBJECT", place=False)
     try:
         return bake.bake_normals(bpy.context, source, lod, size=64, margin=2).method == "Cycles"
     finally:
@@ -272,11 +272,11 @@ def test_one_line_refusals(ts, bake, scene, monkeypatch):
     source = small_pair()
     lod = decimated(ts, source, "lod")
     images = set(bpy.data.images)
-    with pytest.raises(ts.core.errors.TopStocError, match="whole number of pixels from 16 to 16384"):
+    with pytest.raises(ts.core.support.errors.TopStocError, match="whole number of pixels from 16 to 16384"):
         bake.bake_normals(bpy.context, source, lod, size=32768)
     with monkeypatch.context() as low_memory:  # 1 GiB free: an 8192² map (1 GiB while baking) is refused
         low_memory.setattr(bake, "available_memory", lambda: 2 ** 30)
-        with pytest.raises(ts.core.errors.TopStocError, match="8192x8192 normal map needs 1,024 MiB"):
+        with pytest.raises(ts.core.support.errors.TopStocError, match="8192x8192 normal map needs 1,024 MiB"):
             bake.bake_normals(bpy.context, source, lod, size=8192)
     source.modifiers.new("bevel", "BEVEL")
     with pytest.raises(bake.BakeError, match=r"'small[.0-9]*' has modifiers that are not applied \(bevel\)"):
@@ -342,8 +342,8 @@ def test_batch_writes_a_gltf_that_reimports_with_its_map(ts, scene, tmp_path):
 
     from test_batch_formats import _runner
 
-    batch_run = importlib_module(ts, "core.batch_run")
-    scene_io = importlib_module(ts, "blender.scene_io")
+    batch_run = importlib_module(ts, "core.batch.run")
+    scene_io = importlib_module(ts, "blender.io.scene_files")
     source_faces = len(small_pair("pebble").data.polygons)
     bpy.ops.export_scene.gltf(filepath=str(tmp_path / "pebble.gltf"), export_format="GLTF_SEPARATE")
     out = tmp_path / "out"
@@ -375,7 +375,7 @@ def test_batch_refuses_mesh_files_and_bad_sizes(ts, scene, tmp_path):
 
     from test_batch_formats import _runner
 
-    batch_run = importlib_module(ts, "core.batch_run")
+    batch_run = importlib_module(ts, "core.batch.run")
     command = batch_run.blender_command(_runner()) + [
         "--input", str(DATA / "uv_materials/duck/duck_via_assimp.obj"), "--output", str(tmp_path / "out"),
         "--ratio", "0.1", "--bake-normals"]

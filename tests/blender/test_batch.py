@@ -19,7 +19,7 @@ def batch(*args, timeout=300):
 
 
 def has_io(ts):
-    return importlib.util.find_spec(ts.__name__ + ".core.io") is not None
+    return importlib.util.find_spec(ts.__name__ + ".core.api.io") is not None
 
 
 MAKE_SCENE = """
@@ -95,7 +95,7 @@ def test_bad_arguments_exit_non_zero(ts, tmp_path):
 
 def test_mesh_files(ts, tmp_path):
     if not has_io(ts):
-        pytest.skip("topstoc.core.io is not in this build")
+        pytest.skip("topstoc.core.api.io is not in this build")
     inputs = [DATA / "genus0" / "cgal_fandisk.off", DATA / "uv_materials" / "spider" / "spider.obj",
               DATA / "open_boundary" / "kivy_suzanne_monkey.obj",
               DATA / "nonmanifold_degenerate" / "openscad_unparseable.stl"]
@@ -106,7 +106,7 @@ def test_mesh_files(ts, tmp_path):
     data = json.loads(report.read_text())
     assert [f["input"] for f in data["failures"]] == [str(inputs[3])]
     assert len(data["results"]) == 3
-    io = importlib.import_module(ts.__name__ + ".core.io")
+    io = importlib.import_module(ts.__name__ + ".core.api.io")
     for entry in data["results"]:
         written = io.read_mesh(entry["output"])
         assert written.num_vertices == entry["vertices_out"] < entry["vertices_in"]
@@ -119,7 +119,7 @@ def test_mesh_files(ts, tmp_path):
 def test_folders_as_topstoc_batch_takes_them(ts, tmp_path):
     """A folder is searched recursively for supported files, as ``topstoc batch`` does."""
     if not has_io(ts):
-        pytest.skip("topstoc.core.io is not in this build")
+        pytest.skip("topstoc.core.api.io is not in this build")
     folder = tmp_path / "assets"
     (folder / "sub").mkdir(parents=True)
     for source, target in ((DATA / "genus0" / "cgal_fandisk.off", folder / "fandisk.off"),
@@ -138,13 +138,13 @@ def test_folders_as_topstoc_batch_takes_them(ts, tmp_path):
 
 def test_max_error_target(ts, tmp_path):
     if not has_io(ts):
-        pytest.skip("needs topstoc.core.io")
+        pytest.skip("needs topstoc.core.api.io")
     source = DATA / "genus0" / "cgal_fandisk.off"
     report = tmp_path / "r.json"
     done = batch("--input", source, "--max-error", "0.5%", "--output", tmp_path / "o", "--json", report)
     assert done.returncode == 0, done.stdout + done.stderr
     [entry] = json.loads(report.read_text())["results"]
-    io = importlib.import_module(ts.__name__ + ".core.io")
+    io = importlib.import_module(ts.__name__ + ".core.api.io")
     original = io.read_mesh(source)
     diagonal = float(np.linalg.norm(original.vertices.max(axis=0) - original.vertices.min(axis=0)))
     assert entry["error"] is not None and entry["error"] <= 0.005 * diagonal

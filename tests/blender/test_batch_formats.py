@@ -26,7 +26,7 @@ def _runner():
 
 
 def _settings(ts, *argv):
-    batch_settings = importlib.import_module(ts.__name__ + ".core.batch_settings")
+    batch_settings = importlib.import_module(ts.__name__ + ".core.batch.settings")
     parser = argparse.ArgumentParser()
     batch_settings.add_arguments(parser)
     # Fast mode: output vertices are input vertices, so attributes can be compared exactly.
@@ -92,7 +92,7 @@ def _is_bone_shape(obj):
 
 def _read_back(ts, path):
     """Imports ``path`` with Blender's importer; per-corner data of its one mesh object."""
-    scene_io = importlib.import_module(ts.__name__ + ".blender.scene_io")
+    scene_io = importlib.import_module(ts.__name__ + ".blender.io.scene_files")
     scene_io.import_file(str(path))
     [obj] = [o for o in bpy.context.scene.objects if o.type == "MESH" and not _is_bone_shape(o)]
     mesh = obj.data
@@ -175,7 +175,7 @@ def test_round_trip_keeps_what_the_add_on_keeps(ts, scene, tmp_path, kind):
     _character()
     source = tmp_path / f"character.{kind}"
     _export(source, kind)
-    batch_run = importlib.import_module(ts.__name__ + ".core.batch_run")
+    batch_run = importlib.import_module(ts.__name__ + ".core.batch.run")
     out = tmp_path / "out"
     out.mkdir()
     entry = batch_run.run_blender_asset(str(source), str(out), _settings(ts, "--ratio", "0.5"), _runner())
@@ -207,7 +207,7 @@ def test_lod_chain_in_one_file_and_one_file_per_lod(ts, scene, tmp_path):
     _character()
     source = tmp_path / "character.glb"
     _export(source, "glb")
-    batch_run = importlib.import_module(ts.__name__ + ".core.batch_run")
+    batch_run = importlib.import_module(ts.__name__ + ".core.batch.run")
     out = tmp_path / "one"
     out.mkdir()
     entry = batch_run.run_blender_asset(str(source), str(out), _settings(ts, "--screen-pixels", "150", "50", "15"),
@@ -217,7 +217,7 @@ def test_lod_chain_in_one_file_and_one_file_per_lod(ts, scene, tmp_path):
     counts = [lod["vertices"] for lod in body["lods"]]
     assert counts[0] > counts[1] > counts[2]
     assert all(lod["hausdorff_pixels"] <= 1.0 for lod in body["lods"])
-    scene_io = importlib.import_module(ts.__name__ + ".blender.scene_io")
+    scene_io = importlib.import_module(ts.__name__ + ".blender.io.scene_files")
     scene_io.import_file(str(out / "character.glb"))
     meshes = {o.name: o for o in bpy.context.scene.objects if o.type == "MESH" and not _is_bone_shape(o)}
     assert sorted(meshes) == ["Body_LOD0", "Body_LOD1", "Body_LOD2"]
@@ -243,7 +243,7 @@ def test_usd_without_usd_support_is_a_clear_failure(ts, scene, tmp_path):
         pytest.skip("this Blender has USD")
     source = tmp_path / "asset.usdc"
     source.write_bytes(b"PXR-USDC")
-    batch_run = importlib.import_module(ts.__name__ + ".core.batch_run")
+    batch_run = importlib.import_module(ts.__name__ + ".core.batch.run")
     outcome = batch_run.run_asset(str(source), str(tmp_path / "out"), _settings(ts, "--ratio", "0.5"), _runner())
     assert outcome["status"] == "failed"
     assert "built without USD" in outcome["message"], outcome["message"]

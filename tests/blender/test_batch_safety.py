@@ -23,7 +23,7 @@ def batch(*args, timeout=300):
 def _ring(ts, path):
     path.parent.mkdir(parents=True, exist_ok=True)
     v, f = meshgen.torus(24, 12)
-    ts.core.io.write_mesh(path, ts.core.io.MeshData(vertices=v, triangles=f))
+    ts.core.api.io.write_mesh(path, ts.core.api.io.MeshData(vertices=v, triangles=f))
     return path
 
 

@@ -23,9 +23,10 @@ def test_every_error_derives_from_topstoc_error(ts):
 
 def _refusals(ts, obj):
     """What each entry point raises for ``obj``: (error class, message)."""
-    analysis = importlib.import_module(ts.__name__ + ".blender.analysis")
-    metrics = importlib.import_module(ts.__name__ + ".blender.metrics")
-    calls = [(ts.blender.pipeline.DecimationError, lambda: ts.blender.pipeline.decimate(bpy.context, obj, Params())),
+    analysis = importlib.import_module(ts.__name__ + ".blender.analysis.topology")
+    metrics = importlib.import_module(ts.__name__ + ".blender.analysis.metrics")
+    pipeline = ts.blender.decimation.pipeline
+    calls = [(pipeline.DecimationError, lambda: pipeline.decimate(bpy.context, obj, Params())),
              (analysis.AnalysisError, lambda: analysis.analyse(obj)),
              (metrics.MetricsError, lambda: metrics.measure(obj, reference=obj))]
     found = []

@@ -1,4 +1,4 @@
-"""Each guidance source changes the sampling the documented way (topstoc.core.guidance)."""
+"""Each guidance source changes the sampling the documented way (topstoc.core.api.guidance)."""
 
 import bpy
 import numpy as np
@@ -14,7 +14,7 @@ def sphere(name="Sphere", subdivisions=4):
 
 
 def run(ts, obj, **params):
-    return ts.blender.pipeline.decimate(bpy.context, obj, Params(**params))
+    return ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(**params))
 
 
 def density_ratio(vertices, faces, kept, region):
@@ -64,7 +64,7 @@ def test_keep_and_drop_are_exact(ts, scene):
 
 
 def test_colour_convention_round_trips(ts, scene):
-    rules = ts.core.guidance
+    rules = ts.core.api.guidance
     for name, u in rules.GUIDANCE_LEVELS.items():
         colour = rules.guidance_color(u)
         assert rules.color_to_guidance(colour[None, :3])[0] == pytest.approx(u)
@@ -74,7 +74,7 @@ def test_colour_convention_round_trips(ts, scene):
     writer = import_module(ts.__name__ + ".blender.operators.guidance")
     for value in (-1.0, -0.5, 0.0, 0.5, 1.0):
         writer.write_guidance(obj, np.isclose(np.round(u * 2) / 2, value), None, value)
-    read = ts.blender.guidance.read_color_guidance(obj.data, obj.topstoc.color_attribute)
+    read = ts.blender.decimation.guidance.read_color_guidance(obj.data, obj.topstoc.color_attribute)
     np.testing.assert_allclose(read, np.round(u * 2) / 2, atol=1e-6)
 
 
@@ -216,7 +216,7 @@ def test_direct_selection_in_edit_mode(ts, scene):
     bpy.context.tool_settings.mesh_select_mode = (True, False, False)
     assert bpy.ops.topstoc.set_guidance(level="KEEP") == {"FINISHED"}
     bpy.ops.object.mode_set(mode="OBJECT")
-    u = ts.blender.guidance.read_color_guidance(obj.data, obj.topstoc.color_attribute)
+    u = ts.blender.decimation.guidance.read_color_guidance(obj.data, obj.topstoc.color_attribute)
     np.testing.assert_allclose(u[select], 1.0)
     np.testing.assert_allclose(u[~select], 0.0, atol=1e-6)
     r = run(ts, obj, ratio=0.02).result
@@ -227,13 +227,13 @@ def test_missing_sources_are_reported_and_nothing_changes(ts, scene):
     obj, v, f = sphere(subdivisions=2)
     obj.topstoc.use_vertex_group = True
     obj.topstoc.vertex_group = "Nope"
-    with pytest.raises(ts.blender.guidance.GuidanceError, match="vertex group 'Nope' not found"):
+    with pytest.raises(ts.blender.decimation.guidance.GuidanceError, match="vertex group 'Nope' not found"):
         run(ts, obj)
     with pytest.raises(RuntimeError, match="vertex group 'Nope' not found"):  # the operator's error report
         bpy.ops.topstoc.guided_decimate(ratio=0.5)
     obj.topstoc.use_vertex_group = False
     obj.topstoc.color_attribute = "Paint"
-    with pytest.raises(ts.blender.guidance.GuidanceError, match="colour attribute 'Paint' not found"):
+    with pytest.raises(ts.blender.decimation.guidance.GuidanceError, match="colour attribute 'Paint' not found"):
         run(ts, obj)
     assert [o.name for o in bpy.data.objects] == ["Sphere"]
     assert len(obj.data.vertices) == len(v)
@@ -244,10 +244,10 @@ def test_guidance_layer_and_palette(ts, scene):
     assert bpy.ops.topstoc.add_guidance_layer() == {"FINISHED"}
     layer = obj.data.color_attributes[obj.topstoc.color_attribute]
     assert obj.data.color_attributes.active_color.name == layer.name
-    u = ts.blender.guidance.read_color_guidance(obj.data, layer.name)
+    u = ts.blender.decimation.guidance.read_color_guidance(obj.data, layer.name)
     np.testing.assert_allclose(u, 0.0, atol=1e-6)                       # created neutral grey
     palette = bpy.data.palettes["TopStoc Guidance"]
-    rules = ts.core.guidance
+    rules = ts.core.api.guidance
     decoded = [rules.color_to_guidance(np.array(c.color)[None])[0] for c in palette.colors]
     np.testing.assert_allclose(decoded, [1.0, 0.5, 0.0, -0.5, -1.0], atol=1e-6)
 
@@ -259,17 +259,18 @@ def test_control_points_over_the_target_are_reported_on_the_result(ts, scene):
     obj, v, f = sphere()
     keep = v[:, 2] > 0.3  # about a third of the sphere as control points, far over 5 %
     paint(ts, obj, keep, 1.0)
-    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.05))
+    pipeline = ts.blender.decimation.pipeline
+    run = pipeline.decimate(bpy.context, obj, Params(ratio=0.05))
     over, reason = run.result.stats.over_budget, run.result.stats.over_budget_reason
     assert run.result.num_vertices >= keep.sum() > round(0.05 * len(v))
     assert over == run.result.num_vertices - round(0.05 * len(v)) and reason == "control points"
-    out = ts.blender.pipeline.write_output(run)
+    out = pipeline.write_output(run)
     assert out["topstoc_over_budget"] == over and out["topstoc_over_budget_reason"] == reason
     target = round(0.05 * len(v))
     assert (f"target missed: {run.result.num_vertices:,} vertices for {target:,} ({over:,} over"
-            in ts.blender.pipeline.summary(run)) and ts.blender.pipeline.summary(run).endswith("; control points)")
+            in pipeline.summary(run)) and pipeline.summary(run).endswith("; control points)")
     assert out["topstoc_target_missed"] == run.result.stats.target_missed.text()
     plain, _, _ = sphere("Plain")
-    out = ts.blender.pipeline.write_output(ts.blender.pipeline.decimate(bpy.context, plain, Params(ratio=0.05)))
+    out = pipeline.write_output(pipeline.decimate(bpy.context, plain, Params(ratio=0.05)))
     assert out["topstoc_over_budget"] == 0 and out["topstoc_over_budget_reason"] == ""
     assert out["topstoc_target_missed"] == ""

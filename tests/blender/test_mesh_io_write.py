@@ -10,10 +10,10 @@ import meshgen
 
 
 def test_geometry_written_is_what_blender_reads_back(ts, scene, monkeypatch):
-    mesh_io, dna = ts.blender.mesh_io, ts.blender.dna_arrays
+    mesh_io, dna = ts.blender.io.mesh_io, ts.blender.io.dna_arrays
     vertices, triangles = meshgen.torus(48, 24)
     triangles = np.asarray(triangles)
-    edges = ts.core.mesh_edges(triangles, len(vertices))
+    edges = ts.core.api.mesh_edges(triangles, len(vertices))
     used = {}
     write = dna.write_field
 

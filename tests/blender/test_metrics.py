@@ -15,9 +15,9 @@ from helpers import make_object, positions, select_only
 
 @pytest.fixture
 def mods(ts):
-    names = {"metrics": "blender.metrics", "overlay_data": "blender.overlay_data", "overlays": "blender.overlays",
-             "operators": "blender.operators.metrics", "panel": "blender.ui.metrics", "colors": "core.colors",
-             "watch": "blender.watch"}
+    names = {"metrics": "blender.analysis.metrics", "overlay_data": "blender.ui.overlay_data",
+             "overlays": "blender.ui.overlays", "operators": "blender.operators.metrics", "panel": "blender.ui.metrics",
+             "colors": "core.support.colors", "watch": "blender.preview.watch"}
     return type("Mods", (), {key: importlib.import_module(f"{ts.__name__}.{name}") for key, name in names.items()})
 
 
@@ -146,9 +146,9 @@ def test_error_overlay_and_colour_attribute(mods, decimated):
 
 def test_clusters_and_samples_of_the_last_decimation(mods, ts, scene):
     obj = make_object("Ball", *meshgen.icosphere(3))
-    run = ts.blender.pipeline.decimate(bpy.context, obj, type("P", (), dict(
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, type("P", (), dict(
         target_mode="RATIO", ratio=0.1, seed=5, adaptivity=0.5, density="off", placement="subsample", refine=0))())
-    ts.blender.pipeline.store_samples(run)
+    ts.blender.decimation.pipeline.store_samples(run)
     show = bpy.context.scene.topstoc.overlays
     show.show_samples = show.show_clusters = True
     samples, labels = mods.overlay_data.last_decimation(obj)

@@ -73,8 +73,8 @@ class Redo:
 
 def test_status_line_and_redo_panel_text(ts, scene, capfd):
     obj = loose_triangles()
-    run = ts.blender.pipeline.decimate(bpy.context, obj, scene.topstoc, target={"ratio": 0.1})
-    assert ts.blender.pipeline.summary(run).endswith("; " + expected_text())
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, scene.topstoc, target={"ratio": 0.1})
+    assert ts.blender.decimation.pipeline.summary(run).endswith("; " + expected_text())
     select_only(obj)
     capfd.readouterr()
     assert bpy.ops.topstoc.guided_decimate(ratio=0.1) == {"FINISHED"}

@@ -101,8 +101,8 @@ def corner_data(mesh):
 @pytest.fixture
 def quality_result(ts, scene):
     obj = sphere_with_everything()
-    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.1, quality="QUALITY", seed=3))
-    out = ts.blender.pipeline.write_output(run)
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.1, quality="QUALITY", seed=3))
+    out = ts.blender.decimation.pipeline.write_output(run)
     return obj, out
 
 

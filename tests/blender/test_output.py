@@ -60,8 +60,8 @@ def test_uvs_and_materials_survive_exactly(ts, scene, path):
     obj = import_obj(DATA / path)
     source = obj.data
     before = snapshot(source)
-    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.2, seed=3))
-    out = ts.blender.pipeline.write_output(run)
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.2, seed=3))
+    out = ts.blender.decimation.pipeline.write_output(run)
     assert snapshot(source) == before                        # the original is untouched
     mesh = out.data
     assert len(mesh.polygons) == run.result.num_triangles < len(source.loop_triangles)
@@ -100,8 +100,8 @@ def test_shading_and_materials_come_from_the_source_face(ts, scene, shading):
     for poly in source.polygons:
         poly.use_smooth = {"flat": False, "smooth": True, "mixed": poly.index % 3 == 0}[shading]
         poly.material_index = poly.index % 3
-    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.3))
-    mesh = ts.blender.pipeline.write_output(run).data
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.3))
+    mesh = ts.blender.decimation.pipeline.write_output(run).data
     assert 0 < len(mesh.polygons) < len(source.polygons)
     source_polygon = run.prepared.arrays.triangle_polygon[run.result.face_source]
     assert [p.use_smooth for p in mesh.polygons] == [source.polygons[int(s)].use_smooth for s in source_polygon]
@@ -125,8 +125,8 @@ def test_attributes_and_vertex_groups_carry_over(ts, scene):
     group = obj.vertex_groups.new(name="Ring")
     group.add(list(range(0, n, 2)), 0.25, "REPLACE")
     group.add(list(range(1, n, 2)), 0.75, "REPLACE")
-    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.3))
-    out = ts.blender.pipeline.write_output(run)
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.3))
+    out = ts.blender.decimation.pipeline.write_output(run)
     m = out.data
     kept = kept_ids(mesh, m)
     np.testing.assert_array_equal(kept, run.result.kept)
@@ -161,8 +161,8 @@ def test_custom_normals_carry_over(ts, scene):
         mesh.use_auto_smooth = True
     mesh.normals_split_custom_set(normals.tolist())
     assert mesh.has_custom_normals
-    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.3))
-    out = ts.blender.pipeline.write_output(run).data
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.3))
+    out = ts.blender.decimation.pipeline.write_output(run).data
     assert out.has_custom_normals
     if hasattr(out, "corner_normals"):
         values = np.array([n.vector[:] for n in out.corner_normals])
@@ -217,8 +217,8 @@ def test_all_selected_meshes_are_decimated(ts, scene):
 
 
 def _reports_error(ts, obj, match, **params):
-    with pytest.raises(ts.blender.pipeline.DecimationError, match=match):
-        ts.blender.pipeline.decimate(bpy.context, obj, Params(**params))
+    with pytest.raises(ts.blender.decimation.pipeline.DecimationError, match=match):
+        ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(**params))
 
 
 def test_bad_input_is_reported_and_nothing_is_lost(ts, scene):
@@ -247,17 +247,17 @@ def test_messy_meshes_decimate(ts, scene):
     scene.collection.objects.link(obj)
     select_only(obj)
     before = snapshot(mesh)
-    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.2))
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.2))
     report = run.prepared.mesh.report()
     assert report.nonmanifold_edges >= 1 and report.zero_area_triangles >= 1 and report.isolated_vertices >= 1
-    out = ts.blender.pipeline.write_output(run)
+    out = ts.blender.decimation.pipeline.write_output(run)
     assert 0 < len(out.data.polygons) < len(faces)
     assert snapshot(mesh) == before
 
 
 def test_cache_reprepares_after_an_edit(ts, scene):
     obj = make_object("Ball", *meshgen.icosphere(3))
-    cache = ts.blender.cache.prepared_meshes
+    cache = ts.blender.preview.cache.prepared_meshes
     first = cache.get(obj.data)
     assert cache.get(obj.data) is first                   # unchanged: reused
     co = positions(obj.data)
@@ -272,16 +272,16 @@ def test_cache_reprepares_after_an_edit(ts, scene):
 def test_max_deviation_target(ts, scene):
     obj = make_object("Ball", *meshgen.icosphere(4))
     params = Params(target_mode="MAX_ERROR", max_error=1.0, max_error_relative=True)
-    run = ts.blender.pipeline.decimate(bpy.context, obj, params)
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, params)
     assert run.parameters["max_error"] == pytest.approx(0.01) and run.parameters["relative"]
     assert run.result.num_vertices < len(obj.data.vertices)
     # Measured independently of the search: the symmetric Hausdorff error is within 1 % of the diagonal.
     import importlib
 
-    hausdorff = importlib.import_module(ts.__name__ + ".core.hausdorff")
+    hausdorff = importlib.import_module(ts.__name__ + ".core.api.hausdorff")
     mesh = run.prepared.mesh
     measured = hausdorff.hausdorff((mesh.vertices, mesh.triangles), (run.result.vertices, run.result.triangles),
                                    samples=200_000)
     assert measured.symmetric.max <= 0.01 * mesh.diagonal * 1.05
-    out = ts.blender.pipeline.write_output(run)
+    out = ts.blender.decimation.pipeline.write_output(run)
     assert len(out.data.vertices) == run.result.num_vertices

@@ -126,8 +126,8 @@ def check_flags(source, mesh, kept, moved):
 @pytest.mark.parametrize("quality", ["FAST", "QUALITY"])
 def test_flags_follow_the_flagged_curves(ts, flagged_sphere, quality):
     obj = flagged_sphere
-    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.15, seed=4, quality=quality))
-    out = ts.blender.pipeline.write_output(run)
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.15, seed=4, quality=quality))
+    out = ts.blender.decimation.pipeline.write_output(run)
     kept = np.asarray(run.result.kept)
     moved = np.any(positions(out.data) != positions(obj.data)[kept], axis=1)
     assert (quality == "QUALITY") == bool(moved.any())  # the quality mode moved some vertices
@@ -143,8 +143,8 @@ def test_flags_follow_the_flagged_curves(ts, flagged_sphere, quality):
 def test_in_place_result_keeps_the_flags(ts, flagged_sphere):
     obj = flagged_sphere
     source = obj.data.copy()
-    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.2, seed=1))
-    ts.blender.pipeline.write_output(run, mode="IN_PLACE")
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.2, seed=1))
+    ts.blender.decimation.pipeline.write_output(run, mode="IN_PLACE")
     assert len(obj.data.vertices) == run.result.num_vertices
     check_flags(source, obj.data, np.asarray(run.result.kept), np.zeros(run.result.num_vertices, dtype=bool))
     bpy.data.meshes.remove(source)
@@ -152,7 +152,7 @@ def test_in_place_result_keeps_the_flags(ts, flagged_sphere):
 
 def test_live_preview_shows_the_flags(ts, flagged_sphere):
     obj = flagged_sphere
-    session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(quality="FAST", seed=2), ratio=None)
+    session = ts.blender.preview.session.PreviewSession(bpy.context, obj, Params(quality="FAST", seed=2), ratio=None)
     try:
         session.update(0.2)
         kept = np.asarray(session.result.kept)
@@ -165,8 +165,8 @@ def test_a_mesh_without_flags_gets_none(ts, scene):
     bpy.ops.mesh.primitive_uv_sphere_add(segments=36, ring_count=18)
     obj = bpy.context.object
     obj.topstoc.use_sharp = True
-    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.15, seed=4))
-    mesh = ts.blender.pipeline.write_output(run).data
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.15, seed=4))
+    mesh = ts.blender.decimation.pipeline.write_output(run).data
     for flag in FLAGS:
         assert not edge_flag(mesh, flag).any()
     names = {attribute.name for attribute in mesh.attributes}
@@ -178,8 +178,8 @@ def test_flags_not_used_as_borders_follow_the_rule(ts, flagged_sphere):
     edge is still flagged exactly where the rule finds a chain (here: few or none)."""
     obj = flagged_sphere
     obj.topstoc.use_uv_seams = obj.topstoc.use_sharp = False
-    run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.15, seed=4, quality="QUALITY"))
-    out = ts.blender.pipeline.write_output(run).data
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.15, seed=4, quality="QUALITY"))
+    out = ts.blender.decimation.pipeline.write_output(run).data
     kept = np.asarray(run.result.kept)
     moved = np.any(positions(out) != positions(obj.data)[kept], axis=1)
     out_pairs = edge_pairs(out)

@@ -61,17 +61,18 @@ def triangles_of(mesh):
 
 def reference(ts, obj, ratio, quality, seed):
     """The same decimation through the operator's pipeline (main thread, its own engine call)."""
-    return ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=ratio, quality=quality, seed=seed)).result
+    pipeline = ts.blender.decimation.pipeline
+    return pipeline.decimate(bpy.context, obj, Params(ratio=ratio, quality=quality, seed=seed)).result
 
 
 @pytest.fixture
 def donut(ts, scene):
-    ts.blender.cache.prepared_meshes.clear()
+    ts.blender.preview.cache.prepared_meshes.clear()
     return make_object("Donut", *meshgen.torus(96, 48))
 
 
 def test_a_rested_quality_result_is_applied_as_shown(ts, scene, donut, monkeypatch):
-    preview, pipeline = ts.blender.preview, ts.blender.pipeline
+    preview, pipeline = ts.blender.preview.session, ts.blender.decimation.pipeline
     engine = EngineCalls(monkeypatch, pipeline)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=3), ratio=0.1)
     try:
@@ -109,8 +110,8 @@ def test_with_fast_chosen_the_drag_shows_drafts_and_the_rested_result_is_applied
                                                                                           monkeypatch):
     """Drag frames are drafts (no attribute sources, no final output check); the rested result
     is the full fast decimation, checked, with the draft's geometry, and Enter writes it as shown."""
-    preview = ts.blender.preview
-    engine = EngineCalls(monkeypatch, ts.blender.pipeline)
+    preview = ts.blender.preview.session
+    engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="FAST", seed=2), ratio=0.1)
     try:
         assert wait_for(lambda: session.poll())
@@ -137,8 +138,8 @@ def test_with_fast_chosen_the_drag_shows_drafts_and_the_rested_result_is_applied
 
 
 def test_applying_during_a_drag_computes_the_chosen_settings_on_the_worker(ts, scene, donut, monkeypatch):
-    preview = ts.blender.preview
-    engine = EngineCalls(monkeypatch, ts.blender.pipeline)
+    preview = ts.blender.preview.session
+    engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=5), ratio=0.1)
     try:
         assert wait_for(lambda: session.poll())
@@ -164,15 +165,15 @@ def test_applying_during_a_drag_computes_the_chosen_settings_on_the_worker(ts, s
     expected = reference(ts, donut, 0.17, "QUALITY", 5)
     np.testing.assert_array_equal(np.asarray(run.result.samples), np.asarray(expected.samples))
     np.testing.assert_array_equal(np.asarray(run.result.vertices), np.asarray(expected.vertices))
-    out = ts.blender.pipeline.write_output(run)
+    out = ts.blender.decimation.pipeline.write_output(run)
     assert len(out.data.vertices) == expected.num_vertices
     assert wait_for(lambda: not preview_threads(), 10), preview_threads()
 
 
 def test_applying_uses_the_quality_result_still_being_computed(ts, scene, donut, monkeypatch):
     """Enter while the rested quality result is on its way: that computation is the one applied."""
-    preview = ts.blender.preview
-    engine = EngineCalls(monkeypatch, ts.blender.pipeline)
+    preview = ts.blender.preview.session
+    engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=1), ratio=0.1)
     try:
         assert wait_for(lambda: session.poll())
@@ -189,8 +190,8 @@ def test_applying_uses_the_quality_result_still_being_computed(ts, scene, donut,
 
 
 def test_closing_while_applying_writes_nothing_and_leaves_no_thread(ts, scene, donut, monkeypatch):
-    preview = ts.blender.preview
-    engine = EngineCalls(monkeypatch, ts.blender.pipeline)
+    preview = ts.blender.preview.session
+    engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline)
     before = snapshot(donut.data)
     names = set(bpy.data.objects.keys())
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=5), ratio=0.1)
@@ -213,8 +214,8 @@ def test_closing_while_applying_writes_nothing_and_leaves_no_thread(ts, scene, d
 def test_enter_before_the_attribute_sources_are_found_waits_for_them(ts, scene, donut, monkeypatch):
     """The rested Quality result shows before the worker has found where its moved vertices take
     their attributes from: Enter then waits for that (no new decimation), on the modal's timer."""
-    preview = ts.blender.preview
-    engine = EngineCalls(monkeypatch, ts.blender.pipeline)
+    preview = ts.blender.preview.session
+    engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline)
     gate, held, threads = threading.Event(), threading.Event(), []
     find = preview.moved_vertices
 
@@ -244,8 +245,8 @@ def test_enter_before_the_attribute_sources_are_found_waits_for_them(ts, scene, 
 def test_a_rested_symmetric_result_is_applied_as_shown(ts, scene, donut, monkeypatch):
     """Symmetry with Fast chosen: the drag shows plain Fast results, the rest the mirrored one,
     which Enter writes without decimating again."""
-    preview = ts.blender.preview
-    engine = EngineCalls(monkeypatch, ts.blender.pipeline)
+    preview = ts.blender.preview.session
+    engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline)
     params = Params(quality="FAST", seed=2, use_symmetry=True, symmetry_axis="X")
     session = preview.PreviewSession(bpy.context, donut, params, ratio=0.1)
     try:
@@ -255,7 +256,7 @@ def test_a_rested_symmetric_result_is_applied_as_shown(ts, scene, donut, monkeyp
         assert run is not None and engine.count() == calls == 2
     finally:
         session.close()
-    expected = ts.blender.pipeline.decimate(bpy.context, donut, params).result
+    expected = ts.blender.decimation.pipeline.decimate(bpy.context, donut, params).result
     np.testing.assert_array_equal(np.asarray(run.result.vertices), np.asarray(expected.vertices))
     assert run.parameters["symmetry"] == "X"
     co = np.asarray(run.result.vertices)

@@ -48,8 +48,8 @@ def wait_for(condition, seconds=20.0):
 
 
 def test_session_returns_before_the_preparation_and_shows_the_first_result(ts, scene, monkeypatch):
-    preview = ts.blender.preview
-    ts.blender.cache.prepared_meshes.clear()
+    preview = ts.blender.preview.session
+    ts.blender.preview.cache.prepared_meshes.clear()
     obj = make_object("Donut", *meshgen.torus(96, 48))
     gate, steps, reached = gated_report(monkeypatch, preview, "validate")
     threading.Timer(10, gate.set).start()  # a session that waited would still end, later
@@ -78,8 +78,8 @@ def test_session_returns_before_the_preparation_and_shows_the_first_result(ts, s
 
 
 def test_a_request_during_the_preparation_is_the_first_result(ts, scene, monkeypatch):
-    preview = ts.blender.preview
-    ts.blender.cache.prepared_meshes.clear()
+    preview = ts.blender.preview.session
+    ts.blender.preview.cache.prepared_meshes.clear()
     obj = make_object("Donut", *meshgen.torus(64, 32))
     gate, _steps, reached = gated_report(monkeypatch, preview, "order")
     session = preview.PreviewSession(bpy.context, obj, Params(seed=1), ratio=0.1)
@@ -97,8 +97,8 @@ def test_a_request_during_the_preparation_is_the_first_result(ts, scene, monkeyp
 
 
 def test_close_during_preparation_stops_the_engine_and_leaves_the_object(ts, scene, monkeypatch):
-    preview = ts.blender.preview
-    cache = ts.blender.cache.prepared_meshes
+    preview = ts.blender.preview.session
+    cache = ts.blender.preview.cache.prepared_meshes
     cache.clear()
     obj = make_object("Donut", *meshgen.torus(96, 48))
     before = snapshot(obj.data)
@@ -122,8 +122,8 @@ def test_close_during_preparation_stops_the_engine_and_leaves_the_object(ts, sce
 
 
 def test_a_prepared_mesh_is_not_prepared_again(ts, scene, monkeypatch):
-    preview = ts.blender.preview
-    cache = ts.blender.cache.prepared_meshes
+    preview = ts.blender.preview.session
+    cache = ts.blender.preview.cache.prepared_meshes
     cache.clear()
     obj = make_object("Donut", *meshgen.torus(64, 32))
     first = preview.PreviewSession(bpy.context, obj, Params(), ratio=0.2)
@@ -144,13 +144,13 @@ def test_a_prepared_mesh_is_not_prepared_again(ts, scene, monkeypatch):
 
 
 def test_a_failed_preparation_surfaces_on_poll(ts, scene):
-    preview = ts.blender.preview
+    preview = ts.blender.preview.session
     # a coordinate Blender holds but the engine refuses (found while preparing, on the worker)
     obj = make_object("Flat", [(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)], [(0, 1, 2), (1, 3, 2)])
     obj.data.vertices[3].co = (float("nan"), 1.0, 0.0)
     session = preview.PreviewSession(bpy.context, obj, Params(), ratio=0.5)
     try:
-        with pytest.raises(ts.blender.pipeline.DecimationError, match="'Flat'.*finite"):
+        with pytest.raises(ts.blender.decimation.pipeline.DecimationError, match="'Flat'.*finite"):
             assert wait_for(lambda: session.poll() and False, 10)
     finally:
         session.close()
@@ -158,12 +158,12 @@ def test_a_failed_preparation_surfaces_on_poll(ts, scene):
 
 
 def test_a_guidance_error_stops_the_started_preparation(ts, scene):
-    preview = ts.blender.preview
-    ts.blender.cache.prepared_meshes.clear()
+    preview = ts.blender.preview.session
+    ts.blender.preview.cache.prepared_meshes.clear()
     obj = make_object("Donut", *meshgen.torus(64, 32))
     obj.topstoc.use_vertex_group, obj.topstoc.vertex_group = True, "no such group"
     before = snapshot(obj.data)
-    with pytest.raises(ts.blender.guidance.GuidanceError, match="no such group"):
+    with pytest.raises(ts.blender.decimation.guidance.GuidanceError, match="no such group"):
         preview.PreviewSession(bpy.context, obj, Params(), ratio=0.2)
     assert wait_for(lambda: not preview_threads(), 10), preview_threads()
     assert snapshot(obj.data) == before and not obj.hide_get()

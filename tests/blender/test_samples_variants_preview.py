@@ -73,7 +73,7 @@ def test_preview_session(ts, scene):
     obj = make_object("Donut", *meshgen.torus(64, 32))
     from helpers import Params
 
-    session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(seed=4, quality="QUALITY"))
+    session = ts.blender.preview.session.PreviewSession(bpy.context, obj, Params(seed=4, quality="QUALITY"))
     assert not obj.hide_get() and session.preview is None  # nothing changes before a result shows
     for ratio in (0.5, 0.1, 0.02):
         session.update(ratio)
@@ -147,7 +147,7 @@ def test_refined_decimation_keeps_uvs_and_restores(ts, scene):
     bpy.ops.uv.smart_project(island_margin=0.02)  # several islands: seams the refinement must keep
     bpy.ops.object.mode_set(mode="OBJECT")
     obj.topstoc.use_uv_seams = True
-    plain_run = ts.blender.pipeline.decimate(bpy.context, obj, Params(ratio=0.1, seed=3))
+    plain_run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.1, seed=3))
     assert bpy.ops.topstoc.guided_decimate(ratio=0.1, seed=3, quality="CUSTOM", refine=6, placement="subsample") == {"FINISHED"}
     first = bpy.data.objects["Knot_TopStoc"]
     assert len(first.data.vertices) <= max(plain_run.result.num_vertices, plain_run.result.stats.target_vertices)

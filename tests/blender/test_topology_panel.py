@@ -18,8 +18,9 @@ from helpers import make_object, positions, select_only
 
 @pytest.fixture
 def mods(ts):
-    names = {"analysis": "blender.analysis", "overlay_data": "blender.overlay_data", "panel": "blender.ui.topology",
-             "colors": "core.colors", "watch": "blender.watch", "mesh_edit": "blender.mesh_edit"}
+    names = {"analysis": "blender.analysis.topology", "overlay_data": "blender.ui.overlay_data",
+             "panel": "blender.ui.topology", "colors": "core.support.colors", "watch": "blender.preview.watch",
+             "mesh_edit": "blender.io.mesh_edit"}
     return type("Mods", (), {key: importlib.import_module(f"{ts.__name__}.{name}") for key, name in names.items()})
 
 
@@ -346,7 +347,7 @@ def test_self_intersecting_mesh_reports_the_tetgen_refusal(mods, scene):
 
 
 def test_nonmanifold_mesh_loop_search_reports_in_the_panel(mods, ts, scene):
-    data = importlib.import_module(ts.__name__ + ".core.io").read_mesh(
+    data = importlib.import_module(ts.__name__ + ".core.api.io").read_mesh(
         str(DATA / "nonmanifold_degenerate/openscad_issue1580-back-to-back.stl"))
     obj = make_object("Scan", data.vertices, data.triangles)
     assert bpy.ops.topstoc.analyse() == {"FINISHED"}

@@ -136,8 +136,8 @@ def big_mesh_preview(source):
 
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
     import meshgen
-    from topstoc.blender import mesh_io
-    from topstoc.core.io import read_mesh
+    from topstoc.blender.io import mesh_io
+    from topstoc.core.api.io import read_mesh
 
     data = read_mesh(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "open_boundary",
                                   "kivy_suzanne_monkey.obj"))
@@ -158,7 +158,7 @@ def big_mesh_preview(source):
     settings.target_mode, settings.ratio = "VERTICES", 0.3
     report["values"]["big_triangles"] = int(len(triangles))
     window, area, region, _space = view3d()
-    sessions = sys.modules[ADDON.__name__ + ".blender.preview"]
+    sessions = sys.modules[ADDON.__name__ + ".blender.preview.session"]
     operators = sys.modules[ADDON.__name__ + ".blender.operators.preview"]
     created = []
     original_init = sessions.PreviewSession.__init__

@@ -22,7 +22,7 @@ RATIO = float(ARGS[1]) if len(ARGS) > 1 else 0.05
 
 def triangles_of(obj):
     """(vertices, triangles) of ``obj``'s evaluated mesh in object space (modifiers applied)."""
-    from topstoc.blender import mesh_io
+    from topstoc.blender.io import mesh_io
 
     evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
     mesh = evaluated.to_mesh()

@@ -4,7 +4,7 @@
         [--name NAME] [--subdivide LEVELS] [--transform] [--decimate RATIO] [--measure]
         [--analyse] [--loops]
 
-Reads any mesh format through topstoc.core.io; --subdivide splits every triangle into four
+Reads any mesh format through topstoc.core.api.io; --subdivide splits every triangle into four
 (midpoint subdivision: same shape and topology, more triangles); --transform moves, rotates and
 scales the object non-uniformly (overlays must follow); --decimate adds "<name>_TopStoc" at the
 same place (moved back from beside the original); --measure stores the Hausdorff figures on the decimated object; --analyse and
@@ -40,8 +40,8 @@ def main():
     sys.path.insert(0, os.environ["TOPSTOC_BUILD_PYTHON"])
     if addon_utils.enable("topstoc", default_set=True) is None:
         raise RuntimeError("could not enable topstoc")
-    from topstoc.blender import mesh_io
-    from topstoc.core import io
+    from topstoc.blender.io import mesh_io
+    from topstoc.core.api import io
 
     cube = bpy.data.objects.get("Cube")
     if cube is not None:

@@ -31,7 +31,7 @@ def steps():
     yield 0.5
     session.shot("error_on", [decimated])
     session.keep_for_docs("error_on", "hausdorff-colours.png")
-    from topstoc.blender import overlays  # the add-on's modules, as registered
+    from topstoc.blender.ui import overlays  # the add-on's modules, as registered
 
     session.report["values"]["drawn_error"] = overlays.drawn_primitives(decimated)
     session.report["values"]["legend_object"] = getattr(overlays.legend_object(bpy.context), "name", None)

@@ -26,7 +26,7 @@ def positions(mesh):
 
 
 def steps():
-    regenerate = sys.modules[ADDON.__name__ + ".blender.regenerate"]
+    regenerate = sys.modules[ADDON.__name__ + ".blender.preview.regenerate"]
     runs = []
     original = regenerate.regenerate
 

@@ -10,7 +10,7 @@ from conftest import BUILD, DATA
 from pixels import count_near, count_on_ramp, crop, outside
 
 sys.path.insert(0, str(BUILD / "python"))
-from topstoc.core import colors  # noqa: E402  (bpy-free)
+from topstoc.core.support import colors  # noqa: E402  (bpy-free)
 
 
 def ramp():

@@ -12,7 +12,7 @@ from conftest import BUILD, DATA
 from pixels import count_near, crop, outside
 
 sys.path.insert(0, str(BUILD / "python"))
-from topstoc.core import colors  # noqa: E402  (bpy-free)
+from topstoc.core.support import colors  # noqa: E402  (bpy-free)
 
 OVERLAYS = {"handles": colors.HANDLE, "tunnels": colors.TUNNEL, "generators": colors.GENERATOR,
             "boundary": colors.BOUNDARY}

@@ -134,7 +134,7 @@ def steps():
     # 5. Disabling the add-on removes the draw handlers: nothing is drawn any more.
     import addon_utils
 
-    from topstoc.blender import overlays
+    from topstoc.blender.ui import overlays
 
     addon_utils.disable("topstoc", default_set=True)
     session.check("draw handlers removed", overlays._handlers == {})

@@ -94,7 +94,7 @@ def test_pip_wheel_runs_topstoc_decimate_in_a_bare_root(tmp_path, suite, tag):
         python3 -m venv /work/venv &&
         /work/venv/bin/pip install -q --no-index --find-links /work/wheelhouse /work/{wheel.name} &&
         /work/venv/bin/topstoc decimate /work/mesh.off /work/out.obj --ratio 0.3 --json > /work/report.json &&
-        /work/venv/bin/python -c "import topstoc.core.native, sys; print(open('/proc/self/maps').read())" > /work/maps &&
+        /work/venv/bin/python -c "import topstoc.core.support.native, sys; print(open('/proc/self/maps').read())" > /work/maps &&
         ldd /work/venv/lib/python3.*/site-packages/topstoc/_topstoc*.so""")
     assert "not found" not in out, out
     assert (work / "out.obj").read_text() == reference_decimation(tmp_path)
@@ -127,7 +127,7 @@ obj.select_set(True)
 result = bpy.ops.topstoc.guided_decimate(target_mode="RATIO", ratio=0.3, output="NEW_OBJECT")
 out = bpy.context.view_layer.objects.active
 m = out.data
-native = importlib.import_module(name + ".core.native").engine
+native = importlib.import_module(name + ".core.support.native").engine
 print("RESULT", result.pop(), out.name, len(m.vertices), len(m.edges), len(m.polygons))
 print("NATIVE", native.__file__)
 print("MAPS")

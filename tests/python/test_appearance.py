@@ -1,4 +1,4 @@
-"""UVs and colours in the collapse cost (topstoc.core.appearance, ``topstoc decimate
+"""UVs and colours in the collapse cost (topstoc.core.carry.appearance, ``topstoc decimate
 --attribute-weight``): they keep a UV-mapped mesh's texture where it was, and weight 0 is the
 geometry-only result to the bit.
 
@@ -14,11 +14,11 @@ import pytest
 
 import cli
 from topstoc.core import Mesh
-from topstoc.core.appearance import appearance_attributes, fill_missing_uvs
-from topstoc.core.attributes import transfer_attributes, uv_seam_edges
-from topstoc.core.decimate import ATTRIBUTE_WEIGHT
-from topstoc.core.errors import TopStocError
-from topstoc.core.io import MeshData, read_mesh, write_mesh
+from topstoc.core.carry.appearance import appearance_attributes, fill_missing_uvs
+from topstoc.core.carry.attributes import transfer_attributes, uv_seam_edges
+from topstoc.core.api.decimate import ATTRIBUTE_WEIGHT
+from topstoc.core.support.errors import TopStocError
+from topstoc.core.api.io import MeshData, read_mesh, write_mesh
 from uv_cylinder import uv_cylinder, uv_distortion
 
 run_json = functools.partial(cli.run_json, "decimate")
@@ -178,7 +178,7 @@ def test_batch_uses_the_files_uvs_unless_the_weight_is_zero(tmp_path):
 def test_batch_settings_carry_the_weight_to_blender():
     import argparse
 
-    from topstoc.core import batch_settings
+    from topstoc.core.batch import settings as batch_settings
 
     parser = argparse.ArgumentParser()
     batch_settings.add_arguments(parser)

@@ -1,5 +1,5 @@
-"""Custom normals in the collapse cost (topstoc.core.appearance) and hard edges as borders
-(topstoc.core.attributes.hard_normal_edges): a hard-surface mesh keeps its shading, and weight 0
+"""Custom normals in the collapse cost (topstoc.core.carry.appearance) and hard edges as borders
+(topstoc.core.carry.attributes.hard_normal_edges): a hard-surface mesh keeps its shading, and weight 0
 is the geometry-only result to the bit.
 
 The shading error is measured on the capped cylinder of tests/capped_cylinder.py (hard rims, caps
@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 from topstoc.core import Mesh
-from topstoc.core.appearance import appearance_attributes, unit_corner_normals
-from topstoc.core.attributes import corner_values, hard_normal_edges, moved_vertices
-from topstoc.core.decimate import ATTRIBUTE_WEIGHT
-from topstoc.core.errors import TopStocError
-from topstoc.core.hausdorff import closest_points
+from topstoc.core.carry.appearance import appearance_attributes, unit_corner_normals
+from topstoc.core.carry.attributes import corner_values, hard_normal_edges, moved_vertices
+from topstoc.core.api.decimate import ATTRIBUTE_WEIGHT
+from topstoc.core.support.errors import TopStocError
+from topstoc.core.api.hausdorff import closest_points
 from capped_cylinder import AROUND, capped_cylinder, shading_error
 
 TARGET = 120  # vertices, of 834

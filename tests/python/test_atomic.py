@@ -1,4 +1,4 @@
-"""Writes survive faults (topstoc.core.atomic): a signal or a full disk leaves neither a half-written
+"""Writes survive faults (topstoc.core.support.atomic): a signal or a full disk leaves neither a half-written
 file at the final name nor a temporary file; a killed process's temporary files are swept by the
 next write to that output; a batch report that cannot be written leaves no stale one behind."""
 
@@ -14,8 +14,8 @@ import pytest
 import cli
 import meshgen
 from conftest import BUILD
-from topstoc.core import atomic
-from topstoc.core.io import MeshData, read_mesh, write_mesh
+from topstoc.core.support import atomic
+from topstoc.core.api.io import MeshData, read_mesh, write_mesh
 
 # The CLI with the rename held back: it prints the temporary file's name, then waits there for the
 # test's signal (the write itself has happened, the rename not yet).

@@ -1,4 +1,4 @@
-"""UV seams and attribute transfer (topstoc.core.attributes) against brute force."""
+"""UV seams and attribute transfer (topstoc.core.carry.attributes) against brute force."""
 
 import pathlib
 
@@ -6,8 +6,8 @@ import numpy as np
 
 from meshgen import torus
 from topstoc.core import Mesh
-from topstoc.core.attributes import material_regions, transfer_attributes, uv_seam_edges
-from topstoc.core.io import MeshData, read_mesh
+from topstoc.core.carry.attributes import material_regions, transfer_attributes, uv_seam_edges
+from topstoc.core.api.io import MeshData, read_mesh
 
 DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
 
@@ -122,7 +122,7 @@ def test_quality_mode_colours_within_the_source_triangle():
 def test_point_and_corner_values_by_hand():
     """Two input triangles sharing edge (1, 2), with a seam there (corner values differ across
     it); output vertex 0 stays at input vertex 0, output vertex 1 moved into triangle 1."""
-    from topstoc.core.attributes import MovedVertices, corner_values, point_values
+    from topstoc.core.carry.attributes import MovedVertices, corner_values, point_values
 
     triangles = np.array([[0, 1, 2], [2, 1, 3]])
     moved = MovedVertices(face=np.array([-1, 1]), weights=np.array([[1.0, 0, 0], [0.2, 0.3, 0.5]]))
@@ -152,7 +152,7 @@ def dense_weights(weights, rows, columns):
 def test_point_weights_by_hand():
     """Vertex 0 did not move (its zero weight in group 2 stays); vertex 1 moved into triangle 1,
     whose corners 2, 1, 3 have weights in groups 0, 1 and 2 (corner 3 only in group 2)."""
-    from topstoc.core.attributes import MovedVertices, SparseWeights, point_weights
+    from topstoc.core.carry.attributes import MovedVertices, SparseWeights, point_weights
 
     triangles = np.array([[0, 1, 2], [2, 1, 3]])
     moved = MovedVertices(face=np.array([-1, 1]), weights=np.array([[1.0, 0, 0], [0.2, 0.3, 0.5]]))
@@ -181,7 +181,7 @@ def test_point_weights_by_hand():
 def test_point_weights_match_a_dense_mix_on_a_quality_decimation():
     """Random sparse weights on a torus through a quality decimation against the dense
     reference: kept vertices copy their rows, moved ones mix their source triangle's rows."""
-    from topstoc.core.attributes import SparseWeights, moved_vertices, point_weights
+    from topstoc.core.carry.attributes import SparseWeights, moved_vertices, point_weights
 
     vertices, triangles = torus(40, 20)
     rng = np.random.default_rng(5)

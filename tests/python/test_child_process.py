@@ -1,4 +1,4 @@
-"""Children started by ``topstoc.core.child_process.run`` die when the process that started them is
+"""Children started by ``topstoc.core.batch.child_process.run`` die when the process that started them is
 killed (what keeps a killed Dask worker's Blender from running on as an orphan), and the batch
 removes what a killed Blender left in the output folder. The real Blender under a Dask worker is
 tested in tests/pipeline/test_blender_child.py."""
@@ -14,13 +14,13 @@ import uuid
 import pytest
 
 from conftest import BUILD
-from topstoc.core import batch_run, child_process
+from topstoc.core.batch import run as batch_run, child_process
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG is Linux only")
 
 STARTER = """
 import subprocess, sys
-from topstoc.core import child_process
+from topstoc.core.batch import child_process
 run = child_process.run if sys.argv[1] == "die-with-parent" else subprocess.run
 run([sys.executable, "-c", "import time; time.sleep(60)", sys.argv[2]])
 """

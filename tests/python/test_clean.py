@@ -1,4 +1,4 @@
-"""topstoc.core.clean: small handles, tunnels and holes removed in one step (docs/design.md §4.6).
+"""topstoc.core.api.clean: small handles, tunnels and holes removed in one step (docs/design.md §4.6).
 
 Genus and holes are checked with GUDHI's Betti numbers, the untouched surface by comparing
 positions with the input through the result's maps, and the patches' shape with the thesis'
@@ -13,10 +13,10 @@ import cli
 import meshgen
 import reference
 from topology_checks import gudhi_betti
-from topstoc.core import edit
-from topstoc.core.clean import clean
-from topstoc.core.errors import TopStocError
-from topstoc.core.loops import self_intersections
+from topstoc.core.api import edit
+from topstoc.core.api.clean import clean
+from topstoc.core.support.errors import TopStocError
+from topstoc.core.api.loops import self_intersections
 
 
 def genus(vertices, triangles):
@@ -170,7 +170,7 @@ def test_sizes_relative_to_the_diagonal_and_zero():
 
 
 def test_cli_clean(tmp_path):
-    from topstoc.core.io import MeshData, read_mesh, write_mesh
+    from topstoc.core.api.io import MeshData, read_mesh, write_mesh
 
     vertices, triangles = cleanup_meshes.block_with_arches(3, 1, jitter=0.05, seed=9)
     source, target = tmp_path / "in.obj", tmp_path / "out.ply"
@@ -195,9 +195,9 @@ def test_cli_clean(tmp_path):
 
 
 def test_local_removal_is_the_whole_mesh_edit(monkeypatch):
-    from topstoc.core import local_edit
-    from topstoc.core.local_edit import LocalEditor
-    from topstoc.core.loops import handle_tunnel_loops
+    from topstoc.core.api import local_edit
+    from topstoc.core.api.local_edit import LocalEditor
+    from topstoc.core.api.loops import handle_tunnel_loops
 
     vertices, triangles = cleanup_meshes.block_with_arches(30, 0, jitter=0.05, seed=10)
     loop = min(handle_tunnel_loops(vertices, triangles).handles, key=lambda loop: loop.length).vertices
@@ -221,7 +221,7 @@ def test_local_removal_is_the_whole_mesh_edit(monkeypatch):
 
 
 def test_scanned_elephant_holes_and_handles(data_dir):
-    from topstoc.core.io import read_mesh
+    from topstoc.core.api.io import read_mesh
 
     data = read_mesh(str(data_dir / "open_boundary" / "cgal_elephant-with-holes.off"))
     vertices, triangles = data.vertices, data.triangles
@@ -245,7 +245,7 @@ def test_scanned_elephant_holes_and_handles(data_dir):
 
 
 def test_a_failed_removal_is_reported_not_retried(monkeypatch):
-    from topstoc.core import local_edit
+    from topstoc.core.api import local_edit
 
     vertices, triangles = cleanup_meshes.block_with_arches(3, 1, jitter=0.05, seed=13)
     calls = []
@@ -264,7 +264,7 @@ def test_a_failed_removal_is_reported_not_retried(monkeypatch):
 
 
 def test_a_hole_whose_patch_would_cross_the_surface_stays_open():
-    from topstoc.core.clean import crossing_patches
+    from topstoc.core.api.clean import crossing_patches
 
     vertices, triangles = cleanup_meshes.perforated_plate(2, 0, side=12, seed=14)
     holes = edit.boundary_loops(vertices, triangles)
@@ -292,7 +292,7 @@ def test_a_hole_whose_patch_would_cross_the_surface_stays_open():
 
 def test_cli_lists_handles_first_and_shortens_long_lists(tmp_path):
     from topstoc.core.cli.clean import SHOWN
-    from topstoc.core.io import MeshData, write_mesh
+    from topstoc.core.api.io import MeshData, write_mesh
 
     vertices, triangles = cleanup_meshes.perforated_plate(SHOWN + 10, 1, side=40, seed=15)
     source = tmp_path / "plate.obj"

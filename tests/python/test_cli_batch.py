@@ -6,7 +6,7 @@ import json
 
 import cli
 import meshgen
-from topstoc.core.io import MeshData, read_mesh, write_mesh
+from topstoc.core.api.io import MeshData, read_mesh, write_mesh
 
 batch = functools.partial(cli.run, "batch", timeout=300)
 
@@ -75,7 +75,7 @@ def test_orphaned_scratch_of_dead_processes_is_removed(tmp_path):
     import subprocess
     import sys
 
-    from topstoc.core.batch_run import remove_orphaned_scratch
+    from topstoc.core.batch.run import remove_orphaned_scratch
 
     gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
     dead_pid = int(gone.stdout)
@@ -183,8 +183,8 @@ def test_warnings_come_back_with_the_asset_one_line_each(tmp_path):
     [entry] = json.loads((tmp_path / "out" / "topstoc-report.json").read_text())["results"]
     assert entry["warnings"] == [expected[len("topstoc: warning: "):]]
     # the task itself carries them back (a Dask worker's outcome travels the same way)
-    from topstoc.core.batch_run import run_asset
-    from topstoc.core.batch_settings import from_args
+    from topstoc.core.batch.run import run_asset
+    from topstoc.core.batch.settings import from_args
     from topstoc.core.cli import build_parser
 
     settings = from_args(build_parser().parse_args(["batch", "--input", "x", "--output", "y", "--ratio", "1"]))
@@ -212,7 +212,7 @@ def test_obj_lods_get_the_mtl_beside_them_and_report_dropped_normals(tmp_path):
 def test_bake_normals_is_checked_and_mesh_files_refuse_it(tmp_path):
     """``--bake-normals SIZE`` reaches the Blender batch through the settings (to_argv); a bad size
     is one error line, and a mesh file, which has no material for the map, fails with a reason."""
-    from topstoc.core import batch_settings
+    from topstoc.core.batch import settings as batch_settings
 
     a = _torus(tmp_path / "a", "ring.obj")
     done = batch("--input", a, "--output", tmp_path / "out", "--ratio", 0.5, "--bake-normals", 8, "--workers", 0)

@@ -10,8 +10,8 @@ import pytest
 
 import cli
 from meshgen import torus
-from topstoc.core.decimate import decimate as core_decimate
-from topstoc.core.io import MeshData, read_mesh, write_mesh
+from topstoc.core.api.decimate import decimate as core_decimate
+from topstoc.core.api.io import MeshData, read_mesh, write_mesh
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data"

@@ -9,8 +9,8 @@ import meshgen
 import reference as ref
 from cli import run as topstoc
 
-io = pytest.importorskip("topstoc.core.io", reason="file I/O (topstoc.core.io) is not in this build")
-pytest.importorskip("topstoc.core.topology", reason="topstoc.core.topology is not in this build")
+io = pytest.importorskip("topstoc.core.api.io", reason="file I/O (topstoc.core.api.io) is not in this build")
+pytest.importorskip("topstoc.core.api.topology", reason="topstoc.core.api.topology is not in this build")
 
 
 def genus_of(vertices, triangles):
@@ -81,7 +81,7 @@ def test_remove_handle_by_loop_and_by_index(data_dir, tmp_path):
     bad = topstoc("remove-handle", source, tmp_path / "x.ply", "--loop", "0,1,40")
     assert bad.returncode == 1 and "not joined by an edge" in bad.stderr
 
-    pytest.importorskip("topstoc.core.loops", reason="handle loops (topstoc.core.loops) are not in this build")
+    pytest.importorskip("topstoc.core.api.loops", reason="handle loops (topstoc.core.api.loops) are not in this build")
     double = data_dir / "genus_positive" / "cgal_double-torus-example.off"
     for kind in ([], ["--tunnel"]):
         run = topstoc("remove-handle", double, tmp_path / "single.off", "--index", "1", *kind, "--json")

@@ -9,7 +9,7 @@ import numpy as np
 import cli
 import homology_check as hc
 from meshgen import genus_slab, torus
-from topstoc.core.io import MeshData, read_mesh, write_mesh
+from topstoc.core.api.io import MeshData, read_mesh, write_mesh
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data"

@@ -10,7 +10,7 @@ import pytest
 
 import cli
 from topstoc.core import Mesh
-from topstoc.core.io import MeshData, read_mesh, write_mesh
+from topstoc.core.api.io import MeshData, read_mesh, write_mesh
 
 DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
 measure = functools.partial(cli.run, "measure", timeout=120)

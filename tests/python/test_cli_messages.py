@@ -14,7 +14,7 @@ import cli
 import meshgen
 import topstoc
 from topstoc.core.cli import build_parser, messages, progress
-from topstoc.core.io import MeshData, write_mesh
+from topstoc.core.api.io import MeshData, write_mesh
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data"
@@ -198,7 +198,7 @@ def _on_a_terminal(*args, code: str = None) -> str:
 
 def test_on_a_terminal_progress_is_erased_before_the_report(tmp_path):
     text = _on_a_terminal("decimate", DATA / "genus_positive" / "cgal_elephant.off", tmp_path / "out.off",
-                          "--max-error", "0.3%", code=_slowed("topstoc.core.mesh_file_job", "prepare_file", 1.5))
+                          "--max-error", "0.3%", code=_slowed("topstoc.core.api.mesh_file_job", "prepare_file", 1.5))
     pieces = text.split("\r\x1b[K")
     drawn = [p for p in pieces if p.startswith("topstoc decimate: ")]
     assert drawn, text  # the search outlasts the one-second delay
@@ -210,7 +210,7 @@ def test_on_a_terminal_progress_is_erased_before_the_report(tmp_path):
 def test_on_a_terminal_a_long_batch_asset_shows_its_clock(tmp_path):
     text = _on_a_terminal("batch", "--input", DATA / "genus_positive" / "cgal_elephant.off", "--output", tmp_path,
                           "--max-error", "0.3%", "--workers", 0,
-                          code=_slowed("topstoc.core.batch_mesh", "decimate_mesh_file", 2.5))
+                          code=_slowed("topstoc.core.batch.mesh_asset", "decimate_mesh_file", 2.5))
     # a bar (tqdm installed) or the ticker line: either way the clock runs while the asset works
     clocks = re.findall(r"topstoc batch: (?:0 of 1 assets done \.\.\. (\d+) s|.*?\| 0/1 \[(\d\d:\d\d)<)", text)
     assert len(set(clocks)) >= 2, text  # redrawn with a later time while the one asset works

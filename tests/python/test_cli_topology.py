@@ -7,9 +7,9 @@ import pytest
 
 import cli
 
-pytest.importorskip("topstoc.core.io")
-from topstoc.core.io import read_mesh  # noqa: E402
-from topstoc.core.topology import topology  # noqa: E402
+pytest.importorskip("topstoc.core.api.io")
+from topstoc.core.api.io import read_mesh  # noqa: E402
+from topstoc.core.api.topology import topology  # noqa: E402
 
 run_cli = functools.partial(cli.run, "topology", timeout=120)
 

@@ -10,8 +10,8 @@ import pytest
 
 import cli
 from conftest import BUILD, ROOT, DATA
-from topstoc.core import batch_run
-from topstoc.core.errors import TopStocError
+from topstoc.core.batch import run as batch_run
+from topstoc.core.support.errors import TopStocError
 
 INSTALL_HINT = 'pip install "topstoc[cluster]"'
 #: Runs the command line with Dask's packages hidden: a None entry in sys.modules makes

@@ -1,9 +1,9 @@
-"""Overlay and error colours (topstoc.core.colors): the ramp, the legend, cluster classes."""
+"""Overlay and error colours (topstoc.core.support.colors): the ramp, the legend, cluster classes."""
 
 import numpy as np
 import pytest
 
-from topstoc.core import colors
+from topstoc.core.support import colors
 
 
 def test_error_ramp_ends_and_clamps():

@@ -227,7 +227,7 @@ SUMS_SCRIPT = """
 import sys
 sys.path[:0] = sys.argv[1:3]
 import meshgen
-from topstoc.core.native import engine
+from topstoc.core.support.native import engine
 vertices, triangles = meshgen.icosphere(7)  # 327,680 triangles: above the parallel threshold
 vertices = vertices * (1 + 0.01 * ((vertices * 1e4) % 1))  # uneven, so the order of sums shows
 stats = engine.aspect_ratio_stats(vertices, triangles)
@@ -348,7 +348,7 @@ def test_creases_become_borders_on_hard_surface_models():
     assert np.isin(creased.kept, crease_vertices).sum() > 0.3 * creased.num_vertices
     check_output(mesh, creased, reference.invariants(mesh.num_vertices, mesh.triangles))
     # and the result stays closer to the original (mean symmetric Hausdorff distance)
-    from topstoc.core.hausdorff import hausdorff
+    from topstoc.core.api.hausdorff import hausdorff
     plain_error = hausdorff(mesh, plain, samples=50000).symmetric.mean
     creased_error = hausdorff(mesh, creased, samples=50000).symmetric.mean
     assert creased_error < 0.8 * plain_error

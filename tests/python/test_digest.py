@@ -1,4 +1,4 @@
-"""Array digests for the add-on's caches (topstoc.core.digest, the engine's content digest)."""
+"""Array digests for the add-on's caches (topstoc.core.support.digest, the engine's content digest)."""
 
 import os
 import subprocess
@@ -7,8 +7,8 @@ import sys
 import numpy as np
 
 from conftest import BUILD
-from topstoc.core.digest import array_digest
-from topstoc.core.native import engine
+from topstoc.core.support.digest import array_digest
+from topstoc.core.support.native import engine
 
 
 def test_any_changed_byte_dtype_or_shape_changes_the_digest():
@@ -33,7 +33,7 @@ def test_any_changed_byte_dtype_or_shape_changes_the_digest():
 
 
 def test_the_digest_does_not_depend_on_the_number_of_threads():
-    code = ("import numpy as np; from topstoc.core.digest import array_digest; "
+    code = ("import numpy as np; from topstoc.core.support.digest import array_digest; "
             "print(array_digest(np.arange(3_000_000, dtype=np.int64) * 7919 % 1000003))")
     outputs = {subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                               env={**os.environ, "OMP_NUM_THREADS": threads, "PYTHONPATH": str(BUILD / "python")}).stdout for threads in ("1", "2")}

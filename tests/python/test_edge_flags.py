@@ -1,12 +1,12 @@
-"""Carried edge flags (core/edge_flags.py) against a brute-force search of the flagged paths."""
+"""Carried edge flags (core/carry/edge_flags.py) against a brute-force search of the flagged paths."""
 
 from collections import defaultdict, deque
 
 import numpy as np
 import pytest
 
-from topstoc.core.edge_flags import EdgeFlagError, carried_edge_flags
-from topstoc.core.errors import TopStocError
+from topstoc.core.carry.edge_flags import EdgeFlagError, carried_edge_flags
+from topstoc.core.support.errors import TopStocError
 
 
 def reference(flagged, edges, kept, moved=None):

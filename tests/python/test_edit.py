@@ -12,7 +12,7 @@ import pytest
 
 import meshgen
 import reference as ref
-from topstoc.core import edit
+from topstoc.core.api import edit
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 CGAL_EDIT = ROOT / "build" / "peers" / "cgal_edit"
@@ -621,10 +621,10 @@ def test_remove_every_handle_until_genus_zero(path):
 
 @pytest.mark.parametrize("path", genus_meshes(), ids=lambda p: p.stem)
 def test_remove_handle_loops_from_the_loops_module_until_genus_zero(path):
-    """The same with the handle loops of topstoc.core.loops (Dey et al.: persistence inside the
+    """The same with the handle loops of topstoc.core.api.loops (Dey et al.: persistence inside the
     volume, then shortened), removed one after another: the loops found at the start are used
     while all their edges are still there (ids off a cut do not change), else found again."""
-    loops = pytest.importorskip("topstoc.core.loops", reason="topstoc.core.loops is not in this build")
+    loops = pytest.importorskip("topstoc.core.api.loops", reason="topstoc.core.api.loops is not in this build")
     vertices, triangles = read_off(path)
     genus = (2 - closed_surface_summary(triangles)[1]) // 2
     current_v, current_t = vertices, triangles
@@ -770,7 +770,7 @@ def test_removing_every_handle_never_makes_the_surface_intersect_itself(data_dir
     every intermediate surface must be free of self-intersections), removed one by one down to
     genus 0. Each surface is also checked by the exact self-intersection test (and by CGAL's
     when the peer is built)."""
-    loops = pytest.importorskip("topstoc.core.loops", reason="topstoc.core.loops is not in this build")
+    loops = pytest.importorskip("topstoc.core.api.loops", reason="topstoc.core.api.loops is not in this build")
     vertices, triangles = read_off(data_dir / "genus_positive" / name)
     genus = (2 - closed_surface_summary(triangles)[1]) // 2
     current_v, current_t = vertices, triangles

@@ -153,8 +153,8 @@ def test_random_manifolds_and_pinched_surfaces(seed):
 def test_a_pool_never_serves_another_mesh_or_layout():
     """Kept floods are told apart by the mesh's and layout's serial numbers, not addresses: one
     pool used (through the engine) for another mesh, or another layout, floods afresh."""
-    from topstoc.core.job import make_job
-    from topstoc.core.native import engine
+    from topstoc.core.api.job import make_job
+    from topstoc.core.support.native import engine
     dragon = load(DATA / "genus0/cgal_ChineseDragon-10kv.off")
     other = Mesh(dragon.vertices * 2.0, dragon.triangles)  # same size, other mesh
     pool = engine.FloodCachePool()

@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-from topstoc.core import fresh_memory
+from topstoc.core.support import fresh_memory
 
 
 def test_without_jemalloc_arrays_come_from_numpy():
@@ -51,7 +51,7 @@ def test_a_process_allocating_with_jemalloc_maps_arrays_at_once():
     # Debian's Blender 3.4 links libjemalloc.so.2; a Python started with it preloaded allocates
     # the same way (numpy's arrays too) and sees jemalloc's functions through dlsym.
     script = (
-        "import mmap, numpy as np; from topstoc.core import fresh_memory; "
+        "import mmap, numpy as np; from topstoc.core.support import fresh_memory; "
         "assert fresh_memory._populate_flag() == mmap.MAP_POPULATE; "
         "a = fresh_memory.empty(1 << 20, np.float64); assert isinstance(a.base, memoryview); print('ok')"
     )

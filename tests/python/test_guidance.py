@@ -1,11 +1,11 @@
-"""topstoc.core.guidance: the documented guidance rules, checked against brute force."""
+"""topstoc.core.api.guidance: the documented guidance rules, checked against brute force."""
 
 import itertools
 
 import numpy as np
 import pytest
 
-from topstoc.core import guidance as rules
+from topstoc.core.api import guidance as rules
 
 import meshgen
 

@@ -13,7 +13,7 @@ import meshgen
 from threads import outputs_by_thread_count
 from reference import read_off
 import topstoc
-from topstoc.core.native import engine
+from topstoc.core.support.native import engine
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -334,7 +334,7 @@ def run_cli(*args):
 
 
 def test_measure_command_prints_the_spec_keys(data_dir, tmp_path):
-    pytest.importorskip("topstoc.core.io", reason="the mesh readers (topstoc.core.io) are not merged yet")
+    pytest.importorskip("topstoc.core.api.io", reason="the mesh readers (topstoc.core.api.io) are not merged yet")
     a = data_dir / "genus_positive" / "cgal_eight.off"
     done = run_cli("measure", str(a), str(a), "--json", "--samples", "20000")
     assert done.returncode == 0, done.stderr

@@ -1,4 +1,4 @@
-"""Mesh file I/O (topstoc.core.io): every test file against an independent parser written
+"""Mesh file I/O (topstoc.core.api.io): every test file against an independent parser written
 here in plain Python/numpy, against the statistics in tests/data/LICENSES.md, round trips
 through every format, and the error cases."""
 
@@ -12,8 +12,8 @@ import warnings
 import numpy as np
 import pytest
 
-from topstoc.core import io
-from topstoc.core.io import MeshData, read_mesh, write_mesh
+from topstoc.core.api import io
+from topstoc.core.api.io import MeshData, read_mesh, write_mesh
 
 DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
 MESH_FILES = sorted(p for p in DATA.rglob("*") if p.is_file() and re.search(r"\.(obj|ply|off|stl)(\.gz)?$", p.name)

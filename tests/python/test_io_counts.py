@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import cli
-from topstoc.core.io import MeshFileWarning, encode_mesh, read_mesh
+from topstoc.core.api.io import MeshFileWarning, encode_mesh, read_mesh
 
 DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
 ELEPHANT = DATA / "genus_positive" / "cgal_elephant.off"  # 2,775 vertices, 5,558 triangles

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 import topstoc
-from topstoc.core import io
-from topstoc.core.io import MeshData, MeshFileWarning, read_mesh, write_mesh
+from topstoc.core.api import io
+from topstoc.core.api.io import MeshData, MeshFileWarning, read_mesh, write_mesh
 
 REGRESSIONS = pathlib.Path(__file__).resolve().parents[1] / "data" / "regressions"
 FUZZ_REGRESSIONS = pathlib.Path(__file__).resolve().parents[1] / "fuzz" / "regressions"

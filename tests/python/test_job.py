@@ -1,4 +1,4 @@
-"""The decimation job (core/job.py): every parameter resolved and checked once, when the job is
+"""The decimation job (core/api/job.py): every parameter resolved and checked once, when the job is
 made; the public decimate is a thin adapter that gives the same result as running the job."""
 
 import dataclasses
@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from topstoc.core import Mesh, read_mesh
-from topstoc.core import job as job_module
-from topstoc.core.decimate import run_job
-from topstoc.core.errors import TopStocError
-from topstoc.core.job import QUALITY_COLLAPSES, QUALITY_REFINE, make_job
+from topstoc.core.api import job as job_module
+from topstoc.core.api.decimate import run_job
+from topstoc.core.support.errors import TopStocError
+from topstoc.core.api.job import QUALITY_COLLAPSES, QUALITY_REFINE, make_job
 
 from conftest import DATA
 

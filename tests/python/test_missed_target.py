@@ -12,9 +12,9 @@ import pytest
 import cli
 from test_symmetry import suzanne
 from topstoc.core import Mesh, read_mesh, write_mesh
-from topstoc.core.budget import MissedTarget, missed_target
-from topstoc.core.io import MeshData
-from topstoc.core.symmetry import decimate_mirrored
+from topstoc.core.api.budget import MissedTarget, missed_target
+from topstoc.core.api.io import MeshData
+from topstoc.core.api.symmetry import decimate_mirrored
 
 from conftest import DATA
 

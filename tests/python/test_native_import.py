@@ -2,7 +2,7 @@
 
 Each case builds a throw-away `topstoc` package (the staged Python sources without the compiled
 module) in a temporary folder, adds a module file that cannot load for one reason, and imports
-`topstoc.core.native` in a fresh interpreter.
+`topstoc.core.support.native` in a fresh interpreter.
 """
 
 import importlib.machinery
@@ -40,7 +40,7 @@ def package(tmp_path) -> pathlib.Path:
 
 
 def import_native(path: pathlib.Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-c", "import topstoc.core.native as n; print(n.engine.__file__)"],
+    return subprocess.run([sys.executable, "-c", "import topstoc.core.support.native as n; print(n.engine.__file__)"],
                           cwd=path, env=bare_env(PYTHONPATH=str(path), PATH="/usr/bin:/bin"),
                           capture_output=True, text=True, timeout=60)
 

@@ -1,11 +1,11 @@
-"""The figures of a normal-map bake (core/normal_bake.py): ray reach, island gaps, memory, and
+"""The figures of a normal-map bake (core/carry/normal_bake.py): ray reach, island gaps, memory, and
 the overlap test that decides whether a LOD's UV map can hold a normal map."""
 
 import numpy as np
 import pytest
 
-from topstoc.core import normal_bake
-from topstoc.core.errors import TopStocError
+from topstoc.core.carry import normal_bake
+from topstoc.core.support.errors import TopStocError
 
 
 def grid(n, low=0.0, high=1.0):

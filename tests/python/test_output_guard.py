@@ -8,7 +8,7 @@ import pytest
 
 import cli
 import meshgen
-from topstoc.core.io import MeshData, read_mesh, write_mesh
+from topstoc.core.api.io import MeshData, read_mesh, write_mesh
 
 batch = functools.partial(cli.run, "batch", timeout=300)
 

@@ -1,4 +1,4 @@
-"""Numeric parameters of the public API (addon/core/params.py): NumPy scalars accepted like
+"""Numeric parameters of the public API (addon/core/support/params.py): NumPy scalars accepted like
 Python numbers, booleans refused, ranges checked before any conversion, messages that name
 the parameter, its range and the value."""
 
@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import topstoc
-from topstoc.core import params
-from topstoc.core.io import read_mesh
+from topstoc.core.support import params
+from topstoc.core.api.io import read_mesh
 
 DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
 
@@ -161,7 +161,7 @@ def test_loops_and_edit_parameter_errors(mesh):
         topstoc.handle_tunnel_loops(mesh, seed=2**64)
     with pytest.raises(ValueError, match="coarse_vertices must be an integer, got True"):
         topstoc.handle_tunnel_loops(mesh, coarse_vertices=True)
-    from topstoc.core import edit
+    from topstoc.core.api import edit
     with pytest.raises(ValueError, match=r"max_edges must lie in \[3,"):
         edit.fill_holes(mesh.vertices, mesh.triangles, max_edges=2)
     with pytest.raises(ValueError, match=r"max_dp_corners must lie in \[3,"):
@@ -171,7 +171,7 @@ def test_loops_and_edit_parameter_errors(mesh):
 
 
 def test_sampling_probabilities_rate(mesh):
-    from topstoc.core.decimate import sampling_probabilities
+    from topstoc.core.api.decimate import sampling_probabilities
     p32 = sampling_probabilities(mesh, np.float32(0.25))
     np.testing.assert_array_equal(p32, sampling_probabilities(mesh, 0.25))
     with pytest.raises(ValueError, match="rate must be a number, got True"):

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from conftest import BUILD, DATA, ROOT
-from topstoc.core.io import read_mesh
+from topstoc.core.api.io import read_mesh
 
 README = (ROOT / "README.md").read_text()
 ELEPHANT = DATA / "genus_positive" / "cgal_elephant.off"

@@ -1,4 +1,4 @@
-"""Screen-size targets (topstoc.core.screen_size) and pruning small parts (topstoc.core.prune),
+"""Screen-size targets (topstoc.core.batch.screen_size) and pruning small parts (topstoc.core.batch.prune),
 checked against a pinhole camera, brute-force bounding spheres and the project's Hausdorff."""
 
 import json
@@ -9,12 +9,12 @@ import pytest
 
 import cli
 import meshgen
-from topstoc.core.batch_mesh import decimate_mesh_file
-from topstoc.core.hausdorff import hausdorff
-from topstoc.core.io import MeshData, read_mesh, write_mesh
-from topstoc.core.mesh import Mesh
-from topstoc.core.prune import prune_small_parts, triangle_parts
-from topstoc.core.screen_size import bounding_sphere, projected_pixels, screen_target
+from topstoc.core.batch.mesh_asset import decimate_mesh_file
+from topstoc.core.api.hausdorff import hausdorff
+from topstoc.core.api.io import MeshData, read_mesh, write_mesh
+from topstoc.core.api.mesh import Mesh
+from topstoc.core.batch.prune import prune_small_parts, triangle_parts
+from topstoc.core.batch.screen_size import bounding_sphere, projected_pixels, screen_target
 
 
 def test_projected_diameter_matches_a_pinhole_camera():

@@ -9,7 +9,7 @@ import pytest
 import meshgen  # noqa: F401  (tests/ on the path)
 import reference
 from topstoc.core import Mesh, read_mesh
-from topstoc.core.symmetry import decimate_symmetric, mirror_partners
+from topstoc.core.api.symmetry import decimate_symmetric, mirror_partners
 
 DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
 SUZANNE = DATA / "open_boundary/kivy_suzanne_monkey.obj"
@@ -106,7 +106,7 @@ def test_bad_axis_is_refused():
 # -- the command line and the batch ------------------------------------------------------------
 
 def _write_suzanne(path):
-    from topstoc.core.io import MeshData, write_mesh
+    from topstoc.core.api.io import MeshData, write_mesh
 
     mesh = suzanne()
     write_mesh(path, MeshData(vertices=mesh.vertices, triangles=mesh.triangles))

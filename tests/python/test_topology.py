@@ -6,7 +6,7 @@ import pytest
 
 import meshgen
 import reference
-from topstoc.core.topology import generators, topology
+from topstoc.core.api.topology import generators, topology
 
 gudhi = pytest.importorskip("gudhi")
 from topology_checks import check_generators, gudhi_betti, gudhi_essential_edges  # noqa: E402

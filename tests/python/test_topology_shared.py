@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from conftest import SHARED_MESHES
-from topstoc.core.topology import generators, topology
+from topstoc.core.api.topology import generators, topology
 
 pytest.importorskip("gudhi")
-io = pytest.importorskip("topstoc.core.io")
+io = pytest.importorskip("topstoc.core.api.io")
 from topology_checks import check_generators, gudhi_betti  # noqa: E402
 
 MESH_SUFFIXES = (".off", ".obj", ".ply", ".stl", ".gz", ".bz2")

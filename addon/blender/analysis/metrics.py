@@ -14,12 +14,13 @@ import time
 import bpy
 import numpy as np
 
-from ..core.colors import error_colors
-from ..core.guidance import srgb_to_linear
-from ..core.hausdorff import hausdorff
-from ..core.native import engine
-from ..core.errors import TopStocError
-from . import mesh_io, watch
+from ...core.support.colors import error_colors
+from ...core.api.guidance import srgb_to_linear
+from ...core.api.hausdorff import hausdorff
+from ...core.support.native import engine
+from ...core.support.errors import TopStocError
+from ..io import mesh_io
+from ..preview import watch
 
 ERROR_ATTRIBUTE = "TopStoc Error"
 

@@ -1,9 +1,9 @@
 """The Topology panel's data: invariants (fast) and handle/tunnel loops (slow, in a thread).
 
-Invariants come from topstoc.core.topology on the mesh as Blender stores it: its loop
+Invariants come from topstoc.core.api.topology on the mesh as Blender stores it: its loop
 triangles (n-gons fan-triangulated; χ and the Betti numbers do not depend on how) plus its
 loose edges. V, E and F are shown in Blender's own terms (vertices, edges, polygons), per
-component too. Everything is stored on the object (props_analysis), so undo restores it
+component too. Everything is stored on the object (props/results.py), so undo restores it
 with the mesh.
 
 The loop list holds the handle and tunnel loops of the last search (valid while the mesh's
@@ -19,11 +19,12 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from ..core import loops as core_loops
-from ..core.topology import Topology, topology as compute_topology
-from ..core.errors import TopStocError
-from . import mesh_io, watch
-from .cache import prepared_meshes
+from ...core.api import loops as core_loops
+from ...core.api.topology import Topology, topology as compute_topology
+from ...core.support.errors import TopStocError
+from ..io import mesh_io
+from ..preview import watch
+from ..preview.cache import prepared_meshes
 
 SEARCH_KINDS = ("HANDLE", "TUNNEL")
 
@@ -62,7 +63,7 @@ def loop_length(co: np.ndarray, ids) -> float:
 def _fillable(vertices, triangles) -> dict:
     """{frozenset of loop vertices: fillable} from the editing engine's boundary loops."""
     try:
-        from ..core import edit
+        from ...core.api import edit
     except ImportError:
         return {}
     return {frozenset(loop.vertices.tolist()): loop.fillable for loop in edit.boundary_loops(vertices, triangles)}

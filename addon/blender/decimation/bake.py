@@ -4,7 +4,7 @@ selected-to-active), so a low LOD still shades like the sculpt.
 The result keeps its UV map (the decimation keeps UV seams exactly) when every texel of it belongs
 to one place of the surface, else gets one from Blender's Smart UV Project with island gaps sized
 for the resolution. The rays reach from the measured Hausdorff distance between the two
-(core/normal_bake.py). Where Cycles bakes nothing (Debian's Blender 3.4), the same rays are cast
+(core/carry/normal_bake.py). Where Cycles bakes nothing (Debian's Blender 3.4), the same rays are cast
 by bake_raycast.py. The image is saved beside the .blend
 (or a given folder) or packed, and the result gets copies of its materials with an Image Texture
 and a Normal Map node feeding the shader's Normal input; the source's materials are untouched.
@@ -20,11 +20,12 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from ..core.errors import TopStocError
-from ..core.hausdorff import hausdorff
-from ..core.normal_bake import (MAX_OVERLAP, available_memory, check_memory, check_size, island_margin,
-                                overlap_fraction, ray_reach)
-from . import bake_raycast, mesh_io
+from ...core.support.errors import TopStocError
+from ...core.api.hausdorff import hausdorff
+from ...core.carry.normal_bake import (MAX_OVERLAP, available_memory, check_memory, check_size, island_margin,
+                                       overlap_fraction, ray_reach)
+from . import bake_raycast
+from ..io import mesh_io
 
 BAKE_UV_NAME = "TopStoc Bake"  #: the UV map made when the result has no usable one
 HAUSDORFF_SAMPLES = 200_000

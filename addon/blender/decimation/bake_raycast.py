@@ -10,7 +10,7 @@ import numpy as np
 from mathutils import Vector
 from mathutils.bvhtree import BVHTree
 
-from ..core.normal_bake import dilate, rasterize
+from ...core.carry.normal_bake import dilate, rasterize
 
 
 def _corner_normals(mesh) -> np.ndarray:

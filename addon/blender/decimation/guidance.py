@@ -1,6 +1,6 @@
 """Guidance sources of a Blender object -> engine arguments (u, regions, borders, view, boxes).
 
-The rules that turn each source into ``u`` and combine them are in topstoc.core.guidance;
+The rules that turn each source into ``u`` and combine them are in topstoc.core.api.guidance;
 this module only reads Blender data. Problems with the user's settings (a vertex group or
 colour attribute that does not exist, no camera) raise GuidanceError with a message for the
 status bar; nothing is modified.
@@ -17,13 +17,13 @@ import bpy
 import numpy as np
 from mathutils import Matrix, Vector
 
-from ..core import guidance as rules
-from ..core.appearance import Appearance, appearance_attributes
-from ..core.attributes import hard_normal_edges, uv_seam_edges
-from ..core.decimate import Box, View
-from ..core.errors import TopStocError
-from . import mesh_io
-from .props import DEFAULT_COLOR_LAYER
+from ...core.api import guidance as rules
+from ...core.carry.appearance import Appearance, appearance_attributes
+from ...core.carry.attributes import hard_normal_edges, uv_seam_edges
+from ...core.api.decimate import Box, View
+from ...core.support.errors import TopStocError
+from ..io import mesh_io
+from ..props import DEFAULT_COLOR_LAYER
 
 
 class GuidanceError(TopStocError):
@@ -60,7 +60,7 @@ def _matrix(m: Matrix) -> np.ndarray:
 
 
 def read_color_guidance(mesh, name: str) -> np.ndarray:
-    """u per vertex from a colour attribute (rules in topstoc.core.guidance)."""
+    """u per vertex from a colour attribute (rules in topstoc.core.api.guidance)."""
     return _read_color(mesh, name)()
 
 
@@ -152,7 +152,7 @@ def appearance_color(mesh, settings):
 def _read_appearance(obj, arrays: mesh_io.MeshArrays) -> tuple:
     """Reads the active UV map, the appearance colour (appearance_color) and the custom normals
     (mesh_io.read_custom_normals; normals Blender derives from the shape are left out, see
-    core/appearance.py); returns (the function giving the engine's attributes, what they hold).
+    core/carry/appearance.py); returns (the function giving the engine's attributes, what they hold).
     Colours enter as sRGB in [0, 1]."""
     mesh = obj.data
     names, uv, color, color_key, color_domain = [], None, None, None, None

@@ -21,13 +21,13 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from ..core.appearance import refines
-from ..core.attributes import MovedVertices, moved_vertices, point_weights
-from ..core.decimate import run_job
-from ..core.errors import TopStocError
-from ..core.job import ATTRIBUTE_WEIGHT, DecimationJob, make_job
-from . import carry, mesh_io
-from .cache import Prepared, prepared_meshes
+from ...core.carry.appearance import refines
+from ...core.carry.attributes import MovedVertices, moved_vertices, point_weights
+from ...core.api.decimate import run_job
+from ...core.support.errors import TopStocError
+from ...core.api.job import ATTRIBUTE_WEIGHT, DecimationJob, make_job
+from ..io import carry, mesh_io
+from ..preview.cache import Prepared, prepared_meshes
 from .guidance import EngineGuidance, gather, guidance_layers
 
 LAST_SAMPLES = "Last"
@@ -53,7 +53,7 @@ class Run:
 
 def settings_of(panel) -> dict:
     """The DecimationParameters values of a panel, as plain JSON-able values."""
-    from .props import DecimationParameters
+    from ..props import DecimationParameters
 
     return {name: getattr(panel, name) for name in DecimationParameters.__annotations__ if hasattr(panel, name)}
 
@@ -95,7 +95,7 @@ def decimate_options(panel) -> dict:
 
 def look_kwargs(options: dict, appearance) -> dict:
     """The engine's ``attributes`` for ``options``: the look (``appearance``, a function giving
-    core.appearance.Appearance) at the options' ``attribute_weight`` when the refinement runs
+    core.carry.appearance.Appearance) at the options' ``attribute_weight`` when the refinement runs
     (the only stage that uses it), else nothing."""
     weight = options.get("attribute_weight", ATTRIBUTE_WEIGHT)
     if appearance is None or weight == 0 or not refines(options.get("mode", "quality"), options.get("refine")):
@@ -104,7 +104,7 @@ def look_kwargs(options: dict, appearance) -> dict:
 
 
 def engine_job(mesh, target: dict, options: dict, guidance: EngineGuidance) -> DecimationJob:
-    """The one adapter from the add-on to the engine: the DecimationJob (core/job.py) of a
+    """The one adapter from the add-on to the engine: the DecimationJob (core/api/job.py) of a
     target, a panel's options (decimate_options) and the guidance gathered from the scene."""
     choices = {name: value for name, value in options.items() if name != "attribute_weight"}
     return make_job(mesh, **target, **choices, guidance=guidance.guidance, regions=guidance.regions,

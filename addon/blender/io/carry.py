@@ -11,7 +11,7 @@ the output position plus the key's offset (key minus mesh position) at the place
 A vertex that did not move is the input vertex ``kept[i]``, so every key equals the source's key
 there exactly. A vertex the quality mode moved (filtered placement, quadric collapses) takes each
 key's offset interpolated at its place on the basis: ``t`` is the input triangle its attributes
-come from and ``w`` its barycentric weights there (topstoc.core.attributes.moved_vertices, the
+come from and ``w`` its barycentric weights there (topstoc.core.carry.attributes.moved_vertices, the
 same as for UVs and colours), so the morph follows the surface the vertex now stands on.
 Vertex-group weights (the rig's skin) are mixed at the same place (pipeline.skin_weights).
 """
@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from ..core.attributes import MovedVertices, point_values
+from ...core.carry.attributes import MovedVertices, point_values
 from . import dna_arrays
 
 KEY_SETTINGS = ("value", "slider_min", "slider_max", "mute", "interpolation", "vertex_group")

@@ -29,7 +29,7 @@ from typing import Optional
 import bpy
 import numpy as np
 
-from ..core import fresh_memory
+from ...core.support import fresh_memory
 
 # DNA_meshdata_types.h in 3.x
 MEDGE = np.dtype([("v", "<u4", 2), ("crease", "u1"), ("bweight", "u1"), ("flag", "<i2")])

@@ -1,4 +1,4 @@
-"""Writes a topology edit (topstoc.core.edit.EditResult) back into a Blender mesh.
+"""Writes a topology edit (topstoc.core.api.edit.EditResult) back into a Blender mesh.
 
 The engine edits the mesh's loop triangles; this module turns the result back into polygons:
 
@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from ..core.errors import TopStocError
-from ..core.ranges import concatenated_ranges
+from ...core.support.errors import TopStocError
+from ...core.support.ranges import concatenated_ranges
 from . import mesh_io
 
 # Per-element properties read and written through foreach_get/set where the Blender version has them.
@@ -274,7 +274,7 @@ def build_edited_mesh(old, arrays: mesh_io.MeshArrays, result, new) -> bpy.types
     vertex_map = np.full(len(old.vertices), -1, dtype=np.int64)
     created = np.flatnonzero(layout.vertex_source >= 0)
     vertex_map[layout.vertex_source[created][::-1]] = created[::-1]
-    from .analysis import loose_edges
+    from ..analysis.topology import loose_edges
 
     wires = loose_edges(old)
     wires = vertex_map[wires] if len(wires) else np.zeros((0, 2), dtype=np.int64)

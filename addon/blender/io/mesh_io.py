@@ -5,7 +5,7 @@ its polygon and the loop of each corner, so results can take every attribute exa
 the face and corner they came from. Writing builds a triangle mesh from a DecimateResult and
 copies UV maps, colour and generic attributes, materials, smooth flags, custom split normals
 (vertices the quality mode moved interpolate theirs) and the seam and sharp flags of edges along
-the input's flagged curves (core/edge_flags.py); vertex-group weights are read and written
+the input's flagged curves (core/carry/edge_flags.py); vertex-group weights are read and written
 sparsely (read_vertex_weights, write_vertex_weights).
 
 Where Blender keeps a field as a plain attribute (positions and UV maps from 3.5, material slots
@@ -23,13 +23,13 @@ from typing import Optional
 import bpy
 import numpy as np
 
-from ..core.attributes import (FLAT_CORNER_ANGLE, MovedVertices, SparseWeights, corner_values, moved_vertices,
-                               point_values)
-from ..core.digest import array_digest
-from ..core.edge_flags import carried_edge_flags
-from ..core import fresh_memory
-from ..core.mesh_edges import mesh_edges
-from ..core.ranges import matching_rows
+from ...core.carry.attributes import (FLAT_CORNER_ANGLE, MovedVertices, SparseWeights, corner_values, moved_vertices,
+                                      point_values)
+from ...core.support.digest import array_digest
+from ...core.carry.edge_flags import carried_edge_flags
+from ...core.support import fresh_memory
+from ...core.api.mesh_edges import mesh_edges
+from ...core.support.ranges import matching_rows
 from . import dna_arrays
 
 # Attribute data type -> (foreach key, values per element, numpy dtype)
@@ -437,7 +437,7 @@ def read_carried_edge_flags(source: bpy.types.Mesh) -> dict:
 
 
 def output_edge_flags(flagged: dict, edges: np.ndarray, kept, moved=None) -> dict:
-    """{flag: bool per output edge} for ``read_carried_edge_flags``' input flags (core/edge_flags.py's
+    """{flag: bool per output edge} for ``read_carried_edge_flags``' input flags (core/carry/edge_flags.py's
     rule; ``moved``: output vertices not at their input vertex); flags set nowhere are left out.
     Touches no Blender data (the preview calls it on a worker)."""
     out = {}
@@ -656,7 +656,7 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
     Points take the attributes of their kept input vertex, faces those of their source
     polygon, corners those of the input loop ``corner_source`` names. Vertices the quality mode
     moved (``moved``, found when not given) take point and corner values interpolated in their
-    source triangle (topstoc.core.attributes; corners from that triangle's own loops, so UV
+    source triangle (topstoc.core.carry.attributes; corners from that triangle's own loops, so UV
     seams stay exact); integers, flags and rotations take the nearest corner's value. Output
     edges are new: seam and sharp flags mark the output edges that follow a flagged input curve
     (carry_edge_flags); creases and bevel weights are not carried.

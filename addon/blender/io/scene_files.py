@@ -16,8 +16,8 @@ import shutil
 import tempfile
 
 import bpy
-from ..core import atomic
-from ..core.errors import TopStocError
+from ...core.support import atomic
+from ...core.support.errors import TopStocError
 
 IMPORTERS = {"gltf": "gltf", "glb": "gltf", "fbx": "fbx", "usd": "usd", "usda": "usd", "usdc": "usd", "usdz": "usd"}
 _ADDONS = {"gltf": "io_scene_gltf2", "fbx": "io_scene_fbx"}
@@ -157,7 +157,7 @@ def save(path: str, objects=None) -> list:
     folder = os.path.dirname(path)
     kind = extension(path)
     os.makedirs(folder, exist_ok=True)
-    # Named after the output, so the batch can remove what a killed Blender left (batch_run).
+    # Named after the output, so the batch can remove what a killed Blender left (core/batch/run.py).
     scratch = tempfile.mkdtemp(prefix=f".topstoc-partial-{os.path.basename(path)}-", dir=folder)
     try:
         staged = os.path.join(scratch, os.path.basename(path))

@@ -1,12 +1,12 @@
 """The clean-up operator: remove every small handle and tunnel, fill every small hole in one
-step (topstoc.core.clean, docs/design.md §4.6), with undo, on the active mesh."""
+step (topstoc.core.api.clean, docs/design.md §4.6), with undo, on the active mesh."""
 
 from __future__ import annotations
 
 import bpy
 from bpy.props import FloatProperty, IntProperty
 
-from ...core.clean import clean
+from ...core.api.clean import clean
 from . import polls
 from .topology import _why_not_editable, run_edit
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import bpy
 
-from ..topology_help import HELP
+from ..ui.topology_help import HELP
 
 
 class TOPSTOC_OT_explain(bpy.types.Operator):

@@ -7,9 +7,9 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-from .. import analysis
-from ..operators.topology import _loop_ids, _LoopOperator, _mesh_object
-from ..overlay_data import positions
+from ..analysis import topology as analysis
+from .topology import _loop_ids, _LoopOperator, _mesh_object
+from ..ui.overlay_data import positions
 from . import polls
 
 #: The view's distance in loop radii: the loop then fills about half of the view's height.

@@ -6,8 +6,8 @@ import bpy
 import numpy as np
 from bpy.props import EnumProperty, FloatProperty
 
-from ...core import guidance as rules
-from .. import mesh_io
+from ...core.api import guidance as rules
+from ..io import mesh_io
 from . import polls
 
 LEVELS = [("KEEP", "Keep", "Always keep (u = 1)"), ("MORE", "More", "More detail (u = 0.5)"),

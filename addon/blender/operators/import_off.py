@@ -1,5 +1,5 @@
 """File › Import › OFF (.off): Blender reads OBJ, PLY and STL itself; OFF goes through the
-add-on's own reader (topstoc.core.io), which also takes .off.gz and per-vertex colours."""
+add-on's own reader (topstoc.core.api.io), which also takes .off.gz and per-vertex colours."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import numpy as np
 from bpy.props import CollectionProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 
-from ...core.io import MeshFileWarning, read_mesh
-from .. import mesh_io
+from ...core.api.io import MeshFileWarning, read_mesh
+from ..io import mesh_io
 
 
 def polygon_corners(triangles: np.ndarray, triangle_polygon: np.ndarray):

@@ -9,7 +9,7 @@ import bpy
 from bpy.props import FloatProperty, IntProperty
 from mathutils import Euler, Vector
 
-from .. import metrics
+from ..analysis import metrics
 from . import polls
 
 

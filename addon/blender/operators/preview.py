@@ -25,10 +25,10 @@ from types import SimpleNamespace
 
 import bpy
 
-from .. import pipeline
-from ...core.errors import TopStocError
-from ..guidance import GuidanceError
-from ..preview import PreviewSession, cancelled
+from ..decimation import pipeline
+from ...core.support.errors import TopStocError
+from ..decimation.guidance import GuidanceError
+from ..preview.session import PreviewSession, cancelled
 from ..props import OperatorParameters, fill_from_scene, settings_names
 from . import polls
 from .decimate import select_results

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import bpy
 
-from .. import pipeline, regenerate
-from ..guidance import GuidanceError
+from ..decimation import pipeline
+from ..preview import regenerate
+from ..decimation.guidance import GuidanceError
 from . import polls
 
 

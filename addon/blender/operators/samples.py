@@ -5,8 +5,8 @@ from __future__ import annotations
 import bpy
 from bpy.props import StringProperty
 
-from .. import pipeline
-from ...core.errors import TopStocError
+from ..decimation import pipeline
+from ...core.support.errors import TopStocError
 from . import polls
 
 

@@ -15,10 +15,12 @@ import bpy
 import numpy as np
 from bpy.props import EnumProperty
 
-from ...core import edit
-from .. import analysis, mesh_edit, mesh_io, watch
+from ...core.api import edit
+from ..analysis import topology as analysis
+from ..io import mesh_edit, mesh_io
+from ..preview import watch
 from . import polls
-from ...core.errors import TopStocError
+from ...core.support.errors import TopStocError
 
 #: Searches running in the background, by object name (the panel shows their progress).
 running: dict = {}

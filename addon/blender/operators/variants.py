@@ -6,8 +6,8 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-from .. import bake, pipeline
-from ...core.errors import TopStocError
+from ..decimation import bake, pipeline
+from ...core.support.errors import TopStocError
 from ..props import OperatorBakeParameters, OperatorParameters, explicit_engine_options, fill_from_scene
 from . import polls
 

@@ -12,8 +12,8 @@ import threading
 from collections import OrderedDict
 from dataclasses import dataclass
 
-from ..core.mesh import Mesh
-from . import mesh_io
+from ...core.api.mesh import Mesh
+from ..io import mesh_io
 
 
 @dataclass

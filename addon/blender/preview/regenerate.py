@@ -18,7 +18,7 @@ from types import SimpleNamespace
 import bpy
 from bpy.app.handlers import persistent
 
-from . import pipeline
+from ..decimation import pipeline
 
 DEBOUNCE = 0.75  #: seconds of quiet after the last source edit
 

@@ -24,7 +24,7 @@ dropped.
 
 While the user drags, the preview shows drafts of the fast mode (plain TopStoc, milliseconds):
 the geometry without the attribute sources and without the engine's final output check (its
-partition checks and repairs still run; core.decimate's ``draft``). When the drag pauses for
+partition checks and repairs still run; core.api.decimate's ``draft``). When the drag pauses for
 PAUSE_SECONDS, the same ratio is computed in full with the chosen settings in the background,
 checked, and replaces the draft when it is ready (the paint means the same in both modes, so
 the density does not jump); Enter writes only such a result. A draft takes about three
@@ -42,11 +42,12 @@ from typing import Optional
 import bpy
 import numpy as np
 
-from ..core.attributes import moved_vertices
-from ..core.loops import Cancelled
-from ..core.mesh_edges import mesh_edges
-from . import mesh_io, pipeline
-from .guidance import read as read_guidance
+from ...core.carry.attributes import moved_vertices
+from ...core.api.loops import Cancelled
+from ...core.api.mesh_edges import mesh_edges
+from ..io import mesh_io
+from ..decimation import pipeline
+from ..decimation.guidance import read as read_guidance
 
 PREVIEW_SUFFIX = "_TopStocPreview"
 WORKERS = 2 if (os.cpu_count() or 1) >= 2 else 1

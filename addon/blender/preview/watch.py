@@ -17,7 +17,7 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
-from . import mesh_io
+from ..io import mesh_io
 
 _epochs: dict = defaultdict(int)
 _stamps: dict = {}  # object name -> (epoch, mesh name, stamp)

@@ -8,9 +8,9 @@ import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
                        FloatVectorProperty, IntProperty, PointerProperty, StringProperty)
 
-from ..core.decimate import ATTRIBUTE_WEIGHT
-from . import props_analysis
-from .props_analysis import TOPSTOC_PG_metrics, TOPSTOC_PG_overlays, TOPSTOC_PG_topology
+from ...core.api.decimate import ATTRIBUTE_WEIGHT
+from . import results as props_analysis
+from .results import TOPSTOC_PG_metrics, TOPSTOC_PG_overlays, TOPSTOC_PG_topology
 
 #: Material slots that can carry a guidance weight (later slots count as 0).
 MAX_MATERIAL_SLOTS = 32
@@ -100,7 +100,7 @@ BAKE_STORES = [("PACK", "Pack", "Pack the normal map into the .blend file"),
 
 
 class BakeParameters:
-    """The "Bake Normals" option of Guided Decimate and the LOD chain (a mixin; blender/bake.py)."""
+    """The "Bake Normals" option of Guided Decimate and the LOD chain (a mixin; blender/decimation/bake.py)."""
 
     bake_normals: BoolProperty(name="Bake Normals", default=False,
                                description="Bake a tangent-space normal map from the original onto each new "

@@ -3,7 +3,7 @@
 Results live on the object (``obj.topstoc.topology``, ``obj.topstoc.metrics``), so undo and
 redo restore them together with the mesh they describe, and they survive saving. Vertex-id
 lists (loops, boundary and generator edges, per-face errors) are ID-property arrays on the
-same property groups; topstoc.blender.analysis and .metrics read and write them. Their keys
+same property groups; topstoc.blender.analysis.topology and .metrics read and write them. Their keys
 must differ from the RNA property names (RNA properties are stored under their own names):
 "generator_edges", "boundary_vertices", "nonmanifold_edge_ids", "nonmanifold_vertex_ids",
 "face_error", and "vertices" on each loop.

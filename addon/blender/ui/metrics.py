@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import bpy
 
-from .. import metrics
+from ..analysis import metrics
 from .panels import _MeshPanel, _Panel, wrapped
 
 SIDES = (("symmetric", "Symmetric"), ("forward", "Forward (original → this)"),

@@ -15,8 +15,10 @@ from typing import Optional
 import bpy
 import numpy as np
 
-from ..core import colors
-from . import mesh_io, metrics, watch
+from ...core.support import colors
+from ..io import mesh_io
+from ..analysis import metrics
+from ..preview import watch
 
 LINES, POINTS, TRIS = "LINES", "POINTS", "TRIS"
 
@@ -130,7 +132,7 @@ _labels: dict = {}
 
 
 def _samples_entry(obj):
-    from .pipeline import LAST_SAMPLES
+    from ..decimation.pipeline import LAST_SAMPLES
 
     entry = obj.topstoc.sample_sets.get(LAST_SAMPLES)
     return entry if entry is not None and "samples" in entry else None
@@ -147,7 +149,7 @@ def last_decimation(obj, context=None):
     memo = _labels.get(obj.name_full)
     if memo is not None and memo[0] == key:
         return memo[1]
-    from . import pipeline
+    from ..decimation import pipeline
 
     value = None
     try:

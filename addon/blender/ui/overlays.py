@@ -15,7 +15,8 @@ from __future__ import annotations
 
 import bpy
 
-from . import overlay_data, watch
+from . import overlay_data
+from ..preview import watch
 
 DEPTH_BIAS = 2e-5  # in normalised device depth; pulls overlays in front of the surface they lie on
 LEGEND_MARGIN, LEGEND_WIDTH, LEGEND_HEIGHT = 20, 18, 180
@@ -62,7 +63,7 @@ def _signature(obj, show, error_percent: float) -> tuple:
 
 def _error_percent(context, show) -> float:
     """One error scale for every object shown (metrics.shared_error_percent)."""
-    from . import metrics
+    from ..analysis import metrics
 
     return metrics.shared_error_percent(context.visible_objects, show.error_scale) if show.show_error else 0.0
 
@@ -166,8 +167,8 @@ def _draw_legend():
     import gpu
     from gpu_extras.batch import batch_for_shader
 
-    from ..core import colors
-    from . import metrics
+    from ...core.support import colors
+    from ..analysis import metrics
 
     show = context.scene.topstoc.overlays
     scale = metrics.error_scale(obj, _error_percent(context, show))  # the scale every object shown uses

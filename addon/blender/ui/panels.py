@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import bpy
 
-from ..pipeline import face_estimate
+from ..decimation.pipeline import face_estimate
 
 CATEGORY = "TopStoc"
 

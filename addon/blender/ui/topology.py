@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import bpy
 
-from .. import analysis
-from ..topology_help import HELP
+from ..analysis import topology as analysis
+from .topology_help import HELP
 from ..operators.topology import running
 from .panels import _MeshPanel, _Panel, _mesh, wrapped
 

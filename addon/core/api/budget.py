@@ -10,7 +10,7 @@ vertex) away from it. Why, in the words every channel uses:
 - "topology": samples the topology needs (each loose piece keeps at least a triangle, each
   hole and handle its loops);
 - "symmetry": the mirrored sample set is larger (or, where partners of absorbed samples were
-  dropped, smaller) than the plain draw (core/symmetry.py);
+  dropped, smaller) than the plain draw (core/api/symmetry.py);
 - "absorbed clusters": clusters that neighbours absorbed were not all made up for;
 - "zero-area input": the input's triangles have no area in double precision (coordinates so
   small that their squared lengths underflow), so the clean-up of zero-area triangles removes

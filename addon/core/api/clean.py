@@ -9,7 +9,7 @@ Per handle the cheaper of its two cuts is taken by loop length: cutting along th
 cuts the handle off, cutting along the tunnel loop fills the tunnel; the shorter loop has the
 shorter cut and, for the small defects this is for, the smaller patches (both are reported).
 Handles are removed in rounds: a round computes the loops of the current surface
-(topstoc.core.loops) and removes the shortest loops below the size that share no vertex with
+(topstoc.core.api.loops) and removes the shortest loops below the size that share no vertex with
 one removed before in the round. The 2g handle and tunnel loops of a component are independent
 in its homology, so disjoint ones do not separate the surface together, and each removal drops
 the genus by one (remove_handle checks anyway that each cut leaves its component in one
@@ -33,7 +33,7 @@ import numpy as np
 
 from . import edit
 from .edit import EditResult, Patch
-from .errors import TopStocError
+from ..support.errors import TopStocError
 from .local_edit import LocalEditor
 from .mesh import as_vertices
 
@@ -323,7 +323,7 @@ def crossing_patches(result: EditResult) -> set:
     """The ``Patch.hole`` values of the patches that cross another triangle of ``result``.
 
     Only triangles whose bounding boxes meet a patch's box can cross it: those are tested
-    (exact tests, topstoc.core.loops.self_intersections), not the whole mesh."""
+    (exact tests, topstoc.core.api.loops.self_intersections), not the whole mesh."""
     from .loops import self_intersections
 
     if not result.patches:

@@ -29,12 +29,13 @@ from typing import TYPE_CHECKING, Optional, Sequence
 
 import numpy as np
 
-from . import budget, params
-from .errors import TopStocError
+from . import budget
+from ..support import params
+from ..support.errors import TopStocError
 from .job import (  # noqa: F401 - View, Box and the constants are this module's public names too
     ATTRIBUTE_WEIGHT, DENSITY_MODES, MAX_ATTRIBUTE_CHANNELS, MODES, PLACEMENTS, QUALITY_COLLAPSES, QUALITY_REFINE,
     Box, DecimationJob, View, attribute_arrays, guidance_values, make_job, target_vertex_count)
-from .native import engine
+from ..support.native import engine
 
 if TYPE_CHECKING:  # for annotations only: mesh.py imports this module
     from .mesh import Mesh
@@ -75,7 +76,7 @@ class DecimateStats:
     output_checked: bool = True
     control_points: int = 0     #: vertices the guidance keeps (u = 1)
     zero_area_input: int = 0    #: input triangles without area (in double precision)
-    #: a mirror-symmetric result (core/symmetry.py): vertices of the plain decimation it was made from (else 0)
+    #: a mirror-symmetric result (core/api/symmetry.py): vertices of the plain decimation it was made from (else 0)
     mirrored_from: int = 0
     output_triangles: int = 0   #: triangles of the result
     #: re-created from a sample list (decimate_with_samples): no target was asked, none missed
@@ -92,7 +93,7 @@ class DecimateStats:
     def over_budget_reason(self) -> str:
         """Why the result is over budget: "" (it is not), "control points" (the vertices painted to
         stay outnumber the target), "borders" (so do the corners of borders), "symmetry" (the
-        mirrored sample set) or "topology" (samples the topology needed); see core/budget.py."""
+        mirrored sample set) or "topology" (samples the topology needed); see core/api/budget.py."""
         return budget.over_reason(self) if self.over_budget else ""
 
     @property
@@ -134,7 +135,7 @@ class DecimateResult:
     samples: np.ndarray
     stats: DecimateStats
     parameters: dict = field(default_factory=dict)
-    #: with ``max_error``: how the error-bounded search went (see topstoc.core.error_bound)
+    #: with ``max_error``: how the error-bounded search went (see topstoc.core.api.error_bound)
     error_bound: Optional[object] = None
 
     @property
@@ -205,7 +206,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     difference d in a channel costs as much as moving the surface by w * d bounding-box
     diagonals. attribute_weights: a number or one per channel (default ATTRIBUTE_WEIGHT).
     Only the refinement (quality mode) uses them; output attributes still come from the input
-    through corner_source (topstoc.core.attributes interpolates those of moved vertices).
+    through corner_source (topstoc.core.carry.attributes interpolates those of moved vertices).
     max_error: the fewest vertices whose symmetric Hausdorff error stays within this bound
     (absolute, or a fraction of the bounding-box diagonal with ``relative=True``), found by a
     search over re-decimations with the same seed; ``result.error_bound`` tells how it went.
@@ -227,8 +228,8 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
 
 
 def run_job(mesh: Mesh, job: DecimationJob) -> DecimateResult:
-    """Runs a DecimationJob (core/job.py): mirrored (core/symmetry.py), error-bounded (a search
-    over vertex counts, core/error_bound.py) or one engine call."""
+    """Runs a DecimationJob (core/api/job.py): mirrored (core/api/symmetry.py), error-bounded (a search
+    over vertex counts, core/api/error_bound.py) or one engine call."""
     if job.symmetry is not None:
         from .symmetry import decimate_job_mirrored
 

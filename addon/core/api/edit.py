@@ -9,7 +9,7 @@ arrays and, for every new vertex, triangle and corner, where it came from in the
 only what an edit creates (hole patches) needs made-up values, and they take them from the
 hole's surroundings.
 
->>> from topstoc.core import edit
+>>> from topstoc.core.api import edit
 >>> result = edit.remove_handle(vertices, triangles, loop)      # loop: vertex ids in order
 >>> uvs = result.corner_attribute(corner_uvs)                    # (m, 3, 2) -> (m', 3, 2)
 """
@@ -22,9 +22,9 @@ from typing import List, Optional, Sequence
 import numpy as np
 
 from .mesh import as_vertices
-from . import params
-from .native import engine
-from .errors import TopStocError
+from ..support import params
+from ..support.native import engine
+from ..support.errors import TopStocError
 
 #: Patch methods, from the thesis' planar projection to the last resort (hole_triangulation.hpp).
 FILL_METHODS = ("planar", "minimum_weight", "split", "fan")
@@ -305,7 +305,7 @@ def remove_handle(vertices, triangles, loop: Sequence[int], *, allow_separating:
     The edit never makes the surface intersect itself: when a patch (or a moved triangle)
     would cross the surface, the copies are pulled apart more or less and refined, faired
     patches are tried; if none is free of intersections, ValueError names the problem (a
-    shorter loop around the same handle usually works: see topstoc.core.loops).
+    shorter loop around the same handle usually works: see topstoc.core.api.loops).
     ``allow_self_intersections=True`` returns the first candidate instead.
     """
     vertices = as_vertices(vertices)

@@ -20,9 +20,9 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 from .hausdorff import as_surface
-from . import params
-from .native import engine
-from .errors import TopStocError
+from ..support import params
+from ..support.native import engine
+from ..support.errors import TopStocError
 
 DEFAULT_SEARCH_SAMPLES = 50_000
 MAX_TOLERANCE = 1e-3  #: relative bracket of the Hausdorff max in each probe (see hausdorff.py)

@@ -32,7 +32,7 @@ Applied afterwards by the engine: box empties (a vertex inside a box takes that 
 weight, the last box wins where boxes overlap) and the view (back faces ``p *= back_ratio``,
 silhouette band ``p = 1``, outside the frustum at most ``outside_probability``). UV seams,
 sharp edges and material borders are not guidance but borders: no cluster crosses them
-(UV seams are found by topstoc.core.attributes.uv_seam_edges).
+(UV seams are found by topstoc.core.carry.attributes.uv_seam_edges).
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ from __future__ import annotations
 from typing import Iterable, Optional, Sequence, Tuple
 
 import numpy as np
-from .errors import TopStocError
+from ..support.errors import TopStocError
 
 #: Direct-selection levels (thesis fig. 4.13): name -> u.
 GUIDANCE_LEVELS = {"KEEP": 1.0, "MORE": 0.5, "NEUTRAL": 0.0, "LESS": -0.5, "DROP": -1.0}

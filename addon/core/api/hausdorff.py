@@ -34,9 +34,9 @@ from typing import Optional
 
 import numpy as np
 
-from . import params
-from .native import engine
-from .errors import TopStocError
+from ..support import params
+from ..support.native import engine
+from ..support.errors import TopStocError
 
 DEFAULT_SAMPLES = 1_000_000
 

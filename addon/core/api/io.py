@@ -47,9 +47,9 @@ from typing import List, Optional
 
 import numpy as np
 
-from . import atomic
-from .native import engine
-from .errors import TopStocError
+from ..support import atomic
+from ..support.native import engine
+from ..support.errors import TopStocError
 
 FORMATS = ("obj", "ply", "off", "stl")
 COMPRESSIONS = ("gz", "bz2")
@@ -304,7 +304,7 @@ def write_mesh(path, data: MeshData) -> None:
     """Writes ``data`` in the format the extension names; .gz (or .bz2) compresses.
 
     Formats carry what they can (CARRIES, dropped_attributes); PLY is written binary little-endian, STL
-    binary. The file is written atomically (topstoc.core.atomic): a failed or interrupted write
+    binary. The file is written atomically (topstoc.core.support.atomic): a failed or interrupted write
     never leaves a half-written file at ``path``, and a symlink at ``path`` is written through.
     """
     name = os.fspath(path)

@@ -3,7 +3,7 @@
 ``make_job`` turns what a caller gives (a ratio or a count, the mode, guidance, view, boxes,
 regions, borders, appearance attributes, a symmetry axis...) into a frozen ``DecimationJob``:
 the mode resolved into placement and refinement, the target into the engine's vertex count,
-every number range-checked (core/params.py) and every array in the engine's layout. The job is
+every number range-checked (core/support/params.py) and every array in the engine's layout. The job is
 what the engine binding reads (native/python/bind_decimate.cpp), field by field, once; the
 public ``decimate``, the command line, the batch and the add-on all build one.
 """
@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING, Optional, Sequence
 
 import numpy as np
 
-from . import params
-from .errors import TopStocError
+from ..support import params
+from ..support.errors import TopStocError
 
 if TYPE_CHECKING:  # for annotations only
     from .mesh import Mesh
@@ -66,7 +66,7 @@ class View:
         self.as_engine()  # refuse bad fields where the view is made (and again where it is used)
 
     def as_engine(self) -> dict:
-        """The engine's view, every field checked (core/params.py): ParameterError names the field."""
+        """The engine's view, every field checked (core/support/params.py): ParameterError names the field."""
         if (self.eye is None) == (self.direction is None):
             raise params.ParameterError("a view needs exactly one of eye (perspective) or direction (orthographic)")
         d = {
@@ -112,7 +112,7 @@ class Box:
         return cls(m, value)
 
     def as_engine(self):
-        """(world_to_box, value) for the engine, checked (core/params.py)."""
+        """(world_to_box, value) for the engine, checked (core/support/params.py)."""
         return (params.array("box world_to_box", self.world_to_box, (4, 4)),
                 params.number("box value", self.value, -1, 1))
 
@@ -248,7 +248,7 @@ class DecimationJob:
     fast_path: int = 0
     max_repair_rounds: int = 200
     draft: bool = False
-    symmetry: Optional[str] = None                  #: mirror axis "X", "Y", "Z" (core/symmetry.py)
+    symmetry: Optional[str] = None                  #: mirror axis "X", "Y", "Z" (core/api/symmetry.py)
     symmetry_tolerance: Optional[float] = None
 
     @property
@@ -300,7 +300,7 @@ def make_target(mesh: Mesh, ratio=None, vertices=None, triangles=None, max_error
 
 def resolve_placement(mode: str, placement: Optional[str], symmetry=None) -> str:
     """The placement for a mode and the caller's choice (None: the mode's own). A mirrored job
-    keeps input positions unless told otherwise (core/symmetry.py)."""
+    keeps input positions unless told otherwise (core/api/symmetry.py)."""
     if placement is None:
         placement = "subsample" if symmetry is not None or mode == "fast" else "filtered"
     if placement not in PLACEMENTS:
@@ -326,7 +326,7 @@ def make_job(mesh: Mesh, ratio=None, target_vertices=None, target_triangles=None
              fast_path=None, max_repair_rounds=200, refine=None, attributes=None, attribute_weights=None,
              draft=False, symmetry=None, symmetry_tolerance=None) -> DecimationJob:
     """The DecimationJob for ``decimate``'s keywords (see there), every one checked here, once,
-    in the order ``decimate`` always checked them; ``symmetry``: a mirror axis (core/symmetry.py).
+    in the order ``decimate`` always checked them; ``symmetry``: a mirror axis (core/api/symmetry.py).
     Raises TopStocError naming the bad one."""
     one_target(ratio, target_vertices, target_triangles, max_error)
     if mode not in MODES:

@@ -27,9 +27,9 @@ from typing import Callable, Optional
 import numpy as np
 
 from .mesh import Mesh
-from . import params
-from .native import engine
-from .errors import TopStocError
+from ..support import params
+from ..support.native import engine
+from ..support.errors import TopStocError
 
 #: Raised when a progress callback returns False.
 Cancelled = engine.Cancelled

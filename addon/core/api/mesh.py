@@ -7,9 +7,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .decimate import decimate, decimate_with_samples
-from .digest import array_digest
-from .native import engine
-from .errors import TopStocError
+from ..support.digest import array_digest
+from ..support.native import engine
+from ..support.errors import TopStocError
 
 
 @dataclass(frozen=True)
@@ -191,7 +191,7 @@ class Mesh:
                 floods.clear()
 
     def decimate(self, ratio=None, target_vertices=None, target_triangles=None, **options):
-        """TopStoc decimation; see topstoc.core.decimate.decimate for every option."""
+        """TopStoc decimation; see topstoc.core.api.decimate.decimate for every option."""
         return decimate(self, ratio, target_vertices, target_triangles, **options)
 
     def decimate_with_samples(self, samples, **options):

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .native import engine
+from ..support.native import engine
 
 
 @dataclass(frozen=True)

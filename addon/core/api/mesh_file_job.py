@@ -3,8 +3,8 @@ prepare the Mesh, UV seams and material borders as borders, the look (UVs, colou
 attributes where the refinement runs, decimate (mirrored when asked), carry the attributes
 over, write atomically.
 
-``topstoc decimate`` (core/cli/decimate.py) runs it once; the batch (core/batch_mesh.py) once
-per LOD of each mesh file. The decimation itself is a DecimationJob (core/job.py).
+``topstoc decimate`` (core/cli/decimate.py) runs it once; the batch (core/batch/mesh_asset.py) once
+per LOD of each mesh file. The decimation itself is a DecimationJob (core/api/job.py).
 """
 
 from __future__ import annotations
@@ -14,12 +14,12 @@ from typing import Optional
 
 import numpy as np
 
-from .appearance import Appearance, appearance_attributes, refines
-from .attributes import material_regions, transfer_attributes, uv_seam_edges
+from ..carry.appearance import Appearance, appearance_attributes, refines
+from ..carry.attributes import material_regions, transfer_attributes, uv_seam_edges
 from .decimate import DecimateResult, run_job
 from .io import MeshData, dropped_attributes, write_mesh
 from .job import DecimationJob, make_job
-from .materials import carry_libraries
+from ..carry.materials import carry_libraries
 from .mesh import Mesh
 
 

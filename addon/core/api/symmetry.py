@@ -25,7 +25,7 @@ import dataclasses
 import warnings
 
 import numpy as np
-from .errors import TopStocError
+from ..support.errors import TopStocError
 
 AXES = {"X": 0, "Y": 1, "Z": 2}
 MAX_ROUNDS = 6
@@ -145,9 +145,9 @@ def decimate_symmetric(mesh, axis: str = "X", *, tolerance: float = None, **opti
 
 
 def decimate_job_mirrored(mesh, job):
-    """Runs a DecimationJob with a ``symmetry`` axis (core/job.py): the plain job's draw, mirrored.
+    """Runs a DecimationJob with a ``symmetry`` axis (core/api/job.py): the plain job's draw, mirrored.
     The result's stats keep the plain job's target (``mirrored_from``: the plain result's
-    vertices), so a mirrored set larger than the target is reported over budget (core/budget.py)."""
+    vertices), so a mirrored set larger than the target is reported over budget (core/api/budget.py)."""
     from .decimate import decimate_with_samples, run_job
 
     axis, placement = job.symmetry, job.placement

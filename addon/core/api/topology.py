@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .native import engine
+from ..support.native import engine
 
 _KINDS = ("vertex", "graph", "surface")  # native kind codes 0, 1, 2
 

@@ -10,7 +10,7 @@ appended by the one process that drives the batch (never by workers) as results 
 ``key`` = SHA-256 of the input's absolute path, its content hash and the settings fingerprint,
 so an edited input or other settings make the asset run again. Content alone cannot tell an
 input from a LOD an earlier run wrote (a LOD is new content, so it would be decimated again):
-outputs never go where inputs are read (topstoc.core.output_guard), and an input that is one of
+outputs never go where inputs are read (topstoc.core.support.output_guard), and an input that is one of
 the outputs the manifest lists (the same file, under any name) is refused (``check_inputs``).
 An asset is skipped when its last record in any of the folder's manifests is "done" and every
 output it lists still exists. Each record is written with one ``write`` and flushed to disk, so
@@ -24,8 +24,8 @@ import hashlib
 import json
 import os
 
-from .errors import TopStocError, shown_path
-from .output_guard import file_identity, identities
+from ..support.errors import TopStocError, shown_path
+from ..support.output_guard import file_identity, identities
 
 MANIFEST_NAME = "topstoc-manifest.jsonl"
 

@@ -3,7 +3,7 @@
 The file is read in its own vertex order, decimated once per LOD (UV seams and material
 borders kept as borders, so UVs, vertex colours and materials carry over exactly), optionally
 pruned of small parts (screen targets), measured against the original with the project's
-Hausdorff distance and written atomically (topstoc.core.io.write_mesh: temporary file, then
+Hausdorff distance and written atomically (topstoc.core.api.io.write_mesh: temporary file, then
 rename). A LOD chain gives one file per LOD, ``<stem>_LOD<i>.<ext>``.
 """
 
@@ -12,13 +12,13 @@ from __future__ import annotations
 import os
 import time
 
-from . import batch_settings
-from .budget import missed_dict
-from .errors import TopStocError
-from .hausdorff import hausdorff
-from .io import mesh_format, read_mesh
-from .job import ATTRIBUTE_WEIGHT
-from .mesh_file_job import prepare_file
+from . import settings as batch_settings
+from ..api.budget import missed_dict
+from ..support.errors import TopStocError
+from ..api.hausdorff import hausdorff
+from ..api.io import mesh_format, read_mesh
+from ..api.job import ATTRIBUTE_WEIGHT
+from ..api.mesh_file_job import prepare_file
 from .prune import prune_small_parts
 
 #: samples on the original for the per-LOD error in the report: 100 per input triangle, within

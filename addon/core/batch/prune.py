@@ -3,7 +3,7 @@
 At a small screen size a bolt or a button far below a pixel only costs triangles. A part here
 is a set of triangles connected through shared vertices; a part whose bounding-box diagonal is
 below ``min_size`` is dropped from the decimation result, and the result's vertex, face and
-corner maps are compacted so that attributes still carry over (topstoc.core.attributes, the
+corner maps are compacted so that attributes still carry over (topstoc.core.carry.attributes, the
 add-on's mesh writer). Parts at or above the size are kept untouched; a result whose every
 part is small keeps its largest part, so a LOD is never empty.
 """
@@ -14,7 +14,7 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
-from .errors import TopStocError
+from ..support.errors import TopStocError
 
 
 @dataclass(frozen=True)

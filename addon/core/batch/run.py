@@ -1,14 +1,14 @@
 """Running batch assets: one task per asset, serially or on a Dask cluster.
 
 ``run_asset`` is the task. Mesh files are decimated in the worker's own process
-(topstoc.core.batch_mesh); Blender formats (.blend, glTF/GLB, FBX, USD) run one Blender per
+(topstoc.core.batch.mesh_asset); Blender formats (.blend, glTF/GLB, FBX, USD) run one Blender per
 asset: ``blender -b`` or a Python with PyPI's ``bpy`` (``--blender``), which runs the add-on's
 batch (topstoc.blender.batch) and writes its files atomically. A task never raises for a bad
 asset: it returns a failure record, so the other assets go on and Dask does not retry a
 deterministic failure. A worker that dies (killed, out of memory) is a different matter: Dask
 reschedules its tasks on the other workers; the outputs are written to temporary names and
 renamed, so a killed task leaves no half-written output, and its Blender child dies with it
-(topstoc.core.child_process).
+(topstoc.core.batch.child_process).
 """
 
 from __future__ import annotations
@@ -21,9 +21,10 @@ import time
 import traceback
 import warnings
 
-from . import atomic, batch_settings, child_process
-from .atomic import pid_alive
-from .errors import TopStocError, one_line, shown_path
+from ..support import atomic
+from . import settings as batch_settings, child_process
+from ..support.atomic import pid_alive
+from ..support.errors import TopStocError, one_line, shown_path
 
 MESH_EXTENSIONS = (".obj", ".ply", ".off", ".stl")
 COMPRESSED = (".gz", ".bz2")
@@ -84,15 +85,19 @@ def write_report(path: str, report: dict) -> None:
     atomic.write_text(path, text, discard_old=True)
 
 
+# The topstoc package's folder (this file is topstoc/core/batch/run.py).
+_PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
 def package_root() -> str:
     """The folder holding the topstoc package (put on the Blender subprocess's sys.path)."""
-    return os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    return os.path.dirname(_PACKAGE_DIR)
 
 
 def blender_command(blender: str) -> list:
     """The command that runs the add-on's batch with ``blender``: a Blender executable, or a Python
     interpreter that has PyPI's ``bpy`` (its name starts with "python")."""
-    package = os.path.basename(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    package = os.path.basename(_PACKAGE_DIR)
     if os.path.basename(blender).startswith("python"):
         # os._exit, not sys.exit: PyPI's bpy 4.5 deadlocks in interpreter shutdown after a batch
         # (outputs already written atomically; the exit status is what counts).
@@ -148,7 +153,7 @@ def run_asset(path: str, out_dir: str, settings: dict, blender: str = None) -> d
         try:
             kind = asset_kind(path)
             if kind == "mesh":
-                from .batch_mesh import decimate_mesh_file
+                from .mesh_asset import decimate_mesh_file
 
                 entry = decimate_mesh_file(path, out_dir, settings)
             elif kind == "blender":
@@ -187,7 +192,7 @@ def _local_cluster(workers: int):
 
 def package_version() -> tuple:
     """This topstoc's version, where it runs (called on the scheduler and the workers)."""
-    from .. import bl_info
+    from ... import bl_info
 
     return tuple(bl_info["version"])
 

@@ -14,7 +14,7 @@ conversion used here:
   ``N = 2 f tan(asin(r / D)) = R tan(asin(r / D)) / tan(fov / 2)``;
 - world units per pixel ``w = 2 r / N`` (for the distance form this equals
   ``sqrt(D^2 - r^2) / f``: the scale at the depth of the silhouette); the max-error target is
-  ``pixel_error * w``, fed to the error-bounded decimation (topstoc.core.error_bound).
+  ``pixel_error * w``, fed to the error-bounded decimation (topstoc.core.api.error_bound).
 
 The pixel figure is thus the symmetric Hausdorff error divided by ``w``. It is the on-axis,
 first-order figure engines use: surface points nearer the camera than the silhouette (down
@@ -22,7 +22,7 @@ to depth ``D - r``) and points off the view axis project up to ``sqrt(D^2 - r^2)
 and ``1 / cos(fov / 2)`` times larger.
 
 Small parts: a connected part whose bounding-box diagonal projects below ``prune_pixels`` can
-be dropped from a LOD (topstoc.core.prune); its world size is ``prune_pixels * w``.
+be dropped from a LOD (topstoc.core.batch.prune); its world size is ``prune_pixels * w``.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
-from .errors import TopStocError
+from ..support.errors import TopStocError
 
 DEFAULT_FOV_DEGREES = 60.0
 DEFAULT_RESOLUTION = 1080

@@ -5,7 +5,7 @@ to the Blender subprocess unchanged).
 Targets take one value (one output) or several (a LOD chain ``_LOD0 … _LODn``, one LOD per
 value): ``--ratio 1 0.5 0.25``, ``--screen-pixels 800 200 50``. A chain is ordered finest first,
 as game engines number LODs: LOD0 is the most detailed, whatever order the values come in.
-Screen-size targets (topstoc.core.screen_size) become a max-error target per asset.
+Screen-size targets (topstoc.core.batch.screen_size) become a max-error target per asset.
 """
 
 from __future__ import annotations
@@ -14,11 +14,11 @@ import hashlib
 import json
 import math
 
-from .appearance import attribute_weight
-from .decimate import ATTRIBUTE_WEIGHT
+from ..carry.appearance import attribute_weight
+from ..api.decimate import ATTRIBUTE_WEIGHT
 from .screen_size import DEFAULT_FOV_DEGREES, DEFAULT_PIXEL_ERROR, DEFAULT_RESOLUTION
-from .errors import TopStocError
-from .normal_bake import check_size
+from ..support.errors import TopStocError
+from ..carry.normal_bake import check_size
 
 TARGET_KINDS = ("ratio", "vertices", "triangles", "max_error", "screen_pixels", "screen_distance")
 SCREEN_KINDS = ("screen_pixels", "screen_distance")

@@ -36,7 +36,7 @@ from typing import List, Optional
 
 import numpy as np
 
-from .errors import TopStocError
+from ..support.errors import TopStocError
 
 UV_CHANNELS = ("u", "v")
 COLOR_CHANNELS = ("r", "g", "b")

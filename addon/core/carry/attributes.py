@@ -21,8 +21,8 @@ from typing import Optional
 
 import numpy as np
 
-from .io import MeshData
-from .ranges import matching_rows
+from ..api.io import MeshData
+from ..support.ranges import matching_rows
 
 
 def uv_seam_edges(triangles, corner_uvs) -> np.ndarray:

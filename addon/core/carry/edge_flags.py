@@ -24,7 +24,7 @@ from typing import Optional
 
 import numpy as np
 
-from .errors import TopStocError
+from ..support.errors import TopStocError
 
 
 class EdgeFlagError(TopStocError):

@@ -1,5 +1,5 @@
 """The figures of a normal-map bake, without Blender: how far the bake's rays reach, how wide the
-UV islands' gaps are, and whether the image fits in memory (the Blender side: blender/bake.py).
+UV islands' gaps are, and whether the image fits in memory (the Blender side: blender/decimation/bake.py).
 
 Selected-to-active baking casts a ray inward from every texel's point on the low-poly surface
 pushed out by the cage extrusion, over at most the max ray distance. The decimated surface lies
@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .errors import TopStocError
+from ..support.errors import TopStocError
 
 MIN_SIZE = 16
 MAX_SIZE = 16384

@@ -14,14 +14,14 @@ import os
 import sys
 import time
 
-from .. import batch_settings
+from ..batch import settings as batch_settings
 from . import messages, progress
-from ..batch_run import (find_inputs, misnamed_failure, remove_orphaned_scratch, remove_stale_temporaries,
+from ..batch.run import (find_inputs, misnamed_failure, remove_orphaned_scratch, remove_stale_temporaries,
                          run_dask, run_serial, utf8_name, write_report)
-from ..budget import report_missed
-from ..manifest import Manifest, content_hash, task_key
-from ..errors import TopStocError
-from ..output_guard import check_folders, prepare_output, check_outputs, output_folder
+from ..api.budget import report_missed
+from ..batch.manifest import Manifest, content_hash, task_key
+from ..support.errors import TopStocError
+from ..support.output_guard import check_folders, prepare_output, check_outputs, output_folder
 
 REPORT_NAME = "topstoc-report.json"
 
@@ -103,8 +103,8 @@ class Progress:
 
 def _check_names(tasks, out_dir, settings, inputs) -> None:
     """Two inputs must not write the same output file, nor any output be an input."""
-    from ..batch_mesh import output_paths
-    from ..batch_run import asset_kind
+    from ..batch.mesh_asset import output_paths
+    from ..batch.run import asset_kind
 
     owners = {}
     for _, path in tasks:

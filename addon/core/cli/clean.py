@@ -8,8 +8,8 @@ plus the input, output and the new mesh's topology.
 from __future__ import annotations
 
 from . import print_json
-from ..errors import TopStocError
-from ..output_guard import add_overwrite_argument, prepare_output
+from ..support.errors import TopStocError
+from ..support.output_guard import add_overwrite_argument, prepare_output
 
 #: Lines of removed and left items printed without --json.
 SHOWN = 40
@@ -38,9 +38,9 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    from ..clean import clean
-    from ..io import read_mesh, write_mesh
-    from ..topology import topology
+    from ..api.clean import clean
+    from ..api.io import read_mesh, write_mesh
+    from ..api.topology import topology
     from .edit import carried_over
 
     if args.keep_largest is not None and args.keep_largest < 0:

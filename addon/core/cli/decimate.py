@@ -3,7 +3,7 @@
 The output keeps the input's UVs, vertex colours and materials: material borders and UV
 seams are passed to the decimation as borders, so they survive, and the attributes are
 copied through the result's corner and face source maps. In quality mode the UVs and colours
-also enter the collapse cost (``--attribute-weight``, topstoc.core.appearance), so a UV-mapped
+also enter the collapse cost (``--attribute-weight``, topstoc.core.carry.appearance), so a UV-mapped
 asset keeps its look. ``seconds`` in the JSON report is
 the work itself (mesh preparation, seams, decimation), without reading and writing files.
 """
@@ -14,15 +14,15 @@ import time
 
 import numpy as np
 
-from ..appearance import attribute_weight, refines
-from ..batch_settings import parse_max_error
-from ..budget import missed_dict, missed_text
-from ..errors import TopStocError
-from ..io import mesh_format, read_mesh
-from ..job import ATTRIBUTE_WEIGHT
-from ..mesh_file_job import prepare_file
-from ..output_guard import add_overwrite_argument, prepare_output
-from ..symmetry import AXES
+from ..carry.appearance import attribute_weight, refines
+from ..batch.settings import parse_max_error
+from ..api.budget import missed_dict, missed_text
+from ..support.errors import TopStocError
+from ..api.io import mesh_format, read_mesh
+from ..api.job import ATTRIBUTE_WEIGHT
+from ..api.mesh_file_job import prepare_file
+from ..support.output_guard import add_overwrite_argument, prepare_output
+from ..api.symmetry import AXES
 from . import print_json, progress
 
 DENSITIES = ("off", "uniform", "adaptive")

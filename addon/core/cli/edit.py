@@ -13,8 +13,8 @@ import time
 import numpy as np
 
 from . import print_json, progress
-from ..errors import TopStocError
-from ..output_guard import add_overwrite_argument, prepare_output
+from ..support.errors import TopStocError
+from ..support.output_guard import add_overwrite_argument, prepare_output
 
 
 def add_parser(subparsers) -> None:
@@ -73,8 +73,8 @@ def _ids(text: str, what: str) -> list:
 
 def run_fill(args) -> int:
     prepare_output(args.output, [args.input], overwrite=args.overwrite)
-    from ..edit import fill_holes
-    from ..io import read_mesh
+    from ..api.edit import fill_holes
+    from ..api.io import read_mesh
 
     data = read_mesh(args.input)
     holes = _ids(args.holes, "--holes") if args.holes is not None else None
@@ -101,8 +101,8 @@ def run_fill(args) -> int:
 
 def run_remove_handle(args) -> int:
     prepare_output(args.output, [args.input], overwrite=args.overwrite)
-    from ..edit import remove_handle
-    from ..io import read_mesh
+    from ..api.edit import remove_handle
+    from ..api.io import read_mesh
 
     data = read_mesh(args.input)
     progress.stage("removing the handle")
@@ -114,7 +114,7 @@ def run_remove_handle(args) -> int:
         loop = np.asarray(_ids(args.loop, "--loop"))
         kind = "given"
     else:
-        from ..loops import handle_tunnel_loops
+        from ..api.loops import handle_tunnel_loops
 
         found = handle_tunnel_loops(data.vertices, data.triangles)
         loops_seconds = time.perf_counter() - start
@@ -134,8 +134,8 @@ def run_remove_handle(args) -> int:
 
 
 def _finish(args, data, result, seconds: float, details: dict) -> int:
-    from ..io import write_mesh
-    from ..topology import topology
+    from ..api.io import write_mesh
+    from ..api.topology import topology
 
     write_mesh(args.output, carried_over(data, result))
     info = topology(result.vertices, result.triangles)
@@ -160,7 +160,7 @@ def _finish(args, data, result, seconds: float, details: dict) -> int:
 
 def carried_over(data, result):
     """The input's MeshData with the edit applied: attributes follow the result's maps."""
-    from ..io import MeshData
+    from ..api.io import MeshData
 
     return MeshData(
         vertices=result.vertices, triangles=result.triangles,

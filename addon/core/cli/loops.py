@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 import time
-from ..errors import TopStocError
+from ..support.errors import TopStocError
 from . import progress
 
 
@@ -35,9 +35,9 @@ def add_parser(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..io import read_mesh  # imported here so that --help works without the readers
-    from ..loops import handle_tunnel_loops
-    from ..mesh import Mesh
+    from ..api.io import read_mesh  # imported here so that --help works without the readers
+    from ..api.loops import handle_tunnel_loops
+    from ..api.mesh import Mesh
 
     data = read_mesh(args.input)
     if args.coarse_vertices is not None and args.coarse_vertices <= 0:

@@ -13,11 +13,11 @@ from __future__ import annotations
 import argparse
 import time
 
-from .. import atomic
+from ..support import atomic
 from . import progress
 
-from ..hausdorff import DEFAULT_SAMPLES, hausdorff
-from ..output_guard import prepare_output
+from ..api.hausdorff import DEFAULT_SAMPLES, hausdorff
+from ..support.output_guard import prepare_output
 
 
 def add_parser(subparsers) -> None:
@@ -56,7 +56,7 @@ def errors_file(name: str) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..io import read_mesh  # imported here so that --help works without the readers
+    from ..api.io import read_mesh  # imported here so that --help works without the readers
 
     errors = None if args.errors is None else errors_file(args.errors)
     prepare_output(errors, [args.a, args.b])

@@ -10,12 +10,12 @@ import argparse
 import sys
 
 from . import progress
-from ..errors import one_line
+from ..support.errors import one_line
 
 EXIT_FAILURE = 1
 EXIT_USAGE = 2
 
-#: One line saying what went wrong (core/errors.py: OS errors in words, naming the file).
+#: One line saying what went wrong (core/support/errors.py: OS errors in words, naming the file).
 error_text = one_line
 
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import time
 
-from ..io import read_mesh
-from ..topology import topology
+from ..api.io import read_mesh
+from ..api.topology import topology
 from . import print_json, progress
 
 #: Components listed in the text report before "... and N more".

@@ -12,8 +12,8 @@ file is removed:
   main thread and only over handlers Python can put back; elsewhere (a Dask worker's task,
   Blender's own handlers) the next write sweeps up instead;
 - SIGKILL cannot be caught: ``sweep`` removes the temporary files whose process is gone; the
-  commands call it before they write (topstoc.core.output_guard.prepare_output), the batch
-  after its run (topstoc.core.batch_run.remove_stale_temporaries). Not on every write: a
+  commands call it before they write (topstoc.core.support.output_guard.prepare_output), the batch
+  after its run (topstoc.core.batch.run.remove_stale_temporaries). Not on every write: a
   folder of many outputs would be listed once per file.
 """
 

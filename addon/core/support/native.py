@@ -25,7 +25,7 @@ from .errors import TopStocError
 if "OMP_WAIT_POLICY" not in os.environ:
     os.environ.setdefault("GOMP_SPINCOUNT", "100000")
 
-_PACKAGE = __name__.rsplit(".", 2)[0]  # topstoc, or bl_ext.<repository>.topstoc in Blender 4.2+
+_PACKAGE = __name__.rsplit(".", 3)[0]  # topstoc, or bl_ext.<repository>.topstoc in Blender 4.2+
 
 
 def _native_distribution_dir():
@@ -44,7 +44,7 @@ def _load():
             return importlib.import_module(name)
         except ImportError as error:
             errors.append(error)
-    package_dir = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    package_dir = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # topstoc/
     directories = [package_dir] + [d for d in [_native_distribution_dir()] if d]
     # The first error (the module next to the package) explains a local build; when only the
     # native distribution is installed, its error is the informative one.

@@ -164,7 +164,7 @@ MeshFile read_mesh_path(const std::string& path) {
   for (const char* suffix : {".gz", ".bz2"}) {
     const std::string s(suffix);
     if (path.size() > s.size() && path.compare(path.size() - s.size(), s.size(), s) == 0)
-      throw std::invalid_argument(path + ": compressed files are read through topstoc.core.io (Python)");
+      throw std::invalid_argument(path + ": compressed files are read through topstoc.core.api.io (Python)");
   }
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw std::runtime_error(path + ": cannot open the file");
