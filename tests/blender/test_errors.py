@@ -9,8 +9,8 @@ import pytest
 import meshgen
 from helpers import Params, make_object
 
-ERRORS = [("pipeline", "DecimationError"), ("guidance", "GuidanceError"), ("analysis", "AnalysisError"),
-          ("mesh_edit", "EditError"), ("metrics", "MetricsError")]
+ERRORS = [("decimation.pipeline", "DecimationError"), ("decimation.guidance", "GuidanceError"),
+          ("analysis.topology", "AnalysisError"), ("io.mesh_edit", "EditError"), ("analysis.metrics", "MetricsError")]
 
 
 def test_every_error_derives_from_topstoc_error(ts):
