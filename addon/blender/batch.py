@@ -80,11 +80,11 @@ def _mesh_objects(bpy, path: str, names) -> list:
 
 def _world_vertices(objects) -> np.ndarray:
     """Every vertex of ``objects`` in world space (for the asset's bounding sphere)."""
-    from .io import mesh_io
+    from .io import mesh_read
 
     chunks = []
     for obj in objects:
-        local = mesh_io.read_positions(obj.data).astype(np.float64)
+        local = mesh_read.read_positions(obj.data).astype(np.float64)
         matrix = np.array(obj.matrix_world, dtype=np.float64)
         chunks.append(local @ matrix[:3, :3].T + matrix[:3, 3])
     return np.concatenate(chunks) if chunks else np.zeros((0, 3))

@@ -39,11 +39,11 @@ def _load(path: str, scene) -> bpy.types.Object:
         obj = bpy.context.selected_objects[0]
     else:
         from ..core.api import io
-        from .io import mesh_io
+        from .io import mesh_write
 
         data = io.read_mesh(path)
         mesh = bpy.data.meshes.new(pathlib.Path(path).name.split(".")[0])
-        mesh_io.fill_geometry(mesh, data.vertices, data.triangles)
+        mesh_write.fill_geometry(mesh, data.vertices, data.triangles)
         obj = bpy.data.objects.new(mesh.name, mesh)
         scene.collection.objects.link(obj)
     bpy.context.view_layer.objects.active = obj
@@ -123,10 +123,10 @@ def main(argv=None) -> int:
     obj = _load(args.input, scene)
     # Guidance as an artist would paint it: the top fifth (the head) keeps more detail. The
     # budget stays the target's, so the rest gets less.
-    from .io import mesh_io
+    from .io import mesh_read
 
     world = np.array(obj.matrix_world)
-    points = mesh_io.read_positions(obj.data) @ world[:3, :3].T + world[:3, 3]
+    points = mesh_read.read_positions(obj.data) @ world[:3, :3].T + world[:3, 3]
     extent = points.max(axis=0) - points.min(axis=0)
     z = points[:, 2] if extent[1] <= extent[2] else points[:, 1]  # "up" as the render shows it
     write_guidance(obj, z >= np.quantile(z, 0.8), None, 0.5)

@@ -52,7 +52,7 @@ def read_binary_ply(path):
 
 def make_object(name, vertices, triangles):
     mesh = bpy.data.meshes.new(name)
-    ts.blender.io.mesh_io.fill_geometry(mesh, vertices, triangles)
+    ts.blender.io.mesh_write.fill_geometry(mesh, vertices, triangles)
     obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     return obj
@@ -88,9 +88,9 @@ def topstoc_first_result(obj, ratio):
 
 def stages(obj, ratio):
     """The same work stage by stage (one run): where the first result's time goes."""
-    mesh_io, t = ts.blender.io.mesh_io, {}
+    mesh_read, mesh_write, t = ts.blender.io.mesh_read, ts.blender.io.mesh_write, {}
     clock = time.perf_counter()
-    arrays = mesh_io.read_mesh(obj.data)
+    arrays = mesh_read.read_mesh(obj.data)
     t["read"], clock = time.perf_counter() - clock, time.perf_counter()
     arrays.digest()
     t["fingerprint"], clock = time.perf_counter() - clock, time.perf_counter()
@@ -101,7 +101,7 @@ def stages(obj, ratio):
     result = mesh.decimate(ratio=ratio, seed=1, mode="fast")  # as the first result (Params: fast)
     t["decimate"], clock = time.perf_counter() - clock, time.perf_counter()
     written = bpy.data.meshes.new("stage")
-    mesh_io.fill_geometry(written, result.vertices, result.triangles)
+    mesh_write.fill_geometry(written, result.vertices, result.triangles)
     t["write geometry"] = time.perf_counter() - clock
     bpy.data.meshes.remove(written)
     return t

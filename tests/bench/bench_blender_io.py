@@ -58,10 +58,11 @@ def main():
     if not HORSE.exists():
         print(f"skipped: {HORSE} is not available")
         return 0
-    mesh_io, carry = ts.blender.io.mesh_io, ts.blender.io.carry
+    io = ts.blender.io
+    mesh_read, mesh_write, mesh_attributes, carry = io.mesh_read, io.mesh_write, io.mesh_attributes, io.carry
     data = ts.core.api.io.read_mesh(str(HORSE))
     mesh = bpy.data.meshes.new("Horse")
-    mesh_io.fill_geometry(mesh, data.vertices, data.triangles)
+    mesh_write.fill_geometry(mesh, data.vertices, data.triangles)
     obj = bpy.data.objects.new("Horse", mesh)
     bpy.context.scene.collection.objects.link(obj)
     n, corners = len(mesh.vertices), len(mesh.loops)
@@ -80,32 +81,32 @@ def main():
     print(f"machine: {machine()}; Blender {bpy.app.version_string}")
     print(f"mesh: {HORSE.name} ({n:,} vertices, {corners:,} corners), a UV map, a byte colour per corner, "
           f"{SHAPE_KEYS} shape keys")
-    row("positions (read_positions)", lambda: mesh_io.read_positions(mesh),
+    row("positions (read_positions)", lambda: mesh_read.read_positions(mesh),
         lambda: per_element(mesh.vertices, "co", n, 3),
-        lambda: (mesh_io.read_positions(mesh), per_element(mesh.vertices, "co", n, 3)))
-    row("corner vertices (corner_vertices)", lambda: mesh_io.corner_vertices(mesh),
+        lambda: (mesh_read.read_positions(mesh), per_element(mesh.vertices, "co", n, 3)))
+    row("corner vertices (corner_vertices)", lambda: mesh_read.corner_vertices(mesh),
         lambda: per_element(mesh.loops, "vertex_index", corners, 1, np.uint32),
-        lambda: (mesh_io.corner_vertices(mesh), per_element(mesh.loops, "vertex_index", corners, 1, np.uint32)[:, 0]))
-    row("the mesh as the engine takes it (read_mesh)", lambda: mesh_io.read_mesh(mesh),
+        lambda: (mesh_read.corner_vertices(mesh), per_element(mesh.loops, "vertex_index", corners, 1, np.uint32)[:, 0]))
+    row("the mesh as the engine takes it (read_mesh)", lambda: mesh_read.read_mesh(mesh),
         lambda: (per_element(mesh.vertices, "co", n, 3), per_element(mesh.loops, "vertex_index", corners, 1, np.uint32),
                  per_element(mesh.polygons, "loop_start", len(mesh.polygons), 1, np.uint32)),
-        lambda: (mesh_io.read_mesh(mesh).triangles.ravel(),
+        lambda: (mesh_read.read_mesh(mesh).triangles.ravel(),
                  per_element(mesh.loops, "vertex_index", corners, 1, np.uint32)[:, 0]))
-    row("a UV map (read_uv_map)", lambda: mesh_io.read_uv_map(mesh, "UV"),
+    row("a UV map (read_uv_map)", lambda: mesh_attributes.read_uv_map(mesh, "UV"),
         lambda: per_element(mesh.uv_layers["UV"].data, "uv", corners, 2),
-        lambda: (mesh_io.read_uv_map(mesh, "UV"), per_element(mesh.uv_layers["UV"].data, "uv", corners, 2)))
-    row("a byte colour per corner (read_attribute)", lambda: mesh_io.read_attribute(paint, corners),
+        lambda: (mesh_attributes.read_uv_map(mesh, "UV"), per_element(mesh.uv_layers["UV"].data, "uv", corners, 2)))
+    row("a byte colour per corner (read_attribute)", lambda: mesh_attributes.read_attribute(paint, corners),
         lambda: per_element(paint.data, "color_srgb", corners, 4),
-        lambda: (mesh_io.read_attribute(paint, corners)[0], per_element(paint.data, "color_srgb", corners, 4)))
+        lambda: (mesh_attributes.read_attribute(paint, corners)[0], per_element(paint.data, "color_srgb", corners, 4)))
     row(f"{SHAPE_KEYS} shape keys (read_shape_keys)", lambda: carry.read_shape_keys(mesh),
         lambda: [per_element(block.data, "co", n, 3) for block in blocks],
         lambda: (np.stack(carry.read_shape_keys(mesh).coordinates).astype(np.float32),
                  np.stack([per_element(block.data, "co", n, 3) for block in blocks])))
     out = bpy.data.meshes.new("Written")
     out.vertices.add(n)
-    row("write positions (write_positions)", lambda: mesh_io.write_positions(out, data.vertices),
+    row("write positions (write_positions)", lambda: mesh_write.write_positions(out, data.vertices),
         lambda: out.vertices.foreach_set("co", data.vertices.astype(np.float32).ravel()),
-        lambda: (mesh_io.read_positions(out), data.vertices.astype(np.float32)))
+        lambda: (mesh_read.read_positions(out), data.vertices.astype(np.float32)))
     edit_row(data)
     return 0
 
@@ -118,7 +119,7 @@ def edit_row(data):
     times = {}
     for kind in ("topstoc", "blender"):
         mesh = bpy.data.meshes.new(kind)
-        ts.blender.io.mesh_io.fill_geometry(mesh, data.vertices, data.triangles)
+        ts.blender.io.mesh_write.fill_geometry(mesh, data.vertices, data.triangles)
         obj = bpy.data.objects.new(kind, mesh)
         bpy.context.scene.collection.objects.link(obj)
         group = obj.vertex_groups.new(name="Group")
@@ -151,7 +152,9 @@ if __name__ == "__main__":
     addon_utils.enable("topstoc", default_set=True)
     import topstoc as ts  # noqa: E402
     import topstoc.blender.io.carry  # noqa: E402,F401
-    import topstoc.blender.io.mesh_io  # noqa: E402,F401
+    import topstoc.blender.io.mesh_read  # noqa: E402,F401
+    import topstoc.blender.io.mesh_write  # noqa: E402,F401
+    import topstoc.blender.io.mesh_attributes  # noqa: E402,F401
 
     code = main()
     sys.stdout.flush()

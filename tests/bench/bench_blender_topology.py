@@ -90,7 +90,7 @@ def main(argv):
                platform.processor())
     print(f"machine: {os.cpu_count()} cores, {cpu}; Blender {bpy.app.version_string}; "
           f"load average {os.getloadavg()[0]:.1f}")
-    from topstoc.blender.io import mesh_io
+    from topstoc.blender.io import mesh_write
     from topstoc.core.api import io
 
     for spec in args.mesh:
@@ -98,7 +98,7 @@ def main(argv):
         data = io.read_mesh(str(DATA / path) if not os.path.isabs(path) else path)
         vertices, triangles, how = subdivide(data.vertices, data.triangles, int(levels or 0))
         mesh = bpy.data.meshes.new(pathlib.Path(path).stem)
-        mesh_io.fill_geometry(mesh, vertices, triangles)
+        mesh_write.fill_geometry(mesh, vertices, triangles)
         obj = bpy.data.objects.new(mesh.name, mesh)
         bpy.context.scene.collection.objects.link(obj)
         for other in bpy.context.scene.objects:

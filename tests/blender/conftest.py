@@ -65,7 +65,7 @@ def ts(addon_module):
     import importlib
 
     package = sys.modules[addon_module]
-    for sub in ("core", "core.api.guidance", "blender.decimation.pipeline", "blender.io.mesh_io",
+    for sub in ("core", "core.api.guidance", "blender.decimation.pipeline", "blender.io.mesh_read",
                 "blender.preview.session", "blender.preview.cache", "blender.decimation.guidance"):
         importlib.import_module(f"{addon_module}.{sub}")
     return package

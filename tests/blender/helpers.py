@@ -19,7 +19,7 @@ def make_object(name, vertices, faces, collection=None):
 def drop_mistyped_edge_selection(mesh):
     """Blender 5.0.x's edge pass (from_pydata) types ``.select_edge`` INT32_2D, and a test writing
     ``MeshEdge.select`` would then crash Blender: remove that layer as a script would have to.
-    (The add-on's own guard, mesh_io.mistyped_edge_flags, is tested on unrepaired meshes.)"""
+    (The add-on's own guard, edge_flags.mistyped_edge_flags, is tested on unrepaired meshes.)"""
     broken = mesh.attributes.get(".select_edge")
     if broken is not None and broken.data_type != "BOOLEAN":
         mesh.attributes.remove(broken)

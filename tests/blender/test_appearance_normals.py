@@ -46,7 +46,7 @@ def decimate(obj, **options):
 def error(ts, out):
     vertices, triangles, normals = capped_cylinder()
     mesh = out.data
-    out_normals = ts.blender.io.mesh_io.read_custom_normals(mesh)
+    out_normals = ts.blender.io.mesh_read.read_custom_normals(mesh)
     assert out_normals is not None
     out_triangles = np.array([tuple(p.vertices) for p in mesh.polygons])
     return shading_error(vertices, triangles, normals, positions(mesh), out_triangles,
@@ -57,7 +57,7 @@ def error(ts, out):
 def test_the_input_holds_the_normals(ts, scene):
     obj = cylinder()
     vertices, triangles, normals = capped_cylinder()
-    read = ts.blender.io.mesh_io.read_custom_normals(obj.data)
+    read = ts.blender.io.mesh_read.read_custom_normals(obj.data)
     np.testing.assert_allclose(read, normals.reshape(-1, 3), atol=2e-3)  # Blender stores them encoded
 
 
@@ -128,7 +128,7 @@ def test_a_flat_shaded_fbx_asset_decimates_to_its_target(ts, scene, tmp_path):
     corner's normal is its own face's."""
     obj = flat_shaded_fbx_suzanne(tmp_path)
     mesh = obj.data
-    normals = ts.blender.io.mesh_io.read_custom_normals(mesh)
+    normals = ts.blender.io.mesh_read.read_custom_normals(mesh)
     assert len(mesh.vertices) == 7958 and normals is not None
     assert len(np.unique(np.round(normals, 3), axis=0)) > len(mesh.vertices)  # split at every edge
     select_only(obj)
@@ -137,7 +137,7 @@ def test_a_flat_shaded_fbx_asset_decimates_to_its_target(ts, scene, tmp_path):
     out = bpy.context.active_object
     assert out is not obj and obj.topstoc.use_hard_normals
     assert abs(len(out.data.vertices) - target) <= 0.01 * target, (len(out.data.vertices), target)
-    out_normals = ts.blender.io.mesh_io.read_custom_normals(out.data).astype(np.float64)
+    out_normals = ts.blender.io.mesh_read.read_custom_normals(out.data).astype(np.float64)
     faces = np.array([p.vertices[:] for p in out.data.polygons])
     p = positions(out.data)[faces]
     face = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])

@@ -41,7 +41,7 @@ def calc_edges_mesh(ts, vertices, triangles):
 
 def check_written(ts, vertices, triangles):
     mesh = bpy.data.meshes.new("written")
-    ts.blender.io.mesh_io.fill_geometry(mesh, vertices, triangles)
+    ts.blender.io.mesh_write.fill_geometry(mesh, vertices, triangles)
     reference = calc_edges_mesh(ts, vertices, triangles)
     assert len(mesh.edges) == len(reference.edges) > 0
     np.testing.assert_array_equal(np.unique(edge_pairs(mesh), axis=0), np.unique(edge_pairs(reference), axis=0))
@@ -89,17 +89,17 @@ def test_small_empty_and_degenerate_input(ts, scene):
     mesh = check_written(ts, vertices, np.array([[0, 1, 2], [1, 3, 2]], dtype=np.int32))
     assert len(mesh.edges) == 5
     empty = bpy.data.meshes.new("empty")
-    ts.blender.io.mesh_io.fill_geometry(empty, vertices, np.zeros((0, 3), dtype=np.int32))
+    ts.blender.io.mesh_write.fill_geometry(empty, vertices, np.zeros((0, 3), dtype=np.int32))
     assert (len(empty.vertices), len(empty.edges), len(empty.polygons)) == (4, 0, 0)
     # a repeated vertex has no edge of its own in the engine: Blender derives the edges then
     degenerate = bpy.data.meshes.new("degenerate")
-    ts.blender.io.mesh_io.fill_geometry(degenerate, vertices, np.array([[0, 1, 2], [1, 3, 3]], dtype=np.int32))
+    ts.blender.io.mesh_write.fill_geometry(degenerate, vertices, np.array([[0, 1, 2], [1, 3, 3]], dtype=np.int32))
     assert len(degenerate.polygons) == 2 and len(degenerate.edges) >= 3
 
 
 def test_edge_flags_writable_after_blenders_edge_pass(ts):
     """Blender 5.0.x's edge pass leaves ``.select_edge`` typed INT32_2D and writing
-    ``MeshEdge.select`` then crashes; mesh_io.calc_edges removes such a layer, so the flag
+    ``MeshEdge.select`` then crashes; edge_flags.calc_edges removes such a layer, so the flag
     copy after an edit (mesh_edit) writes and reads back the flags it was given."""
     vertices, triangles = meshgen.icosphere(1)
     mesh = bpy.data.meshes.new("flags")
@@ -112,7 +112,7 @@ def test_edge_flags_writable_after_blenders_edge_pass(ts):
     mesh.polygons.foreach_set("loop_start", np.arange(0, 3 * m, 3, dtype=np.int32))
     if bpy.app.version < (4, 0, 0):
         mesh.polygons.foreach_set("loop_total", np.full(m, 3, dtype=np.int32))
-    ts.blender.io.mesh_io.calc_edges(mesh)
+    ts.blender.io.edge_flags.calc_edges(mesh)
     for attribute in mesh.attributes:
         if attribute.name in (".select_edge", ".hide_edge", "sharp_edge"):
             assert (attribute.domain, attribute.data_type) == ("EDGE", "BOOLEAN"), attribute.name

@@ -34,7 +34,7 @@ def test_read_mesh_matches_blenders_loop_triangles(ts, scene, kind):
         faces.append((0, 1, 2, 3, len(vertices) - 1)[::-1])
         obj = make_object("Grid", vertices, faces)
         assert len(obj.data.loops) != 3 * len(obj.data.polygons)
-    arrays = ts.blender.io.mesh_io.read_mesh(obj.data)
+    arrays = ts.blender.io.mesh_read.read_mesh(obj.data)
     triangles, loops, polygon = reference_triangulation(obj.data)
     np.testing.assert_array_equal(arrays.triangles, triangles)
     np.testing.assert_array_equal(arrays.triangle_loops, loops)
@@ -48,7 +48,7 @@ def test_read_mesh_matches_blenders_loop_triangles(ts, scene, kind):
 def test_read_edges_matches_the_per_edge_flags(ts, scene, flag):
     obj = make_object("Ball", *meshgen.icosphere(2))
     mesh = obj.data
-    read_edges = ts.blender.io.mesh_io.read_edges
+    read_edges = ts.blender.io.edge_flags.read_edges
     assert read_edges(mesh, flag).shape == (0, 2)  # none flagged (4.0+: no attribute at all)
     for index in (3, 17, 40):
         setattr(mesh.edges[index], flag, True)
@@ -75,7 +75,7 @@ def test_read_edges_keeps_each_flag_apart_from_the_others(ts, scene, flag):
             edge.crease = 0.75
             edge.bevel_weight = 1.0
     expected = np.array([tuple(e.vertices) for e in mesh.edges if getattr(e, flag)])
-    found = ts.blender.io.mesh_io.read_edges(mesh, flag)
+    found = ts.blender.io.edge_flags.read_edges(mesh, flag)
     assert found.dtype == np.int32 and len(expected) > 100
     np.testing.assert_array_equal(found, expected)
     if (3, 0, 0) <= bpy.app.version < (4, 0, 0):  # read from the MEdge array, not edge by edge
@@ -97,7 +97,7 @@ def test_flags_and_loop_order_are_scanned_block_by_block(ts, scene):
         mesh.edges[index].use_seam = True
     expected = np.array([tuple(mesh.edges[i].vertices) for i in (5, dna.SCAN_BLOCK - 1, dna.SCAN_BLOCK,
                                                                   len(mesh.edges) - 1)])
-    np.testing.assert_array_equal(ts.blender.io.mesh_io.read_edges(mesh, "use_seam"), expected)
+    np.testing.assert_array_equal(ts.blender.io.edge_flags.read_edges(mesh, "use_seam"), expected)
     if (3, 0, 0) <= bpy.app.version < (4, 0, 0):
         np.testing.assert_array_equal(dna.flagged_edges(mesh, "use_seam"), expected)
         assert dna.triangles_in_loop_order(mesh) is True
@@ -115,11 +115,11 @@ def test_polygon_materials_and_corners_match_the_per_element_accessors(ts, scene
         mesh.materials.append(bpy.data.materials.new(f"Slot{slot}"))
     for polygon in mesh.polygons:
         polygon.material_index = (polygon.index * 7) % 3
-    mesh_io, dna = ts.blender.io.mesh_io, ts.blender.io.dna_arrays
+    mesh_read, dna = ts.blender.io.mesh_read, ts.blender.io.dna_arrays
     corners = np.array([loop.vertex_index for loop in mesh.loops])
-    np.testing.assert_array_equal(mesh_io.corner_vertices(mesh), corners)
-    np.testing.assert_array_equal(mesh_io.corner_edges(mesh), [loop.edge_index for loop in mesh.loops])
-    arrays = mesh_io.read_mesh(mesh)
+    np.testing.assert_array_equal(mesh_read.corner_vertices(mesh), corners)
+    np.testing.assert_array_equal(mesh_read.corner_edges(mesh), [loop.edge_index for loop in mesh.loops])
+    arrays = mesh_read.read_mesh(mesh)
     np.testing.assert_array_equal(arrays.polygon_material, [p.material_index for p in mesh.polygons])
     if (3, 0, 0) <= bpy.app.version < (3, 6, 0):  # these Blenders keep MLoop and MPoly arrays
         np.testing.assert_array_equal(dna.loop_indices(mesh, "v"), corners)
@@ -162,7 +162,7 @@ def test_byte_colours_are_read_as_their_stored_srgb_values(ts, scene, domain):
     layer.data.foreach_set("color_srgb", (stored / 255.0).astype(np.float32).ravel())
     expected = np.array([tuple(value.color_srgb) for value in layer.data], dtype=np.float32)
     assert len(np.unique(np.round(expected * 255))) == 256
-    values, key = ts.blender.io.mesh_io.read_attribute(layer, count)
+    values, key = ts.blender.io.mesh_attributes.read_attribute(layer, count)
     assert key == "color_srgb"
     np.testing.assert_array_equal(values, expected)
     np.testing.assert_array_equal(ts.blender.io.dna_arrays.byte_colors_srgb(layer), expected)

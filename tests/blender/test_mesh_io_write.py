@@ -1,4 +1,4 @@
-"""Writing a triangle mesh into Blender (mesh_io.fill_geometry, the Live Preview's frames and every
+"""Writing a triangle mesh into Blender (mesh_write.fill_geometry, the Live Preview's frames and every
 result's geometry): what Blender's per-element accessors read back is the mesh written, whichever
 way it went in (Blender 3.0-3.5: straight into the MLoop, MPoly and MEdge arrays, dna_arrays;
 later versions: attributes and foreach_set)."""
@@ -10,10 +10,10 @@ import meshgen
 
 
 def test_geometry_written_is_what_blender_reads_back(ts, scene, monkeypatch):
-    mesh_io, dna = ts.blender.io.mesh_io, ts.blender.io.dna_arrays
+    mesh_write, dna = ts.blender.io.mesh_write, ts.blender.io.dna_arrays
     vertices, triangles = meshgen.torus(48, 24)
     triangles = np.asarray(triangles)
-    edges = ts.core.api.mesh_edges(triangles, len(vertices))
+    edges = ts.core.mesh_edges(triangles, len(vertices))
     used = {}
     write = dna.write_field
 
@@ -22,7 +22,7 @@ def test_geometry_written_is_what_blender_reads_back(ts, scene, monkeypatch):
         return used[prop]
     monkeypatch.setattr(dna, "write_field", recorded)
     mesh = bpy.data.meshes.new("Written")
-    mesh_io.fill_geometry(mesh, vertices, triangles, edges)
+    mesh_write.fill_geometry(mesh, vertices, triangles, edges)
     legacy = (3, 0, 0) <= bpy.app.version < (3, 6, 0)  # these Blenders keep MLoop / MPoly / MEdge arrays
     assert used == dict.fromkeys(used, legacy) and len(used) == (5 if legacy else 1)  # 4.x: loop_start only
     np.testing.assert_array_equal([loop.vertex_index for loop in mesh.loops], triangles.ravel())

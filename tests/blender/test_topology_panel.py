@@ -529,14 +529,14 @@ def test_edit_on_a_from_pydata_mesh_keeps_edge_flags(mods, scene):
     mesh.edges.foreach_set("use_seam", marked)
     mesh.edges.foreach_set("use_edge_sharp", marked)
     marked_pairs = {tuple(p) for p in pairs[marked].tolist()}
-    readable = "select" not in mods.mesh_edit.mesh_io.mistyped_edge_flags(mesh)
+    readable = "select" not in mods.mesh_edit.edge_flags.mistyped_edge_flags(mesh)
     mesh.polygons.foreach_set("select", np.zeros(len(mesh.polygons), dtype=bool))
     mesh.polygons[3].select = True
     with in_edit_mode():
         assert bpy.ops.topstoc.delete_faces() == {"FINISHED"}
     out = obj.data
     assert len(out.polygons) == len(faces) - 1
-    assert mods.mesh_edit.mesh_io.mistyped_edge_flags(out) == {}
+    assert mods.mesh_edit.edge_flags.mistyped_edge_flags(out) == {}
     out_pairs = [tuple(sorted(e.vertices[:])) for e in out.edges]
     # delete_faces keeps every vertex (same ids), so edges are compared by their vertex pairs
     assert {p for p, e in zip(out_pairs, out.edges) if e.use_seam} == marked_pairs

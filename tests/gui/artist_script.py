@@ -136,14 +136,14 @@ def big_mesh_preview(source):
 
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
     import meshgen
-    from topstoc.blender.io import mesh_io
+    from topstoc.blender.io import mesh_write
     from topstoc.core.api.io import read_mesh
 
     data = read_mesh(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "open_boundary",
                                   "kivy_suzanne_monkey.obj"))
     vertices, triangles = meshgen.subdivide(data.vertices, data.triangles, 4)  # 1.0M triangles
     mesh = bpy.data.meshes.new("Big")
-    mesh_io.fill_geometry(mesh, vertices, triangles)
+    mesh_write.fill_geometry(mesh, vertices, triangles)
     big = bpy.data.objects.new("Big", mesh)
     # Xvfb's software rasteriser takes seconds to draw a million triangles (a GPU milliseconds),
     # and the event loop waits for each frame: drawn as its bounds, Esc reaches the modal in time

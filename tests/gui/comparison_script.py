@@ -22,12 +22,12 @@ RATIO = float(ARGS[1]) if len(ARGS) > 1 else 0.05
 
 def triangles_of(obj):
     """(vertices, triangles) of ``obj``'s evaluated mesh in object space (modifiers applied)."""
-    from topstoc.blender.io import mesh_io
+    from topstoc.blender.io import mesh_read
 
     evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
     mesh = evaluated.to_mesh()
     try:
-        arrays = mesh_io.read_mesh(mesh)
+        arrays = mesh_read.read_mesh(mesh)
         return arrays.vertices.copy(), arrays.triangles.copy()
     finally:
         evaluated.to_mesh_clear()

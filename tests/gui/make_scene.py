@@ -40,7 +40,7 @@ def main():
     sys.path.insert(0, os.environ["TOPSTOC_BUILD_PYTHON"])
     if addon_utils.enable("topstoc", default_set=True) is None:
         raise RuntimeError("could not enable topstoc")
-    from topstoc.blender.io import mesh_io
+    from topstoc.blender.io import mesh_write
     from topstoc.core.api import io
 
     cube = bpy.data.objects.get("Cube")
@@ -54,7 +54,7 @@ def main():
 
         vertices, triangles = meshgen.subdivide(vertices, triangles, args.subdivide)
     mesh = bpy.data.meshes.new(args.name)
-    mesh_io.fill_geometry(mesh, vertices, triangles)
+    mesh_write.fill_geometry(mesh, vertices, triangles)
     obj = bpy.data.objects.new(args.name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     if args.transform:

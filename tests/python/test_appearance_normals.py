@@ -22,7 +22,7 @@ TARGET = 120  # vertices, of 834
 
 
 def carried_normals(vertices, triangles, corner_normals, result) -> np.ndarray:
-    """(m', 3, 3) the result's corner normals as the add-on carries them (mesh_io): the source
+    """(m', 3, 3) the result's corner normals as the add-on carries them (mesh_write): the source
     corner's, interpolated for moved vertices and renormalised."""
     m = len(triangles)
     moved = moved_vertices(vertices, triangles, result)

@@ -19,7 +19,7 @@ from ...core.api.guidance import srgb_to_linear
 from ...core.api.hausdorff import hausdorff
 from ...core.support.native import engine
 from ...core.support.errors import TopStocError
-from ..io import mesh_io
+from ..io import mesh_access, mesh_read
 from ..preview import watch
 
 ERROR_ATTRIBUTE = "TopStoc Error"
@@ -38,9 +38,9 @@ def reference_of(obj):
     return source if source is not None and source.type == "MESH" and source != obj else None
 
 
-def _arrays(obj, role: str) -> mesh_io.MeshArrays:
-    mesh_io.check_mesh_object(obj, MetricsError)
-    arrays = mesh_io.read_mesh(obj.data)
+def _arrays(obj, role: str) -> mesh_read.MeshArrays:
+    mesh_read.check_mesh_object(obj, MetricsError)
+    arrays = mesh_read.read_mesh(obj.data)
     if len(arrays.triangles) == 0:
         raise MetricsError(f"{role} '{obj.name}' has no faces")
     return arrays
@@ -62,7 +62,7 @@ def is_current(obj) -> bool:
     memo = _current.get(obj.name_full)
     if memo is not None and memo[0] == key:
         return memo[1]
-    current = (mesh_io.read_mesh(obj.data).digest() + mesh_io.read_mesh(reference.data).digest()) == settings.stamp
+    current = (mesh_read.read_mesh(obj.data).digest() + mesh_read.read_mesh(reference.data).digest()) == settings.stamp
     _current[obj.name_full] = (key, current)
     return current
 
@@ -76,7 +76,7 @@ def measure(obj, reference=None, samples: int = None) -> dict:
     settings = obj.topstoc.metrics
     reference = reference if reference is not None else reference_of(obj)
     try:
-        mesh_io.check_mesh_object(obj, MetricsError)
+        mesh_read.check_mesh_object(obj, MetricsError)
         if reference is None:
             raise MetricsError(f"'{obj.name}' has no original to compare with: pick one under Original")
         start = time.perf_counter()
@@ -163,11 +163,11 @@ def write_error_colors(obj, percent: float = 0.0) -> bpy.types.Attribute:
     if errors is None:
         raise MetricsError(f"'{obj.name}' has no up-to-date error measurement: press Measure first")
     mesh = obj.data
-    arrays = mesh_io.read_mesh(mesh)
+    arrays = mesh_read.read_mesh(mesh)
     polygon_error = np.zeros(len(mesh.polygons))
     np.maximum.at(polygon_error, arrays.triangle_polygon, errors)
     loop_polygon = np.repeat(np.arange(len(mesh.polygons)),
-                             mesh_io._indices(mesh.polygons, "loop_total", len(mesh.polygons)))
+                             mesh_access.read_indices(mesh.polygons, "loop_total", len(mesh.polygons)))
     colors = error_colors(polygon_error, error_scale(obj, percent))[loop_polygon]
     attribute = mesh.color_attributes.get(ERROR_ATTRIBUTE)
     if attribute is not None and (attribute.domain != "CORNER" or attribute.data_type != "FLOAT_COLOR"):

@@ -22,7 +22,7 @@ import numpy as np
 from ...core.api import loops as core_loops
 from ...core.api.topology import Topology, topology as compute_topology
 from ...core.support.errors import TopStocError
-from ..io import mesh_io
+from ..io import mesh_access, mesh_read
 from ..preview import watch
 from ..preview.cache import prepared_meshes
 
@@ -40,8 +40,8 @@ def loose_edges(mesh) -> np.ndarray:
         return np.zeros((0, 2), dtype=np.int32)
     used = np.zeros(count, dtype=bool)
     if len(mesh.loops):
-        used[mesh_io.corner_edges(mesh)] = True
-    return mesh_io._indices(mesh.edges, "vertices", count, 2)[~used]
+        used[mesh_read.corner_edges(mesh)] = True
+    return mesh_access.read_indices(mesh.edges, "vertices", count, 2)[~used]
 
 
 def _flat(arrays) -> list:
@@ -78,10 +78,10 @@ def analyse(obj, carried_loops: Optional[list] = None) -> Topology:
     """
     topology = obj.topstoc.topology
     try:
-        mesh_io.check_mesh_object(obj, AnalysisError)
+        mesh_read.check_mesh_object(obj, AnalysisError)
         start = time.perf_counter()
         mesh = obj.data
-        arrays = mesh_io.read_mesh(mesh)
+        arrays = mesh_read.read_mesh(mesh)
         wires = loose_edges(mesh)
         try:
             info = compute_topology(arrays.vertices, arrays.triangles, wires, generators=True)
@@ -102,9 +102,9 @@ def _store(obj, info, arrays, wires, stamp: str, seconds: float, carried_loops) 
     topology = obj.topstoc.topology
     count = len(info.components)
     component_of = info.vertex_component
-    edges = mesh_io._indices(mesh.edges, "vertices", len(mesh.edges), 2)
-    polygon_first = mesh_io.corner_vertices(mesh)[mesh_io._indices(mesh.polygons, "loop_start", len(mesh.polygons))] \
-        if len(mesh.polygons) else np.zeros(0, dtype=np.int32)
+    edges = mesh_access.read_indices(mesh.edges, "vertices", len(mesh.edges), 2)
+    starts = mesh_access.read_indices(mesh.polygons, "loop_start", len(mesh.polygons))
+    polygon_first = mesh_read.corner_vertices(mesh)[starts] if len(mesh.polygons) else np.zeros(0, dtype=np.int32)
     edges_per = _per_component(component_of, edges[:, 0] if len(edges) else edges.reshape(-1), count)
     faces_per = _per_component(component_of, polygon_first, count)
 
@@ -237,7 +237,7 @@ class LoopSearch:
 
 def start_search(obj) -> LoopSearch:
     """Reads the mesh (main thread) for a search. Raises AnalysisError for unusable meshes."""
-    mesh_io.check_mesh_object(obj, AnalysisError)
+    mesh_read.check_mesh_object(obj, AnalysisError)
     if len(obj.data.polygons) == 0:
         raise AnalysisError(f"'{obj.name}' has no faces")
     try:

@@ -25,7 +25,7 @@ from ...core.api.hausdorff import hausdorff
 from ...core.carry.normal_bake import (MAX_OVERLAP, available_memory, check_memory, check_size, island_margin,
                                        overlap_fraction, ray_reach)
 from . import bake_raycast
-from ..io import mesh_io
+from ..io import mesh_read
 
 BAKE_UV_NAME = "TopStoc Bake"  #: the UV map made when the result has no usable one
 HAUSDORFF_SAMPLES = 200_000
@@ -54,7 +54,7 @@ class Baked:
 def check_bakeable(source, result) -> None:
     """One-line errors for what a bake cannot use: non-meshes, a source without faces, modifiers."""
     for obj in (source, result):
-        mesh_io.check_mesh_object(obj, BakeError)
+        mesh_read.check_mesh_object(obj, BakeError)
     if len(source.data.polygons) == 0:
         raise BakeError(f"'{source.name}' has no faces to bake a normal map from")
     if len(result.data.polygons) == 0:
@@ -67,7 +67,7 @@ def check_bakeable(source, result) -> None:
 
 
 def _world_triangles(obj, matrix) -> tuple:
-    arrays = mesh_io.read_mesh(obj.data)
+    arrays = mesh_read.read_mesh(obj.data)
     m = np.array(matrix, dtype=np.float64)
     return arrays.vertices @ m[:3, :3].T + m[:3, 3], arrays.triangles
 

@@ -22,7 +22,7 @@ from ...core.carry.appearance import Appearance, appearance_attributes
 from ...core.carry.attributes import hard_normal_edges, uv_seam_edges
 from ...core.api.decimate import Box, View
 from ...core.support.errors import TopStocError
-from ..io import mesh_io
+from ..io import mesh_read, mesh_attributes, edge_flags
 from ..props import DEFAULT_COLOR_LAYER
 
 
@@ -71,8 +71,8 @@ def _read_color(mesh, name: str) -> Callable[[], np.ndarray]:
         raise GuidanceError(f"colour attribute '{name}' not found on mesh '{mesh.name}' "
                             "(paint it in Vertex Paint mode or use 'Add Guidance Layer')")
     count = len(mesh.vertices) if attribute.domain == "POINT" else len(mesh.loops)
-    values, key = mesh_io.read_attribute(attribute, count)
-    corner_vertex = mesh_io.corner_vertices(mesh) if attribute.domain == "CORNER" else None
+    values, key = mesh_attributes.read_attribute(attribute, count)
+    corner_vertex = mesh_read.corner_vertices(mesh) if attribute.domain == "CORNER" else None
     n = len(mesh.vertices)
 
     def guidance() -> np.ndarray:
@@ -86,15 +86,15 @@ def _read_color(mesh, name: str) -> Callable[[], np.ndarray]:
     return guidance
 
 
-def _read_borders(obj, settings, arrays: mesh_io.MeshArrays) -> Callable[[list], Optional[np.ndarray]]:
+def _read_borders(obj, settings, arrays: mesh_read.MeshArrays) -> Callable[[list], Optional[np.ndarray]]:
     """Reads seams, sharp edges and the hard edges of custom normals; returns the function giving
     the border edges (it appends what it found to the list of sources it is given). A hard edge is
     a border so that each side's output corners take that side's normals, as at a UV seam."""
     mesh = obj.data
-    uv_maps = mesh_io.read_uv_maps(mesh) if settings.use_uv_seams else {}
-    marked = mesh_io.read_edges(mesh, "use_seam") if settings.use_uv_seams else np.zeros((0, 2), np.int32)
-    sharp = mesh_io.read_edges(mesh, "use_edge_sharp") if settings.use_sharp else np.zeros((0, 2), np.int32)
-    normals = mesh_io.read_custom_normals(mesh) if settings.use_hard_normals else None
+    uv_maps = mesh_attributes.read_uv_maps(mesh) if settings.use_uv_seams else {}
+    marked = edge_flags.read_edges(mesh, "use_seam") if settings.use_uv_seams else np.zeros((0, 2), np.int32)
+    sharp = edge_flags.read_edges(mesh, "use_edge_sharp") if settings.use_sharp else np.zeros((0, 2), np.int32)
+    normals = mesh_read.read_custom_normals(mesh) if settings.use_hard_normals else None
 
     def borders(sources: list) -> Optional[np.ndarray]:
         parts = []
@@ -149,26 +149,26 @@ def appearance_color(mesh, settings):
     return None
 
 
-def _read_appearance(obj, arrays: mesh_io.MeshArrays) -> tuple:
+def _read_appearance(obj, arrays: mesh_read.MeshArrays) -> tuple:
     """Reads the active UV map, the appearance colour (appearance_color) and the custom normals
-    (mesh_io.read_custom_normals; normals Blender derives from the shape are left out, see
+    (mesh_read.read_custom_normals; normals Blender derives from the shape are left out, see
     core/carry/appearance.py); returns (the function giving the engine's attributes, what they hold).
     Colours enter as sRGB in [0, 1]."""
     mesh = obj.data
     names, uv, color, color_key, color_domain = [], None, None, None, None
     layer = mesh.uv_layers.active
     if layer is not None:
-        uv = mesh_io.read_uv_map(mesh, layer.name)
+        uv = mesh_attributes.read_uv_map(mesh, layer.name)
         names.append(f"UV map '{layer.name}'")
     attribute = appearance_color(mesh, obj.topstoc)
     if attribute is not None and attribute.domain in ("POINT", "CORNER"):
         count = len(mesh.vertices) if attribute.domain == "POINT" else len(mesh.loops)
-        read = mesh_io.read_attribute(attribute, count)
+        read = mesh_attributes.read_attribute(attribute, count)
         if read is not None:
             color, color_key = read
             color_domain = attribute.domain
             names.append(f"colours '{attribute.name}'")
-    normals = mesh_io.read_custom_normals(mesh)
+    normals = mesh_read.read_custom_normals(mesh)
     if normals is not None:
         names.append("custom normals")
 
@@ -231,12 +231,12 @@ def _viewport_view(obj, region_3d) -> View:
     return View(direction=list(direction), view_projection=_matrix(clip))
 
 
-def gather(obj, arrays: mesh_io.MeshArrays, scene, depsgraph=None, region_3d=None) -> EngineGuidance:
+def gather(obj, arrays: mesh_read.MeshArrays, scene, depsgraph=None, region_3d=None) -> EngineGuidance:
     """Reads every enabled guidance source of ``obj`` into engine arguments."""
     return read(obj, arrays, scene, depsgraph, region_3d)()
 
 
-def read(obj, arrays: mesh_io.MeshArrays, scene, depsgraph=None,
+def read(obj, arrays: mesh_read.MeshArrays, scene, depsgraph=None,
          region_3d=None) -> Callable[[], EngineGuidance]:
     """Reads every enabled guidance source of ``obj`` (Blender data: the main thread) and returns
     the function that turns what was read into engine arguments (numpy only: any thread; the
@@ -252,7 +252,7 @@ def read(obj, arrays: mesh_io.MeshArrays, scene, depsgraph=None,
         group = obj.vertex_groups.get(settings.vertex_group)
         if group is None:
             raise GuidanceError(f"vertex group '{settings.vertex_group}' not found on '{obj.name}'")
-        weights, assigned = mesh_io.read_vertex_group(obj, group.index)
+        weights, assigned = mesh_attributes.read_vertex_group(obj, group.index)
         mapping = settings.vertex_group_mapping
         sources.append((lambda: rules.vertex_group_guidance(weights, assigned, mapping),
                         settings.vertex_group_strength))

@@ -26,7 +26,7 @@ from ...core.carry.attributes import MovedVertices, moved_vertices, point_weight
 from ...core.api.decimate import run_job
 from ...core.support.errors import TopStocError
 from ...core.api.job import ATTRIBUTE_WEIGHT, DecimationJob, make_job
-from ..io import carry, mesh_io
+from ..io import mesh_read, mesh_write, mesh_attributes, carry
 from ..preview.cache import Prepared, prepared_meshes
 from .guidance import EngineGuidance, gather, guidance_layers
 
@@ -143,7 +143,7 @@ def face_estimate(panel, mesh):
 
 def check_decimatable(obj) -> None:
     """Raises DecimationError unless ``obj`` is a mesh object with faces, in Object Mode."""
-    mesh_io.check_mesh_object(obj, DecimationError)
+    mesh_read.check_mesh_object(obj, DecimationError)
     if len(obj.data.polygons) == 0:
         raise DecimationError(f"'{obj.name}' has no faces to decimate")
 
@@ -151,10 +151,10 @@ def check_decimatable(obj) -> None:
 def prepare(obj) -> Prepared:
     """The cached prepared mesh of ``obj``, with a clear error for unusable meshes."""
     check_decimatable(obj)
-    return prepare_arrays(obj.name, obj.data.name_full, mesh_io.read_mesh(obj.data))
+    return prepare_arrays(obj.name, obj.data.name_full, mesh_read.read_mesh(obj.data))
 
 
-def prepare_arrays(obj_name: str, mesh_name: str, arrays: mesh_io.MeshArrays, progress=None) -> Prepared:
+def prepare_arrays(obj_name: str, mesh_name: str, arrays: mesh_read.MeshArrays, progress=None) -> Prepared:
     """``prepare`` for arrays already read (any thread: no Blender data is touched); progress:
     see :class:`topstoc.core.Mesh` (its False raises ``Cancelled``)."""
     try:
@@ -202,13 +202,13 @@ def _object_materials(source, new) -> None:
             new.material_slots[index].material = slot.material
 
 
-def skin_weights(obj, arrays: mesh_io.MeshArrays, kept: np.ndarray, moved) -> tuple:
+def skin_weights(obj, arrays: mesh_read.MeshArrays, kept: np.ndarray, moved) -> tuple:
     """(group names, the output vertices' vertex-group weights): a vertex that did not move keeps
     its input vertex's; a moved one mixes its source triangle's (core/attributes.point_weights),
     rescaled to sum to 1 when the source's weights read (those of the kept vertices and of the
     moved vertices' triangles) all sum to 1."""
     corners = moved.source_corners(arrays.triangles, moved.moved).ravel()
-    names, source = mesh_io.read_vertex_weights(obj, np.concatenate([kept, corners]))
+    names, source = mesh_attributes.read_vertex_weights(obj, np.concatenate([kept, corners]))
     return names, point_weights(source, kept, moved, arrays.triangles, normalise=source.normalised())
 
 
@@ -232,7 +232,7 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
     if mode == "IN_PLACE" or into is not None:
         target = obj if into is None else into
         old = target.data
-        mesh = mesh_io.build_result_mesh(obj.data, arrays, run.result, old.name + "_TopStoc", moved,
+        mesh = mesh_write.build_result_mesh(obj.data, arrays, run.result, old.name + "_TopStoc", moved,
                                          guidance_layers(obj), keep_guidance=into is None)
         if into is not None:  # the result's own material choices win over the source's
             mesh.materials.clear()
@@ -246,7 +246,7 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
         mesh.name = old_name
     else:
         name = name or f"{obj.name}_TopStoc"
-        mesh = mesh_io.build_result_mesh(obj.data, arrays, run.result, name, moved, guidance_layers(obj),
+        mesh = mesh_write.build_result_mesh(obj.data, arrays, run.result, name, moved, guidance_layers(obj),
                                          keep_guidance=False)
         carry.copy_custom_properties(obj.data, mesh)
         target = bpy.data.objects.new(name, mesh)
@@ -256,7 +256,7 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
         carry.copy_custom_properties(obj, target)
         if place:
             carry.place_beside(obj, target)
-    mesh_io.write_vertex_weights(target, group_names, weights)
+    mesh_attributes.write_vertex_weights(target, group_names, weights)
     carry.write_shape_keys(target, shape_keys, arrays.vertices, run.result.vertices, kept, moved, arrays.triangles)
     target["topstoc_source"] = obj.name
     target["topstoc_parameters"] = json.dumps(run.parameters)

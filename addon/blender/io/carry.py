@@ -1,5 +1,5 @@
 """What follows the source object onto a decimated result: shape keys, modifiers, parent,
-collections and custom properties (vertex groups and mesh attributes: see mesh_io).
+collections and custom properties (vertex groups and mesh attributes: see mesh_attributes and mesh_write).
 
 Shape keys: the result has every key of the source with its name, value, slider range, mute
 flag, interpolation, vertex group and relative key. A key's position at output vertex ``i`` is

@@ -25,7 +25,7 @@ import numpy as np
 
 from ...core.support.errors import TopStocError
 from ...core.support.ranges import concatenated_ranges
-from . import mesh_io
+from . import mesh_access, mesh_read, mesh_write, mesh_attributes, edge_flags
 
 # Per-element properties read and written through foreach_get/set where the Blender version has them.
 _VERTEX_FLAGS = ("select", "hide")
@@ -52,7 +52,7 @@ class PolygonLayout:
     corner_patch: np.ndarray    #: (c,) index of the patch a corner belongs to, or -1
 
 
-def polygon_layout(arrays: mesh_io.MeshArrays, result) -> PolygonLayout:
+def polygon_layout(arrays: mesh_read.MeshArrays, result) -> PolygonLayout:
     """Maps an EditResult on ``arrays``' loop triangles back to polygons (see the module text)."""
     triangle_loops = arrays.triangle_loops
     n_loops = arrays.num_loops
@@ -134,17 +134,17 @@ def _polygon_corners(arrays, polygons: int):
 
 def _fill_polygons(mesh, layout: PolygonLayout, loose_edges: np.ndarray) -> None:
     mesh.vertices.add(len(layout.vertices))
-    mesh_io.write_positions(mesh, layout.vertices)
+    mesh_write.write_positions(mesh, layout.vertices)
     if len(loose_edges):
         mesh.edges.add(len(loose_edges))
-        mesh_io._set_int_field(mesh, ".edge_verts", mesh.edges, "vertices", loose_edges)
+        mesh_access.write_indices(mesh, ".edge_verts", mesh.edges, "vertices", loose_edges)
     corners = len(layout.corner_vertex)
     mesh.loops.add(corners)
     mesh.polygons.add(len(layout.loop_total))
     if corners:
-        mesh_io._set_int_field(mesh, ".corner_vert", mesh.loops, "vertex_index", layout.corner_vertex)
-        mesh_io.write_polygon_loops(mesh, layout.loop_start, layout.loop_total)
-    mesh_io.calc_edges(mesh)
+        mesh_access.write_indices(mesh, ".corner_vert", mesh.loops, "vertex_index", layout.corner_vertex)
+        mesh_write.write_polygon_loops(mesh, layout.loop_start, layout.loop_total)
+    edge_flags.calc_edges(mesh)
 
 
 def _gather(values: np.ndarray, source: np.ndarray) -> np.ndarray:
@@ -186,8 +186,8 @@ def _edge_keys(edges: np.ndarray, n: int) -> np.ndarray:
 def _edge_sources(old_mesh, new_mesh, vertex_source: np.ndarray) -> np.ndarray:
     """For each new edge, the old edge between the same source vertices, or -1."""
     n_old = len(old_mesh.vertices)
-    old_edges = mesh_io._indices(old_mesh.edges, "vertices", len(old_mesh.edges), 2).astype(np.int64)
-    new_edges = mesh_io._indices(new_mesh.edges, "vertices", len(new_mesh.edges), 2).astype(np.int64)
+    old_edges = mesh_access.read_indices(old_mesh.edges, "vertices", len(old_mesh.edges), 2).astype(np.int64)
+    new_edges = mesh_access.read_indices(new_mesh.edges, "vertices", len(new_mesh.edges), 2).astype(np.int64)
     if len(new_edges) == 0 or len(old_edges) == 0:
         return np.full(len(new_edges), -1, dtype=np.int64)
     ends = vertex_source[new_edges]
@@ -209,19 +209,19 @@ def _edge_sources(old_mesh, new_mesh, vertex_source: np.ndarray) -> np.ndarray:
 def _copy_flags(old, new, domain: str, names, source: np.ndarray, unreadable=()) -> None:
     """Element flags of ``old``'s elements of ``domain`` onto ``new``'s (each from its source
     element, unflagged without one)."""
-    collection_old = getattr(old, mesh_io.DOMAIN_COLLECTIONS[domain])
-    collection_new = getattr(new, mesh_io.DOMAIN_COLLECTIONS[domain])
+    collection_old = getattr(old, mesh_access.DOMAIN_COLLECTIONS[domain])
+    collection_new = getattr(new, mesh_access.DOMAIN_COLLECTIONS[domain])
     if len(collection_new) == 0 or len(collection_old) == 0:
         return
     names = [name for name in names if name not in unreadable]
-    as_attributes = mesh_io.ELEMENT_FLAG_ATTRIBUTES[domain] if bpy.app.version >= (4, 0, 0) else {}
+    as_attributes = edge_flags.ELEMENT_FLAG_ATTRIBUTES[domain] if bpy.app.version >= (4, 0, 0) else {}
     _copy_flag_attributes(old, new, domain, [name for name in names if name in as_attributes], source)
     element = collection_old[0]
     for name in names:
         if name in as_attributes or not hasattr(element, name):
             continue
         dtype = bool if isinstance(getattr(element, name), bool) else np.float32
-        picked = _gather(mesh_io._get(collection_old, name, len(collection_old), 1, dtype), source)
+        picked = _gather(mesh_access.read_array(collection_old, name, len(collection_old), 1, dtype), source)
         if picked.any():
             collection_new.foreach_set(name, picked)
 
@@ -229,21 +229,21 @@ def _copy_flags(old, new, domain: str, names, source: np.ndarray, unreadable=())
 def _copy_flag_attributes(old, new, domain: str, names, source: np.ndarray) -> None:
     """Blender 4.0+: flags are attributes, present only when some element has the flag."""
     for name in names:
-        attribute = mesh_io.element_flag_attribute(old, domain, name)
-        kind = mesh_io.ELEMENT_FLAG_ATTRIBUTES[domain][name][1]
+        attribute = edge_flags.element_flag_attribute(old, domain, name)
+        kind = edge_flags.ELEMENT_FLAG_ATTRIBUTES[domain][name][1]
         if attribute is None or (attribute.domain, attribute.data_type) != (domain, kind):
-            continue  # none flagged (the default), or mistyped (see mesh_io.mistyped_edge_flags)
-        values, key = mesh_io.read_attribute(attribute, mesh_io._domain_size(old, domain))
+            continue  # none flagged (the default), or mistyped (see edge_flags.mistyped_edge_flags)
+        values, key = mesh_attributes.read_attribute(attribute, mesh_access.domain_size(old, domain))
         picked = _gather(values[:, 0], source)
         if picked.any():
-            mesh_io.attribute_for_write(new, attribute.name, kind, domain).data.foreach_set(key, picked)
+            mesh_access.attribute_for_write(new, attribute.name, kind, domain).data.foreach_set(key, picked)
 
 
 def _copy_attributes(old, new, layout: PolygonLayout, result, edge_source: np.ndarray, uv_names: set) -> None:
     sources = {"POINT": layout.vertex_source, "FACE": layout.polygon_source, "EDGE": edge_source,
                "CORNER": layout.corner_loop}
     # flags (4.0+: attributes such as "sharp_edge" too) go through _copy_flags
-    flag_names = {name for flags in mesh_io.ELEMENT_FLAG_ATTRIBUTES.values() for names, _ in flags.values()
+    flag_names = {name for flags in edge_flags.ELEMENT_FLAG_ATTRIBUTES.values() for names, _ in flags.values()
                   for name in names} if bpy.app.version >= (4, 0, 0) else set()
     for attribute in old.attributes:
         name = attribute.name
@@ -251,7 +251,7 @@ def _copy_attributes(old, new, layout: PolygonLayout, result, edge_source: np.nd
         if name in _SKIPPED or name.startswith(".") or name in uv_names or attribute.domain not in sources \
                 or name in flag_names:
             continue
-        read = mesh_io.read_attribute(attribute, mesh_io._domain_size(old, attribute.domain))
+        read = mesh_attributes.read_attribute(attribute, mesh_access.domain_size(old, attribute.domain))
         if read is None:
             continue
         values, key = read
@@ -262,12 +262,12 @@ def _copy_attributes(old, new, layout: PolygonLayout, result, edge_source: np.nd
             picked = _patch_mean(values, layout.corner_loop, layout.corner_patch)
         else:
             picked = _gather(values, sources[domain])
-        target = mesh_io.attribute_for_write(new, name, attribute.data_type, domain)
+        target = mesh_access.attribute_for_write(new, name, attribute.data_type, domain)
         if len(picked):
             target.data.foreach_set(key, np.ascontiguousarray(picked).ravel())
 
 
-def build_edited_mesh(old, arrays: mesh_io.MeshArrays, result, new) -> bpy.types.Mesh:
+def build_edited_mesh(old, arrays: mesh_read.MeshArrays, result, new) -> bpy.types.Mesh:
     """Fills the empty mesh ``new`` with ``result`` (an EditResult on ``arrays``, read from the
     mesh ``old``) and ``old``'s attributes."""
     layout = polygon_layout(arrays, result)
@@ -286,30 +286,30 @@ def build_edited_mesh(old, arrays: mesh_io.MeshArrays, result, new) -> bpy.types
             new.materials.append(material)
     polygon_source = layout.polygon_source
     if len(polygon_source) and np.any(arrays.polygon_material):
-        mesh_io.write_polygon_materials(new, _gather(arrays.polygon_material, polygon_source))
-    smooth = mesh_io.read_polygon_smooth(old) if len(polygon_source) else None
+        mesh_write.write_polygon_materials(new, _gather(arrays.polygon_material, polygon_source))
+    smooth = mesh_read.read_polygon_smooth(old) if len(polygon_source) else None
     if smooth is not None:
-        mesh_io.write_polygon_smooth(new, _gather(smooth, polygon_source))
+        mesh_write.write_polygon_smooth(new, _gather(smooth, polygon_source))
 
     uv_names = set()
     for uv in old.uv_layers:
         uv_names.add(uv.name)
-        values = mesh_io.read_uv_map(old, uv.name)
-        mesh_io.write_uv_map(new, uv.name, _patch_mean(values, layout.corner_loop, layout.corner_patch)
+        values = mesh_attributes.read_uv_map(old, uv.name)
+        mesh_attributes.write_uv_map(new, uv.name, _patch_mean(values, layout.corner_loop, layout.corner_patch)
                              if len(layout.corner_loop) else values[:0])
     if old.uv_layers.active is not None:
         new.uv_layers.active_index = old.uv_layers.active_index
 
     edge_source = _edge_sources(old, new, layout.vertex_source)
     _copy_flags(old, new, "POINT", _VERTEX_FLAGS, layout.vertex_source)
-    _copy_flags(old, new, "EDGE", _EDGE_FLAGS, edge_source, unreadable=mesh_io.mistyped_edge_flags(old))
+    _copy_flags(old, new, "EDGE", _EDGE_FLAGS, edge_source, unreadable=edge_flags.mistyped_edge_flags(old))
     _copy_flags(old, new, "FACE", _POLYGON_FLAGS, polygon_source)
     _copy_attributes(old, new, layout, result, edge_source, uv_names)
     colors = old.color_attributes
     if colors.active_color is not None and new.color_attributes.get(colors.active_color.name) is not None:
         new.color_attributes.active_color = new.color_attributes[colors.active_color.name]
 
-    normals = mesh_io.read_custom_normals(old)
+    normals = mesh_read.read_custom_normals(old)
     if normals is not None and len(layout.corner_loop):
         if hasattr(new, "use_auto_smooth"):
             new.use_auto_smooth = True
@@ -319,7 +319,7 @@ def build_edited_mesh(old, arrays: mesh_io.MeshArrays, result, new) -> bpy.types
     return new
 
 
-def apply_edit(obj, arrays: mesh_io.MeshArrays, result) -> bpy.types.Mesh:
+def apply_edit(obj, arrays: mesh_read.MeshArrays, result) -> bpy.types.Mesh:
     """Writes the edit into ``obj``'s own mesh datablock (so Edit Mode, undo, other users of the
     mesh and its settings see the same datablock); vertex groups follow the vertices."""
     mesh = obj.data
@@ -327,7 +327,7 @@ def apply_edit(obj, arrays: mesh_io.MeshArrays, result) -> bpy.types.Mesh:
         raise EditError(f"'{obj.name}' has shape keys; apply or remove them before editing its topology")
     source = np.asarray(result.vertex_source, dtype=np.int64)
     copies = np.flatnonzero(source >= 0)
-    groups = mesh_io.collect_vertex_groups(obj, source[copies])
+    groups = mesh_attributes.collect_vertex_groups(obj, source[copies])
     snapshot = mesh.copy()  # the data to carry over, read while the mesh itself is rebuilt
     try:
         mesh.clear_geometry()
@@ -336,5 +336,5 @@ def apply_edit(obj, arrays: mesh_io.MeshArrays, result) -> bpy.types.Mesh:
         bpy.data.meshes.remove(snapshot)
     for group_name, (ids, weights) in groups.items():
         groups[group_name] = (copies[np.asarray(ids, dtype=np.int64)].tolist(), weights)
-    mesh_io.apply_vertex_groups(obj, groups)
+    mesh_attributes.apply_vertex_groups(obj, groups)
     return mesh

@@ -7,7 +7,7 @@ import numpy as np
 from bpy.props import EnumProperty, FloatProperty
 
 from ...core.api import guidance as rules
-from ..io import mesh_io
+from ..io import mesh_access, mesh_read, mesh_attributes, edge_flags
 from . import polls
 
 LEVELS = [("KEEP", "Keep", "Always keep (u = 1)"), ("MORE", "More", "More detail (u = 0.5)"),
@@ -40,14 +40,14 @@ def write_guidance(obj, vertex_mask: np.ndarray, polygon_mask: np.ndarray, u: fl
         count, mask = len(mesh.vertices), vertex_mask
     else:
         count = len(mesh.loops)
-        loop_vertex = mesh_io.corner_vertices(mesh)
+        loop_vertex = mesh_read.corner_vertices(mesh)
         if polygon_mask is not None:
             loop_polygon = np.repeat(np.arange(len(mesh.polygons)),
-                                     mesh_io._indices(mesh.polygons, "loop_total", len(mesh.polygons)))
+                                     mesh_access.read_indices(mesh.polygons, "loop_total", len(mesh.polygons)))
             mask = polygon_mask[loop_polygon]
         else:
             mask = vertex_mask[loop_vertex]
-    values, key = mesh_io.read_attribute(attribute, count)
+    values, key = mesh_attributes.read_attribute(attribute, count)
     color = rules.guidance_color(u)
     if key == "color":
         color = np.r_[rules.srgb_to_linear(color[:3]), 1.0]
@@ -108,8 +108,8 @@ class TOPSTOC_OT_set_guidance(bpy.types.Operator):
         bpy.ops.object.mode_set(mode="OBJECT")
         try:
             mesh = obj.data
-            vertex_mask = mesh_io.read_element_flag(mesh, "POINT", "select")
-            polygon_mask = mesh_io.read_element_flag(mesh, "FACE", "select") if faces else None
+            vertex_mask = edge_flags.read_element_flag(mesh, "POINT", "select")
+            polygon_mask = edge_flags.read_element_flag(mesh, "FACE", "select") if faces else None
             count = write_guidance(obj, vertex_mask, polygon_mask, u)
         finally:
             bpy.ops.object.mode_set(mode="EDIT")

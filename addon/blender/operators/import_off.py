@@ -12,7 +12,7 @@ from bpy.props import CollectionProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 
 from ...core.api.io import MeshFileWarning, read_mesh
-from ..io import mesh_io
+from ..io import mesh_access, mesh_write
 
 
 def polygon_corners(triangles: np.ndarray, triangle_polygon: np.ndarray):
@@ -47,11 +47,11 @@ def mesh_from_file(path: str, name: str, notes: list) -> bpy.types.Mesh:
     corners, totals = polygon_corners(data.triangles, data.triangle_polygon)
     mesh = bpy.data.meshes.new(name)
     mesh.vertices.add(data.num_vertices)
-    mesh_io.write_positions(mesh, data.vertices)
+    mesh_write.write_positions(mesh, data.vertices)
     mesh.loops.add(len(corners))
-    mesh_io._set_int_field(mesh, ".corner_vert", mesh.loops, "vertex_index", corners)
+    mesh_access.write_indices(mesh, ".corner_vert", mesh.loops, "vertex_index", corners)
     mesh.polygons.add(len(totals))
-    mesh_io.write_polygon_loops(mesh, np.r_[0, np.cumsum(totals)[:-1]], totals)
+    mesh_write.write_polygon_loops(mesh, np.r_[0, np.cumsum(totals)[:-1]], totals)
     mesh.update(calc_edges=True)
     if data.vertex_colors is not None:
         colors = np.ones((data.num_vertices, 4), dtype=np.float32)

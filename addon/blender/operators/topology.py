@@ -17,7 +17,7 @@ from bpy.props import EnumProperty
 
 from ...core.api import edit
 from ..analysis import topology as analysis
-from ..io import mesh_edit, mesh_io
+from ..io import mesh_access, mesh_read, edge_flags, mesh_edit
 from ..preview import watch
 from . import polls
 from ...core.support.errors import TopStocError
@@ -267,7 +267,7 @@ def run_edit(operator, context, compute, dropped: int = -1, verb: str = "edited"
             except analysis.AnalysisError as error:
                 return refuse(str(error))
         try:
-            arrays = mesh_io.read_mesh(obj.data)
+            arrays = mesh_read.read_mesh(obj.data)
             result = compute(obj, arrays)
             carried = analysis.carry_loops(obj, result, dropped)
             mesh_edit.apply_edit(obj, arrays, result)
@@ -305,7 +305,7 @@ class TOPSTOC_OT_select_loop(_LoopOperator, bpy.types.Operator):
                 return {"CANCELLED"}
             mesh = obj.data
             ids = _loop_ids(obj)
-            edges = mesh_io._indices(mesh.edges, "vertices", len(mesh.edges), 2).astype(np.int64)
+            edges = mesh_access.read_indices(mesh.edges, "vertices", len(mesh.edges), 2).astype(np.int64)
             n = len(mesh.vertices)
             keys = np.minimum(edges[:, 0], edges[:, 1]) * n + np.maximum(edges[:, 0], edges[:, 1])
             following = np.roll(ids, -1)
@@ -400,7 +400,7 @@ triangulation, robust fallbacks)"""
                 raise TopStocError("the mesh has no holes")
             if mode == "ALL":
                 return edit.fill_holes(arrays.vertices, arrays.triangles, skip_unfillable=True)
-            selected = mesh_io.read_element_flag(o.data, "POINT", "select")
+            selected = edge_flags.read_element_flag(o.data, "POINT", "select")
             picked = [i for i, hole in enumerate(holes)
                       if (selected[hole.vertices] & selected[np.roll(hole.vertices, -1)]).any()]
             if not picked:
@@ -427,7 +427,7 @@ class TOPSTOC_OT_delete_faces(bpy.types.Operator):
 
     def execute(self, context):
         def compute(o, arrays):
-            selected = mesh_io.read_element_flag(o.data, "FACE", "select")
+            selected = edge_flags.read_element_flag(o.data, "FACE", "select")
             if not selected.any():
                 raise TopStocError("no faces are selected")
             return edit.delete_faces(arrays.vertices, arrays.triangles, selected[arrays.triangle_polygon])

@@ -13,14 +13,14 @@ from collections import OrderedDict
 from dataclasses import dataclass
 
 from ...core.api.mesh import Mesh
-from ..io import mesh_io
+from ..io import mesh_read
 
 
 @dataclass
 class Prepared:
     """A Blender mesh read into arrays and prepared for the engine."""
 
-    arrays: mesh_io.MeshArrays
+    arrays: mesh_read.MeshArrays
     mesh: Mesh
     digest: str
 
@@ -38,9 +38,9 @@ class PreparedCache:
 
     def get(self, mesh_data) -> Prepared:
         """The prepared form of a bpy Mesh, re-prepared when its geometry changed (main thread)."""
-        return self.prepare(mesh_data.name_full, mesh_io.read_mesh(mesh_data))
+        return self.prepare(mesh_data.name_full, mesh_read.read_mesh(mesh_data))
 
-    def prepare(self, name: str, arrays: mesh_io.MeshArrays, progress=None) -> Prepared:
+    def prepare(self, name: str, arrays: mesh_read.MeshArrays, progress=None) -> Prepared:
         """The preparation of ``arrays`` read from the mesh datablock ``name`` (its ``name_full``):
         cached, or made now (any thread; reads no Blender data). ``progress`` is handed to
         :class:`Mesh` (its False cancels with ``Cancelled``; nothing is cached then)."""

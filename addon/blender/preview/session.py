@@ -45,7 +45,7 @@ import numpy as np
 from ...core.carry.attributes import moved_vertices
 from ...core.api.loops import Cancelled
 from ...core.api.mesh_edges import mesh_edges
-from ..io import mesh_io
+from ..io import mesh_read, mesh_write, edge_flags
 from ..decimation import pipeline
 from ..decimation.guidance import read as read_guidance
 
@@ -66,8 +66,8 @@ class PreviewSession:
                  deferred: bool = False):
         pipeline.check_decimatable(obj)
         self.obj = obj
-        arrays = mesh_io.read_mesh(obj.data)  # the main thread's work: Blender data
-        self._edge_flags = mesh_io.read_carried_edge_flags(obj.data)  # seams, sharp edges the preview shows
+        arrays = mesh_read.read_mesh(obj.data)  # the main thread's work: Blender data
+        self._edge_flags = edge_flags.read_carried_edge_flags(obj.data)  # seams, sharp edges the preview shows
         self.num_triangles = len(arrays.triangles)
         self.guidance = None                   # made by the worker from what is read below
         self._read_guidance = None             # the rules to run on it (guidance.read)
@@ -189,7 +189,7 @@ class PreviewSession:
         if any(len(pairs) for pairs in self._edge_flags.values()):
             kept = np.asarray(result.kept, dtype=np.int64)
             moved = np.any(np.asarray(result.vertices) != self.prepared.arrays.vertices[kept], axis=1)
-            flags = mesh_io.output_edge_flags(self._edge_flags, edges.vertices, kept, moved)
+            flags = edge_flags.output_edge_flags(self._edge_flags, edges.vertices, kept, moved)
         return self.key(ratio, final), result, edges, time.perf_counter() - start, flags
 
     def _make_preview(self) -> None:
@@ -208,14 +208,14 @@ class PreviewSession:
 
     def show(self, key, result, edges, seconds: float, flags: dict = None) -> None:
         """Puts a result into the preview object (main thread); key: ratio or (ratio, final);
-        flags: its edges' seam and sharp flags (mesh_io.output_edge_flags)."""
+        flags: its edges' seam and sharp flags (edge_flags.output_edge_flags)."""
         start = time.perf_counter()
         ratio, final = key if isinstance(key, tuple) else (key, False)
         if self.preview is None:
             self._make_preview()
-        mesh_io.fill_geometry(self.mesh, result.vertices, result.triangles, edges)
+        mesh_write.fill_geometry(self.mesh, result.vertices, result.triangles, edges)
         if flags and len(self.mesh.edges) == len(edges):  # (Blender's own edge pass: other edges)
-            mesh_io.write_edge_flags(self.mesh, flags)
+            edge_flags.write_edge_flags(self.mesh, flags)
         self.ratio, self.final, self.result, self.seconds_decimate = ratio, final, result, seconds
         self.seconds_write = time.perf_counter() - start
         self._last_shown = time.perf_counter()

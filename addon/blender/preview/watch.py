@@ -17,7 +17,7 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
-from ..io import mesh_io
+from ..io import mesh_access, mesh_read
 
 _epochs: dict = defaultdict(int)
 _stamps: dict = {}  # object name -> (epoch, mesh name, stamp)
@@ -37,9 +37,9 @@ def connectivity_stamp(mesh: bpy.types.Mesh) -> str:
     """Fingerprint of the mesh's vertex count, edges and polygons (not its positions)."""
     h = hashlib.blake2b(digest_size=16)
     h.update(np.array([len(mesh.vertices), len(mesh.edges), len(mesh.polygons)], dtype=np.int64).data)
-    h.update(mesh_io._indices(mesh.edges, "vertices", len(mesh.edges), 2).data)
-    h.update(mesh_io._indices(mesh.polygons, "loop_start", len(mesh.polygons)).data)
-    h.update(mesh_io.corner_vertices(mesh).data)
+    h.update(mesh_access.read_indices(mesh.edges, "vertices", len(mesh.edges), 2).data)
+    h.update(mesh_access.read_indices(mesh.polygons, "loop_start", len(mesh.polygons)).data)
+    h.update(mesh_read.corner_vertices(mesh).data)
     return h.hexdigest()
 
 

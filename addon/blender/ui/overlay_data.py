@@ -16,7 +16,7 @@ import bpy
 import numpy as np
 
 from ...core.support import colors
-from ..io import mesh_io
+from ..io import mesh_read
 from ..analysis import metrics
 from ..preview import watch
 
@@ -40,7 +40,7 @@ class Primitive:
 
 
 def positions(mesh) -> np.ndarray:
-    return mesh_io.read_positions(mesh)
+    return mesh_read.read_positions(mesh)
 
 
 def _id_array(group, key: str, dtype=np.int32) -> np.ndarray:
@@ -109,7 +109,7 @@ def topology_primitives(obj, show) -> list:
 
 
 def _corner_positions(obj):
-    arrays = mesh_io.read_mesh(obj.data)
+    arrays = mesh_read.read_mesh(obj.data)
     return arrays, arrays.vertices.astype(np.float32)[arrays.triangles.reshape(-1)]
 
 
