@@ -38,7 +38,7 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
 
     @classmethod
     def poll(cls, context):
-        return polls.refuse(cls, polls.selected_meshes(context))
+        return polls.refuse(cls, polls.selected_meshes_in_object_mode(context))
 
     def invoke(self, context, event):
         fill_from_scene(self, context.scene.topstoc)  # the panel's settings; the redo panel tweaks them

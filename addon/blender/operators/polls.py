@@ -36,7 +36,7 @@ def active_mesh_in_object_mode(context):
     return active_mesh(context) or object_mode(context)
 
 
-def selected_meshes(context):
+def selected_meshes_in_object_mode(context):
     if not any(obj.type == "MESH" for obj in context.selected_objects):
         return "Select one or more mesh objects"
     return object_mode(context)
