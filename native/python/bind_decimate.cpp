@@ -229,26 +229,28 @@ void bind_decimate(py::module_& m) {
 
   m.def(
       "decimate_with_samples",
-      [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& samples, const std::string& placement,
-         int32_t max_repair_rounds, int32_t refine_vertices, const py::handle& guidance, int32_t refine_triangles,
-         const py::handle& attributes, const py::handle& attribute_weights) {
-        // guidance, attributes and the counts were checked in Python (core/api/decimate.py, core/api/job.py)
+      [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& replay) {
+        // its counts, guidance and attributes were checked in Python (core/api/decimate.py, core/api/job.py)
+        const py::object samples = replay.attr("samples");
         auto ids = ids_from(samples, -1, "samples");
         JobArrays arrays;
-        const double* u = data_of(arrays.guidance, guidance);
-        const CornerAttributes corner_attributes = attributes_of(mesh, arrays, attributes, attribute_weights);
+        const double* u = data_of(arrays.guidance, replay.attr("guidance"));
+        const CornerAttributes corner_attributes =
+            attributes_of(mesh, arrays, replay.attr("attributes"), replay.attr("attribute_weights"));
+        const Placement placement = placement_from(replay.attr("placement").cast<std::string>());
+        const int32_t max_repair_rounds = replay.attr("max_repair_rounds").cast<int32_t>();
+        const int32_t refine_vertices = replay.attr("refine_vertices").cast<int32_t>();
+        const int32_t refine_triangles = replay.attr("refine_triangles").cast<int32_t>();
         DecimateResult r;
         {
           EngineCall call;
-          r = decimate_with_samples(mesh, layout, std::move(ids), placement_from(placement), max_repair_rounds,
-                                    refine_vertices, u, corner_attributes, refine_triangles);
+          r = decimate_with_samples(mesh, layout, std::move(ids), placement, max_repair_rounds, refine_vertices, u,
+                                    corner_attributes, refine_triangles);
         }
         return result_dict(std::move(r));
       },
-      py::arg("mesh"), py::arg("layout"), py::arg("samples"), py::arg("placement") = "subsample",
-      py::arg("max_repair_rounds") = 200, py::arg("refine_vertices") = 0, py::arg("guidance") = py::none(),
-      py::arg("refine_triangles") = 0, py::arg("attributes") = py::none(), py::arg("attribute_weights") = py::none(),
-      "Re-creates a decimation from its saved sample list.");
+      py::arg("mesh"), py::arg("layout"), py::arg("replay"),
+      "Re-creates a decimation from a topstoc.core.api.decimate.SampleReplay (its saved sample list).");
 
   m.def(
       "sampling_probabilities",

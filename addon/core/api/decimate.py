@@ -264,6 +264,21 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
                           parameters=parameters)
 
 
+@dataclass(frozen=True)
+class SampleReplay:
+    """A decimation to re-create from its sample list, as the engine's decimate_with_samples reads
+    it (made by decimate_with_samples once every value is checked)."""
+
+    samples: np.ndarray
+    placement: str = "subsample"
+    max_repair_rounds: int = 200
+    refine_vertices: int = 0
+    refine_triangles: int = 0
+    guidance: Optional[np.ndarray] = None           #: u per vertex (guidance_values), or None
+    attributes: Optional[np.ndarray] = None         #: corner values (attribute_arrays), or None
+    attribute_weights: Optional[np.ndarray] = None  #: one weight per attribute channel, or None
+
+
 def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, feature_angle: float = 0.0,
                           placement: str = "subsample", refine_vertices: int = 0, refine_triangles: int = 0,
                           guidance=None, attributes=None, attribute_weights=None) -> DecimateResult:
@@ -284,10 +299,10 @@ def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, fe
     feature_angle = params.number("feature_angle (radians)", feature_angle, 0, math.pi)
     attribute_values, attribute_weights = attribute_arrays(mesh, attributes, attribute_weights)
     layout = mesh.feature_layout(regions, borders, feature_angle)
-    raw = engine.decimate_with_samples(mesh.native, layout, samples, placement=placement,
-                                       refine_vertices=int(refine_vertices), guidance=guidance_values(mesh, guidance),
-                                       refine_triangles=int(refine_triangles), attributes=attribute_values,
-                                       attribute_weights=attribute_weights)
+    replay = SampleReplay(samples, placement, refine_vertices=int(refine_vertices),
+                          refine_triangles=int(refine_triangles), guidance=guidance_values(mesh, guidance),
+                          attributes=attribute_values, attribute_weights=attribute_weights)
+    raw = engine.decimate_with_samples(mesh.native, layout, replay)
     return _result(raw, dict(samples=len(samples), placement=placement, feature_angle=feature_angle,
                              refine_vertices=int(refine_vertices), refine_triangles=int(refine_triangles)), mesh)
 
