@@ -67,7 +67,8 @@ class RecordingLayout:
 def fake_panel(cls, seen):
     """Stands in for an instance of panel ``cls`` (only Blender makes those): a recording layout
     and the panel's own methods that its draw calls on self."""
-    methods = {"draw_mesh": cls.draw_mesh} if hasattr(cls, "draw_mesh") else {}
+    methods = {name: getattr(cls, name) for name in ("draw_mesh", "draw_settings", "draw_analysed")
+               if hasattr(cls, name)}
     return type("P", (), {"layout": RecordingLayout(seen), **methods})()
 
 

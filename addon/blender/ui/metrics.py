@@ -5,7 +5,7 @@ from __future__ import annotations
 import bpy
 
 from ..analysis import metrics
-from .panels import _MeshPanel, _Panel, wrapped
+from .panels import _MeshPanel, _Panel, property_split, wrapped
 
 SIDES = (("symmetric", "Symmetric"), ("forward", "Forward (original → this)"),
          ("backward", "Backward (this → original)"))
@@ -24,13 +24,11 @@ def distance_rows(obj) -> list:
 
 class TOPSTOC_PT_metrics(_MeshPanel, bpy.types.Panel):
     bl_label = "Metrics"
-    bl_idname = "TOPSTOC_PT_metrics"
     bl_order = 20
 
     def draw_mesh(self, context, layout, obj):
         settings = obj.topstoc.metrics
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        property_split(layout)
         col = layout.column()
         col.prop(settings, "reference")
         if settings.reference is None:
@@ -70,7 +68,6 @@ class TOPSTOC_PT_metrics(_MeshPanel, bpy.types.Panel):
 
 class TOPSTOC_PT_metrics_colors(_Panel, bpy.types.Panel):
     bl_label = "Colour by Error"
-    bl_idname = "TOPSTOC_PT_metrics_colors"
     bl_parent_id = "TOPSTOC_PT_metrics"
 
     def draw_header(self, context):
@@ -78,8 +75,7 @@ class TOPSTOC_PT_metrics_colors(_Panel, bpy.types.Panel):
 
     def draw(self, context):
         layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        property_split(layout)
         show = context.scene.topstoc.overlays
         layout.active = show.show_error
         layout.prop(show, "error_scale")
@@ -88,7 +84,6 @@ class TOPSTOC_PT_metrics_colors(_Panel, bpy.types.Panel):
 
 class TOPSTOC_PT_metrics_view(_Panel, bpy.types.Panel):
     bl_label = "View"
-    bl_idname = "TOPSTOC_PT_metrics_view"
     bl_parent_id = "TOPSTOC_PT_metrics"
 
     def draw(self, context):

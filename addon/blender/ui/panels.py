@@ -43,9 +43,35 @@ def _text_width(context, text: str, scale: float) -> float:
 
 
 class _Panel:
+    """A panel of the TopStoc tab; its id is its class name (Blender's default for bl_idname)."""
+
     bl_space_type = "VIEW_3D"
     bl_region_type = "UI"
     bl_category = CATEGORY
+
+
+class _ClosedPanel(_Panel):
+    """A sub-panel (``bl_parent_id``) that starts closed."""
+
+    bl_options = {"DEFAULT_CLOSED"}
+
+
+class _SettingsPanel(_Panel):
+    """A panel of the scene's decimation settings."""
+
+    def draw(self, context):
+        self.draw_settings(context, self.layout, context.scene.topstoc)
+
+
+class _ClosedSettingsPanel(_SettingsPanel, _ClosedPanel):
+    """A closed sub-panel of the scene's decimation settings."""
+
+
+def property_split(layout):
+    """``layout`` with each property's name in a label column beside its field, no decorators."""
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    return layout
 
 
 def _mesh(context):
@@ -63,6 +89,8 @@ class _MeshPanel(_Panel):
             self.layout.label(text="Select a mesh")
             return
         self.draw_mesh(context, self.layout, obj)
+
+
 def _estimate_text(context, settings) -> str:
     obj = context.active_object
     if obj is None or obj.type != "MESH":
@@ -85,20 +113,16 @@ def draw_bake(layout, settings) -> None:
         col.prop(settings, "bake_store")
 
 
-class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
+class TOPSTOC_PT_decimate(_SettingsPanel, bpy.types.Panel):
     bl_label = "Guided Decimation"
-    bl_idname = "TOPSTOC_PT_decimate"
     bl_order = 0
 
-    def draw(self, context):
-        layout = self.layout
-        settings = context.scene.topstoc
+    def draw_settings(self, context, layout, settings):
         row = layout.row(align=True)
         row.menu("TOPSTOC_MT_presets", text="Presets")
         row.operator("topstoc.preset_add", text="", icon="ADD")
         row.operator("topstoc.preset_add", text="", icon="REMOVE").remove_active = True
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        property_split(layout)
         col = layout.column(align=True)
         col.prop(settings, "target_mode")
         if settings.target_mode == "RATIO":
@@ -143,17 +167,12 @@ class TOPSTOC_PT_decimate(_Panel, bpy.types.Panel):
             col.prop(obj.topstoc, "auto_regenerate")
 
 
-class TOPSTOC_PT_advanced(_Panel, bpy.types.Panel):
+class TOPSTOC_PT_advanced(_ClosedSettingsPanel, bpy.types.Panel):
     bl_label = "Advanced"
-    bl_idname = "TOPSTOC_PT_advanced"
     bl_parent_id = "TOPSTOC_PT_decimate"
-    bl_options = {"DEFAULT_CLOSED"}
 
-    def draw(self, context):
-        layout = self.layout
-        settings = context.scene.topstoc
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+    def draw_settings(self, context, layout, settings):
+        property_split(layout)
         col = layout.column(align=True)
         col.prop(settings, "seed")
         col.prop(settings, "adaptivity")
@@ -172,7 +191,6 @@ class TOPSTOC_PT_advanced(_Panel, bpy.types.Panel):
 
 class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
     bl_label = "Guidance"
-    bl_idname = "TOPSTOC_PT_guidance"
     bl_parent_id = "TOPSTOC_PT_decimate"
 
     def draw(self, context):
@@ -209,9 +227,7 @@ class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
         box = layout.box()
         box.prop(s, "use_vertex_group")
         if s.use_vertex_group:  # a label column: beside its field a name gets a third and is cut
-            col = box.column()
-            col.use_property_split = True
-            col.use_property_decorate = False
+            col = property_split(box.column())
             col.prop_search(s, "vertex_group", obj, "vertex_groups")
             col.prop(s, "vertex_group_mapping")
             col.prop(s, "vertex_group_strength")
@@ -233,9 +249,7 @@ class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
         box = layout.box()
         box.prop(scene, "use_view")
         if scene.use_view:
-            col = box.column()
-            col.use_property_split = True  # as the vertex group's settings
-            col.use_property_decorate = False
+            col = property_split(box.column())  # as the vertex group's settings
             col.prop(scene, "view_source")
             box.prop(scene, "back_ratio")
             box.prop(scene, "silhouette_angle")
@@ -245,15 +259,11 @@ class TOPSTOC_PT_guidance(_Panel, bpy.types.Panel):
                 box.prop(scene, "outside_probability")
 
 
-class TOPSTOC_PT_variants(_Panel, bpy.types.Panel):
+class TOPSTOC_PT_variants(_ClosedSettingsPanel, bpy.types.Panel):
     bl_label = "Multiview & LODs"
-    bl_idname = "TOPSTOC_PT_variants"
     bl_parent_id = "TOPSTOC_PT_decimate"
-    bl_options = {"DEFAULT_CLOSED"}
 
-    def draw(self, context):
-        layout = self.layout
-        settings = context.scene.topstoc
+    def draw_settings(self, context, layout, settings):
         col = layout.column(align=True)
         col.prop(settings, "variants")
         col.prop(settings, "variance")
@@ -263,17 +273,11 @@ class TOPSTOC_PT_variants(_Panel, bpy.types.Panel):
         layout.operator("topstoc.lod_chain", icon="MOD_DECIM")
 
 
-class TOPSTOC_PT_samples(_Panel, bpy.types.Panel):
+class TOPSTOC_PT_samples(_MeshPanel, _ClosedPanel, bpy.types.Panel):
     bl_label = "Samples"
-    bl_idname = "TOPSTOC_PT_samples"
     bl_parent_id = "TOPSTOC_PT_decimate"
-    bl_options = {"DEFAULT_CLOSED"}
 
-    def draw(self, context):
-        layout = self.layout
-        obj = context.object
-        if obj is None or obj.type != "MESH":
-            return
+    def draw_mesh(self, context, layout, obj):
         show = context.scene.topstoc.overlays
         col = layout.column(align=True)  # the last decimation's samples and clusters (thesis fig. 4.1)
         col.prop(show, "show_samples", toggle=True, icon="DOT")

@@ -7,7 +7,7 @@ import bpy
 from ..analysis import topology as analysis
 from .topology_help import HELP
 from ..operators.topology import running
-from .panels import _MeshPanel, _Panel, _mesh, wrapped
+from .panels import _ClosedPanel, _MeshPanel, _Panel, _mesh, wrapped
 
 KIND_ICONS = {"HANDLE": "MOD_CURVE", "TUNNEL": "MOD_SCREW", "BOUNDARY": "MOD_EDGESPLIT"}
 
@@ -85,7 +85,6 @@ class TOPSTOC_UL_loops(bpy.types.UIList):
 
 class TOPSTOC_PT_topology(_MeshPanel, bpy.types.Panel):
     bl_label = "Topology"
-    bl_idname = "TOPSTOC_PT_topology"
     bl_order = 10
 
     def draw_mesh(self, context, layout, obj):
@@ -123,24 +122,23 @@ def _analysed(context):
 
 
 class _AnalysedPanel(_Panel):
-    """A sub-panel shown once the active mesh has been analysed."""
+    """A sub-panel shown once the active mesh has been analysed: draws its results."""
 
     @classmethod
     def poll(cls, context):
         return _analysed(context) is not None
 
-
-class TOPSTOC_PT_topology_components(_AnalysedPanel, bpy.types.Panel):
-    bl_label = "Components"
-    bl_idname = "TOPSTOC_PT_topology_components"
-    bl_parent_id = "TOPSTOC_PT_topology"
-    bl_options = {"DEFAULT_CLOSED"}
-
     def draw(self, context):
-        layout = self.layout
         topology = _analysed(context)
-        if topology is None:
-            return
+        if topology is not None:
+            self.draw_analysed(context, self.layout, topology)
+
+
+class TOPSTOC_PT_topology_components(_AnalysedPanel, _ClosedPanel, bpy.types.Panel):
+    bl_label = "Components"
+    bl_parent_id = "TOPSTOC_PT_topology"
+
+    def draw_analysed(self, context, layout, topology):
         layout.template_list("TOPSTOC_UL_components", "", topology, "components", topology, "component_index",
                              rows=3)
         if 0 <= topology.component_index < len(topology.components):
@@ -155,14 +153,9 @@ class TOPSTOC_PT_topology_components(_AnalysedPanel, bpy.types.Panel):
 
 class TOPSTOC_PT_topology_loops(_AnalysedPanel, bpy.types.Panel):
     bl_label = "Loops"
-    bl_idname = "TOPSTOC_PT_topology_loops"
     bl_parent_id = "TOPSTOC_PT_topology"
 
-    def draw(self, context):
-        layout = self.layout
-        topology = _analysed(context)
-        if topology is None:
-            return
+    def draw_analysed(self, context, layout, topology):
         obj = topology.id_data  # the object the results are stored on
         if topology.loops_message:
             wrapped(layout, context, topology.loops_message,
@@ -194,7 +187,6 @@ class TOPSTOC_PT_topology_loops(_AnalysedPanel, bpy.types.Panel):
 
 class TOPSTOC_PT_topology_edit(_Panel, bpy.types.Panel):
     bl_label = "Edit"
-    bl_idname = "TOPSTOC_PT_topology_edit"
     bl_parent_id = "TOPSTOC_PT_topology"
 
     def draw(self, context):
@@ -211,11 +203,9 @@ class TOPSTOC_PT_topology_edit(_Panel, bpy.types.Panel):
         layout.operator("topstoc.clean", text="Clean Up Small Flaws", icon="MOD_SMOOTH")
 
 
-class TOPSTOC_PT_topology_overlays(_Panel, bpy.types.Panel):
+class TOPSTOC_PT_topology_overlays(_ClosedPanel, bpy.types.Panel):
     bl_label = "Overlays"
-    bl_idname = "TOPSTOC_PT_topology_overlays"
     bl_parent_id = "TOPSTOC_PT_topology"
-    bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
         layout = self.layout
