@@ -21,6 +21,7 @@ from ...core.support.native import engine
 from ...core.support.errors import TopStocError
 from ..io import mesh_access, mesh_read
 from ..preview import watch
+from .failures import stored_failure
 
 ERROR_ATTRIBUTE = "TopStoc Error"
 
@@ -75,7 +76,7 @@ def measure(obj, reference=None, samples: int = None) -> dict:
     """
     settings = obj.topstoc.metrics
     reference = reference if reference is not None else reference_of(obj)
-    try:
+    with stored_failure(settings, MetricsError):
         mesh_read.check_mesh_object(obj, MetricsError)
         if reference is None:
             raise MetricsError(f"'{obj.name}' has no original to compare with: pick one under Original")
@@ -88,10 +89,6 @@ def measure(obj, reference=None, samples: int = None) -> dict:
         except ValueError as error:
             raise MetricsError(f"'{obj.name}' vs '{reference.name}': {error}") from None
         seconds = time.perf_counter() - start
-    except MetricsError as error:
-        settings.state, settings.message = "ERROR", str(error)
-        settings.revision += 1
-        raise
     for side, distance in (("symmetric", result.symmetric), ("forward", result.forward),
                            ("backward", result.backward)):
         for figure in ("max", "mean", "rms"):

@@ -25,6 +25,7 @@ from ...core.support.errors import TopStocError
 from ..io import mesh_access, mesh_read
 from ..preview import watch
 from ..preview.cache import prepared_meshes
+from .failures import stored_failure
 
 SEARCH_KINDS = ("HANDLE", "TUNNEL")
 
@@ -77,7 +78,7 @@ def analyse(obj, carried_loops: Optional[list] = None) -> Topology:
     Raises AnalysisError (the message is stored for the panel too).
     """
     topology = obj.topstoc.topology
-    try:
+    with stored_failure(topology, AnalysisError):
         mesh_read.check_mesh_object(obj, AnalysisError)
         start = time.perf_counter()
         mesh = obj.data
@@ -88,10 +89,6 @@ def analyse(obj, carried_loops: Optional[list] = None) -> Topology:
         except ValueError as error:
             raise AnalysisError(f"'{obj.name}': {error}") from None
         seconds = time.perf_counter() - start
-    except AnalysisError as error:
-        topology.state, topology.message = "ERROR", str(error)
-        topology.revision += 1
-        raise
     stamp = watch.connectivity_stamp(obj.data)
     _store(obj, info, arrays, wires, stamp, seconds, carried_loops)
     return info
