@@ -295,19 +295,26 @@ class PreviewSession:
         if wait > 0:
             time.sleep(wait)
 
-    def poll(self) -> bool:
-        """Shows the newest finished result (main thread); True when the view changed.
-
-        The workers are already computing the next requests meanwhile, if there are any. A
-        failed preparation or decimation raises here (DecimationError, or the engine's error)."""
+    def _take_finished(self):
+        """The newest finished (order, result) not yet taken, or None (main thread). A worker's
+        error is raised here, so engine errors surface on the main thread; a request that came
+        while a worker was stopping gets a worker."""
         with self._lock:
             finished, self._finished = self._finished, None
             error, self._error = self._error, None
             if finished:
                 self._shown_order = finished[0]
         if error is not None:
-            raise error  # engine errors surface on the main thread
-        self._start_worker()  # a request that came while a worker was stopping
+            raise error
+        self._start_worker()
+        return finished
+
+    def poll(self) -> bool:
+        """Shows the newest finished result (main thread); True when the view changed.
+
+        The workers are already computing the next requests meanwhile, if there are any. A
+        failed preparation or decimation raises here (DecimationError, or the engine's error)."""
+        finished = self._take_finished()
         if finished:
             self.show(*finished[1])
         elif not self.final and self.ratio is not None and not self.busy \
@@ -359,14 +366,7 @@ class PreviewSession:
         """While applying (main thread): the Run once its result and attribute sources are ready,
         else None. Results of the drag that finish meanwhile are dropped (the preview is about to
         go); a failed decimation raises here."""
-        with self._lock:
-            finished, self._finished = self._finished, None
-            error, self._error = self._error, None
-            if finished:
-                self._shown_order = finished[0]
-        if error is not None:
-            raise error
-        self._start_worker()
+        finished = self._take_finished()
         if self._applying is None:
             return None
         if self._to_apply is None and finished is not None and finished[1][0] == self._applying:
