@@ -35,6 +35,11 @@ def _redraw(_self, context):
                 area.tag_redraw()
 
 
+def _overlay_switch(name: str, default: bool, description: str):
+    """A setting that turns one overlay on or off (the 3D views redraw)."""
+    return BoolProperty(name=name, default=default, update=_redraw, description=description)
+
+
 class _Invariants:
     """What a component and the whole mesh both report (a mixin: Blender registers the
     properties of a property group's bases too)."""
@@ -130,23 +135,16 @@ class TOPSTOC_PG_metrics(bpy.types.PropertyGroup):
 class TOPSTOC_PG_overlays(bpy.types.PropertyGroup):
     """Which overlays the 3D views draw (scene-wide), and how."""
 
-    show_handles: BoolProperty(name="Handle Loops", default=True, update=_redraw,
-                               description="Draw handle loops (yellow)")
-    show_tunnels: BoolProperty(name="Tunnel Loops", default=True, update=_redraw,
-                               description="Draw tunnel loops (turquoise)")
-    show_generators: BoolProperty(name="Generator Edges", default=True, update=_redraw,
-                                  description="Draw the 2g unpaired (generator) edges (pink)")
-    show_boundary: BoolProperty(name="Boundary Vertices", default=True, update=_redraw,
-                                description="Draw the vertices on boundary loops (red)")
-    show_nonmanifold: BoolProperty(name="Non-Manifold", default=True, update=_redraw,
-                                   description="Draw non-manifold edges and vertices (orange)")
-    show_samples: BoolProperty(name="Show Kept Vertices", default=False, update=_redraw,
-                               description="Draw the sampled vertices of the last decimation (blue)")
-    show_clusters: BoolProperty(name="Show Regions", default=False, update=_redraw,
-                                description="Colour the original by the clusters of the last decimation "
-                                            "(red: faces that became output triangles)")
-    show_error: BoolProperty(name="Error Colours", default=False, update=_redraw,
-                             description="Colour the decimated mesh by its Hausdorff error per face")
+    show_handles: _overlay_switch("Handle Loops", True, "Draw handle loops (yellow)")
+    show_tunnels: _overlay_switch("Tunnel Loops", True, "Draw tunnel loops (turquoise)")
+    show_generators: _overlay_switch("Generator Edges", True, "Draw the 2g unpaired (generator) edges (pink)")
+    show_boundary: _overlay_switch("Boundary Vertices", True, "Draw the vertices on boundary loops (red)")
+    show_nonmanifold: _overlay_switch("Non-Manifold", True, "Draw non-manifold edges and vertices (orange)")
+    show_samples: _overlay_switch("Show Kept Vertices", False,
+                                  "Draw the sampled vertices of the last decimation (blue)")
+    show_clusters: _overlay_switch("Show Regions", False, "Colour the original by the clusters of the last "
+                                   "decimation (red: faces that became output triangles)")
+    show_error: _overlay_switch("Error Colours", False, "Colour the decimated mesh by its Hausdorff error per face")
     error_scale: FloatProperty(name="Red At", default=0.0, min=0.0, soft_max=5.0, precision=3, update=_redraw,
                                description="The error shown red, in % of the original's diagonal; 0: the "
                                            "largest error measured")
