@@ -31,6 +31,7 @@ import numpy as np
 
 from . import budget
 from ..support import params
+from ..support.counts import MeshCounts
 from ..support.errors import TopStocError
 from .job import (  # noqa: F401 - View, Box and the constants are this module's public names too
     ATTRIBUTE_WEIGHT, DENSITY_MODES, MAX_ATTRIBUTE_CHANNELS, MODES, PLACEMENTS, QUALITY_COLLAPSES, QUALITY_REFINE,
@@ -112,7 +113,7 @@ class DecimateStats:
 
 
 @dataclass(frozen=True)
-class DecimateResult:
+class DecimateResult(MeshCounts):
     """A decimated mesh and how it maps to the input.
 
     ``kept[i]`` is the input vertex that output vertex ``i`` stands for; ``face_source[j]`` the
@@ -137,14 +138,6 @@ class DecimateResult:
     parameters: dict = field(default_factory=dict)
     #: with ``max_error``: how the error-bounded search went (see topstoc.core.api.error_bound)
     error_bound: Optional[object] = None
-
-    @property
-    def num_vertices(self) -> int:
-        return len(self.vertices)
-
-    @property
-    def num_triangles(self) -> int:
-        return len(self.triangles)
 
     def aspect_ratio(self) -> dict:
         """Triangle aspect ratio (thesis eq. 4.2): mean, max and count of degenerate ones."""

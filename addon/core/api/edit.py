@@ -25,6 +25,7 @@ from .mesh import as_vertices
 from ..support import params
 from ..support.native import engine
 from ..support.errors import TopStocError
+from ..support.counts import MeshCounts
 
 #: Patch methods, from the thesis' planar projection to the last resort (hole_triangulation.hpp).
 FILL_METHODS = ("planar", "minimum_weight", "split", "fan")
@@ -75,7 +76,7 @@ class Patch:
 
 
 @dataclass(frozen=True)
-class EditResult:
+class EditResult(MeshCounts):
     """A new mesh and how it maps to the edit's input.
 
     ``vertex_source[i]`` is the input vertex that vertex ``i`` copies (-1 for a vertex the edit
@@ -93,14 +94,6 @@ class EditResult:
     input_triangles: int
     cut_sides: List[CutSide] = field(default_factory=list)
     patches: List[Patch] = field(default_factory=list)
-
-    @property
-    def num_vertices(self) -> int:
-        return len(self.vertices)
-
-    @property
-    def num_triangles(self) -> int:
-        return len(self.triangles)
 
     def vertex_map(self) -> np.ndarray:
         """For each input vertex, its new id (the first copy when a cut split it), or -1."""

@@ -48,6 +48,7 @@ from typing import List, Optional
 import numpy as np
 
 from ..support import atomic
+from ..support.counts import MeshCounts
 from ..support.native import engine
 from ..support.errors import TopStocError
 
@@ -59,7 +60,7 @@ CARRIES = {"obj": ("corner_uvs", "vertex_colors", "triangle_material"),
 
 
 @dataclass
-class MeshData:
+class MeshData(MeshCounts):
     """A mesh as stored in a file, in the file's vertex and face order.
 
     vertices: (n, 3) float64. triangles: (m, 3) int32, polygons fan-triangulated as
@@ -105,18 +106,10 @@ class MeshData:
         self.material_names = list(self.material_names)
         self.material_libraries = list(self.material_libraries)
 
-    @property
-    def num_vertices(self) -> int:
-        return len(self.vertices)
-
     def attributes(self) -> List[str]:
         """Names of the optional attributes this mesh carries."""
         return [name for name in ("corner_uvs", "vertex_colors", "triangle_material")
                 if getattr(self, name) is not None]
-
-    @property
-    def num_triangles(self) -> int:
-        return len(self.triangles)
 
     def summary(self) -> str:
         """One line: counts and which attributes the mesh carries."""
