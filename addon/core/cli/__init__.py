@@ -41,6 +41,15 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def subcommand(subparsers, name: str, summary: str, description: str, *files) -> argparse.ArgumentParser:
+    """A subcommand's parser (``summary`` for the list, ``description`` for its --help) with its
+    positional file arguments, each ``(name, metavar, help)``, in order."""
+    parser = subparsers.add_parser(name, help=summary, description=description)
+    for dest, metavar, text in files:
+        parser.add_argument(dest, metavar=metavar, help=text)
+    return parser
+
+
 def print_json(data) -> None:
     """Prints a JSON document (numpy scalars and arrays converted)."""
     def convert(value):

@@ -15,7 +15,7 @@ import sys
 import time
 
 from ..batch import settings as batch_settings
-from . import messages, progress
+from . import messages, progress, subcommand
 from ..batch.run import (find_inputs, misnamed_failure, remove_orphaned_scratch, remove_stale_temporaries,
                          run_dask, run_serial, utf8_name, write_report)
 from ..api.budget import report_missed
@@ -27,11 +27,11 @@ REPORT_NAME = "topstoc-report.json"
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser(
-        "batch", help="decimate many assets (Dask cluster, local workers or serial)",
-        description="Decimate many assets into DIR, one task per asset, with resume. Mesh files "
-                    "(OBJ, PLY, OFF, STL) need no Blender; .blend, glTF/GLB, FBX and USD run a Blender "
-                    "per asset. Give one target value per output, or several for a LOD chain.")
+    parser = subcommand(
+        subparsers, "batch", "decimate many assets (Dask cluster, local workers or serial)",
+        "Decimate many assets into DIR, one task per asset, with resume. Mesh files "
+        "(OBJ, PLY, OFF, STL) need no Blender; .blend, glTF/GLB, FBX and USD run a Blender "
+        "per asset. Give one target value per output, or several for a LOD chain.")
     batch_settings.add_io_arguments(parser)
     batch_settings.add_arguments(parser)
     runner = parser.add_mutually_exclusive_group()

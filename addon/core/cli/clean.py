@@ -7,7 +7,7 @@ plus the input, output and the new mesh's topology.
 
 from __future__ import annotations
 
-from . import print_json
+from . import print_json, subcommand
 from ..support.errors import TopStocError
 from ..support.output_guard import add_overwrite_argument, prepare_output
 
@@ -16,15 +16,15 @@ SHOWN = 40
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser(
-        "clean", help="remove small handles and tunnels, fill small holes",
-        description="Remove every handle or tunnel whose shortest loop is below a size (cutting along the "
-                    "shorter of its handle and tunnel loop and closing both sides) and fill every hole whose "
-                    "border is below a size, with patches refined and faired into the surface; the rest of "
-                    "the surface is left exactly as it was. Sizes are lengths, or percentages of the bounding "
-                    "box's diagonal like 1%%.")
-    parser.add_argument("input", metavar="IN", help="input mesh file")
-    parser.add_argument("output", metavar="OUT", help="output mesh file")
+    parser = subcommand(
+        subparsers, "clean", "remove small handles and tunnels, fill small holes",
+        "Remove every handle or tunnel whose shortest loop is below a size (cutting along the "
+        "shorter of its handle and tunnel loop and closing both sides) and fill every hole whose "
+        "border is below a size, with patches refined and faired into the surface; the rest of "
+        "the surface is left exactly as it was. Sizes are lengths, or percentages of the bounding "
+        "box's diagonal like 1%%.",
+        ("input", "IN", "input mesh file"),
+        ("output", "OUT", "output mesh file"))
     parser.add_argument("--max-handle", metavar="SIZE", default=None,
                         help="remove handles whose shortest loop is shorter (default 1%% of the diagonal; 0: none)")
     parser.add_argument("--max-hole", metavar="SIZE", default=None,

@@ -23,18 +23,18 @@ from ..api.job import ATTRIBUTE_WEIGHT
 from ..api.mesh_file_job import prepare_file
 from ..support.output_guard import add_overwrite_argument, prepare_output
 from ..api.symmetry import AXES
-from . import print_json, progress
+from . import print_json, progress, subcommand
 
 DENSITIES = ("off", "uniform", "adaptive")
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser(
-        "decimate", help="decimate a mesh file with TopStoc",
-        description="Decimate IN to OUT (OBJ, PLY, OFF, STL, optionally .gz) with topology control. "
-                    "UVs, vertex colours and materials are kept. Give exactly one target.")
-    parser.add_argument("input", metavar="IN", help="input mesh file")
-    parser.add_argument("output", metavar="OUT", help="output mesh file (format from its extension)")
+    parser = subcommand(
+        subparsers, "decimate", "decimate a mesh file with TopStoc",
+        "Decimate IN to OUT (OBJ, PLY, OFF, STL, optionally .gz) with topology control. "
+        "UVs, vertex colours and materials are kept. Give exactly one target.",
+        ("input", "IN", "input mesh file"),
+        ("output", "OUT", "output mesh file (format from its extension)"))
     target = parser.add_mutually_exclusive_group(required=True)
     target.add_argument("--ratio", type=float, metavar="R", help="fraction of the vertices to keep, in (0, 1]")
     target.add_argument("--vertices", type=int, metavar="N", help="output vertex count")

@@ -12,20 +12,20 @@ import time
 
 import numpy as np
 
-from . import print_json, progress
+from . import print_json, progress, subcommand
 from ..support.errors import TopStocError
 from ..support.output_guard import add_overwrite_argument, prepare_output
 
 
 def add_parser(subparsers) -> None:
-    fill = subparsers.add_parser(
-        "fill-holes", help="fill holes (boundary loops)",
-        description="Fill every hole of IN (or the ones chosen) and write OUT. Each hole is triangulated on its "
-                    "best-fit plane when its border projects there without overlap, else in 3D (minimum-weight "
-                    "triangulation). Holes are numbered over the whole mesh in the order of their lowest vertex id; "
-                    "the --json report lists each filled one with its first (lowest) vertex.")
-    fill.add_argument("input", metavar="IN", help="input mesh file")
-    fill.add_argument("output", metavar="OUT", help="output mesh file")
+    fill = subcommand(
+        subparsers, "fill-holes", "fill holes (boundary loops)",
+        "Fill every hole of IN (or the ones chosen) and write OUT. Each hole is triangulated on its "
+        "best-fit plane when its border projects there without overlap, else in 3D (minimum-weight "
+        "triangulation). Holes are numbered over the whole mesh in the order of their lowest vertex id; "
+        "the --json report lists each filled one with its first (lowest) vertex.",
+        ("input", "IN", "input mesh file"),
+        ("output", "OUT", "output mesh file"))
     fill.add_argument("--holes", metavar="I,J,...", help="fill only these holes (indices, comma-separated)")
     fill.add_argument("--max-edges", type=int, metavar="N", help="fill only holes with at most N edges")
     fill.add_argument("--skip-unfillable", action="store_true",
@@ -36,13 +36,13 @@ def add_parser(subparsers) -> None:
     _patch_options(fill)
     fill.set_defaults(run=run_fill)
 
-    handle = subparsers.add_parser(
-        "remove-handle", help="remove a handle or tunnel (cut along its loop, fill both holes)",
-        description="Cut IN along a handle loop (or tunnel loop) and fill both holes: the genus of that component "
-                    "drops by one, nothing else changes. Loops are those of the loops subcommand, counted over all "
-                    "components in order; or give the loop's vertex ids with --loop.")
-    handle.add_argument("input", metavar="IN", help="input mesh file")
-    handle.add_argument("output", metavar="OUT", help="output mesh file")
+    handle = subcommand(
+        subparsers, "remove-handle", "remove a handle or tunnel (cut along its loop, fill both holes)",
+        "Cut IN along a handle loop (or tunnel loop) and fill both holes: the genus of that component "
+        "drops by one, nothing else changes. Loops are those of the loops subcommand, counted over all "
+        "components in order; or give the loop's vertex ids with --loop.",
+        ("input", "IN", "input mesh file"),
+        ("output", "OUT", "output mesh file"))
     which = handle.add_mutually_exclusive_group(required=True)
     which.add_argument("--index", type=int, metavar="K", help="the K-th handle loop (0-based)")
     which.add_argument("--loop", metavar="V0,V1,...", help="a closed edge loop given by its vertex ids in order")

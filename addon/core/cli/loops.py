@@ -10,16 +10,16 @@ from __future__ import annotations
 import argparse
 import time
 from ..support.errors import TopStocError
-from . import progress
+from . import progress, subcommand
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser(
-        "loops", help="handle and tunnel loops",
-        description="Handle and tunnel loops of every closed orientable component (TetGen + "
-                    "persistence, shortened on the surface). Large components go through a "
-                    "coarse decimation of themselves and the loops are carried back.")
-    parser.add_argument("input", metavar="IN", help="mesh file (OBJ, PLY, OFF, STL, optionally .gz/.bz2)")
+    parser = subcommand(
+        subparsers, "loops", "handle and tunnel loops",
+        "Handle and tunnel loops of every closed orientable component (TetGen + "
+        "persistence, shortened on the surface). Large components go through a "
+        "coarse decimation of themselves and the loops are carried back.",
+        ("input", "IN", "mesh file (OBJ, PLY, OFF, STL, optionally .gz/.bz2)"))
     route = parser.add_mutually_exclusive_group()
     route.add_argument("--coarse-vertices", type=int, metavar="N",
                        help="always go through a coarse decimation with about N vertices")

@@ -14,22 +14,22 @@ import argparse
 import time
 
 from ..support import atomic
-from . import progress
+from . import progress, subcommand
 
 from ..api.hausdorff import DEFAULT_SAMPLES, hausdorff
 from ..support.output_guard import prepare_output
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser(
-        "measure", help="Hausdorff distance between two meshes",
-        description="Hausdorff distance between A (the original) and B (its approximation), "
-                    "sampled on vertices, edges and faces (Metro / MESH style), in % of A's bounding-box "
-                    "diagonal. Forward (A -> B): how far A's surface lies from B's (detail B misses); "
-                    "backward (B -> A): how far B's surface lies from A's (where B strays); symmetric: "
-                    "the larger of the two, the Hausdorff distance.")
-    parser.add_argument("a", metavar="A", help="original mesh (OBJ, PLY, OFF, STL, optionally .gz)")
-    parser.add_argument("b", metavar="B", help="approximation to compare with A")
+    parser = subcommand(
+        subparsers, "measure", "Hausdorff distance between two meshes",
+        "Hausdorff distance between A (the original) and B (its approximation), "
+        "sampled on vertices, edges and faces (Metro / MESH style), in % of A's bounding-box "
+        "diagonal. Forward (A -> B): how far A's surface lies from B's (detail B misses); "
+        "backward (B -> A): how far B's surface lies from A's (where B strays); symmetric: "
+        "the larger of the two, the Hausdorff distance.",
+        ("a", "A", "original mesh (OBJ, PLY, OFF, STL, optionally .gz)"),
+        ("b", "B", "approximation to compare with A"))
     density = parser.add_mutually_exclusive_group()
     density.add_argument("--samples", type=int, default=None,
                          metavar="N", help=f"about how many samples to take on A (default {DEFAULT_SAMPLES}); "

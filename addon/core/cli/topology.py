@@ -13,18 +13,18 @@ import time
 
 from ..api.io import read_mesh
 from ..api.topology import topology
-from . import print_json, progress
+from . import print_json, progress, subcommand
 
 #: Components listed in the text report before "... and N more".
 TEXT_COMPONENTS = 20
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser(
-        "topology", help="topological invariants per component",
-        description="Betti numbers, Euler characteristic, genus, orientability, manifoldness and "
-                    "boundary loops of every connected component of IN (OBJ, PLY, OFF, STL, .gz).")
-    parser.add_argument("input", metavar="IN", help="input mesh file")
+    parser = subcommand(
+        subparsers, "topology", "topological invariants per component",
+        "Betti numbers, Euler characteristic, genus, orientability, manifoldness and "
+        "boundary loops of every connected component of IN (OBJ, PLY, OFF, STL, .gz).",
+        ("input", "IN", "input mesh file"))
     parser.add_argument("--generators", action="store_true",
                         help="also the 2g generator edges and loops of each closed orientable component")
     parser.add_argument("--json", action="store_true", help="print a JSON report")
