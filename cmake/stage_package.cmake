@@ -7,6 +7,13 @@ foreach(f IN LISTS old_files)
     file(REMOVE "${DST}/${f}")
   endif()
 endforeach()
+# Folders addon/ no longer has (a module moved elsewhere) go too, not to linger empty in the zips.
+file(GLOB_RECURSE old_dirs LIST_DIRECTORIES true RELATIVE "${DST}" "${DST}/*")
+foreach(d IN LISTS old_dirs)
+  if(IS_DIRECTORY "${DST}/${d}" AND NOT EXISTS "${SRC}/${d}")
+    file(REMOVE_RECURSE "${DST}/${d}")
+  endif()
+endforeach()
 file(COPY "${SRC}/" DESTINATION "${DST}" PATTERN "__pycache__" EXCLUDE PATTERN "*.pyc" EXCLUDE)
 # The staged package carries its compiled module itself, so its manifest drops the release's
 # `wheels = [...]` (the topstoc_native wheels only scripts/build_extension.sh packs).
