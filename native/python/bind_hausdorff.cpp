@@ -136,6 +136,24 @@ void bind_hausdorff(py::module_& m) {
       "Forward (A to B), backward (B to A) and symmetric Hausdorff distance.");
 
   m.def(
+      "bracket_one_sided_max",
+      [](const Surface& from, const Surface& to, double tolerance, int64_t max_queries) {
+        OneSidedBracket r;
+        {
+          EngineCall call;
+          r = bracket_one_sided_max(from, to, tolerance, max_queries);
+        }
+        py::dict out;
+        out["lower"] = r.lower;
+        out["upper"] = r.upper;
+        out["queries"] = r.queries;
+        out["converged"] = r.converged;
+        return out;
+      },
+      py::arg("from_surface"), py::arg("to_surface"), py::arg("tolerance"), py::arg("max_queries") = 4000000,
+      "Guaranteed bracket (lower, upper) of the one-sided max distance from one surface to the other.");
+
+  m.def(
       "hausdorff_with_samples",
       [](const Surface& a, const SurfaceSamples& a_samples, const Surface& b, double percentile, double max_tolerance) {
         HausdorffResult r;

@@ -8,6 +8,11 @@ namespace topstoc {
 
 namespace {
 
+// Nodes of at most this many triangles are bounded through their triangles' corners (the distance
+// to one triangle of the other surface is convex, so it peaks at one of them); larger ones
+// through their box's corners.
+constexpr int32_t kCornerBoundSlots = 64;
+
 struct Piece {
   double p[3][3];     // corners
   double d[3];        // their distances to the other surface
@@ -65,6 +70,37 @@ class MaxSearch {
     return out;
   }
 
+  // The same search seeded from the sampled surface's own BVH instead of all its triangles:
+  // nodes by their bound, a leaf's triangles handed to the pieces when it is opened.
+  MaxBracket run_from_tree(const TriangleBvh& tree) {
+    open_node(tree, 0);
+    double top = 0.0;
+    while (true) {
+      const double node_top = nodes.empty() ? -1.0 : nodes.top().first;
+      const double piece_top = open.empty() ? -1.0 : open.top().upper;
+      top = std::max(node_top, piece_top);
+      if (top < 0.0 || tolerated(top) || out.queries + 16 > max_queries) break;
+      if (node_top >= piece_top) {
+        const int32_t i = nodes.top().second;
+        nodes.pop();
+        const TriangleBvh::Node& n = tree.node(i);
+        if (n.count > 0) {
+          for (int32_t s = n.first; s < n.first + n.count; ++s) add_triangle(tree.slot_corners(s), tree.slot_triangle(s));
+        } else {
+          open_node(tree, i + 1);
+          open_node(tree, n.first);
+        }
+      } else {
+        const Piece piece = open.top();
+        open.pop();
+        subdivide(piece);
+      }
+    }
+    out.converged = top < 0.0 || tolerated(top);
+    out.upper = std::max({out.lower, settled, top});
+    return out;
+  }
+
  private:
   const Surface& from;
   const std::vector<double>& vertex_distance;
@@ -81,10 +117,16 @@ class MaxSearch {
 
   bool tolerated(double upper) const { return upper <= std::max(out.lower * (1 + relative_tolerance), floor); }
 
-  ClosestHit query(const double* x) {
+  // The nearest point of the other surface to a point that need not lie on the sampled one.
+  ClosestHit nearest(const double* x) {
     const ClosestHit hit = bvh.closest(x, hint);
     hint = hit.slot;
     ++out.queries;
+    return hit;
+  }
+
+  ClosestHit query(const double* x) {
+    const ClosestHit hit = nearest(x);
     if (std::sqrt(hit.distance2) > out.lower) {
       out.lower = std::sqrt(hit.distance2);
       std::copy_n(x, 3, out.lower_point);
@@ -130,6 +172,68 @@ class MaxSearch {
     } else {
       open.push(piece);
     }
+  }
+
+  std::priority_queue<std::pair<double, int32_t>> nodes;  // (bound, node) of run_from_tree
+
+  // Bounds every point in a node's box: its centre's distance plus half the box diagonal
+  // (1-Lipschitz), or the farthest corner (of its triangles, or of the box) from the centre's
+  // nearest triangle (convex). A point of the surface in the node (its first triangle's
+  // centroid) raises the lower bound.
+  void open_node(const TriangleBvh& tree, int32_t i) {
+    const TriangleBvh::Node& n = tree.node(i);
+    double centre[3], half2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      centre[k] = 0.5 * (n.lo[k] + n.hi[k]);
+      half2 += 0.25 * (n.hi[k] - n.lo[k]) * (n.hi[k] - n.lo[k]);
+    }
+    const ClosestHit hit = nearest(centre);
+    double upper = std::sqrt(hit.distance2) + std::sqrt(half2);
+    const double* a = &to_positions[3 * size_t(to_triangles[3 * size_t(hit.triangle)])];
+    const double* b = &to_positions[3 * size_t(to_triangles[3 * size_t(hit.triangle) + 1])];
+    const double* c = &to_positions[3 * size_t(to_triangles[3 * size_t(hit.triangle) + 2])];
+    // A node's triangles fill slots [first, last): from its leftmost leaf to its rightmost one.
+    int32_t leaf = i, right = i;
+    while (tree.node(leaf).count == 0) ++leaf;
+    while (tree.node(right).count == 0) right = tree.node(right).first;
+    const int32_t first = tree.node(leaf).first, last = tree.node(right).first + tree.node(right).count;
+    double farthest = 0.0, closest[3];
+    if (last - first <= kCornerBoundSlots) {  // the triangles' own corners: tight where the surfaces are close
+      for (int32_t s = first; s < last; ++s)
+        for (int j = 0; j < 3; ++j)
+          farthest = std::max(farthest, closest_point_on_triangle(tree.slot_corners(s) + 3 * j, a, b, c, closest));
+    } else {
+      for (int corner = 0; corner < 8; ++corner) {
+        const double x[3] = {corner & 1 ? n.hi[0] : n.lo[0], corner & 2 ? n.hi[1] : n.lo[1],
+                             corner & 4 ? n.hi[2] : n.lo[2]};
+        farthest = std::max(farthest, closest_point_on_triangle(x, a, b, c, closest));
+      }
+    }
+    upper = std::min(upper, std::sqrt(farthest));
+    const double* t = tree.slot_corners(first);
+    const double centroid[3] = {(t[0] + t[3] + t[6]) / 3.0, (t[1] + t[4] + t[7]) / 3.0, (t[2] + t[5] + t[8]) / 3.0};
+    query(centroid);
+    if (out.lower_triangle == -2) out.lower_triangle = tree.slot_triangle(first);
+    if (tolerated(upper)) {
+      settled = std::max(settled, upper);
+    } else {
+      nodes.emplace(upper, i);
+    }
+  }
+
+  // One triangle of the sampled surface as a piece: its corners measured, then bounded.
+  void add_triangle(const double* corners, int32_t source) {
+    Piece piece;
+    piece.source = source;
+    for (int j = 0; j < 3; ++j) {
+      std::copy_n(corners + 3 * j, 3, piece.p[j]);
+      const ClosestHit hit = query(piece.p[j]);
+      if (out.lower_triangle == -2) out.lower_triangle = source;
+      piece.d[j] = std::sqrt(hit.distance2);
+      piece.near[j] = hit.triangle;
+    }
+    piece.near[3] = -1;
+    keep(piece);
   }
 
   // The sampled surface's triangles as the first pieces, with each used vertex's nearest triangle.
@@ -192,6 +296,14 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
                               double start, const double* start_point, double relative_tolerance,
                               int64_t max_queries) {
   return MaxSearch(from, vertex_distance, to, start, start_point, relative_tolerance, max_queries).run();
+}
+
+MaxBracket bound_max_distance_by_tree(const Surface& from, const Surface& to, double relative_tolerance,
+                                      int64_t max_queries) {
+  static const std::vector<double> no_vertex_distance;
+  const double origin[3] = {0.0, 0.0, 0.0};
+  MaxSearch search(from, no_vertex_distance, to, 0.0, origin, relative_tolerance, max_queries);
+  return search.run_from_tree(from.bvh());
 }
 
 }  // namespace topstoc

@@ -39,4 +39,10 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
                               double start, const double* start_point, double relative_tolerance,
                               int64_t max_queries = 4000000);
 
+/// The same bracket without any distance known beforehand: the search starts from the root of A's
+/// own BVH (a node's box bounds its triangles) and opens only the nodes that may hide a larger
+/// distance, so a large A close to B costs far fewer queries than measuring all its vertices.
+MaxBracket bound_max_distance_by_tree(const Surface& from, const Surface& to, double relative_tolerance,
+                                      int64_t max_queries = 4000000);
+
 }  // namespace topstoc

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <utility>
 
 namespace topstoc {
 
@@ -45,6 +46,13 @@ inline double box_distance2(const double* p, const double* lo, const double* hi)
 constexpr double kPruneSlack = 1.0 + 1e-12;
 
 }  // namespace
+
+// A triangle's centroid next to its id: the build partitions these in place, so its scans are
+// sequential instead of gathering through an index.
+struct TriangleBvh::BuildItem {
+  double centroid[3];
+  int32_t id;
+};
 
 double closest_point_on_triangle(const double* p, const double* a, const double* b, const double* c,
                                  double* closest) {
@@ -117,10 +125,13 @@ TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int6
         unordered[9 * size_t(f) + 3 * c + k] = x;
         centroids[3 * size_t(f) + k] += x / 3.0;
       }
-  std::vector<int32_t> order(m);
-  std::iota(order.begin(), order.end(), 0);
+  std::vector<BuildItem> items(m);
+  for (int32_t f = 0; f < m; ++f) items[f] = {{centroids[3 * size_t(f)], centroids[3 * size_t(f) + 1],
+                                                centroids[3 * size_t(f) + 2]}, f};
   nodes_.reserve(2 * size_t(m / kLeafSize + 1));
-  build(0, m, unordered, centroids, order);
+  build(0, m, unordered, items.data());
+  std::vector<int32_t> order(m);
+  for (int32_t s = 0; s < m; ++s) order[s] = items[s].id;
   // Store the corners in leaf order so that a leaf's triangles sit together in memory.
   triangle_ids_ = order;
 #pragma omp parallel for schedule(static) if(m >= 100000)
@@ -128,44 +139,51 @@ TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int6
     std::copy_n(&unordered[9 * size_t(order[s])], 9, &corners_[9 * size_t(s)]);
 }
 
-int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>& corners,
-                           const std::vector<double>& centroids, std::vector<int32_t>& order) {
+int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items) {
   // Median split along the longest axis of the centroids' box: a balanced tree, built in
-  // O(m log m), that serves nearest-point queries well.
+  // O(m log m), that serves nearest-point queries well. Boxes come from the children, so each
+  // triangle's corners are read once.
   const int32_t index = static_cast<int32_t>(nodes_.size());
   nodes_.push_back(Node{});
   Node node{};
-  double centre_lo[3], centre_hi[3];
-  for (int k = 0; k < 3; ++k) {
-    node.lo[k] = centre_lo[k] = std::numeric_limits<double>::infinity();
-    node.hi[k] = centre_hi[k] = -std::numeric_limits<double>::infinity();
-  }
-  for (int32_t i = begin; i < end; ++i) {
-    const int32_t f = order[i];
-    for (int c = 0; c < 3; ++c)
-      for (int k = 0; k < 3; ++k) {
-        node.lo[k] = std::min(node.lo[k], corners[9 * size_t(f) + 3 * c + k]);
-        node.hi[k] = std::max(node.hi[k], corners[9 * size_t(f) + 3 * c + k]);
-      }
-    for (int k = 0; k < 3; ++k) {
-      centre_lo[k] = std::min(centre_lo[k], centroids[3 * size_t(f) + k]);
-      centre_hi[k] = std::max(centre_hi[k], centroids[3 * size_t(f) + k]);
-    }
-  }
   if (end - begin <= kLeafSize) {
+    for (int k = 0; k < 3; ++k) {
+      node.lo[k] = std::numeric_limits<double>::infinity();
+      node.hi[k] = -std::numeric_limits<double>::infinity();
+    }
+    for (int32_t i = begin; i < end; ++i)
+      for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 3; ++k) {
+          node.lo[k] = std::min(node.lo[k], corners[9 * size_t(items[i].id) + 3 * c + k]);
+          node.hi[k] = std::max(node.hi[k], corners[9 * size_t(items[i].id) + 3 * c + k]);
+        }
     node.first = begin;
     node.count = end - begin;
   } else {
+    double centre_lo[3], centre_hi[3];
+    for (int k = 0; k < 3; ++k) {
+      centre_lo[k] = std::numeric_limits<double>::infinity();
+      centre_hi[k] = -std::numeric_limits<double>::infinity();
+    }
+    for (int32_t i = begin; i < end; ++i)
+      for (int k = 0; k < 3; ++k) {
+        centre_lo[k] = std::min(centre_lo[k], items[i].centroid[k]);
+        centre_hi[k] = std::max(centre_hi[k], items[i].centroid[k]);
+      }
     int axis = 0;
     for (int k = 1; k < 3; ++k)
       if (centre_hi[k] - centre_lo[k] > centre_hi[axis] - centre_lo[axis]) axis = k;
     const int32_t middle = begin + (end - begin) / 2;
-    std::nth_element(order.begin() + begin, order.begin() + middle, order.begin() + end, [&](int32_t x, int32_t y) {
-      const double cx = centroids[3 * size_t(x) + axis], cy = centroids[3 * size_t(y) + axis];
-      return cx < cy || (cx == cy && x < y);
+    std::nth_element(items + begin, items + middle, items + end, [axis](const BuildItem& x, const BuildItem& y) {
+      return x.centroid[axis] < y.centroid[axis] || (x.centroid[axis] == y.centroid[axis] && x.id < y.id);
     });
-    build(begin, middle, corners, centroids, order);
-    node.first = build(middle, end, corners, centroids, order);
+    const int32_t left = build(begin, middle, corners, items);
+    const int32_t right = build(middle, end, corners, items);
+    for (int k = 0; k < 3; ++k) {
+      node.lo[k] = std::min(nodes_[left].lo[k], nodes_[right].lo[k]);
+      node.hi[k] = std::max(nodes_[left].hi[k], nodes_[right].hi[k]);
+    }
+    node.first = right;
     node.count = 0;
   }
   nodes_[index] = node;

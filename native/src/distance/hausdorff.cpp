@@ -129,8 +129,12 @@ Surface::Surface(std::vector<double> positions, std::vector<int32_t> triangles)
     area += triangle_area(&positions_[3 * size_t(t[0])], &positions_[3 * size_t(t[1])], &positions_[3 * size_t(t[2])]);
   }
   area_ = area;
+}
 
-  // Distinct edges: sort the (low, high, side) keys of all triangle sides.
+void Surface::build_edges() const {
+  // Distinct edges, built on first use (sampling needs them, closest-point queries do not): sort
+  // the (low, high, side) keys of all triangle sides.
+  const int32_t m = num_triangles();
   std::vector<std::pair<uint64_t, int64_t>> sides;
   sides.reserve(3 * size_t(m));
   face_edges_.assign(3 * size_t(m), -1);
@@ -148,6 +152,16 @@ Surface::Surface(std::vector<double> positions, std::vector<int32_t> triangles)
     }
     face_edges_[sides[i].second] = int32_t(edges_.size() / 2 - 1);
   }
+}
+
+const std::vector<int32_t>& Surface::edges() const {
+  std::call_once(edges_once_, [this] { build_edges(); });
+  return edges_;
+}
+
+const std::vector<int32_t>& Surface::face_edges() const {
+  std::call_once(edges_once_, [this] { build_edges(); });
+  return face_edges_;
 }
 
 const TriangleBvh& Surface::bvh() const {
@@ -398,6 +412,17 @@ void bracket_max(const Surface& from, const Surface& to, OneSidedDistance& side,
   if (bracket.lower_triangle >= 0)
     side.face_max[bracket.lower_triangle] = std::max(side.face_max[bracket.lower_triangle], bracket.lower);
   side.refine_queries = bracket.queries;
+}
+
+OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, double tolerance, int64_t max_queries) {
+  if (!(tolerance > 0.0)) throw std::invalid_argument("tolerance must be positive, got " + shown(tolerance));
+  const MaxBracket bracket = bound_max_distance_by_tree(from, to, tolerance, max_queries);
+  OneSidedBracket r;
+  r.lower = bracket.lower;
+  r.upper = bracket.upper;
+  r.queries = bracket.queries;
+  r.converged = bracket.converged;
+  return r;
 }
 
 HausdorffResult hausdorff(const Surface& a, const SurfaceSamples& a_samples, const Surface& b, double percentile,

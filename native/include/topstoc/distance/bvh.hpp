@@ -7,6 +7,7 @@
 // segments or points they are.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -38,14 +39,21 @@ class TriangleBvh {
   int64_t num_triangles() const { return int64_t(triangle_ids_.size()); }
   int64_t num_nodes() const { return int64_t(nodes_.size()); }
 
- private:
   struct Node {
     double lo[3], hi[3];
     int32_t first;  ///< leaf: first slot; inner: index of the second child (the first follows the node)
     int32_t count;  ///< leaf: number of triangles (> 0); inner: 0
   };
-  int32_t build(int32_t begin, int32_t end, const std::vector<double>& corners, const std::vector<double>& centroids,
-                std::vector<int32_t>& order);
+  /// Node i (0 is the root; an inner node's children are i + 1 and first), for walks over the tree.
+  const Node& node(int32_t i) const { return nodes_[std::size_t(i)]; }
+  /// The 9 corner coordinates of the triangle in a slot, and its caller's id.
+  const double* slot_corners(int32_t slot) const { return &corners_[9 * std::size_t(slot)]; }
+  int32_t slot_triangle(int32_t slot) const { return triangle_ids_[std::size_t(slot)]; }
+
+ private:
+  struct BuildItem;
+  /// Builds the subtree over items [begin, end), which it reorders.
+  int32_t build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items);
   double slot_distance2(const double* p, int32_t slot, double* closest) const;
 
   std::vector<Node> nodes_;

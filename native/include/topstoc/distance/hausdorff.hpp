@@ -26,7 +26,7 @@
 
 namespace topstoc {
 
-/// A triangle mesh validated for measurement, with its edges and (built on first use) its BVH.
+/// A triangle mesh validated for measurement, with its edges and its BVH (both built on first use).
 class Surface {
  public:
   /// positions: 3 per vertex; triangles: 3 vertex ids per triangle. Throws std::invalid_argument
@@ -39,8 +39,8 @@ class Surface {
   const std::vector<int32_t>& triangles() const { return triangles_; }
   /// Distinct undirected edges (2 vertex ids per edge, lower first) and, per triangle side c
   /// (corner c to c+1), its edge id; -1 where the side repeats a vertex.
-  const std::vector<int32_t>& edges() const { return edges_; }
-  const std::vector<int32_t>& face_edges() const { return face_edges_; }
+  const std::vector<int32_t>& edges() const;
+  const std::vector<int32_t>& face_edges() const;
   /// 1 for vertices used by a triangle.
   const std::vector<uint8_t>& used() const { return used_; }
   /// Bounding-box diagonal of the vertices used by triangles.
@@ -50,8 +50,12 @@ class Surface {
   const TriangleBvh& bvh() const;
 
  private:
+  void build_edges() const;
+
   std::vector<double> positions_;
-  std::vector<int32_t> triangles_, edges_, face_edges_;
+  std::vector<int32_t> triangles_;
+  mutable std::vector<int32_t> edges_, face_edges_;
+  mutable std::once_flag edges_once_;
   std::vector<uint8_t> used_;
   double diagonal_ = 0.0, area_ = 0.0;
   mutable std::once_flag bvh_once_;
@@ -102,6 +106,19 @@ struct OneSidedDistance {
 /// skip the percentile.
 OneSidedDistance one_sided_distance(const Surface& from, const SurfaceSamples& samples, const Surface& to,
                                     double percentile_fraction);
+
+/// A guaranteed bracket of the one-sided maximum: lower <= max over `from` of dist(x, to) <= upper.
+struct OneSidedBracket {
+  double lower = 0.0, upper = 0.0;
+  int64_t queries = 0;     ///< closest-point queries made (vertices included)
+  bool converged = true;   ///< upper <= lower * (1 + tolerance); false when max_queries ran out
+};
+
+/// Brackets the one-sided maximum from `from` to `to` without sampling `from`: a walk down `from`'s
+/// BVH opening only the boxes that may hide a larger distance, then the bounded refinement of
+/// their triangles (bounded_max.hpp), until the relative gap is within `tolerance` (> 0) or
+/// `max_queries` queries were made (the bracket holds either way).
+OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, double tolerance, int64_t max_queries);
 
 struct HausdorffParams {
   int64_t samples = 1000000;   ///< wanted samples on the first surface (ignored when step > 0)
