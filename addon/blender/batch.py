@@ -30,6 +30,7 @@ from ..core.api.decimate import ATTRIBUTE_WEIGHT
 from ..core.batch.prune import prune_small_parts
 from ..core.batch.run import misnamed_failure, utf8_name, write_report
 from ..core.support.errors import TopStocError, one_line, shown_path
+from ..core.api.hausdorff import as_surface
 from ..core.support.output_guard import check_folders, prepare_output, output_folder
 
 BLEND = ".blend"
@@ -149,7 +150,7 @@ def _decimate_object(bpy, pipeline, obj, settings, targets) -> tuple:
     """Decimates one object once per LOD; returns (report entry, LOD objects)."""
     scale = _world_scale(obj)
     n = len(obj.data.vertices)
-    lods, lod_objects = [], []
+    lods, lod_objects, surfaces = [], [], {}  # surfaces: the original's, measured once for all LODs
     for index, (target, screen) in enumerate(targets):
         if screen is not None:  # world units -> the object's own units
             target = {"max_error": target["max_error"] / scale}
@@ -159,10 +160,14 @@ def _decimate_object(bpy, pipeline, obj, settings, targets) -> tuple:
             run.result, pruned = prune_small_parts(run.result, settings["prune_pixels"] * screen.world_per_pixel / scale)
             entry["pruned"] = pruned.as_dict()
         bound = getattr(run.result, "error_bound", None)
-        error = lod_error(run.prepared.mesh, run.result, None)
+        if id(run.prepared.mesh) not in surfaces:
+            surfaces[id(run.prepared.mesh)] = as_surface(run.prepared.mesh, "original")
+        error = lod_error(run.prepared.mesh, run.result, None, settings.get("exact_error", False),
+                          surfaces[id(run.prepared.mesh)])
         error["hausdorff_world"] = error["hausdorff"] * scale
         if screen is not None:
             error["hausdorff_pixels"] = screen.to_pixels(error["hausdorff_world"])
+            error["hausdorff_upper_pixels"] = screen.to_pixels(error["hausdorff_upper"] * scale)
             error["screen"] = screen.as_dict()
         entry.update(vertices=run.result.num_vertices, triangles=run.result.num_triangles,
                      repairs=run.result.stats.repairs, seconds=run.seconds, target_missed=missed_dict(run.result.stats),

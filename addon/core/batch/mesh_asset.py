@@ -2,9 +2,10 @@
 
 The file is read in its own vertex order, decimated once per LOD (UV seams and material
 borders kept as borders, so UVs, vertex colours and materials carry over exactly), optionally
-pruned of small parts (screen targets), measured against the original with the project's
-Hausdorff distance and written atomically (topstoc.core.api.io.write_mesh: temporary file, then
-rename). A LOD chain gives one file per LOD, ``<stem>_LOD<i>.<ext>``.
+pruned of small parts (screen targets), measured against the original (a bounded estimate of
+the Hausdorff max, or the exact bracketed max with --exact-error) and written atomically
+(topstoc.core.api.io.write_mesh: temporary file, then rename). A LOD chain gives one file per
+LOD, ``<stem>_LOD<i>.<ext>``.
 """
 
 from __future__ import annotations
@@ -15,15 +16,12 @@ import time
 from . import settings as batch_settings
 from ..api.budget import missed_dict
 from ..support.errors import TopStocError
-from ..api.hausdorff import hausdorff
+from ..api.error_estimate import estimate_error, exact_error
+from ..api.hausdorff import as_surface
 from ..api.io import mesh_format, read_mesh
 from ..api.job import ATTRIBUTE_WEIGHT
 from ..api.mesh_file_job import prepare_file
 from .prune import prune_small_parts
-
-#: samples on the original for the per-LOD error in the report: 100 per input triangle, within
-#: these bounds (dense enough on small assets, bounded cost on large ones)
-REPORT_SAMPLES = (10_000, 50_000)
 
 
 def output_paths(path: str, out_dir: str, settings: dict) -> list:
@@ -40,18 +38,20 @@ def output_paths(path: str, out_dir: str, settings: dict) -> list:
             for i in range(len(settings["values"]))]
 
 
-def lod_error(original, result, screen) -> dict:
-    """Measured symmetric Hausdorff error of a LOD (absolute, relative, in pixels)."""
-    low, high = REPORT_SAMPLES
-    samples = int(min(high, max(low, 100 * original.num_triangles)))
-    # The sampled maximum (max_tolerance=0): refining it towards a guaranteed bound took 13.5 s
-    # instead of 0.34 s (a 65k-triangle torus at ratio 0.2, 50 times the decimation's time) and
-    # moved the figure by under 0.1 %.
-    measured = hausdorff(original, result, samples=samples, percentile=0.0, max_tolerance=0.0)
-    error = float(measured.symmetric.max)
-    entry = {"hausdorff": error, "hausdorff_samples": samples, "hausdorff_relative": error / measured.diagonal if measured.diagonal else 0.0}
+def lod_error(original, result, screen, exact: bool = False, original_surface=None) -> dict:
+    """The symmetric Hausdorff error of a LOD (absolute, relative, in pixels): by default a bounded
+    estimate with its guaranteed upper bound, the exact bracketed max with ``exact``
+    (topstoc.core.api.error_estimate). original_surface: the original's measurement surface, kept
+    across the LODs of one asset (its closest-point index is built once)."""
+    bound = (exact_error if exact else estimate_error)(original, result, original_surface=original_surface)
+    diagonal = original_surface.diagonal if original_surface is not None else as_surface(original).diagonal
+    entry = {"hausdorff": bound.estimate, "hausdorff_upper": bound.upper,
+             "hausdorff_kind": bound.as_dict()["kind"], "hausdorff_converged": bound.converged,
+             "hausdorff_relative": bound.estimate / diagonal if diagonal else 0.0,
+             "hausdorff_upper_relative": bound.upper / diagonal if diagonal else 0.0}
     if screen is not None:
-        entry["hausdorff_pixels"] = screen.to_pixels(error)
+        entry["hausdorff_pixels"] = screen.to_pixels(bound.estimate)
+        entry["hausdorff_upper_pixels"] = screen.to_pixels(bound.upper)
         entry["screen"] = screen.as_dict()
     return entry
 
@@ -68,6 +68,7 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
     source = prepare_file(path, data, options.get("mode"), options.get("refine"),
                           settings.get("attribute_weight", ATTRIBUTE_WEIGHT))
     lods = []
+    surface = as_surface(source.mesh, "original")
     for index, ((target, screen), output) in enumerate(zip(batch_settings.engine_targets(settings, data.vertices),
                                                           outputs)):
         started = time.perf_counter()
@@ -79,7 +80,8 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
         bound = getattr(result, "error_bound", None)
         entry.update(vertices=result.num_vertices, triangles=result.num_triangles, repairs=result.stats.repairs,
                      search_error=None if bound is None else float(bound.achieved_error),
-                     target_missed=missed_dict(result.stats), **lod_error(source.mesh, result, screen))
+                     target_missed=missed_dict(result.stats),
+                     **lod_error(source.mesh, result, screen, settings.get("exact_error", False), surface))
         entry["dropped_attributes"] = source.write(result, output)
         entry["seconds"] = time.perf_counter() - started
         lods.append(entry)

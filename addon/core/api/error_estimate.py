@@ -1,0 +1,90 @@
+"""A bounded estimate of the symmetric Hausdorff max (docs/design.md §3.1): cheap enough to report for
+every output of a batch and to guide an error-bounded search, with a guaranteed bracket.
+
+>>> bound = estimate_error(original, decimated)
+>>> bound.estimate <= exact maximum <= bound.upper
+
+Each side (original to result, result to original) is bracketed by the engine
+(``bracket_one_sided_max``): a walk down the measured surface's own BVH. A node's box bounds the
+distance of every point in it (its centre's distance plus half its diagonal: the distance to a
+surface is 1-Lipschitz; or the farthest box corner from the centre's nearest triangle: the
+distance to one triangle is convex); only nodes whose bound exceeds ``(1 + gap)`` times the best
+distance found are opened, and a leaf's triangles are subdivided as in the exact measurement
+(hausdorff.py) until the same test holds. ``estimate`` is the best distance found, attained at a
+point of the surface (so it never exceeds the exact maximum); ``upper`` is the largest bound
+left, which no point exceeds. The walk stops at ``queries`` closest-point queries per side; the
+bracket holds then too, only wider (``converged`` False). ``exact_error`` asks for the gap and
+the query budget of the exact bracketed maximum of hausdorff.py.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .hausdorff import as_surface
+from ..support.native import engine
+
+DEFAULT_GAP = 0.25         #: relative gap aimed at between the estimate and its upper bound, by default
+DEFAULT_QUERIES = 100_000  #: closest-point queries per side for the default estimate (then the bracket stops)
+EXACT_GAP = 1e-3           #: the gap of the exact bracketed maximum (hausdorff.py's max_tolerance)
+EXACT_QUERIES = 20_000_000 #: closest-point queries per side for the exact one
+
+
+@dataclass(frozen=True)
+class ErrorBound:
+    """estimate <= exact symmetric Hausdorff max <= upper (absolute, units of the mesh)."""
+
+    estimate: float
+    upper: float
+    forward: tuple      #: (estimate, upper) from the original to the result
+    backward: tuple     #: (estimate, upper) from the result to the original
+    gap: float          #: the relative gap asked for
+    queries: int        #: closest-point queries made
+    converged: bool     #: upper <= estimate * (1 + gap) on both sides (False: the query budget ran out)
+
+    @property
+    def exact(self) -> bool:
+        """True when the bracket is as tight as the exact measurement's."""
+        return self.gap <= EXACT_GAP
+
+    def as_dict(self) -> dict:
+        return {"estimate": self.estimate, "upper": self.upper, "gap": self.gap, "converged": self.converged,
+                "kind": "exact" if self.exact else "estimate"}
+
+
+def estimate_error(original, result, gap: float = DEFAULT_GAP, queries: int = DEFAULT_QUERIES, *,
+                   original_surface=None) -> ErrorBound:
+    """Brackets the symmetric Hausdorff max between ``original`` and ``result`` (each
+    ``(vertices, triangles)``, an object with both, or an engine Surface) within the relative
+    ``gap``, with at most ``queries`` closest-point queries per side (module docs).
+    original_surface: the original's engine Surface when the caller keeps one, so that its
+    closest-point index is built once for several results."""
+    a = original_surface or as_surface(original, "original")
+    b = as_surface(result, "result")
+    forward = engine.bracket_one_sided_max(a, b, tolerance=gap, max_queries=int(queries))
+    backward = engine.bracket_one_sided_max(b, a, tolerance=gap, max_queries=int(queries))
+    if not (forward["converged"] and backward["converged"]):  # the walk's best is not spread: add samples
+        forward["lower"] = max(forward["lower"], _sampled_max(original, b, queries // 2))
+        backward["lower"] = max(backward["lower"], _sampled_max(result, a, queries // 2))
+    return ErrorBound(estimate=max(forward["lower"], backward["lower"]),
+                      upper=max(forward["upper"], backward["upper"]),
+                      forward=(forward["lower"], forward["upper"]), backward=(backward["lower"], backward["upper"]),
+                      gap=float(gap), queries=int(forward["queries"] + backward["queries"]),
+                      converged=bool(forward["converged"] and backward["converged"]))
+
+
+def exact_error(original, result, *, original_surface=None) -> ErrorBound:
+    """The exact bracketed maximum (hausdorff.py's, relative gap 1e-3)."""
+    return estimate_error(original, result, EXACT_GAP, EXACT_QUERIES, original_surface=original_surface)
+
+
+def _sampled_max(mesh, other, count: int) -> float:
+    """Largest distance to ``other`` among about ``count`` points spread over ``mesh`` (every
+    k-th triangle's centroid, in the mesh's own order): attained, so a lower bound of the max."""
+    vertices, triangles = mesh if isinstance(mesh, tuple) else (mesh.vertices, mesh.triangles)
+    triangles = np.asarray(triangles).reshape(-1, 3)
+    step = max(1, -(-len(triangles) // max(1, int(count))))
+    centroids = np.asarray(vertices, dtype=np.float64)[triangles[::step]].mean(axis=1)
+    return float(engine.closest_points(other, centroids)["distance"].max(initial=0.0))

@@ -1,0 +1,79 @@
+"""The bounded Hausdorff estimate (topstoc.core.api.error_estimate): estimate <= exact max <= upper.
+
+The exact max comes from an independent measure: CGAL's bounded_error_Hausdorff_distance (a
+peer program, skipped when not built) on real meshes, and closed forms on meshes whose
+Hausdorff distance is known exactly.
+"""
+
+import importlib
+
+import numpy as np
+import pytest
+
+import topstoc
+from peer_runs import cgal_hausdorff, peer, read_off, write_off
+
+estimates = importlib.import_module(topstoc.__name__ + ".core.api.error_estimate")
+
+
+def grid(n: int, z=None):
+    """(n+1)^2 vertices on the unit square at height z (one per vertex, or 0), 2 n^2 triangles."""
+    x, y = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1), indexing="ij")
+    vertices = np.stack([x.ravel(), y.ravel(), np.zeros(x.size) if z is None else z], axis=1)
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    v = (i * (n + 1) + j).ravel()
+    triangles = np.concatenate([np.stack([v, v + n + 1, v + 1], 1), np.stack([v + 1, v + n + 1, v + n + 2], 1)])
+    return vertices, triangles.astype(np.int32)
+
+
+@pytest.mark.parametrize("gap, queries", [(estimates.DEFAULT_GAP, estimates.DEFAULT_QUERIES), (0.25, 40)])
+def test_a_raised_vertex_is_bracketed(gap, queries):
+    # One interior vertex of a flat grid raised by h: the symmetric max is exactly h (the raised
+    # vertex's distance to the plane; every point of the plane is nearer the pyramid than that).
+    flat = grid(20)
+    z = np.zeros(len(flat[0]))
+    z[10 * 21 + 10] = 0.07
+    raised = grid(20, z)
+    bound = estimates.estimate_error(flat, raised, gap, queries)
+    assert bound.estimate <= 0.07 + 1e-12
+    assert bound.upper >= 0.07 - 1e-12
+    if bound.converged:
+        assert bound.upper <= bound.estimate * (1 + gap) + 1e-12
+    else:  # the query budget ran out: the bracket still holds, only wider
+        assert queries == 40
+
+
+def test_a_shifted_copy_is_bracketed_and_the_exact_bracket_is_tight():
+    # A fine grid and a coarse one lifted by 0.03: every point of either is 0.03 from the other.
+    fine, coarse = grid(32), grid(4)
+    coarse = (coarse[0] + [0.0, 0.0, 0.03], coarse[1])
+    for bound in (estimates.estimate_error(fine, coarse), estimates.exact_error(fine, coarse)):
+        assert bound.estimate <= 0.03 + 1e-12 <= bound.upper + 2e-12
+    exact = estimates.exact_error(fine, coarse)
+    assert exact.exact and exact.as_dict()["kind"] == "exact"
+    assert exact.upper <= exact.estimate * (1 + estimates.EXACT_GAP) + 1e-12
+
+
+PAIRS = [("genus0/cgal_fandisk.off", "fast", 0.1), ("genus0/cgal_fandisk.off", "quality", 0.02),
+         ("genus_positive/cgal_elephant.off", "quality", 0.1), ("genus_positive/cgal_knot1.off", "fast", 0.05)]
+
+
+@pytest.mark.parametrize("name, mode, ratio", PAIRS)
+@pytest.mark.parametrize("queries", [estimates.DEFAULT_QUERIES, 300])
+def test_agrees_with_cgal(data_dir, tmp_path, name, mode, ratio, queries):
+    if peer("cgal_hausdorff") is None:
+        pytest.skip("the peer program cgal_hausdorff was not built (libcgal-dev)")
+    source = data_dir / name
+    a = read_off(source)
+    b = topstoc.Mesh(*a).decimate(ratio=ratio, seed=1, mode=mode)
+    decimated = tmp_path / "decimated.off"
+    write_off(decimated, b.vertices, b.triangles)
+    cgal = cgal_hausdorff(source, decimated, error_bound_fraction=2e-5, mean_samples=1000)
+    truth = max(cgal["forward"]["max_bounded"], cgal["backward"]["max_bounded"])
+    bound = estimates.estimate_error(a, (b.vertices, b.triangles), queries=queries)
+    print(f"{name} {mode} {ratio} queries {queries}: estimate {bound.estimate:.6g} <= CGAL {truth:.6g} "
+          f"<= upper {bound.upper:.6g} (converged {bound.converged})")
+    assert bound.estimate <= truth + cgal["error_bound"]
+    assert bound.upper >= truth - cgal["error_bound"]
+    for side, ours in (("forward", bound.forward), ("backward", bound.backward)):
+        assert ours[0] <= cgal[side]["max_bounded"] + cgal["error_bound"] <= ours[1] + 2 * cgal["error_bound"]
