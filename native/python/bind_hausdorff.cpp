@@ -137,21 +137,24 @@ void bind_hausdorff(py::module_& m) {
 
   m.def(
       "bracket_one_sided_max",
-      [](const Surface& from, const Surface& to, double tolerance, int64_t max_queries) {
+      [](const Surface& from, const Surface& to, double tolerance, int64_t max_queries, double threshold) {
         OneSidedBracket r;
         {
           EngineCall call;
-          r = bracket_one_sided_max(from, to, tolerance, max_queries);
+          r = bracket_one_sided_max(from, to, tolerance, max_queries, threshold);
         }
         py::dict out;
         out["lower"] = r.lower;
         out["upper"] = r.upper;
+        out["lower_point"] = copy_array(std::vector<double>(r.lower_point, r.lower_point + 3));
         out["queries"] = r.queries;
         out["converged"] = r.converged;
         return out;
       },
       py::arg("from_surface"), py::arg("to_surface"), py::arg("tolerance"), py::arg("max_queries") = 4000000,
-      "Guaranteed bracket (lower, upper) of the one-sided max distance from one surface to the other.");
+      py::arg("threshold") = -1.0,
+      "Guaranteed bracket (lower, upper) of the one-sided max distance from one surface to the other "
+      "(threshold >= 0: only as tight as deciding whether the max exceeds it needs).");
 
   m.def(
       "hausdorff_with_samples",

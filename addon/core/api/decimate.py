@@ -220,9 +220,10 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     return run_job(mesh, job)
 
 
-def run_job(mesh: Mesh, job: DecimationJob) -> DecimateResult:
+def run_job(mesh: Mesh, job: DecimationJob, progress=None) -> DecimateResult:
     """Runs a DecimationJob (core/api/job.py): mirrored (core/api/symmetry.py), error-bounded (a search
-    over vertex counts, core/api/error_bound.py) or one engine call."""
+    over vertex counts, core/api/error_bound.py) or one engine call. progress: the error-bounded
+    search's ``progress(probe, target, vertices, error, passed)`` (False cancels; error_bound.py)."""
     if job.symmetry is not None:
         from .symmetry import decimate_job_mirrored
 
@@ -231,7 +232,7 @@ def run_job(mesh: Mesh, job: DecimationJob) -> DecimateResult:
         from .error_bound import search_vertex_count
 
         result, report = search_vertex_count(mesh, job.target.max_error, lambda count: run_job(mesh, job.at(count)),
-                                             relative=job.target.relative)
+                                             relative=job.target.relative, progress=progress)
         return dataclasses.replace(result, error_bound=report, parameters={
             **result.parameters, "max_error": job.target.max_error, "relative": job.target.relative})
     layout, floods = mesh.layout_and_floods(job.regions, job.borders, job.feature_angle)

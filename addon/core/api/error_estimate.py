@@ -43,6 +43,7 @@ class ErrorBound:
     gap: float          #: the relative gap asked for
     queries: int        #: closest-point queries made
     converged: bool     #: upper <= estimate * (1 + gap) on both sides (False: the query budget ran out)
+    witness: object = None  #: decide_error: a point of the original farther than the bound from the result
 
     @property
     def exact(self) -> bool:
@@ -88,3 +89,56 @@ def _sampled_max(mesh, other, count: int) -> float:
     step = max(1, -(-len(triangles) // max(1, int(count))))
     centroids = np.asarray(vertices, dtype=np.float64)[triangles[::step]].mean(axis=1)
     return float(engine.closest_points(other, centroids)["distance"].max(initial=0.0))
+
+
+def decide_error(original, result, bound: float, *, original_surface=None) -> ErrorBound:
+    """Whether the symmetric Hausdorff max exceeds ``bound``, decided exactly but no tighter than
+    that needs: the walk settles every box and piece whose bound is within ``bound`` and stops at
+    the first distance above it. Within the bound when ``upper <= bound`` (guaranteed), above it
+    when ``estimate > bound`` (attained); a max within the exact gap of the bound counts as above."""
+    a = original_surface or as_surface(original, "original")
+    b = as_surface(result, "result")
+    sides = []
+    for x, y in ((a, b), (b, a)):
+        side = engine.bracket_one_sided_max(x, y, tolerance=EXACT_GAP, max_queries=EXACT_QUERIES, threshold=bound)
+        sides.append(side)
+        if side["lower"] > bound:  # decided: above
+            break
+    forward = (sides[0]["lower"], sides[0]["upper"])
+    backward = (sides[1]["lower"], sides[1]["upper"]) if len(sides) > 1 else (0.0, float("inf"))
+    witness = sides[0]["lower_point"] if sides[0]["lower"] > bound else None
+    return ErrorBound(witness=witness,estimate=max(forward[0], backward[0]), upper=max(forward[1], backward[1]),
+                      forward=forward, backward=backward, gap=EXACT_GAP,
+                      queries=int(sum(side["queries"] for side in sides)),
+                      converged=all(side["converged"] or side["lower"] > bound for side in sides))
+
+
+class SampledError:
+    """The largest distance over points spread on both surfaces, for many results of one original:
+    attained, so never above the exact maximum (a lower bound, not a bracket). The original's
+    points (every k-th triangle's centroid and vertex, about ``samples`` in all) are taken once;
+    on a result: its vertices, and every k-th triangle's centroid and edge midpoint."""
+
+    def __init__(self, original, original_surface, samples: int = 40_000):
+        vertices, triangles = _arrays(original)
+        step = max(1, -(-len(triangles) // max(1, samples // 2)))
+        self.points = np.concatenate([vertices[triangles[::step]].mean(axis=1), vertices[triangles[::step, 0]]])
+        self.surface, self.samples = original_surface, samples
+
+    def add_witness(self, point) -> None:
+        """Measures this point of the original from now on (one an exact check found too far)."""
+        self.points = np.concatenate([self.points, np.asarray(point, dtype=np.float64).reshape(1, 3)])
+
+    def __call__(self, result) -> float:
+        vertices, triangles = _arrays(result)
+        step = max(1, -(-len(triangles) // max(1, self.samples // 2)))
+        corners = vertices[triangles[::step]]
+        points = np.concatenate([vertices, corners.mean(axis=1), 0.5 * (corners[:, 0] + corners[:, 1])])
+        forward = engine.closest_points(as_surface(result, "result"), self.points)["distance"]
+        backward = engine.closest_points(self.surface, points)["distance"]
+        return float(max(forward.max(initial=0.0), backward.max(initial=0.0)))
+
+
+def _arrays(mesh):
+    vertices, triangles = mesh if isinstance(mesh, tuple) else (mesh.vertices, mesh.triangles)
+    return np.asarray(vertices, dtype=np.float64), np.asarray(triangles, dtype=np.int64).reshape(-1, 3)

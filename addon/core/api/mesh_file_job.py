@@ -42,8 +42,9 @@ class MeshFileJob:
         return make_job(self.mesh, **target, **options, symmetry=symmetry, regions=self.regions, borders=borders,
                         **self.attribute_kwargs)
 
-    def decimate(self, target: dict, options: dict, symmetry=None) -> DecimateResult:
-        return run_job(self.mesh, self.job(target, options, symmetry))
+    def decimate(self, target: dict, options: dict, symmetry=None, progress=None) -> DecimateResult:
+        """progress: the error-bounded search's, for a max_error target (run_job)."""
+        return run_job(self.mesh, self.job(target, options, symmetry), progress)
 
     def write(self, result: DecimateResult, output: str) -> list:
         """Writes ``result`` with the input's attributes to ``output``; returns what its format

@@ -43,12 +43,14 @@ def lod_error(original, result, screen, exact: bool = False, original_surface=No
     estimate with its guaranteed upper bound, the exact bracketed max with ``exact``
     (topstoc.core.api.error_estimate). original_surface: the original's measurement surface, kept
     across the LODs of one asset (its closest-point index is built once)."""
+    started = time.perf_counter()
     bound = (exact_error if exact else estimate_error)(original, result, original_surface=original_surface)
     diagonal = original_surface.diagonal if original_surface is not None else as_surface(original).diagonal
     entry = {"hausdorff": bound.estimate, "hausdorff_upper": bound.upper,
              "hausdorff_kind": bound.as_dict()["kind"], "hausdorff_converged": bound.converged,
              "hausdorff_relative": bound.estimate / diagonal if diagonal else 0.0,
-             "hausdorff_upper_relative": bound.upper / diagonal if diagonal else 0.0}
+             "hausdorff_upper_relative": bound.upper / diagonal if diagonal else 0.0,
+             "hausdorff_seconds": time.perf_counter() - started}
     if screen is not None:
         entry["hausdorff_pixels"] = screen.to_pixels(bound.estimate)
         entry["hausdorff_upper_pixels"] = screen.to_pixels(bound.upper)

@@ -138,9 +138,14 @@ def run(args) -> int:
     source = prepare_file(args.input, data, args.mode, args.refine, weight)
     options = dict(seed=args.seed, adaptivity=args.adaptivity, density=args.density, guidance=guidance,
                    mode=args.mode, placement=args.placement, refine=args.refine)
-    progress.stage("decimating" if args.max_error is None else
-                   f"searching the vertex count for --max-error {args.max_error}")
-    result = source.decimate(target, options, args.symmetry)
+    searching = f"searching the vertex count for --max-error {args.max_error}"
+    progress.stage("decimating" if args.max_error is None else searching)
+
+    def probed(probe, count, vertices, error, passed):  # one stage line per probe of the search
+        progress.stage(f"{searching}: probe {probe}, {vertices:,} vertices, error {error:.4g} "
+                       f"{'within' if passed else 'above'} the bound")
+
+    result = source.decimate(target, options, args.symmetry, probed if args.max_error is not None else None)
     seconds = time.perf_counter() - start
     progress.stage(f"writing {args.output}")
     dropped = source.write(result, args.output)

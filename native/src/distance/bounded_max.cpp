@@ -72,14 +72,17 @@ class MaxSearch {
 
   // The same search seeded from the sampled surface's own BVH instead of all its triangles:
   // nodes by their bound, a leaf's triangles handed to the pieces when it is opened.
-  MaxBracket run_from_tree(const TriangleBvh& tree) {
+  MaxBracket run_from_tree(const TriangleBvh& tree, double threshold) {
+    decided_at = threshold;
     open_node(tree, 0);
     double top = 0.0;
     while (true) {
       const double node_top = nodes.empty() ? -1.0 : nodes.top().first;
       const double piece_top = open.empty() ? -1.0 : open.top().upper;
       top = std::max(node_top, piece_top);
-      if (top < 0.0 || tolerated(top) || out.queries + 16 > max_queries) break;
+      if (top < 0.0 || tolerated(top) || out.queries + 16 > max_queries ||
+          (decided_at >= 0.0 && out.lower > decided_at))
+        break;
       if (node_top >= piece_top) {
         const int32_t i = nodes.top().second;
         nodes.pop();
@@ -114,8 +117,13 @@ class MaxSearch {
   int32_t hint = -1;
   std::priority_queue<Piece, std::vector<Piece>, ByUpper> open;
   double settled = 0.0;  // the highest bound among pieces dropped as tolerated
+  // run_from_tree's threshold: bounds at or below it are settled, and a distance above it ends
+  // the search (whether the max exceeds it is then decided)
+  double decided_at = -1.0;
 
-  bool tolerated(double upper) const { return upper <= std::max(out.lower * (1 + relative_tolerance), floor); }
+  bool tolerated(double upper) const {
+    return upper <= std::max({out.lower * (1 + relative_tolerance), floor, decided_at});
+  }
 
   // The nearest point of the other surface to a point that need not lie on the sampled one.
   ClosestHit nearest(const double* x) {
@@ -299,11 +307,11 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
 }
 
 MaxBracket bound_max_distance_by_tree(const Surface& from, const Surface& to, double relative_tolerance,
-                                      int64_t max_queries) {
+                                      int64_t max_queries, double threshold) {
   static const std::vector<double> no_vertex_distance;
   const double origin[3] = {0.0, 0.0, 0.0};
   MaxSearch search(from, no_vertex_distance, to, 0.0, origin, relative_tolerance, max_queries);
-  return search.run_from_tree(from.bvh());
+  return search.run_from_tree(from.bvh(), threshold);
 }
 
 }  // namespace topstoc

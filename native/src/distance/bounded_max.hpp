@@ -42,7 +42,9 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
 /// The same bracket without any distance known beforehand: the search starts from the root of A's
 /// own BVH (a node's box bounds its triangles) and opens only the nodes that may hide a larger
 /// distance, so a large A close to B costs far fewer queries than measuring all its vertices.
+/// threshold (>= 0 to use it): bounds at or below it need no refinement and a distance above it
+/// ends the search, so only whether the max exceeds it is decided (cheaper near neither).
 MaxBracket bound_max_distance_by_tree(const Surface& from, const Surface& to, double relative_tolerance,
-                                      int64_t max_queries = 4000000);
+                                      int64_t max_queries = 4000000, double threshold = -1.0);
 
 }  // namespace topstoc

@@ -414,12 +414,14 @@ void bracket_max(const Surface& from, const Surface& to, OneSidedDistance& side,
   side.refine_queries = bracket.queries;
 }
 
-OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, double tolerance, int64_t max_queries) {
+OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, double tolerance, int64_t max_queries,
+                                      double threshold) {
   if (!(tolerance > 0.0)) throw std::invalid_argument("tolerance must be positive, got " + shown(tolerance));
-  const MaxBracket bracket = bound_max_distance_by_tree(from, to, tolerance, max_queries);
+  const MaxBracket bracket = bound_max_distance_by_tree(from, to, tolerance, max_queries, threshold);
   OneSidedBracket r;
   r.lower = bracket.lower;
   r.upper = bracket.upper;
+  std::copy_n(bracket.lower_point, 3, r.lower_point);
   r.queries = bracket.queries;
   r.converged = bracket.converged;
   return r;

@@ -110,6 +110,7 @@ OneSidedDistance one_sided_distance(const Surface& from, const SurfaceSamples& s
 /// A guaranteed bracket of the one-sided maximum: lower <= max over `from` of dist(x, to) <= upper.
 struct OneSidedBracket {
   double lower = 0.0, upper = 0.0;
+  double lower_point[3] = {0, 0, 0};  ///< a point of `from` at distance `lower`
   int64_t queries = 0;     ///< closest-point queries made (vertices included)
   bool converged = true;   ///< upper <= lower * (1 + tolerance); false when max_queries ran out
 };
@@ -117,8 +118,10 @@ struct OneSidedBracket {
 /// Brackets the one-sided maximum from `from` to `to` without sampling `from`: a walk down `from`'s
 /// BVH opening only the boxes that may hide a larger distance, then the bounded refinement of
 /// their triangles (bounded_max.hpp), until the relative gap is within `tolerance` (> 0) or
-/// `max_queries` queries were made (the bracket holds either way).
-OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, double tolerance, int64_t max_queries);
+/// `max_queries` queries were made (the bracket holds either way). threshold >= 0: stop as soon as
+/// the max is known to lie above it or at most at it (the bracket is then only as tight as that needs).
+OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, double tolerance, int64_t max_queries,
+                                      double threshold = -1.0);
 
 struct HausdorffParams {
   int64_t samples = 1000000;   ///< wanted samples on the first surface (ignored when step > 0)
