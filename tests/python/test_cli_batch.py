@@ -225,3 +225,22 @@ def test_bake_normals_is_checked_and_mesh_files_refuse_it(tmp_path):
     assert settings["bake_normals"] == 512 and batch_settings.to_argv(settings)[-2:] == ["--bake-normals", "512"]
     plain = batch_settings.from_args(parser.parse_args(["--ratio", "0.5"]))
     assert "bake_normals" not in plain and "--bake-normals" not in batch_settings.to_argv(plain)
+
+
+def test_the_error_report_is_a_bracket_and_exact_on_request(tmp_path):
+    """Default: a bounded estimate (estimate <= upper, both against an independent exact
+    measurement); --exact-error: the exact bracketed max, within 0.1 %."""
+    from topstoc.core.hausdorff import hausdorff
+    source = _torus(tmp_path / "in")
+    lods = {}
+    for flag in ((), ("--exact-error",)):
+        out = tmp_path / ("exact" if flag else "estimate")
+        done = batch("--input", source, "--output", out, "--ratio", 0.3, "--workers", 0, *flag)
+        assert done.returncode == 0, done.stderr
+        [entry] = json.loads((out / "topstoc-report.json").read_text())["results"]
+        [lods[bool(flag)]] = entry["lods"]
+        truth = hausdorff(read_mesh(source), read_mesh(entry["output"]), samples=300_000, percentile=0).symmetric
+        lod = lods[bool(flag)]
+        assert lod["hausdorff"] <= truth.max_upper and lod["hausdorff_upper"] >= truth.max
+        assert lod["hausdorff_kind"] == ("exact" if flag else "estimate")
+    assert lods[True]["hausdorff_upper"] <= lods[True]["hausdorff"] * 1.001 + 1e-12
