@@ -14,7 +14,9 @@ distance found are opened, and a leaf's triangles are subdivided as in the exact
 point of the surface (so it never exceeds the exact maximum); ``upper`` is the largest bound
 left, which no point exceeds. The walk stops at ``queries`` closest-point queries per side; the
 bracket holds then too, only wider (``converged`` False). ``exact_error`` asks for the gap and
-the query budget of the exact bracketed maximum of hausdorff.py.
+the query budget of the exact bracketed maximum of hausdorff.py. ``decide_error`` asks only whether the maximum
+exceeds a bound (the error-bounded search's exact check); ``SampledError`` is the search's
+cheap estimate (distances attained at points spread on both surfaces, no upper bound).
 """
 
 from __future__ import annotations
@@ -84,10 +86,9 @@ def exact_error(original, result, *, original_surface=None) -> ErrorBound:
 def _sampled_max(mesh, other, count: int) -> float:
     """Largest distance to ``other`` among about ``count`` points spread over ``mesh`` (every
     k-th triangle's centroid, in the mesh's own order): attained, so a lower bound of the max."""
-    vertices, triangles = mesh if isinstance(mesh, tuple) else (mesh.vertices, mesh.triangles)
-    triangles = np.asarray(triangles).reshape(-1, 3)
+    vertices, triangles = _arrays(mesh)
     step = max(1, -(-len(triangles) // max(1, int(count))))
-    centroids = np.asarray(vertices, dtype=np.float64)[triangles[::step]].mean(axis=1)
+    centroids = vertices[triangles[::step]].mean(axis=1)
     return float(engine.closest_points(other, centroids)["distance"].max(initial=0.0))
 
 
