@@ -29,7 +29,9 @@ from .hausdorff import as_surface
 from ..support.native import engine
 
 DEFAULT_GAP = 0.25         #: relative gap aimed at between the estimate and its upper bound, by default
-DEFAULT_QUERIES = 100_000  #: closest-point queries per side for the default estimate (then the bracket stops)
+#: closest-point queries per side for the default estimate (then the bracket stops): one query
+#: per 8 triangles of the two surfaces, within these bounds, so the report costs a fraction of the decimation
+DEFAULT_QUERIES = (2_000, 100_000)
 EXACT_GAP = 1e-3           #: the gap of the exact bracketed maximum (hausdorff.py's max_tolerance)
 EXACT_QUERIES = 20_000_000 #: closest-point queries per side for the exact one
 
@@ -57,15 +59,18 @@ class ErrorBound:
                 "kind": "exact" if self.exact else "estimate"}
 
 
-def estimate_error(original, result, gap: float = DEFAULT_GAP, queries: int = DEFAULT_QUERIES, *,
+def estimate_error(original, result, gap: float = DEFAULT_GAP, queries=None, *,
                    original_surface=None) -> ErrorBound:
     """Brackets the symmetric Hausdorff max between ``original`` and ``result`` (each
     ``(vertices, triangles)``, an object with both, or an engine Surface) within the relative
-    ``gap``, with at most ``queries`` closest-point queries per side (module docs).
+    ``gap``, with at most ``queries`` closest-point queries per side (default: DEFAULT_QUERIES).
     original_surface: the original's engine Surface when the caller keeps one, so that its
     closest-point index is built once for several results."""
     a = original_surface or as_surface(original, "original")
     b = as_surface(result, "result")
+    if queries is None:
+        low, high = DEFAULT_QUERIES
+        queries = min(high, max(low, (a.num_triangles + b.num_triangles) // 8))
     forward = engine.bracket_one_sided_max(a, b, tolerance=gap, max_queries=int(queries))
     backward = engine.bracket_one_sided_max(b, a, tolerance=gap, max_queries=int(queries))
     if not (forward["converged"] and backward["converged"]):  # the walk's best is not spread: add samples

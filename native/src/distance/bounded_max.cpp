@@ -11,7 +11,7 @@ namespace {
 // Nodes of at most this many triangles are bounded through their triangles' corners (the distance
 // to one triangle of the other surface is convex, so it peaks at one of them); larger ones
 // through their box's corners.
-constexpr int32_t kCornerBoundSlots = 64;
+constexpr int32_t kCornerBoundSlots = 16;
 
 struct Piece {
   double p[3][3];     // corners
