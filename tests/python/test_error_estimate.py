@@ -26,7 +26,7 @@ def grid(n: int, z=None):
     return vertices, triangles.astype(np.int32)
 
 
-@pytest.mark.parametrize("gap, queries", [(estimates.DEFAULT_GAP, None), (0.25, 40)])
+@pytest.mark.parametrize("gap, queries", [(estimates.DEFAULT_GAP, None), (0.25, 100_000), (0.25, 40)])
 def test_a_raised_vertex_is_bracketed(gap, queries):
     # One interior vertex of a flat grid raised by h: the symmetric max is exactly h (the raised
     # vertex's distance to the plane; every point of the plane is nearer the pyramid than that).
@@ -37,10 +37,10 @@ def test_a_raised_vertex_is_bracketed(gap, queries):
     bound = estimates.estimate_error(flat, raised, gap, queries)
     assert bound.estimate <= 0.07 + 1e-12
     assert bound.upper >= 0.07 - 1e-12
+    # converged with a generous budget; otherwise the bracket still holds, only wider
+    assert bound.converged or queries != 100_000
     if bound.converged:
         assert bound.upper <= bound.estimate * (1 + gap) + 1e-12
-    else:  # the query budget ran out: the bracket still holds, only wider
-        assert queries == 40
 
 
 def test_a_shifted_copy_is_bracketed_and_the_exact_bracket_is_tight():

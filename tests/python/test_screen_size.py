@@ -81,7 +81,9 @@ def test_screen_target_error_within_the_pixel_bound(tmp_path, pixels):
     assert written.num_vertices < original.num_vertices
     [lod] = entry["lods"]
     assert lod["hausdorff_pixels"] <= 1.0 and lod["screen"]["pixels"] == pixels
-    assert lod["hausdorff_pixels"] == pytest.approx(error_pixels, rel=0.05)
+    # the report's bounded estimate: a distance attained (below the denser measurement, within
+    # 10 % of it) and a guaranteed upper bound (above it)
+    assert error_pixels * 0.9 <= lod["hausdorff_pixels"] <= error_pixels * 1.01 <= lod["hausdorff_upper_pixels"] * 1.01
 
 
 def test_smaller_screen_fewer_vertices_lod_chain(tmp_path):

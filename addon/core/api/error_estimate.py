@@ -74,8 +74,8 @@ def estimate_error(original, result, gap: float = DEFAULT_GAP, queries=None, *,
     forward = engine.bracket_one_sided_max(a, b, tolerance=gap, max_queries=int(queries))
     backward = engine.bracket_one_sided_max(b, a, tolerance=gap, max_queries=int(queries))
     if not (forward["converged"] and backward["converged"]):  # the walk's best is not spread: add samples
-        forward["lower"] = max(forward["lower"], _sampled_max(original, b, queries // 2))
-        backward["lower"] = max(backward["lower"], _sampled_max(result, a, queries // 2))
+        forward["lower"] = max(forward["lower"], _sampled_max(original, b, 2 * queries))
+        backward["lower"] = max(backward["lower"], _sampled_max(result, a, 2 * queries))
     return ErrorBound(estimate=max(forward["lower"], backward["lower"]),
                       upper=max(forward["upper"], backward["upper"]),
                       forward=(forward["lower"], forward["upper"]), backward=(backward["lower"], backward["upper"]),
@@ -90,11 +90,14 @@ def exact_error(original, result, *, original_surface=None) -> ErrorBound:
 
 def _sampled_max(mesh, other, count: int) -> float:
     """Largest distance to ``other`` among about ``count`` points spread over ``mesh`` (every
-    k-th triangle's centroid, in the mesh's own order): attained, so a lower bound of the max."""
+    k-th triangle's centroid and edge midpoints, in the mesh's own order): attained, so a lower
+    bound of the max."""
     vertices, triangles = _arrays(mesh)
-    step = max(1, -(-len(triangles) // max(1, int(count))))
-    centroids = vertices[triangles[::step]].mean(axis=1)
-    return float(engine.closest_points(other, centroids)["distance"].max(initial=0.0))
+    step = max(1, -(-3 * len(triangles) // max(1, int(count))))
+    corners = vertices[triangles[::step]]
+    points = np.concatenate([corners.mean(axis=1), 0.5 * (corners[:, 0] + corners[:, 1]),
+                             0.5 * (corners[:, 1] + corners[:, 2])])
+    return float(engine.closest_points(other, points)["distance"].max(initial=0.0))
 
 
 def decide_error(original, result, bound: float, *, original_surface=None) -> ErrorBound:
