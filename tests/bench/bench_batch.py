@@ -77,7 +77,7 @@ def error_seconds(report: dict) -> float:
 #: Blender's Decimate modifier (Collapse) applied to a mesh file read with topstoc's reader
 MODIFIER_SCRIPT = """
 import sys, time, bpy
-from topstoc.core.io import read_mesh
+from topstoc.core.api.io import read_mesh
 path, ratio = sys.argv[sys.argv.index("--") + 1], float(sys.argv[-1])
 data = read_mesh(path)
 mesh = bpy.data.meshes.new("m")

@@ -230,7 +230,7 @@ def test_bake_normals_is_checked_and_mesh_files_refuse_it(tmp_path):
 def test_the_error_report_is_a_bracket_and_exact_on_request(tmp_path):
     """Default: a bounded estimate (estimate <= upper, both against an independent exact
     measurement); --exact-error: the exact bracketed max, within 0.1 %."""
-    from topstoc.core.hausdorff import hausdorff
+    from topstoc.core.api.hausdorff import hausdorff
     source = _torus(tmp_path / "in")
     lods = {}
     for flag in ((), ("--exact-error",)):

@@ -304,9 +304,9 @@ def test_error_bounded_decimation_meets_the_bound_with_a_minimal_count(data_dir,
 def test_error_bounded_search_reports_progress_and_cancels(eight):
     mesh = topstoc.Mesh(*eight)
     seen = []
-    error_bound = importlib.import_module(topstoc.__name__ + ".core.error_bound")
-    decimate = importlib.import_module(topstoc.__name__ + ".core.decimate")
-    job = importlib.import_module(topstoc.__name__ + ".core.job").make_job(mesh, max_error=0.03, relative=True, seed=9)
+    error_bound = importlib.import_module(topstoc.__name__ + ".core.api.error_bound")
+    decimate = importlib.import_module(topstoc.__name__ + ".core.api.decimate")
+    job = importlib.import_module(topstoc.__name__ + ".core.api.job").make_job(mesh, max_error=0.03, relative=True, seed=9)
     result = decimate.run_job(mesh, job, progress=lambda *args: seen.append(args))
     # one call per probe, in order, with the probe's target, output count and error
     assert [(n, vertices, error) for _, n, vertices, error, _ in seen] == result.error_bound.probes
