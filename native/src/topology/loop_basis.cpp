@@ -187,6 +187,7 @@ class LoopSelection {
     convert_edge_classes();
     collect_cycle_pieces();
     seed_roots();
+    lower_cutoff();  // the persistence cycles' pieces often span already: no tree grows unbounded
     grow_from_roots();
     // Shortest first, keep what extends the handle or the tunnel basis.
     const auto picked = pick_shortest(candidates, dim, g);
@@ -212,7 +213,8 @@ class LoopSelection {
   int64_t order = 0;
   std::vector<int32_t> roots;
   std::vector<uint8_t> is_root;
-  double cutoff = ShortestPaths::kInfinity;
+  double cutoff = ShortestPaths::kInfinity;  // no pick is longer: the larger of the two below
+  double kind_cutoff[2] = {ShortestPaths::kInfinity, ShortestPaths::kInfinity};  // per kind
 
   // Coordinates in the basis (handle cycles, tunnel cycles) tell the two subspaces apart: bits
   // 0..g-1 are the handle cycles' coefficients, g..2g-1 the tunnel cycles'. Every class below is
@@ -303,15 +305,17 @@ class LoopSelection {
     max_roots = std::min(max_roots, n);
   }
 
-  // No loop longer than `cutoff` can be chosen: the candidates found so far that are at most
-  // that long already span both subspaces, and the final pick takes loops shortest first. So
-  // each root only grows its tree to that distance and looks at the edges inside it, and longer
-  // candidates are dropped: once every handle has a root nearby, a root costs what lies near it,
-  // not the whole surface, and the selection grows about linearly with the genus.
+  // No loop of a kind longer than its cutoff can be chosen: the candidates found so far that
+  // are at most that long already span the kind's subspace, and the final pick takes loops
+  // shortest first. So each root only grows its tree to half the larger cutoff and looks at the
+  // edges inside it, and longer candidates are dropped: once every handle has a root nearby, a
+  // root costs what lies near it, not the whole surface, and the selection grows about
+  // linearly with the genus.
   void lower_cutoff() {
     const auto picked = pick_shortest(candidates, dim, g);
     if (int32_t(picked[0].size()) < g || int32_t(picked[1].size()) < g) return;
-    cutoff = std::max(picked[0].back()->length, picked[1].back()->length);
+    for (int32_t kind : {0, 1}) kind_cutoff[kind] = picked[kind].back()->length;
+    cutoff = std::max(kind_cutoff[0], kind_cutoff[1]);
     // A candidate not picked is in the span of shorter picks, now and later: only the picks
     // stay candidates, and a new one must be independent of the picks shorter than itself.
     std::vector<uint8_t> is_pick(candidates.size(), 0);
@@ -402,7 +406,7 @@ class LoopSelection {
         if (bound > cutoff) continue;
         cycle_class(prefix, a, b, e, cls);
         const int32_t kind = kind_of(cls);
-        if (kind != kNeither) local.push_back({bound, e, kind});
+        if (kind != kNeither && bound <= kind_cutoff[kind]) local.push_back({bound, e, kind});
       }
   }
 
