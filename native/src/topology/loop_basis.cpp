@@ -211,7 +211,7 @@ class LoopSelection {
   std::vector<uint64_t> edge_class;      // each edge's class in cycle coordinates, `words` words each
   std::vector<Candidate> candidates;
   int64_t order = 0;
-  std::vector<int32_t> roots;
+  std::vector<int32_t> roots, root_kind;  // the kind of the cycle a root was put on (kNeither: none)
   std::vector<uint8_t> is_root;
   double cutoff = ShortestPaths::kInfinity;  // no pick is longer: the larger of the two below
   double kind_cutoff[2] = {ShortestPaths::kInfinity, ShortestPaths::kInfinity};  // per kind
@@ -284,22 +284,24 @@ class LoopSelection {
       }
   }
 
-  void add_root(int32_t v) {
+  void add_root(int32_t v, int32_t kind) {
     if (!is_root[v]) {
       is_root[v] = 1;
       roots.push_back(v);
+      root_kind.push_back(kind);
     }
   }
 
   // Roots: spread along each persistence cycle, then farthest-point samples (grow_from_roots).
   // One root on every cycle before the second on any: the short loops of every handle appear
-  // early, so the cutoff falls early.
+  // early, so the cutoff falls early. A root on a cycle is there for loops of that cycle's kind.
   void seed_roots() {
     is_root.assign(n, 0);
-    for (const auto* c : ordered) add_root(s.edge_vertices[2 * size_t(c->generator_edge)]);
+    auto kind = [](const PersistentCycle* c) { return int32_t(c->handle ? kHandle : kTunnel); };
+    for (const auto* c : ordered) add_root(s.edge_vertices[2 * size_t(c->generator_edge)], kind(c));
     for (const auto* c : ordered) {
       const size_t k = c->edges.size();
-      for (size_t i = 1; i <= 3 && k; ++i) add_root(s.edge_vertices[2 * size_t(c->edges[(i * k) / 4 % k])]);
+      for (size_t i = 1; i <= 3 && k; ++i) add_root(s.edge_vertices[2 * size_t(c->edges[(i * k) / 4 % k])], kind(c));
     }
     if (max_roots <= 0) max_roots = 12 + 4 * dim;
     max_roots = std::min(max_roots, n);
@@ -355,8 +357,11 @@ class LoopSelection {
     BallCycles ball(s);
     for (size_t r = 0; r < roots.size() && int32_t(r) < max_roots; ++r) {
       if (progress) progress->update(double(r) / max_roots);
-      // A cycle through the root at most `cutoff` long stays within half of it from the root.
-      sp.run({roots[r]}, [](int32_t) { return true; }, [](int32_t) { return true; }, -1, cutoff / 2);
+      // A cycle through the root at most `cutoff` long stays within half of it from the root; a
+      // root on a persistence cycle looks as far as its kind's loops need (about half the work
+      // when one kind's loops are much the longer, as the tunnels through a thick part).
+      const double reach = root_kind[r] == kNeither ? cutoff : kind_cutoff[root_kind[r]];
+      sp.run({roots[r]}, [](int32_t) { return true; }, [](int32_t) { return true; }, -1, reach / 2);
       path_classes(sp, prefix, nearest_root);
       local_cycles(sp, prefix, local);
       take_local_cycles(sp, prefix, local, ball, mark);
@@ -367,7 +372,7 @@ class LoopSelection {
         int32_t far = -1;
         for (int32_t v = 0; v < n; ++v)
           if (!is_root[v] && (far < 0 || nearest_root[v] > nearest_root[far])) far = v;
-        if (far >= 0) add_root(far);
+        if (far >= 0) add_root(far, kNeither);
       }
     }
   }
