@@ -172,8 +172,8 @@ def render_loop_families(name: str, figures: dict) -> str:
            f"next to the {grid['name']} reference (CPU seconds over the grid's: the cost should follow size and "
            "genus, not the shape). Issue 39's goal: ≤ 1 s for any genus ≤ 150 mesh of ≤ 20k triangles, "
            "≤ 10 s for genus 1,000 at 1M triangles.", "", *source_lines(figures), "",
-           "| Family | Triangles | Genus (components) | Route | Wall | CPU | Selection | CPU ÷ grid |"
-           + (" Before: wall / CPU / selection | CPU speed-up |" if with_baseline else ""),
+           "| Family | Triangles | Genus (components) | Route | Wall | CPU | Selection (wall) | CPU ÷ grid |"
+           + (" Before: wall / CPU / selection (wall) | CPU speed-up |" if with_baseline else ""),
            "|---|---|---|---|---|---|---|---|" + ("---|---|" if with_baseline else "")]
     for row in rows:
         line = (f"| {row['name']} | {row['triangles']:,} | {row['genus']} ({row['components']}) | "
