@@ -217,7 +217,8 @@ def test_local_removal_is_the_whole_mesh_edit(monkeypatch):
         assert np.array_equal(getattr(local, name), getattr(whole, name)), name
     assert [p.boundary.tolist() for p in local.patches] == [p.boundary.tolist() for p in whole.patches]
     corners = local.vertices[local.triangles]
-    assert np.array_equal(editor.low, corners.min(axis=1)) and np.array_equal(editor.high, corners.max(axis=1))
+    low, high = editor.boxes()
+    assert np.array_equal(low, corners.min(axis=1)) and np.array_equal(high, corners.max(axis=1))
 
 
 def test_scanned_elephant_holes_and_handles(data_dir):

@@ -23,8 +23,22 @@ class LocalEditor:
     current mesh up to date between edits, so that finding a neighbourhood reads no mesh."""
 
     def __init__(self, vertices: np.ndarray, triangles: np.ndarray):
+        # One row per axis, with room to grow: the scan for a neighbourhood compares six
+        # contiguous rows (a tenth of the time of reducing (m, 3) arrays across their rows), and
+        # an edit's new triangles are appended in place instead of copying every box.
         corners = vertices[triangles]
-        self.low, self.high = corners.min(axis=1), corners.max(axis=1)
+        self.low, self.high = np.ascontiguousarray(corners.min(axis=1).T), np.ascontiguousarray(corners.max(axis=1).T)
+        self.count = len(triangles)
+
+    def boxes(self) -> tuple:
+        """(low, high) corners of the current triangles' boxes, (m, 3) each."""
+        return self.low[:, :self.count].T, self.high[:, :self.count].T
+
+    def _near(self, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+        """The triangles whose boxes meet [low, high]."""
+        lo, hi = self.low[:, :self.count], self.high[:, :self.count]
+        return np.flatnonzero((hi[0] >= low[0]) & (hi[1] >= low[1]) & (hi[2] >= low[2]) &
+                              (lo[0] <= high[0]) & (lo[1] <= high[1]) & (lo[2] <= high[2]))
 
     def remove_handle(self, vertices: np.ndarray, triangles: np.ndarray, loop: np.ndarray, **options) -> EditResult:
         """``edit.remove_handle(vertices, triangles, loop, **options)`` for the mesh this editor
@@ -32,7 +46,7 @@ class LocalEditor:
         points = vertices[loop]
         grow = float(np.linalg.norm(points - np.roll(points, -1, axis=0), axis=1).sum())
         low, high = points.min(axis=0) - grow, points.max(axis=0) + grow
-        near = np.flatnonzero(np.all(self.high >= low, axis=1) & np.all(self.low <= high, axis=1))
+        near = self._near(low, high)
         result = None
         if len(near) * 2 <= len(triangles):
             ids = np.unique(triangles[near])
@@ -53,10 +67,15 @@ class LocalEditor:
 
     def _update(self, result: EditResult, changed: np.ndarray, m: int) -> None:
         corners = result.vertices[result.triangles[changed]]
-        self.low[changed], self.high[changed] = corners.min(axis=1), corners.max(axis=1)
+        self.low[:, changed], self.high[:, changed] = corners.min(axis=1).T, corners.max(axis=1).T
         added = result.vertices[result.triangles[m:]]
-        self.low = np.concatenate([self.low, added.min(axis=1)])
-        self.high = np.concatenate([self.high, added.max(axis=1)])
+        end = m + len(added)
+        if end > self.low.shape[1]:  # double the room: appends cost their own size on average
+            room = max(end, 2 * self.low.shape[1])
+            self.low = np.concatenate([self.low[:, :m], np.empty((3, room - m))], axis=1)
+            self.high = np.concatenate([self.high[:, :m], np.empty((3, room - m))], axis=1)
+        self.low[:, m:end], self.high[:, m:end] = added.min(axis=1).T, added.max(axis=1).T
+        self.count = end
 
 
 def _inside(local: EditResult, n: int, m: int, low, high) -> bool:
