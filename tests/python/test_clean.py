@@ -310,9 +310,9 @@ def test_cli_lists_handles_first_and_shortens_long_lists(tmp_path):
 def test_a_round_of_local_removals_is_the_chain_of_whole_mesh_edits():
     """Several removals written in place by one LocalEditor give the arrays, maps and patches of
     the same removals done one after another on the whole mesh and composed (clean.compose)."""
-    from topstoc.core.clean import compose, identity
-    from topstoc.core.local_edit import LocalEditor
-    from topstoc.core.loops import handle_tunnel_loops
+    from topstoc.core.api.clean import compose, identity
+    from topstoc.core.api.local_edit import LocalEditor
+    from topstoc.core.api.loops import handle_tunnel_loops
 
     vertices, triangles = cleanup_meshes.block_with_arches(12, 0, jitter=0.05, seed=4)
     loops, used = [], set()
