@@ -162,6 +162,31 @@ def render_quality(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def render_loop_families(name: str, figures: dict) -> str:
+    """bench_loops.py --families --json: loops per generated family, next to the 7 x 19 grid and the baseline build."""
+    rows = figures["families"]
+    grid = rows[0]
+    with_baseline = all("baseline" in row for row in rows)
+    out = [f"## Handle and tunnel loops across shapes (`{name}`)", "",
+           f"`{figures['benchmark']}`: each family of `tests/loop_families.py` at its size and genus, "
+           f"next to the {grid['name']} reference (CPU seconds over the grid's: the cost should follow size and "
+           "genus, not the shape). Issue 39's goal: ≤ 1 s for any genus ≤ 150 mesh of ≤ 20k triangles, "
+           "≤ 10 s for genus 1,000 at 1M triangles.", "", *source_lines(figures), "",
+           "| Family | Triangles | Genus (components) | Route | Wall | CPU | Selection (wall) | CPU ÷ grid |"
+           + (" Before: wall / CPU / selection (wall) | CPU speed-up |" if with_baseline else ""),
+           "|---|---|---|---|---|---|---|---|" + ("---|---|" if with_baseline else "")]
+    for row in rows:
+        line = (f"| {row['name']} | {row['triangles']:,} | {row['genus']} ({row['components']}) | "
+                f"{'/'.join(row['routes'])} | {row['seconds']:.2f} s | {row['cpu']:.2f} s | "
+                f"{row['stages']['select']:.2f} s | {row['cpu'] / grid['cpu']:.2f} |")
+        if with_baseline:
+            before = row["baseline"]
+            line += (f" {before['seconds']:.2f} / {before['cpu']:.2f} / {before['stages']['select']:.2f} s | "
+                     f"{before['cpu'] / row['cpu']:.1f}× |")
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
 def render_carried_over(name: str, figures: dict) -> str:
     """Figures measured before the benchmarks saved JSON, kept as they were published."""
     out = [f"## {figures['title']} (`{name}`)", "", *source_lines(figures), "", figures["note"], "",
@@ -178,8 +203,10 @@ def render_result(path: pathlib.Path) -> str:
         return render_decimate(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_quality.py":
         return render_quality(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_loops.py --families":
+        return render_loop_families(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
-                     "the --json of bench_decimate.py and bench_quality.py, and carried-over figures)")
+                     "the --json of bench_decimate.py, bench_quality.py and bench_loops.py --families, and carried-over figures)")
 
 
 def render() -> str:

@@ -2,6 +2,15 @@
 """Handle and tunnel loops on large genus >= 10 meshes, time per stage (issue 5 benchmark).
 
     /usr/bin/python3 tests/bench/bench_loops.py [--repeats 3] [--peer] [--verify] [--only NAME]
+    /usr/bin/python3 tests/bench/bench_loops.py --families [--big] [--baseline DIR] [--json FILE]
+
+--families (issue 39): the generated families of tests/loop_families.py (plates with irregular
+holes, Swiss-cheese balls, lattices, Schwarz-P and gyroid surfaces, knotted and linked tubes),
+time per family against its size and genus next to the 7 x 19 hole grid, wall and CPU seconds
+(medians of --repeats; the wall clock also measures the neighbours on a shared machine); --big
+adds the 1M-triangle member of genus 1,000 (one run). --baseline DIR times the same meshes with
+another build's package (say, main's build/python) in a child process of the same run: the
+before and after of a change. --json FILE saves the figures for scripts/benchmarks_md.py.
 
 Meshes (made here with ../shared/tools/loop_subdiv.py into build/bench_meshes, never committed;
 skips cleanly when ../shared is absent):
@@ -22,6 +31,7 @@ span the outside, tunnels the reverse, all span the surface).
 """
 
 import argparse
+import json
 import os
 import resource
 import pathlib
@@ -33,7 +43,8 @@ import time
 import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "build" / "python"))
+BUILD = os.environ.get("TOPSTOC_BENCH_BUILD", str(ROOT / "build" / "python"))  # --baseline's child sets it
+sys.path.insert(0, BUILD)
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "tests" / "bench"))
 
@@ -74,10 +85,16 @@ def make(name: str, base: str, levels: int) -> pathlib.Path:
     return path
 
 
+def cpu_seconds() -> float:
+    """CPU time of this process and its finished children (TetGen runs in a forked child)."""
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + children.ru_utime + children.ru_stime
+
+
 def timed(function):
-    wall, cpu = time.perf_counter(), time.process_time()
+    wall, cpu = time.perf_counter(), cpu_seconds()
     value = function()
-    return value, time.perf_counter() - wall, time.process_time() - cpu
+    return value, time.perf_counter() - wall, cpu_seconds() - cpu
 
 
 def verify(data, component) -> str:
@@ -103,14 +120,82 @@ def verify(data, component) -> str:
     return "all checks pass" if not failed else "FAILED: " + ", ".join(failed)
 
 
+STAGES = ["prepare", "decimate", "self_intersections", "tetrahedralize", "persistence", "select", "map", "shorten",
+          "verify"]
+
+
+def time_family(name: str, repeats: int) -> dict:
+    """One family member: its size, genus and the medians of `repeats` runs of the loops."""
+    import loop_families
+
+    vertices, triangles = {**loop_families.FAMILIES, **loop_families.BIG_FAMILIES}[name]()
+    runs = [timed(lambda: handle_tunnel_loops(vertices, triangles)) for _ in range(repeats)]
+    result = runs[-1][0]
+    return {"name": name, "triangles": len(triangles), "components": len(result.components),
+            "genus": sum(c.genus or 0 for c in result.components),
+            "routes": sorted({c.route for c in result.components if c.route}),
+            "seconds": statistics.median(r[1] for r in runs), "cpu": statistics.median(r[2] for r in runs),
+            "stages": {k: statistics.median(r[0].seconds[k] for r in runs) for k in STAGES}}
+
+
+def baseline(build: str, name: str, repeats: int) -> dict:
+    """time_family with another build's package, in a child process."""
+    out = subprocess.run([sys.executable, __file__, "--child", name, "--repeats", str(repeats)], check=True,
+                         capture_output=True, text=True, env={**os.environ, "TOPSTOC_BENCH_BUILD": build})
+    return json.loads(out.stdout.splitlines()[-1])
+
+
+def families(args) -> int:
+    import loop_families
+
+    names = list(loop_families.FAMILIES) + (list(loop_families.BIG_FAMILIES) if args.big else [])
+    print(f"machine: {machine()}")
+    rows = []
+    for name in names:
+        repeats = 1 if name in loop_families.BIG_FAMILIES else args.repeats
+        row = time_family(name, repeats)
+        if args.baseline:
+            before = baseline(args.baseline, name, repeats)
+            row["baseline"] = {k: before[k] for k in ("seconds", "cpu", "stages")}
+        rows.append(row)
+        grid = rows[0]
+        was = (f"; before {row['baseline']['seconds']:.2f} s (CPU {row['baseline']['cpu']:.2f} s, select "
+               f"{row['baseline']['stages']['select']:.2f} s)") if args.baseline else ""
+        print(f"{name}: {row['triangles']:,} triangles, genus {row['genus']} in {row['components']} component(s), "
+              f"{'/'.join(row['routes'])} route: {row['seconds']:.2f} s (CPU {row['cpu']:.2f} s, select "
+              f"{row['stages']['select']:.2f} s), {row['cpu'] / grid['cpu']:.2f}x the grid's CPU{was}", flush=True)
+    if args.json:
+        figures = {"benchmark": "tests/bench/bench_loops.py --families", "machine": machine(),
+                   "date": time.strftime("%Y-%m-%d"), "repeats": args.repeats,
+                   "method": "handle_tunnel_loops(vertices, triangles) per family member (tests/loop_families.py), "
+                             "wall and CPU seconds, medians of the repeats (one run at 1M triangles); "
+                             + ("the baseline is " + args.baseline + " timed in a child process of the same run"
+                                if args.baseline else "no baseline"),
+                   "families": rows}
+        temporary = pathlib.Path(args.json + ".tmp")
+        temporary.write_text(json.dumps(figures, indent=1) + "\n")
+        temporary.replace(args.json)
+    return 0
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--families", action="store_true", help="time the generated families (issue 39)")
+    parser.add_argument("--big", action="store_true", help="with --families: also the 1M-triangle member")
+    parser.add_argument("--baseline", help="with --families: another build's python directory, timed alongside")
+    parser.add_argument("--json", help="with --families: save the figures here")
+    parser.add_argument("--child", help=argparse.SUPPRESS)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--peer", action="store_true", help="also time the full route on the ~100k meshes")
     parser.add_argument("--peer-big", action="store_true", help="also time the full route on the ~1M meshes")
     parser.add_argument("--verify", action="store_true", help="check the loops on the full tetrahedralization")
     parser.add_argument("--only", help="run only this case")
     args = parser.parse_args()
+    if args.child:
+        print(json.dumps(time_family(args.child, args.repeats)))
+        return 0
+    if args.families:
+        return families(args)
     if not (SHARED / "tools" / "loop_subdiv.py").exists():
         print(f"skipped: {SHARED / 'tools'} not found (the benchmark meshes are made from ../shared)")
         return 0

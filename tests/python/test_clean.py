@@ -211,13 +211,15 @@ def test_local_removal_is_the_whole_mesh_edit(monkeypatch):
         return original(v, t, *args, **kwargs)
 
     monkeypatch.setattr(local_edit.edit, "remove_handle", recording)
-    local = editor.remove_handle(vertices, triangles, loop, refine=True, fair=True)
+    editor.remove_handle(loop, 0, refine=True, fair=True)
+    local = editor.result()
     assert len(sizes) == 1 and sizes[0] < len(triangles) / 4  # edited on a neighbourhood
     for name in ("vertices", "triangles", "vertex_source", "face_source", "corner_source"):
         assert np.array_equal(getattr(local, name), getattr(whole, name)), name
     assert [p.boundary.tolist() for p in local.patches] == [p.boundary.tolist() for p in whole.patches]
     corners = local.vertices[local.triangles]
-    assert np.array_equal(editor.low, corners.min(axis=1)) and np.array_equal(editor.high, corners.max(axis=1))
+    low, high = editor.boxes()
+    assert np.array_equal(low, corners.min(axis=1)) and np.array_equal(high, corners.max(axis=1))
 
 
 def test_scanned_elephant_holes_and_handles(data_dir):
@@ -303,3 +305,32 @@ def test_cli_lists_handles_first_and_shortens_long_lists(tmp_path):
     assert len(items) == SHOWN and items[0].startswith("  left hole")  # the large holes come before the filled
     # SHOWN + 10 filled, 3 left (the large hole, the plate's edge, the open component): 13 not shown
     assert done.stdout.splitlines()[-1] == "  ... and 13 more (--json lists every one)"
+
+
+def test_a_round_of_local_removals_is_the_chain_of_whole_mesh_edits():
+    """Several removals written in place by one LocalEditor give the arrays, maps and patches of
+    the same removals done one after another on the whole mesh and composed (clean.compose)."""
+    from topstoc.core.api.clean import compose, identity
+    from topstoc.core.api.local_edit import LocalEditor
+    from topstoc.core.api.loops import handle_tunnel_loops
+
+    vertices, triangles = cleanup_meshes.block_with_arches(12, 0, jitter=0.05, seed=4)
+    loops, used = [], set()
+    for loop in sorted(handle_tunnel_loops(vertices, triangles).handles, key=lambda loop: loop.length):
+        if not used & set(loop.vertices.tolist()):
+            loops.append(loop.vertices)
+            used |= set(loop.vertices.tolist())
+    assert len(loops) >= 4
+    editor = LocalEditor(vertices, triangles)
+    chain = identity(vertices, triangles)
+    for tag, loop in enumerate(loops):
+        editor.remove_handle(loop, tag, refine=True, fair=True)
+        chain = compose(chain, edit.remove_handle(chain.vertices, chain.triangles, loop, refine=True, fair=True), tag)
+    local = editor.result()
+    for name in ("vertices", "triangles", "vertex_source", "face_source", "corner_source"):
+        assert np.array_equal(getattr(local, name), getattr(chain, name)), name
+    assert [(p.hole, p.boundary.tolist(), p.triangles, p.vertices) for p in local.patches] == \
+        [(p.hole, p.boundary.tolist(), p.triangles, p.vertices) for p in chain.patches]
+    low, high = editor.boxes()
+    corners = local.vertices[local.triangles]
+    assert np.array_equal(low, corners.min(axis=1)) and np.array_equal(high, corners.max(axis=1))

@@ -34,7 +34,7 @@ import numpy as np
 from . import edit
 from .edit import EditResult, Patch
 from ..support.errors import TopStocError
-from .local_edit import LocalEditor
+from .local_edit import LocalEditor, through
 from .mesh import as_vertices
 
 #: Default size of a small handle or hole, as a fraction of the bounding box's diagonal.
@@ -184,14 +184,6 @@ def identity(vertices: np.ndarray, triangles: np.ndarray) -> EditResult:
                       input_vertices=n, input_triangles=m)
 
 
-def _through(first: np.ndarray, second: np.ndarray) -> np.ndarray:
-    """first[second] where second >= 0, else -1."""
-    out = np.full(second.shape, -1, dtype=np.int32)
-    valid = second >= 0
-    out[valid] = first[second[valid]]
-    return out
-
-
 def compose(first: EditResult, second: EditResult, tag: Optional[int] = None) -> EditResult:
     """``second`` (an edit of ``first``'s result) with its maps taken back to ``first``'s input.
 
@@ -204,9 +196,9 @@ def compose(first: EditResult, second: EditResult, tag: Optional[int] = None) ->
         raise TopStocError("internal: a clean-up step renumbered the vertices")
     patches = list(first.patches) + [p if tag is None else dataclasses.replace(p, hole=tag) for p in second.patches]
     return EditResult(vertices=second.vertices, triangles=second.triangles,
-                      vertex_source=_through(first.vertex_source, second.vertex_source),
-                      face_source=_through(first.face_source, second.face_source),
-                      corner_source=_through(first.corner_source.reshape(-1), second.corner_source),
+                      vertex_source=through(first.vertex_source, second.vertex_source),
+                      face_source=through(first.face_source, second.face_source),
+                      corner_source=through(first.corner_source.reshape(-1), second.corner_source),
                       input_vertices=first.input_vertices, input_triangles=first.input_triangles,
                       patches=patches)
 
@@ -400,7 +392,7 @@ def _removal_round(state: EditResult, found, size: float, budget: int, fair: boo
     """Removes up to ``budget`` loops below ``size``, shortest first, no two sharing a vertex."""
     candidates = sorted((loop for c in found.components if c.status == "ok" for loop in c.loops),
                         key=lambda loop: (loop.length, loop.kind))
-    used = np.zeros(state.num_vertices, dtype=bool)
+    used = np.zeros(state.num_vertices, dtype=bool)  # loops are in the round's first ids, kept by every edit
     count, stale = 0, {}
     editor = LocalEditor(state.vertices, state.triangles)
     for loop in candidates:
@@ -410,27 +402,27 @@ def _removal_round(state: EditResult, found, size: float, budget: int, fair: boo
         key = frozenset(ids.tolist())
         if used[ids].any() or key in failed:
             continue
+        tag = len(removed)
         try:
-            step, style = _remove_one(editor, state, ids, fair)
+            patches, style = _remove_one(editor, ids, tag, fair)
         except ValueError as error:
             # A loop that now separates was made redundant by a removal earlier in this round;
             # the next round's loops settle it. Anything else is this loop's own failure.
             (stale if "separates" in str(error) else failed)[key] = str(error).splitlines()[0]
             continue
         used[ids] = True
-        area, aspect = patch_quality(step.vertices, step.triangles, step.patches)
-        tag = len(removed)
+        area, aspect = patch_quality(editor.vertices.view(), editor.triangles.view(), patches)
         removed.append(Removed(loop.kind, float(loop.length), len(ids), area, aspect,
                                state.vertex_source[ids].astype(np.int32), style))
-        state = compose(state, step, tag)
-        used = np.concatenate([used, np.zeros(state.num_vertices - len(used), dtype=bool)])
         count += 1
+    if count:
+        state = compose(state, editor.result())
     if count == 0:
         failed.update(stale)  # nothing else changed: these loops separate on their own
     return state, count
 
 
-def _remove_one(editor: LocalEditor, state: EditResult, ids: np.ndarray, fair: bool) -> tuple:
+def _remove_one(editor: LocalEditor, ids: np.ndarray, tag: int, fair: bool) -> tuple:
     """remove_handle with the best patches that do not make the surface cross itself: faired,
     else refined but flat, else flat. A faired cap continues the tube it closes, so the two caps
     of a thick handle bulge towards each other and can cross; flat ones do not."""
@@ -438,7 +430,7 @@ def _remove_one(editor: LocalEditor, state: EditResult, ids: np.ndarray, fair: b
         (("flat", False, False),)
     for number, (style, refine, fair_patch) in enumerate(styles):
         try:
-            return editor.remove_handle(state.vertices, state.triangles, ids, refine=refine, fair=fair_patch), style
+            return editor.remove_handle(ids, tag, refine=refine, fair=fair_patch), style
         except ValueError as error:
             if number + 1 == len(styles) or "intersect itself" not in str(error):
                 raise

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "topology/ball_cycles.hpp"
 #include "topology/shortest_paths.hpp"
 
 namespace topstoc {
@@ -107,6 +108,47 @@ std::vector<int32_t> match(const std::vector<std::vector<uint8_t>>& coefficient)
   return cycle_of_loop;
 }
 
+// A basis in echelon form (rows by their top bit) that only answers "independent?": the global
+// pick tests thousands of candidates and needs neither the combinations nor the sources that
+// Z2Basis keeps. Rows keep their insertion order, so it also answers "in the span of the first
+// k rows?".
+class Span {
+ public:
+  explicit Span(int32_t dim) : words_((dim + 63) / 64), pivot_(dim, -1), x_(words_) {}
+  int32_t rank() const { return int32_t(rows_.size() / std::max(words_, 1)); }
+  /// Adds v when it is independent of the rows; returns whether it was.
+  bool insert(const Z2Vector& v) {
+    if (reduce(v, rank())) return false;
+    pivot_[top_] = rank();
+    rows_.insert(rows_.end(), x_.begin(), x_.end());
+    return true;
+  }
+  /// Whether v lies in the span of the first k rows.
+  bool spans(const Z2Vector& v, int32_t k) { return reduce(v, k); }
+
+ private:
+  // v reduced by the first k rows into x_ (its top bit into top_); true when that leaves zero.
+  // Rows have distinct top bits, so a top bit without such a row means v is outside the span.
+  bool reduce(const Z2Vector& v, int32_t k) {
+    std::copy(v.words.begin(), v.words.end(), x_.begin());
+    for (int32_t w = words_ - 1; w >= 0;) {
+      if (!x_[w]) {
+        --w;
+        continue;
+      }
+      top_ = 64 * w + 63 - __builtin_clzll(x_[w]);
+      if (pivot_[top_] < 0 || pivot_[top_] >= k) return false;
+      const uint64_t* row = &rows_[size_t(words_) * pivot_[top_]];
+      for (int32_t j = 0; j <= w; ++j) x_[j] ^= row[j];
+    }
+    return true;
+  }
+
+  int32_t words_, top_ = -1;
+  std::vector<int32_t> pivot_;
+  std::vector<uint64_t> rows_, x_;
+};
+
 // Sorts the candidates shortest first and takes, per kind, those that extend the kind's basis
 // (a matroid greedy: the result is a shortest basis among the candidates). Returns the picks
 // per kind; both have g entries when the candidates span both subspaces.
@@ -114,7 +156,7 @@ std::array<std::vector<const Candidate*>, 2> pick_shortest(std::vector<Candidate
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
     return std::tie(x.length, x.order) < std::tie(y.length, y.order);
   });
-  Z2Basis chosen[2] = {Z2Basis(dim), Z2Basis(dim)};
+  Span chosen[2] = {Span(dim), Span(dim)};
   std::array<std::vector<const Candidate*>, 2> picked;
   for (const auto& c : candidates) {
     if (chosen[c.kind].rank() < g && chosen[c.kind].insert(c.cls)) picked[c.kind].push_back(&c);
@@ -145,6 +187,7 @@ class LoopSelection {
     convert_edge_classes();
     collect_cycle_pieces();
     seed_roots();
+    lower_cutoff();  // the persistence cycles' pieces often span already: no tree grows unbounded
     grow_from_roots();
     // Shortest first, keep what extends the handle or the tunnel basis.
     const auto picked = pick_shortest(candidates, dim, g);
@@ -168,9 +211,10 @@ class LoopSelection {
   std::vector<uint64_t> edge_class;      // each edge's class in cycle coordinates, `words` words each
   std::vector<Candidate> candidates;
   int64_t order = 0;
-  std::vector<int32_t> roots;
+  std::vector<int32_t> roots, root_kind;  // the kind of the cycle a root was put on (kNeither: none)
   std::vector<uint8_t> is_root;
-  double cutoff = ShortestPaths::kInfinity;
+  double cutoff = ShortestPaths::kInfinity;  // no pick is longer: the larger of the two below
+  double kind_cutoff[2] = {ShortestPaths::kInfinity, ShortestPaths::kInfinity};  // per kind
 
   // Coordinates in the basis (handle cycles, tunnel cycles) tell the two subspaces apart: bits
   // 0..g-1 are the handle cycles' coefficients, g..2g-1 the tunnel cycles'. Every class below is
@@ -240,38 +284,67 @@ class LoopSelection {
       }
   }
 
-  void add_root(int32_t v) {
+  void add_root(int32_t v, int32_t kind) {
     if (!is_root[v]) {
       is_root[v] = 1;
       roots.push_back(v);
+      root_kind.push_back(kind);
     }
   }
 
   // Roots: spread along each persistence cycle, then farthest-point samples (grow_from_roots).
   // One root on every cycle before the second on any: the short loops of every handle appear
-  // early, so the cutoff falls early.
+  // early, so the cutoff falls early. A root on a cycle is there for loops of that cycle's kind.
   void seed_roots() {
     is_root.assign(n, 0);
-    for (const auto* c : ordered) add_root(s.edge_vertices[2 * size_t(c->generator_edge)]);
+    auto kind = [](const PersistentCycle* c) { return int32_t(c->handle ? kHandle : kTunnel); };
+    for (const auto* c : ordered) add_root(s.edge_vertices[2 * size_t(c->generator_edge)], kind(c));
     for (const auto* c : ordered) {
       const size_t k = c->edges.size();
-      for (size_t i = 1; i <= 3 && k; ++i) add_root(s.edge_vertices[2 * size_t(c->edges[(i * k) / 4 % k])]);
+      for (size_t i = 1; i <= 3 && k; ++i) add_root(s.edge_vertices[2 * size_t(c->edges[(i * k) / 4 % k])], kind(c));
     }
     if (max_roots <= 0) max_roots = 12 + 4 * dim;
     max_roots = std::min(max_roots, n);
   }
 
-  // No loop longer than `cutoff` can be chosen: the candidates found so far that are at most
-  // that long already span both subspaces, and the final pick takes loops shortest first. So
-  // each root only grows its tree to that distance and looks at the edges inside it, and longer
-  // candidates are dropped: once every handle has a root nearby, a root costs what lies near it,
-  // not the whole surface, and the selection grows about linearly with the genus.
+  // No loop of a kind longer than its cutoff can be chosen: the candidates found so far that
+  // are at most that long already span the kind's subspace, and the final pick takes loops
+  // shortest first. So each root only grows its tree to half the larger cutoff and looks at the
+  // edges inside it, and longer candidates are dropped: once every handle has a root nearby, a
+  // root costs what lies near it, not the whole surface, and the selection grows about
+  // linearly with the genus.
   void lower_cutoff() {
     const auto picked = pick_shortest(candidates, dim, g);
     if (int32_t(picked[0].size()) < g || int32_t(picked[1].size()) < g) return;
-    cutoff = std::max(picked[0].back()->length, picked[1].back()->length);
-    while (!candidates.empty() && candidates.back().length > cutoff) candidates.pop_back();
+    for (int32_t kind : {0, 1}) kind_cutoff[kind] = picked[kind].back()->length;
+    cutoff = std::max(kind_cutoff[0], kind_cutoff[1]);
+    // A candidate not picked is in the span of shorter picks, now and later: only the picks
+    // stay candidates, and a new one must be independent of the picks shorter than itself.
+    std::vector<uint8_t> is_pick(candidates.size(), 0);
+    for (const auto& kind : picked)
+      for (const Candidate* c : kind) is_pick[c - candidates.data()] = 1;
+    std::vector<Candidate> kept;
+    for (size_t i = 0; i < candidates.size(); ++i)
+      if (is_pick[i]) kept.push_back(std::move(candidates[i]));
+    candidates = std::move(kept);
+    for (int32_t kind : {0, 1}) {
+      shorter_picks[kind] = Span(dim);
+      pick_lengths[kind].clear();
+    }
+    for (const auto& c : candidates) {  // shortest first
+      shorter_picks[c.kind].insert(c.cls);
+      pick_lengths[c.kind].push_back(c.length);
+    }
   }
+
+  // Whether a cycle of this kind, class and length is in the span of shorter picks (never picked).
+  bool spanned_by_shorter(int32_t kind, const Z2Vector& cls, double length) {
+    const auto& lengths = pick_lengths[kind];
+    const int32_t k = int32_t(std::lower_bound(lengths.begin(), lengths.end(), length) - lengths.begin());
+    return k > 0 && shorter_picks[kind].spans(cls, k);
+  }
+  Span shorter_picks[2] = {Span(0), Span(0)};
+  std::vector<double> pick_lengths[2];
 
   // Per root: a shortest-path tree to the cutoff, the classes of its paths, and the
   // fundamental cycles of its non-tree edges that extend a kind's basis.
@@ -281,12 +354,17 @@ class LoopSelection {
     std::vector<double> nearest_root(n, ShortestPaths::kInfinity);
     std::vector<uint32_t> mark(n, 0);
     std::vector<LocalCycle> local;
+    BallCycles ball(s);
     for (size_t r = 0; r < roots.size() && int32_t(r) < max_roots; ++r) {
       if (progress) progress->update(double(r) / max_roots);
-      sp.run({roots[r]}, [](int32_t) { return true; }, [](int32_t) { return true; }, -1, cutoff);
+      // A cycle through the root at most `cutoff` long stays within half of it from the root; a
+      // root on a persistence cycle looks as far as its kind's loops need (about half the work
+      // when one kind's loops are much the longer, as the tunnels through a thick part).
+      const double reach = root_kind[r] == kNeither ? cutoff : kind_cutoff[root_kind[r]];
+      sp.run({roots[r]}, [](int32_t) { return true; }, [](int32_t) { return true; }, -1, reach / 2);
       path_classes(sp, prefix, nearest_root);
       local_cycles(sp, prefix, local);
-      take_local_cycles(sp, prefix, local, mark);
+      take_local_cycles(sp, prefix, local, ball, mark);
       // Often enough to follow the cutoff down, rarely enough that the picks cost little.
       if ((r & (r + 1)) == 0 || r % 64 == 63) lower_cutoff();
       // Next root: the persistence-cycle roots first, then the vertex farthest from all roots.
@@ -294,7 +372,7 @@ class LoopSelection {
         int32_t far = -1;
         for (int32_t v = 0; v < n; ++v)
           if (!is_root[v] && (far < 0 || nearest_root[v] > nearest_root[far])) far = v;
-        if (far >= 0) add_root(far);
+        if (far >= 0) add_root(far, kNeither);
       }
     }
   }
@@ -321,7 +399,7 @@ class LoopSelection {
   }
 
   // Fundamental cycles of the non-tree edges between settled vertices within the cutoff, of
-  // one kind, as a heap shortest (through the root) first.
+  // one kind.
   void local_cycles(const ShortestPaths& sp, const std::vector<uint64_t>& prefix, std::vector<LocalCycle>& local) const {
     local.clear();
     Z2Vector cls(dim);
@@ -333,34 +411,36 @@ class LoopSelection {
         if (bound > cutoff) continue;
         cycle_class(prefix, a, b, e, cls);
         const int32_t kind = kind_of(cls);
-        if (kind != kNeither) local.push_back({bound, e, kind});
+        if (kind != kNeither && bound <= kind_cutoff[kind]) local.push_back({bound, e, kind});
       }
-    std::make_heap(local.begin(), local.end(), later);
   }
 
-  // Taken shortest first from a heap: the loop usually stops long before the end, so a full
-  // sort of every non-tree edge per root would be wasted (same order: the key is total).
-  static bool later(const LocalCycle& x, const LocalCycle& y) { return std::tie(x.bound, x.edge) > std::tie(y.bound, y.edge); }
-
-  // Adds as candidates the local cycles that extend their kind's basis at this root.
+  // Adds as candidates the local cycles that extend their kind's basis of the shorter ones at
+  // this root (shortest through the root first, ties by edge), found by union-find on the ball.
   void take_local_cycles(const ShortestPaths& sp, const std::vector<uint64_t>& prefix, std::vector<LocalCycle>& local,
-                         std::vector<uint32_t>& mark) {
-    Z2Basis kept[2] = {Z2Basis(dim), Z2Basis(dim)};
+                         BallCycles& ball, std::vector<uint32_t>& mark) {
+    std::sort(local.begin(), local.end(),
+              [](const LocalCycle& x, const LocalCycle& y) { return std::tie(x.bound, x.edge) < std::tie(y.bound, y.edge); });
+    std::vector<int32_t> edges;
+    std::vector<int8_t> group;
+    for (const auto& c : local) edges.push_back(c.edge), group.push_back(int8_t(c.kind));
+    ball.start(sp, edges, group);
+    std::vector<uint8_t> keep;
     Z2Vector cls(dim);
-    while (!local.empty()) {
-      std::pop_heap(local.begin(), local.end(), later);
-      const LocalCycle c = local.back();
-      local.pop_back();
-      if (kept[c.kind].rank() == g) {
-        if (kept[1 - c.kind].rank() == g) break;
-        continue;
+    for (int32_t kind : {int32_t(kHandle), int32_t(kTunnel)}) {
+      edges.clear();
+      for (const auto& c : local)
+        if (c.kind == kind) edges.push_back(c.edge);
+      ball.independent(int8_t(kind), edges, keep);
+      for (size_t i = 0; i < edges.size(); ++i) {
+        if (!keep[i]) continue;
+        const int32_t a = s.edge_vertices[2 * size_t(edges[i])], b = s.edge_vertices[2 * size_t(edges[i]) + 1];
+        cycle_class(prefix, a, b, edges[i], cls);
+        auto loop = tree_cycle(sp, a, b, mark);
+        const double length = loop_length(s, loop, weight);
+        if (spanned_by_shorter(kind, cls, length)) continue;
+        candidates.push_back({length, kind, order++, std::move(loop), cls});
       }
-      const int32_t a = s.edge_vertices[2 * size_t(c.edge)], b = s.edge_vertices[2 * size_t(c.edge) + 1];
-      cycle_class(prefix, a, b, c.edge, cls);
-      if (!kept[c.kind].insert(cls)) continue;
-      auto loop = tree_cycle(sp, a, b, mark);
-      const double length = loop_length(s, loop, weight);
-      candidates.push_back({length, c.kind, order++, std::move(loop), cls});
     }
   }
 

@@ -10,6 +10,12 @@
 // when its class lies in the handle (tunnel) subspace and is independent of the loops kept so
 // far. Every kept loop is a simple closed edge cycle.
 //
+// The cost follows the size and the genus, not the shape: once the candidates span both
+// subspaces, the longest loop they need (the cutoff) bounds every tree to half of it around its
+// root; within a tree, the cycles independent of its shorter ones come from union-find on the
+// faces (ball_cycles.hpp), not from eliminating their classes; and a new candidate is dropped
+// when the picks shorter than it already span its class, so the candidates stay about 2g.
+//
 // Each loop is then matched to a persistence generator edge: writing the kept handle loops in
 // the basis of the handle cycles gives an invertible matrix, whose non-zero diagonal under some
 // permutation pairs each loop with the generator of a cycle it contains.
