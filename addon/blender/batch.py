@@ -223,6 +223,7 @@ def decimate_scene_file(path: str, out_dir: str, settings: dict) -> dict:
     else:
         scene_io.import_file(path)
     objects = _mesh_objects(bpy, path, settings["objects"])
+    cleaned = _clean_objects(objects, settings["clean"]) if "clean" in settings else {}
     stem, _ = os.path.splitext(os.path.basename(path))
     settings = dict(settings, bake_folder=out_dir, bake_stem=stem)
     asset = _world_vertices(objects)
@@ -234,6 +235,8 @@ def decimate_scene_file(path: str, out_dir: str, settings: dict) -> dict:
             continue
         done.add(obj.data.name)
         entry, lod_objects = _decimate_object(bpy, pipeline, obj, settings, targets)
+        if obj.data.name in cleaned:  # counts in: the mesh before its clean-up
+            entry["vertices_in"], entry["clean"] = cleaned[obj.data.name]
         entries.append(entry)
         if settings["chain"]:
             sources.append(obj)
@@ -260,6 +263,24 @@ def decimate_scene_file(path: str, out_dir: str, settings: dict) -> dict:
             "vertices_out": sum(e["vertices_out"] for e in entries),
             "triangles_out": sum(e["triangles_out"] for e in entries),
             "seconds": sum(e["seconds"] for e in entries), "error": None, "objects": entries}
+
+
+def _clean_objects(objects, kwargs: dict) -> dict:
+    """Cleans each mesh as ``topstoc clean`` does (a shared mesh once), in place, attributes
+    carried over; returns (vertices before, CleanResult.as_json) by mesh name."""
+    from ..core.api.clean import clean
+    from .io import mesh_edit, mesh_read
+
+    reports = {}
+    for obj in objects:
+        if obj.data.name in reports:
+            continue
+        name = obj.data.name
+        arrays = mesh_read.read_mesh(obj.data)
+        result = clean(arrays.vertices, arrays.triangles, **kwargs)
+        mesh_edit.apply_edit(obj, arrays, result.edit)
+        reports[name] = (len(arrays.vertices), result.as_json())
+    return reports
 
 
 def _register_addon() -> None:

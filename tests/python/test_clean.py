@@ -334,3 +334,39 @@ def test_a_round_of_local_removals_is_the_chain_of_whole_mesh_edits():
     low, high = editor.boxes()
     corners = local.vertices[local.triangles]
     assert np.array_equal(low, corners.min(axis=1)) and np.array_equal(high, corners.max(axis=1))
+
+
+def test_a_non_manifold_component_is_left_and_the_others_cleaned():
+    """One non-manifold component used to stop the loops of the whole mesh (no handle removed
+    anywhere); now it is reported and left bit for bit, and the other component is cleaned."""
+    from topstoc.core.api.component_loops import loops_by_component
+    from topstoc.core.api.loops import handle_tunnel_loops
+
+    block, block_triangles = cleanup_meshes.block_with_arches(2, 0, jitter=0.05, seed=5)
+    fin, fin_triangles = meshgen.tetrahedra_sharing_edge()  # four triangles on one edge
+    n, m = len(block), len(block_triangles)
+    vertices = np.vstack([block, fin + [0.0, 0.0, 20.0]])
+    triangles = np.vstack([block_triangles, fin_triangles + n]).astype(np.int32)
+    with pytest.raises(ValueError, match="non-manifold"):
+        handle_tunnel_loops(vertices, triangles)
+
+    found = loops_by_component(vertices, triangles)
+    assert [c.status for c in found.components] == ["ok", "refused"]
+    assert "edge 0-1" not in found.components[1].detail and f"edge {n}-{n + 1}" in found.components[1].detail
+    alone = handle_tunnel_loops(block, block_triangles)  # the block's loops, in its own ids = the whole's
+    assert [loop.vertices.tolist() for loop in found.components[0].loops] == \
+        [loop.vertices.tolist() for loop in alone.components[0].loops]
+
+    result = clean(vertices, triangles, max_handle=6.0)
+    assert result.count("handle") + result.count("tunnel") == 2 and result.count("hole") == 0
+    e = result.edit
+    cleaned_block = np.isin(e.face_source, np.arange(m)) | (e.face_source < 0)
+    assert genus(e.vertices, e.triangles[cleaned_block]) == 0
+    [left] = result.left
+    assert left.kind == "component" and left.vertices.tolist() == [n]
+    assert left.reason.startswith("component 1 left as is: non-manifold: 1 edges have three or more triangles")
+    # The fin: the same triangles on the same vertex ids, at the same positions bit for bit.
+    rows = np.flatnonzero(e.face_source >= m)
+    assert np.array_equal(e.face_source[rows], np.arange(m, m + len(fin_triangles)))
+    assert np.array_equal(e.triangles[rows], triangles[m:])
+    assert e.vertices[n:n + len(fin)].tobytes() == vertices[n:].tobytes()

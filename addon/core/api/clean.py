@@ -360,7 +360,7 @@ def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional
                           max_rounds: int, removed: list, left: list, seconds: dict) -> tuple:
     """Rounds of loop computation and removal (module docstring); returns (state, rounds).
     Adds the time spent computing loops to ``seconds["loops"]``."""
-    from .loops import handle_tunnel_loops
+    from .component_loops import loops_by_component
 
     if state.num_triangles == 0:
         return state, 0
@@ -369,7 +369,7 @@ def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional
     while True:
         started = time.perf_counter()
         try:
-            found = handle_tunnel_loops(state.vertices, state.triangles)
+            found = loops_by_component(state.vertices, state.triangles)  # a bad component spoils no other
         except ValueError as error:
             left.append(Left("component", 0.0, f"handle and tunnel loops not computed: {error}",
                              np.zeros(0, np.int32)))
@@ -440,9 +440,13 @@ def _remove_one(editor: LocalEditor, ids: np.ndarray, tag: int, fair: bool) -> t
 def _report_left(state: EditResult, found, size: float, keep_largest: Optional[int], failed: dict,
                  left: list) -> None:
     """One entry per loop still there (each handle has a handle and a tunnel loop) saying why."""
-    for component in found.components:
+    from .component_loops import REFUSED
+
+    for number, component in enumerate(found.components):
         if component.status != "ok":
-            left.append(Left("component", 0.0, f"loops undefined ({component.status}): {component.detail}",
+            why = component.detail if component.status == REFUSED else \
+                f"loops undefined ({component.status}): {component.detail}"
+            left.append(Left("component", 0.0, f"component {number} left as is: {why}",
                              np.array([state.vertex_source[component.first_vertex]], np.int32)))
             continue
         for loop in component.loops:

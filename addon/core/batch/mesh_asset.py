@@ -66,6 +66,9 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
     outputs = output_paths(path, out_dir, settings)
     data = read_mesh(path)
     start = time.perf_counter()
+    vertices_in, triangles_in, cleaned = data.num_vertices, data.num_triangles, None
+    if "clean" in settings:
+        data, cleaned = clean_asset(data, settings["clean"])
     options = settings["options"]
     source = prepare_file(path, data, options.get("mode"), options.get("refine"),
                           settings.get("attribute_weight", ATTRIBUTE_WEIGHT))
@@ -89,9 +92,19 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
         lods.append(entry)
     first = lods[0]
     return {"input": os.fspath(path), "output": first["output"], "outputs": outputs,
-            "vertices_in": data.num_vertices, "triangles_in": data.num_triangles,
+            "vertices_in": vertices_in, "triangles_in": triangles_in,
             "vertices_out": first["vertices"], "triangles_out": first["triangles"],
             "seconds": time.perf_counter() - start, "repairs": first["repairs"], "error": first["search_error"],
             "target_missed": first["target_missed"],
             "attributes": source.appearance.channels if source.attribute_kwargs else [],
-            "lods": lods}
+            "lods": lods, **({} if cleaned is None else {"clean": cleaned})}
+
+
+def clean_asset(data, kwargs: dict) -> tuple:
+    """(the mesh cleaned as ``topstoc clean`` does, attributes carried over; its report: what was
+    removed, what was left and why, CleanResult.as_json)."""
+    from ..api.clean import clean
+    from ..cli.edit import carried_over
+
+    result = clean(data.vertices, data.triangles, **kwargs)
+    return carried_over(data, result.edit), result.as_json()

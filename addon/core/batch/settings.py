@@ -19,6 +19,7 @@ from ..api.decimate import ATTRIBUTE_WEIGHT
 from .screen_size import DEFAULT_FOV_DEGREES, DEFAULT_PIXEL_ERROR, DEFAULT_RESOLUTION
 from ..support.errors import TopStocError
 from ..carry.normal_bake import check_size
+from ..cli import clean as clean_cli
 
 TARGET_KINDS = ("ratio", "vertices", "triangles", "max_error", "screen_pixels", "screen_distance")
 SCREEN_KINDS = ("screen_pixels", "screen_distance")
@@ -99,6 +100,10 @@ def add_arguments(parser) -> None:
                              "axis (object-local in Blender formats)")
     parser.add_argument("--objects", nargs="+", metavar="NAME",
                         help="Blender formats: objects to decimate (default: every mesh object)")
+    parser.add_argument("--clean", action="store_true",
+                        help="before decimating, remove small handles and fill small holes as `topstoc clean` "
+                             "does, with its options below; the report says what was removed and what was left")
+    clean_cli.add_options(parser)
 
 
 def parse_max_error(text: str) -> tuple:
@@ -147,12 +152,25 @@ def from_args(args) -> dict:
         optional["bake_normals"] = check_size(args.bake_normals)
     if getattr(args, "exact_error", False):  # absent when off, likewise
         optional["exact_error"] = True
+    optional.update(_clean(args))
     return {**optional, "target": kind, "values": values, "chain": len(values) > 1,
             "pixel_error": args.pixel_error, "fov": args.fov, "resolution": args.resolution,
             "prune_pixels": args.prune_pixels, "lod_files": bool(args.lod_files), "format": out_format,
             "options": {"seed": args.seed, "adaptivity": args.adaptivity, "density": args.density,
                         "mode": args.mode, "placement": args.placement, "refine": args.refine},
             "objects": list(args.objects) if args.objects else None}
+
+
+def _clean(args) -> dict:
+    """{"clean": clean()'s keyword arguments} with --clean, {} without (absent: older digests hold)."""
+    kwargs = clean_cli.options(args)
+    if args.clean:
+        return {"clean": kwargs}
+    given = [name for name in ("max_handle", "max_hole", "keep_largest") if kwargs[name] is not None]
+    if given or not kwargs["fair"]:
+        name = given[0].replace("_", "-") if given else "flat"
+        raise TopStocError(f"--{name} is an option of --clean; add --clean to clean the assets")
+    return {}
 
 
 def finest_first(kind: str, values: list) -> list:
@@ -192,6 +210,8 @@ def to_argv(settings: dict) -> list:
         argv += ["--objects", *settings["objects"]]
     if settings.get("bake_normals"):
         argv += ["--bake-normals", str(settings["bake_normals"])]
+    if "clean" in settings:
+        argv += ["--clean", *clean_cli.to_argv(settings["clean"])]
     return argv
 
 

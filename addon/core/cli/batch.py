@@ -138,7 +138,17 @@ def _summary(entry: dict) -> str:
         text = f"{entry['vertices_in']} -> {' / '.join(map(str, lods))} vertices ({len(lods)} LODs)"
     else:
         text = f"{entry['vertices_in']} -> {entry['vertices_out']} vertices, {entry['triangles_out']} triangles"
-    return text + "".join("; " + phrase for phrase in report_missed(entry))
+    return text + "".join("; " + phrase for phrase in _cleaned(entry) + report_missed(entry))
+
+
+def _cleaned(entry: dict) -> list:
+    """'cleaned: …' for an asset cleaned with --clean (a mesh file, or summed over a scene's meshes)."""
+    reports = [entry["clean"]] if "clean" in entry else [o["clean"] for o in entry.get("objects") or [] if "clean" in o]
+    if not reports:
+        return []
+    handles, holes = (sum(r[key] for r in reports) for key in ("handles_removed", "holes_filled"))
+    left = sum(len(r["left"]) for r in reports)
+    return [f"cleaned: {handles} handles removed, {holes} holes filled, {left} left (see the report)"]
 
 
 def parse_chunk(text: str) -> tuple:

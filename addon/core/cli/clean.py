@@ -25,6 +25,14 @@ def add_parser(subparsers) -> None:
         "box's diagonal like 1%%.",
         ("input", "IN", "input mesh file"),
         ("output", "OUT", "output mesh file"))
+    add_options(parser)
+    parser.add_argument("--json", action="store_true", help="print a JSON report")
+    add_overwrite_argument(parser)
+    parser.set_defaults(run=run)
+
+
+def add_options(parser) -> None:
+    """The clean-up's sizes and patch style, the same for ``topstoc clean`` and ``batch --clean``."""
     parser.add_argument("--max-handle", metavar="SIZE", default=None,
                         help="remove handles whose shortest loop is shorter (default 1%% of the diagonal; 0: none)")
     parser.add_argument("--max-hole", metavar="SIZE", default=None,
@@ -32,9 +40,24 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--keep-largest", type=int, metavar="N",
                         help="keep the N largest handles (with no --max-handle, remove all others)")
     parser.add_argument("--flat", action="store_true", help="flat patches with the border's vertices only")
-    parser.add_argument("--json", action="store_true", help="print a JSON report")
-    add_overwrite_argument(parser)
-    parser.set_defaults(run=run)
+
+
+def options(args) -> dict:
+    """The keyword arguments of ``topstoc.core.api.clean.clean`` given by the parsed options
+    (JSON-able: the batch keeps them in its settings)."""
+    if args.keep_largest is not None and args.keep_largest < 0:
+        raise TopStocError(f"--keep-largest must be 0 or more, got {args.keep_largest}")
+    return {"max_handle": args.max_handle, "max_hole": args.max_hole, "keep_largest": args.keep_largest,
+            "fair": not args.flat}
+
+
+def to_argv(kwargs: dict) -> list:
+    """Options that reproduce ``kwargs`` (an ``options`` result)."""
+    argv = []
+    for name in ("max_handle", "max_hole", "keep_largest"):
+        if kwargs[name] is not None:
+            argv += ["--" + name.replace("_", "-"), str(kwargs[name])]
+    return argv + ([] if kwargs["fair"] else ["--flat"])
 
 
 def run(args) -> int:
@@ -43,12 +66,10 @@ def run(args) -> int:
     from ..api.topology import topology
     from .edit import carried_over
 
-    if args.keep_largest is not None and args.keep_largest < 0:
-        raise TopStocError(f"--keep-largest must be 0 or more, got {args.keep_largest}")
+    kwargs = options(args)
     prepare_output(args.output, [args.input], overwrite=args.overwrite)
     data = read_mesh(args.input)
-    result = clean(data.vertices, data.triangles, max_handle=args.max_handle, max_hole=args.max_hole,
-                   keep_largest=args.keep_largest, fair=not args.flat)
+    result = clean(data.vertices, data.triangles, **kwargs)
     write_mesh(args.output, carried_over(data, result.edit))
     info = topology(result.vertices, result.triangles)
     if args.json:
