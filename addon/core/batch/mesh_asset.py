@@ -104,7 +104,7 @@ def clean_asset(data, kwargs: dict) -> tuple:
     """(the mesh cleaned as ``topstoc clean`` does, attributes carried over; its report: what was
     removed, what was left and why, CleanResult.as_json)."""
     from ..api.clean import clean
-    from ..cli.edit import carried_over
+    from ..carry.edited_mesh import carried_over
 
     result = clean(data.vertices, data.triangles, **kwargs)
     return carried_over(data, result.edit), result.as_json()

@@ -64,7 +64,7 @@ def run(args) -> int:
     from ..api.clean import clean
     from ..api.io import read_mesh, write_mesh
     from ..api.topology import topology
-    from .edit import carried_over
+    from ..carry.edited_mesh import carried_over
 
     kwargs = options(args)
     prepare_output(args.output, [args.input], overwrite=args.overwrite)
