@@ -26,6 +26,12 @@ void cross(const double* a, const double* b, const double* c, double* out) {
   out[2] = u[0] * w[1] - u[1] * w[0];
 }
 
+// The unit normal along an area-weighted sum of face normals (zero for a zero sum).
+void unit_normal(const double* sum, double* out) {
+  const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+  for (int j = 0; j < 3; ++j) out[j] = len > 0 ? sum[j] / len : 0.0;
+}
+
 // Exclusive prefix sum in place over counts[0..n), with counts[n] receiving the total.
 template <class Counts>
 void exclusive_scan(Counts& counts) {
@@ -145,8 +151,7 @@ class OneRingScan {
       ends[2 * size_t(i)] = (uint64_t(uint32_t(p)) << 32) | uint32_t(2 * i);         // side v -> p
       ends[2 * size_t(i) + 1] = (uint64_t(uint32_t(q)) << 32) | uint32_t(2 * i + 1);  // side q -> v
     }
-    const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
-    for (int j = 0; j < 3; ++j) a.normals[3 * size_t(v) + j] = len > 0 ? sum[j] / len : 0.0;
+    unit_normal(sum, &a.normals[3 * size_t(v)]);
     return lowest_of;
   }
 
@@ -223,10 +228,22 @@ class OneRingScan {
   }
 };
 
-// Second adjacency pass: the neighbours into place and the importance weight, which needs the
-// neighbours' normals from the first pass.
-void place_neighbours_and_weigh(const Buffer<int32_t>& scratch, const Buffer<int32_t>& vfo, const Buffer<int32_t>& offsets,
-                                const Buffer<double>& normals, Buffer<int32_t>& adjacency, Buffer<double>& weights) {
+// The neighbours into place: each vertex's list moves from twice its first face slot to its
+// offset, in vertex order, within the same buffer (a vertex has at most two neighbours per face,
+// so no list lands on one not moved yet). Then the buffer holds the adjacency and its tail can go.
+void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offsets, Buffer<int32_t>& lists) {
+  const int32_t n = int32_t(offsets.size()) - 1;
+  for (int32_t v = 0; v < n; ++v) {
+    const int32_t* from = lists.data() + 2 * size_t(vfo[v]);
+    std::copy(from, from + (offsets[v + 1] - offsets[v]), lists.begin() + offsets[v]);
+  }
+  lists.resize(offsets[n]);
+  release_unused(lists);
+}
+
+// The importance weight, from the neighbours' normals.
+void weigh(const Buffer<int32_t>& offsets, const Buffer<int32_t>& adjacency, const Buffer<double>& normals,
+           Buffer<double>& weights) {
   const int32_t n = int32_t(offsets.size()) - 1;
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
@@ -235,8 +252,7 @@ void place_neighbours_and_weigh(const Buffer<int32_t>& scratch, const Buffer<int
       weights[v] = 0.0;
       continue;
     }
-    const int32_t* neighbours = scratch.data() + 2 * size_t(vfo[v]);
-    std::copy(neighbours, neighbours + d, adjacency.begin() + offsets[v]);
+    const int32_t* neighbours = adjacency.data() + offsets[v];
     // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
     const double* nv = &normals[3 * size_t(v)];
     double dots = 0.0;
@@ -599,15 +615,40 @@ void Mesh::build_adjacency(Progress& progress) {
   exclusive_scan(adjacency_offsets_);
   exclusive_scan(greater);
   num_edges_ = greater[n];
-  adjacency_.resize(adjacency_offsets_[n]);
-  weights_.resize(n);
+  compact_neighbours(vfo, adjacency_offsets_, scratch);
+  adjacency_.swap(scratch);
 
   progress.stage("normals and weights", 0.8, 0.92);
-  place_neighbours_and_weigh(scratch, vfo, adjacency_offsets_, normals_, adjacency_, weights_);
+  weights_.resize(n);
+  weigh(adjacency_offsets_, adjacency_, normals_, weights_);
+  Buffer<double>().swap(normals_);  // 24 bytes a vertex that only view guidance reads again: rebuilt then
   progress.stage("components", 0.92, 1.0);
   Buffer<int32_t>& root = greater;  // its offsets are no longer needed
   report_.components = number_components(sets, vfo, euler, root, component_, component_euler_);
   mean_weight_ = mean_of_weights(adjacency_offsets_, weights_);
+}
+
+// The normals as the one-ring pass computed them (the same sums in the same order).
+void Mesh::build_normals() const {
+  std::call_once(normals_once_, [this] {
+    const int32_t n = num_vertices_;
+    const auto& vfo = vertex_face_offsets_;
+    normals_.resize(3 * size_t(n));
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (int32_t v = 0; v < n; ++v) {
+      double sum[3] = {0, 0, 0};
+      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
+        const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
+        double fn[3];
+        cross(position(t[0]), position(t[1]), position(t[2]), fn);
+        sum[0] += fn[0];
+        sum[1] += fn[1];
+        sum[2] += fn[2];
+      }
+      unit_normal(sum, &normals_[3 * size_t(v)]);
+    }
+    normals_built_.store(true, std::memory_order_release);
+  });
 }
 
 // Apart from the one-ring pass: three square roots and divisions per face were a sixth of that
