@@ -136,6 +136,7 @@ class Mesh {
     if (!normals_built_.load(std::memory_order_acquire)) build_normals();
   }
   void build_normals() const;
+  void fill_normals() const;
   void ensure_vertex_areas() const {
     if (!areas_built_.load(std::memory_order_acquire)) build_vertex_areas();
   }
