@@ -77,6 +77,18 @@ def peer(triangles: int, ratio: float):
             "bytes_per_triangle": int(done.stderr.split()[-1]) * 1024 / figures["triangles"]}
 
 
+def save(path: pathlib.Path, rows: list, ratio: float) -> None:
+    figures = {"benchmark": "tests/bench/bench_scale.py", "machine": machine(),
+               "date": datetime.date.today().isoformat(), "ratio": ratio,
+               "method": "bumpy torus from tests/meshgen.py, 1 % of the vertices, seed 1; each mode in a fresh "
+                         "process: peak RSS above the interpreter's baseline per input triangle (input arrays "
+                         "included); meshopt_bench once per size, /usr/bin/time's peak of the whole program",
+               "sizes": rows}
+    temporary = path.with_suffix(".json.tmp")
+    temporary.write_text(json.dumps(figures, indent=1) + "\n")
+    temporary.replace(path)  # atomic: never a half-written file under the final name
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("triangles", nargs="*", type=float, default=[2e6], help="mesh sizes (default 2e6)")
@@ -106,23 +118,14 @@ def main() -> int:
             m = row["meshopt"]
             print(f"{'':>11}  meshopt_simplify {m['simplify_s']:.2f} s, simplifySloppy {m['sloppy_s']:.2f} s, "
                   f"peak {m['bytes_per_triangle']:.0f} B/triangle (whole program, reading included)")
+        if args.json:  # after every size: a run stopped at a bigger size keeps the smaller ones
+            save(pathlib.Path(args.json), rows, args.ratio)
     if len(rows) > 1:
         first, last = rows[0], rows[-1]
         for mode in ("quality", "fast"):
             t0 = first[mode]["prepare_s"] + first[mode]["decimate_s"]
             t1 = last[mode]["prepare_s"] + last[mode]["decimate_s"]
             print(f"{mode}: {last['triangles'] / first['triangles']:.1f}x the triangles took {t1 / t0:.1f}x the time")
-    if args.json:
-        figures = {"benchmark": "tests/bench/bench_scale.py", "machine": machine(),
-                   "date": datetime.date.today().isoformat(), "ratio": args.ratio,
-                   "method": "bumpy torus from tests/meshgen.py, 1 % of the vertices, seed 1; each mode in a fresh "
-                             "process: peak RSS above the interpreter's baseline per input triangle (input arrays "
-                             "included); meshopt_bench once per size, /usr/bin/time's peak of the whole program",
-                   "sizes": rows}
-        path = pathlib.Path(args.json)
-        temporary = path.with_suffix(".json.tmp")
-        temporary.write_text(json.dumps(figures, indent=1) + "\n")
-        temporary.replace(path)
     return 0
 
 
