@@ -203,3 +203,25 @@ def test_point_weights_match_a_dense_mix_on_a_quality_decimation():
     expected = np.einsum("kj,kjg->kg", moved.weights[at], table[corners])
     np.testing.assert_allclose(out_table[at], expected, atol=1e-12)
     np.testing.assert_array_equal(out_member[at], expected != 0)
+
+
+def test_moved_vertices_take_the_closest_cluster_triangle_whatever_the_block_size(monkeypatch):
+    from meshgen import bumpy_torus
+    from topstoc.core import attributes
+
+    vertices, triangles = bumpy_torus(6000)
+    result = Mesh(vertices, triangles).decimate(ratio=0.05, seed=3)  # quality mode: free vertices move
+    whole = attributes.moved_vertices(vertices, triangles, result)
+    monkeypatch.setattr(attributes, "TRIANGLES_PER_BLOCK", 7)  # blocks that split clusters' triangles
+    blocks = attributes.moved_vertices(vertices, triangles, result)
+    assert np.array_equal(whole.face, blocks.face) and np.array_equal(whole.weights, blocks.weights)
+    moved = whole.moved
+    assert len(moved) > 0.5 * len(result.vertices)
+    # brute force: every triangle with a corner in the vertex's cluster, the closest, lowest id on ties
+    labels = np.asarray(result.labels)
+    for v in moved[:40]:
+        candidates = np.flatnonzero((labels[triangles] == v).any(axis=1))
+        corners = vertices[triangles[candidates]]
+        point = np.repeat(result.vertices[v][None], len(candidates), axis=0)
+        _, distance = attributes._clamped_barycentric(point, corners[:, 0], corners[:, 1], corners[:, 2])
+        assert whole.face[v] == candidates[np.flatnonzero(distance == distance.min())[0]]
