@@ -191,7 +191,7 @@ def render_scale(name: str, figures: dict) -> str:
     """bench_scale.py --json: prepare + decimate time and peak memory per triangle by mesh size."""
     out = [f"## Scale: time and memory by mesh size (`{name}`)", "",
            f"`{figures['benchmark']}` at {percent(figures['ratio'])} of the vertices; cold = prepare + decimate in a "
-           "fresh process; peak = resident memory above the interpreter's per input triangle, input arrays "
+           "fresh process; peak = resident memory above the interpreter's baseline, per input triangle, input arrays "
            "included. meshopt_simplify in the same run (its peak: the whole program, file reading included).", "",
            *source_lines(figures), "",
            "| Triangles | Mode | Prepare | Decimate | Cold | Peak per triangle | meshopt_simplify "
