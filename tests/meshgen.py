@@ -248,7 +248,7 @@ def bumpy_torus(triangles: int, chunk: int = 1 << 20):
     cell) with bumps of several frequencies on its tube and a tenth of an edge of noise, like a
     dense scan (the same mesh on every run): float64 (n, 3)
     vertices and int32 (m, 3) triangles, filled `chunk` grid points at a time so that the
-    arrays themselves are the only big allocation (100M triangles: 3.6 GB)."""
+    arrays themselves are the only big allocation (100M triangles: 2.4 GB)."""
     nv = max(3, int(round((triangles / 4) ** 0.5)))
     nu = max(3, int(round(triangles / (2 * nv))))
     vertices = np.empty((nu * nv, 3))
