@@ -145,14 +145,14 @@ void add_vertex_quadric(const Mesh& mesh, const QuadricFrame& frame, int32_t v, 
 // material edge) off its course. Each thread owns a range of clusters and adds to them in input
 // order, so the sums do not depend on the number of threads.
 VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
-                                const std::vector<int32_t>& label, int32_t clusters, const QuadricFrame& table) {
+                                const std::vector<int32_t>& label, int32_t clusters, const QuadricFrame& frame) {
   const int channels = params.attributes.values ? params.attributes.channels : 0;
   VertexQuadrics quadrics(clusters, channels);
   const auto& faces = mesh.faces();
   const auto& face_source = mesh.face_source();
   const int stride = quadrics.stride();
-  const double* center = table.center;
-  const double scale = 1.0 / table.extent;
+  const double* center = frame.center;
+  const double scale = 1.0 / frame.extent;
   auto unit = [&](int32_t v, double* p) {
     for (int i = 0; i < 3; ++i) p[i] = (mesh.position(v)[i] - center[i]) * scale;
   };
@@ -165,7 +165,7 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
       for (int32_t v = 0; v < n; ++v)
         if (label[v] >= low && label[v] < high) {
           double sum[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
-          add_vertex_quadric(mesh, table, v, sum);
+          add_vertex_quadric(mesh, frame, v, sum);
           quadrics.add(label[v], sum);
         }
     } else {
@@ -182,7 +182,7 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
           for (int a = 0; a < channels; ++a)
             values[size_t(j) * channels + a] =
                 params.attributes.values[(3 * size_t(face_source[f]) + j) * channels + a] *
-                params.attributes.weights[a] * table.diagonal;
+                params.attributes.weights[a] * frame.diagonal;
         if (!quadrics.face(p[0], p[1], p[2], values.data(), face.data())) continue;
         for (double& x : face) x *= 1.0 / 3.0;
         for (int j = 0; j < 3; ++j)
@@ -302,13 +302,13 @@ class Refinement {
   void run() {
     const auto& source = mesh.vertex_source();
     CollapseSetup setup;
-    const auto table = quadric_frame(mesh, layout);
-    for (int i = 0; i < 3; ++i) setup.center[i] = table->center[i];
-    setup.extent = table->extent;
+    const auto frame = quadric_frame(mesh, layout);
+    for (int i = 0; i < 3; ++i) setup.center[i] = frame->center[i];
+    setup.extent = frame->extent;
     label.resize(num_input);
 #pragma omp parallel for schedule(static) if (num_input >= kParallelMin)
     for (int32_t v = 0; v < num_input; ++v) label[v] = result.labels[source[v]];
-    setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *table);
+    setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *frame);
     set_up_vertices(setup);
     lock_inconsistent(setup);
     setup.quota = quotas();
