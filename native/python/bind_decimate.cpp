@@ -308,7 +308,7 @@ void bind_decimate(py::module_& m) {
       },
       py::arg("vertices"), py::arg("triangles"), py::arg("labels"), py::arg("output"), py::arg("moved"),
       "For each moved output vertex, the closest input triangle touching its cluster and the clamped barycentric "
-      "weights there (addon/core/attributes.py moved_vertices): (face, weights).");
+      "weights there (addon/core/carry/attributes.py moved_vertices): (face, weights).");
 }
 
 }  // namespace topstoc::python

@@ -226,7 +226,7 @@ def _clamped_barycentric(points, a, b, c):
 
 def test_moved_vertices_take_the_closest_triangle_of_their_cluster():
     from meshgen import bumpy_torus
-    from topstoc.core.attributes import moved_vertices
+    from topstoc.core.carry.attributes import moved_vertices
 
     vertices, triangles = bumpy_torus(6000)
     result = Mesh(vertices, triangles).decimate(ratio=0.05, seed=3)  # quality mode: free vertices move

@@ -1,6 +1,6 @@
 // Where the attributes of output vertices that moved (quality mode's placement) come from: the
 // closest input triangle touching the vertex's cluster and barycentric weights in it
-// (addon/core/attributes.py's moved_vertices, docs/design.md §1.3).
+// (addon/core/carry/attributes.py's moved_vertices, docs/design.md §1.3).
 #pragma once
 
 #include <cstdint>
