@@ -187,6 +187,35 @@ def render_loop_families(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def render_scale(name: str, figures: dict) -> str:
+    """bench_scale.py --json: prepare + decimate time and peak memory per triangle by mesh size."""
+    out = [f"## Scale: time and memory by mesh size (`{name}`)", "",
+           f"`{figures['benchmark']}` at {percent(figures['ratio'])} of the vertices; cold = prepare + decimate in a "
+           "fresh process; peak = resident memory above the interpreter's baseline, per input triangle, input arrays "
+           "included. meshopt_simplify in the same run (its peak: the whole program, file reading included).", "",
+           *source_lines(figures), "",
+           "| Triangles | Mode | Prepare | Decimate | Cold | Peak per triangle | meshopt_simplify "
+           "| simplify ÷ cold | meshopt peak per triangle |", "|---|---|---|---|---|---|---|---|---|"]
+    for row in figures["sizes"]:
+        peer = row.get("meshopt")
+        for mode in ("quality", "fast"):
+            f = row[mode]
+            cold = f["prepare_s"] + f["decimate_s"]
+            out.append(f"| {row['triangles']:,} | {mode} | {ms(1000 * f['prepare_s'])} | {ms(1000 * f['decimate_s'])} "
+                       f"| {ms(1000 * cold)} | {f['bytes_per_triangle']:.0f} B "
+                       f"| {'—' if peer is None else ms(1000 * peer['simplify_s'])} "
+                       f"| {times(None if peer is None else peer['simplify_s'], cold)} "
+                       f"| {'—' if peer is None else format(peer['bytes_per_triangle'], '.0f') + ' B'} |")
+    sizes = figures["sizes"]
+    if len(sizes) > 1:
+        growth = [f"{mode} {(sizes[-1][mode]['prepare_s'] + sizes[-1][mode]['decimate_s']) / (sizes[0][mode]['prepare_s'] + sizes[0][mode]['decimate_s']):.1f}×"
+                  for mode in ("quality", "fast")]
+        out += ["", f"From {sizes[0]['triangles']:,} to {sizes[-1]['triangles']:,} triangles "
+                f"({sizes[-1]['triangles'] / sizes[0]['triangles']:.0f}× the size) the cold time grew "
+                + " and ".join(growth) + "."]
+    return "\n".join(out) + "\n"
+
+
 def render_carried_over(name: str, figures: dict) -> str:
     """Figures measured before the benchmarks saved JSON, kept as they were published."""
     out = [f"## {figures['title']} (`{name}`)", "", *source_lines(figures), "", figures["note"], "",
@@ -205,8 +234,11 @@ def render_result(path: pathlib.Path) -> str:
         return render_quality(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_loops.py --families":
         return render_loop_families(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_scale.py":
+        return render_scale(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
-                     "the --json of bench_decimate.py, bench_quality.py and bench_loops.py --families, and carried-over figures)")
+                     "the --json of bench_decimate.py, bench_quality.py, bench_loops.py --families and "
+                     "bench_scale.py, and carried-over figures)")
 
 
 def render() -> str:

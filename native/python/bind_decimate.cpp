@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "convert.hpp"
+#include "topstoc/decimate/moved_sources.hpp"
 #include "topstoc/core/validate.hpp"
 #include "topstoc/decimate/decimate.hpp"
 #include "topstoc/core/quality.hpp"
@@ -282,6 +283,32 @@ void bind_decimate(py::module_& m) {
         return d;
       },
       py::arg("vertices"), py::arg("triangles"), "Aspect ratio (thesis eq. 4.2): mean, max, degenerate count.");
+
+  m.def(
+      "moved_sources",
+      [](const py::handle& vertices, const py::handle& triangles, const py::handle& labels,
+         const py::handle& output, const py::handle& moved) {
+        const auto input = positions_array(vertices, "vertices");
+        const auto tris = indices_array(triangles, 3, "triangles");
+        const int64_t n = int64_t(input.size() / 3), m = int64_t(tris.size() / 3);
+        const auto label = ids_from(labels, n, "labels");
+        const auto out = positions_array(output, "output");
+        const int64_t k = int64_t(out.size() / 3);
+        const auto flags = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>::ensure(moved);
+        if (!flags || flags.size() != k) throw std::invalid_argument("moved must hold one flag per output vertex");
+        require_indices_in_range(tris.data(), m, 3, n, "triangle");
+        for (int32_t l : label)
+          if (l >= k) throw std::invalid_argument("labels name an output vertex out of range");
+        MovedSources sources;
+        {
+          EngineCall call;
+          sources = moved_sources(input.data(), tris.data(), m, label.data(), out.data(), flags.data(), k);
+        }
+        return py::make_tuple(to_array(std::move(sources.face)), to_array(std::move(sources.weights), 3));
+      },
+      py::arg("vertices"), py::arg("triangles"), py::arg("labels"), py::arg("output"), py::arg("moved"),
+      "For each moved output vertex, the closest input triangle touching its cluster and the clamped barycentric "
+      "weights there (addon/core/carry/attributes.py moved_vertices): (face, weights).");
 }
 
 }  // namespace topstoc::python

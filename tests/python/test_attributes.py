@@ -203,3 +203,44 @@ def test_point_weights_match_a_dense_mix_on_a_quality_decimation():
     expected = np.einsum("kj,kjg->kg", moved.weights[at], table[corners])
     np.testing.assert_allclose(out_table[at], expected, atol=1e-12)
     np.testing.assert_array_equal(out_member[at], expected != 0)
+
+
+def _clamped_barycentric(points, a, b, c):
+    """Reference: barycentric weights of each point's projection onto triangle (a, b, c),
+    negative weights clamped to 0 and the rest renormalised, and the distance from the point to
+    the weighted point; degenerate triangles give their first corner."""
+    e0, e1, d = b - a, c - a, points - a
+    d00, d01, d11 = (e0 * e0).sum(1), (e0 * e1).sum(1), (e1 * e1).sum(1)
+    d20, d21 = (d * e0).sum(1), (d * e1).sum(1)
+    denominator = d00 * d11 - d01 * d01
+    ok = denominator > 0
+    safe = np.where(ok, denominator, 1.0)
+    w1 = np.where(ok, (d11 * d20 - d01 * d21) / safe, 0.0)
+    w2 = np.where(ok, (d00 * d21 - d01 * d20) / safe, 0.0)
+    w = np.clip(np.stack([1.0 - w1 - w2, w1, w2], axis=1), 0.0, None)
+    total = w.sum(1, keepdims=True)
+    w = np.where(total > 0, w / np.where(total > 0, total, 1.0), [1.0, 0.0, 0.0])
+    at = w[:, :1] * a + w[:, 1:2] * b + w[:, 2:] * c
+    return w, np.linalg.norm(points - at, axis=1)
+
+
+def test_moved_vertices_take_the_closest_triangle_of_their_cluster():
+    from meshgen import bumpy_torus
+    from topstoc.core.carry.attributes import moved_vertices
+
+    vertices, triangles = bumpy_torus(6000)
+    result = Mesh(vertices, triangles).decimate(ratio=0.05, seed=3)  # quality mode: free vertices move
+    moved = moved_vertices(vertices, triangles, result)
+    still = np.all(result.vertices == vertices[result.kept], axis=1)
+    assert np.array_equal(moved.face < 0, still) and still.sum() < 0.5 * len(still)
+    assert np.array_equal(moved.weights[still], np.tile([1.0, 0.0, 0.0], (still.sum(), 1)))
+    # brute force: every triangle with a corner in the vertex's cluster, the closest, lowest id on ties
+    labels = np.asarray(result.labels)
+    for v in moved.moved[:60]:
+        candidates = np.flatnonzero((labels[triangles] == v).any(axis=1))
+        corners = vertices[triangles[candidates]]
+        point = np.repeat(result.vertices[v][None], len(candidates), axis=0)
+        w, distance = _clamped_barycentric(point, corners[:, 0], corners[:, 1], corners[:, 2])
+        best = np.flatnonzero(distance == distance.min())[0]
+        assert moved.face[v] == candidates[best]
+        assert moved.weights[v].tobytes() == w[best].tobytes()  # the same arithmetic, bit for bit

@@ -101,3 +101,22 @@ def test_quality_results_state_the_goals_per_case_and_name_the_worst():
     assert "| a.off | 0.5% | 100 | 0.50 | 2.00 | yes |" in text
     assert "| b.off | 50 triangles | 100 (topology) | 2.00 | 2.00 | yes |" in text
     assert "2 cases (2 meshes × 0.5%, 50 triangles)" in text
+
+
+def test_scale_results_render_ratios_and_growth():
+    def mode(prepare, decimate, per_triangle):
+        return {"prepare_s": prepare, "decimate_s": decimate, "bytes_per_triangle": per_triangle}
+    figures = {"benchmark": "tests/bench/bench_scale.py", "machine": "test machine", "date": "2000-01-01",
+               "ratio": 0.01, "sizes": [
+                   {"triangles": 2000, "vertices": 1000, "quality": mode(1.0, 1.0, 99.6), "fast": mode(1.0, 0.5, 70.2),
+                    "meshopt": {"simplify_s": 12.0, "sloppy_s": 1.0, "bytes_per_triangle": 120.0}},
+                   {"triangles": 20000, "vertices": 10000, "quality": mode(9.0, 11.0, 90.0),
+                    "fast": mode(10.0, 5.0, 60.0), "meshopt": None}]}
+    text = benchmarks_md.render_scale("s.json", figures)
+    rows = [[c.strip() for c in line.strip("|").split("|")] for line in text.splitlines() if line.startswith("| 2")]
+    # cold = prepare + decimate; 12 / 2 and 12 / 1.5; the second size has no peer
+    assert rows[0] == ["2,000", "quality", "1.00 s", "1.00 s", "2.00 s", "100 B", "12.00 s", "6.0×", "120 B"]
+    assert rows[1] == ["2,000", "fast", "1.00 s", "500 ms", "1.50 s", "70 B", "12.00 s", "8.0×", "120 B"]
+    assert rows[2][4:] == ["20.00 s", "90 B", "—", "—", "—"]
+    # 20 / 2 and 15 / 1.5
+    assert "(10× the size) the cold time grew quality 10.0× and fast 10.0×" in text

@@ -26,6 +26,12 @@ void cross(const double* a, const double* b, const double* c, double* out) {
   out[2] = u[0] * w[1] - u[1] * w[0];
 }
 
+// The unit normal along an area-weighted sum of face normals (zero for a zero sum).
+void unit_normal(const double* sum, double* out) {
+  const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+  for (int j = 0; j < 3; ++j) out[j] = len > 0 ? sum[j] / len : 0.0;
+}
+
 // Exclusive prefix sum in place over counts[0..n), with counts[n] receiving the total.
 template <class Counts>
 void exclusive_scan(Counts& counts) {
@@ -69,7 +75,6 @@ struct OneRingArrays {
   Buffer<int32_t>& greater;  // neighbours above the vertex
   Buffer<int32_t>& euler;    // the vertex's share of V - E + F
   Buffer<int32_t>& first_corner;
-  Buffer<double>& normals;
   Buffer<uint8_t>& manifold_vertex;
   SharedUnionFind& sets;  // components: each set's root is its lowest vertex
 };
@@ -93,7 +98,6 @@ class OneRingScan {
     if (k == 0) {  // isolated: no neighbours, in no component
       a.first_corner[v] = -1;
       a.degree[v] = a.greater[v] = a.euler[v] = 0;
-      a.normals[3 * size_t(v)] = a.normals[3 * size_t(v) + 1] = a.normals[3 * size_t(v) + 2] = 0.0;
       return;
     }
     const int32_t lowest_of = read_faces(v, first, k, counts.zero_area);
@@ -117,12 +121,11 @@ class OneRingScan {
   std::vector<uint64_t> ends;  // (neighbour, 2 slot + (1 if the arc enters it))
   std::vector<int32_t> end_rank, in, out, next;
 
-  // Reads v's k faces: the first corner, the normal, the link's arc ends; counts the faces v
-  // is the lowest vertex of (returned) and, among them, those of zero area.
+  // Reads v's k faces: the first corner, the link's arc ends; counts the faces v is the lowest
+  // vertex of (returned) and, among them, those of zero area.
   int32_t read_faces(int32_t v, int32_t first, int32_t k, int32_t& zero_area) {
     ends.resize(2 * size_t(k));
     end_rank.resize(2 * size_t(k));
-    double sum[3] = {0, 0, 0};
     int32_t lowest_of = 0;
     const int32_t* faces = a.faces.data();
     const int32_t* vertex_faces = a.vertex_faces.data() + first;
@@ -131,22 +134,16 @@ class OneRingScan {
       const int32_t* t = faces + 3 * size_t(vertex_faces[i]);
       const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
       if (i == 0) a.first_corner[v] = 3 * a.face_source[vertex_faces[0]] + c;
-      // Area-weighted: the unnormalised face normal (twice the area) summed at each corner.
-      double fn[3];
-      cross(positions + 3 * size_t(t[0]), positions + 3 * size_t(t[1]), positions + 3 * size_t(t[2]), fn);
-      sum[0] += fn[0];
-      sum[1] += fn[1];
-      sum[2] += fn[2];
       const int32_t p = t[(c + 1) % 3], q = t[(c + 2) % 3];
       if (v < p && v < q) {
         ++lowest_of;
+        double fn[3];
+        cross(positions + 3 * size_t(t[0]), positions + 3 * size_t(t[1]), positions + 3 * size_t(t[2]), fn);
         if (fn[0] == 0.0 && fn[1] == 0.0 && fn[2] == 0.0) ++zero_area;
       }
       ends[2 * size_t(i)] = (uint64_t(uint32_t(p)) << 32) | uint32_t(2 * i);         // side v -> p
       ends[2 * size_t(i) + 1] = (uint64_t(uint32_t(q)) << 32) | uint32_t(2 * i + 1);  // side q -> v
     }
-    const double len = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
-    for (int j = 0; j < 3; ++j) a.normals[3 * size_t(v) + j] = len > 0 ? sum[j] / len : 0.0;
     return lowest_of;
   }
 
@@ -223,10 +220,22 @@ class OneRingScan {
   }
 };
 
-// Second adjacency pass: the neighbours into place and the importance weight, which needs the
-// neighbours' normals from the first pass.
-void place_neighbours_and_weigh(const Buffer<int32_t>& scratch, const Buffer<int32_t>& vfo, const Buffer<int32_t>& offsets,
-                                const Buffer<double>& normals, Buffer<int32_t>& adjacency, Buffer<double>& weights) {
+// The neighbours into place: each vertex's list moves from twice its first face slot to its
+// offset, in vertex order, within the same buffer (a vertex has at most two neighbours per face,
+// so no list lands on one not moved yet). Then the buffer holds the adjacency and its tail can go.
+void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offsets, Buffer<int32_t>& lists) {
+  const int32_t n = int32_t(offsets.size()) - 1;
+  for (int32_t v = 0; v < n; ++v) {
+    const int32_t* from = lists.data() + 2 * size_t(vfo[v]);
+    std::copy(from, from + (offsets[v + 1] - offsets[v]), lists.begin() + offsets[v]);
+  }
+  lists.resize(offsets[n]);
+  release_unused(lists);
+}
+
+// The importance weight, from the neighbours' normals.
+void weigh(const Buffer<int32_t>& offsets, const Buffer<int32_t>& adjacency, const Buffer<double>& normals,
+           Buffer<double>& weights) {
   const int32_t n = int32_t(offsets.size()) - 1;
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (int32_t v = 0; v < n; ++v) {
@@ -235,8 +244,7 @@ void place_neighbours_and_weigh(const Buffer<int32_t>& scratch, const Buffer<int
       weights[v] = 0.0;
       continue;
     }
-    const int32_t* neighbours = scratch.data() + 2 * size_t(vfo[v]);
-    std::copy(neighbours, neighbours + d, adjacency.begin() + offsets[v]);
+    const int32_t* neighbours = adjacency.data() + offsets[v];
     // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
     const double* nv = &normals[3 * size_t(v)];
     double dots = 0.0;
@@ -573,12 +581,11 @@ void Mesh::build_adjacency(Progress& progress) {
   Buffer<int32_t> scratch(2 * vertex_faces_.size());
   Buffer<int32_t> degree(n + 1), greater(n + 1), euler(n);
   degree[n] = greater[n] = 0;
-  normals_.resize(3 * size_t(n));
   manifold_vertex_.resize(n);
   first_corner_.resize(n);
   SharedUnionFind sets(n);
   const OneRingArrays arrays{faces_, face_source_, vertex_faces_, vfo, positions_, scratch, degree, greater,
-                             euler, first_corner_, normals_, manifold_vertex_, sets};
+                             euler, first_corner_, manifold_vertex_, sets};
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
 #pragma omp parallel reduction(+ : boundary, nonmanifold_edges, inconsistent, pinched, zero_area) if (n >= kParallelMin)
   {
@@ -599,15 +606,47 @@ void Mesh::build_adjacency(Progress& progress) {
   exclusive_scan(adjacency_offsets_);
   exclusive_scan(greater);
   num_edges_ = greater[n];
-  adjacency_.resize(adjacency_offsets_[n]);
-  weights_.resize(n);
+  compact_neighbours(vfo, adjacency_offsets_, scratch);
+  adjacency_.swap(scratch);
 
+  // The normals after the pass, not in it: then they never take memory alongside its buffer.
   progress.stage("normals and weights", 0.8, 0.92);
-  place_neighbours_and_weigh(scratch, vfo, adjacency_offsets_, normals_, adjacency_, weights_);
+  fill_normals();
+  weights_.resize(n);
+  weigh(adjacency_offsets_, adjacency_, normals_, weights_);
+  Buffer<double>().swap(normals_);  // 24 bytes a vertex that only view guidance reads again: rebuilt then
   progress.stage("components", 0.92, 1.0);
   Buffer<int32_t>& root = greater;  // its offsets are no longer needed
   report_.components = number_components(sets, vfo, euler, root, component_, component_euler_);
   mean_weight_ = mean_of_weights(adjacency_offsets_, weights_);
+}
+
+// Area-weighted: the unnormalised face normals (twice the areas) summed at each vertex, in the
+// order of its faces, then normalised.
+void Mesh::fill_normals() const {
+  const int32_t n = num_vertices_;
+  const auto& vfo = vertex_face_offsets_;
+  normals_.resize(3 * size_t(n));
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (int32_t v = 0; v < n; ++v) {
+    double sum[3] = {0, 0, 0};
+    for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
+      const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
+      double fn[3];
+      cross(position(t[0]), position(t[1]), position(t[2]), fn);
+      sum[0] += fn[0];
+      sum[1] += fn[1];
+      sum[2] += fn[2];
+    }
+    unit_normal(sum, &normals_[3 * size_t(v)]);
+  }
+}
+
+void Mesh::build_normals() const {
+  std::call_once(normals_once_, [this] {
+    fill_normals();
+    normals_built_.store(true, std::memory_order_release);
+  });
 }
 
 // Apart from the one-ring pass: three square roots and divisions per face were a sixth of that

@@ -104,40 +104,39 @@ void bounding_box(const Mesh& mesh, double center[3], double& extent, double& di
   if (!(diagonal > 0) || !std::isfinite(diagonal)) diagonal = 1.0;
 }
 
-// Per input vertex, a third of the quadric of each triangle around it (in normalised
-// coordinates), so that a cluster's sum weighs each triangle by the share of its corners in the
-// cluster. It depends on the mesh only: kept with the layout, re-decimations skip it.
-struct QuadricTable {
+// The frame quadrics are computed in: the bounding box's centre and half extent, and its
+// diagonal in those units. It depends on the mesh only: kept with the layout.
+struct QuadricFrame {
   double center[3] = {0, 0, 0}, extent = 1.0;
   double diagonal = 1.0;  // of the bounding box, normalised
-  std::vector<double> quadric;  // 10 per vertex
 };
 
-std::shared_ptr<const QuadricTable> vertex_quadric_table(const Mesh& mesh, const FeatureLayout& layout) {
-  auto cached = std::static_pointer_cast<const QuadricTable>(layout.quadric_table.get());
-  if (cached && cached->quadric.size() == 10 * size_t(mesh.num_vertices())) return cached;
-  auto table = std::make_shared<QuadricTable>();
-  bounding_box(mesh, table->center, table->extent, table->diagonal);
-  const int32_t n = mesh.num_vertices();
-  table->quadric.assign(10 * size_t(n), 0.0);
+std::shared_ptr<const QuadricFrame> quadric_frame(const Mesh& mesh, const FeatureLayout& layout) {
+  auto cached = std::static_pointer_cast<const QuadricFrame>(layout.quadric_frame.get());
+  if (cached) return cached;
+  auto frame = std::make_shared<QuadricFrame>();
+  bounding_box(mesh, frame->center, frame->extent, frame->diagonal);
+  layout.quadric_frame.set(frame);
+  return frame;
+}
+
+// A third of the quadric of each triangle around input vertex v (in normalised coordinates),
+// added into sum[10] in the order of v's faces, so that a cluster's sum weighs each triangle by
+// the share of its corners in the cluster. Computed where it is added, not kept: a table of
+// them was 80 bytes per input vertex.
+void add_vertex_quadric(const Mesh& mesh, const QuadricFrame& frame, int32_t v, double* sum) {
   const auto& faces = mesh.faces();
   const auto& vfo = mesh.vertex_face_offsets();
   const auto& vf = mesh.vertex_faces();
-  const double scale = 1.0 / table->extent;
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
-    double* sum = &table->quadric[10 * size_t(v)];
-    for (int32_t k = vfo[v]; k < vfo[v + 1]; ++k) {
-      const int32_t* t = &faces[3 * size_t(vf[k])];
-      double p[3][3], face[10], area;
-      for (int j = 0; j < 3; ++j)
-        for (int i = 0; i < 3; ++i) p[j][i] = (mesh.position(t[j])[i] - table->center[i]) * scale;
-      if (!VertexQuadrics::plane(p[0], p[1], p[2], face, &area)) continue;
-      for (int i = 0; i < 10; ++i) sum[i] += face[i] * (1.0 / 3.0);
-    }
+  const double scale = 1.0 / frame.extent;
+  for (int32_t k = vfo[v]; k < vfo[v + 1]; ++k) {
+    const int32_t* t = &faces[3 * size_t(vf[k])];
+    double p[3][3], face[10], area;
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) p[j][i] = (mesh.position(t[j])[i] - frame.center[i]) * scale;
+    if (!VertexQuadrics::plane(p[0], p[1], p[2], face, &area)) continue;
+    for (int i = 0; i < 10; ++i) sum[i] += face[i] * (1.0 / 3.0);
   }
-  layout.quadric_table.set(table);
-  return table;
 }
 
 // Each output vertex stands for the input triangles of its cluster (each weighed by the share of
@@ -146,14 +145,14 @@ std::shared_ptr<const QuadricTable> vertex_quadric_table(const Mesh& mesh, const
 // material edge) off its course. Each thread owns a range of clusters and adds to them in input
 // order, so the sums do not depend on the number of threads.
 VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
-                                const std::vector<int32_t>& label, int32_t clusters, const QuadricTable& table) {
+                                const std::vector<int32_t>& label, int32_t clusters, const QuadricFrame& frame) {
   const int channels = params.attributes.values ? params.attributes.channels : 0;
   VertexQuadrics quadrics(clusters, channels);
   const auto& faces = mesh.faces();
   const auto& face_source = mesh.face_source();
   const int stride = quadrics.stride();
-  const double* center = table.center;
-  const double scale = 1.0 / table.extent;
+  const double* center = frame.center;
+  const double scale = 1.0 / frame.extent;
   auto unit = [&](int32_t v, double* p) {
     for (int i = 0; i < 3; ++i) p[i] = (mesh.position(v)[i] - center[i]) * scale;
   };
@@ -164,7 +163,11 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
     const int32_t low = int32_t(int64_t(clusters) * me / threads), high = int32_t(int64_t(clusters) * (me + 1) / threads);
     if (channels == 0) {
       for (int32_t v = 0; v < n; ++v)
-        if (label[v] >= low && label[v] < high) quadrics.add(label[v], &table.quadric[10 * size_t(v)]);
+        if (label[v] >= low && label[v] < high) {
+          double sum[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+          add_vertex_quadric(mesh, frame, v, sum);
+          quadrics.add(label[v], sum);
+        }
     } else {
       // Attributes: each face's generalised quadric, a third to the cluster of each corner.
       std::vector<double> face(stride), values(3 * size_t(channels));
@@ -179,7 +182,7 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
           for (int a = 0; a < channels; ++a)
             values[size_t(j) * channels + a] =
                 params.attributes.values[(3 * size_t(face_source[f]) + j) * channels + a] *
-                params.attributes.weights[a] * table.diagonal;
+                params.attributes.weights[a] * frame.diagonal;
         if (!quadrics.face(p[0], p[1], p[2], values.data(), face.data())) continue;
         for (double& x : face) x *= 1.0 / 3.0;
         for (int j = 0; j < 3; ++j)
@@ -187,6 +190,8 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
       }
     }
   }
+  // The edge tables are built on first use: a mesh without feature edges never needs them here.
+  if (layout.feature_edges.empty()) return quadrics;
   const auto& ev = mesh.edge_vertices();
   const auto& efo = mesh.edge_face_offsets();
   const auto& ef = mesh.edge_faces();
@@ -297,13 +302,13 @@ class Refinement {
   void run() {
     const auto& source = mesh.vertex_source();
     CollapseSetup setup;
-    const auto table = vertex_quadric_table(mesh, layout);
-    for (int i = 0; i < 3; ++i) setup.center[i] = table->center[i];
-    setup.extent = table->extent;
+    const auto frame = quadric_frame(mesh, layout);
+    for (int i = 0; i < 3; ++i) setup.center[i] = frame->center[i];
+    setup.extent = frame->extent;
     label.resize(num_input);
 #pragma omp parallel for schedule(static) if (num_input >= kParallelMin)
     for (int32_t v = 0; v < num_input; ++v) label[v] = result.labels[source[v]];
-    setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *table);
+    setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *frame);
     set_up_vertices(setup);
     lock_inconsistent(setup);
     setup.quota = quotas();

@@ -7,10 +7,16 @@
 // threads. Elements not written explicitly hold garbage: fill what a loop skips.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <new>
 #include <utility>
 #include <vector>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
 
 namespace topstoc {
 
@@ -37,5 +43,20 @@ struct UninitialisedAllocator : std::allocator<T> {
 
 template <class T>
 using Buffer = std::vector<T, UninitialisedAllocator<T>>;
+
+/// Gives the whole pages past a buffer's end back to the system (Linux; elsewhere nothing): a
+/// buffer shrunk with resize() keeps its capacity, and its unused tail then costs address space
+/// only. Those pages read as zero if the buffer grows again.
+template <class T>
+void release_unused(Buffer<T>& buffer) {
+#if defined(__linux__)
+  const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
+  const uintptr_t first = (uintptr_t(buffer.data() + buffer.size()) + page - 1) / page * page;
+  const uintptr_t last = uintptr_t(buffer.data() + buffer.capacity()) / page * page;
+  if (last > first) madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
+#else
+  (void)buffer;
+#endif
+}
 
 }  // namespace topstoc

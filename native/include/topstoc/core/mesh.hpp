@@ -95,8 +95,9 @@ class Mesh {
   /// Edge id between a and b, or -1.
   int32_t find_edge(int32_t a, int32_t b) const;
 
-  /// Unit area-weighted vertex normals (zero for vertices without area).
-  const Buffer<double>& normals() const { return normals_; }
+  /// Unit area-weighted vertex normals (zero for vertices without area). The preparation needs
+  /// them for the weights only and frees them; they are computed again on first use, once.
+  const Buffer<double>& normals() const { return ensure_normals(), normals_; }
   /// A third of the area of the triangles around each vertex, and its mean over vertices in
   /// faces. Computed on first use, once, whichever thread asks: only area-weighted sampling
   /// reads them.
@@ -131,6 +132,11 @@ class Mesh {
     if (!edges_built_.load(std::memory_order_acquire)) build_edges();
   }
   void build_edges() const;
+  void ensure_normals() const {
+    if (!normals_built_.load(std::memory_order_acquire)) build_normals();
+  }
+  void build_normals() const;
+  void fill_normals() const;
   void ensure_vertex_areas() const {
     if (!areas_built_.load(std::memory_order_acquire)) build_vertex_areas();
   }
@@ -147,7 +153,11 @@ class Mesh {
   mutable Buffer<int32_t> adjacency_edge_, edge_vertices_, edge_face_offsets_, edge_faces_, face_edges_;
   mutable std::once_flag edges_once_;
   mutable std::atomic<bool> edges_built_{false};
-  Buffer<double> normals_, weights_;
+  Buffer<double> weights_;
+  // Built in the preparation, freed after it, built again on first use (ensure_normals).
+  mutable Buffer<double> normals_;
+  mutable std::once_flag normals_once_;
+  mutable std::atomic<bool> normals_built_{false};
   double mean_weight_ = 0.0, diagonal_ = 0.0;
   // Built on first use (ensure_vertex_areas).
   mutable Buffer<double> vertex_areas_;

@@ -77,7 +77,7 @@ struct FeatureLayout {
   DerivedTable sampling_table;  ///< sampling.cpp's importance table for its last parameters
   DerivedTable selection_uniforms;  ///< sampling.cpp's per-vertex uniforms of the seed drawn last
   DerivedTable candidate_order;     ///< candidate_order.cpp's vertices in the order a slider's draws take them
-  DerivedTable quadric_table;   ///< refine.cpp's per-vertex quadrics (they depend on the mesh only)
+  DerivedTable quadric_frame;   ///< refine.cpp's normalisation frame (it depends on the mesh only)
   int32_t region_border_edges = 0;
   int32_t flagged_edges = 0;
   int32_t crease_edges = 0;

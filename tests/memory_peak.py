@@ -1,0 +1,68 @@
+"""Peak memory of one prepare + decimate on a generated mesh, measured in a fresh process.
+
+Shared by tests/bench/bench_scale.py (2M to 100M triangles) and
+tests/python/test_memory_ceiling.py (2M). The child process imports numpy and topstoc, reads
+its resident size (the baseline: the interpreter and the module), generates the bumpy torus
+(tests/meshgen.py), resets the kernel's high-water mark (/proc/self/clear_refs, so that the
+generator's temporaries are not counted), then prepares and decimates. The figure is
+(high-water mark - baseline) / input triangles: the input arrays (float64 vertices, int32
+triangles, 24 bytes a triangle) are included, as the caller holds them throughout.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import pathlib
+import subprocess
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+BUILD = pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build"))
+
+CHILD = r"""
+import json, sys, time
+sys.path[:0] = [{python!r}, {tests!r}]
+import numpy as np
+from topstoc.core import Mesh
+import meshgen
+
+def status(name):
+    with open("/proc/self/status") as handle:
+        for line in handle:
+            if line.startswith(name + ":"):
+                return int(line.split()[1]) * 1024
+    raise RuntimeError(name + " not in /proc/self/status")
+
+base = status("VmRSS")
+vertices, triangles = meshgen.bumpy_torus({triangles})
+with open("/proc/self/clear_refs", "w") as handle:
+    handle.write("5")  # the high-water mark starts again from the arrays in hand
+start = time.perf_counter()
+mesh = Mesh(vertices, triangles)
+prepared = time.perf_counter()
+result = mesh.decimate(ratio={ratio}, mode={mode!r}, seed=1)
+done = time.perf_counter()
+print(json.dumps({{"triangles": len(triangles), "vertices": len(vertices), "prepare_s": prepared - start,
+                  "decimate_s": done - prepared, "peak_bytes": status("VmHWM") - base,
+                  "output_vertices": len(result.vertices), "output_triangles": len(result.triangles),
+                  "topology_kept": bool(result.stats.topology_kept)}}))
+"""
+
+
+def measure(triangles: int, mode: str, ratio: float = 0.01) -> dict:
+    """One prepare + decimate of a bumpy torus of about `triangles` triangles in a fresh process:
+    times, peak bytes above the interpreter's baseline and per input triangle, output size."""
+    code = CHILD.format(python=str(BUILD / "python"), tests=str(ROOT / "tests"), triangles=int(triangles),
+                        ratio=float(ratio), mode=mode)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"the {mode} run on {triangles} triangles failed:\n{done.stderr[-2000:]}")
+    figures = json.loads(done.stdout.splitlines()[-1])
+    figures["bytes_per_triangle"] = figures["peak_bytes"] / figures["triangles"]
+    return figures
+
+
+def available() -> bool:
+    """The kernel lets a process reset its own high-water mark (Linux 4.0 and later)."""
+    return os.access("/proc/self/clear_refs", os.W_OK)

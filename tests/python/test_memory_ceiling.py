@@ -1,0 +1,36 @@
+"""Peak memory of prepare + decimate per input triangle on a 2M-triangle mesh, measured in a
+fresh process (tests/memory_peak.py): a ceiling that catches a change adding a per-triangle
+array, and issue 39's goals (100 bytes a triangle in quality mode, 70 in fast mode, input arrays
+included), not reached yet. A memory figure, not a time: the same on a busy machine."""
+
+import pytest
+
+import memory_peak
+
+pytestmark = pytest.mark.skipif(not memory_peak.available(), reason="needs /proc/self/clear_refs (Linux)")
+
+TRIANGLES = 2_000_000
+#: What the engine reaches now, with a few bytes of margin (glibc's heap keeps some freed memory).
+CEILING = {"quality": 145, "fast": 142}
+#: Issue 39's goals.
+GOAL = {"quality": 100, "fast": 70}
+
+
+@pytest.fixture(scope="module")
+def peaks():
+    return {mode: memory_peak.measure(TRIANGLES, mode) for mode in ("quality", "fast")}
+
+
+@pytest.mark.parametrize("mode", ["quality", "fast"])
+def test_peak_per_triangle_stays_under_the_ceiling(peaks, mode):
+    figures = peaks[mode]
+    assert figures["triangles"] > 0.99 * TRIANGLES and figures["topology_kept"]
+    assert 0.009 * figures["vertices"] < figures["output_vertices"] < 0.011 * figures["vertices"]
+    # the input arrays alone are 24 bytes a triangle: a figure below that measured nothing
+    assert 24 < figures["bytes_per_triangle"] <= CEILING[mode], figures
+
+
+@pytest.mark.xfail(strict=True, reason="issue 39's memory goal is not reached yet (see docs/benchmarks.md)")
+@pytest.mark.parametrize("mode", ["quality", "fast"])
+def test_peak_per_triangle_meets_the_goal(peaks, mode):
+    assert peaks[mode]["bytes_per_triangle"] <= GOAL[mode]
