@@ -138,6 +138,7 @@ class TeamState {
       waiter_.wake();
     }
   }
+  std::mutex& critical() { return critical_; }
   void rethrow() {
     if (error_) std::rethrow_exception(error_);
   }
@@ -148,11 +149,14 @@ class TeamState {
   std::atomic<uint64_t> epoch_{0};
   std::atomic<bool> aborted_{false};
   Waiter waiter_;
+  std::mutex critical_;
   std::mutex error_mutex_;
   std::exception_ptr error_;
 };
 
 void Team::barrier() { state_.barrier(); }
+void Team::lock() { state_.critical().lock(); }
+void Team::unlock() { state_.critical().unlock(); }
 
 namespace {
 

@@ -81,12 +81,23 @@ class Team {
   int size() const { return size_; }
   /// Waits until every member has reached this barrier.
   void barrier();
-  /// Runs f on member 0 between two barriers (the others wait).
+  /// Runs f on member 0, then waits at a barrier (as OpenMP's single: no barrier before it).
   template <class F>
   void single(F f) {
-    barrier();
     if (index_ == 0) f();
     barrier();
+  }
+  /// Runs f while no other member of the team runs a critical section.
+  template <class F>
+  void critical(F f) {
+    lock();
+    try {
+      f();
+    } catch (...) {
+      unlock();
+      throw;
+    }
+    unlock();
   }
   /// body(i) for this member's static chunk of [begin, end) (no barrier after it).
   template <class F>
@@ -94,8 +105,17 @@ class Team {
     const Range r = static_chunk(begin, end, index_, size_);
     for (int64_t i = r.begin; i < r.end; ++i) body(i);
   }
+  /// body(i) for runs of `grain` indices taken in turn from the shared counter `next` (set to the
+  /// first index before the region) up to end, by whichever member is free (no barrier after it).
+  template <class F>
+  void for_dynamic(std::atomic<int64_t>& next, int64_t end, int64_t grain, F&& body) const {
+    for (int64_t first; (first = next.fetch_add(grain, std::memory_order_relaxed)) < end;)
+      for (int64_t i = first, last = std::min(end, first + grain); i < last; ++i) body(i);
+  }
 
  private:
+  void lock();
+  void unlock();
   TeamState& state_;
   int index_, size_;
 };
@@ -153,10 +173,7 @@ void parallel_for_dynamic(int64_t begin, int64_t end, int64_t grain, int64_t min
     return;
   }
   std::atomic<int64_t> next{begin};
-  parallel_region(team, [&](Team&) {
-    for (int64_t first; (first = next.fetch_add(grain, std::memory_order_relaxed)) < end;)
-      for (int64_t i = first, last = std::min(end, first + grain); i < last; ++i) body(i);
-  });
+  parallel_region(team, [&](Team& t) { t.for_dynamic(next, end, grain, body); });
 }
 
 /// Each member's accumulate(partial, i) over its static chunk into its own partial (a copy of
