@@ -202,12 +202,16 @@ T parallel_reduce(int64_t begin, int64_t end, int64_t min_parallel, const T& ide
   return total;
 }
 
+/// parallel_reduce for counts: accumulate(count, i) adds to a count of an exact (integer) type.
+template <class T, class Accumulate>
+T parallel_sum(int64_t begin, int64_t end, int64_t min_parallel, Accumulate&& accumulate) {
+  return parallel_reduce(begin, end, min_parallel, T{}, accumulate, [](T& total, const T& part) { total += part; });
+}
+
 /// Sum of term(i) over [begin, end) for exact (integer) terms.
 template <class T, class Term>
 T parallel_count(int64_t begin, int64_t end, int64_t min_parallel, Term&& term) {
-  return parallel_reduce(
-      begin, end, min_parallel, T{}, [&](T& sum, int64_t i) { sum += term(i); },
-      [](T& total, const T& part) { total += part; });
+  return parallel_sum<T>(begin, end, min_parallel, [&](T& sum, int64_t i) { sum += term(i); });
 }
 
 /// Runs a() and b() at once on two threads when `threads` (else one after the other).
