@@ -16,6 +16,10 @@
 
 #include "core/machine_load.hpp"
 
+#if defined(__unix__) || defined(__APPLE__)
+#include <pthread.h>
+#endif
+
 #if defined(__x86_64__) || defined(__i386__) || defined(_M_X64) || defined(_M_IX86)
 #include <immintrin.h>
 #define TOPSTOC_PAUSE() _mm_pause()
@@ -214,6 +218,21 @@ class Pool {
 
 thread_local std::unique_ptr<Pool> t_pool;
 
+// A forked child has only the thread that forked: the pool it inherited has no workers, so it is
+// abandoned (not joined) and the next parallel call makes a new one.
+std::atomic<unsigned> forks{0};
+thread_local unsigned t_pool_fork = 0;
+
+void watch_forks() {
+#if defined(__unix__) || defined(__APPLE__)
+  static const bool registered = [] {
+    pthread_atfork(nullptr, nullptr, [] { forks.fetch_add(1); });
+    return true;
+  }();
+  (void)registered;
+#endif
+}
+
 }  // namespace
 
 namespace detail {
@@ -232,7 +251,12 @@ void run_team(int threads, void (*run)(void*, Team&), void* context) {
     run(context, team);
     return;
   }
-  if (!t_pool) t_pool = std::make_unique<Pool>();
+  if (t_pool && t_pool_fork != forks.load()) (void)t_pool.release();  // its workers are gone
+  if (!t_pool) {
+    watch_forks();
+    t_pool = std::make_unique<Pool>();
+    t_pool_fork = forks.load();
+  }
   TeamState state(threads);
   t_in_team = true;
   t_pool->run(threads, run, context, state);
@@ -246,15 +270,7 @@ int max_threads() { return t_in_team ? 1 : (t_max_threads > 0 ? t_max_threads : 
 
 void set_max_threads(int threads) { t_max_threads = std::max(1, threads); }
 
-#ifdef _OPENMP
-}  // namespace topstoc
-#include <omp.h>
-namespace topstoc {
-// While some loops still run on OpenMP teams (the conversion in progress).
-int thread_index() { return t_in_team || t_index ? t_index : omp_get_thread_num(); }
-#else
 int thread_index() { return t_index; }
-#endif
 
 int free_cores() {
   const int others = other_runnable_threads();
