@@ -13,7 +13,37 @@
 #include <cstdint>
 #include <vector>
 
+#if defined(_MSC_VER)
+#define TOPSTOC_NOINLINE __declspec(noinline)
+#define TOPSTOC_RESTRICT
+#elif defined(__GNUC__) || defined(__clang__)
+#define TOPSTOC_NOINLINE __attribute__((noinline))
+#define TOPSTOC_RESTRICT __restrict__
+#else
+#define TOPSTOC_NOINLINE
+#define TOPSTOC_RESTRICT
+#endif
+
 namespace topstoc {
+
+namespace detail {
+// A loop's steps run in a function of their own, as OpenMP outlines a loop: the compiler then
+// inlines the body into this small function (inside a large caller it stops inlining), and the
+// closure is reached through this reference alone, so stores through byte pointers in the body
+// do not force its captures to be read again at every step.
+template <class F>
+TOPSTOC_NOINLINE void run_range(int64_t begin, int64_t end, F& TOPSTOC_RESTRICT body) {
+  for (int64_t i = begin; i < end; ++i) body(i);
+}
+
+// The same for a reduction, into a local copy of the partial that the body's stores cannot alias.
+template <class T, class F>
+TOPSTOC_NOINLINE void accumulate_range(int64_t begin, int64_t end, T& partial, F& TOPSTOC_RESTRICT accumulate) {
+  T local = partial;
+  for (int64_t i = begin; i < end; ++i) accumulate(local, i);
+  partial = local;
+}
+}  // namespace detail
 
 /// Loops shorter than this run on one thread: waking and joining workers costs more than they
 /// save below it, and far more when other programs hold the cores (inside Blender a small
@@ -103,14 +133,14 @@ class Team {
   template <class F>
   void for_static(int64_t begin, int64_t end, F&& body) const {
     const Range r = static_chunk(begin, end, index_, size_);
-    for (int64_t i = r.begin; i < r.end; ++i) body(i);
+    detail::run_range(r.begin, r.end, body);
   }
   /// body(i) for runs of `grain` indices taken in turn from the shared counter `next` (set to the
   /// first index before the region) up to end, by whichever member is free (no barrier after it).
   template <class F>
   void for_dynamic(std::atomic<int64_t>& next, int64_t end, int64_t grain, F&& body) const {
     for (int64_t first; (first = next.fetch_add(grain, std::memory_order_relaxed)) < end;)
-      for (int64_t i = first, last = std::min(end, first + grain); i < last; ++i) body(i);
+      detail::run_range(first, std::min(end, first + grain), body);
   }
 
  private:
@@ -153,9 +183,7 @@ template <class F>
 void parallel_for(int64_t begin, int64_t end, int64_t min_parallel, F&& body) {
   const int team = team_for(end - begin, min_parallel);
   if (team <= 1) {
-    detail::serially([&] {
-      for (int64_t i = begin; i < end; ++i) body(i);
-    });
+    detail::serially([&] { detail::run_range(begin, end, body); });
     return;
   }
   parallel_region(team, [&](Team& t) { t.for_static(begin, end, body); });
@@ -167,9 +195,7 @@ template <class F>
 void parallel_for_dynamic(int64_t begin, int64_t end, int64_t grain, int64_t min_parallel, F&& body) {
   const int team = team_for(end - begin, min_parallel);
   if (team <= 1) {
-    detail::serially([&] {
-      for (int64_t i = begin; i < end; ++i) body(i);
-    });
+    detail::serially([&] { detail::run_range(begin, end, body); });
     return;
   }
   std::atomic<int64_t> next{begin};
@@ -185,9 +211,7 @@ T parallel_reduce(int64_t begin, int64_t end, int64_t min_parallel, const T& ide
   const int team = team_for(end - begin, min_parallel);
   T total = identity;
   if (team <= 1) {
-    detail::serially([&] {
-      for (int64_t i = begin; i < end; ++i) accumulate(total, i);
-    });
+    detail::serially([&] { detail::accumulate_range(begin, end, total, accumulate); });
     return total;
   }
   struct alignas(64) Slot {
@@ -195,8 +219,8 @@ T parallel_reduce(int64_t begin, int64_t end, int64_t min_parallel, const T& ide
   };
   std::vector<Slot> partial(size_t(team), Slot{identity});
   parallel_region(team, [&](Team& t) {
-    T& mine = partial[size_t(t.index())].value;
-    t.for_static(begin, end, [&](int64_t i) { accumulate(mine, i); });
+    const Range r = static_chunk(begin, end, t.index(), t.size());
+    detail::accumulate_range(r.begin, r.end, partial[size_t(t.index())].value, accumulate);
   });
   for (const Slot& p : partial) combine(total, p.value);
   return total;
