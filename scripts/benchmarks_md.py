@@ -224,6 +224,24 @@ def render_carried_over(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def render_paired(name: str, figures: dict) -> str:
+    """bench_threads_paired.py --json: two builds in alternating runs, the median of the pair ratios."""
+    pairs = figures["pairs"]
+    out = [f"## Paired runs: {figures['new']} against {figures['old']} (`{name}`)", "",
+           *source_lines(figures),
+           f"- Method: `tests/bench/bench_decimate.py` on {figures['mesh']} at {figures['ratio']:.0%}, "
+           f"{figures['repeats']} repeats per run, {len(pairs)} pairs of runs with the builds alternating; "
+           f"load average {figures['load_average']:.1f} at the end", "",
+           "| Figure | Old (median) | New (median) | New / old, median of the pairs | Pairs' range |",
+           "|---|---|---|---|---|"]
+    for label, ratio in figures["median_ratio"].items():
+        ratios = [p[label]["new"] / p[label]["old"] for p in pairs]
+        old = statistics.median(p[label]["old"] for p in pairs)
+        new = statistics.median(p[label]["new"] for p in pairs)
+        out.append(f"| {label} | {ms(old)} | {ms(new)} | {ratio:.3f} | {min(ratios):.3f}–{max(ratios):.3f} |")
+    return "\n".join(out) + "\n"
+
+
 def render_result(path: pathlib.Path) -> str:
     figures = json.loads(path.read_text())
     if isinstance(figures, dict) and figures.get("carried_over"):
@@ -236,9 +254,11 @@ def render_result(path: pathlib.Path) -> str:
         return render_loop_families(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_scale.py":
         return render_scale(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_threads_paired.py":
+        return render_paired(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
-                     "the --json of bench_decimate.py, bench_quality.py, bench_loops.py --families and "
-                     "bench_scale.py, and carried-over figures)")
+                     "the --json of bench_decimate.py, bench_quality.py, bench_loops.py --families, "
+                     "bench_scale.py and bench_threads_paired.py, and carried-over figures)")
 
 
 def render() -> str:

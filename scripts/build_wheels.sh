@@ -2,7 +2,7 @@
 # Makes the self-contained Linux x86-64 wheels in dist/ (see docs/packaging.md):
 #   topstoc-VERSION-cp3XX-cp3XX-manylinux_*.whl         pip: the package (API, CLI, add-on) + module
 #   topstoc_native-VERSION-cp3XX-cp3XX-manylinux_*.whl  the module only, for the Blender extension
-# for CPython 3.11 (Blender 4.2-5.0) and 3.13 (Blender 5.1+). TetGen, libgomp and OpenMesh are
+# for CPython 3.11 (Blender 4.2-5.0) and 3.13 (Blender 5.1+). TetGen and OpenMesh are
 # bundled by auditwheel (renamed copies in *.libs/, found through RUNPATH); glibc and libstdc++
 # come from the system, as the manylinux policy printed at the end allows.
 #

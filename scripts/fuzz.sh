@@ -15,7 +15,7 @@ SECONDS_EACH=${1:-10}
 shift || true
 TARGETS=("$@")
 [ ${#TARGETS[@]} -eq 0 ] && TARGETS=(fuzz_read_obj fuzz_read_ply fuzz_read_off fuzz_read_stl fuzz_round_trip fuzz_decimate)
-ensure_packages $RUNTIME_PACKAGES clang-14 libclang-rt-14-dev libomp-14-dev || exit 1
+ensure_packages $RUNTIME_PACKAGES clang-14 libclang-rt-14-dev || exit 1
 
 BUILD=${TOPSTOC_FUZZ_BUILD:-build-fuzz}
 launcher=()
@@ -33,7 +33,7 @@ CORPUS_ROOT=${TOPSTOC_CACHE:-/var/cache/topstoc}/fuzz
 # libFuzzer's own leak detection needs ptrace, which containers often forbid).
 export ASAN_OPTIONS=${ASAN_OPTIONS:-abort_on_error=1:detect_leaks=0:allocator_may_return_null=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-export OMP_NUM_THREADS=1
+export TOPSTOC_NUM_THREADS=1
 failed=()
 total=0
 for target in "${TARGETS[@]}"; do

@@ -5,7 +5,7 @@
 #   topstoc_native-VERSION-cp3XX-...whl                         the extension's engine wheels
 #   topstoc-VERSION-linux_x64.zip                               Blender 4.2+ (scripts/build_extension.sh)
 #   topstoc-VERSION-legacy-addon.zip                            Blender 3.4-4.1 with CPython 3.11
-# The legacy zip holds the engine built on this machine (it needs this system's TetGen and libgomp).
+# The legacy zip holds the engine built on this machine (it needs this system's TetGen).
 set -eu -o pipefail
 cd "$(dirname "$0")/.."
 if [ "$(id -u)" != 0 ]; then

@@ -1,7 +1,10 @@
 #!/usr/bin/python3
 """Decimation speed next to meshoptimizer, measured in the same run (issue 2 benchmark).
 
-    /usr/bin/python3 tests/bench/bench_decimate.py [MESH] [--ratios 0.1,0.01] [--repeats 7] [--json FILE]
+    /usr/bin/python3 tests/bench/bench_decimate.py [MESH] [--ratios 0.1,0.01] [--repeats 7] [--json FILE] [--no-peer]
+
+The engine comes from build/python, or from TOPSTOC_BENCH_BUILD/python when that is set (another
+build of the same checkout: bench_threads_paired.py compares two this way).
 
 Default mesh: ../shared/meshes/big/horse_loop2_1.55M.ply (skips cleanly when absent). Times:
   - first decimation: topstoc.Mesh (validation, adjacency, weights) + decimate, file read excluded;
@@ -30,14 +33,15 @@ import sys
 import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "build" / "python"))
+BUILD = pathlib.Path(os.environ.get("TOPSTOC_BENCH_BUILD", ROOT / "build"))
+sys.path.insert(0, str(BUILD / "python"))
 
 from topstoc.core import Mesh, read_mesh  # noqa: E402
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from machine import machine  # noqa: E402
 
 DEFAULT_MESH = ROOT.parent / "shared" / "meshes" / "big" / "horse_loop2_1.55M.ply"
-PEER = ROOT / "build" / "peers" / "meshopt_bench"
+PEER = BUILD / "peers" / "meshopt_bench"
 REFINED = {"mode": "quality"}
 
 
@@ -51,6 +55,7 @@ def main() -> int:
     parser.add_argument("--ratios", default="0.1,0.01")
     parser.add_argument("--repeats", type=int, default=7)
     parser.add_argument("--json", metavar="FILE", help="write the medians and the machine here")
+    parser.add_argument("--no-peer", action="store_true", help="skip meshoptimizer (comparing our builds only)")
     args = parser.parse_args()
     path = pathlib.Path(args.mesh)
     if not path.exists():
@@ -109,7 +114,7 @@ def main() -> int:
             mesh.decimate(ratio=step, seed=2, mode="fast", draft=True)
             draft_steps.append(time.perf_counter() - start)
         peer = None
-        if PEER.exists():
+        if PEER.exists() and not args.no_peer:
             out = subprocess.run([str(PEER), str(path), str(ratio), str(args.repeats)], capture_output=True,
                                  text=True, check=True)
             peer = json.loads(out.stdout)

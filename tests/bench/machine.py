@@ -6,7 +6,7 @@ import platform
 
 
 def machine() -> str:
-    """Cores, OpenMP threads, CPU model, kernel and load average, on one line."""
+    """Cores, the engine's thread limit, CPU model, kernel and load average, on one line."""
     model = "unknown CPU"
     try:
         for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
@@ -15,7 +15,7 @@ def machine() -> str:
                 break
     except OSError:
         pass
-    threads = os.environ.get("OMP_NUM_THREADS", str(os.cpu_count()))
+    threads = os.environ.get("TOPSTOC_NUM_THREADS") or os.environ.get("OMP_NUM_THREADS") or str(os.cpu_count())
     load = " ".join(f"{x:.2f}" for x in os.getloadavg())
-    return (f"{os.cpu_count()} cores ({threads} OpenMP threads), {model}, "
+    return (f"{os.cpu_count()} cores (at most {threads} threads), {model}, "
             f"{platform.system()} {platform.release()}, load average {load}")

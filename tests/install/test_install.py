@@ -26,7 +26,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 DIST = ROOT / "dist"
 CACHE = pathlib.Path(os.environ.get("TOPSTOC_CACHE", "/var/cache/topstoc"))
 MESH = ROOT / "tests" / "data" / "genus_positive" / "cgal_eight.off"
-BUNDLED = ("libtet", "libgomp")  # what the roots lack and the wheels carry (OpenMesh: headers only)
+BUNDLED = ("libtet",)  # what the roots lack and the wheels carry (OpenMesh: headers only; threads: the engine's own)
 
 sys.path.insert(0, str(ROOT / "build" / "python"))
 import topstoc  # noqa: E402  (this checkout's build: the reference)
@@ -160,8 +160,7 @@ def test_blender_installs_the_extension_and_runs_guided_decimate(tmp_path):
     native_file = next(l for l in out.splitlines() if l.startswith("NATIVE")).split(maxsplit=1)[1]
     assert "/extensions/.local/lib/python3.13/site-packages/topstoc_native/" in native_file
     maps = out.split("MAPS", 1)[1]
-    # libtet exists only in the wheel; Blender itself links the system libgomp, and the module
-    # must still use its own renamed copy.
+    # libtet exists only in the wheel: the module must use its own renamed copy.
     for name, paths in loaded_from_wheel(maps).items():
         assert any("/site-packages/topstoc_native.libs/" in p for p in paths), (name, paths)
 

@@ -3,7 +3,6 @@
 // on the whole sample list, and flood_update() against flood() on the new list, as
 // clustering.hpp promises.
 #include <doctest/doctest.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <climits>
@@ -13,6 +12,7 @@
 #include <vector>
 
 #include "meshes.hpp"
+#include "topstoc/core/parallel.hpp"
 #include "topstoc/decimate/clustering.hpp"
 #include "topstoc/decimate/features.hpp"
 #include "topstoc/io/io.hpp"
@@ -156,11 +156,11 @@ TEST_CASE("flood on several threads gives the keys and crossing edges of one thr
   std::mt19937 random(31);
   const Mesh mesh = make_mesh(topstoc_test::torus(300, 160));  // 48,000 vertices
   const auto layout = no_features(mesh);
-  const int before = omp_get_max_threads();
+  const int before = max_threads();
   for (const int32_t count : {9000, 1500}) {  // the first level parallel, or only later ones
     const auto samples = topstoc_test::random_samples(mesh.num_vertices(), count, random);
     auto run = [&](int threads, std::vector<int32_t>& cross) {
-      omp_set_num_threads(threads);
+      set_max_threads(threads);
       Clustering c;
       flood(mesh, *layout, samples, c, &cross);
       std::sort(cross.begin(), cross.end());
@@ -175,7 +175,7 @@ TEST_CASE("flood on several threads gives the keys and crossing edges of one thr
       CHECK(cross_many == cross_one);
     }
   }
-  omp_set_num_threads(before);
+  set_max_threads(before);
 }
 
 // Both incremental updates against a fresh flood, on each mesh.

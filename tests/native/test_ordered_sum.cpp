@@ -1,8 +1,7 @@
 // Parallel sums in fixed blocks (core/ordered_sum.hpp): serial == parallel to the bit, on data
-// where a plain OpenMP reduction is not; and the two sums that used such a reduction
+// where a plain per-thread reduction is not; and the two sums that used such a reduction
 // (aspect_ratio_stats, Hausdorff's sample count) on a mesh large enough for the parallel path.
 #include <doctest/doctest.h>
-#include <omp.h>
 
 #include <cmath>
 #include <cstring>
@@ -11,6 +10,7 @@
 #include <vector>
 
 #include "core/ordered_sum.hpp"
+#include "topstoc/core/parallel.hpp"
 #include "meshes.hpp"
 #include "topstoc/core/quality.hpp"
 #include "topstoc/distance/hausdorff.hpp"
@@ -19,13 +19,13 @@ using namespace topstoc;
 
 namespace {
 
-// Runs f with the given OpenMP team size, restoring the previous one.
+// Runs f with the given team size, restoring the previous one.
 template <class F>
 auto with_threads(int threads, F f) {
-  const int before = omp_get_max_threads();
-  omp_set_num_threads(threads);
+  const int before = max_threads();
+  set_max_threads(threads);
   auto result = f();
-  omp_set_num_threads(before);
+  set_max_threads(before);
   return result;
 }
 
@@ -56,7 +56,6 @@ topstoc_test::Arrays big_torus() {
 }  // namespace
 
 TEST_CASE("ordered_sum: fixed blocks in order, the same bits on 1, 2 and 3 threads") {
-  REQUIRE(omp_get_num_procs() >= 1);
   const auto x = uneven_terms(3 * kParallelMin + 17);
   const int64_t n = int64_t(x.size());
   // The reference, written out: each block of kSumBlock in order, then the blocks in order.
@@ -72,10 +71,8 @@ TEST_CASE("ordered_sum: fixed blocks in order, the same bits on 1, 2 and 3 threa
   }
   // The data is such that a plain reduction's bits follow the thread count (what was fixed).
   auto reduction = [&] {
-    double sum = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : sum)
-    for (int64_t i = 0; i < n; ++i) sum += x[i];
-    return sum;
+    return parallel_reduce(
+        0, n, 0, 0.0, [&](double& sum, int64_t i) { sum += x[i]; }, [](double& sum, double part) { sum += part; });
   };
   CHECK_FALSE(same_bits(with_threads(1, reduction), with_threads(2, reduction)));
 }

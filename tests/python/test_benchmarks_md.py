@@ -120,3 +120,17 @@ def test_scale_results_render_ratios_and_growth():
     assert rows[2][4:] == ["20.00 s", "90 B", "—", "—", "—"]
     # 20 / 2 and 15 / 1.5
     assert "(10× the size) the cold time grew quality 10.0× and fast 10.0×" in text
+
+
+def test_paired_results_render_the_median_of_the_pair_ratios():
+    # new / old per pair: 0.9, 1.2, 1.0 -> median 1.0 (not 1.05 / 1.0, the ratio of the medians)
+    pairs = [{"re-decimation": {"old": 100.0, "new": 90.0}}, {"re-decimation": {"old": 50.0, "new": 60.0}},
+             {"re-decimation": {"old": 200.0, "new": 200.0}}]
+    figures = {"benchmark": "tests/bench/bench_threads_paired.py", "machine": "m", "date": "2000-01-01",
+               "load_average": 3.0, "mesh": "h.ply", "ratio": 0.1, "repeats": 3, "old": "A", "new": "B",
+               "pairs": pairs, "median_ratio": {"re-decimation": 1.0}}
+    text = benchmarks_md.render_paired("p.json", figures)
+    row = [line for line in text.splitlines() if line.startswith("| re-decimation")][0]
+    assert [cell.strip() for cell in row.strip("|").split("|")] == ["re-decimation", "100 ms", "90 ms", "1.000",
+                                                                   "0.900–1.200"]
+    assert "3 pairs of runs" in text and "## Paired runs: B against A" in text

@@ -36,5 +36,5 @@ def test_the_digest_does_not_depend_on_the_number_of_threads():
     code = ("import numpy as np; from topstoc.core.support.digest import array_digest; "
             "print(array_digest(np.arange(3_000_000, dtype=np.int64) * 7919 % 1000003))")
     outputs = {subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                              env={**os.environ, "OMP_NUM_THREADS": threads, "PYTHONPATH": str(BUILD / "python")}).stdout for threads in ("1", "2")}
+                              env={**os.environ, "TOPSTOC_NUM_THREADS": threads, "PYTHONPATH": str(BUILD / "python")}).stdout for threads in ("1", "2")}
     assert len(outputs) == 1

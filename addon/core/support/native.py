@@ -15,16 +15,6 @@ import os
 from . import native_diagnosis
 from .errors import TopStocError
 
-# Idle OpenMP threads spin briefly (about 100,000 turns), then sleep: a decimation runs dozens
-# of parallel loops with short serial stretches between them, and waking a sleeping thread per
-# loop is a noticeable share of a re-decimation, while libgomp's default spin after every loop
-# keeps the cores busy long after. The engine's free-core count
-# does not mistake our own spinning threads for other programs' (parallel.cpp). Only takes
-# effect if libgomp is not loaded yet (plain Python, bpy and the extension's bundled libgomp);
-# Debian's Blender loads its own first. A user's OMP_WAIT_POLICY or GOMP_SPINCOUNT wins.
-if "OMP_WAIT_POLICY" not in os.environ:
-    os.environ.setdefault("GOMP_SPINCOUNT", "100000")
-
 _PACKAGE = __name__.rsplit(".", 3)[0]  # topstoc, or bl_ext.<repository>.topstoc in Blender 4.2+
 
 

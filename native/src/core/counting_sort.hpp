@@ -4,8 +4,6 @@
 // out run by run, so the result never depends on the number of threads.
 #pragma once
 
-#include <omp.h>
-
 #include <algorithm>
 #include <cstdint>
 #include <memory>
@@ -21,7 +19,7 @@ namespace topstoc {
 template <class Key, class Place, class Offsets>
 void stable_counting_sort(int64_t count, int32_t buckets, Key key, Place place, Offsets& offsets) {
   if (count > INT32_MAX) throw std::invalid_argument("mesh is too large: more than 2^31 incidences");
-  const int team = count >= kParallelMin ? omp_get_max_threads() : 1;
+  const int team = count >= kParallelMin ? max_threads() : 1;
   offsets.resize(size_t(buckets) + 1);
   if (team == 1) {  // the plain serial sort: no per-thread tables
     std::fill(offsets.begin(), offsets.end(), 0);
@@ -36,41 +34,40 @@ void stable_counting_sort(int64_t count, int32_t buckets, Key key, Place place, 
   // update) the threads' rows would otherwise share lines that every item writes.
   const size_t row = (size_t(buckets) + 15) / 16 * 16 + 16;
   std::vector<int64_t> range_start;    // per thread: first position of its range of buckets
-#pragma omp parallel num_threads(team)
-  {
+  parallel_region(team, [&](Team& t) {
     // The team may come out smaller than asked; the runs follow the team actually running.
-    const int threads = omp_get_num_threads(), me = omp_get_thread_num();
-#pragma omp single
-    {
+    const int threads = t.size(), me = t.index();
+    t.single([&] {
       cursors.reset(new int32_t[size_t(threads) * row]);  // each thread clears its own row
       range_start.assign(threads + 1, 0);
-    }
+    });
     int32_t* mine = cursors.get() + size_t(me) * row;
     std::fill(mine, mine + buckets, 0);
     const int64_t begin = count * me / threads, end = count * (me + 1) / threads;
     for (int64_t i = begin; i < end; ++i) ++mine[key(i)];
-#pragma omp barrier
+    t.barrier();
     // Each thread totals one range of buckets; the ranges' starts follow in order.
     const int32_t first = int32_t(int64_t(buckets) * me / threads), last = int32_t(int64_t(buckets) * (me + 1) / threads);
     int64_t total = 0;
     for (int32_t b = first; b < last; ++b)
-      for (int t = 0; t < threads; ++t) total += cursors[size_t(t) * row + b];
+      for (int r = 0; r < threads; ++r) total += cursors[size_t(r) * row + b];
     range_start[me + 1] = total;
-#pragma omp barrier
-#pragma omp single
-    for (int t = 0; t < threads; ++t) range_start[t + 1] += range_start[t];
+    t.barrier();
+    t.single([&] {
+      for (int r = 0; r < threads; ++r) range_start[r + 1] += range_start[r];
+    });
     int64_t at = range_start[me];
     for (int32_t b = first; b < last; ++b) {
       offsets[b] = int32_t(at);
-      for (int t = 0; t < threads; ++t) {
-        const int32_t n = cursors[size_t(t) * row + b];
-        cursors[size_t(t) * row + b] = int32_t(at);
+      for (int r = 0; r < threads; ++r) {
+        const int32_t n = cursors[size_t(r) * row + b];
+        cursors[size_t(r) * row + b] = int32_t(at);
         at += n;
       }
     }
-#pragma omp barrier
+    t.barrier();
     for (int64_t i = begin; i < end; ++i) place(i, mine[key(i)]++);
-  }
+  });
   offsets[buckets] = int32_t(count);
 }
 

@@ -45,11 +45,10 @@ std::array<uint64_t, 2> content_digest(const void* data, size_t bytes) {
   const auto* p = static_cast<const unsigned char*>(data);
   const int64_t blocks = int64_t((bytes + kBlockBytes - 1) / kBlockBytes);
   std::vector<std::array<uint64_t, 2>> digests(blocks);
-#pragma omp parallel for schedule(static) if (blocks >= 8)
-  for (int64_t b = 0; b < blocks; ++b) {
+  parallel_for(0, blocks, 8, [&](int64_t b) {
     const size_t begin = size_t(b) * kBlockBytes;
     digests[b] = block_digest(p + begin, std::min(kBlockBytes, bytes - begin), uint64_t(b) * 4);
-  }
+  });
   std::array<uint64_t, 2> h = {mix64(bytes), mix64(~uint64_t(bytes))};
   for (const auto& d : digests) {
     h[0] = mix64(rotate(h[0], 23) ^ d[0]);

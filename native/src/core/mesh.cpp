@@ -1,7 +1,6 @@
 #include "topstoc/core/mesh.hpp"
 #include "topstoc/core/parallel.hpp"
 
-#include <omp.h>
 
 #include <algorithm>
 #include <array>
@@ -237,12 +236,11 @@ void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offse
 void weigh(const Buffer<int32_t>& offsets, const Buffer<int32_t>& adjacency, const Buffer<double>& normals,
            Buffer<double>& weights) {
   const int32_t n = int32_t(offsets.size()) - 1;
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
+  parallel_for(0, n, kParallelMin, [&](int32_t v) {
     const int32_t d = offsets[v + 1] - offsets[v];
     if (d == 0) {
       weights[v] = 0.0;
-      continue;
+      return;
     }
     const int32_t* neighbours = adjacency.data() + offsets[v];
     // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
@@ -253,7 +251,7 @@ void weigh(const Buffer<int32_t>& offsets, const Buffer<int32_t>& adjacency, con
       dots += nv[0] * nu[0] + nv[1] * nu[1] + nv[2] * nu[2];
     }
     weights[v] = std::clamp((double(d) - dots) / (2.0 * double(d)), 0.0, 1.0);
-  }
+  });
 }
 
 // Components, numbered in order of their lowest vertex (each set's root), and the Euler
@@ -262,8 +260,7 @@ void weigh(const Buffer<int32_t>& offsets, const Buffer<int32_t>& adjacency, con
 int32_t number_components(SharedUnionFind& sets, const Buffer<int32_t>& vfo, const Buffer<int32_t>& euler,
                           Buffer<int32_t>& root, Buffer<int32_t>& component, Buffer<int64_t>& component_euler) {
   const int32_t n = int32_t(vfo.size()) - 1;
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) root[v] = sets.find(v);
+  parallel_for(0, n, kParallelMin, [&](int32_t v) { root[v] = sets.find(v); });
   component.resize(n);
   int32_t components = 0;
   for (int32_t v = 0; v < n; ++v) {
@@ -308,16 +305,17 @@ Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangl
   if (num_triangles > INT32_MAX / 3) throw std::invalid_argument("mesh is too large: more than 2^31 / 3 triangles");
   require_finite_positions(positions, num_vertices_);
   // Minimum and maximum are exact, so the box is the same on any number of threads.
-  double lo0 = positions[0], lo1 = positions[1], lo2 = positions[2], hi0 = lo0, hi1 = lo1, hi2 = lo2;
-  const int32_t n = num_vertices_;
-#pragma omp parallel for schedule(static) reduction(min : lo0, lo1, lo2) reduction(max : hi0, hi1, hi2) \
-    if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
-    const double* p = positions + 3 * size_t(v);
-    lo0 = std::min(lo0, p[0]), lo1 = std::min(lo1, p[1]), lo2 = std::min(lo2, p[2]);
-    hi0 = std::max(hi0, p[0]), hi1 = std::max(hi1, p[1]), hi2 = std::max(hi2, p[2]);
-  }
-  const double lo[3] = {lo0, lo1, lo2}, hi[3] = {hi0, hi1, hi2};
+  using Box = std::array<double, 6>;  // lowest x, y, z, highest x, y, z
+  const Box box = parallel_reduce(
+      0, num_vertices_, kParallelMin, Box{positions[0], positions[1], positions[2], positions[0], positions[1], positions[2]},
+      [&](Box& b, int32_t v) {
+        const double* p = positions + 3 * size_t(v);
+        for (int k = 0; k < 3; ++k) b[k] = std::min(b[k], p[k]), b[k + 3] = std::max(b[k + 3], p[k]);
+      },
+      [](Box& b, const Box& part) {
+        for (int k = 0; k < 3; ++k) b[k] = std::min(b[k], part[k]), b[k + 3] = std::max(b[k + 3], part[k + 3]);
+      });
+  const double lo[3] = {box[0], box[1], box[2]}, hi[3] = {box[3], box[4], box[5]};
   diagonal_ = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
@@ -334,20 +332,24 @@ void Mesh::validate_faces(const int32_t* triangles, int64_t num_triangles) {
   // shared check names the row); a repeated vertex drops the triangle.
   const int64_t m = num_triangles;
   const uint32_t n = uint32_t(num_vertices_);
-  int out_of_range = 0, degenerate = 0;
-#pragma omp parallel for schedule(static) reduction(| : out_of_range) reduction(+ : degenerate) if (m >= kParallelMin)
-  for (int64_t f = 0; f < m; ++f) {
-    const int32_t* t = triangles + 3 * f;
-    out_of_range |= (uint32_t(t[0]) >= n) | (uint32_t(t[1]) >= n) | (uint32_t(t[2]) >= n);
-    degenerate += (t[0] == t[1]) | (t[1] == t[2]) | (t[2] == t[0]);
-  }
+  struct Counts {
+    int out_of_range = 0, degenerate = 0;
+  };
+  const Counts counts = parallel_reduce(
+      0, m, kParallelMin, Counts{},
+      [&](Counts& c, int64_t f) {
+        const int32_t* t = triangles + 3 * f;
+        c.out_of_range |= (uint32_t(t[0]) >= n) | (uint32_t(t[1]) >= n) | (uint32_t(t[2]) >= n);
+        c.degenerate += (t[0] == t[1]) | (t[1] == t[2]) | (t[2] == t[0]);
+      },
+      [](Counts& c, const Counts& part) { c.out_of_range |= part.out_of_range, c.degenerate += part.degenerate; });
+  const int out_of_range = counts.out_of_range, degenerate = counts.degenerate;
   if (out_of_range) require_indices_in_range(triangles, num_triangles, 3, num_vertices_, "triangle");
   report_.degenerate_triangles = degenerate;
   // The candidates, in input order; duplicates among them go once the vertices are renumbered.
   face_source_.resize(m - degenerate);
   if (degenerate == 0) {
-#pragma omp parallel for schedule(static) if (m >= kParallelMin)
-    for (int64_t f = 0; f < m; ++f) face_source_[f] = int32_t(f);
+    parallel_for(0, m, kParallelMin, [&](int64_t f) { face_source_[f] = int32_t(f); });
   } else {
     int64_t j = 0;
     for (int64_t f = 0; f < m; ++f) {
@@ -385,8 +387,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
   Buffer<uint64_t> key(n), other_key(n);
   Buffer<int32_t> other_vertex(n);
   vertex_source_.resize(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
+  parallel_for(0, n, kParallelMin, [&](int32_t v) {
     vertex_source_[v] = v;
     uint64_t k = 0;
     for (int axis = 0; axis < 3; ++axis) {
@@ -397,7 +398,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
       k |= spread_bits(uint64_t(unit * 2097151.0)) << axis;
     }
     key[v] = k;
-  }
+  });
   // Vertices by key, ties by vertex: a stable least-significant-digit radix sort over the 63
   // bits the keys use, starting from vertex order.
   {
@@ -423,12 +424,11 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
   Buffer<int32_t>().swap(other_vertex);
   vertex_index_.resize(n);
   positions_.resize(3 * size_t(n));
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t i = 0; i < n; ++i) {
+  parallel_for(0, n, kParallelMin, [&](int32_t i) {
     const int32_t old = vertex_source_[i];
     vertex_index_[old] = i;
     for (int k = 0; k < 3; ++k) positions_[3 * size_t(i) + k] = positions[3 * size_t(old) + k];
-  }
+  });
   // The candidate faces in the new numbering, in order of their lowest vertex, ties in input
   // order. A counting sort with a bucket per vertex scatters every face to a random place;
   // instead the keys (lowest vertex, candidate) are radix-sorted in
@@ -440,13 +440,12 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
   const int32_t m = static_cast<int32_t>(face_source_.size());
   Buffer<uint64_t> keyed(m);
   Buffer<int32_t> renumbered(3 * size_t(m));
-#pragma omp parallel for schedule(static) if (m >= kParallelMin)
-  for (int32_t i = 0; i < m; ++i) {
+  parallel_for(0, m, kParallelMin, [&](int32_t i) {
     const int32_t* t = &triangles[3 * size_t(face_source_[i])];
     int32_t* r = &renumbered[3 * size_t(i)];
     for (int c = 0; c < 3; ++c) r[c] = vertex_index_[t[c]];
     keyed[i] = (uint64_t(uint32_t(std::min({r[0], r[1], r[2]}))) << 32) | uint32_t(i);
-  }
+  });
   {
     int bits = 1;
     while (bits < 31 && (int64_t(1) << bits) < int64_t(n)) ++bits;
@@ -465,8 +464,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
   }
   faces_.resize(3 * size_t(m));
   Buffer<int32_t> source(m), lowest_offsets(size_t(n) + 1);
-#pragma omp parallel for schedule(static) if (m >= kParallelMin)
-  for (int32_t j = 0; j < m; ++j) {
+  parallel_for(0, m, kParallelMin, [&](int32_t j) {
     // The rows are read in a new order: fetch a few faces ahead.
     if (j + 8 < m) __builtin_prefetch(&renumbered[3 * size_t(keyed[j + 8] & 0xffffffffu)]);
     const int64_t i = int64_t(keyed[j] & 0xffffffffu);
@@ -476,7 +474,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     // this face's, starts here.
     const int64_t lowest = int64_t(keyed[j] >> 32), previous = j ? int64_t(keyed[j - 1] >> 32) : -1;
     for (int64_t v = previous + 1; v <= lowest; ++v) lowest_offsets[v] = j;
-  }
+  });
   for (int64_t v = int64_t(keyed[m - 1] >> 32) + 1; v <= int64_t(n); ++v) lowest_offsets[v] = m;
   Buffer<int32_t>().swap(renumbered);
   face_source_.swap(source);
@@ -490,13 +488,12 @@ void Mesh::drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets) {
   const int32_t m = num_faces();
   std::vector<uint8_t> duplicate(m, 0);
   int32_t duplicates = 0;
-#pragma omp parallel reduction(+ : duplicates) if (n >= kParallelMin)
-  {
+  parallel_region(team_for(n, kParallelMin), [&](Team& team) {
     std::vector<std::pair<uint64_t, int32_t>> run;  // (other two vertices, face), long runs only
-#pragma omp for schedule(static)
-    for (int32_t v = 0; v < n; ++v) {
+    int32_t found = 0;                              // this thread's duplicates
+    team.for_static(0, n, [&](int32_t v) {
       const int32_t b = lowest_offsets[v], e = lowest_offsets[v + 1];
-      if (e - b < 2) continue;
+      if (e - b < 2) return;
       auto others = [&](int32_t f) {
         const int32_t* t = &faces_[3 * size_t(f)];
         const int32_t x = t[0] == v ? t[1] : t[0], y = t[2] == v ? t[1] : t[2];
@@ -507,17 +504,18 @@ void Mesh::drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets) {
           if (duplicate[i]) continue;
           const uint64_t key = others(i);
           for (int32_t j = i + 1; j < e; ++j)
-            if (!duplicate[j] && others(j) == key) duplicate[j] = 1, ++duplicates;
+            if (!duplicate[j] && others(j) == key) duplicate[j] = 1, ++found;
         }
       } else {  // a fan around a low vertex: sort instead of comparing every pair
         run.clear();
         for (int32_t i = b; i < e; ++i) run.push_back({others(i), i});
         std::sort(run.begin(), run.end());
         for (size_t i = 1; i < run.size(); ++i)
-          if (run[i].first == run[i - 1].first) duplicate[run[i].second] = 1, ++duplicates;
+          if (run[i].first == run[i - 1].first) duplicate[run[i].second] = 1, ++found;
       }
-    }
-  }
+    });
+    team.critical([&] { duplicates += found; });
+  });
   if (duplicates == 0) return;
   report_.duplicate_triangles = duplicates;
   // Dropped triangles (the repeated-vertex ones are there already) in input order, with rows.
@@ -548,9 +546,9 @@ void Mesh::drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets) {
 std::vector<int32_t> Mesh::caller_triangles() const {
   std::vector<int32_t> out(3 * size_t(report_.input_triangles));
   const int32_t m = num_faces();
-#pragma omp parallel for schedule(static) if (m >= kParallelMin)
-  for (int32_t f = 0; f < m; ++f)
+  parallel_for(0, m, kParallelMin, [&](int32_t f) {
     for (int c = 0; c < 3; ++c) out[3 * size_t(face_source_[f]) + c] = vertex_source_[faces_[3 * size_t(f) + c]];
+  });
   for (size_t i = 0; i < report_.dropped_triangles.size(); ++i)
     for (int c = 0; c < 3; ++c) out[3 * size_t(report_.dropped_triangles[i]) + c] = dropped_rows_[3 * i + c];
   return out;
@@ -562,10 +560,9 @@ void Mesh::build_vertex_faces() {
   stable_counting_sort(
       int64_t(faces_.size()), num_vertices_, [&](int64_t c) { return faces_[c]; },
       [&](int64_t c, int32_t at) { vertex_faces_[at] = int32_t(c / 3); }, vertex_face_offsets_);
-  int32_t isolated = 0;
   const int32_t n = num_vertices_;
-#pragma omp parallel for schedule(static) reduction(+ : isolated) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) isolated += vertex_face_offsets_[v + 1] == vertex_face_offsets_[v];
+  const int32_t isolated = parallel_count<int32_t>(
+      0, n, kParallelMin, [&](int32_t v) { return vertex_face_offsets_[v + 1] == vertex_face_offsets_[v]; });
   report_.isolated_vertices = isolated;
 }
 
@@ -587,15 +584,15 @@ void Mesh::build_adjacency(Progress& progress) {
   const OneRingArrays arrays{faces_, face_source_, vertex_faces_, vfo, positions_, scratch, degree, greater,
                              euler, first_corner_, manifold_vertex_, sets};
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
-#pragma omp parallel reduction(+ : boundary, nonmanifold_edges, inconsistent, pinched, zero_area) if (n >= kParallelMin)
-  {
+  parallel_region(team_for(n, kParallelMin), [&](Team& team) {
     OneRingScan scan(arrays);
     OneRingCounts mine;
-#pragma omp for schedule(static)
-    for (int32_t v = 0; v < n; ++v) scan.scan(v, mine);
-    boundary += mine.boundary, nonmanifold_edges += mine.nonmanifold_edges, inconsistent += mine.inconsistent;
-    pinched += mine.pinched, zero_area += mine.zero_area;
-  }
+    team.for_static(0, n, [&](int32_t v) { scan.scan(v, mine); });
+    team.critical([&] {
+      boundary += mine.boundary, nonmanifold_edges += mine.nonmanifold_edges, inconsistent += mine.inconsistent;
+      pinched += mine.pinched, zero_area += mine.zero_area;
+    });
+  });
   report_.boundary_edges = boundary;
   report_.nonmanifold_edges = nonmanifold_edges;
   report_.inconsistent_edges = inconsistent;
@@ -627,8 +624,7 @@ void Mesh::fill_normals() const {
   const int32_t n = num_vertices_;
   const auto& vfo = vertex_face_offsets_;
   normals_.resize(3 * size_t(n));
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
+  parallel_for(0, n, kParallelMin, [&](int32_t v) {
     double sum[3] = {0, 0, 0};
     for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
       const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
@@ -639,7 +635,7 @@ void Mesh::fill_normals() const {
       sum[2] += fn[2];
     }
     unit_normal(sum, &normals_[3 * size_t(v)]);
-  }
+  });
 }
 
 void Mesh::build_normals() const {
@@ -656,8 +652,7 @@ void Mesh::build_vertex_areas() const {
     const int32_t n = num_vertices_;
     const auto& vfo = vertex_face_offsets_;
     vertex_areas_.resize(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-    for (int32_t v = 0; v < n; ++v) {
+    parallel_for(0, n, kParallelMin, [&](int32_t v) {
       double area = 0.0;
       for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
         const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
@@ -666,7 +661,7 @@ void Mesh::build_vertex_areas() const {
         area += std::sqrt(fn[0] * fn[0] + fn[1] * fn[1] + fn[2] * fn[2]) / 6.0;  // a third of half the cross
       }
       vertex_areas_[v] = area;
-    }
+    });
     // Summed in vertex order on one thread, as the mean weight.
     double total = 0.0;
     int64_t counted = 0;
@@ -689,8 +684,7 @@ void Mesh::build_edges() const {
     // how many face sides lead to higher neighbours (each edge belongs to its lower end).
     Buffer<int32_t> lower(n), edge_base(n + 1), side_base(n + 1);
     edge_base[n] = side_base[n] = 0;
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-    for (int32_t v = 0; v < n; ++v) {
+    parallel_for(0, n, kParallelMin, [&](int32_t v) {
       const int32_t* row = adjacency_.data() + ao[v];
       const int32_t d = ao[v + 1] - ao[v];
       lower[v] = int32_t(std::lower_bound(row, row + d, v) - row);
@@ -702,7 +696,7 @@ void Mesh::build_edges() const {
         sides += (t[(c + 1) % 3] > v) + (t[(c + 2) % 3] > v);
       }
       side_base[v] = sides;
-    }
+    });
     exclusive_scan(edge_base);
     exclusive_scan(side_base);
     adjacency_edge_.resize(ao[n]);
@@ -713,11 +707,9 @@ void Mesh::build_edges() const {
     // Edges numbered by lower end, then higher end; each vertex writes its own edges: their
     // slots in both rows, their ends, the edge of each face side it owns, and its edges' faces
     // in increasing order.
-#pragma omp parallel if (n >= kParallelMin)
-    {
+    parallel_region(team_for(n, kParallelMin), [&](Team& team) {
       std::vector<int32_t> fill;
-#pragma omp for schedule(static)
-      for (int32_t v = 0; v < n; ++v) {
+      team.for_static(0, n, [&](int32_t v) {
         const int32_t* row = adjacency_.data() + ao[v];
         const int32_t d = ao[v + 1] - ao[v], low = lower[v], higher = d - low;
         for (int32_t r = low; r < d; ++r) {
@@ -757,8 +749,8 @@ void Mesh::build_edges() const {
             edge_faces_[fill[face_edges_[3 * size_t(f) + side] - edge_base[v]]++] = f;
           }
         }
-      }
-    }
+      });
+    });
     edge_face_offsets_[num_edges_] = side_base[n];
     edges_built_.store(true, std::memory_order_release);
   });

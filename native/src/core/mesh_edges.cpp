@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <memory>
 
-#include <omp.h>
 
 #include "topstoc/core/incidence.hpp"
 #include "topstoc/core/parallel.hpp"
@@ -65,7 +64,7 @@ MeshEdges mesh_edges(const int32_t* triangles, int64_t num_triangles, int32_t nu
   }
   MeshEdges out;
   out.corner_edge.resize(corners);
-  const int team = num_vertices >= kParallelMin ? omp_get_max_threads() : 1;
+  const int team = num_vertices >= kParallelMin ? max_threads() : 1;
   if (team == 1) {
     // One pass, numbering the edges as they are met.
     std::vector<Mark> marks(num_vertices);
@@ -85,23 +84,20 @@ MeshEdges mesh_edges(const int32_t* triangles, int64_t num_triangles, int32_t nu
   // Threads: count each lower vertex's distinct edges, then number them from the prefix sums.
   // Each thread keeps its own marks.
   std::vector<int32_t> first_edge(size_t(num_vertices) + 1, 0);
-#pragma omp parallel num_threads(team)
-  {
+  parallel_region(team, [&](Team& t) {
     std::vector<Mark> marks(num_vertices);
-#pragma omp for schedule(static)
-    for (int32_t v = 0; v < num_vertices; ++v) {
+    t.for_static(0, num_vertices, [&](int32_t v) {
       int32_t distinct = 0;
       visit_bucket(offsets, bucket.get(), v, marks, [&](Mark&, int32_t, int32_t, bool fresh) { distinct += fresh; });
       first_edge[size_t(v) + 1] = distinct;
-    }
-#pragma omp single
-    {
+    });
+    t.barrier();  // (an OpenMP for ends with one)
+    t.single([&] {
       for (int32_t v = 0; v < num_vertices; ++v) first_edge[v + 1] += first_edge[v];
       out.vertices.resize(2 * size_t(first_edge[num_vertices]));
-    }
+    });
     std::fill(marks.begin(), marks.end(), Mark());
-#pragma omp for schedule(static)
-    for (int32_t v = 0; v < num_vertices; ++v) {
+    t.for_static(0, num_vertices, [&](int32_t v) {
       int32_t next = first_edge[v];
       visit_bucket(offsets, bucket.get(), v, marks, [&](Mark& mark, int32_t higher, int32_t corner, bool fresh) {
         if (fresh) {
@@ -112,8 +108,8 @@ MeshEdges mesh_edges(const int32_t* triangles, int64_t num_triangles, int32_t nu
         }
         out.corner_edge[corner] = mark.edge;
       });
-    }
-  }
+    });
+  });
   return out;
 }
 

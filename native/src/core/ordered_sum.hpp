@@ -24,9 +24,9 @@ template <class Partial, class Accumulate, class Combine>
 Partial ordered_reduce(int64_t n, Accumulate accumulate, Combine combine) {
   const int64_t blocks = (n + kSumBlock - 1) / kSumBlock;
   std::vector<Partial> partial(size_t(std::max<int64_t>(blocks, 0)), Partial{});
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int64_t b = 0; b < blocks; ++b)
+  parallel_for(0, blocks, parallel_if(n >= kParallelMin), [&](int64_t b) {
     for (int64_t i = b * kSumBlock, end = std::min(n, (b + 1) * kSumBlock); i < end; ++i) accumulate(partial[b], i);
+  });
   Partial total{};
   for (const Partial& p : partial) combine(total, p);
   return total;

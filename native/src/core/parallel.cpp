@@ -1,64 +1,281 @@
 #include "topstoc/core/parallel.hpp"
 
-#include <dirent.h>
-#include <omp.h>
-
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <exception>
+#include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
+#include <vector>
+
+#include "core/machine_load.hpp"
+
+#if defined(__unix__) || defined(__APPLE__)
+#include <pthread.h>
+#endif
+
+#if defined(__x86_64__) || defined(__i386__) || defined(_M_X64) || defined(_M_IX86)
+#include <immintrin.h>
+#define TOPSTOC_PAUSE() _mm_pause()
+#elif defined(_MSC_VER) && defined(_M_ARM64)
+#include <intrin.h>
+#define TOPSTOC_PAUSE() __yield()
+#elif defined(__aarch64__) || defined(__arm__)
+#define TOPSTOC_PAUSE() __asm__ __volatile__("yield")
+#else
+#define TOPSTOC_PAUSE() ((void)0)
+#endif
 
 namespace topstoc {
 
 namespace {
 
-// Runnable threads on the whole machine at this instant (the kernel's count, caller included);
-// -1 when unknown.
-int runnable_threads() {
-  std::FILE* file = std::fopen("/proc/loadavg", "r");
-  if (!file) return -1;
-  double one, five, fifteen;
-  int running = 0, total = 0;
-  const int read = std::fscanf(file, "%lf %lf %lf %d/%d", &one, &five, &fifteen, &running, &total);
-  std::fclose(file);
-  return read == 5 ? running : -1;
+// How long a waiting thread spins before it sleeps. Consecutive loops of one decimation follow
+// each other within microseconds, and waking a sleeping thread costs far more than that; a
+// spin much longer than the gaps only burns a core the host (Blender) may want.
+std::chrono::nanoseconds spin_time() {
+  static const std::chrono::nanoseconds time = [] {
+    const char* text = std::getenv("TOPSTOC_SPIN_US");  // for measuring only
+    return std::chrono::microseconds(text && *text ? std::max(0L, std::strtol(text, nullptr, 10)) : 1000);
+  }();
+  return time;
 }
 
-// Runnable threads of this process (caller included). Our own OpenMP workers may still be
-// spinning after the previous call (libgomp's default wait policy, which Blender's libgomp
-// keeps): they would otherwise count as busy cores.
-int own_runnable_threads() {
-  DIR* tasks = opendir("/proc/self/task");
-  if (!tasks) return 1;
-  int running = 0;
-  char line[512];
-  while (const dirent* entry = readdir(tasks)) {
-    if (entry->d_name[0] == '.') continue;
-    const std::string path = std::string("/proc/self/task/") + entry->d_name + "/stat";
-    std::FILE* file = std::fopen(path.c_str(), "r");
-    if (!file) continue;
-    const size_t size = std::fread(line, 1, sizeof line - 1, file);
-    std::fclose(file);
-    line[size] = '\0';
-    // "tid (name) S ...": the state follows the last ')' (names may hold spaces and parens).
-    const char* close = std::strrchr(line, ')');
-    if (close && close[1] == ' ' && close[2] == 'R') ++running;
+// The thread limit the environment sets: TOPSTOC_NUM_THREADS, else OMP_NUM_THREADS (its first
+// entry), else none.
+int environment_limit() {
+  for (const char* name : {"TOPSTOC_NUM_THREADS", "OMP_NUM_THREADS"}) {
+    const char* text = std::getenv(name);
+    if (!text || !*text) continue;
+    const long value = std::strtol(text, nullptr, 10);
+    if (value >= 1) return int(std::min(value, 4096L));
   }
-  closedir(tasks);
-  return std::max(running, 1);
+  return 0;
+}
+
+// The most threads one team uses: the usable cores, capped by the environment.
+int ceiling() {
+  static const int value = [] {
+    const int cores = usable_cores(), limit = environment_limit();
+    return std::max(1, limit > 0 ? std::min(cores, limit) : cores);
+  }();
+  return value;
+}
+
+thread_local int t_max_threads = 0;  // 0: not set, ceiling()
+thread_local int t_index = 0;
+thread_local bool t_in_team = false;  // inside a team of two or more (nested calls run serially)
+
+// Spin-then-sleep waiting on a condition other threads make true: ready() must read only
+// atomics, and whoever makes it true calls wake() afterwards.
+class Waiter {
+ public:
+  template <class Ready>
+  void wait(Ready ready) {
+    const auto start = std::chrono::steady_clock::now();
+    const auto limit = spin_time();
+    for (unsigned turn = 1;; ++turn) {
+      if (ready()) return;
+      TOPSTOC_PAUSE();
+      if (turn % 64 == 0 && std::chrono::steady_clock::now() - start >= limit) break;
+    }
+    sleepers_.fetch_add(1);
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      condition_.wait(lock, ready);
+    }
+    sleepers_.fetch_sub(1);
+  }
+  // A sleeper counted itself before it checked ready() under the mutex: taking the mutex here
+  // after the condition changed means it either sees the change or is waiting for this notify.
+  void wake() {
+    if (sleepers_.load() == 0) return;
+    { std::lock_guard<std::mutex> lock(mutex_); }
+    condition_.notify_all();
+  }
+
+ private:
+  std::atomic<int> sleepers_{0};
+  std::mutex mutex_;
+  std::condition_variable condition_;
+};
+
+// Unwinds the members still running after another member threw.
+struct Aborted {};
+
+}  // namespace
+
+class TeamState {
+ public:
+  explicit TeamState(int size) : size_(size) {}
+  void barrier() {
+    if (size_ <= 1) return;
+    if (aborted_.load()) throw Aborted{};
+    const uint64_t epoch = epoch_.load();
+    if (arrived_.fetch_add(1) + 1 == size_) {
+      arrived_.store(0);
+      epoch_.fetch_add(1);
+      waiter_.wake();
+      return;
+    }
+    waiter_.wait([&] { return epoch_.load() != epoch || aborted_.load(); });
+    if (epoch_.load() == epoch) throw Aborted{};
+  }
+  // Runs one member's share, keeping the first exception any member throws.
+  void run_member(void (*run)(void*, Team&), void* context, int index) {
+    try {
+      Team team(*this, index, size_);
+      run(context, team);
+    } catch (const Aborted&) {
+    } catch (...) {
+      {
+        std::lock_guard<std::mutex> lock(error_mutex_);
+        if (!error_) error_ = std::current_exception();
+      }
+      aborted_.store(true);
+      waiter_.wake();
+    }
+  }
+  std::mutex& critical() { return critical_; }
+  void rethrow() {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  const int size_;
+  std::atomic<int> arrived_{0};
+  std::atomic<uint64_t> epoch_{0};
+  std::atomic<bool> aborted_{false};
+  Waiter waiter_;
+  std::mutex critical_;
+  std::mutex error_mutex_;
+  std::exception_ptr error_;
+};
+
+void Team::barrier() { state_.barrier(); }
+void Team::lock() { state_.critical().lock(); }
+void Team::unlock() { state_.critical().unlock(); }
+
+namespace {
+
+// The workers of one calling thread. A job is one atomic word, (serial << 16) | team size, so a
+// worker reads the number and the size of a job together; size 0 tells the workers to exit.
+class Pool {
+ public:
+  ~Pool() {
+    post(0);
+    for (std::thread& thread : threads_) thread.join();
+  }
+
+  void run(int size, void (*run)(void*, Team&), void* context, TeamState& state) {
+    while (int(threads_.size()) < size - 1) {
+      const int id = int(threads_.size()) + 1;
+      threads_.emplace_back([this, id, seen = job_.load()] { work(id, seen); });
+    }
+    run_ = run;
+    context_ = context;
+    state_ = &state;
+    pending_.store(size - 1);
+    post(size);
+    state.run_member(run, context, 0);
+    done_.wait([&] { return pending_.load() == 0; });
+  }
+
+ private:
+  void post(int size) {
+    job_.store(((job_.load() >> 16) + 1) << 16 | uint64_t(size));
+    start_.wake();
+  }
+
+  void work(int id, uint64_t seen) {
+    t_index = id;
+    t_in_team = true;
+    for (;;) {
+      start_.wait([&] { return job_.load() != seen; });
+      seen = job_.load();
+      const int size = int(seen & 0xFFFF);
+      if (size == 0) return;
+      if (id >= size) continue;  // not in this team
+      state_->run_member(run_, context_, id);
+      if (pending_.fetch_sub(1) == 1) done_.wake();
+    }
+  }
+
+  std::vector<std::thread> threads_;
+  std::atomic<uint64_t> job_{0};
+  void (*run_)(void*, Team&) = nullptr;  // the current job, written before job_ names it
+  void* context_ = nullptr;
+  TeamState* state_ = nullptr;
+  std::atomic<int> pending_{0};  // workers of the current job still running
+  Waiter start_, done_;
+};
+
+thread_local std::unique_ptr<Pool> t_pool;
+
+// A forked child has only the thread that forked: the pool it inherited has no workers, so it is
+// abandoned (not joined) and the next parallel call makes a new one.
+std::atomic<unsigned> forks{0};
+thread_local unsigned t_pool_fork = 0;
+
+void watch_forks() {
+#if defined(__unix__) || defined(__APPLE__)
+  static const bool registered = [] {
+    pthread_atfork(nullptr, nullptr, [] { forks.fetch_add(1); });
+    return true;
+  }();
+  (void)registered;
+#endif
 }
 
 }  // namespace
 
+namespace detail {
+
+void run_team(int threads, void (*run)(void*, Team&), void* context) {
+  threads = std::min(threads, 0xFFFF);
+  if (threads <= 1 || t_in_team) {  // serially, as member 0 of a team of one
+    const int index = t_index;
+    t_index = 0;
+    TeamState state(1);
+    struct Restore {
+      int index;
+      ~Restore() { t_index = index; }
+    } restore{index};
+    Team team(state, 0, 1);
+    run(context, team);
+    return;
+  }
+  if (t_pool && t_pool_fork != forks.load()) (void)t_pool.release();  // its workers are gone
+  if (!t_pool) {
+    watch_forks();
+    t_pool = std::make_unique<Pool>();
+    t_pool_fork = forks.load();
+  }
+  TeamState state(threads);
+  t_in_team = true;
+  t_pool->run(threads, run, context, state);
+  t_in_team = false;
+  state.rethrow();
+}
+
+}  // namespace detail
+
+int max_threads() { return t_in_team ? 1 : (t_max_threads > 0 ? t_max_threads : ceiling()); }
+
+void set_max_threads(int threads) { t_max_threads = std::max(1, threads); }
+
+int thread_index() { return t_index; }
+
 int free_cores() {
-  // Read before this thread ever changes its own team size: OMP_NUM_THREADS or the core count.
-  static const int ceiling = std::max(1, std::min(omp_get_num_procs(), omp_get_max_threads()));
-  const int running = runnable_threads();
-  if (running < 0) return ceiling;
-  if (running <= 1) return ceiling;  // only the caller: no need to look closer
-  const int others = running - own_runnable_threads();
-  return std::clamp(omp_get_num_procs() - others, 1, ceiling);
+  const int others = other_runnable_threads();
+  if (others < 0) return ceiling();
+  return std::clamp(usable_cores() - others, 1, ceiling());
 }
 
 namespace {
@@ -68,10 +285,6 @@ std::atomic<int> running_calls{0};
 RunningCall::RunningCall() { running_calls.fetch_add(1); }
 RunningCall::~RunningCall() { running_calls.fetch_sub(1); }
 
-void use_free_cores() {
-  // Our own running calls count as busy in free_cores() only while their threads are on a core
-  // at this instant; dividing by the calls in flight gives each its share either way.
-  omp_set_num_threads(std::max(1, free_cores() / std::max(1, running_calls.load())));
-}
+void use_free_cores() { set_max_threads(std::max(1, free_cores() / std::max(1, running_calls.load()))); }
 
 }  // namespace topstoc

@@ -6,9 +6,9 @@
 // between the cores on every append (the flood's per-level lists lost a sixth of its time).
 #pragma once
 
-#include <omp.h>
-
 #include <vector>
+
+#include "topstoc/core/parallel.hpp"
 
 namespace topstoc {
 
@@ -20,7 +20,7 @@ class PerThread {
   T& operator[](int thread) { return slots_[size_t(thread)].value; }
   const T& operator[](int thread) const { return slots_[size_t(thread)].value; }
   /// The calling thread's value (inside a parallel region; thread 0's outside one).
-  T& mine() { return (*this)[omp_get_thread_num()]; }
+  T& mine() { return (*this)[thread_index()]; }
 
  private:
   // 64 bytes, the cache line of the x86-64 and ARMv8 cores this runs on.

@@ -1,8 +1,10 @@
 #include "topstoc/core/self_intersections.hpp"
+#include "topstoc/core/parallel.hpp"
 
 #include <tetgen.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <mutex>
 #include <stdexcept>
@@ -198,11 +200,10 @@ std::vector<std::pair<int32_t, int32_t>> self_intersections(const double* positi
   }
   const int64_t cells = int64_t(starts.size()) - 1;
   // Threads pay off on large meshes only (and a parallel region costs a time slice on a busy machine).
-#pragma omp parallel if (num_triangles > 50000)
-  {
+  std::atomic<int64_t> next_cell{0};
+  parallel_region(num_triangles > 50000 ? max_threads() : 1, [&](Team& team) {
     std::vector<std::pair<int32_t, int32_t>> found;
-#pragma omp for schedule(dynamic, 64)
-    for (int64_t c = 0; c < cells; ++c) {
+    team.for_dynamic(next_cell, cells, 64, [&](int64_t c) {
       for (size_t i = starts[c]; i < starts[c + 1]; ++i)
         for (size_t j = i + 1; j < starts[c + 1]; ++j) {
           int32_t s = entries[i].second, t = entries[j].second;
@@ -221,10 +222,9 @@ std::vector<std::pair<int32_t, int32_t>> self_intersections(const double* positi
           if (first != entries[i].first) continue;
           if (triangles_intersect(positions, triangles + 3 * size_t(s), triangles + 3 * size_t(t))) found.emplace_back(s, t);
         }
-    }
-#pragma omp critical
-    pairs.insert(pairs.end(), found.begin(), found.end());
-  }
+    });
+    team.critical([&] { pairs.insert(pairs.end(), found.begin(), found.end()); });
+  });
   std::sort(pairs.begin(), pairs.end());
   if (max_pairs > 0 && int64_t(pairs.size()) > max_pairs) pairs.resize(max_pairs);
   return pairs;

@@ -38,15 +38,14 @@ std::shared_ptr<const CandidateOrder> candidate_order(const Mesh& mesh, const Fe
   const int32_t n = mesh.num_vertices();
   constexpr int32_t kNone = kRateBuckets;  // not drawn at random: a corner, isolated, or q = 0
   Buffer<uint8_t> bucket(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
+  parallel_for(0, n, kParallelMin, [&](int32_t v) {
     const uint8_t cls = table->cls[v];
     const double q = table->q[v], u = uniforms.u[v];
     const double p_star = u / (u + kFirstThreshold * (1.0 - u));
     bucket[v] = uint8_t((cls != kSurface && cls != kCurve) || !(q > 0.0) ? kNone
                         : cls == kCurve                                  ? rate_bucket(p_star * p_star / q)
                                                                          : rate_bucket(p_star / q));
-  }
+  });
   for (int32_t v = 0; v < n; ++v)
     if (table->cls[v] == kCorner) order->corners.push_back(v);
   order->vertices.resize(n);

@@ -4,7 +4,6 @@
 #include "../core/counting_sort.hpp"
 #include "../core/per_thread.hpp"
 
-#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -59,7 +58,7 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   const auto& vertex_feature = layout.vertex_feature;
   const bool has_features = layout.has_feature_vertices;  // else vertex_feature is all zero
   std::vector<uint8_t> queued(n, 0);
-  const int threads = omp_get_max_threads();
+  const int threads = max_threads();
   PerThread<std::vector<int32_t>> next(threads), cross(threads);
   PerThread<std::vector<Lowering>> outboxes(threads);
   uint64_t* keys = key.data();
@@ -134,19 +133,18 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
     if (team == 1) {
       relax_run(0, count, 0, n, next[0], cross[0], outboxes[0]);
     } else {
-#pragma omp parallel num_threads(team)
-      {
+      parallel_region(team, [&](Team& running) {
         // Each thread owns an equal range of vertex ids, near a region of the mesh (ids follow
         // a space-filling curve), and relaxes the run of the sorted frontier inside it. Few
         // edges join two ranges, so the outboxes stay short. The team may come out smaller
         // than asked: the ranges follow the team actually running.
-        const int me = omp_get_thread_num(), size = omp_get_num_threads();
+        const int me = running.index(), size = running.size();
         const int32_t lo = int32_t(int64_t(n) * me / size), hi = int32_t(int64_t(n) * (me + 1) / size);
         const int64_t begin = std::lower_bound(front, front + count, lo) - front;
         const int64_t end = std::lower_bound(front, front + count, hi) - front;
         auto& mine = next[me];
         relax_run(begin, end, lo, hi, mine, cross[me], outboxes[me]);
-#pragma omp barrier
+        running.barrier();
         // The lowerings of this range found by the other threads; the smallest wins, as it
         // would in one pass, whatever the order.
         for (int t = 0; t < size; ++t) {
@@ -161,7 +159,7 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
             }
           }
         }
-      }
+      });
       for (int t = 0; t < team; ++t) outboxes[t].clear();
     }
     // Next frontier in vertex order: a short one sorted, a longer one read off the flags, eight
@@ -177,18 +175,16 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
     } else {
       for (int t = 0; t < threads; ++t) next[t].clear();
       const int64_t words = int64_t(n) / 8;
-#pragma omp parallel if (n >= kParallelMin)  // the scan reads every flag, however few are set
-      {
+      parallel_region(team_for(n, kParallelMin), [&](Team& team) {  // the scan reads every flag, however few are set
         auto& mine = next.mine();
-#pragma omp for schedule(static)
-        for (int64_t w = 0; w < words; ++w) {
+        team.for_static(0, words, [&](int64_t w) {
           const uint64_t word = flag_word(in_next + 8 * w);
-          if (!word) continue;
+          if (!word) return;
           std::memset(in_next + 8 * w, 0, 8);
           for (uint32_t bits = flag_bits(word); bits; bits &= bits - 1)
             mine.push_back(int32_t(8 * w + __builtin_ctz(bits)));
-        }
-      }
+        });
+      });
       for (int32_t v = int32_t(8 * words); v < n; ++v)  // the last few, past the whole words
         if (in_next[v]) {
           in_next[v] = 0;
@@ -210,8 +206,7 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
   std::vector<uint64_t>& key = c.key;
   if (first_new == 0) {  // a full fill: nothing reached yet (the clustering is not read)
     key.resize(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-    for (int32_t v = 0; v < n; ++v) key[v] = kUnreached;
+    parallel_for(0, n, kParallelMin, [&](int32_t v) { key[v] = kUnreached; });
   } else if (int32_t(key.size()) != n) {
     throw std::invalid_argument("flood_add: the clustering is not one of this mesh");
   }
@@ -255,15 +250,13 @@ void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vect
     }
   }
   // Kept clusters take their new ranks; the vertices of removed ones are emptied (unreached).
-  const int threads = omp_get_max_threads();
+  const int threads = max_threads();
   PerThread<std::vector<int32_t>> emptied_by_thread(threads);
-#pragma omp parallel if (n >= kParallelMin)
-  {
+  parallel_region(team_for(n, kParallelMin), [&](Team& team) {
     auto& mine = emptied_by_thread.mine();
-#pragma omp for schedule(static)
-    for (int32_t v = 0; v < n; ++v) {
+    team.for_static(0, n, [&](int32_t v) {
       const uint64_t k = key[v];
-      if (k == kUnreached) continue;
+      if (k == kUnreached) return;
       const int32_t rank = new_rank[rank_of(k)];
       if (rank < 0) {
         key[v] = kUnreached;
@@ -271,8 +264,8 @@ void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vect
       } else {
         key[v] = cluster_key(dist_of(k), rank);
       }
-    }
-  }
+    });
+  });
   // Emptied vertices are refilled from the kept vertices around them, each entering the fill
   // at its own distance, and from the added samples (a multi-source search, as in flood()).
   // Seeds are listed once each (a flag per vertex) and ordered by distance with a stable

@@ -1,9 +1,10 @@
 #include "decimate/collapser.hpp"
+#include "topstoc/core/parallel.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
-#include <omp.h>
 
 namespace topstoc {
 
@@ -59,7 +60,7 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   waiting_.assign(n, 0);
   settled_.assign(n, 0);
   merged_from_.assign(n, -1);
-  scratch_ = PerThread<Scratch>(std::max(1, omp_get_max_threads()));
+  scratch_ = PerThread<Scratch>(max_threads());
   for (int t = 0; t < scratch_.size(); ++t) scratch_[t].mark.assign(n, 0);
   // Every vertex's cheapest collapse, each edge evaluated once (from its lower end) where it
   // costs the same both ways. A thread owns the lower ends it evaluates; what it finds for the
@@ -70,13 +71,11 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   };
   const int threads = scratch_.size();
   PerThread<std::vector<std::pair<int32_t, Best>>> found(threads);
-#pragma omp parallel num_threads(threads) if (n >= 10000)
-  {
+  parallel_region(n >= 10000 ? threads : 1, [&](Team& team) {
     Scratch& scratch = scratch_.mine();
     auto& mine = found.mine();
     std::vector<int32_t> around;
-#pragma omp for schedule(static)
-    for (int32_t u = 0; u < n; ++u) {
+    team.for_static(0, n, [&](int32_t u) {
       const bool u_queues = queues(u);
       neighbours(u, scratch, around);
       for (int32_t v : around) {
@@ -86,8 +85,8 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
         if (u_queues && better(u, v, uv)) target_[u] = v, best_cost[u] = uv;
         if (v_queues) mine.push_back({v, {u, u_queues && free_pair(u, v) ? uv : cost(v, u)}});
       }
-    }
-  }
+    });
+  });
   for (int t = 0; t < threads; ++t)
     for (const auto& [v, offer] : found[t])
       if (better(v, offer.target, offer.cost)) target_[v] = offer.target, best_cost[v] = offer.cost;
@@ -278,8 +277,7 @@ int32_t Collapser::remove_thin(double min_shape, Stop keep) {
   // neighbours collapsed, hence the rounds.
   const int32_t m = static_cast<int32_t>(alive_face_.size());
   std::vector<uint8_t> flagged(m, 0);
-#pragma omp parallel for schedule(static) if (m >= 100000)
-  for (int32_t t = 0; t < m; ++t) flagged[t] = alive_face_[t] && (zero_area(t) || thin(t, min_shape));
+  parallel_for(0, m, 100000, [&](int32_t t) { flagged[t] = alive_face_[t] && (zero_area(t) || thin(t, min_shape)); });
   std::vector<int32_t> candidates;
   for (int32_t t = 0; t < m; ++t)
     if (flagged[t]) candidates.push_back(t);
@@ -373,15 +371,14 @@ void Collapser::reserve_batch(Batch& batch, uint32_t ring) {
 // The reserved collapses whose cost changed or which are no longer allowed are evaluated anew.
 void Collapser::check_reserved(Batch& batch) {
   const int32_t checks = int32_t(batch.reserved.size());
-#pragma omp parallel for schedule(dynamic, 4) if (checks >= 16)
-  for (int32_t k = 0; k < checks; ++k) {
+  parallel_for_dynamic(0, checks, 4, 16, [&](int32_t k) {
     const int32_t i = batch.reserved[k], u = batch.vertices[i], v = target_[u];
     if (batch.key[i] != cost(u, v)) {
       batch.status[i] = kEvaluate;
     } else if (!allowed(u, v, scratch_.mine())) {
       batch.status[i] = kEvaluateChecked;
     }
-  }
+  });
 }
 
 // Applies the ready collapses in cost order (until the target), notes those to evaluate anew
@@ -428,19 +425,18 @@ void Collapser::cost_after_batch(Batch& batch, uint32_t ring) {
   batch.pair_cost_from.assign(pairs, 0.0);
   batch.pair_cost_to.assign(pairs, 0.0);
   batch.pending_best.assign(evaluations, Best());
-#pragma omp parallel if (pairs + 8 * evaluations >= 64)
-  {
-#pragma omp for schedule(static) nowait
-    for (int32_t i = 0; i < pairs; ++i) {
+  std::atomic<int64_t> next_evaluation{0};
+  parallel_region(pairs + 8 * evaluations >= 64 ? max_threads() : 1, [&](Team& team) {
+    team.for_static(0, pairs, [&](int32_t i) {
       const int32_t v = batch.pair_from[i], x = batch.pair_to[i];
       const bool v_queues = queues(v), x_queues = queues(x);
       if (v_queues) batch.pair_cost_from[i] = cost(v, x);
       if (x_queues) batch.pair_cost_to[i] = v_queues && free_pair(x, v) ? batch.pair_cost_from[i] : cost(x, v);
-    }
-#pragma omp for schedule(dynamic, 4)
-    for (int32_t i = 0; i < evaluations; ++i)
+    });
+    team.for_dynamic(next_evaluation, evaluations, 4, [&](int32_t i) {
       batch.pending_best[i] = evaluate(batch.pending[i], batch.pending_checked[i], scratch_.mine());
-  }
+    });
+  });
   for (int32_t i = 0; i < evaluations; ++i) {
     settle(batch.pending[i], batch.pending_best[i]);
     settled_[batch.pending[i]] = ring;  // settled: the neighbour updates below leave it alone
@@ -795,22 +791,21 @@ int32_t Collapser::refit(const std::vector<double>& radius2) {
   const int32_t n = static_cast<int32_t>(merged_into_.size());
   std::vector<double> goal(3 * size_t(n));
   std::vector<uint8_t> better(n, 0);
-#pragma omp parallel for schedule(static) if (n >= 10000)
-  for (int32_t v = 0; v < n; ++v) {
+  parallel_for(0, n, 10000, [&](int32_t v) {
     // A vertex a collapse put at its quadric's minimum is there already.
-    if (merged_into_[v] >= 0 || !is_free(v) || size_[v] == 0 || placed_[v]) continue;
+    if (merged_into_[v] >= 0 || !is_free(v) || size_[v] == 0 || placed_[v]) return;
     Quadric q;
     s_.quadrics.reduced(v, -1, q);
     const double* p = position(v);
     double step[3];
-    if (!q.truncated_step(p, step)) continue;
+    if (!q.truncated_step(p, step)) return;
     const double len2 = step[0] * step[0] + step[1] * step[1] + step[2] * step[2];
-    if (!(len2 > 0)) continue;
+    if (!(len2 > 0)) return;
     const double scale = len2 > radius2[v] ? std::sqrt(radius2[v] / len2) : 1.0;
     double* x = &goal[3 * size_t(v)];
     for (int i = 0; i < 3; ++i) x[i] = p[i] + scale * step[i];
     better[v] = q.error(x) < q.error(p);
-  }
+  });
   int32_t moved = 0;
   for (int32_t v = 0; v < n; ++v) {
     ShapeFloor floor{v, -1};

@@ -1,7 +1,6 @@
 #include "topstoc/decimate/decimate.hpp"
 #include "topstoc/core/parallel.hpp"
 
-#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -154,14 +153,13 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   const bool relabel = !draft || placement == Placement::Filtered;
   if (relabel && std::find(partition.absorbed.begin(), partition.absorbed.end(), 1) != partition.absorbed.end()) {
     const int32_t n = mesh.num_vertices();
-    PerThread<std::vector<int32_t>> found(omp_get_max_threads());
-#pragma omp parallel if (n >= kParallelMin)
-    {
+    PerThread<std::vector<int32_t>> found(max_threads());
+    parallel_region(team_for(n, kParallelMin), [&](Team& team) {
       auto& mine = found.mine();
-#pragma omp for schedule(static)
-      for (int32_t v = 0; v < n; ++v)
+      team.for_static(0, n, [&](int32_t v) {
         if (label(v) >= 0 && partition.absorbed[label(v)]) mine.push_back(v);
-    }
+      });
+    });
     append_and_clear(found, orphans);
   }
   for (bool changed = !orphans.empty(); changed;) {
@@ -182,9 +180,8 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   const std::vector<double> filtered =
       placement == Placement::Filtered ? filtered_positions(mesh, layout, samples, clustering) : std::vector<double>();
   result.vertices.resize(3 * result.kept.size());
-#pragma omp parallel for schedule(static) if (k >= kParallelMinCostly)
-  for (int32_t s = 0; s < k; ++s) {
-    if (output_index[s] < 0) continue;
+  parallel_for(0, k, kParallelMinCostly, [&](int32_t s) {
+    if (output_index[s] < 0) return;
     for (int j = 0; j < 3; ++j)
       result.vertices[3 * size_t(output_index[s]) + j] =
           filtered.empty() ? mesh.position(samples[s])[j] : filtered[3 * size_t(s) + j];
@@ -193,7 +190,7 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
     const double* p = &result.vertices[3 * size_t(output_index[s])];
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
       for (int j = 0; j < 3; ++j) result.vertices[3 * size_t(output_index[s]) + j] = mesh.position(samples[s])[j];
-  }
+  });
   const size_t t = partition.source_face.size();
   result.triangles.resize(3 * t);
   auto publish_ids = [&]() {  // public ids are the caller's
@@ -204,8 +201,7 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
     result.seconds_output = seconds_since(start);
   };
   if (draft) {  // geometry only (DecimateParams::draft)
-#pragma omp parallel for schedule(static) if (t >= kParallelMin)
-    for (size_t i = 0; i < 3 * t; ++i) result.triangles[i] = output_index[partition.triangles[i]];
+    parallel_for(0, 3 * t, parallel_if(t >= kParallelMin), [&](size_t i) { result.triangles[i] = output_index[partition.triangles[i]]; });
     publish_ids();
     return result;
   }
@@ -214,13 +210,12 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   // Looking the corner up here instead would be four reads far apart per corner (its first
   // face, the face's corners, the caller's id).
   std::vector<int32_t> single_corner(k, -1);
-#pragma omp parallel for schedule(static) if (k >= kParallelMinCostly)
-  for (int32_t s = 0; s < k; ++s)
+  parallel_for(0, k, kParallelMinCostly, [&](int32_t s) {
     if (output_index[s] >= 0 && layout.sectors[samples[s]] <= 1) single_corner[s] = mesh.first_corner()[samples[s]];
+  });
   result.face_source.resize(t);
   result.corner_source.resize(3 * t);
-#pragma omp parallel for schedule(static) if (t >= kParallelMin)
-  for (size_t i = 0; i < t; ++i) {
+  parallel_for(0, t, kParallelMin, [&](size_t i) {
     const int32_t f = partition.source_face[i];
     result.face_source[i] = mesh.face_source()[f];
     for (int j = 0; j < 3; ++j) {
@@ -230,12 +225,11 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
                                             ? single_corner[rank]
                                             : attribute_corner(mesh, layout, clustering, f, j, samples[rank]);
     }
-  }
+  });
   const auto& source = mesh.vertex_source();
   result.labels.resize(clustering.key.size());
   const int64_t n = int64_t(clustering.key.size());
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int64_t v = 0; v < n; ++v) result.labels[source[v]] = label(v) >= 0 ? output_index[label(v)] : -1;
+  parallel_for(0, n, kParallelMin, [&](int64_t v) { result.labels[source[v]] = label(v) >= 0 ? output_index[label(v)] : -1; });
   publish_ids();
   return result;
 }

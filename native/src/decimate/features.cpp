@@ -37,9 +37,7 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
   const auto& efo = mesh.edge_face_offsets();
   const auto& ef = mesh.edge_faces();
   const auto& source = mesh.face_source();
-  int32_t region_borders = 0;
-#pragma omp parallel for schedule(static) reduction(+ : region_borders) if (num_edges >= kParallelMin)
-  for (int32_t e = 0; e < num_edges; ++e) {
+  layout.region_border_edges = parallel_sum<int32_t>(0, num_edges, kParallelMin, [&](int32_t& region_borders, int32_t e) {
     const int32_t k = efo[e + 1] - efo[e];
     if (k != 2) {
       layout.edge_feature[e] = 1;  // boundary or non-manifold
@@ -47,8 +45,7 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
       layout.edge_feature[e] = 1;
       ++region_borders;
     }
-  }
-  layout.region_border_edges = region_borders;
+  });
   for (int64_t i = 0; i < num_flagged; ++i) {
     const int32_t a = flagged[2 * i], b = flagged[2 * i + 1];
     const int32_t n = mesh.num_vertices();
@@ -75,18 +72,15 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
       n[0] /= len, n[1] /= len, n[2] /= len;
       return true;
     };
-    int32_t creases = 0;
-#pragma omp parallel for schedule(static) reduction(+ : creases) if (num_edges >= kParallelMin)
-    for (int32_t e = 0; e < num_edges; ++e) {
-      if (layout.edge_feature[e] || efo[e + 1] - efo[e] != 2) continue;
+    layout.crease_edges = parallel_sum<int32_t>(0, num_edges, kParallelMin, [&](int32_t& creases, int32_t e) {
+      if (layout.edge_feature[e] || efo[e + 1] - efo[e] != 2) return;
       double n0[3], n1[3];
-      if (!unit_normal(ef[efo[e]], n0) || !unit_normal(ef[efo[e] + 1], n1)) continue;
+      if (!unit_normal(ef[efo[e]], n0) || !unit_normal(ef[efo[e] + 1], n1)) return;
       if (n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] < threshold) {
         layout.edge_feature[e] = 1;
         ++creases;
       }
-    }
-    layout.crease_edges = creases;
+    });
   }
   for (int32_t e = 0; e < num_edges; ++e)
     if (layout.edge_feature[e]) layout.feature_edges.push_back(e);
@@ -108,12 +102,10 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   layout.vertex_feature.assign(n, 0);
   layout.vertex_corner.assign(n, 0);
   layout.chi_constant.assign(n, 0);
-#pragma omp parallel if (n >= kParallelMin)
-  {
+  parallel_region(team_for(n, kParallelMin), [&](Team& team) {
     std::vector<int32_t> fan_of_slot;
-#pragma omp for schedule(static)
-    for (int32_t v = 0; v < n; ++v) {
-      if (vfo[v] == vfo[v + 1]) continue;  // isolated: belongs to no cluster
+    team.for_static(0, n, [&](int32_t v) {
+      if (vfo[v] == vfo[v + 1]) return;  // isolated: belongs to no cluster
       int32_t degree = 0, copies = featureless ? ao[v + 1] - ao[v] : 0, first_copies = -1;
       bool same_copies = true;
       for (int32_t i = ao[v]; i < ao[v + 1] && !featureless; ++i) {
@@ -141,8 +133,8 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
       layout.vertex_corner[v] = layout.vertex_feature[v] && !curve_vertex;
       const int32_t faces = vfo[v + 1] - vfo[v];
       layout.chi_constant[v] = 6 * sectors - 3 * copies + 2 * faces;
-    }
-  }
+    });
+  });
 }
 
 void trace_curves(const Mesh& mesh, FeatureLayout& layout) {

@@ -7,9 +7,9 @@
 #include "../core/per_thread.hpp"
 #include "pinched_fans.hpp"
 
-#include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <climits>
 #include <cmath>
@@ -148,13 +148,12 @@ void test_slivers(const Mesh& mesh, const std::vector<int32_t>& samples, const s
   std::vector<double> at;
   if (3 * count > k) {
     at.resize(3 * size_t(k));
-#pragma omp parallel for schedule(static) if (k >= kParallelMinCostly)
-    for (int32_t s = 0; s < k; ++s)
+    parallel_for(0, k, kParallelMinCostly, [&](int32_t s) {
       for (int j = 0; j < 3; ++j) at[3 * size_t(s) + j] = mesh.position(samples[s])[j];
+    });
   }
   auto position = [&](int32_t s) { return at.empty() ? mesh.position(samples[s]) : &at[3 * size_t(s)]; };
-#pragma omp parallel for schedule(static) if (count >= kParallelMin)
-  for (int64_t l = 0; l < count; ++l) {
+  parallel_for(0, count, kParallelMin, [&](int64_t l) {
     const int32_t i = listed[l];
     const double* p[3];
     for (int j = 0; j < 3; ++j) p[j] = position(triangles[3 * size_t(i) + j]);
@@ -172,7 +171,7 @@ void test_slivers(const Mesh& mesh, const std::vector<int32_t>& samples, const s
     // stay normal numbers) the square root is not needed: nearly every triangle is.
     const bool clearly_not = longest > 1e-140 && c2 > 2e-18 * longest * longest;
     sliver[i] = !clearly_not && std::sqrt(c2) <= 1e-9 * longest;
-  }
+  });
 }
 
 }  // namespace
@@ -260,7 +259,7 @@ class PartitionCheck {
                  const std::vector<int32_t>* candidate_faces, CheckState* state)
       : mesh(mesh), layout(layout), samples(samples), c(c), required(required), check_slivers(check_slivers),
         candidate_faces(candidate_faces), state(state), carried(state ? *state : local), n(mesh.num_vertices()),
-        k(static_cast<int32_t>(samples.size())), m(mesh.num_faces()), threads(omp_get_max_threads()),
+        k(static_cast<int32_t>(samples.size())), m(mesh.num_faces()), threads(max_threads()),
         faces(mesh.faces()), vfo(mesh.vertex_face_offsets()), marks(threads) {}
 
   Partition run() {
@@ -378,18 +377,23 @@ class PartitionCheck {
     } else if (test_all) {
       carried.emits.resize(m);
       uint8_t* emits = carried.emits.data();
-#pragma omp parallel for schedule(static) num_threads(team) reduction(| : unreached)
-      for (int32_t f = 0; f < m; ++f) {
-        const auto l = corner_labels(f);
-        emits[f] = distinct(l);
-        unreached |= (l[0] | l[1] | l[2]) < 0;
-      }
+      unreached = parallel_reduce(
+          0, m, parallel_if(team > 1), 0,
+          [&](int& any, int32_t f) {
+            const auto l = corner_labels(f);
+            emits[f] = distinct(l);
+            any |= (l[0] | l[1] | l[2]) < 0;
+          },
+          [](int& any, int part) { any |= part; });
       carried.valid = true;
       carried.changed.clear();
     } else {
-#pragma omp parallel for schedule(static) reduction(| : unreached) if (n >= kParallelMin)
-      for (int32_t v = 0; v < n; ++v)
-        if (label(v) < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
+      unreached = parallel_reduce(
+          0, n, kParallelMin, 0,
+          [&](int& any, int32_t v) {
+            if (label(v) < 0 && vfo[v] != vfo[v + 1]) any = 1;
+          },
+          [](int& any, int part) { any |= part; });
     }
     return !unreached;
   }
@@ -411,9 +415,9 @@ class PartitionCheck {
     } else if (candidate_faces) {
       carried.emits.assign(m, 0);
       const int64_t count = int64_t(candidate_faces->size());
-#pragma omp parallel for schedule(static) if (count >= kParallelMin)
-      for (int64_t i = 0; i < count; ++i)
+      parallel_for(0, count, kParallelMin, [&](int64_t i) {
         carried.emits[(*candidate_faces)[i]] = three_clusters((*candidate_faces)[i]);
+      });
     }
     carried.valid = true;
     carried.changed.clear();
@@ -466,28 +470,24 @@ class PartitionCheck {
     int64_t tail = 0;
     for (int32_t f = int32_t(8 * words); f < m; ++f) tail += emits[f];
     std::vector<int64_t> run_start(team + 1, 0);
-#pragma omp parallel num_threads(team)
-    {
-      const int me = omp_get_thread_num();
+    parallel_region(team, [&](Team& running) {
+      const int me = running.index();
       int64_t mine = 0;
-#pragma omp for schedule(static)
-      for (int64_t w = 0; w < words; ++w) mine += flag_count(flag_word(emits + 8 * w));
+      running.for_static(0, words, [&](int64_t w) { mine += flag_count(flag_word(emits + 8 * w)); });
       run_start[me + 1] = mine;
-#pragma omp barrier
-#pragma omp single
-      {
-        for (int r = 0; r < omp_get_num_threads(); ++r) run_start[r + 1] += run_start[r];
-        out.source_face.resize(run_start[omp_get_num_threads()] + tail);
+      running.barrier();
+      running.single([&] {
+        for (int r = 0; r < running.size(); ++r) run_start[r + 1] += run_start[r];
+        out.source_face.resize(run_start[running.size()] + tail);
         out.triangles.resize(3 * out.source_face.size());
-      }
+      });
       int64_t at = run_start[me];
-#pragma omp for schedule(static)
-      for (int64_t w = 0; w < words; ++w) {
+      running.for_static(0, words, [&](int64_t w) {
         const uint64_t word = flag_word(emits + 8 * w);
-        if (!word) continue;
+        if (!word) return;
         for (uint32_t bits = flag_bits(word); bits; bits &= bits - 1) write(at++, int32_t(8 * w + __builtin_ctz(bits)));
-      }
-    }
+      });
+    });
     for (int64_t f = 8 * words, at = int64_t(out.source_face.size()) - tail; f < m; ++f)
       if (emits[f]) write(at++, int32_t(f));
   }
@@ -558,21 +558,22 @@ class PartitionCheck {
         if (!affected[int32_t(key >> 32)]) seen_pairs[0].push_back(key);
     int32_t links = 0, edges = 0, lonely = 0;
     const int64_t evaluated = int64_t(todo.size());
-#pragma omp parallel reduction(+ : links, edges, lonely) if (evaluated >= kParallelMinCostly)
-    {
+    std::atomic<int64_t> next_sample{0};
+    parallel_region(team_for(evaluated, kParallelMinCostly), [&](Team& running) {
       LinkArcs link;
       auto& seen_here = seen_pairs.mine();
       auto& repeated = repeated_lists.mine();
       auto& named = named_lists.mine();
-#pragma omp for schedule(dynamic, 256)
-      for (int64_t i = 0; i < evaluated; ++i) {
-        const int32_t s = todo[i], issues_before = links + edges + lonely;
-        if (!evaluate(s, link, seen_here, links, edges, lonely))
+      int32_t my_links = 0, my_edges = 0, my_lonely = 0;
+      running.for_dynamic(next_sample, evaluated, 256, [&](int64_t i) {
+        const int32_t s = todo[i], issues_before = my_links + my_edges + my_lonely;
+        if (!evaluate(s, link, seen_here, my_links, my_edges, my_lonely))
           repeated.push_back(s);
-        else if (links + edges + lonely != issues_before)
+        else if (my_links + my_edges + my_lonely != issues_before)
           named.push_back(s);
-      }
-    }
+      });
+      running.critical([&] { links += my_links, edges += my_edges, lonely += my_lonely; });
+    });
     bad_link = links, bad_edge = edges, isolated = lonely;
   }
 

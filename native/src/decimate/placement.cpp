@@ -50,20 +50,19 @@ std::vector<double> filtered_positions(const Mesh& mesh, const FeatureLayout& la
     const double d2 = (p[0] - s[0]) * (p[0] - s[0]) + (p[1] - s[1]) * (p[1] - s[1]) + (p[2] - s[2]) * (p[2] - s[2]);
     radius2[label(v)] = std::max(radius2[label(v)], d2);
   }
-#pragma omp parallel for schedule(static) if (k >= kParallelMin)
-  for (int32_t s = 0; s < k; ++s) {
+  parallel_for(0, k, kParallelMin, [&](int32_t s) {
     const double* p = at(samples[s]);
     double* x = &out[3 * size_t(s)];
-    if (layout.vertex_feature[samples[s]]) continue;
+    if (layout.vertex_feature[samples[s]]) return;
     double move[3];
-    if (!quadrics[s].truncated_step(p, move)) continue;
+    if (!quadrics[s].truncated_step(p, move)) return;
     const double len2 = move[0] * move[0] + move[1] * move[1] + move[2] * move[2];
     const double scale = len2 > radius2[s] && len2 > 0 ? std::sqrt(radius2[s] / len2) : 1.0;
     double moved[3];
     for (int i = 0; i < 3; ++i) moved[i] = (p[i] + scale * move[i]) * extent + center[i];
     if (std::isfinite(moved[0]) && std::isfinite(moved[1]) && std::isfinite(moved[2]))
       for (int i = 0; i < 3; ++i) x[i] = moved[i];
-  }
+  });
   return out;
 }
 

@@ -7,7 +7,6 @@
 #include <stdexcept>
 #include <string>
 
-#include <omp.h>
 
 #include "decimate/collapser.hpp"
 #include "topstoc/core/parallel.hpp"
@@ -157,9 +156,8 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
     for (int i = 0; i < 3; ++i) p[i] = (mesh.position(v)[i] - center[i]) * scale;
   };
   const int32_t n = mesh.num_vertices(), m = mesh.num_faces();
-#pragma omp parallel if (n >= kParallelMin)
-  {
-    const int32_t threads = omp_get_num_threads(), me = omp_get_thread_num();
+  parallel_region(team_for(n, kParallelMin), [&](Team& team) {
+    const int32_t threads = team.size(), me = team.index();
     const int32_t low = int32_t(int64_t(clusters) * me / threads), high = int32_t(int64_t(clusters) * (me + 1) / threads);
     if (channels == 0) {
       for (int32_t v = 0; v < n; ++v)
@@ -189,7 +187,7 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
           if (l[j] >= low && l[j] < high) quadrics.add(l[j], face.data());
       }
     }
-  }
+  });
   // The edge tables are built on first use: a mesh without feature edges never needs them here.
   if (layout.feature_edges.empty()) return quadrics;
   const auto& ev = mesh.edge_vertices();
@@ -306,8 +304,7 @@ class Refinement {
     for (int i = 0; i < 3; ++i) setup.center[i] = frame->center[i];
     setup.extent = frame->extent;
     label.resize(num_input);
-#pragma omp parallel for schedule(static) if (num_input >= kParallelMin)
-    for (int32_t v = 0; v < num_input; ++v) label[v] = result.labels[source[v]];
+    parallel_for(0, num_input, kParallelMin, [&](int32_t v) { label[v] = result.labels[source[v]]; });
     setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *frame);
     set_up_vertices(setup);
     lock_inconsistent(setup);
@@ -439,12 +436,10 @@ class Refinement {
     std::vector<int32_t> survivor(n);
     for (int32_t v = 0; v < n; ++v) survivor[v] = collapser.survivor(v);
     std::vector<double> radius2(n, 0.0);
-#pragma omp parallel if (num_input >= kParallelMin)
-    {
+    parallel_region(team_for(num_input, kParallelMin), [&](Team& team) {
       std::vector<double> mine(n, 0.0);
-#pragma omp for schedule(static) nowait
-      for (int32_t v = 0; v < num_input; ++v) {
-        if (label[v] < 0) continue;
+      team.for_static(0, num_input, [&](int32_t v) {
+        if (label[v] < 0) return;
         const int32_t s = survivor[label[v]];
         const double* p = collapser.position(s);
         double d2 = 0;
@@ -453,10 +448,11 @@ class Refinement {
           d2 += d * d;
         }
         mine[s] = std::max(mine[s], d2);
-      }
-#pragma omp critical(topstoc_refit_radius)
-      for (int32_t v = 0; v < n; ++v) radius2[v] = std::max(radius2[v], mine[v]);
-    }
+      });
+      team.critical([&] {
+        for (int32_t v = 0; v < n; ++v) radius2[v] = std::max(radius2[v], mine[v]);
+      });
+    });
     return radius2;
   }
 
@@ -489,9 +485,9 @@ class Refinement {
     std::vector<int32_t> final_index(n);
     for (int32_t v = 0; v < n; ++v) final_index[v] = new_index[collapser.survivor(v)];
     const int64_t labels = int64_t(result.labels.size());
-#pragma omp parallel for schedule(static) if (labels >= kParallelMin)
-    for (int64_t i = 0; i < labels; ++i)
+    parallel_for(0, labels, kParallelMin, [&](int64_t i) {
       if (result.labels[i] >= 0) result.labels[i] = final_index[result.labels[i]];
+    });
   }
 };
 

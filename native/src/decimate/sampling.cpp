@@ -9,7 +9,6 @@
 
 #include <limits>
 #include <memory>
-#include <omp.h>
 
 #include "core/counting_sort.hpp"
 #include "core/id_bits.hpp"
@@ -143,9 +142,9 @@ std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const 
   // The vertex areas are built on first use: asked for once, before the loop (on all threads).
   const double mean_area = params.area_weighted ? mesh.mean_vertex_area() : 0.0;
   const double* area = mean_area > 0 ? mesh.vertex_areas().data() : nullptr;
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v)
+  parallel_for(0, n, kParallelMin, [&](int32_t v) {
     if (cls[v] == kSurface || cls[v] == kCurve) table->q[v] = importance(mesh, params, v, area, mean_area);
+  });
   table->surface_q.reserve(n);
   for (int32_t v = 0; v < n; ++v) {
     if (cls[v] == kSurface) table->surface_q.push_back(table->q[v]);
@@ -190,13 +189,12 @@ std::vector<double> guidance_multipliers(const Mesh& mesh, const SamplingParams&
   const int32_t n = mesh.num_vertices();
   std::vector<double> m(n, 1.0);
   if (!params.guidance && params.boxes.empty()) return m;
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
+  parallel_for(0, n, kParallelMin, [&](int32_t v) {
     double u = params.guidance ? params.guidance[mesh.vertex_source()[v]] : 0.0;
     for (const auto& box : params.boxes)
       if (inside_box(box, mesh.position(v))) u = box.value;
     m[v] = guidance_multiplier(u);
-  }
+  });
   return m;
 }
 
@@ -216,15 +214,14 @@ std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& 
   const int32_t n = mesh.num_vertices();
   std::vector<double> p(n);
   const bool guided = has_per_vertex_guidance(params);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v) {
+  parallel_for(0, n, kParallelMin, [&](int32_t v) {
     if (!guided || cls[v] == kIsolated || cls[v] == kCorner) {
       p[v] = plain_probability(cls[v], q[v], k);
     } else {
       const double surface = surface_probability(mesh, params, v, k, q[v], multiplier[v]);
       p[v] = cls[v] == kCurve ? std::sqrt(surface) : surface;
     }
-  }
+  });
   return p;
 }
 
@@ -323,9 +320,9 @@ std::shared_ptr<const SelectionUniforms> selection_uniforms(const Mesh& mesh, co
   auto table = std::make_shared<SelectionUniforms>();
   table->seed = seed;
   table->u.resize(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (int32_t v = 0; v < n; ++v)
+  parallel_for(0, n, kParallelMin, [&](int32_t v) {
     table->u[v] = uniform01(seed, kStreamSelection, uint64_t(mesh.vertex_source()[v]));
+  });
   layout.selection_uniforms.set(table);
   return table;
 }
@@ -412,12 +409,11 @@ double mean_edge_length(const Mesh& mesh) {
   const auto& ev = mesh.edge_vertices();
   const int32_t m = mesh.num_edges();
   std::vector<double> length(m);
-#pragma omp parallel for schedule(static) if (m >= kParallelMin)
-  for (int32_t e = 0; e < m; ++e) {
+  parallel_for(0, m, kParallelMin, [&](int32_t e) {
     const double* a = mesh.position(ev[2 * e]);
     const double* b = mesh.position(ev[2 * e + 1]);
     length[e] = std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
-  }
+  });
   // Summed in edge order on one thread: a reduction's order, and so its last bits, would depend
   // on the number of threads.
   double total = 0.0;

@@ -1,8 +1,8 @@
 #include "topstoc/decimate/verify.hpp"
 
-#include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <cmath>
 
@@ -35,12 +35,11 @@ struct VertexArcs {
       return c[0] != c[1] && c[1] != c[2] && c[2] != c[0];
     };
     const bool parallel = t >= kParallelMin;
-    const int threads = parallel ? omp_get_max_threads() : 1;
+    const int threads = parallel ? max_threads() : 1;
     std::vector<int64_t> range_arcs(threads + 1, 0);
     Buffer<int32_t> fill(n);  // per vertex: where its next arc goes
-#pragma omp parallel num_threads(threads)
-    {
-      const int me = omp_get_thread_num(), team = omp_get_num_threads();
+    parallel_region(threads, [&](Team& running) {
+      const int me = running.index(), team = running.size();
       const int32_t lo = int32_t(int64_t(n) * me / team), hi = int32_t(int64_t(n) * (me + 1) / team);
       // Counts: offsets[v + 1] holds v's (each range writes its own slots lo + 1 .. hi).
       for (int32_t v = lo; v < hi; ++v) offsets[v + 1] = 0;
@@ -53,17 +52,16 @@ struct VertexArcs {
       int64_t sum = 0;
       for (int32_t v = lo; v < hi; ++v) sum += offsets[v + 1];
       range_arcs[me + 1] = sum;
-#pragma omp barrier
-#pragma omp single
-      {
+      running.barrier();
+      running.single([&] {
         for (int r = 0; r < team; ++r) range_arcs[r + 1] += range_arcs[r];
         arcs.resize(range_arcs[team]);
         offsets[0] = 0;
-      }
+      });
       // Ends: offsets[v + 1] is where v's arcs end and v + 1's start.
       int64_t end = range_arcs[me];
       for (int32_t v = lo; v < hi; ++v) offsets[v + 1] = int32_t(end += offsets[v + 1]);
-#pragma omp barrier
+      running.barrier();
       for (int32_t v = lo; v < hi; ++v) fill[v] = offsets[v];
       for (int64_t i = 0; i < t; ++i) {
         if (!valid(i)) continue;
@@ -71,7 +69,7 @@ struct VertexArcs {
         for (int j = 0; j < 3; ++j)
           if (c[j] >= lo && c[j] < hi) arcs[fill[c[j]]++] = {c[(j + 1) % 3], c[(j + 2) % 3]};
       }
-    }
+    });
   }
 };
 
@@ -151,12 +149,10 @@ class OutputChecker {
   std::vector<uint8_t> on_boundary, used;
 
   void count_nonfinite() {
-    int32_t nonfinite = 0;
-#pragma omp parallel for schedule(static) reduction(+ : nonfinite) if (n >= kParallelMin)
-    for (int32_t v = 0; v < n; ++v)
-      nonfinite += !std::isfinite(positions[3 * size_t(v)]) || !std::isfinite(positions[3 * size_t(v) + 1]) ||
-                   !std::isfinite(positions[3 * size_t(v) + 2]);
-    check.nonfinite = nonfinite;
+    check.nonfinite = parallel_count<int32_t>(0, n, kParallelMin, [&](int32_t v) {
+      return !std::isfinite(positions[3 * size_t(v)]) || !std::isfinite(positions[3 * size_t(v) + 1]) ||
+             !std::isfinite(positions[3 * size_t(v) + 2]);
+    });
   }
 
   // Which input components are manifold, oriented surfaces (the guarantee's domain), allowing
@@ -170,8 +166,7 @@ class OutputChecker {
     for (int32_t comp = 0; comp < num_components && pinched.count > 0; ++comp)
       if (pinched.pinched_surface[comp]) manifold[comp] = 1;
     component_of.resize(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-    for (int32_t v = 0; v < n; ++v) component_of[v] = mesh.component()[kept[v]];
+    parallel_for(0, n, kParallelMin, [&](int32_t v) { component_of[v] = mesh.component()[kept[v]]; });
   }
 
   // Per triangle: repeated corners, mixed components, zero area; triangles per component
@@ -180,24 +175,25 @@ class OutputChecker {
     triangles_in.assign(num_components, 0);
     euler.assign(num_components, 0);
     int32_t repeated_corner = 0, mixed_triangles = 0, zero_area = 0;
-#pragma omp parallel reduction(+ : repeated_corner, mixed_triangles, zero_area) if (t >= kParallelMin)
-    {
+    parallel_region(team_for(t, kParallelMin), [&](Team& team) {
       std::vector<int32_t> mine(num_components, 0);
-#pragma omp for schedule(static)
-      for (int32_t i = 0; i < t; ++i) {
+      int32_t my_repeated = 0, my_mixed = 0, my_zero = 0;
+      team.for_static(0, t, [&](int32_t i) {
         const int32_t* c = &triangles[3 * size_t(i)];
         if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) {
-          ++repeated_corner;
-          continue;
+          ++my_repeated;
+          return;
         }
         const int32_t comp = component_of[c[0]];
-        if (component_of[c[1]] != comp || component_of[c[2]] != comp) ++mixed_triangles;
+        if (component_of[c[1]] != comp || component_of[c[2]] != comp) ++my_mixed;
         ++mine[comp];
-        if (has_zero_area(c)) ++zero_area;
-      }
-#pragma omp critical(topstoc_output_triangles)
-      for (int32_t comp = 0; comp < num_components; ++comp) triangles_in[comp] += mine[comp];
-    }
+        if (has_zero_area(c)) ++my_zero;
+      });
+      team.critical([&] {
+        repeated_corner += my_repeated, mixed_triangles += my_mixed, zero_area += my_zero;
+        for (int32_t comp = 0; comp < num_components; ++comp) triangles_in[comp] += mine[comp];
+      });
+    });
     check.repeated_corner = repeated_corner;
     check.mixed_triangles = mixed_triangles;
     check.zero_area = zero_area;
@@ -229,15 +225,13 @@ class OutputChecker {
     on_boundary.assign(n, 0);
     used.assign(n, 0);
     int32_t duplicate = 0, nonmanifold_edges = 0, inconsistent_edges = 0, nonmanifold_vertices = 0;
-#pragma omp parallel reduction(+ : duplicate, nonmanifold_edges, inconsistent_edges, nonmanifold_vertices) \
-    if (n >= kParallelMinCostly)
-    {
+    std::atomic<int64_t> next_vertex{0};
+    parallel_region(team_for(n, kParallelMinCostly), [&](Team& team) {
       LinkArcs link;
       std::vector<std::array<int32_t, 2>> corner_pairs;
       std::vector<int64_t> my_euler(num_components, 0);
       LinkIssues mine;
-#pragma omp for schedule(dynamic, 512)
-      for (int32_t v = 0; v < n; ++v) {
+      team.for_dynamic(next_vertex, n, 512, [&](int32_t v) {
         const int32_t count = around.offsets[v + 1] - around.offsets[v];
         const VertexArcs::Arc* arcs = around.arcs.data() + around.offsets[v];
         if (one_cycle(arcs, count) && manifold[component_of[v]]) {
@@ -248,15 +242,16 @@ class OutputChecker {
           ++euler_v;
           for (int32_t i = 0; i < count; ++i)
             if (arcs[i].from > v) --euler_v, pieces.unite(v, arcs[i].from);
-          continue;
+          return;
         }
         check_link(v, arcs, count, link, corner_pairs, my_euler, mine);
-      }
-      duplicate += mine.duplicate, nonmanifold_edges += mine.nonmanifold_edges;
-      inconsistent_edges += mine.inconsistent_edges, nonmanifold_vertices += mine.nonmanifold_vertices;
-#pragma omp critical(topstoc_output_euler)
-      for (int32_t comp = 0; comp < num_components; ++comp) euler[comp] += my_euler[comp];
-    }
+      });
+      team.critical([&] {
+        duplicate += mine.duplicate, nonmanifold_edges += mine.nonmanifold_edges;
+        inconsistent_edges += mine.inconsistent_edges, nonmanifold_vertices += mine.nonmanifold_vertices;
+        for (int32_t comp = 0; comp < num_components; ++comp) euler[comp] += my_euler[comp];
+      });
+    });
     check.duplicate += duplicate;
     check.nonmanifold_edges += nonmanifold_edges;
     check.inconsistent_edges += inconsistent_edges;

@@ -1,4 +1,5 @@
 #include "topstoc/distance/bvh.hpp"
+#include "topstoc/core/parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -117,14 +118,14 @@ TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int6
   corners_.resize(9 * size_t(m));
   std::vector<double> centroids(3 * size_t(m));
   std::vector<double> unordered(9 * size_t(m));
-#pragma omp parallel for schedule(static) if(m >= 100000)
-  for (int32_t f = 0; f < m; ++f)
+  parallel_for(0, m, 100000, [&](int32_t f) {
     for (int c = 0; c < 3; ++c)
       for (int k = 0; k < 3; ++k) {
         const double x = positions[3 * size_t(triangles[3 * size_t(f) + c]) + k];
         unordered[9 * size_t(f) + 3 * c + k] = x;
         centroids[3 * size_t(f) + k] += x / 3.0;
       }
+  });
   std::vector<BuildItem> items(m);
   for (int32_t f = 0; f < m; ++f) items[f] = {{centroids[3 * size_t(f)], centroids[3 * size_t(f) + 1],
                                                 centroids[3 * size_t(f) + 2]}, f};
@@ -134,9 +135,9 @@ TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int6
   for (int32_t s = 0; s < m; ++s) order[s] = items[s].id;
   // Store the corners in leaf order so that a leaf's triangles sit together in memory.
   triangle_ids_ = order;
-#pragma omp parallel for schedule(static) if(m >= 100000)
-  for (int32_t s = 0; s < m; ++s)
+  parallel_for(0, m, 100000, [&](int32_t s) {
     std::copy_n(&unordered[9 * size_t(order[s])], 9, &corners_[9 * size_t(s)]);
+  });
 }
 
 int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items) {

@@ -59,15 +59,13 @@ Lengths surface_lengths(const Surface& s) {
   const int64_t num_edges = int64_t(e.size() / 2), m = s.num_triangles();
   l.edge.resize(num_edges);
   l.longest.resize(m);
-#pragma omp parallel for schedule(static) if(num_edges >= kParallelMin)
-  for (int64_t i = 0; i < num_edges; ++i) l.edge[i] = length(&p[3 * size_t(e[2 * i])], &p[3 * size_t(e[2 * i + 1])]);
-#pragma omp parallel for schedule(static) if(m >= kParallelMin)
-  for (int64_t f = 0; f < m; ++f) {
+  parallel_for(0, num_edges, kParallelMin, [&](int64_t i) { l.edge[i] = length(&p[3 * size_t(e[2 * i])], &p[3 * size_t(e[2 * i + 1])]); });
+  parallel_for(0, m, kParallelMin, [&](int64_t f) {
     const double* a = &p[3 * size_t(t[3 * f])];
     const double* b = &p[3 * size_t(t[3 * f + 1])];
     const double* c = &p[3 * size_t(t[3 * f + 2])];
     l.longest[f] = std::max({length(a, b), length(b, c), length(c, a)});
-  }
+  });
   return l;
 }
 
@@ -218,8 +216,7 @@ SurfaceSamples sample_surface(const Surface& surface, double step) {
       std::copy_n(&p[3 * size_t(v)], 3, &s.points[3 * size_t(next)]);
       s.element[next++] = v;
     }
-#pragma omp parallel for schedule(static) if(num_edges >= kParallelMin)
-  for (int64_t i = 0; i < num_edges; ++i) {
+  parallel_for(0, num_edges, kParallelMin, [&](int64_t i) {
     const double* a = &p[3 * size_t(e[2 * i])];
     const double* b = &p[3 * size_t(e[2 * i + 1])];
     const int64_t n = edge_offsets[i + 1] - edge_offsets[i] + 1;
@@ -229,9 +226,8 @@ SurfaceSamples sample_surface(const Surface& surface, double step) {
       for (int c = 0; c < 3; ++c) s.points[3 * size_t(out) + c] = a[c] + x * (b[c] - a[c]);
       s.element[out] = int32_t(i);
     }
-  }
-#pragma omp parallel for schedule(dynamic, 1024) if(total >= kParallelMin)
-  for (int64_t f = 0; f < m; ++f) {
+  });
+  parallel_for_dynamic(0, m, 1024, parallel_if(total >= kParallelMin), [&](int64_t f) {
     const double* a = &p[3 * size_t(t[3 * f])];
     const double* b = &p[3 * size_t(t[3 * f + 1])];
     const double* c = &p[3 * size_t(t[3 * f + 2])];
@@ -250,7 +246,7 @@ SurfaceSamples sample_surface(const Surface& surface, double step) {
         emit((double(i) + 1.0 / 3.0) * inv, (double(j) + 1.0 / 3.0) * inv);
         if (i + j + 2 <= n) emit((double(i) + 2.0 / 3.0) * inv, (double(j) + 2.0 / 3.0) * inv);
       }
-  }
+  });
   return s;
 }
 
@@ -281,14 +277,13 @@ std::vector<ClosestHit> closest_points(const Surface& surface, const double* poi
   const TriangleBvh& bvh = surface.bvh();
   std::vector<ClosestHit> hits(count);
   const int64_t blocks = (count + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(dynamic, 4) if(count >= 4 * kBlock)
-  for (int64_t block = 0; block < blocks; ++block) {
+  parallel_for_dynamic(0, blocks, 4, parallel_if(count >= 4 * kBlock), [&](int64_t block) {
     int32_t hint = -1;
     for (int64_t i = block * kBlock; i < std::min(count, (block + 1) * kBlock); ++i) {
       hits[i] = bvh.closest(points + 3 * i, hint);
       hint = hits[i].slot;
     }
-  }
+  });
   return hits;
 }
 
@@ -306,15 +301,14 @@ OneSidedDistance one_sided_distance(const Surface& from, const SurfaceSamples& s
   {
     const TriangleBvh& bvh = to.bvh();
     const int64_t blocks = (count + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(dynamic, 4) if(count >= 4 * kBlock)
-    for (int64_t block = 0; block < blocks; ++block) {
+    parallel_for_dynamic(0, blocks, 4, parallel_if(count >= 4 * kBlock), [&](int64_t block) {
       int32_t hint = -1;
       for (int64_t i = block * kBlock; i < std::min(count, (block + 1) * kBlock); ++i) {
         const ClosestHit hit = bvh.closest(&samples.points[3 * size_t(i)], hint);
         distance[i] = std::sqrt(hit.distance2);
         hint = hit.slot;
       }
-    }
+    });
   }
 
   OneSidedDistance r;
@@ -388,8 +382,7 @@ OneSidedDistance one_sided_distance(const Surface& from, const SurfaceSamples& s
   for (int64_t i = samples.num_vertex_samples; i < samples.num_vertex_samples + samples.num_edge_samples; ++i)
     edge_max[samples.element[i]] = std::max(edge_max[samples.element[i]], distance[i]);
   r.face_max.assign(m, 0.0);
-#pragma omp parallel for schedule(static) if(m >= kParallelMin)
-  for (int64_t f = 0; f < m; ++f) {
+  parallel_for(0, m, kParallelMin, [&](int64_t f) {
     double x = 0.0;
     for (int64_t i = samples.face_offsets[f]; i < samples.face_offsets[f + 1]; ++i) x = std::max(x, distance[i]);
     for (int c = 0; c < 3; ++c) {
@@ -397,7 +390,7 @@ OneSidedDistance one_sided_distance(const Surface& from, const SurfaceSamples& s
       if (fe[3 * f + c] >= 0) x = std::max(x, edge_max[fe[3 * f + c]]);
     }
     r.face_max[f] = x;
-  }
+  });
   return r;
 }
 

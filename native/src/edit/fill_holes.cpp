@@ -7,6 +7,7 @@
 #include <string>
 
 #include "topstoc/core/incidence.hpp"
+#include "topstoc/core/parallel.hpp"
 #include "edit/patch_fairing.hpp"
 
 namespace topstoc {
@@ -63,8 +64,7 @@ std::vector<BoundaryLoop> boundary_loops(const int32_t* triangles, int64_t num_t
   const VertexTriangles around = vertex_triangles(triangles, num_triangles, num_vertices);
   // A triangle side is on the boundary when no other triangle holds both its ends.
   std::vector<uint8_t> boundary_side(3 * size_t(num_triangles), 0);
-#pragma omp parallel for schedule(static) if (num_triangles > 400000)  // threads cost more below
-  for (int64_t t = 0; t < num_triangles; ++t)
+  parallel_for(0, num_triangles, parallel_if(num_triangles > 400000), [&](int64_t t) {  // threads cost more below
     for (int c = 0; c < 3; ++c) {
       const int32_t a = triangles[3 * t + c], b = triangles[3 * t + (c + 1) % 3];
       bool shared = false;
@@ -75,6 +75,7 @@ std::vector<BoundaryLoop> boundary_loops(const int32_t* triangles, int64_t num_t
       }
       boundary_side[3 * t + c] = !shared;
     }
+  });
   // Boundary neighbours of every vertex (CSR), and whether the triangle runs towards each.
   std::vector<int32_t> offsets(size_t(num_vertices) + 1, 0);
   for (int64_t t = 0; t < num_triangles; ++t)
@@ -298,8 +299,7 @@ class HoleFilling {
   // Triangulate (and optionally refine and fair) every hole independently.
   void triangulate_all() {
     patches.resize(count);
-#pragma omp parallel for schedule(dynamic, 1) if (count >= 16)
-    for (int64_t h = 0; h < int64_t(count); ++h) {
+    parallel_for_dynamic(0, int64_t(count), 1, parallel_if(count >= 16), [&](int64_t h) {
       PreparedHole& p = prepared[h];
       patches[h] = triangulate_hole(p.hole, options.triangulation);
       if (options.refine || options.fair) {
@@ -309,7 +309,7 @@ class HoleFilling {
         patches[h].added_points = std::move(patch.added);
         patches[h].triangles = std::move(patch.triangles);
       }
-    }
+    });
   }
 
   // The patches' vertices and triangles appended to r, in hole order, with their records.

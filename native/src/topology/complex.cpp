@@ -8,7 +8,8 @@
 #include <stdexcept>
 #include <string>
 
-#include <omp.h>
+#include "core/per_thread.hpp"
+#include "topstoc/core/parallel.hpp"
 
 namespace topstoc {
 
@@ -16,7 +17,7 @@ namespace {
 
 constexpr int64_t kMaxSides = (int64_t(1) << 30) - 1;  // side_twin stores 2 * side in an int32
 
-int32_t pass_threads(int64_t items) { return items >= kParallelMinimum ? std::max(1, omp_get_max_threads()) : 1; }
+int32_t pass_threads(int64_t items) { return items >= kParallelMinimum ? max_threads() : 1; }
 
 // Stable counting sort of items 0..count-1 into buckets 0..num_buckets-1: count_item(i, hist)
 // increments hist[bucket of i]; place(i, hist) writes item i at hist[bucket of i]++. Runs on
@@ -28,9 +29,9 @@ void counting_sort(int64_t count, int32_t num_buckets, CountItem count_item, Pla
   const int32_t chunks = pass_threads(count);
   histograms.assign(size_t(chunks) * size_t(num_buckets), 0);
   auto hist = [&](int32_t c) { return histograms.data() + size_t(c) * size_t(num_buckets); };
-#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
-  for (int32_t c = 0; c < chunks; ++c)
+  parallel_for(0, chunks, parallel_if(chunks > 1), [&](int32_t c) {
     for (int64_t i = count * c / chunks; i < count * (c + 1) / chunks; ++i) count_item(i, hist(c));
+  });
   offsets.assign(size_t(num_buckets) + 1, 0);
   int64_t running = 0;
   for (int32_t b = 0; b < num_buckets; ++b) {
@@ -43,9 +44,9 @@ void counting_sort(int64_t count, int32_t num_buckets, CountItem count_item, Pla
   }
   if (running > INT32_MAX) throw std::invalid_argument("complex is too large: more than 2^31 incidences");
   offsets[num_buckets] = static_cast<int32_t>(running);
-#pragma omp parallel for schedule(static, 1) num_threads(chunks) if (chunks > 1)
-  for (int32_t c = 0; c < chunks; ++c)
+  parallel_for(0, chunks, parallel_if(chunks > 1), [&](int32_t c) {
     for (int64_t i = count * c / chunks; i < count * (c + 1) / chunks; ++i) place(i, hist(c));
+  });
 }
 
 // Sorts a small range in place (insertion sort; buckets here hold a handful of entries), falling
@@ -96,15 +97,14 @@ std::vector<int32_t> morton_order(const double* positions, int32_t n) {
     }
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
   std::vector<uint64_t> keyed(n), scratch(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-  for (int32_t v = 0; v < n; ++v) {
+  parallel_for(0, n, kParallelMinimum, [&](int32_t v) {
     uint32_t key = 0;
     for (int k = 0; k < 3; ++k) {
       const double t = (positions[3 * size_t(v) + k] - lo[k]) / extent;
       key |= spread_bits(uint32_t(std::clamp(t, 0.0, 1.0) * 1023.0)) << k;
     }
     keyed[v] = (uint64_t(key) << 32) | uint32_t(v);
-  }
+  });
   // Least significant digit first, 3 passes of 10 bits over the 30-bit key (stable).
   for (int shift = 32; shift < 62; shift += 10) {
     std::vector<int32_t> count(1025, 0);
@@ -197,8 +197,7 @@ void renumber_and_sort(SimplicialComplex& out, std::vector<int32_t> order, std::
     wires[i] = std::min(a, b);
     wires[i + 1] = std::max(a, b);
   }
-#pragma omp parallel for schedule(static) if (out.triangles.size() >= size_t(kParallelMinimum))
-  for (size_t i = 0; i < out.triangles.size(); ++i) out.triangles[i] = index[out.triangles[i]];
+  parallel_for(0, out.triangles.size(), kParallelMinimum, [&](size_t i) { out.triangles[i] = index[out.triangles[i]]; });
   auto lowest = [&](int64_t t) {
     const int32_t* x = &out.triangles[3 * size_t(t)];
     return std::min({x[0], x[1], x[2]});
@@ -284,15 +283,15 @@ void link_sides(SimplicialComplex& out, const std::vector<int32_t>& wires) {
 
   // Per vertex: list its edges and link the sides of each. Vertices holding an edge with no
   // triangle or with three and more (rare) are flagged and read again serially below, so the
-  // parallel loop allocates nothing (an exception must not escape an OpenMP region).
+  // parallel loop allocates nothing.
   out.side_twin.resize(num_sides);
   std::vector<uint8_t> special(n, 0);
   const int32_t threads = pass_threads(num_sides);
   std::vector<uint64_t> scratch(size_t(threads) * size_t(most_entries));
-  int64_t num_edges = 0;
-#pragma omp parallel for schedule(dynamic, 8192) reduction(+ : num_edges) num_threads(threads)
-  for (int32_t v = 0; v < n; ++v) {
-    uint64_t* begin = scratch.data() + size_t(omp_get_thread_num()) * size_t(most_entries);
+  PerThread<int64_t> edges_found(threads);
+  parallel_for_dynamic(0, n, 8192, parallel_if(threads > 1), [&](int32_t v) {
+    int64_t& num_edges = edges_found.mine();
+    uint64_t* begin = scratch.data() + size_t(thread_index()) * size_t(most_entries);
     uint64_t* end =
         begin + edges_at(out, v, star.data(), star_offsets.data(), wire_ends.data(), wire_at, begin);
     for (uint64_t* i = begin; i < end;) {
@@ -317,7 +316,9 @@ void link_sides(SimplicialComplex& out, const std::vector<int32_t>& wires) {
       }
       i = j;
     }
-  }
+  });
+  int64_t num_edges = 0;
+  for (int t = 0; t < threads; ++t) num_edges += edges_found[t];
   if (num_edges > INT32_MAX) throw std::invalid_argument("complex is too large: more than 2^31 edges");
   out.num_edges = static_cast<int32_t>(num_edges);
 

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "core/union_find.hpp"
+#include "topstoc/core/parallel.hpp"
 
 namespace topstoc {
 
@@ -134,16 +135,14 @@ class TopologyAnalysis {
     sheet_open.assign(num_triangles, 0);
     triangle_flags.assign(num_triangles, 0);
     split_fan.assign(n, 0);
-#pragma omp parallel sections num_threads(2) if (num_sides >= kParallelMinimum)
-    {
-#pragma omp section
-      join_sheets();
-#pragma omp section
-      for (int32_t v = 0; v < n; ++v) {
-        const int32_t triangles = k.vertex_triangles[v];
-        split_fan[v] = triangles > 0 && walk.fan_size(k.vertex_side[v], triangles) != triangles;
-      }
-    }
+    parallel_invoke(
+        num_sides >= kParallelMinimum, [&] { join_sheets(); },
+        [&] {
+          for (int32_t v = 0; v < n; ++v) {
+            const int32_t triangles = k.vertex_triangles[v];
+            split_fan[v] = triangles > 0 && walk.fan_size(k.vertex_side[v], triangles) != triangles;
+          }
+        });
   }
 
   void join_sheets() {
