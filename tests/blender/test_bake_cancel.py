@@ -4,6 +4,7 @@ a cancelled bake leaves the LOD as it was, and a cancelled Guided Decimate or LO
 scene as before the run (the operators' callback is replaced by one that cancels: the tests' hook)."""
 
 import importlib
+import os
 
 import bpy
 import numpy as np
@@ -67,8 +68,11 @@ def test_a_cancelled_bake_leaves_the_lod_as_it_was(ts, bake, scene):
 RUNS = {"guided_decimate": {"ratio": 0.2}, "lod_chain": {"ratios": "1.0, 0.2"}}
 
 
-@pytest.mark.parametrize("operator", sorted(RUNS))
-def test_a_cancelled_operator_leaves_the_scene_as_before(ts, bake, scene, monkeypatch, operator):
+@pytest.mark.parametrize("operator, store", [(name, "PACK") for name in sorted(RUNS)] + [("guided_decimate", "FILE")])
+def test_a_cancelled_operator_leaves_the_scene_as_before(ts, bake, scene, tmp_path, monkeypatch, operator, store):
+    """Saved beside the .blend (store FILE), the maps already written are removed too."""
+    monkeypatch.setattr(bake, "bake_folder", lambda: str(tmp_path))
+    (tmp_path / "a_TopStoc_normal.png").write_bytes(b"the user's file")  # taken: the bake writes _1
     sources = [small_pair("a"), small_pair("b")]
     select_only(sources[0])
     if operator == "guided_decimate":                             # two sources: the first one's bake is undone too
@@ -83,8 +87,10 @@ def test_a_cancelled_operator_leaves_the_scene_as_before(ts, bake, scene, monkey
     monkeypatch.setattr(bake_run, "cursor_progress", cancelling)
     selected = sorted(o.name for o in bpy.context.selected_objects)
     before = datablocks(), [snapshot(s.data) for s in sources]
-    assert getattr(bpy.ops.topstoc, operator)(bake_normals=True, bake_size="256", bake_margin=2,
+    assert getattr(bpy.ops.topstoc, operator)(bake_normals=True, bake_size="256", bake_margin=2, bake_store=store,
                                               **RUNS[operator]) == {"CANCELLED"}
     assert calls and calls[0][0] < 0.75 <= calls[0][-1]          # the run got that far before cancelling
     assert (datablocks(), [snapshot(s.data) for s in sources]) == before
     assert sorted(o.name for o in bpy.context.selected_objects) == selected
+    assert os.listdir(tmp_path) == ["a_TopStoc_normal.png"]
+    assert (tmp_path / "a_TopStoc_normal.png").read_bytes() == b"the user's file"

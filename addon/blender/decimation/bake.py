@@ -412,7 +412,8 @@ def bake_results(context, settings, pairs, progress=None) -> tuple:
 
 def remove_results(results) -> None:
     """Removes decimated results with what bakes gave them (material copies holding the map node,
-    their images) and their meshes when nothing else uses them: a cancelled run leaves nothing."""
+    their images and the files saved for them: fresh names, never a user's file) and their meshes
+    when nothing else uses them: a cancelled run leaves nothing."""
     materials = {slot.material for obj in results for slot in obj.material_slots if slot.material is not None
                  and slot.material.node_tree and any(n.label == NODE_LABEL for n in slot.material.node_tree.nodes)}
     images = {node.image for material in materials for node in material.node_tree.nodes
@@ -426,4 +427,7 @@ def remove_results(results) -> None:
     for material in materials:
         bpy.data.materials.remove(material)
     for image in images:
+        path = bpy.path.abspath(image.filepath_raw) if image.packed_file is None else ""
+        if path and os.path.isfile(path):
+            os.remove(path)
         bpy.data.images.remove(image)
