@@ -251,13 +251,15 @@ def decimate_scene_file(path: str, out_dir: str, settings: dict) -> dict:
     stem, ext = os.path.splitext(name)
     ext = "." + settings["format"] if settings["format"] else ext
     outputs = []
+    embed = bool(settings.get("bake_normals"))  # an FBX then carries its baked maps
     if settings["chain"] and settings["lod_files"]:
         others = [o for o in bpy.context.scene.objects if o.type != "MESH"]  # armatures, empties
         for index in range(len(targets)):
             lod_set = [lods[index] for lods in chains] + others
-            outputs.append(scene_io.save(os.path.join(out_dir, f"{stem}_LOD{index}{ext}"), lod_set)[-1])
+            outputs.append(scene_io.save(os.path.join(out_dir, f"{stem}_LOD{index}{ext}"), lod_set,
+                                         embed_textures=embed)[-1])
     else:
-        outputs.append(scene_io.save(os.path.join(out_dir, stem + ext))[-1])
+        outputs.append(scene_io.save(os.path.join(out_dir, stem + ext), embed_textures=embed)[-1])
     return {"input": path, "output": outputs[0], "outputs": outputs,
             "vertices_in": sum(e["vertices_in"] for e in entries),
             "vertices_out": sum(e["vertices_out"] for e in entries),

@@ -333,28 +333,37 @@ def test_in_place_cannot_bake(ts, scene):
         bpy.ops.topstoc.guided_decimate(ratio=0.2, output="IN_PLACE", bake_normals=True)
 
 
-def test_batch_writes_a_gltf_that_reimports_with_its_map(ts, scene, tmp_path):
-    """``--bake-normals SIZE``: the map is a PNG next to the output, the glTF's material uses it as
-    its normalTexture, and Blender's importer reads it back into a Normal Map node."""
+def batch_bake(ts, tmp_path, kind):
+    """Runs the batch with ``--bake-normals 128`` on a pebble written as ``pebble.<kind>``; returns
+    (command, output folder, the LOD's report entry, source faces)."""
     import json
     import subprocess
-    import sys
 
     from test_batch_formats import _runner
 
     batch_run = importlib_module(ts, "core.batch.run")
-    scene_io = importlib_module(ts, "blender.io.scene_files")
     source_faces = len(small_pair("pebble").data.polygons)
-    bpy.ops.export_scene.gltf(filepath=str(tmp_path / "pebble.gltf"), export_format="GLTF_SEPARATE")
+    importlib_module(ts, "blender.io.scene_files").save(str(tmp_path / f"pebble.{kind}"))
     out = tmp_path / "out"
     report = tmp_path / "report.json"
     command = batch_run.blender_command(_runner()) + [
-        "--input", str(tmp_path / "pebble.gltf"), "--output", str(out), "--json", str(report),
+        "--input", str(tmp_path / f"pebble.{kind}"), "--output", str(out), "--json", str(report),
         "--ratio", "0.1", "--bake-normals", "128"]
     done = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     [lod] = json.loads(report.read_text())["results"][0]["objects"][0]["lods"]
     assert lod["normal_map"] == str(out / "pebble_pebble_normal.png") and os.path.isfile(lod["normal_map"])
+    return command, out, lod, source_faces
+
+
+def test_batch_writes_a_gltf_that_reimports_with_its_map(ts, scene, tmp_path):
+    """``--bake-normals SIZE``: the map is a PNG next to the output, the glTF's material uses it as
+    its normalTexture, and Blender's importer reads it back into a Normal Map node."""
+    import json
+    import subprocess
+
+    scene_io = importlib_module(ts, "blender.io.scene_files")
+    command, out, lod, source_faces = batch_bake(ts, tmp_path, "gltf")
     gltf = json.loads((out / "pebble.gltf").read_text())
     [material] = gltf["materials"]
     texture = gltf["textures"][material["normalTexture"]["index"]]
@@ -368,6 +377,31 @@ def test_batch_writes_a_gltf_that_reimports_with_its_map(ts, scene, tmp_path):
     again = subprocess.run(command, capture_output=True, text=True, timeout=300)  # a new run replaces it
     assert again.returncode == 0 and sorted(os.listdir(out)) == ["pebble.bin", "pebble.gltf",
                                                                  "pebble_pebble_normal.png"]
+
+
+def test_batch_writes_an_fbx_that_reimports_with_its_map(ts, scene, tmp_path):
+    """The FBX output carries the baked map (embedded: an FBX names its images by absolute path):
+    moved elsewhere without the PNG, it re-imports with the map's pixels in a Normal Map node."""
+    import shutil
+
+    _command, out, lod, source_faces = batch_bake(ts, tmp_path, "fbx")
+    written = bpy.data.images.load(lod["normal_map"])
+    expected = np.empty(len(written.pixels), dtype=np.float32)
+    written.pixels.foreach_get(expected)
+    bpy.data.images.remove(written)
+    moved = tmp_path / "moved"
+    shutil.move(str(out), str(moved))
+    os.remove(moved / "pebble_pebble_normal.png")
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    importlib_module(ts, "blender.io.scene_files").import_file(str(moved / "pebble.fbx"))
+    [obj] = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+    image = normal_map_image(obj)
+    assert image is not None and tuple(image.size) == (128, 128)
+    pixels = np.empty(len(image.pixels), dtype=np.float32)
+    image.pixels.foreach_get(pixels)
+    assert np.array_equal(pixels, expected) and np.ptp(expected) > 0.3  # the baked map, not a placeholder
+    assert sum(len(p.vertices) - 2 for p in obj.data.polygons) == lod["triangles"] < source_faces / 5
 
 
 def test_batch_refuses_mesh_files_and_bad_sizes(ts, scene, tmp_path):

@@ -269,14 +269,15 @@ def has_detail(image) -> bool:
     return bool((unit[:, 2] < np.cos(np.radians(1.0))).any())
 
 
-def _bake_image(source, result, image, uv_map: str, reach: tuple, margin: int, expect_detail: bool) -> str:
+def _bake_image(source, result, image, uv_map: str, reach: tuple, margin: int, expect_detail: bool,
+                progress=None) -> str:
     """Bakes into ``image`` with Cycles, or by ray casting when Cycles leaves the map flat though
-    the surfaces differ; returns which ("Cycles" or "ray cast")."""
+    the surfaces differ (told to ``progress``); returns which ("Cycles" or "ray cast")."""
     extrusion, max_ray = reach
     _run_bake(extrusion, max_ray, margin, image.size[0], result.name)
     if not expect_detail or has_detail(image):
         return "Cycles"
-    bake_raycast.bake(source, result, image, uv_map, extrusion, max_ray, margin)
+    bake_raycast.bake(source, result, image, uv_map, extrusion, max_ray, margin, progress)
     if not has_detail(image):
         raise BakeError(f"the bake onto '{result.name}' came back empty: no ray from it reached "
                         f"'{source.name}'")
@@ -328,11 +329,12 @@ def bake_folder() -> str:
 
 
 def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16, store: str = "PACK",
-                 folder: str = None, name: str = None, replace: bool = False) -> Baked:
+                 folder: str = None, name: str = None, replace: bool = False, progress=None) -> Baked:
     """Bakes ``source``'s shading normals onto ``result`` (its decimated copy) as a tangent-space
     normal map of ``size``² with ``margin`` pixels of bleed. store: "PACK" (into the .blend) or
     "FILE" (``<folder>/<name>_normal.png``; by default beside the .blend, named after the result;
-    an existing file replaced only with ``replace``)."""
+    an existing file replaced only with ``replace``). ``progress(fraction)`` follows the ray cast;
+    its False cancels (bake_raycast.Cancelled), leaving ``result`` as it was, like a failed bake."""
     size = check_size(size)
     check_memory(size, available_memory())
     check_bakeable(source, result)
@@ -341,6 +343,7 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
         folder = folder or bake_folder()
     hausdorff_max, diagonal, extrusion, max_ray = measure_reach(source, result)
     old_materials = [slot.material for slot in result.material_slots]
+    old_uv = (result.data.uv_layers.active_index, [layer.name for layer in result.data.uv_layers])
     image, made = None, []
     with _SceneState(context, source, result) as state:
         try:
@@ -353,15 +356,16 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
             state.use_cycles()
             # surfaces this close give a flat map rightly (an LOD0 at ratio 1)
             method = _bake_image(source, result, image, uv_map, (extrusion, max_ray), margin,
-                                 hausdorff_max > DETAIL * diagonal)
+                                 hausdorff_max > DETAIL * diagonal, progress)
             if active_uv >= 0:  # the map made for the bake is not the one the user edits
                 result.data.uv_layers.active_index = active_uv
             path = save_image(image, folder, bpy.path.clean_name(name or result.name), replace) \
                 if store == "FILE" else ""
             if store != "FILE":
                 pack_image(image)
-        except BakeError:
+        except (BakeError, bake_raycast.Cancelled):
             _undo_materials(result, old_materials, made, image)
+            _undo_uv_map(result, *old_uv)
             raise
     return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, method, path)
 
@@ -376,17 +380,54 @@ def _undo_materials(result, old_materials, made, image) -> None:
         bpy.data.images.remove(image)
 
 
-def bake_results(context, settings, pairs) -> tuple:
+def _undo_uv_map(result, active: int, names: list) -> None:
+    """Removes a UV map the bake made and makes the user's active one active again."""
+    layers = result.data.uv_layers
+    for name in [layer.name for layer in layers if layer.name not in names]:
+        layers.remove(layers[name])
+    if active >= 0:
+        layers.active_index = active
+
+
+def bake_results(context, settings, pairs, progress=None) -> tuple:
     """Bakes every (source, result) pair with an operator's BakeParameters; returns (status lines,
-    one-line failures). A failed bake leaves its result as decimated."""
+    one-line failures). A failed bake leaves its result as decimated. ``progress(fraction)`` follows
+    the whole run; its False cancels (bake_raycast.Cancelled raised, the current result as it was)."""
     lines, failures = [], []
-    for source, result in pairs:
+    pairs = list(pairs)
+    for index, (source, result) in enumerate(pairs):
+        told = None if progress is None else (lambda f, i=index: progress((i + f) / len(pairs)))
         try:
             baked = bake_normals(context, source, result, size=int(settings.bake_size),
-                                 margin=settings.bake_margin, store=settings.bake_store)
+                                 margin=settings.bake_margin, store=settings.bake_store, progress=told)
+        except bake_raycast.Cancelled:
+            raise
         except TopStocError as error:
             failures.append(f"Bake Normals: {error}")
             continue
         where = baked.path or "packed"
         lines.append(f"{result.name}: {baked.image.size[0]}² normal map ({where}, reach {baked.extrusion:.4g})")
     return lines, failures
+
+
+def remove_results(results) -> None:
+    """Removes decimated results with what bakes gave them (material copies holding the map node,
+    their images and the files saved for them: fresh names, never a user's file) and their meshes
+    when nothing else uses them: a cancelled run leaves nothing."""
+    materials = {slot.material for obj in results for slot in obj.material_slots if slot.material is not None
+                 and slot.material.node_tree and any(n.label == NODE_LABEL for n in slot.material.node_tree.nodes)}
+    images = {node.image for material in materials for node in material.node_tree.nodes
+              if node.label == NODE_LABEL and node.image is not None}
+    meshes = {obj.data for obj in results}
+    for obj in results:
+        bpy.data.objects.remove(obj)
+    for mesh in meshes:
+        if mesh.users == 0:
+            bpy.data.meshes.remove(mesh)
+    for material in materials:
+        bpy.data.materials.remove(material)
+    for image in images:
+        path = bpy.path.abspath(image.filepath_raw) if image.packed_file is None else ""
+        if path and os.path.isfile(path):
+            os.remove(path)
+        bpy.data.images.remove(image)

@@ -2,7 +2,8 @@
 (Debian's Blender 3.4): the same rays as Cycles' bake (from the result's surface pushed out by the
 extrusion, inward along its smooth normal, at most the max ray distance; first hit on the source),
 cast with Blender's BVH tree, and the source's smooth normal at the hit written in the result's
-MikkTSpace tangent frame (what the Normal Map node reads back). Texel centres only, no antialiasing."""
+MikkTSpace tangent frame (what the Normal Map node reads back). Texel centres only, no antialiasing.
+The rays go in chunks, each reported to ``progress`` (whose False cancels: the image is left as it was)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,13 @@ from mathutils import Vector
 from mathutils.bvhtree import BVHTree
 
 from ...core.carry.normal_bake import dilate, rasterize
+from ...core.support.errors import TopStocError
+
+CHUNK = 8192  #: rays cast between two progress reports
+
+
+class Cancelled(TopStocError):
+    """The progress callback asked the ray cast to stop."""
 
 
 def _corner_normals(mesh) -> np.ndarray:
@@ -69,21 +77,29 @@ def _source_normals(mesh, matrix, hits, triangle_ids) -> np.ndarray:
     return _unit(np.einsum("ij,ijk->ik", weights, normals[loops[triangle_ids]]))
 
 
-def _cast(tree, origins, directions, reach) -> tuple:
-    """(hit locations, triangle ids, whether hit) of the first hits within ``reach``."""
+def _cast(tree, origins, directions, reach, progress=None) -> tuple:
+    """(hit locations, triangle ids, whether hit) of the first hits within ``reach``; ``progress``
+    is told the fraction cast after every CHUNK rays, and its False raises Cancelled."""
     hits = np.zeros_like(origins)
     ids = np.zeros(len(origins), dtype=np.int64)
     found = np.zeros(len(origins), dtype=bool)
-    for i, (origin, direction) in enumerate(zip(origins.tolist(), directions.tolist())):
-        location, _normal, index, _distance = tree.ray_cast(Vector(origin), Vector(direction), reach)
-        if index is not None:
-            hits[i], ids[i], found[i] = location, index, True
+    for start in range(0, len(origins), CHUNK):
+        stop = min(start + CHUNK, len(origins))
+        for i, origin, direction in zip(range(start, stop), origins[start:stop].tolist(),
+                                        directions[start:stop].tolist()):
+            location, _normal, index, _distance = tree.ray_cast(Vector(origin), Vector(direction), reach)
+            if index is not None:
+                hits[i], ids[i], found[i] = location, index, True
+        if progress is not None and progress(stop / len(origins)) is False:
+            raise Cancelled("normal map bake cancelled")
     return hits, ids, found
 
 
-def bake(source, result, image, uv_map: str, extrusion: float, max_ray: float, margin: int) -> None:
+def bake(source, result, image, uv_map: str, extrusion: float, max_ray: float, margin: int,
+         progress=None) -> None:
     """Writes the tangent-space normals of ``source`` seen from ``result`` (placed where the source
-    is) into ``image`` (square), laid out on ``uv_map``, with ``margin`` texels of bleed."""
+    is) into ``image`` (square), laid out on ``uv_map``, with ``margin`` texels of bleed.
+    ``progress(fraction)`` is called as the rays go; its False raises Cancelled, ``image`` untouched."""
     size = image.size[0]
     matrix = np.array(source.matrix_world, dtype=np.float64)
     mesh = result.data
@@ -101,7 +117,7 @@ def bake(source, result, image, uv_map: str, extrusion: float, max_ray: float, m
 
     _, source_vertices = _triangles(source.data)
     tree = BVHTree.FromPolygons(_world(source.data, matrix).tolist(), source_vertices.tolist())
-    hits, ids, found = _cast(tree, points + extrusion * normal, -normal, max_ray)
+    hits, ids, found = _cast(tree, points + extrusion * normal, -normal, max_ray, progress)
     seen = normal.copy()
     seen[found] = _source_normals(source.data, matrix, hits[found], ids[found])
     encoded = np.stack([np.einsum("ij,ij->i", seen, axis) for axis in (tangent, bitangent, normal)], axis=1)

@@ -127,7 +127,7 @@ def import_file(path: str) -> None:
         bpy.ops.wm.usd_import(filepath=filepath)
 
 
-def _export(kind: str, filepath: str, selected: bool) -> None:
+def _export(kind: str, filepath: str, selected: bool, embed_textures: bool = False) -> None:
     _enable_addon(IMPORTERS.get(kind, kind))
     if kind in ("gltf", "glb"):
         if bpy.app.version < (3, 5, 0):
@@ -139,6 +139,8 @@ def _export(kind: str, filepath: str, selected: bool) -> None:
     elif kind == "fbx":
         operator = bpy.ops.export_scene.fbx
         options = dict(use_selection=selected, add_leaf_bones=False, use_mesh_modifiers=False)
+        if embed_textures:  # the images travel inside the file (FBX would name them by absolute path)
+            options.update(path_mode="COPY", embed_textures=True)
     elif kind in ("usd", "usda", "usdc", "usdz"):
         _check_usd(filepath)
         operator = bpy.ops.wm.usd_export
@@ -149,10 +151,10 @@ def _export(kind: str, filepath: str, selected: bool) -> None:
     operator(filepath=filepath, **_supported(operator, options))
 
 
-def save(path: str, objects=None) -> list:
+def save(path: str, objects=None, embed_textures: bool = False) -> list:
     """Writes the scene (or only ``objects`` and what they need) to ``path`` atomically; returns the
     files written (the main file last). A symlink at ``path`` is written through: its target is
-    replaced, the link kept."""
+    replaced, the link kept. ``embed_textures``: an FBX carries its images inside."""
     path = atomic.target(os.path.abspath(path))
     folder = os.path.dirname(path)
     kind = extension(path)
@@ -169,7 +171,7 @@ def save(path: str, objects=None) -> list:
             if selected:
                 for obj in bpy.context.view_layer.objects:
                     obj.select_set(obj in objects)
-            _export(kind, staged, selected)
+            _export(kind, staged, selected, embed_textures)
         if not os.path.exists(staged):
             raise TopStocError(f"{path}: the exporter wrote nothing")
         produced = sorted(name for name in os.listdir(scratch) if name != os.path.basename(path))

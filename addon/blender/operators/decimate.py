@@ -6,11 +6,11 @@ import time
 
 import bpy
 
-from ..decimation import bake, pipeline
+from ..decimation import pipeline
 from ...core.support.errors import TopStocError
 from ..props import OperatorBakeParameters, OperatorParameters, explicit_engine_options, fill_from_scene
 from ..ui.panels import draw_bake
-from . import polls
+from . import bake_run, polls
 
 
 def select_results(context, outputs) -> None:
@@ -81,7 +81,11 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
         baked = []
         if self.bake_normals and outputs:
             if self.output == "NEW_OBJECT":
-                baked, bake_failures = bake.bake_results(context, self, zip(sources, outputs))
+                done = bake_run.bake_or_discard(context, self, zip(sources, outputs), outputs)
+                if done is None:
+                    self.report({"WARNING"}, "TopStoc: Bake Normals cancelled; nothing was changed")
+                    return {"CANCELLED"}
+                baked, bake_failures = done
                 failures += bake_failures
             else:
                 failures.append("Bake Normals needs Output: New Object (in place, no original is left to "

@@ -6,10 +6,10 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-from ..decimation import bake, pipeline
+from ..decimation import pipeline
 from ...core.support.errors import TopStocError
 from ..props import OperatorBakeParameters, OperatorParameters, explicit_engine_options, fill_from_scene
-from . import polls
+from . import bake_run, polls
 
 
 def parse_ratios(text: str) -> list:
@@ -77,9 +77,17 @@ class _VariantsBase(OperatorParameters):
             return {"CANCELLED"}
         names = self.names(obj, runs)
         outputs = [pipeline.write_output(run, "NEW_OBJECT", name=name, place=False) for run, name in zip(runs, names)]
-        _lay_out(obj, outputs, _collection(context, self.collection_name(obj)))
+        made_collection = bpy.data.collections.get(self.collection_name(obj)) is None
+        collection = _collection(context, self.collection_name(obj))
+        _lay_out(obj, outputs, collection)
         if getattr(self, "bake_normals", False):
-            baked, failures = bake.bake_results(context, self, [(obj, output) for output in outputs])
+            done = bake_run.bake_or_discard(context, self, [(obj, output) for output in outputs], outputs)
+            if done is None:
+                if made_collection:
+                    bpy.data.collections.remove(collection)
+                self.report({"WARNING"}, "TopStoc: Bake Normals cancelled; nothing was changed")
+                return {"CANCELLED"}
+            baked, failures = done
             for line in baked:
                 self.report({"INFO"}, f"TopStoc: {line}")
             for message in failures:
