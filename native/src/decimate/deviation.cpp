@@ -51,13 +51,14 @@ Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const s
   const int32_t n = collapser.vertices();
   std::vector<int32_t> survivor(n);
   for (int32_t v = 0; v < n; ++v) survivor[v] = collapser.survivor(v);
+  Deviation out;
+  for (int32_t v = 0; v < n; ++v) out.vertices += survivor[v] == v;
   std::vector<double> positions(3 * size_t(n));
   std::vector<int32_t> live;
   for (int32_t v = 0; v < n; ++v)
     for (int i = 0; i < 3; ++i) positions[3 * size_t(v) + i] = collapser.position(v)[i];
   for (size_t t = 0; 3 * t < triangles.size(); ++t)
     if (collapser.face_alive(int32_t(t))) live.insert(live.end(), &triangles[3 * t], &triangles[3 * t] + 3);
-  Deviation out;
   out.vertex2.assign(n, 0.0);
   out.faces = static_cast<int32_t>(live.size() / 3);
   if (out.faces == 0) return out;

@@ -25,7 +25,8 @@ struct Deviation {
   /// the farthest point found around it, from the input to the surface or back.
   std::vector<double> vertex2;
   double top2 = 0.0;    ///< the largest of them
-  int32_t faces = 0;    ///< live triangles
+  int32_t faces = 0;     ///< live triangles
+  int32_t vertices = 0;  ///< live vertices
 };
 
 /// From the input: each input vertex, triangle centre and side middle to the collapsed surface,

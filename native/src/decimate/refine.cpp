@@ -381,7 +381,7 @@ class Refinement {
   // Max-aware collapses (RefineParams::max_aware): a first run, then a second whose cost
   // weights grow with how far the first one's surface ended from the input around each vertex,
   // so that it keeps more vertices where the first deviated most (a step of reweighting toward
-  // the smallest max error). The run with fewer triangles, or as many and a smaller
+  // the smallest max error). The run nearer the target, or as near and with the smaller
   // deviation, is kept.
   void collapse_max_aware(CollapseSetup setup, const double* center, double extent) {
     std::vector<int32_t> first_triangles = result.triangles, first_corners = result.corner_source;
@@ -395,7 +395,13 @@ class Refinement {
     Collapser second(result.triangles, result.corner_source, std::move(setup));
     collapse(second, center, extent);
     const Deviation after = surface_deviation(mesh, input, label, second, result.triangles);
-    if (after.faces < before.faces || (after.faces == before.faces && after.top2 <= before.top2)) {
+    // How far each run stayed above the target (0 once reached): the nearer run wins, then the
+    // smaller deviation.
+    auto excess = [&](const Deviation& d) {
+      return params.target_triangles > 0 ? std::max(0, d.faces - params.target_triangles)
+                                         : std::max(0, d.vertices - params.target_vertices);
+    };
+    if (excess(after) < excess(before) || (excess(after) == excess(before) && after.top2 <= before.top2)) {
       finish(second);
       return;
     }
