@@ -92,14 +92,22 @@ def percent(ratio: float) -> str:
     return f"{ratio:.0%}" if round(ratio * 100, 6).is_integer() else f"{ratio:.1%}"
 
 
+# Errors below this (% of the diagonal) count as exact, as in bench_quality.py (EXACT there).
+EXACT = 1e-6
+
+
+def error_ratio(ours: float, peer: float) -> float:
+    return max(ours, EXACT) / max(peer, EXACT)
+
+
 def goal_ratios(case: dict) -> tuple:
     """Issue 40's two figures: our mean over the better of Blender and MeshLab, our max over the best peer."""
     tools = case["tools"]
     means = [tools[n]["mean"] for n in ("Blender Collapse", "MeshLab") if tools.get(n)]
     maxes = [tools[n]["max"] for n in QUALITY_PEERS if tools.get(n)]
     ours = tools["topstoc quality"]
-    return (ours["mean"] / min(means) if means and min(means) > 0 else None,
-            ours["max"] / min(maxes) if maxes and min(maxes) > 0 else None)
+    return (error_ratio(ours["mean"], min(means)) if means else None,
+            error_ratio(ours["max"], min(maxes)) if maxes else None)
 
 
 def goal_lines(cases: list) -> list:
@@ -151,7 +159,7 @@ def render_quality(name: str, figures: dict) -> str:
             continue
         cells = []
         for key, _ in QUALITY_FIGURES:
-            ratios = [a[key] / b[key] for a, b in pairs if b[key] > 0]
+            ratios = [error_ratio(a[key], b[key]) for a, b in pairs]
             cells.append(f"{statistics.median(ratios):.3f}× [{max(ratios):.2f}]" if ratios else "—")
         kept = sum(bool(b["topology"]) for _, b in pairs)
         out.append(f"| {peer} | " + " | ".join(cells) + f" | {kept}/{len(pairs)} |")

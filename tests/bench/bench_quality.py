@@ -274,6 +274,16 @@ def run_batched_peers(cases, blender_jobs, fs_jobs, work, samples) -> None:
                 topology=signature(got["vertices"], got["triangles"]) == case["signature"])
 
 
+# Errors below this (in % of the diagonal: 1e-8 of it, below the rounding of a float32 output)
+# count as exact: the ratio of two such figures (a flat mesh all tools keep flat) measures
+# rounding, not quality.
+EXACT = 1e-6
+
+
+def error_ratio(ours: float, peer: float) -> float:
+    return max(ours, EXACT) / max(peer, EXACT)
+
+
 def goal_ratios(case) -> tuple[float | None, float | None]:
     """Our mean over the better of Blender and MeshLab; our max over the best peer's (issue 40's goals)."""
     ours = case["tools"].get("topstoc quality")
@@ -281,8 +291,8 @@ def goal_ratios(case) -> tuple[float | None, float | None]:
         return None, None
     means = [case["tools"][n]["mean"] for n in ("Blender Collapse", "MeshLab") if case["tools"].get(n)]
     maxes = [case["tools"][n]["max"] for n in PEERS if case["tools"].get(n)]
-    mean = ours["mean"] / min(means) if means and min(means) > 0 else None
-    worst = ours["max"] / min(maxes) if maxes and min(maxes) > 0 else None
+    mean = error_ratio(ours["mean"], min(means)) if means else None
+    worst = error_ratio(ours["max"], min(maxes)) if maxes else None
     return mean, worst
 
 
@@ -317,7 +327,7 @@ def summarize(cases) -> None:
             continue
         parts = []
         for key in ("mean", "max", "ar_mean", "ar_max"):
-            values = [a[key] / b[key] for a, b in pairs if b[key] > 0]
+            values = [error_ratio(a[key], b[key]) for a, b in pairs]
             parts.append(f"{key} {statistics.median(values):.3f} [{max(values):.2f}]")
         parts.append(f"peer keeps topology {sum(b['topology'] for _, b in pairs)}/{len(pairs)}")
         print(f"  vs {name}: " + ", ".join(parts))

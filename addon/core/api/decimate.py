@@ -188,7 +188,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     collapses themselves place a vertex joining two free vertices at the quadric optimum either
     way; placement only decides the final re-fit.
     refine: None = the mode's own (quality: the first pass keeps the target plus
-    max(QUALITY_COLLAPSES, target / 4) vertices, or the whole mesh up to 5 * QUALITY_COLLAPSES;
+    max(QUALITY_COLLAPSES, target / 4) vertices, or the whole mesh up to 8 * QUALITY_COLLAPSES;
     fast: 0). 0 = off (fastest). f >= 1: TopStoc keeps f times the target (so refine=1 leaves
     the collapses almost nothing to do), then edge collapses ordered by quadric error against
     the input thin it to the target (topology and borders kept, painted regions keeping their

@@ -73,6 +73,11 @@ class Collapser {
   const double* world(int32_t v) const { return &s_.world[3 * size_t(v)]; }
   const double* position(int32_t v) const { return &s_.positions[3 * size_t(v)]; }
   bool is_free(int32_t v) const { return s_.curve[v] < 0 && !s_.locked[v]; }
+  int32_t vertices() const { return static_cast<int32_t>(merged_into_.size()); }
+  /// The caller's coordinates in the normalised ones of position().
+  void normalise(const double* world, double* out) const {
+    for (int i = 0; i < 3; ++i) out[i] = (world[i] - s_.center[i]) * (1.0 / s_.extent);
+  }
 
  private:
   bool free_pair(int32_t from, int32_t to) const {

@@ -670,10 +670,15 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
 
 namespace {
 
+// A refined decimation starts from the whole mesh up to this many times refine_collapses
+// vertices: below that the collapses' time is small, and the stochastic first pass's choices
+// cost quality (3.8 times the mean error on a 62k-vertex character; docs/benchmarks.md).
+constexpr double kWholeMeshCollapses = 8.0;
+
 // Vertices the first pass of a refined decimation keeps (see DecimateParams::refine_collapses).
 int32_t first_pass_vertices(const DecimateParams& params, int32_t active) {
   const double target = params.target_vertices, collapses = std::max(0, params.refine_collapses);
-  if (collapses > 0 && active <= 5.0 * collapses) return active;
+  if (collapses > 0 && active <= kWholeMeshCollapses * collapses) return active;
   const double extra = collapses > 0 ? std::max(collapses, 0.25 * target) : 0.0;
   return int32_t(std::min<double>(active, std::max(std::ceil(params.refine * target), target + extra)));
 }
@@ -696,6 +701,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   refine.target_triangles = target_triangles;
   refine.multipliers = &multipliers;
   refine.refit = params.placement == Placement::Filtered;
+  refine.max_aware = refine.refit;
   refine.attributes = params.attributes;
   refine_by_collapses(mesh, layout, refine, result);
   result.target_vertices = params.target_vertices;
@@ -766,6 +772,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
     refine.target_triangles = refine_vertices > 0 ? refine_triangles : 0;
     refine.zero_area_only = refine_vertices == 0;
     refine.refit = refine_vertices > 0 && placement == Placement::Filtered;
+    refine.max_aware = refine.refit;
     refine.attributes = attributes;
     refine_by_collapses(mesh, layout, refine, result);
   }

@@ -9,6 +9,7 @@
 
 
 #include "decimate/collapser.hpp"
+#include "decimate/deviation.hpp"
 #include "topstoc/core/parallel.hpp"
 
 namespace topstoc {
@@ -17,6 +18,9 @@ namespace {
 
 // Slivers (shape quality below this, see Collapser) the stochastic pass left are collapsed first.
 constexpr double kSliverShape = 0.1;
+// Max-aware second run: a vertex's cost weight is 1 + this times its first-run deviation over
+// the largest (squared distances), so the worst region's collapses cost a hundred times more.
+constexpr double kDeviationWeight = 100.0;
 
 // Guidance bins: 0 for m = 0 (never sampled), 1 for control points, then m on a quarter-octave
 // scale.
@@ -313,11 +317,13 @@ class Refinement {
     setup.optimal_placement = !params.zero_area_only;
     // The zero-area clean-up keeps the caller's positions.
     const double center[3] = {setup.center[0], setup.center[1], setup.center[2]}, extent = setup.extent;
+    if (params.max_aware && n == num_input - mesh.report().isolated_vertices) {
+      collapse_max_aware(std::move(setup), center, extent);
+      return;
+    }
     Collapser collapser(result.triangles, result.corner_source, std::move(setup));
     collapse(collapser, center, extent);
-    if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
-    result.issues_remaining.sliver = collapser.zero_area_faces();
-    compact(collapser);
+    finish(collapser);
   }
 
  private:
@@ -372,6 +378,46 @@ class Refinement {
       if (at_flip)
         for (int j = 0; j < 3; ++j) setup.locked[result.triangles[3 * t + j]] = 1;
     }
+  }
+
+  // Max-aware collapses (RefineParams::max_aware): a first run, then a second whose cost
+  // weights grow with how far the first one's surface ended from the input around each vertex,
+  // so that it keeps more vertices where the first deviated most (a step of reweighting toward
+  // the smallest max error). The run nearer the target, or as near and with the smaller
+  // deviation, is kept.
+  void collapse_max_aware(CollapseSetup setup, const double* center, double extent) {
+    std::vector<int32_t> first_triangles = result.triangles, first_corners = result.corner_source;
+    Collapser first(first_triangles, first_corners, CollapseSetup(setup));
+    collapse(first, center, extent);
+    const int32_t first_collapses = result.refine_collapses;
+    const InputSurface input(mesh, first);
+    const Deviation before = surface_deviation(mesh, input, label, first, first_triangles);
+    if (before.top2 > 0)
+      for (int32_t v = 0; v < n; ++v) setup.weight[v] *= 1.0 + kDeviationWeight * before.vertex2[v] / before.top2;
+    Collapser second(result.triangles, result.corner_source, std::move(setup));
+    collapse(second, center, extent);
+    const Deviation after = surface_deviation(mesh, input, label, second, result.triangles);
+    // How far each run stayed above the target (0 once reached): the nearer run wins, then the
+    // smaller deviation.
+    auto excess = [&](const Deviation& d) {
+      return params.target_triangles > 0 ? std::max(0, d.faces - params.target_triangles)
+                                         : std::max(0, d.vertices - params.target_vertices);
+    };
+    if (excess(after) < excess(before) || (excess(after) == excess(before) && after.top2 <= before.top2)) {
+      finish(second);
+      return;
+    }
+    result.triangles = first_triangles;
+    result.corner_source = first_corners;
+    result.refine_collapses = first_collapses;
+    finish(first);
+  }
+
+  // The zero-area triangles left moved off, and the result compacted.
+  void finish(Collapser& collapser) {
+    if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
+    result.issues_remaining.sliver = collapser.zero_area_faces();
+    compact(collapser);
   }
 
   // The target's share of each guidance bin, from the input vertices in it.

@@ -47,6 +47,10 @@ struct RefineParams {
   /// Finally move every free vertex to its quadric's minimum (filtered placement on the final
   /// clusters): what placement="filtered" means for a refined result.
   bool refit = false;
+  /// When the first pass kept every vertex (a mesh small enough to collapse whole), collapse
+  /// twice: the second run weighs each vertex's cost by how far the first run's surface ended
+  /// from the input there (a smaller max error, for the time of a second run).
+  bool max_aware = false;
   CornerAttributes attributes;
 };
 

@@ -48,7 +48,7 @@ struct DecimateParams {
   /// then quadric-ordered collapses thin the result to the target (better error, slower).
   double refine = 0.0;
   /// With refine, C > 0: the first pass keeps at least target + max(C, target / 4) vertices,
-  /// and all of them when the mesh has at most 5 C. Small meshes then skip the stochastic
+  /// and all of them when the mesh has at most 8 C. Small meshes then skip the stochastic
   /// pass, whose choices cost quality; on big ones the collapses' time grows with the target,
   /// not with the mesh, while the stochastic pass does the bulk.
   int32_t refine_collapses = 0;

@@ -1,0 +1,38 @@
+// How far a run of collapses left the surface from the input, both ways, sampled at points of
+// each surface and found with a search structure: what the max-aware refinement
+// (refine.hpp, RefineParams::max_aware) weighs its second run by and chooses its result by.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "decimate/collapser.hpp"
+#include "topstoc/core/mesh.hpp"
+#include "topstoc/distance/bvh.hpp"
+
+namespace topstoc {
+
+/// The input in the collapses' normalised coordinates, with a search structure over its
+/// triangles.
+struct InputSurface {
+  InputSurface(const Mesh& mesh, const Collapser& collapser);
+  std::vector<double> positions;  ///< 3 per input vertex
+  TriangleBvh bvh;
+};
+
+struct Deviation {
+  /// Per vertex the collapses started from: the squared distance (normalised coordinates) of
+  /// the farthest point found around it, from the input to the surface or back.
+  std::vector<double> vertex2;
+  double top2 = 0.0;    ///< the largest of them
+  int32_t faces = 0;     ///< live triangles
+  int32_t vertices = 0;  ///< live vertices
+};
+
+/// From the input: each input vertex, triangle centre and side middle to the collapsed surface,
+/// kept per vertex the collapses started from (label: input vertex -> that vertex, -1 for none).
+/// Back: each live triangle's centre, corners and side middles to the input, kept per corner.
+Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const std::vector<int32_t>& label,
+                          Collapser& collapser, const std::vector<int32_t>& triangles);
+
+}  // namespace topstoc
