@@ -1,0 +1,35 @@
+#!/bin/bash
+# Compiles and links the engine's Python module for macOS arm64 and x86_64 with zig's clang and
+# libc++ (a link check: nothing here runs macOS). The module is a Mach-O bundle whose CPython
+# symbols stay undefined (`-undefined dynamic_lookup`, added by pybind11 on macOS, as every
+# macOS extension module links), so no Python framework is needed at link time. Prints each
+# link step's command and output; the bundles land in build/macos-ARCH/ and tests/cross checks them.
+#
+# CPython's headers: Debian's libpython3.11-dev (no macOS pyconfig.h is reachable here), enough for
+# a compile and link check, not for a shipped wheel (that is the cibuildwheel workflow's job).
+set -eu -o pipefail
+source "$(dirname "$0")/common.sh"  # cd to the checkout; ensure_packages
+ensure_packages cmake make libphat-dev dpkg-dev curl
+VENV=${TOPSTOC_CACHE:-/var/cache/topstoc}/wheel-venv
+"$VENV/bin/python" -c "import ziglang, pybind11" 2>/dev/null ||
+  { echo "error: no ziglang/pybind11 in $VENV: run scripts/build_wheels.sh first" >&2; exit 1; }
+ZIG=$("$VENV/bin/python" -c "import ziglang, os; print(os.path.join(os.path.dirname(ziglang.__file__), 'zig'))")
+source scripts/zig_toolchain.sh
+TETGEN=$(tetgen_source)
+
+for arch in aarch64 x86_64; do
+  dir=build/macos-$arch
+  zig_cmake_args "$arch-macos.11.0"
+  echo "== macOS $arch: zig c++ -target $arch-macos.11.0"
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "${ZIG_CMAKE_ARGS[@]}" -DTOPSTOC_TETGEN_SOURCE="$TETGEN" \
+    -DTOPSTOC_PYTHON_HEADERS_ONLY=ON -DPython_INCLUDE_DIR="$(python_include 3.11 amd64)" \
+    -DPYTHON_IS_DEBUG=OFF -DPYTHON_MODULE_DEBUG_POSTFIX= -DPYTHON_MODULE_EXTENSION=.cpython-311-darwin.so \
+    -Dpybind11_DIR="$("$VENV/bin/python" -m pybind11 --cmakedir)" >"$dir.log" 2>&1 ||
+    { tail -40 "$dir.log"; exit 1; }
+  cmake --build "$dir" --target _topstoc -j2 >>"$dir.log" 2>&1 || { tail -40 "$dir.log"; exit 1; }
+  # The link step again, verbosely: its command line and whatever the linker says.
+  rm -f "$dir"/python/topstoc/_topstoc*.so
+  cmake --build "$dir" --target _topstoc -- VERBOSE=1 2>&1 | grep -A20 -E "Linking CXX|c\+\+ .*-o python/topstoc" |
+    grep -v "^gmake\|^\[" | sed 's/^/   /'
+  ls -l "$dir"/python/topstoc/_topstoc*.so
+done
