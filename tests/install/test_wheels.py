@@ -55,7 +55,7 @@ def test_wheel_needs_glibc_2_28_at_most(wheel, tmp_path):
     assert versions and {name for name, _ in versions} == {"GLIBC"}, versions  # no GLIBCXX, CXXABI
     newest = max(tuple(map(int, v.split("."))) for _, v in versions)
     assert newest <= (2, 28), newest
-    shown = subprocess.run([str(AUDITWHEEL), "show", str(wheel)], capture_output=True, text=True, check=True).stdout
+    shown = subprocess.run([str(AUDITWHEEL), "-v", "show", str(wheel)], capture_output=True, text=True, check=True).stdout
     shown = " ".join(shown.split())  # auditwheel wraps its lines
     assert "requires no external shared libraries" in shown, shown
     consistent = re.search(r'consistent with the following platform tag:\s*"manylinux_2_(\d+)_(\w+)"', shown)
