@@ -5,19 +5,23 @@
 # macOS extension module links), so no Python framework is needed at link time. Prints each
 # link step's command and output; the bundles land in build/macos-ARCH/ and tests/cross checks them.
 #
+#   scripts/build_macos.sh [ARCH...]    aarch64 and x86_64 unless given
+#
 # CPython's headers: Debian's libpython3.11-dev of the same CPU (no macOS pyconfig.h is reachable
 # here): enough for a compile and link check, not for a shipped wheel (the cibuildwheel workflow's).
 set -eu -o pipefail
 source "$(dirname "$0")/common.sh"  # cd to the checkout; ensure_packages
 ensure_packages cmake make libphat-dev dpkg-dev curl
 VENV=${TOPSTOC_CACHE:-/var/cache/topstoc}/wheel-venv
+export PATH=/usr/bin:/bin:$PATH  # Debian's cmake, as scripts/build_wheels.sh uses
 "$VENV/bin/python" -c "import ziglang, pybind11" 2>/dev/null ||
   { echo "error: no ziglang/pybind11 in $VENV: run scripts/build_wheels.sh first" >&2; exit 1; }
 ZIG=$("$VENV/bin/python" -c "import ziglang, os; print(os.path.join(os.path.dirname(ziglang.__file__), 'zig'))")
 source scripts/zig_toolchain.sh
 TETGEN=$(tetgen_source)
 
-for arch in aarch64 x86_64; do
+ARCHS=("$@"); [ $# -gt 0 ] || ARCHS=(aarch64 x86_64)
+for arch in "${ARCHS[@]}"; do
   dir=build/macos-$arch debian_arch=amd64
   [ "$arch" = aarch64 ] && debian_arch=arm64  # the pyconfig.h of the same CPU (sizes, alignment)
   zig_cmake_args "$arch-macos.11.0"
