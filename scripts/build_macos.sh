@@ -1,7 +1,8 @@
 #!/bin/bash
 # Compiles and links the engine's Python module for macOS arm64 and x86_64 with zig's clang and
-# libc++ (a link check: nothing here runs macOS). The module is a Mach-O bundle whose CPython
-# symbols stay undefined (`-undefined dynamic_lookup`, added by pybind11 on macOS, as every
+# libc++ (a link check: nothing here runs macOS). The module is a Mach-O dynamic library (a bundle
+# would be usual, but zig 0.15's linker crashes on -bundle: cmake/zig_macos_rules.cmake) whose
+# CPython symbols stay undefined (`-undefined dynamic_lookup`, added by pybind11 on macOS, as every
 # macOS extension module links), so no Python framework is needed at link time. Prints each
 # link step's command and output; the bundles land in build/macos-ARCH/ and tests/cross checks them.
 #
@@ -27,6 +28,7 @@ for arch in "${ARCHS[@]}"; do
   zig_cmake_args "$arch-macos.11.0"
   echo "== macOS $arch: zig c++ -target $arch-macos.11.0"
   cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "${ZIG_CMAKE_ARGS[@]}" -DTOPSTOC_TETGEN_SOURCE="$TETGEN" \
+    -DCMAKE_USER_MAKE_RULES_OVERRIDE="$PWD/cmake/zig_macos_rules.cmake" \
     -DTOPSTOC_PYTHON_HEADERS_ONLY=ON -DPython_INCLUDE_DIR="$(python_include 3.11 $debian_arch)" \
     -DPYTHON_IS_DEBUG=OFF -DPYTHON_MODULE_DEBUG_POSTFIX= -DPYTHON_MODULE_EXTENSION=.cpython-311-darwin.so \
     -Dpybind11_DIR="$("$VENV/bin/python" -m pybind11 --cmakedir)" >"$dir.log" 2>&1 ||
