@@ -1,9 +1,9 @@
 #!/bin/bash
 # Makes every file a user downloads, in dist/, on a Debian 12 machine (run as root; a user with
 # sudo is re-run under sudo, since the Debian 13 root needs debootstrap and chroot):
-#   topstoc-VERSION-cp311-cp311-manylinux_*.whl, ...-cp313-...  pip (scripts/build_wheels.sh)
+#   topstoc-VERSION-cp311-cp311-manylinux_2_28_{x86_64,aarch64}.whl, ...-cp313-...  pip (scripts/build_wheels.sh)
 #   topstoc_native-VERSION-cp3XX-...whl                         the extension's engine wheels
-#   topstoc-VERSION-linux_x64.zip                               Blender 4.2+ (scripts/build_extension.sh)
+#   topstoc-VERSION-linux_{x64,arm64}.zip                       Blender 4.2+ (scripts/build_extension.sh)
 #   topstoc-VERSION-legacy-addon.zip                            Blender 3.4-4.1 with CPython 3.11
 # The legacy zip holds the engine built on this machine (it needs this system's TetGen).
 set -eu -o pipefail
@@ -14,7 +14,7 @@ if [ "$(id -u)" != 0 ]; then
 fi
 VERSION=$(sed -n 's/^version = "\(.*\)"/\1/p' pyproject.toml | head -1)
 
-scripts/build_wheels.sh      # empties dist/, then writes the four wheels
+scripts/build_wheels.sh      # empties dist/, then writes the eight wheels
 scripts/build_extension.sh   # packs the extension zip with Blender 4.3's own tools
 
 source scripts/common.sh     # ensure_packages, build (the engine for this machine's CPython 3.11)

@@ -101,12 +101,15 @@ else
 fi
 
 # The release files as users get them (root only: the roots are entered with chroot): the wheels
-# and the extension zip are built (scripts/build_wheels.sh, build_extension.sh), then installed in
-# cached minimal Debian 12/13 roots without the build's libraries and in Debian 13's Blender 4.3.
+# (x86-64 and arm64, zig) and the extension zips are built (scripts/build_wheels.sh,
+# build_extension.sh), checked (tags, symbol versions) and installed in cached minimal Debian 12/13
+# roots without the build's libraries and in Debian 13's Blender 4.3. Then the macOS link check.
 if [ "$(id -u)" = 0 ]; then
-  run "release wheels and extension zip" bash -c "scripts/build_wheels.sh && scripts/build_extension.sh"
-  run "install tests (bare Debian roots, Blender 4.3 extension, Blender 3.4 legacy zip)" \
+  run "release wheels and extension zips" bash -c "scripts/build_wheels.sh && scripts/build_extension.sh"
+  run "install tests (wheel checks, bare Debian roots, Blender 4.3 extension, Blender 3.4 legacy zip)" \
     /usr/bin/python3 -m pytest "${PYTEST_ARGS[@]}" tests/install
+  run "macOS arm64 and x86_64 module link (zig, scripts/build_macos.sh)" \
+    bash -c "scripts/build_macos.sh && /usr/bin/python3 -m pytest ${PYTEST_ARGS[*]} tests/cross"
 fi
 
 if [ ${#failed[@]} -gt 0 ]; then

@@ -35,7 +35,7 @@ def test_staged_package_has_the_manifest_next_to_init():
     staged = tomllib.loads((package / "blender_manifest.toml").read_text())
     release = tomllib.loads((ROOT / "blender_manifest.toml").read_text())
     # The staged package holds its module itself: the release's topstoc_native wheels are dropped.
-    assert "wheels" not in staged and len(release.pop("wheels")) == 2
+    assert "wheels" not in staged and len(release.pop("wheels")) == 4
     assert staged == release
     assert list(package.glob("_topstoc*.so"))
 
@@ -52,16 +52,18 @@ def test_import_never_needs_bpy():
     assert int(done.stdout) == 81
 
 
-def test_manifest_lists_the_native_wheel_for_each_blender_python():
-    """Blender 4.2-5.0 embed CPython 3.11, 5.1+ CPython 3.13: one topstoc_native wheel each."""
+def test_manifest_lists_the_native_wheel_for_each_blender_python_and_platform():
+    """Blender 4.2-5.0 embed CPython 3.11, 5.1+ CPython 3.13: one topstoc_native wheel each, for
+    Linux x86-64 and arm64, at glibc 2.28 (RHEL/Rocky 8, the VFX Reference Platform's oldest)."""
     import re
 
     manifest = tomllib.loads((ROOT / "blender_manifest.toml").read_text())
-    assert manifest["platforms"] == ["linux-x64"]
+    assert manifest["platforms"] == ["linux-x64", "linux-arm64"]
     pattern = re.compile(r"\./wheels/topstoc_native-(?P<version>[^-]+)-(?P<py>cp3\d+)-(?P=py)-"
-                         r"manylinux_2_(?P<glibc>\d+)_x86_64\.whl")
+                         r"manylinux_2_(?P<glibc>\d+)_(?P<arch>x86_64|aarch64)\.whl")
     matches = [pattern.fullmatch(w) for w in manifest["wheels"]]
     assert all(matches), manifest["wheels"]
-    assert sorted(m["py"] for m in matches) == ["cp311", "cp313"]
+    assert sorted((m["py"], m["arch"]) for m in matches) == [
+        ("cp311", "aarch64"), ("cp311", "x86_64"), ("cp313", "aarch64"), ("cp313", "x86_64")]
     assert {m["version"] for m in matches} == {manifest["version"]}
-    assert all(int(m["glibc"]) <= 35 for m in matches)  # Ubuntu 22.04's glibc 2.35 at most
+    assert all(int(m["glibc"]) <= 28 for m in matches)
