@@ -3,6 +3,9 @@
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ROOT"
+# ccache (when installed) keys paths inside the checkout relative to it, so a fresh clone anywhere
+# reuses the compiles of earlier ones.
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$ROOT}
 
 # Debian packages: the build and runtime, then peers and tools used by tests and benchmarks.
 RUNTIME_PACKAGES="blender cmake g++ make pybind11-dev libopenmesh-dev libtet1.5-dev libphat-dev
