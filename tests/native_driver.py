@@ -1,5 +1,6 @@
-"""The C++ command-line driver (native/tools/topstoc_decimate.cpp) as the tests run it: the Linux
-build's, the Windows build's under Wine (tests/windows), and the cases both are compared on."""
+"""The C++ command-line driver (native/tools/topstoc_decimate.cpp) as the tests run it: this
+machine's build, the cross builds (scripts/cross_build.sh) of Windows under Wine and of Linux
+aarch64 under QEMU (tests/cross), and the cases they are compared on."""
 
 import os
 import pathlib
@@ -10,10 +11,9 @@ import numpy as np
 from conftest import BUILD, DATA, ROOT
 
 LINUX_DRIVER = BUILD / "topstoc_decimate"
-WINDOWS_BUILD = pathlib.Path(os.environ.get("TOPSTOC_WINDOWS_BUILD", ROOT / "build-windows"))
-WINDOWS_DRIVER = WINDOWS_BUILD / "topstoc_decimate.exe"
-WINE = pathlib.Path("/usr/lib/wine/wine64")
 CACHE = pathlib.Path(os.environ.get("TOPSTOC_CACHE", "/var/cache/topstoc"))
+WINE = pathlib.Path("/usr/lib/wine/wine64")
+ARM64_ROOT = CACHE / "arm64-bookworm-root"  # scripts/arm64_root.sh
 
 #: (input, output format, arguments): every reader and writer, both modes, materials and open borders
 CASES = [
@@ -25,9 +25,16 @@ CASES = [
 ]
 
 
-def wine_env() -> dict:
-    """Wine with its own prefix in the cache (made on first use) and without its debug chatter."""
-    return dict(os.environ, WINEPREFIX=str(CACHE / "wine-prefix"), WINEDEBUG="-all")
+def cross_runner(target: str):
+    """(command prefix, environment, build folder) to run a cross build's programs here:
+    Windows under Wine (its own prefix in the cache, no debug chatter); aarch64 under QEMU through
+    binfmt_misc, its libraries from the arm64 root. None when this machine cannot run them."""
+    build = ROOT / f"build-{target}"
+    if target == "windows" and WINE.exists():
+        return [WINE], dict(os.environ, WINEPREFIX=str(CACHE / "wine-prefix"), WINEDEBUG="-all"), build
+    if target == "aarch64" and ARM64_ROOT.is_dir() and pathlib.Path("/proc/sys/fs/binfmt_misc/qemu-aarch64").exists():
+        return [], dict(os.environ, QEMU_LD_PREFIX=str(ARM64_ROOT)), build
+    return None
 
 
 def run_driver(command: list, source: pathlib.Path, out: pathlib.Path, args: list, env=None):

@@ -1,7 +1,7 @@
 """The C++ command-line driver (build/topstoc_decimate): the same file as the Python CLI for the
 same input, target, seed and mode (an independent path: Python reads, prepares, calls the engine
 and writes there), clear refusals, and the input never written over. Its Windows build is
-compared with it under Wine (tests/windows)."""
+compared with it under Wine (tests/cross)."""
 
 import pytest
 
