@@ -46,7 +46,7 @@ def noisy_torus(path: pathlib.Path, nu: int = 480, nv: int = 260) -> pathlib.Pat
     """A 124,800-vertex torus with seeded noise, as binary PLY: big enough for the engine's
     parallel loops (kParallelMin = 100,000), irregular enough that ties in costs are rare."""
     from meshgen import torus
-    from topstoc.core.io import MeshData, write_mesh
+    from topstoc.core import MeshData, write_mesh
 
     vertices, triangles = torus(nu, nv)
     vertices = np.asarray(vertices, float) + np.random.default_rng(11).normal(0, 2e-3, (len(vertices), 3))

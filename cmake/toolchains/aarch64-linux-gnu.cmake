@@ -1,4 +1,4 @@
-# Cross-compiling for Linux aarch64 with Debian's g++-aarch64-linux-gnu (glibc 2.36, libgomp): the
+# Cross-compiling for Linux aarch64 with Debian's g++-aarch64-linux-gnu (glibc 2.36): the
 # engine's C++ tests and command-line driver, run in the arm64 Debian root under QEMU user
 # emulation (scripts/aarch64_test.sh). Dependencies are looked up under CMAKE_FIND_ROOT_PATH (the
 # prefix cmake/deps installed into) and the cross toolchain's own folders, never the host's /usr.

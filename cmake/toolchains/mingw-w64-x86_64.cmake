@@ -1,5 +1,5 @@
 # Cross-compiling for Windows x64 with Debian's mingw-w64 (g++-mingw-w64-x86-64-posix: the posix
-# thread model, which has std::thread, std::mutex and libgomp). Everything links statically, so the
+# thread model, which has std::thread and std::mutex). Everything links statically, so the
 # .exe files need no DLL next to them; tests run under Wine (CMAKE_CROSSCOMPILING_EMULATOR).
 # Dependencies are looked up only under CMAKE_FIND_ROOT_PATH (pass -DCMAKE_FIND_ROOT_PATH=PREFIX,
 # the prefix cmake/deps installed into), never in the host's /usr.
@@ -9,9 +9,6 @@ set(CMAKE_C_COMPILER x86_64-w64-mingw32-gcc-posix)
 set(CMAKE_CXX_COMPILER x86_64-w64-mingw32-g++-posix)
 set(CMAKE_RC_COMPILER x86_64-w64-mingw32-windres)
 set(CMAKE_EXE_LINKER_FLAGS_INIT "-static")
-# FindOpenMP would name libgomp.dll.a (the import library) by path; a bare name lets -static
-# take libgomp.a.
-set(OpenMP_gomp_LIBRARY gomp CACHE STRING "libgomp, linked statically")
 set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
 set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)

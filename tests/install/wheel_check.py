@@ -33,9 +33,11 @@ def euler(vertices: np.ndarray, triangles: np.ndarray) -> tuple:
 
 
 def check_import() -> None:
-    import topstoc
-    from topstoc.core.native import engine
+    import importlib
 
+    import topstoc
+
+    engine = importlib.import_module("topstoc._topstoc")  # the compiled module, in every layout
     for module in (topstoc, engine):
         location = pathlib.Path(module.__file__).resolve()
         assert "site-packages" in location.parts, f"{module.__name__} comes from {location}, not an install"
@@ -43,7 +45,7 @@ def check_import() -> None:
 
 
 def check_decimation(mesh: pathlib.Path, mode: str, work: pathlib.Path) -> None:
-    from topstoc.core.io import read_mesh
+    from topstoc.core import read_mesh
 
     out = work / f"{mode}.obj"
     done = subprocess.run([sys.executable, "-m", "topstoc", "decimate", str(mesh), str(out), "--ratio", str(RATIO),
