@@ -13,23 +13,9 @@ CACHE=${TOPSTOC_CACHE:-/var/cache/topstoc}
 ROOTFS=$CACHE/trixie-root
 PACKAGES="python3 python3-venv python3-dev blender xvfb xauth ca-certificates libgl1-mesa-dri"
 
+source "$(dirname "${BASH_SOURCE[0]}")/debian_root.sh"  # make_debian_root
 make_root() {
-  command -v debootstrap >/dev/null ||
-    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -q debootstrap >/dev/null; } || return 1
-  local tmp=$CACHE/trixie-root.partial
-  rm -rf "$tmp"; mkdir -p "$CACHE"
-  echo "== making a Debian 13 root in $ROOTFS (once; ~5 min)" >&2
-  debootstrap --variant=minbase trixie "$tmp" http://deb.debian.org/debian >"$CACHE/debootstrap.log" 2>&1 ||
-    { tail -20 "$CACHE/debootstrap.log" >&2; return 1; }
-  cp /etc/resolv.conf "$tmp/etc/resolv.conf"
-  if ls /usr/local/share/ca-certificates/*.crt >/dev/null 2>&1; then
-    mkdir -p "$tmp/usr/local/share/ca-certificates"
-    cp /usr/local/share/ca-certificates/*.crt "$tmp/usr/local/share/ca-certificates/"
-  fi
-  chroot "$tmp" /bin/bash -c "apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -q \
-    --no-install-recommends $PACKAGES >/dev/null && update-ca-certificates >/dev/null 2>&1" ||
-    { echo "error: could not install $PACKAGES in the Debian 13 root" >&2; return 1; }
-  mv "$tmp" "$ROOTFS"
+  make_debian_root "$ROOTFS" trixie "$(dpkg --print-architecture)" "$PACKAGES" "$CACHE/debootstrap.log"
 }
 
 # Runs a command inside the root with /proc, /sys, /dev and this checkout mounted. The mounts live

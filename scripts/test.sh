@@ -1,12 +1,13 @@
 #!/bin/bash
-# Runs every test: the C++ engine (tests/native, ctest), the Python API (plain python3 and NumPy 2),
-# the batch on Dask, a short fuzzing pass, the add-on inside Debian's Blender 3.4 (legacy add-on)
-# and as an extension in PyPI's bpy 4.2 (.venv), 4.5 LTS and 5.0 (CPython 3.11) and 5.2 LTS
-# (CPython 3.13, in a Debian 13 root), the real GUI under Xvfb in Blender 3.4 and Debian 13's
-# Blender 4.3, and (as root) the release wheels and extension installed in bare roots. Installs
-# what is missing first; the bpy venvs, the pipeline venv and the Debian roots are cached outside
-# the checkout in ${TOPSTOC_CACHE:-/var/cache/topstoc} (the first run downloads ~3 GB). Prints each
-# suite's time. Exit code 0 only if every suite passed.
+# Runs every test: the C++ engine (tests/native, ctest; and built for Windows, run under Wine), the
+# Python API (plain python3 and NumPy 2), the batch on Dask, a short fuzzing pass, the add-on
+# inside Debian's Blender 3.4 (legacy add-on) and as an extension in PyPI's bpy 4.2 (.venv), 4.5
+# LTS and 5.0 (CPython 3.11) and 5.2 LTS (CPython 3.13, in a Debian 13 root), the real GUI under
+# Xvfb in Blender 3.4 and Debian 13's Blender 4.3, and (as root) the release wheels and extension
+# installed in bare roots and Linux aarch64 under QEMU. Installs what is missing first; the bpy
+# venvs, the pipeline venv, the Wine prefix and the Debian roots are cached outside the checkout
+# in ${TOPSTOC_CACHE:-/var/cache/topstoc} (the first run downloads ~4 GB). Prints each suite's
+# time. Exit code 0 only if every suite passed.
 set -o pipefail
 source "$(dirname "$0")/common.sh"
 ensure_packages $RUNTIME_PACKAGES $TEST_PACKAGES || exit 1
@@ -66,6 +67,9 @@ run "batch on Dask and OpenJD (venv-pipeline)" env PATH="$PIPELINE_VENV/bin:$PAT
 # Fuzz targets (clang, ASan + UBSan): every kept input once, then 5 s of new inputs per target.
 # Long runs: scripts/fuzz.sh SECONDS. The Python suite under ASan + UBSan: scripts/sanitize.sh.
 run "fuzzing, short pass (scripts/fuzz.sh 5)" scripts/fuzz.sh 5
+# The engine for Windows x64 (mingw-w64, static): its doctest binary under Wine, and its
+# command-line driver's files byte-compared with this build's (scripts/windows_test.sh).
+run "C++ engine under Wine (mingw-w64)" scripts/windows_test.sh
 if [ -d tests/blender ]; then
   run "add-on in Blender $(blender -v 2>/dev/null | head -1 | awk '{print $2}')" \
     blender -b --factory-startup --python-exit-code 1 --python-expr \
@@ -110,6 +114,11 @@ if [ "$(id -u)" = 0 ]; then
     /usr/bin/python3 -m pytest "${PYTEST_ARGS[@]}" tests/install
   run "macOS arm64 and x86_64 module link (zig, scripts/build_macos.sh)" \
     bash -c "scripts/build_macos.sh && /usr/bin/python3 -m pytest ${PYTEST_ARGS[*]} tests/cross"
+  # Linux aarch64 under QEMU user emulation in a cached arm64 Debian 12 root: the cross-built C++
+  # tests and driver, then the aarch64 wheel from dist/ and part of tests/python (scripts/aarch64_test.sh).
+  run "Python API on Linux aarch64 under QEMU" scripts/aarch64_test.sh
+else
+  echo "== skipped: Linux aarch64 under QEMU (binfmt_misc and the arm64 root's chroot need root: run as root)"
 fi
 
 if [ ${#failed[@]} -gt 0 ]; then

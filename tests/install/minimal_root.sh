@@ -13,19 +13,10 @@ SUITE=${1:?usage: minimal_root.sh bookworm|trixie [run DIR CMD]}
 CACHE=${TOPSTOC_CACHE:-/var/cache/topstoc}
 ROOTFS=$CACHE/minimal-$SUITE-root
 
+source "$(dirname "$0")/../../scripts/debian_root.sh"  # make_debian_root
 make_root() {
-  command -v debootstrap >/dev/null ||
-    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -q debootstrap >/dev/null; } || return 1
-  local tmp=$ROOTFS.partial log=$CACHE/minimal-$SUITE-root.log
-  rm -rf "$tmp"; mkdir -p "$CACHE"
-  echo "== making a minimal Debian $SUITE root in $ROOTFS (once; ~3 min)" >&2
-  debootstrap --variant=minbase "$SUITE" "$tmp" http://deb.debian.org/debian >"$log" 2>&1 ||
-    { tail -20 "$log" >&2; return 1; }
-  cp /etc/resolv.conf "$tmp/etc/resolv.conf"
-  chroot "$tmp" /bin/bash -c "apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -q \
-    --no-install-recommends python3 python3-venv >/dev/null && apt-get clean" >>"$log" 2>&1 ||
-    { echo "error: could not install python3 in the $SUITE root (see $log)" >&2; return 1; }
-  mv "$tmp" "$ROOTFS"
+  make_debian_root "$ROOTFS" "$SUITE" "$(dpkg --print-architecture)" "python3 python3-venv" \
+    "$CACHE/minimal-$SUITE-root.log"
 }
 
 [ -d "$ROOTFS" ] || make_root || exit 1

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "portable.hpp"
 namespace topstoc {
 
 class IdBits {
@@ -25,7 +26,7 @@ class IdBits {
   template <class Visit>
   void for_each(Visit visit) const {
     for (size_t w = 0; w < words_.size(); ++w)
-      for (uint64_t word = words_[w]; word; word &= word - 1) visit(int32_t(64 * w + size_t(__builtin_ctzll(word))));
+      for (uint64_t word = words_[w]; word; word &= word - 1) visit(int32_t(64 * w + size_t(lowest_bit(word))));
   }
 
  private:

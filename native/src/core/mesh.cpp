@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "core/counting_sort.hpp"
+#include "core/portable.hpp"
 #include "core/union_find.hpp"
 #include "topstoc/core/validate.hpp"
 
@@ -466,7 +467,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
   Buffer<int32_t> source(m), lowest_offsets(size_t(n) + 1);
   parallel_for(0, m, kParallelMin, [&](int32_t j) {
     // The rows are read in a new order: fetch a few faces ahead.
-    if (j + 8 < m) __builtin_prefetch(&renumbered[3 * size_t(keyed[j + 8] & 0xffffffffu)]);
+    if (j + 8 < m) prefetch(&renumbered[3 * size_t(keyed[j + 8] & 0xffffffffu)]);
     const int64_t i = int64_t(keyed[j] & 0xffffffffu);
     for (int c = 0; c < 3; ++c) faces_[3 * size_t(j) + c] = renumbered[3 * size_t(i) + c];
     source[j] = face_source_[i];

@@ -3,7 +3,7 @@
 #include "../core/byte_flags.hpp"
 #include "../core/counting_sort.hpp"
 #include "../core/per_thread.hpp"
-
+#include "../core/portable.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -90,11 +90,11 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
     auto relax = [&](int64_t i, int32_t lo, int32_t hi, std::vector<int32_t>& mine, std::vector<int32_t>& my_cross,
                      std::vector<Lowering>& outbox, auto cross) {
       // The frontier is known ahead: fetch the rows and keys the next iterations will read.
-      if (i + 16 < count) __builtin_prefetch(&ao[front[i + 16]]);
+      if (i + 16 < count) prefetch(&ao[front[i + 16]]);
       if (i + 8 < count) {
         const int32_t ahead = front[i + 8];
-        __builtin_prefetch(&adj[ao[ahead]]);
-        __builtin_prefetch(&keys[ahead]);
+        prefetch(&adj[ao[ahead]]);
+        prefetch(&keys[ahead]);
       }
       const int32_t v = front[i];
       const int32_t rank = rank_of(keys[v]);  // v's key is final
@@ -182,7 +182,7 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
           if (!word) return;
           std::memset(in_next + 8 * w, 0, 8);
           for (uint32_t bits = flag_bits(word); bits; bits &= bits - 1)
-            mine.push_back(int32_t(8 * w + __builtin_ctz(bits)));
+            mine.push_back(int32_t(8 * w + lowest_bit(bits)));
         });
       });
       for (int32_t v = int32_t(8 * words); v < n; ++v)  // the last few, past the whole words

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/fans.hpp"
+#include "core/portable.hpp"
 #include "pinched_fans.hpp"
 
 namespace topstoc {
@@ -268,7 +269,7 @@ void collect_boundary_loops(const Mesh& mesh, FeatureLayout& layout) {
 std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, const int32_t* face_region,
                                                           int64_t face_region_count, const int32_t* flagged_edges,
                                                           int64_t num_flagged_edges, double feature_angle) {
-  if (!(feature_angle >= 0.0 && feature_angle <= M_PI))
+  if (!(feature_angle >= 0.0 && feature_angle <= kPi))
     throw std::invalid_argument("feature angle must lie in [0, pi] radians");
   auto layout = std::make_shared<FeatureLayout>();
   mark_feature_edges(mesh, face_region, face_region_count, flagged_edges, num_flagged_edges, feature_angle, *layout);

@@ -5,6 +5,7 @@
 #include "../core/byte_flags.hpp"
 #include "../core/id_bits.hpp"
 #include "../core/per_thread.hpp"
+#include "../core/portable.hpp"
 #include "pinched_fans.hpp"
 
 
@@ -485,7 +486,7 @@ class PartitionCheck {
       running.for_static(0, words, [&](int64_t w) {
         const uint64_t word = flag_word(emits + 8 * w);
         if (!word) return;
-        for (uint32_t bits = flag_bits(word); bits; bits &= bits - 1) write(at++, int32_t(8 * w + __builtin_ctz(bits)));
+        for (uint32_t bits = flag_bits(word); bits; bits &= bits - 1) write(at++, int32_t(8 * w + lowest_bit(bits)));
       });
     });
     for (int64_t f = 8 * words, at = int64_t(out.source_face.size()) - tail; f < m; ++f)

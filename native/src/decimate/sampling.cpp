@@ -13,6 +13,7 @@
 #include "core/counting_sort.hpp"
 #include "core/id_bits.hpp"
 #include "core/ordered_sum.hpp"
+#include "core/portable.hpp"
 #include "decimate/candidate_order.hpp"
 #include "decimate/draw.hpp"
 #include "topstoc/core/random.hpp"
@@ -549,7 +550,7 @@ void validate_sampling_params(const Mesh& mesh, const SamplingParams& params) {
   if (params.view.enabled) {
     const auto& view = params.view;
     require(view.back_ratio >= 0.0 && view.back_ratio <= 1.0, "view back_ratio must lie in [0, 1]");
-    require(view.silhouette_angle >= 0.0 && view.silhouette_angle <= M_PI, "silhouette angle must lie in [0, pi]");
+    require(view.silhouette_angle >= 0.0 && view.silhouette_angle <= kPi, "silhouette angle must lie in [0, pi]");
     require(view.silhouette_falloff >= 0.0, "silhouette falloff must be >= 0");
     require(view.outside_probability >= 0.0 && view.outside_probability <= 1.0,
             "outside-frustum probability must lie in [0, 1]");

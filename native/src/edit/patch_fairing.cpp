@@ -4,13 +4,13 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "core/portable.hpp"
+
 namespace topstoc {
 
 namespace {
 
 using Vec = std::array<double, 3>;
-
-constexpr double kPi = 3.14159265358979323846;
 
 Vec sub(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }

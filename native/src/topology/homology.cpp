@@ -2,11 +2,13 @@
 
 #include <stdexcept>
 
+#include "core/portable.hpp"
+
 namespace topstoc {
 
 int32_t Z2Vector::top() const {
   for (size_t k = words.size(); k-- > 0;)
-    if (words[k]) return int32_t(64 * k + 63 - __builtin_clzll(words[k]));
+    if (words[k]) return int32_t(64 * k + size_t(highest_bit(words[k])));
   return -1;
 }
 

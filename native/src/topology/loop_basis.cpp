@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "core/portable.hpp"
 #include "topology/ball_cycles.hpp"
 #include "topology/shortest_paths.hpp"
 
@@ -136,7 +137,7 @@ class Span {
         --w;
         continue;
       }
-      top_ = 64 * w + 63 - __builtin_clzll(x_[w]);
+      top_ = 64 * w + highest_bit(x_[w]);
       if (pivot_[top_] < 0 || pivot_[top_] >= k) return false;
       const uint64_t* row = &rows_[size_t(words_) * pivot_[top_]];
       for (int32_t j = 0; j <= w; ++j) x_[j] ^= row[j];

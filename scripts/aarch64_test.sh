@@ -1,0 +1,37 @@
+#!/bin/bash
+# The Linux aarch64 suite (scripts/test.sh, as root), run on this x86-64 machine under QEMU user
+# emulation with the cached arm64 Debian 12 root (scripts/arm64_root.sh):
+# 1. the engine's C++ tests and command-line driver cross-built (scripts/cross_build.sh aarch64):
+#    the doctest summary, and the driver's files compared with this machine's byte for byte
+#    (tests/cross -k aarch64);
+# 2. the aarch64 cp311 wheel (dist/ from scripts/build_wheels.sh, or TOPSTOC_AARCH64_WHEEL)
+#    installed into a venv in the root: tests/install/wheel_check.py, then the Python API tests
+#    in PYTHON_TESTS below, less the stress pass (emulation is 10-30x slower, so not all of
+#    tests/python: the engine's guarantees, the prepared mesh, sampling and the file formats, about
+#    5 minutes here; test_native_import.py needs a build tree, not an installed wheel).
+set -u -o pipefail
+source "$(dirname "$0")/common.sh"  # cd to the checkout
+PYTHON_TESTS="tests/python/test_mesh.py tests/python/test_io.py tests/python/test_sampling.py
+  tests/python/test_guarantees.py"
+ROOTFS=$(scripts/arm64_root.sh) || exit 1
+
+scripts/cross_build.sh aarch64 || exit 1
+echo "== C++ tests (doctest) under QEMU: build-aarch64/tests/native/topstoc_tests"
+QEMU_LD_PREFIX=$ROOTFS build-aarch64/tests/native/topstoc_tests | grep -v '^\[doctest\] run with' || exit 1
+echo "== the aarch64 driver against this machine's driver (tests/cross)"
+/usr/bin/python3 -m pytest -q -p no:cacheprovider tests/cross -k aarch64 || exit 1
+
+WHEEL=${TOPSTOC_AARCH64_WHEEL:-$(ls dist/topstoc-*-cp311-cp311-*aarch64.whl 2>/dev/null | head -1)}
+[ -f "$WHEEL" ] || { echo "error: no topstoc cp311 aarch64 wheel in dist/ (scripts/build_wheels.sh)" >&2; exit 1; }
+# The root sees only this folder: the wheel and the tests (their meshes included), no build tree.
+WORK=build-aarch64/wheel-test
+rm -rf "$WORK"; mkdir -p "$WORK"
+cp "$WHEEL" "$WORK/"
+cp -r tests "$WORK/tests"
+echo "== $(basename "$WHEEL") in the arm64 root: install check and $(echo $PYTHON_TESTS | wc -w) test files"
+scripts/arm64_root.sh run "$WORK" "
+  python3 -m venv --system-site-packages /work/venv &&
+  /work/venv/bin/pip install -q --no-index --no-deps /work/$(basename "$WHEEL") &&
+  /work/venv/bin/python /work/tests/install/wheel_check.py &&
+  TOPSTOC_BUILD=/work/no-build /work/venv/bin/python -m pytest -q -p no:cacheprovider $(echo $PYTHON_TESTS) \
+    --deselect tests/python/test_guarantees.py::test_stress_pass_finds_nothing"
