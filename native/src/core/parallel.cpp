@@ -166,54 +166,67 @@ namespace {
 
 // The workers of one calling thread. A job is one atomic word, (serial << 16) | team size, so a
 // worker reads the number and the size of a job together; size 0 tells the workers to exit.
+// The workers share the job's state with the pool (shared_ptr), so a worker may outlive it.
 class Pool {
  public:
   ~Pool() {
     post(0);
-    for (std::thread& thread : threads_) thread.join();
+    for (std::thread& thread : threads_) {
+#ifdef _WIN32
+      thread.detach();  // joining while this thread exits (thread_local) deadlocks on the loader lock
+#else
+      thread.join();
+#endif
+    }
   }
 
   void run(int size, void (*run)(void*, Team&), void* context, TeamState& state) {
     while (int(threads_.size()) < size - 1) {
       const int id = int(threads_.size()) + 1;
-      threads_.emplace_back([this, id, seen = job_.load()] { work(id, seen); });
+      threads_.emplace_back([shared = shared_, id, seen = shared_->job.load()] { work(*shared, id, seen); });
     }
-    run_ = run;
-    context_ = context;
-    state_ = &state;
-    pending_.store(size - 1);
+    Shared& s = *shared_;
+    s.run = run;
+    s.context = context;
+    s.state = &state;
+    s.pending.store(size - 1);
     post(size);
     state.run_member(run, context, 0);
-    done_.wait([&] { return pending_.load() == 0; });
+    s.done.wait([&] { return s.pending.load() == 0; });
   }
 
  private:
+  struct Shared {
+    std::atomic<uint64_t> job{0};
+    void (*run)(void*, Team&) = nullptr;  // the current job, written before job names it
+    void* context = nullptr;
+    TeamState* state = nullptr;
+    std::atomic<int> pending{0};  // workers of the current job still running
+    Waiter start, done;
+  };
+
   void post(int size) {
-    job_.store(((job_.load() >> 16) + 1) << 16 | uint64_t(size));
-    start_.wake();
+    Shared& s = *shared_;
+    s.job.store(((s.job.load() >> 16) + 1) << 16 | uint64_t(size));
+    s.start.wake();
   }
 
-  void work(int id, uint64_t seen) {
+  static void work(Shared& s, int id, uint64_t seen) {
     t_index = id;
     t_in_team = true;
     for (;;) {
-      start_.wait([&] { return job_.load() != seen; });
-      seen = job_.load();
+      s.start.wait([&] { return s.job.load() != seen; });
+      seen = s.job.load();
       const int size = int(seen & 0xFFFF);
       if (size == 0) return;
       if (id >= size) continue;  // not in this team
-      state_->run_member(run_, context_, id);
-      if (pending_.fetch_sub(1) == 1) done_.wake();
+      s.state->run_member(s.run, s.context, id);
+      if (s.pending.fetch_sub(1) == 1) s.done.wake();
     }
   }
 
   std::vector<std::thread> threads_;
-  std::atomic<uint64_t> job_{0};
-  void (*run_)(void*, Team&) = nullptr;  // the current job, written before job_ names it
-  void* context_ = nullptr;
-  TeamState* state_ = nullptr;
-  std::atomic<int> pending_{0};  // workers of the current job still running
-  Waiter start_, done_;
+  std::shared_ptr<Shared> shared_ = std::make_shared<Shared>();
 };
 
 thread_local std::unique_ptr<Pool> t_pool;
