@@ -171,9 +171,9 @@ def test_legacy_zip_installs_in_debian_blender_3_4(tmp_path):
     """The legacy add-on zip (module built on this host) in Debian 12's Blender 3.4."""
     blender = shutil.which("blender") or pytest.skip("no Blender on this host")
     zip_file = ROOT / "build" / "dist" / "topstoc-addon.zip"
-    if not zip_file.exists():
-        subprocess.run(["cmake", "--build", str(ROOT / "build"), "--target", "addon_zip"], check=True,
-                       capture_output=True)
+    # Always packed anew: a zip left from an older checkout state would test old sources.
+    subprocess.run(["cmake", "--build", str(ROOT / "build"), "--target", "addon_zip"], check=True,
+                   capture_output=True)
     (tmp_path / "run.py").write_text(BLENDER_SCRIPT)
     env = {"PATH": "/usr/bin:/bin", "HOME": str(tmp_path), "LANG": "C.UTF-8"}
     done = subprocess.run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",

@@ -164,20 +164,26 @@ void Team::unlock() { state_.critical().unlock(); }
 
 namespace {
 
+#ifdef _WIN32
+std::atomic<bool> process_exiting{false};  // set by an atexit handler (watch_exit)
+#endif
+
 // The workers of one calling thread. A job is one atomic word, (serial << 16) | team size, so a
 // worker reads the number and the size of a job together; size 0 tells the workers to exit.
 // The workers share the job's state with the pool (shared_ptr), so a worker may outlive it.
 class Pool {
  public:
   ~Pool() {
-    post(0);
-    for (std::thread& thread : threads_) {
 #ifdef _WIN32
-      thread.detach();  // joining while this thread exits (thread_local) deadlocks on the loader lock
+    // At process exit Windows has already killed the workers, maybe inside a wait holding its
+    // mutex: waking them would hang. Otherwise they are told to leave and detached, as joining
+    // while this thread exits (thread_local) deadlocks on the loader lock.
+    if (!process_exiting.load()) post(0);
+    for (std::thread& thread : threads_) thread.detach();
 #else
-      thread.join();
+    post(0);
+    for (std::thread& thread : threads_) thread.join();
 #endif
-    }
   }
 
   void run(int size, void (*run)(void*, Team&), void* context, TeamState& state) {
@@ -236,6 +242,16 @@ thread_local std::unique_ptr<Pool> t_pool;
 std::atomic<unsigned> forks{0};
 thread_local unsigned t_pool_fork = 0;
 
+void watch_exit() {
+#ifdef _WIN32
+  static const bool registered = [] {
+    std::atexit([] { process_exiting.store(true); });
+    return true;
+  }();
+  (void)registered;
+#endif
+}
+
 void watch_forks() {
 #if defined(__unix__) || defined(__APPLE__)
   static const bool registered = [] {
@@ -267,6 +283,7 @@ void run_team(int threads, void (*run)(void*, Team&), void* context) {
   if (t_pool && t_pool_fork != forks.load()) (void)t_pool.release();  // its workers are gone
   if (!t_pool) {
     watch_forks();
+    watch_exit();
     t_pool = std::make_unique<Pool>();
     t_pool_fork = forks.load();
   }
