@@ -11,6 +11,7 @@
 
 #include "core/ordered_sum.hpp"
 #include "topstoc/core/parallel.hpp"
+#include "with_threads.hpp"
 #include "meshes.hpp"
 #include "topstoc/core/quality.hpp"
 #include "topstoc/distance/hausdorff.hpp"
@@ -18,16 +19,6 @@
 using namespace topstoc;
 
 namespace {
-
-// Runs f with the given team size, restoring the previous one.
-template <class F>
-auto with_threads(int threads, F f) {
-  const int before = max_threads();
-  set_max_threads(threads);
-  auto result = f();
-  set_max_threads(before);
-  return result;
-}
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 

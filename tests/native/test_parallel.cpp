@@ -18,19 +18,11 @@
 
 #include "core/per_thread.hpp"
 #include "topstoc/core/parallel.hpp"
+#include "with_threads.hpp"
 
 using namespace topstoc;
 
 namespace {
-
-// Runs f with the calling thread's team size set to `threads`, restoring it after.
-template <class F>
-void with_threads(int threads, F f) {
-  const int before = max_threads();
-  set_max_threads(threads);
-  f();
-  set_max_threads(before);
-}
 
 constexpr int kTeams[] = {1, 2, 3, 7};
 
