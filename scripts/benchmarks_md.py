@@ -250,6 +250,38 @@ def render_paired(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def render_attributes(name: str, figures: dict) -> str:
+    """bench_attributes.py --json: UV, normal and colour error next to meshoptimizer and Blender."""
+    units = {"uv": "UV (texture units)", "normal": "normal (°)", "color": "colour (RGB)"}
+    peers = ("meshopt_simplifyWithAttributes", "Blender Collapse")
+    out = [f"## The look after decimation (`{name}`)", "", *source_lines(figures),
+           f"- Method: `tests/bench/bench_attributes.py`, mean error over {figures['samples']} points per direction "
+           f"(`tests/attribute_error.py`); ours at attribute weight {figures['attribute_weight']}, each peer at our "
+           "triangle count; ours ÷ peer below 1 means ours is closer to the source's look", "",
+           "| Asset | Target | Triangles (target: ours / meshopt / Blender) | Error | Ours | meshopt | Blender | "
+           "Ours ÷ meshopt | Ours ÷ Blender |", "|---|---|---|---|---|---|---|---|---|"]
+    for case in figures["cases"]:
+        tools = case["tools"]
+        ours = tools["topstoc quality"]
+        counts = " / ".join("—" if tools.get(t) is None else str(tools[t]["triangles"])
+                            for t in ("topstoc quality", *peers))
+        for channel in case["channels"]:
+            cells = ["—" if tools.get(p) is None else f"{tools[p][channel]:.4g}" for p in peers]
+            ratios = ["—" if tools.get(p) is None else f"{attribute_ratio(ours[channel], tools[p][channel]):.2f}"
+                      for p in peers]
+            out.append(f"| {case['asset']} | {case['ratio']:.0%} | {case['target_triangles']}: {counts} | {units[channel]} | "
+                       f"{ours[channel]:.4g} | {' | '.join(cells)} | {' | '.join(ratios)} |")
+    out += ["", "| Ours ÷ peer | Median | Worst | Above 1.0 |", "|---|---|---|---|"]
+    for label, entry in figures["summary"].items():
+        out.append(f"| {label} | {entry['median']:.3f} | {entry['worst']:.3f} | {entry['above_1']} of {entry['cases']} |")
+    return "\n".join(out) + "\n"
+
+
+def attribute_ratio(ours: float, peer: float) -> float:
+    """ours / peer as bench_attributes.py prints it: equal near-zero errors count as 1."""
+    return 1.0 if max(ours, peer) < 1e-9 else (ours / peer if peer > 0 else float("inf"))
+
+
 def render_result(path: pathlib.Path) -> str:
     figures = json.loads(path.read_text())
     if isinstance(figures, dict) and figures.get("carried_over"):
@@ -260,12 +292,14 @@ def render_result(path: pathlib.Path) -> str:
         return render_quality(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_loops.py --families":
         return render_loop_families(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_attributes.py":
+        return render_attributes(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_scale.py":
         return render_scale(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_threads_paired.py":
         return render_paired(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
-                     "the --json of bench_decimate.py, bench_quality.py, bench_loops.py --families, "
+                     "the --json of bench_decimate.py, bench_quality.py, bench_attributes.py, bench_loops.py --families, "
                      "bench_scale.py and bench_threads_paired.py, and carried-over figures)")
 
 

@@ -120,7 +120,11 @@ def assets(names) -> list[dict]:
 
 # -- TopStoc -----------------------------------------------------------------------------------
 
-def run_ours(asset: dict, ratio: float) -> tuple[dict, float]:
+def target_triangles(asset: dict, ratio: float) -> int:
+    return max(4, round(ratio * len(asset["triangles"])))
+
+
+def run_ours(asset: dict, ratio: float, weight: float = ATTRIBUTE_WEIGHT) -> tuple[dict, float]:
     """Quality mode with the look in the cost, seams and hard edges as borders; attributes carried."""
     t = asset["triangles"]
     look = appearance_attributes(t, asset.get("uv"), asset.get("color"), asset.get("normal"))
@@ -130,9 +134,9 @@ def run_ours(asset: dict, ratio: float) -> tuple[dict, float]:
     if asset.get("normal") is not None:
         borders.append(hard_normal_edges(t, asset["normal"]))
     start = time.perf_counter()
-    result = Mesh(asset["vertices"], t).decimate(target_triangles=max(4, round(ratio * len(t))),
+    result = Mesh(asset["vertices"], t).decimate(target_triangles=target_triangles(asset, ratio),
                                                  borders=np.concatenate(borders).astype(np.int64),
-                                                 **look.decimate_kwargs(ATTRIBUTE_WEIGHT))
+                                                 **look.decimate_kwargs(weight))
     seconds = time.perf_counter() - start
     moved = moved_vertices(asset["vertices"], t, result)
     out = {"vertices": result.vertices, "triangles": np.asarray(result.triangles, dtype=np.int64)}
@@ -313,7 +317,8 @@ def ratio(ours: float, peer: float) -> float:
 def print_case(case: dict) -> None:
     tools = case["tools"]
     ours = tools["topstoc quality"]
-    print(f"\n{case['asset']} at {case['ratio']:.0%} ({case['input_triangles']} triangles)")
+    print(f"\n{case['asset']} at {case['ratio']:.0%} ({case['input_triangles']} triangles, "
+          f"target {case['target_triangles']})")
     print(f"  {'tool':32s} {'triangles':>9s} " + " ".join(f"{c:>9s}" for c in case["channels"])
           + "   ours ÷ this")
     for name, row in tools.items():
@@ -349,6 +354,7 @@ def main() -> int:
     parser.add_argument("--ratios", default="0.1,0.02")
     parser.add_argument("--samples", type=int, default=50_000, help="points per direction")
     parser.add_argument("--assets", default="", help="comma-separated names (default: all)")
+    parser.add_argument("--weight", type=float, default=ATTRIBUTE_WEIGHT, help="our attribute weight")
     parser.add_argument("--json", help="write the figures to this file")
     args = parser.parse_args()
     print(f"machine: {machine()}")
@@ -356,9 +362,10 @@ def main() -> int:
     cases, blender_jobs = [], []
     for asset in assets([a for a in args.assets.split(",") if a]):
         for r in (float(x) for x in args.ratios.split(",")):
-            ours = run_ours(asset, r)
+            ours = run_ours(asset, r, args.weight)
             triangles = len(ours[0]["triangles"])
             case = {"asset": asset["name"], "ratio": r, "input_triangles": int(len(asset["triangles"])),
+                    "target_triangles": target_triangles(asset, r),
                     "channels": [c for c in CHANNELS if asset.get(c) is not None],
                     "tools": {"topstoc quality": figures(asset, ours, args.samples),
                               PEERS[0]: figures(asset, meshopt and run_meshopt(meshopt, asset, triangles),
@@ -374,7 +381,7 @@ def main() -> int:
     if args.json:
         report = {"benchmark": "tests/bench/bench_attributes.py", "machine": machine(),
                   "date": time.strftime("%Y-%m-%d", time.gmtime()), "samples": args.samples,
-                  "attribute_weight": ATTRIBUTE_WEIGHT, "meshopt_weights": MESHOPT_WEIGHTS,
+                  "attribute_weight": args.weight, "meshopt_weights": MESHOPT_WEIGHTS,
                   "cases": cases, "summary": summary}
         path = pathlib.Path(args.json)
         temporary = path.with_suffix(".tmp")
