@@ -260,14 +260,15 @@ def render_attributes(name: str, figures: dict) -> str:
            "triangle count; ours ÷ peer below 1 means ours is closer to the source's look", "",
            "| Asset | Target | Triangles (target: ours / meshopt / Blender) | Error | Ours | meshopt | Blender | "
            "Ours ÷ meshopt | Ours ÷ Blender |", "|---|---|---|---|---|---|---|---|---|"]
+    units = {**units, "geometry_mean": "geometry, mean (% of diagonal)"}
     for case in figures["cases"]:
         tools = case["tools"]
         ours = tools["topstoc quality"]
         counts = " / ".join("—" if tools.get(t) is None else str(tools[t]["triangles"])
                             for t in ("topstoc quality", *peers))
-        for channel in case["channels"]:
+        for channel in [*case["channels"], "geometry_mean"]:
             cells = ["—" if tools.get(p) is None else f"{tools[p][channel]:.4g}" for p in peers]
-            ratios = ["—" if tools.get(p) is None else f"{attribute_ratio(ours[channel], tools[p][channel]):.2f}"
+            ratios = ["—" if tools.get(p) is None else attribute_ratio(ours[channel], tools[p][channel], channel)
                       for p in peers]
             out.append(f"| {case['asset']} | {case['ratio']:.0%} | {case['target_triangles']}: {counts} | {units[channel]} | "
                        f"{ours[channel]:.4g} | {' | '.join(cells)} | {' | '.join(ratios)} |")
@@ -277,9 +278,11 @@ def render_attributes(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
-def attribute_ratio(ours: float, peer: float) -> float:
-    """ours / peer as bench_attributes.py prints it: equal near-zero errors count as 1."""
-    return 1.0 if max(ours, peer) < 1e-9 else (ours / peer if peer > 0 else float("inf"))
+def attribute_ratio(ours: float, peer: float, channel: str) -> str:
+    """ours / peer as bench_attributes.py computes it (both raised to the noise floor first)."""
+    floor = EXACT if channel == "geometry_mean" else 1e-9
+    value = max(ours, floor) / max(peer, floor)
+    return f"{value:.2f}" if value < 100 else "> 100"
 
 
 def render_result(path: pathlib.Path) -> str:

@@ -18,6 +18,8 @@ The errors (tests/attribute_error.py): per point sampled on the result and on th
 difference between the result's interpolated value and the source's at the closest point; mean
 over both directions. UV in texture units, normal in degrees, colour as RGB distance in [0, 1]
 units. Printed per case with our figure over each peer's; then medians and worst over the cases.
+Each output's symmetric mean distance to the source (topstoc.hausdorff, % of the diagonal) is
+printed beside them: where the geometry drifts, so does the look.
 
 Assets (licences in tests/data/LICENSES.md and ../shared/meshes/licenses):
   - duck: tests/data/uv_materials/duck (UVs, the file's normals), one component;
@@ -48,7 +50,7 @@ sys.path.insert(0, str(ROOT / "build" / "python"))
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
-from topstoc.core import Mesh  # noqa: E402
+from topstoc.core import Mesh, hausdorff  # noqa: E402
 from topstoc.core.api.decimate import ATTRIBUTE_WEIGHT  # noqa: E402
 from topstoc.core.api.hausdorff import closest_points  # noqa: E402
 from topstoc.core.api.io import read_mesh  # noqa: E402
@@ -306,12 +308,20 @@ def figures(asset: dict, out: tuple[dict, float] | None, samples: int) -> dict |
         return None
     result, seconds = out
     errors = attribute_errors(asset, result, closest_points, samples)
-    return {"triangles": int(len(result["triangles"])), "seconds": seconds, **errors}
+    distance = hausdorff(Mesh(asset["vertices"], asset["triangles"]),
+                         Mesh(np.asarray(result["vertices"], dtype=np.float64), result["triangles"]))
+    return {"triangles": int(len(result["triangles"])), "seconds": seconds, **errors,
+            "geometry_mean": 100 * distance.symmetric.mean / distance.diagonal}
 
 
-def ratio(ours: float, peer: float) -> float:
-    """ours / peer; equal near-zero errors count as 1."""
-    return 1.0 if max(ours, peer) < 1e-9 else (ours / peer if peer > 0 else float("inf"))
+# Errors below these count as exact (geometry in % of the diagonal, as bench_quality.py's EXACT).
+EXACT = {"geometry_mean": 1e-6}
+
+
+def ratio(ours: float, peer: float, channel: str = "") -> float:
+    """ours / peer, each raised to the noise floor first (EXACT, else 1e-9)."""
+    floor = EXACT.get(channel, 1e-9)
+    return max(ours, floor) / max(peer, floor)
 
 
 def print_case(case: dict) -> None:
@@ -320,15 +330,15 @@ def print_case(case: dict) -> None:
     print(f"\n{case['asset']} at {case['ratio']:.0%} ({case['input_triangles']} triangles, "
           f"target {case['target_triangles']})")
     print(f"  {'tool':32s} {'triangles':>9s} " + " ".join(f"{c:>9s}" for c in case["channels"])
-          + "   ours ÷ this")
+          + f" {'geom. %':>9s}   ours ÷ this")
     for name, row in tools.items():
         if row is None:
             print(f"  {name:32s} missing")
             continue
         ratios = "" if name == "topstoc quality" else " ".join(
-            f"{ratio(ours[c], row[c]):6.2f}" for c in case["channels"])
+            f"{ratio(ours[c], row[c], c):6.2f}" for c in case["channels"])
         print(f"  {name:32s} {row['triangles']:9d} " + " ".join(f"{row[c]:9.4g}" for c in case["channels"])
-              + f"   {ratios}")
+              + f" {row['geometry_mean']:9.3g}   {ratios}")
 
 
 def summarize(cases: list[dict]) -> dict:
@@ -336,15 +346,15 @@ def summarize(cases: list[dict]) -> dict:
     summary = {}
     print("\nours ÷ peer (below 1: ours is closer to the source's look)")
     for peer in PEERS:
-        for channel in CHANNELS:
-            values = [ratio(c["tools"]["topstoc quality"][channel], c["tools"][peer][channel])
-                      for c in cases if channel in c["channels"] and c["tools"].get(peer)]
+        for channel in (*CHANNELS, "geometry_mean"):
+            values = [ratio(c["tools"]["topstoc quality"][channel], c["tools"][peer][channel], channel)
+                      for c in cases if channel in (*c["channels"], "geometry_mean") and c["tools"].get(peer)]
             if not values:
                 continue
             entry = {"median": statistics.median(values), "worst": max(values), "cases": len(values),
                      "above_1": sum(v > 1.0 for v in values)}
             summary[f"{channel} vs {peer}"] = entry
-            print(f"  {channel:7s} vs {peer:32s} median {entry['median']:.3f}  worst {entry['worst']:.3f}  "
+            print(f"  {channel:13s} vs {peer:32s} median {entry['median']:.3f}  worst {entry['worst']:.3f}  "
                   f"above 1.0 in {entry['above_1']} of {entry['cases']}")
     return summary
 
