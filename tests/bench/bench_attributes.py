@@ -102,22 +102,39 @@ def paint(vertices: np.ndarray) -> np.ndarray:
     return rgb
 
 
-def assets(names) -> list[dict]:
-    """The assets (module docs) as dicts of tests/attribute_error.py, plus "name"."""
-    found = []
-    for name, path in (("duck", DATA / "uv_materials/duck/duck_via_assimp.obj"),
-                       ("spider", DATA / "uv_materials/spider/spider.obj"),
-                       ("suzanne", DATA / "open_boundary/kivy_suzanne_monkey.obj")):
-        data = read_mesh(path)
-        found.append({"name": name, "vertices": data.vertices, "triangles": data.triangles.astype(np.int64),
-                      "uv": data.corner_uvs, "normal": obj_corner_normals(path, data.triangles)})
+def _obj_asset(name: str, path: pathlib.Path) -> dict:
+    data = read_mesh(path)
+    return {"name": name, "vertices": data.vertices, "triangles": data.triangles.astype(np.int64),
+            "uv": data.corner_uvs, "normal": obj_corner_normals(path, data.triangles)}
+
+
+def _painted_dragon() -> dict:
     dragon = read_mesh(DATA / "genus0/cgal_ChineseDragon-10kv.off")
     triangles = dragon.triangles.astype(np.int64)
-    found.append({"name": "painted dragon", "vertices": dragon.vertices, "triangles": triangles,
-                  "color": paint(dragon.vertices)[triangles]})
+    return {"name": "painted dragon", "vertices": dragon.vertices, "triangles": triangles,
+            "color": paint(dragon.vertices)[triangles]}
+
+
+def _capped_cylinder() -> dict:
     vertices, triangles, normals = capped_cylinder()
-    found.append({"name": "capped cylinder", "vertices": vertices, "triangles": triangles, "normal": normals})
-    return [a for a in found if not names or a["name"] in names]
+    return {"name": "capped cylinder", "vertices": vertices, "triangles": triangles, "normal": normals}
+
+
+ASSETS = {
+    "duck": lambda: _obj_asset("duck", DATA / "uv_materials/duck/duck_via_assimp.obj"),
+    "spider": lambda: _obj_asset("spider", DATA / "uv_materials/spider/spider.obj"),
+    "suzanne": lambda: _obj_asset("suzanne", DATA / "open_boundary/kivy_suzanne_monkey.obj"),
+    "painted dragon": _painted_dragon,
+    "capped cylinder": _capped_cylinder,
+}
+
+
+def assets(names) -> list[dict]:
+    """The assets ``names`` (all when empty; module docs) as dicts of tests/attribute_error.py, plus "name"."""
+    unknown = [n for n in names if n not in ASSETS]
+    if unknown:
+        raise SystemExit(f"error: unknown assets {unknown}; known: {', '.join(ASSETS)}")
+    return [load() for name, load in ASSETS.items() if not names or name in names]
 
 
 # -- TopStoc -----------------------------------------------------------------------------------
