@@ -61,6 +61,8 @@ py::dict result_dict(EditResult&& r) {
     patch["first_vertex"] = p.first_vertex;
     patch["num_vertices"] = p.num_vertices;
     patch["method"] = fill_method_name(p.method);
+    patch["refined"] = p.refined;
+    patch["faired"] = p.faired;
     patch["normal"] = copy_array(std::vector<double>(p.normal, p.normal + 3));
     patches.append(patch);
   }
@@ -170,7 +172,7 @@ void bind_fills(py::module_& m) {
       "remove_handle",
       [](const py::handle& vertices, const py::handle& triangles, const py::handle& loop, bool allow_separating,
          double separation, bool planar, int32_t max_dp_corners, bool refine, bool fair,
-         bool allow_self_intersections) {
+         bool allow_self_intersections, bool step_down) {
         if (!(separation >= 0.0 && separation < 1.0))
           throw std::invalid_argument("separation must lie in [0, 1), got " + std::to_string(separation));
         Arrays a = arrays_from(vertices, triangles);
@@ -180,6 +182,7 @@ void bind_fills(py::module_& m) {
         options.allow_separating = allow_separating;
         options.separation = separation;
         options.allow_self_intersections = allow_self_intersections;
+        options.step_down = step_down;
         EditResult r;
         {
           EngineCall call;
@@ -190,7 +193,7 @@ void bind_fills(py::module_& m) {
       },
       py::arg("vertices"), py::arg("triangles"), py::arg("loop"), py::arg("allow_separating") = false,
       py::arg("separation") = 0.25, py::arg("planar") = true, py::arg("max_dp_corners") = 300, py::arg("refine") = false, py::arg("fair") = false,
-      py::arg("allow_self_intersections") = false,
+      py::arg("allow_self_intersections") = false, py::arg("step_down") = false,
       "Cuts along a handle or tunnel loop and fills both holes: the genus drops by one.");
 }
 

@@ -785,3 +785,24 @@ def test_removing_every_handle_never_makes_the_surface_intersect_itself(data_dir
             pairs = cgal_new_intersections(tmp_path, current_v, current_t, 0)
             assert not pairs, (name, pairs[:5])
     assert summary(current_v, current_t) == (1, 0, True, True, [0])
+
+
+def test_remove_handle_steps_down_to_flatter_patches_in_one_call():
+    """step_down=True is the sequence faired, refined, flat of separate calls, in one: the same
+    arrays as the first of those calls that succeeds, its patches saying what they are."""
+    import cleanup_meshes
+    from topstoc.core.api.loops import handle_tunnel_loops
+
+    vertices, triangles = cleanup_meshes.block_with_arches(0, 1, large_size=4, jitter=0.05, seed=3)
+    loop = min(handle_tunnel_loops(vertices, triangles).handles, key=lambda loop: loop.length).vertices
+    with pytest.raises(ValueError, match="intersect itself"):  # a thick handle: faired caps bulge into each other
+        edit.remove_handle(vertices, triangles, loop, refine=True, fair=True)
+    stepped = edit.remove_handle(vertices, triangles, loop, refine=True, fair=True, step_down=True)
+    refined = edit.remove_handle(vertices, triangles, loop, refine=True)
+    for name in ("vertices", "triangles", "vertex_source", "face_source", "corner_source"):
+        assert np.array_equal(getattr(stepped, name), getattr(refined, name)), name
+    assert [(p.refined, p.faired) for p in stepped.patches] == [(True, False)] * 2
+    faired = edit.remove_handle(vertices, triangles, loop, refine=True, fair=True, allow_self_intersections=True)
+    assert [(p.refined, p.faired) for p in faired.patches] == [(True, True)] * 2
+    flat = edit.remove_handle(vertices, triangles, loop)
+    assert [(p.refined, p.faired) for p in flat.patches] == [(False, False)] * 2

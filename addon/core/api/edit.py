@@ -73,6 +73,8 @@ class Patch:
     vertices: slice             #: the vertices it added (empty unless refined, faired or a fan)
     method: str                 #: one of FILL_METHODS: the last resort any part of it needed
     normal: np.ndarray          #: the projection plane's normal, or the boundary's Newell normal
+    refined: bool = False       #: refined towards the surrounding edge length
+    faired: bool = False        #: and faired
 
 
 @dataclass(frozen=True)
@@ -185,7 +187,8 @@ def _result(raw: dict, vertices: np.ndarray, triangles) -> EditResult:
     patches = [Patch(hole=int(p["hole"]), boundary=p["boundary"],
                      triangles=slice(p["first_triangle"], p["first_triangle"] + p["num_triangles"]),
                      vertices=slice(p["first_vertex"], p["first_vertex"] + p["num_vertices"]),
-                     method=p["method"], normal=p["normal"]) for p in raw["patches"]]
+                     method=p["method"], normal=p["normal"], refined=bool(p["refined"]),
+                     faired=bool(p["faired"])) for p in raw["patches"]]
     return EditResult(vertices=raw["vertices"], triangles=raw["triangles"],
                       vertex_source=raw["vertex_source"], face_source=raw["face_source"],
                       corner_source=raw["corner_source"], input_vertices=len(vertices),
@@ -284,7 +287,7 @@ def fill_loops(vertices, triangles, loops: Sequence[Sequence[int]], *, planar: b
 
 def remove_handle(vertices, triangles, loop: Sequence[int], *, allow_separating: bool = False,
                   separation: float = 0.25, planar: bool = True, max_dp_corners: int = 300, refine: bool = False,
-                  fair: bool = False, allow_self_intersections: bool = False) -> EditResult:
+                  fair: bool = False, allow_self_intersections: bool = False, step_down: bool = False) -> EditResult:
     """Removes the handle or tunnel that ``loop`` goes around: cut along it, fill both holes.
 
     The genus of that component drops by one; components and boundary loops stay. A loop that
@@ -299,12 +302,14 @@ def remove_handle(vertices, triangles, loop: Sequence[int], *, allow_separating:
     would cross the surface, the copies are pulled apart more or less and refined, faired
     patches are tried; if none is free of intersections, ValueError names the problem (a
     shorter loop around the same handle usually works: see topstoc.core.api.loops).
-    ``allow_self_intersections=True`` returns the first candidate instead.
+    ``allow_self_intersections=True`` returns the first candidate instead. ``step_down=True``
+    then tries refined flat patches, then flat ones, before giving up (``Patch.refined`` and
+    ``Patch.faired`` say which were kept).
     """
     vertices = as_vertices(vertices)
     raw = engine.remove_handle(vertices, triangles, _loop(loop), allow_separating=allow_separating,
                                separation=params.number("separation", separation, 0, 1, high_open=True),
-                               allow_self_intersections=bool(allow_self_intersections),
+                               allow_self_intersections=bool(allow_self_intersections), step_down=bool(step_down),
                                **_fill_options(planar, max_dp_corners, refine, fair))
     return _result(raw, vertices, triangles)
 

@@ -131,7 +131,7 @@ bool triangles_intersect(const double* positions, const int32_t* t1, const int32
 
 std::vector<std::pair<int32_t, int32_t>> self_intersections(const double* positions, int32_t num_vertices,
                                                             const int32_t* triangles, int32_t num_triangles,
-                                                            int64_t max_pairs) {
+                                                            int64_t max_pairs, const uint8_t* only_with) {
   std::vector<std::pair<int32_t, int32_t>> pairs;
   if (num_triangles == 0) return pairs;
   // Bounding boxes and a grid whose cells are about twice the mean box size.
@@ -176,16 +176,29 @@ std::vector<std::pair<int32_t, int32_t>> self_intersections(const double* positi
       to[k] = cell_of(b[3 + k] - lo[k], dims[k] - 1);
     }
   };
-  // (cell, triangle) entries, grouped by cell.
-  std::vector<std::pair<int64_t, int32_t>> entries;
-  entries.reserve(4 * size_t(num_triangles));
-  for (int32_t t = 0; t < num_triangles; ++t) {
-    if (repeats_vertex(triangles + 3 * size_t(t))) continue;  // no area: reported as (t, t) only
+  const auto each_cell = [&](int32_t t, auto&& visit) {
     int64_t from[3], to[3];
     cell_range(t, from, to);
     for (int64_t x = from[0]; x <= to[0]; ++x)
       for (int64_t y = from[1]; y <= to[1]; ++y)
-        for (int64_t z = from[2]; z <= to[2]; ++z) entries.emplace_back((x * dims[1] + y) * dims[2] + z, t);
+        for (int64_t z = from[2]; z <= to[2]; ++z) visit((x * dims[1] + y) * dims[2] + z);
+  };
+  // With only_with, only the cells of flagged triangles matter: every pair tested has one.
+  std::vector<int64_t> wanted;
+  if (only_with) {
+    for (int32_t t = 0; t < num_triangles; ++t)
+      if (only_with[t] && !repeats_vertex(triangles + 3 * size_t(t))) each_cell(t, [&](int64_t c) { wanted.push_back(c); });
+    std::sort(wanted.begin(), wanted.end());
+    wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
+  }
+  // (cell, triangle) entries, grouped by cell.
+  std::vector<std::pair<int64_t, int32_t>> entries;
+  entries.reserve(only_with ? 8 * wanted.size() : 4 * size_t(num_triangles));
+  for (int32_t t = 0; t < num_triangles; ++t) {
+    if (repeats_vertex(triangles + 3 * size_t(t))) continue;  // no area: reported as (t, t) only
+    each_cell(t, [&](int64_t c) {
+      if (!only_with || std::binary_search(wanted.begin(), wanted.end(), c)) entries.emplace_back(c, t);
+    });
   }
   std::sort(entries.begin(), entries.end());
   std::vector<size_t> starts;
@@ -194,6 +207,7 @@ std::vector<std::pair<int32_t, int32_t>> self_intersections(const double* positi
   starts.push_back(entries.size());
 
   for (int32_t t = 0; t < num_triangles; ++t) {
+    if (only_with && !only_with[t]) continue;
     const double* a = positions + 3 * size_t(triangles[3 * size_t(t)]);
     if (repeats_vertex(triangles + 3 * size_t(t)) || degenerate(a, positions + 3 * size_t(triangles[3 * size_t(t) + 1]), positions + 3 * size_t(triangles[3 * size_t(t) + 2])))
       pairs.emplace_back(t, t);
@@ -204,9 +218,11 @@ std::vector<std::pair<int32_t, int32_t>> self_intersections(const double* positi
   parallel_region(num_triangles > 50000 ? max_threads() : 1, [&](Team& team) {
     std::vector<std::pair<int32_t, int32_t>> found;
     team.for_dynamic(next_cell, cells, 64, [&](int64_t c) {
-      for (size_t i = starts[c]; i < starts[c + 1]; ++i)
-        for (size_t j = i + 1; j < starts[c + 1]; ++j) {
+      for (size_t i = starts[c]; i < starts[c + 1]; ++i) {
+        if (only_with && !only_with[entries[i].second]) continue;  // paired from the flagged side
+        for (size_t j = only_with ? starts[c] : i + 1; j < starts[c + 1]; ++j) {
           int32_t s = entries[i].second, t = entries[j].second;
+          if (only_with && (j == i || (only_with[t] && j < i))) continue;  // flagged pairs once
           if (s > t) std::swap(s, t);
           const double* bs = &box[6 * size_t(s)];
           const double* bt = &box[6 * size_t(t)];
@@ -222,6 +238,7 @@ std::vector<std::pair<int32_t, int32_t>> self_intersections(const double* positi
           if (first != entries[i].first) continue;
           if (triangles_intersect(positions, triangles + 3 * size_t(s), triangles + 3 * size_t(t))) found.emplace_back(s, t);
         }
+      }
     });
     team.critical([&] { pairs.insert(pairs.end(), found.begin(), found.end()); });
   });

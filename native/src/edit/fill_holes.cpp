@@ -326,6 +326,8 @@ class HoleFilling {
       filled.first_vertex = static_cast<int32_t>(r.vertex_source.size());
       filled.num_vertices = static_cast<int32_t>(patch.added_points.size() / 3);
       filled.method = patch.method;
+      filled.refined = options.refine || options.fair;
+      filled.faired = options.fair;
       std::copy(patch.normal, patch.normal + 3, filled.normal);
       r.vertices.insert(r.vertices.end(), patch.added_points.begin(), patch.added_points.end());
       r.vertex_source.insert(r.vertex_source.end(), size_t(filled.num_vertices), -1);

@@ -1,10 +1,13 @@
 #include "topstoc/edit/remove_handle.hpp"
 #include "topstoc/core/self_intersections.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace topstoc {
 
@@ -104,9 +107,30 @@ bool edit_intersects(const EditResult& r) {
     const int32_t* c = &r.triangles[3 * size_t(t)];
     touched[t] = r.face_source[t] < 0 || moved[c[0]] || moved[c[1]] || moved[c[2]];
   }
-  for (const auto& [a, b] : self_intersections(r.vertices.data(), n, r.triangles.data(), m))
-    if (touched[a] || touched[b]) return true;
-  return false;
+  return !self_intersections(r.vertices.data(), n, r.triangles.data(), m, 1, touched.data()).empty();
+}
+
+struct Attempt {
+  double separation;
+  bool refine, fair;
+  bool operator==(const Attempt& o) const { return separation == o.separation && refine == o.refine && fair == o.fair; }
+};
+
+// The candidates remove_handle tries for one fill, in order: the copies pulled apart more or
+// less, with the fill asked for and with a refined, faired one.
+std::vector<Attempt> attempts(double s0, bool refine, bool fair) {
+  return {{s0, refine, fair},          {s0, true, true},           {0.5 * s0, true, true},
+          {std::min(0.45, 1.6 * s0), true, true}, {0.5 * s0, refine, fair}, {0.1 * s0, true, true},
+          {std::min(0.45, 1.6 * s0), refine, fair}};
+}
+
+// The fills asked for: options.fill, then with step_down the coarser ones (refined, then flat).
+std::vector<std::pair<bool, bool>> fills(const RemoveHandleOptions& options) {
+  const bool refine = options.fill.refine || options.fill.fair, fair = options.fill.fair;
+  std::vector<std::pair<bool, bool>> out{{options.fill.refine, fair}};
+  if (options.step_down && fair) out.emplace_back(true, false);
+  if (options.step_down && refine) out.emplace_back(false, false);
+  return out;
 }
 
 }  // namespace
@@ -131,24 +155,19 @@ EditResult remove_handle(const double* positions, int32_t num_vertices, const in
   // copies pulled apart more or less and with a refined, faired patch; the first candidate
   // free of intersections wins. (Found when removing the handles of a genus-6 part one by
   // one: the fourth patch crossed the surface and TetGen refused the next step.)
-  struct Attempt {
-    double separation;
-    bool refine, fair;
-  };
-  const double s0 = options.separation;
-  const Attempt attempts[] = {
-      {s0, options.fill.refine, options.fill.fair}, {s0, true, true},         {0.5 * s0, true, true},
-      {std::min(0.45, 1.6 * s0), true, true},        {0.5 * s0, options.fill.refine, options.fill.fair},
-      {0.1 * s0, true, true},                        {std::min(0.45, 1.6 * s0), options.fill.refine, options.fill.fair},
-  };
-  for (const Attempt& attempt : attempts) {
-    EditResult candidate = cut;
-    if (attempt.separation > 0) separate_sides(candidate, attempt.separation);
-    FillOptions fill = options.fill;
-    fill.refine = attempt.refine;
-    fill.fair = attempt.fair;
-    fill_loops_into(candidate, holes, fill);
-    if (options.allow_self_intersections || !edit_intersects(candidate)) return candidate;
+  std::vector<Attempt> tried;
+  for (const auto& [refine, fair] : fills(options)) {
+    for (const Attempt& attempt : attempts(options.separation, refine, fair)) {
+      if (std::find(tried.begin(), tried.end(), attempt) != tried.end()) continue;  // same result again
+      tried.push_back(attempt);
+      EditResult candidate = cut;
+      if (attempt.separation > 0) separate_sides(candidate, attempt.separation);
+      FillOptions fill = options.fill;
+      fill.refine = attempt.refine;
+      fill.fair = attempt.fair;
+      fill_loops_into(candidate, holes, fill);
+      if (options.allow_self_intersections || !edit_intersects(candidate)) return candidate;
+    }
   }
   throw std::invalid_argument("removing the handle along this loop would make the surface intersect itself (every "
                               "fill patch tried crosses the surface); try a shorter or flatter loop around it");

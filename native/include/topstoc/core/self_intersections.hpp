@@ -16,10 +16,12 @@
 namespace topstoc {
 
 /// Intersecting triangle pairs (i < j, sorted; (i, i) for a zero-area triangle i); at most
-/// max_pairs of them (the first in that order) when max_pairs > 0.
+/// max_pairs of them (the first in that order) when max_pairs > 0. With only_with (one flag per
+/// triangle), only the pairs with a flagged triangle (and flagged zero-area triangles): the
+/// same pairs as filtering the full answer, at the cost of the flagged triangles' cells.
 std::vector<std::pair<int32_t, int32_t>> self_intersections(const double* positions, int32_t num_vertices,
                                                             const int32_t* triangles, int32_t num_triangles,
-                                                            int64_t max_pairs = 0);
+                                                            int64_t max_pairs = 0, const uint8_t* only_with = nullptr);
 
 /// True when triangles (a, b, c) and (p, q, r) (vertex ids into positions) intersect other than in
 /// shared vertices or a shared edge. Each triangle must name three distinct vertices (throws

@@ -26,6 +26,8 @@ struct FilledHole {
   int32_t num_vertices = 0;
   FillMethod method = FillMethod::Planar;
   double normal[3] = {0, 0, 0};      ///< plane normal (planar) or the boundary's Newell normal
+  bool refined = false;              ///< refined towards the surrounding edge length
+  bool faired = false;               ///< and faired (see FillOptions)
 };
 
 /// The copies of a cut loop on one side: a cycle (closed) or, where the loop touched the mesh

@@ -25,6 +25,9 @@ struct RemoveHandleOptions {
   /// returned: other patches are tried, then std::invalid_argument. True returns the first
   /// candidate whatever it intersects (for callers that only need the topology).
   bool allow_self_intersections = false;
+  /// When every patch tried crosses the surface, step down to coarser fills: a refined flat one,
+  /// then a flat one (the attempts separate calls with those fills would make, each once).
+  bool step_down = false;
 };
 
 /// Cuts along the closed edge loop (see cut_along_loop) and fills every side of the cut (see
