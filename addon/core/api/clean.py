@@ -13,8 +13,10 @@ Handles are removed in rounds: a round computes the loops of the current surface
 one removed before in the round. The 2g handle and tunnel loops of a component are independent
 in its homology, so disjoint ones do not separate the surface together, and each removal drops
 the genus by one (remove_handle checks anyway that each cut leaves its component in one
-piece, on the surface as it is then); the next round recomputes the loops of what is left,
-since a removal changes the loops of the others. A removal runs on the loop's neighbourhood
+piece, on the surface as it is then). When a round removed every loop below the size and the
+loops it left untouched are twice the genus left in number, those are what is left (_survivors
+says why); else the next round recomputes the loops of what is left, since a removal changes
+the loops of the others. A removal runs on the loop's neighbourhood
 (local_edit.py). Holes are filled first; a patch that would cross the surface is replaced by a
 flat one or its hole left open and reported.
 
@@ -361,6 +363,7 @@ def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional
     """Rounds of loop computation and removal (module docstring); returns (state, rounds).
     Adds the time spent computing loops to ``seconds["loops"]``."""
     from .component_loops import loops_by_component
+    from .topology import topology
 
     if state.num_triangles == 0:
         return state, 0
@@ -379,28 +382,56 @@ def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional
         budget = found.genus - keep_largest if keep_largest is not None else found.genus
         if rounds >= max_rounds or budget <= 0:
             break
-        state, count = _removal_round(state, found, size, budget, fair, failed, removed)
+        state, count, used = _removal_round(state, found, size, budget, fair, failed, removed)
         if count == 0:
             break
         rounds += 1
+        if used is not None:
+            survivors = _survivors(found, used)
+            if len(survivors.handles) + len(survivors.tunnels) == 2 * _genus(topology(state.vertices, state.triangles)):
+                found = survivors  # they span what is left: no loops to compute again
+                break
     _report_left(state, found, size, keep_largest, failed, left)
     return state, rounds
 
 
+def _survivors(found, used: np.ndarray):
+    """``found`` without the loops that touch a removed loop's vertex ``used``.
+
+    A loop that touches none is still a loop of the edited surface (its edges and positions
+    are kept) of the same kind: a cut along a handle loop cuts the inside along a disk, which
+    keeps every loop bounding inside bounding and makes no loop bound outside that did not
+    (and the other way round for a tunnel). The untouched loops stay independent (a relation
+    among them on the edited surface would be one with the removed loops before), so when
+    there are twice the genus left of them they span every handle and tunnel left."""
+    def kept(loops):
+        return tuple(loop for loop in loops if not used[np.asarray(loop.vertices, dtype=np.int64)].any())
+
+    components = tuple(dataclasses.replace(c, handles=kept(c.handles), tunnels=kept(c.tunnels),
+                                           genus=min(len(kept(c.handles)), len(kept(c.tunnels))))
+                       if c.status == "ok" else c for c in found.components)
+    return dataclasses.replace(found, components=components)
+
+
 def _removal_round(state: EditResult, found, size: float, budget: int, fair: bool, failed: dict,
                    removed: list) -> tuple:
-    """Removes up to ``budget`` loops below ``size``, shortest first, no two sharing a vertex."""
+    """Removes up to ``budget`` loops below ``size``, shortest first, no two sharing a vertex.
+    Returns (state, count removed, the removed loops' vertices as a mask when every loop below
+    the size was removed, touches one removed or the budget was reached; else None)."""
     candidates = sorted((loop for c in found.components if c.status == "ok" for loop in c.loops),
                         key=lambda loop: (loop.length, loop.kind))
     used = np.zeros(state.num_vertices, dtype=bool)  # loops are in the round's first ids, kept by every edit
-    count, stale = 0, {}
+    count, stale, complete = 0, {}, True
     editor = LocalEditor(state.vertices, state.triangles)
     for loop in candidates:
         if count >= budget or loop.length >= size:
             break
         ids = np.asarray(loop.vertices, dtype=np.int64)
         key = frozenset(ids.tolist())
-        if used[ids].any() or key in failed:
+        if used[ids].any():  # most often the other loop of a handle removed (see _survivors)
+            continue
+        if key in failed:
+            complete = False  # the next round's loops may hold another loop for this one's handle
             continue
         tag = len(removed)
         try:
@@ -409,6 +440,7 @@ def _removal_round(state: EditResult, found, size: float, budget: int, fair: boo
             # A loop that now separates was made redundant by a removal earlier in this round;
             # the next round's loops settle it. Anything else is this loop's own failure.
             (stale if "separates" in str(error) else failed)[key] = str(error).splitlines()[0]
+            complete = False
             continue
         used[ids] = True
         area, aspect = patch_quality(editor.vertices.view(), editor.triangles.view(), patches)
@@ -419,22 +451,16 @@ def _removal_round(state: EditResult, found, size: float, budget: int, fair: boo
         state = compose(state, editor.result())
     if count == 0:
         failed.update(stale)  # nothing else changed: these loops separate on their own
-    return state, count
+    return state, count, used if complete else None
 
 
 def _remove_one(editor: LocalEditor, ids: np.ndarray, tag: int, fair: bool) -> tuple:
     """remove_handle with the best patches that do not make the surface cross itself: faired,
-    else refined but flat, else flat. A faired cap continues the tube it closes, so the two caps
-    of a thick handle bulge towards each other and can cross; flat ones do not."""
-    styles = (("faired", True, True), ("refined", True, False), ("flat", False, False)) if fair else \
-        (("flat", False, False),)
-    for number, (style, refine, fair_patch) in enumerate(styles):
-        try:
-            return editor.remove_handle(ids, tag, refine=refine, fair=fair_patch), style
-        except ValueError as error:
-            if number + 1 == len(styles) or "intersect itself" not in str(error):
-                raise
-    raise AssertionError("unreachable")
+    else refined but flat, else flat (remove_handle's step_down). A faired cap continues the
+    tube it closes, so the two caps of a thick handle bulge towards each other and can cross;
+    flat ones do not. Returns (patches, their style)."""
+    patches = editor.remove_handle(ids, tag, refine=fair, fair=fair, step_down=fair)
+    return patches, "faired" if patches[0].faired else "refined" if patches[0].refined else "flat"
 
 
 def _report_left(state: EditResult, found, size: float, keep_largest: Optional[int], failed: dict,

@@ -2,9 +2,10 @@
 
 ``edit.remove_handle`` copies the whole mesh and tests the new triangles against all others,
 so removing k handles costs k passes over the mesh. Here the edit runs on the triangles whose
-bounding boxes meet the loop's box grown by the loop's length, and is written back in place:
-moved vertices and changed triangles over their old rows, new ones appended to arrays with room
-to grow, so a removal costs its neighbourhood, not the mesh. It is the same edit when three
+bounding boxes meet the loop's box grown by half the loop's length (then by its length, when
+the first is too small), and is written back in place: moved vertices and changed triangles
+over their old rows, new ones appended to arrays with room to grow, so a removal costs its
+neighbourhood, not the mesh. It is the same edit when three
 things hold, each checked, else the whole mesh is edited:
 - every triangle the edit created or moved has its bounding box inside the grown box, so every
   triangle it could cross is in the neighbourhood and was tested;
@@ -18,7 +19,12 @@ import numpy as np
 
 from . import edit
 from ..support.errors import TopStocError
+from .box_index import BoxIndex
 from .edit import EditResult, Patch
+
+
+#: The neighbourhoods tried, smallest first: the loop's box grown by these times its length.
+GROWTH = (0.5, 1.0)
 
 
 class _Growing:
@@ -70,6 +76,7 @@ class LocalEditor:
         corners = self.vertices.view()[self.triangles.view()]
         self.box = [_Growing(corners[:, :, axis].min(axis=1)) for axis in range(3)] + \
                    [_Growing(corners[:, :, axis].max(axis=1)) for axis in range(3)]
+        self.index = BoxIndex(*self.boxes())
 
     def result(self) -> EditResult:
         """The mesh so far, with its maps to the mesh given and the patches made (arrays copied)."""
@@ -84,19 +91,22 @@ class LocalEditor:
 
     def _near(self, low: np.ndarray, high: np.ndarray) -> np.ndarray:
         """The triangles whose boxes meet [low, high]."""
-        lx, ly, lz, hx, hy, hz = (b.view() for b in self.box)
-        return np.flatnonzero((hx >= low[0]) & (hy >= low[1]) & (hz >= low[2]) &
-                              (lx <= high[0]) & (ly <= high[1]) & (lz <= high[2]))
+        rows = self.index.candidates(low, high, self.triangles.count)
+        lx, ly, lz, hx, hy, hz = (b.data[rows] for b in self.box)
+        return rows[(hx >= low[0]) & (hy >= low[1]) & (hz >= low[2]) &
+                    (lx <= high[0]) & (ly <= high[1]) & (lz <= high[2])]
 
     def remove_handle(self, loop: np.ndarray, tag: int, **options) -> list:
         """``edit.remove_handle(vertices, triangles, loop, **options)`` on the mesh held (loop in
         its ids), done in place; returns the new patches (ids of the mesh held, ``hole=tag``)."""
         vertices, triangles = self.vertices.view(), self.triangles.view()
         points = vertices[loop]
-        grow = float(np.linalg.norm(points - np.roll(points, -1, axis=0), axis=1).sum())
-        low, high = points.min(axis=0) - grow, points.max(axis=0) + grow
-        near = self._near(low, high)
-        if len(near) * 2 <= len(triangles):
+        length = float(np.linalg.norm(points - np.roll(points, -1, axis=0), axis=1).sum())
+        for grow in GROWTH:
+            low, high = points.min(axis=0) - grow * length, points.max(axis=0) + grow * length
+            near = self._near(low, high)
+            if len(near) * 2 > len(triangles):
+                break
             ids = np.unique(triangles[near])
             try:
                 local = edit.remove_handle(vertices[ids], np.searchsorted(ids, triangles[near]).astype(np.int32),
@@ -104,15 +114,17 @@ class LocalEditor:
             except ValueError as error:
                 if "separates" not in str(error):
                     raise
-                local = None
-            if local is not None and _inside(local, len(ids), len(near), low, high):
-                return self._write(ids, near, local, tag)
+                continue
+            if _inside(local, len(ids), len(near), low, high):
+                return self._write(ids, near, local, tag, (low, high))
         whole = edit.remove_handle(vertices, triangles, loop, **options)
-        return self._write(np.arange(len(vertices)), np.arange(len(triangles)), whole, tag)
+        return self._write(np.arange(len(vertices)), np.arange(len(triangles)), whole, tag,
+                           (np.full(3, -np.inf), np.full(3, np.inf)))
 
-    def _write(self, ids: np.ndarray, near: np.ndarray, local: EditResult, tag: int) -> list:
+    def _write(self, ids: np.ndarray, near: np.ndarray, local: EditResult, tag: int, inside: tuple) -> list:
         """An edit of the triangles `near` (vertices `ids`) written over them; its new vertices
-        and triangles appended. The edit keeps its input's ids and appends (as cuts and fills do)."""
+        and triangles appended, every changed box inside the box ``inside`` (low, high). The edit
+        keeps its input's ids and appends (as cuts and fills do)."""
         n, m, n_local, m_local = self.vertices.count, self.triangles.count, len(ids), len(near)
         if not np.array_equal(local.vertex_source[:n_local], np.arange(n_local)) or \
                 not np.array_equal(local.face_source[:m_local], np.arange(m_local)):
@@ -131,15 +143,19 @@ class LocalEditor:
         patches = [Patch(hole=tag, boundary=to_global[p.boundary],
                          triangles=slice(m + p.triangles.start - m_local, m + p.triangles.stop - m_local),
                          vertices=slice(n + p.vertices.start - n_local, n + p.vertices.stop - n_local),
-                         method=p.method, normal=p.normal) for p in local.patches]
+                         method=p.method, normal=p.normal, refined=p.refined, faired=p.faired)
+                   for p in local.patches]
         self.patches += patches
-        changed = np.concatenate([near, np.arange(m, self.triangles.count)])
-        corners = self.vertices.view()[self.triangles.view()[changed]]
+        rows = np.concatenate([near, np.arange(m, self.triangles.count)])
+        corners = self.vertices.view()[self.triangles.view()[rows]]
+        moved = np.zeros(len(near), dtype=bool)
         for axis in range(3):
             for box, values in ((self.box[axis], corners[:, :, axis].min(axis=1)),
                                 (self.box[3 + axis], corners[:, :, axis].max(axis=1))):
+                moved |= box.data[near] != values[:len(near)]
                 box.append(values[len(near):])
                 box.data[near] = values[:len(near)]
+        self.index.record(*inside, np.concatenate([near[moved], np.arange(m, self.triangles.count)]))
         return patches
 
 
