@@ -224,6 +224,30 @@ def render_scale(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def render_cleanup_speed(name: str, figures: dict) -> str:
+    """bench_cleanup.py --speed --json: the clean-up's time on many small handles, before and after."""
+    cases = figures["cases"]
+    with_baseline = any("baseline" in row for row in cases)
+    out = [f"## Clean-up speed: many small handles (`{name}`)", "",
+           f"`{figures['benchmark']}`: a block with K unit arches (loops about 4) and 4 large ones (loops 12), "
+           "jittered by 0.05 and subdivided L times, cleaned with size 6. Issue 43's goal: 1,000 handles on a "
+           "1M-triangle mesh in ≤ 10 s.", "", *source_lines(figures), "",
+           "| Arches, subdivisions | Triangles | Genus before → after | Loops left below the size | Worst patch aspect "
+           "| Patches | Wall | CPU | Loops (wall) |" + (" Before: wall / CPU | CPU speed-up |" if with_baseline else ""),
+           "|---|---|---|---|---|---|---|---|---|" + ("---|---|" if with_baseline else "")]
+    for row in cases:
+        styles = ", ".join(f"{count} {style}" for style, count in sorted(row["styles"].items()))
+        line = (f"| {row['small_arches']:,}, {row['subdivisions']} | {row['triangles']:,} | {row['genus_before']} → "
+                f"{row['genus_after']} | {row['loops_left_below']} | {row['patch_aspect']:.2f} | {styles} "
+                f"| {row['wall']:.1f} s | {row['cpu']:.1f} s | {row['loops_wall']:.1f} s |")
+        before = row.get("baseline")
+        if with_baseline:
+            line += (" — | — |" if before is None else
+                     f" {before['wall']:.1f} s / {before['cpu']:.1f} s | {before['cpu'] / row['cpu']:.1f}× |")
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
 def render_carried_over(name: str, figures: dict) -> str:
     """Figures measured before the benchmarks saved JSON, kept as they were published."""
     out = [f"## {figures['title']} (`{name}`)", "", *source_lines(figures), "", figures["note"], "",
@@ -301,9 +325,12 @@ def render_result(path: pathlib.Path) -> str:
         return render_scale(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_threads_paired.py":
         return render_paired(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_cleanup.py --speed":
+        return render_cleanup_speed(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
                      "the --json of bench_decimate.py, bench_quality.py, bench_attributes.py, bench_loops.py --families, "
-                     "bench_scale.py and bench_threads_paired.py, and carried-over figures)")
+                     "bench_scale.py, bench_threads_paired.py and bench_cleanup.py --speed, and carried-over "
+                     "figures)")
 
 
 def render() -> str:

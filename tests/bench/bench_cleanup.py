@@ -1,6 +1,7 @@
 """Benchmark: the topology clean-up (topstoc.core.api.clean) on meshes with many small defects.
 
     /usr/bin/python3 tests/bench/bench_cleanup.py [--handles 10,100,300] [--holes 50,300,1000]
+    /usr/bin/python3 tests/bench/bench_cleanup.py --speed 1000:0,1000:2 [--baseline DIR] [--json FILE]
 
 Cases (tests/cleanup_meshes.py, positions jittered by 0.05 like a scan):
   * block + k small arches + 4 large ones: genus k + 4; the small handles' loops are 4 long,
@@ -14,6 +15,12 @@ Cases (tests/cleanup_meshes.py, positions jittered by 0.05 like a scan):
     the handle case (it keeps handles: a reference for "the genus left").
   * the same blocks subdivided once and Taubin-smoothed: organic little handles (loops about
     3.2, the large ones 11; size 5), where the faired caps are kept.
+  * --speed K:L: the block with K small arches (and 4 large), subdivided L times (1000:2 is
+    1,200,128 triangles: the issue's 1,000 handles on a 1M-triangle mesh), cleaned in a child
+    process: wall and CPU seconds (TetGen's forked children included), genus, loops left below
+    the size on the output (computed again, not timed), patch styles; --baseline DIR times
+    another build's python directory the same way (--baseline-cases: only those); --json FILE
+    saves the figures for scripts/benchmarks_md.py.
   * the criterion: on the elephant (tests/data, holes filled) and on unit arches, each handle
     loop and each tunnel loop crossing it removed apart: does the shorter one give the smaller
     patch area?
@@ -22,22 +29,25 @@ Cases (tests/cleanup_meshes.py, positions jittered by 0.05 like a scan):
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import pathlib
 import subprocess
 import sys
+import resource
 import tempfile
 import time
 
 import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path[:0] = [str(ROOT / "build" / "python"), str(ROOT / "tests"), str(ROOT / "tests" / "bench")]
+BUILD = os.environ.get("TOPSTOC_BENCH_BUILD", str(ROOT / "build" / "python"))  # --baseline's child sets it
+sys.path[:0] = [BUILD, str(ROOT / "tests"), str(ROOT / "tests" / "bench")]
 
 import cleanup_meshes  # noqa: E402
 import meshgen  # noqa: E402
 import reference  # noqa: E402
-from machine import machine  # noqa: E402
+from machine import machine, save_figures  # noqa: E402
 from topstoc.core.api import edit  # noqa: E402
 from topstoc.core.api.clean import clean, patch_quality  # noqa: E402
 from topstoc.core.api.io import read_mesh  # noqa: E402
@@ -179,12 +189,80 @@ def bench_criterion(name: str, vertices, triangles) -> None:
     print(f"criterion on {name}: the shorter loop gave the smaller patch (or the only one) in {agree} of {total} pairs")
 
 
+def cpu_seconds() -> float:
+    """CPU time of this process and its finished children (TetGen runs in a forked child)."""
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+def speed_case(case: str) -> dict:
+    """One --speed case ("K:L"), cleaned in this process: the figures as a dict."""
+    k, levels = (int(x) for x in case.split(":"))
+    vertices, triangles = cleanup_meshes.block_with_arches(k, 4, jitter=0.05, seed=k)
+    vertices, triangles = meshgen.subdivide(vertices, triangles, levels) if levels else (vertices, triangles)
+    wall, cpu = time.perf_counter(), cpu_seconds()
+    result = clean(vertices, triangles, max_handle=SIZE, max_hole=0)
+    wall, cpu = time.perf_counter() - wall, cpu_seconds() - cpu
+    loops = handle_tunnel_loops(result.vertices, result.triangles)
+    styles = {}
+    for item in result.removed:
+        styles[item.patch] = styles.get(item.patch, 0) + 1
+    return {"case": case, "small_arches": k, "subdivisions": levels, "triangles": len(triangles),
+            "genus_before": result.genus_before, "genus_after": result.genus_after,
+            "removed": len(result.removed), "rounds": result.rounds,
+            "loops_left_below": sum(1 for loop in loops.handles + loops.tunnels if loop.length < SIZE),
+            "patch_aspect": result.patch_aspect, "styles": styles, "wall": wall, "cpu": cpu,
+            "loops_wall": result.seconds.get("loops", 0.0)}
+
+
+def speed_in_child(case: str, build: str) -> dict:
+    """speed_case in a child process with the python package of ``build``."""
+    out = subprocess.run([sys.executable, __file__, "--child", case], check=True, capture_output=True, text=True,
+                         env={**os.environ, "TOPSTOC_BENCH_BUILD": build})
+    return json.loads(out.stdout.splitlines()[-1])
+
+
+def speed(args) -> int:
+    """--speed: each case with this build (and --baseline's), printed and saved with --json."""
+    print(machine(), flush=True)
+    rows = []
+    for case in args.speed.split(","):
+        row = speed_in_child(case, BUILD)
+        if args.baseline and (args.baseline_cases is None or case in args.baseline_cases.split(",")):
+            row["baseline"] = speed_in_child(case, args.baseline)
+        rows.append(row)
+        was = (f"; before: {row['baseline']['wall']:.1f} s wall, {row['baseline']['cpu']:.1f} s CPU"
+               if "baseline" in row else "")
+        print(f"{row['small_arches']} arches, {row['subdivisions']} subdivisions: {row['triangles']:,} triangles, "
+              f"genus {row['genus_before']} -> {row['genus_after']}, {row['removed']} removed in {row['rounds']} "
+              f"round(s), loops left below the size {row['loops_left_below']}, patch aspect <= "
+              f"{row['patch_aspect']:.2f}, {row['styles']}: {row['wall']:.1f} s wall, {row['cpu']:.1f} s CPU "
+              f"(loops {row['loops_wall']:.1f} s wall){was}", flush=True)
+    if args.json:
+        save_figures(args.json, "tests/bench/bench_cleanup.py --speed",
+                     "clean(vertices, triangles, max_handle=6, max_hole=0) once per case in a child process, wall "
+                     "and CPU seconds (the process and its TetGen children); "
+                     + (f"the baseline is {args.baseline} timed the same way in the same run" if args.baseline
+                        else "no baseline"), cases=rows)
+    return 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--handles", default="10,100,300", help="small handle counts, comma-separated")
     parser.add_argument("--smooth", default="10,100", help="small handle counts on smoothed blocks")
     parser.add_argument("--holes", default="50,300,1000", help="small hole counts, comma-separated")
+    parser.add_argument("--speed", help="only time these cases K:L (K small arches, L subdivisions), comma-separated")
+    parser.add_argument("--baseline", help="with --speed: another build's python directory, timed alongside")
+    parser.add_argument("--baseline-cases", help="with --baseline: only these cases (default: all)")
+    parser.add_argument("--json", help="with --speed: save the figures here")
+    parser.add_argument("--child", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.child:
+        print(json.dumps(speed_case(args.child)))
+        return 0
+    if args.speed:
+        return speed(args)
     print(machine())
     for k in (int(x) for x in args.handles.split(",") if x):
         bench_handles(k)

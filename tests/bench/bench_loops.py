@@ -48,7 +48,7 @@ sys.path.insert(0, BUILD)
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "tests" / "bench"))
 
-from machine import machine  # noqa: E402
+from machine import machine, save_figures  # noqa: E402
 from topstoc.core import Mesh, handle_tunnel_loops, read_mesh, tetrahedralize_surface, write_mesh  # noqa: E402
 from topstoc.core.api.io import MeshData  # noqa: E402
 
@@ -165,16 +165,11 @@ def families(args) -> int:
               f"{'/'.join(row['routes'])} route: {row['seconds']:.2f} s (CPU {row['cpu']:.2f} s, select "
               f"{row['stages']['select']:.2f} s), {row['cpu'] / grid['cpu']:.2f}x the grid's CPU{was}", flush=True)
     if args.json:
-        figures = {"benchmark": "tests/bench/bench_loops.py --families", "machine": machine(),
-                   "date": time.strftime("%Y-%m-%d"), "repeats": args.repeats,
-                   "method": "handle_tunnel_loops(vertices, triangles) per family member (tests/loop_families.py), "
-                             "wall and CPU seconds, medians of the repeats (one run at 1M triangles); "
-                             + ("the baseline is " + args.baseline + " timed in a child process of the same run"
-                                if args.baseline else "no baseline"),
-                   "families": rows}
-        temporary = pathlib.Path(args.json + ".tmp")
-        temporary.write_text(json.dumps(figures, indent=1) + "\n")
-        temporary.replace(args.json)
+        save_figures(args.json, "tests/bench/bench_loops.py --families",
+                     "handle_tunnel_loops(vertices, triangles) per family member (tests/loop_families.py), wall and "
+                     "CPU seconds, medians of the repeats (one run at 1M triangles); "
+                     + ("the baseline is " + args.baseline + " timed in a child process of the same run"
+                        if args.baseline else "no baseline"), repeats=args.repeats, families=rows)
     return 0
 
 

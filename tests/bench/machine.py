@@ -19,3 +19,16 @@ def machine() -> str:
     load = " ".join(f"{x:.2f}" for x in os.getloadavg())
     return (f"{os.cpu_count()} cores (at most {threads} threads), {model}, "
             f"{platform.system()} {platform.release()}, load average {load}")
+
+
+def save_figures(path: str, benchmark: str, method: str, **figures) -> None:
+    """A benchmark's figures as JSON for scripts/benchmarks_md.py, with the machine and the date,
+    written atomically (never a half-written file under the final name)."""
+    import json
+    import time
+
+    document = {"benchmark": benchmark, "machine": machine(), "date": time.strftime("%Y-%m-%d"), "method": method,
+                **figures}
+    temporary = pathlib.Path(str(path) + ".tmp")
+    temporary.write_text(json.dumps(document, indent=1) + "\n")
+    temporary.replace(path)

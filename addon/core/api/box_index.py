@@ -22,7 +22,8 @@ class BoxIndex:
 
     def __init__(self, low: np.ndarray, high: np.ndarray):
         self.count = len(low)
-        self.edit_low, self.edit_high, self.edit_rows = [], [], []
+        self.edit_box = np.empty((16, 6))  # per recorded edit: low then high, with room to grow
+        self.edit_rows = []
         if self.count == 0:
             self.cell = 1.0
             return
@@ -39,8 +40,9 @@ class BoxIndex:
 
     def record(self, low: np.ndarray, high: np.ndarray, rows: np.ndarray) -> None:
         """An edit changed or added triangles ``rows``, all with boxes inside [low, high]."""
-        self.edit_low.append(np.asarray(low, dtype=np.float64))
-        self.edit_high.append(np.asarray(high, dtype=np.float64))
+        if len(self.edit_rows) == len(self.edit_box):
+            self.edit_box = np.concatenate([self.edit_box, np.empty_like(self.edit_box)])
+        self.edit_box[len(self.edit_rows)] = np.concatenate([low, high])
         self.edit_rows.append(np.asarray(rows, dtype=np.int64))
 
     def candidates(self, low: np.ndarray, high: np.ndarray, total: int) -> np.ndarray:
@@ -69,7 +71,7 @@ class BoxIndex:
         """The rows of the recorded edits whose boxes meet [low, high]."""
         if not self.edit_rows:
             return np.zeros(0, dtype=np.int64)
-        lows, highs = np.asarray(self.edit_low), np.asarray(self.edit_high)
-        meet = np.flatnonzero(np.all(highs >= low, axis=1) & np.all(lows <= high, axis=1))
+        boxes = self.edit_box[:len(self.edit_rows)]
+        meet = np.flatnonzero(np.all(boxes[:, 3:] >= low, axis=1) & np.all(boxes[:, :3] <= high, axis=1))
         return np.unique(np.concatenate([self.edit_rows[i] for i in meet])) if len(meet) else \
             np.zeros(0, dtype=np.int64)
