@@ -1,0 +1,31 @@
+// Tiny budgets (docs/design.md §2.10): once the collapses reached a result of a few hundred
+// triangles, its free vertices are fitted to the input in a few rounds of least squares, both
+// ways (as Hoppe et al. 1993 fit a mesh to points): the quadrics that placed them sum planes
+// over clusters too large to stand for the surface.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "decimate/collapser.hpp"
+#include "decimate/deviation.hpp"
+
+namespace topstoc {
+
+/// Results with at most this many live triangles are fitted.
+constexpr int32_t kTinyFitFaces = 400;
+
+struct TinyFit {
+  int32_t rounds = 0;        ///< rounds kept (each lowered the error)
+  double before2 = 0.0;      ///< mean squared distance, both ways, before the first round
+  double after2 = 0.0;       ///< and after the last kept one
+};
+
+/// Rounds (at most `rounds`) of: pair each input vertex with its closest point on the result
+/// and each sample of the result (7 per triangle) with its closest point on the input; move the
+/// free vertices to the least-squares fit of those pairs; keep a move only where no triangle
+/// folds or thins (Collapser::try_move), and a round only if the mean squared distance fell and
+/// the largest did not grow.
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, const InputSurface& input, int32_t rounds);
+
+}  // namespace topstoc
