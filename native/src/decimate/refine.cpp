@@ -424,7 +424,7 @@ class Refinement {
   // triangles left moved off, and the result compacted.
   void finish(Collapser& collapser) {
     if (params.refit && !params.attributes.values && collapser.live_faces() <= kTinyFitFaces)
-      fit_tiny(mesh, collapser, InputSurface(mesh, collapser), kTinyFitRounds);
+      fit_tiny(mesh, collapser, kTinyFitRounds);
     if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
     result.issues_remaining.sliver = collapser.zero_area_faces();
     compact(collapser);

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+
+#include "topstoc/distance/bvh.hpp"
 
 namespace topstoc {
 
@@ -9,6 +12,10 @@ namespace {
 
 // Input vertices paired with the result: at most this many (every k-th vertex of a larger input).
 constexpr int64_t kFitPoints = 20000;
+// Input triangles the result's samples are paired with: at most this many (every k-th of a
+// larger input; the gaps are far smaller than a tiny result's deviation, and a search structure
+// over a million triangles cost more than the collapses).
+constexpr int64_t kFitTriangles = 200000;
 // Each unknown is pulled to where it stands with this share of the mean diagonal of the normal
 // equations, so that a vertex few pairs see stays put.
 constexpr double kStay = 1e-3;
@@ -41,8 +48,14 @@ void barycentric(const double* p, const double* a, const double* b, const double
 
 class Fit {
  public:
-  Fit(const Mesh& mesh, Collapser& collapser, const InputSurface& input) : c_(collapser), input_(input) {
+  Fit(const Mesh& mesh, Collapser& collapser) : c_(collapser) {
     const std::vector<int32_t>& triangles = c_.triangles();
+    input_.resize(3 * size_t(mesh.num_vertices()));
+    for (int32_t w = 0; w < mesh.num_vertices(); ++w) c_.normalise(mesh.position(w), &input_[3 * size_t(w)]);
+    const int64_t faces = mesh.num_faces(), step = std::max<int64_t>(1, (faces + kFitTriangles - 1) / kFitTriangles);
+    std::vector<int32_t> some;
+    for (int64_t f = 0; f < faces; f += step) some.insert(some.end(), &mesh.faces()[3 * f], &mesh.faces()[3 * f + 3]);
+    if (!some.empty()) input_bvh_ = std::make_unique<TriangleBvh>(input_.data(), some.data(), int64_t(some.size() / 3));
     // Every k-th input vertex in a triangle (isolated ones are no part of the surface).
     const auto& vfo = mesh.vertex_face_offsets();
     int32_t in_faces = 0;
@@ -59,7 +72,7 @@ class Fit {
     for (size_t i = 0; i < free_.size(); ++i) unknown_[free_[i]] = int32_t(i);
   }
 
-  bool empty() const { return free_.empty() || faces_.empty() || points_.empty(); }
+  bool empty() const { return free_.empty() || faces_.empty() || points_.empty() || !input_bvh_; }
 
   // The pairs of the current result and their weighted mean and largest squared distance.
   struct Error {
@@ -75,7 +88,7 @@ class Fit {
     const double point_weight = 1.0 / double(points_.size());
     int32_t hint = -1;
     for (int32_t w : points_) {
-      const double* p = &input_.positions[3 * size_t(w)];
+      const double* p = &input_[3 * size_t(w)];
       const ClosestHit hit = result.closest(p, hint);
       hint = hit.slot;
       Pair pair{hit.triangle, {}, {p[0], p[1], p[2]}, point_weight};
@@ -91,7 +104,7 @@ class Fit {
         Pair pair{f, {b[0], b[1], b[2]}, {}, area[f] / (7.0 * total)};
         double s[3];
         at(pair, s);
-        const ClosestHit hit = input_.bvh.closest(s, hint);
+        const ClosestHit hit = input_bvh_->closest(s, hint);
         hint = hit.slot;
         for (int i = 0; i < 3; ++i) pair.target[i] = hit.point[i];
         pairs_.push_back(pair);
@@ -205,7 +218,8 @@ class Fit {
   }
 
   Collapser& c_;
-  const InputSurface& input_;
+  std::vector<double> input_;                // normalised input positions
+  std::unique_ptr<TriangleBvh> input_bvh_;  // over (some of) the input's triangles
   std::vector<int32_t> points_;   // the input vertices paired with the result
   std::vector<int32_t> faces_;    // 3 vertex ids per live triangle
   std::vector<int32_t> free_;     // the unknowns' vertices
@@ -216,9 +230,9 @@ class Fit {
 
 }  // namespace
 
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, const InputSurface& input, int32_t rounds) {
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds) {
   TinyFit out;
-  Fit fit(mesh, collapser, input);
+  Fit fit(mesh, collapser);
   if (fit.empty()) return out;
   auto error = fit.pair_up();
   out.before2 = out.after2 = error.mean2;

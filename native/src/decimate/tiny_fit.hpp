@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "decimate/collapser.hpp"
-#include "decimate/deviation.hpp"
+#include "topstoc/core/mesh.hpp"
 
 namespace topstoc {
 
@@ -21,11 +21,12 @@ struct TinyFit {
   double after2 = 0.0;       ///< and after the last kept one
 };
 
-/// Rounds (at most `rounds`) of: pair each input vertex with its closest point on the result
-/// and each sample of the result (7 per triangle) with its closest point on the input; move the
-/// free vertices to the least-squares fit of those pairs; keep a move only where no triangle
-/// folds or thins (Collapser::try_move), and a round only if the mean squared distance fell and
-/// the largest did not grow.
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, const InputSurface& input, int32_t rounds);
+/// Rounds (at most `rounds`) of: pair input vertices (at most 20,000, evenly taken) with their
+/// closest point on the result and 7 points of each result triangle with their closest point
+/// on the input (on at most 200,000 of its triangles, evenly taken); move the free and boundary
+/// vertices to the least-squares fit of those pairs, each only where no triangle folds or thins
+/// (Collapser::try_move); keep a round only if the mean squared distance fell and the largest
+/// did not grow.
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds);
 
 }  // namespace topstoc
