@@ -14,6 +14,7 @@ import meshgen
 from threads import outputs_by_thread_count
 from reference import read_off
 import topstoc
+from topstoc.core.api.error_estimate import EXACT_GAP
 from topstoc.core.support.native import engine
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -292,12 +293,13 @@ def test_error_bounded_decimation_meets_the_bound_with_a_minimal_count(data_dir,
     check = topstoc.hausdorff(mesh, result, samples=200_000, percentile=0)
     assert check.symmetric.max <= report.achieved_error * (1 + 1e-12) <= absolute * (1 + 1e-12)
     # minimal within the resolution: the target just below was measured above the bound (an
-    # attained distance, so the exact maximum exceeds the bound too)
+    # attained distance, so the exact maximum exceeds the bound too), or within the exact
+    # check's gap of it, which decide_error counts as above
     assert 0 < report.target_vertices - report.failed_target <= report.resolution
     assert report.resolution == max(1, int(0.01 * report.target_vertices))
     below = mesh.decimate(target_vertices=report.failed_target, seed=5)
     again = topstoc.hausdorff(mesh, below, samples=200_000, percentile=0)
-    assert report.failed_error > absolute
+    assert report.failed_error > absolute * (1 - EXACT_GAP)
     assert again.symmetric.max_upper >= report.failed_error * (1 - 1e-12)
 
 

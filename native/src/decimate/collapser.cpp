@@ -807,14 +807,19 @@ int32_t Collapser::refit(const std::vector<double>& radius2) {
     better[v] = q.error(x) < q.error(p);
   });
   int32_t moved = 0;
-  for (int32_t v = 0; v < n; ++v) {
-    ShapeFloor floor{v, -1};
-    if (better[v] && keeps_shape(v, -1, &goal[3 * size_t(v)], floor)) {
-      move_to(v, &goal[3 * size_t(v)]);
-      ++moved;
-    }
-  }
+  for (int32_t v = 0; v < n; ++v) moved += better[v] && try_move(v, &goal[3 * size_t(v)]);
   return moved;
+}
+
+bool Collapser::try_move(int32_t v, const double* x) {
+  ShapeFloor floor{v, -1};
+  if (!keeps_shape(v, -1, x, floor)) return false;
+  move_to(v, x);
+  return true;
+}
+
+void Collapser::restore(int32_t v, const double* position, const double* world) {
+  for (int i = 0; i < 3; ++i) s_.positions[3 * size_t(v) + i] = position[i], s_.world[3 * size_t(v) + i] = world[i];
 }
 
 }  // namespace topstoc

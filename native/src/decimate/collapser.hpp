@@ -38,6 +38,7 @@ struct CollapseSetup {
   std::vector<int32_t> curve;         ///< feature curve of the vertex (it moves only along it), or -1
   std::vector<int32_t> curve_size;    ///< per curve: its vertices
   std::vector<uint8_t> curve_closed;  ///< per curve
+  std::vector<uint8_t> on_boundary;   ///< per vertex: on a mesh boundary's curve, one sector (a fit may move it)
   std::vector<int32_t> corner_sector; ///< per corner: the sector (side of the borders) of its vertex
   std::vector<int32_t> bin, quota;    ///< per vertex its guidance bin; per bin the vertices to keep
   bool optimal_placement = true;      ///< off: every collapse is a half-edge collapse
@@ -61,6 +62,15 @@ class Collapser {
   /// most radius2[v] (squared, normalised) away, where no triangle folds or becomes a sliver.
   int32_t refit(const std::vector<double>& radius2);
 
+  /// Moves free vertex v to x (normalised) when no triangle around it folds, loses area or
+  /// becomes a sliver; false (nothing moved) otherwise.
+  bool try_move(int32_t v, const double* x);
+  /// Puts v back where it was (normalised and caller's coordinates, as read before a move).
+  void restore(int32_t v, const double* position, const double* world);
+
+  int32_t live_faces() const { return alive_faces_; }
+  /// The triangles as the collapses renamed them (dead ones included: see face_alive).
+  const std::vector<int32_t>& triangles() const { return tri_; }
   int32_t zero_area_faces() const;
   std::vector<int32_t> zero_area_face_list() const;
   /// Moves v to the input position `world` when no triangle around it folds, loses area or
@@ -73,6 +83,8 @@ class Collapser {
   const double* world(int32_t v) const { return &s_.world[3 * size_t(v)]; }
   const double* position(int32_t v) const { return &s_.positions[3 * size_t(v)]; }
   bool is_free(int32_t v) const { return s_.curve[v] < 0 && !s_.locked[v]; }
+  /// Free, or an unlocked vertex of a mesh boundary (which has no other side to keep).
+  bool fittable(int32_t v) const { return is_free(v) || (!s_.locked[v] && !s_.on_boundary.empty() && s_.on_boundary[v]); }
   int32_t vertices() const { return static_cast<int32_t>(merged_into_.size()); }
   /// The caller's coordinates in the normalised ones of position().
   void normalise(const double* world, double* out) const {

@@ -10,6 +10,7 @@
 
 #include "decimate/collapser.hpp"
 #include "decimate/deviation.hpp"
+#include "decimate/tiny_fit.hpp"
 #include "topstoc/core/parallel.hpp"
 
 namespace topstoc {
@@ -18,6 +19,8 @@ namespace {
 
 // Slivers (shape quality below this, see Collapser) the stochastic pass left are collapsed first.
 constexpr double kSliverShape = 0.1;
+// Rounds of the least-squares fit of a tiny result (tiny_fit.hpp).
+constexpr int32_t kTinyFitRounds = 4;
 // Max-aware second run: a vertex's cost weight is 1 + this times its first-run deviation over
 // the largest (squared distances), so the worst region's collapses cost a hundred times more.
 constexpr double kDeviationWeight = 100.0;
@@ -347,12 +350,15 @@ class Refinement {
     setup.curve.assign(n, -1);
     setup.curve_size.assign(layout.num_curves(), 0);
     setup.curve_closed = layout.curve_closed;
+    setup.on_boundary.assign(n, 0);
     setup.bin.resize(n);
     for (int32_t i = 0; i < n; ++i) {
       const int32_t v = index[result.kept[i]];
       const double m = multiplier(v);
       if (layout.vertex_feature[v]) setup.curve[i] = layout.vertex_curve[v];
       if (setup.curve[i] >= 0) ++setup.curve_size[setup.curve[i]];
+      // A curve vertex with one sector lies on a mesh boundary (a seam or crease has two).
+      setup.on_boundary[i] = setup.curve[i] >= 0 && layout.sectors[v] == 1;
       setup.locked[i] = layout.vertex_corner[v] || (layout.vertex_feature[v] && setup.curve[i] < 0) || m == kForcedMultiplier;
       if (m == kForcedMultiplier)  // a control point stays where the user put it
         for (int k = 0; k < 3; ++k) setup.world[3 * size_t(i) + k] = mesh.position(v)[k];
@@ -413,8 +419,12 @@ class Refinement {
     finish(first);
   }
 
-  // The zero-area triangles left moved off, and the result compacted.
+  // A tiny result fitted to the input (after the max-aware choice, which compares the
+  // collapses' own results; not with attributes, which the fit does not weigh), the zero-area
+  // triangles left moved off, and the result compacted.
   void finish(Collapser& collapser) {
+    if (params.refit && !params.attributes.values && collapser.live_faces() <= kTinyFitFaces)
+      fit_tiny(mesh, collapser, kTinyFitRounds);
     if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
     result.issues_remaining.sliver = collapser.zero_area_faces();
     compact(collapser);

@@ -1,0 +1,254 @@
+#include "decimate/tiny_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "topstoc/distance/bvh.hpp"
+
+namespace topstoc {
+
+namespace {
+
+// Input vertices paired with the result: at most this many (every k-th vertex of a larger input).
+constexpr int64_t kFitPoints = 20000;
+// Input triangles the result's samples are paired with: at most this many (every k-th of a
+// larger input; the gaps are far smaller than a tiny result's deviation, and a search structure
+// over a million triangles cost more than the collapses).
+constexpr int64_t kFitTriangles = 200000;
+// Each unknown is pulled to where it stands with this share of the mean diagonal of the normal
+// equations, so that a vertex few pairs see stays put.
+constexpr double kStay = 1e-3;
+// Samples of each result triangle paired with the input, as barycentric weights.
+constexpr double kSamples[7][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.5, 0.5, 0.0}, {0.0, 0.5, 0.5}, {0.5, 0.0, 0.5},
+                                   {0.6, 0.2, 0.2},             {0.2, 0.6, 0.2}, {0.2, 0.2, 0.6}};
+
+// A point of the result, sum of b[j] times corner j of `face`, and where it should be.
+struct Pair {
+  int32_t face;
+  double b[3], target[3], weight;
+};
+
+// Barycentric weights of p (a point of triangle a, b, c) in it; a degenerate triangle gives
+// its first corner.
+void barycentric(const double* p, const double* a, const double* b, const double* c, double* w) {
+  double e0[3], e1[3], d[3];
+  for (int i = 0; i < 3; ++i) e0[i] = b[i] - a[i], e1[i] = c[i] - a[i], d[i] = p[i] - a[i];
+  auto dot = [](const double* x, const double* y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
+  const double d00 = dot(e0, e0), d01 = dot(e0, e1), d11 = dot(e1, e1), d20 = dot(d, e0), d21 = dot(d, e1);
+  const double det = d00 * d11 - d01 * d01;
+  if (!(det > 0)) {
+    w[0] = 1.0, w[1] = w[2] = 0.0;
+    return;
+  }
+  w[1] = std::clamp((d11 * d20 - d01 * d21) / det, 0.0, 1.0);
+  w[2] = std::clamp((d00 * d21 - d01 * d20) / det, 0.0, 1.0 - w[1]);
+  w[0] = 1.0 - w[1] - w[2];
+}
+
+class Fit {
+ public:
+  Fit(const Mesh& mesh, Collapser& collapser) : c_(collapser) {
+    const std::vector<int32_t>& triangles = c_.triangles();
+    input_.resize(3 * size_t(mesh.num_vertices()));
+    for (int32_t w = 0; w < mesh.num_vertices(); ++w) c_.normalise(mesh.position(w), &input_[3 * size_t(w)]);
+    const int64_t faces = mesh.num_faces(), step = std::max<int64_t>(1, (faces + kFitTriangles - 1) / kFitTriangles);
+    std::vector<int32_t> some;
+    for (int64_t f = 0; f < faces; f += step) some.insert(some.end(), &mesh.faces()[3 * f], &mesh.faces()[3 * f + 3]);
+    if (!some.empty()) input_bvh_ = std::make_unique<TriangleBvh>(input_.data(), some.data(), int64_t(some.size() / 3));
+    // Every k-th input vertex in a triangle (isolated ones are no part of the surface).
+    const auto& vfo = mesh.vertex_face_offsets();
+    int32_t in_faces = 0;
+    for (int32_t w = 0; w < mesh.num_vertices(); ++w) in_faces += vfo[w] < vfo[w + 1];
+    const int32_t stride = int32_t(std::max<int64_t>(1, (in_faces + kFitPoints - 1) / kFitPoints));
+    for (int32_t w = 0, seen = 0; w < mesh.num_vertices(); ++w)
+      if (vfo[w] < vfo[w + 1] && seen++ % stride == 0) points_.push_back(w);
+    for (int32_t t = 0; t < int32_t(triangles.size() / 3); ++t)
+      if (c_.face_alive(t)) faces_.insert(faces_.end(), &triangles[3 * size_t(t)], &triangles[3 * size_t(t) + 3]);
+    unknown_.assign(c_.vertices(), -1);
+    for (int32_t v : faces_)
+      if (c_.fittable(v) && unknown_[v] < 0) unknown_[v] = int32_t(free_.size()), free_.push_back(v);
+    std::sort(free_.begin(), free_.end());  // vertex order: moves are tried in it
+    for (size_t i = 0; i < free_.size(); ++i) unknown_[free_[i]] = int32_t(i);
+  }
+
+  bool empty() const { return free_.empty() || faces_.empty() || points_.empty() || !input_bvh_; }
+
+  // The pairs of the current result and their weighted mean and largest squared distance.
+  struct Error {
+    double mean2 = 0.0, top2 = 0.0;
+  };
+  Error pair_up() {
+    pairs_.clear();
+    std::vector<double> positions(3 * size_t(c_.vertices()));
+    for (int32_t v : faces_)
+      for (int i = 0; i < 3; ++i) positions[3 * size_t(v) + i] = c_.position(v)[i];
+    const int32_t m = int32_t(faces_.size() / 3);
+    const TriangleBvh result(positions.data(), faces_.data(), m);
+    const double point_weight = 1.0 / double(points_.size());
+    int32_t hint = -1;
+    for (int32_t w : points_) {
+      const double* p = &input_[3 * size_t(w)];
+      const ClosestHit hit = result.closest(p, hint);
+      hint = hit.slot;
+      Pair pair{hit.triangle, {}, {p[0], p[1], p[2]}, point_weight};
+      barycentric(hit.point, corner(hit.triangle, 0), corner(hit.triangle, 1), corner(hit.triangle, 2), pair.b);
+      pairs_.push_back(pair);
+    }
+    std::vector<double> area(m);
+    double total = 0.0;
+    for (int32_t f = 0; f < m; ++f) total += area[f] = twice_area(f);
+    hint = -1;
+    for (int32_t f = 0; f < m && total > 0; ++f)
+      for (const auto& b : kSamples) {
+        Pair pair{f, {b[0], b[1], b[2]}, {}, area[f] / (7.0 * total)};
+        double s[3];
+        at(pair, s);
+        const ClosestHit hit = input_bvh_->closest(s, hint);
+        hint = hit.slot;
+        for (int i = 0; i < 3; ++i) pair.target[i] = hit.point[i];
+        pairs_.push_back(pair);
+      }
+    Error error;
+    for (const Pair& pair : pairs_) {
+      const double d2 = distance2(pair);
+      error.mean2 += pair.weight * d2;
+      error.top2 = std::max(error.top2, d2);
+    }
+    return error;
+  }
+
+  // The least-squares positions of the free vertices for the current pairs; false when the
+  // normal equations are singular.
+  bool solve(std::vector<double>& x) const {
+    const size_t k = free_.size();
+    std::vector<double> a(k * k, 0.0), rhs(3 * k, 0.0);
+    for (const Pair& pair : pairs_) {
+      const int32_t* c = &faces_[3 * size_t(pair.face)];
+      double fixed[3] = {pair.target[0], pair.target[1], pair.target[2]};
+      for (int j = 0; j < 3; ++j)
+        if (unknown_[c[j]] < 0)
+          for (int i = 0; i < 3; ++i) fixed[i] -= pair.b[j] * c_.position(c[j])[i];
+      for (int j = 0; j < 3; ++j) {
+        const int32_t r = unknown_[c[j]];
+        if (r < 0 || pair.b[j] == 0.0) continue;
+        for (int l = 0; l < 3; ++l)
+          if (unknown_[c[l]] >= 0) a[size_t(r) * k + size_t(unknown_[c[l]])] += pair.weight * pair.b[j] * pair.b[l];
+        for (int i = 0; i < 3; ++i) rhs[3 * size_t(r) + i] += pair.weight * pair.b[j] * fixed[i];
+      }
+    }
+    double trace = 0.0;
+    for (size_t r = 0; r < k; ++r) trace += a[r * k + r];
+    const double stay = kStay * trace / double(k);
+    if (!(stay > 0)) return false;
+    for (size_t r = 0; r < k; ++r) {
+      a[r * k + r] += stay;
+      for (int i = 0; i < 3; ++i) rhs[3 * r + i] += stay * c_.position(free_[r])[i];
+    }
+    return cholesky_solve(a, k, rhs, x);
+  }
+
+  // Moves each free vertex to x where its triangles allow it; returns the old states.
+  int32_t apply(const std::vector<double>& x) {
+    saved_.clear();
+    int32_t moved = 0;
+    for (size_t r = 0; r < free_.size(); ++r) {
+      const int32_t v = free_[r];
+      Saved s{v, {}, {}};
+      for (int i = 0; i < 3; ++i) s.position[i] = c_.position(v)[i], s.world[i] = c_.world(v)[i];
+      if (c_.try_move(v, &x[3 * r])) saved_.push_back(s), ++moved;
+    }
+    return moved;
+  }
+
+  void undo() {
+    for (auto it = saved_.rbegin(); it != saved_.rend(); ++it) c_.restore(it->v, it->position, it->world);
+  }
+
+ private:
+  struct Saved {
+    int32_t v;
+    double position[3], world[3];
+  };
+  const double* corner(int32_t f, int j) const { return c_.position(faces_[3 * size_t(f) + j]); }
+  double twice_area(int32_t f) const {
+    const double *a = corner(f, 0), *b = corner(f, 1), *c = corner(f, 2);
+    double u[3], w[3];
+    for (int i = 0; i < 3; ++i) u[i] = b[i] - a[i], w[i] = c[i] - a[i];
+    const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    return std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  }
+  void at(const Pair& pair, double* s) const {
+    for (int i = 0; i < 3; ++i)
+      s[i] = pair.b[0] * corner(pair.face, 0)[i] + pair.b[1] * corner(pair.face, 1)[i] + pair.b[2] * corner(pair.face, 2)[i];
+  }
+  double distance2(const Pair& pair) const {
+    double s[3];
+    at(pair, s);
+    return (s[0] - pair.target[0]) * (s[0] - pair.target[0]) + (s[1] - pair.target[1]) * (s[1] - pair.target[1]) +
+           (s[2] - pair.target[2]) * (s[2] - pair.target[2]);
+  }
+  // Solves A X = B for a symmetric positive definite A (k by k) and three right-hand sides.
+  static bool cholesky_solve(std::vector<double>& a, size_t k, const std::vector<double>& b, std::vector<double>& x) {
+    for (size_t j = 0; j < k; ++j) {
+      double d = a[j * k + j];
+      for (size_t l = 0; l < j; ++l) d -= a[j * k + l] * a[j * k + l];
+      if (!(d > 0)) return false;
+      a[j * k + j] = std::sqrt(d);
+      for (size_t r = j + 1; r < k; ++r) {
+        double s = a[r * k + j];
+        for (size_t l = 0; l < j; ++l) s -= a[r * k + l] * a[j * k + l];
+        a[r * k + j] = s / a[j * k + j];
+      }
+    }
+    x = b;
+    for (int i = 0; i < 3; ++i) {
+      for (size_t r = 0; r < k; ++r) {  // L y = b
+        double s = x[3 * r + i];
+        for (size_t l = 0; l < r; ++l) s -= a[r * k + l] * x[3 * l + i];
+        x[3 * r + i] = s / a[r * k + r];
+      }
+      for (size_t r = k; r-- > 0;) {  // Lᵀ x = y
+        double s = x[3 * r + i];
+        for (size_t l = r + 1; l < k; ++l) s -= a[l * k + r] * x[3 * l + i];
+        x[3 * r + i] = s / a[r * k + r];
+      }
+    }
+    return true;
+  }
+
+  Collapser& c_;
+  std::vector<double> input_;                // normalised input positions
+  std::unique_ptr<TriangleBvh> input_bvh_;  // over (some of) the input's triangles
+  std::vector<int32_t> points_;   // the input vertices paired with the result
+  std::vector<int32_t> faces_;    // 3 vertex ids per live triangle
+  std::vector<int32_t> free_;     // the unknowns' vertices
+  std::vector<int32_t> unknown_;  // per vertex: its unknown, or -1 (fixed)
+  std::vector<Pair> pairs_;
+  std::vector<Saved> saved_;
+};
+
+}  // namespace
+
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds) {
+  TinyFit out;
+  Fit fit(mesh, collapser);
+  if (fit.empty()) return out;
+  auto error = fit.pair_up();
+  out.before2 = out.after2 = error.mean2;
+  std::vector<double> x;
+  for (int32_t round = 0; round < rounds; ++round) {
+    if (!fit.solve(x) || fit.apply(x) == 0) break;
+    const auto next = fit.pair_up();
+    if (!(next.mean2 < error.mean2) || next.top2 > error.top2) {
+      fit.undo();
+      break;
+    }
+    error = next;
+    out.after2 = error.mean2;
+    ++out.rounds;
+  }
+  return out;
+}
+
+}  // namespace topstoc

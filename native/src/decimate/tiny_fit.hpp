@@ -1,0 +1,32 @@
+// Tiny budgets (docs/design.md §2.10): once the collapses reached a result of a few hundred
+// triangles, its free vertices are fitted to the input in a few rounds of least squares, both
+// ways (as Hoppe et al. 1993 fit a mesh to points): the quadrics that placed them sum planes
+// over clusters too large to stand for the surface.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "decimate/collapser.hpp"
+#include "topstoc/core/mesh.hpp"
+
+namespace topstoc {
+
+/// Results with at most this many live triangles are fitted.
+constexpr int32_t kTinyFitFaces = 400;
+
+struct TinyFit {
+  int32_t rounds = 0;        ///< rounds kept (each lowered the error)
+  double before2 = 0.0;      ///< mean squared distance, both ways, before the first round
+  double after2 = 0.0;       ///< and after the last kept one
+};
+
+/// Rounds (at most `rounds`) of: pair input vertices (at most 20,000, evenly taken) with their
+/// closest point on the result and 7 points of each result triangle with their closest point
+/// on the input (on at most 200,000 of its triangles, evenly taken); move the free and boundary
+/// vertices to the least-squares fit of those pairs, each only where no triangle folds or thins
+/// (Collapser::try_move); keep a round only if the mean squared distance fell and the largest
+/// did not grow.
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds);
+
+}  // namespace topstoc

@@ -1,0 +1,74 @@
+"""Tiny budgets: a quality result of at most 400 triangles is fitted to the input by least
+squares both ways (native/src/decimate/tiny_fit.cpp, docs/design.md §2.10).
+
+Errors are measured by topstoc.hausdorff (checked against CGAL in test_hausdorff_peers.py) and
+compared with meshoptimizer's quadric simplification at the same triangle count; the boundary
+check measures the result's boundary against the input's boundary polyline in numpy.
+"""
+
+import numpy as np
+import pytest
+
+import topstoc
+from peer_runs import meshopt_simplify, peer, read_off
+from reference import invariants
+
+
+def _boundary_edges(triangles):
+    t = np.asarray(triangles)
+    edges = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    unique, count = np.unique(edges, axis=0, return_counts=True)
+    return unique[count == 1]
+
+
+def _distance_to_segments(points, a, b):
+    """Distance from each point to the nearest of the segments a[i]-b[i]."""
+    d = b - a
+    length2 = np.einsum("ij,ij->i", d, d)
+    t = np.einsum("pij,ij->pi", points[:, None, :] - a[None], d) / np.where(length2 > 0, length2, 1.0)[None]
+    closest = a[None] + np.clip(t, 0.0, 1.0)[..., None] * d[None]
+    return np.sqrt(((points[:, None, :] - closest) ** 2).sum(axis=2)).min(axis=1)
+
+
+@pytest.mark.parametrize("name, target", [("genus0/cgal_fandisk.off", 25), ("open_boundary/cgal_mushroom.off", 50)])
+def test_tiny_budget_beats_meshopt_mean_and_max(data_dir, tmp_path, name, target):
+    if peer("meshopt_simplify") is None:
+        pytest.skip("peer program meshopt_simplify was not built (libmeshoptimizer-dev)")
+    source = data_dir / name
+    vertices, triangles = read_off(source)
+    ours = topstoc.Mesh(vertices, triangles).decimate(target_triangles=target, seed=0)
+    assert abs(len(ours.triangles) - target) <= 1
+    assert ours.stats.topology_kept
+    assert invariants(len(ours.vertices), ours.triangles) == invariants(len(vertices), triangles)
+    theirs_path = tmp_path / "meshopt.off"
+    meshopt_simplify(source, theirs_path, 3 * len(ours.triangles))
+    theirs = read_off(theirs_path)
+    assert len(theirs[1]) <= len(ours.triangles)
+    ours_error = topstoc.hausdorff((vertices, triangles), (ours.vertices, ours.triangles), samples=200_000)
+    theirs_error = topstoc.hausdorff((vertices, triangles), theirs, samples=200_000)
+    # Before the fit, fandisk at 25 triangles had mean 1.60 % and max 9.6 % of the diagonal
+    # against meshopt's 1.46 % and 8.6 %; with it 1.28 % and 7.0 %.
+    assert ours_error.symmetric.mean < 0.95 * theirs_error.symmetric.mean
+    assert ours_error.symmetric.max < theirs_error.symmetric.max
+
+
+@pytest.mark.parametrize("target", [25, 50, 100])
+def test_tiny_fit_keeps_boundaries_near_the_input_boundary(data_dir, target):
+    # The fit moves boundary vertices too (a mesh boundary has one side, nothing to keep exact
+    # across it): the result's boundary must stay as near the input's boundary polyline as the
+    # surface stays near the input, and keep its loops.
+    vertices, triangles = read_off(data_dir / "open_boundary/cgal_mushroom.off")
+    vertices = np.asarray(vertices, dtype=float)
+    result = topstoc.Mesh(vertices, triangles).decimate(target_triangles=target, seed=0)
+    assert result.stats.topology_kept
+    assert invariants(len(result.vertices), result.triangles) == invariants(len(vertices), triangles)
+    source_edges, result_edges = _boundary_edges(triangles), _boundary_edges(result.triangles)
+    out = np.asarray(result.vertices, dtype=float)
+    s = np.linspace(0.0, 1.0, 9)[None, :, None]
+    points = (out[result_edges[:, 0]][:, None] * (1 - s) + out[result_edges[:, 1]][:, None] * s).reshape(-1, 3)
+    boundary = _distance_to_segments(points, vertices[source_edges[:, 0]], vertices[source_edges[:, 1]]).max()
+    surface = topstoc.hausdorff((vertices, triangles), (result.vertices, result.triangles), samples=100_000)
+    assert boundary <= surface.symmetric.max
+    zero = np.linalg.norm(np.cross(out[result.triangles[:, 1]] - out[result.triangles[:, 0]],
+                                   out[result.triangles[:, 2]] - out[result.triangles[:, 0]]), axis=1) == 0
+    assert not zero.any()
