@@ -2,9 +2,11 @@
 
 The main thread reads every object first (``pipeline.read_input``: Blender data can only be
 read there) and writes the results at the end; the worker prepares and decimates, saying how far
-it got. ``cancel`` stops the engine at its next step while it prepares a mesh or searches an
-error target; a plain decimation already running cannot be stopped and ends unseen. Nothing in
-the scene changes before the caller writes, so a cancelled job leaves every object as it was.
+it got, and finds where moved vertices take their attributes from (numpy and engine work the
+write would otherwise do on the main thread). ``cancel`` stops the engine at its next step
+while it prepares a mesh or searches an error target; a plain decimation already running cannot
+be stopped and ends unseen. Nothing in the scene changes before the caller writes, so a
+cancelled job leaves every object as it was.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ import threading
 import time
 
 from ...core.api.loops import Cancelled
+from ...core.carry.attributes import moved_vertices
 from ...core.support.errors import TopStocError
 from . import pipeline
 
@@ -47,6 +50,8 @@ class BackgroundDecimation:
         for index, read in enumerate(self.reads):
             try:
                 run = pipeline.decimate_read(read, self._preparing(index), self._searching(index))
+                self._state = (index, 1.0, "finding the sources of moved vertices")
+                run.moved = moved_vertices(read.arrays.vertices, read.arrays.triangles, run.result)  # not at the write
                 outcome = (run, None)
             except Cancelled:
                 return
