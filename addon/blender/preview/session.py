@@ -323,9 +323,11 @@ class PreviewSession:
 
     def _stagger(self) -> None:
         """Spreads the workers' starts over one computation's time, so that their results
-        arrive evenly instead of in pairs (and each starts from a newer request)."""
+        arrive evenly instead of in pairs (and each starts from a newer request). A rested
+        drag's request starts at once."""
         with self._lock:
-            if self._workers < 2 or not self._typical:
+            resting = self._pending is not None and self._pending[1] and not self.direct
+            if self._workers < 2 or not self._typical or resting:
                 return
             wait = self._typical / WORKERS - (time.perf_counter() - self._last_start)
         if wait > 0:
