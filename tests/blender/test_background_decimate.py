@@ -38,10 +38,13 @@ def test_the_worker_gives_the_operators_results(ts, donuts, settings):
     job = background(ts).BackgroundDecimation(reads_of(ts, donuts, **settings))
     assert job.wait(120) and job.progress()[0] == 1.0
     assert [failure for _run, failure in job.outcomes] == [None, None]
-    for (run, _failure), obj in zip(job.outcomes, donuts):
+    for (run, _failure), obj, read in zip(job.outcomes, donuts, job.reads):
         assert run.obj == obj
         expected = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(**settings)).result
         assert_same_result(run.result, expected)
+        vertices, kept = np.asarray(run.result.vertices), np.asarray(run.result.kept)
+        moved = np.flatnonzero(np.any(vertices != read.arrays.vertices[kept], axis=1))
+        np.testing.assert_array_equal(run.moved.moved, moved)  # found on the worker, for the write
         if "max_error" in settings:  # the search ran, and reported each probe
             assert run.result.error_bound is not None and len(run.result.error_bound.probes) > 1
 
