@@ -165,7 +165,7 @@ def rested_quality(obj, ratio, drag_seconds=1.0, event_interval=0.01):
     """Seconds from the drag resting (the last ratio requested) to the rested Quality result on
     screen, the way the modal runs it (requests every 10 ms over [ratio / 1.5, ratio], then
     polling at the modal timer's 60 Hz), and the seconds of that Quality computation itself."""
-    session = ts.blender.preview.PreviewSession(bpy.context, obj, Params(ratio, quality="QUALITY"), ratio=ratio)
+    session = ts.blender.preview.session.PreviewSession(bpy.context, obj, Params(ratio, quality="QUALITY"), ratio=ratio)
     session.wait_prepared()
     sweep = np.geomspace(ratio / 1.5, ratio, 40)
     start, i = time.perf_counter(), 0
@@ -224,6 +224,27 @@ def applied(session, ratio):
     return time.perf_counter() - start, busy, out
 
 
+def print_rest(ratio, rests):
+    rest, computed = (statistics.median(r[i] for r in rests) for i in range(2))
+    print(f"  ratio {ratio}: Live Preview, drag rested -> Quality result shown: {rest:.3f} s (its computation "
+          f"{computed:.3f} s; medians of {len(rests)}, max {max(r[0] for r in rests):.3f} s; goal <= 0.3 s up to "
+          f"200k triangles, <= 1 s on the horse)")
+
+
+def subdivided(vertices, triangles):
+    """Every triangle split in four at its edges' midpoints (a bigger mesh of the same shape)."""
+    triangles = np.asarray(triangles, dtype=np.int64)
+    edges = np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]]), axis=1)
+    unique, index = np.unique(edges, axis=0, return_inverse=True)
+    index = index.ravel() + len(vertices)
+    count = len(triangles)
+    a, b, c = index[:count], index[count:2 * count], index[2 * count:]
+    t0, t1, t2 = triangles.T
+    split = np.concatenate([np.stack(corners, axis=1) for corners in ((t0, a, c), (t1, b, a), (t2, c, b), (a, b, c))])
+    midpoints = (vertices[unique[:, 0]] + vertices[unique[:, 1]]) / 2
+    return np.concatenate([vertices, midpoints]), split.astype(np.int32)
+
+
 def modifier_apply(obj, ratio):
     copy = obj.copy()
     copy.data = obj.data.copy()
@@ -250,6 +271,8 @@ def main(argv):
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--updates", type=int, default=20)
     parser.add_argument("--modifier-repeat", type=int, default=1)
+    parser.add_argument("--only-rest", action="store_true", help="measure only the rested Quality result")
+    parser.add_argument("--subdivide", type=int, default=0, help="split every triangle in four this many times")
     args = parser.parse_args(argv)
     if not os.path.exists(args.mesh):
         print(f"skipped: {args.mesh} is not available")
@@ -264,9 +287,14 @@ def main(argv):
         vertices, triangles = data.vertices, data.triangles
     except ImportError:
         vertices, triangles = read_binary_ply(args.mesh)
+    for _ in range(args.subdivide):
+        vertices, triangles = subdivided(vertices, triangles)
     obj = make_object("Horse", vertices, triangles)
     print(f"mesh: {args.mesh} ({len(vertices):,} vertices, {len(triangles):,} triangles)")
     for ratio in args.ratios:
+        if args.only_rest:
+            print_rest(ratio, [rested_quality(obj, ratio) for _ in range(args.repeat)])
+            continue
         firsts = []
         for _ in range(args.repeat):
             seconds, ours = topstoc_first_result(obj, ratio)
@@ -303,9 +331,7 @@ def main(argv):
         print(f"  Live Preview Enter (Quality): before {before:.3f} s on the main thread (decimate again + write); "
               f"now {rested:.3f} s for a rested result (write only, {before / rested:.1f}x less), during a drag "
               f"{dragged:.3f} s until written with {busy:.3f} s of it on the main thread (medians of {len(applies)})")
-        rest, computed = (statistics.median(r[i] for r in rests) for i in range(2))
-        print(f"  Live Preview, drag rested -> Quality result shown: {rest:.3f} s (its computation {computed:.3f} s; "
-              f"medians of {len(rests)}; goal <= 0.3 s up to 200k triangles, <= 1 s on the horse)")
+        print_rest(ratio, rests)
         if modifier:
             mod_seconds = statistics.median(s for s, _ in modifier)
             print(f"  Blender Decimate modifier (Collapse) apply {mod_seconds:8.3f} s (median of "

@@ -28,7 +28,7 @@ from ...core.support.errors import TopStocError
 from ...core.api.job import ATTRIBUTE_WEIGHT, DecimationJob, make_job
 from ..io import mesh_read, mesh_write, mesh_attributes, carry
 from ..preview.cache import Prepared, prepared_meshes
-from .guidance import EngineGuidance, gather, guidance_layers
+from .guidance import EngineGuidance, gather, guidance_layers, read as read_guidance
 
 LAST_SAMPLES = "Last"
 
@@ -112,9 +112,10 @@ def engine_job(mesh, target: dict, options: dict, guidance: EngineGuidance) -> D
                     **look_kwargs(options, guidance.appearance))
 
 
-def run_engine(mesh, job: DecimationJob):
-    """One engine decimation of a job (every add-on decimation passes here)."""
-    return run_job(mesh, job)
+def run_engine(mesh, job: DecimationJob, progress=None):
+    """One engine decimation of a job (every add-on decimation passes here); progress: an error
+    target's search (core.api.decimate.run_job)."""
+    return run_job(mesh, job, progress)
 
 
 def input_triangles(mesh) -> int:
@@ -169,17 +170,49 @@ def prepare_arrays(obj_name: str, mesh_name: str, arrays: mesh_read.MeshArrays, 
 def decimate(context, obj, panel, *, target: dict = None, region_3d=None) -> Run:
     """Decimates ``obj`` with the scene's guidance and a panel's settings (nothing written);
     ``target`` replaces the panel's."""
-    start = time.perf_counter()
-    prepared = prepare(obj)
-    guidance = gather(obj, prepared.arrays, context.scene, None, region_3d)
-    target = target if target is not None else target_kwargs(panel)
-    options = decimate_options(panel)
+    return decimate_read(read_input(context, obj, panel, target=target, region_3d=region_3d))
+
+
+@dataclass
+class Input:
+    """What one decimation of an object needs from Blender, read on the main thread."""
+
+    obj: bpy.types.Object
+    arrays: mesh_read.MeshArrays
+    read_guidance: object     #: guidance.read's function: the engine guidance (any thread)
+    target: dict
+    options: dict
+    settings: dict
+    started: float            #: when the read began (a Run's seconds count from it)
+
+
+def read_input(context, obj, panel, *, target: dict = None, region_3d=None) -> Input:
+    """Reads ``obj``'s mesh, guidance sources and a panel's settings (main thread: Blender data);
+    ``target`` replaces the panel's. Unusable meshes and guidance raise here."""
+    started = time.perf_counter()
+    check_decimatable(obj)
+    arrays = mesh_read.read_mesh(obj.data)
+    reader = read_guidance(obj, arrays, context.scene, None, region_3d)
+    return Input(obj, arrays, reader, target if target is not None else target_kwargs(panel),
+                 decimate_options(panel), settings_of(panel), started)
+
+
+def decimate_read(read: Input, prepare_progress=None, progress=None) -> Run:
+    """Prepares (cached) and decimates what ``read_input`` read; reads no Blender data (any thread).
+    prepare_progress: the preparation's ``(fraction, stage)``, progress: an error target's search
+    ``(probe, target, vertices, error, passed)``; either returning False raises ``Cancelled``."""
+    obj_name = read.obj.name
+    prepared = prepare_arrays(obj_name, read.obj.data.name_full, read.arrays, prepare_progress)
+    if prepare_progress is not None:  # also when the cache held it: the decimation starts
+        prepare_progress(1.0, "prepared")
+    guidance = read.read_guidance()
     try:
-        result = run_engine(prepared.mesh, engine_job(prepared.mesh, target, options, guidance))
+        job = engine_job(prepared.mesh, read.target, read.options, guidance)
+        result = run_engine(prepared.mesh, job) if progress is None else run_engine(prepared.mesh, job, progress)
     except ValueError as error:
-        raise DecimationError(f"'{obj.name}': {error}") from None
-    return make_run(obj, prepared, guidance, result, target, options, time.perf_counter() - start,
-                    settings_of(panel))
+        raise DecimationError(f"'{obj_name}': {error}") from None
+    return make_run(read.obj, prepared, guidance, result, read.target, read.options,
+                    time.perf_counter() - read.started, read.settings)
 
 
 def make_run(obj, prepared: Prepared, guidance: EngineGuidance, result, target: dict, options: dict,

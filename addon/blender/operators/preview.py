@@ -5,7 +5,7 @@ returns; the preview session fingerprints, prepares (when the mesh is not cached
 on a worker thread while the header and status bar show the preparation's progress with a wait
 cursor. Esc cancels then too, and the engine stops preparing (not only the waiting); the object
 is left as it was. The preview shows the Fast result with its wireframe while dragging and the
-chosen Quality when the drag pauses. The sidebar's ratio follows the drag (and goes back on
+chosen Quality when the drag rests (throughout, where the chosen Quality is fast enough). The sidebar's ratio follows the drag (and goes back on
 cancel).
 
 Enter (or a click) applies the dragged ratio at the panel's settings. When the result on screen

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import threading
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ...core.api.mesh import Mesh
 from ..io import mesh_read
@@ -23,6 +23,8 @@ class Prepared:
     arrays: mesh_read.MeshArrays
     mesh: Mesh
     digest: str
+    #: the live preview's seconds of its latest chosen-settings result, per options (session.py)
+    final_seconds: dict = field(default_factory=dict)
 
 
 class PreparedCache:

@@ -24,11 +24,15 @@ dropped.
 
 While the user drags, the preview shows drafts of the fast mode (plain TopStoc, milliseconds):
 the geometry without the attribute sources and without the engine's final output check (its
-partition checks and repairs still run; core.api.decimate's ``draft``). When the drag pauses for
-PAUSE_SECONDS, the same ratio is computed in full with the chosen settings in the background,
-checked, and replaces the draft when it is ready (the paint means the same in both modes, so
-the density does not jump); Enter writes only such a result. A draft takes about three
-quarters of the full fast decimation's time.
+partition checks and repairs still run; core.api.decimate's ``draft``). When no new ratio has
+been asked for REST_SECONDS, the drag rests: the same ratio is computed in full with the chosen
+settings on a free worker (the draft still running is not waited for), checked, and replaces
+the draft when it is ready (the paint means the same in both modes, so the density does not
+jump); Enter writes only such a result. A draft takes about three quarters of the full fast
+decimation's time. Where the chosen settings' result took at most DIRECT_SECONDS (measured on
+this mesh, in this session or an earlier one), the drag asks for it directly: the draft is
+the result itself. The chosen settings' recent results are kept per ratio, so going back to a
+ratio shows its result at once.
 """
 
 from __future__ import annotations
@@ -36,6 +40,7 @@ from __future__ import annotations
 import os
 import threading
 import time
+from collections import OrderedDict
 from concurrent.futures import ThreadPoolExecutor
 from typing import Optional
 
@@ -51,7 +56,9 @@ from ..decimation.guidance import read as read_guidance
 
 PREVIEW_SUFFIX = "_TopStocPreview"
 WORKERS = 2 if (os.cpu_count() or 1) >= 2 else 1
-PAUSE_SECONDS = 0.35  # a drag paused this long gets the chosen mode's result
+REST_SECONDS = 0.08  # no new ratio asked this long: the drag rests (mouse events come every ~10 ms)
+DIRECT_SECONDS = 0.12  # a chosen-settings result this fast is what the drag shows, instead of drafts
+KEPT_RESULTS = 8  # chosen-settings results kept per ratio
 THREAD_PREFIX = "topstoc-preview"
 
 
@@ -74,7 +81,7 @@ class PreviewSession:
         self._guidance_read = threading.Event()
         self.options = pipeline.decimate_options(panel)
         self.settings = pipeline.settings_of(panel)  # what an applied result remembers (Regenerate)
-        # While dragging: drafts of the fast mode, unmirrored; on a pause: the chosen settings, in full.
+        # While dragging: drafts of the fast mode, unmirrored; at rest: the chosen settings, in full.
         self.drag_options = dict(self.options, mode="fast", placement=None, refine=None, draft=True, symmetry=None)
         self.prepared = None                   # set by the worker once the mesh is prepared
         self.mesh = self.preview = None        # made when the first result is shown
@@ -85,6 +92,10 @@ class PreviewSession:
         self._progress = (0.0, "fingerprint")  # preparation: fraction done and current step
         self._workers = 1                      # worker loops running (the start job counts)
         self._pending = self.key(ratio, False) if ratio is not None else None  # latest request not started
+        self._asked = self._pending            # latest request, and when it came (rest detection)
+        self._asked_at = time.perf_counter()
+        self._kept = OrderedDict()             # ratio -> finished chosen-settings computation (KEPT_RESULTS)
+        self._options_key = repr(sorted(self.options.items()))  # the prepared mesh's final_seconds key
         self._started: Optional[tuple] = None  # newest computation started
         self._started_count = 0                # computations started (their order numbers)
         self._shown_order = 0                  # order number of the result shown last
@@ -94,7 +105,6 @@ class PreviewSession:
         self._typical = 0.0                    # running average of a computation's seconds
         self.ratio: Optional[float] = None
         self.final = False                     # the shown result has the chosen settings
-        self._last_shown = time.perf_counter()
         self._applying = None                  # key of the result Enter asked for, until it is written
         self._to_apply = None                  # (ratio, result, seconds) of it, once computed
         self._sources = None                   # (result, MovedVertices or None while found) of the newest
@@ -149,6 +159,9 @@ class PreviewSession:
             raise
         with self._lock:
             self.prepared = prepared
+            self.final_seconds = prepared.final_seconds.get(self._options_key)  # an earlier session's
+            if self._pending is not None and self.direct:  # the first request, fast enough in full
+                self._pending = self._asked = self.key(self._pending[0], True)
         self._ready.set()
         self._work()
 
@@ -218,26 +231,41 @@ class PreviewSession:
             edge_flags.write_edge_flags(self.mesh, flags)
         self.ratio, self.final, self.result, self.seconds_decimate = ratio, final, result, seconds
         self.seconds_write = time.perf_counter() - start
-        self._last_shown = time.perf_counter()
 
     def update(self, ratio: float, final: bool = False) -> None:
         """Synchronous update (benchmarks, tests); waits for the preparation first."""
         self.wait_prepared()
         self.show(*self.compute(ratio, final))
         with self._lock:
-            self._started = self.key(ratio, final)
+            self._started = self._asked = self.key(ratio, final)
+            self._asked_at = time.perf_counter()
+
+    @property
+    def direct(self) -> bool:
+        """True when the drag asks for the chosen settings' result itself (it is fast enough)."""
+        return self.final_seconds is not None and self.final_seconds <= DIRECT_SECONDS
 
     def request(self, ratio: float, final: bool = False) -> None:
-        """Asks for ``ratio`` (fast while dragging; ``final``: the chosen settings); only the
-        latest request is computed (after the preparation, if it still runs). Back at the ratio
-        whose chosen-settings result is on screen, that result stays: nothing is computed and
-        the results still on their way are dropped."""
+        """Asks for ``ratio`` (a draft while dragging, or the chosen settings' result when
+        ``direct``; ``final``: the chosen settings); only the latest request is computed (after
+        the preparation, if it still runs). Back at the ratio whose chosen-settings result is on
+        screen, that result stays: nothing is computed and the results still on their way are
+        dropped; one kept from earlier is shown again without computing."""
+        final = final or self.direct
         with self._lock:
-            if not final and self.final and ratio == self.ratio:
+            self._asked, self._asked_at = self.key(ratio, final), time.perf_counter()
+            if self.final and ratio == self.ratio:
                 self._pending = self._finished = self._started = None
                 self._shown_order = self._started_count
                 return
-            self._pending = self.key(ratio, final)
+            kept = self._kept.get(ratio) if final else None
+            if kept is not None:  # computed before: it becomes the newest result
+                self._pending, self._started = None, self._asked
+                self._started_count += 1
+                self._finished = (self._started_count, kept)
+                self._kept.move_to_end(ratio)
+                return
+            self._pending = self._asked
         self._start_worker()
 
     def _start_worker(self) -> None:
@@ -274,22 +302,32 @@ class PreviewSession:
                 seconds = finished[3]
                 self._typical = 0.7 * self._typical + 0.3 * seconds if self._typical else seconds
                 if key[1]:
-                    self.final_seconds = seconds
+                    self._keep(key[0], seconds, finished)
                 # A newer result replaces one not shown yet; an older one than shown is dropped.
                 newest = self._finished[0] if self._finished else self._shown_order
                 sources = False
                 if order > newest:
                     self._finished = (order, finished)
-                    if key[1]:  # a result Enter may write: find its attribute sources now
+                    if key[1] and key == self._asked:  # a result Enter may write: its attribute sources
                         self._sources, sources = (finished[1], None), True
             if sources:
                 self._find_sources(finished[1])
 
+    def _keep(self, ratio: float, seconds: float, finished) -> None:
+        """Remembers a chosen-settings computation and its seconds (worker, under the lock)."""
+        self.final_seconds = self.prepared.final_seconds[self._options_key] = seconds
+        self._kept[ratio] = finished
+        self._kept.move_to_end(ratio)
+        while len(self._kept) > KEPT_RESULTS:
+            self._kept.popitem(last=False)
+
     def _stagger(self) -> None:
         """Spreads the workers' starts over one computation's time, so that their results
-        arrive evenly instead of in pairs (and each starts from a newer request)."""
+        arrive evenly instead of in pairs (and each starts from a newer request). A rested
+        drag's request starts at once."""
         with self._lock:
-            if self._workers < 2 or not self._typical:
+            resting = self._pending is not None and self._pending[1] and not self.direct
+            if self._workers < 2 or not self._typical or resting:
                 return
             wait = self._typical / WORKERS - (time.perf_counter() - self._last_start)
         if wait > 0:
@@ -317,12 +355,12 @@ class PreviewSession:
         finished = self._take_finished()
         if finished:
             self.show(*finished[1])
-        elif not self.final and self.ratio is not None and not self.busy \
-                and time.perf_counter() - self._last_shown >= PAUSE_SECONDS:
-            with self._lock:
-                idle = self._pending is None
-            if idle:  # the drag paused: replace the fast result with the chosen settings'
-                self.request(self.ratio, final=True)
+        with self._lock:
+            rested = (self.ratio is not None and self._asked is not None and not self._asked[1]
+                      and time.perf_counter() - self._asked_at >= REST_SECONDS)
+            asked = self._asked
+        if rested:  # the drag rests: its ratio with the chosen settings, while any draft finishes
+            self.request(asked[0], final=True)
         return finished is not None
 
     @property
