@@ -115,12 +115,16 @@ def triangles(obj):
 
 
 
-# (mesh, whether the bake makes its own UV map, how many times closer the baked LOD must shade).
-# The Suzanne meets the issue's 3x; the other two fall short by the geometry a 2 % LOD cannot
-# follow (the rock's polygonal silhouette, the duck's neck crease): measured 2.6x and 1.9x.
-CASES = [(sculpted_suzanne, True, 3.0),   # no UV map: Smart UV Project
-         (sculpted_rock, False, 2.3),     # a UV map with one place per texel: kept
-         (duck, True, 1.5)]               # its own UV map overlaps (mirrored halves): a new one
+# Cycles 3.x bends every shading normal toward the face's own normal where the view grazes
+# (ensure_valid_reflection, for diffuse too; 4.x only for glossy): a normal map on a LOD's large
+# faces loses part of its effect there, in Cycles 3.x renders only (EEVEE 3.4 shows the duck 4.2x).
+CYCLES_3 = bpy.app.version < (4, 0, 0)
+
+# (mesh, whether the bake makes its own UV map, how many times closer the baked LOD must shade
+# in Cycles). The rock falls short by its polygonal silhouette, which no normal map changes.
+CASES = [(sculpted_suzanne, True, 3.0),              # no UV map: Smart UV Project
+         (sculpted_rock, False, 2.3),                # a UV map with one place per texel: kept
+         (duck, True, 2.0 if CYCLES_3 else 3.0)]     # its own UV map overlaps (mirrored halves): a new one
 
 
 @pytest.fixture
@@ -183,18 +187,12 @@ def test_baked_map_shades_like_the_source(ts, bake, scene, tmp_path, make, uv_ma
     result.image.pixels.foreach_get(normals)
     assert np.ptp(normals.reshape(-1, 4)[:, 0]) > 0.3  # not the flat (0.5, 0.5, 1) it started as
 
-    shading.setup(RENDER_SIZE)
-    shading.frame([source])
-    folder = str(tmp_path)
-    images = [shading.render(obj, folder, obj.name) for obj in (source, bare, baked)]
-    mask = shading.covered(*images)
-    assert mask.sum() > 0.15 * RENDER_SIZE ** 2
-    bare_difference = shading.shading_difference(images[0], images[1], mask)
-    baked_difference = shading.shading_difference(images[0], images[2], mask)
+    bare_difference, baked_difference = shading_differences(source, bare, baked, str(tmp_path), "CYCLES")
     print(f"{source.name} ({result.method}): {triangles(source)} -> {triangles(baked)} triangles; mean shading "
           f"difference bare {bare_difference:.4f}, baked {baked_difference:.4f} "
           f"({bare_difference / baked_difference:.1f}x closer)")
     assert baked_difference * closer <= bare_difference
+    folder = str(tmp_path)
 
     out = os.environ.get("TOPSTOC_PICTURES") or folder
     counts = [f"{label}\n{triangles(obj):,} triangles" for label, obj in
@@ -202,6 +200,71 @@ def test_baked_map_shades_like_the_source(ts, bake, scene, tmp_path, make, uv_ma
     picture = os.path.join(out, f"bake_normals_{source.name.split('_')[0]}.png")
     shading.side_by_side([source, bare, baked], counts, picture)
     assert os.path.getsize(picture) < 500_000
+
+
+def shading_differences(source, bare, baked, folder, engine):
+    """(bare LOD's, baked LOD's) mean shading difference to the source, rendered with ``engine``."""
+    shading.setup(RENDER_SIZE, engine)
+    shading.frame([source])
+    images = [shading.render(obj, folder, obj.name) for obj in (source, bare, baked)]
+    mask = shading.covered(*images)
+    assert mask.sum() > 0.15 * RENDER_SIZE ** 2
+    return (shading.shading_difference(images[0], images[1], mask),
+            shading.shading_difference(images[0], images[2], mask))
+
+
+def test_the_duck_shades_like_its_source_in_eevee(ts, bake, scene, tmp_path):
+    """The UV-mapped asset in EEVEE (the viewport's material look, free of Cycles 3.x's normal
+    bending): the baked LOD at least 3x closer to the source than the bare one."""
+    source = duck()
+    bare = decimated(ts, source, source.name + "_bare")
+    baked = decimated(ts, source, source.name + "_baked")
+    bake.bake_normals(bpy.context, source, baked, size=BAKE_SIZE, margin=8, store="PACK")
+    bare_difference, baked_difference = shading_differences(source, bare, baked, str(tmp_path), "EEVEE")
+    print(f"duck in EEVEE: mean shading difference bare {bare_difference:.4f}, baked {baked_difference:.4f} "
+          f"({bare_difference / baked_difference:.1f}x closer)")
+    assert baked_difference * 3.0 <= bare_difference
+
+
+def custom_normals_pair():
+    """A bumped icosphere with custom normals (its own smooth ones, set: Blender marks no edge
+    sharp) and its 20 % LOD, which carries them and the sharp edges setting them marked."""
+    source = small_pair("custom")
+    mesh = source.data
+    if hasattr(mesh, "use_auto_smooth"):
+        mesh.use_auto_smooth = True
+    mesh.normals_split_custom_set_from_vertices([tuple(v.normal) for v in mesh.vertices])
+    assert mesh.has_custom_normals and not any(e.use_edge_sharp for e in mesh.edges)
+    return source
+
+
+def corner_normals(mesh):
+    if hasattr(mesh, "corner_normals"):
+        return np.array([tuple(n.vector) for n in mesh.corner_normals])
+    mesh.calc_normals_split()
+    return np.array([tuple(loop.normal) for loop in mesh.loops])
+
+
+def test_the_lod_bakes_with_its_own_smooth_normals(ts, bake, scene, monkeypatch):
+    """The custom normals the decimation carries (the source's detail at the LOD's corners, and
+    the sharp edges setting them marks) go before the bake: the map is made for, and read with,
+    the LOD's own smooth normals. A failed bake puts them back exactly."""
+    source = custom_normals_pair()
+    lods = [decimated(ts, source, f"lod{i}") for i in range(2)]
+    carried = corner_normals(lods[1].data), [e.use_edge_sharp for e in lods[1].data.edges]
+    assert lods[0].data.has_custom_normals and any(carried[1])
+    bake.bake_normals(bpy.context, source, lods[0], size=64, margin=2)
+    mesh = lods[0].data
+    assert not mesh.has_custom_normals and not any(e.use_edge_sharp for e in mesh.edges)
+    smooth = np.array([tuple(v.normal) for v in mesh.vertices])[[loop.vertex_index for loop in mesh.loops]]
+    assert np.allclose(corner_normals(mesh), smooth, atol=1e-5)   # one normal per vertex: no split
+    monkeypatch.setattr(bake, "_run_bake", lambda *args: None)
+    monkeypatch.setattr(bake.bake_raycast, "bake", lambda *args: None)
+    with pytest.raises(bake.BakeError, match="came back empty"):
+        bake.bake_normals(bpy.context, source, lods[1], size=64, margin=2)
+    assert lods[1].data.has_custom_normals
+    assert np.allclose(corner_normals(lods[1].data), carried[0], atol=1e-4)
+    assert [e.use_edge_sharp for e in lods[1].data.edges] == carried[1]
 
 
 def test_the_user_state_comes_back(ts, bake, scene):

@@ -25,7 +25,8 @@ from ...core.api.hausdorff import hausdorff
 from ...core.carry.normal_bake import (MAX_OVERLAP, available_memory, check_memory, check_size, island_margin,
                                        overlap_fraction, ray_reach)
 from . import bake_raycast
-from ..io import mesh_read
+from ..io import edge_flags, mesh_read
+from ..io.mesh_access import read_array
 
 BAKE_UV_NAME = "TopStoc Bake"  #: the UV map made when the result has no usable one
 HAUSDORFF_SAMPLES = 200_000
@@ -116,6 +117,38 @@ def ensure_uv_map(obj, size: int, margin: int) -> tuple:
     finally:
         bpy.ops.object.mode_set(mode="OBJECT")
     return name, True
+
+
+def own_normals(result):
+    """Gives ``result`` (the only selected object and the active one) its own smooth normals, no
+    custom normals and no sharp edges: the decimation carried the source's custom normals (its
+    detail sampled at the LOD's few corners, and sharp edges wherever those differ), which tilt
+    the bake's rays and tangent frames; the map carries the source's shading instead, hard edges
+    included. Returns what restore_normals puts back (None: nothing changed)."""
+    mesh = result.data
+    normals = mesh_read.read_custom_normals(mesh)
+    sharp = read_array(mesh.edges, "use_edge_sharp", len(mesh.edges), 1, bool)
+    angle = getattr(mesh, "auto_smooth_angle", None)  # Blender < 4.1 splits normals at wider angles
+    if normals is None and not sharp.any() and (angle is None or not mesh.use_auto_smooth or angle >= np.pi):
+        return None
+    if normals is not None:
+        bpy.ops.mesh.customdata_custom_splitnormals_clear()
+    if angle is not None:
+        mesh.auto_smooth_angle = np.pi
+    edge_flags.write_edge_flags(mesh, {"use_edge_sharp": np.zeros(len(sharp), dtype=bool)})
+    return normals, angle, sharp
+
+
+def restore_normals(result, saved) -> None:
+    """Puts back the custom normals and sharp edges own_normals took from ``result``."""
+    if saved is None:
+        return
+    normals, angle, sharp = saved
+    if angle is not None:
+        result.data.auto_smooth_angle = angle
+    if normals is not None:
+        result.data.normals_split_custom_set(normals)
+    edge_flags.write_edge_flags(result.data, {"use_edge_sharp": sharp})
 
 
 def new_image(name: str, size: int) -> bpy.types.Image:
@@ -344,10 +377,11 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
     hausdorff_max, diagonal, extrusion, max_ray = measure_reach(source, result)
     old_materials = [slot.material for slot in result.material_slots]
     old_uv = (result.data.uv_layers.active_index, [layer.name for layer in result.data.uv_layers])
-    image, made = None, []
+    image, made, normals = None, [], None
     with _SceneState(context, source, result) as state:
         try:
             state.select([result])
+            normals = own_normals(result)
             active_uv = result.data.uv_layers.active_index
             uv_map, unwrapped = ensure_uv_map(result, size, margin)
             image = new_image(f"{result.name}_normal", size)
@@ -366,6 +400,7 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
         except (BakeError, bake_raycast.Cancelled):
             _undo_materials(result, old_materials, made, image)
             _undo_uv_map(result, *old_uv)
+            restore_normals(result, normals)
             raise
     return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, method, path)
 

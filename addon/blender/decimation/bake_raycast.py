@@ -63,6 +63,21 @@ def _tangent_frames(mesh, uv_map: str, rotation: np.ndarray) -> tuple:
     return normals, _unit(tangents.reshape(-1, 3) @ rotation.T), signs
 
 
+def _frames(normal, tangent, sign) -> np.ndarray:
+    """(k, 3, 3) columns tangent, bitangent, normal, interpolated and not normalised: the frame
+    the Normal Map node decodes with (colour x T + y B + z N), B = sign N x T."""
+    return np.stack([tangent, sign[:, None] * np.cross(normal, tangent), normal], axis=2)
+
+
+def _encode(frames, normals) -> np.ndarray:
+    """The unit tangent-space vectors the frames decode into ``normals``, as Blender's bake
+    writes them (the frame inverted, not assumed orthonormal); (0, 0, 1) in a degenerate frame."""
+    encoded = np.tile((0.0, 0.0, 1.0), (len(normals), 1))
+    good = np.abs(np.linalg.det(frames)) > 1e-9
+    encoded[good] = np.linalg.solve(frames[good], normals[good][:, :, None])[:, :, 0]
+    return _unit(encoded)
+
+
 def _source_normals(mesh, matrix, hits, triangle_ids) -> np.ndarray:
     """The source's smooth (corner) normal at each hit point of its loop triangles."""
     loops, vertices = _triangles(mesh)
@@ -110,17 +125,16 @@ def bake(source, result, image, uv_map: str, extrusion: float, max_ray: float, m
     normals, tangents, signs = _tangent_frames(mesh, uv_map, matrix[:3, :3])
     corner = loops[triangle]                                      # (k, 3) loops of each texel's triangle
     points = np.einsum("ij,ijk->ik", weights, _world(mesh, matrix)[vertices[triangle]])
-    normal = _unit(np.einsum("ij,ijk->ik", weights, normals[corner]))
-    tangent = np.einsum("ij,ijk->ik", weights, tangents[corner])
-    tangent = _unit(tangent - normal * np.einsum("ij,ij->i", tangent, normal)[:, None])
-    bitangent = signs[corner[:, 0]][:, None] * np.cross(normal, tangent)
+    normal = np.einsum("ij,ijk->ik", weights, normals[corner])
+    frames = _frames(normal, np.einsum("ij,ijk->ik", weights, tangents[corner]), signs[corner[:, 0]])
+    normal = _unit(normal)
 
     _, source_vertices = _triangles(source.data)
     tree = BVHTree.FromPolygons(_world(source.data, matrix).tolist(), source_vertices.tolist())
     hits, ids, found = _cast(tree, points + extrusion * normal, -normal, max_ray, progress)
     seen = normal.copy()
     seen[found] = _source_normals(source.data, matrix, hits[found], ids[found])
-    encoded = np.stack([np.einsum("ij,ij->i", seen, axis) for axis in (tangent, bitangent, normal)], axis=1)
+    encoded = _encode(frames, seen)
 
     values = np.zeros((size * size, 3))
     values[texels] = encoded * 0.5 + 0.5
