@@ -302,15 +302,15 @@ def has_detail(image) -> bool:
     return bool((unit[:, 2] < np.cos(np.radians(1.0))).any())
 
 
-def _bake_image(source, result, image, uv_map: str, reach: tuple, margin: int, expect_detail: bool,
-                progress=None) -> str:
+def _bake_image(source, result, image, uv_map: str, reach: tuple, margin: int, expect_detail: bool):
     """Bakes into ``image`` with Cycles, or by ray casting when Cycles leaves the map flat though
-    the surfaces differ (told to ``progress``); returns which ("Cycles" or "ray cast")."""
+    the surfaces differ, yielding the fraction done; returns which ("Cycles" or "ray cast")."""
     extrusion, max_ray = reach
     _run_bake(extrusion, max_ray, margin, image.size[0], result.name)
     if not expect_detail or has_detail(image):
         return "Cycles"
-    bake_raycast.bake(source, result, image, uv_map, extrusion, max_ray, margin, progress)
+    yield 0.0  # Cycles' turn done (nothing to show for it): the rays follow
+    yield from bake_raycast.bake_steps(source, result, image, uv_map, extrusion, max_ray, margin)
     if not has_detail(image):
         raise BakeError(f"the bake onto '{result.name}' came back empty: no ray from it reached "
                         f"'{source.name}'")
@@ -366,8 +366,17 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
     """Bakes ``source``'s shading normals onto ``result`` (its decimated copy) as a tangent-space
     normal map of ``size``² with ``margin`` pixels of bleed. store: "PACK" (into the .blend) or
     "FILE" (``<folder>/<name>_normal.png``; by default beside the .blend, named after the result;
-    an existing file replaced only with ``replace``). ``progress(fraction)`` follows the ray cast;
+    an existing file replaced only with ``replace``). ``progress(fraction)`` follows the bake;
     its False cancels (bake_raycast.Cancelled), leaving ``result`` as it was, like a failed bake."""
+    return bake_raycast.drive(bake_normals_steps(context, source, result, size=size, margin=margin, store=store,
+                                                 folder=folder, name=name, replace=replace), progress)
+
+
+def bake_normals_steps(context, source, result, *, size: int = 1024, margin: int = 16, store: str = "PACK",
+                       folder: str = None, name: str = None, replace: bool = False):
+    """bake_normals one step at a time: a generator yielding the fraction done (0 when ready to
+    bake, then per chunk of rays), returning the Baked. Closed early (``close()``), or failing, it
+    leaves ``result`` and the scene as they were."""
     size = check_size(size)
     check_memory(size, available_memory())
     check_bakeable(source, result)
@@ -388,20 +397,22 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
             made = give_materials(result, image, uv_map)
             state.select([source, result])
             state.use_cycles()
+            yield 0.0
             # surfaces this close give a flat map rightly (an LOD0 at ratio 1)
-            method = _bake_image(source, result, image, uv_map, (extrusion, max_ray), margin,
-                                 hausdorff_max > DETAIL * diagonal, progress)
+            method = yield from _bake_image(source, result, image, uv_map, (extrusion, max_ray), margin,
+                                            hausdorff_max > DETAIL * diagonal)
             if active_uv >= 0:  # the map made for the bake is not the one the user edits
                 result.data.uv_layers.active_index = active_uv
             path = save_image(image, folder, bpy.path.clean_name(name or result.name), replace) \
                 if store == "FILE" else ""
             if store != "FILE":
                 pack_image(image)
-        except (BakeError, bake_raycast.Cancelled):
+        except (BakeError, bake_raycast.Cancelled, GeneratorExit):
             _undo_materials(result, old_materials, made, image)
             _undo_uv_map(result, *old_uv)
             restore_normals(result, normals)
             raise
+    yield 1.0
     return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, method, path)
 
 
@@ -424,19 +435,31 @@ def _undo_uv_map(result, active: int, names: list) -> None:
         layers.active_index = active
 
 
-def bake_results(context, settings, pairs, progress=None) -> tuple:
-    """Bakes every (source, result) pair with an operator's BakeParameters; returns (status lines,
-    one-line failures). A failed bake leaves its result as decimated. ``progress(fraction)`` follows
-    the whole run; its False cancels (bake_raycast.Cancelled raised, the current result as it was)."""
+def _scaled(steps, start: float, share: float):
+    """Yields what the generator ``steps`` yields mapped onto [start, start + share]; returns its
+    value. Closed early, it closes ``steps`` (whose clean-up then runs)."""
+    try:
+        while True:
+            try:
+                fraction = next(steps)
+            except StopIteration as done:
+                return done.value
+            yield start + share * fraction
+    finally:
+        steps.close()
+
+
+def bake_results_steps(context, settings, pairs):
+    """Bakes every (source, result) pair with an operator's BakeParameters, yielding the fraction
+    of the whole run done; returns (status lines, one-line failures). A failed bake leaves its
+    result as decimated; closed early, the result being baked is left as it was."""
     lines, failures = [], []
     pairs = list(pairs)
     for index, (source, result) in enumerate(pairs):
-        told = None if progress is None else (lambda f, i=index: progress((i + f) / len(pairs)))
+        steps = bake_normals_steps(context, source, result, size=int(settings.bake_size),
+                                   margin=settings.bake_margin, store=settings.bake_store)
         try:
-            baked = bake_normals(context, source, result, size=int(settings.bake_size),
-                                 margin=settings.bake_margin, store=settings.bake_store, progress=told)
-        except bake_raycast.Cancelled:
-            raise
+            baked = yield from _scaled(steps, index / len(pairs), 1 / len(pairs))
         except TopStocError as error:
             failures.append(f"Bake Normals: {error}")
             continue

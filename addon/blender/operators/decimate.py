@@ -26,7 +26,8 @@ def selected_meshes(context):
     return [obj for obj in context.selected_objects if obj.type == "MESH"]
 
 
-class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy.types.Operator):
+class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bake_run.BakeModal,
+                                 bpy.types.Operator):
     """Decimate the selected meshes with TopStoc, honouring their guidance"""
 
     bl_idname = "topstoc.guided_decimate"
@@ -42,6 +43,7 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
 
     def invoke(self, context, event):
         fill_from_scene(self, context.scene.topstoc)  # the panel's settings; the redo panel tweaks them
+        self._modal = bake_run.can_run_modal(context)  # a bake then runs modal: progress, Esc cancels
         return self.execute(context)
 
     def draw(self, context):
@@ -78,18 +80,26 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
                     missed.append(f"{obj.name}: {run.result.stats.target_missed.text()}")
             except TopStocError as error:
                 failures.append(str(error))
-        baked = []
+        self._run = (start, outputs, lines, failures, missed)
         if self.bake_normals and outputs:
-            if self.output == "NEW_OBJECT":
+            if self.output != "NEW_OBJECT":
+                failures.append("Bake Normals needs Output: New Object (in place, no original is left to "
+                                "bake from)")
+            elif getattr(self, "_modal", False):
+                return self.start_bake(context, list(zip(sources, outputs)), outputs)
+            else:
                 done = bake_run.bake_or_discard(context, self, zip(sources, outputs), outputs)
                 if done is None:
                     self.report({"WARNING"}, "TopStoc: Bake Normals cancelled; nothing was changed")
                     return {"CANCELLED"}
-                baked, bake_failures = done
-                failures += bake_failures
-            else:
-                failures.append("Bake Normals needs Output: New Object (in place, no original is left to "
-                                "bake from)")
+                return self.bake_finished(context, done)
+        return self.bake_finished(context, ([], []))
+
+    def bake_finished(self, context, done):
+        """Reports the run (and its bake: ``done``, its status lines and failures)."""
+        start, outputs, lines, failures, missed = self._run
+        baked, bake_failures = done
+        failures = failures + bake_failures
         self.target_missed = "\n".join(missed)
         for message in failures:
             self.report({"ERROR"}, message)
