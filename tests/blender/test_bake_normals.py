@@ -415,7 +415,9 @@ def batch_bake(ts, tmp_path, kind):
     done = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     [lod] = json.loads(report.read_text())["results"][0]["objects"][0]["lods"]
-    assert lod["normal_map"] == str(out / "pebble_pebble_normal.png") and os.path.isfile(lod["normal_map"])
+    # <output>_<object>_normal.png; USD's importer names the object after its mesh
+    assert lod["normal_map"] == str(out / f"pebble_{'Icosphere' if kind.startswith('usd') else 'pebble'}_normal.png")
+    assert os.path.isfile(lod["normal_map"])
     return command, out, lod, source_faces
 
 
@@ -502,3 +504,34 @@ def test_a_map_beside_the_blend_never_replaces_a_file(ts, bake, scene, tmp_path,
     reread = bpy.data.images.load(result.path)
     assert tuple(reread.size) == (64, 64)
     assert np.allclose(decoded(reread), decoded(result.image), atol=1 / 255)
+
+
+def test_batch_writes_a_usd_that_reimports_with_its_map(ts, scene, tmp_path):
+    """``--bake-normals`` with USD output: the UsdPreviewSurface's normal input reads the baked
+    PNG (by a path relative to the output), and Blender's importer reads it back into a Normal
+    Map node. Debian's Blender 3.4 is built without USD."""
+    if not bpy.app.build_options.usd:
+        pytest.skip(f"Blender {bpy.app.version_string} is built without USD")
+    _command, out, lod, source_faces = batch_bake(ts, tmp_path, "usda")
+    text = (out / "pebble.usda").read_text()
+    name = os.path.basename(lod["normal_map"])
+    assert "normal3f inputs:normal.connect = </root/_materials/" in text
+    assert f"asset inputs:file = @./textures/{name}@" in text  # USD's exporter copies it there
+    assert sorted(os.listdir(out)) == ["pebble.usda", name, "textures"] and name in os.listdir(out / "textures")
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    for image in list(bpy.data.images):
+        bpy.data.images.remove(image)
+    importlib_module(ts, "blender.io.scene_files").import_file(str(out / "pebble.usda"))
+    [obj] = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+    image = normal_map_image(obj)
+    assert image is not None and tuple(image.size) == (128, 128)
+    written = bpy.data.images.load(lod["normal_map"])
+    assert np.array_equal(pixels_of(image), pixels_of(written)) and np.ptp(pixels_of(written)) > 0.3
+    assert sum(len(p.vertices) - 2 for p in obj.data.polygons) == lod["triangles"] < source_faces / 5
+
+
+def pixels_of(image):
+    out = np.empty(len(image.pixels), dtype=np.float32)
+    image.pixels.foreach_get(out)
+    return out
