@@ -535,3 +535,57 @@ def pixels_of(image):
     out = np.empty(len(image.pixels), dtype=np.float32)
     image.pixels.foreach_get(out)
     return out
+
+
+def skinned(source):
+    """``source`` deformed by a one-bone armature (every vertex weighted to it) posed a quarter
+    turn away from its rest pose."""
+    armature = bpy.data.objects.new("rig", bpy.data.armatures.new("rig"))
+    bpy.context.scene.collection.objects.link(armature)
+    select_only(armature)
+    bpy.ops.object.mode_set(mode="EDIT")
+    bone = armature.data.edit_bones.new("bone")
+    bone.head, bone.tail = (0.0, 0.0, -1.0), (0.0, 0.0, 0.0)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    armature.pose.bones["bone"].rotation_mode = "XYZ"
+    armature.pose.bones["bone"].rotation_euler = (np.pi / 2, 0.0, 0.0)
+    group = source.vertex_groups.new(name="bone")
+    group.add(list(range(len(source.data.vertices))), 1.0, "REPLACE")
+    source.modifiers.new("rig", "ARMATURE").object = armature
+    bpy.context.view_layer.update()
+    return armature
+
+
+def evaluated_positions(obj):
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    return np.array([tuple(v.co) for v in evaluated.data.vertices])
+
+
+def test_a_skinned_source_bakes_in_its_rest_pose(ts, bake, scene, monkeypatch):
+    """An armature-deformed source and its LOD (which keeps the weights and the Armature modifier)
+    bake from the rest pose (what Cycles sees while baking), giving the same map as the same
+    pair without the armature; the pose, the modifiers and the weights are as before."""
+    source = small_pair("skinned")
+    rig = skinned(source)
+    lods = [decimated(ts, source, f"lod{i}") for i in range(2)]
+    assert [m.type for m in lods[0].modifiers] == ["ARMATURE"] and "bone" in lods[0].vertex_groups
+    weights = [[g.weight for g in v.groups] for v in lods[0].data.vertices]
+    rest_positions = np.array([tuple(v.co) for v in source.data.vertices])
+    assert np.abs(evaluated_positions(source) - rest_positions).max() > 0.5     # posed
+    seen = []
+    run_bake = bake._run_bake
+    monkeypatch.setattr(bake, "_run_bake", lambda *args: (seen.append(evaluated_positions(source)),
+                                                          run_bake(*args))[1])
+    posed = bake.bake_normals(bpy.context, source, lods[0], size=64, margin=2)
+    assert np.allclose(seen[0], rest_positions, atol=1e-6)                       # Cycles bakes the rest pose
+    assert np.abs(evaluated_positions(source) - rest_positions).max() > 0.5     # posed again
+    for obj in (source, lods[1]):
+        obj.modifiers.clear()
+    bpy.context.view_layer.update()
+    rest = bake.bake_normals(bpy.context, source, lods[1], size=64, margin=2)
+    assert posed.method == rest.method and np.ptp(pixels_of(rest.image)) > 0.3
+    assert np.abs(pixels_of(posed.image) - pixels_of(rest.image)).max() <= 1 / 255
+    modifier = lods[0].modifiers["rig"]
+    assert modifier.object == rig and modifier.show_viewport and modifier.show_render
+    assert tuple(rig.pose.bones["bone"].rotation_euler) == pytest.approx((np.pi / 2, 0.0, 0.0))
+    assert [[g.weight for g in v.groups] for v in lods[0].data.vertices] == weights

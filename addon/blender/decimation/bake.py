@@ -53,7 +53,8 @@ class Baked:
 
 
 def check_bakeable(source, result) -> None:
-    """One-line errors for what a bake cannot use: non-meshes, a source without faces, modifiers."""
+    """One-line errors for what a bake cannot use: non-meshes, a source without faces, modifiers
+    (but Armature ones: the bake uses the rest pose)."""
     for obj in (source, result):
         mesh_read.check_mesh_object(obj, BakeError)
     if len(source.data.polygons) == 0:
@@ -61,7 +62,7 @@ def check_bakeable(source, result) -> None:
     if len(result.data.polygons) == 0:
         raise BakeError(f"'{result.name}' has no faces to bake a normal map onto")
     for obj in (source, result):
-        live = [m.name for m in obj.modifiers if m.show_render or m.show_viewport]
+        live = [m.name for m in obj.modifiers if (m.show_render or m.show_viewport) and m.type != "ARMATURE"]
         if live:
             raise BakeError(f"'{obj.name}' has modifiers that are not applied ({', '.join(live)}): apply or "
                             f"disable them before baking normals")
@@ -227,8 +228,9 @@ def give_materials(result, image, uv_map: str) -> list:
 
 
 class _SceneState:
-    """The render engine, Cycles device and samples, selection, active object, visibility and the
-    result's placement, put back when the ``with`` block ends, whatever happens in it."""
+    """The render engine, Cycles device and samples, selection, active object, visibility, the
+    result's placement and the Armature modifiers (off while baking), put back when the ``with``
+    block ends, whatever happens in it."""
 
     def __init__(self, context, source, result):
         self.context, self.source, self.result = context, source, result
@@ -238,8 +240,12 @@ class _SceneState:
         self.hidden = {obj: (obj.hide_get(), obj.hide_viewport, obj.hide_select) for obj in (source, result)}
         self.matrix = result.matrix_basis.copy()
         self.cycles = None
+        self.armatures = {m: (m.show_viewport, m.show_render) for obj in (source, result)
+                          for m in obj.modifiers if m.type == "ARMATURE"}
 
     def __enter__(self):
+        for modifier in self.armatures:  # skinned: both baked in their rest pose, as their meshes are
+            modifier.show_viewport = modifier.show_render = False
         for obj in self.hidden:
             obj.hide_set(False)
             obj.hide_viewport = obj.hide_select = False
@@ -264,6 +270,8 @@ class _SceneState:
         if self.cycles is not None:
             scene.cycles.device, scene.cycles.samples = self.cycles
         scene.render.engine = self.engine
+        for modifier, (viewport, render) in self.armatures.items():
+            modifier.show_viewport, modifier.show_render = viewport, render
         self.result.matrix_basis = self.matrix
         for obj, (hidden, viewport, unselectable) in self.hidden.items():
             obj.hide_viewport, obj.hide_select = viewport, unselectable
