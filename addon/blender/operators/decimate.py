@@ -92,31 +92,36 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bak
                 if done is None:
                     self.report({"WARNING"}, "TopStoc: Bake Normals cancelled; nothing was changed")
                     return {"CANCELLED"}
-                return self.bake_finished(context, done)
-        return self.bake_finished(context, ([], []))
+                return report_run(self, context, done)
+        return report_run(self, context, ([], []))
 
     def bake_finished(self, context, done):
-        """Reports the run (and its bake: ``done``, its status lines and failures)."""
-        start, outputs, lines, failures, missed = self._run
-        baked, bake_failures = done
-        failures = failures + bake_failures
-        self.target_missed = "\n".join(missed)
-        for message in failures:
-            self.report({"ERROR"}, message)
-        for message in missed:  # a missed target is a warning where the user looks, not a footnote
-            self.report({"WARNING"}, f"TopStoc: {message}")
-        if not outputs:
-            return {"CANCELLED"}
-        if self.output == "NEW_OBJECT":
-            select_results(context, outputs)
-        for line in baked:
-            self.report({"INFO"}, f"TopStoc: {line}")
-        seconds = time.perf_counter() - start
-        if len(lines) == 1:
-            self.report({"INFO"}, f"TopStoc: {lines[0]}; {seconds:.3f} s with output")
-        else:
-            self.report({"INFO"}, f"TopStoc: {len(lines)} objects decimated in {seconds:.3f} s")
-        return {"FINISHED"}
+        return report_run(self, context, done)
+
+
+def report_run(operator, context, done):
+    """Reports the operator's run (and its bake: ``done``, its status lines and failures); returns
+    the operator's result."""
+    start, outputs, lines, failures, missed = operator._run
+    baked, bake_failures = done
+    failures = failures + bake_failures
+    operator.target_missed = "\n".join(missed)
+    for message in failures:
+        operator.report({"ERROR"}, message)
+    for message in missed:  # a missed target is a warning where the user looks, not a footnote
+        operator.report({"WARNING"}, f"TopStoc: {message}")
+    if not outputs:
+        return {"CANCELLED"}
+    if operator.output == "NEW_OBJECT":
+        select_results(context, outputs)
+    for line in baked:
+        operator.report({"INFO"}, f"TopStoc: {line}")
+    seconds = time.perf_counter() - start
+    if len(lines) == 1:
+        operator.report({"INFO"}, f"TopStoc: {lines[0]}; {seconds:.3f} s with output")
+    else:
+        operator.report({"INFO"}, f"TopStoc: {len(lines)} objects decimated in {seconds:.3f} s")
+    return {"FINISHED"}
 
 
 CLASSES = (TOPSTOC_OT_guided_decimate,)
