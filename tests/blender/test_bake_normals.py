@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import shading
-from conftest import DATA
+from conftest import DATA, PACKAGE
 from helpers import positions, select_only, snapshot
 
 RATIO = 0.02
@@ -589,3 +589,32 @@ def test_a_skinned_source_bakes_in_its_rest_pose(ts, bake, scene, monkeypatch):
     assert modifier.object == rig and modifier.show_viewport and modifier.show_render
     assert tuple(rig.pose.bones["bone"].rotation_euler) == pytest.approx((np.pi / 2, 0.0, 0.0))
     assert [[g.weight for g in v.groups] for v in lods[0].data.vertices] == weights
+
+
+def test_batch_bakes_a_posed_skinned_character(ts, scene, tmp_path):
+    """``--bake-normals`` on a .blend whose rigged character is posed: the LOD is baked (in the rest
+    pose) and keeps its weights and its Armature modifier on the rig."""
+    import launch
+    from test_character import MAKE_CHARACTER
+
+    source = tmp_path / "character.blend"
+    code = MAKE_CHARACTER.format(tests=str(DATA.parent / "blender"), path=str(source)).replace(
+        "make_character()\n", "make_character()\nbpy.data.objects['Rig'].pose.bones['Upper'].rotation_mode = 'XYZ'\n"
+        "bpy.data.objects['Rig'].pose.bones['Upper'].rotation_euler = (1.0, 0.0, 0.4)\n")
+    made = launch.background(expr=code, timeout=120)
+    assert made.returncode == 0, made.stderr
+    out = tmp_path / "out"
+    done = launch.background(PACKAGE / "batch.py", "--input", source, "--ratio", "0.3",
+                             "--output", out, "--bake-normals", "64", timeout=300)
+    assert done.returncode == 0, done.stderr
+    try:
+        bpy.ops.wm.open_mainfile(filepath=str(out / "character.blend"))
+    except RuntimeError as error:
+        pytest.skip(f"this Blender cannot read the batch Blender's file: {error}")
+    body, rig = bpy.data.objects["Body"], bpy.data.objects["Rig"]
+    assert tuple(rig.pose.bones["Upper"].rotation_euler) == pytest.approx((1.0, 0.0, 0.4))
+    assert [(m.type, m.object, m.show_viewport) for m in body.modifiers] == [("ARMATURE", rig, True)]
+    assert {g.name for g in body.vertex_groups} >= {"Lower", "Upper"}
+    assert all(len(v.groups) for v in body.data.vertices)
+    image = normal_map_image(body)
+    assert image is not None and tuple(image.size) == (64, 64) and np.ptp(pixels_of(image)) > 0.1
