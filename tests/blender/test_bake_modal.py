@@ -28,7 +28,7 @@ def stand_in(bake_run):
     """An operator with BakeModal whose Blender timer and handler are a token and nothing."""
 
     class Operator(bake_run.BakeModal):
-        bake_size, bake_margin, bake_store = "64", 2, "PACK"
+        bake_size, bake_margin, bake_store, bake_colour = "64", 2, "PACK", False
 
         def __init__(self):
             self.reports, self.finished, self.cancelled = [], None, False

@@ -618,3 +618,96 @@ def test_batch_bakes_a_posed_skinned_character(ts, scene, tmp_path):
     assert all(len(v.groups) for v in body.data.vertices)
     image = normal_map_image(body)
     assert image is not None and tuple(image.size) == (64, 64) and np.ptp(pixels_of(image)) > 0.1
+
+
+def painted_suzanne():
+    """Suzanne subdivided three times (about 63k triangles), smooth, without a UV map, its Base
+    Color a colour attribute painted per vertex in stripes a 2 % LOD's few vertices cannot hold
+    (a scan's colours, say)."""
+    bpy.ops.mesh.primitive_monkey_add()
+    monkey = subdivided(bpy.context.active_object, 3)
+    monkey.name = "painted"
+    while monkey.data.uv_layers:
+        monkey.data.uv_layers.remove(monkey.data.uv_layers[0])
+    mesh = monkey.data
+    for polygon in mesh.polygons:
+        polygon.use_smooth = True
+    co = positions(mesh).astype(np.float64)
+    stripes = np.stack([0.5 + 0.4 * np.sin(14 * co[:, 0]), 0.5 + 0.4 * np.sin(14 * co[:, 2] + 1.0),
+                        0.5 + 0.4 * np.sin(10 * co[:, 1] + 2.0), np.ones(len(co))], axis=1)
+    attribute = mesh.color_attributes.new("paint", "FLOAT_COLOR", "POINT")
+    attribute.data.foreach_set("color", stripes.astype(np.float32).ravel())
+    material = bpy.data.materials.new("paint")
+    material.use_nodes = True
+    tree = material.node_tree
+    node = tree.nodes.new("ShaderNodeVertexColor")
+    node.layer_name = "paint"
+    tree.links.new(node.outputs["Color"], next(n for n in tree.nodes if n.type == "BSDF_PRINCIPLED").inputs["Base Color"])
+    mesh.materials.append(material)
+    return monkey
+
+
+def colour_difference(reference, other, mask):
+    return float(np.abs(reference[..., :3] - other[..., :3]).mean(axis=-1)[mask].mean())
+
+
+def test_baked_colour_shows_the_source_colours_closer(ts, bake, scene, tmp_path, cycles_bakes):
+    """A source without UV map (the bake lays one out) painted per vertex: asked, the bake lays the
+    base colour on that map too. Rendered, the 2 % LOD reading its colour from it is closer to the
+    source than the bare LOD and than the LOD with the normal map only (both showing the colours
+    the LOD's few vertices carried). The colour has no ray-cast fallback: Cycles must bake."""
+    if not cycles_bakes:
+        pytest.skip(f"Blender {bpy.app.version_string}'s Cycles bakes nothing here (before a first render)")
+    source = painted_suzanne()
+    bare, normals_only, coloured = (decimated(ts, source, f"{name}") for name in ("bare", "normals", "colour"))
+    bake.bake_normals(bpy.context, source, normals_only, size=BAKE_SIZE, margin=8)
+    result = bake.bake_normals(bpy.context, source, coloured, size=BAKE_SIZE, margin=8, colour=True)
+    assert result.unwrapped and result.colour is not None and result.colour.packed_file is not None
+    for slot in coloured.material_slots:
+        shader = next(n for n in slot.material.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+        assert shader.inputs["Base Color"].links[0].from_node.image == result.colour
+    shading.setup(RENDER_SIZE)
+    shading.frame([source])
+    images = [shading.render(obj, str(tmp_path), obj.name) for obj in (source, bare, normals_only, coloured)]
+    mask = shading.covered(*images)
+    bare_d, normals_d, colour_d = (colour_difference(images[0], image, mask) for image in images[1:])
+    print(f"painted Suzanne: mean colour difference bare {bare_d:.4f}, normal map {normals_d:.4f}, "
+          f"normal and colour maps {colour_d:.4f}")
+    assert 1.25 * colour_d < normals_d < bare_d  # measured 1.5x (bpy 4.5)
+
+
+def test_a_colour_bake_cycles_leaves_blank_is_refused_and_undone(ts, bake, scene, monkeypatch):
+    """Where Cycles bakes no colour, a one-line error; the LOD's materials, UV maps, normals and
+    the images are as before the bake (the normal map it made is removed too)."""
+    source = painted_suzanne()
+    lod = decimated(ts, source, "lod")
+    before = ([slot.material for slot in lod.material_slots], [layer.name for layer in lod.data.uv_layers],
+              set(bpy.data.images), {m.name for m in bpy.data.materials})
+    monkeypatch.setattr(bake.bake_colour, "run_colour_bake", lambda *args: None)
+    with pytest.raises(bake.BakeError, match="^this Blender's Cycles baked no colour onto 'lod'$"):
+        bake.bake_normals(bpy.context, source, lod, size=64, margin=2, colour=True)
+    assert ([slot.material for slot in lod.material_slots], [layer.name for layer in lod.data.uv_layers],
+            set(bpy.data.images), {m.name for m in bpy.data.materials}) == before
+
+
+def test_guided_decimate_bakes_colour_on_request(ts, scene, cycles_bakes):
+    """Bake Colour (off by default) gives the result's material its Base Color from a baked image;
+    where Cycles bakes nothing, the run says so and the result stays as decimated."""
+    source = painted_suzanne()
+    assert not scene.topstoc.bake_colour
+    select_only(source)
+    run = lambda: bpy.ops.topstoc.guided_decimate(ratio=0.05, bake_normals=True, bake_size="256",  # noqa: E731
+                                                  bake_margin=4, bake_colour=True)
+    if cycles_bakes:
+        assert run() == {"FINISHED"}
+    else:  # the failure is an error report, which bpy.ops raises in background mode
+        with pytest.raises(RuntimeError, match="Bake Normals: this Blender's Cycles baked no colour onto"):
+            run()
+    [lod] = [o for o in bpy.context.scene.objects if o.type == "MESH" and o is not source]
+    shader = next(n for n in lod.material_slots[0].material.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+    colour = shader.inputs["Base Color"].links[0].from_node
+    if cycles_bakes:
+        assert colour.type == "TEX_IMAGE" and tuple(colour.image.size) == (256, 256)
+        assert normal_map_image(lod) is not None
+    else:
+        assert colour.type == "VERTEX_COLOR" and normal_map_image(lod) is None

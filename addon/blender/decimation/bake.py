@@ -24,7 +24,7 @@ from ...core.support.errors import TopStocError
 from ...core.api.hausdorff import hausdorff
 from ...core.carry.normal_bake import (MAX_OVERLAP, available_memory, check_memory, check_size, island_margin,
                                        overlap_fraction, ray_reach)
-from . import bake_raycast
+from . import bake_colour, bake_raycast
 from ..io import edge_flags, mesh_read
 from ..io.mesh_access import read_array
 
@@ -50,6 +50,7 @@ class Baked:
     max_ray: float           #: max ray distance (world units)
     method: str = "Cycles"   #: "Cycles", or "ray cast" where this Blender's Cycles baked nothing
     path: str = ""           #: the saved file ("" when packed)
+    colour: object = None    #: the base colour image (bake_colour.py), or None
 
 
 def check_bakeable(source, result) -> None:
@@ -325,14 +326,14 @@ def _bake_image(source, result, image, uv_map: str, reach: tuple, margin: int, e
     return "ray cast"
 
 
-def save_image(image, folder: str, stem: str, replace: bool = False) -> str:
-    """Writes ``image`` as ``<folder>/<stem>_normal.png`` atomically and points the image at it;
+def save_image(image, folder: str, stem: str, replace: bool = False, kind: str = "normal") -> str:
+    """Writes ``image`` as ``<folder>/<stem>_<kind>.png`` atomically and points the image at it;
     returns the path. A file of that name is replaced only with ``replace`` (the batch's own
     output), else the next free name is taken (``_1``, ``_2`` …)."""
-    path = os.path.join(folder, f"{stem}_normal.png")
+    path = os.path.join(folder, f"{stem}_{kind}.png")
     index = 1
     while os.path.exists(path) and not replace:
-        path = os.path.join(folder, f"{stem}_normal_{index}.png")
+        path = os.path.join(folder, f"{stem}_{kind}_{index}.png")
         index += 1
     handle, staged = tempfile.mkstemp(prefix=".topstoc-", suffix=".png", dir=folder)
     os.close(handle)
@@ -370,18 +371,21 @@ def bake_folder() -> str:
 
 
 def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16, store: str = "PACK",
-                 folder: str = None, name: str = None, replace: bool = False, progress=None) -> Baked:
+                 folder: str = None, name: str = None, replace: bool = False, colour: bool = False,
+                 progress=None) -> Baked:
     """Bakes ``source``'s shading normals onto ``result`` (its decimated copy) as a tangent-space
     normal map of ``size``² with ``margin`` pixels of bleed. store: "PACK" (into the .blend) or
     "FILE" (``<folder>/<name>_normal.png``; by default beside the .blend, named after the result;
-    an existing file replaced only with ``replace``). ``progress(fraction)`` follows the bake;
-    its False cancels (bake_raycast.Cancelled), leaving ``result`` as it was, like a failed bake."""
+    an existing file replaced only with ``replace``). ``colour``: the base colour too, where the
+    map has a UV map of its own (bake_colour.py). ``progress(fraction)`` follows the bake; its
+    False cancels (bake_raycast.Cancelled), leaving ``result`` as it was, like a failed bake."""
     return bake_raycast.drive(bake_normals_steps(context, source, result, size=size, margin=margin, store=store,
-                                                 folder=folder, name=name, replace=replace), progress)
+                                                 folder=folder, name=name, replace=replace, colour=colour),
+                              progress)
 
 
 def bake_normals_steps(context, source, result, *, size: int = 1024, margin: int = 16, store: str = "PACK",
-                       folder: str = None, name: str = None, replace: bool = False):
+                       folder: str = None, name: str = None, replace: bool = False, colour: bool = False):
     """bake_normals one step at a time: a generator yielding the fraction done (0 when ready to
     bake, then per chunk of rays), returning the Baked. Closed early (``close()``), or failing, it
     leaves ``result`` and the scene as they were."""
@@ -394,7 +398,7 @@ def bake_normals_steps(context, source, result, *, size: int = 1024, margin: int
     hausdorff_max, diagonal, extrusion, max_ray = measure_reach(source, result)
     old_materials = [slot.material for slot in result.material_slots]
     old_uv = (result.data.uv_layers.active_index, [layer.name for layer in result.data.uv_layers])
-    image, made, normals = None, [], None
+    image, made, normals, colour_image = None, [], None, None
     with _SceneState(context, source, result) as state:
         try:
             state.select([result])
@@ -409,19 +413,45 @@ def bake_normals_steps(context, source, result, *, size: int = 1024, margin: int
             # surfaces this close give a flat map rightly (an LOD0 at ratio 1)
             method = yield from _bake_image(source, result, image, uv_map, (extrusion, max_ray), margin,
                                             hausdorff_max > DETAIL * diagonal)
+            if colour and unwrapped:
+                yield 1.0
+                colour_image = _bake_colour(result, made, uv_map, (extrusion, max_ray), margin, size)
             if active_uv >= 0:  # the map made for the bake is not the one the user edits
                 result.data.uv_layers.active_index = active_uv
-            path = save_image(image, folder, bpy.path.clean_name(name or result.name), replace) \
-                if store == "FILE" else ""
-            if store != "FILE":
-                pack_image(image)
+            stem = bpy.path.clean_name(name or result.name)
+            path = save_image(image, folder, stem, replace) if store == "FILE" else ""
+            if colour_image is not None and store == "FILE":
+                save_image(colour_image, folder, stem, replace, kind="color")
+            for baked in (image, colour_image) if store != "FILE" else ():
+                if baked is not None:
+                    pack_image(baked)
         except (BakeError, bake_raycast.Cancelled, GeneratorExit):
+            if colour_image is not None:
+                bpy.data.images.remove(colour_image)
             _undo_materials(result, old_materials, made, image)
             _undo_uv_map(result, *old_uv)
             restore_normals(result, normals)
             raise
     yield 1.0
-    return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, method, path)
+    return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, method, path, colour_image)
+
+
+def _bake_colour(result, materials, uv_map: str, reach: tuple, margin: int, size: int):
+    """The source's base colour baked with Cycles into a new image on ``uv_map`` that
+    ``materials`` (the result's copies) read their Base Color from; an error when Cycles bakes none."""
+    image = bake_colour.new_colour_image(f"{result.name}_color", size)
+    for material in materials:
+        bake_colour.wire_colour(material, image, uv_map)
+    try:
+        bake_colour.run_colour_bake(*reach, margin, size)
+    except RuntimeError as error:
+        bpy.data.images.remove(image)
+        raise BakeError(f"baking the colour onto '{result.name}' failed: {str(error).strip().splitlines()[-1]}") \
+            from None
+    if bake_colour.is_blank(image):
+        bpy.data.images.remove(image)
+        raise BakeError(f"this Blender's Cycles baked no colour onto '{result.name}'")
+    return image
 
 
 def _undo_materials(result, old_materials, made, image) -> None:
@@ -465,7 +495,8 @@ def bake_results_steps(context, settings, pairs):
     pairs = list(pairs)
     for index, (source, result) in enumerate(pairs):
         steps = bake_normals_steps(context, source, result, size=int(settings.bake_size),
-                                   margin=settings.bake_margin, store=settings.bake_store)
+                                   margin=settings.bake_margin, store=settings.bake_store,
+                                   colour=settings.bake_colour)
         try:
             baked = yield from _scaled(steps, index / len(pairs), 1 / len(pairs))
         except TopStocError as error:
@@ -483,7 +514,7 @@ def remove_results(results) -> None:
     materials = {slot.material for obj in results for slot in obj.material_slots if slot.material is not None
                  and slot.material.node_tree and any(n.label == NODE_LABEL for n in slot.material.node_tree.nodes)}
     images = {node.image for material in materials for node in material.node_tree.nodes
-              if node.label == NODE_LABEL and node.image is not None}
+              if node.label in (NODE_LABEL, bake_colour.COLOUR_LABEL) and node.image is not None}
     meshes = {obj.data for obj in results}
     for obj in results:
         bpy.data.objects.remove(obj)
