@@ -657,7 +657,7 @@ def test_baked_colour_shows_the_source_colours_closer(ts, bake, scene, tmp_path,
     source than the bare LOD and than the LOD with the normal map only (both showing the colours
     the LOD's few vertices carried). The colour has no ray-cast fallback: Cycles must bake."""
     if not cycles_bakes:
-        pytest.skip(f"Blender {bpy.app.version_string}'s Cycles bakes nothing here (before a first render)")
+        pytest.skip(f"Blender {bpy.app.version_string}'s Cycles baked nothing in this session")
     source = painted_suzanne()
     bare, normals_only, coloured = (decimated(ts, source, f"{name}") for name in ("bare", "normals", "colour"))
     bake.bake_normals(bpy.context, source, normals_only, size=BAKE_SIZE, margin=8)
