@@ -12,8 +12,9 @@ from mathutils import Vector
 SUN_DIRECTION = (math.radians(50), 0.0, math.radians(-35))  #: the sun's rotation (from the upper left front)
 
 
-def setup(size: int = 256) -> None:
-    """Cycles on the CPU, direct light only, no cast shadows, black world, transparent film, Standard view."""
+def setup(size: int = 256, engine: str = "CYCLES") -> None:
+    """Cycles on the CPU, direct light only (or EEVEE: ``engine="EEVEE"``, the viewport's material
+    look), no cast shadows, black world, transparent film, Standard view."""
     scene = bpy.context.scene
     scene.render.engine = "CYCLES"
     scene.cycles.device = "CPU"
@@ -37,6 +38,14 @@ def setup(size: int = 256) -> None:
         sun_data.use_shadow = False
     if hasattr(getattr(sun_data, "cycles", None), "cast_shadow"):
         sun_data.cycles.cast_shadow = False
+    if engine == "EEVEE":
+        for name in ("BLENDER_EEVEE_NEXT", "BLENDER_EEVEE"):  # 4.2-4.5 call it EEVEE Next
+            try:
+                scene.render.engine = name
+                break
+            except TypeError:
+                continue
+        scene.eevee.taa_render_samples = 8
     sun = bpy.data.objects.new("sun", sun_data)
     sun.rotation_euler = SUN_DIRECTION
     scene.collection.objects.link(sun)

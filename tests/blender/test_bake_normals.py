@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import shading
-from conftest import DATA
+from conftest import DATA, PACKAGE
 from helpers import positions, select_only, snapshot
 
 RATIO = 0.02
@@ -115,12 +115,16 @@ def triangles(obj):
 
 
 
-# (mesh, whether the bake makes its own UV map, how many times closer the baked LOD must shade).
-# The Suzanne meets the issue's 3x; the other two fall short by the geometry a 2 % LOD cannot
-# follow (the rock's polygonal silhouette, the duck's neck crease): measured 2.6x and 1.9x.
-CASES = [(sculpted_suzanne, True, 3.0),   # no UV map: Smart UV Project
-         (sculpted_rock, False, 2.3),     # a UV map with one place per texel: kept
-         (duck, True, 1.5)]               # its own UV map overlaps (mirrored halves): a new one
+# Cycles 3.x bends every shading normal toward the face's own normal where the view grazes
+# (ensure_valid_reflection, for diffuse too; 4.x only for glossy): a normal map on a LOD's large
+# faces loses part of its effect there, in Cycles 3.x renders only (EEVEE 3.4 shows the duck 4.2x).
+CYCLES_3 = bpy.app.version < (4, 0, 0)
+
+# (mesh, whether the bake makes its own UV map, how many times closer the baked LOD must shade
+# in Cycles). The rock falls short by its polygonal silhouette, which no normal map changes.
+CASES = [(sculpted_suzanne, True, 3.0),              # no UV map: Smart UV Project
+         (sculpted_rock, False, 2.3),                # a UV map with one place per texel: kept
+         (duck, True, 2.0 if CYCLES_3 else 3.0)]     # its own UV map overlaps (mirrored halves): a new one
 
 
 @pytest.fixture
@@ -183,18 +187,12 @@ def test_baked_map_shades_like_the_source(ts, bake, scene, tmp_path, make, uv_ma
     result.image.pixels.foreach_get(normals)
     assert np.ptp(normals.reshape(-1, 4)[:, 0]) > 0.3  # not the flat (0.5, 0.5, 1) it started as
 
-    shading.setup(RENDER_SIZE)
-    shading.frame([source])
-    folder = str(tmp_path)
-    images = [shading.render(obj, folder, obj.name) for obj in (source, bare, baked)]
-    mask = shading.covered(*images)
-    assert mask.sum() > 0.15 * RENDER_SIZE ** 2
-    bare_difference = shading.shading_difference(images[0], images[1], mask)
-    baked_difference = shading.shading_difference(images[0], images[2], mask)
+    bare_difference, baked_difference = shading_differences(source, bare, baked, str(tmp_path), "CYCLES")
     print(f"{source.name} ({result.method}): {triangles(source)} -> {triangles(baked)} triangles; mean shading "
           f"difference bare {bare_difference:.4f}, baked {baked_difference:.4f} "
           f"({bare_difference / baked_difference:.1f}x closer)")
     assert baked_difference * closer <= bare_difference
+    folder = str(tmp_path)
 
     out = os.environ.get("TOPSTOC_PICTURES") or folder
     counts = [f"{label}\n{triangles(obj):,} triangles" for label, obj in
@@ -202,6 +200,71 @@ def test_baked_map_shades_like_the_source(ts, bake, scene, tmp_path, make, uv_ma
     picture = os.path.join(out, f"bake_normals_{source.name.split('_')[0]}.png")
     shading.side_by_side([source, bare, baked], counts, picture)
     assert os.path.getsize(picture) < 500_000
+
+
+def shading_differences(source, bare, baked, folder, engine):
+    """(bare LOD's, baked LOD's) mean shading difference to the source, rendered with ``engine``."""
+    shading.setup(RENDER_SIZE, engine)
+    shading.frame([source])
+    images = [shading.render(obj, folder, obj.name) for obj in (source, bare, baked)]
+    mask = shading.covered(*images)
+    assert mask.sum() > 0.15 * RENDER_SIZE ** 2
+    return (shading.shading_difference(images[0], images[1], mask),
+            shading.shading_difference(images[0], images[2], mask))
+
+
+def test_the_duck_shades_like_its_source_in_eevee(ts, bake, scene, tmp_path):
+    """The UV-mapped asset in EEVEE (the viewport's material look, free of Cycles 3.x's normal
+    bending): the baked LOD at least 3x closer to the source than the bare one."""
+    source = duck()
+    bare = decimated(ts, source, source.name + "_bare")
+    baked = decimated(ts, source, source.name + "_baked")
+    bake.bake_normals(bpy.context, source, baked, size=BAKE_SIZE, margin=8, store="PACK")
+    bare_difference, baked_difference = shading_differences(source, bare, baked, str(tmp_path), "EEVEE")
+    print(f"duck in EEVEE: mean shading difference bare {bare_difference:.4f}, baked {baked_difference:.4f} "
+          f"({bare_difference / baked_difference:.1f}x closer)")
+    assert baked_difference * 3.0 <= bare_difference
+
+
+def custom_normals_pair():
+    """A bumped icosphere with custom normals (its own smooth ones, set: Blender marks no edge
+    sharp) and its 20 % LOD, which carries them and the sharp edges setting them marked."""
+    source = small_pair("custom")
+    mesh = source.data
+    if hasattr(mesh, "use_auto_smooth"):
+        mesh.use_auto_smooth = True
+    mesh.normals_split_custom_set_from_vertices([tuple(v.normal) for v in mesh.vertices])
+    assert mesh.has_custom_normals and not any(e.use_edge_sharp for e in mesh.edges)
+    return source
+
+
+def corner_normals(mesh):
+    if hasattr(mesh, "corner_normals"):
+        return np.array([tuple(n.vector) for n in mesh.corner_normals])
+    mesh.calc_normals_split()
+    return np.array([tuple(loop.normal) for loop in mesh.loops])
+
+
+def test_the_lod_bakes_with_its_own_smooth_normals(ts, bake, scene, monkeypatch):
+    """The custom normals the decimation carries (the source's detail at the LOD's corners, and
+    the sharp edges setting them marks) go before the bake: the map is made for, and read with,
+    the LOD's own smooth normals. A failed bake puts them back exactly."""
+    source = custom_normals_pair()
+    lods = [decimated(ts, source, f"lod{i}") for i in range(2)]
+    carried = corner_normals(lods[1].data), [e.use_edge_sharp for e in lods[1].data.edges]
+    assert lods[0].data.has_custom_normals and any(carried[1])
+    bake.bake_normals(bpy.context, source, lods[0], size=64, margin=2)
+    mesh = lods[0].data
+    assert not mesh.has_custom_normals and not any(e.use_edge_sharp for e in mesh.edges)
+    smooth = np.array([tuple(v.normal) for v in mesh.vertices])[[loop.vertex_index for loop in mesh.loops]]
+    assert np.allclose(corner_normals(mesh), smooth, atol=1e-5)   # one normal per vertex: no split
+    monkeypatch.setattr(bake, "_run_bake", lambda *args: None)
+    monkeypatch.setattr(bake.bake_raycast, "bake_steps", lambda *args: iter(()))
+    with pytest.raises(bake.BakeError, match="came back empty"):
+        bake.bake_normals(bpy.context, source, lods[1], size=64, margin=2)
+    assert lods[1].data.has_custom_normals
+    assert np.allclose(corner_normals(lods[1].data), carried[0], atol=1e-4)
+    assert [e.use_edge_sharp for e in lods[1].data.edges] == carried[1]
 
 
 def test_the_user_state_comes_back(ts, bake, scene):
@@ -231,7 +294,7 @@ def test_an_empty_bake_is_refused_and_undone(ts, bake, scene, monkeypatch):
     materials = [slot.material for slot in lod.material_slots]
     images = set(bpy.data.images)
     monkeypatch.setattr(bake, "_run_bake", lambda *args: None)
-    monkeypatch.setattr(bake.bake_raycast, "bake", lambda *args: None)
+    monkeypatch.setattr(bake.bake_raycast, "bake_steps", lambda *args: iter(()))
     with pytest.raises(bake.BakeError, match="came back empty: no ray from it reached"):
         bake.bake_normals(bpy.context, source, lod, size=64, margin=2)
     assert [slot.material for slot in lod.material_slots] == materials
@@ -352,7 +415,9 @@ def batch_bake(ts, tmp_path, kind):
     done = subprocess.run(command, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     [lod] = json.loads(report.read_text())["results"][0]["objects"][0]["lods"]
-    assert lod["normal_map"] == str(out / "pebble_pebble_normal.png") and os.path.isfile(lod["normal_map"])
+    # <output>_<object>_normal.png; USD's importer names the object after its mesh
+    assert lod["normal_map"] == str(out / f"pebble_{'Icosphere' if kind.startswith('usd') else 'pebble'}_normal.png")
+    assert os.path.isfile(lod["normal_map"])
     return command, out, lod, source_faces
 
 
@@ -439,3 +504,210 @@ def test_a_map_beside_the_blend_never_replaces_a_file(ts, bake, scene, tmp_path,
     reread = bpy.data.images.load(result.path)
     assert tuple(reread.size) == (64, 64)
     assert np.allclose(decoded(reread), decoded(result.image), atol=1 / 255)
+
+
+def test_batch_writes_a_usd_that_reimports_with_its_map(ts, scene, tmp_path):
+    """``--bake-normals`` with USD output: the UsdPreviewSurface's normal input reads the baked
+    PNG (by a path relative to the output), and Blender's importer reads it back into a Normal
+    Map node. Debian's Blender 3.4 is built without USD."""
+    if not bpy.app.build_options.usd:
+        pytest.skip(f"Blender {bpy.app.version_string} is built without USD")
+    _command, out, lod, source_faces = batch_bake(ts, tmp_path, "usda")
+    text = (out / "pebble.usda").read_text()
+    name = os.path.basename(lod["normal_map"])
+    assert "normal3f inputs:normal.connect = </root/_materials/" in text
+    assert f"asset inputs:file = @./textures/{name}@" in text  # USD's exporter copies it there
+    assert sorted(os.listdir(out)) == ["pebble.usda", name, "textures"] and name in os.listdir(out / "textures")
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    for image in list(bpy.data.images):
+        bpy.data.images.remove(image)
+    importlib_module(ts, "blender.io.scene_files").import_file(str(out / "pebble.usda"))
+    [obj] = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+    image = normal_map_image(obj)
+    assert image is not None and tuple(image.size) == (128, 128)
+    written = bpy.data.images.load(lod["normal_map"])
+    assert np.array_equal(pixels_of(image), pixels_of(written)) and np.ptp(pixels_of(written)) > 0.3
+    assert sum(len(p.vertices) - 2 for p in obj.data.polygons) == lod["triangles"] < source_faces / 5
+
+
+def pixels_of(image):
+    out = np.empty(len(image.pixels), dtype=np.float32)
+    image.pixels.foreach_get(out)
+    return out
+
+
+def skinned(source):
+    """``source`` deformed by a one-bone armature (every vertex weighted to it) posed a quarter
+    turn away from its rest pose."""
+    armature = bpy.data.objects.new("rig", bpy.data.armatures.new("rig"))
+    bpy.context.scene.collection.objects.link(armature)
+    select_only(armature)
+    bpy.ops.object.mode_set(mode="EDIT")
+    bone = armature.data.edit_bones.new("bone")
+    bone.head, bone.tail = (0.0, 0.0, -1.0), (0.0, 0.0, 0.0)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    armature.pose.bones["bone"].rotation_mode = "XYZ"
+    armature.pose.bones["bone"].rotation_euler = (np.pi / 2, 0.0, 0.0)
+    group = source.vertex_groups.new(name="bone")
+    group.add(list(range(len(source.data.vertices))), 1.0, "REPLACE")
+    source.modifiers.new("rig", "ARMATURE").object = armature
+    bpy.context.view_layer.update()
+    return armature
+
+
+def evaluated_positions(obj):
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    return np.array([tuple(v.co) for v in evaluated.data.vertices])
+
+
+def test_a_skinned_source_bakes_in_its_rest_pose(ts, bake, scene, monkeypatch):
+    """An armature-deformed source and its LOD (which keeps the weights and the Armature modifier)
+    bake from the rest pose (what Cycles sees while baking), giving the same map as the same
+    pair without the armature; the pose, the modifiers and the weights are as before."""
+    source = small_pair("skinned")
+    rig = skinned(source)
+    lods = [decimated(ts, source, f"lod{i}") for i in range(2)]
+    assert [m.type for m in lods[0].modifiers] == ["ARMATURE"] and "bone" in lods[0].vertex_groups
+    weights = [[g.weight for g in v.groups] for v in lods[0].data.vertices]
+    rest_positions = np.array([tuple(v.co) for v in source.data.vertices])
+    assert np.abs(evaluated_positions(source) - rest_positions).max() > 0.5     # posed
+    seen = []
+    run_bake = bake._run_bake
+    monkeypatch.setattr(bake, "_run_bake", lambda *args: (seen.append(evaluated_positions(source)),
+                                                          run_bake(*args))[1])
+    posed = bake.bake_normals(bpy.context, source, lods[0], size=64, margin=2)
+    assert np.allclose(seen[0], rest_positions, atol=1e-6)                       # Cycles bakes the rest pose
+    assert np.abs(evaluated_positions(source) - rest_positions).max() > 0.5     # posed again
+    for obj in (source, lods[1]):
+        obj.modifiers.clear()
+    bpy.context.view_layer.update()
+    rest = bake.bake_normals(bpy.context, source, lods[1], size=64, margin=2)
+    assert posed.method == rest.method and np.ptp(pixels_of(rest.image)) > 0.3
+    assert np.abs(pixels_of(posed.image) - pixels_of(rest.image)).max() <= 1 / 255
+    modifier = lods[0].modifiers["rig"]
+    assert modifier.object == rig and modifier.show_viewport and modifier.show_render
+    assert tuple(rig.pose.bones["bone"].rotation_euler) == pytest.approx((np.pi / 2, 0.0, 0.0))
+    assert [[g.weight for g in v.groups] for v in lods[0].data.vertices] == weights
+
+
+def test_batch_bakes_a_posed_skinned_character(ts, scene, tmp_path):
+    """``--bake-normals`` on a .blend whose rigged character is posed: the LOD is baked (in the rest
+    pose) and keeps its weights and its Armature modifier on the rig."""
+    import launch
+    from test_character import MAKE_CHARACTER
+
+    source = tmp_path / "character.blend"
+    code = MAKE_CHARACTER.format(tests=str(DATA.parent / "blender"), path=str(source)).replace(
+        "make_character()\n", "make_character()\nbpy.data.objects['Rig'].pose.bones['Upper'].rotation_mode = 'XYZ'\n"
+        "bpy.data.objects['Rig'].pose.bones['Upper'].rotation_euler = (1.0, 0.0, 0.4)\n")
+    made = launch.background(expr=code, timeout=120)
+    assert made.returncode == 0, made.stderr
+    out = tmp_path / "out"
+    done = launch.background(PACKAGE / "batch.py", "--input", source, "--ratio", "0.3",
+                             "--output", out, "--bake-normals", "64", timeout=300)
+    assert done.returncode == 0, done.stderr
+    try:
+        bpy.ops.wm.open_mainfile(filepath=str(out / "character.blend"))
+    except RuntimeError as error:
+        pytest.skip(f"this Blender cannot read the batch Blender's file: {error}")
+    body, rig = bpy.data.objects["Body"], bpy.data.objects["Rig"]
+    assert tuple(rig.pose.bones["Upper"].rotation_euler) == pytest.approx((1.0, 0.0, 0.4))
+    assert [(m.type, m.object, m.show_viewport) for m in body.modifiers] == [("ARMATURE", rig, True)]
+    assert {g.name for g in body.vertex_groups} >= {"Lower", "Upper"}
+    assert all(len(v.groups) for v in body.data.vertices)
+    image = normal_map_image(body)
+    assert image is not None and tuple(image.size) == (64, 64) and np.ptp(pixels_of(image)) > 0.1
+
+
+def painted_suzanne():
+    """Suzanne subdivided three times (about 63k triangles), smooth, without a UV map, its Base
+    Color a colour attribute painted per vertex in stripes a 2 % LOD's few vertices cannot hold
+    (a scan's colours, say)."""
+    bpy.ops.mesh.primitive_monkey_add()
+    monkey = subdivided(bpy.context.active_object, 3)
+    monkey.name = "painted"
+    while monkey.data.uv_layers:
+        monkey.data.uv_layers.remove(monkey.data.uv_layers[0])
+    mesh = monkey.data
+    for polygon in mesh.polygons:
+        polygon.use_smooth = True
+    co = positions(mesh).astype(np.float64)
+    stripes = np.stack([0.5 + 0.4 * np.sin(14 * co[:, 0]), 0.5 + 0.4 * np.sin(14 * co[:, 2] + 1.0),
+                        0.5 + 0.4 * np.sin(10 * co[:, 1] + 2.0), np.ones(len(co))], axis=1)
+    attribute = mesh.color_attributes.new("paint", "FLOAT_COLOR", "POINT")
+    attribute.data.foreach_set("color", stripes.astype(np.float32).ravel())
+    material = bpy.data.materials.new("paint")
+    material.use_nodes = True
+    tree = material.node_tree
+    node = tree.nodes.new("ShaderNodeVertexColor")
+    node.layer_name = "paint"
+    tree.links.new(node.outputs["Color"], next(n for n in tree.nodes if n.type == "BSDF_PRINCIPLED").inputs["Base Color"])
+    mesh.materials.append(material)
+    return monkey
+
+
+def colour_difference(reference, other, mask):
+    return float(np.abs(reference[..., :3] - other[..., :3]).mean(axis=-1)[mask].mean())
+
+
+def test_baked_colour_shows_the_source_colours_closer(ts, bake, scene, tmp_path, cycles_bakes):
+    """A source without UV map (the bake lays one out) painted per vertex: asked, the bake lays the
+    base colour on that map too. Rendered, the 2 % LOD reading its colour from it is closer to the
+    source than the bare LOD and than the LOD with the normal map only (both showing the colours
+    the LOD's few vertices carried). The colour has no ray-cast fallback: Cycles must bake."""
+    if not cycles_bakes:
+        pytest.skip(f"Blender {bpy.app.version_string}'s Cycles baked nothing in this session")
+    source = painted_suzanne()
+    bare, normals_only, coloured = (decimated(ts, source, f"{name}") for name in ("bare", "normals", "colour"))
+    bake.bake_normals(bpy.context, source, normals_only, size=BAKE_SIZE, margin=8)
+    result = bake.bake_normals(bpy.context, source, coloured, size=BAKE_SIZE, margin=8, colour=True)
+    assert result.unwrapped and result.colour is not None and result.colour.packed_file is not None
+    for slot in coloured.material_slots:
+        shader = next(n for n in slot.material.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+        assert shader.inputs["Base Color"].links[0].from_node.image == result.colour
+    shading.setup(RENDER_SIZE)
+    shading.frame([source])
+    images = [shading.render(obj, str(tmp_path), obj.name) for obj in (source, bare, normals_only, coloured)]
+    mask = shading.covered(*images)
+    bare_d, normals_d, colour_d = (colour_difference(images[0], image, mask) for image in images[1:])
+    print(f"painted Suzanne: mean colour difference bare {bare_d:.4f}, normal map {normals_d:.4f}, "
+          f"normal and colour maps {colour_d:.4f}")
+    assert 1.25 * colour_d < normals_d < bare_d  # measured 1.5x (bpy 4.5)
+
+
+def test_a_colour_bake_cycles_leaves_blank_is_refused_and_undone(ts, bake, scene, monkeypatch):
+    """Where Cycles bakes no colour, a one-line error; the LOD's materials, UV maps, normals and
+    the images are as before the bake (the normal map it made is removed too)."""
+    source = painted_suzanne()
+    lod = decimated(ts, source, "lod")
+    before = ([slot.material for slot in lod.material_slots], [layer.name for layer in lod.data.uv_layers],
+              set(bpy.data.images), {m.name for m in bpy.data.materials})
+    monkeypatch.setattr(bake.bake_colour, "run_colour_bake", lambda *args: None)
+    with pytest.raises(bake.BakeError, match="^this Blender's Cycles baked no colour onto 'lod'$"):
+        bake.bake_normals(bpy.context, source, lod, size=64, margin=2, colour=True)
+    assert ([slot.material for slot in lod.material_slots], [layer.name for layer in lod.data.uv_layers],
+            set(bpy.data.images), {m.name for m in bpy.data.materials}) == before
+
+
+def test_guided_decimate_bakes_colour_on_request(ts, scene, cycles_bakes):
+    """Bake Colour (off by default) gives the result's material its Base Color from a baked image;
+    where Cycles bakes nothing, the run says so and the result stays as decimated."""
+    source = painted_suzanne()
+    assert not scene.topstoc.bake_colour
+    select_only(source)
+    run = lambda: bpy.ops.topstoc.guided_decimate(ratio=0.05, bake_normals=True, bake_size="256",  # noqa: E731
+                                                  bake_margin=4, bake_colour=True)
+    if cycles_bakes:
+        assert run() == {"FINISHED"}
+    else:  # the failure is an error report, which bpy.ops raises in background mode
+        with pytest.raises(RuntimeError, match="Bake Normals: this Blender's Cycles baked no colour onto"):
+            run()
+    [lod] = [o for o in bpy.context.scene.objects if o.type == "MESH" and o is not source]
+    shader = next(n for n in lod.material_slots[0].material.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+    colour = shader.inputs["Base Color"].links[0].from_node
+    if cycles_bakes:
+        assert colour.type == "TEX_IMAGE" and tuple(colour.image.size) == (256, 256)
+        assert normal_map_image(lod) is not None
+    else:
+        assert colour.type == "VERTEX_COLOR" and normal_map_image(lod) is None

@@ -24,8 +24,9 @@ from ...core.support.errors import TopStocError
 from ...core.api.hausdorff import hausdorff
 from ...core.carry.normal_bake import (MAX_OVERLAP, available_memory, check_memory, check_size, island_margin,
                                        overlap_fraction, ray_reach)
-from . import bake_raycast
-from ..io import mesh_read
+from . import bake_colour, bake_raycast
+from ..io import edge_flags, mesh_read
+from ..io.mesh_access import read_array
 
 BAKE_UV_NAME = "TopStoc Bake"  #: the UV map made when the result has no usable one
 HAUSDORFF_SAMPLES = 200_000
@@ -49,10 +50,12 @@ class Baked:
     max_ray: float           #: max ray distance (world units)
     method: str = "Cycles"   #: "Cycles", or "ray cast" where this Blender's Cycles baked nothing
     path: str = ""           #: the saved file ("" when packed)
+    colour: object = None    #: the base colour image (bake_colour.py), or None
 
 
 def check_bakeable(source, result) -> None:
-    """One-line errors for what a bake cannot use: non-meshes, a source without faces, modifiers."""
+    """One-line errors for what a bake cannot use: non-meshes, a source without faces, modifiers
+    (but Armature ones: the bake uses the rest pose)."""
     for obj in (source, result):
         mesh_read.check_mesh_object(obj, BakeError)
     if len(source.data.polygons) == 0:
@@ -60,7 +63,7 @@ def check_bakeable(source, result) -> None:
     if len(result.data.polygons) == 0:
         raise BakeError(f"'{result.name}' has no faces to bake a normal map onto")
     for obj in (source, result):
-        live = [m.name for m in obj.modifiers if m.show_render or m.show_viewport]
+        live = [m.name for m in obj.modifiers if (m.show_render or m.show_viewport) and m.type != "ARMATURE"]
         if live:
             raise BakeError(f"'{obj.name}' has modifiers that are not applied ({', '.join(live)}): apply or "
                             f"disable them before baking normals")
@@ -116,6 +119,38 @@ def ensure_uv_map(obj, size: int, margin: int) -> tuple:
     finally:
         bpy.ops.object.mode_set(mode="OBJECT")
     return name, True
+
+
+def own_normals(result):
+    """Gives ``result`` (the only selected object and the active one) its own smooth normals, no
+    custom normals and no sharp edges: the decimation carried the source's custom normals (its
+    detail sampled at the LOD's few corners, and sharp edges wherever those differ), which tilt
+    the bake's rays and tangent frames; the map carries the source's shading instead, hard edges
+    included. Returns what restore_normals puts back (None: nothing changed)."""
+    mesh = result.data
+    normals = mesh_read.read_custom_normals(mesh)
+    sharp = read_array(mesh.edges, "use_edge_sharp", len(mesh.edges), 1, bool)
+    angle = getattr(mesh, "auto_smooth_angle", None)  # Blender < 4.1 splits normals at wider angles
+    if normals is None and not sharp.any() and (angle is None or not mesh.use_auto_smooth or angle >= np.pi):
+        return None
+    if normals is not None:
+        bpy.ops.mesh.customdata_custom_splitnormals_clear()
+    if angle is not None:
+        mesh.auto_smooth_angle = np.pi
+    edge_flags.write_edge_flags(mesh, {"use_edge_sharp": np.zeros(len(sharp), dtype=bool)})
+    return normals, angle, sharp
+
+
+def restore_normals(result, saved) -> None:
+    """Puts back the custom normals and sharp edges own_normals took from ``result``."""
+    if saved is None:
+        return
+    normals, angle, sharp = saved
+    if angle is not None:
+        result.data.auto_smooth_angle = angle
+    if normals is not None:
+        result.data.normals_split_custom_set(normals)
+    edge_flags.write_edge_flags(result.data, {"use_edge_sharp": sharp})
 
 
 def new_image(name: str, size: int) -> bpy.types.Image:
@@ -194,8 +229,9 @@ def give_materials(result, image, uv_map: str) -> list:
 
 
 class _SceneState:
-    """The render engine, Cycles device and samples, selection, active object, visibility and the
-    result's placement, put back when the ``with`` block ends, whatever happens in it."""
+    """The render engine, Cycles device and samples, selection, active object, visibility, the
+    result's placement and the Armature modifiers (off while baking), put back when the ``with``
+    block ends, whatever happens in it."""
 
     def __init__(self, context, source, result):
         self.context, self.source, self.result = context, source, result
@@ -205,8 +241,12 @@ class _SceneState:
         self.hidden = {obj: (obj.hide_get(), obj.hide_viewport, obj.hide_select) for obj in (source, result)}
         self.matrix = result.matrix_basis.copy()
         self.cycles = None
+        self.armatures = {m: (m.show_viewport, m.show_render) for obj in (source, result)
+                          for m in obj.modifiers if m.type == "ARMATURE"}
 
     def __enter__(self):
+        for modifier in self.armatures:  # skinned: both baked in their rest pose, as their meshes are
+            modifier.show_viewport = modifier.show_render = False
         for obj in self.hidden:
             obj.hide_set(False)
             obj.hide_viewport = obj.hide_select = False
@@ -231,6 +271,8 @@ class _SceneState:
         if self.cycles is not None:
             scene.cycles.device, scene.cycles.samples = self.cycles
         scene.render.engine = self.engine
+        for modifier, (viewport, render) in self.armatures.items():
+            modifier.show_viewport, modifier.show_render = viewport, render
         self.result.matrix_basis = self.matrix
         for obj, (hidden, viewport, unselectable) in self.hidden.items():
             obj.hide_viewport, obj.hide_select = viewport, unselectable
@@ -269,29 +311,29 @@ def has_detail(image) -> bool:
     return bool((unit[:, 2] < np.cos(np.radians(1.0))).any())
 
 
-def _bake_image(source, result, image, uv_map: str, reach: tuple, margin: int, expect_detail: bool,
-                progress=None) -> str:
+def _bake_image(source, result, image, uv_map: str, reach: tuple, margin: int, expect_detail: bool):
     """Bakes into ``image`` with Cycles, or by ray casting when Cycles leaves the map flat though
-    the surfaces differ (told to ``progress``); returns which ("Cycles" or "ray cast")."""
+    the surfaces differ, yielding the fraction done; returns which ("Cycles" or "ray cast")."""
     extrusion, max_ray = reach
     _run_bake(extrusion, max_ray, margin, image.size[0], result.name)
     if not expect_detail or has_detail(image):
         return "Cycles"
-    bake_raycast.bake(source, result, image, uv_map, extrusion, max_ray, margin, progress)
+    yield 0.0  # Cycles' turn done (nothing to show for it): the rays follow
+    yield from bake_raycast.bake_steps(source, result, image, uv_map, extrusion, max_ray, margin)
     if not has_detail(image):
         raise BakeError(f"the bake onto '{result.name}' came back empty: no ray from it reached "
                         f"'{source.name}'")
     return "ray cast"
 
 
-def save_image(image, folder: str, stem: str, replace: bool = False) -> str:
-    """Writes ``image`` as ``<folder>/<stem>_normal.png`` atomically and points the image at it;
+def save_image(image, folder: str, stem: str, replace: bool = False, kind: str = "normal") -> str:
+    """Writes ``image`` as ``<folder>/<stem>_<kind>.png`` atomically and points the image at it;
     returns the path. A file of that name is replaced only with ``replace`` (the batch's own
     output), else the next free name is taken (``_1``, ``_2`` …)."""
-    path = os.path.join(folder, f"{stem}_normal.png")
+    path = os.path.join(folder, f"{stem}_{kind}.png")
     index = 1
     while os.path.exists(path) and not replace:
-        path = os.path.join(folder, f"{stem}_normal_{index}.png")
+        path = os.path.join(folder, f"{stem}_{kind}_{index}.png")
         index += 1
     handle, staged = tempfile.mkstemp(prefix=".topstoc-", suffix=".png", dir=folder)
     os.close(handle)
@@ -329,12 +371,24 @@ def bake_folder() -> str:
 
 
 def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16, store: str = "PACK",
-                 folder: str = None, name: str = None, replace: bool = False, progress=None) -> Baked:
+                 folder: str = None, name: str = None, replace: bool = False, colour: bool = False,
+                 progress=None) -> Baked:
     """Bakes ``source``'s shading normals onto ``result`` (its decimated copy) as a tangent-space
     normal map of ``size``² with ``margin`` pixels of bleed. store: "PACK" (into the .blend) or
     "FILE" (``<folder>/<name>_normal.png``; by default beside the .blend, named after the result;
-    an existing file replaced only with ``replace``). ``progress(fraction)`` follows the ray cast;
-    its False cancels (bake_raycast.Cancelled), leaving ``result`` as it was, like a failed bake."""
+    an existing file replaced only with ``replace``). ``colour``: the base colour too, where the
+    map has a UV map of its own (bake_colour.py). ``progress(fraction)`` follows the bake; its
+    False cancels (bake_raycast.Cancelled), leaving ``result`` as it was, like a failed bake."""
+    return bake_raycast.drive(bake_normals_steps(context, source, result, size=size, margin=margin, store=store,
+                                                 folder=folder, name=name, replace=replace, colour=colour),
+                              progress)
+
+
+def bake_normals_steps(context, source, result, *, size: int = 1024, margin: int = 16, store: str = "PACK",
+                       folder: str = None, name: str = None, replace: bool = False, colour: bool = False):
+    """bake_normals one step at a time: a generator yielding the fraction done (0 when ready to
+    bake, then per chunk of rays), returning the Baked. Closed early (``close()``), or failing, it
+    leaves ``result`` and the scene as they were."""
     size = check_size(size)
     check_memory(size, available_memory())
     check_bakeable(source, result)
@@ -344,30 +398,60 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
     hausdorff_max, diagonal, extrusion, max_ray = measure_reach(source, result)
     old_materials = [slot.material for slot in result.material_slots]
     old_uv = (result.data.uv_layers.active_index, [layer.name for layer in result.data.uv_layers])
-    image, made = None, []
+    image, made, normals, colour_image = None, [], None, None
     with _SceneState(context, source, result) as state:
         try:
             state.select([result])
+            normals = own_normals(result)
             active_uv = result.data.uv_layers.active_index
             uv_map, unwrapped = ensure_uv_map(result, size, margin)
             image = new_image(f"{result.name}_normal", size)
             made = give_materials(result, image, uv_map)
             state.select([source, result])
             state.use_cycles()
+            yield 0.0
             # surfaces this close give a flat map rightly (an LOD0 at ratio 1)
-            method = _bake_image(source, result, image, uv_map, (extrusion, max_ray), margin,
-                                 hausdorff_max > DETAIL * diagonal, progress)
+            method = yield from _bake_image(source, result, image, uv_map, (extrusion, max_ray), margin,
+                                            hausdorff_max > DETAIL * diagonal)
+            if colour and unwrapped:
+                yield 1.0
+                colour_image = _bake_colour(result, made, uv_map, (extrusion, max_ray), margin, size)
             if active_uv >= 0:  # the map made for the bake is not the one the user edits
                 result.data.uv_layers.active_index = active_uv
-            path = save_image(image, folder, bpy.path.clean_name(name or result.name), replace) \
-                if store == "FILE" else ""
-            if store != "FILE":
-                pack_image(image)
-        except (BakeError, bake_raycast.Cancelled):
+            stem = bpy.path.clean_name(name or result.name)
+            path = save_image(image, folder, stem, replace) if store == "FILE" else ""
+            if colour_image is not None and store == "FILE":
+                save_image(colour_image, folder, stem, replace, kind="color")
+            for baked in (image, colour_image) if store != "FILE" else ():
+                if baked is not None:
+                    pack_image(baked)
+        except (BakeError, bake_raycast.Cancelled, GeneratorExit):
+            if colour_image is not None:
+                bpy.data.images.remove(colour_image)
             _undo_materials(result, old_materials, made, image)
             _undo_uv_map(result, *old_uv)
+            restore_normals(result, normals)
             raise
-    return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, method, path)
+    yield 1.0
+    return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, method, path, colour_image)
+
+
+def _bake_colour(result, materials, uv_map: str, reach: tuple, margin: int, size: int):
+    """The source's base colour baked with Cycles into a new image on ``uv_map`` that
+    ``materials`` (the result's copies) read their Base Color from; an error when Cycles bakes none."""
+    image = bake_colour.new_colour_image(f"{result.name}_color", size)
+    for material in materials:
+        bake_colour.wire_colour(material, image, uv_map)
+    try:
+        bake_colour.run_colour_bake(*reach, margin, size)
+    except RuntimeError as error:
+        bpy.data.images.remove(image)
+        raise BakeError(f"baking the colour onto '{result.name}' failed: {str(error).strip().splitlines()[-1]}") \
+            from None
+    if bake_colour.is_blank(image):
+        bpy.data.images.remove(image)
+        raise BakeError(f"this Blender's Cycles baked no colour onto '{result.name}'")
+    return image
 
 
 def _undo_materials(result, old_materials, made, image) -> None:
@@ -389,19 +473,32 @@ def _undo_uv_map(result, active: int, names: list) -> None:
         layers.active_index = active
 
 
-def bake_results(context, settings, pairs, progress=None) -> tuple:
-    """Bakes every (source, result) pair with an operator's BakeParameters; returns (status lines,
-    one-line failures). A failed bake leaves its result as decimated. ``progress(fraction)`` follows
-    the whole run; its False cancels (bake_raycast.Cancelled raised, the current result as it was)."""
+def _scaled(steps, start: float, share: float):
+    """Yields what the generator ``steps`` yields mapped onto [start, start + share]; returns its
+    value. Closed early, it closes ``steps`` (whose clean-up then runs)."""
+    try:
+        while True:
+            try:
+                fraction = next(steps)
+            except StopIteration as done:
+                return done.value
+            yield start + share * fraction
+    finally:
+        steps.close()
+
+
+def bake_results_steps(context, settings, pairs):
+    """Bakes every (source, result) pair with an operator's BakeParameters, yielding the fraction
+    of the whole run done; returns (status lines, one-line failures). A failed bake leaves its
+    result as decimated; closed early, the result being baked is left as it was."""
     lines, failures = [], []
     pairs = list(pairs)
     for index, (source, result) in enumerate(pairs):
-        told = None if progress is None else (lambda f, i=index: progress((i + f) / len(pairs)))
+        steps = bake_normals_steps(context, source, result, size=int(settings.bake_size),
+                                   margin=settings.bake_margin, store=settings.bake_store,
+                                   colour=settings.bake_colour)
         try:
-            baked = bake_normals(context, source, result, size=int(settings.bake_size),
-                                 margin=settings.bake_margin, store=settings.bake_store, progress=told)
-        except bake_raycast.Cancelled:
-            raise
+            baked = yield from _scaled(steps, index / len(pairs), 1 / len(pairs))
         except TopStocError as error:
             failures.append(f"Bake Normals: {error}")
             continue
@@ -417,7 +514,7 @@ def remove_results(results) -> None:
     materials = {slot.material for obj in results for slot in obj.material_slots if slot.material is not None
                  and slot.material.node_tree and any(n.label == NODE_LABEL for n in slot.material.node_tree.nodes)}
     images = {node.image for material in materials for node in material.node_tree.nodes
-              if node.label == NODE_LABEL and node.image is not None}
+              if node.label in (NODE_LABEL, bake_colour.COLOUR_LABEL) and node.image is not None}
     meshes = {obj.data for obj in results}
     for obj in results:
         bpy.data.objects.remove(obj)

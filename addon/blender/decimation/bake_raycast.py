@@ -3,7 +3,8 @@
 extrusion, inward along its smooth normal, at most the max ray distance; first hit on the source),
 cast with Blender's BVH tree, and the source's smooth normal at the hit written in the result's
 MikkTSpace tangent frame (what the Normal Map node reads back). Texel centres only, no antialiasing.
-The rays go in chunks, each reported to ``progress`` (whose False cancels: the image is left as it was)."""
+The bake is a generator yielding after every chunk of rays (drive runs one to its end with a
+progress callback whose False cancels: the image is left as it was)."""
 
 from __future__ import annotations
 
@@ -63,6 +64,21 @@ def _tangent_frames(mesh, uv_map: str, rotation: np.ndarray) -> tuple:
     return normals, _unit(tangents.reshape(-1, 3) @ rotation.T), signs
 
 
+def _frames(normal, tangent, sign) -> np.ndarray:
+    """(k, 3, 3) columns tangent, bitangent, normal, interpolated and not normalised: the frame
+    the Normal Map node decodes with (colour x T + y B + z N), B = sign N x T."""
+    return np.stack([tangent, sign[:, None] * np.cross(normal, tangent), normal], axis=2)
+
+
+def _encode(frames, normals) -> np.ndarray:
+    """The unit tangent-space vectors the frames decode into ``normals``, as Blender's bake
+    writes them (the frame inverted, not assumed orthonormal); (0, 0, 1) in a degenerate frame."""
+    encoded = np.tile((0.0, 0.0, 1.0), (len(normals), 1))
+    good = np.abs(np.linalg.det(frames)) > 1e-9
+    encoded[good] = np.linalg.solve(frames[good], normals[good][:, :, None])[:, :, 0]
+    return _unit(encoded)
+
+
 def _source_normals(mesh, matrix, hits, triangle_ids) -> np.ndarray:
     """The source's smooth (corner) normal at each hit point of its loop triangles."""
     loops, vertices = _triangles(mesh)
@@ -77,9 +93,9 @@ def _source_normals(mesh, matrix, hits, triangle_ids) -> np.ndarray:
     return _unit(np.einsum("ij,ijk->ik", weights, normals[loops[triangle_ids]]))
 
 
-def _cast(tree, origins, directions, reach, progress=None) -> tuple:
-    """(hit locations, triangle ids, whether hit) of the first hits within ``reach``; ``progress``
-    is told the fraction cast after every CHUNK rays, and its False raises Cancelled."""
+def _cast(tree, origins, directions, reach):
+    """Yields the fraction cast after every CHUNK rays; returns (hit locations, triangle ids,
+    whether hit) of the first hits within ``reach``."""
     hits = np.zeros_like(origins)
     ids = np.zeros(len(origins), dtype=np.int64)
     found = np.zeros(len(origins), dtype=bool)
@@ -90,16 +106,27 @@ def _cast(tree, origins, directions, reach, progress=None) -> tuple:
             location, _normal, index, _distance = tree.ray_cast(Vector(origin), Vector(direction), reach)
             if index is not None:
                 hits[i], ids[i], found[i] = location, index, True
-        if progress is not None and progress(stop / len(origins)) is False:
-            raise Cancelled("normal map bake cancelled")
+        yield stop / len(origins)
     return hits, ids, found
 
 
-def bake(source, result, image, uv_map: str, extrusion: float, max_ray: float, margin: int,
-         progress=None) -> None:
+def drive(steps, progress=None):
+    """Runs the generator ``steps`` to its end, telling ``progress`` every fraction it yields;
+    progress's False closes it (its own clean-up runs) and raises Cancelled. Returns its value."""
+    while True:
+        try:
+            fraction = next(steps)
+        except StopIteration as done:
+            return done.value
+        if progress is not None and progress(fraction) is False:
+            steps.close()
+            raise Cancelled("normal map bake cancelled")
+
+
+def bake_steps(source, result, image, uv_map: str, extrusion: float, max_ray: float, margin: int):
     """Writes the tangent-space normals of ``source`` seen from ``result`` (placed where the source
-    is) into ``image`` (square), laid out on ``uv_map``, with ``margin`` texels of bleed.
-    ``progress(fraction)`` is called as the rays go; its False raises Cancelled, ``image`` untouched."""
+    is) into ``image`` (square), laid out on ``uv_map``, with ``margin`` texels of bleed, yielding
+    the fraction of rays cast after every chunk (``image`` is written after the last)."""
     size = image.size[0]
     matrix = np.array(source.matrix_world, dtype=np.float64)
     mesh = result.data
@@ -110,17 +137,16 @@ def bake(source, result, image, uv_map: str, extrusion: float, max_ray: float, m
     normals, tangents, signs = _tangent_frames(mesh, uv_map, matrix[:3, :3])
     corner = loops[triangle]                                      # (k, 3) loops of each texel's triangle
     points = np.einsum("ij,ijk->ik", weights, _world(mesh, matrix)[vertices[triangle]])
-    normal = _unit(np.einsum("ij,ijk->ik", weights, normals[corner]))
-    tangent = np.einsum("ij,ijk->ik", weights, tangents[corner])
-    tangent = _unit(tangent - normal * np.einsum("ij,ij->i", tangent, normal)[:, None])
-    bitangent = signs[corner[:, 0]][:, None] * np.cross(normal, tangent)
+    normal = np.einsum("ij,ijk->ik", weights, normals[corner])
+    frames = _frames(normal, np.einsum("ij,ijk->ik", weights, tangents[corner]), signs[corner[:, 0]])
+    normal = _unit(normal)
 
     _, source_vertices = _triangles(source.data)
     tree = BVHTree.FromPolygons(_world(source.data, matrix).tolist(), source_vertices.tolist())
-    hits, ids, found = _cast(tree, points + extrusion * normal, -normal, max_ray, progress)
+    hits, ids, found = yield from _cast(tree, points + extrusion * normal, -normal, max_ray)
     seen = normal.copy()
     seen[found] = _source_normals(source.data, matrix, hits[found], ids[found])
-    encoded = np.stack([np.einsum("ij,ij->i", seen, axis) for axis in (tangent, bitangent, normal)], axis=1)
+    encoded = _encode(frames, seen)
 
     values = np.zeros((size * size, 3))
     values[texels] = encoded * 0.5 + 0.5

@@ -62,40 +62,50 @@ def write_run(operator, run, done: Outcome) -> None:
 
 
 def conclude(operator, context, done: Outcome):
-    """Bakes when asked, reports, selects the results (main thread, after every write)."""
-    outputs, lines, failures, sources, missed = done.outputs, done.lines, done.failures, done.sources, done.missed
-    baked = []
-    if operator.bake_normals and outputs:
-        if operator.output == "NEW_OBJECT":
-            finished = bake_run.bake_or_discard(context, operator, zip(sources, outputs), outputs)
+    """Bakes when asked (modal where the window gets events: the operator's bake_finished then
+    reports), else reports at once; selects the results (main thread, after every write)."""
+    if operator.bake_normals and done.outputs:
+        if operator.output != "NEW_OBJECT":
+            done.failures.append("Bake Normals needs Output: New Object (in place, no original is left to "
+                                 "bake from)")
+        elif getattr(operator, "_modal", False):
+            operator._done = done
+            return operator.start_bake(context, list(zip(done.sources, done.outputs)), done.outputs)
+        else:
+            finished = bake_run.bake_or_discard(context, operator, zip(done.sources, done.outputs), done.outputs)
             if finished is None:
                 operator.report({"WARNING"}, "TopStoc: Bake Normals cancelled; nothing was changed")
                 return {"CANCELLED"}
-            baked, bake_failures = finished
-            failures += bake_failures
-        else:
-            failures.append("Bake Normals needs Output: New Object (in place, no original is left to "
-                            "bake from)")
-    operator.target_missed = "\n".join(missed)
+            return report_run(operator, context, done, finished)
+    return report_run(operator, context, done, ([], []))
+
+
+def report_run(operator, context, done: Outcome, baked_run):
+    """Reports the operator's run and its bake (``baked_run``: its status lines and failures);
+    returns the operator's result."""
+    baked, bake_failures = baked_run
+    failures = done.failures + bake_failures
+    operator.target_missed = "\n".join(done.missed)
     for message in failures:
         operator.report({"ERROR"}, message)
-    for message in missed:  # a missed target is a warning where the user looks, not a footnote
+    for message in done.missed:  # a missed target is a warning where the user looks, not a footnote
         operator.report({"WARNING"}, f"TopStoc: {message}")
-    if not outputs:
+    if not done.outputs:
         return {"CANCELLED"}
     if operator.output == "NEW_OBJECT":
-        select_results(context, outputs)
+        select_results(context, done.outputs)
     for line in baked:
         operator.report({"INFO"}, f"TopStoc: {line}")
     seconds = time.perf_counter() - done.started
-    if len(lines) == 1:
-        operator.report({"INFO"}, f"TopStoc: {lines[0]}; {seconds:.3f} s with output")
+    if len(done.lines) == 1:
+        operator.report({"INFO"}, f"TopStoc: {done.lines[0]}; {seconds:.3f} s with output")
     else:
-        operator.report({"INFO"}, f"TopStoc: {len(lines)} objects decimated in {seconds:.3f} s")
+        operator.report({"INFO"}, f"TopStoc: {len(done.lines)} objects decimated in {seconds:.3f} s")
     return {"FINISHED"}
 
 
-class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy.types.Operator):
+class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bake_run.BakeModal,
+                                 bpy.types.Operator):
     """Decimate the selected meshes with TopStoc, honouring their guidance"""
 
     bl_idname = "topstoc.guided_decimate"
@@ -111,6 +121,7 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
 
     def invoke(self, context, event):
         fill_from_scene(self, context.scene.topstoc)  # the panel's settings; the redo panel tweaks them
+        self._modal = bake_run.can_run_modal(context)  # a bake then runs modal: progress, Esc cancels
         objects = selected_meshes(context)
         big = sum(pipeline.input_triangles(obj.data) for obj in objects) >= BACKGROUND_TRIANGLES
         if context.window is None or not (big or self.target_mode == "MAX_ERROR"):
@@ -162,6 +173,7 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
         self.job = BackgroundDecimation(reads, deferred=True)  # begun by the first modal event
         self.timer = context.window_manager.event_timer_add(0.1, window=context.window)
         context.window_manager.modal_handler_add(self)
+        self._in_modal = True  # a bake started after the decimations reuses this modal handler
         context.window_manager.progress_begin(0, 100)
         self._show(context)
         return {"RUNNING_MODAL"}
@@ -181,7 +193,12 @@ class TOPSTOC_OT_guided_decimate(OperatorParameters, OperatorBakeParameters, bpy
         context.window_manager.progress_end()
         self._status(context, None)
 
+    def bake_finished(self, context, baked_run):
+        return report_run(self, context, self._done, baked_run)
+
     def modal(self, context, event):
+        if getattr(self, "_bake", None) is not None:  # the decimations are written; the bake steps
+            return bake_run.BakeModal.modal(self, context, event)
         self.job.begin()  # after invoke has returned to Blender (BackgroundDecimation.begin)
         if event.type == "ESC" and event.value == "PRESS":
             self.job.cancel()

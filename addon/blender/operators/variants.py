@@ -50,7 +50,7 @@ def _lay_out(source, objects, collection) -> None:
         obj.location.x += step * (i + 1)
 
 
-class _VariantsBase(OperatorParameters):
+class _VariantsBase(OperatorParameters, bake_run.BakeModal):
     bl_options = {"REGISTER", "UNDO"}
 
     @classmethod
@@ -59,6 +59,7 @@ class _VariantsBase(OperatorParameters):
 
     def invoke(self, context, event):
         fill_from_scene(self, context.scene.topstoc)
+        self._modal = bake_run.can_run_modal(context)  # a bake then runs modal: progress, Esc cancels
         return self.execute(context)
 
     def variants(self, context) -> list:
@@ -80,18 +81,34 @@ class _VariantsBase(OperatorParameters):
         made_collection = bpy.data.collections.get(self.collection_name(obj)) is None
         collection = _collection(context, self.collection_name(obj))
         _lay_out(obj, outputs, collection)
+        self._made = (obj, runs, outputs, collection if made_collection else None)
         if getattr(self, "bake_normals", False):
-            done = bake_run.bake_or_discard(context, self, [(obj, output) for output in outputs], outputs)
+            pairs = [(obj, output) for output in outputs]
+            if getattr(self, "_modal", False):
+                return self.start_bake(context, pairs, outputs)
+            done = bake_run.bake_or_discard(context, self, pairs, outputs)
             if done is None:
-                if made_collection:
-                    bpy.data.collections.remove(collection)
+                self.bake_cancelled(context)
                 self.report({"WARNING"}, "TopStoc: Bake Normals cancelled; nothing was changed")
                 return {"CANCELLED"}
-            baked, failures = done
-            for line in baked:
-                self.report({"INFO"}, f"TopStoc: {line}")
-            for message in failures:
-                self.report({"ERROR"}, message)
+            return self.bake_finished(context, done)
+        return self._report_runs()
+
+    def bake_finished(self, context, done):
+        baked, failures = done
+        for line in baked:
+            self.report({"INFO"}, f"TopStoc: {line}")
+        for message in failures:
+            self.report({"ERROR"}, message)
+        return self._report_runs()
+
+    def bake_cancelled(self, context) -> None:
+        collection = self._made[3]
+        if collection is not None:
+            bpy.data.collections.remove(collection)
+
+    def _report_runs(self):
+        obj, runs, outputs, _collection = self._made
         counts = ", ".join(f"{run.result.num_vertices:,}" for run in runs)
         self.report({"INFO"}, f"TopStoc: {len(runs)} variants of {obj.name} ({counts} vertices) "
                               f"in {runs[0].seconds:.3f} s")

@@ -111,6 +111,7 @@ def draw_bake(layout, settings) -> None:
         col.prop(settings, "bake_size", text="Size")  # "Resolution" does not fit the label column
         col.prop(settings, "bake_margin")
         col.prop(settings, "bake_store")
+        col.prop(settings, "bake_colour")
 
 
 class TOPSTOC_PT_decimate(_SettingsPanel, bpy.types.Panel):

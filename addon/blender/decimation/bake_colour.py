@@ -1,0 +1,55 @@
+"""The source's base colour baked onto a result whose normal map has a UV map of its own
+(bake.py made one: the source's layout could not hold a map). Cycles' Diffuse Color pass, selected
+to active over the normal map's rays, lands on that map, and the result's material copies read
+their Base Color from it: the colour the source shows at each point of the LOD, where the kept UV
+map, interpolated over the LOD's large faces, would show the texture shifted."""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+
+COLOUR_LABEL = "TopStoc Base Color"
+
+
+def new_colour_image(name: str, size: int) -> bpy.types.Image:
+    """A black ``size``² sRGB image to bake the colour into."""
+    image = bpy.data.images.new(name, size, size, alpha=False, float_buffer=False)
+    image.generated_color = (0.0, 0.0, 0.0, 1.0)
+    return image
+
+
+def wire_colour(material, image, uv_map: str) -> None:
+    """Feeds the Base Color of ``material``'s shader from ``image`` on ``uv_map`` (an Image Texture,
+    made the active node: the bake writes into it); the link it replaces is removed."""
+    tree = material.node_tree
+    shader = next((n for n in tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
+    if shader is None:
+        return
+    texture = tree.nodes.new("ShaderNodeTexImage")
+    texture.image, texture.label = image, COLOUR_LABEL
+    texture.location = (shader.location.x - 600, shader.location.y)
+    coordinates = tree.nodes.new("ShaderNodeUVMap")
+    coordinates.uv_map = uv_map
+    coordinates.location = (shader.location.x - 800, shader.location.y)
+    tree.links.new(coordinates.outputs["UV"], texture.inputs["Vector"])
+    for link in list(shader.inputs["Base Color"].links):
+        tree.links.remove(link)
+    tree.links.new(texture.outputs["Color"], shader.inputs["Base Color"])
+    for node in tree.nodes:
+        node.select = node is texture
+    tree.nodes.active = texture
+
+
+def run_colour_bake(extrusion: float, max_ray: float, margin: int, size: int) -> None:
+    """Bakes the selected objects' diffuse colour into the active object's active image nodes."""
+    bpy.ops.object.bake(type="DIFFUSE", pass_filter={"COLOR"}, use_selected_to_active=True, use_cage=False,
+                        cage_extrusion=extrusion, max_ray_distance=max_ray, margin=margin,
+                        target="IMAGE_TEXTURES", save_mode="INTERNAL", use_clear=True, width=size, height=size)
+
+
+def is_blank(image) -> bool:
+    """Whether the image is still the black it was made with (Cycles baked nothing)."""
+    pixels = np.empty(len(image.pixels), dtype=np.float32)
+    image.pixels.foreach_get(pixels)
+    return not (pixels.reshape(-1, image.channels)[:, :3] > 1e-3).any()
