@@ -57,6 +57,16 @@ def gate_preparation(background):
     return reached, release, lambda: setattr(background.BackgroundDecimation, "_preparing", original)
 
 
+def normal_map_image(obj):
+    """The image the result's first material feeds its Normal Map node with (None: no map)."""
+    if not obj.material_slots or obj.material_slots[0].material is None:
+        return None
+    for node in obj.material_slots[0].material.node_tree.nodes:
+        if node.type == "NORMAL_MAP" and node.inputs["Color"].links:
+            return node.inputs["Color"].links[0].from_node.image
+    return None
+
+
 def steps():
     window, area, region = view3d()
     override = dict(window=window, area=area, region=region)
@@ -146,6 +156,26 @@ def steps():
     check("the immediate run writes the same mesh", done == {"FINISHED"} and direct is not None
           and mesh_state(direct.data) == modal and len(modal[0]) < len(before[0]) // 5,
           f"{len(modal[0])} vertices against {len(before[0])}")
+    # 3: the worker's run, then Bake Normals stepped by the same modal handler
+    bpy.data.objects.remove(direct)
+    torus = bpy.data.objects["Torus"]
+    torus.select_set(True)
+    bpy.context.view_layer.objects.active = torus
+    settings = bpy.context.scene.topstoc  # the undo steps above gave the scene new data
+    settings.bake_normals, settings.bake_size = True, "256"
+    with bpy.context.temp_override(**override):
+        started = bpy.ops.topstoc.guided_decimate("INVOKE_DEFAULT")
+    check("the run with Bake Normals is modal", started == {"RUNNING_MODAL"})
+    for _ in range(1200):
+        yield 0.05
+        out = bpy.data.objects.get("Torus_TopStoc")
+        if out is not None and normal_map_image(out) is not None and shown[-1] is None:
+            break
+    out = bpy.data.objects.get("Torus_TopStoc")
+    check("the bake after the worker's run hooks a normal map into the result",
+          out is not None and normal_map_image(out) is not None and mesh_state(out.data) == modal,
+          f"{sorted(bpy.data.objects.keys())}, map {out and normal_map_image(out)}")
+    check("the header is cleared after the bake", shown[-1] is None, shown[-3:])
 
 
 def run():

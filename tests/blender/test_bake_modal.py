@@ -92,12 +92,20 @@ def test_esc_leaves_the_scene_as_before(ts, bake_run, scene, steps):
     assert (datablocks(), snapshot(source.data), [slot.material for slot in source.material_slots]) == before
 
 
-def test_the_operators_bake_modal_only_with_events(ts, scene):
-    """Guided Decimate and the LOD chain take their modal from BakeModal; without events (Blender
-    in background mode, as here) their invoke bakes at once."""
+def test_the_operators_bake_modal_only_with_events(ts, scene, monkeypatch):
+    """Guided Decimate and the LOD chain take their modal from BakeModal (Guided Decimate's own
+    modal, which also runs big decimations on a worker, hands a running bake's events to it);
+    without events (Blender in background mode, as here) their invoke bakes at once."""
     bake_run = importlib.import_module(f"{ts.__name__}.blender.operators.bake_run")
     for operator in (bpy.types.TOPSTOC_OT_guided_decimate, bpy.types.TOPSTOC_OT_lod_chain):
-        assert issubclass(operator, bake_run.BakeModal) and operator.modal is bake_run.BakeModal.modal
+        assert issubclass(operator, bake_run.BakeModal)
+    assert bpy.types.TOPSTOC_OT_lod_chain.modal is bake_run.BakeModal.modal
+    events = []
+    monkeypatch.setattr(bake_run.BakeModal, "modal", lambda self, context, event: events.append(event) or {"PASS"})
+    baking = SimpleNamespace(_bake=object())
+    assert bpy.types.TOPSTOC_OT_guided_decimate.modal(baking, bpy.context, "an event") == {"PASS"}
+    assert events == ["an event"]
+    monkeypatch.undo()
     assert not bake_run.can_run_modal(bpy.context)
     source = small_pair()
     assert bpy.ops.topstoc.guided_decimate("INVOKE_DEFAULT", ratio=0.2, bake_normals=True,

@@ -11,4 +11,4 @@ def test_guided_decimate_modal_esc_and_completion(ts):
     done = windowed(script, "--enable-event-simulate", env=clean_environment(TOPSTOC_BUILD_PYTHON=BUILD / "python"))
     lines = [line for line in done.stdout.splitlines() if line.startswith("decimate check")]
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
-    assert len(lines) == 14 and all(line.endswith(": ok") for line in lines), lines
+    assert len(lines) == 17 and all(line.endswith(": ok") for line in lines), lines

@@ -106,7 +106,7 @@ class BakeModal:
             self.bake_cancelled(context)
             self.report({"WARNING"}, "TopStoc: Bake Normals cancelled; nothing was changed")
             return {"CANCELLED"}
-        if event.type != "TIMER" or event.timer != self._timer:
+        if event.type != "TIMER":  # (Blender's Event does not say which timer fired)
             return {"RUNNING_MODAL"}  # the scene is set up for the bake: other input waits
         try:
             finished = self._bake.step()
