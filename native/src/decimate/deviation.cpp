@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "topstoc/core/parallel.hpp"
+
 namespace topstoc {
 
 namespace {
@@ -13,31 +15,83 @@ std::vector<double> normalised(const Mesh& mesh, const Collapser& collapser) {
   return out;
 }
 
-// Each input vertex, triangle centre and side middle to the collapsed surface, kept per
-// first-pass vertex of the vertex (of each corner, for a centre; of the first end, for a side).
+// out[i] = the squared distance from point(i, xyz) to `surface`, for i in [0, count), in static
+// chunks (each thread passes its last hit on as the next query's hint; the answer does not
+// depend on the hint, so any team size gives the same bits). point returns false to skip i (0).
+template <class Point>
+std::vector<double> distances2(const TriangleBvh& surface, int64_t count, Point&& point) {
+  std::vector<double> out(size_t(count), 0.0);
+  parallel_region(team_for(count, kParallelMinCostly), [&](Team& team) {
+    int32_t hint = -1;
+    team.for_static(0, count, [&](int64_t i) {
+      double p[3];
+      if (!point(i, p)) return;
+      const ClosestHit hit = surface.closest(p, hint);
+      hint = hit.slot;
+      out[size_t(i)] = hit.distance2;
+    });
+  });
+  return out;
+}
+
+// Each input vertex to the collapsed surface, kept per first-pass vertex of the vertex. (The
+// input's triangles are small next to the result's: their centres and side middles, four
+// times as many queries, had moved the weights and the choice of run little.)
 void from_input(const Mesh& mesh, const std::vector<double>& input, const std::vector<int32_t>& label,
                 const TriangleBvh& surface, std::vector<double>& out2) {
-  int32_t hint = -1;
-  auto distance2 = [&](const double* point) {
-    const ClosestHit hit = surface.closest(point, hint);
-    hint = hit.slot;
-    return hit.distance2;
-  };
+  const std::vector<double> at_vertex = distances2(surface, mesh.num_vertices(), [&](int64_t w, double* p) {
+    std::copy_n(&input[3 * size_t(w)], 3, p);
+    return label[w] >= 0;
+  });
   for (int32_t w = 0; w < mesh.num_vertices(); ++w)
-    if (label[w] >= 0) out2[label[w]] = std::max(out2[label[w]], distance2(&input[3 * size_t(w)]));
-  const auto& faces = mesh.faces();
-  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
-    const int32_t* q = &faces[3 * size_t(f)];
-    if (label[q[0]] < 0 || label[q[1]] < 0 || label[q[2]] < 0) continue;
-    const double* p[3] = {&input[3 * size_t(q[0])], &input[3 * size_t(q[1])], &input[3 * size_t(q[2])]};
-    double point[3];
-    for (int j = 0; j < 3; ++j) {
-      for (int i = 0; i < 3; ++i) point[i] = 0.5 * (p[j][i] + p[(j + 1) % 3][i]);
-      out2[label[q[j]]] = std::max(out2[label[q[j]]], distance2(point));
+    if (label[w] >= 0) out2[label[w]] = std::max(out2[label[w]], at_vertex[w]);
+}
+
+// Each live triangle's centre, corners and side middles to the input, the largest kept per
+// corner (back2, per collapser vertex). A corner or side shared by several triangles is
+// measured once.
+void to_input(const TriangleBvh& input, Collapser& collapser, const std::vector<int32_t>& live,
+              std::vector<double>& back2) {
+  const size_t faces = live.size() / 3;
+  std::vector<int32_t> corners(live);
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  std::vector<std::pair<int32_t, int32_t>> sides;
+  sides.reserve(3 * faces);
+  for (size_t c = 0; c < live.size(); ++c) {
+    const int32_t a = live[c], b = live[c % 3 == 2 ? c - 2 : c + 1];
+    sides.push_back({std::min(a, b), std::max(a, b)});
+  }
+  std::sort(sides.begin(), sides.end());
+  sides.erase(std::unique(sides.begin(), sides.end()), sides.end());
+  // The points: the corners, then the side middles, then the centres.
+  const int64_t nc = int64_t(corners.size()), ns = int64_t(sides.size());
+  const std::vector<double> at = distances2(input, nc + ns + int64_t(faces), [&](int64_t i, double* p) {
+    if (i < nc) {
+      std::copy_n(collapser.position(corners[i]), 3, p);
+      return true;
     }
-    for (int i = 0; i < 3; ++i) point[i] = (p[0][i] + p[1][i] + p[2][i]) / 3.0;
-    const double centre2 = distance2(point);
-    for (int j = 0; j < 3; ++j) out2[label[q[j]]] = std::max(out2[label[q[j]]], centre2);
+    if (i < nc + ns) {
+      const double* a = collapser.position(sides[i - nc].first);
+      const double* b = collapser.position(sides[i - nc].second);
+      for (int k = 0; k < 3; ++k) p[k] = 0.5 * (a[k] + b[k]);
+      return true;
+    }
+    const int32_t* c = &live[3 * size_t(i - nc - ns)];
+    const double* q[3] = {collapser.position(c[0]), collapser.position(c[1]), collapser.position(c[2])};
+    for (int k = 0; k < 3; ++k) p[k] = (q[0][k] + q[1][k] + q[2][k]) / 3.0;
+    return true;
+  });
+  auto corner = [&](int32_t v) { return at[std::lower_bound(corners.begin(), corners.end(), v) - corners.begin()]; };
+  auto side = [&](int32_t a, int32_t b) {
+    const std::pair<int32_t, int32_t> key{std::min(a, b), std::max(a, b)};
+    return at[nc + (std::lower_bound(sides.begin(), sides.end(), key) - sides.begin())];
+  };
+  for (size_t t = 0; t < faces; ++t) {
+    const int32_t* c = &live[3 * t];
+    double best = at[nc + ns + int64_t(t)];
+    for (int j = 0; j < 3; ++j) best = std::max({best, corner(c[j]), side(c[j], c[(j + 1) % 3])});
+    for (int j = 0; j < 3; ++j) back2[c[j]] = std::max(back2[c[j]], best);
   }
 }
 
@@ -63,27 +117,8 @@ Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const s
   out.faces = static_cast<int32_t>(live.size() / 3);
   if (out.faces == 0) return out;
   from_input(mesh, input.positions, label, TriangleBvh(positions.data(), live.data(), out.faces), out.vertex2);
-  // Back to the input: each live triangle's centre, corners and side middles.
   std::vector<double> back2(n, 0.0);
-  int32_t hint = -1;
-  auto distance2 = [&](const double* point) {
-    const ClosestHit hit = input.bvh.closest(point, hint);
-    hint = hit.slot;
-    return hit.distance2;
-  };
-  for (size_t t = 0; 3 * t < triangles.size(); ++t) {
-    if (!collapser.face_alive(int32_t(t))) continue;
-    const int32_t* c = &triangles[3 * t];
-    const double* p[3] = {collapser.position(c[0]), collapser.position(c[1]), collapser.position(c[2])};
-    double point[3];
-    for (int i = 0; i < 3; ++i) point[i] = (p[0][i] + p[1][i] + p[2][i]) / 3.0;
-    double best = distance2(point);
-    for (int j = 0; j < 3; ++j) {
-      for (int i = 0; i < 3; ++i) point[i] = 0.5 * (p[j][i] + p[(j + 1) % 3][i]);
-      best = std::max({best, distance2(point), distance2(p[j])});
-    }
-    for (int j = 0; j < 3; ++j) back2[c[j]] = std::max(back2[c[j]], best);
-  }
+  to_input(input.bvh, collapser, live, back2);
   for (int32_t v = 0; v < n; ++v) out.vertex2[v] = std::max(out.vertex2[v], back2[survivor[v]]);
   out.top2 = n > 0 ? *std::max_element(out.vertex2.begin(), out.vertex2.end()) : 0.0;
   return out;

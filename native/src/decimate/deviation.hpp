@@ -29,9 +29,10 @@ struct Deviation {
   int32_t vertices = 0;  ///< live vertices
 };
 
-/// From the input: each input vertex, triangle centre and side middle to the collapsed surface,
-/// kept per vertex the collapses started from (label: input vertex -> that vertex, -1 for none).
-/// Back: each live triangle's centre, corners and side middles to the input, kept per corner.
+/// From the input: each input vertex to the collapsed surface, kept per vertex the collapses
+/// started from (label: input vertex -> that vertex, -1 for none). Back: each live triangle's
+/// centre, corners and side middles to the input, kept per corner. On the engine's threads; the
+/// same bits for any team size.
 Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const std::vector<int32_t>& label,
                           Collapser& collapser, const std::vector<int32_t>& triangles);
 
