@@ -34,9 +34,15 @@ std::vector<double> distances2(const TriangleBvh& surface, int64_t count, Point&
   return out;
 }
 
-// Each input vertex to the collapsed surface, kept per first-pass vertex of the vertex. (The
-// input's triangles are small next to the result's: their centres and side middles, four
-// times as many queries, had moved the weights and the choice of run little.)
+// A triangle whose measured points reach kNear times the farthest distance found gets more
+// points: where the max lies is measured more finely. (The Lipschitz bound, corner distance
+// plus size, flagged nearly every triangle: input sides are about as long as the deviations.)
+constexpr double kNear = 0.5;
+bool near_top(double measured2, double top2) { return measured2 >= kNear * kNear * top2; }
+
+// Each input vertex to the collapsed surface, kept per first-pass vertex of the vertex; then
+// the side middles and centre of each input triangle near the top (near_top), kept per
+// first-pass vertex of its corners (every triangle's four points cost four times the queries).
 void from_input(const Mesh& mesh, const std::vector<double>& input, const std::vector<int32_t>& label,
                 const TriangleBvh& surface, std::vector<double>& out2) {
   const std::vector<double> at_vertex = distances2(surface, mesh.num_vertices(), [&](int64_t w, double* p) {
@@ -45,6 +51,31 @@ void from_input(const Mesh& mesh, const std::vector<double>& input, const std::v
   });
   for (int32_t w = 0; w < mesh.num_vertices(); ++w)
     if (label[w] >= 0) out2[label[w]] = std::max(out2[label[w]], at_vertex[w]);
+  const double top2 = at_vertex.empty() ? 0.0 : *std::max_element(at_vertex.begin(), at_vertex.end());
+  const auto& faces = mesh.faces();
+  auto corner = [&](int32_t f, int j) { return &input[3 * size_t(faces[3 * size_t(f) + j])]; };
+  std::vector<int32_t> near;
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+    const int32_t* q = &faces[3 * size_t(f)];
+    if (label[q[0]] < 0 || label[q[1]] < 0 || label[q[2]] < 0) continue;
+    const double measured2 = std::max({at_vertex[q[0]], at_vertex[q[1]], at_vertex[q[2]]});
+    if (near_top(measured2, top2)) near.push_back(f);
+  }
+  // Four points per such triangle: its side middles (0..2), then its centre (3).
+  const std::vector<double> at_face = distances2(surface, 4 * int64_t(near.size()), [&](int64_t i, double* p) {
+    const int32_t f = near[size_t(i / 4)];
+    const int j = int(i % 4);
+    const double* c[3] = {corner(f, 0), corner(f, 1), corner(f, 2)};
+    for (int k = 0; k < 3; ++k) p[k] = j < 3 ? 0.5 * (c[j][k] + c[(j + 1) % 3][k]) : (c[0][k] + c[1][k] + c[2][k]) / 3.0;
+    return true;
+  });
+  for (size_t h = 0; h < near.size(); ++h) {
+    const double found2 = *std::max_element(&at_face[4 * h], &at_face[4 * h] + 4);
+    for (int j = 0; j < 3; ++j) {
+      const int32_t v = label[faces[3 * size_t(near[h]) + j]];
+      out2[v] = std::max(out2[v], found2);
+    }
+  }
 }
 
 // Each live triangle's centre, corners and side middles to the input, the largest kept per
@@ -87,12 +118,30 @@ void to_input(const TriangleBvh& input, Collapser& collapser, const std::vector<
     const std::pair<int32_t, int32_t> key{std::min(a, b), std::max(a, b)};
     return at[nc + (std::lower_bound(sides.begin(), sides.end(), key) - sides.begin())];
   };
+  std::vector<double> best(faces);
   for (size_t t = 0; t < faces; ++t) {
     const int32_t* c = &live[3 * t];
-    double best = at[nc + ns + int64_t(t)];
-    for (int j = 0; j < 3; ++j) best = std::max({best, corner(c[j]), side(c[j], c[(j + 1) % 3])});
-    for (int j = 0; j < 3; ++j) back2[c[j]] = std::max(back2[c[j]], best);
+    best[t] = at[nc + ns + int64_t(t)];
+    for (int j = 0; j < 3; ++j) best[t] = std::max({best[t], corner(c[j]), side(c[j], c[(j + 1) % 3])});
   }
+  // Triangles near the top (near_top) get the centres of their three corner quarters too (the
+  // points measured split each into four).
+  const double top2 = best.empty() ? 0.0 : *std::max_element(best.begin(), best.end());
+  auto at_corner = [&](size_t t, int j) { return collapser.position(live[3 * t + size_t(j)]); };
+  std::vector<int32_t> near;
+  for (size_t t = 0; t < faces; ++t)
+    if (near_top(best[t], top2)) near.push_back(int32_t(t));
+  const std::vector<double> quarters = distances2(input, 3 * int64_t(near.size()), [&](int64_t i, double* p) {
+    const size_t t = size_t(near[size_t(i / 3)]);
+    const int j = int(i % 3);
+    const double *a = at_corner(t, j), *b = at_corner(t, (j + 1) % 3), *c = at_corner(t, (j + 2) % 3);
+    for (int k = 0; k < 3; ++k) p[k] = (4.0 * a[k] + b[k] + c[k]) / 6.0;
+    return true;
+  });
+  for (size_t h = 0; h < near.size(); ++h)
+    best[size_t(near[h])] = std::max(best[size_t(near[h])], *std::max_element(&quarters[3 * h], &quarters[3 * h] + 3));
+  for (size_t t = 0; t < faces; ++t)
+    for (int j = 0; j < 3; ++j) back2[live[3 * t + j]] = std::max(back2[live[3 * t + j]], best[t]);
 }
 
 }  // namespace
