@@ -43,14 +43,21 @@ bool near_top(double measured2, double top2) { return measured2 >= kNear * kNear
 // Each input vertex to the collapsed surface, kept per first-pass vertex of the vertex; then
 // the side middles and centre of each input triangle near the top (near_top), kept per
 // first-pass vertex of its corners (every triangle's four points cost four times the queries).
-void from_input(const Mesh& mesh, const std::vector<double>& input, const std::vector<int32_t>& label,
-                const TriangleBvh& surface, std::vector<double>& out2) {
+// Returns the mean distance at the input vertices, weighted by their areas.
+double from_input(const Mesh& mesh, const InputSurface& surface_in, const std::vector<int32_t>& label,
+                  const TriangleBvh& surface, std::vector<double>& out2) {
+  const std::vector<double>& input = surface_in.positions;
   const std::vector<double> at_vertex = distances2(surface, mesh.num_vertices(), [&](int64_t w, double* p) {
     std::copy_n(&input[3 * size_t(w)], 3, p);
     return label[w] >= 0;
   });
+  double sum = 0.0, area = 0.0;  // in vertex order: the same bits for any team size
   for (int32_t w = 0; w < mesh.num_vertices(); ++w)
-    if (label[w] >= 0) out2[label[w]] = std::max(out2[label[w]], at_vertex[w]);
+    if (label[w] >= 0) {
+      out2[label[w]] = std::max(out2[label[w]], at_vertex[w]);
+      sum += surface_in.area[w] * std::sqrt(at_vertex[w]);
+      area += surface_in.area[w];
+    }
   const double top2 = at_vertex.empty() ? 0.0 : *std::max_element(at_vertex.begin(), at_vertex.end());
   const auto& faces = mesh.faces();
   auto corner = [&](int32_t f, int j) { return &input[3 * size_t(faces[3 * size_t(f) + j])]; };
@@ -76,6 +83,7 @@ void from_input(const Mesh& mesh, const std::vector<double>& input, const std::v
       out2[v] = std::max(out2[v], found2);
     }
   }
+  return area > 0.0 ? sum / area : 0.0;
 }
 
 // Each live triangle's centre, corners and side middles to the input, the largest kept per
@@ -144,10 +152,25 @@ void to_input(const TriangleBvh& input, Collapser& collapser, const std::vector<
     for (int j = 0; j < 3; ++j) back2[live[3 * t + j]] = std::max(back2[live[3 * t + j]], best[t]);
 }
 
+std::vector<double> vertex_areas(const Mesh& mesh, const std::vector<double>& positions) {
+  std::vector<double> out(size_t(mesh.num_vertices()), 0.0);
+  const auto& faces = mesh.faces();
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+    const int32_t* q = &faces[3 * size_t(f)];
+    const double *a = &positions[3 * size_t(q[0])], *b = &positions[3 * size_t(q[1])], *c = &positions[3 * size_t(q[2])];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    const double third = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) / 6.0;
+    for (int j = 0; j < 3; ++j) out[size_t(q[j])] += third;
+  }
+  return out;
+}
+
 }  // namespace
 
 InputSurface::InputSurface(const Mesh& mesh, const Collapser& collapser)
-    : positions(normalised(mesh, collapser)), bvh(positions.data(), mesh.faces().data(), mesh.num_faces()) {}
+    : positions(normalised(mesh, collapser)), area(vertex_areas(mesh, positions)),
+      bvh(positions.data(), mesh.faces().data(), mesh.num_faces()) {}
 
 Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const std::vector<int32_t>& label,
                           Collapser& collapser, const std::vector<int32_t>& triangles) {
@@ -165,7 +188,7 @@ Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const s
   out.vertex2.assign(n, 0.0);
   out.faces = static_cast<int32_t>(live.size() / 3);
   if (out.faces == 0) return out;
-  from_input(mesh, input.positions, label, TriangleBvh(positions.data(), live.data(), out.faces), out.vertex2);
+  out.mean = from_input(mesh, input, label, TriangleBvh(positions.data(), live.data(), out.faces), out.vertex2);
   std::vector<double> back2(n, 0.0);
   to_input(input.bvh, collapser, live, back2);
   for (int32_t v = 0; v < n; ++v) out.vertex2[v] = std::max(out.vertex2[v], back2[survivor[v]]);

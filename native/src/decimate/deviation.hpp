@@ -17,6 +17,7 @@ namespace topstoc {
 struct InputSurface {
   InputSurface(const Mesh& mesh, const Collapser& collapser);
   std::vector<double> positions;  ///< 3 per input vertex
+  std::vector<double> area;       ///< per input vertex: a third of its triangles' areas
   TriangleBvh bvh;
 };
 
@@ -25,6 +26,7 @@ struct Deviation {
   /// the farthest point found around it, from the input to the surface or back.
   std::vector<double> vertex2;
   double top2 = 0.0;    ///< the largest of them
+  double mean = 0.0;    ///< mean distance from the input, its vertices weighted by their areas
   int32_t faces = 0;     ///< live triangles
   int32_t vertices = 0;  ///< live vertices
 };

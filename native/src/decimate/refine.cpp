@@ -29,6 +29,9 @@ constexpr double kDeviationWeight = 100.0;
 // second weighs where either run before it ended farthest.
 constexpr double kRestart = 2.0;
 constexpr int kRounds = 2;
+// A rerun wins on its max only while its mean distance from the input stays within this
+// fraction of the first run's: the reruns trade mean for max.
+constexpr double kMeanSlack = 0.05;
 
 // Guidance bins: 0 for m = 0 (never sampled), 1 for control points, then m on a quarter-octave
 // scale.
@@ -395,7 +398,8 @@ class Refinement {
   // start from the first's state at kRestart times the target (the collapses before it are
   // shared), their cost weights grown where the runs before ended farthest from the input, so
   // that they keep more vertices there (reweighting toward the smallest max error). The run
-  // nearest the target, then with the smallest deviation, is kept.
+  // nearest the target, then with the smallest deviation (its mean within kMeanSlack of the
+  // first run's), is kept.
   void collapse_max_aware(CollapseSetup setup, const double* center, double extent) {
     const std::vector<double> guidance = setup.weight;
     result.refine_vertices = params.target_vertices;
@@ -410,6 +414,7 @@ class Refinement {
     const InputSurface input(mesh, *best);
     Deviation best_deviation = surface_deviation(mesh, input, label, *best, result.triangles), last = best_deviation;
     std::vector<int32_t> best_triangles = result.triangles, best_corners = result.corner_source;
+    const double mean_bound = (1.0 + kMeanSlack) * best_deviation.mean;
     std::vector<double> worst(n, 0.0);  // per vertex: its largest deviation over the largest, of every run so far
     for (int round = 0; round < kRounds && last.top2 > 0; ++round) {
       for (int32_t v = 0; v < n; ++v) worst[v] = std::max(worst[v], last.vertex2[v] / last.top2);
@@ -419,8 +424,8 @@ class Refinement {
       run->reweigh(deviation_weights(*run, guidance, worst));
       const int32_t collapses = shared + collapse_rest(*run, center, extent);
       last = surface_deviation(mesh, input, label, *run, result.triangles);
-      if (excess(last) < excess(best_deviation) ||
-          (excess(last) == excess(best_deviation) && last.top2 <= best_deviation.top2)) {
+      if (excess(last) < excess(best_deviation) || (excess(last) == excess(best_deviation) &&
+                                                    last.top2 <= best_deviation.top2 && last.mean <= mean_bound)) {
         best = std::move(run);
         best_deviation = last;
         best_collapses = collapses;
