@@ -1,9 +1,10 @@
 """Quality mode on a mesh it collapses whole: the first pass keeps every vertex up to
-8 x QUALITY_COLLAPSES vertices, and the collapses run twice, the second weighted by where the
-first one's surface ended farthest from the input (refine.cpp, collapse_max_aware).
+8 x QUALITY_COLLAPSES vertices, and the last collapses are rerun from twice the target, weighted
+by where the runs before ended farthest from the input (refine.cpp, collapse_max_aware).
 
 Errors by topstoc.hausdorff (checked against a brute-force distance in test_hausdorff.py);
-topology, orientation and degeneracy by tests/reference.py, independent of the engine.
+topology, orientation and degeneracy by tests/reference.py, independent of the engine; the
+worst cases against meshoptimizer's simplifier (build/peers/meshopt_simplify), run here.
 """
 
 import pathlib
@@ -13,8 +14,9 @@ import pytest
 
 import meshgen
 import reference
+from peer_runs import meshopt_simplify, peer, write_off
 from test_decimate import check_output
-from topstoc.core import Mesh, hausdorff
+from topstoc.core import Mesh, hausdorff, read_mesh
 
 DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
 
@@ -83,3 +85,29 @@ def test_guarantees_hold_on_adversarial_inputs(what, mesh):
         assert reference.invariants(r.num_vertices, r.triangles) == expected, (what, ratio)
         assert reference.degenerate_or_duplicate(r.triangles) == (0, 0), (what, ratio)
         assert not any(r.stats.output_check.values()), (what, ratio, r.stats.output_check)
+
+
+# The cases of tests/data where the max error is furthest above meshoptimizer's at the same
+# triangle count (bench_quality.py, issue 40): (mesh, ratio, bound on ours / meshopt's, the
+# ratio with one rerun from scratch). Ours is the guaranteed bound (max_upper), meshopt's the
+# largest distance found, a lower bound of its max: the ratio of the true maxima is below it.
+# couplingdown (a CAD part at 2 %) stays above the issue's 1.15 goal.
+WORST = [("genus_positive/cgal_couplingdown.off", 0.02, 1.25, 1.206),
+         ("genus_positive/cgal_elephant.off", 0.02, 1.06, 1.082),
+         ("genus_positive/cgal_anchor_dense.off", 0.02, 1.06, 1.028),
+         ("genus_positive/cgal_turbine.off", 0.02, 0.90, 0.936)]
+
+
+@pytest.mark.parametrize("name, ratio, bound, before", WORST, ids=[w[0] for w in WORST])
+def test_the_max_error_against_meshopt_on_the_worst_cases(tmp_path, name, ratio, bound, before):
+    if peer("meshopt_simplify") is None:
+        pytest.skip("peer program meshopt_simplify was not built (libmeshoptimizer-dev)")
+    v, t = reference.read_off(DATA / name)
+    r = Mesh(v, t).decimate(target_triangles=round(ratio * len(t)), seed=0)
+    write_off(tmp_path / "in.off", v, t)
+    meshopt_simplify(tmp_path / "in.off", tmp_path / "meshopt.off", 3 * r.num_triangles)
+    theirs = read_mesh(str(tmp_path / "meshopt.off"))
+    assert theirs.num_triangles <= r.num_triangles  # the peer has no more triangles than we do
+    ours = hausdorff((v, t), r, samples=100_000, relative=True).symmetric
+    peer_max = hausdorff((v, t), theirs, samples=100_000, relative=True, max_tolerance=0).symmetric.max
+    assert ours.max_upper < bound * peer_max, (name, ours.max_upper / peer_max)

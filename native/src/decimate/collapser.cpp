@@ -108,6 +108,17 @@ int32_t Collapser::survivor(int32_t v) {
   return root;
 }
 
+void Collapser::reweigh(std::vector<double> weight) {
+  s_.weight = std::move(weight);
+  const int32_t n = vertices();
+  std::vector<Best> best(n);
+  parallel_for(0, n, kParallelMinCostly, [&](int32_t u) {
+    if (merged_into_[u] < 0) best[u] = evaluate(u, false, scratch_.mine());
+  });
+  for (int32_t u = 0; u < n; ++u)
+    if (merged_into_[u] < 0) settle(u, best[u]);
+}
+
 void Collapser::neighbours(int32_t v, Scratch& scratch, std::vector<int32_t>& out) const {
   out.clear();
   const uint32_t stamp = ++scratch.stamp;

@@ -58,6 +58,9 @@ class Collapser {
   int32_t remove_thin(double min_shape, Stop keep);
   /// Collapses in cost order until `target` is reached or no collapse is allowed.
   int32_t run(Stop target);
+  /// Replaces every vertex's cost weight and costs every queued collapse anew: a copy of a
+  /// collapser taken part-way continues under other weights (the max-aware refinement).
+  void reweigh(std::vector<double> weight);
   /// Moves every free vertex to its quadric's minimum along the directions it constrains, at
   /// most radius2[v] (squared, normalised) away, where no triangle folds or becomes a sliver.
   int32_t refit(const std::vector<double>& radius2);

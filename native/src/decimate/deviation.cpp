@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "topstoc/core/parallel.hpp"
+
 namespace topstoc {
 
 namespace {
@@ -13,38 +15,162 @@ std::vector<double> normalised(const Mesh& mesh, const Collapser& collapser) {
   return out;
 }
 
-// Each input vertex, triangle centre and side middle to the collapsed surface, kept per
-// first-pass vertex of the vertex (of each corner, for a centre; of the first end, for a side).
-void from_input(const Mesh& mesh, const std::vector<double>& input, const std::vector<int32_t>& label,
-                const TriangleBvh& surface, std::vector<double>& out2) {
-  int32_t hint = -1;
-  auto distance2 = [&](const double* point) {
-    const ClosestHit hit = surface.closest(point, hint);
-    hint = hit.slot;
-    return hit.distance2;
-  };
+// out[i] = the squared distance from point(i, xyz) to `surface`, for i in [0, count), in static
+// chunks (each thread passes its last hit on as the next query's hint; the answer does not
+// depend on the hint, so any team size gives the same bits). point returns false to skip i (0).
+template <class Point>
+std::vector<double> distances2(const TriangleBvh& surface, int64_t count, Point&& point) {
+  std::vector<double> out(size_t(count), 0.0);
+  parallel_region(team_for(count, kParallelMinCostly), [&](Team& team) {
+    int32_t hint = -1;
+    team.for_static(0, count, [&](int64_t i) {
+      double p[3];
+      if (!point(i, p)) return;
+      const ClosestHit hit = surface.closest(p, hint);
+      hint = hit.slot;
+      out[size_t(i)] = hit.distance2;
+    });
+  });
+  return out;
+}
+
+// A triangle whose measured points reach kNear times the farthest distance found gets more
+// points: where the max lies is measured more finely. (The Lipschitz bound, corner distance
+// plus size, flagged nearly every triangle: input sides are about as long as the deviations.)
+constexpr double kNear = 0.5;
+bool near_top(double measured2, double top2) { return measured2 >= kNear * kNear * top2; }
+
+// Each input vertex to the collapsed surface, kept per first-pass vertex of the vertex; then
+// the side middles and centre of each input triangle near the top (near_top), kept per
+// first-pass vertex of its corners (every triangle's four points cost four times the queries).
+// Returns the mean distance at the input vertices, weighted by their areas.
+double from_input(const Mesh& mesh, const InputSurface& surface_in, const std::vector<int32_t>& label,
+                  const TriangleBvh& surface, std::vector<double>& out2) {
+  const std::vector<double>& input = surface_in.positions;
+  const std::vector<double> at_vertex = distances2(surface, mesh.num_vertices(), [&](int64_t w, double* p) {
+    std::copy_n(&input[3 * size_t(w)], 3, p);
+    return label[w] >= 0;
+  });
+  double sum = 0.0, area = 0.0;  // in vertex order: the same bits for any team size
   for (int32_t w = 0; w < mesh.num_vertices(); ++w)
-    if (label[w] >= 0) out2[label[w]] = std::max(out2[label[w]], distance2(&input[3 * size_t(w)]));
+    if (label[w] >= 0) {
+      out2[label[w]] = std::max(out2[label[w]], at_vertex[w]);
+      sum += surface_in.area[w] * std::sqrt(at_vertex[w]);
+      area += surface_in.area[w];
+    }
+  const double top2 = at_vertex.empty() ? 0.0 : *std::max_element(at_vertex.begin(), at_vertex.end());
   const auto& faces = mesh.faces();
+  auto corner = [&](int32_t f, int j) { return &input[3 * size_t(faces[3 * size_t(f) + j])]; };
+  std::vector<int32_t> near;
   for (int32_t f = 0; f < mesh.num_faces(); ++f) {
     const int32_t* q = &faces[3 * size_t(f)];
     if (label[q[0]] < 0 || label[q[1]] < 0 || label[q[2]] < 0) continue;
-    const double* p[3] = {&input[3 * size_t(q[0])], &input[3 * size_t(q[1])], &input[3 * size_t(q[2])]};
-    double point[3];
-    for (int j = 0; j < 3; ++j) {
-      for (int i = 0; i < 3; ++i) point[i] = 0.5 * (p[j][i] + p[(j + 1) % 3][i]);
-      out2[label[q[j]]] = std::max(out2[label[q[j]]], distance2(point));
-    }
-    for (int i = 0; i < 3; ++i) point[i] = (p[0][i] + p[1][i] + p[2][i]) / 3.0;
-    const double centre2 = distance2(point);
-    for (int j = 0; j < 3; ++j) out2[label[q[j]]] = std::max(out2[label[q[j]]], centre2);
+    const double measured2 = std::max({at_vertex[q[0]], at_vertex[q[1]], at_vertex[q[2]]});
+    if (near_top(measured2, top2)) near.push_back(f);
   }
+  // Four points per such triangle: its side middles (0..2), then its centre (3).
+  const std::vector<double> at_face = distances2(surface, 4 * int64_t(near.size()), [&](int64_t i, double* p) {
+    const int32_t f = near[size_t(i / 4)];
+    const int j = int(i % 4);
+    const double* c[3] = {corner(f, 0), corner(f, 1), corner(f, 2)};
+    for (int k = 0; k < 3; ++k) p[k] = j < 3 ? 0.5 * (c[j][k] + c[(j + 1) % 3][k]) : (c[0][k] + c[1][k] + c[2][k]) / 3.0;
+    return true;
+  });
+  for (size_t h = 0; h < near.size(); ++h) {
+    const double found2 = *std::max_element(&at_face[4 * h], &at_face[4 * h] + 4);
+    for (int j = 0; j < 3; ++j) {
+      const int32_t v = label[faces[3 * size_t(near[h]) + j]];
+      out2[v] = std::max(out2[v], found2);
+    }
+  }
+  return area > 0.0 ? sum / area : 0.0;
+}
+
+// Each live triangle's centre, corners and side middles to the input, the largest kept per
+// corner (back2, per collapser vertex). A corner or side shared by several triangles is
+// measured once.
+void to_input(const TriangleBvh& input, Collapser& collapser, const std::vector<int32_t>& live,
+              std::vector<double>& back2) {
+  const size_t faces = live.size() / 3;
+  std::vector<int32_t> corners(live);
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  std::vector<std::pair<int32_t, int32_t>> sides;
+  sides.reserve(3 * faces);
+  for (size_t c = 0; c < live.size(); ++c) {
+    const int32_t a = live[c], b = live[c % 3 == 2 ? c - 2 : c + 1];
+    sides.push_back({std::min(a, b), std::max(a, b)});
+  }
+  std::sort(sides.begin(), sides.end());
+  sides.erase(std::unique(sides.begin(), sides.end()), sides.end());
+  // The points: the corners, then the side middles, then the centres.
+  const int64_t nc = int64_t(corners.size()), ns = int64_t(sides.size());
+  const std::vector<double> at = distances2(input, nc + ns + int64_t(faces), [&](int64_t i, double* p) {
+    if (i < nc) {
+      std::copy_n(collapser.position(corners[i]), 3, p);
+      return true;
+    }
+    if (i < nc + ns) {
+      const double* a = collapser.position(sides[i - nc].first);
+      const double* b = collapser.position(sides[i - nc].second);
+      for (int k = 0; k < 3; ++k) p[k] = 0.5 * (a[k] + b[k]);
+      return true;
+    }
+    const int32_t* c = &live[3 * size_t(i - nc - ns)];
+    const double* q[3] = {collapser.position(c[0]), collapser.position(c[1]), collapser.position(c[2])};
+    for (int k = 0; k < 3; ++k) p[k] = (q[0][k] + q[1][k] + q[2][k]) / 3.0;
+    return true;
+  });
+  auto corner = [&](int32_t v) { return at[std::lower_bound(corners.begin(), corners.end(), v) - corners.begin()]; };
+  auto side = [&](int32_t a, int32_t b) {
+    const std::pair<int32_t, int32_t> key{std::min(a, b), std::max(a, b)};
+    return at[nc + (std::lower_bound(sides.begin(), sides.end(), key) - sides.begin())];
+  };
+  std::vector<double> best(faces);
+  for (size_t t = 0; t < faces; ++t) {
+    const int32_t* c = &live[3 * t];
+    best[t] = at[nc + ns + int64_t(t)];
+    for (int j = 0; j < 3; ++j) best[t] = std::max({best[t], corner(c[j]), side(c[j], c[(j + 1) % 3])});
+  }
+  // Triangles near the top (near_top) get the centres of their three corner quarters too (the
+  // points measured split each into four).
+  const double top2 = best.empty() ? 0.0 : *std::max_element(best.begin(), best.end());
+  auto at_corner = [&](size_t t, int j) { return collapser.position(live[3 * t + size_t(j)]); };
+  std::vector<int32_t> near;
+  for (size_t t = 0; t < faces; ++t)
+    if (near_top(best[t], top2)) near.push_back(int32_t(t));
+  const std::vector<double> quarters = distances2(input, 3 * int64_t(near.size()), [&](int64_t i, double* p) {
+    const size_t t = size_t(near[size_t(i / 3)]);
+    const int j = int(i % 3);
+    const double *a = at_corner(t, j), *b = at_corner(t, (j + 1) % 3), *c = at_corner(t, (j + 2) % 3);
+    for (int k = 0; k < 3; ++k) p[k] = (4.0 * a[k] + b[k] + c[k]) / 6.0;
+    return true;
+  });
+  for (size_t h = 0; h < near.size(); ++h)
+    best[size_t(near[h])] = std::max(best[size_t(near[h])], *std::max_element(&quarters[3 * h], &quarters[3 * h] + 3));
+  for (size_t t = 0; t < faces; ++t)
+    for (int j = 0; j < 3; ++j) back2[live[3 * t + j]] = std::max(back2[live[3 * t + j]], best[t]);
+}
+
+std::vector<double> vertex_areas(const Mesh& mesh, const std::vector<double>& positions) {
+  std::vector<double> out(size_t(mesh.num_vertices()), 0.0);
+  const auto& faces = mesh.faces();
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+    const int32_t* q = &faces[3 * size_t(f)];
+    const double *a = &positions[3 * size_t(q[0])], *b = &positions[3 * size_t(q[1])], *c = &positions[3 * size_t(q[2])];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    const double third = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) / 6.0;
+    for (int j = 0; j < 3; ++j) out[size_t(q[j])] += third;
+  }
+  return out;
 }
 
 }  // namespace
 
 InputSurface::InputSurface(const Mesh& mesh, const Collapser& collapser)
-    : positions(normalised(mesh, collapser)), bvh(positions.data(), mesh.faces().data(), mesh.num_faces()) {}
+    : positions(normalised(mesh, collapser)), area(vertex_areas(mesh, positions)),
+      bvh(positions.data(), mesh.faces().data(), mesh.num_faces()) {}
 
 Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const std::vector<int32_t>& label,
                           Collapser& collapser, const std::vector<int32_t>& triangles) {
@@ -62,28 +188,9 @@ Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const s
   out.vertex2.assign(n, 0.0);
   out.faces = static_cast<int32_t>(live.size() / 3);
   if (out.faces == 0) return out;
-  from_input(mesh, input.positions, label, TriangleBvh(positions.data(), live.data(), out.faces), out.vertex2);
-  // Back to the input: each live triangle's centre, corners and side middles.
+  out.mean = from_input(mesh, input, label, TriangleBvh(positions.data(), live.data(), out.faces), out.vertex2);
   std::vector<double> back2(n, 0.0);
-  int32_t hint = -1;
-  auto distance2 = [&](const double* point) {
-    const ClosestHit hit = input.bvh.closest(point, hint);
-    hint = hit.slot;
-    return hit.distance2;
-  };
-  for (size_t t = 0; 3 * t < triangles.size(); ++t) {
-    if (!collapser.face_alive(int32_t(t))) continue;
-    const int32_t* c = &triangles[3 * t];
-    const double* p[3] = {collapser.position(c[0]), collapser.position(c[1]), collapser.position(c[2])};
-    double point[3];
-    for (int i = 0; i < 3; ++i) point[i] = (p[0][i] + p[1][i] + p[2][i]) / 3.0;
-    double best = distance2(point);
-    for (int j = 0; j < 3; ++j) {
-      for (int i = 0; i < 3; ++i) point[i] = 0.5 * (p[j][i] + p[(j + 1) % 3][i]);
-      best = std::max({best, distance2(point), distance2(p[j])});
-    }
-    for (int j = 0; j < 3; ++j) back2[c[j]] = std::max(back2[c[j]], best);
-  }
+  to_input(input.bvh, collapser, live, back2);
   for (int32_t v = 0; v < n; ++v) out.vertex2[v] = std::max(out.vertex2[v], back2[survivor[v]]);
   out.top2 = n > 0 ? *std::max_element(out.vertex2.begin(), out.vertex2.end()) : 0.0;
   return out;

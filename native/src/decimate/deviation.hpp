@@ -17,6 +17,7 @@ namespace topstoc {
 struct InputSurface {
   InputSurface(const Mesh& mesh, const Collapser& collapser);
   std::vector<double> positions;  ///< 3 per input vertex
+  std::vector<double> area;       ///< per input vertex: a third of its triangles' areas
   TriangleBvh bvh;
 };
 
@@ -25,13 +26,15 @@ struct Deviation {
   /// the farthest point found around it, from the input to the surface or back.
   std::vector<double> vertex2;
   double top2 = 0.0;    ///< the largest of them
+  double mean = 0.0;    ///< mean distance from the input, its vertices weighted by their areas
   int32_t faces = 0;     ///< live triangles
   int32_t vertices = 0;  ///< live vertices
 };
 
-/// From the input: each input vertex, triangle centre and side middle to the collapsed surface,
-/// kept per vertex the collapses started from (label: input vertex -> that vertex, -1 for none).
-/// Back: each live triangle's centre, corners and side middles to the input, kept per corner.
+/// From the input: each input vertex to the collapsed surface, kept per vertex the collapses
+/// started from (label: input vertex -> that vertex, -1 for none). Back: each live triangle's
+/// centre, corners and side middles to the input, kept per corner. On the engine's threads; the
+/// same bits for any team size.
 Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const std::vector<int32_t>& label,
                           Collapser& collapser, const std::vector<int32_t>& triangles);
 

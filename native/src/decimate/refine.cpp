@@ -24,6 +24,14 @@ constexpr int32_t kTinyFitRounds = 4;
 // Max-aware second run: a vertex's cost weight is 1 + this times its first-run deviation over
 // the largest (squared distances), so the worst region's collapses cost a hundred times more.
 constexpr double kDeviationWeight = 100.0;
+// The max-aware reruns start from the first run's state at this many times the target (the
+// last collapses decide where the largest deviations end up), and there are this many: the
+// second weighs where either run before it ended farthest.
+constexpr double kRestart = 2.0;
+constexpr int kRounds = 2;
+// A rerun wins on its max only while its mean distance from the input stays within this
+// fraction of the first run's: the reruns trade mean for max.
+constexpr double kMeanSlack = 0.05;
 
 // Guidance bins: 0 for m = 0 (never sampled), 1 for control points, then m on a quarter-octave
 // scale.
@@ -386,37 +394,69 @@ class Refinement {
     }
   }
 
-  // Max-aware collapses (RefineParams::max_aware): a first run, then a second whose cost
-  // weights grow with how far the first one's surface ended from the input around each vertex,
-  // so that it keeps more vertices where the first deviated most (a step of reweighting toward
-  // the smallest max error). The run nearer the target, or as near and with the smaller
-  // deviation, is kept.
+  // Max-aware collapses (RefineParams::max_aware): a first run, then kRounds more that each
+  // start from the first's state at kRestart times the target (the collapses before it are
+  // shared), their cost weights grown where the runs before ended farthest from the input, so
+  // that they keep more vertices there (reweighting toward the smallest max error). The run
+  // nearest the target, then with the smallest deviation (its mean within kMeanSlack of the
+  // first run's), is kept.
   void collapse_max_aware(CollapseSetup setup, const double* center, double extent) {
-    std::vector<int32_t> first_triangles = result.triangles, first_corners = result.corner_source;
-    Collapser first(first_triangles, first_corners, CollapseSetup(setup));
-    collapse(first, center, extent);
-    const int32_t first_collapses = result.refine_collapses;
-    const InputSurface input(mesh, first);
-    const Deviation before = surface_deviation(mesh, input, label, first, first_triangles);
-    if (before.top2 > 0)
-      for (int32_t v = 0; v < n; ++v) setup.weight[v] *= 1.0 + kDeviationWeight * before.vertex2[v] / before.top2;
-    Collapser second(result.triangles, result.corner_source, std::move(setup));
-    collapse(second, center, extent);
-    const Deviation after = surface_deviation(mesh, input, label, second, result.triangles);
-    // How far each run stayed above the target (0 once reached): the nearer run wins, then the
-    // smaller deviation.
-    auto excess = [&](const Deviation& d) {
-      return params.target_triangles > 0 ? std::max(0, d.faces - params.target_triangles)
-                                         : std::max(0, d.vertices - params.target_vertices);
-    };
-    if (excess(after) < excess(before) || (excess(after) == excess(before) && after.top2 <= before.top2)) {
-      finish(second);
-      return;
+    const std::vector<double> guidance = setup.weight;
+    result.refine_vertices = params.target_vertices;
+    result.refine_triangles = params.target_triangles;
+    const Collapser::Stop stop = target(), restart{int32_t(kRestart * stop.vertices), int32_t(kRestart * stop.faces)};
+    // Every run works on result's arrays: its own are copied in before it goes on.
+    auto best = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
+    const int32_t shared = best->remove_thin(kSliverShape, stop) + best->run(restart);
+    const Collapser at_restart(*best);
+    const std::vector<int32_t> restart_triangles = result.triangles, restart_corners = result.corner_source;
+    int32_t best_collapses = shared + collapse_rest(*best, center, extent);
+    const InputSurface input(mesh, *best);
+    Deviation best_deviation = surface_deviation(mesh, input, label, *best, result.triangles), last = best_deviation;
+    std::vector<int32_t> best_triangles = result.triangles, best_corners = result.corner_source;
+    const double mean_bound = (1.0 + kMeanSlack) * best_deviation.mean;
+    std::vector<double> worst(n, 0.0);  // per vertex: its largest deviation over the largest, of every run so far
+    for (int round = 0; round < kRounds && last.top2 > 0; ++round) {
+      for (int32_t v = 0; v < n; ++v) worst[v] = std::max(worst[v], last.vertex2[v] / last.top2);
+      result.triangles = restart_triangles;
+      result.corner_source = restart_corners;
+      auto run = std::make_unique<Collapser>(at_restart);
+      run->reweigh(deviation_weights(*run, guidance, worst));
+      const int32_t collapses = shared + collapse_rest(*run, center, extent);
+      last = surface_deviation(mesh, input, label, *run, result.triangles);
+      if (excess(last) < excess(best_deviation) || (excess(last) == excess(best_deviation) &&
+                                                    last.top2 <= best_deviation.top2 && last.mean <= mean_bound)) {
+        best = std::move(run);
+        best_deviation = last;
+        best_collapses = collapses;
+        best_triangles = result.triangles;
+        best_corners = result.corner_source;
+      }
     }
-    result.triangles = first_triangles;
-    result.corner_source = first_corners;
-    result.refine_collapses = first_collapses;
-    finish(first);
+    result.triangles = std::move(best_triangles);
+    result.corner_source = std::move(best_corners);
+    result.refine_collapses = best_collapses;
+    finish(*best);
+  }
+
+  // How far a run stayed above the target (0 once reached).
+  int32_t excess(const Deviation& d) const {
+    return params.target_triangles > 0 ? std::max(0, d.faces - params.target_triangles)
+                                       : std::max(0, d.vertices - params.target_vertices);
+  }
+
+  // The weight of each vertex alive in `restarted`: its guidance weight times 1 +
+  // kDeviationWeight x the largest worst[] (a squared deviation over the largest) of the
+  // vertices merged into it.
+  std::vector<double> deviation_weights(Collapser& restarted, std::vector<double> weight,
+                                        const std::vector<double>& worst) const {
+    std::vector<double> merged(n, 0.0);
+    for (int32_t v = 0; v < n; ++v) {
+      const int32_t s = restarted.survivor(v);
+      merged[s] = std::max(merged[s], worst[v]);
+    }
+    for (int32_t v = 0; v < n; ++v) weight[v] *= 1.0 + kDeviationWeight * merged[v];
+    return weight;
   }
 
   // A tiny result fitted to the input (after the max-aware choice, which compares the
@@ -477,11 +517,17 @@ class Refinement {
     // Slivers the stochastic pass left (near-collinear corners, needles) go first: the
     // collapses thin the result anyway, and none of them makes a triangle thinner than the
     // thinnest around it was (Collapser::keeps_shape).
-    const Collapser::Stop stop{params.target_vertices, params.target_triangles};
-    result.refine_collapses = collapser.remove_thin(kSliverShape, stop);
-    result.refine_collapses += collapser.run(stop);
+    result.refine_collapses = collapser.remove_thin(kSliverShape, target());
+    result.refine_collapses += collapse_rest(collapser, center, extent);
+  }
+
+  Collapser::Stop target() const { return {params.target_vertices, params.target_triangles}; }
+
+  // From where the collapses stand: to the target, the optional re-fit and a last clean-up.
+  int32_t collapse_rest(Collapser& collapser, const double* center, double extent) {
+    const int32_t collapses = collapser.run(target());
     if (params.refit) collapser.refit(cluster_radii(collapser, center, extent));
-    result.refine_collapses += collapser.remove_thin(0.0, {});
+    return collapses + collapser.remove_thin(0.0, {});
   }
 
   // Each vertex may move as far as its cluster reaches (as filtered placement allows): the

@@ -47,9 +47,9 @@ struct RefineParams {
   /// Finally move every free vertex to its quadric's minimum (filtered placement on the final
   /// clusters): what placement="filtered" means for a refined result.
   bool refit = false;
-  /// When the first pass kept every vertex (a mesh small enough to collapse whole), collapse
-  /// twice: the second run weighs each vertex's cost by how far the first run's surface ended
-  /// from the input there (a smaller max error, for the time of a second run).
+  /// When the first pass kept every vertex (a mesh small enough to collapse whole), rerun the
+  /// last collapses, each vertex's cost weighed by how far the runs before ended from the input
+  /// there, and keep the best run (a smaller max error, for the time of the reruns).
   bool max_aware = false;
   CornerAttributes attributes;
 };
