@@ -71,6 +71,7 @@ class TOPSTOC_PG_loop(bpy.types.PropertyGroup):
     kind: EnumProperty(name="Kind", items=LOOP_KINDS)
     component: IntProperty(name="Component")
     length: FloatProperty(name="Length", subtype="DISTANCE")
+    relative: FloatProperty(name="Size", description="Length as a fraction of the bounding box's diagonal")
     num_edges: IntProperty(name="Edges")
     fillable: BoolProperty(name="Fillable", default=True)
 

@@ -79,8 +79,13 @@ class TOPSTOC_UL_components(bpy.types.UIList):
 class TOPSTOC_UL_loops(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
         warning = item.kind == "BOUNDARY" and not item.fillable
-        layout.label(text=f"{item.name}: {item.num_edges} edges",
-                     icon="ERROR" if warning else KIND_ICONS.get(item.kind, "DOT"))
+        layout.label(text=f"{item.name}: {loop_size(item)}", icon="ERROR" if warning else KIND_ICONS.get(item.kind, "DOT"))
+
+
+def loop_size(item) -> str:
+    """A loop's size as the list shows it: its length as a percentage of the diagonal (the unit
+    of the clean-up's sizes) and its edge count."""
+    return f"{100 * item.relative:.2g} %, {item.num_edges} edges"
 
 
 class TOPSTOC_PT_topology(_MeshPanel, bpy.types.Panel):
@@ -180,7 +185,7 @@ class TOPSTOC_PT_topology_loops(_AnalysedPanel, bpy.types.Panel):
             row.operator("topstoc.cut_loop", text="Cut")
             row.operator("topstoc.remove_loop", text="Remove")
         row = layout.row()
-        row.label(text=f"{active.num_edges} edges, length {active.length:.4g}")
+        row.label(text=f"{active.num_edges} edges, length {active.length:.4g} ({100 * active.relative:.2g} %)")
         help_button(row, {"HANDLE": "handle", "TUNNEL": "tunnel"}.get(active.kind, "boundary_loop"))
         wrapped(layout, context, HELP[{"HANDLE": "handle", "TUNNEL": "tunnel"}.get(active.kind, "boundary_loop")])
 
