@@ -399,6 +399,25 @@ def test_nonmanifold_mesh_loop_search_reports_in_the_panel(mods, ts, scene):
     assert {p.name for p in shown} >= {"nonmanifold_edges"}
 
 
+def test_find_loops_searches_past_a_refused_component(mods, scene):
+    """A non-manifold piece beside a genus-2 block: Find Loops used to fail on the whole mesh;
+    now it lists the block's loops and names the refused piece in one line of its message."""
+    import cleanup_meshes
+
+    block, block_triangles = cleanup_meshes.block_with_arches(2, 0, jitter=0.05, seed=5)
+    fin, fin_triangles = meshgen.tetrahedra_sharing_edge()
+    n = len(block)
+    obj = make_object("Two", np.vstack([block, fin + [0.0, 0.0, 20.0]]),
+                      np.vstack([block_triangles, fin_triangles + n]))
+    assert bpy.ops.topstoc.find_loops() == {"FINISHED"}
+    t = obj.topstoc.topology
+    assert t.loops_state == "OK" and "\n" not in t.loops_message
+    assert f"component 1 (from vertex {n}): non-manifold" in t.loops_message, t.loops_message
+    kinds = [loop.kind for loop in t.loops]
+    assert kinds.count("HANDLE") == kinds.count("TUNNEL") == 2
+    assert all(mods.analysis.loop_vertices(loop).max() < n for loop in t.loops)
+
+
 def test_loop_view_looks_through_the_loop(ts):
     """Frame Loop's view: centred on the loop, four radii away, along its plane's normal from the
     viewer's side; a straight run of points keeps the view's direction."""

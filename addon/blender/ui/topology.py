@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import bpy
 
-from ..analysis import topology as analysis
+from ..analysis import clean_plan, topology as analysis
 from .topology_help import HELP
 from ..operators.topology import running
 from .panels import _ClosedPanel, _MeshPanel, _Panel, _mesh, wrapped
@@ -206,6 +206,12 @@ class TOPSTOC_PT_topology_edit(_Panel, bpy.types.Panel):
         col.operator("topstoc.delete_faces", icon="TRASH")
         # the full name, "... Small Handles and Holes", does not fit the sidebar (the tooltip says it)
         layout.operator("topstoc.clean", text="Clean Up Small Flaws", icon="MOD_SMOOTH")
+        shown = clean_plan.shown(obj) if obj is not None else None
+        if shown is not None:  # the clean-up waits for Enter or Esc
+            box = layout.box()
+            wrapped(box, context, f"Preview: {shown.summary()}", "HIDE_OFF")
+            box.label(text="Green: removed, violet: left")
+            box.label(text="Enter: apply, Esc: cancel")
 
 
 class TOPSTOC_PT_topology_overlays(_ClosedPanel, bpy.types.Panel):
@@ -222,6 +228,7 @@ class TOPSTOC_PT_topology_overlays(_ClosedPanel, bpy.types.Panel):
         col.prop(show, "line_width")
         col.prop(show, "active_width")
         col.prop(show, "point_size")
+        col.prop(show, "marker_size")
 
 
 CLASSES = (TOPSTOC_UL_components, TOPSTOC_UL_loops, TOPSTOC_PT_topology, TOPSTOC_PT_topology_components,
