@@ -56,6 +56,7 @@ def test_preview_counts_are_what_the_clean_up_does_and_undo_restores(mods, scene
         (plan.handles, plan.holes, plan.left)
     assert plan.summary() == f"removes 4 handles, fills 2 holes; leaves {plan.left}"
 
+    assert bpy.ops.topstoc.find_loops() == {"FINISHED"}
     bpy.ops.ed.undo_push(message="before the clean-up")
     assert bpy.ops.topstoc.clean("EXEC_DEFAULT", True, max_handle=size, max_hole=size) == {"FINISHED"}
     obj = bpy.data.objects[name]
@@ -63,6 +64,8 @@ def test_preview_counts_are_what_the_clean_up_does_and_undo_restores(mods, scene
     assert genus - t.genus == plan.handles and holes - t.boundary_loops == plan.holes  # done = shown
     assert t.edit_message.startswith("Removes 4 handles, fills 2 holes")
     assert mods.plan.shown(obj) is None                          # the preview ends with the clean-up
+    # a cut loop's edges stay (a cap's rim): no searched loop is kept, Find Loops lists what is left
+    assert [loop.kind for loop in t.loops] == ["BOUNDARY"] * t.boundary_loops and "Find Loops" in t.loops_message
     bpy.ops.ed.undo()
     obj = bpy.data.objects[name]
     assert snapshot(obj.data) == before
@@ -123,14 +126,20 @@ def test_marked_loops_are_the_active_loop_and_the_preview(mods, scene):
     assert bpy.ops.topstoc.find_loops() == {"FINISHED"}
     t = obj.topstoc.topology
     t.loop_index = 0
-    [(points, colour)] = mods.overlay_data.marked_loops(obj, show)
-    ids = np.asarray(t.loops[0]["vertices"])
-    np.testing.assert_array_equal(points, positions(obj.data)[ids])
+    marked = mods.overlay_data.marked_loops(obj, show)
+    searched = [loop for loop in t.loops if loop.kind != "BOUNDARY"]
+    assert len(marked) == len(searched) + (t.loops[0].kind == "BOUNDARY")  # every handle and tunnel, the active hole
+    for (points, colour), loop in zip(marked, searched):
+        np.testing.assert_array_equal(points, positions(obj.data)[np.asarray(loop["vertices"])])
+        assert colour == (mods.colors.HANDLE if loop.kind == "HANDLE" else mods.colors.TUNNEL)
+    show.show_handles = False
+    assert len(mods.overlay_data.marked_loops(obj, show)) == len(searched) // 2 + (t.loops[0].kind == "BOUNDARY")
+    show.show_handles = True
     size = percent(vertices, 6.0)
     plan = mods.plan.plan(obj, mods.mesh_read.read_mesh(obj.data), f"{size}%", f"{size}%", None)
     mods.plan.show(obj, plan)
     marked = mods.overlay_data.marked_loops(obj, show)
-    assert len(marked) == len(plan.loops(True)) + len(plan.loops(False)) + 1
+    assert len(marked) == len(plan.loops(True)) + len(plan.loops(False))  # the preview's rings only
     assert sum(colour == mods.colors.CLEAN_REMOVE for _p, colour in marked) == plan.handles + plan.holes
     mods.plan.hide(obj)
 

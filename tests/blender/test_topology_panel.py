@@ -436,7 +436,8 @@ def test_loop_view_looks_through_the_loop(ts):
         radius = np.linalg.norm(points - points.mean(axis=0), axis=1).max()
         assert distance == pytest.approx(frame.RADII * radius)
         first = directions[0]
-        assert abs(abs(first @ normal) - 1) < 1e-9 and first @ viewer > 0 and len(directions) == 7
+        assert abs(abs(first @ normal) - 1) < 1e-9 and first @ viewer > 0 and len(directions) == 15
+        assert all(abs(abs(d @ normal) - np.sqrt(0.5)) < 1e-9 for d in directions[2:10])  # 45 degrees to the plane
     line = np.outer(np.arange(4.0), [1.0, 0.0, 0.0])
     assert len(frame.loop_view(line, normal)[2]) == 1  # a straight run: the present direction only
 

@@ -54,10 +54,13 @@ below the size; the rest of the surface stays exactly as it was. Shows what it w
             made["plan"] = self._plan(target, arrays)  # the previewed plan when the mesh and sizes are its
             return made["plan"].result.edit
 
-        status = run_edit(self, context, compute, verb="cleaned")
+        status = run_edit(self, context, compute, verb="cleaned", carry=False)
         clean_plan.hide(obj)
         if "plan" in made and status == {"FINISHED"}:
             result = made["plan"].result
+            topology = obj.topstoc.topology
+            if topology.loops_state == "OK":  # the searched loops were dropped: most went with their handles
+                topology.loops_state, topology.loops_message = "NONE", "Cleaned: Find Loops lists what is left"
             text = f"TopStoc: {made['plan'].summary()} (genus {result.genus_before} -> {result.genus_after})"
             obj.topstoc.topology.edit_message = text[len("TopStoc: "):].capitalize()
             self.report({"INFO"}, text)

@@ -210,27 +210,27 @@ def clean_preview_primitives(obj) -> list:
 
 def marked_loops(obj, show) -> list:
     """(points (k, 3) in object space, colour) of the loops that get a ring when they are small
-    on screen: the active loop, and every loop of the clean-up's preview."""
-    co = None
+    on screen: every loop of the clean-up's preview when it is shown, else every handle and
+    tunnel loop shown and the active loop (a hole's too)."""
+    co = positions(obj.data) if obj.type == "MESH" else np.zeros((0, 3), np.float32)
     out = []
     shown = clean_plan.shown(obj)
     if shown is not None:
-        co = positions(obj.data)
         for removed, color in ((False, colors.CLEAN_LEAVE), (True, colors.CLEAN_REMOVE)):
             for _kind, ids in shown.loops(removed):
                 ids = ids[(ids >= 0) & (ids < len(co))]
                 if len(ids):
                     out.append((co[ids], color))
-    if obj.type == "MESH" and topology_current(obj):
+    if shown is None and obj.type == "MESH" and topology_current(obj):  # the preview rings replace these
         topology = obj.topstoc.topology
-        if 0 <= topology.loop_index < len(topology.loops):
-            loop = topology.loops[topology.loop_index]
-            wanted = {"HANDLE": show.show_handles, "TUNNEL": show.show_tunnels, "BOUNDARY": show.show_boundary}
-            co = positions(obj.data) if co is None else co
+        wanted = {"HANDLE": show.show_handles, "TUNNEL": show.show_tunnels, "BOUNDARY": show.show_boundary}
+        color = {"HANDLE": colors.HANDLE, "TUNNEL": colors.TUNNEL, "BOUNDARY": colors.BOUNDARY}
+        for index, loop in enumerate(topology.loops):
+            if not wanted[loop.kind] or (loop.kind == "BOUNDARY" and index != topology.loop_index):
+                continue
             ids = _id_array(loop, "vertices")
-            if wanted[loop.kind] and len(ids) and _valid(ids, len(co)):
-                color = {"HANDLE": colors.HANDLE, "TUNNEL": colors.TUNNEL, "BOUNDARY": colors.BOUNDARY}[loop.kind]
-                out.append((co[ids], color))
+            if len(ids) and _valid(ids, len(co)):
+                out.append((co[ids], color[loop.kind]))
     return out
 
 

@@ -189,10 +189,14 @@ def _draw_rings():
 
     gpu.state.blend_set("ALPHA")
     steps = 32
-    for x, y, radius, color in rings:
-        points = [(x + radius * math.cos(2 * math.pi * i / steps), y + radius * math.sin(2 * math.pi * i / steps), 0.0)
-                  for i in range(steps)]
-        pairs = [p for i in range(steps) for p in (points[i], points[(i + 1) % steps])]
+    circle = [(math.cos(2 * math.pi * i / steps), math.sin(2 * math.pi * i / steps)) for i in range(steps + 1)]
+    by_color = {}
+    for x, y, radius, color in rings:  # one batch per colour
+        pairs = by_color.setdefault(tuple(color), [])
+        for i in range(steps):
+            pairs += [(x + radius * circle[i][0], y + radius * circle[i][1], 0.0),
+                      (x + radius * circle[i + 1][0], y + radius * circle[i + 1][1], 0.0)]
+    for color, pairs in by_color.items():
         shader.uniform_float("color", color)
         batch_for_shader(shader, "LINES", {"pos": pairs}).draw(shader)
     gpu.state.blend_set("NONE")
