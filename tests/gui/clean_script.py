@@ -30,6 +30,43 @@ def loop_on_screen(obj, ids):
     return [None if p is None else (region.x + p.x, region.y + p.y) for p in points]
 
 
+def close_up(obj, ids):
+    """Points the view at the loop's vertices from above the surface there (their mean normal,
+    tilted 35 degrees), 14 loop radii away, with the wireframe on: the arch and the triangles
+    around it fill the view. Returns the view (location, rotation, distance) to come back to."""
+    from mathutils import Quaternion
+
+    _window, _area, _region, space = session.view3d()
+    world = obj.matrix_world
+    points = [world @ obj.data.vertices[i].co for i in ids]
+    centre = sum(points, Vector()) / len(points)
+    radius = max((p - centre).length for p in points)
+    normal = (world.to_3x3() @ sum((obj.data.vertices[i].normal for i in ids), Vector())).normalized()
+    view = space.region_3d
+    view.view_location = centre
+    view.view_rotation = normal.to_track_quat("Z", "Y") @ Quaternion((1, 0, 0), 0.6)
+    view.view_distance = 14 * radius
+    space.overlay.show_wireframes = True
+    return view.view_location.copy(), view.view_rotation.copy(), view.view_distance
+
+
+def keep_middle(shot_name, file_name, width=560, height=420):
+    """With TOPSTOC_DOC_SHOTS=DIR, saves the middle of the 3D view of a screenshot (a small file)."""
+    folder = os.environ.get("TOPSTOC_DOC_SHOTS")
+    if not folder:
+        return
+    _window, _area, region, _space = session.view3d()
+    pixels = np.load(os.path.join(session.OUT, shot_name + ".npy"))
+    x0 = region.x + (region.width - width) // 2
+    y0 = region.y + (region.height - height) // 2
+    crop = np.ascontiguousarray(pixels[y0:y0 + height, x0:x0 + width])
+    image = bpy.data.images.new(file_name, width, height, alpha=False)
+    image.pixels.foreach_set(crop.ravel())
+    image.filepath_raw, image.file_format = os.path.join(os.path.abspath(folder), file_name), "PNG"
+    image.save()
+    bpy.data.images.remove(image)
+
+
 def steps():
     session.enable_addon()
     from topstoc.blender.analysis import clean_plan
@@ -51,7 +88,6 @@ def steps():
     values["loop_sizes"] = [loop.relative for loop in topology.loops]
     yield 0.5
     session.shot("clean_before", [obj])
-    session.keep_for_docs("clean_before", "clean-before.png")
 
     # Frame Loop on the smallest loop: it fills a good part of the view afterwards.
     topology.loop_index = 0
@@ -68,6 +104,15 @@ def steps():
     session.check("frame loop ran", result == {"FINISHED"})
     session.shot("frame_loop", [obj])
     session.frame([obj], tilt=0.1, turn=0.0, distance_factor=2.0)
+
+    view = space.region_3d
+    full = (view.view_location.copy(), view.view_rotation.copy(), view.view_distance)
+    close = close_up(obj, ids)
+    yield 0.5
+    session.shot("close_before", [obj])
+    keep_middle("close_before", "clean-close-before.png")
+    view.view_location, view.view_rotation, view.view_distance = full
+    space.overlay.show_wireframes = False
 
     # The clean-up from the panel's button: a preview first, Esc leaves the mesh as it was.
     with session.override():
@@ -100,7 +145,13 @@ def steps():
                   and values["vertices_after"] > values["vertices_before"])
     yield 0.3
     session.shot("clean_after", [obj])
-    session.keep_for_docs("clean_after", "clean-after.png")
+    view.view_location, view.view_rotation, view.view_distance = close  # the same close view as before
+    space.overlay.show_wireframes = True
+    yield 0.5
+    session.shot("close_after", [obj])
+    keep_middle("close_after", "clean-close-after.png")
+    view.view_location, view.view_rotation, view.view_distance = full
+    space.overlay.show_wireframes = False
 
     with session.override():
         bpy.ops.ed.undo()
