@@ -185,7 +185,7 @@ class TOPSTOC_PT_topology_loops(_AnalysedPanel, bpy.types.Panel):
             row.operator("topstoc.cut_loop", text="Cut")
             row.operator("topstoc.remove_loop", text="Remove")
         row = layout.row()
-        row.label(text=f"{active.num_edges} edges, length {active.length:.4g} ({100 * active.relative:.2g} %)")
+        row.label(text=f"{active.num_edges} edges, length {active.length:.4g}")  # the list row has its %
         help_button(row, {"HANDLE": "handle", "TUNNEL": "tunnel"}.get(active.kind, "boundary_loop"))
         wrapped(layout, context, HELP[{"HANDLE": "handle", "TUNNEL": "tunnel"}.get(active.kind, "boundary_loop")])
 
