@@ -91,6 +91,12 @@ def test_preview_overlay_draws_removed_green_and_left_violet(mods, scene):
     assert len(removed) == sum(len(ids) for _kind, ids in plan.loops(True))
     lengths = [np.linalg.norm(co[ids] - co[np.roll(ids, -1)], axis=1).sum() for _kind, ids in plan.loops(False)]
     assert min(lengths) > 6.0 and len(left) == sum(len(ids) for _kind, ids in plan.loops(False))
+    from test_registration import fake_panel
+
+    panel = importlib.import_module(f"{mods.plan.__name__.rsplit('.', 2)[0]}.ui.topology").TOPSTOC_PT_topology_edit
+    seen = set()
+    panel.draw(fake_panel(panel, seen), bpy.context)              # the Edit panel draws the preview's box
+    assert "topstoc.clean" in seen
     bpy.ops.mesh.primitive_cube_add()
     obj.data = bpy.context.active_object.data                    # another mesh: the preview is stale
     assert mods.overlay_data.clean_preview_primitives(obj) == []
