@@ -130,6 +130,12 @@ def steps():
     yield 0.5
     plan = clean_plan.shown(obj)
     session.check("the preview is shown", result == {"RUNNING_MODAL"} and plan is not None)
+    press(window, "NUMPAD_MINUS")  # both sizes down by 1.5: fewer handles to remove
+    yield 0.5
+    values["smaller_preview_handles"] = clean_plan.shown(obj).handles
+    press(window, "NUMPAD_PLUS")   # and back
+    yield 0.5
+    plan = clean_plan.shown(obj)
     values["preview"] = {"handles": plan.handles, "holes": plan.holes, "left": plan.left,
                          "summary": plan.summary()}
     session.shot("clean_preview", [obj])
