@@ -309,6 +309,51 @@ def attribute_ratio(ours: float, peer: float, channel: str) -> str:
     return f"{value:.2f}" if value < 100 else "> 100"
 
 
+def _signed_percent(value) -> str:
+    return "—" if value is None else f"{100 * value:+.2f} %"
+
+
+def render_cleanup(name: str, figures: dict) -> str:
+    """bench_cleanup.py --json: handles against a voxel remesh at the same detail, holes against
+    PyMeshFix and MeshLab on the same plates."""
+    out = [f"## Topology clean-up next to MeshLab and PyMeshFix (`{name}`)", "",
+           f"`{figures['benchmark']}`: small handles removed below the size, the rest of the surface kept; "
+           "the anchor for handles is a voxel remesh at the same detail (MeshLab's Uniform Mesh Resampling, "
+           "marching cubes on cells one mean edge long), which removes handles by throwing the surface away: "
+           "the genus it leaves and the area it changes. PyMeshFix's repair keeps every handle.", "",
+           *source_lines(figures), "",
+           "| Case | Triangles | Genus before → after (ours) | Voxel remesh: genus after | PyMeshFix repair: genus "
+           "after | Area changed: ours / voxel | Voxel ÷ ours (area change) | Input triangles kept (ours) "
+           "| Worst patch aspect | Time: ours (loops) / voxel |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for row in figures["handles"]:
+        voxel = row.get("voxel")
+        ratio = "—" if voxel is None else f"{abs(voxel['area_change']) / max(abs(row['area_change']), 1e-12):.0f}×"
+        out.append(f"| {row['case']} | {row['triangles']:,} | {row['genus_before']} → {row['genus_after']} "
+                   f"| {'—' if voxel is None else voxel['genus']} "
+                   f"| {'—' if row.get('pymeshfix_genus') is None else row['pymeshfix_genus']} "
+                   f"| {_signed_percent(row['area_change'])} / {_signed_percent(None if voxel is None else voxel['area_change'])} "
+                   f"| {ratio} | {100 * row['kept']:.1f} % | {row['patch_aspect']:.2f} "
+                   f"| {row['seconds']:.2f} s ({row['loops_seconds']:.2f} s) / "
+                   f"{'—' if voxel is None else format(voxel['seconds'], '.2f') + ' s'} |")
+    out += ["", "Holes: plates with k holes of 2 × 2 quads (border 8) and 4 of 4 × 4 (border 16), size 10; "
+            "PyMeshFix `fill_small_boundaries(nbe=10)` and MeshLab Close Holes (up to 10 edges, refined) on the "
+            "same plate. Aspect ratio R / 2r (1: equilateral); rise: the new vertices' largest distance "
+            "from the plate's plane (the jitter is 0.05).", "",
+            "| k | Triangles | Borders before → after: ours, PyMeshFix, MeshLab | Worst patch aspect: ours, "
+            "PyMeshFix, MeshLab | Rise: ours, PyMeshFix, MeshLab | Input triangles kept: ours, PyMeshFix, MeshLab "
+            "| Time: ours, PyMeshFix, MeshLab |", "|---|---|---|---|---|---|---|"]
+    for row in figures["holes"]:
+        tools = [row.get(n) for n in ("ours", "pymeshfix", "meshlab")]
+
+        def cells(key, form):
+            return ", ".join("—" if f is None else form(f[key]) for f in tools)
+
+        out.append(f"| {row['k']:,} | {row['triangles']:,} | {row['borders_before']} → {cells('borders_after', str)} "
+                   f"| {cells('patch_aspect', lambda v: f'{v:.2f}')} | {cells('rise', lambda v: f'{v:.3f}')} "
+                   f"| {cells('kept', lambda v: f'{100 * v:.0f} %')} | {cells('seconds', lambda v: f'{v:.3f} s')} |")
+    return "\n".join(out) + "\n"
+
+
 def render_result(path: pathlib.Path) -> str:
     figures = json.loads(path.read_text())
     if isinstance(figures, dict) and figures.get("carried_over"):
@@ -327,9 +372,11 @@ def render_result(path: pathlib.Path) -> str:
         return render_paired(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_cleanup.py --speed":
         return render_cleanup_speed(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_cleanup.py":
+        return render_cleanup(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
                      "the --json of bench_decimate.py, bench_quality.py, bench_attributes.py, bench_loops.py --families, "
-                     "bench_scale.py, bench_threads_paired.py and bench_cleanup.py --speed, and carried-over "
+                     "bench_scale.py, bench_threads_paired.py, bench_cleanup.py and bench_cleanup.py --speed, and carried-over "
                      "figures)")
 
 

@@ -1,20 +1,26 @@
 """Benchmark: the topology clean-up (topstoc.core.api.clean) on meshes with many small defects.
 
     /usr/bin/python3 tests/bench/bench_cleanup.py [--handles 10,100,300] [--holes 50,300,1000]
+    /usr/bin/python3 tests/bench/bench_cleanup.py --handles 10,100 --holes 50,1000 --scan --json FILE
     /usr/bin/python3 tests/bench/bench_cleanup.py --speed 1000:0,1000:2 [--baseline DIR] [--json FILE]
 
 Cases (tests/cleanup_meshes.py, positions jittered by 0.05 like a scan):
   * block + k small arches + 4 large ones: genus k + 4; the small handles' loops are 4 long,
     the large ones' 12; size 6. Figures: genus before/after, handles left above the size, loops
-    left below it (recomputed on the output), worst patch aspect (R / 2r), time.
+    left below it (recomputed on the output), worst patch aspect (R / 2r), area changed, time.
+    Anchor: a voxel remesh at the same detail (MeshLab's uniform resampling, marching cubes on
+    cells one mean edge long): the genus it leaves and the area it changes; PyMeshFix's repair.
   * plate with k 2 x 2-quad holes (border 8) and 4 large ones (border 16); size 10. Figures: holes
     left, worst patch aspect, the patches' largest distance from the plate's plane, input
     triangles kept bit for bit, time; PyMeshFix (fill_small_boundaries, up to 10 boundary edges)
-    on the same input, run by the Python named in TOPSTOC_PYMESHFIX_PYTHON (a venv with
-    ``pip install pymeshfix``; default /tmp/clean-venv/bin/python), and its MeshFix.repair on
-    the handle case (it keeps handles: a reference for "the genus left").
+    and MeshLab (Close Holes, up to 10 edges, refined) on the same input.
+  * --scan: the Stanford armadillo (tests/data) with 8 pinched handles added, size 1 %; the voxel
+    remesh at its median edge length beside it.
   * the same blocks subdivided once and Taubin-smoothed: organic little handles (loops about
     3.2, the large ones 11; size 5), where the faired caps are kept.
+  * the criterion: on the elephant (tests/data, holes filled) and on unit arches, each handle
+    loop and each tunnel loop crossing it removed apart: does the shorter one give the smaller
+    patch area?
   * --speed K:L: the block with K small arches (and 4 large), subdivided L times (1000:2 is
     1,200,128 triangles: the issue's 1,000 handles on a 1M-triangle mesh), cleaned in a child
     process: wall and CPU seconds (TetGen's forked children included), genus, loops left below
@@ -24,6 +30,10 @@ Cases (tests/cleanup_meshes.py, positions jittered by 0.05 like a scan):
   * the criterion: on the elephant (tests/data, holes filled) and on unit arches, each handle
     loop and each tunnel loop crossing it removed apart: does the shorter one give the smaller
     patch area?
+
+The peers run in their own Pythons: TOPSTOC_PYMESHFIX_PYTHON (a venv with ``pip install
+pymeshfix``; default /tmp/clean-venv/bin/python) and TOPSTOC_PYMESHLAB_PYTHON (default the
+project's .venv, which has pymeshlab); a peer that is not there is left out (a dash).
 """
 
 from __future__ import annotations
@@ -57,6 +67,7 @@ from topstoc.core.api.topology import topology  # noqa: E402
 SIZE = 6.0
 HOLE_SIZE = 10.0
 PYMESHFIX = os.environ.get("TOPSTOC_PYMESHFIX_PYTHON", "/tmp/clean-venv/bin/python")
+PYMESHLAB = os.environ.get("TOPSTOC_PYMESHLAB_PYTHON", str(ROOT / ".venv" / "bin" / "python"))
 
 # Run in the PyMeshFix venv: reads in.npz, writes out.npz with the result and its time.
 PEER = """
@@ -73,16 +84,54 @@ np.savez(sys.argv[2], v=v2, f=f2, seconds=time.perf_counter() - start)
 """
 
 
-def peer(vertices, triangles, mode: str):
-    """PyMeshFix's result (vertices, triangles, seconds), or None when it is not installed."""
-    if not pathlib.Path(PYMESHFIX).exists():
+# Run in the pymeshlab venv: "fill" closes holes of up to argv[4] edges (refined), "voxel"
+# resamples on a grid of cell argv[4] (marching cubes: MeshLab's Uniform Mesh Resampling).
+MESHLAB = """
+import sys, time, numpy as np, pymeshlab
+data = np.load(sys.argv[1])
+ms = pymeshlab.MeshSet(); ms.add_mesh(pymeshlab.Mesh(data["v"], data["f"].astype(np.int32)))
+start = time.perf_counter()
+if sys.argv[3] == "fill":
+    ms.meshing_close_holes(maxholesize=int(sys.argv[4]), refinehole=True)
+else:
+    ms.generate_resampled_uniform_mesh(cellsize=pymeshlab.PureValue(float(sys.argv[4])),
+                                       offset=pymeshlab.PureValue(0.0), mergeclosevert=True)
+seconds = time.perf_counter() - start
+m = ms.current_mesh()
+np.savez(sys.argv[2], v=m.vertex_matrix(), f=m.face_matrix(), seconds=seconds)
+"""
+
+
+def peer(vertices, triangles, mode: str, python: str = PYMESHFIX, script: str = PEER, *extra):
+    """A peer's result (vertices, triangles, seconds), or None when its Python is not there."""
+    if not pathlib.Path(python).exists():
         return None
     with tempfile.TemporaryDirectory() as tmp:
         source, target = pathlib.Path(tmp, "in.npz"), pathlib.Path(tmp, "out.npz")
         np.savez(source, v=vertices, f=triangles)
-        subprocess.run([PYMESHFIX, "-c", PEER, str(source), str(target), mode], check=True)
+        subprocess.run([python, "-c", script, str(source), str(target), mode, *map(str, extra)], check=True)
         out = np.load(target)
         return out["v"], out["f"], float(out["seconds"])
+
+
+def area(vertices, triangles) -> float:
+    q = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles, dtype=np.int64)]
+    return float(0.5 * np.linalg.norm(np.cross(q[:, 1] - q[:, 0], q[:, 2] - q[:, 0]), axis=1).sum())
+
+
+def voxel_anchor(vertices, triangles, cell: float):
+    """MeshLab's voxel remesh at cell ``cell``: {genus, area_change, triangles, seconds} or None."""
+    out = peer(vertices, triangles, "voxel", PYMESHLAB, MESHLAB, cell)
+    if out is None:
+        return None
+    return {"genus": genus(out[0], out[1]), "area_change": area(out[0], out[1]) / area(vertices, triangles) - 1,
+            "triangles": int(len(out[1])), "kept": kept_bit_for_bit(vertices, triangles, out[0], out[1]),
+            "seconds": out[2]}
+
+
+def mean_edge(vertices, triangles) -> float:
+    t = np.asarray(triangles, dtype=np.int64)
+    return float(np.linalg.norm(vertices[t[:, 0]] - vertices[t[:, 1]], axis=1).mean())
 
 
 def genus(vertices, triangles) -> int:
@@ -113,52 +162,87 @@ def created(vertices, triangles, out_vertices, out_triangles):
     return aspect, float(np.abs(out_vertices[fresh, 2]).max()) if fresh.any() else 0.0, int(fresh.sum())
 
 
-def bench_handles(k: int, smooth: bool = False) -> None:
+def handles_row(name: str, vertices, triangles, size, voxel_cell: float) -> dict:
+    """Ours on one mesh with small handles, the voxel anchor and PyMeshFix's repair beside it."""
+    start = time.perf_counter()
+    result = clean(vertices, triangles, max_handle=size, max_hole=0)
+    seconds = time.perf_counter() - start
+    loops = handle_tunnel_loops(result.vertices, result.triangles)
+    row = {"case": name, "triangles": int(len(triangles)), "genus_before": result.genus_before,
+           "genus_after": result.genus_after, "removed": result.count("handle") + result.count("tunnel"),
+           "loops_below_size": sum(1 for loop in loops.handles + loops.tunnels if loop.length < result.max_handle),
+           "rounds": result.rounds, "patch_aspect": result.patch_aspect,
+           "area_change": area(result.vertices, result.triangles) / area(vertices, triangles) - 1,
+           "kept": kept_bit_for_bit(vertices, triangles, result.vertices, result.triangles),
+           "seconds": seconds, "loops_seconds": result.seconds.get("loops", 0.0),
+           "voxel": voxel_anchor(vertices, triangles, voxel_cell), "voxel_cell": voxel_cell}
+    fixed = peer(vertices, triangles, "repair")
+    row["pymeshfix_genus"] = None if fixed is None else genus(fixed[0], fixed[1])
+    voxel = row["voxel"]
+    print(f"{name}: {row['triangles']} triangles, genus {row['genus_before']} -> {row['genus_after']} "
+          f"(loops left below the size: {row['loops_below_size']}), removed {row['removed']} in {row['rounds']} rounds, "
+          f"patch aspect <= {row['patch_aspect']:.2f}, area {100 * row['area_change']:+.3f} %, input triangles kept "
+          f"{100 * row['kept']:.1f} %, {seconds:.2f} s (loops {row['loops_seconds']:.2f} s)")
+    if voxel is not None:
+        print(f"  voxel remesh (MeshLab, cell {voxel_cell:.3g}): genus {voxel['genus']}, area {100 * voxel['area_change']:+.2f} % "
+              f"({abs(voxel['area_change']) / max(abs(row['area_change']), 1e-12):.0f}x ours), input triangles kept "
+              f"{100 * voxel['kept']:.1f} %, {voxel['seconds']:.2f} s")
+    if fixed is not None:
+        print(f"  PyMeshFix repair: genus {row['pymeshfix_genus']}")
+    return row
+
+
+def bench_handles(k: int, smooth: bool = False) -> dict:
     vertices, triangles = cleanup_meshes.block_with_arches(k, 4, jitter=0.0 if smooth else 0.05, seed=k)
     size = SIZE
     if smooth:  # subdivided and smoothed: organic little handles, loops about 3.2 (large ones 11)
         vertices, triangles = meshgen.subdivide(vertices, triangles, 1)
         vertices, size = cleanup_meshes.smoothed(vertices, triangles), 5.0
-    start = time.perf_counter()
-    result = clean(vertices, triangles, max_handle=size, max_hole=0)
-    seconds = time.perf_counter() - start
-    loops = handle_tunnel_loops(result.vertices, result.triangles)
-    below = sum(1 for loop in loops.handles + loops.tunnels if loop.length < size)
-    print(f"handles k={k}{' smoothed' if smooth else ''}: {len(triangles)} triangles, genus {result.genus_before} -> {result.genus_after} "
-          f"(handles left above the size: {result.genus_after}, loops left below it: {below}), "
-          f"removed {result.count('handle')} handle + {result.count('tunnel')} tunnel loops in {result.rounds} "
-          f"rounds, patch aspect <= {result.patch_aspect:.2f}, {seconds:.2f} s "
-          f"(of which computing loops {result.seconds.get('loops', 0):.2f} s; {len(result.left)} loops reported left)")
-    fixed = peer(vertices, triangles, "repair")
-    if fixed is not None:
-        print(f"  PyMeshFix repair: genus {genus(vertices, triangles)} -> {genus(fixed[0], fixed[1])}, "
-              f"{fixed[2]:.2f} s, input triangles kept bit for bit "
-              f"{100 * kept_bit_for_bit(vertices, triangles, fixed[0], fixed[1]):.1f} %")
+    name = f"{k} arches{' smoothed' if smooth else ''}"
+    return handles_row(name, vertices, triangles, size, mean_edge(vertices, triangles))
 
 
-def bench_holes(k: int) -> None:
+def bench_scan() -> dict:
+    """The armadillo scan with 8 pinched handles (the GUI test's input), size 1 %."""
+    data = read_mesh(str(ROOT / "tests" / "data" / "genus0" / "cgal_armadillo.off.gz"))
+    vertices, triangles, _arches = cleanup_meshes.with_pinched_handles(data.vertices, data.triangles, 8, seed=1)
+    cell = float(np.median(np.linalg.norm(vertices[triangles[:, 0]] - vertices[triangles[:, 1]], axis=1)))
+    return handles_row("armadillo scan + 8 pinched handles", vertices, triangles, "1%", cell)
+
+
+def fill_figures(vertices, triangles, out_vertices, out_triangles, seconds) -> dict:
+    """A hole filler's output on the plate: borders left, patch aspect, rise, triangles kept."""
+    aspect, rise, added = created(vertices, triangles, out_vertices, out_triangles)
+    return {"borders_after": len(edit.boundary_loops(out_vertices, out_triangles)), "patch_aspect": aspect,
+            "rise": rise, "added_vertices": added, "seconds": seconds,
+            "kept": kept_bit_for_bit(vertices, triangles, out_vertices, out_triangles)}
+
+
+def bench_holes(k: int) -> dict:
     side = int(np.ceil(3 * np.sqrt(1.4 * k))) + 16
     vertices, triangles = cleanup_meshes.perforated_plate(k, 4, side=side, small_size=2, jitter=0.05, seed=k)
     holes = len(edit.boundary_loops(vertices, triangles))
     start = time.perf_counter()
     result = clean(vertices, triangles, max_hole=HOLE_SIZE, max_handle=0)
     seconds = time.perf_counter() - start
-    fresh = result.edit.vertex_source < 0
-    rise = float(np.abs(result.vertices[fresh, 2]).max()) if fresh.any() else 0.0
-    left = len(edit.boundary_loops(result.vertices, result.triangles))
-    kept = kept_bit_for_bit(vertices, triangles, result.vertices, result.triangles)
-    print(f"holes k={k}: {len(triangles)} triangles, {holes} borders -> {left} (the 4 large ones and the plate's "
-          f"edge stay), patch aspect <= {result.patch_aspect:.2f}, {int(fresh.sum())} vertices added, "
-          f"<= {rise:.3f} off the plane, "
-          f"input triangles kept bit for bit {100 * kept:.1f} %, {seconds:.3f} s")
-    fixed = peer(vertices, triangles, "fill")
-    if fixed is None:
-        print(f"  PyMeshFix: not installed for {PYMESHFIX}")
-        return
-    aspect, rise, added = created(vertices, triangles, fixed[0], fixed[1])
-    print(f"  PyMeshFix fill_small_boundaries(10): {holes} borders -> {len(edit.boundary_loops(fixed[0], fixed[1]))}, "
-          f"patch aspect <= {aspect:.2f}, {added} vertices added, <= {rise:.3f} off the plane, input triangles kept bit for bit "
-          f"{100 * kept_bit_for_bit(vertices, triangles, fixed[0], fixed[1]):.1f} %, {fixed[2]:.3f} s")
+    row = {"k": k, "triangles": int(len(triangles)), "borders_before": holes,
+           "ours": fill_figures(vertices, triangles, result.vertices, result.triangles, seconds)}
+    row["ours"]["patch_aspect"] = result.patch_aspect  # the patches' own (created() matches by position)
+    for name, python, script, mode, extra in (("pymeshfix", PYMESHFIX, PEER, "fill", ()),
+                                              ("meshlab", PYMESHLAB, MESHLAB, "fill", (10,))):
+        out = peer(vertices, triangles, mode, python, script, *extra)
+        row[name] = None if out is None else fill_figures(vertices, triangles, *out)
+    for name in ("ours", "pymeshfix", "meshlab"):
+        f = row[name]
+        if f is None:
+            print(f"  {name}: not installed")
+            continue
+        print(f"holes k={k} {name}: {holes} borders -> {f['borders_after']}, patch aspect <= {f['patch_aspect']:.2f}, "
+              f"{f['added_vertices']} vertices added, <= {f['rise']:.3f} off the plane, input triangles kept "
+              f"{100 * f['kept']:.1f} %, {f['seconds']:.3f} s"
+              + ("" if name == "ours" else f" (aspect ours / theirs {row['ours']['patch_aspect'] / f['patch_aspect']:.2f}, "
+                                            f"time theirs / ours {f['seconds'] / row['ours']['seconds']:.2f})"))
+    return row
 
 
 def removal_area(vertices, triangles, loop):
@@ -255,7 +339,9 @@ def main(argv=None) -> int:
     parser.add_argument("--speed", help="only time these cases K:L (K small arches, L subdivisions), comma-separated")
     parser.add_argument("--baseline", help="with --speed: another build's python directory, timed alongside")
     parser.add_argument("--baseline-cases", help="with --baseline: only these cases (default: all)")
-    parser.add_argument("--json", help="with --speed: save the figures here")
+    parser.add_argument("--scan", action="store_true", help="also the armadillo scan with pinched handles")
+    parser.add_argument("--no-criterion", action="store_true", help="skip the loop-choice criterion")
+    parser.add_argument("--json", help="save the figures here (with --speed: the speed figures)")
     parser.add_argument("--child", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.child:
@@ -264,12 +350,19 @@ def main(argv=None) -> int:
     if args.speed:
         return speed(args)
     print(machine())
-    for k in (int(x) for x in args.handles.split(",") if x):
-        bench_handles(k)
-    for k in (int(x) for x in args.smooth.split(",") if x):
-        bench_handles(k, smooth=True)
-    for k in (int(x) for x in args.holes.split(",") if x):
-        bench_holes(k)
+    handles = [bench_handles(k) for k in (int(x) for x in args.handles.split(",") if x)]
+    handles += [bench_handles(k, smooth=True) for k in (int(x) for x in args.smooth.split(",") if x)]
+    handles += [bench_scan()] if args.scan else []
+    holes = [bench_holes(k) for k in (int(x) for x in args.holes.split(",") if x)]
+    if args.json:
+        save_figures(args.json, "tests/bench/bench_cleanup.py",
+                     "tests/cleanup_meshes.py blocks with k unit arches and 4 large ones (size 6), smoothed ones "
+                     "(size 5), plates with k small holes (size 10); the armadillo scan with 8 pinched handles "
+                     "(size 1 %); peers in the same run: MeshLab (pymeshlab) Close Holes and Uniform Mesh "
+                     "Resampling at one mean edge, PyMeshFix fill_small_boundaries(10) and repair",
+                     handles=handles, holes=holes)
+    if args.no_criterion:
+        return 0
     elephant = read_mesh(str(ROOT / "tests" / "data" / "open_boundary" / "cgal_elephant-with-holes.off"))
     filled = edit.fill_holes(elephant.vertices, elephant.triangles, refine=True, fair=True)
     bench_criterion("elephant (holes filled)", filled.vertices, filled.triangles)

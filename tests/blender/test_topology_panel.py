@@ -135,6 +135,41 @@ def test_find_loops_step_and_select(mods, scene):
     assert not any(p.select for p in obj.data.polygons)
 
 
+def test_loop_list_is_sorted_by_size_relative_to_the_diagonal(mods, scene):
+    """Handles, tunnels and holes in one list, shortest first, each with its length over the
+    bounding box's diagonal; checked against lengths computed here from the input's positions,
+    and still sorted after an edit carries the loops over."""
+    import cleanup_meshes
+
+    block, block_triangles = cleanup_meshes.block_with_arches(3, 2, jitter=0.05, seed=4)
+    plate, plate_triangles = cleanup_meshes.perforated_plate(1, 0, side=6, jitter=0.05, seed=4)
+    vertices = np.vstack([block, plate + [0.0, 0.0, -3.0]])  # a plate (edge 24, hole 4) below the block
+    triangles = np.vstack([block_triangles, plate_triangles + len(block)])
+    obj = make_object("Arches", vertices, triangles)
+    assert bpy.ops.topstoc.find_loops() == {"FINISHED"}
+    t = obj.topstoc.topology
+    diagonal = np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0))
+
+    def independent(item):
+        ids = mods.analysis.loop_vertices(item)
+        return np.linalg.norm(vertices[ids] - vertices[np.roll(ids, -1)], axis=1).sum()
+
+    lengths = [independent(item) for item in t.loops]
+    assert sorted(item.kind for item in t.loops) == ["BOUNDARY"] * 2 + ["HANDLE"] * 5 + ["TUNNEL"] * 5
+    assert lengths == sorted(lengths) and lengths[0] < 6 < lengths[-1]  # small flaws first, large last
+    assert t.loops[0].kind != "BOUNDARY" or lengths[0] < 5 and t.loops[-1].kind == "BOUNDARY"  # the plate's edge last
+    for item, length in zip(t.loops, lengths):
+        assert item.length == pytest.approx(length, rel=1e-5)
+        assert item.relative == pytest.approx(length / diagonal, rel=1e-5)
+        assert mods.panel.loop_size(item).startswith(f"{100 * length / diagonal:.2g} %")
+    handles = [item.name for item in t.loops if item.kind == "HANDLE"]
+    assert handles == [f"Handle {i}" for i in range(1, 6)]  # numbered in the list's order
+    t.loop_index = [item.kind for item in t.loops].index("HANDLE")
+    assert bpy.ops.topstoc.remove_loop() == {"FINISHED"}
+    assert [item.length for item in t.loops] == sorted(item.length for item in t.loops)
+    assert sum(item.kind == "HANDLE" for item in t.loops) >= 3
+
+
 def add_attributes(obj):
     mesh = obj.data
     uv = mesh.uv_layers.new(name="UVMap")
@@ -364,6 +399,25 @@ def test_nonmanifold_mesh_loop_search_reports_in_the_panel(mods, ts, scene):
     assert {p.name for p in shown} >= {"nonmanifold_edges"}
 
 
+def test_find_loops_searches_past_a_refused_component(mods, scene):
+    """A non-manifold piece beside a genus-2 block: Find Loops used to fail on the whole mesh;
+    now it lists the block's loops and names the refused piece in one line of its message."""
+    import cleanup_meshes
+
+    block, block_triangles = cleanup_meshes.block_with_arches(2, 0, jitter=0.05, seed=5)
+    fin, fin_triangles = meshgen.tetrahedra_sharing_edge()
+    n = len(block)
+    obj = make_object("Two", np.vstack([block, fin + [0.0, 0.0, 20.0]]),
+                      np.vstack([block_triangles, fin_triangles + n]))
+    assert bpy.ops.topstoc.find_loops() == {"FINISHED"}
+    t = obj.topstoc.topology
+    assert t.loops_state == "OK" and "\n" not in t.loops_message
+    assert f"component 1 (from vertex {n}): non-manifold" in t.loops_message, t.loops_message
+    kinds = [loop.kind for loop in t.loops]
+    assert kinds.count("HANDLE") == kinds.count("TUNNEL") == 2
+    assert all(mods.analysis.loop_vertices(loop).max() < n for loop in t.loops)
+
+
 def test_loop_view_looks_through_the_loop(ts):
     """Frame Loop's view: centred on the loop, four radii away, along its plane's normal from the
     viewer's side; a straight run of points keeps the view's direction."""
@@ -382,7 +436,8 @@ def test_loop_view_looks_through_the_loop(ts):
         radius = np.linalg.norm(points - points.mean(axis=0), axis=1).max()
         assert distance == pytest.approx(frame.RADII * radius)
         first = directions[0]
-        assert abs(abs(first @ normal) - 1) < 1e-9 and first @ viewer > 0 and len(directions) == 7
+        assert abs(abs(first @ normal) - 1) < 1e-9 and first @ viewer > 0 and len(directions) == 15
+        assert all(abs(abs(d @ normal) - np.sqrt(0.5)) < 1e-9 for d in directions[2:10])  # 45 degrees to the plane
     line = np.outer(np.arange(4.0), [1.0, 0.0, 0.0])
     assert len(frame.loop_view(line, normal)[2]) == 1  # a straight run: the present direction only
 
@@ -409,16 +464,16 @@ def test_overlay_arrays_follow_the_analysis(mods, scene):
     bpy.ops.topstoc.find_loops()
     t = obj.topstoc.topology
     show = bpy.context.scene.topstoc.overlays
-    t.loop_index = 1
+    t.loop_index = [loop.kind for loop in t.loops].index("HANDLE")
     prims = {p.name: p for p in mods.overlay_data.topology_primitives(obj, show)}
     co = positions(obj.data)
-    active = mods.analysis.loop_vertices(t.loops[1])
+    active = mods.analysis.loop_vertices(t.loops[t.loop_index])
     np.testing.assert_allclose(prims["active_loop"].positions.reshape(-1, 2, 3)[:, 0], co[active])
     assert prims["active_loop"].size == "active" and prims["active_loop"].color == mods.colors.HANDLE
     # its corners as dots of the active width too: a tiny loop shows as a dot at least when zoomed out
     np.testing.assert_allclose(prims["active_loop_points"].positions, co[active])
     assert prims["active_loop_points"].size == "active" and prims["active_loop_points"].kind == "POINTS"
-    handle_edges = sum(loop.num_edges for i, loop in enumerate(t.loops) if loop.kind == "HANDLE" and i != 1)
+    handle_edges = sum(loop.num_edges for i, loop in enumerate(t.loops) if loop.kind == "HANDLE" and i != t.loop_index)
     assert len(prims["handles"]) == 2 * handle_edges and prims["tunnels"].color == mods.colors.TUNNEL
     assert len(prims["generators"]) == 2 * 4 and prims["generators"].color == mods.colors.GENERATOR
     show.show_handles = False

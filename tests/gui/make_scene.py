@@ -2,10 +2,11 @@
 
     blender -b --factory-startup --python make_scene.py -- --mesh FILE --output SCENE.blend
         [--name NAME] [--subdivide LEVELS] [--transform] [--decimate RATIO] [--measure]
-        [--analyse] [--loops]
+        [--analyse] [--loops] [--pinched-handles N]
 
 Reads any mesh format through topstoc.core.api.io; --subdivide splits every triangle into four
-(midpoint subdivision: same shape and topology, more triangles); --transform moves, rotates and
+(midpoint subdivision: same shape and topology, more triangles); --pinched-handles adds N thin
+arches, a scanner's bridges (tests/cleanup_meshes.py, seed 1); --transform moves, rotates and
 scales the object non-uniformly (overlays must follow); --decimate adds "<name>_TopStoc" at the
 same place (moved back from beside the original); --measure stores the Hausdorff figures on the decimated object; --analyse and
 --loops store the topology and the handle/tunnel loops on the mesh. The default scene's cube
@@ -32,6 +33,7 @@ def parse(argv):
     parser.add_argument("--measure", action="store_true")
     parser.add_argument("--analyse", action="store_true")
     parser.add_argument("--loops", action="store_true")
+    parser.add_argument("--pinched-handles", type=int, default=0)
     return parser.parse_args(argv)
 
 
@@ -53,6 +55,12 @@ def main():
         import meshgen
 
         vertices, triangles = meshgen.subdivide(vertices, triangles, args.subdivide)
+    if args.pinched_handles:
+        sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+        import cleanup_meshes
+
+        vertices, triangles, _arches = cleanup_meshes.with_pinched_handles(vertices, triangles, args.pinched_handles,
+                                                                           seed=1)
     mesh = bpy.data.meshes.new(args.name)
     mesh_write.fill_geometry(mesh, vertices, triangles)
     obj = bpy.data.objects.new(args.name, mesh)

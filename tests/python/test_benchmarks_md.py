@@ -134,3 +134,26 @@ def test_paired_results_render_the_median_of_the_pair_ratios():
     assert [cell.strip() for cell in row.strip("|").split("|")] == ["re-decimation", "100 ms", "90 ms", "1.000",
                                                                    "0.900–1.200"]
     assert "3 pairs of runs" in text and "## Paired runs: B against A" in text
+
+
+def test_cleanup_results_render_the_anchors_and_their_ratio():
+    voxel = {"genus": 6, "area_change": -0.16, "triangles": 900, "kept": 0.0, "seconds": 0.4}
+    figures = {"benchmark": "tests/bench/bench_cleanup.py", "machine": "m", "date": "2000-01-01",
+               "handles": [{"case": "10 arches", "triangles": 4392, "genus_before": 14, "genus_after": 4,
+                            "area_change": 0.0008, "kept": 0.953, "patch_aspect": 1.28, "seconds": 0.6,
+                            "loops_seconds": 0.5, "voxel": voxel, "pymeshfix_genus": 14},
+                           {"case": "no peers", "triangles": 10, "genus_before": 1, "genus_after": 0,
+                            "area_change": 0.001, "kept": 0.9, "patch_aspect": 1.1, "seconds": 0.1,
+                            "loops_seconds": 0.1, "voxel": None, "pymeshfix_genus": None}],
+               "holes": [{"k": 50, "triangles": 3000, "borders_before": 55,
+                          "ours": {"borders_after": 5, "patch_aspect": 1.4, "rise": 0.0, "kept": 1.0, "seconds": 0.02},
+                          "pymeshfix": None,
+                          "meshlab": {"borders_after": 5, "patch_aspect": 4.19, "rise": 0.016, "kept": 1.0,
+                                      "seconds": 0.39}}]}
+    text = benchmarks_md.render_cleanup("c.json", figures)
+    rows = {line.split("|")[1].strip(): [c.strip() for c in line.strip("|").split("|")]
+            for line in text.splitlines() if line.startswith("| ")}
+    # 0.16 / 0.0008, computed here
+    assert rows["10 arches"][1:7] == ["4,392", "14 → 4", "6", "14", "+0.08 % / -16.00 %", "200×"]
+    assert rows["no peers"][3:7] == ["—", "—", "+0.10 % / —", "—"]
+    assert rows["50"][2:4] == ["55 → 5, —, 5", "1.40, —, 4.19"]

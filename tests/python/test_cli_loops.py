@@ -93,3 +93,27 @@ def test_errors_are_one_line(tmp_path):
     broken.write_bytes(gzip.compress(b"OFF\n3 1 0\n0 0 0\n1 0 0\n"))
     done = topstoc(broken)
     assert done.returncode == 1 and done.stdout == ""
+
+
+def test_a_refused_component_is_one_line_and_the_others_are_searched(tmp_path):
+    """A non-manifold component beside a genus-2 block used to stop the command with an error:
+    now it is one line naming it (in the file's ids) and the block's loops are listed."""
+    import cleanup_meshes
+    from meshgen import tetrahedra_sharing_edge
+
+    block, block_triangles = cleanup_meshes.block_with_arches(2, 0, jitter=0.05, seed=5)
+    fin, fin_triangles = tetrahedra_sharing_edge()  # four triangles on one edge
+    n = len(block)
+    path = tmp_path / "two.off"
+    write_mesh(path, MeshData(vertices=np.vstack([block, fin + [0.0, 0.0, 20.0]]),
+                              triangles=np.vstack([block_triangles, fin_triangles + n]).astype(np.int32)))
+    done = topstoc(path)
+    assert done.returncode == 0, done.stderr
+    refused = [line for line in done.stdout.splitlines() if line.startswith("component 1")]
+    assert len(refused) == 1 and "refused" in refused[0] and "non-manifold" in refused[0], done.stdout
+    assert f"edge {n}-{n + 1}" in refused[0]  # the file's vertex ids, not the component's own
+    doc = run_json(path)
+    assert [c["status"] for c in doc["components"]] == ["ok", "refused"]
+    assert doc["components"][0]["genus"] == 2 and len(doc["components"][0]["handles"]) == 2
+    for loop in doc["components"][0]["handles"] + doc["components"][0]["tunnels"]:
+        assert hc.is_simple_edge_cycle(loop, block_triangles)

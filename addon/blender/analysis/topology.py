@@ -7,8 +7,8 @@ component too. Everything is stored on the object (props/results.py), so undo re
 with the mesh.
 
 The loop list holds the handle and tunnel loops of the last search (valid while the mesh's
-connectivity is unchanged, or carried through the add-on's own edits) followed by the
-boundary loops of the last analysis.
+connectivity is unchanged, or carried through the add-on's own edits) and the boundary loops
+of the last analysis, sorted by length (shortest first).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from ...core.api import loops as core_loops
+from ...core.api import component_loops, loops as core_loops
 from ...core.api.topology import Topology, topology as compute_topology
 from ...core.support.errors import TopStocError
 from ..io import mesh_access, mesh_read
@@ -159,16 +159,21 @@ def _store(obj, info, arrays, wires, stamp: str, seconds: float, carried_loops) 
 
 
 def _set_loops(topology, co, entries, info, fillable) -> None:
+    """The loop list, shortest first (the small flaws a clean-up removes come first), each
+    with its length as a fraction of the bounding box's diagonal."""
     topology.loops.clear()
     counters = {"HANDLE": 0, "TUNNEL": 0, "BOUNDARY": 0}
-    for kind, ids in entries:
-        ids = np.asarray(ids, dtype=np.int64)
+    diagonal = float(np.linalg.norm(np.ptp(co, axis=0))) if len(co) else 0.0
+    measured = sorted(((loop_length(co, ids), kind, np.asarray(ids, dtype=np.int64)) for kind, ids in entries),
+                      key=lambda entry: entry[0])  # stable: equal lengths keep their order
+    for length, kind, ids in measured:
         item = topology.loops.add()
         counters[kind] += 1
         item.name = f"{kind.capitalize()} {counters[kind]}"
         item.kind = kind
         item.component = int(info.vertex_component[ids[0]]) if info is not None and len(ids) else 0
-        item.length = loop_length(co, ids)
+        item.length = length
+        item.relative = length / diagonal if diagonal > 0 else 0.0
         item.num_edges = len(ids)
         item.fillable = fillable.get(frozenset(ids.tolist()), True) if kind == "BOUNDARY" else True
         item["vertices"] = ids.tolist()
@@ -223,12 +228,15 @@ class LoopSearch:
 
     def run(self) -> None:
         start = time.perf_counter()
-        try:
-            self.result = core_loops.handle_tunnel_loops(self.mesh, progress=self._progress)
+        try:  # a refused component (not manifold, self-intersecting) spoils no other
+            self.result = component_loops.loops_by_component(self.mesh.vertices, self.mesh.triangles, mesh=self.mesh,
+                                                             progress=self._progress)
         except core_loops.Cancelled:
             self.error = "cancelled"
         except ValueError as error:
             self.error = f"'{self.object_name}': {error}"
+        if self.result is not None and component_loops.all_refused(self.result):  # nothing to show
+            self.error = f"'{self.object_name}': " + "; ".join(component_loops.refusals(self.result))
         self.seconds = time.perf_counter() - start
 
 
@@ -261,7 +269,11 @@ def finish_search(obj, search: LoopSearch) -> str:
     found = [("HANDLE", loop.vertices) for loop in result.handles] + \
             [("TUNNEL", loop.vertices) for loop in result.tunnels]
     parts = [f"{len(result.handles)} handle and {len(result.tunnels)} tunnel loops in {search.seconds:.2f} s"]
-    skipped = [c for c in result.components if c.status != "ok"]
+    refused = component_loops.refusals(result)
+    if refused:  # one line: the first refused component, and how many more
+        more = f" (and {len(refused) - 1} more refused)" if len(refused) > 1 else ""
+        parts.append(f"{refused[0]}{more}; left without loops")
+    skipped = [c for c in result.components if c.status not in ("ok", component_loops.REFUSED)]
     if skipped:
         parts.append(f"{len(skipped)} component{'s' if len(skipped) > 1 else ''} without loops "
                      f"({skipped[0].detail})")

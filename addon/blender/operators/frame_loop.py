@@ -20,7 +20,8 @@ def loop_view(points: np.ndarray, towards_viewer) -> tuple:
     """(centre, view distance, directions) that frame ``points`` (world space, (k, 3)): the
     directions to look from, best first: along the normal of their best-fit plane (through the
     loop) from the side of ``towards_viewer`` (a vector from the scene to the present view), the
-    other side, then the plane's own axes and the present direction."""
+    other side, then at 45 degrees to the plane, then the plane's own axes and the present
+    direction."""
     centre = points.mean(axis=0)
     offsets = points - centre
     radius = float(np.linalg.norm(offsets, axis=1).max()) if len(points) else 0.0
@@ -30,7 +31,11 @@ def loop_view(points: np.ndarray, towards_viewer) -> tuple:
         _u, singular, axes = np.linalg.svd(offsets, full_matrices=False)
         if singular[1] > 1e-9 * max(singular[0], 1e-300):  # not a straight run of points
             normal = axes[2] if np.dot(axes[2], viewer) >= 0 else -axes[2]
-            directions = [normal, -normal, axes[0], -axes[0], axes[1], -axes[1]]
+            # through the loop, then at 45 degrees to its plane (a loop round a thin tube is hidden
+            # by the tube along its axis, and edge-on in its plane), then in its plane
+            oblique = [(side * normal + sign * axis) / np.sqrt(2.0) for side in (1, -1)
+                       for axis in (axes[0], axes[1]) for sign in (1, -1)]
+            directions = [normal, -normal] + oblique + [axes[0], -axes[0], axes[1], -axes[1]]
     directions.append(viewer / max(np.linalg.norm(viewer), 1e-300))
     return centre, max(radius, 1e-6) * RADII, directions
 

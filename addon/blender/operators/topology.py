@@ -244,11 +244,14 @@ class _HandleLoopOperator(_LoopOperator):
     kind_message = "The active loop is a boundary (a hole's rim): fill it with Fill Holes instead"
 
 
-def run_edit(operator, context, compute, dropped: int = -1, verb: str = "edited", uses_loop: bool = False) -> set:
+def run_edit(operator, context, compute, dropped: int = -1, verb: str = "edited", uses_loop: bool = False,
+             carry: bool = True) -> set:
     """Runs ``compute(obj, arrays) -> EditResult`` on the active mesh, writes it, re-analyses.
 
     Nothing is changed when ``compute`` raises (the message goes to the status bar).
     ``uses_loop``: ``compute`` uses a stored loop, which a changed mesh invalidates.
+    ``carry``: keep the searched loops whose edges are still there (all but ``dropped``); an
+    edit that removes many handles says False (a cut loop's edges stay, as a patch's rim).
     """
     obj = _mesh_object(context)
     topology = obj.topstoc.topology
@@ -269,7 +272,7 @@ def run_edit(operator, context, compute, dropped: int = -1, verb: str = "edited"
         try:
             arrays = mesh_read.read_mesh(obj.data)
             result = compute(obj, arrays)
-            carried = analysis.carry_loops(obj, result, dropped)
+            carried = analysis.carry_loops(obj, result, dropped) if carry else []
             mesh_edit.apply_edit(obj, arrays, result)
         except ValueError as error:  # EditError or an engine refusal
             return refuse(f"'{obj.name}': {error}")

@@ -71,6 +71,7 @@ class TOPSTOC_PG_loop(bpy.types.PropertyGroup):
     kind: EnumProperty(name="Kind", items=LOOP_KINDS)
     component: IntProperty(name="Component")
     length: FloatProperty(name="Length", subtype="DISTANCE")
+    relative: FloatProperty(name="Size", description="Length as a fraction of the bounding box's diagonal")
     num_edges: IntProperty(name="Edges")
     fillable: BoolProperty(name="Fillable", default=True)
 
@@ -151,6 +152,10 @@ class TOPSTOC_PG_overlays(bpy.types.PropertyGroup):
     line_width: FloatProperty(name="Line Width", default=3.0, min=1.0, max=20.0, update=_redraw)
     active_width: FloatProperty(name="Active Loop Width", default=7.0, min=1.0, max=30.0, update=_redraw)
     point_size: FloatProperty(name="Point Size", default=5.0, min=1.0, max=30.0, update=_redraw)
+    marker_size: FloatProperty(name="Small Loop Ring", default=28.0, min=0.0, max=200.0, update=_redraw,
+                               description="A loop smaller than this on screen (pixels) gets a ring this wide "
+                                           "around it, drawn over everything, so it can be found at any zoom "
+                                           "(0: no rings)")
 
 
 CLASSES = (TOPSTOC_PG_component, TOPSTOC_PG_loop, TOPSTOC_PG_topology, TOPSTOC_PG_metrics, TOPSTOC_PG_overlays)

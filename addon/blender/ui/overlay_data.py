@@ -17,7 +17,7 @@ import numpy as np
 
 from ...core.support import colors
 from ..io import mesh_read
-from ..analysis import metrics
+from ..analysis import clean_plan, metrics
 from ..preview import watch
 
 LINES, POINTS, TRIS = "LINES", "POINTS", "TRIS"
@@ -182,7 +182,79 @@ def decimation_primitives(obj, show, context=None) -> list:
     return out
 
 
+def _segments(loops, n: int) -> np.ndarray:
+    """Vertex-id pairs of the loops' edges whose two ends are vertices of the mesh (a loop
+    through vertices the clean-up creates has gaps there)."""
+    pairs = [np.stack([ids, np.roll(ids, -1)], axis=1) for _kind, ids in loops]
+    if not pairs:
+        return np.zeros(0, dtype=np.int64)
+    pairs = np.concatenate(pairs)
+    return pairs[((pairs >= 0) & (pairs < n)).all(axis=1)].reshape(-1)
+
+
+def clean_preview_primitives(obj) -> list:
+    """The clean-up's preview: what it will remove (green, thick) and leave (violet)."""
+    shown = clean_plan.shown(obj)
+    if shown is None:
+        return []
+    co = positions(obj.data)
+    out = []
+    for removed, name, color, size in ((False, "clean_leave", colors.CLEAN_LEAVE, "line"),
+                                       (True, "clean_remove", colors.CLEAN_REMOVE, "active")):
+        ids = _segments(shown.loops(removed), len(co))
+        if len(ids):
+            out.append(Primitive(name, LINES, co[ids], color, size=size))
+            out.append(Primitive(name + "_points", POINTS, co[np.unique(ids)], color, size=size))
+    return out
+
+
+def marked_loops(obj, show) -> list:
+    """(points (k, 3) in object space, colour) of the loops that get a ring when they are small
+    on screen: every loop of the clean-up's preview when it is shown, else every handle and
+    tunnel loop shown and the active loop (a hole's too)."""
+    co = positions(obj.data) if obj.type == "MESH" else np.zeros((0, 3), np.float32)
+    out = []
+    shown = clean_plan.shown(obj)
+    if shown is not None:
+        for removed, color in ((False, colors.CLEAN_LEAVE), (True, colors.CLEAN_REMOVE)):
+            for _kind, ids in shown.loops(removed):
+                ids = ids[(ids >= 0) & (ids < len(co))]
+                if len(ids):
+                    out.append((co[ids], color))
+    if shown is None and obj.type == "MESH" and topology_current(obj):  # the preview rings replace these
+        topology = obj.topstoc.topology
+        wanted = {"HANDLE": show.show_handles, "TUNNEL": show.show_tunnels, "BOUNDARY": show.show_boundary}
+        color = {"HANDLE": colors.HANDLE, "TUNNEL": colors.TUNNEL, "BOUNDARY": colors.BOUNDARY}
+        for index, loop in enumerate(topology.loops):
+            if not wanted[loop.kind] or (loop.kind == "BOUNDARY" and index != topology.loop_index):
+                continue
+            ids = _id_array(loop, "vertices")
+            if len(ids) and _valid(ids, len(co)):
+                out.append((co[ids], color[loop.kind]))
+    return out
+
+
+def small_loop_rings(loops, matrix, width: float, height: float, min_pixels: float) -> list:
+    """(x, y, radius, colour) in region pixels of a ring around each loop smaller than
+    ``min_pixels`` on screen. ``loops``: (points, colour) pairs; ``matrix``: the view's
+    perspective matrix times the object's world matrix (4 x 4). Loops behind the eye get none."""
+    rings = []
+    if min_pixels <= 0:
+        return rings
+    matrix = np.asarray(matrix, dtype=np.float64)
+    for points, color in loops:
+        clip = np.c_[np.asarray(points, dtype=np.float64), np.ones(len(points))] @ matrix.T
+        if (clip[:, 3] <= 1e-12).any():
+            continue
+        pixels = (clip[:, :2] / clip[:, 3:4] + 1.0) * 0.5 * np.array([width, height])
+        low, high = pixels.min(axis=0), pixels.max(axis=0)
+        if (high - low).max() < min_pixels:
+            centre = (low + high) / 2
+            rings.append((float(centre[0]), float(centre[1]), min_pixels / 2, color))
+    return rings
+
+
 def object_primitives(obj, show, context=None, error_percent: float = None) -> list:
     """Everything the overlays draw for one object, in draw order (faces first)."""
     return (decimation_primitives(obj, show, context) + error_primitives(obj, show, error_percent)
-            + topology_primitives(obj, show))
+            + topology_primitives(obj, show) + clean_preview_primitives(obj))

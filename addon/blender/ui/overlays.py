@@ -8,7 +8,12 @@ non-manifold elements, samples and cluster regions, Hausdorff error colours and 
   lines and colours lying on the surface win over the surface itself.
 - Batches are cached per object and rebuilt only when the object's geometry, its results or
   the overlay settings change (see ``_signature``).
-- ``unregister`` removes both draw handlers and frees every batch.
+- Widths are in pixels at the interface's scale (``preferences.system.pixel_size``), so HiDPI
+  screens get lines as thick as others.
+- A loop smaller on screen than ``marker_size`` pixels (the active loop, the clean-up preview's
+  loops) also gets a ring of that size, drawn over everything: a loop of a few tenths of a
+  percent of the object is a dot or nothing at the zoom that shows the whole object.
+- ``unregister`` removes the draw handlers and frees every batch.
 """
 
 from __future__ import annotations
@@ -16,6 +21,7 @@ from __future__ import annotations
 import bpy
 
 from . import overlay_data
+from ..analysis import clean_plan
 from ..preview import watch
 
 DEPTH_BIAS = 2e-5  # in normalised device depth; pulls overlays in front of the surface they lie on
@@ -28,7 +34,13 @@ _batches: dict = {}  # object name -> (signature, [(Primitive, GPUBatch)])
 
 def _any_shown(show) -> bool:
     return any((show.show_handles, show.show_tunnels, show.show_generators, show.show_boundary,
-                show.show_nonmanifold, show.show_samples, show.show_clusters, show.show_error))
+                show.show_nonmanifold, show.show_samples, show.show_clusters, show.show_error,
+                clean_plan.any_shown()))
+
+
+def pixel_scale() -> float:
+    """Pixels per interface pixel (display scale and line width preference)."""
+    return float(getattr(bpy.context.preferences.system, "pixel_size", 1.0) or 1.0)
 
 
 def _shader(kind: str):
@@ -58,7 +70,7 @@ def _signature(obj, show, error_percent: float) -> tuple:
             (last.parameters, last.vertices_out) if last is not None else None,
             show.show_handles, show.show_tunnels, show.show_generators, show.show_boundary,
             show.show_nonmanifold, show.show_samples, show.show_clusters, show.show_error,
-            round(show.error_scale, 6), round(error_percent, 9))
+            round(show.error_scale, 6), round(error_percent, 9), clean_plan.revision[0])
 
 
 def _error_percent(context, show) -> float:
@@ -108,7 +120,8 @@ def _draw_view():
 
     region = context.region
     viewport = (float(region.width), float(region.height))
-    widths = {"line": show.line_width, "active": show.active_width, "point": show.point_size}
+    scale = pixel_scale()
+    widths = {"line": scale * show.line_width, "active": scale * show.active_width, "point": scale * show.point_size}
     gpu.state.depth_test_set("LESS_EQUAL")
     gpu.state.depth_mask_set(False)
     gpu.state.blend_set("ALPHA")
@@ -141,6 +154,52 @@ def _draw_view():
         gpu.state.blend_set("NONE")
         gpu.state.depth_mask_set(True)
         gpu.state.depth_test_set("NONE")
+
+
+def _draw_rings():
+    """Rings around the loops too small to see at this zoom (overlay_data.small_loop_rings),
+    in region pixels, over everything (no depth test in this pass)."""
+    context = bpy.context
+    scene = context.scene
+    if scene is None or not hasattr(scene, "topstoc") or not _any_shown(scene.topstoc.overlays):
+        return
+    show = scene.topstoc.overlays
+    region, view = context.region, context.region_data
+    if view is None:
+        return
+    size = pixel_scale() * show.marker_size
+    rings = []
+    for obj in context.visible_objects:
+        if obj.type == "MESH" and obj.data is not None:
+            loops = overlay_data.marked_loops(obj, show)
+            if loops:
+                matrix = view.perspective_matrix @ obj.matrix_world
+                rings += overlay_data.small_loop_rings(loops, matrix, region.width, region.height, size)
+    if not rings:
+        return
+    import math
+
+    from gpu_extras.batch import batch_for_shader
+
+    shader = _shader("LINES")
+    shader.bind()
+    shader.uniform_float("viewportSize", (float(region.width), float(region.height)))
+    shader.uniform_float("lineWidth", pixel_scale() * show.line_width)
+    import gpu
+
+    gpu.state.blend_set("ALPHA")
+    steps = 32
+    circle = [(math.cos(2 * math.pi * i / steps), math.sin(2 * math.pi * i / steps)) for i in range(steps + 1)]
+    by_color = {}
+    for x, y, radius, color in rings:  # one batch per colour
+        pairs = by_color.setdefault(tuple(color), [])
+        for i in range(steps):
+            pairs += [(x + radius * circle[i][0], y + radius * circle[i][1], 0.0),
+                      (x + radius * circle[i + 1][0], y + radius * circle[i + 1][1], 0.0)]
+    for color, pairs in by_color.items():
+        shader.uniform_float("color", color)
+        batch_for_shader(shader, "LINES", {"pos": pairs}).draw(shader)
+    gpu.state.blend_set("NONE")
 
 
 def legend_object(context):
@@ -219,6 +278,7 @@ def register():
     space = bpy.types.SpaceView3D
     _handlers["view"] = space.draw_handler_add(_draw_view, (), "WINDOW", "POST_VIEW")
     _handlers["legend"] = space.draw_handler_add(_draw_legend, (), "WINDOW", "POST_PIXEL")
+    _handlers["rings"] = space.draw_handler_add(_draw_rings, (), "WINDOW", "POST_PIXEL")
     tag_redraw()
 
 
@@ -228,6 +288,7 @@ def unregister():
         space.draw_handler_remove(_handlers.pop(name), "WINDOW")
     _batches.clear()
     _shaders.clear()
+    clean_plan.hide()
     if not bpy.app.background:
         tag_redraw()
 

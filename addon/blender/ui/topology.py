@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import bpy
 
-from ..analysis import topology as analysis
+from ..analysis import clean_plan, topology as analysis
 from .topology_help import HELP
 from ..operators.topology import running
 from .panels import _ClosedPanel, _MeshPanel, _Panel, _mesh, wrapped
@@ -79,8 +79,13 @@ class TOPSTOC_UL_components(bpy.types.UIList):
 class TOPSTOC_UL_loops(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
         warning = item.kind == "BOUNDARY" and not item.fillable
-        layout.label(text=f"{item.name}: {item.num_edges} edges",
-                     icon="ERROR" if warning else KIND_ICONS.get(item.kind, "DOT"))
+        layout.label(text=f"{item.name}: {loop_size(item)}", icon="ERROR" if warning else KIND_ICONS.get(item.kind, "DOT"))
+
+
+def loop_size(item) -> str:
+    """A loop's size as the list shows it: its length as a percentage of the diagonal (the unit
+    of the clean-up's sizes) and its edge count."""
+    return f"{100 * item.relative:.2g} %, {item.num_edges} edges"
 
 
 class TOPSTOC_PT_topology(_MeshPanel, bpy.types.Panel):
@@ -180,7 +185,7 @@ class TOPSTOC_PT_topology_loops(_AnalysedPanel, bpy.types.Panel):
             row.operator("topstoc.cut_loop", text="Cut")
             row.operator("topstoc.remove_loop", text="Remove")
         row = layout.row()
-        row.label(text=f"{active.num_edges} edges, length {active.length:.4g}")
+        row.label(text=f"{active.num_edges} edges, length {active.length:.4g}")  # the list row has its %
         help_button(row, {"HANDLE": "handle", "TUNNEL": "tunnel"}.get(active.kind, "boundary_loop"))
         wrapped(layout, context, HELP[{"HANDLE": "handle", "TUNNEL": "tunnel"}.get(active.kind, "boundary_loop")])
 
@@ -201,6 +206,12 @@ class TOPSTOC_PT_topology_edit(_Panel, bpy.types.Panel):
         col.operator("topstoc.delete_faces", icon="TRASH")
         # the full name, "... Small Handles and Holes", does not fit the sidebar (the tooltip says it)
         layout.operator("topstoc.clean", text="Clean Up Small Flaws", icon="MOD_SMOOTH")
+        shown = clean_plan.shown(obj) if obj is not None else None
+        if shown is not None:  # the clean-up waits for Enter or Esc
+            box = layout.box()
+            wrapped(box, context, f"Preview: {shown.summary()}", "HIDE_OFF")
+            box.label(text="Green: removed, violet: left")
+            box.label(text="Enter: apply, Esc: cancel")
 
 
 class TOPSTOC_PT_topology_overlays(_ClosedPanel, bpy.types.Panel):
@@ -217,6 +228,7 @@ class TOPSTOC_PT_topology_overlays(_ClosedPanel, bpy.types.Panel):
         col.prop(show, "line_width")
         col.prop(show, "active_width")
         col.prop(show, "point_size")
+        col.prop(show, "marker_size")
 
 
 CLASSES = (TOPSTOC_UL_components, TOPSTOC_UL_loops, TOPSTOC_PT_topology, TOPSTOC_PT_topology_components,

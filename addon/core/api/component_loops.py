@@ -19,11 +19,13 @@ from .loops import ComponentLoops, LoopsResult, handle_tunnel_loops
 REFUSED = "refused"
 
 
-def loops_by_component(vertices: np.ndarray, triangles: np.ndarray, **options) -> LoopsResult:
+def loops_by_component(vertices: np.ndarray, triangles: np.ndarray, mesh=None, **options) -> LoopsResult:
     """``handle_tunnel_loops(vertices, triangles, **options)``, per component when it refuses
-    the whole (module docstring); components ordered by smallest vertex id either way."""
+    the whole (module docstring); components ordered by smallest vertex id either way.
+    ``mesh``: the same surface as a prepared ``topstoc.Mesh``, used for the whole-mesh call."""
     try:
-        return handle_tunnel_loops(vertices, triangles, **options)
+        return handle_tunnel_loops(vertices, triangles, **options) if mesh is None else \
+            handle_tunnel_loops(mesh, **options)
     except ValueError:
         pass
     from .topology import topology
@@ -44,6 +46,17 @@ def loops_by_component(vertices: np.ndarray, triangles: np.ndarray, **options) -
             seconds[stage] = seconds.get(stage, 0.0) + value
     return LoopsResult(components=tuple(components), seconds=seconds, coarse_target=0, coarse_rounds=0,
                        coarse_samples_added=0)
+
+
+def refusals(result: LoopsResult) -> list:
+    """One line per refused component: "component N (from vertex V): <reason>"."""
+    return [f"component {number} (from vertex {c.first_vertex}): {c.detail}"
+            for number, c in enumerate(result.components) if c.status == REFUSED]
+
+
+def all_refused(result: LoopsResult) -> bool:
+    """True when no component could be searched because each was refused (nothing was found)."""
+    return bool(result.components) and all(c.status == REFUSED for c in result.components)
 
 
 def _reason(message: str, used: np.ndarray) -> str:

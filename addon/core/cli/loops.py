@@ -1,7 +1,9 @@
 """``loops IN``: handle and tunnel loops of a mesh file (docs/design.md §6).
 
 Prints, per component (ordered by smallest vertex id), the genus and the g handle and g tunnel
-loops as vertex ids in the file's vertex order, with their lengths. With --json the document
+loops as vertex ids in the file's vertex order, with their lengths. A component the search refuses
+(not manifold, self-intersecting) is one line, status "refused", and the others are searched;
+when every component is refused that is the error. With --json the document
 is ``{components: [{genus, status, handles: [[ids...]...], tunnels: [[...]...], ...}], seconds}``.
 """
 
@@ -36,7 +38,7 @@ def add_parser(subparsers) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..api.io import read_mesh  # imported here so that --help works without the readers
-    from ..api.loops import handle_tunnel_loops
+    from ..api.component_loops import all_refused, loops_by_component, refusals
     from ..api.mesh import Mesh
 
     data = read_mesh(args.input)
@@ -45,8 +47,12 @@ def run(args: argparse.Namespace) -> int:
     progress.stage("finding handle and tunnel loops")
     started = time.perf_counter()
     mesh = Mesh(data.vertices, data.triangles)
-    result = handle_tunnel_loops(mesh, coarse_vertices=0 if args.full else args.coarse_vertices,
-                                 shorten=not args.no_shorten, metric=args.metric, seed=args.seed)
+    # a refused component (not manifold, self-intersecting) is reported and the others searched
+    result = loops_by_component(data.vertices, data.triangles, mesh=mesh,
+                                coarse_vertices=0 if args.full else args.coarse_vertices,
+                                shorten=not args.no_shorten, metric=args.metric, seed=args.seed)
+    if all_refused(result):
+        raise TopStocError("; ".join(refusals(result)))
     seconds = time.perf_counter() - started
     document = result.as_json()
     document["seconds"] = {"total": seconds, **document["seconds"]}

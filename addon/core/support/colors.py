@@ -21,6 +21,8 @@ GENERATOR = (1.0, 0.41, 0.71, 1.0)         #: pink
 BOUNDARY = (1.0, 0.0, 0.0, 1.0)            #: red
 NONMANIFOLD = (1.0, 0.5, 0.0, 1.0)         #: orange: edges with 3+ triangles, pinched vertices
 SAMPLE = (0.0, 0.25, 1.0, 1.0)             #: deep blue
+CLEAN_REMOVE = (0.1, 1.0, 0.25, 1.0)       #: green: a loop or hole the clean-up will remove (preview)
+CLEAN_LEAVE = (0.75, 0.35, 1.0, 1.0)       #: violet: one it will leave (above the size, or not removable)
 CLUSTER_BORDER = (0.12, 0.16, 0.45, 1.0)   #: dark blue: faces on a border of two clusters
 CLUSTER_CORNER = (0.9, 0.1, 0.1, 1.0)      #: red: faces whose corners lie in three clusters
 
