@@ -302,8 +302,13 @@ class LoopSelection {
   void seed_roots() {
     is_root.assign(n, 0);
     auto kind = [](const PersistentCycle* c) { return int32_t(c->handle ? kHandle : kTunnel); };
-    for (const auto* c : ordered) add_root(s.edge_vertices[2 * size_t(c->generator_edge)], kind(c));
-    for (const auto* c : ordered) {
+    // Longest cycles first: their pieces set the first cutoffs, and a root on them finds the
+    // short loop that replaces them, so the cutoff falls before many trees have grown far.
+    std::vector<const PersistentCycle*> by_length = ordered;
+    std::stable_sort(by_length.begin(), by_length.end(),
+                     [](const PersistentCycle* a, const PersistentCycle* b) { return a->edges.size() > b->edges.size(); });
+    for (const auto* c : by_length) add_root(s.edge_vertices[2 * size_t(c->generator_edge)], kind(c));
+    for (const auto* c : by_length) {
       const size_t k = c->edges.size();
       for (size_t i = 1; i <= 3 && k; ++i) add_root(s.edge_vertices[2 * size_t(c->edges[(i * k) / 4 % k])], kind(c));
     }
