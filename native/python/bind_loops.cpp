@@ -153,11 +153,13 @@ void bind_loops(py::module_& m) {
         d["points"] = to_array(std::move(tets.points), 3);
         d["tets"] = to_array(std::move(tets.tets), 4);
         d["inside"] = to_array(std::move(tets.inside));
+        d["perturbed"] = tets.perturbed;
         return d;
       },
       py::arg("vertices"), py::arg("triangles"),
       "TetGen tetrahedralization of the inside and outside of a closed surface inside a box: points (the "
-      "surface's first, then box corners and Steiner points), tets (k, 4) and inside (k,) flags.");
+      "surface's first, then box corners and Steiner points), tets (k, 4), inside (k,) flags and perturbed (TetGen "
+      "ran on slightly moved surface vertices; false when it refused them and the exact positions were used).");
 }
 
 }  // namespace topstoc::python

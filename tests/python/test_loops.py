@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import homology_check as hc
+import loop_families
 import meshgen
 import reference
 import topstoc
@@ -301,6 +302,37 @@ def test_self_intersecting_surface_is_refused_with_the_triangles():
         topstoc.handle_tunnel_loops(vertices, triangles)
     with pytest.raises(ValueError, match="intersects itself"):
         topstoc.tetrahedralize_surface(vertices, triangles)
+
+
+def unit_cube(z0=0.0, shift=0.0):
+    v = np.array([[x + shift, y + shift, z + z0] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
+    f = [[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1], [2, 3, 7], [2, 7, 6], [0, 2, 6],
+         [0, 6, 4], [1, 5, 7], [1, 7, 3]]
+    return v, np.array(f, dtype=np.int32)
+
+
+def test_tetgen_sees_perturbed_positions_and_falls_back_to_exact():
+    """TetGen runs on vertices moved by at most 1e-7 of their shortest edge (its exact arithmetic
+    on the tube's co-circular rings is slow); the points returned are the surface's own, and
+    the sides are right. Where that move would make faces cross (two cubes 1e-9 apart), TetGen
+    refuses it and the exact positions are used."""
+    vertices, triangles = loop_families.torus_knot(2, 3, samples=120, around=8)
+    tets = topstoc.tetrahedralize_surface(vertices, triangles)
+    assert tets["perturbed"]
+    assert np.array_equal(tets["points"][:len(vertices)], vertices)
+    inside = tets["inside"].astype(bool)
+    assert hc.betti([tets["tets"][inside]])[:3] == [1, 1, 0]
+    assert hc.betti([tets["tets"][~inside]])[:3] == [1, 1, 1]
+    check_sides(vertices, triangles, tets)
+    for gap, perturbed in ((1e-5, True), (1e-9, False)):
+        (v1, f1), (v2, f2) = unit_cube(), unit_cube(1 + gap, shift=0.3)
+        vertices, triangles = np.vstack([v1, v2]), np.vstack([f1, f2 + 8])
+        tets = topstoc.tetrahedralize_surface(vertices, triangles)
+        assert tets["perturbed"] == perturbed, gap
+        assert np.array_equal(tets["points"][:16], vertices)
+        inside = tets["inside"].astype(bool)
+        assert hc.betti([tets["tets"][inside]])[:3] == [2, 0, 0]
+        assert hc.betti([tets["tets"][~inside]])[:3] == [1, 0, 2]
 
 
 def test_self_intersections_agree_with_brute_force():

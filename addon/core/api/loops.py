@@ -231,6 +231,9 @@ def tetrahedralize_surface(vertices, triangles) -> dict:
 
     Returns ``points`` ((p, 3): the surface's vertices first, then the box corners and Steiner
     points), ``tets`` ((k, 4) point ids) and ``inside`` ((k,) 1 inside the surface, 0 outside).
+    ``perturbed`` is True when TetGen ran on the surface's vertices moved by at most 1e-7 of their
+    shortest edge (fast on coplanar and cospherical vertices; the points returned are the exact
+    ones), False when TetGen refused that and the exact positions were used.
     Raises ValueError when TetGen refuses the surface (for instance when it intersects itself).
     """
     return engine.tetrahedralize_surface(np.asarray(vertices), np.asarray(triangles))

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <memory>
 #include <functional>
 #include <stdexcept>
 #include <tuple>
@@ -9,6 +11,7 @@
 #include "core/portable.hpp"
 #include "topology/ball_cycles.hpp"
 #include "topology/shortest_paths.hpp"
+#include "topstoc/core/parallel.hpp"
 
 namespace topstoc {
 
@@ -299,8 +302,13 @@ class LoopSelection {
   void seed_roots() {
     is_root.assign(n, 0);
     auto kind = [](const PersistentCycle* c) { return int32_t(c->handle ? kHandle : kTunnel); };
-    for (const auto* c : ordered) add_root(s.edge_vertices[2 * size_t(c->generator_edge)], kind(c));
-    for (const auto* c : ordered) {
+    // Longest cycles first: their pieces set the first cutoffs, and a root on them finds the
+    // short loop that replaces them, so the cutoff falls before many trees have grown far.
+    std::vector<const PersistentCycle*> by_length = ordered;
+    std::stable_sort(by_length.begin(), by_length.end(),
+                     [](const PersistentCycle* a, const PersistentCycle* b) { return a->edges.size() > b->edges.size(); });
+    for (const auto* c : by_length) add_root(s.edge_vertices[2 * size_t(c->generator_edge)], kind(c));
+    for (const auto* c : by_length) {
       const size_t k = c->edges.size();
       for (size_t i = 1; i <= 3 && k; ++i) add_root(s.edge_vertices[2 * size_t(c->edges[(i * k) / 4 % k])], kind(c));
     }
@@ -347,35 +355,76 @@ class LoopSelection {
   Span shorter_picks[2] = {Span(0), Span(0)};
   std::vector<double> pick_lengths[2];
 
-  // Per root: a shortest-path tree to the cutoff, the classes of its paths, and the
-  // fundamental cycles of its non-tree edges that extend a kind's basis.
-  void grow_from_roots() {
-    ShortestPaths sp(s, weight);
-    std::vector<uint64_t> prefix(size_t(words) * n);
-    std::vector<double> nearest_root(n, ShortestPaths::kInfinity);
-    std::vector<uint32_t> mark(n, 0);
+  // One member's scratch for growing trees from roots.
+  struct RootWork {
+    explicit RootWork(const LoopSelection& ls)
+        : sp(ls.s, ls.weight), prefix(size_t(ls.words) * ls.n), nearest_root(ls.n, ShortestPaths::kInfinity),
+          mark(ls.n, 0), ball(ls.s) {}
+    ShortestPaths sp;
+    std::vector<uint64_t> prefix;
+    std::vector<double> nearest_root;  // over the roots this member grew
+    std::vector<uint32_t> mark;
+    uint32_t mark_stamp = 0;
     std::vector<LocalCycle> local;
-    BallCycles ball(s);
-    for (size_t r = 0; r < roots.size() && int32_t(r) < max_roots; ++r) {
-      if (progress) progress->update(double(r) / max_roots);
-      // A cycle through the root at most `cutoff` long stays within half of it from the root; a
-      // root on a persistence cycle looks as far as its kind's loops need (about half the work
-      // when one kind's loops are much the longer, as the tunnels through a thick part).
-      const double reach = root_kind[r] == kNeither ? cutoff : kind_cutoff[root_kind[r]];
-      sp.run({roots[r]}, [](int32_t) { return true; }, [](int32_t) { return true; }, -1, reach / 2);
-      path_classes(sp, prefix, nearest_root);
-      local_cycles(sp, prefix, local);
-      take_local_cycles(sp, prefix, local, ball, mark);
-      // Often enough to follow the cutoff down, rarely enough that the picks cost little.
-      if ((r & (r + 1)) == 0 || r % 64 == 63) lower_cutoff();
+    BallCycles ball;
+  };
+
+  // Whether lower_cutoff runs after root r: often enough to follow the cutoff down, rarely
+  // enough that the picks cost little.
+  static bool lowers_cutoff_after(size_t r) { return (r & (r + 1)) == 0 || r % 64 == 63; }
+
+  // Per root: a shortest-path tree to the cutoff, the classes of its paths, and the
+  // fundamental cycles of its non-tree edges that extend a kind's basis. Roots between two
+  // lower_cutoff calls see the same cutoffs and picks, so they grow on the team; their
+  // candidates join in root order (as one after the other would give).
+  void grow_from_roots() {
+    std::vector<std::unique_ptr<RootWork>> work(size_t(std::max(1, max_threads())));
+    for (size_t r = 0; r < roots.size() && int32_t(r) < max_roots;) {
+      size_t end = r + 1;
+      while (!lowers_cutoff_after(end - 1) && end < roots.size() && int32_t(end) < max_roots) ++end;
+      std::vector<std::vector<Candidate>> found(end - r);
+      std::atomic<int64_t> next{int64_t(r)};
+      parallel_region(end - r >= 2 ? int(work.size()) : 1, [&](Team& team) {
+        auto& mine = work[size_t(team.index())];
+        if (!mine) mine = std::make_unique<RootWork>(*this);
+        team.for_dynamic(next, int64_t(end), 1, [&](int64_t i) {
+          if (progress && team.index() == 0) progress->update(double(i) / max_roots);
+          grow_from_root(size_t(i), *mine, found[size_t(i) - r]);
+        });
+      });
+      for (auto& list : found)
+        for (auto& c : list)
+          if (!spanned_by_shorter(c.kind, c.cls, c.length)) {
+            c.order = order++;
+            candidates.push_back(std::move(c));
+          }
+      if (lowers_cutoff_after(end - 1)) lower_cutoff();
+      r = end;
       // Next root: the persistence-cycle roots first, then the vertex farthest from all roots.
-      if (r + 1 == roots.size() && int32_t(roots.size()) < max_roots) {
+      if (r == roots.size() && int32_t(roots.size()) < max_roots) {
         int32_t far = -1;
-        for (int32_t v = 0; v < n; ++v)
-          if (!is_root[v] && (far < 0 || nearest_root[v] > nearest_root[far])) far = v;
+        double far_distance = 0.0;
+        for (int32_t v = 0; v < n; ++v) {
+          double nearest = ShortestPaths::kInfinity;
+          for (const auto& w : work)
+            if (w) nearest = std::min(nearest, w->nearest_root[v]);
+          if (!is_root[v] && (far < 0 || nearest > far_distance)) far = v, far_distance = nearest;
+        }
         if (far >= 0) add_root(far, kNeither);
       }
     }
+  }
+
+  // Root r's tree and the cycles through it that extend their kind's basis at this root.
+  void grow_from_root(size_t r, RootWork& w, std::vector<Candidate>& found) const {
+    // A cycle through the root at most `cutoff` long stays within half of it from the root; a
+    // root on a persistence cycle looks as far as its kind's loops need (about half the work
+    // when one kind's loops are much the longer, as the tunnels through a thick part).
+    const double reach = root_kind[r] == kNeither ? cutoff : kind_cutoff[root_kind[r]];
+    w.sp.run({roots[r]}, [](int32_t) { return true; }, [](int32_t) { return true; }, -1, reach / 2);
+    path_classes(w.sp, w.prefix, w.nearest_root);
+    local_cycles(w.sp, w.prefix, w.local);
+    take_local_cycles(w, found);
   }
 
   // Class of the tree path from the root to each settled vertex.
@@ -416,42 +465,43 @@ class LoopSelection {
       }
   }
 
-  // Adds as candidates the local cycles that extend their kind's basis of the shorter ones at
-  // this root (shortest through the root first, ties by edge), found by union-find on the ball.
-  void take_local_cycles(const ShortestPaths& sp, const std::vector<uint64_t>& prefix, std::vector<LocalCycle>& local,
-                         BallCycles& ball, std::vector<uint32_t>& mark) {
+  // The local cycles that extend their kind's basis of the shorter ones at this root (shortest
+  // through the root first, ties by edge), found by union-find on the ball, into `found` (the
+  // caller drops those spanned by shorter picks and numbers the rest).
+  void take_local_cycles(RootWork& w, std::vector<Candidate>& found) const {
+    auto& local = w.local;
     std::sort(local.begin(), local.end(),
               [](const LocalCycle& x, const LocalCycle& y) { return std::tie(x.bound, x.edge) < std::tie(y.bound, y.edge); });
     std::vector<int32_t> edges;
     std::vector<int8_t> group;
     for (const auto& c : local) edges.push_back(c.edge), group.push_back(int8_t(c.kind));
-    ball.start(sp, edges, group);
+    w.ball.start(w.sp, edges, group);
     std::vector<uint8_t> keep;
-    Z2Vector cls(dim);
     for (int32_t kind : {int32_t(kHandle), int32_t(kTunnel)}) {
       edges.clear();
       for (const auto& c : local)
         if (c.kind == kind) edges.push_back(c.edge);
-      ball.independent(int8_t(kind), edges, keep);
+      w.ball.independent(int8_t(kind), edges, keep);
       for (size_t i = 0; i < edges.size(); ++i) {
         if (!keep[i]) continue;
         const int32_t a = s.edge_vertices[2 * size_t(edges[i])], b = s.edge_vertices[2 * size_t(edges[i]) + 1];
-        cycle_class(prefix, a, b, edges[i], cls);
-        auto loop = tree_cycle(sp, a, b, mark);
+        Z2Vector cls(dim);
+        cycle_class(w.prefix, a, b, edges[i], cls);
+        auto loop = tree_cycle(w, a, b);
         const double length = loop_length(s, loop, weight);
-        if (spanned_by_shorter(kind, cls, length)) continue;
-        candidates.push_back({length, kind, order++, std::move(loop), cls});
+        found.push_back({length, kind, 0, std::move(loop), std::move(cls)});
       }
     }
   }
 
   // The simple cycle through non-tree edge (a, b): tree paths from a and b up to their lowest
   // common ancestor, as lca ... a, then b ... (child of lca).
-  std::vector<int32_t> tree_cycle(const ShortestPaths& sp, int32_t a, int32_t b, std::vector<uint32_t>& mark) {
-    ++mark_stamp;
-    for (int32_t v = a; v >= 0; v = sp.parent(v)) mark[v] = mark_stamp;
+  static std::vector<int32_t> tree_cycle(RootWork& w, int32_t a, int32_t b) {
+    const ShortestPaths& sp = w.sp;
+    ++w.mark_stamp;
+    for (int32_t v = a; v >= 0; v = sp.parent(v)) w.mark[v] = w.mark_stamp;
     int32_t lca = b;
-    while (mark[lca] != mark_stamp) lca = sp.parent(lca);
+    while (w.mark[lca] != w.mark_stamp) lca = sp.parent(lca);
     std::vector<int32_t> loop;
     for (int32_t v = a; v != lca; v = sp.parent(v)) loop.push_back(v);
     loop.push_back(lca);
@@ -461,7 +511,6 @@ class LoopSelection {
     loop.insert(loop.end(), down.begin(), down.end());
     return loop;
   }
-  uint32_t mark_stamp = 0;
 
   // Match loops with generator edges through their coefficients in the persistence basis.
   std::vector<SelectedLoop> match_to_generators(const std::array<std::vector<const Candidate*>, 2>& picked) const {

@@ -1,6 +1,9 @@
 #include "topology/loop_shortening.hpp"
 
+#include "topstoc/core/parallel.hpp"
+
 #include <algorithm>
+#include <atomic>
 #include <queue>
 #include <tuple>
 
@@ -281,6 +284,26 @@ std::vector<int32_t> LoopTightener::tighten(std::vector<int32_t> loop, const Tig
   }
   for (int32_t v : loop) on_loop_[v] = -1;
   return loop;
+}
+
+void tighten_loops(const ClosedSurface& surface, const std::vector<double>& edge_weight, const SurfaceHomology* homology,
+                   std::vector<std::vector<int32_t>>& loops, const TightenParams& params, Progress* progress) {
+  const int64_t n = int64_t(loops.size());
+  std::atomic<int64_t> next{0};
+  std::atomic<bool> stop{false};
+  // Loops of very uneven cost: taken one at a time by whichever member is free.
+  parallel_region(n >= 2 ? max_threads() : 1, [&](Team& team) {
+    LoopTightener tightener(surface, edge_weight, homology);
+    Progress* mine = team.index() == 0 ? progress : nullptr;
+    try {
+      team.for_dynamic(next, n, 1, [&](int64_t i) {
+        if (!stop.load(std::memory_order_relaxed)) loops[size_t(i)] = tightener.tighten(std::move(loops[size_t(i)]), params, mine);
+      });
+    } catch (...) {
+      stop = true;
+      throw;
+    }
+  });
 }
 
 }  // namespace topstoc

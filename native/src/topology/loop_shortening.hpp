@@ -67,4 +67,11 @@ class LoopTightener {
   uint32_t tree_stamp_ = 0;
 };
 
+/// Tightens every loop in place (tighten with `params`) on the calling thread's team, one
+/// LoopTightener per member: a loop's result depends on that loop alone, not on the team size or
+/// on which member took it. Only member 0 reports to `progress`; when it cancels, the others stop
+/// taking loops.
+void tighten_loops(const ClosedSurface& surface, const std::vector<double>& edge_weight, const SurfaceHomology* homology,
+                   std::vector<std::vector<int32_t>>& loops, const TightenParams& params, Progress* progress);
+
 }  // namespace topstoc

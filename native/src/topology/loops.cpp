@@ -13,6 +13,7 @@
 #include "topology/loop_shortening.hpp"
 #include "topology/persistence.hpp"
 #include "topology/closed_surface.hpp"
+#include "topstoc/core/parallel.hpp"
 #include "topstoc/topology/tetrahedralize.hpp"
 
 namespace topstoc {
@@ -324,8 +325,10 @@ class LoopsComputation {
       progress.stage("shorten (coarse)", job.at(0.55), job.at(0.6));
       const auto coarse_weight = edge_weights(view.surface, params.count_edges);
       const SurfaceHomology coarse_homology(view.surface);
-      LoopTightener coarse_tightener(view.surface, coarse_weight, &coarse_homology);
-      for (auto& loop : analysis.loops) loop.vertices = coarse_tightener.tighten(loop.vertices, TightenParams{}, &progress);
+      std::vector<std::vector<int32_t>> loops;
+      for (auto& loop : analysis.loops) loops.push_back(std::move(loop.vertices));
+      tighten_loops(view.surface, coarse_weight, &coarse_homology, loops, TightenParams{}, &progress);
+      for (size_t i = 0; i < loops.size(); ++i) analysis.loops[i].vertices = std::move(loops[i]);
     }
     result.seconds_shorten += seconds_since(start);
     start = Clock::now();
@@ -400,44 +403,53 @@ class LoopsComputation {
     const ClosedSurface& fine = job.fine;
     const auto& loops = job.found.loops;
     ComponentLoops& out = job.out;
-    const auto start = Clock::now();
+    auto start = Clock::now();
     progress.stage("shorten", job.at(0.7), job.at(1.0));
-    double checking = 0.0;  // spent verifying inside the shortening loop
-    TightenParams local_moves;  // loops carried back from a tightened coarse loop need small moves only
-    local_moves.max_window = 64;
-    LoopTightener tightener(fine, job.fine_weight, &homology);
+    std::vector<std::vector<int32_t>> shortened = loops;
+    if (params.shorten) {
+      TightenParams moves;  // loops carried back from a tightened coarse loop need small moves only
+      if (out.route == "coarse") moves.max_window = 64;
+      tighten_loops(fine, job.fine_weight, &homology, shortened, moves, &progress);
+      result.seconds_shorten += seconds_since(start);
+      start = Clock::now();
+      check_shortened(job, homology, classes, shortened);
+      result.seconds_verify += seconds_since(start);
+    }
     const std::vector<double> euclidean = params.count_edges ? edge_weights(fine, false) : job.fine_weight;
-    std::vector<uint8_t> seen(fine.num_vertices(), 0);
     auto to_caller = [&](int32_t v) { return mesh.vertex_source()[fine.mesh_vertex[v]]; };
     for (size_t i = 0; i < loops.size(); ++i) {
       HandleTunnelLoop loop;
       loop.handle = job.found.is_handle[i];
       loop.initial_length = loop_length(fine, loops[i], euclidean);
       for (int32_t v : loops[i]) loop.initial_vertices.push_back(to_caller(v));
-      std::vector<int32_t> shortened = loops[i];
-      if (params.shorten) {
-        progress.update(double(i) / double(loops.size()));
-        shortened = tightener.tighten(loops[i], out.route == "coarse" ? local_moves : TightenParams{}, &progress);
-        const auto verify_start = Clock::now();
-        check_simple(fine, shortened, seen);
-        if (!(homology.class_of_loop(fine, shortened) == classes[i]) ||
-            homology.integer_class_of_loop(fine, shortened) != homology.integer_class_of_loop(fine, loops[i]))
-          throw std::logic_error(component_name(job.k, job.check) + ": shortening changed a loop's class");
-        if (loop_length(fine, shortened, job.fine_weight) > loop_length(fine, loops[i], job.fine_weight) * (1 + 1e-12))
-          throw std::logic_error(component_name(job.k, job.check) + ": shortening made a loop longer");
-        checking += seconds_since(verify_start);
-      }
-      loop.length = loop_length(fine, shortened, euclidean);
-      for (int32_t v : shortened) loop.vertices.push_back(to_caller(v));
+      loop.length = loop_length(fine, shortened[i], euclidean);
+      for (int32_t v : shortened[i]) loop.vertices.push_back(to_caller(v));
       loop.generator[0] = to_caller(job.found.generators[i].first);
       loop.generator[1] = to_caller(job.found.generators[i].second);
       (loop.handle ? out.handles : out.tunnels).push_back(std::move(loop));
     }
-    result.seconds_shorten += seconds_since(start) - checking;
-    result.seconds_verify += checking;
     if (int32_t(out.handles.size()) != out.genus || int32_t(out.tunnels.size()) != out.genus)
       throw std::logic_error(component_name(job.k, job.check) + ": expected " + std::to_string(out.genus) +
                              " loops of each kind");
+  }
+
+  // Each shortened loop is simple, keeps its class and is no longer than before (on the team:
+  // the checks are independent).
+  void check_shortened(const ComponentJob& job, const SurfaceHomology& homology, const std::vector<Z2Vector>& classes,
+                       const std::vector<std::vector<int32_t>>& shortened) {
+    const ClosedSurface& fine = job.fine;
+    const auto& loops = job.found.loops;
+    parallel_region(loops.size() >= 2 ? max_threads() : 1, [&](Team& team) {
+      std::vector<uint8_t> seen(fine.num_vertices(), 0);
+      team.for_static(0, int64_t(loops.size()), [&](int64_t i) {
+        check_simple(fine, shortened[i], seen);
+        if (!(homology.class_of_loop(fine, shortened[i]) == classes[i]) ||
+            homology.integer_class_of_loop(fine, shortened[i]) != homology.integer_class_of_loop(fine, loops[i]))
+          throw std::logic_error(component_name(job.k, job.check) + ": shortening changed a loop's class");
+        if (loop_length(fine, shortened[i], job.fine_weight) > loop_length(fine, loops[i], job.fine_weight) * (1 + 1e-12))
+          throw std::logic_error(component_name(job.k, job.check) + ": shortening made a loop longer");
+      });
+    });
   }
 };
 

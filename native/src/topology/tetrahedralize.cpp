@@ -100,6 +100,8 @@ void run_tetgen(tetgenio& in, std::vector<double>& points, std::vector<int32_t>&
     throw std::runtime_error("cannot start a process for TetGen");
   }
   if (child == 0) {
+    // The host's crash handlers (Python's faulthandler) would print for TetGen's crash on refusal.
+    for (int sig : {SIGSEGV, SIGABRT, SIGBUS, SIGFPE, SIGILL}) signal(sig, SIG_DFL);
     close(data[0]);
     close(text[0]);
     dup2(text[1], 1);
@@ -209,9 +211,9 @@ void refuse_self_intersections(const double* positions, int32_t num_vertices, co
 
 // TetGen's input: the surface's vertices, then the 8 corners of a box around it; the
 // surface's triangles, then the box's 6 quads. Fills mesh.points and mesh.tets.
-void tetrahedralize_in_box(const double* positions, int32_t num_vertices, const int32_t* triangles,
-                           int32_t num_triangles, Progress* progress, TetMesh& mesh) {
-  std::vector<double> points(positions, positions + 3 * size_t(num_vertices));
+void tetrahedralize_in_box(const std::vector<double>& tetgen_positions, const double* positions, int32_t num_vertices,
+                           const int32_t* triangles, int32_t num_triangles, Progress* progress, TetMesh& mesh) {
+  std::vector<double> points(tetgen_positions);
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (int32_t v = 0; v < num_vertices; ++v)
     for (int k = 0; k < 3; ++k) {
@@ -249,7 +251,8 @@ void tetrahedralize_in_box(const double* positions, int32_t num_vertices, const 
   run_tetgen(in.io, mesh.points, mesh.tets, progress);
   if (mesh.points.size() < 3 * size_t(num_vertices)) throw TetgenRefused(0, "TetGen lost surface vertices");
   for (size_t i = 0; i < 3 * size_t(num_vertices); ++i)
-    if (mesh.points[i] != positions[i]) throw TetgenRefused(0, "TetGen moved or renumbered a surface vertex");
+    if (mesh.points[i] != tetgen_positions[i]) throw TetgenRefused(0, "TetGen moved or renumbered a surface vertex");
+  std::copy(positions, positions + 3 * size_t(num_vertices), mesh.points.begin());
 }
 
 // Distinct faces of the tetrahedra (numbered in sorted corner order) and each tetrahedron's
@@ -334,16 +337,11 @@ void mark_outside(TetMesh& mesh, const std::vector<int32_t>& face_tets, const st
   }
 }
 
-}  // namespace
-
-TetMesh tetrahedralize_surface(const double* positions, int32_t num_vertices, const int32_t* triangles,
-                               int32_t num_triangles, Progress* progress) {
-  const auto check_start = std::chrono::steady_clock::now();
-  refuse_self_intersections(positions, num_vertices, triangles, num_triangles);
-  TetMesh mesh;
-  mesh.num_surface_points = num_vertices;
-  mesh.seconds_check = std::chrono::duration<double>(std::chrono::steady_clock::now() - check_start).count();
-  tetrahedralize_in_box(positions, num_vertices, triangles, num_triangles, progress, mesh);
+// TetGen on the given positions for the surface's vertices, then the faces, the sides and the
+// check that every surface triangle separates inside from outside.
+void tetrahedralize_at(const std::vector<double>& tetgen_positions, const double* positions, int32_t num_vertices,
+                       const int32_t* triangles, int32_t num_triangles, Progress* progress, TetMesh& mesh) {
+  tetrahedralize_in_box(tetgen_positions, positions, num_vertices, triangles, num_triangles, progress, mesh);
   const auto face_tets = number_faces(mesh);
   const auto on_surface = find_surface_faces(mesh, triangles, num_triangles);
   mark_outside(mesh, face_tets, on_surface);
@@ -355,7 +353,56 @@ TetMesh tetrahedralize_surface(const double* positions, int32_t num_vertices, co
       throw TetgenRefused(0, "surface triangle " + std::to_string(t) +
                                  " does not separate inside from outside (the surface is not the boundary of a solid)");
   }
-  return mesh;
+}
+
+}  // namespace
+
+std::vector<double> tetgen_perturbation(const double* positions, int32_t num_vertices, const int32_t* triangles,
+                                        int32_t num_triangles) {
+  std::vector<double> shortest(num_vertices, INFINITY);
+  for (int32_t t = 0; t < num_triangles; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int32_t a = triangles[3 * size_t(t) + k], b = triangles[3 * size_t(t) + (k + 1) % 3];
+      double d2 = 0.0;
+      for (int c = 0; c < 3; ++c) d2 += (positions[3 * size_t(a) + c] - positions[3 * size_t(b) + c]) *
+                                        (positions[3 * size_t(a) + c] - positions[3 * size_t(b) + c]);
+      shortest[a] = std::min(shortest[a], std::sqrt(d2));
+      shortest[b] = std::min(shortest[b], std::sqrt(d2));
+    }
+  std::vector<double> moved(positions, positions + 3 * size_t(num_vertices));
+  for (size_t i = 0; i < moved.size(); ++i) {
+    const double scale = std::isfinite(shortest[i / 3]) ? kTetgenPerturbation * shortest[i / 3] : 0.0;
+    uint64_t z = (uint64_t(i) + 1) * 0x9E3779B97F4A7C15ull;  // splitmix64: a fixed pseudo-random sign and size
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    moved[i] += scale * (double(z >> 11) * 0x1.0p-52 - 1.0);  // uniform in [-scale, scale)
+  }
+  return moved;
+}
+
+TetMesh tetrahedralize_surface(const double* positions, int32_t num_vertices, const int32_t* triangles,
+                               int32_t num_triangles, Progress* progress) {
+  const auto check_start = std::chrono::steady_clock::now();
+  refuse_self_intersections(positions, num_vertices, triangles, num_triangles);
+  const double seconds_check = std::chrono::duration<double>(std::chrono::steady_clock::now() - check_start).count();
+  // Perturbed positions first (TetGen's exact arithmetic on coplanar and cospherical vertices is
+  // slow); if TetGen refuses them, the exact positions decide.
+  for (const bool perturbed : {true, false}) {
+    TetMesh mesh;
+    mesh.num_surface_points = num_vertices;
+    mesh.seconds_check = seconds_check;
+    try {
+      const std::vector<double> at = perturbed ? tetgen_perturbation(positions, num_vertices, triangles, num_triangles)
+                                                : std::vector<double>(positions, positions + 3 * size_t(num_vertices));
+      tetrahedralize_at(at, positions, num_vertices, triangles, num_triangles, progress, mesh);
+      mesh.perturbed = perturbed;
+      return mesh;
+    } catch (const TetgenRefused&) {
+      if (!perturbed) throw;
+    }
+  }
+  throw std::logic_error("unreachable");
 }
 
 }  // namespace topstoc

@@ -7,6 +7,12 @@
 // then told apart by a flood fill from the box that never crosses a surface triangle:
 // reached ones lie outside, the rest inside. This needs no seed point and no winding numbers.
 //
+// TetGen sees each surface vertex moved by a fixed pseudo-random amount of at most
+// kTetgenPerturbation times its shortest edge: on flat plates and exact circles its exact
+// arithmetic otherwise dominates. Only the tetrahedra's connectivity is used, with the surface's
+// own positions; a surface with parts that close would be changed, but TetGen refuses such a
+// perturbed input and the exact positions are tried.
+//
 // TetGen 1.5 crashes its process when it rejects an input (it frees its memory twice), so on
 // POSIX systems it runs in a forked child process that hands the result back through a pipe;
 // a rejection becomes a TetgenRefused exception, and cancelling kills the child. A surface that
@@ -44,11 +50,20 @@ struct TetMesh {
   std::vector<int32_t> tet_faces;  ///< 4 per tetrahedron: its faces
   std::vector<int32_t> surface_face;  ///< per surface triangle (input order): its face id
   int32_t num_surface_points = 0;
+  bool perturbed = false;       ///< TetGen ran on the perturbed positions (false: it refused them)
   double seconds_check = 0.0;   ///< spent checking for self-intersections before TetGen
   int32_t num_points() const { return int32_t(points.size() / 3); }
   int32_t num_tets() const { return int32_t(tets.size() / 4); }
   int32_t num_faces() const { return int32_t(faces.size() / 3); }
 };
+
+/// Largest move of a vertex for TetGen, as a fraction of its shortest edge.
+constexpr double kTetgenPerturbation = 1e-7;
+
+/// The positions TetGen is given: each coordinate moved by a fixed pseudo-random amount (a
+/// function of its index) of at most kTetgenPerturbation times the vertex's shortest edge.
+std::vector<double> tetgen_perturbation(const double* positions, int32_t num_vertices, const int32_t* triangles,
+                                        int32_t num_triangles);
 
 /// Tetrahedralizes the inside and the outside of the closed surface (num_vertices positions,
 /// num_triangles triangles of vertex ids; every vertex used). Throws TetgenRefused when TetGen
