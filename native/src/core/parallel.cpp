@@ -35,13 +35,7 @@ namespace {
 // How long a waiting thread spins before it sleeps. Consecutive loops of one decimation follow
 // each other within microseconds, and waking a sleeping thread costs far more than that; a
 // spin much longer than the gaps only burns a core the host (Blender) may want.
-std::chrono::nanoseconds spin_time() {
-  static const std::chrono::nanoseconds time = [] {
-    const char* text = std::getenv("TOPSTOC_SPIN_US");  // for measuring only
-    return std::chrono::microseconds(text && *text ? std::max(0L, std::strtol(text, nullptr, 10)) : 1000);
-  }();
-  return time;
-}
+constexpr std::chrono::microseconds kSpinTime{1000};
 
 // The thread limit the environment sets: TOPSTOC_NUM_THREADS, else OMP_NUM_THREADS (its first
 // entry), else none.
@@ -75,11 +69,10 @@ class Waiter {
   template <class Ready>
   void wait(Ready ready) {
     const auto start = std::chrono::steady_clock::now();
-    const auto limit = spin_time();
     for (unsigned turn = 1;; ++turn) {
       if (ready()) return;
       TOPSTOC_PAUSE();
-      if (turn % 64 == 0 && std::chrono::steady_clock::now() - start >= limit) break;
+      if (turn % 64 == 0 && std::chrono::steady_clock::now() - start >= kSpinTime) break;
     }
     sleepers_.fetch_add(1);
     {
