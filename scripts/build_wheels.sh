@@ -84,10 +84,7 @@ native_wheel() {  # native_wheel PYTAG ARCH SO
   local info=$dir/topstoc_native-$VERSION.dist-info
   rm -rf "$dir"; mkdir -p "$dir/topstoc_native" "$info/licenses"
   cp "$so" "$dir/topstoc_native/"
-  cat >"$dir/topstoc_native/__init__.py" <<'PY'
-"""TopStoc's compiled engine `_topstoc` on its own, for the Blender extension (whose add-on
-package holds no binary). Everything else is in the `topstoc` package."""
-PY
+  cp packaging/topstoc_native/__init__.py "$dir/topstoc_native/"
   cp LICENSE licenses/* "$info/licenses/"
   {
     echo "Metadata-Version: 2.4"
