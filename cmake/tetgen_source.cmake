@@ -1,5 +1,5 @@
 # TetGen compiled from its source folder TOPSTOC_TETGEN_SOURCE (tetgen.h, tetgen.cxx,
-# predicates.cxx; scripts/build_wheels.sh unpacks Debian's tetgen source package) into a static
+# predicates.cxx; scripts/fetch_deps.py fetches them for the zig builds) into a static
 # library linked into the module, so a wheel needs no libtet beside it.
 add_library(tet STATIC ${TOPSTOC_TETGEN_SOURCE}/tetgen.cxx ${TOPSTOC_TETGEN_SOURCE}/predicates.cxx)
 target_compile_definitions(tet PUBLIC TETLIBRARY)

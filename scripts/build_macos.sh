@@ -12,14 +12,13 @@
 # here): enough for a compile and link check, not for a shipped wheel (the cibuildwheel workflow's).
 set -eu -o pipefail
 source "$(dirname "$0")/common.sh"  # cd to the checkout; ensure_packages
-ensure_packages cmake make libphat-dev dpkg-dev curl
+ensure_packages cmake make python3
 VENV=${TOPSTOC_CACHE:-/var/cache/topstoc}/wheel-venv
 export PATH=/usr/bin:/bin:$PATH  # Debian's cmake, as scripts/build_wheels.sh uses
 "$VENV/bin/python" -c "import ziglang, pybind11" 2>/dev/null ||
   { echo "error: no ziglang/pybind11 in $VENV: run scripts/build_wheels.sh first" >&2; exit 1; }
 ZIG=$("$VENV/bin/python" -c "import ziglang, os; print(os.path.join(os.path.dirname(ziglang.__file__), 'zig'))")
 source scripts/zig_toolchain.sh
-TETGEN=$(tetgen_source)
 
 ARCHS=("$@"); [ $# -gt 0 ] || ARCHS=(aarch64 x86_64)
 for arch in "${ARCHS[@]}"; do
@@ -27,7 +26,7 @@ for arch in "${ARCHS[@]}"; do
   [ "$arch" = aarch64 ] && debian_arch=arm64  # the pyconfig.h of the same CPU (sizes, alignment)
   zig_cmake_args "$arch-macos.11.0"
   echo "== macOS $arch: zig c++ -target $arch-macos.11.0"
-  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "${ZIG_CMAKE_ARGS[@]}" -DTOPSTOC_TETGEN_SOURCE="$TETGEN" \
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "${ZIG_CMAKE_ARGS[@]}" \
     -DCMAKE_USER_MAKE_RULES_OVERRIDE="$PWD/cmake/zig_macos_rules.cmake" \
     -DTOPSTOC_PYTHON_HEADERS_ONLY=ON -DPython_INCLUDE_DIR="$(python_include 3.11 $debian_arch)" \
     -DPYTHON_IS_DEBUG=OFF -DPYTHON_MODULE_DEBUG_POSTFIX= -DPYTHON_MODULE_EXTENSION=.cpython-311-darwin.so \

@@ -15,7 +15,7 @@
 # a venv under ${TOPSTOC_CACHE:-/var/cache/topstoc}, zig's caches and the fetched sources in its cross/.
 set -eu -o pipefail
 source "$(dirname "$0")/common.sh"  # cd to the checkout; ensure_packages
-ensure_packages g++ cmake make libtet1.5-dev libphat-dev python3-dev python3-venv unzip binutils dpkg-dev curl
+ensure_packages g++ cmake make libtet1.5-dev libphat-dev python3-dev python3-venv unzip binutils
 
 CACHE=${TOPSTOC_CACHE:-/var/cache/topstoc}
 VENV=$CACHE/wheel-venv
@@ -50,8 +50,7 @@ TEMPLATE=$(ls "$OUT"/template/topstoc-"$VERSION"-cp311-cp311-*.whl)
 
 # --- the modules: zig, one target at a time --------------------------------------------------
 ZIG=$(python -c "import ziglang, os; print(os.path.join(os.path.dirname(ziglang.__file__), 'zig'))")
-source scripts/zig_toolchain.sh  # zig_cmake_args, tetgen_source, python_include
-TETGEN=$(tetgen_source)
+source scripts/zig_toolchain.sh  # zig_cmake_args, python_include
 zig_module() {  # zig_module ARCH PYVERSION: builds the module, prints its path
   local arch=$1 py=$2 debian_arch dir=build/zig-$1-cp${2/./} log=$OUT/zig-$1-cp${2/./}.log
   [ "$arch" = aarch64 ] && debian_arch=arm64 || debian_arch=amd64
@@ -59,7 +58,7 @@ zig_module() {  # zig_module ARCH PYVERSION: builds the module, prints its path
   include=$(python_include "$py" "$debian_arch")
   zig_cmake_args "$arch-linux-gnu.2.28"
   echo "== $arch cp${py/./}: zig c++ -target $arch-linux-gnu.2.28" >&2
-  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "${ZIG_CMAKE_ARGS[@]}" -DTOPSTOC_TETGEN_SOURCE="$TETGEN" \
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "${ZIG_CMAKE_ARGS[@]}" \
     -DTOPSTOC_PYTHON_HEADERS_ONLY=ON -DPython_INCLUDE_DIR="$include" \
     -DPYTHON_IS_DEBUG=OFF -DPYTHON_MODULE_DEBUG_POSTFIX= -DPYTHON_MODULE_EXTENSION="$suffix" \
     -Dpybind11_DIR="$(python -m pybind11 --cmakedir)" >"$log" 2>&1 &&
@@ -85,10 +84,7 @@ native_wheel() {  # native_wheel PYTAG ARCH SO
   local info=$dir/topstoc_native-$VERSION.dist-info
   rm -rf "$dir"; mkdir -p "$dir/topstoc_native" "$info/licenses"
   cp "$so" "$dir/topstoc_native/"
-  cat >"$dir/topstoc_native/__init__.py" <<'PY'
-"""TopStoc's compiled engine `_topstoc` on its own, for the Blender extension (whose add-on
-package holds no binary). Everything else is in the `topstoc` package."""
-PY
+  cp packaging/topstoc_native/__init__.py "$dir/topstoc_native/"
   cp LICENSE licenses/* "$info/licenses/"
   {
     echo "Metadata-Version: 2.4"

@@ -8,9 +8,12 @@ DEST/tetgen  TetGen 1.5.0 (tetgen.cxx, predicates.cxx, tetgen.h, LICENSE) from D
 DEST/phat    PHAT 1.6's headers (include/phat/...) from Debian's arch-independent libphat-dev
              package (header-only; its orig tarball is not on the mirror)
 
-cmake/deps/CMakeLists.txt then builds TetGen as a static library for the target compiler. Plain
-Python (urllib, tarfile), so that the Wine build here and cibuildwheel's before-all step on every
-hosted runner (Windows included) fetch the same bytes. Downloads are kept in DEST/downloads.
+The one fetcher of these sources for every build that does not use the host's packages: the
+zig builds (scripts/zig_toolchain.sh: the Linux wheels and the macOS link) compile DEST/tetgen into
+the module, the cross builds (scripts/cross_build.sh) and cibuildwheel's before-all step on every
+hosted runner (Windows included) build it as a static library with cmake/deps/CMakeLists.txt.
+Plain Python (urllib, tarfile), so that all of them get the same bytes. Downloads are kept in
+DEST/downloads; a DEST already unpacked from the same pins is left as it is.
 """
 
 import hashlib
@@ -25,6 +28,7 @@ MIRROR = "https://deb.debian.org/debian/pool/main"
 TETGEN = ("t/tetgen/tetgen_1.5.0.orig.tar.gz", "4d114861d5ef2063afd06ef38885ec46822e90e7b4ea38c864f76493451f9cf3")
 PHAT = ("p/phat/libphat-dev_1.6-2_all.deb", "87b276b57a4267f4a5f91f8a98dfd23bf4ca99f429a2586e3379508df7223a0d")
 TETGEN_FILES = ("tetgen.cxx", "predicates.cxx", "tetgen.h", "LICENSE")
+PINS = f"{TETGEN[1]} {TETGEN[0]}\n{PHAT[1]} {PHAT[0]}\n"  # written to DEST/pins once unpacked
 
 
 def download(path: str, sha256: str, downloads: pathlib.Path) -> bytes:
@@ -67,11 +71,23 @@ def extract(archive: tarfile.TarFile, take, dest: pathlib.Path) -> None:
             target.write_bytes(archive.extractfile(member).read())
 
 
+def unpacked(dest: pathlib.Path) -> bool:
+    """Whether dest holds every file, unpacked from the current pins."""
+    stamp = dest / "pins"
+    return (stamp.exists() and stamp.read_text() == PINS
+            and all((dest / "tetgen" / f).exists() for f in TETGEN_FILES)
+            and (dest / "phat/include/phat/boundary_matrix.h").exists())
+
+
 def main() -> None:
     if len(sys.argv) != 2:
         sys.exit(__doc__)
     dest = pathlib.Path(sys.argv[1]).resolve()
+    if unpacked(dest):
+        print(dest)
+        return
     downloads = dest / "downloads"
+    (dest / "pins").unlink(missing_ok=True)
     for name in ("tetgen", "phat"):
         shutil.rmtree(dest / name, ignore_errors=True)
     with tarfile.open(fileobj=io.BytesIO(download(*TETGEN, downloads)), mode="r:gz") as archive:
@@ -83,6 +99,8 @@ def main() -> None:
     missing = [f for f in TETGEN_FILES if not (dest / "tetgen" / f).exists()]
     if missing or not (dest / "phat/include/phat/boundary_matrix.h").exists():
         sys.exit(f"error: the archives lack {missing or 'phat/boundary_matrix.h'}")
+    (dest / "pins.partial").write_text(PINS)
+    (dest / "pins.partial").replace(dest / "pins")
     print(dest)
 
 

@@ -1,15 +1,17 @@
 # Cross builds with zig (PyPI's `ziglang`, pinned in scripts/build_wheels.sh's venv): the
-# compilers, TetGen's sources and CPython's headers for a target, all cached under
-# ${TOPSTOC_CACHE:-/var/cache/topstoc}/cross so a warm run downloads and builds nothing twice.
-# Sourced, not run; needs ZIG (the zig binary). Used by scripts/build_wheels.sh and tests/cross.
+# compilers and CPython's headers for a target, cached under ${TOPSTOC_CACHE:-/var/cache/topstoc}/cross
+# so a warm run downloads and builds nothing twice. TetGen's sources and PHAT's headers come from
+# scripts/fetch_deps.py (pinned SHA-256s), as for the cross builds and cibuildwheel.
+# Sourced from the checkout, not run; needs ZIG (the zig binary). Used by scripts/build_wheels.sh
+# and scripts/build_macos.sh.
 #
 #   zig_cmake_args TARGET   CMake arguments (array ZIG_CMAKE_ARGS) for a zig target such as
 #                           x86_64-linux-gnu.2.28, aarch64-linux-gnu.2.28, aarch64-macos
-#                           (PHAT's headers included: Debian's libphat-dev)
-#   tetgen_source           TetGen's source folder (Debian's tetgen source package, checked)
+#                           (TetGen compiled into the module, PHAT's headers)
 #   python_include VER ARCH the folder holding pythonVER/ for Debian ARCH (amd64, arm64)
 
 CROSS=${TOPSTOC_CACHE:-/var/cache/topstoc}/cross
+DEPS=${TOPSTOC_CACHE:-/var/cache/topstoc}/deps-src  # scripts/fetch_deps.py's folder, shared with cross_build.sh
 export ZIG_GLOBAL_CACHE_DIR=$CROSS/zig-cache  # zig's own libc++ and libc stubs, built once per target
 
 zig_cmake_args() {
@@ -26,8 +28,7 @@ zig_cmake_args() {
     cmp -s "$dir/$tool.new" "$dir/$tool" && rm "$dir/$tool.new" || mv "$dir/$tool.new" "$dir/$tool"
     chmod +x "$dir/$tool"
   done
-  # PHAT is header-only: Debian's libphat-dev headers, alone in a folder of their own.
-  [ -f "$CROSS/phat/phat/boundary_matrix.h" ] || { mkdir -p "$CROSS/phat" && cp -r /usr/include/phat "$CROSS/phat/"; }
+  python3 scripts/fetch_deps.py "$DEPS" >/dev/null || return 1
   case $target in *-macos*) system=Darwin ;; *-windows*) system=Windows ;; *) system=Linux ;; esac
   processor=${target%%-*}
   ZIG_CMAKE_ARGS=(-DCMAKE_SYSTEM_NAME=$system -DCMAKE_SYSTEM_PROCESSOR=$processor
@@ -36,28 +37,9 @@ zig_cmake_args() {
     # Nothing of the host's libraries or headers: every dependency is given by path.
     -DCMAKE_FIND_ROOT_PATH="$CROSS/none" -DCMAKE_FIND_ROOT_PATH_MODE_INCLUDE=ONLY
     -DCMAKE_FIND_ROOT_PATH_MODE_LIBRARY=ONLY -DCMAKE_FIND_ROOT_PATH_MODE_PACKAGE=ONLY
-    -DTOPSTOC_TESTS=OFF -DTOPSTOC_PEERS=OFF -DPHAT_INCLUDE_DIR="$CROSS/phat")
+    -DTOPSTOC_TESTS=OFF -DTOPSTOC_PEERS=OFF -DTOPSTOC_TETGEN_SOURCE="$DEPS/tetgen" -DPHAT_INCLUDE_DIR="$DEPS/phat/include")
   command -v ccache >/dev/null && ZIG_CMAKE_ARGS+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   return 0
-}
-
-# TetGen 1.5.0 as Debian ships it (tetgen_1.5.0-5: the upstream tarball + Debian's patches),
-# its two tarballs checked against the hashes of the package's .dsc.
-TETGEN_DSC=tetgen_1.5.0-5.dsc
-TETGEN_FILES="4d114861d5ef2063afd06ef38885ec46822e90e7b4ea38c864f76493451f9cf3 tetgen_1.5.0.orig.tar.gz
-1e172e9ed169b472926433378de5d81935e5c89e1e70c558e1556e4ff7af291a tetgen_1.5.0-5.debian.tar.xz"
-tetgen_source() {
-  local dir=$CROSS/tetgen pool=http://deb.debian.org/debian/pool/main/t/tetgen
-  if [ ! -f "$dir/src/tetgen.cxx" ]; then
-    echo "== fetching TetGen's Debian source package ($TETGEN_DSC) into $dir" >&2
-    rm -rf "$dir"; mkdir -p "$dir"
-    for file in "$TETGEN_DSC" $(cut -d' ' -f2 <<<"$TETGEN_FILES"); do
-      curl -sSf -o "$dir/$file" "$pool/$file" || return 1
-    done
-    (cd "$dir" && sha256sum -c --quiet <<<"$TETGEN_FILES") || { echo "error: TetGen's tarballs do not match" >&2; return 1; }
-    dpkg-source -x "$dir/$TETGEN_DSC" "$dir/src" >/dev/null || return 1
-  fi
-  echo "$dir/src"
 }
 
 # CPython's headers for a Debian architecture: libpythonVER-dev of Debian 12 (3.11) or 13

@@ -1,6 +1,11 @@
 """Checks an installed topstoc wheel where it was installed, with nothing of a checkout on the path:
 
     python wheel_check.py [MESH]
+    python wheel_check.py --native [MESH]   the topstoc_native wheel, as the Blender extension uses it
+
+--native: the add-on's sources (this checkout's addon/, copied as the extension holds them: no
+binary inside) must load the engine from the installed `topstoc_native`, and no `topstoc`
+distribution may be installed beside it; then the same decimations.
 
 Run by cibuildwheel's test-command on every hosted runner (pyproject.toml) and by the Linux aarch64
 suite under QEMU (scripts/aarch64_test.sh). `topstoc` must import from site-packages with its
@@ -12,8 +17,11 @@ every check held. Plain Python: no pytest, no conftest putting a build tree on s
 """
 
 import hashlib
+import importlib.util
 import json
+import os
 import pathlib
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -44,12 +52,29 @@ def check_import() -> None:
     print(f"imported {engine.__name__} from {engine.__file__}")
 
 
-def check_decimation(mesh: pathlib.Path, mode: str, work: pathlib.Path) -> None:
+def use_extension_layout(work: pathlib.Path) -> dict:
+    """Puts a copy of addon/ on the path as `topstoc` (the extension's add-on package, no binary)
+    and checks that its engine is the installed topstoc_native's; returns the environment that
+    gives child processes the same path."""
+    assert importlib.util.find_spec("topstoc") is None, "a topstoc package is installed beside topstoc_native"
+    shutil.copytree(HERE.parents[1] / "addon", work / "topstoc", ignore=shutil.ignore_patterns("__pycache__"))
+    assert not list((work / "topstoc").glob("_topstoc*")), "addon/ holds a compiled module"
+    sys.path.insert(0, str(work))
+    from topstoc.core.support.native import engine
+
+    location = pathlib.Path(engine.__file__).resolve()
+    assert engine.__name__ == "topstoc_native._topstoc" and "site-packages" in location.parts, location
+    print(f"the add-on loaded {engine.__name__} from {engine.__file__}")
+    return dict(os.environ, PYTHONPATH=os.pathsep.join([str(work), os.environ.get("PYTHONPATH", "")]))
+
+
+def check_decimation(mesh: pathlib.Path, mode: str, work: pathlib.Path, env=None) -> None:
     from topstoc.core import read_mesh
 
     out = work / f"{mode}.obj"
     done = subprocess.run([sys.executable, "-m", "topstoc", "decimate", str(mesh), str(out), "--ratio", str(RATIO),
-                           "--seed", "1", "--mode", mode, "--json"], capture_output=True, text=True, timeout=600)
+                           "--seed", "1", "--mode", mode, "--json"], capture_output=True, text=True, timeout=600,
+                          env=env)
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     source, result = read_mesh(mesh), read_mesh(out)
@@ -68,12 +93,15 @@ def check_decimation(mesh: pathlib.Path, mode: str, work: pathlib.Path) -> None:
 
 
 def main() -> int:
-    mesh = pathlib.Path(sys.argv[1]) if len(sys.argv) > 1 else MESH
+    args = sys.argv[1:]
+    native = "--native" in args
+    args = [a for a in args if a != "--native"]
+    mesh = pathlib.Path(args[0]) if args else MESH
     try:
-        check_import()
         with tempfile.TemporaryDirectory() as work:
+            env = use_extension_layout(pathlib.Path(work)) if native else check_import()
             for mode in ("fast", "quality"):
-                check_decimation(mesh, mode, pathlib.Path(work))
+                check_decimation(mesh, mode, pathlib.Path(work), env)
     except AssertionError as error:
         print(f"wheel check FAILED: {error}", file=sys.stderr)
         return 1

@@ -1,6 +1,7 @@
 // The engine's thread pool (core/parallel.hpp): static chunks that follow the length and team size
 // only, loops and reductions equal to serial ones for any team, exceptions carried to the caller,
-// nested calls serial, and many calls in a row or from two threads at once.
+// nested calls serial, many calls in a row or from two threads at once, and pools outliving their
+// calling threads.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -205,7 +206,7 @@ TEST_CASE("a parallel call inside a worker runs serially there, as member 0 of a
   });
 }
 
-TEST_CASE("many short parallel calls in a row, and two calling threads with pools of their own") {
+TEST_CASE("many short parallel calls in a row, and two calling threads at once") {
   with_threads(2, [] {
     int64_t total = 0;
     for (int call = 0; call < 3000; ++call) total += parallel_count<int64_t>(0, 3, 0, [](int64_t i) { return i; });
@@ -222,6 +223,42 @@ TEST_CASE("many short parallel calls in a row, and two calling threads with pool
   b.join();
   CHECK(sums[0] == 500 * 5050);
   CHECK(sums[1] == 500 * 5050);
+}
+
+namespace {
+
+// Two threads each make one parallel call on three threads and end, as the preview's workers come
+// and go. Member 0 of each waits until both calls run, so they hold two pools at once. Returns
+// whether every member of both teams ran (each team adds its members' 1 + 2 + 3).
+bool two_callers_at_once() {
+  std::atomic<int> running{0};
+  int64_t sums[2] = {0, 0};
+  auto call = [&](int64_t* sum) {
+    set_max_threads(3);
+    parallel_region(3, [&](Team& t) {
+      if (t.index() == 0) {
+        running.fetch_add(1);
+        while (running.load() < 2) std::this_thread::yield();
+      }
+      t.critical([&] { *sum += t.index() + 1; });
+    });
+  };
+  std::thread a(call, &sums[0]), b(call, &sums[1]);
+  a.join();
+  b.join();
+  return sums[0] == 6 && sums[1] == 6;
+}
+
+}  // namespace
+
+TEST_CASE("calling threads that end leave their pools to later callers: no worker is started again") {
+  CHECK(two_callers_at_once());  // two pools of two workers at least are idle now
+  const int workers = detail::worker_threads();
+  int rounds_ok = 0;
+  for (int round = 0; round < 10; ++round) rounds_ok += two_callers_at_once();
+  CHECK(rounds_ok == 10);
+  CHECK(workers >= 4);
+  CHECK(detail::worker_threads() == workers);
 }
 
 TEST_CASE("parallel_invoke runs both tasks, on two threads or one") {

@@ -67,3 +67,18 @@ def test_manifest_lists_the_native_wheel_for_each_blender_python_and_platform():
         ("cp311", "aarch64"), ("cp311", "x86_64"), ("cp313", "aarch64"), ("cp313", "x86_64")]
     assert {m["version"] for m in matches} == {manifest["version"]}
     assert all(int(m["glibc"]) <= 28 for m in matches)
+
+
+def test_the_native_distribution_is_built_from_the_same_project_and_version():
+    """packaging/topstoc_native/pyproject.toml (the extension's wheel, built by cibuildwheel)
+    builds this CMake project at the package's version into the package topstoc_native only."""
+    package = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    native_dir = ROOT / "packaging" / "topstoc_native"
+    native = tomllib.loads((native_dir / "pyproject.toml").read_text())
+    assert native["project"]["name"] == "topstoc_native"
+    assert native["project"]["version"] == package["project"]["version"]
+    assert native["project"]["license"] == package["project"]["license"]
+    cmake = native["tool"]["scikit-build"]["cmake"]
+    assert (native_dir / cmake["source-dir"]).resolve() == ROOT
+    assert cmake["define"]["TOPSTOC_WHEEL_PACKAGE"] == "topstoc_native"
+    assert "TOPSTOC_WHEEL_PACKAGE" not in package["tool"]["scikit-build"]["cmake"]["define"]

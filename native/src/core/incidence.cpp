@@ -50,33 +50,35 @@ VertexTriangles vertex_triangles(const int32_t* triangles, int64_t num_triangles
 }
 
 void vertex_star(const VertexTriangles& around, const int32_t* triangles, int32_t v, std::vector<StarEdge>& star) {
+  // Each triangle of v contributes its two edges at v, v -> next (outgoing) and prev -> v, as one
+  // entry each; sorted by the other end, the entries of one edge are then merged in place (no
+  // scratch of its own: a thread_local one was destroyed on freed memory under mingw-w64).
   star.clear();
-  // Each triangle of v contributes its two edges at v: v -> next (outgoing) and prev -> v.
-  struct Side {
-    int32_t other, triangle;
-    bool outgoing;
-  };
-  thread_local std::vector<Side> sides;  // reused: stars are asked for in tight loops
-  sides.clear();
   for (int32_t i = around.begin(v); i < around.end(v); ++i) {
     const int32_t t = around.list[i];
     const int32_t* c = triangles + 3 * size_t(t);
     const int k = c[0] == v ? 0 : c[1] == v ? 1 : 2;
-    sides.push_back({c[(k + 1) % 3], t, true});
-    sides.push_back({c[(k + 2) % 3], t, false});
+    star.push_back(StarEdge{c[(k + 1) % 3], 1, {t, -1}, {true, false}});
+    star.push_back(StarEdge{c[(k + 2) % 3], 1, {t, -1}, {false, false}});
   }
-  std::sort(sides.begin(), sides.end(), [](const Side& a, const Side& b) {
-    return a.other != b.other ? a.other < b.other : a.triangle < b.triangle;
+  std::sort(star.begin(), star.end(), [](const StarEdge& a, const StarEdge& b) {
+    return a.other != b.other ? a.other < b.other : a.triangle[0] < b.triangle[0];
   });
-  for (const Side& s : sides) {
-    if (star.empty() || star.back().other != s.other) star.push_back(StarEdge{s.other, 0, {-1, -1}, {false, false}});
-    StarEdge& e = star.back();
+  size_t kept = 0;
+  for (size_t i = 0; i < star.size(); ++i) {
+    const StarEdge side = star[i];
+    if (kept == 0 || star[kept - 1].other != side.other) {
+      star[kept++] = side;
+      continue;
+    }
+    StarEdge& e = star[kept - 1];
     if (e.count < 2) {
-      e.triangle[e.count] = s.triangle;
-      e.outgoing[e.count] = s.outgoing;
+      e.triangle[e.count] = side.triangle[0];
+      e.outgoing[e.count] = side.outgoing[0];
     }
     ++e.count;
   }
+  star.resize(kept);
 }
 
 const StarEdge* find_star_edge(const std::vector<StarEdge>& star, int32_t other) {

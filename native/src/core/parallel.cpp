@@ -4,13 +4,9 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
-#include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <exception>
-#include <memory>
 #include <mutex>
-#include <string>
 #include <thread>
 #include <vector>
 
@@ -39,13 +35,7 @@ namespace {
 // How long a waiting thread spins before it sleeps. Consecutive loops of one decimation follow
 // each other within microseconds, and waking a sleeping thread costs far more than that; a
 // spin much longer than the gaps only burns a core the host (Blender) may want.
-std::chrono::nanoseconds spin_time() {
-  static const std::chrono::nanoseconds time = [] {
-    const char* text = std::getenv("TOPSTOC_SPIN_US");  // for measuring only
-    return std::chrono::microseconds(text && *text ? std::max(0L, std::strtol(text, nullptr, 10)) : 1000);
-  }();
-  return time;
-}
+constexpr std::chrono::microseconds kSpinTime{1000};
 
 // The thread limit the environment sets: TOPSTOC_NUM_THREADS, else OMP_NUM_THREADS (its first
 // entry), else none.
@@ -79,11 +69,10 @@ class Waiter {
   template <class Ready>
   void wait(Ready ready) {
     const auto start = std::chrono::steady_clock::now();
-    const auto limit = spin_time();
     for (unsigned turn = 1;; ++turn) {
       if (ready()) return;
       TOPSTOC_PAUSE();
-      if (turn % 64 == 0 && std::chrono::steady_clock::now() - start >= limit) break;
+      if (turn % 64 == 0 && std::chrono::steady_clock::now() - start >= kSpinTime) break;
     }
     sleepers_.fetch_add(1);
     {
@@ -164,102 +153,90 @@ void Team::unlock() { state_.critical().unlock(); }
 
 namespace {
 
-#ifdef _WIN32
-std::atomic<bool> process_exiting{false};  // set by an atexit handler (watch_exit)
-#endif
+std::atomic<int> workers_started{0};  // in this process, for tests (detail::worker_threads)
 
-// The workers of one calling thread. A job is one atomic word, (serial << 16) | team size, so a
-// worker reads the number and the size of a job together; size 0 tells the workers to exit.
-// The workers share the job's state with the pool (shared_ptr), so a worker may outlive it.
+// The workers one parallel call runs on. A job is one atomic word, (serial << 16) | team size,
+// so a worker reads the number and the size of a job together. A pool is never destroyed and its
+// workers never end (Pools says why).
 class Pool {
  public:
-  ~Pool() {
-#ifdef _WIN32
-    // At process exit Windows has already killed the workers, maybe inside a wait holding its
-    // mutex: waking them would hang. Otherwise they are told to leave and detached, as joining
-    // while this thread exits (thread_local) deadlocks on the loader lock.
-    if (!process_exiting.load()) post(0);
-    for (std::thread& thread : threads_) thread.detach();
-#else
-    post(0);
-    for (std::thread& thread : threads_) thread.join();
-#endif
-  }
-
   void run(int size, void (*run)(void*, Team&), void* context, TeamState& state) {
-    while (int(threads_.size()) < size - 1) {
-      const int id = int(threads_.size()) + 1;
-      threads_.emplace_back([shared = shared_, id, seen = shared_->job.load()] { work(*shared, id, seen); });
+    while (workers_ < size - 1) {
+      std::thread([this, id = workers_ + 1, seen = job_.load()] { work(id, seen); }).detach();
+      ++workers_;
+      workers_started.fetch_add(1);
     }
-    Shared& s = *shared_;
-    s.run = run;
-    s.context = context;
-    s.state = &state;
-    s.pending.store(size - 1);
-    post(size);
+    run_ = run;
+    context_ = context;
+    state_ = &state;
+    pending_.store(size - 1);
+    job_.store(((job_.load() >> 16) + 1) << 16 | uint64_t(size));
+    start_.wake();
     state.run_member(run, context, 0);
-    s.done.wait([&] { return s.pending.load() == 0; });
+    done_.wait([&] { return pending_.load() == 0; });
   }
 
  private:
-  struct Shared {
-    std::atomic<uint64_t> job{0};
-    void (*run)(void*, Team&) = nullptr;  // the current job, written before job names it
-    void* context = nullptr;
-    TeamState* state = nullptr;
-    std::atomic<int> pending{0};  // workers of the current job still running
-    Waiter start, done;
-  };
-
-  void post(int size) {
-    Shared& s = *shared_;
-    s.job.store(((s.job.load() >> 16) + 1) << 16 | uint64_t(size));
-    s.start.wake();
-  }
-
-  static void work(Shared& s, int id, uint64_t seen) {
+  void work(int id, uint64_t seen) {
     t_index = id;
     t_in_team = true;
     for (;;) {
-      s.start.wait([&] { return s.job.load() != seen; });
-      seen = s.job.load();
-      const int size = int(seen & 0xFFFF);
-      if (size == 0) return;
-      if (id >= size) continue;  // not in this team
-      s.state->run_member(s.run, s.context, id);
-      if (s.pending.fetch_sub(1) == 1) s.done.wake();
+      start_.wait([&] { return job_.load() != seen; });
+      seen = job_.load();
+      if (id >= int(seen & 0xFFFF)) continue;  // not in this team
+      state_->run_member(run_, context_, id);
+      if (pending_.fetch_sub(1) == 1) done_.wake();
     }
   }
 
-  std::vector<std::thread> threads_;
-  std::shared_ptr<Shared> shared_ = std::make_shared<Shared>();
+  int workers_ = 0;  // changed by the call running on the pool only
+  std::atomic<uint64_t> job_{0};
+  void (*run_)(void*, Team&) = nullptr;  // the current job, written before job_ names it
+  void* context_ = nullptr;
+  TeamState* state_ = nullptr;
+  std::atomic<int> pending_{0};  // workers of the current job still running
+  Waiter start_, done_;
 };
 
-thread_local std::unique_ptr<Pool> t_pool;
+// The pools not running a call: a call takes one (the one last given back, whose workers are
+// likely still spinning) and gives it back, so calls from several threads at once run on pools
+// of their own, and a thread that ends leaves its pool to the next caller. Nothing here is ever
+// destroyed, on purpose: an idle worker may be waiting on its pool even while the process exits.
+// No destructor runs at thread exit either: mingw-w64 (emutls) ran thread_local destructors on
+// storage it had already freed, and Windows runs them under the loader lock.
+class Pools {
+ public:
+  Pool* take() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (idle_.empty()) return new Pool;
+    Pool* pool = idle_.back();
+    idle_.pop_back();
+    return pool;
+  }
+  void give(Pool* pool) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    idle_.push_back(pool);
+  }
 
-// A forked child has only the thread that forked: the pool it inherited has no workers, so it is
-// abandoned (not joined) and the next parallel call makes a new one.
-std::atomic<unsigned> forks{0};
-thread_local unsigned t_pool_fork = 0;
+ private:
+  std::mutex mutex_;
+  std::vector<Pool*> idle_;
+};
 
-void watch_exit() {
-#ifdef _WIN32
-  static const bool registered = [] {
-    std::atexit([] { process_exiting.store(true); });
-    return true;
-  }();
-  (void)registered;
-#endif
-}
+std::atomic<Pools*> current_pools{nullptr};
 
-void watch_forks() {
+// A forked child has only the thread that forked: it starts over with no pools (the inherited
+// ones have no workers, and their lock may be held by a thread that is gone).
+Pools& pools() {
+  static const bool made = [] {
+    current_pools.store(new Pools);
 #if defined(__unix__) || defined(__APPLE__)
-  static const bool registered = [] {
-    pthread_atfork(nullptr, nullptr, [] { forks.fetch_add(1); });
+    pthread_atfork(nullptr, nullptr, [] { current_pools.store(new Pools); });
+#endif
     return true;
   }();
-  (void)registered;
-#endif
+  (void)made;
+  return *current_pools.load();
 }
 
 }  // namespace
@@ -280,19 +257,21 @@ void run_team(int threads, void (*run)(void*, Team&), void* context) {
     run(context, team);
     return;
   }
-  if (t_pool && t_pool_fork != forks.load()) (void)t_pool.release();  // its workers are gone
-  if (!t_pool) {
-    watch_forks();
-    watch_exit();
-    t_pool = std::make_unique<Pool>();
-    t_pool_fork = forks.load();
-  }
+  struct Taken {  // the pool this call runs on, given back however the call ends
+    Pools& pools;
+    Pool* pool = pools.take();
+    ~Taken() {
+      t_in_team = false;
+      pools.give(pool);
+    }
+  } taken{pools()};
   TeamState state(threads);
   t_in_team = true;
-  t_pool->run(threads, run, context, state);
-  t_in_team = false;
+  taken.pool->run(threads, run, context, state);
   state.rethrow();
 }
+
+int worker_threads() { return workers_started.load(); }
 
 }  // namespace detail
 

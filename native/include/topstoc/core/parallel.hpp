@@ -1,9 +1,9 @@
 // The engine's threads: a small pool of its own on std::thread (no OpenMP runtime to ship next to
 // a host's), parallel loops with fixed static chunks, and when threads pay off at all.
 //
-// Each thread that starts parallel work (an engine call's thread) owns a pool of workers, made
-// on first use and grown to the largest team it asked for; the caller works as member 0. A
-// parallel call made inside a worker runs serially in it. Between calls, idle workers spin for a
+// Each parallel call runs on a pool of workers of its own for its duration, taken from the idle
+// pools (or made) and grown to the team it asks for; the caller works as member 0. A parallel call
+// made inside a worker runs serially in it. Pools and their workers last as long as the process. Between calls, idle workers spin for a
 // short while (the next loop of a decimation usually follows within microseconds) and then sleep:
 // nothing spins when the engine is idle.
 #pragma once
@@ -154,6 +154,9 @@ namespace detail {
 /// Runs run(context, team) on a team of `threads` (this thread as member 0; serially when
 /// threads <= 1 or inside a worker); rethrows the first exception a member threw.
 void run_team(int threads, void (*run)(void*, Team&), void* context);
+
+/// The worker threads started so far in this process (they never end).
+int worker_threads();
 }  // namespace detail
 
 /// Runs region(team) on `threads` threads at once, this one as member 0, and waits for them.
