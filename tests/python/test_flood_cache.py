@@ -130,7 +130,7 @@ def test_threads_sharing_a_mesh_get_the_fresh_results():
         assert_same(got, expected[ratio])
     assert sum(got.stats.flood_updated for got in results.values()) > len(results) // 2
     _layout, floods = mesh.layout_and_floods()
-    assert floods.size == 2  # three threads, at most two kept floods
+    assert 1 <= floods.size <= 2  # three threads, at most two kept floods (two only if they overlapped)
     mesh.clear_floods()
     assert floods.size == 0
 
