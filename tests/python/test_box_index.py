@@ -4,7 +4,7 @@ every triangle's box, on a mesh the clean-up's LocalEditor edits in place."""
 import numpy as np
 
 import cleanup_meshes
-from topstoc.core.api.box_index import BoxIndex
+from topstoc.core.api.box_index import BoxIndex, sorted_unique
 from topstoc.core.api.local_edit import LocalEditor
 from topstoc.core.api.loops import handle_tunnel_loops
 
@@ -35,6 +35,9 @@ def test_the_index_finds_what_a_scan_finds_while_handles_are_removed():
     rng = np.random.default_rng(3)
     for tag, loop in enumerate(loops):
         editor.remove_handle(loop, tag, refine=True, fair=True)
+        corners = editor.vertices.view()[editor.triangles.view()]
+        low, high = editor.boxes()  # updated only where the edit moved or renumbered corners
+        assert np.array_equal(low, corners.min(axis=1)) and np.array_equal(high, corners.max(axis=1))
         lows, highs = queries(rng, editor.vertices.view(), 40)
         for low, high in zip(lows, highs):
             assert np.array_equal(editor._near(low, high), scan(editor, low, high))
@@ -60,3 +63,11 @@ def test_candidates_cover_boxes_of_any_size_and_recorded_edits():
         found = index.candidates(q_low, q_high, len(low))
         assert np.all(np.diff(found) > 0) and set(meet) <= set(found.tolist())
     assert len(index.candidates(np.full(3, -1.0), np.full(3, 1.0), len(low))) < len(low) / 2  # it does prune
+
+
+def test_sorted_unique_is_numpys_unique():
+    rng = np.random.default_rng(4)
+    for values in (rng.integers(0, 50, 300), rng.integers(-5, 10**6, 7000).astype(np.int32),
+                   np.zeros(0, np.int64), np.array([3])):
+        found = sorted_unique(values)
+        assert np.array_equal(found, np.unique(values)) and found.dtype == values.dtype

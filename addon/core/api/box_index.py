@@ -16,6 +16,13 @@ import numpy as np
 MAX_COLUMNS = 4096
 
 
+def sorted_unique(values: np.ndarray) -> np.ndarray:
+    """np.unique of a 1-D integer array by a sort (numpy's hashing unique is many times slower on
+    the few thousand ids of a neighbourhood)."""
+    values = np.sort(values)
+    return values[np.concatenate([[True], values[1:] != values[:-1]])] if len(values) else values
+
+
 class BoxIndex:
     """Candidates for "boxes meeting [low, high]" over boxes that change only inside recorded
     edits' boxes (see the module docstring)."""
@@ -65,7 +72,7 @@ class BoxIndex:
         lengths = stops - starts
         offsets = np.repeat(starts - np.concatenate([[0], np.cumsum(lengths)[:-1]]), lengths)
         found = self.order[np.arange(int(lengths.sum()), dtype=np.int64) + offsets]
-        return np.unique(np.concatenate([found, self._edited(low, high)]))
+        return sorted_unique(np.concatenate([found, self._edited(low, high)]))
 
     def _edited(self, low: np.ndarray, high: np.ndarray) -> np.ndarray:
         """The rows of the recorded edits whose boxes meet [low, high]."""
@@ -73,5 +80,5 @@ class BoxIndex:
             return np.zeros(0, dtype=np.int64)
         boxes = self.edit_box[:len(self.edit_rows)]
         meet = np.flatnonzero(np.all(boxes[:, 3:] >= low, axis=1) & np.all(boxes[:, :3] <= high, axis=1))
-        return np.unique(np.concatenate([self.edit_rows[i] for i in meet])) if len(meet) else \
+        return sorted_unique(np.concatenate([self.edit_rows[i] for i in meet])) if len(meet) else \
             np.zeros(0, dtype=np.int64)

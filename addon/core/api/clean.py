@@ -237,9 +237,10 @@ def clean(vertices, triangles, *, max_handle: Size = None, max_hole: Size = None
     left: List[Left] = []
     state = _fill_small_holes(vertices, triangles, hole_size, fair, removed, left)
     seconds = {"holes": time.perf_counter() - started}
-    state, rounds = _remove_small_handles(state, handle_size, keep_largest, fair, max_rounds, removed, left, seconds)
+    state, rounds, genus_after = _remove_small_handles(state, handle_size, keep_largest, fair, max_rounds, removed,
+                                                       left, seconds)
     seconds["handles"] = time.perf_counter() - started - seconds["holes"]
-    genus_after = _genus(topology(state.vertices, state.triangles))
+    genus_after = _genus(topology(state.vertices, state.triangles)) if genus_after is None else genus_after
     seconds["total"] = time.perf_counter() - started
     return CleanResult(edit=state, removed=removed, left=left, max_handle=handle_size, max_hole=hole_size,
                        keep_largest=None if keep_largest is None else int(keep_largest),
@@ -360,15 +361,16 @@ def _tagged(filled: EditResult, chosen: list, holes: list, vertices, style: str,
 
 def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional[int], fair: bool,
                           max_rounds: int, removed: list, left: list, seconds: dict) -> tuple:
-    """Rounds of loop computation and removal (module docstring); returns (state, rounds).
+    """Rounds of loop computation and removal (module docstring); returns (state, rounds, the
+    genus of state when it was computed on the way, else None).
     Adds the time spent computing loops to ``seconds["loops"]``."""
     from .component_loops import loops_by_component
     from .topology import topology
 
     if state.num_triangles == 0:
-        return state, 0
+        return state, 0, None
     failed = {}  # frozenset of vertex ids (stable: edits only append) -> why the removal failed
-    rounds = 0
+    rounds, genus = 0, None
     while True:
         started = time.perf_counter()
         try:
@@ -376,7 +378,7 @@ def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional
         except ValueError as error:
             left.append(Left("component", 0.0, f"handle and tunnel loops not computed: {error}",
                              np.zeros(0, np.int32)))
-            return state, rounds
+            return state, rounds, None
         finally:
             seconds["loops"] = seconds.get("loops", 0.0) + time.perf_counter() - started
         budget = found.genus - keep_largest if keep_largest is not None else found.genus
@@ -388,11 +390,13 @@ def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional
         rounds += 1
         if used is not None:
             survivors = _survivors(found, used)
-            if len(survivors.handles) + len(survivors.tunnels) == 2 * _genus(topology(state.vertices, state.triangles)):
+            genus = _genus(topology(state.vertices, state.triangles))
+            if len(survivors.handles) + len(survivors.tunnels) == 2 * genus:
                 found = survivors  # they span what is left: no loops to compute again
                 break
+            genus = None  # the next round changes state
     _report_left(state, found, size, keep_largest, failed, left)
-    return state, rounds
+    return state, rounds, genus
 
 
 def _survivors(found, used: np.ndarray):
