@@ -13,10 +13,10 @@ Handles are removed in rounds: a round computes the loops of the current surface
 one removed before in the round. The 2g handle and tunnel loops of a component are independent
 in its homology, so disjoint ones do not separate the surface together, and each removal drops
 the genus by one (remove_handle checks anyway that each cut leaves its component in one
-piece, on the surface as it is then). When a round removed every loop below the size and the
-loops it left untouched are twice the genus left in number, those are what is left (_survivors
-says why); else the next round recomputes the loops of what is left, since a removal changes
-the loops of the others. A removal runs on the loop's neighbourhood
+piece, on the surface as it is then). After a round that removed anything the next round
+recomputes the loops of what is left: a removal changes the shortest loops of the others (a
+loop that depended on removed ones can now be the shortest of its handle, and below the size).
+A removal runs on the loop's neighbourhood
 (local_edit.py). Holes are filled first; a patch that would cross the surface is replaced by a
 flat one or its hole left open and reported.
 
@@ -237,10 +237,10 @@ def clean(vertices, triangles, *, max_handle: Size = None, max_hole: Size = None
     left: List[Left] = []
     state = _fill_small_holes(vertices, triangles, hole_size, fair, removed, left)
     seconds = {"holes": time.perf_counter() - started}
-    state, rounds, genus_after = _remove_small_handles(state, handle_size, keep_largest, fair, max_rounds, removed,
+    state, rounds = _remove_small_handles(state, handle_size, keep_largest, fair, max_rounds, removed,
                                                        left, seconds)
     seconds["handles"] = time.perf_counter() - started - seconds["holes"]
-    genus_after = _genus(topology(state.vertices, state.triangles)) if genus_after is None else genus_after
+    genus_after = _genus(topology(state.vertices, state.triangles))
     seconds["total"] = time.perf_counter() - started
     return CleanResult(edit=state, removed=removed, left=left, max_handle=handle_size, max_hole=hole_size,
                        keep_largest=None if keep_largest is None else int(keep_largest),
@@ -361,16 +361,14 @@ def _tagged(filled: EditResult, chosen: list, holes: list, vertices, style: str,
 
 def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional[int], fair: bool,
                           max_rounds: int, removed: list, left: list, seconds: dict) -> tuple:
-    """Rounds of loop computation and removal (module docstring); returns (state, rounds, the
-    genus of state when it was computed on the way, else None).
+    """Rounds of loop computation and removal (module docstring); returns (state, rounds).
     Adds the time spent computing loops to ``seconds["loops"]``."""
     from .component_loops import loops_by_component
-    from .topology import topology
 
     if state.num_triangles == 0:
-        return state, 0, None
+        return state, 0
     failed = {}  # frozenset of vertex ids (stable: edits only append) -> why the removal failed
-    rounds, genus = 0, None
+    rounds = 0
     while True:
         started = time.perf_counter()
         try:
@@ -378,64 +376,35 @@ def _remove_small_handles(state: EditResult, size: float, keep_largest: Optional
         except ValueError as error:
             left.append(Left("component", 0.0, f"handle and tunnel loops not computed: {error}",
                              np.zeros(0, np.int32)))
-            return state, rounds, None
+            return state, rounds
         finally:
             seconds["loops"] = seconds.get("loops", 0.0) + time.perf_counter() - started
         budget = found.genus - keep_largest if keep_largest is not None else found.genus
         if rounds >= max_rounds or budget <= 0:
             break
-        state, count, used = _removal_round(state, found, size, budget, fair, failed, removed)
+        state, count = _removal_round(state, found, size, budget, fair, failed, removed)
         if count == 0:
             break
         rounds += 1
-        if used is not None:
-            survivors = _survivors(found, used)
-            genus = _genus(topology(state.vertices, state.triangles))
-            if len(survivors.handles) + len(survivors.tunnels) == 2 * genus:
-                found = survivors  # they span what is left: no loops to compute again
-                break
-            genus = None  # the next round changes state
     _report_left(state, found, size, keep_largest, failed, left)
-    return state, rounds, genus
-
-
-def _survivors(found, used: np.ndarray):
-    """``found`` without the loops that touch a removed loop's vertex ``used``.
-
-    A loop that touches none is still a loop of the edited surface (its edges and positions
-    are kept) of the same kind: a cut along a handle loop cuts the inside along a disk, which
-    keeps every loop bounding inside bounding and makes no loop bound outside that did not
-    (and the other way round for a tunnel). The untouched loops stay independent (a relation
-    among them on the edited surface would be one with the removed loops before), so when
-    there are twice the genus left of them they span every handle and tunnel left."""
-    def kept(loops):
-        return tuple(loop for loop in loops if not used[np.asarray(loop.vertices, dtype=np.int64)].any())
-
-    components = tuple(dataclasses.replace(c, handles=kept(c.handles), tunnels=kept(c.tunnels),
-                                           genus=min(len(kept(c.handles)), len(kept(c.tunnels))))
-                       if c.status == "ok" else c for c in found.components)
-    return dataclasses.replace(found, components=components)
+    return state, rounds
 
 
 def _removal_round(state: EditResult, found, size: float, budget: int, fair: bool, failed: dict,
                    removed: list) -> tuple:
     """Removes up to ``budget`` loops below ``size``, shortest first, no two sharing a vertex.
-    Returns (state, count removed, the removed loops' vertices as a mask when every loop below
-    the size was removed, touches one removed or the budget was reached; else None)."""
+    Returns (state, count removed)."""
     candidates = sorted((loop for c in found.components if c.status == "ok" for loop in c.loops),
                         key=lambda loop: (loop.length, loop.kind))
     used = np.zeros(state.num_vertices, dtype=bool)  # loops are in the round's first ids, kept by every edit
-    count, stale, complete = 0, {}, True
+    count, stale = 0, {}
     editor = LocalEditor(state.vertices, state.triangles)
     for loop in candidates:
         if count >= budget or loop.length >= size:
             break
         ids = np.asarray(loop.vertices, dtype=np.int64)
         key = frozenset(ids.tolist())
-        if used[ids].any():  # most often the other loop of a handle removed (see _survivors)
-            continue
-        if key in failed:
-            complete = False  # the next round's loops may hold another loop for this one's handle
+        if used[ids].any() or key in failed:  # most often the other loop of a handle removed
             continue
         tag = len(removed)
         try:
@@ -444,7 +413,6 @@ def _removal_round(state: EditResult, found, size: float, budget: int, fair: boo
             # A loop that now separates was made redundant by a removal earlier in this round;
             # the next round's loops settle it. Anything else is this loop's own failure.
             (stale if "separates" in str(error) else failed)[key] = str(error).splitlines()[0]
-            complete = False
             continue
         used[ids] = True
         area, aspect = patch_quality(editor.vertices.view(), editor.triangles.view(), patches)
@@ -455,7 +423,7 @@ def _removal_round(state: EditResult, found, size: float, budget: int, fair: boo
         state = compose(state, editor.result())
     if count == 0:
         failed.update(stale)  # nothing else changed: these loops separate on their own
-    return state, count, used if complete else None
+    return state, count
 
 
 def _remove_one(editor: LocalEditor, ids: np.ndarray, tag: int, fair: bool) -> tuple:
