@@ -109,15 +109,33 @@ def _copy_armature_modifiers(source, target) -> None:
             copy.use_bone_envelopes = modifier.use_bone_envelopes
 
 
-def _bake(bpy, source, result, settings, name: str) -> str:
+def _bake(bpy, source, result, settings, name: str) -> dict:
     """Bakes the normal map asked for (--bake-normals) from ``source`` onto ``result`` as
-    ``<output folder>/<name>_normal.png``; returns its path."""
+    ``<output folder>/<name>_normal.png``, and with --bake-colour the base colour as
+    ``<name>_color.png`` where the result got a UV map of its own; returns the report's entries
+    (``normal_map``, ``colour_map``: its path, or None where the source's UV layout was kept)."""
     from .decimation import bake
 
     size = settings["bake_normals"]
+    colour = bool(settings.get("bake_colour"))
     baked = bake.bake_normals(bpy.context, source, result, size=size, margin=bake_margin(size), store="FILE",
-                              folder=settings["bake_folder"], name=name, replace=True)
-    return baked.path
+                              folder=settings["bake_folder"], name=name, replace=True, colour=colour)
+    maps = {"normal_map": baked.path}
+    if colour:
+        maps["colour_map"] = baked.colour_path or None
+    if baked.colour_path and settings["bake_format"] in ("gltf", "glb"):
+        maps["dropped_colour_attributes"] = _drop_colour_attributes(result)
+    return maps
+
+
+def _drop_colour_attributes(result) -> list:
+    """Removes ``result``'s colour attributes, returning their names: glTF multiplies the base
+    colour by the vertex colours (COLOR_0), and its base colour is now the baked texture."""
+    attributes = result.data.color_attributes
+    names = [attribute.name for attribute in attributes]
+    for name in names:
+        attributes.remove(attributes[name])
+    return names
 
 
 def bake_margin(size: int) -> int:
@@ -127,10 +145,10 @@ def bake_margin(size: int) -> int:
 
 def _write_in_place(bpy, pipeline, obj, run, settings, name: str):
     """The pipeline's IN_PLACE write; with --bake-normals the original mesh is kept on a
-    temporary object to bake from, then removed. Returns the normal map's path or None."""
+    temporary object to bake from, then removed. Returns _bake's report entries ({} without)."""
     if not settings.get("bake_normals"):
         pipeline.write_output(run, "IN_PLACE")
-        return None
+        return {}
     original = obj.data
     holder = bpy.data.objects.new(f"{obj.name} (original)", original)
     bpy.context.scene.collection.objects.link(holder)
@@ -177,14 +195,13 @@ def _decimate_object(bpy, pipeline, obj, settings, targets) -> tuple:
             lod = pipeline.write_output(run, "NEW_OBJECT", name=name)
             lod.name = name  # the source keeps its name until it is removed below
             if settings.get("bake_normals"):
-                entry["normal_map"] = _bake(bpy, obj, lod, settings, f"{settings['bake_stem']}_{name}")
+                entry.update(_bake(bpy, obj, lod, settings, f"{settings['bake_stem']}_{name}"))
             _copy_armature_modifiers(obj, lod)
             entry["object"] = lod.name
             lod_objects.append(lod)
         else:
-            normal_map = _write_in_place(bpy, pipeline, obj, run, settings, f"{settings['bake_stem']}_{obj.name}")
-            if normal_map:
-                entry["normal_map"] = normal_map
+            maps = _write_in_place(bpy, pipeline, obj, run, settings, f"{settings['bake_stem']}_{obj.name}")
+            entry.update(maps)
         lods.append(entry)
     report = {"object": obj.name, "vertices_in": n, "vertices_out": lods[0]["vertices"],
               "triangles_out": lods[0]["triangles"], "seconds": sum(lod["seconds"] for lod in lods),
@@ -225,7 +242,8 @@ def decimate_scene_file(path: str, out_dir: str, settings: dict) -> dict:
     objects = _mesh_objects(bpy, path, settings["objects"])
     cleaned = _clean_objects(objects, settings["clean"]) if "clean" in settings else {}
     stem, _ = os.path.splitext(os.path.basename(path))
-    settings = dict(settings, bake_folder=out_dir, bake_stem=stem)
+    out_format = settings["format"] or os.path.splitext(path)[1].lstrip(".").lower()
+    settings = dict(settings, bake_folder=out_dir, bake_stem=stem, bake_format=out_format)
     asset = _world_vertices(objects)
     targets = batch_settings.engine_targets(settings, asset)
     entries, chains, sources = [], [], []

@@ -227,6 +227,26 @@ def test_bake_normals_is_checked_and_mesh_files_refuse_it(tmp_path):
     assert "bake_normals" not in plain and "--bake-normals" not in batch_settings.to_argv(plain)
 
 
+def test_bake_colour_needs_bake_normals(tmp_path):
+    """``--bake-colour`` alone is one error line naming --bake-normals; with it, the settings carry it
+    to the Blender batch (to_argv) and leave the settings of a run without it as they were."""
+    from topstoc.core.batch import settings as batch_settings
+
+    a = _torus(tmp_path / "a", "ring.obj")
+    done = batch("--input", a, "--output", tmp_path / "out", "--ratio", 0.5, "--bake-colour", "--workers", 0)
+    cli.assert_one_error_line("batch", done, "--bake-colour needs --bake-normals SIZE")
+    assert not (tmp_path / "out").exists()
+    parser = __import__("argparse").ArgumentParser()
+    batch_settings.add_arguments(parser)
+    settings = batch_settings.from_args(parser.parse_args(["--ratio", "0.5", "--bake-normals", "64", "--bake-colour"]))
+    assert settings["bake_colour"] is True
+    assert batch_settings.to_argv(settings)[-3:] == ["--bake-normals", "64", "--bake-colour"]
+    again = batch_settings.from_args(parser.parse_args(batch_settings.to_argv(settings)))
+    assert again == settings
+    normals_only = batch_settings.from_args(parser.parse_args(["--ratio", "0.5", "--bake-normals", "64"]))
+    assert "bake_colour" not in normals_only and "--bake-colour" not in batch_settings.to_argv(normals_only)
+
+
 def test_the_error_report_is_a_bracket_and_exact_on_request(tmp_path):
     """Default: a bounded estimate (estimate <= upper, both against an independent exact
     measurement); --exact-error: the exact bracketed max, within 0.1 %."""

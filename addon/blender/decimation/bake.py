@@ -51,6 +51,7 @@ class Baked:
     method: str = "Cycles"   #: "Cycles", or "ray cast" where this Blender's Cycles baked nothing
     path: str = ""           #: the saved file ("" when packed)
     colour: object = None    #: the base colour image (bake_colour.py), or None
+    colour_path: str = ""    #: its saved file ("" when packed or not baked)
 
 
 def check_bakeable(source, result) -> None:
@@ -420,8 +421,9 @@ def bake_normals_steps(context, source, result, *, size: int = 1024, margin: int
                 result.data.uv_layers.active_index = active_uv
             stem = bpy.path.clean_name(name or result.name)
             path = save_image(image, folder, stem, replace) if store == "FILE" else ""
+            colour_path = ""
             if colour_image is not None and store == "FILE":
-                save_image(colour_image, folder, stem, replace, kind="color")
+                colour_path = save_image(colour_image, folder, stem, replace, kind="color")
             for baked in (image, colour_image) if store != "FILE" else ():
                 if baked is not None:
                     pack_image(baked)
@@ -433,7 +435,8 @@ def bake_normals_steps(context, source, result, *, size: int = 1024, margin: int
             restore_normals(result, normals)
             raise
     yield 1.0
-    return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, method, path, colour_image)
+    return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, method, path, colour_image,
+                 colour_path)
 
 
 def _bake_colour(result, materials, uv_map: str, reach: tuple, margin: int, size: int):

@@ -73,6 +73,10 @@ def add_arguments(parser) -> None:
     parser.add_argument("--bake-normals", type=int, metavar="SIZE",
                         help="Blender formats: bake a SIZE x SIZE tangent-space normal map from each source onto "
                              "each result (a PNG next to the output, used by its materials; margin SIZE/64 px)")
+    parser.add_argument("--bake-colour", action="store_true",
+                        help="with --bake-normals: where the result gets a UV map of its own (the source's "
+                             "layout is not kept), bake the source's base colour onto it too (a second PNG, "
+                             "the materials' base colour)")
     parser.add_argument("--exact-error", action="store_true",
                         help="report each output's exact bracketed Hausdorff max (relative gap 0.1 %%) instead "
                              "of the default bounded estimate (a guaranteed upper bound within 25 %% of a "
@@ -150,6 +154,11 @@ def from_args(args) -> dict:
         optional["attribute_weight"] = weight
     if getattr(args, "bake_normals", None) is not None:  # absent when off, likewise
         optional["bake_normals"] = check_size(args.bake_normals)
+    if getattr(args, "bake_colour", False):  # absent when off, likewise
+        if "bake_normals" not in optional:
+            raise TopStocError("--bake-colour needs --bake-normals SIZE (the colour is baked onto the normal "
+                               "map's UV map)")
+        optional["bake_colour"] = True
     if getattr(args, "exact_error", False):  # absent when off, likewise
         optional["exact_error"] = True
     optional.update(_clean(args))
@@ -210,6 +219,8 @@ def to_argv(settings: dict) -> list:
         argv += ["--objects", *settings["objects"]]
     if settings.get("bake_normals"):
         argv += ["--bake-normals", str(settings["bake_normals"])]
+    if settings.get("bake_colour"):
+        argv.append("--bake-colour")
     if "clean" in settings:
         argv += ["--clean", *clean_cli.to_argv(settings["clean"])]
     return argv
