@@ -83,24 +83,32 @@ def texels(image, uvs):
     return srgb_to_linear(pixels[y, x].astype(np.float64))
 
 
-def test_batch_bakes_the_base_colour_into_a_gltf(ts, scene, tmp_path):
+def batch_bake_colour(ts, tmp_path, out_format: str):
+    """Runs the batch on the scene saved as ``painted.blend`` with ``--ratio 0.02 --bake-normals 256
+    --bake-colour --format out_format`` (skipped where Cycles bakes no colour); returns (output
+    folder, the LOD's report entry)."""
     from test_batch_formats import _runner
 
-    source = painted_suzanne()
-    tree, colours = source_colours(source)
-    source_faces = len(source.data.polygons)
     blend = tmp_path / "painted.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend), copy=True)
     out, report = tmp_path / "out", tmp_path / "report.json"
     command = importlib_module(ts, "core.batch.run").blender_command(_runner()) + [
         "--input", str(blend), "--output", str(out), "--json", str(report), "--ratio", "0.02",
-        "--format", "gltf", "--bake-normals", "256", "--bake-colour"]
+        "--format", out_format, "--bake-normals", "256", "--bake-colour"]
     done = subprocess.run(command, capture_output=True, text=True, timeout=600)
     if done.returncode and "Cycles baked no colour" in done.stderr:
         pytest.skip(f"Blender {bpy.app.version_string}'s Cycles bakes no colour selected-to-active "
                     f"(the colour bake has no ray-cast fallback)")
     assert done.returncode == 0, done.stderr[-2000:]
     [lod] = json.loads(report.read_text())["results"][0]["objects"][0]["lods"]
+    return out, lod
+
+
+def test_batch_bakes_the_base_colour_into_a_gltf(ts, scene, tmp_path):
+    source = painted_suzanne()
+    tree, colours = source_colours(source)
+    source_faces = len(source.data.polygons)
+    out, lod = batch_bake_colour(ts, tmp_path, "gltf")
     assert lod["colour_map"] == str(out / "painted_painted_color.png")
     assert lod["normal_map"] == str(out / "painted_painted_normal.png")
     assert lod["dropped_colour_attributes"] == ["paint"]  # its colours are in the texture now
@@ -138,6 +146,35 @@ def test_batch_bakes_the_base_colour_into_a_gltf(ts, scene, tmp_path):
     assert np.abs(bias).max() < 0.005        # measured 0.0008 (bpy 4.5); 0.02 darker with the specular layer on
     assert baked_error.mean() < 0.03         # measured 0.021 (bpy 4.5)
     assert baked_error.mean() < 0.6 * blended_error.mean()  # measured 0.5x
+
+
+def test_batch_embeds_the_base_colour_in_an_fbx(ts, scene, tmp_path):
+    """The FBX output carries the baked colour (embedded, as the normal map): moved elsewhere without
+    the PNGs, it re-imports with the colour PNG's pixels feeding the Base Color. FBX has no rule
+    multiplying vertex colours in: the LOD keeps its colour attribute."""
+    import shutil
+
+    painted_suzanne()
+    out, lod = batch_bake_colour(ts, tmp_path, "fbx")
+    assert "dropped_colour_attributes" not in lod
+    written = bpy.data.images.load(lod["colour_map"])
+    expected = np.empty(len(written.pixels), dtype=np.float32)
+    written.pixels.foreach_get(expected)
+    moved = tmp_path / "moved"
+    shutil.move(str(out), str(moved))
+    for name in os.listdir(moved):
+        if name.endswith(".png"):
+            os.remove(moved / name)
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    importlib_module(ts, "blender.io.scene_files").import_file(str(moved / "painted.fbx"))
+    [obj] = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+    node = base_colour_image(obj)
+    assert node is not None and tuple(node.image.size) == (256, 256)
+    pixels = np.empty(len(node.image.pixels), dtype=np.float32)
+    node.image.pixels.foreach_get(pixels)
+    assert np.array_equal(pixels, expected) and np.ptp(expected) > 0.3
+    assert "paint" in obj.data.color_attributes
 
 
 def test_the_colour_bake_leaves_the_source_material_as_it_was(ts, scene):
