@@ -177,6 +177,34 @@ def test_batch_embeds_the_base_colour_in_an_fbx(ts, scene, tmp_path):
     assert "paint" in obj.data.color_attributes
 
 
+def test_batch_connects_the_base_colour_in_a_usd(ts, scene, tmp_path):
+    """USD output: the UsdPreviewSurface's diffuseColor reads the colour PNG (the exporter copies it
+    to textures/), and Blender's importer reads it back into the Base Color. Debian's Blender 3.4
+    is built without USD."""
+    if not bpy.app.build_options.usd:
+        pytest.skip(f"Blender {bpy.app.version_string} is built without USD")
+    painted_suzanne()
+    out, lod = batch_bake_colour(ts, tmp_path, "usda")
+    name = os.path.basename(lod["colour_map"])
+    text = (out / "painted.usda").read_text()
+    assert "color3f inputs:diffuseColor.connect = </root/_materials/" in text
+    assert f"asset inputs:file = @./textures/{name}@" in text
+    assert name in os.listdir(out / "textures")
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    for image in list(bpy.data.images):
+        bpy.data.images.remove(image)
+    importlib_module(ts, "blender.io.scene_files").import_file(str(out / "painted.usda"))
+    [obj] = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+    node = base_colour_image(obj)
+    assert node is not None and tuple(node.image.size) == (256, 256)
+    written = bpy.data.images.load(lod["colour_map"])
+    imported, expected = (np.empty(len(i.pixels), dtype=np.float32) for i in (node.image, written))
+    node.image.pixels.foreach_get(imported)
+    written.pixels.foreach_get(expected)
+    assert np.array_equal(imported, expected) and np.ptp(expected) > 0.3
+
+
 def test_the_colour_bake_leaves_the_source_material_as_it_was(ts, scene):
     """The colour bake turns the source's specular layer off while it runs (it dims the Diffuse
     Color pass) and puts it back."""
