@@ -374,21 +374,48 @@ def test_a_non_manifold_component_is_left_and_the_others_cleaned():
     assert e.vertices[n:n + len(fin)].tobytes() == vertices[n:].tobytes()
 
 
-def test_no_handle_below_the_size_is_left_after_its_neighbours_go():
+@pytest.fixture(scope="module")
+def pinched_scan():
+    """The armadillo scan with 8 pinched handles (bench_cleanup --scan), cleaned at 1 %:
+    (vertices, triangles, result)."""
+    from topstoc.core.api.io import read_mesh
+
+    data = read_mesh(str(DATA / "genus0" / "cgal_armadillo.off.gz"))
+    vertices, triangles, _arches = cleanup_meshes.with_pinched_handles(data.vertices, data.triangles, 8, seed=1)
+    return vertices, triangles, clean(vertices, triangles, max_handle="1%", max_hole=0)
+
+
+def test_no_handle_below_the_size_is_left_after_its_neighbours_go(pinched_scan):
     """The armadillo scan with 8 pinched handles at 1 %: removing the short loops can make a
     longer loop of a handle left shorter than the size (it no longer depends on them), so every
     round after a removal computes the loops again; a fresh computation on the output finds no
     handle or tunnel loop below the size."""
-    from topstoc.core.api.io import read_mesh
     from topstoc.core.api.loops import handle_tunnel_loops
 
-    data = read_mesh(str(DATA / "genus0" / "cgal_armadillo.off.gz"))
-    vertices, triangles, _arches = cleanup_meshes.with_pinched_handles(data.vertices, data.triangles, 8, seed=1)
-    result = clean(vertices, triangles, max_handle="1%", max_hole=0)
+    vertices, triangles, result = pinched_scan
     size = 0.01 * float(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)))
     again = handle_tunnel_loops(result.vertices, result.triangles)
     assert min((loop.length for loop in again.handles + again.tunnels), default=np.inf) >= size
     assert genus(result.vertices, result.triangles) == result.genus_after == len(again.handles)
     assert all("not below the size" in item.reason for item in result.left if item.kind in ("handle", "tunnel"))
 
+
+def test_caps_of_pinched_handles_are_no_slivers(pinched_scan):
+    """The pinched handles' loops are 3 edges shorter than the scan's edges, and pulling the
+    loop's copies apart makes some copies slivers (aspect up to 15.6): a faired cap that was the
+    copy's own triangle now has a vertex lifted off it, and every cap is within aspect 5."""
+    vertices, triangles, result = pinched_scan
+    e = result.edit
+    assert result.count("handle") + result.count("tunnel") == 7
+    caps = [p for p in e.patches if len(p.boundary) == 3]
+    assert len(caps) == 14 and all(p.faired for p in caps)
+    own = reference.aspect_ratios(e.vertices, np.array([p.boundary for p in caps]))
+    lifted = [p for p, a in zip(caps, own) if a > 5]
+    assert len(lifted) >= 3  # the copies that are slivers: each has a vertex of its own now
+    assert all(p.vertices.stop - p.vertices.start == 1 and p.triangles.stop - p.triangles.start == 3
+               for p in lifted)
+    assert patch_aspect(result) <= 5
+    assert max(item.patch_aspect for item in result.removed) == pytest.approx(patch_aspect(result))
+    assert len(self_intersections(result.vertices, result.triangles)) == 0
+    assert_rest_unchanged(vertices, triangles, result)
 

@@ -557,6 +557,39 @@ def test_refine_and_fair_patch():
     assert np.allclose(carried[patch.vertices], colours[fair.vertex_source[patch.boundary]].mean(axis=0))
 
 
+
+def test_fair_lifts_a_sliver_patch_off_its_plane():
+    """A triangular hole that is a sliver: its flat patch is the hole's own triangle (aspect
+    6.7), which no flat refinement improves; the faired patch lifts a centre vertex off it, to
+    the sphere's outside (where fairing bends it), low enough that every triangle is within
+    aspect 5. A well-shaped triangular hole keeps its one triangle."""
+    vertices, triangles = meshgen.icosphere(3)
+    a, b, c = triangles[0]
+    middle = 0.5 * (vertices[a] + vertices[b])
+    vertices[c] += 0.85 * (middle - vertices[c])  # c slides towards edge ab, on the sphere
+    vertices[c] /= np.linalg.norm(vertices[c])
+    holed = np.delete(triangles, 0, axis=0)
+    assert ref.aspect_ratios(vertices, triangles[:1])[0] > 6.5
+    for options in ({}, {"refine": True}):
+        (patch,) = edit.fill_holes(vertices, holed, **options).patches
+        assert patch.triangles.stop - patch.triangles.start == 1
+    fair = edit.fill_holes(vertices, holed, fair=True)
+    (patch,) = fair.patches
+    assert patch.vertices.stop - patch.vertices.start == 1 and patch.triangles.stop - patch.triangles.start == 3
+    assert ref.aspect_ratios(fair.vertices, fair.triangles[patch.triangles]).max() <= 5
+    lifted = fair.vertices[patch.vertices.start]
+    centroid = vertices[[a, b, c]].mean(axis=0)
+    normal = np.cross(vertices[b] - vertices[a], vertices[c] - vertices[a])
+    rise = np.dot(lifted - centroid, normal / np.linalg.norm(normal))
+    assert np.allclose(lifted - centroid, rise * normal / np.linalg.norm(normal))  # straight above
+    assert np.dot(normal, centroid) > 0 and 0 < rise < np.linalg.norm(vertices[a] - vertices[b])
+    assert summary(fair.vertices, fair.triangles)[:4] == (1, 0, True, True)
+    # A well-shaped hole: the faired patch is its own triangle, as the flat one.
+    sphere, sphere_triangles = meshgen.icosphere(3)
+    good = edit.fill_holes(sphere, np.delete(sphere_triangles, 0, axis=0), fair=True)
+    assert good.patches[0].triangles.stop - good.patches[0].triangles.start == 1
+
+
 # --- remove a handle ------------------------------------------------------------------------------------
 
 def test_remove_handle_torus_both_ways(tmp_path):

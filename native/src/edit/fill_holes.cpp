@@ -14,6 +14,9 @@ namespace topstoc {
 
 namespace {
 
+// The worst aspect ratio a faired patch's triangle may have before lift_slivers reshapes it.
+constexpr double kMaxFairedAspect = 5.0;
+
 std::string hole_name(size_t h) { return "hole " + std::to_string(h); }
 
 uint64_t pair_key(int32_t a, int32_t b) {
@@ -305,7 +308,7 @@ class HoleFilling {
       if (options.refine || options.fair) {
         PatchMesh patch{p.hole.points, patches[h].added_points, patches[h].triangles};
         refine_patch(patch, p.ring, p.hole.forbidden);
-        if (options.fair) fair_patch(patch, p.ring);
+        if (options.fair) fair_patch(patch, p.ring), lift_slivers(patch, p.ring, kMaxFairedAspect);
         patches[h].added_points = std::move(patch.added);
         patches[h].triangles = std::move(patch.triangles);
       }

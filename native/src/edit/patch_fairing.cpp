@@ -5,6 +5,7 @@
 #include <unordered_map>
 
 #include "core/portable.hpp"
+#include "topstoc/core/quality.hpp"
 
 namespace topstoc {
 
@@ -220,6 +221,83 @@ void fair_patch(PatchMesh& patch, const PatchRing& ring) {
       rr = next_rr;
     }
     for (int32_t j = 0; j < free_count; ++j) patch.added[3 * size_t(j) + axis] = x[j];
+  }
+}
+
+namespace {
+
+double aspect(const Vec& a, const Vec& b, const Vec& c) { return aspect_ratio(a.data(), b.data(), c.data()); }
+
+// Lifting the centroid g of triangle abc to g + h n (n its unit normal) and joining it to the
+// corners: the worst aspect of the three triangles.
+struct Lift {
+  Vec a, b, c, centre, normal;
+  double worst(double h) const {
+    const Vec p{centre[0] + h * normal[0], centre[1] + h * normal[1], centre[2] + h * normal[2]};
+    return std::max({aspect(a, b, p), aspect(b, c, p), aspect(c, a, p)});
+  }
+  // The height with the least worst aspect: sampled up to twice the longest side (the worst
+  // aspect only grows beyond), then refined around the best sample.
+  double best_height() const {
+    double step = 2 * std::max({norm(sub(a, b)), norm(sub(b, c)), norm(sub(c, a))}) / 64, best_h = 0;
+    double best = worst(0);
+    for (int i = 1; i <= 64; ++i)
+      if (const double w = worst(i * step); w < best) best = w, best_h = i * step;
+    for (int round = 0; round < 20; ++round) {
+      step *= 0.5;
+      for (double h : {best_h - step, best_h + step})
+        if (const double w = worst(h); h > 0 && w < best) best = w, best_h = h;
+    }
+    return best_h;
+  }
+  // The height nearest `wanted` (never above the best height: higher only bulges more and
+  // shapes worse) whose worst aspect is within max_aspect, by bisection towards the best
+  // height; the best height when none is. A small margin keeps a recomputation within too.
+  double height_near(double wanted, double max_aspect) const {
+    const double best_h = best_height(), limit = max_aspect * (1 - 1e-9);
+    double good = best_h, bad = std::min(wanted, best_h);
+    if (worst(bad) <= limit || !(worst(good) <= limit)) return worst(bad) <= limit ? bad : good;
+    for (int round = 0; round < 40; ++round) {
+      const double middle = 0.5 * (good + bad);
+      (worst(middle) <= limit ? good : bad) = middle;
+    }
+    return good;
+  }
+};
+
+}  // namespace
+
+void lift_slivers(PatchMesh& patch, const PatchRing& ring, double max_aspect) {
+  const int32_t k = static_cast<int32_t>(patch.boundary.size() / 3);
+  std::vector<Lift> lifts;
+  const size_t first = patch.added.size(), count = patch.triangles.size();
+  for (size_t t = 0; t < count; ++t) {
+    const auto tri = patch.triangles[t];
+    const Vec a = position(patch, tri[0]), b = position(patch, tri[1]), c = position(patch, tri[2]);
+    const Vec normal = cross(sub(b, a), sub(c, a));
+    const double own = aspect(a, b, c), length = norm(normal);
+    if (!(own > max_aspect) || !(length > 0)) continue;
+    const Vec g{(a[0] + b[0] + c[0]) / 3, (a[1] + b[1] + c[1]) / 3, (a[2] + b[2] + c[2]) / 3};
+    const Lift lift{a, b, c, g, {normal[0] / length, normal[1] / length, normal[2] / length}};
+    if (!(lift.worst(lift.best_height()) < own)) continue;  // a needle too thin for one vertex: left as is
+    const int32_t id = k + static_cast<int32_t>(patch.added.size() / 3);
+    patch.added.insert(patch.added.end(), g.begin(), g.end());
+    patch.triangles[t] = {tri[0], tri[1], id};
+    patch.triangles.push_back({tri[1], tri[2], id});
+    patch.triangles.push_back({tri[2], tri[0], id});
+    lifts.push_back(lift);
+  }
+  if (lifts.empty()) return;
+  // Each new vertex goes where the fairing puts it above or below its triangle (the surface's
+  // continuation), or as near there as keeps its triangles within max_aspect. The others stay.
+  PatchMesh faired = patch;
+  fair_patch(faired, ring);
+  for (size_t j = 0; j < lifts.size(); ++j) {
+    const Lift& lift = lifts[j];
+    double rise = 0;
+    for (int i = 0; i < 3; ++i) rise += (faired.added[first + 3 * j + i] - lift.centre[i]) * lift.normal[i];
+    const double height = std::copysign(lift.height_near(std::abs(rise), max_aspect), rise);
+    for (int i = 0; i < 3; ++i) patch.added[first + 3 * j + i] = lift.centre[i] + height * lift.normal[i];
   }
 }
 

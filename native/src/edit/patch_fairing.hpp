@@ -36,4 +36,10 @@ void refine_patch(PatchMesh& patch, const PatchRing& ring, const ForbiddenDiagon
 /// boundary and ring fixed; conjugate gradients on the normal equations.
 void fair_patch(PatchMesh& patch, const PatchRing& ring);
 
+/// Splits every patch triangle of aspect above max_aspect (a sliver: a faired patch of a small
+/// hole can be the hole's own triangle) at its centroid, and lifts the new vertex off the
+/// sliver's plane to the side fairing bends it, to where its three triangles are within
+/// max_aspect, or as near as they get. A patch within max_aspect is left as it is.
+void lift_slivers(PatchMesh& patch, const PatchRing& ring, double max_aspect);
+
 }  // namespace topstoc
