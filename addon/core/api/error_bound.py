@@ -144,26 +144,16 @@ def search_vertex_count(mesh, max_error: float, decimate_at: Callable[[int], obj
     probe = _Probes(mesh, original, bound, decimate_at, progress)
 
     lo, hi = _bracket(probe, active, resolution)
+    if not check_passes:
+        lo, hi = _bisect(probe, lo, hi, resolution)  # on the estimate alone
     # The estimate passes hi: check it exactly. Should the check fail, its far point joins the
-    # estimate's points, the next target above that the estimate still passes is checked, and
-    # the rest of the search runs on exact checks (up to the full count, which always passes:
-    # its decimation is the input itself).
-    if check_passes:  # every target the estimate passes is checked exactly at once
-        if hi != active and not probe(hi, exact=True):
-            lo, hi = hi, active
-        lo, hi = _bisect(probe.judge, lo, hi, resolution)
-    else:
-        lo, hi = _bisect(probe, lo, hi, resolution)
-        # The estimate passes hi: check it exactly. Should the check fail, its far point joins the
-        # estimate's points, the next target above that the estimate still passes is checked, and
-        # the rest of the search runs on exact checks.
-        if hi != active and not probe(hi, exact=True):
-            while True:
-                lo = hi
-                hi = next((n for n in sorted(probe.results) if n > lo and probe(n)), active)
-                if hi == active or probe(hi, exact=True):
-                    break
-            lo, hi = _bisect(lambda n: probe(n, exact=True), lo, hi, resolution)
+    # estimate's points and the next probed target above that the estimate still passes is
+    # checked (up to the full count, which always passes: its decimation is the input itself).
+    while hi != active and not probe(hi, exact=True):
+        lo = hi
+        hi = next((n for n in sorted(probe.results) if n > lo and probe(n)), active)
+    # then on to the resolution on exact checks (the estimate first with check_passes)
+    lo, hi = _bisect(probe.judge if check_passes else lambda n: probe(n, exact=True), lo, hi, resolution)
     if hi not in probe.results:
         probe(hi, exact=True)  # the full count: only reached when every smaller target failed
     result, error, passed = probe.results[hi]
