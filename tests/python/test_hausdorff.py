@@ -303,6 +303,23 @@ def test_error_bounded_decimation_meets_the_bound_with_a_minimal_count(data_dir,
     assert again.symmetric.max_upper >= report.failed_error * (1 - 1e-12)
 
 
+def test_error_bounded_search_decimates_few_targets_and_stays_minimal(data_dir):
+    # fandisk at 0.3 % in quality mode: the bisection on the estimate followed by exact checks
+    # decimated 14 targets; the predicted bracket and exact checks of passing targets decimate 9
+    vertices, triangles = read_off(data_dir / "genus0/cgal_fandisk.off")
+    mesh = topstoc.Mesh(vertices, triangles)
+    result = mesh.decimate(max_error=0.003, relative=True, seed=1)
+    report = result.error_bound
+    assert len({target for target, *_ in report.probes}) <= 11
+    check = topstoc.hausdorff(mesh, result, samples=200_000, percentile=0)
+    assert check.symmetric.max <= report.max_error * (1 + 1e-12)
+    # minimal: one resolution fewer vertices measures above the bound, exactly
+    assert report.failed_target == report.target_vertices - report.resolution
+    below = mesh.decimate(target_vertices=report.failed_target, seed=1)
+    again = topstoc.hausdorff(mesh, below, samples=200_000, percentile=0)
+    assert again.symmetric.max_upper > report.max_error * (1 - EXACT_GAP)
+
+
 def test_error_bounded_search_reports_progress_and_cancels(eight):
     mesh = topstoc.Mesh(*eight)
     seen = []

@@ -232,7 +232,8 @@ def run_job(mesh: Mesh, job: DecimationJob, progress=None) -> DecimateResult:
         from .error_bound import search_vertex_count
 
         result, report = search_vertex_count(mesh, job.target.max_error, lambda count: run_job(mesh, job.at(count)),
-                                             relative=job.target.relative, progress=progress)
+                                             relative=job.target.relative, progress=progress,
+                                             check_passes=job.mode == "quality")
         return dataclasses.replace(result, error_bound=report, parameters={
             **result.parameters, "max_error": job.target.max_error, "relative": job.target.relative})
     layout, floods = mesh.layout_and_floods(job.regions, job.borders, job.feature_angle)

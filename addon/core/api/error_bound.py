@@ -1,15 +1,17 @@
 """Error-bounded decimation (docs/design.md §2.11): the fewest vertices whose symmetric Hausdorff error stays
 under a bound.
 
-A re-decimation of a prepared mesh costs milliseconds, so the search simply tries vertex
-targets: it brackets the answer by factors of four, then bisects (geometrically) until the
-smallest passing target and the largest failing one are within the resolution. Every probe
-uses the same seed and the original's one measurement surface (its closest-point index built
-once), so the search is reproducible. The search runs on a cheap estimate first: the largest
-distance over about 40,000 points spread on both surfaces (attained, so a probe above the bound
-fails for certain). Only the answer is then checked exactly
+The search tries vertex targets. It brackets the answer by extrapolating the power law error ~
+c * count^-a through its last two probes (a = 1 at first, as for a surface), then bisects
+(geometrically) until the smallest passing target and the largest failing one are within the
+resolution. Every
+probe uses the same seed and the original's one measurement surface (its closest-point index
+built once), so the search is reproducible. A probe is judged on a cheap estimate first: the
+largest distance over about 40,000 points spread on both surfaces (attained, so a probe above the
+bound fails for certain). A passing target is checked exactly
 (topstoc.core.error_estimate.decide_error: the guaranteed bracket of the exact maximum, refined
-only as far as deciding the bound needs). Should it fail, the point it found too far joins the
+only as far as deciding the bound needs): at once with ``check_passes`` (quality mode, where a
+decimation costs more than a check), else only the answer. A failed check's far point joins the
 estimate's points and the search goes on above it. Error need not fall monotonically with the vertex count (each count draws other
 samples); the guarantee is the one the search can check: the returned decimation's error is
 within the bound (a guaranteed upper bound of its exact maximum), and the target
@@ -82,13 +84,36 @@ class _Probes:
             raise Cancelled("the error-bounded search was cancelled")
         return passed
 
+    def judge(self, n: int) -> bool:
+        """The estimate first (above the bound fails for certain), then the exact check."""
+        return self(n) and self(n, exact=True)
 
-def _bisect(probe: _Probes, lo: int, hi: int, resolution: float, exact: bool) -> tuple:
-    """Narrows (lo fails, hi passes) until within the resolution."""
+
+def _bracket(probe: _Probes, active: int, resolution: float) -> tuple:
+    """A failing and a passing target on the estimate (lo 0: none below fails; hi ``active``: the
+    full count, never probed). Each step extrapolates the power law through the last two probes (a
+    first guess of error ~ 1/count, as for a surface) and aims a quarter past the bound."""
+    lo, hi, n, previous = 0, active, min(active, max(4, active // 64)), None
+    while (lo == 0 or hi == active) and hi - lo > resolution_count(hi, resolution) and hi > 4:
+        passed = probe(n)
+        lo, hi = (lo, n) if passed else (n, hi)
+        error, slope = probe.results[n][1], 1.0
+        if previous is not None and error > 0 and probe.results[previous][1] > 0 and error != probe.results[previous][1]:
+            slope = math.log(probe.results[previous][1] / error) / math.log(n / previous)
+            slope = min(max(slope, 0.25), 4.0)
+        step = (error / probe.bound) ** (1 / slope) if error > 0 and probe.bound > 0 else 0.25
+        step = min(max(step * (0.8 if passed else 1.25), 1 / 16), 16)
+        previous, n = n, min(max(int(round(n * step)), lo + 1, 1), hi - 1)
+    return lo, hi
+
+
+def _bisect(judge: Callable[[int], bool], lo: int, hi: int, resolution: float) -> tuple:
+    """Narrows (lo fails, hi passes by ``judge``) geometrically until within the resolution. (The
+    error's plateaus and noise near the bound defeat interpolation: it probed more than this.)"""
     while hi - lo > resolution_count(hi, resolution):
         mid = int(round(math.sqrt(lo * hi))) if lo > 0 else hi // 2
         mid = min(max(mid, lo + 1), hi - 1)
-        if probe(mid, exact):
+        if judge(mid):
             hi = mid
         else:
             lo = mid
@@ -96,13 +121,16 @@ def _bisect(probe: _Probes, lo: int, hi: int, resolution: float, exact: bool) ->
 
 
 def search_vertex_count(mesh, max_error: float, decimate_at: Callable[[int], object], *,
-                        relative: bool = False, resolution: float = 0.01, progress=None):
+                        relative: bool = False, resolution: float = 0.01, check_passes: bool = False,
+                        progress=None):
     """Finds the smallest vertex target whose decimation has symmetric error <= max_error.
 
     mesh: the prepared topstoc.Mesh; decimate_at(n): its decimation with n target vertices
     (fixed seed and options). relative: max_error is a fraction of the bounding-box diagonal
     (0.01 = 1 %). resolution: stop when the failing and passing targets differ by at most
-    ``max(1, resolution * target)``. progress: ``progress(probe, target, vertices, error,
+    ``max(1, resolution * target)``. check_passes: check every target the estimate passes exactly
+    at once (fewer decimations, more exact checks: for when a decimation costs more than a check)
+    rather than only the answer. progress: ``progress(probe, target, vertices, error,
     passed)`` after every probe; False stops the search with ``Cancelled``.
     Returns (DecimateResult, ErrorBoundReport).
     """
@@ -115,41 +143,17 @@ def search_vertex_count(mesh, max_error: float, decimate_at: Callable[[int], obj
     active = report.input_vertices - report.isolated_vertices
     probe = _Probes(mesh, original, bound, decimate_at, progress)
 
-    # Bracket: lo fails (0 = nothing below tried), hi passes (the full vertex count always does:
-    # its decimation is the input itself).
-    lo, hi = 0, active
-    n = min(active, max(4, active // 64))
-    if probe(n):
-        hi = n
-        while hi > 4:
-            n = max(1, hi // 4)
-            if probe(n):
-                hi = n
-            else:
-                lo = n
-                break
-    else:
-        lo = n
-        while True:
-            n = min(active, 4 * lo)
-            if n == active:
-                break
-            if probe(n):
-                hi = n
-                break
-            lo = n
+    lo, hi = _bracket(probe, active, resolution)
+    if not check_passes:
+        lo, hi = _bisect(probe, lo, hi, resolution)  # on the estimate alone
     # The estimate passes hi: check it exactly. Should the check fail, its far point joins the
-    # estimate's points, the next target above that the estimate still passes is checked, and
-    # the rest of the search runs on exact checks (up to the full count, which always passes:
-    # its decimation is the input itself).
-    lo, hi = _bisect(probe, lo, hi, resolution, exact=False)
-    if hi != active and not probe(hi, exact=True):
-        while True:
-            lo = hi
-            hi = next((n for n in sorted(probe.results) if n > lo and probe(n)), active)
-            if hi == active or probe(hi, exact=True):
-                break
-        lo, hi = _bisect(probe, lo, hi, resolution, exact=True)
+    # estimate's points and the next probed target above that the estimate still passes is
+    # checked (up to the full count, which always passes: its decimation is the input itself).
+    while hi != active and not probe(hi, exact=True):
+        lo = hi
+        hi = next((n for n in sorted(probe.results) if n > lo and probe(n)), active)
+    # then on to the resolution on exact checks (the estimate first with check_passes)
+    lo, hi = _bisect(probe.judge if check_passes else lambda n: probe(n, exact=True), lo, hi, resolution)
     if hi not in probe.results:
         probe(hi, exact=True)  # the full count: only reached when every smaller target failed
     result, error, passed = probe.results[hi]
