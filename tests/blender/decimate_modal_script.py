@@ -12,27 +12,11 @@ import addon_utils
 import bpy
 
 sys.path.insert(0, os.environ["TOPSTOC_BUILD_PYTHON"])
-failures = []
-state = {}
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from windowed_steps import Checks, view3d  # noqa: E402
 
-
-def check(name, ok, detail=""):
-    print(f"decimate check {name}: {'ok' if ok else 'FAILED'}" + ("" if ok or not detail else f" ({detail})"),
-          flush=True)
-    if not ok:
-        failures.append(name)
-
-
-def finish():
-    sys.stdout.flush()
-    os._exit(1 if failures else 0)
-
-
-def view3d():
-    window = bpy.context.window_manager.windows[0]
-    area = next(a for a in window.screen.areas if a.type == "VIEW_3D")
-    region = next(r for r in area.regions if r.type == "WINDOW")
-    return window, area, region
+checks = Checks("decimate")
+check = checks.check
 
 
 def mesh_state(mesh):
@@ -178,17 +162,6 @@ def steps():
     check("the header is cleared after the bake", shown[-1] is None, shown[-3:])
 
 
-def run():
-    try:
-        return next(state["steps"])
-    except StopIteration:
-        finish()
-    except Exception:
-        traceback.print_exc()
-        failures.append("exception")
-        finish()
-
-
 try:
     addon_utils.enable("topstoc", default_set=True)
     for obj in list(bpy.data.objects):
@@ -197,8 +170,7 @@ try:
     decimate = sys.modules["topstoc.blender.operators.decimate"]
     background = sys.modules["topstoc.blender.decimation.background"]
     cache = sys.modules["topstoc.blender.preview.cache"]
-    state["steps"] = steps()
-    bpy.app.timers.register(run, first_interval=1.0)
+    checks.drive(steps())
 except Exception:
     traceback.print_exc()
     os._exit(1)

@@ -11,27 +11,11 @@ import addon_utils
 import bpy
 
 sys.path.insert(0, os.environ["TOPSTOC_BUILD_PYTHON"])
-failures = []
-state = {}
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from windowed_steps import Checks, view3d  # noqa: E402
 
-
-def check(name, ok, detail=""):
-    print(f"preview check {name}: {'ok' if ok else 'FAILED'}" + ("" if ok or not detail else f" ({detail})"),
-          flush=True)
-    if not ok:
-        failures.append(name)
-
-
-def finish():
-    sys.stdout.flush()
-    os._exit(1 if failures else 0)
-
-
-def view3d():
-    window = bpy.context.window_manager.windows[0]
-    area = next(a for a in window.screen.areas if a.type == "VIEW_3D")
-    region = next(r for r in area.regions if r.type == "WINDOW")
-    return window, area, region
+checks = Checks("preview")
+check = checks.check
 
 
 def steps():
@@ -334,26 +318,13 @@ def apply_steps(window, area, region, cx, cy):
         sessions.PreviewSession.__init__ = original_init
 
 
-def run():
-    try:
-        delay = next(state["steps"])
-        return delay
-    except StopIteration:
-        finish()
-    except Exception:
-        traceback.print_exc()
-        failures.append("exception")
-        finish()
-
-
 try:
     addon_utils.enable("topstoc", default_set=True)
     bpy.ops.mesh.primitive_torus_add(major_segments=96, minor_segments=48)
     sessions = sys.modules["topstoc.blender.preview.session"]
     sessions.prepared_meshes_clear = sys.modules["topstoc.blender.preview.cache"].prepared_meshes.clear
     operators = sys.modules["topstoc.blender.operators.preview"]
-    state["steps"] = steps()
-    bpy.app.timers.register(run, first_interval=1.0)
+    checks.drive(steps())
 except Exception:
     traceback.print_exc()
     os._exit(1)
