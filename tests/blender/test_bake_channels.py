@@ -1,10 +1,12 @@
-"""The source's image-textured Roughness and Metallic baked onto a 5 % LOD that gets a UV map of its
-own (blender/decimation/bake_channels.py, with Bake Colour): a Suzanne without UV map whose
-material reads both from procedural images over its generated coordinates. After Guided Decimate,
+"""The source's image-textured Roughness, Metallic and Emission colour baked onto a 5 % LOD that gets a
+UV map of its own (blender/decimation/bake_channels.py, with Bake Colour): a Suzanne without UV map
+whose material reads them from procedural images over its generated coordinates. After Guided Decimate,
 the LOD's material reads each from a baked image on its own map whose values at points of the
 LOD's faces match the source's texture at the closest source points; the source's material comes
 back node for node; a failed channel bake leaves nothing behind.
 """
+
+import os
 
 import bpy
 import numpy as np
@@ -12,10 +14,11 @@ import pytest
 from mathutils.bvhtree import BVHTree
 
 from helpers import positions, select_only
-from test_bake_colour_batch import face_samples
+from test_bake_colour_batch import face_samples, srgb_to_linear
 from test_bake_normals import importlib_module, subdivided
 
 TEXTURE_SIZE = 64
+EMISSION = "Emission Color" if bpy.app.version >= (4, 0, 0) else "Emission"
 
 
 def roughness_of(generated):
@@ -28,10 +31,19 @@ def metallic_of(generated):
     return 0.5 + 0.4 * np.sin(2 * np.pi * 2 * generated[:, 1])
 
 
-def procedural_image(name, function):
-    """A TEXTURE_SIZE² Non-Color float image holding ``function`` of its texel centres' (u, v)."""
+def emission_of(generated):
+    """The emission image's grey (linear) at generated coordinates (a product of both)."""
+    return 0.2 + 0.6 * generated[:, 0] * generated[:, 1]
+
+
+CHANNELS = (("Roughness", roughness_of), ("Metallic", metallic_of), (EMISSION, emission_of))
+
+
+def procedural_image(name, function, data=True):
+    """A TEXTURE_SIZE² float image (Non-Color with ``data``, else linear colour) holding ``function`` of its texel centres' (u, v)."""
     image = bpy.data.images.new(name, TEXTURE_SIZE, TEXTURE_SIZE, alpha=False, float_buffer=True)
-    image.colorspace_settings.name = "Non-Color"
+    if data:
+        image.colorspace_settings.name = "Non-Color"
     centres = (np.arange(TEXTURE_SIZE) + 0.5) / TEXTURE_SIZE
     v, u = np.meshgrid(centres, centres, indexing="ij")
     value = function(np.stack([u.ravel(), v.ravel()], axis=1))
@@ -42,8 +54,8 @@ def procedural_image(name, function):
 
 
 def textured_suzanne():
-    """Suzanne subdivided three times, smooth, without UV map; its Principled BSDF's Roughness and
-    Metallic read from procedural images over the generated coordinates."""
+    """Suzanne subdivided three times, smooth, without UV map; its Principled BSDF's Roughness,
+    Metallic and Emission colour read from procedural images over the generated coordinates."""
     bpy.ops.mesh.primitive_monkey_add()
     monkey = subdivided(bpy.context.active_object, 3)
     monkey.name = "textured"
@@ -56,9 +68,9 @@ def textured_suzanne():
     tree = material.node_tree
     shader = next(n for n in tree.nodes if n.type == "BSDF_PRINCIPLED")
     coordinates = tree.nodes.new("ShaderNodeTexCoord")
-    for name, function in (("Roughness", roughness_of), ("Metallic", metallic_of)):
+    for name, function in CHANNELS:
         node = tree.nodes.new("ShaderNodeTexImage")
-        node.image, node.extension = procedural_image(name.lower(), function), "EXTEND"
+        node.image, node.extension = procedural_image(name.split()[0].lower(), function, name != EMISSION), "EXTEND"
         tree.links.new(coordinates.outputs["Generated"], node.inputs["Vector"])
         tree.links.new(node.outputs["Color"], shader.inputs[name])
     monkey.data.materials.append(material)
@@ -130,7 +142,7 @@ def decimate_with_channels(source):
     return lod
 
 
-def test_guided_decimate_bakes_roughness_and_metallic(ts, scene):
+def test_guided_decimate_bakes_the_textured_channels(ts, scene):
     source = textured_suzanne()
     material = source.material_slots[0].material
     before = tree_snapshot(material)
@@ -139,21 +151,22 @@ def test_guided_decimate_bakes_roughness_and_metallic(ts, scene):
     assert len(lod.data.polygons) < len(source.data.polygons) / 10
     lod_material = lod.material_slots[0].material
     assert lod_material is not material
-    for name, function in (("Roughness", roughness_of), ("Metallic", metallic_of)):
+    for name, function in CHANNELS:
         wired = input_image(lod_material, name)
         assert wired is not None, f"the LOD's {name} reads no baked image"
         node, uv_map = wired
-        assert node.image.colorspace_settings.name == "Non-Color" and tuple(node.image.size) == (256, 256)
-        assert node.image.packed_file is not None and node.image.name == f"{lod.name}_{name.lower()}"
+        data = name != EMISSION
+        assert (node.image.colorspace_settings.name == "Non-Color") == data and tuple(node.image.size) == (256, 256)
+        assert node.image.packed_file is not None and node.image.name == f"{lod.name}_{name.split()[0].lower()}"
         points, uvs, _, _ = face_samples(lod.data, uv_map)
-        baked = sample(node.image, uvs)
+        baked = sample(node.image, uvs) if data else srgb_to_linear(sample(node.image, uvs))
         expected = function(generated(source.data, closest_source_points(source, points)))
         error = np.abs(baked - expected)
         print(f"{name}: baked range {baked.min():.3f}..{baked.max():.3f}, mean error {error.mean():.4f}, "
               f"95th percentile {np.percentile(error, 95):.4f}, over 0.1 {(error > 0.1).mean():.4f} of {len(error)}")
-        assert np.ptp(baked) > 0.6                                # the texture, not a flat value
-        assert error.mean() < 0.015                               # measured 0.0022, 0.0054 (bpy 4.5)
-        assert np.percentile(error, 95) < 0.03                    # measured 0.0016, 0.0088 (bpy 4.5)
+        assert np.ptp(baked) > 0.5                                # the texture, not a flat value
+        assert error.mean() < 0.015                               # measured 0.0022, 0.0054, 0.0018 (bpy 4.5)
+        assert np.percentile(error, 95) < 0.03                    # measured 0.0016, 0.0088, 0.0021 (bpy 4.5)
 
 
 def test_a_failed_channel_bake_leaves_nothing(ts, scene, monkeypatch):
@@ -186,8 +199,63 @@ def test_a_failed_channel_bake_leaves_nothing(ts, scene, monkeypatch):
 def test_only_image_textured_channels_are_baked(ts, scene):
     channels = importlib_module(ts, "blender.decimation.bake_channels")
     source = textured_suzanne()
-    assert [kind for kind, _, _ in channels.textured_channels(source)] == ["roughness", "metallic"]
+    assert [kind for kind, _, _ in channels.textured_channels(source)] == ["roughness", "metallic", "emission"]
     shader = next(n for n in source.material_slots[0].material.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
     tree = source.material_slots[0].material.node_tree
     tree.links.remove(shader.inputs["Metallic"].links[0])
-    assert [kind for kind, _, _ in channels.textured_channels(source)] == ["roughness"]
+    assert [kind for kind, _, _ in channels.textured_channels(source)] == ["roughness", "emission"]
+
+
+def test_batch_writes_the_channels_beside_a_gltf(ts, scene, tmp_path):
+    """``--bake-colour`` in the batch: the roughness and metallic PNGs next to the output as
+    ``<stem>_<object>_<channel>.png`` (Non-Color values within the texture's range), and the glTF's
+    material gets a metallicRoughnessTexture Blender's exporter combines from them."""
+    import json
+    import subprocess
+
+    from test_batch_formats import _runner
+
+    source = textured_suzanne()
+    for node in source.material_slots[0].material.node_tree.nodes:
+        if node.type == "TEX_IMAGE":
+            node.image.pack()  # the batch's Blender reads the source's textures from the .blend
+    blend = tmp_path / "textured.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend), copy=True)
+    out, report = tmp_path / "out", tmp_path / "report.json"
+    command = importlib_module(ts, "core.batch.run").blender_command(_runner()) + [
+        "--input", str(blend), "--output", str(out), "--json", str(report), "--ratio", "0.05",
+        "--format", "gltf", "--bake-normals", "256", "--bake-colour"]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=600)
+    if done.returncode and "Cycles baked no colour" in done.stderr:
+        pytest.skip(f"Blender {bpy.app.version_string}'s Cycles bakes no colour selected-to-active")
+    assert done.returncode == 0, done.stderr[-2000:]
+    [lod] = json.loads(report.read_text())["results"][0]["objects"][0]["lods"]
+    for kind, function in (("roughness", roughness_of), ("metallic", metallic_of)):
+        assert lod[f"{kind}_map"] == str(out / f"textured_textured_{kind}.png")
+        written = bpy.data.images.load(lod[f"{kind}_map"])
+        written.colorspace_settings.name = "Non-Color"
+        pixels = np.empty(len(written.pixels), dtype=np.float32)
+        written.pixels.foreach_get(pixels)
+        values = pixels.reshape(-1, written.channels)[:, 0]
+        expected = function(generated(source.data, positions(source.data).astype(np.float64)))
+        covered = values[values > 0.01]  # texels the bake reached (the rest stays black)
+        low, high = np.percentile(covered, [1, 99])  # the island edges' texels blend in the black
+        print(f"{kind}: texels' 1st-99th percentiles {low:.3f}..{high:.3f}, the texture's range "
+              f"{expected.min():.3f}..{expected.max():.3f}")
+        assert expected.min() - 0.02 < low < expected.min() + 0.1 and expected.max() - 0.1 < high < expected.max() + 0.02
+        assert np.ptp(covered) > 0.6
+    assert not [name for name in os.listdir(out) if name.startswith(".topstoc-")]
+    gltf = json.loads((out / "textured.gltf").read_text())
+    [material] = gltf["materials"]
+    print("glTF material:", json.dumps(material), "images:", [i.get("uri") for i in gltf.get("images", [])])
+    reference = material["pbrMetallicRoughness"]["metallicRoughnessTexture"]
+    uri = gltf["images"][gltf["textures"][reference["index"]]["source"]]["uri"]
+    combined = bpy.data.images.load(str(out / uri))  # Blender's exporter packs G = roughness, B = metallic
+    combined.colorspace_settings.name = "Non-Color"
+    for channel, kind in ((1, "roughness"), (2, "metallic")):
+        single = bpy.data.images.load(lod[f"{kind}_map"], check_existing=True)
+        single.colorspace_settings.name = "Non-Color"
+        a, b = (np.empty(len(i.pixels), dtype=np.float32) for i in (combined, single))
+        combined.pixels.foreach_get(a)
+        single.pixels.foreach_get(b)
+        assert np.abs(a.reshape(-1, combined.channels)[:, channel] - b.reshape(-1, single.channels)[:, 0]).max() < 1 / 255
