@@ -259,3 +259,34 @@ def test_batch_writes_the_channels_beside_a_gltf(ts, scene, tmp_path):
         combined.pixels.foreach_get(a)
         single.pixels.foreach_get(b)
         assert np.abs(a.reshape(-1, combined.channels)[:, channel] - b.reshape(-1, single.channels)[:, 0]).max() < 1 / 255
+
+
+def test_cancel_and_removal_take_the_channel_maps_too(ts, scene, monkeypatch):
+    """Cancelled between two channels (Esc), the bake leaves the LOD, the images and the source's
+    material as they were; a finished bake's result removed (a cancelled multi-object run) takes
+    its channel images with it."""
+    from test_bake_normals import decimated
+
+    bake = importlib_module(ts, "blender.decimation.bake")
+    raycast = importlib_module(ts, "blender.decimation.bake_raycast")
+    source = textured_suzanne()
+    lod = decimated(ts, source, "lod")
+    material = source.material_slots[0].material
+    monkeypatch.setattr(bake.bake_colour, "is_blank", lambda image: False)  # Cycles 3.4 bakes no colour
+    before = ([slot.material for slot in lod.material_slots], [layer.name for layer in lod.data.uv_layers],
+              set(bpy.data.images), {m.name for m in bpy.data.materials}, tree_snapshot(material))
+    baked = []
+    real = bake.bake_channels.run_emit_bake
+    monkeypatch.setattr(bake.bake_channels, "run_emit_bake", lambda *args: (baked.append(1), real(*args)))
+    with pytest.raises(raycast.Cancelled):
+        bake.bake_normals(bpy.context, source, lod, size=64, margin=2, colour=True,
+                          progress=lambda fraction: len(baked) < 2)
+    assert len(baked) == 2                                        # roughness and metallic were baked
+    assert ([slot.material for slot in lod.material_slots], [layer.name for layer in lod.data.uv_layers],
+            set(bpy.data.images), {m.name for m in bpy.data.materials}, tree_snapshot(material)) == before
+    result = bake.bake_normals(bpy.context, source, lod, size=64, margin=2, colour=True)
+    assert sorted(result.channels) == ["emission", "metallic", "roughness"]
+    assert {image.name for image in bpy.data.images} - {image.name for image in before[2]} == {
+        "lod_normal", "lod_color", "lod_roughness", "lod_metallic", "lod_emission"}
+    bake.remove_results([lod])
+    assert set(bpy.data.images) == before[2] and tree_snapshot(material) == before[-1]
