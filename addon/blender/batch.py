@@ -112,8 +112,10 @@ def _copy_armature_modifiers(source, target) -> None:
 def _bake(bpy, source, result, settings, name: str) -> dict:
     """Bakes the normal map asked for (--bake-normals) from ``source`` onto ``result`` as
     ``<output folder>/<name>_normal.png``, and with --bake-colour the base colour as
-    ``<name>_color.png`` where the result got a UV map of its own; returns the report's entries
-    (``normal_map``, ``colour_map``: its path, or None where the source's UV layout was kept)."""
+    ``<name>_color.png`` where the result got a UV map of its own, with the source's other
+    image-textured channels as ``<name>_roughness.png`` … (bake_channels.py); returns the report's
+    entries (``normal_map``, ``colour_map``: its path, or None where the source's UV layout was
+    kept; ``roughness_map`` … for each channel baked)."""
     from .decimation import bake
 
     size = settings["bake_normals"]
@@ -123,6 +125,7 @@ def _bake(bpy, source, result, settings, name: str) -> dict:
     maps = {"normal_map": baked.path}
     if colour:
         maps["colour_map"] = baked.colour_path or None
+        maps.update({f"{kind}_map": path for kind, path in (baked.channel_paths or {}).items()})
     if baked.colour_path and settings["bake_format"] in ("gltf", "glb"):
         maps["dropped_colour_attributes"] = _drop_colour_attributes(result)
     return maps

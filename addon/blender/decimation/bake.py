@@ -24,7 +24,7 @@ from ...core.support.errors import TopStocError
 from ...core.api.hausdorff import hausdorff
 from ...core.carry.normal_bake import (MAX_OVERLAP, available_memory, check_memory, check_size, island_margin,
                                        overlap_fraction, ray_reach)
-from . import bake_colour, bake_raycast
+from . import bake_channels, bake_colour, bake_raycast
 from ..io import edge_flags, mesh_read
 from ..io.mesh_access import read_array
 
@@ -52,6 +52,8 @@ class Baked:
     path: str = ""           #: the saved file ("" when packed)
     colour: object = None    #: the base colour image (bake_colour.py), or None
     colour_path: str = ""    #: its saved file ("" when packed or not baked)
+    channels: dict = None    #: {"roughness": image, …}: the source's other image-textured channels (bake_channels.py)
+    channel_paths: dict = None  #: {"roughness": saved file, …} (empty when packed)
 
 
 def check_bakeable(source, result) -> None:
@@ -377,8 +379,9 @@ def bake_normals(context, source, result, *, size: int = 1024, margin: int = 16,
     """Bakes ``source``'s shading normals onto ``result`` (its decimated copy) as a tangent-space
     normal map of ``size``² with ``margin`` pixels of bleed. store: "PACK" (into the .blend) or
     "FILE" (``<folder>/<name>_normal.png``; by default beside the .blend, named after the result;
-    an existing file replaced only with ``replace``). ``colour``: the base colour too, where the
-    map has a UV map of its own (bake_colour.py). ``progress(fraction)`` follows the bake; its
+    an existing file replaced only with ``replace``). ``colour``: the base colour too, and every
+    other channel the source's materials feed from an image, where the map has a UV map of its own
+    (bake_colour.py, bake_channels.py; saved as ``<name>_color.png``, ``<name>_roughness.png`` …). ``progress(fraction)`` follows the bake; its
     False cancels (bake_raycast.Cancelled), leaving ``result`` as it was, like a failed bake."""
     return bake_raycast.drive(bake_normals_steps(context, source, result, size=size, margin=margin, store=store,
                                                  folder=folder, name=name, replace=replace, colour=colour),
@@ -399,7 +402,7 @@ def bake_normals_steps(context, source, result, *, size: int = 1024, margin: int
     hausdorff_max, diagonal, extrusion, max_ray = measure_reach(source, result)
     old_materials = [slot.material for slot in result.material_slots]
     old_uv = (result.data.uv_layers.active_index, [layer.name for layer in result.data.uv_layers])
-    image, made, normals, colour_image = None, [], None, None
+    image, made, normals, colour_image, channels = None, [], None, None, {}
     with _SceneState(context, source, result) as state:
         try:
             state.select([result])
@@ -417,26 +420,30 @@ def bake_normals_steps(context, source, result, *, size: int = 1024, margin: int
             if colour and unwrapped:
                 yield 1.0
                 colour_image = _bake_colour(result, made, uv_map, (extrusion, max_ray), margin, size)
+                yield from _bake_channels(source, result, made, uv_map, (extrusion, max_ray), margin, size, channels)
             if active_uv >= 0:  # the map made for the bake is not the one the user edits
                 result.data.uv_layers.active_index = active_uv
             stem = bpy.path.clean_name(name or result.name)
             path = save_image(image, folder, stem, replace) if store == "FILE" else ""
-            colour_path = ""
+            colour_path, channel_paths = "", {}
             if colour_image is not None and store == "FILE":
                 colour_path = save_image(colour_image, folder, stem, replace, kind="color")
-            for baked in (image, colour_image) if store != "FILE" else ():
+            for kind, baked in channels.items() if store == "FILE" else ():
+                channel_paths[kind] = save_image(baked, folder, stem, replace, kind=kind)
+            for baked in (image, colour_image, *channels.values()) if store != "FILE" else ():
                 if baked is not None:
                     pack_image(baked)
         except (BakeError, bake_raycast.Cancelled, GeneratorExit):
-            if colour_image is not None:
-                bpy.data.images.remove(colour_image)
+            for baked in (colour_image, *channels.values()):
+                if baked is not None:
+                    bpy.data.images.remove(baked)
             _undo_materials(result, old_materials, made, image)
             _undo_uv_map(result, *old_uv)
             restore_normals(result, normals)
             raise
     yield 1.0
     return Baked(image, uv_map, unwrapped, hausdorff_max, extrusion, max_ray, method, path, colour_image,
-                 colour_path)
+                 colour_path, channels, channel_paths)
 
 
 def _bake_colour(result, materials, uv_map: str, reach: tuple, margin: int, size: int):
@@ -455,6 +462,19 @@ def _bake_colour(result, materials, uv_map: str, reach: tuple, margin: int, size
         bpy.data.images.remove(image)
         raise BakeError(f"this Blender's Cycles baked no colour onto '{result.name}'")
     return image
+
+
+def _bake_channels(source, result, materials, uv_map: str, reach: tuple, margin: int, size: int, baked: dict):
+    """Bakes each channel the source's materials feed from an image (bake_channels.py) into
+    ``baked`` ({kind: image}, filled as they come: a failure leaves the done ones to remove)."""
+    for channel in bake_channels.textured_channels(source):
+        yield 1.0
+        try:
+            baked[channel[0]] = bake_channels.bake_channel(source, result, materials, channel, uv_map, reach,
+                                                           margin, size)
+        except RuntimeError as error:
+            raise BakeError(f"baking the {channel[0]} onto '{result.name}' failed: "
+                            f"{str(error).strip().splitlines()[-1]}") from None
 
 
 def _undo_materials(result, old_materials, made, image) -> None:
@@ -517,7 +537,7 @@ def remove_results(results) -> None:
     materials = {slot.material for obj in results for slot in obj.material_slots if slot.material is not None
                  and slot.material.node_tree and any(n.label == NODE_LABEL for n in slot.material.node_tree.nodes)}
     images = {node.image for material in materials for node in material.node_tree.nodes
-              if node.label in (NODE_LABEL, bake_colour.COLOUR_LABEL) and node.image is not None}
+              if node.label in {NODE_LABEL, bake_colour.COLOUR_LABEL, *bake_channels.LABELS} and node.image is not None}
     meshes = {obj.data for obj in results}
     for obj in results:
         bpy.data.objects.remove(obj)

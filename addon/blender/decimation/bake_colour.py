@@ -11,6 +11,8 @@ from contextlib import contextmanager
 import bpy
 import numpy as np
 
+from . import bake_channels
+
 COLOUR_LABEL = "TopStoc Base Color"
 
 
@@ -24,23 +26,7 @@ def new_colour_image(name: str, size: int) -> bpy.types.Image:
 def wire_colour(material, image, uv_map: str) -> None:
     """Feeds the Base Color of ``material``'s shader from ``image`` on ``uv_map`` (an Image Texture,
     made the active node: the bake writes into it); the link it replaces is removed."""
-    tree = material.node_tree
-    shader = next((n for n in tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
-    if shader is None:
-        return
-    texture = tree.nodes.new("ShaderNodeTexImage")
-    texture.image, texture.label = image, COLOUR_LABEL
-    texture.location = (shader.location.x - 600, shader.location.y)
-    coordinates = tree.nodes.new("ShaderNodeUVMap")
-    coordinates.uv_map = uv_map
-    coordinates.location = (shader.location.x - 800, shader.location.y)
-    tree.links.new(coordinates.outputs["UV"], texture.inputs["Vector"])
-    for link in list(shader.inputs["Base Color"].links):
-        tree.links.remove(link)
-    tree.links.new(texture.outputs["Color"], shader.inputs["Base Color"])
-    for node in tree.nodes:
-        node.select = node is texture
-    tree.nodes.active = texture
+    bake_channels.wire_channel(material, image, uv_map, ("Base Color",), COLOUR_LABEL)
 
 
 def run_colour_bake(extrusion: float, max_ray: float, margin: int, size: int) -> None:

@@ -111,8 +111,9 @@ class BakeParameters:
                              description="Pixels the map bleeds past every UV island (against seams in mipmaps)")
     bake_store: EnumProperty(name="Image", items=BAKE_STORES, default="PACK")
     bake_colour: BoolProperty(name="Bake Colour", default=False,
-                              description="Also bake the original's base colour, where the normal map gets a UV "
-                                          "map of its own (the original has none, or one with overlapping islands)")
+                              description="Also bake the original's base colour and its image-textured Roughness, "
+                                          "Metallic, Emission and Alpha, where the normal map gets a UV map of its "
+                                          "own (the original has none, or one with overlapping islands)")
 
 
 class OperatorParameters:

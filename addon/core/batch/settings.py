@@ -76,7 +76,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--bake-colour", action="store_true",
                         help="with --bake-normals: where the result gets a UV map of its own (the source's "
                              "layout is not kept), bake the source's base colour onto it too (a second PNG, "
-                             "the materials' base colour)")
+                             "the materials' base colour), and each image-textured Roughness, Metallic, "
+                             "Emission or Alpha (<name>_roughness.png ...)")
     parser.add_argument("--exact-error", action="store_true",
                         help="report each output's exact bracketed Hausdorff max (relative gap 0.1 %%) instead "
                              "of the default bounded estimate (a guaranteed upper bound within 25 %% of a "
