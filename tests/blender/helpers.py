@@ -1,5 +1,9 @@
 """Helpers for the Blender tests: build objects from numpy arrays, read them back."""
 
+import threading
+import time
+from typing import NamedTuple
+
 import bpy
 import numpy as np
 
@@ -86,3 +90,48 @@ class Params:
         self.output = "NEW_OBJECT"
         for key, value in kw.items():
             setattr(self, key, value)
+
+
+def wait_for(condition, seconds=30.0):
+    """Polls ``condition`` every 5 ms for up to ``seconds``; True as soon as it holds."""
+    end = time.perf_counter() + seconds
+    while time.perf_counter() < end:
+        if condition():
+            return True
+        time.sleep(0.005)
+    return condition()
+
+
+class EngineCall(NamedTuple):
+    mode: str
+    target: object
+    draft: bool
+    thread: str
+
+
+class EngineCalls:
+    """Wraps pipeline.run_engine: records each call (EngineCall); while ``gate`` is clear, calls
+    for which ``hold(job)`` is true wait for it (``held`` is set when one does)."""
+
+    def __init__(self, monkeypatch, pipeline, hold=lambda job: job.mode == "quality"):
+        self.calls = []
+        self.gate, self.held = threading.Event(), threading.Event()
+        self.gate.set()
+        original = pipeline.run_engine
+
+        def run_engine(mesh, job):
+            self.calls.append(EngineCall(job.mode, job.target, bool(job.draft), threading.current_thread().name))
+            if hold(job) and not self.gate.is_set():
+                self.held.set()
+                self.gate.wait(30)
+            return original(mesh, job)
+
+        monkeypatch.setattr(pipeline, "run_engine", run_engine)
+
+    def count(self, mode=None, draft=None):
+        return sum(1 for call in self.calls
+                   if (mode is None or call.mode == mode) and (draft is None or call.draft == draft))
+
+    def kinds(self, start=0):
+        """(mode, draft) of each call from ``start`` on."""
+        return [(call.mode, call.draft) for call in self.calls[start:]]

@@ -16,39 +16,7 @@ import numpy as np
 import pytest
 
 import meshgen
-from helpers import Params, make_object, positions, snapshot
-
-
-class EngineCalls:
-    """Wraps pipeline.run_engine: counts calls per mode and thread, optionally holds quality ones."""
-
-    def __init__(self, monkeypatch, pipeline):
-        self.calls = []
-        self.gate = threading.Event()
-        self.gate.set()
-        self.held = threading.Event()
-        original = pipeline.run_engine
-
-        def run_engine(mesh, job):
-            self.calls.append((job.mode, job.target, threading.current_thread().name))
-            if job.mode == "quality" and not self.gate.is_set():
-                self.held.set()
-                self.gate.wait(30)
-            return original(mesh, job)
-
-        monkeypatch.setattr(pipeline, "run_engine", run_engine)
-
-    def count(self, mode=None):
-        return sum(1 for m, _t, _thread in self.calls if mode is None or m == mode)
-
-
-def wait_for(condition, seconds=30.0):
-    end = time.perf_counter() + seconds
-    while time.perf_counter() < end:
-        if condition():
-            return True
-        time.sleep(0.005)
-    return condition()
+from helpers import EngineCalls, Params, make_object, positions, snapshot, wait_for
 
 
 def preview_threads():
@@ -79,7 +47,7 @@ def test_a_rested_quality_result_is_applied_as_shown(ts, scene, donut, monkeypat
         assert wait_for(lambda: session.poll() or session.final)  # the fast result, then the rested quality one
         assert wait_for(lambda: (session.poll(), session.final)[1]), engine.calls
         assert wait_for(lambda: not session.busy) and session.ratio == 0.1  # its attribute sources found too
-        assert [m for m, _t, _thread in engine.calls] == ["fast", "quality"]
+        assert [call.mode for call in engine.calls] == ["fast", "quality"]
         shown_vertices = positions(session.mesh).copy()
         shown_triangles = triangles_of(session.mesh)
         session.request(0.1)  # a mouse move that ends at the same ratio keeps the Quality result
@@ -151,7 +119,7 @@ def test_applying_during_a_drag_computes_the_chosen_settings_on_the_worker(ts, s
         assert time.perf_counter() - start < 0.5
         assert engine.held.wait(10) and session.applying
         assert session.poll_apply() is None  # the main thread is free while the worker computes
-        _mode, target, thread = next(call for call in engine.calls if call[0] == "quality")
+        _mode, target, _draft, thread = next(call for call in engine.calls if call.mode == "quality")
         assert target.ratio == 0.17 and thread.startswith(preview.THREAD_PREFIX)
         engine.gate.set()
         runs = []

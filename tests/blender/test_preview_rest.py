@@ -7,49 +7,15 @@ decimation at that ratio.
 The tests set the thresholds (REST_SECONDS, DIRECT_SECONDS) to 0 or to a day instead of relying
 on the machine's speed, and hold engine calls with gates where "still computing" matters."""
 
-import threading
-import time
 
 import bpy
 import numpy as np
 import pytest
 
 import meshgen
-from helpers import Params, make_object
+from helpers import EngineCalls, Params, make_object, wait_for
 
 DAY = 86400.0
-
-
-class Engine:
-    """Wraps pipeline.run_engine: records (mode, draft) per call; ``hold_drafts`` holds drafts."""
-
-    def __init__(self, monkeypatch, pipeline):
-        self.calls = []
-        self.drafts = threading.Event()
-        self.drafts.set()
-        self.draft_held = threading.Event()
-        original = pipeline.run_engine
-
-        def run_engine(mesh, job):
-            self.calls.append((job.mode, bool(job.draft)))
-            if job.draft and not self.drafts.is_set():
-                self.draft_held.set()
-                self.drafts.wait(30)
-            return original(mesh, job)
-
-        monkeypatch.setattr(pipeline, "run_engine", run_engine)
-
-    def count(self, mode=None, draft=None):
-        return sum(1 for m, d in self.calls if (mode is None or m == mode) and (draft is None or d == draft))
-
-
-def wait_for(condition, seconds=30.0):
-    end = time.perf_counter() + seconds
-    while time.perf_counter() < end:
-        if condition():
-            return True
-        time.sleep(0.005)
-    return condition()
 
 
 def shown_until(session, condition):
@@ -80,7 +46,7 @@ def drag(session, ratios):
 
 def test_the_rest_is_the_absence_of_new_ratios_and_gives_the_quality_result(ts, donut, monkeypatch):
     preview = ts.blender.preview.session
-    engine = Engine(monkeypatch, ts.blender.decimation.pipeline)
+    engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline, hold=lambda job: job.draft)
     monkeypatch.setattr(preview, "REST_SECONDS", DAY)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=4), ratio=0.1)
     try:
@@ -99,35 +65,35 @@ def test_the_rest_is_the_absence_of_new_ratios_and_gives_the_quality_result(ts, 
 @pytest.mark.skipif(__import__("os").cpu_count() < 2, reason="one preview worker: a rest waits for the draft")
 def test_a_rest_does_not_wait_for_the_draft_still_running(ts, donut, monkeypatch):
     preview = ts.blender.preview.session
-    engine = Engine(monkeypatch, ts.blender.decimation.pipeline)
+    engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline, hold=lambda job: job.draft)
     monkeypatch.setattr(preview, "REST_SECONDS", DAY)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=5), ratio=0.1)
     try:
         assert shown_until(session, lambda: session.ratio == 0.1)
-        engine.drafts.clear()
+        engine.gate.clear()
         session.request(0.2)
-        assert wait_for(engine.draft_held.is_set)  # the draft at 0.2 runs (held)
+        assert wait_for(engine.held.is_set)  # the draft at 0.2 runs (held)
         monkeypatch.setattr(preview, "REST_SECONDS", 0.0)
         assert shown_until(session, lambda: session.final)  # computed beside it
         assert_is_the_operators_result(ts, donut, session, 0.2, 5)
-        engine.drafts.set()
+        engine.gate.set()
         assert wait_for(lambda: not session.busy)
         assert not session.poll() and session.final  # the late draft is dropped, not shown over it
     finally:
-        engine.drafts.set()
+        engine.gate.set()
         session.close()
 
 
 def test_a_fast_quality_result_is_what_the_drag_shows(ts, donut, monkeypatch):
     preview = ts.blender.preview.session
-    engine = Engine(monkeypatch, ts.blender.decimation.pipeline)
+    engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline, hold=lambda job: job.draft)
     monkeypatch.setattr(preview, "DIRECT_SECONDS", DAY)  # any measured Quality time is fast enough
     params = Params(quality="QUALITY", seed=6)
     session = preview.PreviewSession(bpy.context, donut, params, ratio=0.1)
     try:
         assert not session.direct  # nothing measured yet: the first frame is a draft
         assert shown_until(session, lambda: session.final)  # then the rested Quality result
-        assert session.direct and engine.calls == [("fast", True), ("quality", False)]
+        assert session.direct and engine.kinds() == [("fast", True), ("quality", False)]
         session.request(0.15)
         assert engine.count("fast") == 1  # no draft asked: the drag asks for the result itself
         assert shown_until(session, lambda: session.ratio == 0.15)
@@ -147,7 +113,7 @@ def test_a_fast_quality_result_is_what_the_drag_shows(ts, donut, monkeypatch):
 
 def test_a_slow_quality_result_leaves_the_drag_to_drafts(ts, donut, monkeypatch):
     preview = ts.blender.preview.session
-    engine = Engine(monkeypatch, ts.blender.decimation.pipeline)
+    engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline, hold=lambda job: job.draft)
     monkeypatch.setattr(preview, "DIRECT_SECONDS", 0.0)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=7), ratio=0.1)
     try:
@@ -155,14 +121,14 @@ def test_a_slow_quality_result_leaves_the_drag_to_drafts(ts, donut, monkeypatch)
         monkeypatch.setattr(preview, "REST_SECONDS", DAY)
         session.request(0.15)
         assert shown_until(session, lambda: session.ratio == 0.15)
-        assert not session.final and engine.calls[-1] == ("fast", True)
+        assert not session.final and engine.kinds()[-1] == ("fast", True)
     finally:
         session.close()
 
 
 def test_a_ratio_rested_at_before_shows_its_kept_result_without_computing(ts, donut, monkeypatch):
     preview = ts.blender.preview.session
-    engine = Engine(monkeypatch, ts.blender.decimation.pipeline)
+    engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline, hold=lambda job: job.draft)
     monkeypatch.setattr(preview, "DIRECT_SECONDS", 0.0)  # drafts while dragging
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=8), ratio=0.1)
     try:
@@ -175,7 +141,7 @@ def test_a_ratio_rested_at_before_shows_its_kept_result_without_computing(ts, do
         session.request(0.1)  # back: a draft is asked, then the rest finds the kept result
         assert shown_until(session, lambda: session.final and session.ratio == 0.1)
         assert session.result is first and engine.count("quality") == 2
-        assert engine.calls[calls:] in ([], [("fast", True)])  # at most the draft before the rest
+        assert engine.kinds(calls) in ([], [("fast", True)])  # at most the draft before the rest
         assert_is_the_operators_result(ts, donut, session, 0.1, 8)
     finally:
         session.close()

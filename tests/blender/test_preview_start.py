@@ -13,7 +13,7 @@ import bpy
 import pytest
 
 import meshgen
-from helpers import Params, make_object, snapshot
+from helpers import Params, make_object, snapshot, wait_for
 
 
 def gated_report(monkeypatch, preview_module, hold_at):
@@ -36,15 +36,6 @@ def gated_report(monkeypatch, preview_module, hold_at):
 
 def preview_threads():
     return [t for t in threading.enumerate() if t.name.startswith("topstoc-preview")]
-
-
-def wait_for(condition, seconds=20.0):
-    end = time.perf_counter() + seconds
-    while time.perf_counter() < end:
-        if condition():
-            return True
-        time.sleep(0.005)
-    return condition()
 
 
 def test_session_returns_before_the_preparation_and_shows_the_first_result(ts, scene, monkeypatch):
