@@ -1,7 +1,9 @@
 """Batch decimation inside Blender (or PyPI's bpy): mesh files and Blender's own formats (docs/design.md §6).
 
 Mesh files (OBJ, PLY, OFF, STL, optionally .gz/.bz2) go through topstoc.core.batch.mesh_asset (the
-same code ``topstoc batch`` runs without Blender). .blend files are opened; glTF/GLB, FBX and
+same code ``topstoc batch`` runs without Blender); with --bake-normals, OBJ, PLY and STL files are
+imported with Blender's importers and go the Blender formats' way, written as OBJ (its .mtl names
+the maps) or a Blender format (mesh_asset.check_bakeable says why others are refused). .blend files are opened; glTF/GLB, FBX and
 USD are imported with Blender's importers into an empty scene. Their mesh objects (all, or
 those named with --objects) are decimated with the add-on's pipeline (the Guided Decimate
 operator's: guidance stored on the objects, UVs, colours, materials, vertex groups and
@@ -24,7 +26,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from ..core.batch import settings as batch_settings
-from ..core.batch.mesh_asset import decimate_mesh_file, lod_error
+from ..core.batch.mesh_asset import check_bakeable, decimate_mesh_file, lod_error
 from ..core.api.budget import missed_dict, report_missed
 from ..core.api.decimate import ATTRIBUTE_WEIGHT
 from ..core.batch.prune import prune_small_parts
@@ -247,6 +249,8 @@ def decimate_scene_file(path: str, out_dir: str, settings: dict) -> dict:
     stem, _ = os.path.splitext(os.path.basename(path))
     out_format = settings["format"] or os.path.splitext(path)[1].lstrip(".").lower()
     settings = dict(settings, bake_folder=out_dir, bake_stem=stem, bake_format=out_format)
+    if _is_mesh_file(path):  # a chain writes one file per LOD, as without Blender (mesh_asset.output_paths)
+        settings["lod_files"] = True
     asset = _world_vertices(objects)
     targets = batch_settings.engine_targets(settings, asset)
     entries, chains, sources = [], [], []
@@ -352,9 +356,11 @@ def main(argv=None) -> int:
             continue
         print(f"{prefix}: decimating ...", flush=True)
         try:
-            if _is_mesh_file(path):
+            if _is_mesh_file(path) and not settings.get("bake_normals"):
                 entry = decimate_mesh_file(path, args.output, settings)
             else:
+                if _is_mesh_file(path):  # baked maps: imported, decimated, baked and exported by Blender
+                    check_bakeable(path, settings)
                 _register_addon()
                 entry = decimate_scene_file(path, args.output, settings)
         except Exception as error:  # one broken input must not stop the batch

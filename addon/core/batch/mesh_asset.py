@@ -58,11 +58,31 @@ def lod_error(original, result, screen, exact: bool = False, original_surface=No
     return entry
 
 
+#: The outputs whose materials can reference a baked map, for a mesh file baked through Blender.
+BAKED_FORMATS = ("obj", "gltf", "glb", "fbx", "usd", "usda", "usdc", "usdz", "blend")
+
+
+def check_bakeable(path: str, settings: dict) -> None:
+    """TopStocError unless Blender can import the mesh file ``path`` and its output format has a
+    material to reference the baked maps (--bake-normals sends a mesh file through Blender)."""
+    kind, compression = mesh_format(path)
+    if compression:
+        raise TopStocError(f"{path}: --bake-normals imports mesh files with Blender, which reads no "
+                           f".{compression}: decompress the file first")
+    if kind == "off":
+        raise TopStocError(f"{path}: --bake-normals imports mesh files with Blender, which has no OFF "
+                           f"importer: convert the file to OBJ or PLY first (topstoc convert)")
+    out = settings["format"] or kind
+    if out not in BAKED_FORMATS:
+        raise TopStocError(f"{path}: a .{out} output has no material to reference the baked maps: pass "
+                           f"--format obj (its .mtl names them), gltf, glb, fbx or usd")
+
+
 def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
-    """Decimates one mesh file into ``out_dir``; returns its report entry."""
+    """Decimates one mesh file into ``out_dir``; returns its report entry. (With --bake-normals a
+    mesh file goes through Blender instead: run.run_asset, blender/batch.py.)"""
     if settings.get("bake_normals"):
-        raise TopStocError(f"{path}: --bake-normals needs a Blender format (.blend, glTF, FBX, USD): a mesh "
-                           f"file has no material to hold the map")
+        raise TopStocError(f"{path}: --bake-normals runs mesh files through Blender (topstoc batch does)")
     outputs = output_paths(path, out_dir, settings)
     data = read_mesh(path)
     start = time.perf_counter()
