@@ -26,12 +26,14 @@ from .prune import prune_small_parts
 
 def output_paths(path: str, out_dir: str, settings: dict) -> list:
     """The files the asset ``path`` is written to, one per LOD: in the input's format, uncompressed
-    unless settings keep compression (or --format names one)."""
+    unless settings keep compression (or --format names one; a Blender format with --bake-normals)."""
     kind, compression = mesh_format(path)
     compression = compression if settings.get("keep_compression") else None
     name = os.path.basename(os.fspath(path))
     stem = name[:name.lower().rindex("." + kind)]
-    if settings["format"]:
+    if settings["format"] in batch_settings.BLENDER_FORMATS and settings.get("bake_normals"):
+        kind, compression = settings["format"], None  # written by Blender (check_bakeable)
+    elif settings["format"]:
         kind, compression = mesh_format("x." + settings["format"])
     ext = "." + kind + ("." + compression if compression else "")
     return [os.path.join(out_dir, batch_settings.lod_name(stem, i, settings) + ext)
@@ -63,15 +65,13 @@ BAKED_FORMATS = ("obj", "gltf", "glb", "fbx", "usd", "usda", "usdc", "usdz", "bl
 
 
 def check_bakeable(path: str, settings: dict) -> None:
-    """TopStocError unless Blender can import the mesh file ``path`` and its output format has a
-    material to reference the baked maps (--bake-normals sends a mesh file through Blender)."""
+    """TopStocError unless Blender can import the mesh file ``path`` (OFF and compressed PLY/STL/OFF
+    through a temporary PLY: blender/batch.py) and its output format has a material to reference
+    the baked maps (--bake-normals sends a mesh file through Blender)."""
     kind, compression = mesh_format(path)
-    if compression:
-        raise TopStocError(f"{path}: --bake-normals imports mesh files with Blender, which reads no "
-                           f".{compression}: decompress the file first")
-    if kind == "off":
-        raise TopStocError(f"{path}: --bake-normals imports mesh files with Blender, which has no OFF "
-                           f"importer: convert the file to OBJ or PLY first (topstoc convert)")
+    if compression and kind == "obj":  # Blender would find no .mtl beside a decompressed copy
+        raise TopStocError(f"{path}: --bake-normals imports OBJ files with Blender, which reads no "
+                           f".{compression}: decompress the file (and keep its .mtl beside it) first")
     out = settings["format"] or kind
     if out not in BAKED_FORMATS:
         raise TopStocError(f"{path}: a .{out} output has no material to reference the baked maps: pass "
