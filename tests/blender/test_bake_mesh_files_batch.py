@@ -11,6 +11,7 @@ import subprocess
 
 import bpy
 import numpy as np
+import pytest
 
 from test_bake_normals import importlib_module, normal_map_image
 
@@ -29,7 +30,7 @@ def subdivided_suzanne(path) -> int:
         obj.data.uv_layers.remove(layer)
     export = bpy.ops.wm.obj_export
     names = {p.identifier for p in export.get_rna_type().properties}
-    options = {"export_materials": False, "export_selected_objects": True}
+    options = {"export_materials": False, "export_selected_objects": True, "export_uv": False}
     export(filepath=str(path), **{k: v for k, v in options.items() if k in names})
     return len(obj.data.polygons)
 
@@ -130,3 +131,18 @@ def test_outputs_without_a_material_are_refused(ts, scene, tmp_path):
         assert done.returncode == 1 and entry is None
         assert f"a .{fmt} output has no material to reference the baked maps: pass --format obj" in done.stderr
         assert not (out / f"suzanne.{fmt}").exists()
+
+
+def test_the_colour_map_is_the_mtl_diffuse_map(ts, scene, tmp_path):
+    """--bake-colour: the LOD got a UV map of its own (the OBJ has none), so its base colour is
+    baked too and the .mtl names it as map_Kd beside the normal map."""
+    subdivided_suzanne(tmp_path / "suzanne.obj")
+    out = tmp_path / "out"
+    done, entry = run_batch(ts, tmp_path / "suzanne.obj", out, "--bake-colour")
+    if done.returncode and "Cycles baked no colour" in done.stderr:
+        pytest.skip(f"Blender {bpy.app.version_string}'s Cycles bakes no colour selected-to-active")
+    assert done.returncode == 0, done.stderr[-2000:]
+    [lod] = entry["objects"][0]["lods"]
+    assert lod["colour_map"] == str(out / "suzanne_Suzanne_color.png") and os.path.isfile(lod["colour_map"])
+    maps = mtl_maps(out / "suzanne.mtl")
+    assert (maps["map_Kd"], maps["map_Bump"]) == ("suzanne_Suzanne_color.png", "suzanne_Suzanne_normal.png")
