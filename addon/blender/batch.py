@@ -1,7 +1,9 @@
 """Batch decimation inside Blender (or PyPI's bpy): mesh files and Blender's own formats (docs/design.md §6).
 
 Mesh files (OBJ, PLY, OFF, STL, optionally .gz/.bz2) go through topstoc.core.batch.mesh_asset (the
-same code ``topstoc batch`` runs without Blender). .blend files are opened; glTF/GLB, FBX and
+same code ``topstoc batch`` runs without Blender); with --bake-normals, mesh files are imported
+with Blender's importers (OFF and compressed ones as a temporary PLY) and go the Blender formats' way, written as OBJ (its .mtl names
+the maps) or a Blender format (mesh_asset.check_bakeable says why others are refused). .blend files are opened; glTF/GLB, FBX and
 USD are imported with Blender's importers into an empty scene. Their mesh objects (all, or
 those named with --objects) are decimated with the add-on's pipeline (the Guided Decimate
 operator's: guidance stored on the objects, UVs, colours, materials, vertex groups and
@@ -18,19 +20,21 @@ from __future__ import annotations
 
 import os
 import sys
+import tempfile
 import traceback
 from types import SimpleNamespace
 
 import numpy as np
 
 from ..core.batch import settings as batch_settings
-from ..core.batch.mesh_asset import decimate_mesh_file, lod_error
+from ..core.batch.mesh_asset import check_bakeable, decimate_mesh_file, lod_error
 from ..core.api.budget import missed_dict, report_missed
 from ..core.api.decimate import ATTRIBUTE_WEIGHT
 from ..core.batch.prune import prune_small_parts
 from ..core.batch.run import misnamed_failure, utf8_name, write_report
 from ..core.support.errors import TopStocError, one_line, shown_path
 from ..core.api.hausdorff import as_surface
+from ..core.api.io import mesh_format, read_mesh, write_mesh
 from ..core.support.output_guard import check_folders, prepare_output, output_folder
 
 BLEND = ".blend"
@@ -240,13 +244,16 @@ def decimate_scene_file(path: str, out_dir: str, settings: dict) -> dict:
         raise FileNotFoundError(f"{path}: no such file")
     if path.lower().endswith(BLEND):
         bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
+    elif _is_mesh_file(path):
+        _import_mesh_file(scene_io, path)
     else:
         scene_io.import_file(path)
     objects = _mesh_objects(bpy, path, settings["objects"])
     cleaned = _clean_objects(objects, settings["clean"]) if "clean" in settings else {}
-    stem, _ = os.path.splitext(os.path.basename(path))
-    out_format = settings["format"] or os.path.splitext(path)[1].lstrip(".").lower()
-    settings = dict(settings, bake_folder=out_dir, bake_stem=stem, bake_format=out_format)
+    stem, ext = _output_name(path, settings)
+    settings = dict(settings, bake_folder=out_dir, bake_stem=stem, bake_format=ext.lstrip(".").lower())
+    if _is_mesh_file(path):  # a chain writes one file per LOD, as without Blender (mesh_asset.output_paths)
+        settings["lod_files"] = True
     asset = _world_vertices(objects)
     targets = batch_settings.engine_targets(settings, asset)
     entries, chains, sources = [], [], []
@@ -268,9 +275,6 @@ def decimate_scene_file(path: str, out_dir: str, settings: dict) -> dict:
             for lod_entry, lod in zip(entry["lods"], lods):
                 lod_entry["object"] = lod.name
 
-    name = os.path.basename(path)
-    stem, ext = os.path.splitext(name)
-    ext = "." + settings["format"] if settings["format"] else ext
     outputs = []
     embed = bool(settings.get("bake_normals"))  # an FBX then carries its baked maps
     if settings["chain"] and settings["lod_files"]:
@@ -286,6 +290,31 @@ def decimate_scene_file(path: str, out_dir: str, settings: dict) -> dict:
             "vertices_out": sum(e["vertices_out"] for e in entries),
             "triangles_out": sum(e["triangles_out"] for e in entries),
             "seconds": sum(e["seconds"] for e in entries), "error": None, "objects": entries}
+
+
+def _output_name(path: str, settings: dict) -> tuple:
+    """(stem, .ext) of the outputs: the input's name (a mesh file's without its format and compression,
+    as mesh_asset.output_paths names them) and --format's extension or the input's."""
+    name = os.path.basename(path)
+    if _is_mesh_file(path):
+        kind, _ = mesh_format(path)
+        stem, ext = name[:name.lower().rindex("." + kind)], "." + kind
+    else:
+        stem, ext = os.path.splitext(name)
+    return stem, "." + settings["format"] if settings["format"] else ext
+
+
+def _import_mesh_file(scene_io, path: str) -> None:
+    """A mesh file into an empty scene with Blender's importer; OFF (Blender has no importer) and
+    compressed PLY/STL/OFF are read with the project's reader and imported as a temporary PLY."""
+    kind, compression = mesh_format(path)
+    if kind != "off" and not compression:
+        scene_io.import_file(path)
+        return
+    with tempfile.TemporaryDirectory(prefix="topstoc-mesh-") as scratch:
+        copy = os.path.join(scratch, _output_name(path, {"format": "ply"})[0] + ".ply")  # objects keep the stem
+        write_mesh(copy, read_mesh(path))
+        scene_io.import_file(copy)
 
 
 def _clean_objects(objects, kwargs: dict) -> dict:
@@ -352,9 +381,11 @@ def main(argv=None) -> int:
             continue
         print(f"{prefix}: decimating ...", flush=True)
         try:
-            if _is_mesh_file(path):
+            if _is_mesh_file(path) and not settings.get("bake_normals"):
                 entry = decimate_mesh_file(path, args.output, settings)
             else:
+                if _is_mesh_file(path):  # baked maps: imported, decimated, baked and exported by Blender
+                    check_bakeable(path, settings)
                 _register_addon()
                 entry = decimate_scene_file(path, args.output, settings)
         except Exception as error:  # one broken input must not stop the batch

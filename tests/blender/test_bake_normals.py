@@ -470,7 +470,7 @@ def test_batch_writes_an_fbx_that_reimports_with_its_map(ts, scene, tmp_path):
     assert sum(len(p.vertices) - 2 for p in obj.data.polygons) == lod["triangles"] < source_faces / 5
 
 
-def test_batch_refuses_mesh_files_and_bad_sizes(ts, scene, tmp_path):
+def test_batch_refuses_bad_sizes_and_outputs_without_materials(ts, scene, tmp_path):
     import subprocess
 
     from test_batch_formats import _runner
@@ -481,8 +481,8 @@ def test_batch_refuses_mesh_files_and_bad_sizes(ts, scene, tmp_path):
         "--ratio", "0.1", "--bake-normals"]
     done = subprocess.run(command + ["100000"], capture_output=True, text=True, timeout=300)
     assert done.returncode == 1 and "whole number of pixels from 16 to 16384, got 100000" in done.stderr
-    done = subprocess.run(command + ["64"], capture_output=True, text=True, timeout=300)
-    assert done.returncode == 1 and "--bake-normals needs a Blender format" in done.stderr
+    done = subprocess.run(command + ["64", "--format", "ply"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 1 and "a .ply output has no material to reference the baked maps" in done.stderr
 
 
 def importlib_module(ts, name):

@@ -209,16 +209,27 @@ def test_obj_lods_get_the_mtl_beside_them_and_report_dropped_normals(tmp_path):
     assert (out / "spider.mtl").read_bytes() == (spider.parent / "spider.mtl").read_bytes()
 
 
-def test_bake_normals_is_checked_and_mesh_files_refuse_it(tmp_path):
+def test_bake_normals_is_checked_and_mapless_outputs_refuse_it(tmp_path):
     """``--bake-normals SIZE`` reaches the Blender batch through the settings (to_argv); a bad size
-    is one error line, and a mesh file, which has no material for the map, fails with a reason."""
+    is one error line; a mesh file (baked through Blender) fails with a reason, before any Blender
+    runs, when its output has no material for the map or Blender cannot read it."""
     from topstoc.core.batch import settings as batch_settings
 
     a = _torus(tmp_path / "a", "ring.obj")
     done = batch("--input", a, "--output", tmp_path / "out", "--ratio", 0.5, "--bake-normals", 8, "--workers", 0)
     cli.assert_one_error_line("batch", done, "normal map size must be a whole number of pixels from 16")
-    done = batch("--input", a, "--output", tmp_path / "out", "--ratio", 0.5, "--bake-normals", 64, "--workers", 0)
-    assert done.returncode == 1 and "--bake-normals needs a Blender format" in done.stdout + done.stderr
+    done = batch("--input", a, "--output", tmp_path / "out", "--ratio", 0.5, "--bake-normals", 64, "--workers", 0,
+                 "--format", "stl", "--blender", tmp_path / "no-blender")
+    assert done.returncode == 1 and "ring.obj: a .stl output has no material to reference the baked maps: pass " \
+        "--format obj" in done.stdout + done.stderr
+    assert not (tmp_path / "out" / "ring.stl").exists()
+    packed = tmp_path / "b" / "ring.obj.gz"
+    packed.parent.mkdir()
+    write_mesh(packed, read_mesh(a))
+    done = batch("--input", packed, "--output", tmp_path / "out2", "--ratio", 0.5, "--bake-normals", 64,
+                 "--workers", 0, "--blender", tmp_path / "no-blender")
+    assert done.returncode == 1 and "ring.obj.gz: --bake-normals imports OBJ files with Blender, which reads no " \
+        ".gz: decompress the file" in done.stdout + done.stderr
     parser = __import__("argparse").ArgumentParser()
     batch_settings.add_arguments(parser)
     settings = batch_settings.from_args(parser.parse_args(["--ratio", "0.5", "--bake-normals", "512"]))

@@ -1,4 +1,5 @@
-"""Blender's own importers and exporters for the batch: .blend, glTF/GLB, FBX and USD.
+"""Blender's own importers and exporters for the batch: .blend, glTF/GLB, FBX and USD (and OBJ, PLY,
+STL in, OBJ out, for mesh files whose LODs get baked maps: OBJ's .mtl holds them).
 
 Import clears the scene first (glTF with the importer's "merge vertices": glTF splits vertices
 wherever a normal or UV changes) (so one Blender can batch many files); export writes into a
@@ -19,7 +20,8 @@ import bpy
 from ...core.support import atomic
 from ...core.support.errors import TopStocError
 
-IMPORTERS = {"gltf": "gltf", "glb": "gltf", "fbx": "fbx", "usd": "usd", "usda": "usd", "usdc": "usd", "usdz": "usd"}
+IMPORTERS = {"gltf": "gltf", "glb": "gltf", "fbx": "fbx", "usd": "usd", "usda": "usd", "usdc": "usd", "usdz": "usd",
+             "obj": "obj", "ply": "ply", "stl": "stl"}
 _ADDONS = {"gltf": "io_scene_gltf2", "fbx": "io_scene_fbx"}
 
 
@@ -104,10 +106,10 @@ def clear_scene() -> None:
 
 
 def import_file(path: str) -> None:
-    """Reads a glTF/GLB, FBX or USD file into an empty scene."""
+    """Reads a glTF/GLB, FBX, USD, OBJ, PLY or STL file into an empty scene."""
     kind = IMPORTERS.get(extension(path))
     if kind is None:
-        raise TopStocError(f"{path}: not a glTF, FBX or USD file")
+        raise TopStocError(f"{path}: not a glTF, FBX, USD, OBJ, PLY or STL file")
     if not os.path.isfile(path):
         raise FileNotFoundError(f"{path}: no such file")
     clear_scene()
@@ -122,9 +124,23 @@ def import_file(path: str) -> None:
         operator(filepath=filepath, **_supported(operator, {"merge_vertices": True}))
     elif kind == "fbx":
         bpy.ops.import_scene.fbx(filepath=filepath)
+    elif kind in ("obj", "ply", "stl"):
+        _import_mesh_file(kind, filepath)
     else:
         _check_usd(path)
         bpy.ops.wm.usd_import(filepath=filepath)
+
+
+def _import_mesh_file(kind: str, filepath: str) -> None:
+    """OBJ, PLY or STL with Blender's own importer: the C++ one where this Blender has it (OBJ from
+    3.3, PLY from 4.0, STL from 4.1), else the Python add-on's."""
+    if f"{kind}_import" in dir(bpy.ops.wm):
+        getattr(bpy.ops.wm, f"{kind}_import")(filepath=filepath)
+        return
+    import addon_utils
+
+    addon_utils.enable(f"io_mesh_{kind}", default_set=True)
+    getattr(bpy.ops.import_mesh, kind)(filepath=filepath)
 
 
 def _export(kind: str, filepath: str, selected: bool, embed_textures: bool = False) -> None:
@@ -146,8 +162,13 @@ def _export(kind: str, filepath: str, selected: bool, embed_textures: bool = Fal
         operator = bpy.ops.wm.usd_export
         options = dict(selected_objects_only=selected, export_uvmaps=True, export_materials=True,
                        export_armatures=True, export_shapekeys=True)
+    elif kind == "obj":
+        # The images go next to the output (the baked maps are there already), the .mtl names them so.
+        operator = bpy.ops.wm.obj_export
+        options = dict(export_selected_objects=selected, export_materials=True, export_uv=True,
+                       export_normals=True, apply_modifiers=False, path_mode="COPY")
     else:
-        raise TopStocError(f"cannot export .{kind} (Blender formats: blend, gltf, glb, fbx, usd, usda, usdc, usdz)")
+        raise TopStocError(f"cannot export .{kind} (Blender formats: blend, gltf, glb, fbx, usd, usda, usdc, usdz; obj)")
     operator(filepath=filepath, **_supported(operator, options))
 
 

@@ -26,12 +26,14 @@ from .prune import prune_small_parts
 
 def output_paths(path: str, out_dir: str, settings: dict) -> list:
     """The files the asset ``path`` is written to, one per LOD: in the input's format, uncompressed
-    unless settings keep compression (or --format names one)."""
+    unless settings keep compression (or --format names one; a Blender format with --bake-normals)."""
     kind, compression = mesh_format(path)
     compression = compression if settings.get("keep_compression") else None
     name = os.path.basename(os.fspath(path))
     stem = name[:name.lower().rindex("." + kind)]
-    if settings["format"]:
+    if settings["format"] in batch_settings.BLENDER_FORMATS and settings.get("bake_normals"):
+        kind, compression = settings["format"], None  # written by Blender (check_bakeable)
+    elif settings["format"]:
         kind, compression = mesh_format("x." + settings["format"])
     ext = "." + kind + ("." + compression if compression else "")
     return [os.path.join(out_dir, batch_settings.lod_name(stem, i, settings) + ext)
@@ -58,11 +60,29 @@ def lod_error(original, result, screen, exact: bool = False, original_surface=No
     return entry
 
 
+#: The outputs whose materials can reference a baked map, for a mesh file baked through Blender.
+BAKED_FORMATS = ("obj", "gltf", "glb", "fbx", "usd", "usda", "usdc", "usdz", "blend")
+
+
+def check_bakeable(path: str, settings: dict) -> None:
+    """TopStocError unless Blender can import the mesh file ``path`` (OFF and compressed PLY/STL/OFF
+    through a temporary PLY: blender/batch.py) and its output format has a material to reference
+    the baked maps (--bake-normals sends a mesh file through Blender)."""
+    kind, compression = mesh_format(path)
+    if compression and kind == "obj":  # Blender would find no .mtl beside a decompressed copy
+        raise TopStocError(f"{path}: --bake-normals imports OBJ files with Blender, which reads no "
+                           f".{compression}: decompress the file (and keep its .mtl beside it) first")
+    out = settings["format"] or kind
+    if out not in BAKED_FORMATS:
+        raise TopStocError(f"{path}: a .{out} output has no material to reference the baked maps: pass "
+                           f"--format obj (its .mtl names them), gltf, glb, fbx or usd")
+
+
 def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
-    """Decimates one mesh file into ``out_dir``; returns its report entry."""
+    """Decimates one mesh file into ``out_dir``; returns its report entry. (With --bake-normals a
+    mesh file goes through Blender instead: run.run_asset, blender/batch.py.)"""
     if settings.get("bake_normals"):
-        raise TopStocError(f"{path}: --bake-normals needs a Blender format (.blend, glTF, FBX, USD): a mesh "
-                           f"file has no material to hold the map")
+        raise TopStocError(f"{path}: --bake-normals runs mesh files through Blender (topstoc batch does)")
     outputs = output_paths(path, out_dir, settings)
     data = read_mesh(path)
     start = time.perf_counter()

@@ -1,7 +1,7 @@
 """Running batch assets: one task per asset, serially or on a Dask cluster.
 
 ``run_asset`` is the task. Mesh files are decimated in the worker's own process
-(topstoc.core.batch.mesh_asset); Blender formats (.blend, glTF/GLB, FBX, USD) run one Blender per
+(topstoc.core.batch.mesh_asset), or with --bake-normals as Blender formats are; Blender formats (.blend, glTF/GLB, FBX, USD) run one Blender per
 asset: ``blender -b`` or a Python with PyPI's ``bpy`` (``--blender``), which runs the add-on's
 batch (topstoc.blender.batch) and writes its files atomically. A task never raises for a bad
 asset: it returns a failure record, so the other assets go on and Dask does not retry a
@@ -152,7 +152,12 @@ def run_asset(path: str, out_dir: str, settings: dict, blender: str = None) -> d
         warnings.simplefilter("always")
         try:
             kind = asset_kind(path)
-            if kind == "mesh":
+            if kind == "mesh" and settings.get("bake_normals"):  # the maps need Blender's bake and exporter
+                from .mesh_asset import check_bakeable
+
+                check_bakeable(path, settings)
+                entry = run_blender_asset(path, out_dir, settings, find_blender(blender))
+            elif kind == "mesh":
                 from .mesh_asset import decimate_mesh_file
 
                 entry = decimate_mesh_file(path, out_dir, settings)

@@ -71,8 +71,9 @@ def add_arguments(parser) -> None:
                         help="write outputs in this format, e.g. obj, ply, ply.gz, glb (default: the input's, "
                              "uncompressed)")
     parser.add_argument("--bake-normals", type=int, metavar="SIZE",
-                        help="Blender formats: bake a SIZE x SIZE tangent-space normal map from each source onto "
-                             "each result (a PNG next to the output, used by its materials; margin SIZE/64 px)")
+                        help="bake a SIZE x SIZE tangent-space normal map from each source onto each result (a PNG "
+                             "next to the output, used by its materials; margin SIZE/64 px); OBJ, PLY and STL "
+                             "files go through Blender then and are written as OBJ (.mtl) or a Blender format")
     parser.add_argument("--bake-colour", action="store_true",
                         help="with --bake-normals: where the result gets a UV map of its own (the source's "
                              "layout is not kept), bake the source's base colour onto it too (a second PNG, "
