@@ -305,7 +305,7 @@ def test_error_bounded_decimation_meets_the_bound_with_a_minimal_count(data_dir,
 
 def test_error_bounded_search_decimates_few_targets_and_stays_minimal(data_dir):
     # fandisk at 0.3 % in quality mode: the bisection on the estimate followed by exact checks
-    # decimated 14 targets; the predicted bracket and exact checks of passing targets decimate 9
+    # decimated more than 11 targets (design.md §2.11 says how the search brackets and checks)
     vertices, triangles = read_off(data_dir / "genus0/cgal_fandisk.off")
     mesh = topstoc.Mesh(vertices, triangles)
     result = mesh.decimate(max_error=0.003, relative=True, seed=1)

@@ -56,7 +56,7 @@ from ..decimation.guidance import read as read_guidance
 
 PREVIEW_SUFFIX = "_TopStocPreview"
 WORKERS = 2 if (os.cpu_count() or 1) >= 2 else 1
-REST_SECONDS = 0.08  # no new ratio asked this long: the drag rests (mouse events come every ~10 ms)
+REST_SECONDS = 0.08  # no new ratio asked this long: the drag rests (several mouse events would have come)
 DIRECT_SECONDS = 0.12  # a chosen-settings result this fast is what the drag shows, instead of drafts
 KEPT_RESULTS = 8  # chosen-settings results kept per ratio
 THREAD_PREFIX = "topstoc-preview"
