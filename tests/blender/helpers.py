@@ -135,3 +135,24 @@ class EngineCalls:
     def kinds(self, start=0):
         """(mode, draft) of each call from ``start`` on."""
         return [(call.mode, call.draft) for call in self.calls[start:]]
+
+
+def pixels_of(image) -> np.ndarray:
+    """An image's pixels as one float32 array."""
+    out = np.empty(len(image.pixels), dtype=np.float32)
+    image.pixels.foreach_get(out)
+    return out
+
+
+def reimported(ts, path, images: bool = False):
+    """Removes every object (and every image, with ``images``), imports ``path`` through the
+    add-on's scene_files and returns the one mesh object it brought."""
+    import importlib
+
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+    for image in list(bpy.data.images) if images else ():
+        bpy.data.images.remove(image)
+    importlib.import_module(f"{ts.__name__}.blender.io.scene_files").import_file(str(path))
+    [obj] = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+    return obj

@@ -13,6 +13,7 @@ import bpy
 import numpy as np
 import pytest
 
+from helpers import pixels_of, reimported
 from test_bake_normals import importlib_module, normal_map_image
 
 SIZE = 128
@@ -74,17 +75,12 @@ def test_an_obj_is_baked_into_an_obj_whose_mtl_names_the_map(ts, scene, tmp_path
     assert not (tmp_path / "suzanne.mtl").exists()  # the input's folder is left alone
 
     written = bpy.data.images.load(lod["normal_map"])
-    expected = np.empty(len(written.pixels), dtype=np.float32)
-    written.pixels.foreach_get(expected)
-    for obj in list(bpy.data.objects):
-        bpy.data.objects.remove(obj)
-    importlib_module(ts, "blender.io.scene_files").import_file(str(out / "suzanne.obj"))
-    [obj] = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+    expected = pixels_of(written)
+    obj = reimported(ts, out / "suzanne.obj")
     image = normal_map_image(obj)
     assert image is not None and tuple(image.size) == (SIZE, SIZE)
     assert os.path.samefile(bpy.path.abspath(image.filepath), lod["normal_map"])
-    pixels = np.empty(len(image.pixels), dtype=np.float32)
-    image.pixels.foreach_get(pixels)
+    pixels = pixels_of(image)
     assert np.array_equal(pixels, expected) and np.ptp(expected) > 0.3  # the baked map, not a blank one
     assert sum(len(p.vertices) - 2 for p in obj.data.polygons) == lod["triangles"] < 2 * source_faces / 10
 
