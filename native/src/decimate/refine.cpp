@@ -460,10 +460,11 @@ class Refinement {
   }
 
   // A tiny result fitted to the input (after the max-aware choice, which compares the
-  // collapses' own results; not with attributes, which the fit does not weigh), the zero-area
-  // triangles left moved off, and the result compacted.
+  // collapses' own results), the zero-area triangles left moved off, and the result compacted.
+  // With attributes too: a vertex the fit moves takes the input's attributes where it lands
+  // (attributes.moved_vertices), and seam vertices, whose sides differ, do not move.
   void finish(Collapser& collapser) {
-    if (params.refit && !params.attributes.values && collapser.live_faces() <= kTinyFitFaces)
+    if (params.refit && collapser.live_faces() <= kTinyFitFaces)
       fit_tiny(mesh, collapser, kTinyFitRounds);
     if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
     result.issues_remaining.sliver = collapser.zero_area_faces();
