@@ -35,7 +35,7 @@ def expected_loose(ratio: float) -> dict:
     asked = max(1, round(ratio * 3 * LOOSE))
     got = 3 * LOOSE  # every piece keeps its triangle
     return {"asked": asked, "got": got, "unit": "vertices", "off": got - asked,
-            "fraction": pytest.approx((got - asked) / asked), "reason": "topology"}
+            "fraction": pytest.approx((got - asked) / asked), "reason": "topology", "detail": ""}
 
 
 @pytest.fixture(scope="module")
@@ -176,3 +176,27 @@ def test_a_replay_of_samples_asked_for_no_target():
                                        refine_vertices=result.stats.refine_vertices)
     assert again.num_vertices == result.num_vertices
     assert again.stats.replayed and again.stats.target_missed is None
+
+
+def test_non_manifold_edges_are_the_reason_only_where_they_hold_most_of_the_result():
+    from types import SimpleNamespace
+
+    from topstoc.core.api.budget import over_reason
+
+    def stats(**given):
+        base = dict(forced=0, target_vertices=500, control_points=0, mirrored_from=0, nonmanifold_vertices=0,
+                    output_vertices=900, replayed=False, target_triangles=0, output_triangles=1800,
+                    zero_area_input=0)
+        return SimpleNamespace(**{**base, **given})
+
+    assert over_reason(stats(nonmanifold_vertices=700)) == "non-manifold edges"
+    missed = missed_target(stats(nonmanifold_vertices=700))
+    assert missed.detail == "700 of the result's 900 vertices lie on them"
+    assert missed.text().endswith("; non-manifold edges: 700 of the result's 900 vertices lie on them)")
+    # fewer than the target, or under half of the result: something else holds it
+    assert over_reason(stats(nonmanifold_vertices=499)) == "topology"
+    assert over_reason(stats(nonmanifold_vertices=600, output_vertices=1300)) == "topology"
+    assert over_reason(stats(nonmanifold_vertices=600, output_vertices=1300, forced=500)) == "borders"
+    # painted control points that outnumber the target still come first
+    assert over_reason(stats(nonmanifold_vertices=700, forced=600, control_points=600)) == "control points"
+    assert MissedTarget(1, 2, "topology").as_dict()["detail"] == ""

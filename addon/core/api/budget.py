@@ -7,6 +7,10 @@ vertex) away from it. Why, in the words every channel uses:
 - "control points": the vertices painted to stay (u = 1) outnumber the target;
 - "borders": corners of borders (seams, materials, sharp or hard-normal edges), always kept,
   outnumber the target;
+- "non-manifold edges": the result's vertices on non-manifold edges (edges of three or more
+  triangles) outnumber the target and make up at least half of the result: each such curve
+  keeps its course and at least one edge, each sheet along it its triangles, so the topology
+  stays; the detail says how many vertices that is;
 - "topology": samples the topology needs (each loose piece keeps at least a triangle, each
   hole and handle its loops);
 - "symmetry": the mirrored sample set is larger (or, where partners of absorbed samples were
@@ -39,6 +43,7 @@ class MissedTarget:
     got: int
     reason: str
     unit: str = "vertices"
+    detail: str = ""  #: what the reason costs, in words ("" when the reason says it all)
 
     @property
     def off(self) -> int:
@@ -53,19 +58,24 @@ class MissedTarget:
     def as_dict(self) -> dict:
         """The ``target_missed`` object of the JSON reports."""
         return {"asked": self.asked, "got": self.got, "unit": self.unit, "off": self.off,
-                "fraction": self.fraction, "reason": self.reason}
+                "fraction": self.fraction, "reason": self.reason, "detail": self.detail}
 
     def text(self) -> str:
         """One phrase for a report line: "target missed: 871 vertices for 796 (75 over, +9.4 %; symmetry)"."""
         side = "over" if self.off > 0 else "under"
+        detail = f": {self.detail}" if self.detail else ""
         return (f"target missed: {self.got:,} {self.unit} for {self.asked:,} ({abs(self.off):,} {side}, "
-                f"{100 * self.fraction:+.1f} %; {self.reason})")
+                f"{100 * self.fraction:+.1f} %; {self.reason}{detail})")
 
 
 def over_reason(stats) -> str:
     """Why a result with these DecimateStats landed over its target (see the module docs)."""
+    if stats.forced >= stats.target_vertices and stats.control_points:
+        return "control points"
+    if stats.nonmanifold_vertices >= max(stats.target_vertices, stats.output_vertices / 2):
+        return "non-manifold edges"  # and they are most of the result
     if stats.forced >= stats.target_vertices:
-        return "control points" if stats.control_points else "borders"
+        return "borders"
     if stats.mirrored_from and stats.mirrored_from - stats.target_vertices <= tolerance(stats.target_vertices):
         return "symmetry"  # the plain draw met the target, its mirrored set did not
     return "topology"
@@ -82,7 +92,10 @@ def missed_target(stats) -> Optional[MissedTarget]:
     if abs(got - asked) <= tolerance(asked):
         return None
     if got > asked:
-        return MissedTarget(asked, got, over_reason(stats), unit)
+        reason = over_reason(stats)
+        detail = (f"{stats.nonmanifold_vertices:,} of the result's {stats.output_vertices:,} vertices lie on them"
+                  if reason == "non-manifold edges" else "")
+        return MissedTarget(asked, got, reason, unit, detail)
     if stats.zero_area_input:
         return MissedTarget(asked, got, "zero-area input", unit)
     return MissedTarget(asked, got, "symmetry" if stats.mirrored_from else "absorbed clusters", unit)
@@ -111,5 +124,5 @@ def report_missed(entry: dict) -> list:
             if missed:
                 name = (f"{obj['object']} " if "object" in obj else "") + (f"LOD{lod['lod']} " if len(lods) > 1 else "")
                 phrases.append(name + MissedTarget(missed["asked"], missed["got"], missed["reason"],
-                                                   missed["unit"]).text())
+                                                   missed["unit"], missed.get("detail", "")).text())
     return phrases

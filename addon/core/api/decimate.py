@@ -83,6 +83,8 @@ class DecimateStats:
     #: re-created from a sample list (decimate_with_samples): no target was asked, none missed
     replayed: bool = False
     target_triangles: int = 0   #: the triangle target asked for (0: none)
+    #: vertices of the result on non-manifold edges (three or more triangles; counted when the input has some)
+    nonmanifold_vertices: int = 0
 
     @property
     def over_budget(self) -> int:
@@ -93,7 +95,8 @@ class DecimateStats:
     @property
     def over_budget_reason(self) -> str:
         """Why the result is over budget: "" (it is not), "control points" (the vertices painted to
-        stay outnumber the target), "borders" (so do the corners of borders), "symmetry" (the
+        stay outnumber the target), "non-manifold edges" (so do the result's vertices on them),
+        "borders" (so do the corners of borders), "symmetry" (the
         mirrored sample set) or "topology" (samples the topology needed); see core/api/budget.py."""
         return budget.over_reason(self) if self.over_budget else ""
 
@@ -243,7 +246,15 @@ def run_job(mesh: Mesh, job: DecimationJob, progress=None) -> DecimateResult:
 
 #: DecimateStats fields counted in Python; every other field is the engine result's of the same name
 _COUNTED_HERE = {"output_vertices", "output_triangles", "target_triangles", "control_points", "zero_area_input",
-                 "mirrored_from", "replayed"}
+                 "mirrored_from", "replayed", "nonmanifold_vertices"}
+
+
+def vertices_on_nonmanifold_edges(triangles: np.ndarray) -> int:
+    """Vertices on an edge of three or more of these triangles."""
+    t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    edges = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    return len(np.unique(unique[counts > 2]))
 
 
 def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob] = None) -> DecimateResult:
@@ -252,7 +263,9 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
                           output_triangles=len(raw["triangles"]),
                           target_triangles=0 if job is None else int(job.target.triangles or 0),
                           control_points=0 if job is None else job.control_points,
-                          zero_area_input=mesh.native.report["zero_area_triangles"], replayed=job is None)
+                          zero_area_input=mesh.native.report["zero_area_triangles"], replayed=job is None,
+                          nonmanifold_vertices=vertices_on_nonmanifold_edges(raw["triangles"])
+                          if mesh.native.report["nonmanifold_edges"] else 0)
     return DecimateResult(vertices=raw["vertices"], triangles=raw["triangles"], kept=raw["kept"],
                           face_source=raw["face_source"], corner_source=raw["corner_source"],
                           labels=raw["labels"], samples=raw["samples"], stats=stats,
