@@ -549,12 +549,8 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
     if (nu != faces_u || count != 2) return false;  // a closed fan around u
   } else {
     if (s_.curve[v] != cu && !s_.locked[v]) return false;
-    // count fans sharing only the curve's two neighbours of u have faces_u - count + 2 of them.
-    if (nu != faces_u - count + 2) return false;
-    for (int32_t i = 0; i < count; ++i)
-      for (int32_t j = 0; j < i; ++j)
-        if (sector_at(on_edge[i], u) == sector_at(on_edge[j], u)) return false;
-    if (s_.curve_closed[cu] && s_.curve_size[cu] <= 3) return false;
+    if (!curve_fans(u, nu, faces_u, on_edge, count)) return false;
+    if (s_.curve_closed[cu] ? s_.curve_size[cu] <= 3 : !curve_keeps_an_edge(cu)) return false;
   }
   const uint32_t sv = ++scratch.stamp;
   int32_t nv = 0, shared = 0;
@@ -575,6 +571,30 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
   placement(u, v, q, x);
   ShapeFloor floor{u, v};
   return keeps_shape(u, v, x, floor) && keeps_shape(v, u, x, floor);
+}
+
+// Are u's triangles around the edge laid out as on a curve? A curve vertex's sectors each hold
+// one of them (count fans from the curve's other edge to this one, sharing only those two
+// neighbours: faces_u - count + 2 of them); a dead end's each hold two (count / 2 fans from the
+// edge round to it again, sharing only v: faces_u - count / 2 + 1), and only along its
+// non-manifold edge.
+bool Collapser::curve_fans(int32_t u, int32_t nu, int32_t faces_u, const int32_t* on_edge, int32_t count) const {
+  const int32_t per_sector = is_dead_end(u) ? 2 : 1;
+  if (per_sector == 2 && (count < 3 || count % 2 != 0)) return false;
+  if (nu != faces_u - count / per_sector + 3 - per_sector) return false;
+  for (int32_t i = 0; i < count; ++i) {
+    int32_t same = 0;
+    for (int32_t j = 0; j < count; ++j) same += sector_at(on_edge[i], u) == sector_at(on_edge[j], u);
+    if (same != per_sector) return false;
+  }
+  return true;
+}
+
+// An open curve keeps at least one edge (two vertices, its locked ends included): shrunk to a
+// point, sheets that touched along it would touch at a vertex only.
+bool Collapser::curve_keeps_an_edge(int32_t curve) const {
+  const int32_t locked_ends = s_.curve_locked_ends.empty() ? 2 : s_.curve_locked_ends[curve];
+  return s_.curve_size[curve] - 1 + locked_ends >= 2;
 }
 
 // Would collapsing u into v turn a triangle (u, a, b) into one v already has? Only possible when
@@ -753,6 +773,7 @@ void Collapser::collapse(int32_t u, int32_t v) {
     }
     sides[num_sides++] = side;
   }
+  const bool dead_end = is_dead_end(u);
   moved_faces_.clear();
   for (const int32_t* t = faces_begin(u); t != faces_end(u); ++t) {
     if (!alive_face_[*t]) continue;
@@ -769,6 +790,17 @@ void Collapser::collapse(int32_t u, int32_t v) {
     moved_faces_.push_back(*t);
   }
   append_faces(v, moved_faces_.data(), static_cast<int32_t>(moved_faces_.size()));
+  if (dead_end) {
+    // Each sheet around the dead end held two of the edge's triangles, one on each side of the
+    // curve at v: with u gone the curve ends at v, and each sheet's two sides there are one.
+    int32_t from[kMaxSheets], to[kMaxSheets], pairs = 0;
+    for (int32_t i = 0; i < num_sides; ++i)
+      for (int32_t j = i + 1; j < num_sides; ++j)
+        if (sides[i].sector == sides[j].sector) from[pairs] = sides[i].corner_sector, to[pairs++] = sides[j].corner_sector;
+    merge_sides(v, from, to, pairs);
+    s_.dead_end[u] = 0;
+    s_.dead_end[v] = !s_.locked[v];
+  }
   if (s_.curve[u] >= 0) --s_.curve_size[s_.curve[u]];
   --count_[s_.bin[u]];
   --alive_vertices_;
@@ -778,6 +810,20 @@ void Collapser::collapse(int32_t u, int32_t v) {
   heap_.remove(u);
   target_[u] = -1;
   merged_from_[v] = u;
+}
+
+// Renames v's corner sectors from[i] to to[i] (the moved triangles took the side of to[i]).
+void Collapser::merge_sides(int32_t v, const int32_t* from, const int32_t* to, int32_t count) {
+  for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t)
+    for (int j = 0; j < 3; ++j) {
+      const size_t corner = 3 * size_t(*t) + j;
+      if (tri_[corner] != v) continue;
+      for (int32_t i = 0; i < count; ++i)
+        if (s_.corner_sector[corner] == from[i]) {
+          s_.corner_sector[corner] = to[i];
+          break;
+        }
+    }
 }
 
 // After collapsing u into v, alone: v's collapses all change (its quadric grew, it may have

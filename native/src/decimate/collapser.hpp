@@ -36,8 +36,14 @@ struct CollapseSetup {
   std::vector<double> weight;         ///< cost multiplier per vertex (guidance)
   std::vector<uint8_t> locked;        ///< never moves, never removed
   std::vector<int32_t> curve;         ///< feature curve of the vertex (it moves only along it), or -1
-  std::vector<int32_t> curve_size;    ///< per curve: its vertices
+  std::vector<int32_t> curve_size;    ///< per curve: its vertices that may move (locked ends not counted)
   std::vector<uint8_t> curve_closed;  ///< per curve
+  /// Per open curve: its ends that are locked (0-2; empty: 2 each). With curve_size it says how
+  /// many edges the curve has left, and an open curve keeps at least one.
+  std::vector<int32_t> curve_locked_ends;
+  /// Per vertex: the end of an open non-manifold curve that no other feature edge meets (where
+  /// two sheets stop touching); it moves along the curve onto its neighbour, which becomes the end.
+  std::vector<uint8_t> dead_end;
   std::vector<uint8_t> on_boundary;   ///< per vertex: on a mesh boundary's curve, one sector (a fit may move it)
   std::vector<int32_t> corner_sector; ///< per corner: the sector (side of the borders) of its vertex
   std::vector<int32_t> bin, quota;    ///< per vertex its guidance bin; per bin the vertices to keep
@@ -140,6 +146,10 @@ class Collapser {
   }
   bool queues(int32_t u) const { return !s_.locked[u] && !at_quota(u); }
   bool allowed(int32_t u, int32_t v, Scratch& scratch) const;
+  bool is_dead_end(int32_t v) const { return !s_.dead_end.empty() && s_.dead_end[v]; }
+  bool curve_fans(int32_t u, int32_t nu, int32_t faces_u, const int32_t* on_edge, int32_t count) const;
+  bool curve_keeps_an_edge(int32_t curve) const;
+  void merge_sides(int32_t v, const int32_t* from, const int32_t* to, int32_t count);
   bool duplicates_a_face(int32_t u, int32_t v, const int32_t* on_edge, int32_t count) const;
   bool merges_unlike_edges(int32_t u, int32_t v, const int32_t* on_edge, int32_t count) const;
   // The shape floor of one move or collapse (shape_floor2 of its ends), found when a triangle

@@ -42,25 +42,6 @@ int32_t guidance_bin(double m) {
   return 2 + 40 + std::clamp(int32_t(std::lround(4.0 * std::log2(m))), -40, 40);
 }
 
-// Vertices on an edge whose two triangles run along it the same way (inconsistently oriented).
-std::vector<uint8_t> on_inconsistent_edge(const Mesh& mesh) {
-  std::vector<uint8_t> flipped(mesh.num_vertices(), 0);
-  const auto& faces = mesh.faces();
-  const auto& face_edges = mesh.face_edges();
-  const auto& efo = mesh.edge_face_offsets();
-  const auto& edge_faces = mesh.edge_faces();
-  const auto& ev = mesh.edge_vertices();
-  auto starts_at = [&](int32_t f, int32_t e) {  // the corner the edge leaves in face f
-    for (int c = 0; c < 3; ++c)
-      if (face_edges[3 * size_t(f) + c] == e) return faces[3 * size_t(f) + c];
-    return -1;
-  };
-  for (int32_t e = 0; e + 1 < int32_t(efo.size()); ++e)
-    if (efo[e + 1] - efo[e] == 2 && starts_at(edge_faces[efo[e]], e) == starts_at(edge_faces[efo[e] + 1], e))
-      flipped[ev[2 * size_t(e)]] = flipped[ev[2 * size_t(e) + 1]] = 1;
-  return flipped;
-}
-
 // Vertex quota per bin (see RefineParams): sum over the bin's vertices of min(1, k m), k solved
 // so the quotas sum to `target`, rounded by largest remainder.
 std::vector<int32_t> bin_quotas(const std::vector<double>& vertices, const std::vector<double>& multiplier_sum,
@@ -323,6 +304,7 @@ class Refinement {
     setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *frame);
     set_up_vertices(setup);
     lock_inconsistent(setup);
+    count_locked_ends(setup);
     setup.quota = quotas();
     set_up_corner_sectors(setup);
     setup.optimal_placement = !params.zero_area_only;
@@ -360,14 +342,19 @@ class Refinement {
     setup.curve_closed = layout.curve_closed;
     setup.on_boundary.assign(n, 0);
     setup.bin.resize(n);
+    const std::vector<int32_t> end_curve = dead_end_curves();
+    setup.dead_end.assign(end_curve.empty() ? 0 : n, 0);
     for (int32_t i = 0; i < n; ++i) {
       const int32_t v = index[result.kept[i]];
       const double m = multiplier(v);
       if (layout.vertex_feature[v]) setup.curve[i] = layout.vertex_curve[v];
+      const bool dead_end = !end_curve.empty() && end_curve[v] >= 0 && m != kForcedMultiplier;
+      if (dead_end) setup.curve[i] = end_curve[v], setup.dead_end[i] = 1;
       if (setup.curve[i] >= 0) ++setup.curve_size[setup.curve[i]];
       // A curve vertex with one sector lies on a mesh boundary (a seam or crease has two).
       setup.on_boundary[i] = setup.curve[i] >= 0 && layout.sectors[v] == 1;
-      setup.locked[i] = layout.vertex_corner[v] || (layout.vertex_feature[v] && setup.curve[i] < 0) || m == kForcedMultiplier;
+      setup.locked[i] = (layout.vertex_corner[v] && !dead_end) || (layout.vertex_feature[v] && setup.curve[i] < 0) ||
+                        m == kForcedMultiplier;
       if (m == kForcedMultiplier)  // a control point stays where the user put it
         for (int k = 0; k < 3; ++k) setup.world[3 * size_t(i) + k] = mesh.position(v)[k];
       setup.weight[i] = m == kForcedMultiplier ? 1.0 : std::max(m, 1.0 / 81.0);
@@ -377,20 +364,81 @@ class Refinement {
       setup.positions[i] = (setup.world[i] - setup.center[i % 3]) * (1.0 / setup.extent);
   }
 
+  // Per input vertex, the open curve it ends as a dead end the collapses may move (-1
+  // elsewhere; empty without non-manifold edges): no other feature edge meets it, its one edge
+  // is non-manifold and each sheet goes round it once (two sectors for an edge of four
+  // triangles). There two sheets stop touching; the layout keeps it as a corner.
+  std::vector<int32_t> dead_end_curves() const {
+    std::vector<int32_t> end_curve;
+    if (mesh.report().nonmanifold_edges == 0) return end_curve;
+    end_curve.assign(num_input, -1);
+    const auto& offsets = layout.curve_offsets;
+    const auto& vertices = layout.curve_vertices;
+    for (int32_t c = 0; c < layout.num_curves(); ++c) {
+      if (layout.curve_closed[c] || offsets[c + 1] - offsets[c] < 2) continue;
+      for (const auto& [end, next] : {std::pair{offsets[c], offsets[c] + 1}, std::pair{offsets[c + 1] - 1, offsets[c + 1] - 2}}) {
+        const int32_t v = vertices[end], e = mesh.find_edge(v, vertices[next]);
+        if (layout.feature_degree[v] != 1 || e < 0) continue;
+        const int32_t k = mesh.edge_face_count(e);
+        if (k >= 3 && 2 * layout.sectors[v] == k) end_curve[v] = c;
+      }
+    }
+    return end_curve;
+  }
+
+  // A dead end locked after all (lock_inconsistent) is a locked end of its curve again; every
+  // other open curve end is locked.
+  void count_locked_ends(CollapseSetup& setup) const {
+    setup.curve_locked_ends.assign(layout.num_curves(), 0);
+    for (int32_t c = 0; c < layout.num_curves(); ++c) setup.curve_locked_ends[c] = layout.curve_closed[c] ? 0 : 2;
+    for (int32_t i = 0; i < int32_t(setup.dead_end.size()); ++i) {
+      if (!setup.dead_end[i]) continue;
+      if (setup.locked[i]) {
+        --setup.curve_size[setup.curve[i]];
+        setup.curve[i] = -1;
+        setup.dead_end[i] = 0;
+      } else {
+        --setup.curve_locked_ends[setup.curve[i]];
+      }
+    }
+  }
+
   // Vertices next to a pinched vertex (several fans) or on a non-manifold edge are free: the
   // collapses that would delete a wing or a sheet there are refused one by one
   // (Collapser::duplicates_a_face, merges_unlike_edges). Freezing their rings had stopped
-  // scans and multi-part models far above the target. The triangles at an inconsistently
-  // oriented edge stay: collapsing it away would make its component consistently oriented.
+  // scans and multi-part models far above the target. One inconsistently oriented edge per
+  // component keeps its two triangles (their corners locked): collapsing every such edge away
+  // would make the component consistently oriented. (Locking the rings of all of them froze
+  // whole regions of scans: Stanford's dragon at its lowest resolution kept 2,528 triangles.)
   void lock_inconsistent(CollapseSetup& setup) const {
     if (mesh.report().inconsistent_edges == 0) return;
+    struct Side {
+      int32_t a, b, face;
+      bool forward;
+    };
+    std::vector<Side> sides;
+    sides.reserve(result.triangles.size());
+    for (int32_t t = 0; t < int32_t(result.triangles.size() / 3); ++t)
+      for (int j = 0; j < 3; ++j) {
+        const int32_t from = result.triangles[3 * size_t(t) + j], to = result.triangles[3 * size_t(t) + (j + 1) % 3];
+        sides.push_back({std::min(from, to), std::max(from, to), t, from < to});
+      }
+    std::sort(sides.begin(), sides.end(), [](const Side& x, const Side& y) {
+      return x.a < y.a || (x.a == y.a && (x.b < y.b || (x.b == y.b && x.face < y.face)));
+    });
     const auto& index = mesh.vertex_index();
-    const auto flipped = on_inconsistent_edge(mesh);
-    for (size_t t = 0; t < result.triangles.size() / 3; ++t) {
-      bool at_flip = false;
-      for (int j = 0; j < 3; ++j) at_flip |= flipped[index[result.kept[result.triangles[3 * t + j]]]] != 0;
-      if (at_flip)
-        for (int j = 0; j < 3; ++j) setup.locked[result.triangles[3 * t + j]] = 1;
+    std::vector<uint8_t> component_done(mesh.report().components + 1, 0);
+    for (size_t i = 0; i < sides.size();) {
+      size_t k = i;
+      while (k < sides.size() && sides[k].a == sides[i].a && sides[k].b == sides[i].b) ++k;
+      const int32_t component = mesh.component()[index[result.kept[sides[i].a]]];
+      if (k - i == 2 && sides[i].forward == sides[i + 1].forward && component >= 0 &&
+          size_t(component) < component_done.size() && !component_done[component]) {
+        component_done[component] = 1;
+        for (size_t s = i; s < k; ++s)
+          for (int j = 0; j < 3; ++j) setup.locked[result.triangles[3 * size_t(sides[s].face) + j]] = 1;
+      }
+      i = k;
     }
   }
 
