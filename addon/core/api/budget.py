@@ -7,10 +7,9 @@ vertex) away from it. Why, in the words every channel uses:
 - "control points": the vertices painted to stay (u = 1) outnumber the target;
 - "borders": corners of borders (seams, materials, sharp or hard-normal edges), always kept,
   outnumber the target;
-- "non-manifold edges": the result's vertices on non-manifold edges (edges of three or more
-  triangles) outnumber the target and make up at least half of the result: each such curve
-  keeps its course and at least one edge, each sheet along it its triangles, so the topology
-  stays; the detail says how many vertices that is;
+- "non-manifold edges": at least half of the result's vertices lie on non-manifold edges (edges
+  of three or more triangles): each such curve keeps its course and at least one edge, each
+  sheet along it its triangles, so the topology stays; the detail says how many vertices that is;
 - "topology": samples the topology needs (each loose piece keeps at least a triangle, each
   hole and handle its loops);
 - "symmetry": the mirrored sample set is larger (or, where partners of absorbed samples were
@@ -72,8 +71,8 @@ def over_reason(stats) -> str:
     """Why a result with these DecimateStats landed over its target (see the module docs)."""
     if stats.forced >= stats.target_vertices and stats.control_points:
         return "control points"
-    if stats.nonmanifold_vertices >= max(stats.target_vertices, stats.output_vertices / 2):
-        return "non-manifold edges"  # and they are most of the result
+    if stats.nonmanifold_vertices >= stats.output_vertices / 2:
+        return "non-manifold edges"
     if stats.forced >= stats.target_vertices:
         return "borders"
     if stats.mirrored_from and stats.mirrored_from - stats.target_vertices <= tolerance(stats.target_vertices):

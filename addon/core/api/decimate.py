@@ -95,7 +95,7 @@ class DecimateStats:
     @property
     def over_budget_reason(self) -> str:
         """Why the result is over budget: "" (it is not), "control points" (the vertices painted to
-        stay outnumber the target), "non-manifold edges" (so do the result's vertices on them),
+        stay outnumber the target), "non-manifold edges" (half the result's vertices lie on them),
         "borders" (so do the corners of borders), "symmetry" (the
         mirrored sample set) or "topology" (samples the topology needed); see core/api/budget.py."""
         return budget.over_reason(self) if self.over_budget else ""
