@@ -153,4 +153,4 @@ def test_blender_batch_reports_the_missed_target(ts, scene, tmp_path):
     asked, got = round(0.1 * 3 * LOOSE), 3 * LOOSE
     missed = [lod["target_missed"] for o in entry["objects"] for lod in o["lods"]]
     assert missed == [{"asked": asked, "got": got, "unit": "vertices", "off": got - asked,
-                       "fraction": pytest.approx((got - asked) / asked), "reason": "topology"}]
+                       "fraction": pytest.approx((got - asked) / asked), "reason": "topology", "detail": ""}]
