@@ -8,6 +8,7 @@
 
 #include "convert.hpp"
 #include "topstoc/decimate/moved_sources.hpp"
+#include "topstoc/core/progress.hpp"
 #include "topstoc/core/validate.hpp"
 #include "topstoc/decimate/decimate.hpp"
 #include "topstoc/core/quality.hpp"
@@ -15,6 +16,11 @@
 namespace topstoc::python {
 
 namespace {
+
+// The Python side's CancelFlag (std::atomic is neither copyable nor movable: held by pointer).
+struct CancelToken {
+  CancelFlag flag{false};
+};
 
 DensityMode density_from(const std::string& name) {
   if (name == "off") return DensityMode::Off;
@@ -209,24 +215,35 @@ void bind_decimate(py::module_& m) {
       .def("clear", &FloodCachePool::clear, "Frees the caches not in use.")
       .def_property_readonly("size", &FloodCachePool::size, "Caches held (in use or not).");
 
+  py::class_<CancelToken>(m, "CancelFlag",
+                          "Set from any thread, stops the decimation given it at its next check (raises Cancelled).")
+      .def(py::init<>())
+      .def("set", [](CancelToken& token) { token.flag = true; }, "Asks the decimation to stop.")
+      .def_property_readonly("is_set", [](const CancelToken& token) { return token.flag.load(); });
+
   m.def(
       "decimate",
-      [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& job, const py::handle& flood_caches) {
+      [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& job, const py::handle& flood_caches,
+         const py::handle& cancel) {
         JobArrays arrays;
         DecimateParams params = params_from(mesh, job, arrays);
         params.flood_caches = flood_caches.is_none() ? nullptr : flood_caches.cast<FloodCachePool*>();
         const py::object triangles = job.attr("target").attr("triangles");
         const int32_t target_triangles = triangles.is_none() ? 0 : triangles.cast<int32_t>();
+        const CancelFlag* flag = cancel.is_none() ? nullptr : &cancel.cast<CancelToken&>().flag;
         DecimateResult r;
         {
           EngineCall call;
+          CancelScope scope(flag);
           r = target_triangles > 0 ? decimate_to_triangles(mesh, layout, params, target_triangles)
                                    : decimate(mesh, layout, params);
         }
         return result_dict(std::move(r));
       },
       py::arg("mesh"), py::arg("layout"), py::arg("job"), py::arg("flood_caches") = py::none(),
-      "TopStoc decimation of a topstoc.core.api.job.DecimationJob (a triangle target when it has one).");
+      py::arg("cancel") = py::none(),
+      "TopStoc decimation of a topstoc.core.api.job.DecimationJob (a triangle target when it has one); "
+      "cancel: a CancelFlag another thread may set (Cancelled is raised).");
 
   m.def(
       "decimate_with_samples",

@@ -7,37 +7,13 @@
 #include <vector>
 
 #include "decimate/collapser.hpp"
+#include "collapse_setup.hpp"
 #include "meshes.hpp"
 
-using topstoc::CollapseSetup;
 using topstoc::Collapser;
+using topstoc_test::torus_setup;
 
 namespace {
-
-// A torus (no borders, no feature curves), its plane quadrics summed at the corners.
-CollapseSetup torus_setup(const topstoc_test::Arrays& mesh) {
-  const int32_t n = int32_t(mesh.positions.size() / 3);
-  CollapseSetup s;
-  s.quadrics = topstoc::VertexQuadrics(n, 0);
-  for (size_t t = 0; 3 * t < mesh.triangles.size(); ++t) {
-    const int32_t* c = &mesh.triangles[3 * t];
-    double plane[10], area;
-    if (!topstoc::VertexQuadrics::plane(&mesh.positions[3 * size_t(c[0])], &mesh.positions[3 * size_t(c[1])],
-                                        &mesh.positions[3 * size_t(c[2])], plane, &area))
-      continue;
-    for (int j = 0; j < 3; ++j)
-      for (int k = 0; k < 10; ++k) s.quadrics.at(c[j])[k] += plane[k];
-  }
-  s.positions = mesh.positions;
-  s.world = mesh.positions;
-  s.weight.assign(n, 1.0);
-  s.locked.assign(n, 0);
-  s.curve.assign(n, -1);
-  s.corner_sector.assign(mesh.triangles.size(), 0);
-  s.bin.assign(n, 0);
-  s.quota = {0};  // no bin holds vertices back
-  return s;
-}
 
 // Live vertices of `c` with x > 0.
 int32_t alive_on_positive_side(const Collapser& c) {

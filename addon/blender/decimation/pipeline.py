@@ -112,10 +112,10 @@ def engine_job(mesh, target: dict, options: dict, guidance: EngineGuidance) -> D
                     **look_kwargs(options, guidance.appearance))
 
 
-def run_engine(mesh, job: DecimationJob, progress=None):
+def run_engine(mesh, job: DecimationJob, progress=None, cancel=None):
     """One engine decimation of a job (every add-on decimation passes here); progress: an error
-    target's search (core.api.decimate.run_job)."""
-    return run_job(mesh, job, progress)
+    target's search, cancel: a CancelFlag that stops it (core.api.decimate.run_job)."""
+    return run_job(mesh, job, progress, cancel)
 
 
 def input_triangles(mesh) -> int:

@@ -38,6 +38,9 @@ from .job import (  # noqa: F401 - View, Box and the constants are this module's
     Box, DecimationJob, View, attribute_arrays, guidance_values, make_job, target_vertex_count)
 from ..support.native import engine
 
+#: a flag another thread sets to stop a decimation (run_job's ``cancel``)
+CancelFlag = engine.CancelFlag
+
 if TYPE_CHECKING:  # for annotations only: mesh.py imports this module
     from .mesh import Mesh
 
@@ -223,10 +226,12 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     return run_job(mesh, job)
 
 
-def run_job(mesh: Mesh, job: DecimationJob, progress=None) -> DecimateResult:
+def run_job(mesh: Mesh, job: DecimationJob, progress=None, cancel: Optional[CancelFlag] = None) -> DecimateResult:
     """Runs a DecimationJob (core/api/job.py): mirrored (core/api/symmetry.py), error-bounded (a search
     over vertex counts, core/api/error_bound.py) or one engine call. progress: the error-bounded
-    search's ``progress(probe, target, vertices, error, passed)`` (False cancels; error_bound.py)."""
+    search's ``progress(probe, target, vertices, error, passed)`` (False cancels; error_bound.py).
+    cancel: a CancelFlag another thread may set to stop the engine at its next check (raises
+    Cancelled; a mirrored job runs to its end)."""
     if job.symmetry is not None:
         from .symmetry import decimate_job_mirrored
 
@@ -234,13 +239,13 @@ def run_job(mesh: Mesh, job: DecimationJob, progress=None) -> DecimateResult:
     if job.target.max_error is not None:
         from .error_bound import search_vertex_count
 
-        result, report = search_vertex_count(mesh, job.target.max_error, lambda count: run_job(mesh, job.at(count)),
+        result, report = search_vertex_count(mesh, job.target.max_error, lambda count: run_job(mesh, job.at(count), cancel=cancel),
                                              relative=job.target.relative, progress=progress,
                                              check_passes=job.mode == "quality")
         return dataclasses.replace(result, error_bound=report, parameters={
             **result.parameters, "max_error": job.target.max_error, "relative": job.target.relative})
     layout, floods = mesh.layout_and_floods(job.regions, job.borders, job.feature_angle)
-    raw = engine.decimate(mesh.native, layout, job, flood_caches=floods)
+    raw = engine.decimate(mesh.native, layout, job, flood_caches=floods, cancel=cancel)
     return _result(raw, job.parameters(), mesh, job)
 
 

@@ -1,5 +1,6 @@
 #include "decimate/collapser.hpp"
 #include "topstoc/core/parallel.hpp"
+#include "topstoc/core/progress.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -323,6 +324,7 @@ int32_t Collapser::run(Stop target) {
   int32_t collapses = 0;
   Batch batch;
   while (!reached(target)) {
+    check_cancelled("collapses");
     if (heap_.empty()) {
       // Some region could not reach its quota: the others give the rest, by cost alone.
       if (!use_quota_) break;

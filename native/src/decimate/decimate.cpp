@@ -565,6 +565,7 @@ class BorrowedCache {
 // One pass: draw samples for `target`, then flood, check, repair, emit.
 DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
                              int32_t target, int32_t top_up_to, FloodCache* cache) {
+  check_cancelled("sampling");
   const int32_t active = active_vertices(mesh);
   const auto start = Clock::now();
   SampleSet set = select_samples(mesh, layout, params.sampling, target);
@@ -703,6 +704,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   refine.refit = params.placement == Placement::Filtered;
   refine.max_aware = refine.refit;
   refine.attributes = params.attributes;
+  check_cancelled("refinement");
   refine_by_collapses(mesh, layout, refine, result);
   result.target_vertices = params.target_vertices;
   // What must stay whatever the target: border corners and control points (the first pass

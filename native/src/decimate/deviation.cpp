@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "topstoc/core/parallel.hpp"
+#include "topstoc/core/progress.hpp"
 
 namespace topstoc {
 
@@ -174,6 +175,7 @@ InputSurface::InputSurface(const Mesh& mesh, const Collapser& collapser)
 
 Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const std::vector<int32_t>& label,
                           Collapser& collapser, const std::vector<int32_t>& triangles) {
+  check_cancelled("deviation");
   const int32_t n = collapser.vertices();
   std::vector<int32_t> survivor(n);
   for (int32_t v = 0; v < n; ++v) survivor[v] = collapser.survivor(v);

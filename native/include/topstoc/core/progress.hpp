@@ -7,6 +7,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <stdexcept>
@@ -56,5 +57,32 @@ class Progress {
   double begin_ = 0.0, end_ = 1.0, reported_ = 0.0;
   std::chrono::steady_clock::time_point last_{};
 };
+
+/// A flag another thread sets to stop an engine call at its next cancel check (a live preview
+/// drops a computation whose ratio the user moved away from).
+using CancelFlag = std::atomic<bool>;
+
+namespace detail {
+inline thread_local const CancelFlag* current_cancel = nullptr;
+}
+
+/// Makes `flag` the calling thread's cancel flag for the scope's lifetime (null: none).
+class CancelScope {
+ public:
+  explicit CancelScope(const CancelFlag* flag) : previous_(detail::current_cancel) { detail::current_cancel = flag; }
+  ~CancelScope() { detail::current_cancel = previous_; }
+  CancelScope(const CancelScope&) = delete;
+  CancelScope& operator=(const CancelScope&) = delete;
+
+ private:
+  const CancelFlag* previous_;
+};
+
+/// Throws Cancelled(stage) when the calling thread's cancel flag is set (checks between steps of
+/// serial code; threads of a team have none).
+inline void check_cancelled(const char* stage) {
+  const CancelFlag* flag = detail::current_cancel;
+  if (flag != nullptr && flag->load(std::memory_order_relaxed)) throw Cancelled(stage);
+}
 
 }  // namespace topstoc
