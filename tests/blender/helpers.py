@@ -107,6 +107,7 @@ class EngineCall(NamedTuple):
     target: object
     draft: bool
     thread: str
+    cancel: object = None  # the CancelFlag it was given (a speculation), else None
 
 
 class EngineCalls:
@@ -119,12 +120,13 @@ class EngineCalls:
         self.gate.set()
         original = pipeline.run_engine
 
-        def run_engine(mesh, job):
-            self.calls.append(EngineCall(job.mode, job.target, bool(job.draft), threading.current_thread().name))
+        def run_engine(mesh, job, progress=None, cancel=None):
+            self.calls.append(EngineCall(job.mode, job.target, bool(job.draft), threading.current_thread().name,
+                                         cancel))
             if hold(job) and not self.gate.is_set():
                 self.held.set()
                 self.gate.wait(30)
-            return original(mesh, job)
+            return original(mesh, job, progress, cancel)
 
         monkeypatch.setattr(pipeline, "run_engine", run_engine)
 

@@ -133,12 +133,12 @@ class EngineCalls:
         self.calls, self.gate, self.held = [], threading.Event(), threading.Event()
         self.gate.set()
 
-        def run_engine(mesh, job):
+        def run_engine(mesh, job, progress=None, cancel=None):
             self.calls.append((job.mode, job.target, threading.current_thread().name))
             if job.mode == "quality" and not self.gate.is_set():
                 self.held.set()
                 self.gate.wait(30)
-            return self.original(mesh, job)
+            return self.original(mesh, job, progress, cancel)
 
         pipeline.run_engine = run_engine
 

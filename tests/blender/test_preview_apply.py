@@ -79,6 +79,7 @@ def test_with_fast_chosen_the_drag_shows_drafts_and_the_rested_result_is_applied
     """Drag frames are drafts (no attribute sources, no final output check); the rested result
     is the full fast decimation, checked, with the draft's geometry, and Enter writes it as shown."""
     preview = ts.blender.preview.session
+    monkeypatch.setattr(preview, "SPECULATE", False)  # the full result only once the drag rests
     engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="FAST", seed=2), ratio=0.1)
     try:
@@ -107,6 +108,7 @@ def test_with_fast_chosen_the_drag_shows_drafts_and_the_rested_result_is_applied
 
 def test_applying_during_a_drag_computes_the_chosen_settings_on_the_worker(ts, scene, donut, monkeypatch):
     preview = ts.blender.preview.session
+    monkeypatch.setattr(preview, "SPECULATE", False)  # no quality computation before Enter's
     engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=5), ratio=0.1)
     try:
@@ -119,8 +121,8 @@ def test_applying_during_a_drag_computes_the_chosen_settings_on_the_worker(ts, s
         assert time.perf_counter() - start < 0.5
         assert engine.held.wait(10) and session.applying
         assert session.poll_apply() is None  # the main thread is free while the worker computes
-        _mode, target, _draft, thread = next(call for call in engine.calls if call.mode == "quality")
-        assert target.ratio == 0.17 and thread.startswith(preview.THREAD_PREFIX)
+        call = next(call for call in engine.calls if call.mode == "quality")
+        assert call.target.ratio == 0.17 and call.thread.startswith(preview.THREAD_PREFIX)
         engine.gate.set()
         runs = []
         assert wait_for(lambda: runs.append(session.poll_apply()) or runs[-1] is not None)
@@ -141,6 +143,7 @@ def test_applying_during_a_drag_computes_the_chosen_settings_on_the_worker(ts, s
 def test_applying_uses_the_quality_result_still_being_computed(ts, scene, donut, monkeypatch):
     """Enter while the rested quality result is on its way: that computation is the one applied."""
     preview = ts.blender.preview.session
+    monkeypatch.setattr(preview, "SPECULATE", False)  # the rest starts it (test_preview_speculation.py: ahead of it)
     engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=1), ratio=0.1)
     try:

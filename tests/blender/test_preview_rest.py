@@ -46,6 +46,7 @@ def drag(session, ratios):
 
 def test_the_rest_is_the_absence_of_new_ratios_and_gives_the_quality_result(ts, donut, monkeypatch):
     preview = ts.blender.preview.session
+    monkeypatch.setattr(preview, "SPECULATE", False)  # (test_preview_speculation.py: computed ahead of the rest)
     engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline, hold=lambda job: job.draft)
     monkeypatch.setattr(preview, "REST_SECONDS", DAY)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=4), ratio=0.1)
@@ -113,6 +114,7 @@ def test_a_fast_quality_result_is_what_the_drag_shows(ts, donut, monkeypatch):
 
 def test_a_slow_quality_result_leaves_the_drag_to_drafts(ts, donut, monkeypatch):
     preview = ts.blender.preview.session
+    monkeypatch.setattr(preview, "SPECULATE", False)
     engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline, hold=lambda job: job.draft)
     monkeypatch.setattr(preview, "DIRECT_SECONDS", 0.0)
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=7), ratio=0.1)

@@ -33,6 +33,12 @@ decimation's time. Where the chosen settings' result took at most DIRECT_SECONDS
 this mesh, in this session or an earlier one), the drag asks for it directly: the draft is
 the result itself. The chosen settings' recent results are kept per ratio, so going back to a
 ratio shows its result at once.
+
+Where that result is slow, a worker with no draft to compute starts it for the latest ratio
+while the drag goes on (SPECULATE): the ratio moving on cancels it in the engine, and when the
+drag rests there it is already under way (the rest takes it over instead of starting anew) or
+done (it is shown as soon as it is, rest or not). One such computation runs at a time, so a
+worker stays free for the drafts.
 """
 
 from __future__ import annotations
@@ -49,6 +55,7 @@ import numpy as np
 
 from ...core.carry.attributes import moved_vertices
 from ...core.api.loops import Cancelled
+from ...core.api.decimate import CancelFlag
 from ...core.api.mesh_edges import mesh_edges
 from ..io import mesh_read, mesh_write, edge_flags
 from ..decimation import pipeline
@@ -59,6 +66,7 @@ WORKERS = 2 if (os.cpu_count() or 1) >= 2 else 1
 REST_SECONDS = 0.08  # no new ratio asked this long: the drag rests (several mouse events would have come)
 DIRECT_SECONDS = 0.12  # a chosen-settings result this fast is what the drag shows, instead of drafts
 KEPT_RESULTS = 8  # chosen-settings results kept per ratio
+SPECULATE = True  # a worker with no draft to compute starts the latest ratio's chosen-settings result
 THREAD_PREFIX = "topstoc-preview"
 
 
@@ -95,6 +103,8 @@ class PreviewSession:
         self._asked = self._pending            # latest request, and when it came (rest detection)
         self._asked_at = time.perf_counter()
         self._kept = OrderedDict()             # ratio -> finished chosen-settings computation (KEPT_RESULTS)
+        self._speculation = None               # (key, CancelFlag) of the chosen-settings computation
+                                               # started ahead of the rest (SPECULATE), while it runs
         self._options_key = repr(sorted(self.options.items()))  # the prepared mesh's final_seconds key
         self._started: Optional[tuple] = None  # newest computation started
         self._started_count = 0                # computations started (their order numbers)
@@ -190,13 +200,15 @@ class PreviewSession:
         """A request's key: (ratio, made in full with the chosen settings)."""
         return ratio, bool(final)
 
-    def compute(self, ratio: float, final: bool = False):
+    def compute(self, ratio: float, final: bool = False, cancel: Optional[CancelFlag] = None):
         """Decimates at ``ratio`` (fast, or with the chosen settings with ``final``) and derives the
-        result's edges (any thread: the main thread then only copies arrays into the preview)."""
+        result's edges (any thread: the main thread then only copies arrays into the preview);
+        ``cancel`` set stops the engine (Cancelled)."""
         start = time.perf_counter()
         options = self.options if final else self.drag_options
         mesh = self.prepared.mesh
-        result = pipeline.run_engine(mesh, pipeline.engine_job(mesh, {"ratio": ratio}, options, self.guidance))
+        job = pipeline.engine_job(mesh, {"ratio": ratio}, options, self.guidance)
+        result = pipeline.run_engine(mesh, job) if cancel is None else pipeline.run_engine(mesh, job, cancel=cancel)
         edges = mesh_edges(result.triangles, len(result.vertices))
         flags = {}
         if any(len(pairs) for pairs in self._edge_flags.values()):
@@ -258,6 +270,15 @@ class PreviewSession:
                 self._pending = self._finished = self._started = None
                 self._shown_order = self._started_count
                 return
+            if self._finished is not None and self._finished[1][0] == self.key(ratio, True):
+                self._pending = None  # that result is about to be shown
+                return
+            if self._speculation is not None:
+                if self._speculation[0][0] != ratio:  # the drag moved on: stop it in the engine
+                    self._speculation[1].set()
+                elif final and not self._speculation[1].is_set:  # the rest takes over the one running
+                    self._pending = None
+                    return
             kept = self._kept.get(ratio) if final else None
             if kept is not None:  # computed before: it becomes the newest result
                 self._pending, self._started = None, self._asked
@@ -276,42 +297,95 @@ class PreviewSession:
                 self._pool.submit(self._work)
 
     def _work(self) -> None:
-        """Worker loop: computes the latest pending request until none is new."""
+        """Worker loop: computes the latest pending request until none is new, then the latest
+        ratio's chosen-settings result ahead of the rest (SPECULATE)."""
         while True:
             self._stagger()
             with self._lock:
                 key, self._pending = self._pending, None
                 if key is None or key == self._started or self._cancel.is_set():
-                    self._workers -= 1
-                    return
-                self._started = key
-                self._started_count += 1
-                self._last_start = time.perf_counter()
-                order = self._started_count
-            try:
-                finished = self.compute(*key)
-            except Exception as error:  # noqa: BLE001 - handed to the main thread
-                with self._lock:
-                    self._error, self._started = error, None
-                    self._workers -= 1
+                    speculation, order = self._speculation_to_start(), 0
+                    if speculation is None:
+                        self._workers -= 1
+                        return
+                else:
+                    speculation, order = None, self._mark_started(key)
+            if not (self._speculate(*speculation) if speculation else self._compute_request(key, order)):
                 return
+
+    def _mark_started(self, key) -> int:
+        """Records that ``key`` starts now (under the lock); its order number."""
+        self._started = key
+        self._started_count += 1
+        self._last_start = time.perf_counter()
+        return self._started_count
+
+    def _compute_request(self, key, order: int) -> bool:
+        """Computes a request (worker) and hands it to the main thread unless a newer one was;
+        False when the worker ends (an error, or the session closed)."""
+        try:
+            finished = self.compute(*key)
+        except Exception as error:  # noqa: BLE001 - handed to the main thread
             with self._lock:
-                if self._cancel.is_set():  # closed meanwhile: the result ends unseen
-                    self._workers -= 1
-                    return
-                seconds = finished[3]
-                self._typical = 0.7 * self._typical + 0.3 * seconds if self._typical else seconds
-                if key[1]:
-                    self._keep(key[0], seconds, finished)
-                # A newer result replaces one not shown yet; an older one than shown is dropped.
-                newest = self._finished[0] if self._finished else self._shown_order
-                sources = False
-                if order > newest:
-                    self._finished = (order, finished)
-                    if key[1] and key == self._asked:  # a result Enter may write: its attribute sources
-                        self._sources, sources = (finished[1], None), True
-            if sources:
-                self._find_sources(finished[1])
+                self._error, self._started = error, None
+                self._workers -= 1
+            return False
+        with self._lock:
+            if self._cancel.is_set():  # closed meanwhile: the result ends unseen
+                self._workers -= 1
+                return False
+            seconds = finished[3]
+            self._typical = 0.7 * self._typical + 0.3 * seconds if self._typical else seconds
+            if key[1]:
+                self._keep(key[0], seconds, finished)
+            # A newer result replaces one not shown yet; an older one than shown is dropped.
+            newest = self._finished[0] if self._finished else self._shown_order
+            sources = False
+            if order > newest:
+                self._finished = (order, finished)
+                if key[1] and key == self._asked:  # a result Enter may write: its attribute sources
+                    self._sources, sources = (finished[1], None), True
+        if sources:
+            self._find_sources(finished[1])
+        return True
+
+    def _speculation_to_start(self):
+        """(key, CancelFlag) of the latest drag ratio's chosen-settings computation when a worker
+        with nothing else to do should start it, else None (under the lock)."""
+        asked = self._asked
+        if (not SPECULATE or self._speculation is not None or asked is None or asked[1] or self.direct
+                or self._cancel.is_set() or asked[0] in self._kept or (self.final and self.ratio == asked[0])):
+            return None
+        self._speculation = (self.key(asked[0], True), CancelFlag())
+        return self._speculation
+
+    def _speculate(self, key, cancel: CancelFlag) -> bool:
+        """Computes a speculation (worker): kept like any chosen-settings result, and shown when
+        the drag is still at its ratio; dropped when cancelled. False when the worker ends (an
+        error, or the session closed)."""
+        finished = error = None
+        try:
+            finished = self.compute(*key, cancel=cancel)
+        except Cancelled:
+            pass
+        except Exception as failure:  # noqa: BLE001 - handed to the main thread
+            error = failure
+        with self._lock:
+            self._speculation = None
+            if error is not None or self._cancel.is_set():
+                self._error, self._workers = error or self._error, self._workers - 1
+                return False
+            if finished is None:
+                return True
+            self._keep(key[0], finished[3], finished)
+            shown = self._asked is not None and self._asked[0] == key[0]
+            if shown:  # newer than anything computed for the drag so far
+                self._started_count += 1
+                self._finished = (self._started_count, finished)
+                self._sources = (finished[1], None)
+        if shown:
+            self._find_sources(finished[1])
+        return True
 
     def _keep(self, ratio: float, seconds: float, finished) -> None:
         """Remembers a chosen-settings computation and its seconds (worker, under the lock)."""
@@ -327,7 +401,7 @@ class PreviewSession:
         drag's request starts at once."""
         with self._lock:
             resting = self._pending is not None and self._pending[1] and not self.direct
-            if self._workers < 2 or not self._typical or resting:
+            if self._workers < 2 or not self._typical or resting or self._pending is None:
                 return
             wait = self._typical / WORKERS - (time.perf_counter() - self._last_start)
         if wait > 0:
@@ -453,6 +527,8 @@ class PreviewSession:
         unseen; workers never touch Blender data, so nothing waits for them."""
         self._cancel.set()
         with self._lock:
+            if self._speculation is not None:
+                self._speculation[1].set()
             self._pending = self._applying = self._to_apply = self._finished = self._sources = None
         self._pool.shutdown(wait=False)
         if self.preview is not None:
