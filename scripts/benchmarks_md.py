@@ -248,6 +248,26 @@ def render_cleanup_speed(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def render_blender_rest(name: str, figures: dict) -> str:
+    """bench_blender_decimate.py --only-rest --json: seconds from a drag resting to the Live Preview's
+    Quality result, per mesh and ratio, for each build measured (before, after)."""
+    labels = sorted({label for mesh in figures["meshes"] for row in mesh["ratios"].values() for label in row},
+                    key=lambda label: (label != "before", label))
+    out = [f"## Live Preview: drag rested → Quality result (`{name}`)", "",
+           f"`{figures['benchmark']}` in Blender {figures['blender']}. Issue 39's goal: ≤ 0.3 s up to 200k "
+           "triangles, ≤ 1 s on the horse. Per build: the rest's seconds (the Quality computation's own seconds; "
+           "updates shown per second during the drag; load average).", "", *source_lines(figures), "",
+           "| Mesh | Triangles | Ratio | " + " | ".join(labels) + " |", "|---|---|---|" + "---|" * len(labels)]
+    for mesh in figures["meshes"]:
+        for ratio, row in mesh["ratios"].items():
+            cells = ["—" if row.get(label) is None else
+                     f"{row[label]['rest_s']:.3f} s ({row[label]['computed_s']:.3f} s; "
+                     f"{row[label]['drag_updates_per_s']:.0f}/s; load {row[label]['load_average']:.1f})"
+                     for label in labels]
+            out.append(f"| {mesh['mesh']} | {mesh['triangles']:,} | {percent(float(ratio))} | " + " | ".join(cells) + " |")
+    return "\n".join(out) + "\n"
+
+
 def render_carried_over(name: str, figures: dict) -> str:
     """Figures measured before the benchmarks saved JSON, kept as they were published."""
     out = [f"## {figures['title']} (`{name}`)", "", *source_lines(figures), "", figures["note"], "",
@@ -382,9 +402,12 @@ def render_result(path: pathlib.Path) -> str:
         return render_cleanup_speed(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_cleanup.py":
         return render_cleanup(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_blender_decimate.py --only-rest":
+        return render_blender_rest(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
                      "the --json of bench_decimate.py, bench_quality.py, bench_attributes.py, bench_loops.py --families, "
-                     "bench_scale.py, bench_threads_paired.py, bench_cleanup.py and bench_cleanup.py --speed, and carried-over "
+                     "bench_scale.py, bench_threads_paired.py, bench_cleanup.py, bench_cleanup.py --speed and "
+                     "bench_blender_decimate.py --only-rest, and carried-over "
                      "figures)")
 
 

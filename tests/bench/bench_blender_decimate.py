@@ -3,6 +3,11 @@
     blender -b --factory-startup --python tests/bench/bench_blender_decimate.py -- [--ratios 0.01 0.1]
         [--mesh PATH] [--repeat 3] [--updates 20]
     .venv/bin/python tests/bench/bench_blender_decimate.py -- ...   (PyPI's bpy)
+    ... -- --only-rest --mesh bumpy_torus:150000 --json docs/bench_results/bench_blender_rest.json --label after
+
+``--mesh`` also takes ``bumpy_torus:TRIANGLES`` (tests/meshgen.py). With ``--only-rest --json FILE
+--label NAME`` the rest figures are merged into FILE under NAME per mesh and ratio, so that runs of
+two builds (TOPSTOC_BUILD) alternating one mesh at a time fill one table.
 
 On the 1.55M-triangle horse (../shared/meshes/big, skipped when absent): time to first result
 (read the Blender mesh + prepare + decimate + write the new object with attributes) and the time
@@ -15,6 +20,7 @@ result on screen. Prints medians and ratios.
 """
 
 import argparse
+import json
 import os
 import pathlib
 import platform
@@ -27,6 +33,10 @@ import addon_utils  # noqa: E402
 import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path[:0] = [str(ROOT / "tests"), str(ROOT / "tests" / "bench")]
+import meshgen  # noqa: E402
+from machine import save_figures  # noqa: E402
+
 HORSE = ROOT.parent / "shared" / "meshes" / "big" / "horse_loop2_1.55M.ply"
 
 
@@ -164,16 +174,18 @@ def preview_drag(obj, ratio, seconds=4.0, event_interval=0.01, span=2.0):
 def rested_quality(obj, ratio, drag_seconds=1.0, event_interval=0.01):
     """Seconds from the drag resting (the last ratio requested) to the rested Quality result on
     screen, the way the modal runs it (requests every 10 ms over [ratio / 1.5, ratio], then
-    polling at the modal timer's 60 Hz), and the seconds of that Quality computation itself."""
+    polling at the modal timer's 60 Hz), the seconds of that Quality computation itself, and the
+    updates shown per second during the drag."""
     session = ts.blender.preview.session.PreviewSession(bpy.context, obj, Params(ratio, quality="QUALITY"), ratio=ratio)
     session.wait_prepared()
     sweep = np.geomspace(ratio / 1.5, ratio, 40)
-    start, i = time.perf_counter(), 0
+    start, i, shown = time.perf_counter(), 0, 0
     while time.perf_counter() - start < drag_seconds:
         session.request(float(sweep[i % len(sweep)]))
         i += 1
-        session.poll()
+        shown += session.poll()
         time.sleep(event_interval)
+    rate = shown / (time.perf_counter() - start)
     session.request(ratio)  # the drag rests here
     rested = time.perf_counter()
     while not (session.final and session.ratio == ratio):
@@ -182,7 +194,7 @@ def rested_quality(obj, ratio, drag_seconds=1.0, event_interval=0.01):
     seconds = time.perf_counter() - rested
     computed = session.final_seconds
     session.close()
-    return seconds, computed
+    return seconds, computed, rate
 
 
 def preview_apply(obj, ratio):
@@ -225,10 +237,30 @@ def applied(session, ratio):
 
 
 def print_rest(ratio, rests):
-    rest, computed = (statistics.median(r[i] for r in rests) for i in range(2))
+    rest, computed, rate = (statistics.median(r[i] for r in rests) for i in range(3))
     print(f"  ratio {ratio}: Live Preview, drag rested -> Quality result shown: {rest:.3f} s (its computation "
           f"{computed:.3f} s; medians of {len(rests)}, max {max(r[0] for r in rests):.3f} s; goal <= 0.3 s up to "
-          f"200k triangles, <= 1 s on the horse)")
+          f"200k triangles, <= 1 s on the horse); {rate:.1f} updates shown per second during the drag")
+    return {"ratio": ratio, "rest_s": rest, "rest_max_s": max(r[0] for r in rests), "computed_s": computed,
+            "drag_updates_per_s": rate, "repeats": len(rests), "load_average": os.getloadavg()[0]}
+
+
+REST_METHOD = ("a PreviewSession with Quality chosen, after a 1 s drag (a ratio requested every 10 ms over "
+               "[ratio / 1.5, ratio]): seconds from the last request to the Quality result on screen (polled at "
+               "60 Hz), medians of the repeats; builds alternate one mesh at a time (TOPSTOC_BUILD)")
+
+
+def save_rest(path, label, mesh, counts, rows):
+    """Merges one build's rest figures (``label``) for one mesh into the JSON file at ``path``."""
+    figures = json.loads(pathlib.Path(path).read_text()) if os.path.exists(path) else {"meshes": []}
+    entry = next((m for m in figures["meshes"] if m["mesh"] == mesh), None)
+    if entry is None:
+        entry = {"mesh": mesh, "vertices": counts[0], "triangles": counts[1], "ratios": {}}
+        figures["meshes"].append(entry)
+    for row in rows:
+        entry["ratios"].setdefault(str(row["ratio"]), {})[label] = row
+    save_figures(path, "tests/bench/bench_blender_decimate.py --only-rest", REST_METHOD,
+                 blender=bpy.app.version_string, meshes=figures["meshes"])
 
 
 def subdivided(vertices, triangles):
@@ -273,27 +305,27 @@ def main(argv):
     parser.add_argument("--modifier-repeat", type=int, default=1)
     parser.add_argument("--only-rest", action="store_true", help="measure only the rested Quality result")
     parser.add_argument("--subdivide", type=int, default=0, help="split every triangle in four this many times")
+    parser.add_argument("--json", metavar="FILE", help="with --only-rest: merge the rest figures into this file")
+    parser.add_argument("--label", default="after", help="the build's name in --json (before, after)")
     args = parser.parse_args(argv)
-    if not os.path.exists(args.mesh):
+    generated = args.mesh.startswith("bumpy_torus:")
+    if not generated and not os.path.exists(args.mesh):
         print(f"skipped: {args.mesh} is not available")
         return 0
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")),
                platform.processor())
     print(f"machine: {os.cpu_count()} cores, {cpu}; Blender {bpy.app.version_string}; "
           f"load average {os.getloadavg()[0]:.1f}; OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY', 'default')}")
-    try:
-        from topstoc.core.api.io import read_mesh  # any format when the io module is built
-        data = read_mesh(args.mesh)
-        vertices, triangles = data.vertices, data.triangles
-    except ImportError:
-        vertices, triangles = read_binary_ply(args.mesh)
+    vertices, triangles = read_input(args.mesh)
     for _ in range(args.subdivide):
         vertices, triangles = subdivided(vertices, triangles)
     obj = make_object("Horse", vertices, triangles)
-    print(f"mesh: {args.mesh} ({len(vertices):,} vertices, {len(triangles):,} triangles)")
+    print(f"mesh: {args.mesh} ({len(vertices):,} vertices, {len(triangles):,} triangles); "
+          f"add-on from {pathlib.Path(ts.__file__).parent}")
+    rest_rows = []
     for ratio in args.ratios:
         if args.only_rest:
-            print_rest(ratio, [rested_quality(obj, ratio) for _ in range(args.repeat)])
+            rest_rows.append(print_rest(ratio, [rested_quality(obj, ratio) for _ in range(args.repeat)]))
             continue
         firsts = []
         for _ in range(args.repeat):
@@ -338,8 +370,23 @@ def main(argv):
                   f"{len(modifier)}) -> {modifier[0][1][0]:,} v, {modifier[0][1][1]:,} t")
             print(f"  ratio modifier / TopStoc first result: {mod_seconds / first:.1f}x; "
                   f"modifier / slider update: {mod_seconds / update:.0f}x")
+    if args.json and rest_rows:
+        name = pathlib.Path(args.mesh).name + (f", subdivided {args.subdivide}x" if args.subdivide else "")
+        save_rest(args.json, args.label, name, (len(vertices), len(triangles)), rest_rows)
     print(f"load average after the run: {os.getloadavg()[0]:.1f} (on {os.cpu_count()} cores)")
     return 0
+
+
+def read_input(spec):
+    """Vertices and triangles of a mesh file, or of ``bumpy_torus:TRIANGLES`` (tests/meshgen.py)."""
+    if spec.startswith("bumpy_torus:"):
+        return meshgen.bumpy_torus(int(float(spec.split(":", 1)[1])))
+    try:
+        from topstoc.core.api.io import read_mesh  # any format when the io module is built
+        data = read_mesh(spec)
+        return data.vertices, data.triangles
+    except ImportError:
+        return read_binary_ply(spec)
 
 
 if __name__ == "__main__":
