@@ -35,7 +35,8 @@ the result itself. The chosen settings' recent results are kept per ratio, so go
 ratio shows its result at once.
 
 Where that result is slow, a worker with no draft to compute starts it for the latest ratio
-while the drag goes on (SPECULATE): the ratio moving on cancels it in the engine, and when the
+when the drag pauses (SPECULATE, SPECULATE_AFTER: shorter than a rest, longer than between two
+mouse events, so that a sweep keeps both workers for drafts): the ratio moving on cancels it in the engine, and when the
 drag rests there it is already under way (the rest takes it over instead of starting anew) or
 done (it is shown as soon as it is, rest or not). One such computation runs at a time, so a
 worker stays free for the drafts.
@@ -67,6 +68,7 @@ REST_SECONDS = 0.08  # no new ratio asked this long: the drag rests (several mou
 DIRECT_SECONDS = 0.12  # a chosen-settings result this fast is what the drag shows, instead of drafts
 KEPT_RESULTS = 8  # chosen-settings results kept per ratio
 SPECULATE = True  # a worker with no draft to compute starts the latest ratio's chosen-settings result
+SPECULATE_AFTER = 0.02  # ... once no new ratio came this long (a pause of the hand, not between two events)
 THREAD_PREFIX = "topstoc-preview"
 
 
@@ -304,13 +306,15 @@ class PreviewSession:
             with self._lock:
                 key, self._pending = self._pending, None
                 if key is None or key == self._started or self._cancel.is_set():
-                    speculation, order = self._speculation_to_start(), 0
-                    if speculation is None:
+                    (speculation, wait), order = self._speculation_to_start(), 0
+                    if speculation is None and wait is None:
                         self._workers -= 1
                         return
                 else:
-                    speculation, order = None, self._mark_started(key)
-            if not (self._speculate(*speculation) if speculation else self._compute_request(key, order)):
+                    speculation, wait, order = None, None, self._mark_started(key)
+            if wait is not None:  # the drag may only be between two events: look again then
+                time.sleep(wait)
+            elif not (self._speculate(*speculation) if speculation else self._compute_request(key, order)):
                 return
 
     def _mark_started(self, key) -> int:
@@ -350,14 +354,18 @@ class PreviewSession:
         return True
 
     def _speculation_to_start(self):
-        """(key, CancelFlag) of the latest drag ratio's chosen-settings computation when a worker
-        with nothing else to do should start it, else None (under the lock)."""
+        """For a worker with nothing else to do (under the lock): ((key, CancelFlag), None) of the
+        latest drag ratio's chosen-settings computation when it should start it, (None, seconds)
+        when it should look again in that many seconds, (None, None) when it may end."""
         asked = self._asked
         if (not SPECULATE or self._speculation is not None or asked is None or asked[1] or self.direct
                 or self._cancel.is_set() or asked[0] in self._kept or (self.final and self.ratio == asked[0])):
-            return None
+            return None, None
+        wait = SPECULATE_AFTER - (time.perf_counter() - self._asked_at)
+        if wait > 0:
+            return None, wait
         self._speculation = (self.key(asked[0], True), CancelFlag())
-        return self._speculation
+        return self._speculation, None
 
     def _speculate(self, key, cancel: CancelFlag) -> bool:
         """Computes a speculation (worker): kept like any chosen-settings result, and shown when
