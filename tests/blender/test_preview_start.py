@@ -70,6 +70,7 @@ def test_session_returns_before_the_preparation_and_shows_the_first_result(ts, s
 
 def test_a_request_during_the_preparation_is_the_first_result(ts, scene, monkeypatch):
     preview = ts.blender.preview.session
+    monkeypatch.setattr(preview, "SPECULATE", False)  # only the requests are computed
     ts.blender.preview.cache.prepared_meshes.clear()
     obj = make_object("Donut", *meshgen.torus(64, 32))
     gate, _steps, reached = gated_report(monkeypatch, preview, "order")
