@@ -214,8 +214,8 @@ def apply_steps(window, area, region, cx, cy):
         # 7: Enter during the drag: the Quality result at the dragged ratio is computed on the worker
         # (drafts while dragging and no rest, which a loaded machine may take between the events:
         # test_preview_rest.py tests those)
-        rest, direct = sessions.REST_SECONDS, sessions.DIRECT_SECONDS
-        sessions.REST_SECONDS, sessions.DIRECT_SECONDS = 86400.0, 0.0
+        rest, direct, speculate = sessions.REST_SECONDS, sessions.DIRECT_SECONDS, sessions.SPECULATE
+        sessions.REST_SECONDS, sessions.DIRECT_SECONDS, sessions.SPECULATE = 86400.0, 0.0, False
         engine.calls.clear()
         yield from start(0.1)
         for _ in range(200):
@@ -251,7 +251,7 @@ def apply_steps(window, area, region, cx, cy):
               and not torus.hide_get() and not operators.running
               and not any(t.name.startswith(sessions.THREAD_PREFIX) for t in threading.enumerate()))
         bpy.data.objects.remove(out)
-        sessions.REST_SECONDS, sessions.DIRECT_SECONDS = rest, direct
+        sessions.REST_SECONDS, sessions.DIRECT_SECONDS, sessions.SPECULATE = rest, direct, speculate
 
         # 8: Esc while the result to apply is computed: nothing written, the source as it was
         before = mesh_arrays(torus.data)

@@ -69,9 +69,11 @@ def test_lod_chain(ts, scene):
         bpy.ops.topstoc.lod_chain(ratios="1, 2")
 
 
-def test_preview_session(ts, scene):
+def test_preview_session(ts, scene, monkeypatch):
     obj = make_object("Donut", *meshgen.torus(64, 32))
     from helpers import Params
+
+    monkeypatch.setattr(ts.blender.preview.session, "SPECULATE", False)  # drafts until the drag rests
 
     session = ts.blender.preview.session.PreviewSession(bpy.context, obj, Params(seed=4, quality="QUALITY"))
     assert not obj.hide_get() and session.preview is None  # nothing changes before a result shows
