@@ -101,6 +101,29 @@ def test_cancel_while_preparing_stops_the_engine_and_changes_nothing(ts, donuts,
     assert cache.misses == misses + 1 and not cache._entries  # stopped in the engine: nothing cached
 
 
+def test_cancel_during_a_decimation_stops_the_engine(ts, donuts, monkeypatch):
+    """Esc once the mesh is prepared: the decimation running gets Cancelled from the engine."""
+    module, pipeline = background(ts), ts.blender.decimation.pipeline
+    original, raised, jobs = pipeline.run_engine, [], []
+
+    def run_engine(mesh, job, progress=None, cancel=None):
+        jobs[0].cancel()  # as if Esc came while the engine runs
+        try:
+            return original(mesh, job, progress, cancel)
+        except BaseException as error:
+            raised.append(error)
+            raise
+
+    monkeypatch.setattr(pipeline, "run_engine", run_engine)
+    before = snapshot(donuts[0].data)
+    jobs.append(module.BackgroundDecimation(reads_of(ts, donuts[:1], ratio=0.1, quality="QUALITY", seed=2),
+                                            deferred=True))
+    jobs[0].begin()
+    assert jobs[0].wait(30) and jobs[0].outcomes == [] and jobs[0].cancelled
+    assert len(raised) == 1 and isinstance(raised[0], ts.core.api.loops.Cancelled)
+    assert snapshot(donuts[0].data) == before
+
+
 def test_cancel_during_an_error_search_stops_at_the_next_probe(ts, donuts, monkeypatch):
     module = background(ts)
     probes = []

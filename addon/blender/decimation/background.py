@@ -3,10 +3,10 @@
 The main thread reads every object first (``pipeline.read_input``: Blender data can only be
 read there) and writes the results at the end; the worker prepares and decimates, saying how far
 it got, and finds where moved vertices take their attributes from (numpy and engine work the
-write would otherwise do on the main thread). ``cancel`` stops the engine at its next step
-while it prepares a mesh or searches an error target; a plain decimation already running cannot
-be stopped and ends unseen. Nothing in the scene changes before the caller writes, so a
-cancelled job leaves every object as it was.
+write would otherwise do on the main thread). ``cancel`` stops the engine at its next step,
+whether it prepares a mesh, decimates it or searches an error target (a mirrored decimation runs
+to its end, unseen). Nothing in the scene changes before the caller writes, so a cancelled job
+leaves every object as it was.
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from __future__ import annotations
 import threading
 import time
 
+from ...core.api.decimate import CancelFlag
 from ...core.api.loops import Cancelled
 from ...core.carry.attributes import moved_vertices
 from ...core.support.errors import TopStocError
@@ -32,6 +33,7 @@ class BackgroundDecimation:
         self.error = None   # an unexpected exception of the worker, raised by ``finished``
         self.started = time.perf_counter()
         self._cancel = threading.Event()
+        self._stop_engine = CancelFlag()  # set with _cancel: stops a decimation already running
         self._lock = threading.Lock()
         self._state = (0, 0.0, "preparing")  # object index, fraction of its preparation, what runs
         self._thread = threading.Thread(target=self._work, name=THREAD_NAME, daemon=True)
@@ -49,7 +51,7 @@ class BackgroundDecimation:
     def _work(self) -> None:
         for index, read in enumerate(self.reads):
             try:
-                run = pipeline.decimate_read(read, self._preparing(index), self._searching(index))
+                run = pipeline.decimate_read(read, self._preparing(index), self._searching(index), self._stop_engine)
                 self._state = (index, 1.0, "finding the sources of moved vertices")
                 run.moved = moved_vertices(read.arrays.vertices, read.arrays.triangles, run.result)  # not at the write
                 outcome = (run, None)
@@ -79,8 +81,10 @@ class BackgroundDecimation:
         return told
 
     def cancel(self) -> None:
-        """Stops the worker at the engine's next step; what it finishes after is dropped."""
+        """Stops the worker at the engine's next step (a preparation's, a decimation's or an error
+        search's); what it finishes after is dropped."""
         self._cancel.set()
+        self._stop_engine.set()
 
     @property
     def cancelled(self) -> bool:

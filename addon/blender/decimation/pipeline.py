@@ -197,10 +197,11 @@ def read_input(context, obj, panel, *, target: dict = None, region_3d=None) -> I
                  decimate_options(panel), settings_of(panel), started)
 
 
-def decimate_read(read: Input, prepare_progress=None, progress=None) -> Run:
+def decimate_read(read: Input, prepare_progress=None, progress=None, cancel=None) -> Run:
     """Prepares (cached) and decimates what ``read_input`` read; reads no Blender data (any thread).
     prepare_progress: the preparation's ``(fraction, stage)``, progress: an error target's search
-    ``(probe, target, vertices, error, passed)``; either returning False raises ``Cancelled``."""
+    ``(probe, target, vertices, error, passed)``; either returning False raises ``Cancelled``, as
+    does ``cancel`` (a CancelFlag) once set, in the decimation."""
     obj_name = read.obj.name
     prepared = prepare_arrays(obj_name, read.obj.data.name_full, read.arrays, prepare_progress)
     if prepare_progress is not None:  # also when the cache held it: the decimation starts
@@ -208,7 +209,8 @@ def decimate_read(read: Input, prepare_progress=None, progress=None) -> Run:
     guidance = read.read_guidance()
     try:
         job = engine_job(prepared.mesh, read.target, read.options, guidance)
-        result = run_engine(prepared.mesh, job) if progress is None else run_engine(prepared.mesh, job, progress)
+        result = (run_engine(prepared.mesh, job) if progress is None and cancel is None
+                  else run_engine(prepared.mesh, job, progress, cancel))
     except ValueError as error:
         raise DecimationError(f"'{obj_name}': {error}") from None
     return make_run(read.obj, prepared, guidance, result, read.target, read.options,
