@@ -36,10 +36,10 @@ ratio shows its result at once.
 
 Where that result is slow, a worker with no draft to compute starts it for the latest ratio
 when the drag pauses (SPECULATE, SPECULATE_AFTER: shorter than a rest, longer than between two
-mouse events, so that a sweep keeps both workers for drafts): the ratio moving on cancels it in the engine, and when the
-drag rests there it is already under way (the rest takes it over instead of starting anew) or
-done (it is shown as soon as it is, rest or not). One such computation runs at a time, so a
-worker stays free for the drafts.
+mouse events, so that a sweep keeps both workers for drafts). The ratio moving on cancels it in
+the engine; when the drag rests there it is already under way (the rest takes it over instead
+of starting anew) or done (it is shown as soon as it is, rest or not). One such computation
+runs at a time, so a worker stays free for the drafts.
 """
 
 from __future__ import annotations
