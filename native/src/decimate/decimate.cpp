@@ -1,5 +1,6 @@
 #include "topstoc/decimate/decimate.hpp"
 #include "topstoc/core/parallel.hpp"
+#include "topstoc/core/progress.hpp"
 
 
 #include <algorithm>
@@ -277,6 +278,7 @@ class ClusterRun {
     result.fast_path = fast_path;
     start = Clock::now();
     for (int32_t round = 0;; ++round) {
+      check_cancelled("checking");  // (a cached flood left half-updated is emptied: BorrowedCache)
       const bool slivers = repair_slivers && round < kSliverRounds;
       check(round, slivers);
       accumulate(result.issues_found, partition.issues);
@@ -299,6 +301,7 @@ class ClusterRun {
     if (partition.issues.sliver > 0 && partition.issues.topological() == 0)
       result.issues_remaining.sliver = partition.issues.sliver;
     result.seconds_checking = seconds_since(start);
+    check_cancelled("output");
     return finish(mesh, layout, std::move(samples), clustering, partition, placement, draft, std::move(result));
   }
 
