@@ -68,7 +68,9 @@ REST_SECONDS = 0.08  # no new ratio asked this long: the drag rests (several mou
 DIRECT_SECONDS = 0.12  # a chosen-settings result this fast is what the drag shows, instead of drafts
 KEPT_RESULTS = 8  # chosen-settings results kept per ratio
 SPECULATE = True  # a worker with no draft to compute starts the latest ratio's chosen-settings result
-SPECULATE_AFTER = 0.02  # ... once no new ratio came this long (a pause of the hand, not between two events)
+SPECULATE_AFTER = 0.02  # ... once no new ratio came this long (a pause of the hand, not between two events),
+                        # or twice the drag's recent interval between ratios when that is longer
+EVENT_GAP = 0.1  # ratios asked closer than this are one drag's events (their interval is averaged)
 THREAD_PREFIX = "topstoc-preview"
 
 
@@ -104,6 +106,7 @@ class PreviewSession:
         self._pending = self.key(ratio, False) if ratio is not None else None  # latest request not started
         self._asked = self._pending            # latest request, and when it came (rest detection)
         self._asked_at = time.perf_counter()
+        self._interval = 0.0                   # running average of the seconds between a drag's ratios
         self._kept = OrderedDict()             # ratio -> finished chosen-settings computation (KEPT_RESULTS)
         self._speculation = None               # (key, CancelFlag) of the chosen-settings computation
                                                # started ahead of the rest (SPECULATE), while it runs
@@ -267,7 +270,10 @@ class PreviewSession:
         dropped; one kept from earlier is shown again without computing."""
         final = final or self.direct
         with self._lock:
-            self._asked, self._asked_at = self.key(ratio, final), time.perf_counter()
+            now = time.perf_counter()
+            if now - self._asked_at < EVENT_GAP:  # within a drag (a loaded machine spaces its events)
+                self._interval = 0.7 * self._interval + 0.3 * (now - self._asked_at)
+            self._asked, self._asked_at = self.key(ratio, final), now
             if self.final and ratio == self.ratio:
                 self._pending = self._finished = self._started = None
                 self._shown_order = self._started_count
@@ -361,7 +367,8 @@ class PreviewSession:
         if (not SPECULATE or self._speculation is not None or asked is None or asked[1] or self.direct
                 or self._cancel.is_set() or asked[0] in self._kept or (self.final and self.ratio == asked[0])):
             return None, None
-        wait = SPECULATE_AFTER - (time.perf_counter() - self._asked_at)
+        pause = min(REST_SECONDS, max(SPECULATE_AFTER, 2 * self._interval))
+        wait = pause - (time.perf_counter() - self._asked_at)
         if wait > 0:
             return None, wait
         self._speculation = (self.key(asked[0], True), CancelFlag())
