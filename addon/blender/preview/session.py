@@ -107,6 +107,8 @@ class PreviewSession:
         self._asked = self._pending            # latest request, and when it came (rest detection)
         self._asked_at = time.perf_counter()
         self._interval = 0.0                   # running average of the seconds between a drag's ratios
+        self._new_request = threading.Event()  # wakes a worker waiting to speculate
+        self._waiting = 0                      # workers waiting so (not staggered against: idle)
         self._kept = OrderedDict()             # ratio -> finished chosen-settings computation (KEPT_RESULTS)
         self._speculation = None               # (key, CancelFlag) of the chosen-settings computation
                                                # started ahead of the rest (SPECULATE), while it runs
@@ -295,6 +297,7 @@ class PreviewSession:
                 self._kept.move_to_end(ratio)
                 return
             self._pending = self._asked
+        self._new_request.set()
         self._start_worker()
 
     def _start_worker(self) -> None:
@@ -312,14 +315,18 @@ class PreviewSession:
             with self._lock:
                 key, self._pending = self._pending, None
                 if key is None or key == self._started or self._cancel.is_set():
+                    self._new_request.clear()
                     (speculation, wait), order = self._speculation_to_start(), 0
                     if speculation is None and wait is None:
                         self._workers -= 1
                         return
+                    self._waiting += wait is not None
                 else:
                     speculation, wait, order = None, None, self._mark_started(key)
-            if wait is not None:  # the drag may only be between two events: look again then
-                time.sleep(wait)
+            if wait is not None:  # the drag may only be between two events: look again then (or at one)
+                self._new_request.wait(wait)
+                with self._lock:
+                    self._waiting -= 1
             elif not (self._speculate(*speculation) if speculation else self._compute_request(key, order)):
                 return
 
@@ -416,7 +423,7 @@ class PreviewSession:
         drag's request starts at once."""
         with self._lock:
             resting = self._pending is not None and self._pending[1] and not self.direct
-            if self._workers < 2 or not self._typical or resting or self._pending is None:
+            if self._workers - self._waiting < 2 or not self._typical or resting or self._pending is None:
                 return
             wait = self._typical / WORKERS - (time.perf_counter() - self._last_start)
         if wait > 0:
@@ -541,6 +548,7 @@ class PreviewSession:
         preparation is cancelled in the engine (at its next step) and a running decimation ends
         unseen; workers never touch Blender data, so nothing waits for them."""
         self._cancel.set()
+        self._new_request.set()
         with self._lock:
             if self._speculation is not None:
                 self._speculation[1].set()
