@@ -1,5 +1,7 @@
 """The prepared mesh: validation, repairs, weights, and what it must never do."""
 
+import time
+
 import numpy as np
 import pytest
 
@@ -138,6 +140,38 @@ def test_progress_answering_false_cancels_at_that_step(stop_at):
     with pytest.raises(Cancelled, match=stop_at):
         Mesh(v, t, progress=progress)
     assert heard == STEPS[:STEPS.index(stop_at) + 1]
+
+
+def test_the_long_preparation_steps_stop_at_cancel_points_inside_them():
+    # Progress reports at most every 50 ms; a callback slower than that hears every cancel point.
+    # The order step (radix passes over vertices and faces) and the one-ring pass took seconds
+    # on 20M triangles with no point to stop at inside them (Esc waited for them to end).
+    from topstoc.core import Cancelled
+
+    v, t = meshgen.torus(48, 24)
+    heard = []
+
+    def slow(fraction, stage):
+        heard.append((stage, fraction))
+        time.sleep(0.055)
+        return True
+
+    Mesh(v, t, progress=slow)
+    stages = [stage for stage, _ in heard]
+    assert stages.count("order") >= 10 and stages.count("adjacency") >= 8 and stages.count("validate") >= 3
+    fractions = [fraction for _, fraction in heard]
+    assert fractions == sorted(fractions) and fractions[-1] < 1.0
+
+    answered = []
+
+    def cancel_mid_order(fraction, stage):
+        answered.append(stage)
+        time.sleep(0.055)
+        return answered.count("order") < 4  # inside the vertex sort's passes
+
+    with pytest.raises(Cancelled, match="order"):
+        Mesh(v, t, progress=cancel_mid_order)
+    assert answered == stages[:stages.index("order") + 4]
 
 
 def test_progress_errors_are_clear():

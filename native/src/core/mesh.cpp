@@ -304,7 +304,11 @@ Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangl
   if (num_vertices_ == 0) throw std::invalid_argument("mesh has no vertices");
   if (num_triangles <= 0) throw std::invalid_argument("mesh has no triangles");
   if (num_triangles > INT32_MAX / 3) throw std::invalid_argument("mesh is too large: more than 2^31 / 3 triangles");
+  // Every step below that takes more than a few tenths of a second on 20M triangles ends with a
+  // cancel point (progress.update), so that Esc stops the preparation within about a second.
+  progress.stage("validate", 0.0, 0.15);
   require_finite_positions(positions, num_vertices_);
+  progress.update(0.3);
   // Minimum and maximum are exact, so the box is the same on any number of threads.
   using Box = std::array<double, 6>;  // lowest x, y, z, highest x, y, z
   const Box box = parallel_reduce(
@@ -320,11 +324,10 @@ Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangl
   diagonal_ = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
-  progress.stage("validate", 0.0, 0.15);
+  progress.update(0.5);
   validate_faces(triangles, num_triangles);
   progress.stage("order", 0.15, 0.45);
-  reorder_for_locality(positions, triangles, lo, hi);
-  progress.update(0.6);  // a cancel point between the stage's two halves (seconds each on 20M triangles)
+  reorder_for_locality(positions, triangles, lo, hi, progress);
   build_vertex_faces();
   build_adjacency(progress);
 }
@@ -383,7 +386,7 @@ uint64_t spread_bits(uint64_t x) {
 }  // namespace
 
 void Mesh::reorder_for_locality(const double* positions, const int32_t* triangles, const double* lo,
-                                 const double* hi) {
+                                 const double* hi, Progress& progress) {
   const int32_t n = num_vertices_;
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
   Buffer<uint64_t> key(n), other_key(n);
@@ -401,6 +404,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     }
     key[v] = k;
   });
+  progress.update(0.05);
   // Vertices by key, ties by vertex: a stable least-significant-digit radix sort over the 63
   // bits the keys use, starting from vertex order.
   {
@@ -419,6 +423,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
           offsets);
       key.swap(other_key);
       vertex_source_.swap(other_vertex);
+      progress.update(0.05 + 0.45 * (shift + kDigit) / 63.0);  // a pass is a tenth of the stage
     }
   }
   Buffer<uint64_t>().swap(key);
@@ -431,6 +436,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     vertex_index_[old] = i;
     for (int k = 0; k < 3; ++k) positions_[3 * size_t(i) + k] = positions[3 * size_t(old) + k];
   });
+  progress.update(0.55);
   // The candidate faces in the new numbering, in order of their lowest vertex, ties in input
   // order. A counting sort with a bucket per vertex scatters every face to a random place;
   // instead the keys (lowest vertex, candidate) are radix-sorted in
@@ -448,6 +454,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     for (int c = 0; c < 3; ++c) r[c] = vertex_index_[t[c]];
     keyed[i] = (uint64_t(uint32_t(std::min({r[0], r[1], r[2]}))) << 32) | uint32_t(i);
   });
+  progress.update(0.65);
   {
     int bits = 1;
     while (bits < 31 && (int64_t(1) << bits) < int64_t(n)) ++bits;
@@ -462,6 +469,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
           m, int32_t(mask + 1), [&](int64_t i) { return int32_t((from[i] >> shift) & mask); },
           [&](int64_t i, int32_t at) { other[at] = from[i]; }, ignored);
       keyed.swap(other);
+      progress.update(0.65 + 0.2 * (pass + 1) / passes);
     }
   }
   faces_.resize(3 * size_t(m));
@@ -480,6 +488,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
   for (int64_t v = int64_t(keyed[m - 1] >> 32) + 1; v <= int64_t(n); ++v) lowest_offsets[v] = m;
   Buffer<int32_t>().swap(renumbered);
   face_source_.swap(source);
+  progress.update(0.95);
   drop_duplicate_faces(lowest_offsets);
 }
 
@@ -586,15 +595,22 @@ void Mesh::build_adjacency(Progress& progress) {
   const OneRingArrays arrays{faces_, face_source_, vertex_faces_, vfo, positions_, scratch, degree, greater,
                              euler, first_corner_, manifold_vertex_, sets};
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
-  parallel_region(team_for(n, kParallelMin), [&](Team& team) {
-    OneRingScan scan(arrays);
-    OneRingCounts mine;
-    team.for_static(0, n, [&](int32_t v) { scan.scan(v, mine); });
-    team.critical([&] {
-      boundary += mine.boundary, nonmanifold_edges += mine.nonmanifold_edges, inconsistent += mine.inconsistent;
-      pinched += mine.pinched, zero_area += mine.zero_area;
+  // In slices of the vertices with a cancel point after each (the pass is seconds on 20M
+  // triangles); each vertex's scan is its own, so the slicing changes nothing.
+  constexpr int32_t kSlices = 8;
+  for (int32_t slice = 0; slice < kSlices; ++slice) {
+    const int32_t begin = int32_t(int64_t(n) * slice / kSlices), end = int32_t(int64_t(n) * (slice + 1) / kSlices);
+    parallel_region(team_for(end - begin, kParallelMin), [&](Team& team) {
+      OneRingScan scan(arrays);
+      OneRingCounts mine;
+      team.for_static(begin, end, [&](int32_t v) { scan.scan(v, mine); });
+      team.critical([&] {
+        boundary += mine.boundary, nonmanifold_edges += mine.nonmanifold_edges, inconsistent += mine.inconsistent;
+        pinched += mine.pinched, zero_area += mine.zero_area;
+      });
     });
-  });
+    progress.update(0.8 * (slice + 1) / kSlices);
+  }
   report_.boundary_edges = boundary;
   report_.nonmanifold_edges = nonmanifold_edges;
   report_.inconsistent_edges = inconsistent;
@@ -611,6 +627,7 @@ void Mesh::build_adjacency(Progress& progress) {
   // The normals after the pass, not in it: then they never take memory alongside its buffer.
   progress.stage("normals and weights", 0.8, 0.92);
   fill_normals();
+  progress.update(0.5);
   weights_.resize(n);
   weigh(adjacency_offsets_, adjacency_, normals_, weights_);
   Buffer<double>().swap(normals_);  // 24 bytes a vertex that only view guidance reads again: rebuilt then
