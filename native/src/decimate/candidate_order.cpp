@@ -40,7 +40,7 @@ std::shared_ptr<const CandidateOrder> candidate_order(const Mesh& mesh, const Fe
   Buffer<uint8_t> bucket(n);
   parallel_for(0, n, kParallelMin, [&](int32_t v) {
     const uint8_t cls = table->cls[v];
-    const double q = table->q[v], u = uniforms.u[v];
+    const double q = table->q[v], u = uniforms.at(v);
     const double p_star = u / (u + kFirstThreshold * (1.0 - u));
     bucket[v] = uint8_t((cls != kSurface && cls != kCurve) || !(q > 0.0) ? kNone
                         : cls == kCurve                                  ? rate_bucket(p_star * p_star / q)
@@ -54,7 +54,7 @@ std::shared_ptr<const CandidateOrder> candidate_order(const Mesh& mesh, const Fe
   stable_counting_sort(n, kNone + 1, [&](int64_t v) { return bucket[v]; },
                        [&](int64_t v, int32_t at) {
                          order->vertices[at] = int32_t(v);
-                         order->u[at] = uniforms.u[v];
+                         order->u[at] = uniforms.at(int32_t(v));
                          order->q[at] = table->cls[v] == kCurve ? -table->q[v] : table->q[v];
                        },
                        order->offsets);

@@ -24,8 +24,6 @@ using namespace draw;  // the classes, tables and key test shared with candidate
 
 namespace {
 
-constexpr uint64_t kStreamSelection = 1;
-
 std::vector<uint8_t> classify(const Mesh& mesh, const FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
   const auto& vfo = mesh.vertex_face_offsets();
@@ -146,24 +144,20 @@ std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const 
   parallel_for(0, n, kParallelMin, [&](int32_t v) {
     if (cls[v] == kSurface || cls[v] == kCurve) table->q[v] = importance(mesh, params, v, area, mean_area);
   });
-  table->surface_q.reserve(n);
+  table->surface.values.reserve(n);
   for (int32_t v = 0; v < n; ++v) {
-    if (cls[v] == kSurface) table->surface_q.push_back(table->q[v]);
-    else if (cls[v] == kCurve) table->curve_q.push_back(table->q[v]);
+    if (cls[v] == kSurface) table->surface.values.push_back(table->q[v]);
+    else if (cls[v] == kCurve) table->curve.values.push_back(table->q[v]);
     else if (cls[v] == kCorner) table->corners += 1.0;
     table->active += cls[v] != kIsolated;
     table->total_q += table->q[v];
   }
-  sort_ascending(table->surface_q);
-  sort_ascending(table->curve_q);
+  sort_ascending(table->surface.values);
+  sort_ascending(table->curve.values);
   // Prefix sums, in order (their last bits are part of the result).
-  table->surface_sum.resize(table->surface_q.size() + 1);
-  table->surface_sum[0] = 0.0;
-  for (size_t i = 0; i < table->surface_q.size(); ++i) table->surface_sum[i + 1] = table->surface_sum[i] + table->surface_q[i];
-  table->curve_sqrt_sum.resize(table->curve_q.size() + 1);
-  table->curve_sqrt_sum[0] = 0.0;
-  for (size_t i = 0; i < table->curve_q.size(); ++i)
-    table->curve_sqrt_sum[i + 1] = table->curve_sqrt_sum[i] + std::sqrt(table->curve_q[i]);
+  table->curve.root = true;
+  table->surface.sum_up();
+  table->curve.sum_up();
   layout.sampling_table.set(table);
   return table;
 }
@@ -276,20 +270,18 @@ double solve_guided_rate(const Mesh& mesh, const std::vector<uint8_t>& cls, cons
 // The sum of the probabilities without guidance at rate k (the expected sample count), and
 // its derivative.
 double expected_count(const ImportanceTable& table, double k, double& slope) {
-  const size_t surfaces = table.surface_q.size(), curves = table.curve_q.size();
+  const size_t surfaces = table.surface.values.size(), curves = table.curve.values.size();
   const double limit = k > 0 ? 1.0 / k : std::numeric_limits<double>::infinity();
-  const size_t s = std::lower_bound(table.surface_q.begin(), table.surface_q.end(), limit) - table.surface_q.begin();
-  const size_t c = std::lower_bound(table.curve_q.begin(), table.curve_q.end(), limit) - table.curve_q.begin();
-  const double root = std::sqrt(k);
-  slope = table.surface_sum[s] + (k > 0 ? 0.5 * table.curve_sqrt_sum[c] / root : 0.0);
-  return table.corners + k * table.surface_sum[s] + double(surfaces - s) + root * table.curve_sqrt_sum[c] +
-         double(curves - c);
+  const size_t s = table.surface.count_below(limit), c = table.curve.count_below(limit);
+  const double root = std::sqrt(k), surface_sum = table.surface.sum_before(s), curve_sum = table.curve.sum_before(c);
+  slope = surface_sum + (k > 0 ? 0.5 * curve_sum / root : 0.0);
+  return table.corners + k * surface_sum + double(surfaces - s) + root * curve_sum + double(curves - c);
 }
 
 double solve_rate(const ImportanceTable& table, double target) {
   double min_q = 1e300;
-  if (!table.surface_q.empty()) min_q = std::min(min_q, table.surface_q.front());
-  if (!table.curve_q.empty()) min_q = std::min(min_q, table.curve_q.front());
+  if (!table.surface.values.empty()) min_q = std::min(min_q, table.surface.values.front());
+  if (!table.curve.values.empty()) min_q = std::min(min_q, table.curve.values.front());
   auto evaluate = [&](double k, double& slope) { return expected_count(table, k, slope); };
   if (table.total_q <= 0 || target <= table.corners) return 0.0;
   double lo = 0.0, hi = min_q < 1e300 ? 1.0 / min_q : 1.0;
@@ -311,7 +303,9 @@ double solve_rate(const ImportanceTable& table, double target) {
   return k;
 }
 
-// This seed's uniforms, from the layout when they are there (`reused`), else made and kept there.
+// This seed's uniforms. The first draw with a seed only notes it and hashes each vertex where it
+// is read (a single decimation never keeps n doubles for it); a second draw with the same seed
+// (a slider) makes them and keeps them on the layout; `reused` from then on.
 std::shared_ptr<const SelectionUniforms> selection_uniforms(const Mesh& mesh, const FeatureLayout& layout,
                                                             uint64_t seed, bool& reused) {
   auto cached = std::static_pointer_cast<const SelectionUniforms>(layout.selection_uniforms.get());
@@ -320,10 +314,12 @@ std::shared_ptr<const SelectionUniforms> selection_uniforms(const Mesh& mesh, co
   if (reused) return cached;
   auto table = std::make_shared<SelectionUniforms>();
   table->seed = seed;
-  table->u.resize(n);
-  parallel_for(0, n, kParallelMin, [&](int32_t v) {
-    table->u[v] = uniform01(seed, kStreamSelection, uint64_t(mesh.vertex_source()[v]));
-  });
+  table->vertex_source = mesh.vertex_source().data();
+  if (cached && cached->seed == seed) {  // the second draw with this seed: a slider's, as before
+    reused = true;
+    table->u.resize(n);
+    parallel_for(0, n, kParallelMin, [&](int32_t v) { table->u[v] = table->hashed(v); });
+  }
   layout.selection_uniforms.set(table);
   return table;
 }
@@ -348,7 +344,7 @@ std::vector<Candidate> pareto_candidates(const Mesh& mesh, const SelectionUnifor
         block.sum += pv;
         if (pv >= 1.0 && forced) block.forced.push_back(v);
         double key;
-        if (pv > 0.0 && pv < 1.0 && pareto_key_below(uniforms.u[v], pv, threshold, key))
+        if (pv > 0.0 && pv < 1.0 && pareto_key_below(uniforms.at(v), pv, threshold, key))
           block.candidates.push_back({key, v});
       },
       [](Found& total, const Found& block) {
