@@ -10,6 +10,10 @@
 
 #include "topstoc/core/random.hpp"
 
+namespace topstoc {
+class Mesh;
+}
+
 namespace topstoc::draw {
 
 enum VertexClass : uint8_t { kIsolated = 0, kSurface = 1, kCurve = 2, kCorner = 3 };
@@ -56,13 +60,43 @@ struct ImportanceTable {
   double adaptivity = 0.0, flat_floor = 0.0;
   bool area_weighted = false;
   std::vector<uint8_t> cls;
-  std::vector<double> q;
   SortedSums surface;  // q of the surface vertices, summed
   SortedSums curve;    // q of the curve vertices, their square roots summed
   double corners = 0.0;
   double total_q = 0.0;  // over surface and curve vertices
   int32_t active = 0;    // vertices in triangles
 };
+
+// Importance q(v) = 1 + α (x / x̄ - 1), floored so flat regions are not starved; 0 for vertices
+// not sampled stochastically (isolated, corners). With area weighting q is also scaled by the
+// vertex's area over the mean, so that samples per unit area, not per vertex, follow the weights
+// on irregularly tessellated meshes. Computed where read from the mesh's weights (a table of
+// them was n doubles kept on the layout).
+class Importance {
+ public:
+  /// weights: the mesh's importance weights and their mean; area: the vertex areas and their
+  /// mean, or null without area weighting.
+  Importance(const ImportanceTable& table, const double* weights, double mean_weight, const double* area,
+             double mean_area)
+      : table_(table), weights_(weights), area_(area), mean_weight_(mean_weight), mean_area_(mean_area) {}
+
+  double operator()(int32_t v) const {
+    const uint8_t cls = table_.cls[v];
+    if (cls != kSurface && cls != kCurve) return 0.0;
+    const double mean = mean_weight_;
+    const double q = std::max(mean > 0 ? 1.0 + table_.adaptivity * (weights_[v] / mean - 1.0) : 1.0, table_.flat_floor);
+    return area_ ? q * area_[v] / mean_area_ : q;
+  }
+
+ private:
+  const ImportanceTable& table_;
+  const double* weights_;
+  const double* area_;
+  double mean_weight_, mean_area_;
+};
+
+/// The importance of `table`'s vertices on `mesh` (sampling.cpp).
+Importance importance(const Mesh& mesh, const ImportanceTable& table);
 
 // The uniform U of every vertex for one seed (it depends on the seed and the vertex's caller id
 // only), kept with the layout for the seed drawn last: a slider's draws read them instead of

@@ -93,7 +93,8 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   const bool featureless = layout.feature_edges.empty();  // every edge one copy, none a feature
   const int32_t* ae = featureless ? nullptr : mesh.adjacency_edge().data();
   const auto& vfo = mesh.vertex_face_offsets();
-  layout.feature_degree.assign(n, 0);
+  layout.feature_degree.clear();
+  if (!featureless) layout.feature_degree.assign(n, 0);
   layout.sectors.assign(n, 0);
   // Sectors per face slot matter only where a vertex has more than one (see sector_of).
   const auto& report = mesh.report();
@@ -125,7 +126,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
         sectors = vertex_fans(mesh, v, [&](int32_t e) { return layout.edge_feature[e] != 0; }, fan_of_slot);
         std::copy(fan_of_slot.begin(), fan_of_slot.end(), layout.sector_of_slot.begin() + vfo[v]);
       }
-      layout.feature_degree[v] = degree;
+      if (!featureless) layout.feature_degree[v] = degree;
       layout.sectors[v] = sectors;
       layout.vertex_feature[v] = degree > 0 || sectors > 1;
       // A curve vertex continues one curve: two feature edges of the same kind and one sector
@@ -140,8 +141,9 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
 
 void trace_curves(const Mesh& mesh, FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
+  layout.vertex_curve.clear();
+  if (layout.feature_edges.empty()) return;  // no curves (and no table of them: curve_of)
   layout.vertex_curve.assign(n, -1);
-  if (layout.feature_edges.empty()) return;  // no curves
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
   const auto& ae = mesh.adjacency_edge();

@@ -36,18 +36,6 @@ std::vector<uint8_t> classify(const Mesh& mesh, const FeatureLayout& layout) {
   return cls;
 }
 
-// Importance factor q(v) = 1 + α (x / x̄ - 1), floored so flat regions are not starved.
-// With area weighting (`area`: the vertex areas, `mean_area` their mean), q is also scaled by the
-// vertex's area over the mean, so that samples per unit area, not per vertex, follow the weights
-// on irregularly tessellated meshes.
-inline double importance(const Mesh& mesh, const SamplingParams& params, int32_t v, const double* area,
-                         double mean_area) {
-  const double mean = mesh.mean_weight();
-  const double q = std::max(mean > 0 ? 1.0 + params.adaptivity * (mesh.weights()[v] / mean - 1.0) : 1.0,
-                            params.flat_floor);
-  return area ? q * area[v] / mean_area : q;
-}
-
 bool inside_box(const BoxGuidance& box, const double* p) {
   const double* m = box.world_to_box;
   for (int r = 0; r < 3; ++r) {
@@ -124,6 +112,17 @@ void sort_ascending(std::vector<double>& values) {
   }
 }
 
+}  // namespace
+
+Importance draw::importance(const Mesh& mesh, const ImportanceTable& table) {
+  // The vertex areas are built on first use: asked for here, before any loop reads them.
+  const double mean_area = table.area_weighted ? mesh.mean_vertex_area() : 0.0;
+  const double* area = mean_area > 0 ? mesh.vertex_areas().data() : nullptr;
+  return Importance(table, mesh.weights().data(), mesh.mean_weight(), area, mean_area);
+}
+
+namespace {
+
 std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const FeatureLayout& layout,
                                                         const SamplingParams& params) {
   auto cached = std::static_pointer_cast<const ImportanceTable>(layout.sampling_table.get());
@@ -137,20 +136,15 @@ std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const 
   table->cls = classify(mesh, layout);
   const auto& cls = table->cls;
   const int32_t n = mesh.num_vertices();
-  table->q.assign(n, 0.0);
-  // The vertex areas are built on first use: asked for once, before the loop (on all threads).
-  const double mean_area = params.area_weighted ? mesh.mean_vertex_area() : 0.0;
-  const double* area = mean_area > 0 ? mesh.vertex_areas().data() : nullptr;
-  parallel_for(0, n, kParallelMin, [&](int32_t v) {
-    if (cls[v] == kSurface || cls[v] == kCurve) table->q[v] = importance(mesh, params, v, area, mean_area);
-  });
+  const Importance q = importance(mesh, *table);
   table->surface.values.reserve(n);
   for (int32_t v = 0; v < n; ++v) {
-    if (cls[v] == kSurface) table->surface.values.push_back(table->q[v]);
-    else if (cls[v] == kCurve) table->curve.values.push_back(table->q[v]);
+    const double qv = q(v);
+    if (cls[v] == kSurface) table->surface.values.push_back(qv);
+    else if (cls[v] == kCurve) table->curve.values.push_back(qv);
     else if (cls[v] == kCorner) table->corners += 1.0;
     table->active += cls[v] != kIsolated;
-    table->total_q += table->q[v];
+    table->total_q += qv;
   }
   sort_ascending(table->surface.values);
   sort_ascending(table->curve.values);
@@ -204,16 +198,18 @@ double surface_probability(const Mesh& mesh, const SamplingParams& params, int32
   return std::clamp(p, 0.0, 1.0);
 }
 
-std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& cls, const std::vector<double>& q,
+std::vector<double> probabilities(const Mesh& mesh, const ImportanceTable& table,
                                   const std::vector<double>& multiplier, const SamplingParams& params, double k) {
   const int32_t n = mesh.num_vertices();
+  const auto& cls = table.cls;
+  const Importance q = importance(mesh, table);
   std::vector<double> p(n);
   const bool guided = has_per_vertex_guidance(params);
   parallel_for(0, n, kParallelMin, [&](int32_t v) {
     if (!guided || cls[v] == kIsolated || cls[v] == kCorner) {
-      p[v] = plain_probability(cls[v], q[v], k);
+      p[v] = plain_probability(cls[v], q(v), k);
     } else {
-      const double surface = surface_probability(mesh, params, v, k, q[v], multiplier[v]);
+      const double surface = surface_probability(mesh, params, v, k, q(v), multiplier[v]);
       p[v] = cls[v] == kCurve ? std::sqrt(surface) : surface;
     }
   });
@@ -224,10 +220,10 @@ std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& 
 // grows with k; it is bracketed by doubling, then found by regula falsi (Illinois variant),
 // each step one parallel pass over the vertices. When the forced vertices alone exceed the
 // target, k = 0 (the count is then theirs, reported as over budget).
-double solve_guided_rate(const Mesh& mesh, const std::vector<uint8_t>& cls, const std::vector<double>& q,
-                         const std::vector<double>& multiplier, const SamplingParams& params, double target) {
+double solve_guided_rate(const Mesh& mesh, const ImportanceTable& table, const std::vector<double>& multiplier,
+                         const SamplingParams& params, double target) {
   auto excess = [&](double k) {
-    const auto p = probabilities(mesh, cls, q, multiplier, params, k);
+    const auto p = probabilities(mesh, table, multiplier, params, k);
     double sum = 0.0;
     for (double x : p) sum += x;
     return sum - target;
@@ -561,7 +557,7 @@ void validate_sampling_params(const Mesh& mesh, const SamplingParams& params) {
 std::vector<double> sampling_probabilities(const Mesh& mesh, const FeatureLayout& layout,
                                            const SamplingParams& params, double k) {
   const auto table = importance_table(mesh, layout, params);
-  return probabilities(mesh, table->cls, table->q, guidance_multipliers(mesh, params), params, k);
+  return probabilities(mesh, *table, guidance_multipliers(mesh, params), params, k);
 }
 
 SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const SamplingParams& params,
@@ -576,7 +572,7 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
   const int32_t target = std::clamp(target_vertices, 0, active);
   // Multipliers are read only with per-vertex guidance (all ones otherwise: not made).
   const auto multiplier = has_per_vertex_guidance(params) ? guidance_multipliers(mesh, params) : std::vector<double>();
-  out.rate = out.guided ? solve_guided_rate(mesh, cls, table->q, multiplier, params, target) : solve_rate(*table, target);
+  out.rate = out.guided ? solve_guided_rate(mesh, *table, multiplier, params, target) : solve_rate(*table, target);
   // The draw takes exactly the target, guided or not; only vertices with p = 1 (corners,
   // control points) can push it over.
   const int32_t count = target;
@@ -630,11 +626,11 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
     // Without per-vertex guidance p is a formula of the class, q and the rate: computed where
     // it is read instead of written to and read back from n doubles (a slider draws anew for
     // every frame).
-    const auto& q = table->q;
+    const Importance q = importance(mesh, *table);
     const double rate = out.rate;
-    draw([&cls, &q, rate](int32_t v) { return plain_probability(cls[v], q[v], rate); });
+    draw([&cls, &q, rate](int32_t v) { return plain_probability(cls[v], q(v), rate); });
   } else {
-    const auto p = probabilities(mesh, cls, table->q, multiplier, params, out.rate);
+    const auto p = probabilities(mesh, *table, multiplier, params, out.rate);
     draw([&p](int32_t v) { return p[v]; });
   }
   sort_vertex_ids(out.samples, n);
