@@ -37,6 +37,28 @@ def test_weights_follow_eq_4_1_against_independent_formula():
     assert mesh.weights.max() > 0.1
 
 
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_neighbours_of_non_manifold_vertices_against_independent_edges(seed):
+    # A manifold vertex has as many neighbours as faces (one more on a border) and keeps them in
+    # place; a vertex on fins or where fans meet has more and takes the other path. A soup of
+    # random triangles over few vertices has both, next to a closed torus and a fin of 5 sheets.
+    rng = np.random.default_rng(seed)
+    torus_v, torus_t = meshgen.torus(12, 8)
+    soup_v = rng.normal(size=(40, 3))
+    soup_t = rng.integers(0, 40, size=(300, 3))
+    fin_v = np.array([[0, 0, 0], [0, 0, 1]] + [[np.cos(a), np.sin(a), 0.5] for a in np.linspace(0, 6, 5)], float)
+    fin_t = np.array([[0, 1, 2 + i] for i in range(5)])
+    v, t = meshgen.disjoint((torus_v, torus_t), (soup_v, soup_t), (fin_v, fin_t))
+    mesh = Mesh(v, t)
+    kept = np.delete(t, mesh.report().dropped_triangles, axis=0)
+    expected = np.unique(reference.undirected_edges(kept), axis=0)
+    got = np.unique(np.sort(mesh.native.edges, axis=1), axis=0)
+    np.testing.assert_array_equal(got, expected)
+    assert mesh.native.num_edges == len(expected)
+    np.testing.assert_allclose(mesh.weights, reference.importance_weights(v, kept), atol=1e-12)
+    assert mesh.report().nonmanifold_edges > 0
+
+
 def test_report_counts_repairs_and_defects():
     v, t = tetrahedron()
     extra_vertices = np.vstack([v, [[5, 5, 5], [6, 6, 6]]])  # two isolated vertices
