@@ -329,11 +329,7 @@ Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangl
   if (num_vertices_ == 0) throw std::invalid_argument("mesh has no vertices");
   if (num_triangles <= 0) throw std::invalid_argument("mesh has no triangles");
   if (num_triangles > INT32_MAX / 3) throw std::invalid_argument("mesh is too large: more than 2^31 / 3 triangles");
-  // Every step below that takes more than a few tenths of a second on 20M triangles ends with a
-  // cancel point (progress.update), so that Esc stops the preparation within about a second.
-  progress.stage("validate", 0.0, 0.15);
   require_finite_positions(positions, num_vertices_);
-  progress.update(0.3);
   // Minimum and maximum are exact, so the box is the same on any number of threads.
   using Box = std::array<double, 6>;  // lowest x, y, z, highest x, y, z
   const Box box = parallel_reduce(
@@ -349,7 +345,9 @@ Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangl
   diagonal_ = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
-  progress.update(0.5);
+  // From here every step that takes more than a few tenths of a second on 20M triangles ends
+  // with a cancel point (progress.update), so that Esc stops the preparation within a second.
+  progress.stage("validate", 0.0, 0.15);
   validate_faces(triangles, num_triangles);
   progress.stage("order", 0.15, 0.45);
   reorder_for_locality(positions, triangles, lo, hi, progress);
