@@ -12,6 +12,13 @@
 
 namespace topstoc {
 
+int32_t FeatureLayout::chi_of(const Mesh& mesh, int32_t v) const {
+  if (!chi_constant.empty()) return chi_constant[v];
+  const auto& ao = mesh.adjacency_offsets();
+  const auto& vfo = mesh.vertex_face_offsets();
+  return 6 * sectors[v] - 3 * (ao[v + 1] - ao[v]) + 2 * (vfo[v + 1] - vfo[v]);  // one copy per edge
+}
+
 int32_t FeatureLayout::sector_of(const Mesh& mesh, int32_t v, int32_t f) const {
   const auto& vfo = mesh.vertex_face_offsets();
   const auto& vf = mesh.vertex_faces();
@@ -103,7 +110,9 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
     layout.sector_of_slot.assign(mesh.vertex_faces().size(), 0);
   layout.vertex_feature.assign(n, 0);
   layout.vertex_corner.assign(n, 0);
-  layout.chi_constant.assign(n, 0);
+  // Without feature edges chi_of computes the constant (n integers fewer on a large scan).
+  layout.chi_constant.clear();
+  if (!featureless) layout.chi_constant.assign(n, 0);
   parallel_region(team_for(n, kParallelMin), [&](Team& team) {
     std::vector<int32_t> fan_of_slot;
     team.for_static(0, n, [&](int32_t v) {
@@ -134,7 +143,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
       const bool curve_vertex = degree == 2 && same_copies && sectors == first_copies;
       layout.vertex_corner[v] = layout.vertex_feature[v] && !curve_vertex;
       const int32_t faces = vfo[v + 1] - vfo[v];
-      layout.chi_constant[v] = 6 * sectors - 3 * copies + 2 * faces;
+      if (!featureless) layout.chi_constant[v] = 6 * sectors - 3 * copies + 2 * faces;
     });
   });
 }

@@ -75,7 +75,8 @@ struct FeatureLayout {
   std::vector<int32_t> face_sheet;
   /// 6 * (sectors - (sum of incident edge copies) / 2 + incident faces / 3): summed over a
   /// cluster's vertices it gives six times the cluster's Euler characteristic up to the terms
-  /// of edges and faces shared with other clusters (see partition.cpp).
+  /// of edges and faces shared with other clusters (see partition.cpp). Empty without feature
+  /// edges, where every edge is one copy and chi_of computes it.
   std::vector<int32_t> chi_constant;
   DerivedTable sampling_table;  ///< sampling.cpp's importance table for its last parameters
   DerivedTable selection_uniforms;  ///< sampling.cpp's per-vertex uniforms of the seed drawn last
@@ -90,6 +91,8 @@ struct FeatureLayout {
   int32_t curve_of(int32_t v) const { return vertex_curve.empty() ? -1 : vertex_curve[v]; }
   /// Copies of edge e in the mesh cut along the feature edges.
   int32_t edge_copies(const Mesh& mesh, int32_t e) const { return edge_feature[e] ? mesh.edge_face_count(e) : 1; }
+  /// chi_constant of vertex v.
+  int32_t chi_of(const Mesh& mesh, int32_t v) const;
   /// Sector of face f at vertex v (f must contain v).
   int32_t sector_of(const Mesh& mesh, int32_t v, int32_t f) const;
 };
