@@ -82,7 +82,8 @@ def save(path: pathlib.Path, rows: list, ratio: float) -> None:
                "date": datetime.date.today().isoformat(), "ratio": ratio,
                "method": "bumpy torus from tests/meshgen.py, 1 % of the vertices, seed 1; each mode in a fresh "
                          "process: peak RSS above the interpreter's baseline per input triangle (input arrays "
-                         "included); meshopt_bench once per size, /usr/bin/time's peak of the whole program",
+                         "included), also the preparation's peak and the prepared mesh's resident size; "
+                         "meshopt_bench once per size, /usr/bin/time's peak of the whole program",
                "sizes": rows}
     temporary = path.with_suffix(".json.tmp")
     temporary.write_text(json.dumps(figures, indent=1) + "\n")
@@ -107,7 +108,8 @@ def main() -> int:
             f = row[mode] = memory_peak.measure(int(size), mode, args.ratio)
             print(f"{f['triangles']:>11,} triangles, {mode:7}: prepare {f['prepare_s']:.2f} s, decimate "
                   f"{f['decimate_s']:.2f} s (cold {f['prepare_s'] + f['decimate_s']:.2f} s), peak "
-                  f"{f['bytes_per_triangle']:.0f} B/triangle", flush=True)
+                  f"{f['bytes_per_triangle']:.1f} B/triangle (preparation's {f['prepare_bytes_per_triangle']:.1f}, "
+                  f"prepared mesh {f['prepared_bytes_per_triangle']:.1f})", flush=True)
         row["triangles"], row["vertices"] = row["quality"]["triangles"], row["quality"]["vertices"]
         row["meshopt"] = m = None if args.no_peer else peer(int(size), args.ratio)
         rows.append(row)

@@ -1,5 +1,7 @@
 """The prepared mesh: validation, repairs, weights, and what it must never do."""
 
+import time
+
 import numpy as np
 import pytest
 
@@ -33,6 +35,28 @@ def test_weights_follow_eq_4_1_against_independent_formula():
     flat_v, flat_t = meshgen.grid(6, 6)
     assert np.all(Mesh(flat_v, flat_t).weights < 1e-12)
     assert mesh.weights.max() > 0.1
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_neighbours_of_non_manifold_vertices_against_independent_edges(seed):
+    # A manifold vertex has as many neighbours as faces (one more on a border) and keeps them in
+    # place; a vertex on fins or where fans meet has more and takes the other path. A soup of
+    # random triangles over few vertices has both, next to a closed torus and a fin of 5 sheets.
+    rng = np.random.default_rng(seed)
+    torus_v, torus_t = meshgen.torus(12, 8)
+    soup_v = rng.normal(size=(40, 3))
+    soup_t = rng.integers(0, 40, size=(300, 3))
+    fin_v = np.array([[0, 0, 0], [0, 0, 1]] + [[np.cos(a), np.sin(a), 0.5] for a in np.linspace(0, 6, 5)], float)
+    fin_t = np.array([[0, 1, 2 + i] for i in range(5)])
+    v, t = meshgen.disjoint((torus_v, torus_t), (soup_v, soup_t), (fin_v, fin_t))
+    mesh = Mesh(v, t)
+    kept = np.delete(t, mesh.report().dropped_triangles, axis=0)
+    expected = np.unique(reference.undirected_edges(kept), axis=0)
+    got = np.unique(np.sort(mesh.native.edges, axis=1), axis=0)
+    np.testing.assert_array_equal(got, expected)
+    assert mesh.native.num_edges == len(expected)
+    np.testing.assert_allclose(mesh.weights, reference.importance_weights(v, kept), atol=1e-12)
+    assert mesh.report().nonmanifold_edges > 0
 
 
 def test_report_counts_repairs_and_defects():
@@ -113,11 +137,17 @@ def test_components_and_diagonal():
 STEPS = ["validate", "order", "adjacency", "normals and weights", "components"]
 
 
+def steps_of(stages):
+    """The stages in order, each once: the long steps also report inside themselves (at most
+    every 50 ms, so on a small mesh only when the machine stalls)."""
+    return [stage for i, stage in enumerate(stages) if i == 0 or stages[i - 1] != stage]
+
+
 def test_progress_hears_every_preparation_step():
     v, t = meshgen.torus(48, 24)
     heard = []
     mesh = Mesh(v, t, progress=lambda fraction, stage: heard.append((fraction, stage)))
-    assert [stage for _, stage in heard] == STEPS
+    assert steps_of([stage for _, stage in heard]) == STEPS
     fractions = [fraction for fraction, _ in heard]
     assert fractions == sorted(fractions) and fractions[0] == 0.0 and fractions[-1] < 1.0
     plain = Mesh(v, t)
@@ -137,7 +167,39 @@ def test_progress_answering_false_cancels_at_that_step(stop_at):
 
     with pytest.raises(Cancelled, match=stop_at):
         Mesh(v, t, progress=progress)
-    assert heard == STEPS[:STEPS.index(stop_at) + 1]
+    assert steps_of(heard) == STEPS[:STEPS.index(stop_at) + 1] and heard.count(stop_at) == 1
+
+
+def test_the_long_preparation_steps_stop_at_cancel_points_inside_them():
+    # Progress reports at most every 50 ms; a callback slower than that hears every cancel point.
+    # The order step (radix passes over vertices and faces) and the one-ring pass took seconds
+    # on 20M triangles with no point to stop at inside them (Esc waited for them to end).
+    from topstoc.core import Cancelled
+
+    v, t = meshgen.torus(48, 24)
+    heard = []
+
+    def slow(fraction, stage):
+        heard.append((stage, fraction))
+        time.sleep(0.055)
+        return True
+
+    Mesh(v, t, progress=slow)
+    stages = [stage for stage, _ in heard]
+    assert stages.count("order") >= 10 and stages.count("adjacency") >= 8
+    fractions = [fraction for _, fraction in heard]
+    assert fractions == sorted(fractions) and fractions[-1] < 1.0
+
+    answered = []
+
+    def cancel_mid_order(fraction, stage):
+        answered.append(stage)
+        time.sleep(0.055)
+        return answered.count("order") < 4  # inside the vertex sort's passes
+
+    with pytest.raises(Cancelled, match="order"):
+        Mesh(v, t, progress=cancel_mid_order)
+    assert answered == stages[:stages.index("order") + 4]
 
 
 def test_progress_errors_are_clear():

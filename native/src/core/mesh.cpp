@@ -70,7 +70,7 @@ struct OneRingArrays {
   const Buffer<int32_t>& vertex_faces;
   const Buffer<int32_t>& vfo;
   const Buffer<double>& positions;
-  Buffer<int32_t>& scratch;  // each vertex's sorted neighbours, at twice its first face slot
+  Buffer<int32_t>& scratch;  // each vertex's sorted neighbours, at its first face slot + its id
   Buffer<int32_t>& degree;
   Buffer<int32_t>& greater;  // neighbours above the vertex
   Buffer<int32_t>& euler;    // the vertex's share of V - E + F
@@ -101,8 +101,10 @@ class OneRingScan {
       return;
     }
     const int32_t lowest_of = read_faces(v, first, k, counts.zero_area);
-    int32_t* neighbours = a.scratch.data() + 2 * size_t(first);
+    list.resize(2 * size_t(k));  // at most two neighbours per face
+    int32_t* neighbours = list.data();
     const int32_t d = sort_neighbours(neighbours);
+    keep_neighbours(v, first, k, neighbours, d);
     const int32_t lower = int32_t(std::lower_bound(neighbours, neighbours + d, v) - neighbours);
     a.degree[v] = d;
     a.greater[v] = d - lower;
@@ -116,8 +118,19 @@ class OneRingScan {
     }
   }
 
+  /// (vertex, its sorted neighbours) of the vertices with more than one neighbour per face plus one.
+  std::vector<std::pair<int32_t, std::vector<int32_t>>> overflow;
+
  private:
   const OneRingArrays& a;
+  std::vector<int32_t> list;  // this vertex's neighbours
+
+  // A manifold vertex has as many neighbours as faces, one more on a border: its slots in
+  // `scratch`, one more than its faces, hold them. More (non-manifold edges) wait in `overflow`.
+  void keep_neighbours(int32_t v, int32_t first, int32_t k, const int32_t* neighbours, int32_t d) {
+    if (d <= k + 1) std::copy(neighbours, neighbours + d, a.scratch.data() + size_t(first) + size_t(v));
+    else overflow.emplace_back(v, std::vector<int32_t>(neighbours, neighbours + d));
+  }
   std::vector<uint64_t> ends;  // (neighbour, 2 slot + (1 if the arc enters it))
   std::vector<int32_t> end_rank, in, out, next;
 
@@ -220,14 +233,26 @@ class OneRingScan {
   }
 };
 
-// The neighbours into place: each vertex's list moves from twice its first face slot to its
-// offset, in vertex order, within the same buffer (a vertex has at most two neighbours per face,
-// so no list lands on one not moved yet). Then the buffer holds the adjacency and its tail can go.
-void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offsets, Buffer<int32_t>& lists) {
+// The neighbours into place: each vertex's list moves from its first face slot + its id to its
+// offset, in vertex order. Without overflow (every vertex within one neighbour per face plus
+// one) that happens within the same buffer, as no list lands on one not moved yet, and then the
+// buffer's tail can go; otherwise the lists go to a buffer of their own. `overflow` is sorted.
+void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offsets,
+                        const std::vector<std::pair<int32_t, std::vector<int32_t>>>& overflow, Buffer<int32_t>& lists) {
   const int32_t n = int32_t(offsets.size()) - 1;
+  Buffer<int32_t> own;
+  if (!overflow.empty()) own.resize(offsets[n]);
+  int32_t* to = overflow.empty() ? lists.data() : own.data();
+  size_t next = 0;  // the next vertex in overflow
   for (int32_t v = 0; v < n; ++v) {
-    const int32_t* from = lists.data() + 2 * size_t(vfo[v]);
-    std::copy(from, from + (offsets[v + 1] - offsets[v]), lists.begin() + offsets[v]);
+    const int32_t d = offsets[v + 1] - offsets[v];
+    const bool over = next < overflow.size() && overflow[next].first == v;
+    const int32_t* from = over ? overflow[next++].second.data() : lists.data() + size_t(vfo[v]) + size_t(v);
+    std::copy(from, from + d, to + offsets[v]);
+  }
+  if (!overflow.empty()) {
+    lists.swap(own);
+    return;
   }
   lists.resize(offsets[n]);
   release_unused(lists);
@@ -320,11 +345,13 @@ Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangl
   diagonal_ = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
+  // From here every step that takes more than a few tenths of a second on 20M triangles ends
+  // with a cancel point (progress.update), so that Esc stops the preparation within a second.
   progress.stage("validate", 0.0, 0.15);
   validate_faces(triangles, num_triangles);
   progress.stage("order", 0.15, 0.45);
-  reorder_for_locality(positions, triangles, lo, hi);
-  progress.update(0.6);  // a cancel point between the stage's two halves (seconds each on 20M triangles)
+  reorder_for_locality(positions, triangles, lo, hi, progress);
+  progress.update(1.0);
   build_vertex_faces();
   build_adjacency(progress);
 }
@@ -383,7 +410,7 @@ uint64_t spread_bits(uint64_t x) {
 }  // namespace
 
 void Mesh::reorder_for_locality(const double* positions, const int32_t* triangles, const double* lo,
-                                 const double* hi) {
+                                 const double* hi, Progress& progress) {
   const int32_t n = num_vertices_;
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
   Buffer<uint64_t> key(n), other_key(n);
@@ -401,6 +428,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     }
     key[v] = k;
   });
+  progress.update(0.05);
   // Vertices by key, ties by vertex: a stable least-significant-digit radix sort over the 63
   // bits the keys use, starting from vertex order.
   {
@@ -419,6 +447,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
           offsets);
       key.swap(other_key);
       vertex_source_.swap(other_vertex);
+      progress.update(0.05 + 0.45 * (shift + kDigit) / 63.0);  // a pass is a tenth of the stage
     }
   }
   Buffer<uint64_t>().swap(key);
@@ -431,6 +460,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     vertex_index_[old] = i;
     for (int k = 0; k < 3; ++k) positions_[3 * size_t(i) + k] = positions[3 * size_t(old) + k];
   });
+  progress.update(0.55);
   // The candidate faces in the new numbering, in order of their lowest vertex, ties in input
   // order. A counting sort with a bucket per vertex scatters every face to a random place;
   // instead the keys (lowest vertex, candidate) are radix-sorted in
@@ -448,6 +478,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     for (int c = 0; c < 3; ++c) r[c] = vertex_index_[t[c]];
     keyed[i] = (uint64_t(uint32_t(std::min({r[0], r[1], r[2]}))) << 32) | uint32_t(i);
   });
+  progress.update(0.65);
   {
     int bits = 1;
     while (bits < 31 && (int64_t(1) << bits) < int64_t(n)) ++bits;
@@ -462,6 +493,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
           m, int32_t(mask + 1), [&](int64_t i) { return int32_t((from[i] >> shift) & mask); },
           [&](int64_t i, int32_t at) { other[at] = from[i]; }, ignored);
       keyed.swap(other);
+      progress.update(0.65 + 0.2 * (pass + 1) / passes);
     }
   }
   faces_.resize(3 * size_t(m));
@@ -480,6 +512,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
   for (int64_t v = int64_t(keyed[m - 1] >> 32) + 1; v <= int64_t(n); ++v) lowest_offsets[v] = m;
   Buffer<int32_t>().swap(renumbered);
   face_source_.swap(source);
+  progress.update(0.95);
   drop_duplicate_faces(lowest_offsets);
 }
 
@@ -573,11 +606,12 @@ void Mesh::build_adjacency(Progress& progress) {
   const int32_t n = num_vertices_;
   const auto& vfo = vertex_face_offsets_;
   // First pass, per vertex, from its faces alone (OneRingScan). Neighbours wait in `scratch`
-  // (at twice the vertex's first face slot: it has at most two per face) until the offsets are
-  // known. Edge ids and tables come later, on demand (build_edges).
+  // (at the vertex's first face slot + its id; a non-manifold vertex's extra ones in `overflow`)
+  // until the offsets are known: half the memory of slots for two neighbours per face, which
+  // was the preparation's peak. Edge ids and tables come later, on demand (build_edges).
   // Buffers are written on the threads that fill them (see core/buffer.hpp): every entry a loop
   // skips is set explicitly.
-  Buffer<int32_t> scratch(2 * vertex_faces_.size());
+  Buffer<int32_t> scratch(vertex_faces_.size() + size_t(n));
   Buffer<int32_t> degree(n + 1), greater(n + 1), euler(n);
   degree[n] = greater[n] = 0;
   manifold_vertex_.resize(n);
@@ -586,15 +620,24 @@ void Mesh::build_adjacency(Progress& progress) {
   const OneRingArrays arrays{faces_, face_source_, vertex_faces_, vfo, positions_, scratch, degree, greater,
                              euler, first_corner_, manifold_vertex_, sets};
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
-  parallel_region(team_for(n, kParallelMin), [&](Team& team) {
-    OneRingScan scan(arrays);
-    OneRingCounts mine;
-    team.for_static(0, n, [&](int32_t v) { scan.scan(v, mine); });
-    team.critical([&] {
-      boundary += mine.boundary, nonmanifold_edges += mine.nonmanifold_edges, inconsistent += mine.inconsistent;
-      pinched += mine.pinched, zero_area += mine.zero_area;
+  std::vector<std::pair<int32_t, std::vector<int32_t>>> overflow;
+  // In slices of the vertices with a cancel point after each (the pass is seconds on 20M
+  // triangles); each vertex's scan is its own, so the slicing changes nothing.
+  constexpr int32_t kSlices = 8;
+  for (int32_t slice = 0; slice < kSlices; ++slice) {
+    const int32_t begin = int32_t(int64_t(n) * slice / kSlices), end = int32_t(int64_t(n) * (slice + 1) / kSlices);
+    parallel_region(team_for(end - begin, kParallelMin), [&](Team& team) {
+      OneRingScan scan(arrays);
+      OneRingCounts mine;
+      team.for_static(begin, end, [&](int32_t v) { scan.scan(v, mine); });
+      team.critical([&] {
+        boundary += mine.boundary, nonmanifold_edges += mine.nonmanifold_edges, inconsistent += mine.inconsistent;
+        pinched += mine.pinched, zero_area += mine.zero_area;
+        for (auto& entry : scan.overflow) overflow.push_back(std::move(entry));
+      });
     });
-  });
+    progress.update(0.8 * (slice + 1) / kSlices);
+  }
   report_.boundary_edges = boundary;
   report_.nonmanifold_edges = nonmanifold_edges;
   report_.inconsistent_edges = inconsistent;
@@ -605,12 +648,15 @@ void Mesh::build_adjacency(Progress& progress) {
   exclusive_scan(adjacency_offsets_);
   exclusive_scan(greater);
   num_edges_ = greater[n];
-  compact_neighbours(vfo, adjacency_offsets_, scratch);
+  std::sort(overflow.begin(), overflow.end());
+  compact_neighbours(vfo, adjacency_offsets_, overflow, scratch);
+  decltype(overflow)().swap(overflow);
   adjacency_.swap(scratch);
 
   // The normals after the pass, not in it: then they never take memory alongside its buffer.
   progress.stage("normals and weights", 0.8, 0.92);
   fill_normals();
+  progress.update(0.5);
   weights_.resize(n);
   weigh(adjacency_offsets_, adjacency_, normals_, weights_);
   Buffer<double>().swap(normals_);  // 24 bytes a vertex that only view guidance reads again: rebuilt then

@@ -37,10 +37,11 @@ std::shared_ptr<const CandidateOrder> candidate_order(const Mesh& mesh, const Fe
   order->table = table;
   const int32_t n = mesh.num_vertices();
   constexpr int32_t kNone = kRateBuckets;  // not drawn at random: a corner, isolated, or q = 0
+  const Importance importance_of = importance(mesh, *table);
   Buffer<uint8_t> bucket(n);
   parallel_for(0, n, kParallelMin, [&](int32_t v) {
     const uint8_t cls = table->cls[v];
-    const double q = table->q[v], u = uniforms.u[v];
+    const double q = importance_of(v), u = uniforms.at(v);
     const double p_star = u / (u + kFirstThreshold * (1.0 - u));
     bucket[v] = uint8_t((cls != kSurface && cls != kCurve) || !(q > 0.0) ? kNone
                         : cls == kCurve                                  ? rate_bucket(p_star * p_star / q)
@@ -54,8 +55,8 @@ std::shared_ptr<const CandidateOrder> candidate_order(const Mesh& mesh, const Fe
   stable_counting_sort(n, kNone + 1, [&](int64_t v) { return bucket[v]; },
                        [&](int64_t v, int32_t at) {
                          order->vertices[at] = int32_t(v);
-                         order->u[at] = uniforms.u[v];
-                         order->q[at] = table->cls[v] == kCurve ? -table->q[v] : table->q[v];
+                         order->u[at] = uniforms.at(int32_t(v));
+                         order->q[at] = table->cls[v] == kCurve ? -importance_of(int32_t(v)) : importance_of(int32_t(v));
                        },
                        order->offsets);
   const int32_t drawn = order->offsets[kNone];

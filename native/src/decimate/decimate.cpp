@@ -537,6 +537,18 @@ DecimateResult verified(const Mesh& mesh, const FeatureLayout& layout, DecimateR
   return reported(std::move(result));
 }
 
+// The guidance multipliers, empty when every one would be 1 (no painted guidance, no boxes):
+// the refinement treats no multipliers as all ones, and n doubles of ones were a twentieth of a
+// large decimation's peak memory.
+std::vector<double> multipliers_if_guided(const Mesh& mesh, const SamplingParams& sampling) {
+  if (!sampling.guidance && sampling.boxes.empty()) return {};
+  return guidance_multipliers(mesh, sampling);
+}
+
+const std::vector<double>* or_null(const std::vector<double>& multipliers) {
+  return multipliers.empty() ? nullptr : &multipliers;
+}
+
 int32_t active_vertices(const Mesh& mesh) {
   return mesh.num_vertices() - mesh.report().isolated_vertices;
 }
@@ -649,9 +661,9 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
       full.draft = false;
       return stochastic_pass(mesh, layout, full, refined);
     }
-    const std::vector<double> multipliers = guidance_multipliers(mesh, params.sampling);
+    const std::vector<double> multipliers = multipliers_if_guided(mesh, params.sampling);
     RefineParams cleanup;
-    cleanup.multipliers = &multipliers;
+    cleanup.multipliers = or_null(multipliers);
     cleanup.zero_area_only = true;
     refine_by_collapses(mesh, layout, cleanup, best);
   }
@@ -699,11 +711,11 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   first.placement = Placement::Subsample;  // the refinement places the vertices it keeps
   first.target_vertices = first_pass_vertices(params, active);
   DecimateResult result = stochastic_pass(mesh, layout, first, true);
-  const std::vector<double> multipliers = guidance_multipliers(mesh, params.sampling);
+  const std::vector<double> multipliers = multipliers_if_guided(mesh, params.sampling);
   RefineParams refine;
   refine.target_vertices = params.target_vertices;
   refine.target_triangles = target_triangles;
-  refine.multipliers = &multipliers;
+  refine.multipliers = or_null(multipliers);
   refine.refit = params.placement == Placement::Filtered;
   refine.max_aware = refine.refit;
   refine.attributes = params.attributes;
@@ -714,7 +726,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   // may have drawn every vertex, which says nothing about the budget).
   result.forced = 0;
   for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-    result.forced += layout.vertex_corner[v] || multipliers[v] == kForcedMultiplier;
+    result.forced += layout.vertex_corner[v] || (!multipliers.empty() && multipliers[v] == kForcedMultiplier);
   return verified(mesh, layout, std::move(result));
 }
 

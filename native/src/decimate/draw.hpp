@@ -8,6 +8,12 @@
 #include <cstdint>
 #include <vector>
 
+#include "topstoc/core/random.hpp"
+
+namespace topstoc {
+class Mesh;
+}
+
 namespace topstoc::draw {
 
 enum VertexClass : uint8_t { kIsolated = 0, kSurface = 1, kCurve = 2, kCorner = 3 };
@@ -18,6 +24,35 @@ struct Candidate {
   bool operator<(const Candidate& o) const { return key < o.key || (key == o.key && vertex < o.vertex); }
 };
 
+// Values sorted ascending and the running sum of their terms (the value, or its square root),
+// kept at every kStride-th entry only: sum_before(s) adds the few terms after the last kept
+// sum in the same order as a full running sum would, so it gives the same bits with n / 64
+// doubles instead of n (the full sums were a twentieth of a large decimation's peak).
+struct SortedSums {
+  static constexpr size_t kStride = 64;
+  std::vector<double> values;
+  bool root = false;  // terms are sqrt(value)
+  std::vector<double> kept;  // kept[j]: the sum of the terms before entry j * kStride
+
+  double term(size_t i) const { return root ? std::sqrt(values[i]) : values[i]; }
+  void sum_up() {
+    kept.assign(values.size() / kStride + 1, 0.0);
+    double sum = 0.0;
+    for (size_t i = 0; i < values.size(); ++i) {
+      sum += term(i);
+      if ((i + 1) % kStride == 0) kept[(i + 1) / kStride] = sum;
+    }
+  }
+  /// The sum of the terms of entries 0..s-1 (0 <= s <= values.size()).
+  double sum_before(size_t s) const {
+    double sum = kept[s / kStride];
+    for (size_t i = s / kStride * kStride; i < s; ++i) sum += term(i);
+    return sum;
+  }
+  /// How many values lie below `limit`.
+  size_t count_below(double limit) const { return std::lower_bound(values.begin(), values.end(), limit) - values.begin(); }
+};
+
 // Per-vertex class and importance q (0 where not sampled stochastically), with q sorted per
 // class for solving the rate. Depends on the mesh, the layout and three parameters only, so it
 // is kept on the layout and reused while they stay the same (a slider changes only the target).
@@ -25,20 +60,57 @@ struct ImportanceTable {
   double adaptivity = 0.0, flat_floor = 0.0;
   bool area_weighted = false;
   std::vector<uint8_t> cls;
-  std::vector<double> q;
-  std::vector<double> surface_q, surface_sum;    // sorted ascending; prefix sums of q
-  std::vector<double> curve_q, curve_sqrt_sum;   // sorted ascending; prefix sums of sqrt(q)
+  SortedSums surface;  // q of the surface vertices, summed
+  SortedSums curve;    // q of the curve vertices, their square roots summed
   double corners = 0.0;
   double total_q = 0.0;  // over surface and curve vertices
   int32_t active = 0;    // vertices in triangles
 };
 
+// Importance q(v) = 1 + α (x / x̄ - 1), floored so flat regions are not starved; 0 for vertices
+// not sampled stochastically (isolated, corners). With area weighting q is also scaled by the
+// vertex's area over the mean, so that samples per unit area, not per vertex, follow the weights
+// on irregularly tessellated meshes. Computed where read from the mesh's weights (a table of
+// them was n doubles kept on the layout).
+class Importance {
+ public:
+  /// weights: the mesh's importance weights and their mean; area: the vertex areas and their
+  /// mean, or null without area weighting.
+  Importance(const ImportanceTable& table, const double* weights, double mean_weight, const double* area,
+             double mean_area)
+      : table_(table), weights_(weights), area_(area), mean_weight_(mean_weight), mean_area_(mean_area) {}
+
+  double operator()(int32_t v) const {
+    const uint8_t cls = table_.cls[v];
+    if (cls != kSurface && cls != kCurve) return 0.0;
+    const double mean = mean_weight_;
+    const double q = std::max(mean > 0 ? 1.0 + table_.adaptivity * (weights_[v] / mean - 1.0) : 1.0, table_.flat_floor);
+    return area_ ? q * area_[v] / mean_area_ : q;
+  }
+
+ private:
+  const ImportanceTable& table_;
+  const double* weights_;
+  const double* area_;
+  double mean_weight_, mean_area_;
+};
+
+/// The importance of `table`'s vertices on `mesh` (sampling.cpp).
+Importance importance(const Mesh& mesh, const ImportanceTable& table);
+
 // The uniform U of every vertex for one seed (it depends on the seed and the vertex's caller id
 // only), kept with the layout for the seed drawn last: a slider's draws read them instead of
 // hashing every vertex again (a tenth of a draft's time).
+// The random stream of the selection's uniforms.
+constexpr uint64_t kStreamSelection = 1;
+
 struct SelectionUniforms {
   uint64_t seed = 0;
-  std::vector<double> u;
+  std::vector<double> u;  // empty until a second draw with this seed (sampling.cpp)
+  const int32_t* vertex_source = nullptr;  // the mesh's caller ids, for hashing
+
+  double hashed(int32_t v) const { return uniform01(seed, kStreamSelection, uint64_t(vertex_source[v])); }
+  double at(int32_t v) const { return u.empty() ? hashed(v) : u[v]; }
 };
 
 // The draw's first Pareto threshold without density control. With 1, the expected number of

@@ -12,6 +12,13 @@
 
 namespace topstoc {
 
+int32_t FeatureLayout::chi_of(const Mesh& mesh, int32_t v) const {
+  if (!chi_constant.empty()) return chi_constant[v];
+  const auto& ao = mesh.adjacency_offsets();
+  const auto& vfo = mesh.vertex_face_offsets();
+  return 6 * sectors[v] - 3 * (ao[v + 1] - ao[v]) + 2 * (vfo[v + 1] - vfo[v]);  // one copy per edge
+}
+
 int32_t FeatureLayout::sector_of(const Mesh& mesh, int32_t v, int32_t f) const {
   const auto& vfo = mesh.vertex_face_offsets();
   const auto& vf = mesh.vertex_faces();
@@ -93,7 +100,8 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   const bool featureless = layout.feature_edges.empty();  // every edge one copy, none a feature
   const int32_t* ae = featureless ? nullptr : mesh.adjacency_edge().data();
   const auto& vfo = mesh.vertex_face_offsets();
-  layout.feature_degree.assign(n, 0);
+  layout.feature_degree.clear();
+  if (!featureless) layout.feature_degree.assign(n, 0);
   layout.sectors.assign(n, 0);
   // Sectors per face slot matter only where a vertex has more than one (see sector_of).
   const auto& report = mesh.report();
@@ -102,7 +110,9 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
     layout.sector_of_slot.assign(mesh.vertex_faces().size(), 0);
   layout.vertex_feature.assign(n, 0);
   layout.vertex_corner.assign(n, 0);
-  layout.chi_constant.assign(n, 0);
+  // Without feature edges chi_of computes the constant (n integers fewer on a large scan).
+  layout.chi_constant.clear();
+  if (!featureless) layout.chi_constant.assign(n, 0);
   parallel_region(team_for(n, kParallelMin), [&](Team& team) {
     std::vector<int32_t> fan_of_slot;
     team.for_static(0, n, [&](int32_t v) {
@@ -125,7 +135,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
         sectors = vertex_fans(mesh, v, [&](int32_t e) { return layout.edge_feature[e] != 0; }, fan_of_slot);
         std::copy(fan_of_slot.begin(), fan_of_slot.end(), layout.sector_of_slot.begin() + vfo[v]);
       }
-      layout.feature_degree[v] = degree;
+      if (!featureless) layout.feature_degree[v] = degree;
       layout.sectors[v] = sectors;
       layout.vertex_feature[v] = degree > 0 || sectors > 1;
       // A curve vertex continues one curve: two feature edges of the same kind and one sector
@@ -133,15 +143,16 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
       const bool curve_vertex = degree == 2 && same_copies && sectors == first_copies;
       layout.vertex_corner[v] = layout.vertex_feature[v] && !curve_vertex;
       const int32_t faces = vfo[v + 1] - vfo[v];
-      layout.chi_constant[v] = 6 * sectors - 3 * copies + 2 * faces;
+      if (!featureless) layout.chi_constant[v] = 6 * sectors - 3 * copies + 2 * faces;
     });
   });
 }
 
 void trace_curves(const Mesh& mesh, FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
+  layout.vertex_curve.clear();
+  if (layout.feature_edges.empty()) return;  // no curves (and no table of them: curve_of)
   layout.vertex_curve.assign(n, -1);
-  if (layout.feature_edges.empty()) return;  // no curves
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
   const auto& ae = mesh.adjacency_edge();

@@ -217,11 +217,11 @@ void SampleLinks::renumber(const std::vector<int32_t>& new_rank, int32_t count) 
 std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layout, int32_t num_samples,
                                     const Clustering& c) {
   // 6 chi = sum over the cluster's vertices of the layout's per-vertex constant, corrected by
-  // the edges and faces the cluster shares with others (see FeatureLayout::chi_constant).
+  // the edges and faces the cluster shares with others (see FeatureLayout::chi_constant, chi_of).
   std::vector<int64_t> chi6(num_samples, 0);
   auto label = [&c](int32_t v) { return c.label(v); };
   for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-    if (label(v) >= 0) chi6[label(v)] += layout.chi_constant[v];
+    if (label(v) >= 0) chi6[label(v)] += layout.chi_of(mesh, v);
   const auto& faces = mesh.faces();
   const auto& fe = mesh.face_edges();
   const auto& efo = mesh.edge_face_offsets();

@@ -347,7 +347,7 @@ class Refinement {
     for (int32_t i = 0; i < n; ++i) {
       const int32_t v = index[result.kept[i]];
       const double m = multiplier(v);
-      if (layout.vertex_feature[v]) setup.curve[i] = layout.vertex_curve[v];
+      if (layout.vertex_feature[v]) setup.curve[i] = layout.curve_of(v);
       const bool dead_end = !end_curve.empty() && end_curve[v] >= 0 && m != kForcedMultiplier;
       if (dead_end) setup.curve[i] = end_curve[v], setup.dead_end[i] = 1;
       if (setup.curve[i] >= 0) ++setup.curve_size[setup.curve[i]];

@@ -24,8 +24,6 @@ using namespace draw;  // the classes, tables and key test shared with candidate
 
 namespace {
 
-constexpr uint64_t kStreamSelection = 1;
-
 std::vector<uint8_t> classify(const Mesh& mesh, const FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
   const auto& vfo = mesh.vertex_face_offsets();
@@ -36,18 +34,6 @@ std::vector<uint8_t> classify(const Mesh& mesh, const FeatureLayout& layout) {
              : layout.vertex_feature[v] ? kCurve
                                         : kSurface;
   return cls;
-}
-
-// Importance factor q(v) = 1 + α (x / x̄ - 1), floored so flat regions are not starved.
-// With area weighting (`area`: the vertex areas, `mean_area` their mean), q is also scaled by the
-// vertex's area over the mean, so that samples per unit area, not per vertex, follow the weights
-// on irregularly tessellated meshes.
-inline double importance(const Mesh& mesh, const SamplingParams& params, int32_t v, const double* area,
-                         double mean_area) {
-  const double mean = mesh.mean_weight();
-  const double q = std::max(mean > 0 ? 1.0 + params.adaptivity * (mesh.weights()[v] / mean - 1.0) : 1.0,
-                            params.flat_floor);
-  return area ? q * area[v] / mean_area : q;
 }
 
 bool inside_box(const BoxGuidance& box, const double* p) {
@@ -126,6 +112,17 @@ void sort_ascending(std::vector<double>& values) {
   }
 }
 
+}  // namespace
+
+Importance draw::importance(const Mesh& mesh, const ImportanceTable& table) {
+  // The vertex areas are built on first use: asked for here, before any loop reads them.
+  const double mean_area = table.area_weighted ? mesh.mean_vertex_area() : 0.0;
+  const double* area = mean_area > 0 ? mesh.vertex_areas().data() : nullptr;
+  return Importance(table, mesh.weights().data(), mesh.mean_weight(), area, mean_area);
+}
+
+namespace {
+
 std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const FeatureLayout& layout,
                                                         const SamplingParams& params) {
   auto cached = std::static_pointer_cast<const ImportanceTable>(layout.sampling_table.get());
@@ -139,31 +136,22 @@ std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const 
   table->cls = classify(mesh, layout);
   const auto& cls = table->cls;
   const int32_t n = mesh.num_vertices();
-  table->q.assign(n, 0.0);
-  // The vertex areas are built on first use: asked for once, before the loop (on all threads).
-  const double mean_area = params.area_weighted ? mesh.mean_vertex_area() : 0.0;
-  const double* area = mean_area > 0 ? mesh.vertex_areas().data() : nullptr;
-  parallel_for(0, n, kParallelMin, [&](int32_t v) {
-    if (cls[v] == kSurface || cls[v] == kCurve) table->q[v] = importance(mesh, params, v, area, mean_area);
-  });
-  table->surface_q.reserve(n);
+  const Importance q = importance(mesh, *table);
+  table->surface.values.reserve(n);
   for (int32_t v = 0; v < n; ++v) {
-    if (cls[v] == kSurface) table->surface_q.push_back(table->q[v]);
-    else if (cls[v] == kCurve) table->curve_q.push_back(table->q[v]);
+    const double qv = q(v);
+    if (cls[v] == kSurface) table->surface.values.push_back(qv);
+    else if (cls[v] == kCurve) table->curve.values.push_back(qv);
     else if (cls[v] == kCorner) table->corners += 1.0;
     table->active += cls[v] != kIsolated;
-    table->total_q += table->q[v];
+    table->total_q += qv;
   }
-  sort_ascending(table->surface_q);
-  sort_ascending(table->curve_q);
+  sort_ascending(table->surface.values);
+  sort_ascending(table->curve.values);
   // Prefix sums, in order (their last bits are part of the result).
-  table->surface_sum.resize(table->surface_q.size() + 1);
-  table->surface_sum[0] = 0.0;
-  for (size_t i = 0; i < table->surface_q.size(); ++i) table->surface_sum[i + 1] = table->surface_sum[i] + table->surface_q[i];
-  table->curve_sqrt_sum.resize(table->curve_q.size() + 1);
-  table->curve_sqrt_sum[0] = 0.0;
-  for (size_t i = 0; i < table->curve_q.size(); ++i)
-    table->curve_sqrt_sum[i + 1] = table->curve_sqrt_sum[i] + std::sqrt(table->curve_q[i]);
+  table->curve.root = true;
+  table->surface.sum_up();
+  table->curve.sum_up();
   layout.sampling_table.set(table);
   return table;
 }
@@ -210,16 +198,18 @@ double surface_probability(const Mesh& mesh, const SamplingParams& params, int32
   return std::clamp(p, 0.0, 1.0);
 }
 
-std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& cls, const std::vector<double>& q,
+std::vector<double> probabilities(const Mesh& mesh, const ImportanceTable& table,
                                   const std::vector<double>& multiplier, const SamplingParams& params, double k) {
   const int32_t n = mesh.num_vertices();
+  const auto& cls = table.cls;
+  const Importance q = importance(mesh, table);
   std::vector<double> p(n);
   const bool guided = has_per_vertex_guidance(params);
   parallel_for(0, n, kParallelMin, [&](int32_t v) {
     if (!guided || cls[v] == kIsolated || cls[v] == kCorner) {
-      p[v] = plain_probability(cls[v], q[v], k);
+      p[v] = plain_probability(cls[v], q(v), k);
     } else {
-      const double surface = surface_probability(mesh, params, v, k, q[v], multiplier[v]);
+      const double surface = surface_probability(mesh, params, v, k, q(v), multiplier[v]);
       p[v] = cls[v] == kCurve ? std::sqrt(surface) : surface;
     }
   });
@@ -230,10 +220,10 @@ std::vector<double> probabilities(const Mesh& mesh, const std::vector<uint8_t>& 
 // grows with k; it is bracketed by doubling, then found by regula falsi (Illinois variant),
 // each step one parallel pass over the vertices. When the forced vertices alone exceed the
 // target, k = 0 (the count is then theirs, reported as over budget).
-double solve_guided_rate(const Mesh& mesh, const std::vector<uint8_t>& cls, const std::vector<double>& q,
-                         const std::vector<double>& multiplier, const SamplingParams& params, double target) {
+double solve_guided_rate(const Mesh& mesh, const ImportanceTable& table, const std::vector<double>& multiplier,
+                         const SamplingParams& params, double target) {
   auto excess = [&](double k) {
-    const auto p = probabilities(mesh, cls, q, multiplier, params, k);
+    const auto p = probabilities(mesh, table, multiplier, params, k);
     double sum = 0.0;
     for (double x : p) sum += x;
     return sum - target;
@@ -276,20 +266,18 @@ double solve_guided_rate(const Mesh& mesh, const std::vector<uint8_t>& cls, cons
 // The sum of the probabilities without guidance at rate k (the expected sample count), and
 // its derivative.
 double expected_count(const ImportanceTable& table, double k, double& slope) {
-  const size_t surfaces = table.surface_q.size(), curves = table.curve_q.size();
+  const size_t surfaces = table.surface.values.size(), curves = table.curve.values.size();
   const double limit = k > 0 ? 1.0 / k : std::numeric_limits<double>::infinity();
-  const size_t s = std::lower_bound(table.surface_q.begin(), table.surface_q.end(), limit) - table.surface_q.begin();
-  const size_t c = std::lower_bound(table.curve_q.begin(), table.curve_q.end(), limit) - table.curve_q.begin();
-  const double root = std::sqrt(k);
-  slope = table.surface_sum[s] + (k > 0 ? 0.5 * table.curve_sqrt_sum[c] / root : 0.0);
-  return table.corners + k * table.surface_sum[s] + double(surfaces - s) + root * table.curve_sqrt_sum[c] +
-         double(curves - c);
+  const size_t s = table.surface.count_below(limit), c = table.curve.count_below(limit);
+  const double root = std::sqrt(k), surface_sum = table.surface.sum_before(s), curve_sum = table.curve.sum_before(c);
+  slope = surface_sum + (k > 0 ? 0.5 * curve_sum / root : 0.0);
+  return table.corners + k * surface_sum + double(surfaces - s) + root * curve_sum + double(curves - c);
 }
 
 double solve_rate(const ImportanceTable& table, double target) {
   double min_q = 1e300;
-  if (!table.surface_q.empty()) min_q = std::min(min_q, table.surface_q.front());
-  if (!table.curve_q.empty()) min_q = std::min(min_q, table.curve_q.front());
+  if (!table.surface.values.empty()) min_q = std::min(min_q, table.surface.values.front());
+  if (!table.curve.values.empty()) min_q = std::min(min_q, table.curve.values.front());
   auto evaluate = [&](double k, double& slope) { return expected_count(table, k, slope); };
   if (table.total_q <= 0 || target <= table.corners) return 0.0;
   double lo = 0.0, hi = min_q < 1e300 ? 1.0 / min_q : 1.0;
@@ -311,7 +299,9 @@ double solve_rate(const ImportanceTable& table, double target) {
   return k;
 }
 
-// This seed's uniforms, from the layout when they are there (`reused`), else made and kept there.
+// This seed's uniforms. The first draw with a seed only notes it and hashes each vertex where it
+// is read (a single decimation never keeps n doubles for it); a second draw with the same seed
+// (a slider) makes them and keeps them on the layout; `reused` from then on.
 std::shared_ptr<const SelectionUniforms> selection_uniforms(const Mesh& mesh, const FeatureLayout& layout,
                                                             uint64_t seed, bool& reused) {
   auto cached = std::static_pointer_cast<const SelectionUniforms>(layout.selection_uniforms.get());
@@ -320,10 +310,12 @@ std::shared_ptr<const SelectionUniforms> selection_uniforms(const Mesh& mesh, co
   if (reused) return cached;
   auto table = std::make_shared<SelectionUniforms>();
   table->seed = seed;
-  table->u.resize(n);
-  parallel_for(0, n, kParallelMin, [&](int32_t v) {
-    table->u[v] = uniform01(seed, kStreamSelection, uint64_t(mesh.vertex_source()[v]));
-  });
+  table->vertex_source = mesh.vertex_source().data();
+  if (cached && cached->seed == seed) {  // the second draw with this seed: a slider's, as before
+    reused = true;
+    table->u.resize(n);
+    parallel_for(0, n, kParallelMin, [&](int32_t v) { table->u[v] = table->hashed(v); });
+  }
   layout.selection_uniforms.set(table);
   return table;
 }
@@ -348,7 +340,7 @@ std::vector<Candidate> pareto_candidates(const Mesh& mesh, const SelectionUnifor
         block.sum += pv;
         if (pv >= 1.0 && forced) block.forced.push_back(v);
         double key;
-        if (pv > 0.0 && pv < 1.0 && pareto_key_below(uniforms.u[v], pv, threshold, key))
+        if (pv > 0.0 && pv < 1.0 && pareto_key_below(uniforms.at(v), pv, threshold, key))
           block.candidates.push_back({key, v});
       },
       [](Found& total, const Found& block) {
@@ -565,7 +557,7 @@ void validate_sampling_params(const Mesh& mesh, const SamplingParams& params) {
 std::vector<double> sampling_probabilities(const Mesh& mesh, const FeatureLayout& layout,
                                            const SamplingParams& params, double k) {
   const auto table = importance_table(mesh, layout, params);
-  return probabilities(mesh, table->cls, table->q, guidance_multipliers(mesh, params), params, k);
+  return probabilities(mesh, *table, guidance_multipliers(mesh, params), params, k);
 }
 
 SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const SamplingParams& params,
@@ -580,7 +572,7 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
   const int32_t target = std::clamp(target_vertices, 0, active);
   // Multipliers are read only with per-vertex guidance (all ones otherwise: not made).
   const auto multiplier = has_per_vertex_guidance(params) ? guidance_multipliers(mesh, params) : std::vector<double>();
-  out.rate = out.guided ? solve_guided_rate(mesh, cls, table->q, multiplier, params, target) : solve_rate(*table, target);
+  out.rate = out.guided ? solve_guided_rate(mesh, *table, multiplier, params, target) : solve_rate(*table, target);
   // The draw takes exactly the target, guided or not; only vertices with p = 1 (corners,
   // control points) can push it over.
   const int32_t count = target;
@@ -634,11 +626,11 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
     // Without per-vertex guidance p is a formula of the class, q and the rate: computed where
     // it is read instead of written to and read back from n doubles (a slider draws anew for
     // every frame).
-    const auto& q = table->q;
+    const Importance q = importance(mesh, *table);
     const double rate = out.rate;
-    draw([&cls, &q, rate](int32_t v) { return plain_probability(cls[v], q[v], rate); });
+    draw([&cls, &q, rate](int32_t v) { return plain_probability(cls[v], q(v), rate); });
   } else {
-    const auto p = probabilities(mesh, cls, table->q, multiplier, params, out.rate);
+    const auto p = probabilities(mesh, *table, multiplier, params, out.rate);
     draw([&p](int32_t v) { return p[v]; });
   }
   sort_vertex_ids(out.samples, n);

@@ -123,7 +123,8 @@ class Mesh {
 
  private:
   void validate_faces(const int32_t* triangles, int64_t num_triangles);
-  void reorder_for_locality(const double* positions, const int32_t* triangles, const double* lo, const double* hi);
+  void reorder_for_locality(const double* positions, const int32_t* triangles, const double* lo, const double* hi,
+                            Progress& progress);
   void drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets);
   void build_vertex_faces();
   /// The one-ring pass: adjacency, normals, weights, manifoldness, components.

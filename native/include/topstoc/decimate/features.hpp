@@ -45,7 +45,9 @@ struct FeatureLayout {
   uint64_t serial = new_serial();       ///< no other layout of this process has it (for caches)
   std::vector<uint8_t> edge_feature;    ///< per edge: 1 if no cluster may cross it
   std::vector<int32_t> feature_edges;   ///< ids of the feature edges
-  std::vector<int32_t> feature_degree;  ///< per vertex: number of feature edges
+  /// Per vertex: number of feature edges; empty without feature edges (then there are no curves,
+  /// whose ends are what reads it).
+  std::vector<int32_t> feature_degree;
   std::vector<int32_t> sectors;         ///< per vertex: fans once feature edges are cut
   /// Per slot of mesh.vertex_faces(): sector of that face. Empty when every vertex is one sector
   /// (a manifold mesh without feature edges); use sector_of().
@@ -58,7 +60,8 @@ struct FeatureLayout {
   std::vector<int32_t> curve_offsets{0};
   std::vector<int32_t> curve_vertices;
   std::vector<uint8_t> curve_closed;
-  std::vector<int32_t> vertex_curve;  ///< curve of each non-corner feature vertex, else -1
+  /// Curve of each non-corner feature vertex, else -1; empty when there are no curves (use curve_of).
+  std::vector<int32_t> vertex_curve;
   /// Mesh boundary loops (cycles of edges with one triangle, continued at a vertex within one
   /// fan: loops touching at a pinch stay apart), as vertex sets: each must meet three clusters
   /// or it closes up in the output, whatever corners split it into curves.
@@ -72,7 +75,8 @@ struct FeatureLayout {
   std::vector<int32_t> face_sheet;
   /// 6 * (sectors - (sum of incident edge copies) / 2 + incident faces / 3): summed over a
   /// cluster's vertices it gives six times the cluster's Euler characteristic up to the terms
-  /// of edges and faces shared with other clusters (see partition.cpp).
+  /// of edges and faces shared with other clusters (see partition.cpp). Empty without feature
+  /// edges, where every edge is one copy and chi_of computes it.
   std::vector<int32_t> chi_constant;
   DerivedTable sampling_table;  ///< sampling.cpp's importance table for its last parameters
   DerivedTable selection_uniforms;  ///< sampling.cpp's per-vertex uniforms of the seed drawn last
@@ -83,8 +87,12 @@ struct FeatureLayout {
   int32_t crease_edges = 0;
 
   int32_t num_curves() const { return static_cast<int32_t>(curve_closed.size()); }
+  /// The curve of vertex v, -1 for none.
+  int32_t curve_of(int32_t v) const { return vertex_curve.empty() ? -1 : vertex_curve[v]; }
   /// Copies of edge e in the mesh cut along the feature edges.
   int32_t edge_copies(const Mesh& mesh, int32_t e) const { return edge_feature[e] ? mesh.edge_face_count(e) : 1; }
+  /// chi_constant of vertex v.
+  int32_t chi_of(const Mesh& mesh, int32_t v) const;
   /// Sector of face f at vertex v (f must contain v).
   int32_t sector_of(const Mesh& mesh, int32_t v, int32_t f) const;
 };
