@@ -77,19 +77,6 @@ class Collapser {
   /// Puts v back where it was (normalised and caller's coordinates, as read before a move).
   void restore(int32_t v, const double* position, const double* world);
 
-  /// What Collapser::flip changed, to undo it.
-  struct Flip {
-    int32_t f = -1, g = -1, a = -1, b = -1, c = -1, d = -1;
-    int32_t tri[6], source[6], sector[6];
-  };
-  /// Turns the edge from corner `side` of live triangle f to the next corner into the other
-  /// diagonal of f and its neighbour there (edge_flip.cpp): only a manifold, consistently
-  /// oriented edge off the feature curves and seams, where no edge joins the two opposite
-  /// corners yet and neither new triangle folds against the old ones or is a sliver. False
-  /// (nothing changed) otherwise.
-  bool flip(int32_t f, int32_t side, Flip& saved);
-  void unflip(const Flip& saved);
-
   int32_t live_faces() const { return alive_faces_; }
   /// The triangles as the collapses renamed them (dead ones included: see face_alive).
   const std::vector<int32_t>& triangles() const { return tri_; }

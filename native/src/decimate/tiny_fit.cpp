@@ -21,16 +21,8 @@ constexpr int64_t kFitTriangles = 200000;
 // many closest-point queries each way (the bracket stays valid when they run out).
 constexpr double kMaxTolerance = 1e-2;
 constexpr int64_t kMaxQueries = 2000000;
-// The same for the farthest point of two triangles an edge flip would change.
-constexpr double kReachTolerance = 5e-3;
 // Times a move whose max grew is tried again with more corners held.
 constexpr int32_t kHoldTries = 8;
-// Flips tried where the max lies, and how much they may raise the pairs' mean (a fraction).
-constexpr int32_t kFlips = 16;
-constexpr double kFlipMeanSlack = 0.05;
-constexpr double kFlipGain = 0.98;
-// Flips around the max weighed against the whole surfaces per step, the most promising first.
-constexpr int32_t kFlipTries = 4;
 // The shortest step toward the least-squares positions tried when the full one is refused.
 constexpr double kSmallestStep = 0.25;
 // Each unknown is pulled to where it stands with this share of the mean diagonal of the normal
@@ -81,31 +73,12 @@ class Fit {
     for (int32_t w = 0, seen = 0; w < mesh.num_vertices(); ++w)
       if (vfo[w] < vfo[w + 1] && seen++ % stride == 0) points_.push_back(w);
     for (int32_t t = 0; t < int32_t(triangles.size() / 3); ++t)
-      if (c_.face_alive(t)) live_.push_back(t);
-    refresh();
+      if (c_.face_alive(t)) faces_.insert(faces_.end(), &triangles[3 * size_t(t)], &triangles[3 * size_t(t) + 3]);
     unknown_.assign(c_.vertices(), -1);
     for (int32_t v : faces_)
       if (c_.fittable(v) && unknown_[v] < 0) unknown_[v] = int32_t(free_.size()), free_.push_back(v);
     std::sort(free_.begin(), free_.end());  // vertex order: moves are tried in it
     for (size_t i = 0; i < free_.size(); ++i) unknown_[free_[i]] = int32_t(i);
-  }
-
-  // The live triangles' corners anew from the collapser (after a flip).
-  void refresh() {
-    faces_.clear();
-    for (int32_t t : live_)
-      faces_.insert(faces_.end(), &c_.triangles()[3 * size_t(t)], &c_.triangles()[3 * size_t(t) + 3]);
-  }
-  // The collapser's triangles that share a side with result triangle f, and f.
-  std::vector<int32_t> around(int32_t f) const {
-    std::vector<int32_t> out;
-    const int32_t* c = &faces_[3 * size_t(f)];
-    for (size_t t = 0; t < live_.size(); ++t) {
-      int32_t shared = 0;
-      for (int j = 0; j < 3; ++j) shared += faces_[3 * t + j] == c[0] || faces_[3 * t + j] == c[1] || faces_[3 * t + j] == c[2];
-      if (shared >= 2) out.push_back(live_[t]);
-    }
-    return out;
   }
 
   bool empty() const { return free_.empty() || faces_.empty() || points_.empty() || !input_; }
@@ -123,25 +96,6 @@ class Fit {
     const MaxBracket back = bound_max_distance_by_tree(*input_, result, kMaxTolerance, kMaxQueries);
     const MaxBracket& far = there.lower >= back.lower ? there : back;
     return {far.lower, std::max(there.upper, back.upper), result.bvh().closest(far.lower_point, -1).triangle};
-  }
-
-  // How far the farthest point of the collapser's triangles f and g (as they stand there, not
-  // in faces_) lies from the input (a bracket's upper end).
-  double reach(int32_t f, int32_t g) const {
-    std::vector<double> corners;
-    for (int32_t t : {f, g})
-      for (int j = 0; j < 3; ++j) corners.insert(corners.end(), c_.position(c_.triangles()[3 * size_t(t) + j]),
-                                                 c_.position(c_.triangles()[3 * size_t(t) + j]) + 3);
-    const Surface pair(std::move(corners), {0, 1, 2, 3, 4, 5});
-    return bound_max_distance_by_tree(pair, *input_, kReachTolerance, kMaxQueries).upper;
-  }
-
-  // Whether some point of either surface lies farther than `limit` from the other (decided
-  // only: cheaper than the bracket).
-  bool max_exceeds(double limit) const {
-    const Surface result(positions(), faces_);
-    return bound_max_distance_by_tree(result, *input_, kMaxTolerance, kMaxQueries, limit).lower > limit ||
-           bound_max_distance_by_tree(*input_, result, kMaxTolerance, kMaxQueries, limit).lower > limit;
   }
 
   // Keeps the corners of result triangle f where they stand in the moves that follow.
@@ -313,7 +267,6 @@ class Fit {
   Collapser& c_;
   std::unique_ptr<Surface> input_;  // normalised input positions and (some of) its triangles
   std::vector<int32_t> points_;   // the input vertices paired with the result
-  std::vector<int32_t> live_;     // the collapser's live triangles
   std::vector<int32_t> faces_;    // 3 vertex ids per live triangle
   std::vector<int32_t> free_;     // the unknowns' vertices
   std::vector<int32_t> unknown_;  // per vertex: its unknown, or -1 (fixed)
@@ -324,57 +277,13 @@ class Fit {
 
 }  // namespace
 
-// Flips an edge around the result triangle nearest to where the max lies while one brings the
-// two triangles on it nearer the input (the farthest point of the pair by kFlipGain) without
-// raising the max or the pairs' mean by more than kFlipMeanSlack: the collapses can leave a
-// triangle spanning a gap of the input (a handle, a concavity) that no vertex move takes off.
-static int32_t flip_far_edges(Fit& fit, Collapser& collapser, Fit::Error& error, Fit::Bracket& max) {
-  int32_t flips = 0;
-  Collapser::Flip saved;
-  struct Candidate {
-    double gain;
-    int32_t face, side;
-  };
-  std::vector<Candidate> candidates;
-  for (; flips < kFlips && max.face >= 0; ++flips) {
-    candidates.clear();
-    for (int32_t f : fit.around(max.face))
-      for (int32_t side = 0; side < 3; ++side) {
-        if (!collapser.flip(f, side, saved)) continue;
-        const double after = fit.reach(saved.f, saved.g);
-        collapser.unflip(saved);
-        const double before = fit.reach(saved.f, saved.g);
-        if (after < kFlipGain * before) candidates.push_back({before - after, f, side});
-      }
-    std::stable_sort(candidates.begin(), candidates.end(),
-                     [](const Candidate& x, const Candidate& y) { return x.gain > y.gain; });
-    bool flipped = false;
-    if (candidates.size() > size_t(kFlipTries)) candidates.resize(kFlipTries);
-    for (const Candidate& candidate : candidates) {
-      collapser.flip(candidate.face, candidate.side, saved);
-      fit.refresh();
-      if (!fit.max_exceeds(max.upper) && fit.pair_up().mean2 <= (1.0 + kFlipMeanSlack) * error.mean2) {
-        max = fit.symmetric_max(), flipped = true;
-        break;
-      }
-      collapser.unflip(saved);
-      fit.refresh();
-    }
-    if (!flipped) break;
-  }
-  error = fit.pair_up();
-  return flips;
-}
-
 TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds) {
   TinyFit out;
   Fit fit(mesh, collapser);
   if (fit.empty()) return out;
   auto error = fit.pair_up();
   auto max = fit.symmetric_max();
-  out.before2 = error.mean2;
-  out.flips = flip_far_edges(fit, collapser, error, max);
-  out.after2 = error.mean2;
+  out.before2 = out.after2 = error.mean2;
   std::vector<double> x;
   // A move is kept when the pairs' mean fell, their largest distance and the surfaces' max did
   // not grow. When only the max grew, the corners of the result triangle nearest to where it

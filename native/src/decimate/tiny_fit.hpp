@@ -16,14 +16,12 @@ namespace topstoc {
 constexpr int32_t kTinyFitFaces = 400;
 
 struct TinyFit {
-  int32_t flips = 0;         ///< edges flipped where the max lay (each lowered it)
   int32_t rounds = 0;        ///< rounds kept (each lowered the error)
-  double before2 = 0.0;      ///< mean squared distance, both ways, before the flips and rounds
+  double before2 = 0.0;      ///< mean squared distance, both ways, before the first round
   double after2 = 0.0;       ///< and after the last kept one
 };
 
-/// First edge flips where the max lies (Collapser::flip), each kept only if it brings its two
-/// triangles nearer the input without raising the symmetric max; then rounds (at most `rounds`) of: pair input vertices (at most 20,000, evenly taken) with their
+/// Rounds (at most `rounds`) of: pair input vertices (at most 20,000, evenly taken) with their
 /// closest point on the result and 7 points of each result triangle with their closest point
 /// on the input (on at most 200,000 of its triangles, evenly taken); move the free and boundary
 /// vertices to the least-squares fit of those pairs, each only where no triangle folds or thins
