@@ -6,11 +6,14 @@ compared with meshoptimizer's quadric simplification at the same triangle count;
 check measures the result's boundary against the input's boundary polyline in numpy.
 """
 
+import json
+import pathlib
+
 import numpy as np
 import pytest
 
 import topstoc
-from peer_runs import meshopt_simplify, peer, read_off
+from peer_runs import cgal_hausdorff, meshopt_simplify, peer, read_off, write_off
 from reference import invariants
 
 
@@ -71,3 +74,32 @@ def test_tiny_fit_keeps_boundaries_near_the_input_boundary(data_dir, target):
     zero = np.linalg.norm(np.cross(out[result.triangles[:, 1]] - out[result.triangles[:, 0]],
                                    out[result.triangles[:, 2]] - out[result.triangles[:, 0]]), axis=1) == 0
     assert not zero.any()
+
+
+# Small results whose max the fit used to raise (it judged the max on its own samples only), with
+# the best peer's max on the same case: Blender Collapse at our triangle count, in % of the
+# diagonal, from docs/bench_results/bench_quality_worst_cases_after.json (bench_quality.py, 100k
+# samples: a lower bound of Blender's true max). (mesh, target, bound on ours over Blender's.)
+# The old fit gave 1.38 (knot1) and 1.80 (mushroom); mushroom stays above the issue's 1.15.
+WORST_SMALL = [("genus_positive/cgal_knot1.off", 128, 1.15), ("open_boundary/cgal_mushroom.off", 92, 1.30)]
+BENCH = pathlib.Path(__file__).resolve().parents[2] / "docs/bench_results/bench_quality_worst_cases_after.json"
+
+
+@pytest.mark.parametrize("name, target, bound", WORST_SMALL, ids=[w[0] for w in WORST_SMALL])
+def test_the_fit_keeps_the_max_near_the_best_peer(data_dir, tmp_path, name, target, bound):
+    if peer("cgal_hausdorff") is None:
+        pytest.skip("peer program cgal_hausdorff was not built (CGAL)")
+    case = next(c for c in json.loads(BENCH.read_text())["cases"]
+                if c["mesh"] == pathlib.Path(name).name and c["target"] == target)
+    blender = case["tools"]["Blender Collapse"]
+    vertices, triangles = read_off(data_dir / name)
+    ours = topstoc.Mesh(vertices, triangles).decimate(target_triangles=target, seed=0)
+    assert len(ours.triangles) == blender["triangles"] and ours.stats.topology_kept
+    write_off(tmp_path / "in.off", vertices, triangles)
+    write_off(tmp_path / "ours.off", ours.vertices, ours.triangles)
+    # CGAL's bounded max both ways (independent of the engine's distance code), in % of the diagonal
+    cgal = cgal_hausdorff(tmp_path / "in.off", tmp_path / "ours.off", mean_samples=10_000)
+    v = np.asarray(vertices, dtype=float)
+    ours_max = 100 * max(cgal["forward"]["max_bounded"], cgal["backward"]["max_bounded"]) / np.linalg.norm(
+        v.max(axis=0) - v.min(axis=0))
+    assert ours_max <= bound * blender["max"], ours_max / blender["max"]

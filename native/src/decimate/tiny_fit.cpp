@@ -4,7 +4,8 @@
 #include <cmath>
 #include <memory>
 
-#include "topstoc/distance/bvh.hpp"
+#include "distance/bounded_max.hpp"
+#include "topstoc/distance/hausdorff.hpp"
 
 namespace topstoc {
 
@@ -16,6 +17,14 @@ constexpr int64_t kFitPoints = 20000;
 // larger input; the gaps are far smaller than a tiny result's deviation, and a search structure
 // over a million triangles cost more than the collapses).
 constexpr int64_t kFitTriangles = 200000;
+// The symmetric max that judges a round is bracketed to this relative width, with at most this
+// many closest-point queries each way (the bracket stays valid when they run out).
+constexpr double kMaxTolerance = 1e-2;
+constexpr int64_t kMaxQueries = 2000000;
+// Times a move whose max grew is tried again with more corners held.
+constexpr int32_t kHoldTries = 8;
+// The shortest step toward the least-squares positions tried when the full one is refused.
+constexpr double kSmallestStep = 0.25;
 // Each unknown is pulled to where it stands with this share of the mean diagonal of the normal
 // equations, so that a vertex few pairs see stays put.
 constexpr double kStay = 1e-3;
@@ -50,12 +59,12 @@ class Fit {
  public:
   Fit(const Mesh& mesh, Collapser& collapser) : c_(collapser) {
     const std::vector<int32_t>& triangles = c_.triangles();
-    input_.resize(3 * size_t(mesh.num_vertices()));
-    for (int32_t w = 0; w < mesh.num_vertices(); ++w) c_.normalise(mesh.position(w), &input_[3 * size_t(w)]);
+    std::vector<double> positions(3 * size_t(mesh.num_vertices()));
+    for (int32_t w = 0; w < mesh.num_vertices(); ++w) c_.normalise(mesh.position(w), &positions[3 * size_t(w)]);
     const int64_t faces = mesh.num_faces(), step = std::max<int64_t>(1, (faces + kFitTriangles - 1) / kFitTriangles);
     std::vector<int32_t> some;
     for (int64_t f = 0; f < faces; f += step) some.insert(some.end(), &mesh.faces()[3 * f], &mesh.faces()[3 * f + 3]);
-    if (!some.empty()) input_bvh_ = std::make_unique<TriangleBvh>(input_.data(), some.data(), int64_t(some.size() / 3));
+    if (!some.empty()) input_ = std::make_unique<Surface>(std::move(positions), std::move(some));
     // Every k-th input vertex in a triangle (isolated ones are no part of the surface).
     const auto& vfo = mesh.vertex_face_offsets();
     int32_t in_faces = 0;
@@ -72,7 +81,28 @@ class Fit {
     for (size_t i = 0; i < free_.size(); ++i) unknown_[free_[i]] = int32_t(i);
   }
 
-  bool empty() const { return free_.empty() || faces_.empty() || points_.empty() || !input_bvh_; }
+  bool empty() const { return free_.empty() || faces_.empty() || points_.empty() || !input_; }
+
+  // A bracket on the symmetric Hausdorff max between the result and (the fitted part of) the
+  // input, over every point of both surfaces: the pairs only sample it, and a round that lowers
+  // their mean can still lift the surface away between the samples.
+  struct Bracket {
+    double lower = 0.0, upper = 0.0;
+    int32_t face = -1;  // the result triangle nearest the point where `lower` was found
+  };
+  Bracket symmetric_max() const {
+    const Surface result(positions(), faces_);
+    const MaxBracket there = bound_max_distance_by_tree(result, *input_, kMaxTolerance, kMaxQueries);
+    const MaxBracket back = bound_max_distance_by_tree(*input_, result, kMaxTolerance, kMaxQueries);
+    const MaxBracket& far = there.lower >= back.lower ? there : back;
+    return {far.lower, std::max(there.upper, back.upper), result.bvh().closest(far.lower_point, -1).triangle};
+  }
+
+  // Keeps the corners of result triangle f where they stand in the moves that follow.
+  void hold(int32_t f) {
+    for (int j = 0; j < 3; ++j) held_.push_back(faces_[3 * size_t(f) + j]);
+  }
+  void release() { held_.clear(); }
 
   // The pairs of the current result and their weighted mean and largest squared distance.
   struct Error {
@@ -80,15 +110,13 @@ class Fit {
   };
   Error pair_up() {
     pairs_.clear();
-    std::vector<double> positions(3 * size_t(c_.vertices()));
-    for (int32_t v : faces_)
-      for (int i = 0; i < 3; ++i) positions[3 * size_t(v) + i] = c_.position(v)[i];
+    const std::vector<double> at_vertices = positions();
     const int32_t m = int32_t(faces_.size() / 3);
-    const TriangleBvh result(positions.data(), faces_.data(), m);
+    const TriangleBvh result(at_vertices.data(), faces_.data(), m);
     const double point_weight = 1.0 / double(points_.size());
     int32_t hint = -1;
     for (int32_t w : points_) {
-      const double* p = &input_[3 * size_t(w)];
+      const double* p = &input_->positions()[3 * size_t(w)];
       const ClosestHit hit = result.closest(p, hint);
       hint = hit.slot;
       Pair pair{hit.triangle, {}, {p[0], p[1], p[2]}, point_weight};
@@ -104,7 +132,7 @@ class Fit {
         Pair pair{f, {b[0], b[1], b[2]}, {}, area[f] / (7.0 * total)};
         double s[3];
         at(pair, s);
-        const ClosestHit hit = input_bvh_->closest(s, hint);
+        const ClosestHit hit = input_->bvh().closest(s, hint);
         hint = hit.slot;
         for (int i = 0; i < 3; ++i) pair.target[i] = hit.point[i];
         pairs_.push_back(pair);
@@ -148,12 +176,24 @@ class Fit {
     return cholesky_solve(a, k, rhs, x);
   }
 
+  // The positions a step (0 to 1) of the way from where the free vertices stand to x.
+  std::vector<double> toward(const std::vector<double>& x, double step) const {
+    std::vector<double> y(x.size());
+    for (size_t r = 0; r < free_.size(); ++r)
+      for (int i = 0; i < 3; ++i) {
+        const double now = c_.position(free_[r])[i];
+        y[3 * r + i] = step == 1.0 ? x[3 * r + i] : now + step * (x[3 * r + i] - now);
+      }
+    return y;
+  }
+
   // Moves each free vertex to x where its triangles allow it; returns the old states.
   int32_t apply(const std::vector<double>& x) {
     saved_.clear();
     int32_t moved = 0;
     for (size_t r = 0; r < free_.size(); ++r) {
       const int32_t v = free_[r];
+      if (std::find(held_.begin(), held_.end(), v) != held_.end()) continue;
       Saved s{v, {}, {}};
       for (int i = 0; i < 3; ++i) s.position[i] = c_.position(v)[i], s.world[i] = c_.world(v)[i];
       if (c_.try_move(v, &x[3 * r])) saved_.push_back(s), ++moved;
@@ -170,6 +210,13 @@ class Fit {
     int32_t v;
     double position[3], world[3];
   };
+  // The result's vertex positions (zero for the vertices no live triangle uses).
+  std::vector<double> positions() const {
+    std::vector<double> at(3 * size_t(c_.vertices()), 0.0);
+    for (int32_t v : faces_)
+      for (int i = 0; i < 3; ++i) at[3 * size_t(v) + i] = c_.position(v)[i];
+    return at;
+  }
   const double* corner(int32_t f, int j) const { return c_.position(faces_[3 * size_t(f) + j]); }
   double twice_area(int32_t f) const {
     const double *a = corner(f, 0), *b = corner(f, 1), *c = corner(f, 2);
@@ -218,14 +265,14 @@ class Fit {
   }
 
   Collapser& c_;
-  std::vector<double> input_;                // normalised input positions
-  std::unique_ptr<TriangleBvh> input_bvh_;  // over (some of) the input's triangles
+  std::unique_ptr<Surface> input_;  // normalised input positions and (some of) its triangles
   std::vector<int32_t> points_;   // the input vertices paired with the result
   std::vector<int32_t> faces_;    // 3 vertex ids per live triangle
   std::vector<int32_t> free_;     // the unknowns' vertices
   std::vector<int32_t> unknown_;  // per vertex: its unknown, or -1 (fixed)
   std::vector<Pair> pairs_;
   std::vector<Saved> saved_;
+  std::vector<int32_t> held_;  // vertices the moves leave where they are
 };
 
 }  // namespace
@@ -235,16 +282,33 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds) {
   Fit fit(mesh, collapser);
   if (fit.empty()) return out;
   auto error = fit.pair_up();
+  auto max = fit.symmetric_max();
   out.before2 = out.after2 = error.mean2;
   std::vector<double> x;
-  for (int32_t round = 0; round < rounds; ++round) {
-    if (!fit.solve(x) || fit.apply(x) == 0) break;
-    const auto next = fit.pair_up();
-    if (!(next.mean2 < error.mean2) || next.top2 > error.top2) {
+  // A move is kept when the pairs' mean fell, their largest distance and the surfaces' max did
+  // not grow. When only the max grew, the corners of the result triangle nearest to where it
+  // grew are held and the move tried again (a few times); then at half the step, a quarter.
+  auto kept = [&](double step) {
+    fit.release();
+    for (int32_t tries = 0; tries < kHoldTries; ++tries) {
+      if (fit.apply(fit.toward(x, step)) == 0) return false;
+      const auto next = fit.pair_up();
+      if (!(next.mean2 < error.mean2 && next.top2 <= error.top2)) break;
+      const auto next_max = fit.symmetric_max();
+      if (next_max.lower <= max.upper) {
+        error = next, max = next_max;
+        return true;
+      }
       fit.undo();
-      break;
+      fit.hold(next_max.face);
     }
-    error = next;
+    fit.undo();
+    return false;
+  };
+  for (int32_t round = 0; round < rounds && fit.solve(x); ++round) {
+    bool moved = false;
+    for (double step = 1.0; step >= kSmallestStep && !moved; step *= 0.5) moved = kept(step);
+    if (!moved) break;
     out.after2 = error.mean2;
     ++out.rounds;
   }

@@ -25,8 +25,9 @@ struct TinyFit {
 /// closest point on the result and 7 points of each result triangle with their closest point
 /// on the input (on at most 200,000 of its triangles, evenly taken); move the free and boundary
 /// vertices to the least-squares fit of those pairs, each only where no triangle folds or thins
-/// (Collapser::try_move); keep a round only if the mean squared distance fell and the largest
-/// did not grow.
+/// (Collapser::try_move); keep a round only if the mean squared distance fell, the largest pair
+/// distance did not grow, and neither did the symmetric Hausdorff max over both whole surfaces
+/// (a bracket from bounded_max.hpp: the pairs alone miss where the surface lifts between them).
 TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds);
 
 }  // namespace topstoc
