@@ -157,6 +157,30 @@ void bind_hausdorff(py::module_& m) {
       "(threshold >= 0: only as tight as deciding whether the max exceeds it needs).");
 
   m.def(
+      "quick_hausdorff_bound",
+      [](const Surface& a, const Surface& b, double tolerance) {
+        if (!(tolerance > 0.0)) throw std::invalid_argument("tolerance must be positive, got " + std::to_string(tolerance));
+        QuickBound r;
+        {
+          EngineCall call;
+          r = quick_hausdorff_bound(a, b, tolerance);
+        }
+        py::dict out;
+        out["forward_lower"] = r.forward_lower;
+        out["forward_upper"] = r.forward_upper;
+        out["backward_lower"] = r.backward_lower;
+        out["backward_upper"] = r.backward_upper;
+        out["forward_mean"] = r.forward_mean;
+        out["queries"] = r.queries;
+        out["grid_queries"] = r.grid_queries;
+        out["refined"] = r.refined;
+        return out;
+      },
+      py::arg("a"), py::arg("b"), py::arg("tolerance"),
+      "Guaranteed upper bound of the symmetric max between a big surface A and a small one B without a "
+      "search structure over A's triangles; the lower values are distances attained.");
+
+  m.def(
       "hausdorff_with_samples",
       [](const Surface& a, const SurfaceSamples& a_samples, const Surface& b, double percentile, double max_tolerance) {
         HausdorffResult r;

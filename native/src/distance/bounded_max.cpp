@@ -18,6 +18,7 @@ struct Piece {
   double d[3];        // their distances to the other surface
   int32_t near[4];    // triangles of the other surface: nearest to each corner and to the centroid
   int32_t source;     // triangle of the sampled surface this piece lies in
+  int32_t hint;       // slot of the other surface's tree near the piece: where its queries start
   double upper;       // bound on the distance over the piece
 };
 
@@ -29,7 +30,8 @@ double distance2(const double* a, const double* b) {
   return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
 }
 
-// Largest distance from a point of the triangle to its nearest corner (see the header).
+}  // namespace
+
 double nearest_corner_reach(const double p[3][3]) {
   double a2 = distance2(p[1], p[2]), b2 = distance2(p[2], p[0]), c2 = distance2(p[0], p[1]);
   const double longest2 = std::max({a2, b2, c2});
@@ -42,6 +44,8 @@ double nearest_corner_reach(const double p[3][3]) {
   if (!(area16 > 0)) return 0.5 * std::sqrt(longest2);
   return std::sqrt(longest2) * std::sqrt(a2 * b2 * c2 / area16);
 }
+
+namespace {
 
 // One bound_max_distance run: pieces of the sampled surface in a queue by their upper bound,
 // the worst split into four until the bound is within the tolerance of the best distance found.
@@ -58,6 +62,11 @@ class MaxSearch {
 
   MaxBracket run() {
     seed_pieces();
+    return run_queue();
+  }
+
+  // Splits the queued pieces, worst first, until the rest is tolerated or the budget is spent.
+  MaxBracket run_queue() {
     while (!open.empty()) {
       if (tolerated(open.top().upper)) break;  // the best remaining cannot beat the tolerance
       if (out.queries + 7 > max_queries) break;
@@ -70,11 +79,26 @@ class MaxSearch {
     return out;
   }
 
+  // The same search over the listed triangles of the sampled surface only (the others bounded
+  // by the caller).
+  MaxBracket run_over(const std::vector<int32_t>& listed) {
+    const auto& positions = from.positions();
+    const auto& triangles = from.triangles();
+    int32_t hint = -1;
+    for (int32_t f : listed) {
+      double corners[9];
+      for (int j = 0; j < 3; ++j) std::copy_n(&positions[3 * size_t(triangles[3 * size_t(f) + j])], 3, corners + 3 * j);
+      hint = add_triangle(corners, f, hint);
+    }
+    return run_queue();
+  }
+
   // The same search seeded from the sampled surface's own BVH instead of all its triangles:
   // nodes by their bound, a leaf's triangles handed to the pieces when it is opened.
   MaxBracket run_from_tree(const TriangleBvh& tree, double threshold) {
     decided_at = threshold;
-    open_node(tree, 0);
+    node_hint.assign(size_t(tree.num_nodes()), -1);
+    open_node(tree, 0, -1);
     double top = 0.0;
     while (true) {
       const double node_top = nodes.empty() ? -1.0 : nodes.top().first;
@@ -87,11 +111,13 @@ class MaxSearch {
         const int32_t i = nodes.top().second;
         nodes.pop();
         const TriangleBvh::Node& n = tree.node(i);
+        const int32_t hint = node_hint[size_t(i)];
         if (n.count > 0) {
-          for (int32_t s = n.first; s < n.first + n.count; ++s) add_triangle(tree.slot_corners(s), tree.slot_triangle(s));
+          for (int32_t s = n.first; s < n.first + n.count; ++s)
+            add_triangle(tree.slot_corners(s), tree.slot_triangle(s), hint);
         } else {
-          open_node(tree, i + 1);
-          open_node(tree, n.first);
+          open_node(tree, i + 1, hint);
+          open_node(tree, n.first, hint);
         }
       } else {
         const Piece piece = open.top();
@@ -114,7 +140,6 @@ class MaxSearch {
   const int64_t max_queries;
   const double floor;  // a tiny absolute floor, so that identical surfaces (max 0) do not subdivide forever
   MaxBracket out;
-  int32_t hint = -1;
   std::priority_queue<Piece, std::vector<Piece>, ByUpper> open;
   double settled = 0.0;  // the highest bound among pieces dropped as tolerated
   // run_from_tree's threshold: bounds at or below it are settled, and a distance above it ends
@@ -126,15 +151,15 @@ class MaxSearch {
   }
 
   // The nearest point of the other surface to a point that need not lie on the sampled one.
-  ClosestHit nearest(const double* x) {
+  // hint: a slot found near x (the queue's order jumps about, so the previous query's is not).
+  ClosestHit nearest(const double* x, int32_t hint) {
     const ClosestHit hit = bvh.closest(x, hint);
-    hint = hit.slot;
     ++out.queries;
     return hit;
   }
 
-  ClosestHit query(const double* x) {
-    const ClosestHit hit = nearest(x);
+  ClosestHit query(const double* x, int32_t hint) {
+    const ClosestHit hit = nearest(x, hint);
     if (std::sqrt(hit.distance2) > out.lower) {
       out.lower = std::sqrt(hit.distance2);
       std::copy_n(x, 3, out.lower_point);
@@ -162,7 +187,7 @@ class MaxSearch {
   void centroid_near(Piece& piece) {
     double centroid[3];
     for (int k = 0; k < 3; ++k) centroid[k] = (piece.p[0][k] + piece.p[1][k] + piece.p[2][k]) / 3.0;
-    const ClosestHit hit = query(centroid);
+    const ClosestHit hit = query(centroid, piece.hint);
     if (out.lower_triangle == -2) out.lower_triangle = piece.source;
     piece.near[3] = hit.triangle;
   }
@@ -182,20 +207,24 @@ class MaxSearch {
     }
   }
 
-  std::priority_queue<std::pair<double, int32_t>> nodes;  // (bound, node) of run_from_tree
+  // run_from_tree's open nodes: (bound, node) in the queue's order, and the slot of the other
+  // surface's tree nearest to the node's centre (its children's queries start there)
+  std::priority_queue<std::pair<double, int32_t>> nodes;
+  std::vector<int32_t> node_hint;
 
   // Bounds every point in a node's box: its centre's distance plus half the box diagonal
   // (1-Lipschitz), or the farthest corner (of its triangles, or of the box) from the centre's
   // nearest triangle (convex). A point of the surface in the node (its first triangle's
   // centroid) raises the lower bound.
-  void open_node(const TriangleBvh& tree, int32_t i) {
+  void open_node(const TriangleBvh& tree, int32_t i, int32_t hint) {
     const TriangleBvh::Node& n = tree.node(i);
     double centre[3], half2 = 0.0;
     for (int k = 0; k < 3; ++k) {
       centre[k] = 0.5 * (n.lo[k] + n.hi[k]);
       half2 += 0.25 * (n.hi[k] - n.lo[k]) * (n.hi[k] - n.lo[k]);
     }
-    const ClosestHit hit = nearest(centre);
+    const ClosestHit hit = nearest(centre, hint);
+    node_hint[size_t(i)] = hit.slot;
     double upper = std::sqrt(hit.distance2) + std::sqrt(half2);
     const double* a = &to_positions[3 * size_t(to_triangles[3 * size_t(hit.triangle)])];
     const double* b = &to_positions[3 * size_t(to_triangles[3 * size_t(hit.triangle) + 1])];
@@ -220,7 +249,7 @@ class MaxSearch {
     upper = std::min(upper, std::sqrt(farthest));
     const double* t = tree.slot_corners(first);
     const double centroid[3] = {(t[0] + t[3] + t[6]) / 3.0, (t[1] + t[4] + t[7]) / 3.0, (t[2] + t[5] + t[8]) / 3.0};
-    query(centroid);
+    query(centroid, hit.slot);
     if (out.lower_triangle == -2) out.lower_triangle = tree.slot_triangle(first);
     if (tolerated(upper)) {
       settled = std::max(settled, upper);
@@ -230,27 +259,36 @@ class MaxSearch {
   }
 
   // One triangle of the sampled surface as a piece: its corners measured, then bounded.
-  void add_triangle(const double* corners, int32_t source) {
+  // Returns the slot found nearest to its last corner (where a neighbour's queries start).
+  int32_t add_triangle(const double* corners, int32_t source, int32_t hint) {
     Piece piece;
     piece.source = source;
     for (int j = 0; j < 3; ++j) {
       std::copy_n(corners + 3 * j, 3, piece.p[j]);
-      const ClosestHit hit = query(piece.p[j]);
+      const ClosestHit hit = query(piece.p[j], hint);
+      hint = hit.slot;
       if (out.lower_triangle == -2) out.lower_triangle = source;
       piece.d[j] = std::sqrt(hit.distance2);
       piece.near[j] = hit.triangle;
     }
     piece.near[3] = -1;
+    piece.hint = hint;
     keep(piece);
+    return hint;
   }
 
   // The sampled surface's triangles as the first pieces, with each used vertex's nearest triangle.
   void seed_pieces() {
     const auto& positions = from.positions();
     const auto& triangles = from.triangles();
-    std::vector<int32_t> vertex_near(from.num_vertices(), -1);
+    std::vector<int32_t> vertex_near(from.num_vertices(), -1), vertex_slot(from.num_vertices(), -1);
+    int32_t hint = -1;
     for (int32_t v = 0; v < from.num_vertices(); ++v)
-      if (from.used()[v]) vertex_near[v] = query(&positions[3 * size_t(v)]).triangle;
+      if (from.used()[v]) {
+        const ClosestHit hit = query(&positions[3 * size_t(v)], hint);
+        vertex_near[v] = hit.triangle;
+        vertex_slot[v] = hint = hit.slot;
+      }
     out.lower_triangle = -1;
     for (int32_t f = 0; f < from.num_triangles(); ++f) {
       Piece piece;
@@ -262,6 +300,7 @@ class MaxSearch {
         piece.near[j] = vertex_near[v];
       }
       piece.near[3] = -1;
+      piece.hint = vertex_slot[triangles[3 * size_t(f)]];
       keep(piece);
     }
   }
@@ -274,7 +313,7 @@ class MaxSearch {
       const double* a = piece.p[j];
       const double* b = piece.p[(j + 1) % 3];
       for (int k = 0; k < 3; ++k) mid[j][k] = 0.5 * (a[k] + b[k]);
-      const ClosestHit hit = query(mid[j]);
+      const ClosestHit hit = query(mid[j], piece.hint);
       if (out.lower_triangle == -2) out.lower_triangle = piece.source;
       dm[j] = std::sqrt(hit.distance2);
       nm[j] = hit.triangle;
@@ -293,6 +332,7 @@ class MaxSearch {
         c.near[j] = near[child[j]];
       }
       c.near[3] = piece.near[3];
+      c.hint = piece.hint;
       keep(c);
     }
   }
@@ -304,6 +344,13 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
                               double start, const double* start_point, double relative_tolerance,
                               int64_t max_queries) {
   return MaxSearch(from, vertex_distance, to, start, start_point, relative_tolerance, max_queries).run();
+}
+
+MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,
+                                    double start, double relative_tolerance, int64_t max_queries) {
+  static const std::vector<double> no_vertex_distance;
+  const double origin[3] = {0.0, 0.0, 0.0};
+  return MaxSearch(from, no_vertex_distance, to, start, origin, relative_tolerance, max_queries).run_over(triangles);
 }
 
 MaxBracket bound_max_distance_by_tree(const Surface& from, const Surface& to, double relative_tolerance,

@@ -39,6 +39,13 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
                               double start, const double* start_point, double relative_tolerance,
                               int64_t max_queries = 4000000);
 
+/// The same bracket over the listed triangles of A only (start: a distance attained elsewhere).
+MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,
+                                    double start, double relative_tolerance, int64_t max_queries);
+
+/// The largest distance from a point of the triangle p to its nearest corner (r(T) above).
+double nearest_corner_reach(const double p[3][3]);
+
 /// The same bracket without any distance known beforehand: the search starts from the root of A's
 /// own BVH (a node's box bounds its triangles) and opens only the nodes that may hide a larger
 /// distance, so a large A close to B costs far fewer queries than measuring all its vertices.

@@ -123,6 +123,22 @@ struct OneSidedBracket {
 OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, double tolerance, int64_t max_queries,
                                       double threshold = -1.0);
 
+/// A guaranteed upper bound of the symmetric max between a big surface A and a small one B (a
+/// decimation of A) that builds no search structure over A's triangles (quick_bound.cpp).
+struct QuickBound {
+  double forward_lower = 0.0;   ///< attained: a point of A this far from B
+  double forward_upper = 0.0;   ///< no point of A is farther from B
+  double backward_lower = 0.0;  ///< attained: a point of B this far from A
+  double backward_upper = 0.0;  ///< no point of B is farther from A
+  double forward_mean = 0.0;    ///< mean distance from A to B of one vertex per grid cell (an estimate)
+  int64_t queries = 0;          ///< closest-point queries on B's BVH
+  int64_t grid_queries = 0;     ///< nearest-vertex queries on A's grid
+  int64_t refined = 0;          ///< triangles of A bracketed exactly
+};
+
+/// The bound for a (big) and b (small); bounds are split until within (1 + tolerance) of a distance found.
+QuickBound quick_hausdorff_bound(const Surface& a, const Surface& b, double tolerance);
+
 struct HausdorffParams {
   int64_t samples = 1000000;   ///< wanted samples on the first surface (ignored when step > 0)
   double step = 0.0;           ///< sample spacing; 0 = derive from `samples`

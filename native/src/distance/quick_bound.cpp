@@ -1,0 +1,347 @@
+// A guaranteed upper bound of the symmetric Hausdorff max between a big surface A (an original)
+// and a small one B (its decimation) that builds no search structure over A's triangles.
+//
+// A to B: A's vertices are grouped by the cells of a grid (vertex_grid.hpp); one vertex per cell
+// is measured against B's BVH, the others against the triangle of B found for it (any triangle
+// of B bounds the distance to B from above). A triangle of A whose corners were all measured
+// against one triangle T of B lies no farther from B than its farthest corner from T (the
+// distance to T is convex); otherwise no farther than its farthest corner bound plus its
+// nearest-corner reach (the distance to B is 1-Lipschitz). Triangles whose bound exceeds
+// (1 + tolerance) times the largest distance measured are bracketed exactly (bounded_max.hpp).
+// B to A: the distance from a point of B to the triangles around a vertex of A bounds its
+// distance to A from above (the vertex: the grid's nearest for B's vertices, then reached by
+// stepping to nearer neighbours from the one found for a neighbouring point; where that bound
+// exceeds A's largest distance to B found, the grid's nearest too, then an exact search); over a piece of a triangle of B it is at most the largest at its corners plus the
+// piece's nearest-corner reach, and pieces are split at their edge midpoints until that bound
+// is within (1 + tolerance) of the largest corner value (or kMaxDepth splits).
+// The lower bound is attained: the largest distance measured exactly from a point of A to B, or
+// from one of the kTopExact points of B with the largest bounds to A (through the grid).
+#include "topstoc/distance/hausdorff.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <utility>
+#include <vector>
+
+#include "../core/ordered_sum.hpp"
+#include "distance/bounded_max.hpp"
+#include "distance/vertex_grid.hpp"
+#include "topstoc/core/parallel.hpp"
+
+namespace topstoc {
+
+namespace {
+
+constexpr int64_t kCellBlock = 64;     // grid cells one task measures, chaining its BVH hints
+constexpr int kMaxDepth = 10;          // splits of a triangle of B at most (4^10 pieces)
+constexpr double kCellSpacings = 4.0;  // grid cell side in A's mean vertex spacings (about 8 vertices a cell)
+constexpr int64_t kRefineQueries = 20000000;
+constexpr int64_t kTopQueries = 256;
+constexpr int64_t kTopExact = 16;  // points of B measured exactly (the backward lower bound)
+
+struct Corners {
+  double p[3][3];
+};
+
+Corners corners_of(const Surface& s, int32_t f) {
+  Corners c;
+  for (int j = 0; j < 3; ++j) std::copy_n(&s.positions()[3 * size_t(s.triangles()[3 * size_t(f) + j])], 3, c.p[j]);
+  return c;
+}
+
+double distance2(const double* a, const double* b) {
+  return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+}
+
+double distance_to_triangle(const double* x, const Surface& s, int32_t f) {
+  const Corners t = corners_of(s, f);
+  double closest[3];
+  return std::sqrt(closest_point_on_triangle(x, t.p[0], t.p[1], t.p[2], closest));
+}
+
+// A to B, per vertex of A: an upper bound of its distance to B (exact for each cell's first
+// vertex) and the triangle of B it was measured against.
+struct VertexBounds {
+  std::vector<double> upper;
+  std::vector<int32_t> against;
+  double lower = 0.0;  // the largest exact distance
+  double mean = 0.0;   // the mean exact distance of the cells' first vertices (one per cell: spread over A)
+  int64_t queries = 0;
+};
+
+VertexBounds bound_vertices(const Surface& a, const Surface& b, const VertexGrid& grid) {
+  VertexBounds out;
+  out.upper.assign(size_t(a.num_vertices()), 0.0);
+  out.against.assign(size_t(a.num_vertices()), -1);
+  const TriangleBvh& bvh = b.bvh();
+  const auto& positions = a.positions();
+  const int64_t cells = grid.num_cells();
+  std::vector<double> exact(static_cast<size_t>(cells));
+  const int64_t blocks = (cells + kCellBlock - 1) / kCellBlock;
+  parallel_for_dynamic(0, blocks, 4, parallel_if(cells >= 4 * kCellBlock), [&](int64_t block) {
+    int32_t hint = -1;
+    for (int64_t c = block * kCellBlock; c < std::min(cells, (block + 1) * kCellBlock); ++c) {
+      const int32_t leader = grid.order()[size_t(grid.cell_start(c))];
+      const ClosestHit hit = bvh.closest(&positions[3 * size_t(leader)], hint);
+      hint = hit.slot;
+      exact[size_t(c)] = std::sqrt(hit.distance2);
+      out.upper[size_t(leader)] = exact[size_t(c)];
+      out.against[size_t(leader)] = hit.triangle;
+      for (int64_t i = grid.cell_start(c) + 1; i < grid.cell_start(c + 1); ++i) {
+        const int32_t v = grid.order()[size_t(i)];
+        out.upper[size_t(v)] = distance_to_triangle(&positions[3 * size_t(v)], b, hit.triangle);
+        out.against[size_t(v)] = hit.triangle;
+      }
+    }
+  });
+  for (double d : exact) out.lower = std::max(out.lower, d);
+  out.mean = cells > 0 ? ordered_sum(cells, [&](int64_t c) { return exact[size_t(c)]; }) / double(cells) : 0.0;
+  out.queries = cells;
+  // The vertices whose bound exceeds the largest exact distance are measured exactly too, the
+  // highest first (kTopQueries at most): the max usually lies among them, and a higher lower
+  // bound settles more triangles below.
+  std::vector<std::pair<double, int32_t>> above;
+  for (int32_t v = 0; v < a.num_vertices(); ++v)
+    if (out.upper[size_t(v)] > out.lower) above.emplace_back(out.upper[size_t(v)], v);
+  const size_t top = std::min(above.size(), size_t(kTopQueries));
+  std::partial_sort(above.begin(), above.begin() + ptrdiff_t(top), above.end(), std::greater<>());
+  int32_t hint = -1;
+  for (size_t i = 0; i < top; ++i) {
+    const int32_t v = above[i].second;
+    const ClosestHit hit = bvh.closest(&positions[3 * size_t(v)], hint);
+    hint = hit.slot;
+    out.upper[size_t(v)] = std::sqrt(hit.distance2);
+    out.against[size_t(v)] = hit.triangle;
+    out.lower = std::max(out.lower, out.upper[size_t(v)]);
+  }
+  out.queries += int64_t(top);
+  return out;
+}
+
+// Per triangle of A, a bound of its distance to B from its corners' (the file comment).
+double triangle_bound(const Surface& a, const Surface& b, const VertexBounds& v, int32_t f, double threshold) {
+  const int32_t* t = &a.triangles()[3 * size_t(f)];
+  const double corner_max = std::max({v.upper[size_t(t[0])], v.upper[size_t(t[1])], v.upper[size_t(t[2])]});
+  const int32_t j0 = v.against[size_t(t[0])];
+  if (j0 == v.against[size_t(t[1])] && j0 == v.against[size_t(t[2])]) return corner_max;  // convex
+  const Corners c = corners_of(a, f);
+  double bound = corner_max + nearest_corner_reach(c.p);
+  if (bound <= threshold) return bound;
+  for (int k = 0; k < 3; ++k) {  // each corner's triangle of B against all three corners
+    const int32_t j = v.against[size_t(t[k])];
+    double farthest = 0.0;
+    for (int i = 0; i < 3; ++i) farthest = std::max(farthest, distance_to_triangle(c.p[i], b, j));
+    bound = std::min(bound, farthest);
+  }
+  return bound;
+}
+
+struct ForwardSums {
+  double settled = 0.0;   // largest bound among triangles not refined
+  double longest2 = 0.0;  // the longest side's square
+};
+
+void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, QuickBound& out,
+                   double& reach) {
+  const VertexBounds v = bound_vertices(a, b, grid);
+  const double threshold = v.lower * (1.0 + tolerance);
+  std::vector<uint8_t> refine(size_t(a.num_triangles()), 0);
+  const ForwardSums sums = ordered_reduce<ForwardSums>(
+      a.num_triangles(),
+      [&](ForwardSums& s, int64_t f) {
+        const double bound = triangle_bound(a, b, v, int32_t(f), threshold);
+        if (bound > threshold) refine[size_t(f)] = 1;
+        else s.settled = std::max(s.settled, bound);
+        const Corners c = corners_of(a, int32_t(f));
+        s.longest2 = std::max({s.longest2, distance2(c.p[0], c.p[1]), distance2(c.p[1], c.p[2]), distance2(c.p[2], c.p[0])});
+      },
+      [](ForwardSums& total, const ForwardSums& part) {
+        total.settled = std::max(total.settled, part.settled);
+        total.longest2 = std::max(total.longest2, part.longest2);
+      });
+  std::vector<int32_t> listed;
+  for (int32_t f = 0; f < a.num_triangles(); ++f)
+    if (refine[size_t(f)]) listed.push_back(f);
+  out.forward_lower = v.lower;
+  out.forward_upper = std::max(v.lower, sums.settled);
+  out.forward_mean = v.mean;
+  reach = std::sqrt(sums.longest2 / 3.0);  // no point of a triangle is farther from its corners
+  out.queries = v.queries;
+  out.refined = int64_t(listed.size());
+  if (!listed.empty()) {
+    const MaxBracket bracket = bound_max_over_triangles(a, listed, b, v.lower, tolerance, kRefineQueries);
+    out.forward_lower = std::max(out.forward_lower, bracket.lower);
+    out.forward_upper = std::max(out.forward_upper, bracket.upper);
+    out.queries += bracket.queries;
+  }
+}
+
+// Triangles of A around each vertex, and the distance bound of a point to A through them: the
+// nearest vertex's triangles (any triangle of A bounds the distance to A from above).
+struct Stars {
+  explicit Stars(const Surface& a) : offset(size_t(a.num_vertices()) + 1, 0) {
+    const auto& t = a.triangles();
+    for (int32_t v : t) ++offset[size_t(v) + 1];
+    for (size_t v = 1; v < offset.size(); ++v) offset[v] += offset[v - 1];
+    triangle.resize(t.size());
+    std::vector<int64_t> next(offset.begin(), offset.end() - 1);
+    for (size_t c = 0; c < t.size(); ++c) triangle[size_t(next[size_t(t[c])]++)] = int32_t(c / 3);
+  }
+  std::vector<int64_t> offset;
+  std::vector<int32_t> triangle;
+};
+
+struct Bound {
+  double distance;
+  int32_t vertex;  // the vertex of A it was found around: where a nearby point's walk starts
+};
+
+// From `start`, steps to the nearest corner of the current vertex's triangles while that is
+// nearer to y, then bounds y's distance to A by the triangles around the vertex reached.
+Bound distance_bound(const double* y, int32_t start, const Surface& a, const Stars& stars) {
+  const auto& positions = a.positions();
+  const auto& triangles = a.triangles();
+  int32_t v = start;
+  double best2 = distance2(y, &positions[3 * size_t(v)]);
+  for (bool moved = true; moved;) {
+    moved = false;
+    const int32_t from = v;
+    for (int64_t i = stars.offset[size_t(from)]; i < stars.offset[size_t(from) + 1]; ++i)
+      for (int c = 0; c < 3; ++c) {
+        const int32_t w = triangles[3 * size_t(stars.triangle[size_t(i)]) + c];
+        const double d2 = distance2(y, &positions[3 * size_t(w)]);
+        if (d2 < best2) best2 = d2, v = w, moved = true;
+      }
+  }
+  double best = std::sqrt(best2);
+  for (int64_t i = stars.offset[size_t(v)]; i < stars.offset[size_t(v) + 1]; ++i)
+    best = std::min(best, distance_to_triangle(y, a, stars.triangle[size_t(i)]));
+  return {best, v};
+}
+
+// The distance from y to A, given a bound of it: the nearest point lies in a triangle with a
+// corner within bound + reach of y (reach: no point of a triangle is farther from its corners).
+double exact_distance(const double* y, double bound, double reach, const Surface& a, const VertexGrid& grid,
+                      const Stars& stars) {
+  double best = bound;
+  const double radius = bound + reach;
+  grid.for_each_near(y, radius, [&](int32_t v) {
+    if (distance2(y, &a.positions()[3 * size_t(v)]) > radius * radius) return;
+    for (int64_t i = stars.offset[size_t(v)]; i < stars.offset[size_t(v) + 1]; ++i)
+      best = std::min(best, distance_to_triangle(y, a, stars.triangle[size_t(i)]));
+  });
+  return best;
+}
+
+// B to A for one triangle of B: its pieces split until each one's bound (largest corner value
+// plus reach) is within the tolerance of the largest corner value found (floor: `floor`).
+struct PieceBound {
+  double upper = 0.0;
+  int64_t queries = 0;
+  double worst = 0.0;             // the largest bound at a measured point
+  double worst_point[3] = {0, 0, 0};
+};
+
+PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], const Surface& a, const VertexGrid& grid,
+                                   const Stars& stars, double reach, double floor, double tolerance) {
+  struct Piece {
+    Corners c;
+    Bound d[3];
+    int depth;
+  };
+  PieceBound out;
+  for (int j = 0; j < 3; ++j)
+    if (corner[j].distance > out.worst) out.worst = corner[j].distance, std::copy_n(t.p[j], 3, out.worst_point);
+  double best = std::max({floor, corner[0].distance, corner[1].distance, corner[2].distance});
+  std::vector<Piece> stack{{t, {corner[0], corner[1], corner[2]}, 0}};
+  double settled = 0.0;
+  while (!stack.empty()) {
+    const Piece piece = stack.back();
+    stack.pop_back();
+    const double upper =
+        std::max({piece.d[0].distance, piece.d[1].distance, piece.d[2].distance}) + nearest_corner_reach(piece.c.p);
+    if (upper <= best * (1.0 + tolerance) || piece.depth >= kMaxDepth) {
+      settled = std::max(settled, upper);
+      continue;
+    }
+    double mid[3][3];
+    Bound dm[3];
+    for (int j = 0; j < 3; ++j) {
+      for (int k = 0; k < 3; ++k) mid[j][k] = 0.5 * (piece.c.p[j][k] + piece.c.p[(j + 1) % 3][k]);
+      dm[j] = distance_bound(mid[j], piece.d[j].vertex, a, stars);
+      if (dm[j].distance > floor) {  // the walk may have stopped short: start from the nearest vertex too
+        const Bound again = distance_bound(mid[j], grid.nearest(mid[j]).vertex, a, stars);
+        if (again.distance < dm[j].distance) dm[j] = again;
+      }
+      if (dm[j].distance > floor)  // its triangles may miss a long one that is nearer: measure exactly
+        dm[j].distance = exact_distance(mid[j], dm[j].distance, reach, a, grid, stars);
+      best = std::max(best, dm[j].distance);
+      if (dm[j].distance > out.worst) out.worst = dm[j].distance, std::copy_n(mid[j], 3, out.worst_point);
+      ++out.queries;
+    }
+    const double* point[6] = {piece.c.p[0], piece.c.p[1], piece.c.p[2], mid[0], mid[1], mid[2]};
+    const Bound value[6] = {piece.d[0], piece.d[1], piece.d[2], dm[0], dm[1], dm[2]};
+    static const int kChildren[4][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {3, 4, 5}};
+    for (const auto& child : kChildren) {
+      Piece next;
+      next.depth = piece.depth + 1;
+      for (int j = 0; j < 3; ++j) {
+        std::copy_n(point[child[j]], 3, next.c.p[j]);
+        next.d[j] = value[child[j]];
+      }
+      stack.push_back(next);
+    }
+  }
+  // A piece settled before a later midpoint raised `best` stays settled: its bound holds anyway.
+  out.upper = settled;
+  return out;
+}
+
+void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, double reach,
+                    QuickBound& out) {
+  const Stars stars(a);
+  std::vector<Bound> vertex(size_t(b.num_vertices()), Bound{0.0, -1});
+  parallel_for(0, b.num_vertices(), kParallelMinCostly, [&](int64_t y) {
+    if (!b.used()[size_t(y)]) return;
+    const double* p = &b.positions()[3 * size_t(y)];
+    vertex[size_t(y)] = distance_bound(p, grid.nearest(p).vertex, a, stars);
+    if (vertex[size_t(y)].distance > out.forward_lower)
+      vertex[size_t(y)].distance = exact_distance(p, vertex[size_t(y)].distance, reach, a, grid, stars);
+  });
+  const double floor = out.forward_lower;
+  std::vector<PieceBound> per(size_t(b.num_triangles()));
+  parallel_for_dynamic(0, b.num_triangles(), 16, kParallelMinCostly, [&](int64_t f) {
+    const int32_t* t = &b.triangles()[3 * size_t(f)];
+    const Bound d[3] = {vertex[size_t(t[0])], vertex[size_t(t[1])], vertex[size_t(t[2])]};
+    per[size_t(f)] = bound_backward_triangle(corners_of(b, int32_t(f)), d, a, grid, stars, reach, floor, tolerance);
+  });
+  out.grid_queries = b.num_vertices();
+  std::vector<std::pair<double, int32_t>> worst;
+  for (int32_t f = 0; f < b.num_triangles(); ++f) {
+    out.backward_upper = std::max(out.backward_upper, per[size_t(f)].upper);
+    out.grid_queries += per[size_t(f)].queries;
+    worst.emplace_back(per[size_t(f)].worst, f);
+  }
+  // The points of B with the largest bounds measured exactly: attained distances from B to A.
+  const size_t top = std::min(worst.size(), size_t(kTopExact));
+  std::partial_sort(worst.begin(), worst.begin() + ptrdiff_t(top), worst.end(), std::greater<>());
+  for (size_t i = 0; i < top; ++i) {
+    const PieceBound& p = per[size_t(worst[i].second)];
+    out.backward_lower = std::max(out.backward_lower, exact_distance(p.worst_point, p.worst, reach, a, grid, stars));
+  }
+}
+
+}  // namespace
+
+QuickBound quick_hausdorff_bound(const Surface& a, const Surface& b, double tolerance) {
+  const double spacing = std::sqrt(2.0 * a.area() / std::max(1, a.num_triangles()));
+  const VertexGrid grid(a, kCellSpacings * spacing);
+  QuickBound out;
+  double reach = 0.0;
+  bound_forward(a, b, grid, tolerance, out, reach);
+  bound_backward(a, b, grid, tolerance, reach, out);
+  return out;
+}
+
+}  // namespace topstoc
