@@ -4,19 +4,29 @@ every output of a batch and to guide an error-bounded search, with a guaranteed 
 >>> bound = estimate_error(original, decimated)
 >>> bound.estimate <= exact maximum <= bound.upper
 
-Each side (original to result, result to original) is bracketed by the engine
-(``bracket_one_sided_max``): a walk down the measured surface's own BVH. A node's box bounds the
-distance of every point in it (its centre's distance plus half its diagonal: the distance to a
-surface is 1-Lipschitz; or the farthest box corner from the centre's nearest triangle: the
-distance to one triangle is convex); only nodes whose bound exceeds ``(1 + gap)`` times the best
-distance found are opened, and a leaf's triangles are subdivided as in the exact measurement
-(hausdorff.py) until the same test holds. ``estimate`` is the best distance found, attained at a
-point of the surface (so it never exceeds the exact maximum); ``upper`` is the largest bound
-left, which no point exceeds. The walk stops at ``queries`` closest-point queries per side; the
-bracket holds then too, only wider (``converged`` False). ``exact_error`` asks for the gap and
-the query budget of the exact bracketed maximum of hausdorff.py. ``decide_error`` asks only whether the maximum
-exceeds a bound (the error-bounded search's exact check); ``SampledError`` is the search's
-cheap estimate (distances attained at points spread on both surfaces, no upper bound).
+By default (``queries`` None) the engine's quick bound (``quick_hausdorff_bound``,
+native/src/distance/quick_bound.cpp), which builds no search structure over the original's
+triangles: the original's vertices are grouped by the cells of a grid, one per cell measured
+against the result's BVH and the others against the triangle found for it (any triangle of the
+result bounds the distance from above); a triangle of the original is bounded by its corners
+(the distance to one triangle is convex; the distance to a surface is 1-Lipschitz), and the few
+whose bound exceeds ``(1 + gap)`` times the largest distance measured are bracketed exactly.
+The result's triangles are split until the distance to the original's triangles around a
+nearby vertex, plus the piece's reach, is within ``(1 + gap)`` of the largest such value;
+the points with the 16 largest are measured exactly. ``estimate`` is the largest distance
+measured exactly (attained, so never above the exact maximum); ``upper`` the largest bound
+(no point is farther). ``mean`` estimates the mean distance from the original (its vertices'
+bounds, area-weighted).
+
+With ``queries``, each side is bracketed by a walk down the measured surface's own BVH
+(``bracket_one_sided_max``): a node's box bounds the distance of every point in it; only nodes
+whose bound exceeds ``(1 + gap)`` times the best distance found are opened, and a leaf's
+triangles are subdivided as in the exact measurement (hausdorff.py) until the same test holds,
+or until ``queries`` closest-point queries per side (then the bracket holds, only wider,
+``converged`` False). ``exact_error`` asks for the gap and the query budget of the exact
+bracketed maximum of hausdorff.py. ``decide_error`` asks only whether the maximum exceeds a
+bound (the error-bounded search's exact check); ``SampledError`` is the search's cheap estimate
+(distances attained at points spread on both surfaces, no upper bound).
 """
 
 from __future__ import annotations
@@ -29,9 +39,6 @@ from .hausdorff import as_surface
 from ..support.native import engine
 
 DEFAULT_GAP = 0.25         #: relative gap aimed at between the estimate and its upper bound, by default
-#: closest-point queries per side for the default estimate (then the bracket stops): one query
-#: per 8 triangles of the two surfaces, within these bounds, so the report costs a fraction of the decimation
-DEFAULT_QUERIES = (2_000, 100_000)
 EXACT_GAP = 1e-3           #: the gap of the exact bracketed maximum (hausdorff.py's max_tolerance)
 EXACT_QUERIES = 20_000_000 #: closest-point queries per side for the exact one
 
@@ -46,8 +53,9 @@ class ErrorBound:
     backward: tuple     #: (estimate, upper) from the result to the original
     gap: float          #: the relative gap asked for
     queries: int        #: closest-point queries made
-    converged: bool     #: upper <= estimate * (1 + gap) on both sides (False: the query budget ran out)
+    converged: bool     #: upper <= estimate * (1 + gap)
     witness: object = None  #: decide_error: a point of the original farther than the bound from the result
+    mean: float = float("nan")  #: the quick bound's estimate of the mean distance from the original
 
     @property
     def exact(self) -> bool:
@@ -62,15 +70,20 @@ class ErrorBound:
 def estimate_error(original, result, gap: float = DEFAULT_GAP, queries=None, *,
                    original_surface=None) -> ErrorBound:
     """Brackets the symmetric Hausdorff max between ``original`` and ``result`` (each
-    ``(vertices, triangles)``, an object with both, or an engine Surface) within the relative
-    ``gap``, with at most ``queries`` closest-point queries per side (default: DEFAULT_QUERIES).
-    original_surface: the original's engine Surface when the caller keeps one, so that its
-    closest-point index is built once for several results."""
+    ``(vertices, triangles)``, an object with both, or an engine Surface): by the quick bound
+    (``queries`` None), or by the BVH walks within the relative ``gap`` with at most ``queries``
+    closest-point queries per side. original_surface: the original's engine Surface when the
+    caller keeps one for several results."""
     a = original_surface or as_surface(original, "original")
     b = as_surface(result, "result")
     if queries is None:
-        low, high = DEFAULT_QUERIES
-        queries = min(high, max(low, (a.num_triangles + b.num_triangles) // 8))
+        quick = engine.quick_hausdorff_bound(a, b, tolerance=float(gap))
+        forward = (quick["forward_lower"], quick["forward_upper"])
+        backward = (quick["backward_lower"], quick["backward_upper"])
+        estimate, upper = max(forward[0], backward[0]), max(forward[1], backward[1])
+        return ErrorBound(estimate=estimate, upper=upper, forward=forward, backward=backward, gap=float(gap),
+                          queries=int(quick["queries"] + quick["grid_queries"]),
+                          converged=bool(upper <= estimate * (1 + gap)), mean=float(quick["forward_mean"]))
     forward = engine.bracket_one_sided_max(a, b, tolerance=gap, max_queries=int(queries))
     backward = engine.bracket_one_sided_max(b, a, tolerance=gap, max_queries=int(queries))
     if not (forward["converged"] and backward["converged"]):  # the walk's best is not spread: add samples
