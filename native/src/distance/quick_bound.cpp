@@ -36,7 +36,8 @@ namespace {
 constexpr int64_t kCellBlock = 64;     // grid cells one task measures, chaining its BVH hints
 constexpr int kMaxDepth = 10;          // splits of a triangle of B at most (4^10 pieces)
 constexpr double kCellSpacings = 4.0;  // grid cell side in A's mean vertex spacings (about 8 vertices a cell)
-constexpr int64_t kRefineQueries = 20000000;
+constexpr int64_t kRefineQueries = 20000000;  // per run of kRefineRun triangles
+constexpr int64_t kRefineRun = 2048;
 constexpr int64_t kTopQueries = 256;
 constexpr int64_t kTopExact = 16;  // points of B measured exactly (the backward lower bound)
 
@@ -169,8 +170,15 @@ void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, d
   reach = std::sqrt(sums.longest2 / 3.0);  // no point of a triangle is farther from its corners
   out.queries = v.queries;
   out.refined = int64_t(listed.size());
-  if (!listed.empty()) {
-    const MaxBracket bracket = bound_max_over_triangles(a, listed, b, v.lower, tolerance, kRefineQueries);
+  // Bracketed in fixed runs of triangles on the engine's threads (the same bits for any team size).
+  const int64_t runs = (int64_t(listed.size()) + kRefineRun - 1) / kRefineRun;
+  std::vector<MaxBracket> brackets(static_cast<size_t>(runs));
+  parallel_for_dynamic(0, runs, 1, parallel_if(runs > 1), [&](int64_t r) {
+    const auto first = listed.begin() + r * kRefineRun;
+    const std::vector<int32_t> run(first, first + std::min<int64_t>(kRefineRun, listed.end() - first));
+    brackets[size_t(r)] = bound_max_over_triangles(a, run, b, v.lower, tolerance, kRefineQueries);
+  });
+  for (const MaxBracket& bracket : brackets) {
     out.forward_lower = std::max(out.forward_lower, bracket.lower);
     out.forward_upper = std::max(out.forward_upper, bracket.upper);
     out.queries += bracket.queries;
