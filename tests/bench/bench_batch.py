@@ -12,7 +12,7 @@ asset = (wall time x processes - summed per-asset work) / assets: process start-
 writing, measuring, scheduling (the cluster's start-up included). Per mode, the per-asset time
 with the error report against without it (the report's own seconds taken out). On the horse
 (../shared/meshes/big, --horse-ratio): the Blender batch's time per asset with the default error
-report and with --exact-error, next to Blender's Decimate modifier at the same ratio. The JSON report of the cluster
+report (the quick bound) and with --exact-error, next to Blender's Decimate modifier at the same ratio. The JSON report of the cluster
 run is printed at the end (--report FILE keeps the whole report); --json FILE writes the figures
 (per mode: wall and work seconds, assets per minute, overhead, load average before and after).
 """
@@ -207,7 +207,10 @@ def main() -> int:
         cluster = next(row[3] for row in rows if row[0].startswith("local Dask cluster"))
         if args.json:
             pathlib.Path(args.json).write_text(json.dumps(
-                {"machine": machine(), "assets": len(paths), "triangles": triangles, "ratio": args.ratio,
+                {"benchmark": "tests/bench/bench_batch.py", "date": time.strftime("%Y-%m-%d"), "build": str(BUILD),
+                 "method": f"--count {args.count} --ratio {args.ratio}, horse at {args.horse_ratio}; wall seconds on a "
+                           "shared machine (load averages per mode); the error report's share from its own timing",
+                 "machine": machine(), "assets": len(paths), "triangles": triangles, "ratio": args.ratio,
                  "outputs_identical": identical, "modes": figures,
                  "error_report": [{"mode": l, "error_seconds": e, "work_seconds": w} for l, e, w in errors],
                  "horse": horse}, indent=2))

@@ -11,9 +11,11 @@
 // B to A: the distance from a point of B to the triangles around a vertex of A bounds its
 // distance to A from above (the vertex: the grid's nearest for B's vertices, then reached by
 // stepping to nearer neighbours from the one found for a neighbouring point; where that bound
-// exceeds A's largest distance to B found, the grid's nearest too, then an exact search); over a piece of a triangle of B it is at most the largest at its corners plus the
-// piece's nearest-corner reach, and pieces are split at their edge midpoints until that bound
-// is within (1 + tolerance) of the largest corner value (or kMaxDepth splits).
+// exceeds A's largest distance to B found, the grid's nearest too, then an exact search). Over
+// a piece of a triangle of B it is at most the largest at its corners plus the piece's
+// nearest-corner reach, or the farthest corner from a corner's triangle of A (convex); pieces
+// are split at their edge midpoints until that is within (1 + tolerance) of the largest corner
+// value (or kMaxDepth splits).
 // The lower bound is attained: the largest distance measured exactly from a point of A to B, or
 // from one of the kTopExact points of B with the largest bounds to A (through the grid).
 #include "topstoc/distance/hausdorff.hpp"
@@ -21,6 +23,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -202,7 +205,8 @@ struct Stars {
 
 struct Bound {
   double distance;
-  int32_t vertex;  // the vertex of A it was found around: where a nearby point's walk starts
+  int32_t vertex;    // the vertex of A it was found around: where a nearby point's walk starts
+  int32_t triangle;  // the triangle of A at that distance
 };
 
 // From `start`, steps to the nearest corner of the current vertex's triangles while that is
@@ -222,28 +226,32 @@ Bound distance_bound(const double* y, int32_t start, const Surface& a, const Sta
         if (d2 < best2) best2 = d2, v = w, moved = true;
       }
   }
-  double best = std::sqrt(best2);
-  for (int64_t i = stars.offset[size_t(v)]; i < stars.offset[size_t(v) + 1]; ++i)
-    best = std::min(best, distance_to_triangle(y, a, stars.triangle[size_t(i)]));
-  return {best, v};
+  Bound out{std::numeric_limits<double>::infinity(), v, -1};  // v is a corner of each: no farther than v
+  for (int64_t i = stars.offset[size_t(v)]; i < stars.offset[size_t(v) + 1]; ++i) {
+    const double d = distance_to_triangle(y, a, stars.triangle[size_t(i)]);
+    if (d < out.distance) out.distance = d, out.triangle = stars.triangle[size_t(i)];
+  }
+  return out;
 }
 
 // The distance from y to A, given a bound of it: the nearest point lies in a triangle with a
 // corner within bound + reach of y (reach: no point of a triangle is farther from its corners).
-double exact_distance(const double* y, double bound, double reach, const Surface& a, const VertexGrid& grid,
-                      const Stars& stars) {
-  double best = bound;
-  const double radius = bound + reach;
+Bound exact_distance(const double* y, Bound bound, double reach, const Surface& a, const VertexGrid& grid,
+                     const Stars& stars) {
+  const double radius = bound.distance + reach;
   grid.for_each_near(y, radius, [&](int32_t v) {
     if (distance2(y, &a.positions()[3 * size_t(v)]) > radius * radius) return;
-    for (int64_t i = stars.offset[size_t(v)]; i < stars.offset[size_t(v) + 1]; ++i)
-      best = std::min(best, distance_to_triangle(y, a, stars.triangle[size_t(i)]));
+    for (int64_t i = stars.offset[size_t(v)]; i < stars.offset[size_t(v) + 1]; ++i) {
+      const double d = distance_to_triangle(y, a, stars.triangle[size_t(i)]);
+      if (d < bound.distance) bound.distance = d, bound.triangle = stars.triangle[size_t(i)];
+    }
   });
-  return best;
+  return bound;
 }
 
 // B to A for one triangle of B: its pieces split until each one's bound (largest corner value
-// plus reach) is within the tolerance of the largest corner value found (floor: `floor`).
+// plus reach, or the farthest corner from a corner's triangle of A: the distance to one triangle
+// is convex) is within the tolerance of the largest corner value found (floor: `floor`).
 struct PieceBound {
   double upper = 0.0;
   int64_t queries = 0;
@@ -267,8 +275,13 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
   while (!stack.empty()) {
     const Piece piece = stack.back();
     stack.pop_back();
-    const double upper =
+    double upper =
         std::max({piece.d[0].distance, piece.d[1].distance, piece.d[2].distance}) + nearest_corner_reach(piece.c.p);
+    for (const Bound& corner_bound : piece.d) {  // the distance to one triangle of A is convex: its corners'
+      double farthest = 0.0;
+      for (int i = 0; i < 3; ++i) farthest = std::max(farthest, distance_to_triangle(piece.c.p[i], a, corner_bound.triangle));
+      upper = std::min(upper, farthest);
+    }
     if (upper <= best * (1.0 + tolerance) || piece.depth >= kMaxDepth) {
       settled = std::max(settled, upper);
       continue;
@@ -283,7 +296,7 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
         if (again.distance < dm[j].distance) dm[j] = again;
       }
       if (dm[j].distance > floor)  // its triangles may miss a long one that is nearer: measure exactly
-        dm[j].distance = exact_distance(mid[j], dm[j].distance, reach, a, grid, stars);
+        dm[j] = exact_distance(mid[j], dm[j], reach, a, grid, stars);
       best = std::max(best, dm[j].distance);
       if (dm[j].distance > out.worst) out.worst = dm[j].distance, std::copy_n(mid[j], 3, out.worst_point);
       ++out.queries;
@@ -309,13 +322,13 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
 void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, double reach,
                     QuickBound& out) {
   const Stars stars(a);
-  std::vector<Bound> vertex(size_t(b.num_vertices()), Bound{0.0, -1});
+  std::vector<Bound> vertex(size_t(b.num_vertices()), Bound{0.0, -1, -1});
   parallel_for(0, b.num_vertices(), kParallelMinCostly, [&](int64_t y) {
     if (!b.used()[size_t(y)]) return;
     const double* p = &b.positions()[3 * size_t(y)];
     vertex[size_t(y)] = distance_bound(p, grid.nearest(p).vertex, a, stars);
     if (vertex[size_t(y)].distance > out.forward_lower)
-      vertex[size_t(y)].distance = exact_distance(p, vertex[size_t(y)].distance, reach, a, grid, stars);
+      vertex[size_t(y)] = exact_distance(p, vertex[size_t(y)], reach, a, grid, stars);
   });
   const double floor = out.forward_lower;
   std::vector<PieceBound> per(size_t(b.num_triangles()));
@@ -336,7 +349,8 @@ void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, 
   std::partial_sort(worst.begin(), worst.begin() + ptrdiff_t(top), worst.end(), std::greater<>());
   for (size_t i = 0; i < top; ++i) {
     const PieceBound& p = per[size_t(worst[i].second)];
-    out.backward_lower = std::max(out.backward_lower, exact_distance(p.worst_point, p.worst, reach, a, grid, stars));
+    const Bound exact = exact_distance(p.worst_point, Bound{p.worst, -1, -1}, reach, a, grid, stars);
+    out.backward_lower = std::max(out.backward_lower, exact.distance);
   }
 }
 
