@@ -382,6 +382,39 @@ def render_cleanup(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def render_batch(name: str, figures: dict) -> str:
+    """bench_batch.py --json: assets per minute by mode, the error report's share, the horse next to
+    Blender's Decimate modifier."""
+    label = f", {figures['label']}" if figures.get("label") else ""
+    out = [f"## Batch throughput and the error report{label} (`{name}`)", "", *source_lines(figures),
+           f"- Assets: {figures['assets']} of {figures['triangles'] // figures['assets']:,} triangles, ratio "
+           f"{figures['ratio']}; outputs byte-identical across the modes: {figures['outputs_identical']}", "",
+           "| mode | wall s | assets/min | overhead ms/asset | error report s of work s | with ÷ without the report | load before / after |",
+           "|---|---|---|---|---|---|---|"]
+    reports = {row["mode"]: row for row in figures["error_report"]}
+    for row in figures["modes"]:
+        report = reports[row["mode"]]
+        without = max(1e-9, report["work_seconds"] - report["error_seconds"])
+        out.append(f"| {row['mode']} | {row['wall_seconds']:.1f} | {row['assets_per_minute']:.0f} | "
+                   f"{row['overhead_ms_per_asset']:.0f} | {report['error_seconds']:.2f} of {report['work_seconds']:.2f} | "
+                   f"{report['work_seconds'] / without:.2f}× | {row['load_before']:.2f} / {row['load_after']:.2f} |")
+    horse = figures.get("horse") or {}
+    if "estimate" in horse:
+        out += ["", "| horse, Blender batch | s per asset | error report s | hausdorff | hausdorff_upper | "
+                    "Decimate modifier ÷ asset time |", "|---|---|---|---|---|---|"]
+        modifier = horse.get("modifier_seconds")
+        for kind, title in (("estimate", "default report"), ("exact", "--exact-error")):
+            if kind not in horse:
+                continue
+            h = horse[kind]
+            speed = f"{modifier / h['asset_seconds']:.1f}×" if modifier else "—"
+            out.append(f"| {title} | {h['asset_seconds']:.2f} | {h['error_seconds']:.2f} | "
+                       f"{h['lod']['hausdorff']:.4g} | {h['lod']['hausdorff_upper']:.4g} | {speed} |")
+        if modifier:
+            out += ["", f"Blender's Decimate modifier on the horse in the same run: {modifier:.1f} s."]
+    return "\n".join(out) + "\n"
+
+
 def render_result(path: pathlib.Path) -> str:
     figures = json.loads(path.read_text())
     if isinstance(figures, dict) and figures.get("carried_over"):
@@ -404,10 +437,12 @@ def render_result(path: pathlib.Path) -> str:
         return render_cleanup(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_blender_decimate.py --only-rest":
         return render_blender_rest(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_batch.py":
+        return render_batch(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
                      "the --json of bench_decimate.py, bench_quality.py, bench_attributes.py, bench_loops.py --families, "
-                     "bench_scale.py, bench_threads_paired.py, bench_cleanup.py, bench_cleanup.py --speed and "
-                     "bench_blender_decimate.py --only-rest, and carried-over "
+                     "bench_scale.py, bench_threads_paired.py, bench_cleanup.py, bench_cleanup.py --speed, "
+                     "bench_blender_decimate.py --only-rest and bench_batch.py, and carried-over "
                      "figures)")
 
 

@@ -259,9 +259,8 @@ def test_bake_colour_needs_bake_normals(tmp_path):
 
 
 def test_the_error_report_is_a_bracket_and_exact_on_request(tmp_path):
-    """Default: the quick bound (estimate <= upper, both against an independent exact measurement,
-    the upper within 1.5x of it) and an estimated mean distance; --exact-error: the exact
-    bracketed max, within 0.1 %, and no estimated mean."""
+    """Default: a bounded estimate (estimate <= upper, both against an independent exact
+    measurement); --exact-error: the exact bracketed max, within 0.1 %."""
     from topstoc.core.api.hausdorff import hausdorff
     source = _torus(tmp_path / "in")
     lods = {}
@@ -275,8 +274,4 @@ def test_the_error_report_is_a_bracket_and_exact_on_request(tmp_path):
         lod = lods[bool(flag)]
         assert lod["hausdorff"] <= truth.max_upper and lod["hausdorff_upper"] >= truth.max
         assert lod["hausdorff_kind"] == ("exact" if flag else "estimate")
-        assert lod["hausdorff_upper"] <= 1.5 * truth.max_upper
-        assert ("hausdorff_mean" in lod) == (not flag)
     assert lods[True]["hausdorff_upper"] <= lods[True]["hausdorff"] * 1.001 + 1e-12
-    measured = hausdorff(read_mesh(source), read_mesh(entry["output"]), samples=300_000, percentile=0).forward.mean
-    assert 0.6 * measured <= lods[False]["hausdorff_mean"] <= 1.4 * measured

@@ -4,25 +4,28 @@ every output of a batch and to guide an error-bounded search, with a guaranteed 
 >>> bound = estimate_error(original, decimated)
 >>> bound.estimate <= exact maximum <= bound.upper
 
-By default (``queries`` None) the engine's quick bound (``quick_hausdorff_bound``,
-native/src/distance/quick_bound.cpp), which builds no search structure over the original's
-triangles: the original's vertices are grouped by the cells of a grid, one per cell measured
-against the result's BVH and the others against the triangle found for it (any triangle of the
-result bounds the distance from above); a triangle of the original is bounded by its corners
-(the distance to one triangle is convex; the distance to a surface is 1-Lipschitz), and the few
-whose bound exceeds ``(1 + gap)`` times the largest distance measured are bracketed exactly.
-The result's triangles are split until the distance to the original's triangles around a
-nearby vertex, plus the piece's reach, is within ``(1 + gap)`` of the largest such value;
-the points with the 16 largest are measured exactly. ``estimate`` is the largest distance
-measured exactly (attained, so never above the exact maximum); ``upper`` the largest bound
-(no point is farther). ``mean`` estimates the mean distance from the original (its vertices'
-bounds, area-weighted).
+For a big original (QUICK_TRIANGLES or more) by default, the engine's quick bound
+(``quick_hausdorff_bound``, native/src/distance/quick_bound.cpp), which builds no search
+structure over the original's triangles: the original's vertices are grouped by the cells of a
+grid, one per cell measured against the result's BVH and the others against the triangle found
+for it (any triangle of the result bounds the distance from above); a triangle of the original
+is bounded by its corners (the distance to one triangle is convex; the distance to a surface is
+1-Lipschitz), and the few whose bound exceeds ``(1 + gap)`` times the largest distance measured
+are bracketed exactly. The result's triangles are split until the distance to the original's
+triangles around a nearby vertex, plus the piece's reach, is within ``(1 + gap)`` of the largest
+such value; the points with the 16 largest are measured exactly. Where a side's bound is still
+above ``(1 + gap)`` times the estimate (a tiny maximum against long sides: a result nearly on the
+original), that side is bracketed by the walk below too, and the tighter bounds kept.
+``estimate`` is the largest distance measured exactly (attained, so never above the exact
+maximum); ``upper`` the largest bound (no point is farther). ``mean`` estimates the mean
+distance from the original (one measured vertex per grid cell, unweighted).
 
-With ``queries``, each side is bracketed by a walk down the measured surface's own BVH
+Otherwise each side is bracketed by a walk down the measured surface's own BVH
 (``bracket_one_sided_max``): a node's box bounds the distance of every point in it; only nodes
 whose bound exceeds ``(1 + gap)`` times the best distance found are opened, and a leaf's
 triangles are subdivided as in the exact measurement (hausdorff.py) until the same test holds,
-or until ``queries`` closest-point queries per side (then the bracket holds, only wider,
+or until ``queries`` closest-point queries per side (default: one per 8 triangles of the two
+surfaces, 2,000 to 100,000) (then the bracket holds, only wider,
 ``converged`` False). ``exact_error`` asks for the gap and the query budget of the exact
 bracketed maximum of hausdorff.py. ``decide_error`` asks only whether the maximum exceeds a
 bound (the error-bounded search's exact check); ``SampledError`` is the search's cheap estimate
@@ -39,6 +42,11 @@ from .hausdorff import as_surface
 from ..support.native import engine
 
 DEFAULT_GAP = 0.25         #: relative gap aimed at between the estimate and its upper bound, by default
+#: closest-point queries a side for the BVH walks (one per 8 triangles of the two surfaces, within these)
+WALK_QUERIES = (2_000, 100_000)
+#: originals of this many triangles or more get the quick bound by default: building their BVH for
+#: the walks costs more than the decimation (on smaller ones the walks settle in fewer queries)
+QUICK_TRIANGLES = 250_000
 EXACT_GAP = 1e-3           #: the gap of the exact bracketed maximum (hausdorff.py's max_tolerance)
 EXACT_QUERIES = 20_000_000 #: closest-point queries per side for the exact one
 
@@ -68,22 +76,32 @@ class ErrorBound:
 
 
 def estimate_error(original, result, gap: float = DEFAULT_GAP, queries=None, *,
-                   original_surface=None) -> ErrorBound:
+                   original_surface=None, quick=None) -> ErrorBound:
     """Brackets the symmetric Hausdorff max between ``original`` and ``result`` (each
-    ``(vertices, triangles)``, an object with both, or an engine Surface): by the quick bound
-    (``queries`` None), or by the BVH walks within the relative ``gap`` with at most ``queries``
-    closest-point queries per side. original_surface: the original's engine Surface when the
-    caller keeps one for several results."""
+    ``(vertices, triangles)``, an object with both, or an engine Surface) within the relative
+    ``gap``: by the quick bound (``quick`` True; by default when the original has QUICK_TRIANGLES
+    triangles or more and no ``queries`` are given), else by the BVH walks with at most ``queries``
+    closest-point queries per side (default: one per 8 triangles of the two surfaces, WALK_QUERIES).
+    original_surface: the original's engine Surface when the caller keeps one for several results."""
     a = original_surface or as_surface(original, "original")
     b = as_surface(result, "result")
-    if queries is None:
-        quick = engine.quick_hausdorff_bound(a, b, tolerance=float(gap))
-        forward = (quick["forward_lower"], quick["forward_upper"])
-        backward = (quick["backward_lower"], quick["backward_upper"])
-        estimate, upper = max(forward[0], backward[0]), max(forward[1], backward[1])
-        return ErrorBound(estimate=estimate, upper=upper, forward=forward, backward=backward, gap=float(gap),
-                          queries=int(quick["queries"] + quick["grid_queries"]),
-                          converged=bool(upper <= estimate * (1 + gap)), mean=float(quick["forward_mean"]))
+    if quick is None:
+        quick = queries is None and a.num_triangles >= QUICK_TRIANGLES
+    if quick:
+        found = engine.quick_hausdorff_bound(a, b, tolerance=float(gap))
+        sides = [[found["forward_lower"], found["forward_upper"]], [found["backward_lower"], found["backward_upper"]]]
+        queries = found["queries"] + found["grid_queries"]
+        estimate = max(sides[0][0], sides[1][0])
+        for side, (x, y) in zip(sides, ((a, b), (b, a))):
+            if side[1] > estimate * (1 + gap):  # not settled (a tiny max against long sides): the walk too
+                walk = engine.bracket_one_sided_max(x, y, tolerance=gap, max_queries=_walk_budget(a, b))
+                side[0], side[1] = max(side[0], walk["lower"]), min(side[1], walk["upper"])  # both hold
+                queries += walk["queries"]
+        estimate, upper = max(sides[0][0], sides[1][0]), max(sides[0][1], sides[1][1])
+        return ErrorBound(estimate=estimate, upper=upper, forward=tuple(sides[0]), backward=tuple(sides[1]),
+                          gap=float(gap), queries=int(queries), converged=bool(upper <= estimate * (1 + gap)),
+                          mean=float(found["forward_mean"]))
+    queries = _walk_budget(a, b) if queries is None else queries
     forward = engine.bracket_one_sided_max(a, b, tolerance=gap, max_queries=int(queries))
     backward = engine.bracket_one_sided_max(b, a, tolerance=gap, max_queries=int(queries))
     if not (forward["converged"] and backward["converged"]):  # the walk's best is not spread: add samples
@@ -94,6 +112,12 @@ def estimate_error(original, result, gap: float = DEFAULT_GAP, queries=None, *,
                       forward=(forward["lower"], forward["upper"]), backward=(backward["lower"], backward["upper"]),
                       gap=float(gap), queries=int(forward["queries"] + backward["queries"]),
                       converged=bool(forward["converged"] and backward["converged"]))
+
+
+def _walk_budget(a, b) -> int:
+    """Closest-point queries a side for the quick bound's fallback walk: one per 8 triangles of the two surfaces."""
+    low, high = WALK_QUERIES
+    return min(high, max(low, (a.num_triangles + b.num_triangles) // 8))
 
 
 def exact_error(original, result, *, original_surface=None) -> ErrorBound:

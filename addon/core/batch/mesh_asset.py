@@ -2,7 +2,7 @@
 
 The file is read in its own vertex order, decimated once per LOD (UV seams and material
 borders kept as borders, so UVs, vertex colours and materials carry over exactly), optionally
-pruned of small parts (screen targets), measured against the original (the quick bound of the
+pruned of small parts (screen targets), measured against the original (a bounded estimate of the
 Hausdorff max, or the exact bracketed max with --exact-error) and written atomically
 (topstoc.core.api.io.write_mesh: temporary file, then rename). A LOD chain gives one file per
 LOD, ``<stem>_LOD<i>.<ext>``.
@@ -41,9 +41,9 @@ def output_paths(path: str, out_dir: str, settings: dict) -> list:
 
 
 def lod_error(original, result, screen, exact: bool = False, original_surface=None) -> dict:
-    """The symmetric Hausdorff error of a LOD (absolute, relative, in pixels): by default the quick
-    bound (``hausdorff`` attained, ``hausdorff_upper`` guaranteed, aimed within 25 % of it;
-    ``hausdorff_mean`` the estimated mean distance), the exact bracketed max with ``exact``
+    """The symmetric Hausdorff error of a LOD (absolute, relative, in pixels): by default a bounded
+    estimate (``hausdorff`` attained, ``hausdorff_upper`` guaranteed, aimed within 25 % of it; for
+    big sources the quick bound, with ``hausdorff_mean``), the exact bracketed max with ``exact``
     (topstoc.core.api.error_estimate). original_surface: the original's measurement surface, kept
     across the LODs of one asset."""
     started = time.perf_counter()
@@ -54,7 +54,7 @@ def lod_error(original, result, screen, exact: bool = False, original_surface=No
              "hausdorff_relative": bound.estimate / diagonal if diagonal else 0.0,
              "hausdorff_upper_relative": bound.upper / diagonal if diagonal else 0.0,
              "hausdorff_seconds": time.perf_counter() - started}
-    if bound.mean == bound.mean:  # the quick bound's mean (NaN for the exact bracket)
+    if bound.mean == bound.mean:  # the quick bound's mean (NaN for the walks)
         entry["hausdorff_mean"] = bound.mean
     if screen is not None:
         entry["hausdorff_pixels"] = screen.to_pixels(bound.estimate)

@@ -15,7 +15,7 @@
 // a piece of a triangle of B it is at most the largest at its corners plus the piece's
 // nearest-corner reach, or the farthest corner from a corner's triangle of A (convex); pieces
 // are split at their edge midpoints until that is within (1 + tolerance) of the largest corner
-// value (or kMaxDepth splits).
+// value (highest first, kMaxSplits splits at most).
 // The lower bound is attained: the largest distance measured exactly from a point of A to B, or
 // from one of the kTopExact points of B with the largest bounds to A (through the grid).
 #include "topstoc/distance/hausdorff.hpp"
@@ -37,10 +37,11 @@ namespace topstoc {
 namespace {
 
 constexpr int64_t kCellBlock = 64;     // grid cells one task measures, chaining its BVH hints
-constexpr int kMaxDepth = 10;          // splits of a triangle of B at most (4^10 pieces)
+constexpr int kMaxSplits = 256;        // splits of a triangle of B at most
 constexpr double kCellSpacings = 4.0;  // grid cell side in A's mean vertex spacings (about 8 vertices a cell)
-constexpr int64_t kRefineQueries = 20000000;  // per run of kRefineRun triangles
 constexpr int64_t kRefineRun = 2048;
+constexpr int64_t kRefineQueries = 16 * kRefineRun;  // per run: 16 a triangle (the bracket holds when they run out)
+constexpr double kFloor = 1e-12;  // distances below this fraction of the diagonal count as none (coincident surfaces)
 constexpr int64_t kTopQueries = 256;
 constexpr int64_t kTopExact = 16;  // points of B measured exactly (the backward lower bound)
 
@@ -149,7 +150,7 @@ struct ForwardSums {
 void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, QuickBound& out,
                    double& reach) {
   const VertexBounds v = bound_vertices(a, b, grid);
-  const double threshold = v.lower * (1.0 + tolerance);
+  const double threshold = std::max(v.lower * (1.0 + tolerance), kFloor * std::max(a.diagonal(), b.diagonal()));
   std::vector<uint8_t> refine(size_t(a.num_triangles()), 0);
   const ForwardSums sums = ordered_reduce<ForwardSums>(
       a.num_triangles(),
@@ -264,27 +265,38 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
   struct Piece {
     Corners c;
     Bound d[3];
-    int depth;
+    double upper;
   };
+  auto bounded = [&](Piece& piece) {  // Lipschitz, then convex through each corner's triangle of A
+    piece.upper =
+        std::max({piece.d[0].distance, piece.d[1].distance, piece.d[2].distance}) + nearest_corner_reach(piece.c.p);
+    for (const Bound& corner_bound : piece.d) {
+      double farthest = 0.0;
+      for (int i = 0; i < 3; ++i) farthest = std::max(farthest, distance_to_triangle(piece.c.p[i], a, corner_bound.triangle));
+      piece.upper = std::min(piece.upper, farthest);
+    }
+  };
+  auto lower_bound_first = [](const Piece& x, const Piece& y) { return x.upper < y.upper; };
   PieceBound out;
   for (int j = 0; j < 3; ++j)
     if (corner[j].distance > out.worst) out.worst = corner[j].distance, std::copy_n(t.p[j], 3, out.worst_point);
   double best = std::max({floor, corner[0].distance, corner[1].distance, corner[2].distance});
-  std::vector<Piece> stack{{t, {corner[0], corner[1], corner[2]}, 0}};
+  std::vector<Piece> open{{t, {corner[0], corner[1], corner[2]}, 0.0}};
+  bounded(open.front());
   double settled = 0.0;
-  while (!stack.empty()) {
-    const Piece piece = stack.back();
-    stack.pop_back();
-    double upper =
-        std::max({piece.d[0].distance, piece.d[1].distance, piece.d[2].distance}) + nearest_corner_reach(piece.c.p);
-    for (const Bound& corner_bound : piece.d) {  // the distance to one triangle of A is convex: its corners'
-      double farthest = 0.0;
-      for (int i = 0; i < 3; ++i) farthest = std::max(farthest, distance_to_triangle(piece.c.p[i], a, corner_bound.triangle));
-      upper = std::min(upper, farthest);
-    }
-    if (upper <= best * (1.0 + tolerance) || piece.depth >= kMaxDepth) {
-      settled = std::max(settled, upper);
+  // The highest bound first, kMaxSplits splits at most: a result nearly on the original (a
+  // tiny max against long sides) would need pieces far smaller than that; the bound holds anyway.
+  for (int splits = 0; !open.empty(); ++splits) {
+    std::pop_heap(open.begin(), open.end(), lower_bound_first);
+    const Piece piece = open.back();
+    open.pop_back();
+    if (piece.upper <= best * (1.0 + tolerance)) {
+      settled = std::max(settled, piece.upper);
       continue;
+    }
+    if (splits >= kMaxSplits) {
+      settled = std::max(settled, piece.upper);  // the highest left: every other is lower
+      break;
     }
     double mid[3][3];
     Bound dm[3];
@@ -306,12 +318,13 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
     static const int kChildren[4][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {3, 4, 5}};
     for (const auto& child : kChildren) {
       Piece next;
-      next.depth = piece.depth + 1;
       for (int j = 0; j < 3; ++j) {
         std::copy_n(point[child[j]], 3, next.c.p[j]);
         next.d[j] = value[child[j]];
       }
-      stack.push_back(next);
+      bounded(next);
+      open.push_back(next);
+      std::push_heap(open.begin(), open.end(), lower_bound_first);
     }
   }
   // A piece settled before a later midpoint raised `best` stays settled: its bound holds anyway.
@@ -330,7 +343,7 @@ void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, 
     if (vertex[size_t(y)].distance > out.forward_lower)
       vertex[size_t(y)] = exact_distance(p, vertex[size_t(y)], reach, a, grid, stars);
   });
-  const double floor = out.forward_lower;
+  const double floor = std::max(out.forward_lower, kFloor * std::max(a.diagonal(), b.diagonal()));
   std::vector<PieceBound> per(size_t(b.num_triangles()));
   parallel_for_dynamic(0, b.num_triangles(), 16, kParallelMinCostly, [&](int64_t f) {
     const int32_t* t = &b.triangles()[3 * size_t(f)];
