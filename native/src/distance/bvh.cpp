@@ -1,6 +1,5 @@
 #include "topstoc/distance/bvh.hpp"
 #include "topstoc/core/parallel.hpp"
-#include "distance/radix_sort.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -49,25 +48,12 @@ constexpr double kPruneSlack = 1.0 + 1e-12;
 
 }  // namespace
 
-// A triangle's place on a Morton curve through its centroid, next to its id: the build sorts
-// these, so that each node's triangles are one run of the curve.
+// A triangle's centroid next to its id: the build partitions these in place, so its scans are
+// sequential instead of gathering through an index.
 struct TriangleBvh::BuildItem {
-  uint64_t code;
+  double centroid[3];
   int32_t id;
 };
-
-namespace {
-
-constexpr int kAxisBits = 14;  // cells per axis of the Morton curve: 2^14
-
-// The kAxisBits bits of x spread to every third bit.
-uint64_t spread_bits(uint64_t x) {
-  uint64_t out = 0;
-  for (int b = 0; b < kAxisBits; ++b) out |= ((x >> b) & 1) << (3 * b);
-  return out;
-}
-
-}  // namespace
 
 double closest_point_on_triangle(const double* p, const double* a, const double* b, const double* c,
                                  double* closest) {
@@ -128,48 +114,36 @@ double closest_point_on_triangle(const double* p, const double* a, const double*
 }
 
 TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int64_t num_triangles) {
-  // Triangles sorted along a Morton curve through their centroids (Lauterbach et al. 2009,
-  // "LBVH"), then split where the curve crosses the highest differing cell boundary: linear
-  // time, where median splits took O(m log m) and most of a million-triangle measurement.
   const int32_t m = static_cast<int32_t>(num_triangles);
-  auto centroid = [&](int32_t f, int k) {
-    const int32_t* t = &triangles[3 * size_t(f)];
-    return (positions[3 * size_t(t[0]) + k] + positions[3 * size_t(t[1]) + k] + positions[3 * size_t(t[2]) + k]) / 3.0;
-  };
-  double lo[3], hi[3];
-  for (int k = 0; k < 3; ++k) lo[k] = std::numeric_limits<double>::infinity(), hi[k] = -lo[k];
-  for (int32_t f = 0; f < m; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const double x = centroid(f, k);
-      lo[k] = std::min(lo[k], x), hi[k] = std::max(hi[k], x);
-    }
-  std::vector<BuildItem> items(m);
-  const double cells = double((1 << kAxisBits) - 1);
-  parallel_for(0, m, 100000, [&](int32_t f) {
-    uint64_t code = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double unit = hi[k] > lo[k] ? (centroid(f, k) - lo[k]) / (hi[k] - lo[k]) : 0.0;
-      code |= spread_bits(uint64_t(std::clamp(unit, 0.0, 1.0) * cells)) << (2 - k);
-    }
-    items[f] = {code, f};
-  });
-  radix_sort(items, 3 * kAxisBits);
-  // The corners in leaf order, so that a leaf's triangles sit together in memory.
-  triangle_ids_.resize(m);
   corners_.resize(9 * size_t(m));
-  parallel_for(0, m, 100000, [&](int32_t s) {
-    const int32_t f = triangle_ids_[s] = items[s].id;
+  std::vector<double> centroids(3 * size_t(m));
+  std::vector<double> unordered(9 * size_t(m));
+  parallel_for(0, m, 100000, [&](int32_t f) {
     for (int c = 0; c < 3; ++c)
-      std::copy_n(&positions[3 * size_t(triangles[3 * size_t(f) + c])], 3, &corners_[9 * size_t(s) + 3 * c]);
+      for (int k = 0; k < 3; ++k) {
+        const double x = positions[3 * size_t(triangles[3 * size_t(f) + c]) + k];
+        unordered[9 * size_t(f) + 3 * c + k] = x;
+        centroids[3 * size_t(f) + k] += x / 3.0;
+      }
   });
+  std::vector<BuildItem> items(m);
+  for (int32_t f = 0; f < m; ++f) items[f] = {{centroids[3 * size_t(f)], centroids[3 * size_t(f) + 1],
+                                                centroids[3 * size_t(f) + 2]}, f};
   nodes_.reserve(2 * size_t(m / kLeafSize + 1));
-  build(0, m, items.data());
+  build(0, m, unordered, items.data());
+  std::vector<int32_t> order(m);
+  for (int32_t s = 0; s < m; ++s) order[s] = items[s].id;
+  // Store the corners in leaf order so that a leaf's triangles sit together in memory.
+  triangle_ids_ = order;
+  parallel_for(0, m, 100000, [&](int32_t s) {
+    std::copy_n(&unordered[9 * size_t(order[s])], 9, &corners_[9 * size_t(s)]);
+  });
 }
 
-int32_t TriangleBvh::build(int32_t begin, int32_t end, const BuildItem* items) {
-  // The split: the first item whose code has the highest bit in which the range's first and last
-  // codes differ (the middle when all codes are equal). Boxes come from the children, so each
-  // slot's corners are read once.
+int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items) {
+  // Median split along the longest axis of the centroids' box: a balanced tree, built in
+  // O(m log m), that serves nearest-point queries well. Boxes come from the children, so each
+  // triangle's corners are read once.
   const int32_t index = static_cast<int32_t>(nodes_.size());
   nodes_.push_back(Node{});
   Node node{};
@@ -178,24 +152,34 @@ int32_t TriangleBvh::build(int32_t begin, int32_t end, const BuildItem* items) {
       node.lo[k] = std::numeric_limits<double>::infinity();
       node.hi[k] = -std::numeric_limits<double>::infinity();
     }
-    for (int64_t i = 9 * int64_t(begin); i < 9 * int64_t(end); i += 3)
-      for (int k = 0; k < 3; ++k) {
-        node.lo[k] = std::min(node.lo[k], corners_[size_t(i) + k]);
-        node.hi[k] = std::max(node.hi[k], corners_[size_t(i) + k]);
-      }
+    for (int32_t i = begin; i < end; ++i)
+      for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 3; ++k) {
+          node.lo[k] = std::min(node.lo[k], corners[9 * size_t(items[i].id) + 3 * c + k]);
+          node.hi[k] = std::max(node.hi[k], corners[9 * size_t(items[i].id) + 3 * c + k]);
+        }
     node.first = begin;
     node.count = end - begin;
   } else {
-    const uint64_t differ = items[begin].code ^ items[end - 1].code;
-    int32_t middle = begin + (end - begin) / 2;
-    if (differ != 0) {
-      uint64_t bit = uint64_t(1) << (3 * kAxisBits - 1);
-      while (!(differ & bit)) bit >>= 1;
-      middle = int32_t(std::partition_point(items + begin, items + end,
-                                            [bit](const BuildItem& x) { return !(x.code & bit); }) - items);
+    double centre_lo[3], centre_hi[3];
+    for (int k = 0; k < 3; ++k) {
+      centre_lo[k] = std::numeric_limits<double>::infinity();
+      centre_hi[k] = -std::numeric_limits<double>::infinity();
     }
-    const int32_t left = build(begin, middle, items);
-    const int32_t right = build(middle, end, items);
+    for (int32_t i = begin; i < end; ++i)
+      for (int k = 0; k < 3; ++k) {
+        centre_lo[k] = std::min(centre_lo[k], items[i].centroid[k]);
+        centre_hi[k] = std::max(centre_hi[k], items[i].centroid[k]);
+      }
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (centre_hi[k] - centre_lo[k] > centre_hi[axis] - centre_lo[axis]) axis = k;
+    const int32_t middle = begin + (end - begin) / 2;
+    std::nth_element(items + begin, items + middle, items + end, [axis](const BuildItem& x, const BuildItem& y) {
+      return x.centroid[axis] < y.centroid[axis] || (x.centroid[axis] == y.centroid[axis] && x.id < y.id);
+    });
+    const int32_t left = build(begin, middle, corners, items);
+    const int32_t right = build(middle, end, corners, items);
     for (int k = 0; k < 3; ++k) {
       node.lo[k] = std::min(nodes_[left].lo[k], nodes_[right].lo[k]);
       node.hi[k] = std::max(nodes_[left].hi[k], nodes_[right].hi[k]);

@@ -1,5 +1,5 @@
 // A least-significant-digit radix sort of items by an unsigned 64-bit `code` member: linear time
-// for the spatial orders of the distance module (the BVH's Morton curve, the vertex grid's cells).
+// for the vertex grid's order of the vertices by cell.
 #pragma once
 
 #include <algorithm>

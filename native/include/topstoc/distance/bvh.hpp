@@ -52,8 +52,8 @@ class TriangleBvh {
 
  private:
   struct BuildItem;
-  /// Builds the subtree over slots [begin, end) (items: their Morton codes, sorted).
-  int32_t build(int32_t begin, int32_t end, const BuildItem* items);
+  /// Builds the subtree over items [begin, end), which it reorders.
+  int32_t build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items);
   double slot_distance2(const double* p, int32_t slot, double* closest) const;
 
   std::vector<Node> nodes_;
