@@ -293,7 +293,7 @@ def read(obj, arrays: mesh_read.MeshArrays, scene, depsgraph=None,
                 u = rules.material_guidance(n, arrays.triangles, arrays.triangle_material, material_weights)
                 values.append((u, material_strength))
                 out.sources.append("material slot weights")
-            if len(np.unique(arrays.polygon_material)) > 1:
+            if arrays.several_materials():
                 out.regions = rules.compact_regions(arrays.triangle_material)
                 out.sources.append("material borders")
         out.guidance = rules.combine(values, n)
