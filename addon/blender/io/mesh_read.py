@@ -30,24 +30,46 @@ class MeshArrays:
     bytes a triangle, which the prepared-mesh cache would hold); ``polygons_of`` and
     ``loops_of`` map a few triangles without making them."""
 
-    vertices: np.ndarray          #: (n, 3) float64
-    triangles: np.ndarray         #: (m, 3) int32 vertex ids (loop triangles)
+    _vertices: Optional[np.ndarray]   #: (n, 3) float64, None once handed over
+    _triangles: Optional[np.ndarray]  #: (m, 3) int32 vertex ids (loop triangles), None once handed over
     _triangle_polygon: Optional[np.ndarray]  #: (m,) int32 polygon of each triangle
     _triangle_loops: Optional[np.ndarray]    #: (m, 3) int32 loop of each triangle corner
     polygon_material: np.ndarray  #: (p,) int32 material slot per polygon (read-only)
     num_edges: int
     num_loops: int
+    _engine: object = None        #: the prepared core Mesh holding the positions and triangles
+    _handed_triangles: int = 0    #: how many triangles were handed over
+
+    @property
+    def vertices(self) -> np.ndarray:
+        return self._vertices if self._vertices is not None else self._engine.vertices
+
+    @property
+    def triangles(self) -> np.ndarray:
+        return self._triangles if self._triangles is not None else self._engine.triangles
+
+    def hand_over(self, mesh) -> None:
+        """Drops the positions and triangles, which ``mesh`` (their prepared core Mesh) keeps a copy
+        of: read again they come from it bit for bit (read-only, made on first use), so a big
+        decimation runs without a second copy (24 bytes a triangle)."""
+        self._engine, self._handed_triangles = mesh, self.num_triangles
+        self._vertices = self._triangles = None
+
+    @property
+    def num_triangles(self) -> int:
+        """len(triangles), without taking them back from the engine."""
+        return len(self._triangles) if self._triangles is not None else self._handed_triangles
 
     @property
     def triangle_polygon(self) -> np.ndarray:
         if self._triangle_polygon is None:
-            return np.arange(len(self.triangles), dtype=np.int32)
+            return np.arange(self.num_triangles, dtype=np.int32)
         return self._triangle_polygon
 
     @property
     def triangle_loops(self) -> np.ndarray:
         if self._triangle_loops is None:
-            return np.arange(3 * len(self.triangles), dtype=np.int32).reshape(-1, 3)
+            return np.arange(3 * self.num_triangles, dtype=np.int32).reshape(-1, 3)
         return self._triangle_loops
 
     @property
