@@ -40,12 +40,13 @@ def test_the_addon_holds_only_the_input_arrays(ts, big_torus, monkeypatch, quali
     triangle), the polygon and loop maps of a triangle mesh (16) and the material slots (4) were
     held before."""
     pipeline = ts.blender.decimation.pipeline
-    held = []
+    held, taken_back = [], []
     engine = pipeline.run_engine
 
-    def measured(*args):
+    def measured(mesh, *args):
         held.append(tracemalloc.get_traced_memory()[0])
-        return engine(*args)
+        taken_back.append(mesh._vertices is not None or mesh._triangles is not None)  # the engine's copies
+        return engine(mesh, *args)
 
     monkeypatch.setattr(pipeline, "run_engine", measured)
     tracemalloc.start()
@@ -69,6 +70,7 @@ def test_the_addon_holds_only_the_input_arrays(ts, big_torus, monkeypatch, quali
     finally:
         tracemalloc.stop()
     assert len(held) == 1 and held[0] <= 0.5 * m, f"{held[0] / m:.1f} bytes a triangle held"
+    assert taken_back == [False]  # nothing read the arrays back before the decimation (the look did)
     assert write_peak <= 4 * m, f"the write's peak: {write_peak / m:.1f} bytes a triangle"
     assert len(out.data.vertices) == run.result.num_vertices
     bpy.data.objects.remove(out)

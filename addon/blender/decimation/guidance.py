@@ -174,6 +174,8 @@ def _read_appearance(obj, arrays: mesh_read.MeshArrays) -> tuple:
 
     @functools.lru_cache(maxsize=1)
     def appearance() -> Appearance:
+        if uv is None and color is None and normals is None:  # nothing to read the triangles for
+            return Appearance()
         corner_uvs = None if uv is None else uv[arrays.triangle_loops]
         rgb = None
         if color is not None:
