@@ -230,7 +230,7 @@ def render_blender_memory(name: str, figures: dict) -> str:
            f"`{figures['benchmark']}`, Blender {figures['blender']}, Guided Decimate at {percent(figures['ratio'])} "
            "of the vertices; peak = resident memory above Blender's own mesh, per triangle.", "",
            *source_lines(figures), "",
-           "| Triangles | Mode | Guided Decimate | Engine alone | Added by the add-on | Its time | The engine's |",
+           "| Triangles | Mode | Guided Decimate | Engine alone | Difference | Its time | The engine's |",
            "|---|---|---|---|---|---|---|"]
     for row in figures["runs"]:
         addon, engine = row["addon"], row["engine"]
