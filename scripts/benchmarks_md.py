@@ -224,6 +224,23 @@ def render_scale(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def render_blender_memory(name: str, figures: dict) -> str:
+    """bench_blender_background.py --memory --json: Guided Decimate's peak above Blender's mesh next to the engine's."""
+    out = [f"## Guided Decimate's memory in Blender (`{name}`)", "",
+           f"`{figures['benchmark']}`, Blender {figures['blender']}, Guided Decimate at {percent(figures['ratio'])} "
+           "of the vertices; peak = resident memory above Blender's own mesh, per triangle.", "",
+           *source_lines(figures), "",
+           "| Triangles | Mode | Guided Decimate | Engine alone | Difference | Its time | The engine's |",
+           "|---|---|---|---|---|---|---|"]
+    for row in figures["runs"]:
+        addon, engine = row["addon"], row["engine"]
+        out.append(f"| {addon['triangles']:,} | {row['mode']} | {addon['bytes_per_triangle']:.0f} B "
+                   f"| {engine['bytes_per_triangle']:.0f} B "
+                   f"| {addon['bytes_per_triangle'] - engine['bytes_per_triangle']:.1f} B "
+                   f"| {ms(1000 * addon['seconds'])} | {ms(1000 * engine['seconds'])} |")
+    return "\n".join(out) + "\n"
+
+
 def render_cleanup_speed(name: str, figures: dict) -> str:
     """bench_cleanup.py --speed --json: the clean-up's time on many small handles, before and after."""
     cases = figures["cases"]
@@ -429,6 +446,8 @@ def render_result(path: pathlib.Path) -> str:
         return render_attributes(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_scale.py":
         return render_scale(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_blender_background.py --memory":
+        return render_blender_memory(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_threads_paired.py":
         return render_paired(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_cleanup.py --speed":
@@ -441,8 +460,8 @@ def render_result(path: pathlib.Path) -> str:
         return render_batch(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
                      "the --json of bench_decimate.py, bench_quality.py, bench_attributes.py, bench_loops.py --families, "
-                     "bench_scale.py, bench_threads_paired.py, bench_cleanup.py, bench_cleanup.py --speed, "
-                     "bench_blender_decimate.py --only-rest and bench_batch.py, and carried-over "
+                     "bench_scale.py, bench_blender_background.py --memory, bench_threads_paired.py, bench_cleanup.py, "
+                     "bench_cleanup.py --speed, bench_blender_decimate.py --only-rest and bench_batch.py, and carried-over "
                      "figures)")
 
 

@@ -3,6 +3,8 @@ and the add-on's Max Deviation against a ratio target at the same result size.
 
     .venv/bin/python tests/bench/bench_blender_background.py -- [--triangles 20000000] [--ratio 0.01]
     .venv/bin/python tests/bench/bench_blender_background.py -- --mesh PATH --max-error 0.3
+    .venv/bin/python tests/bench/bench_blender_background.py -- --memory --triangles 20000000 \
+        [--json docs/bench_results/bench_blender_memory.json]
 
 Long run (a generated bumpy torus): the main thread's seconds at invoke (reading the mesh and its
 guidance) and at the end (writing the result), the worker's seconds, the longest gap between two
@@ -10,9 +12,13 @@ polls of a 10 Hz loop while the worker runs (what the modal's timer would see: t
 longest stall), and the seconds from a cancel during the preparation to the worker's end.
 Max Deviation: seconds of the error target on the worker, next to a ratio target giving the same
 vertex count (both prepared beforehand), with the probes the search made.
+Memory (--memory): peak resident memory above Blender's own mesh per triangle, Guided Decimate's
+worker path (read, prepare and decimate on the worker, write) next to the engine alone on the
+arrays the add-on reads, each in a fresh process (tests/blender/memory_peak_script.py), both modes.
 """
 
 import argparse
+import json
 import os
 import pathlib
 import sys
@@ -100,15 +106,53 @@ def max_deviation(obj, max_error, quality):
           f"{seconds / ratio_seconds:.1f}x (goal <= 3x)", flush=True)
 
 
+def memory(triangles, ratio, path):
+    """Peaks of the worker path and of the engine alone, each in a fresh process; saved to ``path``."""
+    sys.path.insert(0, str(ROOT / "tests" / "blender"))
+    from launch import background, clean_environment
+
+    build = pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build")) / "python"
+    rows = []
+    for mode in ("QUALITY", "FAST"):
+        row = {"mode": mode.lower()}
+        for kind in ("addon", "engine"):
+            done = background(ROOT / "tests" / "blender" / "memory_peak_script.py", kind, triangles, mode, ratio,
+                              timeout=3600, env=clean_environment(TOPSTOC_BUILD_PYTHON=build))
+            if done.returncode != 0:
+                raise SystemExit(f"the {kind} run failed:\n{done.stderr[-2000:]}")
+            row[kind] = json.loads(next(line for line in reversed(done.stdout.splitlines()) if line.startswith("{")))
+        rows.append(row)
+        addon, engine = row["addon"], row["engine"]
+        print(f"  {mode}: {addon['triangles']:,} triangles, Guided Decimate {addon['bytes_per_triangle']:.1f} B/triangle "
+              f"above Blender's mesh ({addon['seconds']:.1f} s), the engine alone {engine['bytes_per_triangle']:.1f} "
+              f"({engine['seconds']:.1f} s): the add-on adds "
+              f"{addon['bytes_per_triangle'] - engine['bytes_per_triangle']:.1f}", flush=True)
+    if path:
+        sys.path.insert(0, str(ROOT / "tests" / "bench"))
+        from machine import save_figures
+
+        save_figures(path, "tests/bench/bench_blender_background.py --memory",
+                     "bumpy torus object from tests/meshgen.py, seed 1; each run in a fresh process: peak RSS above "
+                     "the process after the object was made (Blender's own mesh in hand), per triangle; Guided "
+                     "Decimate = read, prepare and decimate on the worker, moved sources, write as a new object; "
+                     "engine alone = Mesh(...).decimate on the arrays the add-on reads",
+                     blender=bpy.app.version_string, ratio=ratio, runs=rows)
+
+
 def main(argv):
     parser = argparse.ArgumentParser()
     parser.add_argument("--triangles", type=int, default=2_000_000)
     parser.add_argument("--ratio", type=float, default=0.01)
     parser.add_argument("--mesh", help="a mesh file for --max-error (default: the generated torus)")
     parser.add_argument("--max-error", type=float, help="percent of the diagonal: time Max Deviation instead")
+    parser.add_argument("--memory", action="store_true", help="peak memory of the worker path and of the engine")
+    parser.add_argument("--json", metavar="FILE", help="with --memory: write the figures here")
     args = parser.parse_args(argv)
     print(f"machine: {os.cpu_count()} cores; Blender {bpy.app.version_string}; load average "
           f"{os.getloadavg()[0]:.1f}", flush=True)
+    if args.memory:
+        memory(args.triangles, args.ratio, args.json)
+        return 0
     if args.mesh:
         data = ts.core.api.io.read_mesh(args.mesh)
         vertices, triangles, name = data.vertices, data.triangles, pathlib.Path(args.mesh).name

@@ -166,3 +166,23 @@ def test_byte_colours_are_read_as_their_stored_srgb_values(ts, scene, domain):
     assert key == "color_srgb"
     np.testing.assert_array_equal(values, expected)
     np.testing.assert_array_equal(ts.blender.io.dna_arrays.byte_colors_srgb(layer), expected)
+
+
+def test_positions_are_widened_in_place_block_by_block(ts, scene, monkeypatch):
+    """The float64 positions, widened inside their own array a block at a time, equal Blender's
+    float32 values (read by RNA vertex by vertex) exactly, past block boundaries and at the end;
+    a mesh without material slots reads one shared zero for its polygons' slots."""
+    mesh_read = ts.blender.io.mesh_read
+    monkeypatch.setattr(mesh_read, "WIDEN_BLOCK", 1000)  # 7,680 values: eight blocks, the last partial
+    obj = make_object("Ball", *meshgen.icosphere(4))
+    mesh = obj.data
+    assert 3 * len(mesh.vertices) % 1000 != 0
+    arrays = mesh_read.read_mesh(mesh)
+    co = np.array([tuple(v.co) for v in mesh.vertices], dtype=np.float32)
+    assert arrays.vertices.dtype == np.float64 and arrays.vertices.flags.c_contiguous
+    np.testing.assert_array_equal(arrays.vertices, co.astype(np.float64))
+    np.testing.assert_array_equal(mesh_read.read_positions(mesh), co)
+    assert len(arrays.polygon_material) == len(mesh.polygons) and not np.any(arrays.polygon_material)
+    assert arrays.polygon_material.strides == (0,)  # no array a polygon long
+    empty = bpy.data.meshes.new("Empty")
+    assert mesh_read.read_positions_float64(empty).shape == (0, 3)

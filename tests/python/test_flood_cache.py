@@ -169,3 +169,20 @@ def test_a_pool_never_serves_another_mesh_or_layout():
     assert not run(other, other.feature_layout(), 1020)
     assert not run(dragon, creased, 1030)
     assert pool.size == 1  # one thread: the same cache each time, refilled
+
+
+def test_cleared_layouts_are_built_again_with_the_same_results():
+    """clear_layouts (a one-shot job frees its layout, sampling tables and floods) drops the
+    cached layout; the next decimations build a new one and give the same results bit for bit."""
+    vertices, triangles = meshgen.torus(48, 24)
+    mesh = Mesh(vertices, triangles)
+    before = [mesh.decimate(ratio=ratio, seed=2, mode=mode) for ratio, mode in ((0.2, "quality"), (0.1, "fast"))]
+    layout = mesh.feature_layout()
+    mesh.clear_layouts()
+    assert mesh.feature_layout() is not layout
+    mesh.clear_layouts()
+    after = [mesh.decimate(ratio=ratio, seed=2, mode=mode) for ratio, mode in ((0.2, "quality"), (0.1, "fast"))]
+    for old, new in zip(before, after):
+        np.testing.assert_array_equal(old.vertices, new.vertices)
+        np.testing.assert_array_equal(old.triangles, new.triangles)
+        np.testing.assert_array_equal(old.samples, new.samples)

@@ -51,7 +51,8 @@ class BackgroundDecimation:
     def _work(self) -> None:
         for index, read in enumerate(self.reads):
             try:
-                run = pipeline.decimate_read(read, self._preparing(index), self._searching(index), self._stop_engine)
+                run = pipeline.decimate_read(read, self._preparing(index), self._searching(index), self._stop_engine,
+                                             one_shot=True)
                 self._state = (index, 1.0, "finding the sources of moved vertices")
                 run.moved = moved_vertices(read.arrays.vertices, read.arrays.triangles, run.result)  # not at the write
                 outcome = (run, None)
@@ -114,7 +115,7 @@ class BackgroundDecimation:
         done = min(1.0, (index + 0.5 * fraction) / max(1, len(self.reads)))
         if index < len(self.reads):
             read = self.reads[index]
-            what = f"'{read.obj.name}' ({len(read.arrays.triangles):,} triangles, {index + 1} of {len(self.reads)}): " \
+            what = f"'{read.obj.name}' ({read.arrays.num_triangles:,} triangles, {index + 1} of {len(self.reads)}): " \
                    f"{doing}"
         else:
             what = "writing the results"

@@ -174,6 +174,8 @@ def _read_appearance(obj, arrays: mesh_read.MeshArrays) -> tuple:
 
     @functools.lru_cache(maxsize=1)
     def appearance() -> Appearance:
+        if uv is None and color is None and normals is None:  # nothing to read the triangles for
+            return Appearance()
         corner_uvs = None if uv is None else uv[arrays.triangle_loops]
         rgb = None
         if color is not None:
@@ -293,7 +295,7 @@ def read(obj, arrays: mesh_read.MeshArrays, scene, depsgraph=None,
                 u = rules.material_guidance(n, arrays.triangles, arrays.triangle_material, material_weights)
                 values.append((u, material_strength))
                 out.sources.append("material slot weights")
-            if len(np.unique(arrays.polygon_material)) > 1:
+            if arrays.several_materials():
                 out.regions = rules.compact_regions(arrays.triangle_material)
                 out.sources.append("material borders")
         out.guidance = rules.combine(values, n)

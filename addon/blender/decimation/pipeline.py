@@ -197,13 +197,18 @@ def read_input(context, obj, panel, *, target: dict = None, region_3d=None) -> I
                  decimate_options(panel), settings_of(panel), started)
 
 
-def decimate_read(read: Input, prepare_progress=None, progress=None, cancel=None) -> Run:
+def decimate_read(read: Input, prepare_progress=None, progress=None, cancel=None, one_shot: bool = False) -> Run:
     """Prepares (cached) and decimates what ``read_input`` read; reads no Blender data (any thread).
     prepare_progress: the preparation's ``(fraction, stage)``, progress: an error target's search
     ``(probe, target, vertices, error, passed)``; either returning False raises ``Cancelled``, as
-    does ``cancel`` (a CancelFlag) once set, in the decimation."""
+    does ``cancel`` (a CancelFlag) once set, in the decimation.
+    one_shot (a big job on the worker): the read's positions and triangles are handed to the
+    prepared mesh (MeshArrays.hand_over) and its layouts freed after, so that neither is kept
+    beside the engine's working set; the result is the same."""
     obj_name = read.obj.name
     prepared = prepare_arrays(obj_name, read.obj.data.name_full, read.arrays, prepare_progress)
+    if one_shot:
+        read.arrays.hand_over(prepared.mesh)
     if prepare_progress is not None:  # also when the cache held it: the decimation starts
         prepare_progress(1.0, "prepared")
     guidance = read.read_guidance()
@@ -213,6 +218,8 @@ def decimate_read(read: Input, prepare_progress=None, progress=None, cancel=None
                   else run_engine(prepared.mesh, job, progress, cancel))
     except ValueError as error:
         raise DecimationError(f"'{obj_name}': {error}") from None
+    if one_shot:
+        prepared.mesh.clear_layouts()
     return make_run(read.obj, prepared, guidance, result, read.target, read.options,
                     time.perf_counter() - read.started, read.settings)
 

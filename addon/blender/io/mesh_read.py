@@ -26,28 +26,71 @@ class MeshArrays:
 
     For a mesh of triangles stored in loop order (Blender's usual layout) the triangles are the
     polygons and their corners the loops in order: ``triangle_polygon`` and ``triangle_loops``
-    are then made when first read (``None`` given), since the Live Preview's start, which reads
-    the mesh on the main thread, rarely needs them (two arrays of 4 and 12 bytes a triangle)."""
+    are then ``None`` inside and made afresh on each read, never kept (two arrays of 4 and 12
+    bytes a triangle, which the prepared-mesh cache would hold); ``polygons_of`` and
+    ``loops_of`` map a few triangles without making them."""
 
-    vertices: np.ndarray          #: (n, 3) float64
-    triangles: np.ndarray         #: (m, 3) int32 vertex ids (loop triangles)
+    _vertices: Optional[np.ndarray]   #: (n, 3) float64, None once handed over
+    _triangles: Optional[np.ndarray]  #: (m, 3) int32 vertex ids (loop triangles), None once handed over
     _triangle_polygon: Optional[np.ndarray]  #: (m,) int32 polygon of each triangle
     _triangle_loops: Optional[np.ndarray]    #: (m, 3) int32 loop of each triangle corner
-    polygon_material: np.ndarray  #: (p,) int32 material slot per polygon
+    polygon_material: np.ndarray  #: (p,) int32 material slot per polygon (read-only)
     num_edges: int
     num_loops: int
+    _engine: object = None        #: the prepared core Mesh holding the positions and triangles
+    _handed_triangles: int = 0    #: how many triangles were handed over
+
+    @property
+    def vertices(self) -> np.ndarray:
+        return self._vertices if self._vertices is not None else self._engine.vertices
+
+    @property
+    def triangles(self) -> np.ndarray:
+        return self._triangles if self._triangles is not None else self._engine.triangles
+
+    def hand_over(self, mesh) -> None:
+        """Drops the positions and triangles, which ``mesh`` (their prepared core Mesh) keeps a copy
+        of: read again they come from it bit for bit (read-only, made on first use), so a big
+        decimation runs without a second copy (24 bytes a triangle)."""
+        self._engine, self._handed_triangles = mesh, self.num_triangles
+        self._vertices = self._triangles = None
+
+    @property
+    def num_triangles(self) -> int:
+        """len(triangles), without taking them back from the engine."""
+        return len(self._triangles) if self._triangles is not None else self._handed_triangles
 
     @property
     def triangle_polygon(self) -> np.ndarray:
         if self._triangle_polygon is None:
-            self._triangle_polygon = np.arange(len(self.triangles), dtype=np.int32)
+            return np.arange(self.num_triangles, dtype=np.int32)
         return self._triangle_polygon
 
     @property
     def triangle_loops(self) -> np.ndarray:
         if self._triangle_loops is None:
-            self._triangle_loops = np.arange(3 * len(self.triangles), dtype=np.int32).reshape(-1, 3)
+            return np.arange(3 * self.num_triangles, dtype=np.int32).reshape(-1, 3)
         return self._triangle_loops
+
+    @property
+    def loop_map(self) -> Optional[np.ndarray]:
+        """``triangle_loops``, or None when they are the loops in order (loop 3 t + c)."""
+        return self._triangle_loops
+
+    def polygons_of(self, triangles: np.ndarray) -> np.ndarray:
+        """The polygon of each of the given triangle ids."""
+        ids = np.asarray(triangles, dtype=np.int64)
+        return ids if self._triangle_polygon is None else self._triangle_polygon[ids]
+
+    def loops_of(self, corners: np.ndarray) -> np.ndarray:
+        """The loop of each of the given triangle corners (flat ids, 3 t + c)."""
+        ids = np.asarray(corners, dtype=np.int64).reshape(-1)
+        return ids if self._triangle_loops is None else self._triangle_loops.reshape(-1)[ids]
+
+    def several_materials(self) -> bool:
+        """True when the polygons use more than one material slot (no sorted copy, as np.unique)."""
+        slots = self.polygon_material
+        return len(slots) > 1 and slots.strides != (0,) and bool(np.any(slots != slots[0]))
 
     @property
     def triangle_material(self) -> np.ndarray:
@@ -76,11 +119,37 @@ def position_attribute(mesh):
     return typed_attribute(mesh, "position", "POINT", "FLOAT_VECTOR")
 
 
+def _position_source(mesh) -> tuple:
+    """(collection, key) whose foreach_get gives the float32 positions."""
+    attribute = position_attribute(mesh)
+    return (attribute.data, "vector") if attribute is not None else (mesh.vertices, "co")
+
+
 def read_positions(mesh) -> np.ndarray:
     """(n, 3) float32 vertex positions (object-local)."""
-    attribute = position_attribute(mesh)
-    return read_array(attribute.data if attribute is not None else mesh.vertices,
-                "vector" if attribute is not None else "co", len(mesh.vertices), 3, np.float32)
+    collection, key = _position_source(mesh)
+    return read_array(collection, key, len(mesh.vertices), 3, np.float32)
+
+
+#: values widened to float64 at a time (the temporary numpy makes where a block overlaps its source)
+WIDEN_BLOCK = 1 << 20
+
+
+def read_positions_float64(mesh) -> np.ndarray:
+    """(n, 3) float64 vertex positions, without a float32 array n long beside them: Blender's
+    float32 values land in the upper half of the float64 array's own memory and are widened in
+    place front to back (value i is written below every value not yet read). A float32 copy the
+    main thread frees stays in its heap while the worker decimates (6 bytes a triangle)."""
+    n = len(mesh.vertices)
+    out = fresh_memory.empty(3 * n, np.float64)
+    narrow = out.view(np.float32)[3 * n:]
+    if n:
+        collection, key = _position_source(mesh)
+        collection.foreach_get(key, narrow)
+    for start in range(0, 3 * n, WIDEN_BLOCK):
+        stop = min(start + WIDEN_BLOCK, 3 * n)
+        out[start:stop] = narrow[start:stop]  # numpy copies a block first where it overlaps its source
+    return out.reshape(n, 3)
 
 
 def read_polygon_smooth(mesh) -> Optional[np.ndarray]:
@@ -125,8 +194,8 @@ def _polygon_materials(mesh) -> np.ndarray:
     attribute = mesh.attributes.get("material_index")
     if attribute is not None and attribute.domain == "FACE":
         return read_array(attribute.data, "value", p, 1, np.int32)
-    if len(mesh.materials) <= 1:
-        return np.zeros(p, dtype=np.int32)
+    if len(mesh.materials) <= 1:  # all slot 0: one shared zero, no array a polygon long
+        return np.broadcast_to(np.zeros(1, dtype=np.int32), (p,))
     return read_array(mesh.polygons, "material_index", p, 1, np.int32)
 
 
@@ -143,11 +212,11 @@ def _triangles_in_loop_order(mesh) -> bool:
 
 def read_mesh(mesh: bpy.types.Mesh) -> MeshArrays:
     """Reads positions and the loop triangulation of ``mesh`` (object mode data)."""
-    n = len(mesh.vertices)
-    vertices = fresh_memory.empty(3 * n, np.float64).reshape(n, 3)
-    np.copyto(vertices, read_positions(mesh))
+    # First: Blender 4.x reads the polygons' loop starts for it, freed before the big arrays take that memory
+    in_order = _triangles_in_loop_order(mesh)
+    vertices = read_positions_float64(mesh)
     corners = corner_vertices(mesh)
-    if _triangles_in_loop_order(mesh):  # a triangle mesh: the loop triangles are the polygons
+    if in_order:  # a triangle mesh: the loop triangles are the polygons
         m = len(mesh.polygons)
         triangle_loops = triangle_polygons = None  # in order: made when read (MeshArrays)
         triangles = corners.reshape(m, 3)

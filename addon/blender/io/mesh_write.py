@@ -151,8 +151,8 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
     out = bpy.data.meshes.new(name)
     fill_geometry(out, result.vertices, result.triangles)
     kept = np.asarray(result.kept, dtype=np.int64)
-    face_polygon = arrays.triangle_polygon[np.asarray(result.face_source, dtype=np.int64)]
-    corner_loop = arrays.triangle_loops.reshape(-1)[np.asarray(result.corner_source, dtype=np.int64).reshape(-1)]
+    face_polygon = arrays.polygons_of(result.face_source)
+    corner_loop = arrays.loops_of(result.corner_source)
     m = len(result.triangles)
     if moved is None:
         moved = moved_vertices(arrays.vertices, arrays.triangles, result)
@@ -162,7 +162,7 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
         if domain == "POINT":
             return point_values(values, kept, moved, arrays.triangles, nearest)
         if domain == "CORNER":
-            return corner_values(values, corner_loop, result.triangles, moved, arrays.triangle_loops, nearest)
+            return corner_values(values, corner_loop, result.triangles, moved, arrays.loop_map, nearest)
         return values[face_polygon]
 
     for material in source.materials:

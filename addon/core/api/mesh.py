@@ -190,6 +190,11 @@ class Mesh:
             if floods is not None:
                 floods.clear()
 
+    def clear_layouts(self) -> None:
+        """Frees the feature layouts and their floods (a one-shot job's: a later decimation builds
+        them again, with the same result)."""
+        self._layouts.clear()
+
     def decimate(self, ratio=None, target_vertices=None, target_triangles=None, **options):
         """TopStoc decimation; see topstoc.core.api.decimate.decimate for every option."""
         return decimate(self, ratio, target_vertices, target_triangles, **options)

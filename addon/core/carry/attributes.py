@@ -107,7 +107,10 @@ class MovedVertices:
 
     def source_corners(self, triangles, vertices) -> np.ndarray:
         """(k, 3) int64 input vertices of the source triangles of the moved output ``vertices``
-        (gathered before widening: ``triangles`` may be the whole input mesh)."""
+        (gathered before widening: ``triangles`` may be the whole input mesh; None: the corners
+        in order, 3 t + c)."""
+        if triangles is None:
+            return 3 * self.face[vertices][:, None].astype(np.int64) + np.arange(3)
         return np.asarray(triangles)[self.face[vertices]].astype(np.int64)
 
 
@@ -217,7 +220,8 @@ def corner_values(values, corner_source, output_triangles, moved: MovedVertices,
     """Per-corner ``values`` for the output corners (flat, 3 per output triangle).
 
     values: one row per input corner; corner_source: the input corner each output corner copies
-    (flat); triangle_corners: (m, 3) the input corner of each input triangle's corners. Corners
+    (flat); triangle_corners: (m, 3) the input corner of each input triangle's corners (None: the
+    corners in order, 3 t + c). Corners
     of moved vertices are interpolated in the vertex's source triangle, from that triangle's own
     corners, so a value that differs across a seam never mixes the two sides."""
     values = np.asarray(values)
@@ -240,9 +244,7 @@ def transfer_attributes(data: MeshData, result) -> MeshData:
     moved = moved_vertices(data.vertices, data.triangles, result) if need else None
     uvs = None
     if data.corner_uvs is not None:
-        m = len(data.triangles)
-        flat = corner_values(data.corner_uvs.reshape(-1, 2), result.corner_source, result.triangles, moved,
-                             np.arange(3 * m).reshape(m, 3))
+        flat = corner_values(data.corner_uvs.reshape(-1, 2), result.corner_source, result.triangles, moved, None)
         uvs = flat.reshape(-1, 3, 2)
     colors = None
     if data.vertex_colors is not None:
