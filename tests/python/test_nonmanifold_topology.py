@@ -4,6 +4,7 @@ output lost components. A book of three pages plus four spheres: fast mode at ra
 spheres, quality mode keeps everything."""
 
 import functools
+import json
 
 import numpy as np
 
@@ -61,3 +62,18 @@ def test_fast_mode_losing_components_is_not_kept_and_the_cli_warns(tmp_path):
     assert "lost components" in fast.stderr and "topology NOT kept" in fast.stderr
     quality = topstoc(source, tmp_path / "quality.obj", "--ratio", 0.1, "--mode", "quality", "--seed", 1)
     assert quality.returncode == 0 and "topology" not in quality.stderr
+
+
+def test_batch_reports_the_topology_not_kept(tmp_path):
+    vertices, triangles = book_and_spheres()
+    source = tmp_path / "book.obj"
+    write_mesh(source, MeshData(vertices=np.asarray(vertices, float), triangles=np.asarray(triangles)))
+    out = tmp_path / "out"
+    done = cli.run("batch", "--input", source, "--output", out, "--ratio", "0.1", "--mode", "fast", "--seed", 1,
+                   "--workers", "0", "--progress", "lines")
+    assert done.returncode == 0, done.stderr
+    line = next(text for text in done.stdout.splitlines() if "book.obj:" in text)
+    assert "topology NOT kept: " in line and "lost components" in line
+    assert "1 done (1 missed their target, 1 did not keep the topology)" in done.stdout
+    lod = json.loads((out / "topstoc-report.json").read_text())["results"][0]["lods"][0]
+    assert lod["topology_kept"] is False and lod["topology_warning"].startswith("topology NOT kept: ")
