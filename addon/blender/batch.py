@@ -28,7 +28,7 @@ import numpy as np
 
 from ..core.batch import settings as batch_settings
 from ..core.batch.mesh_asset import check_bakeable, decimate_mesh_file, lod_error
-from ..core.api.budget import missed_dict, report_missed
+from ..core.api.budget import missed_dict, report_missed, report_topology
 from ..core.api.decimate import ATTRIBUTE_WEIGHT
 from ..core.batch.prune import prune_small_parts
 from ..core.batch.run import misnamed_failure, utf8_name, write_report
@@ -196,6 +196,7 @@ def _decimate_object(bpy, pipeline, obj, settings, targets) -> tuple:
             error["screen"] = screen.as_dict()
         entry.update(vertices=run.result.num_vertices, triangles=run.result.num_triangles,
                      repairs=run.result.stats.repairs, seconds=run.seconds, target_missed=missed_dict(run.result.stats),
+                     topology_kept=run.result.stats.topology_kept, topology_warning=run.result.stats.topology_warning,
                      search_error=None if bound is None else float(bound.achieved_error), **error)
         if settings["chain"]:
             name = batch_settings.lod_name(obj.name, index, settings)
@@ -396,7 +397,7 @@ def main(argv=None) -> int:
         report["results"].append(entry)
         print(f"{prefix}: {entry['vertices_in']} -> {entry['vertices_out']} vertices, "
               f"{entry['triangles_out']} triangles in {entry['seconds']:.3f} s -> {entry['output']}"
-              + "".join("; " + phrase for phrase in report_missed(entry)), flush=True)
+              + "".join("; " + phrase for phrase in report_missed(entry) + report_topology(entry)), flush=True)
     if args.json:
         write_report(args.json, report)
     print(f"topstoc batch: {len(report['results'])} done, {len(report['failures'])} failed", flush=True)

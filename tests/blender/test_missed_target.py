@@ -154,3 +154,31 @@ def test_blender_batch_reports_the_missed_target(ts, scene, tmp_path):
     missed = [lod["target_missed"] for o in entry["objects"] for lod in o["lods"]]
     assert missed == [{"asked": asked, "got": got, "unit": "vertices", "off": got - asked,
                        "fraction": pytest.approx((got - asked) / asked), "reason": "topology", "detail": ""}]
+
+
+def test_guided_decimate_warns_when_the_topology_is_not_kept(ts, scene, capfd):
+    """A book of three pages and four spheres: the fast mode at 10 % loses spheres (the count is
+    checked here from the result object), the quality mode keeps them and says nothing."""
+    import meshgen
+    vertices, triangles = meshgen.disjoint(meshgen.subdivide(*meshgen.book(3), 3), *[meshgen.icosphere(1)] * 4)
+    obj = make_object("Book", vertices, triangles)
+    capfd.readouterr()
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.1, quality="FAST", seed=1) == {"FINISHED"}
+    out = bpy.context.active_object
+    reports = capfd.readouterr().out
+    parent = list(range(len(out.data.vertices)))  # the result's pieces, by union-find over its faces
+
+    def root(v):
+        while parent[v] != v:
+            v = parent[v]
+        return v
+
+    for polygon in out.data.polygons:
+        for v in polygon.vertices:
+            parent[root(v)] = root(polygon.vertices[0])
+    used = {v for polygon in out.data.polygons for v in polygon.vertices}
+    assert len({root(v) for v in used}) < 5  # the input has five pieces
+    assert "Warning: TopStoc: Book: topology NOT kept: " in reports and "lost components" in reports
+    select_only(obj)
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.1, quality="QUALITY", seed=1) == {"FINISHED"}
+    assert "topology NOT kept" not in capfd.readouterr().out

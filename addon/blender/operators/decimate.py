@@ -42,7 +42,8 @@ NAVIGATION = {"MIDDLEMOUSE", "WHEELUPMOUSE", "WHEELDOWNMOUSE", "TRACKPADPAN", "T
 
 
 class Outcome:
-    """What one run of the operator made: its outputs and the lines it reports."""
+    """What one run of the operator made: its outputs and the lines it reports (``missed``: a
+    missed target or a topology not kept, one warning line each)."""
 
     def __init__(self, started: float):
         self.started = started
@@ -59,6 +60,8 @@ def write_run(operator, run, done: Outcome) -> None:
     done.lines.append(pipeline.summary(run))
     if run.result.stats.target_missed is not None:
         done.missed.append(f"{run.obj.name}: {run.result.stats.target_missed.text()}")
+    if run.result.stats.topology_warning:
+        done.missed.append(f"{run.obj.name}: {run.result.stats.topology_warning}")
 
 
 def conclude(operator, context, done: Outcome):

@@ -116,6 +116,8 @@ class _VariantsBase(OperatorParameters, bake_run.BakeModal):
             missed = run.result.stats.target_missed
             if missed is not None:
                 self.report({"WARNING"}, f"TopStoc: {output.name}: {missed.text()}")
+            if run.result.stats.topology_warning:
+                self.report({"WARNING"}, f"TopStoc: {output.name}: {run.result.stats.topology_warning}")
         return {"FINISHED"}
 
 

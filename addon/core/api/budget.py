@@ -112,16 +112,28 @@ def missed_dict(stats) -> Optional[dict]:
     return None if missed is None else missed.as_dict()
 
 
+def _lods(entry: dict):
+    """(owner, LOD) of each LOD of a batch report entry: its own (a mesh file) or its objects' (a
+    scene file)."""
+    for obj in [entry] + list(entry.get("objects") or []):
+        for lod in obj.get("lods") or []:
+            yield obj, lod
+
+
+def _lod_name(obj: dict, lod: dict) -> str:
+    """"Chair LOD1 " for a phrase; empty for the single LOD of a mesh file."""
+    return (f"{obj['object']} " if "object" in obj else "") + (f"LOD{lod['lod']} " if len(obj["lods"]) > 1 else "")
+
+
 def report_missed(entry: dict) -> list:
     """The missed targets of a batch report entry, one phrase each: its LODs' (a mesh file) or
     its objects' LODs' (a scene file), named when there are several."""
-    phrases = []
-    for obj in [entry] + list(entry.get("objects") or []):
-        lods = obj.get("lods") or []
-        for lod in lods:
-            missed = lod.get("target_missed")
-            if missed:
-                name = (f"{obj['object']} " if "object" in obj else "") + (f"LOD{lod['lod']} " if len(lods) > 1 else "")
-                phrases.append(name + MissedTarget(missed["asked"], missed["got"], missed["reason"],
-                                                   missed["unit"], missed.get("detail", "")).text())
-    return phrases
+    return [_lod_name(obj, lod) + MissedTarget(missed["asked"], missed["got"], missed["reason"], missed["unit"],
+                                               missed.get("detail", "")).text()
+            for obj, lod in _lods(entry) if (missed := lod.get("target_missed"))]
+
+
+def report_topology(entry: dict) -> list:
+    """The LODs of a batch report entry whose topology was not kept ("topology NOT kept: ...",
+    DecimateStats.topology_warning), one phrase each, named like report_missed's."""
+    return [_lod_name(obj, lod) + lod["topology_warning"] for obj, lod in _lods(entry) if lod.get("topology_warning")]

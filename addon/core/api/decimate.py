@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Optional, Sequence
 import numpy as np
 
 from . import budget
+from .invariants import invariants_kept
 from ..support import params
 from ..support.counts import MeshCounts
 from ..support.errors import TopStocError
@@ -88,6 +89,10 @@ class DecimateStats:
     target_triangles: int = 0   #: the triangle target asked for (0: none)
     #: vertices of the result on non-manifold edges (three or more triangles; counted when the input has some)
     nonmanifold_vertices: int = 0
+    #: when the partition checks left issues (they cannot judge some non-manifold inputs' own
+    #: clusters): every input component's invariants match its output's (core/api/invariants.py);
+    #: None when it was not needed
+    invariants_kept: Optional[bool] = None
 
     @property
     def over_budget(self) -> int:
@@ -110,12 +115,34 @@ class DecimateStats:
 
     @property
     def topology_kept(self) -> Optional[bool]:
-        """True when no topological issue remained (see issues_remaining) and the final check
-        confirmed it; None for a draft, whose output was not re-checked."""
+        """True when the final check passed and either no topological issue remained (see
+        issues_remaining) or every component kept its invariants (see invariants_kept); None for
+        a draft, whose output was not re-checked."""
         if not self.output_checked:
             return None
-        return not any(v for k, v in self.issues_remaining.items() if k != "sliver") and \
-            not any(v for k, v in self.output_check.items() if k != "zero_area")
+        return not self.check_violations and (not self.issues_left or bool(self.invariants_kept))
+
+    @property
+    def topology_warning(self) -> str:
+        """"topology NOT kept: 5 lost components, ..." for a report, or "" when it was kept (or not
+        checked: a draft)."""
+        if self.topology_kept is not False:
+            return ""
+        counts = {**{k: v for k, v in self.issues_remaining.items() if k != "sliver"},
+                  **{k: v for k, v in self.output_check.items() if k != "zero_area"}}
+        found = ", ".join(f"{v} {k.replace('_', ' ')}" for k, v in counts.items() if v)
+        return "topology NOT kept: " + found + ("" if self.check_violations else
+                                                 " (and an input component's invariants changed)")
+
+    @property
+    def issues_left(self) -> int:
+        """Topological issues the partition checks left (issues_remaining but slivers)."""
+        return sum(v for k, v in self.issues_remaining.items() if k != "sliver")
+
+    @property
+    def check_violations(self) -> int:
+        """Violations the final output check found (output_check but zero-area triangles)."""
+        return sum(v for k, v in self.output_check.items() if k != "zero_area")
 
 
 @dataclass(frozen=True)
@@ -251,7 +278,7 @@ def run_job(mesh: Mesh, job: DecimationJob, progress=None, cancel: Optional[Canc
 
 #: DecimateStats fields counted in Python; every other field is the engine result's of the same name
 _COUNTED_HERE = {"output_vertices", "output_triangles", "target_triangles", "control_points", "zero_area_input",
-                 "mirrored_from", "replayed", "nonmanifold_vertices"}
+                 "mirrored_from", "replayed", "nonmanifold_vertices", "invariants_kept"}
 
 
 def vertices_on_nonmanifold_edges(triangles: np.ndarray) -> int:
@@ -271,6 +298,9 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
                           zero_area_input=mesh.native.report["zero_area_triangles"], replayed=job is None,
                           nonmanifold_vertices=vertices_on_nonmanifold_edges(raw["triangles"])
                           if mesh.native.report["nonmanifold_edges"] else 0)
+    if stats.output_checked and stats.issues_left and not stats.check_violations:
+        kept = invariants_kept(mesh.vertices, mesh.triangles, raw["vertices"], raw["triangles"], raw["kept"])
+        stats = dataclasses.replace(stats, invariants_kept=kept)
     return DecimateResult(vertices=raw["vertices"], triangles=raw["triangles"], kept=raw["kept"],
                           face_source=raw["face_source"], corner_source=raw["corner_source"],
                           labels=raw["labels"], samples=raw["samples"], stats=stats,

@@ -108,7 +108,8 @@ def decimate_mesh_file(path: str, out_dir: str, settings: dict) -> dict:
         bound = getattr(result, "error_bound", None)
         entry.update(vertices=result.num_vertices, triangles=result.num_triangles, repairs=result.stats.repairs,
                      search_error=None if bound is None else float(bound.achieved_error),
-                     target_missed=missed_dict(result.stats),
+                     target_missed=missed_dict(result.stats), topology_kept=result.stats.topology_kept,
+                     topology_warning=result.stats.topology_warning,
                      **lod_error(source.mesh, result, screen, settings.get("exact_error", False), surface))
         entry["dropped_attributes"] = source.write(result, output)
         entry["seconds"] = time.perf_counter() - started

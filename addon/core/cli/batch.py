@@ -18,7 +18,7 @@ from ..batch import settings as batch_settings
 from . import messages, progress, subcommand
 from ..batch.run import (find_inputs, misnamed_failure, remove_orphaned_scratch, remove_stale_temporaries,
                          run_dask, run_serial, utf8_name, write_report)
-from ..api.budget import report_missed
+from ..api.budget import report_missed, report_topology
 from ..batch.manifest import Manifest, content_hash, task_key
 from ..support.errors import TopStocError
 from ..support.output_guard import check_folders, prepare_output, check_outputs, output_folder
@@ -138,7 +138,7 @@ def _summary(entry: dict) -> str:
         text = f"{entry['vertices_in']} -> {' / '.join(map(str, lods))} vertices ({len(lods)} LODs)"
     else:
         text = f"{entry['vertices_in']} -> {entry['vertices_out']} vertices, {entry['triangles_out']} triangles"
-    return text + "".join("; " + phrase for phrase in _cleaned(entry) + report_missed(entry))
+    return text + "".join("; " + phrase for phrase in _cleaned(entry) + report_missed(entry) + report_topology(entry))
 
 
 def _cleaned(entry: dict) -> list:
@@ -260,7 +260,10 @@ def run(args) -> int:
               "failures": [failures[i] for i in sorted(failures)], "skipped": skipped}
     write_report(report_path, report)
     missed = sum(bool(report_missed(entry)) for entry in results.values())
-    print(f"topstoc batch: {len(results)} done" + (f" ({missed} missed their target)" if missed else "")
+    lost = sum(bool(report_topology(entry)) for entry in results.values())
+    notes = [text for count, text in ((missed, f"{missed} missed their target"),
+                                      (lost, f"{lost} did not keep the topology")) if count]
+    print(f"topstoc batch: {len(results)} done" + (f" ({', '.join(notes)})" if notes else "")
           + f", {len(skipped)} skipped, {len(failures)} failed in {report['seconds']:.1f} s; report {report_path}",
           flush=True)
     return 1 if failures else 0

@@ -23,7 +23,7 @@ from ..api.job import ATTRIBUTE_WEIGHT
 from ..api.mesh_file_job import prepare_file
 from ..support.output_guard import add_overwrite_argument, prepare_output
 from ..api.symmetry import AXES
-from . import print_json, progress, subcommand
+from . import messages, print_json, progress, subcommand
 
 DENSITIES = ("off", "uniform", "adaptive")
 
@@ -189,4 +189,6 @@ def run(args) -> int:
               f"{result.num_vertices} vertices, {result.num_triangles} triangles in {seconds:.3f} s "
               f"({stats.repairs} repair samples)" + missed_text(stats)
               + (f"; not written: {', '.join(dropped)}" if dropped else ""))
+    if stats.topology_warning:  # exit 0 (the output is written), but never silently
+        messages.print_warning(f"{args.output}: {stats.topology_warning}")
     return 0

@@ -1,0 +1,79 @@
+"""topology_kept on non-manifold inputs, whose partition checks leave issues they cannot judge:
+True when every component kept its invariants, False (and said so on the command line) when the
+output lost components. A book of three pages plus four spheres: fast mode at ratio 0.1 loses the
+spheres, quality mode keeps everything."""
+
+import functools
+import json
+
+import numpy as np
+
+import cli
+import meshgen
+from topstoc.core.api.io import MeshData, write_mesh
+from topstoc.core.api.mesh import Mesh
+
+topstoc = functools.partial(cli.run, "decimate", timeout=120)
+
+
+def book_and_spheres():
+    return meshgen.disjoint(meshgen.subdivide(*meshgen.book(3), 3), *[meshgen.icosphere(1)] * 4)
+
+
+def components_and_euler(triangles):
+    """(components, V - E + F) counted here with a union-find over the triangles' vertices."""
+    t = np.asarray(triangles, dtype=np.int64)
+    parent = {int(v): int(v) for v in np.unique(t)}
+
+    def root(v):
+        while parent[v] != v:
+            parent[v] = parent[parent[v]]
+            v = parent[v]
+        return v
+
+    for a, b, c in t.tolist():
+        parent[root(b)] = root(a)
+        parent[root(c)] = root(a)
+    edges = np.unique(np.sort(t[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)
+    return len({root(v) for v in parent}), len(parent) - len(edges) + len(t)
+
+
+def test_quality_keeps_the_topology_the_partition_checks_cannot_judge():
+    vertices, triangles = book_and_spheres()
+    result = Mesh(vertices, triangles).decimate(0.1, mode="quality", seed=1)
+    assert result.stats.issues_left > 0 and result.stats.check_violations == 0  # the checks' blind spot
+    assert components_and_euler(result.triangles) == components_and_euler(triangles) == (5, 9)
+    assert result.stats.invariants_kept and result.stats.topology_kept
+    assert result.stats.topology_warning == ""
+
+
+def test_fast_mode_losing_components_is_not_kept_and_the_cli_warns(tmp_path):
+    vertices, triangles = book_and_spheres()
+    result = Mesh(vertices, triangles).decimate(0.1, mode="fast", seed=1)
+    components, _ = components_and_euler(result.triangles)
+    assert components < 5 and result.stats.output_check["lost_components"] == 5 - components
+    assert result.stats.topology_kept is False
+    assert "topology NOT kept" in result.stats.topology_warning
+
+    source = tmp_path / "book.obj"
+    write_mesh(source, MeshData(vertices=np.asarray(vertices, float), triangles=np.asarray(triangles)))
+    fast = topstoc(source, tmp_path / "fast.obj", "--ratio", 0.1, "--mode", "fast", "--seed", 1)
+    assert fast.returncode == 0 and (tmp_path / "fast.obj").exists()
+    assert "lost components" in fast.stderr and "topology NOT kept" in fast.stderr
+    quality = topstoc(source, tmp_path / "quality.obj", "--ratio", 0.1, "--mode", "quality", "--seed", 1)
+    assert quality.returncode == 0 and "topology" not in quality.stderr
+
+
+def test_batch_reports_the_topology_not_kept(tmp_path):
+    vertices, triangles = book_and_spheres()
+    source = tmp_path / "book.obj"
+    write_mesh(source, MeshData(vertices=np.asarray(vertices, float), triangles=np.asarray(triangles)))
+    out = tmp_path / "out"
+    done = cli.run("batch", "--input", source, "--output", out, "--ratio", "0.1", "--mode", "fast", "--seed", 1,
+                   "--workers", "0", "--progress", "lines")
+    assert done.returncode == 0, done.stderr
+    line = next(text for text in done.stdout.splitlines() if "book.obj:" in text)
+    assert "topology NOT kept: " in line and "lost components" in line
+    assert "1 done (1 missed their target, 1 did not keep the topology)" in done.stdout
+    lod = json.loads((out / "topstoc-report.json").read_text())["results"][0]["lods"][0]
+    assert lod["topology_kept"] is False and lod["topology_warning"].startswith("topology NOT kept: ")
