@@ -48,9 +48,8 @@ py::dict result_dict(HausdorffResult&& r) {
   return out;
 }
 
-}  // namespace
-
-void bind_hausdorff(py::module_& m) {
+// The surfaces, their samples and closest-point queries.
+void bind_surfaces(py::module_& m) {
   py::class_<Surface, std::shared_ptr<Surface>>(
       m, "Surface", "Triangle mesh validated for measurement (caller's arrays as given), with a closest-point index.")
       .def(py::init(&make_surface), py::arg("vertices"), py::arg("triangles"))
@@ -115,6 +114,12 @@ void bind_hausdorff(py::module_& m) {
         return out;
       },
       py::arg("surface"), py::arg("points"), "Nearest point on the surface of each point: distance, triangle, point.");
+}
+
+}  // namespace
+
+void bind_hausdorff(py::module_& m) {
+  bind_surfaces(m);
 
   m.def(
       "hausdorff",
