@@ -445,6 +445,27 @@ class ClusterRun {
     added.erase(std::remove_if(added.begin(), added.end(), [&](int32_t v) { return clustering.dist(v) == 0; }),
                 added.end());
     if (added.empty() && !clean) added = samples_next_to_named();
+    if (added.empty() && !clean) added = samples_in_lost_components();
+    return added;
+  }
+
+  // The repairs stalled (an issue they cannot fix, e.g. triangles of a component facing both
+  // ways, named nothing new) and a component has no triangle left: only the Euler check saw
+  // it, and it names clusters only when it is the sole finding. Split each such component's
+  // widest cluster, so that no component is lost while repair rounds remain.
+  std::vector<int32_t> samples_in_lost_components() const {
+    std::vector<uint8_t> has_triangle(mesh.num_components(), 0);
+    for (size_t i = 0; i < partition.triangles.size(); i += 3)
+      has_triangle[mesh.component()[samples[partition.triangles[i]]]] = 1;
+    std::vector<int32_t> widest(mesh.num_components(), -1);
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+      const int32_t comp = mesh.component()[v];
+      if (clustering.label(v) < 0 || clustering.dist(v) == 0 || has_triangle[comp]) continue;
+      if (widest[comp] < 0 || clustering.dist(v) > clustering.dist(widest[comp])) widest[comp] = v;
+    }
+    std::vector<int32_t> added;
+    for (int32_t v : widest)
+      if (v >= 0) added.push_back(v);
     return added;
   }
 
