@@ -1,7 +1,7 @@
 """topology_kept on non-manifold inputs, whose partition checks leave issues they cannot judge:
 True when every component kept its invariants, False (and said so on the command line) when the
-output lost components. A book of three pages plus four spheres: fast mode at ratio 0.1 loses the
-spheres, quality mode keeps everything."""
+output lost components. A book of three pages plus four spheres: fast mode at ratio 0.1 keeps them
+all, and with its repair rounds capped at 3 loses the spheres, which the reports must tell."""
 
 import functools
 import json
@@ -10,8 +10,10 @@ import numpy as np
 
 import cli
 import meshgen
+from topstoc.core.api import job
 from topstoc.core.api.io import MeshData, write_mesh
 from topstoc.core.api.mesh import Mesh
+from topstoc.core.cli import main as cli_main
 
 topstoc = functools.partial(cli.run, "decimate", timeout=120)
 
@@ -47,9 +49,29 @@ def test_quality_keeps_the_topology_the_partition_checks_cannot_judge():
     assert result.stats.topology_warning == ""
 
 
-def test_fast_mode_losing_components_is_not_kept_and_the_cli_warns(tmp_path):
+def test_fast_mode_keeps_the_spheres(tmp_path):
+    # The repairs stall on the book's fins; the spheres left without a triangle are then split
+    # (test_fast_components.py), so fast mode keeps every component too.
     vertices, triangles = book_and_spheres()
     result = Mesh(vertices, triangles).decimate(0.1, mode="fast", seed=1)
+    assert components_and_euler(result.triangles) == components_and_euler(triangles) == (5, 9)
+    assert result.stats.topology_kept is True and result.stats.output_check["lost_components"] == 0
+    source = tmp_path / "book.obj"
+    write_mesh(source, MeshData(vertices=np.asarray(vertices, float), triangles=np.asarray(triangles)))
+    fast = topstoc(source, tmp_path / "fast.obj", "--ratio", 0.1, "--mode", "fast", "--seed", 1)
+    assert fast.returncode == 0 and "topology" not in fast.stderr
+
+
+def few_repair_rounds(monkeypatch):
+    """Jobs (so the command line's too, run in this process) stop after 3 repair rounds: the
+    spheres are then still lost, the case the reports must tell."""
+    monkeypatch.setitem(job.make_job.__kwdefaults__, "max_repair_rounds", 3)
+
+
+def test_fast_mode_losing_components_is_not_kept_and_the_cli_warns(tmp_path, monkeypatch, capsys):
+    few_repair_rounds(monkeypatch)
+    vertices, triangles = book_and_spheres()
+    result = Mesh(vertices, triangles).decimate(0.1, mode="fast", seed=1, max_repair_rounds=3)
     components, _ = components_and_euler(result.triangles)
     assert components < 5 and result.stats.output_check["lost_components"] == 5 - components
     assert result.stats.topology_kept is False
@@ -57,23 +79,26 @@ def test_fast_mode_losing_components_is_not_kept_and_the_cli_warns(tmp_path):
 
     source = tmp_path / "book.obj"
     write_mesh(source, MeshData(vertices=np.asarray(vertices, float), triangles=np.asarray(triangles)))
-    fast = topstoc(source, tmp_path / "fast.obj", "--ratio", 0.1, "--mode", "fast", "--seed", 1)
-    assert fast.returncode == 0 and (tmp_path / "fast.obj").exists()
-    assert "lost components" in fast.stderr and "topology NOT kept" in fast.stderr
+    assert cli_main(["decimate", str(source), str(tmp_path / "fast.obj"), "--ratio", "0.1", "--mode", "fast",
+                     "--seed", "1"]) == 0
+    assert (tmp_path / "fast.obj").exists()
+    stderr = capsys.readouterr().err
+    assert "lost components" in stderr and "topology NOT kept" in stderr
     quality = topstoc(source, tmp_path / "quality.obj", "--ratio", 0.1, "--mode", "quality", "--seed", 1)
     assert quality.returncode == 0 and "topology" not in quality.stderr
 
 
-def test_batch_reports_the_topology_not_kept(tmp_path):
+def test_batch_reports_the_topology_not_kept(tmp_path, monkeypatch, capsys):
+    few_repair_rounds(monkeypatch)
     vertices, triangles = book_and_spheres()
     source = tmp_path / "book.obj"
     write_mesh(source, MeshData(vertices=np.asarray(vertices, float), triangles=np.asarray(triangles)))
     out = tmp_path / "out"
-    done = cli.run("batch", "--input", source, "--output", out, "--ratio", "0.1", "--mode", "fast", "--seed", 1,
-                   "--workers", "0", "--progress", "lines")
-    assert done.returncode == 0, done.stderr
-    line = next(text for text in done.stdout.splitlines() if "book.obj:" in text)
+    assert cli_main(["batch", "--input", str(source), "--output", str(out), "--ratio", "0.1", "--mode", "fast",
+                     "--seed", "1", "--workers", "0", "--progress", "lines"]) == 0
+    stdout = capsys.readouterr().out
+    line = next(text for text in stdout.splitlines() if "book.obj:" in text)
     assert "topology NOT kept: " in line and "lost components" in line
-    assert "1 done (1 missed their target, 1 did not keep the topology)" in done.stdout
+    assert "1 done (1 missed their target, 1 did not keep the topology)" in stdout
     lod = json.loads((out / "topstoc-report.json").read_text())["results"][0]["lods"][0]
     assert lod["topology_kept"] is False and lod["topology_warning"].startswith("topology NOT kept: ")
