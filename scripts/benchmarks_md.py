@@ -317,7 +317,7 @@ def render_attributes(name: str, figures: dict) -> str:
     peers = ("meshopt_simplifyWithAttributes", "Blender Collapse")
     out = [f"## The look after decimation (`{name}`)", "", *source_lines(figures),
            f"- Method: `tests/bench/bench_attributes.py`, mean error over {figures['samples']} points per direction "
-           f"(`tests/attribute_error.py`); ours at attribute weight {figures['attribute_weight']}{kind_shares(figures)}, each peer at our "
+           f"(`tests/attribute_error.py`); ours at attribute weight {figures['attribute_weight']}, each peer at our "
            "triangle count; ours ÷ peer below 1 means ours is closer to the source's look", "",
            "| Asset | Target | Triangles (target: ours / meshopt / Blender) | Error | Ours | meshopt | Blender | "
            "Ours ÷ meshopt | Ours ÷ Blender |", "|---|---|---|---|---|---|---|---|---|"]
@@ -337,14 +337,6 @@ def render_attributes(name: str, figures: dict) -> str:
     for label, entry in figures["summary"].items():
         out.append(f"| {label} | {entry['median']:.3f} | {entry['worst']:.3f} | {entry['above_1']} of {entry['cases']} |")
     return "\n".join(out) + "\n"
-
-
-def kind_shares(figures: dict) -> str:
-    """The share of the weight each kind of channel took (bench_attributes.json's kind_factors), if saved."""
-    factors = figures.get("kind_factors")
-    if not factors:
-        return ""
-    return " (times " + ", ".join(f"{factor:g} for {kind}" for kind, factor in factors.items()) + ")"
 
 
 def attribute_ratio(ours: float, peer: float, channel: str) -> str:

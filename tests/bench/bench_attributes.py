@@ -4,8 +4,7 @@
     python3 tests/bench/bench_attributes.py [--ratios 0.1,0.02] [--samples 50000] [--assets a,b] [--json FILE]
 
 For each asset and ratio, TopStoc's quality mode decimates it with its look in the cost (the public
-API as the add-on calls it: topstoc.core.carry.appearance's attributes at ATTRIBUTE_WEIGHT, each
-kind's channels at its share of it (KIND_FACTORS), UV seams
+API as the add-on calls it: topstoc.core.carry.appearance's attributes at ATTRIBUTE_WEIGHT, UV seams
 and hard normal edges as borders, the attributes carried through the result's source maps); every
 peer then decimates the same asset to our triangle count:
   - meshopt_simplifyWithAttributes (meshoptimizer 0.22 from PyPI's `meshoptimizer` 0.2.30a0, in a
@@ -55,7 +54,7 @@ from topstoc.core import Mesh, hausdorff  # noqa: E402
 from topstoc.core.api.decimate import ATTRIBUTE_WEIGHT  # noqa: E402
 from topstoc.core.api.hausdorff import closest_points  # noqa: E402
 from topstoc.core.api.io import read_mesh  # noqa: E402
-from topstoc.core.carry.appearance import KIND_FACTORS, appearance_attributes, unit_corner_normals  # noqa: E402
+from topstoc.core.carry.appearance import appearance_attributes, unit_corner_normals  # noqa: E402
 from topstoc.core.carry.attributes import corner_values, hard_normal_edges, moved_vertices, uv_seam_edges  # noqa: E402
 from attribute_error import CHANNELS, attribute_errors  # noqa: E402
 from capped_cylinder import capped_cylinder  # noqa: E402
@@ -409,7 +408,7 @@ def main() -> int:
     if args.json:
         report = {"benchmark": "tests/bench/bench_attributes.py", "machine": machine(),
                   "date": time.strftime("%Y-%m-%d", time.gmtime()), "samples": args.samples,
-                  "attribute_weight": args.weight, "kind_factors": KIND_FACTORS, "meshopt_weights": MESHOPT_WEIGHTS,
+                  "attribute_weight": args.weight, "meshopt_weights": MESHOPT_WEIGHTS,
                   "cases": cases, "summary": summary}
         path = pathlib.Path(args.json)
         temporary = path.with_suffix(".tmp")

@@ -90,11 +90,9 @@ def test_the_duck_keeps_its_look_better_than_meshopt(duck):
     with_look = attribute_errors(duck, ours, brute_closest_points, SAMPLES)
     without = attribute_errors(duck, plain, brute_closest_points, SAMPLES)
     print(f"duck at 10 %: {with_look} with the look in the cost, {without} without")
-    # the normals in the cost keep the shading (at a tenth of the weight, appearance.KIND_FACTORS, so
-    # that the shape is kept too: about 0.8x the error without them); the UVs
-    # were already closer than meshopt's without them
-    assert with_look["normal"] < 0.9 * without["normal"], (with_look, without)
-    assert with_look["uv"] < 0.5 * MESHOPT_UV and with_look["normal"] < MESHOPT_NORMAL, with_look
+    # the normals in the cost keep the shading; the UVs were already closer than meshopt's without them
+    assert with_look["normal"] < 0.7 * without["normal"], (with_look, without)
+    assert with_look["uv"] < 0.5 * MESHOPT_UV and with_look["normal"] < 0.8 * MESHOPT_NORMAL, with_look
 
 
 def test_the_duck_keeps_its_look_better_than_meshopt_in_the_same_run(duck):

@@ -88,10 +88,9 @@ class DecimationParameters:
         name="Appearance", default=ATTRIBUTE_WEIGHT, min=0.0, soft_max=1.0, precision=3,
         description="How much Quality mode protects the look: the active UV map, the colour attribute "
                     "(never the guidance paint) and custom normals are weighed with the shape, so textures "
-                    "stretch less, colours smear less and hard-surface shading stays. A UV difference of 1 "
-                    "costs like moving the surface by this fraction of the object's size; a colour "
-                    "difference of 1 by 0.3 of it, normals about 1 radian apart by 0.1. 0: shape only. "
-                    "Fast mode ignores it")
+                    "stretch less, colours smear less and hard-surface shading stays. A UV or colour "
+                    "difference of 1, or normals about 1 radian apart, costs like moving the surface by this "
+                    "fraction of the object's size. 0: shape only. Fast mode ignores it")
     output: EnumProperty(name="Output", items=OUTPUT_MODES, default="NEW_OBJECT")
 
 

@@ -21,11 +21,11 @@ the mean of all known UVs, so a region without UVs is a constant field, which no
 it can bend (cost 0) and only the triangles bordering it see a slope. A map without any UV
 contributes nothing. Colours must be finite.
 
-The weight is the engine's, scaled per kind (KIND_FACTORS): a difference ``d`` in a channel (UVs
-in texture units, colours in [0, 1], normals as the length of the difference of two unit vectors:
-2 sin(angle / 2), about the angle in radians for small angles, 2 for opposite normals) costs as
-much as moving the surface by ``weight * factor * d`` bounding-box diagonals (ATTRIBUTE_WEIGHT by
-default); weight 0 passes nothing, so the result is the one without attributes, to the bit. Fast mode ignores attributes (only the refinement uses them).
+The weight is the engine's: a difference ``d`` in a channel (UVs in texture units, colours in
+[0, 1], normals as the length of the difference of two unit vectors: 2 sin(angle / 2), about the
+angle in radians for small angles, 2 for opposite normals) costs as much as moving the surface by ``weight * d`` bounding-box diagonals
+(ATTRIBUTE_WEIGHT by default); weight 0 passes nothing, so the result is the one without
+attributes, to the bit. Fast mode ignores attributes (only the refinement uses them).
 """
 
 from __future__ import annotations
@@ -38,11 +38,6 @@ import numpy as np
 
 from ..support.errors import TopStocError
 
-#: Per kind of channel, its share of the one weight the caller gives (tests/bench/bench_attributes.py,
-#: docs/benchmarks.md). Normals follow the shape, whose planes the quadrics already weigh: at the full
-#: weight they drew the collapses away from the geometry (Suzanne at 10 %: 3.0x the mean distance
-#: of weight 0). A colour's difference shows less than a UV's, which moves the whole texture.
-KIND_FACTORS = {"uv": 1.0, "color": 0.3, "normal": 0.1}
 UV_CHANNELS = ("u", "v")
 COLOR_CHANNELS = ("r", "g", "b")
 NORMAL_CHANNELS = ("x", "y", "z")
@@ -62,13 +57,12 @@ class Appearance:
         return list(dict.fromkeys(name.split(".")[0] for name in self.channels))
 
     def decimate_kwargs(self, weight: float) -> dict:
-        """``decimate`` keywords at ``weight`` (validated), each channel's weight ``weight`` times
-        its kind's KIND_FACTORS: nothing when there are no channels or the weight is 0."""
+        """``decimate`` keywords at ``weight`` (validated): nothing when there are no channels
+        or the weight is 0."""
         weight = attribute_weight(weight)
         if self.values is None or weight == 0.0:
             return {}
-        factors = np.array([KIND_FACTORS[name.split(".")[0]] for name in self.channels])
-        return {"attributes": self.values, "attribute_weights": weight * factors}
+        return {"attributes": self.values, "attribute_weights": weight}
 
 
 def refines(mode: str = "quality", refine=None) -> bool:

@@ -57,9 +57,8 @@ def add_parser(subparsers) -> None:
                              "error (default: set by --mode)")
     parser.add_argument("--attribute-weight", type=float, default=ATTRIBUTE_WEIGHT, metavar="W",
                         help="how much the input's UVs and vertex colours count in quality mode's collapses: "
-                             "a UV difference d costs as much as moving the surface by W x d bounding-box "
-                             "diagonals, a colour or normal difference by 0.3 or 0.1 of that "
-                             f"(default {ATTRIBUTE_WEIGHT}; 0 = geometry only; fast mode ignores it)")
+                             "a difference d costs as much as moving the surface by W x d bounding-box "
+                             f"diagonals (default {ATTRIBUTE_WEIGHT}; 0 = geometry only; fast mode ignores it)")
     parser.add_argument("--symmetry", type=str.upper, choices=AXES, metavar="{x,y,z}",
                         help="mirror-symmetric result across the plane through the origin normal to this "
                              "axis (like Blender's Decimate modifier; the input must be symmetric there)")
