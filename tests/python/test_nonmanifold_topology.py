@@ -10,6 +10,7 @@ import numpy as np
 
 import cli
 import meshgen
+from reference import invariants
 from topstoc.core.api import job
 from topstoc.core.api.io import MeshData, write_mesh
 from topstoc.core.api.mesh import Mesh
@@ -23,21 +24,10 @@ def book_and_spheres():
 
 
 def components_and_euler(triangles):
-    """(components, V - E + F) counted here with a union-find over the triangles' vertices."""
+    """(components, V - E + F), counted by tests/reference.py independently of the engine."""
     t = np.asarray(triangles, dtype=np.int64)
-    parent = {int(v): int(v) for v in np.unique(t)}
-
-    def root(v):
-        while parent[v] != v:
-            parent[v] = parent[parent[v]]
-            v = parent[v]
-        return v
-
-    for a, b, c in t.tolist():
-        parent[root(b)] = root(a)
-        parent[root(c)] = root(a)
-    edges = np.unique(np.sort(t[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)
-    return len({root(v) for v in parent}), len(parent) - len(edges) + len(t)
+    per_component = invariants(int(t.max()) + 1, t)
+    return len(per_component), sum(chi for chi, *_ in per_component)
 
 
 def test_quality_keeps_the_topology_the_partition_checks_cannot_judge():
