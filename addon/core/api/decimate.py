@@ -299,7 +299,7 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
                           nonmanifold_vertices=vertices_on_nonmanifold_edges(raw["triangles"])
                           if mesh.native.report["nonmanifold_edges"] else 0)
     if stats.output_checked and stats.issues_left and not stats.check_violations:
-        kept = invariants_kept(mesh.vertices, mesh.triangles, raw["vertices"], raw["triangles"], raw["kept"])
+        kept = invariants_kept(mesh.input_topology, raw["vertices"], raw["triangles"], raw["kept"])
         stats = dataclasses.replace(stats, invariants_kept=kept)
     return DecimateResult(vertices=raw["vertices"], triangles=raw["triangles"], kept=raw["kept"],
                           face_source=raw["face_source"], corner_source=raw["corner_source"],

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .topology import ComponentTopology, topology
+from .topology import ComponentTopology, Topology, topology
 
 
 def _signature(component: ComponentTopology) -> tuple:
@@ -21,10 +21,10 @@ def _signature(component: ComponentTopology) -> tuple:
             len(component.boundary_paths), component.manifold, component.orientable)
 
 
-def invariants_kept(vertices, triangles, out_vertices, out_triangles, kept) -> bool:
-    """True when every input component with an edge has exactly one output component, of the
-    same invariants (see the module text); kept[i] is the input vertex of output vertex i."""
-    before = topology(vertices, triangles)
+def invariants_kept(before: Topology, out_vertices, out_triangles, kept) -> bool:
+    """True when every input component with an edge (before: the input's topology) has exactly
+    one output component, of the same invariants (see the module text); kept[i] is the input
+    vertex of output vertex i."""
     after = topology(out_vertices, out_triangles)
     kept = np.asarray(kept)
     pieces: dict[int, list] = {}

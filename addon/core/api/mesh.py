@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .decimate import decimate, decimate_with_samples
+from .topology import topology
 from ..support.digest import array_digest
 from ..support.native import engine
 from ..support.errors import TopStocError
@@ -103,6 +104,7 @@ class Mesh:
         self._native = engine.Mesh(vertices, triangles, progress=progress)
         self._vertices = None
         self._triangles = None
+        self._topology = None  # the input's, computed on first use (input_topology)
         self._layouts: dict = {}
         self._keep_floods = bool(keep_floods)
 
@@ -194,6 +196,14 @@ class Mesh:
         """Frees the feature layouts and their floods (a one-shot job's: a later decimation builds
         them again, with the same result)."""
         self._layouts.clear()
+
+    @property
+    def input_topology(self):
+        """The input's topology (core/api/topology.py), computed once: every decimation of a
+        mesh whose partition checks leave issues compares its output with it (invariants.py)."""
+        if self._topology is None:
+            self._topology = topology(self.vertices, self.triangles)
+        return self._topology
 
     def decimate(self, ratio=None, target_vertices=None, target_triangles=None, **options):
         """TopStoc decimation; see topstoc.core.api.decimate.decimate for every option."""
