@@ -88,14 +88,19 @@ def test_a_moved_ratio_cancels_the_speculation_in_the_engine(ts, donut, preview,
         session.close()
 
 
+def speculating_at(session, engine, ratio):
+    """After the first speculation (at 0.1), the drag moves to ratio: its Quality call is held."""
+    assert shown_until(session, lambda: session.final and session.ratio == 0.1)
+    engine.gate.clear()
+    session.request(ratio)
+    assert wait_for(lambda: [call.target.ratio for call in quality_calls(engine)][-1:] == [ratio])
+
+
 def test_the_rest_takes_over_the_speculation_running(ts, donut, preview, monkeypatch):
     engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline, hold=lambda job: job.mode == "quality")
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=6), ratio=0.1)
     try:
-        assert shown_until(session, lambda: session.final and session.ratio == 0.1)  # the first speculation
-        engine.gate.clear()
-        session.request(0.15)
-        assert wait_for(lambda: [call.target.ratio for call in quality_calls(engine)][-1:] == [0.15])
+        speculating_at(session, engine, 0.15)
         assert shown_until(session, lambda: session.ratio == 0.15 and not session.final)  # the draft
         monkeypatch.setattr(preview, "REST_SECONDS", 0.0)
         session.poll()  # the drag rests: its request is the speculation already running
@@ -113,10 +118,7 @@ def test_enter_applies_the_speculation_still_being_computed(ts, donut, preview, 
     engine = EngineCalls(monkeypatch, ts.blender.decimation.pipeline, hold=lambda job: job.mode == "quality")
     session = preview.PreviewSession(bpy.context, donut, Params(quality="QUALITY", seed=7), ratio=0.1)
     try:
-        assert shown_until(session, lambda: session.final and session.ratio == 0.1)  # the first speculation
-        engine.gate.clear()
-        session.request(0.17)
-        assert wait_for(lambda: [call.target.ratio for call in quality_calls(engine)][-1:] == [0.17])
+        speculating_at(session, engine, 0.17)
         assert session.apply(0.17) is None and session.applying
         engine.gate.set()
         runs = []
