@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "distance/radix_sort.hpp"
+#include "core/counting_sort.hpp"
 
 namespace topstoc {
 
@@ -17,6 +17,21 @@ struct CellItem {
   uint64_t code;  // the cell's key
   int32_t vertex;
 };
+
+// Items by their lowest `bits` bits of code, ties in their given order: least-significant-digit
+// passes of the engine's stable counting sort.
+void sort_by_code(std::vector<CellItem>& items, int bits) {
+  constexpr int kDigit = 11;
+  constexpr uint64_t kMask = (uint64_t(1) << kDigit) - 1;
+  std::vector<CellItem> other(items.size());
+  std::vector<int32_t> offsets;
+  for (int shift = 0; shift < bits; shift += kDigit) {
+    stable_counting_sort(
+        int64_t(items.size()), int32_t(kMask + 1), [&](int64_t i) { return int32_t((items[i].code >> shift) & kMask); },
+        [&](int64_t i, int32_t at) { other[size_t(at)] = items[size_t(i)]; }, offsets);
+    items.swap(other);
+  }
+}
 
 uint64_t mix(uint64_t key) { return key * 0x9E3779B97F4A7C15ULL; }
 
@@ -43,7 +58,7 @@ VertexGrid::VertexGrid(const Surface& surface, double cell) : positions_(surface
       c[k] = std::min(extent_[k] - 1, int64_t((positions_[3 * size_t(v) + k] - lo_[k]) / cell_));
     items.push_back({key_of(c[0], c[1], c[2]), v});
   }
-  radix_sort(items, 3 * kAxisBits);
+  sort_by_code(items, 3 * kAxisBits);
   order_.resize(items.size());
   for (size_t i = 0; i < items.size(); ++i) {
     order_[i] = items[i].vertex;
