@@ -80,7 +80,9 @@ def test_hard_edges_keep_each_side_its_normals(ts, scene):
     obj.topstoc.use_hard_normals = False
     loose_out = decimate(obj)
     loose = error(ts, loose_out)
-    assert bordered["mean"] < 0.2 * loose["mean"], (bordered, loose)
+    # The tiny fit moves the loose result's free vertices onto the input, which narrows the gap
+    # to about 4x; were the hard edges not borders, the two results would be the same.
+    assert bordered["mean"] < 0.3 * loose["mean"], (bordered, loose)
     assert not any("hard edges" in s for s in json.loads(loose_out["topstoc_parameters"])["sources"])
 
 
