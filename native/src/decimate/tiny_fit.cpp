@@ -21,6 +21,9 @@ constexpr int64_t kFitTriangles = 200000;
 // many closest-point queries each way (the bracket stays valid when they run out).
 constexpr double kMaxTolerance = 1e-2;
 constexpr int64_t kMaxQueries = 2000000;
+// A result whose pairs all lie this close to the input (normalised coordinates) lies on it:
+// nothing to fit, and the max's bracket could not settle on surfaces that coincide.
+constexpr double kOnTheInput = 1e-9;
 // Times a move whose max grew is tried again with more corners held.
 constexpr int32_t kHoldTries = 8;
 // The shortest step toward the least-squares positions tried when the full one is refused.
@@ -282,6 +285,7 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds) {
   Fit fit(mesh, collapser);
   if (fit.empty()) return out;
   auto error = fit.pair_up();
+  if (error.top2 <= kOnTheInput * kOnTheInput) return out;
   auto max = fit.symmetric_max();
   out.before2 = out.after2 = error.mean2;
   std::vector<double> x;
