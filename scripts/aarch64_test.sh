@@ -6,13 +6,18 @@
 #    (tests/cross -k aarch64);
 # 2. the aarch64 cp311 wheel (dist/ from scripts/build_wheels.sh, or TOPSTOC_AARCH64_WHEEL)
 #    installed into a venv in the root: tests/install/wheel_check.py, then the Python API tests
-#    in PYTHON_TESTS below, less the stress pass (emulation is 10-30x slower, so not all of
+#    in PYTHON_TESTS below, less DESELECT (emulation is 10-30x slower, so not all of
 #    tests/python: the engine's guarantees, the prepared mesh, sampling and the file formats, about
 #    5 minutes here; test_native_import.py needs a build tree, not an installed wheel).
 set -u -o pipefail
 source "$(dirname "$0")/common.sh"  # cd to the checkout
 PYTHON_TESTS="tests/python/test_mesh.py tests/python/test_io.py tests/python/test_sampling.py
   tests/python/test_guarantees.py"
+# Deselected besides the stress pass: the random surfaces past the first 8 manifold and 6 pinched
+# seeds (the same code paths again; the native suite runs them all, tests/cross compares files).
+DESELECT="--deselect tests/python/test_guarantees.py::test_stress_pass_finds_nothing"
+for seed in $(seq 8 39); do DESELECT+=" --deselect 'tests/python/test_guarantees.py::test_random_manifolds_keep_every_guarantee[$seed]'"; done
+for seed in $(seq 6 29); do DESELECT+=" --deselect 'tests/python/test_guarantees.py::test_random_pinched_surfaces_keep_every_fan[$seed]'"; done
 ROOTFS=$(scripts/arm64_root.sh) || exit 1
 
 scripts/cross_build.sh aarch64 || exit 1
@@ -33,5 +38,4 @@ scripts/arm64_root.sh run "$WORK" "
   python3 -m venv --system-site-packages /work/venv &&
   /work/venv/bin/pip install -q --no-index --no-deps /work/$(basename "$WHEEL") &&
   /work/venv/bin/python /work/tests/install/wheel_check.py &&
-  TOPSTOC_BUILD=/work/no-build /work/venv/bin/python -m pytest -q -p no:cacheprovider $(echo $PYTHON_TESTS) \
-    --deselect tests/python/test_guarantees.py::test_stress_pass_finds_nothing"
+  TOPSTOC_BUILD=/work/no-build /work/venv/bin/python -m pytest -q -p no:cacheprovider $(echo $PYTHON_TESTS) $DESELECT"
