@@ -636,6 +636,21 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
 
 namespace {
 
+// A first pass whose repairs stalled above the target, taken the rest of the way by quality
+// mode's collapses (refine.hpp: the topology of every component, its non-manifold curves and
+// its borders kept), keeping input positions (half-edge collapses) as fast mode promises.
+void collapse_rest(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
+                   DecimateResult& result) {
+  const std::vector<double> multipliers = multipliers_if_guided(mesh, params.sampling);
+  RefineParams rest;
+  rest.target_vertices = params.target_vertices;
+  rest.multipliers = or_null(multipliers);
+  rest.keep_positions = true;
+  rest.attributes = params.attributes;
+  check_cancelled("refinement");
+  refine_by_collapses(mesh, layout, rest, result);
+}
+
 // TopStoc to params.target_vertices. `refined`: a first pass the refinement thins next, which
 // removes zero-area triangles and whose output is checked after it, so neither happens here
 // (except the check that decides whether a fast-path miss must be redone).
@@ -663,14 +678,27 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
   }
   const auto excess = [&](const DecimateResult& r) { return int32_t(r.kept.size()) - target; };
   const int32_t tolerance = budget_tolerance(target);
+  // Issues the repairs could not fix (what the partition check cannot judge: non-manifold
+  // edges, a component whose triangles face both ways) come back at every lower draw.
+  const bool stalled = best.issues_remaining.topological() > 0;
   int32_t drawn = target;
-  for (int pass = 0; pass < params.budget_passes && excess(best) > tolerance && best.forced < target; ++pass) {
+  for (int pass = 0; pass < params.budget_passes && excess(best) > tolerance && best.forced < target && !stalled;
+       ++pass) {
     drawn = std::max(1, drawn - excess(best) - tolerance);
     DecimateResult r = decimate_once(mesh, layout, params, drawn, target, nullptr);
     if (std::abs(excess(r)) < std::abs(excess(best))) {
       r.flood_updated = best.flood_updated;  // (it tells of the draw for the target)
       best = std::move(r);
     }
+  }
+  if (!refined && stalled && excess(best) > tolerance) {
+    if (params.draft) {
+      // The collapses follow the result's labels and corners, which a draft leaves out.
+      DecimateParams full = params;
+      full.draft = false;
+      return stochastic_pass(mesh, layout, full, refined);
+    }
+    collapse_rest(mesh, layout, params, best);
   }
   // An input with collinear vertices can leave zero-area triangles the repairs could not
   // remove: collapse one edge of each (never an output with a zero-area triangle).

@@ -307,8 +307,8 @@ class Refinement {
     count_locked_ends(setup);
     setup.quota = quotas();
     set_up_corner_sectors(setup);
-    setup.optimal_placement = !params.zero_area_only;
-    // The zero-area clean-up keeps the caller's positions.
+    // The zero-area clean-up and fast mode keep the caller's positions.
+    setup.optimal_placement = !params.zero_area_only && !params.keep_positions;
     const double center[3] = {setup.center[0], setup.center[1], setup.center[2]}, extent = setup.extent;
     if (params.max_aware && n == num_input - mesh.report().isolated_vertices) {
       collapse_max_aware(std::move(setup), center, extent);

@@ -51,6 +51,9 @@ struct RefineParams {
   /// last collapses, each vertex's cost weighed by how far the runs before ended from the input
   /// there, and keep the best run (a smaller max error, for the time of the reruns).
   bool max_aware = false;
+  /// Every collapse a half-edge collapse (no optimal placement): the output keeps input
+  /// positions, as fast mode promises.
+  bool keep_positions = false;
   CornerAttributes attributes;
 };
 
