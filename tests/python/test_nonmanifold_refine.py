@@ -1,17 +1,28 @@
-"""Quality mode on non-manifold input: sheets meeting along an edge are simplified, not frozen.
+"""Non-manifold input: sheets meeting along an edge are simplified, not frozen.
 
 A non-manifold edge is a feature curve: the collapses may shorten it (each sheet keeps one fan
 on its side) but never remove a sheet. Checked with tests/reference.py, independent of the engine.
+Both modes: fast mode's first pass stalls on what its partition check cannot judge (non-manifold
+edges, triangles facing both ways), and quality mode's collapses take it the rest of the way,
+keeping input positions.
 """
 
 import pathlib
 
 import numpy as np
+import pytest
 
 import reference
 from topstoc.core import Mesh, read_mesh
 
 DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
+MODES = ["quality", "fast"]
+
+
+def assert_positions(mode, mesh, r):
+    """Fast mode's output vertices are input vertices, where they were (quality mode moves them)."""
+    if mode == "fast":
+        np.testing.assert_array_equal(np.asarray(r.vertices), np.asarray(mesh.vertices)[np.asarray(r.kept)])
 
 
 def three_sheets(length=40, width=12):
@@ -43,11 +54,12 @@ def spine_edges(triangles):
     return edges[counts > 2], counts[counts > 2]
 
 
-def test_a_non_manifold_curve_is_shortened_and_keeps_its_three_sheets():
+@pytest.mark.parametrize("mode", MODES)
+def test_a_non_manifold_curve_is_shortened_and_keeps_its_three_sheets(mode):
     vertices, triangles, length = three_sheets()
     mesh = Mesh(vertices, triangles)
     expected = reference.invariants(len(vertices), triangles)
-    r = mesh.decimate(ratio=0.05, seed=0)
+    r = mesh.decimate(ratio=0.05, seed=0, mode=mode)
     kept = np.asarray(r.kept)
     on_spine = int(np.count_nonzero(kept < length))
     # The old collapser refused every edge with three triangles: all 40 spine vertices stayed.
@@ -57,6 +69,7 @@ def test_a_non_manifold_curve_is_shortened_and_keeps_its_three_sheets():
     assert reference.invariants(r.num_vertices, r.triangles) == expected
     assert reference.degenerate_or_duplicate(r.triangles) == (0, 0)
     assert not any(r.stats.output_check.values())
+    assert_positions(mode, mesh, r)
 
 
 def nonmanifold_pieces(triangles):
@@ -81,7 +94,8 @@ def nonmanifold_pieces(triangles):
     return edges, np.unique(roots, return_inverse=True)[1], len(np.unique(roots))
 
 
-def test_a_scan_with_non_manifold_edges_gets_nearer_its_target():
+@pytest.mark.parametrize("mode", MODES)
+def test_a_scan_with_non_manifold_edges_gets_nearer_its_target(mode):
     # Stanford's dragon at its lowest resolution: 494 non-manifold edges in 233 curves of one to
     # eight edges (mostly a folded triangle glued on two edges: its three corners are kept), 5
     # pinched vertices and 90 inconsistently oriented edges. The rings of every vertex on a
@@ -95,7 +109,7 @@ def test_a_scan_with_non_manifold_edges_gets_nearer_its_target():
     expected = reference.invariants(len(mesh.vertices), cleaned)
     input_edges, input_piece, input_pieces = nonmanifold_pieces(cleaned)
     for target in (1110, 222):
-        r = mesh.decimate(target_triangles=target, seed=0)
+        r = mesh.decimate(target_triangles=target, seed=0, mode=mode)
         assert r.num_triangles < 2000, r.num_triangles  # 2,528 with the rings of inconsistent edges frozen
         assert reference.invariants(r.num_vertices, r.triangles) == expected
         assert reference.degenerate_or_duplicate(r.triangles) == (0, 0)
@@ -125,6 +139,7 @@ def test_a_scan_with_non_manifold_edges_gets_nearer_its_target():
         assert missed.reason == "non-manifold edges" and 2 * on_curves >= r.num_vertices
         assert missed.detail == f"{on_curves:,} of the result's {r.num_vertices:,} vertices lie on them"
         assert "non-manifold edges: " in missed.text()
+        assert_positions(mode, mesh, r)
 
 
 def inconsistent_edges(triangles):
@@ -159,7 +174,8 @@ def grid(n, height):
     return vertices, np.concatenate([np.column_stack([a, b, d]), np.column_stack([a, d, c])])
 
 
-def test_an_orientation_seam_does_not_freeze_the_region_around_it():
+@pytest.mark.parametrize("mode", MODES)
+def test_an_orientation_seam_does_not_freeze_the_region_around_it(mode):
     # A bumpy sheet whose right half is flipped: a column of 117 inconsistently oriented edges.
     # Locking the rings of all of them kept three columns of vertices; one per component is
     # enough to keep the component inconsistently oriented.
@@ -170,13 +186,14 @@ def test_an_orientation_seam_does_not_freeze_the_region_around_it():
     mesh = Mesh(vertices, triangles)
     expected = reference.invariants(len(vertices), triangles)
     target = 140  # 2 % of 6,962 triangles
-    r = mesh.decimate(target_triangles=target, seed=0)
+    r = mesh.decimate(target_triangles=target, seed=0, mode=mode)
     assert abs(r.num_triangles - target) <= 2, r.num_triangles  # the old rings kept about 400
     assert r.stats.target_missed is None
     assert inconsistent_edges(r.triangles) > 0
     assert reference.invariants(r.num_vertices, r.triangles) == expected
     assert reference.degenerate_or_duplicate(r.triangles) == (0, 0)
     assert not any(r.stats.output_check.values())
+    assert_positions(mode, mesh, r)
 
 
 def touching_sheets(n=41, reach=0.25):
@@ -196,7 +213,8 @@ def touching_sheets(n=41, reach=0.25):
     return vertices, np.concatenate([triangles, remap[triangles][:, ::-1]]), index[columns, row]
 
 
-def test_a_touching_segment_shortens_along_itself_and_keeps_an_edge():
+@pytest.mark.parametrize("mode", MODES)
+def test_a_touching_segment_shortens_along_itself_and_keeps_an_edge(mode):
     # Its dead ends may move along it now (Collapser::curve_fans), but it keeps one edge: shrunk to
     # a point, the sheets would touch at a vertex only.
     vertices, triangles, segment = touching_sheets()
@@ -205,7 +223,7 @@ def test_a_touching_segment_shortens_along_itself_and_keeps_an_edge():
     mesh = Mesh(vertices, triangles)
     expected = reference.invariants(len(vertices), triangles)
     for target in (300, 40):
-        r = mesh.decimate(target_triangles=target, seed=0)
+        r = mesh.decimate(target_triangles=target, seed=0, mode=mode)
         assert r.stats.target_missed is None, r.stats.target_missed
         assert reference.invariants(r.num_vertices, r.triangles) == expected
         assert reference.degenerate_or_duplicate(r.triangles) == (0, 0)
@@ -218,6 +236,7 @@ def test_a_touching_segment_shortens_along_itself_and_keeps_an_edge():
         assert len(on) == len(out_edges) + 1
         assert np.isin(kept[on], segment).all()
         np.testing.assert_array_equal(np.asarray(r.vertices)[on], vertices[kept[on]])
+        assert_positions(mode, mesh, r)
 
 
 def boundary_edges(triangles):

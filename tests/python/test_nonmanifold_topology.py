@@ -89,6 +89,7 @@ def test_batch_reports_the_topology_not_kept(tmp_path, monkeypatch, capsys):
     stdout = capsys.readouterr().out
     line = next(text for text in stdout.splitlines() if "book.obj:" in text)
     assert "topology NOT kept: " in line and "lost components" in line
-    assert "1 done (1 missed their target, 1 did not keep the topology)" in stdout
+    # (the stalled first pass is collapsed to its target, so only the topology is reported)
+    assert "1 done (1 did not keep the topology)" in stdout
     lod = json.loads((out / "topstoc-report.json").read_text())["results"][0]["lods"][0]
     assert lod["topology_kept"] is False and lod["topology_warning"].startswith("topology NOT kept: ")

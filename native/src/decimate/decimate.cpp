@@ -644,6 +644,7 @@ void collapse_rest(const Mesh& mesh, const FeatureLayout& layout, const Decimate
   const std::vector<double> multipliers = multipliers_if_guided(mesh, params.sampling);
   RefineParams rest;
   rest.target_vertices = params.target_vertices;
+  rest.target_triangles = params.target_triangles;
   rest.multipliers = or_null(multipliers);
   rest.keep_positions = true;
   rest.attributes = params.attributes;
@@ -861,6 +862,7 @@ DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layo
   }
   DecimateResult best;
   int32_t best_error = INT32_MAX;
+  params.target_triangles = target_triangles;
   for (int it = 0; it < std::max(1, max_iterations); ++it) {
     params.target_vertices = std::clamp(int32_t(std::lround(vertices)), 1, active);
     DecimateResult r = decimate(mesh, layout, params);

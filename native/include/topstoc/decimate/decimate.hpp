@@ -52,6 +52,9 @@ struct DecimateParams {
   /// pass, whose choices cost quality; on big ones the collapses' time grows with the target,
   /// not with the mesh, while the stochastic pass does the bulk.
   int32_t refine_collapses = 0;
+  /// > 0: the caller's triangle target (decimate_to_triangles). A plain TopStoc pass whose
+  /// repairs stalled above the target is collapsed to this many triangles.
+  int32_t target_triangles = 0;
   CornerAttributes attributes;  ///< attribute-aware cost of the refinement
   /// Floods of earlier decimations of this mesh and layout (flood_cache.hpp), or null: the
   /// result is the same either way, nearby targets of one seed come sooner (not with the fast
