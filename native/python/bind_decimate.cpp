@@ -115,6 +115,7 @@ py::dict result_dict(DecimateResult&& r) {
   d["refine_vertices"] = r.refine_vertices;
   d["refine_triangles"] = r.refine_triangles;
   d["refine_collapses"] = r.refine_collapses;
+  d["refine_keeps_positions"] = r.refine_keeps_positions;
   d["repair_rounds"] = r.repair_rounds;
   d["repairs"] = r.repairs;
   d["issues_found"] = issues_dict(r.issues_found);
@@ -259,11 +260,12 @@ void bind_decimate(py::module_& m) {
         const int32_t max_repair_rounds = replay.attr("max_repair_rounds").cast<int32_t>();
         const int32_t refine_vertices = replay.attr("refine_vertices").cast<int32_t>();
         const int32_t refine_triangles = replay.attr("refine_triangles").cast<int32_t>();
+        const bool refine_keeps_positions = replay.attr("refine_keeps_positions").cast<bool>();
         DecimateResult r;
         {
           EngineCall call;
           r = decimate_with_samples(mesh, layout, std::move(ids), placement, max_repair_rounds, refine_vertices, u,
-                                    corner_attributes, refine_triangles);
+                                    corner_attributes, refine_triangles, refine_keeps_positions);
         }
         return result_dict(std::move(r));
       },

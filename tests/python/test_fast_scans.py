@@ -101,3 +101,15 @@ def test_a_draft_of_a_stalled_first_pass_is_the_full_result():
     for name in ("samples", "kept", "vertices", "triangles", "face_source", "corner_source", "labels"):
         np.testing.assert_array_equal(getattr(draft, name), getattr(full, name), err_msg=name)
     assert draft.stats.output_checked and draft.stats.topology_kept
+
+
+@pytest.mark.parametrize("target", [dict(ratio=0.02), dict(target_triangles=27)])
+def test_a_collapsed_fast_result_replays_from_its_samples(target):
+    mesh = spider()
+    r = mesh.decimate(mode="fast", seed=0, **target)
+    assert r.stats.refine_keeps_positions
+    again = mesh.decimate_with_samples(r.samples, placement="subsample", refine_vertices=r.stats.refine_vertices,
+                                       refine_triangles=r.stats.refine_triangles,
+                                       refine_keeps_positions=r.stats.refine_keeps_positions)
+    for name in ("kept", "vertices", "triangles", "face_source", "corner_source", "labels"):
+        np.testing.assert_array_equal(getattr(again, name), getattr(r, name), err_msg=name)

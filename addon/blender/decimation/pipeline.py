@@ -328,7 +328,10 @@ def store_samples(run: Run, name: str = LAST_SAMPLES) -> None:
         entry = sets.add()
         entry.name = name
     # A refined result replays with its refinement target and the same per-vertex guidance.
-    entry.parameters = json.dumps(dict(run.parameters, refine_vertices=int(run.result.stats.refine_vertices),
+    stats = run.result.stats
+    entry.parameters = json.dumps(dict(run.parameters, refine_vertices=int(stats.refine_vertices),
+                                       refine_triangles=int(stats.refine_triangles),
+                                       refine_keeps_positions=bool(stats.refine_keeps_positions),
                                        placement=run.result.parameters.get("placement", "subsample"),
                                        guidance_digest=guidance_digest(run.guidance.guidance)))
     entry.mesh_digest = run.prepared.digest
@@ -362,6 +365,8 @@ def restore(context, obj, name: str) -> Run:
                                   guidance.appearance) if refine_vertices else {}
     result = prepared.mesh.decimate_with_samples(samples, placement=parameters.get("placement", "subsample"),
                                                  refine_vertices=refine_vertices,
+                                                 refine_triangles=int(parameters.get("refine_triangles", 0)),
+                                                 refine_keeps_positions=bool(parameters.get("refine_keeps_positions")),
                                                  guidance=guidance.guidance if refine_vertices else None,
                                                  **guidance.layout_kwargs(), **attributes)
     return Run(obj, prepared, guidance, result, parameters, time.perf_counter() - start)

@@ -71,6 +71,8 @@ class DecimateStats:
     refine_vertices: int = 0    #: target of the quadric refinement (0: not refined)
     refine_triangles: int = 0   #: its triangle target, when it had one
     refine_collapses: int = 0   #: collapses the refinement made
+    #: the refinement's collapses kept input positions (fast mode's, where its repairs stalled)
+    refine_keeps_positions: bool = False
     output_vertices: int = 0    #: vertices of the result
     #: the final check of the output against the input's components (manifold, orientation,
     #: components, Euler characteristic, boundary loops, duplicates, finite coordinates; see
@@ -317,6 +319,7 @@ class SampleReplay:
     max_repair_rounds: int = 200
     refine_vertices: int = 0
     refine_triangles: int = 0
+    refine_keeps_positions: bool = False
     guidance: Optional[np.ndarray] = None           #: u per vertex (guidance_values), or None
     attributes: Optional[np.ndarray] = None         #: corner values (attribute_arrays), or None
     attribute_weights: Optional[np.ndarray] = None  #: one weight per attribute channel, or None
@@ -324,12 +327,14 @@ class SampleReplay:
 
 def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, feature_angle: float = 0.0,
                           placement: str = "subsample", refine_vertices: int = 0, refine_triangles: int = 0,
-                          guidance=None, attributes=None, attribute_weights=None) -> DecimateResult:
+                          refine_keeps_positions: bool = False, guidance=None, attributes=None,
+                          attribute_weights=None) -> DecimateResult:
     """Re-creates a decimation from ``DecimateResult.samples`` (thesis 4.1.3).
 
     With the same mesh, regions, borders, feature angle and placement the output is identical.
     A refined result (``refine`` > 0) also needs ``refine_vertices=result.stats.refine_vertices``,
-    ``refine_triangles=result.stats.refine_triangles`` and the same ``guidance`` and
+    ``refine_triangles=result.stats.refine_triangles``,
+    ``refine_keeps_positions=result.stats.refine_keeps_positions`` and the same ``guidance`` and
     ``attributes``.
     """
     if placement not in PLACEMENTS:
@@ -343,11 +348,13 @@ def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, fe
     attribute_values, attribute_weights = attribute_arrays(mesh, attributes, attribute_weights)
     layout = mesh.feature_layout(regions, borders, feature_angle)
     replay = SampleReplay(samples, placement, refine_vertices=int(refine_vertices),
-                          refine_triangles=int(refine_triangles), guidance=guidance_values(mesh, guidance),
+                          refine_triangles=int(refine_triangles), refine_keeps_positions=bool(refine_keeps_positions),
+                          guidance=guidance_values(mesh, guidance),
                           attributes=attribute_values, attribute_weights=attribute_weights)
     raw = engine.decimate_with_samples(mesh.native, layout, replay)
     return _result(raw, dict(samples=len(samples), placement=placement, feature_angle=feature_angle,
-                             refine_vertices=int(refine_vertices), refine_triangles=int(refine_triangles)), mesh)
+                             refine_vertices=int(refine_vertices), refine_triangles=int(refine_triangles),
+                             refine_keeps_positions=bool(refine_keeps_positions)), mesh)
 
 
 def sampling_probabilities(mesh: Mesh, rate: float, *, adaptivity: float = 0.5,

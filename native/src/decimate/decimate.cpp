@@ -794,7 +794,7 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                      Placement placement, int32_t max_repair_rounds, int32_t refine_vertices,
                                      const double* guidance, const CornerAttributes& attributes,
-                                     int32_t refine_triangles) {
+                                     int32_t refine_triangles, bool refine_keeps_positions) {
   if (samples.empty()) throw std::invalid_argument("the sample list is empty");
   const auto& vfo = mesh.vertex_face_offsets();
   for (size_t i = 0; i < samples.size(); ++i) {
@@ -840,6 +840,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
     refine.zero_area_only = refine_vertices == 0;
     refine.refit = refine_vertices > 0 && placement == Placement::Filtered;
     refine.max_aware = refine.refit;
+    refine.keep_positions = refine_keeps_positions;
     refine.attributes = attributes;
     refine_by_collapses(mesh, layout, refine, result);
   }

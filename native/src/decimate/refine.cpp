@@ -563,6 +563,7 @@ class Refinement {
     }
     result.refine_vertices = params.target_vertices;
     result.refine_triangles = params.target_triangles;
+    result.refine_keeps_positions = params.keep_positions;
     // Slivers the stochastic pass left (near-collinear corners, needles) go first: the
     // collapses thin the result anyway, and none of them makes a triangle thinner than the
     // thinnest around it was (Collapser::keeps_shape).

@@ -96,6 +96,7 @@ struct DecimateResult {
   int32_t refine_vertices = 0;         ///< target of the quadric refinement (0: none)
   int32_t refine_triangles = 0;        ///< its triangle target, when it had one (0: none)
   int32_t refine_collapses = 0;        ///< collapses it made
+  bool refine_keeps_positions = false; ///< its collapses were half-edge only (fast mode's)
   double seconds_sampling = 0, seconds_clustering = 0, seconds_checking = 0, seconds_output = 0;
   double seconds_verify = 0;  ///< the final output check (verify.hpp)
   double seconds_refine = 0;
@@ -112,7 +113,8 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                      Placement placement, int32_t max_repair_rounds = 200,
                                      int32_t refine_vertices = 0, const double* guidance = nullptr,
-                                     const CornerAttributes& attributes = {}, int32_t refine_triangles = 0);
+                                     const CornerAttributes& attributes = {}, int32_t refine_triangles = 0,
+                                     bool refine_keeps_positions = false);
 
 /// Decimates to about `target_triangles` output triangles (within 1 % where the mesh allows),
 /// re-decimating with a corrected vertex target up to `max_iterations` times.
