@@ -680,11 +680,12 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
   const auto excess = [&](const DecimateResult& r) { return int32_t(r.kept.size()) - target; };
   const int32_t tolerance = budget_tolerance(target);
   // Issues the repairs could not fix (what the partition check cannot judge: non-manifold
-  // edges, a component whose triangles face both ways) come back at every lower draw.
+  // edges, a component whose triangles face both ways) come back at every lower draw: a plain
+  // pass skips those draws and collapses to the target instead (below).
   const bool stalled = best.issues_remaining.topological() > 0;
+  const int passes = stalled && !refined ? 0 : params.budget_passes;
   int32_t drawn = target;
-  for (int pass = 0; pass < params.budget_passes && excess(best) > tolerance && best.forced < target && !stalled;
-       ++pass) {
+  for (int pass = 0; pass < passes && excess(best) > tolerance && best.forced < target; ++pass) {
     drawn = std::max(1, drawn - excess(best) - tolerance);
     DecimateResult r = decimate_once(mesh, layout, params, drawn, target, nullptr);
     if (std::abs(excess(r)) < std::abs(excess(best))) {
