@@ -216,7 +216,9 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     regions: an id per input triangle (materials, UV islands), borders: (k, 2) vertex pairs;
     no cluster crosses either, and both survive exactly. view, boxes: see View and Box.
     mode: "quality" (default): placement "filtered" and quadric collapses after a TopStoc pass
-    (see QUALITY_COLLAPSES); "fast": the thesis' TopStoc, placement "subsample", no refinement.
+    (see QUALITY_COLLAPSES); "fast": the thesis' TopStoc, placement "subsample", no refinement
+    (except where its repairs stall above the target, as on non-manifold or inconsistently
+    oriented input: then the collapses finish it, keeping input positions; docs/design.md §2.7).
     placement and refine, when given, override what the mode sets.
     placement: "subsample" keeps the first pass's input positions, "filtered" moves surface
     vertices to the quadric-optimal point of their cluster (borders stay). In quality mode the
