@@ -181,3 +181,22 @@ def test_refined_decimation_keeps_uvs_and_restores(ts, scene):
     select_only(obj)
     assert bpy.ops.topstoc.restore_samples(name="Last") == {"FINISHED"}
     assert output_geometry(bpy.data.objects["Knot_Last"]) == output_geometry(first)
+
+
+def test_a_fast_result_collapsed_after_a_stall_restores(ts, scene):
+    # A bumpy grid whose right half is flipped: fast mode's repairs stall on the orientation seam
+    # and half-edge collapses take the result to its target (docs/design.md §2.7); the saved set
+    # must replay those collapses, not quality mode's placed ones.
+    vertices, triangles = meshgen.grid(40, 40)
+    vertices[:, 2] = 2 * np.sin(vertices[:, 0] / 6) * np.cos(vertices[:, 1] / 7)
+    right = vertices[triangles].mean(axis=1)[:, 0] > 20
+    triangles[right] = triangles[right][:, ::-1]
+    obj = make_object("Seam", vertices, triangles)
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.05, seed=2, quality="FAST") == {"FINISHED"}
+    first = bpy.data.objects["Seam_TopStoc"]
+    assert len(first.data.vertices) <= 1.05 * 0.05 * len(vertices)  # the stalled pass kept nearly all
+    saved = obj.topstoc.sample_sets["Last"]
+    assert '"refine_keeps_positions": true' in saved.parameters
+    select_only(obj)
+    assert bpy.ops.topstoc.restore_samples(name="Last") == {"FINISHED"}
+    assert output_geometry(bpy.data.objects["Seam_Last"]) == output_geometry(first)
