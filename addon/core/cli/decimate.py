@@ -109,7 +109,7 @@ def attribute_report(requested: float, used: bool, args, data, appearance) -> di
         if requested == 0:
             report["unused_because"] = "--attribute-weight 0"
         elif not refines(args.mode, args.refine):
-            report["unused_because"] = f"{args.mode} mode without refinement (only the refinement weighs attributes)"
+            report["unused_because"] = f"{args.mode} mode (only the quality refinement weighs attributes)"
         elif data.corner_uvs is None and data.vertex_colors is None:
             report["unused_because"] = "the input has no UVs or vertex colours"
         else:
