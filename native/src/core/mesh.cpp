@@ -66,7 +66,6 @@ void sort_small(uint64_t* first, uint64_t* last) {
 // The arrays the first adjacency pass reads and writes (the Mesh's own, by reference).
 struct OneRingArrays {
   const Buffer<int32_t>& faces;
-  const Buffer<int32_t>& face_source;
   const Buffer<int32_t>& vertex_faces;
   const Buffer<int32_t>& vfo;
   const Buffer<double>& positions;
@@ -74,7 +73,6 @@ struct OneRingArrays {
   Buffer<int32_t>& degree;
   Buffer<int32_t>& greater;  // neighbours above the vertex
   Buffer<int32_t>& euler;    // the vertex's share of V - E + F
-  Buffer<int32_t>& first_corner;
   Buffer<uint8_t>& manifold_vertex;
   SharedUnionFind& sets;  // components: each set's root is its lowest vertex
 };
@@ -96,7 +94,6 @@ class OneRingScan {
     const int32_t first = a.vfo[v], k = a.vfo[v + 1] - first;
     a.manifold_vertex[v] = 1;
     if (k == 0) {  // isolated: no neighbours, in no component
-      a.first_corner[v] = -1;
       a.degree[v] = a.greater[v] = a.euler[v] = 0;
       return;
     }
@@ -134,7 +131,7 @@ class OneRingScan {
   std::vector<uint64_t> ends;  // (neighbour, 2 slot + (1 if the arc enters it))
   std::vector<int32_t> end_rank, in, out, next;
 
-  // Reads v's k faces: the first corner, the link's arc ends; counts the faces v is the lowest
+  // Reads v's k faces: the link's arc ends; counts the faces v is the lowest
   // vertex of (returned) and, among them, those of zero area.
   int32_t read_faces(int32_t v, int32_t first, int32_t k, int32_t& zero_area) {
     ends.resize(2 * size_t(k));
@@ -146,7 +143,6 @@ class OneRingScan {
     for (int32_t i = 0; i < k; ++i) {
       const int32_t* t = faces + 3 * size_t(vertex_faces[i]);
       const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-      if (i == 0) a.first_corner[v] = 3 * a.face_source[vertex_faces[0]] + c;
       const int32_t p = t[(c + 1) % 3], q = t[(c + 2) % 3];
       if (v < p && v < q) {
         ++lowest_of;
@@ -589,6 +585,14 @@ std::vector<int32_t> Mesh::caller_triangles() const {
   return out;
 }
 
+int32_t Mesh::first_corner(int32_t v) const {
+  const int32_t first = vertex_face_offsets_[v];
+  if (first == vertex_face_offsets_[v + 1]) return -1;
+  const int32_t f = vertex_faces_[first];
+  const int32_t* t = &faces_[3 * size_t(f)];
+  return 3 * face_source_[f] + (t[0] == v ? 0 : t[1] == v ? 1 : 2);
+}
+
 void Mesh::build_vertex_faces() {
   // Each vertex's faces in increasing order: a stable counting sort of the corners.
   vertex_faces_.resize(faces_.size());
@@ -615,10 +619,9 @@ void Mesh::build_adjacency(Progress& progress) {
   Buffer<int32_t> degree(n + 1), greater(n + 1), euler(n);
   degree[n] = greater[n] = 0;
   manifold_vertex_.resize(n);
-  first_corner_.resize(n);
   SharedUnionFind sets(n);
-  const OneRingArrays arrays{faces_, face_source_, vertex_faces_, vfo, positions_, scratch, degree, greater,
-                             euler, first_corner_, manifold_vertex_, sets};
+  const OneRingArrays arrays{faces_, vertex_faces_, vfo, positions_, scratch, degree, greater,
+                             euler, manifold_vertex_, sets};
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
   std::vector<std::pair<int32_t, std::vector<int32_t>>> overflow;
   // In slices of the vertices with a cancel point after each (the pass is seconds on 20M

@@ -108,7 +108,7 @@ int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Cl
       if (faces[3 * size_t(f) + j] == v) return 3 * mesh.face_source()[f] + j;
     return -1;
   };
-  if (layout.sectors[sample_vertex] <= 1) return mesh.first_corner()[sample_vertex];  // one side: any face will do
+  if (layout.sectors[sample_vertex] <= 1) return mesh.first_corner(sample_vertex);  // one side: any face will do
   const auto& efo = mesh.edge_face_offsets();  // (built on first use: only borders come here)
   const auto& ef = mesh.edge_faces();
   int32_t current = face;
@@ -207,12 +207,11 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
     return result;
   }
   // A sample with one sector has one corner to copy attributes from, whatever the triangle:
-  // the mesh's first corner of it (others walk per output corner, see attribute_corner).
-  // Looking the corner up here instead would be four reads far apart per corner (its first
-  // face, the face's corners, the caller's id).
+  // the mesh's first corner of it (others walk per output corner, see attribute_corner),
+  // looked up once per sample here rather than per output corner (four reads far apart).
   std::vector<int32_t> single_corner(k, -1);
   parallel_for(0, k, kParallelMinCostly, [&](int32_t s) {
-    if (output_index[s] >= 0 && layout.sectors[samples[s]] <= 1) single_corner[s] = mesh.first_corner()[samples[s]];
+    if (output_index[s] >= 0 && layout.sectors[samples[s]] <= 1) single_corner[s] = mesh.first_corner(samples[s]);
   });
   result.face_source.resize(t);
   result.corner_source.resize(3 * t);

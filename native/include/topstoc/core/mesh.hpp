@@ -77,9 +77,10 @@ class Mesh {
   // Faces around each vertex, CSR.
   const Buffer<int32_t>& vertex_face_offsets() const { return vertex_face_offsets_; }
   const Buffer<int32_t>& vertex_faces() const { return vertex_faces_; }
-  /// The caller's corner (3 x caller triangle + slot) of each vertex in its first face, -1 for
-  /// a vertex in no face: where an output vertex with one side takes its attributes from.
-  const Buffer<int32_t>& first_corner() const { return first_corner_; }
+  /// The caller's corner (3 x caller triangle + slot) of vertex v in its first face, -1 for a
+  /// vertex in no face: where an output vertex with one side takes its attributes from.
+  /// Looked up from the faces (a table of it was 4 bytes a vertex kept for a few reads).
+  int32_t first_corner(int32_t v) const;
   // Edges (lower id first), the faces of each edge (CSR) and the edge of each face side. These
   // tables (about a third of the mesh's memory) are built on first use, once, whichever thread
   // asks: a decimation of a closed mesh without borders never needs them.
@@ -147,7 +148,7 @@ class Mesh {
   int32_t num_vertices_ = 0;
   Buffer<double> positions_;
   Buffer<int32_t> faces_, face_source_, vertex_source_, vertex_index_;
-  Buffer<int32_t> vertex_face_offsets_, vertex_faces_, first_corner_;
+  Buffer<int32_t> vertex_face_offsets_, vertex_faces_;
   Buffer<int32_t> adjacency_offsets_, adjacency_;
   int32_t num_edges_ = 0;
   // Built on first use (ensure_edges).
