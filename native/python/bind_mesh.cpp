@@ -79,8 +79,15 @@ void bind_mesh(py::module_& m) {
                                return count;
                              })
       .def_property_readonly("num_curves", &FeatureLayout::num_curves)
-      .def_property_readonly("edge_feature", [](const FeatureLayout& l) { return copy_array(l.edge_feature); })
-      .def_property_readonly("vertex_feature", [](const FeatureLayout& l) { return copy_array(l.vertex_feature); });
+      // (Empty tables mean all zero: see features.hpp.)
+      .def_property_readonly("edge_feature",
+                             [](const FeatureLayout& l) {
+                               return copy_array(l.edge_feature.empty() ? std::vector<uint8_t>(l.num_edges, 0)
+                                                                        : l.edge_feature);
+                             })
+      .def_property_readonly("vertex_feature", [](const FeatureLayout& l) {
+        return copy_array(l.vertex_feature.empty() ? std::vector<uint8_t>(l.num_vertices, 0) : l.vertex_feature);
+      });
 
   m.def(
       "content_digest",

@@ -267,7 +267,7 @@ TEST_CASE("a check after relabelling feature vertices by hand finds what a check
     const auto& adj = mesh.adjacency();
     std::vector<int32_t> on_feature;
     for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-      if (kase.layout->vertex_feature[v]) on_feature.push_back(v);
+      if (kase.layout->is_feature_vertex(v)) on_feature.push_back(v);
     REQUIRE(on_feature.size() > 10);
     for (uint32_t seed = 1; seed <= 40; ++seed) {
       std::mt19937 random(seed);

@@ -49,7 +49,7 @@ void check_draws(const Mesh& mesh, const std::function<std::shared_ptr<const Fea
   const auto layout = make_layout();
   const int32_t n = mesh.num_vertices();
   int32_t corners = 0;
-  for (int32_t v = 0; v < n; ++v) corners += layout->vertex_corner[v];
+  for (int32_t v = 0; v < n; ++v) corners += layout->is_corner(v);
   std::vector<int32_t> targets;
   for (double f : {0.6, 0.3, 0.2, 0.1, 0.05, 0.02, 0.01, 0.003}) targets.push_back(std::max(1, int32_t(f * n)));
   targets.push_back(corners + 3);

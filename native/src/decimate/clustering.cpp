@@ -54,9 +54,8 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
   // Edge ids are read only at feature vertices and for cross edges: without either the mesh
   // need not build its edge tables.
   const int32_t* ae = cross_edges || layout.has_feature_vertices ? mesh.adjacency_edge().data() : nullptr;
-  const auto& edge_feature = layout.edge_feature;
   const auto& vertex_feature = layout.vertex_feature;
-  const bool has_features = layout.has_feature_vertices;  // else vertex_feature is all zero
+  const bool has_features = layout.has_feature_vertices;  // else vertex_feature is all zero (or empty)
   std::vector<uint8_t> queued(n, 0);
   const int threads = max_threads();
   PerThread<std::vector<int32_t>> next(threads), cross(threads);
@@ -110,7 +109,7 @@ void relax_levels(const Mesh& mesh, const FeatureLayout& layout, std::vector<int
         }
         if (candidate >= held) continue;
         // Feature vertices are entered only along feature edges.
-        if (has_features && vertex_feature[u] && !edge_feature[ae[j]]) continue;
+        if (has_features && vertex_feature[u] && !layout.is_feature_edge(ae[j])) continue;
         if (u < lo || u >= hi) {
           outbox.push_back({u, candidate});
         } else {
@@ -317,7 +316,7 @@ int32_t step_towards_sample(const Mesh& mesh, const FeatureLayout& layout, const
     const int32_t p = adj[j];
     if (c.label(p) != c.label(x) || c.dist(p) != c.dist(x) - 1) continue;
     // The fill could not come this way (edge ids are read at feature vertices only).
-    if (layout.vertex_feature[x] && !layout.edge_feature[mesh.adjacency_edge()[j]]) continue;
+    if (layout.is_feature_vertex(x) && !layout.is_feature_edge(mesh.adjacency_edge()[j])) continue;
     if (best < 0 || p < best) best = p;
   }
   return best;

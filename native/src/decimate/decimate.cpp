@@ -108,7 +108,7 @@ int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Cl
       if (faces[3 * size_t(f) + j] == v) return 3 * mesh.face_source()[f] + j;
     return -1;
   };
-  if (layout.sectors[sample_vertex] <= 1) return mesh.first_corner(sample_vertex);  // one side: any face will do
+  if (layout.sectors_of(mesh, sample_vertex) <= 1) return mesh.first_corner(sample_vertex);  // one side: any face will do
   const auto& efo = mesh.edge_face_offsets();  // (built on first use: only borders come here)
   const auto& ef = mesh.edge_faces();
   int32_t current = face;
@@ -211,7 +211,7 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   // looked up once per sample here rather than per output corner (four reads far apart).
   std::vector<int32_t> single_corner(k, -1);
   parallel_for(0, k, kParallelMinCostly, [&](int32_t s) {
-    if (output_index[s] >= 0 && layout.sectors[samples[s]] <= 1) single_corner[s] = mesh.first_corner(samples[s]);
+    if (output_index[s] >= 0 && layout.sectors_of(mesh, samples[s]) <= 1) single_corner[s] = mesh.first_corner(samples[s]);
   });
   result.face_source.resize(t);
   result.corner_source.resize(3 * t);
@@ -776,7 +776,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   // may have drawn every vertex, which says nothing about the budget).
   result.forced = 0;
   for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-    result.forced += layout.vertex_corner[v] || (!multipliers.empty() && multipliers[v] == kForcedMultiplier);
+    result.forced += layout.is_corner(v) || (!multipliers.empty() && multipliers[v] == kForcedMultiplier);
   return verified(mesh, layout, std::move(result));
 }
 
@@ -814,7 +814,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
   std::vector<uint8_t> listed(mesh.num_vertices(), 0);
   for (int32_t v : samples) listed[v] = 1;
   for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-    if (layout.vertex_corner[v] && !listed[v]) samples.push_back(v);
+    if (layout.is_corner(v) && !listed[v]) samples.push_back(v);
   DecimateResult result;
   result.target_vertices = static_cast<int32_t>(samples.size());
   result.selected = result.target_vertices;

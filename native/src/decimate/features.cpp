@@ -16,14 +16,20 @@ int32_t FeatureLayout::chi_of(const Mesh& mesh, int32_t v) const {
   if (!chi_constant.empty()) return chi_constant[v];
   const auto& ao = mesh.adjacency_offsets();
   const auto& vfo = mesh.vertex_face_offsets();
-  return 6 * sectors[v] - 3 * (ao[v + 1] - ao[v]) + 2 * (vfo[v + 1] - vfo[v]);  // one copy per edge
+  return 6 * sectors_of(mesh, v) - 3 * (ao[v + 1] - ao[v]) + 2 * (vfo[v + 1] - vfo[v]);  // one copy per edge
+}
+
+int32_t FeatureLayout::sectors_of(const Mesh& mesh, int32_t v) const {
+  if (!sectors.empty()) return sectors[v];
+  const auto& vfo = mesh.vertex_face_offsets();
+  return vfo[v + 1] > vfo[v] ? 1 : 0;
 }
 
 int32_t FeatureLayout::sector_of(const Mesh& mesh, int32_t v, int32_t f) const {
   const auto& vfo = mesh.vertex_face_offsets();
   const auto& vf = mesh.vertex_faces();
   for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i)
-    if (vf[i] == f) return sectors[v] <= 1 ? 0 : sector_of_slot[i];
+    if (vf[i] == f) return sectors_of(mesh, v) <= 1 ? 0 : sector_of_slot[i];
   return -1;
 }
 
@@ -32,7 +38,6 @@ namespace {
 void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t face_region_count,
                         const int32_t* flagged, int64_t num_flagged, double feature_angle, FeatureLayout& layout) {
   const int32_t num_edges = mesh.num_edges();
-  layout.edge_feature.assign(num_edges, 0);
   if (face_region && face_region_count != mesh.report().input_triangles)
     throw std::invalid_argument("face regions have " + std::to_string(face_region_count) +
                                 " entries, but the mesh has " + std::to_string(mesh.report().input_triangles) +
@@ -42,6 +47,7 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
   if (!face_region && num_flagged == 0 && feature_angle <= 0 && mesh.report().boundary_edges == 0 &&
       mesh.report().nonmanifold_edges == 0)
     return;
+  layout.edge_feature.assign(num_edges, 0);
   const auto& efo = mesh.edge_face_offsets();
   const auto& ef = mesh.edge_faces();
   const auto& source = mesh.face_source();
@@ -92,6 +98,7 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
   }
   for (int32_t e = 0; e < num_edges; ++e)
     if (layout.edge_feature[e]) layout.feature_edges.push_back(e);
+  if (layout.feature_edges.empty()) std::vector<uint8_t>().swap(layout.edge_feature);  // all zero: is_feature_edge
 }
 
 void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
@@ -101,6 +108,12 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   const int32_t* ae = featureless ? nullptr : mesh.adjacency_edge().data();
   const auto& vfo = mesh.vertex_face_offsets();
   layout.feature_degree.clear();
+  layout.sectors.clear(), layout.vertex_feature.clear(), layout.vertex_corner.clear();
+  const auto& manifold = mesh.manifold_vertex();
+  if (featureless && parallel_count<int32_t>(0, n, kParallelMin, [&](int32_t v) {
+        return vfo[v + 1] > vfo[v] && !manifold[v];
+      }) == 0)
+    return;  // one sector per vertex in faces, no feature vertex, no corner: the tables stay empty
   if (!featureless) layout.feature_degree.assign(n, 0);
   layout.sectors.assign(n, 0);
   // Sectors per face slot matter only where a vertex has more than one (see sector_of).
@@ -123,7 +136,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
         const int32_t e = ae[i];
         const int32_t c = layout.edge_copies(mesh, e);
         copies += c;
-        if (layout.edge_feature[e]) {
+        if (layout.is_feature_edge(e)) {
           ++degree;
           if (first_copies < 0) first_copies = c;
           same_copies = same_copies && c == first_copies;
@@ -132,7 +145,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
       // A manifold vertex without feature edges is one sector (slots stay 0); others need the fans.
       int32_t sectors = 1;
       if (degree > 0 || !mesh.manifold_vertex()[v]) {
-        sectors = vertex_fans(mesh, v, [&](int32_t e) { return layout.edge_feature[e] != 0; }, fan_of_slot);
+        sectors = vertex_fans(mesh, v, [&](int32_t e) { return layout.is_feature_edge(e); }, fan_of_slot);
         std::copy(fan_of_slot.begin(), fan_of_slot.end(), layout.sector_of_slot.begin() + vfo[v]);
       }
       if (!featureless) layout.feature_degree[v] = degree;
@@ -285,6 +298,8 @@ std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, cons
   auto layout = std::make_shared<FeatureLayout>();
   mark_feature_edges(mesh, face_region, face_region_count, flagged_edges, num_flagged_edges, feature_angle, *layout);
   compute_sectors_and_corners(mesh, *layout);
+  layout->num_vertices = mesh.num_vertices();
+  layout->num_edges = mesh.num_edges();
   layout->has_feature_vertices =
       std::find(layout->vertex_feature.begin(), layout->vertex_feature.end(), 1) != layout->vertex_feature.end();
   trace_curves(mesh, *layout);

@@ -597,7 +597,7 @@ class PartitionCheck {
     if (link.arcs == 0) {
       // No triangle: the neighbours absorbed this cluster (the pillow case) unless the sample
       // must stay. The Euler characteristic check confirms the topology either way.
-      if (required[samples[s]] || layout.vertex_corner[samples[s]]) {
+      if (required[samples[s]] || layout.is_corner(samples[s])) {
         ++lonely;
         marks.add(s);
       } else {
@@ -831,7 +831,7 @@ class PartitionCheck {
   void blame_non_disks(const std::vector<uint8_t>& failing) {
     const auto chi6 = cluster_euler6(mesh, layout, k, c);
     for (int32_t s = 0; s < k; ++s)
-      if (failing[mesh.component()[samples[s]]] && chi6[s] != 6 * int64_t(layout.sectors[samples[s]])) {
+      if (failing[mesh.component()[samples[s]]] && chi6[s] != 6 * int64_t(layout.sectors_of(mesh, samples[s]))) {
         ++out.issues.non_disk;
         out.split_clusters.push_back(s);
       }

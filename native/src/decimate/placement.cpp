@@ -53,7 +53,7 @@ std::vector<double> filtered_positions(const Mesh& mesh, const FeatureLayout& la
   parallel_for(0, k, kParallelMin, [&](int32_t s) {
     const double* p = at(samples[s]);
     double* x = &out[3 * size_t(s)];
-    if (layout.vertex_feature[samples[s]]) return;
+    if (layout.is_feature_vertex(samples[s])) return;
     double move[3];
     if (!quadrics[s].truncated_step(p, move)) return;
     const double len2 = move[0] * move[0] + move[1] * move[1] + move[2] * move[2];

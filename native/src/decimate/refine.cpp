@@ -247,7 +247,7 @@ void relocate_zero_area(const Mesh& mesh, const FeatureLayout& layout, const Ref
       if (!collapser.is_free(v)) continue;
       for (int32_t i = offsets[v]; i < offsets[v + 1]; ++i) {
         const int32_t w = members[i];
-        if (w == index[result.kept[v]] || layout.vertex_feature[w] || vfo[w] == vfo[w + 1]) continue;
+        if (w == index[result.kept[v]] || layout.is_feature_vertex(w) || vfo[w] == vfo[w + 1]) continue;
         if (params.multipliers && (*params.multipliers)[w] == 0.0) continue;
         if (!collapser.place(v, mesh.position(w), t)) continue;
         result.kept[v] = source[w];
@@ -347,13 +347,13 @@ class Refinement {
     for (int32_t i = 0; i < n; ++i) {
       const int32_t v = index[result.kept[i]];
       const double m = multiplier(v);
-      if (layout.vertex_feature[v]) setup.curve[i] = layout.curve_of(v);
+      if (layout.is_feature_vertex(v)) setup.curve[i] = layout.curve_of(v);
       const bool dead_end = !end_curve.empty() && end_curve[v] >= 0 && m != kForcedMultiplier;
       if (dead_end) setup.curve[i] = end_curve[v], setup.dead_end[i] = 1;
       if (setup.curve[i] >= 0) ++setup.curve_size[setup.curve[i]];
       // A curve vertex with one sector lies on a mesh boundary (a seam or crease has two).
-      setup.on_boundary[i] = setup.curve[i] >= 0 && layout.sectors[v] == 1;
-      setup.locked[i] = (layout.vertex_corner[v] && !dead_end) || (layout.vertex_feature[v] && setup.curve[i] < 0) ||
+      setup.on_boundary[i] = setup.curve[i] >= 0 && layout.sectors_of(mesh, v) == 1;
+      setup.locked[i] = (layout.is_corner(v) && !dead_end) || (layout.is_feature_vertex(v) && setup.curve[i] < 0) ||
                         m == kForcedMultiplier;
       if (m == kForcedMultiplier)  // a control point stays where the user put it
         for (int k = 0; k < 3; ++k) setup.world[3 * size_t(i) + k] = mesh.position(v)[k];
@@ -380,7 +380,7 @@ class Refinement {
         const int32_t v = vertices[end], e = mesh.find_edge(v, vertices[next]);
         if (layout.feature_degree[v] != 1 || e < 0) continue;
         const int32_t k = mesh.edge_face_count(e);
-        if (k >= 3 && 2 * layout.sectors[v] == k) end_curve[v] = c;
+        if (k >= 3 && 2 * layout.sectors_of(mesh, v) == k) end_curve[v] = c;
       }
     }
     return end_curve;
@@ -545,7 +545,7 @@ class Refinement {
     std::vector<int32_t> internal_face;
     for (size_t c = 0; c < setup.corner_sector.size(); ++c) {
       const int32_t vertex = index[result.kept[result.triangles[c]]];
-      if (layout.sectors[vertex] <= 1) continue;
+      if (layout.sectors_of(mesh, vertex) <= 1) continue;
       if (internal_face.empty()) {
         internal_face.assign(mesh.report().input_triangles, -1);
         for (int32_t f = 0; f < mesh.num_faces(); ++f) internal_face[mesh.face_source()[f]] = f;

@@ -30,8 +30,8 @@ std::vector<uint8_t> classify(const Mesh& mesh, const FeatureLayout& layout) {
   std::vector<uint8_t> cls(n);
   for (int32_t v = 0; v < n; ++v)
     cls[v] = vfo[v] == vfo[v + 1] ? kIsolated
-             : layout.vertex_corner[v] ? kCorner
-             : layout.vertex_feature[v] ? kCurve
+             : layout.is_corner(v) ? kCorner
+             : layout.is_feature_vertex(v) ? kCurve
                                         : kSurface;
   return cls;
 }
@@ -429,7 +429,6 @@ std::vector<int32_t> select_with_density(const Mesh& mesh, const FeatureLayout& 
   const int32_t eps_big = params.density_rings > 0 ? params.density_rings : std::max(2, int32_t(std::lround(1.25 * r)));
   const int32_t eps_small = std::max(1, int32_t(eps_big / std::max(1.0, params.density_ratio)));
   const double eps_euclid = params.density_epsilon > 0 ? params.density_epsilon : r * mean_edge_length(mesh);
-  const auto& feature = layout.vertex_feature;
   const auto& ae = mesh.adjacency_edge();
 
   std::vector<uint8_t> blocked(n, 0);
@@ -454,8 +453,8 @@ std::vector<int32_t> select_with_density(const Mesh& mesh, const FeatureLayout& 
                               (pu[2] - ps[2]) * (pu[2] - ps[2]);
             if (d2 > eps_euclid * eps_euclid) return false;
           }
-          if (surface) return !feature[u];
-          return feature[u] ? layout.edge_feature[ae[slot]] != 0 : true;
+          if (surface) return !layout.is_feature_vertex(u);
+          return layout.is_feature_vertex(u) ? layout.is_feature_edge(ae[slot]) : true;
         },
         [&](int32_t v) { blocked[v] = 1; });
   };

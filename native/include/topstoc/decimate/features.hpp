@@ -43,18 +43,24 @@ class DerivedTable {
 
 struct FeatureLayout {
   uint64_t serial = new_serial();       ///< no other layout of this process has it (for caches)
-  std::vector<uint8_t> edge_feature;    ///< per edge: 1 if no cluster may cross it
+  /// Per edge: 1 if no cluster may cross it; empty without feature edges (use is_feature_edge).
+  std::vector<uint8_t> edge_feature;
   std::vector<int32_t> feature_edges;   ///< ids of the feature edges
   /// Per vertex: number of feature edges; empty without feature edges (then there are no curves,
   /// whose ends are what reads it).
   std::vector<int32_t> feature_degree;
-  std::vector<int32_t> sectors;         ///< per vertex: fans once feature edges are cut
+  /// Per vertex: fans once feature edges are cut. Empty, as are vertex_feature and
+  /// vertex_corner, on a mesh without feature edges whose vertices are all manifold (one sector
+  /// each, none on a feature, no corner: 4.5 bytes a triangle of a large closed scan not kept);
+  /// read them with sectors_of, is_feature_vertex and is_corner.
+  std::vector<int32_t> sectors;
   /// Per slot of mesh.vertex_faces(): sector of that face. Empty when every vertex is one sector
   /// (a manifold mesh without feature edges); use sector_of().
   std::vector<int32_t> sector_of_slot;
-  std::vector<uint8_t> vertex_feature;  ///< per vertex: on a feature curve, or a corner
+  std::vector<uint8_t> vertex_feature;  ///< per vertex: on a feature curve, or a corner (or empty)
   bool has_feature_vertices = false;    ///< any vertex_feature set (else no edge ids are needed)
-  std::vector<uint8_t> vertex_corner;   ///< per vertex: always kept
+  std::vector<uint8_t> vertex_corner;   ///< per vertex: always kept (or empty)
+  int32_t num_vertices = 0, num_edges = 0;  ///< of the mesh the layout was built on
   /// Curves: open segments run from corner to corner (both included); closed loops hold only
   /// curve vertices (start not repeated).
   std::vector<int32_t> curve_offsets{0};
@@ -87,10 +93,15 @@ struct FeatureLayout {
   int32_t crease_edges = 0;
 
   int32_t num_curves() const { return static_cast<int32_t>(curve_closed.size()); }
+  bool is_feature_edge(int32_t e) const { return !edge_feature.empty() && edge_feature[e]; }
+  bool is_feature_vertex(int32_t v) const { return !vertex_feature.empty() && vertex_feature[v]; }
+  bool is_corner(int32_t v) const { return !vertex_corner.empty() && vertex_corner[v]; }
+  /// sectors[v], or where that table is empty 1 for a vertex in faces and 0 for an isolated one.
+  int32_t sectors_of(const Mesh& mesh, int32_t v) const;
   /// The curve of vertex v, -1 for none.
   int32_t curve_of(int32_t v) const { return vertex_curve.empty() ? -1 : vertex_curve[v]; }
   /// Copies of edge e in the mesh cut along the feature edges.
-  int32_t edge_copies(const Mesh& mesh, int32_t e) const { return edge_feature[e] ? mesh.edge_face_count(e) : 1; }
+  int32_t edge_copies(const Mesh& mesh, int32_t e) const { return is_feature_edge(e) ? mesh.edge_face_count(e) : 1; }
   /// chi_constant of vertex v.
   int32_t chi_of(const Mesh& mesh, int32_t v) const;
   /// Sector of face f at vertex v (f must contain v).
