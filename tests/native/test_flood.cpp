@@ -1,7 +1,7 @@
 // Clustering: flood() against the definition (each vertex joins the sample of least
 // (hop distance, rank), by a breadth-first search per sample), and flood_add() against flood()
 // on the whole sample list, and flood_update() against flood() on the new list, as
-// clustering.hpp promises.
+// clustering.hpp promises; and flood_drop_tail() against flood() on the samples it keeps.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -224,4 +224,47 @@ TEST_CASE("flood_update refuses lists that are not increasing vertex ids") {
   flood(mesh, *layout, {1, 5, 9}, c);
   CHECK_THROWS_AS(flood_update(mesh, *layout, {1, 5, 9}, {9, 5}, c), std::invalid_argument);
   CHECK_THROWS_AS(flood_update(mesh, *layout, {1, 5, 9}, {1, 1000}, c), std::invalid_argument);
+}
+
+namespace {
+
+// A draw (increasing vertex ids) followed by repair samples appended in any order, as a
+// decimation makes them: dropping the appended ones gives exactly the flood of the draw.
+void check_drop_tail(const Mesh& mesh, const FeatureLayout& layout, std::mt19937& random) {
+  const int32_t n = mesh.num_vertices();
+  for (int round = 0; round < 6; ++round) {
+    std::vector<int32_t> all = topstoc_test::random_samples(n, std::max(2, n / (8 + 4 * round)), random);
+    const int32_t drawn = std::max<int32_t>(1, int32_t(all.size()) * (round + 1) / 8);
+    std::sort(all.begin(), all.begin() + drawn);
+    std::vector<int32_t> draw(all.begin(), all.begin() + drawn);
+    Clustering fresh, repaired;
+    flood(mesh, layout, draw, fresh);
+    flood(mesh, layout, draw, repaired);
+    flood_add(mesh, layout, all, drawn, repaired);
+    flood_drop_tail(mesh, layout, drawn, int32_t(all.size()), repaired);
+    CHECK(repaired.key == fresh.key);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("flood_drop_tail gives back exactly the flood of the samples before the appended ones") {
+  std::mt19937 random(31);
+  SUBCASE("torus, no features") {
+    const Mesh mesh = make_mesh(topstoc_test::torus(20, 11));
+    check_drop_tail(mesh, *no_features(mesh), random);
+  }
+  SUBCASE("grid with a boundary, a border curve across it") {
+    const Mesh mesh = make_mesh(topstoc_test::grid(14, 10));
+    check_drop_tail(mesh, *column_border(mesh), random);
+  }
+  SUBCASE("a mesh with holes (tests/data): boundary curves") {
+    const MeshFile file = read_mesh_path(TOPSTOC_TEST_DATA "/open_boundary/cgal_elephant-with-holes.off");
+    const Mesh mesh(file.vertices, file.triangles.data(), file.num_triangles());
+    check_drop_tail(mesh, *no_features(mesh), random);
+  }
+  const Mesh mesh = make_mesh(topstoc_test::torus(8, 6));
+  Clustering c;
+  flood(mesh, *no_features(mesh), {1, 5, 9}, c);
+  CHECK_THROWS_AS(flood_drop_tail(mesh, *no_features(mesh), 4, 3, c), std::invalid_argument);
 }

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -223,32 +224,14 @@ void seed_and_relax(const Mesh& mesh, const FeatureLayout& layout, const std::ve
   relax_levels(mesh, layout, std::move(frontier), 0, key, cross_edges, changed);
 }
 
-}  // namespace
-
-void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& old_samples,
-                  const std::vector<int32_t>& samples, Clustering& c, std::vector<int32_t>* changed,
-                  std::vector<int32_t>* new_rank_out) {
+// Kept clusters take their new ranks (new_rank[old rank], -1: removed); the vertices of removed
+// ones are emptied and refilled from around them, with the added samples `frontier` (ranks
+// added_rank) relaxing outwards: what flood() gives for the new list.
+void rerank_and_refill(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& new_rank,
+                       std::vector<int32_t> frontier, const std::vector<int32_t>& added_rank, Clustering& c,
+                       std::vector<int32_t>* changed) {
   const int32_t n = mesh.num_vertices();
   std::vector<uint64_t>& key = c.key;
-  if (int32_t(key.size()) != n) throw std::invalid_argument("flood_update: the clustering is not one of this mesh");
-  for (const auto* list : {&old_samples, &samples})
-    for (size_t i = 0; i < list->size(); ++i)
-      if ((*list)[i] < 0 || (*list)[i] >= n || (i > 0 && (*list)[i] <= (*list)[i - 1]))
-        throw std::invalid_argument("flood_update: sample lists must be increasing vertex ids of the mesh");
-  // Both lists are sorted, so the samples in both keep their order: their new ranks compare as
-  // the old ones did, and every key of a kept cluster stays what flood() would give it.
-  std::vector<int32_t> new_rank(old_samples.size(), -1), frontier, added_rank;
-  for (size_t i = 0, j = 0; i < old_samples.size() || j < samples.size();) {
-    if (j == samples.size() || (i < old_samples.size() && old_samples[i] < samples[j])) {
-      ++i;  // removed
-    } else if (i == old_samples.size() || samples[j] < old_samples[i]) {
-      frontier.push_back(samples[j]);  // added
-      added_rank.push_back(int32_t(j++));
-    } else {
-      new_rank[i++] = int32_t(j++);
-    }
-  }
-  // Kept clusters take their new ranks; the vertices of removed ones are emptied (unreached).
   const int threads = max_threads();
   PerThread<std::vector<int32_t>> emptied_by_thread(threads);
   parallel_region(team_for(n, kParallelMin), [&](Team& team) {
@@ -294,7 +277,44 @@ void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vect
       [&](int64_t i, int32_t at) { seeds[at] = found[i]; }, level_start);
   for (size_t i = 0; i < frontier.size(); ++i) key[frontier[i]] = cluster_key(0, added_rank[i]);
   relax_levels(mesh, layout, std::move(frontier), 0, key, nullptr, changed, seeds);
+}
+
+}  // namespace
+
+void flood_update(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& old_samples,
+                  const std::vector<int32_t>& samples, Clustering& c, std::vector<int32_t>* changed,
+                  std::vector<int32_t>* new_rank_out) {
+  const int32_t n = mesh.num_vertices();
+  std::vector<uint64_t>& key = c.key;
+  if (int32_t(key.size()) != n) throw std::invalid_argument("flood_update: the clustering is not one of this mesh");
+  for (const auto* list : {&old_samples, &samples})
+    for (size_t i = 0; i < list->size(); ++i)
+      if ((*list)[i] < 0 || (*list)[i] >= n || (i > 0 && (*list)[i] <= (*list)[i - 1]))
+        throw std::invalid_argument("flood_update: sample lists must be increasing vertex ids of the mesh");
+  // Both lists are sorted, so the samples in both keep their order: their new ranks compare as
+  // the old ones did, and every key of a kept cluster stays what flood() would give it.
+  std::vector<int32_t> new_rank(old_samples.size(), -1), frontier, added_rank;
+  for (size_t i = 0, j = 0; i < old_samples.size() || j < samples.size();) {
+    if (j == samples.size() || (i < old_samples.size() && old_samples[i] < samples[j])) {
+      ++i;  // removed
+    } else if (i == old_samples.size() || samples[j] < old_samples[i]) {
+      frontier.push_back(samples[j]);  // added
+      added_rank.push_back(int32_t(j++));
+    } else {
+      new_rank[i++] = int32_t(j++);
+    }
+  }
+  rerank_and_refill(mesh, layout, new_rank, std::move(frontier), added_rank, c, changed);
   if (new_rank_out) *new_rank_out = std::move(new_rank);
+}
+
+void flood_drop_tail(const Mesh& mesh, const FeatureLayout& layout, int32_t keep, int32_t count, Clustering& c) {
+  if (int32_t(c.key.size()) != mesh.num_vertices() || keep < 0 || keep > count)
+    throw std::invalid_argument("flood_drop_tail: the clustering is not one of this mesh");
+  if (keep == count) return;
+  std::vector<int32_t> new_rank(count, -1);
+  std::iota(new_rank.begin(), new_rank.begin() + keep, 0);
+  rerank_and_refill(mesh, layout, new_rank, {}, {}, c, nullptr);
 }
 
 void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples, Clustering& out,

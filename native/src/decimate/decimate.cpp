@@ -130,9 +130,11 @@ int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Cl
   return corner_of(current, sample_vertex);
 }
 
+// The output from the final clustering; relabelled (if given) receives each vertex whose
+// cluster was absorbed, with its key before it joined a neighbouring one.
 DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                       Clustering& clustering, const Partition& partition, Placement placement, bool draft,
-                      DecimateResult result) {
+                      DecimateResult result, std::vector<std::pair<int32_t, uint64_t>>* relabelled) {
   const auto start = Clock::now();
   const int32_t k = static_cast<int32_t>(samples.size());
   // Output vertices: the samples that carry triangles, in sample order.
@@ -173,6 +175,7 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
         if (l >= 0 && !partition.absorbed[l] && (best < 0 || l < best)) best = l;
       }
       if (best >= 0) {
+        if (relabelled) relabelled->push_back({v, clustering.key[v]});
         clustering.relabel(v, best);
         changed = true;
       }
@@ -301,7 +304,12 @@ class ClusterRun {
       result.issues_remaining.sliver = partition.issues.sliver;
     result.seconds_checking = seconds_since(start);
     check_cancelled("output");
-    return finish(mesh, layout, std::move(samples), clustering, partition, placement, draft, std::move(result));
+    std::vector<std::pair<int32_t, uint64_t>> relabelled;
+    const int32_t drawn = keeper ? int32_t(keeper->samples.size()) : 0, count = int32_t(samples.size());
+    DecimateResult out = finish(mesh, layout, std::move(samples), clustering, partition, placement, draft,
+                                std::move(result), keeper ? &relabelled : nullptr);
+    if (keeper) hand_flood_to_cache(relabelled, drawn, count);
+    return out;
   }
 
  private:
@@ -313,6 +321,7 @@ class ClusterRun {
   const std::vector<uint8_t>& required;
   const int32_t top_up_to;
   FloodCache* cache;  // until the first check is handed to it
+  FloodCache* keeper = nullptr;  // the cache that takes the flood of the draw once the output is made
   std::vector<int32_t> samples;
   DecimateResult result;
   Clustering clustering;
@@ -343,7 +352,8 @@ class ClusterRun {
     std::vector<int32_t> new_rank;
     flood_update(mesh, layout, cache->samples, samples, cache->clustering, &checked.changed, &new_rank);
     cache->samples = samples;
-    clustering = cache->clustering;
+    clustering = std::move(cache->clustering);  // given back at the end (hand_flood_to_cache)
+    keeper = cache;
     checked.renumber(new_rank, int32_t(samples.size()));
     if (!checked.valid) checked.changed.clear();  // every face is tested
     result.flood_updated = true;
@@ -355,8 +365,23 @@ class ClusterRun {
     cache->mesh = mesh.serial();
     cache->layout = layout.serial;
     cache->samples = samples;
-    cache->clustering = clustering;
+    cache->clustering = Clustering();  // the flood of the draw is handed over at the end
     cache->first_check = CheckState();
+    keeper = cache;
+  }
+
+  // The cache keeps the flood of the draw: the output made, the working state goes, the absorbed
+  // clusters' vertices take back their keys and the samples the repairs and top-ups appended are
+  // dropped (flood_drop_tail), which gives exactly the flood of the draw without a copy of it
+  // alongside the decimation's working set (4 bytes a triangle of its peak).
+  void hand_flood_to_cache(const std::vector<std::pair<int32_t, uint64_t>>& relabelled, int32_t drawn,
+                           int32_t count) {
+    partition = Partition();
+    checked = CheckState();
+    snapshot = Snapshot();
+    for (auto it = relabelled.rbegin(); it != relabelled.rend(); ++it) clustering.key[it->first] = it->second;
+    flood_drop_tail(mesh, layout, drawn, count, clustering);
+    keeper->clustering = std::move(clustering);
   }
 
   // One round's partition check; the first check goes to the cache too.

@@ -41,6 +41,12 @@ inline uint64_t cluster_key(int32_t dist, int32_t rank) { return (uint64_t(uint3
 void flood(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& samples, Clustering& out,
            std::vector<int32_t>* cross_edges = nullptr);
 
+/// Turns a clustering of `count` samples (ranks 0..count) into exactly what flood() gives for
+/// the first `keep` of them: the clusters of the others are emptied and refilled from around
+/// them. A decimation's repairs append samples to its draw: dropping them gives back the flood
+/// of the draw, which is what a later decimation at a nearby target starts from.
+void flood_drop_tail(const Mesh& mesh, const FeatureLayout& layout, int32_t keep, int32_t count, Clustering& c);
+
 /// One step from x towards its sample: the lowest-id neighbour in the same cluster one hop
 /// closer that the fill could have come from (-1 for a sample).
 int32_t step_towards_sample(const Mesh& mesh, const FeatureLayout& layout, const Clustering& clustering, int32_t x);
