@@ -254,28 +254,6 @@ void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offse
   release_unused(lists);
 }
 
-// The importance weight, from the neighbours' normals.
-void weigh(const Buffer<int32_t>& offsets, const Buffer<int32_t>& adjacency, const Buffer<double>& normals,
-           Buffer<double>& weights) {
-  const int32_t n = int32_t(offsets.size()) - 1;
-  parallel_for(0, n, kParallelMin, [&](int32_t v) {
-    const int32_t d = offsets[v + 1] - offsets[v];
-    if (d == 0) {
-      weights[v] = 0.0;
-      return;
-    }
-    const int32_t* neighbours = adjacency.data() + offsets[v];
-    // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
-    const double* nv = &normals[3 * size_t(v)];
-    double dots = 0.0;
-    for (int32_t r = 0; r < d; ++r) {
-      const double* nu = &normals[3 * size_t(neighbours[r])];
-      dots += nv[0] * nu[0] + nv[1] * nu[1] + nv[2] * nu[2];
-    }
-    weights[v] = std::clamp((double(d) - dots) / (2.0 * double(d)), 0.0, 1.0);
-  });
-}
-
 // Components, numbered in order of their lowest vertex (each set's root), and the Euler
 // characteristic V - E + F of each from every vertex's share: itself, the edges to its higher
 // neighbours and the faces it is the lowest vertex of. Returns how many; `root` is scratch.
@@ -656,13 +634,8 @@ void Mesh::build_adjacency(Progress& progress) {
   decltype(overflow)().swap(overflow);
   adjacency_.swap(scratch);
 
-  // The normals after the pass, not in it: then they never take memory alongside its buffer.
   progress.stage("normals and weights", 0.8, 0.92);
-  fill_normals();
-  progress.update(0.5);
-  weights_.resize(n);
-  weigh(adjacency_offsets_, adjacency_, normals_, weights_);
-  Buffer<double>().swap(normals_);  // 24 bytes a vertex that only view guidance reads again: rebuilt then
+  weigh();
   progress.stage("components", 0.92, 1.0);
   Buffer<int32_t>& root = greater;  // its offsets are no longer needed
   report_.components = number_components(sets, vfo, euler, root, component_, component_euler_);
@@ -671,22 +644,64 @@ void Mesh::build_adjacency(Progress& progress) {
 
 // Area-weighted: the unnormalised face normals (twice the areas) summed at each vertex, in the
 // order of its faces, then normalised.
+void Mesh::normal_at(int32_t v, double* out) const {
+  const auto& vfo = vertex_face_offsets_;
+  double sum[3] = {0, 0, 0};
+  for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
+    const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
+    double fn[3];
+    cross(position(t[0]), position(t[1]), position(t[2]), fn);
+    sum[0] += fn[0];
+    sum[1] += fn[1];
+    sum[2] += fn[2];
+  }
+  unit_normal(sum, out);
+}
+
 void Mesh::fill_normals() const {
   const int32_t n = num_vertices_;
-  const auto& vfo = vertex_face_offsets_;
   normals_.resize(3 * size_t(n));
-  parallel_for(0, n, kParallelMin, [&](int32_t v) {
-    double sum[3] = {0, 0, 0};
-    for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-      const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
-      double fn[3];
-      cross(position(t[0]), position(t[1]), position(t[2]), fn);
-      sum[0] += fn[0];
-      sum[1] += fn[1];
-      sum[2] += fn[2];
-    }
-    unit_normal(sum, &normals_[3 * size_t(v)]);
-  });
+  parallel_for(0, n, kParallelMin, [&](int32_t v) { normal_at(v, &normals_[3 * size_t(v)]); });
+}
+
+// The importance weight of thesis eq. 4.1 from the neighbours' normals, without a normal per
+// vertex (24 bytes a vertex, which made this step the preparation's peak): vertices are weighed a
+// block at a time with the normals of the block and of one block on either side in a ring (ids
+// follow a space-filling curve, so nearly every neighbour is there); a neighbour outside has its
+// normal computed where read, to the same bits.
+void Mesh::weigh() {
+  constexpr int32_t kBlock = 1 << 14;
+  const int32_t n = num_vertices_;
+  const int64_t span = 3 * int64_t(kBlock);  // the ring holds ids [b - kBlock, b + 2 kBlock)
+  std::vector<double> ring(3 * size_t(std::min<int64_t>(span, n)));
+  auto slot = [&](int32_t v) { return &ring[3 * size_t(v % span)]; };
+  auto compute = [&](int32_t from, int32_t to) {
+    parallel_for(from, to, kParallelMinCostly, [&](int32_t v) { normal_at(v, slot(v)); });
+  };
+  weights_.resize(n);
+  compute(0, int32_t(std::min<int64_t>(n, 2 * int64_t(kBlock))));
+  for (int32_t b = 0; b < n; b += kBlock) {
+    const int32_t end = int32_t(std::min<int64_t>(n, int64_t(b) + kBlock));
+    const int64_t low = int64_t(b) - kBlock, high = std::min<int64_t>(n, int64_t(b) + 2 * kBlock);
+    if (b > 0 && high > int64_t(b) + kBlock) compute(b + kBlock, int32_t(high));  // the block after this one
+    parallel_for(b, end, kParallelMinCostly, [&](int32_t v) {
+      const int32_t d = adjacency_offsets_[v + 1] - adjacency_offsets_[v];
+      if (d == 0) {
+        weights_[v] = 0.0;
+        return;
+      }
+      const int32_t* neighbours = adjacency_.data() + adjacency_offsets_[v];
+      // Thesis eq. 4.1: x(v) = (|N_v| - sum_u n_v . n_u) / (2 |N_v|), the one-ring normal deviation.
+      const double* nv = slot(v);
+      double dots = 0.0, far[3];
+      for (int32_t r = 0; r < d; ++r) {
+        const int32_t u = neighbours[r];
+        const double* nu = u >= low && u < high ? slot(u) : (normal_at(u, far), far);
+        dots += nv[0] * nu[0] + nv[1] * nu[1] + nv[2] * nu[2];
+      }
+      weights_[v] = std::clamp((double(d) - dots) / (2.0 * double(d)), 0.0, 1.0);
+    });
+  }
 }
 
 void Mesh::build_normals() const {

@@ -139,6 +139,10 @@ class Mesh {
   }
   void build_normals() const;
   void fill_normals() const;
+  /// The unit area-weighted normal of v, as normals() holds it.
+  void normal_at(int32_t v, double* out) const;
+  /// The importance weights from the normals, computed a window of vertices at a time.
+  void weigh();
   void ensure_vertex_areas() const {
     if (!areas_built_.load(std::memory_order_acquire)) build_vertex_areas();
   }
