@@ -232,7 +232,10 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   const auto& source = mesh.vertex_source();
   result.labels.resize(clustering.key.size());
   const int64_t n = int64_t(clustering.key.size());
-  parallel_for(0, n, kParallelMin, [&](int64_t v) { result.labels[source[v]] = label(v) >= 0 ? output_index[label(v)] : -1; });
+  const bool in_mesh_order = result.labels_in_mesh_order;
+  parallel_for(0, n, kParallelMin, [&](int64_t v) {
+    result.labels[in_mesh_order ? v : source[v]] = label(v) >= 0 ? output_index[label(v)] : -1;
+  });
   publish_ids();
   return result;
 }
@@ -630,6 +633,7 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
   const auto start = Clock::now();
   SampleSet set = select_samples(mesh, layout, params.sampling, target);
   DecimateResult result;
+  result.labels_in_mesh_order = params.labels_in_mesh_order;
   result.target_vertices = params.target_vertices;
   result.selected = static_cast<int32_t>(set.samples.size());
   result.forced = set.forced;
@@ -784,6 +788,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   DecimateParams first = params;
   first.refine = 0.0;
   first.placement = Placement::Subsample;  // the refinement places the vertices it keeps
+  first.labels_in_mesh_order = true;        // what the refinement reads (no copy in its order)
   first.target_vertices = first_pass_vertices(params, active);
   DecimateResult result = stochastic_pass(mesh, layout, first, true);
   const std::vector<double> multipliers = multipliers_if_guided(mesh, params.sampling);

@@ -299,8 +299,15 @@ class Refinement {
     const auto frame = quadric_frame(mesh, layout);
     for (int i = 0; i < 3; ++i) setup.center[i] = frame->center[i];
     setup.extent = frame->extent;
-    label.resize(num_input);
-    parallel_for(0, num_input, kParallelMin, [&](int32_t v) { label[v] = result.labels[source[v]]; });
+    // The labels in the mesh's order: taken as they are from a refined decimation's first pass,
+    // else gathered; the caller's are published from them at the end (publish_labels).
+    if (result.labels_in_mesh_order) {
+      label = std::move(result.labels);
+    } else {
+      label.resize(num_input);
+      parallel_for(0, num_input, kParallelMin, [&](int32_t v) { label[v] = result.labels[source[v]]; });
+    }
+    std::vector<int32_t>().swap(result.labels);
     setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *frame);
     set_up_vertices(setup);
     lock_inconsistent(setup);
@@ -312,11 +319,12 @@ class Refinement {
     const double center[3] = {setup.center[0], setup.center[1], setup.center[2]}, extent = setup.extent;
     if (params.max_aware && n == num_input - mesh.report().isolated_vertices) {
       collapse_max_aware(std::move(setup), center, extent);
-      return;
+    } else {
+      Collapser collapser(result.triangles, result.corner_source, std::move(setup));
+      collapse(collapser, center, extent);
+      finish(collapser);
     }
-    Collapser collapser(result.triangles, result.corner_source, std::move(setup));
-    collapse(collapser, center, extent);
-    finish(collapser);
+    publish_labels();
   }
 
  private:
@@ -327,6 +335,19 @@ class Refinement {
   const int32_t n, num_input;
   const bool guided;
   std::vector<int32_t> label;  // per input vertex: its output vertex
+  std::vector<int32_t> final_index;  // per output vertex of the first pass: its vertex in the result
+
+  // The caller's labels from the mesh-order ones, once the collapser is gone (the two tables
+  // then never sit beside it).
+  void publish_labels() {
+    const auto& source = mesh.vertex_source();
+    result.labels.resize(num_input);
+    parallel_for(0, num_input, kParallelMin, [&](int32_t v) {
+      result.labels[source[v]] = label[v] >= 0 ? final_index[label[v]] : -1;
+    });
+    std::vector<int32_t>().swap(label);
+    result.labels_in_mesh_order = false;
+  }
 
   double multiplier(int32_t v) const { return guided ? (*params.multipliers)[v] : 1.0; }
 
@@ -634,12 +655,8 @@ class Refinement {
     result.triangles.resize(3 * faces);
     result.corner_source.resize(3 * faces);
     result.face_source.resize(faces);
-    std::vector<int32_t> final_index(n);
+    final_index.resize(n);
     for (int32_t v = 0; v < n; ++v) final_index[v] = new_index[collapser.survivor(v)];
-    const int64_t labels = int64_t(result.labels.size());
-    parallel_for(0, labels, kParallelMin, [&](int64_t i) {
-      if (result.labels[i] >= 0) result.labels[i] = final_index[result.labels[i]];
-    });
   }
 };
 

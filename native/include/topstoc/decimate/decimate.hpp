@@ -66,6 +66,8 @@ struct DecimateParams {
   /// run as always, so the mesh is the one a full decimation gives; output_checked tells that
   /// it was not re-checked. A frame takes about three quarters of a full decimation's time.
   bool draft = false;
+  /// Internal (a refined decimation's first pass): labels in the mesh's vertex order.
+  bool labels_in_mesh_order = false;
 };
 
 struct DecimateResult {
@@ -77,6 +79,9 @@ struct DecimateResult {
   std::vector<int32_t> face_source;    ///< caller's triangle each output triangle comes from
   std::vector<int32_t> corner_source;  ///< 3 per output triangle: caller's corner 3 * triangle + slot
   std::vector<int32_t> labels;         ///< per input vertex: output vertex of its cluster, -1 if none
+  /// Internal: labels are in the mesh's vertex order, not the caller's (a refined decimation's
+  /// first pass, whose labels the refinement reads in that order and publishes in the caller's).
+  bool labels_in_mesh_order = false;
   int32_t target_vertices = 0;
   int32_t selected = 0;                ///< samples drawn before repairs
   int32_t forced = 0;                  ///< corners and control points among them
