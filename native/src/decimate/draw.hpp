@@ -24,33 +24,44 @@ struct Candidate {
   bool operator<(const Candidate& o) const { return key < o.key || (key == o.key && vertex < o.vertex); }
 };
 
-// Values sorted ascending and the running sum of their terms (the value, or its square root),
-// kept at every kStride-th entry only: sum_before(s) adds the few terms after the last kept
-// sum in the same order as a full running sum would, so it gives the same bits with n / 64
-// doubles instead of n (the full sums were a twentieth of a large decimation's peak).
+// Vertices in ascending order of a value computed where read (value(v), the importance), and
+// the running sum of their terms (the value, or its square root), kept at every kStride-th
+// entry only: sum_before(s) adds the few terms after the last kept sum in the same order as a
+// full running sum would, so it gives the same bits with n / 64 doubles instead of n (the full
+// sums were a twentieth of a large decimation's peak). Vertex ids instead of the sorted values
+// themselves: 4 bytes a vertex instead of 8 kept on the layout.
 struct SortedSums {
   static constexpr size_t kStride = 64;
-  std::vector<double> values;
+  std::vector<int32_t> ids;
   bool root = false;  // terms are sqrt(value)
   std::vector<double> kept;  // kept[j]: the sum of the terms before entry j * kStride
 
-  double term(size_t i) const { return root ? std::sqrt(values[i]) : values[i]; }
-  void sum_up() {
-    kept.assign(values.size() / kStride + 1, 0.0);
+  size_t size() const { return ids.size(); }
+  template <class Value>
+  double term(const Value& value, size_t i) const {
+    return root ? std::sqrt(value(ids[i])) : value(ids[i]);
+  }
+  template <class Value>
+  void sum_up(const Value& value) {
+    kept.assign(ids.size() / kStride + 1, 0.0);
     double sum = 0.0;
-    for (size_t i = 0; i < values.size(); ++i) {
-      sum += term(i);
+    for (size_t i = 0; i < ids.size(); ++i) {
+      sum += term(value, i);
       if ((i + 1) % kStride == 0) kept[(i + 1) / kStride] = sum;
     }
   }
-  /// The sum of the terms of entries 0..s-1 (0 <= s <= values.size()).
-  double sum_before(size_t s) const {
+  /// The sum of the terms of entries 0..s-1 (0 <= s <= size()).
+  template <class Value>
+  double sum_before(const Value& value, size_t s) const {
     double sum = kept[s / kStride];
-    for (size_t i = s / kStride * kStride; i < s; ++i) sum += term(i);
+    for (size_t i = s / kStride * kStride; i < s; ++i) sum += term(value, i);
     return sum;
   }
   /// How many values lie below `limit`.
-  size_t count_below(double limit) const { return std::lower_bound(values.begin(), values.end(), limit) - values.begin(); }
+  template <class Value>
+  size_t count_below(const Value& value, double limit) const {
+    return std::partition_point(ids.begin(), ids.end(), [&](int32_t v) { return value(v) < limit; }) - ids.begin();
+  }
 };
 
 // Per-vertex class and importance q (0 where not sampled stochastically), with q sorted per
@@ -60,8 +71,8 @@ struct ImportanceTable {
   double adaptivity = 0.0, flat_floor = 0.0;
   bool area_weighted = false;
   std::vector<uint8_t> cls;
-  SortedSums surface;  // q of the surface vertices, summed
-  SortedSums curve;    // q of the curve vertices, their square roots summed
+  SortedSums surface;  // the surface vertices by q, q summed
+  SortedSums curve;    // the curve vertices by q, the square roots of q summed
   double corners = 0.0;
   double total_q = 0.0;  // over surface and curve vertices
   int32_t active = 0;    // vertices in triangles

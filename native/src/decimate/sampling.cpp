@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -78,10 +79,11 @@ double apply_view(const ViewGuidance& view, const double* position, const double
   return p;
 }
 
-// Sorts ascending, exactly as std::sort would: non-negative doubles order like their bit patterns,
-// so a radix sort over the bits that differ does it in a few linear passes (the importance table
-// of a million vertices was the first decimation's longest serial step).
-void sort_ascending(std::vector<double>& values) {
+// Puts ids in ascending order of their values (ids[i]'s is values[i]; equal values keep their
+// order), exactly as a stable sort would: non-negative doubles order like their bit patterns, so
+// a radix sort over the bits that differ does it in a few linear passes (the importance table of
+// a million vertices was the first decimation's longest serial step). values ends up sorted too.
+void sort_ascending(std::vector<double>& values, std::vector<int32_t>& ids) {
   uint64_t any = 0, all = ~uint64_t(0);
   bool plain = true;  // no negative number, -0 or NaN
   for (double x : values) {
@@ -91,24 +93,33 @@ void sort_ascending(std::vector<double>& values) {
     plain &= !(bits >> 63) && !std::isnan(x);
   }
   if (!plain) {
-    std::sort(values.begin(), values.end());
+    std::vector<size_t> order(values.size());
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return values[a] < values[b]; });
+    std::vector<double> sorted_values(values.size());
+    std::vector<int32_t> sorted_ids(ids.size());
+    for (size_t i = 0; i < order.size(); ++i) sorted_values[i] = values[order[i]], sorted_ids[i] = ids[order[i]];
+    values.swap(sorted_values);
+    ids.swap(sorted_ids);
     return;
   }
   constexpr int kDigit = 16;  // 4 passes at most (11-bit digits took 5-6 on real weights)
   constexpr uint64_t kMask = (uint64_t(1) << kDigit) - 1;
   std::vector<double> other(values.size());
-  std::vector<int32_t> offsets;
+  std::vector<int32_t> other_ids(ids.size()), offsets;
   for (int shift = 0; shift < 64; shift += kDigit) {
     if ((((any ^ all) >> shift) & kMask) == 0) continue;  // the same digit everywhere
     const double* from = values.data();
+    const int32_t* from_ids = ids.data();
     auto digit = [&](int64_t i) {
       uint64_t bits;
       std::memcpy(&bits, &from[i], sizeof bits);
       return int32_t((bits >> shift) & kMask);
     };
     stable_counting_sort(int64_t(values.size()), int32_t(kMask + 1), digit,
-                         [&](int64_t i, int32_t at) { other[at] = from[i]; }, offsets);
+                         [&](int64_t i, int32_t at) { other[at] = from[i], other_ids[at] = from_ids[i]; }, offsets);
     values.swap(other);
+    ids.swap(other_ids);
   }
 }
 
@@ -137,21 +148,26 @@ std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const 
   const auto& cls = table->cls;
   const int32_t n = mesh.num_vertices();
   const Importance q = importance(mesh, *table);
-  table->surface.values.reserve(n);
-  for (int32_t v = 0; v < n; ++v) {
-    const double qv = q(v);
-    if (cls[v] == kSurface) table->surface.values.push_back(qv);
-    else if (cls[v] == kCurve) table->curve.values.push_back(qv);
-    else if (cls[v] == kCorner) table->corners += 1.0;
-    table->active += cls[v] != kIsolated;
-    table->total_q += qv;
+  {
+    std::vector<double> surface_q, curve_q;  // the values, for sorting only
+    surface_q.reserve(n);
+    table->surface.ids.reserve(n);
+    for (int32_t v = 0; v < n; ++v) {
+      const double qv = q(v);
+      if (cls[v] == kSurface) surface_q.push_back(qv), table->surface.ids.push_back(v);
+      else if (cls[v] == kCurve) curve_q.push_back(qv), table->curve.ids.push_back(v);
+      else if (cls[v] == kCorner) table->corners += 1.0;
+      table->active += cls[v] != kIsolated;
+      table->total_q += qv;
+    }
+    sort_ascending(surface_q, table->surface.ids);
+    sort_ascending(curve_q, table->curve.ids);
   }
-  sort_ascending(table->surface.values);
-  sort_ascending(table->curve.values);
+  table->surface.ids.shrink_to_fit();
   // Prefix sums, in order (their last bits are part of the result).
   table->curve.root = true;
-  table->surface.sum_up();
-  table->curve.sum_up();
+  table->surface.sum_up(q);
+  table->curve.sum_up(q);
   layout.sampling_table.set(table);
   return table;
 }
@@ -265,20 +281,21 @@ double solve_guided_rate(const Mesh& mesh, const ImportanceTable& table, const s
 // their prefix sums: the vertices with k q < 1 are a prefix, the rest count 1 each.
 // The sum of the probabilities without guidance at rate k (the expected sample count), and
 // its derivative.
-double expected_count(const ImportanceTable& table, double k, double& slope) {
-  const size_t surfaces = table.surface.values.size(), curves = table.curve.values.size();
+double expected_count(const ImportanceTable& table, const Importance& q, double k, double& slope) {
+  const size_t surfaces = table.surface.size(), curves = table.curve.size();
   const double limit = k > 0 ? 1.0 / k : std::numeric_limits<double>::infinity();
-  const size_t s = table.surface.count_below(limit), c = table.curve.count_below(limit);
-  const double root = std::sqrt(k), surface_sum = table.surface.sum_before(s), curve_sum = table.curve.sum_before(c);
+  const size_t s = table.surface.count_below(q, limit), c = table.curve.count_below(q, limit);
+  const double root = std::sqrt(k), surface_sum = table.surface.sum_before(q, s),
+               curve_sum = table.curve.sum_before(q, c);
   slope = surface_sum + (k > 0 ? 0.5 * curve_sum / root : 0.0);
   return table.corners + k * surface_sum + double(surfaces - s) + root * curve_sum + double(curves - c);
 }
 
-double solve_rate(const ImportanceTable& table, double target) {
+double solve_rate(const ImportanceTable& table, const Importance& q, double target) {
   double min_q = 1e300;
-  if (!table.surface.values.empty()) min_q = std::min(min_q, table.surface.values.front());
-  if (!table.curve.values.empty()) min_q = std::min(min_q, table.curve.values.front());
-  auto evaluate = [&](double k, double& slope) { return expected_count(table, k, slope); };
+  if (table.surface.size() > 0) min_q = std::min(min_q, q(table.surface.ids.front()));
+  if (table.curve.size() > 0) min_q = std::min(min_q, q(table.curve.ids.front()));
+  auto evaluate = [&](double k, double& slope) { return expected_count(table, q, k, slope); };
   if (table.total_q <= 0 || target <= table.corners) return 0.0;
   double lo = 0.0, hi = min_q < 1e300 ? 1.0 / min_q : 1.0;
   double slope = 0.0;
@@ -571,7 +588,7 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
   const int32_t target = std::clamp(target_vertices, 0, active);
   // Multipliers are read only with per-vertex guidance (all ones otherwise: not made).
   const auto multiplier = has_per_vertex_guidance(params) ? guidance_multipliers(mesh, params) : std::vector<double>();
-  out.rate = out.guided ? solve_guided_rate(mesh, *table, multiplier, params, target) : solve_rate(*table, target);
+  out.rate = out.guided ? solve_guided_rate(mesh, *table, multiplier, params, target) : solve_rate(*table, importance(mesh, *table), target);
   // The draw takes exactly the target, guided or not; only vertices with p = 1 (corners,
   // control points) can push it over.
   const int32_t count = target;
@@ -595,7 +612,7 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
     // Without guidance the sum of the probabilities comes from the table: the same value
     // whichever way the candidates were found.
     double slope;
-    if (plain) out.expected = expected_count(*table, out.rate, slope);
+    if (plain) out.expected = expected_count(*table, importance(mesh, *table), out.rate, slope);
     out.forced = static_cast<int32_t>(forced.size());
     const int32_t free_count = std::max<int32_t>(0, count - out.forced);
     // (Nothing to widen when the forced vertices fill the count: ten passes found no candidate
