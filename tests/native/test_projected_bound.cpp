@@ -124,3 +124,34 @@ TEST_CASE("the max's bracket of a coarse surface over a fine one settles in few 
   CHECK(bracket.upper <= 0.015 * 1.01 * (1 + 1e-12));
   CHECK(bracket.queries < 10000);
 }
+
+TEST_CASE("a fine surface under a coarse one settles its small triangles without measuring them") {
+  // A flat 100 x 100 grid under an 8 x 8 grid of squares 0.01 to 0.014 above it: a leaf's
+  // triangle spans less than one coarse triangle and is settled by the bound beneath it
+  // (15,902 queries without it; 11,422 with it). The bracket holds against a dense sampling.
+  const Surface fine = grid(100, [](double, double) { return 0.0; });
+  std::vector<double> positions;
+  std::vector<int32_t> triangles;
+  const int m = 8;
+  for (int j = 0; j <= m; ++j)
+    for (int i = 0; i <= m; ++i)
+      positions.insert(positions.end(), {-0.05 + 1.1 * i / m, -0.05 + 1.1 * j / m, 0.01 + 0.001 * ((i * 7 + j * 3) % 5)});
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < m; ++i) {
+      const int32_t a = j * (m + 1) + i, b = a + 1, c = a + m + 1, d = c + 1;
+      triangles.insert(triangles.end(), {a, b, d, a, d, c});
+    }
+  const Surface coarse(std::move(positions), std::move(triangles));
+  const topstoc::MaxBracket bracket = topstoc::bound_max_distance_by_tree(fine, coarse, 1e-2, 4000000);
+  CHECK(bracket.converged);
+  CHECK(bracket.upper <= bracket.lower * 1.01 * (1 + 1e-12));
+  double sampled = 0.0;
+  for (int32_t f = 0; f < fine.num_triangles(); f += 7) {
+    double p[3][3];
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) p[j][k] = fine.positions()[3 * size_t(fine.triangles()[3 * size_t(f) + j]) + k];
+    sampled = std::max(sampled, sampled_max(p, coarse));
+  }
+  CHECK(bracket.upper >= sampled * (1 - 1e-12));
+  CHECK(bracket.queries < 13000);
+}

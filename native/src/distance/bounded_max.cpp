@@ -24,6 +24,9 @@ constexpr int32_t kBeneathCandidates = 256;
 // candidate and a split piece cost about the same, counting the bound's failures near creases;
 // measured on fandisk, the elephant, mushroom and knot1 at 92-400 triangles).
 constexpr double kCandidatesPerPiece = 1.0;
+// A leaf's triangle spanning at most this many triangles of the other surface is first tried
+// with the bound beneath it alone (its corners measured only when that does not settle it).
+constexpr double kSettleSpan = 2.5;
 
 struct Piece {
   double p[3][3];     // corners
@@ -127,7 +130,7 @@ class MaxSearch {
         const int32_t hint = node_hint[size_t(i)];
         if (n.count > 0) {
           for (int32_t s = n.first; s < n.first + n.count; ++s)
-            add_triangle(tree.slot_corners(s), tree.slot_triangle(s), hint);
+            if (!settled_beneath(tree.slot_corners(s))) add_triangle(tree.slot_corners(s), tree.slot_triangle(s), hint);
         } else {
           open_node(tree, i + 1, hint);
           open_node(tree, n.first, hint);
@@ -215,8 +218,9 @@ class MaxSearch {
       centroid_near(piece);
       bound(piece);
     }
+    // only a bound that settles the piece is looked for: the box searched stays small
     if (!tolerated(piece.upper) && worth_projecting(piece))
-      piece.upper = std::min(piece.upper, projected_bound(piece.p, to, piece.upper, kBeneathCandidates, scratch));
+      piece.upper = std::min(piece.upper, projected_bound(piece.p, to, threshold(), kBeneathCandidates, scratch));
     if (tolerated(piece.upper)) {
       settled = std::max(settled, piece.upper);
     } else {
@@ -224,19 +228,37 @@ class MaxSearch {
     }
   }
 
+  // About how many triangles of the other surface a triangle spans (one more than its area over
+  // their mean area).
+  double spanned(const double p[3][3]) const {
+    double u[3], w[3], n[3];
+    for (int k = 0; k < 3; ++k) u[k] = p[1][k] - p[0][k], w[k] = p[2][k] - p[0][k];
+    n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
+    return 1.0 + 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) / to_mean_area;
+  }
+
   // Whether the bound through the triangles beneath a piece costs less than the splits the
   // Lipschitz bound needs to settle it: about (reach / slack)^2 pieces, against about two
   // candidates per triangle of the other surface the piece spans.
   bool worth_projecting(const Piece& piece) const {
-    const double slack = threshold() - std::max({piece.d[0], piece.d[1], piece.d[2]});
-    double u[3], w[3], n[3];
-    for (int k = 0; k < 3; ++k) u[k] = piece.p[1][k] - piece.p[0][k], w[k] = piece.p[2][k] - piece.p[0][k];
-    n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
-    const double candidates = 1.0 + std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) / to_mean_area;
+    const double candidates = 2.0 * spanned(piece.p) - 1.0;
     if (candidates > kBeneathSpan) return false;
+    const double slack = threshold() - std::max({piece.d[0], piece.d[1], piece.d[2]});
     if (!(slack > 0)) return true;
     const double splits = nearest_corner_reach(piece.p) / slack;
     return candidates < kCandidatesPerPiece * splits * splits;
+  }
+
+  // A leaf's triangle settled by the bound beneath it without measuring its corners, where the
+  // other surface is far coarser (a tiny result seen from its input): a few candidates.
+  bool settled_beneath(const double* corners) {
+    const double p[3][3] = {{corners[0], corners[1], corners[2]}, {corners[3], corners[4], corners[5]},
+                            {corners[6], corners[7], corners[8]}};
+    if (spanned(p) > kSettleSpan) return false;
+    const double bound = projected_bound(p, to, threshold(), kBeneathCandidates, scratch);
+    if (!tolerated(bound)) return false;
+    settled = std::max(settled, bound);
+    return true;
   }
 
   // run_from_tree's open nodes: (bound, node) in the queue's order, and the slot of the other
