@@ -4,6 +4,8 @@
 #include <cmath>
 #include <queue>
 
+#include "distance/projected_bound.hpp"
+
 namespace topstoc {
 
 namespace {
@@ -12,6 +14,19 @@ namespace {
 // to one triangle of the other surface is convex, so it peaks at one of them); larger ones
 // through their box's corners.
 constexpr int32_t kCornerBoundSlots = 16;
+// A piece that the corner bounds leave open is bounded through the other surface's triangles
+// beneath it (projected_bound.hpp) when it spans about this many of them at most (larger ones
+// are split first: near creases the bound fails, and a failure costs its candidates), and
+// when fewer lie in its box than this.
+constexpr double kBeneathSpan = 64.0;
+constexpr int32_t kBeneathCandidates = 256;
+// ... and when they are fewer than the pieces the Lipschitz bound would split it into (a
+// candidate and a split piece cost about the same, counting the bound's failures near creases;
+// measured on fandisk, the elephant, mushroom and knot1 at 92-400 triangles).
+constexpr double kCandidatesPerPiece = 1.0;
+// A leaf's triangle spanning at most this many triangles of the other surface is first tried
+// with the bound beneath it alone (its corners measured only when that does not settle it).
+constexpr double kSettleSpan = 2.5;
 
 struct Piece {
   double p[3][3];     // corners
@@ -53,9 +68,10 @@ class MaxSearch {
  public:
   MaxSearch(const Surface& from, const std::vector<double>& vertex_distance, const Surface& to, double start,
             const double* start_point, double relative_tolerance, int64_t max_queries)
-      : from(from), vertex_distance(vertex_distance), to_positions(to.positions()), to_triangles(to.triangles()),
+      : from(from), vertex_distance(vertex_distance), to(to), to_positions(to.positions()), to_triangles(to.triangles()),
         bvh(to.bvh()), relative_tolerance(relative_tolerance), max_queries(max_queries),
-        floor(1e-13 * std::max(from.diagonal(), to.diagonal())) {
+        floor(1e-13 * std::max(from.diagonal(), to.diagonal())),
+        to_mean_area(to.area() / std::max(1, to.num_triangles())) {
     out.lower = start;
     std::copy_n(start_point, 3, out.lower_point);
   }
@@ -114,7 +130,7 @@ class MaxSearch {
         const int32_t hint = node_hint[size_t(i)];
         if (n.count > 0) {
           for (int32_t s = n.first; s < n.first + n.count; ++s)
-            add_triangle(tree.slot_corners(s), tree.slot_triangle(s), hint);
+            if (!settled_beneath(tree.slot_corners(s))) add_triangle(tree.slot_corners(s), tree.slot_triangle(s), hint);
         } else {
           open_node(tree, i + 1, hint);
           open_node(tree, n.first, hint);
@@ -133,22 +149,24 @@ class MaxSearch {
  private:
   const Surface& from;
   const std::vector<double>& vertex_distance;
+  const Surface& to;
   const std::vector<double>& to_positions;
   const std::vector<int32_t>& to_triangles;
   const TriangleBvh& bvh;
   const double relative_tolerance;
   const int64_t max_queries;
   const double floor;  // a tiny absolute floor, so that identical surfaces (max 0) do not subdivide forever
+  const double to_mean_area;  // the mean triangle area of the other surface
   MaxBracket out;
+  BeneathScratch scratch;
   std::priority_queue<Piece, std::vector<Piece>, ByUpper> open;
   double settled = 0.0;  // the highest bound among pieces dropped as tolerated
   // run_from_tree's threshold: bounds at or below it are settled, and a distance above it ends
   // the search (whether the max exceeds it is then decided)
   double decided_at = -1.0;
 
-  bool tolerated(double upper) const {
-    return upper <= std::max({out.lower * (1 + relative_tolerance), floor, decided_at});
-  }
+  double threshold() const { return std::max({out.lower * (1 + relative_tolerance), floor, decided_at}); }
+  bool tolerated(double upper) const { return upper <= threshold(); }
 
   // The nearest point of the other surface to a point that need not lie on the sampled one.
   // hint: a slot found near x (the queue's order jumps about, so the previous query's is not).
@@ -200,11 +218,47 @@ class MaxSearch {
       centroid_near(piece);
       bound(piece);
     }
+    // only a bound that settles the piece is looked for: the box searched stays small
+    if (!tolerated(piece.upper) && worth_projecting(piece))
+      piece.upper = std::min(piece.upper, projected_bound(piece.p, to, threshold(), kBeneathCandidates, scratch));
     if (tolerated(piece.upper)) {
       settled = std::max(settled, piece.upper);
     } else {
       open.push(piece);
     }
+  }
+
+  // About how many triangles of the other surface a triangle spans (one more than its area over
+  // their mean area).
+  double spanned(const double p[3][3]) const {
+    double u[3], w[3], n[3];
+    for (int k = 0; k < 3; ++k) u[k] = p[1][k] - p[0][k], w[k] = p[2][k] - p[0][k];
+    n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
+    return 1.0 + 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) / to_mean_area;
+  }
+
+  // Whether the bound through the triangles beneath a piece costs less than the splits the
+  // Lipschitz bound needs to settle it: about (reach / slack)^2 pieces, against about two
+  // candidates per triangle of the other surface the piece spans.
+  bool worth_projecting(const Piece& piece) const {
+    const double candidates = 2.0 * spanned(piece.p) - 1.0;
+    if (candidates > kBeneathSpan) return false;
+    const double slack = threshold() - std::max({piece.d[0], piece.d[1], piece.d[2]});
+    if (!(slack > 0)) return true;
+    const double splits = nearest_corner_reach(piece.p) / slack;
+    return candidates < kCandidatesPerPiece * splits * splits;
+  }
+
+  // A leaf's triangle settled by the bound beneath it without measuring its corners, where the
+  // other surface is far coarser (a tiny result seen from its input): a few candidates.
+  bool settled_beneath(const double* corners) {
+    const double p[3][3] = {{corners[0], corners[1], corners[2]}, {corners[3], corners[4], corners[5]},
+                            {corners[6], corners[7], corners[8]}};
+    if (spanned(p) > kSettleSpan) return false;
+    const double bound = projected_bound(p, to, threshold(), kBeneathCandidates, scratch);
+    if (!tolerated(bound)) return false;
+    settled = std::max(settled, bound);
+    return true;
   }
 
   // run_from_tree's open nodes: (bound, node) in the queue's order, and the slot of the other

@@ -1,0 +1,166 @@
+#include "distance/projected_bound.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace topstoc {
+
+namespace {
+
+constexpr double kNoBound = std::numeric_limits<double>::infinity();
+// A triangle of B counts as facing T when its projection keeps at least this share of its area
+// (nearly vertical ones would give heights by dividing by almost nothing).
+constexpr double kFacing = 1e-6;
+// Boundary sides this close to T (relative to its longest side) count as crossing it.
+constexpr double kMargin = 1e-9;
+
+double dot(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+void cross(const double* a, const double* b, double* out) {
+  out[0] = a[1] * b[2] - a[2] * b[1], out[1] = a[2] * b[0] - a[0] * b[2], out[2] = a[0] * b[1] - a[1] * b[0];
+}
+// (b - a) x (c - a) in the plane: positive when a, b, c turn counterclockwise.
+double turn(const double* a, const double* b, const double* c) {
+  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+// T's plane: (u, v) coordinates in it and the height along its unit normal.
+struct Frame {
+  double origin[3], u[3], v[3], n[3];
+  void project(const double* q, double* out) const {
+    const double d[3] = {q[0] - origin[0], q[1] - origin[1], q[2] - origin[2]};
+    out[0] = dot(d, u), out[1] = dot(d, v), out[2] = dot(d, n);
+  }
+};
+
+// A polygon of (u, v, height) points, clipped to the left of a -> b (heights interpolated).
+int clip(const double (*in)[3], int count, const double* a, const double* b, double (*out)[3]) {
+  int kept = 0;
+  for (int i = 0; i < count; ++i) {
+    const double* p = in[i];
+    const double* q = in[(i + 1) % count];
+    const double sp = turn(a, b, p), sq = turn(a, b, q);
+    if (sp >= 0) std::copy_n(p, 3, out[kept++]);
+    if ((sp >= 0) != (sq >= 0)) {
+      const double t = sp / (sp - sq);
+      for (int k = 0; k < 3; ++k) out[kept][k] = p[k] + t * (q[k] - p[k]);
+      ++kept;
+    }
+  }
+  return kept;
+}
+
+// Whether segment a-b comes within distance `margin` of triangle t (counterclockwise).
+bool meets(const double* a, const double* b, const double (*t)[3], double margin) {
+  double lo = 0.0, hi = 1.0;
+  for (int i = 0; i < 3; ++i) {
+    const double* s = t[i];
+    const double* e = t[(i + 1) % 3];
+    const double slack = margin * std::sqrt((e[0] - s[0]) * (e[0] - s[0]) + (e[1] - s[1]) * (e[1] - s[1]));
+    const double fa = turn(s, e, a) + slack, fb = turn(s, e, b) + slack;  // >= 0: inside this side
+    if (fa < 0 && fb < 0) return false;
+    if (fa < 0) lo = std::max(lo, fa / (fa - fb));
+    if (fb < 0) hi = std::min(hi, fa / (fa - fb));
+  }
+  return lo <= hi;
+}
+
+using Side = BeneathScratch::Side;
+
+}  // namespace
+
+double projected_bound(const double p[3][3], const Surface& to, double limit, int32_t max_candidates,
+                       BeneathScratch& scratch) {
+  Frame frame;
+  double e1[3], e2[3];
+  for (int k = 0; k < 3; ++k) frame.origin[k] = p[0][k], e1[k] = p[1][k] - p[0][k], e2[k] = p[2][k] - p[0][k];
+  cross(e1, e2, frame.n);
+  const double twice_area = std::sqrt(dot(frame.n, frame.n)), l1 = std::sqrt(dot(e1, e1));
+  if (!(twice_area > 0 && l1 > 0)) return kNoBound;
+  for (int k = 0; k < 3; ++k) frame.n[k] /= twice_area, frame.u[k] = e1[k] / l1;
+  cross(frame.n, frame.u, frame.v);
+  double t[3][3];
+  for (int j = 0; j < 3; ++j) frame.project(p[j], t[j]);
+
+  // B's triangles in T's box grown by the limit: nothing beyond it can bring a bound under it.
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::min({p[0][k], p[1][k], p[2][k]}) - limit;
+    hi[k] = std::max({p[0][k], p[1][k], p[2][k]}) + limit;
+  }
+  const TriangleBvh& tree = to.bvh();
+  std::vector<int32_t>& stack = scratch.stack;
+  std::vector<int32_t>& slots = scratch.slots;
+  stack.assign(1, 0);
+  slots.clear();
+  while (!stack.empty()) {
+    const TriangleBvh::Node& node = tree.node(stack.back());
+    const int32_t i = stack.back();
+    stack.pop_back();
+    bool overlaps = true;
+    for (int k = 0; k < 3; ++k) overlaps = overlaps && node.lo[k] <= hi[k] && node.hi[k] >= lo[k];
+    if (!overlaps) continue;
+    if (node.count == 0) {
+      stack.push_back(i + 1), stack.push_back(node.first);
+      continue;
+    }
+    for (int32_t s = node.first; s < node.first + node.count; ++s) slots.push_back(s);
+    if (int32_t(slots.size()) > max_candidates) return kNoBound;
+  }
+
+  // The facing triangles over T give the bound, and those of their sides that come near T must
+  // be shared by two of them in opposite directions (no boundary of U crosses T).
+  const double margin = kMargin * std::max({l1, std::hypot(t[2][0], t[2][1]), std::hypot(t[2][0] - l1, t[2][1])});
+  const double t_lo[2] = {std::min(0.0, t[2][0]) - margin, -margin};
+  const double t_hi[2] = {std::max(l1, t[2][0]) + margin, t[2][1] + margin};
+  std::vector<Side>& sides = scratch.sides;
+  sides.clear();
+  double bound = 0.0;
+  bool covered = false;
+  for (int32_t slot : slots) {
+    const double* corners = tree.slot_corners(slot);
+    double q[9];
+    for (int j = 0; j < 3; ++j) frame.project(corners + 3 * j, q + 3 * j);
+    bool apart = false;
+    for (int k = 0; k < 2; ++k)
+      apart = apart || std::max({q[k], q[3 + k], q[6 + k]}) < t_lo[k] || std::min({q[k], q[3 + k], q[6 + k]}) > t_hi[k];
+    if (apart) continue;  // neither over T nor with a side near it
+    double f1[3], f2[3], normal[3];
+    for (int k = 0; k < 3; ++k) f1[k] = corners[3 + k] - corners[k], f2[k] = corners[6 + k] - corners[k];
+    cross(f1, f2, normal);
+    const double area = turn(q, q + 3, q + 6);
+    if (!(area > kFacing * std::sqrt(dot(normal, normal)))) continue;
+    double ring[2][9][3];
+    int count = 3;
+    for (int j = 0; j < 3; ++j) std::copy_n(t[j], 3, ring[0][j]);
+    for (int j = 0; j < 3 && count > 0; ++j)  // T clipped to the triangle's three sides
+      count = clip(ring[j % 2], count, q + 3 * j, q + 3 * ((j + 1) % 3), ring[(j + 1) % 2]);
+    // Heights of the triangle's plane over the overlap's corners (the clip carried T's zeros).
+    for (int m = 0; m < count; ++m) {
+      const double* x = ring[1][m];
+      const double w1 = turn(q, x, q + 6) / area, w2 = turn(q, q + 3, x) / area, w0 = 1.0 - w1 - w2;
+      bound = std::max(bound, std::abs(w0 * q[2] + w1 * q[5] + w2 * q[8]));
+      covered = true;
+    }
+    if (bound > limit) return kNoBound;
+    const int32_t* ids = &to.triangles()[3 * size_t(tree.slot_triangle(slot))];
+    for (int j = 0; j < 3; ++j) {
+      const int32_t a = ids[j], b = ids[(j + 1) % 3];
+      if (meets(q + 3 * j, q + 3 * ((j + 1) % 3), t, margin)) sides.push_back(a < b ? Side{a, b, 1} : Side{b, a, -1});
+    }
+  }
+  if (!covered) return kNoBound;
+  std::sort(sides.begin(), sides.end(),
+            [](const Side& x, const Side& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+  for (size_t i = 0; i < sides.size();) {
+    size_t j = i;
+    int32_t net = 0;
+    for (; j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b; ++j) net += sides[j].sign;
+    if (net != 0) return kNoBound;
+    i = j;
+  }
+  return bound;
+}
+
+}  // namespace topstoc

@@ -1,0 +1,34 @@
+// A bound on the distance from a flat triangle to a surface lying beneath it like a sheet.
+//
+// Seen along the triangle T's normal, the triangles of the other surface B that face the same way
+// form a chain U. Where the boundary of U (its sides not shared with another triangle of U in the
+// opposite direction) does not cross T, every point x of T lies over a triangle of U (the count
+// of U's triangles over a point is constant between boundary sides), so d(x, B) is at most the
+// height of that triangle's plane over x. Heights are linear over each triangle's overlap with T,
+// so their largest value sits at a corner of an overlap polygon. This settles a piece of a surface
+// that runs over many small triangles of the other one in a single step, where the distance's
+// Lipschitz bound would split it until its pieces were smaller than the deviation.
+#pragma once
+
+#include <vector>
+
+#include "topstoc/distance/hausdorff.hpp"
+
+namespace topstoc {
+
+/// Buffers one caller reuses from call to call.
+struct BeneathScratch {
+  std::vector<int32_t> stack, slots;
+  struct Side {
+    int32_t a, b, sign;  // vertex ids (lower first) and +1 or -1 for the direction
+  };
+  std::vector<Side> sides;
+};
+
+/// An upper bound on max over triangle p of dist(x, to), or +infinity when B does not lie under
+/// the whole triangle within `limit` (or more than `max_candidates` of its triangles would be
+/// looked at).
+double projected_bound(const double p[3][3], const Surface& to, double limit, int32_t max_candidates,
+                       BeneathScratch& scratch);
+
+}  // namespace topstoc
