@@ -492,9 +492,12 @@ class Refinement {
       auto run = std::make_unique<Collapser>(at_restart);
       run->reweigh(deviation_weights(*run, guidance, worst));
       const int32_t collapses = shared + collapse_rest(*run, center, extent);
-      last = surface_deviation(mesh, input, label, *run, result.triangles);
-      if (excess(last) < excess(best_deviation) || (excess(last) == excess(best_deviation) &&
-                                                    last.top2 <= best_deviation.top2 && last.mean <= mean_bound)) {
+      // The last run's deviation serves only the choice: measured until it loses.
+      const Rival rival{best_deviation.top2, mean_bound};
+      last = surface_deviation(mesh, input, label, *run, result.triangles, round + 1 == kRounds ? &rival : nullptr);
+      if (excess(last) < excess(best_deviation) ||
+          (excess(last) == excess(best_deviation) && last.complete && last.top2 <= best_deviation.top2 &&
+           last.mean <= mean_bound)) {
         best = std::move(run);
         best_deviation = last;
         best_collapses = collapses;
