@@ -8,6 +8,7 @@
 #include <string>
 
 
+#include "decimate/collapse_snapshots.hpp"
 #include "decimate/collapser.hpp"
 #include "decimate/deviation.hpp"
 #include "decimate/tiny_fit.hpp"
@@ -475,8 +476,8 @@ class Refinement {
     result.refine_triangles = params.target_triangles;
     const Collapser::Stop stop = target(), restart{int32_t(kRestart * stop.vertices), int32_t(kRestart * stop.faces)};
     // Every run works on result's arrays: its own are copied in before it goes on.
-    auto best = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
-    const int32_t shared = best->remove_thin(kSliverShape, stop) + best->run(restart);
+    std::unique_ptr<Collapser> best;
+    const int32_t shared = shared_run(std::move(setup), stop, restart, best);
     const Collapser at_restart(*best);
     const std::vector<int32_t> restart_triangles = result.triangles, restart_corners = result.corner_source;
     int32_t best_collapses = shared + collapse_rest(*best, center, extent);
@@ -509,6 +510,29 @@ class Refinement {
     result.corner_source = std::move(best_corners);
     result.refine_collapses = best_collapses;
     finish(*best);
+  }
+
+  // The first run to `restart` (slivers first), from a state kept by an earlier refinement
+  // toward as many vertices or more when there is one; it keeps its own where its batches start
+  // to depend on the target. Returns the collapses from the start.
+  int32_t shared_run(CollapseSetup setup, Collapser::Stop stop, Collapser::Stop restart, std::unique_ptr<Collapser>& run) {
+    CollapseSnapshots* snapshots = params.target_triangles == 0 && !guided ? params.snapshots : nullptr;
+    if (!snapshots) {
+      run = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
+      return run->remove_thin(kSliverShape, stop) + run->run(restart);
+    }
+    const std::vector<uint64_t> start = start_key(setup, result.triangles, result.corner_source);
+    int32_t before = 0;
+    if (const auto kept = snapshots->find(start, restart.vertices)) {
+      run = resumed(*kept, result.triangles, result.corner_source, std::move(setup.quota));
+      before = kept->collapses;
+    } else {
+      run = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
+      before = run->remove_thin(kSliverShape, stop);
+    }
+    return before + run->run(restart, [&](const Collapser& state, int32_t made) {
+      snapshots->keep(snapshot(start, restart.vertices, before + made, state));
+    });
   }
 
   // How far a run stayed above the target (0 once reached).
