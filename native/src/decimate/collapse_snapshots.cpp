@@ -47,6 +47,17 @@ std::vector<uint64_t> start_key(const CollapseSetup& s, const std::vector<int32_
   return key;
 }
 
+std::vector<uint64_t> input_surface_key(const Mesh& mesh, const Collapser& collapser) {
+  std::vector<uint64_t> key;
+  add(key, mesh.position(0), 3 * size_t(mesh.num_vertices()));
+  add(key, mesh.faces().data(), mesh.faces().size());
+  const double corners[2][3] = {{0, 0, 0}, {1, 1, 1}};
+  double normalised[2][3];
+  for (int i = 0; i < 2; ++i) collapser.normalise(corners[i], normalised[i]);
+  add(key, &normalised[0][0], 6);
+  return key;
+}
+
 std::shared_ptr<const CollapseSnapshots::Entry> snapshot(std::vector<uint64_t> start, int32_t run_vertices,
                                                          int32_t collapses, const Collapser& collapser) {
   auto entry = std::make_shared<CollapseSnapshots::Entry>();
@@ -100,9 +111,22 @@ void CollapseSnapshots::keep(std::shared_ptr<const Entry> entry) {
   entries_.erase(entries_.begin() + (highest == 0 && capacity_ > 1 ? 1 : 0));
 }
 
+std::shared_ptr<const InputSurface> CollapseSnapshots::input_surface(
+    const std::vector<uint64_t>& key, const std::function<std::shared_ptr<const InputSurface>()>& make) {
+  std::lock_guard<std::mutex> lock(mutex_);  // held while one is made: a second caller takes it
+  if (!surface_ || surface_key_ != key) {
+    surface_ = nullptr;  // the old one freed before the new one is made
+    surface_ = make();
+    surface_key_ = key;
+  }
+  return surface_;
+}
+
 void CollapseSnapshots::clear() {
   std::lock_guard<std::mutex> lock(mutex_);
   entries_.clear();
+  surface_ = nullptr;
+  surface_key_.clear();
 }
 
 size_t CollapseSnapshots::size() const {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "decimate/collapser.hpp"
+#include "topstoc/core/mesh.hpp"
 #include "topstoc/decimate/collapse_snapshots.hpp"
 
 namespace topstoc {
@@ -24,6 +25,10 @@ struct CollapseSnapshots::Entry {
 /// CollapseSetup must be added here.
 std::vector<uint64_t> start_key(const CollapseSetup& setup, const std::vector<int32_t>& triangles,
                                 const std::vector<int32_t>& corner_source);
+
+/// The key of the input's search structure (InputSurface): the mesh's positions and triangles
+/// and the collapses' normalisation.
+std::vector<uint64_t> input_surface_key(const Mesh& mesh, const Collapser& collapser);
 
 /// The entry for `collapser` at the point Collapser::run's before_tail reports.
 std::shared_ptr<const CollapseSnapshots::Entry> snapshot(std::vector<uint64_t> start, int32_t run_vertices,

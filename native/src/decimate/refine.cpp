@@ -481,7 +481,8 @@ class Refinement {
     const Collapser at_restart(*best);
     const std::vector<int32_t> restart_triangles = result.triangles, restart_corners = result.corner_source;
     int32_t best_collapses = shared + collapse_rest(*best, center, extent);
-    const InputSurface input(mesh, *best);
+    const std::shared_ptr<const InputSurface> kept_input = input_surface(*best);
+    const InputSurface& input = *kept_input;
     Deviation best_deviation = surface_deviation(mesh, input, label, *best, result.triangles), last = best_deviation;
     std::vector<int32_t> best_triangles = result.triangles, best_corners = result.corner_source;
     const double mean_bound = (1.0 + kMeanSlack) * best_deviation.mean;
@@ -532,6 +533,14 @@ class Refinement {
     }
     return before + run->run(restart, [&](const Collapser& state, int32_t made) {
       snapshots->keep(snapshot(start, restart.vertices, before + made, state));
+    });
+  }
+
+  // The input's search structure: the one kept with the collapse states when there are some.
+  std::shared_ptr<const InputSurface> input_surface(const Collapser& collapser) const {
+    if (!params.snapshots) return std::make_shared<const InputSurface>(mesh, collapser);
+    return params.snapshots->input_surface(input_surface_key(mesh, collapser), [&] {
+      return std::make_shared<const InputSurface>(mesh, collapser);
     });
   }
 

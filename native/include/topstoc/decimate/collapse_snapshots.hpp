@@ -2,16 +2,19 @@
 // preview asks for one ratio after another). A mesh collapsed whole goes the same way toward
 // every vertex target until its batches start to depend on the target (they shrink near it):
 // a run toward a lower target resumes from the state an earlier run kept there, with the same
-// result to the bit.
+// result to the bit. The input's search structure for the distance passes is kept with them.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <vector>
 
 namespace topstoc {
+
+struct InputSurface;
 
 class CollapseSnapshots {
  public:
@@ -30,7 +33,12 @@ class CollapseSnapshots {
   /// Keeps a state; beyond the capacity the oldest is dropped, except the one for the highest
   /// target (which serves every lower one).
   void keep(std::shared_ptr<const Entry> entry);
-  /// Frees every kept state.
+  /// The input's search structure for the refinement's distance passes (deviation.hpp), kept
+  /// with the states: the one kept under `key` (input_surface_key), else the one `make` makes,
+  /// kept instead.
+  std::shared_ptr<const InputSurface> input_surface(const std::vector<uint64_t>& key,
+                                                    const std::function<std::shared_ptr<const InputSurface>()>& make);
+  /// Frees every kept state and the search structure.
   void clear();
   /// States kept.
   size_t size() const;
@@ -39,6 +47,8 @@ class CollapseSnapshots {
   mutable std::mutex mutex_;
   size_t capacity_;
   std::vector<std::shared_ptr<const Entry>> entries_;  // the most recently kept last
+  std::vector<uint64_t> surface_key_;
+  std::shared_ptr<const InputSurface> surface_;
 };
 
 }  // namespace topstoc
