@@ -78,6 +78,7 @@ std::unique_ptr<Collapser> resumed(const CollapseSnapshots::Entry& entry, std::v
   auto out = std::make_unique<Collapser>(*entry.state);
   out->use_arrays(triangles, corner_source);
   out->set_quota(std::move(quota));
+  out->fit_threads();  // the state may come from a call on a team of another size
   return out;
 }
 

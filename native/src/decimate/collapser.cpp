@@ -61,8 +61,7 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   waiting_.assign(n, 0);
   settled_.assign(n, 0);
   merged_from_.assign(n, -1);
-  scratch_ = PerThread<Scratch>(max_threads());
-  for (int t = 0; t < scratch_.size(); ++t) scratch_[t].mark.assign(n, 0);
+  fit_threads();
   // Every vertex's cheapest collapse, each edge evaluated once (from its lower end) where it
   // costs the same both ways. A thread owns the lower ends it evaluates; what it finds for the
   // higher ends is merged afterwards. The cheapest by (cost, id) does not depend on the order.
@@ -326,6 +325,12 @@ void Collapser::use_arrays(std::vector<int32_t>& triangles, std::vector<int32_t>
 }
 
 void Collapser::set_quota(std::vector<int32_t> quota) { s_.quota = std::move(quota); }
+
+void Collapser::fit_threads() {
+  const int32_t n = static_cast<int32_t>(s_.weight.size());
+  scratch_ = PerThread<Scratch>(max_threads());
+  for (int t = 0; t < scratch_.size(); ++t) scratch_[t].mark.assign(n, 0);
+}
 
 int32_t Collapser::run(Stop target, const BeforeTail& before_tail) {
   int32_t collapses = 0;

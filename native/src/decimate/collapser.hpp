@@ -75,6 +75,9 @@ class Collapser {
   /// The vertices each guidance bin keeps (CollapseSetup::quota), for a copy resumed toward
   /// another target.
   void set_quota(std::vector<int32_t> quota);
+  /// Scratch for each of the engine's threads now (a copy made on a team of another size:
+  /// scratch holds no state between steps, so the result does not change).
+  void fit_threads();
   /// Replaces every vertex's cost weight and costs every queued collapse anew: a copy of a
   /// collapser taken part-way continues under other weights (the max-aware refinement).
   void reweigh(std::vector<double> weight);
