@@ -29,6 +29,7 @@ namespace topstoc {
 /// What the collapses know about each vertex. Positions are normalised (centred on the bounding
 /// box and divided by its half extent) so that quadrics neither overflow nor underflow; `world`
 /// holds the caller's coordinates, which stay exact for every vertex that does not move.
+/// A field added here joins start_key (collapse_snapshots.cpp), which tells kept states apart.
 struct CollapseSetup {
   VertexQuadrics quadrics{0, 0};
   std::vector<double> positions;      ///< normalised, 3 per vertex
