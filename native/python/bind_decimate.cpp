@@ -216,6 +216,13 @@ void bind_decimate(py::module_& m) {
       .def("clear", &FloodCachePool::clear, "Frees the caches not in use.")
       .def_property_readonly("size", &FloodCachePool::size, "Caches held (in use or not).");
 
+  py::class_<CollapseSnapshots>(m, "CollapseSnapshots",
+                                 "Collapse states of earlier quality decimations of one mesh and feature layout, "
+                                 "from which lower targets resume.")
+      .def(py::init<size_t>(), py::arg("capacity") = 2)
+      .def("clear", &CollapseSnapshots::clear, "Frees the kept states.")
+      .def_property_readonly("size", &CollapseSnapshots::size, "States kept.");
+
   py::class_<CancelToken>(m, "CancelFlag",
                           "Set from any thread, stops the decimation given it at its next check (raises Cancelled).")
       .def(py::init<>())
@@ -225,10 +232,12 @@ void bind_decimate(py::module_& m) {
   m.def(
       "decimate",
       [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& job, const py::handle& flood_caches,
-         const py::handle& cancel) {
+         const py::handle& cancel, const py::handle& collapse_snapshots) {
         JobArrays arrays;
         DecimateParams params = params_from(mesh, job, arrays);
         params.flood_caches = flood_caches.is_none() ? nullptr : flood_caches.cast<FloodCachePool*>();
+        params.collapse_snapshots =
+            collapse_snapshots.is_none() ? nullptr : collapse_snapshots.cast<CollapseSnapshots*>();
         const py::object triangles = job.attr("target").attr("triangles");
         const int32_t target_triangles = triangles.is_none() ? 0 : triangles.cast<int32_t>();
         const CancelFlag* flag = cancel.is_none() ? nullptr : &cancel.cast<CancelToken&>().flag;
@@ -242,9 +251,10 @@ void bind_decimate(py::module_& m) {
         return result_dict(std::move(r));
       },
       py::arg("mesh"), py::arg("layout"), py::arg("job"), py::arg("flood_caches") = py::none(),
-      py::arg("cancel") = py::none(),
+      py::arg("cancel") = py::none(), py::arg("collapse_snapshots") = py::none(),
       "TopStoc decimation of a topstoc.core.api.job.DecimationJob (a triangle target when it has one); "
-      "cancel: a CancelFlag another thread may set (Cancelled is raised).");
+      "cancel: a CancelFlag another thread may set (Cancelled is raised); collapse_snapshots: a "
+      "CollapseSnapshots of this mesh and layout (the same result, lower targets sooner).");
 
   m.def(
       "decimate_with_samples",

@@ -275,8 +275,8 @@ def run_job(mesh: Mesh, job: DecimationJob, progress=None, cancel: Optional[Canc
                                              check_passes=job.mode == "quality")
         return dataclasses.replace(result, error_bound=report, parameters={
             **result.parameters, "max_error": job.target.max_error, "relative": job.target.relative})
-    layout, floods = mesh.layout_and_floods(job.regions, job.borders, job.feature_angle)
-    raw = engine.decimate(mesh.native, layout, job, flood_caches=floods, cancel=cancel)
+    layout, floods, snapshots = mesh.kept_for_reuse(job.regions, job.borders, job.feature_angle)
+    raw = engine.decimate(mesh.native, layout, job, flood_caches=floods, cancel=cancel, collapse_snapshots=snapshots)
     return _result(raw, job.parameters(), mesh, job)
 
 

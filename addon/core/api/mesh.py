@@ -96,7 +96,9 @@ class Mesh:
         each step (validate, order, adjacency, normals and weights, components); returning False
         stops the preparation with ``topstoc.core.Cancelled`` (the live preview's Esc).
         keep_floods: keep the floods of recent decimations so that nearby targets come sooner
-        (see layout_and_floods); False saves that memory, results are the same."""
+        (see layout_and_floods), and the collapse states of recent quality decimations of meshes
+        collapsed whole so that lower targets come sooner (see kept_for_reuse); False saves that
+        memory, results are the same."""
         vertices = as_vertices(vertices)
         triangles = _as_triangles(triangles)
         # The engine copies what it needs (reading float64 and int32 arrays in place) and can
@@ -176,21 +178,33 @@ class Mesh:
         of flooding afresh, with the same result (2 kept per layout, 9 bytes per vertex and 1
         per triangle each; ``clear_floods`` frees them). None instead of the floods when the
         mesh was made with keep_floods=False."""
+        return self.kept_for_reuse(regions, borders, feature_angle)[:2]
+
+    def kept_for_reuse(self, regions=None, borders=None, feature_angle: float = 0.0):
+        """(layout, floods, collapse states) for decimations with this layout: the floods as in
+        layout_and_floods; the collapse states (engine.CollapseSnapshots, 2 kept per layout, a few
+        hundred bytes per vertex each) let a quality decimation of a mesh collapsed whole resume toward
+        a lower target from where an earlier one's collapses stopped depending on its target, with
+        the same result (the input's search structure for their distance passes is kept with them,
+        a few hundred bytes per vertex more). None for both when the mesh was made with
+        keep_floods=False."""
         key = (_digest(regions), _digest(borders), float(feature_angle))
         entry = self._layouts.get(key)
         if entry is None:
-            entry = (engine.build_feature_layout(self._native, regions, borders, float(feature_angle)),
-                     engine.FloodCachePool() if self._keep_floods else None)
+            layout = engine.build_feature_layout(self._native, regions, borders, float(feature_angle))
+            entry = ((layout, engine.FloodCachePool(), engine.CollapseSnapshots()) if self._keep_floods
+                     else (layout, None, None))
             if len(self._layouts) >= 8:
                 self._layouts.pop(next(iter(self._layouts)))
             self._layouts[key] = entry
         return entry
 
     def clear_floods(self) -> None:
-        """Frees the floods kept for re-decimation (see layout_and_floods)."""
-        for _layout, floods in self._layouts.values():
+        """Frees the floods and collapse states kept for re-decimation (see kept_for_reuse)."""
+        for _layout, floods, snapshots in self._layouts.values():
             if floods is not None:
                 floods.clear()
+                snapshots.clear()
 
     def clear_layouts(self) -> None:
         """Frees the feature layouts and their floods (a one-shot job's: a later decimation builds

@@ -29,10 +29,10 @@ bool thinner(double twice_area2, double edges, double shape2) {
 }  // namespace
 
 Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corner_source, CollapseSetup setup)
-    : tri_(triangles), corner_source_(corner_source), s_(std::move(setup)),
+    : tri_(&triangles), corner_source_(&corner_source), s_(std::move(setup)),
       heap_(static_cast<int32_t>(s_.weight.size())) {
   const int32_t n = static_cast<int32_t>(s_.weight.size());
-  const size_t m = tri_.size() / 3;
+  const size_t m = tri_->size() / 3;
   count_.assign(s_.quota.size(), 0);
   alive_vertices_ = n;
   alive_faces_ = static_cast<int32_t>(m);
@@ -40,7 +40,7 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   begin_.assign(n, 0);
   size_.assign(n, 0);
   capacity_.assign(n, 0);
-  for (int32_t v : tri_) ++capacity_[v];
+  for (int32_t v : *tri_) ++capacity_[v];
   int32_t offset = 0;
   for (int32_t v = 0; v < n; ++v) {
     begin_[v] = offset;
@@ -50,7 +50,7 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   pool_.resize(offset);
   for (size_t t = 0; t < m; ++t)
     for (int j = 0; j < 3; ++j) {
-      const int32_t v = tri_[3 * t + j];
+      const int32_t v = (*tri_)[3 * t + j];
       pool_[begin_[v] + size_[v]++] = int32_t(t);
     }
   alive_face_.assign(m, 1);
@@ -61,8 +61,7 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   waiting_.assign(n, 0);
   settled_.assign(n, 0);
   merged_from_.assign(n, -1);
-  scratch_ = PerThread<Scratch>(max_threads());
-  for (int t = 0; t < scratch_.size(); ++t) scratch_[t].mark.assign(n, 0);
+  fit_threads();
   // Every vertex's cheapest collapse, each edge evaluated once (from its lower end) where it
   // costs the same both ways. A thread owns the lower ends it evaluates; what it finds for the
   // higher ends is merged afterwards. The cheapest by (cost, id) does not depend on the order.
@@ -125,7 +124,7 @@ void Collapser::neighbours(int32_t v, Scratch& scratch, std::vector<int32_t>& ou
   const uint32_t stamp = ++scratch.stamp;
   for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t)
     for (int j = 0; j < 3; ++j) {
-      const int32_t w = tri_[3 * size_t(*t) + j];
+      const int32_t w = (*tri_)[3 * size_t(*t) + j];
       if (w != v && scratch.mark[w] != stamp) {
         scratch.mark[w] = stamp;
         out.push_back(w);
@@ -135,7 +134,7 @@ void Collapser::neighbours(int32_t v, Scratch& scratch, std::vector<int32_t>& ou
 
 int32_t Collapser::sector_at(int32_t t, int32_t v) const {
   for (int j = 0; j < 3; ++j)
-    if (tri_[3 * size_t(t) + j] == v) return s_.corner_sector[3 * size_t(t) + j];
+    if ((*tri_)[3 * size_t(t) + j] == v) return s_.corner_sector[3 * size_t(t) + j];
   return -1;
 }
 
@@ -239,7 +238,7 @@ void Collapser::settle(int32_t u, Best best) {
 
 bool Collapser::zero_area(int32_t t) const {
   // In the caller's coordinates: that is what the output holds.
-  const int32_t* c = &tri_[3 * size_t(t)];
+  const int32_t* c = &(*tri_)[3 * size_t(t)];
   const double* a = world(c[0]);
   const double* b = world(c[1]);
   const double* d = world(c[2]);
@@ -251,7 +250,7 @@ bool Collapser::zero_area(int32_t t) const {
 bool Collapser::thin(int32_t t, double min_shape) const {
   if (min_shape <= 0.0) return false;
   double n[3];
-  const int32_t* c = &tri_[3 * size_t(t)];
+  const int32_t* c = &(*tri_)[3 * size_t(t)];
   normal(c, c[0], position(c[0]), n);
   return shape(c, c[0], position(c[0]), std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])) < min_shape;
 }
@@ -299,7 +298,7 @@ int32_t Collapser::remove_thin(double min_shape, Stop keep) {
     for (int32_t t : candidates) {
       if (reached(keep)) return collapses;
       if (!alive_face_[t] || !(zero_area(t) || thin(t, min_shape))) continue;
-      const int32_t* c = &tri_[3 * size_t(t)];
+      const int32_t* c = &(*tri_)[3 * size_t(t)];
       for (int j = 0; j < 6; ++j) {
         const int32_t u = c[j % 3], v = c[(j % 3 + (j < 3 ? 1 : 2)) % 3];
         if (s_.locked[u] || !allowed(u, v, scratch_[0])) continue;
@@ -320,9 +319,24 @@ int32_t Collapser::batch_size(int32_t excess) const {
   return std::clamp(std::min(excess / 64, alive_vertices_ / 1024), 1, 128);
 }
 
-int32_t Collapser::run(Stop target) {
+void Collapser::use_arrays(std::vector<int32_t>& triangles, std::vector<int32_t>& corner_source) {
+  tri_ = &triangles;
+  corner_source_ = &corner_source;
+}
+
+void Collapser::set_quota(std::vector<int32_t> quota) { s_.quota = std::move(quota); }
+
+void Collapser::fit_threads() {
+  const int32_t n = static_cast<int32_t>(s_.weight.size());
+  scratch_ = PerThread<Scratch>(max_threads());
+  for (int t = 0; t < scratch_.size(); ++t) scratch_[t].mark.assign(n, 0);
+}
+
+int32_t Collapser::run(Stop target, const BeforeTail& before_tail) {
   int32_t collapses = 0;
   Batch batch;
+  bool in_tail = false;
+  int32_t last_size = 0;  // of the last batch: one collapse, so none was left out at the target
   while (!reached(target)) {
     check_cancelled("collapses");
     if (heap_.empty()) {
@@ -333,7 +347,11 @@ int32_t Collapser::run(Stop target) {
         if (merged_into_[u] < 0) update(u);
       continue;
     }
-    take_batch(batch, batch_size(target.faces > 0 ? (alive_faces_ - target.faces) / 2 : alive_vertices_ - target.vertices));
+    const int32_t size = batch_size(target.faces > 0 ? (alive_faces_ - target.faces) / 2 : alive_vertices_ - target.vertices);
+    if (before_tail && !in_tail && target.faces == 0 && use_quota_ && size != batch_size(INT32_MAX)) before_tail(*this, collapses);
+    in_tail = in_tail || size != batch_size(INT32_MAX);
+    last_size = size;
+    take_batch(batch, size);
     const uint32_t ring = ++ring_stamp_;
     reserve_batch(batch, ring);
     check_reserved(batch);
@@ -341,6 +359,10 @@ int32_t Collapser::run(Stop target) {
     cost_after_batch(batch, ring);
     settle_survivors(batch, ring);
   }
+  // Batches of one collapse all the way (fewer than 2048 vertices left): the target never
+  // mattered, and a lower one passes through this state.
+  if (before_tail && !in_tail && last_size == 1 && target.faces == 0 && use_quota_ && reached(target))
+    before_tail(*this, collapses);
   return collapses;
 }
 
@@ -486,10 +508,10 @@ bool Collapser::mark_ring(int32_t u, int32_t v, uint32_t ring) {
   for (int32_t w : {u, v})
     for (const int32_t* t = faces_begin(w); t != faces_end(w); ++t)
       for (int j = 0; j < 3; ++j)
-        if (waiting_[tri_[3 * size_t(*t) + j]] == ring) return false;
+        if (waiting_[(*tri_)[3 * size_t(*t) + j]] == ring) return false;
   for (int32_t w : {u, v})
     for (const int32_t* t = faces_begin(w); t != faces_end(w); ++t)
-      for (int j = 0; j < 3; ++j) waiting_[tri_[3 * size_t(*t) + j]] = ring;
+      for (int j = 0; j < 3; ++j) waiting_[(*tri_)[3 * size_t(*t) + j]] = ring;
   return true;
 }
 
@@ -531,7 +553,7 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
     ++faces_u;
     bool with_v = false;
     for (int j = 0; j < 3; ++j) {
-      const int32_t w = tri_[3 * size_t(*t) + j];
+      const int32_t w = (*tri_)[3 * size_t(*t) + j];
       if (w == u) continue;
       with_v |= w == v;
       if (mark[w] != su) {
@@ -558,7 +580,7 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
   int32_t nv = 0, shared = 0;
   for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t)
     for (int j = 0; j < 3; ++j) {
-      const int32_t w = tri_[3 * size_t(*t) + j];
+      const int32_t w = (*tri_)[3 * size_t(*t) + j];
       if (w == v || mark[w] == sv) continue;
       shared += mark[w] == su;
       mark[w] = sv;
@@ -607,7 +629,7 @@ bool Collapser::duplicates_a_face(int32_t u, int32_t v, const int32_t* on_edge, 
   int32_t opposite[kMaxSheets];
   for (int32_t i = 0; i < count; ++i)
     for (int j = 0; j < 3; ++j) {
-      const int32_t w = tri_[3 * size_t(on_edge[i]) + j];
+      const int32_t w = (*tri_)[3 * size_t(on_edge[i]) + j];
       if (w != u && w != v) opposite[i] = w;
     }
   auto is_opposite = [&](int32_t w) { return std::find(opposite, opposite + count, w) != opposite + count; };
@@ -615,7 +637,7 @@ bool Collapser::duplicates_a_face(int32_t u, int32_t v, const int32_t* on_edge, 
     if (has(*t, v)) continue;
     int32_t pair[2], found = 0;
     for (int j = 0; j < 3; ++j) {
-      const int32_t w = tri_[3 * size_t(*t) + j];
+      const int32_t w = (*tri_)[3 * size_t(*t) + j];
       if (w != u && is_opposite(w)) pair[found++] = w;
     }
     if (found < 2) continue;
@@ -633,7 +655,7 @@ bool Collapser::merges_unlike_edges(int32_t u, int32_t v, const int32_t* on_edge
   for (int32_t i = 0; i < count; ++i) {
     int32_t o = -1;
     for (int j = 0; j < 3; ++j) {
-      const int32_t w = tri_[3 * size_t(on_edge[i]) + j];
+      const int32_t w = (*tri_)[3 * size_t(on_edge[i]) + j];
       if (w != u && w != v) o = w;
     }
     int32_t at_u = 0, at_v = 0;
@@ -657,7 +679,7 @@ bool Collapser::merges_unlike_edges(int32_t u, int32_t v, const int32_t* on_edge
 double Collapser::shape_floor2(int32_t v) const {
   double floor2 = kMinShape * kMinShape;
   for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) {
-    const int32_t* c = &tri_[3 * size_t(*t)];
+    const int32_t* c = &(*tri_)[3 * size_t(*t)];
     double n[3];
     normal(c, v, position(v), n);
     const double area2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2], edges = squared_edges(c, v, position(v));
@@ -672,7 +694,7 @@ bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, Shape
   const double* p = position(moved);
   for (const int32_t* t = faces_begin(moved); t != faces_end(moved); ++t) {
     if (other >= 0 && has(*t, other)) continue;
-    const int32_t* c = &tri_[3 * size_t(*t)];
+    const int32_t* c = &(*tri_)[3 * size_t(*t)];
     double before[3], after[3];
     normal(c, moved, p, before);
     normal(c, moved, x, after);
@@ -686,7 +708,7 @@ bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, Shape
       for (int i = 0; i < 3; ++i) before[i] = 0.0;
       for (const int32_t* f = faces_begin(moved); f != faces_end(moved); ++f) {
         double n[3];
-        normal(&tri_[3 * size_t(*f)], moved, p, n);
+        normal(&(*tri_)[3 * size_t(*f)], moved, p, n);
         for (int i = 0; i < 3; ++i) before[i] += n[i];
       }
       before2 = before[0] * before[0] + before[1] * before[1] + before[2] * before[2];
@@ -769,8 +791,8 @@ void Collapser::collapse(int32_t u, int32_t v) {
     --alive_faces_;
     Side side{sector_at(*t, u), -1, -1};
     for (int j = 0; j < 3; ++j) {
-      const int32_t w = tri_[3 * size_t(*t) + j];
-      if (w == v) side.corner = corner_source_[3 * size_t(*t) + j], side.corner_sector = s_.corner_sector[3 * size_t(*t) + j];
+      const int32_t w = (*tri_)[3 * size_t(*t) + j];
+      if (w == v) side.corner = (*corner_source_)[3 * size_t(*t) + j], side.corner_sector = s_.corner_sector[3 * size_t(*t) + j];
       if (w != u) remove_face(w, *t);
     }
     sides[num_sides++] = side;
@@ -780,13 +802,13 @@ void Collapser::collapse(int32_t u, int32_t v) {
   for (const int32_t* t = faces_begin(u); t != faces_end(u); ++t) {
     if (!alive_face_[*t]) continue;
     for (int j = 0; j < 3; ++j)
-      if (tri_[3 * size_t(*t) + j] == u) {
+      if ((*tri_)[3 * size_t(*t) + j] == u) {
         const size_t corner = 3 * size_t(*t) + j;
         const Side* side = &sides[0];
         for (int32_t i = 1; i < num_sides; ++i)
           if (s_.corner_sector[corner] == sides[i].sector) side = &sides[i];
-        tri_[corner] = v;
-        corner_source_[corner] = side->corner;
+        (*tri_)[corner] = v;
+        (*corner_source_)[corner] = side->corner;
         s_.corner_sector[corner] = side->corner_sector;
       }
     moved_faces_.push_back(*t);
@@ -819,7 +841,7 @@ void Collapser::merge_sides(int32_t v, const int32_t* from, const int32_t* to, i
   for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t)
     for (int j = 0; j < 3; ++j) {
       const size_t corner = 3 * size_t(*t) + j;
-      if (tri_[corner] != v) continue;
+      if ((*tri_)[corner] != v) continue;
       for (int32_t i = 0; i < count; ++i)
         if (s_.corner_sector[corner] == from[i]) {
           s_.corner_sector[corner] = to[i];

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "decimate/indexed_heap.hpp"
@@ -28,6 +29,7 @@ namespace topstoc {
 /// What the collapses know about each vertex. Positions are normalised (centred on the bounding
 /// box and divided by its half extent) so that quadrics neither overflow nor underflow; `world`
 /// holds the caller's coordinates, which stay exact for every vertex that does not move.
+/// A field added here joins start_key (collapse_snapshots.cpp), which tells kept states apart.
 struct CollapseSetup {
   VertexQuadrics quadrics{0, 0};
   std::vector<double> positions;      ///< normalised, 3 per vertex
@@ -62,8 +64,21 @@ class Collapser {
   /// Collapses an edge of every zero-area triangle, and of every triangle with a shape quality
   /// below min_shape, where a collapse is allowed, until `keep` is reached.
   int32_t remove_thin(double min_shape, Stop keep);
-  /// Collapses in cost order until `target` is reached or no collapse is allowed.
-  int32_t run(Stop target);
+  /// Called with the state and the collapses made so far where a run's batches start to
+  /// depend on its target (they shrink near it), or at its end when they never did: up to there
+  /// a run to any lower vertex target goes the same way.
+  using BeforeTail = std::function<void(const Collapser&, int32_t)>;
+  /// Collapses in cost order until `target` is reached or no collapse is allowed; before_tail
+  /// (vertex targets only) hears the state where the target starts to matter.
+  int32_t run(Stop target, const BeforeTail& before_tail = {});
+  /// Works on these arrays from now on (a copy's own copies of the arrays it was taken with).
+  void use_arrays(std::vector<int32_t>& triangles, std::vector<int32_t>& corner_source);
+  /// The vertices each guidance bin keeps (CollapseSetup::quota), for a copy resumed toward
+  /// another target.
+  void set_quota(std::vector<int32_t> quota);
+  /// Scratch for each of the engine's threads now (a copy made on a team of another size:
+  /// scratch holds no state between steps, so the result does not change).
+  void fit_threads();
   /// Replaces every vertex's cost weight and costs every queued collapse anew: a copy of a
   /// collapser taken part-way continues under other weights (the max-aware refinement).
   void reweigh(std::vector<double> weight);
@@ -79,7 +94,9 @@ class Collapser {
 
   int32_t live_faces() const { return alive_faces_; }
   /// The triangles as the collapses renamed them (dead ones included: see face_alive).
-  const std::vector<int32_t>& triangles() const { return tri_; }
+  const std::vector<int32_t>& triangles() const { return *tri_; }
+  /// The corner sources as the collapses renamed the corners.
+  const std::vector<int32_t>& corner_source() const { return *corner_source_; }
   int32_t zero_area_faces() const;
   std::vector<int32_t> zero_area_face_list() const;
   /// Moves v to the input position `world` when no triangle around it folds, loses area or
@@ -169,7 +186,7 @@ class Collapser {
   void neighbours(int32_t v, Scratch& scratch, std::vector<int32_t>& out) const;
   int32_t sector_at(int32_t t, int32_t v) const;
   bool has(int32_t t, int32_t v) const {
-    const int32_t* c = &tri_[3 * size_t(t)];
+    const int32_t* c = &(*tri_)[3 * size_t(t)];
     return c[0] == v || c[1] == v || c[2] == v;
   }
   // The live faces of v.
@@ -178,8 +195,8 @@ class Collapser {
   void remove_face(int32_t v, int32_t t);
   void append_faces(int32_t v, const int32_t* faces, int32_t count);
 
-  std::vector<int32_t>& tri_;
-  std::vector<int32_t>& corner_source_;
+  std::vector<int32_t>* tri_;            // updated in place (the caller's arrays)
+  std::vector<int32_t>* corner_source_;
   CollapseSetup s_;
   std::vector<int32_t> count_;  // per bin: vertices alive
   bool use_quota_ = true;

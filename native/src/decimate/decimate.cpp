@@ -799,6 +799,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   refine.refit = params.placement == Placement::Filtered;
   refine.max_aware = refine.refit;
   refine.attributes = params.attributes;
+  refine.snapshots = params.collapse_snapshots;
   check_cancelled("refinement");
   refine_by_collapses(mesh, layout, refine, result);
   result.target_vertices = params.target_vertices;

@@ -58,10 +58,12 @@ bool near_top(double measured2, double top2) { return measured2 >= kNear * kNear
 
 // Each input vertex to the collapsed surface, kept per first-pass vertex of the vertex; then
 // the side middles and centre of each input triangle near the top (near_top), kept per
-// first-pass vertex of its corners (every triangle's four points cost four times the queries).
-// Returns the mean distance at the input vertices, weighted by their areas.
-double from_input(const Mesh& mesh, const InputSurface& surface_in, const std::vector<int32_t>& label,
-                  const TriangleBvh& surface, std::vector<double>& out2) {
+// first-pass vertex of its corners (every triangle's points cost two to four times the queries).
+// Sets out.mean, the mean distance at the input vertices weighted by their areas; stops after
+// the vertices (out.complete false) when they show the run is not within `rival`.
+void from_input(const Mesh& mesh, const InputSurface& surface_in, const std::vector<int32_t>& label,
+                const TriangleBvh& surface, const Rival* rival, Deviation& out) {
+  std::vector<double>& out2 = out.vertex2;
   const std::vector<double>& input = surface_in.positions;
   const std::vector<double> at_vertex = distances2(surface, mesh.num_vertices(), [&](int64_t w, double* p) {
     std::copy_n(&input[3 * size_t(w)], 3, p);
@@ -75,6 +77,12 @@ double from_input(const Mesh& mesh, const InputSurface& surface_in, const std::v
       area += surface_in.area[w];
     }
   const double top2 = at_vertex.empty() ? 0.0 : *std::max_element(at_vertex.begin(), at_vertex.end());
+  out.mean = area > 0.0 ? sum / area : 0.0;
+  if (rival && (out.mean > rival->mean || top2 > rival->top2)) {
+    out.complete = false;
+    out.top2 = top2;
+    return;
+  }
   const auto& faces = mesh.faces();
   auto corner = [&](int32_t f, int j) { return &input[3 * size_t(faces[3 * size_t(f) + j])]; };
   std::vector<int32_t> near;
@@ -84,22 +92,38 @@ double from_input(const Mesh& mesh, const InputSurface& surface_in, const std::v
     const double measured2 = std::max({at_vertex[q[0]], at_vertex[q[1]], at_vertex[q[2]]});
     if (near_top(measured2, top2)) near.push_back(f);
   }
-  // Four points per such triangle: its side middles (0..2), then its centre (3).
-  const std::vector<double> at_face = distances2(surface, 4 * int64_t(near.size()), [&](int64_t i, double* p) {
-    const int32_t f = near[size_t(i / 4)];
-    const int j = int(i % 4);
+  // The points: the middle of each side of such triangles, once per side (a side between two
+  // of them is measured once), then their centres.
+  const auto& face_edges = mesh.face_edges();
+  const auto& edge_vertices = mesh.edge_vertices();
+  std::vector<int32_t> side_index(size_t(mesh.num_edges()), -1), sides;
+  for (int32_t f : near)
+    for (int j = 0; j < 3; ++j) {
+      const int32_t e = face_edges[3 * size_t(f) + j];
+      if (side_index[e] < 0) side_index[e] = int32_t(sides.size()), sides.push_back(e);
+    }
+  const int64_t ns = int64_t(sides.size());
+  const std::vector<double> at = distances2(surface, ns + int64_t(near.size()), [&](int64_t i, double* p) {
+    if (i < ns) {
+      const double *a = &input[3 * size_t(edge_vertices[2 * size_t(sides[i])])],
+                   *b = &input[3 * size_t(edge_vertices[2 * size_t(sides[i]) + 1])];
+      for (int k = 0; k < 3; ++k) p[k] = 0.5 * (a[k] + b[k]);
+      return true;
+    }
+    const int32_t f = near[size_t(i - ns)];
     const double* c[3] = {corner(f, 0), corner(f, 1), corner(f, 2)};
-    for (int k = 0; k < 3; ++k) p[k] = j < 3 ? 0.5 * (c[j][k] + c[(j + 1) % 3][k]) : (c[0][k] + c[1][k] + c[2][k]) / 3.0;
+    for (int k = 0; k < 3; ++k) p[k] = (c[0][k] + c[1][k] + c[2][k]) / 3.0;
     return true;
   });
   for (size_t h = 0; h < near.size(); ++h) {
-    const double found2 = *std::max_element(&at_face[4 * h], &at_face[4 * h] + 4);
+    const int32_t f = near[h];
+    double found2 = at[size_t(ns) + h];
+    for (int j = 0; j < 3; ++j) found2 = std::max(found2, at[size_t(side_index[face_edges[3 * size_t(f) + j]])]);
     for (int j = 0; j < 3; ++j) {
-      const int32_t v = label[faces[3 * size_t(near[h]) + j]];
+      const int32_t v = label[faces[3 * size_t(f) + j]];
       out2[v] = std::max(out2[v], found2);
     }
   }
-  return area > 0.0 ? sum / area : 0.0;
 }
 
 // Each live triangle's centre, corners and side middles to the input, the largest kept per
@@ -189,7 +213,7 @@ InputSurface::InputSurface(const Mesh& mesh, const Collapser& collapser)
       bvh(positions.data(), mesh.faces().data(), mesh.num_faces()) {}
 
 Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const std::vector<int32_t>& label,
-                          Collapser& collapser, const std::vector<int32_t>& triangles) {
+                          Collapser& collapser, const std::vector<int32_t>& triangles, const Rival* rival) {
   check_cancelled("deviation");
   const FreeCoresNow team;
   const int32_t n = collapser.vertices();
@@ -206,7 +230,8 @@ Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const s
   out.vertex2.assign(n, 0.0);
   out.faces = static_cast<int32_t>(live.size() / 3);
   if (out.faces == 0) return out;
-  out.mean = from_input(mesh, input, label, TriangleBvh(positions.data(), live.data(), out.faces), out.vertex2);
+  from_input(mesh, input, label, TriangleBvh(positions.data(), live.data(), out.faces), rival, out);
+  if (!out.complete) return out;
   std::vector<double> back2(n, 0.0);
   to_input(input.bvh, collapser, live, back2);
   for (int32_t v = 0; v < n; ++v) out.vertex2[v] = std::max(out.vertex2[v], back2[survivor[v]]);

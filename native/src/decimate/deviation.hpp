@@ -29,13 +29,25 @@ struct Deviation {
   double mean = 0.0;    ///< mean distance from the input, its vertices weighted by their areas
   int32_t faces = 0;     ///< live triangles
   int32_t vertices = 0;  ///< live vertices
+  /// False when the measure stopped early (surface_deviation's rival): vertex2 and top2 then
+  /// hold only what the input's vertices found.
+  bool complete = true;
+};
+
+/// What a run must stay within to be chosen over the best run so far: no point farther than
+/// top2 (squared), a mean of at most `mean`.
+struct Rival {
+  double top2 = 0.0;
+  double mean = 0.0;
 };
 
 /// From the input: each input vertex to the collapsed surface, kept per vertex the collapses
 /// started from (label: input vertex -> that vertex, -1 for none). Back: each live triangle's
 /// centre, corners and side middles to the input, kept per corner. On the engine's threads; the
-/// same bits for any team size.
+/// same bits for any team size. With a rival, the measure stops (complete false) as soon as the
+/// input's vertices show the run is not within it: their mean or one of them is beyond it.
 Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const std::vector<int32_t>& label,
-                          Collapser& collapser, const std::vector<int32_t>& triangles);
+                          Collapser& collapser, const std::vector<int32_t>& triangles,
+                          const Rival* rival = nullptr);
 
 }  // namespace topstoc

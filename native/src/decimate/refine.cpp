@@ -8,6 +8,7 @@
 #include <string>
 
 
+#include "decimate/collapse_snapshots.hpp"
 #include "decimate/collapser.hpp"
 #include "decimate/deviation.hpp"
 #include "decimate/tiny_fit.hpp"
@@ -475,12 +476,13 @@ class Refinement {
     result.refine_triangles = params.target_triangles;
     const Collapser::Stop stop = target(), restart{int32_t(kRestart * stop.vertices), int32_t(kRestart * stop.faces)};
     // Every run works on result's arrays: its own are copied in before it goes on.
-    auto best = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
-    const int32_t shared = best->remove_thin(kSliverShape, stop) + best->run(restart);
+    std::unique_ptr<Collapser> best;
+    const int32_t shared = shared_run(std::move(setup), stop, restart, best);
     const Collapser at_restart(*best);
     const std::vector<int32_t> restart_triangles = result.triangles, restart_corners = result.corner_source;
     int32_t best_collapses = shared + collapse_rest(*best, center, extent);
-    const InputSurface input(mesh, *best);
+    const std::shared_ptr<const InputSurface> kept_input = input_surface(*best);
+    const InputSurface& input = *kept_input;
     Deviation best_deviation = surface_deviation(mesh, input, label, *best, result.triangles), last = best_deviation;
     std::vector<int32_t> best_triangles = result.triangles, best_corners = result.corner_source;
     const double mean_bound = (1.0 + kMeanSlack) * best_deviation.mean;
@@ -492,9 +494,12 @@ class Refinement {
       auto run = std::make_unique<Collapser>(at_restart);
       run->reweigh(deviation_weights(*run, guidance, worst));
       const int32_t collapses = shared + collapse_rest(*run, center, extent);
-      last = surface_deviation(mesh, input, label, *run, result.triangles);
-      if (excess(last) < excess(best_deviation) || (excess(last) == excess(best_deviation) &&
-                                                    last.top2 <= best_deviation.top2 && last.mean <= mean_bound)) {
+      // The last run's deviation serves only the choice: measured until it loses.
+      const Rival rival{best_deviation.top2, mean_bound};
+      last = surface_deviation(mesh, input, label, *run, result.triangles, round + 1 == kRounds ? &rival : nullptr);
+      if (excess(last) < excess(best_deviation) ||
+          (excess(last) == excess(best_deviation) && last.complete && last.top2 <= best_deviation.top2 &&
+           last.mean <= mean_bound)) {
         best = std::move(run);
         best_deviation = last;
         best_collapses = collapses;
@@ -506,6 +511,37 @@ class Refinement {
     result.corner_source = std::move(best_corners);
     result.refine_collapses = best_collapses;
     finish(*best);
+  }
+
+  // The first run to `restart` (slivers first), from a state kept by an earlier refinement
+  // toward as many vertices or more when there is one; it keeps its own where its batches start
+  // to depend on the target. Returns the collapses from the start.
+  int32_t shared_run(CollapseSetup setup, Collapser::Stop stop, Collapser::Stop restart, std::unique_ptr<Collapser>& run) {
+    CollapseSnapshots* snapshots = params.target_triangles == 0 && !guided ? params.snapshots : nullptr;
+    if (!snapshots) {
+      run = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
+      return run->remove_thin(kSliverShape, stop) + run->run(restart);
+    }
+    const std::vector<uint64_t> start = start_key(setup, result.triangles, result.corner_source);
+    int32_t before = 0;
+    if (const auto kept = snapshots->find(start, restart.vertices)) {
+      run = resumed(*kept, result.triangles, result.corner_source, std::move(setup.quota));
+      before = kept->collapses;
+    } else {
+      run = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
+      before = run->remove_thin(kSliverShape, stop);
+    }
+    return before + run->run(restart, [&](const Collapser& state, int32_t made) {
+      snapshots->keep(snapshot(start, restart.vertices, before + made, state));
+    });
+  }
+
+  // The input's search structure: the one kept with the collapse states when there are some.
+  std::shared_ptr<const InputSurface> input_surface(const Collapser& collapser) const {
+    if (!params.snapshots) return std::make_shared<const InputSurface>(mesh, collapser);
+    return params.snapshots->input_surface(input_surface_key(mesh, collapser), [&] {
+      return std::make_shared<const InputSurface>(mesh, collapser);
+    });
   }
 
   // How far a run stayed above the target (0 once reached).

@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "topstoc/decimate/collapse_snapshots.hpp"
 #include "topstoc/decimate/decimate.hpp"
 #include "topstoc/decimate/features.hpp"
 #include "topstoc/core/mesh.hpp"
@@ -54,6 +55,9 @@ struct RefineParams {
   /// Every collapse a half-edge collapse (no optimal placement): the output keeps input
   /// positions, as fast mode promises.
   bool keep_positions = false;
+  /// Collapse states of earlier max-aware refinements of this mesh and layout, or null: a run
+  /// toward a lower vertex target resumes from one (unguided vertex targets only; the same result).
+  CollapseSnapshots* snapshots = nullptr;
   CornerAttributes attributes;
 };
 

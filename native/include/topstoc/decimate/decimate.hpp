@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "topstoc/decimate/features.hpp"
+#include "topstoc/decimate/collapse_snapshots.hpp"
 #include "topstoc/decimate/flood_cache.hpp"
 #include "topstoc/core/mesh.hpp"
 #include "topstoc/decimate/partition.hpp"
@@ -60,6 +61,9 @@ struct DecimateParams {
   /// result is the same either way, nearby targets of one seed come sooner (not with the fast
   /// path, whose results can differ from a full scan's).
   FloodCachePool* flood_caches = nullptr;
+  /// Collapse states of earlier quality decimations of this mesh and layout
+  /// (collapse_snapshots.hpp), or null: the same result either way, lower targets sooner.
+  CollapseSnapshots* collapse_snapshots = nullptr;
   /// A live-preview frame (plain TopStoc only, refine 0): the output's geometry (samples, kept,
   /// vertices, triangles) without face_source, corner_source and labels, and without the final
   /// output check (verify.hpp) unless the fast path needs it. The partition checks and repairs

@@ -1,0 +1,62 @@
+"""Collapse states kept between quality decimations (native collapse_snapshots.hpp): a mesh
+collapsed whole goes the same way toward every vertex target until its batches start to depend
+on the target, so a decimation toward a lower target resumes from the state an earlier one kept
+there. The promise is the same mesh as a fresh decimation: every result is compared, array for
+array and figure for figure, with the same decimation of a mesh that keeps nothing
+(``keep_floods=False``), and the states are checked to be kept where they apply and not elsewhere.
+"""
+
+import numpy as np
+import pytest
+
+import meshgen
+from topstoc.core import Mesh
+
+FIELDS = ("vertices", "triangles", "kept", "face_source", "corner_source", "labels", "samples")
+
+
+@pytest.fixture(scope="module")
+def torus():
+    return meshgen.bumpy_torus(20000)  # 10k vertices: collapsed whole, in batches
+
+
+def assert_same(a, b):
+    for name in FIELDS:
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    assert a.stats.refine_collapses == b.stats.refine_collapses
+
+
+def kept(mesh):
+    return mesh.kept_for_reuse()[2].size
+
+
+def test_a_drag_down_and_back_up_gives_the_fresh_results(torus):
+    mesh, plain = Mesh(*torus), Mesh(*torus, keep_floods=False)
+    assert plain.kept_for_reuse()[2] is None
+    for ratio in (0.1, 0.06, 0.03, 0.01, 0.02, 0.08, 0.1, 0.005):
+        assert_same(mesh.decimate(ratio=ratio), plain.decimate(ratio=ratio))
+        assert 1 <= kept(mesh) <= 2
+    mesh.clear_floods()
+    assert kept(mesh) == 0
+
+
+def test_attributes_and_seeds_keep_their_own_states(torus):
+    vertices, triangles = torus
+    uv = np.stack([vertices[:, 0], vertices[:, 1]], axis=1)[triangles]  # per corner
+    mesh, plain = Mesh(*torus), Mesh(*torus, keep_floods=False)
+    for options in (dict(ratio=0.05), dict(ratio=0.05, attributes=uv), dict(ratio=0.03, attributes=uv),
+                    dict(ratio=0.03, seed=5), dict(ratio=0.02)):
+        assert_same(mesh.decimate(**options), plain.decimate(**options))
+
+
+def test_guided_and_triangle_targets_keep_no_state(torus):
+    vertices, _ = torus
+    guidance = np.where(vertices[:, 2] > 0, 0.5, 0.0)
+    mesh, plain = Mesh(*torus), Mesh(*torus, keep_floods=False)
+    assert_same(mesh.decimate(ratio=0.05, guidance=guidance), plain.decimate(ratio=0.05, guidance=guidance))
+    assert_same(mesh.decimate(target_triangles=900), plain.decimate(target_triangles=900))
+    assert kept(mesh) == 0
+    # A state kept by an unguided decimation is not taken by a guided one.
+    mesh.decimate(ratio=0.05)
+    assert kept(mesh) == 1
+    assert_same(mesh.decimate(ratio=0.03, guidance=guidance), plain.decimate(ratio=0.03, guidance=guidance))
