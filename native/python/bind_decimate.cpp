@@ -207,9 +207,8 @@ DecimateParams params_from(const Mesh& mesh, const py::handle& job, JobArrays& a
   return params;
 }
 
-}  // namespace
-
-void bind_decimate(py::module_& m) {
+// What a mesh keeps between decimations (floods, collapse states) and the cancel flag.
+void bind_decimation_state(py::module_& m) {
   py::class_<FloodCachePool>(m, "FloodCachePool",
                              "Floods of earlier decimations of one mesh and feature layout, reused by nearby targets.")
       .def(py::init<size_t>(), py::arg("capacity") = 2)
@@ -228,7 +227,12 @@ void bind_decimate(py::module_& m) {
       .def(py::init<>())
       .def("set", [](CancelToken& token) { token.flag = true; }, "Asks the decimation to stop.")
       .def_property_readonly("is_set", [](const CancelToken& token) { return token.flag.load(); });
+}
 
+}  // namespace
+
+void bind_decimate(py::module_& m) {
+  bind_decimation_state(m);
   m.def(
       "decimate",
       [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& job, const py::handle& flood_caches,
