@@ -48,9 +48,7 @@ std::vector<uint64_t> start_key(const CollapseSetup& s, const std::vector<int32_
 }
 
 std::vector<uint64_t> input_surface_key(const Mesh& mesh, const Collapser& collapser) {
-  std::vector<uint64_t> key;
-  add(key, mesh.position(0), 3 * size_t(mesh.num_vertices()));
-  add(key, mesh.faces().data(), mesh.faces().size());
+  std::vector<uint64_t> key{mesh.serial()};  // a Mesh never changes: its serial names its positions and triangles
   const double corners[2][3] = {{0, 0, 0}, {1, 1, 1}};
   double normalised[2][3];
   for (int i = 0; i < 2; ++i) collapser.normalise(corners[i], normalised[i]);

@@ -26,8 +26,8 @@ struct CollapseSnapshots::Entry {
 std::vector<uint64_t> start_key(const CollapseSetup& setup, const std::vector<int32_t>& triangles,
                                 const std::vector<int32_t>& corner_source);
 
-/// The key of the input's search structure (InputSurface): the mesh's positions and triangles
-/// and the collapses' normalisation.
+/// The key of the input's search structure (InputSurface): the mesh (its serial, as the flood
+/// caches key it) and the collapses' normalisation.
 std::vector<uint64_t> input_surface_key(const Mesh& mesh, const Collapser& collapser);
 
 /// The entry for `collapser` at the point Collapser::run's before_tail reports.
