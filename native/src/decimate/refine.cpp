@@ -8,6 +8,7 @@
 #include <string>
 
 
+#include "decimate/attribute_wedges.hpp"
 #include "decimate/collapse_snapshots.hpp"
 #include "decimate/collapser.hpp"
 #include "decimate/deviation.hpp"
@@ -143,10 +144,11 @@ void add_vertex_quadric(const Mesh& mesh, const QuadricFrame& frame, int32_t v, 
 VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
                                 const std::vector<int32_t>& label, int32_t clusters, const QuadricFrame& frame) {
   const int channels = params.attributes.values ? params.attributes.channels : 0;
-  VertexQuadrics quadrics(clusters, channels);
+  VertexQuadrics quadrics(clusters, channels, params.attributes.wedges);
+  const std::vector<uint8_t> wedge = quadrics.wedges() > 0
+      ? corner_wedges(mesh, params.attributes, label, clusters, quadrics.wedges()) : std::vector<uint8_t>();
   const auto& faces = mesh.faces();
   const auto& face_source = mesh.face_source();
-  const int stride = quadrics.stride();
   const double* center = frame.center;
   const double scale = 1.0 / frame.extent;
   auto unit = [&](int32_t v, double* p) {
@@ -164,8 +166,9 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
           quadrics.add(label[v], sum);
         }
     } else {
-      // Attributes: each face's generalised quadric, a third to the cluster of each corner.
-      std::vector<double> face(stride), values(3 * size_t(channels));
+      // Attributes: each face's generalised quadric, a third to the cluster of each corner
+      // (to that corner's wedge there: attribute_wedges.hpp).
+      std::vector<double> face(quadrics.face_size()), values(3 * size_t(channels));
       for (int32_t f = 0; f < m; ++f) {
         const int32_t* t = &faces[3 * size_t(f)];
         const int32_t l[3] = {label[t[0]], label[t[1]], label[t[2]]};
@@ -180,8 +183,13 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
                 params.attributes.weights[a] * frame.diagonal;
         if (!quadrics.face(p[0], p[1], p[2], values.data(), face.data())) continue;
         for (double& x : face) x *= 1.0 / 3.0;
-        for (int j = 0; j < 3; ++j)
-          if (l[j] >= low && l[j] < high) quadrics.add(l[j], face.data());
+        double centroid[3];
+        for (int i = 0; i < 3; ++i) centroid[i] = (p[0][i] + p[1][i] + p[2][i]) / 3.0;
+        for (int j = 0; j < 3; ++j) {
+          if (!(l[j] >= low && l[j] < high)) continue;
+          if (wedge.empty()) quadrics.add(l[j], face.data());
+          else quadrics.add_corner(l[j], wedge[3 * size_t(f) + j], face.data(), centroid);
+        }
       }
     }
   });

@@ -19,8 +19,17 @@
 // planar UV map) and grows where the attributes bend or jump. So the collapse order and the
 // optimal placement see the attributes without solving a larger system. The weights are
 // applied to the values before the faces are added (see RefineParams::attributes).
+//
+// With wedges (Hoppe 1999, as meshoptimizer's attribute quadrics): a vertex keeps α, G_j, E_j
+// apart for each wedge, the corners around it that share attribute values, so a UV seam's or
+// hard edge's two sides each have their own best s and the jump between them costs nothing.
+// A vertex's quadric is then the plain part once minus each wedge's G_j G_jᵀ/α etc. A merge
+// pairs each wedge with the other vertex's wedge whose fields agree best where they meet (at
+// the midpoint of their area-weighted centroids, kept per wedge), when that choice is mutual;
+// any other wedge stays apart while a slot is free.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -31,11 +40,18 @@ namespace topstoc {
 
 class VertexQuadrics {
  public:
-  VertexQuadrics(int32_t vertices, int channels)
-      : channels_(channels), stride_(channels > 0 ? 11 + 4 * channels : 10), data_(size_t(vertices) * stride_, 0.0) {}
+  /// wedges > 0 (with channels): up to that many attribute parts per vertex (file comment).
+  VertexQuadrics(int32_t vertices, int channels, int wedges = 0)
+      : channels_(channels),
+        wedges_(channels > 0 ? std::min(wedges, kMaxWedges) : 0),
+        stride_(wedges_ > 0 ? 10 + wedges_ * wedge_size() : channels > 0 ? 11 + 4 * channels : 10),
+        data_(size_t(vertices) * stride_, 0.0) {}
 
   int channels() const { return channels_; }
+  int wedges() const { return wedges_; }
   int stride() const { return stride_; }
+  /// The length of one face's record from face(): the plain quadric, α, then G_j, E_j per channel.
+  int face_size() const { return channels_ > 0 ? 11 + 4 * channels_ : 10; }
   double* at(int32_t v) { return &data_[size_t(v) * stride_]; }
   const double* at(int32_t v) const { return &data_[size_t(v) * stride_]; }
 
@@ -58,7 +74,7 @@ class VertexQuadrics {
     return true;
   }
 
-  /// Writes face (p0, p1, p2)'s quadric into out (stride() doubles): its plane weighted by its
+  /// Writes face (p0, p1, p2)'s quadric into out (face_size() doubles): its plane weighted by its
   /// area and, with channels, its attribute fields through `values` (3 corners × channels).
   /// Returns false (out untouched) for a face of zero area.
   bool face(const double* p0, const double* p1, const double* p2, const double* values, double* out) const {
@@ -102,10 +118,27 @@ class VertexQuadrics {
     for (int i = 0; i < 10; ++i) x[i] += q[i];  // the plain quadric: a fixed loop the compiler unrolls
     for (int i = 10; i < stride_; ++i) x[i] += q[i];
   }
-  void merge(int32_t into, int32_t from) { add(into, at(from)); }
+  /// Wedge mode: adds a face record (face(), already scaled to this corner's share) to vertex
+  /// v's plain part and to its wedge `slot`, whose centroid sum takes the face's `centroid`.
+  void add_corner(int32_t v, int slot, const double* record, const double* centroid) {
+    double* x = at(v);
+    for (int i = 0; i < 10; ++i) x[i] += record[i];
+    double* wedge = x + 10 + slot * wedge_size();
+    const double alpha = record[10];
+    wedge[0] += alpha;
+    for (int i = 0; i < 3; ++i) wedge[1 + i] += alpha * centroid[i];
+    for (int i = 0; i < 4 * channels_; ++i) wedge[4 + i] += record[11 + i];
+  }
+
+  void merge(int32_t into, int32_t from) {
+    if (wedges_ > 0) return merge_wedges(at(into), at(from));
+    add(into, at(from));
+  }
 
   /// The plain quadric of u's (and v's, when v >= 0) sum with the attributes at their best.
+  /// The sum is u merged into v, as merge(v, u) makes it.
   void reduced(int32_t u, int32_t v, Quadric& out) const {
+    if (wedges_ > 0) return reduced_wedges(u, v, out);
     const double* qu = at(u);
     if (channels_ == 0) {
       for (int i = 0; i < 6; ++i) out.a[i] = qu[i];
@@ -138,9 +171,90 @@ class VertexQuadrics {
   }
 
   static constexpr int kMaxChannels = 16;
+  static constexpr int kMaxWedges = 8;
 
  private:
+  int wedge_size() const { return 4 + 4 * channels_; }
+
+  /// How far wedges a and b's attribute fields are apart (squared, summed over the channels)
+  /// at the midpoint of their centroids.
+  double wedge_gap(const double* a, const double* b) const {
+    double p[3];
+    for (int i = 0; i < 3; ++i) p[i] = 0.5 * (a[1 + i] / a[0] + b[1 + i] / b[0]);
+    double gap = 0;
+    for (int j = 0; j < channels_; ++j) {
+      const double* ga = a + 4 + 4 * j;
+      const double* gb = b + 4 + 4 * j;
+      const double sa = (ga[0] * p[0] + ga[1] * p[1] + ga[2] * p[2] + ga[3]) / a[0];
+      const double sb = (gb[0] * p[0] + gb[1] * p[1] + gb[2] * p[2] + gb[3]) / b[0];
+      gap += (sa - sb) * (sa - sb);
+    }
+    return gap;
+  }
+
+  /// The wedge of vertex record x nearest to `wedge` (-1 when x has none).
+  int nearest_wedge(const double* x, const double* wedge) const {
+    int best = -1;
+    double best_gap = 0;
+    for (int k = 0; k < wedges_; ++k) {
+      const double* w = x + 10 + k * wedge_size();
+      if (!(w[0] > 0)) continue;
+      const double gap = wedge_gap(w, wedge);
+      if (best < 0 || gap < best_gap) best = k, best_gap = gap;
+    }
+    return best;
+  }
+
+  /// Adds vertex record `from` to `into`, pairing their wedges (file comment).
+  void merge_wedges(double* into, const double* from) const {
+    const int size = wedge_size();
+    int target[kMaxWedges];
+    bool used[kMaxWedges];
+    for (int k = 0; k < wedges_; ++k) used[k] = into[10 + k * size] > 0;
+    for (int k = 0; k < wedges_; ++k) {
+      const double* w = from + 10 + k * size;
+      target[k] = -1;
+      if (!(w[0] > 0)) continue;
+      const int near = nearest_wedge(into, w);
+      if (near >= 0 && nearest_wedge(from, into + 10 + near * size) == k) {
+        target[k] = near;
+        continue;
+      }
+      for (int free = 0; free < wedges_ && target[k] < 0; ++free)
+        if (!used[free]) target[k] = free, used[free] = true;
+      if (target[k] < 0) target[k] = near;
+    }
+    for (int i = 0; i < 10; ++i) into[i] += from[i];
+    for (int k = 0; k < wedges_; ++k)
+      if (target[k] >= 0)
+        for (int i = 0; i < size; ++i) into[10 + target[k] * size + i] += from[10 + k * size + i];
+  }
+
+  void reduced_wedges(int32_t u, int32_t v, Quadric& out) const {
+    double sum[10 + kMaxWedges * (4 + 4 * kMaxChannels)];
+    const double* base = at(v >= 0 ? v : u);
+    for (int i = 0; i < stride_; ++i) sum[i] = base[i];
+    if (v >= 0) merge_wedges(sum, at(u));
+    for (int i = 0; i < 6; ++i) out.a[i] = sum[i];
+    for (int i = 0; i < 3; ++i) out.b[i] = sum[6 + i];
+    out.c = sum[9];
+    for (int k = 0; k < wedges_; ++k) {
+      const double* w = sum + 10 + k * wedge_size();
+      const double alpha = w[0];
+      if (!(alpha > 0)) continue;
+      for (int j = 0; j < channels_; ++j) {
+        const double* g = w + 4 + 4 * j;
+        const double e = g[3];
+        out.a[0] -= g[0] * g[0] / alpha, out.a[1] -= g[0] * g[1] / alpha, out.a[2] -= g[0] * g[2] / alpha;
+        out.a[3] -= g[1] * g[1] / alpha, out.a[4] -= g[1] * g[2] / alpha, out.a[5] -= g[2] * g[2] / alpha;
+        for (int i = 0; i < 3; ++i) out.b[i] -= e * g[i] / alpha;
+        out.c -= e * e / alpha;
+      }
+    }
+  }
+
   int channels_;
+  int wedges_;
   int stride_;
   std::vector<double> data_;
 };

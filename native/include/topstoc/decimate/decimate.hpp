@@ -31,6 +31,9 @@ struct CornerAttributes {
   const double* values = nullptr;
   int channels = 0;
   const double* weights = nullptr;
+  /// Up to this many attribute quadrics per vertex, one per wedge (the corners that share
+  /// values: a seam's two sides), so a seam's jump costs nothing (vertex_quadrics.hpp); 0: one.
+  int wedges = 4;
 };
 
 
