@@ -144,9 +144,16 @@ void add_vertex_quadric(const Mesh& mesh, const QuadricFrame& frame, int32_t v, 
 VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
                                 const std::vector<int32_t>& label, int32_t clusters, const QuadricFrame& frame) {
   const int channels = params.attributes.values ? params.attributes.channels : 0;
-  VertexQuadrics quadrics(clusters, channels, params.attributes.wedges);
-  const std::vector<uint8_t> wedge = quadrics.wedges() > 0
-      ? corner_wedges(mesh, params.attributes, label, clusters, quadrics.wedges()) : std::vector<uint8_t>();
+  // Wedges only where some cluster has two: otherwise one attribute part per vertex is the same.
+  std::vector<uint8_t> wedge;
+  int wedges = 0;
+  if (channels > 0 && params.attributes.wedges > 1) {
+    wedge = corner_wedges(mesh, params.attributes, label, clusters,
+                          std::min(params.attributes.wedges, VertexQuadrics::kMaxWedges));
+    for (uint8_t w : wedge) wedges = std::max(wedges, w + 1);
+    if (wedges < 2) wedge.clear(), wedges = 0;
+  }
+  VertexQuadrics quadrics(clusters, channels, wedges);
   const auto& faces = mesh.faces();
   const auto& face_source = mesh.face_source();
   const double* center = frame.center;

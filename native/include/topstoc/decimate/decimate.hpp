@@ -31,8 +31,9 @@ struct CornerAttributes {
   const double* values = nullptr;
   int channels = 0;
   const double* weights = nullptr;
-  /// Up to this many attribute quadrics per vertex, one per wedge (the corners that share
-  /// values: a seam's two sides), so a seam's jump costs nothing (vertex_quadrics.hpp); 0: one.
+  /// Up to this many attribute quadrics per vertex (at most 8), one per wedge (the corners that
+  /// share values: a seam's two sides), so a seam's jump costs nothing (vertex_quadrics.hpp);
+  /// 0 or 1: one per vertex. Meshes whose clusters have one wedge each store one either way.
   int wedges = 4;
 };
 
