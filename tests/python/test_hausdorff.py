@@ -303,14 +303,25 @@ def test_error_bounded_decimation_meets_the_bound_with_a_minimal_count(data_dir,
     assert again.symmetric.max_upper >= report.failed_error * (1 - 1e-12)
 
 
-def test_error_bounded_search_decimates_few_targets_and_stays_minimal(data_dir):
+def test_error_bounded_search_decimates_few_targets_and_stays_minimal(data_dir, monkeypatch):
     # fandisk at 0.3 % in quality mode: the bisection on the estimate followed by exact checks
-    # decimated more than 11 targets (design.md §2.11 says how the search brackets and checks)
+    # decimated more than 11 targets; with every pass the coarse estimate found checked exactly,
+    # 4 exact checks; the fine estimate leaves only the answer to check (design.md §2.11)
     vertices, triangles = read_off(data_dir / "genus0/cgal_fandisk.off")
     mesh = topstoc.Mesh(vertices, triangles)
+    error_bound = importlib.import_module(topstoc.__name__ + ".core.api.error_bound")
+    checked, decide = [], error_bound.decide_error
+
+    def counted(mesh, result, bound, **kwargs):
+        checked.append(result.num_vertices)
+        return decide(mesh, result, bound, **kwargs)
+
+    monkeypatch.setattr(error_bound, "decide_error", counted)
     result = mesh.decimate(max_error=0.003, relative=True, seed=1)
+    monkeypatch.undo()
     report = result.error_bound
     assert len({target for target, *_ in report.probes}) <= 11
+    assert len(checked) <= 2 and checked[-1] == report.output_vertices
     check = topstoc.hausdorff(mesh, result, samples=200_000, percentile=0)
     assert check.symmetric.max <= report.max_error * (1 + 1e-12)
     # minimal: one resolution fewer vertices measures above the bound, exactly
@@ -318,6 +329,21 @@ def test_error_bounded_search_decimates_few_targets_and_stays_minimal(data_dir):
     below = mesh.decimate(target_vertices=report.failed_target, seed=1)
     again = topstoc.hausdorff(mesh, below, samples=200_000, percentile=0)
     assert again.symmetric.max_upper > report.max_error * (1 - EXACT_GAP)
+
+
+def test_error_bounded_search_returns_the_fewest_passing_vertices_from_its_first_probe(data_dir):
+    # The error is not monotone in the count, so a search at the resolution need not find the
+    # fewest vertices that pass. On fandisk at 0.3 % every target from the search's first probe
+    # (active // 64) up to the answer, checked exactly, fails.
+    vertices, triangles = read_off(data_dir / "genus0/cgal_fandisk.off")
+    mesh = topstoc.Mesh(vertices, triangles)
+    report = mesh.decimate(max_error=0.003, relative=True, seed=1).error_bound
+    error_estimate = importlib.import_module(topstoc.__name__ + ".core.api.error_estimate")
+    original = importlib.import_module(topstoc.__name__ + ".core.api.hausdorff").as_surface(mesh, "mesh")
+    passing = [n for n in range(mesh.num_vertices // 64, report.target_vertices + 1)
+               if error_estimate.decide_error(mesh, mesh.decimate(target_vertices=n, seed=1), report.max_error,
+                                              original_surface=original).upper <= report.max_error]
+    assert passing == [report.target_vertices]
 
 
 def test_error_bounded_search_reports_progress_and_cancels(eight):
