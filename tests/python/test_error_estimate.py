@@ -111,24 +111,3 @@ def test_the_quick_bound_holds_against_the_exact_max_and_is_near_it(data_dir, na
         assert quick.estimate >= 0.9 * exact.estimate
         measured = hausdorff(original, result, samples=200_000, percentile=0).forward.mean
         assert 0.6 * measured <= quick.mean <= 1.4 * measured
-
-
-def test_the_fine_sampled_estimate_finds_a_far_point_on_an_edge():
-    # A unit square with a 0.2 x 0.2 notch cut from its lower border at x in [0.65, 0.85]; the
-    # result spans the notch with one edge. Its point (0.75, 0) is 0.1 from the original (the
-    # notch's walls); its vertices, centroids and first edges' midpoints (the coarse samples) lie on it.
-    n = 20
-    xs = np.linspace(0, 1, n + 1)
-    vertices = np.array([(x, y, 0.0) for y in xs for x in xs])
-    cells = [(i, j) for j in range(n) for i in range(n) if not (13 <= i < 17 and j < 4)]
-    triangles = np.array([t for i, j in cells for t in (
-        (j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1),
-        (j * (n + 1) + i, (j + 1) * (n + 1) + i + 1, (j + 1) * (n + 1) + i))])
-    result = (np.array([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], dtype=float), np.array([[0, 1, 2], [0, 2, 3]]))
-    original = (vertices, triangles)
-    surface = importlib.import_module(topstoc.__name__ + ".core.api.hausdorff").as_surface(original, "original")
-    exact = estimates.estimate_error(original, result, gap=1e-3)
-    assert exact.estimate == pytest.approx(0.1, rel=1e-3)  # the notch's depth
-    assert estimates.SampledError(original, surface)(result) < 1e-9
-    sampled = estimates.SampledError(original, surface, fine=True)(result)
-    assert 0.9 * exact.estimate <= sampled <= exact.estimate * (1 + 1e-12)

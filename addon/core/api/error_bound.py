@@ -11,13 +11,8 @@ largest distance over about 40,000 points spread on both surfaces (attained, so 
 bound fails for certain). A passing target is checked exactly
 (topstoc.core.error_estimate.decide_error: the guaranteed bracket of the exact maximum, refined
 only as far as deciding the bound needs): at once with ``check_passes`` (quality mode, where a
-decimation costs more than a check), else only the answer. On an original of FINE_VERTICES or
-more, quality mode samples each result finely instead (edges cut evenly, a grid inside each
-triangle: a coarse result's far point from the original mostly lies on a long edge, between the
-coarse samples, and the coarse estimate passed targets the exact check then failed), checks only
-the answer, and bisects on to half the resolution (the bisection aims differently, and the
-error's non-monotone steps could otherwise leave its answer a few vertices above the checked
-path's). A failed check's far point joins the estimate's points and the search goes on above it. Error need not fall monotonically with the vertex count (each count draws other
+decimation costs more than a check), else only the answer. A failed check's far point joins the
+estimate's points and the search goes on above it. Error need not fall monotonically with the vertex count (each count draws other
 samples); the guarantee is the one the search can check: the returned decimation's error is
 within the bound (a guaranteed upper bound of its exact maximum), and the target
 ``resolution`` below it (``failed_target``) measured a distance above the bound. ``progress(probe, target, vertices, error, passed)``, when given, is called after every
@@ -55,11 +50,6 @@ class ErrorBoundReport:
     seconds: float = 0.0
 
 
-#: with check_passes, originals of at least this many vertices get SampledError's fine samples
-#: and only the answer checked exactly (on smaller ones the fine samples cost about a decimation)
-FINE_VERTICES = 5_000
-
-
 def resolution_count(target: int, resolution: float) -> int:
     """Vertex-count resolution at ``target`` for a relative resolution."""
     return max(1, int(math.floor(resolution * target)))
@@ -69,8 +59,8 @@ class _Probes:
     """The probes of one search: each target decimated once and judged, by the sampled estimate
     or exactly (see the module docs)."""
 
-    def __init__(self, mesh, original, bound: float, decimate_at: Callable[[int], object], progress, fine: bool):
-        self.mesh, self.original, self.sampled = mesh, original, SampledError(mesh, original, fine=fine)
+    def __init__(self, mesh, original, bound: float, decimate_at: Callable[[int], object], progress):
+        self.mesh, self.original, self.sampled = mesh, original, SampledError(mesh, original)
         self.bound, self.decimate_at, self.progress = bound, decimate_at, progress
         self.probes, self.results, self.exact, self.queries = [], {}, set(), 0
 
@@ -140,8 +130,7 @@ def search_vertex_count(mesh, max_error: float, decimate_at: Callable[[int], obj
     (0.01 = 1 %). resolution: stop when the failing and passing targets differ by at most
     ``max(1, resolution * target)``. check_passes: check every target the estimate passes exactly
     at once (fewer decimations, more exact checks: for when a decimation costs more than a check)
-    rather than only the answer; on an original of FINE_VERTICES or more, sample the results
-    finely instead, check only the answer, then bisect to half the resolution. progress: ``progress(probe, target, vertices, error,
+    rather than only the answer. progress: ``progress(probe, target, vertices, error,
     passed)`` after every probe; False stops the search with ``Cancelled``.
     Returns (DecimateResult, ErrorBoundReport).
     """
@@ -152,11 +141,7 @@ def search_vertex_count(mesh, max_error: float, decimate_at: Callable[[int], obj
     bound = max_error * original.diagonal if relative else float(max_error)
     report = mesh.report()
     active = report.input_vertices - report.isolated_vertices
-    # where checks pay (check_passes), a big mesh's results are sampled finely instead: the extra
-    # points cost less than the exact checks of every pass they replace
-    fine = check_passes and active >= FINE_VERTICES
-    check_passes = check_passes and not fine
-    probe = _Probes(mesh, original, bound, decimate_at, progress, fine)
+    probe = _Probes(mesh, original, bound, decimate_at, progress)
 
     lo, hi = _bracket(probe, active, resolution)
     if not check_passes:
@@ -169,10 +154,6 @@ def search_vertex_count(mesh, max_error: float, decimate_at: Callable[[int], obj
         hi = next((n for n in sorted(probe.results) if n > lo and probe(n)), active)
     # then on to the resolution on exact checks (the estimate first with check_passes)
     lo, hi = _bisect(probe.judge if check_passes else lambda n: probe(n, exact=True), lo, hi, resolution)
-    if fine and hi != active:
-        # the error is not monotone in the count: the answer of a bisection at the resolution
-        # may lie a little above one a differently aimed one finds; half the resolution closes it
-        lo, hi = _bisect(probe.judge, lo, hi, resolution / 2)
     if hi not in probe.results:
         probe(hi, exact=True)  # the full count: only reached when every smaller target failed
     result, error, passed = probe.results[hi]

@@ -163,15 +163,13 @@ class SampledError:
     """The largest distance over points spread on both surfaces, for many results of one original:
     attained, so never above the exact maximum (a lower bound, not a bracket). The original's
     points (every k-th triangle's centroid and vertex, about ``samples`` in all) are taken once;
-    on a result: its vertices, and every k-th triangle's centroid and edge midpoint, or with
-    ``fine`` about ``samples`` points along its edges and inside its triangles (_spread: closer to
-    the exact maximum on coarse results, for the cost of more queries)."""
+    on a result: its vertices, and every k-th triangle's centroid and edge midpoint."""
 
-    def __init__(self, original, original_surface, samples: int = 40_000, fine: bool = False):
+    def __init__(self, original, original_surface, samples: int = 40_000):
         vertices, triangles = _arrays(original)
         step = max(1, -(-len(triangles) // max(1, samples // 2)))
         self.points = np.concatenate([vertices[triangles[::step]].mean(axis=1), vertices[triangles[::step, 0]]])
-        self.surface, self.samples, self.fine = original_surface, samples, fine
+        self.surface, self.samples = original_surface, samples
 
     def add_witness(self, point) -> None:
         """Measures this point of the original from now on (one an exact check found too far)."""
@@ -179,41 +177,12 @@ class SampledError:
 
     def __call__(self, result) -> float:
         vertices, triangles = _arrays(result)
-        spread = _spread if self.fine else _coarse
-        points = np.concatenate([vertices, spread(vertices, triangles, self.samples)])
+        step = max(1, -(-len(triangles) // max(1, self.samples // 2)))
+        corners = vertices[triangles[::step]]
+        points = np.concatenate([vertices, corners.mean(axis=1), 0.5 * (corners[:, 0] + corners[:, 1])])
         forward = engine.closest_points(as_surface(result, "result"), self.points)["distance"]
         backward = engine.closest_points(self.surface, points)["distance"]
         return float(max(forward.max(initial=0.0), backward.max(initial=0.0)))
-
-
-def _coarse(vertices, triangles, count: int):
-    """Every k-th triangle's centroid and the midpoint of its first edge, about ``count`` points."""
-    step = max(1, -(-len(triangles) // max(1, count // 2)))
-    corners = vertices[np.asarray(triangles).reshape(-1, 3)[::step]]
-    return np.concatenate([corners.mean(axis=1), 0.5 * (corners[:, 0] + corners[:, 1])])
-
-
-def _spread(vertices, triangles, count: int):
-    """About ``count`` points on the triangles: half along the edges, each cut evenly as finely as
-    that allows, half inside, on each triangle's barycentric grid of the finest level that fits
-    (a coarse result's farthest point from the original mostly lies on one of its long edges or
-    inside a large triangle); _coarse's when the edges would be cut in fewer than 3 pieces."""
-    triangles = np.asarray(triangles).reshape(-1, 3)
-    if len(triangles) == 0:
-        return np.zeros((0, 3))
-    edges = np.unique(np.sort(triangles[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)
-    cuts = count // 2 // len(edges) + 1
-    if cuts < 3:
-        return _coarse(vertices, triangles, count)
-    t = np.arange(1, cuts)[None, :, None] / cuts
-    along = (1 - t) * vertices[edges[:, 0]][:, None] + t * vertices[edges[:, 1]][:, None]
-    level = 3  # (level - 1)(level - 2) / 2 points inside a triangle: the centroid at 3
-    while level * (level - 1) // 2 * len(triangles) <= count // 2:  # the next level fits
-        level += 1
-    grid = np.array([(i, j, level - i - j) for i in range(1, level) for j in range(1, level - i)],
-                    dtype=np.float64) / level
-    inside = np.einsum("gk,tkd->tgd", grid, vertices[triangles])
-    return np.concatenate([along.reshape(-1, 3), inside.reshape(-1, 3)])
 
 
 def _arrays(mesh):
