@@ -424,6 +424,35 @@ def render_batch(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def render_error_search(name: str, figures: dict) -> str:
+    """bench_error_search.py --json: max_error searches against one count-target decimation at the answer."""
+    cases = figures["cases"]
+    with_baseline = any("baseline" in row for row in cases)
+    out = [f"## Error-bounded search (`{name}`)", "",
+           f"`{figures['benchmark']}`: a `max_error` search (relative to the diagonal) next to one count-target "
+           "decimation at its answer, both on a fresh mesh. Issue 39's goal: the search within 3× the count "
+           "target. Decimated: targets decimated; probes: their judgements (the estimate, then an exact check of some).", "",
+           *source_lines(figures), "",
+           "| Mesh, bound, mode | Decimated / probes | Target (failed) | Search: wall / CPU | Count target: wall / CPU "
+           "| Search ÷ count (CPU) | Search CPU: decimations, exact checks, estimates (calls) |"
+           + (" Baseline build (--baseline): decimated, target, search CPU, ÷ count (CPU) |" if with_baseline else ""),
+           "|---|---|---|---|---|---|---|" + ("---|" if with_baseline else "")]
+    for row in cases:
+        split = row.get("split", {})
+        parts = ", ".join(f"{split[key]['cpu']:.2f} s ({split[key]['calls']})" if key in split else "—"
+                          for key in ("decimations", "exact_checks", "estimates"))
+        line = (f"| {row['mesh']} {100 * row['bound']:.1f} %, {row['mode']} | {row['decimated']} / {row['probes']} "
+                f"| {row['target']:,} ({row['failed']:,}) | {row['search']:.2f} s / {row['search_cpu']:.2f} s "
+                f"| {row['count']:.3f} s / {row['count_cpu']:.3f} s | {row['search_cpu'] / row['count_cpu']:.1f}× | {parts} |")
+        before = row.get("baseline")
+        if with_baseline:
+            line += (" — |" if before is None else
+                     f" {before['decimated']}, {before['target']:,}, {before['search_cpu']:.2f} s, "
+                     f"{before['search_cpu'] / before['count_cpu']:.1f}× |")
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
 def render_result(path: pathlib.Path) -> str:
     figures = json.loads(path.read_text())
     if isinstance(figures, dict) and figures.get("carried_over"):
@@ -450,10 +479,12 @@ def render_result(path: pathlib.Path) -> str:
         return render_blender_rest(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_batch.py":
         return render_batch(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_error_search.py":
+        return render_error_search(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
                      "the --json of bench_decimate.py, bench_quality.py, bench_attributes.py, bench_loops.py --families, "
                      "bench_scale.py, bench_blender_background.py --memory, bench_threads_paired.py, bench_cleanup.py, "
-                     "bench_cleanup.py --speed, bench_blender_decimate.py --only-rest and bench_batch.py, and carried-over "
+                     "bench_cleanup.py --speed, bench_blender_decimate.py --only-rest, bench_batch.py and bench_error_search.py, and carried-over "
                      "figures)")
 
 
