@@ -162,6 +162,28 @@ void bind_hausdorff(py::module_& m) {
       "(threshold >= 0: only as tight as deciding whether the max exceeds it needs).");
 
   m.def(
+      "bracket_symmetric_max",
+      [](const Surface& a, const Surface& b, double tolerance, int64_t max_queries) {
+        SymmetricBracket r;
+        {
+          EngineCall call;
+          r = bracket_symmetric_max(a, b, tolerance, max_queries);
+        }
+        py::dict out;
+        for (const auto& [name, side] : {std::pair{"forward", &r.forward}, std::pair{"backward", &r.backward}}) {
+          py::dict d;
+          d["lower"] = side->lower;
+          d["upper"] = side->upper;
+          d["queries"] = side->queries;
+          d["converged"] = side->converged;
+          out[name] = d;
+        }
+        return out;
+      },
+      py::arg("a"), py::arg("b"), py::arg("tolerance"), py::arg("max_queries") = 20000000,
+      "Guaranteed brackets of both one-sided maxima, each side from its surface's vertices.");
+
+  m.def(
       "quick_hausdorff_bound",
       [](const Surface& a, const Surface& b, double tolerance) {
         if (!(tolerance > 0.0)) throw std::invalid_argument("tolerance must be positive, got " + std::to_string(tolerance));

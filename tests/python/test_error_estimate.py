@@ -79,21 +79,21 @@ def test_agrees_with_cgal(data_dir, tmp_path, name, mode, ratio, queries):
         assert ours[0] <= cgal[side]["max_bounded"] + cgal["error_bound"] <= ours[1] + 2 * cgal["error_bound"]
 
 
-#: (mesh, mode, ratio, settles): settles False where the result is nearly on the original over
-#: long sides (CAD), which the quick bound does not settle within its budget: there it only holds.
-QUICK_CASES = [("genus0/cgal_fandisk.off", "quality", 0.1, False), ("genus0/cgal_armadillo.off.gz", "fast", 0.02, True),
-               ("genus_positive/cgal_elephant.off", "quality", 0.01, True),
-               ("open_boundary/cgal_mushroom.off", "quality", 0.01, True),
-               ("nonmanifold_degenerate/dragon_vrip_res4.ply.gz", "fast", 0.02, True),
-               ("open_boundary/kivy_suzanne_monkey.obj", "quality", 0.1, True)]
+#: (mesh, mode, ratio): on CAD (fandisk) the quick bound alone does not settle a result nearly on
+#: the original over long sides; the walk it falls back on then does.
+QUICK_CASES = [("genus0/cgal_fandisk.off", "quality", 0.1), ("genus0/cgal_armadillo.off.gz", "fast", 0.02),
+               ("genus_positive/cgal_elephant.off", "quality", 0.01),
+               ("open_boundary/cgal_mushroom.off", "quality", 0.01),
+               ("nonmanifold_degenerate/dragon_vrip_res4.ply.gz", "fast", 0.02),
+               ("open_boundary/kivy_suzanne_monkey.obj", "quality", 0.1)]
 
 
-@pytest.mark.parametrize("name, mode, ratio, settles", QUICK_CASES)
-def test_the_quick_bound_holds_against_the_exact_max_and_is_near_it(data_dir, name, mode, ratio, settles):
+@pytest.mark.parametrize("name, mode, ratio", QUICK_CASES)
+def test_the_quick_bound_holds_against_the_exact_max_and_is_near_it(data_dir, name, mode, ratio):
     # The quick bound (the default for big originals: no search structure over the original's
     # triangles) against the exact bracketed max, side by side: its upper bound is never below the
-    # exact max (each side too), its estimate never above. Where it settles, the upper bound is
-    # within 1.5x of the exact max (25 % aimed at) and the estimate within 10 %, and its mean
+    # exact max (each side too), its estimate never above. It settles: the upper bound is within
+    # 25 % of its estimate, within 1.5x of the exact max, the estimate within 10 %, and its mean
     # estimates the mean distance from the original (one vertex per grid cell, unweighted), within 40 %.
     from topstoc.core.api.hausdorff import hausdorff
     from topstoc.core.api.io import read_mesh
@@ -105,9 +105,8 @@ def test_the_quick_bound_holds_against_the_exact_max_and_is_near_it(data_dir, na
     assert quick.upper >= exact.estimate and quick.estimate <= exact.upper
     assert quick.forward[1] >= exact.forward[0] and quick.backward[1] >= exact.backward[0]
     assert quick.forward[0] <= exact.forward[1] and quick.backward[0] <= exact.backward[1]
-    assert quick.converged == settles
-    if settles:
-        assert quick.upper <= 1.5 * exact.upper
-        assert quick.estimate >= 0.9 * exact.estimate
-        measured = hausdorff(original, result, samples=200_000, percentile=0).forward.mean
-        assert 0.6 * measured <= quick.mean <= 1.4 * measured
+    assert quick.converged and quick.upper <= (1 + estimates.DEFAULT_GAP) * quick.estimate
+    assert quick.upper <= 1.5 * exact.upper
+    assert quick.estimate >= 0.9 * exact.estimate
+    measured = hausdorff(original, result, samples=200_000, percentile=0).forward.mean
+    assert 0.6 * measured <= quick.mean <= 1.4 * measured

@@ -15,18 +15,21 @@ are bracketed exactly. The result's triangles are split until the distance to th
 triangles around a nearby vertex, plus the piece's reach, is within ``(1 + gap)`` of the largest
 such value; the points with the 16 largest are measured exactly. Where a side's bound is still
 above ``(1 + gap)`` times the estimate (a tiny maximum against long sides: a result nearly on the
-original), that side is bracketed by the walk below too, and the tighter bounds kept.
+original), that side is bracketed too by a walk down its surface's BVH (``bracket_one_sided_max``,
+which opens only the boxes that may hide a larger distance) until it converges, and the tighter
+bounds kept.
 ``estimate`` is the largest distance measured exactly (attained, so never above the exact
 maximum); ``upper`` the largest bound (no point is farther). ``mean`` estimates the mean
 distance from the original (one measured vertex per grid cell, unweighted).
 
-Otherwise each side is bracketed by a walk down the measured surface's own BVH
-(``bracket_one_sided_max``): a node's box bounds the distance of every point in it; only nodes
-whose bound exceeds ``(1 + gap)`` times the best distance found are opened, and a leaf's
-triangles are subdivided as in the exact measurement (hausdorff.py) until the same test holds,
-or until ``queries`` closest-point queries per side (default: one per 8 triangles of the two
-surfaces, 2,000 to 100,000) (then the bracket holds, only wider,
-``converged`` False). ``exact_error`` asks for the gap and the query budget of the exact
+Otherwise both sides are bracketed at once (``bracket_symmetric_max``, on two threads): every
+vertex of a side's surface is measured, then its triangles are bounded by their corners (the
+distance is 1-Lipschitz; the distance to one triangle of the other surface is convex) and by the
+other surface's triangles beneath them (distance/projected_bound.cpp), and only those whose bound
+exceeds ``(1 + gap)`` times the largest distance found are split and measured again, until none
+is left (``converged``) or ``queries`` closest-point queries a side were spent (default: the
+exact measurement's budget, which the originals tried never reach; then the bracket holds, only
+wider). ``exact_error`` asks for the gap and the query budget of the exact
 bracketed maximum of hausdorff.py. ``decide_error`` asks only whether the maximum exceeds a
 bound (the error-bounded search's exact check); ``SampledError`` is the search's cheap estimate
 (distances attained at points spread on both surfaces, no upper bound).
@@ -42,10 +45,8 @@ from .hausdorff import as_surface
 from ..support.native import engine
 
 DEFAULT_GAP = 0.25         #: relative gap aimed at between the estimate and its upper bound, by default
-#: closest-point queries a side for the BVH walks (one per 8 triangles of the two surfaces, within these)
-WALK_QUERIES = (2_000, 100_000)
-#: originals of this many triangles or more get the quick bound by default: building their BVH for
-#: the walks costs more than the decimation (on smaller ones the walks settle in fewer queries)
+#: originals of this many triangles or more get the quick bound by default: building their BVH and
+#: measuring all their vertices costs more than the decimation (smaller ones settle in fewer queries)
 QUICK_TRIANGLES = 250_000
 EXACT_GAP = 1e-3           #: the gap of the exact bracketed maximum (hausdorff.py's max_tolerance)
 EXACT_QUERIES = 20_000_000 #: closest-point queries per side for the exact one
@@ -80,8 +81,8 @@ def estimate_error(original, result, gap: float = DEFAULT_GAP, queries=None, *,
     """Brackets the symmetric Hausdorff max between ``original`` and ``result`` (each
     ``(vertices, triangles)``, an object with both, or an engine Surface) within the relative
     ``gap``: by the quick bound (``quick`` True; by default when the original has QUICK_TRIANGLES
-    triangles or more and no ``queries`` are given), else by the BVH walks with at most ``queries``
-    closest-point queries per side (default: one per 8 triangles of the two surfaces, WALK_QUERIES).
+    triangles or more and no ``queries`` are given), else from both surfaces' vertices with at most
+    ``queries`` closest-point queries per side after them (default: EXACT_QUERIES).
     original_surface: the original's engine Surface when the caller keeps one for several results."""
     a = original_surface or as_surface(original, "original")
     b = as_surface(result, "result")
@@ -94,30 +95,24 @@ def estimate_error(original, result, gap: float = DEFAULT_GAP, queries=None, *,
         estimate = max(sides[0][0], sides[1][0])
         for side, (x, y) in zip(sides, ((a, b), (b, a))):
             if side[1] > estimate * (1 + gap):  # not settled (a tiny max against long sides): the walk too
-                walk = engine.bracket_one_sided_max(x, y, tolerance=gap, max_queries=_walk_budget(a, b))
+                walk = engine.bracket_one_sided_max(x, y, tolerance=gap, max_queries=EXACT_QUERIES)
                 side[0], side[1] = max(side[0], walk["lower"]), min(side[1], walk["upper"])  # both hold
                 queries += walk["queries"]
         estimate, upper = max(sides[0][0], sides[1][0]), max(sides[0][1], sides[1][1])
         return ErrorBound(estimate=estimate, upper=upper, forward=tuple(sides[0]), backward=tuple(sides[1]),
                           gap=float(gap), queries=int(queries), converged=bool(upper <= estimate * (1 + gap)),
                           mean=float(found["forward_mean"]))
-    queries = _walk_budget(a, b) if queries is None else queries
-    forward = engine.bracket_one_sided_max(a, b, tolerance=gap, max_queries=int(queries))
-    backward = engine.bracket_one_sided_max(b, a, tolerance=gap, max_queries=int(queries))
-    if not (forward["converged"] and backward["converged"]):  # the walk's best is not spread: add samples
+    queries = EXACT_QUERIES if queries is None else queries
+    found = engine.bracket_symmetric_max(a, b, tolerance=float(gap), max_queries=int(queries))
+    forward, backward = found["forward"], found["backward"]
+    if not (forward["converged"] and backward["converged"]):  # the budget ran out: add spread samples
         forward["lower"] = max(forward["lower"], _sampled_max(original, b, 2 * queries))
         backward["lower"] = max(backward["lower"], _sampled_max(result, a, 2 * queries))
-    return ErrorBound(estimate=max(forward["lower"], backward["lower"]),
-                      upper=max(forward["upper"], backward["upper"]),
+    estimate, upper = max(forward["lower"], backward["lower"]), max(forward["upper"], backward["upper"])
+    return ErrorBound(estimate=estimate, upper=upper,
                       forward=(forward["lower"], forward["upper"]), backward=(backward["lower"], backward["upper"]),
                       gap=float(gap), queries=int(forward["queries"] + backward["queries"]),
-                      converged=bool(forward["converged"] and backward["converged"]))
-
-
-def _walk_budget(a, b) -> int:
-    """Closest-point queries a side for the quick bound's fallback walk: one per 8 triangles of the two surfaces."""
-    low, high = WALK_QUERIES
-    return min(high, max(low, (a.num_triangles + b.num_triangles) // 8))
+                      converged=bool(upper <= estimate * (1 + gap)))
 
 
 def exact_error(original, result, *, original_surface=None) -> ErrorBound:

@@ -336,13 +336,17 @@ class MaxSearch {
     const auto& positions = from.positions();
     const auto& triangles = from.triangles();
     std::vector<int32_t> vertex_near(from.num_vertices(), -1), vertex_slot(from.num_vertices(), -1);
+    // without distances from the caller, the queries' own (the same values)
+    std::vector<double> measured(vertex_distance.empty() ? from.num_vertices() : 0, 0.0);
     int32_t hint = -1;
     for (int32_t v = 0; v < from.num_vertices(); ++v)
       if (from.used()[v]) {
         const ClosestHit hit = query(&positions[3 * size_t(v)], hint);
         vertex_near[v] = hit.triangle;
         vertex_slot[v] = hint = hit.slot;
+        if (!measured.empty()) measured[v] = std::sqrt(hit.distance2);
       }
+    const std::vector<double>& distance = measured.empty() ? vertex_distance : measured;
     out.lower_triangle = -1;
     for (int32_t f = 0; f < from.num_triangles(); ++f) {
       Piece piece;
@@ -350,7 +354,7 @@ class MaxSearch {
       for (int j = 0; j < 3; ++j) {
         const int32_t v = triangles[3 * size_t(f) + j];
         std::copy_n(&positions[3 * size_t(v)], 3, piece.p[j]);
-        piece.d[j] = vertex_distance[v];
+        piece.d[j] = distance[v];
         piece.near[j] = vertex_near[v];
       }
       piece.near[3] = -1;
@@ -398,6 +402,12 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
                               double start, const double* start_point, double relative_tolerance,
                               int64_t max_queries) {
   return MaxSearch(from, vertex_distance, to, start, start_point, relative_tolerance, max_queries).run();
+}
+
+MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, double start, const double* start_point,
+                                   double relative_tolerance, int64_t max_queries) {
+  static const std::vector<double> no_vertex_distance;  // the vertices' own queries give them
+  return MaxSearch(from, no_vertex_distance, to, start, start_point, relative_tolerance, max_queries).run();
 }
 
 MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,

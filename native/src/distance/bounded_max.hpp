@@ -33,11 +33,19 @@ struct MaxBracket {
 };
 
 /// Brackets max over A of dist(x, B). start: the distance and point already known (e.g. the
-/// sampled max); vertex_distance: the distance of every vertex of A used by a triangle.
+/// sampled max); vertex_distance: the distance of every vertex of A used by a triangle (empty:
+/// taken from the queries that find each vertex's nearest triangle).
 /// relative_tolerance > 0; max_queries bounds the work (the bracket stays valid when it is hit).
 MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& vertex_distance, const Surface& to,
                               double start, const double* start_point, double relative_tolerance,
                               int64_t max_queries = 4000000);
+
+/// The same bracket with every used vertex of A measured first (one query each): cheaper than the
+/// walk down A's tree (below) unless A is far finer than the distances, the usual case of a
+/// decimation and its original. start (attained elsewhere, e.g. on the other side) settles every
+/// piece within the tolerance of it.
+MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, double start, const double* start_point,
+                                   double relative_tolerance, int64_t max_queries);
 
 /// The same bracket over the listed triangles of A only (start: a distance attained elsewhere).
 MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,

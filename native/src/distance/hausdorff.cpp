@@ -407,16 +407,34 @@ void bracket_max(const Surface& from, const Surface& to, OneSidedDistance& side,
   side.refine_queries = bracket.queries;
 }
 
-OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, double tolerance, int64_t max_queries,
-                                      double threshold) {
-  if (!(tolerance > 0.0)) throw std::invalid_argument("tolerance must be positive, got " + shown(tolerance));
-  const MaxBracket bracket = bound_max_distance_by_tree(from, to, tolerance, max_queries, threshold);
+namespace {
+
+OneSidedBracket one_sided(const MaxBracket& bracket) {
   OneSidedBracket r;
   r.lower = bracket.lower;
   r.upper = bracket.upper;
   std::copy_n(bracket.lower_point, 3, r.lower_point);
   r.queries = bracket.queries;
   r.converged = bracket.converged;
+  return r;
+}
+
+}  // namespace
+
+OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, double tolerance, int64_t max_queries,
+                                      double threshold) {
+  if (!(tolerance > 0.0)) throw std::invalid_argument("tolerance must be positive, got " + shown(tolerance));
+  return one_sided(bound_max_distance_by_tree(from, to, tolerance, max_queries, threshold));
+}
+
+SymmetricBracket bracket_symmetric_max(const Surface& a, const Surface& b, double tolerance, int64_t max_queries) {
+  if (!(tolerance > 0.0)) throw std::invalid_argument("tolerance must be positive, got " + shown(tolerance));
+  const double origin[3] = {0.0, 0.0, 0.0};
+  a.bvh(), b.bvh();  // built before the sides share them
+  SymmetricBracket r;
+  parallel_invoke(
+      true, [&] { r.forward = one_sided(bound_max_from_vertices(a, b, 0.0, origin, tolerance, max_queries)); },
+      [&] { r.backward = one_sided(bound_max_from_vertices(b, a, 0.0, origin, tolerance, max_queries)); });
   return r;
 }
 
