@@ -163,11 +163,11 @@ void bind_hausdorff(py::module_& m) {
 
   m.def(
       "bracket_symmetric_max",
-      [](const Surface& a, const Surface& b, double tolerance, int64_t max_queries) {
+      [](const Surface& a, const Surface& b, double tolerance, double resolution, int64_t max_queries) {
         SymmetricBracket r;
         {
           EngineCall call;
-          r = bracket_symmetric_max(a, b, tolerance, max_queries);
+          r = bracket_symmetric_max(a, b, tolerance, resolution, max_queries);
         }
         py::dict out;
         for (const auto& [name, side] : {std::pair{"forward", &r.forward}, std::pair{"backward", &r.backward}}) {
@@ -180,8 +180,9 @@ void bind_hausdorff(py::module_& m) {
         }
         return out;
       },
-      py::arg("a"), py::arg("b"), py::arg("tolerance"), py::arg("max_queries") = 20000000,
-      "Guaranteed brackets of both one-sided maxima, each side from its surface's vertices.");
+      py::arg("a"), py::arg("b"), py::arg("tolerance"), py::arg("resolution") = 1e-13, py::arg("max_queries") = 20000000,
+      "Guaranteed brackets of both one-sided maxima, each side from its surface's vertices (bounds under "
+      "resolution x the larger diagonal count as settled).");
 
   m.def(
       "quick_hausdorff_bound",

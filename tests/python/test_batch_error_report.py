@@ -50,3 +50,21 @@ def test_exact_on_request_is_within_the_default_bracket(data_dir):
     assert exact["hausdorff_kind"] == "exact" and exact["hausdorff_converged"]
     assert exact["hausdorff_upper"] <= exact["hausdorff"] * 1.001 + 1e-12
     assert estimate["hausdorff"] <= exact["hausdorff_upper"] and exact["hausdorff"] <= estimate["hausdorff_upper"]
+
+
+def test_a_result_on_its_original_up_to_rounding_settles_at_the_resolution():
+    # A subdivided icosphere decimated to 30 % gives back its flat faces: the max is rounding
+    # (about 1e-13 of the diagonal), and no relative gap can settle it. The report settles it under
+    # 1e-7 of the diagonal (error_estimate.RESOLUTION), still bracketing the exact max.
+    import meshgen
+    vertices, triangles = meshgen.subdivide(*meshgen.icosphere(2), 1)
+    vertices = np.asarray(vertices) * 7.0 + [30.0, -12.0, 5.0]
+    original = topstoc.Mesh(vertices, triangles)
+    result = original.decimate(ratio=0.3, seed=1)
+    entry = lod_error(original, result, None)
+    truth = hausdorff((vertices, triangles), (result.vertices, result.triangles), samples=200_000, percentile=0).symmetric
+    diagonal = np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0))
+    assert truth.max_upper < 1e-9 * diagonal  # the result lies on the original
+    assert entry["hausdorff"] <= truth.max_upper * (1 + 1e-12) and entry["hausdorff_upper"] >= truth.max
+    assert entry["hausdorff_converged"] is True
+    assert entry["hausdorff_upper"] <= 1e-7 * diagonal * (1 + 1e-9)  # error_estimate.RESOLUTION

@@ -27,9 +27,9 @@ vertex of a side's surface is measured, then its triangles are bounded by their 
 distance is 1-Lipschitz; the distance to one triangle of the other surface is convex) and by the
 other surface's triangles beneath them (distance/projected_bound.cpp), and only those whose bound
 exceeds ``(1 + gap)`` times the largest distance found are split and measured again, until none
-is left (``converged``) or ``queries`` closest-point queries a side were spent (default: the
-exact measurement's budget, which the originals tried never reach; then the bracket holds, only
-wider). ``exact_error`` asks for the gap and the query budget of the exact
+is left, or all are under RESOLUTION times the larger diagonal (``converged``), or ``queries``
+closest-point queries a side were spent (default: the exact measurement's budget, which the
+originals tried never reach; then the bracket holds, only wider). ``exact_error`` asks for the gap and the query budget of the exact
 bracketed maximum of hausdorff.py. ``decide_error`` asks only whether the maximum exceeds a
 bound (the error-bounded search's exact check); ``SampledError`` is the search's cheap estimate
 (distances attained at points spread on both surfaces, no upper bound).
@@ -48,7 +48,12 @@ DEFAULT_GAP = 0.25         #: relative gap aimed at between the estimate and its
 #: originals of this many triangles or more get the quick bound by default: building their BVH and
 #: measuring all their vertices costs more than the decimation (smaller ones settle in fewer queries)
 QUICK_TRIANGLES = 250_000
+#: a bound under this share of the larger diagonal counts as settled: a result lying on its original
+#: up to rounding (float32 coordinates, as most mesh files store them, round at 6e-8 of their size)
+#: is not split down to that rounding
+RESOLUTION = 1e-7
 EXACT_GAP = 1e-3           #: the gap of the exact bracketed maximum (hausdorff.py's max_tolerance)
+EXACT_RESOLUTION = 1e-13   #: the exact one's floor (the engine's own)
 EXACT_QUERIES = 20_000_000 #: closest-point queries per side for the exact one
 
 
@@ -62,7 +67,7 @@ class ErrorBound:
     backward: tuple     #: (estimate, upper) from the result to the original
     gap: float          #: the relative gap asked for
     queries: int        #: closest-point queries made
-    converged: bool     #: upper <= estimate * (1 + gap)
+    converged: bool     #: upper <= estimate * (1 + gap), or upper under the resolution (see RESOLUTION)
     witness: object = None  #: decide_error: a point of the original farther than the bound from the result
     mean: float = float("nan")  #: the quick bound's estimate of the mean distance from the original
 
@@ -77,15 +82,17 @@ class ErrorBound:
 
 
 def estimate_error(original, result, gap: float = DEFAULT_GAP, queries=None, *,
-                   original_surface=None, quick=None) -> ErrorBound:
+                   original_surface=None, quick=None, resolution: float = RESOLUTION) -> ErrorBound:
     """Brackets the symmetric Hausdorff max between ``original`` and ``result`` (each
     ``(vertices, triangles)``, an object with both, or an engine Surface) within the relative
     ``gap``: by the quick bound (``quick`` True; by default when the original has QUICK_TRIANGLES
     triangles or more and no ``queries`` are given), else from both surfaces' vertices with at most
-    ``queries`` closest-point queries per side after them (default: EXACT_QUERIES).
+    ``queries`` closest-point queries per side after them (default: EXACT_QUERIES); bounds under
+    ``resolution`` times the larger diagonal count as settled.
     original_surface: the original's engine Surface when the caller keeps one for several results."""
     a = original_surface or as_surface(original, "original")
     b = as_surface(result, "result")
+    floor = resolution * max(a.diagonal, b.diagonal)
     if quick is None:
         quick = queries is None and a.num_triangles >= QUICK_TRIANGLES
     if quick:
@@ -100,10 +107,11 @@ def estimate_error(original, result, gap: float = DEFAULT_GAP, queries=None, *,
                 queries += walk["queries"]
         estimate, upper = max(sides[0][0], sides[1][0]), max(sides[0][1], sides[1][1])
         return ErrorBound(estimate=estimate, upper=upper, forward=tuple(sides[0]), backward=tuple(sides[1]),
-                          gap=float(gap), queries=int(queries), converged=bool(upper <= estimate * (1 + gap)),
-                          mean=float(found["forward_mean"]))
+                          gap=float(gap), queries=int(queries),
+                          converged=bool(upper <= max(estimate * (1 + gap), floor)), mean=float(found["forward_mean"]))
     queries = EXACT_QUERIES if queries is None else queries
-    found = engine.bracket_symmetric_max(a, b, tolerance=float(gap), max_queries=int(queries))
+    found = engine.bracket_symmetric_max(a, b, tolerance=float(gap), resolution=float(resolution),
+                                         max_queries=int(queries))
     forward, backward = found["forward"], found["backward"]
     if not (forward["converged"] and backward["converged"]):  # the budget ran out: add spread samples
         forward["lower"] = max(forward["lower"], _sampled_max(original, b, 2 * queries))
@@ -112,12 +120,13 @@ def estimate_error(original, result, gap: float = DEFAULT_GAP, queries=None, *,
     return ErrorBound(estimate=estimate, upper=upper,
                       forward=(forward["lower"], forward["upper"]), backward=(backward["lower"], backward["upper"]),
                       gap=float(gap), queries=int(forward["queries"] + backward["queries"]),
-                      converged=bool(upper <= estimate * (1 + gap)))
+                      converged=bool(upper <= max(estimate * (1 + gap), floor)))
 
 
 def exact_error(original, result, *, original_surface=None) -> ErrorBound:
     """The exact bracketed maximum (hausdorff.py's, relative gap 1e-3)."""
-    return estimate_error(original, result, EXACT_GAP, EXACT_QUERIES, original_surface=original_surface)
+    return estimate_error(original, result, EXACT_GAP, EXACT_QUERIES, original_surface=original_surface,
+                          resolution=EXACT_RESOLUTION)
 
 
 def _sampled_max(mesh, other, count: int) -> float:

@@ -67,10 +67,10 @@ namespace {
 class MaxSearch {
  public:
   MaxSearch(const Surface& from, const std::vector<double>& vertex_distance, const Surface& to, double start,
-            const double* start_point, double relative_tolerance, int64_t max_queries)
+            const double* start_point, double relative_tolerance, int64_t max_queries, double resolution = 1e-13)
       : from(from), vertex_distance(vertex_distance), to(to), to_positions(to.positions()), to_triangles(to.triangles()),
         bvh(to.bvh()), relative_tolerance(relative_tolerance), max_queries(max_queries),
-        floor(1e-13 * std::max(from.diagonal(), to.diagonal())),
+        floor(resolution * std::max(from.diagonal(), to.diagonal())),
         to_mean_area(to.area() / std::max(1, to.num_triangles())) {
     out.lower = start;
     std::copy_n(start_point, 3, out.lower_point);
@@ -155,7 +155,9 @@ class MaxSearch {
   const TriangleBvh& bvh;
   const double relative_tolerance;
   const int64_t max_queries;
-  const double floor;  // a tiny absolute floor, so that identical surfaces (max 0) do not subdivide forever
+  // an absolute floor (resolution x the larger diagonal; by default tiny), so that identical
+  // surfaces (max 0) do not subdivide forever
+  const double floor;
   const double to_mean_area;  // the mean triangle area of the other surface
   MaxBracket out;
   BeneathScratch scratch;
@@ -404,10 +406,11 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
   return MaxSearch(from, vertex_distance, to, start, start_point, relative_tolerance, max_queries).run();
 }
 
-MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, double start, const double* start_point,
-                                   double relative_tolerance, int64_t max_queries) {
+MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, double relative_tolerance,
+                                   double resolution, int64_t max_queries) {
   static const std::vector<double> no_vertex_distance;  // the vertices' own queries give them
-  return MaxSearch(from, no_vertex_distance, to, start, start_point, relative_tolerance, max_queries).run();
+  const double origin[3] = {0.0, 0.0, 0.0};
+  return MaxSearch(from, no_vertex_distance, to, 0.0, origin, relative_tolerance, max_queries, resolution).run();
 }
 
 MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,

@@ -42,10 +42,11 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
 
 /// The same bracket with every used vertex of A measured first (one query each): cheaper than the
 /// walk down A's tree (below) unless A is far finer than the distances, the usual case of a
-/// decimation and its original. start (attained elsewhere, e.g. on the other side) settles every
-/// piece within the tolerance of it.
-MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, double start, const double* start_point,
-                                   double relative_tolerance, int64_t max_queries);
+/// decimation and its original. resolution: bounds under resolution x the larger diagonal count
+/// as settled (the search's floor; 1e-13 elsewhere), so that a result lying on its original up to
+/// rounding is not split down to that rounding.
+MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, double relative_tolerance,
+                                   double resolution, int64_t max_queries);
 
 /// The same bracket over the listed triangles of A only (start: a distance attained elsewhere).
 MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,

@@ -427,14 +427,15 @@ OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, do
   return one_sided(bound_max_distance_by_tree(from, to, tolerance, max_queries, threshold));
 }
 
-SymmetricBracket bracket_symmetric_max(const Surface& a, const Surface& b, double tolerance, int64_t max_queries) {
+SymmetricBracket bracket_symmetric_max(const Surface& a, const Surface& b, double tolerance, double resolution,
+                                       int64_t max_queries) {
   if (!(tolerance > 0.0)) throw std::invalid_argument("tolerance must be positive, got " + shown(tolerance));
-  const double origin[3] = {0.0, 0.0, 0.0};
+  if (!(resolution >= 0.0)) throw std::invalid_argument("resolution must not be negative, got " + shown(resolution));
   a.bvh(), b.bvh();  // built before the sides share them
   SymmetricBracket r;
   parallel_invoke(
-      true, [&] { r.forward = one_sided(bound_max_from_vertices(a, b, 0.0, origin, tolerance, max_queries)); },
-      [&] { r.backward = one_sided(bound_max_from_vertices(b, a, 0.0, origin, tolerance, max_queries)); });
+      true, [&] { r.forward = one_sided(bound_max_from_vertices(a, b, tolerance, resolution, max_queries)); },
+      [&] { r.backward = one_sided(bound_max_from_vertices(b, a, tolerance, resolution, max_queries)); });
   return r;
 }
 

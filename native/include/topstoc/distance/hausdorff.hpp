@@ -123,15 +123,17 @@ struct OneSidedBracket {
 OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, double tolerance, int64_t max_queries,
                                       double threshold = -1.0);
 
-/// The symmetric maximum between A and B bracketed within `tolerance` (> 0), or less tightly once
-/// `max_queries` queries a side were made: each side starts from every vertex of its surface
-/// measured (bounded_max.hpp, bound_max_from_vertices); the two sides run at once on two threads.
-/// (Settling the second side against the first one's distance was tried: a higher threshold makes
-/// the bound beneath a piece fail more often, and it cost more queries on the horse and armadillo.)
+/// The symmetric maximum between A and B bracketed within `tolerance` (> 0), or under
+/// `resolution` x the larger diagonal, or less tightly once `max_queries` queries a side were
+/// made: each side starts from every vertex of its surface measured (bounded_max.hpp,
+/// bound_max_from_vertices); the two sides run at once on two threads. (Settling the second side
+/// against the first one's distance was tried: a higher threshold makes the bound beneath a piece
+/// fail more often, and it cost more queries on the horse and armadillo.)
 struct SymmetricBracket {
   OneSidedBracket forward, backward;
 };
-SymmetricBracket bracket_symmetric_max(const Surface& a, const Surface& b, double tolerance, int64_t max_queries);
+SymmetricBracket bracket_symmetric_max(const Surface& a, const Surface& b, double tolerance, double resolution,
+                                       int64_t max_queries);
 
 /// A guaranteed upper bound of the symmetric max between a big surface A and a small one B (a
 /// decimation of A) that builds no search structure over A's triangles (quick_bound.cpp).
