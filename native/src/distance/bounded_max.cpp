@@ -212,17 +212,18 @@ class MaxSearch {
     piece.near[3] = hit.triangle;
   }
 
-  // Bounds a new piece (with its centroid's nearest triangle when the corners' do not settle
-  // it) and queues it unless tolerated.
+  // Bounds a new piece (by the triangles beneath it when its corners' do not settle it, then
+  // with its centroid's nearest triangle, a query that rarely settles a piece the bound beneath
+  // left open) and queues it unless tolerated.
   void keep(Piece& piece) {
     bound(piece);
+    // only a bound that settles the piece is looked for: the box searched stays small
+    if (!tolerated(piece.upper) && worth_projecting(piece))
+      piece.upper = std::min(piece.upper, projected_bound(piece.p, to, threshold(), kBeneathCandidates, scratch));
     if (!tolerated(piece.upper)) {
       centroid_near(piece);
       bound(piece);
     }
-    // only a bound that settles the piece is looked for: the box searched stays small
-    if (!tolerated(piece.upper) && worth_projecting(piece))
-      piece.upper = std::min(piece.upper, projected_bound(piece.p, to, threshold(), kBeneathCandidates, scratch));
     if (tolerated(piece.upper)) {
       settled = std::max(settled, piece.upper);
     } else {
