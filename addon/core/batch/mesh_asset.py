@@ -42,8 +42,9 @@ def output_paths(path: str, out_dir: str, settings: dict) -> list:
 
 def lod_error(original, result, screen, exact: bool = False, original_surface=None) -> dict:
     """The symmetric Hausdorff error of a LOD (absolute, relative, in pixels): by default a bounded
-    estimate (``hausdorff`` attained, ``hausdorff_upper`` guaranteed, aimed within 25 % of it; for
-    big sources the quick bound, with ``hausdorff_mean``), the exact bracketed max with ``exact``
+    estimate (``hausdorff`` attained, ``hausdorff_upper`` guaranteed, within 25 % of it or under 1e-7
+    of the diagonal; for big sources the quick bound, with ``hausdorff_mean``), the exact bracketed
+    max with ``exact``
     (topstoc.core.api.error_estimate). original_surface: the original's measurement surface, kept
     across the LODs of one asset."""
     started = time.perf_counter()

@@ -82,7 +82,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--exact-error", action="store_true",
                         help="report each output's exact bracketed Hausdorff max (relative gap 0.1 %%) instead "
                              "of the default bounded estimate (hausdorff: a distance attained; hausdorff_upper: "
-                             "a guaranteed upper bound, aimed within 25 %% of it; for sources of 250,000 "
+                             "a guaranteed upper bound, within 25 %% of it; for sources of 250,000 "
                              "triangles or more the quick bound, with hausdorff_mean: the mean distance, estimated)")
     parser.add_argument("--keep-compression", action="store_true",
                         help="mesh files: a compressed input (.gz, .bz2) gives a compressed output (default: "
