@@ -180,7 +180,8 @@ void bind_hausdorff(py::module_& m) {
         }
         return out;
       },
-      py::arg("a"), py::arg("b"), py::arg("tolerance"), py::arg("resolution") = 1e-13, py::arg("max_queries") = 20000000,
+      py::arg("a"), py::arg("b"), py::arg("tolerance"), py::arg("resolution") = 1e-13,
+      py::arg("max_queries") = 20000000,
       "Guaranteed brackets of both one-sided maxima, each side from its surface's vertices (bounds under "
       "resolution x the larger diagonal count as settled).");
 

@@ -67,8 +67,9 @@ TEST_CASE("surfaces that coincide settle under the resolution, the same on one t
   const Surface fine = grid(40, [](int, int) { return 0.25; });
   const Surface coarse = grid(5, [](int, int) { return 0.25; });
   const double resolution = 1e-7, floor = resolution * std::sqrt(2.0);
-  const auto one = with_threads(1, [&] { return topstoc::bracket_symmetric_max(fine, coarse, 0.25, resolution, 20000000); });
-  const auto two = with_threads(2, [&] { return topstoc::bracket_symmetric_max(fine, coarse, 0.25, resolution, 20000000); });
+  const auto bracket = [&] { return topstoc::bracket_symmetric_max(fine, coarse, 0.25, resolution, 20000000); };
+  const auto one = with_threads(1, bracket);
+  const auto two = with_threads(2, bracket);
   CHECK(symmetric(one, true) <= floor * (1 + 1e-12));
   CHECK(symmetric(one, false) >= 0.0);
   for (const auto& [a, b] : {std::pair{one.forward, two.forward}, std::pair{one.backward, two.backward}}) {

@@ -62,7 +62,8 @@ def test_a_result_on_its_original_up_to_rounding_settles_at_the_resolution():
     original = topstoc.Mesh(vertices, triangles)
     result = original.decimate(ratio=0.3, seed=1)
     entry = lod_error(original, result, None)
-    truth = hausdorff((vertices, triangles), (result.vertices, result.triangles), samples=200_000, percentile=0).symmetric
+    truth = hausdorff((vertices, triangles), (result.vertices, result.triangles), samples=200_000,
+                      percentile=0).symmetric
     diagonal = np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0))
     assert truth.max_upper < 1e-9 * diagonal  # the result lies on the original
     assert entry["hausdorff"] <= truth.max_upper * (1 + 1e-12) and entry["hausdorff_upper"] >= truth.max

@@ -29,10 +29,11 @@ other surface's triangles beneath them (distance/projected_bound.cpp), and only 
 exceeds ``(1 + gap)`` times the largest distance found are split and measured again, until none
 is left, or all are under RESOLUTION times the larger diagonal (``converged``), or ``queries``
 closest-point queries a side were spent (default: the exact measurement's budget, which the
-originals tried never reach; then the bracket holds, only wider). ``exact_error`` asks for the gap and the query budget of the exact
-bracketed maximum of hausdorff.py. ``decide_error`` asks only whether the maximum exceeds a
-bound (the error-bounded search's exact check); ``SampledError`` is the search's cheap estimate
-(distances attained at points spread on both surfaces, no upper bound).
+originals tried never reach; then the bracket holds, only wider). ``exact_error`` asks for the
+gap, floor and query budget of the exact bracketed maximum of hausdorff.py. ``decide_error``
+asks only whether the maximum exceeds a bound (the error-bounded search's exact check);
+``SampledError`` is the search's cheap estimate (distances attained at points spread on both
+surfaces, no upper bound).
 """
 
 from __future__ import annotations
