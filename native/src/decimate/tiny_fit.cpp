@@ -93,10 +93,14 @@ class Fit {
     double lower = 0.0, upper = 0.0;
     int32_t face = -1;  // the result triangle nearest the point where `lower` was found
   };
-  Bracket symmetric_max() const {
+  // threshold >= 0: only whether the max exceeds it is decided (bounded_max.hpp), cheaper, and
+  // the second side is skipped once the first exceeds it.
+  Bracket symmetric_max(double threshold = -1.0) const {
     const Surface result(positions(), faces_);
-    const MaxBracket there = bound_max_distance_by_tree(result, *input_, kMaxTolerance, kMaxQueries);
-    const MaxBracket back = bound_max_distance_by_tree(*input_, result, kMaxTolerance, kMaxQueries);
+    const MaxBracket there = bound_max_distance_by_tree(result, *input_, kMaxTolerance, kMaxQueries, threshold);
+    const MaxBracket back = threshold >= 0.0 && there.lower > threshold
+                                ? MaxBracket{}
+                                : bound_max_distance_by_tree(*input_, result, kMaxTolerance, kMaxQueries, threshold);
     const MaxBracket& far = there.lower >= back.lower ? there : back;
     return {far.lower, std::max(there.upper, back.upper), result.bvh().closest(far.lower_point, -1).triangle};
   }
@@ -292,13 +296,15 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds) {
   // A move is kept when the pairs' mean fell, their largest distance and the surfaces' max did
   // not grow. When only the max grew, the corners of the result triangle nearest to where it
   // grew are held and the move tried again (a few times); then at half the step, a quarter.
-  auto kept = [&](double step) {
+  // The last round's moves need only be judged against the max (no later round compares with
+  // theirs): its bracket decides only whether the max grew.
+  auto kept = [&](double step, bool last) {
     fit.release();
     for (int32_t tries = 0; tries < kHoldTries; ++tries) {
       if (fit.apply(fit.toward(x, step)) == 0) return false;
       const auto next = fit.pair_up();
       if (!(next.mean2 < error.mean2 && next.top2 <= error.top2)) break;
-      const auto next_max = fit.symmetric_max();
+      const auto next_max = fit.symmetric_max(last ? max.upper : -1.0);
       if (next_max.lower <= max.upper) {
         error = next, max = next_max;
         return true;
@@ -311,7 +317,7 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds) {
   };
   for (int32_t round = 0; round < rounds && fit.solve(x); ++round) {
     bool moved = false;
-    for (double step = 1.0; step >= kSmallestStep && !moved; step *= 0.5) moved = kept(step);
+    for (double step = 1.0; step >= kSmallestStep && !moved; step *= 0.5) moved = kept(step, round + 1 == rounds);
     if (!moved) break;
     out.after2 = error.mean2;
     ++out.rounds;
