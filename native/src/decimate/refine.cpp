@@ -583,7 +583,7 @@ class Refinement {
   // (attributes.moved_vertices), and seam vertices, whose sides differ, do not move.
   void finish(Collapser& collapser) {
     if (params.refit && fit_rounds(collapser.live_faces()) > 0)
-      fit_tiny(mesh, collapser, fit_rounds(collapser.live_faces()));
+      fit_tiny(mesh, collapser, fit_rounds(collapser.live_faces()), collapser.live_faces() <= kTinyFitFaces);
     if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
     result.issues_remaining.sliver = collapser.zero_area_faces();
     compact(collapser);

@@ -60,7 +60,7 @@ void barycentric(const double* p, const double* a, const double* b, const double
 
 class Fit {
  public:
-  Fit(const Mesh& mesh, Collapser& collapser) : c_(collapser) {
+  Fit(const Mesh& mesh, Collapser& collapser, bool boundaries) : c_(collapser) {
     const std::vector<int32_t>& triangles = c_.triangles();
     std::vector<double> positions(3 * size_t(mesh.num_vertices()));
     for (int32_t w = 0; w < mesh.num_vertices(); ++w) c_.normalise(mesh.position(w), &positions[3 * size_t(w)]);
@@ -79,7 +79,7 @@ class Fit {
       if (c_.face_alive(t)) faces_.insert(faces_.end(), &triangles[3 * size_t(t)], &triangles[3 * size_t(t) + 3]);
     unknown_.assign(c_.vertices(), -1);
     for (int32_t v : faces_)
-      if (c_.fittable(v) && unknown_[v] < 0) unknown_[v] = int32_t(free_.size()), free_.push_back(v);
+      if ((boundaries ? c_.fittable(v) : c_.is_free(v)) && unknown_[v] < 0) unknown_[v] = int32_t(free_.size()), free_.push_back(v);
     std::sort(free_.begin(), free_.end());  // vertex order: moves are tried in it
     for (size_t i = 0; i < free_.size(); ++i) unknown_[free_[i]] = int32_t(i);
   }
@@ -284,9 +284,9 @@ class Fit {
 
 }  // namespace
 
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds) {
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries) {
   TinyFit out;
-  Fit fit(mesh, collapser);
+  Fit fit(mesh, collapser, boundaries);
   if (fit.empty()) return out;
   auto error = fit.pair_up();
   if (error.top2 <= kOnTheInput * kOnTheInput) return out;

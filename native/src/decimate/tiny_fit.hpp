@@ -14,7 +14,7 @@ namespace topstoc {
 
 /// Results with at most this many live triangles are fitted in up to four rounds, and results
 /// with at most kFitFaces in one (its first round gives most of the gain; a round's max check
-/// costs more than the collapses there).
+/// costs more than the collapses there), their mesh boundaries kept where they are.
 constexpr int32_t kTinyFitFaces = 400;
 constexpr int32_t kFitFaces = 1400;
 
@@ -34,6 +34,7 @@ struct TinyFit {
 /// (Collapser::try_move); keep a round only if the mean squared distance fell, the largest pair
 /// distance did not grow, and neither did the symmetric Hausdorff max over both whole surfaces
 /// (a bracket from bounded_max.hpp: the pairs alone miss where the surface lifts between them).
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds);
+/// boundaries: the unlocked vertices of mesh boundaries move too (else only the free ones).
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries);
 
 }  // namespace topstoc
