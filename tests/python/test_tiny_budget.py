@@ -1,5 +1,6 @@
-"""Tiny budgets: a quality result of at most 400 triangles is fitted to the input by least
-squares both ways (native/src/decimate/tiny_fit.cpp, docs/design.md §2.10).
+"""Tiny budgets: a quality result of at most 1,400 triangles is fitted to the input by least
+squares both ways (four rounds up to 400 triangles, moving mesh boundaries too; one above,
+boundaries kept) (native/src/decimate/tiny_fit.cpp, docs/design.md §2.10).
 
 Errors are measured by topstoc.hausdorff (checked against CGAL in test_hausdorff_peers.py) and
 compared with meshoptimizer's quadric simplification at the same triangle count; the boundary
@@ -103,3 +104,35 @@ def test_the_fit_keeps_the_max_near_the_best_peer(data_dir, tmp_path, name, targ
     ours_max = 100 * max(cgal["forward"]["max_bounded"], cgal["backward"]["max_bounded"]) / np.linalg.norm(
         v.max(axis=0) - v.min(axis=0))
     assert ours_max <= bound * blender["max"], ours_max / blender["max"]
+
+
+# Worst cases of the broad benchmark that the fit now reaches (results of 401-1,400 triangles,
+# one round, mesh boundaries kept): the peers' figures are bench_quality.py's (100k samples, in % of the diagonal) for
+# the same case at our triangle count, from docs/bench_results/bench_quality_broad_fit_max_check.json:
+# fast-simplification (PyPI), MeshLab's and Blender's quadric collapses. Ours is measured the same
+# way (topstoc.hausdorff, 100k samples, checked against CGAL in test_hausdorff_peers.py).
+# (mesh, ratio, peer, bound on our mean over the peer's, bound on our max over the peer's or None).
+# Without the fit: the elephant 0.92 (mean) and 0.83 (max) of Blender's, the duck 0.91 of
+# MeshLab's mean, knot1 0.97 of Blender's mean.
+WORST_MIDDLE = [("genus_positive/cgal_elephant.off", 0.1, "Blender Collapse", 0.86, 0.8),
+                ("uv_materials/duck/duck_via_assimp.obj", 0.1, "MeshLab", 0.8, None),
+                ("genus_positive/cgal_knot1.off", 0.1, "Blender Collapse", 0.88, None)]
+BROAD = pathlib.Path(__file__).resolve().parents[2] / "docs/bench_results/bench_quality_broad_fit_max_check.json"
+
+
+@pytest.mark.parametrize("name, ratio, peer_name, mean_bound, max_bound", WORST_MIDDLE, ids=[w[0] for w in WORST_MIDDLE])
+def test_the_fit_of_a_middle_result_beats_the_peer_it_lost_to(data_dir, name, ratio, peer_name, mean_bound, max_bound):
+    case = next(c for c in json.loads(BROAD.read_text())["cases"]
+                if c["mesh"] == pathlib.Path(name).name and c["ratio"] == ratio)
+    theirs = case["tools"][peer_name]
+    source = topstoc.read_mesh(data_dir / name)
+    vertices, triangles = source.vertices, source.triangles
+    ours = topstoc.Mesh(vertices, triangles).decimate(target_triangles=case["target"], seed=0)
+    assert 400 < len(ours.triangles) <= 1400 and abs(len(ours.triangles) - theirs["triangles"]) <= 5
+    assert ours.stats.topology_kept
+    assert invariants(len(ours.vertices), ours.triangles) == invariants(len(vertices), triangles)
+    error = topstoc.hausdorff((vertices, triangles), (ours.vertices, ours.triangles), samples=100_000,
+                              relative=True, percentile=0)
+    assert 100 * error.symmetric.mean <= mean_bound * theirs["mean"], 100 * error.symmetric.mean / theirs["mean"]
+    if max_bound is not None:
+        assert 100 * error.symmetric.max <= max_bound * theirs["max"], 100 * error.symmetric.max / theirs["max"]

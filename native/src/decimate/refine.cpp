@@ -21,8 +21,6 @@ namespace {
 
 // Slivers (shape quality below this, see Collapser) the stochastic pass left are collapsed first.
 constexpr double kSliverShape = 0.1;
-// Rounds of the least-squares fit of a tiny result (tiny_fit.hpp).
-constexpr int32_t kTinyFitRounds = 4;
 // Max-aware second run: a vertex's cost weight is 1 + this times its first-run deviation over
 // the largest (squared distances), so the worst region's collapses cost a hundred times more.
 constexpr double kDeviationWeight = 100.0;
@@ -584,8 +582,8 @@ class Refinement {
   // With attributes too: a vertex the fit moves takes the input's attributes where it lands
   // (attributes.moved_vertices), and seam vertices, whose sides differ, do not move.
   void finish(Collapser& collapser) {
-    if (params.refit && collapser.live_faces() <= kTinyFitFaces)
-      fit_tiny(mesh, collapser, kTinyFitRounds);
+    if (params.refit && fit_rounds(collapser.live_faces()) > 0)
+      fit_tiny(mesh, collapser, fit_rounds(collapser.live_faces()), collapser.live_faces() <= kTinyFitFaces);
     if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
     result.issues_remaining.sliver = collapser.zero_area_faces();
     compact(collapser);

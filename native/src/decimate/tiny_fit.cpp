@@ -60,7 +60,7 @@ void barycentric(const double* p, const double* a, const double* b, const double
 
 class Fit {
  public:
-  Fit(const Mesh& mesh, Collapser& collapser) : c_(collapser) {
+  Fit(const Mesh& mesh, Collapser& collapser, bool boundaries) : c_(collapser) {
     const std::vector<int32_t>& triangles = c_.triangles();
     std::vector<double> positions(3 * size_t(mesh.num_vertices()));
     for (int32_t w = 0; w < mesh.num_vertices(); ++w) c_.normalise(mesh.position(w), &positions[3 * size_t(w)]);
@@ -79,7 +79,7 @@ class Fit {
       if (c_.face_alive(t)) faces_.insert(faces_.end(), &triangles[3 * size_t(t)], &triangles[3 * size_t(t) + 3]);
     unknown_.assign(c_.vertices(), -1);
     for (int32_t v : faces_)
-      if (c_.fittable(v) && unknown_[v] < 0) unknown_[v] = int32_t(free_.size()), free_.push_back(v);
+      if ((boundaries ? c_.fittable(v) : c_.is_free(v)) && unknown_[v] < 0) unknown_[v] = int32_t(free_.size()), free_.push_back(v);
     std::sort(free_.begin(), free_.end());  // vertex order: moves are tried in it
     for (size_t i = 0; i < free_.size(); ++i) unknown_[free_[i]] = int32_t(i);
   }
@@ -93,10 +93,14 @@ class Fit {
     double lower = 0.0, upper = 0.0;
     int32_t face = -1;  // the result triangle nearest the point where `lower` was found
   };
-  Bracket symmetric_max() const {
+  // threshold >= 0: only whether the max exceeds it is decided (bounded_max.hpp), cheaper, and
+  // the second side is skipped once the first exceeds it.
+  Bracket symmetric_max(double threshold = -1.0) const {
     const Surface result(positions(), faces_);
-    const MaxBracket there = bound_max_distance_by_tree(result, *input_, kMaxTolerance, kMaxQueries);
-    const MaxBracket back = bound_max_distance_by_tree(*input_, result, kMaxTolerance, kMaxQueries);
+    const MaxBracket there = bound_max_distance_by_tree(result, *input_, kMaxTolerance, kMaxQueries, threshold);
+    const MaxBracket back = threshold >= 0.0 && there.lower > threshold
+                                ? MaxBracket{}
+                                : bound_max_distance_by_tree(*input_, result, kMaxTolerance, kMaxQueries, threshold);
     const MaxBracket& far = there.lower >= back.lower ? there : back;
     return {far.lower, std::max(there.upper, back.upper), result.bvh().closest(far.lower_point, -1).triangle};
   }
@@ -280,9 +284,9 @@ class Fit {
 
 }  // namespace
 
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds) {
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries) {
   TinyFit out;
-  Fit fit(mesh, collapser);
+  Fit fit(mesh, collapser, boundaries);
   if (fit.empty()) return out;
   auto error = fit.pair_up();
   if (error.top2 <= kOnTheInput * kOnTheInput) return out;
@@ -292,13 +296,15 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds) {
   // A move is kept when the pairs' mean fell, their largest distance and the surfaces' max did
   // not grow. When only the max grew, the corners of the result triangle nearest to where it
   // grew are held and the move tried again (a few times); then at half the step, a quarter.
-  auto kept = [&](double step) {
+  // The last round's moves need only be judged against the max (no later round compares with
+  // theirs): its bracket decides only whether the max grew.
+  auto kept = [&](double step, bool last) {
     fit.release();
     for (int32_t tries = 0; tries < kHoldTries; ++tries) {
       if (fit.apply(fit.toward(x, step)) == 0) return false;
       const auto next = fit.pair_up();
       if (!(next.mean2 < error.mean2 && next.top2 <= error.top2)) break;
-      const auto next_max = fit.symmetric_max();
+      const auto next_max = fit.symmetric_max(last ? max.upper : -1.0);
       if (next_max.lower <= max.upper) {
         error = next, max = next_max;
         return true;
@@ -311,7 +317,7 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds) {
   };
   for (int32_t round = 0; round < rounds && fit.solve(x); ++round) {
     bool moved = false;
-    for (double step = 1.0; step >= kSmallestStep && !moved; step *= 0.5) moved = kept(step);
+    for (double step = 1.0; step >= kSmallestStep && !moved; step *= 0.5) moved = kept(step, round + 1 == rounds);
     if (!moved) break;
     out.after2 = error.mean2;
     ++out.rounds;

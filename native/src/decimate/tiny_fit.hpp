@@ -1,4 +1,4 @@
-// Tiny budgets (docs/design.md §2.10): once the collapses reached a result of a few hundred
+// Tiny budgets (docs/design.md §2.10): once the collapses reached a result of at most 1,400
 // triangles, its free vertices are fitted to the input in a few rounds of least squares, both
 // ways (as Hoppe et al. 1993 fit a mesh to points): the quadrics that placed them sum planes
 // over clusters too large to stand for the surface.
@@ -12,8 +12,14 @@
 
 namespace topstoc {
 
-/// Results with at most this many live triangles are fitted.
+/// Results with at most this many live triangles are fitted in up to four rounds, and results
+/// with at most kFitFaces in one (its first round gives most of the gain; a round's max check
+/// costs more than the collapses there), their mesh boundaries kept where they are.
 constexpr int32_t kTinyFitFaces = 400;
+constexpr int32_t kFitFaces = 1400;
+
+/// Rounds of the fit for a result of `live_faces` triangles (0: not fitted).
+inline int32_t fit_rounds(int64_t live_faces) { return live_faces <= kTinyFitFaces ? 4 : live_faces <= kFitFaces ? 1 : 0; }
 
 struct TinyFit {
   int32_t rounds = 0;        ///< rounds kept (each lowered the error)
@@ -28,6 +34,7 @@ struct TinyFit {
 /// (Collapser::try_move); keep a round only if the mean squared distance fell, the largest pair
 /// distance did not grow, and neither did the symmetric Hausdorff max over both whole surfaces
 /// (a bracket from bounded_max.hpp: the pairs alone miss where the surface lifts between them).
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds);
+/// boundaries: the unlocked vertices of mesh boundaries move too (else only the free ones).
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries);
 
 }  // namespace topstoc
