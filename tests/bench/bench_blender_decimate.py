@@ -171,11 +171,14 @@ def preview_drag(obj, ratio, seconds=4.0, event_interval=0.01, span=2.0):
     return shown / elapsed
 
 
-def rested_quality(obj, ratio, drag_seconds=1.0, event_interval=0.01):
+def rested_quality(obj, ratio, drag_seconds=1.0, event_interval=0.01, cold=False):
     """Seconds from the drag resting (the last ratio requested) to the rested Quality result on
     screen, the way the modal runs it (requests every 10 ms over [ratio / 1.5, ratio], then
     polling at the modal timer's 60 Hz), the seconds of that Quality computation itself, and the
-    updates shown per second during the drag."""
+    updates shown per second during the drag. cold: the prepared mesh keeps nothing from earlier
+    decimations when the drag starts (else a repeat finds what the one before kept)."""
+    if cold:
+        ts.blender.preview.cache.prepared_meshes.clear_kept()
     session = ts.blender.preview.session.PreviewSession(bpy.context, obj, Params(ratio, quality="QUALITY"), ratio=ratio)
     session.wait_prepared()
     sweep = np.geomspace(ratio / 1.5, ratio, 40)
@@ -247,7 +250,8 @@ def print_rest(ratio, rests):
 
 REST_METHOD = ("a PreviewSession with Quality chosen, after a 1 s drag (a ratio requested every 10 ms over "
                "[ratio / 1.5, ratio]): seconds from the last request to the Quality result on screen (polled at "
-               "60 Hz), medians of the repeats; builds alternate one mesh at a time (TOPSTOC_BUILD)")
+               "60 Hz), medians of the repeats; builds alternate one mesh at a time (TOPSTOC_BUILD); a label "
+               "with 'cold' (--cold): each drag starts with nothing kept from earlier decimations of the mesh")
 
 
 def save_rest(path, label, mesh, counts, rows):
@@ -305,6 +309,8 @@ def main(argv):
     parser.add_argument("--modifier-repeat", type=int, default=1)
     parser.add_argument("--only-rest", action="store_true", help="measure only the rested Quality result")
     parser.add_argument("--subdivide", type=int, default=0, help="split every triangle in four this many times")
+    parser.add_argument("--cold", action="store_true",
+                        help="with --only-rest: each drag starts with nothing kept from earlier decimations")
     parser.add_argument("--json", metavar="FILE", help="with --only-rest: merge the rest figures into this file")
     parser.add_argument("--label", default="after", help="the build's name in --json (before, after)")
     args = parser.parse_args(argv)
@@ -325,7 +331,7 @@ def main(argv):
     rest_rows = []
     for ratio in args.ratios:
         if args.only_rest:
-            rest_rows.append(print_rest(ratio, [rested_quality(obj, ratio) for _ in range(args.repeat)]))
+            rest_rows.append(print_rest(ratio, [rested_quality(obj, ratio, cold=args.cold) for _ in range(args.repeat)]))
             continue
         firsts = []
         for _ in range(args.repeat):

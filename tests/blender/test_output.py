@@ -269,6 +269,18 @@ def test_cache_reprepares_after_an_edit(ts, scene):
     np.testing.assert_allclose(second.mesh.vertices[0], co[0])
 
 
+def test_cache_clear_kept_frees_the_collapse_states_and_keeps_the_preparation(ts, scene):
+    obj = make_object("Torus", *meshgen.bumpy_torus(20000))  # collapsed whole: its quality runs keep states
+    cache = ts.blender.preview.cache.prepared_meshes
+    prepared = cache.get(obj.data)
+    first = prepared.mesh.decimate(ratio=0.05)
+    assert prepared.mesh.kept_for_reuse()[2].size >= 1
+    cache.clear_kept()
+    assert prepared.mesh.kept_for_reuse()[2].size == 0
+    assert cache.get(obj.data) is prepared                # still cached: not prepared again
+    np.testing.assert_array_equal(prepared.mesh.decimate(ratio=0.05).triangles, first.triangles)
+
+
 def test_max_deviation_target(ts, scene):
     obj = make_object("Ball", *meshgen.icosphere(4))
     params = Params(target_mode="MAX_ERROR", max_error=1.0, max_error_relative=True)

@@ -1,10 +1,11 @@
 // The engine's thread pool (core/parallel.hpp): static chunks that follow the length and team size
 // only, loops and reductions equal to serial ones for any team, exceptions carried to the caller,
-// nested calls serial, many calls in a row or from two threads at once, and pools outliving their
-// calling threads.
+// nested calls serial, many calls in a row or from two threads at once, pools outliving their
+// calling threads, and workers that sleep between calls.
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <atomic>
 #include <cstdint>
 #include <numeric>
@@ -14,6 +15,7 @@
 
 #if defined(__unix__) || defined(__APPLE__)
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 #endif
 
@@ -290,6 +292,37 @@ TEST_CASE("a forked child makes a pool of its own instead of waiting for its par
     REQUIRE(waitpid(child, &status, 0) == child);
     CHECK(WIFEXITED(status));
     CHECK(WEXITSTATUS(status) == 0);
+  });
+}
+#endif
+
+#if defined(__unix__) || defined(__APPLE__)
+namespace {
+
+// The process's CPU seconds so far (every thread's).
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+}  // namespace
+
+TEST_CASE("workers sleep between calls: serial gaps between parallel calls cost the process almost no CPU") {
+  // Each call is followed by a 2 ms gap in which the caller sleeps, as the serial steps between a
+  // decimation's batches. Workers that spun through the gaps (for a millisecond each, as before)
+  // would add about 1 ms of CPU per gap; workers that sleep add a few tens of microseconds.
+  with_threads(2, [] {
+    constexpr int kGaps = 40;
+    int64_t total = parallel_count<int64_t>(0, 2, 0, [](int64_t i) { return i; });  // the worker exists
+    const double before = process_cpu_seconds();
+    for (int gap = 0; gap < kGaps; ++gap) {
+      total += parallel_count<int64_t>(0, 2, 0, [](int64_t i) { return i; });
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    const double cpu = process_cpu_seconds() - before;
+    CHECK(total == kGaps + 1);
+    CHECK(cpu < kGaps * 0.3e-3);
   });
 }
 #endif

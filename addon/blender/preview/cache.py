@@ -67,6 +67,14 @@ class PreparedCache:
         with self._lock:
             self._entries.clear()
 
+    def clear_kept(self) -> None:
+        """Frees what the cached meshes keep for later decimations (flood caches, collapse states),
+        keeping their preparations: the next decimation of each starts cold."""
+        with self._lock:
+            entries = list(self._entries.values())
+        for entry in entries:
+            entry.mesh.clear_floods()
+
 
 #: The add-on's cache (cleared on unregister and when a file is loaded).
 prepared_meshes = PreparedCache()

@@ -32,10 +32,11 @@ namespace topstoc {
 
 namespace {
 
-// How long a waiting thread spins before it sleeps. Consecutive loops of one decimation follow
-// each other within microseconds, and waking a sleeping thread costs far more than that; a
-// spin much longer than the gaps only burns a core the host (Blender) may want.
-constexpr std::chrono::microseconds kSpinTime{1000};
+// How long a waiting thread spins before it sleeps: long enough for the next of consecutive
+// loops (microseconds apart), short beside the serial steps between a decimation's batches. A
+// longer spin burned a core per waiting thread on every batch, and on a busy machine the spinner
+// took the core from the member it waited for (two threads then took many times the CPU of one).
+constexpr std::chrono::microseconds kSpinTime{50};
 
 // The thread limit the environment sets: TOPSTOC_NUM_THREADS, else OMP_NUM_THREADS (its first
 // entry), else none.

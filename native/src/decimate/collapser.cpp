@@ -313,6 +313,11 @@ int32_t Collapser::remove_thin(double min_shape, Stop keep) {
   return collapses;
 }
 
+// A batch's checks and costs run on the team only when they are a few hundred microseconds of
+// work: below that, waking the workers costs about what they save (they sleep between batches).
+constexpr int32_t kParallelChecks = 64;      // reserved collapses to check
+constexpr int32_t kParallelCostWork = 512;  // neighbour pairs to cost + 8 per evaluation
+
 // Collapses per batch: 1 (exactly greedy) near the end and on small meshes, up to 128 when
 // many remain, so that the checks and costs of a batch can run in parallel.
 int32_t Collapser::batch_size(int32_t excess) const {
@@ -406,7 +411,7 @@ void Collapser::reserve_batch(Batch& batch, uint32_t ring) {
 // The reserved collapses whose cost changed or which are no longer allowed are evaluated anew.
 void Collapser::check_reserved(Batch& batch) {
   const int32_t checks = int32_t(batch.reserved.size());
-  parallel_for_dynamic(0, checks, 4, 16, [&](int32_t k) {
+  parallel_for_dynamic(0, checks, 4, kParallelChecks, [&](int32_t k) {
     const int32_t i = batch.reserved[k], u = batch.vertices[i], v = target_[u];
     if (batch.key[i] != cost(u, v)) {
       batch.status[i] = kEvaluate;
@@ -461,7 +466,7 @@ void Collapser::cost_after_batch(Batch& batch, uint32_t ring) {
   batch.pair_cost_to.assign(pairs, 0.0);
   batch.pending_best.assign(evaluations, Best());
   std::atomic<int64_t> next_evaluation{0};
-  parallel_region(pairs + 8 * evaluations >= 64 ? max_threads() : 1, [&](Team& team) {
+  parallel_region(pairs + 8 * evaluations >= kParallelCostWork ? max_threads() : 1, [&](Team& team) {
     team.for_static(0, pairs, [&](int32_t i) {
       const int32_t v = batch.pair_from[i], x = batch.pair_to[i];
       const bool v_queues = queues(v), x_queues = queues(x);

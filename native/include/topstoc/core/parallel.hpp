@@ -4,8 +4,8 @@
 // Each parallel call runs on a pool of workers of its own for its duration, taken from the idle
 // pools (or made) and grown to the team it asks for; the caller works as member 0. A parallel call
 // made inside a worker runs serially in it. Pools and their workers last as long as the process. Between calls, idle workers spin for a
-// short while (the next loop of a decimation usually follows within microseconds) and then sleep:
-// nothing spins when the engine is idle.
+// few tens of microseconds (the next of consecutive loops follows within microseconds) and then
+// sleep: nothing spins during the serial steps between loops, nor when the engine is idle.
 #pragma once
 
 #include <algorithm>
