@@ -79,47 +79,48 @@ double apply_view(const ViewGuidance& view, const double* position, const double
   return p;
 }
 
-// Puts ids in ascending order of their values (ids[i]'s is values[i]; equal values keep their
-// order), exactly as a stable sort would: non-negative doubles order like their bit patterns, so
-// a radix sort over the bits that differ does it in a few linear passes (the importance table of
-// a million vertices was the first decimation's longest serial step). values ends up sorted too.
-void sort_ascending(std::vector<double>& values, std::vector<int32_t>& ids) {
-  uint64_t any = 0, all = ~uint64_t(0);
-  bool plain = true;  // no negative number, -0 or NaN
-  for (double x : values) {
+// Puts ids in ascending order of value(id) (equal values keep their order), exactly as a stable
+// sort would. Non-negative doubles order like their bit patterns, so a radix sort over the bits
+// that differ does it in a few linear passes (the importance table of a million vertices was the
+// first decimation's longest serial step); the values are computed where read, so the sort holds
+// two id arrays and no values (three arrays of values and ids were 12 bytes a triangle of the
+// first decimation's peak).
+template <class Value>
+void sort_ascending(std::vector<int32_t>& ids, const Value& value) {
+  auto bits_of = [&](int32_t v) {
+    const double x = value(v);
     uint64_t bits;
     std::memcpy(&bits, &x, sizeof bits);
+    return bits;
+  };
+  uint64_t any = 0, all = ~uint64_t(0);
+  bool plain = true;  // no negative number, -0 or NaN
+  for (int32_t v : ids) {
+    const uint64_t bits = bits_of(v);
     any |= bits, all &= bits;
-    plain &= !(bits >> 63) && !std::isnan(x);
+    plain &= !(bits >> 63) && !std::isnan(value(v));
   }
   if (!plain) {
+    std::vector<double> values(ids.size());
+    for (size_t i = 0; i < ids.size(); ++i) values[i] = value(ids[i]);
     std::vector<size_t> order(values.size());
     std::iota(order.begin(), order.end(), size_t(0));
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return values[a] < values[b]; });
-    std::vector<double> sorted_values(values.size());
     std::vector<int32_t> sorted_ids(ids.size());
-    for (size_t i = 0; i < order.size(); ++i) sorted_values[i] = values[order[i]], sorted_ids[i] = ids[order[i]];
-    values.swap(sorted_values);
+    for (size_t i = 0; i < order.size(); ++i) sorted_ids[i] = ids[order[i]];
     ids.swap(sorted_ids);
     return;
   }
   constexpr int kDigit = 16;  // 4 passes at most (11-bit digits took 5-6 on real weights)
   constexpr uint64_t kMask = (uint64_t(1) << kDigit) - 1;
-  std::vector<double> other(values.size());
-  std::vector<int32_t> other_ids(ids.size()), offsets;
+  std::vector<int32_t> other(ids.size()), offsets;
   for (int shift = 0; shift < 64; shift += kDigit) {
     if ((((any ^ all) >> shift) & kMask) == 0) continue;  // the same digit everywhere
-    const double* from = values.data();
-    const int32_t* from_ids = ids.data();
-    auto digit = [&](int64_t i) {
-      uint64_t bits;
-      std::memcpy(&bits, &from[i], sizeof bits);
-      return int32_t((bits >> shift) & kMask);
-    };
-    stable_counting_sort(int64_t(values.size()), int32_t(kMask + 1), digit,
-                         [&](int64_t i, int32_t at) { other[at] = from[i], other_ids[at] = from_ids[i]; }, offsets);
-    values.swap(other);
-    ids.swap(other_ids);
+    const int32_t* from = ids.data();
+    auto digit = [&](int64_t i) { return int32_t((bits_of(from[i]) >> shift) & kMask); };
+    stable_counting_sort(int64_t(ids.size()), int32_t(kMask + 1), digit,
+                         [&](int64_t i, int32_t at) { other[at] = from[i]; }, offsets);
+    ids.swap(other);
   }
 }
 
@@ -148,22 +149,18 @@ std::shared_ptr<const ImportanceTable> importance_table(const Mesh& mesh, const 
   const auto& cls = table->cls;
   const int32_t n = mesh.num_vertices();
   const Importance q = importance(mesh, *table);
-  {
-    std::vector<double> surface_q, curve_q;  // the values, for sorting only
-    surface_q.reserve(n);
-    table->surface.ids.reserve(n);
-    for (int32_t v = 0; v < n; ++v) {
-      const double qv = q(v);
-      if (cls[v] == kSurface) surface_q.push_back(qv), table->surface.ids.push_back(v);
-      else if (cls[v] == kCurve) curve_q.push_back(qv), table->curve.ids.push_back(v);
-      else if (cls[v] == kCorner) table->corners += 1.0;
-      table->active += cls[v] != kIsolated;
-      table->total_q += qv;
-    }
-    sort_ascending(surface_q, table->surface.ids);
-    sort_ascending(curve_q, table->curve.ids);
+  table->surface.ids.reserve(n);
+  for (int32_t v = 0; v < n; ++v) {
+    const double qv = q(v);
+    if (cls[v] == kSurface) table->surface.ids.push_back(v);
+    else if (cls[v] == kCurve) table->curve.ids.push_back(v);
+    else if (cls[v] == kCorner) table->corners += 1.0;
+    table->active += cls[v] != kIsolated;
+    table->total_q += qv;
   }
   table->surface.ids.shrink_to_fit();
+  sort_ascending(table->surface.ids, q);
+  sort_ascending(table->curve.ids, q);
   // Prefix sums, in order (their last bits are part of the result).
   table->curve.root = true;
   table->surface.sum_up(q);
