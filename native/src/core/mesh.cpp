@@ -256,17 +256,19 @@ void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offse
 
 // Components, numbered in order of their lowest vertex (each set's root), and the Euler
 // characteristic V - E + F of each from every vertex's share: itself, the edges to its higher
-// neighbours and the faces it is the lowest vertex of. Returns how many; `root` is scratch.
-int32_t number_components(SharedUnionFind& sets, const Buffer<int32_t>& vfo, const Buffer<int32_t>& euler,
-                          Buffer<int32_t>& root, Buffer<int32_t>& component, Buffer<int64_t>& component_euler) {
+// neighbours and the faces it is the lowest vertex of. Returns how many. `component` (n entries
+// or more) holds each vertex's root and receives its component in place: a root is its set's
+// lowest id (SharedUnionFind::unite), so it is numbered before the vertices that read it.
+int32_t number_components(const Buffer<int32_t>& vfo, const Buffer<int32_t>& euler, Buffer<int32_t>& component,
+                          Buffer<int64_t>& component_euler) {
   const int32_t n = int32_t(vfo.size()) - 1;
-  parallel_for(0, n, kParallelMin, [&](int32_t v) { root[v] = sets.find(v); });
-  component.resize(n);
   int32_t components = 0;
   for (int32_t v = 0; v < n; ++v) {
+    const int32_t root = component[v];
     if (vfo[v] == vfo[v + 1]) component[v] = -1;
-    else component[v] = root[v] == v ? components++ : component[root[v]];
+    else component[v] = root == v ? components++ : component[root];
   }
+  component.resize(n);
   component_euler.assign(components, 0);
   for (int32_t v = 0; v < n; ++v)
     if (component[v] >= 0) component_euler[component[v]] += euler[v];
@@ -328,6 +330,7 @@ Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangl
   progress.update(1.0);
   build_vertex_faces();
   build_adjacency(progress);
+  release_freed_heap(4 * size_t(num_vertices_));
 }
 
 void Mesh::validate_faces(const int32_t* triangles, int64_t num_triangles) {
@@ -633,12 +636,16 @@ void Mesh::build_adjacency(Progress& progress) {
   compact_neighbours(vfo, adjacency_offsets_, overflow, scratch);
   decltype(overflow)().swap(overflow);
   adjacency_.swap(scratch);
+  // Each vertex's root, where the edge offsets were: the sets go before the weights are made.
+  parallel_for(0, n, kParallelMin, [&](int32_t v) { greater[v] = sets.find(v); });
+  std::vector<int32_t>().swap(sets.parents());
+  release_freed_heap(4 * size_t(n));
 
   progress.stage("normals and weights", 0.8, 0.92);
   weigh();
   progress.stage("components", 0.92, 1.0);
-  Buffer<int32_t>& root = greater;  // its offsets are no longer needed
-  report_.components = number_components(sets, vfo, euler, root, component_, component_euler_);
+  component_.swap(greater);  // the roots
+  report_.components = number_components(vfo, euler, component_, component_euler_);
   mean_weight_ = mean_of_weights(adjacency_offsets_, weights_);
 }
 

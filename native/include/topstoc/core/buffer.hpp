@@ -18,6 +18,9 @@
 #include <sys/mman.h>
 #include <unistd.h>
 #endif
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 namespace topstoc {
 
@@ -75,6 +78,18 @@ void release_unused(Buffer<T>& buffer) {
   if (last > first) madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
 #else
   (void)buffer;
+#endif
+}
+
+/// Gives the heap's free pages back to the system (glibc; elsewhere nothing) after a stage that
+/// freed about `freed` bytes: std::vector's blocks of a few megabytes come from glibc's heap once
+/// its mapping threshold has risen, and stay resident once freed, under the next stage's working
+/// set (2 bytes a triangle of a 2M-triangle decimation's peak). Under 1 MB, nothing is done.
+inline void release_freed_heap(size_t freed) {
+#if defined(__GLIBC__)
+  if (freed >= (size_t(1) << 20)) malloc_trim(0);
+#else
+  (void)freed;
 #endif
 }
 
