@@ -14,6 +14,7 @@
 #include "topstoc/core/random.hpp"
 #include "topstoc/decimate/features.hpp"
 #include "topstoc/decimate/decimate.hpp"
+#include "topstoc/decimate/flood_cache.hpp"
 #include "topstoc/decimate/sampling.hpp"
 #include "topstoc/io/io.hpp"
 
@@ -125,4 +126,37 @@ TEST_CASE("decimate refuses sampling parameters out of range") {
   params.refine = 2.0;  // the refined path checks too (its first pass is a stochastic pass)
   params.sampling.density_ratio = 0.5;
   CHECK_THROWS_AS(decimate(mesh, *layout, params), std::invalid_argument);
+}
+
+// A decimation given no flood caches (a mesh made to be decimated once) leaves none of its draw's
+// per-vertex tables on the layout: they would sit under the next stages' peak. One given caches
+// keeps them for the next draw (a slider), and both give the same result.
+TEST_CASE("a decimation without flood caches keeps no draw tables on the layout, with the same result") {
+  const auto arrays = topstoc_test::torus(60, 40);
+  const Mesh mesh(arrays.positions, arrays.triangles.data(), arrays.num_triangles());
+  const auto once = build_feature_layout(mesh, nullptr, 0, nullptr, 0, 0.0);
+  const auto kept = build_feature_layout(mesh, nullptr, 0, nullptr, 0, 0.0);
+  FloodCachePool pool;
+  for (double refine : {0.0, 2.0}) {
+    for (int32_t target : {300, 290}) {  // the second: a slider's next draw with the same seed
+      CAPTURE(refine);
+      CAPTURE(target);
+      DecimateParams params;
+      params.target_vertices = target;
+      params.refine = refine;
+      params.sampling.seed = 3;
+      const DecimateResult plain = decimate(mesh, *once, params);
+      CHECK(!once->sampling_table.get());
+      CHECK(!once->selection_uniforms.get());
+      CHECK(!once->candidate_order.get());
+      params.flood_caches = &pool;
+      const DecimateResult slider = decimate(mesh, *kept, params);
+      CHECK(bool(kept->sampling_table.get()));
+      CHECK(bool(kept->selection_uniforms.get()));
+      if (target == 290) CHECK(bool(kept->candidate_order.get()));
+      CHECK(plain.vertices == slider.vertices);
+      CHECK(plain.triangles == slider.triangles);
+      CHECK(plain.labels == slider.labels);
+    }
+  }
 }

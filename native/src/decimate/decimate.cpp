@@ -1,4 +1,5 @@
 #include "topstoc/decimate/decimate.hpp"
+#include "topstoc/core/buffer.hpp"
 #include "topstoc/core/parallel.hpp"
 #include "topstoc/core/progress.hpp"
 
@@ -307,11 +308,19 @@ class ClusterRun {
       result.issues_remaining.sliver = partition.issues.sliver;
     result.seconds_checking = seconds_since(start);
     check_cancelled("output");
+    // The output needs the clustering and the last partition only: the check's state (a byte a
+    // face) and the top-ups' snapshot go before it (the cache holds its own first check).
+    checked = CheckState();
+    snapshot = Snapshot();
+    release_freed_heap(8 * size_t(mesh.num_vertices()));
     std::vector<std::pair<int32_t, uint64_t>> relabelled;
     const int32_t drawn = keeper ? int32_t(keeper->samples.size()) : 0, count = int32_t(samples.size());
     DecimateResult out = finish(mesh, layout, std::move(samples), clustering, partition, placement, draft,
                                 std::move(result), keeper ? &relabelled : nullptr);
     if (keeper) hand_flood_to_cache(relabelled, drawn, count);
+    clustering = Clustering();
+    partition = Partition();
+    release_freed_heap(8 * size_t(mesh.num_vertices()));  // the flood, under the refinement otherwise
     return out;
   }
 
@@ -380,8 +389,6 @@ class ClusterRun {
   void hand_flood_to_cache(const std::vector<std::pair<int32_t, uint64_t>>& relabelled, int32_t drawn,
                            int32_t count) {
     partition = Partition();
-    checked = CheckState();
-    snapshot = Snapshot();
     for (auto it = relabelled.rbegin(); it != relabelled.rend(); ++it) clustering.key[it->first] = it->second;
     flood_drop_tail(mesh, layout, drawn, count, clustering);
     keeper->clustering = std::move(clustering);
@@ -625,6 +632,15 @@ class BorrowedCache {
   int exceptions_ = std::uncaught_exceptions();  // in flight when borrowed (a handler may borrow)
 };
 
+// A caller that keeps no floods decimates once: the draw's per-vertex tables (the importance
+// table, a seed's uniforms and candidate order, up to 16 bytes a triangle) are not kept on the
+// layout beside the flood and the refinement either (rebuilt by a later draw, the same bits).
+void forget_draw_tables(const FeatureLayout& layout) {
+  layout.sampling_table.set(nullptr);
+  layout.selection_uniforms.set(nullptr);
+  layout.candidate_order.set(nullptr);
+}
+
 // One pass: draw samples for `target`, then flood, check, repair, emit.
 DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
                              int32_t target, int32_t top_up_to, FloodCache* cache) {
@@ -653,6 +669,8 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
       required[v] = p[v] >= 1.0;
     }
   }
+  if (!params.flood_caches) forget_draw_tables(layout);
+  release_freed_heap(8 * size_t(mesh.num_vertices()));  // the draw's sort, under the flood otherwise
   const bool fast = params.fast_path == 1 || (params.fast_path < 0 && target < 0.05 * active);
   // The fast path finds emitting faces from the flood's crossings, which can miss one that
   // a full scan (and so an updated flood) finds: its results are its own, never updated.

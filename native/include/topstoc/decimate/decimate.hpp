@@ -63,7 +63,9 @@ struct DecimateParams {
   CornerAttributes attributes;  ///< attribute-aware cost of the refinement
   /// Floods of earlier decimations of this mesh and layout (flood_cache.hpp), or null: the
   /// result is the same either way, nearby targets of one seed come sooner (not with the fast
-  /// path, whose results can differ from a full scan's).
+  /// path, whose results can differ from a full scan's). Null also keeps none of the draw's
+  /// per-vertex tables on the layout (a caller without floods decimates once; a later draw
+  /// rebuilds them, the same bits).
   FloodCachePool* flood_caches = nullptr;
   /// Collapse states of earlier quality decimations of this mesh and layout
   /// (collapse_snapshots.hpp), or null: the same result either way, lower targets sooner.
