@@ -186,3 +186,21 @@ def test_cleared_layouts_are_built_again_with_the_same_results():
         np.testing.assert_array_equal(old.vertices, new.vertices)
         np.testing.assert_array_equal(old.triangles, new.triangles)
         np.testing.assert_array_equal(old.samples, new.samples)
+
+
+def test_meshes_from_the_size_limit_up_keep_no_floods_unless_asked(monkeypatch):
+    """By default a mesh keeps floods below Mesh.KEEP_FLOODS_BELOW triangles only (above, the
+    flood and the draw's tables would sit under the next decimation's peak); True keeps them at
+    any size. Kept or not, the nearby re-decimation gives the same mesh."""
+    vertices, triangles = meshgen.bumpy_torus(20_000)
+    count = Mesh(vertices, triangles).num_triangles
+    monkeypatch.setattr(Mesh, "KEEP_FLOODS_BELOW", count)
+    big, asked = Mesh(vertices, triangles), Mesh(vertices, triangles, keep_floods=True)
+    assert big.kept_for_reuse()[1] is None and asked.kept_for_reuse()[1] is not None
+    monkeypatch.setattr(Mesh, "KEEP_FLOODS_BELOW", count + 1)
+    assert Mesh(vertices, triangles).kept_for_reuse()[1] is not None
+    for ratio in (0.05, 0.048):
+        once, slider = big.decimate(ratio=ratio, seed=2), asked.decimate(ratio=ratio, seed=2)
+        assert_same(once, slider)
+        assert not once.stats.flood_updated
+    assert slider.stats.flood_updated

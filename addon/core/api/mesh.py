@@ -91,14 +91,20 @@ class Mesh:
     >>> result.vertices, result.triangles
     """
 
-    def __init__(self, vertices, triangles, progress=None, keep_floods: bool = True):
+    #: keep_floods' default: floods are kept for meshes of fewer triangles (see __init__)
+    KEEP_FLOODS_BELOW = 1_000_000
+
+    def __init__(self, vertices, triangles, progress=None, keep_floods=None):
         """progress: optional ``progress(fraction, stage)``, called from the preparing thread at
         each step (validate, order, adjacency, normals and weights, components); returning False
         stops the preparation with ``topstoc.core.Cancelled`` (the live preview's Esc).
         keep_floods: keep the floods of recent decimations so that nearby targets come sooner
         (see layout_and_floods), and the collapse states of recent quality decimations of meshes
         collapsed whole so that lower targets come sooner (see kept_for_reuse); False saves that
-        memory, results are the same."""
+        memory, and the draw's per-vertex tables are not kept either; results are the same.
+        None (the default): kept for meshes under KEEP_FLOODS_BELOW triangles; above, a
+        decimation's flood, its first check and the draw's tables (8 bytes a triangle and more)
+        would sit under the next one's peak."""
         vertices = as_vertices(vertices)
         triangles = _as_triangles(triangles)
         # The engine copies what it needs (reading float64 and int32 arrays in place) and can
@@ -108,7 +114,8 @@ class Mesh:
         self._triangles = None
         self._topology = None  # the input's, computed on first use (input_topology)
         self._layouts: dict = {}
-        self._keep_floods = bool(keep_floods)
+        self._keep_floods = (bool(keep_floods) if keep_floods is not None
+                             else self._native.num_faces < self.KEEP_FLOODS_BELOW)
 
     # -- the caller's data, read-only --------------------------------------------------------
     @property
