@@ -271,10 +271,10 @@ class ClusterRun {
  public:
   ClusterRun(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples, int32_t max_rounds,
              bool repair_slivers, bool fast_path, const std::vector<uint8_t>& avoid, const std::vector<uint8_t>& required,
-             int32_t top_up_to, FloodCache* cache, DecimateResult result)
+             int32_t top_up_to, FloodCache* cache, bool one_off, DecimateResult result)
       : mesh(mesh), layout(layout), max_rounds(max_rounds), repair_slivers(repair_slivers), fast_path(fast_path),
-        avoid(avoid), required(required), top_up_to(top_up_to), cache(cache), samples(std::move(samples)),
-        result(std::move(result)) {}
+        one_off(one_off), avoid(avoid), required(required), top_up_to(top_up_to), cache(cache),
+        samples(std::move(samples)), result(std::move(result)) {}
 
   DecimateResult run(Placement placement, bool draft) {
     auto start = Clock::now();
@@ -312,7 +312,7 @@ class ClusterRun {
     // face) and the top-ups' snapshot go before it (the cache holds its own first check).
     checked = CheckState();
     snapshot = Snapshot();
-    release_freed_heap(8 * size_t(mesh.num_vertices()));
+    release_heap();
     std::vector<std::pair<int32_t, uint64_t>> relabelled;
     const int32_t drawn = keeper ? int32_t(keeper->samples.size()) : 0, count = int32_t(samples.size());
     DecimateResult out = finish(mesh, layout, std::move(samples), clustering, partition, placement, draft,
@@ -320,7 +320,7 @@ class ClusterRun {
     if (keeper) hand_flood_to_cache(relabelled, drawn, count);
     clustering = Clustering();
     partition = Partition();
-    release_freed_heap(8 * size_t(mesh.num_vertices()));  // the flood, under the refinement otherwise
+    release_heap();  // the flood, under the refinement otherwise
     return out;
   }
 
@@ -329,6 +329,7 @@ class ClusterRun {
   const FeatureLayout& layout;
   const int32_t max_rounds;
   const bool repair_slivers, fast_path;
+  const bool one_off;  // no flood is kept: freed heap goes back between stages (release_heap)
   const std::vector<uint8_t>& avoid;
   const std::vector<uint8_t>& required;
   const int32_t top_up_to;
@@ -392,6 +393,12 @@ class ClusterRun {
     for (auto it = relabelled.rbegin(); it != relabelled.rend(); ++it) clustering.key[it->first] = it->second;
     flood_drop_tail(mesh, layout, drawn, count, clustering);
     keeper->clustering = std::move(clustering);
+  }
+
+  // A one-off decimation's freed heap goes back to the system between stages, so that the next
+  // stage's working set does not sit above it (a slider's decimations skip it: they run again).
+  void release_heap() const {
+    if (one_off) release_freed_heap(8 * size_t(mesh.num_vertices()));
   }
 
   // One round's partition check; the first check goes to the cache too.
@@ -558,9 +565,10 @@ class ClusterRun {
 DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                 Placement placement, int32_t max_rounds, bool repair_slivers, bool fast_path,
                                 const std::vector<uint8_t>& avoid, const std::vector<uint8_t>& required,
-                                int32_t top_up_to, FloodCache* cache, bool draft, DecimateResult result) {
+                                int32_t top_up_to, FloodCache* cache, bool one_off, bool draft,
+                                DecimateResult result) {
   return ClusterRun(mesh, layout, std::move(samples), max_rounds, repair_slivers, fast_path, avoid, required, top_up_to,
-                    cache, std::move(result))
+                    cache, one_off, std::move(result))
       .run(placement, draft);
 }
 
@@ -669,13 +677,17 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
       required[v] = p[v] >= 1.0;
     }
   }
-  if (!params.flood_caches) forget_draw_tables(layout);
-  release_freed_heap(8 * size_t(mesh.num_vertices()));  // the draw's sort, under the flood otherwise
+  const bool one_off = !params.flood_caches;
+  if (one_off) {
+    forget_draw_tables(layout);
+    release_freed_heap(8 * size_t(mesh.num_vertices()));  // the draw's sort, under the flood otherwise
+  }
   const bool fast = params.fast_path == 1 || (params.fast_path < 0 && target < 0.05 * active);
   // The fast path finds emitting faces from the flood's crossings, which can miss one that
   // a full scan (and so an updated flood) finds: its results are its own, never updated.
   return cluster_and_emit(mesh, layout, std::move(set.samples), params.placement, params.max_repair_rounds, true,
-                          fast, avoid, required, top_up_to, fast ? nullptr : cache, params.draft, std::move(result));
+                          fast, avoid, required, top_up_to, fast ? nullptr : cache, one_off, params.draft,
+                          std::move(result));
 }
 
 }  // namespace
@@ -872,7 +884,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
   // A refined result's first pass keeps input positions: the refinement places what it keeps.
   result = cluster_and_emit(mesh, layout, std::move(samples), refine_vertices > 0 ? Placement::Subsample : placement,
                             max_repair_rounds, false, false, {},
-                            std::vector<uint8_t>(mesh.num_vertices(), 0), 0, nullptr, false, std::move(result));
+                            std::vector<uint8_t>(mesh.num_vertices(), 0), 0, nullptr, false, false, std::move(result));
   // A refined result is thinned again; an unrefined one loses its zero-area triangles, as
   // decimate() does.
   if (refine_vertices > 0 || has_zero_area(result)) {
