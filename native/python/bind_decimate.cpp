@@ -229,10 +229,65 @@ void bind_decimation_state(py::module_& m) {
       .def_property_readonly("is_set", [](const CancelToken& token) { return token.flag.load(); });
 }
 
+// Where moved output vertices take their attributes from (moved_sources.hpp).
+void bind_moved_sources(py::module_& m) {
+  m.def(
+      "moved_sources",
+      [](const py::handle& vertices, const py::handle& triangles, const py::handle& labels,
+         const py::handle& output, const py::handle& moved) {
+        const auto input = positions_array(vertices, "vertices");
+        const auto tris = indices_array(triangles, 3, "triangles");
+        const int64_t n = int64_t(input.size() / 3), m = int64_t(tris.size() / 3);
+        const auto label = ids_from(labels, n, "labels");
+        const auto out = positions_array(output, "output");
+        const int64_t k = int64_t(out.size() / 3);
+        const auto flags = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>::ensure(moved);
+        if (!flags || flags.size() != k) throw std::invalid_argument("moved must hold one flag per output vertex");
+        require_indices_in_range(tris.data(), m, 3, n, "triangle");
+        for (int32_t l : label)
+          if (l >= k) throw std::invalid_argument("labels name an output vertex out of range");
+        MovedSources sources;
+        {
+          EngineCall call;
+          sources = moved_sources(input.data(), tris.data(), m, label.data(), out.data(), flags.data(), k);
+        }
+        return py::make_tuple(to_array(std::move(sources.face)), to_array(std::move(sources.weights), 3));
+      },
+      py::arg("vertices"), py::arg("triangles"), py::arg("labels"), py::arg("output"), py::arg("moved"),
+      "For each moved output vertex, the closest input triangle touching its cluster and the clamped barycentric "
+      "weights there (addon/core/carry/attributes.py moved_vertices): (face, weights).");
+
+  m.def(
+      "moved_sources_of_mesh",
+      [](const Mesh& mesh, const py::handle& labels, const py::handle& kept, const py::handle& output) {
+        const int64_t n = mesh.report().input_vertices;
+        const auto label = ids_from(labels, n, "labels");
+        const auto out = positions_array(output, "output");
+        const int64_t k = int64_t(out.size() / 3);
+        const auto kept_ids = ids_from(kept, k, "kept");
+        if (int64_t(label.size()) != n || int64_t(kept_ids.size()) != k)
+          throw std::invalid_argument("labels and kept must be given");
+        for (int32_t l : label)
+          if (l >= k) throw std::invalid_argument("labels name an output vertex out of range");
+        for (int32_t v : kept_ids)
+          if (v < 0 || v >= n || mesh.vertex_index()[v] < 0) throw std::invalid_argument("kept names no mesh vertex");
+        MovedSources sources;
+        {
+          EngineCall call;
+          sources = moved_sources(mesh, label.data(), kept_ids.data(), out.data(), k);
+        }
+        return py::make_tuple(to_array(std::move(sources.face)), to_array(std::move(sources.weights), 3));
+      },
+      py::arg("mesh"), py::arg("labels"), py::arg("kept"), py::arg("output"),
+      "moved_sources read from the prepared mesh (one that dropped no triangle) instead of the caller's arrays; "
+      "moved: the output vertices not at their kept input vertex.");
+}
+
 }  // namespace
 
 void bind_decimate(py::module_& m) {
   bind_decimation_state(m);
+  bind_moved_sources(m);
   m.def(
       "decimate",
       [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& job, const py::handle& flood_caches,
@@ -316,32 +371,6 @@ void bind_decimate(py::module_& m) {
         return d;
       },
       py::arg("vertices"), py::arg("triangles"), "Aspect ratio (thesis eq. 4.2): mean, max, degenerate count.");
-
-  m.def(
-      "moved_sources",
-      [](const py::handle& vertices, const py::handle& triangles, const py::handle& labels,
-         const py::handle& output, const py::handle& moved) {
-        const auto input = positions_array(vertices, "vertices");
-        const auto tris = indices_array(triangles, 3, "triangles");
-        const int64_t n = int64_t(input.size() / 3), m = int64_t(tris.size() / 3);
-        const auto label = ids_from(labels, n, "labels");
-        const auto out = positions_array(output, "output");
-        const int64_t k = int64_t(out.size() / 3);
-        const auto flags = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>::ensure(moved);
-        if (!flags || flags.size() != k) throw std::invalid_argument("moved must hold one flag per output vertex");
-        require_indices_in_range(tris.data(), m, 3, n, "triangle");
-        for (int32_t l : label)
-          if (l >= k) throw std::invalid_argument("labels name an output vertex out of range");
-        MovedSources sources;
-        {
-          EngineCall call;
-          sources = moved_sources(input.data(), tris.data(), m, label.data(), out.data(), flags.data(), k);
-        }
-        return py::make_tuple(to_array(std::move(sources.face)), to_array(std::move(sources.weights), 3));
-      },
-      py::arg("vertices"), py::arg("triangles"), py::arg("labels"), py::arg("output"), py::arg("moved"),
-      "For each moved output vertex, the closest input triangle touching its cluster and the clamped barycentric "
-      "weights there (addon/core/carry/attributes.py moved_vertices): (face, weights).");
 }
 
 }  // namespace topstoc::python

@@ -244,3 +244,31 @@ def test_moved_vertices_take_the_closest_triangle_of_their_cluster():
         best = np.flatnonzero(distance == distance.min())[0]
         assert moved.face[v] == candidates[best]
         assert moved.weights[v].tobytes() == w[best].tobytes()  # the same arithmetic, bit for bit
+
+
+def test_moved_sources_read_from_the_prepared_mesh_are_the_arrays_ones():
+    """moved_vertices_of reads the prepared mesh (its reordered vertices and faces) instead of the
+    caller's arrays, so that a big decimation need not take them back: the same triangle and
+    weights for every output vertex, on a flat grid (ties), a scan with holes and a torus, in both
+    modes; a mesh that dropped a triangle takes the arrays' way."""
+    import meshgen
+    from topstoc.core.carry.attributes import moved_vertices, moved_vertices_of
+    elephant = read_mesh(pathlib.Path(__file__).resolve().parents[1] / "data" / "open_boundary"
+                         / "cgal_elephant-with-holes.off")
+    moved = 0
+    for vertices, triangles in (meshgen.bumpy_torus(20_000), (elephant.vertices, elephant.triangles),
+                                meshgen.grid(40, 30)):
+        mesh = Mesh(vertices, triangles)
+        for mode, ratio in (("quality", 0.1), ("quality", 0.02), ("fast", 0.1)):
+            result = mesh.decimate(ratio=ratio, mode=mode, seed=1)
+            expected, found = moved_vertices(mesh.vertices, mesh.triangles, result), moved_vertices_of(mesh, result)
+            np.testing.assert_array_equal(found.face, expected.face)
+            np.testing.assert_array_equal(found.weights, expected.weights)
+            moved += int((expected.face >= 0).sum())
+    assert moved > 1000  # the comparison covered moved vertices, not only unmoved ones
+    mesh = Mesh(vertices, np.vstack([triangles, [[0, 0, 1]]]))
+    assert len(mesh.native.report["dropped_triangles"]) == 1
+    result = mesh.decimate(ratio=0.2, mode="quality", seed=1)
+    expected, found = moved_vertices(mesh.vertices, mesh.triangles, result), moved_vertices_of(mesh, result)
+    np.testing.assert_array_equal(found.face, expected.face)
+    np.testing.assert_array_equal(found.weights, expected.weights)

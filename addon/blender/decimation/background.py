@@ -16,7 +16,7 @@ import time
 
 from ...core.api.decimate import CancelFlag
 from ...core.api.loops import Cancelled
-from ...core.carry.attributes import moved_vertices
+from ...core.carry.attributes import moved_vertices_of
 from ...core.support.errors import TopStocError
 from . import pipeline
 
@@ -54,7 +54,8 @@ class BackgroundDecimation:
                 run = pipeline.decimate_read(read, self._preparing(index), self._searching(index), self._stop_engine,
                                              one_shot=True)
                 self._state = (index, 1.0, "finding the sources of moved vertices")
-                run.moved = moved_vertices(read.arrays.vertices, read.arrays.triangles, run.result)  # not at the write
+                # not at the write; from the prepared mesh: the arrays handed over stay there
+                run.moved = moved_vertices_of(run.prepared.mesh, run.result)
                 outcome = (run, None)
             except Cancelled:
                 return

@@ -22,7 +22,7 @@ import bpy
 import numpy as np
 
 from ...core.carry.appearance import refines
-from ...core.carry.attributes import MovedVertices, moved_vertices, point_weights
+from ...core.carry.attributes import MovedVertices, moved_vertices_of, point_weights
 from ...core.api.decimate import run_job
 from ...core.support.errors import TopStocError
 from ...core.api.job import ATTRIBUTE_WEIGHT, DecimationJob, make_job
@@ -268,7 +268,7 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
     kept = np.asarray(run.result.kept)
     arrays = run.prepared.arrays
     moved = run.moved if run.moved is not None else \
-        moved_vertices(arrays.vertices, arrays.triangles, run.result)  # quality mode: interpolated
+        moved_vertices_of(run.prepared.mesh, run.result)  # quality mode: interpolated
     group_names, weights = skin_weights(obj, arrays, kept, moved)
     shape_keys = carry.read_shape_keys(obj.data)
     if mode == "IN_PLACE" or into is not None:

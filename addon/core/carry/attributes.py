@@ -134,6 +134,16 @@ def moved_vertices(vertices, triangles, result) -> MovedVertices:
     return MovedVertices(face, weights)
 
 
+def moved_vertices_of(mesh, result) -> MovedVertices:
+    """``moved_vertices`` of ``result`` read from ``mesh``, the prepared core Mesh it was decimated
+    from, so that a big decimation need not take the input arrays back (24 bytes a triangle beside
+    the prepared mesh); from the arrays when the mesh dropped triangles (degenerate, repeated)."""
+    if len(mesh.native.report["dropped_triangles"]):
+        return moved_vertices(mesh.vertices, mesh.triangles, result)
+    face, weights = engine.moved_sources_of_mesh(mesh.native, result.labels, result.kept, result.vertices)
+    return MovedVertices(face, weights)
+
+
 def _combine(values: np.ndarray, corners: np.ndarray, weights: np.ndarray, nearest: bool) -> np.ndarray:
     """values at ``corners`` (k, 3) combined with ``weights`` (k, 3): barycentric, or the value
     of the heaviest corner (``nearest``: integers, flags, rotations)."""

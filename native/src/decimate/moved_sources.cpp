@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace topstoc {
 
@@ -34,31 +35,62 @@ double clamped_barycentric(const double* p, const double* a, const double* b, co
   return std::sqrt((r[0] * r[0] + r[1] * r[1]) + r[2] * r[2]);
 }
 
-}  // namespace
-
-MovedSources moved_sources(const double* input, const int32_t* triangles, int64_t num_triangles,
-                           const int32_t* labels, const double* output, const uint8_t* moved, int64_t num_output) {
+MovedSources unmoved(int64_t num_output) {
   MovedSources out;
   out.face.assign(num_output, -1);
   out.weights.assign(3 * size_t(num_output), 0.0);
   for (int64_t v = 0; v < num_output; ++v) out.weights[3 * size_t(v)] = 1.0;
+  return out;
+}
+
+// Triangle f (corners a, b, c in the clusters l) offered to each moved cluster among its corners,
+// once. A vertex's source changes when strictly closer, or as close from a lower triangle id:
+// the lowest triangle wins ties whatever the order the triangles come in.
+void offer(int64_t f, const int32_t* l, const double* a, const double* b, const double* c, const double* output,
+           const uint8_t* moved, std::vector<double>& closest, MovedSources& out) {
+  for (int j = 0; j < 3; ++j) {
+    const int32_t v = l[j];
+    if (v < 0 || !moved[v] || (j >= 1 && v == l[0]) || (j == 2 && v == l[1])) continue;
+    double w[3];
+    const double distance = clamped_barycentric(output + 3 * size_t(v), a, b, c, w);
+    if (!(distance < closest[v]) && !(distance == closest[v] && out.face[v] >= 0 && f < out.face[v])) continue;
+    closest[v] = distance;
+    out.face[v] = f;
+    for (int i = 0; i < 3; ++i) out.weights[3 * size_t(v) + i] = w[i];
+  }
+}
+
+}  // namespace
+
+MovedSources moved_sources(const double* input, const int32_t* triangles, int64_t num_triangles,
+                           const int32_t* labels, const double* output, const uint8_t* moved, int64_t num_output) {
+  MovedSources out = unmoved(num_output);
   std::vector<double> closest(num_output, std::numeric_limits<double>::infinity());
-  // Triangles in order, a vertex's closest replaced only when strictly closer: the lowest
-  // triangle wins ties. Each triangle counts once per cluster among its corners.
   for (int64_t f = 0; f < num_triangles; ++f) {
     const int32_t* t = triangles + 3 * f;
     const int32_t l[3] = {labels[t[0]], labels[t[1]], labels[t[2]]};
-    for (int j = 0; j < 3; ++j) {
-      const int32_t v = l[j];
-      if (v < 0 || !moved[v] || (j >= 1 && v == l[0]) || (j == 2 && v == l[1])) continue;
-      double w[3];
-      const double distance = clamped_barycentric(output + 3 * size_t(v), input + 3 * size_t(t[0]),
-                                                  input + 3 * size_t(t[1]), input + 3 * size_t(t[2]), w);
-      if (!(distance < closest[v])) continue;
-      closest[v] = distance;
-      out.face[v] = f;
-      for (int i = 0; i < 3; ++i) out.weights[3 * size_t(v) + i] = w[i];
-    }
+    offer(f, l, input + 3 * size_t(t[0]), input + 3 * size_t(t[1]), input + 3 * size_t(t[2]), output, moved, closest,
+          out);
+  }
+  return out;
+}
+
+MovedSources moved_sources(const Mesh& mesh, const int32_t* labels, const int32_t* kept, const double* output,
+                           int64_t num_output) {
+  if (!mesh.report().dropped_triangles.empty())
+    throw std::invalid_argument("moved sources from a prepared mesh that dropped triangles: give the arrays");
+  const auto& index = mesh.vertex_index();
+  const auto& source = mesh.vertex_source();
+  std::vector<uint8_t> moved(num_output, 0);
+  for (int64_t v = 0; v < num_output; ++v)
+    for (int i = 0; i < 3; ++i) moved[v] |= output[3 * size_t(v) + i] != mesh.position(index[kept[v]])[i];
+  MovedSources out = unmoved(num_output);
+  std::vector<double> closest(num_output, std::numeric_limits<double>::infinity());
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+    const int32_t* t = &mesh.faces()[3 * size_t(f)];
+    const int32_t l[3] = {labels[source[t[0]]], labels[source[t[1]]], labels[source[t[2]]]};
+    offer(mesh.face_source()[f], l, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]), output,
+          moved.data(), closest, out);
   }
   return out;
 }

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "topstoc/core/mesh.hpp"
+
 namespace topstoc {
 
 struct MovedSources {
@@ -19,5 +21,11 @@ struct MovedSources {
 /// projection is closest (the lowest triangle on ties), with the clamped barycentric weights.
 MovedSources moved_sources(const double* input, const int32_t* triangles, int64_t num_triangles,
                            const int32_t* labels, const double* output, const uint8_t* moved, int64_t num_output);
+
+/// The same, read from the prepared mesh of the input instead of the caller's arrays (a big
+/// decimation need not take them back), for a mesh that dropped no triangle; labels are the
+/// caller's. Moved: the output vertices not at the position of their kept input vertex.
+MovedSources moved_sources(const Mesh& mesh, const int32_t* labels, const int32_t* kept, const double* output,
+                           int64_t num_output);
 
 }  // namespace topstoc
