@@ -57,6 +57,8 @@ def test_the_addon_holds_only_the_input_arrays(ts, big_torus, monkeypatch, quali
         job = ts.blender.decimation.background.BackgroundDecimation([read])
         assert job.wait(300)
         run = job.outcomes[0][0]
+        # the moved sources read the prepared mesh: nothing took its copies of the arrays back
+        assert run.prepared.mesh._vertices is None and run.prepared.mesh._triangles is None
         # handed over and back from the engine: the arrays Blender gives, read-only
         fresh = ts.blender.io.mesh_read.read_mesh(big_torus.data)
         np.testing.assert_array_equal(read.arrays.vertices, fresh.vertices)
