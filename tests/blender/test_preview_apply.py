@@ -59,7 +59,7 @@ def test_a_rested_quality_result_is_applied_as_shown(ts, scene, donut, monkeypat
     finally:
         session.close()
     written = []
-    monkeypatch.setattr(pipeline, "moved_vertices", lambda *args: written.append(args))
+    monkeypatch.setattr(pipeline, "moved_vertices_of", lambda *args: written.append(args))
     out = pipeline.write_output(run)
     assert not written  # the write did not look for them again
     np.testing.assert_array_equal(positions(out.data), shown_vertices)
