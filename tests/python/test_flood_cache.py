@@ -188,19 +188,26 @@ def test_cleared_layouts_are_built_again_with_the_same_results():
         np.testing.assert_array_equal(old.samples, new.samples)
 
 
-def test_meshes_from_the_size_limit_up_keep_no_floods_unless_asked(monkeypatch):
-    """By default a mesh keeps floods below Mesh.KEEP_FLOODS_BELOW triangles only (above, the
-    flood and the draw's tables would sit under the next decimation's peak); True keeps them at
-    any size. Kept or not, the nearby re-decimation gives the same mesh."""
+def test_meshes_from_the_size_limit_up_keep_floods_from_a_second_decimation(monkeypatch):
+    """By default a mesh keeps floods below Mesh.KEEP_FLOODS_BELOW triangles; above, from its
+    layout's second decimation on (a one-off decimation's flood and the draw's tables would sit
+    under the next one's peak; a slider's pay for themselves). True keeps them from the first,
+    False never. Kept or not, the nearby re-decimations give the same mesh."""
     vertices, triangles = meshgen.bumpy_torus(20_000)
     count = Mesh(vertices, triangles).num_triangles
     monkeypatch.setattr(Mesh, "KEEP_FLOODS_BELOW", count)
     big, asked = Mesh(vertices, triangles), Mesh(vertices, triangles, keep_floods=True)
-    assert big.kept_for_reuse()[1] is None and asked.kept_for_reuse()[1] is not None
-    monkeypatch.setattr(Mesh, "KEEP_FLOODS_BELOW", count + 1)
-    assert Mesh(vertices, triangles).kept_for_reuse()[1] is not None
-    for ratio in (0.05, 0.048):
-        once, slider = big.decimate(ratio=ratio, seed=2), asked.decimate(ratio=ratio, seed=2)
+    never = Mesh(vertices, triangles, keep_floods=False)
+    updated = []
+    for ratio in (0.05, 0.048, 0.046):
+        once, slider, plain = (m.decimate(ratio=ratio, seed=2) for m in (big, asked, never))
         assert_same(once, slider)
-        assert not once.stats.flood_updated
-    assert slider.stats.flood_updated
+        assert_same(once, plain)
+        updated.append((once.stats.flood_updated, slider.stats.flood_updated, plain.stats.flood_updated))
+        if ratio == 0.05:
+            assert big._layouts[next(iter(big._layouts))][1] is None  # the one-off keeps nothing
+    assert never.layout_and_floods()[1] is None and asked.layout_and_floods()[1] is not None
+    monkeypatch.setattr(Mesh, "KEEP_FLOODS_BELOW", count + 1)
+    assert Mesh(vertices, triangles).layout_and_floods()[1] is not None
+    # big: nothing kept by the first decimation, kept by the second, so the third updates it
+    assert updated == [(False, False, False), (False, True, False), (True, True, False)]

@@ -102,9 +102,10 @@ class Mesh:
         (see layout_and_floods), and the collapse states of recent quality decimations of meshes
         collapsed whole so that lower targets come sooner (see kept_for_reuse); False saves that
         memory, and the draw's per-vertex tables are not kept either; results are the same.
-        None (the default): kept for meshes under KEEP_FLOODS_BELOW triangles; above, a
-        decimation's flood, its first check and the draw's tables (8 bytes a triangle and more)
-        would sit under the next one's peak."""
+        None (the default): kept for meshes under KEEP_FLOODS_BELOW triangles; above, from a
+        layout's second decimation on (a slider's, not a one-off's: a decimation's flood, its
+        first check and the draw's tables, 8 bytes a triangle and more, would sit under the next
+        one's peak)."""
         vertices = as_vertices(vertices)
         triangles = _as_triangles(triangles)
         # The engine copies what it needs (reading float64 and int32 arrays in place) and can
@@ -114,8 +115,9 @@ class Mesh:
         self._triangles = None
         self._topology = None  # the input's, computed on first use (input_topology)
         self._layouts: dict = {}
+        # True, False, or None: kept from a layout's second decimation on
         self._keep_floods = (bool(keep_floods) if keep_floods is not None
-                             else self._native.num_faces < self.KEEP_FLOODS_BELOW)
+                             else True if self._native.num_faces < self.KEEP_FLOODS_BELOW else None)
 
     # -- the caller's data, read-only --------------------------------------------------------
     @property
@@ -197,6 +199,8 @@ class Mesh:
         keep_floods=False."""
         key = (_digest(regions), _digest(borders), float(feature_angle))
         entry = self._layouts.get(key)
+        if entry is not None and entry[1] is None and self._keep_floods is None:
+            entry = self._layouts[key] = (entry[0], engine.FloodCachePool(), engine.CollapseSnapshots())
         if entry is None:
             layout = engine.build_feature_layout(self._native, regions, borders, float(feature_angle))
             entry = ((layout, engine.FloodCachePool(), engine.CollapseSnapshots()) if self._keep_floods
