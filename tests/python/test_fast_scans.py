@@ -104,8 +104,9 @@ def test_a_draft_of_a_stalled_first_pass_is_the_full_result():
     assert draft.stats.output_checked and draft.stats.topology_kept
 
 
-@pytest.mark.parametrize("target", [dict(ratio=0.02), dict(target_triangles=27)])
+@pytest.mark.parametrize("target", [dict(ratio=0.02), dict(target_triangles=27), dict(ratio=0.1)])
 def test_a_collapsed_fast_result_replays_from_its_samples(target):
+    # (at 10 % the pass does not stall: it ends above its target, and is collapsed the same way)
     mesh = spider()
     r = mesh.decimate(mode="fast", seed=0, **target)
     assert r.stats.refine_keeps_positions
