@@ -51,6 +51,11 @@ def check_output(mesh, result, expected_invariants):
     np.testing.assert_array_equal(result.labels[source], tri)
 
 
+def plain_count(mesh, ratio, seed):
+    """Vertices the plain TopStoc pass keeps (a draft: fast mode collapses a pass above its target)."""
+    return mesh.decimate(ratio=ratio, seed=seed, mode="fast", draft=True).num_vertices
+
+
 @pytest.mark.parametrize("path", SURFACES, ids=lambda p: p.name)
 def test_topology_kept_for_every_seed_and_ratio(path):
     mesh = load(path)
@@ -67,11 +72,12 @@ def test_topology_kept_for_every_seed_and_ratio(path):
                 if mesh.num_vertices >= 1000:
                     # the budget holds within 1 %, unless the topology needs more samples than
                     # the target allows: then the excess is the repairs the result reports
-                    # (or below it by the collapses that removed zero-area triangles)
+                    # (or below it by the collapses that removed zero-area triangles); quality mode
+                    # keeps no more than the plain TopStoc pass (a draft) where the topology stops it
                     assert abs(miss) <= 0.01 * target or 0 < miss <= result.stats.repairs \
                         or 0 < -miss <= 0.01 * target + result.stats.refine_collapses \
                         or (mode == "quality" and result.stats.over_budget_reason == "topology"
-                            and result.num_vertices <= mesh.decimate(ratio=ratio, seed=seed, mode="fast").num_vertices), \
+                            and result.num_vertices <= plain_count(mesh, ratio, seed)), \
                         (mode, ratio, seed, miss)
 
 

@@ -15,7 +15,9 @@ no topstoc code). Counts, per outcome:
   raised      the engine's final check raised instead of returning
   unreported  topology_kept == True but the independent check found a violation (a lie)
   draft_differs  a draft (decimate(draft=True), one in ten, fast mode) whose samples, vertices
-              or triangles differ from the full decimation's (made after it and checked as above)
+              or triangles differ from the full decimation's (made after it and checked as above),
+              or, where the full decimation collapsed its plain pass further (the draft's
+              collapses_skipped), whose samples differ or whose vertices lack one of the result's
   crashed     any other exception
 Exit code 1 when anything but `ok` happened. Failing cases are written to --save as .npz
 (vertices, triangles) + .json (parameters), ready for tests/data/regressions.
@@ -64,6 +66,17 @@ def random_parameters(rng, drafts=False):
     return params
 
 
+def draft_differences(draft, full):
+    """What differs between a draft and the full decimation it previews (empty: nothing)."""
+    if draft.stats.collapses_skipped:  # the plain pass the full decimation collapsed further
+        differ = [] if full.stats.refine_keeps_positions else ["collapses"]
+        if not set(full.kept.tolist()) <= set(draft.kept.tolist()):
+            differ.append("kept")
+        return differ + ([] if np.array_equal(draft.samples, full.samples) else ["samples"])
+    return [name for name in ("samples", "vertices", "triangles")
+            if not np.array_equal(getattr(draft, name), getattr(full, name))]
+
+
 def engine_check_clean(result):
     """The engine's own final check (verify.hpp) found nothing (zero-area triangles aside)."""
     return not any(v for k, v in result.stats.output_check.items() if k != "zero_area")
@@ -91,8 +104,7 @@ def run(count, seed, save=None, quiet=False, check_every=1, progress=0):
                 r = mesh.decimate(**full_params)
                 if draft is not None:
                     counts["drafts"] += 1
-                    differ = [name for name in ("samples", "vertices", "triangles")
-                              if not np.array_equal(getattr(draft, name), getattr(r, name))]
+                    differ = draft_differences(draft, r)
                 if draft is not None and differ:
                     outcome, detail = "draft_differs", ", ".join(differ)
                 elif not r.stats.topology_kept:

@@ -71,8 +71,10 @@ class DecimateStats:
     refine_vertices: int = 0    #: target of the quadric refinement (0: not refined)
     refine_triangles: int = 0   #: its triangle target, when it had one
     refine_collapses: int = 0   #: collapses the refinement made
-    #: the refinement's collapses kept input positions (fast mode's, where its repairs stalled)
+    #: the refinement's collapses kept input positions (fast mode's, where its pass ended above the target)
     refine_keeps_positions: bool = False
+    #: a draft above its target whose full decimation collapses it further: the frame is the plain pass
+    collapses_skipped: bool = False
     output_vertices: int = 0    #: vertices of the result
     #: the final check of the output against the input's components (manifold, orientation,
     #: components, Euler characteristic, boundary loops, duplicates, finite coordinates; see
@@ -217,8 +219,9 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     no cluster crosses either, and both survive exactly. view, boxes: see View and Box.
     mode: "quality" (default): placement "filtered" and quadric collapses after a TopStoc pass
     (see QUALITY_COLLAPSES); "fast": the thesis' TopStoc, placement "subsample", no refinement
-    (except where its repairs stall above the target, as on non-manifold or inconsistently
-    oriented input: then the collapses finish it, keeping input positions; docs/design.md §2.7).
+    (except where its pass ends above the target: repairs stalled on non-manifold or
+    inconsistently oriented input, or a topology that needs more vertices than drawn; then the
+    collapses finish it, keeping input positions; docs/design.md §2.7).
     placement and refine, when given, override what the mode sets.
     placement: "subsample" keeps the first pass's input positions, "filtered" moves surface
     vertices to the quadric-optimal point of their cluster (borders stay). In quality mode the

@@ -345,9 +345,14 @@ int32_t Collapser::run(Stop target, const BeforeTail& before_tail) {
   while (!reached(target)) {
     check_cancelled("collapses");
     if (heap_.empty()) {
-      // Some region could not reach its quota: the others give the rest, by cost alone.
-      if (!use_quota_) break;
-      use_quota_ = false;
+      // Some region could not reach its quota: the others give the rest, by cost alone. Then,
+      // where every collapse left fails a check, those whose point only fails the shape rule
+      // may keep the survivor where it is (rescue_).
+      if (!use_quota_ && rescue_) break;
+      if (use_quota_)
+        use_quota_ = false;
+      else
+        rescue_ = true;
       for (int32_t u = 0; u < int32_t(merged_into_.size()); ++u)
         if (merged_into_[u] < 0) update(u);
       continue;
@@ -594,12 +599,22 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
   if (shared != count || duplicates_a_face(u, v, on_edge, count)) return false;
   if (cu >= 0 && merges_unlike_edges(u, v, on_edge, count)) return false;
   if (nu + nv < shared + 5) return false;  // v would keep < 3 neighbours
+  double x[3];
+  return shaped_placement(u, v, x) >= 0;
+}
+
+// Where collapsing u into v puts v: 1 at the quadric optimum, 0 elsewhere on the edge, -1
+// nowhere (a triangle around the point would be too thin: the shape rule). In a rescue (run)
+// a free pair whose point fails the rule may keep v where it is instead (0).
+int Collapser::shaped_placement(int32_t u, int32_t v, double x[3]) const {
   Quadric q;
   s_.quadrics.reduced(u, v, q);
-  double x[3];
-  placement(u, v, q, x);
+  const bool optimum = placement(u, v, q, x);
   ShapeFloor floor{u, v};
-  return keeps_shape(u, v, x, floor) && keeps_shape(v, u, x, floor);
+  if (keeps_shape(u, v, x, floor) && keeps_shape(v, u, x, floor)) return optimum ? 1 : 0;
+  if (!rescue_ || !free_pair(u, v)) return -1;
+  for (int i = 0; i < 3; ++i) x[i] = position(v)[i];
+  return keeps_shape(u, v, x, floor) && keeps_shape(v, u, x, floor) ? 0 : -1;
 }
 
 // Are u's triangles around the edge laid out as on a curve? A curve vertex's sectors each hold
@@ -776,10 +791,14 @@ void Collapser::move_to(int32_t v, const double* x) {
 
 void Collapser::collapse(int32_t u, int32_t v) {
   {
-    Quadric q;
-    s_.quadrics.reduced(u, v, q);
     double x[3];
-    placed_[v] = placement(u, v, q, x);
+    if (rescue_) {
+      placed_[v] = shaped_placement(u, v, x) == 1;
+    } else {
+      Quadric q;
+      s_.quadrics.reduced(u, v, q);
+      placed_[v] = placement(u, v, q, x);
+    }
     move_to(v, x);
   }
   // The triangles on the edge vanish. On each side of u's borders (each sheet of a non-manifold

@@ -163,6 +163,7 @@ class Collapser {
   }
   bool queues(int32_t u) const { return !s_.locked[u] && !at_quota(u); }
   bool allowed(int32_t u, int32_t v, Scratch& scratch) const;
+  int shaped_placement(int32_t u, int32_t v, double x[3]) const;
   bool is_dead_end(int32_t v) const { return !s_.dead_end.empty() && s_.dead_end[v]; }
   bool curve_fans(int32_t u, int32_t nu, int32_t faces_u, const int32_t* on_edge, int32_t count) const;
   bool curve_keeps_an_edge(int32_t curve) const;
@@ -200,6 +201,7 @@ class Collapser {
   CollapseSetup s_;
   std::vector<int32_t> count_;  // per bin: vertices alive
   bool use_quota_ = true;
+  bool rescue_ = false;  // every collapse left failed its checks: see shaped_placement
   int32_t alive_vertices_ = 0, alive_faces_ = 0;
   std::vector<int32_t> pool_, begin_, size_, capacity_;  // vertex -> faces
   std::vector<uint8_t> alive_face_, dirty_, placed_;

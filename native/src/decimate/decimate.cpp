@@ -694,7 +694,8 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
 
 namespace {
 
-// A first pass whose repairs stalled above the target, taken the rest of the way by quality
+// A first pass above its target (stalled repairs, or a topology that needs more vertices than
+// drawn), taken the rest of the way by quality
 // mode's collapses (refine.hpp: the topology of every component, its non-manifold curves and
 // its borders kept), keeping input positions (half-edge collapses) as fast mode promises.
 void collapse_rest(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
@@ -751,14 +752,20 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
       best = std::move(r);
     }
   }
-  if (!refined && stalled && excess(best) > tolerance) {
-    if (params.draft) {
+  // A pass above its target (a stalled one, or one whose topology needed more vertices than
+  // drawn) is collapsed the rest of the way. A draft that did not stall stays the plain pass
+  // (a drag stays fast on high-genus meshes at tiny targets); the rest's full result does not.
+  if (!refined && excess(best) > tolerance) {
+    if (params.draft && !stalled) {
+      best.collapses_skipped = true;
+    } else if (params.draft) {
       // The collapses follow the result's labels and corners, which a draft leaves out.
       DecimateParams full = params;
       full.draft = false;
       return stochastic_pass(mesh, layout, full, refined);
+    } else {
+      collapse_rest(mesh, layout, params, best);
     }
-    collapse_rest(mesh, layout, params, best);
   }
   // An input with collinear vertices can leave zero-area triangles the repairs could not
   // remove: collapse one edge of each (never an output with a zero-area triangle).
@@ -928,6 +935,8 @@ DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layo
   for (int it = 0; it < std::max(1, max_iterations); ++it) {
     params.target_vertices = std::clamp(int32_t(std::lround(vertices)), 1, active);
     DecimateResult r = decimate(mesh, layout, params);
+    // The full decimation collapses this pass to the triangle target and stops: so does its draft.
+    if (r.collapses_skipped) return r;
     const int32_t got = static_cast<int32_t>(r.triangles.size() / 3);
     const int32_t error = std::abs(got - target_triangles);
     if (error < best_error) {

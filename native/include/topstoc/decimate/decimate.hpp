@@ -73,8 +73,9 @@ struct DecimateParams {
   /// A live-preview frame (plain TopStoc only, refine 0): the output's geometry (samples, kept,
   /// vertices, triangles) without face_source, corner_source and labels, and without the final
   /// output check (verify.hpp) unless the fast path needs it. The partition checks and repairs
-  /// run as always, so the mesh is the one a full decimation gives; output_checked tells that
-  /// it was not re-checked. A frame takes about three quarters of a full decimation's time.
+  /// run as always, so the mesh is the one a full decimation gives, or its plain pass where
+  /// the full decimation collapses that pass further (collapses_skipped); output_checked tells
+  /// that it was not re-checked. A frame takes about three quarters of a full decimation's time.
   bool draft = false;
   /// Internal (a refined decimation's first pass): labels in the mesh's vertex order.
   bool labels_in_mesh_order = false;
@@ -112,6 +113,9 @@ struct DecimateResult {
   int32_t refine_triangles = 0;        ///< its triangle target, when it had one (0: none)
   int32_t refine_collapses = 0;        ///< collapses it made
   bool refine_keeps_positions = false; ///< its collapses were half-edge only (fast mode's)
+  /// A draft above its target: the collapses that take the full decimation the rest of the way
+  /// were left out (they need the labels a draft leaves out), so the frame is the plain pass.
+  bool collapses_skipped = false;
   double seconds_sampling = 0, seconds_clustering = 0, seconds_checking = 0, seconds_output = 0;
   double seconds_verify = 0;  ///< the final output check (verify.hpp)
   double seconds_refine = 0;
