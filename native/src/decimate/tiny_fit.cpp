@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include "distance/bounded_max.hpp"
 #include "topstoc/distance/hausdorff.hpp"
@@ -82,6 +83,11 @@ class Fit {
       if ((boundaries ? c_.fittable(v) : c_.is_free(v)) && unknown_[v] < 0) unknown_[v] = int32_t(free_.size()), free_.push_back(v);
     std::sort(free_.begin(), free_.end());  // vertex order: moves are tried in it
     for (size_t i = 0; i < free_.size(); ++i) unknown_[free_[i]] = int32_t(i);
+    // The live vertices numbered apart, so that the surfaces measured hold only them.
+    std::vector<int32_t> compact(c_.vertices(), -1);
+    for (int32_t v : faces_)
+      if (compact[v] < 0) compact[v] = int32_t(live_.size()), live_.push_back(v);
+    for (int32_t v : faces_) live_faces_.push_back(compact[v]);
   }
 
   bool empty() const { return free_.empty() || faces_.empty() || points_.empty() || !input_; }
@@ -93,10 +99,11 @@ class Fit {
     double lower = 0.0, upper = 0.0;
     int32_t face = -1;  // the result triangle nearest the point where `lower` was found
   };
-  // threshold >= 0: only whether the max exceeds it is decided (bounded_max.hpp), cheaper, and
-  // the second side is skipped once the first exceeds it.
-  Bracket symmetric_max(double threshold = -1.0) const {
-    const Surface result(positions(), faces_);
+  // at: the result's vertex positions (positions()). threshold >= 0: only whether the max
+  // exceeds it is decided (bounded_max.hpp), cheaper, and the second side is skipped once the
+  // first exceeds it.
+  Bracket symmetric_max(std::vector<double> at, double threshold = -1.0) const {
+    const Surface result(std::move(at), live_faces_);
     const MaxBracket there = bound_max_distance_by_tree(result, *input_, kMaxTolerance, kMaxQueries, threshold);
     const MaxBracket back = threshold >= 0.0 && there.lower > threshold
                                 ? MaxBracket{}
@@ -119,7 +126,7 @@ class Fit {
     pairs_.clear();
     const std::vector<double> at_vertices = positions();
     const int32_t m = int32_t(faces_.size() / 3);
-    const TriangleBvh result(at_vertices.data(), faces_.data(), m);
+    const TriangleBvh result(at_vertices.data(), live_faces_.data(), m);
     const double point_weight = 1.0 / double(points_.size());
     int32_t hint = -1;
     for (int32_t w : points_) {
@@ -212,18 +219,19 @@ class Fit {
     for (auto it = saved_.rbegin(); it != saved_.rend(); ++it) c_.restore(it->v, it->position, it->world);
   }
 
+  // The positions of the result's live vertices, in live_ order (live_faces_ index them).
+  std::vector<double> positions() const {
+    std::vector<double> at(3 * live_.size());
+    for (size_t i = 0; i < live_.size(); ++i)
+      for (int k = 0; k < 3; ++k) at[3 * i + k] = c_.position(live_[i])[k];
+    return at;
+  }
+
  private:
   struct Saved {
     int32_t v;
     double position[3], world[3];
   };
-  // The result's vertex positions (zero for the vertices no live triangle uses).
-  std::vector<double> positions() const {
-    std::vector<double> at(3 * size_t(c_.vertices()), 0.0);
-    for (int32_t v : faces_)
-      for (int i = 0; i < 3; ++i) at[3 * size_t(v) + i] = c_.position(v)[i];
-    return at;
-  }
   const double* corner(int32_t f, int j) const { return c_.position(faces_[3 * size_t(f) + j]); }
   double twice_area(int32_t f) const {
     const double *a = corner(f, 0), *b = corner(f, 1), *c = corner(f, 2);
@@ -275,6 +283,8 @@ class Fit {
   std::unique_ptr<Surface> input_;  // normalised input positions and (some of) its triangles
   std::vector<int32_t> points_;   // the input vertices paired with the result
   std::vector<int32_t> faces_;    // 3 vertex ids per live triangle
+  std::vector<int32_t> live_;        // the vertices of live triangles, in first-use order
+  std::vector<int32_t> live_faces_;  // faces_ with each vertex's index in live_
   std::vector<int32_t> free_;     // the unknowns' vertices
   std::vector<int32_t> unknown_;  // per vertex: its unknown, or -1 (fixed)
   std::vector<Pair> pairs_;
@@ -290,7 +300,14 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool bo
   if (fit.empty()) return out;
   auto error = fit.pair_up();
   if (error.top2 <= kOnTheInput * kOnTheInput) return out;
-  auto max = fit.symmetric_max();
+  // The max before any move, measured only once a move's pairs pass (when none does it is not
+  // needed, and it is the fit's dearest step): from the positions kept here, the same bracket.
+  const std::vector<double> start = fit.positions();
+  std::optional<Fit::Bracket> max;
+  auto max_so_far = [&]() -> const Fit::Bracket& {
+    if (!max) max = fit.symmetric_max(start);
+    return *max;
+  };
   out.before2 = out.after2 = error.mean2;
   std::vector<double> x;
   // A move is kept when the pairs' mean fell, their largest distance and the surfaces' max did
@@ -304,8 +321,9 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool bo
       if (fit.apply(fit.toward(x, step)) == 0) return false;
       const auto next = fit.pair_up();
       if (!(next.mean2 < error.mean2 && next.top2 <= error.top2)) break;
-      const auto next_max = fit.symmetric_max(last ? max.upper : -1.0);
-      if (next_max.lower <= max.upper) {
+      const double upper = max_so_far().upper;
+      const auto next_max = fit.symmetric_max(fit.positions(), last ? upper : -1.0);
+      if (next_max.lower <= upper) {
         error = next, max = next_max;
         return true;
       }
