@@ -38,6 +38,20 @@ PIXELS_PER_DOUBLING = 150.0  # mouse travel that doubles (or halves) the ratio
 running: set = set()
 
 
+def shown_status(session, quality: str) -> str:
+    """The header's words on the result shown: its counts, times and kind. A draft whose full
+    decimation collapses it further (stats.collapses_skipped) says so: the rest shows fewer vertices."""
+    result = session.result
+    if session.final:
+        kind = quality.title()
+    elif result.stats.collapses_skipped:
+        kind = "Fast draft while dragging, above target: the rested result collapses further"
+    else:
+        kind = "Fast draft while dragging"
+    return (f"TopStoc ratio {session.ratio:.4f}: {result.num_vertices:,} vertices, {result.num_triangles:,} "
+            f"triangles ({1000 * session.seconds_decimate:.0f} ms + {1000 * session.seconds_write:.0f} ms)  ({kind})")
+
+
 class TOPSTOC_OT_preview(OperatorParameters, bpy.types.Operator):
     """Live preview: move the mouse left/right to change the ratio (wheel: fine steps); \
 Enter or click applies, Esc or right-click restores"""
@@ -102,11 +116,8 @@ Enter or click applies, Esc or right-click restores"""
             self._status(context, f"TopStoc: decimating '{self.obj_name}' at ratio {self.ratio:.4f} ... "
                                   f"{seconds:.1f} s   Esc: cancel")
             return
-        quality = f"  ({self.quality.title() if s.final else 'Fast draft while dragging'})"
-        self._status(context,
-                     f"TopStoc ratio {s.ratio:.4f}: {result.num_vertices:,} vertices, {result.num_triangles:,} "
-                     f"triangles ({1000 * s.seconds_decimate:.0f} ms + {1000 * s.seconds_write:.0f} ms){quality}   "
-                     "drag: ratio  wheel: fine  Enter/click: apply  Esc/right-click: cancel")
+        self._status(context, f"{shown_status(s, self.quality)}   "
+                              "drag: ratio  wheel: fine  Enter/click: apply  Esc/right-click: cancel")
 
     def _follow(self, context):
         """The sidebar shows the ratio being dragged."""
