@@ -32,6 +32,17 @@ py::dict one_sided_dict(OneSidedDistance&& d) {
   return out;
 }
 
+// One side's bracket: lower, upper, the point at distance lower, queries, converged.
+py::dict bracket_dict(const OneSidedBracket& r) {
+  py::dict out;
+  out["lower"] = r.lower;
+  out["upper"] = r.upper;
+  out["lower_point"] = copy_array(std::vector<double>(r.lower_point, r.lower_point + 3));
+  out["queries"] = r.queries;
+  out["converged"] = r.converged;
+  return out;
+}
+
 py::dict result_dict(HausdorffResult&& r) {
   py::dict out;
   out["forward"] = one_sided_dict(std::move(r.forward));
@@ -148,13 +159,7 @@ void bind_hausdorff(py::module_& m) {
           EngineCall call;
           r = bracket_one_sided_max(from, to, tolerance, max_queries, threshold);
         }
-        py::dict out;
-        out["lower"] = r.lower;
-        out["upper"] = r.upper;
-        out["lower_point"] = copy_array(std::vector<double>(r.lower_point, r.lower_point + 3));
-        out["queries"] = r.queries;
-        out["converged"] = r.converged;
-        return out;
+        return bracket_dict(r);
       },
       py::arg("from_surface"), py::arg("to_surface"), py::arg("tolerance"), py::arg("max_queries") = 4000000,
       py::arg("threshold") = -1.0,
@@ -170,14 +175,8 @@ void bind_hausdorff(py::module_& m) {
           r = bracket_symmetric_max(a, b, tolerance, resolution, max_queries);
         }
         py::dict out;
-        for (const auto& [name, side] : {std::pair{"forward", &r.forward}, std::pair{"backward", &r.backward}}) {
-          py::dict d;
-          d["lower"] = side->lower;
-          d["upper"] = side->upper;
-          d["queries"] = side->queries;
-          d["converged"] = side->converged;
-          out[name] = d;
-        }
+        out["forward"] = bracket_dict(r.forward);
+        out["backward"] = bracket_dict(r.backward);
         return out;
       },
       py::arg("a"), py::arg("b"), py::arg("tolerance"), py::arg("resolution") = 1e-13,
