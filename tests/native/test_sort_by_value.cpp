@@ -1,7 +1,8 @@
 // sort_ascending (core/sort_by_value.hpp) puts ids exactly where std::stable_sort by value does,
 // on each of its paths: spread values (buckets sorted on the carried bits), values equal in the
 // carried bits (read again), a narrow range (the counting pass alone), a bucket too large for
-// the scratch (the radix sort), many equal values, negative values; serial and on two threads.
+// the scratch (the radix sort), many equal values, infinities, negative values; serial and on
+// two threads.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -74,6 +75,10 @@ TEST_CASE("sort_ascending: the order of a stable sort by value on every path") {
   }
   SUBCASE("all equal") {
     std::fill(values.begin(), values.end(), 3.5);
+  }
+  SUBCASE("infinities among spread values") {
+    std::uniform_real_distribution<double> q(0.0, 4.0);
+    for (auto& x : values) x = q(rng) < 0.01 ? HUGE_VAL : q(rng);
   }
   SUBCASE("negative values and zeros") {
     std::uniform_real_distribution<double> q(-1.0, 1.0);

@@ -94,12 +94,13 @@ void sort_ascending(std::vector<int32_t>& ids, const Value& value) {
     std::memcpy(&bits, &x, sizeof bits);
     return bits;
   };
+  constexpr uint64_t kInfinityBits = uint64_t(0x7FF) << 52;  // above: NaN or the sign bit
   uint64_t least = ~uint64_t(0), most = 0;
   bool plain = true;  // no negative number, -0 or NaN
   for (int32_t v : ids) {
     const uint64_t bits = bits_of(v);
     least = std::min(least, bits), most = std::max(most, bits);
-    plain &= !(bits >> 63) && !std::isnan(value(v));
+    plain &= bits <= kInfinityBits;
   }
   if (!plain) {
     std::vector<double> values(ids.size());
