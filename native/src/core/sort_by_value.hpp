@@ -84,8 +84,8 @@ void sort_buckets(std::vector<int32_t>& ids, std::vector<int32_t>& other, const 
 /// buckets that split the bits' range evenly, each id with the next 16 bits of its value beside
 /// it; each bucket is then sorted on those, reading a value at random only where two ids of a
 /// bucket carry the same bits (an LSD radix sort of the ids read every value at random in each
-/// of its four passes: 15 % of a fast decimation at 2M triangles). A bucket too large for a
-/// small scratch (many equal values) takes that LSD radix sort.
+/// of its four passes). A bucket too large for a small scratch (many equal values) takes that
+/// LSD radix sort.
 template <class Value>
 void sort_ascending(std::vector<int32_t>& ids, const Value& value) {
   auto bits_of = [&](int32_t v) {
