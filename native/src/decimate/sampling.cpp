@@ -15,6 +15,7 @@
 #include "core/id_bits.hpp"
 #include "core/ordered_sum.hpp"
 #include "core/portable.hpp"
+#include "core/sort_by_value.hpp"
 #include "decimate/candidate_order.hpp"
 #include "decimate/draw.hpp"
 #include "topstoc/core/random.hpp"
@@ -77,51 +78,6 @@ double apply_view(const ViewGuidance& view, const double* position, const double
   }
   if (view.frustum && !inside_frustum(view, position)) p = std::min(p, view.outside_probability);
   return p;
-}
-
-// Puts ids in ascending order of value(id) (equal values keep their order), exactly as a stable
-// sort would. Non-negative doubles order like their bit patterns, so a radix sort over the bits
-// that differ does it in a few linear passes (the importance table of a million vertices was the
-// first decimation's longest serial step); the values are computed where read, so the sort holds
-// two id arrays and no values (three arrays of values and ids were 12 bytes a triangle of the
-// first decimation's peak).
-template <class Value>
-void sort_ascending(std::vector<int32_t>& ids, const Value& value) {
-  auto bits_of = [&](int32_t v) {
-    const double x = value(v);
-    uint64_t bits;
-    std::memcpy(&bits, &x, sizeof bits);
-    return bits;
-  };
-  uint64_t any = 0, all = ~uint64_t(0);
-  bool plain = true;  // no negative number, -0 or NaN
-  for (int32_t v : ids) {
-    const uint64_t bits = bits_of(v);
-    any |= bits, all &= bits;
-    plain &= !(bits >> 63) && !std::isnan(value(v));
-  }
-  if (!plain) {
-    std::vector<double> values(ids.size());
-    for (size_t i = 0; i < ids.size(); ++i) values[i] = value(ids[i]);
-    std::vector<size_t> order(values.size());
-    std::iota(order.begin(), order.end(), size_t(0));
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return values[a] < values[b]; });
-    std::vector<int32_t> sorted_ids(ids.size());
-    for (size_t i = 0; i < order.size(); ++i) sorted_ids[i] = ids[order[i]];
-    ids.swap(sorted_ids);
-    return;
-  }
-  constexpr int kDigit = 16;  // 4 passes at most (11-bit digits took 5-6 on real weights)
-  constexpr uint64_t kMask = (uint64_t(1) << kDigit) - 1;
-  std::vector<int32_t> other(ids.size()), offsets;
-  for (int shift = 0; shift < 64; shift += kDigit) {
-    if ((((any ^ all) >> shift) & kMask) == 0) continue;  // the same digit everywhere
-    const int32_t* from = ids.data();
-    auto digit = [&](int64_t i) { return int32_t((bits_of(from[i]) >> shift) & kMask); };
-    stable_counting_sort(int64_t(ids.size()), int32_t(kMask + 1), digit,
-                         [&](int64_t i, int32_t at) { other[at] = from[i]; }, offsets);
-    ids.swap(other);
-  }
 }
 
 }  // namespace
