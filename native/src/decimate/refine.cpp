@@ -582,8 +582,8 @@ class Refinement {
   // With attributes too: a vertex the fit moves takes the input's attributes where it lands
   // (attributes.moved_vertices), and seam vertices, whose sides differ, do not move.
   void finish(Collapser& collapser) {
-    if (params.refit && fit_rounds(collapser.live_faces()) > 0)
-      fit_tiny(mesh, collapser, fit_rounds(collapser.live_faces()), collapser.live_faces() <= kTinyFitFaces);
+    const int32_t faces = collapser.live_faces(), rounds = fit_rounds(faces);
+    if (params.refit && rounds > 0) fit_tiny(mesh, collapser, rounds, faces <= kTinyFitFaces);
     if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
     result.issues_remaining.sliver = collapser.zero_area_faces();
     compact(collapser);
