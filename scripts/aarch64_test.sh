@@ -22,7 +22,10 @@ ROOTFS=$(scripts/arm64_root.sh) || exit 1
 
 scripts/cross_build.sh aarch64 || exit 1
 echo "== C++ tests (doctest) under QEMU: build-aarch64/tests/native/topstoc_tests"
-QEMU_LD_PREFIX=$ROOTFS build-aarch64/tests/native/topstoc_tests | grep -v '^\[doctest\] run with' || exit 1
+# The pool's CPU-budget case runs natively only: under emulation the process CPU clock also counts
+# QEMU's own translation and signal work, not the workers' sleeping.
+QEMU_LD_PREFIX=$ROOTFS build-aarch64/tests/native/topstoc_tests --test-case-exclude='workers sleep between calls*' |
+  grep -v '^\[doctest\] run with' || exit 1
 echo "== the aarch64 driver against this machine's driver (tests/cross)"
 /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/cross -k aarch64 || exit 1
 
