@@ -221,7 +221,9 @@ void bind_decimation_state(py::module_& m) {
                                  "from which lower targets resume.")
       .def(py::init<size_t>(), py::arg("capacity") = 2)
       .def("clear", &CollapseSnapshots::clear, "Frees the kept states.")
-      .def_property_readonly("size", &CollapseSnapshots::size, "States kept.");
+      .def_property_readonly("size", &CollapseSnapshots::size, "States kept.")
+      .def_property_readonly("surfaces", &CollapseSnapshots::surfaces,
+                             "Input surfaces kept (the distance passes' and the fit's search structures).");
 
   py::class_<CancelToken>(m, "CancelFlag",
                           "Set from any thread, stops the decimation given it at its next check (raises Cancelled).")

@@ -1,6 +1,7 @@
 // Kept collapse states (collapse_snapshots.hpp): a run resumed from the state an earlier run kept
 // where its batches started to depend on its target gives the fresh run's triangles, also on a
-// team of another size than the one the state was kept on.
+// team of another size than the one the state was kept on. The input surfaces kept with them:
+// one per mesh and step, made once, the least recently used dropped beyond two.
 #include <doctest/doctest.h>
 
 #include <cstdint>
@@ -9,8 +10,10 @@
 
 #include "decimate/collapse_snapshots.hpp"
 #include "decimate/collapser.hpp"
+#include "decimate/deviation.hpp"
 #include "collapse_setup.hpp"
 #include "meshes.hpp"
+#include "topstoc/core/mesh.hpp"
 #include "topstoc/core/parallel.hpp"
 
 using topstoc::Collapser;
@@ -50,4 +53,48 @@ TEST_CASE("a kept collapse state resumed toward a lower target gives the fresh r
     CHECK(same == int32_t(fresh_triangles.size() / 3));
   }
   topstoc::set_max_threads(saved);
+}
+
+TEST_CASE("input surfaces are kept per mesh and step, made once, the least recently used dropped beyond two") {
+  const auto arrays = topstoc_test::torus(40, 20, 0.6, 0.25);
+  const int64_t m = int64_t(arrays.triangles.size() / 3);
+  const topstoc::Mesh mesh(arrays.positions, arrays.triangles.data(), m), same_arrays(arrays.positions, arrays.triangles.data(), m);
+  std::vector<int32_t> triangles = arrays.triangles, corners(triangles.size());
+  for (size_t i = 0; i < corners.size(); ++i) corners[i] = int32_t(i);
+  const Collapser collapser(triangles, corners, topstoc_test::torus_setup(arrays));
+  topstoc::CollapseSnapshots kept;
+  int made = 0;
+  auto get = [&](const topstoc::Mesh& of, int64_t step) {
+    return kept.input_surface(topstoc::input_surface_key(of, collapser, step), [&] {
+      ++made;
+      return topstoc::normalised_input(of, collapser, step);
+    });
+  };
+  const auto whole = get(mesh, 1);
+  REQUIRE(whole->num_triangles() == mesh.num_faces());
+  for (int32_t w = 0; w < mesh.num_vertices(); ++w) {
+    double expected[3];
+    collapser.normalise(mesh.position(w), expected);
+    for (int i = 0; i < 3; ++i) CHECK(whole->positions()[3 * size_t(w) + i] == expected[i]);
+  }
+  CHECK(get(mesh, 1).get() == whole.get());
+  CHECK(made == 1);
+  const auto every_third = get(mesh, 3);
+  CHECK(every_third->num_triangles() == (mesh.num_faces() + 2) / 3);
+  for (int32_t t = 0; t < every_third->num_triangles(); ++t)
+    for (int j = 0; j < 3; ++j) CHECK(every_third->triangles()[3 * size_t(t) + j] == mesh.faces()[9 * size_t(t) + j]);
+  CHECK(made == 2);
+  CHECK(get(mesh, 1).get() == whole.get());  // now the most recently used
+  // Another mesh (the same arrays prepared again): its own surface; the step-3 one goes.
+  CHECK(get(same_arrays, 1).get() != whole.get());
+  CHECK(made == 3);
+  CHECK(kept.surfaces() == 2);
+  CHECK(get(mesh, 1).get() == whole.get());
+  CHECK(made == 3);
+  get(mesh, 3);
+  CHECK(made == 4);
+  kept.clear();
+  CHECK(kept.surfaces() == 0);
+  CHECK(get(mesh, 1).get() != whole.get());
+  CHECK(made == 5);
 }

@@ -55,7 +55,7 @@ TEST_CASE("deviation from the input matches brute force, and a rival stops it on
   collapser.run({n / 10, 0});
   std::vector<int32_t> label(n);
   for (int32_t v = 0; v < n; ++v) label[v] = v;  // every input vertex starts as its own vertex
-  const topstoc::InputSurface input(mesh, collapser);
+  const topstoc::InputSurface input(mesh, topstoc::normalised_input(mesh, collapser, 1));
   const Deviation full = topstoc::surface_deviation(mesh, input, label, collapser, triangles);
   REQUIRE(full.complete);
   REQUIRE(full.top2 > 0.0);

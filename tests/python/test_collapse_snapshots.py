@@ -4,6 +4,7 @@ on the target, so a decimation toward a lower target resumes from the state an e
 there. The promise is the same mesh as a fresh decimation: every result is compared, array for
 array and figure for figure, with the same decimation of a mesh that keeps nothing
 (``keep_floods=False``), and the states are checked to be kept where they apply and not elsewhere.
+The input's search structure the fit of small results measures against is kept with them too.
 """
 
 import numpy as np
@@ -60,3 +61,20 @@ def test_guided_and_triangle_targets_keep_no_state(torus):
     mesh.decimate(ratio=0.05)
     assert kept(mesh) == 1
     assert_same(mesh.decimate(ratio=0.03, guidance=guidance), plain.decimate(ratio=0.03, guidance=guidance))
+
+
+def test_the_fit_of_small_results_measures_against_a_kept_input(torus):
+    """Results of 401-1,400 triangles are fitted to the input: its search structure is made once and
+    kept with the states (one for the whole input: the distance passes' too), also where the first
+    pass is not the whole mesh (refine=3), with the results of a mesh that keeps nothing."""
+    mesh, plain = Mesh(*torus), Mesh(*torus, keep_floods=False)
+    snapshots = mesh.kept_for_reuse()[2]
+    assert snapshots.surfaces == 0
+    for options in (dict(ratio=0.05, refine=3), dict(ratio=0.04, refine=3), dict(ratio=0.05), dict(ratio=0.045)):
+        result = mesh.decimate(**options)
+        assert 401 <= len(result.triangles) <= 1400
+        assert_same(result, plain.decimate(**options))
+        assert snapshots.surfaces == 1
+    assert plain.kept_for_reuse()[2] is None
+    mesh.clear_floods()
+    assert snapshots.surfaces == 0

@@ -1,8 +1,10 @@
 #include "decimate/collapse_snapshots.hpp"
 
+#include <algorithm>
 #include <array>
 
 #include "topstoc/core/digest.hpp"
+#include "topstoc/distance/hausdorff.hpp"
 
 namespace topstoc {
 
@@ -47,8 +49,9 @@ std::vector<uint64_t> start_key(const CollapseSetup& s, const std::vector<int32_
   return key;
 }
 
-std::vector<uint64_t> input_surface_key(const Mesh& mesh, const Collapser& collapser) {
-  std::vector<uint64_t> key{mesh.serial()};  // a Mesh never changes: its serial names its positions and triangles
+std::vector<uint64_t> input_surface_key(const Mesh& mesh, const Collapser& collapser, int64_t step) {
+  // a Mesh never changes: its serial names its positions and triangles
+  std::vector<uint64_t> key{mesh.serial(), uint64_t(step)};
   const double corners[2][3] = {{0, 0, 0}, {1, 1, 1}};
   double normalised[2][3];
   for (int i = 0; i < 2; ++i) collapser.normalise(corners[i], normalised[i]);
@@ -110,27 +113,33 @@ void CollapseSnapshots::keep(std::shared_ptr<const Entry> entry) {
   entries_.erase(entries_.begin() + (highest == 0 && capacity_ > 1 ? 1 : 0));
 }
 
-std::shared_ptr<const InputSurface> CollapseSnapshots::input_surface(
-    const std::vector<uint64_t>& key, const std::function<std::shared_ptr<const InputSurface>()>& make) {
+std::shared_ptr<const Surface> CollapseSnapshots::input_surface(
+    const std::vector<uint64_t>& key, const std::function<std::shared_ptr<const Surface>()>& make) {
   std::lock_guard<std::mutex> lock(mutex_);  // held while one is made: a second caller takes it
-  if (!surface_ || surface_key_ != key) {
-    surface_ = nullptr;  // the old one freed before the new one is made
-    surface_ = make();
-    surface_key_ = key;
-  }
-  return surface_;
+  for (auto kept = surfaces_.begin(); kept != surfaces_.end(); ++kept)
+    if (kept->first == key) {
+      std::rotate(kept, kept + 1, surfaces_.end());  // the most recently used last
+      return surfaces_.back().second;
+    }
+  if (surfaces_.size() >= kSurfaces) surfaces_.erase(surfaces_.begin());  // freed before the new one is made
+  surfaces_.emplace_back(key, make());
+  return surfaces_.back().second;
 }
 
 void CollapseSnapshots::clear() {
   std::lock_guard<std::mutex> lock(mutex_);
   entries_.clear();
-  surface_ = nullptr;
-  surface_key_.clear();
+  surfaces_.clear();
 }
 
 size_t CollapseSnapshots::size() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return entries_.size();
+}
+
+size_t CollapseSnapshots::surfaces() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return surfaces_.size();
 }
 
 }  // namespace topstoc

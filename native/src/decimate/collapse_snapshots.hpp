@@ -26,9 +26,9 @@ struct CollapseSnapshots::Entry {
 std::vector<uint64_t> start_key(const CollapseSetup& setup, const std::vector<int32_t>& triangles,
                                 const std::vector<int32_t>& corner_source);
 
-/// The key of the input's search structure (InputSurface): the mesh (its serial, as the flood
-/// caches key it) and the collapses' normalisation.
-std::vector<uint64_t> input_surface_key(const Mesh& mesh, const Collapser& collapser);
+/// The key of the input's search structure (deviation.hpp's normalised_input): the mesh (its
+/// serial, as the flood caches key it), the collapses' normalisation and the triangles' step.
+std::vector<uint64_t> input_surface_key(const Mesh& mesh, const Collapser& collapser, int64_t step);
 
 /// The entry for `collapser` at the point Collapser::run's before_tail reports.
 std::shared_ptr<const CollapseSnapshots::Entry> snapshot(std::vector<uint64_t> start, int32_t run_vertices,

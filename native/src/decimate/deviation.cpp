@@ -10,12 +10,6 @@ namespace topstoc {
 
 namespace {
 
-std::vector<double> normalised(const Mesh& mesh, const Collapser& collapser) {
-  std::vector<double> out(3 * size_t(mesh.num_vertices()));
-  for (int32_t w = 0; w < mesh.num_vertices(); ++w) collapser.normalise(mesh.position(w), &out[3 * size_t(w)]);
-  return out;
-}
-
 // out[i] = the squared distance from point(i, xyz) to `surface`, for i in [0, count), in static
 // chunks (each thread passes its last hit on as the next query's hint; the answer does not
 // depend on the hint, so any team size gives the same bits). point returns false to skip i (0).
@@ -64,7 +58,7 @@ bool near_top(double measured2, double top2) { return measured2 >= kNear * kNear
 void from_input(const Mesh& mesh, const InputSurface& surface_in, const std::vector<int32_t>& label,
                 const TriangleBvh& surface, const Rival* rival, Deviation& out) {
   std::vector<double>& out2 = out.vertex2;
-  const std::vector<double>& input = surface_in.positions;
+  const std::vector<double>& input = surface_in.surface->positions();
   const std::vector<double> at_vertex = distances2(surface, mesh.num_vertices(), [&](int64_t w, double* p) {
     std::copy_n(&input[3 * size_t(w)], 3, p);
     return label[w] >= 0;
@@ -208,9 +202,19 @@ std::vector<double> vertex_areas(const Mesh& mesh, const std::vector<double>& po
 
 }  // namespace
 
-InputSurface::InputSurface(const Mesh& mesh, const Collapser& collapser)
-    : positions(normalised(mesh, collapser)), area(vertex_areas(mesh, positions)),
-      bvh(positions.data(), mesh.faces().data(), mesh.num_faces()) {}
+std::shared_ptr<const Surface> normalised_input(const Mesh& mesh, const Collapser& collapser, int64_t step) {
+  std::vector<double> positions(3 * size_t(mesh.num_vertices()));
+  for (int32_t w = 0; w < mesh.num_vertices(); ++w) collapser.normalise(mesh.position(w), &positions[3 * size_t(w)]);
+  const auto& faces = mesh.faces();
+  std::vector<int32_t> some;
+  if (step == 1) some.assign(faces.data(), faces.data() + faces.size());
+  for (int64_t f = 0; step > 1 && f < mesh.num_faces(); f += step)
+    some.insert(some.end(), &faces[3 * size_t(f)], &faces[3 * size_t(f) + 3]);
+  return std::make_shared<const Surface>(std::move(positions), std::move(some));
+}
+
+InputSurface::InputSurface(const Mesh& mesh, std::shared_ptr<const Surface> whole)
+    : surface(std::move(whole)), area(vertex_areas(mesh, surface->positions())) {}
 
 Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const std::vector<int32_t>& label,
                           Collapser& collapser, const std::vector<int32_t>& triangles, const Rival* rival) {
@@ -233,7 +237,7 @@ Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const s
   from_input(mesh, input, label, TriangleBvh(positions.data(), live.data(), out.faces), rival, out);
   if (!out.complete) return out;
   std::vector<double> back2(n, 0.0);
-  to_input(input.bvh, collapser, live, back2);
+  to_input(input.surface->bvh(), collapser, live, back2);
   for (int32_t v = 0; v < n; ++v) out.vertex2[v] = std::max(out.vertex2[v], back2[survivor[v]]);
   out.top2 = n > 0 ? *std::max_element(out.vertex2.begin(), out.vertex2.end()) : 0.0;
   return out;

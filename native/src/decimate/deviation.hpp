@@ -4,21 +4,24 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "decimate/collapser.hpp"
 #include "topstoc/core/mesh.hpp"
-#include "topstoc/distance/bvh.hpp"
+#include "topstoc/distance/hausdorff.hpp"
 
 namespace topstoc {
 
-/// The input in the collapses' normalised coordinates, with a search structure over its
-/// triangles.
+/// Every step-th input triangle (1: all of them) over the input's vertices in the collapses'
+/// normalised coordinates: what the distance passes and the fit (tiny_fit.hpp) measure against.
+std::shared_ptr<const Surface> normalised_input(const Mesh& mesh, const Collapser& collapser, int64_t step);
+
+/// The whole input (normalised_input with step 1), with each input vertex's area.
 struct InputSurface {
-  InputSurface(const Mesh& mesh, const Collapser& collapser);
-  std::vector<double> positions;  ///< 3 per input vertex
-  std::vector<double> area;       ///< per input vertex: a third of its triangles' areas
-  TriangleBvh bvh;
+  InputSurface(const Mesh& mesh, std::shared_ptr<const Surface> whole);
+  std::shared_ptr<const Surface> surface;
+  std::vector<double> area;  ///< per input vertex: a third of its triangles' areas
 };
 
 struct Deviation {

@@ -494,8 +494,8 @@ class Refinement {
     const Collapser at_restart(*best);
     const std::vector<int32_t> restart_triangles = result.triangles, restart_corners = result.corner_source;
     int32_t best_collapses = shared + collapse_rest(*best, center, extent);
-    const std::shared_ptr<const InputSurface> kept_input = input_surface(*best);
-    const InputSurface& input = *kept_input;
+    const std::shared_ptr<const Surface> whole = kept_input(*best, 1);
+    const InputSurface input(mesh, whole);
     Deviation best_deviation = surface_deviation(mesh, input, label, *best, result.triangles), last = best_deviation;
     std::vector<int32_t> best_triangles = result.triangles, best_corners = result.corner_source;
     const double mean_bound = (1.0 + kMeanSlack) * best_deviation.mean;
@@ -523,7 +523,7 @@ class Refinement {
     result.triangles = std::move(best_triangles);
     result.corner_source = std::move(best_corners);
     result.refine_collapses = best_collapses;
-    finish(*best);
+    finish(*best, whole);
   }
 
   // The first run to `restart` (slivers first), from a state kept by an earlier refinement
@@ -549,12 +549,12 @@ class Refinement {
     });
   }
 
-  // The input's search structure: the one kept with the collapse states when there are some.
-  std::shared_ptr<const InputSurface> input_surface(const Collapser& collapser) const {
-    if (!params.snapshots) return std::make_shared<const InputSurface>(mesh, collapser);
-    return params.snapshots->input_surface(input_surface_key(mesh, collapser), [&] {
-      return std::make_shared<const InputSurface>(mesh, collapser);
-    });
+  // The input's triangles, every step-th, with their search structure (normalised_input): the
+  // one kept with the collapse states when there are some.
+  std::shared_ptr<const Surface> kept_input(const Collapser& collapser, int64_t step) const {
+    if (!params.snapshots) return normalised_input(mesh, collapser, step);
+    return params.snapshots->input_surface(input_surface_key(mesh, collapser, step),
+                                           [&] { return normalised_input(mesh, collapser, step); });
   }
 
   // How far a run stayed above the target (0 once reached).
@@ -580,10 +580,15 @@ class Refinement {
   // A tiny result fitted to the input (after the max-aware choice, which compares the
   // collapses' own results), the zero-area triangles left moved off, and the result compacted.
   // With attributes too: a vertex the fit moves takes the input's attributes where it lands
-  // (attributes.moved_vertices), and seam vertices, whose sides differ, do not move.
-  void finish(Collapser& collapser) {
+  // (attributes.moved_vertices), and seam vertices, whose sides differ, do not move. whole: the
+  // whole input's surface when the caller has it (the fit's, unless the input is large).
+  void finish(Collapser& collapser, std::shared_ptr<const Surface> whole = nullptr) {
     const int32_t faces = collapser.live_faces(), rounds = fit_rounds(faces);
-    if (params.refit && rounds > 0) fit_tiny(mesh, collapser, rounds, faces <= kTinyFitFaces);
+    if (params.refit && rounds > 0) {
+      const int64_t step = fit_input_step(mesh);
+      const std::shared_ptr<const Surface> input = step == 1 && whole ? whole : kept_input(collapser, step);
+      fit_tiny(mesh, collapser, rounds, faces <= kTinyFitFaces, *input);
+    }
     if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
     result.issues_remaining.sliver = collapser.zero_area_faces();
     compact(collapser);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <memory>
 #include <optional>
 
 #include "distance/bounded_max.hpp"
@@ -61,14 +60,8 @@ void barycentric(const double* p, const double* a, const double* b, const double
 
 class Fit {
  public:
-  Fit(const Mesh& mesh, Collapser& collapser, bool boundaries) : c_(collapser) {
+  Fit(const Mesh& mesh, Collapser& collapser, bool boundaries, const Surface& input) : c_(collapser), input_(&input) {
     const std::vector<int32_t>& triangles = c_.triangles();
-    std::vector<double> positions(3 * size_t(mesh.num_vertices()));
-    for (int32_t w = 0; w < mesh.num_vertices(); ++w) c_.normalise(mesh.position(w), &positions[3 * size_t(w)]);
-    const int64_t faces = mesh.num_faces(), step = std::max<int64_t>(1, (faces + kFitTriangles - 1) / kFitTriangles);
-    std::vector<int32_t> some;
-    for (int64_t f = 0; f < faces; f += step) some.insert(some.end(), &mesh.faces()[3 * f], &mesh.faces()[3 * f + 3]);
-    if (!some.empty()) input_ = std::make_unique<Surface>(std::move(positions), std::move(some));
     // Every k-th input vertex in a triangle (isolated ones are no part of the surface).
     const auto& vfo = mesh.vertex_face_offsets();
     int32_t in_faces = 0;
@@ -90,7 +83,7 @@ class Fit {
     for (int32_t v : faces_) live_faces_.push_back(compact[v]);
   }
 
-  bool empty() const { return free_.empty() || faces_.empty() || points_.empty() || !input_; }
+  bool empty() const { return free_.empty() || faces_.empty() || points_.empty(); }
 
   // A bracket on the symmetric Hausdorff max between the result and (the fitted part of) the
   // input, over every point of both surfaces: the pairs only sample it, and a round that lowers
@@ -280,7 +273,7 @@ class Fit {
   }
 
   Collapser& c_;
-  std::unique_ptr<Surface> input_;  // normalised input positions and (some of) its triangles
+  const Surface* input_;  // normalised input positions and (some of) its triangles
   std::vector<int32_t> points_;   // the input vertices paired with the result
   std::vector<int32_t> faces_;    // 3 vertex ids per live triangle
   std::vector<int32_t> live_;        // the vertices of live triangles, in first-use order
@@ -294,9 +287,13 @@ class Fit {
 
 }  // namespace
 
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries) {
+int64_t fit_input_step(const Mesh& mesh) {
+  return std::max<int64_t>(1, (int64_t(mesh.num_faces()) + kFitTriangles - 1) / kFitTriangles);
+}
+
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input) {
   TinyFit out;
-  Fit fit(mesh, collapser, boundaries);
+  Fit fit(mesh, collapser, boundaries, input);
   if (fit.empty()) return out;
   auto error = fit.pair_up();
   if (error.top2 <= kOnTheInput * kOnTheInput) return out;

@@ -9,6 +9,7 @@
 
 #include "decimate/collapser.hpp"
 #include "topstoc/core/mesh.hpp"
+#include "topstoc/distance/hausdorff.hpp"
 
 namespace topstoc {
 
@@ -27,14 +28,19 @@ struct TinyFit {
   double after2 = 0.0;       ///< and after the last kept one
 };
 
+/// The step between the input triangles the fit measures against (1: all of them): at most
+/// 200,000 are taken, evenly (deviation.hpp's normalised_input with this step is `input` below).
+int64_t fit_input_step(const Mesh& mesh);
+
 /// Rounds (at most `rounds`) of: pair input vertices (at most 20,000, evenly taken) with their
 /// closest point on the result and 7 points of each result triangle with their closest point
-/// on the input (on at most 200,000 of its triangles, evenly taken); move the free and boundary
+/// on `input` (the input's triangles every fit_input_step, in the collapser's normalised
+/// coordinates, made by the caller so that it may be kept for later decimations); move the free and boundary
 /// vertices to the least-squares fit of those pairs, each only where no triangle folds or thins
 /// (Collapser::try_move); keep a round only if the mean squared distance fell, the largest pair
 /// distance did not grow, and neither did the symmetric Hausdorff max over both whole surfaces
 /// (a bracket from bounded_max.hpp: the pairs alone miss where the surface lifts between them).
 /// boundaries: the unlocked vertices of mesh boundaries move too (else only the free ones).
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries);
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input);
 
 }  // namespace topstoc

@@ -2,7 +2,8 @@
 // preview asks for one ratio after another). A mesh collapsed whole goes the same way toward
 // every vertex target until its batches start to depend on the target (they shrink near it):
 // a run toward a lower target resumes from the state an earlier run kept there, with the same
-// result to the bit. The input's search structure for the distance passes is kept with them.
+// result to the bit. The input's search structures for the distance passes and the fit of small
+// results are kept with them.
 #pragma once
 
 #include <cstddef>
@@ -10,11 +11,12 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <utility>
 #include <vector>
 
 namespace topstoc {
 
-struct InputSurface;
+class Surface;
 
 class CollapseSnapshots {
  public:
@@ -33,22 +35,25 @@ class CollapseSnapshots {
   /// Keeps a state; beyond the capacity the oldest is dropped, except the one for the highest
   /// target (which serves every lower one).
   void keep(std::shared_ptr<const Entry> entry);
-  /// The input's search structure for the refinement's distance passes (deviation.hpp), kept
-  /// with the states: the one kept under `key` (input_surface_key), else the one `make` makes,
-  /// kept instead.
-  std::shared_ptr<const InputSurface> input_surface(const std::vector<uint64_t>& key,
-                                                    const std::function<std::shared_ptr<const InputSurface>()>& make);
-  /// Frees every kept state and the search structure.
+  /// The input's triangles with their search structure, for the refinement's distance passes
+  /// and the fit (deviation.hpp's normalised_input), kept with the states: the one kept under
+  /// `key` (input_surface_key), else the one `make` makes, kept too. At most kSurfaces are kept
+  /// (the whole input, and the fit's share of a large one), the least recently used dropped.
+  std::shared_ptr<const Surface> input_surface(const std::vector<uint64_t>& key,
+                                               const std::function<std::shared_ptr<const Surface>()>& make);
+  static constexpr size_t kSurfaces = 2;
+  /// Frees every kept state and search structure.
   void clear();
   /// States kept.
   size_t size() const;
+  /// Input surfaces kept.
+  size_t surfaces() const;
 
  private:
   mutable std::mutex mutex_;
   size_t capacity_;
   std::vector<std::shared_ptr<const Entry>> entries_;  // the most recently kept last
-  std::vector<uint64_t> surface_key_;
-  std::shared_ptr<const InputSurface> surface_;
+  std::vector<std::pair<std::vector<uint64_t>, std::shared_ptr<const Surface>>> surfaces_;  // most recent last
 };
 
 }  // namespace topstoc
