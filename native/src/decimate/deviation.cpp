@@ -29,21 +29,6 @@ std::vector<double> distances2(const TriangleBvh& surface, int64_t count, Point&
   return out;
 }
 
-// A distance pass's team: the cores free now rather than when the call began (a live preview's
-// speculative run starts beside a draft and is often alone by its distance passes); the
-// caller's team size is restored after (its per-thread scratch was sized for it). The answers
-// do not depend on the team size.
-class FreeCoresNow {
- public:
-  FreeCoresNow() { use_free_cores(); }
-  ~FreeCoresNow() { set_max_threads(saved_); }
-  FreeCoresNow(const FreeCoresNow&) = delete;
-  FreeCoresNow& operator=(const FreeCoresNow&) = delete;
-
- private:
-  const int saved_ = max_threads();
-};
-
 // A triangle whose measured points reach kNear times the farthest distance found gets more
 // points: where the max lies is measured more finely. (The Lipschitz bound, corner distance
 // plus size, flagged nearly every triangle: input sides are about as long as the deviations.)
@@ -219,7 +204,7 @@ InputSurface::InputSurface(const Mesh& mesh, std::shared_ptr<const Surface> whol
 Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const std::vector<int32_t>& label,
                           Collapser& collapser, const std::vector<int32_t>& triangles, const Rival* rival) {
   check_cancelled("deviation");
-  const FreeCoresNow team;
+  const FreeCoresNow team;  // a distance pass's team: the cores free now (the answers do not depend on it)
   const int32_t n = collapser.vertices();
   std::vector<int32_t> survivor(n);
   for (int32_t v = 0; v < n; ++v) survivor[v] = collapser.survivor(v);

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "distance/bounded_max.hpp"
+#include "topstoc/core/parallel.hpp"
 #include "topstoc/distance/hausdorff.hpp"
 
 namespace topstoc {
@@ -94,13 +95,21 @@ class Fit {
   };
   // at: the result's vertex positions (positions()). threshold >= 0: only whether the max
   // exceeds it is decided (bounded_max.hpp), cheaper, and the second side is skipped once the
-  // first exceeds it.
+  // first exceeds it; without, the two sides run side by side where a core is free (each side's
+  // bracket is the same on any thread).
   Bracket symmetric_max(std::vector<double> at, double threshold = -1.0) const {
     const Surface result(std::move(at), live_faces_);
-    const MaxBracket there = bound_max_distance_by_tree(result, *input_, kMaxTolerance, kMaxQueries, threshold);
-    const MaxBracket back = threshold >= 0.0 && there.lower > threshold
-                                ? MaxBracket{}
-                                : bound_max_distance_by_tree(*input_, result, kMaxTolerance, kMaxQueries, threshold);
+    MaxBracket there, back;
+    auto measure_there = [&] { there = bound_max_distance_by_tree(result, *input_, kMaxTolerance, kMaxQueries, threshold); };
+    auto measure_back = [&] { back = bound_max_distance_by_tree(*input_, result, kMaxTolerance, kMaxQueries, threshold); };
+    if (threshold >= 0.0) {
+      measure_there();
+      if (!(there.lower > threshold)) measure_back();
+    } else {
+      result.bvh(), input_->bvh();  // built before the sides share them
+      const FreeCoresNow team;
+      parallel_invoke(true, measure_there, measure_back);
+    }
     const MaxBracket& far = there.lower >= back.lower ? there : back;
     return {far.lower, std::max(there.upper, back.upper), result.bvh().closest(far.lower_point, -1).triangle};
   }

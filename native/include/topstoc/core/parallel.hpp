@@ -85,6 +85,20 @@ int max_threads();
 /// Sets the calling thread's team size (at least 1); use_free_cores sets it from the free cores.
 void set_max_threads(int threads);
 
+/// One stage of a call on the cores free now rather than when the call began (use_free_cores; a
+/// live preview's rest starts beside a draft and is often alone by its later stages); the call's
+/// team size is restored after (per-thread scratch sized for it stays valid).
+class FreeCoresNow {
+ public:
+  FreeCoresNow() { use_free_cores(); }
+  ~FreeCoresNow() { set_max_threads(saved_); }
+  FreeCoresNow(const FreeCoresNow&) = delete;
+  FreeCoresNow& operator=(const FreeCoresNow&) = delete;
+
+ private:
+  const int saved_ = max_threads();
+};
+
 /// The calling thread's index in the team it works for (0 outside parallel work).
 int thread_index();
 
