@@ -194,9 +194,9 @@ class Mesh:
         layout_and_floods; the collapse states (engine.CollapseSnapshots, 2 kept per layout, a few
         hundred bytes per vertex each) let a quality decimation of a mesh collapsed whole resume toward
         a lower target from where an earlier one's collapses stopped depending on its target, with
-        the same result (the input's search structure for their distance passes is kept with them,
-        a few hundred bytes per vertex more). None for both when the mesh was made with
-        keep_floods=False."""
+        the same result (the input's search structure for their distance passes and the fit of
+        small results is kept with them, a few hundred bytes per vertex more). None for both when
+        the mesh was made with keep_floods=False."""
         key = (_digest(regions), _digest(borders), float(feature_angle))
         entry = self._layouts.get(key)
         if entry is not None and entry[1] is None and self._keep_floods is None:
