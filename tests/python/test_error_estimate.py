@@ -14,6 +14,7 @@ import topstoc
 from peer_runs import cgal_hausdorff, peer, read_off, write_off
 
 estimates = importlib.import_module(topstoc.__name__ + ".core.api.error_estimate")
+engine = importlib.import_module(topstoc.__name__ + ".core.support.native").engine
 
 
 def grid(n: int, z=None):
@@ -110,3 +111,28 @@ def test_the_quick_bound_holds_against_the_exact_max_and_is_near_it(data_dir, na
     assert quick.estimate >= 0.9 * exact.estimate
     measured = hausdorff(original, result, samples=200_000, percentile=0).forward.mean
     assert 0.6 * measured <= quick.mean <= 1.4 * measured
+
+
+def test_a_result_point_found_too_far_is_measured_on_later_results():
+    # The original: a 10 x 10 grid with a 2 x 2 cell hole centred at (0.5, 0.2); a result of two
+    # triangles spans the hole, so its farthest point from the original is the hole's centre, 0.1
+    # away (closed form), and no vertex, centroid or edge midpoint of it lies in the hole.
+    vertices, triangles = grid(10)
+    centre = vertices[triangles].mean(axis=1)
+    keep = ~((np.abs(centre[:, 0] - 0.5) < 0.1) & (np.abs(centre[:, 1] - 0.2) < 0.1))
+    original = (vertices, triangles[keep])
+    square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=float)
+    results = [(square, np.array([[0, 1, 2], [0, 2, 3]], dtype=np.int32)),
+               (square, np.array([[0, 1, 3], [1, 2, 3]], dtype=np.int32))]
+    surface = importlib.import_module(topstoc.__name__ + ".core.api.hausdorff").as_surface(original)
+    sampled = estimates.SampledError(original, surface)
+    assert max(sampled(result) for result in results) < 1e-12  # the spread points miss the hole
+    decided = estimates.decide_error(original, results[0], 0.05, original_surface=surface)
+    assert decided.estimate > 0.05 and decided.witness is None  # the original lies on the result
+    # the witness: a point of the result (in the hole's plane) farther than the bound
+    assert abs(decided.result_witness[2]) < 1e-12
+    assert engine.closest_points(surface, decided.result_witness.reshape(1, 3))["distance"][0] > 0.05
+    sampled.add_result_witness(decided.result_witness)
+    # each result's closest point to it is measured: attained, above the bound, at most the exact 0.1
+    for result in results:
+        assert 0.05 < sampled(result) <= 0.1 + 1e-12

@@ -320,6 +320,29 @@ def test_error_bounded_search_decimates_few_targets_and_stays_minimal(data_dir):
     assert again.symmetric.max_upper > report.max_error * (1 - EXACT_GAP)
 
 
+def test_error_bounded_search_climbs_just_above_a_failed_exact_check(data_dir):
+    # elephant at 1 % in quality mode: the estimate passes 249 and the exact check fails it; the
+    # answer lies a few vertices above, which a bisection toward the full count reached after
+    # ten decimated targets
+    vertices, triangles = read_off(data_dir / "genus_positive/cgal_elephant.off")
+    mesh = topstoc.Mesh(vertices, triangles)
+    result = mesh.decimate(max_error=0.01, relative=True, seed=1)
+    report = result.error_bound
+    targets = [target for target, *_ in report.probes]
+    assert len(set(targets)) <= 5
+    # every probe above the exact failure steps up from it, none beyond the answer
+    failed_exactly = min(n for n in targets if n < report.target_vertices and targets.count(n) == 2)
+    assert all(failed_exactly <= n <= failed_exactly + 4 * report.resolution for n in targets[targets.index(failed_exactly):])
+    check = topstoc.hausdorff(mesh, result, samples=200_000, percentile=0)
+    assert check.symmetric.max <= report.achieved_error * (1 + 1e-12) <= report.max_error * (1 + 1e-12)
+    # minimal within the resolution: the target below measured a distance above the bound
+    assert 0 < report.target_vertices - report.failed_target <= report.resolution
+    below = mesh.decimate(target_vertices=report.failed_target, seed=1)
+    again = topstoc.hausdorff(mesh, below, samples=200_000, percentile=0)
+    assert report.failed_error > report.max_error * (1 - EXACT_GAP)
+    assert again.symmetric.max_upper >= report.failed_error * (1 - 1e-12)
+
+
 def test_error_bounded_search_returns_the_fewest_passing_vertices_from_its_first_probe(data_dir):
     # The error is not monotone in the count, so a search at the resolution need not find the
     # fewest vertices that pass. On fandisk at 0.3 % every target from the search's first probe

@@ -12,7 +12,8 @@ bound fails for certain). A passing target is checked exactly
 (topstoc.core.error_estimate.decide_error: the guaranteed bracket of the exact maximum, refined
 only as far as deciding the bound needs): at once with ``check_passes`` (quality mode, where a
 decimation costs more than a check), else only the answer. A failed check's far point joins the
-estimate's points and the search goes on above it. Error need not fall monotonically with the vertex count (each count draws other
+estimate's points (on the original: that point; on the result: each later result's closest point
+to it) and the search climbs above it in steps doubling from two resolutions. Error need not fall monotonically with the vertex count (each count draws other
 samples); the guarantee is the one the search can check: the returned decimation's error is
 within the bound (a guaranteed upper bound of its exact maximum), and the target
 ``resolution`` below it (``failed_target``) measured a distance above the bound. ``progress(probe, target, vertices, error, passed)``, when given, is called after every
@@ -75,6 +76,8 @@ class _Probes:
             error = decided.upper if passed else decided.estimate
             if decided.witness is not None:
                 self.sampled.add_witness(decided.witness)
+            if decided.result_witness is not None:
+                self.sampled.add_result_witness(decided.result_witness)
         else:
             error = self.sampled(result)
             passed = error <= self.bound
@@ -86,7 +89,11 @@ class _Probes:
 
     def judge(self, n: int) -> bool:
         """The estimate first (above the bound fails for certain), then the exact check."""
-        return self(n) and self(n, exact=True)
+        return self(n) and self.exactly(n)
+
+    def exactly(self, n: int) -> bool:
+        """The exact check of n, made once (a later call reads its verdict)."""
+        return self.results[n][2] if n in self.exact else self(n, exact=True)
 
 
 def _bracket(probe: _Probes, active: int, resolution: float) -> tuple:
@@ -105,6 +112,21 @@ def _bracket(probe: _Probes, active: int, resolution: float) -> tuple:
         step = min(max(step * (0.8 if passed else 1.25), 1 / 16), 16)
         previous, n = n, min(max(int(round(n * step)), lo + 1, 1), hi - 1)
     return lo, hi
+
+
+def _climb(probe: _Probes, judge: Callable[[int], bool], failed: int, active: int, resolution: float) -> tuple:
+    """(lo, hi) above ``failed``, a target the estimate passed and the exact check failed: steps up
+    from it, each twice the last (from two resolutions), judging each, up to the smallest probed
+    target above that the estimate still passes (hi then still to check exactly) or the full count.
+    The answer usually lies a few hundredths above, where a bisection toward the full count
+    probed many targets."""
+    lo, step = failed, 2 * resolution_count(failed, resolution)
+    cap = next((n for n in sorted(probe.results) if n > failed and probe(n)), active)
+    while lo + step < cap:
+        if judge(lo + step):
+            return lo, lo + step
+        lo, step = lo + step, 2 * step
+    return lo, cap
 
 
 def _bisect(judge: Callable[[int], bool], lo: int, hi: int, resolution: float) -> tuple:
@@ -149,11 +171,11 @@ def search_vertex_count(mesh, max_error: float, decimate_at: Callable[[int], obj
     # The estimate passes hi: check it exactly. Should the check fail, its far point joins the
     # estimate's points and the next probed target above that the estimate still passes is
     # checked (up to the full count, which always passes: its decimation is the input itself).
-    while hi != active and not probe(hi, exact=True):
-        lo = hi
-        hi = next((n for n in sorted(probe.results) if n > lo and probe(n)), active)
+    judge = probe.judge if check_passes else lambda n: probe(n, exact=True)
+    while hi != active and not probe.exactly(hi):
+        lo, hi = _climb(probe, judge, hi, active, resolution)
     # then on to the resolution on exact checks (the estimate first with check_passes)
-    lo, hi = _bisect(probe.judge if check_passes else lambda n: probe(n, exact=True), lo, hi, resolution)
+    lo, hi = _bisect(judge, lo, hi, resolution)
     if hi not in probe.results:
         probe(hi, exact=True)  # the full count: only reached when every smaller target failed
     result, error, passed = probe.results[hi]

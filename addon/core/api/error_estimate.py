@@ -70,6 +70,7 @@ class ErrorBound:
     queries: int        #: closest-point queries made
     converged: bool     #: upper <= estimate * (1 + gap), or upper under the resolution (see RESOLUTION)
     witness: object = None  #: decide_error: a point of the original farther than the bound from the result
+    result_witness: object = None  #: decide_error: a point of the result farther than the bound from the original
     mean: float = float("nan")  #: the quick bound's estimate of the mean distance from the original
 
     @property
@@ -158,7 +159,8 @@ def decide_error(original, result, bound: float, *, original_surface=None) -> Er
     forward = (sides[0]["lower"], sides[0]["upper"])
     backward = (sides[1]["lower"], sides[1]["upper"]) if len(sides) > 1 else (0.0, float("inf"))
     witness = sides[0]["lower_point"] if sides[0]["lower"] > bound else None
-    return ErrorBound(witness=witness,estimate=max(forward[0], backward[0]), upper=max(forward[1], backward[1]),
+    result_witness = sides[1]["lower_point"] if len(sides) > 1 and sides[1]["lower"] > bound else None
+    return ErrorBound(witness=witness, result_witness=result_witness, estimate=max(forward[0], backward[0]), upper=max(forward[1], backward[1]),
                       forward=forward, backward=backward, gap=EXACT_GAP,
                       queries=int(sum(side["queries"] for side in sides)),
                       converged=all(side["converged"] or side["lower"] > bound for side in sides))
@@ -168,24 +170,34 @@ class SampledError:
     """The largest distance over points spread on both surfaces, for many results of one original:
     attained, so never above the exact maximum (a lower bound, not a bracket). The original's
     points (every k-th triangle's centroid and vertex, about ``samples`` in all) are taken once;
-    on a result: its vertices, and every k-th triangle's centroid and edge midpoint."""
+    on a result: its vertices, every k-th triangle's centroid and edge midpoint, and its closest
+    point to each place where an earlier result was found too far (add_result_witness)."""
 
     def __init__(self, original, original_surface, samples: int = 40_000):
         vertices, triangles = _arrays(original)
         step = max(1, -(-len(triangles) // max(1, samples // 2)))
         self.points = np.concatenate([vertices[triangles[::step]].mean(axis=1), vertices[triangles[::step, 0]]])
         self.surface, self.samples = original_surface, samples
+        self.result_witnesses = np.empty((0, 3))
 
     def add_witness(self, point) -> None:
         """Measures this point of the original from now on (one an exact check found too far)."""
         self.points = np.concatenate([self.points, np.asarray(point, dtype=np.float64).reshape(1, 3)])
 
+    def add_result_witness(self, point) -> None:
+        """From now on measures each result's closest point to this one (a point of an earlier
+        result an exact check found too far from the original): the results of nearby counts
+        tend to keep the same bulge, which the spread points can miss."""
+        self.result_witnesses = np.concatenate([self.result_witnesses, np.asarray(point, dtype=np.float64).reshape(1, 3)])
+
     def __call__(self, result) -> float:
         vertices, triangles = _arrays(result)
         step = max(1, -(-len(triangles) // max(1, self.samples // 2)))
         corners = vertices[triangles[::step]]
-        points = np.concatenate([vertices, corners.mean(axis=1), 0.5 * (corners[:, 0] + corners[:, 1])])
-        forward = engine.closest_points(as_surface(result, "result"), self.points)["distance"]
+        surface = as_surface(result, "result")
+        near = engine.closest_points(surface, self.result_witnesses)["point"] if len(self.result_witnesses) else np.empty((0, 3))
+        points = np.concatenate([vertices, corners.mean(axis=1), 0.5 * (corners[:, 0] + corners[:, 1]), near])
+        forward = engine.closest_points(surface, self.points)["distance"]
         backward = engine.closest_points(self.surface, points)["distance"]
         return float(max(forward.max(initial=0.0), backward.max(initial=0.0)))
 
