@@ -5,7 +5,8 @@
 
 For each asset and ratio, TopStoc's quality mode decimates it with its look in the cost (the public
 API as the add-on calls it: topstoc.core.carry.appearance's attributes at ATTRIBUTE_WEIGHT, UV seams
-and hard normal edges as borders, the attributes carried through the result's source maps); every
+and hard normal edges as borders, the attributes carried through the result's source maps and then
+fitted to the source's by least squares, carry.look_fit); every
 peer then decimates the same asset to our triangle count:
   - meshopt_simplifyWithAttributes (meshoptimizer 0.22 from PyPI's `meshoptimizer` 0.2.30a0, in a
     venv made once under ${TOPSTOC_CACHE}), on the asset split into one vertex per distinct
@@ -55,6 +56,7 @@ from topstoc.core.api.decimate import ATTRIBUTE_WEIGHT  # noqa: E402
 from topstoc.core.api.hausdorff import closest_points  # noqa: E402
 from topstoc.core.api.io import read_mesh  # noqa: E402
 from topstoc.core.carry.appearance import appearance_attributes, unit_corner_normals  # noqa: E402
+from topstoc.core.carry.look_fit import fit_look  # noqa: E402
 from topstoc.core.carry.attributes import corner_values, hard_normal_edges, moved_vertices, uv_seam_edges  # noqa: E402
 from attribute_error import CHANNELS, attribute_errors  # noqa: E402
 from capped_cylinder import capped_cylinder  # noqa: E402
@@ -144,7 +146,8 @@ def target_triangles(asset: dict, ratio: float) -> int:
 
 
 def run_ours(asset: dict, ratio: float, weight: float = ATTRIBUTE_WEIGHT) -> tuple[dict, float]:
-    """Quality mode with the look in the cost, seams and hard edges as borders; attributes carried."""
+    """Quality mode with the look in the cost, seams and hard edges as borders; attributes carried
+    and fitted to the source's (carry.look_fit, as the add-on writes them); the seconds count both."""
     t = asset["triangles"]
     look = appearance_attributes(t, asset.get("uv"), asset.get("color"), asset.get("normal"))
     borders = [np.zeros((0, 2), dtype=np.int64)]
@@ -156,7 +159,6 @@ def run_ours(asset: dict, ratio: float, weight: float = ATTRIBUTE_WEIGHT) -> tup
     result = Mesh(asset["vertices"], t).decimate(target_triangles=target_triangles(asset, ratio),
                                                  borders=np.concatenate(borders).astype(np.int64),
                                                  **look.decimate_kwargs(weight))
-    seconds = time.perf_counter() - start
     moved = moved_vertices(asset["vertices"], t, result)
     out = {"vertices": result.vertices, "triangles": np.asarray(result.triangles, dtype=np.int64)}
     m = len(t)
@@ -165,9 +167,12 @@ def run_ours(asset: dict, ratio: float, weight: float = ATTRIBUTE_WEIGHT) -> tup
             values = asset[channel].reshape(3 * m, -1)
             flat = corner_values(values, result.corner_source, result.triangles, moved, np.arange(3 * m).reshape(m, 3))
             out[channel] = flat.reshape(-1, 3, values.shape[1])
-    if out.get("normal") is not None:
-        out["normal"] /= np.linalg.norm(out["normal"], axis=2, keepdims=True)
-    return out, seconds
+    channels = [c for c in CHANNELS if out.get(c) is not None]
+    fitted = fit_look(asset["vertices"], t, out["vertices"], out["triangles"],
+                      {c: (asset[c], out[c], c == "normal") for c in channels})
+    for c in channels:
+        out[c] = fitted[c].reshape(out[c].shape)
+    return out, time.perf_counter() - start
 
 
 # -- meshoptimizer -----------------------------------------------------------------------------
