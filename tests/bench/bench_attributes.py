@@ -169,7 +169,7 @@ def run_ours(asset: dict, ratio: float, weight: float = ATTRIBUTE_WEIGHT) -> tup
             out[channel] = flat.reshape(-1, 3, values.shape[1])
     channels = [c for c in CHANNELS if out.get(c) is not None]
     fitted = fit_look(asset["vertices"], t, out["vertices"], out["triangles"],
-                      {c: (asset[c], out[c], c == "normal") for c in channels})
+                      {c: (asset[c], out[c], c) for c in channels}, result.kept)
     for c in channels:
         out[c] = fitted[c].reshape(out[c].shape)
     return out, time.perf_counter() - start

@@ -100,10 +100,25 @@ def corner_data(mesh):
 
 @pytest.fixture
 def quality_result(ts, scene):
+    """The look out of the cost (attribute weight 0): every layer is carried, none fitted."""
     obj = sphere_with_everything()
-    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.1, quality="QUALITY", seed=3))
+    run = ts.blender.decimation.pipeline.decimate(bpy.context, obj, Params(ratio=0.1, quality="QUALITY", seed=3,
+                                                                        attribute_weight=0.0))
     out = ts.blender.decimation.pipeline.write_output(run)
     return obj, out
+
+
+@pytest.fixture
+def look_result(ts, scene, monkeypatch):
+    """The look in the cost (the default): the source, the result written as the add-on writes
+    it (the look's layers fitted) and the same result with every layer carried."""
+    obj = sphere_with_everything()
+    pipeline = ts.blender.decimation.pipeline
+    run = pipeline.decimate(bpy.context, obj, Params(ratio=0.1, quality="QUALITY", seed=3))
+    assert pipeline.look_layers(run) == {"uv": "UVMap", "color": "paint", "normal": False}
+    fitted = pipeline.write_output(run)
+    monkeypatch.setattr(pipeline, "look_layers", lambda run: None)
+    return obj, fitted, pipeline.write_output(run)
 
 
 def test_moved_vertices_interpolate_in_their_source_triangle(quality_result):
@@ -165,8 +180,9 @@ def test_moved_vertices_interpolate_in_their_source_triangle(quality_result):
             (v, ok_height, ok_paint, ok_id, ok_speckle, ok_uv, ok_keys)
 
 
-def test_uvs_stay_exact_at_seams(quality_result):
-    source, out = quality_result
+@pytest.mark.parametrize("which", ["carried", "fitted"])
+def test_uvs_stay_exact_at_seams(quality_result, look_result, which):
+    source, out = quality_result if which == "carried" else look_result[:2]
     src, dst = source.data, out.data
     corner_in, uv_in = corner_data(src)
     corner_out, uv_out = corner_data(dst)
@@ -183,3 +199,34 @@ def test_uvs_stay_exact_at_seams(quality_result):
             on_seam += 1
             assert tuple(uv_out[loop]) in uvs_at[source_vertex]  # one side's UV exactly, never a mix
     assert on_seam >= 20  # (no seam vertex moved: a moved vertex has one UV, see the test above)
+
+
+def _mapping_error(mesh) -> dict:
+    """Area-weighted mean error at the triangles' quadrature points of the UV map's v and of the
+    paint's red against the closed forms sphere_with_everything painted them with (v = 0.5 +
+    0.5 z, red = 0.5 + 0.4 x, at the point's direction on the unit sphere)."""
+    corner_vertex, uv = corner_data(mesh)
+    red = attribute(mesh, "paint", "color", 4)[:, 0]
+    v = positions(mesh).astype(np.float64)
+    loops = np.array([tuple(p.loop_indices) for p in mesh.polygons])
+    corners = v[corner_vertex[loops]]
+    area = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+    errors = {"v": 0.0, "red": 0.0}
+    for w in np.full((3, 3), 1 / 6) + np.eye(3) / 2:
+        point = np.einsum("j,mjk->mk", w, corners)
+        unit = point / np.linalg.norm(point, axis=1, keepdims=True)
+        errors["v"] += (area * np.abs(uv[loops, 1] @ w - (0.5 + 0.5 * unit[:, 2]))).sum()
+        errors["red"] += (area * np.abs(red[corner_vertex[loops]] @ w - (0.5 + 0.4 * unit[:, 0]))).sum()
+    return {name: value / (3 * area.sum()) for name, value in errors.items()}
+
+
+def test_the_look_is_fitted_to_the_source(look_result):
+    """The active UV map and the appearance colour were in the cost: written fitted
+    (core/carry/look_fit), they follow the closed-form mapping and paint closer than carried
+    from the kept vertices; layers outside the look are carried the same either way."""
+    source, fitted, carried = look_result
+    errors = {name: _mapping_error(out.data) for name, out in (("fitted", fitted), ("carried", carried))}
+    assert errors["fitted"]["v"] < 0.5 * errors["carried"]["v"], errors
+    assert errors["fitted"]["red"] < 0.5 * errors["carried"]["red"], errors
+    for name, key, width in (("height", "value", 1), ("speckle", "color", 4), ("id", "value", 1)):
+        np.testing.assert_array_equal(attribute(fitted.data, name, key, width), attribute(carried.data, name, key, width))

@@ -17,6 +17,7 @@ import os
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from typing import Optional
 
 import bpy
 import numpy as np
@@ -28,7 +29,7 @@ from ...core.support.errors import TopStocError
 from ...core.api.job import ATTRIBUTE_WEIGHT, DecimationJob, make_job
 from ..io import mesh_read, mesh_write, mesh_attributes, carry
 from ..preview.cache import Prepared, prepared_meshes
-from .guidance import EngineGuidance, gather, guidance_layers, read as read_guidance
+from .guidance import EngineGuidance, appearance_color, gather, guidance_layers, read as read_guidance
 
 LAST_SAMPLES = "Last"
 
@@ -237,6 +238,19 @@ def record(target: dict, options: dict, guidance: EngineGuidance, result) -> dic
                 attributes=list(guidance.appearance_sources) if used_look else [])
 
 
+def look_layers(run: Run) -> Optional[dict]:
+    """The layers whose look was in ``run``'s cost, which the written result fits to the source's
+    (mesh_write.fitted_look): {"uv": UV map name, "color": colour attribute name, "normal": bool},
+    or None when the look was not in it."""
+    if not run.result.parameters.get("attribute_channels"):
+        return None
+    used, mesh = run.guidance.appearance().used, run.obj.data
+    color = appearance_color(mesh, run.obj.topstoc) if "color" in used else None
+    uv = mesh.uv_layers.active if "uv" in used else None
+    return {"uv": None if uv is None else uv.name, "color": None if color is None else color.name,
+            "normal": "normal" in used}
+
+
 def _object_materials(source, new) -> None:
     for index, slot in enumerate(source.material_slots):
         if slot.link == "OBJECT" and index < len(new.material_slots):
@@ -275,7 +289,7 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
         target = obj if into is None else into
         old = target.data
         mesh = mesh_write.build_result_mesh(obj.data, arrays, run.result, old.name + "_TopStoc", moved,
-                                         guidance_layers(obj), keep_guidance=into is None)
+                                         guidance_layers(obj), keep_guidance=into is None, look=look_layers(run))
         if into is not None:  # the result's own material choices win over the source's
             mesh.materials.clear()
             for material in old.materials:
@@ -289,7 +303,7 @@ def write_output(run: Run, mode: str = "NEW_OBJECT", name: str = None, place: bo
     else:
         name = name or f"{obj.name}_TopStoc"
         mesh = mesh_write.build_result_mesh(obj.data, arrays, run.result, name, moved, guidance_layers(obj),
-                                         keep_guidance=False)
+                                         keep_guidance=False, look=look_layers(run))
         carry.copy_custom_properties(obj.data, mesh)
         target = bpy.data.objects.new(name, mesh)
         carry.link_like(obj, target, bpy.context.scene)

@@ -13,6 +13,7 @@ import numpy as np
 
 from ...core.carry.attributes import FLAT_CORNER_ANGLE, MovedVertices, corner_values, moved_vertices, point_values
 from ...core.api.mesh_edges import mesh_edges
+from ...core.carry.look_fit import fit_look, vertex_means
 from .mesh_access import attribute_for_write, domain_size, read_array, write_indices
 from .mesh_read import MeshArrays, position_attribute, read_custom_normals, read_polygon_smooth
 from .mesh_attributes import INTERPOLATED, SKIPPED_ATTRIBUTES, read_attribute, read_uv_map, write_uv_map
@@ -131,9 +132,41 @@ def face_normals(vertices, triangles) -> np.ndarray:
     return n / np.where(length > 0, length, 1.0)
 
 
+def fitted_look(source: bpy.types.Mesh, arrays: MeshArrays, result, look: dict, carried) -> dict:
+    """The layers of the look that was in the cost, fitted to the source's (core.carry.look_fit):
+    {("uv", name) | ("color", name) | ("normal", None): values on the layer's domain}. ``look``:
+    {"uv": the UV map's name, "color": the colour attribute's name, "normal": True}, each
+    optional; ``carried(values, domain)`` gives a layer's carried values (build_result_mesh)."""
+    triangles = np.asarray(result.triangles, dtype=np.int64)
+    layers, domains = {}, {}
+    if look.get("uv") and look["uv"] in source.uv_layers:
+        values = read_uv_map(source, look["uv"])
+        layers[("uv", look["uv"])] = (values[arrays.triangle_loops], carried(values, "CORNER"), "uv")
+    attribute = source.attributes.get(look["color"]) if look.get("color") else None
+    if attribute is not None and attribute.domain in ("POINT", "CORNER"):
+        read = read_attribute(attribute, domain_size(source, attribute.domain))
+        if read is not None:
+            values = read[0]
+            point = attribute.domain == "POINT"
+            at = arrays.triangles if point else arrays.triangle_loops
+            here = carried(values, attribute.domain)
+            layers[("color", look["color"])] = (values[at], here[triangles] if point else here, "color")
+            domains[("color", look["color"])] = (attribute.domain, values.dtype)
+    normals = read_custom_normals(source) if look.get("normal") else None
+    if normals is not None:
+        layers[("normal", None)] = (normals[arrays.triangle_loops], carried(normals, "CORNER"), "normal")
+    fitted = fit_look(arrays.vertices, arrays.triangles, result.vertices, triangles, layers, result.kept)
+    for key, (domain, dtype) in domains.items():
+        values = fitted[key]
+        if domain == "POINT":
+            values = vertex_means(values, triangles, len(result.vertices))
+        fitted[key] = np.rint(values).astype(dtype) if np.issubdtype(dtype, np.integer) else values.astype(dtype)
+    return fitted
+
+
 def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: str,
-                      moved: Optional[MovedVertices] = None, guidance: tuple = (), keep_guidance: bool = True
-                      ) -> bpy.types.Mesh:
+                      moved: Optional[MovedVertices] = None, guidance: tuple = (), keep_guidance: bool = True,
+                      look: Optional[dict] = None) -> bpy.types.Mesh:
     """A new mesh datablock holding ``result`` with the source's attributes carried over.
 
     ``guidance``: the names of the guidance paint layers. They are never the result's active or
@@ -146,7 +179,8 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
     source triangle (topstoc.core.carry.attributes; corners from that triangle's own loops, so UV
     seams stay exact); integers, flags and rotations take the nearest corner's value. Output
     edges are new: seam and sharp flags mark the output edges that follow a flagged input curve
-    (carry_edge_flags); creases and bevel weights are not carried.
+    (carry_edge_flags); creases and bevel weights are not carried. ``look`` (the layers that
+    were in the cost, fitted_look): those are fitted to the source's look after the carry.
     """
     out = bpy.data.meshes.new(name)
     fill_geometry(out, result.vertices, result.triangles)
@@ -165,6 +199,7 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
             return corner_values(values, corner_loop, result.triangles, moved, arrays.loop_map, nearest)
         return values[face_polygon]
 
+    fitted = fitted_look(source, arrays, result, look, carried) if look and m else {}
     for material in source.materials:
         out.materials.append(material)
     if m and np.any(arrays.polygon_material):  # all zero is Blender's default: no write
@@ -176,6 +211,9 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
     uv_names = set()
     for uv in source.uv_layers:
         uv_names.add(uv.name)
+        if ("uv", uv.name) in fitted:
+            write_uv_map(out, uv.name, fitted[("uv", uv.name)])
+            continue
         write_uv_map(out, uv.name, carried(read_uv_map(source, uv.name), "CORNER") if m else np.zeros((0, 2)))
     if source.uv_layers.active is not None:
         out.uv_layers.active_index = source.uv_layers.active_index
@@ -191,7 +229,9 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
             continue
         values, key = read
         target = attribute_for_write(out, name_, attribute.data_type, attribute.domain)
-        picked = carried(values, attribute.domain, nearest=attribute.data_type not in INTERPOLATED)
+        picked = fitted.get(("color", name_))
+        if picked is None:
+            picked = carried(values, attribute.domain, nearest=attribute.data_type not in INTERPOLATED)
         if len(picked):
             target.data.foreach_set(key, np.ascontiguousarray(picked).ravel())
     _display_colors(source, out, guidance)
@@ -202,7 +242,9 @@ def build_result_mesh(source: bpy.types.Mesh, arrays: MeshArrays, result, name: 
         if hasattr(out, "use_auto_smooth"):  # Blender < 4.1 needs auto smooth for custom normals
             out.use_auto_smooth = True
             out.auto_smooth_angle = source.auto_smooth_angle
-        corner_normals = carried(normals, "CORNER")
+        corner_normals = fitted.get(("normal", None))  # fitted ones are unit already
+        if corner_normals is None:
+            corner_normals = carried(normals, "CORNER")
         mixed = moved.face[np.asarray(result.triangles).ravel()] >= 0  # interpolated: unit length again
         length = np.linalg.norm(corner_normals[mixed], axis=1, keepdims=True)
         corner_normals[mixed] = corner_normals[mixed] / np.where(length > 0, length, 1)

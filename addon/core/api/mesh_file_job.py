@@ -1,7 +1,7 @@
 """The one recipe that decimates a mesh file read with io.read_mesh (docs/design.md §1.5, §6):
 prepare the Mesh, UV seams and material borders as borders, the look (UVs, colours) as
 attributes where the refinement runs, decimate (mirrored when asked), carry the attributes
-over, write atomically.
+over (the look fitted to the input's where it was in the cost), write atomically.
 
 ``topstoc decimate`` (core/cli/decimate.py) runs it once; the batch (core/batch/mesh_asset.py) once
 per LOD of each mesh file. The decimation itself is a DecimationJob (core/api/job.py).
@@ -47,9 +47,9 @@ class MeshFileJob:
         return run_job(self.mesh, self.job(target, options, symmetry), progress)
 
     def write(self, result: DecimateResult, output: str) -> list:
-        """Writes ``result`` with the input's attributes to ``output``; returns what its format
-        cannot store (io.dropped_attributes)."""
-        out = transfer_attributes(self.data, result)
+        """Writes ``result`` with the input's attributes to ``output`` (the look fitted to the
+        input's where it was in the cost); returns what its format cannot store (io.dropped_attributes)."""
+        out = transfer_attributes(self.data, result, fit=bool(self.attribute_kwargs))
         out.material_libraries = carry_libraries(out.material_libraries, self.path, output)
         write_mesh(output, out)
         return dropped_attributes(out, output)

@@ -22,6 +22,8 @@ from typing import Optional
 import numpy as np
 
 from ..api.io import MeshData
+from .look_fit import fit_look, vertex_means
+from .appearance import fill_missing_uvs
 from ..support.native import engine
 from ..support.ranges import matching_rows
 
@@ -245,20 +247,41 @@ def corner_values(values, corner_source, output_triangles, moved: MovedVertices,
     return out
 
 
-def transfer_attributes(data: MeshData, result) -> MeshData:
+def _fitted_look(data: MeshData, result, uvs, colors) -> tuple:
+    """The carried ``uvs`` (per output corner) and ``colors`` (per output vertex) fitted to the
+    source's (look_fit); corners without a UV stay without."""
+    triangles = np.asarray(result.triangles, dtype=np.int64)
+    layers, missing = {}, None
+    source_uvs = None if uvs is None else fill_missing_uvs(data.triangles, data.corner_uvs)[0]
+    if source_uvs is not None:
+        missing = ~np.isfinite(uvs).all(axis=1)
+        layers["uv"] = (source_uvs, np.where(missing[:, None], 0.0, uvs), "uv")
+    if colors is not None:
+        layers["color"] = (data.vertex_colors[data.triangles], colors[triangles].reshape(-1, colors.shape[1]), "color")
+    fitted = fit_look(data.vertices, data.triangles, result.vertices, triangles, layers, result.kept)
+    if source_uvs is not None:
+        uvs = np.where(missing[:, None], np.nan, fitted["uv"])
+    if colors is not None:
+        colors = vertex_means(fitted["color"], triangles, len(colors)).astype(colors.dtype, copy=False)
+    return uvs, colors
+
+
+def transfer_attributes(data: MeshData, result, fit: bool = False) -> MeshData:
     """The decimated mesh ``result`` (a DecimateResult of ``data``) with ``data``'s UVs,
     vertex colours and materials carried over through its source maps; moved vertices
-    interpolate them (see the module docs)."""
+    interpolate them (see the module docs). ``fit`` (the look was in the cost): UVs and colours
+    are then fitted to the source's (look_fit; corners without a UV stay without)."""
     face_source = np.asarray(result.face_source, dtype=np.int64)
     need = data.corner_uvs is not None or data.vertex_colors is not None
     moved = moved_vertices(data.vertices, data.triangles, result) if need else None
-    uvs = None
+    uvs = colors = None
     if data.corner_uvs is not None:
-        flat = corner_values(data.corner_uvs.reshape(-1, 2), result.corner_source, result.triangles, moved, None)
-        uvs = flat.reshape(-1, 3, 2)
-    colors = None
+        uvs = corner_values(data.corner_uvs.reshape(-1, 2), result.corner_source, result.triangles, moved, None)
     if data.vertex_colors is not None:
         colors = point_values(data.vertex_colors, result.kept, moved, data.triangles)
+    if fit and need and len(result.triangles):
+        uvs, colors = _fitted_look(data, result, uvs, colors)
+    uvs = None if uvs is None else uvs.reshape(-1, 3, 2)
     materials = None if data.triangle_material is None else data.triangle_material[face_source]
     return MeshData(vertices=result.vertices, triangles=result.triangles, corner_uvs=uvs, vertex_colors=colors,
                     triangle_material=materials, material_names=data.material_names,

@@ -10,9 +10,13 @@ carry the same value: one per side of a UV seam or hard edge, so seams stay seam
 together, minimising the squared difference between the output's interpolated value and the
 source's at matched points, sampled in both directions (points on the source to their closest
 point on the output, points on the output to their closest point on the source: what a viewer
-sees from either side), each direction weighed by area as a whole. A small pull towards the
-carried values keeps every wedge determined. Normals are fitted per component and made unit
-again; colours are clamped into [0, 1]. Deterministic: fixed quadrature points, no random draw.
+sees from either side), each direction weighed by area as a whole; matches far off the fit
+(a point sent across a seam to another UV island) are weighed down in two more rounds. A small
+pull towards the carried values keeps every wedge determined. A vertex on a UV seam keeps its
+UVs (both sides of the seam still meet the same texels; the island outlines stay exact); normals
+and colours are fitted on both sides of their hard edges. Normals are fitted per component and
+made unit again; UVs and colours stay within the source's range. Deterministic: fixed
+quadrature points, no random draw. Used where the look was in the decimation's cost.
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ from ..support.native import engine
 MAX_POINTS = 120_000
 #: Sub-triangles per output triangle edge for its quadrature points (s * s points).
 MAX_SUBDIVISION = 4
-#: Pull towards the carried values, relative to a wedge's mean weight from the points.
+#: Pull towards the carried values, relative to a wedge's own weight from the points.
 PULL = 1e-3
 #: Conjugate-gradient iterations at most, and the residual reduction that ends them.
 MAX_ITERATIONS = 200
@@ -69,41 +73,73 @@ def _barycentric(points, corners) -> np.ndarray:
 
 @dataclass
 class _Rows:
-    """Matched points: each row's three output wedges and weights, the source triangle and
-    barycentric weights of its target value, and the row's weight."""
-    wedges: np.ndarray        # (r, 3) int64
-    weights: np.ndarray       # (r, 3)
-    source: np.ndarray        # (r,) source triangle
+    """Matched points: each row's output triangle and barycentric weights there, the source
+    triangle and barycentric weights of its target value, and the row's weight."""
+    triangle: np.ndarray        # (r,) output triangle
+    weights: np.ndarray         # (r, 3)
+    source: np.ndarray          # (r,) source triangle
     source_weights: np.ndarray  # (r, 3)
-    row_weight: np.ndarray    # (r,)
+    row_weight: np.ndarray      # (r,)
+
+
+@dataclass
+class _Wedges:
+    """One layer's wedges: each output corner's, a corner of each, and which are free to move
+    (1.0) or held at their carried values (0.0: the UVs of a vertex on a UV seam)."""
+    corner: np.ndarray  # (3 m_out,) int64
+    first: np.ndarray   # (w,) int64
+    free: np.ndarray    # (w, 1) float64
+
+    @staticmethod
+    def of(out_triangles, carried, held_vertices=None) -> "_Wedges":
+        """Corners of one output vertex with equal carried values are one wedge. ``held_vertices``
+        (bool per output vertex, or None for none): those and every vertex with several wedges
+        keep their carried values."""
+        vertex = out_triangles.ravel()
+        _, first, corner = _groups(np.column_stack([vertex.astype(np.float64), carried]))
+        wedge_vertex = vertex[first]
+        free = np.ones(len(first), dtype=bool)
+        if held_vertices is not None:
+            free = (np.bincount(wedge_vertex)[wedge_vertex] == 1) & ~held_vertices[wedge_vertex]
+        return _Wedges(corner, first, free.astype(np.float64)[:, None])
+
+
+def _groups(keys) -> tuple:
+    """np.unique of ``keys``' rows: (rows, first index of each, each row's group)."""
+    rows, first, group = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    return rows, first, group.ravel()
+
+
+def seam_vertices(triangles, corner_values, count: int) -> np.ndarray:
+    """Bool per vertex (``count`` of them): whether its corners carry more than one value."""
+    vertex = np.asarray(triangles, dtype=np.int64).ravel()
+    values = np.asarray(corner_values, dtype=np.float64).reshape(len(vertex), -1)
+    rows, _, _ = _groups(np.column_stack([vertex.astype(np.float64), values]))
+    return np.bincount(rows[:, 0].astype(np.int64), minlength=count) > 1
 
 
 class LookFit:
-    """Matched points between a source mesh and its decimation, built once and used for every
+    """Matched points between a source mesh and its decimation, found once and used for every
     corner attribute the decimation carries (``fit``)."""
 
-    def __init__(self, source_vertices, source_triangles, out_vertices, out_triangles, wedge_keys):
-        """``wedge_keys`` (3 m_out, j): per output corner, values that tell its wedge apart (the
-        carried values of the attributes that split at seams); corners of one output vertex with
-        equal keys are one wedge."""
+    def __init__(self, source_vertices, source_triangles, out_vertices, out_triangles, kept=None):
+        """``kept``: the input vertex each output vertex stands for (DecimateResult.kept), so that
+        a vertex on one of the source's UV seams keeps its UVs even where the output shows one
+        side only; None: the output's own seams only."""
+        self.source_triangles = np.asarray(source_triangles, dtype=np.int64).reshape(-1, 3)
+        self.kept = None if kept is None else np.asarray(kept, dtype=np.int64)
+        self.source_count, self.out_count = len(source_vertices), len(out_vertices)
         sv = np.asarray(source_vertices, dtype=np.float64)
         st = np.asarray(source_triangles, dtype=np.int64).reshape(-1, 3)
         ov = np.asarray(out_vertices, dtype=np.float64)
-        ot = np.asarray(out_triangles, dtype=np.int64).reshape(-1, 3)
-        keys = np.column_stack([ot.reshape(-1, 1).astype(np.float64), np.asarray(wedge_keys, dtype=np.float64)])
-        _, first, self.corner_wedge = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-        self.corner_wedge = self.corner_wedge.ravel()
-        self.first_corner = first  # a corner of each wedge
-        self.count = len(first)
-        out_wedges = self.corner_wedge.reshape(-1, 3)
-        source_surface = engine.Surface(sv, st)
-        out_surface = engine.Surface(ov, ot)
-        self.rows = self._from_source(sv, st, ov, ot, out_wedges, out_surface)
-        there = self._from_output(sv, st, ov, ot, out_wedges, source_surface)
-        self.rows = _Rows(*(np.concatenate([a, b]) for a, b in zip(vars(self.rows).values(), vars(there).values())))
+        self.triangles = np.asarray(out_triangles, dtype=np.int64).reshape(-1, 3)
+        ot = self.triangles
+        there = self._from_source(sv, st, ov, ot, engine.Surface(ov, ot))
+        back = self._from_output(sv, st, ov, ot, engine.Surface(sv, st))
+        self.rows = _Rows(*(np.concatenate([a, b]) for a, b in zip(vars(there).values(), vars(back).values())))
 
     @staticmethod
-    def _from_source(sv, st, ov, ot, out_wedges, out_surface) -> _Rows:
+    def _from_source(sv, st, ov, ot, out_surface) -> _Rows:
         """Three points in each (every k-th) source triangle, matched to the output."""
         step = max(1, -(-3 * len(st) // MAX_POINTS))
         chosen = np.arange(0, len(st), step)
@@ -115,10 +151,10 @@ class LookFit:
         near = np.asarray(raw["triangle"], dtype=np.int64)
         near_weights = _barycentric(np.asarray(raw["point"]), ov[ot[near]])
         area = _areas(sv, st)[triangle]
-        return _Rows(out_wedges[near], near_weights, triangle, weights, area / max(area.sum(), 1e-300))
+        return _Rows(near, near_weights, triangle, weights, area / max(area.sum(), 1e-300))
 
     @staticmethod
-    def _from_output(sv, st, ov, ot, out_wedges, source_surface) -> _Rows:
+    def _from_output(sv, st, ov, ot, source_surface) -> _Rows:
         """Points on a grid in each output triangle, matched to the source."""
         s = int(np.clip(np.sqrt(MAX_POINTS / max(len(ot), 1)), 1, MAX_SUBDIVISION))
         bary = _grid_barycentrics(s)
@@ -129,99 +165,101 @@ class LookFit:
         near = np.asarray(raw["triangle"], dtype=np.int64)
         near_weights = _barycentric(np.asarray(raw["point"]), sv[st[near]])
         area = _areas(ov, ot)[triangle]
-        return _Rows(out_wedges[triangle], weights, near, near_weights, area / max(area.sum(), 1e-300))
+        return _Rows(triangle, weights, near, near_weights, area / max(area.sum(), 1e-300))
 
-    def fit(self, source_values, carried, unit: bool = False, limits=None) -> np.ndarray:
+    def fit(self, source_values, carried, kind: str) -> np.ndarray:
         """Fitted values per output corner (3 m_out, k) for per-source-corner ``source_values``
-        (m, 3, k) whose carried values are ``carried`` (3 m_out, k). ``unit``: normals (target
-        values renormalised, results made unit); ``limits``: (low, high) to clamp into."""
+        (m, 3, k) whose carried values are ``carried`` (3 m_out, k); the wedges are where the
+        carried values split. ``kind``: "uv", "color" or "normal" (unit vectors: target values
+        renormalised, results made unit); UVs and colours are clamped into the source's range
+        per channel (a colour stays a colour, a UV within its map's extent)."""
         rows = self.rows
         source_values = np.asarray(source_values, dtype=np.float64)
-        carried = np.asarray(carried, dtype=np.float64).reshape(len(self.corner_wedge), -1)
+        carried = np.asarray(carried, dtype=np.float64).reshape(3 * len(self.triangles), -1)
+        unit = kind == "normal"
+        held = None
+        if kind == "uv":
+            held = np.zeros(self.out_count, dtype=bool)
+            if self.kept is not None:
+                held = seam_vertices(self.source_triangles, source_values, self.source_count)[self.kept]
+        wedges = _Wedges.of(self.triangles, carried, held)
+        row_wedges = wedges.corner.reshape(-1, 3)[rows.triangle]
         target = np.einsum("rj,rjk->rk", rows.source_weights, source_values[rows.source])
         if unit:
             target /= np.maximum(np.linalg.norm(target, axis=1, keepdims=True), 1e-300)
-        start = carried[self.first_corner]
-        row_weight = self.rows.row_weight
-        x = self._solve(target, start, row_weight)
+        start = carried[wedges.first]
+        x = _solve(row_wedges, rows.weights, rows.row_weight, target, start, start, wedges.free)
         for _ in range(ROBUST_ROUNDS):
             # rows matched across a seam (another UV island) or a fold pull far: weigh them down
-            miss = np.linalg.norm(np.einsum("rj,rjk->rk", rows.weights, x[rows.wedges]) - target, axis=1)
+            miss = np.linalg.norm(np.einsum("rj,rjk->rk", rows.weights, x[row_wedges]) - target, axis=1)
             order = np.argsort(miss)
-            median = miss[order][np.searchsorted(np.cumsum(row_weight[order]), 0.5 * row_weight.sum())
-                                 .clip(0, len(order) - 1)]
-            scale = ROBUST_SCALE * max(median, 1e-12)
-            x = self._solve(target, x, row_weight / (1 + (miss / scale) ** 2), start)
-        out = x[self.corner_wedge]
+            half = np.searchsorted(np.cumsum(rows.row_weight[order]), 0.5 * rows.row_weight.sum())
+            scale = ROBUST_SCALE * max(miss[order][min(half, len(order) - 1)], 1e-12)
+            x = _solve(row_wedges, rows.weights, rows.row_weight / (1 + (miss / scale) ** 2), target, x, start,
+                       wedges.free)
+        out = x[wedges.corner]
         if unit:
             length = np.linalg.norm(out, axis=1, keepdims=True)
             out = np.where(length > 0, out / np.where(length > 0, length, 1.0), carried)
-        if limits is not None:
-            out = np.clip(out, *limits)
+        else:
+            flat = source_values.reshape(-1, source_values.shape[-1])
+            out = np.clip(out, flat.min(axis=0), flat.max(axis=0))
         return out
 
-    def _solve(self, target, guess, w, start=None) -> np.ndarray:
-        """Least squares over the rows plus the pull to ``start``, by Jacobi-preconditioned
-        conjugate gradients (one per channel, run side by side)."""
-        rows, n = self.rows, self.count
-        start = guess if start is None else start
-        flat_wedges = rows.wedges.ravel()
 
-        def apply_rows(x):      # B x: each row's interpolated value
-            return np.einsum("rj,rjk->rk", rows.weights, x[rows.wedges])
+def _solve(wedges, weights, w, target, guess, start, free) -> np.ndarray:
+    """The wedge values minimising sum_r w_r |sum_j weights_rj x[wedges_rj] - target_r|^2 plus
+    the pull to ``start``, the ``free`` ones only (the others stay at ``guess``), by
+    Jacobi-preconditioned conjugate gradients from ``guess`` (one per channel, side by side)."""
+    n = len(start)
+    flat = wedges.ravel()
 
-        def apply_transpose(y):  # B^T (w y)
-            weighted = (rows.weights * w[:, None])[:, :, None] * y[:, None, :]
-            return np.stack([np.bincount(flat_wedges, weights=weighted[:, :, c].ravel(), minlength=n)
-                             for c in range(y.shape[1])], axis=1)
+    def normal(x):  # (B^T W B + pull) x
+        y = np.einsum("rj,rjk->rk", weights, x[wedges])
+        weighted = (weights * w[:, None])[:, :, None] * y[:, None, :]
+        return np.stack([np.bincount(flat, weights=weighted[:, :, c].ravel(), minlength=n)
+                         for c in range(y.shape[1])], axis=1) + pull * x
 
-        diagonal = np.bincount(flat_wedges, weights=(rows.weights ** 2 * w[:, None]).ravel(), minlength=n)
-        pull = PULL * max(diagonal.mean(), 1e-300)
-        diagonal = diagonal + pull
-
-        def normal(x):
-            return apply_transpose(apply_rows(x)) + pull * x
-
-        rhs = apply_transpose(target) + pull * start
-        x = guess.copy()
-        r = rhs - normal(x)
-        z = r / diagonal[:, None]
-        p = z.copy()
-        rz = (r * z).sum(axis=0)
-        bound = TOLERANCE * np.maximum((rhs * rhs).sum(axis=0), 1e-300)
-        for _ in range(MAX_ITERATIONS):
-            if np.all((r * r).sum(axis=0) <= bound):
-                break
-            q = normal(p)
-            alpha = rz / np.where((p * q).sum(axis=0) > 0, (p * q).sum(axis=0), 1.0)
-            x += alpha * p
-            r -= alpha * q
-            z = r / diagonal[:, None]
-            rz_next = (r * z).sum(axis=0)
-            p = z + (rz_next / np.where(rz > 0, rz, 1.0)) * p
-            rz = rz_next
-        return x
+    diagonal = np.bincount(flat, weights=(weights ** 2 * w[:, None]).ravel(), minlength=n)
+    pull = (PULL * diagonal + 1e-9 * max(diagonal.mean(), 1e-300))[:, None]  # each wedge's own scale
+    diagonal = diagonal[:, None] + pull
+    weighted = (weights * w[:, None])[:, :, None] * target[:, None, :]
+    rhs = np.stack([np.bincount(flat, weights=weighted[:, :, c].ravel(), minlength=n)
+                    for c in range(target.shape[1])], axis=1) + pull * start
+    x = guess.copy()
+    r = (rhs - normal(x)) * free
+    z = r / diagonal
+    p = z.copy()
+    rz = (r * z).sum(axis=0)
+    bound = TOLERANCE * np.maximum((rhs * rhs).sum(axis=0), 1e-300)
+    for _ in range(MAX_ITERATIONS):
+        if np.all((r * r).sum(axis=0) <= bound):
+            break
+        q = normal(p) * free
+        pq = (p * q).sum(axis=0)
+        alpha = rz / np.where(pq > 0, pq, 1.0)
+        x += alpha * p
+        r -= alpha * q
+        z = r / diagonal
+        rz_next = (r * z).sum(axis=0)
+        p = z + (rz_next / np.where(rz > 0, rz, 1.0)) * p
+        rz = rz_next
+    return x
 
 
-def fit_look(source_vertices, source_triangles, out_vertices, out_triangles, layers: dict) -> dict:
+def fit_look(source_vertices, source_triangles, out_vertices, out_triangles, layers: dict, kept=None) -> dict:
     """``layers`` {name: (source values per input triangle corner (m, 3, k), carried values per
-    output corner (3 m_out, k), unit)} fitted together (one LookFit: the wedges split where any
-    layer's carried values do): {name: fitted values per output corner}. ``unit`` layers are
-    normals; the others are clamped into their source's range per channel (a colour stays a
-    colour, a UV within its map's extent)."""
+    output corner (3 m_out, k), kind)} fitted on one set of matched points (LookFit), each on its
+    own wedges (LookFit.fit): {name: fitted values per output corner}. ``kept``: as LookFit's."""
     out_triangles = np.asarray(out_triangles, dtype=np.int64).reshape(-1, 3)
     carried = {name: np.asarray(c, dtype=np.float64).reshape(3 * len(out_triangles), -1)
                for name, (_, c, _) in layers.items()}
     if not layers or len(out_triangles) == 0:
         return carried
-    keys = np.concatenate(list(carried.values()), axis=1)
-    fit = LookFit(source_vertices, source_triangles, out_vertices, out_triangles, keys)
+    fit = LookFit(source_vertices, source_triangles, out_vertices, out_triangles, kept)
     fitted = {}
-    for name, (source, _, unit) in layers.items():
-        source = np.asarray(source, dtype=np.float64)
-        k = source.shape[-1]
-        limits = None if unit else (source.reshape(-1, k).min(axis=0), source.reshape(-1, k).max(axis=0))
-        fitted[name] = fit.fit(source, carried[name], unit=unit, limits=limits)
+    for name, (source, _, kind) in layers.items():
+        fitted[name] = fit.fit(source, carried[name], kind)
     return fitted
 
 
