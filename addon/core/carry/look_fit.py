@@ -96,7 +96,7 @@ class _Wedges:
         (bool per output vertex, or None for none): those and every vertex with several wedges
         keep their carried values."""
         vertex = out_triangles.ravel()
-        _, first, corner = _groups(np.column_stack([vertex.astype(np.float64), carried]))
+        first, corner = _groups(np.column_stack([vertex.astype(np.float64), carried]))
         wedge_vertex = vertex[first]
         free = np.ones(len(first), dtype=bool)
         if held_vertices is not None:
@@ -105,17 +105,25 @@ class _Wedges:
 
 
 def _groups(keys) -> tuple:
-    """np.unique of ``keys``' rows: (rows, first index of each, each row's group)."""
-    rows, first, group = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    return rows, first, group.ravel()
+    """The distinct rows of ``keys`` in lexicographic order: (the first index of each, each
+    row's group); as np.unique(axis=0), in half its time (one stable lexsort)."""
+    order = np.lexsort(keys.T[::-1])
+    ordered = keys[order]
+    new = np.ones(len(keys), dtype=bool)
+    new[1:] = (ordered[1:] != ordered[:-1]).any(axis=1)
+    group = np.empty(len(keys), dtype=np.int64)
+    group[order] = np.cumsum(new) - 1
+    return order[new], group
 
 
 def seam_vertices(triangles, corner_values, count: int) -> np.ndarray:
     """Bool per vertex (``count`` of them): whether its corners carry more than one value."""
     vertex = np.asarray(triangles, dtype=np.int64).ravel()
     values = np.asarray(corner_values, dtype=np.float64).reshape(len(vertex), -1)
-    rows, _, _ = _groups(np.column_stack([vertex.astype(np.float64), values]))
-    return np.bincount(rows[:, 0].astype(np.int64), minlength=count) > 1
+    one = np.zeros((count, values.shape[1]))
+    one[vertex] = values  # one corner's value per vertex (whichever was written last)
+    differs = (values != one[vertex]).any(axis=1)
+    return np.bincount(vertex[differs], minlength=count) > 0
 
 
 class LookFit:
@@ -150,21 +158,22 @@ class LookFit:
         raw = engine.closest_points(out_surface, points)
         near = np.asarray(raw["triangle"], dtype=np.int64)
         near_weights = _barycentric(np.asarray(raw["point"]), ov[ot[near]])
-        area = _areas(sv, st)[triangle]
+        area = np.repeat(_areas(sv, st[chosen]), 3)
         return _Rows(near, near_weights, triangle, weights, area / max(area.sum(), 1e-300))
 
     @staticmethod
     def _from_output(sv, st, ov, ot, source_surface) -> _Rows:
-        """Points on a grid in each output triangle, matched to the source."""
+        """Points on a grid in each (every k-th) output triangle, matched to the source."""
         s = int(np.clip(np.sqrt(MAX_POINTS / max(len(ot), 1)), 1, MAX_SUBDIVISION))
         bary = _grid_barycentrics(s)
-        triangle = np.repeat(np.arange(len(ot)), len(bary))
-        weights = np.tile(bary, (len(ot), 1))
+        chosen = np.arange(0, len(ot), max(1, -(-len(ot) // MAX_POINTS)))
+        triangle = np.repeat(chosen, len(bary))
+        weights = np.tile(bary, (len(chosen), 1))
         points = np.einsum("kj,kjd->kd", weights, ov[ot[triangle]])
         raw = engine.closest_points(source_surface, points)
         near = np.asarray(raw["triangle"], dtype=np.int64)
         near_weights = _barycentric(np.asarray(raw["point"]), sv[st[near]])
-        area = _areas(ov, ot)[triangle]
+        area = np.repeat(_areas(ov, ot[chosen]), len(bary))
         return _Rows(triangle, weights, near, near_weights, area / max(area.sum(), 1e-300))
 
     def fit(self, source_values, carried, kind: str) -> np.ndarray:
