@@ -197,15 +197,15 @@ class LookFit:
         if unit:
             target /= np.maximum(np.linalg.norm(target, axis=1, keepdims=True), 1e-300)
         start = carried[wedges.first]
-        x = _solve(row_wedges, rows.weights, rows.row_weight, target, start, start, wedges.free)
+        system = _System(row_wedges, rows.weights, len(start))
+        x = system.solve(rows.row_weight, target, start, start, wedges.free)
         for _ in range(ROBUST_ROUNDS):
             # rows matched across a seam (another UV island) or a fold pull far: weigh them down
             miss = np.linalg.norm(np.einsum("rj,rjk->rk", rows.weights, x[row_wedges]) - target, axis=1)
             order = np.argsort(miss)
             half = np.searchsorted(np.cumsum(rows.row_weight[order]), 0.5 * rows.row_weight.sum())
             scale = ROBUST_SCALE * max(miss[order][min(half, len(order) - 1)], 1e-12)
-            x = _solve(row_wedges, rows.weights, rows.row_weight / (1 + (miss / scale) ** 2), target, x, start,
-                       wedges.free)
+            x = system.solve(rows.row_weight / (1 + (miss / scale) ** 2), target, x, start, wedges.free)
         out = x[wedges.corner]
         if unit:
             length = np.linalg.norm(out, axis=1, keepdims=True)
@@ -216,44 +216,57 @@ class LookFit:
         return out
 
 
-def _solve(wedges, weights, w, target, guess, start, free) -> np.ndarray:
-    """The wedge values minimising sum_r w_r |sum_j weights_rj x[wedges_rj] - target_r|^2 plus
-    the pull to ``start``, the ``free`` ones only (the others stay at ``guess``), by
-    Jacobi-preconditioned conjugate gradients from ``guess`` (one per channel, side by side)."""
-    n = len(start)
-    flat = wedges.ravel()
+class _System:
+    """The normal equations of the least squares over the rows' wedges, sparse: the pattern of
+    wedge pairs found once per layer, the values for each set of row weights (``solve``)."""
 
-    def normal(x):  # (B^T W B + pull) x
-        y = np.einsum("rj,rjk->rk", weights, x[wedges])
-        weighted = (weights * w[:, None])[:, :, None] * y[:, None, :]
-        return np.stack([np.bincount(flat, weights=weighted[:, :, c].ravel(), minlength=n)
-                         for c in range(y.shape[1])], axis=1) + pull * x
+    def __init__(self, wedges, weights, n: int):
+        self.wedges, self.weights, self.n = wedges, weights, n
+        pairs, entry = np.unique((np.repeat(wedges, 3, axis=1) * n + np.tile(wedges, 3)).ravel(), return_inverse=True)
+        self.entry, self.i, self.j = entry.ravel(), pairs // n, pairs % n
+        self.products = np.repeat(weights, 3, axis=1) * np.tile(weights, 3)  # (r, 9)
 
-    diagonal = np.bincount(flat, weights=(weights ** 2 * w[:, None]).ravel(), minlength=n)
-    pull = (PULL * diagonal + 1e-9 * max(diagonal.mean(), 1e-300))[:, None]  # each wedge's own scale
-    diagonal = diagonal[:, None] + pull
-    weighted = (weights * w[:, None])[:, :, None] * target[:, None, :]
-    rhs = np.stack([np.bincount(flat, weights=weighted[:, :, c].ravel(), minlength=n)
-                    for c in range(target.shape[1])], axis=1) + pull * start
-    x = guess.copy()
-    r = (rhs - normal(x)) * free
-    z = r / diagonal
-    p = z.copy()
-    rz = (r * z).sum(axis=0)
-    bound = TOLERANCE * np.maximum((rhs * rhs).sum(axis=0), 1e-300)
-    for _ in range(MAX_ITERATIONS):
-        if np.all((r * r).sum(axis=0) <= bound):
-            break
-        q = normal(p) * free
-        pq = (p * q).sum(axis=0)
-        alpha = rz / np.where(pq > 0, pq, 1.0)
-        x += alpha * p
-        r -= alpha * q
+    def _gather(self, values) -> np.ndarray:
+        """Per wedge, the sum of ``values`` (r, 3, k) over the rows' corners."""
+        flat = self.wedges.ravel()
+        return np.stack([np.bincount(flat, weights=values[:, :, c].ravel(), minlength=self.n)
+                         for c in range(values.shape[2])], axis=1)
+
+    def solve(self, w, target, guess, start, free) -> np.ndarray:
+        """The wedge values minimising sum_r w_r |sum_j weights_rj x[wedges_rj] - target_r|^2
+        plus the pull to ``start``, the ``free`` ones only (the others stay at ``guess``), by
+        Jacobi-preconditioned conjugate gradients from ``guess`` (one per channel, side by side)."""
+        n = self.n
+        values = np.bincount(self.entry, weights=(self.products * w[:, None]).ravel(), minlength=len(self.i))
+        on_diagonal = self.i == self.j
+        diagonal = np.bincount(self.i[on_diagonal], weights=values[on_diagonal], minlength=n)
+        pull = (PULL * diagonal + 1e-9 * max(diagonal.mean(), 1e-300))[:, None]  # each wedge's own scale
+        diagonal = diagonal[:, None] + pull
+
+        def normal(x):  # (B^T W B + pull) x
+            return np.stack([np.bincount(self.i, weights=values * x[self.j, c], minlength=n)
+                             for c in range(x.shape[1])], axis=1) + pull * x
+
+        rhs = self._gather((self.weights * w[:, None])[:, :, None] * target[:, None, :]) + pull * start
+        x = guess.copy()
+        r = (rhs - normal(x)) * free
         z = r / diagonal
-        rz_next = (r * z).sum(axis=0)
-        p = z + (rz_next / np.where(rz > 0, rz, 1.0)) * p
-        rz = rz_next
-    return x
+        p = z.copy()
+        rz = (r * z).sum(axis=0)
+        bound = TOLERANCE * np.maximum((rhs * rhs).sum(axis=0), 1e-300)
+        for _ in range(MAX_ITERATIONS):
+            if np.all((r * r).sum(axis=0) <= bound):
+                break
+            q = normal(p) * free
+            pq = (p * q).sum(axis=0)
+            alpha = rz / np.where(pq > 0, pq, 1.0)
+            x += alpha * p
+            r -= alpha * q
+            z = r / diagonal
+            rz_next = (r * z).sum(axis=0)
+            p = z + (rz_next / np.where(rz > 0, rz, 1.0)) * p
+            rz = rz_next
+        return x
 
 
 def fit_look(source_vertices, source_triangles, out_vertices, out_triangles, layers: dict, kept=None) -> dict:
