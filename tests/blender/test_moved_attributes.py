@@ -61,6 +61,7 @@ def sphere_with_everything():
     corner_vertex = np.empty(len(mesh.loops), dtype=np.int32)
     mesh.loops.foreach_get("vertex_index", corner_vertex)
     speckle.data.foreach_set("color", per_vertex[corner_vertex].astype(np.float32).ravel())
+    mesh.color_attributes.active_color = mesh.color_attributes["paint"]  # the look's colour
     # a spherical UV map, cut open along one meridian (a real seam: two UVs at its vertices)
     uv = mesh.uv_layers.new(name="UVMap")
     co = vertices[corner_vertex]
