@@ -119,3 +119,22 @@ def test_normals_fit_the_shading_better_and_stay_unit():
     corner_vertex = out_t.ravel()
     spread = [np.ptp(fitted[corner_vertex == v] @ np.array([0, 0, 1.0])) for v in rim[:5]]
     assert min(spread) > 0.5, spread
+
+
+def test_a_mesh_file_is_written_with_its_look_fitted_only_where_the_look_was_in_the_cost(tmp_path):
+    """The mesh-file recipe (topstoc decimate, the batch) writes the fitted UVs when the look was
+    in the cost and the carried ones when it was not (weight 0)."""
+    from topstoc.core.api.io import read_mesh
+    from topstoc.core.api.mesh_file_job import prepare_file
+
+    vertices, triangles, uvs = uv_cylinder()
+    data = MeshData(vertices=vertices, triangles=triangles, corner_uvs=uvs)
+    for weight, fit in ((ATTRIBUTE_WEIGHT, True), (0.0, False)):
+        job = prepare_file(str(tmp_path / "in.obj"), data, weight=weight)
+        result = job.decimate({"target_vertices": 150}, {})
+        job.write(result, str(tmp_path / "out.obj"))
+        written = read_mesh(tmp_path / "out.obj").corner_uvs
+        expected = transfer_attributes(data, result, fit=fit).corner_uvs
+        other = transfer_attributes(data, result, fit=not fit).corner_uvs
+        np.testing.assert_allclose(written, expected, atol=1e-6)
+        assert np.abs(written - other).max() > 1e-3
