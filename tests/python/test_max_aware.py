@@ -111,3 +111,35 @@ def test_the_max_error_against_meshopt_on_the_worst_cases(tmp_path, name, ratio,
     ours = hausdorff((v, t), r, samples=100_000, relative=True).symmetric
     peer_max = hausdorff((v, t), theirs, samples=100_000, relative=True, max_tolerance=0).symmetric.max
     assert ours.max_upper < bound * peer_max, (name, ours.max_upper / peer_max)
+
+
+# Worst max cases of the broad benchmark whose reruns had found a far smaller max that the choice
+# refused (refine.cpp, Refinement::wins): the mushroom's rerun paid 7.5 % of mean for 21 % of max
+# (the mean bound was 5 %); polygon_mesh and couplingdown gained with the third rerun (weight 30
+# between two at 100) and the rule that a max gain must outweigh the mean's loss. The peer is Blender's Decimate
+# (Collapse, keeping the topology) at our triangle count, from bench_quality.py's run in
+# docs/bench_results/bench_quality_broad_fit_middle_after.json (100k samples, % of the diagonal);
+# ours is measured the same way. (mesh, ratio, bound on our max / Blender's, on our mean / Blender's.)
+# Before: mushroom 1.20 (max), polygon_mesh 1.13, couplingdown 1.11; now 0.98, 0.82, 1.03.
+BROAD_42 = pathlib.Path(__file__).resolve().parents[2] / "docs/bench_results/bench_quality_broad_fit_middle_after.json"
+REFUSED = [("open_boundary/cgal_mushroom.off", 0.1, 1.05, 0.85),
+           ("nonmanifold_degenerate/cgal_polygon_mesh.off", 0.1, 0.95, 0.9),
+           ("genus_positive/cgal_couplingdown.off", 0.1, 1.06, 0.7)]
+
+
+@pytest.mark.parametrize("name, ratio, max_bound, mean_bound", REFUSED, ids=[r[0] for r in REFUSED])
+def test_the_choice_takes_the_rerun_that_lowers_the_max(name, ratio, max_bound, mean_bound):
+    import json
+    case = next(c for c in json.loads(BROAD_42.read_text())["cases"]
+                if c["mesh"] == pathlib.Path(name).name and c["ratio"] == ratio)
+    blender = case["tools"]["Blender Collapse"]
+    assert blender["topology"]
+    source = read_mesh(str(DATA / name))
+    v, t = source.vertices, source.triangles
+    mesh = Mesh(v, t)
+    r = mesh.decimate(target_triangles=case["target"], seed=0)
+    assert abs(r.num_triangles - blender["triangles"]) <= 2
+    check_output(mesh, r, reference.invariants(len(v), t))
+    error = hausdorff((v, t), r, samples=100_000, relative=True, percentile=0).symmetric
+    assert 100 * error.max <= max_bound * blender["max"], 100 * error.max / blender["max"]
+    assert 100 * error.mean <= mean_bound * blender["mean"], 100 * error.mean / blender["mean"]
