@@ -69,3 +69,35 @@ def test_a_result_on_its_original_up_to_rounding_settles_at_the_resolution():
     assert entry["hausdorff"] <= truth.max_upper * (1 + 1e-12) and entry["hausdorff_upper"] >= truth.max
     assert entry["hausdorff_converged"] is True
     assert entry["hausdorff_upper"] <= 1e-7 * diagonal * (1 + 1e-9)  # error_estimate.RESOLUTION
+
+
+def _grid(n, half_width, height):
+    """An n x n grid of cells over [-half_width, half_width] x [-1, 1], two triangles each, at
+    z = height(x)."""
+    x, y = np.meshgrid(np.linspace(-half_width, half_width, n + 1), np.linspace(-1.0, 1.0, n + 1))
+    vertices = np.column_stack([x.ravel(), y.ravel(), height(x.ravel())])
+    a = (np.arange(n)[None, :] + (n + 1) * np.arange(n)[:, None]).ravel()
+    triangles = np.concatenate([np.column_stack([a, a + 1, a + n + 2]), np.column_stack([a, a + n + 2, a + n + 1])])
+    return vertices, triangles
+
+
+@pytest.mark.parametrize("slope", [1.0, 2.0])
+def test_pieces_across_a_valley_settle_on_their_quarters_and_bracket_the_max(slope):
+    # A flat sheet at height h = slope over a valley z = slope |x| (one triangle strip each side
+    # of the crease x = 0), the sheet over |x| <= 1 where it stays above the valley: from the sheet
+    # the distance is (h - slope |x|) / sqrt(1 + slope^2), largest over the crease, which no
+    # vertex of the sheet's 7 x 7 cells lies on (the nearest are 1/7 away). The sheet's triangles
+    # across the crease are left open by one triangle of the valley for the whole piece (their far
+    # corner's distance to it exceeds 1.25 times the vertices' largest) and by the bound beneath
+    # (heights are sqrt(1 + slope^2) times the distance): the old search needed a query between
+    # the vertices (65). The bound over their quarters, each with its own side, settles them
+    # without one. One that skipped the midpoints over the crease would come out under the exact max.
+    from topstoc.core.support.native import engine
+    h = slope
+    sheet = as_surface(_grid(7, 1.0, lambda x: np.full_like(x, h)), "sheet")
+    valley = as_surface(_grid(2, 1.5, lambda x: slope * np.abs(x)), "valley")
+    found = engine.bracket_symmetric_max(sheet, valley, tolerance=0.25, resolution=1e-7, max_queries=1_000_000)
+    forward, exact = found["forward"], h / np.sqrt(1 + slope * slope)
+    assert forward["lower"] <= exact * (1 + 1e-12) <= forward["upper"] * (1 + 2e-12)
+    assert forward["upper"] <= 1.25 * forward["lower"] * (1 + 1e-12) and forward["converged"]
+    assert forward["queries"] == 8 * 8  # the sheet's vertices only

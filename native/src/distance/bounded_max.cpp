@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <queue>
 
 #include "distance/projected_bound.hpp"
@@ -27,6 +28,9 @@ constexpr double kCandidatesPerPiece = 1.0;
 // A leaf's triangle spanning at most this many triangles of the other surface is first tried
 // with the bound beneath it alone (its corners measured only when that does not settle it).
 constexpr double kSettleSpan = 2.5;
+// A piece's quarters: of its corners 0, 1, 2 and its edges' midpoints 3 = (0,1), 4 = (1,2), 5 = (2,0).
+constexpr int kQuarters[4][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {3, 4, 5}};
+constexpr double kNoBound = std::numeric_limits<double>::infinity();
 
 struct Piece {
   double p[3][3];     // corners
@@ -67,11 +71,12 @@ namespace {
 class MaxSearch {
  public:
   MaxSearch(const Surface& from, const std::vector<double>& vertex_distance, const Surface& to, double start,
-            const double* start_point, double relative_tolerance, int64_t max_queries, double resolution = 1e-13)
+            const double* start_point, double relative_tolerance, int64_t max_queries, double resolution = 1e-13,
+            bool by_quarters = false)
       : from(from), vertex_distance(vertex_distance), to(to), to_positions(to.positions()), to_triangles(to.triangles()),
         bvh(to.bvh()), relative_tolerance(relative_tolerance), max_queries(max_queries),
         floor(resolution * std::max(from.diagonal(), to.diagonal())),
-        to_mean_area(to.area() / std::max(1, to.num_triangles())) {
+        to_mean_area(to.area() / std::max(1, to.num_triangles())), by_quarters(by_quarters) {
     out.lower = start;
     std::copy_n(start_point, 3, out.lower_point);
   }
@@ -159,6 +164,9 @@ class MaxSearch {
   // surfaces (max 0) do not subdivide forever
   const double floor;
   const double to_mean_area;  // the mean triangle area of the other surface
+  // pieces left open by their corner bounds try the bound over their quarters (quarter_bound)
+  // before the bound beneath them (the vertex-first search only, whose brackets no decimation reads)
+  const bool by_quarters;
   MaxBracket out;
   BeneathScratch scratch;
   std::priority_queue<Piece, std::vector<Piece>, ByUpper> open;
@@ -192,16 +200,58 @@ class MaxSearch {
   // other surface is convex, so over the piece it peaks at a corner): the smaller one holds.
   void bound(Piece& piece) const {
     double upper = std::max({piece.d[0], piece.d[1], piece.d[2]}) + nearest_corner_reach(piece.p);
-    for (int32_t j : piece.near) {
-      if (j < 0) continue;
-      const double* a = &to_positions[3 * size_t(to_triangles[3 * size_t(j)])];
-      const double* b = &to_positions[3 * size_t(to_triangles[3 * size_t(j) + 1])];
-      const double* c = &to_positions[3 * size_t(to_triangles[3 * size_t(j) + 2])];
-      double farthest = 0.0, closest[3];
-      for (int i = 0; i < 3; ++i) farthest = std::max(farthest, closest_point_on_triangle(piece.p[i], a, b, c, closest));
+    for (int n = 0; n < 4; ++n) {
+      const int32_t j = piece.near[n];
+      if (j < 0 || std::find(piece.near, piece.near + n, j) != piece.near + n) continue;  // tried already
+      double farthest = 0.0;
+      for (int i = 0; i < 3; ++i) farthest = std::max(farthest, corner_distance2(piece, i, j));
       upper = std::min(upper, std::sqrt(farthest));
     }
     piece.upper = upper;
+  }
+
+  // The squared distance from a piece's corner to a triangle of the other surface: known where
+  // that is the corner's nearest (the vertex-first search), else measured.
+  double corner_distance2(const Piece& piece, int corner, int32_t triangle) const {
+    if (by_quarters && piece.near[corner] == triangle) return piece.d[corner] * piece.d[corner];
+    return distance2_to(triangle, piece.p[corner]);
+  }
+
+  double distance2_to(int32_t triangle, const double* x) const {
+    const int32_t* ids = &to_triangles[3 * size_t(triangle)];
+    double closest[3];
+    return closest_point_on_triangle(x, &to_positions[3 * size_t(ids[0])], &to_positions[3 * size_t(ids[1])],
+                                     &to_positions[3 * size_t(ids[2])], closest);
+  }
+
+  // The convex bound on each quarter of a piece (cut at its edges' midpoints) with the best of
+  // the triangles nearest to its corners: where the piece straddles an edge of the other surface,
+  // each side gets the triangle beneath it, not one triangle for the whole piece. +infinity when
+  // a quarter stays above the threshold (the piece is split then).
+  double quarter_bound(const Piece& piece) const {
+    int32_t candidate[4];
+    int count = 0;
+    for (int32_t j : piece.near)
+      if (j >= 0 && std::find(candidate, candidate + count, j) == candidate + count) candidate[count++] = j;
+    if (count < 2) return kNoBound;  // bound() tried the one triangle over the whole piece
+    double point[6][3], value[4][6];  // corners, then midpoints m0 = (0,1), m1 = (1,2), m2 = (2,0)
+    for (int i = 0; i < 3; ++i) {
+      std::copy_n(piece.p[i], 3, point[i]);
+      for (int k = 0; k < 3; ++k) point[3 + i][k] = 0.5 * (piece.p[i][k] + piece.p[(i + 1) % 3][k]);
+    }
+    for (int n = 0; n < count; ++n)
+      for (int i = 0; i < 6; ++i)
+        value[n][i] = i < 3 ? corner_distance2(piece, i, candidate[n]) : distance2_to(candidate[n], point[i]);
+    const double limit = threshold() * threshold();
+    double worst = 0.0;
+    for (const auto& quarter : kQuarters) {
+      double best = kNoBound;
+      for (int n = 0; n < count; ++n)
+        best = std::min(best, std::max({value[n][quarter[0]], value[n][quarter[1]], value[n][quarter[2]]}));
+      if (best > limit) return kNoBound;
+      worst = std::max(worst, best);
+    }
+    return std::sqrt(worst);
   }
 
   void centroid_near(Piece& piece) {
@@ -217,6 +267,7 @@ class MaxSearch {
   // left open) and queues it unless tolerated.
   void keep(Piece& piece) {
     bound(piece);
+    if (by_quarters && !tolerated(piece.upper)) piece.upper = std::min(piece.upper, quarter_bound(piece));
     // only a bound that settles the piece is looked for: the box searched stays small
     if (!tolerated(piece.upper) && worth_projecting(piece))
       piece.upper = std::min(piece.upper, projected_bound(piece.p, to, threshold(), kBeneathCandidates, scratch));
@@ -383,8 +434,7 @@ class MaxSearch {
     const double* corner[6] = {piece.p[0], piece.p[1], piece.p[2], mid[0], mid[1], mid[2]};
     const double value[6] = {piece.d[0], piece.d[1], piece.d[2], dm[0], dm[1], dm[2]};
     const int32_t near[6] = {piece.near[0], piece.near[1], piece.near[2], nm[0], nm[1], nm[2]};
-    static const int kChildren[4][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {3, 4, 5}};
-    for (const auto& child : kChildren) {
+    for (const auto& child : kQuarters) {
       Piece c;
       c.source = piece.source;
       for (int j = 0; j < 3; ++j) {
@@ -411,7 +461,7 @@ MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, doubl
                                    double resolution, int64_t max_queries) {
   static const std::vector<double> no_vertex_distance;  // the vertices' own queries give them
   const double origin[3] = {0.0, 0.0, 0.0};
-  return MaxSearch(from, no_vertex_distance, to, 0.0, origin, relative_tolerance, max_queries, resolution).run();
+  return MaxSearch(from, no_vertex_distance, to, 0.0, origin, relative_tolerance, max_queries, resolution, true).run();
 }
 
 MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,
