@@ -10,8 +10,8 @@ structure over the original's triangles: the original's vertices are grouped by 
 grid, one per cell measured against the result's BVH and the others against the triangle found
 for it (any triangle of the result bounds the distance from above); a triangle of the original
 is bounded by its corners (the distance to one triangle is convex; the distance to a surface is
-1-Lipschitz), and the few whose bound exceeds ``(1 + gap)`` times the largest distance measured
-are bracketed exactly. The result's triangles are split until the distance to the original's
+1-Lipschitz); the corners of those whose bound exceeds ``(1 + gap)`` times the largest distance
+measured are measured exactly, and the few still above it bracketed exactly. The result's triangles are split until the distance to the original's
 triangles around a nearby vertex, plus the piece's reach, is within ``(1 + gap)`` of the largest
 such value; the points with the 16 largest are measured exactly. Where a side's bound is still
 above ``(1 + gap)`` times the estimate (a tiny maximum against long sides: a result nearly on the

@@ -6,8 +6,9 @@
 // of B bounds the distance to B from above). A triangle of A whose corners were all measured
 // against one triangle T of B lies no farther from B than its farthest corner from T (the
 // distance to T is convex); otherwise no farther than its farthest corner bound plus its
-// nearest-corner reach (the distance to B is 1-Lipschitz). Triangles whose bound exceeds
-// (1 + tolerance) times the largest distance measured are bracketed exactly (bounded_max.hpp).
+// nearest-corner reach (the distance to B is 1-Lipschitz). The corners of triangles whose bound
+// exceeds (1 + tolerance) times the largest distance measured are then measured exactly (each
+// once), and the triangles still above it bracketed exactly (bounded_max.hpp).
 // B to A: the distance from a point of B to the triangles around a vertex of A bounds its
 // distance to A from above (the vertex: the grid's nearest for B's vertices, then reached by
 // stepping to nearer neighbours from the one found for a neighbouring point; where that bound
@@ -142,6 +143,52 @@ double triangle_bound(const Surface& a, const Surface& b, const VertexBounds& v,
   return bound;
 }
 
+// Measures exactly the vertices of A flagged in `measure` that are not yet (cell by cell, in fixed
+// blocks that chain their BVH hints: the same results on any team size), raising the lower bound.
+void measure_flagged(const Surface& a, const Surface& b, const VertexGrid& grid, const std::vector<uint8_t>& measure,
+                     VertexBounds& v) {
+  const TriangleBvh& bvh = b.bvh();
+  const auto& positions = a.positions();
+  const int64_t cells = grid.num_cells();
+  const int64_t blocks = (cells + kCellBlock - 1) / kCellBlock;
+  std::vector<double> block_max(size_t(blocks), 0.0);
+  std::vector<int64_t> block_queries(size_t(blocks), 0);
+  parallel_for_dynamic(0, blocks, 4, parallel_if(cells >= 4 * kCellBlock), [&](int64_t block) {
+    int32_t hint = -1;
+    for (int64_t i = grid.cell_start(block * kCellBlock); i < grid.cell_start(std::min(cells, (block + 1) * kCellBlock));
+         ++i) {
+      const int32_t vertex = grid.order()[size_t(i)];
+      if (!measure[size_t(vertex)]) continue;
+      const ClosestHit hit = bvh.closest(&positions[3 * size_t(vertex)], hint);
+      hint = hit.slot;
+      v.upper[size_t(vertex)] = std::sqrt(hit.distance2);
+      v.against[size_t(vertex)] = hit.triangle;
+      block_max[size_t(block)] = std::max(block_max[size_t(block)], v.upper[size_t(vertex)]);
+      ++block_queries[size_t(block)];
+    }
+  });
+  for (int64_t block = 0; block < blocks; ++block) {
+    v.lower = std::max(v.lower, block_max[size_t(block)]);
+    v.queries += block_queries[size_t(block)];
+  }
+}
+
+// Triangles of A that their corners' bounds through the cells' triangles leave open get those
+// corners measured exactly (each once): a corner's own nearest triangle of B usually settles them,
+// where bracketing them (three queries a triangle and more) cost several times as many queries.
+void remeasure_open_corners(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance,
+                            VertexBounds& v) {
+  const double threshold = std::max(v.lower * (1.0 + tolerance), kFloor * std::max(a.diagonal(), b.diagonal()));
+  std::vector<uint8_t> open(size_t(a.num_triangles()), 0), measure(size_t(a.num_vertices()), 0);
+  parallel_for(0, a.num_triangles(), kParallelMinCostly, [&](int64_t f) {
+    open[size_t(f)] = triangle_bound(a, b, v, int32_t(f), threshold) > threshold;
+  });
+  for (int32_t f = 0; f < a.num_triangles(); ++f)
+    if (open[size_t(f)])
+      for (int j = 0; j < 3; ++j) measure[size_t(a.triangles()[3 * size_t(f) + j])] = 1;
+  measure_flagged(a, b, grid, measure, v);
+}
+
 struct ForwardSums {
   double settled = 0.0;   // largest bound among triangles not refined
   double longest2 = 0.0;  // the longest side's square
@@ -149,7 +196,8 @@ struct ForwardSums {
 
 void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, QuickBound& out,
                    double& reach) {
-  const VertexBounds v = bound_vertices(a, b, grid);
+  VertexBounds v = bound_vertices(a, b, grid);
+  remeasure_open_corners(a, b, grid, tolerance, v);
   const double threshold = std::max(v.lower * (1.0 + tolerance), kFloor * std::max(a.diagonal(), b.diagonal()));
   std::vector<uint8_t> refine(size_t(a.num_triangles()), 0);
   const ForwardSums sums = ordered_reduce<ForwardSums>(
