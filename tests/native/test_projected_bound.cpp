@@ -88,6 +88,38 @@ TEST_CASE("a hole, a triangle turned over or the grid's edge under the piece giv
   CHECK(projected_bound(p, grid(20, zero, 0), 1.0, 1000, scratch) == projected_bound(p, grid(20, zero), 1.0, 1000, scratch));
 }
 
+TEST_CASE("along a crease: a side on the grid's edge and a face folded back over the piece") {
+  // The grid plus a face rising from its edge x = 1 back over it (to x = 0.6 at height 0.3),
+  // facing up: a piece on the grid with a side on that edge lies on the surface (max 0). The
+  // plain bound fails it twice (the edge is a boundary touching the piece, and the folded face
+  // is higher than the limit over it); along_creases leaves the folded face out and allows the
+  // boundary along the piece's side, adding only the margin's reach. A piece reaching past the
+  // edge still gets no bound (its points there are off the surface).
+  const Surface flat = grid(20, [](double, double) { return 0.0; });
+  std::vector<double> positions = flat.positions();
+  std::vector<int32_t> triangles = flat.triangles();
+  const int32_t base = flat.num_vertices();
+  positions.insert(positions.end(), {1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.6, 0.0, 0.3, 0.6, 1.0, 0.3});
+  triangles.insert(triangles.end(), {base, base + 1, base + 2, base + 2, base + 1, base + 3});
+  const Surface folded(std::move(positions), std::move(triangles));
+  BeneathScratch scratch;
+  const double on[3][3] = {{0.8, 0.3, 0.0}, {1.0, 0.35, 0.0}, {1.0, 0.7, 0.0}};
+  CHECK(projected_bound(on, folded, 0.1, 1000, scratch) == kInfinity);
+  CHECK(projected_bound(on, flat, 0.1, 1000, scratch) == kInfinity);
+  for (const Surface* to : {&flat, &folded}) {
+    const double bound = projected_bound(on, *to, 0.1, 1000, scratch, true);
+    CHECK(bound >= 0.0);
+    CHECK(bound <= 1e-8);
+  }
+  const double raised[3][3] = {{0.8, 0.3, 0.02}, {1.0, 0.35, 0.02}, {1.0, 0.7, 0.02}};
+  const double bound = projected_bound(raised, folded, 0.1, 1000, scratch, true);
+  CHECK(bound >= sampled_max(raised, folded) * (1 - 1e-12));
+  CHECK(bound <= 0.02 * (1 + 1e-6));
+  const double past[3][3] = {{0.8, 0.3, 0.0}, {1.01, 0.35, 0.0}, {1.01, 0.7, 0.0}};
+  CHECK(sampled_max(past, folded) > 0.0);
+  CHECK(projected_bound(past, folded, 0.1, 1000, scratch, true) == kInfinity);
+}
+
 TEST_CASE("over a bumpy grid the bound is never under a dense sampling's distances") {
   const Surface bumpy = grid(30, [](double x, double y) { return 0.03 * std::sin(9 * x) * std::cos(7 * y); });
   std::mt19937 random(5);

@@ -270,7 +270,8 @@ class MaxSearch {
     if (by_quarters && !tolerated(piece.upper)) piece.upper = std::min(piece.upper, quarter_bound(piece));
     // only a bound that settles the piece is looked for: the box searched stays small
     if (!tolerated(piece.upper) && worth_projecting(piece))
-      piece.upper = std::min(piece.upper, projected_bound(piece.p, to, threshold(), kBeneathCandidates, scratch));
+      piece.upper =
+          std::min(piece.upper, projected_bound(piece.p, to, threshold(), kBeneathCandidates, scratch, by_quarters));
     if (!tolerated(piece.upper)) {
       centroid_near(piece);
       bound(piece);

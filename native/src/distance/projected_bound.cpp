@@ -5,6 +5,8 @@
 #include <limits>
 #include <vector>
 
+#include "topstoc/distance/bvh.hpp"
+
 namespace topstoc {
 
 namespace {
@@ -31,6 +33,12 @@ struct Frame {
   void project(const double* q, double* out) const {
     const double d[3] = {q[0] - origin[0], q[1] - origin[1], q[2] - origin[2]};
     out[0] = dot(d, u), out[1] = dot(d, v), out[2] = dot(d, n);
+  }
+  // The distance from the point (a, b) of T's plane to the triangle with the given corners.
+  double distance(const double* ab, const double* corners) const {
+    double x[3], closest[3];
+    for (int k = 0; k < 3; ++k) x[k] = origin[k] + ab[0] * u[k] + ab[1] * v[k];
+    return std::sqrt(closest_point_on_triangle(x, corners, corners + 3, corners + 6, closest));
   }
 };
 
@@ -71,7 +79,7 @@ using Side = BeneathScratch::Side;
 }  // namespace
 
 double projected_bound(const double p[3][3], const Surface& to, double limit, int32_t max_candidates,
-                       BeneathScratch& scratch) {
+                       BeneathScratch& scratch, bool along_creases) {
   Frame frame;
   double e1[3], e2[3];
   for (int k = 0; k < 3; ++k) frame.origin[k] = p[0][k], e1[k] = p[1][k] - p[0][k], e2[k] = p[2][k] - p[0][k];
@@ -118,6 +126,14 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
   sides.clear();
   double bound = 0.0;
   bool covered = false;
+  // along_creases: coverage is decided over T shrunk by the margin (a boundary of U along T's
+  // sides does not fail it), so it is tested at T's incentre, and a point of T outside the shrunk
+  // one lies within margin x (farthest corner from the incentre) / inradius of a point inside it.
+  const double la = std::hypot(t[2][0] - l1, t[2][1]), lb = std::hypot(t[2][0], t[2][1]), perimeter = la + lb + l1;
+  const double incentre[2] = {(la * t[0][0] + lb * t[1][0] + l1 * t[2][0]) / perimeter,
+                              (la * t[0][1] + lb * t[1][1] + l1 * t[2][1]) / perimeter};
+  const double inradius = twice_area / perimeter;
+  if (along_creases && !(inradius > 2 * margin)) return kNoBound;
   for (int32_t slot : slots) {
     const double* corners = tree.slot_corners(slot);
     double q[9];
@@ -137,17 +153,30 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
     for (int j = 0; j < 3 && count > 0; ++j)  // T clipped to the triangle's three sides
       count = clip(ring[j % 2], count, q + 3 * j, q + 3 * ((j + 1) % 3), ring[(j + 1) % 2]);
     // Heights of the triangle's plane over the overlap's corners (the clip carried T's zeros).
+    // along_creases: the distance to the triangle there where the height would raise the bound
+    // (never more than the height; convex over the overlap, so it peaks at one of its corners).
+    double own = 0.0;
     for (int m = 0; m < count; ++m) {
       const double* x = ring[1][m];
       const double w1 = turn(q, x, q + 6) / area, w2 = turn(q, q + 3, x) / area, w0 = 1.0 - w1 - w2;
-      bound = std::max(bound, std::abs(w0 * q[2] + w1 * q[5] + w2 * q[8]));
-      covered = true;
+      const double height = std::abs(w0 * q[2] + w1 * q[5] + w2 * q[8]);
+      own = std::max(own, along_creases && height > std::max(own, bound) ? frame.distance(x, corners) : height);
     }
-    if (bound > limit) return kNoBound;
+    // along_creases: a triangle beyond the limit is left out of U (any part of the chain bounds
+    // what it covers; the sides it leaves unmatched fail the test below where they cross T)
+    if (own > limit) {
+      if (along_creases) continue;
+      return kNoBound;
+    }
+    bound = std::max(bound, own);
+    if (count > 0 && (!along_creases || (turn(q, q + 3, incentre) >= 0 && turn(q + 3, q + 6, incentre) >= 0 &&
+                                         turn(q + 6, q, incentre) >= 0)))
+      covered = true;
     const int32_t* ids = &to.triangles()[3 * size_t(tree.slot_triangle(slot))];
     for (int j = 0; j < 3; ++j) {
       const int32_t a = ids[j], b = ids[(j + 1) % 3];
-      if (meets(q + 3 * j, q + 3 * ((j + 1) % 3), t, margin)) sides.push_back(a < b ? Side{a, b, 1} : Side{b, a, -1});
+      if (meets(q + 3 * j, q + 3 * ((j + 1) % 3), t, along_creases ? -margin : margin))
+        sides.push_back(a < b ? Side{a, b, 1} : Side{b, a, -1});
     }
   }
   if (!covered) return kNoBound;
@@ -159,6 +188,12 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
     for (; j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b; ++j) net += sides[j].sign;
     if (net != 0) return kNoBound;
     i = j;
+  }
+  if (along_creases) {
+    double farthest = 0.0;
+    for (int j = 0; j < 3; ++j) farthest = std::max(farthest, std::hypot(t[j][0] - incentre[0], t[j][1] - incentre[1]));
+    bound += margin * farthest / inradius;
+    if (bound > limit) return kNoBound;
   }
   return bound;
 }

@@ -27,8 +27,12 @@ struct BeneathScratch {
 
 /// An upper bound on max over triangle p of dist(x, to), or +infinity when B does not lie under
 /// the whole triangle within `limit` (or more than `max_candidates` of its triangles would be
-/// looked at).
+/// looked at). along_creases: a tighter test that settles more pieces lying along a crease of B
+/// (a piece on one face with a side on the crease, the other face folded over it): triangles of
+/// B beyond the limit are left out rather than failing the bound, a boundary of U within a
+/// tiny margin of T's sides is allowed (the margin's reach added to the bound), and the distance
+/// to a triangle replaces its plane's height along T's normal.
 double projected_bound(const double p[3][3], const Surface& to, double limit, int32_t max_candidates,
-                       BeneathScratch& scratch);
+                       BeneathScratch& scratch, bool along_creases = false);
 
 }  // namespace topstoc
