@@ -143,8 +143,8 @@ double triangle_bound(const Surface& a, const Surface& b, const VertexBounds& v,
   return bound;
 }
 
-// Measures exactly the vertices of A flagged in `measure` that are not yet (cell by cell, in fixed
-// blocks that chain their BVH hints: the same results on any team size), raising the lower bound.
+// Measures exactly the vertices of A flagged in `measure` (cell by cell, in fixed blocks that chain
+// their BVH hints: the same results on any team size), raising the lower bound.
 void measure_flagged(const Surface& a, const Surface& b, const VertexGrid& grid, const std::vector<uint8_t>& measure,
                      VertexBounds& v) {
   const TriangleBvh& bvh = b.bvh();
