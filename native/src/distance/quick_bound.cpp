@@ -173,20 +173,27 @@ void measure_flagged(const Surface& a, const Surface& b, const VertexGrid& grid,
   }
 }
 
-// Triangles of A that their corners' bounds through the cells' triangles leave open get those
-// corners measured exactly (each once): a corner's own nearest triangle of B usually settles them,
-// where bracketing them (three queries a triangle and more) cost several times as many queries.
-void remeasure_open_corners(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance,
-                            VertexBounds& v) {
-  const double threshold = std::max(v.lower * (1.0 + tolerance), kFloor * std::max(a.diagonal(), b.diagonal()));
-  std::vector<uint8_t> open(size_t(a.num_triangles()), 0), measure(size_t(a.num_vertices()), 0);
-  parallel_for(0, a.num_triangles(), kParallelMinCostly, [&](int64_t f) {
-    open[size_t(f)] = triangle_bound(a, b, v, int32_t(f), threshold) > threshold;
-  });
-  for (int32_t f = 0; f < a.num_triangles(); ++f)
-    if (open[size_t(f)])
-      for (int j = 0; j < 3; ++j) measure[size_t(a.triangles()[3 * size_t(f) + j])] = 1;
+// The open triangles (listed) get their corners measured exactly (each once): a corner's own
+// nearest triangle of B usually settles them, where bracketing them (three queries a triangle and
+// more) cost several times as many queries. Keeps in `listed` those still open; returns the
+// largest bound of those settled.
+double settle_by_exact_corners(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance,
+                               VertexBounds& v, std::vector<int32_t>& listed) {
+  std::vector<uint8_t> measure(size_t(a.num_vertices()), 0);
+  for (int32_t f : listed)
+    for (int j = 0; j < 3; ++j) measure[size_t(a.triangles()[3 * size_t(f) + j])] = 1;
   measure_flagged(a, b, grid, measure, v);
+  const double threshold = std::max(v.lower * (1.0 + tolerance), kFloor * std::max(a.diagonal(), b.diagonal()));
+  std::vector<double> bound(listed.size());
+  parallel_for(0, int64_t(listed.size()), kParallelMinCostly,
+               [&](int64_t i) { bound[size_t(i)] = triangle_bound(a, b, v, listed[size_t(i)], threshold); });
+  double settled = 0.0;
+  size_t kept = 0;
+  for (size_t i = 0; i < listed.size(); ++i)
+    if (bound[i] > threshold) listed[kept++] = listed[i];
+    else settled = std::max(settled, bound[i]);
+  listed.resize(kept);
+  return settled;
 }
 
 struct ForwardSums {
@@ -197,7 +204,6 @@ struct ForwardSums {
 void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, QuickBound& out,
                    double& reach) {
   VertexBounds v = bound_vertices(a, b, grid);
-  remeasure_open_corners(a, b, grid, tolerance, v);
   const double threshold = std::max(v.lower * (1.0 + tolerance), kFloor * std::max(a.diagonal(), b.diagonal()));
   std::vector<uint8_t> refine(size_t(a.num_triangles()), 0);
   const ForwardSums sums = ordered_reduce<ForwardSums>(
@@ -216,8 +222,9 @@ void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, d
   std::vector<int32_t> listed;
   for (int32_t f = 0; f < a.num_triangles(); ++f)
     if (refine[size_t(f)]) listed.push_back(f);
+  const double settled = std::max(sums.settled, settle_by_exact_corners(a, b, grid, tolerance, v, listed));
   out.forward_lower = v.lower;
-  out.forward_upper = std::max(v.lower, sums.settled);
+  out.forward_upper = std::max(v.lower, settled);
   out.forward_mean = v.mean;
   reach = std::sqrt(sums.longest2 / 3.0);  // no point of a triangle is farther from its corners
   out.queries = v.queries;
