@@ -146,7 +146,6 @@ def test_the_quick_bound_measures_the_open_corners_rather_than_bracketing_their_
     # max and stays within the gap.
     from topstoc.core.api.hausdorff import as_surface
     from topstoc.core.api.io import read_mesh
-    from topstoc.core.support.native import engine
     data = read_mesh(data_dir / "genus0/cgal_armadillo.off.gz")
     original = (data.vertices, data.triangles)
     b = topstoc.Mesh(*original).decimate(ratio=0.1, seed=1)
