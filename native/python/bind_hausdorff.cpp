@@ -100,8 +100,11 @@ void bind_surfaces(py::module_& m) {
 
   m.def(
       "closest_points",
-      [](const Surface& surface, const py::handle& points) {
+      [](const Surface& surface, const py::handle& points, const py::object& within) {
         const auto p = positions_from(points, "points");
+        const double stop = within.is_none() ? -1.0 : within.cast<double>();
+        if (!within.is_none() && !(stop >= 0.0))
+          throw std::invalid_argument("within must be a distance >= 0, got " + std::to_string(stop));
         const int64_t n = int64_t(p.size() / 3);
         for (int64_t i = 0; i < n; ++i)
           if (!std::isfinite(p[3 * i]) || !std::isfinite(p[3 * i + 1]) || !std::isfinite(p[3 * i + 2]))
@@ -109,7 +112,7 @@ void bind_surfaces(py::module_& m) {
         std::vector<ClosestHit> hits;
         {
           EngineCall call;
-          hits = closest_points(surface, p.data(), n);
+          hits = closest_points(surface, p.data(), n, stop);
         }
         std::vector<double> distance(n), closest(3 * n);
         std::vector<int32_t> triangle(n);
@@ -124,7 +127,9 @@ void bind_surfaces(py::module_& m) {
         out["point"] = to_array(std::move(closest), 3);
         return out;
       },
-      py::arg("surface"), py::arg("points"), "Nearest point on the surface of each point: distance, triangle, point.");
+      py::arg("surface"), py::arg("points"), py::arg("within") = py::none(),
+      "Nearest point on the surface of each point: distance, triangle, point. within: a point that\n"
+      "close to the surface may get any point within it (attained), a farther one its exact nearest.");
 }
 
 }  // namespace

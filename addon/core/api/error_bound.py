@@ -65,8 +65,10 @@ class _Probes:
         self.bound, self.decimate_at, self.progress = bound, decimate_at, progress
         self.probes, self.results, self.exact, self.queries = [], {}, set(), 0
 
-    def __call__(self, n: int, exact: bool = False) -> bool:
-        """Decimates at n (once), records (result, error); True when within the bound."""
+    def __call__(self, n: int, exact: bool = False, verdict: bool = False) -> bool:
+        """Decimates at n (once), records (result, error); True when within the bound. verdict:
+        only the verdict counts (bisection): a passing estimate records a value within the bound,
+        at least the sampled max, rather than that max (SampledError's ``within``)."""
         result = self.results[n][0] if n in self.results else self.decimate_at(n)
         if exact:
             decided = decide_error(self.mesh, result, self.bound, original_surface=self.original)
@@ -79,7 +81,7 @@ class _Probes:
             if decided.result_witness is not None:
                 self.sampled.add_result_witness(decided.result_witness)
         else:
-            error = self.sampled(result)
+            error = self.sampled(result, self.bound if verdict else None)
             passed = error <= self.bound
         self.probes.append((n, result.num_vertices, error))
         self.results[n] = (result, error, passed)
@@ -89,7 +91,7 @@ class _Probes:
 
     def judge(self, n: int) -> bool:
         """The estimate first (above the bound fails for certain), then the exact check."""
-        return self(n) and self.exactly(n)
+        return self(n, verdict=True) and self.exactly(n)
 
     def exactly(self, n: int) -> bool:
         """The exact check of n, made once (a later call reads its verdict)."""
@@ -121,7 +123,7 @@ def _climb(probe: _Probes, judge: Callable[[int], bool], failed: int, active: in
     The answer usually lies a few hundredths above, where a bisection toward the full count
     probed many targets."""
     lo, step = failed, 2 * resolution_count(failed, resolution)
-    cap = next((n for n in sorted(probe.results) if n > failed and probe(n)), active)
+    cap = next((n for n in sorted(probe.results) if n > failed and probe(n, verdict=True)), active)
     while lo + step < cap:
         if judge(lo + step):
             return lo, lo + step
@@ -167,7 +169,7 @@ def search_vertex_count(mesh, max_error: float, decimate_at: Callable[[int], obj
 
     lo, hi = _bracket(probe, active, resolution)
     if not check_passes:
-        lo, hi = _bisect(probe, lo, hi, resolution)  # on the estimate alone
+        lo, hi = _bisect(lambda n: probe(n, verdict=True), lo, hi, resolution)  # on the estimate alone
     # The estimate passes hi: check it exactly. Should the check fail, its far point joins the
     # estimate's points and the next probed target above that the estimate still passes is
     # checked (up to the full count, which always passes: its decimation is the input itself).

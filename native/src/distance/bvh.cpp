@@ -196,7 +196,7 @@ double TriangleBvh::slot_distance2(const double* p, int32_t slot, double* closes
   return closest_point_on_triangle(p, t, t + 3, t + 6, closest);
 }
 
-ClosestHit TriangleBvh::closest(const double* p, int32_t hint_slot) const {
+ClosestHit TriangleBvh::closest(const double* p, int32_t hint_slot, double within2) const {
   ClosestHit hit;
   hit.distance2 = std::numeric_limits<double>::infinity();
   auto consider = [&](int32_t slot) {
@@ -218,7 +218,7 @@ ClosestHit TriangleBvh::closest(const double* p, int32_t hint_slot) const {
   Entry stack[128];
   int depth = 0;
   stack[depth++] = {0, box_distance2(p, nodes_[0].lo, nodes_[0].hi)};
-  while (depth > 0) {
+  while (depth > 0 && !(hit.distance2 <= within2)) {
     const Entry entry = stack[--depth];
     if (entry.distance2 > hit.distance2 * kPruneSlack) continue;
     const Node& node = nodes_[entry.node];

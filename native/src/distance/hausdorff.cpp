@@ -273,14 +273,16 @@ double step_for_sample_count(const Surface& surface, int64_t samples) {
 
 // --- distances ---------------------------------------------------------------------------------
 
-std::vector<ClosestHit> closest_points(const Surface& surface, const double* points, int64_t count) {
+std::vector<ClosestHit> closest_points(const Surface& surface, const double* points, int64_t count,
+                                       double within) {
   const TriangleBvh& bvh = surface.bvh();
+  const double within2 = within >= 0.0 ? within * within : -1.0;
   std::vector<ClosestHit> hits(count);
   const int64_t blocks = (count + kBlock - 1) / kBlock;
   parallel_for_dynamic(0, blocks, 4, parallel_if(count >= 4 * kBlock), [&](int64_t block) {
     int32_t hint = -1;
     for (int64_t i = block * kBlock; i < std::min(count, (block + 1) * kBlock); ++i) {
-      hits[i] = bvh.closest(points + 3 * i, hint);
+      hits[i] = bvh.closest(points + 3 * i, hint, within2);
       hint = hits[i].slot;
     }
   });

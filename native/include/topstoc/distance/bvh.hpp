@@ -33,8 +33,10 @@ class TriangleBvh {
   TriangleBvh(const double* positions, const int32_t* triangles, int64_t num_triangles);
 
   /// Closest point of the mesh to p. `hint_slot` (a previous hit's slot, or -1) only speeds the
-  /// search up: nearby queries usually have nearby answers.
-  ClosestHit closest(const double* p, int32_t hint_slot = -1) const;
+  /// search up: nearby queries usually have nearby answers. `within2` >= 0: stop at the first
+  /// triangle found within that squared distance (its point, attained, not the closest); a point
+  /// farther than that from every triangle gets the same exact answer as without it.
+  ClosestHit closest(const double* p, int32_t hint_slot = -1, double within2 = -1.0) const;
 
   int64_t num_triangles() const { return int64_t(triangle_ids_.size()); }
   int64_t num_nodes() const { return int64_t(nodes_.size()); }

@@ -83,8 +83,10 @@ SurfaceSamples sample_surface(const Surface& surface, double step);
 /// even the coarsest sampling, every vertex plus one sample per triangle, exceeds it).
 double step_for_sample_count(const Surface& surface, int64_t samples);
 
-/// Nearest points on `surface` of `count` points (3 coordinates each), in parallel.
-std::vector<ClosestHit> closest_points(const Surface& surface, const double* points, int64_t count);
+/// Nearest points on `surface` of `count` points (3 coordinates each), in parallel. `within` >= 0:
+/// a point within that distance of the surface may get any triangle within it (TriangleBvh::closest).
+std::vector<ClosestHit> closest_points(const Surface& surface, const double* points, int64_t count,
+                                       double within = -1.0);
 
 /// Distances from one surface's samples to another surface.
 struct OneSidedDistance {
