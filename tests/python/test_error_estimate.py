@@ -156,3 +156,68 @@ def test_the_quick_bound_measures_the_open_corners_rather_than_bracketing_their_
     exact = estimates.exact_error(original, result)
     assert found["forward_lower"] <= exact.forward[1] and found["forward_upper"] >= exact.forward[0]
     assert found["forward_upper"] <= 1.25 * found["forward_lower"] * (1 + 1e-12)
+
+
+def bumpy(n: int = 30):
+    """A grid with a smooth bump field (heights up to 0.05): closest points vary across it."""
+    x, y = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1), indexing="ij")
+    return grid(n, (0.05 * np.sin(7 * x) * np.cos(5 * y)).ravel())
+
+
+def test_closest_points_within_stops_only_for_points_that_close():
+    # Each point's exact nearest distance d (no ``within``) against the answer with ``within`` w,
+    # points in random order (the hint chained from the previous point is far): a point farther
+    # than w gets the same exact answer; a nearer one a point of the surface at distance d' with
+    # d <= d' <= w (attained, not necessarily the nearest), and for many d' > d (it stopped early).
+    vertices, triangles = bumpy()
+    surface = importlib.import_module(topstoc.__name__ + ".core.api.hausdorff").as_surface((vertices, triangles))
+    rng = np.random.default_rng(3)
+    points = rng.uniform([-0.2, -0.2, -0.3], [1.2, 1.2, 0.3], size=(4000, 3))
+    exact = engine.closest_points(surface, points)
+    for within in (0.05, 0.2):
+        found = engine.closest_points(surface, points, within)
+        far = exact["distance"] > within
+        assert far.any() and (~far).any()
+        assert np.array_equal(found["distance"][far], exact["distance"][far])
+        assert np.array_equal(found["triangle"][far], exact["triangle"][far])
+        near = ~far
+        assert np.all(found["distance"][near] >= exact["distance"][near] - 1e-12)
+        assert np.all(found["distance"][near] <= within + 1e-12)
+        # the point returned is at the distance returned
+        assert np.allclose(np.linalg.norm(found["point"] - points, axis=1), found["distance"], atol=1e-12)
+        assert np.mean(found["distance"][near] > exact["distance"][near] + 1e-9) > 0.2
+    with pytest.raises(ValueError, match="within"):
+        engine.closest_points(surface, points, -1.0)
+
+
+def test_the_sampled_estimate_with_within_gives_the_same_verdict(data_dir):
+    # Decimations of fandisk at several counts, each estimated in full and deciding a bound w
+    # (0.5x, 1x, 2x its full value): the same verdict; above w the same value, within it a value
+    # between the full estimate and w.
+    from topstoc.core.api.hausdorff import as_surface
+    vertices, triangles = read_off(data_dir / "genus0" / "cgal_fandisk.off")
+    sampled = estimates.SampledError((vertices, triangles), as_surface((vertices, triangles)))
+    for count in (200, 1000, 3000):
+        result = topstoc.Mesh(vertices, triangles).decimate(target_vertices=count, seed=1, mode="fast")
+        full = sampled(result)
+        assert full > 0
+        for within in (0.5 * full, full, 2 * full):
+            decided = sampled(result, within)
+            assert (decided <= within) == (full <= within)
+            if full > within:
+                assert decided == full
+            else:
+                assert full - 1e-15 <= decided <= within
+
+
+def test_z_order_keeps_every_point_and_orders_them_by_place():
+    # A permutation of the points; consecutive points along it are far nearer one another than in
+    # the input's shuffled order (the closest-point queries' hints then land near their answers).
+    rng = np.random.default_rng(5)
+    points = rng.uniform(-1, 3, size=(20_000, 3))
+    order = estimates._z_order(points)
+    assert np.array_equal(np.sort(order), np.arange(len(points)))
+    step = lambda p: np.linalg.norm(np.diff(p, axis=0), axis=1).mean()  # noqa: E731
+    assert step(points[order]) < 0.1 * step(points)
+    assert len(estimates._z_order(np.empty((0, 3)))) == 0
+    assert np.array_equal(estimates._z_order(np.ones((4, 3))), np.arange(4))  # all in one place: as given

@@ -8,7 +8,8 @@ resolution. Every
 probe uses the same seed and the original's one measurement surface (its closest-point index
 built once), so the search is reproducible. A probe is judged on a cheap estimate first: the
 largest distance over about 40,000 points spread on both surfaces (attained, so a probe above the
-bound fails for certain). A passing target is checked exactly
+bound fails for certain; in the bisection, where only the verdict counts, it decides the bound:
+see SampledError). A passing target is checked exactly
 (topstoc.core.error_estimate.decide_error: the guaranteed bracket of the exact maximum, refined
 only as far as deciding the bound needs): at once with ``check_passes`` (quality mode, where a
 decimation costs more than a check), else only the answer. A failed check's far point joins the
@@ -46,7 +47,9 @@ class ErrorBoundReport:
     failed_target: int          #: largest probed target above the bound (0: none below)
     failed_error: float         #: a distance attained by it, above the bound (inf when failed_target is 0)
     resolution: int             #: failed_target and target_vertices are at most this far apart
-    probes: list = field(default_factory=list)  #: (target, output vertices, error) per probe, in order
+    #: (target, output vertices, error) per probe, in order (a probe the bisection's estimate passed:
+    #: a value between its sampled max and the bound)
+    probes: list = field(default_factory=list)
     queries: int = 0            #: closest-point queries of all probes
     seconds: float = 0.0
 
