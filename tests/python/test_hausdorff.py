@@ -320,27 +320,40 @@ def test_error_bounded_search_decimates_few_targets_and_stays_minimal(data_dir):
     assert again.symmetric.max_upper > report.max_error * (1 - EXACT_GAP)
 
 
-def test_error_bounded_search_climbs_just_above_a_failed_exact_check(data_dir):
-    # elephant at 1 % in quality mode: the estimate passes 249 and the exact check fails it; the
-    # answer lies a few vertices above, which a bisection toward the full count reached after
-    # ten decimated targets
-    vertices, triangles = read_off(data_dir / "genus_positive/cgal_elephant.off")
-    mesh = topstoc.Mesh(vertices, triangles)
-    result = mesh.decimate(max_error=0.01, relative=True, seed=1)
-    report = result.error_bound
-    targets = [target for target, *_ in report.probes]
-    assert len(set(targets)) <= 5
-    # every probe above the exact failure steps up from it, none beyond the answer
-    failed_exactly = min(n for n in targets if n < report.target_vertices and targets.count(n) == 2)
-    assert all(failed_exactly <= n <= failed_exactly + 4 * report.resolution for n in targets[targets.index(failed_exactly):])
-    check = topstoc.hausdorff(mesh, result, samples=200_000, percentile=0)
-    assert check.symmetric.max <= report.achieved_error * (1 + 1e-12) <= report.max_error * (1 + 1e-12)
-    # minimal within the resolution: the target below measured a distance above the bound
-    assert 0 < report.target_vertices - report.failed_target <= report.resolution
-    below = mesh.decimate(target_vertices=report.failed_target, seed=1)
-    again = topstoc.hausdorff(mesh, below, samples=200_000, percentile=0)
-    assert report.failed_error > report.max_error * (1 - EXACT_GAP)
-    assert again.symmetric.max_upper >= report.failed_error * (1 - 1e-12)
+class _ProbedCounts:
+    """A stand-in for the search's probes: the estimate passes from ``estimate_from`` vertices
+    on; ``results`` holds what was probed before the climb."""
+
+    def __init__(self, estimate_from, results):
+        self.estimate_from, self.results = estimate_from, results
+
+    def __call__(self, n, verdict=False):
+        return n >= self.estimate_from
+
+
+@pytest.mark.parametrize("answer", [251, 330, 399])
+def test_error_bounded_search_climbs_just_above_a_failed_exact_check(answer):
+    # The estimate passed 249 and the exact check failed it; the smallest probed target above
+    # that the estimate passes is 400. The climb steps up from 249 (4, 8, 16, ... vertices) and
+    # the bisection ends at the exact answer within the resolution.
+    from topstoc.core.api import error_bound
+    probe = _ProbedCounts(200, {249: (None, 1.1, False), 400: (None, 0.5, True)})
+    judged = []
+
+    def judge(n):
+        judged.append(n)
+        return n >= answer
+
+    lo, hi = error_bound._climb(probe, judge, 249, 1000, 0.01)
+    assert 249 <= lo < answer <= hi <= 400
+    lo, hi = error_bound._bisect(judge, lo, hi, 0.01)
+    assert lo < answer <= hi and hi - lo <= error_bound.resolution_count(hi, 0.01)
+    assert all(249 < n < 400 for n in judged) and len(set(judged)) == len(judged)
+    bisected = []
+    error_bound._bisect(lambda n: bisected.append(n) or n >= answer, 249, 400, 0.01)
+    if answer == 251:  # where the answer usually lies: two targets instead of six
+        assert judged == [253, 251] and len(bisected) == 6
+    assert len(judged) <= len(bisected) + 4  # farther up the doubling steps cost a few more
 
 
 def test_error_bounded_search_returns_the_fewest_passing_vertices_from_its_first_probe(data_dir):
