@@ -291,5 +291,8 @@ def vertex_means(corner_values, out_triangles, count: int) -> np.ndarray:
     vertex = np.asarray(out_triangles, dtype=np.int64).ravel()
     values = np.asarray(corner_values, dtype=np.float64)
     uses = np.maximum(np.bincount(vertex, minlength=count), 1)
-    return np.stack([np.bincount(vertex, weights=values[:, c], minlength=count) / uses
-                     for c in range(values.shape[1])], axis=1)
+    means = np.stack([np.bincount(vertex, weights=values[:, c], minlength=count) / uses
+                      for c in range(values.shape[1])], axis=1)
+    # a mean may round an ulp past its largest term: kept within the corners' range, so a colour
+    # clamped to the source's stays in it
+    return np.clip(means, values.min(axis=0), values.max(axis=0)) if len(values) else means
