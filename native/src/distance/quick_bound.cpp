@@ -144,7 +144,8 @@ double triangle_bound(const Surface& a, const Surface& b, const VertexBounds& v,
 }
 
 // Measures exactly the vertices of A flagged in `measure` (cell by cell, in fixed blocks that chain
-// their BVH hints: the same results on any team size), raising the lower bound.
+// their BVH hints: the same results on any team size), raising the lower bound. Each cell's first
+// vertex is exact already (bound_vertices) and is skipped.
 void measure_flagged(const Surface& a, const Surface& b, const VertexGrid& grid, const std::vector<uint8_t>& measure,
                      VertexBounds& v) {
   const TriangleBvh& bvh = b.bvh();
@@ -155,17 +156,17 @@ void measure_flagged(const Surface& a, const Surface& b, const VertexGrid& grid,
   std::vector<int64_t> block_queries(size_t(blocks), 0);
   parallel_for_dynamic(0, blocks, 4, parallel_if(cells >= 4 * kCellBlock), [&](int64_t block) {
     int32_t hint = -1;
-    for (int64_t i = grid.cell_start(block * kCellBlock); i < grid.cell_start(std::min(cells, (block + 1) * kCellBlock));
-         ++i) {
-      const int32_t vertex = grid.order()[size_t(i)];
-      if (!measure[size_t(vertex)]) continue;
-      const ClosestHit hit = bvh.closest(&positions[3 * size_t(vertex)], hint);
-      hint = hit.slot;
-      v.upper[size_t(vertex)] = std::sqrt(hit.distance2);
-      v.against[size_t(vertex)] = hit.triangle;
-      block_max[size_t(block)] = std::max(block_max[size_t(block)], v.upper[size_t(vertex)]);
-      ++block_queries[size_t(block)];
-    }
+    for (int64_t c = block * kCellBlock; c < std::min(cells, (block + 1) * kCellBlock); ++c)
+      for (int64_t i = grid.cell_start(c) + 1; i < grid.cell_start(c + 1); ++i) {
+        const int32_t vertex = grid.order()[size_t(i)];
+        if (!measure[size_t(vertex)]) continue;
+        const ClosestHit hit = bvh.closest(&positions[3 * size_t(vertex)], hint);
+        hint = hit.slot;
+        v.upper[size_t(vertex)] = std::sqrt(hit.distance2);
+        v.against[size_t(vertex)] = hit.triangle;
+        block_max[size_t(block)] = std::max(block_max[size_t(block)], v.upper[size_t(vertex)]);
+        ++block_queries[size_t(block)];
+      }
   });
   for (int64_t block = 0; block < blocks; ++block) {
     v.lower = std::max(v.lower, block_max[size_t(block)]);
