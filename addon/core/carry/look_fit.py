@@ -137,8 +137,7 @@ class LookFit:
         self.source_triangles = np.asarray(source_triangles, dtype=np.int64).reshape(-1, 3)
         self.kept = None if kept is None else np.asarray(kept, dtype=np.int64)
         self.source_count, self.out_count = len(source_vertices), len(out_vertices)
-        sv = np.asarray(source_vertices, dtype=np.float64)
-        st = np.asarray(source_triangles, dtype=np.int64).reshape(-1, 3)
+        sv, st = np.asarray(source_vertices, dtype=np.float64), self.source_triangles
         ov = np.asarray(out_vertices, dtype=np.float64)
         self.triangles = np.asarray(out_triangles, dtype=np.int64).reshape(-1, 3)
         ot = self.triangles
