@@ -455,6 +455,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     for (int c = 0; c < 3; ++c) r[c] = vertex_index_[t[c]];
     keyed[i] = (uint64_t(uint32_t(std::min({r[0], r[1], r[2]}))) << 32) | uint32_t(i);
   });
+  Buffer<int32_t>().swap(vertex_index_);  // 2 bytes a triangle, made again on first use
   progress.update(0.65);
   {
     int bits = 1;
@@ -709,6 +710,14 @@ void Mesh::weigh() {
       weights_[v] = std::clamp((double(d) - dots) / (2.0 * double(d)), 0.0, 1.0);
     });
   }
+}
+
+void Mesh::build_vertex_index() const {
+  std::call_once(vertex_index_once_, [this] {
+    vertex_index_.resize(size_t(num_vertices_));
+    parallel_for(0, num_vertices_, kParallelMin, [&](int32_t i) { vertex_index_[vertex_source_[i]] = i; });
+    vertex_index_built_.store(true, std::memory_order_release);
+  });
 }
 
 void Mesh::build_normals() const {

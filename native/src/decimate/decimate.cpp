@@ -667,11 +667,12 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
   result.rate = set.rate;
   result.seconds_sampling = seconds_since(start);
   // Vertices the user excluded (u = -1) are the last choice when a repair needs a new sample;
-  // control points (u = 1) must stay in the output.
-  std::vector<uint8_t> avoid, required(mesh.num_vertices(), 0);
+  // control points (u = 1) must stay in the output. Without guidance both stay empty (none).
+  std::vector<uint8_t> avoid, required;
   if (params.sampling.guidance || !params.sampling.boxes.empty()) {
     const auto p = sampling_probabilities(mesh, layout, params.sampling, set.rate);
     avoid.resize(p.size());
+    required.resize(p.size());
     for (size_t v = 0; v < p.size(); ++v) {
       avoid[v] = p[v] <= 0.0;
       required[v] = p[v] >= 1.0;
@@ -891,7 +892,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
   // A refined result's first pass keeps input positions: the refinement places what it keeps.
   result = cluster_and_emit(mesh, layout, std::move(samples), refine_vertices > 0 ? Placement::Subsample : placement,
                             max_repair_rounds, false, false, {},
-                            std::vector<uint8_t>(mesh.num_vertices(), 0), 0, nullptr, false, false, std::move(result));
+                            {}, 0, nullptr, false, false, std::move(result));
   // A refined result is thinned again; an unrefined one loses its zero-area triangles, as
   // decimate() does.
   if (refine_vertices > 0 || has_zero_area(result)) {

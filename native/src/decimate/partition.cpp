@@ -597,7 +597,7 @@ class PartitionCheck {
     if (link.arcs == 0) {
       // No triangle: the neighbours absorbed this cluster (the pillow case) unless the sample
       // must stay. The Euler characteristic check confirms the topology either way.
-      if (required[samples[s]] || layout.is_corner(samples[s])) {
+      if ((!required.empty() && required[samples[s]]) || layout.is_corner(samples[s])) {
         ++lonely;
         marks.add(s);
       } else {

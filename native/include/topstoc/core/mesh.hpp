@@ -63,9 +63,11 @@ class Mesh {
   /// caller's triangle array.
   const Buffer<int32_t>& faces() const { return faces_; }
   const Buffer<int32_t>& face_source() const { return face_source_; }
-  /// Caller's id of each internal vertex, and internal id of each caller vertex.
+  /// Caller's id of each internal vertex, and internal id of each caller vertex. The second is
+  /// the first's inverse: freed after the preparation, made again on first use, once (a
+  /// one-off fast decimation reads it only after its peak).
   const Buffer<int32_t>& vertex_source() const { return vertex_source_; }
-  const Buffer<int32_t>& vertex_index() const { return vertex_index_; }
+  const Buffer<int32_t>& vertex_index() const { return ensure_vertex_index(), vertex_index_; }
   /// The caller's triangle array as given (3 per triangle, dropped ones included), rebuilt from
   /// the kept faces and the dropped rows: a copy of the input need not be kept.
   std::vector<int32_t> caller_triangles() const;
@@ -130,6 +132,10 @@ class Mesh {
   void build_vertex_faces();
   /// The one-ring pass: adjacency, normals, weights, manifoldness, components.
   void build_adjacency(Progress& progress);
+  void ensure_vertex_index() const {
+    if (!vertex_index_built_.load(std::memory_order_acquire)) build_vertex_index();
+  }
+  void build_vertex_index() const;
   void ensure_edges() const {
     if (!edges_built_.load(std::memory_order_acquire)) build_edges();
   }
@@ -151,7 +157,11 @@ class Mesh {
   uint64_t serial_ = new_serial();
   int32_t num_vertices_ = 0;
   Buffer<double> positions_;
-  Buffer<int32_t> faces_, face_source_, vertex_source_, vertex_index_;
+  Buffer<int32_t> faces_, face_source_, vertex_source_;
+  // Built on first use (ensure_vertex_index).
+  mutable Buffer<int32_t> vertex_index_;
+  mutable std::once_flag vertex_index_once_;
+  mutable std::atomic<bool> vertex_index_built_{false};
   Buffer<int32_t> vertex_face_offsets_, vertex_faces_;
   Buffer<int32_t> adjacency_offsets_, adjacency_;
   int32_t num_edges_ = 0;

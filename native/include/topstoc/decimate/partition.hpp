@@ -122,7 +122,7 @@ struct CheckState {
 };
 
 /// Emits triangles and checks them. `required` marks vertices whose samples must appear in the
-/// output (control points); corners are always required. Other samples left without a
+/// output (control points; empty: none); corners are always required. Other samples left without a
 /// triangle are absorbed by their neighbours. candidate_faces, if given, lists (in increasing
 /// order) a superset of the faces whose corners lie in three clusters (the fast path, thesis
 /// 4.1.1); otherwise every face is scanned.
