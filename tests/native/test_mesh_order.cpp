@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <numeric>
 #include <random>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -85,4 +86,29 @@ TEST_CASE("the prepared vertex order is the Morton order, ties by vertex id") {
     const Arrays b = shuffled(stacked, 2);
     CHECK(prepared_order(b) == morton_order(b.positions));
   }
+}
+
+TEST_CASE("the caller-to-internal vertex map, made on first use, is the inverse of the vertex order") {
+  // Shuffled, with a vertex in no triangle and a dropped (repeated-vertex) triangle.
+  Arrays a = shuffled(topstoc_test::grid(330, 330), 3);
+  const int32_t n = int32_t(a.positions.size() / 3);
+  a.positions.insert(a.positions.end(), {500.0, 500.0, 1.0});
+  a.triangles.insert(a.triangles.end(), {0, 0, 1});
+  const topstoc::Mesh mesh(a.positions, a.triangles.data(), a.num_triangles());
+  REQUIRE(mesh.num_vertices() == n + 1);
+  const void* seen[2] = {nullptr, nullptr};
+  std::thread other([&] { seen[1] = &mesh.vertex_index(); });  // two threads asking at once
+  seen[0] = &mesh.vertex_index();
+  other.join();
+  CHECK(seen[0] == seen[1]);
+  const auto& index = mesh.vertex_index();
+  const auto& source = mesh.vertex_source();
+  REQUIRE(index.size() == size_t(n + 1));
+  int32_t wrong = 0;
+  for (int32_t v = 0; v <= n; ++v) wrong += source[index[v]] != v;
+  CHECK(wrong == 0);
+  // The internal ids of each kept face are the caller's triangle read through the map.
+  for (int32_t f = 0; f < mesh.num_faces(); f += 97)
+    for (int c = 0; c < 3; ++c)
+      CHECK(mesh.faces()[3 * size_t(f) + c] == index[a.triangles[3 * size_t(mesh.face_source()[f]) + c]]);
 }
