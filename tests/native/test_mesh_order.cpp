@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <numeric>
 #include <random>
+#include <stdexcept>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -96,6 +97,12 @@ TEST_CASE("the caller-to-internal vertex map, made on first use, is the inverse 
   a.triangles.insert(a.triangles.end(), {0, 0, 1});
   const topstoc::Mesh mesh(a.positions, a.triangles.data(), a.num_triangles());
   REQUIRE(mesh.num_vertices() == n + 1);
+  // A few caller ids (repeats and the isolated vertex among them) found before the map is made,
+  // then read off it: the same ids.
+  const std::vector<int32_t> few = {n, 7, 0, 7, n / 2, 1};
+  const std::vector<int32_t> scanned = mesh.internal_ids(few);
+  CHECK_THROWS_AS(mesh.internal_ids({n + 1}), std::out_of_range);
+  CHECK_THROWS_AS(mesh.internal_ids({-1}), std::out_of_range);
   const void* seen[2] = {nullptr, nullptr};
   std::thread other([&] { seen[1] = &mesh.vertex_index(); });  // two threads asking at once
   seen[0] = &mesh.vertex_index();
@@ -107,6 +114,8 @@ TEST_CASE("the caller-to-internal vertex map, made on first use, is the inverse 
   int32_t wrong = 0;
   for (int32_t v = 0; v <= n; ++v) wrong += source[index[v]] != v;
   CHECK(wrong == 0);
+  CHECK(mesh.internal_ids(few) == scanned);
+  for (size_t i = 0; i < few.size(); ++i) CHECK(scanned[i] == index[few[i]]);
   // The internal ids of each kept face are the caller's triangle read through the map.
   for (int32_t f = 0; f < mesh.num_faces(); f += 97)
     for (int c = 0; c < 3; ++c)

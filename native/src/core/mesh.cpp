@@ -720,6 +720,29 @@ void Mesh::build_vertex_index() const {
   });
 }
 
+std::vector<int32_t> Mesh::internal_ids(const std::vector<int32_t>& caller_ids) const {
+  const int32_t n = num_vertices_;
+  for (int32_t c : caller_ids)
+    if (c < 0 || c >= n) throw std::out_of_range("vertex " + std::to_string(c) + " is not one of the mesh's");
+  std::vector<int32_t> out(caller_ids.size(), -1);
+  if (vertex_index_built_.load(std::memory_order_acquire)) {
+    for (size_t i = 0; i < out.size(); ++i) out[i] = vertex_index_[caller_ids[i]];
+    return out;
+  }
+  std::vector<std::pair<int32_t, int32_t>> wanted(caller_ids.size());  // (caller id, position)
+  for (size_t i = 0; i < wanted.size(); ++i) wanted[i] = {caller_ids[i], int32_t(i)};
+  std::sort(wanted.begin(), wanted.end());
+  std::vector<uint64_t> bits((size_t(n) + 63) / 64, 0);
+  for (const auto& entry : wanted) bits[size_t(entry.first) >> 6] |= uint64_t(1) << (entry.first & 63);
+  parallel_for(0, n, kParallelMin, [&](int32_t v) {
+    const int32_t c = vertex_source_[v];
+    if (!((bits[size_t(c) >> 6] >> (c & 63)) & 1)) return;
+    auto it = std::lower_bound(wanted.begin(), wanted.end(), std::make_pair(c, INT32_MIN));
+    for (; it != wanted.end() && it->first == c; ++it) out[size_t(it->second)] = v;  // one v per caller id
+  });
+  return out;
+}
+
 void Mesh::build_normals() const {
   std::call_once(normals_once_, [this] {
     fill_normals();

@@ -576,8 +576,7 @@ DecimateResult cluster_and_emit(const Mesh& mesh, const FeatureLayout& layout, s
 // something the partition checks missed would be returned as success, so it is an error.
 void check_result(const Mesh& mesh, const FeatureLayout& layout, DecimateResult& result) {
   const auto start = Clock::now();
-  std::vector<int32_t> kept(result.kept.size());
-  for (size_t i = 0; i < kept.size(); ++i) kept[i] = mesh.vertex_index()[result.kept[i]];
+  const std::vector<int32_t> kept = mesh.internal_ids(result.kept);
   result.output_check = check_output(mesh, layout, kept, result.vertices, result.triangles);
   result.output_checked = true;
   result.seconds_verify = seconds_since(start);

@@ -330,6 +330,7 @@ class Refinement {
       parallel_for(0, num_input, kParallelMin, [&](int32_t v) { label[v] = result.labels[source[v]]; });
     }
     std::vector<int32_t>().swap(result.labels);
+    kept_vertex = mesh.internal_ids(result.kept);
     setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *frame);
     set_up_vertices(setup);
     lock_inconsistent(setup);
@@ -358,6 +359,9 @@ class Refinement {
   const bool guided;
   std::vector<int32_t> label;  // per input vertex: its output vertex
   std::vector<int32_t> final_index;  // per output vertex of the first pass: its vertex in the result
+  // Per output vertex of the first pass: its mesh vertex (found without the mesh's
+  // caller-to-internal map, 2 bytes a triangle, which would otherwise be made under the collapser).
+  std::vector<int32_t> kept_vertex;
 
   // The caller's labels from the mesh-order ones, once the collapser is gone (the two tables
   // then never sit beside it).
@@ -375,7 +379,6 @@ class Refinement {
 
   // Per output vertex: normalised position, weight, feature curve, lock and guidance bin.
   void set_up_vertices(CollapseSetup& setup) const {
-    const auto& index = mesh.vertex_index();
     setup.world = result.vertices;
     setup.positions.resize(3 * size_t(n));
     setup.weight.assign(n, 1.0);
@@ -388,7 +391,7 @@ class Refinement {
     const std::vector<int32_t> end_curve = dead_end_curves();
     setup.dead_end.assign(end_curve.empty() ? 0 : n, 0);
     for (int32_t i = 0; i < n; ++i) {
-      const int32_t v = index[result.kept[i]];
+      const int32_t v = kept_vertex[i];
       const double m = multiplier(v);
       if (layout.is_feature_vertex(v)) setup.curve[i] = layout.curve_of(v);
       const bool dead_end = !end_curve.empty() && end_curve[v] >= 0 && m != kForcedMultiplier;
@@ -469,12 +472,11 @@ class Refinement {
     std::sort(sides.begin(), sides.end(), [](const Side& x, const Side& y) {
       return x.a < y.a || (x.a == y.a && (x.b < y.b || (x.b == y.b && x.face < y.face)));
     });
-    const auto& index = mesh.vertex_index();
     std::vector<uint8_t> component_done(mesh.report().components + 1, 0);
     for (size_t i = 0; i < sides.size();) {
       size_t k = i;
       while (k < sides.size() && sides[k].a == sides[i].a && sides[k].b == sides[i].b) ++k;
-      const int32_t component = mesh.component()[index[result.kept[sides[i].a]]];
+      const int32_t component = mesh.component()[kept_vertex[sides[i].a]];
       if (k - i == 2 && sides[i].forward == sides[i + 1].forward && component >= 0 &&
           size_t(component) < component_done.size() && !component_done[component]) {
         component_done[component] = 1;
@@ -642,11 +644,10 @@ class Refinement {
 
   // Sector of every output corner at its vertex, from the input corner it copies.
   void set_up_corner_sectors(CollapseSetup& setup) const {
-    const auto& index = mesh.vertex_index();
     setup.corner_sector.assign(result.corner_source.size(), 0);
     std::vector<int32_t> internal_face;
     for (size_t c = 0; c < setup.corner_sector.size(); ++c) {
-      const int32_t vertex = index[result.kept[result.triangles[c]]];
+      const int32_t vertex = kept_vertex[result.triangles[c]];
       if (layout.sectors_of(mesh, vertex) <= 1) continue;
       if (internal_face.empty()) {
         internal_face.assign(mesh.report().input_triangles, -1);

@@ -68,6 +68,10 @@ class Mesh {
   /// one-off fast decimation reads it only after its peak).
   const Buffer<int32_t>& vertex_source() const { return vertex_source_; }
   const Buffer<int32_t>& vertex_index() const { return ensure_vertex_index(), vertex_index_; }
+  /// The internal ids of a few caller vertex ids (a result's kept vertices), read off
+  /// vertex_index() once it is made, else found by one scan of vertex_source() without making it.
+  /// Throws std::out_of_range for an id outside the caller's vertices.
+  std::vector<int32_t> internal_ids(const std::vector<int32_t>& caller_ids) const;
   /// The caller's triangle array as given (3 per triangle, dropped ones included), rebuilt from
   /// the kept faces and the dropped rows: a copy of the input need not be kept.
   std::vector<int32_t> caller_triangles() const;
