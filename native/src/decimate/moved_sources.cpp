@@ -79,11 +79,11 @@ MovedSources moved_sources(const Mesh& mesh, const int32_t* labels, const int32_
                            int64_t num_output) {
   if (!mesh.report().dropped_triangles.empty())
     throw std::invalid_argument("moved sources from a prepared mesh that dropped triangles: give the arrays");
-  const auto& index = mesh.vertex_index();
   const auto& source = mesh.vertex_source();
+  const std::vector<int32_t> internal = mesh.internal_ids(std::vector<int32_t>(kept, kept + num_output));
   std::vector<uint8_t> moved(num_output, 0);
   for (int64_t v = 0; v < num_output; ++v)
-    for (int i = 0; i < 3; ++i) moved[v] |= output[3 * size_t(v) + i] != mesh.position(index[kept[v]])[i];
+    for (int i = 0; i < 3; ++i) moved[v] |= output[3 * size_t(v) + i] != mesh.position(internal[v])[i];
   MovedSources out = unmoved(num_output);
   std::vector<double> closest(num_output, std::numeric_limits<double>::infinity());
   for (int32_t f = 0; f < mesh.num_faces(); ++f) {
