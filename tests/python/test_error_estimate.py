@@ -208,6 +208,8 @@ def test_the_sampled_estimate_with_within_gives_the_same_verdict(data_dir):
                 assert within < decided <= full
             else:
                 assert full - 1e-15 <= decided <= within
+            # exact above a share of it: the same value, measured again in full where below
+            assert sampled(result, exact_above=within) == full
 
 
 def test_a_failing_verdict_stops_at_the_first_chunk_beyond_the_bound(data_dir, monkeypatch):

@@ -200,7 +200,11 @@ class SampledError:
         tend to keep the same bulge, which the spread points can miss."""
         self.result_witnesses = np.concatenate([self.result_witnesses, np.asarray(point, dtype=np.float64).reshape(1, 3)])
 
-    def __call__(self, result, within=None) -> float:
+    def __call__(self, result, within=None, exact_above=None) -> float:
+        """The sampled max; with ``within``, only the verdict against it (class docs). exact_above
+        (without within): points that close stop at the first triangle found that close, which
+        leaves the value exact when it is above exact_above; the rare result whose value is not is
+        measured again in full (the same value either way, for fewer triangles visited)."""
         vertices, triangles = _arrays(result)
         step = max(1, -(-len(triangles) // max(1, self.samples // 2)))
         corners = vertices[triangles[::step]]
@@ -209,8 +213,12 @@ class SampledError:
         points = np.concatenate([vertices, corners.mean(axis=1), 0.5 * (corners[:, 0] + corners[:, 1]), near])
         if within is not None:
             return self._verdict(surface, points, len(near), within)
-        forward = engine.closest_points(surface, self.points)["distance"]
-        backward = engine.closest_points(self.surface, points)["distance"]
+        largest = self._largest(surface, points, exact_above)
+        return self._largest(surface, points) if exact_above is not None and largest <= exact_above else largest
+
+    def _largest(self, surface, points: np.ndarray, within=None) -> float:
+        forward = engine.closest_points(surface, self.points, within)["distance"]
+        backward = engine.closest_points(self.surface, points, within)["distance"]
         return float(max(forward.max(initial=0.0), backward.max(initial=0.0)))
 
     def _verdict(self, surface, points: np.ndarray, witnessed: int, within: float) -> float:
