@@ -192,8 +192,8 @@ def test_closest_points_within_stops_only_for_points_that_close():
 
 def test_the_sampled_estimate_with_within_gives_the_same_verdict(data_dir):
     # Decimations of fandisk at several counts, each estimated in full and deciding a bound w
-    # (0.5x, 1x, 2x its full value): the same verdict; above w the same value, within it a value
-    # between the full estimate and w.
+    # (0.5x, 1x, 2x its full value): the same verdict; above w a distance attained above w (the
+    # first chunk's), within it a value between the full estimate and w.
     from topstoc.core.api.hausdorff import as_surface
     vertices, triangles = read_off(data_dir / "genus0" / "cgal_fandisk.off")
     sampled = estimates.SampledError((vertices, triangles), as_surface((vertices, triangles)))
@@ -205,9 +205,94 @@ def test_the_sampled_estimate_with_within_gives_the_same_verdict(data_dir):
             decided = sampled(result, within)
             assert (decided <= within) == (full <= within)
             if full > within:
-                assert decided == full
+                assert within < decided <= full
             else:
                 assert full - 1e-15 <= decided <= within
+            # exact above a share of it: the same value, measured again in full where below
+            assert sampled(result, exact_above=within) == full
+
+
+def test_a_failing_verdict_stops_at_the_first_chunk_beyond_the_bound(data_dir, monkeypatch):
+    # The points each estimate sends to the engine, counted: deciding a bound half the full
+    # estimate (the result fails) measures fewer than the full estimate, deciding twice it (passes)
+    # measures them all; a place found too far before is measured first, so a result that keeps
+    # it fails on its first chunk.
+    from topstoc.core.api.hausdorff import as_surface
+    vertices, triangles = read_off(data_dir / "genus0" / "cgal_fandisk.off")
+    original = as_surface((vertices, triangles))
+    sampled = estimates.SampledError((vertices, triangles), original)
+    measured = []
+    closest = engine.closest_points
+
+    class Counting:
+        def __getattr__(self, name):
+            return getattr(engine, name)
+
+        def closest_points(self, surface, points, *args):
+            measured.append(len(points))
+            return closest(surface, points, *args)
+
+    monkeypatch.setattr(estimates, "engine", Counting())
+    for count in (300, 3000):
+        result = topstoc.Mesh(vertices, triangles).decimate(target_vertices=count, seed=1, mode="fast")
+        measured.clear()
+        full = sampled(result)
+        every = sum(measured)
+        measured.clear()
+        assert sampled(result, 2 * full) <= 2 * full and sum(measured) == every
+        measured.clear()
+        assert sampled(result, 0.5 * full) > 0.5 * full and sum(measured) < every
+    # the far point of the last result, found by the exact check, joins the points: measured first
+    decided = estimates.decide_error((vertices, triangles), result, 0.5 * full, original_surface=original)
+    assert decided.estimate > 0.5 * full
+    if decided.witness is not None:
+        sampled.add_witness(decided.witness)
+    if decided.result_witness is not None:
+        sampled.add_result_witness(decided.result_witness)
+    measured.clear()
+    assert sampled(result, 0.5 * full) > 0.5 * full
+    assert sum(measured) <= len(sampled.points) - sampled.spread + 2 + len(sampled.result_witnesses)
+
+
+def test_the_threshold_walk_decides_as_the_exact_bracket(data_dir):
+    # Fandisk and the elephant decimated in both modes: the threshold walk (decide_error) against
+    # the exact bracket (exact_error, every side converged to 1e-3): below its estimate it fails
+    # with a distance attained above the threshold, above its upper bound (outside the exact gap)
+    # it passes with an upper bound within the threshold.
+    for name, count, mode in [("genus0/cgal_fandisk.off", 400, "quality"), ("genus0/cgal_fandisk.off", 3000, "fast"),
+                              ("genus_positive/cgal_elephant.off", 250, "quality"),
+                              ("genus_positive/cgal_elephant.off", 2000, "fast")]:
+        vertices, triangles = read_off(data_dir / name)
+        result = topstoc.Mesh(vertices, triangles).decimate(target_vertices=count, seed=1, mode=mode)
+        exact = estimates.exact_error((vertices, triangles), result)
+        assert exact.converged
+        for threshold in (0.5 * exact.estimate, 0.99 * exact.estimate):
+            decided = estimates.decide_error((vertices, triangles), result, threshold)
+            assert threshold < decided.estimate <= exact.upper and decided.upper > threshold
+        for threshold in (1.01 * exact.upper, 1.5 * exact.upper, 3 * exact.upper):
+            decided = estimates.decide_error((vertices, triangles), result, threshold)
+            assert exact.estimate <= decided.upper <= threshold and decided.estimate <= exact.upper
+
+
+def test_the_threshold_walk_measures_each_shared_vertex_once(data_dir):
+    # A decimated fandisk as an indexed mesh and as a soup (three vertices of its own per
+    # triangle: the same triangles, so the same tree and the same distances): the walk brackets
+    # both alike, and the indexed one, whose corners are shared, makes fewer queries.
+    vertices, triangles = read_off(data_dir / "genus0" / "cgal_fandisk.off")
+    hausdorff = importlib.import_module(topstoc.__name__ + ".core.api.hausdorff")
+    original = hausdorff.as_surface((vertices, triangles))
+    result = topstoc.Mesh(vertices, triangles).decimate(target_vertices=3000, seed=1, mode="fast")
+    soup_vertices = np.asarray(result.vertices)[np.asarray(result.triangles)].reshape(-1, 3)
+    soup = hausdorff.as_surface((soup_vertices, np.arange(len(soup_vertices), dtype=np.int32).reshape(-1, 3)))
+    indexed = hausdorff.as_surface(result)
+    exact = estimates.exact_error((vertices, triangles), result)
+    for threshold in (0.5 * exact.estimate, 1.5 * exact.upper):
+        found = [engine.bracket_one_sided_max(surface, original, tolerance=estimates.EXACT_GAP,
+                                              max_queries=estimates.EXACT_QUERIES, threshold=threshold)
+                 for surface in (indexed, soup)]
+        assert (found[0]["upper"] <= threshold) == (found[1]["upper"] <= threshold)
+        assert (found[0]["lower"] > threshold) == (found[1]["lower"] > threshold)
+    assert found[0]["queries"] < 0.8 * found[1]["queries"]
 
 
 def test_z_order_keeps_every_point_and_orders_them_by_place():

@@ -35,6 +35,9 @@ from ..support.native import engine
 from ..support.errors import TopStocError
 
 Cancelled = engine.Cancelled
+#: the bracketing's estimates (whose values steer it) are exact above this share of the bound:
+#: points nearer than that stop at the first triangle that near (SampledError's exact_above)
+EXACT_ABOVE = 0.25
 
 @dataclass(frozen=True)
 class ErrorBoundReport:
@@ -84,7 +87,7 @@ class _Probes:
             if decided.result_witness is not None:
                 self.sampled.add_result_witness(decided.result_witness)
         else:
-            error = self.sampled(result, self.bound if verdict else None)
+            error = self.sampled(result, self.bound) if verdict else self.sampled(result, exact_above=EXACT_ABOVE * self.bound)
             passed = error <= self.bound
         self.probes.append((n, result.num_vertices, error))
         self.results[n] = (result, error, passed)

@@ -116,8 +116,9 @@ class MaxSearch {
 
   // The same search seeded from the sampled surface's own BVH instead of all its triangles:
   // nodes by their bound, a leaf's triangles handed to the pieces when it is opened.
-  MaxBracket run_from_tree(const TriangleBvh& tree, double threshold) {
+  MaxBracket run_from_tree(const TriangleBvh& tree, double threshold, bool lean) {
     decided_at = threshold;
+    lean_ = lean && threshold >= 0.0;
     node_hint.assign(size_t(tree.num_nodes()), -1);
     open_node(tree, 0, -1);
     double top = 0.0;
@@ -135,7 +136,7 @@ class MaxSearch {
         const int32_t hint = node_hint[size_t(i)];
         if (n.count > 0) {
           for (int32_t s = n.first; s < n.first + n.count; ++s)
-            if (!settled_beneath(tree.slot_corners(s))) add_triangle(tree.slot_corners(s), tree.slot_triangle(s), hint);
+            if (double tried_at = -1.0; !settled_beneath(tree.slot_corners(s), tried_at)) add_slot(tree, s, hint, tried_at);
         } else {
           open_node(tree, i + 1, hint);
           open_node(tree, n.first, hint);
@@ -174,6 +175,8 @@ class MaxSearch {
   // run_from_tree's threshold: bounds at or below it are settled, and a distance above it ends
   // the search (whether the max exceeds it is then decided)
   double decided_at = -1.0;
+  // run_from_tree's verdict-only walk (the lower bound only decides whether the max exceeds decided_at)
+  bool lean_ = false;
 
   double threshold() const { return std::max({out.lower * (1 + relative_tolerance), floor, decided_at}); }
   bool tolerated(double upper) const { return upper <= threshold(); }
@@ -265,11 +268,13 @@ class MaxSearch {
   // Bounds a new piece (by the triangles beneath it when its corners' do not settle it, then
   // with its centroid's nearest triangle, a query that rarely settles a piece the bound beneath
   // left open) and queues it unless tolerated.
-  void keep(Piece& piece) {
+  // beneath_tried_at: the threshold at which the bound beneath this piece already failed (-1:
+  // not tried); at the same threshold it would fail again.
+  void keep(Piece& piece, double beneath_tried_at = -1.0) {
     bound(piece);
     if (by_quarters && !tolerated(piece.upper)) piece.upper = std::min(piece.upper, quarter_bound(piece));
     // only a bound that settles the piece is looked for: the box searched stays small
-    if (!tolerated(piece.upper) && worth_projecting(piece))
+    if (!tolerated(piece.upper) && beneath_tried_at != threshold() && worth_projecting(piece))
       piece.upper =
           std::min(piece.upper, projected_bound(piece.p, to, threshold(), kBeneathCandidates, scratch, by_quarters));
     if (!tolerated(piece.upper)) {
@@ -306,12 +311,16 @@ class MaxSearch {
 
   // A leaf's triangle settled by the bound beneath it without measuring its corners, where the
   // other surface is far coarser (a tiny result seen from its input): a few candidates.
-  bool settled_beneath(const double* corners) {
+  // tried_at: the threshold at which the bound was tried and failed (else left as it was).
+  bool settled_beneath(const double* corners, double& tried_at) {
     const double p[3][3] = {{corners[0], corners[1], corners[2]}, {corners[3], corners[4], corners[5]},
                             {corners[6], corners[7], corners[8]}};
     if (spanned(p) > kSettleSpan) return false;
     const double bound = projected_bound(p, to, threshold(), kBeneathCandidates, scratch);
-    if (!tolerated(bound)) return false;
+    if (!tolerated(bound)) {
+      tried_at = threshold();
+      return false;
+    }
     settled = std::max(settled, bound);
     return true;
   }
@@ -356,10 +365,13 @@ class MaxSearch {
       }
     }
     upper = std::min(upper, std::sqrt(farthest));
-    const double* t = tree.slot_corners(first);
-    const double centroid[3] = {(t[0] + t[3] + t[6]) / 3.0, (t[1] + t[4] + t[7]) / 3.0, (t[2] + t[5] + t[8]) / 3.0};
-    query(centroid, hit.slot);
-    if (out.lower_triangle == -2) out.lower_triangle = tree.slot_triangle(first);
+    // lean: a node its bound settles needs no lower bound from it.
+    if (!lean_ || !tolerated(upper)) {
+      const double* t = tree.slot_corners(first);
+      const double centroid[3] = {(t[0] + t[3] + t[6]) / 3.0, (t[1] + t[4] + t[7]) / 3.0, (t[2] + t[5] + t[8]) / 3.0};
+      query(centroid, hit.slot);
+      if (out.lower_triangle == -2) out.lower_triangle = tree.slot_triangle(first);
+    }
     if (tolerated(upper)) {
       settled = std::max(settled, upper);
     } else {
@@ -384,6 +396,40 @@ class MaxSearch {
     piece.hint = hint;
     keep(piece);
     return hint;
+  }
+
+  // run_from_tree's measured corners, per vertex of the sampled surface (allocated at the first
+  // leaf opened): distance (-1 while unmeasured), nearest triangle and slot
+  std::vector<double> vertex_d;
+  std::vector<int32_t> vertex_triangle, vertex_slot_near;
+
+  // A leaf's triangle as a piece, as add_triangle, but each vertex of the sampled surface is
+  // measured once (a vertex is a corner of about six triangles): the same distances, fewer queries.
+  // beneath_tried_at: as keep's.
+  void add_slot(const TriangleBvh& tree, int32_t s, int32_t hint, double beneath_tried_at) {
+    if (vertex_d.empty()) {
+      vertex_d.assign(size_t(from.num_vertices()), -1.0);
+      vertex_triangle.assign(size_t(from.num_vertices()), -1);
+      vertex_slot_near.assign(size_t(from.num_vertices()), -1);
+    }
+    const double* corners = tree.slot_corners(s);
+    Piece piece;
+    piece.source = tree.slot_triangle(s);
+    for (int j = 0; j < 3; ++j) {
+      const size_t v = size_t(from.triangles()[3 * size_t(piece.source) + j]);
+      std::copy_n(corners + 3 * j, 3, piece.p[j]);
+      if (vertex_d[v] < 0.0) {
+        const ClosestHit hit = query(piece.p[j], hint);
+        if (out.lower_triangle == -2) out.lower_triangle = piece.source;
+        vertex_d[v] = std::sqrt(hit.distance2), vertex_triangle[v] = hit.triangle, vertex_slot_near[v] = hit.slot;
+      }
+      hint = vertex_slot_near[v];
+      piece.d[j] = vertex_d[v];
+      piece.near[j] = vertex_triangle[v];
+    }
+    piece.near[3] = -1;
+    piece.hint = hint;
+    keep(piece, beneath_tried_at);
   }
 
   // The sampled surface's triangles as the first pieces, with each used vertex's nearest triangle.
@@ -473,11 +519,11 @@ MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32
 }
 
 MaxBracket bound_max_distance_by_tree(const Surface& from, const Surface& to, double relative_tolerance,
-                                      int64_t max_queries, double threshold) {
+                                      int64_t max_queries, double threshold, bool lean) {
   static const std::vector<double> no_vertex_distance;
   const double origin[3] = {0.0, 0.0, 0.0};
   MaxSearch search(from, no_vertex_distance, to, 0.0, origin, relative_tolerance, max_queries);
-  return search.run_from_tree(from.bvh(), threshold);
+  return search.run_from_tree(from.bvh(), threshold, lean);
 }
 
 }  // namespace topstoc

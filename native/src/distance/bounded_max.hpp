@@ -62,7 +62,10 @@ double nearest_corner_reach(const double p[3][3]);
 /// distance, so a large A close to B costs far fewer queries than measuring all its vertices.
 /// threshold (>= 0 to use it): bounds at or below it need no refinement and a distance above it
 /// ends the search, so only whether the max exceeds it is decided (cheaper near neither).
+/// lean (with a threshold): nodes their bound settles are not sampled for the lower bound, so
+/// `lower` is the largest distance met on the way, not the best the walk could report (the
+/// verdict holds; the fit, which reads lower, keeps the full walk).
 MaxBracket bound_max_distance_by_tree(const Surface& from, const Surface& to, double relative_tolerance,
-                                      int64_t max_queries = 4000000, double threshold = -1.0);
+                                      int64_t max_queries = 4000000, double threshold = -1.0, bool lean = false);
 
 }  // namespace topstoc

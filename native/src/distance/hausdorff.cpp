@@ -426,7 +426,7 @@ OneSidedBracket one_sided(const MaxBracket& bracket) {
 OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, double tolerance, int64_t max_queries,
                                       double threshold) {
   if (!(tolerance > 0.0)) throw std::invalid_argument("tolerance must be positive, got " + shown(tolerance));
-  return one_sided(bound_max_distance_by_tree(from, to, tolerance, max_queries, threshold));
+  return one_sided(bound_max_distance_by_tree(from, to, tolerance, max_queries, threshold, true));
 }
 
 SymmetricBracket bracket_symmetric_max(const Surface& a, const Surface& b, double tolerance, double resolution,

@@ -121,7 +121,8 @@ struct OneSidedBracket {
 /// BVH opening only the boxes that may hide a larger distance, then the bounded refinement of
 /// their triangles (bounded_max.hpp), until the relative gap is within `tolerance` (> 0) or
 /// `max_queries` queries were made (the bracket holds either way). threshold >= 0: stop as soon as
-/// the max is known to lie above it or at most at it (the bracket is then only as tight as that needs).
+/// the max is known to lie above it or at most at it (the bracket is then only as tight as that needs;
+/// `lower` is then only the largest distance the walk met, bounded_max.hpp's lean walk).
 OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, double tolerance, int64_t max_queries,
                                       double threshold = -1.0);
 
