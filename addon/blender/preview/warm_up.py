@@ -1,0 +1,101 @@
+"""Live preview warm-ups: while the user drags (drafts on screen), an idle worker builds what the
+rested Quality result resumes from, so that the rest only runs the part that depends on its ratio.
+
+A quality decimation of a mesh collapsed whole goes the same way toward every target until its
+collapses start to depend on the target; the engine keeps that state, and the input's search
+structure, with the prepared mesh (core.api.decimate.warm_up, Mesh.kept_for_reuse). A warm-up
+toward a ratio serves every rest at that ratio or below, with the same result to the bit as a
+decimation that starts from nothing. The warm-ups follow the drag: a new one starts when the
+drag asks a ratio that no state made in this session serves closely (above all of them, or
+WARM_MARGIN below the nearest one above). A rest waits for a warm-up that serves it instead of
+making the same collapses beside it, and cancels one that cannot; closing the session cancels it.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Callable, Optional
+
+from ...core.api.decimate import CancelFlag
+from ...core.api.loops import Cancelled
+
+WARM_MARGIN = 0.85  # a state made toward ratio w serves a rest at r in [WARM_MARGIN w, w] closely enough
+
+
+class WarmUps:
+    """The warm-ups of one preview session (thread-safe). ``warm(ratio, cancel)`` runs one in the
+    engine and returns whether a state is kept for such rests (False: none ever is, for these
+    settings, and no warm-up is tried again)."""
+
+    def __init__(self, warm: Callable[[float, CancelFlag], bool]):
+        self._warm = warm
+        self._lock = threading.Lock()
+        self._made: list = []        # ratios toward which a state was made (warm-ups and rests)
+        self._running = None         # (ratio, CancelFlag, threading.Event set when it ends)
+        self.applies = True          # False once a warm-up kept nothing (guidance, fast mode, ...)
+        self.finished = 0            # warm-ups run to their end
+
+    def wanted(self, ratio: Optional[float]) -> bool:
+        """True when a warm-up toward ``ratio`` would serve a rest there better than what exists."""
+        with self._lock:
+            if ratio is None or not self.applies or self._running is not None:
+                return False
+            above = [made for made in self._made if made >= ratio]
+            return not above or ratio < WARM_MARGIN * min(above)
+
+    def run(self, ratio: float) -> None:
+        """One warm-up toward ``ratio`` (a worker; returns when it ends or is cancelled)."""
+        with self._lock:
+            if self._running is not None:
+                return
+            running = self._running = (ratio, CancelFlag(), threading.Event())
+        kept = None
+        try:
+            kept = self._warm(ratio, running[1])
+        except Cancelled:
+            pass
+        except Exception:  # noqa: BLE001 - the rest's own decimation raises it where it is shown
+            kept = False
+        finally:
+            with self._lock:
+                self._running = None
+                if kept is not None:
+                    self.applies = self.applies and kept
+                    self.finished += 1
+                    if kept:
+                        self._made.append(ratio)
+            running[2].set()
+
+    def settle(self, ratio: float, cancel: Optional[CancelFlag] = None) -> None:
+        """Before a chosen-settings computation at ``ratio``: waits for a running warm-up toward
+        it or above (the computation resumes from its state), cancels one toward a lower ratio.
+        ``cancel`` (the computation's) set while it waits raises Cancelled."""
+        with self._lock:
+            running = self._running
+        if running is None:
+            return
+        if running[0] < ratio:
+            running[1].set()
+            return
+        while not running[2].wait(0.005):
+            if cancel is not None and cancel.is_set:
+                raise Cancelled("cancelled while a warm-up ran")
+
+    def made(self, ratio: float) -> None:
+        """A chosen-settings computation at ``ratio`` kept its own state."""
+        with self._lock:
+            self._made.append(ratio)
+
+    def cancel(self) -> None:
+        """Stops a running warm-up (the session closes)."""
+        with self._lock:
+            running = self._running
+            self.applies = False
+        if running is not None:
+            running[1].set()
+
+    @property
+    def running(self) -> Optional[float]:
+        """The ratio of the warm-up running now, or None."""
+        with self._lock:
+            return None if self._running is None else self._running[0]
