@@ -111,6 +111,7 @@ class PreviewSession:
         self._pending = self.key(ratio, False) if ratio is not None else None  # latest request not started
         self._asked = self._pending            # latest request, and when it came (rest detection)
         self._asked_at = time.perf_counter()
+        self._highest = ratio or 0.0           # the highest ratio asked (what the warm-ups serve)
         self._interval = 0.0                   # running average of the seconds between a drag's ratios
         self._new_request = threading.Event()  # wakes a worker waiting to speculate
         self._waiting = 0                      # workers waiting so (not staggered against: idle)
@@ -291,6 +292,7 @@ class PreviewSession:
             if now - self._asked_at < EVENT_GAP:  # within a drag (a loaded machine spaces its events)
                 self._interval = 0.7 * self._interval + 0.3 * (now - self._asked_at)
             self._asked, self._asked_at = self.key(ratio, final), now
+            self._highest = max(self._highest, ratio)
             if self.final and ratio == self.ratio:
                 self._pending = self._finished = self._started = None
                 self._shown_order = self._started_count
@@ -404,12 +406,12 @@ class PreviewSession:
 
     def _warm_up_to_start(self) -> Optional[float]:
         """For a worker with nothing else to do (under the lock): the ratio to warm the chosen
-        settings' computation up toward (the latest ratio of the drag), or None: not for a rest,
-        whose own computation is asked already."""
+        settings' computation up toward (WarmUps.next), or None: not for a rest, whose own
+        computation is asked already."""
         asked = self._asked
         if asked is None or asked[1] or self.direct or self._cancel.is_set() or asked[0] in self._kept:
             return None
-        return asked[0] if self.warm_ups.wanted(asked[0]) else None
+        return self.warm_ups.next(asked[0], self._highest)
 
     def _speculate(self, key, cancel: CancelFlag) -> bool:
         """Computes a speculation (worker): kept like any chosen-settings result, and shown when

@@ -5,9 +5,10 @@ A quality decimation of a mesh collapsed whole goes the same way toward every ta
 collapses start to depend on the target; the engine keeps that state, and the input's search
 structure, with the prepared mesh (core.api.decimate.warm_up, Mesh.kept_for_reuse). A warm-up
 toward a ratio serves every rest at that ratio or below, with the same result to the bit as a
-decimation that starts from nothing. The warm-ups follow the drag: a new one starts when the
-drag asks a ratio that no state made in this session serves closely (above all of them, or
-WARM_MARGIN below the nearest one above). A rest waits for a warm-up that serves it instead of
+decimation that starts from nothing. The warm-ups follow the drag: first toward a little above
+the highest ratio asked in the session (HEADROOM: the drag wanders up and down, and a state
+serves only ratios below it), then toward the latest ratio when no state made in this session
+serves it closely (within CLOSE above it). A rest waits for a warm-up that serves it instead of
 making the same collapses beside it, and cancels one that cannot; closing the session cancels it.
 """
 
@@ -19,7 +20,8 @@ from typing import Callable, Optional
 from ...core.api.decimate import CancelFlag
 from ...core.api.loops import Cancelled
 
-WARM_MARGIN = 0.85  # a state made toward ratio w serves a rest at r in [WARM_MARGIN w, w] closely enough
+HEADROOM = 1.15  # a warm-up for ratio r goes toward HEADROOM r (capped at 1)
+CLOSE = 1.3  # a state made toward w serves ratio r closely when r <= w <= CLOSE r
 
 
 class WarmUps:
@@ -35,13 +37,16 @@ class WarmUps:
         self.applies = True          # False once a warm-up kept nothing (guidance, fast mode, ...)
         self.finished = 0            # warm-ups run to their end
 
-    def wanted(self, ratio: Optional[float]) -> bool:
-        """True when a warm-up toward ``ratio`` would serve a rest there better than what exists."""
+    def next(self, latest: float, highest: float) -> Optional[float]:
+        """The ratio to warm up toward now, for a drag whose latest ratio is ``latest`` and
+        highest so far ``highest``; None when none is wanted (or one runs)."""
         with self._lock:
-            if ratio is None or not self.applies or self._running is not None:
-                return False
-            above = [made for made in self._made if made >= ratio]
-            return not above or ratio < WARM_MARGIN * min(above)
+            if not self.applies or self._running is not None:
+                return None
+            for ratio in (highest, latest):
+                if not any(ratio <= made <= CLOSE * ratio for made in self._made if made >= ratio):
+                    return min(1.0, HEADROOM * ratio)
+            return None
 
     def run(self, ratio: float) -> None:
         """One warm-up toward ``ratio`` (a worker; returns when it ends or is cancelled)."""
