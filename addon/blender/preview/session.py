@@ -411,7 +411,7 @@ class PreviewSession:
         asked = self._asked
         if asked is None or asked[1] or self.direct or self._cancel.is_set() or asked[0] in self._kept:
             return None
-        return self.warm_ups.next(asked[0], self._highest)
+        return self.warm_ups.next(self._highest)
 
     def _speculate(self, key, cancel: CancelFlag) -> bool:
         """Computes a speculation (worker): kept like any chosen-settings result, and shown when

@@ -5,11 +5,13 @@ A quality decimation of a mesh collapsed whole goes the same way toward every ta
 collapses start to depend on the target; the engine keeps that state, and the input's search
 structure, with the prepared mesh (core.api.decimate.warm_up, Mesh.kept_for_reuse). A warm-up
 toward a ratio serves every rest at that ratio or below, with the same result to the bit as a
-decimation that starts from nothing. The warm-ups follow the drag: first toward a little above
-the highest ratio asked in the session (HEADROOM: the drag wanders up and down, and a state
-serves only ratios below it), then toward the latest ratio when no state made in this session
-serves it closely (within CLOSE above it). A rest waits for a warm-up that serves it instead of
-making the same collapses beside it, and cancels one that cannot; closing the session cancels it.
+decimation that starts from nothing. A warm-up goes toward a little above the highest ratio
+asked in the session (HEADROOM: the drag wanders up and down, and a state serves only ratios
+below it), again when the drag goes above the states made (CLOSE). Not toward each ratio
+of the drag: the mesh keeps two states (the highest, and the latest made), so states made along
+the drag would push out the one a rest at the drag's start resumes from; a rest at a tenth of
+the highest ratio still skips about nine tenths of a cold run's collapses. A rest waits for a warm-up that serves it instead of making the same collapses
+beside it, and cancels one that cannot; closing the session cancels it.
 """
 
 from __future__ import annotations
@@ -37,16 +39,15 @@ class WarmUps:
         self.applies = True          # False once a warm-up kept nothing (guidance, fast mode, ...)
         self.finished = 0            # warm-ups run to their end
 
-    def next(self, latest: float, highest: float) -> Optional[float]:
-        """The ratio to warm up toward now, for a drag whose latest ratio is ``latest`` and
-        highest so far ``highest``; None when none is wanted (or one runs)."""
+    def next(self, highest: float) -> Optional[float]:
+        """The ratio to warm up toward now, for a drag whose highest ratio so far is ``highest``;
+        None when none is wanted (a state made lies at most CLOSE times above it, or one runs)."""
         with self._lock:
             if not self.applies or self._running is not None:
                 return None
-            for ratio in (highest, latest):
-                if not any(ratio <= made <= CLOSE * ratio for made in self._made if made >= ratio):
-                    return min(1.0, HEADROOM * ratio)
-            return None
+            if any(highest <= made <= CLOSE * highest for made in self._made):
+                return None
+            return min(1.0, HEADROOM * highest)
 
     def run(self, ratio: float) -> None:
         """One warm-up toward ``ratio`` (a worker; returns when it ends or is cancelled)."""
