@@ -43,7 +43,8 @@ runs at a time, so a worker stays free for the drafts.
 
 Before that, from the start of the preview and all along the drag, a worker with nothing else to
 do warms the chosen settings' computation up (warm_up.py): it builds what the rested result
-resumes from, toward the ratios the drag asks, so that the rest runs only its final part.
+resumes from, toward a little above the highest ratio asked, so that the rest runs only the
+part that depends on its ratio.
 """
 
 from __future__ import annotations
