@@ -223,7 +223,9 @@ void bind_decimation_state(py::module_& m) {
       .def("clear", &CollapseSnapshots::clear, "Frees the kept states.")
       .def_property_readonly("size", &CollapseSnapshots::size, "States kept.")
       .def_property_readonly("surfaces", &CollapseSnapshots::surfaces,
-                             "Input surfaces kept (the distance passes' and the fit's search structures).");
+                             "Input surfaces kept (the distance passes' and the fit's search structures).")
+      .def_property_readonly("resumed", &CollapseSnapshots::resumed, "Runs that resumed from a kept state.")
+      .def_property_readonly("surfaces_made", &CollapseSnapshots::surfaces_made, "Input surfaces made.");
 
   py::class_<CancelToken>(m, "CancelFlag",
                           "Set from any thread, stops the decimation given it at its next check (raises Cancelled).")
@@ -317,6 +319,27 @@ void bind_decimate(py::module_& m) {
       "TopStoc decimation of a topstoc.core.api.job.DecimationJob (a triangle target when it has one); "
       "cancel: a CancelFlag another thread may set (Cancelled is raised); collapse_snapshots: a "
       "CollapseSnapshots of this mesh and layout (the same result, lower targets sooner).");
+
+  m.def(
+      "warm_up",
+      [](const Mesh& mesh, const FeatureLayout& layout, const py::handle& job, CollapseSnapshots& collapse_snapshots,
+         const py::handle& cancel) {
+        JobArrays arrays;
+        DecimateParams params = params_from(mesh, job, arrays);
+        params.collapse_snapshots = &collapse_snapshots;
+        params.warm_up = true;
+        const py::object triangles = job.attr("target").attr("triangles");
+        if (!triangles.is_none()) return false;  // a triangle target keeps no state
+        const CancelFlag* flag = cancel.is_none() ? nullptr : &cancel.cast<CancelToken&>().flag;
+        EngineCall call;
+        CancelScope scope(flag);
+        return decimate(mesh, layout, params).refine_vertices > 0;
+      },
+      py::arg("mesh"), py::arg("layout"), py::arg("job"), py::arg("collapse_snapshots"),
+      py::arg("cancel") = py::none(),
+      "Builds in collapse_snapshots what a later decimate of this job, or of it at a lower vertex target, "
+      "resumes from (DecimateParams::warm_up), the same result either way; False where none is kept. "
+      "cancel: a CancelFlag (Cancelled is raised).");
 
   m.def(
       "decimate_with_samples",

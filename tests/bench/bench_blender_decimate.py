@@ -248,7 +248,7 @@ def print_rest(ratio, rests):
             "drag_updates_per_s": rate, "repeats": len(rests), "load_average": os.getloadavg()[0]}
 
 
-REST_METHOD = ("a PreviewSession with Quality chosen, after a 1 s drag (a ratio requested every 10 ms over "
+REST_METHOD = ("a PreviewSession with Quality chosen, after a 1 s drag (--drag; a ratio requested every 10 ms over "
                "[ratio / 1.5, ratio]): seconds from the last request to the Quality result on screen (polled at "
                "60 Hz), medians of the repeats; builds alternate one mesh at a time (TOPSTOC_BUILD); a label "
                "with 'cold' (--cold): each drag starts with nothing kept from earlier decimations of the mesh")
@@ -311,6 +311,7 @@ def main(argv):
     parser.add_argument("--subdivide", type=int, default=0, help="split every triangle in four this many times")
     parser.add_argument("--cold", action="store_true",
                         help="with --only-rest: each drag starts with nothing kept from earlier decimations")
+    parser.add_argument("--drag", type=float, default=1.0, help="with --only-rest: seconds of the drag before the rest")
     parser.add_argument("--json", metavar="FILE", help="with --only-rest: merge the rest figures into this file")
     parser.add_argument("--label", default="after", help="the build's name in --json (before, after)")
     args = parser.parse_args(argv)
@@ -331,7 +332,8 @@ def main(argv):
     rest_rows = []
     for ratio in args.ratios:
         if args.only_rest:
-            rest_rows.append(print_rest(ratio, [rested_quality(obj, ratio, cold=args.cold) for _ in range(args.repeat)]))
+            rest_rows.append(print_rest(ratio, [rested_quality(obj, ratio, args.drag, cold=args.cold)
+                                                    for _ in range(args.repeat)]))
             continue
         firsts = []
         for _ in range(args.repeat):

@@ -78,3 +78,51 @@ def test_the_fit_of_small_results_measures_against_a_kept_input(torus):
     assert plain.kept_for_reuse()[2] is None
     mesh.clear_floods()
     assert snapshots.surfaces == 0
+
+
+def test_a_warm_up_is_what_the_next_decimations_resume_from(torus):
+    """warm_up builds the first collapse run's state and the input surface a later decimation at
+    its ratio or below resumes from: that decimation makes no surface and resumes from a kept
+    state, with the results of a mesh that keeps nothing."""
+    from topstoc.core.api.decimate import warm_up, run_job
+    from topstoc.core.api.job import make_job
+
+    mesh, plain = Mesh(*torus), Mesh(*torus, keep_floods=False)
+    snapshots = mesh.kept_for_reuse()[2]
+    assert warm_up(mesh, make_job(mesh, ratio=0.1)) is True
+    assert (snapshots.size, snapshots.surfaces, snapshots.resumed, snapshots.surfaces_made) == (1, 1, 0, 1)
+    for ratio, resumed in ((0.1, 1), (0.07, 2)):
+        assert_same(run_job(mesh, make_job(mesh, ratio=ratio)), plain.decimate(ratio=ratio))
+        assert (snapshots.resumed, snapshots.surfaces_made) == (resumed, 1)
+    # Above the warm-up's ratio nothing serves: the state is made from the start.
+    assert_same(mesh.decimate(ratio=0.15), plain.decimate(ratio=0.15))
+    assert snapshots.resumed == 2
+
+
+def test_a_warm_up_keeps_nothing_where_no_decimation_would(torus):
+    from topstoc.core.api.decimate import warm_up
+    from topstoc.core.api.job import make_job
+
+    vertices, _ = torus
+    mesh = Mesh(*torus)
+    snapshots = mesh.kept_for_reuse()[2]
+    guidance = np.where(vertices[:, 2] > 0, 0.5, 0.0)
+    assert warm_up(mesh, make_job(mesh, ratio=0.05, guidance=guidance)) is False
+    assert warm_up(mesh, make_job(mesh, ratio=0.05, mode="fast")) is False
+    assert warm_up(mesh, make_job(mesh, target_triangles=900)) is False
+    assert warm_up(Mesh(*torus, keep_floods=False), make_job(mesh, ratio=0.05)) is False
+    assert (snapshots.size, snapshots.surfaces_made) == (0, 0)
+
+
+def test_a_cancelled_warm_up_leaves_the_results_unchanged(torus):
+    from topstoc.core.api.decimate import CancelFlag, warm_up
+    from topstoc.core.api.loops import Cancelled
+    from topstoc.core.api.job import make_job
+
+    mesh, plain = Mesh(*torus), Mesh(*torus, keep_floods=False)
+    flag = CancelFlag()
+    flag.set()
+    with pytest.raises(Cancelled):
+        warm_up(mesh, make_job(mesh, ratio=0.1), flag)
+    assert mesh.kept_for_reuse()[2].size == 0
+    assert_same(mesh.decimate(ratio=0.08), plain.decimate(ratio=0.08))

@@ -40,6 +40,11 @@ mouse events, so that a sweep keeps both workers for drafts). The ratio moving o
 the engine; when the drag rests there it is already under way (the rest takes it over instead
 of starting anew) or done (it is shown as soon as it is, rest or not). One such computation
 runs at a time, so a worker stays free for the drafts.
+
+Before that, from the start of the preview and all along the drag, a worker with nothing else to
+do warms the chosen settings' computation up (warm_up.py): it builds what the rested result
+resumes from, toward a little above the highest ratio asked, so that the rest runs only the
+part that depends on its ratio.
 """
 
 from __future__ import annotations
@@ -56,11 +61,12 @@ import numpy as np
 
 from ...core.carry.attributes import moved_vertices
 from ...core.api.loops import Cancelled
-from ...core.api.decimate import CancelFlag
+from ...core.api.decimate import CancelFlag, warm_up
 from ...core.api.mesh_edges import mesh_edges
 from ..io import mesh_read, mesh_write, edge_flags
 from ..decimation import pipeline
 from ..decimation.guidance import read as read_guidance
+from .warm_up import WarmUps
 
 PREVIEW_SUFFIX = "_TopStocPreview"
 WORKERS = 2 if (os.cpu_count() or 1) >= 2 else 1
@@ -106,6 +112,7 @@ class PreviewSession:
         self._pending = self.key(ratio, False) if ratio is not None else None  # latest request not started
         self._asked = self._pending            # latest request, and when it came (rest detection)
         self._asked_at = time.perf_counter()
+        self._highest = ratio or 0.0           # the highest ratio asked (what the warm-ups serve)
         self._interval = 0.0                   # running average of the seconds between a drag's ratios
         self._new_request = threading.Event()  # wakes a worker waiting to speculate
         self._waiting = 0                      # workers waiting so (not staggered against: idle)
@@ -113,6 +120,7 @@ class PreviewSession:
         self._speculation = None               # (key, CancelFlag) of the chosen-settings computation
                                                # started ahead of the rest (SPECULATE), while it runs
         self._options_key = repr(sorted(self.options.items()))  # the prepared mesh's final_seconds key
+        self.warm_ups = WarmUps(self._warm_up)  # what the rests resume from, built by idle workers
         self._started: Optional[tuple] = None  # newest computation started
         self._started_count = 0                # computations started (their order numbers)
         self._shown_order = 0                  # order number of the result shown last
@@ -214,8 +222,12 @@ class PreviewSession:
         start = time.perf_counter()
         options = self.options if final else self.drag_options
         mesh = self.prepared.mesh
+        if final:
+            self.warm_ups.settle(ratio, cancel)
         job = pipeline.engine_job(mesh, {"ratio": ratio}, options, self.guidance)
         result = pipeline.run_engine(mesh, job) if cancel is None else pipeline.run_engine(mesh, job, cancel=cancel)
+        if final:
+            self.warm_ups.made(ratio)
         edges = mesh_edges(result.triangles, len(result.vertices))
         flags = {}
         if any(len(pairs) for pairs in self._edge_flags.values()):
@@ -223,6 +235,11 @@ class PreviewSession:
             moved = np.any(np.asarray(result.vertices) != self.prepared.arrays.vertices[kept], axis=1)
             flags = edge_flags.output_edge_flags(self._edge_flags, edges.vertices, kept, moved)
         return self.key(ratio, final), result, edges, time.perf_counter() - start, flags
+
+    def _warm_up(self, ratio: float, cancel: CancelFlag) -> bool:
+        """WarmUps' engine call: the chosen settings' warm-up toward ``ratio`` (worker)."""
+        mesh = self.prepared.mesh
+        return warm_up(mesh, pipeline.engine_job(mesh, {"ratio": ratio}, self.options, self.guidance), cancel)
 
     def _make_preview(self) -> None:
         """The preview object, beside the hidden original (main thread, first result)."""
@@ -276,6 +293,7 @@ class PreviewSession:
             if now - self._asked_at < EVENT_GAP:  # within a drag (a loaded machine spaces its events)
                 self._interval = 0.7 * self._interval + 0.3 * (now - self._asked_at)
             self._asked, self._asked_at = self.key(ratio, final), now
+            self._highest = max(self._highest, ratio)
             if self.final and ratio == self.ratio:
                 self._pending = self._finished = self._started = None
                 self._shown_order = self._started_count
@@ -317,13 +335,19 @@ class PreviewSession:
                 if key is None or key == self._started or self._cancel.is_set():
                     self._new_request.clear()
                     (speculation, wait), order = self._speculation_to_start(), 0
-                    if speculation is None and wait is None:
+                    warm = self._warm_up_to_start() if speculation is None else None
+                    if speculation is None and wait is None and warm is None:
                         self._workers -= 1
                         return
-                    self._waiting += wait is not None
+                    wait = None if warm is not None else wait
+                    self._waiting += wait is not None or warm is not None
                 else:
-                    speculation, wait, order = None, None, self._mark_started(key)
-            if wait is not None:  # the drag may only be between two events: look again then (or at one)
+                    speculation, wait, warm, order = None, None, None, self._mark_started(key)
+            if warm is not None:  # idle meanwhile: what the rest will resume from (not staggered against)
+                self.warm_ups.run(warm)
+                with self._lock:
+                    self._waiting -= 1
+            elif wait is not None:  # the drag may only be between two events: look again then (or at one)
                 self._new_request.wait(wait)
                 with self._lock:
                     self._waiting -= 1
@@ -380,6 +404,15 @@ class PreviewSession:
             return None, wait
         self._speculation = (self.key(asked[0], True), CancelFlag())
         return self._speculation, None
+
+    def _warm_up_to_start(self) -> Optional[float]:
+        """For a worker with nothing else to do (under the lock): the ratio to warm the chosen
+        settings' computation up toward (WarmUps.next), or None: not for a rest, whose own
+        computation is asked already."""
+        asked = self._asked
+        if asked is None or asked[1] or self.direct or self._cancel.is_set() or asked[0] in self._kept:
+            return None
+        return self.warm_ups.next(self._highest)
 
     def _speculate(self, key, cancel: CancelFlag) -> bool:
         """Computes a speculation (worker): kept like any chosen-settings result, and shown when
@@ -549,6 +582,7 @@ class PreviewSession:
         unseen; workers never touch Blender data, so nothing waits for them."""
         self._cancel.set()
         self._new_request.set()
+        self.warm_ups.cancel()
         with self._lock:
             if self._speculation is not None:
                 self._speculation[1].set()

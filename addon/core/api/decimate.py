@@ -283,6 +283,20 @@ def run_job(mesh: Mesh, job: DecimationJob, progress=None, cancel: Optional[Canc
     return _result(raw, job.parameters(), mesh, job)
 
 
+def warm_up(mesh: Mesh, job: DecimationJob, cancel: Optional[CancelFlag] = None) -> bool:
+    """Builds what a later ``run_job`` of ``job``, or of it at a lower vertex count, resumes from
+    (the first collapse run's state and the input's search structure, kept by the mesh: see
+    Mesh.kept_for_reuse), so that it spends only the part that depends on its target; the
+    results stay the same to the bit. True when a state is kept for such a run (a quality job of
+    a mesh collapsed whole, without guidance); cancel as in run_job (raises Cancelled)."""
+    if job.symmetry is not None or job.target.max_error is not None or job.target.triangles is not None:
+        return False
+    layout, _floods, snapshots = mesh.kept_for_reuse(job.regions, job.borders, job.feature_angle)
+    if snapshots is None:
+        return False
+    return engine.warm_up(mesh.native, layout, job, snapshots, cancel=cancel)
+
+
 #: DecimateStats fields counted in Python; every other field is the engine result's of the same name
 _COUNTED_HERE = {"output_vertices", "output_triangles", "target_triangles", "control_points", "zero_area_input",
                  "mirrored_from", "replayed", "nonmanifold_vertices", "invariants_kept"}

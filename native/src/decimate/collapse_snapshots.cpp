@@ -93,6 +93,7 @@ std::shared_ptr<const CollapseSnapshots::Entry> CollapseSnapshots::find(const st
   for (const auto& e : entries_)
     if (e->start == start && e->run_vertices >= vertices && (!best || e->run_vertices < best->run_vertices))
       best = e;
+  resumed_ += best != nullptr;
   return best;
 }
 
@@ -123,6 +124,7 @@ std::shared_ptr<const Surface> CollapseSnapshots::input_surface(
     }
   if (surfaces_.size() >= kSurfaces) surfaces_.erase(surfaces_.begin());  // freed before the new one is made
   surfaces_.emplace_back(key, make());
+  ++surfaces_made_;
   return surfaces_.back().second;
 }
 
@@ -140,6 +142,16 @@ size_t CollapseSnapshots::size() const {
 size_t CollapseSnapshots::surfaces() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return surfaces_.size();
+}
+
+size_t CollapseSnapshots::resumed() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return resumed_;
+}
+
+size_t CollapseSnapshots::surfaces_made() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return surfaces_made_;
 }
 
 }  // namespace topstoc

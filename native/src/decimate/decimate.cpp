@@ -827,6 +827,9 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   first.placement = Placement::Subsample;  // the refinement places the vertices it keeps
   first.labels_in_mesh_order = true;        // what the refinement reads (no copy in its order)
   first.target_vertices = first_pass_vertices(params, active);
+  first.warm_up = false;
+  if (params.warm_up && (first.target_vertices != active || !params.collapse_snapshots || target_triangles > 0))
+    return {};  // a first pass that depends on the target: no state a later decimation could resume from
   DecimateResult result = stochastic_pass(mesh, layout, first, true);
   const std::vector<double> multipliers = multipliers_if_guided(mesh, params.sampling);
   RefineParams refine;
@@ -837,8 +840,14 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   refine.max_aware = refine.refit;
   refine.attributes = params.attributes;
   refine.snapshots = params.collapse_snapshots;
+  refine.warm_up = params.warm_up;
   check_cancelled("refinement");
   refine_by_collapses(mesh, layout, refine, result);
+  if (params.warm_up) {  // the kept state is the point: the result is unfinished
+    DecimateResult warmed;
+    warmed.refine_vertices = result.refine_vertices;  // set where the max-aware collapses ran
+    return warmed;
+  }
   result.target_vertices = params.target_vertices;
   // What must stay whatever the target: border corners and control points (the first pass
   // may have drawn every vertex, which says nothing about the budget).
@@ -856,6 +865,7 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
     throw std::invalid_argument("refine must be 0 (off) or at least 1, got " + std::to_string(params.refine));
   if (params.refine >= 1.0 && params.target_vertices >= 1 && params.target_vertices <= active)
     return refined(mesh, layout, params, 0);
+  if (params.warm_up) return {};  // plain TopStoc keeps no collapse state
   return stochastic_pass(mesh, layout, params, false);
 }
 

@@ -316,6 +316,7 @@ class Refinement {
                                                  [](double m) { return m != 1.0; })) {}
 
   void run() {
+    if (params.warm_up && (guided || params.target_triangles > 0 || !params.snapshots)) return;  // none kept
     const auto& source = mesh.vertex_source();
     CollapseSetup setup;
     const auto frame = quadric_frame(mesh, layout);
@@ -342,6 +343,9 @@ class Refinement {
     const double center[3] = {setup.center[0], setup.center[1], setup.center[2]}, extent = setup.extent;
     if (params.max_aware && n == num_input - mesh.report().isolated_vertices) {
       collapse_max_aware(std::move(setup), center, extent);
+      if (params.warm_up) return;
+    } else if (params.warm_up) {
+      return;  // no state is kept on this path
     } else {
       Collapser collapser(result.triangles, result.corner_source, std::move(setup));
       collapse(collapser, center, extent);
@@ -513,6 +517,7 @@ class Refinement {
     const std::vector<int32_t> restart_triangles = result.triangles, restart_corners = result.corner_source;
     best.collapses = shared + collapse_rest(*best.collapser, center, extent);
     const std::shared_ptr<const Surface> whole = kept_input(*best.collapser, 1);
+    if (params.warm_up) return;  // what a later run reuses is kept
     const InputSurface input(mesh, whole);
     best.deviation = surface_deviation(mesh, input, label, *best.collapser, result.triangles);
     best.triangles = result.triangles, best.corners = result.corner_source;

@@ -58,6 +58,9 @@ struct RefineParams {
   /// Collapse states of earlier max-aware refinements of this mesh and layout, or null: a run
   /// toward a lower vertex target resumes from one (unguided vertex targets only; the same result).
   CollapseSnapshots* snapshots = nullptr;
+  /// Stop once the kept state and input surface a later refinement reuses are made
+  /// (DecimateParams::warm_up): the result is left unfinished.
+  bool warm_up = false;
   CornerAttributes attributes;
 };
 

@@ -48,10 +48,15 @@ class CollapseSnapshots {
   size_t size() const;
   /// Input surfaces kept.
   size_t surfaces() const;
+  /// Runs that resumed from a kept state (find found one), and input surfaces made, since made.
+  size_t resumed() const;
+  size_t surfaces_made() const;
 
  private:
   mutable std::mutex mutex_;
   size_t capacity_;
+  mutable size_t resumed_ = 0;
+  size_t surfaces_made_ = 0;
   std::vector<std::shared_ptr<const Entry>> entries_;  // the most recently kept last
   std::vector<std::pair<std::vector<uint64_t>, std::shared_ptr<const Surface>>> surfaces_;  // most recent last
 };

@@ -77,6 +77,12 @@ struct DecimateParams {
   /// the full decimation collapses that pass further (collapses_skipped); output_checked tells
   /// that it was not re-checked. A frame takes about three quarters of a full decimation's time.
   bool draft = false;
+  /// A warm-up (quality decimations with collapse_snapshots only): builds what a later
+  /// decimation toward this target or a lower one resumes from, the first collapse run's kept
+  /// state and the input's search structure, and stops there; its result is empty. Does
+  /// nothing where a decimation would keep no state (no snapshots, guidance, a triangle
+  /// target, a mesh not collapsed whole, not max-aware); refine_vertices > 0 tells it did.
+  bool warm_up = false;
   /// Internal (a refined decimation's first pass): labels in the mesh's vertex order.
   bool labels_in_mesh_order = false;
 };
