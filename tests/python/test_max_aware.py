@@ -143,3 +143,25 @@ def test_the_choice_takes_the_rerun_that_lowers_the_max(name, ratio, max_bound, 
     error = hausdorff((v, t), r, samples=100_000, relative=True, percentile=0).symmetric
     assert 100 * error.max <= max_bound * blender["max"], 100 * error.max / blender["max"]
     assert 100 * error.mean <= mean_bound * blender["mean"], 100 * error.mean / blender["mean"]
+
+
+# Below its floor (the topology or the borders stop the collapses above the target) the reruns
+# had restarted from twice the target, which the first run never reached: they began at its end
+# and could not move a vertex. They now restart from twice where it ended (refine.cpp,
+# restart_above), and runs within 2 % of each other's size compare by their max (near_floor).
+# polygon_mesh (non-manifold, 14 boundary loops) at 50 and 100 triangles, 100k samples, % of the
+# diagonal: before 158 triangles, max 7.733 for both targets; now 155, max 6.363 (mean 0.44 ->
+# 0.51: the rerun trades it, within the 10 % bound before the fit).
+def test_below_the_floor_the_reruns_restart_from_the_floor():
+    source = read_mesh(str(DATA / "nonmanifold_degenerate/cgal_polygon_mesh.off"))
+    v, t = source.vertices, source.triangles
+    mesh = Mesh(v, t)
+    results = [mesh.decimate(target_triangles=target, seed=0) for target in (50, 100)]
+    for r in results:
+        assert r.num_triangles > 100 and r.stats.over_budget_reason == "topology"
+        check_output(mesh, r, reference.invariants(len(v), t))
+    # a target below the floor gives the floor's result whatever it is
+    assert np.array_equal(results[0].vertices, results[1].vertices)
+    assert np.array_equal(results[0].triangles, results[1].triangles)
+    error = hausdorff((v, t), results[0], samples=100_000, relative=True, percentile=0).symmetric
+    assert 100 * error.max < 7.0, 100 * error.max

@@ -93,6 +93,7 @@ class Collapser {
   void restore(int32_t v, const double* position, const double* world);
 
   int32_t live_faces() const { return alive_faces_; }
+  int32_t live_vertices() const { return alive_vertices_; }
   /// The triangles as the collapses renamed them (dead ones included: see face_alive).
   const std::vector<int32_t>& triangles() const { return *tri_; }
   /// The corner sources as the collapses renamed the corners.
