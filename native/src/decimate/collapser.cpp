@@ -11,12 +11,6 @@ namespace topstoc {
 
 namespace {
 
-// Collapses and moves may not leave a triangle thinner than this shape quality (Collapser::shape;
-// 0.1 is an aspect ratio of about 5-10 by the thesis' measure) or, one that was thinner already,
-// thinner than kThinShape; either may go lower only as far as the thinnest triangle around the
-// move was (Collapser::shape_floor2).
-constexpr double kMinShape = 0.1;
-constexpr double kThinShape = 0.5 * kMinShape;
 // The most triangles an edge collapsed along a non-manifold curve may have (more stay).
 constexpr int32_t kMaxSheets = 8;
 
@@ -687,17 +681,17 @@ bool Collapser::merges_unlike_edges(int32_t u, int32_t v, const int32_t* on_edge
   return false;
 }
 
-// The squared shape quality of the thinnest triangle with area around `v`, capped at kMinShape's:
-// a move or collapse at v may leave a triangle that thin, so that it never makes the worst
-// triangle around it worse, and a needle (the ends of an input edge far shorter than its
-// neighbours, kept by the first pass) can collapse even when a neighbour then ends a little below
-// kMinShape. Before this floor, a triangle could not end below kMinShape unless it already was,
+// The squared shape quality of the thinnest triangle with area around `v`, capped at the limit's
+// (kMinShape unless set_shape_limits changed it): a move or collapse at v may leave a triangle
+// that thin, so that it never makes the worst triangle around it worse, and a needle (the ends
+// of an input edge far shorter than its neighbours, kept by the first pass) can collapse even
+// when a neighbour then ends a little below kMinShape. Before this floor, a triangle could not end below kMinShape unless it already was,
 // and then with no limit: such needles stayed and stretched as their far corner moved (the
 // Chinese dragon at 10 %: a worst aspect ratio of 7,949 by thesis eq. 4.2, 152 with the floor;
-// Blender's Decimate 831). The limit kThinShape for already thin triangles keeps the freedom
+// Blender's Decimate 831). The limit of half of it for already thin triangles keeps the freedom
 // CAD meshes' long strips need (without it, the coupling at 10 % had twice the mean error).
 double Collapser::shape_floor2(int32_t v) const {
-  double floor2 = kMinShape * kMinShape;
+  double floor2 = min_shape_ * min_shape_;
   for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) {
     const int32_t* c = &(*tri_)[3 * size_t(*t)];
     double n[3];
@@ -735,17 +729,17 @@ bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, Shape
     }
     const double dot = before[0] * after[0] + before[1] * after[1] + before[2] * after[2];
     const double len2 = after[0] * after[0] + after[1] * after[1] + after[2] * after[2];
-    // No flip, no near-fold (normal turned by more than ~80 degrees: cos > 0.17), no loss of area.
-    if (!(dot > 0.0) || dot * dot <= 0.0289 * len2 * before2 || len2 <= 1e-24 * before2) return false;
+    // No flip, no near-fold (normal turned by more than the limit, ~80 degrees), no loss of area.
+    if (!(dot > 0.0) || dot * dot <= fold2_ * len2 * before2 || len2 <= 1e-24 * before2) return false;
     // No sliver: not thinner than the floor (at most kMinShape), unless the triangle was
-    // thinner than kMinShape already and stays within kThinShape.
+    // thinner than kMinShape already and stays within half of it.
     const double edges = squared_edges(c, moved, x);
-    if (!thinner(len2, edges, kMinShape * kMinShape)) continue;
+    if (!thinner(len2, edges, min_shape_ * min_shape_)) continue;
     if (floor.value2 < 0.0)
       floor.value2 = floor.b < 0 ? shape_floor2(floor.a) : std::min(shape_floor2(floor.a), shape_floor2(floor.b));
     if (thinner(len2, edges, floor.value2) &&
-        (!thinner(area2, squared_edges(c, moved, p), kMinShape * kMinShape) ||
-         thinner(len2, edges, kThinShape * kThinShape)))
+        (!thinner(area2, squared_edges(c, moved, p), min_shape_ * min_shape_) ||
+         thinner(len2, edges, 0.25 * min_shape_ * min_shape_)))
       return false;
   }
   return true;

@@ -82,6 +82,18 @@ class Collapser {
   /// Replaces every vertex's cost weight and costs every queued collapse anew: a copy of a
   /// collapser taken part-way continues under other weights (the max-aware refinement).
   void reweigh(std::vector<double> weight);
+  /// Collapses and moves may not leave a triangle thinner than this shape quality (shape();
+  /// 0.1 is an aspect ratio of about 5-10 by the thesis' measure) or, one that was thinner
+  /// already, thinner than half of it; either may go lower only as far as the thinnest triangle
+  /// around the move was (shape_floor2). Nor may a triangle's normal turn by more than the angle
+  /// of cosine kMinTurnCos (about 80 degrees).
+  static constexpr double kMinShape = 0.1, kMinTurnCos = 0.17;
+  /// Other limits from now on (the reruns of a result stopped above its target by the
+  /// topology loosen them; the fit restores them). Flips and area loss stay refused.
+  void set_shape_limits(double min_shape, double min_turn_cos) {
+    min_shape_ = min_shape;
+    fold2_ = min_turn_cos * min_turn_cos;
+  }
   /// Moves every free vertex to its quadric's minimum along the directions it constrains, at
   /// most radius2[v] (squared, normalised) away, where no triangle folds or becomes a sliver.
   int32_t refit(const std::vector<double>& radius2);
@@ -202,7 +214,9 @@ class Collapser {
   CollapseSetup s_;
   std::vector<int32_t> count_;  // per bin: vertices alive
   bool use_quota_ = true;
-  bool rescue_ = false;  // every collapse left failed its checks: see shaped_placement
+  bool rescue_ = false;
+  double min_shape_ = kMinShape;                 // a triangle may end no thinner (keeps_shape)
+  double fold2_ = kMinTurnCos * kMinTurnCos;     // squared cosine of the largest turn of a normal  // every collapse left failed its checks: see shaped_placement
   int32_t alive_vertices_ = 0, alive_faces_ = 0;
   std::vector<int32_t> pool_, begin_, size_, capacity_;  // vertex -> faces
   std::vector<uint8_t> alive_face_, dirty_, placed_;
