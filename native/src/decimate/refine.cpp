@@ -536,6 +536,8 @@ class Refinement {
     // Below the floor the reruns stop where the first run did, under looser checks.
     const bool below_floor = floor.vertices > 0 || floor.faces > 0;
     const Collapser::Stop reached{best.collapser->live_vertices(), stop.faces > 0 ? best.collapser->live_faces() : 0};
+    const std::shared_ptr<const Surface> whole = kept_input(*best.collapser, 1);
+    if (params.warm_up) return;  // what a later run reuses is kept
     if (floor.vertices > at_restart->live_vertices() || floor.faces > at_restart->live_faces()) {
       // The first run stopped above the target (the topology or the borders) and made few
       // collapses after the restart: the reruns restart from kRestart times where it ended
@@ -549,8 +551,6 @@ class Refinement {
       result.triangles = floor_triangles;
       result.corner_source = floor_corners;
     }
-    const std::shared_ptr<const Surface> whole = kept_input(*best.collapser, 1);
-    if (params.warm_up) return;  // what a later run reuses is kept
     const InputSurface input(mesh, whole);
     best.deviation = surface_deviation(mesh, input, label, *best.collapser, result.triangles);
     best.triangles = result.triangles, best.corners = result.corner_source;
