@@ -50,6 +50,7 @@ from topstoc.core import Mesh, hausdorff, read_mesh, topology  # noqa: E402
 from fill_mesh_cache import DEFAULT_CACHE as MESH_CACHE, MANIFEST, cached_path  # noqa: E402
 from machine import machine  # noqa: E402
 from reference import aspect_ratios  # noqa: E402
+from quality_goals import PEERS, error_ratio, goal_ratios, left_out  # noqa: E402
 
 SHARED = ROOT.parent / "shared" / "meshes"
 if not SHARED.exists():
@@ -184,7 +185,6 @@ def fast_simplification_python() -> str | None:
     return str(python)
 
 
-PEERS = ("Blender Collapse", "MeshLab", "meshopt_simplify", "fast-simplification")
 NAMES = ("topstoc quality", "topstoc fast") + PEERS
 
 
@@ -275,28 +275,6 @@ def run_batched_peers(cases, blender_jobs, fs_jobs, work, samples) -> None:
                 topology=signature(got["vertices"], got["triangles"]) == case["signature"])
 
 
-# Errors below this (in % of the diagonal: 1e-8 of it, below the rounding of a float32 output)
-# count as exact: the ratio of two such figures (a flat mesh all tools keep flat) measures
-# rounding, not quality.
-EXACT = 1e-6
-
-
-def error_ratio(ours: float, peer: float) -> float:
-    return max(ours, EXACT) / max(peer, EXACT)
-
-
-def goal_ratios(case) -> tuple[float | None, float | None]:
-    """Our mean over the better of Blender and MeshLab; our max over the best peer's (issue 40's goals)."""
-    ours = case["tools"].get("topstoc quality")
-    if not ours:
-        return None, None
-    means = [case["tools"][n]["mean"] for n in ("Blender Collapse", "MeshLab") if case["tools"].get(n)]
-    maxes = [case["tools"][n]["max"] for n in PEERS if case["tools"].get(n)]
-    mean = error_ratio(ours["mean"], min(means)) if means else None
-    worst = error_ratio(ours["max"], min(maxes)) if maxes else None
-    return mean, worst
-
-
 def print_case(case) -> None:
     print(f"\n{case['mesh']} at {label(case)} ({case['input_triangles']} triangles -> "
           f"peers at {case['peer_triangles']})")
@@ -313,6 +291,8 @@ def print_case(case) -> None:
               f"{f['ar_p99']:8.2f} {f['ar_max']:8.1f} {f['zero_area']:4d} {'yes' if f['topology'] else 'NO':>4s} "
               f"{seconds:>7s}{over}")
     mean, worst = goal_ratios(case)
+    if left_out(case):
+        print(f"  stopped above our count, left out of the goals: {', '.join(left_out(case))}")
     if mean is not None or worst is not None:
         print(f"  quality mean / better of Blender, MeshLab: {mean if mean is not None else float('nan'):.3f}; "
               f"max / best peer: {worst if worst is not None else float('nan'):.3f}")
@@ -346,7 +326,7 @@ def summarize(cases) -> None:
         worst, case = ranked[-1]
         print(f"  {what}: median {statistics.median(values):.3f} (goal <= {goal_median}), worst {worst:.2f} "
               f"({case['mesh']} at {label(case)}), above {goal_every} in {sum(v > goal_every for v in values)}"
-              f"/{len(values)} (goal 0)")
+              f"/{len(values)} (goal 0); no such peer at our count in {len(cases) - len(values)}")
 
 
 def main() -> int:
