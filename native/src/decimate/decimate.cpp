@@ -871,7 +871,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   const int32_t triangles = int32_t(first.triangles.size() / 3), vertices = int32_t(first.kept.size());
   const bool above = target_triangles > 0 ? stopped_above(triangles, target_triangles)
                                           : stopped_above(vertices, params.target_vertices);
-  if (!above) return first;
+  if (!above || params.warm_up) return first;  // a warm-up's result is unfinished
   DecimateParams again = params;
   again.target_vertices = vertices;
   DecimateResult second = refined_once(mesh, layout, again, target_triangles > 0 ? triangles : 0);
