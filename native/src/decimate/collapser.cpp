@@ -542,7 +542,7 @@ void Collapser::offer(int32_t x, int32_t v, int32_t removed, double c) {
 }
 
 // Link condition (Dey et al. 1999): u and v share exactly the vertices opposite their edge, and
-// v keeps at least three neighbours; then the surface stays a manifold of the same topology. An
+// v keeps at least three neighbours (two on a boundary edge at the end); then the surface stays a manifold of the same topology. An
 // interior u may go to any neighbour; a u on a border curve only along the curve, so every border
 // keeps its course and its sides: each of u's sectors (one for a boundary, two for a crease,
 // k for a non-manifold edge of k sheets) is a fan from the curve's other edge to this one and
@@ -592,7 +592,10 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
     }
   if (shared != count || duplicates_a_face(u, v, on_edge, count)) return false;
   if (cu >= 0 && merges_unlike_edges(u, v, on_edge, count)) return false;
-  if (nu + nv < shared + 5) return false;  // v would keep < 3 neighbours
+  // v keeps three neighbours, or two along a boundary (count 1) once nothing else collapses
+  // (rescue_): a disc's last quad becomes its one triangle, v a corner of it (Dey et al.'s
+  // condition with the boundary's dummy vertex); earlier it would cost the small discs' shape.
+  if (nu + nv < shared + (count == 1 && rescue_ ? 4 : 5)) return false;
   double x[3];
   return shaped_placement(u, v, x) >= 0;
 }
