@@ -1,13 +1,10 @@
-"""Scans at their topology's floor (issue 40): a disc goes down to one triangle, and a result
-that stopped above its target is as good as one asked for the count it reached. The floors are
-counted here from Euler's formula, the errors compared with an independent decimation."""
+"""Scans at their topology's floor (issue 40): a disc goes down to one triangle. The floors are
+counted here from Euler's formula."""
 
 import numpy as np
 import pytest
 
-from topstoc.core import Mesh, hausdorff, read_mesh, topology
-
-from conftest import DATA
+from topstoc.core import Mesh, topology
 
 
 def grid_disc(n: int, origin=(0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
@@ -48,23 +45,3 @@ def test_discs_go_down_to_one_triangle_each(mode):
     tri = np.asarray(result.vertices)[np.asarray(result.triangles)]
     area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
     assert (area > 1e-6).all()
-
-
-def mean_error(source, result) -> float:
-    d = hausdorff(source, (result.vertices, result.triangles), samples=30000, relative=True, percentile=0)
-    return d.symmetric.mean
-
-
-def test_a_result_stopped_at_its_floor_is_as_good_as_one_asked_for_that_count():
-    data = read_mesh(str(DATA / "open_boundary/cgal_elephant-with-holes.off"))
-    mesh = Mesh(data.vertices, data.triangles)
-    source = (data.vertices, data.triangles)
-    low = mesh.decimate(ratio=0.05, seed=2, refine=4, placement="filtered")
-    got = len(low.vertices)
-    assert got > 2 * low.stats.target_vertices  # its holes' borders stop it far above the target
-    assert low.stats.over_budget_reason == "topology"
-    direct = mesh.decimate(target_vertices=got, seed=2, refine=4, placement="filtered")
-    assert len(direct.vertices) == got
-    # before, the guidance planned for the unreachable target and starved the surface:
-    # 0.643 % of the diagonal against 0.52 % asked for the same count
-    assert mean_error(source, low) <= 1.05 * mean_error(source, direct)

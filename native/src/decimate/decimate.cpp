@@ -818,8 +818,8 @@ int32_t first_pass_vertices(const DecimateParams& params, int32_t active) {
 // TopStoc to a few times the target, then collapses down to it (refine.hpp). Painted regions
 // keep the share of the budget the guidance gives them. target_triangles > 0: the collapses
 // stop there instead (the vertex target then sets the first pass and the guidance quotas).
-DecimateResult refined_once(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
-                            int32_t target_triangles) {
+DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
+                       int32_t target_triangles) {
   if (params.draft) throw std::invalid_argument("a draft is plain TopStoc: refine must be 0");
   const int32_t active = active_vertices(mesh);
   DecimateParams first = params;
@@ -855,29 +855,6 @@ DecimateResult refined_once(const Mesh& mesh, const FeatureLayout& layout, const
   for (int32_t v = 0; v < mesh.num_vertices(); ++v)
     result.forced += layout.is_corner(v) || (!multipliers.empty() && multipliers[v] == kForcedMultiplier);
   return verified(mesh, layout, std::move(result));
-}
-
-// Whether a result stopped above its target by more than 1 % (the report's tolerance).
-bool stopped_above(int32_t got, int32_t target) { return target > 0 && got > target + std::max(1.0, 0.01 * target); }
-
-// A refined decimation that stopped above its target (its topology's floor) is made again
-// with the count it reached as its target: the guidance and the first pass then plan for
-// that count instead of starving the surface for one it cannot reach (ear_back at 50
-// triangles: 245 either way, mean error 2.29 -> 1.55 % of the diagonal). The second is kept
-// when it has no more triangles; either way the missed target is reported against the first.
-DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
-                       int32_t target_triangles) {
-  DecimateResult first = refined_once(mesh, layout, params, target_triangles);
-  const int32_t triangles = int32_t(first.triangles.size() / 3), vertices = int32_t(first.kept.size());
-  const bool above = target_triangles > 0 ? stopped_above(triangles, target_triangles)
-                                          : stopped_above(vertices, params.target_vertices);
-  if (!above || params.warm_up) return first;  // a warm-up's result is unfinished
-  DecimateParams again = params;
-  again.target_vertices = vertices;
-  DecimateResult second = refined_once(mesh, layout, again, target_triangles > 0 ? triangles : 0);
-  if (second.triangles.size() > first.triangles.size()) return first;
-  second.target_vertices = first.target_vertices;
-  return second;
 }
 
 }  // namespace
