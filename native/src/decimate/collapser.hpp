@@ -214,9 +214,9 @@ class Collapser {
   CollapseSetup s_;
   std::vector<int32_t> count_;  // per bin: vertices alive
   bool use_quota_ = true;
-  bool rescue_ = false;
-  double min_shape_ = kMinShape;                 // a triangle may end no thinner (keeps_shape)
-  double fold2_ = kMinTurnCos * kMinTurnCos;     // squared cosine of the largest turn of a normal  // every collapse left failed its checks: see shaped_placement
+  bool rescue_ = false;  // every collapse left failed its checks: see shaped_placement
+  double min_shape_ = kMinShape;              // a triangle may end no thinner (keeps_shape)
+  double fold2_ = kMinTurnCos * kMinTurnCos;  // squared cosine of the largest turn of a normal
   int32_t alive_vertices_ = 0, alive_faces_ = 0;
   std::vector<int32_t> pool_, begin_, size_, capacity_;  // vertex -> faces
   std::vector<uint8_t> alive_face_, dirty_, placed_;

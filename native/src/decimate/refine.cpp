@@ -42,16 +42,14 @@ constexpr double kMeanSlack = 0.10;
 constexpr double kTinyMeanSlack = 0.05;
 
 // Runs that all stop above the target (the topology or the borders hold them) end a few
-// triangles apart; within this share of their size the smaller max is chosen over the count
-// (truck: 938 triangles and a max 9 % lower than the first run's 929).
+// triangles apart; within this share of their size the smaller max is chosen over the count.
 constexpr double kFloorSlack = 0.02;
 
 // Reruns of a result the topology or the borders stop above its target stop where the first
 // run did, under looser checks (Collapser::set_shape_limits): a triangle may end as thin as shape quality
 // kFloorShape[round] (0.1 elsewhere) and turn by up to a right angle (80 degrees elsewhere).
 // There the last collapses are forced, and the usual checks left only the ones that fold a
-// region flat or bridge a gap: turbine at its genus-11 floor of 138 triangles, max 12.9 -> 4.7 %
-// of the diagonal; beetle at 200, 12.5 -> 4.7 %; truck at 928, 9.6 -> 6.7 %.
+// region flat or bridge a gap (figures: docs/bench_notes/worst-cases.md, fifth pass).
 constexpr double kFloorShape[kRounds] = {0.05, 0.03, 0.05};
 constexpr double kFloorTurnCos = 0.0;
 
