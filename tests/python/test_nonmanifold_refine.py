@@ -265,8 +265,11 @@ def test_an_open_scan_is_simplified_along_its_boundaries_which_stay_on_the_input
         # holes and the rim) is near its least, three edges
         loops = expected[0][1]
         assert len(out_rim) < len(rim) and (ratio > 0.05 or len(out_rim) <= 4 * loops), len(out_rim)
-        # every output boundary vertex is an input boundary vertex, where it was (distance 0)
+        # every output boundary vertex is an input boundary vertex, where it was (distance 0); a
+        # result of at most 400 triangles is fitted with its unlocked boundary vertices free to
+        # move (design §2.10, kTinyFitFaces), so there only near it
         kept = np.asarray(r.kept)
         on = np.unique(out_rim)
         assert np.isin(kept[on], rim).all()
-        np.testing.assert_array_equal(np.asarray(r.vertices)[on], vertices[kept[on]])
+        moved = np.linalg.norm(np.asarray(r.vertices)[on] - vertices[kept[on]], axis=1)
+        assert moved.max() <= (0.0 if len(r.triangles) > 400 else 0.01 * np.sqrt(2)), moved.max()
