@@ -40,8 +40,6 @@ constexpr double kMeanSlack = 0.10;
 // Refinement::wins): at 10 % fandisk at 25 triangles took a rerun whose mean after the fit was
 // 22 % higher for a max 7 % lower.
 constexpr double kTinyMeanSlack = 0.05;
-// Fitted tiny results whose max differ by at most this share are chosen between by their mean.
-constexpr double kFittedMaxTie = 0.02;
 
 // Runs that all stop above the target (the topology or the borders hold them) end a few
 // triangles apart; within this share of their size the smaller max is chosen over the count.
@@ -557,8 +555,6 @@ class Refinement {
     const bool tiny = best.collapser->live_faces() <= kTinyFitFaces;
     const double mean_bound = (1.0 + (tiny ? kTinyMeanSlack : kMeanSlack)) * best.deviation.mean;
     Deviation last = best.deviation;
-    std::vector<Run> fitted_choice;  // tiny results: every complete run, chosen among after the fit
-    const bool by_fit = tiny && params.refit && !below_floor;
     std::vector<double> worst(n, 0.0);  // per vertex: its largest deviation over the largest, of every run so far
     for (int round = 0; round < kRounds && last.top2 > 0; ++round) {
       for (int32_t v = 0; v < n; ++v) worst[v] = std::max(worst[v], last.vertex2[v] / last.top2);
@@ -570,17 +566,9 @@ class Refinement {
       const int32_t collapses = shared + collapse_rest(*run, center, extent, below_floor ? reached : stop);
       // The last run's deviation serves only the choice: measured until it loses.
       const Rival rival{best.deviation.top2, mean_bound};
-      last = surface_deviation(mesh, input, label, *run, result.triangles, round + 1 == kRounds && !by_fit ? &rival : nullptr);
-      if (by_fit && excess(last) == excess(best.deviation)) {
-        if (fitted_choice.empty()) fitted_choice.push_back(Run{std::make_unique<Collapser>(*best.collapser), best.deviation, best.collapses, best.triangles, best.corners});
-        fitted_choice.push_back(Run{std::make_unique<Collapser>(*run), last, collapses, result.triangles, result.corner_source});
-      }
+      last = surface_deviation(mesh, input, label, *run, result.triangles, round + 1 == kRounds ? &rival : nullptr);
       if (wins(last, best.deviation, mean_bound, tiny))
         best = Run{std::move(run), last, collapses, result.triangles, result.corner_source};
-    }
-    if (fitted_choice.size() > 1) {
-      const int32_t chosen = choose_fitted(fitted_choice, excess(best.deviation), whole);
-      if (chosen >= 0) best = std::move(fitted_choice[size_t(chosen)]);
     }
     result.triangles = std::move(best.triangles);
     result.corner_source = std::move(best.corners);
@@ -620,36 +608,6 @@ class Refinement {
     if (!params.snapshots) return normalised_input(mesh, collapser, step);
     return params.snapshots->input_surface(input_surface_key(mesh, collapser, step),
                                            [&] { return normalised_input(mesh, collapser, step); });
-  }
-
-  // Whether fitted candidate `run` beats `best`: a max smaller by a larger share than its
-  // root-mean-square distance is larger, or within kFittedMaxTie the smaller root mean square.
-  static bool fitted_wins(const TinyFit& run, const TinyFit& best) {
-    if (std::abs(run.max - best.max) <= kFittedMaxTie * std::max(run.max, best.max)) return run.after2 < best.after2;
-    const double max_gain = 1.0 - run.max / best.max;
-    const double rms_loss = best.after2 > 0.0 ? std::sqrt(run.after2 / best.after2) - 1.0 : 0.0;
-    return max_gain > 0.0 && max_gain > rms_loss;
-  }
-
-  // Of tiny results, the one with the smallest max once fitted (fitted_wins), among the runs
-  // `excess` above the target; -1 when none could be measured. On CAD meshes the runs' own
-  // deviation, measured at input vertices that sit on corners and creases, misjudges large flat
-  // triangles (docs/bench_notes/tiny-cad-mean.md). Each candidate is fitted on a copy.
-  int32_t choose_fitted(const std::vector<Run>& runs, int32_t excess_of_best, const std::shared_ptr<const Surface>& whole) {
-    int32_t chosen = -1;
-    TinyFit best_fit;
-    const int64_t step = fit_input_step(mesh);
-    for (size_t i = 0; i < runs.size(); ++i) {
-      if (excess(runs[i].deviation) != excess_of_best) continue;
-      result.triangles = runs[i].triangles, result.corner_source = runs[i].corners;
-      Collapser copy(*runs[i].collapser);
-      copy.set_shape_limits(Collapser::kMinShape, Collapser::kMinTurnCos);
-      const int32_t faces = copy.live_faces();
-      const std::shared_ptr<const Surface> input = step == 1 && whole ? whole : kept_input(copy, step);
-      const TinyFit fit = fit_tiny(mesh, copy, fit_rounds(faces), faces <= kTinyFitFaces, *input, true);
-      if (fit.max >= 0.0 && (chosen < 0 || fitted_wins(fit, best_fit))) chosen = int32_t(i), best_fit = fit;
-    }
-    return chosen;
   }
 
   // Whether a rerun's result beats the best so far: nearer the target, or as near with its mean

@@ -363,16 +363,12 @@ void back_off(Fit& fit, const std::vector<double>& start, Fit::Error& error) {
 
 }  // namespace
 
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input,
-                 bool measure_max) {
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input) {
   TinyFit out;
   Fit fit(mesh, collapser, boundaries, input);
   if (fit.empty()) return out;
   auto error = fit.pair_up();
-  if (error.top2 <= kOnTheInput * kOnTheInput) {
-    if (measure_max) out.max = std::sqrt(error.top2);
-    return out;
-  }
+  if (error.top2 <= kOnTheInput * kOnTheInput) return out;
   // The max before any move, measured only once a move's pairs pass (when none does it is not
   // needed, and it is the fit's dearest step): from the positions kept here, the same bracket.
   const std::vector<double> start = fit.positions();
@@ -419,7 +415,6 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool bo
     back_off(fit, start, error);
     out.after2 = error.mean2;
   }
-  if (measure_max) out.max = fit.symmetric_max(fit.positions()).lower;
   return out;
 }
 

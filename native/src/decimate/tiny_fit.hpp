@@ -26,7 +26,6 @@ struct TinyFit {
   int32_t rounds = 0;        ///< rounds kept (each lowered the error)
   double before2 = 0.0;      ///< mean squared distance, both ways, before the first round
   double after2 = 0.0;       ///< and after the last kept one
-  double max = -1.0;         ///< with measure_max: the symmetric max after the fit (lower end of its bracket)
 };
 
 /// The step between the input triangles the fit measures against (1: all of them): at most
@@ -42,8 +41,6 @@ int64_t fit_input_step(const Mesh& mesh);
 /// distance did not grow, and neither did the symmetric Hausdorff max over both whole surfaces
 /// (a bracket from bounded_max.hpp: the pairs alone miss where the surface lifts between them).
 /// boundaries: the unlocked vertices of mesh boundaries move too (else only the free ones).
-/// measure_max: the result's symmetric max after the fit is measured too (TinyFit::max).
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input,
-                 bool measure_max = false);
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input);
 
 }  // namespace topstoc
