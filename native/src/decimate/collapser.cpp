@@ -541,12 +541,12 @@ void Collapser::offer(int32_t x, int32_t v, int32_t removed, double c) {
   }
 }
 
-// Link condition (Dey et al. 1999): u and v share exactly the vertices opposite their edge, and
-// v keeps at least three neighbours (two on a boundary edge at the end); then the surface stays a manifold of the same topology. An
-// interior u may go to any neighbour; a u on a border curve only along the curve, so every border
-// keeps its course and its sides: each of u's sectors (one for a boundary, two for a crease,
-// k for a non-manifold edge of k sheets) is a fan from the curve's other edge to this one and
-// holds exactly one of the edge's triangles.
+// Link condition (Dey et al. 1999): u and v share exactly the vertices opposite their edge, and v
+// keeps at least three neighbours (two on a boundary edge at the end); then the surface stays a
+// manifold of the same topology. An interior u may go to any neighbour; a u on a border curve only
+// along the curve, so every border keeps its course and its sides: each of u's sectors (one for a
+// boundary, two for a crease, k for a non-manifold edge of k sheets) is a fan from the curve's
+// other edge to this one and holds exactly one of the edge's triangles.
 bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
   std::vector<uint32_t>& mark = scratch.mark;
   const uint32_t su = ++scratch.stamp;
@@ -685,14 +685,15 @@ bool Collapser::merges_unlike_edges(int32_t u, int32_t v, const int32_t* on_edge
 }
 
 // The squared shape quality of the thinnest triangle with area around `v`, capped at the limit's
-// (kMinShape unless set_shape_limits changed it): a move or collapse at v may leave a triangle
-// that thin, so that it never makes the worst triangle around it worse, and a needle (the ends
-// of an input edge far shorter than its neighbours, kept by the first pass) can collapse even
-// when a neighbour then ends a little below kMinShape. Before this floor, a triangle could not end below kMinShape unless it already was,
-// and then with no limit: such needles stayed and stretched as their far corner moved (the
-// Chinese dragon at 10 %: a worst aspect ratio of 7,949 by thesis eq. 4.2, 152 with the floor;
-// Blender's Decimate 831). The limit of half of it for already thin triangles keeps the freedom
-// CAD meshes' long strips need (without it, the coupling at 10 % had twice the mean error).
+// (kMinShape unless set_shape_limits changed it): a move or collapse at v may leave a triangle that
+// thin, so that it never makes the worst triangle around it worse, and a needle (the ends of an
+// input edge far shorter than its neighbours, kept by the first pass) can collapse even when a
+// neighbour then ends a little below kMinShape. Before this floor, a triangle could not end below
+// kMinShape unless it already was, and then with no limit: such needles stayed and stretched as
+// their far corner moved (the Chinese dragon at 10 %: a worst aspect ratio of 7,949 by thesis eq.
+// 4.2, 152 with the floor; Blender's Decimate 831). The limit of half of it for already thin
+// triangles keeps the freedom CAD meshes' long strips need (without it, the coupling at 10 % had
+// twice the mean error).
 double Collapser::shape_floor2(int32_t v) const {
   double floor2 = min_shape_ * min_shape_;
   for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) {

@@ -45,11 +45,11 @@ constexpr double kTinyMeanSlack = 0.05;
 // triangles apart; within this share of their size the smaller max is chosen over the count.
 constexpr double kFloorSlack = 0.02;
 
-// Reruns of a result the topology or the borders stop above its target stop where the first
-// run did, under looser checks (Collapser::set_shape_limits): a triangle may end as thin as shape quality
-// kFloorShape[round] (0.1 elsewhere) and turn by up to a right angle (80 degrees elsewhere).
-// There the last collapses are forced, and the usual checks left only the ones that fold a
-// region flat or bridge a gap (figures: docs/bench_notes/worst-cases.md, fifth pass).
+// Reruns of a result the topology or the borders stop above its target stop where the first run
+// did, under looser checks (Collapser::set_shape_limits): a triangle may end as thin as shape
+// quality kFloorShape[round] (0.1 elsewhere) and turn by up to a right angle (80 degrees
+// elsewhere). There the last collapses are forced, and the usual checks left only the ones that
+// fold a region flat or bridge a gap (figures: docs/bench_notes/worst-cases.md, fifth pass).
 constexpr double kFloorShape[kRounds] = {0.05, 0.03, 0.05};
 constexpr double kFloorTurnCos = 0.0;
 
@@ -622,11 +622,16 @@ class Refinement {
     if (excess(run) != excess(best)) {
       // Both stopped above the target, a few triangles apart: the smaller max wins if it pays
       // for its mean, then the one nearer the target.
-      if (run.top2 != best.top2) return run.top2 < best.top2 && 1.0 - std::sqrt(run.top2 / best.top2) > run.mean / best.mean - 1.0;
+      if (run.top2 != best.top2) return lowers_max_for_its_mean(run, best);
       return excess(run) < excess(best);
     }
     if (tiny) return run.top2 <= best.top2;
     if (run.top2 == best.top2) return run.mean < best.mean;
+    return lowers_max_for_its_mean(run, best);
+  }
+
+  // Whether run's max is smaller than best's by a larger share than its mean is larger.
+  static bool lowers_max_for_its_mean(const Deviation& run, const Deviation& best) {
     const double max_gain = 1.0 - std::sqrt(run.top2 / best.top2);
     const double mean_loss = best.mean > 0.0 ? run.mean / best.mean - 1.0 : 0.0;
     return run.top2 < best.top2 && max_gain > mean_loss;
