@@ -6,6 +6,9 @@
 #include <limits>
 #include <numeric>
 #include <utility>
+#if defined(__SSE2__) || defined(_M_X64)
+#include <emmintrin.h>
+#endif
 
 namespace topstoc {
 
@@ -30,15 +33,30 @@ double closest_point_on_segment(const double* p, const double* a, const double* 
   return distance2(p, out);
 }
 
-// Squared distance from p to an axis-aligned box (0 inside).
+// The gap between p and a box along one axis: below = lo - p, above = p - hi. The same value as
+// `below > 0 ? below : (above > 0 ? above : 0)` (NaN included) since lo <= hi, so both are never
+// positive; written as two maxima (MAXPD's operand order: the second when unordered) so that the
+// x and y axes can share one SSE2 instruction.
+inline double axis_gap(double below, double above) {
+  const double outside = above > 0.0 ? above : 0.0;
+  return below > outside ? below : outside;
+}
+
+// Squared distance from p to an axis-aligned box (0 inside), summed as (x^2 + y^2) + z^2 on
+// every path, so the SSE2 and the scalar paths give the same bits as the scalar loop it replaced.
 inline double box_distance2(const double* p, const double* lo, const double* hi) {
-  double d2 = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    const double below = lo[k] - p[k], above = p[k] - hi[k];
-    const double d = below > 0.0 ? below : (above > 0.0 ? above : 0.0);
-    d2 += d * d;
-  }
-  return d2;
+#if defined(__SSE2__) || defined(_M_X64)
+  const __m128d pxy = _mm_loadu_pd(p);  // x and y in the two lanes of one register
+  const __m128d outside = _mm_max_pd(_mm_sub_pd(pxy, _mm_loadu_pd(hi)), _mm_setzero_pd());
+  const __m128d gap = _mm_max_pd(_mm_sub_pd(_mm_loadu_pd(lo), pxy), outside);
+  const __m128d square = _mm_mul_pd(gap, gap);
+  const double dz = axis_gap(lo[2] - p[2], p[2] - hi[2]);
+  return (_mm_cvtsd_f64(square) + _mm_cvtsd_f64(_mm_unpackhi_pd(square, square))) + dz * dz;
+#else
+  double d[3];
+  for (int k = 0; k < 3; ++k) d[k] = axis_gap(lo[k] - p[k], p[k] - hi[k]);
+  return (d[0] * d[0] + d[1] * d[1]) + d[2] * d[2];
+#endif
 }
 
 // A box whose distance exceeds the best one by less than this relative slack is still opened, so
@@ -46,16 +64,7 @@ inline double box_distance2(const double* p, const double* lo, const double* hi)
 // for the deterministic lower-id tie-break).
 constexpr double kPruneSlack = 1.0 + 1e-12;
 
-}  // namespace
-
-// A triangle's centroid next to its id: the build partitions these in place, so its scans are
-// sequential instead of gathering through an index.
-struct TriangleBvh::BuildItem {
-  double centroid[3];
-  int32_t id;
-};
-
-double closest_point_on_triangle(const double* p, const double* a, const double* b, const double* c,
+inline double triangle_distance2(const double* p, const double* a, const double* b, const double* c,
                                  double* closest) {
   // Voronoi regions of the corners, then the edges, then the interior (the region tests of
   // Ericson, Real-Time Collision Detection, 5.1.5), with guarded divisions so that degenerate
@@ -111,6 +120,20 @@ double closest_point_on_triangle(const double* p, const double* a, const double*
     }
   }
   return best;
+}
+
+}  // namespace
+
+// A triangle's centroid next to its id: the build partitions these in place, so its scans are
+// sequential instead of gathering through an index.
+struct TriangleBvh::BuildItem {
+  double centroid[3];
+  int32_t id;
+};
+
+double closest_point_on_triangle(const double* p, const double* a, const double* b, const double* c,
+                                 double* closest) {
+  return triangle_distance2(p, a, b, c, closest);
 }
 
 TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int64_t num_triangles) {
@@ -191,17 +214,15 @@ int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>
   return index;
 }
 
-double TriangleBvh::slot_distance2(const double* p, int32_t slot, double* closest) const {
-  const double* t = &corners_[9 * size_t(slot)];
-  return closest_point_on_triangle(p, t, t + 3, t + 6, closest);
-}
-
 ClosestHit TriangleBvh::closest(const double* p, int32_t hint_slot, double within2) const {
   ClosestHit hit;
   hit.distance2 = std::numeric_limits<double>::infinity();
+  // The triangle test has internal linkage so that it is called directly, not through the shared
+  // module's PLT as the exported closest_point_on_triangle is.
   auto consider = [&](int32_t slot) {
     double q[3];
-    const double d2 = slot_distance2(p, slot, q);
+    const double* t = &corners_[9 * size_t(slot)];
+    const double d2 = triangle_distance2(p, t, t + 3, t + 6, q);
     if (d2 < hit.distance2 || (d2 == hit.distance2 && triangle_ids_[slot] < hit.triangle)) {
       hit.distance2 = d2;
       hit.triangle = triangle_ids_[slot];
@@ -211,32 +232,37 @@ ClosestHit TriangleBvh::closest(const double* p, int32_t hint_slot, double withi
   };
   if (hint_slot >= 0 && hint_slot < int32_t(triangle_ids_.size())) consider(hint_slot);
 
+  // Depth first, nearer child first: the walk goes straight down into the nearer child and keeps
+  // the farther one on the stack, which visits the nodes in the same order as pushing both.
   struct Entry {
     int32_t node;
     double distance2;
   };
   Entry stack[128];
   int depth = 0;
-  stack[depth++] = {0, box_distance2(p, nodes_[0].lo, nodes_[0].hi)};
-  while (depth > 0 && !(hit.distance2 <= within2)) {
-    const Entry entry = stack[--depth];
-    if (entry.distance2 > hit.distance2 * kPruneSlack) continue;
-    const Node& node = nodes_[entry.node];
-    if (node.count > 0) {
-      for (int32_t s = node.first; s < node.first + node.count; ++s) consider(s);
-      continue;
+  Entry entry{0, box_distance2(p, nodes_[0].lo, nodes_[0].hi)};
+  for (;;) {
+    if (hit.distance2 <= within2) break;
+    if (!(entry.distance2 > hit.distance2 * kPruneSlack)) {
+      const Node& node = nodes_[entry.node];
+      if (node.count > 0) {
+        for (int32_t s = node.first; s < node.first + node.count; ++s) consider(s);
+      } else {
+        const int32_t left = entry.node + 1, right = node.first;
+        const double dl = box_distance2(p, nodes_[left].lo, nodes_[left].hi);
+        const double dr = box_distance2(p, nodes_[right].lo, nodes_[right].hi);
+        const Entry nearer = dl <= dr ? Entry{left, dl} : Entry{right, dr};
+        const Entry farther = dl <= dr ? Entry{right, dr} : Entry{left, dl};
+        const double reach = hit.distance2 * kPruneSlack;
+        if (farther.distance2 <= reach) stack[depth++] = farther;
+        if (nearer.distance2 <= reach) {
+          entry = nearer;
+          continue;
+        }
+      }
     }
-    const int32_t left = entry.node + 1, right = node.first;
-    const double dl = box_distance2(p, nodes_[left].lo, nodes_[left].hi);
-    const double dr = box_distance2(p, nodes_[right].lo, nodes_[right].hi);
-    // Push the farther child first so that the nearer one is searched first.
-    if (dl <= dr) {
-      if (dr <= hit.distance2 * kPruneSlack) stack[depth++] = {right, dr};
-      if (dl <= hit.distance2 * kPruneSlack) stack[depth++] = {left, dl};
-    } else {
-      if (dl <= hit.distance2 * kPruneSlack) stack[depth++] = {left, dl};
-      if (dr <= hit.distance2 * kPruneSlack) stack[depth++] = {right, dr};
-    }
+    if (depth == 0) break;
+    entry = stack[--depth];
   }
   return hit;
 }

@@ -56,7 +56,6 @@ class TriangleBvh {
   struct BuildItem;
   /// Builds the subtree over items [begin, end), which it reorders.
   int32_t build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items);
-  double slot_distance2(const double* p, int32_t slot, double* closest) const;
 
   std::vector<Node> nodes_;
   std::vector<double> corners_;          ///< 9 coordinates per slot, in leaf order
