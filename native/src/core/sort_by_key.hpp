@@ -71,6 +71,7 @@ void sort_ids_by_key(int32_t n, const KeyOf& key_of, Buffer<uint64_t>& out, cons
       if (j - i < 2) continue;
       run.clear();
       for (int64_t k = i; k < j; ++k) run.push_back({key_of(int32_t(out[k] & id_mask)), uint32_t(out[k] & id_mask)});
+      if (std::is_sorted(run.begin(), run.end())) continue;  // equal keys (far outliers) keep the id order
       std::sort(run.begin(), run.end());
       const uint64_t high = top(i) << id_bits;
       for (int64_t k = i; k < j; ++k) out[k] = high | run[k - i].second;
