@@ -22,10 +22,10 @@ inline int id_bits_for(int64_t n) {
 
 /// Sorts the ids 0..n-1 by key_of(id) (keys below 2^63), ties by id; out[i] & ((1 << id_bits_for(n))
 /// - 1) is the i-th id. Each id travels in one word under its key's top 64 - b bits (b the bits an
-/// id needs): a stable LSD radix sort of about 11 bits a pass moves 8 bytes an id (a key and an
-/// id beside it were 12, over 63 bits), and ids whose words tie on the key's bits are then put in
-/// order of their whole keys (key_of read again), which on a Z-order of a surface's vertices are
-/// a few. after_pass(done) follows the keys and each pass with the share of passes done (a
+/// id needs): a stable LSD radix sort of about 11 bits a pass moves 8 bytes an id over those
+/// bits (a key beside its id would be 12 bytes over 63 bits), and ids whose words tie on the
+/// key's bits are then put in order of their whole keys (key_of read again), which on a Z-order
+/// of a surface's vertices are a few. after_pass(done) follows the keys and each pass with the share of passes done (a
 /// cancel point).
 template <class KeyOf, class AfterPass>
 void sort_ids_by_key(int32_t n, const KeyOf& key_of, Buffer<uint64_t>& out, const AfterPass& after_pass) {
