@@ -20,6 +20,25 @@ inline int id_bits_for(int64_t n) {
   return bits;
 }
 
+/// Puts a run of (key, id) items, in id order and equal in the key's bits above `bits`, in order
+/// of key then id: a stable radix sort over the low bits, linear however long the run (a far
+/// outlier leaves nearly every vertex in one).
+template <class Item>
+void sort_run_by_low_bits(std::vector<Item>& run, std::vector<Item>& scratch, int bits) {
+  constexpr int kDigit = 11;
+  std::vector<int32_t> next(size_t(1) << kDigit);
+  scratch.resize(run.size());
+  for (int shift = 0; shift < bits; shift += kDigit) {
+    const uint64_t mask = (uint64_t(1) << std::min(kDigit, bits - shift)) - 1;
+    std::fill(next.begin(), next.end(), 0);
+    for (const Item& item : run) ++next[(item.first >> shift) & mask];
+    int32_t at = 0;
+    for (int32_t& slot : next) at += std::exchange(slot, at);
+    for (const Item& item : run) scratch[next[(item.first >> shift) & mask]++] = item;
+    run.swap(scratch);
+  }
+}
+
 /// Sorts the ids 0..n-1 by key_of(id) (keys below 2^63), ties by id; out[i] & ((1 << id_bits_for(n))
 /// - 1) is the i-th id. Each id travels in one word under its key's top 64 - b bits (b the bits an
 /// id needs): a stable LSD radix sort of about 11 bits a pass moves 8 bytes an id over those
@@ -54,6 +73,7 @@ void sort_ids_by_key(int32_t n, const KeyOf& key_of, Buffer<uint64_t>& out, cons
   // then id. The runs' starts are marked first (a bit an id), so that each run is read and
   // written by the one block where it starts.
   constexpr int64_t kBlock = 1 << 16;  // a multiple of 64: a block's bits are its own words
+  constexpr size_t kLongRun = 4096;     // longer runs are radix sorted (linear), shorter compared
   const int64_t blocks = (int64_t(n) + kBlock - 1) / kBlock;
   auto top = [&](int64_t i) { return out[i] >> id_bits; };
   std::vector<uint64_t> starts((size_t(n) + 63) / 64, 0);
@@ -63,7 +83,7 @@ void sort_ids_by_key(int32_t n, const KeyOf& key_of, Buffer<uint64_t>& out, cons
       if (i == 0 || top(i) != top(i - 1)) starts[size_t(i) >> 6] |= uint64_t(1) << (i & 63);
   });
   parallel_for_dynamic(0, blocks, 1, 2, [&](int64_t b) {
-    std::vector<std::pair<uint64_t, uint32_t>> run;
+    std::vector<std::pair<uint64_t, uint32_t>> run, scratch;
     for (int64_t i = b * kBlock, end = std::min<int64_t>(n, (b + 1) * kBlock); i < end; ++i) {
       if (!starts_run(i)) continue;
       int64_t j = i + 1;
@@ -72,7 +92,8 @@ void sort_ids_by_key(int32_t n, const KeyOf& key_of, Buffer<uint64_t>& out, cons
       run.clear();
       for (int64_t k = i; k < j; ++k) run.push_back({key_of(int32_t(out[k] & id_mask)), uint32_t(out[k] & id_mask)});
       if (std::is_sorted(run.begin(), run.end())) continue;  // equal keys (far outliers) keep the id order
-      std::sort(run.begin(), run.end());
+      if (run.size() > kLongRun) sort_run_by_low_bits(run, scratch, id_bits - 1);
+      else std::sort(run.begin(), run.end());
       const uint64_t high = top(i) << id_bits;
       for (int64_t k = i; k < j; ++k) out[k] = high | run[k - i].second;
     }
