@@ -11,6 +11,7 @@
 
 #include "core/counting_sort.hpp"
 #include "core/portable.hpp"
+#include "core/sort_by_key.hpp"
 #include "core/union_find.hpp"
 #include "topstoc/core/validate.hpp"
 
@@ -390,11 +391,7 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
                                  const double* hi, Progress& progress) {
   const int32_t n = num_vertices_;
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
-  Buffer<uint64_t> key(n), other_key(n);
-  Buffer<int32_t> other_vertex(n);
-  vertex_source_.resize(n);
-  parallel_for(0, n, kParallelMin, [&](int32_t v) {
-    vertex_source_[v] = v;
+  auto key_of = [&](int32_t v) {
     uint64_t k = 0;
     for (int axis = 0; axis < 3; ++axis) {
       // Differences near the double range overflow to inf and inf / inf is NaN, which
@@ -403,33 +400,15 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
       const double unit = t >= 0.0 ? std::min(t, 1.0) : 0.0;
       k |= spread_bits(uint64_t(unit * 2097151.0)) << axis;
     }
-    key[v] = k;
-  });
-  progress.update(0.05);
-  // Vertices by key, ties by vertex: a stable least-significant-digit radix sort over the 63
-  // bits the keys use, starting from vertex order.
-  {
-    constexpr int kDigit = 11;
-    constexpr uint64_t kMask = (1u << kDigit) - 1;
-    std::vector<int32_t> offsets;
-    for (int shift = 0; shift < 63; shift += kDigit) {
-      const uint64_t* from_key = key.data();
-      const int32_t* from_vertex = vertex_source_.data();
-      stable_counting_sort(
-          n, int32_t(kMask + 1), [&](int64_t i) { return int32_t((from_key[i] >> shift) & kMask); },
-          [&](int64_t i, int32_t at) {
-            other_key[at] = from_key[i];
-            other_vertex[at] = from_vertex[i];
-          },
-          offsets);
-      key.swap(other_key);
-      vertex_source_.swap(other_vertex);
-      progress.update(0.05 + 0.45 * (shift + kDigit) / 63.0);  // a pass is a tenth of the stage
-    }
-  }
-  Buffer<uint64_t>().swap(key);
-  Buffer<uint64_t>().swap(other_key);
-  Buffer<int32_t>().swap(other_vertex);
+    return k;
+  };
+  // Vertices by key, ties by vertex.
+  Buffer<uint64_t> sorted;
+  sort_ids_by_key(n, key_of, sorted, [&](double done) { progress.update(0.05 + 0.45 * done); });
+  const uint64_t id_mask = (uint64_t(1) << id_bits_for(n)) - 1;
+  vertex_source_.resize(n);
+  parallel_for(0, n, kParallelMin, [&](int32_t i) { vertex_source_[i] = int32_t(sorted[i] & id_mask); });
+  Buffer<uint64_t>().swap(sorted);
   vertex_index_.resize(n);
   positions_.resize(3 * size_t(n));
   parallel_for(0, n, kParallelMin, [&](int32_t i) {
