@@ -254,18 +254,19 @@ void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offse
   release_unused(lists);
 }
 
-// Components, numbered in order of their lowest vertex (each set's root), and the Euler
+// Components, numbered in order of their lowest vertex (each set's root; a vertex without
+// neighbours in none), and the Euler
 // characteristic V - E + F of each from every vertex's share: itself, the edges to its higher
 // neighbours and the faces it is the lowest vertex of. Returns how many. `component` (n entries
 // or more) holds each vertex's root and receives its component in place: a root is its set's
 // lowest id (SharedUnionFind::unite), so it is numbered before the vertices that read it.
-int32_t number_components(const Buffer<int32_t>& vfo, const Buffer<int32_t>& euler, Buffer<int32_t>& component,
+int32_t number_components(const Buffer<int32_t>& ao, const Buffer<int32_t>& euler, Buffer<int32_t>& component,
                           Buffer<int64_t>& component_euler) {
-  const int32_t n = int32_t(vfo.size()) - 1;
+  const int32_t n = int32_t(ao.size()) - 1;
   int32_t components = 0;
   for (int32_t v = 0; v < n; ++v) {
     const int32_t root = component[v];
-    if (vfo[v] == vfo[v + 1]) component[v] = -1;
+    if (ao[v] == ao[v + 1]) component[v] = -1;
     else component[v] = root == v ? components++ : component[root];
   }
   component.resize(n);
@@ -328,7 +329,9 @@ Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangl
   progress.stage("order", 0.15, 0.45);
   reorder_for_locality(positions, triangles, lo, hi, progress);
   progress.update(1.0);
-  build_vertex_faces();
+  fill_vertex_faces();
+  report_.isolated_vertices = parallel_count<int32_t>(
+      0, num_vertices_, kParallelMin, [&](int32_t v) { return vertex_face_offsets_[v + 1] == vertex_face_offsets_[v]; });
   build_adjacency(progress);
   release_freed_heap(4 * size_t(num_vertices_));
 }
@@ -475,7 +478,8 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     }
   }
   faces_.resize(3 * size_t(m));
-  Buffer<int32_t> source(m), lowest_offsets(size_t(n) + 1);
+  Buffer<int32_t> source(m);
+  lowest_offsets_.resize(size_t(n) + 1);
   parallel_for(0, m, kParallelMin, [&](int32_t j) {
     // The rows are read in a new order: fetch a few faces ahead.
     if (j + 8 < m) prefetch(&renumbered[3 * size_t(keyed[j + 8] & 0xffffffffu)]);
@@ -485,16 +489,17 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     // The runs of each lowest vertex: every vertex after the previous face's lowest, up to
     // this face's, starts here.
     const int64_t lowest = int64_t(keyed[j] >> 32), previous = j ? int64_t(keyed[j - 1] >> 32) : -1;
-    for (int64_t v = previous + 1; v <= lowest; ++v) lowest_offsets[v] = j;
+    for (int64_t v = previous + 1; v <= lowest; ++v) lowest_offsets_[v] = j;
   });
-  for (int64_t v = int64_t(keyed[m - 1] >> 32) + 1; v <= int64_t(n); ++v) lowest_offsets[v] = m;
+  for (int64_t v = int64_t(keyed[m - 1] >> 32) + 1; v <= int64_t(n); ++v) lowest_offsets_[v] = m;
   Buffer<int32_t>().swap(renumbered);
   face_source_.swap(source);
   progress.update(0.95);
-  drop_duplicate_faces(lowest_offsets);
+  drop_duplicate_faces();
 }
 
-void Mesh::drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets) {
+void Mesh::drop_duplicate_faces() {
+  const Buffer<int32_t>& lowest_offsets = lowest_offsets_;
   // Duplicates (the same three vertices, either orientation) share their lowest vertex, so they
   // sit in one run of the sorted faces, which holds them in input order: the first is kept.
   const int32_t n = num_vertices_;
@@ -547,6 +552,7 @@ void Mesh::drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets) {
   }
   faces_.resize(3 * size_t(kept));
   face_source_.resize(kept);
+  find_lowest_offsets();
   std::sort(dropped.begin(), dropped.end());
   report_.dropped_triangles.clear();
   dropped_rows_.clear();
@@ -568,23 +574,54 @@ std::vector<int32_t> Mesh::caller_triangles() const {
 }
 
 int32_t Mesh::first_corner(int32_t v) const {
-  const int32_t first = vertex_face_offsets_[v];
-  if (first == vertex_face_offsets_[v + 1]) return -1;
-  const int32_t f = vertex_faces_[first];
+  const int32_t f = first_face(v);
+  if (f < 0) return -1;
   const int32_t* t = &faces_[3 * size_t(f)];
   return 3 * face_source_[f] + (t[0] == v ? 0 : t[1] == v ? 1 : 2);
 }
 
-void Mesh::build_vertex_faces() {
+int32_t Mesh::first_face(int32_t v) const {
+  const int32_t* row = adjacency_.data() + adjacency_offsets_[v];
+  const int32_t* row_end = adjacency_.data() + adjacency_offsets_[v + 1];
+  for (; row != row_end && *row < v; ++row)
+    for (int32_t f = lowest_offsets_[*row]; f < lowest_offsets_[*row + 1]; ++f) {
+      const int32_t* t = &faces_[3 * size_t(f)];
+      if (t[1] == v || t[2] == v || t[0] == v) return f;
+    }
+  return lowest_offsets_[v] < lowest_offsets_[v + 1] ? lowest_offsets_[v] : -1;
+}
+
+int32_t Mesh::face_count(int32_t v) const {
+  int32_t count = 0;
+  for_each_face(v, [&](int32_t) { ++count; });
+  return count;
+}
+
+// After duplicates are dropped: the faces stay in order of their lowest vertex.
+void Mesh::find_lowest_offsets() {
+  const int32_t m = num_faces();
+  int32_t v = 0;
+  for (int32_t f = 0; f < m; ++f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
+    const int32_t lowest = std::min({t[0], t[1], t[2]});
+    while (v <= lowest) lowest_offsets_[v++] = f;
+  }
+  while (v <= num_vertices_) lowest_offsets_[v++] = m;
+}
+
+void Mesh::fill_vertex_faces() const {
   // Each vertex's faces in increasing order: a stable counting sort of the corners.
   vertex_faces_.resize(faces_.size());
   stable_counting_sort(
       int64_t(faces_.size()), num_vertices_, [&](int64_t c) { return faces_[c]; },
       [&](int64_t c, int32_t at) { vertex_faces_[at] = int32_t(c / 3); }, vertex_face_offsets_);
-  const int32_t n = num_vertices_;
-  const int32_t isolated = parallel_count<int32_t>(
-      0, n, kParallelMin, [&](int32_t v) { return vertex_face_offsets_[v + 1] == vertex_face_offsets_[v]; });
-  report_.isolated_vertices = isolated;
+}
+
+void Mesh::build_vertex_faces() const {
+  std::call_once(vertex_faces_once_, [this] {
+    fill_vertex_faces();
+    vertex_faces_built_.store(true, std::memory_order_release);
+  });
 }
 
 void Mesh::build_adjacency(Progress& progress) {
@@ -637,6 +674,9 @@ void Mesh::build_adjacency(Progress& progress) {
   compact_neighbours(vfo, adjacency_offsets_, overflow, scratch);
   decltype(overflow)().swap(overflow);
   adjacency_.swap(scratch);
+  // From here a vertex's faces are walked from the adjacency and the faces' runs (for_each_face).
+  Buffer<int32_t>().swap(vertex_faces_);
+  Buffer<int32_t>().swap(vertex_face_offsets_);
   // Each vertex's root, where the edge offsets were: the sets go before the weights are made.
   parallel_for(0, n, kParallelMin, [&](int32_t v) { greater[v] = sets.find(v); });
   std::vector<int32_t>().swap(sets.parents());
@@ -646,23 +686,22 @@ void Mesh::build_adjacency(Progress& progress) {
   weigh();
   progress.stage("components", 0.92, 1.0);
   component_.swap(greater);  // the roots
-  report_.components = number_components(vfo, euler, component_, component_euler_);
+  report_.components = number_components(adjacency_offsets_, euler, component_, component_euler_);
   mean_weight_ = mean_of_weights(adjacency_offsets_, weights_);
 }
 
 // Area-weighted: the unnormalised face normals (twice the areas) summed at each vertex, in the
 // order of its faces, then normalised.
 void Mesh::normal_at(int32_t v, double* out) const {
-  const auto& vfo = vertex_face_offsets_;
   double sum[3] = {0, 0, 0};
-  for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-    const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
+  for_each_face(v, [&](int32_t f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
     double fn[3];
     cross(position(t[0]), position(t[1]), position(t[2]), fn);
     sum[0] += fn[0];
     sum[1] += fn[1];
     sum[2] += fn[2];
-  }
+  });
   unit_normal(sum, out);
 }
 
@@ -755,16 +794,15 @@ void Mesh::build_normals() const {
 void Mesh::build_vertex_areas() const {
   std::call_once(areas_once_, [this] {
     const int32_t n = num_vertices_;
-    const auto& vfo = vertex_face_offsets_;
     vertex_areas_.resize(n);
     parallel_for(0, n, kParallelMin, [&](int32_t v) {
       double area = 0.0;
-      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-        const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
+      for_each_face(v, [&](int32_t f) {
+        const int32_t* t = &faces_[3 * size_t(f)];
         double fn[3];
         cross(position(t[0]), position(t[1]), position(t[2]), fn);
         area += std::sqrt(fn[0] * fn[0] + fn[1] * fn[1] + fn[2] * fn[2]) / 6.0;  // a third of half the cross
-      }
+      });
       vertex_areas_[v] = area;
     });
     // Summed in vertex order on one thread, as the mean weight.
@@ -784,7 +822,6 @@ void Mesh::build_edges() const {
   std::call_once(edges_once_, [this] {
     const int32_t n = num_vertices_;
     const auto& ao = adjacency_offsets_;
-    const auto& vfo = vertex_face_offsets_;
     // Per vertex: where it sits in its own sorted row (its lower neighbours come first), and
     // how many face sides lead to higher neighbours (each edge belongs to its lower end).
     Buffer<int32_t> lower(n), edge_base(n + 1), side_base(n + 1);
@@ -795,11 +832,11 @@ void Mesh::build_edges() const {
       lower[v] = int32_t(std::lower_bound(row, row + d, v) - row);
       edge_base[v] = d - lower[v];
       int32_t sides = 0;
-      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-        const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
+      for_each_face(v, [&](int32_t f) {
+        const int32_t* t = &faces_[3 * size_t(f)];
         const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
         sides += (t[(c + 1) % 3] > v) + (t[(c + 2) % 3] > v);
-      }
+      });
       side_base[v] = sides;
     });
     exclusive_scan(edge_base);
@@ -828,8 +865,7 @@ void Mesh::build_edges() const {
         }
         fill.assign(higher, 0);
         auto rank = [&](int32_t u) { return int32_t(std::lower_bound(row + low, row + d, u) - (row + low)); };
-        for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-          const int32_t f = vertex_faces_[i];
+        for_each_face(v, [&](int32_t f) {
           const int32_t* t = &faces_[3 * size_t(f)];
           const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
           for (int side : {c, (c + 2) % 3}) {
@@ -839,21 +875,20 @@ void Mesh::build_edges() const {
             face_edges_[3 * size_t(f) + side] = edge_base[v] + j;
             ++fill[j];
           }
-        }
+        });
         int32_t at = side_base[v];
         for (int32_t j = 0; j < higher; ++j) {
           edge_face_offsets_[edge_base[v] + j] = at;
           at += std::exchange(fill[j], at);
         }
-        for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-          const int32_t f = vertex_faces_[i];
+        for_each_face(v, [&](int32_t f) {
           const int32_t* t = &faces_[3 * size_t(f)];
           const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
           for (int side : {c, (c + 2) % 3}) {
             if (t[side == c ? (c + 1) % 3 : side] < v) continue;
             edge_faces_[fill[face_edges_[3 * size_t(f) + side] - edge_base[v]]++] = f;
           }
-        }
+        });
       });
     });
     edge_face_offsets_[num_edges_] = side_base[n];
