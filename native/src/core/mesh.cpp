@@ -63,16 +63,17 @@ void sort_small(uint64_t* first, uint64_t* last) {
   }
 }
 
-// The arrays the first adjacency pass reads and writes (the Mesh's own, by reference).
+// The arrays the first adjacency pass reads and writes (the Mesh's own, by reference). A
+// vertex's faces are those it is not the lowest vertex of (`upper`, CSR) then its own run of the
+// faces, sorted by lowest vertex: in increasing order, as vertex_faces() lists them.
 struct OneRingArrays {
   const Buffer<int32_t>& faces;
-  const Buffer<int32_t>& vertex_faces;
-  const Buffer<int32_t>& vfo;
+  const Buffer<int32_t>& upper;
+  const Buffer<int32_t>& upper_offsets;
+  const Buffer<int32_t>& lowest_offsets;
   const Buffer<double>& positions;
   Buffer<int32_t>& scratch;  // each vertex's sorted neighbours, at its first face slot + its id
   Buffer<int32_t>& degree;
-  Buffer<int32_t>& greater;  // neighbours above the vertex
-  Buffer<int32_t>& euler;    // the vertex's share of V - E + F
   Buffer<uint8_t>& manifold_vertex;
   SharedUnionFind& sets;  // components: each set's root is its lowest vertex
 };
@@ -91,21 +92,20 @@ class OneRingScan {
   explicit OneRingScan(const OneRingArrays& a) : a(a) {}
 
   void scan(int32_t v, OneRingCounts& counts) {
-    const int32_t first = a.vfo[v], k = a.vfo[v + 1] - first;
+    const int32_t upper_first = a.upper_offsets[v], own_first = a.lowest_offsets[v];
+    const int32_t above = a.upper_offsets[v + 1] - upper_first, k = above + a.lowest_offsets[v + 1] - own_first;
     a.manifold_vertex[v] = 1;
     if (k == 0) {  // isolated: no neighbours, in no component
-      a.degree[v] = a.greater[v] = a.euler[v] = 0;
+      a.degree[v] = 0;
       return;
     }
-    const int32_t lowest_of = read_faces(v, first, k, counts.zero_area);
+    read_faces(v, a.upper.data() + upper_first, above, own_first, k, counts.zero_area);
     list.resize(2 * size_t(k));  // at most two neighbours per face
     int32_t* neighbours = list.data();
     const int32_t d = sort_neighbours(neighbours);
-    keep_neighbours(v, first, k, neighbours, d);
+    keep_neighbours(v, upper_first + own_first, k, neighbours, d);
     const int32_t lower = int32_t(std::lower_bound(neighbours, neighbours + d, v) - neighbours);
     a.degree[v] = d;
-    a.greater[v] = d - lower;
-    a.euler[v] = 1 - (d - lower) + lowest_of;
     bool nonmanifold_edge = false, flipped = false;
     count_edges(v, neighbours, d, lower, counts, nonmanifold_edge, flipped);
     const int32_t fans = nonmanifold_edge ? 1 : count_fans(k, d, flipped);
@@ -131,21 +131,18 @@ class OneRingScan {
   std::vector<uint64_t> ends;  // (neighbour, 2 slot + (1 if the arc enters it))
   std::vector<int32_t> end_rank, in, out, next;
 
-  // Reads v's k faces: the link's arc ends; counts the faces v is the lowest
-  // vertex of (returned) and, among them, those of zero area.
-  int32_t read_faces(int32_t v, int32_t first, int32_t k, int32_t& zero_area) {
+  // Reads v's k faces (the first `above` listed in `upper`, then the run from `own_first`): the
+  // link's arc ends; counts the faces v is the lowest vertex of that have zero area.
+  void read_faces(int32_t v, const int32_t* upper, int32_t above, int32_t own_first, int32_t k, int32_t& zero_area) {
     ends.resize(2 * size_t(k));
     end_rank.resize(2 * size_t(k));
-    int32_t lowest_of = 0;
     const int32_t* faces = a.faces.data();
-    const int32_t* vertex_faces = a.vertex_faces.data() + first;
     const double* positions = a.positions.data();
     for (int32_t i = 0; i < k; ++i) {
-      const int32_t* t = faces + 3 * size_t(vertex_faces[i]);
+      const int32_t* t = faces + 3 * size_t(i < above ? upper[i] : own_first + (i - above));
       const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
       const int32_t p = t[(c + 1) % 3], q = t[(c + 2) % 3];
       if (v < p && v < q) {
-        ++lowest_of;
         double fn[3];
         cross(positions + 3 * size_t(t[0]), positions + 3 * size_t(t[1]), positions + 3 * size_t(t[2]), fn);
         if (fn[0] == 0.0 && fn[1] == 0.0 && fn[2] == 0.0) ++zero_area;
@@ -153,7 +150,6 @@ class OneRingScan {
       ends[2 * size_t(i)] = (uint64_t(uint32_t(p)) << 32) | uint32_t(2 * i);         // side v -> p
       ends[2 * size_t(i) + 1] = (uint64_t(uint32_t(q)) << 32) | uint32_t(2 * i + 1);  // side q -> v
     }
-    return lowest_of;
   }
 
   // The distinct neighbours in increasing order (returns how many), with the arcs entering
@@ -229,11 +225,13 @@ class OneRingScan {
   }
 };
 
-// The neighbours into place: each vertex's list moves from its first face slot + its id to its
-// offset, in vertex order. Without overflow (every vertex within one neighbour per face plus
+// The neighbours into place: each vertex's list moves from its first face slot (the faces
+// before it in vertex_faces(): those above lower vertices and the runs of lower vertices) + its
+// id to its offset, in vertex order. Without overflow (every vertex within one neighbour per face plus
 // one) that happens within the same buffer, as no list lands on one not moved yet, and then the
 // buffer's tail can go; otherwise the lists go to a buffer of their own. `overflow` is sorted.
-void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offsets,
+void compact_neighbours(const Buffer<int32_t>& upper_offsets, const Buffer<int32_t>& lowest_offsets,
+                        const Buffer<int32_t>& offsets,
                         const std::vector<std::pair<int32_t, std::vector<int32_t>>>& overflow, Buffer<int32_t>& lists) {
   const int32_t n = int32_t(offsets.size()) - 1;
   Buffer<int32_t> own;
@@ -243,7 +241,7 @@ void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offse
   for (int32_t v = 0; v < n; ++v) {
     const int32_t d = offsets[v + 1] - offsets[v];
     const bool over = next < overflow.size() && overflow[next].first == v;
-    const int32_t* from = over ? overflow[next++].second.data() : lists.data() + size_t(vfo[v]) + size_t(v);
+    const int32_t* from = over ? overflow[next++].second.data() : lists.data() + size_t(upper_offsets[v]) + size_t(lowest_offsets[v]) + size_t(v);
     std::copy(from, from + d, to + offsets[v]);
   }
   if (!overflow.empty()) {
@@ -255,12 +253,13 @@ void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offse
 }
 
 // Components, numbered in order of their lowest vertex (each set's root; a vertex without
-// neighbours in none), and the Euler
-// characteristic V - E + F of each from every vertex's share: itself, the edges to its higher
-// neighbours and the faces it is the lowest vertex of. Returns how many. `component` (n entries
-// or more) holds each vertex's root and receives its component in place: a root is its set's
-// lowest id (SharedUnionFind::unite), so it is numbered before the vertices that read it.
-int32_t number_components(const Buffer<int32_t>& ao, const Buffer<int32_t>& euler, Buffer<int32_t>& component,
+// neighbours in none), and the Euler characteristic V - E + F of each from every vertex's share:
+// itself, the edges to its higher neighbours (its sorted row's tail) and the faces it is the
+// lowest vertex of (its run). Returns how many. `component` (n entries) holds each vertex's root
+// and receives its component in place: a root is its set's lowest id (SharedUnionFind::unite),
+// so it is numbered before the vertices that read it.
+int32_t number_components(const Buffer<int32_t>& ao, const Buffer<int32_t>& adjacency,
+                          const Buffer<int32_t>& lowest_offsets, Buffer<int32_t>& component,
                           Buffer<int64_t>& component_euler) {
   const int32_t n = int32_t(ao.size()) - 1;
   int32_t components = 0;
@@ -269,10 +268,13 @@ int32_t number_components(const Buffer<int32_t>& ao, const Buffer<int32_t>& eule
     if (ao[v] == ao[v + 1]) component[v] = -1;
     else component[v] = root == v ? components++ : component[root];
   }
-  component.resize(n);
   component_euler.assign(components, 0);
-  for (int32_t v = 0; v < n; ++v)
-    if (component[v] >= 0) component_euler[component[v]] += euler[v];
+  for (int32_t v = 0; v < n; ++v) {
+    if (component[v] < 0) continue;
+    const int32_t* row = adjacency.data() + ao[v];
+    const int32_t d = ao[v + 1] - ao[v], lower = int32_t(std::lower_bound(row, row + d, v) - row);
+    component_euler[component[v]] += 1 - (d - lower) + (lowest_offsets[v + 1] - lowest_offsets[v]);
+  }
   return components;
 }
 
@@ -329,9 +331,6 @@ Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangl
   progress.stage("order", 0.15, 0.45);
   reorder_for_locality(positions, triangles, lo, hi, progress);
   progress.update(1.0);
-  fill_vertex_faces();
-  report_.isolated_vertices = parallel_count<int32_t>(
-      0, num_vertices_, kParallelMin, [&](int32_t v) { return vertex_face_offsets_[v + 1] == vertex_face_offsets_[v]; });
   build_adjacency(progress);
   release_freed_heap(4 * size_t(num_vertices_));
 }
@@ -627,20 +626,35 @@ void Mesh::build_vertex_faces() const {
 void Mesh::build_adjacency(Progress& progress) {
   progress.stage("adjacency", 0.45, 0.8);
   const int32_t n = num_vertices_;
-  const auto& vfo = vertex_face_offsets_;
+  // Each vertex's faces it is not the lowest vertex of, in increasing order (a stable counting
+  // sort of the two other corners of each face): with the faces' runs, its faces, in 10 bytes a
+  // triangle where a table of them (vertex_faces()) is 14.
+  Buffer<int32_t> upper, upper_offsets;
+  upper.resize(2 * size_t(num_faces()));
+  stable_counting_sort(
+      2 * int64_t(num_faces()), n,
+      [&](int64_t i) {
+        const int32_t* t = &faces_[3 * size_t(i >> 1)];
+        const int lowest = (t[0] < t[1] && t[0] < t[2]) ? 0 : (t[1] < t[2] ? 1 : 2);
+        return t[(lowest + 1 + (i & 1)) % 3];
+      },
+      [&](int64_t i, int32_t at) { upper[at] = int32_t(i >> 1); }, upper_offsets);
+  report_.isolated_vertices = parallel_count<int32_t>(0, n, kParallelMin, [&](int32_t v) {
+    return upper_offsets[v] == upper_offsets[v + 1] && lowest_offsets_[v] == lowest_offsets_[v + 1];
+  });
   // First pass, per vertex, from its faces alone (OneRingScan). Neighbours wait in `scratch`
   // (at the vertex's first face slot + its id; a non-manifold vertex's extra ones in `overflow`)
   // until the offsets are known: half the memory of slots for two neighbours per face, which
   // was the preparation's peak. Edge ids and tables come later, on demand (build_edges).
   // Buffers are written on the threads that fill them (see core/buffer.hpp): every entry a loop
   // skips is set explicitly.
-  Buffer<int32_t> scratch(vertex_faces_.size() + size_t(n));
-  Buffer<int32_t> degree(n + 1), greater(n + 1), euler(n);
-  degree[n] = greater[n] = 0;
+  Buffer<int32_t> scratch(faces_.size() + size_t(n));
+  Buffer<int32_t> degree(n + 1);
+  degree[n] = 0;
   manifold_vertex_.resize(n);
   SharedUnionFind sets(n);
-  const OneRingArrays arrays{faces_, vertex_faces_, vfo, positions_, scratch, degree, greater,
-                             euler, manifold_vertex_, sets};
+  const OneRingArrays arrays{faces_, upper, upper_offsets, lowest_offsets_, positions_, scratch, degree,
+                             manifold_vertex_, sets};
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
   std::vector<std::pair<int32_t, std::vector<int32_t>>> overflow;
   // In slices of the vertices with a cancel point after each (the pass is seconds on 20M
@@ -668,25 +682,30 @@ void Mesh::build_adjacency(Progress& progress) {
 
   adjacency_offsets_.swap(degree);
   exclusive_scan(adjacency_offsets_);
-  exclusive_scan(greater);
-  num_edges_ = greater[n];
   std::sort(overflow.begin(), overflow.end());
-  compact_neighbours(vfo, adjacency_offsets_, overflow, scratch);
+  compact_neighbours(upper_offsets, lowest_offsets_, adjacency_offsets_, overflow, scratch);
   decltype(overflow)().swap(overflow);
   adjacency_.swap(scratch);
   // From here a vertex's faces are walked from the adjacency and the faces' runs (for_each_face).
-  Buffer<int32_t>().swap(vertex_faces_);
-  Buffer<int32_t>().swap(vertex_face_offsets_);
-  // Each vertex's root, where the edge offsets were: the sets go before the weights are made.
-  parallel_for(0, n, kParallelMin, [&](int32_t v) { greater[v] = sets.find(v); });
+  Buffer<int32_t>().swap(upper);
+  Buffer<int32_t>().swap(upper_offsets);
+  // Each edge at its lower end: the tail of that end's sorted row.
+  const int64_t edges = parallel_count<int64_t>(0, n, kParallelMin, [&](int32_t v) {
+    const int32_t *row = adjacency_.data() + adjacency_offsets_[v], *end = adjacency_.data() + adjacency_offsets_[v + 1];
+    return int64_t(end - std::upper_bound(row, end, v));
+  });
+  if (edges > INT32_MAX) throw std::invalid_argument("mesh is too large: more than 2^31 edges");
+  num_edges_ = int32_t(edges);
+  // Each vertex's root: the sets go before the weights are made.
+  component_.resize(n);
+  parallel_for(0, n, kParallelMin, [&](int32_t v) { component_[v] = sets.find(v); });
   std::vector<int32_t>().swap(sets.parents());
   release_freed_heap(4 * size_t(n));
 
   progress.stage("normals and weights", 0.8, 0.92);
   weigh();
   progress.stage("components", 0.92, 1.0);
-  component_.swap(greater);  // the roots
-  report_.components = number_components(adjacency_offsets_, euler, component_, component_euler_);
+  report_.components = number_components(adjacency_offsets_, adjacency_, lowest_offsets_, component_, component_euler_);
   mean_weight_ = mean_of_weights(adjacency_offsets_, weights_);
 }
 
