@@ -728,6 +728,43 @@ void Mesh::normal_at(int32_t v, double* out) const {
   unit_normal(sum, out);
 }
 
+// normal_at's sums for a range of vertices, the same faces added in the same order: each
+// vertex's faces in the runs of vertices below a first (walked per vertex, as for_each_face),
+// then the runs of [a, b) swept once, each face's cross product made once for its corners in
+// the range instead of once per corner.
+void Mesh::normal_sums(int32_t a, int32_t b, std::vector<double>& sums) const {
+  sums.assign(3 * size_t(b - a), 0.0);
+  auto add = [&](int32_t v, const int32_t* t) {
+    double fn[3];
+    cross(position(t[0]), position(t[1]), position(t[2]), fn);
+    double* sum = &sums[3 * size_t(v - a)];
+    sum[0] += fn[0];
+    sum[1] += fn[1];
+    sum[2] += fn[2];
+  };
+  for (int32_t v = a; v < b; ++v) {
+    const int32_t* row = adjacency_.data() + adjacency_offsets_[v];
+    const int32_t* row_end = adjacency_.data() + adjacency_offsets_[v + 1];
+    for (; row != row_end && *row < a; ++row)
+      for (int32_t f = lowest_offsets_[*row], end = lowest_offsets_[*row + 1]; f < end; ++f) {
+        const int32_t* t = &faces_[3 * size_t(f)];
+        if (t[1] == v || t[2] == v || t[0] == v) add(v, t);
+      }
+  }
+  for (int32_t f = lowest_offsets_[a], end = lowest_offsets_[b]; f < end; ++f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
+    double fn[3];
+    cross(position(t[0]), position(t[1]), position(t[2]), fn);
+    for (int c = 0; c < 3; ++c) {
+      if (t[c] >= b) continue;  // every corner is at or above the run's vertex, so at or above a
+      double* sum = &sums[3 * size_t(t[c] - a)];
+      sum[0] += fn[0];
+      sum[1] += fn[1];
+      sum[2] += fn[2];
+    }
+  }
+}
+
 void Mesh::fill_normals() const {
   const int32_t n = num_vertices_;
   normals_.resize(3 * size_t(n));
@@ -745,8 +782,16 @@ void Mesh::weigh() {
   const int64_t span = 3 * int64_t(kBlock);  // the ring holds ids [b - kBlock, b + 2 kBlock)
   std::vector<double> ring(3 * size_t(std::min<int64_t>(span, n)));
   auto slot = [&](int32_t v) { return &ring[3 * size_t(v % span)]; };
-  auto compute = [&](int32_t from, int32_t to) {
-    parallel_for(from, to, kParallelMinCostly, [&](int32_t v) { normal_at(v, slot(v)); });
+  auto compute = [&](int32_t from, int32_t to) {  // in chunks of vertices, each on one thread
+    constexpr int32_t kChunk = 1024;
+    parallel_region(team_for(to - from, kParallelMinCostly), [&](Team& team) {
+      std::vector<double> sums;
+      team.for_static(0, (to - from + kChunk - 1) / kChunk, [&](int32_t chunk) {
+        const int32_t a = from + chunk * kChunk, e = std::min(to, a + kChunk);
+        normal_sums(a, e, sums);
+        for (int32_t v = a; v < e; ++v) unit_normal(&sums[3 * size_t(v - a)], slot(v));
+      });
+    });
   };
   weights_.resize(n);
   compute(0, int32_t(std::min<int64_t>(n, 2 * int64_t(kBlock))));

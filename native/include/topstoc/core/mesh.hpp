@@ -167,6 +167,8 @@ class Mesh {
   void fill_normals() const;
   /// The unit area-weighted normal of v, as normals() holds it.
   void normal_at(int32_t v, double* out) const;
+  /// The sums normal_at normalises, of the vertices [a, b), into sums (3 a vertex).
+  void normal_sums(int32_t a, int32_t b, std::vector<double>& sums) const;
   /// The importance weights from the normals, computed a window of vertices at a time.
   void weigh();
   void ensure_vertex_areas() const {
