@@ -64,16 +64,17 @@ void sort_small(uint64_t* first, uint64_t* last) {
   }
 }
 
-// The arrays the first adjacency pass reads and writes (the Mesh's own, by reference).
+// The arrays the first adjacency pass reads and writes (the Mesh's own, by reference). A
+// vertex's faces are those it is not the lowest vertex of (`upper`, CSR) then its own run of the
+// faces, sorted by lowest vertex: in increasing order, as vertex_faces() lists them.
 struct OneRingArrays {
   const Buffer<int32_t>& faces;
-  const Buffer<int32_t>& vertex_faces;
-  const Buffer<int32_t>& vfo;
+  const Buffer<int32_t>& upper;
+  const Buffer<int32_t>& upper_offsets;
+  const Buffer<int32_t>& lowest_offsets;
   const Buffer<double>& positions;
   Buffer<int32_t>& scratch;  // each vertex's sorted neighbours, at its first face slot + its id
   Buffer<int32_t>& degree;
-  Buffer<int32_t>& greater;  // neighbours above the vertex
-  Buffer<int32_t>& euler;    // the vertex's share of V - E + F
   Buffer<uint8_t>& manifold_vertex;
   SharedUnionFind& sets;  // components: each set's root is its lowest vertex
 };
@@ -92,21 +93,20 @@ class OneRingScan {
   explicit OneRingScan(const OneRingArrays& a) : a(a) {}
 
   void scan(int32_t v, OneRingCounts& counts) {
-    const int32_t first = a.vfo[v], k = a.vfo[v + 1] - first;
+    const int32_t upper_first = a.upper_offsets[v], own_first = a.lowest_offsets[v];
+    const int32_t above = a.upper_offsets[v + 1] - upper_first, k = above + a.lowest_offsets[v + 1] - own_first;
     a.manifold_vertex[v] = 1;
     if (k == 0) {  // isolated: no neighbours, in no component
-      a.degree[v] = a.greater[v] = a.euler[v] = 0;
+      a.degree[v] = 0;
       return;
     }
-    const int32_t lowest_of = read_faces(v, first, k, counts.zero_area);
+    read_faces(v, a.upper.data() + upper_first, above, own_first, k, counts.zero_area);
     list.resize(2 * size_t(k));  // at most two neighbours per face
     int32_t* neighbours = list.data();
     const int32_t d = sort_neighbours(neighbours);
-    keep_neighbours(v, first, k, neighbours, d);
+    keep_neighbours(v, upper_first + own_first, k, neighbours, d);
     const int32_t lower = int32_t(std::lower_bound(neighbours, neighbours + d, v) - neighbours);
     a.degree[v] = d;
-    a.greater[v] = d - lower;
-    a.euler[v] = 1 - (d - lower) + lowest_of;
     bool nonmanifold_edge = false, flipped = false;
     count_edges(v, neighbours, d, lower, counts, nonmanifold_edge, flipped);
     const int32_t fans = nonmanifold_edge ? 1 : count_fans(k, d, flipped);
@@ -132,21 +132,18 @@ class OneRingScan {
   std::vector<uint64_t> ends;  // (neighbour, 2 slot + (1 if the arc enters it))
   std::vector<int32_t> end_rank, in, out, next;
 
-  // Reads v's k faces: the link's arc ends; counts the faces v is the lowest
-  // vertex of (returned) and, among them, those of zero area.
-  int32_t read_faces(int32_t v, int32_t first, int32_t k, int32_t& zero_area) {
+  // Reads v's k faces (the first `above` listed in `upper`, then the run from `own_first`): the
+  // link's arc ends; counts the faces v is the lowest vertex of that have zero area.
+  void read_faces(int32_t v, const int32_t* upper, int32_t above, int32_t own_first, int32_t k, int32_t& zero_area) {
     ends.resize(2 * size_t(k));
     end_rank.resize(2 * size_t(k));
-    int32_t lowest_of = 0;
     const int32_t* faces = a.faces.data();
-    const int32_t* vertex_faces = a.vertex_faces.data() + first;
     const double* positions = a.positions.data();
     for (int32_t i = 0; i < k; ++i) {
-      const int32_t* t = faces + 3 * size_t(vertex_faces[i]);
+      const int32_t* t = faces + 3 * size_t(i < above ? upper[i] : own_first + (i - above));
       const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
       const int32_t p = t[(c + 1) % 3], q = t[(c + 2) % 3];
       if (v < p && v < q) {
-        ++lowest_of;
         double fn[3];
         cross(positions + 3 * size_t(t[0]), positions + 3 * size_t(t[1]), positions + 3 * size_t(t[2]), fn);
         if (fn[0] == 0.0 && fn[1] == 0.0 && fn[2] == 0.0) ++zero_area;
@@ -154,7 +151,6 @@ class OneRingScan {
       ends[2 * size_t(i)] = (uint64_t(uint32_t(p)) << 32) | uint32_t(2 * i);         // side v -> p
       ends[2 * size_t(i) + 1] = (uint64_t(uint32_t(q)) << 32) | uint32_t(2 * i + 1);  // side q -> v
     }
-    return lowest_of;
   }
 
   // The distinct neighbours in increasing order (returns how many), with the arcs entering
@@ -230,11 +226,13 @@ class OneRingScan {
   }
 };
 
-// The neighbours into place: each vertex's list moves from its first face slot + its id to its
-// offset, in vertex order. Without overflow (every vertex within one neighbour per face plus
+// The neighbours into place: each vertex's list moves from its first face slot (the faces
+// before it in vertex_faces(): those above lower vertices and the runs of lower vertices) + its
+// id to its offset, in vertex order. Without overflow (every vertex within one neighbour per face plus
 // one) that happens within the same buffer, as no list lands on one not moved yet, and then the
 // buffer's tail can go; otherwise the lists go to a buffer of their own. `overflow` is sorted.
-void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offsets,
+void compact_neighbours(const Buffer<int32_t>& upper_offsets, const Buffer<int32_t>& lowest_offsets,
+                        const Buffer<int32_t>& offsets,
                         const std::vector<std::pair<int32_t, std::vector<int32_t>>>& overflow, Buffer<int32_t>& lists) {
   const int32_t n = int32_t(offsets.size()) - 1;
   Buffer<int32_t> own;
@@ -244,7 +242,7 @@ void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offse
   for (int32_t v = 0; v < n; ++v) {
     const int32_t d = offsets[v + 1] - offsets[v];
     const bool over = next < overflow.size() && overflow[next].first == v;
-    const int32_t* from = over ? overflow[next++].second.data() : lists.data() + size_t(vfo[v]) + size_t(v);
+    const int32_t* from = over ? overflow[next++].second.data() : lists.data() + size_t(upper_offsets[v]) + size_t(lowest_offsets[v]) + size_t(v);
     std::copy(from, from + d, to + offsets[v]);
   }
   if (!overflow.empty()) {
@@ -255,24 +253,29 @@ void compact_neighbours(const Buffer<int32_t>& vfo, const Buffer<int32_t>& offse
   release_unused(lists);
 }
 
-// Components, numbered in order of their lowest vertex (each set's root), and the Euler
-// characteristic V - E + F of each from every vertex's share: itself, the edges to its higher
-// neighbours and the faces it is the lowest vertex of. Returns how many. `component` (n entries
-// or more) holds each vertex's root and receives its component in place: a root is its set's
-// lowest id (SharedUnionFind::unite), so it is numbered before the vertices that read it.
-int32_t number_components(const Buffer<int32_t>& vfo, const Buffer<int32_t>& euler, Buffer<int32_t>& component,
+// Components, numbered in order of their lowest vertex (each set's root; a vertex without
+// neighbours in none), and the Euler characteristic V - E + F of each from every vertex's share:
+// itself, the edges to its higher neighbours (its sorted row's tail) and the faces it is the
+// lowest vertex of (its run). Returns how many. `component` (n entries) holds each vertex's root
+// and receives its component in place: a root is its set's lowest id (SharedUnionFind::unite),
+// so it is numbered before the vertices that read it.
+int32_t number_components(const Buffer<int32_t>& ao, const Buffer<int32_t>& adjacency,
+                          const Buffer<int32_t>& lowest_offsets, Buffer<int32_t>& component,
                           Buffer<int64_t>& component_euler) {
-  const int32_t n = int32_t(vfo.size()) - 1;
+  const int32_t n = int32_t(ao.size()) - 1;
   int32_t components = 0;
   for (int32_t v = 0; v < n; ++v) {
     const int32_t root = component[v];
-    if (vfo[v] == vfo[v + 1]) component[v] = -1;
+    if (ao[v] == ao[v + 1]) component[v] = -1;
     else component[v] = root == v ? components++ : component[root];
   }
-  component.resize(n);
   component_euler.assign(components, 0);
-  for (int32_t v = 0; v < n; ++v)
-    if (component[v] >= 0) component_euler[component[v]] += euler[v];
+  for (int32_t v = 0; v < n; ++v) {
+    if (component[v] < 0) continue;
+    const int32_t* row = adjacency.data() + ao[v];
+    const int32_t d = ao[v + 1] - ao[v], lower = int32_t(std::lower_bound(row, row + d, v) - row);
+    component_euler[component[v]] += 1 - (d - lower) + (lowest_offsets[v + 1] - lowest_offsets[v]);
+  }
   return components;
 }
 
@@ -329,7 +332,6 @@ Mesh::Mesh(const double* positions, int64_t num_vertices, const int32_t* triangl
   progress.stage("order", 0.15, 0.45);
   reorder_for_locality(positions, triangles, lo, hi, progress);
   progress.update(1.0);
-  build_vertex_faces();
   build_adjacency(progress);
   release_freed_heap(4 * size_t(num_vertices_));
 }
@@ -454,7 +456,8 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     }
   }
   faces_.resize(3 * size_t(m));
-  Buffer<int32_t> source(m), lowest_offsets(size_t(n) + 1);
+  Buffer<int32_t> source(m);
+  lowest_offsets_.resize(size_t(n) + 1);
   parallel_for(0, m, kParallelMin, [&](int32_t j) {
     // The rows are read in a new order: fetch a few faces ahead.
     if (j + 8 < m) prefetch(&renumbered[3 * size_t(keyed[j + 8] & 0xffffffffu)]);
@@ -464,16 +467,17 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
     // The runs of each lowest vertex: every vertex after the previous face's lowest, up to
     // this face's, starts here.
     const int64_t lowest = int64_t(keyed[j] >> 32), previous = j ? int64_t(keyed[j - 1] >> 32) : -1;
-    for (int64_t v = previous + 1; v <= lowest; ++v) lowest_offsets[v] = j;
+    for (int64_t v = previous + 1; v <= lowest; ++v) lowest_offsets_[v] = j;
   });
-  for (int64_t v = int64_t(keyed[m - 1] >> 32) + 1; v <= int64_t(n); ++v) lowest_offsets[v] = m;
+  for (int64_t v = int64_t(keyed[m - 1] >> 32) + 1; v <= int64_t(n); ++v) lowest_offsets_[v] = m;
   Buffer<int32_t>().swap(renumbered);
   face_source_.swap(source);
   progress.update(0.95);
-  drop_duplicate_faces(lowest_offsets);
+  drop_duplicate_faces();
 }
 
-void Mesh::drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets) {
+void Mesh::drop_duplicate_faces() {
+  const Buffer<int32_t>& lowest_offsets = lowest_offsets_;
   // Duplicates (the same three vertices, either orientation) share their lowest vertex, so they
   // sit in one run of the sorted faces, which holds them in input order: the first is kept.
   const int32_t n = num_vertices_;
@@ -526,6 +530,7 @@ void Mesh::drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets) {
   }
   faces_.resize(3 * size_t(kept));
   face_source_.resize(kept);
+  find_lowest_offsets();
   std::sort(dropped.begin(), dropped.end());
   report_.dropped_triangles.clear();
   dropped_rows_.clear();
@@ -547,42 +552,92 @@ std::vector<int32_t> Mesh::caller_triangles() const {
 }
 
 int32_t Mesh::first_corner(int32_t v) const {
-  const int32_t first = vertex_face_offsets_[v];
-  if (first == vertex_face_offsets_[v + 1]) return -1;
-  const int32_t f = vertex_faces_[first];
+  const int32_t f = first_face(v);
+  if (f < 0) return -1;
   const int32_t* t = &faces_[3 * size_t(f)];
   return 3 * face_source_[f] + (t[0] == v ? 0 : t[1] == v ? 1 : 2);
 }
 
-void Mesh::build_vertex_faces() {
+int32_t Mesh::first_face(int32_t v) const {
+  const int32_t* row = adjacency_.data() + adjacency_offsets_[v];
+  const int32_t* row_end = adjacency_.data() + adjacency_offsets_[v + 1];
+  for (; row != row_end && *row < v; ++row)
+    for (int32_t f = lowest_offsets_[*row]; f < lowest_offsets_[*row + 1]; ++f) {
+      const int32_t* t = &faces_[3 * size_t(f)];
+      if (t[1] == v || t[2] == v || t[0] == v) return f;
+    }
+  return lowest_offsets_[v] < lowest_offsets_[v + 1] ? lowest_offsets_[v] : -1;
+}
+
+int32_t Mesh::face_count(int32_t v) const {
+  int32_t count = 0;
+  for_each_face(v, [&](int32_t) { ++count; });
+  return count;
+}
+
+// After duplicates are dropped: the faces stay in order of their lowest vertex.
+void Mesh::find_lowest_offsets() {
+  const int32_t m = num_faces();
+  int32_t v = 0;
+  for (int32_t f = 0; f < m; ++f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
+    const int32_t lowest = std::min({t[0], t[1], t[2]});
+    while (v <= lowest) lowest_offsets_[v++] = f;
+  }
+  while (v <= num_vertices_) lowest_offsets_[v++] = m;
+}
+
+void Mesh::fill_vertex_faces() const {
   // Each vertex's faces in increasing order: a stable counting sort of the corners.
   vertex_faces_.resize(faces_.size());
   stable_counting_sort(
       int64_t(faces_.size()), num_vertices_, [&](int64_t c) { return faces_[c]; },
       [&](int64_t c, int32_t at) { vertex_faces_[at] = int32_t(c / 3); }, vertex_face_offsets_);
-  const int32_t n = num_vertices_;
-  const int32_t isolated = parallel_count<int32_t>(
-      0, n, kParallelMin, [&](int32_t v) { return vertex_face_offsets_[v + 1] == vertex_face_offsets_[v]; });
-  report_.isolated_vertices = isolated;
+}
+
+void Mesh::build_vertex_faces() const {
+  std::call_once(vertex_faces_once_, [this] {
+    fill_vertex_faces();
+    vertex_faces_built_.store(true, std::memory_order_release);
+  });
 }
 
 void Mesh::build_adjacency(Progress& progress) {
   progress.stage("adjacency", 0.45, 0.8);
   const int32_t n = num_vertices_;
-  const auto& vfo = vertex_face_offsets_;
+  // Each vertex's faces it is not the lowest vertex of, in increasing order (a stable counting
+  // sort of the two other corners of each face): with the faces' runs, its faces, in 10 bytes a
+  // triangle where a table of them (vertex_faces()) is 14.
+  // The two other corners of each face are listed first (the sort reads each twice; this is
+  // below the pass's peak).
+  Buffer<int32_t> upper, upper_offsets, others(2 * size_t(num_faces()));
+  parallel_for(0, num_faces(), kParallelMin, [&](int32_t f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
+    const int lowest = (t[0] < t[1] && t[0] < t[2]) ? 0 : (t[1] < t[2] ? 1 : 2);
+    others[2 * size_t(f)] = t[lowest == 2 ? 0 : lowest + 1];
+    others[2 * size_t(f) + 1] = t[lowest == 0 ? 2 : lowest - 1];
+  });
+  upper.resize(others.size());
+  stable_counting_sort(
+      int64_t(others.size()), n, [&](int64_t i) { return others[i]; },
+      [&](int64_t i, int32_t at) { upper[at] = int32_t(i >> 1); }, upper_offsets);
+  Buffer<int32_t>().swap(others);
+  report_.isolated_vertices = parallel_count<int32_t>(0, n, kParallelMin, [&](int32_t v) {
+    return upper_offsets[v] == upper_offsets[v + 1] && lowest_offsets_[v] == lowest_offsets_[v + 1];
+  });
   // First pass, per vertex, from its faces alone (OneRingScan). Neighbours wait in `scratch`
   // (at the vertex's first face slot + its id; a non-manifold vertex's extra ones in `overflow`)
   // until the offsets are known: half the memory of slots for two neighbours per face, which
   // was the preparation's peak. Edge ids and tables come later, on demand (build_edges).
   // Buffers are written on the threads that fill them (see core/buffer.hpp): every entry a loop
   // skips is set explicitly.
-  Buffer<int32_t> scratch(vertex_faces_.size() + size_t(n));
-  Buffer<int32_t> degree(n + 1), greater(n + 1), euler(n);
-  degree[n] = greater[n] = 0;
+  Buffer<int32_t> scratch(faces_.size() + size_t(n));
+  Buffer<int32_t> degree(n + 1);
+  degree[n] = 0;
   manifold_vertex_.resize(n);
   SharedUnionFind sets(n);
-  const OneRingArrays arrays{faces_, vertex_faces_, vfo, positions_, scratch, degree, greater,
-                             euler, manifold_vertex_, sets};
+  const OneRingArrays arrays{faces_, upper, upper_offsets, lowest_offsets_, positions_, scratch, degree,
+                             manifold_vertex_, sets};
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
   std::vector<std::pair<int32_t, std::vector<int32_t>>> overflow;
   // In slices of the vertices with a cancel point after each (the pass is seconds on 20M
@@ -610,39 +665,83 @@ void Mesh::build_adjacency(Progress& progress) {
 
   adjacency_offsets_.swap(degree);
   exclusive_scan(adjacency_offsets_);
-  exclusive_scan(greater);
-  num_edges_ = greater[n];
   std::sort(overflow.begin(), overflow.end());
-  compact_neighbours(vfo, adjacency_offsets_, overflow, scratch);
+  compact_neighbours(upper_offsets, lowest_offsets_, adjacency_offsets_, overflow, scratch);
   decltype(overflow)().swap(overflow);
   adjacency_.swap(scratch);
-  // Each vertex's root, where the edge offsets were: the sets go before the weights are made.
-  parallel_for(0, n, kParallelMin, [&](int32_t v) { greater[v] = sets.find(v); });
+  // From here a vertex's faces are walked from the adjacency and the faces' runs (for_each_face).
+  Buffer<int32_t>().swap(upper);
+  Buffer<int32_t>().swap(upper_offsets);
+  // Each edge at its lower end: the tail of that end's sorted row.
+  const int64_t edges = parallel_count<int64_t>(0, n, kParallelMin, [&](int32_t v) {
+    const int32_t *row = adjacency_.data() + adjacency_offsets_[v], *end = adjacency_.data() + adjacency_offsets_[v + 1];
+    return int64_t(end - std::upper_bound(row, end, v));
+  });
+  if (edges > INT32_MAX) throw std::invalid_argument("mesh is too large: more than 2^31 edges");
+  num_edges_ = int32_t(edges);
+  // Each vertex's root: the sets go before the weights are made.
+  component_.resize(n);
+  parallel_for(0, n, kParallelMin, [&](int32_t v) { component_[v] = sets.find(v); });
   std::vector<int32_t>().swap(sets.parents());
   release_freed_heap(4 * size_t(n));
 
   progress.stage("normals and weights", 0.8, 0.92);
   weigh();
   progress.stage("components", 0.92, 1.0);
-  component_.swap(greater);  // the roots
-  report_.components = number_components(vfo, euler, component_, component_euler_);
+  report_.components = number_components(adjacency_offsets_, adjacency_, lowest_offsets_, component_, component_euler_);
   mean_weight_ = mean_of_weights(adjacency_offsets_, weights_);
 }
 
 // Area-weighted: the unnormalised face normals (twice the areas) summed at each vertex, in the
 // order of its faces, then normalised.
 void Mesh::normal_at(int32_t v, double* out) const {
-  const auto& vfo = vertex_face_offsets_;
   double sum[3] = {0, 0, 0};
-  for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-    const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
+  for_each_face(v, [&](int32_t f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
     double fn[3];
     cross(position(t[0]), position(t[1]), position(t[2]), fn);
     sum[0] += fn[0];
     sum[1] += fn[1];
     sum[2] += fn[2];
-  }
+  });
   unit_normal(sum, out);
+}
+
+// normal_at's sums for a range of vertices, the same faces added in the same order: each
+// vertex's faces in the runs of vertices below a first (walked per vertex, as for_each_face),
+// then the runs of [a, b) swept once, each face's cross product made once for its corners in
+// the range instead of once per corner.
+void Mesh::normal_sums(int32_t a, int32_t b, std::vector<double>& sums) const {
+  sums.assign(3 * size_t(b - a), 0.0);
+  auto add = [&](int32_t v, const int32_t* t) {
+    double fn[3];
+    cross(position(t[0]), position(t[1]), position(t[2]), fn);
+    double* sum = &sums[3 * size_t(v - a)];
+    sum[0] += fn[0];
+    sum[1] += fn[1];
+    sum[2] += fn[2];
+  };
+  for (int32_t v = a; v < b; ++v) {
+    const int32_t* row = adjacency_.data() + adjacency_offsets_[v];
+    const int32_t* row_end = adjacency_.data() + adjacency_offsets_[v + 1];
+    for (; row != row_end && *row < a; ++row)
+      for (int32_t f = lowest_offsets_[*row], end = lowest_offsets_[*row + 1]; f < end; ++f) {
+        const int32_t* t = &faces_[3 * size_t(f)];
+        if (t[1] == v || t[2] == v || t[0] == v) add(v, t);
+      }
+  }
+  for (int32_t f = lowest_offsets_[a], end = lowest_offsets_[b]; f < end; ++f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
+    double fn[3];
+    cross(position(t[0]), position(t[1]), position(t[2]), fn);
+    for (int c = 0; c < 3; ++c) {
+      if (t[c] >= b) continue;  // every corner is at or above the run's vertex, so at or above a
+      double* sum = &sums[3 * size_t(t[c] - a)];
+      sum[0] += fn[0];
+      sum[1] += fn[1];
+      sum[2] += fn[2];
+    }
+  }
 }
 
 void Mesh::fill_normals() const {
@@ -662,8 +761,16 @@ void Mesh::weigh() {
   const int64_t span = 3 * int64_t(kBlock);  // the ring holds ids [b - kBlock, b + 2 kBlock)
   std::vector<double> ring(3 * size_t(std::min<int64_t>(span, n)));
   auto slot = [&](int32_t v) { return &ring[3 * size_t(v % span)]; };
-  auto compute = [&](int32_t from, int32_t to) {
-    parallel_for(from, to, kParallelMinCostly, [&](int32_t v) { normal_at(v, slot(v)); });
+  auto compute = [&](int32_t from, int32_t to) {  // in chunks of vertices, each on one thread
+    constexpr int32_t kChunk = 1024;
+    parallel_region(team_for(to - from, kParallelMinCostly), [&](Team& team) {
+      std::vector<double> sums;
+      team.for_static(0, (to - from + kChunk - 1) / kChunk, [&](int32_t chunk) {
+        const int32_t a = from + chunk * kChunk, e = std::min(to, a + kChunk);
+        normal_sums(a, e, sums);
+        for (int32_t v = a; v < e; ++v) unit_normal(&sums[3 * size_t(v - a)], slot(v));
+      });
+    });
   };
   weights_.resize(n);
   compute(0, int32_t(std::min<int64_t>(n, 2 * int64_t(kBlock))));
@@ -734,16 +841,15 @@ void Mesh::build_normals() const {
 void Mesh::build_vertex_areas() const {
   std::call_once(areas_once_, [this] {
     const int32_t n = num_vertices_;
-    const auto& vfo = vertex_face_offsets_;
     vertex_areas_.resize(n);
     parallel_for(0, n, kParallelMin, [&](int32_t v) {
       double area = 0.0;
-      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-        const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
+      for_each_face(v, [&](int32_t f) {
+        const int32_t* t = &faces_[3 * size_t(f)];
         double fn[3];
         cross(position(t[0]), position(t[1]), position(t[2]), fn);
         area += std::sqrt(fn[0] * fn[0] + fn[1] * fn[1] + fn[2] * fn[2]) / 6.0;  // a third of half the cross
-      }
+      });
       vertex_areas_[v] = area;
     });
     // Summed in vertex order on one thread, as the mean weight.
@@ -763,7 +869,6 @@ void Mesh::build_edges() const {
   std::call_once(edges_once_, [this] {
     const int32_t n = num_vertices_;
     const auto& ao = adjacency_offsets_;
-    const auto& vfo = vertex_face_offsets_;
     // Per vertex: where it sits in its own sorted row (its lower neighbours come first), and
     // how many face sides lead to higher neighbours (each edge belongs to its lower end).
     Buffer<int32_t> lower(n), edge_base(n + 1), side_base(n + 1);
@@ -774,11 +879,11 @@ void Mesh::build_edges() const {
       lower[v] = int32_t(std::lower_bound(row, row + d, v) - row);
       edge_base[v] = d - lower[v];
       int32_t sides = 0;
-      for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-        const int32_t* t = &faces_[3 * size_t(vertex_faces_[i])];
+      for_each_face(v, [&](int32_t f) {
+        const int32_t* t = &faces_[3 * size_t(f)];
         const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
         sides += (t[(c + 1) % 3] > v) + (t[(c + 2) % 3] > v);
-      }
+      });
       side_base[v] = sides;
     });
     exclusive_scan(edge_base);
@@ -807,8 +912,7 @@ void Mesh::build_edges() const {
         }
         fill.assign(higher, 0);
         auto rank = [&](int32_t u) { return int32_t(std::lower_bound(row + low, row + d, u) - (row + low)); };
-        for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-          const int32_t f = vertex_faces_[i];
+        for_each_face(v, [&](int32_t f) {
           const int32_t* t = &faces_[3 * size_t(f)];
           const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
           for (int side : {c, (c + 2) % 3}) {
@@ -818,21 +922,20 @@ void Mesh::build_edges() const {
             face_edges_[3 * size_t(f) + side] = edge_base[v] + j;
             ++fill[j];
           }
-        }
+        });
         int32_t at = side_base[v];
         for (int32_t j = 0; j < higher; ++j) {
           edge_face_offsets_[edge_base[v] + j] = at;
           at += std::exchange(fill[j], at);
         }
-        for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-          const int32_t f = vertex_faces_[i];
+        for_each_face(v, [&](int32_t f) {
           const int32_t* t = &faces_[3 * size_t(f)];
           const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
           for (int side : {c, (c + 2) % 3}) {
             if (t[side == c ? (c + 1) % 3 : side] < v) continue;
             edge_faces_[fill[face_edges_[3 * size_t(f) + side] - edge_base[v]]++] = f;
           }
-        }
+        });
       });
     });
     edge_face_offsets_[num_edges_] = side_base[n];

@@ -21,8 +21,6 @@ std::vector<uint8_t> corner_wedges(const Mesh& mesh, const CornerAttributes& att
                                    const std::vector<int32_t>& label, int32_t clusters, int max_wedges) {
   const auto& faces = mesh.faces();
   const auto& face_source = mesh.face_source();
-  const auto& vfo = mesh.vertex_face_offsets();
-  const auto& vf = mesh.vertex_faces();
   const int channels = attributes.channels;
   const int32_t m = mesh.num_faces(), n = mesh.num_vertices();
   // The caller's values of the prepared mesh's corner c.
@@ -37,7 +35,7 @@ std::vector<uint8_t> corner_wedges(const Mesh& mesh, const CornerAttributes& att
   for (int32_t v = 0; v < n; ++v) {
     if (label[v] < 0) continue;
     around.clear();
-    for (int32_t k = vfo[v]; k < vfo[v + 1]; ++k) around.push_back(corner_at(vf[k], v));
+    mesh.for_each_face(v, [&](int32_t f) { around.push_back(corner_at(f, v)); });
     for (size_t a = 0; a < around.size(); ++a)
       for (size_t b = 0; b < a; ++b) {
         const double *x = values(around[a]), *y = values(around[b]);

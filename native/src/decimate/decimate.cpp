@@ -874,14 +874,13 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
                                      const double* guidance, const CornerAttributes& attributes,
                                      int32_t refine_triangles, bool refine_keeps_positions) {
   if (samples.empty()) throw std::invalid_argument("the sample list is empty");
-  const auto& vfo = mesh.vertex_face_offsets();
   for (size_t i = 0; i < samples.size(); ++i) {
     const int32_t v = samples[i];
     if (v < 0 || v >= mesh.num_vertices())
       throw std::invalid_argument("sample " + std::to_string(i) + " is vertex " + std::to_string(v) +
                                   ", outside [0, " + std::to_string(mesh.num_vertices()) + ")");
     samples[i] = mesh.vertex_index()[v];
-    if (vfo[samples[i]] == vfo[samples[i] + 1])
+    if (!mesh.in_faces(samples[i]))
       throw std::invalid_argument("sample " + std::to_string(i) + " is vertex " + std::to_string(v) +
                                   ", which lies in no triangle");
   }

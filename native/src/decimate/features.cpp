@@ -15,21 +15,23 @@ namespace topstoc {
 int32_t FeatureLayout::chi_of(const Mesh& mesh, int32_t v) const {
   if (!chi_constant.empty()) return chi_constant[v];
   const auto& ao = mesh.adjacency_offsets();
-  const auto& vfo = mesh.vertex_face_offsets();
-  return 6 * sectors_of(mesh, v) - 3 * (ao[v + 1] - ao[v]) + 2 * (vfo[v + 1] - vfo[v]);  // one copy per edge
+  return 6 * sectors_of(mesh, v) - 3 * (ao[v + 1] - ao[v]) + 2 * mesh.face_count(v);  // one copy per edge
 }
 
 int32_t FeatureLayout::sectors_of(const Mesh& mesh, int32_t v) const {
   if (!sectors.empty()) return sectors[v];
-  const auto& vfo = mesh.vertex_face_offsets();
-  return vfo[v + 1] > vfo[v] ? 1 : 0;
+  return mesh.in_faces(v) ? 1 : 0;
 }
 
 int32_t FeatureLayout::sector_of(const Mesh& mesh, int32_t v, int32_t f) const {
+  if (sectors_of(mesh, v) <= 1) {  // one sector: no slot table needed
+    const int32_t* t = &mesh.faces()[3 * size_t(f)];
+    return t[0] == v || t[1] == v || t[2] == v ? 0 : -1;
+  }
   const auto& vfo = mesh.vertex_face_offsets();
   const auto& vf = mesh.vertex_faces();
   for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i)
-    if (vf[i] == f) return sectors_of(mesh, v) <= 1 ? 0 : sector_of_slot[i];
+    if (vf[i] == f) return sector_of_slot[i];
   return -1;
 }
 
@@ -106,12 +108,11 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   const auto& ao = mesh.adjacency_offsets();
   const bool featureless = layout.feature_edges.empty();  // every edge one copy, none a feature
   const int32_t* ae = featureless ? nullptr : mesh.adjacency_edge().data();
-  const auto& vfo = mesh.vertex_face_offsets();
   layout.feature_degree.clear();
   layout.sectors.clear(), layout.vertex_feature.clear(), layout.vertex_corner.clear();
   const auto& manifold = mesh.manifold_vertex();
   if (featureless && parallel_count<int32_t>(0, n, kParallelMin, [&](int32_t v) {
-        return vfo[v + 1] > vfo[v] && !manifold[v];
+        return mesh.in_faces(v) && !manifold[v];
       }) == 0)
     return;  // one sector per vertex in faces, no feature vertex, no corner: the tables stay empty
   if (!featureless) layout.feature_degree.assign(n, 0);
@@ -120,7 +121,9 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   const auto& report = mesh.report();
   if (!layout.feature_edges.empty() || report.nonmanifold_vertices > 0 || report.nonmanifold_edges > 0 ||
       report.inconsistent_edges > 0)
-    layout.sector_of_slot.assign(mesh.vertex_faces().size(), 0);
+    layout.sector_of_slot.assign(mesh.faces().size(), 0);  // a slot per corner, as vertex_faces()
+  // The slot table's offsets, only where slots are written (its mesh has features or a non-manifold vertex).
+  const int32_t* vfo = layout.sector_of_slot.empty() ? nullptr : mesh.vertex_face_offsets().data();
   layout.vertex_feature.assign(n, 0);
   layout.vertex_corner.assign(n, 0);
   // Without feature edges chi_of computes the constant (n integers fewer on a large scan).
@@ -129,7 +132,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   parallel_region(team_for(n, kParallelMin), [&](Team& team) {
     std::vector<int32_t> fan_of_slot;
     team.for_static(0, n, [&](int32_t v) {
-      if (vfo[v] == vfo[v + 1]) return;  // isolated: belongs to no cluster
+      if (!mesh.in_faces(v)) return;  // isolated: belongs to no cluster
       int32_t degree = 0, copies = featureless ? ao[v + 1] - ao[v] : 0, first_copies = -1;
       bool same_copies = true;
       for (int32_t i = ao[v]; i < ao[v + 1] && !featureless; ++i) {
@@ -155,8 +158,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
       // per side. Everything else on a feature (ends, junctions, pinches) is a corner.
       const bool curve_vertex = degree == 2 && same_copies && sectors == first_copies;
       layout.vertex_corner[v] = layout.vertex_feature[v] && !curve_vertex;
-      const int32_t faces = vfo[v + 1] - vfo[v];
-      if (!featureless) layout.chi_constant[v] = 6 * sectors - 3 * copies + 2 * faces;
+      if (!featureless) layout.chi_constant[v] = 6 * sectors - 3 * copies + 2 * mesh.face_count(v);
     });
   });
 }

@@ -29,13 +29,12 @@ inline uint64_t pair_key(int32_t a, int32_t b) {
 // Adds one sample per group of unreached vertices (the lowest id of each group).
 void seed_unreached(const Mesh& mesh, const Clustering& c, Partition& out) {
   const int32_t n = mesh.num_vertices();
-  const auto& vfo = mesh.vertex_face_offsets();
   const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
   std::vector<uint8_t> seen(n, 0);
   std::vector<int32_t> stack;
   for (int32_t v = 0; v < n; ++v) {
-    if (c.label(v) >= 0 || vfo[v] == vfo[v + 1] || seen[v]) continue;
+    if (c.label(v) >= 0 || !mesh.in_faces(v) || seen[v]) continue;
     out.new_samples.push_back(v);
     seen[v] = 1;
     stack.push_back(v);
@@ -76,13 +75,9 @@ struct Marks {
 // frontiers, scattered over the mesh) are put in vertex order first, and the faces are read back
 // in face order: both walk the mesh's arrays in order instead of at random.
 std::vector<int32_t> faces_around(const Mesh& mesh, const std::vector<int32_t>& vertices) {
-  const auto& vfo = mesh.vertex_face_offsets();
-  const auto& vf = mesh.vertex_faces();
   IdBits vertex_set(mesh.num_vertices()), face_set(mesh.num_faces());
   for (int32_t v : vertices) vertex_set.insert(v);
-  vertex_set.for_each([&](int32_t v) {
-    for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) face_set.insert(vf[i]);
-  });
+  vertex_set.for_each([&](int32_t v) { mesh.for_each_face(v, [&](int32_t f) { face_set.insert(f); }); });
   std::vector<int32_t> faces;
   face_set.for_each([&](int32_t f) { faces.push_back(f); });
   return faces;
@@ -261,7 +256,7 @@ class PartitionCheck {
       : mesh(mesh), layout(layout), samples(samples), c(c), required(required), check_slivers(check_slivers),
         candidate_faces(candidate_faces), state(state), carried(state ? *state : local), n(mesh.num_vertices()),
         k(static_cast<int32_t>(samples.size())), m(mesh.num_faces()), threads(max_threads()),
-        faces(mesh.faces()), vfo(mesh.vertex_face_offsets()), marks(threads) {}
+        faces(mesh.faces()), marks(threads) {}
 
   Partition run() {
     choose_faces_to_test();
@@ -306,7 +301,6 @@ class PartitionCheck {
   const int32_t n, k, m;
   const int threads;
   const Buffer<int32_t>& faces;
-  const Buffer<int32_t>& vfo;
   Partition out;
   Marks marks;
 
@@ -374,7 +368,7 @@ class PartitionCheck {
     int unreached = 0;
     if (patch) {
       for (int32_t v : carried.changed)
-        if (label(v) < 0 && vfo[v] != vfo[v + 1]) unreached = 1;
+        if (label(v) < 0 && mesh.in_faces(v)) unreached = 1;
     } else if (test_all) {
       carried.emits.resize(m);
       uint8_t* emits = carried.emits.data();
@@ -392,7 +386,7 @@ class PartitionCheck {
       unreached = parallel_reduce(
           0, n, kParallelMin, 0,
           [&](int& any, int32_t v) {
-            if (label(v) < 0 && vfo[v] != vfo[v + 1]) any = 1;
+            if (label(v) < 0 && mesh.in_faces(v)) any = 1;
           },
           [](int& any, int part) { any |= part; });
     }

@@ -141,17 +141,15 @@ std::shared_ptr<const QuadricFrame> quadric_frame(const Mesh& mesh, const Featur
 // them was 80 bytes per input vertex.
 void add_vertex_quadric(const Mesh& mesh, const QuadricFrame& frame, int32_t v, double* sum) {
   const auto& faces = mesh.faces();
-  const auto& vfo = mesh.vertex_face_offsets();
-  const auto& vf = mesh.vertex_faces();
   const double scale = 1.0 / frame.extent;
-  for (int32_t k = vfo[v]; k < vfo[v + 1]; ++k) {
-    const int32_t* t = &faces[3 * size_t(vf[k])];
+  mesh.for_each_face(v, [&](int32_t f) {
+    const int32_t* t = &faces[3 * size_t(f)];
     double p[3][3], face[10], area;
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) p[j][i] = (mesh.position(t[j])[i] - frame.center[i]) * scale;
-    if (!VertexQuadrics::plane(p[0], p[1], p[2], face, &area)) continue;
+    if (!VertexQuadrics::plane(p[0], p[1], p[2], face, &area)) return;
     for (int i = 0; i < 10; ++i) sum[i] += face[i] * (1.0 / 3.0);
-  }
+  });
 }
 
 // Each output vertex stands for the input triangles of its cluster (each weighed by the share of
@@ -271,8 +269,6 @@ void relocate_zero_area(const Mesh& mesh, const FeatureLayout& layout, const Ref
     if (label[w] >= 0) members[fill[collapser.survivor(label[w])]++] = w;
   const auto& source = mesh.vertex_source();
   const auto& index = mesh.vertex_index();
-  const auto& vfo = mesh.vertex_face_offsets();
-  const auto& vf = mesh.vertex_faces();
   const auto& faces = mesh.faces();
   for (int32_t t : collapser.zero_area_face_list()) {
     if (!collapser.face_alive(t) || !collapser.zero_area(t)) continue;
@@ -281,12 +277,12 @@ void relocate_zero_area(const Mesh& mesh, const FeatureLayout& layout, const Ref
       if (!collapser.is_free(v)) continue;
       for (int32_t i = offsets[v]; i < offsets[v + 1]; ++i) {
         const int32_t w = members[i];
-        if (w == index[result.kept[v]] || layout.is_feature_vertex(w) || vfo[w] == vfo[w + 1]) continue;
+        if (w == index[result.kept[v]] || layout.is_feature_vertex(w) || !mesh.in_faces(w)) continue;
         if (params.multipliers && (*params.multipliers)[w] == 0.0) continue;
         if (!collapser.place(v, mesh.position(w), t)) continue;
         result.kept[v] = source[w];
         // Attributes from a corner of w (one sector: any of its triangles).
-        const int32_t f = vf[vfo[w]];
+        const int32_t f = mesh.first_face(w);
         int32_t slot = 0;
         while (faces[3 * size_t(f) + slot] != w) ++slot;
         const int32_t corner = 3 * mesh.face_source()[f] + slot;
@@ -694,10 +690,9 @@ class Refinement {
   // The target's share of each guidance bin, from the input vertices in it.
   std::vector<int32_t> quotas() const {
     std::vector<double> bin_vertices(kBins, 0.0), bin_multipliers(kBins, 0.0);
-    const auto& vfo = mesh.vertex_face_offsets();
     if (guided) {
       for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-        if (vfo[v] < vfo[v + 1]) {
+        if (mesh.in_faces(v)) {
           const int32_t b = guidance_bin(multiplier(v));
           bin_vertices[b] += 1.0;
           bin_multipliers[b] += multiplier(v);

@@ -28,10 +28,9 @@ namespace {
 
 std::vector<uint8_t> classify(const Mesh& mesh, const FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
-  const auto& vfo = mesh.vertex_face_offsets();
   std::vector<uint8_t> cls(n);
   for (int32_t v = 0; v < n; ++v)
-    cls[v] = vfo[v] == vfo[v + 1] ? kIsolated
+    cls[v] = !mesh.in_faces(v) ? kIsolated
              : layout.is_corner(v) ? kCorner
              : layout.is_feature_vertex(v) ? kCurve
                                         : kSurface;

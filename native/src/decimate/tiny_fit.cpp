@@ -68,12 +68,11 @@ class Fit {
   Fit(const Mesh& mesh, Collapser& collapser, bool boundaries, const Surface& input) : c_(collapser), input_(&input) {
     const std::vector<int32_t>& triangles = c_.triangles();
     // Every k-th input vertex in a triangle (isolated ones are no part of the surface).
-    const auto& vfo = mesh.vertex_face_offsets();
     int32_t in_faces = 0;
-    for (int32_t w = 0; w < mesh.num_vertices(); ++w) in_faces += vfo[w] < vfo[w + 1];
+    for (int32_t w = 0; w < mesh.num_vertices(); ++w) in_faces += mesh.in_faces(w);
     const int32_t stride = int32_t(std::max<int64_t>(1, (in_faces + kFitPoints - 1) / kFitPoints));
     for (int32_t w = 0, seen = 0; w < mesh.num_vertices(); ++w)
-      if (vfo[w] < vfo[w + 1] && seen++ % stride == 0) points_.push_back(w);
+      if (mesh.in_faces(w) && seen++ % stride == 0) points_.push_back(w);
     for (int32_t t = 0; t < int32_t(triangles.size() / 3); ++t)
       if (c_.face_alive(t)) faces_.insert(faces_.end(), &triangles[3 * size_t(t)], &triangles[3 * size_t(t) + 3]);
     unknown_.assign(c_.vertices(), -1);

@@ -183,10 +183,9 @@ ClosedSurface extract_surface(const Mesh& mesh, const std::vector<int32_t>& vert
   // Faces and edges of the component, numbered in the mesh's order.
   std::vector<int32_t> faces, edges;
   for (int32_t v : vertices)
-    for (int32_t i = mesh.vertex_face_offsets()[v]; i < mesh.vertex_face_offsets()[v + 1]; ++i) {
-      const int32_t f = mesh.vertex_faces()[i];
+    mesh.for_each_face(v, [&](int32_t f) {
       if (mesh.faces()[3 * size_t(f)] == v) faces.push_back(f);  // once per face, from its first corner
-    }
+    });
   std::sort(faces.begin(), faces.end());
   for (int32_t v : vertices)
     for (int32_t i = mesh.adjacency_offsets()[v]; i < mesh.adjacency_offsets()[v + 1]; ++i)

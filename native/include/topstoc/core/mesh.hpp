@@ -80,9 +80,20 @@ class Mesh {
   const Buffer<int32_t>& adjacency_offsets() const { return adjacency_offsets_; }
   const Buffer<int32_t>& adjacency() const { return adjacency_; }
   const Buffer<int32_t>& adjacency_edge() const { return ensure_edges(), adjacency_edge_; }
-  // Faces around each vertex, CSR.
-  const Buffer<int32_t>& vertex_face_offsets() const { return vertex_face_offsets_; }
-  const Buffer<int32_t>& vertex_faces() const { return vertex_faces_; }
+  /// Calls fn(f) for each face f around v, in increasing order. Faces are sorted by their
+  /// lowest vertex, so v's faces are those of each lower neighbour's run that hold v, then v's
+  /// own run: walked where read instead of a table of them (14 bytes a triangle).
+  template <class Fn>
+  void for_each_face(int32_t v, Fn&& fn) const;
+  /// How many faces are around v, and the lowest of them (-1 for a vertex in no face).
+  int32_t face_count(int32_t v) const;
+  int32_t first_face(int32_t v) const;
+  /// Whether v is in a face (a vertex in a face has neighbours, an isolated one none).
+  bool in_faces(int32_t v) const { return adjacency_offsets_[v + 1] > adjacency_offsets_[v]; }
+  /// Faces around each vertex as a table (CSR, the same order as for_each_face), for code that
+  /// numbers a vertex's face slots: freed after the preparation, made again on first use, once.
+  const Buffer<int32_t>& vertex_face_offsets() const { return ensure_vertex_faces(), vertex_face_offsets_; }
+  const Buffer<int32_t>& vertex_faces() const { return ensure_vertex_faces(), vertex_faces_; }
   /// The caller's corner (3 x caller triangle + slot) of vertex v in its first face, -1 for a
   /// vertex in no face: where an output vertex with one side takes its attributes from.
   /// Looked up from the faces (a table of it was 4 bytes a vertex kept for a few reads).
@@ -132,8 +143,13 @@ class Mesh {
   void validate_faces(const int32_t* triangles, int64_t num_triangles);
   void reorder_for_locality(const double* positions, const int32_t* triangles, const double* lo, const double* hi,
                             Progress& progress);
-  void drop_duplicate_faces(const Buffer<int32_t>& lowest_offsets);
-  void build_vertex_faces();
+  void drop_duplicate_faces();
+  void find_lowest_offsets();
+  void fill_vertex_faces() const;
+  void ensure_vertex_faces() const {
+    if (!vertex_faces_built_.load(std::memory_order_acquire)) build_vertex_faces();
+  }
+  void build_vertex_faces() const;
   /// The one-ring pass: adjacency, normals, weights, manifoldness, components.
   void build_adjacency(Progress& progress);
   void ensure_vertex_index() const {
@@ -151,6 +167,8 @@ class Mesh {
   void fill_normals() const;
   /// The unit area-weighted normal of v, as normals() holds it.
   void normal_at(int32_t v, double* out) const;
+  /// The sums normal_at normalises, of the vertices [a, b), into sums (3 a vertex).
+  void normal_sums(int32_t a, int32_t b, std::vector<double>& sums) const;
   /// The importance weights from the normals, computed a window of vertices at a time.
   void weigh();
   void ensure_vertex_areas() const {
@@ -166,7 +184,12 @@ class Mesh {
   mutable Buffer<int32_t> vertex_index_;
   mutable std::once_flag vertex_index_once_;
   mutable std::atomic<bool> vertex_index_built_{false};
-  Buffer<int32_t> vertex_face_offsets_, vertex_faces_;
+  // Faces f with lowest vertex v: [lowest_offsets_[v], lowest_offsets_[v + 1]).
+  Buffer<int32_t> lowest_offsets_;
+  // Built for the one-ring pass, freed after it, built again on first use (ensure_vertex_faces).
+  mutable Buffer<int32_t> vertex_face_offsets_, vertex_faces_;
+  mutable std::once_flag vertex_faces_once_;
+  mutable std::atomic<bool> vertex_faces_built_{false};
   Buffer<int32_t> adjacency_offsets_, adjacency_;
   int32_t num_edges_ = 0;
   // Built on first use (ensure_edges).
@@ -190,5 +213,18 @@ class Mesh {
   MeshReport report_;
   Buffer<int32_t> dropped_rows_;  ///< the caller's corners of each dropped triangle, in report order
 };
+
+template <class Fn>
+void Mesh::for_each_face(int32_t v, Fn&& fn) const {
+  const int32_t* row = adjacency_.data() + adjacency_offsets_[v];
+  const int32_t* row_end = adjacency_.data() + adjacency_offsets_[v + 1];
+  const int32_t* faces = faces_.data();
+  for (; row != row_end && *row < v; ++row)  // the lower neighbours, in increasing order
+    for (int32_t f = lowest_offsets_[*row], end = lowest_offsets_[*row + 1]; f < end; ++f) {
+      const int32_t* t = faces + 3 * size_t(f);
+      if (t[1] == v || t[2] == v || t[0] == v) fn(f);
+    }
+  for (int32_t f = lowest_offsets_[v], end = lowest_offsets_[v + 1]; f < end; ++f) fn(f);
+}
 
 }  // namespace topstoc
