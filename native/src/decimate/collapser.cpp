@@ -710,8 +710,10 @@ double Collapser::shape_floor2(int32_t v, double min_shape) const {
 // `moved` stands at x (other = -1: all of them)?
 bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const {
   const double* p = position(moved);
-  // Collapses where nothing else collapses (rescue_) may leave thinner triangles; moves never.
-  const double min_shape = other >= 0 && rescue_ ? std::min(min_shape_, kRescueShape) : min_shape_;
+  // Collapses at a mesh boundary where nothing else collapses (rescue_) may leave thinner
+  // triangles; moves, and collapses away from every mesh boundary, never.
+  const bool boundary = !s_.on_boundary.empty() && other >= 0 && (s_.on_boundary[moved] || s_.on_boundary[other]);
+  const double min_shape = other >= 0 && rescue_ && boundary ? std::min(min_shape_, kRescueShape) : min_shape_;
   for (const int32_t* t = faces_begin(moved); t != faces_end(moved); ++t) {
     if (other >= 0 && has(*t, other)) continue;
     const int32_t* c = &(*tri_)[3 * size_t(*t)];

@@ -89,8 +89,8 @@ class Collapser {
   /// of cosine kMinTurnCos (about 80 degrees).
   static constexpr double kMinShape = 0.1, kMinTurnCos = 0.17;
   /// Once every collapse left failed its checks (the floor of a scan's ragged boundaries), a
-  /// collapse may leave a triangle as thin as this: the shape rule had held a tenth of the
-  /// boundary vertices above the floor (docs/bench_notes/nonmanifold-scans.md).
+  /// collapse of a mesh boundary's vertex may leave a triangle as thin as this: the shape rule
+  /// had held a tenth of them above the floor (docs/bench_notes/nonmanifold-scans.md).
   static constexpr double kRescueShape = 0.03;
   /// Other limits from now on (the reruns of a result stopped above its target by the
   /// topology loosen them; the fit restores them). Flips and area loss stay refused.
