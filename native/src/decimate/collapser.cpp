@@ -684,8 +684,8 @@ bool Collapser::merges_unlike_edges(int32_t u, int32_t v, const int32_t* on_edge
   return false;
 }
 
-// The squared shape quality of the thinnest triangle with area around `v`, capped at the limit in
-// force, `min_shape` (kMinShape unless set_shape_limits or a rescue changed it): a move or collapse at v may leave a triangle that
+// The squared shape quality of the thinnest triangle with area around `v`, capped at the limit's
+// (kMinShape unless set_shape_limits changed it): a move or collapse at v may leave a triangle that
 // thin, so that it never makes the worst triangle around it worse, and a needle (the ends of an
 // input edge far shorter than its neighbours, kept by the first pass) can collapse even when a
 // neighbour then ends a little below kMinShape. Before this floor, a triangle could not end below
@@ -694,8 +694,8 @@ bool Collapser::merges_unlike_edges(int32_t u, int32_t v, const int32_t* on_edge
 // 4.2, 152 with the floor; Blender's Decimate 831). The limit of half of it for already thin
 // triangles keeps the freedom CAD meshes' long strips need (without it, the coupling at 10 % had
 // twice the mean error).
-double Collapser::shape_floor2(int32_t v, double min_shape) const {
-  double floor2 = min_shape * min_shape;
+double Collapser::shape_floor2(int32_t v) const {
+  double floor2 = min_shape_ * min_shape_;
   for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) {
     const int32_t* c = &(*tri_)[3 * size_t(*t)];
     double n[3];
@@ -710,10 +710,6 @@ double Collapser::shape_floor2(int32_t v, double min_shape) const {
 // `moved` stands at x (other = -1: all of them)?
 bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const {
   const double* p = position(moved);
-  // Collapses at a mesh boundary where nothing else collapses (rescue_) may leave thinner
-  // triangles; moves, and collapses away from every mesh boundary, never.
-  const bool boundary = !s_.on_boundary.empty() && other >= 0 && (s_.on_boundary[moved] || s_.on_boundary[other]);
-  const double min_shape = other >= 0 && rescue_ && boundary ? std::min(min_shape_, kRescueShape) : min_shape_;
   for (const int32_t* t = faces_begin(moved); t != faces_end(moved); ++t) {
     if (other >= 0 && has(*t, other)) continue;
     const int32_t* c = &(*tri_)[3 * size_t(*t)];
@@ -742,13 +738,12 @@ bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, Shape
     // No sliver: not thinner than the floor (at most kMinShape), unless the triangle was
     // thinner than kMinShape already and stays within half of it.
     const double edges = squared_edges(c, moved, x);
-    if (!thinner(len2, edges, min_shape * min_shape)) continue;
+    if (!thinner(len2, edges, min_shape_ * min_shape_)) continue;
     if (floor.value2 < 0.0)
-      floor.value2 = floor.b < 0 ? shape_floor2(floor.a, min_shape)
-                                 : std::min(shape_floor2(floor.a, min_shape), shape_floor2(floor.b, min_shape));
+      floor.value2 = floor.b < 0 ? shape_floor2(floor.a) : std::min(shape_floor2(floor.a), shape_floor2(floor.b));
     if (thinner(len2, edges, floor.value2) &&
-        (!thinner(area2, squared_edges(c, moved, p), min_shape * min_shape) ||
-         thinner(len2, edges, 0.25 * min_shape * min_shape)))
+        (!thinner(area2, squared_edges(c, moved, p), min_shape_ * min_shape_) ||
+         thinner(len2, edges, 0.25 * min_shape_ * min_shape_)))
       return false;
   }
   return true;

@@ -88,10 +88,6 @@ class Collapser {
   /// around the move was (shape_floor2). Nor may a triangle's normal turn by more than the angle
   /// of cosine kMinTurnCos (about 80 degrees).
   static constexpr double kMinShape = 0.1, kMinTurnCos = 0.17;
-  /// Once every collapse left failed its checks (the floor of a scan's ragged boundaries), a
-  /// collapse of a mesh boundary's vertex may leave a triangle as thin as this: the shape rule
-  /// had held a tenth of them above the floor (docs/bench_notes/nonmanifold-scans.md).
-  static constexpr double kRescueShape = 0.03;
   /// Other limits from now on (the reruns of a result stopped above its target by the
   /// topology loosen them; the fit restores them). Flips and area loss stay refused.
   void set_shape_limits(double min_shape, double min_turn_cos) {
@@ -194,7 +190,7 @@ class Collapser {
     double value2 = -1.0;  // not found yet
   };
   bool keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const;
-  double shape_floor2(int32_t v, double min_shape) const;
+  double shape_floor2(int32_t v) const;
   double shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const;
   double squared_edges(const int32_t* c, int32_t replace, const double* at) const;
   void normal(const int32_t* c, int32_t replace, const double* at, double n[3]) const;
