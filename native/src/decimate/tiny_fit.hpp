@@ -19,8 +19,9 @@ namespace topstoc {
 constexpr int32_t kTinyFitFaces = 400;
 constexpr int32_t kFitFaces = 1400;
 
-/// Rounds of the fit for a result of `live_faces` triangles (0: not fitted).
-inline int32_t fit_rounds(int64_t live_faces) { return live_faces <= kTinyFitFaces ? 4 : live_faces <= kFitFaces ? 1 : 0; }
+/// Rounds of the fit for a result of `live_faces` triangles: larger results get one, judged
+/// against a max the caller knows (fit_tiny's known_max).
+inline int32_t fit_rounds(int64_t live_faces) { return live_faces <= kTinyFitFaces ? 4 : 1; }
 
 struct TinyFit {
   int32_t rounds = 0;        ///< rounds kept (each lowered the error)
@@ -41,6 +42,11 @@ int64_t fit_input_step(const Mesh& mesh);
 /// distance did not grow, and neither did the symmetric Hausdorff max over both whole surfaces
 /// (a bracket from bounded_max.hpp: the pairs alone miss where the surface lifts between them).
 /// boundaries: the unlocked vertices of mesh boundaries move too (else only the free ones).
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input);
+/// Results above kFitFaces are fitted only with known_max > 0, a distance between the result and
+/// `input` (the whole input there) that the symmetric max attains: their one round is solved by
+/// conjugate gradients and kept only when a threshold walk a side finds no point farther than it
+/// (the max does not grow), holding the corners where one does.
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input,
+                 double known_max = -1.0);
 
 }  // namespace topstoc
