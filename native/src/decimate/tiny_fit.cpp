@@ -460,17 +460,11 @@ TinyFit fit_large(Fit& fit, const Fit::Error& error, double known_max) {
   const Surface before(start, fit.live_faces());
   for (double step = 1.0; step >= kSmallestStep; step *= 0.5) {
     fit.release();
-    // Pairs near the max before the move hold their triangles; after it, too.
+    // Pairs near the max before the move hold their triangles.
     fit.hold_far_pairs(kNearMax * known_max);
     for (int32_t tries = 0; tries < kHoldTries; ++tries) {
       if (fit.apply(fit.toward(x, step)) == 0) return out;
-      auto next = fit.pair_up();
-      if (tries == 0) {
-        fit.hold_far_pairs(kNearMax * known_max);
-        fit.undo();
-        if (fit.apply(fit.toward(x, step)) == 0) return out;
-        next = fit.pair_up();
-      }
+      const auto next = fit.pair_up();
       if (!(next.mean2 < error.mean2 && next.top2 <= error.top2)) break;
       auto walk = fit.symmetric_max(fit.positions(), known_max, true);
       for (int32_t raised = 0; raised < kHoldTries && walk.lower > known_max; ++raised) {
