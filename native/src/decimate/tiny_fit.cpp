@@ -8,6 +8,7 @@
 #include "decimate/sparse_normal.hpp"
 #include "distance/bounded_max.hpp"
 #include "topstoc/core/parallel.hpp"
+#include "topstoc/distance/bvh.hpp"
 #include "topstoc/distance/hausdorff.hpp"
 
 namespace topstoc {
@@ -125,7 +126,10 @@ class Fit {
     MaxBracket there, back;
     const int64_t budget = lean ? kLargeQueriesPerFace * int64_t(faces_.size() / 3) : kMaxQueries;
     auto measure_there = [&] { there = bound_max_distance_by_tree(result, *input_, kMaxTolerance, budget, threshold, lean); };
-    auto measure_back = [&] { back = bound_max_distance_by_tree(*input_, result, kMaxTolerance, budget, threshold, lean); };
+    auto measure_back = [&] {
+      back = lean ? input_side(result, threshold, budget)
+                  : bound_max_distance_by_tree(*input_, result, kMaxTolerance, budget, threshold, lean);
+    };
     if (threshold >= 0.0) {
       measure_there();
       if (!(there.lower > threshold) && there.converged) measure_back();
@@ -139,6 +143,49 @@ class Fit {
               {0, 0, 0}, there.converged && back.converged, &far == &there};
     for (int k = 0; k < 3; ++k) b.point[k] = far.lower_point[k];
     return b;
+  }
+
+  // Whether the input lies farther than threshold from `result` anywhere (a bracket whose lower
+  // exceeds it where it does): each input vertex measured, then each input triangle bounded by
+  // its corners' largest distance to one result triangle, the nearest to one of its corners
+  // (a distance to a triangle is convex, so over the input triangle it peaks at a corner); the
+  // few triangles that leaves above the threshold are bracketed (bounded_max.hpp).
+  MaxBracket input_side(const Surface& result, double threshold, int64_t budget) const {
+    const std::vector<double>& at = input_->positions();
+    const std::vector<int32_t>& triangles = input_->triangles();
+    const std::vector<double>& corners = result.positions();
+    std::vector<int32_t> nearest(size_t(input_->num_vertices()), -1);
+    MaxBracket out;
+    int32_t hint = -1;
+    for (int32_t v = 0; v < input_->num_vertices(); ++v) {
+      if (!input_->used()[v]) continue;
+      const ClosestHit hit = result.bvh().closest(&at[3 * size_t(v)], hint);
+      hint = hit.slot, nearest[v] = hit.triangle, ++out.queries;
+      if (hit.distance2 > out.lower * out.lower) {
+        out.lower = std::sqrt(hit.distance2);
+        for (int i = 0; i < 3; ++i) out.lower_point[i] = at[3 * size_t(v) + i];
+      }
+    }
+    if (out.lower > threshold) return out.upper = out.lower, out.converged = false, out;
+    std::vector<int32_t> open;
+    const double limit2 = threshold * threshold;
+    for (int32_t s = 0; s < input_->num_triangles(); ++s) {
+      const int32_t* c = &triangles[3 * size_t(s)];
+      bool settled = false;
+      for (int j = 0; j < 3 && !settled; ++j) {
+        const int32_t* t = &live_faces_[3 * size_t(nearest[c[j]])];
+        double far2 = 0.0, point[3];
+        for (int i = 0; i < 3; ++i)
+          far2 = std::max(far2, closest_point_on_triangle(&at[3 * size_t(c[i])], &corners[3 * size_t(t[0])],
+                                                          &corners[3 * size_t(t[1])], &corners[3 * size_t(t[2])], point));
+        settled = far2 <= limit2;
+      }
+      if (!settled) open.push_back(s);
+    }
+    if (open.empty()) return out.upper = threshold, out;
+    MaxBracket rest = bound_max_over_triangles(*input_, open, result, threshold, kMaxTolerance, budget);
+    rest.queries += out.queries;
+    return rest;
   }
 
   // The distance the result at `start` (positions()) had at the far point of b: there the same

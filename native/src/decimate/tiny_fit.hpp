@@ -1,7 +1,7 @@
-// Tiny budgets (docs/design.md §2.10): once the collapses reached a result of at most 1,400
-// triangles, its free vertices are fitted to the input in a few rounds of least squares, both
-// ways (as Hoppe et al. 1993 fit a mesh to points): the quadrics that placed them sum planes
-// over clusters too large to stand for the surface.
+// The fit (docs/design.md §2.10): once the collapses reached their result, its free vertices are
+// fitted to the input in a few rounds of least squares, both ways (as Hoppe et al. 1993 fit a
+// mesh to points): the quadrics that placed them sum planes over clusters too large to stand for
+// the surface. Results above kFitFaces triangles get one round with a cheaper max check.
 #pragma once
 
 #include <cstdint>
@@ -14,8 +14,9 @@
 namespace topstoc {
 
 /// Results with at most this many live triangles are fitted in up to four rounds, and results
-/// with at most kFitFaces in one (its first round gives most of the gain; a round's max check
-/// costs more than the collapses there), their mesh boundaries kept where they are.
+/// with more in one (its first round gives most of the gain; a round's max check costs more
+/// than the collapses there), their mesh boundaries kept where they are; above kFitFaces the
+/// max is not bracketed before the move (fit_tiny's known_max).
 constexpr int32_t kTinyFitFaces = 400;
 constexpr int32_t kFitFaces = 1400;
 
