@@ -121,7 +121,9 @@ class Fit {
   // bracket is the same on any thread).
   // lean (with a threshold): bound_max_distance_by_tree's, and at most kLargeQueriesPerFace
   // queries per result triangle a side (converged false when they run out).
-  Bracket symmetric_max(std::vector<double> at, double threshold = -1.0, bool lean = false) const {
+  // input_passed (lean): the input side already passed at a threshold no higher, the result
+  // where it was: only the result side is walked.
+  Bracket symmetric_max(std::vector<double> at, double threshold = -1.0, bool lean = false, bool input_passed = false) {
     const Surface result(std::move(at), live_faces_);
     MaxBracket there, back;
     const int64_t budget = lean ? kLargeQueriesPerFace * int64_t(faces_.size() / 3) : kMaxQueries;
@@ -130,7 +132,10 @@ class Fit {
       back = lean ? input_side(result, threshold, budget)
                   : bound_max_distance_by_tree(*input_, result, kMaxTolerance, budget, threshold, lean);
     };
-    if (threshold >= 0.0) {
+    if (lean) {  // the input side first: the cheaper one, and it lists every far point it finds
+      if (!input_passed) measure_back();
+      if (!(back.lower > threshold) && back.converged) measure_there();
+    } else if (threshold >= 0.0) {
       measure_there();
       if (!(there.lower > threshold) && there.converged) measure_back();
     } else {
@@ -150,17 +155,20 @@ class Fit {
   // its corners' largest distance to one result triangle, the nearest to one of its corners
   // (a distance to a triangle is convex, so over the input triangle it peaks at a corner); the
   // few triangles that leaves above the threshold are bracketed (bounded_max.hpp).
-  MaxBracket input_side(const Surface& result, double threshold, int64_t budget) const {
+  // far_faces_: the result triangles nearest to the input vertices farther than threshold.
+  MaxBracket input_side(const Surface& result, double threshold, int64_t budget) {
     const std::vector<double>& at = input_->positions();
     const std::vector<int32_t>& triangles = input_->triangles();
     const std::vector<double>& corners = result.positions();
     std::vector<int32_t> nearest(size_t(input_->num_vertices()), -1);
     MaxBracket out;
     int32_t hint = -1;
+    far_faces_.clear();
     for (int32_t v = 0; v < input_->num_vertices(); ++v) {
       if (!input_->used()[v]) continue;
       const ClosestHit hit = result.bvh().closest(&at[3 * size_t(v)], hint);
       hint = hit.slot, nearest[v] = hit.triangle, ++out.queries;
+      if (hit.distance2 > threshold * threshold) far_faces_.push_back(hit.triangle);
       if (hit.distance2 > out.lower * out.lower) {
         out.lower = std::sqrt(hit.distance2);
         for (int i = 0; i < 3; ++i) out.lower_point[i] = at[3 * size_t(v) + i];
@@ -201,6 +209,13 @@ class Fit {
     return std::sqrt(input_->bvh().closest(p, -1).distance2);
   }
   const std::vector<int32_t>& live_faces() const { return live_faces_; }
+
+  // Holds the result triangles the last input_side found input vertices too far from; false
+  // when there were none.
+  bool hold_far_faces() {
+    for (int32_t f : far_faces_) hold(f);
+    return !far_faces_.empty();
+  }
 
   // Keeps the corners of result triangle f where they stand in the moves that follow.
   void hold(int32_t f) {
@@ -458,6 +473,7 @@ class Fit {
   std::vector<Saved> saved_;
   std::vector<uint8_t> held_;  // per vertex: 1 where the moves leave it (empty: none held)
   bool large_ = false;         // above kFitFaces triangles (solve_sparse, lean max walks)
+  std::vector<int32_t> far_faces_;  // input_side's far points' result triangles
 };
 
 }  // namespace
@@ -518,7 +534,7 @@ TinyFit fit_large(Fit& fit, const Fit::Error& error, double known_max) {
         const double was = fit.distance_before(walk, start, before);
         if (!(was >= walk.lower * (1.0 - kSameDistance))) break;
         known_max = (1.0 + kMaxTolerance) * std::max(was, walk.lower);
-        walk = fit.symmetric_max(fit.positions(), known_max, true);
+        walk = fit.symmetric_max(fit.positions(), known_max, true, walk.on_result);
       }
       const bool farther = walk.lower > known_max;
       if (!farther && walk.converged) {
@@ -527,7 +543,7 @@ TinyFit fit_large(Fit& fit, const Fit::Error& error, double known_max) {
       }
       fit.undo();
       if (!farther) return out;  // the walk ran out of queries: nothing to hold
-      fit.hold(walk.face);
+      if (walk.on_result || !fit.hold_far_faces()) fit.hold(walk.face);
     }
     fit.undo();
   }
