@@ -137,7 +137,7 @@ class Fit {
       if (!(back.lower > threshold) && back.converged) measure_there();
     } else if (threshold >= 0.0) {
       measure_there();
-      if (!(there.lower > threshold) && there.converged) measure_back();
+      if (!(there.lower > threshold)) measure_back();
     } else {
       result.bvh(), input_->bvh();  // built before the sides share them
       const FreeCoresNow team;
