@@ -1,7 +1,7 @@
-// The fit (docs/design.md §2.10): once the collapses reached their result, its free vertices are
-// fitted to the input in a few rounds of least squares, both ways (as Hoppe et al. 1993 fit a
-// mesh to points): the quadrics that placed them sum planes over clusters too large to stand for
-// the surface. Results above kFitFaces triangles get one round with a cheaper max check.
+// Tiny budgets (docs/design.md §2.10): once the collapses reached a result of at most 1,400
+// triangles, its free vertices are fitted to the input in a few rounds of least squares, both
+// ways (as Hoppe et al. 1993 fit a mesh to points): the quadrics that placed them sum planes
+// over clusters too large to stand for the surface.
 #pragma once
 
 #include <cstdint>
@@ -14,15 +14,13 @@
 namespace topstoc {
 
 /// Results with at most this many live triangles are fitted in up to four rounds, and results
-/// with more in one (its first round gives most of the gain; a round's max check costs more
-/// than the collapses there), their mesh boundaries kept where they are; above kFitFaces the
-/// max is not bracketed before the move (fit_tiny's known_max).
+/// with at most kFitFaces in one (its first round gives most of the gain; a round's max check
+/// costs more than the collapses there), their mesh boundaries kept where they are.
 constexpr int32_t kTinyFitFaces = 400;
 constexpr int32_t kFitFaces = 1400;
 
-/// Rounds of the fit for a result of `live_faces` triangles: larger results get one, judged
-/// against a max the caller knows (fit_tiny's known_max).
-inline int32_t fit_rounds(int64_t live_faces) { return live_faces <= kTinyFitFaces ? 4 : 1; }
+/// Rounds of the fit for a result of `live_faces` triangles (0: not fitted).
+inline int32_t fit_rounds(int64_t live_faces) { return live_faces <= kTinyFitFaces ? 4 : live_faces <= kFitFaces ? 1 : 0; }
 
 struct TinyFit {
   int32_t rounds = 0;        ///< rounds kept (each lowered the error)
@@ -43,11 +41,6 @@ int64_t fit_input_step(const Mesh& mesh);
 /// distance did not grow, and neither did the symmetric Hausdorff max over both whole surfaces
 /// (a bracket from bounded_max.hpp: the pairs alone miss where the surface lifts between them).
 /// boundaries: the unlocked vertices of mesh boundaries move too (else only the free ones).
-/// Results above kFitFaces are fitted only with known_max > 0, a distance between the result and
-/// `input` (the whole input there) that the symmetric max attains: their one round is solved by
-/// conjugate gradients and kept only when a threshold walk a side finds no point farther than it
-/// (the max does not grow), holding the corners where one does.
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input,
-                 double known_max = -1.0);
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input);
 
 }  // namespace topstoc
