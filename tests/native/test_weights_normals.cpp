@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -12,6 +13,23 @@
 #include "topstoc/core/mesh.hpp"
 
 namespace {
+
+// A double cone: two apexes of `rim` neighbours each, read from outside the weights' ring of
+// blocks by most of their neighbours (their normals are made once: the hub path).
+topstoc_test::Arrays double_cone(int32_t rim) {
+  topstoc_test::Arrays a;
+  a.positions = {0.0, 0.0, -1.0};
+  for (int32_t i = 0; i < rim; ++i) {
+    const double t = 6.283185307179586 * i / rim;
+    a.positions.insert(a.positions.end(), {std::cos(t), std::sin(t), 0.1 * std::sin(7 * t)});
+  }
+  a.positions.insert(a.positions.end(), {0.0, 0.0, 1.0});
+  for (int32_t i = 0; i < rim; ++i) {
+    const int32_t j = (i + 1) % rim;
+    a.triangles.insert(a.triangles.end(), {0, j + 1, i + 1, rim + 1, i + 1, j + 1});
+  }
+  return a;
+}
 
 void check_weights(const topstoc_test::Arrays& a) {
   const topstoc::Mesh mesh(a.positions, a.triangles.data(), a.num_triangles());
@@ -41,4 +59,5 @@ TEST_CASE("the weights are eq. 4.1 from normals() to the bit") {
   check_weights(topstoc_test::torus(300, 230, 2.0, 0.9));  // 69,000 vertices: several blocks
   check_weights(topstoc_test::grid(160, 130));             // borders
   check_weights(topstoc_test::octahedron());
+  check_weights(double_cone(60000));  // apexes of 60,000 neighbours
 }

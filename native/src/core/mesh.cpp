@@ -559,6 +559,8 @@ int32_t Mesh::first_corner(int32_t v) const {
 }
 
 int32_t Mesh::first_face(int32_t v) const {
+  if (vertex_faces_built_.load(std::memory_order_acquire))
+    return vertex_face_offsets_[v] < vertex_face_offsets_[v + 1] ? vertex_faces_[vertex_face_offsets_[v]] : -1;
   const int32_t* row = adjacency_.data() + adjacency_offsets_[v];
   const int32_t* row_end = adjacency_.data() + adjacency_offsets_[v + 1];
   for (; row != row_end && *row < v; ++row)
@@ -600,6 +602,19 @@ void Mesh::build_vertex_faces() const {
     fill_vertex_faces();
     vertex_faces_built_.store(true, std::memory_order_release);
   });
+}
+
+// A vertex's walk reads the runs of its lower neighbours: a vertex of high valence below its
+// neighbours (a fan's centre, a cone's apex) makes each of them read its whole run. Where the
+// walks would read more than kWalkPerFace faces a face, the table is made now and kept.
+void Mesh::keep_vertex_faces_where_walks_cost() {
+  const int64_t reads = parallel_count<int64_t>(0, num_vertices_, kParallelMin, [&](int32_t v) {
+    int64_t sum = 0;
+    for (int32_t i = adjacency_offsets_[v]; i < adjacency_offsets_[v + 1] && adjacency_[i] < v; ++i)
+      sum += lowest_offsets_[adjacency_[i] + 1] - lowest_offsets_[adjacency_[i]];
+    return sum;
+  });
+  if (reads > kWalkPerFace * int64_t(num_faces())) build_vertex_faces();
 }
 
 void Mesh::build_adjacency(Progress& progress) {
@@ -684,6 +699,7 @@ void Mesh::build_adjacency(Progress& progress) {
   parallel_for(0, n, kParallelMin, [&](int32_t v) { component_[v] = sets.find(v); });
   std::vector<int32_t>().swap(sets.parents());
   release_freed_heap(4 * size_t(n));
+  keep_vertex_faces_where_walks_cost();
 
   progress.stage("normals and weights", 0.8, 0.92);
   weigh();
@@ -721,7 +737,13 @@ void Mesh::normal_sums(int32_t a, int32_t b, std::vector<double>& sums) const {
     sum[1] += fn[1];
     sum[2] += fn[2];
   };
+  const bool table = vertex_faces_built_.load(std::memory_order_acquire);
   for (int32_t v = a; v < b; ++v) {
+    if (table) {  // the faces below a's run: the table's row up to it, in the same order
+      for (int32_t i = vertex_face_offsets_[v]; i < vertex_face_offsets_[v + 1] && vertex_faces_[i] < lowest_offsets_[a]; ++i)
+        add(v, &faces_[3 * size_t(vertex_faces_[i])]);
+      continue;
+    }
     const int32_t* row = adjacency_.data() + adjacency_offsets_[v];
     const int32_t* row_end = adjacency_.data() + adjacency_offsets_[v + 1];
     for (; row != row_end && *row < a; ++row)
@@ -772,6 +794,19 @@ void Mesh::weigh() {
       });
     });
   };
+  // Vertices of many neighbours (a fan's centre) are read from outside the ring by each of
+  // them: their normals are made once, with normal_at as everywhere else.
+  constexpr int32_t kHubDegree = 64;
+  auto degree = [&](int32_t v) { return adjacency_offsets_[v + 1] - adjacency_offsets_[v]; };
+  std::vector<int32_t> hubs;
+  for (int32_t v = 0; v < n; ++v)
+    if (degree(v) > kHubDegree) hubs.push_back(v);
+  std::vector<double> hub_normals(3 * hubs.size());
+  parallel_for(0, int32_t(hubs.size()), 1, [&](int32_t i) { normal_at(hubs[i], &hub_normals[3 * size_t(i)]); });
+  auto far_normal = [&](int32_t u, double* out) -> const double* {
+    if (degree(u) <= kHubDegree) return normal_at(u, out), out;
+    return &hub_normals[3 * size_t(std::lower_bound(hubs.begin(), hubs.end(), u) - hubs.begin())];
+  };
   weights_.resize(n);
   compute(0, int32_t(std::min<int64_t>(n, 2 * int64_t(kBlock))));
   for (int32_t b = 0; b < n; b += kBlock) {
@@ -790,7 +825,7 @@ void Mesh::weigh() {
       double dots = 0.0, far[3];
       for (int32_t r = 0; r < d; ++r) {
         const int32_t u = neighbours[r];
-        const double* nu = u >= low && u < high ? slot(u) : (normal_at(u, far), far);
+        const double* nu = u >= low && u < high ? slot(u) : far_normal(u, far);
         dots += nv[0] * nu[0] + nv[1] * nu[1] + nv[2] * nu[2];
       }
       weights_[v] = std::clamp((double(d) - dots) / (2.0 * double(d)), 0.0, 1.0);

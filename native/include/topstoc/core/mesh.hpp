@@ -91,7 +91,8 @@ class Mesh {
   /// Whether v is in a face (a vertex in a face has neighbours, an isolated one none).
   bool in_faces(int32_t v) const { return adjacency_offsets_[v + 1] > adjacency_offsets_[v]; }
   /// Faces around each vertex as a table (CSR, the same order as for_each_face), for code that
-  /// numbers a vertex's face slots: freed after the preparation, made again on first use, once.
+  /// numbers a vertex's face slots: freed after the preparation, made again on first use, once;
+  /// kept from the preparation where the walk would cost more than kWalkPerFace reads a face.
   const Buffer<int32_t>& vertex_face_offsets() const { return ensure_vertex_faces(), vertex_face_offsets_; }
   const Buffer<int32_t>& vertex_faces() const { return ensure_vertex_faces(), vertex_faces_; }
   /// The caller's corner (3 x caller triangle + slot) of vertex v in its first face, -1 for a
@@ -150,6 +151,8 @@ class Mesh {
     if (!vertex_faces_built_.load(std::memory_order_acquire)) build_vertex_faces();
   }
   void build_vertex_faces() const;
+  void keep_vertex_faces_where_walks_cost();
+  static constexpr int64_t kWalkPerFace = 16;
   /// The one-ring pass: adjacency, normals, weights, manifoldness, components.
   void build_adjacency(Progress& progress);
   void ensure_vertex_index() const {
@@ -216,6 +219,10 @@ class Mesh {
 
 template <class Fn>
 void Mesh::for_each_face(int32_t v, Fn&& fn) const {
+  if (vertex_faces_built_.load(std::memory_order_acquire)) {  // the table, where one is kept
+    for (int32_t i = vertex_face_offsets_[v], end = vertex_face_offsets_[v + 1]; i < end; ++i) fn(vertex_faces_[i]);
+    return;
+  }
   const int32_t* row = adjacency_.data() + adjacency_offsets_[v];
   const int32_t* row_end = adjacency_.data() + adjacency_offsets_[v + 1];
   const int32_t* faces = faces_.data();
