@@ -1,6 +1,6 @@
 // one_cycle (link_arcs.hpp), the partition check's shortcut for a closed fan, against the
 // general LinkArcs on every arc set drawn: random arcs among a few vertices, and shuffled
-// cycles, some with one arc changed.
+// cycles, some with one arc changed; and LinkArcs itself on links past its linear scan.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -57,4 +57,43 @@ TEST_CASE("one_cycle is true exactly for a closed fan of three or more arcs") {
   }
   CHECK(cycles > 1000);
   CHECK(others > 1000);
+}
+
+TEST_CASE("LinkArcs past its linear scan: the same neighbours, counts and fans as a plain count") {
+  // Links of up to 3,000 neighbours (a fan's centre), where lookups go through the hash map:
+  // each neighbour numbered in order of first appearance, its arcs counted, the fans found.
+  std::mt19937 random(3);
+  LinkArcs link;  // reused, as the partition check does: a small link after a large one
+  for (int32_t size : {3000, 65, 66, 64, 200, 5}) {
+    std::vector<int32_t> ids(size);
+    for (int32_t i = 0; i < size; ++i) ids[i] = int32_t(random() % 1000000) * 8 + i % 8;
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    std::shuffle(ids.begin(), ids.end(), random);
+    const int32_t n = int32_t(ids.size());
+    std::vector<Arc> arcs;
+    for (int32_t i = 0; i < n; ++i) arcs.push_back({ids[i], ids[(i + 1) % n]});
+    std::shuffle(arcs.begin(), arcs.end(), random);
+    for (int variant = 0; variant < 3; ++variant) {
+      std::vector<Arc> drawn = arcs;
+      if (variant == 1) drawn.pop_back();               // a path: one fan, open
+      if (variant == 2) drawn.push_back(drawn.front());  // a triangle twice
+      link.clear();
+      std::vector<int32_t> order;  // first appearance, as index() numbers them
+      for (const Arc& a : drawn) {
+        link.add(a.from, a.to);
+        for (int32_t id : {a.from, a.to})
+          if (std::find(order.begin(), order.end(), id) == order.end()) order.push_back(id);
+      }
+      REQUIRE(link.neighbours.size() == order.size());
+      int32_t misplaced = 0;
+      for (size_t i = 0; i < order.size(); ++i) misplaced += link.neighbours[i].id != order[i];
+      CHECK(misplaced == 0);
+      CHECK(link.repeated() == (variant == 2));
+      if (variant < 2) {
+        CHECK(link.fans() == 1);
+        CHECK(link.single_fan());
+      }
+    }
+  }
 }

@@ -1,10 +1,12 @@
 // The link of one vertex of a triangle mesh, as arcs: for each triangle (s, a, b) around
 // vertex s, the arc a -> b. Shared by the partition check (a sample's link in the decimated mesh
 // before it is emitted) and the final output check (an output vertex's link). Valences are
-// small, so lookups are linear scans.
+// mostly small, so lookups are linear scans up to kScan neighbours and a hash map above (a fan's
+// centre has thousands).
 #pragma once
 
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 namespace topstoc {
@@ -25,23 +27,35 @@ struct LinkArcs {
     size_t size() const { return size_t(size_); }
     Neighbour& operator[](size_t i) { return items_[i]; }
     const Neighbour& operator[](size_t i) const { return items_[i]; }
-    void clear() { size_ = 0; }
+    void clear() { size_ = 0; }  // the map is made again when a link outgrows the scan
     int32_t index(int32_t id) {
-      const int32_t* ids = ids_.data();
-      for (int32_t i = 0; i < size_; ++i)
-        if (ids[i] == id) return i;
+      if (size_ <= kScan) {
+        const int32_t* ids = ids_.data();
+        for (int32_t i = 0; i < size_; ++i)
+          if (ids[i] == id) return i;
+      } else if (const auto found = map_.find(id); found != map_.end()) {
+        return found->second;
+      }
       if (size_ == int32_t(ids_.size())) {
         ids_.resize(2 * ids_.size() + 16);
         items_.resize(ids_.size());
       }
       ids_[size_] = id;
       items_[size_] = {id};
+      if (size_ == kScan) {  // the link outgrows the scan: every id so far into the map
+        map_.clear();
+        for (int32_t i = 0; i <= size_; ++i) map_.emplace(ids_[i], i);
+      } else if (size_ > kScan) {
+        map_.emplace(id, size_);
+      }
       return size_++;
     }
 
    private:
+    static constexpr int32_t kScan = 64;
     std::vector<int32_t> ids_;
     std::vector<Neighbour> items_;
+    std::unordered_map<int32_t, int32_t> map_;  // id -> index, while size_ > kScan
     int32_t size_ = 0;
   };
   Neighbours neighbours;
