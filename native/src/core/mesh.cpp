@@ -559,16 +559,9 @@ int32_t Mesh::first_corner(int32_t v) const {
 }
 
 int32_t Mesh::first_face(int32_t v) const {
-  if (vertex_faces_built_.load(std::memory_order_acquire))
-    return vertex_face_offsets_[v] < vertex_face_offsets_[v + 1] ? vertex_faces_[vertex_face_offsets_[v]] : -1;
-  const int32_t* row = adjacency_.data() + adjacency_offsets_[v];
-  const int32_t* row_end = adjacency_.data() + adjacency_offsets_[v + 1];
-  for (; row != row_end && *row < v; ++row)
-    for (int32_t f = lowest_offsets_[*row]; f < lowest_offsets_[*row + 1]; ++f) {
-      const int32_t* t = &faces_[3 * size_t(f)];
-      if (t[1] == v || t[2] == v || t[0] == v) return f;
-    }
-  return lowest_offsets_[v] < lowest_offsets_[v + 1] ? lowest_offsets_[v] : -1;
+  int32_t first = -1;
+  walk_faces(v, [&](int32_t f) { return first = f, true; });
+  return first;
 }
 
 int32_t Mesh::face_count(int32_t v) const {

@@ -151,6 +151,9 @@ class Mesh {
     if (!vertex_faces_built_.load(std::memory_order_acquire)) build_vertex_faces();
   }
   void build_vertex_faces() const;
+  /// v's faces in increasing order until stop(f) returns true (for_each_face, first_face).
+  template <class Stop>
+  void walk_faces(int32_t v, Stop&& stop) const;
   void keep_vertex_faces_where_walks_cost();
   static constexpr int64_t kWalkPerFace = 16;
   /// The one-ring pass: adjacency, normals, weights, manifoldness, components.
@@ -217,10 +220,11 @@ class Mesh {
   Buffer<int32_t> dropped_rows_;  ///< the caller's corners of each dropped triangle, in report order
 };
 
-template <class Fn>
-void Mesh::for_each_face(int32_t v, Fn&& fn) const {
+template <class Stop>
+void Mesh::walk_faces(int32_t v, Stop&& stop) const {
   if (vertex_faces_built_.load(std::memory_order_acquire)) {  // the table, where one is kept
-    for (int32_t i = vertex_face_offsets_[v], end = vertex_face_offsets_[v + 1]; i < end; ++i) fn(vertex_faces_[i]);
+    for (int32_t i = vertex_face_offsets_[v], end = vertex_face_offsets_[v + 1]; i < end; ++i)
+      if (stop(vertex_faces_[i])) return;
     return;
   }
   const int32_t* row = adjacency_.data() + adjacency_offsets_[v];
@@ -229,9 +233,15 @@ void Mesh::for_each_face(int32_t v, Fn&& fn) const {
   for (; row != row_end && *row < v; ++row)  // the lower neighbours, in increasing order
     for (int32_t f = lowest_offsets_[*row], end = lowest_offsets_[*row + 1]; f < end; ++f) {
       const int32_t* t = faces + 3 * size_t(f);
-      if (t[1] == v || t[2] == v || t[0] == v) fn(f);
+      if ((t[1] == v || t[2] == v || t[0] == v) && stop(f)) return;
     }
-  for (int32_t f = lowest_offsets_[v], end = lowest_offsets_[v + 1]; f < end; ++f) fn(f);
+  for (int32_t f = lowest_offsets_[v], end = lowest_offsets_[v + 1]; f < end; ++f)
+    if (stop(f)) return;
+}
+
+template <class Fn>
+void Mesh::for_each_face(int32_t v, Fn&& fn) const {
+  walk_faces(v, [&](int32_t f) { return fn(f), false; });
 }
 
 }  // namespace topstoc
