@@ -730,21 +730,9 @@ void Mesh::normal_sums(int32_t a, int32_t b, std::vector<double>& sums) const {
     sum[1] += fn[1];
     sum[2] += fn[2];
   };
-  const bool table = vertex_faces_built_.load(std::memory_order_acquire);
-  for (int32_t v = a; v < b; ++v) {
-    if (table) {  // the faces below a's run: the table's row up to it, in the same order
-      for (int32_t i = vertex_face_offsets_[v]; i < vertex_face_offsets_[v + 1] && vertex_faces_[i] < lowest_offsets_[a]; ++i)
-        add(v, &faces_[3 * size_t(vertex_faces_[i])]);
-      continue;
-    }
-    const int32_t* row = adjacency_.data() + adjacency_offsets_[v];
-    const int32_t* row_end = adjacency_.data() + adjacency_offsets_[v + 1];
-    for (; row != row_end && *row < a; ++row)
-      for (int32_t f = lowest_offsets_[*row], end = lowest_offsets_[*row + 1]; f < end; ++f) {
-        const int32_t* t = &faces_[3 * size_t(f)];
-        if (t[1] == v || t[2] == v || t[0] == v) add(v, t);
-      }
-  }
+  const int32_t below_a = lowest_offsets_[a];  // faces whose lowest vertex is below a
+  for (int32_t v = a; v < b; ++v)
+    walk_faces(v, [&](int32_t f) { return f >= below_a || (add(v, &faces_[3 * size_t(f)]), false); });
   for (int32_t f = lowest_offsets_[a], end = lowest_offsets_[b]; f < end; ++f) {
     const int32_t* t = &faces_[3 * size_t(f)];
     double fn[3];
