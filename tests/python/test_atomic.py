@@ -43,8 +43,10 @@ def ring(tmp_path):
 def test_a_signal_during_the_write_removes_the_temporary_file(ring, tmp_path, signum, status):
     out = tmp_path / "out.ply"
     env = dict(os.environ, PYTHONPATH=str(BUILD / "python"))
+    # SIGINT back to its default: a suite started in the background (`cmd &`) runs with it ignored.
     child = subprocess.Popen([sys.executable, "-c", PAUSED_CLI, "decimate", str(ring), str(out), "--ratio", "0.5"],
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         temporary = child.stdout.readline().strip()
         assert temporary == f"{out}.tmp{child.pid}"
