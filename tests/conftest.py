@@ -19,6 +19,12 @@ for path in (str(BUILD / "python"), str(ROOT / "tests")):
 SANITIZER_VARIABLES = ("LD_PRELOAD", "ASAN_OPTIONS", "UBSAN_OPTIONS")
 
 
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers", "heavy: a long engine check; the suites repeated for another NumPy or Blender, "
+        "which test the interface, skip it (-m 'not heavy'), the first suite runs it")
+
+
 def bare_env(**variables) -> dict:
     """An environment of just ``variables`` for a subprocess, plus the sanitizer runtime's
     variables when they are set (without them an ASan build cannot load)."""

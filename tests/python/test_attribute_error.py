@@ -83,6 +83,7 @@ def test_brute_force_closest_points_match_the_engine(duck):
     np.testing.assert_allclose(at, engine_at, atol=1e-9)
 
 
+@pytest.mark.heavy
 def test_the_duck_keeps_its_look_better_than_meshopt(duck):
     ours, _ = bench.run_ours(duck, 0.1)
     plain, _ = bench.run_ours(duck, 0.1, weight=0.0)

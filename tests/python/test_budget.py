@@ -114,6 +114,7 @@ for mode in ("quality", "fast"):
 """
 
 
+@pytest.mark.heavy
 def test_guided_results_same_serial_and_parallel():
     outputs = threads.outputs_by_thread_count(SERIAL_PARALLEL, DATA / "genus0/cgal_ChineseDragon-10kv.off")
     assert len(set(outputs.values())) == 1, outputs

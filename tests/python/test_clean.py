@@ -385,6 +385,7 @@ def pinched_scan():
     return vertices, triangles, clean(vertices, triangles, max_handle="1%", max_hole=0)
 
 
+@pytest.mark.heavy
 def test_no_handle_below_the_size_is_left_after_its_neighbours_go(pinched_scan):
     """The armadillo scan with 8 pinched handles at 1 %: removing the short loops can make a
     longer loop of a handle left shorter than the size (it no longer depends on them), so every

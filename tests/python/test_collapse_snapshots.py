@@ -31,6 +31,7 @@ def kept(mesh):
     return mesh.kept_for_reuse()[2].size
 
 
+@pytest.mark.heavy
 def test_a_drag_down_and_back_up_gives_the_fresh_results(torus):
     mesh, plain = Mesh(*torus), Mesh(*torus, keep_floods=False)
     assert plain.kept_for_reuse()[2] is None
@@ -41,6 +42,7 @@ def test_a_drag_down_and_back_up_gives_the_fresh_results(torus):
     assert kept(mesh) == 0
 
 
+@pytest.mark.heavy
 def test_attributes_and_seeds_keep_their_own_states(torus):
     vertices, triangles = torus
     uv = np.stack([vertices[:, 0], vertices[:, 1]], axis=1)[triangles]  # per corner
@@ -63,6 +65,7 @@ def test_guided_and_triangle_targets_keep_no_state(torus):
     assert_same(mesh.decimate(ratio=0.03, guidance=guidance), plain.decimate(ratio=0.03, guidance=guidance))
 
 
+@pytest.mark.heavy
 def test_the_fit_of_small_results_measures_against_a_kept_input(torus):
     """Results of 401-1,400 triangles are fitted to the input: its search structure is made once and
     kept with the states (one for the whole input: the distance passes' too), also where the first

@@ -57,6 +57,7 @@ def plain_count(mesh, ratio, seed):
 
 
 @pytest.mark.parametrize("path", SURFACES, ids=lambda p: p.name)
+@pytest.mark.heavy
 def test_topology_kept_for_every_seed_and_ratio(path):
     mesh = load(path)
     expected = reference.invariants(mesh.num_vertices, mesh.triangles)
@@ -81,6 +82,7 @@ def test_topology_kept_for_every_seed_and_ratio(path):
                         (mode, ratio, seed, miss)
 
 
+@pytest.mark.heavy
 def test_big_shared_meshes_keep_topology(shared_meshes):
     for name in ("genus0/cgal_bunny00.off", "genus0/cgal_armadillo.off"):
         mesh = load(shared_meshes / name)
@@ -225,6 +227,7 @@ print(digest.hexdigest())
 """
 
 
+@pytest.mark.heavy
 def test_serial_and_parallel_runs_agree():
     assert len(set(outputs_by_thread_count(SERIAL_PARALLEL_SCRIPT).values())) == 1
 
@@ -242,6 +245,7 @@ print(stats["mean"].hex(), stats["max"].hex(), engine.step_for_sample_count(surf
 """
 
 
+@pytest.mark.heavy
 def test_parallel_sums_are_the_same_to_the_bit():
     # The aspect-ratio mean was an OpenMP reduction: its last bits followed the thread count.
     # (Threads follow the free cores: on a busy machine "2" may run on fewer; the C++ test

@@ -653,6 +653,7 @@ def test_remove_every_handle_until_genus_zero(path):
 
 
 @pytest.mark.parametrize("path", genus_meshes(), ids=lambda p: p.stem)
+@pytest.mark.heavy
 def test_remove_handle_loops_from_the_loops_module_until_genus_zero(path):
     """The same with the handle loops of topstoc.core.api.loops (Dey et al.: persistence inside the
     volume, then shortened), removed one after another: the loops found at the start are used

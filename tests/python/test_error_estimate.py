@@ -61,6 +61,7 @@ PAIRS = [("genus0/cgal_fandisk.off", "fast", 0.1), ("genus0/cgal_fandisk.off", "
 
 @pytest.mark.parametrize("name, mode, ratio", PAIRS)
 @pytest.mark.parametrize("queries", [None, 100_000, 300])
+@pytest.mark.heavy
 def test_agrees_with_cgal(data_dir, tmp_path, name, mode, ratio, queries):
     if peer("cgal_hausdorff") is None:
         pytest.skip("the peer program cgal_hausdorff was not built (libcgal-dev)")
@@ -90,6 +91,7 @@ QUICK_CASES = [("genus0/cgal_fandisk.off", "quality", 0.1), ("genus0/cgal_armadi
 
 
 @pytest.mark.parametrize("name, mode, ratio", QUICK_CASES)
+@pytest.mark.heavy
 def test_the_quick_bound_holds_against_the_exact_max_and_is_near_it(data_dir, name, mode, ratio):
     # The quick bound (the default for big originals: no search structure over the original's
     # triangles) against the exact bracketed max, side by side: its upper bound is never below the

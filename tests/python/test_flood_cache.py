@@ -136,6 +136,7 @@ def test_threads_sharing_a_mesh_get_the_fresh_results():
 
 
 @pytest.mark.parametrize("seed", range(12))
+@pytest.mark.heavy
 def test_random_manifolds_and_pinched_surfaces(seed):
     """Random hulls, tori, grids with holes, several components, and surfaces glued at vertices
     (tests/random_manifolds.py): a drag of 12 steps gives the fresh results."""
@@ -188,6 +189,7 @@ def test_cleared_layouts_are_built_again_with_the_same_results():
         np.testing.assert_array_equal(old.samples, new.samples)
 
 
+@pytest.mark.heavy
 def test_meshes_from_the_size_limit_up_keep_floods_from_a_second_decimation(monkeypatch):
     """By default a mesh keeps floods below Mesh.KEEP_FLOODS_BELOW triangles; above, from its
     layout's second decimation on (a one-off decimation's flood and the draw's tables would sit

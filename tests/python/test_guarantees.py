@@ -42,6 +42,7 @@ def test_random_manifolds_keep_every_guarantee(seed):
         assert_guarantees(vertices, triangles, mesh.decimate(**random_parameters(rng)))
 
 
+@pytest.mark.heavy
 def test_stress_pass_finds_nothing():
     counts = run(400, 7, quiet=True)
     assert counts["ok"] == counts["decimations"] == 400, counts

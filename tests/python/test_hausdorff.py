@@ -280,6 +280,7 @@ def test_caller_arrays_are_not_modified(eight, eight_decimated):
     ("genus_positive/cgal_eight.off", 0.05, False),
     ("open_boundary/cgal_mushroom.off", 0.02, True),
 ])
+@pytest.mark.heavy
 def test_error_bounded_decimation_meets_the_bound_with_a_minimal_count(data_dir, name, bound, relative):
     vertices, triangles = read_off(data_dir / name)
     mesh = topstoc.Mesh(vertices, triangles)
@@ -303,6 +304,7 @@ def test_error_bounded_decimation_meets_the_bound_with_a_minimal_count(data_dir,
     assert again.symmetric.max_upper >= report.failed_error * (1 - 1e-12)
 
 
+@pytest.mark.heavy
 def test_error_bounded_search_decimates_few_targets_and_stays_minimal(data_dir):
     # fandisk at 0.3 % in quality mode: the bisection on the estimate followed by exact checks
     # decimated more than 11 targets (design.md §2.11 says how the search brackets and checks)
@@ -356,6 +358,7 @@ def test_error_bounded_search_climbs_just_above_a_failed_exact_check(answer):
     assert len(judged) <= len(bisected) + 4  # farther up the doubling steps cost a few more
 
 
+@pytest.mark.heavy
 def test_error_bounded_search_returns_the_fewest_passing_vertices_from_its_first_probe(data_dir):
     # The error is not monotone in the count, so a search at the resolution need not find the
     # fewest vertices that pass. On fandisk at 0.3 % every target from the search's first probe
@@ -393,6 +396,7 @@ def test_error_bounded_search_reports_progress_and_cancels(eight):
     assert len(calls) == 2
 
 
+@pytest.mark.heavy
 def test_error_bounded_decimation_is_reproducible(eight):
     mesh = topstoc.Mesh(*eight)
     first = mesh.decimate(max_error=0.03, relative=True, seed=9)

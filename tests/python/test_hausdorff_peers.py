@@ -11,6 +11,8 @@ import pytest
 import topstoc
 from peer_runs import cgal_hausdorff, meshlab_hausdorff, meshopt_simplify, peer, read_off, write_off
 
+pytestmark = pytest.mark.heavy
+
 PAIRS = [  # (mesh, decimation by "topstoc" or "meshopt", ratio of vertices)
     ("genus0/cgal_fandisk.off", "topstoc", 0.1),
     ("genus0/cgal_fandisk.off", "meshopt", 0.1),

@@ -44,6 +44,7 @@ def euler_genus(vertices, triangles):
 
 
 @pytest.mark.parametrize("name", list(SMALL))
+@pytest.mark.heavy
 def test_each_family_gets_a_verified_basis(name):
     vertices, triangles = SMALL[name]()
     result = topstoc.handle_tunnel_loops(vertices, triangles)

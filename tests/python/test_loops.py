@@ -109,6 +109,7 @@ def check_sides(vertices, triangles, tets, samples=60):
 
 
 @pytest.mark.parametrize("name,genus", GENUS_POSITIVE)
+@pytest.mark.heavy
 def test_genus_positive_meshes(data_dir, name, genus):
     vertices, triangles = read_off(data_dir / "genus_positive" / name)
     result = topstoc.handle_tunnel_loops(vertices, triangles)
@@ -191,6 +192,7 @@ def test_a_torus_inside_a_sphere_is_analysed_on_its_own():
 
 @pytest.mark.parametrize("name,target", [("cgal_elephant.off", 600), ("cgal_knot1.off", 400),
                                          ("cgal_turbine.off", 2000), ("cgal_couplingdown.off", 700)])
+@pytest.mark.heavy
 def test_coarse_route_gives_valid_loops_on_the_full_mesh(data_dir, name, target):
     vertices, triangles = read_off(data_dir / "genus_positive" / name)
     result = topstoc.handle_tunnel_loops(vertices, triangles, coarse_vertices=target)
@@ -200,6 +202,7 @@ def test_coarse_route_gives_valid_loops_on_the_full_mesh(data_dir, name, target)
     check_component(vertices, triangles, component)
 
 
+@pytest.mark.heavy
 def test_coarse_route_on_a_subdivided_mesh_matches_the_full_route(data_dir):
     vertices, triangles = meshgen.subdivide(*read_off(data_dir / "genus_positive" / "cgal_eight.off"), 2)
     coarse = topstoc.handle_tunnel_loops(vertices, triangles, coarse_vertices=300).components[0]
@@ -244,6 +247,7 @@ def test_edge_count_metric(data_dir):
     assert sum(len(x) for x in by_edges.loops) <= sum(len(x) for x in by_length.loops)
 
 
+@pytest.mark.heavy
 def test_field_three_agrees(data_dir):
     """Over Z3 too: the loops are genuine handles and tunnels, not only modulo 2."""
     vertices, triangles = read_off(data_dir / "genus_positive" / "cgal_anchor_dense.off")
@@ -335,6 +339,7 @@ def test_tetgen_sees_perturbed_positions_and_falls_back_to_exact():
         assert hc.betti([tets["tets"][~inside]])[:3] == [1, 0, 2]
 
 
+@pytest.mark.heavy
 def test_self_intersections_agree_with_brute_force():
     vertices, triangles = meshgen.torus(10, 5, major=0.3, minor=0.5)
     # Generic positions: the floating-point reference below is unreliable on exact coincidences.

@@ -29,6 +29,7 @@ def bumpy_torus():
     return v * (1.0 + 0.03 * np.sin(7 * around) * np.cos(5 * across))[:, None], t
 
 
+@pytest.mark.heavy
 def test_a_mesh_of_60k_vertices_is_collapsed_whole():
     v, t = bumpy_torus()
     mesh = Mesh(v, t)
@@ -161,6 +162,7 @@ BELOW_FLOOR = [("genus_positive/cgal_turbine.off", 50, "MeshLab", 0.85, 0.8),
 
 
 @pytest.mark.parametrize("name, target, peer_name, max_bound, mean_bound", BELOW_FLOOR, ids=[b[0] for b in BELOW_FLOOR])
+@pytest.mark.heavy
 def test_below_the_floor_the_result_nears_the_peers(name, target, peer_name, max_bound, mean_bound):
     import json
     case = next(c for c in json.loads(FLOOR.read_text())["cases"]

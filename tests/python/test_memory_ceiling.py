@@ -31,6 +31,7 @@ def peaks():
 
 
 @pytest.mark.parametrize("mode", ["quality", "fast"])
+@pytest.mark.heavy
 def test_peak_per_triangle_stays_under_the_ceiling(peaks, mode):
     figures = peaks[mode]
     assert figures["triangles"] > 0.99 * TRIANGLES and figures["topology_kept"]

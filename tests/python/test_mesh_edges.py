@@ -80,5 +80,6 @@ print(hashlib.sha256(edges.vertices.tobytes() + edges.corner_edge.tobytes()).hex
 """
 
 
+@pytest.mark.heavy
 def test_serial_and_parallel_runs_agree():
     assert len(set(outputs_by_thread_count(THREADS_SCRIPT).values())) == 1

@@ -18,6 +18,7 @@ DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
 
 
 @pytest.mark.parametrize("path", SURFACES, ids=lambda p: p.name)
+@pytest.mark.heavy
 def test_topology_orientation_and_budget_kept(path):
     mesh = load(path)
     expected = reference.invariants(mesh.num_vertices, mesh.triangles)
@@ -36,6 +37,7 @@ def test_topology_orientation_and_budget_kept(path):
                     assert r.num_vertices == r.stats.target_vertices, (ratio, seed, refine)
 
 
+@pytest.mark.heavy
 def test_refinement_lowers_the_error():
     for name in ("genus0/cgal_ChineseDragon-10kv.off", "genus_positive/cgal_turbine.off",
                  "genus0/cgal_fandisk.off"):
@@ -53,6 +55,7 @@ def test_refinement_lowers_the_error():
             assert e_refined.max < 1.5 * e_plain.max, (name, ratio, e_plain.max, e_refined.max)
 
 
+@pytest.mark.heavy
 def test_refinement_leaves_no_thinner_worst_triangle_than_plain_topstoc():
     """The worst triangle (aspect ratio, thesis eq. 4.2, reference.py) of the quality mode is no
     worse than plain TopStoc's at the same target. The dragon has needles: the ends of input edges
@@ -188,6 +191,7 @@ def test_bad_refine_values(refine):
         mesh.decimate_with_samples(np.arange(10), refine_vertices=-3)
 
 
+@pytest.mark.heavy
 def test_triangle_and_error_targets():
     v, t = reference.read_off(DATA / "genus0/cgal_fandisk.off")
     mesh = Mesh(v, t)

@@ -133,6 +133,7 @@ def test_pruning_drops_small_parts_and_reports_them(tmp_path):
     assert same is result and report.removed_parts == 0
 
 
+@pytest.mark.heavy
 def test_prune_option_through_the_batch(tmp_path):
     big = meshgen.icosphere(2)
     v, f = meshgen.disjoint(big, (meshgen.icosphere(1)[0] * 0.01, meshgen.icosphere(1)[1]))

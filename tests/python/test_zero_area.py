@@ -23,6 +23,7 @@ def zero_area(result) -> int:
 
 
 @pytest.mark.parametrize("mode", ["fast", "quality"])
+@pytest.mark.heavy
 def test_collinear_vertices_of_a_genus_133_grid(mode):
     mesh = Mesh(*meshgen.genus_grid(7, 19, scale=(2, 2, 3)))
     for ratio in (0.05, 0.03):
