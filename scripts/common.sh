@@ -3,15 +3,21 @@
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ROOT"
-# ccache (when installed) keys paths inside the checkout relative to it, so a fresh clone anywhere
-# reuses the compiles of earlier ones.
+# ccache keys paths inside the checkout relative to it, so a fresh clone anywhere reuses the
+# compiles of earlier ones; its files live with the test caches (the engine is built about ten
+# times per test run: host, Windows, fuzzing, wheels, macOS, aarch64).
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$ROOT}
+if [ -z "${CCACHE_DIR:-}" ]; then  # ccache's own default where the cache folder is not writable
+  _ccache_dir=${TOPSTOC_CACHE:-/var/cache/topstoc}/ccache
+  mkdir -p "$_ccache_dir" 2>/dev/null && [ -w "$_ccache_dir" ] && export CCACHE_DIR=$_ccache_dir
+  unset _ccache_dir
+fi
 
 # Debian packages: the build and runtime, then peers and tools used by tests and benchmarks.
 RUNTIME_PACKAGES="blender cmake g++ make pybind11-dev libopenmesh-dev libtet1.5-dev libphat-dev
   python3 python3-dev python3-numpy python3-pytest"
 TEST_PACKAGES="libmeshoptimizer-dev libcgal-dev python3-gudhi python3-scipy python3-venv xvfb
-  xauth git ca-certificates doctest-dev"
+  xauth git ca-certificates doctest-dev ccache"
 
 as_root() {
   if [ "$(id -u)" = 0 ]; then "$@";
