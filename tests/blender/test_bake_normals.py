@@ -163,6 +163,7 @@ def cycles_bakes(ts, bake, scene):
 
 
 @pytest.mark.parametrize("make, uv_made, closer", CASES, ids=["suzanne", "rock", "duck"])
+@pytest.mark.heavy
 def test_baked_map_shades_like_the_source(ts, bake, scene, tmp_path, make, uv_made, closer):
     source = make()
     bare = decimated(ts, source, source.name + "_bare")
@@ -217,6 +218,7 @@ def shading_differences(source, bare, baked, folder, engine):
             shading.shading_difference(images[0], images[2], mask))
 
 
+@pytest.mark.heavy
 def test_the_duck_shades_like_its_source_in_eevee(ts, bake, scene, tmp_path):
     """The UV-mapped asset in EEVEE (the viewport's material look, free of Cycles 3.x's normal
     bending): the baked LOD at least 3x closer to the source than the bare one."""
@@ -638,6 +640,7 @@ def colour_difference(reference, other, mask):
     return float(np.abs(reference[..., :3] - other[..., :3]).mean(axis=-1)[mask].mean())
 
 
+@pytest.mark.heavy
 def test_baked_colour_shows_the_source_colours_closer(ts, bake, scene, tmp_path, cycles_bakes):
     """A source without UV map (the bake lays one out) painted per vertex: asked, the bake lays the
     base colour on that map too. Rendered, the 2 % LOD reading its colour from it is closer to the

@@ -136,6 +136,7 @@ def test_folders_as_topstoc_batch_takes_them(ts, tmp_path):
     assert missing.returncode == 1 and "nowhere: no such file or folder" in missing.stderr
 
 
+@pytest.mark.heavy
 def test_max_error_target(ts, tmp_path):
     if not has_io(ts):
         pytest.skip("needs topstoc.core.api.io")

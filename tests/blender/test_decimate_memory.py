@@ -86,6 +86,7 @@ def peak(kind: str, triangles: int, mode: str) -> dict:
     return json.loads(next(line for line in reversed(done.stdout.splitlines()) if line.startswith("{")))
 
 
+@pytest.mark.heavy
 def test_the_worker_path_peaks_near_the_engine_alone():
     """2M triangles, quality mode, each path in a fresh process from the same baseline (Blender's
     own mesh in hand): the read, the worker, the moved sources and the write peak at most 8 bytes a
