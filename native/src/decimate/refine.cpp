@@ -572,7 +572,8 @@ class Refinement {
     // The fit moves vertices under the usual limits (under the looser ones it left slivers: a
     // torus at 16 triangles, aspect ratio up to 187 against 35).
     best.collapser->set_shape_limits(Collapser::kMinShape, Collapser::kMinTurnCos);
-    finish(*best.collapser, whole);
+    // The max its samples found: what a result too large for the fit's brackets is held to.
+    finish(*best.collapser, whole, std::sqrt(best.deviation.top2));
   }
 
   // The first run to `restart` (slivers first), from a state kept by an earlier refinement
@@ -675,12 +676,14 @@ class Refinement {
   // With attributes too: a vertex the fit moves takes the input's attributes where it lands
   // (attributes.moved_vertices), and seam vertices, whose sides differ, do not move. whole: the
   // whole input's surface when the caller has it (the fit's, unless the input is large).
-  void finish(Collapser& collapser, std::shared_ptr<const Surface> whole = nullptr) {
+  // known_max: a distance the symmetric max attains (a larger result is fitted only with one,
+  // against the whole input).
+  void finish(Collapser& collapser, std::shared_ptr<const Surface> whole = nullptr, double known_max = -1.0) {
     const int32_t faces = collapser.live_faces(), rounds = fit_rounds(faces);
-    if (params.refit && rounds > 0) {
-      const int64_t step = fit_input_step(mesh);
+    if (params.refit && rounds > 0 && (faces <= kFitFaces || (known_max > 0.0 && large_fit_enabled()))) {
+      const int64_t step = faces <= kFitFaces ? fit_input_step(mesh) : 1;
       const std::shared_ptr<const Surface> input = step == 1 && whole ? whole : kept_input(collapser, step);
-      fit_tiny(mesh, collapser, rounds, faces <= kTinyFitFaces, *input);
+      fit_tiny(mesh, collapser, rounds, faces <= kTinyFitFaces, *input, known_max);
     }
     if (collapser.zero_area_faces() > 0) relocate_zero_area(mesh, layout, params, label, result, collapser);
     result.issues_remaining.sliver = collapser.zero_area_faces();

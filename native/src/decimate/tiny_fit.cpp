@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <optional>
 
+#include "decimate/sparse_normal.hpp"
 #include "distance/bounded_max.hpp"
 #include "topstoc/core/parallel.hpp"
+#include "topstoc/distance/bvh.hpp"
 #include "topstoc/distance/hausdorff.hpp"
 
 namespace topstoc {
@@ -36,6 +39,18 @@ constexpr double kSmallestStep = 0.25;
 // Each unknown is pulled to where it stands with this share of the mean diagonal of the normal
 // equations, so that a vertex few pairs see stays put.
 constexpr double kStay = 1e-3;
+// Results above kFitFaces (fit_large): the normal equations solved by conjugate gradients to
+// this relative residual or this many iterations, and the max judged by one threshold walk a
+// side of at most this many closest-point queries per result triangle (a walk that runs out
+// refuses the move).
+constexpr double kSolveTolerance = 1e-6;
+constexpr int32_t kSolveIterations = 200;
+constexpr int64_t kLargeQueriesPerFace = 40;
+// A distance before the move this close to the one after (relative) is the same, measured
+// again at a point rebuilt from its barycentric weights.
+constexpr double kSameDistance = 1e-9;
+// And the corners of its triangles with a pair farther than this share of the max stay put.
+constexpr double kNearMax = 0.5;
 // Samples of each result triangle paired with the input, as barycentric weights.
 constexpr double kSamples[7][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.5, 0.5, 0.0}, {0.0, 0.5, 0.5}, {0.5, 0.0, 0.5},
                                    {0.6, 0.2, 0.2},             {0.2, 0.6, 0.2}, {0.2, 0.2, 0.6}};
@@ -75,6 +90,7 @@ class Fit {
       if (mesh.in_faces(w) && seen++ % stride == 0) points_.push_back(w);
     for (int32_t t = 0; t < int32_t(triangles.size() / 3); ++t)
       if (c_.face_alive(t)) faces_.insert(faces_.end(), &triangles[3 * size_t(t)], &triangles[3 * size_t(t) + 3]);
+    large_ = int64_t(faces_.size() / 3) > kFitFaces;
     unknown_.assign(c_.vertices(), -1);
     for (int32_t v : faces_)
       if ((boundaries ? c_.fittable(v) : c_.is_free(v)) && unknown_[v] < 0) unknown_[v] = int32_t(free_.size()), free_.push_back(v);
@@ -96,17 +112,36 @@ class Fit {
     double lower = 0.0, upper = 0.0;
     int32_t face = -1;  // the result triangle nearest the point where `lower` was found
     double point[3] = {0, 0, 0};  // that point
+    bool converged = true;  // false when a side ran out of queries (upper then decides nothing)
+    bool on_result = false;  // whether `point` lies on the result (else on the input)
   };
   // at: the result's vertex positions (positions()). threshold >= 0: only whether the max
   // exceeds it is decided (bounded_max.hpp), cheaper, and the second side is skipped once the
   // first exceeds it; without, the two sides run side by side where a core is free (each side's
   // bracket is the same on any thread).
-  Bracket symmetric_max(std::vector<double> at, double threshold = -1.0) const {
+  // lean (with a threshold): the result side over the triangles the last apply moved only, the
+  // input side by input_side, at most kLargeQueriesPerFace queries per result triangle a side
+  // (converged false when they run out).
+  // input_passed (lean): the input side already passed at a threshold no higher, the result
+  // where it was: only the result side is walked.
+  Bracket symmetric_max(std::vector<double> at, double threshold = -1.0, bool lean = false, bool input_passed = false) {
     const Surface result(std::move(at), live_faces_);
     MaxBracket there, back;
-    auto measure_there = [&] { there = bound_max_distance_by_tree(result, *input_, kMaxTolerance, kMaxQueries, threshold); };
-    auto measure_back = [&] { back = bound_max_distance_by_tree(*input_, result, kMaxTolerance, kMaxQueries, threshold); };
-    if (threshold >= 0.0) {
+    const int64_t budget = lean ? kLargeQueriesPerFace * int64_t(faces_.size() / 3) : kMaxQueries;
+    // lean: only the result triangles the last apply moved (the others stood where the max
+    // before the move was measured, and a far point there only raised the threshold again).
+    auto measure_there = [&] {
+      there = lean ? bound_max_over_triangles(result, moved_faces_, *input_, threshold, kMaxTolerance, budget)
+                   : bound_max_distance_by_tree(result, *input_, kMaxTolerance, budget, threshold, lean);
+    };
+    auto measure_back = [&] {
+      back = lean ? input_side(result, threshold, budget)
+                  : bound_max_distance_by_tree(*input_, result, kMaxTolerance, budget, threshold, lean);
+    };
+    if (lean) {  // the input side first: the cheaper one, and it lists every far point it finds
+      if (!input_passed) measure_back();
+      if (!(back.lower > threshold) && back.converged) measure_there();
+    } else if (threshold >= 0.0) {
       measure_there();
       if (!(there.lower > threshold)) measure_back();
     } else {
@@ -115,16 +150,92 @@ class Fit {
       parallel_invoke(true, measure_there, measure_back);
     }
     const MaxBracket& far = there.lower >= back.lower ? there : back;
-    Bracket b{far.lower, std::max(there.upper, back.upper), result.bvh().closest(far.lower_point, -1).triangle};
+    Bracket b{far.lower, std::max(there.upper, back.upper), result.bvh().closest(far.lower_point, -1).triangle,
+              {0, 0, 0}, there.converged && back.converged, &far == &there};
     for (int k = 0; k < 3; ++k) b.point[k] = far.lower_point[k];
     return b;
   }
 
+  // Whether the input lies farther than threshold from `result` anywhere (a bracket whose lower
+  // exceeds it where it does): each input vertex measured, then each input triangle bounded by
+  // its corners' largest distance to one result triangle, the nearest to one of its corners
+  // (a distance to a triangle is convex, so over the input triangle it peaks at a corner); the
+  // few triangles that leaves above the threshold are bracketed (bounded_max.hpp).
+  // far_faces_: the result triangles nearest to the input vertices farther than threshold.
+  MaxBracket input_side(const Surface& result, double threshold, int64_t budget) {
+    const std::vector<double>& at = input_->positions();
+    const std::vector<int32_t>& triangles = input_->triangles();
+    const std::vector<double>& corners = result.positions();
+    std::vector<int32_t> nearest(size_t(input_->num_vertices()), -1);
+    MaxBracket out;
+    int32_t hint = -1;
+    far_faces_.clear();
+    for (int32_t v = 0; v < input_->num_vertices(); ++v) {
+      if (!input_->used()[v]) continue;
+      const ClosestHit hit = result.bvh().closest(&at[3 * size_t(v)], hint);
+      hint = hit.slot, nearest[v] = hit.triangle, ++out.queries;
+      if (hit.distance2 > threshold * threshold) far_faces_.push_back(hit.triangle);
+      if (hit.distance2 > out.lower * out.lower) {
+        out.lower = std::sqrt(hit.distance2);
+        for (int i = 0; i < 3; ++i) out.lower_point[i] = at[3 * size_t(v) + i];
+      }
+    }
+    if (out.lower > threshold) return out.upper = out.lower, out.converged = false, out;
+    std::vector<int32_t> open;
+    const double limit2 = threshold * threshold;
+    for (int32_t s = 0; s < input_->num_triangles(); ++s) {
+      const int32_t* c = &triangles[3 * size_t(s)];
+      bool settled = false;
+      for (int j = 0; j < 3 && !settled; ++j) {
+        const int32_t* t = &live_faces_[3 * size_t(nearest[c[j]])];
+        double far2 = 0.0, point[3];
+        for (int i = 0; i < 3; ++i)
+          far2 = std::max(far2, closest_point_on_triangle(&at[3 * size_t(c[i])], &corners[3 * size_t(t[0])],
+                                                          &corners[3 * size_t(t[1])], &corners[3 * size_t(t[2])], point));
+        settled = far2 <= limit2;
+      }
+      if (!settled) open.push_back(s);
+    }
+    if (open.empty()) return out.upper = threshold, out;
+    MaxBracket rest = bound_max_over_triangles(*input_, open, result, threshold, kMaxTolerance, budget);
+    rest.queries += out.queries;
+    return rest;
+  }
+
+  // The distance the result at `start` (positions()) had at the far point of b: there the same
+  // point of the same triangle (b.face), on the input to the result's surface `before` (made
+  // from start).
+  double distance_before(const Bracket& b, const std::vector<double>& start, const Surface& before) const {
+    if (!b.on_result) return std::sqrt(before.bvh().closest(b.point, -1).distance2);
+    const int32_t* f = &live_faces_[3 * size_t(b.face)];
+    double w[3], p[3] = {0, 0, 0};
+    barycentric(b.point, corner(b.face, 0), corner(b.face, 1), corner(b.face, 2), w);
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) p[i] += w[j] * start[3 * size_t(f[j]) + i];
+    return std::sqrt(input_->bvh().closest(p, -1).distance2);
+  }
+  const std::vector<int32_t>& live_faces() const { return live_faces_; }
+
+  // Holds the result triangles the last input_side found input vertices too far from; false
+  // when there were none.
+  bool hold_far_faces() {
+    for (int32_t f : far_faces_) hold(f);
+    return !far_faces_.empty();
+  }
+
   // Keeps the corners of result triangle f where they stand in the moves that follow.
   void hold(int32_t f) {
-    for (int j = 0; j < 3; ++j) held_.push_back(faces_[3 * size_t(f) + j]);
+    if (held_.empty()) held_.assign(c_.vertices(), 0);
+    for (int j = 0; j < 3; ++j) held_[faces_[3 * size_t(f) + j]] = 1;
   }
   void release() { held_.clear(); }
+
+  // Holds the corners of every result triangle with a pair farther than `limit` (as the last
+  // pair_up found them): where the far points may lie the result stays as it was.
+  void hold_far_pairs(double limit) {
+    for (const Pair& pair : pairs_)
+      if (distance2(pair) > limit * limit) hold(pair.face);
+  }
 
   // The corner of result triangle f nearest p.
   int32_t nearest_corner(int32_t f, const double* p) const {
@@ -201,6 +312,7 @@ class Fit {
   // The least-squares positions of the free vertices for the current pairs; false when the
   // normal equations are singular.
   bool solve(std::vector<double>& x) const {
+    if (large_) return solve_sparse(x);
     const size_t k = free_.size();
     std::vector<double> a(k * k, 0.0), rhs(3 * k, 0.0);
     for (const Pair& pair : pairs_) {
@@ -228,6 +340,44 @@ class Fit {
     return cholesky_solve(a, k, rhs, x);
   }
 
+  // The same for a large result: the normal equations' non-zeros only, by conjugate gradients
+  // from where the vertices stand.
+  bool solve_sparse(std::vector<double>& x) const {
+    const int32_t k = int32_t(free_.size());
+    SparseNormal a(faces_, unknown_, k);
+    std::vector<double> rhs(3 * size_t(k), 0.0);
+    for (const Pair& pair : pairs_) {
+      const int32_t* c = &faces_[3 * size_t(pair.face)];
+      double fixed[3] = {pair.target[0], pair.target[1], pair.target[2]};
+      for (int j = 0; j < 3; ++j)
+        if (unknown_[c[j]] < 0)
+          for (int i = 0; i < 3; ++i) fixed[i] -= pair.b[j] * c_.position(c[j])[i];
+      for (int j = 0; j < 3; ++j) {
+        const int32_t r = unknown_[c[j]];
+        if (r < 0 || pair.b[j] == 0.0) continue;
+        for (int l = 0; l < 3; ++l)
+          if (unknown_[c[l]] >= 0) a.add(r, unknown_[c[l]], pair.weight * pair.b[j] * pair.b[l]);
+        for (int i = 0; i < 3; ++i) rhs[3 * size_t(r) + i] += pair.weight * pair.b[j] * fixed[i];
+      }
+    }
+    double trace = 0.0;
+    for (int32_t r = 0; r < k; ++r) trace += a.diagonal(r);
+    const double stay = kStay * trace / double(k);
+    if (!(stay > 0)) return false;
+    x.assign(3 * size_t(k), 0.0);
+    for (int32_t r = 0; r < k; ++r) {
+      a.add(r, r, stay);
+      for (int i = 0; i < 3; ++i) {
+        rhs[3 * size_t(r) + i] += stay * c_.position(free_[r])[i];
+        x[3 * size_t(r) + i] = c_.position(free_[r])[i];
+      }
+    }
+    a.solve(rhs, x, kSolveTolerance, kSolveIterations);
+    return true;
+  }
+
+  bool large() const { return large_; }
+
   // The positions a step (0 to 1) of the way from where the free vertices stand to x.
   std::vector<double> toward(const std::vector<double>& x, double step) const {
     std::vector<double> y(x.size());
@@ -245,12 +395,24 @@ class Fit {
     int32_t moved = 0;
     for (size_t r = 0; r < free_.size(); ++r) {
       const int32_t v = free_[r];
-      if (std::find(held_.begin(), held_.end(), v) != held_.end()) continue;
+      if (!held_.empty() && held_[v]) continue;
       Saved s{v, {}, {}};
       for (int i = 0; i < 3; ++i) s.position[i] = c_.position(v)[i], s.world[i] = c_.world(v)[i];
       if (c_.try_move(v, &x[3 * r])) saved_.push_back(s), ++moved;
     }
+    list_moved_faces();
     return moved;
+  }
+
+  // The result triangles with a corner among the vertices the last apply moved.
+  void list_moved_faces() {
+    std::vector<uint8_t> moved(c_.vertices(), 0);
+    for (const Saved& s : saved_) moved[s.v] = 1;
+    moved_faces_.clear();
+    for (int32_t f = 0; f < int32_t(faces_.size() / 3); ++f) {
+      const int32_t* c = &faces_[3 * size_t(f)];
+      if (moved[c[0]] || moved[c[1]] || moved[c[2]]) moved_faces_.push_back(f);
+    }
   }
 
   void undo() {
@@ -327,10 +489,18 @@ class Fit {
   std::vector<int32_t> unknown_;  // per vertex: its unknown, or -1 (fixed)
   std::vector<Pair> pairs_;
   std::vector<Saved> saved_;
-  std::vector<int32_t> held_;  // vertices the moves leave where they are
+  std::vector<uint8_t> held_;  // per vertex: 1 where the moves leave it (empty: none held)
+  bool large_ = false;         // above kFitFaces triangles (solve_sparse, lean max walks)
+  std::vector<int32_t> far_faces_;  // input_side's far points' result triangles
+  std::vector<int32_t> moved_faces_;  // result triangles with a corner the last apply moved
 };
 
 }  // namespace
+
+bool large_fit_enabled() {
+  const char* text = std::getenv("TOPSTOC_LARGE_FIT");
+  return text && text[0] == '1';
+}
 
 int64_t fit_input_step(const Mesh& mesh) {
   return std::max<int64_t>(1, (int64_t(mesh.num_faces()) + kFitTriangles - 1) / kFitTriangles);
@@ -360,14 +530,61 @@ void back_off(Fit& fit, const std::vector<double>& start, Fit::Error& error) {
   }
 }
 
+// A result above kFitFaces: one round, judged against known_max (a distance the symmetric max
+// attains before the move) by one lean threshold walk a side instead of two full brackets; the
+// result side walks only the moved triangles (the others are as they were, no farther than the
+// max before). No pairing after the move: the walks alone decide (a second pairing cost as much
+// as the input side's walk, and its test refused moves the walks keep).
+// Where a walk finds the surfaces farther apart than known_max: when the result stood as far
+// there before the move (up to kSameDistance), that distance with the brackets' tolerance
+// (kMaxTolerance, the slack the smaller results' check allows too) is the new known max and
+// the walk runs again; else the
+// corners of the result triangle there are held and the move tried again (a few times), then
+// at half the step.
+TinyFit fit_large(Fit& fit, const Fit::Error& error, double known_max) {
+  TinyFit out;
+  out.before2 = out.after2 = error.mean2;
+  std::vector<double> x;
+  if (!fit.solve(x)) return out;
+  const std::vector<double> start = fit.positions();
+  const Surface before(start, fit.live_faces());
+  for (double step = 1.0; step >= kSmallestStep; step *= 0.5) {
+    fit.release();
+    // Pairs near the max before the move hold their triangles.
+    fit.hold_far_pairs(kNearMax * known_max);
+    for (int32_t tries = 0; tries < kHoldTries; ++tries) {
+      if (fit.apply(fit.toward(x, step)) == 0) return out;
+      auto walk = fit.symmetric_max(fit.positions(), known_max, true);
+      for (int32_t raised = 0; raised < kHoldTries && walk.lower > known_max; ++raised) {
+        const double was = fit.distance_before(walk, start, before);
+        if (!(was >= walk.lower * (1.0 - kSameDistance))) break;
+        known_max = (1.0 + kMaxTolerance) * std::max(was, walk.lower);
+        walk = fit.symmetric_max(fit.positions(), known_max, true, walk.on_result);
+      }
+      const bool farther = walk.lower > known_max;
+      if (!farther && walk.converged) {
+        out.rounds = 1;
+        return out;
+      }
+      fit.undo();
+      if (!farther) return out;  // the walk ran out of queries: nothing to hold
+      if (walk.on_result || !fit.hold_far_faces()) fit.hold(walk.face);
+    }
+    fit.undo();
+  }
+  return out;
+}
+
 }  // namespace
 
-TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input) {
+TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input,
+                 double known_max) {
   TinyFit out;
   Fit fit(mesh, collapser, boundaries, input);
   if (fit.empty()) return out;
   auto error = fit.pair_up();
   if (error.top2 <= kOnTheInput * kOnTheInput) return out;
+  if (fit.large()) return known_max > 0.0 ? fit_large(fit, error, known_max) : out;
   // The max before any move, measured only once a move's pairs pass (when none does it is not
   // needed, and it is the fit's dearest step): from the positions kept here, the same bracket.
   const std::vector<double> start = fit.positions();
