@@ -114,6 +114,7 @@ class Fit {
     double point[3] = {0, 0, 0};  // that point
     bool converged = true;  // false when a side ran out of queries (upper then decides nothing)
     bool on_result = false;  // whether `point` lies on the result (else on the input)
+    bool input_passed = false, result_passed = false;  // (lean) the sides found no farther point
   };
   // at: the result's vertex positions (positions()). threshold >= 0: only whether the max
   // exceeds it is decided (bounded_max.hpp), cheaper, and the second side is skipped once the
@@ -122,9 +123,10 @@ class Fit {
   // lean (with a threshold): the result side over the triangles the last apply moved only, the
   // input side by input_side, at most kLargeQueriesPerFace queries per result triangle a side
   // (converged false when they run out).
-  // input_passed (lean): the input side already passed at a threshold no higher, the result
-  // where it was: only the result side is walked.
-  Bracket symmetric_max(std::vector<double> at, double threshold = -1.0, bool lean = false, bool input_passed = false) {
+  // input_passed, result_passed (lean): that side already passed at a threshold no higher, the
+  // result where it was: it is not walked again.
+  Bracket symmetric_max(std::vector<double> at, double threshold = -1.0, bool lean = false, bool input_passed = false,
+                        bool result_passed = false) {
     const Surface result(std::move(at), live_faces_);
     MaxBracket there, back;
     const int64_t budget = lean ? kLargeQueriesPerFace * int64_t(faces_.size() / 3) : kMaxQueries;
@@ -135,12 +137,21 @@ class Fit {
                    : bound_max_distance_by_tree(result, *input_, kMaxTolerance, budget, threshold, lean);
     };
     auto measure_back = [&] {
-      back = lean ? input_side(result, threshold, budget)
-                  : bound_max_distance_by_tree(*input_, result, kMaxTolerance, budget, threshold, lean);
+      back = bound_max_distance_by_tree(*input_, result, kMaxTolerance, budget, threshold, lean);
     };
-    if (lean) {  // the input side first: the cheaper one, and it lists every far point it finds
-      if (!input_passed) measure_back();
-      if (!(back.lower > threshold) && back.converged) measure_there();
+    // lean: the cheapest check first: the input vertices (listing every far point), then the
+    // moved result triangles, then the input triangles.
+    auto result_side = [&] {
+      if (!result_passed) measure_there();
+      return result_passed = !(there.lower > threshold) && there.converged;
+    };
+    if (lean) {
+      if (!input_passed) {
+        back = input_side(result, threshold, budget, result_side);
+        input_passed = !(back.lower > threshold) && back.converged && result_passed;
+      } else {
+        result_side();
+      }
     } else if (threshold >= 0.0) {
       measure_there();
       if (!(there.lower > threshold)) measure_back();
@@ -153,6 +164,7 @@ class Fit {
     Bracket b{far.lower, std::max(there.upper, back.upper), result.bvh().closest(far.lower_point, -1).triangle,
               {0, 0, 0}, there.converged && back.converged, &far == &there};
     for (int k = 0; k < 3; ++k) b.point[k] = far.lower_point[k];
+    b.input_passed = lean && input_passed, b.result_passed = lean && result_passed;
     return b;
   }
 
@@ -162,7 +174,9 @@ class Fit {
   // (a distance to a triangle is convex, so over the input triangle it peaks at a corner); the
   // few triangles that leaves above the threshold are bracketed (bounded_max.hpp).
   // far_faces_: the result triangles nearest to the input vertices farther than threshold.
-  MaxBracket input_side(const Surface& result, double threshold, int64_t budget) {
+  // between: run once the vertices pass, before the triangles; false ends the walk there.
+  template <class Between>
+  MaxBracket input_side(const Surface& result, double threshold, int64_t budget, Between&& between) {
     const std::vector<double>& at = input_->positions();
     const std::vector<int32_t>& triangles = input_->triangles();
     const std::vector<double>& corners = result.positions();
@@ -181,6 +195,7 @@ class Fit {
       }
     }
     if (out.lower > threshold) return out.upper = out.lower, out.converged = false, out;
+    if (!between()) return out.upper = out.lower, out;
     std::vector<int32_t> open;
     const double limit2 = threshold * threshold;
     for (int32_t s = 0; s < input_->num_triangles(); ++s) {
@@ -559,7 +574,7 @@ TinyFit fit_large(Fit& fit, const Fit::Error& error, double known_max) {
         const double was = fit.distance_before(walk, start, before);
         if (!(was >= walk.lower * (1.0 - kSameDistance))) break;
         known_max = (1.0 + kMaxTolerance) * std::max(was, walk.lower);
-        walk = fit.symmetric_max(fit.positions(), known_max, true, walk.on_result);
+        walk = fit.symmetric_max(fit.positions(), known_max, true, walk.input_passed, walk.result_passed);
       }
       const bool farther = walk.lower > known_max;
       if (!farther && walk.converged) {
