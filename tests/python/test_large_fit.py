@@ -9,6 +9,7 @@ against CGAL in test_hausdorff_peers.py).
 """
 
 import numpy as np
+import pytest
 
 import topstoc
 from topstoc.core import read_mesh
@@ -25,6 +26,7 @@ def _decimate(path):
     return vertices, triangles, result, error.symmetric
 
 
+@pytest.mark.heavy
 def test_a_result_above_1400_triangles_is_fitted_its_mean_lower_and_max_not_higher(data_dir, monkeypatch):
     path = data_dir / "genus0/cgal_ChineseDragon-10kv.off"
     monkeypatch.delenv("TOPSTOC_LARGE_FIT", raising=False)
@@ -56,6 +58,7 @@ print(hashlib.sha256(np.asarray(r.vertices).tobytes() + np.asarray(r.triangles).
 """
 
 
+@pytest.mark.heavy
 def test_the_large_fit_is_the_same_on_any_thread_count(data_dir, monkeypatch):
     monkeypatch.setenv("TOPSTOC_LARGE_FIT", "1")
     outputs = outputs_by_thread_count(SCRIPT, data_dir / "genus0/cgal_ChineseDragon-10kv.off", counts=("1", "2"))
