@@ -173,7 +173,8 @@ def test_below_the_floor_the_result_nears_the_peers(name, target, peer_name, max
     mesh = Mesh(v, t)
     results = [mesh.decimate(target_triangles=x, seed=0) for x in (target, 2 * target)]
     r = results[0]
-    assert r.stats.over_budget_reason == "topology" and r.num_triangles == case["peer_triangles"]
+    # at most the peers' count (past the floor, a scan's rim may lose a few more: extend_past_floor)
+    assert r.stats.over_budget_reason == "topology" and r.num_triangles <= case["peer_triangles"]
     assert abs(theirs["triangles"] - r.num_triangles) <= 2
     check_output(mesh, r, reference.invariants(len(v), t))
     # a target below the floor gives the floor's result whatever it is

@@ -199,7 +199,7 @@ void Collapser::queue(int32_t u, int32_t v, double c) {
 // with `checked`, the cheapest one that passes them. Reads the state only: safe in parallel.
 Collapser::Best Collapser::evaluate(int32_t u, bool checked, Scratch& scratch) const {
   Best best;
-  if (s_.locked[u] || at_quota(u)) return best;
+  if (s_.locked[u] || at_quota(u) || (!held_.empty() && held_[u])) return best;
   neighbours(u, scratch, scratch.list);
   if (!checked) {
     for (int32_t v : scratch.list) {
@@ -788,6 +788,7 @@ void Collapser::move_to(int32_t v, const double* x) {
 }
 
 void Collapser::collapse(int32_t u, int32_t v) {
+  last_removed_ = u;
   {
     double x[3];
     if (rescue_) {

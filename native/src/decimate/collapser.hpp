@@ -94,6 +94,22 @@ class Collapser {
     min_shape_ = min_shape;
     fold2_ = min_turn_cos * min_turn_cos;
   }
+  /// Lets a run that stopped because every collapse left failed its checks try them all again
+  /// (after set_shape_limits loosened them): the next run() queues every vertex anew.
+  void reopen() {
+    use_quota_ = false;
+    rescue_ = false;
+  }
+  /// Makes the next collapse (one vertex fewer) and returns the vertex it removed, or -1 when
+  /// none is left.
+  int32_t collapse_one() { return run({alive_vertices_ - 1, 0}) > 0 ? last_removed_ : -1; }
+  /// u stays from now on (the caller refused its collapse): it is not queued again, though its
+  /// neighbours may still collapse into it.
+  void hold(int32_t u) {
+    if (held_.empty()) held_.assign(target_.size(), 0);
+    held_[u] = 1;
+    settle(u, Best());
+  }
   /// Moves every free vertex to its quadric's minimum along the directions it constrains, at
   /// most radius2[v] (squared, normalised) away, where no triangle folds or becomes a sliver.
   int32_t refit(const std::vector<double>& radius2);
@@ -123,6 +139,7 @@ class Collapser {
   const double* position(int32_t v) const { return &s_.positions[3 * size_t(v)]; }
   bool is_free(int32_t v) const { return s_.curve[v] < 0 && !s_.locked[v]; }
   /// Free, or an unlocked vertex of a mesh boundary (which has no other side to keep).
+  bool on_mesh_boundary(int32_t v) const { return !s_.on_boundary.empty() && s_.on_boundary[v]; }
   bool fittable(int32_t v) const { return is_free(v) || (!s_.locked[v] && !s_.on_boundary.empty() && s_.on_boundary[v]); }
   int32_t vertices() const { return static_cast<int32_t>(merged_into_.size()); }
   /// The caller's coordinates in the normalised ones of position().
@@ -213,6 +230,8 @@ class Collapser {
   std::vector<int32_t>* corner_source_;
   CollapseSetup s_;
   std::vector<int32_t> count_;  // per bin: vertices alive
+  std::vector<uint8_t> held_;  // per vertex: refused by the caller (hold); empty: none
+  int32_t last_removed_ = -1;  // the vertex the last collapse removed
   bool use_quota_ = true;
   bool rescue_ = false;  // every collapse left failed its checks: see shaped_placement
   double min_shape_ = kMinShape;              // a triangle may end no thinner (keeps_shape)

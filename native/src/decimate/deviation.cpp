@@ -228,4 +228,24 @@ Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const s
   return out;
 }
 
+double farthest_around(const InputSurface& input, const Collapser& collapser, const std::vector<int32_t>& triangles,
+                       int32_t v, int k) {
+  std::vector<int32_t> around;
+  for (size_t t = 0; 3 * t < triangles.size(); ++t) {
+    const int32_t* c = &triangles[3 * t];
+    if (collapser.face_alive(int32_t(t)) && (c[0] == v || c[1] == v || c[2] == v)) around.push_back(int32_t(t));
+  }
+  const int64_t per = int64_t(k + 1) * (k + 2) / 2;
+  const std::vector<double> at = distances2(input.surface->bvh(), per * int64_t(around.size()), [&](int64_t i, double* p) {
+    const int32_t* c = &triangles[3 * size_t(around[size_t(i / per)])];
+    int64_t j = i % per, row = 0;  // grid point j: row `row` (weight of c[0] k - row), column j
+    while (j > row) j -= ++row;
+    const double w[3] = {double(k - row) / k, double(row - j) / k, double(j) / k};
+    for (int d = 0; d < 3; ++d)
+      p[d] = w[0] * collapser.position(c[0])[d] + w[1] * collapser.position(c[1])[d] + w[2] * collapser.position(c[2])[d];
+    return true;
+  });
+  return at.empty() ? 0.0 : *std::max_element(at.begin(), at.end());
+}
+
 }  // namespace topstoc

@@ -53,4 +53,10 @@ Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const s
                           Collapser& collapser, const std::vector<int32_t>& triangles,
                           const Rival* rival = nullptr);
 
+/// The largest squared distance to the input from points spread over the live triangles
+/// around vertex v (each split k times along its sides: the corners and every grid point),
+/// finer than surface_deviation's few points per triangle, for a check of one collapse.
+double farthest_around(const InputSurface& input, const Collapser& collapser, const std::vector<int32_t>& triangles,
+                       int32_t v, int k);
+
 }  // namespace topstoc
