@@ -91,6 +91,7 @@ def boundary_edges(triangles) -> np.ndarray:
 
 @pytest.mark.parametrize("name, target, most, before, max_before, mean_before", PAST_FLOOR,
                          ids=[c[0].split("/")[-1] for c in PAST_FLOOR])
+@pytest.mark.heavy
 def test_past_the_floor_a_scan_loses_triangles_not_accuracy(name, target, most, before, max_before, mean_before):
     if name == "range_scan":
         vertices, triangles = range_scan(40, 0)
