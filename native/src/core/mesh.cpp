@@ -663,6 +663,9 @@ void Mesh::build_adjacency(Progress& progress) {
         for (auto& entry : scan.overflow) overflow.push_back(std::move(entry));
       });
     });
+    // The slice's lists of faces above its vertices are read: their pages go back, so that the
+    // pass holds those lists and the neighbour buffer's written slots about one at a time.
+    release_range(upper, size_t(upper_offsets[begin]), size_t(upper_offsets[end]));
     progress.update(0.8 * (slice + 1) / kSlices);
   }
   report_.boundary_edges = boundary;
