@@ -691,8 +691,8 @@ void Mesh::build_adjacency(Progress& progress) {
   if (edges > INT32_MAX) throw std::invalid_argument("mesh is too large: more than 2^31 edges");
   num_edges_ = int32_t(edges);
   // Each vertex's root: the sets go before the weights are made.
-  component_.resize(n);
-  parallel_for(0, n, kParallelMin, [&](int32_t v) { component_[v] = sets.find(v); });
+  Buffer<int32_t> component(n);
+  parallel_for(0, n, kParallelMin, [&](int32_t v) { component[v] = sets.find(v); });
   std::vector<int32_t>().swap(sets.parents());
   release_freed_heap(4 * size_t(n));
   keep_vertex_faces_where_walks_cost();
@@ -700,7 +700,8 @@ void Mesh::build_adjacency(Progress& progress) {
   progress.stage("normals and weights", 0.8, 0.92);
   weigh();
   progress.stage("components", 0.92, 1.0);
-  report_.components = number_components(adjacency_offsets_, adjacency_, lowest_offsets_, component_, component_euler_);
+  report_.components = number_components(adjacency_offsets_, adjacency_, lowest_offsets_, component, component_euler_);
+  component_.assign(component, report_.components);
   mean_weight_ = mean_of_weights(adjacency_offsets_, weights_);
 }
 
