@@ -458,17 +458,25 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
   faces_.resize(3 * size_t(m));
   Buffer<int32_t> source(m);
   lowest_offsets_.resize(size_t(n) + 1);
-  parallel_for(0, m, kParallelMin, [&](int32_t j) {
-    // The rows are read in a new order: fetch a few faces ahead.
-    if (j + 8 < m) prefetch(&renumbered[3 * size_t(keyed[j + 8] & 0xffffffffu)]);
-    const int64_t i = int64_t(keyed[j] & 0xffffffffu);
-    for (int c = 0; c < 3; ++c) faces_[3 * size_t(j) + c] = renumbered[3 * size_t(i) + c];
-    source[j] = face_source_[i];
-    // The runs of each lowest vertex: every vertex after the previous face's lowest, up to
-    // this face's, starts here.
-    const int64_t lowest = int64_t(keyed[j] >> 32), previous = j ? int64_t(keyed[j - 1] >> 32) : -1;
-    for (int64_t v = previous + 1; v <= lowest; ++v) lowest_offsets_[v] = j;
-  });
+  // In slices of the sorted keys, whose read pages go back after each (all but the last key,
+  // which the next slice reads): the keys (8 bytes a triangle) shrink as the faces and their
+  // sources (16) grow, instead of all being held at the end, which was the preparation's peak.
+  constexpr int32_t kSlices = 8;
+  for (int32_t slice = 0; slice < kSlices; ++slice) {
+    const int32_t begin = int32_t(int64_t(m) * slice / kSlices), end = int32_t(int64_t(m) * (slice + 1) / kSlices);
+    parallel_for(begin, end, kParallelMin, [&](int32_t j) {
+      // The rows are read in a new order: fetch a few faces ahead.
+      if (j + 8 < m) prefetch(&renumbered[3 * size_t(keyed[j + 8] & 0xffffffffu)]);
+      const int64_t i = int64_t(keyed[j] & 0xffffffffu);
+      for (int c = 0; c < 3; ++c) faces_[3 * size_t(j) + c] = renumbered[3 * size_t(i) + c];
+      source[j] = face_source_[i];
+      // The runs of each lowest vertex: every vertex after the previous face's lowest, up to
+      // this face's, starts here.
+      const int64_t lowest = int64_t(keyed[j] >> 32), previous = j ? int64_t(keyed[j - 1] >> 32) : -1;
+      for (int64_t v = previous + 1; v <= lowest; ++v) lowest_offsets_[v] = j;
+    });
+    if (end > begin) release_range(keyed, size_t(begin), size_t(end) - 1);
+  }
   for (int64_t v = int64_t(keyed[m - 1] >> 32) + 1; v <= int64_t(n); ++v) lowest_offsets_[v] = m;
   Buffer<int32_t>().swap(renumbered);
   face_source_.swap(source);
