@@ -1,7 +1,8 @@
 // Each vertex's component is held in the fewest bytes its ids need (ComponentIds): compared with
 // components found by a search over the faces (numbered in order of their lowest vertex, -1 for
 // an isolated vertex) on meshes of 1, 100, 300 and 40,000 components, with and without isolated
-// vertices, and the widths those counts give.
+// vertices, and the widths those counts give. The manifold flags (VertexFlags) are held only
+// where a vertex is not manifold.
 #include <doctest/doctest.h>
 
 #include <cstdint>
@@ -83,4 +84,22 @@ TEST_CASE("component ids: every width holds -1 and its largest id") {
     packed.assign(ids, components);
     for (int i = 0; i < 5; ++i) CHECK(packed[i] == values[i]);
   }
+}
+
+TEST_CASE("manifold flags: none held when every vertex is manifold, else each vertex's") {
+  const Arrays torus = topstoc_test::torus(12, 9);
+  const topstoc::Mesh closed(torus.positions, torus.triangles.data(), torus.num_triangles());
+  CHECK(!closed.manifold_vertex().held());
+  CHECK(closed.manifold_vertex().size() == size_t(closed.num_vertices()));
+  for (int32_t v = 0; v < closed.num_vertices(); ++v) CHECK(closed.manifold_vertex()[v] == 1);
+  // Two octahedra sharing a vertex: it is pinched (two fans), the others manifold.
+  Arrays pinched = octahedra(2, 0);
+  for (int32_t& v : pinched.triangles)
+    if (v == 6 + 3) v = 1;  // the second one's vertex (-1, 0, 0) + 3 = (2, 0, 0) becomes the first's (1, 0, 0)
+  const topstoc::Mesh mesh(pinched.positions, pinched.triangles.data(), pinched.num_triangles());
+  CHECK(mesh.manifold_vertex().held());
+  int32_t nonmanifold = 0;
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) nonmanifold += mesh.manifold_vertex()[v] == 0;
+  CHECK(nonmanifold == 1);
+  CHECK(mesh.manifold_vertex()[mesh.vertex_index()[1]] == 0);
 }

@@ -650,10 +650,10 @@ void Mesh::build_adjacency(Progress& progress) {
   Buffer<int32_t> scratch(faces_.size() + size_t(n));
   Buffer<int32_t> degree(n + 1);
   degree[n] = 0;
-  manifold_vertex_.resize(n);
+  Buffer<uint8_t> manifold(n);
   SharedUnionFind sets(n);
   const OneRingArrays arrays{faces_, upper, upper_offsets, lowest_offsets_, positions_, scratch, degree,
-                             manifold_vertex_, sets};
+                             manifold, sets};
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
   std::vector<std::pair<int32_t, std::vector<int32_t>>> overflow;
   // In slices of the vertices with a cancel point after each (the pass is seconds on 20M
@@ -680,6 +680,7 @@ void Mesh::build_adjacency(Progress& progress) {
   report_.nonmanifold_edges = nonmanifold_edges;
   report_.inconsistent_edges = inconsistent;
   report_.nonmanifold_vertices = pinched;
+  manifold_vertex_.assign(std::move(manifold));  // nothing kept when every vertex is manifold
   report_.zero_area_triangles = zero_area;
 
   adjacency_offsets_.swap(degree);

@@ -23,6 +23,7 @@
 #include "topstoc/core/serial.hpp"
 #include "topstoc/core/buffer.hpp"
 #include "topstoc/core/component_ids.hpp"
+#include "topstoc/core/vertex_flags.hpp"
 #include "topstoc/core/progress.hpp"
 
 namespace topstoc {
@@ -133,7 +134,7 @@ class Mesh {
   const Buffer<int64_t>& component_euler() const { return component_euler_; }
   /// True where the vertex's triangles form one consistently oriented fan and none of its
   /// edges is non-manifold.
-  const Buffer<uint8_t>& manifold_vertex() const { return manifold_vertex_; }
+  const VertexFlags& manifold_vertex() const { return manifold_vertex_; }
   /// Length of the bounding box diagonal.
   double diagonal() const { return diagonal_; }
 
@@ -216,7 +217,7 @@ class Mesh {
   mutable std::atomic<bool> areas_built_{false};
   ComponentIds component_;
   Buffer<int64_t> component_euler_;
-  Buffer<uint8_t> manifold_vertex_;
+  VertexFlags manifold_vertex_;
   MeshReport report_;
   Buffer<int32_t> dropped_rows_;  ///< the caller's corners of each dropped triangle, in report order
 };
