@@ -458,17 +458,25 @@ void Mesh::reorder_for_locality(const double* positions, const int32_t* triangle
   faces_.resize(3 * size_t(m));
   Buffer<int32_t> source(m);
   lowest_offsets_.resize(size_t(n) + 1);
-  parallel_for(0, m, kParallelMin, [&](int32_t j) {
-    // The rows are read in a new order: fetch a few faces ahead.
-    if (j + 8 < m) prefetch(&renumbered[3 * size_t(keyed[j + 8] & 0xffffffffu)]);
-    const int64_t i = int64_t(keyed[j] & 0xffffffffu);
-    for (int c = 0; c < 3; ++c) faces_[3 * size_t(j) + c] = renumbered[3 * size_t(i) + c];
-    source[j] = face_source_[i];
-    // The runs of each lowest vertex: every vertex after the previous face's lowest, up to
-    // this face's, starts here.
-    const int64_t lowest = int64_t(keyed[j] >> 32), previous = j ? int64_t(keyed[j - 1] >> 32) : -1;
-    for (int64_t v = previous + 1; v <= lowest; ++v) lowest_offsets_[v] = j;
-  });
+  // In slices of the sorted keys, whose read pages go back after each (all but the last key,
+  // which the next slice reads): the keys (8 bytes a triangle) shrink as the faces and their
+  // sources (16) grow, instead of all being held at the end, which was the preparation's peak.
+  constexpr int32_t kSlices = 8;
+  for (int32_t slice = 0; slice < kSlices; ++slice) {
+    const int32_t begin = int32_t(int64_t(m) * slice / kSlices), end = int32_t(int64_t(m) * (slice + 1) / kSlices);
+    parallel_for(begin, end, kParallelMin, [&](int32_t j) {
+      // The rows are read in a new order: fetch a few faces ahead.
+      if (j + 8 < m) prefetch(&renumbered[3 * size_t(keyed[j + 8] & 0xffffffffu)]);
+      const int64_t i = int64_t(keyed[j] & 0xffffffffu);
+      for (int c = 0; c < 3; ++c) faces_[3 * size_t(j) + c] = renumbered[3 * size_t(i) + c];
+      source[j] = face_source_[i];
+      // The runs of each lowest vertex: every vertex after the previous face's lowest, up to
+      // this face's, starts here.
+      const int64_t lowest = int64_t(keyed[j] >> 32), previous = j ? int64_t(keyed[j - 1] >> 32) : -1;
+      for (int64_t v = previous + 1; v <= lowest; ++v) lowest_offsets_[v] = j;
+    });
+    if (end > begin) release_range(keyed, size_t(begin), size_t(end) - 1);
+  }
   for (int64_t v = int64_t(keyed[m - 1] >> 32) + 1; v <= int64_t(n); ++v) lowest_offsets_[v] = m;
   Buffer<int32_t>().swap(renumbered);
   face_source_.swap(source);
@@ -642,10 +650,10 @@ void Mesh::build_adjacency(Progress& progress) {
   Buffer<int32_t> scratch(faces_.size() + size_t(n));
   Buffer<int32_t> degree(n + 1);
   degree[n] = 0;
-  manifold_vertex_.resize(n);
+  Buffer<uint8_t> manifold(n);
   SharedUnionFind sets(n);
   const OneRingArrays arrays{faces_, upper, upper_offsets, lowest_offsets_, positions_, scratch, degree,
-                             manifold_vertex_, sets};
+                             manifold, sets};
   int32_t boundary = 0, nonmanifold_edges = 0, inconsistent = 0, pinched = 0, zero_area = 0;
   std::vector<std::pair<int32_t, std::vector<int32_t>>> overflow;
   // In slices of the vertices with a cancel point after each (the pass is seconds on 20M
@@ -663,12 +671,16 @@ void Mesh::build_adjacency(Progress& progress) {
         for (auto& entry : scan.overflow) overflow.push_back(std::move(entry));
       });
     });
+    // The slice's lists of faces above its vertices are read: their pages go back, so that the
+    // pass holds those lists and the neighbour buffer's written slots about one at a time.
+    release_range(upper, size_t(upper_offsets[begin]), size_t(upper_offsets[end]));
     progress.update(0.8 * (slice + 1) / kSlices);
   }
   report_.boundary_edges = boundary;
   report_.nonmanifold_edges = nonmanifold_edges;
   report_.inconsistent_edges = inconsistent;
   report_.nonmanifold_vertices = pinched;
+  manifold_vertex_.assign(std::move(manifold));  // nothing kept when every vertex is manifold
   report_.zero_area_triangles = zero_area;
 
   adjacency_offsets_.swap(degree);
@@ -688,8 +700,8 @@ void Mesh::build_adjacency(Progress& progress) {
   if (edges > INT32_MAX) throw std::invalid_argument("mesh is too large: more than 2^31 edges");
   num_edges_ = int32_t(edges);
   // Each vertex's root: the sets go before the weights are made.
-  component_.resize(n);
-  parallel_for(0, n, kParallelMin, [&](int32_t v) { component_[v] = sets.find(v); });
+  Buffer<int32_t> component(n);
+  parallel_for(0, n, kParallelMin, [&](int32_t v) { component[v] = sets.find(v); });
   std::vector<int32_t>().swap(sets.parents());
   release_freed_heap(4 * size_t(n));
   keep_vertex_faces_where_walks_cost();
@@ -697,7 +709,8 @@ void Mesh::build_adjacency(Progress& progress) {
   progress.stage("normals and weights", 0.8, 0.92);
   weigh();
   progress.stage("components", 0.92, 1.0);
-  report_.components = number_components(adjacency_offsets_, adjacency_, lowest_offsets_, component_, component_euler_);
+  report_.components = number_components(adjacency_offsets_, adjacency_, lowest_offsets_, component, component_euler_);
+  component_.assign(component, report_.components);
   mean_weight_ = mean_of_weights(adjacency_offsets_, weights_);
 }
 

@@ -81,6 +81,22 @@ void release_unused(Buffer<T>& buffer) {
 #endif
 }
 
+/// Gives the whole pages of buffer[begin, end) back to the system (Linux, buffers that map their
+/// own pages; elsewhere nothing): entries read for the last time while the rest is still in use
+/// (a pass over vertex slices). Those pages read as zero afterwards.
+template <class T>
+void release_range(Buffer<T>& buffer, size_t begin, size_t end) {
+#if defined(__linux__)
+  if (buffer.capacity() * sizeof(T) < UninitialisedAllocator<T>::kMapped || end <= begin) return;
+  const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
+  const uintptr_t first = (uintptr_t(buffer.data() + begin) + page - 1) / page * page;
+  const uintptr_t last = uintptr_t(buffer.data() + end) / page * page;
+  if (last > first) madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
+#else
+  (void)buffer, (void)begin, (void)end;
+#endif
+}
+
 /// Gives the heap's free pages back to the system (glibc; elsewhere nothing) after a stage that
 /// freed about `freed` bytes: std::vector's blocks of a few megabytes come from glibc's heap once
 /// its mapping threshold has risen, and stay resident once freed, under the next stage's working

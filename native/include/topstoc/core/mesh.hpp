@@ -22,6 +22,8 @@
 
 #include "topstoc/core/serial.hpp"
 #include "topstoc/core/buffer.hpp"
+#include "topstoc/core/component_ids.hpp"
+#include "topstoc/core/vertex_flags.hpp"
 #include "topstoc/core/progress.hpp"
 
 namespace topstoc {
@@ -125,14 +127,14 @@ class Mesh {
   /// Importance weight x(v) of thesis eq. 4.1, in [0, 1]; mean over vertices in faces.
   const Buffer<double>& weights() const { return weights_; }
   double mean_weight() const { return mean_weight_; }
-  /// Connected component of each vertex (-1 for isolated vertices).
-  const Buffer<int32_t>& component() const { return component_; }
+  /// Connected component of each vertex (-1 for isolated vertices), in as few bytes as the ids need.
+  const ComponentIds& component() const { return component_; }
   int32_t num_components() const { return report_.components; }
   /// Euler characteristic V - E + F of each component.
   const Buffer<int64_t>& component_euler() const { return component_euler_; }
   /// True where the vertex's triangles form one consistently oriented fan and none of its
   /// edges is non-manifold.
-  const Buffer<uint8_t>& manifold_vertex() const { return manifold_vertex_; }
+  const VertexFlags& manifold_vertex() const { return manifold_vertex_; }
   /// Length of the bounding box diagonal.
   double diagonal() const { return diagonal_; }
 
@@ -213,9 +215,9 @@ class Mesh {
   mutable double mean_vertex_area_ = 0.0;
   mutable std::once_flag areas_once_;
   mutable std::atomic<bool> areas_built_{false};
-  Buffer<int32_t> component_;
+  ComponentIds component_;
   Buffer<int64_t> component_euler_;
-  Buffer<uint8_t> manifold_vertex_;
+  VertexFlags manifold_vertex_;
   MeshReport report_;
   Buffer<int32_t> dropped_rows_;  ///< the caller's corners of each dropped triangle, in report order
 };
