@@ -209,6 +209,25 @@ def render_scale(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def render_high_valence(name: str, figures: dict) -> str:
+    """bench_high_valence.py --json: decimation time on fans of slivers, this build and a baseline."""
+    modes = figures["modes"]
+    out = [f"## Vertices of high valence: fans of slivers (`{name}`)", "",
+           f"`{figures['benchmark']}` at {percent(figures['ratio'])} of the vertices, one thread; the baseline is "
+           "another build (main's) in the same run.", "", *source_lines(figures), "",
+           "| Mesh | Size | Triangles | Mode | Ours | Baseline | Baseline ÷ ours |", "|---|---|---|---|---|---|---|"]
+    limit = f"over {figures['limit_s']:.0f} s"
+    for row in figures["meshes"]:
+        ours, base = row["ours"], row.get("baseline")
+        for mode in modes:
+            mine = ours[mode]["seconds"] if ours else None
+            theirs = base[mode]["seconds"] if base else None
+            out.append(f"| {row['shape']} | {row['size']:,} | {ours['triangles'] if ours else 2 * row['size']:,} | {mode} "
+                       f"| {limit if mine is None else ms(1000 * mine)} | {limit if theirs is None else ms(1000 * theirs)} "
+                       f"| {'—' if mine is None or theirs is None else times(theirs, mine)} |")
+    return "\n".join(out) + "\n"
+
+
 def render_blender_memory(name: str, figures: dict) -> str:
     """bench_blender_background.py --memory --json: Guided Decimate's peak above Blender's mesh next to the engine's."""
     out = [f"## Guided Decimate's memory in Blender (`{name}`)", "",
@@ -452,6 +471,8 @@ def render_result(path: pathlib.Path) -> str:
         return render_attributes(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_scale.py":
         return render_scale(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_high_valence.py":
+        return render_high_valence(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_blender_background.py --memory":
         return render_blender_memory(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_threads_paired.py":
@@ -468,7 +489,7 @@ def render_result(path: pathlib.Path) -> str:
         return render_error_search(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
                      "the --json of bench_decimate.py, bench_quality.py, bench_attributes.py, bench_loops.py --families, "
-                     "bench_scale.py, bench_blender_background.py --memory, bench_threads_paired.py, bench_cleanup.py, "
+                     "bench_scale.py, bench_high_valence.py, bench_blender_background.py --memory, bench_threads_paired.py, bench_cleanup.py, "
                      "bench_cleanup.py --speed, bench_blender_decimate.py --only-rest, bench_batch.py and bench_error_search.py, and carried-over "
                      "figures)")
 

@@ -2,6 +2,7 @@
 // distance itself against a dense sampling of the triangle.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -70,4 +71,58 @@ TEST_CASE("BVH closest point equals the brute-force minimum over all triangles, 
     CHECK(cold.distance2 == hit.distance2);
     hint = int32_t(random() % num_triangles);  // an unrelated hint must not change the answer
   }
+}
+
+TEST_CASE("BVH over a fan of slivers (slabs): the brute-force minimum at points on and off it") {
+  // A double cone of 3,000 rim vertices (the slivers' boxes all reach the apexes, so the tree
+  // orders and prunes by its slabs) and points on its faces, its edges, its vertices, off it
+  // and far from it: the closest distance and the lowest-id triangle at it, whatever the hint.
+  const int32_t n = 3000;
+  std::vector<double> positions;
+  for (int32_t i = 0; i < n; ++i) {
+    const double a = 2 * 3.141592653589793 * i / n;
+    positions.insert(positions.end(), {std::cos(a), std::sin(a), 0.0});
+  }
+  positions.insert(positions.end(), {0.0, 0.0, 1.0, 0.0, 0.0, -1.0});
+  std::vector<int32_t> triangles;
+  for (int32_t i = 0; i < n; ++i) triangles.insert(triangles.end(), {i, (i + 1) % n, n});
+  for (int32_t i = 0; i < n; ++i) triangles.insert(triangles.end(), {(i + 1) % n, i, n + 1});
+  const int32_t m = 2 * n;
+  const TriangleBvh bvh(positions.data(), triangles.data(), m);
+  CHECK(bvh.has_slabs());
+  std::mt19937 random(23);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto corner = [&](int32_t t, int c) { return &positions[3 * size_t(triangles[3 * size_t(t) + c])]; };
+  int32_t hint = -1, exact_zero = 0;
+  for (int probe = 0; probe < 600; ++probe) {
+    const int32_t t = int32_t(random() % m);
+    double p[3], w[3] = {unit(random), unit(random), unit(random)};
+    const int kind = probe % 6;
+    if (kind == 1) w[2] = 0.0;                  // on an edge
+    if (kind == 2) w[1] = w[2] = 0.0;           // at a vertex
+    const double sum = w[0] + w[1] + w[2];
+    for (int k = 0; k < 3; ++k)
+      p[k] = (w[0] * corner(t, 0)[k] + w[1] * corner(t, 1)[k] + w[2] * corner(t, 2)[k]) / sum;
+    const double scale = kind == 3 ? 1e-6 : kind == 4 ? 0.05 : kind == 5 ? 3.0 : 0.0;  // off the surface
+    for (int k = 0; k < 3; ++k) p[k] += scale * (unit(random) - 0.5);
+    double best = 1e300;
+    int32_t best_triangle = -1;
+    for (int32_t f = 0; f < m; ++f) {
+      double q[3];
+      const double d2 = closest_point_on_triangle(p, corner(f, 0), corner(f, 1), corner(f, 2), q);
+      if (d2 < best) best = d2, best_triangle = f;
+    }
+    exact_zero += best == 0.0;
+    const auto hit = bvh.closest(p, hint);
+    CHECK(hit.distance2 == best);
+    CHECK(hit.triangle == best_triangle);
+    const auto cold = bvh.closest(p);
+    CHECK(cold.triangle == best_triangle);
+    // A query that stops within a distance: a triangle that near, or the closest when none is.
+    const double within2 = 0.5 * best + 1e-9;
+    const auto near = bvh.closest(p, -1, within2);
+    CHECK((near.distance2 <= within2 || (near.distance2 == best && near.triangle == best_triangle)));
+    hint = int32_t(random() % m);
+  }
+  CHECK(exact_zero > 50);  // the vertices: many triangles at distance 0, the lowest id wins
 }

@@ -97,3 +97,56 @@ TEST_CASE("LinkArcs past its linear scan: the same neighbours, counts and fans a
     }
   }
 }
+
+namespace {
+
+// one_cycle as it was written before the sorted lookup: a scan for the next arc at every step.
+bool one_cycle_by_scan(const std::vector<Arc>& arcs) {
+  const int32_t count = int32_t(arcs.size());
+  if (count < 3) return false;
+  const int32_t start = arcs[0].from;
+  int32_t at = arcs[0].to, steps = 1;
+  while (at != start) {
+    if (++steps > count) return false;
+    int32_t next = -1;
+    for (int32_t j = 1; j < count && next < 0; ++j)
+      if (arcs[j].from == at) next = j;
+    if (next < 0) return false;
+    at = arcs[next].to;
+  }
+  return steps == count;
+}
+
+}  // namespace
+
+TEST_CASE("one_cycle past its scan (a fan's centre): the same answer as the scan and as LinkArcs") {
+  // Cycles of 60 to 2,000 arcs in order, backwards (the order a cone's lower apex lists them,
+  // where the scan cost the count squared) and shuffled; then broken: an arc turned aside, one
+  // left out, one repeated, one reversed, two cycles side by side.
+  std::mt19937 random(11);
+  int32_t cycles = 0, others = 0;
+  for (int32_t size : {60, 64, 65, 66, 100, 777, 2000}) {
+    std::vector<int32_t> ring(size);
+    for (int32_t i = 0; i < size; ++i) ring[i] = 5 * i + int32_t(random() % 5);
+    for (int variant = 0; variant < 7; ++variant)
+      for (int order = 0; order < 3; ++order) {
+        std::vector<Arc> arcs;
+        for (int32_t i = 0; i < size; ++i) arcs.push_back({ring[i], ring[(i + 1) % size]});
+        if (variant == 1) arcs[random() % size].to = ring[random() % size];
+        if (variant == 2) arcs.erase(arcs.begin() + random() % size);
+        if (variant == 3) arcs.push_back(arcs[random() % size]);
+        if (variant == 4) std::swap(arcs[0].from, arcs[0].to);
+        if (variant == 5)  // two cycles: the ring split in two halves
+          arcs[size / 2 - 1].to = ring[0], arcs[size - 1].to = ring[size / 2];
+        if (variant == 6) arcs.push_back({ring[0], ring[size / 2]});
+        if (order == 1) std::reverse(arcs.begin(), arcs.end());
+        if (order == 2) std::shuffle(arcs.begin(), arcs.end(), random);
+        const bool got = topstoc::one_cycle(arcs.data(), int32_t(arcs.size()));
+        CHECK(got == one_cycle_by_scan(arcs));
+        CHECK(got == closed_fan(arcs));
+        ++(got ? cycles : others);
+      }
+  }
+  CHECK(cycles == 7 * 3);  // every unbroken cycle, whatever its order
+  CHECK(others >= 6 * 7 * 3 - 6);  // an arc turned aside may land on its own head
+}

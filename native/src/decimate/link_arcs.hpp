@@ -5,7 +5,9 @@
 // centre has thousands).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <utility>
 #include <unordered_map>
 #include <vector>
 
@@ -126,24 +128,42 @@ struct LinkArcs {
 /// Then the arcs' tails are `count` distinct vertices, each with one arc in and one out: the
 /// link of a vertex inside a surface, one consistently oriented fan (what LinkArcs finds with
 /// !repeated(), single_fan() and every neighbour's in + out == 2). The common case, checked
-/// without building the LinkArcs; false for anything else.
-template <class Arc>
-bool one_cycle(const Arc* arcs, int32_t count) {
-  if (count < 3) return false;  // two arcs a -> b, b -> a are one triangle twice
+/// without building the LinkArcs; false for anything else. Up to kScanArcs arcs the next arc is
+/// found by a scan; past them (a fan's centre, a cone's apex: a scan per step would cost the
+/// count squared when the arcs run backwards) in the arcs sorted by tail, the same first one.
+constexpr int32_t kScanArcs = 64;
+
+// one_cycle's walk: next(at) is the first arc after arcs[0] leaving `at`, or -1.
+template <class Arc, class Next>
+bool walks_one_cycle(const Arc* arcs, int32_t count, Next&& next) {
   const int32_t start = arcs[0].from;
   int32_t at = arcs[0].to, steps = 1;
   while (at != start) {
     if (++steps > count) return false;  // a cycle that misses the start
-    int32_t next = -1;
-    for (int32_t j = 1; j < count; ++j)
-      if (arcs[j].from == at) {
-        next = j;
-        break;
-      }
-    if (next < 0) return false;  // a path's end
-    at = arcs[next].to;
+    const int32_t j = next(at);
+    if (j < 0) return false;  // a path's end
+    at = arcs[j].to;
   }
   return steps == count;
+}
+
+template <class Arc>
+bool one_cycle(const Arc* arcs, int32_t count) {
+  if (count < 3) return false;  // two arcs a -> b, b -> a are one triangle twice
+  if (count <= kScanArcs)
+    return walks_one_cycle(arcs, count, [&](int32_t at) {
+      for (int32_t j = 1; j < count; ++j)
+        if (arcs[j].from == at) return j;
+      return int32_t(-1);
+    });
+  std::vector<std::pair<int32_t, int32_t>> by_tail;  // (from, index) of arcs 1..count-1, sorted
+  by_tail.reserve(size_t(count - 1));
+  for (int32_t j = 1; j < count; ++j) by_tail.push_back({arcs[j].from, j});
+  std::sort(by_tail.begin(), by_tail.end());
+  return walks_one_cycle(arcs, count, [&](int32_t at) {
+    const auto found = std::lower_bound(by_tail.begin(), by_tail.end(), std::pair<int32_t, int32_t>{at, 0});
+    return found != by_tail.end() && found->first == at ? found->second : int32_t(-1);
+  });
 }
 
 }  // namespace topstoc

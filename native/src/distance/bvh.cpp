@@ -161,6 +161,16 @@ TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int6
   parallel_for(0, m, 100000, [&](int32_t s) {
     std::copy_n(&unordered[9 * size_t(order[s])], 9, &corners_[9 * size_t(s)]);
   });
+  build_slabs();
+}
+
+// The squared distance from p to the node's slab (0 inside), less a margin for the rounding of
+// the dot products (relative 1e-12, as kPruneSlack): a lower bound of the distance to its triangles.
+inline double TriangleBvh::slab_distance2(const double* p, int32_t node) const {
+  const Slab& slab = slabs_[size_t(node)];
+  const double d = slab.normal[0] * p[0] + slab.normal[1] * p[1] + slab.normal[2] * p[2];
+  const double gap = std::max(slab.lo - d, d - slab.hi) - 1e-12 * (std::abs(d) + std::abs(slab.lo) + std::abs(slab.hi));
+  return gap > 0.0 ? gap * gap : 0.0;
 }
 
 int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items) {
@@ -240,22 +250,34 @@ ClosestHit TriangleBvh::closest(const double* p, int32_t hint_slot, double withi
   };
   Entry stack[128];
   int depth = 0;
-  Entry entry{0, box_distance2(p, nodes_[0].lo, nodes_[0].hi)};
+  // With slabs (slivers' fans), an exact query orders and prunes nodes by the larger of the box's
+  // and the slab's distance: the slivers' boxes all hold p, so the boxes alone would not tell the
+  // near ones. (The answer does not depend on the order.) A query that stops `within2` keeps the
+  // boxes' order, which decides the hit it stops at; the slabs only prune nodes that hold no
+  // triangle as near as the best hit, so it finds the same hits.
+  const bool slabs = !slabs_.empty(), slab_order = slabs && !(within2 >= 0.0);
+  auto bound = [&](int32_t i) {
+    const double box = box_distance2(p, nodes_[i].lo, nodes_[i].hi);
+    return slab_order ? std::max(box, slab_distance2(p, i)) : box;
+  };
+  auto slab_keeps = [&](const Entry& e, double reach) {
+    return !slabs || slab_order || !(slab_distance2(p, e.node) > reach);
+  };
+  Entry entry{0, bound(0)};
   for (;;) {
     if (hit.distance2 <= within2) break;
-    if (!(entry.distance2 > hit.distance2 * kPruneSlack)) {
+    if (!(entry.distance2 > hit.distance2 * kPruneSlack) && slab_keeps(entry, hit.distance2 * kPruneSlack)) {
       const Node& node = nodes_[entry.node];
       if (node.count > 0) {
         for (int32_t s = node.first; s < node.first + node.count; ++s) consider(s);
       } else {
         const int32_t left = entry.node + 1, right = node.first;
-        const double dl = box_distance2(p, nodes_[left].lo, nodes_[left].hi);
-        const double dr = box_distance2(p, nodes_[right].lo, nodes_[right].hi);
+        const double dl = bound(left), dr = bound(right);
         const Entry nearer = dl <= dr ? Entry{left, dl} : Entry{right, dr};
         const Entry farther = dl <= dr ? Entry{right, dr} : Entry{left, dl};
         const double reach = hit.distance2 * kPruneSlack;
-        if (farther.distance2 <= reach) stack[depth++] = farther;
-        if (nearer.distance2 <= reach) {
+        if (farther.distance2 <= reach && slab_keeps(farther, reach)) stack[depth++] = farther;
+        if (nearer.distance2 <= reach && slab_keeps(nearer, reach)) {
           entry = nearer;
           continue;
         }

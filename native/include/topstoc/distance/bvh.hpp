@@ -40,6 +40,8 @@ class TriangleBvh {
 
   int64_t num_triangles() const { return int64_t(triangle_ids_.size()); }
   int64_t num_nodes() const { return int64_t(nodes_.size()); }
+  /// Whether the nodes carry slabs (see Slab): only where many triangles are slivers.
+  bool has_slabs() const { return !slabs_.empty(); }
 
   struct Node {
     double lo[3], hi[3];
@@ -57,7 +59,18 @@ class TriangleBvh {
   /// Builds the subtree over items [begin, end), which it reorders.
   int32_t build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items);
 
+  /// Per node, where slivers are common (a fan's centre, a cone's apex): the node's corners lie
+  /// between lo and hi along a unit normal of its triangles. The slivers' axis-aligned boxes all
+  /// reach the centre and overlap; the slab is thin across them, so a query prunes the far ones.
+  struct Slab {
+    double normal[3];
+    double lo, hi;
+  };
+  void build_slabs();
+  double slab_distance2(const double* p, int32_t node) const;
+
   std::vector<Node> nodes_;
+  std::vector<Slab> slabs_;              ///< empty, or one per node
   std::vector<double> corners_;          ///< 9 coordinates per slot, in leaf order
   std::vector<int32_t> triangle_ids_;    ///< caller's triangle id per slot
 };

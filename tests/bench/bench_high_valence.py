@@ -1,0 +1,152 @@
+#!/usr/bin/python3
+"""Vertices of very high valence (issue 39, "no slow corner"): decimation time on fans of
+slivers around one vertex, next to another build of the engine in the same run.
+
+    /usr/bin/python3 tests/bench/bench_high_valence.py
+    /usr/bin/python3 tests/bench/bench_high_valence.py --baseline /tmp/main-build/python \\
+        --json docs/bench_results/bench_high_valence.json
+
+The family: a double cone (two apexes joined to a rim of n vertices, 2n triangles, closed genus
+0) at n = 10,000 to 80,000; and what an artist meets: a UV sphere of 2,000 segments
+(poles of valence 2,000), a disc fanned from one centre of valence 50,000 (open boundary) and a
+CAD-like cylinder of 5,000 segments whose caps are fans. Each mesh is decimated to 10 % of its
+vertices in each mode of --modes, seed 0, in a fresh process per build with TOPSTOC_NUM_THREADS=1; the time
+is decimate() alone (the Mesh is prepared before the clock starts), the best of --repeat runs.
+--baseline runs the same in a process importing topstoc from that folder (main's build: the
+figures before a change), with a time limit (a quadratic build can take minutes).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import pathlib
+import subprocess
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from machine import machine, save_figures  # noqa: E402
+
+CASES = [("cone", 10000), ("cone", 20000), ("cone", 40000), ("cone", 80000), ("uv_sphere", 2000),
+         ("fan_disc", 50000), ("cylinder_caps", 5000)]
+
+CHILD = r"""
+import json, sys, time
+import numpy as np
+import topstoc as ts
+
+def cone(n):
+    a = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    P = np.vstack([np.c_[np.cos(a), np.sin(a), np.zeros(n)], [0, 0, 1], [0, 0, -1]])
+    i = np.arange(n); j = (i + 1) % n
+    return P, np.vstack([np.c_[i, j, np.full(n, n)], np.c_[j, i, np.full(n, n + 1)]])
+
+def uv_sphere(segments, rings=50):
+    # rings - 1 circles of `segments` vertices between two poles
+    theta = np.pi * np.arange(1, rings) / rings
+    a = np.linspace(0, 2 * np.pi, segments, endpoint=False)
+    P = np.vstack([np.c_[np.outer(np.sin(theta), np.cos(a)).ravel(), np.outer(np.sin(theta), np.sin(a)).ravel(),
+                         np.repeat(np.cos(theta), segments)], [0, 0, 1], [0, 0, -1]])
+    s = np.arange(segments); t = (s + 1) % segments
+    top, bottom = len(P) - 2, len(P) - 1
+    T = [np.c_[s, t, np.full(segments, top)][:, [1, 0, 2]]]
+    for r in range(rings - 2):
+        a0, b0 = r * segments + s, r * segments + t
+        a1, b1 = a0 + segments, b0 + segments
+        T += [np.c_[a0, a1, b0], np.c_[b0, a1, b1]]
+    last = (rings - 2) * segments
+    T.append(np.c_[last + s, np.full(segments, bottom), last + t])
+    return P, np.vstack(T)
+
+def fan_disc(n):
+    a = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    P = np.vstack([np.c_[np.cos(a), np.sin(a), np.zeros(n)], [0, 0, 0]])
+    i = np.arange(n)
+    return P, np.c_[i, (i + 1) % n, np.full(n, n)]
+
+def cylinder_caps(segments, rows=4):
+    a = np.linspace(0, 2 * np.pi, segments, endpoint=False)
+    z = np.linspace(0, 1, rows + 1)
+    P = np.vstack([np.c_[np.tile(np.cos(a), rows + 1), np.tile(np.sin(a), rows + 1), np.repeat(z, segments)],
+                   [0, 0, 0], [0, 0, 1]])
+    s = np.arange(segments); t = (s + 1) % segments
+    T = []
+    for r in range(rows):
+        a0, b0 = r * segments + s, r * segments + t
+        T += [np.c_[a0, b0, a0 + segments], np.c_[b0, b0 + segments, a0 + segments]]
+    low, high = len(P) - 2, len(P) - 1
+    T += [np.c_[t, s, np.full(segments, low)], np.c_[rows * segments + s, rows * segments + t, np.full(segments, high)]]
+    return P, np.vstack(T)
+
+shape, size, repeat = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+P, T = globals()[shape](size)
+mesh = ts.Mesh(P, T)
+out = {"triangles": int(len(T)), "vertices": int(len(P))}
+for mode in sys.argv[4].split(","):
+    best = None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        result = ts.decimate(mesh, ratio=0.1, mode=mode, seed=0)
+        seconds = time.perf_counter() - start
+        best = seconds if best is None else min(best, seconds)
+    out[mode] = {"seconds": best, "output_triangles": int(result.num_triangles)}
+print(json.dumps(out))
+"""
+
+
+def run(python_path: str, shape: str, size: int, repeat: int, modes: str, limit: float):
+    """The child's figures for one mesh, or None when it ran past `limit` seconds."""
+    env = dict(os.environ, PYTHONPATH=python_path, TOPSTOC_NUM_THREADS="1")
+    try:
+        done = subprocess.run([sys.executable, "-c", CHILD, shape, str(size), str(repeat), modes], env=env,
+                              capture_output=True, text=True, timeout=limit, check=True)
+    except subprocess.TimeoutExpired:
+        return None
+    return json.loads(done.stdout.splitlines()[-1])
+
+
+def describe(row: dict, mode: str, args) -> str:
+    """One mode's time, and the baseline's beside it when there is one."""
+    ours, base = row["ours"], row.get("baseline")
+    text = f"{mode} {ours[mode]['seconds']:.2f} s" if ours else f"{mode} over {args.limit:.0f} s"
+    if args.baseline and base and ours:
+        text += f" (baseline {base[mode]['seconds']:.2f} s, {base[mode]['seconds'] / ours[mode]['seconds']:.1f}x)"
+    elif args.baseline:
+        text += " (baseline " + (f"{base[mode]['seconds']:.2f} s)" if base else f"over {args.limit:.0f} s)")
+    return text
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--baseline", metavar="DIR", help="another build's python folder, run beside this one")
+    parser.add_argument("--repeat", type=int, default=2, help="runs per mode (the best is kept)")
+    parser.add_argument("--limit", type=float, default=600.0, help="seconds allowed per mesh and build")
+    parser.add_argument("--modes", default="quality,fast", help="comma-separated modes to time")
+    parser.add_argument("--json", metavar="FILE", help="write the figures and the machine here")
+    args = parser.parse_args()
+    modes = args.modes.split(",")
+    ours = str(ROOT / "build" / "python")
+    print(f"machine: {machine()}")
+    rows = []
+    for shape, size in CASES:
+        row = {"shape": shape, "size": size, "ours": run(ours, shape, size, args.repeat, args.modes, args.limit)}
+        if args.baseline:
+            row["baseline"] = run(args.baseline, shape, size, args.repeat, args.modes, args.limit)
+        rows.append(row)
+        print(f"{shape:14} {size:>7,}: " + ", ".join(describe(row, mode, args) for mode in modes), flush=True)
+        if args.json:  # after every mesh: a run stopped part-way keeps the meshes done
+            save_figures(args.json, "tests/bench/bench_high_valence.py",
+                         "decimate() to 10 % of the vertices, seed 0, one thread, best of --repeat runs in a fresh "
+                         "process per mesh and build; baseline: the same with main's build",
+                         ratio=0.1, repeat=args.repeat, modes=modes, limit_s=args.limit, meshes=rows)
+    cones = [r for r in rows if r["shape"] == "cone" and r["ours"]]
+    for mode in modes:
+        t0, t1 = cones[0]["ours"][mode]["seconds"], cones[-1]["ours"][mode]["seconds"]
+        print(f"cone {mode}: {cones[-1]['size'] / cones[0]['size']:.0f}x the triangles took {t1 / t0:.1f}x the time")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
