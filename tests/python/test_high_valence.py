@@ -14,37 +14,7 @@ import topstoc
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 import reference  # noqa: E402
-
-
-def cone(n):
-    a = np.linspace(0, 2 * np.pi, n, endpoint=False)
-    P = np.vstack([np.c_[np.cos(a), np.sin(a), np.zeros(n)], [0, 0, 1], [0, 0, -1]])
-    i = np.arange(n)
-    j = (i + 1) % n
-    return P, np.vstack([np.c_[i, j, np.full(n, n)], np.c_[j, i, np.full(n, n + 1)]])
-
-
-def fan_disc(n):
-    a = np.linspace(0, 2 * np.pi, n, endpoint=False)
-    P = np.vstack([np.c_[np.cos(a), np.sin(a), np.zeros(n)], [0, 0, 0]])
-    i = np.arange(n)
-    return P, np.c_[i, (i + 1) % n, np.full(n, n)]
-
-
-def cylinder_caps(segments, rows=3):
-    a = np.linspace(0, 2 * np.pi, segments, endpoint=False)
-    z = np.linspace(0, 1, rows + 1)
-    P = np.vstack([np.c_[np.tile(np.cos(a), rows + 1), np.tile(np.sin(a), rows + 1), np.repeat(z, segments)],
-                   [0, 0, 0], [0, 0, 1]])
-    s = np.arange(segments)
-    t = (s + 1) % segments
-    T = []
-    for r in range(rows):
-        a0, b0 = r * segments + s, r * segments + t
-        T += [np.c_[a0, b0, a0 + segments], np.c_[b0, b0 + segments, a0 + segments]]
-    low, high = len(P) - 2, len(P) - 1
-    T += [np.c_[t, s, np.full(segments, low)], np.c_[rows * segments + s, rows * segments + t, np.full(segments, high)]]
-    return P, np.vstack(T)
+from fan_meshes import cone, cylinder_caps, fan_disc  # noqa: E402
 
 
 # Fast mode on the double cone does not keep its topology, on main before this test too: the
