@@ -324,12 +324,10 @@ class Fit {
     return error;
   }
 
-  // The least-squares positions of the free vertices for the current pairs; false when the
-  // normal equations are singular.
-  bool solve(std::vector<double>& x) const {
-    if (large_) return solve_sparse(x);
-    const size_t k = free_.size();
-    std::vector<double> a(k * k, 0.0), rhs(3 * k, 0.0);
+  // The pairs' terms of the normal equations: add(row, column, value) for the matrix, the
+  // right-hand sides (three a row) into rhs; the dense and the sparse solve share it.
+  template <class Add>
+  void add_pairs(Add add, std::vector<double>& rhs) const {
     for (const Pair& pair : pairs_) {
       const int32_t* c = &faces_[3 * size_t(pair.face)];
       double fixed[3] = {pair.target[0], pair.target[1], pair.target[2]};
@@ -340,10 +338,19 @@ class Fit {
         const int32_t r = unknown_[c[j]];
         if (r < 0 || pair.b[j] == 0.0) continue;
         for (int l = 0; l < 3; ++l)
-          if (unknown_[c[l]] >= 0) a[size_t(r) * k + size_t(unknown_[c[l]])] += pair.weight * pair.b[j] * pair.b[l];
+          if (unknown_[c[l]] >= 0) add(r, unknown_[c[l]], pair.weight * pair.b[j] * pair.b[l]);
         for (int i = 0; i < 3; ++i) rhs[3 * size_t(r) + i] += pair.weight * pair.b[j] * fixed[i];
       }
     }
+  }
+
+  // The least-squares positions of the free vertices for the current pairs; false when the
+  // normal equations are singular.
+  bool solve(std::vector<double>& x) const {
+    if (large_) return solve_sparse(x);
+    const size_t k = free_.size();
+    std::vector<double> a(k * k, 0.0), rhs(3 * k, 0.0);
+    add_pairs([&](int32_t r, int32_t l, double v) { a[size_t(r) * k + size_t(l)] += v; }, rhs);
     double trace = 0.0;
     for (size_t r = 0; r < k; ++r) trace += a[r * k + r];
     const double stay = kStay * trace / double(k);
@@ -361,20 +368,7 @@ class Fit {
     const int32_t k = int32_t(free_.size());
     SparseNormal a(faces_, unknown_, k);
     std::vector<double> rhs(3 * size_t(k), 0.0);
-    for (const Pair& pair : pairs_) {
-      const int32_t* c = &faces_[3 * size_t(pair.face)];
-      double fixed[3] = {pair.target[0], pair.target[1], pair.target[2]};
-      for (int j = 0; j < 3; ++j)
-        if (unknown_[c[j]] < 0)
-          for (int i = 0; i < 3; ++i) fixed[i] -= pair.b[j] * c_.position(c[j])[i];
-      for (int j = 0; j < 3; ++j) {
-        const int32_t r = unknown_[c[j]];
-        if (r < 0 || pair.b[j] == 0.0) continue;
-        for (int l = 0; l < 3; ++l)
-          if (unknown_[c[l]] >= 0) a.add(r, unknown_[c[l]], pair.weight * pair.b[j] * pair.b[l]);
-        for (int i = 0; i < 3; ++i) rhs[3 * size_t(r) + i] += pair.weight * pair.b[j] * fixed[i];
-      }
-    }
+    add_pairs([&](int32_t r, int32_t l, double v) { a.add(r, l, v); }, rhs);
     double trace = 0.0;
     for (int32_t r = 0; r < k; ++r) trace += a.diagonal(r);
     const double stay = kStay * trace / double(k);
