@@ -33,3 +33,16 @@ def test_fans_keep_topology(shape, size, mode):
     used = np.unique(out)
     assert len(used) == len(result.vertices)  # no vertex left without a triangle
     assert np.all(np.isfinite(result.vertices))
+
+
+def test_fast_capped_cylinder_past_the_repair_rounds():
+    # 7,000 segments at 10 %: each repair round splits one cluster per cap and the 200 rounds run
+    # out before the caps' fans are clean; the result must still keep the topology (a closed
+    # tube: one sphere).
+    vertices, triangles = cylinder_caps(7000)
+    result = topstoc.decimate(topstoc.Mesh(vertices, triangles), ratio=0.1, mode="fast", seed=0)
+    out = np.asarray(result.triangles)
+    assert reference.invariants(len(result.vertices), out) == reference.invariants(len(vertices), triangles)
+    assert reference.degenerate_or_duplicate(out) == (0, 0)
+    assert len(result.vertices) <= 0.1 * len(vertices) + 1
+    assert np.array_equal(result.vertices, vertices[result.kept])  # fast mode keeps input positions
