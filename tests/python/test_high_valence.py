@@ -46,3 +46,15 @@ def test_fast_capped_cylinder_past_the_repair_rounds():
     assert reference.degenerate_or_duplicate(out) == (0, 0)
     assert len(result.vertices) <= 0.1 * len(vertices) + 1
     assert np.array_equal(result.vertices, vertices[result.kept])  # fast mode keeps input positions
+
+
+def test_fast_cone_draft_is_the_full_result():
+    # At 1,000 the draw for the target is clean and a lower draw stalls: the draft (the Live
+    # Preview) must not show that lower draw's broken surface.
+    vertices, triangles = cone(1000)
+    mesh = topstoc.Mesh(vertices, triangles)
+    draft = topstoc.decimate(mesh, ratio=0.25, mode="fast", seed=0, draft=True)
+    full = topstoc.decimate(mesh, ratio=0.25, mode="fast", seed=0)
+    assert reference.invariants(len(draft.vertices), np.asarray(draft.triangles)) == \
+        reference.invariants(len(vertices), triangles)
+    assert np.array_equal(draft.kept, full.kept) and np.array_equal(draft.triangles, full.triangles)

@@ -776,8 +776,9 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
   // A pass above its target (a stalled one, or one whose topology needed more vertices than
   // drawn) is collapsed the rest of the way. A draft that did not stall stays the plain pass
   // (a drag stays fast on high-genus meshes at tiny targets); the rest's full result does not.
+  // (The pass kept may be a lower draw that stalled where the draw for the target did not.)
   if (!refined && excess(best) > tolerance) {
-    if (params.draft && !stalled) {
+    if (params.draft && best.issues_remaining.topological() == 0) {
       best.collapses_skipped = true;
     } else if (params.draft) {
       // The collapses follow the result's labels and corners, which a draft leaves out.
