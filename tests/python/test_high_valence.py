@@ -58,3 +58,17 @@ def test_fast_cone_draft_is_the_full_result():
     assert reference.invariants(len(draft.vertices), np.asarray(draft.triangles)) == \
         reference.invariants(len(vertices), triangles)
     assert np.array_equal(draft.kept, full.kept) and np.array_equal(draft.triangles, full.triangles)
+
+
+@pytest.mark.parametrize("mode", ["quality", "fast"])
+def test_cone_refined_from_a_smaller_first_pass(mode):
+    # refine=4: the collapses start from a first pass of four times the target, not the whole
+    # mesh (as quality mode does on meshes past 8 x QUALITY_COLLAPSES vertices: the double cone of
+    # n = 80,000). That pass stalls on the cone and was collapsed broken.
+    vertices, triangles = cone(4000)
+    result = topstoc.decimate(topstoc.Mesh(vertices, triangles), ratio=0.1, mode=mode, seed=0, refine=4)
+    out = np.asarray(result.triangles)
+    assert result.stats.topology_kept
+    assert reference.invariants(len(result.vertices), out) == reference.invariants(len(vertices), triangles)
+    assert reference.degenerate_or_duplicate(out) == (0, 0)
+    assert len(result.vertices) <= 0.1 * len(vertices) + 1

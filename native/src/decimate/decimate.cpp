@@ -854,6 +854,15 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   if (params.warm_up && (first.target_vertices != active || !params.collapse_snapshots || target_triangles > 0))
     return {};  // a first pass that depends on the target: no state a later decimation could resume from
   DecimateResult result = stochastic_pass(mesh, layout, first, true);
+  // A first pass whose repairs left issues may be broken (the double cone of n = 80,000): the
+  // collapses would keep it so. If its check rejects it, the first pass is the whole mesh.
+  if (result.issues_remaining.topological() > 0 && first.target_vertices != active) {
+    check_result(mesh, layout, result);
+    if (result.output_check.violations() > 0) {
+      first.target_vertices = active;
+      result = stochastic_pass(mesh, layout, first, true);
+    }
+  }
   const std::vector<double> multipliers = multipliers_if_guided(mesh, params.sampling);
   RefineParams refine;
   refine.target_vertices = params.target_vertices;
