@@ -138,9 +138,10 @@ class Collapser {
   const double* world(int32_t v) const { return &s_.world[3 * size_t(v)]; }
   const double* position(int32_t v) const { return &s_.positions[3 * size_t(v)]; }
   bool is_free(int32_t v) const { return s_.curve[v] < 0 && !s_.locked[v]; }
-  /// Free, or an unlocked vertex of a mesh boundary (which has no other side to keep).
+  /// On a boundary of the mesh (an open scan's rim).
   bool on_mesh_boundary(int32_t v) const { return !s_.on_boundary.empty() && s_.on_boundary[v]; }
-  bool fittable(int32_t v) const { return is_free(v) || (!s_.locked[v] && !s_.on_boundary.empty() && s_.on_boundary[v]); }
+  /// Free, or an unlocked vertex of a mesh boundary (which has no other side to keep).
+  bool fittable(int32_t v) const { return is_free(v) || (!s_.locked[v] && on_mesh_boundary(v)); }
   int32_t vertices() const { return static_cast<int32_t>(merged_into_.size()); }
   /// The caller's coordinates in the normalised ones of position().
   void normalise(const double* world, double* out) const {
