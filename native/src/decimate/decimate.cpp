@@ -711,6 +711,27 @@ void collapse_rest(const Mesh& mesh, const FeatureLayout& layout, const Decimate
   refine_by_collapses(mesh, layout, rest, result);
 }
 
+// One edge of each zero-area triangle collapsed (never an output with a zero-area triangle).
+void collapse_zero_area(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
+                        DecimateResult& result) {
+  const std::vector<double> multipliers = multipliers_if_guided(mesh, params.sampling);
+  RefineParams cleanup;
+  cleanup.multipliers = or_null(multipliers);
+  cleanup.zero_area_only = true;
+  refine_by_collapses(mesh, layout, cleanup, result);
+}
+
+// Every vertex a sample (the input itself, which passes every check), collapsed to the target
+// keeping input positions: what a plain pass falls back to when its repairs left it broken.
+DecimateResult collapsed_from_whole_mesh(const Mesh& mesh, const FeatureLayout& layout,
+                                         const DecimateParams& params) {
+  const int32_t active = active_vertices(mesh);
+  DecimateResult whole = decimate_once(mesh, layout, params, active, active, nullptr);
+  collapse_rest(mesh, layout, params, whole);
+  if (has_zero_area(whole)) collapse_zero_area(mesh, layout, params, whole);
+  return verified(mesh, layout, std::move(whole));
+}
+
 // TopStoc to params.target_vertices. `refined`: a first pass the refinement thins next, which
 // removes zero-area triangles and whose output is checked after it, so neither happens here
 // (except the check that decides whether a fast-path miss must be redone).
@@ -755,8 +776,9 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
   // A pass above its target (a stalled one, or one whose topology needed more vertices than
   // drawn) is collapsed the rest of the way. A draft that did not stall stays the plain pass
   // (a drag stays fast on high-genus meshes at tiny targets); the rest's full result does not.
+  // (The pass kept may be a lower draw that stalled where the draw for the target did not.)
   if (!refined && excess(best) > tolerance) {
-    if (params.draft && !stalled) {
+    if (params.draft && best.issues_remaining.topological() == 0) {
       best.collapses_skipped = true;
     } else if (params.draft) {
       // The collapses follow the result's labels and corners, which a draft leaves out.
@@ -777,11 +799,7 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
       full.draft = false;
       return stochastic_pass(mesh, layout, full, refined);
     }
-    const std::vector<double> multipliers = multipliers_if_guided(mesh, params.sampling);
-    RefineParams cleanup;
-    cleanup.multipliers = or_null(multipliers);
-    cleanup.zero_area_only = true;
-    refine_by_collapses(mesh, layout, cleanup, best);
+    collapse_zero_area(mesh, layout, params, best);
   }
   // A draft's output is not re-checked; a fast-path result is, since the check decides
   // whether it must be redone.
@@ -795,6 +813,11 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
     every_face.fast_path = 0;
     return stochastic_pass(mesh, layout, every_face, refined);
   }
+  // Repairs that ran out of rounds can leave a surface the final check rejects: on a double cone
+  // a sampled apex, one hop from every rim vertex and first on ties, keeps rim pieces in its
+  // cluster, and a round frees one. Collapsing that kept it wrong: start from the whole mesh.
+  if (!refined && best.issues_remaining.topological() > 0 && best.output_check.violations() > 0)
+    return collapsed_from_whole_mesh(mesh, layout, params);
   return reported(std::move(best));  // checked above
 }
 
@@ -831,6 +854,15 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   if (params.warm_up && (first.target_vertices != active || !params.collapse_snapshots || target_triangles > 0))
     return {};  // a first pass that depends on the target: no state a later decimation could resume from
   DecimateResult result = stochastic_pass(mesh, layout, first, true);
+  // A first pass whose repairs left issues may be broken (the double cone of n = 80,000): the
+  // collapses would keep it so. If its check rejects it, the first pass is the whole mesh.
+  if (result.issues_remaining.topological() > 0 && first.target_vertices != active) {
+    check_result(mesh, layout, result);
+    if (result.output_check.violations() > 0) {
+      first.target_vertices = active;
+      result = stochastic_pass(mesh, layout, first, true);
+    }
+  }
   const std::vector<double> multipliers = multipliers_if_guided(mesh, params.sampling);
   RefineParams refine;
   refine.target_vertices = params.target_vertices;
