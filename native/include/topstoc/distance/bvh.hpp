@@ -36,7 +36,9 @@ class TriangleBvh {
   /// search up: nearby queries usually have nearby answers. `within2` >= 0: stop at the first
   /// triangle found within that squared distance (its point, attained, not the closest); a point
   /// farther than that from every triangle gets the same exact answer as without it.
-  ClosestHit closest(const double* p, int32_t hint_slot = -1, double within2 = -1.0) const;
+  /// `tested` (if given) is increased by the triangles the search measured: its work.
+  ClosestHit closest(const double* p, int32_t hint_slot = -1, double within2 = -1.0,
+                     int64_t* tested = nullptr) const;
 
   int64_t num_triangles() const { return int64_t(triangle_ids_.size()); }
   int64_t num_nodes() const { return int64_t(nodes_.size()); }
