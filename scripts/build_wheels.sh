@@ -42,9 +42,12 @@ command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache) 
   pip_launcher=(--config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache)
 
 # --- the package's files: pip's build frontend drives scikit-build-core and CMake -------------
+# ccache keys a compile on the compiler's name and the paths relative to the checkout: built in
+# build-template/ (one level down, as build/) by c++ (as build/; scikit-build-core would name the
+# same gcc x86_64-linux-gnu-g++), the engine's objects are the host build's; only bindings compile.
 echo "== topstoc's files: pip wheel ."
-pip wheel . --no-build-isolation --no-deps -q --disable-pip-version-check -w "$OUT/template" \
-  "${pip_launcher[@]}" >"$OUT/template.log" 2>&1 ||
+CXX=c++ pip wheel . --no-build-isolation --no-deps -q --disable-pip-version-check -w "$OUT/template" \
+  --config-settings=build-dir=build-template "${pip_launcher[@]}" >"$OUT/template.log" 2>&1 ||
   { tail -40 "$OUT/template.log"; exit 1; }
 TEMPLATE=$(ls "$OUT"/template/topstoc-"$VERSION"-cp311-cp311-*.whl)
 
