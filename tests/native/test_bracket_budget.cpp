@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/portable.hpp"
 #include "distance/bounded_max.hpp"
 #include "topstoc/distance/bvh.hpp"
 
@@ -21,7 +22,7 @@ Surface fan(int32_t n) {
   std::vector<double> positions;
   std::vector<int32_t> triangles;
   for (int32_t i = 0; i < n; ++i) {
-    const double a = 2.0 * M_PI * i / n;
+    const double a = 2.0 * topstoc::kPi * i / n;
     positions.insert(positions.end(), {std::cos(a), std::sin(a), 0.0});
     triangles.insert(triangles.end(), {i, (i + 1) % n, n});
   }
@@ -50,7 +51,7 @@ double brute_force_max(const Surface& from, const Surface& to) {
 TEST_CASE("a bracket over a flat fan stops at its budget of measured triangles, and stays valid") {
   const Surface fine = fan(1500), coarse = fan(150);
   const double exact = brute_force_max(fine, coarse);
-  CHECK(exact == doctest::Approx(1.0 - std::cos(M_PI / 150)).epsilon(1e-3));  // the chords' sagitta
+  CHECK(exact == doctest::Approx(1.0 - std::cos(topstoc::kPi / 150)).epsilon(1e-3));  // the chords' sagitta
   for (const bool tree : {false, true}) {
     CAPTURE(tree);
     const int64_t budget = 4000;
