@@ -194,7 +194,7 @@ class MaxSearch {
   // The nearest point of the other surface to a point that need not lie on the sampled one.
   // hint: a slot found near x (the queue's order jumps about, so the previous query's is not).
   ClosestHit nearest(const double* x, int32_t hint) {
-    const ClosestHit hit = bvh.closest(x, hint, -1.0, &tested);
+    const ClosestHit hit = bvh.closest_counted(x, hint, tested);
     ++out.queries;
     return hit;
   }

@@ -224,14 +224,24 @@ int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>
   return index;
 }
 
-ClosestHit TriangleBvh::closest(const double* p, int32_t hint_slot, double within2, int64_t* tested) const {
+ClosestHit TriangleBvh::closest(const double* p, int32_t hint_slot, double within2) const {
+  return search<false>(p, hint_slot, within2, nullptr);
+}
+
+ClosestHit TriangleBvh::closest_counted(const double* p, int32_t hint_slot, int64_t& tested) const {
+  return search<true>(p, hint_slot, -1.0, &tested);
+}
+
+// kCounted: the measured triangles are added to *tested (apart, so that the plain lookup, on the
+// decimation's hot path, does no counting).
+template <bool kCounted>
+ClosestHit TriangleBvh::search(const double* p, int32_t hint_slot, double within2, int64_t* tested) const {
   ClosestHit hit;
-  int64_t measured = 0;
   hit.distance2 = std::numeric_limits<double>::infinity();
   // The triangle test has internal linkage so that it is called directly, not through the shared
   // module's PLT as the exported closest_point_on_triangle is.
   auto consider = [&](int32_t slot) {
-    ++measured;
+    if constexpr (kCounted) ++*tested;
     double q[3];
     const double* t = &corners_[9 * size_t(slot)];
     const double d2 = triangle_distance2(p, t, t + 3, t + 6, q);
@@ -288,7 +298,6 @@ ClosestHit TriangleBvh::closest(const double* p, int32_t hint_slot, double withi
     if (depth == 0) break;
     entry = stack[--depth];
   }
-  if (tested != nullptr) *tested += measured;
   return hit;
 }
 

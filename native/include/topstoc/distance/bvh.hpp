@@ -36,9 +36,9 @@ class TriangleBvh {
   /// search up: nearby queries usually have nearby answers. `within2` >= 0: stop at the first
   /// triangle found within that squared distance (its point, attained, not the closest); a point
   /// farther than that from every triangle gets the same exact answer as without it.
-  /// `tested` (if given) is increased by the triangles the search measured: its work.
-  ClosestHit closest(const double* p, int32_t hint_slot = -1, double within2 = -1.0,
-                     int64_t* tested = nullptr) const;
+  ClosestHit closest(const double* p, int32_t hint_slot = -1, double within2 = -1.0) const;
+  /// The same exact lookup, adding the triangles it measured (its work) to `tested`.
+  ClosestHit closest_counted(const double* p, int32_t hint_slot, int64_t& tested) const;
 
   int64_t num_triangles() const { return int64_t(triangle_ids_.size()); }
   int64_t num_nodes() const { return int64_t(nodes_.size()); }
@@ -57,6 +57,8 @@ class TriangleBvh {
   int32_t slot_triangle(int32_t slot) const { return triangle_ids_[std::size_t(slot)]; }
 
  private:
+  template <bool kCounted>
+  ClosestHit search(const double* p, int32_t hint_slot, double within2, int64_t* tested) const;
   struct BuildItem;
   /// Builds the subtree over items [begin, end), which it reorders.
   int32_t build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items);
