@@ -1,9 +1,12 @@
 # Mirrors addon/ into the staging folder (build/python/topstoc) and puts the extension manifest
-# next to __init__.py. Everything but the compiled module is replaced, so files deleted from
-# addon/ never linger in the staged package.
+# next to __init__.py. Files addon/ no longer has are removed, so none lingers in the staged
+# package; the others are copied only where they changed (file(COPY) skips a file of the same
+# timestamp), so staging an unchanged tree again touches nothing: a test that packs the zips
+# while other suites import the staged package (scripts/test.sh runs two lanes) cannot race them.
 file(GLOB_RECURSE old_files RELATIVE "${DST}" "${DST}/*")
 foreach(f IN LISTS old_files)
-  if(NOT f MATCHES "^_topstoc.*\\.so$")
+  if(NOT f MATCHES "^_topstoc.*\\.so$" AND NOT f STREQUAL "blender_manifest.toml" AND
+     (NOT EXISTS "${SRC}/${f}" OR f MATCHES "(^|/)__pycache__/|\\.pyc$"))
     file(REMOVE "${DST}/${f}")
   endif()
 endforeach()
@@ -27,4 +30,10 @@ if(start GREATER -1)
   string(SUBSTRING "${manifest}" 0 ${start} head)
   set(manifest "${head}\n${rest}")
 endif()
-file(WRITE "${DST}/blender_manifest.toml" "${manifest}")
+set(old_manifest "")
+if(EXISTS "${DST}/blender_manifest.toml")
+  file(READ "${DST}/blender_manifest.toml" old_manifest)
+endif()
+if(NOT old_manifest STREQUAL manifest)
+  file(WRITE "${DST}/blender_manifest.toml" "${manifest}")
+endif()
