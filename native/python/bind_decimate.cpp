@@ -204,6 +204,7 @@ DecimateParams params_from(const Mesh& mesh, const py::handle& job, JobArrays& a
   params.refine = job.attr("refine").cast<double>();
   params.refine_collapses = job.attr("refine_collapses").cast<int32_t>();
   params.draft = job.attr("draft").cast<bool>();
+  params.large_fit = job.attr("large_fit").cast<bool>();
   params.attributes = attributes_of(mesh, arrays, job.attr("attributes"), job.attr("attribute_weights"));
   return params;
 }
@@ -356,11 +357,12 @@ void bind_decimate(py::module_& m) {
         const int32_t refine_vertices = replay.attr("refine_vertices").cast<int32_t>();
         const int32_t refine_triangles = replay.attr("refine_triangles").cast<int32_t>();
         const bool refine_keeps_positions = replay.attr("refine_keeps_positions").cast<bool>();
+        const bool large_fit = replay.attr("large_fit").cast<bool>();
         DecimateResult r;
         {
           EngineCall call;
           r = decimate_with_samples(mesh, layout, std::move(ids), placement, max_repair_rounds, refine_vertices, u,
-                                    corner_attributes, refine_triangles, refine_keeps_positions);
+                                    corner_attributes, refine_triangles, refine_keeps_positions, large_fit);
         }
         return result_dict(std::move(r));
       },

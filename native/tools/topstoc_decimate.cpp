@@ -3,10 +3,11 @@
 // source; the same input, target and seed give the same bytes on all of them
 // (tests/python/test_native_driver.py compares the Linux and the Windows build's files).
 //
-//   topstoc_decimate IN OUT (--vertices N | --ratio R) [--seed S] [--mode fast|quality]
+//   topstoc_decimate IN OUT (--vertices N | --ratio R) [--seed S] [--mode fast|quality|best]
 //
 // IN and OUT: .obj .ply .off .stl (uncompressed). fast: the thesis' TopStoc (input positions);
-// quality: filtered placement and quadric collapses, as the Python API's mode="quality".
+// quality: filtered placement and quadric collapses, as the Python API's mode="quality"; best:
+// quality with the large results' fit too, as mode="best".
 // OUT is written to OUT.partial and renamed over OUT; it may not be IN.
 #include <algorithm>
 #include <cmath>
@@ -35,7 +36,7 @@ constexpr double kQualityRefine = 1.0;
 constexpr int32_t kQualityCollapses = 10000;
 
 const char* const kUsage =
-    "usage: topstoc_decimate IN OUT (--vertices N | --ratio R) [--seed S] [--mode fast|quality]\n";
+    "usage: topstoc_decimate IN OUT (--vertices N | --ratio R) [--seed S] [--mode fast|quality|best]\n";
 
 struct Options {
   std::string in, out, mode = "fast";
@@ -83,7 +84,8 @@ Options parse(int argc, char** argv) {
   if (positional != 2) throw UsageError("give an input and an output file");
   if ((o.vertices > 0) == (o.ratio > 0)) throw UsageError("give one target: --vertices N (N >= 1) or --ratio R");
   if (o.ratio > 1 || o.vertices > INT32_MAX) throw UsageError("the target must lie in (0, 1] or [1, 2^31)");
-  if (o.mode != "fast" && o.mode != "quality") throw UsageError("--mode must be fast or quality, got '" + o.mode + "'");
+  if (o.mode != "fast" && o.mode != "quality" && o.mode != "best")
+    throw UsageError("--mode must be fast, quality or best, got '" + o.mode + "'");
   return o;
 }
 
@@ -102,10 +104,11 @@ MeshFile decimated(const Options& o, const MeshFile& input, const Mesh& mesh) {
   DecimateParams params;
   params.target_vertices = target_of(o, mesh);
   params.sampling.seed = o.seed;
-  if (o.mode == "quality") {
+  if (o.mode != "fast") {
     params.placement = Placement::Filtered;
     params.refine = kQualityRefine;
     params.refine_collapses = kQualityCollapses;
+    params.large_fit = o.mode == "best";
   }
   RunningCall call;
   use_free_cores();

@@ -171,7 +171,7 @@ def test_presets_are_installed_and_apply(ts, scene):
 def test_quality_choice_maps_onto_engine_options(ts, scene):
     pipeline = ts.blender.decimation.pipeline
     settings = scene.topstoc
-    for quality, mode in (("FAST", "fast"), ("QUALITY", "quality")):
+    for quality, mode in (("FAST", "fast"), ("QUALITY", "quality"), ("BEST", "best")):
         settings.quality = quality
         options = pipeline.decimate_options(settings)
         assert options["mode"] == mode and "placement" not in options and "refine" not in options

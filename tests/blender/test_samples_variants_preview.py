@@ -200,3 +200,23 @@ def test_a_fast_result_collapsed_after_a_stall_restores(ts, scene):
     select_only(obj)
     assert bpy.ops.topstoc.restore_samples(name="Last") == {"FINISHED"}
     assert output_geometry(bpy.data.objects["Seam_Last"]) == output_geometry(first)
+
+
+def test_best_fits_a_large_result_and_restores_it(ts, scene):
+    # A result above 1,400 triangles of a mesh collapsed whole: Best fits it to the original
+    # (mode "best", the engine's large fit), Quality leaves it where the collapses put it.
+    vertices, triangles = meshgen.bumpy_torus(20_000)
+    obj = make_object("Bumps", vertices, triangles)
+    results = {}
+    for quality in ("QUALITY", "BEST"):
+        select_only(obj)
+        assert bpy.ops.topstoc.guided_decimate(target_mode="TRIANGLES", triangles=3000, seed=2,
+                                               quality=quality) == {"FINISHED"}
+        results[quality] = bpy.context.active_object
+    quality, best = (output_geometry(results[q]) for q in ("QUALITY", "BEST"))
+    assert best[1] == quality[1] and best[0] != quality[0]  # the same triangles, moved vertices
+    saved = obj.topstoc.sample_sets["Last"]
+    assert '"mode": "best"' in saved.parameters
+    select_only(obj)
+    assert bpy.ops.topstoc.restore_samples(name="Last") == {"FINISHED"}
+    assert output_geometry(bpy.data.objects["Bumps_Last"]) == best

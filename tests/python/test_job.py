@@ -80,7 +80,7 @@ def test_guidance_is_checked_once_for_an_error_bounded_search(fandisk, monkeypat
     (dict(ratio=0.1, adaptivity=2.0), "adaptivity must lie in [0, 1]"),
     (dict(ratio=0.1, symmetry="w"), "symmetry axis must be one of"),
     (dict(ratio=0.1, refine=0.5), "refine must be 0 (off) or a factor of at least 1"),
-    (dict(ratio=0.1, mode="best"), "mode must be one of"),
+    (dict(ratio=0.1, mode="finest"), "mode must be one of"),
 ])
 def test_bad_parameters_fail_when_the_job_is_made(fandisk, options, message):
     with pytest.raises(TopStocError) as error:

@@ -30,7 +30,7 @@ def test_driver_writes_what_the_python_cli_writes(tmp_path, source, fmt, args):
     (["--ratio", "1.5"], "the target must lie in"),
     (["--vertices", "-3"], "--vertices needs a non-negative number, got '-3'"),
     (["--vertices", "12x"], "--vertices needs a non-negative number, got '12x'"),
-    (["--vertices", "10", "--mode", "best"], "--mode must be fast or quality, got 'best'"),
+    (["--vertices", "10", "--mode", "finest"], "--mode must be fast, quality or best, got 'finest'"),
     (["--vertices", "10", "--colour"], "unknown option --colour"),
     (["--vertices"], "--vertices needs a value"),
 ])

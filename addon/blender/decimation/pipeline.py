@@ -74,7 +74,7 @@ def target_kwargs(panel) -> dict:
 
 
 #: the engine mode behind the panel's Quality choice (Custom: the Advanced placement and refinement)
-QUALITY_MODES = {"QUALITY": "quality", "FAST": "fast"}
+QUALITY_MODES = {"QUALITY": "quality", "BEST": "best", "FAST": "fast"}
 
 
 def decimate_options(panel) -> dict:
@@ -381,6 +381,7 @@ def restore(context, obj, name: str) -> Run:
                                                  refine_vertices=refine_vertices,
                                                  refine_triangles=int(parameters.get("refine_triangles", 0)),
                                                  refine_keeps_positions=bool(parameters.get("refine_keeps_positions")),
+                                                 large_fit=parameters.get("mode") == "best",
                                                  guidance=guidance.guidance if refine_vertices else None,
                                                  **guidance.layout_kwargs(), **attributes)
     return Run(obj, prepared, guidance, result, parameters, time.perf_counter() - start)

@@ -5,9 +5,11 @@ them); each output triangle comes from one input triangle and keeps its orientat
 topology of every manifold component (components, genus, boundary loops) is kept; where plain
 clustering would break it, samples are added and the result says how many.
 
-Two modes (``mode=``): ``"quality"`` (the default) runs TopStoc to a few times the target,
+Three modes (``mode=``): ``"quality"`` (the default) runs TopStoc to a few times the target,
 then quadric-ordered edge collapses thin it to the target (``refine``, filtered placement);
-``"fast"`` is the thesis' plain TopStoc (what the live preview shows while the slider moves).
+``"best"`` is quality with a last least-squares fit of the result to the input on large results
+too (smaller ones always get it): a lower mean error for more time; ``"fast"`` is the thesis'
+plain TopStoc (what the live preview shows while the slider moves).
 
 Guidance convention (docs/design.md §2.2): ``u`` in [-1, 1] per vertex. ``u = 0`` follows the global
 target; ``u > 0`` asks for more density, ``u < 0`` for less: a density multiplier
@@ -221,7 +223,11 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     (see QUALITY_COLLAPSES); "fast": the thesis' TopStoc, placement "subsample", no refinement
     (except where its pass ends above the target: repairs stalled on non-manifold or
     inconsistently oriented input, or a topology that needs more vertices than drawn; then the
-    collapses finish it, keeping input positions; docs/design.md §2.7).
+    collapses finish it, keeping input positions; docs/design.md §2.7); "best": quality, then
+    a result above 1,400 triangles whose collapses started from the whole mesh (up to
+    8 * QUALITY_COLLAPSES vertices) is fitted to the input as smaller ones always are, each
+    move kept only where the max error does not grow (about 10 % lower mean error on scans for
+    1.4-1.6 times quality's time; docs/bench_notes/large-fit.md).
     placement and refine, when given, override what the mode sets.
     placement: "subsample" keeps the first pass's input positions, "filtered" moves surface
     vertices to the quadric-optimal point of their cluster (borders stay). In quality mode the
@@ -275,7 +281,7 @@ def run_job(mesh: Mesh, job: DecimationJob, progress=None, cancel: Optional[Canc
 
         result, report = search_vertex_count(mesh, job.target.max_error, lambda count: run_job(mesh, job.at(count), cancel=cancel),
                                              relative=job.target.relative, progress=progress,
-                                             check_passes=job.mode == "quality")
+                                             check_passes=job.mode != "fast")
         return dataclasses.replace(result, error_bound=report, parameters={
             **result.parameters, "max_error": job.target.max_error, "relative": job.target.relative})
     layout, floods, snapshots = mesh.kept_for_reuse(job.regions, job.borders, job.feature_angle)
@@ -339,6 +345,7 @@ class SampleReplay:
     refine_vertices: int = 0
     refine_triangles: int = 0
     refine_keeps_positions: bool = False
+    large_fit: bool = False
     guidance: Optional[np.ndarray] = None           #: u per vertex (guidance_values), or None
     attributes: Optional[np.ndarray] = None         #: corner values (attribute_arrays), or None
     attribute_weights: Optional[np.ndarray] = None  #: one weight per attribute channel, or None
@@ -346,15 +353,15 @@ class SampleReplay:
 
 def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, feature_angle: float = 0.0,
                           placement: str = "subsample", refine_vertices: int = 0, refine_triangles: int = 0,
-                          refine_keeps_positions: bool = False, guidance=None, attributes=None,
-                          attribute_weights=None) -> DecimateResult:
+                          refine_keeps_positions: bool = False, large_fit: bool = False, guidance=None,
+                          attributes=None, attribute_weights=None) -> DecimateResult:
     """Re-creates a decimation from ``DecimateResult.samples`` (thesis 4.1.3).
 
     With the same mesh, regions, borders, feature angle and placement the output is identical.
     A refined result (``refine`` > 0) also needs ``refine_vertices=result.stats.refine_vertices``,
     ``refine_triangles=result.stats.refine_triangles``,
     ``refine_keeps_positions=result.stats.refine_keeps_positions`` and the same ``guidance`` and
-    ``attributes``.
+    ``attributes``; one of mode "best" also ``large_fit=True``.
     """
     if placement not in PLACEMENTS:
         raise TopStocError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
@@ -368,12 +375,12 @@ def decimate_with_samples(mesh: Mesh, samples, *, regions=None, borders=None, fe
     layout = mesh.feature_layout(regions, borders, feature_angle)
     replay = SampleReplay(samples, placement, refine_vertices=int(refine_vertices),
                           refine_triangles=int(refine_triangles), refine_keeps_positions=bool(refine_keeps_positions),
-                          guidance=guidance_values(mesh, guidance),
+                          large_fit=bool(large_fit), guidance=guidance_values(mesh, guidance),
                           attributes=attribute_values, attribute_weights=attribute_weights)
     raw = engine.decimate_with_samples(mesh.native, layout, replay)
     return _result(raw, dict(samples=len(samples), placement=placement, feature_angle=feature_angle,
                              refine_vertices=int(refine_vertices), refine_triangles=int(refine_triangles),
-                             refine_keeps_positions=bool(refine_keeps_positions)), mesh)
+                             refine_keeps_positions=bool(refine_keeps_positions), large_fit=bool(large_fit)), mesh)
 
 
 def sampling_probabilities(mesh: Mesh, rate: float, *, adaptivity: float = 0.5,

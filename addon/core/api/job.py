@@ -26,7 +26,7 @@ if TYPE_CHECKING:  # for annotations only
 
 DENSITY_MODES = ("off", "uniform", "adaptive", "euclidean")
 PLACEMENTS = ("subsample", "filtered")
-MODES = ("quality", "fast")
+MODES = ("quality", "fast", "best")
 #: quality mode: the collapses remove at most max(QUALITY_COLLAPSES, target / 4) vertices
 #: after a stochastic first pass (the time then grows with the target, not with the mesh), and
 #: start from the whole mesh when it has at most 8 * QUALITY_COLLAPSES vertices (the lowest
@@ -252,6 +252,11 @@ class DecimationJob:
     symmetry_tolerance: Optional[float] = None
 
     @property
+    def large_fit(self) -> bool:
+        """Whether large refined results are fitted to the input too (the engine's large_fit): mode "best"."""
+        return self.mode == "best"
+
+    @property
     def control_points(self) -> int:
         """Vertices the guidance keeps whatever the target."""
         return 0 if self.guidance is None else int(np.count_nonzero(self.guidance >= CONTROL_POINT))
@@ -311,7 +316,7 @@ def resolve_placement(mode: str, placement: Optional[str], symmetry=None) -> str
 def resolve_refine(mode: str, refine) -> tuple:
     """(refine, refine_collapses) for a mode and the caller's choice (None: the mode's own)."""
     if refine is None:
-        return (QUALITY_REFINE, QUALITY_COLLAPSES) if mode == "quality" else (0.0, 0)
+        return (QUALITY_REFINE, QUALITY_COLLAPSES) if mode != "fast" else (0.0, 0)
     wanted = "0 (off) or a factor of at least 1"
     refine = params.number("refine", refine, 0, expected=wanted)
     if 0 < refine < 1:

@@ -67,9 +67,9 @@ class Appearance:
 
 def refines(mode: str = "quality", refine=None) -> bool:
     """Whether a decimation with these ``decimate`` options runs the refinement, the only stage
-    that uses attributes: quality mode unless ``refine`` is 0, fast mode when ``refine`` > 0."""
+    that uses attributes: quality and best modes unless ``refine`` is 0, fast mode when ``refine`` > 0."""
     if refine is None:
-        return mode == "quality"
+        return mode != "fast"
     return float(refine) > 0
 
 

@@ -19,7 +19,7 @@ from ..batch.settings import parse_max_error
 from ..api.budget import missed_dict, missed_text
 from ..support.errors import TopStocError
 from ..api.io import mesh_format, read_mesh
-from ..api.job import ATTRIBUTE_WEIGHT
+from ..api.job import ATTRIBUTE_WEIGHT, MODES
 from ..api.mesh_file_job import prepare_file
 from ..support.output_guard import add_overwrite_argument, prepare_output
 from ..api.symmetry import AXES
@@ -46,9 +46,11 @@ def add_parser(subparsers) -> None:
                         help="0 samples uniformly, 1 follows curvature fully (default 0.5)")
     parser.add_argument("--density", choices=DENSITIES, default="off",
                         help="Poisson-disk density control of the samples (default off)")
-    parser.add_argument("--mode", choices=("quality", "fast"), default="quality",
+    parser.add_argument("--mode", choices=MODES, default="quality",
                         help="quality (default): TopStoc to a few times the target, then quadric edge "
-                             "collapses; fast: the thesis' plain TopStoc (milliseconds, higher deviation)")
+                             "collapses; best: quality, then large results fitted to the input too (lower "
+                             "mean deviation, about 1.5x the time); fast: the thesis' plain TopStoc "
+                             "(milliseconds, higher deviation)")
     parser.add_argument("--placement", choices=("subsample", "filtered"), default=None,
                         help="keep input positions, or move surface vertices to their cluster's "
                              "quadric-optimal point (default: filtered in quality mode, subsample in fast)")

@@ -870,6 +870,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   refine.multipliers = or_null(multipliers);
   refine.refit = params.placement == Placement::Filtered;
   refine.max_aware = refine.refit;
+  refine.large_fit = params.large_fit;
   refine.attributes = params.attributes;
   refine.snapshots = params.collapse_snapshots;
   refine.warm_up = params.warm_up;
@@ -904,7 +905,7 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
 DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layout, std::vector<int32_t> samples,
                                      Placement placement, int32_t max_repair_rounds, int32_t refine_vertices,
                                      const double* guidance, const CornerAttributes& attributes,
-                                     int32_t refine_triangles, bool refine_keeps_positions) {
+                                     int32_t refine_triangles, bool refine_keeps_positions, bool large_fit) {
   if (samples.empty()) throw std::invalid_argument("the sample list is empty");
   for (size_t i = 0; i < samples.size(); ++i) {
     const int32_t v = samples[i];
@@ -950,6 +951,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
     refine.refit = refine_vertices > 0 && placement == Placement::Filtered;
     refine.max_aware = refine.refit;
     refine.keep_positions = refine_keeps_positions;
+    refine.large_fit = large_fit;
     refine.attributes = attributes;
     refine_by_collapses(mesh, layout, refine, result);
   }

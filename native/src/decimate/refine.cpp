@@ -736,7 +736,7 @@ class Refinement {
   // against the whole input).
   void finish(Collapser& collapser, std::shared_ptr<const Surface> whole = nullptr, double known_max = -1.0) {
     const int32_t faces = collapser.live_faces(), rounds = fit_rounds(faces);
-    if (params.refit && rounds > 0 && (faces <= kFitFaces || (known_max > 0.0 && large_fit_enabled()))) {
+    if (params.refit && rounds > 0 && (faces <= kFitFaces || (known_max > 0.0 && params.large_fit))) {
       const int64_t step = faces <= kFitFaces ? fit_input_step(mesh) : 1;
       const std::shared_ptr<const Surface> input = step == 1 && whole ? whole : kept_input(collapser, step);
       fit_tiny(mesh, collapser, rounds, faces <= kTinyFitFaces, *input, known_max);

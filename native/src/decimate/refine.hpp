@@ -52,6 +52,8 @@ struct RefineParams {
   /// last collapses, each vertex's cost weighed by how far the runs before ended from the input
   /// there, and keep the best run (a smaller max error, for the time of the reruns).
   bool max_aware = false;
+  /// With refit and max_aware: results above kFitFaces are fitted too (DecimateParams::large_fit).
+  bool large_fit = false;
   /// Every collapse a half-edge collapse (no optimal placement): the output keeps input
   /// positions, as fast mode promises.
   bool keep_positions = false;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <optional>
 
@@ -505,11 +504,6 @@ class Fit {
 };
 
 }  // namespace
-
-bool large_fit_enabled() {
-  const char* text = std::getenv("TOPSTOC_LARGE_FIT");
-  return text && text[0] == '1';
-}
 
 int64_t fit_input_step(const Mesh& mesh) {
   return std::max<int64_t>(1, (int64_t(mesh.num_faces()) + kFitTriangles - 1) / kFitTriangles);

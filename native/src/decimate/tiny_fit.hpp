@@ -30,11 +30,6 @@ struct TinyFit {
   double after2 = 0.0;       ///< and after the last kept one
 };
 
-/// Whether results above kFitFaces are fitted: off unless the environment sets
-/// TOPSTOC_LARGE_FIT=1: its CPU is above what the Live Preview's rest affords
-/// (docs/bench_notes/large-fit.md has the figures).
-bool large_fit_enabled();
-
 /// The step between the input triangles the fit measures against (1: all of them): at most
 /// 200,000 are taken, evenly (deviation.hpp's normalised_input with this step is `input` below).
 int64_t fit_input_step(const Mesh& mesh);

@@ -83,6 +83,10 @@ struct DecimateParams {
   /// nothing where a decimation would keep no state (no snapshots, guidance, a triangle
   /// target, a mesh not collapsed whole, not max-aware); refine_vertices > 0 tells it did.
   bool warm_up = false;
+  /// A refined result above kFitFaces triangles whose max error the refinement measured (a mesh
+  /// collapsed whole) is fitted to the input too, as smaller ones always are (tiny_fit.hpp):
+  /// a lower mean error for more time (docs/bench_notes/large-fit.md). The API's mode "best".
+  bool large_fit = false;
   /// Internal (a refined decimation's first pass): labels in the mesh's vertex order.
   bool labels_in_mesh_order = false;
 };
@@ -139,7 +143,7 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
                                      Placement placement, int32_t max_repair_rounds = 200,
                                      int32_t refine_vertices = 0, const double* guidance = nullptr,
                                      const CornerAttributes& attributes = {}, int32_t refine_triangles = 0,
-                                     bool refine_keeps_positions = false);
+                                     bool refine_keeps_positions = false, bool large_fit = false);
 
 /// Decimates to about `target_triangles` output triangles (within 1 % where the mesh allows),
 /// re-decimating with a corrected vertex target up to `max_iterations` times.
