@@ -24,11 +24,12 @@ def at_our_count(ours: dict, peer: dict | None) -> bool:
     return bool(peer) and peer["triangles"] <= ours["triangles"] * (1 + COUNT_SLACK) + 2
 
 
-def goal_ratios(case: dict) -> tuple[float | None, float | None]:
-    """(mean ÷ the better of Blender and MeshLab, max ÷ the best peer), None where no such peer
-    reached our count."""
+def goal_ratios(case: dict, mode: str = "quality") -> tuple[float | None, float | None]:
+    """(mean ÷ the better of Blender and MeshLab, max ÷ the best peer) of our result in ``mode``,
+    None where no such peer reached our count (the peers decimate to the quality result's count,
+    which the best mode's result shares: its fit only moves vertices)."""
     tools = case["tools"]
-    ours = tools.get("topstoc quality")
+    ours = tools.get(f"topstoc {mode}")
     if not ours:
         return None, None
     means = [tools[n]["mean"] for n in ("Blender Collapse", "MeshLab") if at_our_count(ours, tools.get(n))]
