@@ -102,7 +102,7 @@ def goal_lines(cases: list) -> list:
     modes = [m for m in ("quality", "best") if any(c["tools"].get(f"topstoc {m}") for c in cases)]
     for mode, index in ((mode, index) for mode in modes for index in range(2)):
         what, median_goal, every_goal = goals[index]
-        what = f"{what} ({mode} mode)"
+        what = f"{what} ({mode} mode)" if len(modes) > 1 else what
         ranked = [(goal_ratios(c, mode)[index], c) for c in cases if goal_ratios(c, mode)[index] is not None]
         if not ranked:
             continue

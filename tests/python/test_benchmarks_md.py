@@ -101,6 +101,12 @@ def test_quality_results_state_the_goals_per_case_and_name_the_worst():
     assert "| a.off | 0.5% | 100 | 0.50 | 2.00 | yes |" in text
     assert "| b.off | 50 triangles | 100 (topology) | 2.00 | 2.00 | yes |" in text
     assert "2 cases (2 meshes × 0.5%, 50 triangles)" in text
+    # a run with mode "best" too: the goal lines per mode, best's against the same peers
+    cases[0]["tools"]["topstoc best"] = _tool(0.5, 1.0, 1.2, 10.0)
+    text = benchmarks_md.render_quality("q.json", {"benchmark": "tests/bench/bench_quality.py", "machine": "m",
+                                                   "date": "2000-01-01", "samples": 1000, "cases": cases})
+    assert "max ÷ the best peer (quality mode): median 2.000 (goal ≤ 1.0)" in text
+    assert "mean ÷ the better of Blender and MeshLab (best mode): median 0.250 (goal ≤ 0.9), worst 0.25" in text
 
 
 def test_scale_results_render_ratios_and_growth():
