@@ -103,7 +103,7 @@ def goal_lines(cases: list) -> list:
     for mode, index in ((mode, index) for mode in modes for index in range(2)):
         what, median_goal, every_goal = goals[index]
         what = f"{what} ({mode} mode)" if len(modes) > 1 else what
-        ranked = [(goal_ratios(c, mode)[index], c) for c in cases if goal_ratios(c, mode)[index] is not None]
+        ranked = [(ratio, c) for c in cases if (ratio := goal_ratios(c, mode)[index]) is not None]
         if not ranked:
             continue
         worst, case = max(ranked, key=lambda pair: pair[0])

@@ -63,8 +63,8 @@ run() {  # run NAME COMMAND...: prints the suite's wall time and the cores it ke
   echo "== $name"
   # A suite that hangs (a Blender that never exits) fails after 40 minutes instead of stalling CI.
   local times=$LOGS/cpu.$BASHPID  # one file per lane
-  if /usr/bin/time -q -o "$times" -f "%U %S" timeout -k 30 2400 "$@"; then local verdict=passed
-  else local verdict=FAILED; echo "$name" >>"$FAILED"; fi
+  local verdict=passed
+  /usr/bin/time -q -o "$times" -f "%U %S" timeout -k 30 2400 "$@" || { verdict=FAILED; echo "$name" >>"$FAILED"; }
   local wall=$((SECONDS - start))
   cpu=$(awk -v wall=$wall 'END {printf "%.0f s CPU, %.1f cores", $1 + $2, ($1 + $2) / (wall ? wall : 1)}' "$times")
   echo "== $name: $verdict ($wall s, $cpu)" | tee -a "$LOGS/summary"
@@ -92,20 +92,7 @@ host_lane() {
 }
 
 other_lane() {
-  [ -d tests/blender ] &&
-    run "add-on as an extension in Blender 4.2 (bpy)" env TOPSTOC_BPY=1 $VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/blender
-  # The later Blenders test the add-on's interface to them: the long engine and shading checks
-  # (marked heavy) run in 3.4 and 4.2 only.
-  local version venv
-  for version in "${BPY_311[@]}"; do
-    venv=$CACHE/venvs/bpy-$version
-    [ -d tests/blender ] || break
-    if scripts/bpy_venv.sh "$venv" "$version" /usr/bin/python3; then
-      run "add-on as an extension in Blender $version (bpy)" env TOPSTOC_BPY=1 $venv/bin/python -m pytest "${PYTEST_ARGS[@]}" -m "not heavy" tests/blender
-    else
-      echo "bpy $version venv" >>"$FAILED"
-    fi
-  done
+  [ -d tests/blender ] && bpy_suites
   [ -d tests/gui ] && run "real Blender GUI under Xvfb" $VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/gui
   if [ "$(id -u)" != 0 ]; then
     echo "== skipped: bpy $BPY_313, Blender 4.3, release files and Linux aarch64 (chroot and binfmt_misc need root: run as root)"
@@ -113,6 +100,21 @@ other_lane() {
   fi
   debian13_suites
   release_suites
+}
+
+bpy_suites() {
+  run "add-on as an extension in Blender 4.2 (bpy)" env TOPSTOC_BPY=1 $VENV/bin/python -m pytest "${PYTEST_ARGS[@]}" tests/blender
+  # The later Blenders test the add-on's interface to them: the long engine and shading checks
+  # (marked heavy) run in 3.4 and 4.2 only.
+  local version venv
+  for version in "${BPY_311[@]}"; do
+    venv=$CACHE/venvs/bpy-$version
+    if scripts/bpy_venv.sh "$venv" "$version" /usr/bin/python3; then
+      run "add-on as an extension in Blender $version (bpy)" env TOPSTOC_BPY=1 $venv/bin/python -m pytest "${PYTEST_ARGS[@]}" -m "not heavy" tests/blender
+    else
+      echo "bpy $version venv" >>"$FAILED"
+    fi
+  done
 }
 
 # Debian 13 root (made once, cached): CPython 3.13 for bpy 5.2 and a real Blender 4.3 for the GUI.

@@ -320,7 +320,7 @@ def summarize(cases) -> None:
     for mode, index in ((mode, index) for mode in ("quality", "best") for index in range(2)):
         what, goal_median, goal_every = goals[index]
         what = f"{mode}: {what}"
-        ranked = sorted(((goal_ratios(c, mode)[index], c) for c in cases if goal_ratios(c, mode)[index] is not None),
+        ranked = sorted(((ratio, c) for c in cases if (ratio := goal_ratios(c, mode)[index]) is not None),
                         key=lambda pair: pair[0])
         if not ranked:
             continue
