@@ -548,6 +548,7 @@ void Collapser::offer(int32_t x, int32_t v, int32_t removed, double c) {
 // boundary, two for a crease, k for a non-manifold edge of k sheets) is a fan from the curve's
 // other edge to this one and holds exactly one of the edge's triangles.
 bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
+  if (size_[u] > kWideFan || size_[v] > kWideFan) return allowed_wide(u, v, scratch);
   std::vector<uint32_t>& mark = scratch.mark;
   const uint32_t su = ++scratch.stamp;
   int32_t nu = 0, faces_u = 0;
@@ -600,6 +601,69 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
   return shaped_placement(u, v, x) >= 0;
 }
 
+// allowed() where an end has more than kWideFan faces (the apex of a cone, the centre of a
+// fanned disc): the same conditions, but what walks a wide end's faces comes last, after the
+// cheap ones, and the link is read from the narrow end's neighbours, so that most refusals cost
+// a few faces instead of the valence.
+bool Collapser::allowed_wide(int32_t u, int32_t v, Scratch& scratch) const {
+  const int32_t narrow = size_[u] <= size_[v] ? u : v, wide = narrow == u ? v : u;
+  int32_t on_edge[kMaxSheets], count = 0;
+  for (const int32_t* t = faces_begin(narrow); t != faces_end(narrow); ++t)
+    if (has(*t, wide)) {
+      if (count == kMaxSheets) return false;
+      on_edge[count++] = *t;
+    }
+  if (count == 0) return false;
+  const int32_t cu = s_.curve[u];
+  if (cu < 0 && count != 2) return false;
+  if (cu >= 0 && ((s_.curve[v] != cu && !s_.locked[v]) ||
+                  (s_.curve_closed[cu] ? s_.curve_size[cu] <= 3 : !curve_keeps_an_edge(cu))))
+    return false;
+  const int32_t shared = common_neighbours(narrow, wide, scratch);
+  if (shared != count || duplicates_a_face(u, v, on_edge, count)) return false;
+  if (cu >= 0 && merges_unlike_edges(u, v, on_edge, count)) return false;
+  double x[3];
+  if (shaped_placement(u, v, x) < 0) return false;
+  const int32_t nu = count_neighbours(u, INT32_MAX, scratch), faces_u = size_[u];
+  if (cu < 0 ? nu != faces_u : !curve_fans(u, nu, faces_u, on_edge, count)) return false;
+  const int32_t need = shared + (count == 1 && rescue_ ? 4 : 5) - nu;
+  return need <= 0 || count_neighbours(v, need, scratch) >= need;
+}
+
+// How many neighbours a (a itself not counted) and b have in common, from a's faces.
+int32_t Collapser::common_neighbours(int32_t a, int32_t b, Scratch& scratch) const {
+  const uint32_t stamp = ++scratch.stamp;
+  int32_t shared = 0;
+  for (const int32_t* t = faces_begin(a); t != faces_end(a); ++t)
+    for (int j = 0; j < 3; ++j) {
+      const int32_t w = (*tri_)[3 * size_t(*t) + j];
+      if (w == a || w == b || scratch.mark[w] == stamp) continue;
+      scratch.mark[w] = stamp;
+      shared += faces_holding(w, b, 1) > 0;
+    }
+  return shared;
+}
+
+// v's distinct neighbours, counted up to `enough`.
+int32_t Collapser::count_neighbours(int32_t v, int32_t enough, Scratch& scratch) const {
+  const uint32_t stamp = ++scratch.stamp;
+  int32_t found = 0;
+  for (const int32_t* t = faces_begin(v); t != faces_end(v) && found < enough; ++t)
+    for (int j = 0; j < 3; ++j) {
+      const int32_t w = (*tri_)[3 * size_t(*t) + j];
+      if (w != v && scratch.mark[w] != stamp) scratch.mark[w] = stamp, ++found;
+    }
+  return found;
+}
+
+// The triangles holding both a and b, counted up to `enough`, from the shorter face list.
+int32_t Collapser::faces_holding(int32_t a, int32_t b, int32_t enough) const {
+  if (size_[a] > size_[b]) std::swap(a, b);
+  int32_t found = 0;
+  for (const int32_t* t = faces_begin(a); t != faces_end(a) && found < enough; ++t) found += has(*t, b);
+  return found;
+}
+
 // Where collapsing u into v puts v: 1 at the quadric optimum, 0 elsewhere on the edge, -1
 // nowhere (a triangle around the point would be too thin: the shape rule). In a rescue (run)
 // a free pair whose point fails the rule may keep v where it is instead (0).
@@ -640,7 +704,8 @@ bool Collapser::curve_keeps_an_edge(int32_t curve) const {
 
 // Would collapsing u into v turn a triangle (u, a, b) into one v already has? Only possible when
 // a and b are both opposite the edge, which the link condition allows; around a non-manifold
-// vertex (a sealed wing on a non-manifold edge) that would delete the wing.
+// vertex (a sealed wing on a non-manifold edge) that would delete the wing. Read from the
+// opposite vertices' faces, so a wide u or v is not walked.
 bool Collapser::duplicates_a_face(int32_t u, int32_t v, const int32_t* on_edge, int32_t count) const {
   if (count < 2) return false;
   int32_t opposite[kMaxSheets];
@@ -649,18 +714,16 @@ bool Collapser::duplicates_a_face(int32_t u, int32_t v, const int32_t* on_edge, 
       const int32_t w = (*tri_)[3 * size_t(on_edge[i]) + j];
       if (w != u && w != v) opposite[i] = w;
     }
-  auto is_opposite = [&](int32_t w) { return std::find(opposite, opposite + count, w) != opposite + count; };
-  for (const int32_t* t = faces_begin(u); t != faces_end(u); ++t) {
-    if (has(*t, v)) continue;
-    int32_t pair[2], found = 0;
-    for (int j = 0; j < 3; ++j) {
-      const int32_t w = (*tri_)[3 * size_t(*t) + j];
-      if (w != u && is_opposite(w)) pair[found++] = w;
-    }
-    if (found < 2) continue;
-    for (const int32_t* f = faces_begin(v); f != faces_end(v); ++f)
-      if (has(*f, pair[0]) && has(*f, pair[1])) return true;
-  }
+  auto holds = [&](int32_t a, int32_t b, int32_t c) {
+    const int32_t shortest = size_[a] <= size_[b] ? a : b;
+    for (const int32_t* t = faces_begin(shortest); t != faces_end(shortest); ++t)
+      if (has(*t, a) && has(*t, b) && has(*t, c)) return true;
+    return false;
+  };
+  for (int32_t i = 0; i < count; ++i)
+    for (int32_t k = i + 1; k < count; ++k)
+      if (opposite[i] != opposite[k] && holds(opposite[i], opposite[k], u) && holds(opposite[i], opposite[k], v))
+        return true;
   return false;
 }
 
@@ -675,11 +738,8 @@ bool Collapser::merges_unlike_edges(int32_t u, int32_t v, const int32_t* on_edge
       const int32_t w = (*tri_)[3 * size_t(on_edge[i]) + j];
       if (w != u && w != v) o = w;
     }
-    int32_t at_u = 0, at_v = 0;
-    for (const int32_t* t = faces_begin(u); t != faces_end(u); ++t) at_u += has(*t, o);
-    if (at_u == 2) continue;
-    for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) at_v += has(*t, o);
-    if (at_v != 2) return true;
+    if (faces_holding(u, o, 3) == 2) continue;
+    if (faces_holding(v, o, 3) != 2) return true;
   }
   return false;
 }
@@ -739,14 +799,25 @@ bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, Shape
     // thinner than kMinShape already and stays within half of it.
     const double edges = squared_edges(c, moved, x);
     if (!thinner(len2, edges, min_shape_ * min_shape_)) continue;
-    if (floor.value2 < 0.0)
-      floor.value2 = floor.b < 0 ? shape_floor2(floor.a) : std::min(shape_floor2(floor.a), shape_floor2(floor.b));
-    if (thinner(len2, edges, floor.value2) &&
-        (!thinner(area2, squared_edges(c, moved, p), min_shape_ * min_shape_) ||
-         thinner(len2, edges, 0.25 * min_shape_ * min_shape_)))
+    if ((!thinner(area2, squared_edges(c, moved, p), min_shape_ * min_shape_) ||
+         thinner(len2, edges, 0.25 * min_shape_ * min_shape_)) &&
+        below_floor(len2, edges, floor))
       return false;
   }
   return true;
+}
+
+// Is a triangle thinner than the floor of the move, the lower of its ends' floors? Thinner than
+// both, that is: the end with fewer faces is read first, and the other only when needed.
+bool Collapser::below_floor(double twice_area2, double edges, ShapeFloor& floor) const {
+  int32_t first = floor.a, second = floor.b;
+  double *first2 = &floor.a2, *second2 = &floor.b2;
+  if (second >= 0 && size_[second] < size_[first]) std::swap(first, second), std::swap(first2, second2);
+  if (*first2 < 0.0) *first2 = shape_floor2(first);
+  if (!thinner(twice_area2, edges, *first2)) return false;
+  if (second < 0) return true;
+  if (*second2 < 0.0) *second2 = shape_floor2(second);
+  return thinner(twice_area2, edges, *second2);
 }
 
 // Shape quality 2 sqrt(3) |n| / (sum of squared edges) of triangle c with `replace` at `at`

@@ -194,6 +194,12 @@ class Collapser {
   }
   bool queues(int32_t u) const { return !s_.locked[u] && !at_quota(u); }
   bool allowed(int32_t u, int32_t v, Scratch& scratch) const;
+  // An end with more faces than this is checked by allowed_wide (its walks last).
+  static constexpr int32_t kWideFan = 64;
+  bool allowed_wide(int32_t u, int32_t v, Scratch& scratch) const;
+  int32_t common_neighbours(int32_t a, int32_t b, Scratch& scratch) const;
+  int32_t count_neighbours(int32_t v, int32_t enough, Scratch& scratch) const;
+  int32_t faces_holding(int32_t a, int32_t b, int32_t enough) const;
   int shaped_placement(int32_t u, int32_t v, double x[3]) const;
   bool is_dead_end(int32_t v) const { return !s_.dead_end.empty() && s_.dead_end[v]; }
   bool curve_fans(int32_t u, int32_t nu, int32_t faces_u, const int32_t* on_edge, int32_t count) const;
@@ -204,9 +210,10 @@ class Collapser {
   // The shape floor of one move or collapse (shape_floor2 of its ends), found when a triangle
   // first ends below kMinShape: most moves leave none there.
   struct ShapeFloor {
-    int32_t a, b;          // the ends (b = -1: a move)
-    double value2 = -1.0;  // not found yet
+    int32_t a, b;                // the ends (b = -1: a move)
+    double a2 = -1.0, b2 = -1.0;  // their shape_floor2 (-1: not read yet)
   };
+  bool below_floor(double twice_area2, double edges, ShapeFloor& floor) const;
   bool keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const;
   double shape_floor2(int32_t v) const;
   double shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const;
