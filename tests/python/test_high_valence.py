@@ -14,7 +14,7 @@ import topstoc
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 import reference  # noqa: E402
-from fan_meshes import cone, cylinder_caps, fan_disc  # noqa: E402
+from fan_meshes import cone, cylinder_caps, fan_disc, uv_sphere  # noqa: E402
 
 
 @pytest.mark.parametrize("mode", ["quality", "fast"])
@@ -72,3 +72,20 @@ def test_cone_refined_from_a_smaller_first_pass(mode):
     assert reference.invariants(len(result.vertices), out) == reference.invariants(len(vertices), triangles)
     assert reference.degenerate_or_duplicate(out) == (0, 0)
     assert len(result.vertices) <= 0.1 * len(vertices) + 1
+
+
+@pytest.mark.parametrize("ratio", [0.1, 0.02])
+def test_uv_sphere_first_pass_is_not_below_its_budget(ratio):
+    # A UV sphere of 2,000 segments (98,002 vertices): quality mode's first pass was drawn far
+    # over its budget at the poles, its lower draws went down to 1 sample, and the repairs made
+    # 2,104 vertices of it: the result missed a 10 % target (2,104 for 9,800) and its faces lay
+    # up to 0.53 of the radius inside the sphere. Measured against the sphere itself: the radial
+    # deviation of points spread over every output triangle.
+    vertices, triangles = uv_sphere(2000)
+    result = topstoc.decimate(topstoc.Mesh(vertices, triangles), ratio=ratio, mode="quality", seed=0)
+    assert len(result.vertices) == round(ratio * len(vertices))
+    corners = np.asarray(result.vertices)[np.asarray(result.triangles)]
+    weights = np.array([(a, b, 1 - a - b) for a in np.linspace(0, 1, 7) for b in np.linspace(0, 1, 7) if a + b <= 1])
+    points = np.einsum("sk,fkd->fsd", weights, corners).reshape(-1, 3)
+    deviation = np.abs(1 - np.linalg.norm(points, axis=1))
+    assert deviation.max() < 0.1 and deviation.mean() < 0.002

@@ -704,8 +704,8 @@ bool Collapser::curve_keeps_an_edge(int32_t curve) const {
 
 // Would collapsing u into v turn a triangle (u, a, b) into one v already has? Only possible when
 // a and b are both opposite the edge, which the link condition allows; around a non-manifold
-// vertex (a sealed wing on a non-manifold edge) that would delete the wing. Read from the
-// opposite vertices' faces, so a wide u or v is not walked.
+// vertex (a sealed wing on a non-manifold edge) that would delete the wing. Each triangle is
+// looked for in the shortest face list of its corners, so a wide u, v or opposite is not walked.
 bool Collapser::duplicates_a_face(int32_t u, int32_t v, const int32_t* on_edge, int32_t count) const {
   if (count < 2) return false;
   int32_t opposite[kMaxSheets];
@@ -714,8 +714,9 @@ bool Collapser::duplicates_a_face(int32_t u, int32_t v, const int32_t* on_edge, 
       const int32_t w = (*tri_)[3 * size_t(on_edge[i]) + j];
       if (w != u && w != v) opposite[i] = w;
     }
-  auto holds = [&](int32_t a, int32_t b, int32_t c) {
-    const int32_t shortest = size_[a] <= size_[b] ? a : b;
+  auto holds = [&](int32_t a, int32_t b, int32_t c) {  // a triangle (a, b, c), from the shortest list
+    int32_t shortest = size_[a] <= size_[b] ? a : b;
+    if (size_[c] < size_[shortest]) shortest = c;
     for (const int32_t* t = faces_begin(shortest); t != faces_end(shortest); ++t)
       if (has(*t, a) && has(*t, b) && has(*t, c)) return true;
     return false;
