@@ -286,18 +286,29 @@ int32_t Collapser::remove_thin(double min_shape, Stop keep) {
   std::vector<int32_t> candidates;
   for (int32_t t = 0; t < m; ++t)
     if (flagged[t]) candidates.push_back(t);
+  // On a fan of slivers (a corner of more than kWideFan faces) a collapse's survivor waits for
+  // the next round: each collapse there leaves the next sliver as thin, and collapsing that one
+  // into the same survivor swept a whole arc into one triangle (a fanned disc's rim: a wedge of
+  // 1.8 radians at 10 %). Once a round per vertex, the collapses spread evenly.
+  std::vector<int32_t> took(min_shape > 0.0 ? merged_into_.size() : 0, -1);
+  auto waits = [&](int32_t x, int32_t round) { return !took.empty() && took[x] == round; };
+  auto in_fan = [&](const int32_t* c) {
+    return size_[c[0]] > kWideFan || size_[c[1]] > kWideFan || size_[c[2]] > kWideFan;
+  };
   int32_t collapses = 0;
-  for (bool progress = !candidates.empty(); progress;) {
+  for (int32_t round = 0, progress = !candidates.empty(); progress; ++round) {
     progress = false;
     for (int32_t t : candidates) {
       if (reached(keep)) return collapses;
       if (!alive_face_[t] || !(zero_area(t) || thin(t, min_shape))) continue;
       const int32_t* c = &(*tri_)[3 * size_t(t)];
+      const bool fan = !took.empty() && in_fan(c);
       for (int j = 0; j < 6; ++j) {
         const int32_t u = c[j % 3], v = c[(j % 3 + (j < 3 ? 1 : 2)) % 3];
-        if (s_.locked[u] || !allowed(u, v, scratch_[0])) continue;
+        if (s_.locked[u] || (fan && (waits(u, round) || waits(v, round))) || !allowed(u, v, scratch_[0])) continue;
         collapse(u, v);
         refresh(u, v);
+        if (fan) took[v] = round;
         ++collapses;
         progress = true;
         break;
