@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 
 
 namespace topstoc {
@@ -48,6 +49,8 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
       pool_[begin_[v] + size_[v]++] = int32_t(t);
     }
   alive_face_.assign(m, 1);
+  for (int32_t v = 0; v < n && !tracking_floors_; ++v) tracking_floors_ = size_[v] > kWideFan;
+  if (tracking_floors_) floor_bound_.assign(n, FloorBound());
   dirty_.assign(n, 0);
   placed_.assign(n, 0);
   merged_into_.assign(n, -1);
@@ -265,7 +268,7 @@ bool Collapser::place(int32_t v, const double* world, int32_t face) {
   double* w = &s_.world[3 * size_t(v)];
   double keep_p[3], keep_w[3];
   for (int i = 0; i < 3; ++i) keep_p[i] = p[i], keep_w[i] = w[i], p[i] = at[i], w[i] = world[i];
-  if (!zero_area(face)) return true;
+  if (!zero_area(face)) return moved_floor_bounds(v), true;
   for (int i = 0; i < 3; ++i) p[i] = keep_p[i], w[i] = keep_w[i];  // no gain: back
   return false;
 }
@@ -286,10 +289,11 @@ int32_t Collapser::remove_thin(double min_shape, Stop keep) {
   std::vector<int32_t> candidates;
   for (int32_t t = 0; t < m; ++t)
     if (flagged[t]) candidates.push_back(t);
-  // On a fan of slivers (a corner of more than kWideFan faces) a collapse's survivor waits for
-  // the next round: each collapse there leaves the next sliver as thin, and collapsing that one
-  // into the same survivor swept a whole arc into one triangle (a fanned disc's rim: a wedge of
-  // 1.8 radians at 10 %). Once a round per vertex, the collapses spread evenly.
+  // On a fan of slivers (a corner of more than kWideFan faces) a triangle beside a collapse's
+  // survivor waits for the next round: each collapse there leaves the next sliver as thin, and
+  // collapsing that one into the same survivor swept a whole arc into one triangle (a fanned
+  // disc's rim: a wedge of 1.8 radians at 10 %). Once a round per vertex, the collapses spread
+  // evenly, and never into the fan's centre instead.
   std::vector<int32_t> took(min_shape > 0.0 ? merged_into_.size() : 0, -1);
   auto waits = [&](int32_t x, int32_t round) { return !took.empty() && took[x] == round; };
   auto in_fan = [&](const int32_t* c) {
@@ -303,9 +307,10 @@ int32_t Collapser::remove_thin(double min_shape, Stop keep) {
       if (!alive_face_[t] || !(zero_area(t) || thin(t, min_shape))) continue;
       const int32_t* c = &(*tri_)[3 * size_t(t)];
       const bool fan = !took.empty() && in_fan(c);
+      if (fan && (waits(c[0], round) || waits(c[1], round) || waits(c[2], round))) continue;
       for (int j = 0; j < 6; ++j) {
         const int32_t u = c[j % 3], v = c[(j % 3 + (j < 3 ? 1 : 2)) % 3];
-        if (s_.locked[u] || (fan && (waits(u, round) || waits(v, round))) || !allowed(u, v, scratch_[0])) continue;
+        if (s_.locked[u] || !allowed(u, v, scratch_[0])) continue;
         collapse(u, v);
         refresh(u, v);
         if (fan) took[v] = round;
@@ -767,56 +772,99 @@ bool Collapser::merges_unlike_edges(int32_t u, int32_t v, const int32_t* on_edge
 // triangles keeps the freedom CAD meshes' long strips need (without it, the coupling at 10 % had
 // twice the mean error).
 double Collapser::shape_floor2(int32_t v) const {
-  double floor2 = min_shape_ * min_shape_;
-  for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) {
-    const int32_t* c = &(*tri_)[3 * size_t(*t)];
-    double n[3];
-    normal(c, v, position(v), n);
-    const double area2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2], edges = squared_edges(c, v, position(v));
-    if (area2 > 0.0 && edges > 0.0) floor2 = std::min(floor2, 12.0 * area2 / (edges * edges));
+  double floor2 = std::numeric_limits<double>::infinity();
+  for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) floor2 = std::min(floor2, shape2(*t));
+  if (tracking_floors_ && size_[v] > kWideFan) floor_bound_[v].set(floor2);
+  return std::min(floor2, min_shape_ * min_shape_);
+}
+
+// The squared shape quality of live triangle t, 12 |n|^2 / (sum of squared edges)^2, or infinity
+// for a degenerate one (shape_floor2 leaves those out).
+double Collapser::shape2(int32_t t) const {
+  const int32_t* c = &(*tri_)[3 * size_t(t)];
+  double n[3];
+  normal(c, c[0], position(c[0]), n);
+  const double area2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2], edges = squared_edges(c, c[0], position(c[0]));
+  return area2 > 0.0 && edges > 0.0 ? 12.0 * area2 / (edges * edges) : std::numeric_limits<double>::infinity();
+}
+
+// Triangle t changed (a corner moved or was renamed): a wide corner's bound drops to its shape if
+// that is lower, so that the bound stays at or below the corner's floor.
+void Collapser::lower_floor_bounds(int32_t t) {
+  const int32_t* c = &(*tri_)[3 * size_t(t)];
+  double value = -1.0;
+  for (int j = 0; j < 3; ++j) {
+    const double bound = floor_bound_[c[j]].get();
+    if (bound < 0.0) continue;
+    if (value < 0.0) value = shape2(t);
+    if (value < bound) floor_bound_[c[j]].set(value);
   }
-  return floor2;
+}
+
+// Every triangle of v changed (v moved): v's own bound is dropped, its corners' lowered.
+void Collapser::moved_floor_bounds(int32_t v) {
+  if (!tracking_floors_) return;
+  floor_bound_[v].set(-1.0);
+  for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) lower_floor_bounds(*t);
 }
 
 // Do the triangles of `moved` that do not hold `other` keep their side and some area when
 // `moved` stands at x (other = -1: all of them)?
 bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const {
-  const double* p = position(moved);
-  for (const int32_t* t = faces_begin(moved); t != faces_end(moved); ++t) {
-    if (other >= 0 && has(*t, other)) continue;
-    const int32_t* c = &(*tri_)[3 * size_t(*t)];
-    double before[3], after[3];
-    normal(c, moved, p, before);
-    normal(c, moved, x, after);
-    double before2 = before[0] * before[0] + before[1] * before[1] + before[2] * before[2];
-    const double area2 = before2;
-    if (before2 == 0.0) {
-      // A zero-area triangle has no side to keep. Staying degenerate is no worse (collapsing
-      // coincident vertices one by one is how a fan of them disappears); gaining area, it
-      // must face like the fan.
-      if (after[0] == 0.0 && after[1] == 0.0 && after[2] == 0.0) continue;
-      for (int i = 0; i < 3; ++i) before[i] = 0.0;
-      for (const int32_t* f = faces_begin(moved); f != faces_end(moved); ++f) {
-        double n[3];
-        normal(&(*tri_)[3 * size_t(*f)], moved, p, n);
-        for (int i = 0; i < 3; ++i) before[i] += n[i];
-      }
-      before2 = before[0] * before[0] + before[1] * before[1] + before[2] * before[2];
-    }
-    const double dot = before[0] * after[0] + before[1] * after[1] + before[2] * after[2];
-    const double len2 = after[0] * after[0] + after[1] * after[1] + after[2] * after[2];
-    // No flip, no near-fold (normal turned by more than the limit, ~80 degrees), no loss of area.
-    if (!(dot > 0.0) || dot * dot <= fold2_ * len2 * before2 || len2 <= 1e-24 * before2) return false;
-    // No sliver: not thinner than the floor (at most kMinShape), unless the triangle was
-    // thinner than kMinShape already and stays within half of it.
-    const double edges = squared_edges(c, moved, x);
-    if (!thinner(len2, edges, min_shape_ * min_shape_)) continue;
-    if ((!thinner(area2, squared_edges(c, moved, p), min_shape_ * min_shape_) ||
-         thinner(len2, edges, 0.25 * min_shape_ * min_shape_)) &&
-        below_floor(len2, edges, floor))
-      return false;
+  if (other >= 0 && size_[moved] > kWideFan && !beside_edge_keep_shape(moved, other, x, floor)) return false;
+  for (const int32_t* t = faces_begin(moved); t != faces_end(moved); ++t)
+    if ((other < 0 || !has(*t, other)) && !keeps_face_shape(*t, moved, x, floor)) return false;
+  return true;
+}
+
+// keeps_shape's test first on the triangles of a wide `moved` beside the edge (those holding a
+// vertex opposite it), found from the opposite vertices' faces: where a fan's collapse fails,
+// these fail first (they are the ones squeezed), without the walk of the fan.
+bool Collapser::beside_edge_keep_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const {
+  for (const int32_t* e = faces_begin(other); e != faces_end(other); ++e) {
+    if (!has(*e, moved)) continue;
+    const int32_t* c = &(*tri_)[3 * size_t(*e)];
+    const int32_t o = c[0] != moved && c[0] != other ? c[0] : c[1] != moved && c[1] != other ? c[1] : c[2];
+    if (size_[o] > kWideFan) continue;
+    for (const int32_t* t = faces_begin(o); t != faces_end(o); ++t)
+      if (has(*t, moved) && !has(*t, other) && !keeps_face_shape(*t, moved, x, floor)) return false;
   }
   return true;
+}
+
+// Does triangle t of `moved` keep its side and some area, and not become a sliver, with `moved` at x?
+bool Collapser::keeps_face_shape(int32_t t, int32_t moved, const double* x, ShapeFloor& floor) const {
+  const double* p = position(moved);
+  const int32_t* c = &(*tri_)[3 * size_t(t)];
+  double before[3], after[3];
+  normal(c, moved, p, before);
+  normal(c, moved, x, after);
+  double before2 = before[0] * before[0] + before[1] * before[1] + before[2] * before[2];
+  const double area2 = before2;
+  if (before2 == 0.0) {
+    // A zero-area triangle has no side to keep. Staying degenerate is no worse (collapsing
+    // coincident vertices one by one is how a fan of them disappears); gaining area, it
+    // must face like the fan.
+    if (after[0] == 0.0 && after[1] == 0.0 && after[2] == 0.0) return true;
+    for (int i = 0; i < 3; ++i) before[i] = 0.0;
+    for (const int32_t* f = faces_begin(moved); f != faces_end(moved); ++f) {
+      double n[3];
+      normal(&(*tri_)[3 * size_t(*f)], moved, p, n);
+      for (int i = 0; i < 3; ++i) before[i] += n[i];
+    }
+    before2 = before[0] * before[0] + before[1] * before[1] + before[2] * before[2];
+  }
+  const double dot = before[0] * after[0] + before[1] * after[1] + before[2] * after[2];
+  const double len2 = after[0] * after[0] + after[1] * after[1] + after[2] * after[2];
+  // No flip, no near-fold (normal turned by more than the limit, ~80 degrees), no loss of area.
+  if (!(dot > 0.0) || dot * dot <= fold2_ * len2 * before2 || len2 <= 1e-24 * before2) return false;
+  // No sliver: not thinner than the floor (at most kMinShape), unless the triangle was
+  // thinner than kMinShape already and stays within half of it.
+  const double edges = squared_edges(c, moved, x);
+  if (!thinner(len2, edges, min_shape_ * min_shape_)) return true;
+  return !((!thinner(area2, squared_edges(c, moved, p), min_shape_ * min_shape_) ||
+            thinner(len2, edges, 0.25 * min_shape_ * min_shape_)) &&
+           below_floor(len2, edges, floor));
 }
 
 // Is a triangle thinner than the floor of the move, the lower of its ends' floors? Thinner than
@@ -825,11 +873,19 @@ bool Collapser::below_floor(double twice_area2, double edges, ShapeFloor& floor)
   int32_t first = floor.a, second = floor.b;
   double *first2 = &floor.a2, *second2 = &floor.b2;
   if (second >= 0 && size_[second] < size_[first]) std::swap(first, second), std::swap(first2, second2);
-  if (*first2 < 0.0) *first2 = shape_floor2(first);
-  if (!thinner(twice_area2, edges, *first2)) return false;
-  if (second < 0) return true;
-  if (*second2 < 0.0) *second2 = shape_floor2(second);
-  return thinner(twice_area2, edges, *second2);
+  if (!below_end_floor(twice_area2, edges, first, *first2)) return false;
+  return second < 0 || below_end_floor(twice_area2, edges, second, *second2);
+}
+
+// Thinner than end v's floor (floor2, read once: -1 until then)? A wide end's kept bound, at or
+// below its floor, answers yes without the walk of its faces when the triangle is thinner still.
+bool Collapser::below_end_floor(double twice_area2, double edges, int32_t v, double& floor2) const {
+  if (floor2 < 0.0) {
+    const double bound = floor_bound_.empty() ? -1.0 : floor_bound_[v].get();
+    if (bound >= 0.0 && thinner(twice_area2, edges, std::min(bound, min_shape_ * min_shape_))) return true;
+    floor2 = shape_floor2(v);
+  }
+  return thinner(twice_area2, edges, floor2);
 }
 
 // Shape quality 2 sqrt(3) |n| / (sum of squared edges) of triangle c with `replace` at `at`
@@ -863,11 +919,14 @@ void Collapser::normal(const int32_t* c, int32_t replace, const double* at, doub
 void Collapser::move_to(int32_t v, const double* x) {
   double* p = &s_.positions[3 * size_t(v)];
   double* w = &s_.world[3 * size_t(v)];
+  bool moved = false;
   for (int i = 0; i < 3; ++i) {
     if (p[i] == x[i]) continue;  // unmoved coordinates keep their exact input value
     p[i] = x[i];
     w[i] = x[i] * s_.extent + s_.center[i];
+    moved = true;
   }
+  if (moved) moved_floor_bounds(v);
 }
 
 void Collapser::collapse(int32_t u, int32_t v) {
@@ -920,6 +979,8 @@ void Collapser::collapse(int32_t u, int32_t v) {
     moved_faces_.push_back(*t);
   }
   append_faces(v, moved_faces_.data(), static_cast<int32_t>(moved_faces_.size()));
+  if (tracking_floors_)
+    for (int32_t t : moved_faces_) lower_floor_bounds(t);
   if (dead_end) {
     // Each sheet around the dead end held two of the edge's triangles, one on each side of the
     // curve at v: with u gone the curve ends at v, and each sheet's two sides there are one.
@@ -1007,6 +1068,7 @@ bool Collapser::try_move(int32_t v, const double* x) {
 
 void Collapser::restore(int32_t v, const double* position, const double* world) {
   for (int i = 0; i < 3; ++i) s_.positions[3 * size_t(v) + i] = position[i], s_.world[3 * size_t(v) + i] = world[i];
+  moved_floor_bounds(v);
 }
 
 }  // namespace topstoc

@@ -16,6 +16,7 @@
 // so a collapse allocates nothing.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -215,7 +216,13 @@ class Collapser {
   };
   bool below_floor(double twice_area2, double edges, ShapeFloor& floor) const;
   bool keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const;
+  bool beside_edge_keep_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const;
+  bool keeps_face_shape(int32_t t, int32_t moved, const double* x, ShapeFloor& floor) const;
   double shape_floor2(int32_t v) const;
+  double shape2(int32_t t) const;
+  bool below_end_floor(double twice_area2, double edges, int32_t v, double& floor2) const;
+  void lower_floor_bounds(int32_t t);
+  void moved_floor_bounds(int32_t v);
   double shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const;
   double squared_edges(const int32_t* c, int32_t replace, const double* at) const;
   void normal(const int32_t* c, int32_t replace, const double* at, double n[3]) const;
@@ -246,6 +253,21 @@ class Collapser {
   double fold2_ = kMinTurnCos * kMinTurnCos;  // squared cosine of the largest turn of a normal
   int32_t alive_vertices_ = 0, alive_faces_ = 0;
   std::vector<int32_t> pool_, begin_, size_, capacity_;  // vertex -> faces
+  // Per vertex of more than kWideFan faces whose floor was read: a bound at or below the least
+  // squared shape of its triangles (shape_floor2 before the cap), lowered as they change, so that
+  // a triangle far thinner than a fan's floor is refused without the walk of the fan (-1: none).
+  // Read and written by the checks on the team's threads: a relaxed atomic, the same value by
+  // whichever thread.
+  struct FloorBound {
+    std::atomic<double> value{-1.0};
+    FloorBound() = default;
+    FloorBound(const FloorBound& other) : value(other.get()) {}
+    FloorBound& operator=(const FloorBound& other) { return set(other.get()), *this; }
+    double get() const { return value.load(std::memory_order_relaxed); }
+    void set(double x) const { const_cast<std::atomic<double>&>(value).store(x, std::memory_order_relaxed); }
+  };
+  std::vector<FloorBound> floor_bound_;  // empty: no vertex is wide
+  bool tracking_floors_ = false;
   std::vector<uint8_t> alive_face_, dirty_, placed_;
   std::vector<int32_t> merged_into_, target_;
   IndexedHeap heap_;
