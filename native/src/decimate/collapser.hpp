@@ -259,12 +259,12 @@ class Collapser {
   // Read and written by the checks on the team's threads: a relaxed atomic, the same value by
   // whichever thread.
   struct FloorBound {
-    std::atomic<double> value{-1.0};
+    mutable std::atomic<double> value{-1.0};  // set by shape_floor2, a const read of the state
     FloorBound() = default;
     FloorBound(const FloorBound& other) : value(other.get()) {}
     FloorBound& operator=(const FloorBound& other) { return set(other.get()), *this; }
     double get() const { return value.load(std::memory_order_relaxed); }
-    void set(double x) const { const_cast<std::atomic<double>&>(value).store(x, std::memory_order_relaxed); }
+    void set(double x) const { value.store(x, std::memory_order_relaxed); }
   };
   std::vector<FloorBound> floor_bound_;  // empty: no vertex is wide
   bool tracking_floors_ = false;
