@@ -294,10 +294,11 @@ int32_t Collapser::remove_thin(double min_shape, Stop keep) {
   // collapsing that one into the same survivor swept a whole arc into one triangle (a fanned
   // disc's rim: a wedge of 1.8 radians at 10 %). Once a round per vertex, the collapses spread
   // evenly, and never into the fan's centre instead.
-  std::vector<int32_t> took(min_shape > 0.0 ? merged_into_.size() : 0, -1);
+  // (The rounds' marks are made when the first fan is met: most meshes have none.)
+  std::vector<int32_t> took;
   auto waits = [&](int32_t x, int32_t round) { return !took.empty() && took[x] == round; };
   auto in_fan = [&](const int32_t* c) {
-    return size_[c[0]] > kWideFan || size_[c[1]] > kWideFan || size_[c[2]] > kWideFan;
+    return min_shape > 0.0 && (size_[c[0]] > kWideFan || size_[c[1]] > kWideFan || size_[c[2]] > kWideFan);
   };
   int32_t collapses = 0;
   for (int32_t round = 0, progress = !candidates.empty(); progress; ++round) {
@@ -306,7 +307,8 @@ int32_t Collapser::remove_thin(double min_shape, Stop keep) {
       if (reached(keep)) return collapses;
       if (!alive_face_[t] || !(zero_area(t) || thin(t, min_shape))) continue;
       const int32_t* c = &(*tri_)[3 * size_t(t)];
-      const bool fan = !took.empty() && in_fan(c);
+      const bool fan = in_fan(c);
+      if (fan && took.empty()) took.assign(merged_into_.size(), -1);
       if (fan && (waits(c[0], round) || waits(c[1], round) || waits(c[2], round))) continue;
       for (int j = 0; j < 6; ++j) {
         const int32_t u = c[j % 3], v = c[(j % 3 + (j < 3 ? 1 : 2)) % 3];
@@ -593,9 +595,7 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
   if (cu < 0) {
     if (nu != faces_u || count != 2) return false;  // a closed fan around u
   } else {
-    if (s_.curve[v] != cu && !s_.locked[v]) return false;
-    if (!curve_fans(u, nu, faces_u, on_edge, count)) return false;
-    if (s_.curve_closed[cu] ? s_.curve_size[cu] <= 3 : !curve_keeps_an_edge(cu)) return false;
+    if (!along_curve(u, v) || !curve_fans(u, nu, faces_u, on_edge, count)) return false;
   }
   const uint32_t sv = ++scratch.stamp;
   int32_t nv = 0, shared = 0;
@@ -632,9 +632,7 @@ bool Collapser::allowed_wide(int32_t u, int32_t v, Scratch& scratch) const {
   if (count == 0) return false;
   const int32_t cu = s_.curve[u];
   if (cu < 0 && count != 2) return false;
-  if (cu >= 0 && ((s_.curve[v] != cu && !s_.locked[v]) ||
-                  (s_.curve_closed[cu] ? s_.curve_size[cu] <= 3 : !curve_keeps_an_edge(cu))))
-    return false;
+  if (cu >= 0 && !along_curve(u, v)) return false;
   const int32_t shared = common_neighbours(narrow, wide, scratch);
   if (shared != count || duplicates_a_face(u, v, on_edge, count)) return false;
   if (cu >= 0 && merges_unlike_edges(u, v, on_edge, count)) return false;
@@ -709,6 +707,14 @@ bool Collapser::curve_fans(int32_t u, int32_t nu, int32_t faces_u, const int32_t
     if (same != per_sector) return false;
   }
   return true;
+}
+
+// May curve vertex u go to v? Only along its curve (or onto a locked vertex), and only while the
+// curve keeps its shape: a closed one more than three vertices, an open one an edge.
+bool Collapser::along_curve(int32_t u, int32_t v) const {
+  const int32_t cu = s_.curve[u];
+  if (s_.curve[v] != cu && !s_.locked[v]) return false;
+  return s_.curve_closed[cu] ? s_.curve_size[cu] > 3 : curve_keeps_an_edge(cu);
 }
 
 // An open curve keeps at least one edge (two vertices, its locked ends included): shrunk to a

@@ -195,7 +195,9 @@ class Collapser {
   }
   bool queues(int32_t u) const { return !s_.locked[u] && !at_quota(u); }
   bool allowed(int32_t u, int32_t v, Scratch& scratch) const;
-  // An end with more faces than this is checked by allowed_wide (its walks last).
+  // A vertex with more faces than this is a fan's centre: its collapses are checked by
+  // allowed_wide (its walks last), its floor is kept as a bound, and the sliver clean-up thins
+  // its fan a round at a time.
   static constexpr int32_t kWideFan = 64;
   bool allowed_wide(int32_t u, int32_t v, Scratch& scratch) const;
   int32_t common_neighbours(int32_t a, int32_t b, Scratch& scratch) const;
@@ -204,6 +206,7 @@ class Collapser {
   int shaped_placement(int32_t u, int32_t v, double x[3]) const;
   bool is_dead_end(int32_t v) const { return !s_.dead_end.empty() && s_.dead_end[v]; }
   bool curve_fans(int32_t u, int32_t nu, int32_t faces_u, const int32_t* on_edge, int32_t count) const;
+  bool along_curve(int32_t u, int32_t v) const;
   bool curve_keeps_an_edge(int32_t curve) const;
   void merge_sides(int32_t v, const int32_t* from, const int32_t* to, int32_t count);
   bool duplicates_a_face(int32_t u, int32_t v, const int32_t* on_edge, int32_t count) const;
