@@ -21,7 +21,7 @@ def uv_sphere(segments, rings=50):
                          np.repeat(np.cos(theta), segments)], [0, 0, 1], [0, 0, -1]])
     s = np.arange(segments); t = (s + 1) % segments
     top, bottom = len(P) - 2, len(P) - 1
-    T = [np.c_[s, t, np.full(segments, top)][:, [1, 0, 2]]]
+    T = [np.c_[s, t, np.full(segments, top)]]
     for r in range(rings - 2):
         a0, b0 = r * segments + s, r * segments + t
         a1, b1 = a0 + segments, b0 + segments
