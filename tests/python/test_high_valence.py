@@ -74,21 +74,27 @@ def test_cone_refined_from_a_smaller_first_pass(mode):
     assert len(result.vertices) <= 0.1 * len(vertices) + 1
 
 
-@pytest.mark.parametrize("ratio", [0.1, 0.02])
-def test_uv_sphere_first_pass_is_not_below_its_budget(ratio):
-    # A UV sphere of 2,000 segments (98,002 vertices): quality mode's first pass was drawn far
-    # over its budget at the poles, its lower draws went down to 1 sample, and the repairs made
-    # 2,104 vertices of it: the result missed a 10 % target (2,104 for 9,800) and its faces lay
-    # up to 0.53 of the radius inside the sphere. Measured against the sphere itself: the radial
-    # deviation of points spread over every output triangle.
-    vertices, triangles = uv_sphere(2000)
-    result = topstoc.decimate(topstoc.Mesh(vertices, triangles), ratio=ratio, mode="quality", seed=0)
-    assert len(result.vertices) == round(ratio * len(vertices))
+def sphere_deviation(result):
+    """Max radial deviation from the unit sphere of points spread over every output triangle."""
     corners = np.asarray(result.vertices)[np.asarray(result.triangles)]
     weights = np.array([(a, b, 1 - a - b) for a in np.linspace(0, 1, 7) for b in np.linspace(0, 1, 7) if a + b <= 1])
     points = np.einsum("sk,fkd->fsd", weights, corners).reshape(-1, 3)
-    deviation = np.abs(1 - np.linalg.norm(points, axis=1))
-    assert deviation.max() < 0.1 and deviation.mean() < 0.002
+    return np.abs(1 - np.linalg.norm(points, axis=1)).max()
+
+
+# Every triangle of a UV sphere of 1,000 or 2,000 segments (50 rings) is a sliver. Quality mode
+# took the input's slivers first, by shape, before the collapses by error: that ate the poles'
+# first rings (the pole fanned out to 0.34 of the radius, 0.016 off the sphere at 1,000
+# segments). Above 80,000 vertices its stochastic first pass, clustered by hop count, ran its
+# triangles across many rings (0.062 off at 2,000 segments; with the top cap flipped, as this
+# helper once made it, the first pass missed the 10 % target: 2,104 vertices for 9,800). Ideal:
+# about 0.0004 at 10 %.
+@pytest.mark.parametrize("segments, ratio, bound", [(1000, 0.1, 0.002), (2000, 0.1, 0.002), (2000, 0.02, 0.006)])
+def test_uv_sphere_of_slivers_keeps_to_the_sphere(segments, ratio, bound):
+    vertices, triangles = uv_sphere(segments)
+    result = topstoc.decimate(topstoc.Mesh(vertices, triangles), ratio=ratio, mode="quality", seed=0)
+    assert len(result.vertices) == round(ratio * len(vertices))
+    assert sphere_deviation(result) < bound
 
 
 @pytest.mark.parametrize("size", [300, 2000])

@@ -360,7 +360,7 @@ class Refinement {
     // The zero-area clean-up and fast mode keep the caller's positions.
     setup.optimal_placement = !params.zero_area_only && !params.keep_positions;
     const double center[3] = {setup.center[0], setup.center[1], setup.center[2]}, extent = setup.extent;
-    if (params.max_aware && n == num_input - mesh.report().isolated_vertices) {
+    if (params.max_aware && whole_input()) {
       collapse_max_aware(std::move(setup), center, extent);
       if (params.warm_up) return;
     } else if (params.warm_up) {
@@ -378,6 +378,15 @@ class Refinement {
   const FeatureLayout& layout;
   const RefineParams& params;
   DecimateResult& result;
+
+  // The first pass kept every input vertex: its triangles are the input's own.
+  bool whole_input() const { return n == num_input - mesh.report().isolated_vertices; }
+
+  // Triangles thinner than this go before the target's collapses: needles a stochastic first
+  // pass made between its clusters. The input's own triangles are left to the quadric order: on
+  // an input of slivers (a UV sphere of 1,000 segments) taking them first decimated by shape,
+  // not by error, and ate the poles' rings (max 0.47 % of the diagonal instead of 0.009 %).
+  double sliver_shape() const { return whole_input() ? 0.0 : kSliverShape; }
   const int32_t n, num_input;
   const bool guided;
   std::vector<int32_t> label;  // per input vertex: its output vertex
@@ -551,7 +560,7 @@ class Refinement {
       result.triangles = start_triangles;
       result.corner_source = start_corners;
       at_restart = std::make_unique<Collapser>(result.triangles, result.corner_source, start);
-      shared = at_restart->remove_thin(kSliverShape, stop) + at_restart->run(floor);
+      shared = at_restart->remove_thin(sliver_shape(), stop) + at_restart->run(floor);
       restart_triangles = result.triangles, restart_corners = result.corner_source;
       result.triangles = floor_triangles;
       result.corner_source = floor_corners;
@@ -639,7 +648,7 @@ class Refinement {
     CollapseSnapshots* snapshots = params.target_triangles == 0 && !guided ? params.snapshots : nullptr;
     if (!snapshots) {
       run = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
-      return run->remove_thin(kSliverShape, stop) + run->run(restart);
+      return run->remove_thin(sliver_shape(), stop) + run->run(restart);
     }
     const std::vector<uint64_t> start = start_key(setup, result.triangles, result.corner_source);
     int32_t before = 0;
@@ -648,7 +657,7 @@ class Refinement {
       before = kept->collapses;
     } else {
       run = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
-      before = run->remove_thin(kSliverShape, stop);
+      before = run->remove_thin(sliver_shape(), stop);
     }
     return before + run->run(restart, [&](const Collapser& state, int32_t made) {
       snapshots->keep(snapshot(start, restart.vertices, before + made, state));
@@ -792,7 +801,7 @@ class Refinement {
     // Slivers the stochastic pass left (near-collinear corners, needles) go first: the
     // collapses thin the result anyway, and none of them makes a triangle thinner than the
     // thinnest around it was (Collapser::keeps_shape).
-    result.refine_collapses = collapser.remove_thin(kSliverShape, target());
+    result.refine_collapses = collapser.remove_thin(sliver_shape(), target());
     result.refine_collapses += collapse_rest(collapser, center, extent);
   }
 
