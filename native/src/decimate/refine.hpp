@@ -48,9 +48,10 @@ struct RefineParams {
   /// Finally move every free vertex to its quadric's minimum (filtered placement on the final
   /// clusters): what placement="filtered" means for a refined result.
   bool refit = false;
-  /// When the first pass kept every vertex (a mesh small enough to collapse whole), rerun the
-  /// last collapses, each vertex's cost weighed by how far the runs before ended from the input
-  /// there, and keep the best run (a smaller max error, for the time of the reruns).
+  /// When the first pass kept every vertex (a mesh small enough to collapse whole, or mostly of
+  /// slivers) and there are at most 250,000 of them, rerun the last collapses, each vertex's
+  /// cost weighed by how far the runs before ended from the input there, and keep the best run
+  /// (a smaller max error, for the time of the reruns).
   bool max_aware = false;
   /// With refit and max_aware: results above kFitFaces are fitted too (DecimateParams::large_fit).
   bool large_fit = false;
