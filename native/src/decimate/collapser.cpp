@@ -279,7 +279,7 @@ int32_t Collapser::zero_area_faces() const {
   return count;
 }
 
-int32_t Collapser::remove_thin(double min_shape, Stop keep) {
+int32_t Collapser::remove_thin(double min_shape, Stop keep, bool fans_only) {
   // Candidates are found up front: a collapse makes no zero-area triangle, and a thin one only
   // beside one as thin or thinner (keeps_shape); a failed candidate may pass after its
   // neighbours collapsed, hence the rounds.
@@ -308,6 +308,7 @@ int32_t Collapser::remove_thin(double min_shape, Stop keep) {
       if (!alive_face_[t] || !(zero_area(t) || thin(t, min_shape))) continue;
       const int32_t* c = &(*tri_)[3 * size_t(t)];
       const bool fan = in_fan(c);
+      if (fans_only && !fan && !zero_area(t)) continue;
       if (fan && took.empty()) took.assign(merged_into_.size(), -1);
       if (fan && (waits(c[0], round) || waits(c[1], round) || waits(c[2], round))) continue;
       for (int j = 0; j < 6; ++j) {

@@ -63,8 +63,9 @@ class Collapser {
     int32_t vertices = 0, faces = 0;
   };
   /// Collapses an edge of every zero-area triangle, and of every triangle with a shape quality
-  /// below min_shape, where a collapse is allowed, until `keep` is reached.
-  int32_t remove_thin(double min_shape, Stop keep);
+  /// below min_shape (with fans_only, of those only the ones with a corner of more than
+  /// kWideFan faces), where a collapse is allowed, until `keep` is reached.
+  int32_t remove_thin(double min_shape, Stop keep, bool fans_only = false);
   /// Called with the state and the collapses made so far where a run's batches start to
   /// depend on its target (they shrink near it), or at its end when they never did: up to there
   /// a run to any lower vertex target goes the same way.

@@ -830,44 +830,19 @@ namespace {
 // cost quality (3.8 times the mean error on a 62k-vertex character; docs/benchmarks.md).
 constexpr double kWholeMeshCollapses = 8.0;
 
-// An input mostly of triangles thinner than this (shape quality 4 sqrt(3) area / sum of squared
-// edges; 1 for an equilateral one) starts from the whole mesh whatever its size.
-constexpr double kSliverShape = 0.1;
-constexpr double kMostlySlivers = 0.5;
-// ... up to this many vertices (a UV sphere of 990,002 vertices: 20 s and 0.64 GB collapsed
-// whole, 1.2 s from the stochastic pass); above it the stochastic pass's result is the start.
+// A sliver-heavy mesh (sliver_heavy, refine.hpp) starts from the whole mesh up to this many
+// vertices: on it the stochastic pass's clusters, grown by hop count, stretch along the long
+// edges and its triangles cut across the surface (a UV sphere of 2,000 segments kept 1.8 % of the
+// diagonal as max error from that first pass, 0.002 % collapsed whole). Above it (a UV sphere
+// of 990,002 vertices: 20 s and 0.64 GB collapsed whole, 1.2 s from the stochastic pass) the
+// stochastic pass's result is the start.
 constexpr int32_t kSliverWholeVertices = 2000000;
-
-// Whether most of the input's triangles are slivers (a UV sphere of many segments, a CAD
-// tessellation's long strips), judged on at most 65,536 of them evenly spread. On such
-// a mesh the stochastic pass's clusters, grown by hop count, stretch along the long edges and
-// its triangles cut across the surface: a UV sphere of 2,000 segments kept 1.8 % of the
-// diagonal as max error from that first pass, 0.002 % collapsed whole.
-bool mostly_slivers(const Mesh& mesh) {
-  const int32_t m = mesh.num_faces();
-  const int32_t step = std::max<int32_t>(1, int32_t((int64_t(m) + 65535) / 65536));
-  int64_t seen = 0, thin = 0;
-  for (int32_t f = 0; f < m; f += step) {
-    const int32_t* t = &mesh.faces()[3 * size_t(f)];
-    const double *a = mesh.position(t[0]), *b = mesh.position(t[1]), *c = mesh.position(t[2]);
-    double u[3], w[3], edges = 0;
-    for (int i = 0; i < 3; ++i) {
-      u[i] = b[i] - a[i], w[i] = c[i] - a[i];
-      edges += u[i] * u[i] + w[i] * w[i] + (c[i] - b[i]) * (c[i] - b[i]);
-    }
-    const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-    const double twice_area = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    ++seen;
-    thin += !(2.0 * std::sqrt(3.0) * twice_area >= kSliverShape * edges);
-  }
-  return seen > 0 && thin > kMostlySlivers * double(seen);
-}
 
 // Vertices the first pass of a refined decimation keeps (see DecimateParams::refine_collapses).
 int32_t first_pass_vertices(const Mesh& mesh, const DecimateParams& params, int32_t active) {
   const double target = params.target_vertices, collapses = std::max(0, params.refine_collapses);
   if (collapses > 0 && active <= kWholeMeshCollapses * collapses) return active;
-  if (collapses > 0 && active <= kSliverWholeVertices && mostly_slivers(mesh)) return active;
+  if (collapses > 0 && active <= kSliverWholeVertices && sliver_heavy(mesh)) return active;
   const double extra = collapses > 0 ? std::max(collapses, 0.25 * target) : 0.0;
   return int32_t(std::min<double>(active, std::max(std::ceil(params.refine * target), target + extra)));
 }

@@ -21,6 +21,9 @@ namespace {
 
 // Slivers (shape quality below this, see Collapser) the stochastic pass left are collapsed first.
 constexpr double kSliverShape = 0.1;
+// A mesh with more than this share of its triangles slivers is sliver-heavy (sliver_heavy): a UV
+// sphere of 1,000 segments has 0.37, the 54 meshes of bench_quality.py at most 0.18.
+constexpr double kSliverHeavyShare = 0.25;
 // The max-aware reruns (and the copies of the collapse state they keep) run on a whole input of
 // at most this many vertices: a UV sphere of 990,002 vertices collapsed whole at 10 % took 35 s
 // and 1.9 GB with them, 20 s and 0.64 GB without.
@@ -325,6 +328,26 @@ bool has_zero_area(const DecimateResult& result) {
   return false;
 }
 
+// Judged on at most 65,536 triangles evenly spread: a count, the same on any thread count.
+bool sliver_heavy(const Mesh& mesh) {
+  const int32_t m = mesh.num_faces();
+  const int32_t step = std::max<int32_t>(1, int32_t((int64_t(m) + 65535) / 65536));
+  int64_t seen = 0, thin = 0;
+  for (int32_t f = 0; f < m; f += step) {
+    const int32_t* t = &mesh.faces()[3 * size_t(f)];
+    const double *a = mesh.position(t[0]), *b = mesh.position(t[1]), *c = mesh.position(t[2]);
+    double u[3], w[3], edges = 0;
+    for (int i = 0; i < 3; ++i) {
+      u[i] = b[i] - a[i], w[i] = c[i] - a[i];
+      edges += u[i] * u[i] + w[i] * w[i] + (c[i] - b[i]) * (c[i] - b[i]);
+    }
+    const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    ++seen;  // shape quality 4 sqrt(3) area / sum of squared edges (twice the area is |n|)
+    thin += !(2.0 * std::sqrt(3.0) * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) >= kSliverShape * edges);
+  }
+  return seen > 0 && thin > kSliverHeavyShare * double(seen);
+}
+
 namespace {
 
 // One refinement of a decimation result: the collapser's setup from the result and the
@@ -334,7 +357,7 @@ class Refinement {
  public:
   Refinement(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params, DecimateResult& result)
       : mesh(mesh), layout(layout), params(params), result(result), n(static_cast<int32_t>(result.kept.size())),
-        num_input(mesh.num_vertices()),
+        num_input(mesh.num_vertices()), sliver_heavy_input(sliver_heavy(mesh)),
         guided(params.multipliers && std::any_of(params.multipliers->begin(), params.multipliers->end(),
                                                  [](double m) { return m != 1.0; })) {}
 
@@ -386,12 +409,20 @@ class Refinement {
   // The first pass kept every input vertex: its triangles are the input's own.
   bool whole_input() const { return n == num_input - mesh.report().isolated_vertices; }
 
-  // Triangles thinner than this go before the target's collapses: needles a stochastic first
-  // pass made between its clusters. The input's own triangles are left to the quadric order: on
-  // an input of slivers (a UV sphere of 1,000 segments) taking them first decimated by shape,
-  // not by error, and ate the poles' rings (max 0.47 % of the diagonal instead of 0.009 %).
-  double sliver_shape() const { return whole_input() ? 0.0 : kSliverShape; }
+  // The slivers a first pass made between its clusters (needles), or an input's stray ones, go
+  // before the target's collapses. On a sliver-heavy mesh most are its design and are left to the
+  // quadric order: taken first there, by shape and not by error, they ate a UV sphere's polar
+  // rings (1,000 segments at 10 %: max 0.54 % of the diagonal, 0.009 % now). Its fans of slivers
+  // (a cap's centre, a pole) still go first: left to the collapses, every evaluation of the centre
+  // read its thousands of neighbours and faces (a cylinder of 5,000 segments: 0.8 -> 69 s).
+  // (Left to the quadric order on every input, slivers changed 76 of bench_quality's 214 cases,
+  // max 0.70-1.34x, geomean 1.00: a CAD turbine at its floor lost 45 % on its mean.)
+  int32_t slivers_first(Collapser& collapser, Collapser::Stop stop) const {
+    return collapser.remove_thin(kSliverShape, stop, sliver_heavy_input);
+  }
+
   const int32_t n, num_input;
+  const bool sliver_heavy_input;  // sliver_heavy(mesh)
   const bool guided;
   std::vector<int32_t> label;  // per input vertex: its output vertex
   std::vector<int32_t> final_index;  // per output vertex of the first pass: its vertex in the result
@@ -564,7 +595,7 @@ class Refinement {
       result.triangles = start_triangles;
       result.corner_source = start_corners;
       at_restart = std::make_unique<Collapser>(result.triangles, result.corner_source, start);
-      shared = at_restart->remove_thin(sliver_shape(), stop) + at_restart->run(floor);
+      shared = slivers_first(*at_restart, stop) + at_restart->run(floor);
       restart_triangles = result.triangles, restart_corners = result.corner_source;
       result.triangles = floor_triangles;
       result.corner_source = floor_corners;
@@ -652,7 +683,7 @@ class Refinement {
     CollapseSnapshots* snapshots = params.target_triangles == 0 && !guided ? params.snapshots : nullptr;
     if (!snapshots) {
       run = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
-      return run->remove_thin(sliver_shape(), stop) + run->run(restart);
+      return slivers_first(*run, stop) + run->run(restart);
     }
     const std::vector<uint64_t> start = start_key(setup, result.triangles, result.corner_source);
     int32_t before = 0;
@@ -661,7 +692,7 @@ class Refinement {
       before = kept->collapses;
     } else {
       run = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
-      before = run->remove_thin(sliver_shape(), stop);
+      before = slivers_first(*run, stop);
     }
     return before + run->run(restart, [&](const Collapser& state, int32_t made) {
       snapshots->keep(snapshot(start, restart.vertices, before + made, state));
@@ -805,7 +836,7 @@ class Refinement {
     // Slivers the stochastic pass left (near-collinear corners, needles) go first: the
     // collapses thin the result anyway, and none of them makes a triangle thinner than the
     // thinnest around it was (Collapser::keeps_shape).
-    result.refine_collapses = collapser.remove_thin(sliver_shape(), target());
+    result.refine_collapses = slivers_first(collapser, target());
     result.refine_collapses += collapse_rest(collapser, center, extent);
   }
 

@@ -70,6 +70,11 @@ struct RefineParams {
 /// True when some output triangle of `result` has zero area.
 bool has_zero_area(const DecimateResult& result);
 
+/// Whether more than a quarter of the mesh's triangles are slivers (shape quality 4 sqrt(3) area
+/// / sum of squared edges below 0.1; 1 for an equilateral triangle): a UV sphere of many
+/// segments, a CAD tessellation's long strips.
+bool sliver_heavy(const Mesh& mesh);
+
 /// Thins `result` (a finished decimation of `mesh`, in the caller's ids) to
 /// params.target_vertices output vertices where collapses allow; updates every field of the
 /// result (kept, positions, triangles, sources, labels) and its refine_* figures. The sample
