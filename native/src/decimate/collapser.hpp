@@ -200,6 +200,7 @@ class Collapser {
   // allowed_wide (its walks last), its floor is kept as a bound, and the sliver clean-up thins
   // its fan a round at a time.
   static constexpr int32_t kWideFan = 64;
+  static constexpr size_t kWideTries = 16;  // collapses a wide vertex's evaluation checks (evaluate)
   bool allowed_wide(int32_t u, int32_t v, Scratch& scratch) const;
   int32_t common_neighbours(int32_t a, int32_t b, Scratch& scratch) const;
   int32_t count_neighbours(int32_t v, int32_t enough, Scratch& scratch) const;
