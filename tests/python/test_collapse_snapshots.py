@@ -129,3 +129,22 @@ def test_a_cancelled_warm_up_leaves_the_results_unchanged(torus):
         warm_up(mesh, make_job(mesh, ratio=0.1), flag)
     assert mesh.kept_for_reuse()[2].size == 0
     assert_same(mesh.decimate(ratio=0.08), plain.decimate(ratio=0.08))
+
+
+def test_a_sliver_heavy_mesh_warms_up_and_resumes():
+    """A UV sphere of 2,000 segments (98,002 vertices, every triangle a sliver) is collapsed whole
+    (decimate.cpp, kSliverWholeVertices; above 80,000 vertices a mesh of fair triangles is not),
+    so the Live Preview's warm-up keeps its state and the decimations after it resume from it,
+    with the results of a mesh that keeps nothing."""
+    from fan_meshes import uv_sphere
+    from topstoc.core.api.decimate import warm_up
+    from topstoc.core.api.job import make_job
+
+    sphere = uv_sphere(2000)
+    mesh, plain = Mesh(*sphere), Mesh(*sphere, keep_floods=False)
+    snapshots = mesh.kept_for_reuse()[2]
+    assert warm_up(mesh, make_job(mesh, ratio=0.1)) is True
+    assert snapshots.size == 1
+    for ratio, resumed in ((0.1, 1), (0.05, 2)):
+        assert_same(mesh.decimate(ratio=ratio), plain.decimate(ratio=ratio))
+        assert snapshots.resumed == resumed

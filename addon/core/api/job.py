@@ -30,8 +30,9 @@ MODES = ("quality", "fast", "best")
 #: quality mode: the collapses remove at most max(QUALITY_COLLAPSES, target / 4) vertices
 #: after a stochastic first pass (the time then grows with the target, not with the mesh), and
 #: start from the whole mesh when it has at most 8 * QUALITY_COLLAPSES vertices (the lowest
-#: error; docs/design.md §2.10). QUALITY_REFINE only marks the refinement as on: an explicit
-#: refine=f sizes the first pass as f times the target instead of the budget.
+#: error) or is sliver-heavy, up to 2M vertices (docs/design.md §2.10). QUALITY_REFINE only
+#: marks the refinement as on: an explicit refine=f sizes the first pass as f times the target
+#: instead of the budget.
 QUALITY_REFINE = 1.0
 QUALITY_COLLAPSES = 10_000
 #: default weight of an attribute channel in the collapse cost (see decimate's attributes)

@@ -860,8 +860,11 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   first.labels_in_mesh_order = true;        // what the refinement reads (no copy in its order)
   first.target_vertices = first_pass_vertices(mesh, params, active);
   first.warm_up = false;
-  if (params.warm_up && (first.target_vertices != active || !params.collapse_snapshots || target_triangles > 0))
-    return {};  // a first pass that depends on the target: no state a later decimation could resume from
+  // A first pass that depends on the target, or a whole mesh too large for the max-aware reruns:
+  // no state a later decimation could resume from.
+  if (params.warm_up && (first.target_vertices != active || active > kMaxAwareVertices || !params.collapse_snapshots ||
+                         target_triangles > 0))
+    return {};
   DecimateResult result = stochastic_pass(mesh, layout, first, true);
   // A first pass whose repairs left issues may be broken (the double cone of n = 80,000): the
   // collapses would keep it so. If its check rejects it, the first pass is the whole mesh.

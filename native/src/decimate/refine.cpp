@@ -24,10 +24,6 @@ constexpr double kSliverShape = 0.1;
 // A mesh with more than this share of its triangles slivers is sliver-heavy (sliver_heavy): a UV
 // sphere of 1,000 segments has 0.37, the 54 meshes of bench_quality.py at most 0.18.
 constexpr double kSliverHeavyShare = 0.25;
-// The max-aware reruns (and the copies of the collapse state they keep) run on a whole input of
-// at most this many vertices: a UV sphere of 990,002 vertices collapsed whole at 10 % took 35 s
-// and 1.9 GB with them, 20 s and 0.64 GB without.
-constexpr int32_t kMaxAwareVertices = 250000;
 // The max-aware reruns start from the first run's state at this many times the target (the
 // last collapses decide where the largest deviations end up), and there are kRounds of them,
 // each weighing where any run before it ended farthest.
