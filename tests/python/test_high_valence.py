@@ -88,11 +88,13 @@ def sphere_deviation(result):
 # segments). Above 80,000 vertices its stochastic first pass, clustered by hop count, ran its
 # triangles across many rings (0.062 off at 2,000 segments; with the top cap flipped, as this
 # helper once made it, the first pass missed the 10 % target: 2,104 vertices for 9,800). Ideal:
-# about 0.0004 at 10 %.
+# about 0.0004 at 10 %. Fast mode, the stochastic pass alone, was 0.06-0.07 off at 10 % and 0.21
+# at 2 %; on a sliver-heavy mesh it now collapses the whole mesh keeping input positions.
+@pytest.mark.parametrize("mode", ["quality", "fast"])
 @pytest.mark.parametrize("segments, ratio, bound", [(1000, 0.1, 0.002), (2000, 0.1, 0.002), (2000, 0.02, 0.006)])
-def test_uv_sphere_of_slivers_keeps_to_the_sphere(segments, ratio, bound):
+def test_uv_sphere_of_slivers_keeps_to_the_sphere(segments, ratio, bound, mode):
     vertices, triangles = uv_sphere(segments)
-    result = topstoc.decimate(topstoc.Mesh(vertices, triangles), ratio=ratio, mode="quality", seed=0)
+    result = topstoc.decimate(topstoc.Mesh(vertices, triangles), ratio=ratio, mode=mode, seed=0)
     assert len(result.vertices) == round(ratio * len(vertices))
     assert sphere_deviation(result) < bound
 

@@ -9,7 +9,10 @@ Three modes (``mode=``): ``"quality"`` (the default) runs TopStoc to a few times
 then quadric-ordered edge collapses thin it to the target (``refine``, filtered placement);
 ``"best"`` is quality with a last least-squares fit of the result to the input on large results
 too (smaller ones always get it): a lower mean error for more time; ``"fast"`` is the thesis'
-plain TopStoc (what the live preview shows while the slider moves).
+plain TopStoc (what the live preview shows while the slider moves), except on a sliver-heavy
+mesh of up to 250,000 vertices (a UV sphere of many segments, a CAD strip), where TopStoc's
+clusters, grown by hops, cut across the surface: that mesh is collapsed whole, keeping input
+positions.
 
 Guidance convention (docs/design.md §2.2): ``u`` in [-1, 1] per vertex. ``u = 0`` follows the global
 target; ``u > 0`` asks for more density, ``u < 0`` for less: a density multiplier
@@ -223,7 +226,8 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     (see QUALITY_COLLAPSES); "fast": the thesis' TopStoc, placement "subsample", no refinement
     (except where its pass ends above the target: repairs stalled on non-manifold or
     inconsistently oriented input, or a topology that needs more vertices than drawn; then the
-    collapses finish it, keeping input positions; docs/design.md §2.7); "best": quality, then
+    collapses finish it, keeping input positions; docs/design.md §2.7; and on a sliver-heavy
+    mesh of up to 250,000 vertices, collapsed whole keeping input positions); "best": quality, then
     a result above 1,400 triangles whose collapses started from the whole mesh (up to
     8 * QUALITY_COLLAPSES vertices) is fitted to the input as smaller ones always are, each
     move kept only where the max error does not grow (about 10 % lower mean error on scans for
