@@ -923,12 +923,14 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
   // On a sliver-heavy mesh TopStoc's clusters, grown by hops, cut across the surface (a capped
   // cylinder of 5,000 segments 16.7 % of the diagonal at 10 %): a fast decimation collapses the
   // whole mesh instead, keeping input positions, up to kMaxAwareVertices (about 1-2 s at
-  // 100,000). A draft (the Live Preview's drag) stays TopStoc.
-  if (!params.draft && params.target_vertices >= 1 && params.target_vertices <= active && active <= kMaxAwareVertices &&
+  // 100,000). A draft is that frame made in full (the collapses follow the labels a draft leaves out).
+  if (params.target_vertices >= 1 && params.target_vertices <= active && active <= kMaxAwareVertices &&
       sliver_heavy(mesh)) {
     validate_sampling_params(mesh, params.sampling);
     if (params.max_repair_rounds < 0) throw std::invalid_argument("max_repair_rounds must be >= 0");
-    return collapsed_from_whole_mesh(mesh, layout, params);
+    DecimateParams full = params;
+    full.draft = false;
+    return collapsed_from_whole_mesh(mesh, layout, full);
   }
   return stochastic_pass(mesh, layout, params, false);
 }
