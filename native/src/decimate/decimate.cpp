@@ -732,19 +732,25 @@ DecimateResult collapsed_from_whole_mesh(const Mesh& mesh, const FeatureLayout& 
   return verified(mesh, layout, std::move(whole));
 }
 
-// TopStoc to params.target_vertices. `refined`: a first pass the refinement thins next, which
-// removes zero-area triangles and whose output is checked after it, so neither happens here
-// (except the check that decides whether a fast-path miss must be redone).
-DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
-                               bool refined) {
-  const int32_t active = active_vertices(mesh);
+// The engine's door for a plain decimation: the target, the repair rounds and every caller's
+// sampling parameters checked here.
+void check_plain_params(const Mesh& mesh, const DecimateParams& params, int32_t active) {
   if (params.target_vertices < 1)
     throw std::invalid_argument("target must be at least 1 vertex, got " + std::to_string(params.target_vertices));
   if (params.target_vertices > active)
     throw std::invalid_argument("target of " + std::to_string(params.target_vertices) +
                                 " vertices exceeds the mesh's " + std::to_string(active) + " vertices in triangles");
   if (params.max_repair_rounds < 0) throw std::invalid_argument("max_repair_rounds must be >= 0");
-  validate_sampling_params(mesh, params.sampling);  // the engine's door: every caller's sampling checked here
+  validate_sampling_params(mesh, params.sampling);
+}
+
+// TopStoc to params.target_vertices. `refined`: a first pass the refinement thins next, which
+// removes zero-area triangles and whose output is checked after it, so neither happens here
+// (except the check that decides whether a fast-path miss must be redone).
+DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
+                               bool refined) {
+  const int32_t active = active_vertices(mesh);
+  check_plain_params(mesh, params, active);
   const int32_t target = params.target_vertices;
   // Without guidance the budget is exact. Repairs add samples and absorbed clusters remove
   // some; a shortfall is topped up inside the pass (widest clusters split), an excess (the
@@ -839,10 +845,11 @@ constexpr double kWholeMeshCollapses = 8.0;
 constexpr int32_t kSliverWholeVertices = 2000000;
 
 // Vertices the first pass of a refined decimation keeps (see DecimateParams::refine_collapses).
-int32_t first_pass_vertices(const Mesh& mesh, const DecimateParams& params, int32_t active) {
+int32_t first_pass_vertices(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
+                            int32_t active) {
   const double target = params.target_vertices, collapses = std::max(0, params.refine_collapses);
   if (collapses > 0 && active <= kWholeMeshCollapses * collapses) return active;
-  if (collapses > 0 && active <= kSliverWholeVertices && sliver_heavy(mesh)) return active;
+  if (collapses > 0 && active <= kSliverWholeVertices && sliver_heavy(mesh, layout)) return active;
   const double extra = collapses > 0 ? std::max(collapses, 0.25 * target) : 0.0;
   return int32_t(std::min<double>(active, std::max(std::ceil(params.refine * target), target + extra)));
 }
@@ -858,7 +865,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   first.refine = 0.0;
   first.placement = Placement::Subsample;  // the refinement places the vertices it keeps
   first.labels_in_mesh_order = true;        // what the refinement reads (no copy in its order)
-  first.target_vertices = first_pass_vertices(mesh, params, active);
+  first.target_vertices = first_pass_vertices(mesh, layout, params, active);
   first.warm_up = false;
   // A first pass that depends on the target, or a whole mesh too large for the max-aware reruns:
   // no state a later decimation could resume from.
@@ -924,10 +931,8 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
   // cylinder of 5,000 segments 16.7 % of the diagonal at 10 %): a fast decimation collapses the
   // whole mesh instead, keeping input positions, up to kMaxAwareVertices (about 1-2 s at
   // 100,000). A draft is that frame made in full (the collapses follow the labels a draft leaves out).
-  if (params.target_vertices >= 1 && params.target_vertices <= active && active <= kMaxAwareVertices &&
-      sliver_heavy(mesh)) {
-    validate_sampling_params(mesh, params.sampling);
-    if (params.max_repair_rounds < 0) throw std::invalid_argument("max_repair_rounds must be >= 0");
+  if (active <= kMaxAwareVertices && sliver_heavy(mesh, layout)) {
+    check_plain_params(mesh, params, active);
     DecimateParams full = params;
     full.draft = false;
     return collapsed_from_whole_mesh(mesh, layout, full);

@@ -324,8 +324,10 @@ bool has_zero_area(const DecimateResult& result) {
   return false;
 }
 
+namespace {
+
 // Judged on at most 65,536 triangles evenly spread: a count, the same on any thread count.
-bool sliver_heavy(const Mesh& mesh) {
+bool count_slivers(const Mesh& mesh) {
   const int32_t m = mesh.num_faces();
   const int32_t step = std::max<int32_t>(1, int32_t((int64_t(m) + 65535) / 65536));
   int64_t seen = 0, thin = 0;
@@ -344,6 +346,16 @@ bool sliver_heavy(const Mesh& mesh) {
   return seen > 0 && thin > kSliverHeavyShare * double(seen);
 }
 
+}  // namespace
+
+bool sliver_heavy(const Mesh& mesh, const FeatureLayout& layout) {
+  auto cached = std::static_pointer_cast<const bool>(layout.sliver_heavy.get());
+  if (cached) return *cached;
+  const bool heavy = count_slivers(mesh);
+  layout.sliver_heavy.set(std::make_shared<const bool>(heavy));
+  return heavy;
+}
+
 namespace {
 
 // One refinement of a decimation result: the collapser's setup from the result and the
@@ -353,7 +365,7 @@ class Refinement {
  public:
   Refinement(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params, DecimateResult& result)
       : mesh(mesh), layout(layout), params(params), result(result), n(static_cast<int32_t>(result.kept.size())),
-        num_input(mesh.num_vertices()), sliver_heavy_input(sliver_heavy(mesh)),
+        num_input(mesh.num_vertices()), sliver_heavy_input(sliver_heavy(mesh, layout)),
         guided(params.multipliers && std::any_of(params.multipliers->begin(), params.multipliers->end(),
                                                  [](double m) { return m != 1.0; })) {}
 
@@ -418,7 +430,7 @@ class Refinement {
   }
 
   const int32_t n, num_input;
-  const bool sliver_heavy_input;  // sliver_heavy(mesh)
+  const bool sliver_heavy_input;  // sliver_heavy(mesh, layout)
   const bool guided;
   std::vector<int32_t> label;  // per input vertex: its output vertex
   std::vector<int32_t> final_index;  // per output vertex of the first pass: its vertex in the result

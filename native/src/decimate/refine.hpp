@@ -78,7 +78,8 @@ bool has_zero_area(const DecimateResult& result);
 /// Whether more than a quarter of the mesh's triangles are slivers (shape quality 4 sqrt(3) area
 /// / sum of squared edges below 0.1; 1 for an equilateral triangle): a UV sphere of many
 /// segments, a CAD tessellation's long strips.
-bool sliver_heavy(const Mesh& mesh);
+/// Computed once per mesh and kept with the layout (every decimation reads it).
+bool sliver_heavy(const Mesh& mesh, const FeatureLayout& layout);
 
 /// Thins `result` (a finished decimation of `mesh`, in the caller's ids) to
 /// params.target_vertices output vertices where collapses allow; updates every field of the

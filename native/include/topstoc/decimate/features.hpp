@@ -88,6 +88,7 @@ struct FeatureLayout {
   DerivedTable selection_uniforms;  ///< sampling.cpp's per-vertex uniforms of the seed drawn last
   DerivedTable candidate_order;     ///< candidate_order.cpp's vertices in the order a slider's draws take them
   DerivedTable quadric_frame;   ///< refine.cpp's normalisation frame (it depends on the mesh only)
+  DerivedTable sliver_heavy;    ///< refine.cpp's sliver_heavy verdict (it depends on the mesh only)
   int32_t region_border_edges = 0;
   int32_t flagged_edges = 0;
   int32_t crease_edges = 0;
