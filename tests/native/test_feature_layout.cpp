@@ -5,6 +5,7 @@
 // mesh's first corner of each vertex, looked up where read, against a scan of the triangles.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <numeric>
 #include <vector>
@@ -98,4 +99,44 @@ TEST_CASE("a vertex's first corner is its corner in the first of its triangles t
     REQUIRE(slot >= 0);
     CHECK(mesh.first_corner(v) == 3 * caller_triangle + slot);
   }
+}
+
+// Bends (curve_bends.hpp), against what the grid's border is by construction: a rectangle
+// turns by 90 degrees at its four corners and nowhere else; pushed into a saw-tooth whose
+// teeth turn by 90 degrees every third vertex, at every tip and every notch (and by 45 at
+// its ends); into a zigzag of one vertex in two (it turns by 44 degrees at every vertex, but
+// not over two edges), at none but the corners.
+TEST_CASE("a border's bends are its sharp turns over one and two edges, sharpest first") {
+  const int32_t n = 12, m = 9;
+  topstoc_test::Arrays a = topstoc_test::grid(n, m);
+  auto at = [&](int32_t i, int32_t j) { return i * (m + 1) + j; };  // vertex (i, j) of the grid
+  auto bends_of = [](const topstoc_test::Arrays& arrays) {
+    const Mesh mesh = make(arrays);
+    const auto layout = plain_layout(mesh);
+    std::vector<int32_t> callers;
+    for (int32_t v : layout->curve_bends) callers.push_back(mesh.vertex_source()[v]);
+    std::sort(callers.begin(), callers.end());
+    return callers;
+  };
+  CHECK(bends_of(a) == std::vector<int32_t>{at(0, 0), at(0, m), at(n, 0), at(n, m)});
+  topstoc_test::Arrays zigzag = a, saw = a;
+  std::vector<int32_t> tips;
+  for (int32_t j = 1; j < m; ++j) zigzag.positions[3 * at(0, j)] -= (j % 2) * 0.4;  // along the i = 0 side
+  for (int32_t i = 0; i <= n; ++i) {  // along the j = 0 side: teeth of height 1 every 6 vertices
+    saw.positions[3 * at(i, 0) + 1] -= std::min(i % 6, 6 - i % 6);
+    if (i % 3 == 0) tips.push_back(at(i, 0));
+  }
+  CHECK(bends_of(zigzag) == std::vector<int32_t>{at(0, 0), at(0, m), at(n, 0), at(n, m)});
+  // The saw's ends (0, 0) and (n, 0) are tips or notches too; (0, m) and (n, m) stay corners.
+  tips.push_back(at(0, m)), tips.push_back(at(n, m));
+  std::sort(tips.begin(), tips.end());
+  CHECK(bends_of(saw) == tips);
+  // Sharpest first: the saw's two ends, which turn by 45 degrees, come last.
+  const Mesh mesh = make(saw);
+  const auto layout = plain_layout(mesh);
+  const auto& bends = layout->curve_bends;
+  REQUIRE(bends.size() == tips.size());
+  std::vector<int32_t> last{mesh.vertex_source()[bends[bends.size() - 2]], mesh.vertex_source()[bends.back()]};
+  std::sort(last.begin(), last.end());
+  CHECK(last == std::vector<int32_t>{at(0, 0), at(n, 0)});
 }

@@ -1,5 +1,5 @@
-// The draw without guidance against its definition (sampling.hpp): the vertices with p = 1, and
-// of the others the target's remainder with the smallest Pareto keys (U/(1-U)) ((1-p)/p), U the
+// The draw without guidance against its definition (sampling.hpp): the vertices with p = 1 and
+// the sharpest curve bends (up to an eighth of the target), and of the others the target's remainder with the smallest Pareto keys (U/(1-U)) ((1-p)/p), U the
 // vertex's uniform for the seed. A slider's draws with one seed take a faster way after the
 // first (a candidate order kept on the layout); both ways must give the definition's samples.
 #include <doctest/doctest.h>
@@ -26,10 +26,13 @@ namespace {
 std::vector<int32_t> defined_draw(const Mesh& mesh, const FeatureLayout& layout, const SamplingParams& params,
                                   int32_t target, double rate) {
   const auto p = sampling_probabilities(mesh, layout, params, rate);
+  // The sharpest curve bends, up to an eighth of the target, are kept like p = 1.
+  std::vector<uint8_t> bend(mesh.num_vertices(), 0);
+  for (int32_t i = 0; i < int32_t(layout.curve_bends.size()) && i < target / 8; ++i) bend[layout.curve_bends[i]] = 1;
   std::vector<int32_t> drawn;
   std::vector<std::pair<double, int32_t>> keys;
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-    if (p[v] >= 1.0) {
+    if (p[v] >= 1.0 || (bend[v] && p[v] > 0.0)) {
       drawn.push_back(v);
     } else if (p[v] > 0.0) {
       const double u = uniform01(params.seed, 1, uint64_t(mesh.vertex_source()[v]));

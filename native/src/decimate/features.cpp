@@ -8,6 +8,7 @@
 
 #include "core/fans.hpp"
 #include "core/portable.hpp"
+#include "curve_bends.hpp"
 #include "pinched_fans.hpp"
 
 namespace topstoc {
@@ -305,6 +306,7 @@ std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, cons
   layout->has_feature_vertices =
       std::find(layout->vertex_feature.begin(), layout->vertex_feature.end(), 1) != layout->vertex_feature.end();
   trace_curves(mesh, *layout);
+  layout->curve_bends = find_curve_bends(mesh, *layout);
   collect_boundary_loops(mesh, *layout);
   PinchedVertices pinched = find_pinched_vertices(mesh);
   if (pinched.count > 0) {

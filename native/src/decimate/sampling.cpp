@@ -528,6 +528,36 @@ std::vector<double> sampling_probabilities(const Mesh& mesh, const FeatureLayout
   return probabilities(mesh, *table, guidance_multipliers(mesh, params), params, k);
 }
 
+// The layout's sharpest curve bends, up to an eighth of the count, join the forced vertices
+// (unless never sampled): a random gap at a bend cuts the border's corner off, by up to half
+// the gap (a box-cut isosurface lost 0.5 % of its diagonal so). Returns them sorted, for
+// drop_bends.
+template <class Probability>
+std::vector<int32_t> force_bends(const FeatureLayout& layout, int32_t count, const Probability& probability,
+                                 std::vector<int32_t>& forced) {
+  const size_t take = std::min(layout.curve_bends.size(), size_t(std::max(0, count / 8)));
+  std::vector<int32_t> bends;
+  for (size_t i = 0; i < take; ++i)
+    if (probability(layout.curve_bends[i]) > 0.0) bends.push_back(layout.curve_bends[i]);
+  if (bends.empty()) return bends;
+  std::sort(bends.begin(), bends.end());
+  std::vector<int32_t> already = forced;  // a control point may be a bend
+  std::sort(already.begin(), already.end());
+  for (int32_t v : bends)
+    if (!std::binary_search(already.begin(), already.end(), v)) forced.push_back(v);
+  return bends;
+}
+
+// Removes the forced bends (sorted) from the candidates.
+void drop_bends(const std::vector<int32_t>& bends, std::vector<Candidate>& candidates) {
+  if (bends.empty()) return;
+  candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
+                                  [&bends](const Candidate& c) {
+                                    return std::binary_search(bends.begin(), bends.end(), c.vertex);
+                                  }),
+                   candidates.end());
+}
+
 SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const SamplingParams& params,
                          int32_t target_vertices) {
   validate_sampling_params(mesh, params);
@@ -565,6 +595,8 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
     // whichever way the candidates were found.
     double slope;
     if (plain) out.expected = expected_count(*table, importance(mesh, *table), out.rate, slope);
+    const auto bends = force_bends(layout, count, probability, forced);
+    drop_bends(bends, candidates);
     out.forced = static_cast<int32_t>(forced.size());
     const int32_t free_count = std::max<int32_t>(0, count - out.forced);
     // (Nothing to widen when the forced vertices fill the count: ten passes found no candidate
@@ -573,6 +605,7 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
          free_count > 0 && threshold <= 1e6 && int64_t(candidates.size()) < int64_t(density ? 2 : 1) * free_count + 16;) {
       threshold *= 4;
       candidates = pareto_candidates(mesh, *uniforms, probability, threshold);
+      drop_bends(bends, candidates);
     }
     if (!density) {
       out.samples = std::move(forced);
@@ -584,7 +617,9 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
     } else {
       // Density control may reject many candidates: if the kept superset runs out, take all.
       auto all = [&]() {
-        return pareto_candidates(mesh, *uniforms, probability, std::numeric_limits<double>::infinity());
+        auto every = pareto_candidates(mesh, *uniforms, probability, std::numeric_limits<double>::infinity());
+        drop_bends(bends, every);
+        return every;
       };
       out.samples = select_with_density(mesh, layout, cls, params, std::move(forced), std::move(candidates), all,
                                         std::max(count, out.forced), out.density_rejected);

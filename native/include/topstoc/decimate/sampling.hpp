@@ -55,7 +55,7 @@ struct SamplingParams {
 
 struct SampleSet {
   std::vector<int32_t> samples;  ///< sorted vertex ids
-  int32_t forced = 0;            ///< corners and u = 1 vertices
+  int32_t forced = 0;            ///< corners, u = 1 vertices and the curve bends kept (features.hpp)
   int32_t density_rejected = 0;  ///< candidates skipped by density control
   bool guided = false;           ///< guidance, view or boxes changed the probabilities
   double expected = 0.0;         ///< sum of the probabilities

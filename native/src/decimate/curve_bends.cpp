@@ -1,0 +1,68 @@
+#include "curve_bends.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace topstoc {
+
+namespace {
+
+// Cosine of the turn at b between the directions a -> b and b -> c (1, no turn, when either
+// segment has no length).
+double turn_cosine(const double* a, const double* b, const double* c) {
+  double in[3], out[3], dot = 0, in2 = 0, out2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    in[k] = b[k] - a[k], out[k] = c[k] - b[k];
+    dot += in[k] * out[k], in2 += in[k] * in[k], out2 += out[k] * out[k];
+  }
+  return in2 > 0 && out2 > 0 ? dot / std::sqrt(in2 * out2) : 1.0;
+}
+
+struct Bend {
+  double cosine;  // the larger (milder) of the turns over one and over two edges
+  int32_t vertex;
+  bool operator<(const Bend& o) const { return cosine < o.cosine || (cosine == o.cosine && vertex < o.vertex); }
+};
+
+// The bends of one curve (its vertices in order, closed or running from corner to corner).
+void curve_bends(const Mesh& mesh, const int32_t* curve, int32_t n, bool closed, std::vector<Bend>& out) {
+  if (n < (closed ? 5 : 3)) return;
+  auto at = [&](int32_t i) {  // the i-th vertex, wrapped on a closed curve, else held at the ends
+    return curve[closed ? (i % n + n) % n : std::clamp(i, 0, n - 1)];
+  };
+  auto sharpness = [&](int32_t i) {
+    const double* p = mesh.position(at(i));
+    return Bend{std::max(turn_cosine(mesh.position(at(i - 1)), p, mesh.position(at(i + 1))),
+                         turn_cosine(mesh.position(at(i - 2)), p, mesh.position(at(i + 2)))),
+                at(i)};
+  };
+  const double limit = std::cos(kBendAngle);
+  const int32_t first = closed ? 0 : 1, last = closed ? n : n - 1;  // an open curve's ends are corners
+  for (int32_t i = first; i < last; ++i) {
+    const Bend bend = sharpness(i);
+    if (bend.cosine >= limit) continue;
+    bool sharpest = true;
+    for (int32_t d = -2; d <= 2 && sharpest; ++d) {
+      const int32_t j = i + d;
+      if (d == 0 || (!closed && (j < first || j >= last))) continue;
+      sharpest = bend < sharpness(j);
+    }
+    if (sharpest) out.push_back(bend);
+  }
+}
+
+}  // namespace
+
+std::vector<int32_t> find_curve_bends(const Mesh& mesh, const FeatureLayout& layout) {
+  std::vector<Bend> bends;
+  for (int32_t c = 0; c < layout.num_curves(); ++c) {
+    const int32_t begin = layout.curve_offsets[c], end = layout.curve_offsets[c + 1];
+    curve_bends(mesh, layout.curve_vertices.data() + begin, end - begin, layout.curve_closed[c] != 0, bends);
+  }
+  std::sort(bends.begin(), bends.end());
+  std::vector<int32_t> vertices(bends.size());
+  for (size_t i = 0; i < bends.size(); ++i) vertices[i] = bends[i].vertex;
+  return vertices;
+}
+
+}  // namespace topstoc
