@@ -46,7 +46,7 @@ QUALITY_MODES = [
                            "cleanest result (the live preview shows it when the drag pauses)"),
     ("BEST", "Best", "Quality, then a result of more than 1,400 triangles is fitted to the original as "
                      "smaller ones always are: about 10 % lower mean deviation on scans for about 1.5 times "
-                     "Quality's time (meshes of up to 80,000 vertices; the live preview's pause takes as long)"),
+                     "Quality's time (meshes of up to 250,000 vertices; the live preview's pause takes as long)"),
     ("FAST", "Fast", "The thesis' plain TopStoc: output vertices are input vertices; milliseconds, higher "
                      "deviation (what the live preview shows while dragging)"),
     ("CUSTOM", "Custom", "Plain TopStoc with the Placement and Refine settings under Advanced"),

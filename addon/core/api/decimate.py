@@ -229,7 +229,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     collapses finish it, keeping input positions; docs/design.md §2.7; and on a sliver-heavy
     mesh of up to 250,000 vertices, collapsed whole keeping input positions); "best": quality, then
     a result above 1,400 triangles whose collapses started from the whole mesh (up to
-    8 * QUALITY_COLLAPSES vertices) is fitted to the input as smaller ones always are, each
+    250,000 vertices) is fitted to the input as smaller ones always are, each
     move kept only where the max error does not grow (about 10 % lower mean error on scans for
     1.4-1.6 times quality's time; docs/bench_notes/large-fit.md).
     placement and refine, when given, override what the mode sets.
@@ -238,7 +238,9 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     collapses themselves place a vertex joining two free vertices at the quadric optimum either
     way; placement only decides the final re-fit.
     refine: None = the mode's own (quality: the first pass keeps the target plus
-    max(QUALITY_COLLAPSES, target / 4) vertices, or the whole mesh up to 8 * QUALITY_COLLAPSES;
+    max(QUALITY_COLLAPSES, target / 4) vertices and, up to 500,000 vertices, at least
+    min(8 * target, 125,000), or the
+    whole mesh up to 250,000 vertices;
     fast: 0). 0 = off (fastest). f >= 1: TopStoc keeps f times the target (so refine=1 leaves
     the collapses almost nothing to do), then edge collapses ordered by quadric error against
     the input thin it to the target (topology and borders kept, painted regions keeping their

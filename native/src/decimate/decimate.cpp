@@ -836,6 +836,25 @@ namespace {
 // cost quality (3.8 times the mean error on a 62k-vertex character; docs/benchmarks.md).
 constexpr double kWholeMeshCollapses = 8.0;
 
+// ... and, whatever refine_collapses, up to this many vertices, where the max-aware reruns run
+// (refine.hpp): from the stochastic pass a box-cut gyroid of 172,706 vertices at 10 % had 4.6
+// times the best peer's max error and a field of 600 spheres 2.1 times (the first pass's
+// random gaps, which the collapses cannot fill), in 0.2-0.4 s; collapsed whole 0.9 and 1.2
+// times, in 4-5 s, still faster than Blender's Decimate and MeshLab on them
+// (docs/bench_notes/large-first-pass.md).
+constexpr int32_t kWholeMeshVertices = kMaxAwareVertices;
+
+// Above it, up to kFloorVertices, the first pass keeps at least kFirstPassTimes times the
+// target, up to kFirstPassFloor vertices: on Stanford's dragon scan (437,645 vertices) at 10 % a
+// first pass of 54,700 had 2.3 times Blender's mean error, one of 125,000 1.3 times, in 2 s
+// rather than 1 s (Blender's Decimate 17 s); at 2 %, 18,800 vertices 1.7 times, 70,000 1.05
+// times (docs/bench_notes/large-first-pass.md). Above kFloorVertices the collapser's state for
+// such a pass would raise the peak memory (a 2M-triangle torus at 1 %: 80.7 -> 95.4 bytes a
+// triangle), so larger meshes keep the target and max(refine_collapses, target / 4).
+constexpr int32_t kFirstPassFloor = kWholeMeshVertices / 2;
+constexpr double kFirstPassTimes = 8.0;
+constexpr int32_t kFloorVertices = 2 * kWholeMeshVertices;
+
 // A sliver-heavy mesh (sliver_heavy, refine.hpp) starts from the whole mesh up to this many
 // vertices: on it the stochastic pass's clusters, grown by hop count, stretch along the long
 // edges and its triangles cut across the surface (a UV sphere of 2,000 segments kept 1.8 % of the
@@ -848,10 +867,12 @@ constexpr int32_t kSliverWholeVertices = 2000000;
 int32_t first_pass_vertices(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
                             int32_t active) {
   const double target = params.target_vertices, collapses = std::max(0, params.refine_collapses);
-  if (collapses > 0 && active <= kWholeMeshCollapses * collapses) return active;
+  if (collapses > 0 && (active <= kWholeMeshCollapses * collapses || active <= kWholeMeshVertices)) return active;
   if (collapses > 0 && active <= kSliverWholeVertices && sliver_heavy(mesh, layout)) return active;
   const double extra = collapses > 0 ? std::max(collapses, 0.25 * target) : 0.0;
-  return int32_t(std::min<double>(active, std::max(std::ceil(params.refine * target), target + extra)));
+  const double floor =
+      collapses > 0 && active <= kFloorVertices ? std::min<double>(kFirstPassFloor, kFirstPassTimes * target) : 0.0;
+  return int32_t(std::min<double>(active, std::max({std::ceil(params.refine * target), target + extra, floor})));
 }
 
 // TopStoc to a few times the target, then collapses down to it (refine.hpp). Painted regions
