@@ -1,0 +1,54 @@
+"""Quality mode on a mesh of more than 80,000 vertices against MeshLab's quadric collapse
+(docs/bench_notes/large-first-pass.md): a gyroid cut by a box, a marching-cubes surface of
+about 115,000 vertices whose rim turns at the box's edges. From a stochastic first pass its max
+error at 10 % was 6.3 times MeshLab's; collapsed whole it is 1.19 times (the goal of issue 40,
+1.15, is not met here). Both results are measured by MeshLab's Hausdorff filter, and MeshLab
+decimates to our triangle count."""
+
+import pytest
+
+from peer_runs import meshlab_hausdorff, write_off
+from topstoc.core import Mesh
+
+pymeshlab = pytest.importorskip("pymeshlab")
+pytestmark = pytest.mark.heavy
+
+
+def box_cut_gyroid():
+    ms = pymeshlab.MeshSet()
+    ms.create_implicit_surface(expr="sin(x)*cos(y)+sin(y)*cos(z)+sin(z)*cos(x)", voxelsize=0.11,
+                               minx=-6.2, miny=-6.2, minz=-6.2, maxx=6.2, maxy=6.2, maxz=6.2)
+    ms.meshing_merge_close_vertices()
+    ms.meshing_remove_unreferenced_vertices()
+    m = ms.current_mesh()
+    return m.vertex_matrix(), m.face_matrix()
+
+
+def meshlab_decimation(vertices, triangles, target_triangles):
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertices, triangles))
+    ms.meshing_decimation_quadric_edge_collapse(targetfacenum=target_triangles, optimalplacement=True,
+                                                preservetopology=True, preserveboundary=True)
+    m = ms.current_mesh()
+    return m.vertex_matrix(), m.face_matrix()
+
+
+def symmetric(distances):
+    return max(distances["forward"]["max"], distances["backward"]["max"]), \
+        (distances["forward"]["mean"] + distances["backward"]["mean"]) / 2
+
+
+def test_a_box_cut_gyroid_at_ten_percent_stays_near_meshlab(tmp_path):
+    vertices, triangles = box_cut_gyroid()
+    assert 80_000 < len(vertices) < 250_000  # above the old limit of a whole-mesh start
+    ours = Mesh(vertices, triangles).decimate(target_triangles=len(triangles) // 10, seed=0)
+    theirs = meshlab_decimation(vertices, triangles, ours.num_triangles)
+    paths = {name: tmp_path / f"{name}.off" for name in ("input", "ours", "theirs")}
+    write_off(paths["input"], vertices, triangles)
+    write_off(paths["ours"], ours.vertices, ours.triangles)
+    write_off(paths["theirs"], *theirs)
+    our_max, our_mean = symmetric(meshlab_hausdorff(paths["input"], paths["ours"], samples=300_000))
+    their_max, their_mean = symmetric(meshlab_hausdorff(paths["input"], paths["theirs"], samples=300_000))
+    assert ours.stats.topology_kept
+    assert our_max <= 1.25 * their_max, (our_max, their_max)
+    assert our_mean <= 1.05 * their_mean, (our_mean, their_mean)
