@@ -839,15 +839,14 @@ constexpr double kWholeMeshCollapses = 8.0;
 // ... and, whatever refine_collapses, up to this many vertices, where the max-aware reruns run
 // (refine.hpp): from the stochastic pass a box-cut gyroid of 172,706 vertices at 10 % had 4.6
 // times the best peer's max error and a field of 600 spheres 2.1 times (the first pass's
-// random gaps, which the collapses cannot fill), in 0.2-0.4 s; collapsed whole 0.9 and 1.2
-// times, in 4-5 s, still faster than Blender's Decimate and MeshLab on them
-// (docs/bench_notes/large-first-pass.md).
+// random gaps, which the collapses cannot fill), in 0.2-0.4 s; collapsed whole 0.89 and 0.99
+// times, in 2.6-4.7 s, about Blender's Decimate's time (docs/bench_notes/large-first-pass.md).
 constexpr int32_t kWholeMeshVertices = kMaxAwareVertices;
 
 // Above it, up to kFloorVertices, the first pass keeps at least kFirstPassTimes times the
 // target, up to kFirstPassFloor vertices: on Stanford's dragon scan (437,645 vertices) at 10 % a
-// first pass of 54,700 had 2.3 times Blender's mean error, one of 125,000 1.3 times, in 2 s
-// rather than 1 s (Blender's Decimate 17 s); at 2 %, 18,800 vertices 1.7 times, 70,000 1.05
+// first pass of 54,700 had 2.3 times Blender's mean error, one of 125,000 1.4 times, in 2 s
+// rather than 1 s (Blender's Decimate 15 s); at 2 % 18,800 vertices 1.7 times, 70,000 1.01
 // times (docs/bench_notes/large-first-pass.md). Above kFloorVertices the collapser's state for
 // such a pass would raise the peak memory (a 2M-triangle torus at 1 %: 80.7 -> 95.4 bytes a
 // triangle), so larger meshes keep the target and max(refine_collapses, target / 4).
