@@ -237,14 +237,13 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     vertices to the quadric-optimal point of their cluster (borders stay). In quality mode the
     collapses themselves place a vertex joining two free vertices at the quadric optimum either
     way; placement only decides the final re-fit.
-    refine: None = the mode's own (quality: the first pass keeps the target plus
-    max(QUALITY_COLLAPSES, target / 4) vertices and, up to 500,000 vertices, at least
-    min(8 * target, 125,000), or the
-    whole mesh up to 250,000 vertices;
-    fast: 0). 0 = off (fastest). f >= 1: TopStoc keeps f times the target (so refine=1 leaves
-    the collapses almost nothing to do), then edge collapses ordered by quadric error against
-    the input thin it to the target (topology and borders kept, painted regions keeping their
-    share of the budget). Lower error at a higher cost.
+    refine: None = the mode's own (quality: the whole mesh up to 250,000 vertices, else a first
+    pass of the target plus max(QUALITY_COLLAPSES, target / 4) vertices, and up to 500,000
+    vertices at least min(8 * target, 125,000); fast: 0). 0 = off (fastest). f >= 1: TopStoc
+    keeps f times the target (so refine=1 leaves the collapses almost nothing to do), then edge
+    collapses ordered by quadric error against the input thin it to the target (topology and
+    borders kept, painted regions keeping their share of the budget). Lower error at a higher
+    cost.
     attributes: UVs, colours, normals... that should survive the collapses: (n, k) per vertex
     or (m, 3, k) per corner of the caller's triangles (per corner for UVs with seams). They
     enter the collapse cost as generalised quadrics (docs/design.md §2.10): with weight w, a

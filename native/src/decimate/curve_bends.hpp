@@ -11,7 +11,7 @@ namespace topstoc {
 /// A bend turns the curve by more than this (radians), measured one and two edges around it.
 constexpr double kBendAngle = 40.0 * 3.14159265358979323846 / 180.0;
 
-/// The vertices of layout's traced curves (corners excluded) where the curve turns by more than
+/// The vertices of layout's traced mesh boundaries (corners excluded) where the curve turns by more than
 /// kBendAngle over one edge and over two edges on each side, and more sharply than the two
 /// vertices on either side of it along the curve; sharpest first. A draw that leaves such a
 /// vertex out cuts the corner off the border (sampling.cpp forces them).

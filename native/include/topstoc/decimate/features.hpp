@@ -68,7 +68,7 @@ struct FeatureLayout {
   std::vector<uint8_t> curve_closed;
   /// Curve of each non-corner feature vertex, else -1; empty when there are no curves (use curve_of).
   std::vector<int32_t> vertex_curve;
-  /// Curve vertices where the curve turns sharply, sharpest first (curve_bends.hpp): the draw
+  /// Boundary vertices where the boundary turns sharply, sharpest first (curve_bends.hpp): the draw
   /// keeps them, up to an eighth of its count.
   std::vector<int32_t> curve_bends;
   /// Mesh boundary loops (cycles of edges with one triangle, continued at a vertex within one
