@@ -25,27 +25,29 @@ struct Bend {
 };
 
 // The bends of one curve (its vertices in order, closed or running from corner to corner).
+// Each vertex's sharpness is computed once; a bend is compared with the two on either side.
 void curve_bends(const Mesh& mesh, const int32_t* curve, int32_t n, bool closed, std::vector<Bend>& out) {
   if (n < (closed ? 5 : 3)) return;
   auto at = [&](int32_t i) {  // the i-th vertex, wrapped on a closed curve, else held at the ends
     return curve[closed ? (i % n + n) % n : std::clamp(i, 0, n - 1)];
   };
-  auto sharpness = [&](int32_t i) {
-    const double* p = mesh.position(at(i));
-    return Bend{std::max(turn_cosine(mesh.position(at(i - 1)), p, mesh.position(at(i + 1))),
-                         turn_cosine(mesh.position(at(i - 2)), p, mesh.position(at(i + 2)))),
-                at(i)};
-  };
-  const double limit = std::cos(kBendAngle);
   const int32_t first = closed ? 0 : 1, last = closed ? n : n - 1;  // an open curve's ends are corners
+  std::vector<Bend> sharpness(n, Bend{1.0, -1});
   for (int32_t i = first; i < last; ++i) {
-    const Bend bend = sharpness(i);
+    const double* p = mesh.position(at(i));
+    sharpness[i] = Bend{std::max(turn_cosine(mesh.position(at(i - 1)), p, mesh.position(at(i + 1))),
+                                 turn_cosine(mesh.position(at(i - 2)), p, mesh.position(at(i + 2)))),
+                        at(i)};
+  }
+  const double limit = std::cos(kBendAngle);
+  for (int32_t i = first; i < last; ++i) {
+    const Bend& bend = sharpness[i];
     if (bend.cosine >= limit) continue;
     bool sharpest = true;
     for (int32_t d = -2; d <= 2 && sharpest; ++d) {
       const int32_t j = i + d;
       if (d == 0 || (!closed && (j < first || j >= last))) continue;
-      sharpest = bend < sharpness(j);
+      sharpest = bend < sharpness[(j % n + n) % n];
     }
     if (sharpest) out.push_back(bend);
   }

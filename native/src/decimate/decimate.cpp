@@ -866,7 +866,7 @@ constexpr int32_t kSliverWholeVertices = 2000000;
 int32_t first_pass_vertices(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params,
                             int32_t active) {
   const double target = params.target_vertices, collapses = std::max(0, params.refine_collapses);
-  if (collapses > 0 && (active <= kWholeMeshCollapses * collapses || active <= kWholeMeshVertices)) return active;
+  if (collapses > 0 && active <= std::max<double>(kWholeMeshCollapses * collapses, kWholeMeshVertices)) return active;
   if (collapses > 0 && active <= kSliverWholeVertices && sliver_heavy(mesh, layout)) return active;
   const double extra = collapses > 0 ? std::max(collapses, 0.25 * target) : 0.0;
   const double floor =

@@ -597,6 +597,12 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
     if (plain) out.expected = expected_count(*table, importance(mesh, *table), out.rate, slope);
     const auto bends = force_bends(layout, count, probability, forced);
     drop_bends(bends, candidates);
+    // The candidates below a threshold, the forced bends left out.
+    auto candidates_below = [&](double threshold) {
+      auto found = pareto_candidates(mesh, *uniforms, probability, threshold);
+      drop_bends(bends, found);
+      return found;
+    };
     out.forced = static_cast<int32_t>(forced.size());
     const int32_t free_count = std::max<int32_t>(0, count - out.forced);
     // (Nothing to widen when the forced vertices fill the count: ten passes found no candidate
@@ -604,8 +610,7 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
     for (double threshold = first_threshold;
          free_count > 0 && threshold <= 1e6 && int64_t(candidates.size()) < int64_t(density ? 2 : 1) * free_count + 16;) {
       threshold *= 4;
-      candidates = pareto_candidates(mesh, *uniforms, probability, threshold);
-      drop_bends(bends, candidates);
+      candidates = candidates_below(threshold);
     }
     if (!density) {
       out.samples = std::move(forced);
@@ -616,11 +621,7 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
       }
     } else {
       // Density control may reject many candidates: if the kept superset runs out, take all.
-      auto all = [&]() {
-        auto every = pareto_candidates(mesh, *uniforms, probability, std::numeric_limits<double>::infinity());
-        drop_bends(bends, every);
-        return every;
-      };
+      auto all = [&]() { return candidates_below(std::numeric_limits<double>::infinity()); };
       out.samples = select_with_density(mesh, layout, cls, params, std::move(forced), std::move(candidates), all,
                                         std::max(count, out.forced), out.density_rejected);
     }
