@@ -312,17 +312,21 @@ TEST_CASE("workers sleep between calls: serial gaps between parallel calls cost 
   // Each call is followed by a 2 ms gap in which the caller sleeps, as the serial steps between a
   // decimation's batches. Workers that spun through the gaps (for a millisecond each, as before)
   // would add about 1 ms of CPU per gap; workers that sleep add a few tens of microseconds.
+  // The least of three rounds: on a loaded machine one round can be charged a preempted wake-up.
   with_threads(2, [] {
     constexpr int kGaps = 40;
     int64_t total = parallel_count<int64_t>(0, 2, 0, [](int64_t i) { return i; });  // the worker exists
-    const double before = process_cpu_seconds();
-    for (int gap = 0; gap < kGaps; ++gap) {
-      total += parallel_count<int64_t>(0, 2, 0, [](int64_t i) { return i; });
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    double least = 1e9;
+    for (int round = 0; round < 3; ++round) {
+      const double before = process_cpu_seconds();
+      for (int gap = 0; gap < kGaps; ++gap) {
+        total += parallel_count<int64_t>(0, 2, 0, [](int64_t i) { return i; });
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      }
+      least = std::min(least, process_cpu_seconds() - before);
     }
-    const double cpu = process_cpu_seconds() - before;
-    CHECK(total == kGaps + 1);
-    CHECK(cpu < kGaps * 0.3e-3);
+    CHECK(total == 3 * kGaps + 1);
+    CHECK(least < kGaps * 0.3e-3);
   });
 }
 #endif
