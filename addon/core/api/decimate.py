@@ -239,7 +239,7 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     way; placement only decides the final re-fit.
     refine: None = the mode's own (quality: the whole mesh up to 250,000 vertices, else a first
     pass of the target plus max(QUALITY_COLLAPSES, target / 4) vertices, and up to 500,000
-    vertices at least min(8 * target, 125,000); fast: 0). 0 = off (fastest). f >= 1: TopStoc
+    vertices 8 * target within [125,000, 250,000]; fast: 0). 0 = off (fastest). f >= 1: TopStoc
     keeps f times the target (so refine=1 leaves the collapses almost nothing to do), then edge
     collapses ordered by quadric error against the input thin it to the target (topology and
     borders kept, painted regions keeping their share of the budget). Lower error at a higher
