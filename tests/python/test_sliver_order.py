@@ -13,15 +13,10 @@ import numpy as np
 import pytest
 
 from test_hausdorff import brute_force_distance
+from test_scan_floor import boundary_edges
 from topstoc.core import Mesh
 
 DATA = pathlib.Path(__file__).resolve().parents[1] / "data" / "open_boundary" / "gyroid_rim_corner.npz"
-
-
-def boundary_vertices(triangles):
-    edges = np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]]), axis=1)
-    unique, counts = np.unique(edges, axis=0, return_counts=True)
-    return np.unique(unique[counts == 1])
 
 
 @pytest.mark.parametrize("ratio", [0.9, 0.5, 0.2])
@@ -29,7 +24,7 @@ def test_the_rim_keeps_its_corner(ratio):
     data = np.load(DATA)
     vertices, triangles, corner = data["vertices"], data["triangles"], int(data["corner"])
     diagonal = np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0))
-    rim = boundary_vertices(triangles)
+    rim = np.unique(boundary_edges(triangles))
     assert corner in rim
     result = Mesh(vertices, triangles).decimate(ratio=ratio, seed=0)
     assert result.stats.topology_kept
