@@ -61,34 +61,42 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   fit_threads();
   // Every vertex's cheapest collapse, each edge evaluated once (from its lower end) where it
   // costs the same both ways. A thread owns the lower ends it evaluates; what it finds for the
-  // higher ends is merged afterwards. The cheapest by (cost, id) does not depend on the order.
+  // higher ends is merged after each block of kSetupBlock vertices, so the offers never hold
+  // more than a block's edges (all of them were about 150 bytes a vertex at the collapser's
+  // peak). The cheapest by (cost, id) does not depend on the order.
   std::vector<double> best_cost(n, 0.0);
   auto better = [&](int32_t u, int32_t v, double c) {
     return target_[u] < 0 || c < best_cost[u] || (c == best_cost[u] && v < target_[u]);
   };
   const int threads = scratch_.size();
   PerThread<std::vector<std::pair<int32_t, Best>>> found(threads);
-  parallel_region(n >= 10000 ? threads : 1, [&](Team& team) {
-    Scratch& scratch = scratch_.mine();
-    auto& mine = found.mine();
-    std::vector<int32_t> around;
-    team.for_static(0, n, [&](int32_t u) {
-      const bool u_queues = queues(u);
-      neighbours(u, scratch, around);
-      for (int32_t v : around) {
-        if (v < u) continue;
-        const bool v_queues = queues(v);
-        const double uv = u_queues ? cost(u, v) : 0.0;
-        if (u_queues && better(u, v, uv)) target_[u] = v, best_cost[u] = uv;
-        if (v_queues) mine.push_back({v, {u, u_queues && free_pair(u, v) ? uv : cost(v, u)}});
-      }
+  for (int32_t lo = 0; lo < n; lo += std::min(kSetupBlock, n - lo)) {
+    const int32_t hi = lo + std::min(kSetupBlock, n - lo);
+    parallel_region(n >= 10000 ? threads : 1, [&](Team& team) {
+      Scratch& scratch = scratch_.mine();
+      auto& mine = found.mine();
+      std::vector<int32_t> around;
+      team.for_static(lo, hi, [&](int32_t u) {
+        const bool u_queues = queues(u);
+        neighbours(u, scratch, around);
+        for (int32_t v : around) {
+          if (v < u) continue;
+          const bool v_queues = queues(v);
+          const double uv = u_queues ? cost(u, v) : 0.0;
+          if (u_queues && better(u, v, uv)) target_[u] = v, best_cost[u] = uv;
+          if (v_queues) mine.push_back({v, {u, u_queues && free_pair(u, v) ? uv : cost(v, u)}});
+        }
+      });
     });
-  });
-  for (int t = 0; t < threads; ++t)
-    for (const auto& [v, offer] : found[t])
-      if (better(v, offer.target, offer.cost)) target_[v] = offer.target, best_cost[v] = offer.cost;
+    for (int t = 0; t < threads; ++t) {
+      for (const auto& [v, offer] : found[t])
+        if (better(v, offer.target, offer.cost)) target_[v] = offer.target, best_cost[v] = offer.cost;
+      found[t].clear();
+    }
+  }
   std::vector<int32_t> ids;
   std::vector<double> keys;
+  ids.reserve(n), keys.reserve(n);
   for (int32_t u = 0; u < n; ++u)
     if (target_[u] >= 0) ids.push_back(u), keys.push_back(best_cost[u]);
   heap_.assign(ids, keys);

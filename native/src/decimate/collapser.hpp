@@ -201,6 +201,8 @@ class Collapser {
   // its fan a round at a time.
   static constexpr int32_t kWideFan = 64;
   static constexpr size_t kWideTries = 16;  // collapses a wide vertex's evaluation checks (evaluate)
+  // Vertices whose collapse offers the constructor gathers before merging them (see there).
+  static constexpr int32_t kSetupBlock = 1 << 15;
   bool allowed_wide(int32_t u, int32_t v, Scratch& scratch) const;
   int32_t common_neighbours(int32_t a, int32_t b, Scratch& scratch) const;
   int32_t count_neighbours(int32_t v, int32_t enough, Scratch& scratch) const;
