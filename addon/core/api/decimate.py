@@ -238,8 +238,9 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     collapses themselves place a vertex joining two free vertices at the quadric optimum either
     way; placement only decides the final re-fit.
     refine: None = the mode's own (quality: the whole mesh up to 250,000 vertices, else a first
-    pass of the target plus max(QUALITY_COLLAPSES, target / 4) vertices, and up to 500,000
-    vertices 8 * target within [125,000, 250,000]; fast: 0). 0 = off (fastest). f >= 1: TopStoc
+    pass of the target plus max(QUALITY_COLLAPSES, target / 4) vertices and at least
+    min(8 * target, 250,000), up to 500,000 vertices at least 125,000; fast: 0). 0 = off
+    (fastest). f >= 1: TopStoc
     keeps f times the target (so refine=1 leaves the collapses almost nothing to do), then edge
     collapses ordered by quadric error against the input thin it to the target (topology and
     borders kept, painted regions keeping their share of the budget). Lower error at a higher

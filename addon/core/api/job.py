@@ -28,8 +28,9 @@ DENSITY_MODES = ("off", "uniform", "adaptive", "euclidean")
 PLACEMENTS = ("subsample", "filtered")
 MODES = ("quality", "fast", "best")
 #: quality mode: the collapses remove max(QUALITY_COLLAPSES, target / 4) vertices after a
-#: stochastic first pass (the time then grows with the target, not with the mesh), which on a
-#: mesh of up to 500,000 vertices keeps 8 * target, within [125,000, 250,000]; they start from the
+#: stochastic first pass (the time then grows with the target, not with the mesh), which keeps
+#: at least min(8 * target, 250,000) vertices, and on a mesh of up to 500,000 vertices at least
+#: 125,000; they start from the
 #: whole mesh when it has at most max(8 * QUALITY_COLLAPSES, 250,000) vertices (the lowest
 #: error) or is sliver-heavy, up to 2M vertices (docs/design.md §2.10). QUALITY_REFINE only
 #: marks the refinement as on: an explicit refine=f sizes the first pass as f times the target

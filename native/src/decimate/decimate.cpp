@@ -843,15 +843,17 @@ constexpr double kWholeMeshCollapses = 8.0;
 // times, in 2.6-4.7 s, about Blender's Decimate's time (docs/bench_notes/large-first-pass.md).
 constexpr int32_t kWholeMeshVertices = kMaxAwareVertices;
 
-// Above it, up to kFloorVertices, the first pass keeps kFirstPassTimes times the target, at
-// least kFirstPassFloor and at most kWholeMeshVertices vertices: on Stanford's dragon scan
+// Above it the first pass keeps kFirstPassTimes times the target, at most kWholeMeshVertices
+// vertices, and up to kFloorVertices at least kFirstPassFloor: on Stanford's dragon scan
 // (437,645 vertices) a first pass of the target and 10,000 more had 2.3 times Blender's mean
 // error at 10 % and 1.7 times at 2 %; 8 times the target up to 125,000 left 1.4 times at 10 %
 // (first pass 125,000; 250,000 gives 1.04) and a max 1.34 times the best peer's at 2 % (first
 // pass 70,000; 125,000 gives 0.96), in 1-2.5 s where Blender's Decimate takes 15
-// (docs/bench_notes/large-first-pass.md). Above kFloorVertices the collapser's state for
-// such a pass would raise the peak memory (a 2M-triangle torus at 1 %: 80.7 -> 95.4 bytes a
-// triangle), so larger meshes keep the target and max(refine_collapses, target / 4).
+// (docs/bench_notes/large-first-pass.md). On the horse (775,000 vertices) the target and a
+// quarter more had 3.0 times Blender's mean error at 10 % and 1.7 times at 1 %; 8 times the
+// target, 1.35 and 1.07 times (docs/bench_notes/large-first-pass.md, third section). The
+// collapser's state costs about 450 bytes a first-pass vertex: a 2M-triangle torus at 1 % peaks
+// at 93 bytes a triangle instead of 81.
 constexpr int32_t kFirstPassFloor = kWholeMeshVertices / 2;
 constexpr double kFirstPassTimes = 8.0;
 constexpr int32_t kFloorVertices = 2 * kWholeMeshVertices;
@@ -871,10 +873,8 @@ int32_t first_pass_vertices(const Mesh& mesh, const FeatureLayout& layout, const
   if (collapses > 0 && active <= std::max<double>(kWholeMeshCollapses * collapses, kWholeMeshVertices)) return active;
   if (collapses > 0 && active <= kSliverWholeVertices && sliver_heavy(mesh, layout)) return active;
   const double extra = collapses > 0 ? std::max(collapses, 0.25 * target) : 0.0;
-  const double floor =
-      collapses > 0 && active <= kFloorVertices
-          ? std::clamp<double>(kFirstPassTimes * target, kFirstPassFloor, kWholeMeshVertices)
-          : 0.0;
+  const double times = std::min<double>(kFirstPassTimes * target, kWholeMeshVertices);
+  const double floor = collapses == 0 ? 0.0 : active <= kFloorVertices ? std::max<double>(times, kFirstPassFloor) : times;
   return int32_t(std::min<double>(active, std::max({std::ceil(params.refine * target), target + extra, floor})));
 }
 
