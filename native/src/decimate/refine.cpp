@@ -166,13 +166,47 @@ void add_vertex_quadric(const Mesh& mesh, const QuadricFrame& frame, int32_t v, 
   });
 }
 
+// A sharp bend of a mesh boundary (curve_bends.hpp), which a stochastic first pass keeps
+// (sampling.cpp forces bends), holds its place by a point quadric: three orthogonal planes through
+// it weighted by the squared mean edge length. The border planes are weighted by their own edges'
+// squared lengths, so a bend on a rim of tiny edges (a marching-cubes surface meeting a box edge,
+// a scan's tiny hole) held almost nothing and was cut. A mesh collapsed whole has none: the
+// max-aware reruns guard its max, and there the anchors cost more than they gained (beetle at 2 %:
+// max 1.9 times; docs/bench_notes/large-first-pass.md).
+void add_bend_anchors(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& label,
+                      const QuadricFrame& frame, VertexQuadrics& quadrics) {
+  if (layout.curve_bends.empty()) return;
+  const auto& faces = mesh.faces();
+  const double scale = 1.0 / frame.extent;
+  double sum = 0.0;
+  for (int32_t f = 0; f < mesh.num_faces(); ++f)
+    for (int j = 0; j < 3; ++j) {
+      const double* a = mesh.position(faces[3 * size_t(f) + j]);
+      const double* b = mesh.position(faces[3 * size_t(f) + (j + 1) % 3]);
+      sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+    }
+  const double mean = mesh.num_faces() > 0 ? scale * sum / (3.0 * mesh.num_faces()) : 0.0;
+  const double weight = mean * mean;
+  if (!(weight > 0)) return;
+  for (int32_t v : layout.curve_bends) {
+    if (label[v] < 0) continue;
+    for (int axis = 0; axis < 3; ++axis) {
+      double u[3] = {0, 0, 0};
+      u[axis] = 1.0;
+      const double d = -(mesh.position(v)[axis] - frame.center[axis]) * scale;
+      VertexQuadrics::add_plane(quadrics.at(label[v]), u, d, weight);
+    }
+  }
+}
+
 // Each output vertex stands for the input triangles of its cluster (each weighed by the share of
 // its corners in the cluster) and for the border edges in it: planes through each border edge,
 // perpendicular to its triangles, keep collapses from pulling a border (boundary, seam,
 // material edge) off its course. Each thread owns a range of clusters and adds to them in input
 // order, so the sums do not depend on the number of threads.
 VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
-                                const std::vector<int32_t>& label, int32_t clusters, const QuadricFrame& frame) {
+                                const std::vector<int32_t>& label, int32_t clusters, const QuadricFrame& frame,
+                                bool anchor_bends) {
   const int channels = params.attributes.values ? params.attributes.channels : 0;
   // Wedges only where some cluster has two: otherwise one attribute part per vertex is the same.
   std::vector<uint8_t> wedge;
@@ -261,6 +295,7 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
         if (l[j] >= 0 && (j == 0 || l[j] != l[0])) VertexQuadrics::add_plane(quadrics.at(l[j]), side, d, weight);
     }
   }
+  if (anchor_bends) add_bend_anchors(mesh, layout, label, frame, quadrics);
   return quadrics;
 }
 
@@ -386,7 +421,7 @@ class Refinement {
     }
     std::vector<int32_t>().swap(result.labels);
     kept_vertex = mesh.internal_ids(result.kept);
-    setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *frame);
+    setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *frame, !whole_input());
     set_up_vertices(setup);
     lock_inconsistent(setup);
     count_locked_ends(setup);
