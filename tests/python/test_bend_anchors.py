@@ -10,21 +10,12 @@ import numpy as np
 import pytest
 
 from test_hausdorff import brute_force_distance
+from test_large_first_pass import box_cut_gyroid
 from test_scan_floor import boundary_edges
 from topstoc.core import Mesh
 
-pymeshlab = pytest.importorskip("pymeshlab")
+pytest.importorskip("pymeshlab")
 pytestmark = pytest.mark.heavy
-
-
-def box_cut_gyroid(voxel):
-    ms = pymeshlab.MeshSet()
-    ms.create_implicit_surface(expr="sin(x)*cos(y)+sin(y)*cos(z)+sin(z)*cos(x)", voxelsize=voxel,
-                               minx=-6.2, miny=-6.2, minz=-6.2, maxx=6.2, maxy=6.2, maxz=6.2)
-    ms.meshing_merge_close_vertices()
-    ms.meshing_remove_unreferenced_vertices()
-    m = ms.current_mesh()
-    return m.vertex_matrix(), m.face_matrix()
 
 
 def test_the_rim_keeps_its_bends_at_the_box_edges():

@@ -70,8 +70,8 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   };
   const int threads = scratch_.size();
   PerThread<std::vector<std::pair<int32_t, Best>>> found(threads);
-  for (int32_t lo = 0; lo < n; lo += std::min(kSetupBlock, n - lo)) {
-    const int32_t hi = lo + std::min(kSetupBlock, n - lo);
+  for (int32_t lo = 0, hi; lo < n; lo = hi) {
+    hi = lo + std::min(kSetupBlock, n - lo);
     parallel_region(n >= 10000 ? threads : 1, [&](Team& team) {
       Scratch& scratch = scratch_.mine();
       auto& mine = found.mine();

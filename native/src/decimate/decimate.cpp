@@ -873,8 +873,9 @@ int32_t first_pass_vertices(const Mesh& mesh, const FeatureLayout& layout, const
   if (collapses > 0 && active <= std::max<double>(kWholeMeshCollapses * collapses, kWholeMeshVertices)) return active;
   if (collapses > 0 && active <= kSliverWholeVertices && sliver_heavy(mesh, layout)) return active;
   const double extra = collapses > 0 ? std::max(collapses, 0.25 * target) : 0.0;
-  const double times = std::min<double>(kFirstPassTimes * target, kWholeMeshVertices);
-  const double floor = collapses == 0 ? 0.0 : active <= kFloorVertices ? std::max<double>(times, kFirstPassFloor) : times;
+  double floor = 0.0;
+  if (collapses > 0) floor = std::min<double>(kFirstPassTimes * target, kWholeMeshVertices);
+  if (collapses > 0 && active <= kFloorVertices) floor = std::max<double>(floor, kFirstPassFloor);
   return int32_t(std::min<double>(active, std::max({std::ceil(params.refine * target), target + extra, floor})));
 }
 
