@@ -891,6 +891,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   first.placement = Placement::Subsample;  // the refinement places the vertices it keeps
   first.labels_in_mesh_order = true;        // what the refinement reads (no copy in its order)
   first.target_vertices = first_pass_vertices(mesh, layout, params, active);
+  first.sampling.keep_curves = true;  // the collapses thin the borders (sampling.cpp force_curves)
   first.warm_up = false;
   // A first pass that depends on the target, or a whole mesh too large for the max-aware reruns:
   // no state a later decimation could resume from.

@@ -166,18 +166,10 @@ void add_vertex_quadric(const Mesh& mesh, const QuadricFrame& frame, int32_t v, 
   });
 }
 
-// A sharp bend of a mesh boundary (curve_bends.hpp), which a stochastic first pass keeps
-// (sampling.cpp forces bends), holds its place by a point quadric: three orthogonal planes through
-// it weighted by the squared mean edge length. The border planes are weighted by their own edges'
-// squared lengths, so a bend on a rim of tiny edges (a marching-cubes surface meeting a box edge,
-// a scan's tiny hole) held almost nothing and was cut. A mesh collapsed whole has none: the
-// max-aware reruns guard its max, and there the anchors cost more than they gained (beetle at 2 %:
-// max 1.9 times; docs/bench_notes/large-first-pass.md).
-void add_bend_anchors(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& label,
-                      const QuadricFrame& frame, VertexQuadrics& quadrics) {
-  if (layout.curve_bends.empty()) return;
+// The spacing of the output's vertices, in normalised units: the mean edge length (each side of
+// each face) times the square root of input vertices per target vertex.
+double output_spacing(const Mesh& mesh, const QuadricFrame& frame, int32_t target_vertices) {
   const auto& faces = mesh.faces();
-  const double scale = 1.0 / frame.extent;
   double sum = 0.0;
   for (int32_t f = 0; f < mesh.num_faces(); ++f)
     for (int j = 0; j < 3; ++j) {
@@ -185,8 +177,20 @@ void add_bend_anchors(const Mesh& mesh, const FeatureLayout& layout, const std::
       const double* b = mesh.position(faces[3 * size_t(f) + (j + 1) % 3]);
       sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
     }
-  const double mean = mesh.num_faces() > 0 ? scale * sum / (3.0 * mesh.num_faces()) : 0.0;
-  const double weight = mean * mean;
+  if (mesh.num_faces() == 0) return 0.0;
+  const double mean = sum / (3.0 * mesh.num_faces() * frame.extent);
+  return mean * std::sqrt(double(mesh.num_vertices()) / std::max(1, target_vertices));
+}
+
+// A sharp bend of a mesh boundary (curve_bends.hpp) holds its place by a point quadric: three
+// orthogonal planes through it weighted by the squared output spacing, what a patch of one output
+// triangle costs moved as far. The border planes are weighted by their own edges' squared
+// lengths, so a bend on a rim of tiny edges (a marching-cubes surface meeting a box edge, a scan's
+// tiny hole) held almost nothing and was cut. Only after a stochastic first pass (see
+// add_border_planes).
+void add_bend_anchors(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& label,
+                      const QuadricFrame& frame, double spacing, VertexQuadrics& quadrics) {
+  const double weight = spacing * spacing, scale = 1.0 / frame.extent;
   if (!(weight > 0)) return;
   for (int32_t v : layout.curve_bends) {
     if (label[v] < 0) continue;
@@ -199,14 +203,65 @@ void add_bend_anchors(const Mesh& mesh, const FeatureLayout& layout, const std::
   }
 }
 
+// Planes through each border edge (boundary, seam, material edge), perpendicular to each of its
+// triangles and weighted by the edge's squared length, keep collapses from pulling the border off
+// its course. With spacing > 0 (after a stochastic first pass) each edge also holds its triangle's
+// own plane, weighted by its length times the spacing: a border's deviation across the surface
+// (a terrain's rim profile, which lies in its border planes) then costs what a patch of surface
+// that far off does, where the border's half fan alone held half of that. A mesh collapsed whole
+// has neither these planes nor the anchors: the max-aware reruns guard its max, and there the
+// anchors cost more than they gained (beetle at 2 %: max 1.9 times;
+// docs/bench_notes/large-first-pass.md).
+void add_border_planes(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& label,
+                       const QuadricFrame& frame, double spacing, VertexQuadrics& quadrics) {
+  const auto& faces = mesh.faces();
+  const auto& ev = mesh.edge_vertices();
+  const auto& efo = mesh.edge_face_offsets();
+  const auto& ef = mesh.edge_faces();
+  auto unit = [&](int32_t v, double* p) {
+    for (int i = 0; i < 3; ++i) p[i] = (mesh.position(v)[i] - frame.center[i]) * (1.0 / frame.extent);
+  };
+  for (int32_t e : layout.feature_edges) {
+    const int32_t* ab = &ev[2 * size_t(e)];
+    const int32_t l[2] = {label[ab[0]], label[ab[1]]};
+    auto add = [&](const double* normal, const double* through, double weight) {
+      const double d = -(normal[0] * through[0] + normal[1] * through[1] + normal[2] * through[2]);
+      for (int j = 0; j < 2; ++j)
+        if (l[j] >= 0 && (j == 0 || l[j] != l[0])) VertexQuadrics::add_plane(quadrics.at(l[j]), normal, d, weight);
+    };
+    double a[3], b[3];
+    unit(ab[0], a);
+    unit(ab[1], b);
+    for (int32_t i = efo[e]; i < efo[e + 1]; ++i) {
+      const int32_t* t = &faces[3 * size_t(ef[i])];
+      int32_t opposite = t[0];
+      for (int j = 0; j < 3; ++j)
+        if (t[j] != ab[0] && t[j] != ab[1]) opposite = t[j];
+      double c[3], u[3], w[3], n[3];
+      unit(opposite, c);
+      for (int k = 0; k < 3; ++k) u[k] = b[k] - a[k], w[k] = c[k] - a[k];
+      n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
+      double side[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
+      const double side_length = std::sqrt(side[0] * side[0] + side[1] * side[1] + side[2] * side[2]);
+      if (!(side_length > 0)) continue;
+      for (double& x : side) x /= side_length;
+      const double length2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+      add(side, a, length2);
+      if (!(spacing > 0)) continue;
+      const double n_length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      for (double& x : n) x /= n_length;
+      add(n, a, std::sqrt(length2) * spacing);
+    }
+  }
+}
+
 // Each output vertex stands for the input triangles of its cluster (each weighed by the share of
-// its corners in the cluster) and for the border edges in it: planes through each border edge,
-// perpendicular to its triangles, keep collapses from pulling a border (boundary, seam,
-// material edge) off its course. Each thread owns a range of clusters and adds to them in input
-// order, so the sums do not depend on the number of threads.
+// its corners in the cluster) and for the border edges in it (add_border_planes), after a
+// stochastic first pass also for the bends in it (add_bend_anchors). Each thread owns a range of
+// clusters and adds to them in input order, so the sums do not depend on the number of threads.
 VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
                                 const std::vector<int32_t>& label, int32_t clusters, const QuadricFrame& frame,
-                                bool anchor_bends) {
+                                bool stochastic_start) {
   const int channels = params.attributes.values ? params.attributes.channels : 0;
   // Wedges only where some cluster has two: otherwise one attribute part per vertex is the same.
   std::vector<uint8_t> wedge;
@@ -266,36 +321,9 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
   });
   // The edge tables are built on first use: a mesh without feature edges never needs them here.
   if (layout.feature_edges.empty()) return quadrics;
-  const auto& ev = mesh.edge_vertices();
-  const auto& efo = mesh.edge_face_offsets();
-  const auto& ef = mesh.edge_faces();
-  for (int32_t e : layout.feature_edges) {
-    const int32_t* ab = &ev[2 * size_t(e)];
-    double a[3], b[3];
-    unit(ab[0], a);
-    unit(ab[1], b);
-    for (int32_t i = efo[e]; i < efo[e + 1]; ++i) {
-      const int32_t* t = &faces[3 * size_t(ef[i])];
-      int32_t opposite = t[0];
-      for (int j = 0; j < 3; ++j)
-        if (t[j] != ab[0] && t[j] != ab[1]) opposite = t[j];
-      // The plane holding the edge and the face normal, weighted by the edge length squared.
-      double c[3], u[3], w[3], n[3];
-      unit(opposite, c);
-      for (int k = 0; k < 3; ++k) u[k] = b[k] - a[k], w[k] = c[k] - a[k];
-      n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
-      double side[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
-      const double len = std::sqrt(side[0] * side[0] + side[1] * side[1] + side[2] * side[2]);
-      if (!(len > 0)) continue;
-      for (double& x : side) x /= len;
-      const double d = -(side[0] * a[0] + side[1] * a[1] + side[2] * a[2]);
-      const double weight = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-      int32_t l[2] = {label[ab[0]], label[ab[1]]};
-      for (int j = 0; j < 2; ++j)
-        if (l[j] >= 0 && (j == 0 || l[j] != l[0])) VertexQuadrics::add_plane(quadrics.at(l[j]), side, d, weight);
-    }
-  }
-  if (anchor_bends) add_bend_anchors(mesh, layout, label, frame, quadrics);
+  const double spacing = stochastic_start ? output_spacing(mesh, frame, params.target_vertices) : 0.0;
+  add_border_planes(mesh, layout, label, frame, spacing, quadrics);
+  add_bend_anchors(mesh, layout, label, frame, spacing, quadrics);
   return quadrics;
 }
 

@@ -51,6 +51,9 @@ struct SamplingParams {
   int32_t density_rings = 0;            ///< ε (uniform) or ε_big (adaptive) in rings; 0 = from the target
   double density_ratio = 2.0;           ///< ε_big / ε_small for adaptive density (>= 2 per the thesis)
   double density_epsilon = 0.0;         ///< Euclidean ε; 0 = from the target and the mean edge length
+  /// A first pass the collapses thin next: every feature curve vertex is drawn while they are at
+  /// most a quarter of the count (sampling.cpp, force_curves).
+  bool keep_curves = false;
 };
 
 struct SampleSet {
