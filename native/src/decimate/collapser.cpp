@@ -291,7 +291,7 @@ int32_t Collapser::zero_area_faces() const {
   return count;
 }
 
-int32_t Collapser::remove_thin(double min_shape, Stop keep, bool fans_only) {
+int32_t Collapser::remove_thin(double min_shape, Stop keep, ThinRules rules) {
   // Candidates are found up front: a collapse makes no zero-area triangle, and a thin one only
   // beside one as thin or thinner (keeps_shape); a failed candidate may pass after its
   // neighbours collapsed, hence the rounds.
@@ -320,16 +320,24 @@ int32_t Collapser::remove_thin(double min_shape, Stop keep, bool fans_only) {
       if (!alive_face_[t] || !(zero_area(t) || thin(t, min_shape))) continue;
       const int32_t* c = &(*tri_)[3 * size_t(t)];
       const bool fan = in_fan(c);
-      if (fans_only && !fan && !zero_area(t)) continue;
+      if (rules.fans_only && !fan && !zero_area(t)) continue;
       if (fan && took.empty()) took.assign(merged_into_.size(), -1);
       if (fan && (waits(c[0], round) || waits(c[1], round) || waits(c[2], round))) continue;
       // The six directed collapses, those moving a free vertex first: taken in corner order, a
       // sliver at a rim's bend moved the bend's vertex along the sliver's long edge (a box-cut
-      // gyroid's rim lost a corner of 0.29 % of the diagonal at 50 %).
+      // gyroid's rim lost a corner of 0.29 % of the diagonal at 50 %). The border moves after
+      // them in corner order, or cheapest first (rules).
       int order[6] = {0, 1, 2, 3, 4, 5};
-      std::stable_partition(order, order + 6, [&](int j) { return s_.curve[c[j % 3]] < 0; });
+      auto from = [&](int j) { return c[j % 3]; };
+      auto to = [&](int j) { return c[(j % 3 + (j < 3 ? 1 : 2)) % 3]; };
+      int* border = std::stable_partition(order, order + 6, [&](int j) { return s_.curve[from(j)] < 0; });
+      if (rules.border_moves_by_cost) {
+        double cost_of[6];
+        for (int* j = border; j != order + 6; ++j) cost_of[*j] = cost(from(*j), to(*j));
+        std::stable_sort(border, order + 6, [&](int a, int b) { return cost_of[a] < cost_of[b]; });
+      }
       for (int j : order) {
-        const int32_t u = c[j % 3], v = c[(j % 3 + (j < 3 ? 1 : 2)) % 3];
+        const int32_t u = from(j), v = to(j);
         if (s_.locked[u] || !allowed(u, v, scratch_[0])) continue;
         collapse(u, v);
         refresh(u, v);

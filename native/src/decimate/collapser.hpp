@@ -53,6 +53,12 @@ struct CollapseSetup {
   bool optimal_placement = true;      ///< off: every collapse is a half-edge collapse
 };
 
+/// Which thin triangles Collapser::remove_thin takes, and how (zero-area ones always go).
+struct ThinRules {
+  bool fans_only = false;             ///< only those with a corner of more than Collapser::kWideFan faces
+  bool border_moves_by_cost = false;  ///< a border (feature-curve) vertex's moves: cheapest first
+};
+
 class Collapser {
  public:
   /// triangles and corner_source (3 per face) are updated in place as corners are renamed.
@@ -63,9 +69,8 @@ class Collapser {
     int32_t vertices = 0, faces = 0;
   };
   /// Collapses an edge of every zero-area triangle, and of every triangle with a shape quality
-  /// below min_shape (with fans_only, of those only the ones with a corner of more than
-  /// kWideFan faces), where a collapse is allowed, until `keep` is reached.
-  int32_t remove_thin(double min_shape, Stop keep, bool fans_only = false);
+  /// below min_shape (as `rules` say), where a collapse is allowed, until `keep` is reached.
+  int32_t remove_thin(double min_shape, Stop keep, ThinRules rules = {});
   /// Called with the state and the collapses made so far where a run's batches start to
   /// depend on its target (they shrink near it), or at its end when they never did: up to there
   /// a run to any lower vertex target goes the same way.
