@@ -5,7 +5,8 @@ their distance from the result by brute force (not the engine's closest-point se
 the diagonal:
 - at 0.5 %: border planes are weighted by their edges' squared lengths, so a bend on a rim of
   tiny edges held almost nothing and was cut, 1.52 %; anchored (refine.cpp add_bend_anchors)
-  0.65 %, and 0.19 % with the borders drawn whole (sampling.cpp force_curves);
+  0.46 %, and 0.19 % with the borders drawn whole (sampling.cpp force_curves) and the clean-up's
+  order below;
 - at 2 %: 0.12 % with the rim drawn at random; drawn whole, the sliver clean-up moved a bend
   one tiny edge along the rim, 0.22 %; with a border vertex's moves there taken cheapest first
   (ThinRules::border_moves_by_cost), 0.05 %;
