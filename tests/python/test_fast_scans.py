@@ -120,14 +120,19 @@ def test_a_collapsed_fast_result_replays_from_its_samples(target):
 @pytest.mark.parametrize("ratio", [0.1, 0.05])
 def test_the_spider_reaches_its_floor_where_its_repairs_finish_above_the_target(ratio):
     # No stall here: the repairs finished at 120 (10 %) and 111 (5 %) vertices, and fast mode
-    # stopped there (quality mode: 86). Now the collapses take it on to near its floor (76).
+    # stopped there (quality mode: 86). Now the collapses take it on to near its floor (76). At
+    # 10 % the target is the floor itself (76): 77 meets it within the budget's tolerance; at 5 %
+    # (38) the result must say the topology held it.
     mesh = spider()
     expected = reference.invariants(len(mesh.vertices), mesh.triangles)
     r = mesh.decimate(mode="fast", seed=0, ratio=ratio)
     assert r.num_vertices <= 1.15 * fewest_vertices(expected), r.num_vertices
     assert_same_surface(mesh, r, expected)
     assert r.stats.refine_vertices == r.stats.target_vertices and r.stats.refine_keeps_positions
-    assert r.stats.target_missed.reason == "topology"
+    missed = r.stats.target_missed
+    assert missed is None or missed.reason == "topology"
+    if r.stats.target_vertices < fewest_vertices(expected):
+        assert missed is not None and missed.reason == "topology"
 
 
 @pytest.mark.parametrize("case", ["elephant-with-holes", "genus-16 grid", "torus"])
