@@ -133,42 +133,8 @@ void bounding_box(const Mesh& mesh, double center[3], double& extent, double& di
   if (!(diagonal > 0) || !std::isfinite(diagonal)) diagonal = 1.0;
 }
 
-// The frame quadrics are computed in: the bounding box's centre and half extent, and its
-// diagonal in those units. It depends on the mesh only: kept with the layout.
-struct QuadricFrame {
-  double center[3] = {0, 0, 0}, extent = 1.0;
-  double diagonal = 1.0;  // of the bounding box, normalised
-};
-
-std::shared_ptr<const QuadricFrame> quadric_frame(const Mesh& mesh, const FeatureLayout& layout) {
-  auto cached = std::static_pointer_cast<const QuadricFrame>(layout.quadric_frame.get());
-  if (cached) return cached;
-  auto frame = std::make_shared<QuadricFrame>();
-  bounding_box(mesh, frame->center, frame->extent, frame->diagonal);
-  layout.quadric_frame.set(frame);
-  return frame;
-}
-
-// A third of the quadric of each triangle around input vertex v (in normalised coordinates),
-// added into sum[10] in the order of v's faces, so that a cluster's sum weighs each triangle by
-// the share of its corners in the cluster. Computed where it is added, not kept: a table of
-// them was 80 bytes per input vertex.
-void add_vertex_quadric(const Mesh& mesh, const QuadricFrame& frame, int32_t v, double* sum) {
-  const auto& faces = mesh.faces();
-  const double scale = 1.0 / frame.extent;
-  mesh.for_each_face(v, [&](int32_t f) {
-    const int32_t* t = &faces[3 * size_t(f)];
-    double p[3][3], face[10], area;
-    for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) p[j][i] = (mesh.position(t[j])[i] - frame.center[i]) * scale;
-    if (!VertexQuadrics::plane(p[0], p[1], p[2], face, &area)) return;
-    for (int i = 0; i < 10; ++i) sum[i] += face[i] * (1.0 / 3.0);
-  });
-}
-
-// The spacing of the output's vertices, in normalised units: the mean edge length (each side of
-// each face) times the square root of input vertices per target vertex.
-double output_spacing(const Mesh& mesh, const QuadricFrame& frame, int32_t target_vertices) {
+// The mean edge length (each side of each face) over the half extent `extent`.
+double mean_edge(const Mesh& mesh, double extent) {
   const auto& faces = mesh.faces();
   double sum = 0.0;
   for (int32_t f = 0; f < mesh.num_faces(); ++f)
@@ -177,9 +143,53 @@ double output_spacing(const Mesh& mesh, const QuadricFrame& frame, int32_t targe
       const double* b = mesh.position(faces[3 * size_t(f) + (j + 1) % 3]);
       sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
     }
-  if (mesh.num_faces() == 0) return 0.0;
-  const double mean = sum / (3.0 * mesh.num_faces() * frame.extent);
-  return mean * std::sqrt(double(mesh.num_vertices()) / std::max(1, target_vertices));
+  return mesh.num_faces() > 0 ? sum / (3.0 * mesh.num_faces() * extent) : 0.0;
+}
+
+// The frame quadrics are computed in: the bounding box's centre and half extent, its diagonal
+// and the mean edge length in those units. It depends on the mesh only: kept with the layout, so
+// that a decimation's border terms (output_spacing) do not pass over every face again.
+struct QuadricFrame {
+  double center[3] = {0, 0, 0}, extent = 1.0;
+  double diagonal = 1.0;   // of the bounding box, normalised
+  double mean_edge = 0.0;  // normalised
+};
+
+std::shared_ptr<const QuadricFrame> quadric_frame(const Mesh& mesh, const FeatureLayout& layout) {
+  auto cached = std::static_pointer_cast<const QuadricFrame>(layout.quadric_frame.get());
+  if (cached) return cached;
+  auto frame = std::make_shared<QuadricFrame>();
+  bounding_box(mesh, frame->center, frame->extent, frame->diagonal);
+  frame->mean_edge = mean_edge(mesh, frame->extent);
+  layout.quadric_frame.set(frame);
+  return frame;
+}
+
+// Input vertex v in the frame's normalised coordinates.
+void normalised(const Mesh& mesh, const QuadricFrame& frame, int32_t v, double p[3]) {
+  const double scale = 1.0 / frame.extent;
+  for (int i = 0; i < 3; ++i) p[i] = (mesh.position(v)[i] - frame.center[i]) * scale;
+}
+
+// A third of the quadric of each triangle around input vertex v (in normalised coordinates),
+// added into sum[10] in the order of v's faces, so that a cluster's sum weighs each triangle by
+// the share of its corners in the cluster. Computed where it is added, not kept: a table of
+// them was 80 bytes per input vertex.
+void add_vertex_quadric(const Mesh& mesh, const QuadricFrame& frame, int32_t v, double* sum) {
+  const auto& faces = mesh.faces();
+  mesh.for_each_face(v, [&](int32_t f) {
+    const int32_t* t = &faces[3 * size_t(f)];
+    double p[3][3], face[10], area;
+    for (int j = 0; j < 3; ++j) normalised(mesh, frame, t[j], p[j]);
+    if (!VertexQuadrics::plane(p[0], p[1], p[2], face, &area)) return;
+    for (int i = 0; i < 10; ++i) sum[i] += face[i] * (1.0 / 3.0);
+  });
+}
+
+// The spacing of the output's vertices, in normalised units: the mean edge length times the
+// square root of input vertices per target vertex.
+double output_spacing(const Mesh& mesh, const QuadricFrame& frame, int32_t target_vertices) {
+  return frame.mean_edge * std::sqrt(double(mesh.num_vertices()) / std::max(1, target_vertices));
 }
 
 // A sharp bend of a mesh boundary (curve_bends.hpp) holds its place by a point quadric: three
@@ -190,15 +200,16 @@ double output_spacing(const Mesh& mesh, const QuadricFrame& frame, int32_t targe
 // add_border_planes).
 void add_bend_anchors(const Mesh& mesh, const FeatureLayout& layout, const std::vector<int32_t>& label,
                       const QuadricFrame& frame, double spacing, VertexQuadrics& quadrics) {
-  const double weight = spacing * spacing, scale = 1.0 / frame.extent;
+  const double weight = spacing * spacing;
   if (!(weight > 0)) return;
   for (int32_t v : layout.curve_bends) {
     if (label[v] < 0) continue;
+    double p[3];
+    normalised(mesh, frame, v, p);
     for (int axis = 0; axis < 3; ++axis) {
       double u[3] = {0, 0, 0};
       u[axis] = 1.0;
-      const double d = -(mesh.position(v)[axis] - frame.center[axis]) * scale;
-      VertexQuadrics::add_plane(quadrics.at(label[v]), u, d, weight);
+      VertexQuadrics::add_plane(quadrics.at(label[v]), u, -p[axis], weight);
     }
   }
 }
@@ -218,9 +229,6 @@ void add_border_planes(const Mesh& mesh, const FeatureLayout& layout, const std:
   const auto& ev = mesh.edge_vertices();
   const auto& efo = mesh.edge_face_offsets();
   const auto& ef = mesh.edge_faces();
-  auto unit = [&](int32_t v, double* p) {
-    for (int i = 0; i < 3; ++i) p[i] = (mesh.position(v)[i] - frame.center[i]) * (1.0 / frame.extent);
-  };
   for (int32_t e : layout.feature_edges) {
     const int32_t* ab = &ev[2 * size_t(e)];
     const int32_t l[2] = {label[ab[0]], label[ab[1]]};
@@ -230,15 +238,15 @@ void add_border_planes(const Mesh& mesh, const FeatureLayout& layout, const std:
         if (l[j] >= 0 && (j == 0 || l[j] != l[0])) VertexQuadrics::add_plane(quadrics.at(l[j]), normal, d, weight);
     };
     double a[3], b[3];
-    unit(ab[0], a);
-    unit(ab[1], b);
+    normalised(mesh, frame, ab[0], a);
+    normalised(mesh, frame, ab[1], b);
     for (int32_t i = efo[e]; i < efo[e + 1]; ++i) {
       const int32_t* t = &faces[3 * size_t(ef[i])];
       int32_t opposite = t[0];
       for (int j = 0; j < 3; ++j)
         if (t[j] != ab[0] && t[j] != ab[1]) opposite = t[j];
       double c[3], u[3], w[3], n[3];
-      unit(opposite, c);
+      normalised(mesh, frame, opposite, c);
       for (int k = 0; k < 3; ++k) u[k] = b[k] - a[k], w[k] = c[k] - a[k];
       n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
       double side[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
@@ -275,11 +283,6 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
   VertexQuadrics quadrics(clusters, channels, wedges);
   const auto& faces = mesh.faces();
   const auto& face_source = mesh.face_source();
-  const double* center = frame.center;
-  const double scale = 1.0 / frame.extent;
-  auto unit = [&](int32_t v, double* p) {
-    for (int i = 0; i < 3; ++i) p[i] = (mesh.position(v)[i] - center[i]) * scale;
-  };
   const int32_t n = mesh.num_vertices(), m = mesh.num_faces();
   parallel_region(team_for(n, kParallelMin), [&](Team& team) {
     const int32_t threads = team.size(), me = team.index();
@@ -301,7 +304,7 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
         if (!((l[0] >= low && l[0] < high) || (l[1] >= low && l[1] < high) || (l[2] >= low && l[2] < high)))
           continue;
         double p[3][3];
-        for (int j = 0; j < 3; ++j) unit(t[j], p[j]);
+        for (int j = 0; j < 3; ++j) normalised(mesh, frame, t[j], p[j]);
         for (int j = 0; j < 3; ++j)
           for (int a = 0; a < channels; ++a)
             values[size_t(j) * channels + a] =
