@@ -615,6 +615,19 @@ int32_t active_vertices(const Mesh& mesh) {
   return mesh.num_vertices() - mesh.report().isolated_vertices;
 }
 
+// Vertices of triangles that are pieces of their own (an unwelded mesh is made of them): each
+// piece keeps its triangle, so no draw keeps fewer. Counted only on a mesh of more pieces than
+// a tenth of its faces.
+int32_t loose_triangle_vertices(const Mesh& mesh) {
+  if (10 * int64_t(mesh.report().components) < mesh.num_faces()) return 0;
+  const auto& faces = mesh.faces();
+  int32_t loose = 0;
+  for (size_t t = 0; t < faces.size(); t += 3)
+    loose += 3 * (mesh.face_count(faces[t]) == 1 && mesh.face_count(faces[t + 1]) == 1 &&
+                  mesh.face_count(faces[t + 2]) == 1);
+  return loose;
+}
+
 }  // namespace
 
 namespace {
@@ -769,7 +782,9 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
   // edges, a component whose triangles face both ways) come back at every lower draw: a plain
   // pass skips those draws and collapses to the target instead (below).
   const bool stalled = best.issues_remaining.topological() > 0;
-  const int passes = stalled && !refined ? 0 : params.budget_passes;
+  // Nor when loose triangles alone outnumber the target: every lower draw keeps them too.
+  const bool floored = !refined && loose_triangle_vertices(mesh) > target + tolerance;
+  const int passes = (stalled && !refined) || floored ? 0 : params.budget_passes;
   int32_t drawn = target;
   for (int pass = 0; pass < passes && excess(best) > tolerance && best.forced < target; ++pass) {
     drawn = std::max(1, drawn - excess(best) - tolerance);
