@@ -11,7 +11,8 @@ vertex) away from it. Why, in the words every channel uses:
   of three or more triangles): each such curve keeps its course and at least one edge, each
   sheet along it its triangles, so the topology stays; the detail says how many vertices that is;
 - "topology": samples the topology needs (each loose piece keeps at least a triangle, each
-  hole and handle its loops);
+  hole and handle its loops); where loose triangles (pieces of one triangle, as in an unwelded
+  mesh) make up much of the result, the detail says how many;
 - "symmetry": the mirrored sample set is larger (or, where partners of absorbed samples were
   dropped, smaller) than the plain draw (core/api/symmetry.py);
 - "absorbed clusters": clusters that neighbours absorbed were not all made up for;
@@ -80,6 +81,17 @@ def over_reason(stats) -> str:
     return "topology"
 
 
+def _over_detail(stats, reason: str) -> str:
+    """What the reason of a result over its target costs, in words (see the module docs)."""
+    if reason == "non-manifold edges":
+        return f"{stats.nonmanifold_vertices:,} of the result's {stats.output_vertices:,} vertices lie on them"
+    loose = getattr(stats, "loose_triangles", 0)
+    if reason == "topology" and 3 * loose >= stats.output_vertices / 4:
+        return (f"{loose:,} of the result's {stats.output_triangles:,} triangles are loose pieces, each kept whole; "
+                "weld the mesh first (Blender: Merge by Distance)")
+    return ""
+
+
 def missed_target(stats) -> Optional[MissedTarget]:
     """The MissedTarget of a result's DecimateStats, or None when it met its target (a triangle
     target counts triangles, any other vertices; a replay of samples asked for none)."""
@@ -92,9 +104,7 @@ def missed_target(stats) -> Optional[MissedTarget]:
         return None
     if got > asked:
         reason = over_reason(stats)
-        detail = (f"{stats.nonmanifold_vertices:,} of the result's {stats.output_vertices:,} vertices lie on them"
-                  if reason == "non-manifold edges" else "")
-        return MissedTarget(asked, got, reason, unit, detail)
+        return MissedTarget(asked, got, reason, unit, _over_detail(stats, reason))
     if stats.zero_area_input:
         return MissedTarget(asked, got, "zero-area input", unit)
     return MissedTarget(asked, got, "symmetry" if stats.mirrored_from else "absorbed clusters", unit)

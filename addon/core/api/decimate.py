@@ -98,6 +98,9 @@ class DecimateStats:
     target_triangles: int = 0   #: the triangle target asked for (0: none)
     #: vertices of the result on non-manifold edges (three or more triangles; counted when the input has some)
     nonmanifold_vertices: int = 0
+    #: triangles of the result that are pieces of their own (an unwelded mesh is made of them);
+    #: each piece keeps its triangle. Counted when the input has more pieces than a tenth of its faces
+    loose_triangles: int = 0
     #: when the partition checks left issues (they cannot judge some non-manifold inputs' own
     #: clusters): every input component's invariants match its output's (core/api/invariants.py);
     #: None when it was not needed
@@ -311,7 +314,7 @@ def warm_up(mesh: Mesh, job: DecimationJob, cancel: Optional[CancelFlag] = None)
 
 #: DecimateStats fields counted in Python; every other field is the engine result's of the same name
 _COUNTED_HERE = {"output_vertices", "output_triangles", "target_triangles", "control_points", "zero_area_input",
-                 "mirrored_from", "replayed", "nonmanifold_vertices", "invariants_kept"}
+                 "mirrored_from", "replayed", "nonmanifold_vertices", "loose_triangles", "invariants_kept"}
 
 
 def vertices_on_nonmanifold_edges(triangles: np.ndarray) -> int:
@@ -322,6 +325,15 @@ def vertices_on_nonmanifold_edges(triangles: np.ndarray) -> int:
     return len(np.unique(unique[counts > 2]))
 
 
+def loose_triangles(triangles: np.ndarray) -> int:
+    """Triangles whose three corners are in no other triangle (each a piece of its own)."""
+    t = np.asarray(triangles).reshape(-1, 3)
+    if len(t) == 0:
+        return 0
+    faces = np.bincount(t.ravel())
+    return int(np.count_nonzero((faces[t] == 1).all(axis=1)))
+
+
 def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob] = None) -> DecimateResult:
     stats = DecimateStats(**{f.name: raw[f.name] for f in dataclasses.fields(DecimateStats)  # same names
                              if f.name not in _COUNTED_HERE}, output_vertices=len(raw["vertices"]),
@@ -330,7 +342,9 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
                           control_points=0 if job is None else job.control_points,
                           zero_area_input=mesh.native.report["zero_area_triangles"], replayed=job is None,
                           nonmanifold_vertices=vertices_on_nonmanifold_edges(raw["triangles"])
-                          if mesh.native.report["nonmanifold_edges"] else 0)
+                          if mesh.native.report["nonmanifold_edges"] else 0,
+                          loose_triangles=loose_triangles(raw["triangles"])
+                          if 10 * mesh.native.report["components"] >= mesh.native.report["input_triangles"] else 0)
     if stats.output_checked and stats.issues_left and not stats.check_violations:
         kept = invariants_kept(mesh.input_topology, raw["vertices"], raw["triangles"], raw["kept"])
         stats = dataclasses.replace(stats, invariants_kept=kept)
