@@ -63,8 +63,11 @@ constexpr double kFloorTurnCos = 0.0;
 // triangle missed a bridged notch, beetle 4.65 -> 8.67 %) is farther than the chosen run's max,
 // the max stays no larger and the mean times the count no larger (a surface's mean error falls
 // about as one over the count: a collapse may not cost more than the triangle it saves). At most
-// kExtensionTries collapses are tried.
+// kExtensionTries collapses are tried, on results of at most kExtensionFaces triangles: each try
+// copies the run and measures the whole surface again, and above that size the 64 collapses save
+// under 1 % of the result (a sphere with 4,000 random holes, 17,900 triangles: 2.4 s for 40).
 constexpr int kExtensionTries = 64;
+constexpr int32_t kExtensionFaces = 100 * 2 * kExtensionTries;
 constexpr int kExtensionGrid = 8;
 
 // Guidance bins: 0 for m = 0 (never sampled), 1 for control points, then m on a quarter-octave
@@ -723,7 +726,7 @@ class Refinement {
       if (wins(last, best.deviation, mean_bound, tiny))
         best = Run{std::move(run), last, collapses, result.triangles, result.corner_source};
     }
-    if (below_floor) extend_past_floor(best, input, stop);
+    if (below_floor && best.collapser->live_faces() <= kExtensionFaces) extend_past_floor(best, input, stop);
     result.triangles = std::move(best.triangles);
     result.corner_source = std::move(best.corners);
     result.refine_collapses = best.collapses;
