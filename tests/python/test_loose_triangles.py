@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import meshgen
+import reference
 from topstoc.core import Mesh
 
 
@@ -51,3 +52,34 @@ def test_loose_triangles_stay_beside_a_decimated_surface(mode):
     sphere = r.triangles[(r.vertices[r.triangles][:, :, 0] < 1.5).all(axis=1)]
     assert 0 < len(sphere) <= 1.02 * 500  # the welded sphere took the rest of the budget
     assert r.stats.target_missed is None
+
+
+@pytest.mark.parametrize("mode", ["quality", "fast"])
+def test_a_mesh_of_many_holes_says_they_hold_it(mode):
+    # A sphere with triangles removed at random, no two sharing a vertex: hundreds of holes
+    # (boundary loops, counted by tests/reference.py), each kept with three vertices or more,
+    # hold the result far above a 10 % target; the missed target names them and the clean-up
+    # to run first.
+    v, t = meshgen.icosphere(5)
+    t = np.asarray(t)
+    used = np.zeros(len(v), dtype=bool)
+    removed = np.zeros(len(t), dtype=bool)
+    for f in np.random.default_rng(5).permutation(len(t))[: len(t) // 10]:
+        if not used[t[f]].any():
+            used[t[f]] = removed[f] = True
+    t = t[~removed].astype(np.int32)
+    holes = sum(loops for _chi, loops, _manifold, _orientable in reference.invariants(len(v), t))
+    assert holes == removed.sum() > 500
+    r = Mesh(v, t).decimate(target_triangles=len(t) // 10, seed=0, mode=mode)
+    assert r.stats.holes == holes
+    assert r.stats.topology_kept
+    missed = r.stats.target_missed
+    assert missed.reason in ("topology", "borders") and missed.off > 0
+    assert f"the input's {holes:,} holes keep at least 3 vertices each" in missed.detail
+    assert "topstoc clean --max-hole" in missed.detail
+
+
+def test_a_few_holes_leave_the_detail_out():
+    v, t = meshgen.grid(60, 60)  # one boundary loop
+    r = Mesh(v, t).decimate(target_triangles=4, seed=0)
+    assert r.stats.target_missed is None or "holes" not in r.stats.target_missed.detail

@@ -12,7 +12,8 @@ vertex) away from it. Why, in the words every channel uses:
   sheet along it its triangles, so the topology stays; the detail says how many vertices that is;
 - "topology": samples the topology needs (each loose piece keeps at least a triangle, each
   hole and handle its loops); where loose triangles (pieces of one triangle, as in an unwelded
-  mesh) make up much of the result, the detail says how many;
+  mesh) or holes (boundary loops, each kept with three vertices or more) make up much of the
+  result, the detail says how many and what to do first;
 - "symmetry": the mirrored sample set is larger (or, where partners of absorbed samples were
   dropped, smaller) than the plain draw (core/api/symmetry.py);
 - "absorbed clusters": clusters that neighbours absorbed were not all made up for;
@@ -89,6 +90,10 @@ def _over_detail(stats, reason: str) -> str:
     if reason == "topology" and 3 * loose >= stats.output_vertices / 4:
         return (f"{loose:,} of the result's {stats.output_triangles:,} triangles are loose pieces, each kept whole; "
                 "weld the mesh first (Blender: Merge by Distance)")
+    holes = getattr(stats, "holes", 0)
+    if reason in ("topology", "borders") and 3 * holes >= stats.output_vertices / 4:
+        return (f"the input's {holes:,} holes keep at least 3 vertices each; fill the small ones first "
+                "(topstoc clean --max-hole; Blender: Clean Up Small Handles and Holes)")
     return ""
 
 

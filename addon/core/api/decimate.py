@@ -101,6 +101,9 @@ class DecimateStats:
     #: triangles of the result that are pieces of their own (an unwelded mesh is made of them);
     #: each piece keeps its triangle. Counted when the input has more pieces than a tenth of its faces
     loose_triangles: int = 0
+    #: holes (boundary loops) of the input, each kept with at least three vertices; counted when
+    #: the result lands over its target and the input has boundary edges
+    holes: int = 0
     #: when the partition checks left issues (they cannot judge some non-manifold inputs' own
     #: clusters): every input component's invariants match its output's (core/api/invariants.py);
     #: None when it was not needed
@@ -314,7 +317,7 @@ def warm_up(mesh: Mesh, job: DecimationJob, cancel: Optional[CancelFlag] = None)
 
 #: DecimateStats fields counted in Python; every other field is the engine result's of the same name
 _COUNTED_HERE = {"output_vertices", "output_triangles", "target_triangles", "control_points", "zero_area_input",
-                 "mirrored_from", "replayed", "nonmanifold_vertices", "loose_triangles", "invariants_kept"}
+                 "mirrored_from", "replayed", "nonmanifold_vertices", "loose_triangles", "holes", "invariants_kept"}
 
 
 def vertices_on_nonmanifold_edges(triangles: np.ndarray) -> int:
@@ -345,6 +348,9 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
                           if mesh.native.report["nonmanifold_edges"] else 0,
                           loose_triangles=loose_triangles(raw["triangles"])
                           if 10 * mesh.native.report["components"] >= mesh.native.report["input_triangles"] else 0)
+    missed = stats.target_missed
+    if missed is not None and missed.off > 0 and mesh.native.report["boundary_edges"]:
+        stats = dataclasses.replace(stats, holes=sum(len(c.boundary_loops) for c in mesh.input_topology.components))
     if stats.output_checked and stats.issues_left and not stats.check_violations:
         kept = invariants_kept(mesh.input_topology, raw["vertices"], raw["triangles"], raw["kept"])
         stats = dataclasses.replace(stats, invariants_kept=kept)
