@@ -578,6 +578,11 @@ int32_t Mesh::face_count(int32_t v) const {
   return count;
 }
 
+bool Mesh::loose_face(int32_t f) const {
+  const int32_t* t = &faces_[3 * size_t(f)];
+  return face_count(t[0]) == 1 && face_count(t[1]) == 1 && face_count(t[2]) == 1;
+}
+
 // After duplicates are dropped: the faces stay in order of their lowest vertex.
 void Mesh::find_lowest_offsets() {
   const int32_t m = num_faces();

@@ -615,16 +615,12 @@ int32_t active_vertices(const Mesh& mesh) {
   return mesh.num_vertices() - mesh.report().isolated_vertices;
 }
 
-// Vertices of triangles that are pieces of their own (an unwelded mesh is made of them): each
-// piece keeps its triangle, so no draw keeps fewer. Counted only on a mesh of more pieces than
-// a tenth of its faces.
+// Vertices of triangles that are pieces of their own (Mesh::loose_face): each piece keeps its
+// triangle, so no draw keeps fewer.
 int32_t loose_triangle_vertices(const Mesh& mesh) {
-  if (10 * int64_t(mesh.report().components) < mesh.num_faces()) return 0;
-  const auto& faces = mesh.faces();
+  if (!mesh.many_pieces()) return 0;
   int32_t loose = 0;
-  for (size_t t = 0; t < faces.size(); t += 3)
-    loose += 3 * (mesh.face_count(faces[t]) == 1 && mesh.face_count(faces[t + 1]) == 1 &&
-                  mesh.face_count(faces[t + 2]) == 1);
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) loose += 3 * mesh.loose_face(f);
   return loose;
 }
 

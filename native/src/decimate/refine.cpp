@@ -586,15 +586,14 @@ class Refinement {
   // them (every collapse there was refused, one by one: 2.4 s for 82,000 loose triangles). A
   // piece the first pass brought down to one triangle stays free: the fit may still move it.
   void lock_loose_triangles(CollapseSetup& setup) const {
-    if (10 * int64_t(mesh.report().components) < mesh.num_faces()) return;  // few pieces
+    if (!mesh.many_pieces()) return;
     for (size_t t = 0; t < result.triangles.size(); t += 3) {
       const int32_t* c = &result.triangles[t];
       const int32_t face = mesh.first_face(kept_vertex[c[0]]);
-      bool loose = true;
-      for (int j = 0; j < 3 && loose; ++j)
-        loose = mesh.face_count(kept_vertex[c[j]]) == 1 && mesh.first_face(kept_vertex[c[j]]) == face;
-      if (loose)
-        for (int j = 0; j < 3; ++j) setup.locked[c[j]] = 1;
+      if (mesh.first_face(kept_vertex[c[1]]) != face || mesh.first_face(kept_vertex[c[2]]) != face ||
+          !mesh.loose_face(face))
+        continue;
+      for (int j = 0; j < 3; ++j) setup.locked[c[j]] = 1;
     }
   }
 

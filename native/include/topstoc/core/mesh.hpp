@@ -90,6 +90,11 @@ class Mesh {
   /// How many faces are around v, and the lowest of them (-1 for a vertex in no face).
   int32_t face_count(int32_t v) const;
   int32_t first_face(int32_t v) const;
+  /// Whether face f is a piece of its own (no corner in another face), as an unwelded mesh's
+  /// triangles are; and whether the mesh has pieces enough (more than a tenth of its faces) for
+  /// such faces to be worth looking for.
+  bool loose_face(int32_t f) const;
+  bool many_pieces() const { return 10 * int64_t(report_.components) >= num_faces(); }
   /// Whether v is in a face (a vertex in a face has neighbours, an isolated one none).
   bool in_faces(int32_t v) const { return adjacency_offsets_[v + 1] > adjacency_offsets_[v]; }
   /// Faces around each vertex as a table (CSR, the same order as for_each_face), for code that
