@@ -102,7 +102,7 @@ class DecimateStats:
     #: each piece keeps its triangle. Counted when the input has more pieces than a tenth of its faces
     loose_triangles: int = 0
     #: holes (boundary loops) of the input, each kept with at least three vertices; counted when
-    #: the result lands over its target and the input has boundary edges
+    #: the result lands over its target and the input has boundary edges enough to hold it there
     holes: int = 0
     #: when the partition checks left issues (they cannot judge some non-manifold inputs' own
     #: clusters): every input component's invariants match its output's (core/api/invariants.py);
@@ -348,8 +348,11 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
                           if mesh.native.report["nonmanifold_edges"] else 0,
                           loose_triangles=loose_triangles(raw["triangles"])
                           if 10 * mesh.native.report["components"] >= mesh.native.report["input_triangles"] else 0)
+    # The holes are counted where they may be what holds a result over its target (budget.py:
+    # three vertices a hole, a quarter of its vertices), so at least a quarter as many boundary
+    # edges as result vertices: the input's topology is not computed for every miss.
     missed = stats.target_missed
-    if missed is not None and missed.off > 0 and mesh.native.report["boundary_edges"]:
+    if missed is not None and missed.off > 0 and 4 * mesh.native.report["boundary_edges"] >= stats.output_vertices:
         stats = dataclasses.replace(stats, holes=sum(len(c.boundary_loops) for c in mesh.input_topology.components))
     if stats.output_checked and stats.issues_left and not stats.check_violations:
         kept = invariants_kept(mesh.input_topology, raw["vertices"], raw["triangles"], raw["kept"])
