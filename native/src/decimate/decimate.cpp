@@ -615,15 +615,6 @@ int32_t active_vertices(const Mesh& mesh) {
   return mesh.num_vertices() - mesh.report().isolated_vertices;
 }
 
-// Vertices of triangles that are pieces of their own (Mesh::loose_face): each piece keeps its
-// triangle, so no draw keeps fewer.
-int32_t loose_triangle_vertices(const Mesh& mesh) {
-  if (!mesh.many_pieces()) return 0;
-  int32_t loose = 0;
-  for (int32_t f = 0; f < mesh.num_faces(); ++f) loose += 3 * mesh.loose_face(f);
-  return loose;
-}
-
 }  // namespace
 
 namespace {
@@ -778,9 +769,7 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
   // edges, a component whose triangles face both ways) come back at every lower draw: a plain
   // pass skips those draws and collapses to the target instead (below).
   const bool stalled = best.issues_remaining.topological() > 0;
-  // Nor when loose triangles alone outnumber the target: every lower draw keeps them too.
-  const bool floored = !refined && loose_triangle_vertices(mesh) > target + tolerance;
-  const int passes = (stalled && !refined) || floored ? 0 : params.budget_passes;
+  const int passes = stalled && !refined ? 0 : params.budget_passes;
   int32_t drawn = target;
   for (int pass = 0; pass < passes && excess(best) > tolerance && best.forced < target; ++pass) {
     drawn = std::max(1, drawn - excess(best) - tolerance);
