@@ -350,9 +350,11 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
                           if 10 * mesh.native.report["components"] >= mesh.native.report["input_triangles"] else 0)
     # The holes are counted where they may be what holds a result over its target (budget.py:
     # three vertices a hole, a quarter of its vertices), so at least a quarter as many boundary
-    # edges as result vertices: the input's topology is not computed for every miss.
+    # edges as result vertices, and loose triangles do not explain it already: the input's
+    # topology is not computed for every miss.
     missed = stats.target_missed
-    if missed is not None and missed.off > 0 and 4 * mesh.native.report["boundary_edges"] >= stats.output_vertices:
+    if (missed is not None and missed.off > 0 and 4 * mesh.native.report["boundary_edges"] >= stats.output_vertices
+            and 12 * stats.loose_triangles < stats.output_vertices):
         stats = dataclasses.replace(stats, holes=sum(len(c.boundary_loops) for c in mesh.input_topology.components))
     if stats.output_checked and stats.issues_left and not stats.check_violations:
         kept = invariants_kept(mesh.input_topology, raw["vertices"], raw["triangles"], raw["kept"])
