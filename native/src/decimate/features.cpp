@@ -104,6 +104,17 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
   if (layout.feature_edges.empty()) std::vector<uint8_t>().swap(layout.edge_feature);  // all zero: is_feature_edge
 }
 
+// FeatureLayout::loose_vertices: found once with the layout, not on every draw of a slider.
+std::vector<int32_t> loose_triangle_vertices(const Mesh& mesh) {
+  std::vector<int32_t> loose;
+  if (!mesh.many_pieces()) return loose;
+  const auto& faces = mesh.faces();
+  for (int32_t f = 0; f < mesh.num_faces(); ++f)
+    if (mesh.loose_face(f)) loose.insert(loose.end(), &faces[3 * size_t(f)], &faces[3 * size_t(f)] + 3);
+  std::sort(loose.begin(), loose.end());
+  return loose;
+}
+
 void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
   const auto& ao = mesh.adjacency_offsets();
@@ -307,6 +318,7 @@ std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, cons
       std::find(layout->vertex_feature.begin(), layout->vertex_feature.end(), 1) != layout->vertex_feature.end();
   trace_curves(mesh, *layout);
   layout->curve_bends = find_curve_bends(mesh, *layout);
+  layout->loose_vertices = loose_triangle_vertices(mesh);
   collect_boundary_loops(mesh, *layout);
   PinchedVertices pinched = find_pinched_vertices(mesh);
   if (pinched.count > 0) {

@@ -582,19 +582,14 @@ class Refinement {
   }
 
   // An input triangle that is a piece of its own (an unwelded mesh is made of them) is the
-  // fewest its piece may keep: its corners are locked, so that the collapses never queue or cost
-  // them (every collapse there was refused, one by one: 2.4 s for 82,000 loose triangles). A
-  // piece the first pass brought down to one triangle stays free: the fit may still move it.
+  // fewest its piece may keep: its corners (FeatureLayout::loose_vertices, which the draw
+  // forces) are locked, so that the collapses never queue or cost them (every collapse there was
+  // refused, one by one: 2.4 s for 82,000 loose triangles).
   void lock_loose_triangles(CollapseSetup& setup) const {
-    if (!mesh.many_pieces()) return;
-    for (size_t t = 0; t < result.triangles.size(); t += 3) {
-      const int32_t* c = &result.triangles[t];
-      const int32_t face = mesh.first_face(kept_vertex[c[0]]);
-      if (mesh.first_face(kept_vertex[c[1]]) != face || mesh.first_face(kept_vertex[c[2]]) != face ||
-          !mesh.loose_face(face))
-        continue;
-      for (int j = 0; j < 3; ++j) setup.locked[c[j]] = 1;
-    }
+    const auto& loose = layout.loose_vertices;
+    if (loose.empty()) return;
+    for (int32_t i = 0; i < n; ++i)
+      if (std::binary_search(loose.begin(), loose.end(), kept_vertex[i])) setup.locked[i] = 1;
   }
 
   // A dead end locked after all (lock_inconsistent) is a locked end of its curve again; every

@@ -528,6 +528,15 @@ std::vector<double> sampling_probabilities(const Mesh& mesh, const FeatureLayout
   return probabilities(mesh, *table, guidance_multipliers(mesh, params), params, k);
 }
 
+// Joins the vertices of `kept` (sorted) that are not forced already to the forced vertices.
+void join_forced(const std::vector<int32_t>& kept, std::vector<int32_t>& forced) {
+  if (kept.empty()) return;
+  std::vector<int32_t> already = forced;  // a control point or a corner may be among them
+  std::sort(already.begin(), already.end());
+  for (int32_t v : kept)
+    if (!std::binary_search(already.begin(), already.end(), v)) forced.push_back(v);
+}
+
 // The border vertices the draw keeps, joined to the forced vertices (unless never sampled). With
 // keep_curves (a first pass the collapses thin next) every feature curve vertex, while they are at
 // most a quarter of the count: a random gap on a border is a notch the collapses cannot fill (a
@@ -551,32 +560,20 @@ std::vector<int32_t> force_curves(const FeatureLayout& layout, int32_t count, bo
       if (probability(layout.curve_bends[i]) > 0.0) kept.push_back(layout.curve_bends[i]);
     std::sort(kept.begin(), kept.end());
   }
-  if (kept.empty()) return kept;
-  std::vector<int32_t> already = forced;  // a control point or a corner may be among them
-  std::sort(already.begin(), already.end());
-  for (int32_t v : kept)
-    if (!std::binary_search(already.begin(), already.end(), v)) forced.push_back(v);
+  join_forced(kept, forced);
   return kept;
 }
 
-// The corners of triangles that are pieces of their own (Mesh::loose_face), joined to the
-// forced vertices: each piece keeps its triangle, so a draw without them only sends the repairs
-// after them round by round (327,680 loose triangles: 7.7 s in fast mode). Returns them sorted
-// and joined to `kept`, for drop_kept.
-void force_loose_triangles(const Mesh& mesh, std::vector<int32_t>& kept, std::vector<int32_t>& forced) {
-  if (!mesh.many_pieces()) return;
-  std::vector<int32_t> loose;
-  for (int32_t f = 0; f < mesh.num_faces(); ++f)
-    if (mesh.loose_face(f))
-      for (int j = 0; j < 3; ++j) loose.push_back(mesh.faces()[3 * size_t(f) + j]);
-  if (loose.empty()) return;
-  std::sort(loose.begin(), loose.end());
-  std::vector<int32_t> already = forced;
-  std::sort(already.begin(), already.end());
-  for (int32_t v : loose)
-    if (!std::binary_search(already.begin(), already.end(), v)) forced.push_back(v);
+// The corners of triangles that are pieces of their own (FeatureLayout::loose_vertices), joined
+// to the forced vertices and to `kept` (for drop_kept): each piece keeps its triangle, so a draw
+// without them only sends the repairs after them round by round (327,680 loose triangles: 7.7 s
+// in fast mode).
+void force_loose_triangles(const FeatureLayout& layout, std::vector<int32_t>& kept, std::vector<int32_t>& forced) {
+  if (layout.loose_vertices.empty()) return;
+  join_forced(layout.loose_vertices, forced);
   std::vector<int32_t> joined;
-  std::set_union(kept.begin(), kept.end(), loose.begin(), loose.end(), std::back_inserter(joined));
+  std::set_union(kept.begin(), kept.end(), layout.loose_vertices.begin(), layout.loose_vertices.end(),
+                 std::back_inserter(joined));
   kept = std::move(joined);
 }
 
@@ -628,7 +625,7 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
     double slope;
     if (plain) out.expected = expected_count(*table, importance(mesh, *table), out.rate, slope);
     auto kept = force_curves(layout, count, params.keep_curves, probability, forced);
-    force_loose_triangles(mesh, kept, forced);
+    force_loose_triangles(layout, kept, forced);
     drop_kept(kept, candidates);
     // The candidates below a threshold, the kept border vertices left out.
     auto candidates_below = [&](double threshold) {

@@ -71,6 +71,10 @@ struct FeatureLayout {
   /// Boundary vertices where the boundary turns sharply, sharpest first (curve_bends.hpp): the draw
   /// keeps them, up to an eighth of its count.
   std::vector<int32_t> curve_bends;
+  /// Corners of triangles that are pieces of their own (Mesh::loose_face), sorted: each piece keeps
+  /// its triangle, so the draw forces them and the collapses lock them. Empty unless the mesh has
+  /// many pieces (Mesh::many_pieces).
+  std::vector<int32_t> loose_vertices;
   /// Mesh boundary loops (cycles of edges with one triangle, continued at a vertex within one
   /// fan: loops touching at a pinch stay apart), as vertex sets: each must meet three clusters
   /// or it closes up in the output, whatever corners split it into curves.
