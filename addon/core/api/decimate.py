@@ -338,22 +338,23 @@ def loose_triangles(triangles: np.ndarray) -> int:
 
 
 def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob] = None) -> DecimateResult:
+    report = mesh.native.report  # a dict made on each read: read once
     stats = DecimateStats(**{f.name: raw[f.name] for f in dataclasses.fields(DecimateStats)  # same names
                              if f.name not in _COUNTED_HERE}, output_vertices=len(raw["vertices"]),
                           output_triangles=len(raw["triangles"]),
                           target_triangles=0 if job is None else int(job.target.triangles or 0),
                           control_points=0 if job is None else job.control_points,
-                          zero_area_input=mesh.native.report["zero_area_triangles"], replayed=job is None,
+                          zero_area_input=report["zero_area_triangles"], replayed=job is None,
                           nonmanifold_vertices=vertices_on_nonmanifold_edges(raw["triangles"])
-                          if mesh.native.report["nonmanifold_edges"] else 0,
+                          if report["nonmanifold_edges"] else 0,
                           loose_triangles=loose_triangles(raw["triangles"])
-                          if 10 * mesh.native.report["components"] >= mesh.native.report["input_triangles"] else 0)
+                          if 10 * report["components"] >= report["input_triangles"] else 0)
     # The holes are counted where they may be what holds a result over its target (budget.py:
     # three vertices a hole, a quarter of its vertices), so at least a quarter as many boundary
     # edges as result vertices, and loose triangles do not explain it already: the input's
     # topology is not computed for every miss.
     missed = stats.target_missed
-    if (missed is not None and missed.off > 0 and 4 * mesh.native.report["boundary_edges"] >= stats.output_vertices
+    if (missed is not None and missed.off > 0 and 4 * report["boundary_edges"] >= stats.output_vertices
             and 12 * stats.loose_triangles < stats.output_vertices):
         stats = dataclasses.replace(stats, holes=sum(len(c.boundary_loops) for c in mesh.input_topology.components))
     if stats.output_checked and stats.issues_left and not stats.check_violations:
