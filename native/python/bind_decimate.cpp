@@ -116,6 +116,7 @@ py::dict result_dict(DecimateResult&& r) {
   d["refine_triangles"] = r.refine_triangles;
   d["refine_collapses"] = r.refine_collapses;
   d["refine_keeps_positions"] = r.refine_keeps_positions;
+  d["shape_floor"] = r.shape_floor;
   d["collapses_skipped"] = r.collapses_skipped;
   d["repair_rounds"] = r.repair_rounds;
   d["repairs"] = r.repairs;

@@ -14,6 +14,9 @@ vertex) away from it. Why, in the words every channel uses:
   hole and handle its loops); where loose triangles (pieces of one triangle, as in an unwelded
   mesh) or holes (boundary loops, each kept with three vertices or more) make up much of the
   result, the detail says how many and what to do first;
+- "needle triangles": the input is made mostly of slivers (needles), and the result's triangles
+  may be no thinner than the input's own: the target needs thinner ones (a strip of needles
+  one or two cells wide);
 - "symmetry": the mirrored sample set is larger (or, where partners of absorbed samples were
   dropped, smaller) than the plain draw (core/api/symmetry.py);
 - "absorbed clusters": clusters that neighbours absorbed were not all made up for;
@@ -75,6 +78,8 @@ def over_reason(stats) -> str:
         return "control points"
     if stats.nonmanifold_vertices >= stats.output_vertices / 2:
         return "non-manifold edges"
+    if getattr(stats, "shape_floor", False):
+        return "needle triangles"
     # (The draw forces loose triangles' corners too: where they alone fill the target, the
     # topology holds the result, each piece keeping its triangle.)
     if stats.forced >= stats.target_vertices and 3 * getattr(stats, "loose_triangles", 0) < stats.target_vertices:
@@ -88,6 +93,8 @@ def _over_detail(stats, reason: str) -> str:
     """What the reason of a result over its target costs, in words (see the module docs)."""
     if reason == "non-manifold edges":
         return f"{stats.nonmanifold_vertices:,} of the result's {stats.output_vertices:,} vertices lie on them"
+    if reason == "needle triangles":
+        return "the result's triangles stay no thinner than the input's own needles; the target needs thinner ones"
     loose = getattr(stats, "loose_triangles", 0)
     if reason == "topology" and 3 * loose >= stats.output_vertices / 4:
         return (f"{loose:,} of the result's {stats.output_triangles:,} triangles are loose pieces, each kept whole; "

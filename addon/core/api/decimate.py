@@ -78,6 +78,9 @@ class DecimateStats:
     refine_collapses: int = 0   #: collapses the refinement made
     #: the refinement's collapses kept input positions (fast mode's, where its pass ended above the target)
     refine_keeps_positions: bool = False
+    #: the refinement stopped above its target where only triangles thinner than the input's own
+    #: needles would have gone on (a mesh made mostly of slivers)
+    shape_floor: bool = False
     #: a draft above its target whose full decimation collapses it further: the frame is the plain pass
     collapses_skipped: bool = False
     output_vertices: int = 0    #: vertices of the result

@@ -912,6 +912,7 @@ bool Collapser::below_floor(double twice_area2, double edges, ShapeFloor& floor)
 // Thinner than end v's floor (floor2, read once: -1 until then)? A wide end's kept bound, at or
 // below its floor, answers yes without the walk of its faces when the triangle is thinner still.
 bool Collapser::below_end_floor(double twice_area2, double edges, int32_t v, double& floor2) const {
+  if (!s_.input_floor2.empty() && !thinner(twice_area2, edges, s_.input_floor2[v])) return false;
   if (floor2 < 0.0) {
     const double bound = floor_bound_.empty() ? -1.0 : floor_bound_[v].get();
     if (bound >= 0.0 && thinner(twice_area2, edges, std::min(bound, min_shape_ * min_shape_))) return true;
@@ -963,6 +964,7 @@ void Collapser::move_to(int32_t v, const double* x) {
 
 void Collapser::collapse(int32_t u, int32_t v) {
   last_removed_ = u;
+  if (!s_.input_floor2.empty()) s_.input_floor2[v] = std::min(s_.input_floor2[v], s_.input_floor2[u]);
   {
     double x[3];
     if (rescue_) {

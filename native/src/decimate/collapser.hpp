@@ -51,6 +51,9 @@ struct CollapseSetup {
   std::vector<int32_t> corner_sector; ///< per corner: the sector (side of the borders) of its vertex
   std::vector<int32_t> bin, quota;    ///< per vertex its guidance bin; per bin the vertices to keep
   bool optimal_placement = true;      ///< off: every collapse is a half-edge collapse
+  /// Per vertex: the squared shape of the thinnest input triangle it stands for (a survivor
+  /// takes the lower of its two); a move may leave a triangle that thin. Empty: no such floor.
+  std::vector<double> input_floor2;
 };
 
 /// Which thin triangles Collapser::remove_thin takes, and how (zero-area ones always go).

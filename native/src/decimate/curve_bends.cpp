@@ -18,6 +18,10 @@ double turn_cosine(const double* a, const double* b, const double* c) {
   return in2 > 0 && out2 > 0 ? dot / std::sqrt(in2 * out2) : 1.0;
 }
 
+double squared_distance(const double* a, const double* b) {
+  return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+}
+
 struct Bend {
   double cosine;  // the larger (milder) of the turns over one and over two edges
   int32_t vertex;
@@ -53,21 +57,46 @@ void curve_bends(const Mesh& mesh, const int32_t* curve, int32_t n, bool closed,
   }
 }
 
+// Mesh boundaries only (a curve vertex of one sector): forced samples on a UV seam left the
+// spider of tests/data with output corners taking a UV from across the seam.
+bool traced_boundary(const Mesh& mesh, const FeatureLayout& layout, int32_t begin, int32_t end) {
+  return end - begin >= 3 && layout.sectors_of(mesh, layout.curve_vertices[begin + 1]) == 1;
+}
+
 }  // namespace
 
 std::vector<int32_t> find_curve_bends(const Mesh& mesh, const FeatureLayout& layout) {
   std::vector<Bend> bends;
   for (int32_t c = 0; c < layout.num_curves(); ++c) {
     const int32_t begin = layout.curve_offsets[c], end = layout.curve_offsets[c + 1];
-    // Mesh boundaries only (a curve vertex of one sector): forced samples on a UV seam left the
-    // spider of tests/data with output corners taking a UV from across the seam.
-    if (end - begin < 3 || layout.sectors_of(mesh, layout.curve_vertices[begin + 1]) != 1) continue;
+    if (!traced_boundary(mesh, layout, begin, end)) continue;
     curve_bends(mesh, layout.curve_vertices.data() + begin, end - begin, layout.curve_closed[c] != 0, bends);
   }
   std::sort(bends.begin(), bends.end());
   std::vector<int32_t> vertices(bends.size());
   for (size_t i = 0; i < bends.size(); ++i) vertices[i] = bends[i].vertex;
   return vertices;
+}
+
+std::vector<int32_t> find_sharp_turns(const Mesh& mesh, const FeatureLayout& layout, double edge_ratio) {
+  const double limit = std::cos(kBendAngle);
+  std::vector<int32_t> turns;
+  for (int32_t c = 0; c < layout.num_curves(); ++c) {
+    const int32_t begin = layout.curve_offsets[c], end = layout.curve_offsets[c + 1], n = end - begin;
+    if (!traced_boundary(mesh, layout, begin, end)) continue;
+    const int32_t* curve = layout.curve_vertices.data() + begin;
+    const bool closed = layout.curve_closed[c] != 0;
+    for (int32_t i = closed ? 0 : 1; i < (closed ? n : n - 1); ++i) {
+      const int32_t a = curve[(i + n - 1) % n], b = curve[i], d = curve[(i + 1) % n];
+      const double in2 = squared_distance(mesh.position(a), mesh.position(b));
+      const double out2 = squared_distance(mesh.position(b), mesh.position(d));
+      const double ratio2 = edge_ratio * edge_ratio;
+      if ((in2 > ratio2 * out2 || out2 > ratio2 * in2) &&
+          turn_cosine(mesh.position(a), mesh.position(b), mesh.position(d)) < limit)
+        turns.push_back(b);
+    }
+  }
+  return turns;
 }
 
 }  // namespace topstoc

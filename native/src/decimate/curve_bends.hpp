@@ -17,4 +17,10 @@ constexpr double kBendAngle = 40.0 * 3.14159265358979323846 / 180.0;
 /// vertex out cuts the corner off the border (sampling.cpp forces them).
 std::vector<int32_t> find_curve_bends(const Mesh& mesh, const FeatureLayout& layout);
 
+/// Every vertex of layout's traced mesh boundaries (corners excluded) where the curve turns by
+/// more than kBendAngle over one edge, two such turns side by side included (a strip's two
+/// corners at its end), and one of its two edges is more than `edge_ratio` times as long as
+/// the other; in curve order.
+std::vector<int32_t> find_sharp_turns(const Mesh& mesh, const FeatureLayout& layout, double edge_ratio);
+
 }  // namespace topstoc

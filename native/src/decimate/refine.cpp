@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -11,6 +12,7 @@
 #include "decimate/attribute_wedges.hpp"
 #include "decimate/collapse_snapshots.hpp"
 #include "decimate/collapser.hpp"
+#include "decimate/curve_bends.hpp"
 #include "decimate/deviation.hpp"
 #include "decimate/tiny_fit.hpp"
 #include "topstoc/core/parallel.hpp"
@@ -24,6 +26,12 @@ constexpr double kSliverShape = 0.1;
 // A mesh with more than this share of its triangles slivers is sliver-heavy (sliver_heavy): a UV
 // sphere of 1,000 segments has 0.37, the 54 meshes of bench_quality.py at most 0.18.
 constexpr double kSliverHeavyShare = 0.25;
+// On such an input a collapse may leave a triangle as thin as the thinnest input triangle its
+// vertices stand for, less this share (rounding: congruent needles computed from other corners).
+constexpr double kInputFloorSlack = 1e-6;
+// On such an input, a boundary's sharp turn stays where one of its edges is this many times as
+// long as the other (lock_sharp_turns).
+constexpr double kSharpTurnEdgeRatio = 4.0;
 // The max-aware reruns start from the first run's state at this many times the target (the
 // last collapses decide where the largest deviations end up), and there are kRounds of them,
 // each weighing where any run before it ended farthest.
@@ -415,6 +423,30 @@ bool count_slivers(const Mesh& mesh) {
   return seen > 0 && thin > kSliverHeavyShare * double(seen);
 }
 
+// Per output vertex: the squared shape of the thinnest input triangle around an input vertex it
+// stands for (label), a little below it so that a triangle as thin, computed from other corners,
+// still passes (CollapseSetup::input_floor2).
+std::vector<double> input_shape_floors(const Mesh& mesh, const std::vector<int32_t>& label, int32_t n) {
+  std::vector<double> floor2(n, std::numeric_limits<double>::infinity());
+  const int32_t m = mesh.num_faces();
+  for (int32_t f = 0; f < m; ++f) {
+    const int32_t* t = &mesh.faces()[3 * size_t(f)];
+    const double *a = mesh.position(t[0]), *b = mesh.position(t[1]), *c = mesh.position(t[2]);
+    double u[3], w[3], edges = 0;
+    for (int i = 0; i < 3; ++i) {
+      u[i] = b[i] - a[i], w[i] = c[i] - a[i];
+      edges += u[i] * u[i] + w[i] * w[i] + (c[i] - b[i]) * (c[i] - b[i]);
+    }
+    const double nx = u[1] * w[2] - u[2] * w[1], ny = u[2] * w[0] - u[0] * w[2], nz = u[0] * w[1] - u[1] * w[0];
+    const double area2 = nx * nx + ny * ny + nz * nz;
+    if (!(area2 > 0.0) || !(edges > 0.0)) continue;  // degenerate: no floor (as shape_floor2)
+    const double shape2 = (1.0 - kInputFloorSlack) * 12.0 * area2 / (edges * edges);
+    for (int j = 0; j < 3; ++j)
+      if (label[t[j]] >= 0 && label[t[j]] < n) floor2[label[t[j]]] = std::min(floor2[label[t[j]]], shape2);
+  }
+  return floor2;
+}
+
 }  // namespace
 
 bool sliver_heavy(const Mesh& mesh, const FeatureLayout& layout) {
@@ -458,6 +490,7 @@ class Refinement {
     setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *frame, !whole_input());
     set_up_vertices(setup);
     lock_loose_triangles(setup);
+    lock_sharp_turns(setup);
     lock_inconsistent(setup);
     count_locked_ends(setup);
     setup.quota = quotas();
@@ -471,9 +504,7 @@ class Refinement {
     } else if (params.warm_up) {
       return;  // no state is kept on this path
     } else {
-      Collapser collapser(result.triangles, result.corner_source, std::move(setup));
-      collapse(collapser, center, extent);
-      finish(collapser);
+      collapse_plain(std::move(setup), center, extent);
     }
     publish_labels();
   }
@@ -592,6 +623,83 @@ class Refinement {
       if (std::binary_search(loose.begin(), loose.end(), kept_vertex[i])) setup.locked[i] = 1;
   }
 
+  // On a sliver-heavy input a sharp turn of a boundary between a short edge and a long one
+  // stays. Moving it along the long edge (a strip of needles eaten from its end: a 2,000 x 4
+  // strip of 1 x 0.05 cells at 2 %, max error 25.6 % of the diagonal) was the cheapest collapse:
+  // the short edge's border plane weighs its tiny squared length.
+  void lock_sharp_turns(CollapseSetup& setup) const {
+    if (!sliver_heavy_input) return;
+    for (int32_t v : find_sharp_turns(mesh, layout, kSharpTurnEdgeRatio)) {
+      const int32_t i = label[v];
+      if (i >= 0 && i < n && kept_vertex[i] == v) setup.locked[i] = 1;
+    }
+  }
+
+  // The collapses of a sliver-heavy input stopped above the target by the shape rule: each
+  // triangle no thinner than the thinnest around it, where every triangle of a strip of needles
+  // is as thin (a 20,000 x 8 strip of 1 x 0.001 cells: 163,669 triangles for 32,000). Loosened,
+  // a triangle may be as thin as the input's thinnest where its vertices stand
+  // (input_shape_floors). Only after a stall: on UV spheres and fans, which reach their
+  // targets, the input's slivers as the floor everywhere made the max error 20-250 times larger.
+  bool may_loosen(const CollapseSetup& setup) const {
+    return sliver_heavy_input && !params.zero_area_only && setup.input_floor2.empty();
+  }
+  void loosen(CollapseSetup& setup) const { setup.input_floor2 = input_shape_floors(mesh, label, n); }
+
+  // Whether the shape rule holds a sliver-heavy input's run above its target
+  // (DecimateResult::shape_floor): a copy with no shape limit goes at least halfway from there to
+  // the target. The stalled run works on result's arrays.
+  bool held_by_shape(const Collapser& stalled) const {
+    if (stalled_by(stalled) == 0) return false;
+    std::vector<int32_t> triangles = result.triangles, corners = result.corner_source;
+    Collapser free(stalled);
+    free.use_arrays(triangles, corners);
+    free.set_shape_limits(0.0, Collapser::kMinTurnCos);
+    free.reopen();
+    free.run(target());
+    return 2 * stalled_by(free) <= stalled_by(stalled);
+  }
+  // Loosened collapses are tried where the plain ones stopped at twice the target or more, and
+  // kept where they get at least halfway from there to the target. A stall nearer the target is
+  // the topology's floor at a tiny budget, where CAD parts lost more than they gained: a tray of
+  // 4,520 triangles at 100, 316 -> 272 triangles for a max 0.78 -> 1.22 % of the diagonal; a
+  // filter housing at 100, 120 -> 106 for a mean 1.4 -> 2.2 %.
+  bool stalled_far(const Collapser& plain) const { return stalled_by(plain) >= target_count(); }
+  bool loosened_wins(const Collapser& loosened, const Collapser& plain) const {
+    return 2 * stalled_by(loosened) <= stalled_by(plain);
+  }
+  // How far a collapser stands above the target (0: reached).
+  int32_t stalled_by(const Collapser& collapser) const {
+    return std::max(0, (params.target_triangles > 0 ? collapser.live_faces() : collapser.live_vertices()) - target_count());
+  }
+  int32_t target_count() const { return params.target_triangles > 0 ? params.target_triangles : params.target_vertices; }
+
+  // The plain collapses (fast mode, the zero-area clean-up, large results), loosened after a
+  // stall when that wins (may_loosen, loosened_wins).
+  void collapse_plain(CollapseSetup setup, const double* center, double extent) {
+    std::optional<CollapseSetup> retry;
+    std::vector<int32_t> start_triangles, start_corners;
+    if (may_loosen(setup)) retry = setup, start_triangles = result.triangles, start_corners = result.corner_source;
+    auto collapser = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
+    collapse(*collapser, center, extent);
+    if (retry && stalled_far(*collapser)) {
+      loosen(*retry);
+      const int32_t collapses = result.refine_collapses;
+      auto loosened = std::make_unique<Collapser>(start_triangles, start_corners, std::move(*retry));
+      collapse(*loosened, center, extent);
+      if (loosened_wins(*loosened, *collapser)) {
+        result.triangles.swap(start_triangles);
+        result.corner_source.swap(start_corners);
+        loosened->use_arrays(result.triangles, result.corner_source);
+        collapser = std::move(loosened);
+      } else {
+        result.refine_collapses = collapses;
+      }
+    }
+    if (retry) result.shape_floor = held_by_shape(*collapser);
+    finish(*collapser);
+  }
+
   // A dead end locked after all (lock_inconsistent) is a locked end of its curve again; every
   // other open curve end is locked.
   void count_locked_ends(CollapseSetup& setup) const {
@@ -686,6 +794,21 @@ class Refinement {
       finish(*best.collapser);
       return;
     }
+    if (below_floor && may_loosen(start) && stalled_far(*best.collapser)) {
+      // Stalled on a sliver-heavy input: all over again, loosened, if its first run wins (loosened_wins).
+      CollapseSetup loosened = start;
+      loosen(loosened);
+      std::vector<int32_t> triangles = start_triangles, corners = start_corners;
+      Collapser probe(triangles, corners, loosened);
+      slivers_first(probe, stop);
+      probe.run(stop);
+      if (loosened_wins(probe, *best.collapser)) {
+        result.triangles = start_triangles;
+        result.corner_source = start_corners;
+        collapse_max_aware(std::move(loosened), center, extent);
+        return;
+      }
+    }
     if (floor.vertices > at_restart->live_vertices() || floor.faces > at_restart->live_faces()) {
       // The first run stopped above the target (the topology or the borders) and made few
       // collapses after the restart: the reruns restart from kRestart times where it ended
@@ -724,6 +847,7 @@ class Refinement {
     result.triangles = std::move(best.triangles);
     result.corner_source = std::move(best.corners);
     result.refine_collapses = best.collapses;
+    if (sliver_heavy_input) result.shape_floor = held_by_shape(*best.collapser);
     // The fit moves vertices under the usual limits (under the looser ones it left slivers: a
     // torus at 16 triangles, aspect ratio up to 187 against 35).
     best.collapser->set_shape_limits(Collapser::kMinShape, Collapser::kMinTurnCos);

@@ -123,6 +123,10 @@ struct DecimateResult {
   int32_t refine_triangles = 0;        ///< its triangle target, when it had one (0: none)
   int32_t refine_collapses = 0;        ///< collapses it made
   bool refine_keeps_positions = false; ///< its collapses were half-edge only (fast mode's)
+  /// It stopped above its target where only triangles thinner than the input's own needles
+  /// would have gone on: a sliver-heavy input, whose collapses without the shape rule would have
+  /// gone at least halfway from there to the target (refine.cpp's held_by_shape).
+  bool shape_floor = false;
   /// A draft above its target: the collapses that take the full decimation the rest of the way
   /// were left out (they need the labels a draft leaves out), so the frame is the plain pass.
   bool collapses_skipped = false;
