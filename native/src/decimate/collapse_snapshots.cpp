@@ -45,6 +45,7 @@ std::vector<uint64_t> start_key(const CollapseSetup& s, const std::vector<int32_
   add(key, s.bin);
   key.push_back(s.optimal_placement);
   add(key, s.input_floor2);
+  key.push_back(s.input_floor_flat_only);
   add(key, triangles);
   add(key, corner_source);
   return key;

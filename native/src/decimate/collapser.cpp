@@ -15,6 +15,9 @@ namespace {
 // The most triangles an edge collapsed along a non-manifold curve may have (more stay).
 constexpr int32_t kMaxSheets = 8;
 
+// A triangle whose normal turns by less than about 1e-4 radians keeps its plane (squared sine).
+constexpr double kFlatTurn2 = 1e-8;
+
 // True when a triangle with |n|² = twice_area2 and squared edge lengths summing to `edges` has a
 // shape quality (Collapser::shape) below sqrt(shape2): without roots or divisions.
 bool thinner(double twice_area2, double edges, double shape2) {
@@ -894,25 +897,54 @@ bool Collapser::keeps_face_shape(int32_t t, int32_t moved, const double* x, Shap
   // thinner than kMinShape already and stays within half of it.
   const double edges = squared_edges(c, moved, x);
   if (!thinner(len2, edges, min_shape_ * min_shape_)) return true;
+  // In a flat region (the moved vertex's triangles in one plane, this one keeping it) a needle as
+  // thin as the input's costs nothing (CollapseSetup::input_floor2).
+  bool flat = false;
+  if (!s_.input_floor2.empty() && dot * dot >= (1.0 - kFlatTurn2) * len2 * before2) {
+    if (floor.flat < 0) floor.flat = flat_star(moved);
+    flat = floor.flat;
+  }
   return !((!thinner(area2, squared_edges(c, moved, p), min_shape_ * min_shape_) ||
             thinner(len2, edges, 0.25 * min_shape_ * min_shape_)) &&
-           below_floor(len2, edges, floor));
+           below_floor(len2, edges, flat, floor));
+}
+
+// Whether v's live triangles with area all face one way (normals within kFlatTurn2).
+bool Collapser::flat_star(int32_t v) const {
+  double first[3] = {0, 0, 0}, first2 = 0.0;
+  for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) {
+    double n[3];
+    const int32_t* c = &(*tri_)[3 * size_t(*t)];
+    normal(c, c[0], position(c[0]), n);
+    const double n2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    if (!(n2 > 0.0)) continue;
+    if (first2 == 0.0) {
+      for (int i = 0; i < 3; ++i) first[i] = n[i];
+      first2 = n2;
+      continue;
+    }
+    const double dot = first[0] * n[0] + first[1] * n[1] + first[2] * n[2];
+    if (!(dot > 0.0) || dot * dot < (1.0 - kFlatTurn2) * first2 * n2) return false;
+  }
+  return true;
 }
 
 // Is a triangle thinner than the floor of the move, the lower of its ends' floors? Thinner than
 // both, that is: the end with fewer faces is read first, and the other only when needed.
-bool Collapser::below_floor(double twice_area2, double edges, ShapeFloor& floor) const {
+bool Collapser::below_floor(double twice_area2, double edges, bool flat, ShapeFloor& floor) const {
   int32_t first = floor.a, second = floor.b;
   double *first2 = &floor.a2, *second2 = &floor.b2;
   if (second >= 0 && size_[second] < size_[first]) std::swap(first, second), std::swap(first2, second2);
-  if (!below_end_floor(twice_area2, edges, first, *first2)) return false;
-  return second < 0 || below_end_floor(twice_area2, edges, second, *second2);
+  if (!below_end_floor(twice_area2, edges, flat, first, *first2)) return false;
+  return second < 0 || below_end_floor(twice_area2, edges, flat, second, *second2);
 }
 
 // Thinner than end v's floor (floor2, read once: -1 until then)? A wide end's kept bound, at or
 // below its floor, answers yes without the walk of its faces when the triangle is thinner still.
-bool Collapser::below_end_floor(double twice_area2, double edges, int32_t v, double& floor2) const {
-  if (!s_.input_floor2.empty() && !thinner(twice_area2, edges, s_.input_floor2[v])) return false;
+bool Collapser::below_end_floor(double twice_area2, double edges, bool flat, int32_t v, double& floor2) const {
+  if (!s_.input_floor2.empty() && (flat || !s_.input_floor_flat_only) && size_[v] <= kWideFan &&
+      !thinner(twice_area2, edges, s_.input_floor2[v]))
+    return false;  // no thinner than the input's thinnest where v stands (CollapseSetup::input_floor2)
   if (floor2 < 0.0) {
     const double bound = floor_bound_.empty() ? -1.0 : floor_bound_[v].get();
     if (bound >= 0.0 && thinner(twice_area2, edges, std::min(bound, min_shape_ * min_shape_))) return true;

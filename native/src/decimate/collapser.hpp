@@ -52,8 +52,11 @@ struct CollapseSetup {
   std::vector<int32_t> bin, quota;    ///< per vertex its guidance bin; per bin the vertices to keep
   bool optimal_placement = true;      ///< off: every collapse is a half-edge collapse
   /// Per vertex: the squared shape of the thinnest input triangle it stands for (a survivor
-  /// takes the lower of its two); a move may leave a triangle that thin. Empty: no such floor.
+  /// takes the lower of its two); a move may leave a triangle that thin, where the triangle
+  /// keeps its plane (with input_floor_flat_only) and the vertex has at most kWideFan faces.
+  /// Empty: no such floor.
   std::vector<double> input_floor2;
+  bool input_floor_flat_only = true;
 };
 
 /// Which thin triangles Collapser::remove_thin takes, and how (zero-area ones always go).
@@ -228,14 +231,16 @@ class Collapser {
   struct ShapeFloor {
     int32_t a, b;                // the ends (b = -1: a move)
     double a2 = -1.0, b2 = -1.0;  // their shape_floor2 (-1: not read yet)
+    int8_t flat = -1;             // the moved vertex's triangles lie in one plane (flat_star; -1: not read yet)
   };
-  bool below_floor(double twice_area2, double edges, ShapeFloor& floor) const;
+  bool flat_star(int32_t v) const;
+  bool below_floor(double twice_area2, double edges, bool flat, ShapeFloor& floor) const;
   bool keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const;
   bool beside_edge_keep_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const;
   bool keeps_face_shape(int32_t t, int32_t moved, const double* x, ShapeFloor& floor) const;
   double shape_floor2(int32_t v) const;
   double shape2(int32_t t) const;
-  bool below_end_floor(double twice_area2, double edges, int32_t v, double& floor2) const;
+  bool below_end_floor(double twice_area2, double edges, bool flat, int32_t v, double& floor2) const;
   void lower_floor_bounds(int32_t t);
   void moved_floor_bounds(int32_t v);
   double shape(const int32_t* c, int32_t replace, const double* at, double twice_area) const;
