@@ -29,6 +29,7 @@ constexpr double kSliverHeavyShare = 0.25;
 // On such an input a collapse may leave a triangle as thin as the thinnest input triangle its
 // vertices stand for, less this share (rounding: congruent needles computed from other corners).
 constexpr double kInputFloorSlack = 1e-6;
+// An input vertex of more than this many faces is a fan's centre (input_shape_floors).
 constexpr int32_t kWideInputFan = 64;
 // On such an input, a boundary's sharp turn stays where one of its edges is this many times as
 // long as the other (lock_sharp_turns).
@@ -497,7 +498,8 @@ class Refinement {
     set_up_vertices(setup);
     lock_loose_triangles(setup);
     lock_sharp_turns(setup);
-    if (sliver_heavy_input && !params.zero_area_only) setup.input_floor2 = input_shape_floors(mesh, label, n);  // may_loosen
+    // The input's own shape as a floor, in flat regions (may_loosen: on every collapse after a stall).
+    if (sliver_heavy_input && !params.zero_area_only) setup.input_floor2 = input_shape_floors(mesh, label, n);
     lock_inconsistent(setup);
     count_locked_ends(setup);
     setup.quota = quotas();
