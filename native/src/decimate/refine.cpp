@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
-#include <optional>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -405,22 +404,31 @@ bool has_zero_area(const DecimateResult& result) {
 
 namespace {
 
+// Input face f's squared twice-area (|n|², n its unnormalised normal) and its sum of squared
+// edges: its shape quality is 2 sqrt(3) |n| / edges.
+void face_shape_terms(const Mesh& mesh, int32_t f, double& area2, double& edges) {
+  const int32_t* t = &mesh.faces()[3 * size_t(f)];
+  const double *a = mesh.position(t[0]), *b = mesh.position(t[1]), *c = mesh.position(t[2]);
+  double u[3], w[3];
+  edges = 0;
+  for (int i = 0; i < 3; ++i) {
+    u[i] = b[i] - a[i], w[i] = c[i] - a[i];
+    edges += u[i] * u[i] + w[i] * w[i] + (c[i] - b[i]) * (c[i] - b[i]);
+  }
+  const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+  area2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+}
+
 // Judged on at most 65,536 triangles evenly spread: a count, the same on any thread count.
 bool count_slivers(const Mesh& mesh) {
   const int32_t m = mesh.num_faces();
   const int32_t step = std::max<int32_t>(1, int32_t((int64_t(m) + 65535) / 65536));
   int64_t seen = 0, thin = 0;
   for (int32_t f = 0; f < m; f += step) {
-    const int32_t* t = &mesh.faces()[3 * size_t(f)];
-    const double *a = mesh.position(t[0]), *b = mesh.position(t[1]), *c = mesh.position(t[2]);
-    double u[3], w[3], edges = 0;
-    for (int i = 0; i < 3; ++i) {
-      u[i] = b[i] - a[i], w[i] = c[i] - a[i];
-      edges += u[i] * u[i] + w[i] * w[i] + (c[i] - b[i]) * (c[i] - b[i]);
-    }
-    const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-    ++seen;  // shape quality 4 sqrt(3) area / sum of squared edges (twice the area is |n|)
-    thin += !(2.0 * std::sqrt(3.0) * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) >= kSliverShape * edges);
+    double area2, edges;
+    face_shape_terms(mesh, f, area2, edges);
+    ++seen;
+    thin += !(2.0 * std::sqrt(3.0) * std::sqrt(area2) >= kSliverShape * edges);
   }
   return seen > 0 && thin > kSliverHeavyShare * double(seen);
 }
@@ -433,19 +441,16 @@ bool count_slivers(const Mesh& mesh) {
 std::vector<double> input_shape_floors(const Mesh& mesh, const std::vector<int32_t>& label, int32_t n) {
   std::vector<double> floor2(n, std::numeric_limits<double>::infinity());
   const int32_t m = mesh.num_faces();
-  const auto& offsets = mesh.vertex_face_offsets();
-  auto wide = [&](int32_t v) { return offsets[v + 1] - offsets[v] > kWideInputFan; };
+  // Faces per input vertex, counted here: the mesh's vertex-face table, made on first use, would
+  // stay with the mesh (14 bytes a triangle).
+  std::vector<int32_t> faces_at(mesh.num_vertices(), 0);
+  for (int32_t corner : mesh.faces()) ++faces_at[corner];
+  auto wide = [&](int32_t v) { return faces_at[v] > kWideInputFan; };
   for (int32_t f = 0; f < m; ++f) {
     const int32_t* t = &mesh.faces()[3 * size_t(f)];
     if (wide(t[0]) || wide(t[1]) || wide(t[2])) continue;
-    const double *a = mesh.position(t[0]), *b = mesh.position(t[1]), *c = mesh.position(t[2]);
-    double u[3], w[3], edges = 0;
-    for (int i = 0; i < 3; ++i) {
-      u[i] = b[i] - a[i], w[i] = c[i] - a[i];
-      edges += u[i] * u[i] + w[i] * w[i] + (c[i] - b[i]) * (c[i] - b[i]);
-    }
-    const double nx = u[1] * w[2] - u[2] * w[1], ny = u[2] * w[0] - u[0] * w[2], nz = u[0] * w[1] - u[1] * w[0];
-    const double area2 = nx * nx + ny * ny + nz * nz;
+    double area2, edges;
+    face_shape_terms(mesh, f, area2, edges);
     if (!(area2 > 0.0) || !(edges > 0.0)) continue;  // degenerate: no floor (as shape_floor2)
     const double shape2 = (1.0 - kInputFloorSlack) * 12.0 * area2 / (edges * edges);
     for (int j = 0; j < 3; ++j)
@@ -480,10 +485,6 @@ class Refinement {
   void run() {
     if (params.warm_up && (guided || params.target_triangles > 0 || !params.snapshots)) return;  // none kept
     const auto& source = mesh.vertex_source();
-    CollapseSetup setup;
-    const auto frame = quadric_frame(mesh, layout);
-    for (int i = 0; i < 3; ++i) setup.center[i] = frame->center[i];
-    setup.extent = frame->extent;
     // The labels in the mesh's order: taken as they are from a refined decimation's first pass,
     // else gathered; the caller's are published from them at the end (publish_labels).
     if (result.labels_in_mesh_order) {
@@ -494,18 +495,7 @@ class Refinement {
     }
     std::vector<int32_t>().swap(result.labels);
     kept_vertex = mesh.internal_ids(result.kept);
-    setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *frame, !whole_input());
-    set_up_vertices(setup);
-    lock_loose_triangles(setup);
-    lock_sharp_turns(setup);
-    // The input's own shape as a floor, in flat regions (may_loosen: on every collapse after a stall).
-    if (sliver_heavy_input && !params.zero_area_only) setup.input_floor2 = input_shape_floors(mesh, label, n);
-    lock_inconsistent(setup);
-    count_locked_ends(setup);
-    setup.quota = quotas();
-    set_up_corner_sectors(setup);
-    // The zero-area clean-up and fast mode keep the caller's positions.
-    setup.optimal_placement = !params.zero_area_only && !params.keep_positions;
+    CollapseSetup setup = collapse_setup();
     const double center[3] = {setup.center[0], setup.center[1], setup.center[2]}, extent = setup.extent;
     if (params.max_aware && whole_input() && n <= kMaxAwareVertices) {
       collapse_max_aware(std::move(setup), center, extent);
@@ -523,6 +513,28 @@ class Refinement {
   const FeatureLayout& layout;
   const RefineParams& params;
   DecimateResult& result;
+
+  // The collapser's setup from the first pass's result (its arrays as that pass left them), the
+  // labels and the layout.
+  CollapseSetup collapse_setup() const {
+    CollapseSetup setup;
+    const auto frame = quadric_frame(mesh, layout);
+    for (int i = 0; i < 3; ++i) setup.center[i] = frame->center[i];
+    setup.extent = frame->extent;
+    setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *frame, !whole_input());
+    set_up_vertices(setup);
+    lock_loose_triangles(setup);
+    lock_sharp_turns(setup);
+    // The input's own shape as a floor, in flat regions (may_loosen: on every collapse after a stall).
+    if (sliver_heavy_input && !params.zero_area_only) setup.input_floor2 = input_shape_floors(mesh, label, n);
+    lock_inconsistent(setup);
+    count_locked_ends(setup);
+    setup.quota = quotas();
+    set_up_corner_sectors(setup);
+    // The zero-area clean-up and fast mode keep the caller's positions.
+    setup.optimal_placement = !params.zero_area_only && !params.keep_positions;
+    return setup;
+  }
 
   // The first pass kept every input vertex: its triangles are the input's own.
   bool whole_input() const { return n == num_input - mesh.report().isolated_vertices; }
@@ -685,28 +697,31 @@ class Refinement {
   int32_t target_count() const { return params.target_triangles > 0 ? params.target_triangles : params.target_vertices; }
 
   // The plain collapses (fast mode, the zero-area clean-up, large results), loosened after a
-  // stall when that wins (may_loosen, loosened_wins).
+  // stall when that wins (may_loosen, loosened_wins). The loosened run's setup is built again
+  // from the first pass's arrays, kept for it, rather than copied for every run that might stall.
   void collapse_plain(CollapseSetup setup, const double* center, double extent) {
-    std::optional<CollapseSetup> retry;
+    const bool may_retry = may_loosen(setup);
     std::vector<int32_t> start_triangles, start_corners;
-    if (may_loosen(setup)) retry = setup, start_triangles = result.triangles, start_corners = result.corner_source;
+    if (may_retry) start_triangles = result.triangles, start_corners = result.corner_source;
     auto collapser = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
     collapse(*collapser, center, extent);
-    if (retry && stalled_far(*collapser)) {
-      loosen(*retry);
+    if (may_retry && stalled_far(*collapser)) {
       const int32_t collapses = result.refine_collapses;
-      auto loosened = std::make_unique<Collapser>(start_triangles, start_corners, std::move(*retry));
+      result.triangles.swap(start_triangles);  // the first pass's arrays, for the setup and the run
+      result.corner_source.swap(start_corners);
+      CollapseSetup loosened_setup = collapse_setup();
+      loosen(loosened_setup);
+      auto loosened = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(loosened_setup));
       collapse(*loosened, center, extent);
       if (loosened_wins(*loosened, *collapser)) {
+        collapser = std::move(loosened);
+      } else {  // the plain run's arrays back
         result.triangles.swap(start_triangles);
         result.corner_source.swap(start_corners);
-        loosened->use_arrays(result.triangles, result.corner_source);
-        collapser = std::move(loosened);
-      } else {
         result.refine_collapses = collapses;
       }
     }
-    if (retry) result.shape_floor = held_by_shape(*collapser);
+    if (may_retry) result.shape_floor = held_by_shape(*collapser);
     finish(*collapser);
   }
 
