@@ -105,11 +105,19 @@ void from_input(const Mesh& mesh, const InputSurface& surface_in, const std::vec
   }
 }
 
+// Twice the area of triangle abc.
+double twice_area(const double* a, const double* b, const double* c) {
+  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  return std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
 // Each live triangle's centre, corners and side middles to the input, the largest kept per
-// corner (back2, per collapser vertex). A corner or side shared by several triangles is
-// measured once.
+// corner (back2, per collapser vertex), and their mean over the surface (back_mean: each
+// triangle's seven distances averaged, weighted by its area). A corner or side shared by
+// several triangles is measured once.
 void to_input(const TriangleBvh& input, Collapser& collapser, const std::vector<int32_t>& live,
-              std::vector<double>& back2) {
+              std::vector<double>& back2, double& back_mean) {
   const size_t faces = live.size() / 3;
   std::vector<int32_t> corners(live);
   std::sort(corners.begin(), corners.end());
@@ -146,11 +154,20 @@ void to_input(const TriangleBvh& input, Collapser& collapser, const std::vector<
     return at[nc + (std::lower_bound(sides.begin(), sides.end(), key) - sides.begin())];
   };
   std::vector<double> best(faces);
+  double weighted = 0.0, total_area = 0.0;
   for (size_t t = 0; t < faces; ++t) {
     const int32_t* c = &live[3 * t];
     best[t] = at[nc + ns + int64_t(t)];
-    for (int j = 0; j < 3; ++j) best[t] = std::max({best[t], corner(c[j]), side(c[j], c[(j + 1) % 3])});
+    double sum = std::sqrt(best[t]);
+    for (int j = 0; j < 3; ++j) {
+      best[t] = std::max({best[t], corner(c[j]), side(c[j], c[(j + 1) % 3])});
+      sum += std::sqrt(corner(c[j])) + std::sqrt(side(c[j], c[(j + 1) % 3]));
+    }
+    const double area = twice_area(collapser.position(c[0]), collapser.position(c[1]), collapser.position(c[2]));
+    weighted += area * sum / 7.0;
+    total_area += area;
   }
+  back_mean = total_area > 0.0 ? weighted / total_area : 0.0;
   // Triangles near the top (near_top) get the centres of their three corner quarters too (the
   // points measured split each into four).
   const double top2 = best.empty() ? 0.0 : *std::max_element(best.begin(), best.end());
@@ -176,10 +193,8 @@ std::vector<double> vertex_areas(const Mesh& mesh, const std::vector<double>& po
   const auto& faces = mesh.faces();
   for (int32_t f = 0; f < mesh.num_faces(); ++f) {
     const int32_t* q = &faces[3 * size_t(f)];
-    const double *a = &positions[3 * size_t(q[0])], *b = &positions[3 * size_t(q[1])], *c = &positions[3 * size_t(q[2])];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-    const double third = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) / 6.0;
+    const double third =
+        twice_area(&positions[3 * size_t(q[0])], &positions[3 * size_t(q[1])], &positions[3 * size_t(q[2])]) / 6.0;
     for (int j = 0; j < 3; ++j) out[size_t(q[j])] += third;
   }
   return out;
@@ -222,7 +237,7 @@ Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const s
   from_input(mesh, input, label, TriangleBvh(positions.data(), live.data(), out.faces), rival, out);
   if (!out.complete) return out;
   std::vector<double> back2(n, 0.0);
-  to_input(input.surface->bvh(), collapser, live, back2);
+  to_input(input.surface->bvh(), collapser, live, back2, out.back_mean);
   for (int32_t v = 0; v < n; ++v) out.vertex2[v] = std::max(out.vertex2[v], back2[survivor[v]]);
   out.top2 = n > 0 ? *std::max_element(out.vertex2.begin(), out.vertex2.end()) : 0.0;
   return out;

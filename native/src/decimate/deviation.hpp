@@ -30,6 +30,7 @@ struct Deviation {
   std::vector<double> vertex2;
   double top2 = 0.0;    ///< the largest of them
   double mean = 0.0;    ///< mean distance from the input, its vertices weighted by their areas
+  double back_mean = 0.0;  ///< mean distance to the input from the surface's points, by area
   int32_t faces = 0;     ///< live triangles
   int32_t vertices = 0;  ///< live vertices
   /// False when the measure stopped early (surface_deviation's rival): vertex2 and top2 then
