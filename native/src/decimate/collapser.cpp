@@ -127,6 +127,17 @@ void Collapser::reweigh(std::vector<double> weight) {
     if (merged_into_[u] < 0) settle(u, best[u]);
 }
 
+double Collapser::quadric_error() const {
+  double sum = 0.0;
+  for (int32_t v = 0; v < vertices(); ++v) {
+    if (merged_into_[v] >= 0) continue;
+    Quadric q;
+    s_.quadrics.reduced(v, -1, q);
+    sum += std::max(0.0, q.error(position(v)));
+  }
+  return sum;
+}
+
 void Collapser::neighbours(int32_t v, Scratch& scratch, std::vector<int32_t>& out) const {
   out.clear();
   const uint32_t stamp = ++scratch.stamp;

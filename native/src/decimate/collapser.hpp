@@ -95,6 +95,9 @@ class Collapser {
   /// Replaces every vertex's cost weight and costs every queued collapse anew: a copy of a
   /// collapser taken part-way continues under other weights (the max-aware refinement).
   void reweigh(std::vector<double> weight);
+  /// Costs every live vertex's collapses anew under the same weights (after set_shape_limits
+  /// loosened the checks, so that vertices whose every collapse was refused queue again).
+  void requeue() { reweigh(s_.weight); }
   /// Collapses and moves may not leave a triangle thinner than this shape quality (shape();
   /// 0.1 is an aspect ratio of about 5-10 by the thesis' measure) or, one that was thinner
   /// already, thinner than half of it; either may go lower only as far as the thinnest triangle
@@ -134,6 +137,9 @@ class Collapser {
   void restore(int32_t v, const double* position, const double* world);
 
   int32_t live_faces() const { return alive_faces_; }
+  /// The sum over live vertices of their quadric's error where they stand (normalised, no
+  /// guidance weight): how far the result lies from the input planes it stands for.
+  double quadric_error() const;
   int32_t live_vertices() const { return alive_vertices_; }
   /// The triangles as the collapses renamed them (dead ones included: see face_alive).
   const std::vector<int32_t>& triangles() const { return *tri_; }
