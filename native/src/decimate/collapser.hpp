@@ -67,6 +67,12 @@ struct ThinRules {
 
 class Collapser {
  public:
+  /// A vertex with more faces than this is a fan's centre: its collapses are checked by
+  /// allowed_wide (its walks last), its floor is kept as a bound, and the sliver clean-up thins
+  /// its fan a round at a time. (An input vertex as wide keeps its fan's slivers out of the
+  /// input floors: refine.cpp input_shape_floors.)
+  static constexpr int32_t kWideFan = 64;
+
   /// triangles and corner_source (3 per face) are updated in place as corners are renamed.
   Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corner_source, CollapseSetup setup);
 
@@ -213,10 +219,6 @@ class Collapser {
   }
   bool queues(int32_t u) const { return !s_.locked[u] && !at_quota(u); }
   bool allowed(int32_t u, int32_t v, Scratch& scratch) const;
-  // A vertex with more faces than this is a fan's centre: its collapses are checked by
-  // allowed_wide (its walks last), its floor is kept as a bound, and the sliver clean-up thins
-  // its fan a round at a time.
-  static constexpr int32_t kWideFan = 64;
   static constexpr size_t kWideTries = 16;  // collapses a wide vertex's evaluation checks (evaluate)
   // Vertices whose collapse offers the constructor gathers before merging them (see there).
   static constexpr int32_t kSetupBlock = 1 << 15;

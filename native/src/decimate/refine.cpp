@@ -28,8 +28,6 @@ constexpr double kSliverHeavyShare = 0.25;
 // On such an input a collapse may leave a triangle as thin as the thinnest input triangle its
 // vertices stand for, less this share (rounding: congruent needles computed from other corners).
 constexpr double kInputFloorSlack = 1e-6;
-// An input vertex of more than this many faces is a fan's centre (input_shape_floors).
-constexpr int32_t kWideInputFan = 64;
 // On such an input, a boundary's sharp turn stays where one of its edges is this many times as
 // long as the other (lock_sharp_turns).
 constexpr double kSharpTurnEdgeRatio = 4.0;
@@ -442,7 +440,7 @@ bool count_slivers(const Mesh& mesh) {
 // Per output vertex: the squared shape of the thinnest input triangle around an input vertex it
 // stands for (label), a little below it so that a triangle as thin, computed from other corners,
 // still passes (CollapseSetup::input_floor2). A fan's slivers (at a vertex of more than
-// kWideInputFan faces) are its centre's, not the surface's: left out (a capped cylinder of 5,000
+// Collapser::kWideFan faces) are its centre's, not the surface's: left out (a capped cylinder of 5,000
 // segments at 10 %, max 0.0007 -> 0.047 % of the diagonal with them).
 std::vector<double> input_shape_floors(const Mesh& mesh, const std::vector<int32_t>& label, int32_t n) {
   std::vector<double> floor2(n, std::numeric_limits<double>::infinity());
@@ -451,7 +449,7 @@ std::vector<double> input_shape_floors(const Mesh& mesh, const std::vector<int32
   // stay with the mesh (14 bytes a triangle).
   std::vector<int32_t> faces_at(mesh.num_vertices(), 0);
   for (int32_t corner : mesh.faces()) ++faces_at[corner];
-  auto wide = [&](int32_t v) { return faces_at[v] > kWideInputFan; };
+  auto wide = [&](int32_t v) { return faces_at[v] > Collapser::kWideFan; };
   for (int32_t f = 0; f < m; ++f) {
     const int32_t* t = &mesh.faces()[3 * size_t(f)];
     if (wide(t[0]) || wide(t[1]) || wide(t[2])) continue;
