@@ -182,3 +182,24 @@ def test_below_the_floor_the_result_nears_the_peers(name, target, peer_name, max
     error = hausdorff((v, t), r, samples=100_000, relative=True, percentile=0).symmetric
     assert 100 * error.max <= max_bound * theirs["max"], 100 * error.max / theirs["max"]
     assert 100 * error.mean <= mean_bound * theirs["mean"], 100 * error.mean / theirs["mean"]
+
+
+def test_a_tiny_target_it_reaches_gets_looser_reruns_too(tmp_path):
+    """The turbine (genus 11) at 180 triangles, a target it reaches: under the usual checks the
+    collapses left a max of 11.5 % of the diagonal (bench_quality.py's sampling), where at its
+    floor of 138 triangles, under the floor's looser reruns, it had 5.7 %. A tiny result now gets
+    three more reruns under the floor's checks, kept where they lower the max more than they
+    raise the mean (refine.cpp, loose_rerun). By MeshLab's own Hausdorff, against its quadric
+    collapse at the same count (which keeps the topology here): max 2.05 and mean 1.33 times
+    MeshLab's before, 0.52 and 0.69 now."""
+    pytest.importorskip("pymeshlab")
+    from test_large_first_pass import ours_and_meshlabs
+
+    v, t = reference.read_off(DATA / "genus_positive/cgal_turbine.off")
+    mesh = Mesh(v, t)
+    r = mesh.decimate(target_triangles=180, seed=0)
+    assert r.num_triangles == 180
+    check_output(mesh, r, reference.invariants(len(v), t))
+    (our_max, our_mean), (their_max, their_mean) = ours_and_meshlabs(tmp_path, np.asarray(v), np.asarray(t), r)
+    assert our_max <= 0.75 * their_max, (our_max, their_max)
+    assert our_mean <= 0.85 * their_mean, (our_mean, their_mean)

@@ -858,18 +858,23 @@ class Refinement {
     const double mean_bound = (1.0 + (tiny ? kTinyMeanSlack : kMeanSlack)) * best.deviation.mean;
     Deviation last = best.deviation;
     std::vector<double> worst(n, 0.0);  // per vertex: its largest deviation over the largest, of every run so far
-    for (int round = 0; round < kRounds && last.top2 > 0; ++round) {
+    // A tiny result that reached its target gets kRounds more reruns under the floor's looser
+    // limits, which must lower the max by more than they add to the mean (loose_rerun).
+    const int rounds = tiny && !below_floor ? 2 * kRounds : kRounds;
+    for (int r = 0; r < rounds && last.top2 > 0; ++r) {
+      const int round = r % kRounds;
+      const bool loose_rerun = r >= kRounds;
       for (int32_t v = 0; v < n; ++v) worst[v] = std::max(worst[v], last.vertex2[v] / last.top2);
       result.triangles = restart_triangles;
       result.corner_source = restart_corners;
       auto run = std::make_unique<Collapser>(*at_restart);
       run->reweigh(deviation_weights(*run, guidance, worst, kDeviationWeights[round]));
-      if (below_floor) run->set_shape_limits(kFloorShape[round], kFloorTurnCos);
+      if (below_floor || loose_rerun) run->set_shape_limits(kFloorShape[round], kFloorTurnCos);
       const int32_t collapses = shared + collapse_rest(*run, center, extent, below_floor ? reached : stop);
       // The last run's deviation serves only the choice: measured until it loses.
       const Rival rival{best.deviation.top2, mean_bound};
-      last = surface_deviation(mesh, input, label, *run, result.triangles, round + 1 == kRounds ? &rival : nullptr);
-      if (wins(last, best.deviation, mean_bound, tiny))
+      last = surface_deviation(mesh, input, label, *run, result.triangles, r + 1 == rounds ? &rival : nullptr);
+      if (wins(last, best.deviation, mean_bound, tiny && !loose_rerun))
         best = Run{std::move(run), last, collapses, result.triangles, result.corner_source};
     }
     if (below_floor && best.collapser->live_faces() <= kExtensionFaces) extend_past_floor(best, input, stop);
