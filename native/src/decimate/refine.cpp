@@ -1112,7 +1112,8 @@ class Refinement {
            (params.target_triangles > 0 ? params.target_triangles : 2 * params.target_vertices) <= kTinyFitFaces;
   }
   int32_t tail_choice(std::unique_ptr<Collapser>& collapser, const double* center, double extent) {
-    const Collapser::Stop restart{params.target_triangles > 0 ? 0 : kTailFaces / 2, params.target_triangles > 0 ? kTailFaces : 0};
+    const bool faces = params.target_triangles > 0;
+    const Collapser::Stop restart{faces ? 0 : kTailFaces / 2, faces ? kTailFaces : 0};
     const int32_t shared = collapser->run(restart);
     auto loose = std::make_unique<Collapser>(*collapser);
     std::vector<int32_t> triangles = result.triangles, corners = result.corner_source;
@@ -1122,7 +1123,8 @@ class Refinement {
     loose->requeue();
     const int32_t loose_collapses = shared + collapse_rest(*loose, center, extent);
     // The measure only where the loosened tail lies nearer the input's planes and differs.
-    if (loose->quadric_error() >= collapser->quadric_error() || same_faces(*loose, triangles, *collapser, result.triangles))
+    if (loose->quadric_error() >= collapser->quadric_error() ||
+        same_faces(*loose, triangles, *collapser, result.triangles))
       return plain_collapses;
     const InputSurface input(mesh, kept_input(*collapser, 1));
     const Deviation plain = surface_deviation(mesh, input, label, *collapser, result.triangles);
