@@ -79,7 +79,7 @@ std::vector<int32_t> find_curve_bends(const Mesh& mesh, const FeatureLayout& lay
 }
 
 std::vector<int32_t> find_sharp_turns(const Mesh& mesh, const FeatureLayout& layout, double edge_ratio) {
-  const double limit = std::cos(kBendAngle);
+  const double limit = std::cos(kBendAngle), ratio2 = edge_ratio * edge_ratio;
   std::vector<int32_t> turns;
   for (int32_t c = 0; c < layout.num_curves(); ++c) {
     const int32_t begin = layout.curve_offsets[c], end = layout.curve_offsets[c + 1], n = end - begin;
@@ -90,7 +90,6 @@ std::vector<int32_t> find_sharp_turns(const Mesh& mesh, const FeatureLayout& lay
       const int32_t a = curve[(i + n - 1) % n], b = curve[i], d = curve[(i + 1) % n];
       const double in2 = squared_distance(mesh.position(a), mesh.position(b));
       const double out2 = squared_distance(mesh.position(b), mesh.position(d));
-      const double ratio2 = edge_ratio * edge_ratio;
       if ((in2 > ratio2 * out2 || out2 > ratio2 * in2) &&
           turn_cosine(mesh.position(a), mesh.position(b), mesh.position(d)) < limit)
         turns.push_back(b);

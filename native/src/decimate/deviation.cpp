@@ -160,8 +160,9 @@ void to_input(const TriangleBvh& input, Collapser& collapser, const std::vector<
     best[t] = at[nc + ns + int64_t(t)];
     double sum = std::sqrt(best[t]);
     for (int j = 0; j < 3; ++j) {
-      best[t] = std::max({best[t], corner(c[j]), side(c[j], c[(j + 1) % 3])});
-      sum += std::sqrt(corner(c[j])) + std::sqrt(side(c[j], c[(j + 1) % 3]));
+      const double at_corner2 = corner(c[j]), at_side2 = side(c[j], c[(j + 1) % 3]);
+      best[t] = std::max({best[t], at_corner2, at_side2});
+      sum += std::sqrt(at_corner2) + std::sqrt(at_side2);
     }
     const double area = twice_area(collapser.position(c[0]), collapser.position(c[1]), collapser.position(c[2]));
     weighted += area * sum / 7.0;

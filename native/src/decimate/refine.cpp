@@ -1122,10 +1122,8 @@ class Refinement {
     loose->set_shape_limits(kFloorShape[1], Collapser::kMinTurnCos);
     loose->requeue();
     const int32_t loose_collapses = shared + collapse_rest(*loose, center, extent);
-    // The measure only where the loosened tail lies nearer the input's planes and differs.
-    if (loose->quadric_error() >= collapser->quadric_error() ||
-        same_faces(*loose, triangles, *collapser, result.triangles))
-      return plain_collapses;
+    // The measure only where the loosened tail lies nearer the input's planes.
+    if (loose->quadric_error() >= collapser->quadric_error()) return plain_collapses;
     const InputSurface input(mesh, kept_input(*collapser, 1));
     const Deviation plain = surface_deviation(mesh, input, label, *collapser, result.triangles);
     const Deviation loosened = surface_deviation(mesh, input, label, *loose, triangles);
@@ -1135,17 +1133,6 @@ class Refinement {
     loose->use_arrays(result.triangles, result.corner_source);
     collapser = std::move(loose);
     return loose_collapses;
-  }
-  // Whether two runs from one state left the same live triangles (positions are the input's).
-  static bool same_faces(const Collapser& a, const std::vector<int32_t>& a_triangles, const Collapser& b,
-                         const std::vector<int32_t>& b_triangles) {
-    if (a.live_faces() != b.live_faces()) return false;
-    for (size_t t = 0; 3 * t < a_triangles.size(); ++t) {
-      if (a.face_alive(int32_t(t)) != b.face_alive(int32_t(t))) return false;
-      if (a.face_alive(int32_t(t)) && !std::equal(&a_triangles[3 * t], &a_triangles[3 * t] + 3, &b_triangles[3 * t]))
-        return false;
-    }
-    return true;
   }
   // The loosened tail wins where it stops no farther from the target and its max is smaller by
   // a larger share than its mean both ways is larger, or its max is the same and that mean
