@@ -84,6 +84,33 @@ bool write_all(int fd, const void* data, size_t size) {
   return true;
 }
 
+// TetGen computes without blocking, so a child that neither runs nor sends for this long is
+// stuck: its double free on refusal, which usually aborts it, once left it waiting forever on a
+// lock read from the freed memory (a test of a self-intersecting surface hung in the child's free).
+constexpr auto kStuck = std::chrono::seconds(5);
+
+// The child's CPU ticks (user + system) and whether it is running, from /proc/<pid>/stat; false
+// where there is no /proc (then no child is ever judged stuck).
+bool child_cpu(pid_t child, unsigned long long& ticks, bool& running) {
+  char path[64];
+  std::snprintf(path, sizeof path, "/proc/%d/stat", int(child));
+  FILE* file = std::fopen(path, "r");
+  if (!file) return false;
+  char line[1024];
+  const size_t n = std::fread(line, 1, sizeof line - 1, file);
+  std::fclose(file);
+  line[n] = 0;
+  const char* after_name = std::strrchr(line, ')');  // the name may hold spaces and brackets
+  char state = 0;
+  unsigned long long user = 0, system = 0;
+  if (!after_name || std::sscanf(after_name + 2, "%c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &state,
+                                 &user, &system) != 3)
+    return false;
+  ticks = user + system;
+  running = state == 'R';
+  return true;
+}
+
 void run_tetgen(tetgenio& in, std::vector<double>& points, std::vector<int32_t>& tets, Progress* progress) {
   int data[2], text[2];
   if (pipe(data) != 0) throw std::runtime_error("cannot create a pipe for TetGen");
@@ -132,6 +159,9 @@ void run_tetgen(tetgenio& in, std::vector<double>& points, std::vector<int32_t>&
   std::string bytes, messages;
   bool data_open = true, text_open = true;
   char buffer[1 << 16];
+  // A stuck child (kStuck) is killed; its exit is then reported as TetGen's failure below.
+  unsigned long long last_ticks = 0;
+  auto last_sign = std::chrono::steady_clock::now();
   try {
     while (data_open || text_open) {
       pollfd fds[2] = {{data[0], POLLIN, 0}, {text[0], POLLIN, 0}};
@@ -142,9 +172,19 @@ void run_tetgen(tetgenio& in, std::vector<double>& points, std::vector<int32_t>&
         if (!open || !(fds[i].revents & (POLLIN | POLLHUP | POLLERR))) continue;
         const ssize_t n = read(fds[i].fd, buffer, sizeof buffer);
         if (n > 0)
-          (i == 0 ? bytes : messages).append(buffer, size_t(n));
+          (i == 0 ? bytes : messages).append(buffer, size_t(n)), last_sign = std::chrono::steady_clock::now();
         else
           open = false;
+      }
+      unsigned long long ticks = 0;
+      bool running = false;
+      if (!child_cpu(child, ticks, running)) continue;
+      if (running || ticks != last_ticks) {
+        last_ticks = ticks;
+        last_sign = std::chrono::steady_clock::now();
+      } else if (std::chrono::steady_clock::now() - last_sign > kStuck) {
+        kill(child, SIGKILL);
+        break;
       }
     }
   } catch (...) {
