@@ -53,7 +53,7 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
     }
   alive_face_.assign(m, 1);
   for (int32_t v = 0; v < n && !tracking_floors_; ++v) tracking_floors_ = size_[v] > kWideFan;
-  if (tracking_floors_) floor_bound_.assign(n, FloorBound());
+  if (tracking_floors_) floor_bound_.assign(n, Shared<double>()), flat_star_.assign(n, Shared<int8_t>());
   dirty_.assign(n, 0);
   placed_.assign(n, 0);
   merged_into_.assign(n, -1);
@@ -158,6 +158,7 @@ int32_t Collapser::sector_at(int32_t t, int32_t v) const {
 }
 
 void Collapser::remove_face(int32_t v, int32_t t) {
+  if (tracking_floors_) flat_star_[v].set(-1);
   int32_t* list = &pool_[begin_[v]];
   const int32_t size = size_[v];
   for (int32_t i = 0; i < size; ++i)
@@ -169,6 +170,7 @@ void Collapser::remove_face(int32_t v, int32_t t) {
 }
 
 void Collapser::append_faces(int32_t v, const int32_t* faces, int32_t count) {
+  if (tracking_floors_) flat_star_[v].set(-1);
   if (size_[v] + count > capacity_[v]) {
     // Out of room: the list moves to the end of the pool with space to grow.
     const int32_t capacity = 2 * (size_[v] + count);
@@ -840,6 +842,7 @@ void Collapser::lower_floor_bounds(int32_t t) {
   const int32_t* c = &(*tri_)[3 * size_t(t)];
   double value = -1.0;
   for (int j = 0; j < 3; ++j) {
+    flat_star_[c[j]].set(-1);
     const double bound = floor_bound_[c[j]].get();
     if (bound < 0.0) continue;
     if (value < 0.0) value = shape2(t);
@@ -851,6 +854,7 @@ void Collapser::lower_floor_bounds(int32_t t) {
 void Collapser::moved_floor_bounds(int32_t v) {
   if (!tracking_floors_) return;
   floor_bound_[v].set(-1.0);
+  flat_star_[v].set(-1);
   for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) lower_floor_bounds(*t);
 }
 
@@ -920,8 +924,19 @@ bool Collapser::keeps_face_shape(int32_t t, int32_t moved, const double* x, Shap
            below_floor(len2, edges, flat, floor));
 }
 
-// Whether v's live triangles with area all face one way (normals within kFlatTurn2).
+// Whether v's live triangles with area all face one way (normals within kFlatTurn2); kept for a
+// wide v (flat_star_).
 bool Collapser::flat_star(int32_t v) const {
+  if (tracking_floors_ && size_[v] > kWideFan) {
+    int8_t known = flat_star_[v].get();
+    if (known < 0) flat_star_[v].set(known = walk_flat_star(v));
+    return known;
+  }
+  return walk_flat_star(v);
+}
+
+// flat_star by a walk of v's triangles.
+bool Collapser::walk_flat_star(int32_t v) const {
   double first[3] = {0, 0, 0}, first2 = 0.0;
   for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) {
     double n[3];

@@ -242,6 +242,7 @@ class Collapser {
     int8_t flat = -1;             // the moved vertex's triangles lie in one plane (flat_star; -1: not read yet)
   };
   bool flat_star(int32_t v) const;
+  bool walk_flat_star(int32_t v) const;
   bool below_floor(double twice_area2, double edges, bool flat, ShapeFloor& floor) const;
   bool keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const;
   bool beside_edge_keep_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const;
@@ -281,20 +282,24 @@ class Collapser {
   double fold2_ = kMinTurnCos * kMinTurnCos;  // squared cosine of the largest turn of a normal
   int32_t alive_vertices_ = 0, alive_faces_ = 0;
   std::vector<int32_t> pool_, begin_, size_, capacity_;  // vertex -> faces
+  // A value the checks on the team's threads read and write (a const read of the state caches
+  // it): a relaxed atomic, the same value by whichever thread.
+  template <class T>
+  struct Shared {
+    mutable std::atomic<T> value;
+    explicit Shared(T unset = T(-1)) : value(unset) {}
+    Shared(const Shared& other) : value(other.get()) {}
+    Shared& operator=(const Shared& other) { return set(other.get()), *this; }
+    T get() const { return value.load(std::memory_order_relaxed); }
+    void set(T x) const { value.store(x, std::memory_order_relaxed); }
+  };
   // Per vertex of more than kWideFan faces whose floor was read: a bound at or below the least
   // squared shape of its triangles (shape_floor2 before the cap), lowered as they change, so that
   // a triangle far thinner than a fan's floor is refused without the walk of the fan (-1: none).
-  // Read and written by the checks on the team's threads: a relaxed atomic, the same value by
-  // whichever thread.
-  struct FloorBound {
-    mutable std::atomic<double> value{-1.0};  // set by shape_floor2, a const read of the state
-    FloorBound() = default;
-    FloorBound(const FloorBound& other) : value(other.get()) {}
-    FloorBound& operator=(const FloorBound& other) { return set(other.get()), *this; }
-    double get() const { return value.load(std::memory_order_relaxed); }
-    void set(double x) const { value.store(x, std::memory_order_relaxed); }
-  };
-  std::vector<FloorBound> floor_bound_;  // empty: no vertex is wide
+  std::vector<Shared<double>> floor_bound_;  // empty: no vertex is wide
+  // Per vertex of more than kWideFan faces: flat_star's answer once read, -1 again when one of its
+  // triangles changes, so that a fan's centre is walked once per change, not once per check.
+  std::vector<Shared<int8_t>> flat_star_;  // empty: no vertex is wide
   bool tracking_floors_ = false;
   std::vector<uint8_t> alive_face_, dirty_, placed_;
   std::vector<int32_t> merged_into_, target_;
