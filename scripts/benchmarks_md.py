@@ -213,6 +213,31 @@ def render_scale(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def render_families(name: str, figures: dict) -> str:
+    """bench_families.py --json: time and peak memory per shape family at one size, next to the torus."""
+    baseline = figures.get("baseline")
+    out = [f"## Slow corners: shape families at one size (`{name}`)", "",
+           f"`{figures['benchmark']}`: cold = prepare + decimate in a fresh process; peak = resident memory above the "
+           "interpreter's baseline, per input triangle, input arrays included; ÷ torus = the family's cold time over "
+           "the bumpy torus's at the same mode and ratio." + (" The baseline build ran each case right after."
+                                                               if baseline else ""), "", *source_lines(figures), "",
+           "| Family | Triangles | Mode | Ratio | Cold | ÷ torus | Peak per triangle | Target missed |"
+           + (" Baseline cold | Baseline peak |" if baseline else ""),
+           "|---|---|---|---|---|---|---|---|" + ("---|---|" if baseline else "")]
+    torus = {(r["mode"], r["ratio"]): r["ours"] for r in figures["rows"] if r["family"] == "bumpy_torus"}
+    for row in figures["rows"]:
+        f, ref = row["ours"], torus.get((row["mode"], row["ratio"]))
+        cold = f["prepare_s"] + f["decimate_s"]
+        cells = (f"| {row['family'].replace('_', ' ')} | {f['triangles']:,} | {row['mode']} | {percent(row['ratio'])} "
+                 f"| {ms(1000 * cold)} | {'—' if ref is None else format(cold / (ref['prepare_s'] + ref['decimate_s']), '.1f') + '×'} "
+                 f"| {f['bytes_per_triangle']:.0f} B | {'yes' if f['target_missed'] else 'no'} |")
+        if baseline:
+            b = row["baseline"]
+            cells += f" {ms(1000 * (b['prepare_s'] + b['decimate_s']))} | {b['bytes_per_triangle']:.0f} B |"
+        out.append(cells)
+    return "\n".join(out) + "\n"
+
+
 def render_high_valence(name: str, figures: dict) -> str:
     """bench_high_valence.py --json: decimation time on fans of slivers, this build and a baseline."""
     modes = figures["modes"]
@@ -475,6 +500,8 @@ def render_result(path: pathlib.Path) -> str:
         return render_attributes(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_scale.py":
         return render_scale(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_families.py":
+        return render_families(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_high_valence.py":
         return render_high_valence(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_blender_background.py --memory":
@@ -493,7 +520,7 @@ def render_result(path: pathlib.Path) -> str:
         return render_error_search(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
                      "the --json of bench_decimate.py, bench_quality.py, bench_attributes.py, bench_loops.py --families, "
-                     "bench_scale.py, bench_high_valence.py, bench_blender_background.py --memory, bench_threads_paired.py, bench_cleanup.py, "
+                     "bench_scale.py, bench_families.py, bench_high_valence.py, bench_blender_background.py --memory, bench_threads_paired.py, bench_cleanup.py, "
                      "bench_cleanup.py --speed, bench_blender_decimate.py --only-rest, bench_batch.py and bench_error_search.py, and carried-over "
                      "figures)")
 

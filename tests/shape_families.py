@@ -1,0 +1,88 @@
+"""Generated meshes of one size in shapes a decimator meets, for finding slow corners: each is
+what a benchmark on one kind of mesh does not contain (numpy only, no topstoc code).
+
+Each family is a function of an approximate triangle count returning float64 (n, 3) vertices
+and int32 (m, 3) triangles, the same mesh on every run. The bumpy torus is the reference the
+others are compared with (closed, one component, well-shaped triangles).
+"""
+
+import numpy as np
+
+import fan_meshes
+import loop_families
+import meshgen
+
+
+def bumpy_torus(triangles: int):
+    """The reference: a closed genus-1 scan-like torus (meshgen.bumpy_torus)."""
+    return meshgen.bumpy_torus(triangles)
+
+
+def many_spheres(triangles: int):
+    """Icospheres of 1,280 triangles scattered apart: many small components (a particle scene)."""
+    v, f = meshgen.icosphere(3)
+    count = max(1, triangles // len(f))
+    offsets = np.random.default_rng(1).uniform(-50, 50, (count, 3))
+    vertices = (v[None] + offsets[:, None]).reshape(-1, 3)
+    faces = (f[None] + (np.arange(count) * len(v))[:, None, None]).reshape(-1, 3)
+    return vertices, faces.astype(np.int32)
+
+
+def triangle_soup(triangles: int):
+    """Unwelded triangles, three vertices each (an STL exported without merging): nothing to collapse."""
+    rng = np.random.default_rng(2)
+    centres = rng.uniform(0, 100, (triangles, 1, 3))
+    vertices = (centres + rng.normal(0, 0.3, (triangles, 3, 3))).reshape(-1, 3)
+    return vertices, np.arange(3 * triangles, dtype=np.int32).reshape(-1, 3)
+
+
+def sheet_with_holes(triangles: int):
+    """A wavy open sheet with 2 % of its triangles missing: a scan with thousands of small holes."""
+    side = max(2, int((triangles / 2) ** 0.5))
+    vertices, faces = meshgen.grid(side, side)
+    vertices[:, 2] = 0.3 * np.sin(vertices[:, 0] / 7) * np.cos(vertices[:, 1] / 5)
+    keep = np.random.default_rng(3).random(len(faces)) > 0.02
+    return vertices, faces[keep]
+
+
+def sliver_sphere(triangles: int):
+    """A UV sphere of 250 rings and as many segments as the size needs: slivers near the poles."""
+    rings = 250
+    return fan_meshes.uv_sphere(max(8, triangles // (2 * rings)), rings)
+
+
+def fanned_cylinder(triangles: int):
+    """A cylinder of four rows with fanned caps: two vertices of valence equal to the segments."""
+    return fan_meshes.cylinder_caps(max(8, triangles // 12), 4)
+
+
+def perforated_plate(triangles: int):
+    """A plate with 1,000 random holes (genus 1,000), subdivided up to the size: CAD-like."""
+    vertices, faces = loop_families.perforated_plate(1000)
+    while 4 * len(faces) <= triangles:
+        vertices, faces = meshgen.subdivide(vertices, faces, 1)
+    return vertices, faces
+
+
+def torn_scan(triangles: int):
+    """The bumpy torus with 0.1 % of its triangles missing and a fin on one edge in 2,000."""
+    vertices, faces = meshgen.bumpy_torus(triangles)
+    rng = np.random.default_rng(4)
+    faces = faces[rng.random(len(faces)) > 0.001]
+    fins = faces[rng.choice(len(faces), len(faces) // 2000)]
+    tips = vertices[fins[:, 2]] + rng.normal(0, 0.01, (len(fins), 3))
+    fin_faces = np.column_stack([fins[:, 0], fins[:, 1], len(vertices) + np.arange(len(fins))]).astype(np.int32)
+    return np.vstack([vertices, tips]), np.vstack([faces, fin_faces])
+
+
+def welded_points(triangles: int):
+    """The bumpy torus with 2 % of its vertices moved onto a neighbour: zero-area triangles."""
+    vertices, faces = meshgen.bumpy_torus(triangles)
+    moved = np.random.default_rng(5).choice(len(vertices), len(vertices) // 50, replace=False)
+    vertices = vertices.copy()
+    vertices[moved] = vertices[(moved + 1) % len(vertices)]
+    return vertices, faces
+
+
+FAMILIES = {f.__name__: f for f in (bumpy_torus, many_spheres, triangle_soup, sheet_with_holes, sliver_sphere,
+                                    fanned_cylinder, perforated_plate, torn_scan, welded_points)}
