@@ -772,7 +772,9 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
   const int passes = stalled && !refined ? 0 : params.budget_passes;
   int32_t drawn = target;
   for (int pass = 0; pass < passes && excess(best) > tolerance && best.forced < target; ++pass) {
-    drawn = std::max(1, drawn - excess(best) - tolerance);
+    const int32_t lower = std::max(1, drawn - excess(best) - tolerance);
+    if (lower == drawn) break;  // the same draw again: the same pass (a sheet with thousands of holes, at 1)
+    drawn = lower;
     DecimateResult r = decimate_once(mesh, layout, params, drawn, target, nullptr);
     if (std::abs(excess(r)) < std::abs(excess(best))) {
       r.flood_updated = best.flood_updated;  // (it tells of the draw for the target)
