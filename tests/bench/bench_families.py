@@ -6,7 +6,7 @@ that holds off the benchmark's own mesh).
     /usr/bin/python3 tests/bench/bench_families.py [--triangles 1e6] [--ratios 0.01 0.1]
         [--baseline OTHER_BUILD] [--json docs/bench_results/bench_families.json]
 
-Each family, mode and ratio runs in a fresh process (as tests/memory_peak.py): the time of
+Each family, mode and ratio runs in a fresh process (tests/memory_peak.py): the time of
 Mesh() and of decimate(), and the peak resident memory above the interpreter's baseline per input
 triangle, the input arrays included. "÷ torus" is a family's cold time over the bumpy torus's at
 the same mode and ratio: the cost of the shape itself. With --baseline, another build (main's)
@@ -16,61 +16,16 @@ runs each case right after this one, and the table gives its time and peak too.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import pathlib
-import subprocess
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT / "tests"), str(pathlib.Path(__file__).resolve().parent)]
 
+import memory_peak  # noqa: E402
 from machine import machine, save_figures  # noqa: E402
 from shape_families import FAMILIES  # noqa: E402
-
-CHILD = r"""
-import json, sys, time
-sys.path[:0] = [{python!r}, {tests!r}]
-import numpy as np
-from topstoc.core import Mesh
-import meshgen, shape_families
-
-def status(name):
-    with open("/proc/self/status") as handle:
-        for line in handle:
-            if line.startswith(name + ":"):
-                return int(line.split()[1]) * 1024
-
-warm = Mesh(*meshgen.bumpy_torus(2000))
-warm.decimate(ratio=0.1, mode={mode!r}, seed=1)
-del warm
-base = status("VmRSS")
-vertices, triangles = shape_families.FAMILIES[{family!r}]({triangles})
-vertices = np.ascontiguousarray(vertices, dtype=np.float64)
-triangles = np.ascontiguousarray(triangles, dtype=np.int32)
-with open("/proc/self/clear_refs", "w") as handle:
-    handle.write("5")
-start = time.perf_counter()
-mesh = Mesh(vertices, triangles)
-prepared = time.perf_counter()
-result = mesh.decimate(ratio={ratio}, mode={mode!r}, seed=1)
-done = time.perf_counter()
-print(json.dumps({{"triangles": len(triangles), "vertices": len(vertices), "prepare_s": prepared - start,
-                  "decimate_s": done - prepared, "bytes_per_triangle": (status("VmHWM") - base) / len(triangles),
-                  "output_triangles": len(result.triangles), "target_missed": result.stats.target_missed is not None,
-                  "topology_kept": bool(result.stats.topology_kept)}}))
-"""
-
-
-def run_case(build: pathlib.Path, family: str, triangles: int, mode: str, ratio: float) -> dict:
-    """One family at one mode and ratio in a fresh process of `build`."""
-    code = CHILD.format(python=str(build / "python"), tests=str(ROOT / "tests"), family=family,
-                        triangles=triangles, mode=mode, ratio=ratio)
-    env = {**os.environ, "TOPSTOC_BUILD": str(build)}
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=False)
-    if out.returncode != 0:
-        raise SystemExit(f"error: {family} ({mode}, {ratio}) with {build}: {out.stderr.strip().splitlines()[-1:]}")
-    return json.loads(out.stdout.strip().splitlines()[-1])
 
 
 def cold(figures: dict) -> float:
@@ -94,9 +49,9 @@ def main() -> int:
         for mode in args.modes:
             for ratio in args.ratios:
                 row = {"family": family, "mode": mode, "ratio": ratio,
-                       "ours": run_case(build, family, int(args.triangles), mode, ratio)}
+                       "ours": memory_peak.measure(args.triangles, mode, ratio, family, build)}
                 if args.baseline:
-                    row["baseline"] = run_case(args.baseline.resolve(), family, int(args.triangles), mode, ratio)
+                    row["baseline"] = memory_peak.measure(args.triangles, mode, ratio, family, args.baseline.resolve())
                 reference = next((r for r in rows if r["family"] == "bumpy_torus" and r["mode"] == mode
                                   and r["ratio"] == ratio), row)
                 ours = row["ours"]
