@@ -1,5 +1,6 @@
-// The draw without guidance against its definition (sampling.hpp): the vertices with p = 1 and
-// the sharpest curve bends (up to an eighth of the target), and of the others the target's remainder with the smallest Pareto keys (U/(1-U)) ((1-p)/p), U the
+// The draw without guidance against its definition (sampling.hpp): the vertices with p = 1, the
+// sharpest curve bends (up to an eighth of the target) and three vertices of each short boundary
+// loop, and of the others the target's remainder with the smallest Pareto keys (U/(1-U)) ((1-p)/p), U the
 // vertex's uniform for the seed. A slider's draws with one seed take a faster way after the
 // first (a candidate order kept on the layout); both ways must give the definition's samples.
 #include <doctest/doctest.h>
@@ -29,10 +30,29 @@ std::vector<int32_t> defined_draw(const Mesh& mesh, const FeatureLayout& layout,
   // The sharpest curve bends, up to an eighth of the target, are kept like p = 1.
   std::vector<uint8_t> bend(mesh.num_vertices(), 0);
   for (int32_t i = 0; i < int32_t(layout.curve_bends.size()) && i < target / 8; ++i) bend[layout.curve_bends[i]] = 1;
+  std::vector<uint8_t> kept(mesh.num_vertices(), 0);
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) kept[v] = p[v] >= 1.0 || (bend[v] && p[v] > 0.0);
+  // Each boundary loop too short to expect three samples (length x target / vertices under 3)
+  // and holding fewer than three kept vertices keeps those at 0, 1/3 and 2/3 of its sorted
+  // vertices (p > 0, not kept) until it holds three, where they add up to an eighth of the target.
+  const double per_vertex = double(target) / double(mesh.num_vertices() - mesh.report().isolated_vertices);
+  std::vector<uint8_t> loop_kept(mesh.num_vertices(), 0);
+  int64_t added = 0;
+  for (size_t loop = 0; loop + 1 < layout.boundary_loop_offsets.size(); ++loop) {
+    const int32_t b = layout.boundary_loop_offsets[loop], n = layout.boundary_loop_offsets[loop + 1] - b;
+    if (n < 3 || double(n) * per_vertex >= 3.0) continue;
+    int32_t have = 0;
+    for (int32_t i = 0; i < n; ++i) have += kept[layout.boundary_loop_vertices[size_t(b + i)]];
+    for (int32_t k = 0; k < 3 && have < 3; ++k) {
+      const int32_t v = layout.boundary_loop_vertices[size_t(b + k * n / 3)];
+      if (p[v] > 0.0 && !kept[v]) added += !loop_kept[v], loop_kept[v] = 1, ++have;
+    }
+  }
+  if (4 * added < target) std::fill(loop_kept.begin(), loop_kept.end(), 0);
   std::vector<int32_t> drawn;
   std::vector<std::pair<double, int32_t>> keys;
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-    if (p[v] >= 1.0 || (bend[v] && p[v] > 0.0)) {
+    if (kept[v] || loop_kept[v]) {
       drawn.push_back(v);
     } else if (p[v] > 0.0) {
       const double u = uniform01(params.seed, 1, uint64_t(mesh.vertex_source()[v]));
@@ -91,6 +111,22 @@ TEST_CASE("draws without guidance take the smallest Pareto keys, the first draw 
     auto make_layout = [&]() { return build_feature_layout(mesh, nullptr, 0, nullptr, 0, 0.0); };
     const auto layout = make_layout();
     REQUIRE(std::count(layout->vertex_feature.begin(), layout->vertex_feature.end(), 1) > 100);
+    check_draws(mesh, make_layout);
+  }
+  SUBCASE("a sheet with a hole in one cell in nine: three vertices of each short loop") {
+    const auto grid = topstoc_test::grid(60, 60);
+    std::vector<int32_t> triangles;
+    for (int32_t i = 0; i < 60; ++i)
+      for (int32_t j = 0; j < 60; ++j)
+        if (i % 3 != 1 || j % 3 != 1)
+          triangles.insert(triangles.end(), &grid.triangles[6 * size_t(i * 60 + j)], &grid.triangles[6 * size_t(i * 60 + j) + 6]);
+    const Mesh mesh(grid.positions, triangles.data(), int64_t(triangles.size() / 3));
+    auto make_layout = [&]() { return build_feature_layout(mesh, nullptr, 0, nullptr, 0, 0.0); };
+    const auto layout = make_layout();
+    REQUIRE(layout->boundary_loop_offsets.size() == 400 + 2);  // 400 holes and the rim
+    SamplingParams params;
+    CHECK(select_samples(mesh, *layout, params, 1000).forced >= 3 * 400);  // the holes' three each
+    CHECK(select_samples(mesh, *layout, params, 1000).forced < 3 * 400 + 400);
     check_draws(mesh, make_layout);
   }
   SUBCASE("a grid with a row and a column as borders: corners, p = 1") {

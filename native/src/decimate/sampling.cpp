@@ -579,14 +579,18 @@ void force_loose_triangles(const FeatureLayout& layout, std::vector<int32_t>& ke
 
 // Each boundary loop too short to expect three samples at this count (FeatureLayout::
 // boundary_loop_vertices) keeps three, spread over its vertices (sorted by id, which follows
-// space), joined to the forced vertices and to `kept`: a hole met by fewer clusters closes up,
-// and the partition check's repairs found them one sample per loop and round (a sheet with
-// 17,459 holes at 1 %: 11 rounds, 107,683 repairs).
+// space), joined to the forced vertices and to `kept`, where such loops are many (their three
+// at least an eighth of the count): a hole met by fewer clusters closes up, and the partition
+// check's repairs found them one sample per loop and round (a sheet with 17,459 holes at 1 %:
+// 11 rounds, 107,683 repairs). A few are left to the repairs, which take them in a round or
+// two and leave the budget to the draw (forced, two tiny holes of a painted dragon drew top-ups
+// into its Less region).
 template <class Probability>
-void force_boundary_loops(const FeatureLayout& layout, double per_vertex, const Probability& probability,
+void force_boundary_loops(const FeatureLayout& layout, int32_t count, int32_t active, const Probability& probability,
                           std::vector<int32_t>& kept, std::vector<int32_t>& forced) {
   const int32_t loops = int32_t(layout.boundary_loop_offsets.size()) - 1;
   if (loops <= 0) return;
+  const double per_vertex = double(count) / double(std::max(1, active));
   std::vector<int32_t> already = forced;  // corners and control points count as kept
   std::sort(already.begin(), already.end());
   std::vector<int32_t> added;
@@ -605,9 +609,9 @@ void force_boundary_loops(const FeatureLayout& layout, double per_vertex, const 
         added.push_back(v), ++have;
     }
   }
-  if (added.empty()) return;
   std::sort(added.begin(), added.end());
   added.erase(std::unique(added.begin(), added.end()), added.end());  // loops touching at a pinch
+  if (added.empty() || 4 * int64_t(added.size()) < int64_t(count)) return;
   join_forced(added, forced);
   std::vector<int32_t> joined;
   std::set_union(kept.begin(), kept.end(), added.begin(), added.end(), std::back_inserter(joined));
@@ -663,8 +667,8 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
     if (plain) out.expected = expected_count(*table, importance(mesh, *table), out.rate, slope);
     auto kept = force_curves(layout, count, params.keep_curves, probability, forced);
     force_loose_triangles(layout, kept, forced);
-    const int32_t active = std::max(1, mesh.num_vertices() - mesh.report().isolated_vertices);
-    force_boundary_loops(layout, double(count) / double(active), probability, kept, forced);
+    force_boundary_loops(layout, count, mesh.num_vertices() - mesh.report().isolated_vertices, probability, kept,
+                         forced);
     drop_kept(kept, candidates);
     // The candidates below a threshold, the kept border vertices left out.
     auto candidates_below = [&](double threshold) {

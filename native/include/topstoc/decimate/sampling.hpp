@@ -58,7 +58,7 @@ struct SamplingParams {
 
 struct SampleSet {
   std::vector<int32_t> samples;  ///< sorted vertex ids
-  int32_t forced = 0;            ///< corners, u = 1 vertices and the curve bends kept (features.hpp)
+  int32_t forced = 0;            ///< corners, u = 1 vertices, the curve bends and short loops' three kept (features.hpp)
   int32_t density_rejected = 0;  ///< candidates skipped by density control
   bool guided = false;           ///< guidance, view or boxes changed the probabilities
   double expected = 0.0;         ///< sum of the probabilities
@@ -83,7 +83,9 @@ bool is_guided(const Mesh& mesh, const SamplingParams& params);
 std::vector<double> sampling_probabilities(const Mesh& mesh, const FeatureLayout& layout,
                                            const SamplingParams& params, double k);
 
-/// Draws the samples for a target vertex count (exact without guidance).
+/// Draws the samples for a target vertex count (exact without guidance): the forced vertices
+/// (p = 1, the sharpest curve bends, loose triangles' corners, three of each boundary loop too short
+/// to expect three samples), then the smallest Pareto keys (sampling.cpp).
 SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const SamplingParams& params,
                          int32_t target_vertices);
 
