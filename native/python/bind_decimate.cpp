@@ -105,6 +105,7 @@ py::dict result_dict(DecimateResult&& r) {
   d["target_vertices"] = r.target_vertices;
   d["selected"] = r.selected;
   d["forced"] = r.forced;
+  d["loop_forced"] = r.loop_forced;
   d["density_rejected"] = r.density_rejected;
   d["guided"] = r.guided;
   d["expected_vertices"] = r.expected_vertices;

@@ -82,7 +82,10 @@ def over_reason(stats) -> str:
         return "needle triangles"
     # (The draw forces loose triangles' corners too: where they alone fill the target, the
     # topology holds the result, each piece keeping its triangle.)
-    if stats.forced >= stats.target_vertices and 3 * getattr(stats, "loose_triangles", 0) < stats.target_vertices:
+    # So does it three vertices of each short boundary loop where those are many: the holes, which
+    # the topology keeps, not the borders' corners.
+    corners = stats.forced - getattr(stats, "loop_forced", 0)
+    if corners >= stats.target_vertices and 3 * getattr(stats, "loose_triangles", 0) < stats.target_vertices:
         return "borders"
     if stats.mirrored_from and stats.mirrored_from - stats.target_vertices <= tolerance(stats.target_vertices):
         return "symmetry"  # the plain draw met the target, its mirrored set did not

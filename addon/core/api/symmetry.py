@@ -176,6 +176,7 @@ def decimate_job_mirrored(mesh, job):
         else result.vertices
     stats = dataclasses.replace(result.stats, target_vertices=plain.stats.target_vertices,
                                 target_triangles=plain.stats.target_triangles, forced=plain.stats.forced,
+                                loop_forced=plain.stats.loop_forced,
                                 control_points=plain.stats.control_points, mirrored_from=plain.num_vertices,
                                 replayed=False)
     return dataclasses.replace(result, vertices=vertices, parameters=parameters, stats=stats)

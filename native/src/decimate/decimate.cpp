@@ -660,6 +660,7 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
   result.target_vertices = params.target_vertices;
   result.selected = static_cast<int32_t>(set.samples.size());
   result.forced = set.forced;
+  result.loop_forced = set.loop_forced;
   result.density_rejected = set.density_rejected;
   result.guided = set.guided;
   result.expected_vertices = set.expected;
@@ -941,6 +942,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   // What must stay whatever the target: border corners and control points (the first pass
   // may have drawn every vertex, which says nothing about the budget).
   result.forced = 0;
+  result.loop_forced = 0;
   for (int32_t v = 0; v < mesh.num_vertices(); ++v)
     result.forced += layout.is_corner(v) || (!multipliers.empty() && multipliers[v] == kForcedMultiplier);
   return verified(mesh, layout, std::move(result));

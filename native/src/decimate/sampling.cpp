@@ -584,12 +584,12 @@ void force_loose_triangles(const FeatureLayout& layout, std::vector<int32_t>& ke
 // check's repairs found them one sample per loop and round (a sheet with 17,459 holes at 1 %:
 // 11 rounds, 107,683 repairs). A few are left to the repairs, which take them in a round or
 // two and leave the budget to the draw (forced, two tiny holes of a painted dragon drew top-ups
-// into its Less region).
+// into its Less region). Returns how many it forced.
 template <class Probability>
-void force_boundary_loops(const FeatureLayout& layout, int32_t count, int32_t active, const Probability& probability,
+int32_t force_boundary_loops(const FeatureLayout& layout, int32_t count, int32_t active, const Probability& probability,
                           std::vector<int32_t>& kept, std::vector<int32_t>& forced) {
   const int32_t loops = int32_t(layout.boundary_loop_offsets.size()) - 1;
-  if (loops <= 0) return;
+  if (loops <= 0) return 0;
   const double per_vertex = double(count) / double(std::max(1, active));
   std::vector<int32_t> already = forced;  // corners and control points count as kept
   std::sort(already.begin(), already.end());
@@ -611,11 +611,12 @@ void force_boundary_loops(const FeatureLayout& layout, int32_t count, int32_t ac
   }
   std::sort(added.begin(), added.end());
   added.erase(std::unique(added.begin(), added.end()), added.end());  // loops touching at a pinch
-  if (added.empty() || 4 * int64_t(added.size()) < int64_t(count)) return;
+  if (added.empty() || 4 * int64_t(added.size()) < int64_t(count)) return 0;
   join_forced(added, forced);
   std::vector<int32_t> joined;
   std::set_union(kept.begin(), kept.end(), added.begin(), added.end(), std::back_inserter(joined));
   kept = std::move(joined);
+  return int32_t(added.size());
 }
 
 // Removes the kept border vertices (sorted) from the candidates.
@@ -667,8 +668,8 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
     if (plain) out.expected = expected_count(*table, importance(mesh, *table), out.rate, slope);
     auto kept = force_curves(layout, count, params.keep_curves, probability, forced);
     force_loose_triangles(layout, kept, forced);
-    force_boundary_loops(layout, count, mesh.num_vertices() - mesh.report().isolated_vertices, probability, kept,
-                         forced);
+    out.loop_forced = force_boundary_loops(layout, count, mesh.num_vertices() - mesh.report().isolated_vertices,
+                                           probability, kept, forced);
     drop_kept(kept, candidates);
     // The candidates below a threshold, the kept border vertices left out.
     auto candidates_below = [&](double threshold) {

@@ -106,6 +106,7 @@ struct DecimateResult {
   int32_t target_vertices = 0;
   int32_t selected = 0;                ///< samples drawn before repairs
   int32_t forced = 0;                  ///< corners and control points among them
+  int32_t loop_forced = 0;             ///< of those, three vertices of each short boundary loop (the holes')
   int32_t density_rejected = 0;
   bool guided = false;
   double expected_vertices = 0.0;      ///< sum of the sampling probabilities

@@ -59,6 +59,7 @@ struct SamplingParams {
 struct SampleSet {
   std::vector<int32_t> samples;  ///< sorted vertex ids
   int32_t forced = 0;            ///< corners, u = 1 vertices, the curve bends and short loops' three kept (features.hpp)
+  int32_t loop_forced = 0;       ///< of those, the three of each short boundary loop
   int32_t density_rejected = 0;  ///< candidates skipped by density control
   bool guided = false;           ///< guidance, view or boxes changed the probabilities
   double expected = 0.0;         ///< sum of the probabilities
