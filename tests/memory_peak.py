@@ -1,10 +1,11 @@
 """Peak memory of one prepare + decimate on a generated mesh, measured in a fresh process.
 
 Shared by tests/bench/bench_scale.py (2M to 100M triangles), tests/bench/bench_families.py (each
-shape family at one size) and tests/python/test_memory_ceiling.py (2M). The child process imports numpy and topstoc, makes one
-decimation of a 2,000-triangle mesh (what NumPy imports on first use and the engine's threads),
-reads its resident size (the baseline: the interpreter, the modules, the threads), generates the mesh
-(tests/shape_families.py: the bumpy torus unless asked), resets the kernel's high-water mark (/proc/self/clear_refs, so that the
+shape family at one size) and tests/python/test_memory_ceiling.py (2M). The child process
+imports numpy and topstoc, makes one decimation of a 2,000-triangle mesh (what NumPy imports on
+first use and the engine's threads), reads its resident size (the baseline: the interpreter,
+the modules, the threads), generates the mesh (tests/shape_families.py: the bumpy torus unless
+asked), resets the kernel's high-water mark (/proc/self/clear_refs, so that the
 generator's temporaries are not counted), then prepares and decimates. The figure is
 (high-water mark - baseline) / input triangles: the input arrays (float64 vertices, int32
 triangles, 24 bytes a triangle) are included, as the caller holds them throughout. The same is

@@ -57,7 +57,8 @@ def main() -> int:
                 ours = row["ours"]
                 line = (f"{family:18s} {mode:7s} {ratio:5.2f}: {ours['triangles']:>9,} triangles, prepare "
                         f"{ours['prepare_s']:.2f} s + decimate {ours['decimate_s']:.2f} s "
-                        f"({cold(ours) / cold(reference['ours']):.1f}x the torus), peak {ours['bytes_per_triangle']:.0f} B/triangle")
+                        f"({cold(ours) / cold(reference['ours']):.1f}x the torus), "
+                        f"peak {ours['bytes_per_triangle']:.0f} B/triangle")
                 if args.baseline:
                     base = row["baseline"]
                     line += f"; baseline {cold(base):.2f} s, {base['bytes_per_triangle']:.0f} B/triangle"
