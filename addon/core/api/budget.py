@@ -82,8 +82,8 @@ def over_reason(stats) -> str:
         return "needle triangles"
     # (The draw forces loose triangles' corners too: where they alone fill the target, the
     # topology holds the result, each piece keeping its triangle.)
-    # So does it three vertices of each short boundary loop where those are many: the holes, which
-    # the topology keeps, not the borders' corners.
+    # It forces three vertices of each short boundary loop too, where those are many: the holes',
+    # which the topology keeps; they are not the borders' corners.
     corners = stats.forced - getattr(stats, "loop_forced", 0)
     if corners >= stats.target_vertices and 3 * getattr(stats, "loose_triangles", 0) < stats.target_vertices:
         return "borders"

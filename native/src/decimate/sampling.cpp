@@ -580,14 +580,14 @@ void force_loose_triangles(const FeatureLayout& layout, std::vector<int32_t>& ke
 // Each boundary loop too short to expect three samples at this count (FeatureLayout::
 // boundary_loop_vertices) keeps three, spread over its vertices (sorted by id, which follows
 // space), joined to the forced vertices and to `kept`, where such loops are many (their three
-// at least an eighth of the count): a hole met by fewer clusters closes up, and the partition
-// check's repairs found them one sample per loop and round (a sheet with 17,459 holes at 1 %:
-// 11 rounds, 107,683 repairs). A few are left to the repairs, which take them in a round or
-// two and leave the budget to the draw (forced, two tiny holes of a painted dragon drew top-ups
-// into its Less region). Returns how many it forced.
+// at least a quarter of the count): a hole met by fewer clusters closes up, and the partition
+// check's repairs found them one sample per loop and round (a scan's thousands of small holes
+// took round after round). A few are left to the repairs, which take them in a round or two
+// and leave the budget to the draw (forced, a painted dragon's two tiny holes drew top-ups into
+// its Less region). Returns how many it forced.
 template <class Probability>
-int32_t force_boundary_loops(const FeatureLayout& layout, int32_t count, int32_t active, const Probability& probability,
-                          std::vector<int32_t>& kept, std::vector<int32_t>& forced) {
+int32_t force_boundary_loops(const FeatureLayout& layout, int32_t count, int32_t active,
+                             const Probability& probability, std::vector<int32_t>& kept, std::vector<int32_t>& forced) {
   const int32_t loops = int32_t(layout.boundary_loop_offsets.size()) - 1;
   if (loops <= 0) return 0;
   const double per_vertex = double(count) / double(std::max(1, active));
