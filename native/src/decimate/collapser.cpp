@@ -170,7 +170,6 @@ void Collapser::remove_face(int32_t v, int32_t t) {
 }
 
 void Collapser::append_faces(int32_t v, const int32_t* faces, int32_t count) {
-  if (tracking_floors_) flat_star_[v].set(-1);
   if (size_[v] + count > capacity_[v]) {
     // Out of room: the list moves to the end of the pool with space to grow.
     const int32_t capacity = 2 * (size_[v] + count);
@@ -855,7 +854,6 @@ void Collapser::lower_floor_bounds(int32_t t) {
 void Collapser::moved_floor_bounds(int32_t v) {
   if (!tracking_floors_) return;
   floor_bound_[v].set(-1.0);
-  flat_star_[v].set(-1);
   for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) lower_floor_bounds(*t);
 }
 

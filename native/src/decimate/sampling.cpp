@@ -537,6 +537,16 @@ void join_forced(const std::vector<int32_t>& kept, std::vector<int32_t>& forced)
     if (!std::binary_search(already.begin(), already.end(), v)) forced.push_back(v);
 }
 
+// Joins `more` (sorted) to `kept` (sorted, for drop_kept) and, those not forced already, to the
+// forced vertices.
+void keep_and_force(const std::vector<int32_t>& more, std::vector<int32_t>& kept, std::vector<int32_t>& forced) {
+  if (more.empty()) return;
+  join_forced(more, forced);
+  std::vector<int32_t> joined;
+  std::set_union(kept.begin(), kept.end(), more.begin(), more.end(), std::back_inserter(joined));
+  kept = std::move(joined);
+}
+
 // The border vertices the draw keeps, joined to the forced vertices (unless never sampled). With
 // keep_curves (a first pass the collapses thin next) every feature curve vertex, while they are at
 // most a quarter of the count: a random gap on a border is a notch the collapses cannot fill (a
@@ -569,12 +579,7 @@ std::vector<int32_t> force_curves(const FeatureLayout& layout, int32_t count, bo
 // without them only sends the repairs after them round by round (327,680 loose triangles: 7.7 s
 // in fast mode).
 void force_loose_triangles(const FeatureLayout& layout, std::vector<int32_t>& kept, std::vector<int32_t>& forced) {
-  if (layout.loose_vertices.empty()) return;
-  join_forced(layout.loose_vertices, forced);
-  std::vector<int32_t> joined;
-  std::set_union(kept.begin(), kept.end(), layout.loose_vertices.begin(), layout.loose_vertices.end(),
-                 std::back_inserter(joined));
-  kept = std::move(joined);
+  keep_and_force(layout.loose_vertices, kept, forced);
 }
 
 // Each boundary loop too short to expect three samples at this count (FeatureLayout::
@@ -612,10 +617,7 @@ int32_t force_boundary_loops(const FeatureLayout& layout, int32_t count, int32_t
   std::sort(added.begin(), added.end());
   added.erase(std::unique(added.begin(), added.end()), added.end());  // loops touching at a pinch
   if (added.empty() || 4 * int64_t(added.size()) < int64_t(count)) return 0;
-  join_forced(added, forced);
-  std::vector<int32_t> joined;
-  std::set_union(kept.begin(), kept.end(), added.begin(), added.end(), std::back_inserter(joined));
-  kept = std::move(joined);
+  keep_and_force(added, kept, forced);
   return int32_t(added.size());
 }
 
