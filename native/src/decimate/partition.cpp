@@ -15,7 +15,6 @@
 #include <climits>
 #include <cmath>
 #include <memory>
-#include <unordered_map>
 
 namespace topstoc {
 
@@ -314,9 +313,10 @@ class PartitionCheck {
   std::vector<uint8_t> kept_sliver;
   bool keep_slivers = false;
   int32_t emitted = 0;
-  // Clusters adjacent along a feature curve, with the copies of their edge.
-  std::unordered_map<uint64_t, int32_t> feature_copies;
-  std::vector<std::pair<uint64_t, int32_t>> feature_pairs;  // the same, sorted
+  // Clusters adjacent along a feature curve, with the copies of their edge, sorted by key; a
+  // sample's pairs with higher samples start at pair_rows[sample].
+  std::vector<std::pair<uint64_t, int32_t>> feature_pairs;
+  std::vector<int32_t> pair_rows;
   // The samples to evaluate.
   bool incremental = false;
   std::vector<uint8_t> sliver;  // per emitted triangle: 0, 1 or kUntested
@@ -488,13 +488,47 @@ class PartitionCheck {
   }
 
   // --- feature pairs: clusters adjacent along a feature curve, with the copies of their edge ---
+  // Grouped by the lower sample (a counting sort), each group put in order and its repeats
+  // summed: the same sorted list a map would give, without a node per pair.
   void collect_feature_pairs() {
+    if (layout.feature_edges.empty()) return;  // (the edge table is built on first use: not for this)
+    const auto& ev = mesh.edge_vertices();
+    std::vector<int32_t> start(size_t(k) + 1, 0);
     for (int32_t e : layout.feature_edges) {
-      const int32_t lx = label(mesh.edge_vertices()[2 * size_t(e)]), ly = label(mesh.edge_vertices()[2 * size_t(e) + 1]);
-      if (lx != ly) feature_copies[pair_key(lx, ly)] += layout.edge_copies(mesh, e);
+      const int32_t lx = label(ev[2 * size_t(e)]), ly = label(ev[2 * size_t(e) + 1]);
+      if (lx != ly) ++start[std::min(lx, ly) + 1];
     }
-    feature_pairs.assign(feature_copies.begin(), feature_copies.end());
-    std::sort(feature_pairs.begin(), feature_pairs.end());
+    for (int32_t s = 0; s < k; ++s) start[s + 1] += start[s];
+    if (start[k] == 0) return;
+    std::vector<std::pair<int32_t, int32_t>> higher(start[k]);  // per pair: higher sample, copies
+    std::vector<int32_t> fill(start.begin(), start.end() - 1);
+    for (int32_t e : layout.feature_edges) {
+      const int32_t lx = label(ev[2 * size_t(e)]), ly = label(ev[2 * size_t(e) + 1]);
+      if (lx != ly) higher[fill[std::min(lx, ly)]++] = {std::max(lx, ly), layout.edge_copies(mesh, e)};
+    }
+    pair_rows.assign(size_t(k) + 1, 0);
+    feature_pairs.reserve(higher.size());
+    for (int32_t s = 0; s < k; ++s) {
+      pair_rows[s] = int32_t(feature_pairs.size());
+      auto* row = higher.data() + start[s];
+      std::sort(row, row + (start[s + 1] - start[s]));
+      for (int32_t i = start[s]; i < start[s + 1]; ++i) {
+        const uint64_t key = pair_key(s, higher[i].first);
+        if (!feature_pairs.empty() && feature_pairs.back().first == key) feature_pairs.back().second += higher[i].second;
+        else feature_pairs.push_back({key, higher[i].second});
+      }
+    }
+    pair_rows[k] = int32_t(feature_pairs.size());
+  }
+
+  // The copies expected along the feature pair (s, nb), or nullptr when they are no pair.
+  const std::pair<uint64_t, int32_t>* feature_pair(int32_t s, int32_t nb) const {
+    if (feature_pairs.empty()) return nullptr;
+    const uint64_t key = pair_key(s, nb);
+    const auto first = feature_pairs.begin() + pair_rows[std::min(s, nb)];
+    const auto last = feature_pairs.begin() + pair_rows[std::min(s, nb) + 1];
+    const auto it = std::lower_bound(first, last, key, [](const auto& p, uint64_t x) { return p.first < x; });
+    return it != last && it->first == key ? &*it : nullptr;
   }
 
   // --- the samples to evaluate ------------------------------------------------------------------
@@ -580,7 +614,7 @@ class PartitionCheck {
     const Arc* around = arcs.get() + arc_offsets[s];
     if (!any_dropped && mesh.manifold_vertex()[samples[s]] && one_cycle(around, incident(s))) {
       chi6_out[s] = 6 - incident(s);  // 6 - 3 neighbours + 2 triangles, as many of each
-      if (!feature_copies.empty())
+      if (!feature_pairs.empty())
         for (int32_t i = 0; i < incident(s); ++i) check_edge(s, around[i].from, 2, seen_here, edges);
       return true;
     }
@@ -619,8 +653,7 @@ class PartitionCheck {
   void check_edge(int32_t s, int32_t nb, int32_t triangles, std::vector<uint64_t>& seen_here, int32_t& edges) {
     if (nb < s) return;
     int32_t expected = 2;
-    const auto it = feature_copies.empty() ? feature_copies.end() : feature_copies.find(pair_key(s, nb));
-    if (it != feature_copies.end()) {
+    if (const auto* it = feature_pair(s, nb)) {
       expected = it->second;
       seen_here.push_back(it->first);
     }
@@ -693,8 +726,8 @@ class PartitionCheck {
         bool expected = false;
         for (const auto& nb : link.neighbours)
           if (nb.in > 1 || nb.out > 1) {
-            const auto it = feature_copies.find(pair_key(s, nb.id));
-            if (it != feature_copies.end() && it->second > 2) expected = true;
+            const auto* it = feature_pair(s, nb.id);
+            if (it && it->second > 2) expected = true;
           }
         if (expected) continue;
         ++bad_link;
