@@ -849,6 +849,14 @@ std::vector<int32_t> Mesh::internal_ids(const std::vector<int32_t>& caller_ids) 
     for (size_t i = 0; i < out.size(); ++i) out[i] = vertex_index_[caller_ids[i]];
     return out;
   }
+  if (2 * caller_ids.size() >= size_t(n)) {
+    // Half the vertices or more (a result that keeps most of its input): the inverse of
+    // vertex_source takes no more memory than the sorted list below, and no searches.
+    std::vector<int32_t> inverse(n);
+    parallel_for(0, n, kParallelMin, [&](int32_t v) { inverse[vertex_source_[v]] = v; });
+    parallel_for(int64_t(0), int64_t(out.size()), kParallelMin, [&](int64_t i) { out[i] = inverse[caller_ids[i]]; });
+    return out;
+  }
   std::vector<std::pair<int32_t, int32_t>> wanted(caller_ids.size());  // (caller id, position)
   for (size_t i = 0; i < wanted.size(); ++i) wanted[i] = {caller_ids[i], int32_t(i)};
   std::sort(wanted.begin(), wanted.end());
