@@ -615,6 +615,12 @@ int32_t active_vertices(const Mesh& mesh) {
   return mesh.num_vertices() - mesh.report().isolated_vertices;
 }
 
+// Every triangle a piece of its own (an unwelded mesh): each piece keeps its three corners, so
+// the draw forces every vertex and no collapse is possible. The result is the input.
+bool only_loose_triangles(const Mesh& mesh, const FeatureLayout& layout) {
+  return int64_t(layout.loose_vertices.size()) == active_vertices(mesh);
+}
+
 }  // namespace
 
 namespace {
@@ -786,7 +792,7 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
   // drawn) is collapsed the rest of the way. A draft that did not stall stays the plain pass
   // (a drag stays fast on high-genus meshes at tiny targets); the rest's full result does not.
   // (The pass kept may be a lower draw that stalled where the draw for the target did not.)
-  if (!refined && excess(best) > tolerance) {
+  if (!refined && excess(best) > tolerance && !only_loose_triangles(mesh, layout)) {
     if (params.draft && best.issues_remaining.topological() == 0) {
       best.collapses_skipped = true;
     } else if (params.draft) {
@@ -954,6 +960,14 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
   const int32_t active = active_vertices(mesh);
   if (!(params.refine == 0.0 || params.refine >= 1.0))
     throw std::invalid_argument("refine must be 0 (off) or at least 1, got " + std::to_string(params.refine));
+  if (params.warm_up && only_loose_triangles(mesh, layout)) return {};
+  if (params.refine >= 1.0 && only_loose_triangles(mesh, layout)) {
+    // Nothing to refine or place: the plain pass gives the input, without the collapser's set-up.
+    DecimateParams plain = params;
+    plain.refine = 0.0;
+    plain.placement = Placement::Subsample;
+    return stochastic_pass(mesh, layout, plain, false);
+  }
   if (params.refine >= 1.0 && params.target_vertices >= 1 && params.target_vertices <= active)
     return refined(mesh, layout, params, 0);
   if (params.warm_up) return {};  // plain TopStoc keeps no collapse state
@@ -1038,7 +1052,7 @@ DecimateResult decimate_to_triangles(const Mesh& mesh, const FeatureLayout& layo
                                 std::to_string(mesh.num_faces()) + " triangles");
   // First guess from the input's triangle-to-vertex ratio, then correct by what came out.
   double vertices = double(target_triangles) * active / mesh.num_faces();
-  if (params.refine >= 1.0) {
+  if (params.refine >= 1.0 && !only_loose_triangles(mesh, layout)) {
     // The collapses stop at the triangle count itself: one pass.
     params.target_vertices = std::clamp(int32_t(std::lround(vertices)), 1, active);
     return refined(mesh, layout, params, target_triangles);
