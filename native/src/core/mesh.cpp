@@ -907,81 +907,91 @@ void Mesh::build_vertex_areas() const {
   });
 }
 
+void Mesh::edge_numbering(Buffer<int32_t>& lower, Buffer<int32_t>& edge_base) const {
+  const int32_t n = num_vertices_;
+  const auto& ao = adjacency_offsets_;
+  lower.resize(n);
+  edge_base.resize(size_t(n) + 1);
+  edge_base[n] = 0;
+  parallel_for(0, n, kParallelMin, [&](int32_t v) {
+    const int32_t* row = adjacency_.data() + ao[v];
+    const int32_t d = ao[v + 1] - ao[v];
+    lower[v] = int32_t(std::lower_bound(row, row + d, v) - row);
+    edge_base[v] = d - lower[v];  // (each edge belongs to its lower end)
+  });
+  exclusive_scan(edge_base);
+}
+
 void Mesh::build_edges() const {
   std::call_once(edges_once_, [this] {
     const int32_t n = num_vertices_;
     const auto& ao = adjacency_offsets_;
-    // Per vertex: where it sits in its own sorted row (its lower neighbours come first), and
-    // how many face sides lead to higher neighbours (each edge belongs to its lower end).
-    Buffer<int32_t> lower(n), edge_base(n + 1), side_base(n + 1);
-    edge_base[n] = side_base[n] = 0;
-    parallel_for(0, n, kParallelMin, [&](int32_t v) {
-      const int32_t* row = adjacency_.data() + ao[v];
-      const int32_t d = ao[v + 1] - ao[v];
-      lower[v] = int32_t(std::lower_bound(row, row + d, v) - row);
-      edge_base[v] = d - lower[v];
-      int32_t sides = 0;
-      for_each_face(v, [&](int32_t f) {
-        const int32_t* t = &faces_[3 * size_t(f)];
-        const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-        sides += (t[(c + 1) % 3] > v) + (t[(c + 2) % 3] > v);
-      });
-      side_base[v] = sides;
-    });
-    exclusive_scan(edge_base);
-    exclusive_scan(side_base);
+    Buffer<int32_t> lower, edge_base;
+    edge_numbering(lower, edge_base);
     adjacency_edge_.resize(ao[n]);
     edge_vertices_.resize(2 * size_t(num_edges_));
     edge_face_offsets_.resize(size_t(num_edges_) + 1);
-    edge_faces_.resize(faces_.size());
-    face_edges_.resize(faces_.size());
-    // Edges numbered by lower end, then higher end; each vertex writes its own edges: their
-    // slots in both rows, their ends, the edge of each face side it owns, and its edges' faces
-    // in increasing order.
+    edge_face_offsets_[num_edges_] = 0;
+    // Each vertex writes its own edges: their slots in both rows, their ends and how many faces
+    // each has (summed into offsets after).
     parallel_region(team_for(n, kParallelMin), [&](Team& team) {
-      std::vector<int32_t> fill;
       team.for_static(0, n, [&](int32_t v) {
         const int32_t* row = adjacency_.data() + ao[v];
-        const int32_t d = ao[v + 1] - ao[v], low = lower[v], higher = d - low;
+        const int32_t d = ao[v + 1] - ao[v], low = lower[v];
         for (int32_t r = low; r < d; ++r) {
           const int32_t u = row[r], e = edge_base[v] + (r - low);
           adjacency_edge_[ao[v] + r] = e;
           edge_vertices_[2 * size_t(e)] = v;
           edge_vertices_[2 * size_t(e) + 1] = u;
+          edge_face_offsets_[e] = 0;
           // The same edge in u's row, among u's lower neighbours (sorted, and v is one of them).
           const int32_t* u_row = adjacency_.data() + ao[u];
           adjacency_edge_[ao[u] + int32_t(std::lower_bound(u_row, u_row + lower[u], v) - u_row)] = e;
         }
-        fill.assign(higher, 0);
-        auto rank = [&](int32_t u) { return int32_t(std::lower_bound(row + low, row + d, u) - (row + low)); };
+        for_each_face(v, [&](int32_t f) {
+          const int32_t* t = &faces_[3 * size_t(f)];
+          const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+          for (int32_t u : {t[(c + 1) % 3], t[(c + 2) % 3]})
+            if (u > v) ++edge_face_offsets_[edge_base[v] + int32_t(std::lower_bound(row + low, row + d, u) - (row + low))];
+        });
+      });
+    });
+    exclusive_scan(edge_face_offsets_);
+    edges_built_.store(true, std::memory_order_release);
+  });
+}
+
+void Mesh::build_edge_faces() const {
+  ensure_edges();
+  std::call_once(edge_faces_once_, [this] {
+    const int32_t n = num_vertices_;
+    const auto& ao = adjacency_offsets_;
+    Buffer<int32_t> lower, edge_base;
+    edge_numbering(lower, edge_base);
+    edge_faces_.resize(faces_.size());
+    face_edges_.resize(faces_.size());
+    // Each vertex writes the edge of each face side it owns and its edges' faces, in
+    // increasing order.
+    parallel_region(team_for(n, kParallelMin), [&](Team& team) {
+      std::vector<int32_t> fill;
+      team.for_static(0, n, [&](int32_t v) {
+        const int32_t* row = adjacency_.data() + ao[v];
+        const int32_t d = ao[v + 1] - ao[v], low = lower[v];
+        fill.assign(edge_face_offsets_.data() + edge_base[v], edge_face_offsets_.data() + edge_base[v + 1]);
         for_each_face(v, [&](int32_t f) {
           const int32_t* t = &faces_[3 * size_t(f)];
           const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
           for (int side : {c, (c + 2) % 3}) {
             const int32_t u = t[side == c ? (c + 1) % 3 : side];
             if (u < v) continue;  // the edge belongs to the other end
-            const int32_t j = rank(u);
+            const int32_t j = int32_t(std::lower_bound(row + low, row + d, u) - (row + low));
             face_edges_[3 * size_t(f) + side] = edge_base[v] + j;
-            ++fill[j];
-          }
-        });
-        int32_t at = side_base[v];
-        for (int32_t j = 0; j < higher; ++j) {
-          edge_face_offsets_[edge_base[v] + j] = at;
-          at += std::exchange(fill[j], at);
-        }
-        for_each_face(v, [&](int32_t f) {
-          const int32_t* t = &faces_[3 * size_t(f)];
-          const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-          for (int side : {c, (c + 2) % 3}) {
-            if (t[side == c ? (c + 1) % 3 : side] < v) continue;
-            edge_faces_[fill[face_edges_[3 * size_t(f) + side] - edge_base[v]]++] = f;
+            edge_faces_[fill[j]++] = f;
           }
         });
       });
     });
-    edge_face_offsets_[num_edges_] = side_base[n];
-    edges_built_.store(true, std::memory_order_release);
+    edge_faces_built_.store(true, std::memory_order_release);
   });
 }
 

@@ -108,16 +108,22 @@ class Mesh {
   int32_t first_corner(int32_t v) const;
   // Edges (lower id first), the faces of each edge (CSR) and the edge of each face side. These
   // tables (about a third of the mesh's memory) are built on first use, once, whichever thread
-  // asks: a decimation of a closed mesh without borders never needs them.
+  // asks: a decimation of a closed mesh without borders never needs them. The faces of each
+  // edge and the edges of each face (24 bytes a triangle) are built apart, on their own first
+  // use: the borders of a scan need the edges and their face counts only.
   const Buffer<int32_t>& edge_vertices() const { return ensure_edges(), edge_vertices_; }
   const Buffer<int32_t>& edge_face_offsets() const { return ensure_edges(), edge_face_offsets_; }
-  const Buffer<int32_t>& edge_faces() const { return ensure_edges(), edge_faces_; }
+  const Buffer<int32_t>& edge_faces() const { return ensure_edge_faces(), edge_faces_; }
   /// face_edges[3f + c] is the edge from corner c to corner c+1 of face f.
-  const Buffer<int32_t>& face_edges() const { return ensure_edges(), face_edges_; }
+  const Buffer<int32_t>& face_edges() const { return ensure_edge_faces(), face_edges_; }
   int32_t edge_face_count(int32_t e) const {
     ensure_edges();
     return edge_face_offsets_[e + 1] - edge_face_offsets_[e];
   }
+  /// Calls fn(f) for each face of edge e, in increasing order (edge_faces()' order), from that
+  /// table where it is built, else from the lower end's faces: for code that reads a few edges.
+  template <class Fn>
+  void for_each_edge_face(int32_t e, Fn&& fn) const;
   /// Edge id between a and b, or -1.
   int32_t find_edge(int32_t a, int32_t b) const;
 
@@ -173,6 +179,13 @@ class Mesh {
     if (!edges_built_.load(std::memory_order_acquire)) build_edges();
   }
   void build_edges() const;
+  void ensure_edge_faces() const {
+    if (!edge_faces_built_.load(std::memory_order_acquire)) build_edge_faces();
+  }
+  void build_edge_faces() const;
+  /// Per vertex its own slot in its sorted row (its lower neighbours first), and the id of its
+  /// first edge (edges are numbered by lower end, then higher end; n + 1 entries).
+  void edge_numbering(Buffer<int32_t>& lower, Buffer<int32_t>& edge_base) const;
   void ensure_normals() const {
     if (!normals_built_.load(std::memory_order_acquire)) build_normals();
   }
@@ -209,6 +222,8 @@ class Mesh {
   mutable Buffer<int32_t> adjacency_edge_, edge_vertices_, edge_face_offsets_, edge_faces_, face_edges_;
   mutable std::once_flag edges_once_;
   mutable std::atomic<bool> edges_built_{false};
+  mutable std::once_flag edge_faces_once_;
+  mutable std::atomic<bool> edge_faces_built_{false};
   Buffer<double> weights_;
   // Built in the preparation, freed after it, built again on first use (ensure_normals).
   mutable Buffer<double> normals_;
@@ -249,6 +264,20 @@ void Mesh::walk_faces(int32_t v, Stop&& stop) const {
 template <class Fn>
 void Mesh::for_each_face(int32_t v, Fn&& fn) const {
   walk_faces(v, [&](int32_t f) { return fn(f), false; });
+}
+
+template <class Fn>
+void Mesh::for_each_edge_face(int32_t e, Fn&& fn) const {
+  ensure_edges();
+  if (edge_faces_built_.load(std::memory_order_acquire)) {
+    for (int32_t i = edge_face_offsets_[e], end = edge_face_offsets_[e + 1]; i < end; ++i) fn(edge_faces_[i]);
+    return;
+  }
+  const int32_t a = edge_vertices_[2 * size_t(e)], b = edge_vertices_[2 * size_t(e) + 1];
+  for_each_face(a, [&](int32_t f) {
+    const int32_t* t = &faces_[3 * size_t(f)];
+    if (t[0] == b || t[1] == b || t[2] == b) fn(f);
+  });
 }
 
 }  // namespace topstoc
