@@ -52,7 +52,8 @@ void mark_feature_edges(const Mesh& mesh, const int32_t* face_region, int64_t fa
     return;
   layout.edge_feature.assign(num_edges, 0);
   const auto& efo = mesh.edge_face_offsets();
-  const auto& ef = mesh.edge_faces();
+  // The faces of each edge only where regions or creases are compared across edges.
+  const int32_t* ef = face_region || feature_angle > 0 ? mesh.edge_faces().data() : nullptr;
   const auto& source = mesh.face_source();
   layout.region_border_edges = parallel_sum<int32_t>(0, num_edges, kParallelMin, [&](int32_t& region_borders, int32_t e) {
     const int32_t k = efo[e + 1] - efo[e];
@@ -128,19 +129,25 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
       }) == 0)
     return;  // one sector per vertex in faces, no feature vertex, no corner: the tables stay empty
   if (!featureless) layout.feature_degree.assign(n, 0);
-  layout.sectors.assign(n, 0);
   // Sectors per face slot matter only where a vertex has more than one (see sector_of).
   const auto& report = mesh.report();
-  if (!layout.feature_edges.empty() || report.nonmanifold_vertices > 0 || report.nonmanifold_edges > 0 ||
-      report.inconsistent_edges > 0)
+  // Where every feature edge is a boundary edge and every vertex manifold, each vertex's faces
+  // are one fan (a boundary edge joins no two faces): one sector each, no fans to find, and each
+  // edge one copy, so sectors_of and chi_of need no tables either.
+  const bool borders_only = report.nonmanifold_vertices == 0 && report.nonmanifold_edges == 0 &&
+                            report.inconsistent_edges == 0 && layout.region_border_edges == 0 &&
+                            layout.flagged_edges == 0 && layout.crease_edges == 0;
+  if (!borders_only) {
+    layout.sectors.assign(n, 0);
     layout.sector_of_slot.assign(mesh.faces().size(), 0);  // a slot per corner, as vertex_faces()
+  }
   // The slot table's offsets, only where slots are written (its mesh has features or a non-manifold vertex).
   const int32_t* vfo = layout.sector_of_slot.empty() ? nullptr : mesh.vertex_face_offsets().data();
   layout.vertex_feature.assign(n, 0);
   layout.vertex_corner.assign(n, 0);
   // Without feature edges chi_of computes the constant (n integers fewer on a large scan).
   layout.chi_constant.clear();
-  if (!featureless) layout.chi_constant.assign(n, 0);
+  if (!featureless && !borders_only) layout.chi_constant.assign(n, 0);
   parallel_region(team_for(n, kParallelMin), [&](Team& team) {
     std::vector<int32_t> fan_of_slot;
     team.for_static(0, n, [&](int32_t v) {
@@ -159,18 +166,18 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
       }
       // A manifold vertex without feature edges is one sector (slots stay 0); others need the fans.
       int32_t sectors = 1;
-      if (degree > 0 || !mesh.manifold_vertex()[v]) {
+      if (!borders_only && (degree > 0 || !mesh.manifold_vertex()[v])) {
         sectors = vertex_fans(mesh, v, [&](int32_t e) { return layout.is_feature_edge(e); }, fan_of_slot);
         std::copy(fan_of_slot.begin(), fan_of_slot.end(), layout.sector_of_slot.begin() + vfo[v]);
       }
       if (!featureless) layout.feature_degree[v] = degree;
-      layout.sectors[v] = sectors;
+      if (!borders_only) layout.sectors[v] = sectors;
       layout.vertex_feature[v] = degree > 0 || sectors > 1;
       // A curve vertex continues one curve: two feature edges of the same kind and one sector
       // per side. Everything else on a feature (ends, junctions, pinches) is a corner.
       const bool curve_vertex = degree == 2 && same_copies && sectors == first_copies;
       layout.vertex_corner[v] = layout.vertex_feature[v] && !curve_vertex;
-      if (!featureless) layout.chi_constant[v] = 6 * sectors - 3 * copies + 2 * mesh.face_count(v);
+      if (!featureless && !borders_only) layout.chi_constant[v] = 6 * sectors - 3 * copies + 2 * mesh.face_count(v);
     });
   });
 }

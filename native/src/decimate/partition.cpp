@@ -217,24 +217,24 @@ std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layou
   for (int32_t v = 0; v < mesh.num_vertices(); ++v)
     if (label(v) >= 0) chi6[label(v)] += layout.chi_of(mesh, v);
   const auto& faces = mesh.faces();
-  const auto& fe = mesh.face_edges();
-  const auto& efo = mesh.edge_face_offsets();
-  const auto& ef = mesh.edge_faces();
-  const auto& ev = mesh.edge_vertices();
   for (int32_t f = 0; f < mesh.num_faces(); ++f) {
     const int32_t la = label(faces[3 * size_t(f)]), lb = label(faces[3 * size_t(f) + 1]),
                   lc = label(faces[3 * size_t(f) + 2]);
     if (la == lb && lb == lc) continue;
     chi6[la] -= 2, chi6[lb] -= 2, chi6[lc] -= 2;
-    for (int s = 0; s < 3; ++s) {
-      const int32_t e = fe[3 * size_t(f) + s];
-      if (ef[efo[e]] != f) continue;  // each edge once, from its first face
-      const int32_t lx = label(ev[2 * size_t(e)]), ly = label(ev[2 * size_t(e) + 1]);
-      if (lx == ly) continue;
-      const int32_t copies = layout.edge_copies(mesh, e);
-      chi6[lx] += 3 * copies, chi6[ly] += 3 * copies;
-    }
   }
+  // Each edge between two clusters once, from its lower end (from the adjacency: the faces of
+  // each edge are a table of their own, not built for this).
+  const auto& ao = mesh.adjacency_offsets();
+  const auto& adj = mesh.adjacency();
+  const int32_t* ae = layout.feature_edges.empty() ? nullptr : mesh.adjacency_edge().data();
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+    for (int32_t i = ao[v]; i < ao[v + 1]; ++i) {
+      const int32_t u = adj[i];
+      if (u < v || label(u) == label(v)) continue;
+      const int32_t copies = ae ? layout.edge_copies(mesh, ae[i]) : 1;
+      chi6[label(v)] += 3 * copies, chi6[label(u)] += 3 * copies;
+    }
   return chi6;
 }
 

@@ -243,8 +243,6 @@ void add_border_planes(const Mesh& mesh, const FeatureLayout& layout, const std:
                        const QuadricFrame& frame, double spacing, VertexQuadrics& quadrics) {
   const auto& faces = mesh.faces();
   const auto& ev = mesh.edge_vertices();
-  const auto& efo = mesh.edge_face_offsets();
-  const auto& ef = mesh.edge_faces();
   for (int32_t e : layout.feature_edges) {
     const int32_t* ab = &ev[2 * size_t(e)];
     const int32_t l[2] = {label[ab[0]], label[ab[1]]};
@@ -256,8 +254,8 @@ void add_border_planes(const Mesh& mesh, const FeatureLayout& layout, const std:
     double a[3], b[3];
     normalised(mesh, frame, ab[0], a);
     normalised(mesh, frame, ab[1], b);
-    for (int32_t i = efo[e]; i < efo[e + 1]; ++i) {
-      const int32_t* t = &faces[3 * size_t(ef[i])];
+    mesh.for_each_edge_face(e, [&](int32_t f) {
+      const int32_t* t = &faces[3 * size_t(f)];
       int32_t opposite = t[0];
       for (int j = 0; j < 3; ++j)
         if (t[j] != ab[0] && t[j] != ab[1]) opposite = t[j];
@@ -267,15 +265,15 @@ void add_border_planes(const Mesh& mesh, const FeatureLayout& layout, const std:
       n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
       double side[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
       const double side_length = std::sqrt(side[0] * side[0] + side[1] * side[1] + side[2] * side[2]);
-      if (!(side_length > 0)) continue;
+      if (!(side_length > 0)) return;
       for (double& x : side) x /= side_length;
       const double length2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
       add(side, a, length2);
-      if (!(spacing > 0)) continue;
+      if (!(spacing > 0)) return;
       const double n_length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
       for (double& x : n) x /= n_length;
       add(n, a, std::sqrt(length2) * spacing);
-    }
+    });
   }
 }
 

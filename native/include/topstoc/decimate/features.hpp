@@ -52,10 +52,11 @@ struct FeatureLayout {
   /// Per vertex: fans once feature edges are cut. Empty, as are vertex_feature and
   /// vertex_corner, on a mesh without feature edges whose vertices are all manifold (one sector
   /// each, none on a feature, no corner: 4.5 bytes a triangle of a large closed scan not kept);
-  /// read them with sectors_of, is_feature_vertex and is_corner.
+  /// read them with sectors_of, is_feature_vertex and is_corner. Empty too (but not those two)
+  /// where the only feature edges are boundary edges at manifold vertices (one sector each).
   std::vector<int32_t> sectors;
   /// Per slot of mesh.vertex_faces(): sector of that face. Empty when every vertex is one sector
-  /// (a manifold mesh without feature edges); use sector_of().
+  /// (a manifold mesh without feature edges other than boundary edges); use sector_of().
   std::vector<int32_t> sector_of_slot;
   std::vector<uint8_t> vertex_feature;  ///< per vertex: on a feature curve, or a corner (or empty)
   bool has_feature_vertices = false;    ///< any vertex_feature set (else no edge ids are needed)
@@ -89,7 +90,8 @@ struct FeatureLayout {
   /// 6 * (sectors - (sum of incident edge copies) / 2 + incident faces / 3): summed over a
   /// cluster's vertices it gives six times the cluster's Euler characteristic up to the terms
   /// of edges and faces shared with other clusters (see partition.cpp). Empty without feature
-  /// edges, where every edge is one copy and chi_of computes it.
+  /// edges, or where all are boundary edges at manifold vertices: there every edge is one copy
+  /// and every vertex one sector, and chi_of computes it.
   std::vector<int32_t> chi_constant;
   DerivedTable sampling_table;  ///< sampling.cpp's importance table for its last parameters
   DerivedTable selection_uniforms;  ///< sampling.cpp's per-vertex uniforms of the seed drawn last
