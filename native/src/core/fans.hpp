@@ -2,8 +2,12 @@
 // shared by exactly two triangles and not blocked. With no edge blocked this tells manifold
 // vertices (one fan) from pinched ones; with feature edges blocked it gives the sectors that the
 // decimation treats as separate sides of a border.
+//
+// Everything is read from the vertex's own faces (Mesh::for_each_face): the faces of an edge at
+// v are v's faces holding its other end, so no table of the faces of every edge is needed.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -12,19 +16,46 @@
 
 namespace topstoc {
 
-/// Groups the triangles around v into fans. fan_of_slot receives, for each slot of v in
-/// mesh.vertex_faces(), the fan index (0, 1, ...) in order of first appearance.
-/// blocked(e) says whether edge e separates fans even when it has two triangles.
-/// Returns the number of fans.
+/// The faces around v in Mesh::for_each_face order (the slots), with each face's corner after v
+/// (its side leaving v) and before v (its side arriving at v).
+struct VertexStar {
+  std::vector<int32_t> faces, next, prev;
+  /// (other end, slot) for both sides of every slot, sorted: the faces of edge (v, w) are the
+  /// slots of the run with w.
+  std::vector<std::pair<int32_t, int32_t>> sides;
+
+  void read(const Mesh& mesh, int32_t v) {
+    faces.clear(), next.clear(), prev.clear(), sides.clear();
+    mesh.for_each_face(v, [&](int32_t f) {
+      const int32_t* t = &mesh.faces()[3 * size_t(f)];
+      const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+      const int32_t slot = int32_t(faces.size());
+      faces.push_back(f);
+      next.push_back(t[(c + 1) % 3]);
+      prev.push_back(t[(c + 2) % 3]);
+      sides.push_back({t[(c + 1) % 3], slot});
+      sides.push_back({t[(c + 2) % 3], slot});
+    });
+    std::sort(sides.begin(), sides.end());
+  }
+  int32_t size() const { return int32_t(faces.size()); }
+  /// How many of v's faces hold w: the face count of edge (v, w).
+  int32_t edge_faces(int32_t w) const {
+    const auto lo = std::lower_bound(sides.begin(), sides.end(), std::pair<int32_t, int32_t>{w, INT32_MIN});
+    const auto hi = std::lower_bound(lo, sides.end(), std::pair<int32_t, int32_t>{w + 1, INT32_MIN});
+    return int32_t(hi - lo);
+  }
+};
+
+/// Groups the triangles around v into fans. fan_of_slot receives, for each slot of v (its faces
+/// in Mesh::for_each_face order, as mesh.vertex_faces() lists them), the fan index (0, 1, ...)
+/// in order of first appearance. blocked(e) says whether edge e separates fans even when it has
+/// two triangles. Returns the number of fans. `star` is scratch (read here).
 template <class Blocked>
-int32_t vertex_fans(const Mesh& mesh, int32_t v, Blocked blocked, std::vector<int32_t>& fan_of_slot) {
-  const auto& vfo = mesh.vertex_face_offsets();
-  const auto& vf = mesh.vertex_faces();
-  const auto& faces = mesh.faces();
-  const auto& fe = mesh.face_edges();
-  const auto& efo = mesh.edge_face_offsets();
-  const auto& ef = mesh.edge_faces();
-  const int32_t begin = vfo[v], count = vfo[v + 1] - vfo[v];
+int32_t vertex_fans(const Mesh& mesh, int32_t v, Blocked blocked, std::vector<int32_t>& fan_of_slot,
+                    VertexStar& star) {
+  star.read(mesh, v);
+  const int32_t count = star.size();
   fan_of_slot.resize(count);
   // Union-find over the slots of v; valences are small, so the work stays in fixed buffers.
   std::array<int32_t, 64> small_parent;
@@ -39,26 +70,16 @@ int32_t vertex_fans(const Mesh& mesh, int32_t v, Blocked blocked, std::vector<in
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
-  auto slot_of_face = [&](int32_t f) {
-    for (int32_t i = 0; i < count; ++i)
-      if (vf[begin + i] == f) return i;
-    return -1;
-  };
-  for (int32_t i = 0; i < count; ++i) {
-    const int32_t f = vf[begin + i];
-    const int32_t* t = &faces[3 * size_t(f)];
-    const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-    // The two sides of f at v: leaving v (c -> c+1) and arriving at v (c+2 -> c).
-    for (int side : {c, (c + 2) % 3}) {
-      const int32_t e = fe[3 * size_t(f) + side];
-      if (efo[e + 1] - efo[e] != 2 || blocked(e)) continue;
-      const int32_t g = ef[efo[e]] == f ? ef[efo[e] + 1] : ef[efo[e]];
-      if (g < f) continue;  // each pair once, from its lower face
-      const int32_t j = slot_of_face(g);
-      if (j < 0) continue;
-      const int32_t a = find(i), b = find(j);
-      if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+  // The two faces of an edge with exactly two at v (a run of two sides with the same end).
+  const auto& sides = star.sides;
+  for (size_t a = 0; a < sides.size();) {
+    size_t b = a + 1;
+    while (b < sides.size() && sides[b].first == sides[a].first) ++b;
+    if (b - a == 2 && !blocked(mesh.find_edge(v, sides[a].first))) {
+      const int32_t x = find(sides[a].second), y = find(sides[a + 1].second);
+      if (x != y) parent[x < y ? y : x] = x < y ? x : y;
     }
+    a = b;
   }
   // Roots are the lowest slot of each fan, so numbering roots in slot order numbers fans in
   // order of first appearance.
@@ -69,6 +90,13 @@ int32_t vertex_fans(const Mesh& mesh, int32_t v, Blocked blocked, std::vector<in
     else fan_of_slot[i] = fan_of_slot[root];
   }
   return fans;
+}
+
+/// vertex_fans with a star of its own.
+template <class Blocked>
+int32_t vertex_fans(const Mesh& mesh, int32_t v, Blocked blocked, std::vector<int32_t>& fan_of_slot) {
+  VertexStar star;
+  return vertex_fans(mesh, v, blocked, fan_of_slot, star);
 }
 
 }  // namespace topstoc

@@ -110,8 +110,6 @@ int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Cl
     return -1;
   };
   if (layout.sectors_of(mesh, sample_vertex) <= 1) return mesh.first_corner(sample_vertex);  // one side: any face will do
-  const auto& efo = mesh.edge_face_offsets();  // (built on first use: only borders come here)
-  const auto& ef = mesh.edge_faces();
   int32_t current = face;
   int32_t x = faces[3 * size_t(face) + slot];
   for (int32_t guard = 0; x != sample_vertex && guard <= mesh.num_vertices(); ++guard) {
@@ -119,12 +117,13 @@ int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Cl
     if (p < 0) break;
     const int32_t e = mesh.find_edge(x, p);
     const int32_t side = layout.sector_of(mesh, x, current);
-    int32_t next = ef[efo[e]];
-    for (int32_t i = efo[e]; i < efo[e + 1]; ++i)
-      if (layout.sector_of(mesh, x, ef[i]) == side) {
-        next = ef[i];
-        break;
-      }
+    // The edge's first face on the same side, else its first face.
+    int32_t next = -1;
+    bool same_side = false;
+    mesh.for_each_edge_face(e, [&](int32_t g) {
+      if (next < 0) next = g;
+      if (!same_side && layout.sector_of(mesh, x, g) == side) next = g, same_side = true;
+    });
     current = next;
     x = p;
   }
@@ -421,15 +420,12 @@ class ClusterRun {
   // Only faces around cluster borders can hold three clusters; in face order.
   std::vector<int32_t> faces_near_borders() const {
     std::vector<uint8_t> near_border(mesh.num_faces(), 0);
-    const auto& efo = mesh.edge_face_offsets();
-    const auto& ef = mesh.edge_faces();
-    for (int32_t e : cross_edges)
-      for (int32_t j = efo[e]; j < efo[e + 1]; ++j) near_border[ef[j]] = 1;
+    auto mark = [&](int32_t f) { near_border[f] = 1; };
+    for (int32_t e : cross_edges) mesh.for_each_edge_face(e, mark);
     // The flood does not step between two samples along a feature edge, so such an edge is
     // not among the crossings: a triangle bounded by features (a crease corner on a small
     // mesh) could be missed and its output triangle lost. Feature faces are few.
-    for (int32_t e : layout.feature_edges)
-      for (int32_t j = efo[e]; j < efo[e + 1]; ++j) near_border[ef[j]] = 1;
+    for (int32_t e : layout.feature_edges) mesh.for_each_edge_face(e, mark);
     std::vector<int32_t> candidates;
     for (int32_t f = 0; f < mesh.num_faces(); ++f)
       if (near_border[f]) candidates.push_back(f);

@@ -29,11 +29,15 @@ int32_t FeatureLayout::sector_of(const Mesh& mesh, int32_t v, int32_t f) const {
     const int32_t* t = &mesh.faces()[3 * size_t(f)];
     return t[0] == v || t[1] == v || t[2] == v ? 0 : -1;
   }
-  const auto& vfo = mesh.vertex_face_offsets();
-  const auto& vf = mesh.vertex_faces();
-  for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i)
-    if (vf[i] == f) return sector_of_slot[i];
-  return -1;
+  const auto it = std::lower_bound(sector_slot_vertex.begin(), sector_slot_vertex.end(), v);
+  if (it == sector_slot_vertex.end() || *it != v) return -1;
+  const int32_t* sector = sector_of_slot.data() + sector_slot_offsets[it - sector_slot_vertex.begin()];
+  int32_t found = -1, slot = 0;
+  mesh.for_each_face(v, [&](int32_t g) {
+    if (g == f) found = sector[slot];
+    ++slot;
+  });
+  return found;
 }
 
 namespace {
@@ -116,6 +120,22 @@ std::vector<int32_t> loose_triangle_vertices(const Mesh& mesh) {
   return loose;
 }
 
+// The sectors of the faces around each vertex of more than one sector (FeatureLayout::
+// sector_of_slot): only there does a face's sector need a table.
+void record_sector_slots(const Mesh& mesh, FeatureLayout& layout) {
+  layout.sector_slot_vertex.clear(), layout.sector_slot_offsets.assign(1, 0), layout.sector_of_slot.clear();
+  if (layout.sectors.empty()) return;
+  std::vector<int32_t> fan_of_slot;
+  VertexStar star;
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    if (layout.sectors[v] <= 1) continue;
+    vertex_fans(mesh, v, [&](int32_t e) { return layout.is_feature_edge(e); }, fan_of_slot, star);
+    layout.sector_slot_vertex.push_back(v);
+    layout.sector_of_slot.insert(layout.sector_of_slot.end(), fan_of_slot.begin(), fan_of_slot.end());
+    layout.sector_slot_offsets.push_back(int32_t(layout.sector_of_slot.size()));
+  }
+}
+
 void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   const int32_t n = mesh.num_vertices();
   const auto& ao = mesh.adjacency_offsets();
@@ -137,12 +157,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   const bool borders_only = report.nonmanifold_vertices == 0 && report.nonmanifold_edges == 0 &&
                             report.inconsistent_edges == 0 && layout.region_border_edges == 0 &&
                             layout.flagged_edges == 0 && layout.crease_edges == 0;
-  if (!borders_only) {
-    layout.sectors.assign(n, 0);
-    layout.sector_of_slot.assign(mesh.faces().size(), 0);  // a slot per corner, as vertex_faces()
-  }
-  // The slot table's offsets, only where slots are written (its mesh has features or a non-manifold vertex).
-  const int32_t* vfo = layout.sector_of_slot.empty() ? nullptr : mesh.vertex_face_offsets().data();
+  if (!borders_only) layout.sectors.assign(n, 0);
   layout.vertex_feature.assign(n, 0);
   layout.vertex_corner.assign(n, 0);
   // Without feature edges chi_of computes the constant (n integers fewer on a large scan).
@@ -150,6 +165,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   if (!featureless && !borders_only) layout.chi_constant.assign(n, 0);
   parallel_region(team_for(n, kParallelMin), [&](Team& team) {
     std::vector<int32_t> fan_of_slot;
+    VertexStar star;
     team.for_static(0, n, [&](int32_t v) {
       if (!mesh.in_faces(v)) return;  // isolated: belongs to no cluster
       int32_t degree = 0, copies = featureless ? ao[v + 1] - ao[v] : 0, first_copies = -1;
@@ -167,8 +183,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
       // A manifold vertex without feature edges is one sector (slots stay 0); others need the fans.
       int32_t sectors = 1;
       if (!borders_only && (degree > 0 || !mesh.manifold_vertex()[v])) {
-        sectors = vertex_fans(mesh, v, [&](int32_t e) { return layout.is_feature_edge(e); }, fan_of_slot);
-        std::copy(fan_of_slot.begin(), fan_of_slot.end(), layout.sector_of_slot.begin() + vfo[v]);
+        sectors = vertex_fans(mesh, v, [&](int32_t e) { return layout.is_feature_edge(e); }, fan_of_slot, star);
       }
       if (!featureless) layout.feature_degree[v] = degree;
       if (!borders_only) layout.sectors[v] = sectors;
@@ -180,6 +195,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
       if (!featureless && !borders_only) layout.chi_constant[v] = 6 * sectors - 3 * copies + 2 * mesh.face_count(v);
     });
   });
+  record_sector_slots(mesh, layout);
 }
 
 void trace_curves(const Mesh& mesh, FeatureLayout& layout) {
@@ -265,6 +281,7 @@ void collect_boundary_loops(const Mesh& mesh, FeatureLayout& layout) {
     if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
   };
   std::vector<int32_t> fan_of_slot, at_vertex, fan_of_edge;
+  VertexStar star;
   for (int32_t v = 0; v < n; ++v) {
     at_vertex.clear();
     for (int32_t i = ao[v]; i < ao[v + 1]; ++i)
@@ -274,13 +291,13 @@ void collect_boundary_loops(const Mesh& mesh, FeatureLayout& layout) {
       for (size_t k = 1; k < at_vertex.size(); ++k) unite(slot_of[at_vertex[0]], slot_of[at_vertex[k]]);
       continue;
     }
-    vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot);
+    vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot, star);
     fan_of_edge.clear();
-    for (int32_t e : at_vertex) {  // the fan of the edge's one face
-      const int32_t f = mesh.edge_faces()[mesh.edge_face_offsets()[e]];
+    for (int32_t e : at_vertex) {  // the fan of the edge's one face (v's face holding its other end)
+      const int32_t w = ev[2 * size_t(e)] == v ? ev[2 * size_t(e) + 1] : ev[2 * size_t(e)];
       int32_t fan = -1;
-      for (int32_t i = mesh.vertex_face_offsets()[v]; i < mesh.vertex_face_offsets()[v + 1]; ++i)
-        if (mesh.vertex_faces()[i] == f) fan = fan_of_slot[i - mesh.vertex_face_offsets()[v]];
+      for (int32_t i = 0; i < star.size(); ++i)
+        if (star.next[i] == w || star.prev[i] == w) fan = fan_of_slot[i];
       fan_of_edge.push_back(fan);
     }
     for (size_t k = 0; k < at_vertex.size(); ++k)

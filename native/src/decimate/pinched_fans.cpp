@@ -13,19 +13,12 @@ namespace {
 constexpr int32_t kUnknownSheet = -1;   // an output sheet none of whose triangles names one input sheet
 constexpr int32_t kMergedSheets = -2;   // an output sheet whose triangles lie on different input sheets
 
-// Whether the two triangles of edge e traverse it in opposite directions.
-bool oriented_consistently(const Mesh& mesh, int32_t e) {
-  const auto& faces = mesh.faces();
-  const int32_t a = mesh.edge_vertices()[2 * size_t(e)], b = mesh.edge_vertices()[2 * size_t(e) + 1];
-  int direction[2];
-  for (int k = 0; k < 2; ++k) {
-    const int32_t* t = &faces[3 * size_t(mesh.edge_faces()[mesh.edge_face_offsets()[e] + k])];
-    const int c = t[0] == a ? 0 : t[1] == a ? 1 : 2;
-    direction[k] = t[(c + 1) % 3] == b ? 1 : -1;
-  }
-  return direction[0] != direction[1];
+// Whether the two faces of v's star holding w (the two slots of a run of sides) traverse edge
+// (v, w) in opposite directions: w follows v in one and precedes it in the other.
+bool oriented_consistently(const VertexStar& star, int32_t a, int32_t b) {
+  const auto& sides = star.sides;
+  return (star.next[sides[a].second] == sides[a].first) != (star.next[sides[b].second] == sides[b].first);
 }
-
 
 // The fans of output vertex o from its triangles (ids into `triangles`), joined across the
 // edges at o that exactly two of them share; empty when an edge at o has more than two.
@@ -91,10 +84,19 @@ bool fans_match(std::vector<Fan> input, const std::vector<Fan>& output) {
 }  // namespace
 
 std::vector<int32_t> face_sheets(const Mesh& mesh) {
+  // Each edge (v, w) with exactly two faces joins them, read once at its lower end v.
   UnionFind sheets(mesh.num_faces());
-  for (int32_t e = 0; e < mesh.num_edges(); ++e)
-    if (mesh.edge_face_count(e) == 2)
-      sheets.unite(mesh.edge_faces()[mesh.edge_face_offsets()[e]], mesh.edge_faces()[mesh.edge_face_offsets()[e] + 1]);
+  VertexStar star;
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    star.read(mesh, v);
+    const auto& sides = star.sides;
+    for (size_t a = 0; a < sides.size();) {
+      size_t b = a + 1;
+      while (b < sides.size() && sides[b].first == sides[a].first) ++b;
+      if (b - a == 2 && sides[a].first > v) sheets.unite(star.faces[sides[a].second], star.faces[sides[a + 1].second]);
+      a = b;
+    }
+  }
   std::vector<int32_t> sheet(mesh.num_faces());
   for (int32_t f = 0; f < mesh.num_faces(); ++f) sheet[f] = sheets.find(f);  // roots are the lowest faces
   return sheet;
@@ -102,17 +104,13 @@ std::vector<int32_t> face_sheets(const Mesh& mesh) {
 
 std::vector<Fan> input_fans(const Mesh& mesh, const std::vector<int32_t>& face_sheet, int32_t v) {
   std::vector<int32_t> fan_of_slot;
-  const int32_t count = vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot);
+  VertexStar star;
+  const int32_t count = vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot, star);
   std::vector<Fan> fans(count, Fan{-1, true});
-  const auto& vfo = mesh.vertex_face_offsets();
-  for (int32_t i = vfo[v]; i < vfo[v + 1]; ++i) {
-    const int32_t f = mesh.vertex_faces()[i];
-    Fan& fan = fans[fan_of_slot[i - vfo[v]]];
-    fan.sheet = face_sheet[f];
-    const int32_t* t = &mesh.faces()[3 * size_t(f)];
-    const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
-    for (int side : {c, (c + 2) % 3})
-      if (mesh.edge_face_count(mesh.face_edges()[3 * size_t(f) + side]) == 1) fan.closed = false;
+  for (int32_t i = 0; i < star.size(); ++i) {
+    Fan& fan = fans[fan_of_slot[i]];
+    fan.sheet = face_sheet[star.faces[i]];
+    if (star.edge_faces(star.next[i]) == 1 || star.edge_faces(star.prev[i]) == 1) fan.closed = false;
   }
   return fans;
 }
@@ -124,16 +122,19 @@ PinchedVertices find_pinched_vertices(const Mesh& mesh) {
   out.pinched.assign(n, 0);
   std::vector<uint8_t> has_pinch(mesh.num_components(), 0), other_defect(mesh.num_components(), 0);
   std::vector<int32_t> fan_of_slot;
-  const auto& ao = mesh.adjacency_offsets();
+  VertexStar star;
   for (int32_t v = 0; v < n; ++v) {
     if (mesh.component()[v] < 0 || mesh.manifold_vertex()[v]) continue;
+    // Every edge at v: one or two faces, two traversing it in opposite directions.
+    star.read(mesh, v);
     bool clean_edges = true;
-    for (int32_t i = ao[v]; i < ao[v + 1] && clean_edges; ++i) {
-      const int32_t e = mesh.adjacency_edge()[i];
-      const int32_t count = mesh.edge_face_count(e);
-      clean_edges = count <= 2 && (count < 2 || oriented_consistently(mesh, e));
+    for (size_t a = 0; a < star.sides.size() && clean_edges;) {
+      size_t b = a + 1;
+      while (b < star.sides.size() && star.sides[b].first == star.sides[a].first) ++b;
+      clean_edges = b - a <= 2 && (b - a < 2 || oriented_consistently(star, int32_t(a), int32_t(a + 1)));
+      a = b;
     }
-    if (clean_edges && vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot) >= 2) {
+    if (clean_edges && vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot, star) >= 2) {
       out.pinched[v] = 1;
       ++out.count;
       has_pinch[mesh.component()[v]] = 1;
@@ -193,8 +194,7 @@ int32_t changed_pinched_fans(const Mesh& mesh, const PinchedVertices& pinched, c
   // The input sheet of each output sheet: the one its triangles' corners have in common.
   auto sheets_of = [&](int32_t v, std::vector<int32_t>& into) {
     into.clear();
-    for (int32_t i = mesh.vertex_face_offsets()[v]; i < mesh.vertex_face_offsets()[v + 1]; ++i)
-      into.push_back(sheet[mesh.vertex_faces()[i]]);
+    mesh.for_each_face(v, [&](int32_t f) { into.push_back(sheet[f]); });
     std::sort(into.begin(), into.end());
     into.erase(std::unique(into.begin(), into.end()), into.end());
   };

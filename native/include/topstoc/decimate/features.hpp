@@ -55,9 +55,10 @@ struct FeatureLayout {
   /// read them with sectors_of, is_feature_vertex and is_corner. Empty too (but not those two)
   /// where the only feature edges are boundary edges at manifold vertices (one sector each).
   std::vector<int32_t> sectors;
-  /// Per slot of mesh.vertex_faces(): sector of that face. Empty when every vertex is one sector
-  /// (a manifold mesh without feature edges other than boundary edges); use sector_of().
-  std::vector<int32_t> sector_of_slot;
+  /// The sector of each face around the vertices of more than one sector (their faces in
+  /// Mesh::for_each_face order): sector_slot_vertex lists those vertices in increasing order,
+  /// and the k-th one's faces start at sector_slot_offsets[k] in sector_of_slot. Use sector_of().
+  std::vector<int32_t> sector_slot_vertex, sector_slot_offsets, sector_of_slot;
   std::vector<uint8_t> vertex_feature;  ///< per vertex: on a feature curve, or a corner (or empty)
   bool has_feature_vertices = false;    ///< any vertex_feature set (else no edge ids are needed)
   std::vector<uint8_t> vertex_corner;   ///< per vertex: always kept (or empty)
