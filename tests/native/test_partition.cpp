@@ -292,3 +292,43 @@ TEST_CASE("a check after relabelling feature vertices by hand finds what a check
     }
   }
 }
+
+// Six times V - E + F of each cluster's vertices, the edges between two of them and the faces
+// of three, by a scan of every face: the Euler characteristic of a cluster where every vertex
+// is one sector and every edge one copy (no feature edges but borders).
+std::vector<int64_t> euler6_by_scan(const Mesh& mesh, const Clustering& c, int32_t k) {
+  std::vector<int64_t> chi6(k, 0);
+  std::set<std::pair<int32_t, int32_t>> edges;
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+    const int32_t* t = &mesh.faces()[3 * size_t(f)];
+    for (int j = 0; j < 3; ++j) edges.insert({std::min(t[j], t[(j + 1) % 3]), std::max(t[j], t[(j + 1) % 3])});
+    if (c.label(t[0]) == c.label(t[1]) && c.label(t[1]) == c.label(t[2])) chi6[c.label(t[0])] += 6;
+  }
+  for (const auto& [a, b] : edges)
+    if (c.label(a) == c.label(b)) chi6[c.label(a)] -= 6;
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+    if (c.label(v) >= 0) chi6[c.label(v)] += 6;
+  return chi6;
+}
+
+TEST_CASE("each cluster's Euler characteristic is V - E + F of its own vertices, edges and faces") {
+  std::mt19937 random(7);
+  topstoc_test::Arrays holed = topstoc_test::grid(20, 15);
+  holed.triangles.erase(holed.triangles.begin() + 300, holed.triangles.begin() + 306);  // a hole
+  int32_t compared = 0;
+  for (const topstoc_test::Arrays& a : {topstoc_test::torus(30, 20), topstoc_test::grid(20, 15), holed}) {
+    const Mesh mesh(a.positions, a.triangles.data(), a.num_triangles());
+    const auto layout = build_feature_layout(mesh, nullptr, 0, nullptr, 0, 0.0);
+    for (int32_t count : {1, 5, 40, 200}) {
+      const std::vector<int32_t> samples = topstoc_test::random_samples(mesh.num_vertices(), count, random);
+      Clustering clustering;
+      flood(mesh, *layout, samples, clustering);
+      bool reached = true;  // (the check asks this first: a flood along borders can leave some)
+      for (int32_t v = 0; v < mesh.num_vertices(); ++v) reached = reached && clustering.label(v) >= 0;
+      if (!reached) continue;
+      CHECK(cluster_euler6(mesh, *layout, count, clustering) == euler6_by_scan(mesh, clustering, count));
+      ++compared;
+    }
+  }
+  CHECK(compared >= 6);  // the torus's four and some of the bordered grids'
+}

@@ -212,20 +212,25 @@ std::vector<int64_t> cluster_euler6(const Mesh& mesh, const FeatureLayout& layou
                                     const Clustering& c) {
   // 6 chi = sum over the cluster's vertices of the layout's per-vertex constant, corrected by
   // the edges and faces the cluster shares with others (see FeatureLayout::chi_constant, chi_of).
+  // chi_of's face term (2 per face around the vertex) less the correction of the faces shared
+  // leaves 6 per face all of whose corners lie in the cluster: counted so, no vertex's faces
+  // are walked.
   std::vector<int64_t> chi6(num_samples, 0);
   auto label = [&c](int32_t v) { return c.label(v); };
-  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-    if (label(v) >= 0) chi6[label(v)] += layout.chi_of(mesh, v);
+  const auto& ao = mesh.adjacency_offsets();
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    if (label(v) < 0) continue;
+    chi6[label(v)] += layout.chi_constant.empty() ? 6 * layout.sectors_of(mesh, v) - 3 * (ao[v + 1] - ao[v])
+                                                  : layout.chi_constant[v] - 2 * mesh.face_count(v);
+  }
   const auto& faces = mesh.faces();
   for (int32_t f = 0; f < mesh.num_faces(); ++f) {
     const int32_t la = label(faces[3 * size_t(f)]), lb = label(faces[3 * size_t(f) + 1]),
                   lc = label(faces[3 * size_t(f) + 2]);
-    if (la == lb && lb == lc) continue;
-    chi6[la] -= 2, chi6[lb] -= 2, chi6[lc] -= 2;
+    if (la >= 0 && la == lb && lb == lc) chi6[la] += 6;
   }
   // Each edge between two clusters once, from its lower end (from the adjacency: the faces of
   // each edge are a table of their own, not built for this).
-  const auto& ao = mesh.adjacency_offsets();
   const auto& adj = mesh.adjacency();
   const int32_t* ae = layout.feature_edges.empty() ? nullptr : mesh.adjacency_edge().data();
   for (int32_t v = 0; v < mesh.num_vertices(); ++v)
