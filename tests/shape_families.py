@@ -64,6 +64,13 @@ def perforated_plate(triangles: int):
     return vertices, faces
 
 
+def holed_scan(triangles: int):
+    """The bumpy torus with 20 triangles missing far apart: a closed scan with a few small holes."""
+    vertices, faces = meshgen.bumpy_torus(triangles)
+    missing = np.arange(20) * (len(faces) // 20) + len(faces) // 40
+    return vertices, np.delete(faces, missing, axis=0)
+
+
 def torn_scan(triangles: int):
     """The bumpy torus with 0.1 % of its triangles missing and a fin on one edge in 2,000."""
     vertices, faces = meshgen.bumpy_torus(triangles)
@@ -85,4 +92,4 @@ def welded_points(triangles: int):
 
 
 FAMILIES = {f.__name__: f for f in (bumpy_torus, many_spheres, triangle_soup, sheet_with_holes, sliver_sphere,
-                                    fanned_cylinder, perforated_plate, torn_scan, welded_points)}
+                                    fanned_cylinder, perforated_plate, holed_scan, torn_scan, welded_points)}
