@@ -227,7 +227,10 @@ class Mesh:
         """The input's topology (core/api/topology.py), computed once: every decimation of a
         mesh whose partition checks leave issues compares its output with it (invariants.py)."""
         if self._topology is None:
-            self._topology = topology(self.vertices, self.triangles)
+            # Copies made for this alone are not kept (24 bytes a triangle for the mesh's life).
+            vertices = self._vertices if self._vertices is not None else self._native.caller_vertices
+            triangles = self._triangles if self._triangles is not None else self._native.caller_triangles
+            self._topology = topology(vertices, triangles)
         return self._topology
 
     def decimate(self, ratio=None, target_vertices=None, target_triangles=None, **options):
