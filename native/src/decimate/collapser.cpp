@@ -53,7 +53,11 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
     }
   alive_face_.assign(m, 1);
   for (int32_t v = 0; v < n && !tracking_floors_; ++v) tracking_floors_ = size_[v] > kWideFan;
-  if (tracking_floors_) floor_bound_.assign(n, Shared<double>()), flat_star_.assign(n, Shared<int8_t>());
+  if (tracking_floors_) {
+    floor_bound_.assign(n, Shared<double>());
+    floor_witness_.assign(n, Shared<int32_t>());
+    flat_star_.assign(n, Shared<int8_t>());
+  }
   dirty_.assign(n, 0);
   placed_.assign(n, 0);
   merged_into_.assign(n, -1);
@@ -821,8 +825,10 @@ bool Collapser::merges_unlike_edges(int32_t u, int32_t v, const int32_t* on_edge
 // twice the mean error).
 double Collapser::shape_floor2(int32_t v) const {
   double floor2 = std::numeric_limits<double>::infinity();
-  for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) floor2 = std::min(floor2, shape2(*t));
-  if (tracking_floors_ && size_[v] > kWideFan) floor_bound_[v].set(floor2);
+  int32_t thinnest = -1;
+  for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t)
+    if (const double s = shape2(*t); s < floor2) floor2 = s, thinnest = *t;
+  if (tracking_floors_ && size_[v] > kWideFan) floor_bound_[v].set(floor2), floor_witness_[v].set(thinnest);
   return std::min(floor2, min_shape_ * min_shape_);
 }
 
@@ -973,6 +979,10 @@ bool Collapser::below_end_floor(double twice_area2, double edges, bool flat, int
   if (floor2 < 0.0) {
     const double bound = floor_bound_.empty() ? -1.0 : floor_bound_[v].get();
     if (bound >= 0.0 && thinner(twice_area2, edges, std::min(bound, min_shape_ * min_shape_))) return true;
+    const int32_t witness = floor_witness_.empty() ? -1 : floor_witness_[v].get();
+    if (witness >= 0 && alive_face_[witness] && has(witness, v) &&
+        !thinner(twice_area2, edges, std::min(shape2(witness), min_shape_ * min_shape_)))
+      return false;  // no thinner than one of v's triangles: not below v's floor
     floor2 = shape_floor2(v);
   }
   return thinner(twice_area2, edges, floor2);

@@ -297,6 +297,10 @@ class Collapser {
   // squared shape of its triangles (shape_floor2 before the cap), lowered as they change, so that
   // a triangle far thinner than a fan's floor is refused without the walk of the fan (-1: none).
   std::vector<Shared<double>> floor_bound_;  // empty: no vertex is wide
+  // Per such vertex: its thinnest triangle at the last walk (-1: none). While it is alive and
+  // still the vertex's, its shape bounds the floor from above: a triangle no thinner than it is
+  // not below the floor, without the walk of the fan.
+  std::vector<Shared<int32_t>> floor_witness_;  // empty: no vertex is wide
   // Per vertex of more than kWideFan faces: flat_star's answer once read, -1 again when one of its
   // triangles changes, so that a fan's centre is walked once per change, not once per check.
   std::vector<Shared<int8_t>> flat_star_;  // empty: no vertex is wide
