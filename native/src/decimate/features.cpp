@@ -180,7 +180,8 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
           same_copies = same_copies && c == first_copies;
         }
       }
-      // A manifold vertex without feature edges is one sector (slots stay 0); others need the fans.
+      // A manifold vertex without feature edges, or with boundary edges alone, is one sector;
+      // others need the fans (their faces' sectors are recorded after, record_sector_slots).
       int32_t sectors = 1;
       if (!borders_only && (degree > 0 || !mesh.manifold_vertex()[v])) {
         sectors = vertex_fans(mesh, v, [&](int32_t e) { return layout.is_feature_edge(e); }, fan_of_slot, star);
