@@ -39,6 +39,17 @@ struct VertexStar {
     std::sort(sides.begin(), sides.end());
   }
   int32_t size() const { return int32_t(faces.size()); }
+  /// Calls fn(w, first, count) for each edge (v, w): its `count` faces are the slots of
+  /// sides[first, first + count).
+  template <class Fn>
+  void for_each_edge(Fn&& fn) const {
+    for (size_t a = 0; a < sides.size();) {
+      size_t b = a + 1;
+      while (b < sides.size() && sides[b].first == sides[a].first) ++b;
+      fn(sides[a].first, int32_t(a), int32_t(b - a));
+      a = b;
+    }
+  }
   /// How many of v's faces hold w: the face count of edge (v, w).
   int32_t edge_faces(int32_t w) const {
     const auto lo = std::lower_bound(sides.begin(), sides.end(), std::pair<int32_t, int32_t>{w, INT32_MIN});
@@ -70,17 +81,12 @@ int32_t vertex_fans(const Mesh& mesh, int32_t v, Blocked blocked, std::vector<in
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
-  // The two faces of an edge with exactly two at v (a run of two sides with the same end).
-  const auto& sides = star.sides;
-  for (size_t a = 0; a < sides.size();) {
-    size_t b = a + 1;
-    while (b < sides.size() && sides[b].first == sides[a].first) ++b;
-    if (b - a == 2 && !blocked(mesh.find_edge(v, sides[a].first))) {
-      const int32_t x = find(sides[a].second), y = find(sides[a + 1].second);
-      if (x != y) parent[x < y ? y : x] = x < y ? x : y;
-    }
-    a = b;
-  }
+  // The two faces of an edge with exactly two at v.
+  star.for_each_edge([&](int32_t w, int32_t first, int32_t faces) {
+    if (faces != 2 || blocked(mesh.find_edge(v, w))) return;
+    const int32_t x = find(star.sides[first].second), y = find(star.sides[first + 1].second);
+    if (x != y) parent[x < y ? y : x] = x < y ? x : y;
+  });
   // Roots are the lowest slot of each fan, so numbering roots in slot order numbers fans in
   // order of first appearance.
   int32_t fans = 0;

@@ -89,13 +89,9 @@ std::vector<int32_t> face_sheets(const Mesh& mesh) {
   VertexStar star;
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
     star.read(mesh, v);
-    const auto& sides = star.sides;
-    for (size_t a = 0; a < sides.size();) {
-      size_t b = a + 1;
-      while (b < sides.size() && sides[b].first == sides[a].first) ++b;
-      if (b - a == 2 && sides[a].first > v) sheets.unite(star.faces[sides[a].second], star.faces[sides[a + 1].second]);
-      a = b;
-    }
+    star.for_each_edge([&](int32_t w, int32_t first, int32_t faces) {
+      if (faces == 2 && w > v) sheets.unite(star.faces[star.sides[first].second], star.faces[star.sides[first + 1].second]);
+    });
   }
   std::vector<int32_t> sheet(mesh.num_faces());
   for (int32_t f = 0; f < mesh.num_faces(); ++f) sheet[f] = sheets.find(f);  // roots are the lowest faces
@@ -128,12 +124,9 @@ PinchedVertices find_pinched_vertices(const Mesh& mesh) {
     // Every edge at v: one or two faces, two traversing it in opposite directions.
     star.read(mesh, v);
     bool clean_edges = true;
-    for (size_t a = 0; a < star.sides.size() && clean_edges;) {
-      size_t b = a + 1;
-      while (b < star.sides.size() && star.sides[b].first == star.sides[a].first) ++b;
-      clean_edges = b - a <= 2 && (b - a < 2 || oriented_consistently(star, int32_t(a), int32_t(a + 1)));
-      a = b;
-    }
+    star.for_each_edge([&](int32_t, int32_t first, int32_t faces) {
+      clean_edges = clean_edges && faces <= 2 && (faces < 2 || oriented_consistently(star, first, first + 1));
+    });
     if (clean_edges && vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot, star) >= 2) {
       out.pinched[v] = 1;
       ++out.count;
