@@ -956,9 +956,9 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
   const int32_t active = active_vertices(mesh);
   if (!(params.refine == 0.0 || params.refine >= 1.0))
     throw std::invalid_argument("refine must be 0 (off) or at least 1, got " + std::to_string(params.refine));
-  if (params.warm_up && only_loose_triangles(mesh, layout)) return {};
-  if (params.refine >= 1.0 && only_loose_triangles(mesh, layout)) {
-    // Nothing to refine or place: the plain pass gives the input, without the collapser's set-up.
+  if ((params.warm_up || params.refine >= 1.0) && only_loose_triangles(mesh, layout)) {
+    // Nothing to refine, place or keep: the plain pass gives the input, without the collapser's set-up.
+    if (params.warm_up) return {};
     DecimateParams plain = params;
     plain.refine = 0.0;
     plain.placement = Placement::Subsample;

@@ -3,6 +3,7 @@
 #include "../core/fans.hpp"
 #include "link_arcs.hpp"
 #include "../core/byte_flags.hpp"
+#include "../core/counting_sort.hpp"
 #include "../core/id_bits.hpp"
 #include "../core/per_thread.hpp"
 #include "../core/portable.hpp"
@@ -498,25 +499,25 @@ class PartitionCheck {
   void collect_feature_pairs() {
     if (layout.feature_edges.empty()) return;  // (the edge table is built on first use: not for this)
     const auto& ev = mesh.edge_vertices();
-    std::vector<int32_t> start(size_t(k) + 1, 0);
+    struct Crossing {
+      int32_t lower, higher, copies;
+    };
+    std::vector<Crossing> crossing;
     for (int32_t e : layout.feature_edges) {
       const int32_t lx = label(ev[2 * size_t(e)]), ly = label(ev[2 * size_t(e) + 1]);
-      if (lx != ly) ++start[std::min(lx, ly) + 1];
+      if (lx != ly) crossing.push_back({std::min(lx, ly), std::max(lx, ly), layout.edge_copies(mesh, e)});
     }
-    for (int32_t s = 0; s < k; ++s) start[s + 1] += start[s];
-    if (start[k] == 0) return;
-    std::vector<std::pair<int32_t, int32_t>> higher(start[k]);  // per pair: higher sample, copies
-    std::vector<int32_t> fill(start.begin(), start.end() - 1);
-    for (int32_t e : layout.feature_edges) {
-      const int32_t lx = label(ev[2 * size_t(e)]), ly = label(ev[2 * size_t(e) + 1]);
-      if (lx != ly) higher[fill[std::min(lx, ly)]++] = {std::max(lx, ly), layout.edge_copies(mesh, e)};
-    }
+    if (crossing.empty()) return;
+    std::vector<std::pair<int32_t, int32_t>> higher(crossing.size());  // per pair: higher sample, copies
+    std::vector<int32_t> start;
+    stable_counting_sort(
+        int64_t(crossing.size()), k, [&](int64_t i) { return crossing[i].lower; },
+        [&](int64_t i, int32_t at) { higher[at] = {crossing[i].higher, crossing[i].copies}; }, start);
     pair_rows.assign(size_t(k) + 1, 0);
     feature_pairs.reserve(higher.size());
     for (int32_t s = 0; s < k; ++s) {
       pair_rows[s] = int32_t(feature_pairs.size());
-      auto* row = higher.data() + start[s];
-      std::sort(row, row + (start[s + 1] - start[s]));
+      std::sort(higher.begin() + start[s], higher.begin() + start[s + 1]);
       for (int32_t i = start[s]; i < start[s + 1]; ++i) {
         const uint64_t key = pair_key(s, higher[i].first);
         if (!feature_pairs.empty() && feature_pairs.back().first == key) feature_pairs.back().second += higher[i].second;
