@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/fans.hpp"
+#include "core/per_thread.hpp"
 #include "core/portable.hpp"
 #include "curve_bends.hpp"
 #include "pinched_fans.hpp"
@@ -120,19 +121,25 @@ std::vector<int32_t> loose_triangle_vertices(const Mesh& mesh) {
   return loose;
 }
 
-// The sectors of the faces around each vertex of more than one sector (FeatureLayout::
-// sector_of_slot): only there does a face's sector need a table.
-void record_sector_slots(const Mesh& mesh, FeatureLayout& layout) {
+// The sectors of the faces around the vertices of more than one sector (FeatureLayout::
+// sector_of_slot) that one thread's run of vertices found, in vertex order.
+struct SectorSlots {
+  std::vector<int32_t> vertex, count, sector;
+  void add(int32_t v, const std::vector<int32_t>& fan_of_slot) {
+    vertex.push_back(v);
+    count.push_back(int32_t(fan_of_slot.size()));
+    sector.insert(sector.end(), fan_of_slot.begin(), fan_of_slot.end());
+  }
+};
+
+// Every thread's slots into the layout, in thread order (the static runs' order: by vertex).
+void record_sector_slots(PerThread<SectorSlots>& found, FeatureLayout& layout) {
   layout.sector_slot_vertex.clear(), layout.sector_slot_offsets.assign(1, 0), layout.sector_of_slot.clear();
-  if (layout.sectors.empty()) return;
-  std::vector<int32_t> fan_of_slot;
-  VertexStar star;
-  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-    if (layout.sectors[v] <= 1) continue;
-    vertex_fans(mesh, v, [&](int32_t e) { return layout.is_feature_edge(e); }, fan_of_slot, star);
-    layout.sector_slot_vertex.push_back(v);
-    layout.sector_of_slot.insert(layout.sector_of_slot.end(), fan_of_slot.begin(), fan_of_slot.end());
-    layout.sector_slot_offsets.push_back(int32_t(layout.sector_of_slot.size()));
+  for (int t = 0; t < found.size(); ++t) {
+    const SectorSlots& run = found[t];
+    layout.sector_slot_vertex.insert(layout.sector_slot_vertex.end(), run.vertex.begin(), run.vertex.end());
+    for (int32_t c : run.count) layout.sector_slot_offsets.push_back(layout.sector_slot_offsets.back() + c);
+    layout.sector_of_slot.insert(layout.sector_of_slot.end(), run.sector.begin(), run.sector.end());
   }
 }
 
@@ -163,6 +170,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
   // Without feature edges chi_of computes the constant (n integers fewer on a large scan).
   layout.chi_constant.clear();
   if (!featureless && !borders_only) layout.chi_constant.assign(n, 0);
+  PerThread<SectorSlots> found(max_threads());
   parallel_region(team_for(n, kParallelMin), [&](Team& team) {
     std::vector<int32_t> fan_of_slot;
     VertexStar star;
@@ -181,10 +189,11 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
         }
       }
       // A manifold vertex without feature edges, or with boundary edges alone, is one sector;
-      // others need the fans (their faces' sectors are recorded after, record_sector_slots).
+      // others need the fans (the faces' sectors kept where there are several).
       int32_t sectors = 1;
       if (!borders_only && (degree > 0 || !mesh.manifold_vertex()[v])) {
         sectors = vertex_fans(mesh, v, [&](int32_t e) { return layout.is_feature_edge(e); }, fan_of_slot, star);
+        if (sectors > 1) found.mine().add(v, fan_of_slot);
       }
       if (!featureless) layout.feature_degree[v] = degree;
       if (!borders_only) layout.sectors[v] = sectors;
@@ -196,7 +205,7 @@ void compute_sectors_and_corners(const Mesh& mesh, FeatureLayout& layout) {
       if (!featureless && !borders_only) layout.chi_constant[v] = 6 * sectors - 3 * copies + 2 * mesh.face_count(v);
     });
   });
-  record_sector_slots(mesh, layout);
+  record_sector_slots(found, layout);
 }
 
 void trace_curves(const Mesh& mesh, FeatureLayout& layout) {
