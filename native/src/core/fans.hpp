@@ -61,11 +61,10 @@ struct VertexStar {
 /// Groups the triangles around v into fans. fan_of_slot receives, for each slot of v (its faces
 /// in Mesh::for_each_face order, as mesh.vertex_faces() lists them), the fan index (0, 1, ...)
 /// in order of first appearance. blocked(e) says whether edge e separates fans even when it has
-/// two triangles. Returns the number of fans. `star` is scratch (read here).
+/// two triangles. Returns the number of fans. fans_of_star reads them from v's star as read.
 template <class Blocked>
-int32_t vertex_fans(const Mesh& mesh, int32_t v, Blocked blocked, std::vector<int32_t>& fan_of_slot,
-                    VertexStar& star) {
-  star.read(mesh, v);
+int32_t fans_of_star(const Mesh& mesh, int32_t v, const VertexStar& star, Blocked blocked,
+                     std::vector<int32_t>& fan_of_slot) {
   const int32_t count = star.size();
   fan_of_slot.resize(count);
   // Union-find over the slots of v; valences are small, so the work stays in fixed buffers.
@@ -96,6 +95,14 @@ int32_t vertex_fans(const Mesh& mesh, int32_t v, Blocked blocked, std::vector<in
     else fan_of_slot[i] = fan_of_slot[root];
   }
   return fans;
+}
+
+/// fans_of_star with v's star read into `star` (scratch).
+template <class Blocked>
+int32_t vertex_fans(const Mesh& mesh, int32_t v, Blocked blocked, std::vector<int32_t>& fan_of_slot,
+                    VertexStar& star) {
+  star.read(mesh, v);
+  return fans_of_star(mesh, v, star, blocked, fan_of_slot);
 }
 
 /// vertex_fans with a star of its own.

@@ -127,7 +127,7 @@ PinchedVertices find_pinched_vertices(const Mesh& mesh) {
     star.for_each_edge([&](int32_t, int32_t first, int32_t faces) {
       clean_edges = clean_edges && faces <= 2 && (faces < 2 || oriented_consistently(star, first, first + 1));
     });
-    if (clean_edges && vertex_fans(mesh, v, [](int32_t) { return false; }, fan_of_slot, star) >= 2) {
+    if (clean_edges && fans_of_star(mesh, v, star, [](int32_t) { return false; }, fan_of_slot) >= 2) {
       out.pinched[v] = 1;
       ++out.count;
       has_pinch[mesh.component()[v]] = 1;
