@@ -24,6 +24,12 @@ bool thinner(double twice_area2, double edges, double shape2) {
   return !(12.0 * twice_area2 >= shape2 * edges * edges) || edges == 0.0;
 }
 
+// Whether normals a and n (squared lengths a2, n2 > 0) differ by more than a flat star allows.
+bool apart(const double* a, double a2, const double* n, double n2) {
+  const double dot = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
+  return !(dot > 0.0) || dot * dot < (1.0 - kFlatTurn2) * a2 * n2;
+}
+
 }  // namespace
 
 Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corner_source, CollapseSetup setup)
@@ -57,6 +63,11 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
     floor_bound_.assign(n, Shared<double>());
     floor_witness_.assign(n, Shared<int32_t>());
     flat_star_.assign(n, Shared<int8_t>());
+    flat_reference_.assign(n, Shared<int32_t>());
+    changed_at_.assign(n, 0);
+    kept_costs_of_.assign(n, -1);
+    for (int32_t v = 0; v < n; ++v)
+      if (size_[v] > kWideFan) kept_costs_of_[v] = int32_t(kept_costs_.size()), kept_costs_.emplace_back();
   }
   dirty_.assign(n, 0);
   placed_.assign(n, 0);
@@ -122,6 +133,7 @@ int32_t Collapser::survivor(int32_t v) {
 
 void Collapser::reweigh(std::vector<double> weight) {
   s_.weight = std::move(weight);
+  for (CostCache& kept : kept_costs_) kept.clear();
   const int32_t n = vertices();
   std::vector<Best> best(n);
   parallel_for(0, n, kParallelMinCostly, [&](int32_t u) {
@@ -162,7 +174,8 @@ int32_t Collapser::sector_at(int32_t t, int32_t v) const {
 }
 
 void Collapser::remove_face(int32_t v, int32_t t) {
-  if (tracking_floors_) flat_star_[v].set(-1);
+  // A flat star stays flat without t, unless t was the triangle the others were compared with.
+  if (tracking_floors_ && (flat_star_[v].get() != 1 || flat_reference_[v].get() == t)) flat_star_[v].set(-1);
   int32_t* list = &pool_[begin_[v]];
   const int32_t size = size_[v];
   for (int32_t i = 0; i < size; ++i)
@@ -224,6 +237,31 @@ void Collapser::queue(int32_t u, int32_t v, double c) {
   heap_.set(u, c);
 }
 
+// Calls fn(v, cost of u's collapse onto v) for each v of `around`, with the costs kept where u is
+// wide (CostCache). For one u at a time on any thread (a batch's evaluations are of distinct
+// vertices).
+template <class Fn>
+void Collapser::for_each_cost(int32_t u, const std::vector<int32_t>& around, const Fn& fn) const {
+  const int32_t slot = kept_costs_of_.empty() ? -1 : kept_costs_of_[u];
+  if (slot < 0) {
+    for (int32_t v : around) fn(v, cost(u, v));
+    return;
+  }
+  CostCache& kept = kept_costs_[slot];
+  const uint32_t since_u = changed_at_[u];
+  auto alive = [&](int32_t v) { return merged_into_[v] < 0; };
+  for (int32_t v : around) {
+    const CostCache::Entry* e = kept.find(v);
+    if (e && e->time >= since_u && e->time >= changed_at_[v]) {
+      fn(v, e->cost);
+    } else {
+      const double c = cost(u, v);
+      kept.put(v, clock_, c, alive);
+      fn(v, c);
+    }
+  }
+}
+
 // u's cheapest collapse (lowest id on ties), or none (target -1) for a locked vertex or one at
 // its quota. Checks wait until it is popped (most queued collapses are superseded before that);
 // with `checked`, the cheapest one that passes them. Reads the state only: safe in parallel.
@@ -232,14 +270,13 @@ Collapser::Best Collapser::evaluate(int32_t u, bool checked, Scratch& scratch) c
   if (s_.locked[u] || at_quota(u) || (!held_.empty() && held_[u])) return best;
   neighbours(u, scratch, scratch.list);
   if (!checked) {
-    for (int32_t v : scratch.list) {
-      const double c = cost(u, v);
+    for_each_cost(u, scratch.list, [&](int32_t v, double c) {
       if (best.target < 0 || c < best.cost || (c == best.cost && v < best.target)) best = {v, c};
-    }
+    });
     return best;
   }
   scratch.costs.clear();
-  for (int32_t v : scratch.list) scratch.costs.push_back({cost(u, v), v});
+  for_each_cost(u, scratch.list, [&](int32_t v, double c) { scratch.costs.push_back({c, v}); });
   // A wide vertex tries its kWideTries cheapest: each check of a collapse there reads its faces,
   // and the centre of a fan of thousands, re-evaluated after every collapse on its rim, read them
   // for every neighbour (a cylinder of 5,000 segments with fanned caps: 0.8 -> 12.6 s). Only
@@ -249,6 +286,39 @@ Collapser::Best Collapser::evaluate(int32_t u, bool checked, Scratch& scratch) c
   for (size_t i = 0; i < tries; ++i)
     if (allowed(u, scratch.costs[i].second, scratch)) return {scratch.costs[i].second, scratch.costs[i].first};
   return best;
+}
+
+int64_t Collapser::check_kept_state() const {
+  if (!tracking_floors_) return 0;
+  int64_t checked = 0;
+  Scratch scratch;
+  scratch.mark.assign(merged_into_.size(), 0);
+  for (int32_t v = 0; v < vertices(); ++v) {
+    if (merged_into_[v] >= 0) continue;
+    if (const int8_t known = flat_star_[v].get(); known >= 0) {
+      int32_t first = -1;
+      const bool flat = walk_flat_star(v, &first);
+      if (flat != bool(known) || (flat && first != flat_reference_[v].get())) return -1;
+      ++checked;
+    }
+    if (kept_costs_of_[v] < 0) continue;
+    neighbours(v, scratch, scratch.list);
+    bool same = true;
+    for_each_cost(v, scratch.list, [&](int32_t u, double c) { same = same && c == cost(v, u); });
+    if (!same) return -1;
+    checked += int64_t(scratch.list.size());
+  }
+  return checked;
+}
+
+// Stamps v's quadric or position as changed: the costs kept with it (costs_of) are stale.
+void Collapser::changed(int32_t v) {
+  if (changed_at_.empty()) return;
+  if (++clock_ == 0) {  // the clock wrapped: start again with nothing kept
+    std::fill(changed_at_.begin(), changed_at_.end(), 0);
+    for (CostCache& kept : kept_costs_) kept.clear();
+  }
+  changed_at_[v] = clock_;
 }
 
 // Queues u's cheapest collapse, or takes u out of the queue when it has none: it waits until a
@@ -300,6 +370,7 @@ bool Collapser::place(int32_t v, const double* world, int32_t face) {
   double* w = &s_.world[3 * size_t(v)];
   double keep_p[3], keep_w[3];
   for (int i = 0; i < 3; ++i) keep_p[i] = p[i], keep_w[i] = w[i], p[i] = at[i], w[i] = world[i];
+  changed(v);
   if (!zero_area(face)) return moved_floor_bounds(v), true;
   for (int i = 0; i < 3; ++i) p[i] = keep_p[i], w[i] = keep_w[i];  // no gain: back
   return false;
@@ -848,7 +919,7 @@ void Collapser::lower_floor_bounds(int32_t t) {
   const int32_t* c = &(*tri_)[3 * size_t(t)];
   double value = -1.0;
   for (int j = 0; j < 3; ++j) {
-    flat_star_[c[j]].set(-1);
+    star_face_changed(c[j], t);
     const double bound = floor_bound_[c[j]].get();
     if (bound < 0.0) continue;
     if (value < 0.0) value = shape2(t);
@@ -934,30 +1005,63 @@ bool Collapser::keeps_face_shape(int32_t t, int32_t moved, const double* x, Shap
 bool Collapser::flat_star(int32_t v) const {
   if (tracking_floors_ && size_[v] > kWideFan) {
     int8_t known = flat_star_[v].get();
-    if (known < 0) flat_star_[v].set(known = walk_flat_star(v));
+    if (known < 0) {
+      int32_t first = -1;
+      known = walk_flat_star(v, &first);
+      flat_reference_[v].set(first);
+      flat_star_[v].set(known);
+    }
     return known;
   }
   return walk_flat_star(v);
 }
 
-// flat_star by a walk of v's triangles.
-bool Collapser::walk_flat_star(int32_t v) const {
-  double first[3] = {0, 0, 0}, first2 = 0.0;
+// flat_star by a walk of v's triangles, each compared with the first with area (*reference;
+// -1: none has area).
+bool Collapser::walk_flat_star(int32_t v, int32_t* reference) const {
+  int32_t first = -1;
+  double a[3], a2 = 0.0;
   for (const int32_t* t = faces_begin(v); t != faces_end(v); ++t) {
     double n[3];
-    const int32_t* c = &(*tri_)[3 * size_t(*t)];
-    normal(c, c[0], position(c[0]), n);
-    const double n2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    const double n2 = face_normal2(*t, n);
     if (!(n2 > 0.0)) continue;
-    if (first2 == 0.0) {
-      for (int i = 0; i < 3; ++i) first[i] = n[i];
-      first2 = n2;
-      continue;
+    if (first < 0) {
+      first = *t, a2 = n2;
+      for (int i = 0; i < 3; ++i) a[i] = n[i];
+    } else if (apart(a, a2, n, n2)) {
+      return false;
     }
-    const double dot = first[0] * n[0] + first[1] * n[1] + first[2] * n[2];
-    if (!(dot > 0.0) || dot * dot < (1.0 - kFlatTurn2) * first2 * n2) return false;
   }
+  if (reference) *reference = first;
   return true;
+}
+
+// Triangle t's unnormalised normal into n; returns its squared length.
+double Collapser::face_normal2(int32_t t, double n[3]) const {
+  const int32_t* c = &(*tri_)[3 * size_t(t)];
+  normal(c, c[0], position(c[0]), n);
+  return n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+}
+
+// Triangle t of wide v's star changed (a corner moved or was renamed, or it was added at the end
+// of v's list): v's kept flatness (flat_star_) is updated without a walk where t alone decides it.
+// A flat star stays flat unless t is its first triangle with area or now faces apart from it; a
+// star found not flat is walked again.
+void Collapser::star_face_changed(int32_t v, int32_t t) {
+  if (flat_star_[v].get() != 1) return flat_star_[v].set(-1);
+  const int32_t first = flat_reference_[v].get();
+  if (t == first) return flat_star_[v].set(-1);
+  double n[3];
+  const double n2 = face_normal2(t, n);
+  if (!(n2 > 0.0)) return;                      // no area: the walk skips it
+  if (first < 0) return flat_star_[v].set(-1);  // t is now the first with area
+  const int32_t* f = faces_begin(v);
+  for (; f != faces_end(v) && *f != first; ++f)
+    if (*f == t) return flat_star_[v].set(-1);  // t comes before the first: now it is
+  if (f == faces_end(v)) return flat_star_[v].set(-1);
+  double a[3];
+  const double a2 = face_normal2(first, a);
+  if (apart(a, a2, n, n2)) flat_star_[v].set(0);
 }
 
 // Is a triangle thinner than the floor of the move, the lower of its ends' floors? Thinner than
@@ -1026,7 +1130,7 @@ void Collapser::move_to(int32_t v, const double* x) {
     w[i] = x[i] * s_.extent + s_.center[i];
     moved = true;
   }
-  if (moved) moved_floor_bounds(v);
+  if (moved) changed(v), moved_floor_bounds(v);
 }
 
 void Collapser::collapse(int32_t u, int32_t v) {
@@ -1099,6 +1203,7 @@ void Collapser::collapse(int32_t u, int32_t v) {
   size_[u] = 0;
   merged_into_[u] = v;
   s_.quadrics.merge(v, u);
+  changed(v);
   heap_.remove(u);
   target_[u] = -1;
   merged_from_[v] = u;
@@ -1169,6 +1274,7 @@ bool Collapser::try_move(int32_t v, const double* x) {
 
 void Collapser::restore(int32_t v, const double* position, const double* world) {
   for (int i = 0; i < 3; ++i) s_.positions[3 * size_t(v) + i] = position[i], s_.world[3 * size_t(v) + i] = world[i];
+  changed(v);
   moved_floor_bounds(v);
 }
 

@@ -21,6 +21,7 @@
 #include <functional>
 #include <vector>
 
+#include "decimate/cost_cache.hpp"
 #include "decimate/indexed_heap.hpp"
 #include "decimate/vertex_quadrics.hpp"
 #include "core/per_thread.hpp"
@@ -142,6 +143,11 @@ class Collapser {
   /// Puts v back where it was (normalised and caller's coordinates, as read before a move).
   void restore(int32_t v, const double* position, const double* world);
 
+  /// For tests: checks every wide vertex's kept flatness and the costs its evaluation reads
+  /// (kept or fresh) against a walk of its star and a fresh cost. Returns how many it checked,
+  /// or -1 at the first that differs.
+  int64_t check_kept_state() const;
+
   int32_t live_faces() const { return alive_faces_; }
   /// The sum over live vertices of their quadric's error where they stand (normalised, no
   /// guidance weight): how far the result lies from the input planes it stands for.
@@ -191,6 +197,9 @@ class Collapser {
     double cost = 0.0;
   };
   Best evaluate(int32_t u, bool checked, Scratch& scratch) const;
+  template <class Fn>
+  void for_each_cost(int32_t u, const std::vector<int32_t>& around, const Fn& fn) const;
+  void changed(int32_t v);
   void update(int32_t u, bool checked = false);
   void settle(int32_t u, Best best);
   void offer(int32_t x, int32_t v, int32_t removed, double c);
@@ -242,7 +251,9 @@ class Collapser {
     int8_t flat = -1;             // the moved vertex's triangles lie in one plane (flat_star; -1: not read yet)
   };
   bool flat_star(int32_t v) const;
-  bool walk_flat_star(int32_t v) const;
+  bool walk_flat_star(int32_t v, int32_t* reference = nullptr) const;
+  double face_normal2(int32_t t, double n[3]) const;
+  void star_face_changed(int32_t v, int32_t t);
   bool below_floor(double twice_area2, double edges, bool flat, ShapeFloor& floor) const;
   bool keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const;
   bool beside_edge_keep_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const;
@@ -301,10 +312,21 @@ class Collapser {
   // still the vertex's, its shape bounds the floor from above: a triangle no thinner than it is
   // not below the floor, without the walk of the fan.
   std::vector<Shared<int32_t>> floor_witness_;  // empty: no vertex is wide
-  // Per vertex of more than kWideFan faces: flat_star's answer once read, -1 again when one of its
-  // triangles changes, so that a fan's centre is walked once per change, not once per check.
+  // Per vertex of more than kWideFan faces: flat_star's answer once read (-1: not known), kept as
+  // its triangles change where the changed one alone decides it (star_face_changed), so that a
+  // fan's centre is walked again only when its first triangle changes or it was not flat.
   std::vector<Shared<int8_t>> flat_star_;  // empty: no vertex is wide
+  // Per such vertex with flat_star_ known: the triangle its walk compared the others with (the
+  // first with area; -1: none).
+  std::vector<Shared<int32_t>> flat_reference_;
   bool tracking_floors_ = false;
+  // Where some vertex is wide: per vertex, the clock at its last change of quadric or position
+  // (changed); per vertex wide at the start, the index of its kept costs in kept_costs_ (-1:
+  // none). for_each_cost reads and fills them: a kept cost stands while neither end changed since.
+  std::vector<uint32_t> changed_at_;
+  uint32_t clock_ = 0;
+  std::vector<int32_t> kept_costs_of_;
+  mutable std::vector<CostCache> kept_costs_;
   std::vector<uint8_t> alive_face_, dirty_, placed_;
   std::vector<int32_t> merged_into_, target_;
   IndexedHeap heap_;
