@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Vertices of very high valence (issue 39, "no slow corner"): decimation time on fans of
-slivers around one vertex, next to another build of the engine in the same run.
+slivers around one vertex, next to another build of the engine in the same run (this one is
+TOPSTOC_BUILD's, else build/).
 
     /usr/bin/python3 tests/bench/bench_high_valence.py
     /usr/bin/python3 tests/bench/bench_high_valence.py --baseline /tmp/main-build/python \\
@@ -86,7 +87,7 @@ def main() -> int:
     parser.add_argument("--json", metavar="FILE", help="write the figures and the machine here")
     args = parser.parse_args()
     modes = args.modes.split(",")
-    ours = str(ROOT / "build" / "python")
+    ours = str(pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build")) / "python")
     print(f"machine: {machine()}")
     rows = []
     for shape, size in CASES:
