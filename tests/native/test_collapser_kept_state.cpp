@@ -10,6 +10,7 @@
 
 #include "decimate/collapser.hpp"
 #include "collapse_setup.hpp"
+#include "core/portable.hpp"
 #include "meshes.hpp"
 
 using topstoc::Collapser;
@@ -22,7 +23,7 @@ topstoc_test::Arrays fan_lens(int32_t k, std::mt19937& random) {
   std::uniform_real_distribution<double> jitter(0.85, 1.0);
   topstoc_test::Arrays mesh;
   for (int32_t i = 0; i < k; ++i) {
-    const double a = 2.0 * M_PI * i / k, r = 0.9 * jitter(random);
+    const double a = 2.0 * topstoc::kPi * i / k, r = 0.9 * jitter(random);
     mesh.positions.insert(mesh.positions.end(), {r * std::cos(a), r * std::sin(a), 0.0});
   }
   mesh.positions.insert(mesh.positions.end(), {0.0, 0.0, 0.0, 0.0, 0.0, -0.6});
