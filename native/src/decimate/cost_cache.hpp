@@ -63,7 +63,7 @@ class CostCache {
     for (const Entry& e : old) live += e.vertex >= 0 && alive(e.vertex);
     size_t size = 64;
     shift_ = 58;
-    while (size < 4 * (live + 1)) size *= 2, --shift_;
+    while (size < 3 * (live + 1)) size *= 2, --shift_;  // a third full at most: room to grow
     slots_.assign(size, Entry());
     used_ = 0;
     for (const Entry& e : old)
