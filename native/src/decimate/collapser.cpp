@@ -360,8 +360,7 @@ bool Collapser::thin(int32_t t, double min_shape) const {
   if (min_shape <= 0.0) return false;
   double n[3];
   const int32_t* c = &(*tri_)[3 * size_t(t)];
-  normal(c, c[0], position(c[0]), n);
-  return shape(c, c[0], position(c[0]), std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])) < min_shape;
+  return shape(c, c[0], position(c[0]), std::sqrt(face_normal2(t, n))) < min_shape;
 }
 
 std::vector<int32_t> Collapser::zero_area_face_list() const {
@@ -380,8 +379,7 @@ bool Collapser::place(int32_t v, const double* world, int32_t face) {
   double* w = &s_.world[3 * size_t(v)];
   double keep_p[3], keep_w[3];
   for (int i = 0; i < 3; ++i) keep_p[i] = p[i], keep_w[i] = w[i], p[i] = at[i], w[i] = world[i];
-  changed(v);
-  if (!zero_area(face)) return moved_floor_bounds(v), true;
+  if (!zero_area(face)) return changed(v), moved_floor_bounds(v), true;
   for (int i = 0; i < 3; ++i) p[i] = keep_p[i], w[i] = keep_w[i];  // no gain: back
   return false;
 }
@@ -918,8 +916,7 @@ double Collapser::shape_floor2(int32_t v) const {
 double Collapser::shape2(int32_t t) const {
   const int32_t* c = &(*tri_)[3 * size_t(t)];
   double n[3];
-  normal(c, c[0], position(c[0]), n);
-  const double area2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2], edges = squared_edges(c, c[0], position(c[0]));
+  const double area2 = face_normal2(t, n), edges = squared_edges(c, c[0], position(c[0]));
   return area2 > 0.0 && edges > 0.0 ? 12.0 * area2 / (edges * edges) : std::numeric_limits<double>::infinity();
 }
 
