@@ -68,6 +68,7 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
     kept_costs_of_.assign(n, -1);
     for (int32_t v = 0; v < n; ++v)
       if (size_[v] > kWideFan) kept_costs_of_[v] = int32_t(kept_costs_.size()), kept_costs_.emplace_back();
+    beside_.assign(kept_costs_.size(), 0);
   }
   dirty_.assign(n, 0);
   placed_.assign(n, 0);
@@ -499,6 +500,7 @@ int32_t Collapser::run(Stop target, const BeforeTail& before_tail) {
     in_tail = in_tail || size != batch_size(INT32_MAX);
     last_size = size;
     take_batch(batch, size);
+    ++batches_;
     const uint32_t ring = ++ring_stamp_;
     reserve_batch(batch, ring);
     check_reserved(batch);
@@ -642,23 +644,47 @@ void Collapser::settle_survivors(const Batch& batch, uint32_t ring) {
     settle(v, best);
     for (int32_t k = start; k < i; ++k) {
       const int32_t x = batch.pair_to[k];
-      if (settled_[x] != ring) offer(x, v, merged_from_[v], batch.pair_cost_to[k]);
+      if (settled_[x] == ring) continue;
+      // A wide neighbour whose checks all failed looks again with its checks, once a batch: were it
+      // queued unchecked, a flat fan's centre (cost 0) topped the queue again after every batch
+      // and, reserving its whole rim, emptied the next one.
+      if (target_[x] < 0 && size_[x] > kWideFan && queues(x)) {
+        update(x, true);
+        settled_[x] = ring;
+        continue;
+      }
+      offer(x, v, merged_from_[v], batch.pair_cost_to[k]);
     }
     start = i;
   }
 }
 
-// Marks u, v and their neighbours for this batch; false (nothing marked) if any already is.
+// Marks u, v and their neighbours for this batch; false (nothing marked) if any already is. A
+// wide vertex beside the edge (a fan's centre) may be beside several collapses of a batch: their
+// checks and costs read its position, which none of them moves, and none of its own state (its
+// rim's collapses had gone one per batch: a fanned cap of 69,444 took 70,000 batches).
 bool Collapser::mark_ring(int32_t u, int32_t v, uint32_t ring) {
-  for (int32_t w : {u, v})
-    if (waiting_[w] == ring) return false;
+  auto beside = [&](int32_t w) {
+    const int32_t slot = kept_costs_of_.empty() ? -1 : kept_costs_of_[w];
+    return slot >= 0 && size_[w] > kWideFan && w != u && w != v ? slot : -1;
+  };
+  for (int32_t w : {u, v}) {
+    const int32_t slot = kept_costs_of_.empty() ? -1 : kept_costs_of_[w];
+    if (waiting_[w] == ring || (slot >= 0 && beside_[slot] == ring)) return false;
+  }
   for (int32_t w : {u, v})
     for (const int32_t* t = faces_begin(w); t != faces_end(w); ++t)
       for (int j = 0; j < 3; ++j)
         if (waiting_[(*tri_)[3 * size_t(*t) + j]] == ring) return false;
   for (int32_t w : {u, v})
     for (const int32_t* t = faces_begin(w); t != faces_end(w); ++t)
-      for (int j = 0; j < 3; ++j) waiting_[(*tri_)[3 * size_t(*t) + j]] = ring;
+      for (int j = 0; j < 3; ++j) {
+        const int32_t x = (*tri_)[3 * size_t(*t) + j];
+        if (const int32_t slot = beside(x); slot >= 0)
+          beside_[slot] = ring;
+        else
+          waiting_[x] = ring;
+      }
   return true;
 }
 
@@ -944,6 +970,10 @@ void Collapser::moved_floor_bounds(int32_t v) {
 // Do the triangles of `moved` that do not hold `other` keep their side and some area when
 // `moved` stands at x (other = -1: all of them)?
 bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const {
+  // A wide vertex that stays where it is leaves its other triangles as they were (a half-edge
+  // collapse onto a fan's centre: the walk compared each of its triangles with itself).
+  if (const double* p = position(moved); size_[moved] > kWideFan && x[0] == p[0] && x[1] == p[1] && x[2] == p[2])
+    return true;
   if (other >= 0 && size_[moved] > kWideFan && !beside_edge_keep_shape(moved, other, x, floor)) return false;
   for (const int32_t* t = faces_begin(moved); t != faces_end(moved); ++t)
     if ((other < 0 || !has(*t, other)) && !keeps_face_shape(*t, moved, x, floor)) return false;

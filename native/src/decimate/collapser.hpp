@@ -153,6 +153,8 @@ class Collapser {
   /// guidance weight): how far the result lies from the input planes it stands for.
   double quadric_error() const;
   int32_t live_vertices() const { return alive_vertices_; }
+  /// Batches run() has taken so far (its collapses were reserved, checked and costed together).
+  int64_t batches() const { return batches_; }
   /// The triangles as the collapses renamed them (dead ones included: see face_alive).
   const std::vector<int32_t>& triangles() const { return *tri_; }
   /// The corner sources as the collapses renamed the corners.
@@ -332,8 +334,10 @@ class Collapser {
   IndexedHeap heap_;
   std::vector<int32_t> merged_from_;  // per survivor: the vertex its last collapse removed
   std::vector<uint32_t> waiting_;      // per vertex: the batch whose collapses touched it
+  std::vector<uint32_t> beside_;       // per slot of kept_costs_: the batch whose collapses passed beside it
   std::vector<uint32_t> settled_;      // per vertex: the batch that evaluated it anew
   uint32_t ring_stamp_ = 0;
+  int64_t batches_ = 0;
   PerThread<Scratch> scratch_{0};  // one per thread, each on its own cache lines
   std::vector<int32_t> options_, star_, moved_faces_;
 };
