@@ -25,6 +25,14 @@ constexpr int64_t kFitTriangles = 200000;
 // many closest-point queries each way (the bracket stays valid when they run out).
 constexpr double kMaxTolerance = 1e-2;
 constexpr int64_t kMaxQueries = 2000000;
+// The fit's brackets together: at most this many closest-point queries per input triangle (and
+// kFitQueriesFloor in any case), every kTestedPerQuery triangles the queries measured counting as
+// one more (a query among a fan's slivers measures hundreds); then no further move is tried, and a
+// side of one bracket has half of them at most. The fits of the test meshes took 2-51 a triangle
+// (Suzanne at 10 %: 159); fans of slivers 400-3,700 (a cylinder of 256 segments with fanned
+// caps, 2,560 triangles, at 10 %: 21 brackets, 9.5M, 10 s).
+constexpr int64_t kFitQueriesPerTriangle = 300;
+constexpr int64_t kFitQueriesFloor = 100000;
 // A result whose pairs all lie this close to the input (normalised coordinates) lies on it:
 // nothing to fit, and the max's bracket could not settle on surfaces that coincide.
 constexpr double kOnTheInput = 1e-9;
@@ -104,6 +112,13 @@ class Fit {
 
   bool empty() const { return free_.empty() || faces_.empty() || points_.empty(); }
 
+  // The fit's queries (kFitQueriesPerTriangle), and whether its brackets so far spent them.
+  int64_t query_budget() const {
+    return std::max(kFitQueriesFloor, kFitQueriesPerTriangle * int64_t(input_->num_triangles()));
+  }
+  bool spent() const { return queries_ > query_budget(); }
+  int64_t queries() const { return queries_; }
+
   // A bracket on the symmetric Hausdorff max between the result and (the fitted part of) the
   // input, over every point of both surfaces: the pairs only sample it, and a round that lowers
   // their mean can still lift the surface away between the samples.
@@ -128,7 +143,9 @@ class Fit {
                         bool result_passed = false) {
     const Surface result(std::move(at), live_faces_);
     MaxBracket there, back;
-    const int64_t budget = lean ? kLargeQueriesPerFace * int64_t(faces_.size() / 3) : kMaxQueries;
+    // (a side of a full bracket: half the fit's queries at most)
+    const int64_t budget =
+        lean ? kLargeQueriesPerFace * int64_t(faces_.size() / 3) : std::min(kMaxQueries, query_budget() / 2);
     // lean: only the result triangles the last apply moved (the others stood where the max
     // before the move was measured, and a far point there only raised the threshold again).
     auto measure_there = [&] {
@@ -159,6 +176,7 @@ class Fit {
       const FreeCoresNow team;
       parallel_invoke(true, measure_there, measure_back);
     }
+    queries_ += there.queries + back.queries + (there.tested + back.tested) / kTestedPerQuery;
     const MaxBracket& far = there.lower >= back.lower ? there : back;
     Bracket b{far.lower, std::max(there.upper, back.upper), result.bvh().closest(far.lower_point, -1).triangle,
               {0, 0, 0}, there.converged && back.converged, &far == &there};
@@ -501,6 +519,7 @@ class Fit {
   bool large_ = false;         // above kFitFaces triangles (solve_sparse, lean max walks)
   std::vector<int32_t> far_faces_;  // input_side's far points' result triangles
   std::vector<int32_t> moved_faces_;  // result triangles with a corner the last apply moved
+  int64_t queries_ = 0;               // closest-point queries of the brackets so far
 };
 
 }  // namespace
@@ -516,8 +535,9 @@ namespace {
 // the max falls for a mean squared distance at most kBackOffMean higher (lilium at 2 %: a
 // round that lowered the max moved another vertex out to be the new far one).
 void back_off(Fit& fit, const std::vector<double>& start, Fit::Error& error) {
+  if (fit.spent()) return;
   Fit::Bracket now = fit.symmetric_max(fit.positions());
-  for (int32_t tries = 0; tries < kHoldTries; ++tries) {
+  for (int32_t tries = 0; tries < kHoldTries && !fit.spent(); ++tries) {
     if (!fit.move_back(fit.nearest_corner(now.face, now.point), start, 0.5)) return;
     const auto next = fit.pair_up();
     if (next.mean2 <= kBackOffMean * error.mean2 && !(fit.symmetric_max(fit.positions(), now.lower).lower > now.lower)) {
@@ -604,6 +624,7 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool bo
   // The last round's moves need only be judged against the max (no later round compares with
   // theirs): its bracket decides only whether the max grew.
   auto kept = [&](double step, bool last) {
+    if (fit.spent()) return false;
     fit.release();
     for (int32_t tries = 0; tries < kHoldTries; ++tries) {
       if (fit.apply(fit.toward(x, step)) == 0) return false;
@@ -616,6 +637,7 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool bo
         return true;
       }
       fit.undo();
+      if (fit.spent()) return false;
       fit.hold(next_max.face);
     }
     fit.undo();
@@ -634,6 +656,7 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool bo
     back_off(fit, start, error);
     out.after2 = error.mean2;
   }
+  out.queries = fit.queries();
   return out;
 }
 

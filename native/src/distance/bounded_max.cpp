@@ -31,9 +31,6 @@ constexpr double kSettleSpan = 2.5;
 // A piece's quarters: of its corners 0, 1, 2 and its edges' midpoints 3 = (0,1), 4 = (1,2), 5 = (2,0).
 constexpr int kQuarters[4][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {3, 4, 5}};
 constexpr double kNoBound = std::numeric_limits<double>::infinity();
-// Triangles a lookup measures on average, as the budget counts them (11-13 on fandisk and the
-// Chinese dragon; 334 on a flat fan of 1,500 slivers).
-constexpr int64_t kTestedPerQuery = 16;
 
 struct Piece {
   double p[3][3];     // corners
@@ -100,6 +97,7 @@ class MaxSearch {
     }
     out.converged = open.empty() || tolerated(open.top().upper);
     out.upper = std::max({out.lower, settled, open.empty() ? 0.0 : open.top().upper});
+    out.tested = tested;
     return out;
   }
 
@@ -152,6 +150,7 @@ class MaxSearch {
     }
     out.converged = top < 0.0 || tolerated(top);
     out.upper = std::max({out.lower, settled, top});
+    out.tested = tested;
     return out;
   }
 
