@@ -9,8 +9,9 @@ TOPSTOC_BUILD's, else build/).
 
 The family: a double cone (two apexes joined to a rim of n vertices, 2n triangles, closed genus
 0) at n = 10,000 to 80,000; and what an artist meets: a UV sphere of 2,000 segments
-(poles of valence 2,000), a disc fanned from one centre of valence 50,000 (open boundary) and a
-CAD-like cylinder of 5,000 segments whose caps are fans. Each mesh is decimated to 10 % of its
+(poles of valence 2,000), a disc fanned from one centre of valence 50,000 (open boundary) and
+CAD-like cylinders of 128 to 5,000 segments whose caps are fans (at 10 % those of 128 and 256
+segments are fitted in four rounds, that of 1,000 in one: tiny_fit.cpp). Each mesh is decimated to 10 % of its
 vertices in each mode of --modes, seed 0, in a fresh process per build with TOPSTOC_NUM_THREADS=1; the time
 is decimate() alone (the Mesh is prepared before the clock starts), the best of --repeat runs.
 --baseline runs the same in a process importing topstoc from that folder (main's build: the
@@ -31,7 +32,8 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from machine import machine, save_figures  # noqa: E402
 
 CASES = [("cone", 10000), ("cone", 20000), ("cone", 40000), ("cone", 80000), ("uv_sphere", 2000),
-         ("fan_disc", 50000), ("cylinder_caps", 5000)]
+         ("fan_disc", 50000), ("cylinder_caps", 128), ("cylinder_caps", 256), ("cylinder_caps", 1000),
+         ("cylinder_caps", 5000)]
 
 CHILD = r"""
 import json, sys, time
