@@ -253,7 +253,7 @@ void Collapser::queue(int32_t u, int32_t v, double c) {
 // vertices).
 template <class Fn>
 void Collapser::for_each_cost(int32_t u, const std::vector<int32_t>& around, const Fn& fn) const {
-  const int32_t slot = kept_costs_of_.empty() ? -1 : kept_costs_of_[u];
+  const int32_t slot = kept_slot(u);
   if (slot < 0) {
     for (int32_t v : around) fn(v, cost(u, v));
     return;
@@ -500,7 +500,6 @@ int32_t Collapser::run(Stop target, const BeforeTail& before_tail) {
     in_tail = in_tail || size != batch_size(INT32_MAX);
     last_size = size;
     take_batch(batch, size);
-    ++batches_;
     const uint32_t ring = ++ring_stamp_;
     reserve_batch(batch, ring);
     check_reserved(batch);
@@ -665,13 +664,11 @@ void Collapser::settle_survivors(const Batch& batch, uint32_t ring) {
 // rim's collapses had gone one per batch: a fanned cap of 69,444 took 70,000 batches).
 bool Collapser::mark_ring(int32_t u, int32_t v, uint32_t ring) {
   auto beside = [&](int32_t w) {
-    const int32_t slot = kept_costs_of_.empty() ? -1 : kept_costs_of_[w];
+    const int32_t slot = kept_slot(w);
     return slot >= 0 && size_[w] > kWideFan && w != u && w != v ? slot : -1;
   };
-  for (int32_t w : {u, v}) {
-    const int32_t slot = kept_costs_of_.empty() ? -1 : kept_costs_of_[w];
-    if (waiting_[w] == ring || (slot >= 0 && beside_[slot] == ring)) return false;
-  }
+  for (int32_t w : {u, v})
+    if (const int32_t slot = kept_slot(w); waiting_[w] == ring || (slot >= 0 && beside_[slot] == ring)) return false;
   for (int32_t w : {u, v})
     for (const int32_t* t = faces_begin(w); t != faces_end(w); ++t)
       for (int j = 0; j < 3; ++j)

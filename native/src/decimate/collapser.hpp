@@ -154,7 +154,7 @@ class Collapser {
   double quadric_error() const;
   int32_t live_vertices() const { return alive_vertices_; }
   /// Batches run() has taken so far (its collapses were reserved, checked and costed together).
-  int64_t batches() const { return batches_; }
+  int64_t batches() const { return ring_stamp_; }
   /// The triangles as the collapses renamed them (dead ones included: see face_alive).
   const std::vector<int32_t>& triangles() const { return *tri_; }
   /// The corner sources as the collapses renamed the corners.
@@ -329,6 +329,7 @@ class Collapser {
   uint32_t clock_ = 0;
   std::vector<int32_t> kept_costs_of_;
   mutable std::vector<CostCache> kept_costs_;
+  int32_t kept_slot(int32_t v) const { return kept_costs_of_.empty() ? -1 : kept_costs_of_[v]; }
   std::vector<uint8_t> alive_face_, dirty_, placed_;
   std::vector<int32_t> merged_into_, target_;
   IndexedHeap heap_;
@@ -336,8 +337,7 @@ class Collapser {
   std::vector<uint32_t> waiting_;      // per vertex: the batch whose collapses touched it
   std::vector<uint32_t> beside_;       // per slot of kept_costs_: the batch whose collapses passed beside it
   std::vector<uint32_t> settled_;      // per vertex: the batch that evaluated it anew
-  uint32_t ring_stamp_ = 0;
-  int64_t batches_ = 0;
+  uint32_t ring_stamp_ = 0;  // one per batch run() took
   PerThread<Scratch> scratch_{0};  // one per thread, each on its own cache lines
   std::vector<int32_t> options_, star_, moved_faces_;
 };

@@ -28,7 +28,7 @@ struct TinyFit {
   int32_t rounds = 0;        ///< rounds kept (each lowered the error)
   double before2 = 0.0;      ///< mean squared distance, both ways, before the first round
   double after2 = 0.0;       ///< and after the last kept one
-  int64_t queries = 0;       ///< closest-point queries of its brackets (a round's share of them)
+  int64_t queries = 0;       ///< closest-point queries of its brackets (kTestedPerQuery triangles measured count as one)
 };
 
 /// The step between the input triangles the fit measures against (1: all of them): at most
