@@ -1,6 +1,8 @@
-// The tiny fit's brackets stop at their query budget (tiny_fit.cpp kFitQueriesPerTriangle): on
-// a cylinder with fanned caps, whose slivers made each bracket cost hundreds of queries a
-// triangle, the fit of a 252-triangle result had taken 9.5M queries for 2,560 input triangles.
+// The tiny fit's brackets stop at their query budgets (tiny_fit.cpp kFitQueriesPerTriangle for
+// the whole fit, kSideQueriesPerTriangle for one side of one bracket): on a cylinder with fanned
+// caps, whose slivers made each bracket cost hundreds of queries a triangle, the fit of a
+// 252-triangle result had taken 9.5M queries for 2,560 input triangles, and each side of a
+// bracket on one of 2,000 segments ran to 2M queries (32M triangles measured) unconverged.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -41,10 +43,9 @@ topstoc_test::Arrays fanned_cylinder(int32_t segments, int32_t rows) {
   return a;
 }
 
-}  // namespace
-
-TEST_CASE("the fit of a fan of slivers stops at its query budget") {
-  const auto arrays = fanned_cylinder(256, 4);
+// The fit of a fanned cylinder's decimation to `faces` triangles.
+topstoc::TinyFit fit_cylinder(int32_t segments, int32_t faces) {
+  const auto arrays = fanned_cylinder(segments, 4);
   const int64_t m = arrays.num_triangles();
   const topstoc::Mesh mesh(arrays.positions, arrays.triangles.data(), m);
   // The collapser on the mesh's own numbering, in coordinates that need no normalising.
@@ -54,13 +55,29 @@ TEST_CASE("the fit of a fan of slivers stops at its query budget") {
   std::vector<int32_t> triangles = own.triangles, corners(triangles.size());
   for (size_t i = 0; i < corners.size(); ++i) corners[i] = int32_t(i);
   topstoc::Collapser collapser(triangles, corners, topstoc_test::torus_setup(own));
-  collapser.run({0, 252});
+  collapser.run({0, faces});
   REQUIRE(collapser.live_faces() <= 400);
   const topstoc::Surface input(own.positions, own.triangles);
-  const topstoc::TinyFit fit = topstoc::fit_tiny(mesh, collapser, 4, true, input, -1.0);
+  return topstoc::fit_tiny(mesh, collapser, 4, true, input, -1.0);
+}
+
+}  // namespace
+
+TEST_CASE("the fit of a fan of slivers stops at its query budget") {
+  const topstoc::TinyFit fit = fit_cylinder(256, 252);
   // The budget is checked before each bracket, and a bracket's two sides take it at most.
-  const int64_t budget = 300 * m;
+  const int64_t budget = 300 * 2560;
   CHECK(fit.queries > 0);
   CHECK(fit.queries <= 2 * budget);
+  CHECK(fit.after2 <= fit.before2);
+}
+
+TEST_CASE("one side of a fit's bracket among slivers stops at its own budget") {
+  const topstoc::TinyFit fit = fit_cylinder(2000, 196);
+  // A side: at most 8 queries per input triangle (20,000 here) and 16 times that many triangles
+  // measured (counted one query per 16), the last query's triangles past it at most.
+  const int64_t side = 8 * 20000, slack = 20000 / 16;
+  REQUIRE(fit.brackets > 0);
+  CHECK(fit.queries <= int64_t(fit.brackets) * 2 * (2 * side + slack));
   CHECK(fit.after2 <= fit.before2);
 }

@@ -27,12 +27,15 @@ constexpr double kMaxTolerance = 1e-2;
 constexpr int64_t kMaxQueries = 2000000;
 // The fit's brackets together: at most this many closest-point queries per input triangle (and
 // kFitQueriesFloor in any case), every kTestedPerQuery triangles the queries measured counting as
-// one more (a query among a fan's slivers measures hundreds); then no further move is tried, and a
-// side of one bracket has half of them at most. The fits of the test meshes took 2-51 a triangle
-// (Suzanne at 10 %: 159); fans of slivers 400-3,700 (a cylinder of 256 segments with fanned
-// caps, 2,560 triangles, at 10 %: 21 brackets, 9.5M, 10 s).
+// one more (a query among a fan's slivers measures hundreds); then no further move is tried. The
+// fits of the test meshes took 2-51 a triangle (Suzanne at 10 %: 159); fans of slivers 400-3,700
+// (a cylinder of 256 segments with fanned caps, 2,560 triangles, at 10 %: 21 brackets, 9.5M, 10 s).
 constexpr int64_t kFitQueriesPerTriangle = 300;
 constexpr int64_t kFitQueriesFloor = 100000;
+// One side of one bracket: at most this many per input triangle (kFitQueriesFloor / 2 in any
+// case). The test meshes' sides took up to 4 (50 triangles measured); a fan's ran out at 2M
+// queries or 32M triangles measured, unconverged, its upper bound hundreds of times its lower.
+constexpr int64_t kSideQueriesPerTriangle = 8;
 // A result whose pairs all lie this close to the input (normalised coordinates) lies on it:
 // nothing to fit, and the max's bracket could not settle on surfaces that coincide.
 constexpr double kOnTheInput = 1e-9;
@@ -117,7 +120,13 @@ class Fit {
     return std::max(kFitQueriesFloor, kFitQueriesPerTriangle * int64_t(input_->num_triangles()));
   }
   bool spent() const { return queries_ > query_budget(); }
+  // One side of a full bracket (kSideQueriesPerTriangle), within half the fit's queries.
+  int64_t side_budget() const {
+    const int64_t side = std::max(kFitQueriesFloor / 2, kSideQueriesPerTriangle * int64_t(input_->num_triangles()));
+    return std::min({kMaxQueries, query_budget() / 2, side});
+  }
   int64_t queries() const { return queries_; }
+  int32_t brackets() const { return brackets_; }
 
   // A bracket on the symmetric Hausdorff max between the result and (the fitted part of) the
   // input, over every point of both surfaces: the pairs only sample it, and a round that lowers
@@ -143,9 +152,7 @@ class Fit {
                         bool result_passed = false) {
     const Surface result(std::move(at), live_faces_);
     MaxBracket there, back;
-    // (a side of a full bracket: half the fit's queries at most)
-    const int64_t budget =
-        lean ? kLargeQueriesPerFace * int64_t(faces_.size() / 3) : std::min(kMaxQueries, query_budget() / 2);
+    const int64_t budget = lean ? kLargeQueriesPerFace * int64_t(faces_.size() / 3) : side_budget();
     // lean: only the result triangles the last apply moved (the others stood where the max
     // before the move was measured, and a far point there only raised the threshold again).
     auto measure_there = [&] {
@@ -177,6 +184,7 @@ class Fit {
       parallel_invoke(true, measure_there, measure_back);
     }
     queries_ += there.queries + back.queries + (there.tested + back.tested) / kTestedPerQuery;
+    ++brackets_;
     const MaxBracket& far = there.lower >= back.lower ? there : back;
     Bracket b{far.lower, std::max(there.upper, back.upper), result.bvh().closest(far.lower_point, -1).triangle,
               {0, 0, 0}, there.converged && back.converged, &far == &there};
@@ -520,6 +528,7 @@ class Fit {
   std::vector<int32_t> far_faces_;  // input_side's far points' result triangles
   std::vector<int32_t> moved_faces_;  // result triangles with a corner the last apply moved
   int64_t queries_ = 0;               // closest-point queries of the brackets so far
+  int32_t brackets_ = 0;              // symmetric_max calls so far
 };
 
 }  // namespace
@@ -598,6 +607,13 @@ TinyFit fit_large(Fit& fit, const Fit::Error& error, double known_max) {
   return out;
 }
 
+// What a move's max may reach: the bracket's upper bound, or where a side ran out of queries (a
+// fan's slivers: the upper then hundreds of times the lower, and no move refused) the farthest
+// point found, within the brackets' tolerance.
+double ceiling(const Fit::Bracket& max) {
+  return max.converged ? max.upper : std::min(max.upper, (1.0 + kMaxTolerance) * max.lower);
+}
+
 }  // namespace
 
 TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool boundaries, const Surface& input,
@@ -630,7 +646,7 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool bo
       if (fit.apply(fit.toward(x, step)) == 0) return false;
       const auto next = fit.pair_up();
       if (!(next.mean2 < error.mean2 && next.top2 <= error.top2)) break;
-      const double upper = max_so_far().upper;
+      const double upper = ceiling(max_so_far());
       const auto next_max = fit.symmetric_max(fit.positions(), last ? upper : -1.0);
       if (next_max.lower <= upper) {
         error = next, max = next_max;
@@ -657,6 +673,7 @@ TinyFit fit_tiny(const Mesh& mesh, Collapser& collapser, int32_t rounds, bool bo
     out.after2 = error.mean2;
   }
   out.queries = fit.queries();
+  out.brackets = fit.brackets();
   return out;
 }
 

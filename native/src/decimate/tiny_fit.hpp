@@ -29,6 +29,7 @@ struct TinyFit {
   double before2 = 0.0;      ///< mean squared distance, both ways, before the first round
   double after2 = 0.0;       ///< and after the last kept one
   int64_t queries = 0;       ///< closest-point queries of its brackets (kTestedPerQuery triangles measured count as one)
+  int32_t brackets = 0;      ///< brackets of the symmetric max it measured (each two sides)
 };
 
 /// The step between the input triangles the fit measures against (1: all of them): at most
