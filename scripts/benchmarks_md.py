@@ -244,7 +244,8 @@ def render_high_valence(name: str, figures: dict) -> str:
     out = [f"## Vertices of high valence: fans of slivers (`{name}`)", "",
            f"`{figures['benchmark']}` at {percent(figures['ratio'])} of the vertices, one thread; the baseline is "
            "another build (main's) in the same run.", "", *source_lines(figures), "",
-           "| Mesh | Size | Triangles | Mode | Ours | Baseline | Baseline ÷ ours |", "|---|---|---|---|---|---|---|"]
+           "| Mesh | Size | Triangles | Mode | Ours | Baseline | Baseline ÷ ours | Error mean, max: ours | Baseline's |",
+           "|---|---|---|---|---|---|---|---|---|"]
     limit = f"over {figures['limit_s']:.0f} s"
     for row in figures["meshes"]:
         ours, base = row["ours"], row.get("baseline")
@@ -253,8 +254,17 @@ def render_high_valence(name: str, figures: dict) -> str:
             theirs = base[mode]["seconds"] if base else None
             out.append(f"| {row['shape']} | {row['size']:,} | {ours['triangles'] if ours else 2 * row['size']:,} | {mode} "
                        f"| {limit if mine is None else ms(1000 * mine)} | {limit if theirs is None else ms(1000 * theirs)} "
-                       f"| {'—' if mine is None or theirs is None else times(theirs, mine)} |")
+                       f"| {'—' if mine is None or theirs is None else times(theirs, mine)} "
+                       f"| {fan_error(ours, mode)} | {fan_error(base, mode)} |")
     return "\n".join(out) + "\n"
+
+
+def fan_error(run: dict | None, mode: str) -> str:
+    """A bench_high_valence.py result's Hausdorff mean and max (% of the diagonal), where measured."""
+    figures = run.get(mode, {}) if run else {}
+    if "error_mean" not in figures:
+        return "—"
+    return f"{figures['error_mean']:.3g} %, {figures['error_max']:.3g} %"
 
 
 def render_blender_memory(name: str, figures: dict) -> str:
