@@ -126,3 +126,51 @@ TEST_CASE("BVH over a fan of slivers (slabs): the brute-force minimum at points 
   }
   CHECK(exact_zero > 50);  // the vertices: many triangles at distance 0, the lowest id wins
 }
+
+TEST_CASE("BVH over a flat fanned disc (cones): the brute-force minimum at points on and off it") {
+  // A disc of 4,000 slivers from one centre: the slabs are the disc's plane, so only the sectors'
+  // cones prune in it. Points on its faces, edges and vertices, just off it and far: the closest
+  // distance and the lowest-id triangle at it, whatever the hint (the counted lookup, without the
+  // cones, the same).
+  const int32_t n = 4000;
+  std::vector<double> positions;
+  std::vector<int32_t> triangles;
+  for (int32_t i = 0; i < n; ++i) {
+    const double a = 2 * 3.141592653589793 * i / n;
+    positions.insert(positions.end(), {3.0 + std::cos(a), -2.0 + std::sin(a), 0.5});
+    triangles.insert(triangles.end(), {i, (i + 1) % n, n});
+  }
+  positions.insert(positions.end(), {3.0, -2.0, 0.5});
+  const TriangleBvh bvh(positions.data(), triangles.data(), n);
+  CHECK(bvh.has_slabs());
+  std::mt19937 random(29);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto corner = [&](int32_t t, int c) { return &positions[3 * size_t(triangles[3 * size_t(t) + c])]; };
+  int32_t hint = -1;
+  int64_t tested = 0;
+  for (int probe = 0; probe < 600; ++probe) {
+    const int32_t t = int32_t(random() % n);
+    double p[3], w[3] = {unit(random), unit(random), unit(random)};
+    const int kind = probe % 6;
+    if (kind == 1) w[2] = 0.0;         // on an edge
+    if (kind == 2) w[1] = w[2] = 0.0;  // at a vertex
+    const double sum = w[0] + w[1] + w[2];
+    for (int k = 0; k < 3; ++k) p[k] = (w[0] * corner(t, 0)[k] + w[1] * corner(t, 1)[k] + w[2] * corner(t, 2)[k]) / sum;
+    const double scale = kind == 3 ? 1e-6 : kind == 4 ? 0.05 : kind == 5 ? 3.0 : 0.0;  // off the disc
+    for (int k = 0; k < 3; ++k) p[k] += scale * (unit(random) - 0.5);
+    double best = 1e300;
+    int32_t best_triangle = -1;
+    for (int32_t f = 0; f < n; ++f) {
+      double q[3];
+      const double d2 = closest_point_on_triangle(p, corner(f, 0), corner(f, 1), corner(f, 2), q);
+      if (d2 < best) best = d2, best_triangle = f;
+    }
+    const auto hit = bvh.closest(p, hint);
+    CHECK(hit.distance2 == best);
+    CHECK(hit.triangle == best_triangle);
+    const auto counted = bvh.closest_counted(p, -1, tested);
+    CHECK(counted.triangle == best_triangle);
+    hint = int32_t(random() % n);
+  }
+  CHECK(tested > 0);
+}

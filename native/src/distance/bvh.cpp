@@ -164,14 +164,35 @@ TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int6
   build_slabs();
 }
 
+// The distance from p to the slab's cone (apex, axis, half-angle a < 90 degrees), 0 or less
+// inside: with v = p - apex at angle f to the axis, |v| sin(f - a), or |v| where f - a passes 90
+// degrees (the apex is then the nearest point), less a margin for rounding.
+inline double TriangleBvh::cone_gap(const double* p, const Slab& slab) {
+  const double v[3] = {p[0] - slab.apex[0], p[1] - slab.apex[1], p[2] - slab.apex[2]};
+  const double* a = slab.axis;
+  const double along = a[0] * v[0] + a[1] * v[1] + a[2] * v[2];
+  const double cross[3] = {a[1] * v[2] - a[2] * v[1], a[2] * v[0] - a[0] * v[2], a[0] * v[1] - a[1] * v[0]};
+  const double across = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+  const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  const double sine = across * slab.cos_half - along * slab.sin_half;  // |v| sin(f - a)
+  if (!(sine > 0.0)) return 0.0;
+  const double cosine = along * slab.cos_half + across * slab.sin_half;  // |v| cos(f - a)
+  const double margin = 1e-9 * length + 1e-12 * (std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]) +
+                                                 std::abs(slab.apex[0]) + std::abs(slab.apex[1]) + std::abs(slab.apex[2]));
+  return (cosine < 0.0 ? length : sine) - margin;
+}
+
 // The squared distance from p to the node's slab (0 inside), less a margin for the rounding of
-// the dot products (relative 1e-12, as kPruneSlack): a lower bound of the distance to its triangles.
-inline double TriangleBvh::slab_distance2(const double* p, int32_t node) const {
+// the dot products (relative 1e-12, as kPruneSlack), or with `cones` to its cone where larger: a
+// lower bound of the distance to its triangles.
+inline double TriangleBvh::slab_distance2(const double* p, int32_t node, bool cones) const {
   const Slab& slab = slabs_[size_t(node)];
   const double d = slab.normal[0] * p[0] + slab.normal[1] * p[1] + slab.normal[2] * p[2];
-  const double gap = std::max(slab.lo - d, d - slab.hi) - 1e-12 * (std::abs(d) + std::abs(slab.lo) + std::abs(slab.hi));
+  double gap = std::max(slab.lo - d, d - slab.hi) - 1e-12 * (std::abs(d) + std::abs(slab.lo) + std::abs(slab.hi));
+  if (cones && slab.cos_half > -1.0) gap = std::max(gap, cone_gap(p, slab));
   return gap > 0.0 ? gap * gap : 0.0;
 }
+
 
 int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items) {
   // Median split along the longest axis of the centroids' box: a balanced tree, built in
@@ -267,13 +288,16 @@ ClosestHit TriangleBvh::search(const double* p, int32_t hint_slot, double within
   // near ones. (The answer does not depend on the order.) A query that stops `within2` keeps the
   // boxes' order, which decides the hit it stops at; the slabs only prune nodes that hold no
   // triangle as near as the best hit, so it finds the same hits.
-  const bool slabs = !slabs_.empty(), slab_order = slabs && !(within2 >= 0.0);
+  // The counted lookups (the brackets', whose budgets count the triangles measured) leave the
+  // cones out: there, fewer triangles a lookup spent the same budget on more lookups, each with
+  // its bracket's own work (a 10,000-rim cone at 1 %: 0.9 -> 1.4 s, the same result).
+  const bool slabs = !slabs_.empty(), slab_order = slabs && !(within2 >= 0.0), cones = !kCounted;
   auto bound = [&](int32_t i) {
     const double box = box_distance2(p, nodes_[i].lo, nodes_[i].hi);
-    return slab_order ? std::max(box, slab_distance2(p, i)) : box;
+    return slab_order ? std::max(box, slab_distance2(p, i, cones)) : box;
   };
   auto slab_keeps = [&](const Entry& e, double reach) {
-    return !slabs || slab_order || !(slab_distance2(p, e.node) > reach);
+    return !slabs || slab_order || !(slab_distance2(p, e.node, cones) > reach);
   };
   Entry entry{0, bound(0)};
   for (;;) {

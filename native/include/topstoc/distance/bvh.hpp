@@ -66,12 +66,20 @@ class TriangleBvh {
   /// Per node, where slivers are common (a fan's centre, a cone's apex): the node's corners lie
   /// between lo and hi along a unit normal of its triangles. The slivers' axis-aligned boxes all
   /// reach the centre and overlap; the slab is thin across them, so a query prunes the far ones.
+  /// Where every triangle of the node has a corner at `apex` (a sector of one fan), they also lie
+  /// in the circular cone from it around `axis` of half-angle acos(cos_half) < 90 degrees: a
+  /// query beside the sector prunes it even in the fan's own plane, where the slab cannot
+  /// (cos_half = -2: no such cone).
   struct Slab {
     double normal[3];
     double lo, hi;
+    double apex[3], axis[3];
+    double cos_half = -2.0, sin_half = 0.0;
   };
   void build_slabs();
-  double slab_distance2(const double* p, int32_t node) const;
+  void build_cone(Slab& slab, const double* apex, int32_t first, int32_t end) const;
+  double slab_distance2(const double* p, int32_t node, bool cones) const;
+  static double cone_gap(const double* p, const Slab& slab);
 
   std::vector<Node> nodes_;
   std::vector<Slab> slabs_;              ///< empty, or one per node
