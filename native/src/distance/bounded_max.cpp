@@ -364,8 +364,11 @@ class MaxSearch {
     if (by_quarters && !tolerated(piece.upper)) settle_cheaply(piece);
     // only a bound that settles the piece is looked for: the box searched stays small
     if (!tolerated(piece.upper) && beneath_tried_at != threshold() && worth_projecting(piece))
+    {
       piece.upper =
           std::min(piece.upper, projected_bound(piece.p, to, threshold(), kBeneathCandidates, scratch, by_quarters));
+      tested += int64_t(scratch.slots.size());
+    }
     if (!tolerated(piece.upper)) {
       centroid_near(piece);
       bound(piece);
@@ -413,6 +416,7 @@ class MaxSearch {
                             {corners[6], corners[7], corners[8]}};
     if (spanned(p) > kSettleSpan) return false;
     const double bound = projected_bound(p, to, threshold(), kBeneathCandidates, scratch);
+    tested += int64_t(scratch.slots.size());
     if (!tolerated(bound)) {
       tried_at = threshold();
       return false;
