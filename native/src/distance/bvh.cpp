@@ -193,7 +193,6 @@ inline double TriangleBvh::slab_distance2(const double* p, int32_t node, bool co
   return gap > 0.0 ? gap * gap : 0.0;
 }
 
-
 int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items) {
   // Median split along the longest axis of the centroids' box: a balanced tree, built in
   // O(m log m), that serves nearest-point queries well. Boxes come from the children, so each
@@ -290,7 +289,7 @@ ClosestHit TriangleBvh::search(const double* p, int32_t hint_slot, double within
   // triangle as near as the best hit, so it finds the same hits.
   // The counted lookups (the brackets', whose budgets count the triangles measured) leave the
   // cones out: there, fewer triangles a lookup spent the same budget on more lookups, each with
-  // its bracket's own work (a 10,000-rim cone at 1 %: 0.9 -> 1.4 s, the same result).
+  // its bracket's own work, for the same result (docs/bench_notes/high-valence.md).
   const bool slabs = !slabs_.empty(), slab_order = slabs && !(within2 >= 0.0), cones = !kCounted;
   auto bound = [&](int32_t i) {
     const double box = box_distance2(p, nodes_[i].lo, nodes_[i].hi);
