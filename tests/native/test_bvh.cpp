@@ -4,12 +4,52 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "topstoc/distance/bvh.hpp"
 
 using topstoc::closest_point_on_triangle;
 using topstoc::TriangleBvh;
+
+namespace {
+
+// A mesh as positions and vertex triples, with the points the fan tests probe it at and the
+// brute-force answer there.
+struct Indexed {
+  std::vector<double> positions;
+  std::vector<int32_t> triangles;
+
+  int32_t size() const { return int32_t(triangles.size() / 3); }
+  const double* corner(int32_t t, int c) const { return &positions[3 * size_t(triangles[3 * size_t(t) + c])]; }
+
+  // A point of triangle t inside it (kind 0), on an edge (1) or at a vertex (2), or moved off it
+  // by up to 1e-6, 0.05 or 3 (kinds 3-5).
+  void probe(std::mt19937& random, int32_t t, int kind, double p[3]) const {
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    double w[3] = {unit(random), unit(random), unit(random)};
+    if (kind == 1) w[2] = 0.0;
+    if (kind == 2) w[1] = w[2] = 0.0;
+    const double sum = w[0] + w[1] + w[2];
+    for (int k = 0; k < 3; ++k) p[k] = (w[0] * corner(t, 0)[k] + w[1] * corner(t, 1)[k] + w[2] * corner(t, 2)[k]) / sum;
+    const double scale = kind == 3 ? 1e-6 : kind == 4 ? 0.05 : kind == 5 ? 3.0 : 0.0;
+    for (int k = 0; k < 3; ++k) p[k] += scale * (unit(random) - 0.5);
+  }
+
+  // The smallest squared distance from p over every triangle, and the lowest id at it.
+  std::pair<double, int32_t> nearest(const double* p) const {
+    double best = 1e300;
+    int32_t best_triangle = -1;
+    for (int32_t f = 0; f < size(); ++f) {
+      double q[3];
+      const double d2 = closest_point_on_triangle(p, corner(f, 0), corner(f, 1), corner(f, 2), q);
+      if (d2 < best) best = d2, best_triangle = f;  // strict: the lowest id wins ties
+    }
+    return {best, best_triangle};
+  }
+};
+
+}  // namespace
 
 TEST_CASE("closest point on a triangle is no farther than any point of a dense sampling, and on it") {
   std::mt19937 random(17);
@@ -78,40 +118,24 @@ TEST_CASE("BVH over a fan of slivers (slabs): the brute-force minimum at points 
   // orders and prunes by its slabs) and points on its faces, its edges, its vertices, off it
   // and far from it: the closest distance and the lowest-id triangle at it, whatever the hint.
   const int32_t n = 3000;
-  std::vector<double> positions;
+  Indexed cone;
   for (int32_t i = 0; i < n; ++i) {
     const double a = 2 * 3.141592653589793 * i / n;
-    positions.insert(positions.end(), {std::cos(a), std::sin(a), 0.0});
+    cone.positions.insert(cone.positions.end(), {std::cos(a), std::sin(a), 0.0});
   }
-  positions.insert(positions.end(), {0.0, 0.0, 1.0, 0.0, 0.0, -1.0});
-  std::vector<int32_t> triangles;
-  for (int32_t i = 0; i < n; ++i) triangles.insert(triangles.end(), {i, (i + 1) % n, n});
-  for (int32_t i = 0; i < n; ++i) triangles.insert(triangles.end(), {(i + 1) % n, i, n + 1});
-  const int32_t m = 2 * n;
-  const TriangleBvh bvh(positions.data(), triangles.data(), m);
+  cone.positions.insert(cone.positions.end(), {0.0, 0.0, 1.0, 0.0, 0.0, -1.0});
+  for (int32_t i = 0; i < n; ++i) cone.triangles.insert(cone.triangles.end(), {i, (i + 1) % n, n});
+  for (int32_t i = 0; i < n; ++i) cone.triangles.insert(cone.triangles.end(), {(i + 1) % n, i, n + 1});
+  const int32_t m = cone.size();
+  const TriangleBvh bvh(cone.positions.data(), cone.triangles.data(), m);
   CHECK(bvh.has_slabs());
   std::mt19937 random(23);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  auto corner = [&](int32_t t, int c) { return &positions[3 * size_t(triangles[3 * size_t(t) + c])]; };
   int32_t hint = -1, exact_zero = 0;
   for (int probe = 0; probe < 600; ++probe) {
     const int32_t t = int32_t(random() % m);
-    double p[3], w[3] = {unit(random), unit(random), unit(random)};
-    const int kind = probe % 6;
-    if (kind == 1) w[2] = 0.0;                  // on an edge
-    if (kind == 2) w[1] = w[2] = 0.0;           // at a vertex
-    const double sum = w[0] + w[1] + w[2];
-    for (int k = 0; k < 3; ++k)
-      p[k] = (w[0] * corner(t, 0)[k] + w[1] * corner(t, 1)[k] + w[2] * corner(t, 2)[k]) / sum;
-    const double scale = kind == 3 ? 1e-6 : kind == 4 ? 0.05 : kind == 5 ? 3.0 : 0.0;  // off the surface
-    for (int k = 0; k < 3; ++k) p[k] += scale * (unit(random) - 0.5);
-    double best = 1e300;
-    int32_t best_triangle = -1;
-    for (int32_t f = 0; f < m; ++f) {
-      double q[3];
-      const double d2 = closest_point_on_triangle(p, corner(f, 0), corner(f, 1), corner(f, 2), q);
-      if (d2 < best) best = d2, best_triangle = f;
-    }
+    double p[3];
+    cone.probe(random, t, probe % 6, p);
+    const auto [best, best_triangle] = cone.nearest(p);
     exact_zero += best == 0.0;
     const auto hit = bvh.closest(p, hint);
     CHECK(hit.distance2 == best);
@@ -133,38 +157,23 @@ TEST_CASE("BVH over a flat fanned disc (cones): the brute-force minimum at point
   // distance and the lowest-id triangle at it, whatever the hint (the counted lookup, without the
   // cones, the same).
   const int32_t n = 4000;
-  std::vector<double> positions;
-  std::vector<int32_t> triangles;
+  Indexed disc;
   for (int32_t i = 0; i < n; ++i) {
     const double a = 2 * 3.141592653589793 * i / n;
-    positions.insert(positions.end(), {3.0 + std::cos(a), -2.0 + std::sin(a), 0.5});
-    triangles.insert(triangles.end(), {i, (i + 1) % n, n});
+    disc.positions.insert(disc.positions.end(), {3.0 + std::cos(a), -2.0 + std::sin(a), 0.5});
+    disc.triangles.insert(disc.triangles.end(), {i, (i + 1) % n, n});
   }
-  positions.insert(positions.end(), {3.0, -2.0, 0.5});
-  const TriangleBvh bvh(positions.data(), triangles.data(), n);
+  disc.positions.insert(disc.positions.end(), {3.0, -2.0, 0.5});
+  const TriangleBvh bvh(disc.positions.data(), disc.triangles.data(), n);
   CHECK(bvh.has_slabs());
   std::mt19937 random(29);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  auto corner = [&](int32_t t, int c) { return &positions[3 * size_t(triangles[3 * size_t(t) + c])]; };
   int32_t hint = -1;
   int64_t tested = 0;
   for (int probe = 0; probe < 600; ++probe) {
     const int32_t t = int32_t(random() % n);
-    double p[3], w[3] = {unit(random), unit(random), unit(random)};
-    const int kind = probe % 6;
-    if (kind == 1) w[2] = 0.0;         // on an edge
-    if (kind == 2) w[1] = w[2] = 0.0;  // at a vertex
-    const double sum = w[0] + w[1] + w[2];
-    for (int k = 0; k < 3; ++k) p[k] = (w[0] * corner(t, 0)[k] + w[1] * corner(t, 1)[k] + w[2] * corner(t, 2)[k]) / sum;
-    const double scale = kind == 3 ? 1e-6 : kind == 4 ? 0.05 : kind == 5 ? 3.0 : 0.0;  // off the disc
-    for (int k = 0; k < 3; ++k) p[k] += scale * (unit(random) - 0.5);
-    double best = 1e300;
-    int32_t best_triangle = -1;
-    for (int32_t f = 0; f < n; ++f) {
-      double q[3];
-      const double d2 = closest_point_on_triangle(p, corner(f, 0), corner(f, 1), corner(f, 2), q);
-      if (d2 < best) best = d2, best_triangle = f;
-    }
+    double p[3];
+    disc.probe(random, t, probe % 6, p);
+    const auto [best, best_triangle] = disc.nearest(p);
     const auto hit = bvh.closest(p, hint);
     CHECK(hit.distance2 == best);
     CHECK(hit.triangle == best_triangle);

@@ -173,9 +173,9 @@ inline double TriangleBvh::cone_gap(const double* p, const Slab& slab) {
   const double along = a[0] * v[0] + a[1] * v[1] + a[2] * v[2];
   const double cross[3] = {a[1] * v[2] - a[2] * v[1], a[2] * v[0] - a[0] * v[2], a[0] * v[1] - a[1] * v[0]};
   const double across = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
-  const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
   const double sine = across * slab.cos_half - along * slab.sin_half;  // |v| sin(f - a)
-  if (!(sine > 0.0)) return 0.0;
+  if (!(sine > 0.0)) return 0.0;  // inside the cone: no length needed (most opened nodes)
+  const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
   const double cosine = along * slab.cos_half + across * slab.sin_half;  // |v| cos(f - a)
   const double margin = 1e-9 * length + 1e-12 * (std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]) +
                                                  std::abs(slab.apex[0]) + std::abs(slab.apex[1]) + std::abs(slab.apex[2]));
