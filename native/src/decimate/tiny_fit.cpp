@@ -26,8 +26,8 @@ constexpr int64_t kFitTriangles = 200000;
 constexpr double kMaxTolerance = 1e-2;
 constexpr int64_t kMaxQueries = 2000000;
 // The fit's brackets together: at most this many closest-point queries per input triangle (and
-// kFitQueriesFloor in any case), every kTestedPerQuery triangles the queries measured counting as
-// one more (a query among a fan's slivers measures hundreds); then no further move is tried. The
+// kFitQueriesFloor in any case), every kTestedPerQuery triangles the queries measured (or the
+// bounds beneath looked at) counting as one more (a query among a fan's slivers measures hundreds); then no further move is tried. The
 // fits of the test meshes took 2-51 a triangle (Suzanne at 10 %: 159); fans of slivers 400-3,700
 // (a cylinder of 256 segments with fanned caps, 2,560 triangles, at 10 %: 21 brackets, 9.5M, 10 s).
 constexpr int64_t kFitQueriesPerTriangle = 300;

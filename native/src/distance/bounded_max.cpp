@@ -163,7 +163,7 @@ class MaxSearch {
   const TriangleBvh& bvh;
   const double relative_tolerance;
   const int64_t max_queries;
-  int64_t tested = 0;  // triangles the lookups measured
+  int64_t tested = 0;  // triangles the lookups measured and the bounds beneath looked at
   // an absolute floor (resolution x the larger diagonal; by default tiny), so that identical
   // surfaces (max 0) do not subdivide forever
   const double floor;
@@ -189,6 +189,13 @@ class MaxSearch {
     return out.queries + next > max_queries || tested > kTestedPerQuery * max_queries;
   }
   bool tolerated(double upper) const { return upper <= threshold(); }
+
+  // The bound beneath a triangle (projected_bound.hpp), its candidates counted as measured.
+  double beneath(const double p[3][3], bool along_creases) {
+    const double bound = projected_bound(p, to, threshold(), kBeneathCandidates, scratch, along_creases);
+    tested += int64_t(scratch.slots.size());
+    return bound;
+  }
 
   // The nearest point of the other surface to a point that need not lie on the sampled one.
   // hint: a slot found near x (the queue's order jumps about, so the previous query's is not).
@@ -364,11 +371,7 @@ class MaxSearch {
     if (by_quarters && !tolerated(piece.upper)) settle_cheaply(piece);
     // only a bound that settles the piece is looked for: the box searched stays small
     if (!tolerated(piece.upper) && beneath_tried_at != threshold() && worth_projecting(piece))
-    {
-      piece.upper =
-          std::min(piece.upper, projected_bound(piece.p, to, threshold(), kBeneathCandidates, scratch, by_quarters));
-      tested += int64_t(scratch.slots.size());
-    }
+      piece.upper = std::min(piece.upper, beneath(piece.p, by_quarters));
     if (!tolerated(piece.upper)) {
       centroid_near(piece);
       bound(piece);
@@ -415,8 +418,7 @@ class MaxSearch {
     const double p[3][3] = {{corners[0], corners[1], corners[2]}, {corners[3], corners[4], corners[5]},
                             {corners[6], corners[7], corners[8]}};
     if (spanned(p) > kSettleSpan) return false;
-    const double bound = projected_bound(p, to, threshold(), kBeneathCandidates, scratch);
-    tested += int64_t(scratch.slots.size());
+    const double bound = beneath(p, false);
     if (!tolerated(bound)) {
       tried_at = threshold();
       return false;

@@ -33,7 +33,7 @@ struct MaxBracket {
   double lower_point[3] = {0, 0, 0};
   int32_t lower_triangle = -1; ///< triangle of A holding lower_point when the refinement found it (else -1)
   int64_t queries = 0;         ///< closest-point queries made by the refinement
-  int64_t tested = 0;          ///< triangles of the other surface those queries measured
+  int64_t tested = 0;          ///< triangles of the other surface those queries measured or the bounds beneath looked at
   bool converged = true;       ///< upper <= lower * (1 + tolerance) (false when the query budget ran out)
 };
 
