@@ -59,6 +59,31 @@ inline double box_distance2(const double* p, const double* lo, const double* hi)
 #endif
 }
 
+// Squared distance from p to the box of a triangle's three corners (9 coordinates): the
+// triangle is no nearer, so a leaf skips the triangle test where this exceeds the best hit. The
+// corners' x and y are compared in registers (a box stored to memory and loaded back as one
+// register stalls the load).
+inline double corner_box_distance2(const double* p, const double* t) {
+#if defined(__SSE2__) || defined(_M_X64)
+  const __m128d a = _mm_loadu_pd(t), b = _mm_loadu_pd(t + 3), c = _mm_loadu_pd(t + 6);
+  const __m128d lo = _mm_min_pd(_mm_min_pd(a, b), c), hi = _mm_max_pd(_mm_max_pd(a, b), c);
+  const __m128d pxy = _mm_loadu_pd(p);
+  const __m128d outside = _mm_max_pd(_mm_sub_pd(pxy, hi), _mm_setzero_pd());
+  const __m128d gap = _mm_max_pd(_mm_sub_pd(lo, pxy), outside);
+  const __m128d square = _mm_mul_pd(gap, gap);
+  const double z_lo = std::min(std::min(t[2], t[5]), t[8]), z_hi = std::max(std::max(t[2], t[5]), t[8]);
+  const double dz = axis_gap(z_lo - p[2], p[2] - z_hi);
+  return (_mm_cvtsd_f64(square) + _mm_cvtsd_f64(_mm_unpackhi_pd(square, square))) + dz * dz;
+#else
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::min(std::min(t[k], t[3 + k]), t[6 + k]);
+    hi[k] = std::max(std::max(t[k], t[3 + k]), t[6 + k]);
+  }
+  return box_distance2(p, lo, hi);
+#endif
+}
+
 // A box whose distance exceeds the best one by less than this relative slack is still opened, so
 // that rounding in the box test never hides a triangle at the same distance (exact ties matter
 // for the deterministic lower-id tie-break).
@@ -304,7 +329,13 @@ ClosestHit TriangleBvh::search(const double* p, int32_t hint_slot, double within
     if (!(entry.distance2 > hit.distance2 * kPruneSlack) && slab_keeps(entry, hit.distance2 * kPruneSlack)) {
       const Node& node = nodes_[entry.node];
       if (node.count > 0) {
-        for (int32_t s = node.first; s < node.first + node.count; ++s) consider(s);
+        // A triangle farther by its own box than the best hit, or the hint (measured first),
+        // cannot change the hit; the counted lookups count it all the same (their budgets).
+        for (int32_t s = node.first; s < node.first + node.count; ++s)
+          if (s != hint_slot && !(corner_box_distance2(p, &corners_[9 * size_t(s)]) > hit.distance2 * kPruneSlack))
+            consider(s);
+          else if constexpr (kCounted)
+            ++*tested;
       } else {
         const int32_t left = entry.node + 1, right = node.first;
         const double dl = bound(left), dr = bound(right);
