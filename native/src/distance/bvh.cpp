@@ -88,6 +88,9 @@ inline double corner_box_distance2(const double* p, const double* t) {
 // that rounding in the box test never hides a triangle at the same distance (exact ties matter
 // for the deterministic lower-id tie-break).
 constexpr double kPruneSlack = 1.0 + 1e-12;
+// The margin of a leaf's triangle skip (search), relative to the coordinates' magnitude: a
+// closest point's rounding is under 1e-15 of it.
+constexpr double kSkipMargin = 1e-14;
 
 inline double triangle_distance2(const double* p, const double* a, const double* b, const double* c,
                                  double* closest) {
@@ -187,6 +190,8 @@ TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int6
     std::copy_n(&unordered[9 * size_t(order[s])], 9, &corners_[9 * size_t(s)]);
   });
   build_slabs();
+  for (int k = 0; k < 3; ++k)
+    coordinate_scale_ = std::max({coordinate_scale_, std::abs(nodes_[0].lo[k]), std::abs(nodes_[0].hi[k])});
 }
 
 // The distance from p to the slab's cone (apex, axis, half-angle a < 90 degrees), 0 or less
@@ -285,6 +290,11 @@ ClosestHit TriangleBvh::search(const double* p, int32_t hint_slot, double within
   hit.distance2 = std::numeric_limits<double>::infinity();
   // The triangle test has internal linkage so that it is called directly, not through the shared
   // module's PLT as the exported closest_point_on_triangle is.
+  // A leaf skips a triangle whose corners' box lies beyond skip2: the best hit's distance plus
+  // a margin for the rounding of a closest point (a few units in the last place of the
+  // coordinates, which may put it outside that box), with the nodes' relative slack.
+  const double margin = kSkipMargin * (std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}) + coordinate_scale_);
+  double skip2 = std::numeric_limits<double>::infinity();
   auto consider = [&](int32_t slot) {
     if constexpr (kCounted) ++*tested;
     double q[3];
@@ -295,6 +305,8 @@ ClosestHit TriangleBvh::search(const double* p, int32_t hint_slot, double within
       hit.triangle = triangle_ids_[slot];
       hit.slot = slot;
       for (int k = 0; k < 3; ++k) hit.point[k] = q[k];
+      const double reach = std::sqrt(d2) + margin;
+      skip2 = reach * reach * kPruneSlack;
     }
   };
   if (hint_slot >= 0 && hint_slot < int32_t(triangle_ids_.size())) consider(hint_slot);
@@ -332,7 +344,7 @@ ClosestHit TriangleBvh::search(const double* p, int32_t hint_slot, double within
         // A triangle farther by its own box than the best hit, or the hint (measured first),
         // cannot change the hit; the counted lookups count it all the same (their budgets).
         for (int32_t s = node.first; s < node.first + node.count; ++s)
-          if (s != hint_slot && !(corner_box_distance2(p, &corners_[9 * size_t(s)]) > hit.distance2 * kPruneSlack))
+          if (s != hint_slot && !(corner_box_distance2(p, &corners_[9 * size_t(s)]) > skip2))
             consider(s);
           else if constexpr (kCounted)
             ++*tested;

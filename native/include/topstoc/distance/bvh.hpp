@@ -85,6 +85,7 @@ class TriangleBvh {
   std::vector<Slab> slabs_;              ///< empty, or one per node
   std::vector<double> corners_;          ///< 9 coordinates per slot, in leaf order
   std::vector<int32_t> triangle_ids_;    ///< caller's triangle id per slot
+  double coordinate_scale_ = 0.0;        ///< the largest coordinate's magnitude (search's margin)
 };
 
 }  // namespace topstoc
