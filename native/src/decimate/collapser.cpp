@@ -762,7 +762,26 @@ bool Collapser::allowed(int32_t u, int32_t v, Scratch& scratch) const {
   // condition with the boundary's dummy vertex); earlier it would cost the small discs' shape.
   if (nu + nv < shared + (count == 1 && rescue_ ? 4 : 5)) return false;
   double x[3];
-  return shaped_placement(u, v, x) >= 0;
+  return shaped_placement(u, v, x) >= 0 && (!fan_check_ || keeps_fan(u, v, x, scratch));
+}
+
+// set_fan_check's check of the triangles around u and v that the collapse keeps, u and v at x.
+bool Collapser::keeps_fan(int32_t u, int32_t v, const double* x, Scratch& scratch) const {
+  std::vector<double>& fan = scratch.fan;
+  fan.clear();
+  auto gather = [&](int32_t end, int32_t other) {
+    for (const int32_t* t = faces_begin(end); t != faces_end(end); ++t) {
+      if (has(*t, other)) continue;  // the collapse removes it
+      for (int j = 0; j < 3; ++j) {
+        const int32_t w = (*tri_)[3 * size_t(*t) + j];
+        const double* at = w == end ? x : position(w);
+        fan.insert(fan.end(), at, at + 3);
+      }
+    }
+  };
+  gather(u, v);
+  gather(v, u);
+  return fan_check_(fan.data(), int32_t(fan.size() / 9));
 }
 
 // allowed() where an end has more than kWideFan faces (the apex of a cone, the centre of a
@@ -786,6 +805,7 @@ bool Collapser::allowed_wide(int32_t u, int32_t v, Scratch& scratch) const {
   if (cu >= 0 && merges_unlike_edges(u, v, on_edge, count)) return false;
   double x[3];
   if (shaped_placement(u, v, x) < 0) return false;
+  if (fan_check_ && !keeps_fan(u, v, x, scratch)) return false;
   const int32_t nu = count_neighbours(u, INT32_MAX, scratch), faces_u = size_[u];
   if (cu < 0 ? nu != faces_u : !curve_fans(u, nu, faces_u, on_edge, count)) return false;
   const int32_t need = shared + (count == 1 && rescue_ ? 4 : 5) - nu;

@@ -133,6 +133,12 @@ class Collapser {
     held_[u] = 1;
     settle(u, Best());
   }
+  /// A check of the triangles a collapse leaves around its survivor (`triangles` of them, 9
+  /// normalised coordinates each, the survivor at its placement), called on any thread: false
+  /// refuses the collapse as allowed()'s own checks do.
+  using FanCheck = std::function<bool(const double* corners, int32_t triangles)>;
+  /// From now on (empty: no longer) a collapse must also pass `check`.
+  void set_fan_check(FanCheck check) { fan_check_ = std::move(check); }
   /// Moves every free vertex to its quadric's minimum along the directions it constrains, at
   /// most radius2[v] (squared, normalised) away, where no triangle folds or becomes a sliver.
   int32_t refit(const std::vector<double>& radius2);
@@ -193,6 +199,7 @@ class Collapser {
     uint32_t stamp = 0;
     std::vector<int32_t> list;
     std::vector<std::pair<double, int32_t>> costs;
+    std::vector<double> fan;  // keeps_fan's triangles
   };
   struct Best {
     int32_t target = -1;
@@ -238,6 +245,7 @@ class Collapser {
   int32_t count_neighbours(int32_t v, int32_t enough, Scratch& scratch) const;
   int32_t faces_holding(int32_t a, int32_t b, int32_t enough) const;
   int shaped_placement(int32_t u, int32_t v, double x[3]) const;
+  bool keeps_fan(int32_t u, int32_t v, const double* x, Scratch& scratch) const;
   bool is_dead_end(int32_t v) const { return !s_.dead_end.empty() && s_.dead_end[v]; }
   bool curve_fans(int32_t u, int32_t nu, int32_t faces_u, const int32_t* on_edge, int32_t count) const;
   bool along_curve(int32_t u, int32_t v) const;
@@ -289,6 +297,7 @@ class Collapser {
   std::vector<int32_t> count_;  // per bin: vertices alive
   std::vector<uint8_t> held_;  // per vertex: refused by the caller (hold); empty: none
   int32_t last_removed_ = -1;  // the vertex the last collapse removed
+  FanCheck fan_check_;         // set_fan_check's
   bool use_quota_ = true;
   bool rescue_ = false;  // every collapse left failed its checks: see shaped_placement
   double min_shape_ = kMinShape;              // a triangle may end no thinner (keeps_shape)
