@@ -92,6 +92,20 @@ def voxel_surface(filled: np.ndarray):
     return np.array(vertices, dtype=float), np.array(faces, dtype=np.int32)
 
 
+def open_housing(size=(24, 16, 10), window=(6, 18, 5, 11), holes: int = 3):
+    """A CAD-like housing of unit voxels: walls and a floor one voxel thick, open at the top, a
+    window (x0, x1, y0, y1) through the floor and `holes` 2 x 2 holes through one wall (closed,
+    genus holes + 1): flat faces, where a collapse slides a vertex along a plane at no cost."""
+    nx, ny, nz = size
+    filled = np.zeros(size, dtype=bool)
+    filled[:, :, 0] = filled[0] = filled[-1] = filled[:, 0] = filled[:, -1] = True
+    x0, x1, y0, y1 = window
+    filled[x0:x1, y0:y1, 0] = False
+    for k in range(holes):
+        filled[4 + 6 * k:6 + 6 * k, 0, 4:6] = False
+    return voxel_surface(filled)
+
+
 def genus_slab(genus: int, scale: int = 2):
     """A slab with `genus` square holes in a row (closed, orientable, genus g)."""
     cells = np.ones((2 * genus + 1, 3, 1), dtype=bool)

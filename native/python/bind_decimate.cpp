@@ -118,6 +118,7 @@ py::dict result_dict(DecimateResult&& r) {
   d["refine_collapses"] = r.refine_collapses;
   d["refine_keeps_positions"] = r.refine_keeps_positions;
   d["shape_floor"] = r.shape_floor;
+  d["far_guard"] = r.far_guard;
   d["collapses_skipped"] = r.collapses_skipped;
   d["repair_rounds"] = r.repair_rounds;
   d["repairs"] = r.repairs;

@@ -17,6 +17,9 @@ vertex) away from it. Why, in the words every channel uses:
 - "needle triangles": the input is made mostly of slivers (needles), and the result's triangles
   may be no thinner than the input's own: the target needs thinner ones (a strip of needles
   one or two cells wide);
+- "error guard": quality mode's last collapses toward a target of at most 400 triangles may not
+  lay a triangle farther from the input than twice the error where they began (or 3 % of the
+  diagonal): the collapses past this count would have covered an opening or cut across a part;
 - "symmetry": the mirrored sample set is larger (or, where partners of absorbed samples were
   dropped, smaller) than the plain draw (core/api/symmetry.py);
 - "absorbed clusters": clusters that neighbours absorbed were not all made up for;
@@ -89,6 +92,8 @@ def over_reason(stats) -> str:
         return "borders"
     if stats.mirrored_from and stats.mirrored_from - stats.target_vertices <= tolerance(stats.target_vertices):
         return "symmetry"  # the plain draw met the target, its mirrored set did not
+    if getattr(stats, "far_guard", False):
+        return "error guard"
     return "topology"
 
 
@@ -96,6 +101,8 @@ def _over_detail(stats, reason: str) -> str:
     """What the reason of a result over its target costs, in words (see the module docs)."""
     if reason == "non-manifold edges":
         return f"{stats.nonmanifold_vertices:,} of the result's {stats.output_vertices:,} vertices lie on them"
+    if reason == "error guard":
+        return "the collapses left would lay triangles far from the surface (over its openings)"
     if reason == "needle triangles":
         return "the result's triangles stay no thinner than the input's own needles; the target needs thinner ones"
     loose = getattr(stats, "loose_triangles", 0)

@@ -82,6 +82,9 @@ class DecimateStats:
     #: the refinement stopped above its target where only triangles thinner than the input's own
     #: needles would have gone on (a mesh made mostly of slivers)
     shape_floor: bool = False
+    #: quality mode's tail stopped above its target where only collapses laying triangles far from
+    #: the input (over an opening) would have gone on (budget.py's "error guard")
+    far_guard: bool = False
     #: a draft above its target whose full decimation collapses it further: the frame is the plain pass
     collapses_skipped: bool = False
     output_vertices: int = 0    #: vertices of the result

@@ -128,6 +128,10 @@ struct DecimateResult {
   /// would have gone on: a sliver-heavy input, whose collapses without the shape rule would have
   /// gone at least halfway from there to the target (refine.cpp's held_by_shape).
   bool shape_floor = false;
+  /// It stopped above its target where only collapses that lay triangles far from the input
+  /// (over an opening) would have gone on: without refine.cpp's far guard, its collapses would
+  /// have gone at least halfway from there to the target.
+  bool far_guard = false;
   /// A draft above its target: the collapses that take the full decimation the rest of the way
   /// were left out (they need the labels a draft leaves out), so the frame is the plain pass.
   bool collapses_skipped = false;
