@@ -59,7 +59,7 @@ constexpr double kFloorSlack = 0.02;
 // at 100 triangles) came out as the same max and a mean 16 % higher after it. Below the floor it
 // stops a few more triangles above it (a CAD housing: 116 against 110) and is chosen within
 // kGuardedFloorSlack of the best run's size where its mean is at most kGuardedMean of the best's
-// (there 0.66 and 0.78 of them; after the fit 8.4 % of the diagonal against 17.6 %).
+// (there its max 0.66 of the best run's; after the fit 8.4 % of the diagonal against 17.6 %).
 constexpr double kGuardedFloorSlack = 0.12, kGuardedMax = 0.75, kGuardedMean = 0.9;
 
 // Reruns of a result the topology or the borders stop above its target stop where the first run
