@@ -694,22 +694,22 @@ class Refinement {
   // (DecimateResult::shape_floor): a copy with no shape limit goes at least halfway from there to
   // the target. The stalled run works on result's arrays.
   bool held_by_shape(const Collapser& stalled) const {
-    if (stalled_by(stalled) == 0) return false;
-    std::vector<int32_t> triangles = result.triangles, corners = result.corner_source;
-    Collapser free(stalled);
-    free.use_arrays(triangles, corners);
-    free.set_shape_limits(0.0, Collapser::kMinTurnCos);
-    free.reopen();
-    free.run(target());
-    return 2 * stalled_by(free) <= stalled_by(stalled);
+    return goes_halfway(stalled, [](Collapser& free) { free.set_shape_limits(0.0, Collapser::kMinTurnCos); });
   }
-  // Whether the far guard held a run above the target: without it, its collapses go at least
-  // halfway from there to the target (as held_by_shape).
+  // Whether the far guard held a run above the target: without it (its check is gone once the
+  // run ends), its collapses go at least halfway from there to the target.
   bool held_by_guard(const Collapser& stalled) const {
+    return goes_halfway(stalled, [](Collapser&) {});
+  }
+  // Whether a copy of a run stopped above the target, changed by `loosen`, gets at least halfway
+  // from there to the target.
+  template <class Loosen>
+  bool goes_halfway(const Collapser& stalled, Loosen&& loosen) const {
     if (stalled_by(stalled) == 0) return false;
     std::vector<int32_t> triangles = result.triangles, corners = result.corner_source;
     Collapser free(stalled);
     free.use_arrays(triangles, corners);
+    loosen(free);
     free.reopen();
     free.run(target());
     return 2 * stalled_by(free) <= stalled_by(stalled);
