@@ -288,13 +288,13 @@ template <bool kCounted>
 ClosestHit TriangleBvh::search(const double* p, int32_t hint_slot, double within2, int64_t* tested) const {
   ClosestHit hit;
   hit.distance2 = std::numeric_limits<double>::infinity();
-  // The triangle test has internal linkage so that it is called directly, not through the shared
-  // module's PLT as the exported closest_point_on_triangle is.
   // A leaf skips a triangle whose corners' box lies beyond skip2: the best hit's distance plus
   // a margin for the rounding of a closest point (a few units in the last place of the
   // coordinates, which may put it outside that box), with the nodes' relative slack.
   const double margin = kSkipMargin * (std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}) + coordinate_scale_);
   double skip2 = std::numeric_limits<double>::infinity();
+  // The triangle test has internal linkage so that it is called directly, not through the shared
+  // module's PLT as the exported closest_point_on_triangle is.
   auto consider = [&](int32_t slot) {
     if constexpr (kCounted) ++*tested;
     double q[3];
