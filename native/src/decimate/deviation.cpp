@@ -254,11 +254,7 @@ double farthest_around(const InputSurface& input, const Collapser& collapser, co
   const int64_t per = int64_t(k + 1) * (k + 2) / 2;
   const std::vector<double> at = distances2(input.surface->bvh(), per * int64_t(around.size()), [&](int64_t i, double* p) {
     const int32_t* c = &triangles[3 * size_t(around[size_t(i / per)])];
-    int64_t j = i % per, row = 0;  // grid point j: row `row` (weight of c[0] k - row), column j
-    while (j > row) j -= ++row;
-    const double w[3] = {double(k - row) / k, double(row - j) / k, double(j) / k};
-    for (int d = 0; d < 3; ++d)
-      p[d] = w[0] * collapser.position(c[0])[d] + w[1] * collapser.position(c[1])[d] + w[2] * collapser.position(c[2])[d];
+    triangle_grid_point(collapser.position(c[0]), collapser.position(c[1]), collapser.position(c[2]), k, i % per, p);
     return true;
   });
   return at.empty() ? 0.0 : *std::max_element(at.begin(), at.end());

@@ -54,6 +54,15 @@ Deviation surface_deviation(const Mesh& mesh, const InputSurface& input, const s
                           Collapser& collapser, const std::vector<int32_t>& triangles,
                           const Rival* rival = nullptr);
 
+/// Point `index` of a triangle's grid of k steps a side ((k + 1)(k + 2) / 2 points, row by row
+/// from corner a): written to p.
+inline void triangle_grid_point(const double* a, const double* b, const double* c, int k, int64_t index, double* p) {
+  int64_t j = index, row = 0;  // row `row` (weight of a: k - row), column j
+  while (j > row) j -= ++row;
+  const double w[3] = {double(k - row) / k, double(row - j) / k, double(j) / k};
+  for (int d = 0; d < 3; ++d) p[d] = w[0] * a[d] + w[1] * b[d] + w[2] * c[d];
+}
+
 /// The largest squared distance to the input from points spread over the live triangles
 /// around vertex v (each split k times along its sides: the corners and every grid point),
 /// finer than surface_deviation's few points per triangle, for a check of one collapse.

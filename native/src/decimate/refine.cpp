@@ -582,9 +582,7 @@ class Refinement {
   // Per output vertex of the first pass: its mesh vertex (found without the mesh's
   // caller-to-internal map, 2 bytes a triangle, which would otherwise be made under the collapser).
   std::vector<int32_t> kept_vertex;
-  std::unique_ptr<InputSurface> guard_input_;  // the far guard's input (guard_from), made once
-  double guard_bound2_ = 0.0;                  // its bound (squared, normalised)
-  bool guarded_best_ = false;                  // the chosen run is guarded_run's
+  bool guarded_best_ = false;  // the chosen run is guarded_run's
 
   // The caller's labels from the mesh-order ones, once the collapser is gone (the two tables
   // then never sit beside it).
@@ -932,10 +930,10 @@ class Refinement {
   void guarded_run(Run& best, const Collapser& at_restart, int32_t shared, Collapser::Stop stop,
                    const InputSurface& input, const double* center, double extent) {
     auto run = std::make_unique<Collapser>(at_restart);
-    guard_from(*run);
+    const Collapser::FanCheck guard = far_guard(input, *run);
     const bool below_floor = excess(best.deviation) > 0;
     if (below_floor) run->set_shape_limits(kFloorShape[0], kFloorTurnCos);
-    const int32_t collapses = shared + collapse_rest(*run, center, extent, stop, true);
+    const int32_t collapses = shared + collapse_rest(*run, center, extent, stop, guard);
     Deviation d = surface_deviation(mesh, input, label, *run, result.triangles);
     const double mean = 0.5 * (d.mean + d.back_mean), best_mean = 0.5 * (best.deviation.mean + best.deviation.back_mean);
     const int32_t x = count_of(d), y = count_of(best.deviation);
@@ -947,7 +945,6 @@ class Refinement {
     best = Run{std::move(run), std::move(d), collapses, result.triangles, result.corner_source};
     guarded_best_ = true;
   }
-  int32_t count_of(const Deviation& d) const { return params.target_triangles > 0 ? d.faces : d.vertices; }
 
   // Below the floor: the chosen run continued one collapse at a time toward `stop`, each kept
   // under the rules of kExtensionTries, a refused one undone and its vertex held from then on.
@@ -1069,10 +1066,8 @@ class Refinement {
   }
 
   // How far a run stayed above the target (0 once reached).
-  int32_t excess(const Deviation& d) const {
-    return params.target_triangles > 0 ? std::max(0, d.faces - params.target_triangles)
-                                       : std::max(0, d.vertices - params.target_vertices);
-  }
+  int32_t excess(const Deviation& d) const { return std::max(0, count_of(d) - target_count()); }
+  int32_t count_of(const Deviation& d) const { return params.target_triangles > 0 ? d.faces : d.vertices; }
 
   // The weight of each vertex alive in `restarted`: its guidance weight times 1 +
   // `strength` x the largest worst[] (a squared deviation over the largest) of the vertices
@@ -1213,48 +1208,42 @@ class Refinement {
     return collapse_rest(collapser, center, extent, target());
   }
   int32_t collapse_rest(Collapser& collapser, const double* center, double extent, Collapser::Stop stop,
-                        bool guarded = false) {
+                        const Collapser::FanCheck& guard = {}) {
     // A guarded run is not re-fitted either: at a few dozen vertices a cluster spans half the
     // part, and the re-fit bridged the opening the guard had kept (the fit after checks its max).
-    if (guarded) collapser.set_fan_check(far_guard());
+    const bool guarded = bool(guard);
+    if (guarded) collapser.set_fan_check(guard);
     const int32_t collapses = collapser.run(stop);
     collapser.set_fan_check({});
     if (params.refit && !guarded) collapser.refit(cluster_radii(collapser, center, extent));
     return collapses + collapser.remove_thin(0.0, {});
   }
 
-  // Whether a run toward `stop` gets the far guard (kFarGuard).
+  // Whether a max-aware run toward `stop` gets the far guard (kFarGuard).
   bool guards_tail(Collapser::Stop stop) const {
     const int32_t faces = stop.faces > 0 ? stop.faces : 2 * stop.vertices;
-    return params.refit && params.max_aware && whole_input() && faces <= kTinyFitFaces;
+    return params.refit && faces <= kTinyFitFaces;
   }
 
-  // The far guard's bound from where `collapser` stands (the reruns' start, result.triangles its
-  // triangles).
-  void guard_from(Collapser& collapser) {
-    if (!guard_input_) guard_input_ = std::make_unique<InputSurface>(mesh, kept_input(collapser, 1));
-    const Deviation start = surface_deviation(mesh, *guard_input_, label, collapser, result.triangles);
-    const double floor = kFarGuardFloor * guard_input_->surface->diagonal();
-    guard_bound2_ = std::max(kFarGuard * kFarGuard * start.top2, floor * floor);
-  }
-
-  // The far guard's check (guard_from set its bound).
-  Collapser::FanCheck far_guard() const {
-    const TriangleBvh* input = &guard_input_->surface->bvh();
-    return [input, bound2 = guard_bound2_](const double* corners, int32_t triangles) {
+  // The far guard's check against `input`, its bound from where `start` stands (result.triangles
+  // its triangles).
+  Collapser::FanCheck far_guard(const InputSurface& input, Collapser& start) const {
+    const Deviation deviation = surface_deviation(mesh, input, label, start, result.triangles);
+    const double floor = kFarGuardFloor * input.surface->diagonal();
+    const double bound2 = std::max(kFarGuard * kFarGuard * deviation.top2, floor * floor);
+    const TriangleBvh* bvh = &input.surface->bvh();
+    return [bvh, bound2](const double* corners, int32_t triangles) {
+      constexpr int64_t kPoints = (kGuardGrid + 1) * (kGuardGrid + 2) / 2;
       int32_t hint = -1;
       for (int32_t t = 0; t < triangles; ++t) {
         const double* c = corners + 9 * size_t(t);
-        for (int row = 0; row <= kGuardGrid; ++row)
-          for (int j = 0; j <= row; ++j) {
-            const double w[3] = {double(kGuardGrid - row) / kGuardGrid, double(row - j) / kGuardGrid,
-                                 double(j) / kGuardGrid};
-            double p[3];
-            for (int d = 0; d < 3; ++d) p[d] = w[0] * c[d] + w[1] * c[3 + d] + w[2] * c[6 + d];
-            const ClosestHit hit = input->closest(p, hint, bound2);
-            if (hit.distance2 > bound2) return false;
-            hint = hit.slot;
-          }
+        for (int64_t i = 0; i < kPoints; ++i) {
+          double p[3];
+          triangle_grid_point(c, c + 3, c + 6, kGuardGrid, i, p);
+          const ClosestHit hit = bvh->closest(p, hint, bound2);
+          if (hit.distance2 > bound2) return false;
+          hint = hit.slot;
+        }
       }
       return true;
     };
