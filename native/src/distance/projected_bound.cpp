@@ -31,8 +31,17 @@ double turn(const double* a, const double* b, const double* c) {
 struct Frame {
   double origin[3], u[3], v[3], n[3];
   void project(const double* q, double* out) const {
+    project_flat(q, out);
+    out[2] = height(q);
+  }
+  // The (u, v) coordinates alone, and the height alone.
+  void project_flat(const double* q, double* out) const {
     const double d[3] = {q[0] - origin[0], q[1] - origin[1], q[2] - origin[2]};
-    out[0] = dot(d, u), out[1] = dot(d, v), out[2] = dot(d, n);
+    out[0] = dot(d, u), out[1] = dot(d, v);
+  }
+  double height(const double* q) const {
+    const double d[3] = {q[0] - origin[0], q[1] - origin[1], q[2] - origin[2]};
+    return dot(d, n);
   }
   // The distance from the point (a, b) of T's plane to the triangle with the given corners.
   double distance(const double* ab, const double* corners) const {
@@ -42,31 +51,53 @@ struct Frame {
   }
 };
 
-// A polygon of (u, v, height) points, clipped to the left of a -> b (heights interpolated).
+// A polygon of (u, v, height) points, clipped to the left of a -> b (heights interpolated). Each
+// point's turn is computed once: as the current point and as the one after the previous.
 int clip(const double (*in)[3], int count, const double* a, const double* b, double (*out)[3]) {
+  if (count == 0) return 0;
   int kept = 0;
+  const double first = turn(a, b, in[0]);
+  double sp = first;
   for (int i = 0; i < count; ++i) {
     const double* p = in[i];
-    const double* q = in[(i + 1) % count];
-    const double sp = turn(a, b, p), sq = turn(a, b, q);
+    const bool closing = i + 1 == count;
+    const double* q = closing ? in[0] : in[i + 1];
+    const double sq = closing ? first : turn(a, b, q);
     if (sp >= 0) std::copy_n(p, 3, out[kept++]);
     if ((sp >= 0) != (sq >= 0)) {
       const double t = sp / (sp - sq);
       for (int k = 0; k < 3; ++k) out[kept][k] = p[k] + t * (q[k] - p[k]);
       ++kept;
     }
+    sp = sq;
   }
   return kept;
 }
 
-// Whether segment a-b comes within distance `margin` of triangle t (counterclockwise).
-bool meets(const double* a, const double* b, const double (*t)[3], double margin) {
+// T's three sides (counterclockwise) and their lengths in its plane, for `meets`.
+struct Sides {
+  const double (*t)[3];
+  double length[3];
+  explicit Sides(const double (*corners)[3]) : t(corners) {
+    for (int i = 0; i < 3; ++i) {
+      const double* s = t[i];
+      const double* e = t[(i + 1) % 3];
+      length[i] = std::sqrt((e[0] - s[0]) * (e[0] - s[0]) + (e[1] - s[1]) * (e[1] - s[1]));
+    }
+  }
+  // Where a point lies against each side: turn(side's start, side's end, x), >= 0 inside.
+  void turns(const double* x, double* out) const {
+    for (int i = 0; i < 3; ++i) out[i] = turn(t[i], t[(i + 1) % 3], x);
+  }
+};
+
+// Whether segment a-b comes within distance `margin` of triangle T, given both ends' turns
+// against T's sides (Sides::turns).
+bool meets(const double* a_turns, const double* b_turns, const Sides& sides, double margin) {
   double lo = 0.0, hi = 1.0;
   for (int i = 0; i < 3; ++i) {
-    const double* s = t[i];
-    const double* e = t[(i + 1) % 3];
-    const double slack = margin * std::sqrt((e[0] - s[0]) * (e[0] - s[0]) + (e[1] - s[1]) * (e[1] - s[1]));
-    const double fa = turn(s, e, a) + slack, fb = turn(s, e, b) + slack;  // >= 0: inside this side
+    const double slack = margin * sides.length[i];
+    const double fa = a_turns[i] + slack, fb = b_turns[i] + slack;  // >= 0: inside this side
     if (fa < 0 && fb < 0) return false;
     if (fa < 0) lo = std::max(lo, fa / (fa - fb));
     if (fb < 0) hi = std::min(hi, fa / (fa - fb));
@@ -90,6 +121,7 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
   cross(frame.n, frame.u, frame.v);
   double t[3][3];
   for (int j = 0; j < 3; ++j) frame.project(p[j], t[j]);
+  const Sides t_sides(t);
 
   // B's triangles in T's box grown by the limit: nothing beyond it can bring a bound under it.
   double lo[3], hi[3];
@@ -137,11 +169,12 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
   for (int32_t slot : slots) {
     const double* corners = tree.slot_corners(slot);
     double q[9];
-    for (int j = 0; j < 3; ++j) frame.project(corners + 3 * j, q + 3 * j);
+    for (int j = 0; j < 3; ++j) frame.project_flat(corners + 3 * j, q + 3 * j);
     bool apart = false;
     for (int k = 0; k < 2; ++k)
       apart = apart || std::max({q[k], q[3 + k], q[6 + k]}) < t_lo[k] || std::min({q[k], q[3 + k], q[6 + k]}) > t_hi[k];
     if (apart) continue;  // neither over T nor with a side near it
+    for (int j = 0; j < 3; ++j) q[3 * j + 2] = frame.height(corners + 3 * j);
     double f1[3], f2[3], normal[3];
     for (int k = 0; k < 3; ++k) f1[k] = corners[3 + k] - corners[k], f2[k] = corners[6 + k] - corners[k];
     cross(f1, f2, normal);
@@ -173,9 +206,11 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
                                          turn(q + 6, q, incentre) >= 0)))
       covered = true;
     const int32_t* ids = &to.triangles()[3 * size_t(tree.slot_triangle(slot))];
+    double turns[3][3];
+    for (int j = 0; j < 3; ++j) t_sides.turns(q + 3 * j, turns[j]);
     for (int j = 0; j < 3; ++j) {
       const int32_t a = ids[j], b = ids[(j + 1) % 3];
-      if (meets(q + 3 * j, q + 3 * ((j + 1) % 3), t, along_creases ? -margin : margin))
+      if (meets(turns[j], turns[(j + 1) % 3], t_sides, along_creases ? -margin : margin))
         sides.push_back(a < b ? Side{a, b, 1} : Side{b, a, -1});
     }
   }
