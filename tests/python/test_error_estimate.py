@@ -160,6 +160,32 @@ def test_the_quick_bound_measures_the_open_corners_rather_than_bracketing_their_
     assert found["forward_upper"] <= 1.25 * found["forward_lower"] * (1 + 1e-12)
 
 
+@pytest.mark.parametrize("height, settles", [(0.03, True), (0.01, False)])
+def test_the_quick_bound_settles_a_flat_result_over_a_dome_by_more_splits_where_few_triangles_need_them(
+        height, settles):
+    # The original: a smooth dome of the given height over the unit square (a 200 x 200 grid); the
+    # result: the square's two flat triangles. The backward max lies at the dome's top, where the
+    # square's shared edge passes: both triangles need pieces a few times smaller than the height
+    # there. At 0.03 that takes more than the 256 splits a triangle first gets and fewer than the
+    # retry's 4096, so the backward side settles within the gap on its own (it was 1.78 times its
+    # estimate, leaving the whole side to the exact walk); at 0.01 the retry does not settle either
+    # and the first bound stands. Either way both sides hold the exact bracket's max.
+    from topstoc.core.api.hausdorff import as_surface
+    n = 200
+    x, y = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1), indexing="ij")
+    original = as_surface(grid(n, (height * np.sin(np.pi * x) * np.sin(np.pi * y)).ravel()))
+    square = as_surface((np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=float),
+                         np.array([[0, 1, 2], [0, 2, 3]], dtype=np.int32)))
+    found = engine.quick_hausdorff_bound(original, square, tolerance=0.25)
+    estimate = max(found["forward_lower"], found["backward_lower"])
+    assert (found["backward_upper"] <= 1.25 * estimate * (1 + 1e-12)) == settles
+    for side, (a, b) in (("forward", (original, square)), ("backward", (square, original))):
+        exact = engine.bracket_one_sided_max(a, b, tolerance=1e-3, max_queries=estimates.EXACT_QUERIES)
+        assert exact["converged"]
+        assert found[side + "_lower"] <= exact["upper"] and found[side + "_upper"] >= exact["lower"]
+    assert abs(estimate - height) <= 1e-3 * height  # attained at the top, where the max is
+
+
 def bumpy(n: int = 30):
     """A grid with a smooth bump field (heights up to 0.05): closest points vary across it."""
     x, y = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1), indexing="ij")

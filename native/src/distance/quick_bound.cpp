@@ -16,12 +16,13 @@
 // a piece of a triangle of B it is at most the largest at its corners plus the piece's
 // nearest-corner reach, or the farthest corner from a corner's triangle of A (convex); pieces
 // are split at their edge midpoints until that is within (1 + tolerance) of the largest corner
-// value (highest first, kMaxSplits splits at most).
+// value (highest first, kMaxSplits splits at most; kRetrySplits where few triangles need more).
 // The lower bound is attained: the largest distance measured exactly from a point of A to B, or
 // from one of the kTopExact points of B with the largest bounds to A (through the grid).
 #include "topstoc/distance/hausdorff.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -39,6 +40,11 @@ namespace {
 
 constexpr int64_t kCellBlock = 64;     // grid cells one task measures, chaining its BVH hints
 constexpr int kMaxSplits = 256;        // splits of a triangle of B at most
+// A triangle of B still open after kMaxSplits gets kRetrySplits where at most kRetryTriangles are:
+// a result close to its original has a few such triangles around its largest deviation, whose
+// bound would otherwise leave the whole side to the exact walk over the original.
+constexpr int kRetrySplits = 4096;
+constexpr size_t kRetryTriangles = 256;
 constexpr double kCellSpacings = 4.0;  // grid cell side in A's mean vertex spacings (about 8 vertices a cell)
 constexpr int64_t kRefineRun = 2048;
 constexpr int64_t kRefineQueries = 16 * kRefineRun;  // per run: 16 a triangle (the bracket holds when they run out)
@@ -311,13 +317,14 @@ Bound exact_distance(const double* y, Bound bound, double reach, const Surface& 
 // is convex) is within the tolerance of the largest corner value found (floor: `floor`).
 struct PieceBound {
   double upper = 0.0;
+  bool capped = false;            // stopped at its most splits with a piece above the tolerance
   int64_t queries = 0;
   double worst = 0.0;             // the largest bound at a measured point
   double worst_point[3] = {0, 0, 0};
 };
 
 PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], const Surface& a, const VertexGrid& grid,
-                                   const Stars& stars, double reach, double floor, double tolerance) {
+                                   const Stars& stars, double reach, double floor, double tolerance, int max_splits) {
   struct Piece {
     Corners c;
     Bound d[3];
@@ -340,8 +347,8 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
   std::vector<Piece> open{{t, {corner[0], corner[1], corner[2]}, 0.0}};
   bounded(open.front());
   double settled = 0.0;
-  // The highest bound first, kMaxSplits splits at most: a result nearly on the original (a
-  // tiny max against long sides) would need pieces far smaller than that; the bound holds anyway.
+  // The highest bound first, max_splits at most: a result nearly on the original (a tiny max
+  // against long sides) would need pieces far smaller than that; the bound holds anyway.
   for (int splits = 0; !open.empty(); ++splits) {
     std::pop_heap(open.begin(), open.end(), lower_bound_first);
     const Piece piece = open.back();
@@ -350,8 +357,9 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
       settled = std::max(settled, piece.upper);
       continue;
     }
-    if (splits >= kMaxSplits) {
+    if (splits >= max_splits) {
       settled = std::max(settled, piece.upper);  // the highest left: every other is lower
+      out.capped = true;
       break;
     }
     double mid[3][3];
@@ -388,6 +396,30 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
   return out;
 }
 
+// The triangles that stopped at kMaxSplits, bounded again with kRetrySplits where there are at
+// most kRetryTriangles: kept only if every one of them then settles (else the side is left to
+// the exact walk anyway, and the first bounds stand), so the result does not depend on which
+// retries ran before one failed. bound(f, max_splits) bounds triangle f.
+template <typename BoundTriangle>
+void retry_capped(std::vector<PieceBound>& per, const BoundTriangle& bound) {
+  std::vector<int32_t> capped;
+  for (size_t f = 0; f < per.size(); ++f)
+    if (per[f].capped) capped.push_back(int32_t(f));
+  if (capped.empty() || capped.size() > kRetryTriangles) return;
+  std::vector<PieceBound> again(capped.size());
+  std::atomic<bool> failed{false};
+  parallel_for_dynamic(0, int64_t(capped.size()), 1, parallel_if(capped.size() > 1), [&](int64_t i) {
+    if (failed.load(std::memory_order_relaxed)) return;
+    again[size_t(i)] = bound(capped[size_t(i)], kRetrySplits);
+    if (again[size_t(i)].capped) failed.store(true, std::memory_order_relaxed);
+  });
+  if (failed.load()) return;
+  for (size_t i = 0; i < capped.size(); ++i) {
+    again[i].queries += per[size_t(capped[i])].queries;
+    per[size_t(capped[i])] = again[i];
+  }
+}
+
 void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, double reach,
                     QuickBound& out) {
   const Stars stars(a);
@@ -401,11 +433,14 @@ void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, 
   });
   const double floor = std::max(out.forward_lower, kFloor * std::max(a.diagonal(), b.diagonal()));
   std::vector<PieceBound> per(size_t(b.num_triangles()));
-  parallel_for_dynamic(0, b.num_triangles(), 16, kParallelMinCostly, [&](int64_t f) {
+  auto bound_triangle = [&](int32_t f, int max_splits) {
     const int32_t* t = &b.triangles()[3 * size_t(f)];
     const Bound d[3] = {vertex[size_t(t[0])], vertex[size_t(t[1])], vertex[size_t(t[2])]};
-    per[size_t(f)] = bound_backward_triangle(corners_of(b, int32_t(f)), d, a, grid, stars, reach, floor, tolerance);
-  });
+    return bound_backward_triangle(corners_of(b, f), d, a, grid, stars, reach, floor, tolerance, max_splits);
+  };
+  parallel_for_dynamic(0, b.num_triangles(), 16, kParallelMinCostly,
+                       [&](int64_t f) { per[size_t(f)] = bound_triangle(int32_t(f), kMaxSplits); });
+  retry_capped(per, bound_triangle);
   out.grid_queries = b.num_vertices();
   std::vector<std::pair<double, int32_t>> worst;
   for (int32_t f = 0; f < b.num_triangles(); ++f) {
