@@ -330,12 +330,17 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
     Bound d[3];
     double upper;
   };
-  auto bounded = [&](Piece& piece) {  // Lipschitz, then convex through each corner's triangle of A
+  // Lipschitz, then convex through each corner's triangle of A (each triangle once; its corners
+  // measured until one is as far as the bound so far, which it then cannot lower).
+  auto bounded = [&](Piece& piece) {
     piece.upper =
         std::max({piece.d[0].distance, piece.d[1].distance, piece.d[2].distance}) + nearest_corner_reach(piece.c.p);
-    for (const Bound& corner_bound : piece.d) {
+    for (int j = 0; j < 3; ++j) {
+      const int32_t triangle = piece.d[j].triangle;
+      if ((j > 0 && triangle == piece.d[0].triangle) || (j > 1 && triangle == piece.d[1].triangle)) continue;
       double farthest = 0.0;
-      for (int i = 0; i < 3; ++i) farthest = std::max(farthest, distance_to_triangle(piece.c.p[i], a, corner_bound.triangle));
+      for (int i = 0; i < 3 && farthest < piece.upper; ++i)
+        farthest = std::max(farthest, distance_to_triangle(piece.c.p[i], a, triangle));
       piece.upper = std::min(piece.upper, farthest);
     }
   };
@@ -349,7 +354,7 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
   double settled = 0.0;
   // The highest bound first, max_splits at most: a result nearly on the original (a tiny max
   // against long sides) would need pieces far smaller than that; the bound holds anyway.
-  for (int splits = 0; !open.empty(); ++splits) {
+  for (int splits = 0; !open.empty(); ++splits) {  // pieces that settle once bounded are never queued
     std::pop_heap(open.begin(), open.end(), lower_bound_first);
     const Piece piece = open.back();
     open.pop_back();
@@ -387,6 +392,10 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
         next.d[j] = value[child[j]];
       }
       bounded(next);
+      if (next.upper <= best * (1.0 + tolerance)) {
+        settled = std::max(settled, next.upper);
+        continue;
+      }
       open.push_back(next);
       std::push_heap(open.begin(), open.end(), lower_bound_first);
     }
