@@ -107,6 +107,46 @@ bool meets(const double* a_turns, const double* b_turns, const Sides& sides, dou
 
 using Side = BeneathScratch::Side;
 
+// The slots of the tree's triangles whose boxes meet [lo, hi], into scratch.slots; false where
+// there are more than max_candidates.
+bool collect_candidates(const TriangleBvh& tree, const double* lo, const double* hi, int32_t max_candidates,
+                        BeneathScratch& scratch) {
+  std::vector<int32_t>& stack = scratch.stack;
+  std::vector<int32_t>& slots = scratch.slots;
+  stack.assign(1, 0);
+  slots.clear();
+  while (!stack.empty()) {
+    const TriangleBvh::Node& node = tree.node(stack.back());
+    const int32_t i = stack.back();
+    stack.pop_back();
+    bool overlaps = true;
+    for (int k = 0; k < 3; ++k) overlaps = overlaps && node.lo[k] <= hi[k] && node.hi[k] >= lo[k];
+    if (!overlaps) continue;
+    if (node.count == 0) {
+      stack.push_back(i + 1), stack.push_back(node.first);
+      continue;
+    }
+    for (int32_t s = node.first; s < node.first + node.count; ++s) slots.push_back(s);
+    if (int32_t(slots.size()) > max_candidates) return false;
+  }
+  return true;
+}
+
+// Whether every side is matched by sides in the opposite direction (their signs cancel): then no
+// boundary of U crosses T. Sorts `sides`.
+bool paired(std::vector<Side>& sides) {
+  std::sort(sides.begin(), sides.end(),
+            [](const Side& x, const Side& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+  for (size_t i = 0; i < sides.size();) {
+    size_t j = i;
+    int32_t net = 0;
+    for (; j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b; ++j) net += sides[j].sign;
+    if (net != 0) return false;
+    i = j;
+  }
+  return true;
+}
+
 }  // namespace
 
 double projected_bound(const double p[3][3], const Surface& to, double limit, int32_t max_candidates,
@@ -130,24 +170,8 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
     hi[k] = std::max({p[0][k], p[1][k], p[2][k]}) + limit;
   }
   const TriangleBvh& tree = to.bvh();
-  std::vector<int32_t>& stack = scratch.stack;
-  std::vector<int32_t>& slots = scratch.slots;
-  stack.assign(1, 0);
-  slots.clear();
-  while (!stack.empty()) {
-    const TriangleBvh::Node& node = tree.node(stack.back());
-    const int32_t i = stack.back();
-    stack.pop_back();
-    bool overlaps = true;
-    for (int k = 0; k < 3; ++k) overlaps = overlaps && node.lo[k] <= hi[k] && node.hi[k] >= lo[k];
-    if (!overlaps) continue;
-    if (node.count == 0) {
-      stack.push_back(i + 1), stack.push_back(node.first);
-      continue;
-    }
-    for (int32_t s = node.first; s < node.first + node.count; ++s) slots.push_back(s);
-    if (int32_t(slots.size()) > max_candidates) return kNoBound;
-  }
+  if (!collect_candidates(tree, lo, hi, max_candidates, scratch)) return kNoBound;
+  const std::vector<int32_t>& slots = scratch.slots;
 
   // The facing triangles over T give the bound, and those of their sides that come near T must
   // be shared by two of them in opposite directions (no boundary of U crosses T).
@@ -215,15 +239,7 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
     }
   }
   if (!covered) return kNoBound;
-  std::sort(sides.begin(), sides.end(),
-            [](const Side& x, const Side& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
-  for (size_t i = 0; i < sides.size();) {
-    size_t j = i;
-    int32_t net = 0;
-    for (; j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b; ++j) net += sides[j].sign;
-    if (net != 0) return kNoBound;
-    i = j;
-  }
+  if (!paired(sides)) return kNoBound;
   if (along_creases) {
     double farthest = 0.0;
     for (int j = 0; j < 3; ++j) farthest = std::max(farthest, std::hypot(t[j][0] - incentre[0], t[j][1] - incentre[1]));
