@@ -30,18 +30,14 @@ double turn(const double* a, const double* b, const double* c) {
 // T's plane: (u, v) coordinates in it and the height along its unit normal.
 struct Frame {
   double origin[3], u[3], v[3], n[3];
+  // q's offset from the origin (its coordinates are this offset's dot products with u, v and n).
+  void offset(const double* q, double* d) const {
+    for (int k = 0; k < 3; ++k) d[k] = q[k] - origin[k];
+  }
   void project(const double* q, double* out) const {
-    project_flat(q, out);
-    out[2] = height(q);
-  }
-  // The (u, v) coordinates alone, and the height alone.
-  void project_flat(const double* q, double* out) const {
-    const double d[3] = {q[0] - origin[0], q[1] - origin[1], q[2] - origin[2]};
-    out[0] = dot(d, u), out[1] = dot(d, v);
-  }
-  double height(const double* q) const {
-    const double d[3] = {q[0] - origin[0], q[1] - origin[1], q[2] - origin[2]};
-    return dot(d, n);
+    double d[3];
+    offset(q, d);
+    out[0] = dot(d, u), out[1] = dot(d, v), out[2] = dot(d, n);
   }
   // The distance from the point (a, b) of T's plane to the triangle with the given corners.
   double distance(const double* ab, const double* corners) const {
@@ -192,13 +188,16 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
   if (along_creases && !(inradius > 2 * margin)) return kNoBound;
   for (int32_t slot : slots) {
     const double* corners = tree.slot_corners(slot);
-    double q[9];
-    for (int j = 0; j < 3; ++j) frame.project_flat(corners + 3 * j, q + 3 * j);
+    double q[9], d[3][3];  // the corners' (u, v, height), their heights only once over T
+    for (int j = 0; j < 3; ++j) {
+      frame.offset(corners + 3 * j, d[j]);
+      q[3 * j] = dot(d[j], frame.u), q[3 * j + 1] = dot(d[j], frame.v);
+    }
     bool apart = false;
     for (int k = 0; k < 2; ++k)
       apart = apart || std::max({q[k], q[3 + k], q[6 + k]}) < t_lo[k] || std::min({q[k], q[3 + k], q[6 + k]}) > t_hi[k];
     if (apart) continue;  // neither over T nor with a side near it
-    for (int j = 0; j < 3; ++j) q[3 * j + 2] = frame.height(corners + 3 * j);
+    for (int j = 0; j < 3; ++j) q[3 * j + 2] = dot(d[j], frame.n);
     double f1[3], f2[3], normal[3];
     for (int k = 0; k < 3; ++k) f1[k] = corners[3 + k] - corners[k], f2[k] = corners[6 + k] - corners[k];
     cross(f1, f2, normal);
