@@ -129,46 +129,56 @@ bool collect_candidates(const TriangleBvh& tree, const double* lo, const double*
 }
 
 // Whether every side is matched by sides in the opposite direction (their signs cancel): then no
-// boundary of U crosses T. Sorts `sides`.
-bool paired(std::vector<Side>& sides) {
-  std::sort(sides.begin(), sides.end(),
-            [](const Side& x, const Side& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
-  for (size_t i = 0; i < sides.size();) {
-    size_t j = i;
-    int32_t net = 0;
-    for (; j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b; ++j) net += sides[j].sign;
-    if (net != 0) return false;
-    i = j;
+// boundary of U crosses T. Sums each side's signs in a hash table of the scratch's.
+bool paired(BeneathScratch& scratch) {
+  const std::vector<Side>& sides = scratch.sides;
+  size_t size = 16;
+  while (size < 2 * sides.size()) size *= 2;
+  constexpr uint64_t kEmpty = ~uint64_t(0);
+  scratch.keys.assign(size, kEmpty);
+  scratch.nets.resize(size);
+  for (const Side& side : sides) {
+    const uint64_t key = uint64_t(uint32_t(side.a)) << 32 | uint32_t(side.b);
+    size_t i = size_t((key * 0x9E3779B97F4A7C15ull) >> 40) & (size - 1);
+    while (scratch.keys[i] != kEmpty && scratch.keys[i] != key) i = (i + 1) & (size - 1);
+    if (scratch.keys[i] == kEmpty) scratch.keys[i] = key, scratch.nets[i] = 0;
+    scratch.nets[i] += side.sign;
   }
+  for (size_t i = 0; i < size; ++i)
+    if (scratch.keys[i] != kEmpty && scratch.nets[i] != 0) return false;
   return true;
 }
 
-}  // namespace
-
-double projected_bound(const double p[3][3], const Surface& to, double limit, int32_t max_candidates,
-                       BeneathScratch& scratch, bool along_creases) {
+// T in its own plane: the frame, T's corners as (u, v, 0) and the figures every candidate's test
+// reads. False for a degenerate T.
+struct Flat {
   Frame frame;
-  double e1[3], e2[3];
-  for (int k = 0; k < 3; ++k) frame.origin[k] = p[0][k], e1[k] = p[1][k] - p[0][k], e2[k] = p[2][k] - p[0][k];
-  cross(e1, e2, frame.n);
-  const double twice_area = std::sqrt(dot(frame.n, frame.n)), l1 = std::sqrt(dot(e1, e1));
-  if (!(twice_area > 0 && l1 > 0)) return kNoBound;
-  for (int k = 0; k < 3; ++k) frame.n[k] /= twice_area, frame.u[k] = e1[k] / l1;
-  cross(frame.n, frame.u, frame.v);
   double t[3][3];
-  for (int j = 0; j < 3; ++j) frame.project(p[j], t[j]);
-  const Sides t_sides(t);
-
-  // B's triangles in T's box grown by the limit: nothing beyond it can bring a bound under it.
-  double lo[3], hi[3];
-  for (int k = 0; k < 3; ++k) {
-    lo[k] = std::min({p[0][k], p[1][k], p[2][k]}) - limit;
-    hi[k] = std::max({p[0][k], p[1][k], p[2][k]}) + limit;
+  double twice_area, l1;
+  bool set(const double p[3][3]) {
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) frame.origin[k] = p[0][k], e1[k] = p[1][k] - p[0][k], e2[k] = p[2][k] - p[0][k];
+    cross(e1, e2, frame.n);
+    twice_area = std::sqrt(dot(frame.n, frame.n)), l1 = std::sqrt(dot(e1, e1));
+    if (!(twice_area > 0 && l1 > 0)) return false;
+    for (int k = 0; k < 3; ++k) frame.n[k] /= twice_area, frame.u[k] = e1[k] / l1;
+    cross(frame.n, frame.u, frame.v);
+    for (int j = 0; j < 3; ++j) frame.project(p[j], t[j]);
+    return true;
   }
-  const TriangleBvh& tree = to.bvh();
-  if (!collect_candidates(tree, lo, hi, max_candidates, scratch)) return kNoBound;
-  const std::vector<int32_t>& slots = scratch.slots;
+};
 
+// The bound over the candidates: each(fn) calls fn(corners, triangle) for each candidate of B
+// (its 9 coordinates and its id in `to`). inside_whole: a candidate inside T is its own overlap
+// (no clip; its corners' heights as they are, where the clip would interpolate them again).
+// at, when given: the (u, v) of T where the bound is reached.
+template <typename Each>
+double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScratch& scratch, bool along_creases,
+                  bool inside_whole, double* at, const Each& each) {
+  const Frame& frame = flat.frame;
+  const double(&t)[3][3] = flat.t;
+  const double twice_area = flat.twice_area, l1 = flat.l1;
+  const Sides t_sides(t);
   // The facing triangles over T give the bound, and those of their sides that come near T must
   // be shared by two of them in opposite directions (no boundary of U crosses T).
   const double margin = kMargin * std::max({l1, std::hypot(t[2][0], t[2][1]), std::hypot(t[2][0] - l1, t[2][1])});
@@ -177,7 +187,7 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
   std::vector<Side>& sides = scratch.sides;
   sides.clear();
   double bound = 0.0;
-  bool covered = false;
+  bool covered = false, failed = false;
   // along_creases: coverage is decided over T shrunk by the margin (a boundary of U along T's
   // sides does not fail it), so it is tested at T's incentre, and a point of T outside the shrunk
   // one lies within margin x (farthest corner from the incentre) / inradius of a point inside it.
@@ -186,8 +196,8 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
                               (la * t[0][1] + lb * t[1][1] + l1 * t[2][1]) / perimeter};
   const double inradius = twice_area / perimeter;
   if (along_creases && !(inradius > 2 * margin)) return kNoBound;
-  for (int32_t slot : slots) {
-    const double* corners = tree.slot_corners(slot);
+  each([&](const double* corners, int32_t triangle) {
+    if (failed) return;
     double q[9], d[3][3];  // the corners' (u, v, height), their heights only once over T
     for (int j = 0; j < 3; ++j) {
       frame.offset(corners + 3 * j, d[j]);
@@ -196,55 +206,102 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
     bool apart = false;
     for (int k = 0; k < 2; ++k)
       apart = apart || std::max({q[k], q[3 + k], q[6 + k]}) < t_lo[k] || std::min({q[k], q[3 + k], q[6 + k]}) > t_hi[k];
-    if (apart) continue;  // neither over T nor with a side near it
+    if (apart) return;  // neither over T nor with a side near it
     for (int j = 0; j < 3; ++j) q[3 * j + 2] = dot(d[j], frame.n);
     double f1[3], f2[3], normal[3];
     for (int k = 0; k < 3; ++k) f1[k] = corners[3 + k] - corners[k], f2[k] = corners[6 + k] - corners[k];
     cross(f1, f2, normal);
     const double area = turn(q, q + 3, q + 6);
-    if (!(area > kFacing * std::sqrt(dot(normal, normal)))) continue;
+    if (!(area > kFacing * std::sqrt(dot(normal, normal)))) return;
+    double turns[3][3];
+    for (int j = 0; j < 3; ++j) t_sides.turns(q + 3 * j, turns[j]);
     double ring[2][9][3];
     int count = 3;
-    for (int j = 0; j < 3; ++j) std::copy_n(t[j], 3, ring[0][j]);
-    for (int j = 0; j < 3 && count > 0; ++j)  // T clipped to the triangle's three sides
-      count = clip(ring[j % 2], count, q + 3 * j, q + 3 * ((j + 1) % 3), ring[(j + 1) % 2]);
+    double own = 0.0, own_at[2] = {0.0, 0.0};
+    bool whole = false;
+    if (inside_whole && std::min({turns[0][0], turns[0][1], turns[0][2], turns[1][0], turns[1][1], turns[1][2],
+                                  turns[2][0], turns[2][1], turns[2][2]}) >= 0) {
+      for (int j = 0; j < 3; ++j)
+        if (std::abs(q[3 * j + 2]) >= own) own = std::abs(q[3 * j + 2]), own_at[0] = q[3 * j], own_at[1] = q[3 * j + 1];
+      count = 0, whole = true;
+    } else {
+      for (int j = 0; j < 3; ++j) std::copy_n(t[j], 3, ring[0][j]);
+      for (int j = 0; j < 3 && count > 0; ++j)  // T clipped to the triangle's three sides
+        count = clip(ring[j % 2], count, q + 3 * j, q + 3 * ((j + 1) % 3), ring[(j + 1) % 2]);
+    }
     // Heights of the triangle's plane over the overlap's corners (the clip carried T's zeros).
     // along_creases: the distance to the triangle there where the height would raise the bound
     // (never more than the height; convex over the overlap, so it peaks at one of its corners).
-    double own = 0.0;
     for (int m = 0; m < count; ++m) {
       const double* x = ring[1][m];
       const double w1 = turn(q, x, q + 6) / area, w2 = turn(q, q + 3, x) / area, w0 = 1.0 - w1 - w2;
       const double height = std::abs(w0 * q[2] + w1 * q[5] + w2 * q[8]);
-      own = std::max(own, along_creases && height > std::max(own, bound) ? frame.distance(x, corners) : height);
+      const double value = along_creases && height > std::max(own, bound) ? frame.distance(x, corners) : height;
+      if (value > own) own = value, own_at[0] = x[0], own_at[1] = x[1];
     }
     // along_creases: a triangle beyond the limit is left out of U (any part of the chain bounds
     // what it covers; the sides it leaves unmatched fail the test below where they cross T)
     if (own > limit) {
-      if (along_creases) continue;
-      return kNoBound;
+      failed = !along_creases;
+      return;
     }
+    if (own >= bound && at != nullptr) at[0] = own_at[0], at[1] = own_at[1];
     bound = std::max(bound, own);
-    if (count > 0 && (!along_creases || (turn(q, q + 3, incentre) >= 0 && turn(q + 3, q + 6, incentre) >= 0 &&
-                                         turn(q + 6, q, incentre) >= 0)))
+    if ((count > 0 || whole) && (!along_creases || (turn(q, q + 3, incentre) >= 0 && turn(q + 3, q + 6, incentre) >= 0 &&
+                                                    turn(q + 6, q, incentre) >= 0)))
       covered = true;
-    const int32_t* ids = &to.triangles()[3 * size_t(tree.slot_triangle(slot))];
-    double turns[3][3];
-    for (int j = 0; j < 3; ++j) t_sides.turns(q + 3 * j, turns[j]);
+    const int32_t* ids = &to.triangles()[3 * size_t(triangle)];
     for (int j = 0; j < 3; ++j) {
       const int32_t a = ids[j], b = ids[(j + 1) % 3];
       if (meets(turns[j], turns[(j + 1) % 3], t_sides, along_creases ? -margin : margin))
         sides.push_back(a < b ? Side{a, b, 1} : Side{b, a, -1});
     }
-  }
-  if (!covered) return kNoBound;
-  if (!paired(sides)) return kNoBound;
+  });
+  if (failed || !covered) return kNoBound;
+  if (!paired(scratch)) return kNoBound;
   if (along_creases) {
     double farthest = 0.0;
     for (int j = 0; j < 3; ++j) farthest = std::max(farthest, std::hypot(t[j][0] - incentre[0], t[j][1] - incentre[1]));
     bound += margin * farthest / inradius;
     if (bound > limit) return kNoBound;
   }
+  return bound;
+}
+
+}  // namespace
+
+double projected_bound(const double p[3][3], const Surface& to, double limit, int32_t max_candidates,
+                       BeneathScratch& scratch, bool along_creases) {
+  Flat flat;
+  if (!flat.set(p)) return kNoBound;
+  // B's triangles in T's box grown by the limit: nothing beyond it can bring a bound under it.
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::min({p[0][k], p[1][k], p[2][k]}) - limit;
+    hi[k] = std::max({p[0][k], p[1][k], p[2][k]}) + limit;
+  }
+  const TriangleBvh& tree = to.bvh();
+  if (!collect_candidates(tree, lo, hi, max_candidates, scratch)) return kNoBound;
+  return bound_over(flat, to, limit, scratch, along_creases, false, nullptr, [&](const auto& fn) {
+    for (int32_t slot : scratch.slots) fn(tree.slot_corners(slot), tree.slot_triangle(slot));
+  });
+}
+
+double projected_bound_over(const double p[3][3], const Surface& to, const std::vector<int32_t>& triangles,
+                            double limit, BeneathScratch& scratch, double reached[3]) {
+  Flat flat;
+  if (!flat.set(p)) return kNoBound;
+  const auto& positions = to.positions();
+  const auto& ids = to.triangles();
+  double at[2] = {0.0, 0.0};
+  const double bound = bound_over(flat, to, limit, scratch, false, true, at, [&](const auto& fn) {
+    for (int32_t f : triangles) {
+      double corners[9];
+      for (int j = 0; j < 3; ++j) std::copy_n(&positions[3 * size_t(ids[3 * size_t(f) + j])], 3, corners + 3 * j);
+      fn(corners, f);
+    }
+  });
+  for (int k = 0; k < 3; ++k) reached[k] = flat.frame.origin[k] + at[0] * flat.frame.u[k] + at[1] * flat.frame.v[k];
   return bound;
 }
 

@@ -23,6 +23,8 @@ struct BeneathScratch {
     int32_t a, b, sign;  // vertex ids (lower first) and +1 or -1 for the direction
   };
   std::vector<Side> sides;
+  std::vector<uint64_t> keys;  // the sides' hash table (projected_bound.cpp's paired)
+  std::vector<int32_t> nets;
 };
 
 /// An upper bound on max over triangle p of dist(x, to), or +infinity when B does not lie under
@@ -34,5 +36,12 @@ struct BeneathScratch {
 /// to a triangle replaces its plane's height along T's normal.
 double projected_bound(const double p[3][3], const Surface& to, double limit, int32_t max_candidates,
                        BeneathScratch& scratch, bool along_creases = false);
+
+/// The same bound (without along_creases) over the listed triangles of `to` only, for a surface
+/// without a search tree: triangles left out can fail the test (a side of U left unmatched), never
+/// make the bound wrong. reached: the point of p where the bound is reached (a height over one
+/// triangle of `to`, so the distance there is at most the bound).
+double projected_bound_over(const double p[3][3], const Surface& to, const std::vector<int32_t>& triangles,
+                            double limit, BeneathScratch& scratch, double reached[3]);
 
 }  // namespace topstoc

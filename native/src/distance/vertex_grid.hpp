@@ -33,14 +33,22 @@ class VertexGrid {
   /// the cube around p).
   template <class F>
   void for_each_near(const double* p, double radius, F&& f) const {
-    int64_t lo[3], hi[3];
+    const double lo[3] = {p[0] - radius, p[1] - radius, p[2] - radius};
+    const double hi[3] = {p[0] + radius, p[1] + radius, p[2] + radius};
+    for_each_in_box(lo, hi, f);
+  }
+
+  /// f(vertex) for every vertex in the box [lo, hi] (and maybe a few more: the cells it overlaps).
+  template <class F>
+  void for_each_in_box(const double* lo, const double* hi, F&& f) const {
+    int64_t from[3], to[3];
     for (int k = 0; k < 3; ++k) {
-      lo[k] = std::max<int64_t>(0, int64_t(std::floor((p[k] - radius - lo_[k]) / cell_)));
-      hi[k] = std::min<int64_t>(extent_[k] - 1, int64_t(std::floor((p[k] + radius - lo_[k]) / cell_)));
+      from[k] = std::max<int64_t>(0, int64_t(std::floor((lo[k] - lo_[k]) / cell_)));
+      to[k] = std::min<int64_t>(extent_[k] - 1, int64_t(std::floor((hi[k] - lo_[k]) / cell_)));
     }
-    for (int64_t x = lo[0]; x <= hi[0]; ++x)
-      for (int64_t y = lo[1]; y <= hi[1]; ++y)
-        for (int64_t z = lo[2]; z <= hi[2]; ++z) {
+    for (int64_t x = from[0]; x <= to[0]; ++x)
+      for (int64_t y = from[1]; y <= to[1]; ++y)
+        for (int64_t z = from[2]; z <= to[2]; ++z) {
           const int64_t c = find(key_of(x, y, z));
           if (c < 0) continue;
           for (int64_t i = cell_start_[size_t(c)]; i < cell_start_[size_t(c) + 1]; ++i) f(order_[size_t(i)]);
