@@ -160,7 +160,7 @@ def test_the_quick_bound_measures_the_open_corners_rather_than_bracketing_their_
     assert found["forward_upper"] <= 1.25 * found["forward_lower"] * (1 + 1e-12)
 
 
-@pytest.mark.parametrize("height, settles", [(0.03, True), (0.01, False)])
+@pytest.mark.parametrize("height, settles", [(0.03, True), (0.01, True), (0.003, False)])
 def test_the_quick_bound_settles_a_flat_result_over_a_dome_by_more_splits_where_few_triangles_need_them(
         height, settles):
     # The original: a smooth dome of the given height over the unit square (a 200 x 200 grid); the
@@ -168,8 +168,9 @@ def test_the_quick_bound_settles_a_flat_result_over_a_dome_by_more_splits_where_
     # square's shared edge passes: both triangles need pieces a few times smaller than the height
     # there. At 0.03 that takes more than the 256 splits a triangle first gets and fewer than the
     # retry's 4096, so the backward side settles within the gap on its own (it was 1.78 times its
-    # estimate, leaving the whole side to the exact walk); at 0.01 the retry does not settle either
-    # and the first bound stands. Either way both sides hold the exact bracket's max.
+    # estimate, leaving the whole side to the exact walk); at 0.01 the dome's planes beneath the
+    # pieces settle them (the splits alone left 4.7 times the estimate); at 0.003 neither does and
+    # the first bound stands. Either way both sides hold the exact bracket's max.
     from topstoc.core.api.hausdorff import as_surface
     n = 200
     x, y = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1), indexing="ij")
@@ -184,6 +185,45 @@ def test_the_quick_bound_settles_a_flat_result_over_a_dome_by_more_splits_where_
         assert exact["converged"]
         assert found[side + "_lower"] <= exact["upper"] and found[side + "_upper"] >= exact["lower"]
     assert abs(estimate - height) <= 1e-3 * height  # attained at the top, where the max is
+
+
+@pytest.mark.parametrize("ratio", [0.01, 0.1])
+def test_the_quick_bound_settles_a_result_over_many_small_triangles_by_their_planes_beneath(ratio):
+    # A smooth torus of 160,000 triangles at 1 % and 10 %: each result triangle lies over 10-100 of
+    # the original's, far closer to them than its own size. Their planes' heights beneath a piece of
+    # it bound it at once (projected_bound_over), where the distance's Lipschitz bound split it down
+    # to about the deviation (710,000 walks at 1 %; at 10 % the splits ran out and the bracket was
+    # 8.8 times its estimate). The bracket holds the exact max on both sides and settles.
+    from meshgen import torus
+    from topstoc.core.api.hausdorff import as_surface
+    original = torus(400, 200)
+    b = topstoc.Mesh(*original).decimate(ratio=ratio, seed=1)
+    result = (b.vertices, b.triangles)
+    found = engine.quick_hausdorff_bound(as_surface(original), as_surface(result), tolerance=0.25)
+    assert found["grid_queries"] < 4 * len(b.triangles)  # the walks of the result's vertices and a few pieces
+    exact = estimates.exact_error(original, result)
+    for side in ("forward", "backward"):
+        ours, theirs = (found[side + "_lower"], found[side + "_upper"]), getattr(exact, side)
+        assert ours[0] <= theirs[1] and ours[1] >= theirs[0]
+    estimate = max(found["forward_lower"], found["backward_lower"])
+    assert max(found["forward_upper"], found["backward_upper"]) <= 1.25 * estimate * (1 + 1e-12)
+    assert estimate >= 0.9 * exact.estimate
+
+
+def test_the_quick_bound_holds_around_a_fan_centre_through_its_search_tree():
+    # A cylinder whose caps are fans of 5,000 slivers each: the centres' stars are searched through a
+    # tree of their own (a pass over all of a centre's triangles for every point near it made a
+    # fanned cap's bound take minutes). Both sides still hold the exact bracket's max.
+    from fan_meshes import cylinder_caps
+    from topstoc.core.api.hausdorff import as_surface
+    original = cylinder_caps(5000, 4)
+    for ratio in (0.002, 0.05):
+        b = topstoc.Mesh(*original).decimate(ratio=ratio, seed=1)
+        found = engine.quick_hausdorff_bound(as_surface(original), as_surface((b.vertices, b.triangles)), tolerance=0.25)
+        exact = estimates.exact_error(original, (b.vertices, b.triangles))
+        for side in ("forward", "backward"):
+            ours, theirs = (found[side + "_lower"], found[side + "_upper"]), getattr(exact, side)
+            assert ours[0] <= theirs[1] and ours[1] >= theirs[0]
 
 
 def bumpy(n: int = 30):

@@ -17,6 +17,8 @@
 // nearest-corner reach, or the farthest corner from a corner's triangle of A (convex); pieces
 // are split at their edge midpoints until that is within (1 + tolerance) of the largest corner
 // value (highest first, kMaxSplits splits at most; kRetrySplits where few triangles need more).
+// Before a piece is split, A's triangles near it may settle it at once: where they lie beneath it
+// like a sheet, their planes' heights over it bound it (projected_bound.hpp).
 // The lower bound is attained: the largest distance measured exactly from a point of A to B, or
 // from one of the kTopExact points of B with the largest bounds to A (through the grid).
 #include "topstoc/distance/hausdorff.hpp"
@@ -31,7 +33,9 @@
 
 #include "../core/ordered_sum.hpp"
 #include "distance/bounded_max.hpp"
+#include "distance/projected_bound.hpp"
 #include "distance/vertex_grid.hpp"
+#include "distance/vertex_stars.hpp"
 #include "topstoc/core/parallel.hpp"
 
 namespace topstoc {
@@ -51,6 +55,15 @@ constexpr int64_t kRefineQueries = 16 * kRefineRun;  // per run: 16 a triangle (
 constexpr double kFloor = 1e-12;  // distances below this fraction of the diagonal count as none (coincident surfaces)
 constexpr int64_t kTopQueries = 256;
 constexpr int64_t kTopExact = 16;  // points of B measured exactly (the backward lower bound)
+// The bound beneath (projected_bound.hpp) is tried on pieces of B as large as kBeneathLeast to
+// kBeneathMost of A's mean triangles (smaller ones settle in a few splits; larger ones would look
+// at too many), at most kBeneathTries times along a piece's splits, over at most
+// kBeneathCandidates triangles of A.
+constexpr double kBeneathLeast = 2.0;
+constexpr double kBeneathMost = 256.0;
+constexpr int kBeneathTries = 2;
+constexpr double kBeneathReach = 8.0;  // tried where a piece's reach exceeds this many times its room under the limit
+constexpr size_t kBeneathCandidates = 1024;
 
 struct Corners {
   double p[3][3];
@@ -62,14 +75,15 @@ Corners corners_of(const Surface& s, int32_t f) {
   return c;
 }
 
-double distance2(const double* a, const double* b) {
-  return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+double area(const Corners& c) {
+  double e1[3], e2[3];
+  for (int k = 0; k < 3; ++k) e1[k] = c.p[1][k] - c.p[0][k], e2[k] = c.p[2][k] - c.p[0][k];
+  const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+  return 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
 }
 
-double distance_to_triangle(const double* x, const Surface& s, int32_t f) {
-  const Corners t = corners_of(s, f);
-  double closest[3];
-  return std::sqrt(closest_point_on_triangle(x, t.p[0], t.p[1], t.p[2], closest));
+double distance2(const double* a, const double* b) {
+  return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
 }
 
 // A to B, per vertex of A: an upper bound of its distance to B (exact for each cell's first
@@ -251,65 +265,80 @@ void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, d
   }
 }
 
-// Triangles of A around each vertex, and the distance bound of a point to A through them: the
-// nearest vertex's triangles (any triangle of A bounds the distance to A from above).
-struct Stars {
-  explicit Stars(const Surface& a) : offset(size_t(a.num_vertices()) + 1, 0) {
-    const auto& t = a.triangles();
-    for (int32_t v : t) ++offset[size_t(v) + 1];
-    for (size_t v = 1; v < offset.size(); ++v) offset[v] += offset[v - 1];
-    triangle.resize(t.size());
-    std::vector<int64_t> next(offset.begin(), offset.end() - 1);
-    for (size_t c = 0; c < t.size(); ++c) triangle[size_t(next[size_t(t[c])]++)] = int32_t(c / 3);
+// A piece of B in its own plane: where a vertex of A stands over it, for the candidates of the
+// bound beneath.
+struct PieceFrame {
+  double origin[3], u[3], v[3], n[3];
+  double corner[3][2], side[3][2];  // the piece's corners in (u, v), counterclockwise, and unit sides
+  bool set(const Corners& c) {
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) origin[k] = c.p[0][k], e1[k] = c.p[1][k] - c.p[0][k], e2[k] = c.p[2][k] - c.p[0][k];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    const double nl = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const double l1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    if (!(nl > 0 && l1 > 0)) return false;
+    for (int k = 0; k < 3; ++k) n[k] /= nl, u[k] = e1[k] / l1;
+    v[0] = n[1] * u[2] - n[2] * u[1], v[1] = n[2] * u[0] - n[0] * u[2], v[2] = n[0] * u[1] - n[1] * u[0];
+    corner[0][0] = corner[0][1] = corner[1][1] = 0.0, corner[1][0] = l1;
+    corner[2][0] = e2[0] * u[0] + e2[1] * u[1] + e2[2] * u[2], corner[2][1] = e2[0] * v[0] + e2[1] * v[1] + e2[2] * v[2];
+    for (int j = 0; j < 3; ++j) {
+      const double* a = corner[j];
+      const double* b = corner[(j + 1) % 3];
+      const double length = std::hypot(b[0] - a[0], b[1] - a[1]);
+      if (!(length > 0)) return false;
+      side[j][0] = (b[0] - a[0]) / length, side[j][1] = (b[1] - a[1]) / length;
+    }
+    return true;
   }
-  std::vector<int64_t> offset;
-  std::vector<int32_t> triangle;
+  // Whether x lies over the piece grown by `grow` and within `height` + `grow` of its plane.
+  bool near(const double* x, double grow, double height) const {
+    const double d[3] = {x[0] - origin[0], x[1] - origin[1], x[2] - origin[2]};
+    const double dn = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+    if (!(std::abs(dn) <= height + grow)) return false;
+    const double p[2] = {d[0] * u[0] + d[1] * u[1] + d[2] * u[2], d[0] * v[0] + d[1] * v[1] + d[2] * v[2]};
+    for (int j = 0; j < 3; ++j)
+      if (side[j][0] * (p[1] - corner[j][1]) - side[j][1] * (p[0] - corner[j][0]) < -grow) return false;
+    return true;
+  }
 };
 
-struct Bound {
-  double distance;
-  int32_t vertex;    // the vertex of A it was found around: where a nearby point's walk starts
-  int32_t triangle;  // the triangle of A at that distance
-};
-
-// From `start`, steps to the nearest corner of the current vertex's triangles while that is
-// nearer to y, then bounds y's distance to A by the triangles around the vertex reached.
-Bound distance_bound(const double* y, int32_t start, const Surface& a, const Stars& stars) {
+// A's triangles with a corner near the piece (PieceFrame::near: over it or within `grow` of it, and
+// within `limit` + `grow` of its plane), each once (listed by its first corner near it), into
+// `out`; false where there are more than kBeneathCandidates or a wide star. Triangles left out can only fail the
+// bound beneath (projected_bound_over).
+bool triangles_near(const Corners& piece, double limit, double grow, const Surface& a, const VertexGrid& grid,
+                    const Stars& stars, std::vector<int32_t>& out) {
+  PieceFrame frame;
+  if (!frame.set(piece)) return false;
   const auto& positions = a.positions();
   const auto& triangles = a.triangles();
-  int32_t v = start;
-  double best2 = distance2(y, &positions[3 * size_t(v)]);
-  for (bool moved = true; moved;) {
-    moved = false;
-    const int32_t from = v;
-    for (int64_t i = stars.offset[size_t(from)]; i < stars.offset[size_t(from) + 1]; ++i)
-      for (int c = 0; c < 3; ++c) {
-        const int32_t w = triangles[3 * size_t(stars.triangle[size_t(i)]) + c];
-        const double d2 = distance2(y, &positions[3 * size_t(w)]);
-        if (d2 < best2) best2 = d2, v = w, moved = true;
-      }
+  auto inside = [&](int32_t v) { return frame.near(&positions[3 * size_t(v)], grow, limit); };
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::min({piece.p[0][k], piece.p[1][k], piece.p[2][k]}) - limit - grow;
+    hi[k] = std::max({piece.p[0][k], piece.p[1][k], piece.p[2][k]}) + limit + grow;
   }
-  Bound out{std::numeric_limits<double>::infinity(), v, -1};  // v is a corner of each: no farther than v
-  for (int64_t i = stars.offset[size_t(v)]; i < stars.offset[size_t(v) + 1]; ++i) {
-    const double d = distance_to_triangle(y, a, stars.triangle[size_t(i)]);
-    if (d < out.distance) out.distance = d, out.triangle = stars.triangle[size_t(i)];
-  }
-  return out;
+  out.clear();
+  bool over = false;  // more candidates than kBeneathCandidates, or a wide star (a fan's centre)
+  grid.for_each_in_box(lo, hi, [&](int32_t v) {
+    if (over || !inside(v)) return;
+    over = stars.wide(v);
+    for (int64_t i = stars.begin(v); i < stars.end(v) && !over; ++i) {
+      const int32_t* t = &triangles[3 * size_t(stars.triangle(i))];
+      const int32_t first = inside(t[0]) ? t[0] : inside(t[1]) ? t[1] : t[2];
+      if (first == v) out.push_back(stars.triangle(i));
+    }
+    over = over || out.size() > kBeneathCandidates;
+  });
+  return !over;
 }
 
-// The distance from y to A, given a bound of it: the nearest point lies in a triangle with a
-// corner within bound + reach of y (reach: no point of a triangle is farther from its corners).
-Bound exact_distance(const double* y, Bound bound, double reach, const Surface& a, const VertexGrid& grid,
-                     const Stars& stars) {
-  const double radius = bound.distance + reach;
-  grid.for_each_near(y, radius, [&](int32_t v) {
-    if (distance2(y, &a.positions()[3 * size_t(v)]) > radius * radius) return;
-    for (int64_t i = stars.offset[size_t(v)]; i < stars.offset[size_t(v) + 1]; ++i) {
-      const double d = distance_to_triangle(y, a, stars.triangle[size_t(i)]);
-      if (d < bound.distance) bound.distance = d, bound.triangle = stars.triangle[size_t(i)];
-    }
-  });
-  return bound;
+// The bound beneath a piece of B through A's triangles near it (projected_bound_over), or
+// +infinity; reached: the piece's point where it is reached.
+double beneath(const Corners& piece, double limit, double grow, const Surface& a, const VertexGrid& grid,
+               const Stars& stars, std::vector<int32_t>& candidates, BeneathScratch& scratch, double reached[3]) {
+  if (!triangles_near(piece, limit, grow, a, grid, stars, candidates)) return std::numeric_limits<double>::infinity();
+  return projected_bound_over(piece.p, a, candidates, limit, scratch, reached);
 }
 
 // B to A for one triangle of B: its pieces split until each one's bound (largest corner value
@@ -319,16 +348,17 @@ struct PieceBound {
   double upper = 0.0;
   bool capped = false;            // stopped at its most splits with a piece above the tolerance
   int64_t queries = 0;
-  double worst = 0.0;             // the largest bound at a measured point
+  double worst = 0.0;             // the largest bound at a measured point or of a piece settled beneath
   double worst_point[3] = {0, 0, 0};
 };
 
-PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], const Surface& a, const VertexGrid& grid,
+PieceBound bound_backward_triangle(const Corners& t, const StarBound corner[3], const Surface& a, const VertexGrid& grid,
                                    const Stars& stars, double reach, double floor, double tolerance, int max_splits) {
   struct Piece {
     Corners c;
-    Bound d[3];
+    StarBound d[3];
     double upper;
+    int tries;  // bounds beneath tried on it and the pieces it was split from
   };
   // Lipschitz, then convex through each corner's triangle of A (each triangle once; its corners
   // measured until one is as far as the bound so far, which it then cannot lower).
@@ -349,7 +379,13 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
   for (int j = 0; j < 3; ++j)
     if (corner[j].distance > out.worst) out.worst = corner[j].distance, std::copy_n(t.p[j], 3, out.worst_point);
   double best = std::max({floor, corner[0].distance, corner[1].distance, corner[2].distance});
-  std::vector<Piece> open{{t, {corner[0], corner[1], corner[2]}, 0.0}};
+  std::vector<Piece> open{{t, {corner[0], corner[1], corner[2]}, 0.0, 0}};
+  std::vector<int32_t> candidates;
+  BeneathScratch scratch;
+  // The bound beneath's candidates: A's triangles with a corner within `grow` of the piece (about
+  // a triangle's size; any left out can only fail that bound, never make it wrong).
+  const double grow = std::min(2.0 * reach, grid.cell() / kCellSpacings);
+  const double mean_area = a.area() / std::max(1, a.num_triangles());
   bounded(open.front());
   double settled = 0.0;
   // The highest bound first, max_splits at most: a result nearly on the original (a tiny max
@@ -367,26 +403,42 @@ PieceBound bound_backward_triangle(const Corners& t, const Bound corner[3], cons
       out.capped = true;
       break;
     }
+    const double triangles_over = area(piece.c) / mean_area;
+    const double limit = best * (1.0 + tolerance);
+    const double gap = limit - std::max({piece.d[0].distance, piece.d[1].distance, piece.d[2].distance});
+    const bool tried = piece.tries < kBeneathTries && triangles_over >= kBeneathLeast && triangles_over <= kBeneathMost &&
+                       nearest_corner_reach(piece.c.p) > kBeneathReach * gap;
+    if (tried) {  // over many of A's triangles: their planes may settle it at once
+      double reached[3];
+      const double under = beneath(piece.c, best * (1.0 + tolerance), grow, a, grid, stars, candidates, scratch, reached);
+      if (under <= best * (1.0 + tolerance)) {
+        settled = std::max(settled, under);
+        // its highest point, a bound of its distance there, is where the lower bound may look
+        if (under > out.worst) out.worst = under, std::copy_n(reached, 3, out.worst_point);
+        continue;
+      }
+    }
     double mid[3][3];
-    Bound dm[3];
+    StarBound dm[3];
     for (int j = 0; j < 3; ++j) {
       for (int k = 0; k < 3; ++k) mid[j][k] = 0.5 * (piece.c.p[j][k] + piece.c.p[(j + 1) % 3][k]);
-      dm[j] = distance_bound(mid[j], piece.d[j].vertex, a, stars);
+      dm[j] = star_distance_bound(mid[j], piece.d[j].vertex, a, stars);
       if (dm[j].distance > floor) {  // the walk may have stopped short: start from the nearest vertex too
-        const Bound again = distance_bound(mid[j], grid.nearest(mid[j]).vertex, a, stars);
+        const StarBound again = star_distance_bound(mid[j], grid.nearest(mid[j]).vertex, a, stars);
         if (again.distance < dm[j].distance) dm[j] = again;
       }
       if (dm[j].distance > floor)  // its triangles may miss a long one that is nearer: measure exactly
-        dm[j] = exact_distance(mid[j], dm[j], reach, a, grid, stars);
+        dm[j] = star_exact_distance(mid[j], dm[j], reach, a, grid, stars);
       best = std::max(best, dm[j].distance);
       if (dm[j].distance > out.worst) out.worst = dm[j].distance, std::copy_n(mid[j], 3, out.worst_point);
       ++out.queries;
     }
     const double* point[6] = {piece.c.p[0], piece.c.p[1], piece.c.p[2], mid[0], mid[1], mid[2]};
-    const Bound value[6] = {piece.d[0], piece.d[1], piece.d[2], dm[0], dm[1], dm[2]};
+    const StarBound value[6] = {piece.d[0], piece.d[1], piece.d[2], dm[0], dm[1], dm[2]};
     static const int kChildren[4][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {3, 4, 5}};
     for (const auto& child : kChildren) {
       Piece next;
+      next.tries = piece.tries + (tried ? 1 : 0);
       for (int j = 0; j < 3; ++j) {
         std::copy_n(point[child[j]], 3, next.c.p[j]);
         next.d[j] = value[child[j]];
@@ -432,19 +484,19 @@ void retry_capped(std::vector<PieceBound>& per, const BoundTriangle& bound) {
 void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, double reach,
                     QuickBound& out) {
   const Stars stars(a);
-  std::vector<Bound> vertex(size_t(b.num_vertices()), Bound{0.0, -1, -1});
+  std::vector<StarBound> vertex(size_t(b.num_vertices()), StarBound{0.0, -1, -1});
   parallel_for(0, b.num_vertices(), kParallelMinCostly, [&](int64_t y) {
     if (!b.used()[size_t(y)]) return;
     const double* p = &b.positions()[3 * size_t(y)];
-    vertex[size_t(y)] = distance_bound(p, grid.nearest(p).vertex, a, stars);
+    vertex[size_t(y)] = star_distance_bound(p, grid.nearest(p).vertex, a, stars);
     if (vertex[size_t(y)].distance > out.forward_lower)
-      vertex[size_t(y)] = exact_distance(p, vertex[size_t(y)], reach, a, grid, stars);
+      vertex[size_t(y)] = star_exact_distance(p, vertex[size_t(y)], reach, a, grid, stars);
   });
   const double floor = std::max(out.forward_lower, kFloor * std::max(a.diagonal(), b.diagonal()));
   std::vector<PieceBound> per(size_t(b.num_triangles()));
   auto bound_triangle = [&](int32_t f, int max_splits) {
     const int32_t* t = &b.triangles()[3 * size_t(f)];
-    const Bound d[3] = {vertex[size_t(t[0])], vertex[size_t(t[1])], vertex[size_t(t[2])]};
+    const StarBound d[3] = {vertex[size_t(t[0])], vertex[size_t(t[1])], vertex[size_t(t[2])]};
     return bound_backward_triangle(corners_of(b, f), d, a, grid, stars, reach, floor, tolerance, max_splits);
   };
   parallel_for_dynamic(0, b.num_triangles(), 16, kParallelMinCostly,
@@ -462,7 +514,7 @@ void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, 
   std::partial_sort(worst.begin(), worst.begin() + ptrdiff_t(top), worst.end(), std::greater<>());
   for (size_t i = 0; i < top; ++i) {
     const PieceBound& p = per[size_t(worst[i].second)];
-    const Bound exact = exact_distance(p.worst_point, Bound{p.worst, -1, -1}, reach, a, grid, stars);
+    const StarBound exact = star_exact_distance(p.worst_point, StarBound{p.worst, -1, -1}, reach, a, grid, stars);
     out.backward_lower = std::max(out.backward_lower, exact.distance);
   }
 }
