@@ -5,6 +5,7 @@
 #include <limits>
 #include <queue>
 
+#include "distance/edge_cut.hpp"
 #include "distance/projected_bound.hpp"
 
 namespace topstoc {
@@ -273,84 +274,18 @@ class MaxSearch {
     return std::sqrt(worst);
   }
 
-  // The convex bound on the piece cut in two by a plane through the edge that two of its corners'
-  // nearest triangles j and k share (containing that edge and their mean normal): on j's side
-  // the distance to j, on k's the distance to k, each peaking at a corner of its convex part
-  // (the piece's corners there and the two cut points). Settles a piece straddling one edge of
-  // the other surface, flat or bent, for a few distances. +infinity where no two share an edge.
+  // The convex bound on the piece cut through an edge that two of its corners' nearest triangles
+  // share (edge_cut.hpp). +infinity where no two share an edge.
   double cut_bound(const Piece& piece) const {
     double best = kNoBound;
-    int32_t shared[2];
+    const double limit = threshold() * threshold();
+    auto corner2 = [&](int i, int32_t triangle) { return corner_distance2(piece, i, triangle); };
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b) {
-        const int32_t j = piece.near[a], k = piece.near[b];
-        if (j >= 0 && k >= 0 && j != k && shared_edge(j, k, shared)) best = std::min(best, cut_bound(piece, j, k, shared));
+        best = std::min(best, edge_cut_bound(piece.p, to, piece.near[a], piece.near[b], limit, corner2));
         if (tolerated(best)) return best;
       }
     return best;
-  }
-
-  // cut_bound through the edge that triangles j and k of the other surface share.
-  double cut_bound(const Piece& piece, int32_t j, int32_t k, const int32_t shared[2]) const {
-    const double* e0 = &to_positions[3 * size_t(shared[0])];
-    const double* e1 = &to_positions[3 * size_t(shared[1])];
-    double nj[3], nk[3], e[3], m[3];
-    normal_of(j, nj), normal_of(k, nk);
-    for (int c = 0; c < 3; ++c) e[c] = e1[c] - e0[c], nj[c] += nk[c];
-    m[0] = e[1] * nj[2] - e[2] * nj[1], m[1] = e[2] * nj[0] - e[0] * nj[2], m[2] = e[0] * nj[1] - e[1] * nj[0];
-    const double* apex = &to_positions[3 * size_t(third_corner(j, shared))];  // j's side is m's positive side
-    if ((apex[0] - e0[0]) * m[0] + (apex[1] - e0[1]) * m[1] + (apex[2] - e0[2]) * m[2] < 0)
-      for (double& c : m) c = -c;
-    double side[3];
-    for (int i = 0; i < 3; ++i)
-      side[i] = (piece.p[i][0] - e0[0]) * m[0] + (piece.p[i][1] - e0[1]) * m[1] + (piece.p[i][2] - e0[2]) * m[2];
-    const double limit = threshold() * threshold();
-    double worst = 0.0;
-    for (int i = 0; i < 3; ++i) {  // each corner against its side's triangle (on the plane: both)
-      if (side[i] >= 0) worst = std::max(worst, corner_distance2(piece, i, j));
-      if (side[i] <= 0) worst = std::max(worst, corner_distance2(piece, i, k));
-      if (worst > limit) return kNoBound;
-    }
-    for (int i = 0; i < 3; ++i) {  // the cut points: on both parts
-      const int n = (i + 1) % 3;
-      if (!((side[i] > 0 && side[n] < 0) || (side[i] < 0 && side[n] > 0))) continue;
-      const double t = side[i] / (side[i] - side[n]);
-      double x[3];
-      for (int c = 0; c < 3; ++c) x[c] = piece.p[i][c] + t * (piece.p[n][c] - piece.p[i][c]);
-      worst = std::max({worst, distance2_to(j, x), distance2_to(k, x)});
-      if (worst > limit) return kNoBound;
-    }
-    return std::sqrt(worst);
-  }
-
-  // Whether triangles a and b of the other surface share an edge (its two vertices into edge).
-  bool shared_edge(int32_t a, int32_t b, int32_t edge[2]) const {
-    int count = 0;
-    for (int i = 0; i < 3; ++i)
-      for (int l = 0; l < 3; ++l)
-        if (to_triangles[3 * size_t(a) + i] == to_triangles[3 * size_t(b) + l] && count < 2)
-          edge[count++] = to_triangles[3 * size_t(a) + i];
-    return count == 2;
-  }
-
-  int32_t third_corner(int32_t triangle, const int32_t edge[2]) const {
-    for (int i = 0; i < 3; ++i) {
-      const int32_t v = to_triangles[3 * size_t(triangle) + i];
-      if (v != edge[0] && v != edge[1]) return v;
-    }
-    return edge[0];
-  }
-
-  // A triangle's unit normal (zero for a degenerate one).
-  void normal_of(int32_t triangle, double n[3]) const {
-    const double* a = &to_positions[3 * size_t(to_triangles[3 * size_t(triangle)])];
-    const double* b = &to_positions[3 * size_t(to_triangles[3 * size_t(triangle) + 1])];
-    const double* c = &to_positions[3 * size_t(to_triangles[3 * size_t(triangle) + 2])];
-    double u[3], w[3];
-    for (int i = 0; i < 3; ++i) u[i] = b[i] - a[i], w[i] = c[i] - a[i];
-    n[0] = u[1] * w[2] - u[2] * w[1], n[1] = u[2] * w[0] - u[0] * w[2], n[2] = u[0] * w[1] - u[1] * w[0];
-    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    for (int i = 0; i < 3; ++i) n[i] = length > 0 ? n[i] / length : 0.0;
   }
 
   void centroid_near(Piece& piece) {

@@ -33,6 +33,7 @@
 
 #include "../core/ordered_sum.hpp"
 #include "distance/bounded_max.hpp"
+#include "distance/edge_cut.hpp"
 #include "distance/projected_bound.hpp"
 #include "distance/vertex_grid.hpp"
 #include "distance/vertex_stars.hpp"
@@ -159,6 +160,15 @@ double triangle_bound(const Surface& a, const Surface& b, const VertexBounds& v,
     double farthest = 0.0;
     for (int i = 0; i < 3; ++i) farthest = std::max(farthest, distance_to_triangle(c.p[i], b, j));
     bound = std::min(bound, farthest);
+  }
+  // across an edge of B that two corners' triangles share: each side through its own (edge_cut.hpp)
+  auto corner2 = [&](int i, int32_t triangle) {
+    const double d = distance_to_triangle(c.p[i], b, triangle);
+    return d * d;
+  };
+  for (int k = 0; k < 3 && bound > threshold; ++k) {
+    const int32_t j = v.against[size_t(t[k])], l = v.against[size_t(t[(k + 1) % 3])];
+    bound = std::min(bound, edge_cut_bound(c.p, b, j, l, threshold * threshold, corner2));
   }
   return bound;
 }
