@@ -420,8 +420,8 @@ PieceBound bound_backward_triangle(const Corners& t, const StarBound corner[3], 
                        nearest_corner_reach(piece.c.p) > kBeneathReach * gap;
     if (tried) {  // over many of A's triangles: their planes may settle it at once
       double reached[3];
-      const double under = beneath(piece.c, best * (1.0 + tolerance), grow, a, grid, stars, candidates, scratch, reached);
-      if (under <= best * (1.0 + tolerance)) {
+      const double under = beneath(piece.c, limit, grow, a, grid, stars, candidates, scratch, reached);
+      if (under <= limit) {
         settled = std::max(settled, under);
         // its highest point, a bound of its distance there, is where the lower bound may look
         if (under > out.worst) out.worst = under, std::copy_n(reached, 3, out.worst_point);
