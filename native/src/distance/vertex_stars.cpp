@@ -1,5 +1,6 @@
 #include "distance/vertex_stars.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -31,18 +32,18 @@ Stars::Stars(const Surface& a) : a_(a), offset_(size_t(a.num_vertices()) + 1, 0)
   std::vector<int32_t> corners;
   for (int32_t v = 0; v < a.num_vertices(); ++v) {
     if (!wide(v)) continue;
-    if (tree_of_.empty()) tree_of_.assign(size_t(a.num_vertices()), -1);
     corners.clear();
     for (int64_t i = begin(v); i < end(v); ++i)
       for (int c = 0; c < 3; ++c) corners.push_back(t[3 * size_t(triangle(i)) + c]);
-    tree_of_[size_t(v)] = int32_t(trees_.size());
+    wide_.push_back(v);
     trees_.push_back(std::make_unique<TriangleBvh>(a.positions().data(), corners.data(), end(v) - begin(v)));
   }
 }
 
 Stars::Nearest Stars::nearest(const double* y, int32_t v) const {
   if (wide(v)) {  // the tree's ties go to the lower slot of the star, as the loop's below
-    const ClosestHit hit = trees_[size_t(tree_of_[size_t(v)])]->closest(y);
+    const size_t tree = size_t(std::lower_bound(wide_.begin(), wide_.end(), v) - wide_.begin());
+    const ClosestHit hit = trees_[tree]->closest(y);
     return {std::sqrt(hit.distance2), triangle(begin(v) + hit.triangle)};
   }
   Nearest out{std::numeric_limits<double>::infinity(), -1};

@@ -39,7 +39,7 @@ class Stars {
   const Surface& a_;
   std::vector<int64_t> offset_;
   std::vector<int32_t> triangle_;
-  std::vector<int32_t> tree_of_;  // per vertex: its tree in trees_, or -1 (empty without wide vertices)
+  std::vector<int32_t> wide_;  // the wide vertices, in increasing order; trees_[i] is wide_[i]'s
   std::vector<std::unique_ptr<TriangleBvh>> trees_;
 };
 
