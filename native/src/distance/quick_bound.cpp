@@ -155,16 +155,18 @@ double triangle_bound(const Surface& a, const Surface& b, const VertexBounds& v,
   const Corners c = corners_of(a, f);
   double bound = corner_max + nearest_corner_reach(c.p);
   if (bound <= threshold) return bound;
+  double distance[3][3];  // [k][i]: corner i to corner k's triangle of B
   for (int k = 0; k < 3; ++k) {  // each corner's triangle of B against all three corners
     const int32_t j = v.against[size_t(t[k])];
     double farthest = 0.0;
-    for (int i = 0; i < 3; ++i) farthest = std::max(farthest, distance_to_triangle(c.p[i], b, j));
+    for (int i = 0; i < 3; ++i) farthest = std::max(farthest, distance[k][i] = distance_to_triangle(c.p[i], b, j));
     bound = std::min(bound, farthest);
   }
-  // across an edge of B that two corners' triangles share: each side through its own (edge_cut.hpp)
+  // across an edge of B that two corners' triangles share: each side through its own (edge_cut.hpp),
+  // the corners' distances to them read from above
   auto corner2 = [&](int i, int32_t triangle) {
-    const double d = distance_to_triangle(c.p[i], b, triangle);
-    return d * d;
+    const int k = triangle == v.against[size_t(t[0])] ? 0 : triangle == v.against[size_t(t[1])] ? 1 : 2;
+    return distance[k][i] * distance[k][i];
   };
   for (int k = 0; k < 3 && bound > threshold; ++k) {
     const int32_t j = v.against[size_t(t[k])], l = v.against[size_t(t[(k + 1) % 3])];
@@ -368,13 +370,14 @@ PieceBound bound_backward_triangle(const Corners& t, const StarBound corner[3], 
     Corners c;
     StarBound d[3];
     double upper;
-    int tries;  // bounds beneath tried on it and the pieces it was split from
+    double reach;  // its nearest-corner reach
+    int tries;     // bounds beneath tried on it and the pieces it was split from
   };
   // Lipschitz, then convex through each corner's triangle of A (each triangle once; its corners
   // measured until one is as far as the bound so far, which it then cannot lower).
   auto bounded = [&](Piece& piece) {
-    piece.upper =
-        std::max({piece.d[0].distance, piece.d[1].distance, piece.d[2].distance}) + nearest_corner_reach(piece.c.p);
+    piece.reach = nearest_corner_reach(piece.c.p);
+    piece.upper = std::max({piece.d[0].distance, piece.d[1].distance, piece.d[2].distance}) + piece.reach;
     for (int j = 0; j < 3; ++j) {
       const int32_t triangle = piece.d[j].triangle;
       if ((j > 0 && triangle == piece.d[0].triangle) || (j > 1 && triangle == piece.d[1].triangle)) continue;
@@ -389,7 +392,7 @@ PieceBound bound_backward_triangle(const Corners& t, const StarBound corner[3], 
   for (int j = 0; j < 3; ++j)
     if (corner[j].distance > out.worst) out.worst = corner[j].distance, std::copy_n(t.p[j], 3, out.worst_point);
   double best = std::max({floor, corner[0].distance, corner[1].distance, corner[2].distance});
-  std::vector<Piece> open{{t, {corner[0], corner[1], corner[2]}, 0.0, 0}};
+  std::vector<Piece> open{{t, {corner[0], corner[1], corner[2]}, 0.0, 0.0, 0}};
   std::vector<int32_t> candidates;
   BeneathScratch scratch;
   // The bound beneath's candidates: A's triangles with a corner within `grow` of the piece (about
@@ -417,7 +420,7 @@ PieceBound bound_backward_triangle(const Corners& t, const StarBound corner[3], 
     const double limit = best * (1.0 + tolerance);
     const double gap = limit - std::max({piece.d[0].distance, piece.d[1].distance, piece.d[2].distance});
     const bool tried = piece.tries < kBeneathTries && triangles_over >= kBeneathLeast && triangles_over <= kBeneathMost &&
-                       nearest_corner_reach(piece.c.p) > kBeneathReach * gap;
+                       piece.reach > kBeneathReach * gap;
     if (tried) {  // over many of A's triangles: their planes may settle it at once
       double reached[3];
       const double under = beneath(piece.c, limit, grow, a, grid, stars, candidates, scratch, reached);
