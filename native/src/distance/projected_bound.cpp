@@ -17,6 +17,10 @@ constexpr double kNoBound = std::numeric_limits<double>::infinity();
 constexpr double kFacing = 1e-6;
 // Boundary sides this close to T (relative to its longest side) count as crossing it.
 constexpr double kMargin = 1e-9;
+// projected_bound_over's margin, relative to T's coordinates' magnitude: a few hundred times the
+// rounding of the (u, v) coordinates, so that a boundary of U through a corner or along a side of
+// T (a result lying on its original) costs next to nothing in the bound.
+constexpr double kRoundingMargin = 1e-13;
 // Sides paired by sorting up to this many, by hashing above (paired).
 constexpr size_t kSortedSides = 96;
 
@@ -173,7 +177,10 @@ struct Flat {
   Frame frame;
   double t[3][3];
   double twice_area, l1;
+  double magnitude;  // the largest coordinate's magnitude of T's corners
   bool set(const double p[3][3]) {
+    magnitude = 0.0;
+    for (int j = 0; j < 3; ++j) magnitude = std::max({magnitude, std::abs(p[j][0]), std::abs(p[j][1]), std::abs(p[j][2])});
     double e1[3], e2[3];
     for (int k = 0; k < 3; ++k) frame.origin[k] = p[0][k], e1[k] = p[1][k] - p[0][k], e2[k] = p[2][k] - p[0][k];
     cross(e1, e2, frame.n);
@@ -207,19 +214,21 @@ struct ListedCandidates {
   int32_t triangle(size_t i) const { return ids[i]; }
 };
 
-// The bound over the candidates (SlotCandidates or ListedCandidates). inside_whole: a candidate
-// inside T is its own overlap (no clip; its corners' heights as they are, where the clip would
-// interpolate them again). at, when given: the (u, v) of T where the bound is reached.
+// The bound over the candidates (SlotCandidates or ListedCandidates). listed (projected_bound_over's
+// bound): a candidate inside T is its own overlap (no clip; its corners' heights as they are, where
+// the clip would interpolate them again), and the margin is kRoundingMargin's, not kMargin's. at,
+// when given: the (u, v) of T where the bound is reached.
 template <typename Candidates>
 double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScratch& scratch, bool along_creases,
-                  bool inside_whole, double* at, const Candidates& candidates) {
+                  bool listed, double* at, const Candidates& candidates) {
   const Frame& frame = flat.frame;
   const double(&t)[3][3] = flat.t;
   const double twice_area = flat.twice_area, l1 = flat.l1;
   const Sides t_sides(t);
   // The facing triangles over T give the bound, and those of their sides that come near T must
   // be shared by two of them in opposite directions (no boundary of U crosses T).
-  const double margin = kMargin * std::max({l1, std::hypot(t[2][0], t[2][1]), std::hypot(t[2][0] - l1, t[2][1])});
+  const double longest = std::max({l1, std::hypot(t[2][0], t[2][1]), std::hypot(t[2][0] - l1, t[2][1])});
+  const double margin = listed ? kRoundingMargin * (flat.magnitude + longest) : kMargin * longest;
   const double t_lo[2] = {std::min(0.0, t[2][0]) - margin, -margin};
   const double t_hi[2] = {std::max(l1, t[2][0]) + margin, t[2][1] + margin};
   std::vector<Side>& sides = scratch.sides;
@@ -258,7 +267,7 @@ double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScra
     int count = 3;
     double own = 0.0, own_at[2] = {0.0, 0.0};
     bool whole = false;
-    if (inside_whole && std::min({turns[0][0], turns[0][1], turns[0][2], turns[1][0], turns[1][1], turns[1][2],
+    if (listed && std::min({turns[0][0], turns[0][1], turns[0][2], turns[1][0], turns[1][1], turns[1][2],
                                   turns[2][0], turns[2][1], turns[2][2]}) >= 0) {
       for (int j = 0; j < 3; ++j)
         if (std::abs(q[3 * j + 2]) >= own) own = std::abs(q[3 * j + 2]), own_at[0] = q[3 * j], own_at[1] = q[3 * j + 1];
@@ -329,7 +338,7 @@ double projected_bound_over(const double p[3][3], const Surface& to, const std::
   Flat flat;
   if (!flat.set(p)) return kNoBound;
   double at[2] = {0.0, 0.0};
-  const double bound = bound_over(flat, to, limit, scratch, false, true, at, ListedCandidates{to, triangles});
+  const double bound = bound_over(flat, to, limit, scratch, true, true, at, ListedCandidates{to, triangles});
   for (int k = 0; k < 3; ++k) reached[k] = flat.frame.origin[k] + at[0] * flat.frame.u[k] + at[1] * flat.frame.v[k];
   return bound;
 }

@@ -57,10 +57,10 @@ constexpr double kFloor = 1e-12;  // distances below this fraction of the diagon
 constexpr int64_t kTopQueries = 256;
 constexpr int64_t kTopExact = 16;  // points of B measured exactly (the backward lower bound)
 // The bound beneath (projected_bound.hpp) is tried on pieces of B as large as kBeneathLeast to
-// kBeneathMost of A's mean triangles (smaller ones settle in a few splits; larger ones would look
-// at too many), at most kBeneathTries times along a piece's splits, over at most
-// kBeneathCandidates triangles of A.
-constexpr double kBeneathLeast = 2.0;
+// kBeneathMost of A's mean triangles (smaller ones are mostly settled by their corners; larger
+// ones would look at too many; a result lying on its original needs it even over one triangle),
+// at most kBeneathTries times along a piece's splits, over at most kBeneathCandidates triangles of A.
+constexpr double kBeneathLeast = 0.25;
 constexpr double kBeneathMost = 256.0;
 constexpr int kBeneathTries = 2;
 constexpr double kBeneathReach = 8.0;  // tried where a piece's reach exceeds this many times its room under the limit
