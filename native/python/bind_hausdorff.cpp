@@ -191,12 +191,14 @@ void bind_hausdorff(py::module_& m) {
 
   m.def(
       "quick_hausdorff_bound",
-      [](const Surface& a, const Surface& b, double tolerance) {
+      [](const Surface& a, const Surface& b, double tolerance, double resolution) {
         if (!(tolerance > 0.0)) throw std::invalid_argument("tolerance must be positive, got " + std::to_string(tolerance));
+        if (!(resolution >= 0.0))
+          throw std::invalid_argument("resolution must be zero or positive, got " + std::to_string(resolution));
         QuickBound r;
         {
           EngineCall call;
-          r = quick_hausdorff_bound(a, b, tolerance);
+          r = quick_hausdorff_bound(a, b, tolerance, resolution);
         }
         py::dict out;
         out["forward_lower"] = r.forward_lower;
@@ -209,9 +211,10 @@ void bind_hausdorff(py::module_& m) {
         out["refined"] = r.refined;
         return out;
       },
-      py::arg("a"), py::arg("b"), py::arg("tolerance"),
+      py::arg("a"), py::arg("b"), py::arg("tolerance"), py::arg("resolution") = 1e-12,
       "Guaranteed upper bound of the symmetric max between a big surface A and a small one B without a "
-      "search structure over A's triangles; the lower values are distances attained.");
+      "search structure over A's triangles (bounds under resolution x the larger diagonal count as "
+      "settled; at least 1e-12); the lower values are distances attained.");
 
   m.def(
       "hausdorff_with_samples",

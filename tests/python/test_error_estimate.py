@@ -234,6 +234,53 @@ def test_the_quick_bound_settles_a_result_lying_on_its_original_by_the_triangles
         assert ours[0] <= theirs[1] and ours[1] >= theirs[0]
 
 
+def test_the_quick_bound_settles_a_cad_result_across_the_creases_of_its_original(data_dir):
+    # Fandisk subdivided once (each triangle into four coplanar ones) and decimated to a tenth: the
+    # result's pieces near the original's creases have corners whose nearest triangles lie on the
+    # crease's two faces. Bounded on the crease's two sides (the edge cut), and beneath again once a
+    # piece is 16 times smaller than where that failed, the backward side settles within the gap (its
+    # upper had stayed 93 times the estimate, left to the exact walk). Both sides hold the exact bracket.
+    from meshgen import subdivide
+    from topstoc.core.api.hausdorff import as_surface
+    from topstoc.core.api.io import read_mesh
+    fandisk = read_mesh(data_dir / "genus0" / "cgal_fandisk.off")
+    original = subdivide(fandisk.vertices, fandisk.triangles, 1)
+    b = topstoc.Mesh(*original).decimate(ratio=0.1, seed=1)
+    result = (b.vertices, b.triangles)
+    found = engine.quick_hausdorff_bound(as_surface(original), as_surface(result), tolerance=0.25)
+    estimate = max(found["forward_lower"], found["backward_lower"])
+    assert max(found["forward_upper"], found["backward_upper"]) <= 1.25 * estimate * (1 + 1e-12)
+    exact = estimates.exact_error(original, result)
+    for side in ("forward", "backward"):
+        ours, theirs = (found[side + "_lower"], found[side + "_upper"]), getattr(exact, side)
+        assert ours[0] <= theirs[1] and ours[1] >= theirs[0]
+
+
+def test_the_report_settles_at_its_resolution_where_a_result_lies_on_its_original(data_dir):
+    # The elephant subdivided twice and decimated to 8 %: the result lies on its original up to
+    # rounding (the max is 2.4e-11 of the diagonal). The quick bound takes the report's resolution:
+    # pieces under it count as settled instead of being split toward the rounding (the backward side
+    # had stopped at 1e-5 of the diagonal, 430,000 times its estimate, and was left to the exact
+    # walk). The report converges without the walk, and its bracket holds the exact one's.
+    from meshgen import subdivide
+    from topstoc.core.api.hausdorff import as_surface
+    from topstoc.core.api.io import read_mesh
+    elephant = read_mesh(data_dir / "genus_positive" / "cgal_elephant.off")
+    original = subdivide(elephant.vertices, elephant.triangles, 2)
+    b = topstoc.Mesh(*original).decimate(ratio=0.08, seed=1)
+    result = (b.vertices, b.triangles)
+    a = as_surface(original)
+    found = engine.quick_hausdorff_bound(a, as_surface(result), tolerance=0.25, resolution=estimates.RESOLUTION)
+    assert max(found["forward_upper"], found["backward_upper"]) <= 1.25 * estimates.RESOLUTION * a.diagonal
+    report = estimates.estimate_error(original, result, quick=True)
+    assert report.converged
+    assert report.queries == found["queries"] + found["grid_queries"]  # no exact walk after the bound
+    exact = estimates.exact_error(original, result)
+    assert report.estimate <= exact.upper and report.upper >= exact.estimate
+    with pytest.raises(ValueError, match="resolution"):
+        engine.quick_hausdorff_bound(a, as_surface(result), tolerance=0.25, resolution=-1.0)
+
+
 def test_the_quick_bound_holds_around_a_fan_centre_through_its_search_tree():
     # A cylinder whose caps are fans of 5,000 slivers each: the centres' stars are searched through a
     # tree of their own (a pass over all of a centre's triangles for every point near it made a

@@ -101,12 +101,12 @@ def estimate_error(original, result, gap: float = DEFAULT_GAP, queries=None, *,
     if quick is None:
         quick = queries is None and a.num_triangles >= QUICK_TRIANGLES
     if quick:
-        found = engine.quick_hausdorff_bound(a, b, tolerance=float(gap))
+        found = engine.quick_hausdorff_bound(a, b, tolerance=float(gap), resolution=float(resolution))
         sides = [[found["forward_lower"], found["forward_upper"]], [found["backward_lower"], found["backward_upper"]]]
         queries = found["queries"] + found["grid_queries"]
         estimate = max(sides[0][0], sides[1][0])
         for side, (x, y) in zip(sides, ((a, b), (b, a))):
-            if side[1] > estimate * (1 + gap):  # not settled (a tiny max against long sides): the walk too
+            if side[1] > max(estimate * (1 + gap), floor):  # not settled (a tiny max, long sides): the walk too
                 walk = engine.bracket_one_sided_max(x, y, tolerance=gap, max_queries=EXACT_QUERIES)
                 side[0], side[1] = max(side[0], walk["lower"]), min(side[1], walk["upper"])  # both hold
                 queries += walk["queries"]

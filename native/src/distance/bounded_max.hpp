@@ -56,8 +56,11 @@ MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, doubl
                                    double resolution, int64_t max_queries);
 
 /// The same bracket over the listed triangles of A only (start: a distance attained elsewhere).
+/// floor (>= 0 to use it): bounds at or under this distance count as settled (else 1e-13 of the
+/// larger diagonal, as in bound_max_distance).
 MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,
-                                    double start, double relative_tolerance, int64_t max_queries);
+                                    double start, double relative_tolerance, int64_t max_queries,
+                                    double floor = -1.0);
 
 /// The largest distance from a point of the triangle p to its nearest corner (r(T) above).
 double nearest_corner_reach(const double p[3][3]);

@@ -21,6 +21,9 @@ constexpr double kMargin = 1e-9;
 // rounding of the (u, v) coordinates, so that a boundary of U through a corner or along a side of
 // T (a result lying on its original) costs next to nothing in the bound.
 constexpr double kRoundingMargin = 1e-13;
+// projected_bound_over's margin may grow up to kMargin's where its reach stays within this share of
+// the limit (a result's corner a little off its original's boundary still settles).
+constexpr double kMarginShare = 0.5;
 // Sides paired by sorting up to this many, by hashing above (paired).
 constexpr size_t kSortedSides = 96;
 
@@ -216,8 +219,9 @@ struct ListedCandidates {
 
 // The bound over the candidates (SlotCandidates or ListedCandidates). listed (projected_bound_over's
 // bound): a candidate inside T is its own overlap (no clip; its corners' heights as they are, where
-// the clip would interpolate them again), and the margin is kRoundingMargin's, not kMargin's. at,
-// when given: the (u, v) of T where the bound is reached.
+// the clip would interpolate them again), and the margin is at least kRoundingMargin's and at most
+// kMargin's, as large as keeps its reach within kMarginShare of the limit. at, when given: the (u, v)
+// of T where the bound is reached.
 template <typename Candidates>
 double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScratch& scratch, bool along_creases,
                   bool listed, double* at, const Candidates& candidates) {
@@ -227,14 +231,6 @@ double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScra
   const Sides t_sides(t);
   // The facing triangles over T give the bound, and those of their sides that come near T must
   // be shared by two of them in opposite directions (no boundary of U crosses T).
-  const double longest = std::max({l1, std::hypot(t[2][0], t[2][1]), std::hypot(t[2][0] - l1, t[2][1])});
-  const double margin = listed ? kRoundingMargin * (flat.magnitude + longest) : kMargin * longest;
-  const double t_lo[2] = {std::min(0.0, t[2][0]) - margin, -margin};
-  const double t_hi[2] = {std::max(l1, t[2][0]) + margin, t[2][1] + margin};
-  std::vector<Side>& sides = scratch.sides;
-  sides.clear();
-  double bound = 0.0;
-  bool covered = false;
   // along_creases: coverage is decided over T shrunk by the margin (a boundary of U along T's
   // sides does not fail it), so it is tested at T's incentre, and a point of T outside the shrunk
   // one lies within margin x (farthest corner from the incentre) / inradius of a point inside it.
@@ -242,7 +238,20 @@ double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScra
   const double incentre[2] = {(la * t[0][0] + lb * t[1][0] + l1 * t[2][0]) / perimeter,
                               (la * t[0][1] + lb * t[1][1] + l1 * t[2][1]) / perimeter};
   const double inradius = twice_area / perimeter;
+  double farthest = 0.0;
+  for (int j = 0; j < 3; ++j) farthest = std::max(farthest, std::hypot(t[j][0] - incentre[0], t[j][1] - incentre[1]));
+  const double longest = std::max({l1, lb, la});
+  const double margin =
+      listed ? std::max(kRoundingMargin * (flat.magnitude + longest),
+                        std::min(kMargin * longest, kMarginShare * limit * inradius / farthest))
+             : kMargin * longest;
   if (along_creases && !(inradius > 2 * margin)) return kNoBound;
+  const double t_lo[2] = {std::min(0.0, t[2][0]) - margin, -margin};
+  const double t_hi[2] = {std::max(l1, t[2][0]) + margin, t[2][1] + margin};
+  std::vector<Side>& sides = scratch.sides;
+  sides.clear();
+  double bound = 0.0;
+  bool covered = false;
   for (size_t i = 0; i < candidates.size(); ++i) {
     double buffer[9];
     const double* corners = candidates.corners(i, buffer);
@@ -308,8 +317,6 @@ double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScra
   if (!covered) return kNoBound;
   if (!paired(scratch)) return kNoBound;
   if (along_creases) {
-    double farthest = 0.0;
-    for (int j = 0; j < 3; ++j) farthest = std::max(farthest, std::hypot(t[j][0] - incentre[0], t[j][1] - incentre[1]));
     bound += margin * farthest / inradius;
     if (bound > limit) return kNoBound;
   }

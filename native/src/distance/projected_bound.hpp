@@ -39,9 +39,9 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
 
 /// The same bound with along_creases over the listed triangles of `to` only, for a surface without
 /// a search tree: triangles left out can fail the test (a side of U left unmatched), never make the
-/// bound wrong. Its margin is the coordinates' rounding (not a share of p's size): a boundary of U
-/// through p's corners or along its sides, as where a result lies on its original, costs next to
-/// nothing. reached: the point of p where the bound is reached (a height over one triangle of `to`,
+/// bound wrong. Its margin is at least the coordinates' rounding and grows toward the tree's share
+/// of p's size only while its reach stays within half the limit: a boundary of U through p's corners
+/// or along its sides, as where a result lies on its original, costs next to nothing. reached: the point of p where the bound is reached (a height over one triangle of `to`,
 /// or the distance to it, so the distance there is at most the bound).
 double projected_bound_over(const double p[3][3], const Surface& to, const std::vector<int32_t>& triangles,
                             double limit, BeneathScratch& scratch, double reached[3]);

@@ -53,16 +53,19 @@ constexpr size_t kRetryTriangles = 256;
 constexpr double kCellSpacings = 4.0;  // grid cell side in A's mean vertex spacings (about 8 vertices a cell)
 constexpr int64_t kRefineRun = 2048;
 constexpr int64_t kRefineQueries = 16 * kRefineRun;  // per run: 16 a triangle (the bracket holds when they run out)
-constexpr double kFloor = 1e-12;  // distances below this fraction of the diagonal count as none (coincident surfaces)
+// Distances below this fraction of the diagonal count as none (coincident surfaces): the least
+// settle floor, and the floor under which a midpoint's bound is not measured exactly.
+constexpr double kMeasureFloor = 1e-12;
 constexpr int64_t kTopQueries = 256;
 constexpr int64_t kTopExact = 16;  // points of B measured exactly (the backward lower bound)
-// The bound beneath (projected_bound.hpp) is tried on pieces of B as large as kBeneathLeast to
-// kBeneathMost of A's mean triangles (smaller ones are mostly settled by their corners; larger
-// ones would look at too many; a result lying on its original needs it even over one triangle),
-// at most kBeneathTries times along a piece's splits, over at most kBeneathCandidates triangles of A.
-constexpr double kBeneathLeast = 0.25;
+// The bound beneath (projected_bound.hpp) is tried on pieces of B over at most kBeneathMost of A's
+// mean triangles (larger ones would look at too many), at most kBeneathTries times along a piece's
+// splits and again only once its area is kBeneathShrink times smaller than where it last failed
+// (two splits on: a piece lying along a crease of A settles once its corners are on the crease),
+// over at most kBeneathCandidates triangles of A.
 constexpr double kBeneathMost = 256.0;
-constexpr int kBeneathTries = 2;
+constexpr int kBeneathTries = 3;
+constexpr double kBeneathShrink = 16.0;
 constexpr double kBeneathReach = 8.0;  // tried where a piece's reach exceeds this many times its room under the limit
 constexpr size_t kBeneathCandidates = 1024;
 
@@ -211,12 +214,12 @@ void measure_flagged(const Surface& a, const Surface& b, const VertexGrid& grid,
 // more) cost several times as many queries. Keeps in `listed` those still open; returns the
 // largest bound of those settled.
 double settle_by_exact_corners(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance,
-                               VertexBounds& v, std::vector<int32_t>& listed) {
+                               double floor, VertexBounds& v, std::vector<int32_t>& listed) {
   std::vector<uint8_t> measure(size_t(a.num_vertices()), 0);
   for (int32_t f : listed)
     for (int j = 0; j < 3; ++j) measure[size_t(a.triangles()[3 * size_t(f) + j])] = 1;
   measure_flagged(a, b, grid, measure, v);
-  const double threshold = std::max(v.lower * (1.0 + tolerance), kFloor * std::max(a.diagonal(), b.diagonal()));
+  const double threshold = std::max(v.lower * (1.0 + tolerance), floor);
   std::vector<double> bound(listed.size());
   parallel_for(0, int64_t(listed.size()), kParallelMinCostly,
                [&](int64_t i) { bound[size_t(i)] = triangle_bound(a, b, v, listed[size_t(i)], threshold); });
@@ -234,10 +237,11 @@ struct ForwardSums {
   double longest2 = 0.0;  // the longest side's square
 };
 
-void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, QuickBound& out,
-                   double& reach) {
+// A to B (the file comment); floor: bounds at or under it count as settled.
+void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, double floor,
+                   QuickBound& out, double& reach) {
   VertexBounds v = bound_vertices(a, b, grid);
-  const double threshold = std::max(v.lower * (1.0 + tolerance), kFloor * std::max(a.diagonal(), b.diagonal()));
+  const double threshold = std::max(v.lower * (1.0 + tolerance), floor);
   std::vector<uint8_t> refine(size_t(a.num_triangles()), 0);
   const ForwardSums sums = ordered_reduce<ForwardSums>(
       a.num_triangles(),
@@ -255,7 +259,7 @@ void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, d
   std::vector<int32_t> listed;
   for (int32_t f = 0; f < a.num_triangles(); ++f)
     if (refine[size_t(f)]) listed.push_back(f);
-  const double settled = std::max(sums.settled, settle_by_exact_corners(a, b, grid, tolerance, v, listed));
+  const double settled = std::max(sums.settled, settle_by_exact_corners(a, b, grid, tolerance, floor, v, listed));
   out.forward_lower = v.lower;
   out.forward_upper = std::max(v.lower, settled);
   out.forward_mean = v.mean;
@@ -268,7 +272,7 @@ void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, d
   parallel_for_dynamic(0, runs, 1, parallel_if(runs > 1), [&](int64_t r) {
     const auto first = listed.begin() + r * kRefineRun;
     const std::vector<int32_t> run(first, first + std::min<int64_t>(kRefineRun, listed.end() - first));
-    brackets[size_t(r)] = bound_max_over_triangles(a, run, b, v.lower, tolerance, kRefineQueries);
+    brackets[size_t(r)] = bound_max_over_triangles(a, run, b, v.lower, tolerance, kRefineQueries, floor);
   });
   for (const MaxBracket& bracket : brackets) {
     out.forward_lower = std::max(out.forward_lower, bracket.lower);
@@ -353,9 +357,23 @@ double beneath(const Corners& piece, double limit, double grow, const Surface& a
   return projected_bound_over(piece.p, a, candidates, limit, scratch, reached);
 }
 
+// A piece of B across an edge of A that two of its corners' triangles share: bounded on the edge's
+// two sides, each through its own triangle (edge_cut.hpp), or +infinity above limit.
+double cut_bound(const Corners& piece, const StarBound d[3], const Surface& a, double limit) {
+  auto corner2 = [&](int i, int32_t triangle) {
+    const double distance = distance_to_triangle(piece.p[i], a, triangle);
+    return distance * distance;
+  };
+  double bound = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k)
+    bound = std::min(bound, edge_cut_bound(piece.p, a, d[k].triangle, d[(k + 1) % 3].triangle, limit * limit, corner2));
+  return bound;
+}
+
 // B to A for one triangle of B: its pieces split until each one's bound (largest corner value
 // plus reach, or the farthest corner from a corner's triangle of A: the distance to one triangle
-// is convex) is within the tolerance of the largest corner value found (floor: `floor`).
+// is convex) is within the tolerance of the largest corner value found (at least `settle`; floor:
+// the bound under which a midpoint is not measured exactly).
 struct PieceBound {
   double upper = 0.0;
   bool capped = false;            // stopped at its most splits with a piece above the tolerance
@@ -365,13 +383,16 @@ struct PieceBound {
 };
 
 PieceBound bound_backward_triangle(const Corners& t, const StarBound corner[3], const Surface& a, const VertexGrid& grid,
-                                   const Stars& stars, double reach, double floor, double tolerance, int max_splits) {
+                                   const Stars& stars, double reach, double floor, double settle, double tolerance,
+                                   int max_splits) {
+  constexpr double kNever = std::numeric_limits<double>::infinity();
   struct Piece {
     Corners c;
     StarBound d[3];
     double upper;
-    double reach;  // its nearest-corner reach
-    int tries;     // bounds beneath tried on it and the pieces it was split from
+    double reach;        // its nearest-corner reach
+    int tries;           // bounds beneath that failed on it and the pieces it was split from
+    double failed_over;  // A's mean triangles under the piece where the last of them failed
   };
   // Lipschitz, then convex through each corner's triangle of A (each triangle once; its corners
   // measured until one is as far as the bound so far, which it then cannot lower).
@@ -391,8 +412,8 @@ PieceBound bound_backward_triangle(const Corners& t, const StarBound corner[3], 
   PieceBound out;
   for (int j = 0; j < 3; ++j)
     if (corner[j].distance > out.worst) out.worst = corner[j].distance, std::copy_n(t.p[j], 3, out.worst_point);
-  double best = std::max({floor, corner[0].distance, corner[1].distance, corner[2].distance});
-  std::vector<Piece> open{{t, {corner[0], corner[1], corner[2]}, 0.0, 0.0, 0}};
+  double best = std::max({floor, settle, corner[0].distance, corner[1].distance, corner[2].distance});
+  std::vector<Piece> open{{t, {corner[0], corner[1], corner[2]}, 0.0, 0.0, 0, kNever}};
   std::vector<int32_t> candidates;
   BeneathScratch scratch;
   // The bound beneath's candidates: A's triangles with a corner within `grow` of the piece (about
@@ -416,11 +437,16 @@ PieceBound bound_backward_triangle(const Corners& t, const StarBound corner[3], 
       out.capped = true;
       break;
     }
-    const double triangles_over = area(piece.c) / mean_area;
     const double limit = best * (1.0 + tolerance);
+    const double cut = cut_bound(piece.c, piece.d, a, limit);
+    if (cut <= limit) {  // across an edge of A: each side through its own triangle
+      settled = std::max(settled, cut);
+      continue;
+    }
+    const double triangles_over = area(piece.c) / mean_area;
     const double gap = limit - std::max({piece.d[0].distance, piece.d[1].distance, piece.d[2].distance});
-    const bool tried = piece.tries < kBeneathTries && triangles_over >= kBeneathLeast && triangles_over <= kBeneathMost &&
-                       piece.reach > kBeneathReach * gap;
+    const bool tried = piece.tries < kBeneathTries && triangles_over * kBeneathShrink <= piece.failed_over &&
+                       triangles_over <= kBeneathMost && piece.reach > kBeneathReach * gap;
     if (tried) {  // over many of A's triangles: their planes may settle it at once
       double reached[3];
       const double under = beneath(piece.c, limit, grow, a, grid, stars, candidates, scratch, reached);
@@ -452,6 +478,7 @@ PieceBound bound_backward_triangle(const Corners& t, const StarBound corner[3], 
     for (const auto& child : kChildren) {
       Piece next;
       next.tries = piece.tries + (tried ? 1 : 0);
+      next.failed_over = tried ? triangles_over : piece.failed_over;
       for (int j = 0; j < 3; ++j) {
         std::copy_n(point[child[j]], 3, next.c.p[j]);
         next.d[j] = value[child[j]];
@@ -494,8 +521,9 @@ void retry_capped(std::vector<PieceBound>& per, const BoundTriangle& bound) {
   }
 }
 
-void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, double reach,
-                    QuickBound& out) {
+// B to A (the file comment); settle: bounds at or under it count as settled.
+void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, double settle,
+                    double reach, QuickBound& out) {
   const Stars stars(a);
   std::vector<StarBound> vertex(size_t(b.num_vertices()), StarBound{0.0, -1, -1});
   parallel_for(0, b.num_vertices(), kParallelMinCostly, [&](int64_t y) {
@@ -505,12 +533,12 @@ void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, 
     if (vertex[size_t(y)].distance > out.forward_lower)
       vertex[size_t(y)] = star_exact_distance(p, vertex[size_t(y)], reach, a, grid, stars);
   });
-  const double floor = std::max(out.forward_lower, kFloor * std::max(a.diagonal(), b.diagonal()));
+  const double floor = std::max(out.forward_lower, kMeasureFloor * std::max(a.diagonal(), b.diagonal()));
   std::vector<PieceBound> per(size_t(b.num_triangles()));
   auto bound_triangle = [&](int32_t f, int max_splits) {
     const int32_t* t = &b.triangles()[3 * size_t(f)];
     const StarBound d[3] = {vertex[size_t(t[0])], vertex[size_t(t[1])], vertex[size_t(t[2])]};
-    return bound_backward_triangle(corners_of(b, f), d, a, grid, stars, reach, floor, tolerance, max_splits);
+    return bound_backward_triangle(corners_of(b, f), d, a, grid, stars, reach, floor, settle, tolerance, max_splits);
   };
   parallel_for_dynamic(0, b.num_triangles(), 16, kParallelMinCostly,
                        [&](int64_t f) { per[size_t(f)] = bound_triangle(int32_t(f), kMaxSplits); });
@@ -534,13 +562,14 @@ void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, 
 
 }  // namespace
 
-QuickBound quick_hausdorff_bound(const Surface& a, const Surface& b, double tolerance) {
+QuickBound quick_hausdorff_bound(const Surface& a, const Surface& b, double tolerance, double resolution) {
   const double spacing = std::sqrt(2.0 * a.area() / std::max(1, a.num_triangles()));
   const VertexGrid grid(a, kCellSpacings * spacing);
+  const double settle = std::max(resolution, kMeasureFloor) * std::max(a.diagonal(), b.diagonal());
   QuickBound out;
   double reach = 0.0;
-  bound_forward(a, b, grid, tolerance, out, reach);
-  bound_backward(a, b, grid, tolerance, reach, out);
+  bound_forward(a, b, grid, tolerance, settle, out, reach);
+  bound_backward(a, b, grid, tolerance, settle, reach, out);
   return out;
 }
 

@@ -151,8 +151,10 @@ struct QuickBound {
   int64_t refined = 0;          ///< triangles of A bracketed exactly
 };
 
-/// The bound for a (big) and b (small); bounds are split until within (1 + tolerance) of a distance found.
-QuickBound quick_hausdorff_bound(const Surface& a, const Surface& b, double tolerance);
+/// The bound for a (big) and b (small); bounds are split until within (1 + tolerance) of a distance found,
+/// or until under resolution x the larger diagonal (a result lying on its original is not split down
+/// to the coordinates' rounding; at least 1e-12).
+QuickBound quick_hausdorff_bound(const Surface& a, const Surface& b, double tolerance, double resolution = 1e-12);
 
 struct HausdorffParams {
   int64_t samples = 1000000;   ///< wanted samples on the first surface (ignored when step > 0)
