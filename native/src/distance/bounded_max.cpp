@@ -6,6 +6,7 @@
 #include <queue>
 
 #include "distance/edge_cut.hpp"
+#include "distance/fan_cut.hpp"
 #include "distance/projected_bound.hpp"
 
 namespace topstoc {
@@ -104,7 +105,9 @@ class MaxSearch {
 
   // The same search over the listed triangles of the sampled surface only (the others bounded
   // by the caller).
-  MaxBracket run_over(const std::vector<int32_t>& listed) {
+  // to_stars: see bound_max_over_triangles.
+  MaxBracket run_over(const std::vector<int32_t>& listed, const Stars* to_stars) {
+    fans = to_stars;
     const auto& positions = from.positions();
     const auto& triangles = from.triangles();
     int32_t hint = -1;
@@ -172,6 +175,12 @@ class MaxSearch {
   // pieces left open by their corner bounds try the bound over their quarters (quarter_bound)
   // before the bound beneath them (the vertex-first search only, whose brackets no decimation reads)
   const bool by_quarters;
+  // bound_max_over_triangles' stars of the other surface, when given: its pieces also try the cheap
+  // bounds (settle_cheaply) and the fan cut around a vertex their corners' triangles share
+  const Stars* fans = nullptr;
+  // Whether a piece's near[j] is its corner j's nearest triangle at distance d[j] (every search
+  // but the one seeded with the caller's distances), and the cheap bounds are tried.
+  bool cheap() const { return by_quarters || fans != nullptr; }
   MaxBracket out;
   BeneathScratch scratch;
   std::priority_queue<Piece, std::vector<Piece>, ByUpper> open;
@@ -233,7 +242,7 @@ class MaxSearch {
   // The squared distance from a piece's corner to a triangle of the other surface: known where
   // that is the corner's nearest (the vertex-first search), else measured.
   double corner_distance2(const Piece& piece, int corner, int32_t triangle) const {
-    if (by_quarters && piece.near[corner] == triangle) return piece.d[corner] * piece.d[corner];
+    if (cheap() && piece.near[corner] == triangle) return piece.d[corner] * piece.d[corner];
     return distance2_to(triangle, piece.p[corner]);
   }
 
@@ -303,7 +312,7 @@ class MaxSearch {
   // not tried); at the same threshold it would fail again.
   void keep(Piece& piece, double beneath_tried_at = -1.0) {
     bound(piece);
-    if (by_quarters && !tolerated(piece.upper)) settle_cheaply(piece);
+    if (cheap() && !tolerated(piece.upper)) settle_cheaply(piece);
     // only a bound that settles the piece is looked for: the box searched stays small
     if (!tolerated(piece.upper) && beneath_tried_at != threshold() && worth_projecting(piece))
       piece.upper = std::min(piece.upper, beneath(piece.p, by_quarters));
@@ -322,6 +331,9 @@ class MaxSearch {
   // piece cut along an edge of the other surface, then its quarters.
   void settle_cheaply(Piece& piece) {
     piece.upper = std::min(piece.upper, cut_bound(piece));
+    if (!tolerated(piece.upper) && fans != nullptr)
+      piece.upper = std::min(piece.upper, shared_fan_cut_bound(piece.p, to, *fans, piece.near[0], piece.near[1],
+                                                               piece.near[2], threshold()));
     if (!tolerated(piece.upper)) piece.upper = std::min(piece.upper, quarter_bound(piece));
   }
 
@@ -549,13 +561,14 @@ MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, doubl
 }
 
 MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,
-                                    double start, double relative_tolerance, int64_t max_queries, double floor) {
+                                    double start, double relative_tolerance, int64_t max_queries, double floor,
+                                    const Stars* to_stars) {
   static const std::vector<double> no_vertex_distance;
   const double origin[3] = {0.0, 0.0, 0.0};
   const double diagonal = std::max(from.diagonal(), to.diagonal());
   const double resolution = floor >= 0.0 && diagonal > 0.0 ? floor / diagonal : 1e-13;
   return MaxSearch(from, no_vertex_distance, to, start, origin, relative_tolerance, max_queries, resolution)
-      .run_over(triangles);
+      .run_over(triangles, to_stars);
 }
 
 MaxBracket bound_max_distance_by_tree(const Surface& from, const Surface& to, double relative_tolerance,

@@ -34,6 +34,7 @@
 #include "../core/ordered_sum.hpp"
 #include "distance/bounded_max.hpp"
 #include "distance/edge_cut.hpp"
+#include "distance/fan_cut.hpp"
 #include "distance/projected_bound.hpp"
 #include "distance/vertex_grid.hpp"
 #include "distance/vertex_stars.hpp"
@@ -150,7 +151,8 @@ VertexBounds bound_vertices(const Surface& a, const Surface& b, const VertexGrid
 }
 
 // Per triangle of A, a bound of its distance to B from its corners' (the file comment).
-double triangle_bound(const Surface& a, const Surface& b, const VertexBounds& v, int32_t f, double threshold) {
+double triangle_bound(const Surface& a, const Surface& b, const Stars& b_stars, const VertexBounds& v, int32_t f,
+                      double threshold) {
   const int32_t* t = &a.triangles()[3 * size_t(f)];
   const double corner_max = std::max({v.upper[size_t(t[0])], v.upper[size_t(t[1])], v.upper[size_t(t[2])]});
   const int32_t j0 = v.against[size_t(t[0])];
@@ -175,6 +177,9 @@ double triangle_bound(const Surface& a, const Surface& b, const VertexBounds& v,
     const int32_t j = v.against[size_t(t[k])], l = v.against[size_t(t[(k + 1) % 3])];
     bound = std::min(bound, edge_cut_bound(c.p, b, j, l, threshold * threshold, corner2));
   }
+  if (bound > threshold)  // over a vertex of B that all three corners' triangles hold: sector by sector (fan_cut.hpp)
+    bound = std::min(bound, shared_fan_cut_bound(c.p, b, b_stars, v.against[size_t(t[0])], v.against[size_t(t[1])],
+                                                 v.against[size_t(t[2])], threshold));
   return bound;
 }
 
@@ -213,8 +218,8 @@ void measure_flagged(const Surface& a, const Surface& b, const VertexGrid& grid,
 // nearest triangle of B usually settles them, where bracketing them (three queries a triangle and
 // more) cost several times as many queries. Keeps in `listed` those still open; returns the
 // largest bound of those settled.
-double settle_by_exact_corners(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance,
-                               double floor, VertexBounds& v, std::vector<int32_t>& listed) {
+double settle_by_exact_corners(const Surface& a, const Surface& b, const Stars& b_stars, const VertexGrid& grid,
+                               double tolerance, double floor, VertexBounds& v, std::vector<int32_t>& listed) {
   std::vector<uint8_t> measure(size_t(a.num_vertices()), 0);
   for (int32_t f : listed)
     for (int j = 0; j < 3; ++j) measure[size_t(a.triangles()[3 * size_t(f) + j])] = 1;
@@ -222,7 +227,7 @@ double settle_by_exact_corners(const Surface& a, const Surface& b, const VertexG
   const double threshold = std::max(v.lower * (1.0 + tolerance), floor);
   std::vector<double> bound(listed.size());
   parallel_for(0, int64_t(listed.size()), kParallelMinCostly,
-               [&](int64_t i) { bound[size_t(i)] = triangle_bound(a, b, v, listed[size_t(i)], threshold); });
+               [&](int64_t i) { bound[size_t(i)] = triangle_bound(a, b, b_stars, v, listed[size_t(i)], threshold); });
   double settled = 0.0;
   size_t kept = 0;
   for (size_t i = 0; i < listed.size(); ++i)
@@ -241,12 +246,13 @@ struct ForwardSums {
 void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, double floor,
                    QuickBound& out, double& reach) {
   VertexBounds v = bound_vertices(a, b, grid);
+  const Stars b_stars(b);
   const double threshold = std::max(v.lower * (1.0 + tolerance), floor);
   std::vector<uint8_t> refine(size_t(a.num_triangles()), 0);
   const ForwardSums sums = ordered_reduce<ForwardSums>(
       a.num_triangles(),
       [&](ForwardSums& s, int64_t f) {
-        const double bound = triangle_bound(a, b, v, int32_t(f), threshold);
+        const double bound = triangle_bound(a, b, b_stars, v, int32_t(f), threshold);
         if (bound > threshold) refine[size_t(f)] = 1;
         else s.settled = std::max(s.settled, bound);
         const Corners c = corners_of(a, int32_t(f));
@@ -259,7 +265,7 @@ void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, d
   std::vector<int32_t> listed;
   for (int32_t f = 0; f < a.num_triangles(); ++f)
     if (refine[size_t(f)]) listed.push_back(f);
-  const double settled = std::max(sums.settled, settle_by_exact_corners(a, b, grid, tolerance, floor, v, listed));
+  const double settled = std::max(sums.settled, settle_by_exact_corners(a, b, b_stars, grid, tolerance, floor, v, listed));
   out.forward_lower = v.lower;
   out.forward_upper = std::max(v.lower, settled);
   out.forward_mean = v.mean;
@@ -272,7 +278,7 @@ void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, d
   parallel_for_dynamic(0, runs, 1, parallel_if(runs > 1), [&](int64_t r) {
     const auto first = listed.begin() + r * kRefineRun;
     const std::vector<int32_t> run(first, first + std::min<int64_t>(kRefineRun, listed.end() - first));
-    brackets[size_t(r)] = bound_max_over_triangles(a, run, b, v.lower, tolerance, kRefineQueries, floor);
+    brackets[size_t(r)] = bound_max_over_triangles(a, run, b, v.lower, tolerance, kRefineQueries, floor, &b_stars);
   });
   for (const MaxBracket& bracket : brackets) {
     out.forward_lower = std::max(out.forward_lower, bracket.lower);
@@ -357,9 +363,10 @@ double beneath(const Corners& piece, double limit, double grow, const Surface& a
   return projected_bound_over(piece.p, a, candidates, limit, scratch, reached);
 }
 
-// A piece of B across an edge of A that two of its corners' triangles share: bounded on the edge's
-// two sides, each through its own triangle (edge_cut.hpp), or +infinity above limit.
-double cut_bound(const Corners& piece, const StarBound d[3], const Surface& a, double limit) {
+// A piece of B across an edge of A that two of its corners' triangles share, bounded on the edge's
+// two sides each through its own triangle (edge_cut.hpp), or over a vertex of A that all three
+// hold, sector by sector (fan_cut.hpp); +infinity above limit.
+double cut_bound(const Corners& piece, const StarBound d[3], const Surface& a, const Stars& stars, double limit) {
   auto corner2 = [&](int i, int32_t triangle) {
     const double distance = distance_to_triangle(piece.p[i], a, triangle);
     return distance * distance;
@@ -367,6 +374,8 @@ double cut_bound(const Corners& piece, const StarBound d[3], const Surface& a, d
   double bound = std::numeric_limits<double>::infinity();
   for (int k = 0; k < 3; ++k)
     bound = std::min(bound, edge_cut_bound(piece.p, a, d[k].triangle, d[(k + 1) % 3].triangle, limit * limit, corner2));
+  if (bound > limit)
+    bound = std::min(bound, shared_fan_cut_bound(piece.p, a, stars, d[0].triangle, d[1].triangle, d[2].triangle, limit));
   return bound;
 }
 
@@ -438,8 +447,8 @@ PieceBound bound_backward_triangle(const Corners& t, const StarBound corner[3], 
       break;
     }
     const double limit = best * (1.0 + tolerance);
-    const double cut = cut_bound(piece.c, piece.d, a, limit);
-    if (cut <= limit) {  // across an edge of A: each side through its own triangle
+    const double cut = cut_bound(piece.c, piece.d, a, stars, limit);
+    if (cut <= limit) {  // across an edge or over a vertex of A: each part through its own triangle
       settled = std::max(settled, cut);
       continue;
     }
