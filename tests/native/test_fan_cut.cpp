@@ -87,22 +87,46 @@ TEST_CASE("over a bumpy fan the bound is never under a dense sampling's distance
   CHECK(bounded >= 40);  // not vacuous: fans turning once around their mean normal give a bound
 }
 
-TEST_CASE("an open fan, a fan folded over itself, or triangles sharing no vertex give no bound") {
+TEST_CASE("an open fan, a triangle folded back, or triangles sharing no vertex give no bound") {
   const double p[3][3] = {{-0.2, -0.15, 0.0}, {0.25, -0.1, 0.0}, {0.02, 0.3, 0.0}};
   const Surface open = fan(6, [](int) { return 0.0; }, false);
   CHECK(fan_cut_bound(p, open, Stars(open), 0, 1.0) == kInfinity);
-  // a rim that turns twice around the centre: twelve triangles over two turns
+  // one rim vertex pulled across its neighbour: its two triangles turn against the fan
   std::vector<double> positions = {0, 0, 0};
   std::vector<int32_t> triangles;
-  for (int i = 0; i < 12; ++i) {
-    const double angle = 4 * 3.14159265358979 * i / 12;
-    positions.insert(positions.end(), {std::cos(angle), std::sin(angle), 0.01 * i});
-    triangles.insert(triangles.end(), {0, 1 + i, 1 + (i + 1) % 12});
+  for (int i = 0; i < 6; ++i) {
+    const double angle = 2 * 3.14159265358979 * (i == 2 ? 0.5 : i) / 6;
+    positions.insert(positions.end(), {std::cos(angle), std::sin(angle), 0.0});
+    triangles.insert(triangles.end(), {0, 1 + i, 1 + (i + 1) % 6});
   }
-  const Surface twice(std::move(positions), std::move(triangles));
-  CHECK(fan_cut_bound(p, twice, Stars(twice), 0, 1.0) == kInfinity);
+  const Surface folded(std::move(positions), std::move(triangles));
+  CHECK(fan_cut_bound(p, folded, Stars(folded), 0, 1.0) == kInfinity);
   const Surface flat = fan(7, [](int) { return 0.0; });
   const Stars stars(flat);
   CHECK(shared_fan_cut_bound(p, flat, stars, 0, 2, 4, 1.0) <= 1e-15);  // all hold the centre
   CHECK(shared_fan_cut_bound(p, flat, stars, 0, 2, -1, 1.0) == kInfinity);
+}
+
+TEST_CASE("a fan turning twice around its centre covers space twice: its bound still holds") {
+  std::vector<double> positions = {0, 0, 0};
+  std::vector<int32_t> triangles;
+  for (int i = 0; i < 12; ++i) {
+    const double angle = 4 * 3.14159265358979 * i / 12;
+    positions.insert(positions.end(), {std::cos(angle), std::sin(angle), 0.02 * i});
+    triangles.insert(triangles.end(), {0, 1 + i, 1 + (i + 1) % 12});
+  }
+  const Surface twice(std::move(positions), std::move(triangles));
+  const Stars stars(twice);
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  int bounded = 0;
+  for (int round = 0; round < 20; ++round) {
+    double p[3][3];
+    around(p, 0.2 * unit(random), 0.2 * unit(random), 0.1 * unit(random), 0.3, random);
+    const double bound = fan_cut_bound(p, twice, stars, 0, kInfinity);
+    if (bound == kInfinity) continue;
+    ++bounded;
+    CHECK(bound >= sampled_max(p, twice) * (1 - 1e-12));
+  }
+  CHECK(bounded == 20);
 }

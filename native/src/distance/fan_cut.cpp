@@ -12,7 +12,6 @@ namespace {
 
 constexpr double kNone = std::numeric_limits<double>::infinity();
 constexpr int kMostTriangles = int(Stars::kWideStar);  // wider fans are left to the other bounds
-constexpr double kPi = 3.14159265358979323846;
 
 double dot(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 void cross(const double* a, const double* b, double* out) {
@@ -20,35 +19,40 @@ void cross(const double* a, const double* b, double* out) {
 }
 
 // v's fan: per triangle, its two other corners in the triangle's own order after v (the sector runs
-// from the first spoke to the second), and the fan's mean normal.
+// from the first spoke to the second), the spokes' offsets from v and the two planes' normals.
 struct Fan {
   int count = 0;
-  int32_t triangle[kMostTriangles], from[kMostTriangles], to[kMostTriangles];
-  double axis[3] = {0, 0, 0};
+  int32_t triangle[kMostTriangles];
+  double normal[kMostTriangles][2][3];  // per sector: its two planes' normals, pointing inside
   // False where the fan is too large, not closed (each spoke the start of one sector and the end of
-  // another), or has no normal.
+  // another), or a sector is not turned the way of the fan's mean normal by less than half a turn.
+  // Then the sectors chain around v, each turn covering space once: every point lies in one.
   bool set(const Surface& s, const Stars& stars, int32_t v) {
     count = int(stars.end(v) - stars.begin(v));
     if (count < 3 || count > kMostTriangles) return false;
     const double* c = &s.positions()[3 * size_t(v)];
+    int32_t from[kMostTriangles], to[kMostTriangles];
+    double e[kMostTriangles][3], f[kMostTriangles][3], n[kMostTriangles][3], axis[3] = {0, 0, 0};
     for (int i = 0; i < count; ++i) {
       triangle[i] = stars.triangle(stars.begin(v) + i);
       const int32_t* ids = &s.triangles()[3 * size_t(triangle[i])];
       const int r = ids[0] == v ? 0 : ids[1] == v ? 1 : 2;
       from[i] = ids[(r + 1) % 3], to[i] = ids[(r + 2) % 3];
-      double e[3], f[3], n[3];
-      for (int k = 0; k < 3; ++k) e[k] = s.positions()[3 * size_t(from[i]) + k] - c[k], f[k] = s.positions()[3 * size_t(to[i]) + k] - c[k];
-      cross(e, f, n);
-      for (int k = 0; k < 3; ++k) axis[k] += n[k];
+      for (int k = 0; k < 3; ++k)
+        e[i][k] = s.positions()[3 * size_t(from[i]) + k] - c[k], f[i][k] = s.positions()[3 * size_t(to[i]) + k] - c[k];
+      cross(e[i], f[i], n[i]);
+      for (int k = 0; k < 3; ++k) axis[k] += n[i][k];
     }
     for (int i = 0; i < count; ++i) {
       int starts = 0, ends = 0;
       for (int l = 0; l < count; ++l) starts += from[l] == from[i], ends += to[l] == from[i];
       if (starts != 1 || ends != 1) return false;
     }
-    const double length = std::sqrt(dot(axis, axis));
-    if (!(length > 0)) return false;
-    for (double& x : axis) x /= length;
+    for (int i = 0; i < count; ++i) {
+      if (!(dot(axis, n[i]) > 0)) return false;
+      cross(axis, e[i], normal[i][0]);
+      cross(f[i], axis, normal[i][1]);
+    }
     return true;
   }
 };
@@ -80,29 +84,13 @@ double fan_cut_bound(const double p[3][3], const Surface& to, const Stars& stars
   if (!fan.set(to, stars, v)) return kNone;
   const auto& positions = to.positions();
   const double* c = &positions[3 * size_t(v)];
-  // Each sector's angle around the axis: in (0, pi) for its two planes to bound it, 2 pi in all
-  // for the sectors to turn once around v.
-  double turned = 0.0;
-  double normal[kMostTriangles][2][3];  // per sector: its two planes' normals, pointing inside
-  for (int i = 0; i < fan.count; ++i) {
-    double e[3], f[3], n[3];
-    for (int k = 0; k < 3; ++k) e[k] = positions[3 * size_t(fan.from[i]) + k] - c[k], f[k] = positions[3 * size_t(fan.to[i]) + k] - c[k];
-    cross(e, f, n);
-    const double sine = dot(fan.axis, n);
-    if (!(sine > 0)) return kNone;
-    cross(fan.axis, e, normal[i][0]);
-    cross(f, fan.axis, normal[i][1]);
-    const double cosine = dot(e, f) - dot(fan.axis, e) * dot(fan.axis, f);
-    turned += std::atan2(sine, cosine);
-  }
-  if (!(std::abs(turned - 2 * kPi) < 1.0)) return kNone;  // once around (the angles sum to 2 pi times the turns)
   const double limit2 = limit * limit;
   double worst = 0.0;
   for (int i = 0; i < fan.count; ++i) {
     double ring[2][5][3];
     for (int j = 0; j < 3; ++j) std::copy_n(p[j], 3, ring[0][j]);
-    int count = clip(ring[0], 3, c, normal[i][0], ring[1]);
-    count = count > 0 ? clip(ring[1], count, c, normal[i][1], ring[0]) : 0;
+    int count = clip(ring[0], 3, c, fan.normal[i][0], ring[1]);
+    count = count > 0 ? clip(ring[1], count, c, fan.normal[i][1], ring[0]) : 0;
     const int32_t* ids = &to.triangles()[3 * size_t(fan.triangle[i])];
     for (int m = 0; m < count; ++m) {
       double closest[3];
