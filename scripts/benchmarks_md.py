@@ -467,6 +467,28 @@ def render_batch(name: str, figures: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def render_report(name: str, figures: dict) -> str:
+    """bench_report.py --json: the default error report's CPU time next to the decimation's, per big original."""
+    label = f", {figures['label']}" if figures.get("label") else ""
+    baseline = figures.get("baseline")
+    out = [f"## The error report next to the decimation{label} (`{name}`)", "", *source_lines(figures)]
+    if baseline:
+        out.append(f"- Baseline build: `{baseline}` (same run, alternating case by case)")
+    out += ["", "| case | triangles | decimation s | report s | report ÷ decimation (goal ≤ 20 %) | "
+                "estimate, upper (of the diagonal) | baseline report s |", "|---|---|---|---|---|---|---|"]
+    for row in figures["cases"]:
+        if row.get("missing"):
+            out.append(f"| {row['case']} | — (original absent) | | | | | |")
+            continue
+        base = f"{row['baseline']['report_seconds']:.2f}" if "baseline" in row else "—"
+        settled = "" if row["converged"] else " (not converged)"
+        out.append(f"| {row['case']} | {row['triangles']:,} → {row['result_triangles']:,} | "
+                   f"{row['decimation_seconds']:.2f} | {row['report_seconds']:.2f} | "
+                   f"{row['report_seconds'] / row['decimation_seconds']:.0%} | "
+                   f"{row['estimate']:.3g}, {row['upper']:.3g}{settled} | {base} |")
+    return "\n".join(out) + "\n"
+
+
 def render_error_search(name: str, figures: dict) -> str:
     """bench_error_search.py --json: max_error searches against one count-target decimation at the answer."""
     cases = figures["cases"]
@@ -528,10 +550,12 @@ def render_result(path: pathlib.Path) -> str:
         return render_batch(path.name, figures)
     if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_error_search.py":
         return render_error_search(path.name, figures)
+    if isinstance(figures, dict) and figures.get("benchmark") == "tests/bench/bench_report.py":
+        return render_report(path.name, figures)
     raise SystemExit(f"error: {path}: no renderer for this result file (scripts/benchmarks_md.py knows "
                      "the --json of bench_decimate.py, bench_quality.py, bench_attributes.py, bench_loops.py --families, "
                      "bench_scale.py, bench_families.py, bench_high_valence.py, bench_blender_background.py --memory, bench_threads_paired.py, bench_cleanup.py, "
-                     "bench_cleanup.py --speed, bench_blender_decimate.py --only-rest, bench_batch.py and bench_error_search.py, and carried-over "
+                     "bench_cleanup.py --speed, bench_blender_decimate.py --only-rest, bench_batch.py, bench_error_search.py and bench_report.py, and carried-over "
                      "figures)")
 
 
