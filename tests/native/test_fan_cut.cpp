@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "sampled_distance.hpp"
 #include "distance/fan_cut.hpp"
 
 using topstoc::fan_cut_bound;
@@ -31,19 +32,6 @@ Surface fan(int n, Height height, bool closed = true) {
   }
   for (int i = 0; i < (closed ? n : n - 1); ++i) triangles.insert(triangles.end(), {0, 1 + i, 1 + (i + 1) % n});
   return Surface(std::move(positions), std::move(triangles));
-}
-
-double sampled_max(const double p[3][3], const Surface& to) {
-  const int steps = 40;
-  double best = 0.0;
-  for (int i = 0; i <= steps; ++i)
-    for (int j = 0; i + j <= steps; ++j) {
-      const double u = double(i) / steps, v = double(j) / steps, w = 1 - u - v;
-      double x[3];
-      for (int k = 0; k < 3; ++k) x[k] = w * p[0][k] + u * p[1][k] + v * p[2][k];
-      best = std::max(best, std::sqrt(to.bvh().closest(x).distance2));
-    }
-  return best;
 }
 
 // A triangle of the given size around (cx, cy) at heights z + tilt.

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "sampled_distance.hpp"
 #include "distance/bounded_max.hpp"
 #include "distance/projected_bound.hpp"
 
@@ -40,20 +41,6 @@ Surface grid(int n, Height z, int skip = -1, int flip = -1) {
       triangles.insert(triangles.end(), {a, d, c});
     }
   return Surface(std::move(positions), std::move(triangles));
-}
-
-// The largest distance from a dense sampling of triangle p to the surface (a lower bound of the max).
-double sampled_max(const double p[3][3], const Surface& to) {
-  const int steps = 40;
-  double best = 0.0;
-  for (int i = 0; i <= steps; ++i)
-    for (int j = 0; i + j <= steps; ++j) {
-      const double u = double(i) / steps, v = double(j) / steps, w = 1 - u - v;
-      double x[3];
-      for (int k = 0; k < 3; ++k) x[k] = w * p[0][k] + u * p[1][k] + v * p[2][k];
-      best = std::max(best, std::sqrt(to.bvh().closest(x).distance2));
-    }
-  return best;
 }
 
 const double kInfinity = std::numeric_limits<double>::infinity();

@@ -201,10 +201,7 @@ def test_the_quick_bound_settles_a_result_over_many_small_triangles_by_their_pla
     result = (b.vertices, b.triangles)
     found = engine.quick_hausdorff_bound(as_surface(original), as_surface(result), tolerance=0.25)
     assert found["grid_queries"] < 4 * len(b.triangles)  # the walks of the result's vertices and a few pieces
-    exact = estimates.exact_error(original, result)
-    for side in ("forward", "backward"):
-        ours, theirs = (found[side + "_lower"], found[side + "_upper"]), getattr(exact, side)
-        assert ours[0] <= theirs[1] and ours[1] >= theirs[0]
+    exact = assert_holds_the_exact_bracket(found, original, result)
     estimate = max(found["forward_lower"], found["backward_lower"])
     assert max(found["forward_upper"], found["backward_upper"]) <= 1.25 * estimate * (1 + 1e-12)
     assert estimate >= 0.9 * exact.estimate
@@ -218,64 +215,31 @@ def test_the_quick_bound_settles_a_result_lying_on_its_original_by_the_triangles
     # rounding (its margin had been a billionth of the piece's size, and pieces over fewer than two
     # triangles were not tried), so the backward side settles instead of stopping at 1.6e-4 of the
     # diagonal. Both sides hold the exact bracket.
-    from meshgen import subdivide
     from topstoc.core.api.hausdorff import as_surface
-    from topstoc.core.api.io import read_mesh
-    knot = read_mesh(data_dir / "genus_positive" / "cgal_knot1.off")
-    original = subdivide(knot.vertices, knot.triangles, 2)
-    b = topstoc.Mesh(*original).decimate(ratio=0.1, seed=1)
-    result = (b.vertices, b.triangles)
+    original, result = subdivided_and_decimated(data_dir / "genus_positive" / "cgal_knot1.off", 2, 0.1)
     a = as_surface(original)
     found = engine.quick_hausdorff_bound(a, as_surface(result), tolerance=0.25)
     assert found["backward_upper"] < 1e-9 * a.diagonal
-    exact = estimates.exact_error(original, result)
-    for side in ("forward", "backward"):
-        ours, theirs = (found[side + "_lower"], found[side + "_upper"]), getattr(exact, side)
-        assert ours[0] <= theirs[1] and ours[1] >= theirs[0]
+    assert_holds_the_exact_bracket(found, original, result)
 
 
-def test_the_quick_bound_settles_a_cad_result_across_the_creases_of_its_original(data_dir):
-    # Fandisk subdivided once (each triangle into four coplanar ones) and decimated to a tenth: the
-    # result's pieces near the original's creases have corners whose nearest triangles lie on the
-    # crease's two faces. Bounded on the crease's two sides (the edge cut), and beneath again once a
-    # piece is 16 times smaller than where that failed, the backward side settles within the gap (its
-    # upper had stayed 93 times the estimate, left to the exact walk). Both sides hold the exact bracket.
-    from meshgen import subdivide
+@pytest.mark.parametrize("name", ["genus0/cgal_fandisk.off", "genus_positive/cgal_anchor_dense.off"])
+def test_the_quick_bound_settles_a_cad_result_lying_on_its_subdivided_original(data_dir, name):
+    # A CAD mesh subdivided once (each triangle into four coplanar ones) and decimated to a tenth.
+    # Fandisk: pieces of the result near the original's creases have corners whose nearest triangles
+    # lie on the crease's two faces; bounded on the crease's two sides (the edge cut), and beneath
+    # again once a piece is 16 times smaller than where that failed, the backward side settles (it
+    # had stayed 93 times the estimate, left to the exact walk). The anchor: the result lies within
+    # 5.6e-7 of the diagonal of its original, and where a triangle of either lies across a vertex of
+    # the other its corners' nearest triangles share no edge; bounded sector by sector around that
+    # vertex (the fan cut), both sides settle (they had stayed 189 and 3,224 times the estimate).
+    # Both sides hold the exact bracket.
     from topstoc.core.api.hausdorff import as_surface
-    from topstoc.core.api.io import read_mesh
-    fandisk = read_mesh(data_dir / "genus0" / "cgal_fandisk.off")
-    original = subdivide(fandisk.vertices, fandisk.triangles, 1)
-    b = topstoc.Mesh(*original).decimate(ratio=0.1, seed=1)
-    result = (b.vertices, b.triangles)
+    original, result = subdivided_and_decimated(data_dir / name, 1, 0.1)
     found = engine.quick_hausdorff_bound(as_surface(original), as_surface(result), tolerance=0.25)
     estimate = max(found["forward_lower"], found["backward_lower"])
     assert max(found["forward_upper"], found["backward_upper"]) <= 1.25 * estimate * (1 + 1e-12)
-    exact = estimates.exact_error(original, result)
-    for side in ("forward", "backward"):
-        ours, theirs = (found[side + "_lower"], found[side + "_upper"]), getattr(exact, side)
-        assert ours[0] <= theirs[1] and ours[1] >= theirs[0]
-
-
-def test_the_quick_bound_settles_a_cad_result_lying_across_the_vertices_of_its_original(data_dir):
-    # The anchor (CAD) subdivided once and decimated to a tenth: the result lies within 5.6e-7 of the
-    # diagonal of its original. Where a triangle of either lies across a vertex of the other, its
-    # corners' nearest triangles differ and share no edge; bounded sector by sector around that vertex
-    # (the fan cut), both sides settle within the gap (they had stayed 189 and 3,224 times the
-    # estimate, left to the exact walk). Both sides hold the exact bracket.
-    from meshgen import subdivide
-    from topstoc.core.api.hausdorff import as_surface
-    from topstoc.core.api.io import read_mesh
-    anchor = read_mesh(data_dir / "genus_positive" / "cgal_anchor_dense.off")
-    original = subdivide(anchor.vertices, anchor.triangles, 1)
-    b = topstoc.Mesh(*original).decimate(ratio=0.1, seed=1)
-    result = (b.vertices, b.triangles)
-    found = engine.quick_hausdorff_bound(as_surface(original), as_surface(result), tolerance=0.25)
-    estimate = max(found["forward_lower"], found["backward_lower"])
-    assert max(found["forward_upper"], found["backward_upper"]) <= 1.25 * estimate * (1 + 1e-12)
-    exact = estimates.exact_error(original, result)
-    for side in ("forward", "backward"):
-        ours, theirs = (found[side + "_lower"], found[side + "_upper"]), getattr(exact, side)
-        assert ours[0] <= theirs[1] and ours[1] >= theirs[0]
+    assert_holds_the_exact_bracket(found, original, result)
 
 
 def test_the_report_settles_at_its_resolution_where_a_result_lies_on_its_original(data_dir):
@@ -284,13 +248,8 @@ def test_the_report_settles_at_its_resolution_where_a_result_lies_on_its_origina
     # pieces under it count as settled instead of being split toward the rounding (the backward side
     # had stopped at 1e-5 of the diagonal, 430,000 times its estimate, and was left to the exact
     # walk). The report converges without the walk, and its bracket holds the exact one's.
-    from meshgen import subdivide
     from topstoc.core.api.hausdorff import as_surface
-    from topstoc.core.api.io import read_mesh
-    elephant = read_mesh(data_dir / "genus_positive" / "cgal_elephant.off")
-    original = subdivide(elephant.vertices, elephant.triangles, 2)
-    b = topstoc.Mesh(*original).decimate(ratio=0.08, seed=1)
-    result = (b.vertices, b.triangles)
+    original, result = subdivided_and_decimated(data_dir / "genus_positive" / "cgal_elephant.off", 2, 0.08)
     a = as_surface(original)
     found = engine.quick_hausdorff_bound(a, as_surface(result), tolerance=0.25, resolution=estimates.RESOLUTION)
     assert max(found["forward_upper"], found["backward_upper"]) <= 1.25 * estimates.RESOLUTION * a.diagonal
@@ -467,3 +426,24 @@ def test_z_order_keeps_every_point_and_orders_them_by_place():
     assert step(points[order]) < 0.1 * step(points)
     assert len(estimates._z_order(np.empty((0, 3)))) == 0
     assert np.array_equal(estimates._z_order(np.ones((4, 3))), np.arange(4))  # all in one place: as given
+
+
+def subdivided_and_decimated(path, levels: int, ratio: float):
+    """A test mesh subdivided into coplanar triangles (meshgen.subdivide) and its decimation: a
+    result that can lie on its original, the hardest case for a bound."""
+    from meshgen import subdivide
+    from topstoc.core.api.io import read_mesh
+    mesh = read_mesh(path)
+    original = subdivide(mesh.vertices, mesh.triangles, levels)
+    b = topstoc.Mesh(*original).decimate(ratio=ratio, seed=1)
+    return original, (b.vertices, b.triangles)
+
+
+def assert_holds_the_exact_bracket(found: dict, original, result):
+    """Each side of the quick bound's bracket meets the exact bracket's (both hold the true max);
+    returns the exact one."""
+    exact = estimates.exact_error(original, result)
+    for side in ("forward", "backward"):
+        ours, theirs = (found[side + "_lower"], found[side + "_upper"]), getattr(exact, side)
+        assert ours[0] <= theirs[1] and ours[1] >= theirs[0]
+    return exact
