@@ -561,12 +561,10 @@ MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, doubl
 }
 
 MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,
-                                    double start, double relative_tolerance, int64_t max_queries, double floor,
+                                    double start, double relative_tolerance, int64_t max_queries, double resolution,
                                     const Stars* to_stars) {
   static const std::vector<double> no_vertex_distance;
   const double origin[3] = {0.0, 0.0, 0.0};
-  const double diagonal = std::max(from.diagonal(), to.diagonal());
-  const double resolution = floor >= 0.0 && diagonal > 0.0 ? floor / diagonal : 1e-13;
   return MaxSearch(from, no_vertex_distance, to, start, origin, relative_tolerance, max_queries, resolution)
       .run_over(triangles, to_stars);
 }

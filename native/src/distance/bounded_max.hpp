@@ -58,13 +58,13 @@ MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, doubl
                                    double resolution, int64_t max_queries);
 
 /// The same bracket over the listed triangles of A only (start: a distance attained elsewhere).
-/// floor (>= 0 to use it): bounds at or under this distance count as settled (else 1e-13 of the
-/// larger diagonal, as in bound_max_distance). to_stars (to's triangles around each vertex), when
+/// Bounds under resolution x the larger diagonal count as settled (1e-13 by default, as in
+/// bound_max_distance). to_stars (to's triangles around each vertex), when
 /// given: a piece its corners leave open tries the edge cut, the fan cut (fan_cut.hpp) and its
 /// quarters before it is split (the quick bound's; the decimation's fits pass none).
 MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,
                                     double start, double relative_tolerance, int64_t max_queries,
-                                    double floor = -1.0, const Stars* to_stars = nullptr);
+                                    double resolution = 1e-13, const Stars* to_stars = nullptr);
 
 /// The largest distance from a point of the triangle p to its nearest corner (r(T) above).
 double nearest_corner_reach(const double p[3][3]);

@@ -245,9 +245,10 @@ struct ForwardSums {
   double longest2 = 0.0;  // the longest side's square
 };
 
-// A to B (the file comment); floor: bounds at or under it count as settled.
-void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, double floor,
+// A to B (the file comment); bounds under resolution x the larger diagonal count as settled.
+void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, double tolerance, double resolution,
                    QuickBound& out, double& reach) {
+  const double floor = resolution * std::max(a.diagonal(), b.diagonal());
   VertexBounds v = bound_vertices(a, b, grid);
   const Stars b_stars(b);
   const double threshold = std::max(v.lower * (1.0 + tolerance), floor);
@@ -281,7 +282,7 @@ void bound_forward(const Surface& a, const Surface& b, const VertexGrid& grid, d
   parallel_for_dynamic(0, runs, 1, parallel_if(runs > 1), [&](int64_t r) {
     const auto first = listed.begin() + r * kRefineRun;
     const std::vector<int32_t> run(first, first + std::min<int64_t>(kRefineRun, listed.end() - first));
-    brackets[size_t(r)] = bound_max_over_triangles(a, run, b, v.lower, tolerance, kRefineQueries, floor, &b_stars);
+    brackets[size_t(r)] = bound_max_over_triangles(a, run, b, v.lower, tolerance, kRefineQueries, resolution, &b_stars);
   });
   for (const MaxBracket& bracket : brackets) {
     out.forward_lower = std::max(out.forward_lower, bracket.lower);
@@ -370,8 +371,8 @@ double beneath(const Corners& piece, double limit, double grow, const Surface& a
 // two sides each through its own triangle (edge_cut.hpp), or over a vertex of A that all three
 // hold, sector by sector (fan_cut.hpp); +infinity above limit.
 double cut_bound(const Corners& piece, const StarBound d[3], const Surface& a, const Stars& stars, double limit) {
-  auto corner2 = [&](int i, int32_t triangle) {
-    const double distance = distance_to_triangle(piece.p[i], a, triangle);
+  auto corner2 = [&](int i, int32_t triangle) {  // a corner's distance to its own triangle is known
+    const double distance = triangle == d[i].triangle ? d[i].distance : distance_to_triangle(piece.p[i], a, triangle);
     return distance * distance;
   };
   double bound = std::numeric_limits<double>::infinity();
@@ -577,11 +578,11 @@ void bound_backward(const Surface& a, const Surface& b, const VertexGrid& grid, 
 QuickBound quick_hausdorff_bound(const Surface& a, const Surface& b, double tolerance, double resolution) {
   const double spacing = std::sqrt(2.0 * a.area() / std::max(1, a.num_triangles()));
   const VertexGrid grid(a, kCellSpacings * spacing);
-  const double settle = std::max(resolution, kMeasureFloor) * std::max(a.diagonal(), b.diagonal());
+  const double settled_under = std::max(resolution, kMeasureFloor);  // of the larger diagonal
   QuickBound out;
   double reach = 0.0;
-  bound_forward(a, b, grid, tolerance, settle, out, reach);
-  bound_backward(a, b, grid, tolerance, settle, reach, out);
+  bound_forward(a, b, grid, tolerance, settled_under, out, reach);
+  bound_backward(a, b, grid, tolerance, settled_under * std::max(a.diagonal(), b.diagonal()), reach, out);
   return out;
 }
 
