@@ -56,32 +56,6 @@ struct Frame {
   }
 };
 
-// A polygon of (u, v, height) points, clipped to the left of a -> b (heights interpolated). Each
-// point's turn is computed once: as the current point and as the one after the previous.
-// Inlined: called as a function (once the bound's loop became a template), it cost 2.6 % more
-// instructions in the report.
-[[gnu::always_inline]] inline int clip(const double (*in)[3], int count, const double* a, const double* b,
-                                       double (*out)[3]) {
-  if (count == 0) return 0;
-  int kept = 0;
-  const double first = turn(a, b, in[0]);
-  double sp = first;
-  for (int i = 0; i < count; ++i) {
-    const double* p = in[i];
-    const bool closing = i + 1 == count;
-    const double* q = closing ? in[0] : in[i + 1];
-    const double sq = closing ? first : turn(a, b, q);
-    if (sp >= 0) std::copy_n(p, 3, out[kept++]);
-    if ((sp >= 0) != (sq >= 0)) {
-      const double t = sp / (sp - sq);
-      for (int k = 0; k < 3; ++k) out[kept][k] = p[k] + t * (q[k] - p[k]);
-      ++kept;
-    }
-    sp = sq;
-  }
-  return kept;
-}
-
 // T's three sides (counterclockwise) and their lengths in its plane, for `meets`.
 struct Sides {
   const double (*t)[3];
@@ -114,12 +88,39 @@ bool meets(const double* a_turns, const double* b_turns, const Sides& sides, dou
 }
 
 // Whether a triangle lies wholly beyond one side of T, given its corners' turns against T's sides
-// (Sides::turns): then it does not overlap T. (A quarter of the candidates in a report: clipping T
-// to them only found that.)
+// (Sides::turns): then it does not overlap T.
 bool beyond_a_side(const double (&turns)[3][3]) {
   for (int i = 0; i < 3; ++i)
     if (turns[0][i] < 0 && turns[1][i] < 0 && turns[2][i] < 0) return true;
   return false;
+}
+
+// The corners of a triangle's overlap with T: its corners inside T, where its sides cross T's, and
+// T's corners inside it (the overlap of two triangles is the convex polygon of these). q: its
+// corners as (u, v, height); area: twice its area in T's plane (> 0); turns: its corners' turns
+// against T's sides (Sides::turns). Calls reach(x, height) with each as (u, v) and the height of
+// the triangle's plane there, linear along its sides and over it. False where they do not overlap.
+template <typename Reach>
+bool overlap_corners(const double* q, double area, const double (&turns)[3][3], const double (*t)[3], Reach&& reach) {
+  bool any = false;
+  for (int j = 0; j < 3; ++j) {
+    const double *a = q + 3 * j, *b = q + 3 * ((j + 1) % 3);
+    const double *ta = turns[j], *tb = turns[(j + 1) % 3];
+    if (ta[0] >= 0 && ta[1] >= 0 && ta[2] >= 0) reach(a, std::abs(a[2])), any = true;
+    for (int i = 0; i < 3; ++i) {
+      if ((ta[i] >= 0) == (tb[i] >= 0)) continue;
+      const double s = ta[i] / (ta[i] - tb[i]);  // where a -> b crosses the line of T's side i
+      const int k = (i + 1) % 3, m = (i + 2) % 3;  // inside T's other sides there (turns are linear)
+      if (ta[k] + s * (tb[k] - ta[k]) < 0 || ta[m] + s * (tb[m] - ta[m]) < 0) continue;
+      const double x[3] = {a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2])};
+      reach(x, std::abs(x[2])), any = true;
+    }
+  }
+  for (int i = 0; i < 3; ++i) {
+    const double w0 = turn(q + 3, q + 6, t[i]), w1 = turn(q + 6, q, t[i]), w2 = turn(q, q + 3, t[i]);
+    if (w0 >= 0 && w1 >= 0 && w2 >= 0) reach(t[i], std::abs((w0 * q[2] + w1 * q[5] + w2 * q[8]) / area)), any = true;
+  }
+  return any;
 }
 
 using Side = BeneathScratch::Side;
@@ -227,9 +228,8 @@ struct ListedCandidates {
 };
 
 // The bound over the candidates (SlotCandidates or ListedCandidates). listed (projected_bound_over's
-// bound): a candidate inside T is its own overlap (no clip; its corners' heights as they are, where
-// the clip would interpolate them again), and the margin is at least kRoundingMargin's and at most
-// kMargin's, as large as keeps its reach within kMarginShare of the limit. at, when given: the (u, v)
+// bound): the margin is at least kRoundingMargin's and at most kMargin's, as large as keeps its
+// reach within kMarginShare of the limit. at, when given: the (u, v)
 // of T where the bound is reached.
 template <typename Candidates>
 double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScratch& scratch, bool along_creases,
@@ -281,35 +281,18 @@ double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScra
     if (!(area > kFacing * std::sqrt(dot(normal, normal)))) continue;
     double turns[3][3];
     for (int j = 0; j < 3; ++j) t_sides.turns(q + 3 * j, turns[j]);
-    double ring[2][9][3];
-    int count = 3;
-    double own = 0.0, own_at[2] = {0.0, 0.0};
-    bool whole = false;
-    if (listed && std::min({turns[0][0], turns[0][1], turns[0][2], turns[1][0], turns[1][1], turns[1][2],
-                                  turns[2][0], turns[2][1], turns[2][2]}) >= 0) {
-      for (int j = 0; j < 3; ++j)
-        if (std::abs(q[3 * j + 2]) >= own) own = std::abs(q[3 * j + 2]), own_at[0] = q[3 * j], own_at[1] = q[3 * j + 1];
-      count = 0, whole = true;
-    } else if (beyond_a_side(turns) ||
-               (covered && std::max({std::abs(q[2]), std::abs(q[5]), std::abs(q[8])}) <= bound)) {
-      // No overlap, or none that could raise the bound once T is known covered (the height, linear
-      // over the triangle, peaks at a corner): only its sides near T count.
-      count = 0;
-    } else {
-      for (int j = 0; j < 3; ++j) std::copy_n(t[j], 3, ring[0][j]);
-      for (int j = 0; j < 3 && count > 0; ++j)  // T clipped to the triangle's three sides
-        count = clip(ring[j % 2], count, q + 3 * j, q + 3 * ((j + 1) % 3), ring[(j + 1) % 2]);
-    }
-    // Heights of the triangle's plane over the overlap's corners (the clip carried T's zeros).
+    // The highest height of the triangle's plane over its overlap with T, at one of the overlap's
+    // corners; none looked for where it lies beyond a side of T, or where its corners' heights
+    // cannot raise the bound once T is known covered (a quarter of a report's candidates).
     // along_creases: the distance to the triangle there where the height would raise the bound
     // (never more than the height; convex over the overlap, so it peaks at one of its corners).
-    for (int m = 0; m < count; ++m) {
-      const double* x = ring[1][m];
-      const double w1 = turn(q, x, q + 6) / area, w2 = turn(q, q + 3, x) / area, w0 = 1.0 - w1 - w2;
-      const double height = std::abs(w0 * q[2] + w1 * q[5] + w2 * q[8]);
-      const double value = along_creases && height > std::max(own, bound) ? frame.distance(x, corners) : height;
-      if (value > own) own = value, own_at[0] = x[0], own_at[1] = x[1];
-    }
+    double own = 0.0, own_at[2] = {0.0, 0.0};
+    const bool overlaps =
+        !beyond_a_side(turns) && !(covered && std::max({std::abs(q[2]), std::abs(q[5]), std::abs(q[8])}) <= bound) &&
+        overlap_corners(q, area, turns, t, [&](const double* x, double height) {
+          const double value = along_creases && height > std::max(own, bound) ? frame.distance(x, corners) : height;
+          if (value > own) own = value, own_at[0] = x[0], own_at[1] = x[1];
+        });
     // along_creases: a triangle beyond the limit is left out of U (any part of the chain bounds
     // what it covers; the sides it leaves unmatched fail the test below where they cross T)
     if (own > limit) {
@@ -318,7 +301,7 @@ double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScra
     }
     if (own >= bound && at != nullptr) at[0] = own_at[0], at[1] = own_at[1];
     bound = std::max(bound, own);
-    if ((count > 0 || whole) && (!along_creases || (turn(q, q + 3, incentre) >= 0 && turn(q + 3, q + 6, incentre) >= 0 &&
+    if (overlaps && (!along_creases || (turn(q, q + 3, incentre) >= 0 && turn(q + 3, q + 6, incentre) >= 0 &&
                                                     turn(q + 6, q, incentre) >= 0)))
       covered = true;
     const int32_t* ids = &to.triangles()[3 * size_t(candidates.triangle(i))];
