@@ -144,7 +144,13 @@ bool collect_candidates(const TriangleBvh& tree, const double* lo, const double*
       stack.push_back(i + 1), stack.push_back(node.first);
       continue;
     }
-    for (int32_t s = node.first; s < node.first + node.count; ++s) slots.push_back(s);
+    for (int32_t s = node.first; s < node.first + node.count; ++s) {
+      const double* c = tree.slot_corners(s);  // a leaf's triangle whose own box misses the range cannot count
+      bool meets = true;
+      for (int k = 0; k < 3; ++k)
+        meets = meets && std::min({c[k], c[3 + k], c[6 + k]}) <= hi[k] && std::max({c[k], c[3 + k], c[6 + k]}) >= lo[k];
+      if (meets) slots.push_back(s);
+    }
     if (int32_t(slots.size()) > max_candidates) return false;
   }
   return true;
