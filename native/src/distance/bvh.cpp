@@ -15,6 +15,8 @@ namespace topstoc {
 namespace {
 
 constexpr int32_t kLeafSize = 4;
+// Trees over at least this many triangles build the root's two halves side by side.
+constexpr int32_t kParallelBuild = 4096;
 
 inline double dot(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
@@ -154,6 +156,26 @@ inline double triangle_distance2(const double* p, const double* a, const double*
 
 // A triangle's centroid next to its id: the build partitions these in place, so its scans are
 // sequential instead of gathering through an index.
+namespace {
+
+// The nodes of a subtree over n triangles: median splits down to leaves of at most kLeafSize.
+// (Its halves' sizes differ by one at most, so a level holds two sizes at most: memo.)
+int32_t subtree_nodes(int32_t n, std::vector<std::pair<int32_t, int32_t>>& memo) {
+  if (n <= kLeafSize) return 1;
+  for (const auto& [size, nodes] : memo)
+    if (size == n) return nodes;
+  const int32_t nodes = 1 + subtree_nodes(n / 2, memo) + subtree_nodes(n - n / 2, memo);
+  memo.emplace_back(n, nodes);
+  return nodes;
+}
+
+int32_t subtree_nodes(int32_t n) {
+  std::vector<std::pair<int32_t, int32_t>> memo;
+  return subtree_nodes(n, memo);
+}
+
+}  // namespace
+
 struct TriangleBvh::BuildItem {
   double centroid[3];
   int32_t id;
@@ -180,8 +202,8 @@ TriangleBvh::TriangleBvh(const double* positions, const int32_t* triangles, int6
   std::vector<BuildItem> items(m);
   for (int32_t f = 0; f < m; ++f) items[f] = {{centroids[3 * size_t(f)], centroids[3 * size_t(f) + 1],
                                                 centroids[3 * size_t(f) + 2]}, f};
-  nodes_.reserve(2 * size_t(m / kLeafSize + 1));
-  build(0, m, unordered, items.data());
+  nodes_.resize(size_t(subtree_nodes(m)));
+  build(0, m, 0, unordered, items.data());
   std::vector<int32_t> order(m);
   for (int32_t s = 0; s < m; ++s) order[s] = items[s].id;
   // Store the corners in leaf order so that a leaf's triangles sit together in memory.
@@ -223,12 +245,12 @@ inline double TriangleBvh::slab_distance2(const double* p, int32_t node, bool co
   return gap > 0.0 ? gap * gap : 0.0;
 }
 
-int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items) {
+int32_t TriangleBvh::build(int32_t begin, int32_t end, int32_t index, const std::vector<double>& corners,
+                           BuildItem* items) {
   // Median split along the longest axis of the centroids' box: a balanced tree, built in
   // O(m log m), that serves nearest-point queries well. Boxes come from the children, so each
-  // triangle's corners are read once.
-  const int32_t index = static_cast<int32_t>(nodes_.size());
-  nodes_.push_back(Node{});
+  // triangle's corners are read once. Nodes in depth-first order: a node's left child follows it.
+  int32_t next = index + 1;
   Node node{};
   if (end - begin <= kLeafSize) {
     for (int k = 0; k < 3; ++k) {
@@ -261,8 +283,16 @@ int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>
     std::nth_element(items + begin, items + middle, items + end, [axis](const BuildItem& x, const BuildItem& y) {
       return x.centroid[axis] < y.centroid[axis] || (x.centroid[axis] == y.centroid[axis] && x.id < y.id);
     });
-    const int32_t left = build(begin, middle, corners, items);
-    const int32_t right = build(middle, end, corners, items);
+    const int32_t left = index + 1;
+    int32_t right;
+    if (index == 0 && end - begin >= kParallelBuild) {  // the same tree, its halves side by side
+      right = left + subtree_nodes(middle - begin);
+      parallel_invoke(true, [&] { build(begin, middle, left, corners, items); },
+                      [&] { next = build(middle, end, right, corners, items); });
+    } else {
+      right = build(begin, middle, left, corners, items);
+      next = build(middle, end, right, corners, items);
+    }
     for (int k = 0; k < 3; ++k) {
       node.lo[k] = std::min(nodes_[left].lo[k], nodes_[right].lo[k]);
       node.hi[k] = std::max(nodes_[left].hi[k], nodes_[right].hi[k]);
@@ -271,7 +301,7 @@ int32_t TriangleBvh::build(int32_t begin, int32_t end, const std::vector<double>
     node.count = 0;
   }
   nodes_[index] = node;
-  return index;
+  return next;
 }
 
 ClosestHit TriangleBvh::closest(const double* p, int32_t hint_slot, double within2) const {

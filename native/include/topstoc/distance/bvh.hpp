@@ -60,8 +60,9 @@ class TriangleBvh {
   template <bool kCounted>
   ClosestHit search(const double* p, int32_t hint_slot, double within2, int64_t* tested) const;
   struct BuildItem;
-  /// Builds the subtree over items [begin, end), which it reorders.
-  int32_t build(int32_t begin, int32_t end, const std::vector<double>& corners, BuildItem* items);
+  /// Builds the subtree over items [begin, end), which it reorders, into the nodes from `index`
+  /// on; returns the index past its last node.
+  int32_t build(int32_t begin, int32_t end, int32_t index, const std::vector<double>& corners, BuildItem* items);
 
   /// Per node, where slivers are common (a fan's centre, a cone's apex): the node's corners lie
   /// between lo and hi along a unit normal of its triangles. The slivers' axis-aligned boxes all
