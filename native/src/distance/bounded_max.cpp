@@ -8,6 +8,7 @@
 #include "distance/edge_cut.hpp"
 #include "distance/fan_cut.hpp"
 #include "distance/projected_bound.hpp"
+#include "distance/vertex_stars.hpp"
 
 namespace topstoc {
 
@@ -83,7 +84,9 @@ class MaxSearch {
     std::copy_n(start_point, 3, out.lower_point);
   }
 
-  MaxBracket run() {
+  // to_stars: see fans.
+  MaxBracket run(const Stars* to_stars = nullptr) {
+    fans = to_stars;
     seed_pieces();
     return run_queue();
   }
@@ -175,8 +178,8 @@ class MaxSearch {
   // pieces left open by their corner bounds and the bound beneath them try the bound over their
   // quarters (quarter_bound) (the vertex-first search only, whose brackets no decimation reads)
   const bool by_quarters;
-  // bound_max_over_triangles' stars of the other surface, when given: its pieces also try the cheap
-  // bounds (settle_cheaply) and the fan cut around a vertex their corners' triangles share
+  // stars of the other surface (bound_max_over_triangles', when given; bound_max_from_vertices'):
+  // the pieces also try the fan cut around a vertex their corners' triangles share
   const Stars* fans = nullptr;
   // Whether a piece's near[j] is its corner j's nearest triangle at distance d[j] (every search
   // but the one seeded with the caller's distances), and the cheap bounds are tried.
@@ -558,7 +561,9 @@ MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, doubl
                                    double resolution, int64_t max_queries) {
   static const std::vector<double> no_vertex_distance;  // the vertices' own queries give them
   const double origin[3] = {0.0, 0.0, 0.0};
-  return MaxSearch(from, no_vertex_distance, to, 0.0, origin, relative_tolerance, max_queries, resolution, true).run();
+  const Stars to_stars(to);
+  return MaxSearch(from, no_vertex_distance, to, 0.0, origin, relative_tolerance, max_queries, resolution, true)
+      .run(&to_stars);
 }
 
 MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,

@@ -49,9 +49,10 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
 
 /// The same bracket with every used vertex of A measured first (one query each): cheaper than the
 /// walk down A's tree (below) unless A is far finer than the distances, the usual case of a
-/// decimation and its original. A piece its corner bounds leave open is first bounded on its
-/// quarters, each by the best of the triangles nearest to the piece's corners (this search only:
-/// the others keep the brackets the decimation's fits read). resolution: bounds under resolution x the larger diagonal count
+/// decimation and its original. A piece its corner bounds leave open is cut along an edge or
+/// around a vertex of B (fan_cut.hpp) that its corners' nearest triangles share, then bounded by
+/// the triangles beneath it, then on its quarters, each by the best of the triangles nearest to
+/// the piece's corners (this search only: the others keep the brackets the decimation's fits read). resolution: bounds under resolution x the larger diagonal count
 /// as settled (the search's floor; 1e-13 elsewhere), so that a result lying on its original up to
 /// rounding is not split down to that rounding.
 MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, double relative_tolerance,
