@@ -152,12 +152,6 @@ inline double triangle_distance2(const double* p, const double* a, const double*
   return best;
 }
 
-}  // namespace
-
-// A triangle's centroid next to its id: the build partitions these in place, so its scans are
-// sequential instead of gathering through an index.
-namespace {
-
 // The nodes of a subtree over n triangles: median splits down to leaves of at most kLeafSize.
 // (Its halves' sizes differ by one at most, so a level holds two sizes at most: memo.)
 int32_t subtree_nodes(int32_t n, std::vector<std::pair<int32_t, int32_t>>& memo) {
@@ -176,6 +170,8 @@ int32_t subtree_nodes(int32_t n) {
 
 }  // namespace
 
+// A triangle's centroid next to its id: the build partitions these in place, so its scans are
+// sequential instead of gathering through an index.
 struct TriangleBvh::BuildItem {
   double centroid[3];
   int32_t id;
