@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "topstoc/distance/bvh.hpp"
+#include "with_threads.hpp"
 
 using topstoc::closest_point_on_triangle;
 using topstoc::TriangleBvh;
@@ -182,4 +183,35 @@ TEST_CASE("BVH over a flat fanned disc (cones): the brute-force minimum at point
     hint = int32_t(random() % n);
   }
   CHECK(tested > 0);
+}
+
+TEST_CASE("a tree built on two threads is the one built on one, node for node, its boxes holding their triangles") {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (const int32_t count : {4095, 4096, 9999, 20000}) {  // below and at kParallelBuild, odd halves
+    Indexed mesh;
+    for (int32_t f = 0; f < count; ++f) {
+      const double centre[3] = {unit(random), unit(random), 0.2 * unit(random)};
+      for (int c = 0; c < 3; ++c) {
+        for (int k = 0; k < 3; ++k) mesh.positions.push_back(centre[k] + 0.01 * unit(random));
+        mesh.triangles.push_back(3 * f + c);
+      }
+    }
+    const TriangleBvh one = with_threads(1, [&] { return TriangleBvh(mesh.positions.data(), mesh.triangles.data(), count); });
+    const TriangleBvh two = with_threads(2, [&] { return TriangleBvh(mesh.positions.data(), mesh.triangles.data(), count); });
+    REQUIRE(one.num_nodes() == two.num_nodes());
+    int32_t leaves = 0;
+    for (int32_t i = 0; i < int32_t(one.num_nodes()); ++i) {
+      const TriangleBvh::Node &a = one.node(i), &b = two.node(i);
+      CHECK(a.first == b.first);
+      CHECK(a.count == b.count);
+      for (int k = 0; k < 3; ++k) CHECK((a.lo[k] == b.lo[k] && a.hi[k] == b.hi[k]));
+      if (a.count == 0) continue;
+      leaves += a.count;
+      for (int32_t s = a.first; s < a.first + a.count; ++s)
+        for (int j = 0; j < 9; ++j) CHECK((a.lo[j % 3] <= one.slot_corners(s)[j] && one.slot_corners(s)[j] <= a.hi[j % 3]));
+    }
+    CHECK(leaves == count);  // every slot in exactly one leaf
+    for (int32_t s = 0; s < count; ++s) CHECK(one.slot_triangle(s) == two.slot_triangle(s));
+  }
 }
