@@ -26,8 +26,6 @@ import time
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 BUILD = pathlib.Path(os.environ.get("TOPSTOC_BUILD", ROOT / "build"))
 SHARED = ROOT.parent / "shared" / "meshes"
-if not SHARED.exists():  # a worktree beside the main checkout
-    SHARED = pathlib.Path("/work/shared/meshes")
 HORSE = SHARED / "big" / "horse_loop2_1.55M.ply"
 DATA = ROOT / "tests" / "data"
 
