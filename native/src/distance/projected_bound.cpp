@@ -290,13 +290,14 @@ double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScra
     // The highest height of the triangle's plane over its overlap with T, at one of the overlap's
     // corners; none looked for where it lies beyond a side of T, or where its corners' heights
     // cannot raise the bound once T is known covered (a quarter of a report's candidates).
-    // along_creases: the distance to the triangle there where the height would raise the bound
-    // (never more than the height; convex over the overlap, so it peaks at one of its corners).
+    // along_creases: the distance to the triangle there where the height would exceed the limit
+    // (never more than the height; convex over the overlap, so it peaks at one of its corners);
+    // below it the height settles as well and costs no closest point.
     double own = 0.0, own_at[2] = {0.0, 0.0};
     const bool overlaps =
         !beyond_a_side(turns) && !(covered && std::max({std::abs(q[2]), std::abs(q[5]), std::abs(q[8])}) <= bound) &&
         overlap_corners(q, area, turns, t, [&](const double* x, double height) {
-          const double value = along_creases && height > std::max(own, bound) ? frame.distance(x, corners) : height;
+          const double value = along_creases && height > limit ? frame.distance(x, corners) : height;
           if (value > own) own = value, own_at[0] = x[0], own_at[1] = x[1];
         });
     // along_creases: a triangle beyond the limit is left out of U (any part of the chain bounds

@@ -33,7 +33,7 @@ struct BeneathScratch {
 /// (a piece on one face with a side on the crease, the other face folded over it): triangles of
 /// B beyond the limit are left out rather than failing the bound, a boundary of U within a
 /// tiny margin of T's sides is allowed (the margin's reach added to the bound), and the distance
-/// to a triangle replaces its plane's height along T's normal.
+/// to a triangle replaces its plane's height along T's normal where that height exceeds the limit.
 double projected_bound(const double p[3][3], const Surface& to, double limit, int32_t max_candidates,
                        BeneathScratch& scratch, bool along_creases = false);
 
