@@ -3,9 +3,13 @@
 // under the resolution, and is the same on one thread and two.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <vector>
 
+#include "meshes.hpp"
+#include "topstoc/distance/bvh.hpp"
 #include "topstoc/distance/hausdorff.hpp"
 #include "with_threads.hpp"
 
@@ -76,5 +80,30 @@ TEST_CASE("surfaces that coincide settle under the resolution, the same on one t
     CHECK(a.lower == b.lower);
     CHECK(a.upper == b.upper);
     CHECK(a.queries == b.queries);
+  }
+}
+
+TEST_CASE("the lower bound is at least every vertex's distance, looked up one by one") {
+  // Most vertices are measured by walking from a neighbour's triangle, the ones whose walked
+  // distance exceeds the largest looked-up one by a lookup: the lower bound is the vertices' max.
+  // A bumpy fine torus against a coarse smooth one, both ways.
+  topstoc_test::Arrays bumpy = topstoc_test::torus(90, 40);
+  for (size_t v = 0; v < bumpy.positions.size() / 3; ++v) {
+    double* p = &bumpy.positions[3 * v];
+    const double bump = 1.0 + 0.02 * std::sin(7.0 * std::atan2(p[1], p[0])) * std::cos(5.0 * p[2]);
+    for (int k = 0; k < 3; ++k) p[k] *= bump;
+  }
+  const Surface fine(bumpy.positions, bumpy.triangles);
+  const topstoc_test::Arrays smooth = topstoc_test::torus(18, 9);
+  const Surface coarse(smooth.positions, smooth.triangles);
+  const topstoc::SymmetricBracket r = topstoc::bracket_symmetric_max(fine, coarse, 0.25, 1e-7, 20000000);
+  CHECK(r.forward.queries < fine.num_vertices() / 100);  // walks, not a lookup a vertex
+  for (const auto& [from, to, side] : {std::tuple{&fine, &coarse, &r.forward}, std::tuple{&coarse, &fine, &r.backward}}) {
+    double largest = 0.0;
+    for (int32_t v = 0; v < from->num_vertices(); ++v)
+      largest = std::max(largest, std::sqrt(to->bvh().closest(&from->positions()[3 * size_t(v)]).distance2));
+    CHECK(side->lower >= largest);
+    CHECK(side->upper >= side->lower);
+    CHECK(side->converged);
   }
 }

@@ -23,7 +23,9 @@ maximum); ``upper`` the largest bound (no point is farther). ``mean`` estimates 
 distance from the original (one measured vertex per grid cell, unweighted).
 
 Otherwise both sides are bracketed at once (``bracket_symmetric_max``, on two threads): every
-vertex of a side's surface is measured, then its triangles are bounded by their corners (the
+vertex of a side's surface is measured (most by a walk over the other surface from a
+neighbour's triangle, the rest looked up, those that may hold the largest distance among them),
+then its triangles are bounded by their corners (the
 distance is 1-Lipschitz; the distance to one triangle of the other surface is convex) and by the
 other surface's triangles beneath them (distance/projected_bound.cpp), and only those whose bound
 exceeds ``(1 + gap)`` times the largest distance found are split and measured again, until none

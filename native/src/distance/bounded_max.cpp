@@ -8,6 +8,7 @@
 #include "distance/edge_cut.hpp"
 #include "distance/fan_cut.hpp"
 #include "distance/projected_bound.hpp"
+#include "distance/triangle_walk.hpp"
 #include "distance/vertex_stars.hpp"
 
 namespace topstoc {
@@ -34,6 +35,9 @@ constexpr double kSettleSpan = 2.5;
 // A piece's quarters: of its corners 0, 1, 2 and its edges' midpoints 3 = (0,1), 4 = (1,2), 5 = (2,0).
 constexpr int kQuarters[4][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {3, 4, 5}};
 constexpr double kNoBound = std::numeric_limits<double>::infinity();
+// Steps a vertex's walk takes at most before the tree is asked instead (a walk from a neighbour's
+// triangle takes a few).
+constexpr int kWalkSteps = 16;
 
 struct Piece {
   double p[3][3];     // corners
@@ -84,9 +88,10 @@ class MaxSearch {
     std::copy_n(start_point, 3, out.lower_point);
   }
 
-  // to_stars: see fans.
-  MaxBracket run(const Stars* to_stars = nullptr) {
+  // to_stars: see fans; from_stars: the sampled surface's (the vertex-first search's walk).
+  MaxBracket run(const Stars* to_stars = nullptr, const Stars* from_stars = nullptr) {
     fans = to_stars;
+    own = from_stars;
     seed_pieces();
     return run_queue();
   }
@@ -181,8 +186,10 @@ class MaxSearch {
   // stars of the other surface (bound_max_over_triangles', when given; bound_max_from_vertices'):
   // the pieces also try the fan cut around a vertex their corners' triangles share
   const Stars* fans = nullptr;
-  // Whether a piece's near[j] is its corner j's nearest triangle at distance d[j] (every search
-  // but the one seeded with the caller's distances), and the cheap bounds are tried.
+  const Stars* own = nullptr;  // the sampled surface's triangles around each vertex (run's from_stars)
+  // Whether a piece's near[j] is a triangle at distance d[j] from its corner j, its nearest but
+  // where the vertex-first search's walk ended elsewhere (every search but the one seeded with the
+  // caller's distances), and the cheap bounds are tried.
   bool cheap() const { return by_quarters || fans != nullptr; }
   MaxBracket out;
   BeneathScratch scratch;
@@ -492,14 +499,18 @@ class MaxSearch {
     std::vector<int32_t> vertex_near(from.num_vertices(), -1), vertex_slot(from.num_vertices(), -1);
     // without distances from the caller, the queries' own (the same values)
     std::vector<double> measured(vertex_distance.empty() ? from.num_vertices() : 0, 0.0);
-    int32_t hint = -1;
-    for (int32_t v = 0; v < from.num_vertices(); ++v)
-      if (from.used()[v]) {
-        const ClosestHit hit = query(&positions[3 * size_t(v)], hint);
-        vertex_near[v] = hit.triangle;
-        vertex_slot[v] = hint = hit.slot;
-        if (!measured.empty()) measured[v] = std::sqrt(hit.distance2);
-      }
+    if (by_quarters) {
+      walk_vertices(measured, vertex_near, vertex_slot);
+    } else {
+      int32_t hint = -1;
+      for (int32_t v = 0; v < from.num_vertices(); ++v)
+        if (from.used()[v]) {
+          const ClosestHit hit = query(&positions[3 * size_t(v)], hint);
+          vertex_near[v] = hit.triangle;
+          vertex_slot[v] = hint = hit.slot;
+          if (!measured.empty()) measured[v] = std::sqrt(hit.distance2);
+        }
+    }
     const std::vector<double>& distance = measured.empty() ? vertex_distance : measured;
     out.lower_triangle = -1;
     for (int32_t f = 0; f < from.num_triangles(); ++f) {
@@ -514,6 +525,53 @@ class MaxSearch {
       piece.near[3] = -1;
       piece.hint = vertex_slot[triangles[3 * size_t(f)]];
       keep(piece);
+    }
+  }
+
+  // The vertex-first search's vertices, each bounded by its distance to the triangle of the other
+  // surface that a walk from a neighbour's reaches (triangle_walk.hpp; a tree lookup for the first
+  // vertex of each connected part, or where the walk runs long), in walk_order. Then those whose
+  // bound exceeds the largest distance looked up are looked up, the highest first, until none is
+  // left: the lower bound is the vertices' largest distance, as if each had been looked up (bounds
+  // within `close` aside), and the others keep bounds that are their distances where the walk
+  // ended at the nearest triangle.
+  void walk_vertices(std::vector<double>& distance, std::vector<int32_t>& near, std::vector<int32_t>& slot) {
+    const TriangleWalk walker(to, *fans);
+    std::vector<int32_t> slot_of(size_t(to.num_triangles()));
+    for (int32_t s = 0; s < to.num_triangles(); ++s) slot_of[size_t(bvh.slot_triangle(s))] = s;
+    const auto& positions = from.positions();
+    std::vector<char> looked_up(size_t(from.num_vertices()), 0);
+    auto look_up = [&](int32_t v, int32_t hint) {
+      const ClosestHit hit = query(&positions[3 * size_t(v)], hint);
+      distance[v] = std::sqrt(hit.distance2), near[v] = hit.triangle, slot[v] = hit.slot, looked_up[v] = 1;
+    };
+    // a bound within the floor, less the tolerance, cannot raise the threshold: the walk need not
+    // look for a nearer triangle, nor the vertex be looked up
+    const double close = floor / (1 + relative_tolerance);
+    for (const int32_t f : walk_order(from, *own)) {
+      const int32_t* t = &from.triangles()[3 * size_t(f)];
+      int32_t start = near[t[0]] >= 0 ? near[t[0]] : near[t[1]] >= 0 ? near[t[1]] : near[t[2]];
+      for (int j = 0; j < 3; ++j) {
+        const int32_t v = t[j];
+        if (near[v] >= 0) continue;
+        const TriangleWalk::End end = start >= 0 ? walker.walk(&positions[3 * size_t(v)], start, kWalkSteps, close)
+                                                 : TriangleWalk::End{0.0, -1, false};
+        if (end.settled) {
+          distance[v] = std::sqrt(end.distance2), near[v] = end.triangle, slot[v] = slot_of[size_t(end.triangle)];
+        } else {
+          look_up(v, start >= 0 ? slot_of[size_t(start)] : -1);
+        }
+        start = near[v];
+      }
+    }
+    std::vector<int32_t> order;
+    for (int32_t v = 0; v < from.num_vertices(); ++v)
+      if (near[v] >= 0 && !looked_up[v]) order.push_back(v);
+    std::sort(order.begin(), order.end(),
+              [&](int32_t a, int32_t b) { return distance[a] != distance[b] ? distance[a] > distance[b] : a < b; });
+    for (int32_t v : order) {
+      if (distance[v] <= std::max(out.lower, close)) break;
+      look_up(v, slot[v]);
     }
   }
 
@@ -558,12 +616,12 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
 }
 
 MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, double relative_tolerance,
-                                   double resolution, int64_t max_queries) {
+                                   double resolution, int64_t max_queries, const Stars& from_stars,
+                                   const Stars& to_stars) {
   static const std::vector<double> no_vertex_distance;  // the vertices' own queries give them
   const double origin[3] = {0.0, 0.0, 0.0};
-  const Stars to_stars(to);
   return MaxSearch(from, no_vertex_distance, to, 0.0, origin, relative_tolerance, max_queries, resolution, true)
-      .run(&to_stars);
+      .run(&to_stars, &from_stars);
 }
 
 MaxBracket bound_max_over_triangles(const Surface& from, const std::vector<int32_t>& triangles, const Surface& to,

@@ -47,16 +47,22 @@ MaxBracket bound_max_distance(const Surface& from, const std::vector<double>& ve
                               double start, const double* start_point, double relative_tolerance,
                               int64_t max_queries = 4000000);
 
-/// The same bracket with every used vertex of A measured first (one query each): cheaper than the
-/// walk down A's tree (below) unless A is far finer than the distances, the usual case of a
-/// decimation and its original. A piece its corner bounds leave open is cut along an edge or
-/// around a vertex of B (fan_cut.hpp) that its corners' nearest triangles share, then bounded by
-/// the triangles beneath it, then on its quarters, each by the best of the triangles nearest to
-/// the piece's corners (this search only: the others keep the brackets the decimation's fits read). resolution: bounds under resolution x the larger diagonal count
-/// as settled (the search's floor; 1e-13 elsewhere), so that a result lying on its original up to
-/// rounding is not split down to that rounding.
+/// The same bracket with every used vertex of A measured first: cheaper than the walk down A's
+/// tree (below) unless A is far finer than the distances, the usual case of a decimation and its
+/// original. Each vertex is bounded by its distance to the triangle of B that a walk from a
+/// neighbour's reaches (triangle_walk.hpp), and looked up in B's tree only for the first vertex of
+/// each part of A, where a walk runs long, and where its bound exceeds the largest distance looked
+/// up (the highest first): the lower bound is A's vertices' largest distance. A piece its corner
+/// bounds leave open is cut along an edge or around a vertex of B (fan_cut.hpp) that its corners'
+/// triangles share, then bounded by the triangles beneath it, then on its quarters, each by the
+/// best of the triangles at its corners (this search only: the others keep the brackets the
+/// decimation's fits read). resolution: bounds under resolution x the larger diagonal count as
+/// settled (the search's floor; 1e-13 elsewhere), so that a result lying on its original up to
+/// rounding is not split down to that rounding (nor its vertices under that floor looked up).
+/// from_stars, to_stars: A's and B's triangles around each vertex.
 MaxBracket bound_max_from_vertices(const Surface& from, const Surface& to, double relative_tolerance,
-                                   double resolution, int64_t max_queries);
+                                   double resolution, int64_t max_queries, const Stars& from_stars,
+                                   const Stars& to_stars);
 
 /// The same bracket over the listed triangles of A only (start: a distance attained elsewhere).
 /// Bounds under resolution x the larger diagonal count as settled (1e-13 by default, as in

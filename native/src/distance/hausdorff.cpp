@@ -1,5 +1,6 @@
 #include "topstoc/distance/hausdorff.hpp"
 #include "distance/bounded_max.hpp"
+#include "distance/vertex_stars.hpp"
 #include "topstoc/core/validate.hpp"
 #include "topstoc/core/parallel.hpp"
 #include "../core/ordered_sum.hpp"
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -433,11 +435,19 @@ SymmetricBracket bracket_symmetric_max(const Surface& a, const Surface& b, doubl
                                        int64_t max_queries) {
   if (!(tolerance > 0.0)) throw std::invalid_argument("tolerance must be positive, got " + shown(tolerance));
   if (!(resolution >= 0.0)) throw std::invalid_argument("resolution must not be negative, got " + shown(resolution));
-  a.bvh(), b.bvh();  // built before the sides share them
+  a.bvh(), b.bvh();  // built before the sides share them, as are the triangles around each vertex
+  std::unique_ptr<const Stars> a_stars, b_stars;
+  parallel_invoke(true, [&] { a_stars = std::make_unique<const Stars>(a); },
+                  [&] { b_stars = std::make_unique<const Stars>(b); });
   SymmetricBracket r;
   parallel_invoke(
-      true, [&] { r.forward = one_sided(bound_max_from_vertices(a, b, tolerance, resolution, max_queries)); },
-      [&] { r.backward = one_sided(bound_max_from_vertices(b, a, tolerance, resolution, max_queries)); });
+      true,
+      [&] {
+        r.forward = one_sided(bound_max_from_vertices(a, b, tolerance, resolution, max_queries, *a_stars, *b_stars));
+      },
+      [&] {
+        r.backward = one_sided(bound_max_from_vertices(b, a, tolerance, resolution, max_queries, *b_stars, *a_stars));
+      });
   return r;
 }
 

@@ -128,8 +128,9 @@ OneSidedBracket bracket_one_sided_max(const Surface& from, const Surface& to, do
 
 /// The symmetric maximum between A and B bracketed within `tolerance` (> 0), or under
 /// `resolution` x the larger diagonal, or less tightly once `max_queries` queries a side were
-/// made: each side starts from every vertex of its surface measured (bounded_max.hpp,
-/// bound_max_from_vertices); the two sides run at once on two threads. (Settling the second side
+/// made: each side starts from every vertex of its surface measured, most by a walk over the other
+/// surface from a neighbour's triangle (bounded_max.hpp, bound_max_from_vertices); the two sides
+/// run at once on two threads. (Settling the second side
 /// against the first one's distance was tried: a higher threshold makes the bound beneath a piece
 /// fail more often, and it cost more queries on the horse and armadillo.)
 struct SymmetricBracket {
