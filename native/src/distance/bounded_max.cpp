@@ -564,13 +564,17 @@ class MaxSearch {
         start = near[v];
       }
     }
-    std::vector<int32_t> order;
+    // the vertices left whose bound is above both, as a heap: the highest bound (the lowest id
+    // among equals) on top
+    auto lower_first = [&](int32_t a, int32_t b) { return distance[a] != distance[b] ? distance[a] < distance[b] : a > b; };
+    std::vector<int32_t> above;
     for (int32_t v = 0; v < from.num_vertices(); ++v)
-      if (near[v] >= 0 && !looked_up[v]) order.push_back(v);
-    std::sort(order.begin(), order.end(),
-              [&](int32_t a, int32_t b) { return distance[a] != distance[b] ? distance[a] > distance[b] : a < b; });
-    for (int32_t v : order) {
-      if (distance[v] <= std::max(out.lower, close)) break;
+      if (near[v] >= 0 && !looked_up[v] && distance[v] > std::max(out.lower, close)) above.push_back(v);
+    std::make_heap(above.begin(), above.end(), lower_first);
+    while (!above.empty() && distance[above.front()] > std::max(out.lower, close)) {
+      const int32_t v = above.front();
+      std::pop_heap(above.begin(), above.end(), lower_first);
+      above.pop_back();
       look_up(v, slot[v]);
     }
   }
