@@ -11,6 +11,8 @@
 #include "sampled_distance.hpp"
 #include "distance/bounded_max.hpp"
 #include "distance/projected_bound.hpp"
+#include "distance/triangle_walk.hpp"
+#include "distance/vertex_stars.hpp"
 
 using topstoc::BeneathScratch;
 using topstoc::projected_bound;
@@ -128,6 +130,48 @@ TEST_CASE("over a bumpy grid the bound is never under a dense sampling's distanc
     CHECK(bound >= sampled_max(p, bumpy) * (1 - 1e-12));
   }
   CHECK(bounded >= 50);  // not vacuous: most pieces (73 of 100) lie wholly over the grid
+}
+
+TEST_CASE("the chain grown from the corners' triangles bounds what the tree's candidates bound, never under a sampling") {
+  // The same pieces over the bumpy grid, along creases, from their corners' nearest triangles
+  // (projected_bound_around) and from the tree's (projected_bound): every bound holds against a
+  // dense sampling, and the grown chain settles whatever the tree's does (it looks at fewer).
+  // On the grid with a hole under some pieces, neither settles those.
+  const auto bumps = [](double x, double y) { return 0.03 * std::sin(9 * x) * std::cos(7 * y); };
+  for (const int hole : {-1, 15 * 30 + 15}) {
+    const Surface bumpy = grid(30, bumps, hole);
+    const topstoc::Stars stars(bumpy);
+    const topstoc::TriangleWalk walk(bumpy, stars);
+    std::mt19937 random(9);
+    std::uniform_real_distribution<double> along(0.1, 0.9), height(-0.05, 0.05), tilt(-1.0, 1.0);
+    BeneathScratch scratch;
+    int settled = 0, fewer = 0;
+    for (int round = 0; round < 200; ++round) {
+      double p[3][3];
+      const double size = 0.02 + 0.15 * (round % 10) / 10.0;
+      const double cx = along(random), cy = along(random), cz = height(random);
+      for (int j = 0; j < 3; ++j) {
+        const double angle = 2.0944 * j + tilt(random) * 0.3;
+        p[j][0] = cx + size * std::cos(angle), p[j][1] = cy + size * std::sin(angle);
+        p[j][2] = cz + 0.5 * size * tilt(random);
+      }
+      int32_t near[4] = {-1, -1, -1, -1};
+      for (int j = 0; j < 3; ++j) near[j] = bumpy.bvh().closest(p[j]).triangle;
+      const double boxed = projected_bound(p, bumpy, 0.3, 1000, scratch, true);
+      const size_t looked_at_boxed = scratch.slots.size();
+      const double grown = topstoc::projected_bound_around(p, bumpy, walk, near, 4, 0.3, 1000, scratch);
+      fewer += scratch.slots.size() < looked_at_boxed;
+      if (grown == kInfinity) {
+        CHECK(boxed == kInfinity);
+        continue;
+      }
+      ++settled;
+      CHECK(grown >= sampled_max(p, bumpy) * (1 - 1e-12));
+      CHECK(grown <= boxed);
+    }
+    CHECK(settled >= 80);
+    CHECK(fewer >= settled / 2);
+  }
 }
 
 TEST_CASE("the max's bracket of a coarse surface over a fine one settles in few queries") {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <queue>
 
 #include "distance/edge_cut.hpp"
@@ -187,6 +188,7 @@ class MaxSearch {
   // the pieces also try the fan cut around a vertex their corners' triangles share
   const Stars* fans = nullptr;
   const Stars* own = nullptr;  // the sampled surface's triangles around each vertex (run's from_stars)
+  std::unique_ptr<const TriangleWalk> walker;  // the vertex-first search's, over the other surface
   // Whether a piece's near[j] is a triangle at distance d[j] from its corner j, its nearest but
   // where the vertex-first search's walk ended elsewhere (every search but the one seeded with the
   // caller's distances), and the cheap bounds are tried.
@@ -213,6 +215,15 @@ class MaxSearch {
   // The bound beneath a triangle (projected_bound.hpp), its candidates counted as measured.
   double beneath(const double p[3][3], bool along_creases) {
     const double bound = projected_bound(p, to, threshold(), kBeneathCandidates, scratch, along_creases);
+    tested += int64_t(scratch.slots.size());
+    return bound;
+  }
+
+  // The same along creases over the chain grown from a piece's corners' triangles (the
+  // vertex-first search, whose walker knows the other surface's edge neighbours).
+  double beneath(const Piece& piece) {
+    const double bound =
+        projected_bound_around(piece.p, to, *walker, piece.near, 4, threshold(), kBeneathCandidates, scratch);
     tested += int64_t(scratch.slots.size());
     return bound;
   }
@@ -326,7 +337,7 @@ class MaxSearch {
     if (cheap() && !tolerated(piece.upper)) settle_cheaply(piece);
     // only a bound that settles the piece is looked for: the box searched stays small
     if (!tolerated(piece.upper) && beneath_tried_at != threshold() && worth_projecting(piece))
-      piece.upper = std::min(piece.upper, beneath(piece.p, by_quarters));
+      piece.upper = std::min(piece.upper, by_quarters ? beneath(piece) : beneath(piece.p, false));
     if (cheap() && !tolerated(piece.upper)) piece.upper = std::min(piece.upper, quarter_bound(piece));
     if (!tolerated(piece.upper)) {
       centroid_near(piece);
@@ -536,7 +547,7 @@ class MaxSearch {
   // within `close` aside), and the others keep bounds that are their distances where the walk
   // ended at the nearest triangle.
   void walk_vertices(std::vector<double>& distance, std::vector<int32_t>& near, std::vector<int32_t>& slot) {
-    const TriangleWalk walker(to, *fans);
+    walker = std::make_unique<const TriangleWalk>(to, *fans);
     std::vector<int32_t> slot_of(size_t(to.num_triangles()));
     for (int32_t s = 0; s < to.num_triangles(); ++s) slot_of[size_t(bvh.slot_triangle(s))] = s;
     const auto& positions = from.positions();
@@ -554,7 +565,7 @@ class MaxSearch {
       for (int j = 0; j < 3; ++j) {
         const int32_t v = t[j];
         if (near[v] >= 0) continue;
-        const TriangleWalk::End end = start >= 0 ? walker.walk(&positions[3 * size_t(v)], start, kWalkSteps, close)
+        const TriangleWalk::End end = start >= 0 ? walker->walk(&positions[3 * size_t(v)], start, kWalkSteps, close)
                                                  : TriangleWalk::End{0.0, -1, false};
         if (end.settled) {
           distance[v] = std::sqrt(end.distance2), near[v] = end.triangle, slot[v] = slot_of[size_t(end.triangle)];

@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include "distance/triangle_walk.hpp"
 #include "topstoc/distance/bvh.hpp"
 
 namespace topstoc {
@@ -220,6 +221,8 @@ struct SlotCandidates {
   size_t size() const { return slots.size(); }
   const double* corners(size_t i, double* /*buffer*/) const { return tree.slot_corners(slots[i]); }
   int32_t triangle(size_t i) const { return tree.slot_triangle(slots[i]); }
+  void across(size_t, int) const {}  // the list is whole from the start
+  bool overflowed() const { return false; }
 };
 struct ListedCandidates {
   const Surface& to;
@@ -231,6 +234,47 @@ struct ListedCandidates {
     return buffer;
   }
   int32_t triangle(size_t i) const { return ids[i]; }
+  void across(size_t, int) const {}
+  bool overflowed() const { return false; }
+};
+
+// The candidates as a chain grown from a few triangles of `to`: each side of a triangle kept in U
+// that meets T adds the triangle across it (each met once a call).
+struct GrownCandidates {
+  const Surface& to;
+  const TriangleWalk& walk;
+  const int32_t max_candidates;
+  BeneathScratch& scratch;
+  std::vector<int32_t>& ids;
+  bool over = false;  // more than max_candidates met
+  GrownCandidates(const Surface& to, const TriangleWalk& walk, const int32_t* start, int starts,
+                  int32_t max_candidates, BeneathScratch& scratch)
+      : to(to), walk(walk), max_candidates(max_candidates), scratch(scratch), ids(scratch.slots) {
+    if (scratch.seen.size() != size_t(to.num_triangles()) || ++scratch.call == 0)
+      scratch.seen.assign(size_t(to.num_triangles()), 0), scratch.call = 1;
+    ids.clear();
+    for (int i = 0; i < starts; ++i)
+      if (start[i] >= 0) meet(start[i]);
+  }
+  size_t size() const { return ids.size(); }
+  const double* corners(size_t i, double* buffer) const {
+    const int32_t* t = &to.triangles()[3 * size_t(ids[i])];
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) buffer[3 * j + k] = to.positions()[3 * size_t(t[j]) + size_t(k)];
+    return buffer;
+  }
+  int32_t triangle(size_t i) const { return ids[i]; }
+  void meet(int32_t f) {
+    if (f < 0 || scratch.seen[size_t(f)] == scratch.call) return;
+    scratch.seen[size_t(f)] = scratch.call;
+    if (int32_t(ids.size()) < max_candidates) {
+      ids.push_back(f);
+    } else {
+      over = true;
+    }
+  }
+  void across(size_t i, int side) { meet(walk.neighbour(ids[i], side)); }
+  bool overflowed() const { return over; }
 };
 
 // The bound over the candidates (SlotCandidates or ListedCandidates). listed (projected_bound_over's
@@ -239,7 +283,7 @@ struct ListedCandidates {
 // of T where the bound is reached.
 template <typename Candidates>
 double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScratch& scratch, bool along_creases,
-                  bool listed, double* at, const Candidates& candidates) {
+                  bool listed, double* at, Candidates&& candidates, bool* uncovered = nullptr) {
   const Frame& frame = flat.frame;
   const double(&t)[3][3] = flat.t;
   const double twice_area = flat.twice_area, l1 = flat.l1;
@@ -263,6 +307,12 @@ double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScra
   if (along_creases && !(inradius > 2 * margin)) return kNoBound;
   const double t_lo[2] = {std::min(0.0, t[2][0]) - margin, -margin};
   const double t_hi[2] = {std::max(l1, t[2][0]) + margin, t[2][1] + margin};
+  // Whether a point (u, v) lies within the margin of a corner of T.
+  auto at_corner = [&](const double* x) {
+    for (int j = 0; j < 3; ++j)
+      if ((x[0] - t[j][0]) * (x[0] - t[j][0]) + (x[1] - t[j][1]) * (x[1] - t[j][1]) <= margin * margin) return true;
+    return false;
+  };
   std::vector<Side>& sides = scratch.sides;
   sides.clear();
   double bound = 0.0;
@@ -314,11 +364,19 @@ double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScra
     const int32_t* ids = &to.triangles()[3 * size_t(candidates.triangle(i))];
     for (int j = 0; j < 3; ++j) {
       const int32_t a = ids[j], b = ids[(j + 1) % 3];
-      if (meets(turns[j], turns[(j + 1) % 3], t_sides, along_creases ? -margin : margin))
+      if (meets(turns[j], turns[(j + 1) % 3], t_sides, along_creases ? -margin : margin)) {
         sides.push_back(a < b ? Side{a, b, 1} : Side{b, a, -1});
+        candidates.across(i, j);
+      } else if (along_creases && (at_corner(q + 3 * j) || at_corner(q + 3 * ((j + 1) % 3)))) {
+        candidates.across(i, j);  // around a corner of T on a vertex of B
+      }
     }
   }
-  if (!covered) return kNoBound;
+  if (candidates.overflowed()) return kNoBound;
+  if (!covered) {
+    if (uncovered != nullptr) *uncovered = true;
+    return kNoBound;
+  }
   if (!paired(scratch)) return kNoBound;
   if (along_creases) {
     bound += margin * farthest / inradius;
@@ -342,6 +400,17 @@ double projected_bound(const double p[3][3], const Surface& to, double limit, in
   const TriangleBvh& tree = to.bvh();
   if (!collect_candidates(tree, lo, hi, max_candidates, scratch)) return kNoBound;
   return bound_over(flat, to, limit, scratch, along_creases, false, nullptr, SlotCandidates{tree, scratch.slots});
+}
+
+double projected_bound_around(const double p[3][3], const Surface& to, const TriangleWalk& walk, const int32_t* start,
+                              int starts, double limit, int32_t max_candidates, BeneathScratch& scratch) {
+  Flat flat;
+  if (!flat.set(p)) return kNoBound;
+  bool uncovered = false;
+  const double bound = bound_over(flat, to, limit, scratch, true, false, nullptr,
+                                  GrownCandidates(to, walk, start, starts, max_candidates, scratch), &uncovered);
+  if (!uncovered) return bound;
+  return projected_bound(p, to, limit, max_candidates, scratch, true);
 }
 
 double projected_bound_over(const double p[3][3], const Surface& to, const std::vector<int32_t>& triangles,

@@ -25,7 +25,11 @@ struct BeneathScratch {
   std::vector<Side> sides;
   std::vector<uint64_t> keys;  // the sides' hash table (projected_bound.cpp's paired)
   std::vector<int32_t> nets;
+  std::vector<uint32_t> seen;  // projected_bound_around's: the call that last met each triangle of `to`
+  uint32_t call = 0;
 };
+
+class TriangleWalk;  // distance/triangle_walk.hpp
 
 /// An upper bound on max over triangle p of dist(x, to), or +infinity when B does not lie under
 /// the whole triangle within `limit` (or more than `max_candidates` of its triangles would be
@@ -36,6 +40,13 @@ struct BeneathScratch {
 /// to a triangle replaces its plane's height along T's normal where that height exceeds the limit.
 double projected_bound(const double p[3][3], const Surface& to, double limit, int32_t max_candidates,
                        BeneathScratch& scratch, bool along_creases = false);
+
+/// The same bound with along_creases, its chain U grown from the given triangles of `to` (the
+/// triangles at p's corners) across the sides that meet p (and around p's corners), their
+/// neighbours from `walk`, instead of gathered from `to`'s tree by box: any chain bounds what it
+/// covers. Falls back to projected_bound where the chain grown does not cover p.
+double projected_bound_around(const double p[3][3], const Surface& to, const TriangleWalk& walk, const int32_t* start,
+                              int starts, double limit, int32_t max_candidates, BeneathScratch& scratch);
 
 /// The same bound with along_creases over the listed triangles of `to` only, for a surface without
 /// a search tree: triangles left out can fail the test (a side of U left unmatched), never make the

@@ -32,6 +32,13 @@ class TriangleWalk {
   /// neighbours, are not looked for once the triangle reached lies within `close` of x.
   End walk(const double* x, int32_t start, int max_steps, double close) const;
 
+  /// The triangle across side j (corners j, j + 1) of triangle f, -1 on a border (one of them
+  /// where the side is non-manifold).
+  int32_t neighbour(int32_t f, int j) const {
+    const int32_t known = across_[3 * size_t(f) + size_t(j)];
+    return known != kUnknown ? known : across(f, j);
+  }
+
  private:
   static constexpr int32_t kUnknown = -2;
   const Surface& s_;
