@@ -47,6 +47,18 @@ Surface grid(int n, Height z, int skip = -1, int flip = -1) {
 
 const double kInfinity = std::numeric_limits<double>::infinity();
 
+// A random piece over the middle of the unit square, about 0.02 to 0.17 across (by round), tilted.
+void random_piece(std::mt19937& random, int round, double p[3][3]) {
+  std::uniform_real_distribution<double> along(0.1, 0.9), height(-0.05, 0.05), tilt(-1.0, 1.0);
+  const double size = 0.02 + 0.15 * (round % 10) / 10.0;
+  const double cx = along(random), cy = along(random), cz = height(random);
+  for (int j = 0; j < 3; ++j) {
+    const double angle = 2.0944 * j + tilt(random) * 0.3;
+    p[j][0] = cx + size * std::cos(angle), p[j][1] = cy + size * std::sin(angle);
+    p[j][2] = cz + 0.5 * size * tilt(random);
+  }
+}
+
 }  // namespace
 
 TEST_CASE("over a flat grid the bound is the piece's height, along its own normal when tilted") {
@@ -112,18 +124,11 @@ TEST_CASE("along a crease: a side on the grid's edge and a face folded back over
 TEST_CASE("over a bumpy grid the bound is never under a dense sampling's distances") {
   const Surface bumpy = grid(30, [](double x, double y) { return 0.03 * std::sin(9 * x) * std::cos(7 * y); });
   std::mt19937 random(5);
-  std::uniform_real_distribution<double> along(0.1, 0.9), height(-0.05, 0.05), tilt(-1.0, 1.0);
   BeneathScratch scratch;
   int bounded = 0;
   for (int round = 0; round < 100; ++round) {
     double p[3][3];
-    const double size = 0.02 + 0.15 * (round % 10) / 10.0;
-    const double cx = along(random), cy = along(random), cz = height(random);
-    for (int j = 0; j < 3; ++j) {
-      const double angle = 2.0944 * j + tilt(random) * 0.3;
-      p[j][0] = cx + size * std::cos(angle), p[j][1] = cy + size * std::sin(angle);
-      p[j][2] = cz + 0.5 * size * tilt(random);
-    }
+    random_piece(random, round, p);
     const double bound = projected_bound(p, bumpy, 0.3, 1000, scratch);
     if (bound == kInfinity) continue;
     ++bounded;
@@ -143,18 +148,11 @@ TEST_CASE("the chain grown from the corners' triangles bounds what the tree's ca
     const topstoc::Stars stars(bumpy);
     const topstoc::TriangleWalk walk(bumpy, stars);
     std::mt19937 random(9);
-    std::uniform_real_distribution<double> along(0.1, 0.9), height(-0.05, 0.05), tilt(-1.0, 1.0);
     BeneathScratch scratch;
     int settled = 0, fewer = 0;
     for (int round = 0; round < 200; ++round) {
       double p[3][3];
-      const double size = 0.02 + 0.15 * (round % 10) / 10.0;
-      const double cx = along(random), cy = along(random), cz = height(random);
-      for (int j = 0; j < 3; ++j) {
-        const double angle = 2.0944 * j + tilt(random) * 0.3;
-        p[j][0] = cx + size * std::cos(angle), p[j][1] = cy + size * std::sin(angle);
-        p[j][2] = cz + 0.5 * size * tilt(random);
-      }
+      random_piece(random, round, p);
       int32_t near[4] = {-1, -1, -1, -1};
       for (int j = 0; j < 3; ++j) near[j] = bumpy.bvh().closest(p[j]).triangle;
       const double boxed = projected_bound(p, bumpy, 0.3, 1000, scratch, true);

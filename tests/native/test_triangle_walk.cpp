@@ -19,8 +19,6 @@ using topstoc::TriangleWalk;
 
 namespace {
 
-Surface surface_of(topstoc_test::Arrays a) { return Surface(std::move(a.positions), std::move(a.triangles)); }
-
 double distance2_to(const Surface& s, int32_t f, const double* x) {
   const auto& p = s.positions();
   const int32_t* c = &s.triangles()[3 * size_t(f)];
@@ -40,25 +38,39 @@ std::vector<double> point_on(const Surface& s, int32_t f, double u, double v, do
   return x;
 }
 
+// A surface with the triangles around its vertices and a walk over it.
+struct Walkable {
+  Surface surface;
+  topstoc::Stars stars;
+  TriangleWalk walker;
+  explicit Walkable(topstoc_test::Arrays a)
+      : surface(std::move(a.positions), std::move(a.triangles)), stars(surface), walker(surface, stars) {}
+};
+
+// Checks what every walk's end must be (its distance that of its triangle, never under the
+// surface's) and returns the surface's squared distance by a lookup.
+double checked(const Surface& s, const TriangleWalk::End& end, const double* x) {
+  const double exact2 = s.bvh().closest(x).distance2;
+  CHECK(end.distance2 == distance2_to(s, end.triangle, x));
+  CHECK(end.distance2 >= exact2);
+  return exact2;
+}
+
 }  // namespace
 
 TEST_CASE("on a flat sheet a walk from any triangle within reach ends at the distance of a lookup") {
-  const Surface sheet = surface_of(topstoc_test::grid(30, 30));
-  const topstoc::Stars stars(sheet);
-  const TriangleWalk walker(sheet, stars);
+  const Walkable sheet(topstoc_test::grid(30, 30));
   std::mt19937 random(7);
-  std::uniform_int_distribution<int32_t> any(0, sheet.num_triangles() - 1);
+  std::uniform_int_distribution<int32_t> any(0, sheet.surface.num_triangles() - 1);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   int settled = 0;
   for (int trial = 0; trial < 2000; ++trial) {
     const int32_t target = any(random), start = any(random);
     double u = unit(random), v = unit(random);
     if (u + v > 1) u = 1 - u, v = 1 - v;
-    const std::vector<double> x = point_on(sheet, target, u, v, 0.5 * (unit(random) - 0.5));
-    const TriangleWalk::End end = walker.walk(x.data(), start, 200, 0.0);
-    const double exact2 = sheet.bvh().closest(x.data()).distance2;
-    CHECK(end.distance2 == distance2_to(sheet, end.triangle, x.data()));
-    CHECK(end.distance2 >= exact2);
+    const std::vector<double> x = point_on(sheet.surface, target, u, v, 0.5 * (unit(random) - 0.5));
+    const TriangleWalk::End end = sheet.walker.walk(x.data(), start, 200, 0.0);
+    const double exact2 = checked(sheet.surface, end, x.data());
     if (end.settled) {
       ++settled;
       CHECK(end.distance2 == doctest::Approx(exact2).epsilon(1e-12));
@@ -70,9 +82,8 @@ TEST_CASE("on a flat sheet a walk from any triangle within reach ends at the dis
 TEST_CASE("on a torus a walk from a neighbouring point's triangle finds the nearest, inside and outside") {
   // Points within a tenth of the tube's radius off the surface, each walked from the triangle a
   // lookup gives for a point a few triangles away.
-  const Surface torus = surface_of(topstoc_test::torus(96, 48));
-  const topstoc::Stars stars(torus);
-  const TriangleWalk walker(torus, stars);
+  const Walkable walkable(topstoc_test::torus(96, 48));
+  const Surface& torus = walkable.surface;
   std::mt19937 random(11);
   std::uniform_int_distribution<int32_t> any(0, torus.num_triangles() - 1);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -92,10 +103,8 @@ TEST_CASE("on a torus a walk from a neighbouring point's triangle finds the near
       nearby[k] = x[k] + 0.15 * (unit(random) - 0.5);
     }
     const int32_t start = torus.bvh().closest(nearby.data()).triangle;
-    const TriangleWalk::End end = walker.walk(x.data(), start, 16, 0.0);
-    const double exact2 = torus.bvh().closest(x.data()).distance2;
-    CHECK(end.distance2 == distance2_to(torus, end.triangle, x.data()));
-    CHECK(end.distance2 >= exact2);
+    const TriangleWalk::End end = walkable.walker.walk(x.data(), start, 16, 0.0);
+    const double exact2 = checked(torus, end, x.data());
     CHECK(end.settled);
     exact += end.distance2 <= exact2 * (1 + 1e-9) + 1e-24;
   }
@@ -105,29 +114,22 @@ TEST_CASE("on a torus a walk from a neighbouring point's triangle finds the near
 TEST_CASE("a point beyond a sheet's border walks along it to within a side's length of the nearest") {
   // The walk does not step off a border; along it the edge neighbours lead to the nearest triangle
   // or to one with a corner on the nearest side (their distances are the lookup's up to that side).
-  const Surface sheet = surface_of(topstoc_test::grid(10, 10));
-  const topstoc::Stars stars(sheet);
-  const TriangleWalk walker(sheet, stars);
+  const Walkable sheet(topstoc_test::grid(10, 10));
   for (const std::vector<double>& x : {std::vector<double>{-2.0, 4.3, 0.5}, std::vector<double>{12.0, 12.5, -1.0},
                                        std::vector<double>{5.5, -0.25, 0.0}, std::vector<double>{-0.5, -0.5, 0.0}}) {
-    const TriangleWalk::End end = walker.walk(x.data(), 55, 40, 0.0);
-    const double exact = std::sqrt(sheet.bvh().closest(x.data()).distance2);
+    const TriangleWalk::End end = sheet.walker.walk(x.data(), 55, 40, 0.0);
+    const double exact = std::sqrt(checked(sheet.surface, end, x.data()));
     CHECK(end.settled);
-    CHECK(end.distance2 == distance2_to(sheet, end.triangle, x.data()));
-    CHECK(std::sqrt(end.distance2) >= exact);
     CHECK(std::sqrt(end.distance2) <= exact + 1.0);
   }
 }
 
 TEST_CASE("a walk out of steps says so, and its distance still bounds the surface's") {
-  const Surface sheet = surface_of(topstoc_test::grid(30, 30));
-  const topstoc::Stars stars(sheet);
-  const TriangleWalk walker(sheet, stars);
+  const Walkable sheet(topstoc_test::grid(30, 30));
   const double x[3] = {29.5, 29.5, 0.1};
-  const TriangleWalk::End end = walker.walk(x, 0, 3, 0.0);  // from the far corner of the sheet
+  const TriangleWalk::End end = sheet.walker.walk(x, 0, 3, 0.0);  // from the far corner of the sheet
   CHECK_FALSE(end.settled);
-  CHECK(end.distance2 == distance2_to(sheet, end.triangle, x));
-  CHECK(end.distance2 > sheet.bvh().closest(x).distance2);
+  CHECK(end.distance2 > checked(sheet.surface, end, x));
 }
 
 TEST_CASE("a walk that ends within `close` of the point skips the steps to nearer neighbours") {
@@ -137,13 +139,11 @@ TEST_CASE("a walk that ends within `close` of the point skips the steps to neare
   topstoc_test::Arrays folded = topstoc_test::grid(8, 8);
   for (size_t i = 0; i < folded.positions.size(); i += 3)
     if (folded.positions[i] > 4.0) folded.positions[i + 2] = -(folded.positions[i] - 4.0), folded.positions[i] = 4.0;
-  const Surface sheet = surface_of(folded);
-  const topstoc::Stars stars(sheet);
-  const TriangleWalk walker(sheet, stars);
+  const Walkable sheet(folded);
   const double x[3] = {4.0, 3.5, -0.25};  // on the folded part, a quarter below the fold
   const int32_t start = 2 * (3 * 8 + 3);  // a triangle of the flat part near the fold
-  const TriangleWalk::End far = walker.walk(x, start, 20, 1.0);
-  const TriangleWalk::End near = walker.walk(x, start, 20, 0.0);
+  const TriangleWalk::End far = sheet.walker.walk(x, start, 20, 1.0);
+  const TriangleWalk::End near = sheet.walker.walk(x, start, 20, 0.0);
   CHECK(near.distance2 == doctest::Approx(0.0));
   CHECK(far.distance2 >= near.distance2);
   CHECK(far.distance2 <= 1.0);
