@@ -1,5 +1,7 @@
 #include "distance/triangle_walk.hpp"
 
+#include <utility>
+
 #include "distance/vertex_stars.hpp"
 #include "topstoc/distance/bvh.hpp"
 
@@ -9,12 +11,13 @@ TriangleWalk::TriangleWalk(const Surface& s, const Stars& stars)
     : s_(s), stars_(stars), across_(3 * size_t(s.num_triangles()), kUnknown) {}
 
 int32_t TriangleWalk::across(int32_t f, int j) const {
-  int32_t& known = across_[3 * size_t(f) + j];
+  int32_t& known = across_[3 * size_t(f) + size_t(j)];
   if (known != kUnknown) return known;
   const auto& t = s_.triangles();
-  const int32_t a = t[3 * size_t(f) + j], b = t[3 * size_t(f) + (j + 1) % 3];
+  int32_t a = t[3 * size_t(f) + size_t(j)], b = t[3 * size_t(f) + size_t((j + 1) % 3)];
+  if (stars_.end(b) - stars_.begin(b) < stars_.end(a) - stars_.begin(a)) std::swap(a, b);  // a fan's centre is b
   known = -1;
-  // the first other triangle holding side a-b (one of them where the side is non-manifold)
+  // the first other triangle around a holding b (one of them where the side is non-manifold)
   for (int64_t i = stars_.begin(a); i < stars_.end(a); ++i) {
     const int32_t g = stars_.triangle(i);
     const int32_t* c = &t[3 * size_t(g)];
@@ -97,7 +100,7 @@ std::vector<int32_t> walk_order(const Surface& s, const Stars& stars) {
     order.push_back(first);
     for (size_t i = order.size() - 1; i < order.size(); ++i)
       for (int j = 0; j < 3; ++j) {
-        const int32_t v = s.triangles()[3 * order[i] + size_t(j)];
+        const int32_t v = s.triangles()[3 * size_t(order[i]) + size_t(j)];
         if (spread[size_t(v)]) continue;  // each vertex's triangles are queued once
         spread[size_t(v)] = 1;
         for (int64_t k = stars.begin(v); k < stars.end(v); ++k)

@@ -44,7 +44,8 @@ class TriangleWalk {
   const Surface& s_;
   const Stars& stars_;
   // 3 per triangle: the triangle across side j (corners j, j + 1), -1 on a border, found when
-  // first stepped over (a walk reaches a small part of a big surface)
+  // first stepped over (a walk reaches a small part of a big surface); so one walk object is
+  // used by one thread at a time
   mutable std::vector<int32_t> across_;
   int32_t across(int32_t f, int j) const;
   double distance2(const double* x, int32_t triangle) const;
