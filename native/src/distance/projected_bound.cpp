@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "distance/triangle_walk.hpp"
@@ -221,7 +222,8 @@ struct SlotCandidates {
   size_t size() const { return slots.size(); }
   const double* corners(size_t i, double* /*buffer*/) const { return tree.slot_corners(slots[i]); }
   int32_t triangle(size_t i) const { return tree.slot_triangle(slots[i]); }
-  void across(size_t, int) const {}  // the list is whole from the start
+  static constexpr bool kGrows = false;  // the list is whole from the start
+  void across(size_t, int) const {}
   bool overflowed() const { return false; }
 };
 struct ListedCandidates {
@@ -234,6 +236,7 @@ struct ListedCandidates {
     return buffer;
   }
   int32_t triangle(size_t i) const { return ids[i]; }
+  static constexpr bool kGrows = false;
   void across(size_t, int) const {}
   bool overflowed() const { return false; }
 };
@@ -247,6 +250,7 @@ struct GrownCandidates {
   BeneathScratch& scratch;
   std::vector<int32_t>& ids;
   bool over = false;  // more than max_candidates met
+  static constexpr bool kGrows = true;
   GrownCandidates(const Surface& to, const TriangleWalk& walk, const int32_t* start, int starts,
                   int32_t max_candidates, BeneathScratch& scratch)
       : to(to), walk(walk), max_candidates(max_candidates), scratch(scratch), ids(scratch.slots) {
@@ -367,7 +371,8 @@ double bound_over(const Flat& flat, const Surface& to, double limit, BeneathScra
       if (meets(turns[j], turns[(j + 1) % 3], t_sides, along_creases ? -margin : margin)) {
         sides.push_back(a < b ? Side{a, b, 1} : Side{b, a, -1});
         candidates.across(i, j);
-      } else if (along_creases && (at_corner(q + 3 * j) || at_corner(q + 3 * ((j + 1) % 3)))) {
+      } else if (std::decay_t<Candidates>::kGrows && along_creases &&
+                 (at_corner(q + 3 * j) || at_corner(q + 3 * ((j + 1) % 3)))) {
         candidates.across(i, j);  // around a corner of T on a vertex of B
       }
     }
