@@ -214,6 +214,14 @@ struct Flat {
   }
 };
 
+// Triangle f's corner coordinates copied into buffer (9 values), for candidates listed by id.
+const double* corners_of(const Surface& to, int32_t f, double* buffer) {
+  const int32_t* t = &to.triangles()[3 * size_t(f)];
+  for (int j = 0; j < 3; ++j)
+    for (int k = 0; k < 3; ++k) buffer[3 * j + k] = to.positions()[3 * size_t(t[j]) + size_t(k)];
+  return buffer;
+}
+
 // The candidates of B as the search tree's slots, or as triangle ids of `to` (their corners
 // copied into `buffer`).
 struct SlotCandidates {
@@ -230,11 +238,7 @@ struct ListedCandidates {
   const Surface& to;
   const std::vector<int32_t>& ids;
   size_t size() const { return ids.size(); }
-  const double* corners(size_t i, double* buffer) const {
-    const int32_t* t = &to.triangles()[3 * size_t(ids[i])];
-    for (int j = 0; j < 3; ++j) std::copy_n(&to.positions()[3 * size_t(t[j])], 3, buffer + 3 * j);
-    return buffer;
-  }
+  const double* corners(size_t i, double* buffer) const { return corners_of(to, ids[i], buffer); }
   int32_t triangle(size_t i) const { return ids[i]; }
   static constexpr bool kGrows = false;
   void across(size_t, int) const {}
@@ -261,12 +265,7 @@ struct GrownCandidates {
       if (start[i] >= 0) meet(start[i]);
   }
   size_t size() const { return ids.size(); }
-  const double* corners(size_t i, double* buffer) const {
-    const int32_t* t = &to.triangles()[3 * size_t(ids[i])];
-    for (int j = 0; j < 3; ++j)
-      for (int k = 0; k < 3; ++k) buffer[3 * j + k] = to.positions()[3 * size_t(t[j]) + size_t(k)];
-    return buffer;
-  }
+  const double* corners(size_t i, double* buffer) const { return corners_of(to, ids[i], buffer); }
   int32_t triangle(size_t i) const { return ids[i]; }
   void meet(int32_t f) {
     if (f < 0 || scratch.seen[size_t(f)] == scratch.call) return;
