@@ -390,6 +390,50 @@ def test_binary_ply_variants(tmp_path, order, count_type, index_type):
     np.testing.assert_array_equal(data.vertex_colors, ref["colors"])
 
 
+
+def _grid_strips_ply(rows, cols, strips):
+    """A rows × cols grid of vertices in z = 0 and a tristrips element of `strips` (index lists)."""
+    header = ["ply", "format binary_little_endian 1.0", f"element vertex {rows * cols}", "property float x",
+              "property float y", "property float z", f"element tristrips {len(strips)}",
+              "property list int int vertex_indices", "end_header"]
+    body = b"".join(struct.pack("<fff", c, r, 0.0) for r in range(rows) for c in range(cols))
+    for strip in strips:
+        body += struct.pack("<i", len(strip)) + struct.pack(f"<{len(strip)}i", *strip)
+    return ("\n".join(header) + "\n").encode() + body
+
+
+@pytest.mark.parametrize("joined", ["restart", "degenerate"])
+def test_ply_triangle_strips_read_as_the_grid_they_cover(tmp_path, joined):
+    rows, cols = 4, 5
+    v = lambda r, c: r * cols + c  # noqa: E731
+    strips = [[i for c in range(cols) for i in (v(r, c), v(r + 1, c))] for r in range(rows - 1)]
+    if joined == "restart":  # one row of the element, the strips separated by -1
+        rows_of_element = [[i for k, s in enumerate(strips) for i in ([-1] if k else []) + s]]
+    else:  # one strip: repeated indices join the rows (zero-area triangles, no faces), an even count between
+        joined_strip = []
+        for k, s in enumerate(strips):
+            joined_strip += ([joined_strip[-1], s[0]] if k else []) + s
+        rows_of_element = [joined_strip]
+    path = tmp_path / "strips.ply"
+    path.write_bytes(_grid_strips_ply(rows, cols, rows_of_element))
+    data = read_mesh(path)
+    # The grid's quads, each cut along its diagonal from (r, c + 1) to (r + 1, c): the strip's triangles.
+    quads = [(v(r, c), v(r + 1, c), v(r, c + 1), v(r + 1, c + 1)) for r in range(rows - 1) for c in range(cols - 1)]
+    expected = {frozenset(t) for a, b, c, d in quads for t in ((a, b, c), (c, b, d))}
+    assert len(data.triangles) == len(expected) == 2 * (rows - 1) * (cols - 1)
+    assert {frozenset(t) for t in data.triangles.tolist()} == expected
+    p = data.vertices[data.triangles]
+    turn = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])[:, 2]
+    assert np.all(turn < 0) or np.all(turn > 0)  # every triangle faces one way
+
+
+def test_ply_strip_indices_other_than_the_restart_are_refused(tmp_path):
+    path = tmp_path / "bad_strip.ply"
+    path.write_bytes(_grid_strips_ply(2, 3, [[0, 3, 1, -2, 2, 5]]))
+    with pytest.raises(io.TopStocError, match="vertex index -2 is out of range"):
+        read_mesh(path)
+
+
 def test_ascii_ply_with_uvs_and_alpha(tmp_path):
     text = """ply
 format ascii 1.0

@@ -1,7 +1,8 @@
 // Stanford PLY: ascii, binary_little_endian and binary_big_endian, any scalar types.
 // vertex: x y z, colours (red green blue [alpha], r g b [a] or diffuse_*; bytes scaled to
 // [0, 1]), UVs (s t, u v, texture_u texture_v, texture_s texture_t); face: vertex_indices (or
-// vertex_index) as a list of any integer types, and MeshLab's per-corner `texcoord` list.
+// vertex_index) as a list of any integer types, and MeshLab's per-corner `texcoord` list;
+// tristrips: vertex_indices, strips separated by -1 (older scanners' files).
 // Other elements and properties are read past and ignored.
 #include <algorithm>
 #include <cstring>
@@ -151,8 +152,9 @@ PlyHeader parse_header(const char* data, size_t size) {
           fail_at_line(number, "property " + quote(name) + " declared twice in element '" + element.name + "'");
       const bool list = property.count_type != PlyType::None;
       if (element.name == "vertex" && !list) property.role = vertex_role(name);
-      if (element.name == "face" && list && (name == "vertex_indices" || name == "vertex_index")) {
-        if (!is_integer(property.type)) fail_at_line(number, "face vertex indices must have an integer type");
+      const bool indexed = element.name == "face" || element.name == "tristrips";
+      if (indexed && list && (name == "vertex_indices" || name == "vertex_index")) {
+        if (!is_integer(property.type)) fail_at_line(number, element.name + " vertex indices must have an integer type");
         property.role = Role::Indices;
       }
       if (element.name == "face" && list && name == "texcoord") property.role = Role::TexCoord;
@@ -160,7 +162,7 @@ PlyHeader parse_header(const char* data, size_t size) {
       if (property.role == Role::Indices)
         for (const auto& other : element.properties)
           if (other.role == Role::Indices)
-            fail_at_line(number, "the face element has two vertex index lists ('" + other.name + "' and " +
+            fail_at_line(number, "the " + element.name + " element has two vertex index lists ('" + other.name + "' and " +
                                      quote(name) + ")");
       element.properties.push_back(std::move(property));
     } else {
@@ -326,6 +328,22 @@ void check_ends_after_rows(const PlyHeader& header, Source& source) {
   throw std::invalid_argument("the file goes on after the rows its header declares (" + counts + "): " + rest);
 }
 
+// A triangle strip's triangles: each three consecutive indices, every second one turned so that
+// all face one way. -1 starts a new strip; a triangle with a repeated corner (how strips are
+// joined) is no face. with_uvs: the faces have per-corner UVs, which a strip's corners lack.
+void add_strip(MeshFile& mesh, const std::vector<int32_t>& indices, bool with_uvs) {
+  const double none[6] = {kNaN, kNaN, kNaN, kNaN, kNaN, kNaN};
+  size_t start = 0;
+  for (size_t i = 0; i < indices.size(); ++i) {
+    if (indices[i] < 0) start = i + 1;
+    if (indices[i] < 0 || i < start + 2) continue;
+    int32_t c[3] = {indices[i - 2], indices[i - 1], indices[i]};
+    if ((i - start) % 2 == 1) std::swap(c[0], c[1]);
+    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
+    add_polygon(mesh, c, 3, with_uvs ? none : nullptr, -1, with_uvs, false);
+  }
+}
+
 template <class Source>
 MeshFile read_body(const PlyHeader& header, Source& source) {
   MeshFile mesh;
@@ -340,15 +358,14 @@ MeshFile read_body(const PlyHeader& header, Source& source) {
   std::vector<double> uvs;
   int64_t first_skipped = 0;
   for (const auto& element : header.elements) {
-    if (element.name == "tristrips" && element.count > 0)
-      throw std::invalid_argument("triangle strips (element tristrips) are not supported");
     const bool is_vertex = element.name == "vertex", is_face = element.name == "face";
+    const bool is_strip = element.name == "tristrips";
     bool has[12] = {};
     for (const auto& p : element.properties) has[int(p.role)] = true;
     const bool colors = is_vertex && has[int(Role::Red)] && has[int(Role::Green)] && has[int(Role::Blue)];
     const bool uv = is_vertex && has[int(Role::U)] && has[int(Role::V)];
-    if (is_face && !has[int(Role::Indices)] && element.count > 0)
-      throw std::invalid_argument("the face element has no vertex_indices list");
+    if ((is_face || is_strip) && !has[int(Role::Indices)] && element.count > 0)
+      throw std::invalid_argument("the " + element.name + " element has no vertex_indices list");
     if (is_vertex && !(has[int(Role::X)] && has[int(Role::Y)] && has[int(Role::Z)]) && element.count > 0)
       throw std::invalid_argument("the vertex element has no x, y and z properties");
     if (element.properties.empty()) continue;  // nothing to read, however many rows
@@ -383,6 +400,10 @@ MeshFile read_body(const PlyHeader& header, Source& source) {
             for (int64_t i = 0; i < count; ++i) {
               if (p.role == Role::Indices) {
                 const int64_t v = source.integer(p.type);
+                if (is_strip && v == -1) {  // a strip's restart
+                  corners.push_back(-1);
+                  continue;
+                }
                 if (v < 0 || v > INT32_MAX)
                   throw std::invalid_argument("vertex index " + std::to_string(v) + " is out of range");
                 corners.push_back(int32_t(v));
@@ -412,6 +433,7 @@ MeshFile read_body(const PlyHeader& header, Source& source) {
             default: break;
           }
         }
+        if (is_strip) add_strip(mesh, corners, face_texcoords);
         if (is_face) {
           if (face_texcoords && uvs.size() != 2 * corners.size())
             throw std::invalid_argument("texcoord holds " + std::to_string(uvs.size()) + " values for " +
