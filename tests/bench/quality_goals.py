@@ -24,16 +24,22 @@ def at_our_count(ours: dict, peer: dict | None) -> bool:
     return bool(peer) and peer["triangles"] <= ours["triangles"] * (1 + COUNT_SLACK) + 2
 
 
-def goal_ratios(case: dict, mode: str = "quality") -> tuple[float | None, float | None]:
+def goal_ratios(case: dict, mode: str = "quality", kept_topology: bool = False) -> tuple[float | None, float | None]:
     """(mean ÷ the better of Blender and MeshLab, max ÷ the best peer) of our result in ``mode``,
     None where no such peer reached our count (the peers decimate to the quality result's count,
-    which the best mode's result shares: its fit only moves vertices)."""
+    which the best mode's result shares: its fit only moves vertices). kept_topology: only the
+    peers whose result kept every component's topology, as ours does, enter."""
     tools = case["tools"]
     ours = tools.get(f"topstoc {mode}")
     if not ours:
         return None, None
-    means = [tools[n]["mean"] for n in ("Blender Collapse", "MeshLab") if at_our_count(ours, tools.get(n))]
-    maxes = [tools[n]["max"] for n in PEERS if at_our_count(ours, tools.get(n))]
+
+    def rival(name: str) -> bool:
+        peer = tools.get(name)
+        return at_our_count(ours, peer) and (not kept_topology or bool(peer.get("topology")))
+
+    means = [tools[n]["mean"] for n in ("Blender Collapse", "MeshLab") if rival(n)]
+    maxes = [tools[n]["max"] for n in PEERS if rival(n)]
     return (error_ratio(ours["mean"], min(means)) if means else None,
             error_ratio(ours["max"], min(maxes)) if maxes else None)
 

@@ -37,3 +37,12 @@ def test_no_peer_at_our_count_gives_no_figure():
 def test_exact_results_compare_as_ties():
     c = {"tools": {"topstoc quality": tool(100, 1e-9, 1e-9), "MeshLab": tool(100, 1e-12, 0.0)}}
     assert goal_ratios(c) == (1.0, 1.0)
+
+
+def test_peers_that_changed_the_topology_leave_the_kept_topology_figures():
+    changed = {**tool(100, 0.1, 1.0), "topology": False}
+    kept = {**tool(100, 0.4, 4.0), "topology": True}
+    c = case(**{"Blender Collapse": changed, "MeshLab": kept, "meshopt_simplify": {**tool(100, 0.1, 0.5), "topology": False}})
+    assert goal_ratios(c) == (0.2 / 0.1, 2.0 / 0.5)
+    assert goal_ratios(c, kept_topology=True) == (0.2 / 0.4, 2.0 / 4.0)
+    assert goal_ratios(case(**{"Blender Collapse": changed}), kept_topology=True) == (None, None)
