@@ -459,7 +459,7 @@ constexpr int32_t kParallelCostWork = 512;  // neighbour pairs to cost + 8 per e
 // Collapses per batch: 1 (exactly greedy) near the end and on small meshes, up to 128 when
 // many remain, so that the checks and costs of a batch can run in parallel.
 int32_t Collapser::batch_size(int32_t excess) const {
-  return std::clamp(std::min(excess / 64, alive_vertices_ / 1024), 1, 128);
+  return std::clamp(std::min(excess / 64, alive_vertices_ / 1024), 1, kMaxBatch);
 }
 
 void Collapser::use_arrays(std::vector<int32_t>& triangles, std::vector<int32_t>& corner_source) {
@@ -480,6 +480,7 @@ int32_t Collapser::run(Stop target, const BeforeTail& before_tail) {
   Batch batch;
   bool in_tail = false;
   int32_t last_size = 0;  // of the last batch: one collapse, so none was left out at the target
+  int32_t cap = kMaxBatch;  // smaller while batches' collapses crowd one place
   while (!reached(target)) {
     check_cancelled("collapses");
     if (heap_.empty()) {
@@ -499,11 +500,12 @@ int32_t Collapser::run(Stop target, const BeforeTail& before_tail) {
     if (before_tail && !in_tail && target.faces == 0 && use_quota_ && size != batch_size(INT32_MAX)) before_tail(*this, collapses);
     in_tail = in_tail || size != batch_size(INT32_MAX);
     last_size = size;
-    take_batch(batch, size);
+    take_batch(batch, std::min(size, cap));
     const uint32_t ring = ++ring_stamp_;
     reserve_batch(batch, ring);
     check_reserved(batch);
     collapses += apply_batch(batch, target);
+    cap = next_batch_cap(batch, cap);
     cost_after_batch(batch, ring);
     settle_survivors(batch, ring);
   }
@@ -529,6 +531,27 @@ void Collapser::take_batch(Batch& batch, int32_t size) {
     batch.vertices.push_back(u);
     batch.key.push_back(key);
   }
+  taken_ += int64_t(batch.vertices.size());
+}
+
+// The next batch's largest size. Where the cheapest collapses all touch one another (equal costs
+// on a flat region, whose ties go by vertex id, so neighbours come out together), a full batch
+// reserves one and queues the rest again: a hundred heap operations for each collapse. The cap
+// then drops to twice the collapses that did not wait, and doubles back batch by batch.
+int32_t Collapser::next_batch_cap(const Batch& batch, int32_t cap) {
+  const int32_t taken = int32_t(batch.vertices.size());
+  const int32_t waited = int32_t(std::count(batch.status.begin(), batch.status.end(), uint8_t(kWait)));
+  if (taken >= 16 && 8 * waited > 7 * taken) return std::max(2, 2 * (taken - waited));
+  return std::min(2 * cap, kMaxBatch);
+}
+
+// A collapse with a wide fan's centre at one end is checked (as check_reserved would) before its
+// ring, the whole fan, is marked: such collapses are nearly always refused (the fan would fold),
+// and each marking walked the fan twice. kReady if it may go on.
+uint8_t Collapser::refused_beside_fan(int32_t u, int32_t v, double key) {
+  if (size_[u] <= kWideFan && size_[v] <= kWideFan) return kReady;
+  if (key != cost(u, v)) return kEvaluate;
+  return allowed(u, v, scratch_[0]) ? kReady : kEvaluateChecked;
 }
 
 // Reserve, in cost order, the neighbourhoods of collapses no earlier one of the batch touches:
@@ -542,6 +565,8 @@ void Collapser::reserve_batch(Batch& batch, uint32_t ring) {
     const int32_t u = batch.vertices[i], v = target_[u];
     if (dirty_[u] || merged_into_[v] >= 0) {
       batch.status[i] = kEvaluate;  // its key was a lower bound, or its collapse went stale
+    } else if (const uint8_t refused = refused_beside_fan(u, v, batch.key[i]); refused != kReady) {
+      batch.status[i] = refused;
     } else if (mark_ring(u, v, ring)) {
       batch.reserved.push_back(i);
     } else {
@@ -669,10 +694,12 @@ bool Collapser::mark_ring(int32_t u, int32_t v, uint32_t ring) {
   };
   for (int32_t w : {u, v})
     if (const int32_t slot = kept_slot(w); waiting_[w] == ring || (slot >= 0 && beside_[slot] == ring)) return false;
-  for (int32_t w : {u, v})
+  for (int32_t w : {u, v}) {
+    ring_faces_ += faces_end(w) - faces_begin(w);
     for (const int32_t* t = faces_begin(w); t != faces_end(w); ++t)
       for (int j = 0; j < 3; ++j)
         if (waiting_[(*tri_)[3 * size_t(*t) + j]] == ring) return false;
+  }
   for (int32_t w : {u, v})
     for (const int32_t* t = faces_begin(w); t != faces_end(w); ++t)
       for (int j = 0; j < 3; ++j) {

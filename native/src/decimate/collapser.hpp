@@ -161,6 +161,10 @@ class Collapser {
   int32_t live_vertices() const { return alive_vertices_; }
   /// Batches run() has taken so far (its collapses were reserved, checked and costed together).
   int64_t batches() const { return ring_stamp_; }
+  /// Collapses run() has taken from the queue into its batches (those that waited went back).
+  int64_t taken() const { return taken_; }
+  /// Triangles the batches' reservations walked around their collapses' ends (mark_ring).
+  int64_t ring_faces() const { return ring_faces_; }
   /// The triangles as the collapses renamed them (dead ones included: see face_alive).
   const std::vector<int32_t>& triangles() const { return *tri_; }
   /// The corner sources as the collapses renamed the corners.
@@ -214,6 +218,7 @@ class Collapser {
   void offer(int32_t x, int32_t v, int32_t removed, double c);
   void refresh(int32_t u, int32_t v);
   bool mark_ring(int32_t u, int32_t v, uint32_t ring);
+  static constexpr int32_t kMaxBatch = 128;
   int32_t batch_size(int32_t excess) const;
   // One batch of run(): the cheapest queued collapses, their status, and what they leave to
   // evaluate and to cost again. Kept across batches so that its lists keep their memory.
@@ -225,7 +230,9 @@ class Collapser {
     std::vector<Best> pending_best;
   };
   void take_batch(Batch& batch, int32_t size);
+  static int32_t next_batch_cap(const Batch& batch, int32_t cap);
   void reserve_batch(Batch& batch, uint32_t ring);
+  uint8_t refused_beside_fan(int32_t u, int32_t v, double key);
   void check_reserved(Batch& batch);
   int32_t apply_batch(Batch& batch, Stop target);
   void cost_after_batch(Batch& batch, uint32_t ring);
@@ -347,6 +354,7 @@ class Collapser {
   std::vector<uint32_t> beside_;       // per slot of kept_costs_: the batch whose collapses passed beside it
   std::vector<uint32_t> settled_;      // per vertex: the batch that evaluated it anew
   uint32_t ring_stamp_ = 0;  // one per batch run() took
+  int64_t taken_ = 0, ring_faces_ = 0;  // see taken(), ring_faces()
   PerThread<Scratch> scratch_{0};  // one per thread, each on its own cache lines
   std::vector<int32_t> options_, star_, moved_faces_;
 };
