@@ -56,6 +56,19 @@ def fanned_cylinder(triangles: int):
     return fan_meshes.cylinder_caps(max(8, triangles // 12), 4)
 
 
+def needle_strip(triangles: int):
+    """A flat strip 8 cells across, each cell 1,000 times longer than it is wide: every triangle a
+    needle (a long part's tessellation sliced finely along its length)."""
+    rows = max(1, triangles // 16)
+    x, y = np.meshgrid(np.arange(9.0), 0.001 * np.arange(rows + 1), indexing="ij")
+    vertices = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    i, j = (a.ravel() for a in np.meshgrid(np.arange(8), np.arange(rows), indexing="ij"))
+    a = i * (rows + 1) + j
+    b, d = a + rows + 1, a + 1
+    faces = np.vstack([np.column_stack([a, b, b + 1]), np.column_stack([a, b + 1, d])])
+    return vertices, faces.astype(np.int32)
+
+
 def perforated_plate(triangles: int):
     """A plate with 1,000 random holes (genus 1,000), subdivided up to the size: CAD-like."""
     vertices, faces = loop_families.perforated_plate(1000)
@@ -92,4 +105,5 @@ def welded_points(triangles: int):
 
 
 FAMILIES = {f.__name__: f for f in (bumpy_torus, many_spheres, triangle_soup, sheet_with_holes, sliver_sphere,
-                                    fanned_cylinder, perforated_plate, holed_scan, torn_scan, welded_points)}
+                                    needle_strip, fanned_cylinder, perforated_plate, holed_scan, torn_scan,
+                                    welded_points)}
