@@ -5,9 +5,11 @@
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <random>
 #include <vector>
 
+#include "decimate/collapse_snapshots.hpp"
 #include "decimate/collapser.hpp"
 #include "topstoc/core/parallel.hpp"
 #include "collapse_setup.hpp"
@@ -107,4 +109,33 @@ TEST_CASE("a collapse at a fan's centre is checked before the fan is walked for 
   REQUIRE(run.collapses == k + 2 - keep);
   CHECK(run.ring_faces < 64 * run.batches);
   CHECK(run_to(mesh, setup, keep, 1).live == run.live);
+}
+
+TEST_CASE("a state kept where a capped run's tail starts resumes to the fresh run") {
+  // The cap is part of the collapser's state: a run resumed from a kept state (the Live
+  // Preview's, an error search's) takes the batches the uninterrupted run takes.
+  for (const int32_t rows : {1000, 2000, 3000, 5000}) {
+    topstoc::CollapseSetup setup;
+    const topstoc_test::Arrays mesh = needle_strip(rows, setup);
+    const int32_t n = int32_t(setup.locked.size());
+    for (const int32_t first_target : {n / 2, 2 * n / 3}) {
+      std::vector<int32_t> triangles = mesh.triangles, corners(triangles.size());
+      for (size_t i = 0; i < corners.size(); ++i) corners[i] = int32_t(i);
+      const std::vector<int32_t> sources = corners;
+      Collapser first(triangles, corners, setup);
+      std::shared_ptr<const topstoc::CollapseSnapshots::Entry> kept;
+      first.run({first_target, 0}, [&](const Collapser& state, int32_t made) {
+        kept = topstoc::snapshot({}, first_target, made, state);
+      });
+      REQUIRE(bool(kept));
+      std::vector<int32_t> resumed_triangles, resumed_sources;
+      auto resumed = topstoc::resumed(*kept, resumed_triangles, resumed_sources, {0});
+      const int32_t resumed_collapses = kept->collapses + resumed->run({n / 4, 0});
+      std::vector<int32_t> fresh_triangles = mesh.triangles, fresh_sources = sources;
+      Collapser fresh(fresh_triangles, fresh_sources, setup);
+      CHECK(fresh.run({n / 4, 0}) == resumed_collapses);
+      CHECK(resumed_triangles == fresh_triangles);
+      CHECK(resumed_sources == fresh_sources);
+    }
+  }
 }

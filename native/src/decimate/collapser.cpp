@@ -480,7 +480,6 @@ int32_t Collapser::run(Stop target, const BeforeTail& before_tail) {
   Batch batch;
   bool in_tail = false;
   int32_t last_size = 0;  // of the last batch: one collapse, so none was left out at the target
-  int32_t cap = kMaxBatch;  // smaller while batches' collapses crowd one place
   while (!reached(target)) {
     check_cancelled("collapses");
     if (heap_.empty()) {
@@ -500,12 +499,12 @@ int32_t Collapser::run(Stop target, const BeforeTail& before_tail) {
     if (before_tail && !in_tail && target.faces == 0 && use_quota_ && size != batch_size(INT32_MAX)) before_tail(*this, collapses);
     in_tail = in_tail || size != batch_size(INT32_MAX);
     last_size = size;
-    take_batch(batch, std::min(size, cap));
+    take_batch(batch, std::min(size, batch_cap_));
     const uint32_t ring = ++ring_stamp_;
     reserve_batch(batch, ring);
     check_reserved(batch);
     collapses += apply_batch(batch, target);
-    cap = next_batch_cap(batch, cap);
+    batch_cap_ = next_batch_cap(batch, batch_cap_);
     cost_after_batch(batch, ring);
     settle_survivors(batch, ring);
   }

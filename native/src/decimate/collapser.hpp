@@ -355,6 +355,9 @@ class Collapser {
   std::vector<uint32_t> settled_;      // per vertex: the batch that evaluated it anew
   uint32_t ring_stamp_ = 0;  // one per batch run() took
   int64_t taken_ = 0, ring_faces_ = 0;  // see taken(), ring_faces()
+  // The next batch's largest size (next_batch_cap): part of the state, so that a run resumed
+  // from a kept copy takes the batches the uninterrupted run takes.
+  int32_t batch_cap_ = kMaxBatch;
   PerThread<Scratch> scratch_{0};  // one per thread, each on its own cache lines
   std::vector<int32_t> options_, star_, moved_faces_;
 };
