@@ -1,5 +1,6 @@
 // Small meshes built in code for the C++ tests: a torus grid (genus 1), an octahedron (genus 0)
-// and a planar grid (one boundary loop), each as plain arrays; and random samples on them.
+// and a planar grid (one boundary loop), a fan lens (two wide fans), each as plain arrays; and
+// random samples on them.
 #pragma once
 
 #include <cmath>
@@ -8,6 +9,8 @@
 #include <numeric>
 #include <random>
 #include <vector>
+
+#include "core/portable.hpp"
 
 namespace topstoc_test {
 
@@ -47,6 +50,21 @@ inline Arrays grid(int32_t n, int32_t m) {
       a.triangles.insert(a.triangles.end(), {p, q, q + 1, p, q + 1, p + 1});
     }
   return a;
+}
+
+/// A closed fan lens inside [-1, 1]: a rim of k vertices (radii jittered) in the plane z = 0, a
+/// flat fan above it from the centre k at (0, 0, 0) and a cone below from k + 1 at (0, 0, -0.6).
+inline Arrays fan_lens(int32_t k, std::mt19937& random) {
+  std::uniform_real_distribution<double> jitter(0.85, 1.0);
+  Arrays mesh;
+  for (int32_t i = 0; i < k; ++i) {
+    const double a = 2.0 * topstoc::kPi * i / k, r = 0.9 * jitter(random);
+    mesh.positions.insert(mesh.positions.end(), {r * std::cos(a), r * std::sin(a), 0.0});
+  }
+  mesh.positions.insert(mesh.positions.end(), {0.0, 0.0, 0.0, 0.0, 0.0, -0.6});
+  for (int32_t i = 0; i < k; ++i)
+    mesh.triangles.insert(mesh.triangles.end(), {k, i, (i + 1) % k, k + 1, (i + 1) % k, i});
+  return mesh;
 }
 
 /// Octahedron: vertex 0 = +z, 5 = -z, 1..4 around the equator.

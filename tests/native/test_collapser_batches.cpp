@@ -13,7 +13,6 @@
 #include "decimate/collapser.hpp"
 #include "topstoc/core/parallel.hpp"
 #include "collapse_setup.hpp"
-#include "core/portable.hpp"
 #include "meshes.hpp"
 
 using topstoc::Collapser;
@@ -54,21 +53,6 @@ topstoc_test::Arrays needle_strip(int32_t rows, topstoc::CollapseSetup& setup) {
   return mesh;
 }
 
-// A closed fan lens: a rim of k vertices (radii jittered) in the plane z = 0, a flat fan above it
-// from (0, 0, 0) and a cone below from (0, 0, -0.6). Neither centre is locked.
-topstoc_test::Arrays fan_lens(int32_t k, std::mt19937& random) {
-  std::uniform_real_distribution<double> jitter(0.85, 1.0);
-  topstoc_test::Arrays mesh;
-  for (int32_t i = 0; i < k; ++i) {
-    const double a = 2.0 * topstoc::kPi * i / k, r = 0.9 * jitter(random);
-    mesh.positions.insert(mesh.positions.end(), {r * std::cos(a), r * std::sin(a), 0.0});
-  }
-  mesh.positions.insert(mesh.positions.end(), {0.0, 0.0, 0.0, 0.0, 0.0, -0.6});
-  for (int32_t i = 0; i < k; ++i)
-    mesh.triangles.insert(mesh.triangles.end(), {k, i, (i + 1) % k, k + 1, (i + 1) % k, i});
-  return mesh;
-}
-
 // Triangles of `live` (corners into `positions`) facing -z.
 int64_t facing_down(const std::vector<int32_t>& live, const std::vector<double>& positions) {
   int64_t down = 0;
@@ -102,7 +86,7 @@ TEST_CASE("a collapse at a fan's centre is checked before the fan is walked for 
   // walked the whole fan twice first: about k faces a batch.
   std::mt19937 random(5);
   const int32_t k = 20000, keep = 2000;
-  const topstoc_test::Arrays mesh = fan_lens(k, random);
+  const topstoc_test::Arrays mesh = topstoc_test::fan_lens(k, random);
   auto setup = topstoc_test::torus_setup(mesh);
   setup.input_floor2.assign(k + 2, 1e-6);  // the fans' slivers may stay as thin where flat
   const Run run = run_to(mesh, setup, keep, 2);

@@ -14,30 +14,11 @@
 #include "decimate/collapser.hpp"
 #include "topstoc/core/parallel.hpp"
 #include "collapse_setup.hpp"
-#include "core/portable.hpp"
 #include "meshes.hpp"
 
 using topstoc::Collapser;
 
 namespace {
-
-// A closed fan lens inside [-1, 1]: a rim of k vertices (radii jittered) in the plane z = 0,
-// a flat fan above it from the centre (0, 0, 0) and a cone below from (0, 0, -0.6).
-topstoc_test::Arrays fan_lens(int32_t k, std::mt19937& random) {
-  std::uniform_real_distribution<double> jitter(0.85, 1.0);
-  topstoc_test::Arrays mesh;
-  for (int32_t i = 0; i < k; ++i) {
-    const double a = 2.0 * topstoc::kPi * i / k, r = 0.9 * jitter(random);
-    mesh.positions.insert(mesh.positions.end(), {r * std::cos(a), r * std::sin(a), 0.0});
-  }
-  mesh.positions.insert(mesh.positions.end(), {0.0, 0.0, 0.0, 0.0, 0.0, -0.6});
-  const int32_t top = k, bottom = k + 1;
-  for (int32_t i = 0; i < k; ++i) {
-    const int32_t next = (i + 1) % k;
-    mesh.triangles.insert(mesh.triangles.end(), {top, i, next, bottom, next, i});
-  }
-  return mesh;
-}
 
 int64_t collapse_checking(Collapser& collapser, int32_t keep) {
   int64_t checked = 0;
@@ -54,7 +35,7 @@ int64_t collapse_checking(Collapser& collapser, int32_t keep) {
 TEST_CASE("a fan centre's kept flatness and costs equal a fresh walk after every collapse") {
   std::mt19937 random(3);
   for (const int32_t k : {200, 333}) {
-    const auto mesh = fan_lens(k, random);
+    const auto mesh = topstoc_test::fan_lens(k, random);
     const int32_t n = k + 2;
     std::vector<int32_t> triangles = mesh.triangles, corners(triangles.size());
     for (size_t i = 0; i < corners.size(); ++i) corners[i] = int32_t(i);
@@ -78,7 +59,7 @@ namespace {
 // threads, and the batches it took.
 std::vector<int32_t> run_lens(int32_t k, int32_t keep, int threads, int64_t& batches, std::vector<double>& at) {
   std::mt19937 random(5);
-  const auto mesh = fan_lens(k, random);
+  const auto mesh = topstoc_test::fan_lens(k, random);
   std::vector<int32_t> triangles = mesh.triangles, corners(triangles.size());
   for (size_t i = 0; i < corners.size(); ++i) corners[i] = int32_t(i);
   const int saved = topstoc::max_threads();
