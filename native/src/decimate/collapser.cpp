@@ -547,7 +547,7 @@ int32_t Collapser::next_batch_cap(const Batch& batch, int32_t cap) {
 // A collapse with a wide fan's centre at one end is checked (as check_reserved would) before its
 // ring, the whole fan, is marked: such collapses are nearly always refused (the fan would fold),
 // and each marking walked the fan twice. kReady if it may go on.
-uint8_t Collapser::refused_beside_fan(int32_t u, int32_t v, double key) {
+uint8_t Collapser::refused_at_fan(int32_t u, int32_t v, double key) {
   if (size_[u] <= kWideFan && size_[v] <= kWideFan) return kReady;
   if (key != cost(u, v)) return kEvaluate;
   return allowed(u, v, scratch_[0]) ? kReady : kEvaluateChecked;
@@ -564,7 +564,7 @@ void Collapser::reserve_batch(Batch& batch, uint32_t ring) {
     const int32_t u = batch.vertices[i], v = target_[u];
     if (dirty_[u] || merged_into_[v] >= 0) {
       batch.status[i] = kEvaluate;  // its key was a lower bound, or its collapse went stale
-    } else if (const uint8_t refused = refused_beside_fan(u, v, batch.key[i]); refused != kReady) {
+    } else if (const uint8_t refused = refused_at_fan(u, v, batch.key[i]); refused != kReady) {
       batch.status[i] = refused;
     } else if (mark_ring(u, v, ring)) {
       batch.reserved.push_back(i);

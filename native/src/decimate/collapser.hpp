@@ -163,7 +163,8 @@ class Collapser {
   int64_t batches() const { return ring_stamp_; }
   /// Collapses run() has taken from the queue into its batches (those that waited went back).
   int64_t taken() const { return taken_; }
-  /// Triangles the batches' reservations walked around their collapses' ends (mark_ring).
+  /// Triangles around the ends of the collapses the batches tried to reserve (mark_ring walks them
+  /// until one touches the batch).
   int64_t ring_faces() const { return ring_faces_; }
   /// The triangles as the collapses renamed them (dead ones included: see face_alive).
   const std::vector<int32_t>& triangles() const { return *tri_; }
@@ -232,7 +233,7 @@ class Collapser {
   void take_batch(Batch& batch, int32_t size);
   static int32_t next_batch_cap(const Batch& batch, int32_t cap);
   void reserve_batch(Batch& batch, uint32_t ring);
-  uint8_t refused_beside_fan(int32_t u, int32_t v, double key);
+  uint8_t refused_at_fan(int32_t u, int32_t v, double key);
   void check_reserved(Batch& batch);
   int32_t apply_batch(Batch& batch, Stop target);
   void cost_after_batch(Batch& batch, uint32_t ring);
