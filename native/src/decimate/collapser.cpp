@@ -548,7 +548,7 @@ int32_t Collapser::next_batch_cap(const Batch& batch, int32_t cap) {
 // ring, the whole fan, is marked: such collapses are nearly always refused (the fan would fold),
 // and each marking walked the fan twice. kReady if it may go on.
 uint8_t Collapser::refused_at_fan(int32_t u, int32_t v, double key) {
-  if (size_[u] <= kWideFan && size_[v] <= kWideFan) return kReady;
+  if (!at_fan(u, v)) return kReady;
   if (key != cost(u, v)) return kEvaluate;
   return allowed(u, v, scratch_[0]) ? kReady : kEvaluateChecked;
 }
@@ -580,6 +580,7 @@ void Collapser::check_reserved(Batch& batch) {
   const int32_t checks = int32_t(batch.reserved.size());
   parallel_for_dynamic(0, checks, 4, kParallelChecks, [&](int32_t k) {
     const int32_t i = batch.reserved[k], u = batch.vertices[i], v = target_[u];
+    if (at_fan(u, v)) return;  // refused_at_fan checked it on the same state
     if (batch.key[i] != cost(u, v)) {
       batch.status[i] = kEvaluate;
     } else if (!allowed(u, v, scratch_.mine())) {

@@ -234,6 +234,7 @@ class Collapser {
   static int32_t next_batch_cap(const Batch& batch, int32_t cap);
   void reserve_batch(Batch& batch, uint32_t ring);
   uint8_t refused_at_fan(int32_t u, int32_t v, double key);
+  bool at_fan(int32_t u, int32_t v) const { return size_[u] > kWideFan || size_[v] > kWideFan; }
   void check_reserved(Batch& batch);
   int32_t apply_batch(Batch& batch, Stop target);
   void cost_after_batch(Batch& batch, uint32_t ring);
