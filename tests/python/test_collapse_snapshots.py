@@ -148,3 +148,29 @@ def test_a_sliver_heavy_mesh_warms_up_and_resumes():
     for ratio, resumed in ((0.1, 1), (0.05, 2)):
         assert_same(mesh.decimate(ratio=ratio), plain.decimate(ratio=ratio))
         assert snapshots.resumed == resumed
+
+
+@pytest.mark.heavy
+def test_a_mesh_too_large_to_collapse_whole_warms_up_where_its_first_pass_is_fixed():
+    """Above 250,000 vertices the collapses start from a first pass (decimate.cpp,
+    first_pass_vertices) of 8 times the target, at most 250,000 vertices and, up to 500,000, at
+    least 125,000: the same for every target of 31,250 vertices or more (up to 200,000), and here
+    below 15,625. There a warm-up keeps the collapse run's state and the decimations at its ratio
+    or below resume from it, with the results of a mesh that keeps nothing. In between the first
+    pass grows with the target: a warm-up keeps nothing, and a decimation's state serves only a
+    repeat of its own target (the same first pass)."""
+    from topstoc.core.api.decimate import warm_up
+    from topstoc.core.api.job import make_job
+
+    torus = meshgen.bumpy_torus(540000)  # 270k vertices
+    mesh, plain = Mesh(*torus), Mesh(*torus, keep_floods=False)
+    snapshots = mesh.kept_for_reuse()[2]
+    assert warm_up(mesh, make_job(mesh, ratio=0.3)) is True
+    assert (snapshots.size, snapshots.resumed) == (1, 0)
+    for ratio, resumed in ((0.3, 1), (0.2, 2)):
+        assert_same(mesh.decimate(ratio=ratio), plain.decimate(ratio=ratio))
+        assert snapshots.resumed == resumed
+    assert warm_up(mesh, make_job(mesh, ratio=0.09)) is False  # first pass 8 times the target
+    for resumed in (2, 3):
+        assert_same(mesh.decimate(ratio=0.09), plain.decimate(ratio=0.09))
+        assert snapshots.resumed == resumed

@@ -884,6 +884,19 @@ int32_t first_pass_vertices(const Mesh& mesh, const FeatureLayout& layout, const
   return int32_t(std::min<double>(active, std::max({std::ceil(params.refine * target), target + extra, floor})));
 }
 
+// Whether a decimation toward kWarmUpReach of the target draws as many first-pass vertices
+// (the whole mesh, or the cap or floor above): the pass is then the same for every target in
+// between (the count grows with the target), and a collapse state kept from it serves them. A
+// live preview warms up toward 1.15 times the highest ratio asked, and the rests that follow
+// lie a little under it.
+constexpr double kWarmUpReach = 0.75;
+bool first_pass_fixed(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params, int32_t active,
+                      int32_t first_vertices) {
+  DecimateParams lower = params;
+  lower.target_vertices = std::max(1, int32_t(kWarmUpReach * params.target_vertices));
+  return first_pass_vertices(mesh, layout, lower, active) == first_vertices;
+}
+
 // TopStoc to a few times the target, then collapses down to it (refine.hpp). Painted regions
 // keep the share of the budget the guidance gives them. target_triangles > 0: the collapses
 // stop there instead (the vertex target then sets the first pass and the guidance quotas).
@@ -898,10 +911,9 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   first.target_vertices = first_pass_vertices(mesh, layout, params, active);
   first.sampling.keep_curves = true;  // the collapses thin the borders (sampling.cpp force_curves)
   first.warm_up = false;
-  // A first pass that depends on the target, or a whole mesh too large for the max-aware reruns:
-  // no state a later decimation could resume from.
-  if (params.warm_up && (first.target_vertices != active || active > kMaxAwareVertices || !params.collapse_snapshots ||
-                         target_triangles > 0))
+  // A first pass that depends on the target: no state a later decimation could resume from.
+  if (params.warm_up && (!first_pass_fixed(mesh, layout, params, active, first.target_vertices) ||
+                         !params.collapse_snapshots || target_triangles > 0))
     return {};
   DecimateResult result = stochastic_pass(mesh, layout, first, true);
   // A first pass whose repairs left issues may be broken (the double cone of n = 80,000): the
@@ -937,7 +949,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   refine_by_collapses(mesh, layout, refine, result);
   if (params.warm_up) {  // the kept state is the point: the result is unfinished
     DecimateResult warmed;
-    warmed.refine_vertices = result.refine_vertices;  // set where the max-aware collapses ran
+    warmed.refine_vertices = result.refine_vertices;  // set where a state was kept
     return warmed;
   }
   result.target_vertices = params.target_vertices;

@@ -519,10 +519,11 @@ class Refinement {
     if (params.max_aware && whole_input() && n <= kMaxAwareVertices) {
       collapse_max_aware(std::move(setup), center, extent);
       if (params.warm_up) return;
-    } else if (params.warm_up) {
+    } else if (params.warm_up && !keeps_plain_state()) {
       return;  // no state is kept on this path
     } else {
       collapse_plain(std::move(setup), center, extent);
+      if (params.warm_up) return;
     }
     publish_labels();
   }
@@ -734,16 +735,17 @@ class Refinement {
     const bool may_retry = may_loosen(setup);
     std::vector<int32_t> start_triangles, start_corners;
     if (may_retry) start_triangles = result.triangles, start_corners = result.corner_source;
-    auto collapser = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
-    collapse(collapser, center, extent);
+    std::unique_ptr<Collapser> collapser;
+    collapse(std::move(setup), collapser, center, extent, true);
+    if (params.warm_up) return;  // the kept state is the point
     if (may_retry && stalled_far(*collapser)) {
       const int32_t collapses = result.refine_collapses;
       result.triangles.swap(start_triangles);  // the first pass's arrays, for the setup and the run
       result.corner_source.swap(start_corners);
       CollapseSetup loosened_setup = collapse_setup();
       loosen(loosened_setup);
-      auto loosened = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(loosened_setup));
-      collapse(loosened, center, extent);
+      std::unique_ptr<Collapser> loosened;
+      collapse(std::move(loosened_setup), loosened, center, extent, false);
       if (loosened_wins(*loosened, *collapser)) {
         collapser = std::move(loosened);
       } else {  // the plain run's arrays back
@@ -992,9 +994,10 @@ class Refinement {
 
   // The first run to `restart` (slivers first), from a state kept by an earlier refinement
   // toward as many vertices or more when there is one; it keeps its own where its batches start
-  // to depend on the target. Returns the collapses from the start.
-  int32_t shared_run(CollapseSetup setup, Collapser::Stop stop, Collapser::Stop restart, std::unique_ptr<Collapser>& run) {
-    CollapseSnapshots* snapshots = params.target_triangles == 0 && !guided ? params.snapshots : nullptr;
+  // to depend on the target (`keep` false: neither). Returns the collapses from the start.
+  int32_t shared_run(CollapseSetup setup, Collapser::Stop stop, Collapser::Stop restart, std::unique_ptr<Collapser>& run,
+                     bool keep = true) {
+    CollapseSnapshots* snapshots = keep && params.target_triangles == 0 && !guided ? params.snapshots : nullptr;
     if (!snapshots) {
       run = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
       return slivers_first(*run, stop) + run->run(restart);
@@ -1137,8 +1140,12 @@ class Refinement {
 
   // The collapses: only zero-area clean-up, or slivers first, then the target (fast mode's tail
   // at a tiny target chosen, tail_choice), then the optional re-fit and a last clean-up.
-  void collapse(std::unique_ptr<Collapser>& collapser, const double* center, double extent) {
+  // The plain run from `setup` toward the target. `keep`: from a kept state where one serves it,
+  // its own state kept for later runs (shared_run, keeps_plain_state); a warm-up stops there.
+  void collapse(CollapseSetup setup, std::unique_ptr<Collapser>& collapser, const double* center, double extent,
+                bool keep) {
     if (params.zero_area_only) {
+      collapser = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
       result.refine_collapses += collapser->remove_thin(0.0, {});
       return;
     }
@@ -1148,11 +1155,21 @@ class Refinement {
     // Slivers the stochastic pass left (near-collinear corners, needles) go first: the
     // collapses thin the result anyway, and none of them makes a triangle thinner than the
     // thinnest around it was (Collapser::keeps_shape).
-    result.refine_collapses = slivers_first(*collapser, target());
-    if (chooses_tail())
+    if (chooses_tail()) {
+      collapser = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
+      result.refine_collapses = slivers_first(*collapser, target());
       result.refine_collapses += tail_choice(collapser, center, extent);
-    else
-      result.refine_collapses += collapse_rest(*collapser, center, extent);
+      return;
+    }
+    result.refine_collapses = shared_run(std::move(setup), target(), target(), collapser, keep && keeps_plain_state());
+    if (!params.warm_up) result.refine_collapses += collapse_rest(*collapser, center, extent);
+  }
+
+  // Whether the plain run keeps its state (shared_run): where the first pass is the same for
+  // lower targets (decimate.cpp's first_pass_fixed), so a later run toward one resumes from it,
+  // the same to the bit; not fast mode's tail, run twice (chooses_tail).
+  bool keeps_plain_state() const {
+    return params.snapshots && params.target_triangles == 0 && !guided && !chooses_tail();
   }
 
   // Fast mode's collapses keep input positions, so near a tiny target the shape rule leaves

@@ -79,9 +79,10 @@ struct DecimateParams {
   bool draft = false;
   /// A warm-up (quality decimations with collapse_snapshots only): builds what a later
   /// decimation toward this target or a lower one resumes from, the first collapse run's kept
-  /// state and the input's search structure, and stops there; its result is empty. Does
-  /// nothing where a decimation would keep no state (no snapshots, guidance, a triangle
-  /// target, a mesh not collapsed whole, not max-aware); refine_vertices > 0 tells it did.
+  /// state (and, for a mesh collapsed whole, the input's search structure), and stops there;
+  /// its result is empty. Does nothing where a decimation would keep no state (no snapshots,
+  /// guidance, a triangle target, a first pass that depends on the target); refine_vertices > 0
+  /// tells it did.
   bool warm_up = false;
   /// A refined result above kFitFaces triangles whose max error the refinement measured (a mesh
   /// collapsed whole) is fitted to the input too, as smaller ones always are (tiny_fit.hpp):
