@@ -69,7 +69,9 @@ def random_parameters(rng, drafts=False):
 def draft_differences(draft, full):
     """What differs between a draft and the full decimation it previews (empty: nothing)."""
     if draft.stats.collapses_skipped:  # the plain pass the full decimation collapsed further
-        differ = [] if full.stats.refine_keeps_positions else ["collapses"]
+        # keeping input positions: fast mode's collapses past the pass, or the zero-area clean-up's
+        keeps_positions = full.stats.refine_keeps_positions or full.stats.refine_vertices == 0
+        differ = [] if keeps_positions else ["collapses"]
         if not set(full.kept.tolist()) <= set(draft.kept.tolist()):
             differ.append("kept")
         return differ + ([] if np.array_equal(draft.samples, full.samples) else ["samples"])

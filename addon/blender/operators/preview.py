@@ -40,12 +40,14 @@ running: set = set()
 
 def shown_status(session, quality: str) -> str:
     """The header's words on the result shown: its counts, times and kind. A draft whose full
-    decimation collapses it further (stats.collapses_skipped) says so: the rest shows fewer vertices."""
+    decimation collapses it further (stats.collapses_skipped: above its target, or zero-area
+    triangles left) says so: the rest shows fewer vertices."""
     result = session.result
     if session.final:
         kind = quality.title()
     elif result.stats.collapses_skipped:
-        kind = "Fast draft while dragging, above target: the rested result collapses further"
+        above = ", above target" if result.num_vertices > result.stats.target_vertices else ""
+        kind = f"Fast draft while dragging{above}: the rested result collapses further"
     else:
         kind = "Fast draft while dragging"
     return (f"TopStoc ratio {session.ratio:.4f}: {result.num_vertices:,} vertices, {result.num_triangles:,} "

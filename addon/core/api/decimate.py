@@ -85,7 +85,8 @@ class DecimateStats:
     #: quality mode's tail stopped above its target where only collapses laying triangles far from
     #: the input (over an opening) would have gone on (budget.py's "error guard")
     far_guard: bool = False
-    #: a draft above its target whose full decimation collapses it further: the frame is the plain pass
+    #: a draft whose full decimation collapses it further (above its target, or zero-area triangles
+    #: left for the clean-up): the frame is the plain pass
     collapses_skipped: bool = False
     output_vertices: int = 0    #: vertices of the result
     #: the final check of the output against the input's components (manifold, orientation,
@@ -268,7 +269,8 @@ def decimate(mesh: Mesh, ratio: Optional[float] = None, target_vertices: Optiona
     max_error: the fewest vertices whose symmetric Hausdorff error stays within this bound
     (absolute, or a fraction of the bounding-box diagonal with ``relative=True``), found by a
     search over re-decimations with the same seed; ``result.error_bound`` tells how it went.
-    draft: a live-preview frame (fast mode only): the same vertices and triangles, without
+    draft: a live-preview frame (fast mode only): the same vertices and triangles (or, with
+    ``stats.collapses_skipped``, the plain pass the full decimation collapses further), without
     face_source, corner_source and labels (empty arrays) and without the final output check
     (``stats.output_checked`` False, ``stats.topology_kept`` None). The partition checks and
     repairs still run; what a draft skips is the independent re-check, so show drafts while a

@@ -802,15 +802,14 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
   }
   // An input with collinear vertices can leave zero-area triangles the repairs could not
   // remove: collapse one edge of each (never an output with a zero-area triangle).
+  // A draft keeps them (they show nothing) and says the full result collapses further: the
+  // cleanup follows the labels and corners a draft leaves out, and making such frames in full
+  // (every frame of a scan with collinear points: Stanford's dragon, 5 a second) stalled a drag.
   if (!refined && has_zero_area(best)) {
-    if (params.draft) {
-      // The cleanup follows the result's labels and corners, which a draft leaves out: this
-      // (rare: collinear input vertices) frame is made in full.
-      DecimateParams full = params;
-      full.draft = false;
-      return stochastic_pass(mesh, layout, full, refined);
-    }
-    collapse_zero_area(mesh, layout, params, best);
+    if (params.draft)
+      best.collapses_skipped = true;
+    else
+      collapse_zero_area(mesh, layout, params, best);
   }
   // A draft's output is not re-checked; a fast-path result is, since the check decides
   // whether it must be redone.

@@ -133,8 +133,9 @@ struct DecimateResult {
   /// (over an opening) would have gone on: without refine.cpp's far guard, its collapses would
   /// have gone at least halfway from there to the target.
   bool far_guard = false;
-  /// A draft above its target: the collapses that take the full decimation the rest of the way
-  /// were left out (they need the labels a draft leaves out), so the frame is the plain pass.
+  /// A draft above its target, or with zero-area triangles: the collapses that take the full
+  /// decimation the rest of the way, or clean those up, were left out (they need the labels a
+  /// draft leaves out), so the frame is the plain pass.
   bool collapses_skipped = false;
   double seconds_sampling = 0, seconds_clustering = 0, seconds_checking = 0, seconds_output = 0;
   double seconds_verify = 0;  ///< the final output check (verify.hpp)
