@@ -99,6 +99,13 @@ std::shared_ptr<const CollapseSnapshots::Entry> CollapseSnapshots::find(const st
   return best;
 }
 
+bool CollapseSnapshots::keeps_plain_run(bool warm_up) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const bool keeps = warm_up || plain_runs_ > 0;
+  ++plain_runs_;
+  return keeps;
+}
+
 void CollapseSnapshots::keep(std::shared_ptr<const Entry> entry) {
   std::lock_guard<std::mutex> lock(mutex_);
   for (auto e = entries_.begin(); e != entries_.end(); ++e)

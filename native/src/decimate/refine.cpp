@@ -519,9 +519,9 @@ class Refinement {
     if (params.max_aware && whole_input() && n <= kMaxAwareVertices) {
       collapse_max_aware(std::move(setup), center, extent);
       if (params.warm_up) return;
-    } else if (params.warm_up && !keeps_plain_state()) {
-      return;  // no state is kept on this path
     } else {
+      keeps_plain_state_ = keeps_plain_state();
+      if (params.warm_up && !keeps_plain_state_) return;  // no state is kept on this path
       collapse_plain(std::move(setup), center, extent);
       if (params.warm_up) return;
     }
@@ -584,6 +584,7 @@ class Refinement {
   // caller-to-internal map, 2 bytes a triangle, which would otherwise be made under the collapser).
   std::vector<int32_t> kept_vertex;
   bool guarded_best_ = false;  // the chosen run is guarded_run's
+  bool keeps_plain_state_ = false;  // keeps_plain_state(), asked once a run
 
   // The caller's labels from the mesh-order ones, once the collapser is gone (the two tables
   // then never sit beside it).
@@ -994,10 +995,10 @@ class Refinement {
 
   // The first run to `restart` (slivers first), from a state kept by an earlier refinement
   // toward as many vertices or more when there is one; it keeps its own where its batches start
-  // to depend on the target (`keep` false: neither). Returns the collapses from the start.
+  // to depend on the target (unless `keep` is false). Returns the collapses from the start.
   int32_t shared_run(CollapseSetup setup, Collapser::Stop stop, Collapser::Stop restart, std::unique_ptr<Collapser>& run,
                      bool keep = true) {
-    CollapseSnapshots* snapshots = keep && params.target_triangles == 0 && !guided ? params.snapshots : nullptr;
+    CollapseSnapshots* snapshots = params.target_triangles == 0 && !guided ? params.snapshots : nullptr;
     if (!snapshots) {
       run = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
       return slivers_first(*run, stop) + run->run(restart);
@@ -1011,6 +1012,7 @@ class Refinement {
       run = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
       before = slivers_first(*run, stop);
     }
+    if (!keep) return before + run->run(restart);
     return before + run->run(restart, [&](const Collapser& state, int32_t made) {
       snapshots->keep(snapshot(start, restart.vertices, before + made, state));
     });
@@ -1140,8 +1142,8 @@ class Refinement {
 
   // The collapses: only zero-area clean-up, or slivers first, then the target (fast mode's tail
   // at a tiny target chosen, tail_choice), then the optional re-fit and a last clean-up.
-  // The plain run from `setup` toward the target. `keep`: from a kept state where one serves it,
-  // its own state kept for later runs (shared_run, keeps_plain_state); a warm-up stops there.
+  // The plain run from `setup` toward the target, from a kept state where one serves it (shared_run);
+  // `keep`: its own state kept for later runs where keeps_plain_state; a warm-up stops there.
   void collapse(CollapseSetup setup, std::unique_ptr<Collapser>& collapser, const double* center, double extent,
                 bool keep) {
     if (params.zero_area_only) {
@@ -1161,15 +1163,17 @@ class Refinement {
       result.refine_collapses += tail_choice(collapser, center, extent);
       return;
     }
-    result.refine_collapses = shared_run(std::move(setup), target(), target(), collapser, keep && keeps_plain_state());
+    result.refine_collapses = shared_run(std::move(setup), target(), target(), collapser, keep && keeps_plain_state_);
     if (!params.warm_up) result.refine_collapses += collapse_rest(*collapser, center, extent);
   }
 
-  // Whether the plain run keeps its state (shared_run): where the first pass is the same for
-  // lower targets (decimate.cpp's first_pass_fixed), so a later run toward one resumes from it,
-  // the same to the bit; not fast mode's tail, run twice (chooses_tail).
+  // Whether the plain run keeps its state (shared_run) for a later run toward a lower target,
+  // which resumes from it to the same bits: unguided vertex targets, not fast mode's tail (run
+  // twice: chooses_tail), and not a one-off's first run (CollapseSnapshots::keeps_plain_run).
+  // A warm-up asks only where the first pass is the same for lower targets (first_pass_fixed).
   bool keeps_plain_state() const {
-    return params.snapshots && params.target_triangles == 0 && !guided && !chooses_tail();
+    if (!params.snapshots || params.target_triangles > 0 || guided || chooses_tail()) return false;
+    return params.snapshots->keeps_plain_run(params.warm_up);
   }
 
   // Fast mode's collapses keep input positions, so near a tiny target the shape rule leaves

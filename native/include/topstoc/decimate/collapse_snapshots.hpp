@@ -32,6 +32,11 @@ class CollapseSnapshots {
   /// may resume from: of a run with the same start toward as many vertices or more, the one
   /// with the fewest vertices left; null when there is none.
   std::shared_ptr<const Entry> find(const std::vector<uint64_t>& start, int32_t vertices) const;
+  /// Whether a plain run (no max-aware reruns: a mesh too large to collapse whole) keeps its
+  /// state: a warm-up's does, and any other from the second such run on. A one-off
+  /// decimation's copy (about 450 bytes a first-pass vertex) would sit beside its peak for
+  /// nothing.
+  bool keeps_plain_run(bool warm_up);
   /// Keeps a state; beyond the capacity the oldest is dropped, except the one for the highest
   /// target (which serves every lower one).
   void keep(std::shared_ptr<const Entry> entry);
@@ -56,6 +61,7 @@ class CollapseSnapshots {
   mutable std::mutex mutex_;
   size_t capacity_;
   mutable size_t resumed_ = 0;
+  size_t plain_runs_ = 0;  // plain runs that asked keeps_plain_run
   size_t surfaces_made_ = 0;
   std::vector<std::shared_ptr<const Entry>> entries_;  // the most recently kept last
   std::vector<std::pair<std::vector<uint64_t>, std::shared_ptr<const Surface>>> surfaces_;  // most recent last
