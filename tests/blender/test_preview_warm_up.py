@@ -131,7 +131,8 @@ def test_closing_cancels_the_warm_up_and_a_changed_mesh_starts_anew(ts, torus, p
 def test_the_warm_ups_go_above_the_highest_ratio_asked(ts):
     """One warm-up serves a drag up and down below the highest ratio asked (a warm-up toward each
     ratio of an upward sweep would start from nothing every time); a drag beyond it gets a new
-    one. Where a warm-up keeps nothing (guidance, fast mode ...) none is tried again."""
+    one. Where a warm-up keeps nothing (guidance, fast mode, a first pass that grows with the
+    ratio) none is tried again near that ratio; one that fails, never again."""
     warmed = []
     warm_ups = ts.blender.preview.warm_up.WarmUps(lambda ratio, cancel: warmed.append(ratio) or True)
 
@@ -148,6 +149,15 @@ def test_the_warm_ups_go_above_the_highest_ratio_asked(ts):
     assert step(0.2) == pytest.approx(0.23)
     assert step(0.95) == 1.0
     assert warmed == pytest.approx([0.115, 0.23, 1.0]) and warm_ups.finished == 3
-    nothing = ts.blender.preview.warm_up.WarmUps(lambda ratio, cancel: False)
+    tried = []
+    nothing = ts.blender.preview.warm_up.WarmUps(lambda ratio, cancel: tried.append(ratio) or False)
     nothing.run(nothing.next(0.1))
-    assert nothing.next(0.2) is None and not nothing.applies
+    assert nothing.next(0.1) is None and nothing.next(0.09) is None  # near 0.115: not again
+    nothing.run(nothing.next(0.2))
+    assert tried == pytest.approx([0.115, 0.23]) and nothing.applies and nothing.finished == 2
+
+    def failing(ratio, cancel):
+        raise RuntimeError("the engine failed")
+    broken = ts.blender.preview.warm_up.WarmUps(failing)
+    broken.run(broken.next(0.1))
+    assert broken.next(0.2) is None and not broken.applies

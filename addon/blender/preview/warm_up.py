@@ -3,7 +3,8 @@ rested Quality result resumes from, so that the rest only runs the part that dep
 
 A quality decimation of a mesh collapsed whole goes the same way toward every target until its
 collapses start to depend on the target; the engine keeps that state, and the input's search
-structure, with the prepared mesh (core.api.decimate.warm_up, Mesh.kept_for_reuse). A warm-up
+structure, with the prepared mesh (core.api.decimate.warm_up, Mesh.kept_for_reuse). So does one
+of a larger mesh from its first pass, where that pass is the same for lower targets. A warm-up
 toward a ratio serves every rest at that ratio or below, with the same result to the bit as a
 decimation that starts from nothing. A warm-up goes toward a little above the highest ratio
 asked in the session (HEADROOM: the drag wanders up and down, and a state serves only ratios
@@ -28,24 +29,28 @@ CLOSE = 1.3  # a state made toward w serves ratio r closely when r <= w <= CLOSE
 
 class WarmUps:
     """The warm-ups of one preview session (thread-safe). ``warm(ratio, cancel)`` runs one in the
-    engine and returns whether a state is kept for such rests (False: none ever is, for these
-    settings, and no warm-up is tried again)."""
+    engine and returns whether a state is kept for such rests (False: none is toward that ratio,
+    and none is tried again near it; the engine says so at once). A mesh too large to collapse
+    whole keeps one only where its first pass is the same for lower ratios, which holds above
+    some ratio and not below it, so a drag higher up may warm up after all."""
 
     def __init__(self, warm: Callable[[float, CancelFlag], bool]):
         self._warm = warm
         self._lock = threading.Lock()
         self._made: list = []        # ratios toward which a state was made (warm-ups and rests)
+        self._futile: list = []      # ratios toward which a warm-up kept nothing
         self._running = None         # (ratio, CancelFlag, threading.Event set when it ends)
-        self.applies = True          # False once a warm-up kept nothing (guidance, fast mode, ...)
+        self.applies = True          # False once one failed or the session closed
         self.finished = 0            # warm-ups run to their end
 
     def next(self, highest: float) -> Optional[float]:
         """The ratio to warm up toward now, for a drag whose highest ratio so far is ``highest``;
-        None when none is wanted (a state made lies at most CLOSE times above it, or one runs)."""
+        None when none is wanted (a state made, or a warm-up that kept nothing, lies at most CLOSE
+        times above it, or one runs)."""
         with self._lock:
             if not self.applies or self._running is not None:
                 return None
-            if any(highest <= made <= CLOSE * highest for made in self._made):
+            if any(highest <= made <= CLOSE * highest for made in self._made + self._futile):
                 return None
             return min(1.0, HEADROOM * highest)
 
@@ -55,21 +60,20 @@ class WarmUps:
             if self._running is not None:
                 return
             running = self._running = (ratio, CancelFlag(), threading.Event())
-        kept = None
+        kept, failed = None, False
         try:
             kept = self._warm(ratio, running[1])
         except Cancelled:
             pass
         except Exception:  # noqa: BLE001 - the rest's own decimation raises it where it is shown
-            kept = False
+            failed = True
         finally:
             with self._lock:
                 self._running = None
+                self.applies = self.applies and not failed
                 if kept is not None:
-                    self.applies = self.applies and kept
                     self.finished += 1
-                    if kept:
-                        self._made.append(ratio)
+                    (self._made if kept else self._futile).append(ratio)
             running[2].set()
 
     def settle(self, ratio: float, cancel: Optional[CancelFlag] = None) -> None:
