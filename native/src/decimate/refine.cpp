@@ -1140,10 +1140,10 @@ class Refinement {
     }
   }
 
-  // The collapses: only zero-area clean-up, or slivers first, then the target (fast mode's tail
-  // at a tiny target chosen, tail_choice), then the optional re-fit and a last clean-up.
-  // The plain run from `setup` toward the target, from a kept state where one serves it (shared_run);
-  // `keep`: its own state kept for later runs where keeps_plain_state; a warm-up stops there.
+  // The collapses from `setup`: only zero-area clean-up, or slivers first, then the target (fast
+  // mode's tail at a tiny target chosen, tail_choice; else from a kept state where one serves it,
+  // shared_run, its own kept where `keep` and keeps_plain_state), then the optional re-fit and a
+  // last clean-up. A warm-up stops before those two.
   void collapse(CollapseSetup setup, std::unique_ptr<Collapser>& collapser, const double* center, double extent,
                 bool keep) {
     if (params.zero_area_only) {
