@@ -159,7 +159,8 @@ def test_a_mesh_too_large_to_collapse_whole_warms_up_where_its_first_pass_is_fix
     or below resume from it, with the results of a mesh that keeps nothing. In between the first
     pass grows with the target: a warm-up keeps nothing, and a decimation's state serves only a
     repeat of its own target (the same first pass). A first decimation keeps no state: a one-off's
-    copy would only add to its peak."""
+    copy would only add to its peak. With a border the collapses weigh its planes by the target's
+    spacing, so their start depends on the target and no warm-up keeps anything."""
     from topstoc.core.api.decimate import warm_up
     from topstoc.core.api.job import make_job
 
@@ -178,3 +179,6 @@ def test_a_mesh_too_large_to_collapse_whole_warms_up_where_its_first_pass_is_fix
     for resumed in (2, 3):
         assert_same(mesh.decimate(ratio=0.09), fresh[0.09])
         assert snapshots.resumed == resumed
+    holed = Mesh(torus[0], torus[1][8:])  # a hole: its border is a feature curve
+    assert holed.report().boundary_edges > 0
+    assert warm_up(holed, make_job(holed, ratio=0.3)) is False

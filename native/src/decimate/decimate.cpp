@@ -910,11 +910,14 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   first.target_vertices = first_pass_vertices(mesh, layout, params, active);
   first.sampling.keep_curves = true;  // the collapses thin the borders (sampling.cpp force_curves)
   first.warm_up = false;
-  // A first pass that depends on the target, or guidance (its quotas do from the start): no
-  // state a later decimation could resume from. Said before any pass, so asking costs nothing.
+  // A first pass that depends on the target, or a partial one with feature edges (the collapses
+  // weigh their planes by the target's spacing: refine.cpp's cluster_quadrics), or guidance (its
+  // quotas depend on the target from the start): no state a later decimation toward another
+  // target could resume from. Said before any pass, so asking costs nothing.
   const bool guided = params.sampling.guidance || !params.sampling.boxes.empty();
-  if (params.warm_up && (!first_pass_fixed(mesh, layout, params, active, first.target_vertices) ||
-                         !params.collapse_snapshots || target_triangles > 0 || guided))
+  const bool start_fixed = first_pass_fixed(mesh, layout, params, active, first.target_vertices) &&
+                           (first.target_vertices == active || layout.feature_edges.empty());
+  if (params.warm_up && (!start_fixed || !params.collapse_snapshots || target_triangles > 0 || guided))
     return {};
   DecimateResult result = stochastic_pass(mesh, layout, first, true);
   // A first pass whose repairs left issues may be broken (the double cone of n = 80,000): the
