@@ -599,7 +599,7 @@ DecimateResult verified(const Mesh& mesh, const FeatureLayout& layout, DecimateR
 // the refinement treats no multipliers as all ones, and n doubles of ones were a twentieth of a
 // large decimation's peak memory.
 std::vector<double> multipliers_if_guided(const Mesh& mesh, const SamplingParams& sampling) {
-  if (!sampling.guidance && sampling.boxes.empty()) return {};
+  if (!has_multipliers(sampling)) return {};
   return guidance_multipliers(mesh, sampling);
 }
 
@@ -671,7 +671,7 @@ DecimateResult decimate_once(const Mesh& mesh, const FeatureLayout& layout, cons
   // Vertices the user excluded (u = -1) are the last choice when a repair needs a new sample;
   // control points (u = 1) must stay in the output. Without guidance both stay empty (none).
   std::vector<uint8_t> avoid, required;
-  if (params.sampling.guidance || !params.sampling.boxes.empty()) {
+  if (has_multipliers(params.sampling)) {
     const auto p = sampling_probabilities(mesh, layout, params.sampling, set.rate);
     avoid.resize(p.size());
     required.resize(p.size());
@@ -883,17 +883,19 @@ int32_t first_pass_vertices(const Mesh& mesh, const FeatureLayout& layout, const
   return int32_t(std::min<double>(active, std::max({std::ceil(params.refine * target), target + extra, floor})));
 }
 
-// Whether a decimation toward kWarmUpReach of the target draws as many first-pass vertices
-// (the whole mesh, or the cap or floor above): the pass is then the same for every target in
-// between (the count grows with the target), and a collapse state kept from it serves them. A
-// live preview warms up toward 1.15 times the highest ratio asked, and the rests that follow
-// lie a little under it.
+// Whether the collapses start the same way for every target from kWarmUpReach of this one up,
+// so that a collapse state kept from it serves them: a decimation toward kWarmUpReach of the
+// target draws as many first-pass vertices (the whole mesh, or the cap or floor above; the
+// count grows with the target, so every target in between does too), and no feature edge's
+// planes are weighed by the target (refine.hpp's start_depends_on_target). A live preview warms
+// up toward 1.15 times the highest ratio asked, and the rests that follow lie a little under it.
 constexpr double kWarmUpReach = 0.75;
-bool first_pass_fixed(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params, int32_t active,
-                      int32_t first_vertices) {
+bool start_fixed(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params, int32_t active,
+                 int32_t first_vertices) {
   DecimateParams lower = params;
   lower.target_vertices = std::max(1, int32_t(kWarmUpReach * params.target_vertices));
-  return first_pass_vertices(mesh, layout, lower, active) == first_vertices;
+  return first_pass_vertices(mesh, layout, lower, active) == first_vertices &&
+         !start_depends_on_target(layout, first_vertices == active);
 }
 
 // TopStoc to a few times the target, then collapses down to it (refine.hpp). Painted regions
@@ -910,14 +912,11 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
   first.target_vertices = first_pass_vertices(mesh, layout, params, active);
   first.sampling.keep_curves = true;  // the collapses thin the borders (sampling.cpp force_curves)
   first.warm_up = false;
-  // A first pass that depends on the target, or a partial one with feature edges (the collapses
-  // weigh their planes by the target's spacing: refine.cpp's cluster_quadrics), or guidance (its
-  // quotas depend on the target from the start): no state a later decimation toward another
-  // target could resume from. Said before any pass, so asking costs nothing.
-  const bool guided = params.sampling.guidance || !params.sampling.boxes.empty();
-  const bool start_fixed = first_pass_fixed(mesh, layout, params, active, first.target_vertices) &&
-                           (first.target_vertices == active || layout.feature_edges.empty());
-  if (params.warm_up && (!start_fixed || !params.collapse_snapshots || target_triangles > 0 || guided))
+  // A start that depends on the target (start_fixed), or guidance (its quotas do from the
+  // start): no state a later decimation toward another target could resume from. Said before
+  // any pass, so asking costs nothing.
+  if (params.warm_up && (!start_fixed(mesh, layout, params, active, first.target_vertices) ||
+                         !params.collapse_snapshots || target_triangles > 0 || has_multipliers(params.sampling)))
     return {};
   DecimateResult result = stochastic_pass(mesh, layout, first, true);
   // A first pass whose repairs left issues may be broken (the double cone of n = 80,000): the

@@ -355,7 +355,8 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
   });
   // The edge tables are built on first use: a mesh without feature edges never needs them here.
   if (layout.feature_edges.empty()) return quadrics;
-  const double spacing = stochastic_start ? output_spacing(mesh, frame, params.target_vertices) : 0.0;
+  const bool by_target = start_depends_on_target(layout, !stochastic_start);
+  const double spacing = by_target ? output_spacing(mesh, frame, params.target_vertices) : 0.0;
   add_border_planes(mesh, layout, label, frame, spacing, quadrics);
   add_bend_anchors(mesh, layout, label, frame, spacing, quadrics);
   return quadrics;
@@ -520,9 +521,9 @@ class Refinement {
       collapse_max_aware(std::move(setup), center, extent);
       if (params.warm_up) return;
     } else {
-      keeps_plain_state_ = keeps_plain_state();
-      if (params.warm_up && !keeps_plain_state_) return;  // no state is kept on this path
-      collapse_plain(std::move(setup), center, extent);
+      const bool keep = keeps_plain_state();
+      if (params.warm_up && !keep) return;  // no state is kept on this path
+      collapse_plain(std::move(setup), center, extent, keep);
       if (params.warm_up) return;
     }
     publish_labels();
@@ -584,7 +585,6 @@ class Refinement {
   // caller-to-internal map, 2 bytes a triangle, which would otherwise be made under the collapser).
   std::vector<int32_t> kept_vertex;
   bool guarded_best_ = false;  // the chosen run is guarded_run's
-  bool keeps_plain_state_ = false;  // keeps_plain_state(), asked once a run
 
   // The caller's labels from the mesh-order ones, once the collapser is gone (the two tables
   // then never sit beside it).
@@ -732,12 +732,13 @@ class Refinement {
   // The plain collapses (fast mode, the zero-area clean-up, large results), loosened after a
   // stall when that wins (may_loosen, loosened_wins). The loosened run's setup is built again
   // from the first pass's arrays, kept for it, rather than copied for every run that might stall.
-  void collapse_plain(CollapseSetup setup, const double* center, double extent) {
+  // `keep`: the plain run's state is kept for later runs (keeps_plain_state; not the loosened one's).
+  void collapse_plain(CollapseSetup setup, const double* center, double extent, bool keep) {
     const bool may_retry = may_loosen(setup);
     std::vector<int32_t> start_triangles, start_corners;
     if (may_retry) start_triangles = result.triangles, start_corners = result.corner_source;
     std::unique_ptr<Collapser> collapser;
-    collapse(std::move(setup), collapser, center, extent, true);
+    collapse(std::move(setup), collapser, center, extent, keep);
     if (params.warm_up) return;  // the kept state is the point
     if (may_retry && stalled_far(*collapser)) {
       const int32_t collapses = result.refine_collapses;
@@ -1142,7 +1143,7 @@ class Refinement {
 
   // The collapses from `setup`: only zero-area clean-up, or slivers first, then the target (fast
   // mode's tail at a tiny target chosen, tail_choice; else from a kept state where one serves it,
-  // shared_run, its own kept where `keep` and keeps_plain_state), then the optional re-fit and a
+  // shared_run, its own kept where `keep`), then the optional re-fit and a
   // last clean-up. A warm-up stops before those two.
   void collapse(CollapseSetup setup, std::unique_ptr<Collapser>& collapser, const double* center, double extent,
                 bool keep) {
@@ -1163,14 +1164,14 @@ class Refinement {
       result.refine_collapses += tail_choice(collapser, center, extent);
       return;
     }
-    result.refine_collapses = shared_run(std::move(setup), target(), target(), collapser, keep && keeps_plain_state_);
+    result.refine_collapses = shared_run(std::move(setup), target(), target(), collapser, keep);
     if (!params.warm_up) result.refine_collapses += collapse_rest(*collapser, center, extent);
   }
 
   // Whether the plain run keeps its state (shared_run) for a later run toward a lower target,
   // which resumes from it to the same bits: unguided vertex targets, not fast mode's tail (run
   // twice: chooses_tail), and not a one-off's first run (CollapseSnapshots::keeps_plain_run).
-  // A warm-up asks only where the first pass is the same for lower targets (first_pass_fixed).
+  // A warm-up asks only where the first pass is the same for lower targets (start_fixed).
   bool keeps_plain_state() const {
     if (!params.snapshots || params.target_triangles > 0 || guided || chooses_tail()) return false;
     return params.snapshots->keeps_plain_run(params.warm_up);

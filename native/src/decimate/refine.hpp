@@ -34,6 +34,13 @@ namespace topstoc {
 /// and 1.9 GB with them, 20 s and 0.64 GB without.
 constexpr int32_t kMaxAwareVertices = 250000;
 
+/// Whether the collapses' start depends on their target: from a partial first pass (not the
+/// whole mesh) the planes of feature edges are weighed by the target's output spacing
+/// (cluster_quadrics), so a state kept toward one target serves no other.
+inline bool start_depends_on_target(const FeatureLayout& layout, bool whole_input) {
+  return !whole_input && !layout.feature_edges.empty();
+}
+
 struct RefineParams {
   int32_t target_vertices = 0;
   /// > 0: collapse until this many triangles remain instead (the vertex target then only sets

@@ -145,7 +145,7 @@ double guidance_multiplier(double u) {
 std::vector<double> guidance_multipliers(const Mesh& mesh, const SamplingParams& params) {
   const int32_t n = mesh.num_vertices();
   std::vector<double> m(n, 1.0);
-  if (!params.guidance && params.boxes.empty()) return m;
+  if (!has_multipliers(params)) return m;
   parallel_for(0, n, kParallelMin, [&](int32_t v) {
     double u = params.guidance ? params.guidance[mesh.vertex_source()[v]] : 0.0;
     for (const auto& box : params.boxes)

@@ -73,6 +73,9 @@ struct SampleSet {
 constexpr double kForcedMultiplier = -1.0;
 double guidance_multiplier(double u);
 
+/// Whether painted guidance or boxes are given: the sources of guidance_multipliers.
+inline bool has_multipliers(const SamplingParams& params) { return params.guidance || !params.boxes.empty(); }
+
 /// m per internal vertex from the painted guidance and the boxes (boxes win where they hold it).
 std::vector<double> guidance_multipliers(const Mesh& mesh, const SamplingParams& params);
 
