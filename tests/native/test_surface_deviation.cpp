@@ -1,5 +1,6 @@
 // surface_deviation: the from-input side against brute force over every collapsed triangle (its
-// side middles measured once per side), and the early stop against a rival: it stops only when
+// side middles measured once per side), the back side against brute force over the input, and
+// the early stop against a rival: it stops only when
 // the input's vertices already show a larger mean or a farther point, and never changes a value
 // it does finish.
 #include <doctest/doctest.h>
@@ -38,6 +39,19 @@ double to_collapsed2(const Collapser& c, const std::vector<int32_t>& triangles, 
     best = std::min(best, topstoc::closest_point_on_triangle(p, c.position(triangles[3 * t]),
                                                              c.position(triangles[3 * t + 1]),
                                                              c.position(triangles[3 * t + 2]), q));
+  }
+  return best;
+}
+
+// Squared distance from p to the input's triangles (brute force).
+double to_input2(const topstoc::InputSurface& input, const topstoc::Mesh& mesh, const double* p) {
+  const std::vector<double>& at = input.surface->positions();
+  double best = 1e300;
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+    const int32_t* q = &mesh.faces()[3 * size_t(f)];
+    double c[3];
+    best = std::min(best, topstoc::closest_point_on_triangle(p, &at[3 * size_t(q[0])], &at[3 * size_t(q[1])],
+                                                             &at[3 * size_t(q[2])], c));
   }
   return best;
 }
@@ -88,6 +102,38 @@ TEST_CASE("deviation from the input matches brute force, and a rival stops it on
     }
   }
   CHECK(raised > 0);
+
+  // Back: each live triangle's corners, side middles and centre against brute force, their mean
+  // by area, and every input vertex of a corner's cluster holding at least those distances.
+  double back_sum = 0.0, back_area = 0.0;
+  for (size_t t = 0; 3 * t < triangles.size(); ++t) {
+    if (!collapser.face_alive(int32_t(t))) continue;
+    const double* c[3] = {collapser.position(triangles[3 * t]), collapser.position(triangles[3 * t + 1]),
+                          collapser.position(triangles[3 * t + 2])};
+    double points[7][3];
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) {
+        points[j][k] = c[j][k];
+        points[3 + j][k] = 0.5 * (c[j][k] + c[(j + 1) % 3][k]);
+        points[6][k] = (c[0][k] + c[1][k] + c[2][k]) / 3.0;
+      }
+    double far2 = 0.0, root_sum = 0.0;
+    for (const auto& point : points) {
+      const double d2 = to_input2(input, mesh, point);
+      far2 = std::max(far2, d2);
+      root_sum += std::sqrt(d2);
+    }
+    const double u[3] = {c[1][0] - c[0][0], c[1][1] - c[0][1], c[1][2] - c[0][2]};
+    const double w[3] = {c[2][0] - c[0][0], c[2][1] - c[0][1], c[2][2] - c[0][2]};
+    const double cross[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    const double twice_area = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+    back_sum += twice_area * root_sum / 7.0;
+    back_area += twice_area;
+    for (int32_t v = 0; v < n; ++v)
+      for (int j = 0; j < 3; ++j)
+        if (collapser.survivor(v) == triangles[3 * t + j]) CHECK(full.vertex2[v] >= far2);
+  }
+  CHECK(full.back_mean == doctest::Approx(back_sum / back_area).epsilon(1e-12));
 
   // A rival the run beats or ties: the same measure to the bit.
   const Rival loose{full.top2, full.mean};

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/morton_order.hpp"
 #include "topstoc/core/parallel.hpp"
 #include "topstoc/core/progress.hpp"
 
@@ -26,6 +27,20 @@ std::vector<double> distances2(const TriangleBvh& surface, int64_t count, Point&
       out[size_t(i)] = hit.distance2;
     });
   });
+  return out;
+}
+
+// out[i] = the squared distance from points[3 i ...] to `surface`, the points looked up along a
+// Z-order curve (nearby queries pass their hits on as hints; the answers do not depend on it).
+std::vector<double> distances2_ordered(const TriangleBvh& surface, const std::vector<double>& points) {
+  const int32_t count = int32_t(points.size() / 3);
+  const std::vector<int32_t> order = morton_order(points.data(), count);
+  const std::vector<double> sorted = distances2(surface, count, [&](int64_t i, double* p) {
+    std::copy_n(&points[3 * size_t(order[size_t(i)])], 3, p);
+    return true;
+  });
+  std::vector<double> out(points.size() / 3);
+  for (int32_t i = 0; i < count; ++i) out[size_t(order[size_t(i)])] = sorted[size_t(i)];
   return out;
 }
 
@@ -132,22 +147,22 @@ void to_input(const TriangleBvh& input, Collapser& collapser, const std::vector<
   sides.erase(std::unique(sides.begin(), sides.end()), sides.end());
   // The points: the corners, then the side middles, then the centres.
   const int64_t nc = int64_t(corners.size()), ns = int64_t(sides.size());
-  const std::vector<double> at = distances2(input, nc + ns + int64_t(faces), [&](int64_t i, double* p) {
+  std::vector<double> points(3 * size_t(nc + ns + int64_t(faces)));
+  parallel_for(int64_t(0), nc + ns + int64_t(faces), kParallelMin, [&](int64_t i) {
+    double* p = &points[3 * size_t(i)];
     if (i < nc) {
       std::copy_n(collapser.position(corners[i]), 3, p);
-      return true;
-    }
-    if (i < nc + ns) {
+    } else if (i < nc + ns) {
       const double* a = collapser.position(sides[i - nc].first);
       const double* b = collapser.position(sides[i - nc].second);
       for (int k = 0; k < 3; ++k) p[k] = 0.5 * (a[k] + b[k]);
-      return true;
+    } else {
+      const int32_t* c = &live[3 * size_t(i - nc - ns)];
+      const double* q[3] = {collapser.position(c[0]), collapser.position(c[1]), collapser.position(c[2])};
+      for (int k = 0; k < 3; ++k) p[k] = (q[0][k] + q[1][k] + q[2][k]) / 3.0;
     }
-    const int32_t* c = &live[3 * size_t(i - nc - ns)];
-    const double* q[3] = {collapser.position(c[0]), collapser.position(c[1]), collapser.position(c[2])};
-    for (int k = 0; k < 3; ++k) p[k] = (q[0][k] + q[1][k] + q[2][k]) / 3.0;
-    return true;
   });
+  const std::vector<double> at = distances2_ordered(input, points);
   auto corner = [&](int32_t v) { return at[std::lower_bound(corners.begin(), corners.end(), v) - corners.begin()]; };
   auto side = [&](int32_t a, int32_t b) {
     const std::pair<int32_t, int32_t> key{std::min(a, b), std::max(a, b)};

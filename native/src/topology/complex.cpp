@@ -1,4 +1,6 @@
 #include "topstoc/topology/complex.hpp"
+
+#include "core/morton_order.hpp"
 #include "topstoc/core/validate.hpp"
 
 #include <algorithm>
@@ -73,49 +75,6 @@ void check_sizes_and_positions(const double* positions, int32_t n, int64_t m, in
   if (3 * m > kMaxSides) throw std::invalid_argument("complex is too large: more than 2^30 / 3 triangles");
   if (k > INT32_MAX / 2) throw std::invalid_argument("complex is too large: more than 2^31 / 2 edges");
   if (positions) require_finite_positions(positions, n);
-}
-
-// Spreads the low 10 bits of x so that they occupy every third bit.
-uint32_t spread_bits(uint32_t x) {
-  x &= 0x3ff;
-  x = (x | x << 16) & 0x30000ff;
-  x = (x | x << 8) & 0x300f00f;
-  x = (x | x << 4) & 0x30c30c3;
-  x = (x | x << 2) & 0x9249249;
-  return x;
-}
-
-// Internal vertex order: along a Z-order curve of the positions (10 bits per axis; ties keep
-// the caller's order), by a radix sort of (key, id) pairs.
-std::vector<int32_t> morton_order(const double* positions, int32_t n) {
-  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-  for (int32_t v = 0; v < n; ++v)
-    for (int k = 0; k < 3; ++k) {
-      const double x = positions[3 * size_t(v) + k];
-      lo[k] = v ? std::min(lo[k], x) : x;
-      hi[k] = v ? std::max(hi[k], x) : x;
-    }
-  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
-  std::vector<uint64_t> keyed(n), scratch(n);
-  parallel_for(0, n, kParallelMinimum, [&](int32_t v) {
-    uint32_t key = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double t = (positions[3 * size_t(v) + k] - lo[k]) / extent;
-      key |= spread_bits(uint32_t(std::clamp(t, 0.0, 1.0) * 1023.0)) << k;
-    }
-    keyed[v] = (uint64_t(key) << 32) | uint32_t(v);
-  });
-  // Least significant digit first, 3 passes of 10 bits over the 30-bit key (stable).
-  for (int shift = 32; shift < 62; shift += 10) {
-    std::vector<int32_t> count(1025, 0);
-    for (uint64_t x : keyed) ++count[((x >> shift) & 1023) + 1];
-    for (int i = 0; i < 1024; ++i) count[i + 1] += count[i];
-    for (uint64_t x : keyed) scratch[count[(x >> shift) & 1023]++] = x;
-    keyed.swap(scratch);
-  }
-  std::vector<int32_t> order(n);
-  for (int32_t i = 0; i < n; ++i) order[i] = int32_t(uint32_t(keyed[i]));
-  return order;
 }
 
 // Locality of the caller's arrays, counted while the triangles are copied (one pass): the
