@@ -104,6 +104,17 @@ def welded_points(triangles: int):
     return vertices, faces
 
 
+def flipped_patches(triangles: int):
+    """The bumpy torus with a band of a quarter of its triangles and 1 % of the others at random
+    wound the other way: the flipped patches of an export or of parts merged from mirrors."""
+    vertices, faces = meshgen.bumpy_torus(triangles)
+    centre_angle = np.arctan2(vertices[faces[:, 0], 1], vertices[faces[:, 0], 0])
+    flip = (centre_angle < -np.pi / 2) | (np.random.default_rng(6).random(len(faces)) < 0.01)
+    faces = faces.copy()
+    faces[flip] = faces[flip][:, ::-1]
+    return vertices, faces
+
+
 FAMILIES = {f.__name__: f for f in (bumpy_torus, many_spheres, triangle_soup, sheet_with_holes, sliver_sphere,
                                     needle_strip, fanned_cylinder, perforated_plate, holed_scan, torn_scan,
-                                    welded_points)}
+                                    welded_points, flipped_patches)}

@@ -315,6 +315,7 @@ void bind_decimate(py::module_& m) {
           CancelScope scope(flag);
           r = target_triangles > 0 ? decimate_to_triangles(mesh, layout, params, target_triangles)
                                    : decimate(mesh, layout, params);
+          restore_winding(mesh, r);
         }
         return result_dict(std::move(r));
       },
@@ -366,6 +367,7 @@ void bind_decimate(py::module_& m) {
           EngineCall call;
           r = decimate_with_samples(mesh, layout, std::move(ids), placement, max_repair_rounds, refine_vertices, u,
                                     corner_attributes, refine_triangles, refine_keeps_positions, large_fit);
+          restore_winding(mesh, r);
         }
         return result_dict(std::move(r));
       },

@@ -71,6 +71,22 @@ def test_transfer_copies_through_the_source_maps():
     assert out.material_names == data.material_names
 
 
+def test_every_output_corner_has_a_source_corner_of_its_vertex():
+    # A fast decimation with UV seams walks each output corner's cluster back to its sample for
+    # a corner on the same side of the seams; where the flood's steps led nowhere (a repaired
+    # cluster) the corner was -1, and the caller's arrays were read from their end (the duck at
+    # 20 %, seed 2: 4 corners).
+    data = read_mesh(DATA / "uv_materials" / "duck" / "duck_via_assimp.obj")
+    mesh = Mesh(data.vertices, data.triangles)
+    borders = uv_seam_edges(data.triangles, data.corner_uvs)
+    for ratio in (0.5, 0.3, 0.2, 0.1):
+        for seed in range(5):
+            result = mesh.decimate(ratio=ratio, seed=seed, borders=borders, mode="fast")
+            corners = np.asarray(result.corner_source).ravel()
+            assert corners.min() >= 0, (ratio, seed)
+            np.testing.assert_array_equal(data.triangles.ravel()[corners], result.kept[result.triangles.ravel()])
+
+
 def test_single_material_is_no_region():
     assert material_regions(MeshData(vertices=np.zeros((3, 3)), triangles=[[0, 1, 2]],
                                      triangle_material=[0], material_names=["a"])) is None

@@ -3,8 +3,9 @@
 A non-manifold edge is a feature curve: the collapses may shorten it (each sheet keeps one fan
 on its side) but never remove a sheet. Checked with tests/reference.py, independent of the engine.
 Both modes: fast mode's first pass stalls on what its partition check cannot judge (non-manifold
-edges, triangles facing both ways), and quality mode's collapses take it the rest of the way,
-keeping input positions.
+edges, triangles facing both ways on a non-orientable sheet), and quality mode's collapses take
+it the rest of the way, keeping input positions. (Flipped patches of an orientable component no
+longer stall it: test_winding.py.)
 """
 
 import pathlib

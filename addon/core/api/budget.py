@@ -86,7 +86,8 @@ def over_reason(stats) -> str:
     # (The draw forces loose triangles' corners too: where they alone fill the target, the
     # topology holds the result, each piece keeping its triangle.)
     # It forces three vertices of each short boundary loop too, where those are many: the holes',
-    # which the topology keeps; they are not the borders' corners.
+    # which the topology keeps, and the corners of each component's winding seam; they are not
+    # the borders' corners.
     corners = stats.forced - getattr(stats, "loop_forced", 0)
     if corners >= stats.target_vertices and 3 * getattr(stats, "loose_triangles", 0) < stats.target_vertices:
         return "borders"

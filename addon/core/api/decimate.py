@@ -58,7 +58,7 @@ class DecimateStats:
     target_vertices: int        #: what was asked for (vertex count)
     selected: int               #: samples drawn before repairs
     forced: int                 #: corners and control points among them
-    loop_forced: int            #: of those, three vertices of each short boundary loop (the holes')
+    loop_forced: int            #: of those, three vertices of each short boundary loop (the holes') and the winding seams' corners
     density_rejected: int       #: candidates skipped by density control
     guided: bool                #: guidance, view or boxes changed the probabilities
     expected_vertices: float    #: sum of the sampling probabilities

@@ -5,6 +5,7 @@
 
 
 #include <algorithm>
+#include <unordered_set>
 #include <chrono>
 #include <exception>
 #include <memory>
@@ -97,10 +98,38 @@ std::vector<int32_t> splitting_vertices(const Mesh& mesh, const Clustering& c, c
   return result;
 }
 
+// A corner of `sample_vertex` in a face reached from `face` across edges that are no feature
+// edge, over faces with a corner in the sample's cluster (the same side of every border); a
+// corner of any of its faces where none is. For attribute_corner's flood walk where it fails.
+int32_t corner_across_faces(const Mesh& mesh, const FeatureLayout& layout, const Clustering& c, int32_t face,
+                            int32_t sample_vertex) {
+  const auto& faces = mesh.faces();
+  const int32_t cluster = c.label(sample_vertex);
+  std::vector<int32_t> queue{face};
+  std::unordered_set<int32_t> seen{face};
+  for (size_t next = 0; next < queue.size(); ++next) {
+    const int32_t g = queue[next];
+    for (int j = 0; j < 3; ++j)
+      if (faces[3 * size_t(g) + j] == sample_vertex) return 3 * mesh.face_source()[g] + j;
+    for (int j = 0; j < 3; ++j) {
+      const int32_t e = mesh.face_edges()[3 * size_t(g) + j];
+      if (layout.is_feature_edge(e)) continue;
+      mesh.for_each_edge_face(e, [&](int32_t h) {
+        bool in_cluster = false;
+        for (int i = 0; i < 3; ++i) in_cluster |= c.label(faces[3 * size_t(h) + i]) == cluster;
+        if (in_cluster && seen.insert(h).second) queue.push_back(h);
+      });
+    }
+  }
+  return mesh.first_corner(sample_vertex);
+}
+
 // Corner of the caller's mesh that carries the attributes (UV, colour) an output corner needs:
 // a corner of the sample vertex on the same side of every border as the input face the output
 // triangle came from. Walks the flood's steps back from the face's corner to the sample,
-// carrying the current face across edges so the side is kept.
+// carrying the current face across edges so the side is kept; where no step leads on (a
+// repaired cluster's hop counts), across the cluster's faces instead (a corner of -1 had the
+// caller's arrays read from their end: duck_via_assimp at 20 % in fast mode).
 int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Clustering& c, int32_t face,
                          int32_t slot, int32_t sample_vertex) {
   const auto& faces = mesh.faces();
@@ -127,7 +156,8 @@ int32_t attribute_corner(const Mesh& mesh, const FeatureLayout& layout, const Cl
     current = next;
     x = p;
   }
-  return corner_of(current, sample_vertex);
+  const int32_t corner = corner_of(current, sample_vertex);
+  return corner >= 0 ? corner : corner_across_faces(mesh, layout, c, face, sample_vertex);
 }
 
 // The output from the final clustering; relabelled (if given) receives each vertex whose
@@ -206,6 +236,10 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   };
   if (draft) {  // geometry only (DecimateParams::draft)
     parallel_for(0, 3 * t, parallel_if(t >= kParallelMin), [&](size_t i) { result.triangles[i] = output_index[partition.triangles[i]]; });
+    const std::vector<uint8_t>& flips = mesh.winding_flips();
+    if (!flips.empty())  // the input's winding back (restore_winding, which needs face sources)
+      for (size_t i = 0; i < t; ++i)
+        if (flips[partition.source_face[i]]) std::swap(result.triangles[3 * i + 1], result.triangles[3 * i + 2]);
     publish_ids();
     return result;
   }
@@ -218,6 +252,7 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   });
   result.face_source.resize(t);
   result.corner_source.resize(3 * t);
+  const std::vector<uint8_t>& flips = mesh.winding_flips();
   parallel_for(0, t, kParallelMin, [&](size_t i) {
     const int32_t f = partition.source_face[i];
     result.face_source[i] = mesh.face_source()[f];
@@ -226,7 +261,8 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
       result.triangles[3 * i + j] = output_index[rank];
       result.corner_source[3 * i + j] = single_corner[rank] >= 0
                                             ? single_corner[rank]
-                                            : attribute_corner(mesh, layout, clustering, f, j, samples[rank]);
+                                            : attribute_corner(mesh, layout, clustering, f,
+                                                               winding_slot(flips, f, j), samples[rank]);
     }
   });
   const auto& source = mesh.vertex_source();
@@ -724,6 +760,16 @@ void collapse_zero_area(const Mesh& mesh, const FeatureLayout& layout, const Dec
   refine_by_collapses(mesh, layout, cleanup, result);
 }
 
+// What must stay whatever the target, as result.forced: border corners and control points (a
+// first pass may have drawn every vertex, which says nothing about the budget).
+void count_forced(const Mesh& mesh, const FeatureLayout& layout, const std::vector<double>& multipliers,
+                  DecimateResult& result) {
+  result.forced = 0;
+  result.loop_forced = 0;
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
+    result.forced += layout.is_corner(v) || (!multipliers.empty() && multipliers[v] == kForcedMultiplier);
+}
+
 // Every vertex a sample (the input itself, which passes every check), collapsed to the target
 // keeping input positions: what a plain pass falls back to when its repairs left it broken.
 DecimateResult collapsed_from_whole_mesh(const Mesh& mesh, const FeatureLayout& layout,
@@ -732,6 +778,7 @@ DecimateResult collapsed_from_whole_mesh(const Mesh& mesh, const FeatureLayout& 
   DecimateResult whole = decimate_once(mesh, layout, params, active, active, nullptr);
   collapse_rest(mesh, layout, params, whole);
   if (has_zero_area(whole)) collapse_zero_area(mesh, layout, params, whole);
+  count_forced(mesh, layout, multipliers_if_guided(mesh, params.sampling), whole);
   return verified(mesh, layout, std::move(whole));
 }
 
@@ -810,6 +857,11 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
       best.collapses_skipped = true;
     else
       collapse_zero_area(mesh, layout, params, best);
+    // Some the clean-up cannot remove keeping input positions (a piece of coincident vertices
+    // reduced to a flat tetrahedron: the spider of tests/data, 8 at 20 %): collapsing the whole
+    // mesh keeps other vertices there, where the mesh is small enough for it.
+    if (!params.draft && has_zero_area(best) && active <= kMaxAwareVertices)
+      return collapsed_from_whole_mesh(mesh, layout, params);
   }
   // A draft's output is not re-checked; a fast-path result is, since the check decides
   // whether it must be redone.
@@ -956,12 +1008,7 @@ DecimateResult refined(const Mesh& mesh, const FeatureLayout& layout, const Deci
     return warmed;
   }
   result.target_vertices = params.target_vertices;
-  // What must stay whatever the target: border corners and control points (the first pass
-  // may have drawn every vertex, which says nothing about the budget).
-  result.forced = 0;
-  result.loop_forced = 0;
-  for (int32_t v = 0; v < mesh.num_vertices(); ++v)
-    result.forced += layout.is_corner(v) || (!multipliers.empty() && multipliers[v] == kForcedMultiplier);
+  count_forced(mesh, layout, multipliers, result);
   return verified(mesh, layout, std::move(result));
 }
 
@@ -1049,6 +1096,20 @@ DecimateResult decimate_with_samples(const Mesh& mesh, const FeatureLayout& layo
     refine_by_collapses(mesh, layout, refine, result);
   }
   return verified(mesh, layout, std::move(result));
+}
+
+void restore_winding(const Mesh& mesh, DecimateResult& result) {
+  const std::vector<uint8_t>& flips = mesh.winding_flips();
+  const size_t t = result.face_source.size();
+  if (flips.empty() || 3 * t != result.triangles.size()) return;
+  std::vector<uint8_t> flipped(size_t(mesh.report().input_triangles), 0);  // per caller triangle
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) flipped[size_t(mesh.face_source()[f])] = flips[f];
+  const bool corners = result.corner_source.size() == 3 * t;
+  for (size_t i = 0; i < t; ++i) {
+    if (!flipped[size_t(result.face_source[i])]) continue;
+    std::swap(result.triangles[3 * i + 1], result.triangles[3 * i + 2]);
+    if (corners) std::swap(result.corner_source[3 * i + 1], result.corner_source[3 * i + 2]);
+  }
 }
 
 // Results above this many triangles stop the search for a triangle target at a floor (below).

@@ -121,6 +121,55 @@ std::vector<int32_t> loose_triangle_vertices(const Mesh& mesh) {
   return loose;
 }
 
+// Whether face f has area: its cross product is not zero (the rule Mesh's report counts by).
+bool has_area(const Mesh& mesh, int32_t f) {
+  const int32_t* q = &mesh.faces()[3 * size_t(f)];
+  const double *a = mesh.position(q[0]), *b = mesh.position(q[1]), *c = mesh.position(q[2]);
+  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  return u[1] * w[2] - u[2] * w[1] != 0.0 || u[2] * w[0] - u[0] * w[2] != 0.0 || u[0] * w[1] - u[1] * w[0] != 0.0;
+}
+
+// Whether every face around v has area: a seam corner there never holds a zero-area triangle
+// the clean-up must collapse (coincident vertices: the spider of tests/data).
+bool star_has_area(const Mesh& mesh, int32_t v) {
+  bool all = true;
+  mesh.for_each_face(v, [&](int32_t f) { all = all && has_area(mesh, f); });
+  return all;
+}
+
+// FeatureLayout::winding_seam_vertices: per component, the lowest edge whose two triangles run
+// along it the same way, with no zero-area triangle around their corners (one must be able to
+// go), and those triangles' corners.
+std::vector<int32_t> winding_seam_vertices(const Mesh& mesh) {
+  std::vector<int32_t> seam;
+  if (mesh.report().inconsistent_edges == 0) return seam;
+  std::vector<uint8_t> done(size_t(mesh.report().components) + 1, 0);
+  const auto& faces = mesh.faces();
+  auto runs_forward = [&](int32_t f, int32_t a, int32_t b) {
+    for (int j = 0; j < 3; ++j)
+      if (faces[3 * size_t(f) + j] == a) return faces[3 * size_t(f) + (j + 1) % 3] == b;
+    return false;
+  };
+  for (int32_t e = 0; e < mesh.num_edges(); ++e) {
+    if (mesh.edge_face_count(e) != 2) continue;
+    const int32_t a = mesh.edge_vertices()[2 * size_t(e)], b = mesh.edge_vertices()[2 * size_t(e) + 1];
+    const int32_t component = mesh.component()[a];
+    if (component < 0 || done[size_t(component)]) continue;
+    const int32_t o = mesh.edge_face_offsets()[e], f = mesh.edge_faces()[o], g = mesh.edge_faces()[o + 1];
+    if (runs_forward(f, a, b) != runs_forward(g, a, b)) continue;  // consistent
+    bool clean = true;
+    for (int32_t h : {f, g})
+      for (int j = 0; j < 3; ++j) clean = clean && star_has_area(mesh, faces[3 * size_t(h) + j]);
+    if (!clean) continue;
+    done[size_t(component)] = 1;
+    seam.insert(seam.end(), &faces[3 * size_t(f)], &faces[3 * size_t(f)] + 3);
+    seam.insert(seam.end(), &faces[3 * size_t(g)], &faces[3 * size_t(g)] + 3);
+  }
+  std::sort(seam.begin(), seam.end());
+  seam.erase(std::unique(seam.begin(), seam.end()), seam.end());
+  return seam;
+}
+
 // The sectors of the faces around the vertices of more than one sector (FeatureLayout::
 // sector_of_slot) that one thread's run of vertices found, in vertex order.
 struct SectorSlots {
@@ -353,6 +402,7 @@ std::shared_ptr<const FeatureLayout> build_feature_layout(const Mesh& mesh, cons
   trace_curves(mesh, *layout);
   layout->curve_bends = find_curve_bends(mesh, *layout);
   layout->loose_vertices = loose_triangle_vertices(mesh);
+  layout->winding_seam_vertices = winding_seam_vertices(mesh);
   collect_boundary_loops(mesh, *layout);
   PinchedVertices pinched = find_pinched_vertices(mesh);
   if (pinched.count > 0) {

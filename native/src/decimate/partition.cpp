@@ -261,7 +261,7 @@ class PartitionCheck {
       : mesh(mesh), layout(layout), samples(samples), c(c), required(required), check_slivers(check_slivers),
         candidate_faces(candidate_faces), state(state), carried(state ? *state : local), n(mesh.num_vertices()),
         k(static_cast<int32_t>(samples.size())), m(mesh.num_faces()), threads(max_threads()),
-        faces(mesh.faces()), marks(threads) {}
+        faces(mesh.faces()), flips(mesh.winding_flips()), marks(threads) {}
 
   Partition run() {
     choose_faces_to_test();
@@ -306,6 +306,7 @@ class PartitionCheck {
   const int32_t n, k, m;
   const int threads;
   const Buffer<int32_t>& faces;
+  const std::vector<uint8_t>& flips;  // Mesh::winding_flips()
   Partition out;
   Marks marks;
 
@@ -341,8 +342,10 @@ class PartitionCheck {
   std::vector<uint64_t> seen;
 
   int32_t label(int32_t v) const { return c.label(v); }
+  // A face's corners' labels in its component's consistent winding: the emitted triangle.
   std::array<int32_t, 3> corner_labels(int32_t f) const {
-    return {label(faces[3 * size_t(f)]), label(faces[3 * size_t(f) + 1]), label(faces[3 * size_t(f) + 2])};
+    return {label(faces[3 * size_t(f)]), label(faces[3 * size_t(f) + winding_slot(flips, f, 1)]),
+            label(faces[3 * size_t(f) + winding_slot(flips, f, 2)])};
   }
   static uint8_t distinct(const std::array<int32_t, 3>& l) {
     return uint8_t(l[0] != l[1] && l[1] != l[2] && l[2] != l[0]);
@@ -466,7 +469,7 @@ class PartitionCheck {
     const int64_t words = m / 8;
     auto write = [&](int64_t at, int32_t f) {
       out.source_face[at] = f;
-      for (int j = 0; j < 3; ++j) out.triangles[3 * at + j] = label(faces[3 * size_t(f) + j]);
+      for (int j = 0; j < 3; ++j) out.triangles[3 * at + j] = label(faces[3 * size_t(f) + winding_slot(flips, f, j)]);
     };
     int64_t tail = 0;
     for (int32_t f = int32_t(8 * words); f < m; ++f) tail += emits[f];

@@ -544,7 +544,7 @@ class Refinement {
     setup.extent = frame->extent;
     setup.quadrics = cluster_quadrics(mesh, layout, params, label, n, *frame, !whole_input());
     set_up_vertices(setup);
-    lock_loose_triangles(setup);
+    lock_whole_triangles(setup);
     lock_sharp_turns(setup);
     // The input's own shape as a floor, in flat regions (may_loosen: on every collapse after a stall).
     if (sliver_heavy_input && !params.zero_area_only) setup.input_floor2 = input_shape_floors(mesh, label, n);
@@ -658,12 +658,15 @@ class Refinement {
   // An input triangle that is a piece of its own (an unwelded mesh is made of them) is the
   // fewest its piece may keep: its corners (FeatureLayout::loose_vertices, which the draw
   // forces) are locked, so that the collapses never queue or cost them (every collapse there was
-  // refused, one by one: 2.4 s for 82,000 loose triangles).
-  void lock_loose_triangles(CollapseSetup& setup) const {
-    const auto& loose = layout.loose_vertices;
-    if (loose.empty()) return;
-    for (int32_t i = 0; i < n; ++i)
-      if (std::binary_search(loose.begin(), loose.end(), kept_vertex[i])) setup.locked[i] = 1;
+  // refused, one by one: 2.4 s for 82,000 loose triangles). The winding seam's two triangles a
+  // component (FeatureLayout::winding_seam_vertices) stay the same way, but for the zero-area
+  // clean-up, which must be free to collapse next to them (coincident vertices).
+  void lock_whole_triangles(CollapseSetup& setup) const {
+    for (const auto* kept : {&layout.loose_vertices, &layout.winding_seam_vertices}) {
+      if (kept->empty() || (kept == &layout.winding_seam_vertices && params.zero_area_only)) continue;
+      for (int32_t i = 0; i < n; ++i)
+        if (std::binary_search(kept->begin(), kept->end(), kept_vertex[i])) setup.locked[i] = 1;
+    }
   }
 
   // On a sliver-heavy input a sharp turn of a boundary between a short edge and a long one

@@ -574,12 +574,16 @@ std::vector<int32_t> force_curves(const FeatureLayout& layout, int32_t count, bo
   return kept;
 }
 
-// The corners of triangles that are pieces of their own (FeatureLayout::loose_vertices), joined
-// to the forced vertices and to `kept` (for drop_kept): each piece keeps its triangle, so a draw
-// without them only sends the repairs after them round by round (327,680 loose triangles: 7.7 s
-// in fast mode).
-void force_loose_triangles(const FeatureLayout& layout, std::vector<int32_t>& kept, std::vector<int32_t>& forced) {
+// The corners of triangles that stay whole, joined to the forced vertices and to `kept` (for
+// drop_kept): triangles that are pieces of their own (FeatureLayout::loose_vertices; a draw
+// without them only sends the repairs after them round by round: 327,680 loose triangles, 7.7 s
+// in fast mode) and the winding seam's (FeatureLayout::winding_seam_vertices).
+// Returns how many the winding seam added (no border's corners: DecimateResult::loop_forced).
+int32_t force_whole_triangles(const FeatureLayout& layout, std::vector<int32_t>& kept, std::vector<int32_t>& forced) {
   keep_and_force(layout.loose_vertices, kept, forced);
+  const size_t before = forced.size();
+  keep_and_force(layout.winding_seam_vertices, kept, forced);
+  return int32_t(forced.size() - before);
 }
 
 // Each boundary loop too short to expect three samples at this count (FeatureLayout::
@@ -669,8 +673,8 @@ SampleSet select_samples(const Mesh& mesh, const FeatureLayout& layout, const Sa
     double slope;
     if (plain) out.expected = expected_count(*table, importance(mesh, *table), out.rate, slope);
     auto kept = force_curves(layout, count, params.keep_curves, probability, forced);
-    force_loose_triangles(layout, kept, forced);
-    out.loop_forced = force_boundary_loops(layout, count, mesh.num_vertices() - mesh.report().isolated_vertices,
+    const int32_t seam_forced = force_whole_triangles(layout, kept, forced);
+    out.loop_forced = seam_forced + force_boundary_loops(layout, count, mesh.num_vertices() - mesh.report().isolated_vertices,
                                            probability, kept, forced);
     drop_kept(kept, candidates);
     // The candidates below a threshold, the kept border vertices left out.

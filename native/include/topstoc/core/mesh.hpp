@@ -44,6 +44,12 @@ struct MeshReport {
   std::vector<int32_t> dropped_triangles;  ///< input indices of dropped triangles
 };
 
+/// The slot of face f that holds its corner j in its component's consistent winding (flips:
+/// Mesh::winding_flips(); a flipped face's second and third corners trade places).
+inline int winding_slot(const std::vector<uint8_t>& flips, int32_t f, int j) {
+  return flips.empty() || !flips[size_t(f)] || j == 0 ? j : 3 - j;
+}
+
 class Mesh {
  public:
   /// positions: 3n coordinates; triangles: 3m vertex indices. Throws std::invalid_argument.
@@ -146,6 +152,16 @@ class Mesh {
   /// True where the vertex's triangles form one consistently oriented fan and none of its
   /// edges is non-manifold.
   const VertexFlags& manifold_vertex() const { return manifold_vertex_; }
+  /// Per face: 1 where it runs against a consistent orientation of its component (the component's
+  /// first face sets it; faces meet across edges of two faces), else 0, and 0 on every face of a
+  /// component that has none (a Moebius band). Empty when no edge is inconsistently oriented.
+  /// What a decimation emits its triangles by, so that it need not keep the input's flipped
+  /// patches apart; the output takes each triangle's winding back from its source face. Made on
+  /// first use, once.
+  const std::vector<uint8_t>& winding_flips() const {
+    std::call_once(winding_once_, [this] { build_winding_flips(); });
+    return winding_flips_;
+  }
   /// Length of the bounding box diagonal.
   double diagonal() const { return diagonal_; }
 
@@ -168,6 +184,7 @@ class Mesh {
   template <class Stop>
   void walk_faces(int32_t v, Stop&& stop) const;
   void keep_vertex_faces_where_walks_cost();
+  void build_winding_flips() const;
   static constexpr int64_t kWalkPerFace = 16;
   /// The one-ring pass: adjacency, normals, weights, manifoldness, components.
   void build_adjacency(Progress& progress);
@@ -226,6 +243,8 @@ class Mesh {
   mutable std::atomic<bool> edge_faces_built_{false};
   Buffer<double> weights_;
   // Built in the preparation, freed after it, built again on first use (ensure_normals).
+  mutable std::vector<uint8_t> winding_flips_;
+  mutable std::once_flag winding_once_;
   mutable Buffer<double> normals_;
   mutable std::once_flag normals_once_;
   mutable std::atomic<bool> normals_built_{false};

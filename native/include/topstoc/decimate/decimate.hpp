@@ -107,7 +107,7 @@ struct DecimateResult {
   int32_t target_vertices = 0;
   int32_t selected = 0;                ///< samples drawn before repairs
   int32_t forced = 0;                  ///< corners and control points among them
-  int32_t loop_forced = 0;             ///< of those, three vertices of each short boundary loop (the holes')
+  int32_t loop_forced = 0;             ///< of those, three vertices of each short boundary loop (the holes') and the winding seams' (no border's corners)
   int32_t density_rejected = 0;
   bool guided = false;
   double expected_vertices = 0.0;      ///< sum of the sampling probabilities
@@ -146,6 +146,13 @@ struct DecimateResult {
 
 /// Decimates to params.target_vertices (1 <= target). Throws std::invalid_argument on bad params.
 DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const DecimateParams& params);
+
+/// The engine emits and collapses each component in one winding (Mesh::winding_flips): each
+/// output triangle whose source face runs against it takes that face's winding back (its second
+/// and third corners, and their corner sources, trade places), so the output keeps the input's
+/// flipped patches where they were. Nothing to do for a draft (no face sources: its triangles
+/// are turned back as they are made) or a consistently oriented input.
+void restore_winding(const Mesh& mesh, DecimateResult& result);
 
 /// Re-creates a decimation from a saved sample list (thesis 4.1.3). A refined result also
 /// needs its refine_vertices and the guidance it was made with. Corners the list lacks (feature

@@ -77,6 +77,12 @@ struct FeatureLayout {
   /// its triangle, so the draw forces them and the collapses lock them. Empty unless the mesh has
   /// many pieces (Mesh::many_pieces).
   std::vector<int32_t> loose_vertices;
+  /// Corners of the two triangles across one inconsistently oriented edge per component, sorted:
+  /// the decimation works in one winding per component (Mesh::winding_flips) and gives each
+  /// output triangle its source face's winding back, so these two triangles stay (the draw
+  /// forces their corners, the collapses lock them) and the output stays inconsistently oriented
+  /// where the input was. Empty when no edge is.
+  std::vector<int32_t> winding_seam_vertices;
   /// Mesh boundary loops (cycles of edges with one triangle, continued at a vertex within one
   /// fan: loops touching at a pinch stay apart), as vertex sets: each must meet three clusters
   /// or it closes up in the output, whatever corners split it into curves.
