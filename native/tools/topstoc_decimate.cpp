@@ -113,6 +113,7 @@ MeshFile decimated(const Options& o, const MeshFile& input, const Mesh& mesh) {
   RunningCall call;
   use_free_cores();
   DecimateResult result = decimate(mesh, *layout, params);
+  restore_winding(mesh, result);  // the input's flipped patches, as the Python API gives them
   MeshFile out;
   out.vertices = std::move(result.vertices);
   out.triangles = std::move(result.triangles);

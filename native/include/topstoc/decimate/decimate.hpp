@@ -151,7 +151,8 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
 /// output triangle whose source face runs against it takes that face's winding back (its second
 /// and third corners, and their corner sources, trade places), so the output keeps the input's
 /// flipped patches where they were. Nothing to do for a draft (no face sources: its triangles
-/// are turned back as they are made) or a consistently oriented input.
+/// are turned back as they are made) or a consistently oriented input. Whoever hands a result
+/// out calls it once (the Python bindings, the command-line driver).
 void restore_winding(const Mesh& mesh, DecimateResult& result);
 
 /// Re-creates a decimation from a saved sample list (thesis 4.1.3). A refined result also
