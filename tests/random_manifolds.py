@@ -244,6 +244,80 @@ def surface_facts(n, t):
                 inconsistent=int((directed_count > 1).sum()))
 
 
+def flip_patch(n, triangles, seed):
+    """The triangles with a patch wound the other way (grown across edges from a random
+    triangle to a random share of up to half of them, plus 1 % scattered at random in one mesh
+    of two), as the flipped parts of an export; and which triangles were flipped."""
+    t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    m = len(t)
+    rng = np.random.default_rng(seed)
+    low, high = np.minimum(t, np.roll(t, -1, axis=1)).ravel(), np.maximum(t, np.roll(t, -1, axis=1)).ravel()
+    order = np.argsort(low * n + high, kind="stable")
+    key = (low * n + high)[order]
+    same = np.flatnonzero(key[1:] == key[:-1])  # pairs of sides on one edge: neighbours
+    a, b = order[same] // 3, order[same + 1] // 3
+    neighbours = [[] for _ in range(m)]
+    for x, y in zip(a.tolist(), b.tolist()):
+        neighbours[x].append(y)
+        neighbours[y].append(x)
+    flip = np.zeros(m, bool)
+    size = int(rng.integers(1, max(2, m // 2)))
+    frontier = [int(rng.integers(m))]
+    flip[frontier[0]] = True
+    grown = 1
+    while frontier and grown < size:
+        f = frontier.pop(0)
+        for g in neighbours[f]:
+            if not flip[g] and grown < size:
+                flip[g] = True
+                grown += 1
+                frontier.append(g)
+    if rng.random() < 0.5:
+        flip |= rng.random(m) < 0.01
+    out = t.copy()
+    out[flip] = out[flip][:, ::-1]
+    return out.astype(np.int32), flip
+
+
+def check_windings(n, triangles, out_triangles, kept):
+    """Violations of the windings a decimation of a manifold input with flipped triangles must
+    keep: each output component consistently oriented exactly where its input component is.
+    (Wound back by their sources' flips, the output triangles must be consistently oriented:
+    check_decimation checks that with unflipped.)"""
+    problems = []
+    ot = np.asarray(out_triangles, dtype=np.int64).reshape(-1, 3)
+    if not len(ot):
+        return problems
+    before, after = surface_facts(n, triangles), surface_facts(len(kept), ot)
+    in_comp = before["component"][np.asarray(kept)]
+    for c in range(after["components"]):
+        members = np.unique(in_comp[after["component"] == c])
+        if len(members) == 1 and after["oriented"][c] != before["oriented"][members[0]]:
+            problems.append(f"component {int(members[0])}: consistently oriented "
+                            f"{bool(before['oriented'][members[0]])} -> {bool(after['oriented'][c])}")
+    return problems
+
+
+def unflipped(n, triangles, flip, out_triangles, face_source):
+    """The output with each triangle whose source was flipped wound back: consistently oriented
+    where the decimation is right. Where a component's flipped patches or all its unflipped
+    triangles went, the engine turns that component's first output triangle so that it stays
+    inconsistently oriented (decimate.hpp's restore_winding): that one is wound back too."""
+    t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    flip = np.asarray(flip, bool)
+    ot = np.array(out_triangles, dtype=np.int64).reshape(-1, 3)
+    source = np.asarray(face_source, dtype=np.int64)
+    back = flip[source].copy()
+    component = surface_facts(n, t)["component"][t[:, 0]]  # per input triangle
+    for c in np.unique(component):
+        mine = component[source] == c
+        if flip[component == c].any() and not flip[component == c].all() and mine.any():
+            if flip[source[mine]].all() or not flip[source[mine]].any():
+                back[np.flatnonzero(mine)[0]] ^= True
+    ot[back] = ot[back][:, ::-1]
+    return ot
+
+
 def check_decimation(vertices, triangles, out_vertices, out_triangles, kept, before=None):
     """Violations of the guarantees by a decimation of a manifold input, as a list of strings
     (empty when every guarantee holds). before: surface_facts of the input, if known."""

@@ -6,7 +6,9 @@ Every result's engine-side final check (stats.output_check) must be clean, and t
 independent numpy check runs on every K-th result (--check-every, default all).
 Meshes come from tests/random_manifolds.py (hulls, tori, grids with holes, icospheres, 1-4 of
 them side by side; every PINCHED-th mesh instead 2-4 of them glued at vertices, a spider of
-wings or a chain); each is decimated several times with random ratio, seed, placement,
+wings or a chain; every FLIPPED-th other one with a patch of its triangles wound the other way,
+checked wound back by the sources' flips, and each component as inconsistently oriented as its
+input's); each is decimated several times with random ratio, seed, placement,
 refinement, feature angle and fast path. Every result with ``topology_kept`` is checked by
 random_manifolds.check_decimation, or check_pinched_decimation for glued meshes (numpy/scipy,
 no topstoc code). Counts, per outcome:
@@ -39,11 +41,19 @@ DECIMATIONS_PER_MESH = 8
 PINCHED = 4  # every 4th mesh is a pinched surface (mesh index 3, 7, 11, ...)
 
 
+FLIPPED = 5  # every 5th mesh that is not pinched has a patch of its triangles wound the other way
+
+
 def generated_mesh(mesh_seed):
-    """The mesh for (seed, index), and whether it is a pinched surface."""
+    """The mesh for (seed, index), whether it is a pinched surface, and which of its triangles
+    were flipped (None: none)."""
     if mesh_seed[1] % PINCHED == PINCHED - 1:
-        return random_manifolds.pinched_surface(list(mesh_seed)), True
-    return random_manifolds.random_manifold(list(mesh_seed)), False
+        return random_manifolds.pinched_surface(list(mesh_seed)), True, None
+    vertices, triangles = random_manifolds.random_manifold(list(mesh_seed))
+    if mesh_seed[1] % FLIPPED != FLIPPED - 3:
+        return (vertices, triangles), False, None
+    triangles, flip = random_manifolds.flip_patch(len(vertices), triangles, list(mesh_seed))
+    return (vertices, triangles), False, flip
 
 
 def random_parameters(rng, drafts=False):
@@ -94,9 +104,10 @@ def run(count, seed, save=None, quiet=False, check_every=1, progress=0):
     while done < count:
         mesh_seed = (seed, mesh_index)
         mesh_index += 1
-        (vertices, triangles), pinched = generated_mesh(mesh_seed)
+        (vertices, triangles), pinched, flip = generated_mesh(mesh_seed)
         mesh = topstoc.Mesh(vertices, triangles)
-        before = None if pinched else random_manifolds.surface_facts(len(vertices), triangles)
+        wound = triangles if flip is None else np.where(flip[:, None], triangles[:, ::-1], triangles)
+        before = None if pinched else random_manifolds.surface_facts(len(vertices), wound)
         for _ in range(min(DECIMATIONS_PER_MESH, count - done)):
             params = random_parameters(rng, drafts=True)
             outcome, detail = "ok", ""
@@ -118,9 +129,16 @@ def run(count, seed, save=None, quiet=False, check_every=1, progress=0):
                         if pinched:
                             problems += random_manifolds.check_pinched_decimation(vertices, triangles, r.vertices,
                                                                                   r.triangles, r.kept)
-                        else:
+                        elif flip is None:
                             problems += random_manifolds.check_decimation(vertices, triangles, r.vertices,
                                                                           r.triangles, r.kept, before)
+                        else:  # wound back by the sources' flips, the input's own winding is consistent
+                            back = random_manifolds.unflipped(len(vertices), triangles, flip, r.triangles,
+                                                              r.face_source)
+                            problems += random_manifolds.check_decimation(vertices, wound, r.vertices, back,
+                                                                          r.kept, before)
+                            problems += random_manifolds.check_windings(len(vertices), triangles, r.triangles,
+                                                                        r.kept)
                     if problems:
                         outcome, detail = "unreported", "; ".join(problems)
             except RuntimeError as error:

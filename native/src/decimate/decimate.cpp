@@ -1102,14 +1102,33 @@ void restore_winding(const Mesh& mesh, DecimateResult& result) {
   const std::vector<uint8_t>& flips = mesh.winding_flips();
   const size_t t = result.face_source.size();
   if (flips.empty() || 3 * t != result.triangles.size()) return;
-  std::vector<uint8_t> flipped(size_t(mesh.report().input_triangles), 0);  // per caller triangle
-  for (int32_t f = 0; f < mesh.num_faces(); ++f) flipped[size_t(mesh.face_source()[f])] = flips[f];
+  // Per caller triangle its flip and component; per component the flips its input and its
+  // output triangles have (bit 1: unflipped, bit 2: flipped), and its first output triangle.
+  const size_t components = size_t(mesh.report().components) + 1;
+  std::vector<uint8_t> flipped(size_t(mesh.report().input_triangles), 0), input(components, 0), output(components, 0);
+  std::vector<int32_t> component(flipped.size(), 0), first(components, -1);
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+    const int32_t c = std::max(0, int32_t(mesh.component()[mesh.faces()[3 * size_t(f)]]));
+    flipped[size_t(mesh.face_source()[f])] = flips[f];
+    component[size_t(mesh.face_source()[f])] = c;
+    input[size_t(c)] |= uint8_t(1 << flips[f]);
+  }
   const bool corners = result.corner_source.size() == 3 * t;
-  for (size_t i = 0; i < t; ++i) {
-    if (!flipped[size_t(result.face_source[i])]) continue;
+  auto turn = [&](size_t i) {
     std::swap(result.triangles[3 * i + 1], result.triangles[3 * i + 2]);
     if (corners) std::swap(result.corner_source[3 * i + 1], result.corner_source[3 * i + 2]);
+  };
+  for (size_t i = 0; i < t; ++i) {
+    const size_t source = size_t(result.face_source[i]), c = size_t(component[source]);
+    output[c] |= uint8_t(1 << flipped[source]);
+    if (first[c] < 0) first[c] = int32_t(i);
+    if (flipped[source]) turn(i);
   }
+  // A component whose seam went all the same (a result of a few triangles, whose emission or
+  // collapses kept other sources): its first triangle is turned, so that it stays inconsistently
+  // oriented as its input is (a component's orientation is part of the topology kept).
+  for (size_t c = 0; c < components; ++c)
+    if (input[c] == 3 && output[c] != 3 && first[c] >= 0) turn(size_t(first[c]));
 }
 
 // Results above this many triangles stop the search for a triangle target at a floor (below).

@@ -150,7 +150,9 @@ DecimateResult decimate(const Mesh& mesh, const FeatureLayout& layout, const Dec
 /// The engine emits and collapses each component in one winding (Mesh::winding_flips): each
 /// output triangle whose source face runs against it takes that face's winding back (its second
 /// and third corners, and their corner sources, trade places), so the output keeps the input's
-/// flipped patches where they were. Nothing to do for a draft (no face sources: its triangles
+/// flipped patches where they were; a component whose output triangles all came from one side
+/// of its seams has its first triangle turned (it stays inconsistently oriented, as its input).
+/// Nothing to do for a draft (no face sources: its triangles
 /// are turned back as they are made) or a consistently oriented input. Whoever hands a result
 /// out calls it once (the Python bindings, the command-line driver).
 void restore_winding(const Mesh& mesh, DecimateResult& result);
