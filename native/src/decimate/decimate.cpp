@@ -236,10 +236,12 @@ DecimateResult finish(const Mesh& mesh, const FeatureLayout& layout, std::vector
   };
   if (draft) {  // geometry only (DecimateParams::draft)
     parallel_for(0, 3 * t, parallel_if(t >= kParallelMin), [&](size_t i) { result.triangles[i] = output_index[partition.triangles[i]]; });
-    const std::vector<uint8_t>& flips = mesh.winding_flips();
-    if (!flips.empty())  // the input's winding back (restore_winding, which needs face sources)
-      for (size_t i = 0; i < t; ++i)
-        if (flips[partition.source_face[i]]) std::swap(result.triangles[3 * i + 1], result.triangles[3 * i + 2]);
+    if (!mesh.winding_flips().empty()) {  // the input's winding back, as restore_winding gives a full result
+      result.face_source.resize(t);
+      for (size_t i = 0; i < t; ++i) result.face_source[i] = mesh.face_source()[partition.source_face[i]];
+      restore_winding(mesh, result);
+      std::vector<int32_t>().swap(result.face_source);  // a draft has none
+    }
     publish_ids();
     return result;
   }
