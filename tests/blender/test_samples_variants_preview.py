@@ -183,14 +183,29 @@ def test_refined_decimation_keeps_uvs_and_restores(ts, scene):
     assert output_geometry(bpy.data.objects["Knot_Last"]) == output_geometry(first)
 
 
+def three_sheets(length=40, width=12):
+    """Three curved strips sharing their first row: every edge of that spine has three triangles."""
+    vertices = [(x, 0.0, 0.0) for x in range(length)]
+    triangles = []
+    for k in range(3):
+        direction = np.array([0.0, np.cos(2 * np.pi * k / 3), np.sin(2 * np.pi * k / 3)])
+        rows = [list(range(length))]
+        for j in range(1, width):
+            rows.append(list(range(len(vertices), len(vertices) + length)))
+            vertices += [tuple(j * direction + [x, 0.0, 0.02 * j * j * np.sin(x / 7.0)]) for x in range(length)]
+        for j in range(width - 1):
+            for x in range(length - 1):
+                a, b, c, d = rows[j][x], rows[j][x + 1], rows[j + 1][x], rows[j + 1][x + 1]
+                triangles += [(a, b, d), (a, d, c)]
+    return np.array(vertices), np.array(triangles, dtype=np.int32)
+
+
 def test_a_fast_result_collapsed_after_a_stall_restores(ts, scene):
-    # A bumpy grid whose right half is flipped: fast mode's repairs stall on the orientation seam
-    # and half-edge collapses take the result to its target (docs/design.md §2.7); the saved set
-    # must replay those collapses, not quality mode's placed ones.
-    vertices, triangles = meshgen.grid(40, 40)
-    vertices[:, 2] = 2 * np.sin(vertices[:, 0] / 6) * np.cos(vertices[:, 1] / 7)
-    right = vertices[triangles].mean(axis=1)[:, 0] > 20
-    triangles[right] = triangles[right][:, ::-1]
+    # Three sheets on one spine: fast mode's repairs stall on the non-manifold edges and
+    # half-edge collapses take the result to its target (docs/design.md §2.7); the saved set must
+    # replay those collapses, not quality mode's placed ones. (A flipped half of a grid stalled
+    # them too, before flipped patches were emitted in one winding.)
+    vertices, triangles = three_sheets()
     obj = make_object("Seam", vertices, triangles)
     assert bpy.ops.topstoc.guided_decimate(ratio=0.05, seed=2, quality="FAST") == {"FINISHED"}
     first = bpy.data.objects["Seam_TopStoc"]
