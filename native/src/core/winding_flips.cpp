@@ -7,16 +7,6 @@
 
 namespace topstoc {
 
-namespace {
-
-bool runs_forward(const Mesh& mesh, int32_t f, int32_t e) {
-  for (int c = 0; c < 3; ++c)
-    if (mesh.face_edges()[3 * size_t(f) + c] == e) return mesh.faces()[3 * size_t(f) + c] == mesh.edge_vertices()[2 * size_t(e)];
-  return false;
-}
-
-}  // namespace
-
 void Mesh::build_winding_flips() const {
   if (report_.inconsistent_edges == 0) return;
   const int32_t m = num_faces();
@@ -36,7 +26,7 @@ void Mesh::build_winding_flips() const {
         if (edge_face_count(e) != 2) continue;
         const int32_t o = edge_face_offsets()[e];
         const int32_t g = edge_faces()[o] == f ? edge_faces()[o + 1] : edge_faces()[o];
-        const int8_t want = int8_t(flip[f] ^ (runs_forward(*this, f, e) == runs_forward(*this, g, e)));
+        const int8_t want = int8_t(flip[f] ^ (runs_forward(f, e) == runs_forward(g, e)));
         if (flip[g] < 0) {
           flip[g] = want;
           stack.push_back(g);

@@ -145,18 +145,12 @@ std::vector<int32_t> winding_seam_vertices(const Mesh& mesh) {
   if (mesh.report().inconsistent_edges == 0) return seam;
   std::vector<uint8_t> done(size_t(mesh.report().components) + 1, 0);
   const auto& faces = mesh.faces();
-  auto runs_forward = [&](int32_t f, int32_t a, int32_t b) {
-    for (int j = 0; j < 3; ++j)
-      if (faces[3 * size_t(f) + j] == a) return faces[3 * size_t(f) + (j + 1) % 3] == b;
-    return false;
-  };
   for (int32_t e = 0; e < mesh.num_edges(); ++e) {
     if (mesh.edge_face_count(e) != 2) continue;
-    const int32_t a = mesh.edge_vertices()[2 * size_t(e)], b = mesh.edge_vertices()[2 * size_t(e) + 1];
-    const int32_t component = mesh.component()[a];
+    const int32_t component = mesh.component()[mesh.edge_vertices()[2 * size_t(e)]];
     if (component < 0 || done[size_t(component)]) continue;
     const int32_t o = mesh.edge_face_offsets()[e], f = mesh.edge_faces()[o], g = mesh.edge_faces()[o + 1];
-    if (runs_forward(f, a, b) != runs_forward(g, a, b)) continue;  // consistent
+    if (mesh.runs_forward(f, e) != mesh.runs_forward(g, e)) continue;  // consistent
     bool clean = true;
     for (int32_t h : {f, g})
       for (int j = 0; j < 3; ++j) clean = clean && star_has_area(mesh, faces[3 * size_t(h) + j]);

@@ -56,12 +56,6 @@ std::string edge_name(const Mesh& mesh, int32_t e) {
   return "edge " + std::to_string(a) + "-" + std::to_string(b);
 }
 
-// True when face f runs along edge e from its lower vertex to its higher one.
-bool runs_forward(const Mesh& mesh, int32_t f, int32_t e) {
-  for (int c = 0; c < 3; ++c)
-    if (mesh.face_edges()[3 * size_t(f) + c] == e) return mesh.faces()[3 * size_t(f) + c] == mesh.edge_vertices()[2 * size_t(e)];
-  return false;
-}
 
 }  // namespace
 
@@ -121,7 +115,7 @@ std::vector<SurfaceCheck> check_closed_surfaces(const Mesh& mesh, const std::vec
         const int32_t o = mesh.edge_face_offsets()[e];
         const int32_t g = mesh.edge_faces()[o] == f ? mesh.edge_faces()[o + 1] : mesh.edge_faces()[o];
         // Consistent neighbours run along the edge in opposite directions.
-        const int8_t want = int8_t(flip[f] ^ (runs_forward(mesh, f, e) == runs_forward(mesh, g, e)));
+        const int8_t want = int8_t(flip[f] ^ (mesh.runs_forward(f, e) == mesh.runs_forward(g, e)));
         if (flip[g] < 0) {
           flip[g] = want;
           stack.push_back(g);

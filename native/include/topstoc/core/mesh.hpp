@@ -122,6 +122,13 @@ class Mesh {
   const Buffer<int32_t>& edge_faces() const { return ensure_edge_faces(), edge_faces_; }
   /// face_edges[3f + c] is the edge from corner c to corner c+1 of face f.
   const Buffer<int32_t>& face_edges() const { return ensure_edge_faces(), face_edges_; }
+  /// True when face f runs along its edge e from the edge's lower vertex to its higher one (two
+  /// faces on an edge are wound consistently when they run along it opposite ways).
+  bool runs_forward(int32_t f, int32_t e) const {
+    for (int c = 0; c < 3; ++c)
+      if (face_edges()[3 * size_t(f) + c] == e) return faces_[3 * size_t(f) + c] == edge_vertices()[2 * size_t(e)];
+    return false;
+  }
   int32_t edge_face_count(int32_t e) const {
     ensure_edges();
     return edge_face_offsets_[e + 1] - edge_face_offsets_[e];
