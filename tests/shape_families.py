@@ -115,6 +115,59 @@ def flipped_patches(triangles: int):
     return vertices, faces
 
 
+def foliage_cards(triangles: int):
+    """Separate quads scattered in a box, two triangles each (leaves or grass cards): hundreds of
+    thousands of tiny open components, each at its floor of one triangle below half the count."""
+    count = max(1, triangles // 2)
+    rng = np.random.default_rng(7)
+    centres = rng.uniform(0, 100, (count, 1, 3))
+    u, w = rng.normal(0, 0.2, (count, 1, 3)), rng.normal(0, 0.2, (count, 1, 3))
+    corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], float)
+    vertices = (centres + corners[None, :, :1] * u + corners[None, :, 1:] * w).reshape(-1, 3)
+    base = 4 * np.arange(count)[:, None, None]
+    faces = (base + np.array([[0, 1, 2], [0, 2, 3]])[None]).reshape(-1, 3)
+    return vertices, faces.astype(np.int32)
+
+
+def hair_strips(triangles: int):
+    """Separate bent strips of 8 quads (hair or grass cards of 16 triangles), scattered: many small
+    components with something to collapse in each."""
+    count = max(1, triangles // 16)
+    rng = np.random.default_rng(8)
+    s = np.linspace(0, 1, 9)
+    profile = np.stack([np.zeros(9), s, 0.3 * s * s], -1)  # a curved spine, 9 rings of 2 vertices
+    ring = np.concatenate([profile - [0.05, 0, 0], profile + [0.05, 0, 0]])  # 18 vertices: left, right
+    turn = rng.normal(size=(count, 3, 3))
+    q, _ = np.linalg.qr(turn)
+    vertices = (np.einsum("nij,vj->nvi", q, ring) + rng.uniform(0, 100, (count, 1, 3))).reshape(-1, 3)
+    k = np.arange(8)
+    quads = np.concatenate([np.column_stack([k, k + 9, k + 10]), np.column_stack([k, k + 10, k + 1])])
+    faces = (quads[None] + 18 * np.arange(count)[:, None, None]).reshape(-1, 3)
+    return vertices, faces.astype(np.int32)
+
+
+def long_cable(triangles: int):
+    """A tube of 12 sides wound as a helix of 100 turns, 300,000 times longer than it is thick, its
+    triangles needles along it (a CAD spring or cable): thin, curved and sliver-heavy."""
+    around = 12
+    along = max(4, triangles // (2 * around))
+    angle = 200 * np.pi * np.linspace(0, 1, along)
+    centre = np.column_stack([50 * np.cos(angle), 50 * np.sin(angle), 1000 * angle / angle[-1]])
+    tangent = np.column_stack([-50 * np.sin(angle), 50 * np.cos(angle), np.full(along, 1000 / angle[-1])])
+    tangent /= np.linalg.norm(tangent, axis=1)[:, None]
+    normal = -np.column_stack([np.cos(angle), np.sin(angle), np.zeros(along)])  # towards the axis
+    binormal = np.cross(tangent, normal)
+    phi = 2 * np.pi * np.arange(around) / around
+    ring = np.cos(phi)[None, :, None] * normal[:, None] + np.sin(phi)[None, :, None] * binormal[:, None]
+    vertices = (centre[:, None] + 0.05 * ring).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(along - 1), np.arange(around), indexing="ij")
+    a = (i * around + j).ravel()
+    b = (i * around + (j + 1) % around).ravel()
+    c, d = a + around, b + around
+    faces = np.vstack([np.column_stack([a, b, d]), np.column_stack([a, d, c])])
+    return vertices, faces.astype(np.int32)
+
+
 FAMILIES = {f.__name__: f for f in (bumpy_torus, many_spheres, triangle_soup, sheet_with_holes, sliver_sphere,
                                     needle_strip, fanned_cylinder, perforated_plate, holed_scan, torn_scan,
-                                    welded_points, flipped_patches)}
+                                    welded_points, flipped_patches, foliage_cards, hair_strips, long_cable)}

@@ -58,6 +58,7 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
       pool_[begin_[v] + size_[v]++] = int32_t(t);
     }
   alive_face_.assign(m, 1);
+  find_lone_corners();
   for (int32_t v = 0; v < n && !tracking_floors_; ++v) tracking_floors_ = size_[v] > kWideFan;
   if (tracking_floors_) {
     floor_bound_.assign(n, Shared<double>());
@@ -119,6 +120,18 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   for (int32_t u = 0; u < n; ++u)
     if (target_[u] >= 0) ids.push_back(u), keys.push_back(best_cost[u]);
   heap_.assign(ids, keys);
+}
+
+// Marks the corners of each triangle whose corners are in no other triangle (lone_). Such a
+// triangle is a component of its own: every collapse of it is refused, so none is queued.
+void Collapser::find_lone_corners() {
+  const size_t m = tri_->size() / 3;
+  for (size_t t = 0; t < m; ++t) {
+    const int32_t* c = &(*tri_)[3 * t];
+    if (size_[c[0]] != 1 || size_[c[1]] != 1 || size_[c[2]] != 1) continue;
+    if (lone_.empty()) lone_.assign(size_.size(), 0);
+    for (int j = 0; j < 3; ++j) lone_[c[j]] = 1;
+  }
 }
 
 int32_t Collapser::survivor(int32_t v) {
@@ -278,7 +291,7 @@ void Collapser::for_each_cost(int32_t u, const std::vector<int32_t>& around, con
 // with `checked`, the cheapest one that passes them. Reads the state only: safe in parallel.
 Collapser::Best Collapser::evaluate(int32_t u, bool checked, Scratch& scratch) const {
   Best best;
-  if (s_.locked[u] || at_quota(u) || (!held_.empty() && held_[u])) return best;
+  if (s_.locked[u] || lone(u) || at_quota(u) || (!held_.empty() && held_[u])) return best;
   neighbours(u, scratch, scratch.list);
   if (!checked) {
     for_each_cost(u, scratch.list, [&](int32_t v, double c) {

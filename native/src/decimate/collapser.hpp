@@ -244,7 +244,9 @@ class Collapser {
   bool reached(Stop stop) const {
     return stop.faces > 0 ? alive_faces_ <= stop.faces : alive_vertices_ <= stop.vertices;
   }
-  bool queues(int32_t u) const { return !s_.locked[u] && !at_quota(u); }
+  bool queues(int32_t u) const { return !s_.locked[u] && !lone(u) && !at_quota(u); }
+  bool lone(int32_t u) const { return !lone_.empty() && lone_[u]; }
+  void find_lone_corners();
   bool allowed(int32_t u, int32_t v, Scratch& scratch) const;
   static constexpr size_t kWideTries = 16;  // collapses a wide vertex's evaluation checks (evaluate)
   // Vertices whose collapse offers the constructor gathers before merging them (see there).
@@ -305,6 +307,9 @@ class Collapser {
   CollapseSetup s_;
   std::vector<int32_t> count_;  // per bin: vertices alive
   std::vector<uint8_t> held_;  // per vertex: refused by the caller (hold); empty: none
+  // per vertex: a corner of a triangle that is a whole component (no collapse can keep it: a
+  // scene of leaf cards at its floor had every vertex evaluated in every pass); empty: none
+  std::vector<uint8_t> lone_;
   int32_t last_removed_ = -1;  // the vertex the last collapse removed
   FanCheck fan_check_;         // set_fan_check's
   bool use_quota_ = true;
