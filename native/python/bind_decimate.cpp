@@ -119,6 +119,7 @@ py::dict result_dict(DecimateResult&& r) {
   d["refine_keeps_positions"] = r.refine_keeps_positions;
   d["shape_floor"] = r.shape_floor;
   d["far_guard"] = r.far_guard;
+  d["fold_floor"] = r.fold_floor;
   d["collapses_skipped"] = r.collapses_skipped;
   d["repair_rounds"] = r.repair_rounds;
   d["repairs"] = r.repairs;

@@ -204,3 +204,25 @@ def test_non_manifold_edges_are_the_reason_only_where_they_hold_most_of_the_resu
     # painted control points that outnumber the target still come first
     assert over_reason(stats(nonmanifold_vertices=700, forced=600, control_points=600)) == "control points"
     assert MissedTarget(1, 2, "topology").as_dict()["detail"] == ""
+
+
+def test_folds_reason_on_a_thin_curved_tube():
+    """A tube of 12 sides wound as a helix of 100 turns with 4 rings a turn (shape_families'
+    long_cable): at 1 % every collapse left would flip or fold a triangle, while the topology (an
+    annulus: Euler characteristic 0, two boundary loops, counted by tests/reference.py) would let
+    it go down to a few vertices. The reason says so, not "topology"; a torus below its floor
+    keeps "topology"."""
+    import meshgen
+    import shape_families
+    from reference import invariants
+
+    vertices, faces = shape_families.long_cable(10000)
+    assert invariants(len(vertices), faces) == [(0, 2, True, True)]
+    for mode in ("fast", "quality"):
+        result = Mesh(vertices, faces).decimate(ratio=0.01, mode=mode, seed=1)
+        missed = result.stats.target_missed
+        assert missed.got >= 10 * missed.asked and missed.reason == "folds", (mode, missed)
+        assert "fold" in missed.detail and result.stats.fold_floor
+        assert invariants(len(result.vertices), result.triangles) == [(0, 2, True, True)]
+    torus = Mesh(*meshgen.bumpy_torus(4000)).decimate(target_vertices=4, mode="fast", seed=1)
+    assert torus.stats.target_missed.reason == "topology" and not torus.stats.fold_floor

@@ -17,6 +17,9 @@ vertex) away from it. Why, in the words every channel uses:
 - "needle triangles": the input is made mostly of slivers (needles), and the result's triangles
   may be no thinner than the input's own: the target needs thinner ones (a strip of needles
   one or two cells wide);
+- "folds": the result stands at twice its target or more, and only collapses that would flip,
+  fold or thin triangles are left (a thin part curving more than the budget can follow: a
+  spring, a cable); the topology alone would let it go at least halfway to the target;
 - "error guard": quality mode's last collapses toward a target of at most 400 triangles may not
   lay a triangle farther from the input than twice the error where they began (or 3 % of the
   diagonal): the collapses past this count would have covered an opening or cut across a part;
@@ -95,6 +98,8 @@ def over_reason(stats) -> str:
         return "symmetry"  # the plain draw met the target, its mirrored set did not
     if getattr(stats, "far_guard", False):
         return "error guard"
+    if getattr(stats, "fold_floor", False):
+        return "folds"
     return "topology"
 
 
@@ -106,6 +111,8 @@ def _over_detail(stats, reason: str) -> str:
         return "the collapses left would lay triangles far from the surface (over its openings)"
     if reason == "needle triangles":
         return "the result's triangles stay no thinner than the input's own needles; the target needs thinner ones"
+    if reason == "folds":
+        return "the collapses left would flip, fold or thin triangles: a thin or tightly curved part needs more"
     loose = getattr(stats, "loose_triangles", 0)
     if reason == "topology" and 3 * loose >= stats.output_vertices / 4:
         return (f"{loose:,} of the result's {stats.output_triangles:,} triangles are loose pieces, each kept whole; "

@@ -82,6 +82,9 @@ class DecimateStats:
     #: the refinement stopped above its target where only triangles thinner than the input's own
     #: needles would have gone on (a mesh made mostly of slivers)
     shape_floor: bool = False
+    #: the refinement stopped at twice its target or more where only collapses that flip, fold or
+    #: thin triangles would have gone on (a thin, curved part: budget.py's "folds")
+    fold_floor: bool = False
     #: quality mode's tail stopped above its target where only collapses laying triangles far from
     #: the input (over an opening) would have gone on (budget.py's "error guard")
     far_guard: bool = False

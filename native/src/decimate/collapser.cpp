@@ -1027,6 +1027,7 @@ void Collapser::moved_floor_bounds(int32_t v) {
 // Do the triangles of `moved` that do not hold `other` keep their side and some area when
 // `moved` stands at x (other = -1: all of them)?
 bool Collapser::keeps_shape(int32_t moved, int32_t other, const double* x, ShapeFloor& floor) const {
+  if (!shape_checks_) return true;
   // A wide vertex that stays where it is leaves its other triangles as they were (a half-edge
   // collapse onto a fan's centre: the walk compared each of its triangles with itself).
   if (const double* p = position(moved); size_[moved] > kWideFan && x[0] == p[0] && x[1] == p[1] && x[2] == p[2])

@@ -113,6 +113,9 @@ class Collapser {
   static constexpr double kMinShape = 0.1, kMinTurnCos = 0.17;
   /// Other limits from now on (the reruns of a result stopped above its target by the
   /// topology loosen them; the fit restores them). Flips and area loss stay refused.
+  /// From now on no collapse is refused for the triangles it leaves (no flip, fold or sliver
+  /// check): how far the topology alone would let a run go (refine.cpp's held_by_folds).
+  void drop_shape_checks() { shape_checks_ = false; }
   void set_shape_limits(double min_shape, double min_turn_cos) {
     min_shape_ = min_shape;
     fold2_ = min_turn_cos * min_turn_cos;
@@ -314,6 +317,7 @@ class Collapser {
   FanCheck fan_check_;         // set_fan_check's
   bool use_quota_ = true;
   bool rescue_ = false;  // every collapse left failed its checks: see shaped_placement
+  bool shape_checks_ = true;  // keeps_shape checks the triangles a move leaves (drop_shape_checks)
   double min_shape_ = kMinShape;              // a triangle may end no thinner (keeps_shape)
   double fold2_ = kMinTurnCos * kMinTurnCos;  // squared cosine of the largest turn of a normal
   int32_t alive_vertices_ = 0, alive_faces_ = 0;

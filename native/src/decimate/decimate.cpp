@@ -655,6 +655,14 @@ bool only_loose_triangles(const Mesh& mesh, const FeatureLayout& layout) {
   return int64_t(layout.loose_vertices.size()) == active_vertices(mesh);
 }
 
+// Every triangle of a pass a piece of its own (leaf cards, each at its floor of one triangle):
+// no collapse is possible, so the collapses would only build their tables over it.
+bool only_lone_triangles(const DecimateResult& result) {
+  std::vector<uint8_t> faces(result.vertices.size() / 3, 0);
+  for (int32_t v : result.triangles) faces[v] = uint8_t(std::min(2, faces[v] + 1));
+  return std::all_of(result.triangles.begin(), result.triangles.end(), [&](int32_t v) { return faces[v] == 1; });
+}
+
 }  // namespace
 
 namespace {
@@ -837,7 +845,7 @@ DecimateResult stochastic_pass(const Mesh& mesh, const FeatureLayout& layout, co
   // drawn) is collapsed the rest of the way. A draft that did not stall stays the plain pass
   // (a drag stays fast on high-genus meshes at tiny targets); the rest's full result does not.
   // (The pass kept may be a lower draw that stalled where the draw for the target did not.)
-  if (!refined && excess(best) > tolerance && !only_loose_triangles(mesh, layout)) {
+  if (!refined && excess(best) > tolerance && !only_loose_triangles(mesh, layout) && !only_lone_triangles(best)) {
     if (params.draft && best.issues_remaining.topological() == 0) {
       best.collapses_skipped = true;
     } else if (params.draft) {

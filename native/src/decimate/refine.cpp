@@ -699,6 +699,12 @@ class Refinement {
   bool held_by_shape(const Collapser& stalled) const {
     return goes_halfway(stalled, [](Collapser& free) { free.set_shape_limits(0.0, Collapser::kMinTurnCos); });
   }
+  // Whether the shape checks hold a run at twice the target or more (DecimateResult::fold_floor):
+  // a copy without them goes at least halfway from there to the target. A stall nearer the
+  // target is left to the topology's reason (a copy costs the whole collapser: not for that).
+  bool held_by_folds(const Collapser& stalled) const {
+    return stalled_far(stalled) && goes_halfway(stalled, [](Collapser& free) { free.drop_shape_checks(); });
+  }
   // Whether the far guard held a run above the target: without it (its check is gone once the
   // run ends), its collapses go at least halfway from there to the target.
   bool held_by_guard(const Collapser& stalled) const {
@@ -760,6 +766,7 @@ class Refinement {
       }
     }
     if (may_retry) result.shape_floor = held_by_shape(*collapser);
+    if (!result.shape_floor) result.fold_floor = held_by_folds(*collapser);
     finish(*collapser);
   }
 
@@ -920,6 +927,7 @@ class Refinement {
     result.corner_source = std::move(best.corners);
     result.refine_collapses = best.collapses;
     if (sliver_heavy_input) result.shape_floor = held_by_shape(*best.collapser);
+    if (!result.shape_floor) result.fold_floor = held_by_folds(*best.collapser);
     if (guarded_best_) result.far_guard = held_by_guard(*best.collapser);
     // The fit moves vertices under the usual limits (under the looser ones it left slivers: a
     // torus at 16 triangles, aspect ratio up to 187 against 35).

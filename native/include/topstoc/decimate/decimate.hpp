@@ -129,6 +129,10 @@ struct DecimateResult {
   /// would have gone on: a sliver-heavy input, whose collapses without the shape rule would have
   /// gone at least halfway from there to the target (refine.cpp's held_by_shape).
   bool shape_floor = false;
+  /// It stopped at twice its target or more where only collapses that flip, fold or thin
+  /// triangles would have gone on: without those checks its collapses would have gone at least
+  /// halfway from there to the target (refine.cpp's held_by_folds; a thin, curved part).
+  bool fold_floor = false;
   /// It stopped above its target where only collapses that lay triangles far from the input
   /// (over an opening) would have gone on: without refine.cpp's far guard, its collapses would
   /// have gone at least halfway from there to the target.
