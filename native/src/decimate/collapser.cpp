@@ -134,6 +134,12 @@ void Collapser::find_lone_corners() {
   }
 }
 
+bool Collapser::has_free_vertex() const {
+  for (int32_t v = 0; v < int32_t(merged_into_.size()); ++v)
+    if (merged_into_[v] < 0 && !s_.locked[v] && !lone(v)) return true;
+  return false;
+}
+
 int32_t Collapser::survivor(int32_t v) {
   int32_t root = v;
   while (merged_into_[root] >= 0) root = merged_into_[root];

@@ -162,6 +162,8 @@ class Collapser {
   /// guidance weight): how far the result lies from the input planes it stands for.
   double quadric_error() const;
   int32_t live_vertices() const { return alive_vertices_; }
+  /// Whether some live vertex may still be removed (neither locked nor a lone triangle's corner).
+  bool has_free_vertex() const;
   /// Batches run() has taken so far (its collapses were reserved, checked and costed together).
   int64_t batches() const { return ring_stamp_; }
   /// Collapses run() has taken from the queue into its batches (those that waited went back).

@@ -14,6 +14,7 @@
 #include "decimate/curve_bends.hpp"
 #include "decimate/deviation.hpp"
 #include "decimate/tiny_fit.hpp"
+#include "topstoc/decimate/verify.hpp"
 #include "topstoc/core/parallel.hpp"
 
 namespace topstoc {
@@ -701,9 +702,22 @@ class Refinement {
   }
   // Whether the shape checks hold a run at twice the target or more (DecimateResult::fold_floor):
   // a copy without them goes at least halfway from there to the target. A stall nearer the
-  // target is left to the topology's reason (a copy costs the whole collapser: not for that).
+  // target, or under twice a generous count of what the topology keeps, is left to the
+  // topology's reason without the copy (it costs the whole collapser and a run).
   bool held_by_folds(const Collapser& stalled) const {
-    return stalled_far(stalled) && goes_halfway(stalled, [](Collapser& free) { free.drop_shape_checks(); });
+    return !params.zero_area_only && stalled_far(stalled) && stalled.live_vertices() > 2 * topology_keeps() &&
+           goes_halfway(stalled, [](Collapser& free) { free.drop_shape_checks(); });
+  }
+  // A generous count of the vertices the topology alone keeps: per component 4, 6 a handle and
+  // 3 a boundary loop (a torus stops at 7 to 9 vertices, a disc at 3).
+  int64_t topology_keeps() const {
+    const std::vector<int32_t> loops = component_boundary_loops(mesh, layout);
+    int64_t keeps = 0;
+    for (int32_t c = 0; c < mesh.num_components(); ++c) {
+      const int64_t twice_genus = std::max<int64_t>(0, 2 - mesh.component_euler()[c] - loops[c]);
+      keeps += 4 + 3 * twice_genus + 3 * loops[c];
+    }
+    return keeps;
   }
   // Whether the far guard held a run above the target: without it (its check is gone once the
   // run ends), its collapses go at least halfway from there to the target.
@@ -714,7 +728,7 @@ class Refinement {
   // from there to the target.
   template <class Loosen>
   bool goes_halfway(const Collapser& stalled, Loosen&& loosen) const {
-    if (stalled_by(stalled) == 0) return false;
+    if (stalled_by(stalled) == 0 || !stalled.has_free_vertex()) return false;  // (a copy costs the whole collapser)
     std::vector<int32_t> triangles = result.triangles, corners = result.corner_source;
     Collapser free(stalled);
     free.use_arrays(triangles, corners);
