@@ -734,7 +734,8 @@ class Refinement {
     free.use_arrays(triangles, corners);
     loosen(free);
     free.reopen();
-    free.run(target());
+    const int32_t halfway = target_count() + stalled_by(stalled) / 2;  // no further: the answer is known there
+    free.run(params.target_triangles > 0 ? Collapser::Stop{params.target_vertices, halfway} : Collapser::Stop{halfway, 0});
     return 2 * stalled_by(free) <= stalled_by(stalled);
   }
   // Loosened collapses are tried where the plain ones stopped at twice the target or more, and
