@@ -41,6 +41,22 @@ def test_guided_decimate_reports_the_missed_target(ts, scene):
     assert out["topstoc_over_budget_reason"] == "topology"
 
 
+def test_a_thin_curved_tube_reports_folds(ts, scene):
+    """A tube wound as a helix with 4 rings a turn (shape_families.long_cable): at 1 % every
+    collapse left would flip or fold a triangle, which the object's report says (not the
+    topology: the tube is an annulus, counted by tests/reference.py)."""
+    import shape_families
+
+    vertices, faces = shape_families.long_cable(10000)
+    assert reference.invariants(len(vertices), faces) == [(0, 2, True, True)]
+    make_object("Cable", vertices, faces)
+    assert bpy.ops.topstoc.guided_decimate(ratio=0.01, quality="FAST") == {"FINISHED"}
+    out = bpy.context.active_object
+    assert len(out.data.vertices) >= 10 * round(0.01 * len(vertices))
+    assert out["topstoc_over_budget_reason"] == "folds"
+    assert "folds: the collapses left would flip, fold or thin triangles" in out["topstoc_target_missed"]
+
+
 class Layout:
     """Records what a draw function puts in a layout (labels and their icons)."""
 
