@@ -226,3 +226,23 @@ def test_folds_reason_on_a_thin_curved_tube():
         assert invariants(len(result.vertices), result.triangles) == [(0, 2, True, True)]
     torus = Mesh(*meshgen.bumpy_torus(4000)).decimate(target_vertices=4, mode="fast", seed=1)
     assert torus.stats.target_missed.reason == "topology" and not torus.stats.fold_floor
+
+
+def test_borders_reason_when_the_borders_courses_hold_the_result():
+    """A torus cut into 495 patches (a UV island or material per cell of a grid): at 1 % the 966
+    patch corners are fewer than the 999 vertices asked, yet the patches' borders, each kept on
+    its course, hold 1,128 vertices. The reason is "borders", and the detail counts the result's
+    vertices on them (counted here from the (vertex, region) pairs of the input)."""
+    import meshgen
+
+    vertices, faces = meshgen.bumpy_torus(200000)
+    cell = np.floor(vertices[faces].mean(axis=1) / 0.2).astype(np.int64)
+    regions = np.unique(cell, axis=0, return_inverse=True)[1].reshape(-1)
+    result = Mesh(vertices, faces).decimate(ratio=0.01, regions=regions, mode="fast", seed=1)
+    missed = result.stats.target_missed
+    assert result.stats.forced - result.stats.loop_forced < missed.asked < missed.got
+    pairs = np.unique(np.column_stack([faces.reshape(-1), np.repeat(regions, 3)]), axis=0)
+    on_border = np.bincount(pairs[:, 0], minlength=len(vertices)) > 1
+    count = int(on_border[np.asarray(result.kept)].sum())
+    assert count >= missed.asked and result.stats.border_vertices == count
+    assert missed.reason == "borders" and missed.detail.startswith(f"{count:,} of the result's {missed.got:,} vertices")

@@ -6,7 +6,8 @@ vertex) away from it. Why, in the words every channel uses:
 
 - "control points": the vertices painted to stay (u = 1) outnumber the target;
 - "borders": corners of borders (seams, materials, sharp or hard-normal edges), always kept,
-  outnumber the target;
+  outnumber the target, or the result's vertices on the borders do (each border keeps its course:
+  many small UV islands or material patches), which the detail counts;
 - "non-manifold edges": at least half of the result's vertices lie on non-manifold edges (edges
   of three or more triangles): each such curve keeps its course and at least one edge, each
   sheet along it its triangles, so the topology stays; the detail says how many vertices that is;
@@ -94,6 +95,8 @@ def over_reason(stats) -> str:
     corners = stats.forced - getattr(stats, "loop_forced", 0)
     if corners >= stats.target_vertices and 3 * getattr(stats, "loose_triangles", 0) < stats.target_vertices:
         return "borders"
+    if getattr(stats, "border_vertices", 0) >= stats.target_vertices:
+        return "borders"  # the borders' courses alone hold more vertices than the target
     if stats.mirrored_from and stats.mirrored_from - stats.target_vertices <= tolerance(stats.target_vertices):
         return "symmetry"  # the plain draw met the target, its mirrored set did not
     if getattr(stats, "far_guard", False):
@@ -118,6 +121,10 @@ def _over_detail(stats, reason: str) -> str:
         return (f"{loose:,} of the result's {stats.output_triangles:,} triangles are loose pieces, each kept whole; "
                 "weld the mesh first (Blender: Merge by Distance)")
     holes = getattr(stats, "holes", 0)
+    on_borders = getattr(stats, "border_vertices", 0)
+    if reason == "borders" and on_borders >= stats.target_vertices:
+        return (f"{on_borders:,} of the result's {stats.output_vertices:,} vertices lie on the borders given "
+                "(materials, UV seams, sharp or marked edges), each kept on its course")
     if reason in ("topology", "borders") and 3 * holes >= stats.output_vertices / 4:
         return (f"the input's {holes:,} holes keep at least 3 vertices each; fill the small ones first "
                 "(topstoc clean --max-hole; Blender: Clean Up Small Handles and Holes)")

@@ -115,6 +115,10 @@ class DecimateStats:
     #: holes (boundary loops) of the input, each kept with at least three vertices; counted when
     #: the result lands over its target and the input has boundary edges enough to hold it there
     holes: int = 0
+    #: vertices of the result on the borders the caller gave (a change of region: material, UV
+    #: island; a flagged edge: seam, sharp), each kept on its course; counted when the result lands
+    #: over its target and borders were given
+    border_vertices: int = 0
     #: when the partition checks left issues (they cannot judge some non-manifold inputs' own
     #: clusters): every input component's invariants match its output's (core/api/invariants.py);
     #: None when it was not needed
@@ -329,7 +333,8 @@ def warm_up(mesh: Mesh, job: DecimationJob, cancel: Optional[CancelFlag] = None)
 
 #: DecimateStats fields counted in Python; every other field is the engine result's of the same name
 _COUNTED_HERE = {"output_vertices", "output_triangles", "target_triangles", "control_points", "zero_area_input",
-                 "mirrored_from", "replayed", "nonmanifold_vertices", "loose_triangles", "holes", "invariants_kept"}
+                 "mirrored_from", "replayed", "nonmanifold_vertices", "loose_triangles", "holes", "border_vertices",
+                 "invariants_kept"}
 
 
 def vertices_on_nonmanifold_edges(triangles: np.ndarray) -> int:
@@ -347,6 +352,22 @@ def loose_triangles(triangles: np.ndarray) -> int:
         return 0
     faces = np.bincount(t.ravel())
     return int(np.count_nonzero((faces[t] == 1).all(axis=1)))
+
+
+def vertices_on_borders(num_vertices: int, triangles, kept, regions=None, borders=None) -> int:
+    """Vertices of a result (input vertex ``kept`` of each) on a border: in triangles of two
+    regions or more, or at an end of a given border edge."""
+    on = np.zeros(num_vertices, dtype=bool)
+    if regions is not None:
+        t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+        r = np.asarray(regions).reshape(-1)
+        some = np.zeros(num_vertices, dtype=r.dtype)
+        some[t.reshape(-1)] = np.repeat(r, 3)  # one region of each vertex's triangles
+        for j in range(3):  # a vertex with a triangle of another region is on a border
+            on[t[r != some[t[:, j]], j]] = True
+    if borders is not None and np.size(borders):
+        on[np.asarray(borders, dtype=np.int64).reshape(-1)] = True
+    return int(np.count_nonzero(on[np.asarray(kept, dtype=np.int64)]))
 
 
 def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob] = None) -> DecimateResult:
@@ -369,6 +390,9 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
     if (missed is not None and missed.off > 0 and 4 * report["boundary_edges"] >= stats.output_vertices
             and 12 * stats.loose_triangles < stats.output_vertices):
         stats = dataclasses.replace(stats, holes=sum(len(c.boundary_loops) for c in mesh.input_topology.components))
+    if missed is not None and missed.off > 0 and job is not None and (job.regions is not None or job.borders is not None):
+        stats = dataclasses.replace(stats, border_vertices=vertices_on_borders(
+            len(mesh.vertices), mesh.triangles, raw["kept"], job.regions, job.borders))
     if stats.output_checked and stats.issues_left and not stats.check_violations:
         kept = invariants_kept(mesh.input_topology, raw["vertices"], raw["triangles"], raw["kept"])
         stats = dataclasses.replace(stats, invariants_kept=kept)
