@@ -27,7 +27,11 @@ def test_cards_at_their_floor_keep_one_input_triangle_each(mode, ratio):
     cards = len(faces) // 2
     result = Mesh(vertices, faces).decimate(ratio=ratio, mode=mode, seed=1)
     assert result.num_triangles == cards  # one triangle a card: a disc's floor
-    assert result.stats.target_missed is not None and result.stats.target_missed.reason == "topology"
+    missed = result.stats.target_missed
+    assert missed is not None and missed.reason == "topology"
+    # the detail names the pieces, and no welding: the input's own triangles are not loose
+    assert f"{cards:,} of the result's {cards:,} triangles are separate pieces of the input" in missed.detail
+    assert "weld" not in missed.detail
     # each output triangle lies on one card, and every card has one
     source_card = np.asarray(result.face_source) // 2
     assert sorted(source_card.tolist()) == list(range(cards))
@@ -70,3 +74,7 @@ def test_hair_strips_keep_every_strip_a_disc(mode, ratio):
     assert all(item == (1, 1, True, True) for item in found)  # each a disc: chi 1, one boundary loop
     target = max(3 * strips, int(ratio * len(vertices)))
     assert result.num_vertices <= 1.1 * target
+    if 3 * strips > ratio * len(vertices):  # the strips' floor: the detail names them, not holes to fill
+        missed = result.stats.target_missed
+        assert missed.reason == "topology" and missed.detail == (
+            f"the input's {strips:,} separate open pieces (strips, cards, parts) keep at least a triangle each")

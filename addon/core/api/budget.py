@@ -14,7 +14,9 @@ vertex) away from it. Why, in the words every channel uses:
 - "topology": samples the topology needs (each loose piece keeps at least a triangle, each
   hole and handle its loops); where loose triangles (pieces of one triangle, as in an unwelded
   mesh) or holes (boundary loops, each kept with three vertices or more) make up much of the
-  result, the detail says how many and what to do first;
+  result, the detail says how many and what to do first; where the result's loose triangles are
+  separate pieces of several triangles in the input (leaf cards, hair strips), or the boundary
+  loops are about one a piece (their outlines, not holes), it says that instead;
 - "needle triangles": the input is made mostly of slivers (needles), and the result's triangles
   may be no thinner than the input's own: the target needs thinner ones (a strip of needles
   one or two cells wide);
@@ -118,6 +120,9 @@ def _over_detail(stats, reason: str) -> str:
         return "the collapses left would flip, fold or thin triangles: a thin or tightly curved part needs more"
     loose = getattr(stats, "loose_triangles", 0)
     if reason == "topology" and 3 * loose >= stats.output_vertices / 4:
+        if 3 * getattr(stats, "loose_input", loose) < stats.output_vertices / 4:  # pieces of several triangles
+            return (f"{loose:,} of the result's {stats.output_triangles:,} triangles are separate pieces of the "
+                    "input (cards, leaves, parts), each down to the one triangle it keeps")
         return (f"{loose:,} of the result's {stats.output_triangles:,} triangles are loose pieces, each kept whole; "
                 "weld the mesh first (Blender: Merge by Distance)")
     holes = getattr(stats, "holes", 0)
@@ -125,6 +130,9 @@ def _over_detail(stats, reason: str) -> str:
     if reason == "borders" and on_borders >= stats.target_vertices:
         return (f"{on_borders:,} of the result's {stats.output_vertices:,} vertices lie on the borders given "
                 "(materials, UV seams, sharp or marked edges), each kept on its course")
+    pieces = getattr(stats, "open_pieces", 0)
+    if reason in ("topology", "borders") and 3 * holes >= stats.output_vertices / 4 and 2 * pieces >= holes:
+        return f"the input's {pieces:,} separate open pieces (strips, cards, parts) keep at least a triangle each"
     if reason in ("topology", "borders") and 3 * holes >= stats.output_vertices / 4:
         return (f"the input's {holes:,} holes keep at least 3 vertices each; fill the small ones first "
                 "(topstoc clean --max-hole; Blender: Clean Up Small Handles and Holes)")

@@ -112,9 +112,15 @@ class DecimateStats:
     #: triangles of the result that are pieces of their own (an unwelded mesh is made of them);
     #: each piece keeps its triangle. Counted when the input has more pieces than a tenth of its faces
     loose_triangles: int = 0
+    #: triangles of the input that are pieces of their own, counted with loose_triangles (an
+    #: unwelded mesh: weld it; pieces of several triangles, such as leaf cards, leave this lower)
+    loose_input: int = 0
     #: holes (boundary loops) of the input, each kept with at least three vertices; counted when
     #: the result lands over its target and the input has boundary edges enough to hold it there
     holes: int = 0
+    #: components of the input with a boundary, counted with holes: where the holes are about one a
+    #: component, they are the outlines of separate open pieces (hair strips, cards), not holes
+    open_pieces: int = 0
     #: vertices of the result on the borders the caller gave (a change of region: material, UV
     #: island; a flagged edge: seam, sharp), each kept on its course; counted when the result lands
     #: over its target and borders were given
@@ -333,7 +339,7 @@ def warm_up(mesh: Mesh, job: DecimationJob, cancel: Optional[CancelFlag] = None)
 
 #: DecimateStats fields counted in Python; every other field is the engine result's of the same name
 _COUNTED_HERE = {"output_vertices", "output_triangles", "target_triangles", "control_points", "zero_area_input",
-                 "mirrored_from", "replayed", "nonmanifold_vertices", "loose_triangles", "holes", "border_vertices",
+                 "mirrored_from", "replayed", "nonmanifold_vertices", "loose_triangles", "loose_input", "holes", "open_pieces", "border_vertices",
                  "invariants_kept"}
 
 
@@ -381,6 +387,8 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
                           nonmanifold_vertices=vertices_on_nonmanifold_edges(raw["triangles"])
                           if report["nonmanifold_edges"] else 0,
                           loose_triangles=loose_triangles(raw["triangles"])
+                          if 10 * report["components"] >= report["input_triangles"] else 0,
+                          loose_input=mesh.loose_triangles
                           if 10 * report["components"] >= report["input_triangles"] else 0)
     # The holes are counted where they may be what holds a result over its target (budget.py:
     # three vertices a hole, a quarter of its vertices), so at least a quarter as many boundary
@@ -389,7 +397,9 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
     missed = stats.target_missed
     if (missed is not None and missed.off > 0 and 4 * report["boundary_edges"] >= stats.output_vertices
             and 12 * stats.loose_triangles < stats.output_vertices):
-        stats = dataclasses.replace(stats, holes=sum(len(c.boundary_loops) for c in mesh.input_topology.components))
+        components = mesh.input_topology.components
+        stats = dataclasses.replace(stats, holes=sum(len(c.boundary_loops) for c in components),
+                                    open_pieces=sum(1 for c in components if c.boundary_loops))
     if missed is not None and missed.off > 0 and job is not None and (job.regions is not None or job.borders is not None):
         stats = dataclasses.replace(stats, border_vertices=vertices_on_borders(
             len(mesh.vertices), mesh.triangles, raw["kept"], job.regions, job.borders))

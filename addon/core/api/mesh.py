@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .decimate import decimate, decimate_with_samples
+from .decimate import decimate, decimate_with_samples, loose_triangles
 from .topology import topology
 from ..support.digest import array_digest
 from ..support.native import engine
@@ -114,6 +114,7 @@ class Mesh:
         self._vertices = None
         self._triangles = None
         self._topology = None  # the input's, computed on first use (input_topology)
+        self._loose = None  # loose_triangles, computed on first use
         self._layouts: dict = {}
         # True, False, or None: kept from a layout's second decimation on
         self._keep_floods = (bool(keep_floods) if keep_floods is not None
@@ -221,6 +222,14 @@ class Mesh:
         """Frees the feature layouts and their floods (a one-shot job's: a later decimation builds
         them again, with the same result)."""
         self._layouts.clear()
+
+    @property
+    def loose_triangles(self) -> int:
+        """Input triangles that are pieces of their own (an unwelded mesh is made of them), counted once."""
+        if self._loose is None:
+            triangles = self._triangles if self._triangles is not None else self._native.caller_triangles
+            self._loose = loose_triangles(triangles)
+        return self._loose
 
     @property
     def input_topology(self):
