@@ -78,3 +78,15 @@ def test_hair_strips_keep_every_strip_a_disc(mode, ratio):
         missed = result.stats.target_missed
         assert missed.reason == "topology" and missed.detail == (
             f"the input's {strips:,} separate open pieces (strips, cards, parts) keep at least a triangle each")
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_closed_pieces_below_their_floor_are_named(mode):
+    """Twenty spheres (shape_families.many_spheres) asked for 20 vertices: each closed piece keeps
+    at least 4, and the detail counts the pieces (counted here by tests/reference.py)."""
+    vertices, faces = shape_families.many_spheres(20 * 1280)
+    pieces = int(components(len(vertices), faces).max()) + 1
+    result = Mesh(vertices, faces).decimate(target_vertices=20, mode=mode, seed=1)
+    missed = result.stats.target_missed
+    assert pieces == 20 and missed.got >= 4 * pieces and missed.reason == "topology"
+    assert missed.detail.startswith(f"the input's {pieces:,} separate pieces keep at least a few vertices each")

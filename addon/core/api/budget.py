@@ -16,7 +16,8 @@ vertex) away from it. Why, in the words every channel uses:
   mesh) or holes (boundary loops, each kept with three vertices or more) make up much of the
   result, the detail says how many and what to do first; where the result's loose triangles are
   separate pieces of several triangles in the input (leaf cards, hair strips), or the boundary
-  loops are about one a piece (their outlines, not holes), it says that instead;
+  loops are about one a piece (their outlines, not holes), it says that instead; where the
+  input's pieces alone hold most of the result (many small closed parts), it counts them;
 - "needle triangles": the input is made mostly of slivers (needles), and the result's triangles
   may be no thinner than the input's own: the target needs thinner ones (a strip of needles
   one or two cells wide);
@@ -130,9 +131,13 @@ def _over_detail(stats, reason: str) -> str:
     if reason == "borders" and on_borders >= stats.target_vertices:
         return (f"{on_borders:,} of the result's {stats.output_vertices:,} vertices lie on the borders given "
                 "(materials, UV seams, sharp or marked edges), each kept on its course")
-    pieces = getattr(stats, "open_pieces", 0)
-    if reason in ("topology", "borders") and 3 * holes >= stats.output_vertices / 4 and 2 * pieces >= holes:
-        return f"the input's {pieces:,} separate open pieces (strips, cards, parts) keep at least a triangle each"
+    open_pieces = getattr(stats, "open_pieces", 0)
+    if reason in ("topology", "borders") and 3 * holes >= stats.output_vertices / 4 and 2 * open_pieces >= holes:
+        return f"the input's {open_pieces:,} separate open pieces (strips, cards, parts) keep at least a triangle each"
+    pieces = getattr(stats, "pieces", 0)
+    if reason == "topology" and 4 * pieces >= 3 * stats.output_vertices / 4 and 3 * holes < stats.output_vertices / 4:
+        return (f"the input's {pieces:,} separate pieces keep at least a few vertices each "
+                "(4 for a closed one, 3 for an open one)")
     if reason in ("topology", "borders") and 3 * holes >= stats.output_vertices / 4:
         return (f"the input's {holes:,} holes keep at least 3 vertices each; fill the small ones first "
                 "(topstoc clean --max-hole; Blender: Clean Up Small Handles and Holes)")

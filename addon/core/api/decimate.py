@@ -121,6 +121,8 @@ class DecimateStats:
     #: components of the input with a boundary, counted with holes: where the holes are about one a
     #: component, they are the outlines of separate open pieces (hair strips, cards), not holes
     open_pieces: int = 0
+    #: components of the input, counted when the result lands over its target
+    pieces: int = 0
     #: vertices of the result on the borders the caller gave (a change of region: material, UV
     #: island; a flagged edge: seam, sharp), each kept on its course; counted when the result lands
     #: over its target and borders were given
@@ -339,7 +341,7 @@ def warm_up(mesh: Mesh, job: DecimationJob, cancel: Optional[CancelFlag] = None)
 
 #: DecimateStats fields counted in Python; every other field is the engine result's of the same name
 _COUNTED_HERE = {"output_vertices", "output_triangles", "target_triangles", "control_points", "zero_area_input",
-                 "mirrored_from", "replayed", "nonmanifold_vertices", "loose_triangles", "loose_input", "holes", "open_pieces", "border_vertices",
+                 "mirrored_from", "replayed", "nonmanifold_vertices", "loose_triangles", "loose_input", "holes", "open_pieces", "pieces", "border_vertices",
                  "invariants_kept"}
 
 
@@ -400,6 +402,8 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
         components = mesh.input_topology.components
         stats = dataclasses.replace(stats, holes=sum(len(c.boundary_loops) for c in components),
                                     open_pieces=sum(1 for c in components if c.boundary_loops))
+    if missed is not None and missed.off > 0:
+        stats = dataclasses.replace(stats, pieces=report["components"])
     if missed is not None and missed.off > 0 and job is not None and (job.regions is not None or job.borders is not None):
         stats = dataclasses.replace(stats, border_vertices=vertices_on_borders(
             len(mesh.vertices), mesh.triangles, raw["kept"], job.regions, job.borders))
