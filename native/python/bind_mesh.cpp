@@ -45,6 +45,14 @@ void bind_mesh(py::module_& m) {
            "progress(fraction, stage) hears each preparation step; returning False raises Cancelled.")
       .def_property_readonly("num_vertices", &Mesh::num_vertices)
       .def_property_readonly("num_faces", &Mesh::num_faces)
+      .def_property_readonly(
+          "loose_faces",
+          [](const Mesh& mesh) {
+            int32_t count = 0;
+            for (int32_t f = 0; f < mesh.num_faces(); ++f) count += mesh.loose_face(f);
+            return count;
+          },
+          "Faces that are pieces of their own (Mesh::loose_face: each corner in no other face).")
       .def_property_readonly("num_edges", &Mesh::num_edges)
       .def_property_readonly("diagonal", &Mesh::diagonal)
       .def_property_readonly("mean_weight", &Mesh::mean_weight)

@@ -341,8 +341,8 @@ def warm_up(mesh: Mesh, job: DecimationJob, cancel: Optional[CancelFlag] = None)
 
 #: DecimateStats fields counted in Python; every other field is the engine result's of the same name
 _COUNTED_HERE = {"output_vertices", "output_triangles", "target_triangles", "control_points", "zero_area_input",
-                 "mirrored_from", "replayed", "nonmanifold_vertices", "loose_triangles", "loose_input", "holes", "open_pieces", "pieces", "border_vertices",
-                 "invariants_kept"}
+                 "mirrored_from", "replayed", "nonmanifold_vertices", "loose_triangles", "loose_input", "holes",
+                 "open_pieces", "pieces", "border_vertices", "invariants_kept"}
 
 
 def vertices_on_nonmanifold_edges(triangles: np.ndarray) -> int:
@@ -378,6 +378,22 @@ def vertices_on_borders(num_vertices: int, triangles, kept, regions=None, border
     return int(np.count_nonzero(on[np.asarray(kept, dtype=np.int64)]))
 
 
+def _over_target_counts(stats: DecimateStats, report: dict, mesh: Mesh, kept, job) -> DecimateStats:
+    """The counts that tell what holds a result over its target (budget.py's details): the
+    input's pieces; its holes and open pieces where they may hold it (three vertices a hole, a
+    quarter of the result's vertices, and loose triangles do not explain it already: the input's
+    topology is not computed for every miss); the result's vertices on the borders given."""
+    counts = {"pieces": report["components"]}
+    if 4 * report["boundary_edges"] >= stats.output_vertices and 12 * stats.loose_triangles < stats.output_vertices:
+        components = mesh.input_topology.components
+        counts["holes"] = sum(len(c.boundary_loops) for c in components)
+        counts["open_pieces"] = sum(1 for c in components if c.boundary_loops)
+    if job is not None and (job.regions is not None or job.borders is not None):
+        counts["border_vertices"] = vertices_on_borders(len(mesh.vertices), mesh.triangles, kept, job.regions,
+                                                        job.borders)
+    return dataclasses.replace(stats, **counts)
+
+
 def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob] = None) -> DecimateResult:
     report = mesh.native.report  # a dict made on each read: read once
     stats = DecimateStats(**{f.name: raw[f.name] for f in dataclasses.fields(DecimateStats)  # same names
@@ -392,21 +408,9 @@ def _result(raw: dict, parameters: dict, mesh: Mesh, job: Optional[DecimationJob
                           if 10 * report["components"] >= report["input_triangles"] else 0,
                           loose_input=mesh.loose_triangles
                           if 10 * report["components"] >= report["input_triangles"] else 0)
-    # The holes are counted where they may be what holds a result over its target (budget.py:
-    # three vertices a hole, a quarter of its vertices), so at least a quarter as many boundary
-    # edges as result vertices, and loose triangles do not explain it already: the input's
-    # topology is not computed for every miss.
     missed = stats.target_missed
-    if (missed is not None and missed.off > 0 and 4 * report["boundary_edges"] >= stats.output_vertices
-            and 12 * stats.loose_triangles < stats.output_vertices):
-        components = mesh.input_topology.components
-        stats = dataclasses.replace(stats, holes=sum(len(c.boundary_loops) for c in components),
-                                    open_pieces=sum(1 for c in components if c.boundary_loops))
     if missed is not None and missed.off > 0:
-        stats = dataclasses.replace(stats, pieces=report["components"])
-    if missed is not None and missed.off > 0 and job is not None and (job.regions is not None or job.borders is not None):
-        stats = dataclasses.replace(stats, border_vertices=vertices_on_borders(
-            len(mesh.vertices), mesh.triangles, raw["kept"], job.regions, job.borders))
+        stats = _over_target_counts(stats, report, mesh, raw["kept"], job)
     if stats.output_checked and stats.issues_left and not stats.check_violations:
         kept = invariants_kept(mesh.input_topology, raw["vertices"], raw["triangles"], raw["kept"])
         stats = dataclasses.replace(stats, invariants_kept=kept)

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .decimate import decimate, decimate_with_samples, loose_triangles
+from .decimate import decimate, decimate_with_samples
 from .topology import topology
 from ..support.digest import array_digest
 from ..support.native import engine
@@ -114,7 +114,7 @@ class Mesh:
         self._vertices = None
         self._triangles = None
         self._topology = None  # the input's, computed on first use (input_topology)
-        self._loose = None  # loose_triangles, computed on first use
+        self._loose = None  # loose_triangles, counted on first use
         self._layouts: dict = {}
         # True, False, or None: kept from a layout's second decimation on
         self._keep_floods = (bool(keep_floods) if keep_floods is not None
@@ -225,10 +225,10 @@ class Mesh:
 
     @property
     def loose_triangles(self) -> int:
-        """Input triangles that are pieces of their own (an unwelded mesh is made of them), counted once."""
+        """Triangles that are pieces of their own (an unwelded mesh is made of them; the engine's
+        Mesh::loose_face, which the draw and the collapses keep whole), counted once."""
         if self._loose is None:
-            triangles = self._triangles if self._triangles is not None else self._native.caller_triangles
-            self._loose = loose_triangles(triangles)
+            self._loose = self._native.loose_faces
         return self._loose
 
     @property

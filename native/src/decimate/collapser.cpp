@@ -58,7 +58,7 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
       pool_[begin_[v] + size_[v]++] = int32_t(t);
     }
   alive_face_.assign(m, 1);
-  find_lone_corners();
+  lone_ = lone_corners(*tri_, size_t(n));
   for (int32_t v = 0; v < n && !tracking_floors_; ++v) tracking_floors_ = size_[v] > kWideFan;
   if (tracking_floors_) {
     floor_bound_.assign(n, Shared<double>());
@@ -122,16 +122,16 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   heap_.assign(ids, keys);
 }
 
-// Marks the corners of each triangle whose corners are in no other triangle (lone_). Such a
-// triangle is a component of its own: every collapse of it is refused, so none is queued.
-void Collapser::find_lone_corners() {
-  const size_t m = tri_->size() / 3;
-  for (size_t t = 0; t < m; ++t) {
-    const int32_t* c = &(*tri_)[3 * t];
-    if (size_[c[0]] != 1 || size_[c[1]] != 1 || size_[c[2]] != 1) continue;
-    if (lone_.empty()) lone_.assign(size_.size(), 0);
-    for (int j = 0; j < 3; ++j) lone_[c[j]] = 1;
+std::vector<uint8_t> lone_corners(const std::vector<int32_t>& triangles, size_t num_vertices) {
+  std::vector<uint8_t> faces(num_vertices, 0), lone;
+  for (int32_t v : triangles) faces[size_t(v)] = uint8_t(std::min(2, faces[size_t(v)] + 1));
+  for (size_t t = 0; t + 2 < triangles.size(); t += 3) {
+    const int32_t* c = &triangles[t];
+    if (faces[size_t(c[0])] != 1 || faces[size_t(c[1])] != 1 || faces[size_t(c[2])] != 1) continue;
+    if (lone.empty()) lone.assign(num_vertices, 0);
+    for (int j = 0; j < 3; ++j) lone[size_t(c[j])] = 1;
   }
+  return lone;
 }
 
 bool Collapser::has_free_vertex() const {

@@ -28,6 +28,11 @@
 
 namespace topstoc {
 
+/// Per vertex of `triangles` (corner ids below num_vertices), whether it is a corner of a triangle
+/// that is a component of its own (its corners in no other triangle: no collapse can keep it);
+/// empty when no triangle is.
+std::vector<uint8_t> lone_corners(const std::vector<int32_t>& triangles, size_t num_vertices);
+
 /// What the collapses know about each vertex. Positions are normalised (centred on the bounding
 /// box and divided by its half extent) so that quadrics neither overflow nor underflow; `world`
 /// holds the caller's coordinates, which stay exact for every vertex that does not move.
@@ -251,7 +256,6 @@ class Collapser {
   }
   bool queues(int32_t u) const { return !s_.locked[u] && !lone(u) && !at_quota(u); }
   bool lone(int32_t u) const { return !lone_.empty() && lone_[u]; }
-  void find_lone_corners();
   bool allowed(int32_t u, int32_t v, Scratch& scratch) const;
   static constexpr size_t kWideTries = 16;  // collapses a wide vertex's evaluation checks (evaluate)
   // Vertices whose collapse offers the constructor gathers before merging them (see there).

@@ -15,6 +15,7 @@
 
 #include "topstoc/decimate/clustering.hpp"
 #include "topstoc/decimate/flood_cache.hpp"
+#include "decimate/collapser.hpp"
 #include "decimate/placement.hpp"
 #include "decimate/refine.hpp"
 #include "../core/per_thread.hpp"
@@ -658,9 +659,8 @@ bool only_loose_triangles(const Mesh& mesh, const FeatureLayout& layout) {
 // Every triangle of a pass a piece of its own (leaf cards, each at its floor of one triangle):
 // no collapse is possible, so the collapses would only build their tables over it.
 bool only_lone_triangles(const DecimateResult& result) {
-  std::vector<uint8_t> faces(result.vertices.size() / 3, 0);
-  for (int32_t v : result.triangles) faces[v] = uint8_t(std::min(2, faces[v] + 1));
-  return std::all_of(result.triangles.begin(), result.triangles.end(), [&](int32_t v) { return faces[v] == 1; });
+  const std::vector<uint8_t> lone = lone_corners(result.triangles, result.vertices.size() / 3);
+  return std::all_of(result.triangles.begin(), result.triangles.end(), [&](int32_t v) { return !lone.empty() && lone[v]; });
 }
 
 }  // namespace
