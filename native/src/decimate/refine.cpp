@@ -849,6 +849,23 @@ class Refinement {
     std::vector<int32_t> triangles, corners;
   };
 
+  // A max-aware decimation's first run to its target, before its re-fit (after_run): its state
+  // at the restart, where the reruns start (the collapses before it are shared), kept too.
+  struct FirstRun {
+    Run run;
+    std::unique_ptr<Collapser> at_restart;
+    int32_t shared = 0;
+    std::vector<int32_t> restart_triangles, restart_corners;
+  };
+  FirstRun first_run(CollapseSetup setup, Collapser::Stop stop, Collapser::Stop restart) {
+    FirstRun first;
+    first.shared = shared_run(std::move(setup), stop, restart, first.run.collapser);
+    first.at_restart = std::make_unique<Collapser>(*first.run.collapser);
+    first.restart_triangles = result.triangles, first.restart_corners = result.corner_source;
+    first.run.collapses = first.shared + first.run.collapser->run(stop);
+    return first;
+  }
+
   // Max-aware collapses (RefineParams::max_aware): a first run, then kRounds more that each
   // start from the first's state at kRestart times the target (the collapses before it are
   // shared), their cost weights grown where the runs before ended farthest from the input, so
@@ -860,41 +877,44 @@ class Refinement {
     result.refine_vertices = params.target_vertices;
     result.refine_triangles = params.target_triangles;
     const Collapser::Stop stop = target(), restart{int32_t(kRestart * stop.vertices), int32_t(kRestart * stop.faces)};
-    Run best;  // the first run, then any rerun that wins over the best so far
-    const CollapseSetup start = setup;
+    CollapseSetup start = setup;
     const std::vector<int32_t> start_triangles = result.triangles, start_corners = result.corner_source;
-    int32_t shared = shared_run(std::move(setup), stop, restart, best.collapser);
-    std::unique_ptr<Collapser> at_restart = std::make_unique<Collapser>(*best.collapser);
-    std::vector<int32_t> restart_triangles = result.triangles, restart_corners = result.corner_source;
-    best.collapses = shared + collapse_rest(*best.collapser, center, extent);
+    FirstRun first = first_run(std::move(setup), stop, restart);
+    first.run.collapses += after_run(*first.run.collapser, center, extent);
+    const std::shared_ptr<const Surface> whole = kept_input(*first.run.collapser, 1);
+    if (params.warm_up) return;  // what a later run reuses is kept
+    if (first.run.collapses == 0 && std::find(start.locked.begin(), start.locked.end(), 0) == start.locked.end()) {
+      // Every vertex locked (loose triangles): no run can change the input, so nothing to measure.
+      result.refine_collapses = 0;
+      finish(*first.run.collapser);
+      return;
+    }
+    if (may_loosen(start) && stalled_far(*first.run.collapser)) {
+      // Stalled on a sliver-heavy input: all over again, loosened, kept if it wins (loosened_wins).
+      // (A far stall's reruns never start from its own state at the restart: see floor below.)
+      first.at_restart.reset();
+      std::vector<int32_t> triangles = std::move(result.triangles), corners = std::move(result.corner_source);
+      result.triangles = start_triangles, result.corner_source = start_corners;
+      CollapseSetup loosened = start;
+      loosen(loosened);
+      FirstRun probe = first_run(loosened, stop, restart);
+      if (loosened_wins(*probe.run.collapser, *first.run.collapser)) {
+        probe.run.collapses += after_run(*probe.run.collapser, center, extent);
+        first = std::move(probe);
+        start = std::move(loosened);
+      } else {  // the plain run's arrays back
+        result.triangles = std::move(triangles), result.corner_source = std::move(corners);
+      }
+    }
+    Run best = std::move(first.run);  // the first run, then any rerun that wins over the best so far
+    std::unique_ptr<Collapser> at_restart = std::move(first.at_restart);
+    int32_t shared = first.shared;
+    std::vector<int32_t> restart_triangles = std::move(first.restart_triangles), restart_corners = std::move(first.restart_corners);
     const Collapser::Stop floor = restart_above(*best.collapser, stop);
     // Below the floor the reruns stop where the first run did, under looser checks.
     const bool below_floor = floor.vertices > 0 || floor.faces > 0;
     const Collapser::Stop reached{best.collapser->live_vertices(), stop.faces > 0 ? best.collapser->live_faces() : 0};
-    const std::shared_ptr<const Surface> whole = kept_input(*best.collapser, 1);
-    if (params.warm_up) return;  // what a later run reuses is kept
-    if (best.collapses == 0 && std::find(start.locked.begin(), start.locked.end(), 0) == start.locked.end()) {
-      // Every vertex locked (loose triangles): no run can change the input, so nothing to measure.
-      result.refine_collapses = 0;
-      finish(*best.collapser);
-      return;
-    }
-    if (below_floor && may_loosen(start) && stalled_far(*best.collapser)) {
-      // Stalled on a sliver-heavy input: all over again, loosened, if its first run wins (loosened_wins).
-      CollapseSetup loosened = start;
-      loosen(loosened);
-      std::vector<int32_t> triangles = start_triangles, corners = start_corners;
-      Collapser probe(triangles, corners, loosened);
-      slivers_first(probe, stop);
-      probe.run(stop);
-      if (loosened_wins(probe, *best.collapser)) {
-        result.triangles = start_triangles;
-        result.corner_source = start_corners;
-        collapse_max_aware(std::move(loosened), center, extent);
-        return;
-      }
-    }
-    if (floor.vertices > at_restart->live_vertices() || floor.faces > at_restart->live_faces()) {
+    if (!at_restart || floor.vertices > at_restart->live_vertices() || floor.faces > at_restart->live_faces()) {
       // The first run stopped above the target (the topology or the borders) and made few
       // collapses after the restart: the reruns restart from kRestart times where it ended
       // instead, so that they can still choose which vertices stay.
@@ -1263,8 +1283,12 @@ class Refinement {
     if (guarded) collapser.set_fan_check(guard);
     const int32_t collapses = collapser.run(stop);
     collapser.set_fan_check({});
+    return collapses + after_run(collapser, center, extent, guarded);
+  }
+  // After a run to the target: the optional re-fit and a last clean-up.
+  int32_t after_run(Collapser& collapser, const double* center, double extent, bool guarded = false) {
     if (params.refit && !guarded) collapser.refit(cluster_radii(collapser, center, extent));
-    return collapses + collapser.remove_thin(0.0, {});
+    return collapser.remove_thin(0.0, {});
   }
 
   // Whether a max-aware run toward `stop` gets the far guard (kFarGuard).
