@@ -263,9 +263,10 @@ def test_an_open_scan_is_simplified_along_its_boundaries_which_stay_on_the_input
         assert reference.degenerate_or_duplicate(r.triangles) == (0, 0)
         out_rim = boundary_edges(r.triangles)
         # a boundary is a curve to decimate, not edges to keep: at 3 % each of the 39 loops (38
-        # holes and the rim) is near its least, three edges
+        # holes and the rim) is near its least, three edges (158 edges: the span costs keep a few
+        # where a shortcut cut the outline, max 1.03 -> 0.84 % of the diagonal, mean +2 %)
         loops = expected[0][1]
-        assert len(out_rim) < len(rim) and (ratio > 0.05 or len(out_rim) <= 4 * loops), len(out_rim)
+        assert len(out_rim) < len(rim) and (ratio > 0.05 or len(out_rim) <= 4.5 * loops), len(out_rim)
         # every output boundary vertex is an input boundary vertex, where it was (distance 0); a
         # result of at most 400 triangles is fitted with its unlocked boundary vertices free to
         # move (design §2.10, kTinyFitFaces), so there only near it

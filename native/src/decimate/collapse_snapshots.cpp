@@ -46,6 +46,11 @@ std::vector<uint64_t> start_key(const CollapseSetup& s, const std::vector<int32_
   key.push_back(s.optimal_placement);
   add(key, s.input_floor2);
   key.push_back(s.input_floor_flat_only);
+  add(key, s.curve_order);
+  add(key, s.curve_offsets);
+  add(key, s.curve_slot);
+  add(key, s.curve_points);
+  add(key, &s.span_weight, 1);
   add(key, triangles);
   add(key, corner_source);
   return key;

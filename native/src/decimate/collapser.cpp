@@ -258,7 +258,49 @@ double Collapser::cost(int32_t from, int32_t to) const {
   double x[3];
   placement(from, to, q, x);
   const double w = free_pair(from, to) ? std::max(s_.weight[from], s_.weight[to]) : s_.weight[from];
-  return w * std::max(0.0, q.error(x));
+  double c = std::max(0.0, q.error(x));
+  if (!s_.curve_slot.empty() && s_.curve_slot[from] >= 0 && size_[from] <= kWideFan) c = std::max(c, span_cost(from, to));
+  return w * c;
+}
+
+// A move of curve vertex `from` onto its curve neighbour `to`: the squared distance of the
+// farthest input curve point between `to` and from's other live neighbour from the edge that
+// joins those two, times the edge's squared length and span_weight (0 if `to` is not next along
+// the curve).
+double Collapser::span_cost(int32_t from, int32_t to) const {
+  const int32_t k = s_.curve_slot[from], c = s_.curve[from];
+  const int32_t begin = s_.curve_offsets[c], end = s_.curve_offsets[c + 1];
+  const bool closed = s_.curve_closed[c];
+  auto step = [&](int32_t i, int32_t d) {
+    i += d;
+    return closed ? (i < begin ? end - 1 : i >= end ? begin : i) : i;
+  };
+  auto live = [&](int32_t i) { return i < begin || i >= end || merged_into_[s_.curve_order[i]] < 0; };
+  int32_t ahead = step(k, 1), behind = step(k, -1);
+  while (!live(ahead) && ahead != k) ahead = step(ahead, 1);
+  while (!live(behind) && behind != k) behind = step(behind, -1);
+  if (ahead < begin || ahead >= end || behind < begin || behind >= end || ahead == k || behind == k) return 0.0;
+  int32_t other;
+  if (s_.curve_order[ahead] == to) other = behind;
+  else if (s_.curve_order[behind] == to) other = ahead;
+  else return 0.0;
+  const int32_t o = s_.curve_order[other];
+  const double* a = position(o);
+  const double* b = position(to);
+  double ab[3], length2 = 0;
+  for (int i = 0; i < 3; ++i) ab[i] = b[i] - a[i], length2 += ab[i] * ab[i];
+  double far2 = 0;
+  const int32_t d = other == behind ? 1 : -1;  // from `other` through `from` to `to`
+  for (int32_t i = step(other, d); s_.curve_order[i] != to; i = step(i, d)) {
+    const double* p = &s_.curve_points[3 * size_t(i)];
+    double ap[3], t = 0;
+    for (int j = 0; j < 3; ++j) ap[j] = p[j] - a[j], t += ap[j] * ab[j];
+    t = length2 > 0 ? std::clamp(t / length2, 0.0, 1.0) : 0.0;
+    double d2 = 0;
+    for (int j = 0; j < 3; ++j) d2 += (ap[j] - t * ab[j]) * (ap[j] - t * ab[j]);
+    far2 = std::max(far2, d2);
+  }
+  return s_.span_weight * length2 * far2;
 }
 
 void Collapser::queue(int32_t u, int32_t v, double c) {

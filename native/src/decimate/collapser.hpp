@@ -2,7 +2,9 @@
 // sets it up; docs/design.md §2.10).
 //
 // Each vertex keeps its cheapest allowed collapse in an indexed heap. Costs are quadric errors
-// (vertex_quadrics.hpp) times a guidance weight; an edge between two free vertices collapses to
+// (vertex_quadrics.hpp), a move along a feature curve at least its span cost (how far the input
+// curve points the new edge stands for lie from it: CollapseSetup::curve_order), times a guidance
+// weight; an edge between two free vertices collapses to
 // the point minimising the summed quadric, any other edge moves one end onto the other, so
 // border vertices stay input vertices on their curve. After a collapse only the survivor's
 // collapses are recomputed in full; a neighbour whose queued collapse went to the removed vertex
@@ -63,6 +65,15 @@ struct CollapseSetup {
   /// Empty: no such floor.
   std::vector<double> input_floor2;
   bool input_floor_flat_only = true;
+  /// Each feature curve's vertices in order (FeatureLayout's curves, an open one's corners at its
+  /// ends), curve_offsets[c] to curve_offsets[c + 1], their starting positions (normalised, 3
+  /// each) in curve_points; per vertex its place there (-1: not a curve vertex, or a corner).
+  /// A collapse along a curve then costs at least span_weight times the new edge's squared
+  /// length times the squared distance of the farthest input curve point it stands for from that
+  /// edge. Empty: the quadric alone.
+  std::vector<int32_t> curve_order, curve_offsets, curve_slot;
+  std::vector<double> curve_points;
+  double span_weight = 0.0;
 };
 
 /// Which thin triangles Collapser::remove_thin takes, and how (zero-area ones always go).
@@ -208,6 +219,7 @@ class Collapser {
   }
   bool placement(int32_t from, int32_t to, const Quadric& q, double x[3]) const;
   double cost(int32_t from, int32_t to) const;
+  double span_cost(int32_t from, int32_t to) const;
   // Per-thread scratch: a stamp per vertex marks sets without clearing.
   struct Scratch {
     std::vector<uint32_t> mark;
