@@ -259,7 +259,10 @@ double Collapser::cost(int32_t from, int32_t to) const {
   placement(from, to, q, x);
   const double w = free_pair(from, to) ? std::max(s_.weight[from], s_.weight[to]) : s_.weight[from];
   double c = std::max(0.0, q.error(x));
-  if (!s_.curve_slot.empty() && s_.curve_slot[from] >= 0 && size_[from] <= kWideFan) c = std::max(c, span_cost(from, to));
+  // (A move off the curve has no span; a wide vertex's kept costs see only quadric changes.)
+  if (!s_.curve_slot.empty() && s_.curve_slot[from] >= 0 && kept_slot(from) < 0 &&
+      (s_.curve[to] == s_.curve[from] || s_.locked[to]))
+    c = std::max(c, span_cost(from, to));
   return w * c;
 }
 
