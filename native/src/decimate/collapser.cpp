@@ -78,6 +78,7 @@ Collapser::Collapser(std::vector<int32_t>& triangles, std::vector<int32_t>& corn
   waiting_.assign(n, 0);
   settled_.assign(n, 0);
   merged_from_.assign(n, -1);
+  set_up_spans();
   fit_threads();
   // Every vertex's cheapest collapse, each edge evaluated once (from its lower end) where it
   // costs the same both ways. A thread owns the lower ends it evaluates; what it finds for the
@@ -259,51 +260,95 @@ double Collapser::cost(int32_t from, int32_t to) const {
   placement(from, to, q, x);
   const double w = free_pair(from, to) ? std::max(s_.weight[from], s_.weight[to]) : s_.weight[from];
   double c = std::max(0.0, q.error(x));
-  // (A move off the curve has no span; a wide vertex's kept costs see only quadric changes.)
-  if (!s_.curve_slot.empty() && s_.curve_slot[from] >= 0 && kept_slot(from) < 0 &&
-      (s_.curve[to] == s_.curve[from] || s_.locked[to]))
-    c = std::max(c, span_cost(from, to));
+  // A move along a curve: at least its span (a wide vertex's kept costs see only quadric changes).
+  if (!span_.empty() && s_.curve_slot[from] >= 0 && kept_slot(from) < 0) {
+    const int32_t k = s_.curve_slot[from], p = span_prev_[k], q = span_next_[k];
+    if (p >= 0 && q >= 0 && s_.curve_order[q] == to) c = std::max(c, span_[2 * size_t(k)]);
+    else if (p >= 0 && q >= 0 && s_.curve_order[p] == to) c = std::max(c, span_[2 * size_t(k) + 1]);
+  }
   return w * c;
 }
 
-// A move of curve vertex `from` onto its curve neighbour `to`: the squared distance of the
-// farthest input curve point between `to` and from's other live neighbour from the edge that
-// joins those two, times the edge's squared length and span_weight (0 if `to` is not next along
-// the curve).
-double Collapser::span_cost(int32_t from, int32_t to) const {
-  const int32_t k = s_.curve_slot[from], c = s_.curve[from];
-  const int32_t begin = s_.curve_offsets[c], end = s_.curve_offsets[c + 1];
-  const bool closed = s_.curve_closed[c];
-  auto step = [&](int32_t i, int32_t d) {
-    i += d;
-    return closed ? (i < begin ? end - 1 : i >= end ? begin : i) : i;
-  };
-  auto live = [&](int32_t i) { return i < begin || i >= end || merged_into_[s_.curve_order[i]] < 0; };
-  int32_t ahead = step(k, 1), behind = step(k, -1);
-  while (!live(ahead) && ahead != k) ahead = step(ahead, 1);
-  while (!live(behind) && behind != k) behind = step(behind, -1);
-  if (ahead < begin || ahead >= end || behind < begin || behind >= end || ahead == k || behind == k) return 0.0;
-  int32_t other;
-  if (s_.curve_order[ahead] == to) other = behind;
-  else if (s_.curve_order[behind] == to) other = ahead;
-  else return 0.0;
-  const int32_t o = s_.curve_order[other];
-  const double* a = position(o);
-  const double* b = position(to);
-  double ab[3], length2 = 0;
-  for (int i = 0; i < 3; ++i) ab[i] = b[i] - a[i], length2 += ab[i] * ab[i];
-  double far2 = 0;
-  const int32_t d = other == behind ? 1 : -1;  // from `other` through `from` to `to`
-  for (int32_t i = step(other, d); s_.curve_order[i] != to; i = step(i, d)) {
-    const double* p = &s_.curve_points[3 * size_t(i)];
-    double ap[3], t = 0;
-    for (int j = 0; j < 3; ++j) ap[j] = p[j] - a[j], t += ap[j] * ab[j];
-    t = length2 > 0 ? std::clamp(t / length2, 0.0, 1.0) : 0.0;
-    double d2 = 0;
-    for (int j = 0; j < 3; ++j) d2 += (ap[j] - t * ab[j]) * (ap[j] - t * ab[j]);
-    far2 = std::max(far2, d2);
+// The links along each curve, every vertex live, and each curve vertex's span cost.
+void Collapser::set_up_spans() {
+  if (s_.curve_slot.empty()) return;
+  const int32_t slots = int32_t(s_.curve_order.size());
+  span_prev_.assign(slots, -1);
+  span_next_.assign(slots, -1);
+  span_.assign(2 * size_t(slots), 0.0);
+  for (int32_t c = 0; c + 1 < int32_t(s_.curve_offsets.size()); ++c) {
+    const int32_t begin = s_.curve_offsets[c], end = s_.curve_offsets[c + 1];
+    const bool closed = s_.curve_closed[c];
+    for (int32_t k = begin; k < end; ++k) {
+      span_prev_[k] = k > begin ? k - 1 : closed ? end - 1 : -1;
+      span_next_[k] = k + 1 < end ? k + 1 : closed ? begin : -1;
+    }
   }
-  return s_.span_weight * length2 * far2;
+  for (int32_t k = 0; k < slots; ++k) refresh_span(k);
+}
+
+// Moving the curve vertex of slot k onto either live neighbour replaces its two edges with one
+// joining them: span_weight times that edge's squared length times the squared distance of the
+// farthest input curve point between them from it (0 past a gone end of an open curve). Onto the
+// next (to[0]) the distances are measured from the previous, onto the previous (to[1]) from the
+// next: the two agree only up to rounding.
+void Collapser::span_of(int32_t k, double to[2]) const {
+  to[0] = to[1] = 0.0;
+  const int32_t p = span_prev_[k], q = span_next_[k];
+  if (p < 0 || q < 0 || p == k) return;
+  const int32_t c = s_.curve[s_.curve_order[k]];
+  const int32_t begin = s_.curve_offsets[c], end = s_.curve_offsets[c + 1];
+  const double* a[2] = {position(s_.curve_order[p]), position(s_.curve_order[q])};
+  double ab[2][3], length2 = 0;
+  for (int i = 0; i < 3; ++i) ab[0][i] = a[1][i] - a[0][i], ab[1][i] = -ab[0][i], length2 += ab[0][i] * ab[0][i];
+  double far2[2] = {0, 0};
+  for (int32_t i = p + 1 < end ? p + 1 : begin; i != q; i = i + 1 < end ? i + 1 : begin) {
+    const double* x = &s_.curve_points[3 * size_t(i)];
+    for (int e = 0; e < 2; ++e) {
+      double ax[3], t = 0;
+      for (int j = 0; j < 3; ++j) ax[j] = x[j] - a[e][j], t += ax[j] * ab[e][j];
+      t = length2 > 0 ? std::clamp(t / length2, 0.0, 1.0) : 0.0;
+      double d2 = 0;
+      for (int j = 0; j < 3; ++j) d2 += (ax[j] - t * ab[e][j]) * (ax[j] - t * ab[e][j]);
+      far2[e] = std::max(far2[e], d2);
+    }
+  }
+  for (int e = 0; e < 2; ++e) to[e] = s_.span_weight * length2 * far2[e];
+}
+
+// Slot k's span cost anew, if a curve vertex holds it (not a corner).
+void Collapser::refresh_span(int32_t k) {
+  if (k < 0 || s_.curve_slot[s_.curve_order[k]] != k) return;
+  span_of(k, &span_[2 * size_t(k)]);
+}
+
+// u is gone: its neighbours along the curve are linked, and their spans grow. A dead end (an open
+// curve's end vertex, which holds no slot) leaves its neighbour the curve's end.
+void Collapser::unlink_span(int32_t u) {
+  if (span_.empty() || s_.curve[u] < 0) return;
+  const int32_t k = s_.curve_slot[u];
+  if (k < 0) {
+    const int32_t c = s_.curve[u], begin = s_.curve_offsets[c], end = s_.curve_offsets[c + 1];
+    if (s_.curve_order[begin] == u && span_next_[begin] >= 0)
+      span_prev_[span_next_[begin]] = -1, refresh_span(span_next_[begin]);
+    if (s_.curve_order[end - 1] == u && span_prev_[end - 1] >= 0)
+      span_next_[span_prev_[end - 1]] = -1, refresh_span(span_prev_[end - 1]);
+    return;
+  }
+  const int32_t p = span_prev_[k], q = span_next_[k];
+  if (p >= 0) span_next_[p] = q;
+  if (q >= 0) span_prev_[q] = p;
+  span_prev_[k] = span_next_[k] = -1;
+  refresh_span(p);
+  refresh_span(q);
+}
+
+// v moved: the spans that end at it change.
+void Collapser::span_moved(int32_t v) {
+  if (span_.empty() || s_.curve_slot[v] < 0) return;
+  const int32_t k = s_.curve_slot[v];
+  refresh_span(span_prev_[k]);
+  refresh_span(span_next_[k]);
 }
 
 void Collapser::queue(int32_t u, int32_t v, double c) {
@@ -444,7 +489,7 @@ bool Collapser::place(int32_t v, const double* world, int32_t face) {
   double* w = &s_.world[3 * size_t(v)];
   double keep_p[3], keep_w[3];
   for (int i = 0; i < 3; ++i) keep_p[i] = p[i], keep_w[i] = w[i], p[i] = at[i], w[i] = world[i];
-  if (!zero_area(face)) return changed(v), moved_floor_bounds(v), true;
+  if (!zero_area(face)) return changed(v), moved_floor_bounds(v), span_moved(v), true;
   for (int i = 0; i < 3; ++i) p[i] = keep_p[i], w[i] = keep_w[i];  // no gain: back
   return false;
 }
@@ -1276,7 +1321,7 @@ void Collapser::move_to(int32_t v, const double* x) {
     w[i] = x[i] * s_.extent + s_.center[i];
     moved = true;
   }
-  if (moved) changed(v), moved_floor_bounds(v);
+  if (moved) changed(v), moved_floor_bounds(v), span_moved(v);
 }
 
 void Collapser::collapse(int32_t u, int32_t v) {
@@ -1344,6 +1389,7 @@ void Collapser::collapse(int32_t u, int32_t v) {
     s_.dead_end[v] = !s_.locked[v];
   }
   if (s_.curve[u] >= 0) --s_.curve_size[s_.curve[u]];
+  unlink_span(u);
   --count_[s_.bin[u]];
   --alive_vertices_;
   size_[u] = 0;
@@ -1422,6 +1468,7 @@ void Collapser::restore(int32_t v, const double* position, const double* world) 
   for (int i = 0; i < 3; ++i) s_.positions[3 * size_t(v) + i] = position[i], s_.world[3 * size_t(v) + i] = world[i];
   changed(v);
   moved_floor_bounds(v);
+  span_moved(v);
 }
 
 }  // namespace topstoc

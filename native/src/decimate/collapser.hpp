@@ -219,7 +219,11 @@ class Collapser {
   }
   bool placement(int32_t from, int32_t to, const Quadric& q, double x[3]) const;
   double cost(int32_t from, int32_t to) const;
-  double span_cost(int32_t from, int32_t to) const;
+  void set_up_spans();
+  void span_of(int32_t k, double to[2]) const;
+  void refresh_span(int32_t k);
+  void unlink_span(int32_t u);
+  void span_moved(int32_t v);
   // Per-thread scratch: a stamp per vertex marks sets without clearing.
   struct Scratch {
     std::vector<uint32_t> mark;
@@ -373,6 +377,11 @@ class Collapser {
   std::vector<uint32_t> changed_at_;
   uint32_t clock_ = 0;
   std::vector<int32_t> kept_costs_of_;
+  // Per curve slot (CollapseSetup::curve_order): the slots of its live neighbours along the
+  // curve (-1 past an open curve's end whose vertex is gone) and, for a curve vertex, its span
+  // costs onto the next and onto the previous (span_of); empty without spans.
+  std::vector<int32_t> span_prev_, span_next_;
+  std::vector<double> span_;
   mutable std::vector<CostCache> kept_costs_;
   int32_t kept_slot(int32_t v) const { return kept_costs_of_.empty() ? -1 : kept_costs_of_[v]; }
   std::vector<uint8_t> alive_face_, dirty_, placed_;
