@@ -51,7 +51,10 @@ def test_uvs_in_the_cost_keep_the_texture_in_place():
     assert with_uvs["max"] < without["max"], (with_uvs, without)
 
 
-@pytest.mark.parametrize("weight, seam_most, rms_below", [(ATTRIBUTE_WEIGHT, 10, 0.025), (1.0, 12, 0.0048)])
+# (At weight 1 the border span costs raised the rms 0.0040 -> 0.0044 under NumPy 1 and 0.0042 ->
+# 0.0055 under NumPy 2, whose cylinder differs in its last bits; the rims' max fell: see
+# docs/bench_notes/outline-spans.md. The seam count tells the one-quadric failure apart.)
+@pytest.mark.parametrize("weight, seam_most, rms_below", [(ATTRIBUTE_WEIGHT, 10, 0.025), (1.0, 12, 0.006)])
 def test_the_seam_is_thinned_like_the_rest_and_both_sides_keep_their_texture(weight, seam_most, rms_below):
     """A seam vertex keeps one attribute quadric per side (wedge): the jump from u = 1 to 0
     across the cut costs nothing, so the cut is thinned as the rest of the cylinder is, not kept
