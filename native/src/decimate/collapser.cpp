@@ -263,8 +263,8 @@ double Collapser::cost(int32_t from, int32_t to) const {
   // A move along a curve: at least its span (a wide vertex's kept costs see only quadric changes).
   if (!span_.empty() && s_.curve_slot[from] >= 0 && kept_slot(from) < 0) {
     const int32_t k = s_.curve_slot[from], p = span_prev_[k], q = span_next_[k];
-    if (p >= 0 && q >= 0 && s_.curve_order[q] == to) c = std::max(c, span_[2 * size_t(k)]);
-    else if (p >= 0 && q >= 0 && s_.curve_order[p] == to) c = std::max(c, span_[2 * size_t(k) + 1]);
+    const int onto = p < 0 || q < 0 ? -1 : s_.curve_order[q] == to ? 0 : s_.curve_order[p] == to ? 1 : -1;
+    if (onto >= 0) c = std::max(c, span_[2 * size_t(k) + onto]);
   }
   return w * c;
 }
