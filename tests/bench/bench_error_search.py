@@ -1,6 +1,6 @@
 """Error-bounded search benchmark: targets decimated, probes and time of ``max_error`` searches
 next to one count-target decimation at the answer's count (a fresh mesh each, so both pay the
-preparation), in both modes, on fourteen cases of nine meshes. Each case runs in a child process;
+preparation), in both modes, on fourteen cases of eleven meshes. Each case runs in a child process;
 with ``--baseline DIR`` (another build's python directory, e.g. main's) the baseline's search runs
 right after ours in the same run.
 Set TOPSTOC_NUM_THREADS=1 for CPU figures of one thread.
@@ -25,7 +25,7 @@ from machine import machine  # noqa: E402
 
 BUNNY = ROOT.parent / "shared" / "meshes" / "genus0" / "cgal_bunny00.off"
 DATA = ROOT / "tests" / "data"
-#: (mesh, relative bound): scans, CAD, characters, a knot, an open mesh, a sculpture
+#: (mesh, relative bound): scans, CAD parts, figures, a knot and two open meshes
 CASES = [(BUNNY, 0.003), (BUNNY, 0.01), (DATA / "genus_positive/cgal_elephant.off", 0.01),
          (DATA / "genus_positive/cgal_elephant.off", 0.003), (DATA / "genus0/cgal_fandisk.off", 0.003),
          (DATA / "genus0/cgal_fandisk.off", 0.01), (DATA / "genus_positive/cgal_eight.off", 0.01),
