@@ -224,6 +224,8 @@ for options in (dict(ratio=0.2), dict(ratio=0.02), dict(ratio=0.05, refine=4, pl
     for a in (r.vertices, r.triangles, r.kept, r.corner_source, r.labels, r.samples):
         digest.update(a.tobytes())
     digest.update(r.stats.expected_vertices.hex().encode())  # a sum over every vertex: to the bit
+r = mesh.decimate(mode="quality", ratio=0.01, seed=3)  # quadrics summed in blocks of vertices
+digest.update(r.vertices.tobytes() + r.triangles.tobytes())
 print(digest.hexdigest())
 """
 

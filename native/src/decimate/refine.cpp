@@ -1,8 +1,11 @@
 #include "decimate/refine.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <memory>
+#include <mutex>
+#include <thread>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -190,11 +193,20 @@ double mean_edge(const Mesh& mesh, double extent) {
 
 // The frame quadrics are computed in: the bounding box's centre and half extent, its diagonal
 // and the mean edge length in those units. It depends on the mesh only: kept with the layout, so
-// that a decimation's border terms (output_spacing) do not pass over every face again.
+// that a decimation's border terms (output_spacing) do not pass over every face again. The mean
+// edge is summed on first use: only border terms read it (a pass over every face, serial so that
+// its bits do not follow the team size).
 struct QuadricFrame {
   double center[3] = {0, 0, 0}, extent = 1.0;
-  double diagonal = 1.0;   // of the bounding box, normalised
-  double mean_edge = 0.0;  // normalised
+  double diagonal = 1.0;  // of the bounding box, normalised
+  double mean_edge(const Mesh& mesh) const {
+    std::call_once(edge_once_, [&] { edge_ = topstoc::mean_edge(mesh, extent); });
+    return edge_;
+  }
+
+ private:
+  mutable std::once_flag edge_once_;
+  mutable double edge_ = 0.0;  // normalised
 };
 
 std::shared_ptr<const QuadricFrame> quadric_frame(const Mesh& mesh, const FeatureLayout& layout) {
@@ -202,7 +214,6 @@ std::shared_ptr<const QuadricFrame> quadric_frame(const Mesh& mesh, const Featur
   if (cached) return cached;
   auto frame = std::make_shared<QuadricFrame>();
   bounding_box(mesh, frame->center, frame->extent, frame->diagonal);
-  frame->mean_edge = mean_edge(mesh, frame->extent);
   layout.quadric_frame.set(frame);
   return frame;
 }
@@ -213,25 +224,43 @@ void normalised(const Mesh& mesh, const QuadricFrame& frame, int32_t v, double p
   for (int i = 0; i < 3; ++i) p[i] = (mesh.position(v)[i] - frame.center[i]) * scale;
 }
 
-// A third of the quadric of each triangle around input vertex v (in normalised coordinates),
-// added into sum[10] in the order of v's faces, so that a cluster's sum weighs each triangle by
-// the share of its corners in the cluster. Computed where it is added, not kept: a table of
-// them was 80 bytes per input vertex.
-void add_vertex_quadric(const Mesh& mesh, const QuadricFrame& frame, int32_t v, double* sum) {
+// A third of the quadric of each triangle around each input vertex of [a, b) (in normalised
+// coordinates), summed into sums (10 a vertex) in increasing face order, so that a cluster's sum
+// weighs each triangle by the share of its corners in the cluster. Faces are sorted by their
+// lowest vertex: those of the lower runs that hold a vertex of the block come first (each
+// vertex's neighbours below a, as Mesh::for_each_face walks them), then the block's own runs,
+// each face's plane computed once for all its corners in the block. The same sums, to the bit, as
+// adding each vertex's faces in for_each_face's order; a table of them was 80 bytes a vertex.
+void block_vertex_quadrics(const Mesh& mesh, const QuadricFrame& frame, int32_t a, int32_t b,
+                           std::vector<double>& sums) {
+  sums.assign(10 * size_t(b - a), 0.0);
   const auto& faces = mesh.faces();
-  mesh.for_each_face(v, [&](int32_t f) {
+  auto add_face = [&](int32_t f, int32_t only) {  // to `only`, or to every corner in the block (-1)
     const int32_t* t = &faces[3 * size_t(f)];
     double p[3][3], face[10], area;
     for (int j = 0; j < 3; ++j) normalised(mesh, frame, t[j], p[j]);
     if (!VertexQuadrics::plane(p[0], p[1], p[2], face, &area)) return;
-    for (int i = 0; i < 10; ++i) sum[i] += face[i] * (1.0 / 3.0);
-  });
+    for (int j = 0; j < 3; ++j) {
+      if (only >= 0 ? t[j] != only : (t[j] < a || t[j] >= b)) continue;
+      double* sum = &sums[10 * size_t(t[j] - a)];
+      for (int i = 0; i < 10; ++i) sum[i] += face[i] * (1.0 / 3.0);
+    }
+  };
+  const auto& offsets = mesh.adjacency_offsets();
+  const auto& adjacency = mesh.adjacency();
+  for (int32_t v = a; v < b; ++v)
+    for (int32_t i = offsets[v]; i < offsets[v + 1] && adjacency[i] < a; ++i)  // sorted: lower first
+      for (int32_t f = mesh.lowest_run(adjacency[i]), end = mesh.lowest_run(adjacency[i] + 1); f < end; ++f) {
+        const int32_t* t = &faces[3 * size_t(f)];
+        if (t[0] == v || t[1] == v || t[2] == v) add_face(f, v);
+      }
+  for (int32_t f = mesh.lowest_run(a), end = mesh.lowest_run(b); f < end; ++f) add_face(f, -1);
 }
 
 // The spacing of the output's vertices, in normalised units: the mean edge length times the
 // square root of input vertices per target vertex.
 double output_spacing(const Mesh& mesh, const QuadricFrame& frame, int32_t target_vertices) {
-  return frame.mean_edge * std::sqrt(double(mesh.num_vertices()) / std::max(1, target_vertices));
+  return frame.mean_edge(mesh) * std::sqrt(double(mesh.num_vertices()) / std::max(1, target_vertices));
 }
 
 // A sharp bend of a mesh boundary (curve_bends.hpp) holds its place by a point quadric: three
@@ -303,10 +332,33 @@ void add_border_planes(const Mesh& mesh, const FeatureLayout& layout, const std:
   }
 }
 
+// Adds each labelled input vertex's share of its faces' quadrics (block_vertex_quadrics) to its
+// cluster's, in vertex order. The members sum blocks of vertices at once, each block's sums
+// added to the clusters once the block before it has been: every cluster's sum then takes its
+// vertices in the same order whatever the team size.
+void sum_vertex_quadrics(const Mesh& mesh, const QuadricFrame& frame, const std::vector<int32_t>& label,
+                         VertexQuadrics& quadrics) {
+  constexpr int32_t kBlock = 4096;
+  const int32_t n = mesh.num_vertices(), blocks = (n + kBlock - 1) / kBlock;
+  std::atomic<int32_t> next{0}, added{0};
+  parallel_region(team_for(n, kParallelMin), [&](Team&) {
+    std::vector<double> sums;
+    for (int32_t block = next++; block < blocks; block = next++) {
+      const int32_t a = block * kBlock, b = std::min(n, a + kBlock);
+      block_vertex_quadrics(mesh, frame, a, b, sums);
+      while (added.load(std::memory_order_acquire) != block) std::this_thread::yield();
+      for (int32_t v = a; v < b; ++v)
+        if (label[v] >= 0) quadrics.add(label[v], &sums[10 * size_t(v - a)]);
+      added.store(block + 1, std::memory_order_release);
+    }
+  });
+}
+
 // Each output vertex stands for the input triangles of its cluster (each weighed by the share of
 // its corners in the cluster) and for the border edges in it (add_border_planes), after a
-// stochastic first pass also for the bends in it (add_bend_anchors). Each thread owns a range of
-// clusters and adds to them in input order, so the sums do not depend on the number of threads.
+// stochastic first pass also for the bends in it (add_bend_anchors). Each cluster's sum takes its
+// terms in input order (with attributes each thread owns a range of clusters), so the sums do not
+// depend on the number of threads.
 VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, const RefineParams& params,
                                 const std::vector<int32_t>& label, int32_t clusters, const QuadricFrame& frame,
                                 bool stochastic_start) {
@@ -324,17 +376,12 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
   const auto& faces = mesh.faces();
   const auto& face_source = mesh.face_source();
   const int32_t n = mesh.num_vertices(), m = mesh.num_faces();
-  parallel_region(team_for(n, kParallelMin), [&](Team& team) {
-    const int32_t threads = team.size(), me = team.index();
-    const int32_t low = int32_t(int64_t(clusters) * me / threads), high = int32_t(int64_t(clusters) * (me + 1) / threads);
-    if (channels == 0) {
-      for (int32_t v = 0; v < n; ++v)
-        if (label[v] >= low && label[v] < high) {
-          double sum[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
-          add_vertex_quadric(mesh, frame, v, sum);
-          quadrics.add(label[v], sum);
-        }
-    } else {
+  if (channels == 0) {
+    sum_vertex_quadrics(mesh, frame, label, quadrics);
+  } else {
+    parallel_region(team_for(n, kParallelMin), [&](Team& team) {
+      const int32_t threads = team.size(), me = team.index();
+      const int32_t low = int32_t(int64_t(clusters) * me / threads), high = int32_t(int64_t(clusters) * (me + 1) / threads);
       // Attributes: each face's generalised quadric, a third to the cluster of each corner
       // (to that corner's wedge there: attribute_wedges.hpp).
       std::vector<double> face(quadrics.face_size()), values(3 * size_t(channels));
@@ -360,8 +407,8 @@ VertexQuadrics cluster_quadrics(const Mesh& mesh, const FeatureLayout& layout, c
           else quadrics.add_corner(l[j], wedge[3 * size_t(f) + j], face.data(), centroid);
         }
       }
-    }
-  });
+    });
+  }
   // The edge tables are built on first use: a mesh without feature edges never needs them here.
   if (layout.feature_edges.empty()) return quadrics;
   const bool by_target = start_depends_on_target(layout, !stochastic_start);

@@ -93,6 +93,9 @@ class Mesh {
   /// own run: walked where read instead of a table of them (14 bytes a triangle).
   template <class Fn>
   void for_each_face(int32_t v, Fn&& fn) const;
+  /// Faces are sorted by their lowest vertex: those whose lowest vertex is v are
+  /// [lowest_run(v), lowest_run(v + 1)).
+  int32_t lowest_run(int32_t v) const { return lowest_offsets_[v]; }
   /// How many faces are around v, and the lowest of them (-1 for a vertex in no face).
   int32_t face_count(int32_t v) const;
   int32_t first_face(int32_t v) const;
