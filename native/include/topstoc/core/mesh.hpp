@@ -93,6 +93,11 @@ class Mesh {
   /// own run: walked where read instead of a table of them (14 bytes a triangle).
   template <class Fn>
   void for_each_face(int32_t v, Fn&& fn) const;
+  /// The same for the faces f < limit only (the walk stops at the first face past it).
+  template <class Fn>
+  void for_each_face_below(int32_t v, int32_t limit, Fn&& fn) const {
+    walk_faces(v, [&](int32_t f) { return f >= limit || (fn(f), false); });
+  }
   /// Faces are sorted by their lowest vertex: those whose lowest vertex is v are
   /// [lowest_run(v), lowest_run(v + 1)).
   int32_t lowest_run(int32_t v) const { return lowest_offsets_[v]; }
