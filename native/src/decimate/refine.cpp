@@ -636,20 +636,29 @@ class Refinement {
   // The first pass kept every input vertex: its triangles are the input's own.
   bool whole_input() const { return n == num_input - mesh.report().isolated_vertices; }
 
-  // The slivers a first pass made between its clusters (needles), or an input's stray ones, go
-  // before the target's collapses. On a sliver-heavy mesh most are its design and are left to the
-  // quadric order: taken first there, by shape and not by error, they ate a UV sphere's polar
-  // rings (1,000 segments at 10 %: max 0.54 % of the diagonal, 0.009 % now). Its fans of slivers
-  // (a cap's centre, a pole) still go first: left to the collapses, every evaluation of the centre
-  // read its thousands of neighbours and faces (a cylinder of 5,000 segments: 0.8 -> 69 s).
-  // (Left to the quadric order on every input, slivers changed 76 of bench_quality's 214 cases,
-  // max 0.70-1.34x, geomean 1.00: a CAD turbine at its floor lost 45 % on its mean.)
+  // The slivers a stochastic first pass made between its clusters (needles) go before the
+  // target's collapses. An input's own slivers are its design and are left to the quadric order:
+  // taken first, by shape and not by error, they ate a UV sphere's polar rings (1,000 segments at
+  // 10 %: max 0.54 % of the diagonal, 0.009 % now) and joined the two rims of a CAD part's holes
+  // along their walls' tall thin triangles (a 84k-triangle STL at 10 %: max 1.35 % of the
+  // diagonal, 0.08 % now). Toward a tiny result (kTinyFitFaces) they still go first: there they
+  // let the collapses reach lower floors (a printed part's 140 -> 114 triangles), and left to the
+  // quadric order the results were no better on the whole. Fans of slivers (a cap's centre, a
+  // pole) always go first: left to the collapses, every evaluation of the centre read its
+  // thousands of neighbours and faces (a cylinder of 5,000 segments: 0.8 -> 69 s).
   // A stochastic first pass draws its borders whole: their tiny edges beside the sparse surface
   // make slivers of the triangles along them, and where only a border vertex could move, the
   // first such move in corner order cut a bend (a box-cut gyroid's bend at an edge of the box, by
   // one tiny edge at 2 %: max 0.219 % of the diagonal). There the cheapest by quadric cost goes.
   int32_t slivers_first(Collapser& collapser, Collapser::Stop stop) const {
-    return collapser.remove_thin(kSliverShape, stop, {sliver_heavy_input, !whole_input()});
+    return collapser.remove_thin(kSliverShape, stop, {fans_of_slivers_only(), !whole_input()});
+  }
+  bool fans_of_slivers_only() const {
+    return sliver_heavy_input || (whole_input() && target_faces() > kTinyFitFaces);
+  }
+  // The target in triangles (a vertex target's: about twice its vertices).
+  int32_t target_faces() const {
+    return params.target_triangles > 0 ? params.target_triangles : 2 * params.target_vertices;
   }
 
   const int32_t n, num_input;
@@ -1125,7 +1134,8 @@ class Refinement {
       run = std::make_unique<Collapser>(result.triangles, result.corner_source, std::move(setup));
       return slivers_first(*run, stop) + run->run(restart);
     }
-    const std::vector<uint64_t> start = start_key(setup, result.triangles, result.corner_source);
+    std::vector<uint64_t> start = start_key(setup, result.triangles, result.corner_source);
+    start.push_back(fans_of_slivers_only());  // which slivers went first: states of either kind differ
     int32_t before = 0;
     if (const auto kept = snapshots->find(start, restart.vertices)) {
       run = resumed(*kept, result.triangles, result.corner_source, std::move(setup.quota));
