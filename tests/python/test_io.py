@@ -559,6 +559,18 @@ def test_empty_files_are_errors_in_every_format(tmp_path, name, content):
         read_mesh(tmp_path / name)
 
 
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-be", "utf-16-le"])
+@pytest.mark.parametrize("name", ["box.obj", "box.off", "box.obj.gz"])
+def test_utf16_text_is_named_not_read_as_an_empty_mesh(tmp_path, name, encoding):
+    # A byte-order mark, then text whose every other byte is zero: the readers saw no line.
+    text = ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n" if ".off" in name
+            else "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    data = ("\ufeff" + text).encode(encoding) if encoding != "utf-16" else text.encode(encoding)
+    (tmp_path / name).write_bytes(gzip.compress(data) if name.endswith(".gz") else data)
+    with pytest.raises(ValueError, match=re.escape(f"{name}: the file is UTF-16 text")):
+        read_mesh(tmp_path / name)
+
+
 @pytest.mark.parametrize("name, content, held", [
     ("v.obj", "v 0 0 0\nv 1 0 0\n", "2 vertices, no faces"),
     ("l.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n", "2 vertices, 1 faces with fewer than 3 corners"),
