@@ -6,13 +6,15 @@ vertex) away from it. Why, in the words every channel uses:
 
 - "control points": the vertices painted to stay (u = 1) outnumber the target;
 - "borders": corners of borders (seams, materials, sharp or hard-normal edges), always kept,
-  outnumber the target, or the result's vertices on the borders do (each border keeps its course:
-  many small UV islands or material patches), which the detail counts;
+  outnumber the target, or the result's vertices on the borders given outnumber the target or
+  its excess over it (each border keeps its course: many small UV islands or material patches),
+  which the detail counts;
 - "non-manifold edges": at least half of the result's vertices lie on non-manifold edges (edges
   of three or more triangles): each such curve keeps its course and at least one edge, each
   sheet along it its triangles, so the topology stays; the detail says how many vertices that is;
 - "topology": samples the topology needs (each loose piece keeps at least a triangle, each
-  hole and handle its loops); where loose triangles (pieces of one triangle, as in an unwelded
+  hole and handle its loops), first where the target is below what the pieces and loops need
+  (topology_floor) and forced vertices do not outnumber that; where loose triangles (pieces of one triangle, as in an unwelded
   mesh) or holes (boundary loops, each kept with three vertices or more) make up much of the
   result, the detail says how many and what to do first; where the result's loose triangles are
   separate pieces of several triangles in the input (leaf cards, hair strips), or the boundary
@@ -82,6 +84,15 @@ class MissedTarget:
                 f"{100 * self.fraction:+.1f} %; {self.reason}{detail})")
 
 
+def topology_floor(stats) -> int:
+    """Vertices the result's pieces and boundary loops need at the least: 4 for a closed piece, 3
+    for each boundary loop (an open piece's outline or a hole); handles need more."""
+    pieces, open_pieces, loops = (getattr(stats, k, 0) for k in ("pieces", "open_pieces", "holes"))
+    if not loops:  # the loops are counted only where they may hold the result: any piece needs 3
+        return 3 * pieces
+    return 4 * max(0, pieces - open_pieces) + 3 * max(loops, open_pieces)
+
+
 def over_reason(stats) -> str:
     """Why a result with these DecimateStats landed over its target (see the module docs)."""
     if stats.forced >= stats.target_vertices and stats.control_points:
@@ -96,10 +107,14 @@ def over_reason(stats) -> str:
     # which the topology keeps, and the corners of each component's winding seam; they are not
     # the borders' corners.
     corners = stats.forced - getattr(stats, "loop_forced", 0)
+    floor = topology_floor(stats)
+    if floor > stats.target_vertices and corners <= floor:
+        return "topology"  # the pieces and loops alone need more than the target (the detail counts)
     if corners >= stats.target_vertices and 3 * getattr(stats, "loose_triangles", 0) < stats.target_vertices:
         return "borders"
-    if getattr(stats, "border_vertices", 0) >= stats.target_vertices:
-        return "borders"  # the borders' courses alone hold more vertices than the target
+    on_borders = getattr(stats, "border_vertices", 0)
+    if on_borders and (on_borders >= stats.target_vertices or on_borders >= stats.output_vertices - stats.target_vertices):
+        return "borders"  # the borders' courses hold more vertices than the target, or than the excess
     if stats.mirrored_from and stats.mirrored_from - stats.target_vertices <= tolerance(stats.target_vertices):
         return "symmetry"  # the plain draw met the target, its mirrored set did not
     if getattr(stats, "far_guard", False):
@@ -141,6 +156,13 @@ def _over_detail(stats, reason: str) -> str:
     if reason in ("topology", "borders") and 3 * holes >= stats.output_vertices / 4:
         return (f"the input's {holes:,} holes keep at least 3 vertices each; fill the small ones first "
                 "(topstoc clean --max-hole; Blender: Clean Up Small Handles and Holes)")
+    if reason == "borders" and on_borders:
+        return (f"{on_borders:,} of the result's {stats.output_vertices:,} vertices lie on the borders given "
+                "(materials, UV seams, sharp or marked edges), each kept on its course")
+    floor = topology_floor(stats)
+    if reason == "topology" and pieces and floor >= stats.target_vertices:
+        return (f"the input's {pieces:,} pieces and {holes:,} boundary loops need at least {floor:,} vertices "
+                "(4 a closed piece, 3 a loop)")
     return ""
 
 
