@@ -14,8 +14,8 @@ vertex) away from it. Why, in the words every channel uses:
   sheet along it its triangles, so the topology stays; the detail says how many vertices that is;
 - "topology": samples the topology needs (each loose piece keeps at least a triangle, each
   hole and handle its loops), first where the target is below what the pieces and loops need
-  (topology_floor) and forced vertices do not outnumber that; where loose triangles (pieces of one triangle, as in an unwelded
-  mesh) or holes (boundary loops, each kept with three vertices or more) make up much of the
+  (topology_floor) and forced vertices do not outnumber that; where loose triangles (pieces of
+  one triangle, as in an unwelded mesh) or holes (boundary loops, each kept with three vertices or more) make up much of the
   result, the detail says how many and what to do first; where the result's loose triangles are
   separate pieces of several triangles in the input (leaf cards, hair strips), or the boundary
   loops are about one a piece (their outlines, not holes), it says that instead; where the

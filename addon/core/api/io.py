@@ -234,7 +234,8 @@ def read_mesh(path, max_decompressed_bytes: Optional[int] = MAX_DECOMPRESSED_BYT
         raise TopStocError(f"{name}: the mesh has no triangles: the file is empty")
     # A UTF-16 byte-order mark (a binary STL's header may hold any bytes): the text would parse as nothing.
     if kind != "stl" and data[:2] in (b"\xff\xfe", b"\xfe\xff"):
-        raise TopStocError(f"{name}: the file is UTF-16 text, which mesh readers do not take; save it as UTF-8 or ASCII")
+        raise TopStocError(f"{name}: the file is UTF-16 text, which mesh readers do not take; "
+                           "save it as UTF-8 or ASCII")
     try:
         parsed = engine.read_mesh(data, kind)
     except ValueError as error:

@@ -734,35 +734,35 @@ void Mesh::normal_at(int32_t v, double* out) const {
   unit_normal(sum, out);
 }
 
-// normal_at's sums for a range of vertices, the same faces added in the same order: each
-// vertex's faces in the runs of vertices below a first (walked per vertex, as for_each_face),
-// then the runs of [a, b) swept once, each face's cross product made once for its corners in
-// the range instead of once per corner.
+// normal_at's sums for a range of vertices, the same faces added in the same order
+// (for_block_faces): each face's cross product made once for its corners in the range instead of
+// once per corner.
 void Mesh::normal_sums(int32_t a, int32_t b, std::vector<double>& sums) const {
   sums.assign(3 * size_t(b - a), 0.0);
-  auto add = [&](int32_t v, const int32_t* t) {
-    double fn[3];
-    cross(position(t[0]), position(t[1]), position(t[2]), fn);
+  auto add = [&](const double* fn, int32_t v) {
     double* sum = &sums[3 * size_t(v - a)];
     sum[0] += fn[0];
     sum[1] += fn[1];
     sum[2] += fn[2];
   };
-  const int32_t below_a = lowest_offsets_[a];  // faces whose lowest vertex is below a
-  for (int32_t v = a; v < b; ++v)
-    walk_faces(v, [&](int32_t f) { return f >= below_a || (add(v, &faces_[3 * size_t(f)]), false); });
-  for (int32_t f = lowest_offsets_[a], end = lowest_offsets_[b]; f < end; ++f) {
+  auto face_normal = [&](int32_t f, double* fn) {
     const int32_t* t = &faces_[3 * size_t(f)];
-    double fn[3];
     cross(position(t[0]), position(t[1]), position(t[2]), fn);
-    for (int c = 0; c < 3; ++c) {
-      if (t[c] >= b) continue;  // every corner is at or above the run's vertex, so at or above a
-      double* sum = &sums[3 * size_t(t[c] - a)];
-      sum[0] += fn[0];
-      sum[1] += fn[1];
-      sum[2] += fn[2];
-    }
-  }
+    return t;
+  };
+  for_block_faces(
+      a, b,
+      [&](int32_t f, int32_t v) {
+        double fn[3];
+        face_normal(f, fn);
+        add(fn, v);
+      },
+      [&](int32_t f) {
+        double fn[3];
+        const int32_t* t = face_normal(f, fn);
+        for (int c = 0; c < 3; ++c)
+          if (t[c] < b) add(fn, t[c]);
+      });
 }
 
 void Mesh::fill_normals() const {

@@ -226,11 +226,9 @@ void normalised(const Mesh& mesh, const QuadricFrame& frame, int32_t v, double p
 
 // A third of the quadric of each triangle around each input vertex of [a, b) (in normalised
 // coordinates), summed into sums (10 a vertex) in increasing face order, so that a cluster's sum
-// weighs each triangle by the share of its corners in the cluster. Faces are sorted by their
-// lowest vertex: those of the lower runs that hold a vertex of the block come first (as
-// Mesh::normal_sums takes them), then the block's own runs, each face's plane computed once for
-// all its corners in the block. The same sums, to the bit, as adding each vertex's faces in
-// for_each_face's order; a table of them was 80 bytes a vertex.
+// weighs each triangle by the share of its corners in the cluster: Mesh::for_block_faces, each
+// face's plane computed once for all its corners in the block. The same sums, to the bit, as
+// adding each vertex's faces in for_each_face's order; a table of them was 80 bytes a vertex.
 void block_vertex_quadrics(const Mesh& mesh, const QuadricFrame& frame, int32_t a, int32_t b,
                            std::vector<double>& sums) {
   sums.assign(10 * size_t(b - a), 0.0);
@@ -246,9 +244,7 @@ void block_vertex_quadrics(const Mesh& mesh, const QuadricFrame& frame, int32_t 
       for (int i = 0; i < 10; ++i) sum[i] += face[i] * (1.0 / 3.0);
     }
   };
-  const int32_t below_a = mesh.lowest_run(a);  // faces whose lowest vertex is below a
-  for (int32_t v = a; v < b; ++v) mesh.for_each_face_below(v, below_a, [&](int32_t f) { add_face(f, v); });
-  for (int32_t f = below_a, end = mesh.lowest_run(b); f < end; ++f) add_face(f, -1);
+  mesh.for_block_faces(a, b, add_face, [&](int32_t f) { add_face(f, -1); });
 }
 
 // The spacing of the output's vertices, in normalised units: the mean edge length times the

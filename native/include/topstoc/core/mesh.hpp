@@ -93,14 +93,16 @@ class Mesh {
   /// own run: walked where read instead of a table of them (14 bytes a triangle).
   template <class Fn>
   void for_each_face(int32_t v, Fn&& fn) const;
-  /// The same for the faces f < limit only (the walk stops at the first face past it).
-  template <class Fn>
-  void for_each_face_below(int32_t v, int32_t limit, Fn&& fn) const {
-    walk_faces(v, [&](int32_t f) { return f >= limit || (fn(f), false); });
+  /// The faces around the vertices [a, b), each vertex's in increasing order, for per-vertex sums
+  /// that make each face's term once: below(f, v) for each face of a run below a holding v (walked
+  /// per vertex, as for_each_face), then own(f) once for each face of the runs of [a, b), whose
+  /// corners are all at or above a.
+  template <class Below, class Own>
+  void for_block_faces(int32_t a, int32_t b, Below&& below, Own&& own) const {
+    const int32_t below_a = lowest_offsets_[a];  // faces whose lowest vertex is below a
+    for (int32_t v = a; v < b; ++v) walk_faces(v, [&](int32_t f) { return f >= below_a || (below(f, v), false); });
+    for (int32_t f = below_a, end = lowest_offsets_[b]; f < end; ++f) own(f);
   }
-  /// Faces are sorted by their lowest vertex: those whose lowest vertex is v are
-  /// [lowest_run(v), lowest_run(v + 1)).
-  int32_t lowest_run(int32_t v) const { return lowest_offsets_[v]; }
   /// How many faces are around v, and the lowest of them (-1 for a vertex in no face).
   int32_t face_count(int32_t v) const;
   int32_t first_face(int32_t v) const;
